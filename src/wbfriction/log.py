@@ -1,0 +1,251 @@
+"""The wbfriction log format: reading, validation, and atomic writing of tables.
+
+A log is a Parquet file (or CSV with the same columns), one row per sample:
+
+=====================  ==========  ==================================================
+column                 unit        content
+=====================  ==========  ==================================================
+``time``               s           strictly increasing, uniformly sampled
+``q.<joint>``          rad (m)     position of every actuated joint
+``tau.<joint>``        N·m (N)     measured torque of every torque-controlled joint
+``contact.<frame>``    0 / 1       contact flag of every contact frame
+``base.x`` ... ``base.qw``  m, -   optional world pose of the root (unit quaternion
+                                   x, y, z, w)
+``tau_f_true.<joint>`` N·m         optional true friction (simulations only; never
+                                   used by the estimator)
+=====================  ==========  ==================================================
+
+Names are those of the model. ``tau.<joint>`` of a position-controlled joint is
+allowed and ignored. Schema metadata under the key ``wbfriction`` (JSON) is carried
+through, e.g. the friction parameters a simulator injected.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+import pyarrow.parquet as pq
+
+from .exceptions import InputError
+from .robot import Robot
+
+BASE_COLUMNS = ("base.x", "base.y", "base.z", "base.qx", "base.qy", "base.qz", "base.qw")
+META_KEY = b"wbfriction"
+PREFIXES = ("q.", "tau.", "contact.", "base.", "tau_f_true.")
+
+
+@dataclass
+class Log:
+    """A validated log, with columns mapped to the robot's joints by name.
+
+    Attributes:
+        time: sample times (N,) [s].
+        q: joint positions (N, n_act) in :attr:`Robot.actuated` order [rad].
+        tau: torques of the torque-controlled joints (N, n_tc) [N·m].
+        contact: contact flags (N, n_contacts) in :attr:`Robot.contact_frames` order.
+        base: root poses (N, 7) (x, y, z, qx, qy, qz, qw), or None if not logged.
+        tau_f_true: true friction (N, n_tc) [N·m] with NaN columns for joints not
+            logged, or None if no such column.
+        metadata: the JSON metadata stored with the log.
+        source: file the log came from.
+    """
+
+    time: np.ndarray
+    q: np.ndarray
+    tau: np.ndarray
+    contact: np.ndarray
+    base: np.ndarray | None = None
+    tau_f_true: np.ndarray | None = None
+    metadata: dict = field(default_factory=dict)
+    source: str = "<memory>"
+
+    @property
+    def dt(self) -> float:
+        """Sampling period [s] (median time step)."""
+        return float(np.median(np.diff(self.time)))
+
+    def __len__(self) -> int:
+        return len(self.time)
+
+    def to_table(self, robot: Robot) -> pa.Table:
+        """The log as an Arrow table in the log format."""
+        cols: dict[str, np.ndarray] = {"time": self.time}
+        cols.update({f"q.{n}": self.q[:, i] for i, n in enumerate(robot.actuated)})
+        cols.update({f"tau.{n}": self.tau[:, i] for i, n in enumerate(robot.torque_controlled)})
+        cols.update({f"contact.{n}": self.contact[:, i].astype(np.int8) for i, n in enumerate(robot.contact_frames)})
+        if self.base is not None:
+            cols.update({c: self.base[:, i] for i, c in enumerate(BASE_COLUMNS)})
+        if self.tau_f_true is not None:
+            cols.update({f"tau_f_true.{n}": self.tau_f_true[:, i] for i, n in enumerate(robot.torque_controlled)
+                         if not np.all(np.isnan(self.tau_f_true[:, i]))})
+        return with_metadata(pa.table(cols), self.metadata)
+
+
+# ------------------------------------------------------------------ metadata
+def with_metadata(table: pa.Table, metadata: dict) -> pa.Table:
+    """Attach ``metadata`` (JSON-serialisable) to ``table`` under the ``wbfriction`` key."""
+    return table.replace_schema_metadata({META_KEY: json.dumps(metadata, sort_keys=True).encode()})
+
+
+def read_metadata(table: pa.Table) -> dict:
+    """The ``wbfriction`` metadata of a table ({} if none)."""
+    meta = table.schema.metadata or {}
+    return json.loads(meta[META_KEY]) if META_KEY in meta else {}
+
+
+# ------------------------------------------------------------------- reading
+def read_table(path: str | Path) -> pa.Table:
+    """Read a Parquet or CSV file into an Arrow table.
+
+    Raises:
+        InputError: missing file, unknown extension, or unreadable content.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: file not found")
+    suffix = path.suffix.lower()
+    try:
+        if suffix in (".parquet", ".pq"):
+            return pq.read_table(path)
+        if suffix == ".csv":
+            return pacsv.read_csv(path)
+    except (pa.ArrowException, OSError) as exc:
+        raise InputError(f"{path}: cannot be read: {str(exc).splitlines()[0]}") from exc
+    raise InputError(f"{path}: unknown file type '{suffix}' (expected .parquet or .csv)")
+
+
+def _column(table: pa.Table, name: str, source: str) -> np.ndarray:
+    try:
+        col = table.column(name)
+        values = col.to_numpy(zero_copy_only=False).astype(float)
+    except (pa.ArrowException, ValueError, TypeError) as exc:
+        raise InputError(f"{source}: column '{name}' is not numeric") from exc
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise InputError(f"{source}: column '{name}' has a non-finite value (NaN or inf) at row {bad[0]}")
+    return values
+
+
+def check_time(time: np.ndarray, source: str, rel_tol: float = 0.05) -> None:
+    """Check that ``time`` is strictly increasing and uniformly sampled.
+
+    Raises:
+        InputError: naming the first row at fault.
+    """
+    if time.size < 5:
+        raise InputError(f"{source}: only {time.size} rows; at least 5 samples are needed")
+    step = np.diff(time)
+    bad = np.flatnonzero(step <= 0)
+    if bad.size:
+        raise InputError(f"{source}: column 'time' is not strictly increasing at row {bad[0] + 1}")
+    dt = np.median(step)
+    bad = np.flatnonzero(np.abs(step - dt) > rel_tol * dt)
+    if bad.size:
+        raise InputError(f"{source}: column 'time' is irregular at row {bad[0] + 1} "
+                         f"(step {step[bad[0]]:.6g} s, median {dt:.6g} s)")
+
+
+def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>") -> Log:
+    """Validate an Arrow table against ``robot`` and map its columns by joint name.
+
+    Raises:
+        InputError: missing ``time``, a missing or unknown joint/frame column, NaN, a
+            non-monotonic or irregular time column, contact flags other than 0/1, a
+            partial base pose, or a non-unit quaternion.
+    """
+    names = set(table.column_names)
+    if "time" not in names:
+        raise InputError(f"{source}: missing column 'time'")
+    act, tc = set(robot.actuated), set(robot.torque_controlled)
+    frames = set(robot.contact_frames)
+    for col in table.column_names:
+        prefix, _, item = col.partition(".")
+        known = {"q": act, "tau": act, "tau_f_true": tc, "contact": frames}.get(prefix)
+        if known is not None and item not in known:
+            what = "contact frame" if prefix == "contact" else "joint"
+            raise InputError(f"{source}: column '{col}' names an unknown {what} '{item}' of robot '{robot.name}'")
+    for col in ([f"q.{n}" for n in robot.actuated] + [f"tau.{n}" for n in robot.torque_controlled]
+                + [f"contact.{f}" for f in robot.contact_frames]):
+        if col not in names:
+            raise InputError(f"{source}: missing column '{col}'")
+    time = _column(table, "time", source)
+    check_time(time, source)
+    q = np.column_stack([_column(table, f"q.{n}", source) for n in robot.actuated])
+    tau = np.column_stack([_column(table, f"tau.{n}", source) for n in robot.torque_controlled])
+    contact_cols = []
+    for f in robot.contact_frames:
+        c = _column(table, f"contact.{f}", source)
+        bad = np.flatnonzero((c != 0) & (c != 1))
+        if bad.size:
+            raise InputError(f"{source}: column 'contact.{f}' must hold 0 or 1, found {c[bad[0]]:g} at row {bad[0]}")
+        contact_cols.append(c.astype(bool))
+    contact = np.column_stack(contact_cols)
+    base = None
+    present = [c for c in BASE_COLUMNS if c in names]
+    if present:
+        missing = [c for c in BASE_COLUMNS if c not in names]
+        if missing:
+            raise InputError(f"{source}: base pose is partial: missing column '{missing[0]}'")
+        base = np.column_stack([_column(table, c, source) for c in BASE_COLUMNS])
+        norm = np.linalg.norm(base[:, 3:], axis=1)
+        bad = np.flatnonzero(np.abs(norm - 1.0) > 1e-3)
+        if bad.size:
+            raise InputError(f"{source}: base quaternion is not unit at row {bad[0]} (norm {norm[bad[0]]:.6g})")
+        base[:, 3:] /= norm[:, None]
+    tau_f_true = None
+    if any(c.startswith("tau_f_true.") for c in names):
+        tau_f_true = np.column_stack([
+            _column(table, f"tau_f_true.{n}", source) if f"tau_f_true.{n}" in names else np.full(len(time), np.nan)
+            for n in robot.torque_controlled])
+    return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table), source)
+
+
+def read_log(path: str | Path, robot: Robot) -> Log:
+    """Read and validate a log file (see module docstring for the format).
+
+    Raises:
+        InputError: see :func:`log_from_table`; messages start with the file name.
+    """
+    return log_from_table(read_table(path), robot, source=str(path))
+
+
+# ------------------------------------------------------------------- writing
+def write_atomic(path: str | Path, write) -> None:
+    """Write a file whole or not at all.
+
+    ``write(tmp_path)`` writes to a temporary file in the destination directory, which
+    is then renamed onto ``path`` (atomic on POSIX). On any error the temporary file is
+    removed and ``path`` is left untouched.
+    """
+    path = Path(path)
+    if path.parent and not path.parent.exists():
+        raise InputError(f"{path}: output directory {path.parent} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def write_table(table: pa.Table, path: str | Path) -> None:
+    """Write an Arrow table as Parquet (or CSV if ``path`` ends in .csv), atomically."""
+    path = Path(path)
+    if path.suffix.lower() == ".csv":
+        write_atomic(path, lambda tmp: pacsv.write_csv(table, tmp))
+    else:
+        write_atomic(path, lambda tmp: pq.write_table(table, tmp))
+
+
+def write_log(log: Log, robot: Robot, path: str | Path) -> None:
+    """Write ``log`` in the log format (Parquet, or CSV by extension), atomically."""
+    write_table(log.to_table(robot), path)

@@ -1,0 +1,90 @@
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from wbfriction.kinematics import MeasuredKinematics
+from wbfriction.robot import Robot, load_robot
+
+
+@pytest.fixture(scope="session")
+def talos() -> Robot:
+    return load_robot("talos")
+
+
+def random_state(robot: Robot, rng: np.random.Generator, active: list[int], base_random: bool):
+    """A random configuration (within limits), base pose and a velocity with J v = 0."""
+    model = robot.model
+    data = model.createData()
+    lo, hi = model.lowerPositionLimit[7:], model.upperPositionLimit[7:]
+    angles = rng.uniform(lo, hi)
+    q = robot.configuration(angles)
+    if base_random:
+        q[:7] = pin.SE3ToXYZQUAT(pin.SE3(pin.Quaternion(rng.standard_normal(4)).normalized().matrix(),
+                                         rng.standard_normal(3)))
+    else:  # stance contact frame flat at the origin, as the estimator reconstructs it
+        pin.framesForwardKinematics(model, data, q)
+        q[:7] = pin.SE3ToXYZQUAT(data.oMf[robot.contact_frame_ids[active[0]]].inverse())
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    J = np.vstack([pin.getFrameJacobian(model, data, robot.contact_frame_ids[c], pin.LOCAL) for c in active])
+    v = rng.standard_normal(model.nv)
+    v -= np.linalg.pinv(J) @ (J @ v)  # project onto the constraint J v = 0
+    return q, v
+
+
+def constrained_forward(robot: Robot, q, v, tau_full, active: list[int]) -> np.ndarray:
+    """Ground truth: Pinocchio's proximal constrained dynamics with welded contacts."""
+    model = robot.model
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    models = []
+    for c in active:
+        fid = robot.contact_frame_ids[c]
+        fr = model.frames[fid]
+        models.append(pin.RigidConstraintModel(pin.ContactType.CONTACT_6D, model, fr.parentJoint, fr.placement,
+                                               0, data.oMf[fid], pin.LOCAL))
+    datas = [m.createData() for m in models]
+    pin.initConstraintDynamics(model, data, models, datas)
+    settings = pin.ProximalSettings(1e-14, 1e-12, 200)
+    return pin.constraintDynamics(model, data, q, v, tau_full, models, datas, settings).copy()
+
+
+def truth_samples(robot: Robot, n: int, support: str, seed: int, friction_joints: list[str],
+                  base_random: bool = False):
+    """Random samples with friction injected through the constrained forward dynamics.
+
+    Returns (kin, tau_f_true) where kin.qdd is the true joint acceleration.
+    """
+    rng = np.random.default_rng(seed)
+    model = robot.model
+    n_tc = len(robot.torque_controlled)
+    inject = np.array([j in friction_joints for j in robot.torque_controlled])
+    rows = dict(q=[], qd=[], qdd=[], tau=[], contact=[], base=[], tau_f=[])
+    for k in range(n):
+        if support == "single":
+            active = [int(rng.integers(len(robot.contact_frames)))]
+        else:
+            active = list(range(len(robot.contact_frames)))
+        q, v = random_state(robot, rng, active, base_random)
+        tau_tc = rng.normal(0.0, 20.0, n_tc)
+        tau_f = np.where(inject, rng.normal(0.0, 2.0, n_tc), 0.0)
+        tau_full = np.zeros(model.nv)
+        tau_full[robot.act_v_index[robot.tc_index]] = tau_tc + tau_f
+        tau_full[robot.act_v_index[robot.pc_index]] = rng.normal(0.0, 2.0, len(robot.pc_index))
+        a = constrained_forward(robot, q, v, tau_full, active)
+        contact = np.zeros(len(robot.contact_frames), dtype=bool)
+        contact[active] = True
+        angles = np.array([q[model.idx_qs[model.getJointId(j)]] for j in robot.actuated])
+        rows["q"].append(angles)
+        rows["qd"].append(v[robot.act_v_index])
+        rows["qdd"].append(a[robot.act_v_index])
+        rows["tau"].append(tau_tc)
+        rows["contact"].append(contact)
+        rows["base"].append(q[:7])
+        rows["tau_f"].append(tau_f)
+    arr = {k: np.array(v) for k, v in rows.items()}
+    kin = MeasuredKinematics(time=np.arange(n) * 1e-3, q=arr["q"], qd=arr["qd"], qdd=arr["qdd"], tau=arr["tau"],
+                             contact=arr["contact"], base=arr["base"] if base_random else None)
+    return kin, arr["tau_f"]
