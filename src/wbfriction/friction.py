@@ -117,3 +117,20 @@ def friction_torque(qd: np.ndarray, params: list[FrictionParams]) -> np.ndarray:
     """
     stack = {name: np.array([getattr(p, name) for p in params]) for name in PARAM_NAMES + ("delta_s",)}
     return -smooth(qd, **stack)
+
+
+THESIS_TARGETS: dict[str, FrictionParams] = {
+    "hip_pitch": FrictionParams(F_v=0.2, F_c=0.8, S=0.2, v_s=0.2, tau_os=0.8, a=40.0),
+    "hip_yaw": FrictionParams(F_v=0.2, F_c=0.8, S=0.2, v_s=0.2, tau_os=0.8, a=40.0),
+    "hip_roll": FrictionParams(F_v=0.2, F_c=1.0, S=0.2, v_s=0.2, tau_os=1.0, a=40.0),
+    "knee": FrictionParams(F_v=0.2, F_c=1.0, S=0.2, v_s=0.2, tau_os=1.0, a=40.0),
+    "ankle_roll": FrictionParams(F_v=0.2, F_c=0.1, S=0.2, v_s=0.2, tau_os=0.1, a=40.0),
+    "ankle_pitch": FrictionParams(F_v=0.2, F_c=0.2, S=0.2, v_s=0.2, tau_os=0.2, a=40.0),
+}
+"""The thesis's target friction per joint group (Table 6.1), injected in simulation."""
+
+
+def friction_by_group(groups: dict[str, tuple[str, ...]],
+                      targets: dict[str, FrictionParams] = THESIS_TARGETS) -> dict[str, FrictionParams]:
+    """Per-joint friction parameters from per-group ones (joints of groups not in ``targets``: none)."""
+    return {joint: targets[g] for g, joints in groups.items() if g in targets for joint in joints}

@@ -1,0 +1,188 @@
+"""Identification of the friction model (3.5) from estimated friction (thesis 6.2.2, eq. 6.4).
+
+Per joint, ``scipy.optimize.least_squares(method="trf")`` fits the characteristic
+``f(qd; p)`` of eq. (3.5) to ``-tau_f`` over the valid samples (sign convention of
+:mod:`wbfriction.friction`), with bounds, from several starts. Each parameter gets a
+standard error from the Jacobian at the solution,
+
+.. math:: \\operatorname{cov}(\\hat p) = s^2 (J^T J)^{-1}, \\qquad s^2 = \\frac{\\|r\\|^2}{N - 6},
+
+computed through the SVD of J; a parameter with a component in the numerical null
+space of J (e.g. ``v_s`` when ``S = 0``, or the Stribeck parameters when the data never
+leave the Stribeck region) gets an infinite standard error: the data cannot identify it.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from .friction import PARAM_NAMES, FrictionParams, smooth
+
+LOWER = np.array([0.0, 0.0, -1.0, 1e-4, -np.inf, 1e-2])
+UPPER = np.array([np.inf, np.inf, 50.0, 100.0, np.inf, 1e4])
+"""Bounds of (F_v, F_c, S, v_s, tau_os, a): dissipative viscous and Coulomb parts,
+static friction (1 + S) F_c >= 0, positive Stribeck velocity and tanh slope."""
+
+
+@dataclass
+class FitResult:
+    """Identified parameters of one joint.
+
+    Attributes:
+        joint: joint name.
+        n_samples: number of samples used.
+        params: identified :class:`FrictionParams`, or None if too few samples.
+        stderr: standard error of each parameter (``inf``: not identifiable).
+        rms_residual: RMS of the fit residual [N·m].
+        success, message: from ``least_squares``.
+        rms_error_vs_true: RMS of (estimated - true) friction over the samples used [N·m],
+            when the log had ``tau_f_true``.
+        rms_model_vs_true: RMS of (fitted model torque - true friction) [N·m], likewise.
+        target: the friction parameters injected by a simulator, when known.
+    """
+
+    joint: str
+    n_samples: int
+    params: FrictionParams | None = None
+    stderr: dict[str, float] = field(default_factory=dict)
+    rms_residual: float = float("nan")
+    success: bool = False
+    message: str = ""
+    rms_error_vs_true: float | None = None
+    rms_model_vs_true: float | None = None
+    target: FrictionParams | None = None
+
+    def error_percent(self) -> dict[str, float] | None:
+        """Relative error of each parameter against :attr:`target` [%] (Tables 6.1, 6.2)."""
+        if self.params is None or self.target is None:
+            return None
+        out = {}
+        for name in PARAM_NAMES:
+            t, p = getattr(self.target, name), getattr(self.params, name)
+            out[name] = 100.0 * abs(p - t) / abs(t) if t != 0 else float("nan")
+        return out
+
+    def to_dict(self) -> dict:
+        clean = lambda x: None if x is None or not np.isfinite(x) else float(x)  # noqa: E731
+        d = {"n_samples": self.n_samples, "success": self.success, "message": self.message,
+             "rms_residual": clean(self.rms_residual),
+             "params": None if self.params is None else self.params.to_dict(),
+             "stderr": {k: clean(v) for k, v in self.stderr.items()}}
+        if self.rms_error_vs_true is not None:
+            d["rms_error_vs_true"] = clean(self.rms_error_vs_true)
+            d["rms_model_vs_true"] = clean(self.rms_model_vs_true)
+        if self.target is not None:
+            d["target"] = self.target.to_dict()
+            d["error_percent"] = {k: clean(v) for k, v in (self.error_percent() or {}).items()}
+        return d
+
+
+def _model(x: np.ndarray, qd: np.ndarray, delta_s: float) -> np.ndarray:
+    return smooth(qd, x[0], x[1], x[2], x[3], x[4], x[5], delta_s)
+
+
+def _jacobian(x: np.ndarray, qd: np.ndarray, delta_s: float) -> np.ndarray:
+    F_v, F_c, S, v_s, _, a = x
+    th = np.tanh(a * qd)
+    u = np.abs(qd / v_s)
+    e = np.exp(-u**delta_s)
+    J = np.empty((qd.size, 6))
+    J[:, 0] = qd
+    J[:, 1] = th * (1.0 + S * e)
+    J[:, 2] = F_c * th * e
+    # d/dv_s of exp(-(|qd|/v_s)^d) = e * d * u^d / v_s
+    J[:, 3] = F_c * th * S * e * delta_s * u**delta_s / v_s
+    J[:, 4] = 1.0
+    J[:, 5] = F_c * (1.0 - th**2) * qd * (1.0 + S * e)
+    return J
+
+
+def standard_errors(jac: np.ndarray, residual: np.ndarray, rtol: float = 1e-9) -> np.ndarray:
+    """Standard errors from the Jacobian at a least-squares solution (module docstring)."""
+    n, p = jac.shape
+    s2 = float(residual @ residual) / max(n - p, 1)
+    _, sv, Vt = np.linalg.svd(jac, full_matrices=False)
+    keep = sv > rtol * sv[0] if sv[0] > 0 else np.zeros_like(sv, dtype=bool)
+    V = Vt.T
+    var = (V[:, keep] ** 2 / sv[keep] ** 2).sum(axis=1) * s2
+    null = V[:, ~keep]
+    unidentifiable = (np.abs(null) > 1e-6).any(axis=1) if null.size else np.zeros(p, dtype=bool)
+    return np.where(unidentifiable, np.inf, np.sqrt(var))
+
+
+def initial_guesses(qd: np.ndarray, y: np.ndarray) -> list[np.ndarray]:
+    """Starting points: a linear Coulomb-viscous-offset fit times a grid of (S, v_s, a)."""
+    A = np.column_stack([qd, np.sign(qd), np.ones_like(qd)])
+    (F_v, F_c, tau_os), *_ = np.linalg.lstsq(A, y, rcond=None)
+    F_v, F_c = max(F_v, 0.0), max(F_c, 1e-3)
+    scale = max(np.percentile(np.abs(qd), 90), 1e-3)
+    starts = []
+    for S, vs_frac, a_mul in itertools.product((0.2, 1.0), (0.05, 0.2, 0.5), (5.0, 50.0)):
+        a = min(max(a_mul / scale, LOWER[5] * 10), UPPER[5] / 10)
+        starts.append(np.clip([F_v, F_c, S, vs_frac * scale, tau_os, a], LOWER + 1e-9, UPPER - 1e-9))
+    return starts
+
+
+def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joint: str = "",
+                 x0: np.ndarray | None = None, min_samples: int = 20) -> FitResult:
+    """Fit model (3.5) to friction estimates of one joint (eq. 6.4).
+
+    Args:
+        qd: joint velocities (N,) [rad/s].
+        tau_f: friction torques on the joint (N,) [N·m] (``tau_f = -f(qd)``).
+        delta_s: Stribeck exponent, fixed (thesis: 2).
+        joint: name, for the result.
+        x0: a starting point (6,) in :data:`~wbfriction.friction.PARAM_NAMES` order; by
+            default several (:func:`initial_guesses`), the best fit is kept.
+        min_samples: fewer samples give a result without parameters.
+
+    Returns:
+        :class:`FitResult`.
+    """
+    qd = np.asarray(qd, dtype=float)
+    y = -np.asarray(tau_f, dtype=float)
+    n = qd.size
+    if n < max(min_samples, 7):
+        return FitResult(joint, n, message=f"only {n} valid samples")
+    starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(qd, y)
+    best = None
+    for start in starts:
+        res = least_squares(lambda x: _model(x, qd, delta_s) - y, start,
+                            jac=lambda x: _jacobian(x, qd, delta_s), bounds=(LOWER, UPPER),
+                            method="trf", x_scale="jac", ftol=1e-12, xtol=1e-12, gtol=1e-12, max_nfev=2000)
+        if best is None or res.cost < best.cost:
+            best = res
+    se = standard_errors(_jacobian(best.x, qd, delta_s), best.fun)
+    return FitResult(
+        joint=joint, n_samples=n, params=FrictionParams.from_vector(best.x, delta_s),
+        stderr=dict(zip(PARAM_NAMES, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
+        success=bool(best.success), message=str(best.message))
+
+
+def fit_estimate(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
+                 tau_f_true: np.ndarray | None = None, targets: dict[str, FrictionParams] | None = None,
+                 delta_s: float = 2.0, min_samples: int = 20) -> list[FitResult]:
+    """Fit every joint of a friction estimate on its valid samples.
+
+    Args:
+        joints: names (n,).
+        qd, tau_f, valid: (N, n) arrays of a :class:`~wbfriction.estimate.FrictionEstimate`.
+        tau_f_true: (N, n) true friction (NaN columns for unknown) or None.
+        targets: true parameters per joint name, when known.
+    """
+    out = []
+    for i, joint in enumerate(joints):
+        m = valid[:, i] & np.isfinite(tau_f[:, i]) & np.isfinite(qd[:, i])
+        res = fit_friction(qd[m, i], tau_f[m, i], delta_s=delta_s, joint=joint, min_samples=min_samples)
+        if tau_f_true is not None and np.isfinite(tau_f_true[m, i]).all() and m.any():
+            res.rms_error_vs_true = float(np.sqrt(np.mean((tau_f[m, i] - tau_f_true[m, i]) ** 2)))
+            if res.params is not None:
+                res.rms_model_vs_true = float(np.sqrt(np.mean((res.params.torque(qd[m, i]) - tau_f_true[m, i]) ** 2)))
+        if targets and joint in targets:
+            res.target = targets[joint]
+        out.append(res)
+    return out

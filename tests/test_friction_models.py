@@ -1,0 +1,100 @@
+"""Properties of the friction models of chapter 3 and of their identification."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings, strategies as st
+
+from wbfriction.friction import FrictionParams, coulomb, friction_torque, smooth, stribeck, viscous
+from wbfriction.identify import _jacobian, fit_friction, standard_errors
+
+pos = st.floats(0.01, 10.0)
+vel = st.floats(-20.0, 20.0).filter(lambda x: abs(x) > 1e-2)
+BIG_A = 1e9  # tanh(a qd) == sgn(qd) to double precision for |qd| > 1e-2
+
+
+@given(vel, pos)
+def test_smooth_reduces_to_coulomb(qd, F_c):
+    assert np.isclose(smooth(qd, 0.0, F_c, 0.0, 1.0, 0.0, BIG_A), coulomb(qd, F_c), rtol=1e-12)
+
+
+@given(st.floats(-20.0, 20.0), pos)
+def test_smooth_reduces_to_viscous(qd, F_v):
+    assert np.isclose(smooth(qd, F_v, 0.0, 0.3, 1.0, 0.0, 40.0), viscous(qd, F_v), rtol=1e-12, atol=0)
+
+
+@given(vel, pos, st.floats(0.0, 5.0), st.floats(0.01, 2.0), st.sampled_from([1.0, 2.0, 0.5]))
+def test_smooth_reduces_to_stribeck(qd, F_c, S, v_s, delta_s):
+    expected = stribeck(qd, F_c, (1.0 + S) * F_c, v_s, delta_s)
+    assert np.isclose(smooth(qd, 0.0, F_c, S, v_s, 0.0, BIG_A, delta_s), expected, rtol=1e-12)
+
+
+@given(st.floats(-20.0, 20.0), pos, pos, st.floats(0.0, 5.0), st.floats(0.01, 2.0), st.floats(0.1, 1000.0))
+def test_smooth_is_odd_without_offset(qd, F_v, F_c, S, v_s, a):
+    f = lambda x: smooth(x, F_v, F_c, S, v_s, 0.0, a)  # noqa: E731
+    assert np.isclose(f(-qd), -f(qd), rtol=1e-12, atol=1e-15)
+
+
+@given(st.floats(-20.0, 20.0), pos, pos, st.floats(0.0, 5.0), st.floats(0.01, 2.0), st.floats(0.1, 1000.0))
+def test_dissipative_without_offset(qd, F_v, F_c, S, v_s, a):
+    """qd * tau_f <= 0 (eq. 7.9) for positive parameters and no offset."""
+    p = FrictionParams(F_v, F_c, S, v_s, 0.0, a)
+    assert qd * p.torque(qd) <= 0.0
+
+
+def test_friction_torque_vectorised_matches_per_joint():
+    rng = np.random.default_rng(0)
+    params = [FrictionParams(0.2, 0.8, 0.2, 0.2, 0.8, 40.0), FrictionParams(0.1, 0.1, 0.5, 0.1, -0.1, 20.0)]
+    qd = rng.normal(0, 1, (50, 2))
+    out = friction_torque(qd, params)
+    for j, p in enumerate(params):
+        np.testing.assert_allclose(out[:, j], p.torque(qd[:, j]), rtol=1e-14)
+
+
+def test_analytic_jacobian_matches_finite_differences():
+    rng = np.random.default_rng(1)
+    qd = rng.uniform(-2, 2, 200)
+    x = np.array([0.2, 0.8, 0.3, 0.25, 0.1, 30.0])
+    J = _jacobian(x, qd, 2.0)
+    for i in range(6):
+        h = 1e-6 * max(1.0, abs(x[i]))
+        xp, xm = x.copy(), x.copy()
+        xp[i] += h
+        xm[i] -= h
+        fd = (smooth(qd, *xp) - smooth(qd, *xm)) / (2 * h)
+        np.testing.assert_allclose(J[:, i], fd, rtol=1e-5, atol=1e-7)
+
+
+@settings(max_examples=25, deadline=None)
+@given(F_v=st.floats(0.0, 1.0), F_c=st.floats(0.1, 2.0), S=st.floats(0.1, 1.0), v_s=st.floats(0.05, 0.5),
+       tau_os=st.floats(-1.0, 1.0), a=st.floats(10.0, 100.0))
+def test_fit_recovers_noiseless_parameters(F_v, F_c, S, v_s, tau_os, a):
+    truth = FrictionParams(F_v, F_c, S, v_s, tau_os, a)
+    qd = np.linspace(-8 * v_s - 0.5, 8 * v_s + 0.5, 2001)
+    res = fit_friction(qd, truth.torque(qd))
+    assert res.success
+    np.testing.assert_allclose(res.params.as_vector(), truth.as_vector(), rtol=1e-4, atol=1e-6)
+    assert res.rms_residual < 1e-8
+
+
+def test_fit_marks_unidentifiable_parameters():
+    """Without a Stribeck bump (S = 0) v_s cannot be identified: infinite standard error."""
+    qd = np.linspace(-2, 2, 1001)
+    truth = FrictionParams(0.2, 0.8, 0.0, 0.2, 0.1, 40.0)
+    rng = np.random.default_rng(0)
+    res = fit_friction(qd, truth.torque(qd) + rng.normal(0, 0.01, qd.size), x0=np.array([0.2, 0.8, 0.0, 0.2, 0.1, 40.0]))
+    assert res.params.S < 0.05 or res.stderr["v_s"] > 1.0
+    # a column of zeros in the Jacobian is an unidentifiable direction
+    J = _jacobian(np.array([0.2, 0.8, 0.0, 0.2, 0.1, 40.0]), qd, 2.0)
+    se = standard_errors(J, rng.normal(0, 0.01, qd.size))
+    assert np.isinf(se[3]) and np.isfinite(se[[0, 1, 4, 5]]).all()
+
+
+def test_fit_standard_errors_cover_truth_with_noise():
+    rng = np.random.default_rng(7)
+    truth = FrictionParams(0.2, 0.8, 0.2, 0.2, 0.8, 40.0)
+    qd = rng.uniform(-2.0, 2.0, 4000)
+    res = fit_friction(qd, truth.torque(qd) + rng.normal(0, 0.05, qd.size))
+    z = np.abs(res.params.as_vector() - truth.as_vector()) / np.array([res.stderr[k] for k in
+                                                                     ("F_v", "F_c", "S", "v_s", "tau_os", "a")])
+    assert np.all(z < 5.0), z
