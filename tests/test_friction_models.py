@@ -74,7 +74,7 @@ def test_fit_recovers_noiseless_parameters(F_v, F_c, S, v_s, tau_os, a):
     res = fit_friction(qd, truth.torque(qd))
     assert res.success
     np.testing.assert_allclose(res.params.as_vector(), truth.as_vector(), rtol=1e-4, atol=1e-6)
-    assert res.rms_residual < 1e-8
+    assert res.rms_residual < 1e-6
 
 
 def test_fit_marks_unidentifiable_parameters():

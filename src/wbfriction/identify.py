@@ -149,13 +149,17 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
     if n < max(min_samples, 7):
         return FitResult(joint, n, message=f"only {n} valid samples")
     starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(qd, y)
-    best = None
-    for start in starts:
-        res = least_squares(lambda x: _model(x, qd, delta_s) - y, start,
-                            jac=lambda x: _jacobian(x, qd, delta_s), bounds=(LOWER, UPPER),
-                            method="trf", x_scale="jac", ftol=1e-12, xtol=1e-12, gtol=1e-12, max_nfev=2000)
-        if best is None or res.cost < best.cost:
-            best = res
+
+    def solve(start, max_nfev):
+        return least_squares(lambda x: _model(x, qd, delta_s) - y, start,
+                             jac=lambda x: _jacobian(x, qd, delta_s), bounds=(LOWER, UPPER),
+                             method="trf", x_scale="jac", ftol=1e-10, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev)
+
+    # a short run from every start, then the two best refined
+    if len(starts) > 1:
+        short = sorted((solve(s, 30) for s in starts), key=lambda r: r.cost)
+        starts = [r.x for r in short[:2]]
+    best = min((solve(s, 300) for s in starts), key=lambda r: r.cost)
     se = standard_errors(_jacobian(best.x, qd, delta_s), best.fun)
     return FitResult(
         joint=joint, n_samples=n, params=FrictionParams.from_vector(best.x, delta_s),
@@ -186,3 +190,37 @@ def fit_estimate(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *
             res.target = targets[joint]
         out.append(res)
     return out
+
+
+def fit_friction_table(table, *, delta_s: float = 2.0, min_samples: int = 20, source: str = "<table>") -> list[FitResult]:
+    """Fit every joint of a friction table written by ``wbfriction estimate``.
+
+    The table needs ``qd.<j>``, ``tau_f.<j>`` and ``valid.<j>`` per joint; optional
+    ``tau_f_true.<j>`` columns and ``friction_true`` metadata give the errors against truth.
+
+    Raises:
+        InputError: a joint with some but not all of its columns, or no joint at all.
+    """
+    from .exceptions import InputError
+    from .log import read_metadata
+
+    names = table.column_names
+    joints = [c[len("tau_f."):] for c in names if c.startswith("tau_f.")]
+    if not joints:
+        raise InputError(f"{source}: no 'tau_f.<joint>' column: not a friction table from 'wbfriction estimate'")
+    for j in joints:
+        for prefix in ("qd.", "valid."):
+            if prefix + j not in names:
+                raise InputError(f"{source}: missing column '{prefix}{j}'")
+    col = lambda c: table.column(c).to_numpy(zero_copy_only=False).astype(float)  # noqa: E731
+    qd = np.column_stack([col(f"qd.{j}") for j in joints])
+    tau_f = np.column_stack([col(f"tau_f.{j}") for j in joints])
+    valid = np.column_stack([col(f"valid.{j}") for j in joints]).astype(bool)
+    true = None
+    if any(f"tau_f_true.{j}" in names for j in joints):
+        true = np.column_stack([col(f"tau_f_true.{j}") if f"tau_f_true.{j}" in names else np.full(len(qd), np.nan)
+                                for j in joints])
+    meta = read_metadata(table)
+    targets = {j: FrictionParams.from_dict(p) for j, p in meta.get("friction_true", {}).items()}
+    return fit_estimate(joints, qd, tau_f, valid, tau_f_true=true, targets=targets, delta_s=delta_s,
+                        min_samples=min_samples)

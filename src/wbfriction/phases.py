@@ -10,6 +10,9 @@ Masks (thesis 6.2.1): the first ``lift_off_skip`` seconds after a lift-off and t
 switches). Within the remaining single-support samples:
 
 * ``"single"``: every torque-controlled joint counts;
+The dropped intervals are ``[t_lift_off, t_lift_off + lift_off_skip)`` and
+``[t_touch_down - touch_down_skip, t_touch_down)``.
+
 * ``"swing"`` (default, the thesis's reliable choice): a joint on the limb of the
   stance contact does not count (its estimate multiplies a small acceleration error by a
   large inertia, 6.1.2); a joint of the swinging leg, or of the torso, arms..., does.
@@ -93,9 +96,9 @@ def segment(time: np.ndarray, contact: np.ndarray, lift_off_skip: float = 0.10,
             idx = np.flatnonzero(run_id[start:stop] == s) + start
             a, b = idx[0], idx[-1] + 1
             if a > 0:
-                keep[a:b] &= time[a:b] - time[a] >= lift_off_skip - 1e-12
+                keep[a:b] &= time[a:b] - time[a] >= lift_off_skip - 1e-9
             if b < len(time):
-                keep[a:b] &= time[b] - time[a:b] >= touch_down_skip - 1e-12
+                keep[a:b] &= time[b] - time[a:b] > touch_down_skip + 1e-9
     return Phases(n_contacts, stance, keep)
 
 

@@ -19,7 +19,10 @@ groups and the model are matched name by name.
 from __future__ import annotations
 
 import importlib.metadata
+import os
+import sys
 import tomllib
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cached_property
 from importlib import resources
@@ -48,6 +51,21 @@ def example_robot_data_dir() -> Path:
     if not path.is_dir():  # pragma: no cover - install issue
         raise InputError(f"example-robot-data robots not found at {path}")
     return path
+
+
+@contextmanager
+def _quiet_stderr():
+    """Silence what C++ code (urdfdom) writes to file descriptor 2 meanwhile."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 2)
+    try:
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(devnull)
 
 
 def _resolve(spec: str, base_dir: Path) -> Path:
@@ -236,7 +254,8 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
     if not urdf.is_file():
         raise InputError(f"{urdf}: URDF file not found")
     try:
-        model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+        with _quiet_stderr():
+            model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
     except Exception as exc:  # Pinocchio raises plain RuntimeError/ValueError
         raise InputError(f"{urdf}: URDF does not load: {str(exc).strip().splitlines()[0]}") from exc
     actuated = []

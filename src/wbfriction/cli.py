@@ -1,0 +1,190 @@
+"""Command-line interface: a thin layer over the library.
+
+Commands: ``simulate`` (a log with known friction), ``estimate`` (friction per sample),
+``fit`` (model 3.5 per joint), ``demo`` (all three on the built-in TALOS).
+Bad input prints one line naming the file, column, row or option at fault and exits
+with status 2.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from . import __version__
+from .estimate import EstimateOptions, estimate_log
+from .exceptions import WbfrictionError
+from .friction import PARAM_NAMES
+from .identify import FitResult, fit_friction_table
+from .log import read_log, read_table, write_atomic, write_log, write_table
+from .robot import Robot, load_robot
+from .simulate import FixedFootScenario, simulate_fixed_foot
+
+app = typer.Typer(add_completion=False, no_args_is_help=True,
+                  help="Whole-body joint friction estimation for torque-controlled legged robots.")
+console = Console(stderr=True)
+out = Console(width=max(Console().width, 150))
+
+RobotOpt = typer.Option("talos", "--robot", help="Built-in robot name.")
+UrdfOpt = typer.Option(None, "--urdf", help="URDF of another robot (with --config).")
+ConfigOpt = typer.Option(None, "--config", help="Robot TOML: contact_frames, position_controlled, groups.")
+
+
+@contextmanager
+def _progress(total: int, label: str):
+    with Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                  console=console, transient=True, disable=total < 2000) as bar:
+        task = bar.add_task(label, total=total)
+        yield lambda n: bar.advance(task, n)
+
+
+def _robot(robot: str, urdf: Optional[Path], config: Optional[Path]) -> Robot:
+    return load_robot(robot, urdf=urdf, config=config)
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _options(**kw) -> EstimateOptions:
+    return EstimateOptions(**{k: v for k, v in kw.items() if v is not None})
+
+
+def _fit_rows(results: list[FitResult]) -> Table:
+    """One row per joint: each parameter as value(standard error); ``n.i.``: not identifiable."""
+    table = Table(title="Friction model (3.5): f(qd) fitted to -tau_f, value ±standard error",
+                  caption="n.i.: not identifiable from these data (infinite standard error)", box=None)
+    table.add_column("joint")
+    table.add_column("N", justify="right")
+    for name in PARAM_NAMES:
+        table.add_column(name, justify="right")
+    has_true = any(r.rms_error_vs_true is not None for r in results)
+    if has_true:
+        table.add_column("RMS est-true", justify="right")
+    fmt = lambda v, s: f"{v:.4g} ±{'n.i.' if not np.isfinite(s) else f'{s:.1g}'}"  # noqa: E731
+    pad = [""] if has_true else []
+    for r in results:
+        cells = (["—"] * len(PARAM_NAMES) if r.params is None
+                 else [fmt(getattr(r.params, n), r.stderr[n]) for n in PARAM_NAMES])
+        rms = [f"{r.rms_error_vs_true:.4f}" if r.rms_error_vs_true is not None else ""] if has_true else []
+        table.add_row(r.joint, str(r.n_samples), *cells, *rms)
+        err = r.error_percent()
+        if err is not None:
+            table.add_row("  target", "", *[f"{getattr(r.target, n):.4g}" for n in PARAM_NAMES], *pad, style="dim")
+            table.add_row("  error [%]", "", *[f"{err[n]:.2f}" for n in PARAM_NAMES], *pad, style="dim")
+    return table
+
+
+def _write_params(results: list[FitResult], path: Path, provenance: dict) -> None:
+    doc = {"provenance": provenance, "sign_convention": "tau_f = -f(qd); fit of f (eq. 3.5) to -tau_f",
+           "joints": {r.joint: r.to_dict() for r in results}}
+    text = json.dumps(doc, indent=2, sort_keys=False)
+    write_atomic(path, lambda tmp: tmp.write_text(text))
+
+
+@app.command()
+def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write (.parquet or .csv)."),
+             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             duration: float = typer.Option(6.0, help="Length of the log [s]."),
+             double_support: float = typer.Option(0.5, help="Initial double support [s]."),
+             substeps: int = typer.Option(10, help="Physics steps per 1 ms control period."),
+             log_base: bool = typer.Option(False, help="Write the base pose to the log."),
+             seed: int = typer.Option(0, help="Seed of the reference motion.")) -> None:
+    """Simulate one fixed stance foot, the other leg, arms and torso moving, with known friction."""
+    r = _robot(robot, urdf, config)
+    scenario = FixedFootScenario(duration=duration, double_support=double_support, substeps=substeps,
+                                 log_base=log_base, seed=seed)
+    n = int(round(duration / scenario.dt))
+    with _progress(n, "simulate") as advance:
+        log = simulate_fixed_foot(r, scenario, progress=advance)
+    write_log(log, r, output)
+    console.print(f"wrote {output} ({len(log)} samples, {duration:g} s)")
+
+
+@app.command()
+def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the wbfriction format."),
+             output: Path = typer.Option(..., "-o", "--output", help="Friction table to write."),
+             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             diff: str = typer.Option("central", help="Differentiation: central (6.2) or backward (6.3)."),
+             delay_compensation: bool = typer.Option(True, help="Shift derivatives by their delay (6.1.2)."),
+             torque_alignment: str = typer.Option("zoh", help="zoh: mean of tau[k-1], tau[k]; sample: tau[k]."),
+             mask: str = typer.Option("swing", help="swing: leg joints only while their leg swings; single."),
+             lift_off: float = typer.Option(0.10, help="Seconds dropped after a lift-off."),
+             touch_down: float = typer.Option(0.05, help="Seconds dropped before a touch-down."),
+             ds_weight: float = typer.Option(1.0, help="W of the double-support problem (6.1)."),
+             ds_regularization: float = typer.Option(1e-3, help="Lambda of the double-support problem (6.1)."),
+             cond: bool = typer.Option(False, "--cond", help="Report cond(M_mod^-1) per sample (slower)."),
+             method: str = typer.Option("rnea", help="Single-support route: rnea (fast) or kkt (5.10-5.13).")) -> None:
+    """Estimate the friction torque of every torque-controlled joint at every sample."""
+    r = _robot(robot, urdf, config)
+    data = read_log(log, r)
+    opts = _options(diff=diff, compensate_delay=delay_compensation, torque_alignment=torque_alignment,
+                    mask=mask, lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
+                    ds_regularization=ds_regularization, condition_number=cond, method=method)
+    with _progress(len(data), "estimate") as advance:
+        est = estimate_log(r, data, opts, progress=advance)
+    est.metadata["provenance"] = {"log": str(log), "log_sha256": _sha256(log), "robot": r.name,
+                                  "urdf": str(r.urdf), "wbfriction": __version__}
+    write_table(est.to_table(), output)
+    n_valid = int(est.valid.any(axis=1).sum())
+    console.print(f"wrote {output}: {len(est.time)} samples, {int(est.unique.sum())} in single support, "
+                  f"{n_valid} with a valid joint")
+
+
+@app.command()
+def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wbfriction estimate'."),
+        output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
+        min_samples: int = typer.Option(20, help="Joints with fewer valid samples are not fitted.")) -> None:
+    """Identify the friction model (3.5) of every joint, with standard errors."""
+    table = read_table(friction)
+    results = fit_friction_table(table, min_samples=min_samples, source=str(friction))
+    _write_params(results, output, {"friction": str(friction), "friction_sha256": _sha256(friction),
+                                    "wbfriction": __version__})
+    out.print(_fit_rows(results))
+    console.print(f"wrote {output}")
+
+
+@app.command()
+def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--output-dir", help="Where to write."),
+         robot: str = RobotOpt,
+         duration: float = typer.Option(6.0, help="Length of the simulated log [s]."),
+         seed: int = typer.Option(0, help="Seed of the reference motion.")) -> None:
+    """Main job on a generated log: simulate TALOS with the thesis's friction, estimate, fit."""
+    output_dir.mkdir(parents=True, exist_ok=True)
+    log_path, fr_path, par_path = (output_dir / n for n in ("log.parquet", "friction.parquet", "params.json"))
+    simulate(output=log_path, robot=robot, urdf=None, config=None, duration=duration, double_support=0.5,
+             substeps=10, log_base=False, seed=seed)
+    estimate(log=log_path, output=fr_path, robot=robot, urdf=None, config=None, diff="central",
+             delay_compensation=True, torque_alignment="zoh", mask="swing", lift_off=0.10, touch_down=0.05,
+             ds_weight=1.0, ds_regularization=1e-3, cond=False, method="rnea")
+    fit(friction=fr_path, output=par_path, min_samples=20)
+
+
+def main() -> None:
+    """Entry point: run the app, turning wbfriction errors into one line and exit status 2."""
+    try:
+        app(standalone_mode=False)
+    except WbfrictionError as exc:
+        console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+        sys.exit(2)
+    except typer.Exit as exc:  # pragma: no cover - typer control flow
+        sys.exit(exc.exit_code)
+    except (typer.Abort, KeyboardInterrupt):  # pragma: no cover
+        sys.exit(130)
+    except Exception as exc:  # click usage errors
+        import click
+
+        if isinstance(exc, click.exceptions.ClickException):
+            exc.show()
+            sys.exit(exc.exit_code)
+        raise

@@ -1,0 +1,105 @@
+"""The command line: the main job end to end, and one-line errors with exit status 2."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from wbfriction.log import read_log, write_log
+
+
+def run(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "wbfriction", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, env=dict(os.environ, COLUMNS="200"))
+
+
+@pytest.fixture(scope="module")
+def demo_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("demo")
+    res = run("demo", "-o", out, "--duration", "2.0")
+    assert res.returncode == 0, res.stderr
+    return out, res
+
+
+def test_demo_writes_log_friction_and_params(demo_dir):
+    out, res = demo_dir
+    params = json.loads((out / "params.json").read_text())
+    knee = params["joints"]["leg_right_4_joint"]
+    assert knee["n_samples"] > 1000
+    assert abs(knee["params"]["F_c"] - 1.0) < 0.05 and abs(knee["params"]["tau_os"] - 1.0) < 0.05
+    assert knee["error_percent"]["F_c"] < 5
+    assert params["joints"]["leg_left_4_joint"]["params"] is None  # stance leg: no valid sample
+    assert "leg_right_4_joint" in res.stdout and "error [%]" in res.stdout
+    table = pq.read_table(out / "friction.parquet")
+    for col in ("time", "phase", "unique", "qd.leg_right_4_joint", "tau_f.leg_right_4_joint",
+                "valid.leg_right_4_joint", "tau_f_true.leg_right_4_joint"):
+        assert col in table.column_names
+
+
+def test_estimate_and_fit_commands_with_options(demo_dir, tmp_path):
+    out, _ = demo_dir
+    res = run("estimate", out / "log.parquet", "--robot", "talos", "-o", tmp_path / "f.parquet", "--cond",
+              "--mask", "single", "--diff", "backward")
+    assert res.returncode == 0, res.stderr
+    t = pq.read_table(tmp_path / "f.parquet")
+    cond = t.column("cond").to_numpy()
+    single = t.column("unique").to_numpy(zero_copy_only=False)
+    assert np.isfinite(cond[single]).all() and (cond[single] > 1).all()
+    res = run("fit", tmp_path / "f.parquet", "-o", tmp_path / "p.json")
+    assert res.returncode == 0, res.stderr
+    assert json.loads((tmp_path / "p.json").read_text())["joints"]["leg_left_4_joint"]["n_samples"] > 0
+
+
+def _assert_one_line_error(res, needle):
+    assert res.returncode == 2
+    lines = [ln for ln in res.stderr.strip().splitlines() if ln.strip()]
+    assert len(lines) == 1 and needle in lines[0], res.stderr
+
+
+def test_bad_inputs_exit_2_with_one_line(talos, demo_dir, tmp_path):
+    out, _ = demo_dir
+    log = read_log(out / "log.parquet", talos)
+    # NaN in a joint column
+    bad = read_log(out / "log.parquet", talos)
+    bad.q[5, 3] = np.nan
+    write_log(bad, talos, tmp_path / "nan.parquet")
+    _assert_one_line_error(run("estimate", tmp_path / "nan.parquet", "-o", tmp_path / "x.parquet"),
+                           f"column 'q.{talos.actuated[3]}' has a non-finite value (NaN or inf) at row 5")
+    # no single-support sample
+    log.contact[:] = True
+    write_log(log, talos, tmp_path / "ds.parquet")
+    _assert_one_line_error(run("estimate", tmp_path / "ds.parquet", "-o", tmp_path / "x.parquet"),
+                           "no single-support sample")
+    assert not (tmp_path / "x.parquet").exists()
+    # a URDF that does not load
+    (tmp_path / "broken.urdf").write_text("<robot name='x'><link name='a'/><joint/></robot>")
+    (tmp_path / "r.toml").write_text('contact_frames = ["a"]\n')
+    _assert_one_line_error(run("estimate", out / "log.parquet", "--urdf", tmp_path / "broken.urdf", "--config",
+                               tmp_path / "r.toml", "-o", tmp_path / "x.parquet"), "URDF does not load")
+    _assert_one_line_error(run("estimate", out / "log.parquet", "--robot", "asimo", "-o", tmp_path / "x.parquet"),
+                           "unknown robot 'asimo'")
+    _assert_one_line_error(run("fit", out / "log.parquet", "-o", tmp_path / "p.json"), "no 'tau_f.<joint>' column")
+
+
+def test_any_robot_from_urdf_and_toml(talos, demo_dir, tmp_path):
+    """TALOS given as a user robot (URDF + TOML) gives the built-in's result."""
+    out, _ = demo_dir
+    cfg = tmp_path / "talos.toml"
+    cfg.write_text('name = "mine"\nposition_controlled = ["head_1_joint", "head_2_joint"]\n'
+                   'contact_frames = ["left_sole_link", "right_sole_link"]\n')
+    res = run("estimate", out / "log.parquet", "--urdf", talos.urdf, "--config", cfg, "-o", tmp_path / "f.parquet")
+    assert res.returncode == 0, res.stderr
+    a = pq.read_table(tmp_path / "f.parquet").column("tau_f.leg_right_4_joint").to_numpy()
+    b = pq.read_table(out / "friction.parquet").column("tau_f.leg_right_4_joint").to_numpy()
+    np.testing.assert_array_equal(a, b)
+    # an unknown joint in the TOML is named
+    cfg.write_text('position_controlled = ["neck_joint"]\ncontact_frames = ["left_sole_link"]\n')
+    _assert_one_line_error(run("estimate", out / "log.parquet", "--urdf", talos.urdf, "--config", cfg, "-o",
+                               tmp_path / "g.parquet"), "unknown position-controlled joint 'neck_joint'")
