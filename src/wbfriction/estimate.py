@@ -49,9 +49,11 @@ class EstimateOptions:
         lift_off_skip: seconds dropped after a lift-off [s] (6.2.1: 0.10).
         touch_down_skip: seconds dropped before a touch-down [s] (6.2.1: 0.05).
         mask: ``swing`` (a leg joint counts only while its leg swings) or ``single``.
-        ds_weight: diagonal of W in (6.1), scalar or (n_tc,) [s^4 (N·m)^2 ... relative weights].
+        ds_weight: diagonal of W in (6.1), scalar or (n_tc,): relative weights of the
+            joints' acceleration residuals (dimensionless).
         ds_regularization: diagonal of Lambda in (6.1), scalar or (n_tc,)
-            [(rad/s^2)^2 / (N·m)^2]; scales against ``A^T W A``.
+            [(rad/s^2)^2 / (N·m)^2 with W = 1]; it competes with ``A^T W A``, whose
+            entries are of the order of (1 / joint inertia)^2.
         condition_number: report cond(M_mod^{-1}) per sample (one KKT inverse per sample).
         method: single-support route, ``rnea`` (default) or ``kkt``.
     """
@@ -118,17 +120,12 @@ class FrictionEstimate:
         return with_metadata(pa.table(cols), self.metadata)
 
 
-def _stance_models(robot: Robot) -> dict[int, StanceModel]:
-    cache = robot.__dict__.setdefault("_stance_models", {})
-    return cache
-
-
 def stance_model(robot: Robot, contact_index: int) -> StanceModel:
-    """The (cached) model of ``robot`` rooted at contact frame number ``contact_index``."""
-    cache = _stance_models(robot)
-    if contact_index not in cache:
-        cache[contact_index] = build_stance_model(robot, robot.contact_frames[contact_index])
-    return cache[contact_index]
+    """The model of ``robot`` rooted at contact frame number ``contact_index`` (built once)."""
+    key = ("stance", contact_index)
+    if key not in robot.cache:
+        robot.cache[key] = build_stance_model(robot, robot.contact_frames[contact_index])
+    return robot.cache[key]
 
 
 def _stance_frame_pose(robot: Robot, stance: StanceModel, angles: np.ndarray, base: np.ndarray | None) -> np.ndarray:

@@ -100,6 +100,8 @@ class Robot:
     contact_frames: tuple[str, ...]
     groups: dict[str, tuple[str, ...]] = field(default_factory=dict)
     q_reference: np.ndarray | None = None
+    cache: dict = field(default_factory=dict, repr=False, compare=False)
+    """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.stance`)."""
 
     # ----------------------------------------------------------------- indices
     @cached_property

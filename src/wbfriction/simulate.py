@@ -232,7 +232,5 @@ def simulate_fixed_foot(robot: Robot, scenario: FixedFootScenario = FixedFootSce
         "friction_true": {j: p.to_dict() for j, p in friction.items()},
     }
     time = np.arange(n) * scenario.dt
-    tau_f_true = np.full((n, len(tc)), np.nan)
-    tau_f_true[:, :] = rows["tau_f"]
     return Log(time, rows["q"], rows["tau"], rows["contact"].astype(bool),
-               rows["base"] if scenario.log_base else None, tau_f_true, metadata, source="simulate_fixed_foot")
+               rows["base"] if scenario.log_base else None, rows["tau_f"], metadata, source="simulate_fixed_foot")

@@ -25,7 +25,7 @@ sign (``sign = -1``), so its generalized force changes sign too (the power
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
@@ -59,7 +59,7 @@ def _body(j: int) -> str:
     return f"__wbf_body_{j}"
 
 
-@dataclass(frozen=True)
+@dataclass
 class StanceModel:
     """The robot rooted at one contact frame, with a free-flyer root.
 
@@ -78,6 +78,10 @@ class StanceModel:
     v_index: np.ndarray
     sign: np.ndarray
     layout: JointLayout
+    pool: pin.ModelPool = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.pool = pin.ModelPool(self.model, 1)  # one thread: rneaInParallel as a C++ batch loop
 
     def inverse_dynamics(self, frame_pose: np.ndarray, angles: np.ndarray, qd: np.ndarray,
                          qdd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -102,17 +106,9 @@ class StanceModel:
         a = np.zeros((self.model.nv, n))
         v[self.v_index] = (qd * self.sign).T
         a[self.v_index] = (qdd * self.sign).T
-        tau = pin.rneaInParallel(1, self._pool, np.asfortranarray(q), np.asfortranarray(v), np.asfortranarray(a))
+        tau = pin.rneaInParallel(1, self.pool, np.asfortranarray(q), np.asfortranarray(v), np.asfortranarray(a))
         tau = np.asarray(tau).reshape(self.model.nv, n)
         return (tau[self.v_index].T * self.sign), tau[:6].T.copy()
-
-    @property
-    def _pool(self) -> pin.ModelPool:
-        pool = self.__dict__.get("_pool_cache")
-        if pool is None:
-            pool = pin.ModelPool(self.model, 1)
-            object.__setattr__(self, "_pool_cache", pool)
-        return pool
 
 
 def build_stance_model(robot: Robot, frame: str) -> StanceModel:
