@@ -20,7 +20,7 @@ Sign convention: ``tau_f`` is the torque friction exerts on the joint,
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 import pinocchio as pin
@@ -249,7 +249,7 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
             cond[r] = np.linalg.cond(dyn.Mmod_inv)
     valid = joint_mask(phases, robot.limb_mask, options.mask) & usable[:, None]
     metadata = dict(kin.metadata)
-    metadata["estimate_options"] = {k: (list(v) if isinstance(v, tuple) else v) for k, v in options.__dict__.items()}
+    metadata["estimate_options"] = asdict(options)
     return FrictionEstimate(
         joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
         phase=phases.labels(), unique=ss.copy(), contact=kin.contact, contact_frames=robot.contact_frames,

@@ -102,9 +102,6 @@ class FrictionParams:
         return cls(**{k: float(v) for k, v in d.items()})
 
 
-NO_FRICTION = FrictionParams(F_v=0.0, F_c=0.0, S=0.0, tau_os=0.0)
-
-
 def friction_torque(qd: np.ndarray, params: list[FrictionParams]) -> np.ndarray:
     """Friction torques ``tau_f = -f(qd)`` for several joints at once.
 

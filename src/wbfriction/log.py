@@ -38,7 +38,6 @@ from .robot import Robot
 
 BASE_COLUMNS = ("base.x", "base.y", "base.z", "base.qx", "base.qy", "base.qz", "base.qw")
 META_KEY = b"wbfriction"
-PREFIXES = ("q.", "tau.", "contact.", "base.", "tau_f_true.")
 
 
 @dataclass
