@@ -112,8 +112,12 @@ def friction_torque(qd: np.ndarray, params: list[FrictionParams]) -> np.ndarray:
     Returns:
         tau_f, (N, n_joints) [N·m], in the sign convention of this module.
     """
-    stack = {name: np.array([getattr(p, name) for p in params]) for name in PARAM_NAMES + ("delta_s",)}
-    return -smooth(qd, **stack)
+    return -smooth(qd, **stack_params(params))
+
+
+def stack_params(params: list[FrictionParams]) -> dict[str, np.ndarray]:
+    """Keyword arguments of :func:`smooth` for several joints: each parameter as an (n_joints,) array."""
+    return {name: np.array([getattr(p, name) for p in params]) for name in PARAM_NAMES + ("delta_s",)}
 
 
 THESIS_TARGETS: dict[str, FrictionParams] = {

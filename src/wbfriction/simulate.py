@@ -25,7 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from .exceptions import InputError
-from .friction import FrictionParams, friction_by_group, friction_torque
+from .friction import FrictionParams, friction_by_group, smooth, stack_params
 from .log import Log
 from .robot import Robot
 
@@ -190,7 +190,8 @@ def simulate_fixed_foot(robot: Robot, scenario: FixedFootScenario = FixedFootSce
     tc = robot.tc_index
     iv = robot.act_v_index
     joints_f = [robot.torque_controlled.index(j) for j in friction]
-    params_f = list(friction.values())
+    params_f = stack_params(list(friction.values()))
+    iv_f = iv[tc][joints_f]
     n = int(round(scenario.duration / scenario.dt))
     h = scenario.dt / scenario.substeps
     settings = pin.ProximalSettings(1e-12, 1e-10, 50)
@@ -210,7 +211,7 @@ def simulate_fixed_foot(robot: Robot, scenario: FixedFootScenario = FixedFootSce
         tau_cmd = tau_ff[0] + kp * (q_ref - angles) + kd * (qd_ref - qd)
         tau_f = np.zeros(len(tc))
         if joints_f:
-            tau_f[joints_f] = friction_torque(qd[tc][joints_f][None], params_f)[0]
+            tau_f[joints_f] = -smooth(v[iv_f], **params_f)
         rows["q"][k], rows["tau"][k], rows["tau_f"][k] = angles, tau_cmd[tc], tau_f
         rows["contact"][k] = [c in active for c in range(len(robot.contact_frames))]
         rows["base"][k] = q[:7]
@@ -218,7 +219,7 @@ def simulate_fixed_foot(robot: Robot, scenario: FixedFootScenario = FixedFootSce
         for _ in range(scenario.substeps):
             tau_full[iv] = tau_cmd
             if joints_f:
-                tau_full[iv[tc][joints_f]] += friction_torque(v[iv[tc][joints_f]][None], params_f)[0]
+                tau_full[iv_f] -= smooth(v[iv_f], **params_f)
             a = pin.constraintDynamics(model, data, q, v, tau_full, cmodels, cdatas, settings)
             v = v + a * h
             q = pin.integrate(model, q, v * h)
