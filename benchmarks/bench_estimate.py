@@ -28,8 +28,7 @@ from wbfriction.robot import load_robot  # noqa: E402
 def samples(robot, n: int, seed: int = 0) -> tuple[MeasuredKinematics, np.ndarray, np.ndarray]:
     """Random single-support samples on the left sole (q within limits, qd, qdd, tau)."""
     rng = np.random.default_rng(seed)
-    lo = robot.model.lowerPositionLimit[robot.act_v_index + 1]
-    hi = robot.model.upperPositionLimit[robot.act_v_index + 1]
+    lo, hi = robot.angle_limits
     angles = rng.uniform(lo, hi, (n, robot.n_act))
     qd = rng.normal(0, 1, (n, robot.n_act))
     qdd = rng.normal(0, 5, (n, robot.n_act))

@@ -17,8 +17,7 @@ def random_state(robot: Robot, rng: np.random.Generator, active: list[int], base
     """A random configuration (within limits), base pose and a velocity with J v = 0."""
     model = robot.model
     data = model.createData()
-    lo, hi = model.lowerPositionLimit[7:], model.upperPositionLimit[7:]
-    angles = rng.uniform(lo, hi)
+    angles = rng.uniform(*robot.angle_limits)
     q = robot.configuration(angles)
     if base_random:
         q[:7] = pin.SE3ToXYZQUAT(pin.SE3(pin.Quaternion(rng.standard_normal(4)).normalized().matrix(),
@@ -76,7 +75,7 @@ def truth_samples(robot: Robot, n: int, support: str, seed: int, friction_joints
         a = constrained_forward(robot, q, v, tau_full, active)
         contact = np.zeros(len(robot.contact_frames), dtype=bool)
         contact[active] = True
-        angles = np.array([q[model.idx_qs[model.getJointId(j)]] for j in robot.actuated])
+        angles = robot.angles(q)
         rows["q"].append(angles)
         rows["qd"].append(v[robot.act_v_index])
         rows["qdd"].append(a[robot.act_v_index])

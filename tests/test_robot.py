@@ -45,3 +45,10 @@ def test_config_errors(talos):
         build_robot(talos.urdf, {"contact_frames": ["foot"]})
     with pytest.raises(InputError, match="'contact_frames' is missing"):
         build_robot(talos.urdf, {})
+
+
+def test_angles_invert_configuration(talos):
+    rng = np.random.default_rng(0)
+    angles = rng.uniform(*talos.angle_limits, size=(5, talos.n_act))
+    np.testing.assert_array_equal(talos.angles(talos.configuration(angles)), angles)
+    assert talos.reference_angles[talos.actuated.index("leg_left_4_joint")] > 0.8  # half-sitting knee

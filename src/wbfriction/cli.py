@@ -56,10 +56,6 @@ def _sha256(path: Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def _options(**kw) -> EstimateOptions:
-    return EstimateOptions(**{k: v for k, v in kw.items() if v is not None})
-
-
 def _fit_rows(results: list[FitResult]) -> Table:
     """One row per joint: each parameter as value(standard error); ``n.i.``: not identifiable."""
     table = Table(title="Friction model (3.5): f(qd) fitted to -tau_f, value ±standard error",
@@ -92,45 +88,21 @@ def _write_params(results: list[FitResult], path: Path, provenance: dict) -> Non
     write_atomic(path, lambda tmp: tmp.write_text(text))
 
 
-@app.command()
-def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write (.parquet or .csv)."),
-             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
-             duration: float = typer.Option(6.0, help="Length of the log [s]."),
-             double_support: float = typer.Option(0.5, help="Initial double support [s]."),
-             substeps: int = typer.Option(10, help="Physics steps per 1 ms control period."),
-             log_base: bool = typer.Option(False, help="Write the base pose to the log."),
-             seed: int = typer.Option(0, help="Seed of the reference motion.")) -> None:
-    """Simulate one fixed stance foot, the other leg, arms and torso moving, with known friction."""
-    r = _robot(robot, urdf, config)
-    scenario = FixedFootScenario(duration=duration, double_support=double_support, substeps=substeps,
-                                 log_base=log_base, seed=seed)
-    n = int(round(duration / scenario.dt))
+_E = EstimateOptions()  # one source of defaults: the library's
+_S = FixedFootScenario()
+_MIN_SAMPLES = 20
+
+
+def _run_simulate(r: Robot, output: Path, scenario: FixedFootScenario) -> None:
+    n = int(round(scenario.duration / scenario.dt))
     with _progress(n, "simulate") as advance:
         log = simulate_fixed_foot(r, scenario, progress=advance)
     write_log(log, r, output)
-    console.print(f"wrote {output} ({len(log)} samples, {duration:g} s)")
+    console.print(f"wrote {output} ({len(log)} samples, {scenario.duration:g} s)")
 
 
-@app.command()
-def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the wbfriction format."),
-             output: Path = typer.Option(..., "-o", "--output", help="Friction table to write."),
-             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
-             diff: str = typer.Option("central", help="Differentiation: central (6.2) or backward (6.3)."),
-             delay_compensation: bool = typer.Option(True, help="Shift derivatives by their delay (6.1.2)."),
-             torque_alignment: str = typer.Option("zoh", help="zoh: mean of tau[k-1], tau[k]; sample: tau[k]."),
-             mask: str = typer.Option("swing", help="swing: leg joints only while their leg swings; single."),
-             lift_off: float = typer.Option(0.10, help="Seconds dropped after a lift-off."),
-             touch_down: float = typer.Option(0.05, help="Seconds dropped before a touch-down."),
-             ds_weight: float = typer.Option(1.0, help="W of the double-support problem (6.1)."),
-             ds_regularization: float = typer.Option(1e-3, help="Lambda of the double-support problem (6.1)."),
-             cond: bool = typer.Option(False, "--cond", help="Report cond(M_mod^-1) per sample (slower)."),
-             method: str = typer.Option("rnea", help="Single-support route: rnea (fast) or kkt (5.10-5.13).")) -> None:
-    """Estimate the friction torque of every torque-controlled joint at every sample."""
-    r = _robot(robot, urdf, config)
+def _run_estimate(r: Robot, log: Path, output: Path, opts: EstimateOptions) -> None:
     data = read_log(log, r)
-    opts = _options(diff=diff, compensate_delay=delay_compensation, torque_alignment=torque_alignment,
-                    mask=mask, lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
-                    ds_regularization=ds_regularization, condition_number=cond, method=method)
     with _progress(len(data), "estimate") as advance:
         est = estimate_log(r, data, opts, progress=advance)
     est.metadata["provenance"] = {"log": str(log), "log_sha256": _sha256(log), "robot": r.name,
@@ -141,13 +113,8 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
                   f"{n_valid} with a valid joint")
 
 
-@app.command()
-def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wbfriction estimate'."),
-        output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
-        min_samples: int = typer.Option(20, help="Joints with fewer valid samples are not fitted.")) -> None:
-    """Identify the friction model (3.5) of every joint, with standard errors."""
-    table = read_table(friction)
-    results = fit_friction_table(table, min_samples=min_samples, source=str(friction))
+def _run_fit(friction: Path, output: Path, min_samples: int) -> None:
+    results = fit_friction_table(read_table(friction), min_samples=min_samples, source=str(friction))
     _write_params(results, output, {"friction": str(friction), "friction_sha256": _sha256(friction),
                                     "wbfriction": __version__})
     out.print(_fit_rows(results))
@@ -155,19 +122,64 @@ def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wb
 
 
 @app.command()
+def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write (.parquet or .csv)."),
+             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             duration: float = typer.Option(_S.duration, help="Length of the log [s]."),
+             double_support: float = typer.Option(_S.double_support, help="Initial double support [s]."),
+             substeps: int = typer.Option(_S.substeps, help="Physics steps per 1 ms control period."),
+             log_base: bool = typer.Option(_S.log_base, help="Write the base pose to the log."),
+             seed: int = typer.Option(_S.seed, help="Seed of the reference motion.")) -> None:
+    """Simulate one fixed stance foot, the other leg, arms and torso moving, with known friction."""
+    scenario = FixedFootScenario(duration=duration, double_support=double_support, substeps=substeps,
+                                 log_base=log_base, seed=seed)
+    _run_simulate(_robot(robot, urdf, config), output, scenario)
+
+
+@app.command()
+def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the wbfriction format."),
+             output: Path = typer.Option(..., "-o", "--output", help="Friction table to write."),
+             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             diff: str = typer.Option(_E.diff, help="Differentiation: central (6.2) or backward (6.3)."),
+             delay_compensation: bool = typer.Option(_E.compensate_delay,
+                                                     help="Shift derivatives by their delay (6.1.2)."),
+             torque_alignment: str = typer.Option(_E.torque_alignment,
+                                                  help="zoh: mean of tau[k-1], tau[k]; sample: tau[k]."),
+             mask: str = typer.Option(_E.mask, help="swing: leg joints only while their leg swings; single."),
+             lift_off: float = typer.Option(_E.lift_off_skip, help="Seconds dropped after a lift-off."),
+             touch_down: float = typer.Option(_E.touch_down_skip, help="Seconds dropped before a touch-down."),
+             ds_weight: float = typer.Option(_E.ds_weight, help="W of the double-support problem (6.1)."),
+             ds_regularization: float = typer.Option(_E.ds_regularization,
+                                                     help="Lambda of the double-support problem (6.1)."),
+             cond: bool = typer.Option(_E.condition_number, "--cond",
+                                       help="Report cond(M_mod^-1) per sample (slower)."),
+             method: str = typer.Option(_E.method, help="Single-support route: rnea (fast) or kkt (5.10-5.13).")) -> None:
+    """Estimate the friction torque of every torque-controlled joint at every sample."""
+    opts = EstimateOptions(diff=diff, compensate_delay=delay_compensation, torque_alignment=torque_alignment,
+                           mask=mask, lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
+                           ds_regularization=ds_regularization, condition_number=cond, method=method)
+    _run_estimate(_robot(robot, urdf, config), log, output, opts)
+
+
+@app.command()
+def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wbfriction estimate'."),
+        output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
+        min_samples: int = typer.Option(_MIN_SAMPLES, help="Joints with fewer valid samples are not fitted.")) -> None:
+    """Identify the friction model (3.5) of every joint, with standard errors."""
+    _run_fit(friction, output, min_samples)
+
+
+@app.command()
 def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--output-dir", help="Where to write."),
          robot: str = RobotOpt,
-         duration: float = typer.Option(6.0, help="Length of the simulated log [s]."),
-         seed: int = typer.Option(0, help="Seed of the reference motion.")) -> None:
+         duration: float = typer.Option(_S.duration, help="Length of the simulated log [s]."),
+         seed: int = typer.Option(_S.seed, help="Seed of the reference motion.")) -> None:
     """Main job on a generated log: simulate TALOS with the thesis's friction, estimate, fit."""
     output_dir.mkdir(parents=True, exist_ok=True)
     log_path, fr_path, par_path = (output_dir / n for n in ("log.parquet", "friction.parquet", "params.json"))
-    simulate(output=log_path, robot=robot, urdf=None, config=None, duration=duration, double_support=0.5,
-             substeps=10, log_base=False, seed=seed)
-    estimate(log=log_path, output=fr_path, robot=robot, urdf=None, config=None, diff="central",
-             delay_compensation=True, torque_alignment="zoh", mask="swing", lift_off=0.10, touch_down=0.05,
-             ds_weight=1.0, ds_regularization=1e-3, cond=False, method="rnea")
-    fit(friction=fr_path, output=par_path, min_samples=20)
+    r = _robot(robot, None, None)
+    _run_simulate(r, log_path, FixedFootScenario(duration=duration, seed=seed))
+    _run_estimate(r, log_path, fr_path, EstimateOptions())
+    _run_fit(fr_path, par_path, _MIN_SAMPLES)
 
 
 def main() -> None:

@@ -223,16 +223,19 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     tau_f = np.full((n, n_tc), np.nan)
     cond = np.full(n, np.nan) if options.condition_number else None
     tc = robot.tc_index
-    # single support, exact
     ss = usable & phases.single
-    need_kkt = usable & (phases.double | (ss if (options.method == "kkt" or options.condition_number) else False))
+    # the KKT route (one Pinocchio call per sample) serves double support, and single
+    # support when asked for it or for the condition number
+    kkt_in_single = options.method == "kkt" or options.condition_number
+    need_kkt = usable & (phases.double | (phases.single & kkt_in_single))
     if options.method == "rnea":
+        rnea_progress = None if kkt_in_single else progress  # counted by the KKT pass then
         for c in range(len(robot.contact_frames)):
             rows = np.flatnonzero(ss & (phases.stance == c))
             if rows.size:
                 tau_f[rows] = single_support_friction_rnea(
                     robot, c, kin.q[rows], kin.qd[rows], kin.qdd[rows], kin.tau[rows],
-                    None if kin.base is None else kin.base[rows], progress)
+                    None if kin.base is None else kin.base[rows], rnea_progress)
     rows = np.flatnonzero(need_kkt)
     for start in range(0, rows.size, CHUNK):
         r = rows[start:start + CHUNK]

@@ -169,7 +169,30 @@ class Robot:
         Returns:
             q of shape (nq,) or (N, nq). Continuous joints get (cos, sin) coordinates.
         """
-        return _joint_layout(self.model, self.actuated).configuration(angles, base)
+        return self.layout.configuration(angles, base)
+
+    def angles(self, q: np.ndarray) -> np.ndarray:
+        """Joint positions in :attr:`actuated` order from configurations (N, nq) or (nq,)."""
+        return self.layout.angles(q)
+
+    @cached_property
+    def layout(self) -> "JointLayout":
+        """Configuration layout of :attr:`actuated` in :attr:`model`."""
+        return _joint_layout(self.model, self.actuated)
+
+    @cached_property
+    def reference_angles(self) -> np.ndarray:
+        """Joint positions of :attr:`q_reference` (zeros if there is none), (n_act,)."""
+        return np.zeros(self.n_act) if self.q_reference is None else self.angles(self.q_reference)
+
+    @cached_property
+    def angle_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper joint position limits (n_act,) [rad]; +-inf for continuous joints."""
+        lo, hi = np.full(self.n_act, -np.inf), np.full(self.n_act, np.inf)
+        lay = self.layout
+        lo[lay.q1_joint] = self.model.lowerPositionLimit[lay.q1_index]
+        hi[lay.q1_joint] = self.model.upperPositionLimit[lay.q1_index]
+        return lo, hi
 
 
 @dataclass(frozen=True)
@@ -204,6 +227,17 @@ class JointLayout:
         q[:, self.q2_index] = np.cos(a[:, self.q2_joint])
         q[:, self.q2_index + 1] = np.sin(a[:, self.q2_joint])
         return q[0] if single else q
+
+    def angles(self, q: np.ndarray) -> np.ndarray:
+        """Inverse of :meth:`configuration` (without sign): joint positions from configurations."""
+        q = np.asarray(q, dtype=float)
+        single = q.ndim == 1
+        q = np.atleast_2d(q)
+        n_joints = len(self.q1_joint) + len(self.q2_joint)
+        a = np.empty((q.shape[0], n_joints))
+        a[:, self.q1_joint] = q[:, self.q1_index]
+        a[:, self.q2_joint] = np.arctan2(q[:, self.q2_index + 1], q[:, self.q2_index])
+        return a[0] if single else a
 
 
 def _joint_layout(model: pin.Model, joints: tuple[str, ...]) -> JointLayout:

@@ -62,10 +62,9 @@ class FixedFootScenario:
 def _amplitudes(robot: Robot, swing: set[str], amplitude: float) -> tuple[np.ndarray, np.ndarray]:
     """Reference amplitudes [rad] in single and double support, per actuated joint."""
     ss, ds = np.zeros(robot.n_act), np.zeros(robot.n_act)
-    lo = robot.model.lowerPositionLimit[robot.act_v_index + 1]
-    hi = robot.model.upperPositionLimit[robot.act_v_index + 1]
-    q0 = robot.q_reference[robot.act_v_index + 1] if robot.q_reference is not None else np.zeros(robot.n_act)
-    room = np.maximum(np.minimum(hi - q0, q0 - lo), 0.0)
+    lo, hi = robot.angle_limits
+    q0 = robot.reference_angles
+    room = np.minimum(np.maximum(np.minimum(hi - q0, q0 - lo), 0.0), np.pi)
     pc = set(robot.position_controlled)
     legs = set().union(*(robot.limb(f) for f in robot.contact_frames))
     for i, name in enumerate(robot.actuated):
@@ -84,8 +83,7 @@ class _Reference:
 
     def __init__(self, robot: Robot, scenario: FixedFootScenario, swing: set[str]):
         rng = np.random.default_rng(scenario.seed)
-        self.q0 = (robot.q_reference[robot.act_v_index + 1] if robot.q_reference is not None
-                   else np.zeros(robot.n_act))
+        self.q0 = robot.reference_angles
         self.amp_ss, self.amp_ds = _amplitudes(robot, swing, scenario.amplitude)
         n = robot.n_act
         f0 = scenario.frequency
