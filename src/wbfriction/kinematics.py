@@ -142,18 +142,29 @@ def measure(log: Log, diff: str = "central", *, compensate_delay: bool = True,
 
     Args:
         log: a validated :class:`~wbfriction.log.Log`.
-        diff: differentiation scheme, a key of :data:`DIFFERENTIATORS`.
+        diff: differentiation scheme, a key of :data:`DIFFERENTIATORS`, or ``"true"``:
+            the log's true velocities and accelerations (simulated logs), with the
+            torques as logged (``torque_alignment`` and delays do not apply).
         compensate_delay: shift the derivatives back by the scheme's delay so that they
             describe the same instant as the other inputs (thesis 6.1.2).
         torque_alignment: see :func:`align_torque`.
 
     Raises:
-        InputError: unknown scheme or alignment.
+        InputError: unknown scheme or alignment; ``"true"`` on a log without
+            ``qd_true``/``qdd_true`` columns.
     """
+    if diff == "true":
+        if log.qd_true is None or log.qdd_true is None:
+            raise InputError(f"{log.source}: diff 'true' needs the columns qd_true.* and qdd_true.* "
+                             "(written by the simulators)")
+        return MeasuredKinematics(time=log.time, q=log.q, qd=log.qd_true, qdd=log.qdd_true, tau=log.tau,
+                                  contact=log.contact, base=log.base, tau_f_true=log.tau_f_true,
+                                  metadata=dict(log.metadata))
     try:
         differentiate = DIFFERENTIATORS[diff]
     except KeyError:
-        raise InputError(f"unknown differentiation scheme '{diff}': choose one of {', '.join(DIFFERENTIATORS)}") from None
+        raise InputError(f"unknown differentiation scheme '{diff}': choose one of "
+                         f"{', '.join(DIFFERENTIATORS)}, true") from None
     qd, qdd, delay = differentiate(log.q, log.dt)
     if compensate_delay:
         qd, qdd = _shift_back(qd, delay), _shift_back(qdd, delay)

@@ -13,6 +13,9 @@ column                 unit        content
                                    x, y, z, w)
 ``tau_f_true.<joint>`` N·m         optional true friction (simulations only; never
                                    used by the estimator)
+``qd_true.<joint>``    rad/s       optional true velocity of every actuated joint
+``qdd_true.<joint>``   rad/s²      optional true acceleration (simulations only;
+                                   used only with ``diff="true"``)
 =====================  ==========  ==================================================
 
 Names are those of the model. ``tau.<joint>`` of a position-controlled joint is
@@ -54,6 +57,8 @@ class Log:
             logged, or None if no such column.
         metadata: the JSON metadata stored with the log.
         source: file the log came from.
+        qd_true, qdd_true: true joint velocities [rad/s] and accelerations [rad/s^2]
+            (N, n_act) (simulations only, for evaluation), or None.
     """
 
     time: np.ndarray
@@ -64,6 +69,8 @@ class Log:
     tau_f_true: np.ndarray | None = None
     metadata: dict = field(default_factory=dict)
     source: str = "<memory>"
+    qd_true: np.ndarray | None = None
+    qdd_true: np.ndarray | None = None
 
     @property
     def dt(self) -> float:
@@ -84,6 +91,9 @@ class Log:
         if self.tau_f_true is not None:
             cols.update({f"tau_f_true.{n}": self.tau_f_true[:, i] for i, n in enumerate(robot.torque_controlled)
                          if not np.all(np.isnan(self.tau_f_true[:, i]))})
+        for prefix, x in (("qd_true", self.qd_true), ("qdd_true", self.qdd_true)):
+            if x is not None:
+                cols.update({f"{prefix}.{n}": x[:, i] for i, n in enumerate(robot.actuated)})
         return with_metadata(pa.table(cols), self.metadata)
 
 
@@ -166,7 +176,8 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>") -> Lo
     frames = set(robot.contact_frames)
     for col in table.column_names:
         prefix, _, item = col.partition(".")
-        known = {"q": act, "tau": act, "tau_f_true": tc, "contact": frames}.get(prefix)
+        known = {"q": act, "tau": act, "tau_f_true": tc, "contact": frames, "qd_true": act,
+                 "qdd_true": act}.get(prefix)
         if known is not None and item not in known:
             what = "contact frame" if prefix == "contact" else "joint"
             raise InputError(f"{source}: column '{col}' names an unknown {what} '{item}' of robot '{robot.name}'")
@@ -203,7 +214,15 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>") -> Lo
         tau_f_true = np.column_stack([
             _column(table, f"tau_f_true.{n}", source) if f"tau_f_true.{n}" in names else np.full(len(time), np.nan)
             for n in robot.torque_controlled])
-    return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table), source)
+    truth = {}
+    for prefix in ("qd_true", "qdd_true"):
+        if any(c.startswith(prefix + ".") for c in names):
+            missing = [n for n in robot.actuated if f"{prefix}.{n}" not in names]
+            if missing:
+                raise InputError(f"{source}: missing column '{prefix}.{missing[0]}'")
+            truth[prefix] = np.column_stack([_column(table, f"{prefix}.{n}", source) for n in robot.actuated])
+    return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table), source,
+               qd_true=truth.get("qd_true"), qdd_true=truth.get("qdd_true"))
 
 
 def read_log(path: str | Path, robot: Robot) -> Log:

@@ -1,0 +1,128 @@
+"""Walking controller: constrained inverse dynamics feed-forward plus joint PD.
+
+Feed-forward (thesis 4.4 with the contact wrench as unknown): for the reference
+``(q, v, a)`` with the feet in contact ``c``, ``b = M a + h`` (``pin.rnea``) must equal
+``S^T tau + J_c^T lambda``. The six base rows fix the total contact wrench:
+``b_base = J_c,base^T lambda``. In single support ``J_c,base`` is square and ``lambda``
+unique; in double support the wrench is shared between the feet by the weighted
+minimum norm
+
+.. math:: \\lambda = W^{-1} J_b (J_b^T W^{-1} J_b)^{-1} b_{base}, \\quad W = \\mathrm{diag}(I_6/\\alpha_L, I_6/\\alpha_R),
+
+with ``alpha`` the share of each foot, from the position of the ZMP reference between
+the feet (1 on the foot the ZMP is over, 0 on the other). The joint torques are then
+``tau = b_joint - J_c,joint^T lambda``. Wrenches ``lambda`` are in each sole's LOCAL frame.
+
+PD gains come from each joint's effective inertia ``1 / G_jj``, with ``G`` the
+constrained inverse inertia (the inverse of the KKT matrix on the joint rows), for each
+contact state at the reference posture; the controller switches them with the state.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from ..robot import Robot
+
+
+def contact_jacobian(robot: Robot, data: pin.Data, contacts: np.ndarray) -> np.ndarray:
+    """Stacked 6D Jacobians (6 n_active, nv) of the active soles in their LOCAL frames.
+
+    Requires ``pin.computeJointJacobians`` and ``pin.updateFramePlacements`` on ``data``.
+    """
+    ids = [robot.contact_frame_ids[c] for c in np.flatnonzero(contacts)]
+    if not ids:
+        return np.zeros((0, robot.model.nv))
+    return np.vstack([pin.getFrameJacobian(robot.model, data, f, pin.LOCAL) for f in ids])
+
+
+def foot_shares(zmp: np.ndarray, feet_xy: np.ndarray) -> np.ndarray:
+    """Share (N, 2) of each foot in the contact wrench: the ZMP's position along the segment
+    between the feet, 1 on the foot it is over, clipped to [0, 1]."""
+    d = feet_xy[:, 0] - feet_xy[:, 1]
+    s = np.einsum("ij,ij->i", zmp - feet_xy[:, 1], d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-12)
+    s = np.clip(s, 0.0, 1.0)
+    return np.column_stack([s, 1.0 - s])
+
+
+def feedforward(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, contact: np.ndarray,
+                share: np.ndarray, min_share: float = 1e-3) -> tuple[np.ndarray, np.ndarray]:
+    """Joint torques and contact wrenches of a reference motion (module docstring).
+
+    Args:
+        q, v, a: reference configurations (N, nq), velocities and accelerations (N, nv).
+        contact: active contacts (N, n_contacts).
+        share: each foot's share of the wrench in double support (N, n_contacts).
+
+    Returns:
+        tau (N, n_act) [N·m] for every actuated joint, and the contact wrenches
+        (N, n_contacts, 6) (force [N], moment [N·m]) in the soles' LOCAL frames, zero
+        for feet not in contact.
+    """
+    model, data = robot.model, robot.model.createData()
+    iv = robot.act_v_index
+    n, nc = len(q), len(robot.contact_frames)
+    tau = np.zeros((n, robot.n_act))
+    wrench = np.zeros((n, nc, 6))
+    for k in range(n):
+        b = pin.rnea(model, data, q[k], v[k], a[k])
+        pin.computeJointJacobians(model, data, q[k])
+        pin.updateFramePlacements(model, data)
+        active = np.flatnonzero(contact[k])
+        Jc = contact_jacobian(robot, data, contact[k])
+        Jb = Jc[:, :6]
+        if len(active) == 1:
+            lam = np.linalg.solve(Jb.T, b[:6])
+        else:
+            w_inv = np.repeat(np.maximum(share[k, active], min_share), 6)
+            JW = Jb * w_inv[:, None]
+            lam = JW @ np.linalg.solve(Jb.T @ JW, b[:6])
+        tau[k] = b[iv] - Jc[:, iv].T @ lam
+        wrench[k, active] = lam.reshape(-1, 6)
+    return tau, wrench
+
+
+def constrained_inverse_inertia(robot: Robot, data: pin.Data, q: np.ndarray, contacts: np.ndarray) -> np.ndarray:
+    """``G`` (nv, nv): joint-space acceleration per unit generalised force with the active
+    soles fixed and the position-controlled joints locked (eq. 5.10 without the drift)."""
+    model = robot.model
+    M = pin.crba(model, data, q)
+    M = np.triu(M) + np.triu(M, 1).T
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    S_pc = np.zeros((robot.pc_index.size, model.nv))
+    S_pc[np.arange(robot.pc_index.size), robot.act_v_index[robot.pc_index]] = 1.0
+    J = np.vstack([contact_jacobian(robot, data, contacts), S_pc])
+    Minv = np.linalg.inv(M)
+    MJ = Minv @ J.T
+    return Minv - MJ @ np.linalg.solve(J @ MJ, MJ.T)
+
+
+def pd_gains(robot: Robot, q: np.ndarray, bandwidth: float, damping: float = 0.9
+             ) -> dict[tuple[bool, ...], tuple[np.ndarray, np.ndarray]]:
+    """PD gains per contact state, per torque-controlled joint: ``kp = I w^2``, ``kd = 2 zeta I w``
+    with ``w = 2 pi bandwidth`` and ``I = 1 / G_jj`` the joint's effective inertia in that state.
+
+    A stance leg carries the whole body as an inverted pendulum and needs the large gains
+    its large effective inertia gives; a swinging leg would go unstable with them at
+    1 kHz. The controller therefore switches gains with the contact state.
+
+    Args:
+        q: configuration at which the inertias are evaluated (the reference posture).
+        bandwidth: closed-loop bandwidth [Hz]; damping: ratio zeta.
+
+    Returns:
+        ``{contact flags: (kp [N·m/rad], kd [N·m·s/rad])}`` for double support and each
+        single support.
+    """
+    data = robot.model.createData()
+    nc = len(robot.contact_frames)
+    states = [np.ones(nc, bool)] + [np.eye(nc, dtype=bool)[c] for c in range(nc)]
+    iv_tc = robot.act_v_index[robot.tc_index]
+    w = 2 * np.pi * bandwidth
+    gains = {}
+    for s in states:
+        inertia = 1.0 / np.diag(constrained_inverse_inertia(robot, data, q, s))[iv_tc]
+        gains[tuple(bool(x) for x in s)] = (inertia * w**2, 2 * damping * inertia * w)
+    return gains

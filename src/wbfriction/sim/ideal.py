@@ -1,0 +1,250 @@
+"""The ideal simulator (thesis 6.1): rigid contacts solved exactly, friction (3.5) injected.
+
+Each physics step solves the constrained forward dynamics with ``pin.constraintDynamics``:
+every foot in contact is welded flat to the ground at its planned footprint (6D
+constraint, Baumgarte correction), and the position-controlled joints follow their
+reference exactly, as a constraint: their acceleration is set to the reference's (with
+the same Baumgarte correction), the torque that achieves it found from the same KKT
+factorisation (``constraint_chol.solve``). At touch-down the landing foot is anchored
+flat on the ground and the velocity projected onto the constraints
+(``pin.impulseDynamics``, plastic impact).
+
+The controller (:mod:`wbfriction.sim.control`) runs at the log rate ``1 / dt``; its torque
+is held over the period. Friction ``tau_f = -f(qd)`` of eq. (3.5) acts on the chosen joints
+at every physics step, from the velocity at the start of the step. Integration:
+
+* ``semi-implicit`` Euler: ``v+ = v + h a(q, v)``, ``q+ = q ⊕ h v+`` (default);
+* ``explicit`` (forward) Euler, as in the thesis: ``q+ = q ⊕ h v``, ``v+ = v + h a(q, v)``.
+
+The log carries the measured torques of the torque-controlled joints (the command: the
+torque sensor sits before the friction), the planned contact flags, the friction applied
+(``tau_f_true``), and the true joint velocities and accelerations at every sample
+(``qd_true``, ``qdd_true``), so that differentiation errors can be told apart from the
+estimator's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from ..exceptions import InputError
+from ..friction import FrictionParams, friction_by_group, smooth, stack_params
+from ..log import Log
+from ..robot import Robot
+from ..walking import WalkingReference
+from .control import feedforward, foot_shares, pd_gains
+
+INTEGRATORS = ("semi-implicit", "explicit")
+
+
+@dataclass(frozen=True)
+class IdealOptions:
+    """Parameters of :func:`simulate_ideal`.
+
+    Attributes:
+        substeps: physics steps per control period.
+        integrator: one of :data:`INTEGRATORS`.
+        bandwidth: joint PD bandwidth [Hz]; damping: its damping ratio.
+        gain_blend: time over which PD gains rise to those of a new contact state [s]
+            (a landing leg's small tracking error times the stance gains would
+            otherwise pull the foot on the ground); falling gains apply at once.
+        baumgarte: (Kp [1/s^2], Kd [1/s]) of the contact and position-control constraints.
+        log_base: write the base pose to the log.
+    """
+
+    substeps: int = 1
+    integrator: str = "semi-implicit"
+    bandwidth: float = 15.0
+    damping: float = 0.9
+    gain_blend: float = 0.1
+    baumgarte: tuple[float, float] = (400.0, 40.0)
+    log_base: bool = False
+
+    def __post_init__(self) -> None:
+        if self.integrator not in INTEGRATORS:
+            raise InputError(f"unknown integrator '{self.integrator}': choose one of {', '.join(INTEGRATORS)}")
+        if self.substeps < 1:
+            raise InputError(f"substeps must be at least 1, got {self.substeps}")
+
+
+@dataclass
+class Pull:
+    """An interval where a welded foot pulled on the ground (negative normal force)."""
+
+    frame: str
+    start: float
+    end: float
+    samples: int
+    min_force: float  # [N]
+
+
+@dataclass
+class SimulationResult:
+    """A simulated walk.
+
+    Attributes:
+        log: the log, in the project's format.
+        wrench: contact wrenches (N, n_contacts, 6) in the soles' LOCAL frames [N, N·m],
+            zero off contact; ``wrench[..., 2]`` is the normal force.
+        q: simulated configurations (N, nq); reference: the walking reference.
+    """
+
+    log: Log
+    wrench: np.ndarray
+    q: np.ndarray
+    reference: WalkingReference
+    contact_frames: tuple[str, ...] = field(default_factory=tuple)
+
+    def pulls(self, threshold: float = 0.0) -> list[Pull]:
+        """Intervals where a foot in contact had a normal force below ``threshold`` [N]."""
+        out = []
+        for c, frame in enumerate(self.contact_frames):
+            bad = self.log.contact[:, c] & (self.wrench[:, c, 2] < threshold)
+            edges = np.flatnonzero(np.diff(np.r_[0, bad.astype(np.int8), 0]))
+            for s, e in zip(edges[::2], edges[1::2]):
+                out.append(Pull(frame, float(self.log.time[s]), float(self.log.time[e - 1]), int(e - s),
+                                float(self.wrench[s:e, c, 2].min())))
+        return out
+
+
+def _anchor(feet_k: np.ndarray, c: int) -> pin.SE3:
+    """Planned footprint of foot ``c`` as a flat placement on the ground (z = 0)."""
+    x, y, _, yaw = feet_k[c]
+    cy, sy = np.cos(yaw), np.sin(yaw)
+    return pin.SE3(np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]]), np.array([x, y, 0.0]))
+
+
+def _constraints(robot: Robot, data: pin.Data, active: np.ndarray, anchors: dict[int, pin.SE3],
+                 baumgarte: tuple[float, float]):
+    models = []
+    for c in np.flatnonzero(active):
+        fr = robot.model.frames[robot.contact_frame_ids[c]]
+        cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_6D, robot.model, fr.parentJoint, fr.placement,
+                                      0, anchors[c], pin.LOCAL)
+        cm.setBaumgarteCorrectorParameters(pin.BaumgarteCorrectorParameters(*baumgarte))
+        models.append(cm)
+    datas = [cm.createData() for cm in models]
+    pin.initConstraintDynamics(robot.model, data, models, datas)
+    return models, datas
+
+
+def simulate_ideal(robot: Robot, reference: WalkingReference,
+                   friction: dict[str, FrictionParams] | None = None,
+                   options: IdealOptions = IdealOptions(), progress=None) -> SimulationResult:
+    """Simulate a walk in the ideal simulator (module docstring).
+
+    Args:
+        robot: the robot the reference was planned for.
+        reference: :func:`~wbfriction.walking.walking_reference` output.
+        friction: parameters per torque-controlled joint name; default: the thesis's
+            targets (Table 6.1) on the leg joint groups, none elsewhere.
+        options: :class:`IdealOptions`.
+        progress: optional callable receiving numbers of samples done.
+
+    Returns:
+        A :class:`SimulationResult` whose log has ``len(reference)`` samples.
+
+    Raises:
+        InputError: a friction entry for a joint that is not torque-controlled.
+    """
+    friction = friction_by_group(robot.groups) if friction is None else friction
+    for joint in friction:
+        if joint not in robot.torque_controlled:
+            raise InputError(f"friction given for '{joint}', which is not a torque-controlled joint")
+    model = robot.model
+    data = model.createData()
+    ref = reference
+    n, dt = len(ref), ref.dt
+    h = dt / options.substeps
+    nc = len(robot.contact_frames)
+
+    feet_xy = ref.feet[:, :, :2]
+    tau_ff, _ = feedforward(robot, ref.q, ref.v, ref.a, ref.contact, foot_shares(ref.zmp, feet_xy))
+    gains = pd_gains(robot, ref.q[0], options.bandwidth, options.damping)
+    bkp, bkd = options.baumgarte
+
+    iv = robot.act_v_index
+    tc, pc = robot.tc_index, robot.pc_index
+    iv_tc, iv_pc = iv[tc], iv[pc]
+    joints_f = [robot.torque_controlled.index(j) for j in friction]
+    params_f = stack_params(list(friction.values())) if joints_f else {}
+    iv_f = iv_tc[joints_f]
+    settings = pin.ProximalSettings(1e-12, 1e-10, 50)
+    semi_implicit = options.integrator == "semi-implicit"
+
+    Q = np.empty((n, model.nq))
+    rows = {"tau": np.empty((n, tc.size)), "tau_f": np.zeros((n, tc.size)), "qd": np.empty((n, robot.n_act)),
+            "qdd": np.empty((n, robot.n_act))}
+    wrench = np.zeros((n, nc, 6))
+    q, v = ref.q[0].copy(), ref.v[0].copy()
+    anchors: dict[int, pin.SE3] = {}
+    active = np.zeros(nc, bool)
+    tau_pc = tau_ff[0, pc].copy()
+    tau = np.zeros(model.nv)
+    for k in range(n):
+        if not np.array_equal(ref.contact[k], active):
+            landing = ref.contact[k] & ~active
+            for c in np.flatnonzero(landing):
+                anchors[c] = _anchor(ref.feet[k], c)
+            active = ref.contact[k].copy()
+            blend_to, k_switch = gains[tuple(bool(x) for x in active)], k
+            # gains that rise (a landing leg) ramp up; gains that fall (a lifting leg) drop at once
+            blend_from = blend_to if k == 0 else (np.minimum(kp, blend_to[0]), np.minimum(kd, blend_to[1]))
+            cmodels, cdatas = _constraints(robot, data, active, anchors, options.baumgarte)
+            if landing.any() and k > 0:
+                v = pin.impulseDynamics(model, data, q, v, cmodels, cdatas, 0.0, settings).copy()
+        n_lam = 6 * int(active.sum())
+        r = min(1.0, (k - k_switch) * dt / options.gain_blend) if options.gain_blend > 0 else 1.0
+        kp = blend_from[0] + r * (blend_to[0] - blend_from[0])
+        kd = blend_from[1] + r * (blend_to[1] - blend_from[1])
+        angles, qd = robot.angles(q), v[iv]
+        tau_cmd = tau_ff[k, tc] + kp * (ref.q[k, 7:][tc] - angles[tc]) + kd * (ref.v[k, iv_tc] - qd[tc])
+        for s in range(options.substeps):
+            tau[iv_tc] = tau_cmd
+            if joints_f:
+                tau_f = -smooth(v[iv_f], **params_f)
+                tau[iv_f] += tau_f
+            tau[iv_pc] = tau_pc
+            a = pin.constraintDynamics(model, data, q, v, tau, cmodels, cdatas, settings).copy()
+            lam = data.lambda_c.copy()
+            if pc.size:  # position-controlled joints: acceleration = reference, stabilised
+                a_des = (ref.a[k, iv_pc] + bkd * (ref.v[k, iv_pc] - v[iv_pc])
+                         + bkp * (ref.q[k, 7:][pc] - robot.angles(q)[pc]))
+                rhs = np.zeros((n_lam + model.nv, pc.size))
+                rhs[n_lam + iv_pc, np.arange(pc.size)] = 1.0
+                X = data.constraint_chol.solve(rhs)
+                delta = np.linalg.solve(X[n_lam + iv_pc], a_des - a[iv_pc])
+                a += X[n_lam:] @ delta
+                lam -= X[:n_lam] @ delta
+                tau_pc = tau_pc + delta
+            if s == 0:
+                Q[k] = q
+                rows["tau"][k] = tau_cmd
+                rows["qd"][k], rows["qdd"][k] = qd, a[iv]
+                if joints_f:
+                    rows["tau_f"][k, joints_f] = tau_f
+                wrench[k, active] = lam.reshape(-1, 6)
+            if semi_implicit:
+                v = v + h * a
+                q = pin.integrate(model, q, h * v)
+            else:
+                q = pin.integrate(model, q, h * v)
+                v = v + h * a
+        if progress is not None and (k + 1) % 500 == 0:
+            progress(500)
+    if progress is not None and n % 500:
+        progress(n % 500)
+
+    metadata = {
+        "generator": "wbfriction.sim.ideal.simulate_ideal",
+        "options": asdict(options),
+        "gait": asdict(ref.plan.options),
+        "friction_true": {j: p.to_dict() for j, p in friction.items()},
+    }
+    log = Log(ref.time.copy(), robot.angles(Q), rows["tau"], ref.contact.copy(),
+              Q[:, :7].copy() if options.log_base else None, rows["tau_f"], metadata,
+              source="simulate_ideal", qd_true=rows["qd"], qdd_true=rows["qdd"])
+    return SimulationResult(log, wrench, Q, ref, tuple(robot.contact_frames))

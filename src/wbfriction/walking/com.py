@@ -1,0 +1,92 @@
+"""ZMP reference and the linear-inverted-pendulum centre-of-mass trajectory.
+
+The linear inverted pendulum (Kajita et al., 2003) relates the horizontal centre of mass
+``c`` [m] at a constant height ``z_c`` to the zero-moment point ``p`` [m]:
+
+.. math:: p = c - \\ddot c / \\omega^2, \\qquad \\omega^2 = g / z_c.
+
+Instead of a causal preview controller, the whole trajectory is solved at once (the
+preview horizon is the whole walk): on the sampling grid, with ``c̈`` the central second
+difference, the banded least-squares problem
+
+.. math:: \\min_c \\sum_k \\| c_k - \\ddot c_k / \\omega^2 - p^{ref}_k \\|^2
+
+with the centre of mass at rest (zero velocity and acceleration) at both ends and starting
+over the first ZMP. Away from the ends the ZMP is tracked exactly; near them the ZMP
+deviates briefly, as it must to start and stop a pendulum.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
+
+from .footsteps import FootstepPlan
+
+GRAVITY = 9.81
+
+
+def zmp_reference(plan: FootstepPlan, time: np.ndarray, shift: float | None = None) -> np.ndarray:
+    """Piecewise-linear ZMP reference (N, 2) [m]: under the stance foot in single support,
+    moving linearly to the next stance foot in double support, between the feet at rest.
+
+    Args:
+        plan: the footstep plan (footprint x, y are the feet's centres).
+        time: sample times (N,) [s].
+        shift: duration of the first transfer from between the feet to the first stance
+            foot [s]; default: half the initial double support.
+    """
+    o = plan.options
+    shift = 0.5 * o.initial if shift is None else shift
+    feet = plan.initial_feet.copy()
+    keys: list[tuple[float, np.ndarray]] = [(0.0, feet[:, :2].mean(0))]
+    if plan.steps:
+        keys.append((plan.steps[0].lift_off - shift, feet[:, :2].mean(0)))
+    for s in plan.steps:
+        stance = feet[1 - s.foot, :2].copy()
+        keys += [(s.lift_off, stance), (s.touch_down, stance)]
+        feet[s.foot] = s.target
+    end = plan.steps[-1].touch_down + o.double_support if plan.steps else 0.0
+    keys += [(end, feet[:, :2].mean(0)), (max(plan.duration, end), feet[:, :2].mean(0))]
+    t_k = np.array([k[0] for k in keys])
+    p_k = np.array([k[1] for k in keys])
+    return np.stack([np.interp(time, t_k, p_k[:, i]) for i in range(2)], axis=1)
+
+
+def lipm_com(zmp: np.ndarray, dt: float, height: float, gravity: float = GRAVITY,
+             rest_weight: float = 1e4) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Centre-of-mass trajectory of the linear inverted pendulum for a ZMP reference.
+
+    Args:
+        zmp: ZMP reference (N, 2) [m], on a grid of period ``dt`` [s].
+        height: constant height ``z_c`` of the centre of mass above the ground [m].
+        rest_weight: weight of the rest conditions at both ends.
+
+    Returns:
+        c (N, 2) [m], its central-difference velocity (N, 2) [m/s] and acceleration
+        (N, 2) [m/s^2] (one-sided at the ends, where the pendulum is at rest).
+    """
+    zmp = np.asarray(zmp, dtype=float)
+    n = len(zmp)
+    k = 1.0 / (gravity / height * dt**2)
+    rows = sp.diags([-k * np.ones(n - 2), (1 + 2 * k) * np.ones(n - 2), -k * np.ones(n - 2)], [0, 1, 2],
+                    shape=(n - 2, n))
+    rhs = zmp[1:-1]
+    w = rest_weight
+    rest = sp.lil_matrix((6, n))
+    rest[0, 0] = w  # starts over the first ZMP
+    rest[1, [0, 1]] = [-w, w]  # zero velocity
+    rest[2, [0, 1, 2]] = [w, -2 * w, w]  # zero acceleration
+    rest[3, [n - 2, n - 1]] = [-w, w]
+    rest[4, [n - 3, n - 2, n - 1]] = [w, -2 * w, w]
+    rest[5, n - 1] = w
+    b_rest = np.zeros((6, 2))
+    b_rest[0], b_rest[5] = w * zmp[0], w * zmp[-1]
+    A = sp.vstack([rows, rest.tocsr()]).tocsc()
+    b = np.vstack([rhs, b_rest])
+    c = np.asarray(spsolve((A.T @ A).tocsc(), A.T @ b)).reshape(n, 2)
+    cd = np.gradient(c, dt, axis=0)
+    cdd = np.zeros_like(c)
+    cdd[1:-1] = (c[2:] - 2 * c[1:-1] + c[:-2]) / dt**2
+    return c, cd, cdd

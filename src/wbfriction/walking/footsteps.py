@@ -1,0 +1,190 @@
+"""Footstep plans and their contact timeline (thesis 6.2.2: 0.8 s single, 0.2 s double support).
+
+A plan is a list of steps. Each step lifts one foot at ``lift_off``, swings it for the
+single-support time and puts it down flat at ``target`` (a planar pose on the ground:
+x, y [m] in the world frame, yaw [rad] about the vertical). Between steps, both feet
+stand (double support). Gaits:
+
+* ``forward``: consecutive footprints ``step_length`` apart along the walking direction
+  (the swing foot travels twice that in mid-walk); the last step closes the feet.
+* ``sideways``: the leading foot steps ``step_width`` outward, then the trailing foot
+  follows by as much (every foot travels ``step_width``); positive: to the left.
+* ``turning``: footprints ``turn_length`` apart along an arc, the walking direction
+  turning by ``turn_angle`` per step; the last step closes the feet.
+* ``both``: ``steps`` forward, then ``steps`` sideways (the thesis's combined walk).
+
+Contact indices follow :attr:`Robot.contact_frames`: the plan needs two (left, right).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..exceptions import InputError
+
+GAITS = ("forward", "sideways", "both", "turning")
+
+
+@dataclass(frozen=True)
+class GaitOptions:
+    """Parameters of a walk (defaults: thesis 6.2.2, TALOS-sized lift height).
+
+    Attributes:
+        gait: one of :data:`GAITS`.
+        steps: number of steps (per direction for ``both``).
+        step_length: forward distance between consecutive footprints [m].
+        step_width: lateral displacement of each sideways step [m] (> 0: to the left).
+        turn_length: distance between consecutive footprints when turning [m].
+        turn_angle: change of heading per turning step [rad] (> 0: to the left).
+        single_support: swing duration [s].
+        double_support: double-support duration between steps [s].
+        initial: double support before the first step [s].
+        final: double support after the last step [s].
+        lift_height: apex of the swing foot above the ground [m].
+        com_height: height of the centre of mass above the ground [m]; None: the
+            reference posture's, lowered by ``com_lowering``.
+        com_lowering: lowering of the centre of mass from the reference posture [m].
+        pc_amplitude: amplitude of a slow sine on the position-controlled joints [rad].
+    """
+
+    gait: str = "forward"
+    steps: int = 10
+    step_length: float = 0.3
+    step_width: float = 0.25
+    turn_length: float = 0.15
+    turn_angle: float = 0.2
+    single_support: float = 0.8
+    double_support: float = 0.2
+    initial: float = 1.0
+    final: float = 1.0
+    lift_height: float = 0.05
+    com_height: float | None = None
+    com_lowering: float = 0.04
+    pc_amplitude: float = 0.2
+
+    def __post_init__(self) -> None:
+        if self.gait not in GAITS:
+            raise InputError(f"unknown gait '{self.gait}': choose one of {', '.join(GAITS)}")
+        if self.steps < 1:
+            raise InputError(f"steps must be at least 1, got {self.steps}")
+        for name in ("single_support", "double_support", "initial", "final"):
+            if getattr(self, name) <= 0:
+                raise InputError(f"{name} must be positive, got {getattr(self, name)}")
+
+
+@dataclass(frozen=True)
+class Step:
+    """One step: ``foot`` (contact index) leaves ``start`` at ``lift_off`` and lands on ``target``."""
+
+    foot: int
+    start: np.ndarray  # (3,) x, y, yaw
+    target: np.ndarray  # (3,) x, y, yaw
+    lift_off: float
+    touch_down: float
+
+
+@dataclass(frozen=True)
+class FootstepPlan:
+    """Initial foot poses and the steps, with the timeline they imply.
+
+    Attributes:
+        initial_feet: (2, 3) planar poses (x, y, yaw) of the two feet at t = 0.
+        steps: the steps in time order.
+        duration: total duration [s].
+        options: the :class:`GaitOptions` it was planned with.
+    """
+
+    initial_feet: np.ndarray
+    steps: tuple[Step, ...]
+    duration: float
+    options: GaitOptions = field(default_factory=GaitOptions)
+
+    def contact(self, time: np.ndarray) -> np.ndarray:
+        """Planned contact flags (N, 2): a foot is in contact unless it swings."""
+        time = np.asarray(time, dtype=float)
+        flags = np.ones((len(time), 2), dtype=bool)
+        for s in self.steps:
+            flags[(time >= s.lift_off) & (time < s.touch_down), s.foot] = False
+        return flags
+
+    def feet_at(self, t: float) -> np.ndarray:
+        """Planar poses (2, 3) of the feet's last footprints at time ``t`` (a swinging foot: its start)."""
+        feet = self.initial_feet.copy()
+        for s in self.steps:
+            if t < s.lift_off:
+                break
+            if t >= s.touch_down:
+                feet[s.foot] = s.target
+        return feet
+
+
+def _compose(frame: np.ndarray, local: np.ndarray) -> np.ndarray:
+    """Planar pose ``frame ⊕ local`` (x, y, yaw)."""
+    c, s = np.cos(frame[2]), np.sin(frame[2])
+    return np.array([frame[0] + c * local[0] - s * local[1], frame[1] + s * local[0] + c * local[1],
+                     frame[2] + local[2]])
+
+
+def _walk_targets(frame: np.ndarray, half_width: float, n: int, advance: np.ndarray,
+                  first: int) -> list[tuple[int, np.ndarray]]:
+    """Alternating steps: step i lands at frame_i ⊕ (0, ±w, 0), frame_i = frame ⊕ i·advance; the last closes."""
+    out, f = [], frame.copy()
+    for i in range(n):
+        foot = (first + i) % 2
+        if i < n - 1:
+            f = _compose(f, advance)
+        side = 1.0 if foot == 0 else -1.0
+        out.append((foot, _compose(f, np.array([0.0, side * half_width, 0.0]))))
+    return out
+
+
+def _sideways_targets(feet: np.ndarray, n: int, width: float) -> list[tuple[int, np.ndarray]]:
+    """Leading foot out by ``width`` along its own lateral axis, then the trailing foot by as much."""
+    lead = 0 if width > 0 else 1
+    out, pos = [], feet.copy()
+    for i in range(n):
+        foot = lead if i % 2 == 0 else 1 - lead
+        pos[foot] = _compose(pos[foot], np.array([0.0, width, 0.0]))
+        out.append((foot, pos[foot].copy()))
+    return out
+
+
+def plan_footsteps(initial_feet: np.ndarray, options: GaitOptions = GaitOptions()) -> FootstepPlan:
+    """Plan the steps of a gait from the initial foot poses (module docstring).
+
+    Args:
+        initial_feet: (2, 3) planar poses (x, y, yaw) of the left (0) and right (1) feet.
+        options: :class:`GaitOptions`.
+
+    Returns:
+        A :class:`FootstepPlan`; forward and turning walks start with the right foot,
+        sideways walks with the leading foot.
+    """
+    feet = np.asarray(initial_feet, dtype=float).copy()
+    if feet.shape != (2, 3):
+        raise InputError(f"initial_feet must be (2, 3) (x, y, yaw of two feet), got {feet.shape}")
+    o = options
+    half_width = 0.5 * float(np.hypot(*(feet[0, :2] - feet[1, :2])))
+    frame = 0.5 * (feet[0] + feet[1])
+    frame[2] = feet[0, 2]
+    targets: list[tuple[int, np.ndarray]] = []
+    if o.gait in ("forward", "both"):
+        targets += _walk_targets(frame, half_width, o.steps, np.array([o.step_length, 0.0, 0.0]), first=1)
+    if o.gait == "turning":
+        targets += _walk_targets(frame, half_width, o.steps, np.array([o.turn_length, 0.0, o.turn_angle]),
+                                 first=1 if o.turn_angle >= 0 else 0)
+    if o.gait in ("sideways", "both"):
+        now = feet.copy()
+        for foot, target in targets:
+            now[foot] = target
+        targets += _sideways_targets(now, o.steps, o.step_width)
+
+    steps, t, now = [], o.initial, feet.copy()
+    for foot, target in targets:
+        steps.append(Step(foot, now[foot].copy(), target, t, t + o.single_support))
+        now[foot] = target
+        t += o.single_support + o.double_support
+    duration = t - o.double_support + o.final
+    return FootstepPlan(feet, tuple(steps), duration, o)
