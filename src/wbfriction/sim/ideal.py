@@ -6,8 +6,11 @@ constraint, Baumgarte correction), and the position-controlled joints follow the
 reference exactly, as a constraint: their acceleration is set to the reference's (with
 the same Baumgarte correction), the torque that achieves it found from the same KKT
 factorisation (``constraint_chol.solve``). At touch-down the landing foot is anchored
-flat on the ground and the velocity projected onto the constraints
-(``pin.impulseDynamics``, plastic impact).
+flat on the ground where it lands (its position and heading, z = 0), the configuration
+projected onto that anchor (a tilt and height of micrometres). At every physics step the
+velocity is projected onto the constraints (``pin.impulseDynamics``: the plastic impact at
+touch-down, the integration drift otherwise), so the logged state satisfies ``J v = 0``
+exactly and the Baumgarte term only corrects the position drift.
 
 The controller (:mod:`wbfriction.sim.control`) runs at the log rate ``1 / dt``; its torque
 is held over the period. Friction ``tau_f = -f(qd)`` of eq. (3.5) acts on the chosen joints
@@ -20,7 +23,9 @@ The log carries the measured torques of the torque-controlled joints (the comman
 torque sensor sits before the friction), the planned contact flags, the friction applied
 (``tau_f_true``), and the true joint velocities and accelerations at every sample
 (``qd_true``, ``qdd_true``), so that differentiation errors can be told apart from the
-estimator's.
+estimator's. The true acceleration is the constrained dynamics' without the Baumgarte
+term (thesis 6.1.1: computed as in (5.10) with the friction added), which the stance
+foot's zero acceleration in the estimator assumes.
 """
 
 from __future__ import annotations
@@ -35,7 +40,7 @@ from ..friction import FrictionParams, friction_by_group, smooth, stack_params
 from ..log import Log
 from ..robot import Robot
 from ..walking import WalkingReference
-from .control import feedforward, foot_shares, pd_gains
+from .control import contact_jacobian, feedforward, foot_shares, pd_gains
 
 INTEGRATORS = ("semi-implicit", "explicit")
 
@@ -89,12 +94,14 @@ class SimulationResult:
         log: the log, in the project's format.
         wrench: contact wrenches (N, n_contacts, 6) in the soles' LOCAL frames [N, N·m],
             zero off contact; ``wrench[..., 2]`` is the normal force.
-        q: simulated configurations (N, nq); reference: the walking reference.
+        q: simulated configurations (N, nq); v: velocities (N, nv).
+        reference: the walking reference.
     """
 
     log: Log
     wrench: np.ndarray
     q: np.ndarray
+    v: np.ndarray
     reference: WalkingReference
     contact_frames: tuple[str, ...] = field(default_factory=tuple)
 
@@ -110,11 +117,32 @@ class SimulationResult:
         return out
 
 
-def _anchor(feet_k: np.ndarray, c: int) -> pin.SE3:
-    """Planned footprint of foot ``c`` as a flat placement on the ground (z = 0)."""
-    x, y, _, yaw = feet_k[c]
+def _landing_anchor(placement: pin.SE3) -> pin.SE3:
+    """Where a landing foot is welded: its touch-down position and heading, flat on the ground (z = 0)."""
+    R = placement.rotation
+    yaw = np.arctan2(R[1, 0], R[0, 0])
     cy, sy = np.cos(yaw), np.sin(yaw)
-    return pin.SE3(np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]]), np.array([x, y, 0.0]))
+    return pin.SE3(np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]]),
+                   np.array([placement.translation[0], placement.translation[1], 0.0]))
+
+
+def _project_configuration(robot: Robot, data: pin.Data, q: np.ndarray, contacts: np.ndarray,
+                           anchors: dict[int, pin.SE3], iterations: int = 3) -> np.ndarray:
+    """Move ``q`` by the least joint motion (position-controlled joints excluded) that puts
+    the active soles exactly on their anchors (Gauss-Newton on the 6D placement errors)."""
+    model = robot.model
+    cols = np.setdiff1d(np.arange(model.nv), robot.act_v_index[robot.pc_index])
+    for _ in range(iterations):
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        active = np.flatnonzero(contacts)
+        e = np.concatenate([pin.log6(anchors[c].actInv(data.oMf[robot.contact_frame_ids[c]])).vector
+                            for c in active])
+        J = contact_jacobian(robot, data, contacts)
+        dq = np.zeros(model.nv)
+        dq[cols] = -np.linalg.lstsq(J[:, cols], e, rcond=None)[0]
+        q = pin.integrate(model, q, dq)
+    return q
 
 
 def _constraints(robot: Robot, data: pin.Data, active: np.ndarray, anchors: dict[int, pin.SE3],
@@ -176,6 +204,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
     semi_implicit = options.integrator == "semi-implicit"
 
     Q = np.empty((n, model.nq))
+    V = np.empty((n, model.nv))
     rows = {"tau": np.empty((n, tc.size)), "tau_f": np.zeros((n, tc.size)), "qd": np.empty((n, robot.n_act)),
             "qdd": np.empty((n, robot.n_act))}
     wrench = np.zeros((n, nc, 6))
@@ -187,22 +216,26 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
     for k in range(n):
         if not np.array_equal(ref.contact[k], active):
             landing = ref.contact[k] & ~active
+            pin.framesForwardKinematics(model, data, q)
             for c in np.flatnonzero(landing):
-                anchors[c] = _anchor(ref.feet[k], c)
+                anchors[c] = _landing_anchor(data.oMf[robot.contact_frame_ids[c]])
             active = ref.contact[k].copy()
+            if landing.any():
+                q = _project_configuration(robot, data, q, active, anchors)
             blend_to, k_switch = gains[tuple(bool(x) for x in active)], k
             # gains that rise (a landing leg) ramp up; gains that fall (a lifting leg) drop at once
             blend_from = blend_to if k == 0 else (np.minimum(kp, blend_to[0]), np.minimum(kd, blend_to[1]))
             cmodels, cdatas = _constraints(robot, data, active, anchors, options.baumgarte)
-            if landing.any() and k > 0:
-                v = pin.impulseDynamics(model, data, q, v, cmodels, cdatas, 0.0, settings).copy()
         n_lam = 6 * int(active.sum())
         r = min(1.0, (k - k_switch) * dt / options.gain_blend) if options.gain_blend > 0 else 1.0
         kp = blend_from[0] + r * (blend_to[0] - blend_from[0])
         kd = blend_from[1] + r * (blend_to[1] - blend_from[1])
-        angles, qd = robot.angles(q), v[iv]
-        tau_cmd = tau_ff[k, tc] + kp * (ref.q[k, 7:][tc] - angles[tc]) + kd * (ref.v[k, iv_tc] - qd[tc])
         for s in range(options.substeps):
+            # velocity onto the constraints (plastic impact at touch-down, drift otherwise)
+            v = pin.impulseDynamics(model, data, q, v, cmodels, cdatas, 0.0, settings).copy()
+            if s == 0:
+                angles, qd = robot.angles(q), v[iv]
+                tau_cmd = tau_ff[k, tc] + kp * (ref.q[k, 7:][tc] - angles[tc]) + kd * (ref.v[k, iv_tc] - qd[tc])
             tau[iv_tc] = tau_cmd
             if joints_f:
                 tau_f = -smooth(v[iv_f], **params_f)
@@ -220,10 +253,13 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
                 a += X[n_lam:] @ delta
                 lam -= X[:n_lam] @ delta
                 tau_pc = tau_pc + delta
-            if s == 0:
-                Q[k] = q
+            if s == 0:  # the true acceleration: without the Baumgarte stabilisation term
+                stab = np.concatenate([bkp * cd.contact_placement_error.vector + bkd * cd.contact_velocity_error.vector
+                                       for cd in cdatas] + [np.zeros(model.nv)])
+                a_true = a + data.constraint_chol.solve(stab)[n_lam:]
+                Q[k], V[k] = q, v
                 rows["tau"][k] = tau_cmd
-                rows["qd"][k], rows["qdd"][k] = qd, a[iv]
+                rows["qd"][k], rows["qdd"][k] = qd, a_true[iv]
                 if joints_f:
                     rows["tau_f"][k, joints_f] = tau_f
                 wrench[k, active] = lam.reshape(-1, 6)
@@ -247,4 +283,4 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
     log = Log(ref.time.copy(), robot.angles(Q), rows["tau"], ref.contact.copy(),
               Q[:, :7].copy() if options.log_base else None, rows["tau_f"], metadata,
               source="simulate_ideal", qd_true=rows["qd"], qdd_true=rows["qdd"])
-    return SimulationResult(log, wrench, Q, ref, tuple(robot.contact_frames))
+    return SimulationResult(log, wrench, Q, V, ref, tuple(robot.contact_frames))
