@@ -22,25 +22,45 @@ def run(*args, cwd=None):
 
 @pytest.fixture(scope="module")
 def demo_dir(tmp_path_factory):
+    """simulate -> estimate -> fit, the main job's steps, on a short walk."""
     out = tmp_path_factory.mktemp("demo")
-    res = run("demo", "-o", out, "--duration", "2.0")
+    fr = out / "friction.toml"
+    fr.write_text("[friction.knee]\nF_v = 0.2\nF_c = 1.0\nS = 0.2\nv_s = 0.2\ntau_os = 1.0\na = 40\n"
+                  "[friction.leg_left_4_joint]\nF_c = 0.5\n")
+    res = run("simulate", "-o", out / "log.parquet", "--gait", "forward", "--steps", "3", "--friction", fr)
+    assert res.returncode == 0, res.stderr
+    res = run("estimate", out / "log.parquet", "-o", out / "friction.parquet")
+    assert res.returncode == 0, res.stderr
+    res = run("fit", out / "friction.parquet", "-o", out / "params.json")
     assert res.returncode == 0, res.stderr
     return out, res
 
 
-def test_demo_writes_log_friction_and_params(demo_dir):
+def test_main_job_steps_write_log_friction_and_params(demo_dir):
     out, res = demo_dir
     params = json.loads((out / "params.json").read_text())
     knee = params["joints"]["leg_right_4_joint"]
     assert knee["n_samples"] > 1000
     assert abs(knee["params"]["F_c"] - 1.0) < 0.05 and abs(knee["params"]["tau_os"] - 1.0) < 0.05
     assert knee["error_percent"]["F_c"] < 5
-    assert params["joints"]["leg_left_4_joint"]["params"] is None  # stance leg: no valid sample
+    # the joint's own TOML table overrides its group's
+    assert params["joints"]["leg_left_4_joint"]["target"]["F_c"] == 0.5
+    assert params["joints"]["leg_left_4_joint"]["target"]["F_v"] == 0.0
     assert "leg_right_4_joint" in res.stdout and "error [%]" in res.stdout
     table = pq.read_table(out / "friction.parquet")
     for col in ("time", "phase", "unique", "qd.leg_right_4_joint", "tau_f.leg_right_4_joint",
                 "valid.leg_right_4_joint", "tau_f_true.leg_right_4_joint"):
         assert col in table.column_names
+
+
+def test_demo_prints_the_thesis_table_and_writes_figures(tmp_path):
+    res = run("demo", "-o", tmp_path, "--steps", "2")
+    assert res.returncode == 0, res.stderr
+    assert "T6.2 [%]" in res.stdout and "leg_right_4_joint (knee)" in res.stdout
+    for name in ("fig6_1_support_phases.png", "fig6_2_schemes_time.png", "fig6_3_schemes_velocity.png",
+                 "friction_curves.png", "walk_params.json", "walk_friction.parquet"):
+        assert (tmp_path / name).stat().st_size > 1000, name
+    assert not list(tmp_path.glob(".*.tmp")), "temporary files left behind"
 
 
 def test_estimate_and_fit_commands_with_options(demo_dir, tmp_path):

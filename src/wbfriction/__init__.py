@@ -3,8 +3,9 @@
 Data flow: log (:mod:`~wbfriction.log`) -> measured kinematics
 (:mod:`~wbfriction.kinematics`) -> constrained dynamics (:mod:`~wbfriction.dynamics`,
 :mod:`~wbfriction.stance`) -> friction estimate (:mod:`~wbfriction.estimate`) ->
-identification (:mod:`~wbfriction.identify`); :mod:`~wbfriction.simulate` writes logs
-in the same format.
+identification (:mod:`~wbfriction.identify`). Beside it, :mod:`~wbfriction.walking`
+plans walks and :mod:`~wbfriction.sim` simulates them, writing logs in the same format;
+:mod:`~wbfriction.study` runs the thesis's simulation study.
 
 Sign convention: ``tau_f`` is the torque friction exerts on the joint,
 ``M qdd + h = S^T (tau + tau_f) + J^T lambda``; the model ``f(qd)`` of thesis eq. (3.5) is
@@ -20,10 +21,9 @@ from .identify import FitResult, fit_estimate, fit_friction  # noqa: E402
 from .kinematics import MeasuredKinematics, measure  # noqa: E402
 from .log import Log, read_log, write_log  # noqa: E402
 from .robot import Robot, load_robot  # noqa: E402
-from .simulate import FixedFootScenario, simulate_fixed_foot  # noqa: E402
 
 __all__ = [
-    "EstimateOptions", "FitResult", "FixedFootScenario", "FrictionEstimate", "FrictionParams", "InputError",
+    "EstimateOptions", "FitResult", "FrictionEstimate", "FrictionParams", "InputError",
     "Log", "MeasuredKinematics", "ModelError", "Robot", "WbfrictionError", "estimate_friction", "estimate_log",
-    "fit_estimate", "fit_friction", "load_robot", "measure", "read_log", "simulate_fixed_foot", "write_log",
+    "fit_estimate", "fit_friction", "load_robot", "measure", "read_log", "write_log",
 ]

@@ -1,7 +1,8 @@
 """Command-line interface: a thin layer over the library.
 
-Commands: ``simulate`` (a log with known friction), ``estimate`` (friction per sample),
-``fit`` (model 3.5 per joint), ``demo`` (all three on the built-in TALOS).
+Commands: ``simulate`` (a walk in the ideal simulator, with known friction), ``estimate``
+(friction per sample), ``fit`` (model 3.5 per joint), ``demo`` (the thesis's simulation
+study on the built-in TALOS).
 Bad input prints one line naming the file, column, row or option at fault and exits
 with status 2.
 """
@@ -11,6 +12,7 @@ from __future__ import annotations
 import hashlib
 import json
 import sys
+import time
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Optional
@@ -24,11 +26,12 @@ from rich.table import Table
 from . import __version__
 from .estimate import EstimateOptions, estimate_log
 from .exceptions import WbfrictionError
-from .friction import PARAM_NAMES
+from .friction import PARAM_NAMES, load_friction_toml
 from .identify import FitResult, fit_friction_table
 from .log import read_log, read_table, write_atomic, write_log, write_table
 from .robot import Robot, load_robot
-from .simulate import FixedFootScenario, simulate_fixed_foot
+from .sim import IdealOptions, simulate_ideal
+from .walking import GaitOptions, walking_reference
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Whole-body joint friction estimation for torque-controlled legged robots.")
@@ -89,16 +92,24 @@ def _write_params(results: list[FitResult], path: Path, provenance: dict) -> Non
 
 
 _E = EstimateOptions()  # one source of defaults: the library's
-_S = FixedFootScenario()
+_G = GaitOptions()
+_I = IdealOptions()
 _MIN_SAMPLES = 20
 
 
-def _run_simulate(r: Robot, output: Path, scenario: FixedFootScenario) -> None:
-    n = int(round(scenario.duration / scenario.dt))
-    with _progress(n, "simulate") as advance:
-        log = simulate_fixed_foot(r, scenario, progress=advance)
-    write_log(log, r, output)
-    console.print(f"wrote {output} ({len(log)} samples, {scenario.duration:g} s)")
+def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptions,
+                  friction: Optional[Path]) -> None:
+    params = None if friction is None else load_friction_toml(friction, r.groups, r.torque_controlled)
+    with _progress(1, "plan") as _:
+        console.print(f"planning {gait.steps} steps ({gait.gait})")
+        ref = walking_reference(r, gait)
+    with _progress(len(ref), "simulate") as advance:
+        result = simulate_ideal(r, ref, params, options, progress=advance)
+    write_log(result.log, r, output)
+    console.print(f"wrote {output} ({len(result.log)} samples, {result.log.time[-1]:.1f} s)")
+    for p in result.pulls():
+        console.print(f"[yellow]warning:[/] {p.frame} pulled on the ground from {p.start:.3f} s to {p.end:.3f} s "
+                      f"({p.samples} samples, down to {p.min_force:.1f} N)", highlight=False)
 
 
 def _run_estimate(r: Robot, log: Path, output: Path, opts: EstimateOptions) -> None:
@@ -124,15 +135,23 @@ def _run_fit(friction: Path, output: Path, min_samples: int) -> None:
 @app.command()
 def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write (.parquet or .csv)."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
-             duration: float = typer.Option(_S.duration, help="Length of the log [s]."),
-             double_support: float = typer.Option(_S.double_support, help="Initial double support [s]."),
-             substeps: int = typer.Option(_S.substeps, help="Physics steps per 1 ms control period."),
-             log_base: bool = typer.Option(_S.log_base, help="Write the base pose to the log."),
-             seed: int = typer.Option(_S.seed, help="Seed of the reference motion.")) -> None:
-    """Simulate one fixed stance foot, the other leg, arms and torso moving, with known friction."""
-    scenario = FixedFootScenario(duration=duration, double_support=double_support, substeps=substeps,
-                                 log_base=log_base, seed=seed)
-    _run_simulate(_robot(robot, urdf, config), output, scenario)
+             gait: str = typer.Option(_G.gait, help="forward, sideways, turning, both (forward + sideways) or "
+                                                    "combined (all three)."),
+             steps: int = typer.Option(_G.steps, help="Number of steps (per direction for both/combined)."),
+             step_length: float = typer.Option(_G.step_length, help="Forward distance between footprints [m]."),
+             step_width: float = typer.Option(_G.step_width, help="Sideways step [m]."),
+             turn_angle: float = typer.Option(_G.turn_angle, help="Heading change per turning step [rad]."),
+             lift_height: float = typer.Option(_G.lift_height, help="Swing-foot apex [m]."),
+             friction: Optional[Path] = typer.Option(None, help="TOML with [friction.<group or joint>] tables; "
+                                                               "default: thesis Table 6.1 on the legs."),
+             substeps: int = typer.Option(_I.substeps, help="Physics steps per 1 ms control period."),
+             integrator: str = typer.Option(_I.integrator, help="semi-implicit or explicit Euler."),
+             log_base: bool = typer.Option(_I.log_base, help="Write the base pose to the log.")) -> None:
+    """Simulate a walk in the ideal simulator (rigid contacts, thesis 6.1) with known friction."""
+    gait_opts = GaitOptions(gait=gait, steps=steps, step_length=step_length, step_width=step_width,
+                            turn_angle=turn_angle, lift_height=lift_height)
+    options = IdealOptions(substeps=substeps, integrator=integrator, log_base=log_base)
+    _run_simulate(_robot(robot, urdf, config), output, gait_opts, options, friction)
 
 
 @app.command()
@@ -168,18 +187,49 @@ def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wb
     _run_fit(friction, output, min_samples)
 
 
+def _study_table(result) -> Table:
+    """Tables 6.1/6.2 layout: per leg joint (thesis numbering) target, estimate, error, thesis errors."""
+    table = Table(title="Identified friction (3.5) of the leg joints, combined walk, central differences",
+                  caption="err: error to the target [%]; T6.1 / T6.2: the thesis's errors for the same joint "
+                          "(TORO, straight / straight and sideways)", box=None)
+    table.add_column("#", justify="right")
+    table.add_column("joint")
+    for name in PARAM_NAMES:
+        table.add_column(name, justify="right")
+    for row in result.rows:
+        fit = row.fit
+        err = fit.error_percent() or {}
+        table.add_row(str(row.number), f"{row.joint} ({row.group})",
+                      *[f"{getattr(fit.params, n):.4f}" if fit.params else "—" for n in PARAM_NAMES])
+        table.add_row("", "  target", *[f"{getattr(fit.target, n):.4g}" for n in PARAM_NAMES], style="dim")
+        table.add_row("", "  err [%]", *[f"{err.get(n, float('nan')):.2f}" for n in PARAM_NAMES], style="bold")
+        for label, ref in (("  T6.1 [%]", row.thesis_6_1), ("  T6.2 [%]", row.thesis_6_2)):
+            if ref is not None:
+                table.add_row("", label, *[f"{x:.2f}" for x in ref], style="dim")
+    return table
+
+
 @app.command()
 def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--output-dir", help="Where to write."),
          robot: str = RobotOpt,
-         duration: float = typer.Option(_S.duration, help="Length of the simulated log [s]."),
-         seed: int = typer.Option(_S.seed, help="Seed of the reference motion.")) -> None:
-    """Main job on a generated log: simulate TALOS with the thesis's friction, estimate, fit."""
-    output_dir.mkdir(parents=True, exist_ok=True)
-    log_path, fr_path, par_path = (output_dir / n for n in ("log.parquet", "friction.parquet", "params.json"))
+         steps: int = typer.Option(_G.steps, help="Steps per direction of the combined walk.")) -> None:
+    """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.3."""
+    from .study import run_study, worst_errors
+
+    start = time.perf_counter()
     r = _robot(robot, None, None)
-    _run_simulate(r, log_path, FixedFootScenario(duration=duration, seed=seed))
-    _run_estimate(r, log_path, fr_path, EstimateOptions())
-    _run_fit(fr_path, par_path, _MIN_SAMPLES)
+    with console.status("") as status:
+        result = run_study(r, output_dir, steps=steps, progress=lambda label: status.update(label))
+    out.print(_study_table(result))
+    worst = worst_errors(result.rows)
+    out.print("worst error over the leg joints [%]: " + ", ".join(f"{n} {worst[n]:.2f}" for n in PARAM_NAMES))
+    out.print(f"true accelerations: max |tau_f - tau_f_true| in single support = {result.truth_max_error:.2e} N·m")
+    out.print("right knee, RMS error [N·m] with the leg in swing / in stance: " + "; ".join(
+        f"{k} {a:.4f} / {b:.4f}" for k, (a, b) in result.knee_rms.items()))
+    out.print(f"samples where a welded foot pulled on the ground: {result.pulls}")
+    for f in result.files:
+        console.print(f"wrote {f}")
+    console.print(f"demo finished in {time.perf_counter() - start:.1f} s")
 
 
 def main() -> None:

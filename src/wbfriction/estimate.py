@@ -45,7 +45,8 @@ class EstimateOptions:
     Attributes:
         diff: differentiation scheme (``central`` or ``backward``, see :mod:`~wbfriction.kinematics`).
         compensate_delay: shift the derivatives by their delay (6.1.2).
-        torque_alignment: ``zoh`` (mean of tau[k-1], tau[k]) or ``sample``.
+        torque_alignment: ``zoh`` (mean of tau[k-1], tau[k]), ``sample``, or ``auto``
+            (what the log's metadata declares, else ``zoh``).
         lift_off_skip: seconds dropped after a lift-off [s] (6.2.1: 0.10).
         touch_down_skip: seconds dropped before a touch-down [s] (6.2.1: 0.05).
         mask: ``swing`` (a leg joint counts only while its leg swings) or ``single``.
@@ -60,7 +61,7 @@ class EstimateOptions:
 
     diff: str = "central"
     compensate_delay: bool = True
-    torque_alignment: str = "zoh"
+    torque_alignment: str = "auto"
     lift_off_skip: float = 0.10
     touch_down_skip: float = 0.05
     mask: str = "swing"

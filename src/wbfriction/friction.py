@@ -135,3 +135,48 @@ def friction_by_group(groups: dict[str, tuple[str, ...]],
                       targets: dict[str, FrictionParams] = THESIS_TARGETS) -> dict[str, FrictionParams]:
     """Per-joint friction parameters from per-group ones (joints of groups not in ``targets``: none)."""
     return {joint: targets[g] for g, joints in groups.items() if g in targets for joint in joints}
+
+
+def load_friction_toml(path, groups: dict[str, tuple[str, ...]], joints: tuple[str, ...]) -> dict[str, FrictionParams]:
+    """Friction parameters per joint from a TOML file.
+
+    Each table under ``[friction]`` is named after a joint group or a joint and gives the
+    parameters of (3.5) (missing ones take the :class:`FrictionParams` defaults); a joint's
+    own table overrides its group's::
+
+        [friction.knee]
+        F_v = 0.2
+        F_c = 1.0
+        [friction.leg_right_4_joint]
+        F_c = 1.5
+
+    Raises:
+        InputError: unreadable file, an unknown group, joint or parameter.
+    """
+    import tomllib
+    from pathlib import Path
+
+    from .exceptions import InputError
+
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text())
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise InputError(f"{path}: {exc}") from exc
+    table = doc.get("friction")
+    if not isinstance(table, dict):
+        raise InputError(f"{path}: no [friction] table")
+    out: dict[str, FrictionParams] = {}
+    for is_group in (True, False):  # groups first, joints override
+        for name, values in table.items():
+            if (name in groups) != is_group:
+                continue
+            if not is_group and name not in joints:
+                raise InputError(f"{path}: [friction.{name}] names neither a joint group nor a joint")
+            try:
+                params = FrictionParams.from_dict(values)
+            except (ValueError, TypeError) as exc:
+                raise InputError(f"{path}: [friction.{name}]: {exc}") from exc
+            for joint in (groups[name] if is_group else (name,)):
+                out[joint] = params
+    return out

@@ -22,7 +22,10 @@ makes the central second difference at ``k`` see the mean of ``tau[k-1]`` and
 ``tau[k]``: with piecewise-constant acceleration ``a`` over each period,
 ``(q[k+1] - 2 q[k] + q[k-1]) / dt^2 = (a[k-1] + a[k]) / 2``. The default alignment
 ``"zoh"`` therefore compares the acceleration with that mean; ``"sample"`` uses
-``tau[k]`` (right for torques sampled from a continuous signal).
+``tau[k]`` (right for torques sampled from a continuous signal, and for a simulator that
+integrates with semi-implicit Euler at the log rate, where the central second difference
+at ``k`` is exactly the acceleration caused by ``tau[k]``). ``"auto"`` takes what the log's
+metadata declares (the simulators write it), else ``"zoh"``.
 """
 
 from __future__ import annotations
@@ -137,7 +140,7 @@ class MeasuredKinematics:
 
 
 def measure(log: Log, diff: str = "central", *, compensate_delay: bool = True,
-            torque_alignment: str = "zoh") -> MeasuredKinematics:
+            torque_alignment: str = "auto") -> MeasuredKinematics:
     """Differentiate a log's joint positions and align the other signals (6.1.2).
 
     Args:
@@ -147,7 +150,8 @@ def measure(log: Log, diff: str = "central", *, compensate_delay: bool = True,
             torques as logged (``torque_alignment`` and delays do not apply).
         compensate_delay: shift the derivatives back by the scheme's delay so that they
             describe the same instant as the other inputs (thesis 6.1.2).
-        torque_alignment: see :func:`align_torque`.
+        torque_alignment: see :func:`align_torque`; ``"auto"``: the log's metadata key
+            ``torque_alignment`` when a simulator wrote one, else ``"zoh"``.
 
     Raises:
         InputError: unknown scheme or alignment; ``"true"`` on a log without
@@ -165,6 +169,8 @@ def measure(log: Log, diff: str = "central", *, compensate_delay: bool = True,
     except KeyError:
         raise InputError(f"unknown differentiation scheme '{diff}': choose one of "
                          f"{', '.join(DIFFERENTIATORS)}, true") from None
+    if torque_alignment == "auto":
+        torque_alignment = log.metadata.get("torque_alignment", "zoh")
     qd, qdd, delay = differentiate(log.q, log.dt)
     if compensate_delay:
         qd, qdd = _shift_back(qd, delay), _shift_back(qdd, delay)

@@ -47,7 +47,7 @@ def foot_shares(zmp: np.ndarray, feet_xy: np.ndarray) -> np.ndarray:
 
 
 def feedforward(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, contact: np.ndarray,
-                share: np.ndarray, min_share: float = 1e-3) -> tuple[np.ndarray, np.ndarray]:
+                share: np.ndarray, min_share: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
     """Joint torques and contact wrenches of a reference motion (module docstring).
 
     Args:

@@ -27,7 +27,8 @@ from .footsteps import FootstepPlan
 GRAVITY = 9.81
 
 
-def zmp_reference(plan: FootstepPlan, time: np.ndarray, shift: float | None = None) -> np.ndarray:
+def zmp_reference(plan: FootstepPlan, time: np.ndarray, shift: float | None = None,
+                  same_foot_share: float = 0.25) -> np.ndarray:
     """Piecewise-linear ZMP reference (N, 2) [m]: under the stance foot in single support,
     moving linearly to the next stance foot in double support, between the feet at rest.
 
@@ -36,6 +37,9 @@ def zmp_reference(plan: FootstepPlan, time: np.ndarray, shift: float | None = No
         time: sample times (N,) [s].
         shift: duration of the first transfer from between the feet to the first stance
             foot [s]; default: half the initial double support.
+        same_foot_share: when the same foot steps twice in a row (reversing a sideways
+            walk), the ZMP moves this fraction of the way to the landed foot and back
+            during the double support between, so that the landed foot carries load.
     """
     o = plan.options
     shift = 0.5 * o.initial if shift is None else shift
@@ -43,10 +47,13 @@ def zmp_reference(plan: FootstepPlan, time: np.ndarray, shift: float | None = No
     keys: list[tuple[float, np.ndarray]] = [(0.0, feet[:, :2].mean(0))]
     if plan.steps:
         keys.append((plan.steps[0].lift_off - shift, feet[:, :2].mean(0)))
-    for s in plan.steps:
+    for i, s in enumerate(plan.steps):
         stance = feet[1 - s.foot, :2].copy()
         keys += [(s.lift_off, stance), (s.touch_down, stance)]
         feet[s.foot] = s.target
+        nxt = plan.steps[i + 1] if i + 1 < len(plan.steps) else None
+        if nxt is not None and nxt.foot == s.foot:  # the same foot again: load it briefly
+            keys.append((0.5 * (s.touch_down + nxt.lift_off), stance + same_foot_share * (s.target[:2] - stance)))
     end = plan.steps[-1].touch_down + o.double_support if plan.steps else 0.0
     keys += [(end, feet[:, :2].mean(0)), (max(plan.duration, end), feet[:, :2].mean(0))]
     t_k = np.array([k[0] for k in keys])

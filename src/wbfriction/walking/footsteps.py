@@ -8,10 +8,16 @@ stand (double support). Gaits:
 * ``forward``: consecutive footprints ``step_length`` apart along the walking direction
   (the swing foot travels twice that in mid-walk); the last step closes the feet.
 * ``sideways``: the leading foot steps ``step_width`` outward, then the trailing foot
-  follows by as much (every foot travels ``step_width``); positive: to the left.
+  follows by as much (every foot travels ``step_width``); about half of the steps (an
+  even number) go to the left (``step_width > 0``), the rest back, so that every joint
+  moves both ways.
 * ``turning``: footprints ``turn_length`` apart along an arc, the walking direction
-  turning by ``turn_angle`` per step; the last step closes the feet.
-* ``both``: ``steps`` forward, then ``steps`` sideways (the thesis's combined walk).
+  turning by ``turn_angle`` per step, to the left for the first half of the steps and
+  back to the right for the second (a swinging hip yaw moves one way per turn direction);
+  each half ends by closing the feet.
+* ``both``: ``steps`` forward, then ``steps`` sideways (the thesis's walk of Table 6.2).
+* ``combined``: ``steps`` forward, sideways and turning: every leg joint, the hip yaw
+  included, moves both ways in swing (the demo's walk).
 
 Contact indices follow :attr:`Robot.contact_frames`: the plan needs two (left, right).
 """
@@ -24,7 +30,7 @@ import numpy as np
 
 from ..exceptions import InputError
 
-GAITS = ("forward", "sideways", "both", "turning")
+GAITS = ("forward", "sideways", "turning", "both", "combined")
 
 
 @dataclass(frozen=True)
@@ -54,7 +60,7 @@ class GaitOptions:
     step_length: float = 0.3
     step_width: float = 0.25
     turn_length: float = 0.15
-    turn_angle: float = 0.2
+    turn_angle: float = 0.35
     single_support: float = 0.8
     double_support: float = 0.2
     initial: float = 1.0
@@ -170,16 +176,29 @@ def plan_footsteps(initial_feet: np.ndarray, options: GaitOptions = GaitOptions(
     frame = 0.5 * (feet[0] + feet[1])
     frame[2] = feet[0, 2]
     targets: list[tuple[int, np.ndarray]] = []
-    if o.gait in ("forward", "both"):
-        targets += _walk_targets(frame, half_width, o.steps, np.array([o.step_length, 0.0, 0.0]), first=1)
-    if o.gait == "turning":
-        targets += _walk_targets(frame, half_width, o.steps, np.array([o.turn_length, 0.0, o.turn_angle]),
-                                 first=1 if o.turn_angle >= 0 else 0)
-    if o.gait in ("sideways", "both"):
-        now = feet.copy()
+    def now() -> np.ndarray:
+        pos = feet.copy()
         for foot, target in targets:
-            now[foot] = target
-        targets += _sideways_targets(now, o.steps, o.step_width)
+            pos[foot] = target
+        return pos
+
+    def mid_frame(pos: np.ndarray) -> np.ndarray:
+        f = 0.5 * (pos[0] + pos[1])
+        f[2] = pos[0, 2]
+        return f
+
+    if o.gait in ("forward", "both", "combined"):
+        targets += _walk_targets(frame, half_width, o.steps, np.array([o.step_length, 0.0, 0.0]), first=1)
+    if o.gait in ("sideways", "both", "combined"):
+        half = min(o.steps, 2 * ((o.steps + 3) // 4))  # even: the feet are back together
+        targets += _sideways_targets(now(), half, o.step_width)
+        targets += _sideways_targets(now(), o.steps - half, -o.step_width)
+    if o.gait in ("turning", "combined"):
+        half = (o.steps + 1) // 2
+        for n, angle in ((half, o.turn_angle), (o.steps - half, -o.turn_angle)):
+            if n:
+                targets += _walk_targets(mid_frame(now()), half_width, n,
+                                         np.array([o.turn_length, 0.0, angle]), first=1 if angle >= 0 else 0)
 
     steps, t, now = [], o.initial, feet.copy()
     for foot, target in targets:
