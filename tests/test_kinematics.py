@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, strategies as st
 
 from wbfriction.exceptions import InputError
-from wbfriction.kinematics import align_torque, backward_differences, central_differences, measure
+from wbfriction.kinematics import align_torque, central_differences, measure
 from wbfriction.log import Log
 from wbfriction.phases import joint_mask, segment
 

@@ -100,8 +100,7 @@ _MIN_SAMPLES = 20
 def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptions,
                   friction: Optional[Path]) -> None:
     params = None if friction is None else load_friction_toml(friction, r.groups, r.torque_controlled)
-    with _progress(1, "plan") as _:
-        console.print(f"planning {gait.steps} steps ({gait.gait})")
+    with console.status(f"planning {gait.steps} steps ({gait.gait})"):
         ref = walking_reference(r, gait)
     with _progress(len(ref), "simulate") as advance:
         result = simulate_ideal(r, ref, params, options, progress=advance)

@@ -161,20 +161,19 @@ def measure(log: Log, diff: str = "central", *, compensate_delay: bool = True,
         if log.qd_true is None or log.qdd_true is None:
             raise InputError(f"{log.source}: diff 'true' needs the columns qd_true.* and qdd_true.* "
                              "(written by the simulators)")
-        return MeasuredKinematics(time=log.time, q=log.q, qd=log.qd_true, qdd=log.qdd_true, tau=log.tau,
-                                  contact=log.contact, base=log.base, tau_f_true=log.tau_f_true,
-                                  metadata=dict(log.metadata))
-    try:
-        differentiate = DIFFERENTIATORS[diff]
-    except KeyError:
-        raise InputError(f"unknown differentiation scheme '{diff}': choose one of "
-                         f"{', '.join(DIFFERENTIATORS)}, true") from None
-    if torque_alignment == "auto":
-        torque_alignment = log.metadata.get("torque_alignment", "zoh")
-    qd, qdd, delay = differentiate(log.q, log.dt)
-    if compensate_delay:
-        qd, qdd = _shift_back(qd, delay), _shift_back(qdd, delay)
+        qd, qdd, tau = log.qd_true, log.qdd_true, log.tau
+    else:
+        try:
+            differentiate = DIFFERENTIATORS[diff]
+        except KeyError:
+            raise InputError(f"unknown differentiation scheme '{diff}': choose one of "
+                             f"{', '.join(DIFFERENTIATORS)}, true") from None
+        if torque_alignment == "auto":
+            torque_alignment = log.metadata.get("torque_alignment", "zoh")
+        qd, qdd, delay = differentiate(log.q, log.dt)
+        if compensate_delay:
+            qd, qdd = _shift_back(qd, delay), _shift_back(qdd, delay)
+        tau = align_torque(log.tau, torque_alignment)
     return MeasuredKinematics(
-        time=log.time, q=log.q, qd=qd, qdd=qdd, tau=align_torque(log.tau, torque_alignment),
-        contact=log.contact, base=log.base, tau_f_true=log.tau_f_true,
-        metadata=dict(log.metadata))
+        time=log.time, q=log.q, qd=qd, qdd=qdd, tau=tau, contact=log.contact, base=log.base,
+        tau_f_true=log.tau_f_true, metadata=dict(log.metadata))

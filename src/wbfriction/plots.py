@@ -16,7 +16,7 @@ from .estimate import FrictionEstimate
 from .identify import FitResult
 from .log import write_atomic
 
-_PHASE_COLORS = {"double": "#dddddd", "none": "#ffdddd"}
+_DOUBLE_SUPPORT_COLOR = "#dddddd"
 
 
 def _save(fig: Figure, path: str | Path) -> None:
@@ -27,7 +27,7 @@ def _shade_double_support(ax, est: FrictionEstimate) -> None:
     ds = est.contact.all(axis=1)
     edges = np.flatnonzero(np.diff(np.r_[0, ds.astype(np.int8), 0]))
     for s, e in zip(edges[::2], edges[1::2]):
-        ax.axvspan(est.time[s], est.time[e - 1], color=_PHASE_COLORS["double"], lw=0)
+        ax.axvspan(est.time[s], est.time[e - 1], color=_DOUBLE_SUPPORT_COLOR, lw=0)
 
 
 def support_phases_figure(est: FrictionEstimate, joints: list[str], path: str | Path,

@@ -127,6 +127,20 @@ class Robot:
         return np.array([self.model.idx_vs[self.model.getJointId(n)] for n in self.actuated], dtype=int)
 
     @cached_property
+    def act_q_index(self) -> np.ndarray:
+        """Configuration indices (into ``q``) of the actuated joints (n_act,), for robots whose
+        actuated joints all have one coordinate (revolute or prismatic).
+
+        Raises:
+            ModelError: an actuated joint with more coordinates (a continuous joint).
+        """
+        from .exceptions import ModelError
+
+        if len(self.layout.q2_joint):
+            raise ModelError(f"robot '{self.name}': continuous joints are not supported here")
+        return np.array([self.model.idx_qs[self.model.getJointId(n)] for n in self.actuated], dtype=int)
+
+    @cached_property
     def contact_frame_ids(self) -> tuple[int, ...]:
         """Pinocchio frame ids of :attr:`contact_frames`."""
         return tuple(int(self.model.getFrameId(f)) for f in self.contact_frames)

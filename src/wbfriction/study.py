@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .estimate import EstimateOptions, FrictionEstimate, estimate_log
+from .estimate import EstimateOptions, estimate_log
 from .friction import PARAM_NAMES, THESIS_TARGETS, FrictionParams
 from .identify import FitResult, fit_estimate
 from .log import write_atomic, write_log, write_table

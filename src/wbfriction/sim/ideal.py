@@ -42,6 +42,7 @@ from ..friction import FrictionParams, friction_by_group, smooth, stack_params
 from ..log import Log
 from ..robot import Robot
 from ..walking import WalkingReference
+from ..walking.swing import foot_placement
 from .control import contact_jacobian, feedforward, foot_shares, pd_gains
 
 INTEGRATORS = ("semi-implicit", "explicit")
@@ -124,13 +125,6 @@ class SimulationResult:
                 out.append(Pull(frame, float(self.log.time[s]), float(self.log.time[e - 1]), int(e - s),
                                 float(self.wrench[s:e, c, 2].min())))
         return out
-
-
-def _anchor(feet_k: np.ndarray, c: int) -> pin.SE3:
-    """Planned footprint of foot ``c`` as a flat placement on the ground (z = 0)."""
-    x, y, _, yaw = feet_k[c]
-    cy, sy = np.cos(yaw), np.sin(yaw)
-    return pin.SE3(np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]]), np.array([x, y, 0.0]))
 
 
 def _project_configuration(robot: Robot, data: pin.Data, q: np.ndarray, contacts: np.ndarray,
@@ -219,10 +213,9 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
     iv_f = iv_tc[joints_f]
     settings = pin.ProximalSettings(1e-12, 1e-10, 50)
     semi_implicit = options.integrator == "semi-implicit"
-    iq = np.array([model.joints[model.getJointId(j)].idx_q for j in robot.actuated])
-    if any(model.joints[model.getJointId(j)].nq != 1 for j in robot.actuated):
-        raise InputError(f"robot '{robot.name}': the ideal simulator handles one-coordinate joints only")
+    iq = robot.act_q_index
     iq_pc = iq[pc]
+    ref_angles = ref.q[:, iq]
 
     Q = np.empty((n, model.nq))
     V = np.empty((n, model.nv))
@@ -234,17 +227,18 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
     active = np.zeros(nc, bool)
     tau_pc = tau_ff[0, pc].copy()
     tau = np.zeros(model.nv)
+    kp, kd = gains[tuple(bool(x) for x in ref.contact[0])]
     for k in range(n):
         if not np.array_equal(ref.contact[k], active):
             landing = ref.contact[k] & ~active
             for c in np.flatnonzero(landing):
-                anchors[c] = _anchor(ref.feet[k], c)
+                anchors[c] = foot_placement(ref.feet[k, c])  # planned footprint, flat, z = 0
             active = ref.contact[k].copy()
             if landing.any():
                 q = _project_configuration(robot, data, q, active, anchors)
             blend_to, k_switch = gains[tuple(bool(x) for x in active)], k
             # gains that rise (a landing leg) ramp up; gains that fall (a lifting leg) drop at once
-            blend_from = blend_to if k == 0 else (np.minimum(kp, blend_to[0]), np.minimum(kd, blend_to[1]))
+            blend_from = (np.minimum(kp, blend_to[0]), np.minimum(kd, blend_to[1]))
             cmodels, cdatas = _constraints(robot, data, active, anchors, options.baumgarte)
         n_lam = 6 * int(active.sum())
         r = min(1.0, (k - k_switch) * dt / options.gain_blend) if options.gain_blend > 0 else 1.0
@@ -256,7 +250,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
                 v = pin.impulseDynamics(model, data, q, v, cmodels, cdatas, 0.0, settings).copy()
             if s == 0:
                 angles, qd = q[iq], v[iv]
-                tau_cmd = tau_ff[k, tc] + kp * (ref.q[k, 7:][tc] - angles[tc]) + kd * (ref.v[k, iv_tc] - qd[tc])
+                tau_cmd = tau_ff[k, tc] + kp * (ref_angles[k, tc] - angles[tc]) + kd * (ref.v[k, iv_tc] - qd[tc])
             tau[iv_tc] = tau_cmd
             if joints_f:
                 tau_f = -smooth(v[iv_f], **params_f)
@@ -274,7 +268,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
             X = data.constraint_chol.solve(rhs)
             if pc.size:  # position-controlled joints: acceleration = reference, stabilised
                 a_des = (ref.a[k, iv_pc] + bkd * (ref.v[k, iv_pc] - v[iv_pc])
-                         + bkp * (ref.q[k, 7:][pc] - q[iq_pc]))
+                         + bkp * (ref_angles[k, pc] - q[iq_pc]))
                 delta = _solve_small(X[n_lam + iv_pc, :-1], a_des - a[iv_pc])
                 a += X[n_lam:, :-1] @ delta
                 lam -= X[:n_lam, :-1] @ delta
@@ -307,7 +301,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
         # acceleration tau[k] caused; otherwise the torque is held over several steps
         "torque_alignment": "sample" if semi_implicit and options.substeps == 1 else "zoh",
     }
-    log = Log(ref.time.copy(), robot.angles(Q), rows["tau"], ref.contact.copy(),
+    log = Log(ref.time.copy(), Q[:, iq], rows["tau"], ref.contact.copy(),
               Q[:, :7].copy() if options.log_base else None, rows["tau_f"], metadata,
               source="simulate_ideal", qd_true=rows["qd"], qdd_true=rows["qdd"])
     return SimulationResult(log, wrench, Q, V, ref, tuple(robot.contact_frames))

@@ -115,15 +115,12 @@ class FootstepPlan:
             flags[(time >= s.lift_off) & (time < s.touch_down), s.foot] = False
         return flags
 
-    def feet_at(self, t: float) -> np.ndarray:
-        """Planar poses (2, 3) of the feet's last footprints at time ``t`` (a swinging foot: its start)."""
-        feet = self.initial_feet.copy()
-        for s in self.steps:
-            if t < s.lift_off:
-                break
-            if t >= s.touch_down:
-                feet[s.foot] = s.target
-        return feet
+
+def _mid_frame(feet: np.ndarray) -> np.ndarray:
+    """Walking frame between two planar foot poses: their mean position, the left foot's heading."""
+    f = 0.5 * (feet[0] + feet[1])
+    f[2] = feet[0, 2]
+    return f
 
 
 def _compose(frame: np.ndarray, local: np.ndarray) -> np.ndarray:
@@ -173,22 +170,16 @@ def plan_footsteps(initial_feet: np.ndarray, options: GaitOptions = GaitOptions(
         raise InputError(f"initial_feet must be (2, 3) (x, y, yaw of two feet), got {feet.shape}")
     o = options
     half_width = 0.5 * float(np.hypot(*(feet[0, :2] - feet[1, :2])))
-    frame = 0.5 * (feet[0] + feet[1])
-    frame[2] = feet[0, 2]
     targets: list[tuple[int, np.ndarray]] = []
+
     def now() -> np.ndarray:
         pos = feet.copy()
         for foot, target in targets:
             pos[foot] = target
         return pos
 
-    def mid_frame(pos: np.ndarray) -> np.ndarray:
-        f = 0.5 * (pos[0] + pos[1])
-        f[2] = pos[0, 2]
-        return f
-
     if o.gait in ("forward", "both", "combined"):
-        targets += _walk_targets(frame, half_width, o.steps, np.array([o.step_length, 0.0, 0.0]), first=1)
+        targets += _walk_targets(_mid_frame(feet), half_width, o.steps, np.array([o.step_length, 0.0, 0.0]), first=1)
     if o.gait in ("sideways", "both", "combined"):
         half = min(o.steps, 2 * ((o.steps + 3) // 4))  # even: the feet are back together
         targets += _sideways_targets(now(), half, o.step_width)
@@ -197,7 +188,7 @@ def plan_footsteps(initial_feet: np.ndarray, options: GaitOptions = GaitOptions(
         half = (o.steps + 1) // 2
         for n, angle in ((half, o.turn_angle), (o.steps - half, -o.turn_angle)):
             if n:
-                targets += _walk_targets(mid_frame(now()), half_width, n,
+                targets += _walk_targets(_mid_frame(now()), half_width, n,
                                          np.array([o.turn_length, 0.0, angle]), first=1 if angle >= 0 else 0)
 
     steps, t, now = [], o.initial, feet.copy()

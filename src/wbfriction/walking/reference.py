@@ -26,7 +26,7 @@ from ..exceptions import InputError, ModelError
 from ..robot import Robot
 from .com import lipm_com, zmp_reference
 from .footsteps import FootstepPlan, GaitOptions, plan_footsteps
-from .swing import feet_trajectory, quintic
+from .swing import feet_trajectory, foot_placement, quintic
 
 LWA = pin.LOCAL_WORLD_ALIGNED
 
@@ -89,11 +89,6 @@ def _planar(placement: pin.SE3) -> np.ndarray:
     return np.array([placement.translation[0], placement.translation[1], np.arctan2(R[1, 0], R[0, 0])])
 
 
-def _rz(yaw: float) -> np.ndarray:
-    c, s = np.cos(yaw), np.sin(yaw)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
 def _prescribed(robot: Robot, time: np.ndarray, amplitude: float, period: float = 4.0,
                 ramp: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Angles, velocities, accelerations (N, n_act) of the joints the IK does not solve:
@@ -130,7 +125,7 @@ class _WholeBodyIK:
         iv = robot.act_v_index
         self.sel = np.concatenate([np.arange(6), iv[self.solved_act]])
         self.rest = iv[self.free_act]
-        self.iq_free = iv[self.free_act] + 1  # revolute joints: nq index = nv index + 1
+        self.iq_free = robot.act_q_index[self.free_act]
         if self.sel.size != 18:
             raise ModelError(f"robot '{robot.name}': walking IK needs 6 joints per leg, got {self.sel.size - 6}")
 
@@ -164,8 +159,8 @@ class _WholeBodyIK:
         model, data = self.model, self.data
         q = q_guess.copy()
         q[self.iq_free] = free[0]
-        targets = [pin.SE3(_rz(feet[i, 3]), feet[i, :3].copy()) for i in range(2)]
-        base_R = _rz(yaw[0])
+        targets = [foot_placement(feet[i]) for i in range(2)]
+        base_R = foot_placement(np.array([0.0, 0.0, 0.0, yaw[0]])).rotation
         for _ in range(max_iter):
             J = self._jacobian(q)
             e = self._error(targets, com[0], base_R)
@@ -178,12 +173,12 @@ class _WholeBodyIK:
             raise ModelError(f"whole-body IK did not converge (residual {np.max(np.abs(e)):.2e}): "
                              "is the step reachable?")
         Js, Jr = J[:, self.sel], J[:, self.rest]
-        lu = np.linalg.inv(Js)
+        Js_inv = np.linalg.inv(Js)
         xd = np.concatenate([feet_d[0, :3], [0, 0, feet_d[0, 3]], feet_d[1, :3], [0, 0, feet_d[1, 3]],
                              com[1], [0, 0, yaw[1]]])
         v = np.zeros(model.nv)
         v[self.rest] = free[1]
-        v[self.sel] = lu @ (xd - Jr @ free[1])
+        v[self.sel] = Js_inv @ (xd - Jr @ free[1])
         # drift Jd v: classical accelerations at zero joint acceleration
         pin.centerOfMass(model, data, q, v, np.zeros(model.nv))
         drift = np.zeros(18)
@@ -194,7 +189,7 @@ class _WholeBodyIK:
                               com[2], [0, 0, yaw[2]]])
         a = np.zeros(model.nv)
         a[self.rest] = free[2]
-        a[self.sel] = lu @ (xdd - drift - Jr @ free[2])
+        a[self.sel] = Js_inv @ (xdd - drift - Jr @ free[2])
         return q, v, a
 
 

@@ -9,8 +9,15 @@ leaves and lands with zero velocity and acceleration.
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 
 from .footsteps import FootstepPlan
+
+
+def foot_placement(pose: np.ndarray) -> pin.SE3:
+    """A sole placement from a planned pose (x, y, z [m], yaw [rad]): flat, heading ``yaw``."""
+    c, s = np.cos(pose[3]), np.sin(pose[3])
+    return pin.SE3(np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), np.array(pose[:3], dtype=float))
 
 
 def quintic(s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
