@@ -49,10 +49,11 @@ def support_phases_figure(est: FrictionEstimate, joints: list[str], path: str | 
     _save(fig, path)
 
 
-def derivative_schemes_figure(estimates: dict[str, FrictionEstimate], joint: str, path_time: str | Path,
-                              path_velocity: str | Path) -> None:
+def derivative_schemes_figure(estimates: dict[str, FrictionEstimate], joint: str, foot: int,
+                              path_time: str | Path, path_velocity: str | Path) -> None:
     """Fig. 6.2 (over time) and Fig. 6.3 (over the joint velocity) of one joint for several
-    differentiation schemes, in the single-support samples (both the leg's swing and stance)."""
+    differentiation schemes, in its valid single-support samples, split by whether the
+    joint's leg (the one ending at contact ``foot``) swings or stands."""
     fig_t = Figure(figsize=(11, 4), layout="constrained")
     ax_t = fig_t.subplots()
     fig_v = Figure(figsize=(11, 3.6), layout="constrained")
@@ -66,8 +67,8 @@ def derivative_schemes_figure(estimates: dict[str, FrictionEstimate], joint: str
         tau = np.where(est.unique, est.tau_f[:, i], np.nan)
         ax_t.plot(est.time, tau, lw=0.8, color=f"C{c}", label=label)
         ax = axes_v[c]
-        swing = est.valid[:, i]
-        stance = est.unique & ~swing
+        swing = est.valid[:, i] & ~est.contact[:, foot]
+        stance = est.valid[:, i] & est.contact[:, foot]
         ax.plot(est.qd[stance, i], est.tau_f[stance, i], ".", ms=1.5, color="C3", label="leg in stance")
         ax.plot(est.qd[swing, i], est.tau_f[swing, i], ".", ms=1.5, color="C0", label="leg in swing")
         if est.tau_f_true is not None:

@@ -102,14 +102,16 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
     truth = schemes["true acceleration"]
     truth_err = float(np.nanmax(np.abs(truth.tau_f - truth.tau_f_true)[truth.unique]))
     i_knee = truth.joints.index(knee)
-    swing_k = truth.valid[:, i_knee]  # same phases for every scheme
-    stance_k = truth.unique & ~swing_k
+    foot = next(c for c, f in enumerate(robot.contact_frames) if knee in robot.limb(f))
+    # valid single-support samples (skip windows applied), same for every scheme
+    swing_k = truth.valid[:, i_knee] & ~truth.contact[:, foot]
+    stance_k = truth.valid[:, i_knee] & truth.contact[:, foot]
     knee_rms = {}
     for label, est in schemes.items():
         e = est.tau_f[:, i_knee] - est.tau_f_true[:, i_knee]
         knee_rms[label] = (float(np.sqrt(np.nanmean(e[swing_k] ** 2))), float(np.sqrt(np.nanmean(e[stance_k] ** 2))))
     support_phases_figure(truth, [j for j, side, _ in legs if side == "right"], output_dir / "fig6_1_support_phases.png")
-    derivative_schemes_figure(schemes, knee, output_dir / "fig6_2_schemes_time.png",
+    derivative_schemes_figure(schemes, knee, foot, output_dir / "fig6_2_schemes_time.png",
                               output_dir / "fig6_3_schemes_velocity.png")
     files += [output_dir / n for n in ("knee_log.parquet", "fig6_1_support_phases.png",
                                        "fig6_2_schemes_time.png", "fig6_3_schemes_velocity.png")]
