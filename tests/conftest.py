@@ -1,5 +1,7 @@
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -11,6 +13,18 @@ from wbfriction.robot import Robot, load_robot
 @pytest.fixture(scope="session")
 def talos() -> Robot:
     return load_robot("talos")
+
+
+@pytest.fixture(scope="session")
+def talos_tilted_sole(talos) -> Robot:
+    """TALOS with its right contact frame's axes turned against its joint's (same point), as
+    in URDFs whose sole frames follow another axis convention; the soles stay flat."""
+    model = pin.Model(talos.model)
+    fid = model.getFrameId(talos.contact_frames[1])
+    fr = model.frames[fid]
+    turn = pin.SE3(pin.rpy.rpyToMatrix(np.pi / 2, 0.3, -np.pi / 2), np.zeros(3))
+    model.addFrame(pin.Frame("tilted_sole", fr.parentJoint, fid, fr.placement * turn, pin.FrameType.OP_FRAME))
+    return dataclasses.replace(talos, model=model, contact_frames=(talos.contact_frames[0], "tilted_sole"), cache={})
 
 
 def random_state(robot: Robot, rng: np.random.Generator, active: list[int], base_random: bool):
@@ -33,8 +47,10 @@ def random_state(robot: Robot, rng: np.random.Generator, active: list[int], base
     return q, v
 
 
-def constrained_forward(robot: Robot, q, v, tau_full, active: list[int]) -> np.ndarray:
-    """Ground truth: Pinocchio's proximal constrained dynamics with welded contacts."""
+def constrained_forward(robot: Robot, q, v, tau_full, active: list[int], with_wrench: bool = False):
+    """Ground truth: Pinocchio's proximal constrained dynamics with welded contacts; the
+    acceleration (nv,), and with ``with_wrench`` also the contact wrenches (6 n_active,) in
+    the contact frames (LOCAL)."""
     model = robot.model
     data = model.createData()
     pin.framesForwardKinematics(model, data, q)
@@ -47,7 +63,8 @@ def constrained_forward(robot: Robot, q, v, tau_full, active: list[int]) -> np.n
     datas = [m.createData() for m in models]
     pin.initConstraintDynamics(model, data, models, datas)
     settings = pin.ProximalSettings(1e-14, 1e-12, 200)
-    return pin.constraintDynamics(model, data, q, v, tau_full, models, datas, settings).copy()
+    a = pin.constraintDynamics(model, data, q, v, tau_full, models, datas, settings).copy()
+    return (a, data.lambda_c.copy()) if with_wrench else a
 
 
 def truth_samples(robot: Robot, n: int, support: str, seed: int, friction_joints: list[str],

@@ -31,6 +31,17 @@ def test_single_support_recovers_injected_friction(talos, method, base_random):
     assert np.abs(est.tau_f[:, others]).max() < 1e-6
 
 
+@pytest.mark.parametrize("method", ["rnea", "kkt"])
+def test_contact_frame_turned_against_its_joint(talos_tilted_sole, method):
+    """The stance tree's root is the contact frame itself, whatever its axes (logged base:
+    the frame's pose is taken as it is)."""
+    robot = talos_tilted_sole
+    kin, tau_f_true = truth_samples(robot, 12, "single", seed=4, friction_joints=KNEE_AND_ARM, base_random=True)
+    assert kin.contact[:, 1].any()
+    est = estimate_friction(robot, kin, EstimateOptions(method=method, **NO_MARGIN))
+    assert np.abs(est.tau_f - tau_f_true).max() < 1e-6
+
+
 def test_rnea_route_equals_kkt_route(talos):
     """(5.13) through inverse dynamics on the stance-rooted tree equals (5.10)-(5.13)."""
     kin, _ = truth_samples(talos, 16, "single", seed=2, friction_joints=list(talos.torque_controlled))

@@ -6,9 +6,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from wbfriction.estimate import stance_model
 from wbfriction.exceptions import InputError
 from wbfriction.robot import build_robot
+from wbfriction.stance import stance_model
 
 
 def test_talos_builtin(talos):
@@ -52,3 +52,25 @@ def test_angles_invert_configuration(talos):
     angles = rng.uniform(*talos.angle_limits, size=(5, talos.n_act))
     np.testing.assert_array_equal(talos.angles(talos.configuration(angles)), angles)
     assert talos.reference_angles[talos.actuated.index("leg_left_4_joint")] > 0.8  # half-sitting knee
+
+
+@pytest.mark.parametrize("robot_name", ["talos", "talos_tilted_sole"])
+def test_stance_wrench_is_the_contact_wrench_in_the_contact_frame(robot_name, request):
+    """Root rows of the stance RNEA = the wrench of pin.constraintDynamics (LOCAL), and the
+    joint rows its joint torques, for a random base pose and a random state with J v = 0."""
+    from conftest import constrained_forward, random_state
+
+    robot = request.getfixturevalue(robot_name)
+    rng = np.random.default_rng(7)
+    m = robot.model
+    q, v = random_state(robot, rng, [1], base_random=True)
+    tau = np.zeros(m.nv)
+    tau[robot.act_v_index] = rng.normal(0.0, 10.0, robot.n_act)
+    a, lam = constrained_forward(robot, q, v, tau, [1], with_wrench=True)
+    d = m.createData()
+    pin.framesForwardKinematics(m, d, q)
+    pose = pin.SE3ToXYZQUAT(d.oMf[robot.contact_frame_ids[1]])[None]
+    iv = robot.act_v_index
+    tau_joint, wrench = stance_model(robot, 1).inverse_dynamics(pose, robot.angles(q)[None], v[iv][None], a[iv][None])
+    np.testing.assert_allclose(tau_joint[0], tau[iv], atol=1e-8)
+    np.testing.assert_allclose(wrench[0], lam, atol=1e-8 * (1 + np.abs(lam).max()))

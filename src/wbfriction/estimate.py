@@ -32,7 +32,7 @@ from .kinematics import MeasuredKinematics, measure
 from .log import Log, with_metadata
 from .phases import Phases, joint_mask, segment
 from .robot import Robot
-from .stance import StanceModel, build_stance_model
+from .stance import StanceModel, stance_model
 
 CHUNK = 4096
 METHODS = ("rnea", "kkt")
@@ -119,14 +119,6 @@ class FrictionEstimate:
             if self.tau_f_true is not None and not np.all(np.isnan(self.tau_f_true[:, i])):
                 cols[f"tau_f_true.{j}"] = self.tau_f_true[:, i]
         return with_metadata(pa.table(cols), self.metadata)
-
-
-def stance_model(robot: Robot, contact_index: int) -> StanceModel:
-    """The model of ``robot`` rooted at contact frame number ``contact_index`` (built once)."""
-    key = ("stance", contact_index)
-    if key not in robot.cache:
-        robot.cache[key] = build_stance_model(robot, robot.contact_frames[contact_index])
-    return robot.cache[key]
 
 
 def _stance_frame_pose(robot: Robot, stance: StanceModel, angles: np.ndarray, base: np.ndarray | None) -> np.ndarray:

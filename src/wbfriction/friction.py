@@ -116,8 +116,13 @@ def friction_torque(qd: np.ndarray, params: list[FrictionParams]) -> np.ndarray:
 
 
 def stack_params(params: list[FrictionParams]) -> dict[str, np.ndarray]:
-    """Keyword arguments of :func:`smooth` for several joints: each parameter as an (n_joints,) array."""
-    return {name: np.array([getattr(p, name) for p in params]) for name in PARAM_NAMES + ("delta_s",)}
+    """Keyword arguments of :func:`smooth` for several joints: each parameter as an (n_joints,)
+    array, or as a float when every joint has the same value (cheaper to broadcast)."""
+    out = {}
+    for name in PARAM_NAMES + ("delta_s",):
+        values = np.array([getattr(p, name) for p in params], dtype=float)
+        out[name] = float(values[0]) if values.size and np.all(values == values[0]) else values
+    return out
 
 
 THESIS_TARGETS: dict[str, FrictionParams] = {

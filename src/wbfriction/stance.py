@@ -127,6 +127,19 @@ def build_stance_model(robot: Robot, frame: str) -> StanceModel:
                        model.jointPlacements[j], _body(j), pin.SE3.Identity())
     fr = model.frames[model.getFrameId(frame)]
     rooted = _G.buildModel(graph, _body(fr.parentJoint), fr.placement.inverse(), _G.JointFreeFlyer())
+    # pin.graph places the root joint at the foot body, the contact frame's offset in the
+    # root joint's placement, i.e. on the universe side of the root's motion: the root
+    # configuration would then not be the contact frame's pose (rotations compose in the
+    # wrong order) and the root wrench would act at the body origin. Move the offset to the
+    # child side, so that the root joint frame *is* the contact frame.
+    offset = rooted.jointPlacements[1].copy()
+    rooted.jointPlacements[1] = pin.SE3.Identity()
+    for j in range(2, rooted.njoints):
+        if rooted.parents[j] == 1:
+            rooted.jointPlacements[j] = offset * rooted.jointPlacements[j]
+    for f in rooted.frames:
+        if f.parentJoint == 1 and f.name != "root_joint":
+            f.placement = offset * f.placement
     # Body inertias: set each one from the original body, re-expressed in the frame of the
     # joint that carries it in the rooted tree. (pin.graph 4.1 leaves the inertia of a body
     # reached through a reversed joint with an offset placement in the wrong frame.)
@@ -145,6 +158,14 @@ def build_stance_model(robot: Robot, frame: str) -> StanceModel:
     stance = StanceModel(frame, rooted, v_index, sign, _joint_layout(rooted, robot.actuated))
     _check_kinematics(robot, stance)
     return stance
+
+
+def stance_model(robot: Robot, contact_index: int) -> StanceModel:
+    """The model of ``robot`` rooted at contact frame number ``contact_index`` (built once)."""
+    key = ("stance", contact_index)
+    if key not in robot.cache:
+        robot.cache[key] = build_stance_model(robot, robot.contact_frames[contact_index])
+    return robot.cache[key]
 
 
 def _check_kinematics(robot: Robot, stance: StanceModel, seed: int = 0) -> None:

@@ -24,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..robot import Robot
+from ..stance import stance_model
 
 
 def contact_jacobian(robot: Robot, data: pin.Data, contacts: np.ndarray) -> np.ndarray:
@@ -50,8 +51,13 @@ def feedforward(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, conta
                 share: np.ndarray, min_share: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
     """Joint torques and contact wrenches of a reference motion (module docstring).
 
+    Single-support samples are computed in one batched RNEA pass on the robot re-rooted at
+    the stance sole (:mod:`wbfriction.stance`: the same solution, since the reference keeps
+    the stance sole still), double-support samples one by one with the weighted sharing.
+
     Args:
-        q, v, a: reference configurations (N, nq), velocities and accelerations (N, nv).
+        q, v, a: reference configurations (N, nq), velocities and accelerations (N, nv),
+            with the soles in contact at rest: ``J_c v = 0``, ``J_c a + Jdot_c v = 0``.
         contact: active contacts (N, n_contacts).
         share: each foot's share of the wrench in double support (N, n_contacts).
 
@@ -59,25 +65,34 @@ def feedforward(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, conta
         tau (N, n_act) [N·m] for every actuated joint, and the contact wrenches
         (N, n_contacts, 6) (force [N], moment [N·m]) in the soles' LOCAL frames, zero
         for feet not in contact.
+
+    Raises:
+        ValueError: a sample with no foot in contact.
     """
     model, data = robot.model, robot.model.createData()
-    iv = robot.act_v_index
+    iv, iq = robot.act_v_index, robot.act_q_index
     n, nc = len(q), len(robot.contact_frames)
+    n_active = contact.sum(axis=1)
+    if np.any(n_active == 0):
+        raise ValueError(f"feed-forward: no foot in contact at sample {int(np.argmin(n_active))}")
     tau = np.zeros((n, robot.n_act))
     wrench = np.zeros((n, nc, 6))
-    for k in range(n):
+    for c in range(nc):
+        rows = np.flatnonzero(contact[:, c] & (n_active == 1))
+        if rows.size:
+            sole_pose = np.tile([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0], (rows.size, 1))  # flat; the result is invariant
+            tau[rows], wrench[rows, c] = stance_model(robot, c).inverse_dynamics(
+                sole_pose, q[rows][:, iq], v[rows][:, iv], a[rows][:, iv])
+    for k in np.flatnonzero(n_active > 1):
         b = pin.rnea(model, data, q[k], v[k], a[k])
         pin.computeJointJacobians(model, data, q[k])
         pin.updateFramePlacements(model, data)
         active = np.flatnonzero(contact[k])
         Jc = contact_jacobian(robot, data, contact[k])
         Jb = Jc[:, :6]
-        if len(active) == 1:
-            lam = np.linalg.solve(Jb.T, b[:6])
-        else:
-            w_inv = np.repeat(np.maximum(share[k, active], min_share), 6)
-            JW = Jb * w_inv[:, None]
-            lam = JW @ np.linalg.solve(Jb.T @ JW, b[:6])
+        w_inv = np.repeat(np.maximum(share[k, active], min_share), 6)
+        JW = Jb * w_inv[:, None]
+        lam = JW @ np.linalg.solve(Jb.T @ JW, b[:6])
         tau[k] = b[iv] - Jc[:, iv].T @ lam
         wrench[k, active] = lam.reshape(-1, 6)
     return tau, wrench
@@ -126,3 +141,34 @@ def pd_gains(robot: Robot, q: np.ndarray, bandwidth: float, damping: float = 0.9
         inertia = 1.0 / np.diag(constrained_inverse_inertia(robot, data, q, s))[iv_tc]
         gains[tuple(bool(x) for x in s)] = (inertia * w**2, 2 * damping * inertia * w)
     return gains
+
+
+def gain_schedule(gains: dict[tuple[bool, ...], tuple[np.ndarray, np.ndarray]], contact: np.ndarray,
+                  dt: float, blend: float) -> tuple[np.ndarray, np.ndarray]:
+    """PD gains at every sample of a contact sequence.
+
+    At each change of contact state the gains that rise (a landing leg's) ramp linearly to
+    those of the new state over ``blend`` seconds, so that a landing leg's small tracking
+    error times the stance gains does not pull the foot on the ground; the gains that fall
+    (a lifting leg's) apply at once.
+
+    Args:
+        gains: :func:`pd_gains` output.
+        contact: contact flags (N, n_contacts).
+        dt: sampling period [s]; blend: ramp time [s] (0: switch at once).
+
+    Returns:
+        kp, kd: (N, n_tc) arrays.
+    """
+    n = len(contact)
+    kp_first = next(iter(gains.values()))[0]
+    kp, kd = np.empty((n, kp_first.size)), np.empty((n, kp_first.size))
+    starts = np.flatnonzero(np.any(np.diff(contact, axis=0, prepend=~contact[:1]), axis=1))
+    for i, s in enumerate(starts):
+        e = starts[i + 1] if i + 1 < len(starts) else n
+        to_p, to_d = gains[tuple(bool(x) for x in contact[s])]
+        from_p, from_d = (to_p, to_d) if s == 0 else (np.minimum(kp[s - 1], to_p), np.minimum(kd[s - 1], to_d))
+        r = np.minimum(1.0, np.arange(e - s) * dt / blend)[:, None] if blend > 0 else np.ones((e - s, 1))
+        kp[s:e] = from_p + r * (to_p - from_p)
+        kd[s:e] = from_d + r * (to_d - from_d)
+    return kp, kd

@@ -9,10 +9,10 @@ factorisation (``constraint_chol.solve``). At touch-down the landing foot is anc
 flat on its planned footprint (so that errors do not add up step after step) and the
 configuration projected onto that anchor: the foot snaps by its tracking error, about a
 millimetre, at the touch-down sample (a double-support sample, never used in single
-support). At every physics step the
-velocity is projected onto the constraints (``pin.impulseDynamics``: the plastic impact at
-touch-down, the integration drift otherwise), so the logged state satisfies ``J v = 0``
-exactly and the Baumgarte term only corrects the position drift.
+support). At every logged sample the velocity is projected onto the constraints
+(``pin.impulseDynamics``: the plastic impact at touch-down, the integration drift
+otherwise), so the logged state satisfies ``J v = 0`` exactly and the Baumgarte term only
+corrects the drift between samples.
 
 The controller (:mod:`wbfriction.sim.control`) runs at the log rate ``1 / dt``; its torque
 is held over the period. Friction ``tau_f = -f(qd)`` of eq. (3.5) acts on the chosen joints
@@ -43,7 +43,7 @@ from ..log import Log
 from ..robot import Robot
 from ..walking import WalkingReference
 from ..walking.swing import foot_placement
-from .control import contact_jacobian, feedforward, foot_shares, pd_gains
+from .control import contact_jacobian, feedforward, foot_shares, gain_schedule, pd_gains
 
 INTEGRATORS = ("semi-implicit", "explicit")
 
@@ -61,10 +61,10 @@ class IdealOptions:
             otherwise pull the foot on the ground); falling gains apply at once.
         baumgarte: (Kp [1/s^2], Kd [1/s]) of the contact and position-control constraints.
         log_base: write the base pose to the log.
-        projection: ``"step"``: project the velocity onto the constraints at every physics
-            step (the logged state satisfies ``J v = 0`` exactly: ground truth to 1e-9 N·m);
-            ``"touch-down"``: only at touch-downs, Baumgarte correcting the drift (faster;
-            truth to about 1e-3 N·m).
+        projection: ``"sample"``: project the velocity onto the constraints at every
+            logged sample (the logged state satisfies ``J v = 0`` exactly: ground truth to
+            1e-9 N·m); ``"touch-down"``: only at contact changes, Baumgarte correcting the
+            drift (truth to about 1e-4 N·m).
     """
 
     substeps: int = 1
@@ -74,13 +74,13 @@ class IdealOptions:
     gain_blend: float = 0.1
     baumgarte: tuple[float, float] = (400.0, 40.0)
     log_base: bool = True
-    projection: str = "step"
+    projection: str = "sample"
 
     def __post_init__(self) -> None:
         if self.integrator not in INTEGRATORS:
             raise InputError(f"unknown integrator '{self.integrator}': choose one of {', '.join(INTEGRATORS)}")
-        if self.projection not in ("step", "touch-down"):
-            raise InputError(f"unknown projection '{self.projection}': choose step or touch-down")
+        if self.projection not in ("sample", "touch-down"):
+            raise InputError(f"unknown projection '{self.projection}': choose sample or touch-down")
         if self.substeps < 1:
             raise InputError(f"substeps must be at least 1, got {self.substeps}")
 
@@ -151,8 +151,10 @@ def _solve_small(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     if A.shape == (1, 1):
         return b / A[0, 0]
     if A.shape == (2, 2):
-        det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
-        return np.array([A[1, 1] * b[0] - A[0, 1] * b[1], A[0, 0] * b[1] - A[1, 0] * b[0]]) / det
+        (a00, a01), (a10, a11) = A.tolist()
+        b0, b1 = b.tolist()
+        det = a00 * a11 - a01 * a10
+        return np.array([(a11 * b0 - a01 * b1) / det, (a00 * b1 - a10 * b0) / det])
     return np.linalg.solve(A, b)
 
 
@@ -203,83 +205,78 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
     feet_xy = ref.feet[:, :, :2]
     tau_ff, _ = feedforward(robot, ref.q, ref.v, ref.a, ref.contact, foot_shares(ref.zmp, feet_xy))
     gains = pd_gains(robot, ref.q[0], options.bandwidth, options.damping)
+    kp_all, kd_all = gain_schedule(gains, ref.contact, dt, options.gain_blend)
     bkp, bkd = options.baumgarte
 
-    iv = robot.act_v_index
+    iv, iq = robot.act_v_index, robot.act_q_index
     tc, pc = robot.tc_index, robot.pc_index
-    iv_tc, iv_pc = iv[tc], iv[pc]
+    iv_tc, iv_pc, iq_tc, iq_pc = iv[tc], iv[pc], iq[tc], iq[pc]
     joints_f = [robot.torque_controlled.index(j) for j in friction]
     params_f = stack_params(list(friction.values())) if joints_f else {}
     iv_f = iv_tc[joints_f]
     settings = pin.ProximalSettings(1e-12, 1e-10, 50)
     semi_implicit = options.integrator == "semi-implicit"
-    iq = robot.act_q_index
-    iq_pc = iq[pc]
-    ref_angles = ref.q[:, iq]
+    project_every_sample = options.projection == "sample"
+    # the reference, contiguous per sample
+    ff_tc = np.ascontiguousarray(tau_ff[:, tc])
+    q_ref_tc, v_ref_tc = np.ascontiguousarray(ref.q[:, iq_tc]), np.ascontiguousarray(ref.v[:, iv_tc])
+    q_ref_pc, v_ref_pc, a_ref_pc = ref.q[:, iq_pc], ref.v[:, iv_pc], ref.a[:, iv_pc]
+    switches = set(np.flatnonzero(np.any(np.diff(ref.contact, axis=0, prepend=False), axis=1)).tolist())
 
     Q = np.empty((n, model.nq))
     V = np.empty((n, model.nv))
-    rows = {"tau": np.empty((n, tc.size)), "tau_f": np.zeros((n, tc.size)), "qd": np.empty((n, robot.n_act)),
-            "qdd": np.empty((n, robot.n_act))}
+    A = np.empty((n, model.nv))
+    tau_log = np.empty((n, tc.size))
+    tau_f_log = np.zeros((n, tc.size))
     wrench = np.zeros((n, nc, 6))
     q, v = ref.q[0].copy(), ref.v[0].copy()
     anchors: dict[int, pin.SE3] = {}
     active = np.zeros(nc, bool)
     tau_pc = tau_ff[0, pc].copy()
     tau = np.zeros(model.nv)
-    kp, kd = gains[tuple(bool(x) for x in ref.contact[0])]
     for k in range(n):
-        if not np.array_equal(ref.contact[k], active):
+        switch = k in switches
+        if switch:
             landing = ref.contact[k] & ~active
             for c in np.flatnonzero(landing):
                 anchors[c] = foot_placement(ref.feet[k, c])  # planned footprint, flat, z = 0
             active = ref.contact[k].copy()
             if landing.any():
                 q = _project_configuration(robot, data, q, active, anchors)
-            blend_to, k_switch = gains[tuple(bool(x) for x in active)], k
-            # gains that rise (a landing leg) ramp up; gains that fall (a lifting leg) drop at once
-            blend_from = (np.minimum(kp, blend_to[0]), np.minimum(kd, blend_to[1]))
             cmodels, cdatas = _constraints(robot, data, active, anchors, options.baumgarte)
-        n_lam = 6 * int(active.sum())
-        r = min(1.0, (k - k_switch) * dt / options.gain_blend) if options.gain_blend > 0 else 1.0
-        kp = blend_from[0] + r * (blend_to[0] - blend_from[0])
-        kd = blend_from[1] + r * (blend_to[1] - blend_from[1])
+            n_lam = 6 * int(active.sum())
+            # one right-hand side per position-controlled joint (unit torque) and one for
+            # the contacts' Baumgarte term
+            rhs = np.zeros((n_lam + model.nv, pc.size + 1))
+            rhs[n_lam + iv_pc, np.arange(pc.size)] = 1.0
+        # velocity onto the constraints (plastic impact at touch-down, drift otherwise)
+        if switch or project_every_sample:
+            v = pin.impulseDynamics(model, data, q, v, cmodels, cdatas, 0.0, settings).copy()
+        tau_cmd = ff_tc[k] + kp_all[k] * (q_ref_tc[k] - q[iq_tc]) + kd_all[k] * (v_ref_tc[k] - v[iv_tc])
         for s in range(options.substeps):
-            # velocity onto the constraints (plastic impact at touch-down, drift otherwise)
-            if options.projection == "step" or (k == k_switch and s == 0):
-                v = pin.impulseDynamics(model, data, q, v, cmodels, cdatas, 0.0, settings).copy()
-            if s == 0:
-                angles, qd = q[iq], v[iv]
-                tau_cmd = tau_ff[k, tc] + kp * (ref_angles[k, tc] - angles[tc]) + kd * (ref.v[k, iv_tc] - qd[tc])
+            first = s == 0
             tau[iv_tc] = tau_cmd
             if joints_f:
                 tau_f = -smooth(v[iv_f], **params_f)
                 tau[iv_f] += tau_f
             tau[iv_pc] = tau_pc
             a = pin.constraintDynamics(model, data, q, v, tau, cmodels, cdatas, settings).copy()
-            lam = data.lambda_c.copy()
-            # one solve with the contact factorisation: the response to a unit torque on each
-            # position-controlled joint, and the Baumgarte term of the contacts
-            rhs = np.zeros((n_lam + model.nv, pc.size + 1))
-            rhs[n_lam + iv_pc, np.arange(pc.size)] = 1.0
-            if s == 0:
+            if first:
                 rhs[:n_lam, -1] = np.concatenate([bkp * cd.contact_placement_error.vector
                                                   + bkd * cd.contact_velocity_error.vector for cd in cdatas])
             X = data.constraint_chol.solve(rhs)
+            lam = data.lambda_c
             if pc.size:  # position-controlled joints: acceleration = reference, stabilised
-                a_des = (ref.a[k, iv_pc] + bkd * (ref.v[k, iv_pc] - v[iv_pc])
-                         + bkp * (ref_angles[k, pc] - q[iq_pc]))
+                a_des = a_ref_pc[k] + bkd * (v_ref_pc[k] - v[iv_pc]) + bkp * (q_ref_pc[k] - q[iq_pc])
                 delta = _solve_small(X[n_lam + iv_pc, :-1], a_des - a[iv_pc])
                 a += X[n_lam:, :-1] @ delta
-                lam -= X[:n_lam, :-1] @ delta
+                lam = lam - X[:n_lam, :-1] @ delta
                 tau_pc = tau_pc + delta
-            if s == 0:  # the true acceleration: without the Baumgarte stabilisation term
-                a_true = a + X[n_lam:, -1]
-                Q[k], V[k] = q, v
-                rows["tau"][k] = tau_cmd
-                rows["qd"][k], rows["qdd"][k] = qd, a_true[iv]
+            if first:  # the logged sample; true acceleration: without the Baumgarte term
+                Q[k], V[k], A[k] = q, v, a + X[n_lam:, -1]
+                tau_log[k] = tau_cmd
                 if joints_f:
-                    rows["tau_f"][k, joints_f] = tau_f
+                    tau_f_log[k, joints_f] = tau_f
                 wrench[k, active] = lam.reshape(-1, 6)
             if semi_implicit:
                 v = v + h * a
@@ -301,7 +298,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
         # acceleration tau[k] caused; otherwise the torque is held over several steps
         "torque_alignment": "sample" if semi_implicit and options.substeps == 1 else "zoh",
     }
-    log = Log(ref.time.copy(), Q[:, iq], rows["tau"], ref.contact.copy(),
-              Q[:, :7].copy() if options.log_base else None, rows["tau_f"], metadata,
-              source="simulate_ideal", qd_true=rows["qd"], qdd_true=rows["qdd"])
+    log = Log(ref.time.copy(), Q[:, iq], tau_log, ref.contact.copy(),
+              Q[:, :7].copy() if options.log_base else None, tau_f_log, metadata,
+              source="simulate_ideal", qd_true=V[:, iv], qdd_true=A[:, iv])
     return SimulationResult(log, wrench, Q, V, ref, tuple(robot.contact_frames))

@@ -61,14 +61,16 @@ def zmp_reference(plan: FootstepPlan, time: np.ndarray, shift: float | None = No
     return np.stack([np.interp(time, t_k, p_k[:, i]) for i in range(2)], axis=1)
 
 
-def lipm_com(zmp: np.ndarray, dt: float, height: float, gravity: float = GRAVITY,
-             rest_weight: float = 1e4) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def lipm_com(zmp: np.ndarray, dt: float, height: float, gravity: float = GRAVITY
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Centre-of-mass trajectory of the linear inverted pendulum for a ZMP reference.
 
+    The rest conditions at both ends (module docstring) are hard equality constraints of
+    the least-squares problem, solved through its sparse KKT system.
+
     Args:
-        zmp: ZMP reference (N, 2) [m], on a grid of period ``dt`` [s].
+        zmp: ZMP reference (N, 2) [m], on a grid of period ``dt`` [s], N >= 6.
         height: constant height ``z_c`` of the centre of mass above the ground [m].
-        rest_weight: weight of the rest conditions at both ends.
 
     Returns:
         c (N, 2) [m], its central-difference velocity (N, 2) [m/s] and acceleration
@@ -77,22 +79,21 @@ def lipm_com(zmp: np.ndarray, dt: float, height: float, gravity: float = GRAVITY
     zmp = np.asarray(zmp, dtype=float)
     n = len(zmp)
     k = 1.0 / (gravity / height * dt**2)
-    rows = sp.diags([-k * np.ones(n - 2), (1 + 2 * k) * np.ones(n - 2), -k * np.ones(n - 2)], [0, 1, 2],
-                    shape=(n - 2, n))
-    rhs = zmp[1:-1]
-    w = rest_weight
-    rest = sp.lil_matrix((6, n))
-    rest[0, 0] = w  # starts over the first ZMP
-    rest[1, [0, 1]] = [-w, w]  # zero velocity
-    rest[2, [0, 1, 2]] = [w, -2 * w, w]  # zero acceleration
-    rest[3, [n - 2, n - 1]] = [-w, w]
-    rest[4, [n - 3, n - 2, n - 1]] = [w, -2 * w, w]
-    rest[5, n - 1] = w
-    b_rest = np.zeros((6, 2))
-    b_rest[0], b_rest[5] = w * zmp[0], w * zmp[-1]
-    A = sp.vstack([rows, rest.tocsr()]).tocsc()
-    b = np.vstack([rhs, b_rest])
-    c = np.asarray(spsolve((A.T @ A).tocsc(), A.T @ b)).reshape(n, 2)
+    A = sp.diags([-k * np.ones(n - 2), (1 + 2 * k) * np.ones(n - 2), -k * np.ones(n - 2)], [0, 1, 2],
+                 shape=(n - 2, n), format="csc")
+    C = sp.lil_matrix((6, n))
+    C[0, 0] = 1.0  # starts over the first ZMP
+    C[1, [0, 1]] = [-1.0, 1.0]  # zero velocity
+    C[2, [0, 1, 2]] = [1.0, -2.0, 1.0]  # zero acceleration
+    C[3, [n - 2, n - 1]] = [-1.0, 1.0]
+    C[4, [n - 3, n - 2, n - 1]] = [1.0, -2.0, 1.0]
+    C[5, n - 1] = 1.0  # ends over the last ZMP
+    C = k * C.tocsc()  # scaled like A, for a balanced KKT matrix
+    d = np.zeros((6, 2))
+    d[0], d[5] = k * zmp[0], k * zmp[-1]
+    kkt = sp.bmat([[A.T @ A, C.T], [C, None]], format="csc")
+    sol = spsolve(kkt, np.vstack([A.T @ zmp[1:-1], d]))
+    c = np.asarray(sol).reshape(n + 6, 2)[:n]
     cd = np.gradient(c, dt, axis=0)
     cdd = np.zeros_like(c)
     cdd[1:-1] = (c[2:] - 2 * c[1:-1] + c[:-2]) / dt**2
