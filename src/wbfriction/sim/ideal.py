@@ -53,8 +53,12 @@ class IdealOptions:
     """Parameters of :func:`simulate_ideal`.
 
     Attributes:
-        substeps: physics steps per control period.
-        integrator: one of :data:`INTEGRATORS`.
+        substeps: physics steps per control period (the study uses 10: see
+            :data:`wbfriction.study.SIMULATOR`).
+        integrator: one of :data:`INTEGRATORS`. With one explicit Euler step per sample
+            the central second difference at ``k`` is the acceleration of sample ``k - 1``,
+            which no torque alignment matches (the thesis's setting: F_v up to 25 % off in
+            the study); with several substeps the log approaches continuous time.
         bandwidth: joint PD bandwidth [Hz]; damping: its damping ratio.
         gain_blend: time over which PD gains rise to those of a new contact state [s]
             (a landing leg's small tracking error times the stance gains would
