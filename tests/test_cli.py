@@ -122,3 +122,32 @@ def test_any_robot_from_urdf_and_toml(talos, demo_dir, tmp_path):
     cfg.write_text('position_controlled = ["neck_joint"]\ncontact_frames = ["left_sole_link"]\n')
     _assert_one_line_error(run("estimate", out / "log.parquet", "--urdf", talos.urdf, "--config", cfg, "-o",
                                tmp_path / "g.parquet"), "unknown position-controlled joint 'neck_joint'")
+
+
+def test_filtering_schemes_from_the_command_line(demo_dir, tmp_path):
+    """estimate --diff savgol/butterworth, then fit: the fit filters its model like the
+    estimate (options read back from the table's metadata) and recovers the knee."""
+    out, _ = demo_dir
+    for args in (["--diff", "savgol", "--window", "51", "--poly-order", "4"],
+                 ["--diff", "butterworth", "--cutoff", "25", "--butter-order", "4"]):
+        res = run("estimate", out / "log.parquet", "-o", tmp_path / "f.parquet", *args)
+        assert res.returncode == 0, res.stderr
+        res = run("fit", tmp_path / "f.parquet", "-o", tmp_path / "p.json")
+        assert res.returncode == 0, res.stderr
+        knee = json.loads((tmp_path / "p.json").read_text())["joints"]["leg_right_4_joint"]
+        assert knee["error_percent"]["F_c"] < 5 and knee["error_percent"]["tau_os"] < 5, (args, knee)
+    _assert_one_line_error(run("estimate", out / "log.parquet", "-o", tmp_path / "x.parquet", "--diff", "savgol",
+                               "--window", "50"), "window must be odd")
+    _assert_one_line_error(run("estimate", out / "log.parquet", "-o", tmp_path / "x.parquet", "--diff",
+                               "butterworth", "--cutoff", "600"), "Nyquist")
+
+
+def test_spectrum_command(demo_dir, tmp_path):
+    out, _ = demo_dir
+    res = run("spectrum", out / "log.parquet", "-o", tmp_path / "s.png", "--joints",
+              "leg_right_4_joint,leg_right_3_joint")
+    assert res.returncode == 0, res.stderr
+    assert "suggested cutoff" in res.stdout and "leg_right_3_joint" in res.stdout
+    assert (tmp_path / "s.png").stat().st_size > 1000
+    _assert_one_line_error(run("spectrum", out / "log.parquet", "--joints", "head_1_joint"),
+                           "'head_1_joint' is not a torque-controlled joint")

@@ -98,3 +98,28 @@ def test_fit_standard_errors_cover_truth_with_noise():
     z = np.abs(res.params.as_vector() - truth.as_vector()) / np.array([res.stderr[k] for k in
                                                                      ("F_v", "F_c", "S", "v_s", "tau_os", "a")])
     assert np.all(z < 5.0), z
+
+
+def test_standard_errors_account_for_correlated_residuals():
+    """Residuals correlated over ~100 samples (a filtered estimate): the Newey-West standard
+    errors cover the truth about as often as they should, the white-noise formula does not."""
+    from wbfriction.identify import _model
+
+    truth = FrictionParams(0.2, 0.8, 0.2, 0.2, 0.8, 40.0)
+    t = np.arange(6000) * 1e-3
+    qd = 1.2 * np.sin(2 * np.pi * 0.7 * t) + 0.3 * np.sin(2 * np.pi * 1.9 * t)
+    box = np.ones(101) / np.sqrt(101)
+    inside_hac, inside_white = [], []
+    for seed in range(16):
+        rng = np.random.default_rng(seed)
+        noise = 0.05 * np.convolve(rng.normal(size=t.size + 100), box, mode="valid")
+        res = fit_friction(qd, truth.torque(qd) + noise, x0=truth.as_vector())
+        x = res.params.as_vector()
+        err = np.abs(x - truth.as_vector())[[0, 1, 4]]
+        se_hac = np.array([res.stderr[k] for k in ("F_v", "F_c", "tau_os")])
+        J = _jacobian(x, qd, 2.0)
+        r = _model(x, qd, 2.0) + (truth.torque(qd) + noise)
+        se_white = standard_errors(J, r)[[0, 1, 4]]
+        inside_hac.append(err < 2 * se_hac)
+        inside_white.append(err < 2 * se_white)
+    assert np.mean(inside_hac) > 0.8 and np.mean(inside_white) < 0.5, (np.mean(inside_hac), np.mean(inside_white))

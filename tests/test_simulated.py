@@ -9,7 +9,8 @@ import pytest
 from wbfriction.estimate import EstimateOptions, estimate_log
 from wbfriction.friction import THESIS_TARGETS, FrictionParams
 from wbfriction.identify import fit_estimate
-from wbfriction.sim import IdealOptions, simulate_ideal
+from wbfriction.kinematics import FilterOptions
+from wbfriction.sim import IdealOptions, SensorNoise, apply_sensor_noise, simulate_ideal
 from wbfriction.study import SIMULATOR
 from wbfriction.walking import GaitOptions, walking_reference
 
@@ -110,20 +111,43 @@ def test_reconstructed_base_is_close_to_logged_base(talos, short_walk):
     assert np.abs(with_base.tau_f[m] - without.tau_f[m]).max() < 1e-3
 
 
-def test_combined_walk_identifies_every_leg_joint(talos):
-    """The demo's identification (Table 6.2 layout): central differences, swing samples,
-    the study's simulator (physics at 10 kHz under the 1 kHz controller)."""
+@pytest.fixture(scope="module")
+def combined(talos):
+    """The demo's combined walk (10 steps forward, sideways, turning) on the study's simulator
+    (physics at 10 kHz under the 1 kHz controller), Table 6.1 friction on the legs."""
     ref = walking_reference(talos, GaitOptions(gait="combined", steps=10))
-    log = simulate_ideal(talos, ref, options=SIMULATOR).log
-    est = estimate_log(talos, log)
+    return simulate_ideal(talos, ref, options=SIMULATOR).log
+
+
+def _leg_fits(talos, log, options=EstimateOptions()):
+    est = estimate_log(talos, log, options)
     legs = [j for j in est.joints if j.startswith("leg_")]
     idx = [est.joints.index(j) for j in legs]
     targets = {j: FrictionParams(**p) for j, p in log.metadata["friction_true"].items()}
-    worst = {}
-    for r in fit_estimate(legs, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], targets=targets):
-        for name, e in r.error_percent().items():
-            worst[name] = max(worst.get(name, 0.0), e)
+    fits = fit_estimate(legs, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], targets=targets,
+                        smoother=est.smoother)
+    worst = {n: max(r.error_percent()[n] for r in fits) for n in fits[0].error_percent()}
+    return fits, worst
+
+
+def test_combined_walk_identifies_every_leg_joint(talos, combined):
+    """The demo's identification (Table 6.2 layout): central differences, swing samples."""
+    fits, worst = _leg_fits(talos, combined)
+    for r in fits:
         assert all(np.isfinite(s) for s in r.stderr.values()), r.joint
     print("worst errors [%]", {k: round(v, 2) for k, v in worst.items()})
     assert worst["F_v"] < 2 and worst["F_c"] < 2 and worst["tau_os"] < 2
     assert worst["S"] < 5 and worst["v_s"] < 5 and worst["a"] < 5
+
+
+def test_noisy_positions_need_a_zero_phase_filter(talos, combined):
+    """Position noise of 1e-4 rad (19-bit encoder, 0.05 N·m torque noise): central
+    differences fail; Savitzky-Golay (L = 151, k = 4) with its model filtered alike
+    identifies F_c and tau_os of every leg joint within 10 % (issue target; F_v: see the
+    filter study, reached 14-27 % at worst over the 12 joints depending on the noise draw)."""
+    noisy = apply_sensor_noise(combined, SensorNoise(1e-4, 19, 0.05, seed=1))
+    _, central = _leg_fits(talos, noisy)
+    assert central["F_c"] > 100
+    _, savgol = _leg_fits(talos, noisy, EstimateOptions(diff="savgol", filtering=FilterOptions(window=151)))
+    print("savgol worst errors [%]", {k: round(v, 1) for k, v in savgol.items()})
+    assert savgol["F_c"] < 10 and savgol["tau_os"] < 10 and savgol["F_v"] < 30

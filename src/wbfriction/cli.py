@@ -28,6 +28,7 @@ from .estimate import EstimateOptions, estimate_log
 from .exceptions import WbfrictionError
 from .friction import PARAM_NAMES, load_friction_toml
 from .identify import FitResult, fit_friction_table
+from .kinematics import FilterOptions
 from .log import read_log, read_table, write_atomic, write_log, write_table
 from .robot import Robot, load_robot
 from .sim import IdealOptions, simulate_ideal
@@ -92,6 +93,7 @@ def _write_params(results: list[FitResult], path: Path, provenance: dict) -> Non
 
 
 _E = EstimateOptions()  # one source of defaults: the library's
+_F = FilterOptions()
 _G = GaitOptions()
 _I = IdealOptions()
 _MIN_SAMPLES = 20
@@ -157,7 +159,13 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
 def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the wbfriction format."),
              output: Path = typer.Option(..., "-o", "--output", help="Friction table to write."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
-             diff: str = typer.Option(_E.diff, help="Differentiation: central (6.2) or backward (6.3)."),
+             diff: str = typer.Option(_E.diff, help="Differentiation: central (6.2), backward (6.3), savgol "
+                                                    "(Savitzky-Golay, 7.1.1), butterworth (7.1.2) or true."),
+             window: int = typer.Option(_F.window, help="savgol: window length L (odd) [samples]."),
+             poly_order: int = typer.Option(_F.poly_order, help="savgol: polynomial order k."),
+             weights: str = typer.Option(_F.weights, help="savgol: uniform or gaussian weights."),
+             cutoff: float = typer.Option(_F.cutoff, help="butterworth: cutoff [Hz] (see 'wbfriction spectrum')."),
+             butter_order: int = typer.Option(_F.butter_order, help="butterworth: filter order."),
              delay_compensation: bool = typer.Option(_E.compensate_delay,
                                                      help="Shift derivatives by their delay (6.1.2)."),
              torque_alignment: str = typer.Option(_E.torque_alignment,
@@ -174,7 +182,9 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
     """Estimate the friction torque of every torque-controlled joint at every sample."""
     opts = EstimateOptions(diff=diff, compensate_delay=delay_compensation, torque_alignment=torque_alignment,
                            mask=mask, lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
-                           ds_regularization=ds_regularization, condition_number=cond, method=method)
+                           ds_regularization=ds_regularization, condition_number=cond, method=method,
+                           filtering=FilterOptions(window=window, poly_order=poly_order, weights=weights,
+                                                   cutoff=cutoff, butter_order=butter_order))
     _run_estimate(_robot(robot, urdf, config), log, output, opts)
 
 
@@ -229,6 +239,80 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
     for f in result.files:
         console.print(f"wrote {f}")
     console.print(f"demo finished in {time.perf_counter() - start:.1f} s")
+
+
+@app.command()
+def spectrum(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the wbfriction format."),
+             output: Path = typer.Option(Path("spectrum.png"), "-o", "--output", help="Figure to write (PNG)."),
+             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             joints: Optional[str] = typer.Option(None, help="Comma-separated joints (default: the legs' joints, "
+                                                             "else every torque-controlled one)."),
+             tail: float = typer.Option(0.01, help="Share of the power (above the noise floor) left above the "
+                                                   "suggested cutoff.")) -> None:
+    """Spectrum of the estimated acceleration (Fig. 7.1) and the Butterworth cutoff it suggests."""
+    from .plots import spectrum_figure
+    from .spectrum import acceleration_spectrum
+
+    r = _robot(robot, urdf, config)
+    data = read_log(log, r)
+    if joints is None:
+        legs = [j for f in r.contact_frames for j in r.limb(f) if j in r.torque_controlled]
+        names = legs or list(r.torque_controlled)
+    else:
+        names = [j.strip() for j in joints.split(",") if j.strip()]
+    with _progress(len(data), "dynamics") as advance:
+        spec = acceleration_spectrum(r, data, names, tail=tail, progress=advance)
+    table = Table(title=f"Estimated acceleration (5.10), {spec.span[0]:.2f}-{spec.span[1]:.2f} s", box=None)
+    table.add_column("joint")
+    table.add_column("content ends at [Hz]", justify="right")
+    for j, c in zip(spec.joints, spec.cutoff):
+        table.add_row(j, f"{c:.1f}")
+    out.print(table)
+    out.print(f"suggested cutoff: {spec.suggestion:.1f} Hz  (wbfriction estimate --diff butterworth "
+              f"--cutoff {spec.suggestion:.0f})")
+    spectrum_figure(spec, output)
+    console.print(f"wrote {output}")
+
+
+def _percent(x: float) -> str:
+    return f"{x:.1f}" if x < 1e4 else ("inf" if not np.isfinite(x) else ">1e4")
+
+
+@app.command("study-filters")
+def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-o", "--output-dir",
+                                                  help="Where to write."),
+                  robot: str = RobotOpt,
+                  steps: int = typer.Option(_G.steps, help="Steps per direction of the combined walk."),
+                  seed: int = typer.Option(0, help="Noise seed."),
+                  workers: Optional[int] = typer.Option(None, help="Processes (default: up to 2).")) -> None:
+    """Score the differentiation schemes on noisy logs (thesis 7.2, Fig. 7.2)."""
+    from .filter_study import LEVELS, run_filter_study
+
+    start = time.perf_counter()
+    r = _robot(robot, None, None)
+    with console.status("") as status:
+        result = run_filter_study(r, output_dir, steps=steps, seed=seed, workers=workers,
+                                  progress=lambda label: status.update(label))
+    table = Table(title="Friction of the 12 leg joints through each scheme: combined walk, sensor noise",
+                  caption="rms: estimate - tau_f_true on the valid samples [N·m]; parameters: worst error over "
+                          "the leg joints [%]; se F_v: the largest standard error of F_v the fit reports [% of "
+                          "its value]; *: best scheme of its noise level (lowest worst F_v, F_c, tau_os); "
+                          "inf: a joint left with too few samples",
+                  box=None)
+    for col in ("position noise", "scheme", "N", "rms", *PARAM_NAMES, "se F_v"):
+        table.add_column(col, justify="left" if col in ("position noise", "scheme") else "right")
+    for level in LEVELS:
+        best = result.best(level)
+        for row in (x for x in result.rows if x.position_std == level):
+            noise = "exact log" if level is None else f"{level:g} rad"
+            mark = " *" if row is best else ""
+            table.add_row(noise, row.scheme + mark, str(row.n_samples), f"{row.rms_error:.4g}",
+                          *[_percent(row.worst[n]) for n in PARAM_NAMES], _percent(row.worst_se_F_v),
+                          style="bold" if mark else None)
+    out.print(table)
+    for f in result.files:
+        console.print(f"wrote {f}")
+    console.print(f"study finished in {time.perf_counter() - start:.1f} s")
 
 
 def main() -> None:

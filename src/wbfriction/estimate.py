@@ -28,7 +28,7 @@ import pyarrow as pa
 
 from .dynamics import constrained_dynamics
 from .exceptions import InputError
-from .kinematics import MeasuredKinematics, measure
+from .kinematics import FilterOptions, MeasuredKinematics, Smoother, measure
 from .log import Log, with_metadata
 from .phases import Phases, joint_mask, segment
 from .robot import Robot
@@ -43,7 +43,8 @@ class EstimateOptions:
     """Options of the estimator (defaults from the thesis).
 
     Attributes:
-        diff: differentiation scheme (``central`` or ``backward``, see :mod:`~wbfriction.kinematics`).
+        diff: differentiation scheme: ``central``, ``backward``, ``savgol``, ``butterworth``
+            (:mod:`~wbfriction.kinematics`, :mod:`~wbfriction.filters`) or ``true``.
         compensate_delay: shift the derivatives by their delay (6.1.2).
         torque_alignment: ``zoh`` (mean of tau[k-1], tau[k]), ``sample``, or ``auto``
             (what the log's metadata declares, else ``zoh``).
@@ -57,6 +58,7 @@ class EstimateOptions:
             entries are of the order of (1 / joint inertia)^2.
         condition_number: report cond(M_mod^{-1}) per sample (one KKT inverse per sample).
         method: single-support route, ``rnea`` (default) or ``kkt``.
+        filtering: parameters of the ``savgol`` and ``butterworth`` schemes.
     """
 
     diff: str = "central"
@@ -69,6 +71,7 @@ class EstimateOptions:
     ds_regularization: float | tuple[float, ...] = 1e-3
     condition_number: bool = False
     method: str = "rnea"
+    filtering: FilterOptions = FilterOptions()
 
 
 @dataclass
@@ -87,6 +90,10 @@ class FrictionEstimate:
         contact: (N, n_contacts) flags; ``contact_frames`` their names.
         tau_f_true: (N, n_tc) true friction if the log had it, else None.
         metadata: carried from the log, plus the options used.
+        smoother: the zero-phase smoother the estimate went through (filtering schemes),
+            or None; the fit passes the model through it too
+            (:func:`~wbfriction.identify.fit_friction`). A table records it as the
+            ``estimate_options`` of its metadata.
     """
 
     joints: tuple[str, ...]
@@ -101,6 +108,7 @@ class FrictionEstimate:
     cond: np.ndarray | None = None
     tau_f_true: np.ndarray | None = None
     metadata: dict = field(default_factory=dict)
+    smoother: Smoother | None = None
 
     def to_table(self) -> pa.Table:
         """The estimate as an Arrow table: ``time``, ``phase``, ``unique``, [``cond``],
@@ -243,18 +251,18 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
                                                          options.ds_weight, options.ds_regularization)
         if cond is not None:
             cond[r] = np.linalg.cond(dyn.Mmod_inv)
-    valid = joint_mask(phases, robot.limb_mask, options.mask) & usable[:, None]
+    valid = joint_mask(phases, robot.limb_mask, options.mask) & usable[:, None] & np.isfinite(tau_f)
     metadata = dict(kin.metadata)
     metadata["estimate_options"] = asdict(options)
     return FrictionEstimate(
         joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
         phase=phases.labels(), unique=ss.copy(), contact=kin.contact, contact_frames=robot.contact_frames,
-        cond=cond, tau_f_true=kin.tau_f_true, metadata=metadata)
+        cond=cond, tau_f_true=kin.tau_f_true, metadata=metadata, smoother=kin.smoother)
 
 
 def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOptions(), progress=None) -> FrictionEstimate:
     """Differentiate a log (:func:`~wbfriction.kinematics.measure`) and estimate its friction."""
     kin = measure(log, options.diff, compensate_delay=options.compensate_delay,
-                  torque_alignment=options.torque_alignment)
+                  torque_alignment=options.torque_alignment, filtering=options.filtering)
     kin.metadata.update(robot=robot.name, source=log.source)
     return estimate_friction(robot, kin, options, progress)

@@ -7,9 +7,18 @@ standard error from the Jacobian at the solution,
 
 .. math:: \\operatorname{cov}(\\hat p) = s^2 (J^T J)^{-1}, \\qquad s^2 = \\frac{\\|r\\|^2}{N - 6},
 
-computed through the SVD of J; a parameter with a component in the numerical null
-space of J (e.g. ``v_s`` when ``S = 0``, or the Stribeck parameters when the data never
+computed through the SVD of J, with a Newey-West correction for residuals correlated in
+time (filtered estimates above all; :func:`standard_errors`); a parameter with a component
+in the numerical null space of J (e.g. ``v_s`` when ``S = 0``, or the Stribeck parameters when the data never
 leave the Stribeck region) gets an infinite standard error: the data cannot identify it.
+
+Filtered estimates (thesis 7.1) are compared with the model filtered the same way: when
+the friction went through a zero-phase smoother ``H``, the fit minimises
+``|H(f(qd; p))[valid] + tau_f[valid]|^2`` over the whole time series, as in
+the parallel filtering of robot identification (the filter applied to observations and
+model alike), so that the smoothing of the model's jumps at velocity reversals (Coulomb,
+Stribeck) is not mistaken for a different model. The unfiltered fit on the same samples
+gives the starting point.
 """
 
 from __future__ import annotations
@@ -21,11 +30,21 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from .friction import PARAM_NAMES, FrictionParams, smooth
+from .kinematics import FilterOptions, make_smoother
 
-LOWER = np.array([0.0, 0.0, -1.0, 1e-4, -np.inf, 1e-2])
+LOWER = np.array([0.0, 0.0, 0.0, 1e-4, -np.inf, 1e-2])
 UPPER = np.array([np.inf, np.inf, 50.0, 100.0, np.inf, 1e4])
-"""Bounds of (F_v, F_c, S, v_s, tau_os, a): dissipative viscous and Coulomb parts,
-static friction (1 + S) F_c >= 0, positive Stribeck velocity and tanh slope."""
+"""Bounds of (F_v, F_c, S, v_s, tau_os, a): dissipative viscous and Coulomb parts, static
+friction at least the Coulomb level (S >= 0: the Stribeck effect is a drop from static to
+Coulomb friction), positive Stribeck velocity and tanh slope. The fit further bounds ``v_s``
+by the largest speed in the data: a Stribeck velocity beyond it is not identifiable, and
+the Stribeck term would otherwise mimic viscous friction (S < 0, v_s large)."""
+
+
+def _bounds(qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    upper = UPPER.copy()
+    upper[3] = max(float(np.max(np.abs(qd))), 2 * LOWER[3])
+    return LOWER, upper
 
 
 @dataclass
@@ -101,17 +120,57 @@ def _jacobian(x: np.ndarray, qd: np.ndarray, delta_s: float) -> np.ndarray:
     return J
 
 
-def standard_errors(jac: np.ndarray, residual: np.ndarray, rtol: float = 1e-9) -> np.ndarray:
-    """Standard errors from the Jacobian at a least-squares solution (module docstring)."""
+def standard_errors(jac: np.ndarray, residual: np.ndarray, rtol: float = 1e-9, rows: np.ndarray | None = None,
+                    max_lag: int = 0) -> np.ndarray:
+    """Standard errors from the Jacobian at a least-squares solution (module docstring).
+
+    With ``max_lag > 0`` the residuals may be correlated in time (a filtered estimate, or
+    model error that varies slowly): the covariance is the Newey-West sandwich
+    ``(J^T J)^+ [sum_l w_l G_l] (J^T J)^+`` with Bartlett weights ``w_l = 1 - l / (max_lag + 1)``
+    over the products of the gradients ``g_t = J_t r_t`` of samples ``l`` rows apart in the
+    time series (``rows``: their indices in it; only truly consecutive pairs count).
+
+    Returns:
+        (p,) standard errors; ``inf`` for a parameter with a component in the numerical
+        null space of ``J`` (not identifiable).
+    """
     n, p = jac.shape
-    s2 = float(residual @ residual) / max(n - p, 1)
     _, sv, Vt = np.linalg.svd(jac, full_matrices=False)
     keep = sv > rtol * sv[0] if sv[0] > 0 else np.zeros_like(sv, dtype=bool)
     V = Vt.T
-    var = (V[:, keep] ** 2 / sv[keep] ** 2).sum(axis=1) * s2
     null = V[:, ~keep]
     unidentifiable = (np.abs(null) > 1e-6).any(axis=1) if null.size else np.zeros(p, dtype=bool)
+    if max_lag <= 0:
+        s2 = float(residual @ residual) / max(n - p, 1)
+        var = (V[:, keep] ** 2 / sv[keep] ** 2).sum(axis=1) * s2
+    else:
+        rows = np.arange(n) if rows is None else np.asarray(rows)
+        g = jac * residual[:, None] * np.sqrt(n / max(n - p, 1))
+        meat = g.T @ g
+        for lag in range(1, min(max_lag, n - 1) + 1):
+            pair = rows[lag:] - rows[:-lag] == lag
+            if pair.any():
+                c = g[lag:][pair].T @ g[:-lag][pair]
+                meat += (1.0 - lag / (max_lag + 1.0)) * (c + c.T)
+        bread = (V[:, keep] / sv[keep] ** 2) @ V[:, keep].T  # (J^T J)^+
+        var = np.clip(np.diag(bread @ meat @ bread), 0.0, None)
     return np.where(unidentifiable, np.inf, np.sqrt(var))
+
+
+def correlation_lag(residual: np.ndarray, rows: np.ndarray, threshold: float = 0.05, cap: int = 2000) -> int:
+    """Largest lag worth summing in :func:`standard_errors`: twice the lag at which the
+    residuals' autocorrelation (over samples truly that many rows apart) first falls below
+    ``threshold``, and at least Newey and West's rule of thumb ``4 (n / 100)^(2/9)``."""
+    n = len(residual)
+    rule = int(4 * (n / 100.0) ** (2.0 / 9.0))
+    var = float(residual @ residual) / max(n, 1)
+    if var == 0:
+        return rule
+    for lag in range(1, min(cap, n - 1) + 1):
+        pair = rows[lag:] - rows[:-lag] == lag
+        if pair.sum() < 10 or float(residual[lag:][pair] @ residual[:-lag][pair]) / pair.sum() < threshold * var:
+            return max(rule, 2 * lag)
+    return max(rule, 2 * cap)
 
 
 def initial_guesses(qd: np.ndarray, y: np.ndarray) -> list[np.ndarray]:
@@ -127,8 +186,35 @@ def initial_guesses(qd: np.ndarray, y: np.ndarray) -> list[np.ndarray]:
     return starts
 
 
+def _solve(residual, jacobian, start, bounds, max_nfev):
+    start = np.clip(start, bounds[0] + 1e-12, bounds[1] - 1e-12)
+    return least_squares(residual, start, jac=jacobian, bounds=bounds, method="trf", x_scale="jac",
+                         ftol=1e-10, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev)
+
+
+def _filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, delta_s: float):
+    """Residual and Jacobian of the model passed through ``smoother``, on the rows ``use``."""
+    rows = np.flatnonzero(use)
+
+    def both(x):
+        cols = np.column_stack([_model(x, qd, delta_s), _jacobian(x, qd, delta_s)])
+        return smoother(cols)[rows]
+
+    cache: dict[bytes, np.ndarray] = {}
+
+    def values(x):
+        key = x.tobytes()
+        if key not in cache:
+            cache.clear()
+            cache[key] = both(x)
+        return cache[key]
+
+    return (lambda x: values(x)[:, 0] - y[rows]), (lambda x: values(x)[:, 1:])
+
+
 def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joint: str = "",
-                 x0: np.ndarray | None = None, min_samples: int = 20) -> FitResult:
+                 x0: np.ndarray | None = None, min_samples: int = 20, mask: np.ndarray | None = None,
+                 smoother=None) -> FitResult:
     """Fit model (3.5) to friction estimates of one joint (eq. 6.4).
 
     Args:
@@ -139,28 +225,43 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         x0: a starting point (6,) in :data:`~wbfriction.friction.PARAM_NAMES` order; by
             default several (:func:`initial_guesses`), the best fit is kept.
         min_samples: fewer samples give a result without parameters.
+        mask: (N,) samples to fit (default: every finite one).
+        smoother: the zero-phase smoother ``tau_f`` went through
+            (:attr:`~wbfriction.estimate.FrictionEstimate.smoother`), or None; ``qd`` and
+            ``tau_f`` are then whole time series, ``qd`` NaN where the estimate was left out
+            of the smoothing, and the model goes through the same smoother before it is
+            compared (module docstring). Samples where the smoothed model is undefined are
+            not used.
 
     Returns:
         :class:`FitResult`.
     """
     qd = np.asarray(qd, dtype=float)
     y = -np.asarray(tau_f, dtype=float)
-    n = qd.size
+    use = np.isfinite(qd) & np.isfinite(y)
+    if mask is not None:
+        use &= np.asarray(mask, dtype=bool)
+    if smoother is not None:
+        use &= np.isfinite(smoother(qd))
+    n = int(use.sum())
     if n < max(min_samples, 7):
         return FitResult(joint, n, message=f"only {n} valid samples")
-    starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(qd, y)
-
-    def solve(start, max_nfev):
-        return least_squares(lambda x: _model(x, qd, delta_s) - y, start,
-                             jac=lambda x: _jacobian(x, qd, delta_s), bounds=(LOWER, UPPER),
-                             method="trf", x_scale="jac", ftol=1e-10, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev)
-
+    v, yu = qd[use], y[use]
+    starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(v, yu)
+    residual = lambda x: _model(x, v, delta_s) - yu  # noqa: E731
+    jacobian = lambda x: _jacobian(x, v, delta_s)  # noqa: E731
+    bounds = _bounds(v)
     # a short run from every start, then the two best refined
     if len(starts) > 1:
-        short = sorted((solve(s, 30) for s in starts), key=lambda r: r.cost)
+        short = sorted((_solve(residual, jacobian, s, bounds, 30) for s in starts), key=lambda r: r.cost)
         starts = [r.x for r in short[:2]]
-    best = min((solve(s, 300) for s in starts), key=lambda r: r.cost)
-    se = standard_errors(_jacobian(best.x, qd, delta_s), best.fun)
+    best = min((_solve(residual, jacobian, s, bounds, 300) for s in starts), key=lambda r: r.cost)
+    if smoother is not None:
+        residual, jacobian = _filtered_problem(qd, y, use, smoother, delta_s)
+        best = _solve(residual, jacobian, best.x, bounds, 200)
+    # residuals correlated over the filter's window, or over the span of a model error
+    rows = np.flatnonzero(use)
+    se = standard_errors(jacobian(best.x), best.fun, rows=rows, max_lag=correlation_lag(best.fun, rows))
     return FitResult(
         joint=joint, n_samples=n, params=FrictionParams.from_vector(best.x, delta_s),
         stderr=dict(zip(PARAM_NAMES, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
@@ -169,19 +270,22 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
 
 def fit_estimate(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
                  tau_f_true: np.ndarray | None = None, targets: dict[str, FrictionParams] | None = None,
-                 delta_s: float = 2.0, min_samples: int = 20) -> list[FitResult]:
+                 delta_s: float = 2.0, min_samples: int = 20, smoother=None) -> list[FitResult]:
     """Fit every joint of a friction estimate on its valid samples.
 
     Args:
         joints: names (n,).
-        qd, tau_f, valid: (N, n) arrays of a :class:`~wbfriction.estimate.FrictionEstimate`.
+        qd, tau_f, valid: (N, n) arrays of a :class:`~wbfriction.estimate.FrictionEstimate`
+            (the whole time series: with ``smoother`` the model is filtered along it).
         tau_f_true: (N, n) true friction (NaN columns for unknown) or None.
         targets: true parameters per joint name, when known.
+        smoother: the estimate's smoother (``FrictionEstimate.smoother``) or None.
     """
     out = []
     for i, joint in enumerate(joints):
+        res = fit_friction(qd[:, i], tau_f[:, i], delta_s=delta_s, joint=joint, min_samples=min_samples,
+                           mask=valid[:, i], smoother=smoother)
         m = valid[:, i] & np.isfinite(tau_f[:, i]) & np.isfinite(qd[:, i])
-        res = fit_friction(qd[m, i], tau_f[m, i], delta_s=delta_s, joint=joint, min_samples=min_samples)
         if tau_f_true is not None and np.isfinite(tau_f_true[m, i]).all() and m.any():
             res.rms_error_vs_true = float(np.sqrt(np.mean((tau_f[m, i] - tau_f_true[m, i]) ** 2)))
             if res.params is not None:
@@ -222,5 +326,11 @@ def fit_friction_table(table, *, delta_s: float = 2.0, min_samples: int = 20, so
                                 for j in joints])
     meta = read_metadata(table)
     targets = {j: FrictionParams.from_dict(p) for j, p in meta.get("friction_true", {}).items()}
+    smoother = None
+    if "estimate_options" in meta:
+        opts = meta["estimate_options"]
+        time = col("time")
+        smoother = make_smoother(opts.get("diff", "central"), FilterOptions(**opts.get("filtering", {})),
+                                 float(np.median(np.diff(time))))
     return fit_estimate(joints, qd, tau_f, valid, tau_f_true=true, targets=targets, delta_s=delta_s,
-                        min_samples=min_samples)
+                        min_samples=min_samples, smoother=smoother)

@@ -5,40 +5,34 @@ differentiating the joint positions, with the one the model predicts (chapter 5)
 This module holds the differentiation schemes and the alignment of every other
 signal with what the derivative measures.
 
-Differentiators map positions ``q`` (N, n) sampled every ``dt`` to ``(qd, qdd,
-delay)``: ``qd[k]`` and ``qdd[k]`` are computed from samples up to ``k + lookahead``
-and describe the instant ``k - delay`` (``delay`` in samples, integer). Rows whose
-stencil leaves the log are NaN. New schemes (Savitzky-Golay, Butterworth: thesis 7.1)
-register in :data:`DIFFERENTIATORS`.
+Schemes (:data:`SCHEMES`) map positions ``q`` (N, n) sampled every ``dt`` to
+``(qd, qdd, delay)``: ``qd[k]`` and ``qdd[k]`` describe the instant ``k - delay``
+(``delay`` in samples, integer); rows whose stencil leaves the log are NaN. ``central``
+(6.2) and ``backward`` (6.3) differentiate the raw positions; ``savgol`` and
+``butterworth`` add the zero-phase filters of thesis 7.1 (:mod:`wbfriction.filters`).
 
-Delay compensation (thesis 6.1.2): a causal scheme (backward differences) measures
-the acceleration ``delay`` samples late. With ``compensate_delay=True`` every other
-input is taken from the instant the derivative describes, i.e. the derivatives are
-shifted back by ``delay`` rows. The first difference of a backward scheme keeps half
-a sample of delay, which no integer shift removes (the thesis's residual error).
-
-Torque alignment: a torque command held over each sampling period (zero-order hold)
-makes the central second difference at ``k`` see the mean of ``tau[k-1]`` and
-``tau[k]``: with piecewise-constant acceleration ``a`` over each period,
-``(q[k+1] - 2 q[k] + q[k-1]) / dt^2 = (a[k-1] + a[k]) / 2``. The default alignment
-``"zoh"`` therefore compares the acceleration with that mean; ``"sample"`` uses
-``tau[k]`` (right for torques sampled from a continuous signal, and for a simulator that
-integrates with semi-implicit Euler at the log rate, where the central second difference
-at ``k`` is exactly the acceleration caused by ``tau[k]``). ``"auto"`` takes what the log's
-metadata declares (the simulators write it), else ``"zoh"``.
+Consistency (thesis 6.1.2): a filter applied to the measured acceleration must be applied,
+with the same (zero) delay, to every signal it is compared with. With ``savgol`` the
+positions, velocity and acceleration are the value and derivatives of one local fit
+(7.1-7.8) and the torques go through the same fit's smoother; with ``butterworth`` the
+positions and the central-difference velocity and acceleration (6.2) go through the
+forward-backward low-pass, and the torques too. The estimate (5.13) is then the friction
+seen through the filter (up to the filter's commutation with the slowly varying inertia and
+gravity terms), and the identification passes its model through the same smoother
+(:mod:`wbfriction.identify`). No filter window spans a contact change: the rows whose
+central stencil does (:func:`straddling`: an impact, a touch-down) are left out of every
+filter, so that the rows within a window of them are NaN.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
 from .exceptions import InputError
+from .filters import SavgolSmoother, ZeroPhaseLowpass, savgol_differentiate
 from .log import Log
-
-Differentiator = Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, int]]
 
 
 def central_differences(q: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, int]:
@@ -69,10 +63,56 @@ def backward_differences(q: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarr
     return qd, qdd, 1
 
 
-DIFFERENTIATORS: dict[str, Differentiator] = {
-    "central": central_differences,
-    "backward": backward_differences,
-}
+@dataclass(frozen=True)
+class FilterOptions:
+    """Parameters of the filtering schemes (thesis 7.1; defaults: the thesis's).
+
+    Attributes:
+        window: Savitzky-Golay window length L (odd) [samples].
+        poly_order: Savitzky-Golay polynomial order k (>= 2).
+        weights: Savitzky-Golay weights, ``uniform`` or ``gaussian`` (:func:`~wbfriction.filters.savgol_weights`).
+        cutoff: Butterworth cutoff [Hz] (one pass, -3 dB).
+        butter_order: Butterworth order n.
+    """
+
+    window: int = 151
+    poly_order: int = 4
+    weights: str = "uniform"
+    cutoff: float = 10.0
+    butter_order: int = 6
+
+
+Smoother = SavgolSmoother | ZeroPhaseLowpass
+
+
+def make_smoother(diff: str, filtering: FilterOptions, dt: float) -> Smoother | None:
+    """The zero-phase smoother of a filtering scheme (``savgol``, ``butterworth``), else None.
+
+    Raises:
+        InputError: filter parameters that make no filter.
+    """
+    if diff == "savgol":
+        return SavgolSmoother(filtering.window, filtering.poly_order, dt, filtering.weights)
+    if diff == "butterworth":
+        return ZeroPhaseLowpass(filtering.cutoff, filtering.butter_order, dt)
+    return None
+
+
+DIFFERENTIATORS = {"central": central_differences, "backward": backward_differences}
+SCHEMES = (*DIFFERENTIATORS, "savgol", "butterworth")
+"""Differentiation schemes by name: plain differences, then the filtering ones (module docstring)."""
+
+
+def straddling(contact: np.ndarray) -> np.ndarray:
+    """Rows (N,) whose central-difference stencil ``k-1 .. k+1`` spans a change of the
+    contact flags: their derivatives mix two phases (an impact, a configuration change)."""
+    change = np.zeros(len(contact), dtype=bool)
+    change[1:] = np.any(contact[1:] != contact[:-1], axis=1)
+    out = change.copy()
+    out[:-1] |= change[1:]
+    return out
+
+
 TORQUE_ALIGNMENTS = ("zoh", "sample")
 
 
@@ -120,6 +160,8 @@ class MeasuredKinematics:
         valid: rows where every signal is defined (N,).
         tau_f_true: true friction (N, n_tc), or None.
         metadata: carried from the log.
+        smoother: the filtering scheme's zero-phase smoother, which every signal went
+            through, or None (the identification filters the model with it).
     """
 
     time: np.ndarray
@@ -132,48 +174,69 @@ class MeasuredKinematics:
     valid: np.ndarray | None = None
     tau_f_true: np.ndarray | None = None
     metadata: dict = field(default_factory=dict)
+    smoother: Smoother | None = None
 
     def __post_init__(self) -> None:
         if self.valid is None:
-            self.valid = (np.all(np.isfinite(self.qd), axis=1) & np.all(np.isfinite(self.qdd), axis=1)
-                          & np.all(np.isfinite(self.tau), axis=1))
+            self.valid = (np.all(np.isfinite(self.q), axis=1) & np.all(np.isfinite(self.qd), axis=1)
+                          & np.all(np.isfinite(self.qdd), axis=1) & np.all(np.isfinite(self.tau), axis=1))
+
+
+def _filtered(log: Log, tau: np.ndarray, smoother: Smoother, filtering: FilterOptions
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``q, qd, qdd, tau`` of a filtering scheme (module docstring); rows whose window reaches
+    a row :func:`straddling` a contact change are NaN, except ``q`` (raw there)."""
+    blank = straddling(log.contact)[:, None]
+    qd_c, qdd_c, _ = central_differences(log.q, log.dt)
+    qd_c = np.where(blank, np.nan, qd_c)
+    if isinstance(smoother, SavgolSmoother):  # derivatives of one local fit (7.1-7.8)
+        q_s, qd_s, qdd = savgol_differentiate(np.where(blank, np.nan, log.q), log.dt, filtering.window,
+                                              filtering.poly_order, filtering.weights)
+    else:  # central differences through the zero-phase low-pass (7.1.2)
+        q_s, qd_s, qdd = smoother(np.where(blank, np.nan, log.q)), smoother(qd_c), smoother(qdd_c)
+    tau = smoother(np.where(blank, np.nan, tau))
+    return np.where(np.isfinite(q_s), q_s, log.q), qd_s, qdd, tau
 
 
 def measure(log: Log, diff: str = "central", *, compensate_delay: bool = True,
-            torque_alignment: str = "auto") -> MeasuredKinematics:
-    """Differentiate a log's joint positions and align the other signals (6.1.2).
+            torque_alignment: str = "auto", filtering: FilterOptions = FilterOptions()) -> MeasuredKinematics:
+    """Differentiate a log's joint positions and align the other signals (6.1.2, 7.1).
 
     Args:
         log: a validated :class:`~wbfriction.log.Log`.
-        diff: differentiation scheme, a key of :data:`DIFFERENTIATORS`, or ``"true"``:
-            the log's true velocities and accelerations (simulated logs), with the
-            torques as logged (``torque_alignment`` and delays do not apply).
+        diff: differentiation scheme, one of :data:`SCHEMES`, or ``"true"``: the log's
+            true velocities and accelerations (simulated logs), with the torques as logged
+            (``torque_alignment``, delays and filters do not apply).
         compensate_delay: shift the derivatives back by the scheme's delay so that they
             describe the same instant as the other inputs (thesis 6.1.2).
         torque_alignment: see :func:`align_torque`; ``"auto"``: the log's metadata key
             ``torque_alignment`` when a simulator wrote one, else ``"zoh"``.
+        filtering: parameters of the ``savgol`` and ``butterworth`` schemes.
 
     Raises:
-        InputError: unknown scheme or alignment; ``"true"`` on a log without
+        InputError: unknown scheme or alignment, filter parameters that make no filter, a
+            log too short for the filter; ``"true"`` on a log without
             ``qd_true``/``qdd_true`` columns.
     """
+    q, smoother = log.q, None
     if diff == "true":
         if log.qd_true is None or log.qdd_true is None:
             raise InputError(f"{log.source}: diff 'true' needs the columns qd_true.* and qdd_true.* "
                              "(written by the simulators)")
         qd, qdd, tau = log.qd_true, log.qdd_true, log.tau
     else:
-        try:
-            differentiate = DIFFERENTIATORS[diff]
-        except KeyError:
-            raise InputError(f"unknown differentiation scheme '{diff}': choose one of "
-                             f"{', '.join(DIFFERENTIATORS)}, true") from None
+        if diff not in SCHEMES:
+            raise InputError(f"unknown differentiation scheme '{diff}': choose one of {', '.join(SCHEMES)}, true")
         if torque_alignment == "auto":
             torque_alignment = log.metadata.get("torque_alignment", "zoh")
-        qd, qdd, delay = differentiate(log.q, log.dt)
-        if compensate_delay:
-            qd, qdd = _shift_back(qd, delay), _shift_back(qdd, delay)
+        smoother = make_smoother(diff, filtering, log.dt)
         tau = align_torque(log.tau, torque_alignment)
+        if smoother is None:
+            qd, qdd, delay = DIFFERENTIATORS[diff](log.q, log.dt)
+            if compensate_delay:
+                qd, qdd = _shift_back(qd, delay), _shift_back(qdd, delay)
+        else:
+            q, qd, qdd, tau = _filtered(log, tau, smoother, filtering)
     return MeasuredKinematics(
-        time=log.time, q=log.q, qd=qd, qdd=qdd, tau=tau, contact=log.contact, base=log.base,
-        tau_f_true=log.tau_f_true, metadata=dict(log.metadata))
+        time=log.time, q=q, qd=qd, qdd=qdd, tau=tau, contact=log.contact, base=log.base,
+        tau_f_true=log.tau_f_true, metadata=dict(log.metadata), smoother=smoother)

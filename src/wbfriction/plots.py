@@ -13,6 +13,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .estimate import FrictionEstimate
+from .friction import FrictionParams
 from .identify import FitResult
 from .log import write_atomic
 
@@ -118,4 +119,58 @@ def friction_curves_figure(est: FrictionEstimate, fits: list[FitResult], path: s
     fig.supxlabel("qd [rad/s]")
     fig.supylabel("tau_f [N·m]")
     fig.suptitle("Friction over velocity: valid estimates, fitted model (3.5), target")
+    _save(fig, path)
+
+
+def filter_curves_figure(curves: dict[str, dict], joint: str, target, position_std: float | None,
+                         path: str | Path) -> None:
+    """Fig. 7.2 kind: one joint's valid estimates over velocity for several filters (one
+    panel each, shared axes), with the target and the model fitted through the filter."""
+    n = max(len(curves), 1)
+    columns = min(n, 4)
+    rows = int(np.ceil(n / columns))
+    fig = Figure(figsize=(3.2 * columns, 2.7 * rows + 0.7), layout="constrained")
+    axes = fig.subplots(rows, columns, sharex=True, sharey=True, squeeze=False).ravel()
+    for ax, (label, c) in zip(axes, curves.items()):
+        ax.plot(c["qd"], c["tau_f"], ".", ms=1, color="C0", alpha=0.3)
+        if len(c["qd"]):
+            v = np.linspace(np.min(c["qd"]), np.max(c["qd"]), 400)
+            ax.plot(v, target.torque(v), color="k", lw=2.5, alpha=0.35, label="target")
+            if c["fit"] is not None:
+                ax.plot(v, FrictionParams.from_dict(c["fit"]).torque(v), color="C1", lw=1, label="fit")
+        ax.set_title(label, fontsize=9)
+        ax.tick_params(labelsize=7)
+    for ax in axes[len(curves):]:
+        ax.set_visible(False)
+    axes[0].legend(fontsize=7)
+    lim = 3 * float(np.max(np.abs(target.torque(np.linspace(-1, 1, 50)))))
+    axes[0].set_ylim(-lim, lim)
+    fig.supxlabel("qd [rad/s]")
+    fig.supylabel("tau_f [N·m]")
+    noise = "exact log" if position_std is None else f"position noise {position_std:g} rad"
+    fig.suptitle(f"Fig. 7.2: {joint} over velocity through each filter ({noise})")
+    _save(fig, path)
+
+
+def spectrum_figure(spec, path: str | Path, max_freq: float = 50.0, columns: int = 4) -> None:
+    """Fig. 7.1 kind: amplitude spectrum of the estimated acceleration per joint (log scale,
+    shared axes), the suggested cutoff of each joint dashed, the overall one solid."""
+    n = len(spec.joints)
+    columns = min(columns, n)
+    rows = int(np.ceil(n / columns))
+    fig = Figure(figsize=(3.0 * columns, 2.2 * rows + 0.7), layout="constrained")
+    axes = fig.subplots(rows, columns, sharex=True, sharey=True, squeeze=False).ravel()
+    keep = (spec.freq > 0) & (spec.freq <= max_freq)
+    for i, (ax, joint) in enumerate(zip(axes, spec.joints)):
+        ax.semilogy(spec.freq[keep], spec.amplitude[keep, i], lw=0.7, color="C0")
+        ax.axvline(spec.cutoff[i], color="C1", ls="--", lw=1)
+        ax.axvline(spec.suggestion, color="C3", lw=1)
+        ax.set_title(f"{joint.replace('_joint', '')}: {spec.cutoff[i]:.1f} Hz", fontsize=8)
+        ax.tick_params(labelsize=7)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    fig.supxlabel("frequency [Hz]")
+    fig.supylabel("amplitude of qdd_est [rad/s²]")
+    fig.suptitle(f"Fig. 7.1: spectrum of the estimated acceleration; suggested cutoff {spec.suggestion:.1f} Hz "
+                 f"(dashed: each joint's; the median of them)")
     _save(fig, path)

@@ -138,7 +138,7 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
     say("fitting the friction model of every leg joint")
     idx = [est.joints.index(j) for j, _, _ in legs]
     fits = fit_estimate([j for j, _, _ in legs], est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx],
-                        tau_f_true=est.tau_f_true[:, idx], targets=friction)
+                        tau_f_true=est.tau_f_true[:, idx], targets=friction, smoother=est.smoother)
     rows = [LegRow(j, side, g, thesis_number(side, g), f, TABLE_6_1.get((side, g)), TABLE_6_2.get((side, g)))
             for (j, side, g), f in zip(legs, fits)]
     doc = {"robot": robot.name, "gait": asdict(GaitOptions(gait="combined", steps=steps)),

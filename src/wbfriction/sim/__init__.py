@@ -1,6 +1,8 @@
-"""Simulators that write logs in the project's format: the ideal one (thesis 6.1)."""
+"""Simulators that write logs in the project's format: the ideal one (thesis 6.1), and sensor models."""
 
 from .control import feedforward, pd_gains
 from .ideal import INTEGRATORS, IdealOptions, Pull, SimulationResult, simulate_ideal
+from .sensors import SensorNoise, apply_sensor_noise
 
-__all__ = ["feedforward", "pd_gains", "INTEGRATORS", "IdealOptions", "Pull", "SimulationResult", "simulate_ideal"]
+__all__ = ["feedforward", "pd_gains", "INTEGRATORS", "IdealOptions", "Pull", "SimulationResult", "simulate_ideal",
+           "SensorNoise", "apply_sensor_noise"]
