@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy.ndimage import maximum_filter1d
@@ -149,12 +150,12 @@ class ZeroPhaseLowpass:
         if self.order < 1:
             raise InputError(f"Butterworth order must be at least 1, got {self.order}")
 
-    @property
+    @cached_property
     def sos(self) -> np.ndarray:
         """Second-order sections of one pass."""
         return butter(self.order, self.cutoff, btype="low", fs=1.0 / self.dt, output="sos")
 
-    @property
+    @cached_property
     def half_width(self) -> int:
         """Samples on each side beyond which the forward-backward impulse response holds
         less than :data:`TAIL` of its absolute sum."""
@@ -206,12 +207,16 @@ class SavgolSmoother:
 
     def kernel(self) -> np.ndarray:
         """Impulse response h_0 (L,), symmetric."""
+        return self._kernel.copy()
+
+    @cached_property
+    def _kernel(self) -> np.ndarray:
         return savgol_kernels(self.window, self.order, self.dt, self.weights, max_deriv=0)[0]
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         """Smooth ``x`` (N_samples, ...) along axis 0; rows without a full window of finite
         samples are NaN."""
-        return _fir(x, self.kernel())
+        return _fir(x, self._kernel)
 
 
 def finite_runs(x: np.ndarray) -> list[tuple[int, int]]:
