@@ -1,0 +1,201 @@
+"""A MuJoCo model of a robot, built at run time from the URDF of its Pinocchio model.
+
+The realistic simulator (thesis 6.2) must not share code with the estimator, so it runs on
+MuJoCo (PyPI ``mujoco``). The model comes from the same URDF: visual and collision
+meshes are dropped, the URDF's ``<dynamics>`` (damping, friction) too (friction is injected
+explicitly), a free joint is added at the root, a floor plane, and one box per contact
+frame: the footprint of the foot's collision mesh (from the installed robot package),
+flat under the contact frame. Joints are mapped by name; configurations and velocities
+convert both ways (:class:`MujocoRobot`).
+
+Conventions that differ (field notes): MuJoCo orders joints by its own tree traversal,
+writes quaternions (w, x, y, z) where Pinocchio writes (x, y, z, w), and gives the free
+joint's linear velocity in the world frame where Pinocchio gives it in the base frame.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+
+from ..exceptions import ModelError
+from ..robot import Robot
+
+SOLE_THICKNESS = 0.01  # [m], the contact boxes' height, their bottom face on the contact frame's plane
+
+
+def _read_stl(path: Path) -> np.ndarray:
+    """Vertices (3 n, 3) of a binary STL file."""
+    data = path.read_bytes()
+    n = int(np.frombuffer(data[80:84], np.uint32)[0])
+    tri = np.frombuffer(data[84:84 + 50 * n], dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]))
+    return tri["v"].reshape(-1, 3).astype(float)
+
+
+def sole_footprint(robot: Robot, frame: str, urdf_root: ET.Element | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Rectangle under a contact frame: centre (x, y) and half sizes (x, y) [m], in the frame.
+
+    Read from the collision mesh (binary STL) of the link the frame hangs on: the
+    bounding box, in the frame's axes, of the vertices within 1 cm of the mesh's lowest point.
+
+    Raises:
+        ModelError: no collision mesh to read.
+    """
+    root = ET.parse(robot.urdf).getroot() if urdf_root is None else urdf_root
+    model = robot.model
+    fr = model.frames[model.getFrameId(frame)]
+    link = model.frames[fr.parentFrame]
+    while link.type != pin.FrameType.BODY and link.parentFrame != 0:  # the link carrying the frame
+        link = model.frames[link.parentFrame]
+    for node in root.findall("link"):
+        if node.get("name") != link.name:
+            continue
+        for col in node.findall("collision"):
+            mesh = col.find("geometry/mesh")
+            if mesh is None:
+                continue
+            path = _resolve_mesh(mesh.get("filename"), robot.urdf)
+            scale = np.array([float(s) for s in (mesh.get("scale") or "1 1 1").split()])
+            origin = col.find("origin")
+            xyz = np.array([float(s) for s in ((origin.get("xyz") if origin is not None else None) or "0 0 0").split()])
+            rpy = np.array([float(s) for s in ((origin.get("rpy") if origin is not None else None) or "0 0 0").split()])
+            v = _read_stl(path) * scale
+            v = v @ pin.rpy.rpyToMatrix(*rpy).T + xyz  # in the link frame
+            link_to_frame = link.placement.actInv(fr.placement)  # frame pose in the link
+            v = (v - link_to_frame.translation) @ link_to_frame.rotation  # in the contact frame
+            low = v[v[:, 2] < v[:, 2].min() + 0.01]
+            lo, hi = low[:, :2].min(axis=0), low[:, :2].max(axis=0)
+            return (lo + hi) / 2, (hi - lo) / 2
+    raise ModelError(f"no collision mesh on link '{link.name}' to size the sole of '{frame}'")
+
+
+def _resolve_mesh(filename: str, urdf: Path) -> Path:
+    """A ``package://`` or relative mesh path, found next to the URDF's package tree."""
+    if filename.startswith("package://"):
+        rel = filename[len("package://"):]
+        for parent in Path(urdf).resolve().parents:
+            for candidate in (parent / rel, parent / rel.split("/", 1)[-1]):
+                if candidate.is_file():
+                    return candidate
+        raise ModelError(f"mesh '{filename}' not found above {urdf}")
+    path = (Path(urdf).parent / filename).resolve()
+    if not path.is_file():
+        raise ModelError(f"mesh '{filename}' not found")
+    return path
+
+
+@dataclass
+class MujocoRobot:
+    """A robot's MuJoCo model and the maps between its coordinates and Pinocchio's.
+
+    Attributes:
+        robot: the Pinocchio-side robot.
+        model: the compiled ``mujoco.MjModel``.
+        qpos_index: MuJoCo ``qpos`` address of each actuated joint, in :attr:`Robot.actuated` order.
+        dof_index: MuJoCo ``qvel`` address of each actuated joint.
+        sole_geoms: geom id of each contact frame's box, in :attr:`Robot.contact_frames` order.
+    """
+
+    robot: Robot
+    model: mujoco.MjModel
+    qpos_index: np.ndarray
+    dof_index: np.ndarray
+    sole_geoms: tuple[int, ...]
+
+    def qpos(self, q: np.ndarray) -> np.ndarray:
+        """MuJoCo ``qpos`` (nq,) of a Pinocchio configuration (nq,)."""
+        out = np.zeros(self.model.nq)
+        out[:3] = q[:3]
+        out[3:7] = q[[6, 3, 4, 5]]  # (w, x, y, z)
+        out[self.qpos_index] = q[self.robot.act_q_index]
+        return out
+
+    def q(self, qpos: np.ndarray) -> np.ndarray:
+        """Pinocchio configuration of a MuJoCo ``qpos``."""
+        out = np.zeros(self.robot.model.nq)
+        out[:3] = qpos[:3]
+        out[3:7] = qpos[[4, 5, 6, 3]]
+        out[self.robot.act_q_index] = qpos[self.qpos_index]
+        return out
+
+    def velocity_map(self, q: np.ndarray) -> np.ndarray:
+        """``T`` (nv, nv) with ``qvel = T v`` at configuration ``q`` (Pinocchio's): the base
+        linear velocity turns from the base frame into the world frame."""
+        nv = self.model.nv
+        T = np.zeros((nv, nv))
+        T[:3, :3] = pin.Quaternion(q[3:7]).normalized().matrix()
+        T[3:6, 3:6] = np.eye(3)
+        T[self.dof_index, self.robot.act_v_index] = 1.0
+        return T
+
+
+def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
+    """Build the MuJoCo model of ``robot`` (module docstring).
+
+    Args:
+        robot: a robot with a free-flyer root and contact frames.
+        timestep: physics step [s].
+
+    Raises:
+        ModelError: the URDF does not compile in MuJoCo, a joint missing, no sole mesh.
+    """
+    root = ET.parse(robot.urdf).getroot()
+    footprints = [sole_footprint(robot, f, root) for f in robot.contact_frames]
+    for link in root.findall("link"):
+        for tag in ("visual", "collision"):
+            for e in link.findall(tag):
+                link.remove(e)
+    for joint in root.findall("joint"):
+        for e in joint.findall("dynamics"):
+            joint.remove(e)
+    for tag in ("gazebo", "transmission"):
+        for e in root.findall(tag):
+            root.remove(e)
+    extension = ET.SubElement(root, "mujoco")
+    ET.SubElement(extension, "compiler", discardvisual="true", fusestatic="false", balanceinertia="false")
+    try:
+        spec = mujoco.MjSpec.from_string(ET.tostring(root, encoding="unicode"))
+    except Exception as exc:  # mujoco raises ValueError with its parser's message
+        raise ModelError(f"{robot.urdf}: MuJoCo cannot read the URDF: {exc}") from None
+    spec.option.timestep = timestep
+    spec.worldbody.first_body().add_freejoint()
+    spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1])
+    model = robot.model
+    for frame, (centre, half) in zip(robot.contact_frames, footprints):
+        fr = model.frames[model.getFrameId(frame)]
+        body = spec.body(_body_of_joint(model, fr.parentJoint))
+        if body is None:
+            raise ModelError(f"MuJoCo has no body for the link carrying '{frame}'")
+        pos = fr.placement.act(np.array([centre[0], centre[1], SOLE_THICKNESS / 2]))
+        body.add_geom(name=f"sole_{frame}", type=mujoco.mjtGeom.mjGEOM_BOX,
+                      size=[half[0], half[1], SOLE_THICKNESS / 2], pos=pos,
+                      quat=pin.Quaternion(fr.placement.rotation).coeffs()[[3, 0, 1, 2]])
+    try:
+        mj = spec.compile()
+    except Exception as exc:
+        raise ModelError(f"{robot.urdf}: MuJoCo cannot compile the model: {exc}") from None
+    qpos_index, dof_index = [], []
+    for name in robot.actuated:
+        jid = mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_JOINT, name)
+        if jid < 0:
+            raise ModelError(f"MuJoCo model has no joint '{name}'")
+        qpos_index.append(mj.jnt_qposadr[jid])
+        dof_index.append(mj.jnt_dofadr[jid])
+    soles = tuple(mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_GEOM, f"sole_{f}") for f in robot.contact_frames)
+    return MujocoRobot(robot, mj, np.array(qpos_index), np.array(dof_index), soles)
+
+
+def _body_of_joint(model: pin.Model, joint: int) -> str:
+    """URDF link name of the body a Pinocchio joint moves (the joint's child link)."""
+    for f in model.frames:
+        if f.type == pin.FrameType.BODY and f.parentJoint == joint and f.placement.isIdentity():
+            return f.name
+    raise ModelError(f"no body frame for joint '{model.names[joint]}'")
+
+
+
