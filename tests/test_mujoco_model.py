@@ -7,7 +7,11 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from wbfriction.sim.mujoco_model import SOLE_THICKNESS, build_mujoco_robot, sole_footprint
+from wbfriction.sim.mujoco_model import (
+    SOLE_THICKNESS,
+    build_mujoco_robot,
+    sole_footprint,
+)
 
 
 @pytest.fixture(scope="module")
