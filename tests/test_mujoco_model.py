@@ -70,7 +70,7 @@ def test_soles_are_boxes_flat_under_the_contact_frames(talos, mj_talos):
         np.testing.assert_allclose(d.geom_xpos[geom], expected, atol=1e-12)
         np.testing.assert_allclose(d.geom_xmat[geom].reshape(3, 3), oMf.rotation, atol=1e-12)
         np.testing.assert_allclose(m.geom_size[geom][:2], half)
-        assert m.geom_condim[geom] == 6  # torsional friction holds the stance foot's yaw
+        assert m.geom_condim[geom] == 4  # torsional friction holds the stance foot's yaw
     # TALOS's foot: about 21 cm by 13 cm
     assert 0.20 < 2 * half[0] < 0.23 and 0.12 < 2 * half[1] < 0.15
 
