@@ -18,3 +18,7 @@ class InputError(WbfrictionError, ValueError):
 
 class ModelError(WbfrictionError):
     """A robot model that cannot be used by an algorithm (e.g. an unsupported joint type)."""
+
+
+class SimulationError(WbfrictionError):
+    """A simulation that cannot go on (e.g. the robot fell): the message says when and why."""

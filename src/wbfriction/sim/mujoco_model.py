@@ -128,6 +128,15 @@ class MujocoRobot:
         out[self.robot.act_q_index] = qpos[self.qpos_index]
         return out
 
+    def v(self, qpos: np.ndarray, qvel: np.ndarray) -> np.ndarray:
+        """Pinocchio velocity (nv,) of a MuJoCo state: the inverse of :meth:`velocity_map`."""
+        out = np.zeros(self.robot.model.nv)
+        R = pin.Quaternion(qpos[[4, 5, 6, 3]]).normalized().matrix()
+        out[:3] = R.T @ qvel[:3]
+        out[3:6] = qvel[3:6]
+        out[self.robot.act_v_index] = qvel[self.dof_index]
+        return out
+
     def velocity_map(self, q: np.ndarray) -> np.ndarray:
         """``T`` (nv, nv) with ``qvel = T v`` at configuration ``q`` (Pinocchio's): the base
         linear velocity turns from the base frame into the world frame."""
