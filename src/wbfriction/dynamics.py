@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from .progress import counted
 from .robot import Robot
 
 
@@ -113,7 +114,7 @@ def constrained_dynamics(robot: Robot, angles: np.ndarray, qd: np.ndarray, qdd_m
     qdd_est = np.empty((n, robot.n_act))
     Mmod_inv = np.empty((n, n_tc, n_tc)) if with_Mmod_inv else None
     q_all, v_all = np.empty((n, model.nq)), np.empty((n, model.nv))
-    for k in range(n):
+    for k in counted(n, progress, 256):
         active = list(np.flatnonzero(contact[k]))
         q, v, jacobians = floating_base_state(robot, data, angles[k], qd[k], active,
                                               None if base is None else base[k])
@@ -128,8 +129,4 @@ def constrained_dynamics(robot: Robot, angles: np.ndarray, qd: np.ndarray, qdd_m
             kkt_inv = pin.computeKKTContactDynamicMatrixInverse(model, data, q, Jc)
             Mmod_inv[k] = kkt_inv[np.ix_(iv_tc, iv_tc)]
         q_all[k], v_all[k] = q, v
-        if progress is not None and (k + 1) % 256 == 0:
-            progress(256)
-    if progress is not None and n % 256:
-        progress(n % 256)
     return ConstrainedDynamics(qdd_est, Mmod_inv, q_all, v_all)

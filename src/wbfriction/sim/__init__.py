@@ -2,7 +2,8 @@
 MuJoCo (thesis 6.2), and sensor models."""
 
 from .control import feedforward, pd_gains
-from .ideal import INTEGRATORS, IdealOptions, Pull, SimulationResult, simulate_ideal
+from .common import Pull, SimulationResult
+from .ideal import INTEGRATORS, IdealOptions, simulate_ideal
 from .mujoco_sim import MujocoOptions, simulate_mujoco
 from .sensors import SensorNoise, apply_sensor_noise
 

@@ -25,6 +25,7 @@ import pinocchio as pin
 
 from ..robot import Robot
 from ..stance import stance_model
+from ..walking import WalkingReference
 
 
 def contact_jacobian(robot: Robot, data: pin.Data, contacts: np.ndarray) -> np.ndarray:
@@ -135,12 +136,18 @@ def pd_gains(robot: Robot, q: np.ndarray, bandwidth: float, damping: float = 0.9
     nc = len(robot.contact_frames)
     states = [np.ones(nc, bool)] + [np.eye(nc, dtype=bool)[c] for c in range(nc)]
     iv_tc = robot.act_v_index[robot.tc_index]
-    w = 2 * np.pi * bandwidth
     gains = {}
     for s in states:
         inertia = 1.0 / np.diag(constrained_inverse_inertia(robot, data, q, s))[iv_tc]
-        gains[tuple(bool(x) for x in s)] = (inertia * w**2, 2 * damping * inertia * w)
+        gains[tuple(bool(x) for x in s)] = pd_from_inertia(inertia, bandwidth, damping)
     return gains
+
+
+def pd_from_inertia(inertia: np.ndarray, bandwidth: float, damping: float) -> tuple[np.ndarray, np.ndarray]:
+    """``kp = I w^2`` [N·m/rad], ``kd = 2 zeta I w`` [N·m·s/rad] for inertias ``I`` [kg m^2],
+    ``w = 2 pi bandwidth`` [Hz] and damping ratio ``zeta``."""
+    w = 2 * np.pi * bandwidth
+    return inertia * w**2, 2 * damping * inertia * w
 
 
 def gain_schedule(gains: dict[tuple[bool, ...], tuple[np.ndarray, np.ndarray]], contact: np.ndarray,
@@ -166,9 +173,23 @@ def gain_schedule(gains: dict[tuple[bool, ...], tuple[np.ndarray, np.ndarray]], 
     starts = np.flatnonzero(np.any(np.diff(contact, axis=0, prepend=~contact[:1]), axis=1))
     for i, s in enumerate(starts):
         e = starts[i + 1] if i + 1 < len(starts) else n
-        to_p, to_d = gains[tuple(bool(x) for x in contact[s])]
-        from_p, from_d = (to_p, to_d) if s == 0 else (np.minimum(kp[s - 1], to_p), np.minimum(kd[s - 1], to_d))
-        r = np.minimum(1.0, np.arange(e - s) * dt / blend)[:, None] if blend > 0 else np.ones((e - s, 1))
-        kp[s:e] = from_p + r * (to_p - from_p)
-        kd[s:e] = from_d + r * (to_d - from_d)
+        to = gains[tuple(bool(x) for x in contact[s])]
+        kp[s:e], kd[s:e] = ramp_gains(to if s == 0 else (kp[s - 1], kd[s - 1]), to,
+                                      np.arange(e - s)[:, None] * dt, blend)
     return kp, kd
+
+
+def ramp_gains(current: tuple[np.ndarray, np.ndarray], target: tuple[np.ndarray, np.ndarray],
+               elapsed, blend: float) -> tuple[np.ndarray, np.ndarray]:
+    """Gains ``elapsed`` seconds after a switch from ``current`` to ``target`` (kp, kd): the
+    falling ones at once, the rising ones linearly over ``blend`` seconds (0: at once)."""
+    r = np.minimum(1.0, np.asarray(elapsed) / blend) if blend > 0 else 1.0
+    start = [np.minimum(c, t) for c, t in zip(current, target)]
+    return tuple(s + r * (t - s) for s, t in zip(start, target))
+
+
+def reference_feedforward(robot: Robot, reference: WalkingReference) -> np.ndarray:
+    """:func:`feedforward` torques (N, n_act) of a walking reference, the wrench shared
+    between the feet by its ZMP (:func:`foot_shares`)."""
+    ref = reference
+    return feedforward(robot, ref.q, ref.v, ref.a, ref.contact, foot_shares(ref.zmp, ref.feet[:, :, :2]))[0]

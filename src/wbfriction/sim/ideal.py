@@ -32,18 +32,19 @@ foot's zero acceleration in the estimator assumes.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
 
 from ..exceptions import InputError
-from ..friction import FrictionParams, friction_by_group, smooth, stack_params
-from ..log import Log
+from ..friction import FrictionParams
+from ..progress import counted
 from ..robot import Robot
 from ..walking import WalkingReference
 from ..walking.swing import foot_placement
-from .control import contact_jacobian, feedforward, foot_shares, gain_schedule, pd_gains
+from .common import SimulationResult, injected_friction, simulated_log
+from .control import contact_jacobian, gain_schedule, pd_gains, reference_feedforward
 
 INTEGRATORS = ("semi-implicit", "explicit")
 
@@ -87,48 +88,6 @@ class IdealOptions:
             raise InputError(f"unknown projection '{self.projection}': choose sample or touch-down")
         if self.substeps < 1:
             raise InputError(f"substeps must be at least 1, got {self.substeps}")
-
-
-@dataclass
-class Pull:
-    """An interval where a welded foot pulled on the ground (negative normal force)."""
-
-    frame: str
-    start: float
-    end: float
-    samples: int
-    min_force: float  # [N]
-
-
-@dataclass
-class SimulationResult:
-    """A simulated walk.
-
-    Attributes:
-        log: the log, in the project's format.
-        wrench: contact wrenches (N, n_contacts, 6) in the soles' LOCAL frames [N, N·m],
-            zero off contact; ``wrench[..., 2]`` is the normal force.
-        q: simulated configurations (N, nq); v: velocities (N, nv).
-        reference: the walking reference.
-    """
-
-    log: Log
-    wrench: np.ndarray
-    q: np.ndarray
-    v: np.ndarray
-    reference: WalkingReference
-    contact_frames: tuple[str, ...] = field(default_factory=tuple)
-
-    def pulls(self, threshold: float = 0.0) -> list[Pull]:
-        """Intervals where a foot in contact had a normal force below ``threshold`` [N]."""
-        out = []
-        for c, frame in enumerate(self.contact_frames):
-            bad = self.log.contact[:, c] & (self.wrench[:, c, 2] < threshold)
-            edges = np.flatnonzero(np.diff(np.r_[0, bad.astype(np.int8), 0]))
-            for s, e in zip(edges[::2], edges[1::2]):
-                out.append(Pull(frame, float(self.log.time[s]), float(self.log.time[e - 1]), int(e - s),
-                                float(self.wrench[s:e, c, 2].min())))
-        return out
 
 
 def _project_configuration(robot: Robot, data: pin.Data, q: np.ndarray, contacts: np.ndarray,
@@ -195,10 +154,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
     Raises:
         InputError: a friction entry for a joint that is not torque-controlled.
     """
-    friction = friction_by_group(robot.groups) if friction is None else friction
-    for joint in friction:
-        if joint not in robot.torque_controlled:
-            raise InputError(f"friction given for '{joint}', which is not a torque-controlled joint")
+    injected = injected_friction(robot, friction)
     model = robot.model
     data = model.createData()
     ref = reference
@@ -206,8 +162,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
     h = dt / options.substeps
     nc = len(robot.contact_frames)
 
-    feet_xy = ref.feet[:, :, :2]
-    tau_ff, _ = feedforward(robot, ref.q, ref.v, ref.a, ref.contact, foot_shares(ref.zmp, feet_xy))
+    tau_ff = reference_feedforward(robot, ref)
     gains = pd_gains(robot, ref.q[0], options.bandwidth, options.damping)
     kp_all, kd_all = gain_schedule(gains, ref.contact, dt, options.gain_blend)
     bkp, bkd = options.baumgarte
@@ -215,8 +170,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
     iv, iq = robot.act_v_index, robot.act_q_index
     tc, pc = robot.tc_index, robot.pc_index
     iv_tc, iv_pc, iq_tc, iq_pc = iv[tc], iv[pc], iq[tc], iq[pc]
-    joints_f = [robot.torque_controlled.index(j) for j in friction]
-    params_f = stack_params(list(friction.values())) if joints_f else {}
+    joints_f = injected.joints
     iv_f = iv_tc[joints_f]
     settings = pin.ProximalSettings(1e-12, 1e-10, 50)
     semi_implicit = options.integrator == "semi-implicit"
@@ -238,7 +192,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
     active = np.zeros(nc, bool)
     tau_pc = tau_ff[0, pc].copy()
     tau = np.zeros(model.nv)
-    for k in range(n):
+    for k in counted(n, progress):
         switch = k in switches
         if switch:
             landing = ref.contact[k] & ~active
@@ -261,7 +215,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
             first = s == 0
             tau[iv_tc] = tau_cmd
             if joints_f:
-                tau_f = -smooth(v[iv_f], **params_f)
+                tau_f = injected.torque(v[iv_f])
                 tau[iv_f] += tau_f
             tau[iv_pc] = tau_pc
             a = pin.constraintDynamics(model, data, q, v, tau, cmodels, cdatas, settings).copy()
@@ -288,21 +242,10 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
             else:
                 q = pin.integrate(model, q, h * v)
                 v = v + h * a
-        if progress is not None and (k + 1) % 500 == 0:
-            progress(500)
-    if progress is not None and n % 500:
-        progress(n % 500)
 
-    metadata = {
-        "generator": "wbfriction.sim.ideal.simulate_ideal",
-        "options": asdict(options),
-        "gait": asdict(ref.plan.options),
-        "friction_true": {j: p.to_dict() for j, p in friction.items()},
-        # semi-implicit Euler at the log rate: the central second difference at k is the
-        # acceleration tau[k] caused; otherwise the torque is held over several steps
-        "torque_alignment": "sample" if semi_implicit and options.substeps == 1 else "zoh",
-    }
-    log = Log(ref.time.copy(), Q[:, iq], tau_log, ref.contact.copy(),
-              Q[:, :7].copy() if options.log_base else None, tau_f_log, metadata,
-              source="simulate_ideal", qd_true=V[:, iv], qdd_true=A[:, iv])
+    # semi-implicit Euler at the log rate: the central second difference at k is the
+    # acceleration tau[k] caused; otherwise the torque is held over several steps
+    alignment = "sample" if semi_implicit and options.substeps == 1 else "zoh"
+    log = simulated_log(robot, ref, Q, V, A, tau_log, tau_f_log, ref.contact.copy(), injected,
+                        "wbfriction.sim.ideal.simulate_ideal", options, options.log_base, torque_alignment=alignment)
     return SimulationResult(log, wrench, Q, V, ref, tuple(robot.contact_frames))

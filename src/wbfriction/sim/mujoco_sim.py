@@ -25,19 +25,19 @@ accelerations of that step.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 import pinocchio as pin
 
 from ..exceptions import InputError, SimulationError
-from ..friction import FrictionParams, friction_by_group, smooth, stack_params
-from ..log import Log
+from ..friction import FrictionParams
+from ..progress import counted
 from ..robot import Robot
 from ..walking import WalkingReference
-from .control import feedforward, foot_shares, pd_gains
-from .ideal import SimulationResult
+from .common import SimulationResult, injected_friction, simulated_log
+from .control import pd_from_inertia, pd_gains, ramp_gains, reference_feedforward
 from .mujoco_model import MujocoRobot, build_mujoco_robot
 
 
@@ -99,17 +99,14 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
         progress: optional callable receiving numbers of samples done.
 
     Returns:
-        A :class:`~wbfriction.sim.ideal.SimulationResult`; its ``wrench`` holds the soles'
+        A :class:`~wbfriction.sim.common.SimulationResult`; its ``wrench`` holds the soles'
         normal forces in ``[..., 2]`` (the rest zero).
 
     Raises:
         InputError: friction on a joint that is not torque-controlled.
         SimulationError: the robot fell (the message gives the time).
     """
-    friction = friction_by_group(robot.groups) if friction is None else friction
-    for joint in friction:
-        if joint not in robot.torque_controlled:
-            raise InputError(f"friction given for '{joint}', which is not a torque-controlled joint")
+    injected = injected_friction(robot, friction)
     ref, n, dt = reference, len(reference), reference.dt
     mjr = mjr or build_mujoco_robot(robot, timestep=dt / options.substeps)
     model, data = mjr.model, mujoco.MjData(mjr.model)
@@ -117,18 +114,15 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
     nc = len(robot.contact_frames)
     iq, iv, tc, pc = robot.act_q_index, robot.act_v_index, robot.tc_index, robot.pc_index
     dof_tc, dof_pc = mjr.dof_index[tc], mjr.dof_index[pc]
-    joints_f = [robot.torque_controlled.index(j) for j in friction]
-    params_f = stack_params(list(friction.values())) if joints_f else {}
+    joints_f = injected.joints
     dof_f = dof_tc[joints_f]
 
-    tau_ff, _ = feedforward(robot, ref.q, ref.v, ref.a, ref.contact, foot_shares(ref.zmp, ref.feet[:, :, :2]))
+    tau_ff = reference_feedforward(robot, ref)
     kp_max, kd_max = options.max_gains
     gains = {state: (np.minimum(kp, kp_max), np.minimum(kd, kd_max))
              for state, (kp, kd) in pd_gains(robot, ref.q[0], options.bandwidth, options.damping).items()}
     M = pin.crba(robot.model, robot.model.createData(), ref.q[0])
-    w = 2 * np.pi * options.bandwidth
-    inertia_pc = np.diag(M)[iv[pc]]
-    kp_pc, kd_pc = inertia_pc * w**2, 2 * options.damping * inertia_pc * w
+    kp_pc, kd_pc = pd_from_inertia(np.diag(M)[iv[pc]], options.bandwidth, options.damping)
     q_ref, v_ref = ref.q[:, iq], ref.v[:, iv]
 
     data.qpos[:] = mjr.qpos(ref.q[0])
@@ -142,18 +136,15 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
     state = None
     kp, kd = gains[tuple(bool(x) for x in ref.contact[0])]
     tau = np.zeros(model.nv)
-    for k in range(n):
+    for k in counted(n, progress):
         q = mjr.q(data.qpos)
         v = mjr.v(data.qpos, data.qvel)
         # the controller knows the contact measured over the last period (the plan at first)
         last = contact[k - 1] if k > 0 and contact[k - 1].any() else ref.contact[k]
         measured = tuple(bool(x) for x in last)
-        if measured != state:  # rising gains ramp, falling ones apply at once
-            state, k_switch = measured, k
-            to = gains[state]
-            start = (np.minimum(kp, to[0]), np.minimum(kd, to[1]))
-        r = min(1.0, (k - k_switch) * dt / options.gain_blend) if options.gain_blend > 0 else 1.0
-        kp, kd = start[0] + r * (to[0] - start[0]), start[1] + r * (to[1] - start[1])
+        if measured != state:
+            state, k_switch, before = measured, k, (kp, kd)
+        kp, kd = ramp_gains(before, gains[state], (k - k_switch) * dt, options.gain_blend)
         angles, qd = q[iq], v[iv]
         tau_cmd = tau_ff[k, tc] + kp * (q_ref[k, tc] - angles[tc]) + kd * (v_ref[k, tc] - qd[tc])
         tau[:] = 0.0
@@ -162,7 +153,7 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
         for s in range(options.substeps):
             data.qfrc_applied[:] = tau
             if joints_f:
-                tau_f = -smooth(data.qvel[dof_f], **params_f)
+                tau_f = injected.torque(data.qvel[dof_f])
                 data.qfrc_applied[dof_f] += tau_f
             mujoco.mj_step(model, data)
             if s == options.substeps - 1:  # the soles' forces over this period, from its last step
@@ -177,21 +168,11 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
         if not np.isfinite(data.qpos).all() or data.qpos[2] < options.fall_height * z0 or data.warning.number[
                 int(mujoco.mjtWarning.mjWARN_BADQACC)] > 0:
             raise SimulationError(f"the robot fell (or the simulation diverged) at t = {ref.time[k]:.3f} s")
-        if progress is not None and (k + 1) % 500 == 0:
-            progress(500)
-    if progress is not None and n % 500:
-        progress(n % 500)
 
-    metadata = {
-        "generator": "wbfriction.sim.mujoco_sim.simulate_mujoco",
-        "options": asdict(options),
-        "gait": asdict(ref.plan.options),
-        "friction_true": {j: p.to_dict() for j, p in friction.items()},
-        "torque_alignment": "zoh",  # the torque is held over the substeps of each period
-        "contact_source": f"sole normal force > {options.contact_threshold:g} N",
-    }
-    log = Log(ref.time.copy(), Q[:, iq], tau_log, contact, Q[:, :7].copy() if options.log_base else None,
-              tau_f_log, metadata, source="simulate_mujoco", qd_true=V[:, iv], qdd_true=A[:, iv])
+    log = simulated_log(robot, ref, Q, V, A, tau_log, tau_f_log, contact, injected,
+                        "wbfriction.sim.mujoco_sim.simulate_mujoco", options, options.log_base,
+                        torque_alignment="zoh",  # the torque is held over the substeps of each period
+                        contact_source=f"sole normal force > {options.contact_threshold:g} N")
     wrench = np.zeros((n, nc, 6))
     wrench[:, :, 2] = force
     return SimulationResult(log, wrench, Q, V, ref, tuple(robot.contact_frames))

@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..exceptions import InputError, ModelError
+from ..progress import counted
 from ..robot import Robot
 from .com import lipm_com, zmp_reference
 from .footsteps import FootstepPlan, GaitOptions, plan_footsteps
@@ -232,14 +233,10 @@ def walking_reference(robot: Robot, options: GaitOptions = GaitOptions(), dt: fl
     V = np.empty((n, model.nv))
     A = np.empty((n, model.nv))
     q, v, a = q0, np.zeros(model.nv), np.zeros(model.nv)
-    for k in range(n):
+    for k in counted(n, progress):
         guess = pin.integrate(model, q, v * dt + 0.5 * a * dt**2)
         free = (free_q[k, ik.free_act], free_qd[k, ik.free_act], free_qdd[k, ik.free_act])
         q, v, a = ik.solve(guess, free, feet[k], feet_d[k], feet_dd[k], (com[k], com_d[k], com_dd[k]),
                            (yaw[0][k], yaw[1][k], yaw[2][k]))
         Q[k], V[k], A[k] = q, v, a
-        if progress is not None and (k + 1) % 500 == 0:
-            progress(500)
-    if progress is not None and n % 500:
-        progress(n % 500)
     return WalkingReference(time, Q, V, A, plan.contact(time), feet, com, zmp, plan)

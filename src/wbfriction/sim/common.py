@@ -1,0 +1,103 @@
+"""What both simulators share: the injected friction, the result, and the log they write."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from ..exceptions import InputError
+from ..friction import FrictionParams, friction_by_group, smooth, stack_params
+from ..log import Log
+from ..robot import Robot
+from ..walking import WalkingReference
+
+
+@dataclass
+class InjectedFriction:
+    """Friction (3.5) a simulator applies to some torque-controlled joints.
+
+    Attributes:
+        params: parameters per joint name.
+        joints: their indices among the torque-controlled joints.
+    """
+
+    params: dict[str, FrictionParams]
+    joints: list[int]
+
+    def __post_init__(self) -> None:
+        self._stacked = stack_params(list(self.params.values())) if self.joints else {}
+
+    def torque(self, qd: np.ndarray) -> np.ndarray:
+        """``tau_f = -f(qd)`` (eq. 3.5) of the joints, from their velocities (n_f,) [rad/s]."""
+        return -smooth(qd, **self._stacked)
+
+
+def injected_friction(robot: Robot, friction: dict[str, FrictionParams] | None) -> InjectedFriction:
+    """Friction to inject: the given parameters per joint or, by default, the thesis's targets
+    (Table 6.1) on the leg joint groups.
+
+    Raises:
+        InputError: an entry for a joint that is not torque-controlled.
+    """
+    friction = friction_by_group(robot.groups) if friction is None else friction
+    for joint in friction:
+        if joint not in robot.torque_controlled:
+            raise InputError(f"friction given for '{joint}', which is not a torque-controlled joint")
+    return InjectedFriction(dict(friction), [robot.torque_controlled.index(j) for j in friction])
+
+
+@dataclass
+class Pull:
+    """An interval where a welded foot pulled on the ground (negative normal force)."""
+
+    frame: str
+    start: float
+    end: float
+    samples: int
+    min_force: float  # [N]
+
+
+@dataclass
+class SimulationResult:
+    """A simulated walk.
+
+    Attributes:
+        log: the log, in the project's format.
+        wrench: contact wrenches (N, n_contacts, 6) in the soles' LOCAL frames [N, N·m],
+            zero off contact; ``wrench[..., 2]`` is the normal force.
+        q: simulated configurations (N, nq); v: velocities (N, nv).
+        reference: the walking reference.
+    """
+
+    log: Log
+    wrench: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    reference: WalkingReference
+    contact_frames: tuple[str, ...] = field(default_factory=tuple)
+
+    def pulls(self, threshold: float = 0.0) -> list[Pull]:
+        """Intervals where a foot in contact had a normal force below ``threshold`` [N]."""
+        out = []
+        for c, frame in enumerate(self.contact_frames):
+            bad = self.log.contact[:, c] & (self.wrench[:, c, 2] < threshold)
+            edges = np.flatnonzero(np.diff(np.r_[0, bad.astype(np.int8), 0]))
+            for s, e in zip(edges[::2], edges[1::2]):
+                out.append(Pull(frame, float(self.log.time[s]), float(self.log.time[e - 1]), int(e - s),
+                                float(self.wrench[s:e, c, 2].min())))
+        return out
+
+
+def simulated_log(robot: Robot, reference: WalkingReference, Q: np.ndarray, V: np.ndarray, A: np.ndarray,
+                  tau: np.ndarray, tau_f: np.ndarray, contact: np.ndarray, friction: InjectedFriction,
+                  generator: str, options, log_base: bool, **metadata) -> Log:
+    """A simulated walk in the log format: joint angles and the true joint velocities and
+    accelerations from the full states ``Q`` (N, nq), ``V``, ``A`` (N, nv), torques and
+    friction of the torque-controlled joints, contact flags, the base pose if ``log_base``;
+    metadata: the generator, its options, the gait, the true friction, and ``metadata``."""
+    iq, iv = robot.act_q_index, robot.act_v_index
+    meta = {"generator": generator, "options": asdict(options), "gait": asdict(reference.plan.options),
+            "friction_true": {j: p.to_dict() for j, p in friction.params.items()}, **metadata}
+    return Log(reference.time.copy(), Q[:, iq], tau, contact, Q[:, :7].copy() if log_base else None, tau_f, meta,
+               source=generator.rsplit(".", 1)[-1], qd_true=V[:, iv], qdd_true=A[:, iv])
