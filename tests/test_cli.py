@@ -151,3 +151,28 @@ def test_spectrum_command(demo_dir, tmp_path):
     assert (tmp_path / "s.png").stat().st_size > 1000
     _assert_one_line_error(run("spectrum", out / "log.parquet", "--joints", "head_1_joint"),
                            "'head_1_joint' is not a torque-controlled joint")
+
+
+def test_simulate_on_mujoco_with_sensors_from_toml(talos, tmp_path):
+    """``simulate --simulator mujoco`` writes the project's log with measured contact flags
+    and the sensors of a TOML (the command line overriding it); bad sensor input is one
+    line, exit 2, no output."""
+    (tmp_path / "sensors.toml").write_text("[sensors]\nposition_std = 1e-4\nencoder_bits = 19\nseed = 3\n")
+    log_path = tmp_path / "mj.parquet"
+    res = run("simulate", "--simulator", "mujoco", "--gait", "forward", "--steps", "1", "-o", log_path,
+              "--sensors", tmp_path / "sensors.toml", "--torque-noise", "0.05", "--delay", "1")
+    assert res.returncode == 0, res.stderr
+    log = read_log(log_path, talos)
+    assert log.metadata["options"]["sensors"] == {"position_std": 1e-4, "encoder_bits": 19, "torque_std": 0.05,
+                                                  "seed": 3}
+    assert log.metadata["options"]["delay"] == pytest.approx(1e-3)
+    assert log.metadata["contact_source"].startswith("sole normal force") and log.tau_f_true is not None
+    (tmp_path / "bad.toml").write_text("[sensors]\nposition_noise = 1e-4\n")
+    bad = tmp_path / "bad.parquet"
+    _assert_one_line_error(run("simulate", "--simulator", "mujoco", "--steps", "1", "-o", bad, "--sensors",
+                               tmp_path / "bad.toml"), "[sensors] has unknown key(s) position_noise")
+    _assert_one_line_error(run("simulate", "--simulator", "mujoco", "--steps", "1", "-o", bad, "--delay", "0.5"),
+                           "must be a multiple of the control period")
+    _assert_one_line_error(run("simulate", "--simulator", "mujoco", "--steps", "1", "-o", bad, "--mujoco-friction",
+                               "coulomb"), "friction must be one of model, mujoco")
+    assert not bad.exists()

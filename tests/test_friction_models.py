@@ -123,3 +123,21 @@ def test_standard_errors_account_for_correlated_residuals():
         inside_hac.append(err < 2 * se_hac)
         inside_white.append(err < 2 * se_white)
     assert np.mean(inside_hac) > 0.8 and np.mean(inside_white) < 0.5, (np.mean(inside_hac), np.mean(inside_white))
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.floats(0.05, 2.0), st.floats(0.1, 3.0), st.floats(10.0, 100.0), st.integers(0, 2**16))
+def test_coulomb_viscous_fit_with_held_parameters(F_v, F_c, a, seed):
+    """Holding S, v_s and tau_os (MuJoCo's frictionloss + damping has none) recovers F_v,
+    F_c and a from noisy data, keeps the held values exactly, and gives them zero error."""
+    rng = np.random.default_rng(seed)
+    qd = rng.uniform(-2.0, 2.0, 3000)
+    truth = FrictionParams(F_v=F_v, F_c=F_c, a=a)
+    tau_f = truth.torque(qd) + rng.normal(0.0, 0.01, qd.size)
+    fixed = {"S": 0.0, "v_s": 0.1, "tau_os": 0.0}
+    res = fit_friction(qd, tau_f, fixed=fixed)
+    for name, value in fixed.items():
+        assert getattr(res.params, name) == value and res.stderr[name] == 0.0
+    assert abs(res.params.F_v - F_v) < 5 * res.stderr["F_v"] + 1e-3
+    assert abs(res.params.F_c - F_c) < 5 * res.stderr["F_c"] + 1e-3
+    assert abs(res.params.F_c - F_c) / F_c < 0.02 and abs(res.params.F_v - F_v) / F_v < 0.05

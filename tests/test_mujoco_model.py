@@ -7,6 +7,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from wbfriction.friction import FrictionParams
 from wbfriction.sim.mujoco_model import (
     SOLE_THICKNESS,
     build_mujoco_robot,
@@ -105,3 +106,84 @@ def test_talos_walks_forward_and_sideways_on_mujoco(talos, mj_talos):
     single = ~np.any(np.diff(log.contact.astype(int), axis=0), axis=1)
     inner = single[:-1] & single[1:]
     assert np.median(np.abs(a_fd - log.qdd_true[1:-1])[inner]) < 0.5
+
+
+def test_mujoco_friction_torque_is_the_force_mujoco_applied(talos, mj_talos):
+    """MuJoCo's own joint friction (frictionloss + damping): the torque read from the
+    constraint and damper forces is what closes MuJoCo's equation of motion, M qacc + c =
+    tau_f on the friction joints and 0 elsewhere (robot in the air: no contact, no torque),
+    and it dissipates."""
+    import copy
+
+    from wbfriction.friction import friction_by_group
+    from wbfriction.sim.common import injected_friction
+    from wbfriction.sim.mujoco_sim import _set_mujoco_friction, mujoco_friction_torque
+
+    params = {j: FrictionParams(F_v=0.3, F_c=1.5) for j in friction_by_group(talos.groups)}
+    injected = injected_friction(talos, params)
+    dofs = mj_talos.dof_index[talos.tc_index][injected.joints]
+    model = copy.copy(mj_talos.model)
+    _set_mujoco_friction(model, dofs, injected)
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(3)
+    data.qpos[:] = mj_talos.qpos(talos.configuration(talos.reference_angles))
+    data.qpos[2] = 5.0
+    data.qvel[6:] = rng.normal(0, 1.0, model.nv - 6)
+    data.qvel[dofs[:3]] = [1e-4, -2e-4, 0.0]  # in the sticking region too
+    mujoco.mj_forward(model, data)
+    assert data.ncon == 0
+    M = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, M)
+    closing = M @ data.qacc + data.qfrc_bias
+    tau_f = mujoco_friction_torque(data, dofs)
+    np.testing.assert_allclose(closing[dofs], tau_f, atol=1e-8)
+    others = np.setdiff1d(np.arange(model.nv), dofs)
+    np.testing.assert_allclose(closing[others], 0.0, atol=1e-8)
+    assert np.all(data.qvel[dofs] * tau_f <= 1e-12) and np.abs(tau_f).max() > 1.0
+    # the shared model is untouched
+    assert np.all(mj_talos.model.dof_frictionloss == 0)
+
+
+def test_swing_estimate_is_reliable_and_stance_is_not_on_mujoco(talos, mj_talos):
+    """Thesis 6.2 (Fig. 6.4): on real (soft) contacts the right knee's friction, estimated
+    with central differences, is close to the truth while its leg swings, and far off while
+    it stands; contact flags come from measured forces."""
+    from wbfriction.estimate import EstimateOptions, estimate_log
+    from wbfriction.friction import THESIS_TARGETS
+    from wbfriction.sim.mujoco_sim import simulate_mujoco
+    from wbfriction.walking import GaitOptions, walking_reference
+
+    knee = "leg_right_4_joint"
+    ref = walking_reference(talos, GaitOptions(gait="forward", steps=4))
+    log = simulate_mujoco(talos, ref, {knee: THESIS_TARGETS["knee"]}, mjr=mj_talos).log
+    assert log.metadata["contact_source"].startswith("sole normal force")
+    est = estimate_log(talos, log, EstimateOptions(mask="single"))
+    i = est.joints.index(knee)
+    err = est.tau_f[:, i] - est.tau_f_true[:, i]
+    right = talos.contact_frames.index(next(f for f in talos.contact_frames if knee in talos.limb(f)))
+    swing = est.valid[:, i] & ~est.contact[:, right]
+    stance = est.valid[:, i] & est.contact[:, right]
+    rms = lambda m: float(np.sqrt(np.mean(err[m] ** 2)))  # noqa: E731
+    assert swing.sum() > 1000 and stance.sum() > 1000
+    assert rms(swing) < 0.1 * THESIS_TARGETS["knee"].F_c  # measured 0.03 N·m
+    assert rms(stance) > 10 * rms(swing)  # measured 3 N·m
+
+
+def test_sensor_noise_quantisation_and_delay_in_the_loop(talos, mj_talos):
+    """With sensors on, the log holds encoder counts of the noisy true position, the
+    delay must be whole control periods, and the walk still completes with a 2 ms delay."""
+    from wbfriction.exceptions import InputError
+    from wbfriction.sim import MujocoOptions, SensorNoise, simulate_mujoco
+    from wbfriction.walking import GaitOptions, walking_reference
+
+    ref = walking_reference(talos, GaitOptions(gait="forward", steps=2))
+    noise = SensorNoise(position_std=1e-4, encoder_bits=19, torque_std=0.05, seed=4)
+    res = simulate_mujoco(talos, ref, options=MujocoOptions(sensors=noise, delay=0.002), mjr=mj_talos)
+    counts = res.log.q / noise.resolution
+    np.testing.assert_allclose(counts, np.round(counts), atol=1e-6)
+    diff = res.log.q - res.q[:, talos.act_q_index]
+    assert abs(diff.std() - 1e-4) < 1e-5 and np.abs(diff).max() < 6e-4
+    again = simulate_mujoco(talos, ref, options=MujocoOptions(sensors=noise, delay=0.002), mjr=mj_talos)
+    np.testing.assert_array_equal(again.log.tau, res.log.tau)  # seeded: the same run twice
+    with pytest.raises(InputError, match="multiple of the control period"):
+        simulate_mujoco(talos, ref, options=MujocoOptions(delay=0.0015), mjr=mj_talos)

@@ -20,18 +20,20 @@ from typing import Optional
 import numpy as np
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 from . import __version__
 from .estimate import EstimateOptions, estimate_log
-from .exceptions import WbfrictionError
+from .exceptions import InputError, WbfrictionError
 from .friction import PARAM_NAMES, load_friction_toml
+from .sim.sensors import load_sensors_toml
 from .identify import FitResult, fit_friction_table
 from .kinematics import FilterOptions
 from .log import read_log, read_table, write_atomic, write_log, write_table
 from .robot import Robot, load_robot
-from .sim import IdealOptions, simulate_ideal
+from .sim import IdealOptions, MujocoOptions, SensorNoise, simulate_ideal, simulate_mujoco
 from .walking import GaitOptions, walking_reference
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
@@ -96,16 +98,19 @@ _E = EstimateOptions()  # one source of defaults: the library's
 _F = FilterOptions()
 _G = GaitOptions()
 _I = IdealOptions()
+_M = MujocoOptions()
+SIMULATORS = ("ideal", "mujoco")
 _MIN_SAMPLES = 20
 
 
-def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptions,
+def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptions | MujocoOptions,
                   friction: Optional[Path]) -> None:
     params = None if friction is None else load_friction_toml(friction, r.groups, r.torque_controlled)
     with console.status(f"planning {gait.steps} steps ({gait.gait})"):
         ref = walking_reference(r, gait)
+    run = simulate_mujoco if isinstance(options, MujocoOptions) else simulate_ideal
     with _progress(len(ref), "simulate") as advance:
-        result = simulate_ideal(r, ref, params, options, progress=advance)
+        result = run(r, ref, params, options, progress=advance)
     write_log(result.log, r, output)
     console.print(f"wrote {output} ({len(result.log)} samples, {result.log.time[-1]:.1f} s)")
     for p in result.pulls():
@@ -145,13 +150,38 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              lift_height: float = typer.Option(_G.lift_height, help="Swing-foot apex [m]."),
              friction: Optional[Path] = typer.Option(None, help="TOML with [friction.<group or joint>] tables; "
                                                                "default: thesis Table 6.1 on the legs."),
-             substeps: int = typer.Option(_I.substeps, help="Physics steps per 1 ms control period."),
-             integrator: str = typer.Option(_I.integrator, help="semi-implicit or explicit Euler."),
+             simulator: str = typer.Option("ideal", help="ideal (rigid contacts, thesis 6.1) or mujoco (soft "
+                                                         "contacts, measured contact flags, sensors, thesis 6.2)."),
+             substeps: Optional[int] = typer.Option(None, help=f"Physics steps per 1 ms control period (default: "
+                                                              f"{_I.substeps} ideal, {_M.substeps} mujoco)."),
+             integrator: str = typer.Option(_I.integrator, help="ideal: semi-implicit or explicit Euler."),
+             mujoco_friction: str = typer.Option(_M.friction, help="mujoco: model (eq. 3.5 as a joint torque) or "
+                                                                   "mujoco (MuJoCo's frictionloss = F_c, damping = F_v)."),
+             sensors: Optional[Path] = typer.Option(None, help="mujoco: TOML with a [sensors] table (position_std, "
+                                                               "encoder_bits, torque_std, seed, delay); the options "
+                                                               "below override it."),
+             position_noise: Optional[float] = typer.Option(None, help="mujoco: joint-position noise std [rad]."),
+             encoder_bits: Optional[int] = typer.Option(None, help="mujoco: encoder resolution [bits per turn]."),
+             torque_noise: Optional[float] = typer.Option(None, help="mujoco: torque-sensor noise std [N·m]."),
+             noise_seed: Optional[int] = typer.Option(None, help="mujoco: seed of the sensor noise."),
+             delay: Optional[float] = typer.Option(None, help="mujoco: measurement-to-command delay [ms], whole "
+                                                              "control periods."),
              log_base: bool = typer.Option(_I.log_base, help="Write the base pose to the log.")) -> None:
-    """Simulate a walk in the ideal simulator (rigid contacts, thesis 6.1) with known friction."""
+    """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic)."""
     gait_opts = GaitOptions(gait=gait, steps=steps, step_length=step_length, step_width=step_width,
                             turn_angle=turn_angle, lift_height=lift_height)
-    options = IdealOptions(substeps=substeps, integrator=integrator, log_base=log_base)
+    if simulator not in SIMULATORS:
+        raise InputError(f"--simulator must be one of {', '.join(SIMULATORS)}, got '{simulator}'")
+    if simulator == "ideal":
+        options = IdealOptions(substeps=substeps or _I.substeps, integrator=integrator, log_base=log_base)
+    else:
+        table = load_sensors_toml(sensors) if sensors is not None else {}
+        given = {"position_std": position_noise, "encoder_bits": encoder_bits, "torque_std": torque_noise,
+                 "seed": noise_seed, "delay": None if delay is None else delay * 1e-3}
+        table.update({k: v for k, v in given.items() if v is not None})
+        lag = float(table.pop("delay", 0.0))
+        options = MujocoOptions(substeps=substeps or _M.substeps, friction=mujoco_friction,
+                                sensors=SensorNoise(**table), delay=lag, log_base=log_base)
     _run_simulate(_robot(robot, urdf, config), output, gait_opts, options, friction)
 
 
@@ -196,40 +226,65 @@ def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wb
     _run_fit(friction, output, min_samples)
 
 
-def _study_table(result) -> Table:
+def _study_table(rows, title: str, params=PARAM_NAMES) -> Table:
     """Tables 6.1/6.2 layout: per leg joint (thesis numbering) target, estimate, error, thesis errors."""
-    table = Table(title="Identified friction (3.5) of the leg joints, combined walk, central differences",
+    table = Table(title=title, box=None,
                   caption="err: error to the target [%]; T6.1 / T6.2: the thesis's errors for the same joint "
-                          "(TORO, straight / straight and sideways)", box=None)
+                          "(TORO, straight / straight and sideways)")
     table.add_column("#", justify="right")
     table.add_column("joint")
-    for name in PARAM_NAMES:
+    for name in params:
         table.add_column(name, justify="right")
-    for row in result.rows:
+    cols = [PARAM_NAMES.index(n) for n in params]
+    for row in rows:
         fit = row.fit
         err = fit.error_percent() or {}
         table.add_row(str(row.number), f"{row.joint} ({row.group})",
-                      *[f"{getattr(fit.params, n):.4f}" if fit.params else "—" for n in PARAM_NAMES])
-        table.add_row("", "  target", *[f"{getattr(fit.target, n):.4g}" for n in PARAM_NAMES], style="dim")
-        table.add_row("", "  err [%]", *[f"{err.get(n, float('nan')):.2f}" for n in PARAM_NAMES], style="bold")
+                      *[f"{getattr(fit.params, n):.4f}" if fit.params else "—" for n in params])
+        table.add_row("", "  target", *[f"{getattr(fit.target, n):.4g}" for n in params], style="dim")
+        table.add_row("", "  err [%]", *[f"{err.get(n, float('nan')):.2f}" for n in params], style="bold")
         for label, ref in (("  T6.1 [%]", row.thesis_6_1), ("  T6.2 [%]", row.thesis_6_2)):
             if ref is not None:
-                table.add_row("", label, *[f"{x:.2f}" for x in ref], style="dim")
+                table.add_row("", label, *[f"{ref[c]:.2f}" for c in cols], style="dim")
     return table
+
+
+def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
+    from .realistic_study import run_realistic_study, worst_scored
+
+    with console.status("") as status:
+        result = run_realistic_study(r, output_dir, steps=steps, progress=lambda label: status.update(label))
+    for case in result.cases:
+        out.print(_study_table(case.rows, f"MuJoCo, combined walk, swing phase: {case.label}", case.scored))
+        worst = worst_scored(case)
+        out.print("worst error over the leg joints [%]: " + ", ".join(f"{n} {v:.2f}" for n, v in worst.items()))
+    out.print("right knee alone, RMS error [N·m] (central differences): " + "; ".join(
+        f"{k} {v:.4f}" for k, v in result.knee_rms.items()))
+    return result.files
 
 
 @app.command()
 def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--output-dir", help="Where to write."),
          robot: str = RobotOpt,
-         steps: int = typer.Option(_G.steps, help="Steps per direction of the combined walk.")) -> None:
-    """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.3."""
+         steps: int = typer.Option(_G.steps, help="Steps per direction of the combined walk."),
+         simulator: str = typer.Option("ideal", help="ideal: Tables 6.1/6.2, Fig. 6.1-6.3; mujoco: the realistic "
+                                                     "simulator's study, Fig. 6.4-6.5.")) -> None:
+    """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.5."""
     from .study import run_study, worst_errors
 
     start = time.perf_counter()
+    if simulator not in SIMULATORS:
+        raise InputError(f"--simulator must be one of {', '.join(SIMULATORS)}, got '{simulator}'")
     r = _robot(robot, None, None)
+    if simulator == "mujoco":
+        for f in _demo_mujoco(output_dir, r, steps):
+            console.print(f"wrote {f}")
+        console.print(f"demo finished in {time.perf_counter() - start:.1f} s")
+        return
     with console.status("") as status:
         result = run_study(r, output_dir, steps=steps, progress=lambda label: status.update(label))
-    out.print(_study_table(result))
+    out.print(_study_table(result.rows, "Identified friction (3.5) of the leg joints, combined walk, "
+                                        "central differences"))
     worst = worst_errors(result.rows)
     out.print("worst error over the leg joints [%]: " + ", ".join(f"{n} {worst[n]:.2f}" for n in PARAM_NAMES))
     out.print(f"true accelerations: max |tau_f - tau_f_true| in single support = {result.truth_max_error:.2e} N·m")
@@ -320,7 +375,7 @@ def main() -> None:
     try:
         app(standalone_mode=False)
     except WbfrictionError as exc:
-        console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+        console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
         sys.exit(2)
     except typer.Exit as exc:  # pragma: no cover - typer control flow
         sys.exit(exc.exit_code)

@@ -214,7 +214,7 @@ def _filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, 
 
 def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joint: str = "",
                  x0: np.ndarray | None = None, min_samples: int = 20, mask: np.ndarray | None = None,
-                 smoother=None) -> FitResult:
+                 smoother=None, fixed: dict[str, float] | None = None) -> FitResult:
     """Fit model (3.5) to friction estimates of one joint (eq. 6.4).
 
     Args:
@@ -232,10 +232,26 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
             of the smoothing, and the model goes through the same smoother before it is
             compared (module docstring). Samples where the smoothed model is undefined are
             not used.
+        fixed: parameters held at a value instead of fitted (standard error 0), e.g.
+            ``{"S": 0, "v_s": 0.1, "tau_os": 0}`` for a Coulomb-viscous model.
 
     Returns:
         :class:`FitResult`.
+
+    Raises:
+        ValueError: an unknown name in ``fixed``.
     """
+    fixed = dict(fixed or {})
+    if set(fixed) - set(PARAM_NAMES):
+        raise ValueError(f"unknown parameter(s) to fix: {', '.join(sorted(set(fixed) - set(PARAM_NAMES)))}")
+    free = np.array([name not in fixed for name in PARAM_NAMES])
+    held = np.array([float(fixed.get(name, 0.0)) for name in PARAM_NAMES])
+
+    def full(z: np.ndarray) -> np.ndarray:
+        x = held.copy()
+        x[free] = z
+        return x
+
     qd = np.asarray(qd, dtype=float)
     y = -np.asarray(tau_f, dtype=float)
     use = np.isfinite(qd) & np.isfinite(y)
@@ -248,29 +264,33 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         return FitResult(joint, n, message=f"only {n} valid samples")
     v, yu = qd[use], y[use]
     starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(v, yu)
-    residual = lambda x: _model(x, v, delta_s) - yu  # noqa: E731
-    jacobian = lambda x: _jacobian(x, v, delta_s)  # noqa: E731
-    bounds = _bounds(v)
+    starts = list({tuple(x[free]): x[free] for x in starts}.values())  # distinct over the free ones
+    residual = lambda z: _model(full(z), v, delta_s) - yu  # noqa: E731
+    jacobian = lambda z: _jacobian(full(z), v, delta_s)[:, free]  # noqa: E731
+    bounds = tuple(b[free] for b in _bounds(v))
     # a short run from every start, then the two best refined
     if len(starts) > 1:
         short = sorted((_solve(residual, jacobian, s, bounds, 30) for s in starts), key=lambda r: r.cost)
         starts = [r.x for r in short[:2]]
     best = min((_solve(residual, jacobian, s, bounds, 300) for s in starts), key=lambda r: r.cost)
     if smoother is not None:
-        residual, jacobian = _filtered_problem(qd, y, use, smoother, delta_s)
+        f_residual, f_jacobian = _filtered_problem(qd, y, use, smoother, delta_s)
+        residual, jacobian = (lambda z: f_residual(full(z))), (lambda z: f_jacobian(full(z))[:, free])
         best = _solve(residual, jacobian, best.x, bounds, 200)
     # residuals correlated over the filter's window, or over the span of a model error
     rows = np.flatnonzero(use)
-    se = standard_errors(jacobian(best.x), best.fun, rows=rows, max_lag=correlation_lag(best.fun, rows))
+    se = np.zeros(len(PARAM_NAMES))
+    se[free] = standard_errors(jacobian(best.x), best.fun, rows=rows, max_lag=correlation_lag(best.fun, rows))
     return FitResult(
-        joint=joint, n_samples=n, params=FrictionParams.from_vector(best.x, delta_s),
+        joint=joint, n_samples=n, params=FrictionParams.from_vector(full(best.x), delta_s),
         stderr=dict(zip(PARAM_NAMES, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
         success=bool(best.success), message=str(best.message))
 
 
 def fit_estimate(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
                  tau_f_true: np.ndarray | None = None, targets: dict[str, FrictionParams] | None = None,
-                 delta_s: float = 2.0, min_samples: int = 20, smoother=None) -> list[FitResult]:
+                 delta_s: float = 2.0, min_samples: int = 20, smoother=None,
+                 fixed: dict[str, float] | None = None) -> list[FitResult]:
     """Fit every joint of a friction estimate on its valid samples.
 
     Args:
@@ -280,11 +300,12 @@ def fit_estimate(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *
         tau_f_true: (N, n) true friction (NaN columns for unknown) or None.
         targets: true parameters per joint name, when known.
         smoother: the estimate's smoother (``FrictionEstimate.smoother``) or None.
+        fixed: parameters held instead of fitted (:func:`fit_friction`).
     """
     out = []
     for i, joint in enumerate(joints):
         res = fit_friction(qd[:, i], tau_f[:, i], delta_s=delta_s, joint=joint, min_samples=min_samples,
-                           mask=valid[:, i], smoother=smoother)
+                           mask=valid[:, i], smoother=smoother, fixed=fixed)
         m = valid[:, i] & np.isfinite(tau_f[:, i]) & np.isfinite(qd[:, i])
         if tau_f_true is not None and np.isfinite(tau_f_true[m, i]).all() and m.any():
             res.rms_error_vs_true = float(np.sqrt(np.mean((tau_f[m, i] - tau_f_true[m, i]) ** 2)))

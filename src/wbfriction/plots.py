@@ -174,3 +174,24 @@ def spectrum_figure(spec, path: str | Path, max_freq: float = 50.0, columns: int
     fig.suptitle(f"Fig. 7.1: spectrum of the estimated acceleration; suggested cutoff {spec.suggestion:.1f} Hz "
                  f"(dashed: each joint's; the median of them)")
     _save(fig, path)
+
+
+def velocity_panels_figure(panels: list[tuple[str, FrictionEstimate, np.ndarray]], joint: str,
+                           target: FrictionParams | None, path: str | Path, title: str) -> None:
+    """Friction of one joint over its velocity, one panel per (label, estimate, samples mask),
+    on shared axes, with the target curve (Fig. 6.4, 6.5)."""
+    fig = Figure(figsize=(5.0 * len(panels), 3.8), layout="constrained")
+    axes = fig.subplots(1, len(panels), sharex=True, sharey=True, squeeze=False)[0]
+    for ax, (label, est, mask) in zip(axes, panels):
+        i = est.joints.index(joint)
+        ax.plot(est.qd[mask, i], est.tau_f[mask, i], ".", ms=1.5, alpha=0.4, color="C0", label="estimate")
+        if target is not None:
+            v = np.linspace(np.nanmin(est.qd[mask, i]), np.nanmax(est.qd[mask, i]), 400)
+            ax.plot(v, target.torque(v), color="k", lw=2, alpha=0.6, label="target")
+        ax.set_title(f"{label} ({int(mask.sum())} samples)", fontsize=9)
+        ax.set_xlabel(f"{joint.replace('_joint', '')} velocity [rad/s]")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("tau_f [N·m]")
+    axes[0].legend(loc="upper right", fontsize=8, markerscale=6)
+    fig.suptitle(title)
+    _save(fig, path)

@@ -3,10 +3,12 @@
 The realistic simulator (thesis 6.2) must not share code with the estimator, so it runs on
 MuJoCo (PyPI ``mujoco``). The model comes from the same URDF: visual and collision
 meshes are dropped, the URDF's ``<dynamics>`` (damping, friction) too (friction is injected
-explicitly), a free joint is added at the root, a floor plane, and one box per contact
+explicitly), a free joint is added at the root, a floor plane, one motor per actuated
+joint (torque = ``ctrl``, clipped at the URDF's effort limit), and one box per contact
 frame: the footprint of the foot's collision mesh (from the installed robot package),
-flat under the contact frame, with sliding and torsional friction. Joints are mapped by name; configurations and velocities
-convert both ways (:class:`MujocoRobot`).
+flat under the contact frame, with sliding and torsional friction, and a touch sensor
+(the sum of the normal forces of the contacts within the sole) on it. Joints are mapped
+by name; configurations and velocities convert both ways (:class:`MujocoRobot`).
 
 Conventions that differ (field notes): MuJoCo orders joints by its own tree traversal,
 writes quaternions (w, x, y, z) where Pinocchio writes (x, y, z, w), and gives the free
@@ -22,11 +24,13 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pinocchio as pin
+from scipy.spatial.transform import Rotation
 
 from ..exceptions import ModelError
 from ..robot import Robot
 
 SOLE_THICKNESS = 0.01  # [m], the contact boxes' height, their bottom face on the contact frame's plane
+TOUCH_MARGIN = 0.005  # [m], how far beyond the sole's edges its touch sensor reaches
 SOLE_FRICTION = (1.0, 0.02, 0.0)
 """Sliding and torsional [m] friction of the soles (``condim`` 4). Without the torsional
 part a stance foot spins about the vertical (measured: the hip yaw lost track and TALOS
@@ -104,6 +108,10 @@ class MujocoRobot:
         qpos_index: MuJoCo ``qpos`` address of each actuated joint, in :attr:`Robot.actuated` order.
         dof_index: MuJoCo ``qvel`` address of each actuated joint.
         sole_geoms: geom id of each contact frame's box, in :attr:`Robot.contact_frames` order.
+        touch_index: ``sensordata`` address of each sole's touch sensor (normal force [N]).
+
+    Actuator ``i`` is the motor of joint ``robot.actuated[i]``: ``data.ctrl`` takes the
+    joint torques [N·m] in :attr:`Robot.actuated` order.
     """
 
     robot: Robot
@@ -111,6 +119,7 @@ class MujocoRobot:
     qpos_index: np.ndarray
     dof_index: np.ndarray
     sole_geoms: tuple[int, ...]
+    touch_index: np.ndarray
 
     def qpos(self, q: np.ndarray) -> np.ndarray:
         """MuJoCo ``qpos`` (nq,) of a Pinocchio configuration (nq,)."""
@@ -121,20 +130,22 @@ class MujocoRobot:
         return out
 
     def q(self, qpos: np.ndarray) -> np.ndarray:
-        """Pinocchio configuration of a MuJoCo ``qpos``."""
-        out = np.zeros(self.robot.model.nq)
-        out[:3] = qpos[:3]
-        out[3:7] = qpos[[4, 5, 6, 3]]
-        out[self.robot.act_q_index] = qpos[self.qpos_index]
+        """Pinocchio configurations (..., nq) of MuJoCo ``qpos`` (..., nq_mj)."""
+        qpos = np.asarray(qpos)
+        out = np.zeros(qpos.shape[:-1] + (self.robot.model.nq,))
+        out[..., :3] = qpos[..., :3]
+        out[..., 3:7] = qpos[..., [4, 5, 6, 3]]
+        out[..., self.robot.act_q_index] = qpos[..., self.qpos_index]
         return out
 
     def v(self, qpos: np.ndarray, qvel: np.ndarray) -> np.ndarray:
-        """Pinocchio velocity (nv,) of a MuJoCo state: the inverse of :meth:`velocity_map`."""
-        out = np.zeros(self.robot.model.nv)
-        R = pin.Quaternion(qpos[[4, 5, 6, 3]]).normalized().matrix()
-        out[:3] = R.T @ qvel[:3]
-        out[3:6] = qvel[3:6]
-        out[self.robot.act_v_index] = qvel[self.dof_index]
+        """Pinocchio velocities (..., nv) of MuJoCo states: the inverse of :meth:`velocity_map`."""
+        qpos, qvel = np.asarray(qpos), np.asarray(qvel)
+        out = np.zeros(qvel.shape[:-1] + (self.robot.model.nv,))
+        base = Rotation.from_quat(qpos.reshape(-1, qpos.shape[-1])[:, [4, 5, 6, 3]])  # scalar last
+        out[..., :3] = base.inv().apply(qvel.reshape(-1, qvel.shape[-1])[:, :3]).reshape(qvel.shape[:-1] + (3,))
+        out[..., 3:6] = qvel[..., 3:6]
+        out[..., self.robot.act_v_index] = qvel[..., self.dof_index]
         return out
 
     def velocity_map(self, q: np.ndarray) -> np.ndarray:
@@ -171,7 +182,7 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
         for e in root.findall(tag):
             root.remove(e)
     extension = ET.SubElement(root, "mujoco")
-    ET.SubElement(extension, "compiler", discardvisual="true", fusestatic="false", balanceinertia="false")
+    ET.SubElement(extension, "compiler", discardvisual="true", fusestatic="true", balanceinertia="false")
     try:
         spec = mujoco.MjSpec.from_string(ET.tostring(root, encoding="unicode"))
     except Exception as exc:  # mujoco raises ValueError with its parser's message
@@ -190,6 +201,20 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
                       size=[half[0], half[1], SOLE_THICKNESS / 2], pos=pos,
                       quat=pin.Quaternion(fr.placement.rotation).coeffs()[[3, 0, 1, 2]],
                       condim=4, friction=list(SOLE_FRICTION))
+        # the touch sensor counts the contacts whose point lies in its site: the sole, grown
+        body.add_site(name=f"touch_{frame}", type=mujoco.mjtGeom.mjGEOM_BOX, pos=pos,
+                      size=[half[0] + TOUCH_MARGIN, half[1] + TOUCH_MARGIN, SOLE_THICKNESS],
+                      quat=pin.Quaternion(fr.placement.rotation).coeffs()[[3, 0, 1, 2]])
+        spec.add_sensor(name=f"touch_{frame}", type=mujoco.mjtSensor.mjSENS_TOUCH,
+                        objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"touch_{frame}")
+    for name in robot.actuated:
+        jid = model.getJointId(name)
+        effort = float(model.effortLimit[model.joints[jid].idx_v])
+        motor = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        motor.set_to_motor()
+        if np.isfinite(effort) and effort > 0:
+            motor.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+            motor.forcerange = [-effort, effort]
     try:
         mj = spec.compile()
     except Exception as exc:
@@ -202,7 +227,9 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
         qpos_index.append(mj.jnt_qposadr[jid])
         dof_index.append(mj.jnt_dofadr[jid])
     soles = tuple(mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_GEOM, f"sole_{f}") for f in robot.contact_frames)
-    return MujocoRobot(robot, mj, np.array(qpos_index), np.array(dof_index), soles)
+    touch = np.array([mj.sensor_adr[mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_SENSOR, f"touch_{f}")]
+                      for f in robot.contact_frames])
+    return MujocoRobot(robot, mj, np.array(qpos_index), np.array(dof_index), soles, touch)
 
 
 def _body_of_joint(model: pin.Model, joint: int) -> str:

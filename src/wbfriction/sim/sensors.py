@@ -49,15 +49,63 @@ class SensorNoise:
         return None if self.encoder_bits is None else 2.0 * np.pi / 2.0**self.encoder_bits
 
 
+    @property
+    def active(self) -> bool:
+        """Whether the sensors change anything."""
+        return self.position_std > 0 or self.encoder_bits is not None or self.torque_std > 0
+
+    def draw(self, n: int, n_q: int, n_tau: int) -> tuple[np.ndarray, np.ndarray]:
+        """The position (n, n_q) [rad] and torque (n, n_tau) [N·m] noise of ``n`` samples,
+        from :attr:`seed` (zeros where a noise is off)."""
+        rng = np.random.default_rng(self.seed)
+        eps_q = rng.normal(0.0, self.position_std, (n, n_q)) if self.position_std > 0 else np.zeros((n, n_q))
+        eps_tau = rng.normal(0.0, self.torque_std, (n, n_tau)) if self.torque_std > 0 else np.zeros((n, n_tau))
+        return eps_q, eps_tau
+
+    def encoder(self, q: np.ndarray) -> np.ndarray:
+        """Positions [rad] as the encoder reads them: rounded to its resolution, if any."""
+        return q if self.resolution is None else np.round(q / self.resolution) * self.resolution
+
+
 def apply_sensor_noise(log: Log, noise: SensorNoise) -> Log:
     """The log the sensors would have written (module docstring); ``log`` is not changed.
 
     The noise parameters are recorded in the metadata key ``sensor_noise``.
     """
-    rng = np.random.default_rng(noise.seed)
-    q = log.q + rng.normal(0.0, noise.position_std, log.q.shape) if noise.position_std > 0 else log.q.copy()
-    if noise.resolution is not None:
-        q = np.round(q / noise.resolution) * noise.resolution
-    tau = log.tau + rng.normal(0.0, noise.torque_std, log.tau.shape) if noise.torque_std > 0 else log.tau.copy()
+    eps_q, eps_tau = noise.draw(len(log), log.q.shape[1], log.tau.shape[1])
+    q = noise.encoder(log.q + eps_q)
     metadata = {**log.metadata, "sensor_noise": asdict(noise)}
-    return dataclasses.replace(log, q=q, tau=tau, metadata=metadata)
+    return dataclasses.replace(log, q=q, tau=log.tau + eps_tau, metadata=metadata)
+
+
+SENSOR_KEYS = ("position_std", "encoder_bits", "torque_std", "seed", "delay")
+
+
+def load_sensors_toml(path) -> dict:
+    """The ``[sensors]`` table of a TOML file: any of :data:`SENSOR_KEYS`, e.g.::
+
+        [sensors]
+        position_std = 1e-4   # rad
+        encoder_bits = 19
+        torque_std = 0.05     # N·m
+        seed = 0
+        delay = 0.002         # s, measurement to command
+
+    Raises:
+        InputError: unreadable file, no ``[sensors]`` table, an unknown key.
+    """
+    import tomllib
+    from pathlib import Path
+
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text())
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise InputError(f"{path}: {exc}") from exc
+    table = doc.get("sensors")
+    if not isinstance(table, dict):
+        raise InputError(f"{path}: no [sensors] table")
+    unknown = sorted(set(table) - set(SENSOR_KEYS))
+    if unknown:
+        raise InputError(f"{path}: [sensors] has unknown key(s) {', '.join(unknown)}; known: {', '.join(SENSOR_KEYS)}")
+    return dict(table)
