@@ -158,19 +158,10 @@ def load_friction_toml(path, groups: dict[str, tuple[str, ...]], joints: tuple[s
     Raises:
         InputError: unreadable file, an unknown group, joint or parameter.
     """
-    import tomllib
-    from pathlib import Path
-
+    from .config import toml_table
     from .exceptions import InputError
 
-    path = Path(path)
-    try:
-        doc = tomllib.loads(path.read_text())
-    except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise InputError(f"{path}: {exc}") from exc
-    table = doc.get("friction")
-    if not isinstance(table, dict):
-        raise InputError(f"{path}: no [friction] table")
+    table = toml_table(path, "friction")
     out: dict[str, FrictionParams] = {}
     for is_group in (True, False):  # groups first, joints override
         for name, values in table.items():

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from .config import read_toml
 from .exceptions import InputError
 
 BUILTIN_ROBOTS = ("talos",)
@@ -270,16 +271,6 @@ def _joint_layout(model: pin.Model, joints: tuple[str, ...]) -> JointLayout:
 
 
 # --------------------------------------------------------------------- loading
-def _load_config(path: Path) -> dict:
-    try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh)
-    except FileNotFoundError as exc:
-        raise InputError(f"{path}: robot configuration file not found") from exc
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: not valid TOML: {exc}") from exc
-
-
 def _check_names(names, known, what: str, source: str) -> None:
     for n in names:
         if n not in known:
@@ -370,12 +361,12 @@ def load_robot(name: str | None = "talos", *, urdf: str | Path | None = None,
         if urdf is None or config is None:
             raise InputError("--urdf and --config must be given together")
         cfg_path = Path(config)
-        cfg = _load_config(cfg_path)
+        cfg = read_toml(cfg_path)
         cfg["_dir"] = str(cfg_path.parent)
         return build_robot(Path(urdf), cfg, source=str(cfg_path))
     if name not in BUILTIN_ROBOTS:
         raise InputError(f"unknown robot '{name}': built-in robots are {', '.join(BUILTIN_ROBOTS)}; "
                          "otherwise give --urdf and --config")
     text = resources.files("wbfriction.robots").joinpath(f"{name}.toml").read_text()
-    cfg = tomllib.loads(text)
+    cfg = tomllib.loads(text)  # the package's own file
     return build_robot(_resolve(cfg["urdf"], Path(".")), cfg, source=f"built-in robot '{name}'")

@@ -94,17 +94,9 @@ def load_sensors_toml(path) -> dict:
     Raises:
         InputError: unreadable file, no ``[sensors]`` table, an unknown key.
     """
-    import tomllib
-    from pathlib import Path
+    from ..config import toml_table
 
-    path = Path(path)
-    try:
-        doc = tomllib.loads(path.read_text())
-    except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise InputError(f"{path}: {exc}") from exc
-    table = doc.get("sensors")
-    if not isinstance(table, dict):
-        raise InputError(f"{path}: no [sensors] table")
+    table = toml_table(path, "sensors")
     unknown = sorted(set(table) - set(SENSOR_KEYS))
     if unknown:
         raise InputError(f"{path}: [sensors] has unknown key(s) {', '.join(unknown)}; known: {', '.join(SENSOR_KEYS)}")
