@@ -160,7 +160,7 @@ def test_swing_estimate_is_reliable_and_stance_is_not_on_mujoco(talos, mj_talos)
     est = estimate_log(talos, log, EstimateOptions(mask="single"))
     i = est.joints.index(knee)
     err = est.tau_f[:, i] - est.tau_f_true[:, i]
-    right = talos.contact_frames.index(next(f for f in talos.contact_frames if knee in talos.limb(f)))
+    right = talos.contact_of(knee)
     swing = est.valid[:, i] & ~est.contact[:, right]
     stance = est.valid[:, i] & est.contact[:, right]
     rms = lambda m: float(np.sqrt(np.mean(err[m] ** 2)))  # noqa: E731

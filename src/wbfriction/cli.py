@@ -103,6 +103,11 @@ SIMULATORS = ("ideal", "mujoco")
 _MIN_SAMPLES = 20
 
 
+def _check_simulator(simulator: str) -> None:
+    if simulator not in SIMULATORS:
+        raise InputError(f"--simulator must be one of {', '.join(SIMULATORS)}, got '{simulator}'")
+
+
 def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptions | MujocoOptions,
                   friction: Optional[Path]) -> None:
     params = None if friction is None else load_friction_toml(friction, r.groups, r.torque_controlled)
@@ -170,8 +175,7 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic)."""
     gait_opts = GaitOptions(gait=gait, steps=steps, step_length=step_length, step_width=step_width,
                             turn_angle=turn_angle, lift_height=lift_height)
-    if simulator not in SIMULATORS:
-        raise InputError(f"--simulator must be one of {', '.join(SIMULATORS)}, got '{simulator}'")
+    _check_simulator(simulator)
     if simulator == "ideal":
         options = IdealOptions(substeps=substeps or _I.substeps, integrator=integrator, log_base=log_base)
     else:
@@ -273,8 +277,7 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
     from .study import run_study, worst_errors
 
     start = time.perf_counter()
-    if simulator not in SIMULATORS:
-        raise InputError(f"--simulator must be one of {', '.join(SIMULATORS)}, got '{simulator}'")
+    _check_simulator(simulator)
     r = _robot(robot, None, None)
     if simulator == "mujoco":
         for f in _demo_mujoco(output_dir, r, steps):

@@ -69,8 +69,7 @@ class RealisticResult:
 
 def _swing(est: FrictionEstimate, robot: Robot, joint: str) -> np.ndarray:
     """Valid samples of ``joint`` while its leg swings."""
-    foot = next(c for c, f in enumerate(robot.contact_frames) if joint in robot.limb(f))
-    return est.valid[:, est.joints.index(joint)] & ~est.contact[:, foot]
+    return est.valid[:, est.joints.index(joint)] & ~est.contact[:, robot.contact_of(joint)]
 
 
 def run_realistic_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int = 5,

@@ -157,6 +157,11 @@ class Robot:
         path = set(self.model.supports[joint_id])
         return tuple(n for n in self.actuated if self.model.getJointId(n) in path)
 
+    def contact_of(self, joint: str) -> int | None:
+        """Index of the contact frame whose :meth:`limb` holds ``joint`` (a leg joint's
+        foot), or None."""
+        return next((c for c, f in enumerate(self.contact_frames) if joint in self.limb(f)), None)
+
     @cached_property
     def limb_mask(self) -> np.ndarray:
         """Boolean (n_contacts, n_tc): torque-controlled joint ``j`` lies on contact ``c``'s limb."""

@@ -113,7 +113,7 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
     truth = schemes["true acceleration"]
     truth_err = float(np.nanmax(np.abs(truth.tau_f - truth.tau_f_true)[truth.unique]))
     i_knee = truth.joints.index(knee)
-    foot = next(c for c, f in enumerate(robot.contact_frames) if knee in robot.limb(f))
+    foot = robot.contact_of(knee)
     # valid single-support samples (skip windows applied), same for every scheme
     swing_k = truth.valid[:, i_knee] & ~truth.contact[:, foot]
     stance_k = truth.valid[:, i_knee] & truth.contact[:, foot]

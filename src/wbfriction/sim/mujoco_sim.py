@@ -205,6 +205,8 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
     state, k_switch, before = None, 0, None
     kp_act[tc], kd_act[tc] = gains[tuple(bool(x) for x in ref.contact[0])]
     tau_f = np.zeros(len(joints_f))
+    torque_friction = bool(joints_f) and not native  # (3.5) applied by us at every physics step
+    bad_qacc = int(mujoco.mjtWarning.mjWARN_BADQACC)
     for k in counted(n, progress):
         qpos[k], qvel[k] = data.qpos, data.qvel
         q_meas[k] = options.sensors.encoder(data.qpos[mjr.qpos_index] + eps_q[k])
@@ -219,7 +221,7 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
         commands[k % (delay + 1)] = tau_ff[k] + kp_act * (q_ref[k] - q_meas[k]) + kd_act * (v_ref[k] - qd_meas)
         data.ctrl[:] = commands[(k - delay) % (delay + 1)] if k >= delay else tau_ff[k]  # at first: feed-forward
         for s in range(options.substeps):
-            if joints_f and not native:
+            if torque_friction:
                 tau_f = injected.torque(data.qvel[dof_f])
                 data.qfrc_applied[dof_f] = tau_f
             mujoco.mj_step(model, data)
@@ -230,8 +232,8 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
         # the soles' normal forces over this period, from its last step
         force[k] = data.sensordata[mjr.touch_index]
         contact[k] = force[k] > options.contact_threshold
-        if not np.isfinite(data.qpos).all() or data.qpos[2] < options.fall_height * z0 or data.warning.number[
-                int(mujoco.mjtWarning.mjWARN_BADQACC)] > 0:
+        if (not np.isfinite(data.qpos).all() or data.qpos[2] < options.fall_height * z0
+                or data.warning.number[bad_qacc] > 0):
             raise SimulationError(f"the robot fell (or the simulation diverged) at t = {ref.time[k]:.3f} s")
 
     Q, V = mjr.q(qpos), mjr.v(qpos, qvel)
