@@ -141,3 +141,19 @@ def test_coulomb_viscous_fit_with_held_parameters(F_v, F_c, a, seed):
     assert abs(res.params.F_v - F_v) < 5 * res.stderr["F_v"] + 1e-3
     assert abs(res.params.F_c - F_c) < 5 * res.stderr["F_c"] + 1e-3
     assert abs(res.params.F_c - F_c) / F_c < 0.02 and abs(res.params.F_v - F_v) / F_v < 0.05
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 2**16))
+def test_injected_friction_fast_path_equals_the_model(seed):
+    """The simulators' in-place evaluation of (3.5), per physics step, is ``-smooth``."""
+    from wbfriction.sim.common import InjectedFriction
+
+    rng = np.random.default_rng(seed)
+    params = {f"j{i}": FrictionParams(F_v=rng.uniform(0, 1), F_c=rng.uniform(0, 2), S=rng.uniform(0, 1),
+                                      v_s=rng.uniform(0.05, 1), tau_os=rng.normal(), a=rng.uniform(5, 100))
+              for i in range(5)}
+    injected = InjectedFriction(params, list(range(5)))
+    qd = rng.normal(0, 2, 5)
+    expected = np.array([p.torque(v) for p, v in zip(params.values(), qd)])
+    np.testing.assert_allclose(injected.torque(qd), expected, rtol=1e-12, atol=1e-14)
