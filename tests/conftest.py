@@ -16,6 +16,11 @@ def talos() -> Robot:
 
 
 @pytest.fixture(scope="session")
+def toro() -> Robot:
+    return load_robot("toro")
+
+
+@pytest.fixture(scope="session")
 def talos_tilted_sole(talos) -> Robot:
     """TALOS with its right contact frame's axes turned against its joint's (same point), as
     in URDFs whose sole frames follow another axis convention; the soles stay flat."""

@@ -27,9 +27,12 @@ def _random_state(talos, rng):
     return q, rng.normal(0, 1, talos.model.nv)
 
 
-def test_mass_matrix_gravity_and_bias_agree_with_pinocchio(talos, mj_talos):
+@pytest.mark.parametrize("robot_name", ["talos", "toro"])
+def test_mass_matrix_gravity_and_bias_agree_with_pinocchio(robot_name, request):
     """M_pin = T^T M_mj T, g_pin = T^T g_mj and h_pin = T^T (h_mj + M_mj dT/dt v), with T
     mapping Pinocchio's velocities to MuJoCo's, on random states."""
+    talos = request.getfixturevalue(robot_name)
+    mj_talos = request.getfixturevalue("mj_talos") if robot_name == "talos" else build_mujoco_robot(talos)
     m, d = mj_talos.model, mujoco.MjData(mj_talos.model)
     data = talos.model.createData()
     rng = np.random.default_rng(0)

@@ -34,8 +34,9 @@ import pinocchio as pin
 from .config import read_toml
 from .exceptions import InputError
 
-BUILTIN_ROBOTS = ("talos",)
+BUILTIN_ROBOTS = ("talos", "toro")
 _ERD_PREFIX = "example-robot-data:"
+_GENERATED = "wbfriction:"  # a URDF this package generates (robots/toro.py)
 
 
 def example_robot_data_dir() -> Path:
@@ -72,6 +73,9 @@ def _quiet_stderr():
 def _resolve(spec: str, base_dir: Path) -> Path:
     if spec.startswith(_ERD_PREFIX):
         return example_robot_data_dir() / spec[len(_ERD_PREFIX):]
+    if spec == _GENERATED + "toro":
+        from .robots.toro import toro_urdf_path
+        return toro_urdf_path()
     path = Path(spec).expanduser()
     return path if path.is_absolute() else (base_dir / path)
 
@@ -90,6 +94,9 @@ class Robot:
         contact_frames: names of the 6D contact frames (feet soles), as configured.
         groups: named joint groups (e.g. ``knee``), used to set friction per group.
         q_reference: a standing configuration (nq,), e.g. TALOS's ``half_sitting``.
+        balance_gains: (K [N·m/rad], D [N·m·s/rad]) of the MuJoCo walking controller's
+            base-attitude stabiliser (:func:`wbfriction.sim.control.attitude_ankle_torques`);
+            a property of the simulated robot, not used by the estimator.
     """
 
     name: str
@@ -101,6 +108,7 @@ class Robot:
     contact_frames: tuple[str, ...]
     groups: dict[str, tuple[str, ...]] = field(default_factory=dict)
     q_reference: np.ndarray | None = None
+    balance_gains: tuple[float, float] = (0.0, 0.0)
     cache: dict = field(default_factory=dict, repr=False, compare=False)
     """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.stance`)."""
 
@@ -289,7 +297,9 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
         urdf: URDF file. A free-flyer root joint is added (a URDF-declared floating
             joint is ignored by Pinocchio's parser, so the result is the same).
         config: keys ``name``, ``contact_frames`` (required), ``position_controlled``,
-            ``torque_controlled``, ``groups``, ``srdf``/``reference_configuration``.
+            ``torque_controlled``, ``groups``, ``srdf``/``reference_configuration`` (an SRDF
+            posture), ``reference_angles`` (joint name -> angle [rad], set over it),
+            ``balance_gains`` (:attr:`Robot.balance_gains`).
         source: file name used in error messages.
 
     Raises:
@@ -338,6 +348,12 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
         ref = config.get("reference_configuration")
         if ref is not None and ref in model.referenceConfigurations:
             q_ref = np.array(model.referenceConfigurations[ref], dtype=float)
+    angles = dict(config.get("reference_angles", {}))
+    if angles:
+        _check_names(list(angles), known, "joint in reference_angles", source)
+        q_ref = pin.neutral(model) if q_ref is None else q_ref
+        for name, angle in angles.items():
+            q_ref[model.idx_qs[model.getJointId(name)]] = float(angle)
     return Robot(
         name=str(config.get("name", urdf.stem)),
         model=model,
@@ -348,7 +364,18 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
         contact_frames=tuple(frames),
         groups=groups,
         q_reference=q_ref,
+        balance_gains=_balance_gains(config.get("balance_gains", (0.0, 0.0)), source),
     )
+
+
+def _balance_gains(value, source: str) -> tuple[float, float]:
+    try:
+        K, D = (float(x) for x in value)
+    except (TypeError, ValueError):
+        raise InputError(f"{source}: 'balance_gains' must be two numbers [K, D], got {value!r}") from None
+    if K < 0 or D < 0:
+        raise InputError(f"{source}: 'balance_gains' must be >= 0, got {value!r}")
+    return K, D
 
 
 def load_robot(name: str | None = "talos", *, urdf: str | Path | None = None,

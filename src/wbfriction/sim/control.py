@@ -188,6 +188,35 @@ def ramp_gains(current: tuple[np.ndarray, np.ndarray], target: tuple[np.ndarray,
     return tuple(s + r * (t - s) for s, t in zip(start, target))
 
 
+def attitude_ankle_torques(R: np.ndarray, omega: np.ndarray, R_ref: np.ndarray, omega_ref: np.ndarray,
+                           gains: tuple[float, float], ankle_axes: list[np.ndarray], load: np.ndarray) -> list[np.ndarray]:
+    """Torques of the stance ankles that right the base (an ankle strategy on the IMU).
+
+    The base's tilt error ``e = log(R R_ref^T)`` and rate error ``omega - omega_ref`` (both
+    in the world frame) call for the moment ``m = -(K e + D (omega - omega_ref))`` on the
+    body, its vertical component dropped (the heading is left to the legs' PD). A joint
+    torque ``t`` about a world axis ``a`` acts on the body above the joint with ``-t a``,
+    so each stance ankle joint gets ``t = -a . m`` times its foot's share of the load. The rate comes from the body, not from the
+    ankle joint: its damping is not bound by the foot's small inertia as the joint PD's
+    is (:func:`~wbfriction.sim.mujoco_sim.simulate_mujoco`).
+
+    Args:
+        R, R_ref: measured and reference base orientations (3, 3).
+        omega, omega_ref: measured and reference base angular velocities, world frame [rad/s].
+        gains: (K [N·m/rad], D [N·m·s/rad]).
+        ankle_axes: per foot, the world axes (n_j, 3) of its ankle joints.
+        load: each foot's normal force [N] (0: not in contact).
+
+    Returns:
+        Per foot, torques (n_j,) [N·m] to add to its ankle joints' commands.
+    """
+    K, D = gains
+    m = -(K * pin.log3(R @ R_ref.T) + D * (omega - omega_ref))
+    m[2] = 0.0
+    share = load / load.sum() if load.sum() > 0 else np.zeros_like(load)
+    return [-s * (axes @ m) for s, axes in zip(share, ankle_axes)]
+
+
 def reference_feedforward(robot: Robot, reference: WalkingReference) -> np.ndarray:
     """:func:`feedforward` torques (N, n_act) of a walking reference, the wrench shared
     between the feet by its ZMP (:func:`foot_shares`)."""

@@ -49,11 +49,12 @@ def _read_stl(path: Path) -> np.ndarray:
 def sole_footprint(robot: Robot, frame: str, urdf_root: ET.Element | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Rectangle under a contact frame: centre (x, y) and half sizes (x, y) [m], in the frame.
 
-    Read from the collision mesh (binary STL) of the link the frame hangs on: the
-    bounding box, in the frame's axes, of the vertices within 1 cm of the mesh's lowest point.
+    Read from the collision geometry (a binary STL mesh or a box) of the link the frame
+    hangs on: the bounding box, in the frame's axes, of the vertices within 1 cm of the
+    lowest one.
 
     Raises:
-        ModelError: no collision mesh to read.
+        ModelError: no collision mesh or box to read.
     """
     root = ET.parse(robot.urdf).getroot() if urdf_root is None else urdf_root
     model = robot.model
@@ -65,22 +66,33 @@ def sole_footprint(robot: Robot, frame: str, urdf_root: ET.Element | None = None
         if node.get("name") != link.name:
             continue
         for col in node.findall("collision"):
-            mesh = col.find("geometry/mesh")
-            if mesh is None:
+            v = _collision_vertices(col, robot.urdf)
+            if v is None:
                 continue
-            path = _resolve_mesh(mesh.get("filename"), robot.urdf)
-            scale = np.array([float(s) for s in (mesh.get("scale") or "1 1 1").split()])
-            origin = col.find("origin")
-            xyz = np.array([float(s) for s in ((origin.get("xyz") if origin is not None else None) or "0 0 0").split()])
-            rpy = np.array([float(s) for s in ((origin.get("rpy") if origin is not None else None) or "0 0 0").split()])
-            v = _read_stl(path) * scale
-            v = v @ pin.rpy.rpyToMatrix(*rpy).T + xyz  # in the link frame
             link_to_frame = link.placement.actInv(fr.placement)  # frame pose in the link
             v = (v - link_to_frame.translation) @ link_to_frame.rotation  # in the contact frame
             low = v[v[:, 2] < v[:, 2].min() + 0.01]
             lo, hi = low[:, :2].min(axis=0), low[:, :2].max(axis=0)
             return (lo + hi) / 2, (hi - lo) / 2
-    raise ModelError(f"no collision mesh on link '{link.name}' to size the sole of '{frame}'")
+    raise ModelError(f"no collision mesh or box on link '{link.name}' to size the sole of '{frame}'")
+
+
+def _collision_vertices(col: ET.Element, urdf: Path) -> np.ndarray | None:
+    """Vertices (n, 3) of a URDF collision element in its link's frame: a binary STL mesh's,
+    or a box's corners; None for other shapes."""
+    mesh, box = col.find("geometry/mesh"), col.find("geometry/box")
+    if mesh is not None:
+        scale = np.array([float(s) for s in (mesh.get("scale") or "1 1 1").split()])
+        v = _read_stl(_resolve_mesh(mesh.get("filename"), urdf)) * scale
+    elif box is not None:
+        half = np.array([float(s) for s in box.get("size").split()]) / 2
+        v = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
+    else:
+        return None
+    origin = col.find("origin")
+    xyz = np.array([float(s) for s in ((origin.get("xyz") if origin is not None else None) or "0 0 0").split()])
+    rpy = np.array([float(s) for s in ((origin.get("rpy") if origin is not None else None) or "0 0 0").split()])
+    return v @ pin.rpy.rpyToMatrix(*rpy).T + xyz
 
 
 def _resolve_mesh(filename: str, urdf: Path) -> Path:
@@ -109,6 +121,8 @@ class MujocoRobot:
         dof_index: MuJoCo ``qvel`` address of each actuated joint.
         sole_geoms: geom id of each contact frame's box, in :attr:`Robot.contact_frames` order.
         touch_index: ``sensordata`` address of each sole's touch sensor (normal force [N]).
+        joint_ids: MuJoCo joint id of each actuated joint.
+        base_body: body id of the floating base (the free joint's body).
 
     Actuator ``i`` is the motor of joint ``robot.actuated[i]``: ``data.ctrl`` takes the
     joint torques [N·m] in :attr:`Robot.actuated` order.
@@ -120,6 +134,8 @@ class MujocoRobot:
     dof_index: np.ndarray
     sole_geoms: tuple[int, ...]
     touch_index: np.ndarray
+    joint_ids: np.ndarray
+    base_body: int = 1
 
     def qpos(self, q: np.ndarray) -> np.ndarray:
         """MuJoCo ``qpos`` (nq,) of a Pinocchio configuration (nq,)."""
@@ -219,17 +235,19 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
         mj = spec.compile()
     except Exception as exc:
         raise ModelError(f"{robot.urdf}: MuJoCo cannot compile the model: {exc}") from None
-    qpos_index, dof_index = [], []
+    qpos_index, dof_index, joint_ids = [], [], []
     for name in robot.actuated:
         jid = mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_JOINT, name)
         if jid < 0:
             raise ModelError(f"MuJoCo model has no joint '{name}'")
         qpos_index.append(mj.jnt_qposadr[jid])
         dof_index.append(mj.jnt_dofadr[jid])
+        joint_ids.append(jid)
     soles = tuple(mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_GEOM, f"sole_{f}") for f in robot.contact_frames)
     touch = np.array([mj.sensor_adr[mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_SENSOR, f"touch_{f}")]
                       for f in robot.contact_frames])
-    return MujocoRobot(robot, mj, np.array(qpos_index), np.array(dof_index), soles, touch)
+    base = int(mj.jnt_bodyid[np.flatnonzero(mj.jnt_type == mujoco.mjtJoint.mjJNT_FREE)[0]])
+    return MujocoRobot(robot, mj, np.array(qpos_index), np.array(dof_index), soles, touch, np.array(joint_ids), base)
 
 
 def _body_of_joint(model: pin.Model, joint: int) -> str:

@@ -18,7 +18,12 @@ box soles; one motor per joint). Differences forced by real contacts:
   ankle): ``kd <= I / dt``, ``kp <= I / dt^2``. A stance ankle's gains, designed for the
   whole body, blew up a foot rocking on its edge at a turning step's touch-down (measured);
 * the position-controlled joints follow their reference through a stiff PD (gains from
-  their inertia at the reference bandwidth), not as a constraint.
+  their inertia at the reference bandwidth), not as a constraint;
+* optionally (``balance``, per robot), the stance ankles right the base from the IMU
+  (:func:`~wbfriction.sim.control.attitude_ankle_torques`): the damping the ankle PD
+  cannot have on a light foot. The TORO-like robot, whose feet and ankle roll inertia are
+  small, falls without it (measured: a forward walk at 9.2 s, a sideways one at 6.9 s).
+  The ankles are each leg's last two joints.
 
 Friction, two independent implementations (:data:`FRICTION_MODES`):
 
@@ -51,6 +56,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 import pinocchio as pin
+from scipy.spatial.transform import Rotation
 
 from ..exceptions import InputError, SimulationError
 from ..friction import FrictionParams, friction_by_group
@@ -58,7 +64,7 @@ from ..progress import counted
 from ..robot import Robot
 from ..walking import WalkingReference
 from .common import InjectedFriction, SimulationResult, injected_friction, simulated_log
-from .control import pd_from_inertia, pd_gains, ramp_gains, reference_feedforward
+from .control import attitude_ankle_torques, pd_from_inertia, pd_gains, ramp_gains, reference_feedforward
 from .mujoco_model import MujocoRobot, build_mujoco_robot
 from .sensors import SensorNoise
 
@@ -80,6 +86,9 @@ class MujocoOptions:
         sensors: sensor noise of the controller's and the log's measurements.
         delay: time from a measurement to the command computed from it acting [s], a
             whole number of control periods.
+        balance: (K [N·m/rad], D [N·m·s/rad]) of the base-attitude stabiliser on the
+            stance ankles (:func:`~wbfriction.sim.control.attitude_ankle_torques`); None:
+            the robot's :attr:`~wbfriction.robot.Robot.balance_gains`.
         fall_height: the simulation stops with an error when the base drops below this
             share of its initial height.
         log_base: write the base pose to the log.
@@ -94,6 +103,7 @@ class MujocoOptions:
     friction: str = "model"
     sensors: SensorNoise = SensorNoise()
     delay: float = 0.0
+    balance: tuple[float, float] | None = None
     fall_height: float = 0.5
     log_base: bool = True
 
@@ -180,6 +190,14 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
         _set_mujoco_friction(model, dof_f, injected)
     data = mujoco.MjData(model)
 
+    # base-attitude stabiliser: each leg's last two joints (the ankle), the reference base attitude
+    balance = robot.balance_gains if options.balance is None else options.balance
+    stabilise = any(balance)
+    ankles = [np.array([robot.actuated.index(j) for j in robot.limb(f)[-2:]]) for f in robot.contact_frames]
+    ankle_jnt = [mjr.joint_ids[a] for a in ankles]
+    R_ref = Rotation.from_quat(ref.q[:, 3:7]).as_matrix()
+    w_ref = np.einsum("nij,nj->ni", R_ref, ref.v[:, 3:6])  # world frame
+
     # the controller: feed-forward, PD gains per contact state
     tau_ff = reference_feedforward(robot, ref)
     free = np.diag(pin.crba(robot.model, robot.model.createData(), ref.q[0]))[iv]  # inertia, upstream held
@@ -218,7 +236,14 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
             state, k_switch, before = measured, k, (kp_act[tc].copy(), kd_act[tc].copy())
         if (k - k_switch) * dt <= options.gain_blend + dt:
             kp_act[tc], kd_act[tc] = ramp_gains(before, gains[state], (k - k_switch) * dt, options.gain_blend)
-        commands[k % (delay + 1)] = tau_ff[k] + kp_act * (q_ref[k] - q_meas[k]) + kd_act * (v_ref[k] - qd_meas)
+        command = tau_ff[k] + kp_act * (q_ref[k] - q_meas[k]) + kd_act * (v_ref[k] - qd_meas)
+        if stabilise:
+            R = data.xmat[mjr.base_body].reshape(3, 3)
+            load = (force[k - 1] if k > 0 else np.ones(nc)) * np.array(measured)
+            for a, t in zip(ankles, attitude_ankle_torques(R, R @ data.qvel[3:6], R_ref[k], w_ref[k], balance,
+                                                           [data.xaxis[j] for j in ankle_jnt], load)):
+                command[a] += t
+        commands[k % (delay + 1)] = command
         data.ctrl[:] = commands[(k - delay) % (delay + 1)] if k >= delay else tau_ff[k]  # at first: feed-forward
         for s in range(options.substeps):
             if torque_friction:
