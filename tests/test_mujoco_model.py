@@ -31,23 +31,23 @@ def _random_state(talos, rng):
 def test_mass_matrix_gravity_and_bias_agree_with_pinocchio(robot_name, request):
     """M_pin = T^T M_mj T, g_pin = T^T g_mj and h_pin = T^T (h_mj + M_mj dT/dt v), with T
     mapping Pinocchio's velocities to MuJoCo's, on random states."""
-    talos = request.getfixturevalue(robot_name)
-    mj_talos = request.getfixturevalue("mj_talos") if robot_name == "talos" else build_mujoco_robot(talos)
-    m, d = mj_talos.model, mujoco.MjData(mj_talos.model)
-    data = talos.model.createData()
+    robot = request.getfixturevalue(robot_name)
+    mjr = request.getfixturevalue("mj_talos") if robot_name == "talos" else build_mujoco_robot(robot)
+    m, d = mjr.model, mujoco.MjData(mjr.model)
+    data = robot.model.createData()
     rng = np.random.default_rng(0)
     M_mj = np.zeros((m.nv, m.nv))
     for _ in range(5):
-        q, v = _random_state(talos, rng)
-        T = mj_talos.velocity_map(q)
-        d.qpos[:], d.qvel[:] = mj_talos.qpos(q), T @ v
+        q, v = _random_state(robot, rng)
+        T = mjr.velocity_map(q)
+        d.qpos[:], d.qvel[:] = mjr.qpos(q), T @ v
         mujoco.mj_forward(m, d)
         mujoco.mj_fullM(m, d, M_mj)
-        M = pin.crba(talos.model, data, q)
+        M = pin.crba(robot.model, data, q)
         M = np.triu(M) + np.triu(M, 1).T
         np.testing.assert_allclose(T.T @ M_mj @ T, M, atol=1e-9)
-        g = pin.computeGeneralizedGravity(talos.model, data, q)
-        h = pin.nonLinearEffects(talos.model, data, q, v)
+        g = pin.computeGeneralizedGravity(robot.model, data, q)
+        h = pin.nonLinearEffects(robot.model, data, q, v)
         d.qvel[:] = 0
         mujoco.mj_forward(m, d)
         np.testing.assert_allclose(T.T @ d.qfrc_bias, g, atol=1e-8)
@@ -57,7 +57,7 @@ def test_mass_matrix_gravity_and_bias_agree_with_pinocchio(robot_name, request):
         Tdot_v = np.zeros(m.nv)
         Tdot_v[:3] = T[:3, :3] @ np.cross(v[3:6], v[:3])
         np.testing.assert_allclose(T.T @ (d.qfrc_bias + M_mj @ Tdot_v), h, atol=1e-8)
-        np.testing.assert_allclose(mj_talos.q(mj_talos.qpos(q)), q, atol=1e-15)
+        np.testing.assert_allclose(mjr.q(mjr.qpos(q)), q, atol=1e-15)
 
 
 def test_soles_are_boxes_flat_under_the_contact_frames(talos, mj_talos):

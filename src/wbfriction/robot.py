@@ -36,7 +36,7 @@ from .exceptions import InputError
 
 BUILTIN_ROBOTS = ("talos", "toro")
 _ERD_PREFIX = "example-robot-data:"
-_GENERATED = "wbfriction:"  # a URDF this package generates (robots/toro.py)
+_GENERATED = "wbfriction:"  # a URDF this package generates: "wbfriction:<name>" (robots/<name>.py)
 
 
 def example_robot_data_dir() -> Path:
@@ -73,9 +73,14 @@ def _quiet_stderr():
 def _resolve(spec: str, base_dir: Path) -> Path:
     if spec.startswith(_ERD_PREFIX):
         return example_robot_data_dir() / spec[len(_ERD_PREFIX):]
-    if spec == _GENERATED + "toro":
+    if spec.startswith(_GENERATED):
         from .robots.toro import toro_urdf_path
-        return toro_urdf_path()
+        generators = {"toro": toro_urdf_path}
+        name = spec[len(_GENERATED):]
+        if name not in generators:
+            raise InputError(f"no generated URDF '{spec}': known are "
+                             + ", ".join(_GENERATED + n for n in generators))
+        return generators[name]()
     path = Path(spec).expanduser()
     return path if path.is_absolute() else (base_dir / path)
 

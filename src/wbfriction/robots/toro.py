@@ -163,72 +163,68 @@ def _box_inertia(mass: float, size: tuple[float, float, float]) -> np.ndarray:
     return mass / 12.0 * np.array([y * y + z * z, x * x + z * z, x * x + y * y])
 
 
-def _specs() -> dict[str, JointSpec]:
-    return {s.name: s for s in TABLE_4_1}
+_SPEC = {s.name: s for s in TABLE_4_1}
 
 
 def _leg(side: str, s: float, M: float) -> list[_Joint]:
-    spec = _specs()
     thigh = SEGMENT_MASS["thigh"] * M - 2 * DRIVE
     shank = SEGMENT_MASS["shank"] * M - DRIVE
     p = f"{side}_"
     drive = (0.08, 0.08, 0.08)
     return [
-        _Joint(p + "hip_roll", spec["hip_roll"], "pelvis", _Link(p + "hip_roll_link", DRIVE, (0, 0, 0), drive),
+        _Joint(p + "hip_roll", _SPEC["hip_roll"], "pelvis", _Link(p + "hip_roll_link", DRIVE, (0, 0, 0), drive),
                (0.0, s * HIP_SPACING / 2, 0.0), (s, 0, 0)),
-        _Joint(p + "hip_pitch", spec["hip_pitch"], p + "hip_roll_link",
+        _Joint(p + "hip_pitch", _SPEC["hip_pitch"], p + "hip_roll_link",
                _Link(p + "hip_pitch_link", DRIVE, (0, 0, 0), drive), (0, 0, 0), (0, 1, 0)),
-        _Joint(p + "hip_yaw", spec["hip_yaw"], p + "hip_pitch_link",
+        _Joint(p + "hip_yaw", _SPEC["hip_yaw"], p + "hip_pitch_link",
                _Link(p + "thigh", thigh, (0, 0, -0.433 * THIGH), (0.12, 0.12, THIGH)), (0, 0, 0), (0, 0, s)),
-        _Joint(p + "knee", spec["knee"], p + "thigh",
+        _Joint(p + "knee", _SPEC["knee"], p + "thigh",
                _Link(p + "shank", shank, (0, 0, -0.433 * SHANK), (0.10, 0.10, SHANK)), (0, 0, -THIGH), (0, 1, 0)),
-        _Joint(p + "ankle_roll", spec["ankle_roll"], p + "shank",
+        _Joint(p + "ankle_roll", _SPEC["ankle_roll"], p + "shank",
                _Link(p + "ankle_roll_link", DRIVE, (0, 0, 0), (0.06, 0.06, 0.06)), (0, 0, -SHANK), (s, 0, 0)),
-        _Joint(p + "ankle_pitch", spec["ankle_pitch"], p + "ankle_roll_link",
+        _Joint(p + "ankle_pitch", _SPEC["ankle_pitch"], p + "ankle_roll_link",
                _Link(p + "foot", SEGMENT_MASS["foot"] * M, (0, 0, -ANKLE_HEIGHT / 2),
                      (FOOT_LENGTH, FOOT_WIDTH, ANKLE_HEIGHT)), (0, 0, 0), (0, 1, 0)),
     ]
 
 
 def _arm(side: str, s: float, M: float) -> list[_Joint]:
-    spec = _specs()
     upper = SEGMENT_MASS["upper_arm"] * M - 2 * DRIVE
     fore = SEGMENT_MASS["forearm"] * M - 0.2
     p = f"{side}_"
     drive = (0.07, 0.07, 0.07)
     return [
-        _Joint(p + "shoulder_1", spec["shoulder_1"], "torso", _Link(p + "shoulder_1_link", DRIVE, (0, 0, 0), drive),
+        _Joint(p + "shoulder_1", _SPEC["shoulder_1"], "torso", _Link(p + "shoulder_1_link", DRIVE, (0, 0, 0), drive),
                (0.0, s * SHOULDER_SPACING / 2, SHOULDER_HEIGHT - HIP_HEIGHT - WAIST_ABOVE_HIP), (0, 1, 0)),
-        _Joint(p + "shoulder_2", spec["shoulder_2"], p + "shoulder_1_link",
+        _Joint(p + "shoulder_2", _SPEC["shoulder_2"], p + "shoulder_1_link",
                _Link(p + "shoulder_2_link", DRIVE, (0, 0, 0), drive), (0, 0, 0), (s, 0, 0)),
-        _Joint(p + "shoulder_3", spec["shoulder_3"], p + "shoulder_2_link",
+        _Joint(p + "shoulder_3", _SPEC["shoulder_3"], p + "shoulder_2_link",
                _Link(p + "upper_arm", upper, (0, 0, -0.436 * UPPER_ARM), (0.08, 0.08, UPPER_ARM)), (0, 0, 0),
                (0, 0, s)),
-        _Joint(p + "elbow", spec["elbow"], p + "upper_arm",
+        _Joint(p + "elbow", _SPEC["elbow"], p + "upper_arm",
                _Link(p + "forearm", fore, (0, 0, -0.430 * FOREARM), (0.07, 0.07, FOREARM)), (0, 0, -UPPER_ARM),
                (0, -1, 0)),
-        _Joint(p + "wrist_1", spec["wrist_1"], p + "forearm",
+        _Joint(p + "wrist_1", _SPEC["wrist_1"], p + "forearm",
                _Link(p + "wrist_1_link", 0.2, (0, 0, 0), (0.05, 0.05, 0.05)), (0, 0, -FOREARM), (0, 0, s)),
-        _Joint(p + "wrist_2", spec["wrist_2"], p + "wrist_1_link",
+        _Joint(p + "wrist_2", _SPEC["wrist_2"], p + "wrist_1_link",
                _Link(p + "hand", SEGMENT_MASS["hand"] * M, (0, 0, -0.506 * HAND), (0.08, 0.03, HAND)), (0, 0, 0),
                (0, 1, 0)),
     ]
 
 
 def _tree(M: float = MASS) -> tuple[_Link, list[_Joint]]:
-    spec = _specs()
     pelvis = _Link("pelvis", SEGMENT_MASS["pelvis"] * M, (0, 0, 0.03), (0.18, HIP_SPACING + 0.10, 0.16))
     torso_len = SHOULDER_HEIGHT - HIP_HEIGHT - WAIST_ABOVE_HIP + NECK_ABOVE_SHOULDER
     head_len = HEIGHT - SHOULDER_HEIGHT - NECK_ABOVE_SHOULDER
     torso = _Link("torso", SEGMENT_MASS["torso"] * M, (0, 0, torso_len / 2), (0.22, SHOULDER_SPACING - 0.08, torso_len))
     head = SEGMENT_MASS["head"] * M - 0.3
     joints = _leg("right", RIGHT, M) + _leg("left", LEFT, M)
-    joints.append(_Joint("waist", spec["waist"], "pelvis", torso, (0, 0, WAIST_ABOVE_HIP), (0, 0, 1)))
+    joints.append(_Joint("waist", _SPEC["waist"], "pelvis", torso, (0, 0, WAIST_ABOVE_HIP), (0, 0, 1)))
     joints += _arm("right", RIGHT, M) + _arm("left", LEFT, M)
     joints += [
-        _Joint("neck_yaw", spec["neck_yaw"], "torso", _Link("neck_link", 0.3, (0, 0, 0), (0.06, 0.06, 0.06)),
+        _Joint("neck_yaw", _SPEC["neck_yaw"], "torso", _Link("neck_link", 0.3, (0, 0, 0), (0.06, 0.06, 0.06)),
                (0, 0, torso_len), (0, 0, 1)),
-        _Joint("neck_pitch", spec["neck_pitch"], "neck_link",
+        _Joint("neck_pitch", _SPEC["neck_pitch"], "neck_link",
                _Link("head", head, (0, 0, head_len / 2), (0.20, 0.18, head_len)), (0, 0, 0), (0, 1, 0)),
     ]
     return pelvis, joints

@@ -196,9 +196,10 @@ def attitude_ankle_torques(R: np.ndarray, omega: np.ndarray, R_ref: np.ndarray, 
     in the world frame) call for the moment ``m = -(K e + D (omega - omega_ref))`` on the
     body, its vertical component dropped (the heading is left to the legs' PD). A joint
     torque ``t`` about a world axis ``a`` acts on the body above the joint with ``-t a``,
-    so each stance ankle joint gets ``t = -a . m`` times its foot's share of the load. The rate comes from the body, not from the
-    ankle joint: its damping is not bound by the foot's small inertia as the joint PD's
-    is (:func:`~wbfriction.sim.mujoco_sim.simulate_mujoco`).
+    so each stance ankle joint gets ``t = -a . m`` times its foot's share of the load.
+    The rate comes from the body, not from the ankle joint: its damping is not bound by
+    the foot's small inertia as the joint PD's is
+    (:func:`~wbfriction.sim.mujoco_sim.simulate_mujoco`).
 
     Args:
         R, R_ref: measured and reference base orientations (3, 3).

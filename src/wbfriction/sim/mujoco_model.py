@@ -135,7 +135,7 @@ class MujocoRobot:
     sole_geoms: tuple[int, ...]
     touch_index: np.ndarray
     joint_ids: np.ndarray
-    base_body: int = 1
+    base_body: int
 
     def qpos(self, q: np.ndarray) -> np.ndarray:
         """MuJoCo ``qpos`` (nq,) of a Pinocchio configuration (nq,)."""

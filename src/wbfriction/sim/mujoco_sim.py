@@ -193,10 +193,11 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
     # base-attitude stabiliser: each leg's last two joints (the ankle), the reference base attitude
     balance = robot.balance_gains if options.balance is None else options.balance
     stabilise = any(balance)
-    ankles = [np.array([robot.actuated.index(j) for j in robot.limb(f)[-2:]]) for f in robot.contact_frames]
-    ankle_jnt = [mjr.joint_ids[a] for a in ankles]
-    R_ref = Rotation.from_quat(ref.q[:, 3:7]).as_matrix()
-    w_ref = np.einsum("nij,nj->ni", R_ref, ref.v[:, 3:6])  # world frame
+    if stabilise:
+        ankles = [np.array([robot.actuated.index(j) for j in robot.limb(f)[-2:]]) for f in robot.contact_frames]
+        ankle_jnt = [mjr.joint_ids[a] for a in ankles]
+        R_ref = Rotation.from_quat(ref.q[:, 3:7]).as_matrix()
+        w_ref = np.einsum("nij,nj->ni", R_ref, ref.v[:, 3:6])  # world frame
 
     # the controller: feed-forward, PD gains per contact state
     tau_ff = reference_feedforward(robot, ref)
@@ -239,7 +240,7 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
         command = tau_ff[k] + kp_act * (q_ref[k] - q_meas[k]) + kd_act * (v_ref[k] - qd_meas)
         if stabilise:
             R = data.xmat[mjr.base_body].reshape(3, 3)
-            load = (force[k - 1] if k > 0 else np.ones(nc)) * np.array(measured)
+            load = (force[k - 1] if k > 0 else np.ones(nc)) * last
             for a, t in zip(ankles, attitude_ankle_torques(R, R @ data.qvel[3:6], R_ref[k], w_ref[k], balance,
                                                            [data.xaxis[j] for j in ankle_jnt], load)):
                 command[a] += t
