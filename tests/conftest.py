@@ -109,3 +109,17 @@ def truth_samples(robot: Robot, n: int, support: str, seed: int, friction_joints
     kin = MeasuredKinematics(time=np.arange(n) * 1e-3, q=arr["q"], qd=arr["qd"], qdd=arr["qdd"], tau=arr["tau"],
                              contact=arr["contact"], base=arr["base"] if base_random else None)
     return kin, arr["tau_f"]
+
+
+@pytest.fixture(scope="session")
+def combined_walk(talos):
+    """The demo's combined walk (forward, sideways, turning), 3 steps per direction, Table 6.1
+    friction on every leg joint, the demo's simulator (physics at 10 kHz)."""
+    from wbfriction.friction import THESIS_TARGETS
+    from wbfriction.sim import simulate_ideal
+    from wbfriction.study import SIMULATOR, _leg_joints
+    from wbfriction.walking import GaitOptions, walking_reference
+
+    friction = {j: THESIS_TARGETS[g] for j, _, g in _leg_joints(talos)}
+    ref = walking_reference(talos, GaitOptions(gait="combined", steps=3))
+    return simulate_ideal(talos, ref, friction, SIMULATOR)

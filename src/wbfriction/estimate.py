@@ -28,8 +28,8 @@ import pyarrow as pa
 
 from .dynamics import constrained_dynamics
 from .exceptions import InputError
-from .kinematics import FilterOptions, MeasuredKinematics, Smoother, measure
-from .log import Log, with_metadata
+from .kinematics import FILTERING_SCHEMES, FilterOptions, MeasuredKinematics, Smoother, make_smoother, measure
+from .log import Log, read_metadata, with_metadata
 from .phases import Phases, joint_mask, segment
 from .robot import Robot
 from .stance import StanceModel, stance_model
@@ -83,6 +83,10 @@ class FrictionEstimate:
         time: (N,) [s].
         qd: joint velocities (N, n_tc) [rad/s] (same differentiation as ``qdd_msr``).
         tau_f: estimated friction torque (N, n_tc) [N·m]; NaN where not estimated.
+        qdd: measured accelerations ``qdd_msr`` (N, n_tc) [rad/s^2].
+        delta_qdd: acceleration difference (5.12) ``qdd_msr - qdd_est`` (N, n_tc)
+            [rad/s^2]; NaN where not estimated. ``qdd - delta_qdd`` is the estimated
+            acceleration ``qdd_est`` (5.10).
         valid: (N, n_tc) samples to trust (single support, margins, mask).
         phase: (N,) ``single`` / ``double`` / ``flight``.
         unique: (N,) the estimate is the exact unique solution (single support).
@@ -90,6 +94,11 @@ class FrictionEstimate:
         contact: (N, n_contacts) flags; ``contact_frames`` their names.
         tau_f_true: (N, n_tc) true friction if the log had it, else None.
         metadata: carried from the log, plus the options used.
+        companion_delta_qdd: the single-support acceleration difference through the other
+            kind of scheme (N, n_tc) [rad/s^2] (NaN elsewhere), or None: unfiltered
+            (central differences) for a filtering scheme, Savitzky-Golay filtered otherwise;
+            so that Fig. 7.4 can show the difference with and without filtering.
+            ``companion_diff`` names its scheme.
         smoother: the zero-phase smoother the estimate went through (filtering schemes),
             or None; the fit passes the model through it too
             (:func:`~wbfriction.identify.fit_friction`). A table records it as the
@@ -105,15 +114,20 @@ class FrictionEstimate:
     unique: np.ndarray
     contact: np.ndarray
     contact_frames: tuple[str, ...]
+    qdd: np.ndarray | None = None
+    delta_qdd: np.ndarray | None = None
     cond: np.ndarray | None = None
     tau_f_true: np.ndarray | None = None
     metadata: dict = field(default_factory=dict)
     smoother: Smoother | None = None
+    companion_delta_qdd: np.ndarray | None = None
+    companion_diff: str | None = None
 
     def to_table(self) -> pa.Table:
         """The estimate as an Arrow table: ``time``, ``phase``, ``unique``, [``cond``],
         ``contact.<frame>``, and per joint ``qd.<j>``, ``tau_f.<j>``, ``valid.<j>``,
-        [``tau_f_true.<j>``]."""
+        ``qdd.<j>``, ``delta_qdd.<j>``, [``delta_qdd_companion.<j>``], [``tau_f_true.<j>``];
+        the companion's scheme is the metadata key ``companion_diff``."""
         cols: dict[str, object] = {"time": self.time, "phase": pa.array(self.phase.astype(str)).dictionary_encode(),
                                    "unique": self.unique}
         if self.cond is not None:
@@ -124,9 +138,72 @@ class FrictionEstimate:
             cols[f"qd.{j}"] = self.qd[:, i]
             cols[f"tau_f.{j}"] = self.tau_f[:, i]
             cols[f"valid.{j}"] = self.valid[:, i]
+            for name, arr in (("qdd", self.qdd), ("delta_qdd", self.delta_qdd),
+                              ("delta_qdd_companion", self.companion_delta_qdd)):
+                if arr is not None:
+                    cols[f"{name}.{j}"] = arr[:, i]
             if self.tau_f_true is not None and not np.all(np.isnan(self.tau_f_true[:, i])):
                 cols[f"tau_f_true.{j}"] = self.tau_f_true[:, i]
-        return with_metadata(pa.table(cols), self.metadata)
+        metadata = dict(self.metadata)
+        if self.companion_diff is not None:
+            metadata["companion_diff"] = self.companion_diff
+        return with_metadata(pa.table(cols), metadata)
+
+
+def _optional_columns(table: pa.Table, prefix: str, joints) -> np.ndarray | None:
+    """(N, n) of ``<prefix>.<joint>`` columns, NaN for a missing one; None if all are missing."""
+    names = set(table.column_names)
+    if not any(f"{prefix}.{j}" in names for j in joints):
+        return None
+    return np.column_stack([_float_column(table, f"{prefix}.{j}") if f"{prefix}.{j}" in names
+                            else np.full(table.num_rows, np.nan) for j in joints])
+
+
+def _float_column(table: pa.Table, name: str) -> np.ndarray:
+    return table.column(name).to_numpy(zero_copy_only=False).astype(float)
+
+
+def estimate_from_table(table: pa.Table, source: str = "<table>") -> FrictionEstimate:
+    """Read back a friction table written by ``wbfriction estimate`` (:meth:`FrictionEstimate.to_table`).
+
+    The joints are those with a ``tau_f.<j>`` column; each needs ``qd.<j>`` and ``valid.<j>``.
+    ``time`` and ``phase`` are needed; the contact flags, ``qdd``, ``delta_qdd``, the
+    companion and ``tau_f_true`` columns are optional (older tables, or tables of other
+    tools). The smoother is rebuilt from the ``estimate_options`` metadata.
+
+    Raises:
+        InputError: no joint, or a missing column (named with ``source``).
+    """
+    names = table.column_names
+    joints = tuple(c[len("tau_f."):] for c in names if c.startswith("tau_f."))
+    if not joints:
+        raise InputError(f"{source}: no 'tau_f.<joint>' column: not a friction table from 'wbfriction estimate'")
+    for c in ("time", *[f"{p}{j}" for j in joints for p in ("qd.", "valid.")]):
+        if c not in names:
+            raise InputError(f"{source}: missing column '{c}'")
+    time = _float_column(table, "time")
+    stack = lambda prefix: np.column_stack([_float_column(table, f"{prefix}.{j}") for j in joints])  # noqa: E731
+    frames = tuple(c[len("contact."):] for c in names if c.startswith("contact."))
+    contact = (np.column_stack([_float_column(table, f"contact.{f}") for f in frames]).astype(bool) if frames
+               else np.zeros((len(time), 0), dtype=bool))
+    phase = (np.asarray(table.column("phase").to_pylist(), dtype=str) if "phase" in names
+             else np.full(len(time), "single"))
+    unique = (np.asarray(table.column("unique").to_numpy(zero_copy_only=False), dtype=bool) if "unique" in names
+              else phase == "single")
+    meta = read_metadata(table)
+    smoother = None
+    if "estimate_options" in meta and len(time) > 1:
+        opts = meta["estimate_options"]
+        smoother = make_smoother(opts.get("diff", "central"), FilterOptions(**opts.get("filtering", {})),
+                                 float(np.median(np.diff(time))))
+    return FrictionEstimate(
+        joints=joints, time=time, qd=stack("qd"), tau_f=stack("tau_f"), valid=stack("valid").astype(bool),
+        phase=phase, unique=unique, contact=contact, contact_frames=frames,
+        qdd=_optional_columns(table, "qdd", joints), delta_qdd=_optional_columns(table, "delta_qdd", joints),
+        cond=_float_column(table, "cond") if "cond" in names else None,
+        tau_f_true=_optional_columns(table, "tau_f_true", joints), metadata=meta, smoother=smoother,
+        companion_delta_qdd=_optional_columns(table, "delta_qdd_companion", joints),
+        companion_diff=meta.get("companion_diff"))
 
 
 def _stance_frame_pose(robot: Robot, stance: StanceModel, angles: np.ndarray, base: np.ndarray | None) -> np.ndarray:
@@ -147,7 +224,7 @@ def _stance_frame_pose(robot: Robot, stance: StanceModel, angles: np.ndarray, ba
 
 def single_support_friction_rnea(robot: Robot, contact_index: int, angles: np.ndarray, qd: np.ndarray,
                                  qdd: np.ndarray, tau_tc: np.ndarray, base: np.ndarray | None = None,
-                                 progress=None) -> np.ndarray:
+                                 progress=None) -> tuple[np.ndarray, np.ndarray]:
     """Single-support friction (5.13) by inverse dynamics on the stance-rooted tree.
 
     Args:
@@ -159,18 +236,40 @@ def single_support_friction_rnea(robot: Robot, contact_index: int, angles: np.nd
         progress: optional callable receiving numbers of samples done.
 
     Returns:
-        tau_f (N, n_tc) [N·m], sign convention of :mod:`wbfriction.friction`.
+        ``(tau_f, delta_qdd)``: friction (N, n_tc) [N·m], sign convention of
+        :mod:`wbfriction.friction`, and the acceleration difference (5.12)
+        ``Delta qdd_tc = qdd_msr - qdd_est = M_mod^{-1} tau_f`` (N, n_tc) [rad/s^2],
+        with ``M_mod`` the stance-rooted mass matrix of the torque-controlled joints
+        (:meth:`~wbfriction.stance.StanceModel.joint_mass_matrix`).
     """
     stance = stance_model(robot, contact_index)
-    out = np.empty_like(tau_tc, dtype=float)
+    tau_f = np.empty_like(tau_tc, dtype=float)
+    delta = np.empty_like(tau_tc, dtype=float)
     for start in range(0, angles.shape[0], CHUNK):
         sl = slice(start, start + CHUNK)
         pose = _stance_frame_pose(robot, stance, angles[sl], None if base is None else base[sl])
         tau_joint, _ = stance.inverse_dynamics(pose, angles[sl], qd[sl], qdd[sl])
-        out[sl] = tau_joint[:, robot.tc_index] - tau_tc[sl]
+        tau_f[sl] = tau_joint[:, robot.tc_index] - tau_tc[sl]
+        M_mod = stance.joint_mass_matrix(angles[sl], robot.tc_index)
+        delta[sl] = np.linalg.solve(M_mod, tau_f[sl][..., None])[..., 0]
         if progress is not None:
-            progress(len(out[sl]))
-    return out
+            progress(len(tau_f[sl]))
+    return tau_f, delta
+
+
+def single_support(robot: Robot, kin: MeasuredKinematics, rows: np.ndarray, stance: np.ndarray,
+                   progress=None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`single_support_friction_rnea` on the rows ``rows`` (N,) of ``kin``, each on its
+    stance contact ``stance`` (N,); returns ``(tau_f, delta_qdd)`` (N, n_tc), NaN elsewhere."""
+    n, n_tc = len(kin.time), len(robot.torque_controlled)
+    tau_f, delta = np.full((n, n_tc), np.nan), np.full((n, n_tc), np.nan)
+    for c in range(len(robot.contact_frames)):
+        r = np.flatnonzero(rows & (stance == c))
+        if r.size:
+            tau_f[r], delta[r] = single_support_friction_rnea(
+                robot, c, kin.q[r], kin.qd[r], kin.qdd[r], kin.tau[r], None if kin.base is None else kin.base[r],
+                progress)
+    return tau_f, delta
 
 
 def _diag(value, n: int) -> np.ndarray:
@@ -221,7 +320,6 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     usable = kin.valid & (phases.n_contacts > 0)
     if not np.any(usable & phases.single):
         raise InputError("the log has no single-support sample (exactly one contact flag set) with defined derivatives")
-    tau_f = np.full((n, n_tc), np.nan)
     cond = np.full(n, np.nan) if options.condition_number else None
     tc = robot.tc_index
     ss = usable & phases.single
@@ -231,24 +329,23 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     need_kkt = usable & (phases.double | (phases.single & kkt_in_single))
     if options.method == "rnea":
         rnea_progress = None if kkt_in_single else progress  # counted by the KKT pass then
-        for c in range(len(robot.contact_frames)):
-            rows = np.flatnonzero(ss & (phases.stance == c))
-            if rows.size:
-                tau_f[rows] = single_support_friction_rnea(
-                    robot, c, kin.q[rows], kin.qd[rows], kin.qdd[rows], kin.tau[rows],
-                    None if kin.base is None else kin.base[rows], rnea_progress)
+        tau_f, delta = single_support(robot, kin, ss, phases.stance, rnea_progress)
+    else:
+        tau_f, delta = np.full((n, n_tc), np.nan), np.full((n, n_tc), np.nan)
     rows = np.flatnonzero(need_kkt)
     for start in range(0, rows.size, CHUNK):
         r = rows[start:start + CHUNK]
         dyn = constrained_dynamics(robot, kin.q[r], kin.qd[r], kin.qdd[r], kin.tau[r], kin.contact[r],
                                    None if kin.base is None else kin.base[r], with_Mmod_inv=True, progress=progress)
-        delta = kin.qdd[r][:, tc] - dyn.qdd_est[:, tc]
+        d = kin.qdd[r][:, tc] - dyn.qdd_est[:, tc]
         is_ss = phases.single[r]
         if options.method == "kkt" and np.any(is_ss):
-            tau_f[r[is_ss]] = np.linalg.solve(dyn.Mmod_inv[is_ss], delta[is_ss][..., None])[..., 0]
+            tau_f[r[is_ss]] = np.linalg.solve(dyn.Mmod_inv[is_ss], d[is_ss][..., None])[..., 0]
+            delta[r[is_ss]] = d[is_ss]
         if np.any(~is_ss):
-            tau_f[r[~is_ss]] = regularised_least_squares(dyn.Mmod_inv[~is_ss], delta[~is_ss],
+            tau_f[r[~is_ss]] = regularised_least_squares(dyn.Mmod_inv[~is_ss], d[~is_ss],
                                                          options.ds_weight, options.ds_regularization)
+            delta[r[~is_ss]] = d[~is_ss]
         if cond is not None:
             cond[r] = np.linalg.cond(dyn.Mmod_inv)
     valid = joint_mask(phases, robot.limb_mask, options.mask) & usable[:, None] & np.isfinite(tau_f)
@@ -257,12 +354,32 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     return FrictionEstimate(
         joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
         phase=phases.labels(), unique=ss.copy(), contact=kin.contact, contact_frames=robot.contact_frames,
-        cond=cond, tau_f_true=kin.tau_f_true, metadata=metadata, smoother=kin.smoother)
+        qdd=kin.qdd[:, tc], delta_qdd=delta, cond=cond, tau_f_true=kin.tau_f_true, metadata=metadata, smoother=kin.smoother)
 
 
-def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOptions(), progress=None) -> FrictionEstimate:
-    """Differentiate a log (:func:`~wbfriction.kinematics.measure`) and estimate its friction."""
+def companion_scheme(diff: str) -> str:
+    """The scheme of the other kind (Fig. 7.4): ``central`` for a filtering scheme,
+    ``savgol`` for the others."""
+    return "central" if diff in FILTERING_SCHEMES else "savgol"
+
+
+def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOptions(), progress=None,
+                 companion: bool = False) -> FrictionEstimate:
+    """Differentiate a log (:func:`~wbfriction.kinematics.measure`) and estimate its friction.
+
+    With ``companion``, the single-support acceleration difference is also computed through
+    :func:`companion_scheme` (:attr:`FrictionEstimate.companion_delta_qdd`; one more
+    inverse-dynamics pass over the single-support samples).
+    """
     kin = measure(log, options.diff, compensate_delay=options.compensate_delay,
                   torque_alignment=options.torque_alignment, filtering=options.filtering)
     kin.metadata.update(robot=robot.name, source=log.source)
-    return estimate_friction(robot, kin, options, progress)
+    est = estimate_friction(robot, kin, options, progress)
+    if companion:
+        other = companion_scheme(options.diff)
+        kin2 = measure(log, other, compensate_delay=options.compensate_delay,
+                       torque_alignment=options.torque_alignment, filtering=options.filtering)
+        phases = segment(kin2.time, kin2.contact, options.lift_off_skip, options.touch_down_skip)
+        _, est.companion_delta_qdd = single_support(robot, kin2, kin2.valid & phases.single, phases.stance)
+        est.companion_diff = other
+    return est

@@ -30,7 +30,6 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from .friction import PARAM_NAMES, FrictionParams, smooth
-from .kinematics import FilterOptions, make_smoother
 
 LOWER = np.array([0.0, 0.0, 0.0, 1e-4, -np.inf, 1e-2])
 UPPER = np.array([np.inf, np.inf, 50.0, 100.0, np.inf, 1e4])
@@ -318,40 +317,17 @@ def fit_estimate(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *
 
 
 def fit_friction_table(table, *, delta_s: float = 2.0, min_samples: int = 20, source: str = "<table>") -> list[FitResult]:
-    """Fit every joint of a friction table written by ``wbfriction estimate``.
+    """Fit every joint of a friction table written by ``wbfriction estimate``
+    (:func:`~wbfriction.estimate.estimate_from_table`).
 
-    The table needs ``qd.<j>``, ``tau_f.<j>`` and ``valid.<j>`` per joint; optional
-    ``tau_f_true.<j>`` columns and ``friction_true`` metadata give the errors against truth.
+    Optional ``tau_f_true.<j>`` columns and ``friction_true`` metadata give the errors against truth.
 
     Raises:
         InputError: a joint with some but not all of its columns, or no joint at all.
     """
-    from .exceptions import InputError
-    from .log import read_metadata
+    from .estimate import estimate_from_table
 
-    names = table.column_names
-    joints = [c[len("tau_f."):] for c in names if c.startswith("tau_f.")]
-    if not joints:
-        raise InputError(f"{source}: no 'tau_f.<joint>' column: not a friction table from 'wbfriction estimate'")
-    for j in joints:
-        for prefix in ("qd.", "valid."):
-            if prefix + j not in names:
-                raise InputError(f"{source}: missing column '{prefix}{j}'")
-    col = lambda c: table.column(c).to_numpy(zero_copy_only=False).astype(float)  # noqa: E731
-    qd = np.column_stack([col(f"qd.{j}") for j in joints])
-    tau_f = np.column_stack([col(f"tau_f.{j}") for j in joints])
-    valid = np.column_stack([col(f"valid.{j}") for j in joints]).astype(bool)
-    true = None
-    if any(f"tau_f_true.{j}" in names for j in joints):
-        true = np.column_stack([col(f"tau_f_true.{j}") if f"tau_f_true.{j}" in names else np.full(len(qd), np.nan)
-                                for j in joints])
-    meta = read_metadata(table)
-    targets = {j: FrictionParams.from_dict(p) for j, p in meta.get("friction_true", {}).items()}
-    smoother = None
-    if "estimate_options" in meta:
-        opts = meta["estimate_options"]
-        time = col("time")
-        smoother = make_smoother(opts.get("diff", "central"), FilterOptions(**opts.get("filtering", {})),
-                                 float(np.median(np.diff(time))))
-    return fit_estimate(joints, qd, tau_f, valid, tau_f_true=true, targets=targets, delta_s=delta_s,
-                        min_samples=min_samples, smoother=smoother)
+    est = estimate_from_table(table, source)
+    targets = {j: FrictionParams.from_dict(p) for j, p in est.metadata.get("friction_true", {}).items()}
+    return fit_estimate(est.joints, est.qd, est.tau_f, est.valid, tau_f_true=est.tau_f_true, targets=targets,
+                        delta_s=delta_s, min_samples=min_samples, smoother=est.smoother)

@@ -99,7 +99,8 @@ def make_smoother(diff: str, filtering: FilterOptions, dt: float) -> Smoother | 
 
 
 DIFFERENTIATORS = {"central": central_differences, "backward": backward_differences}
-SCHEMES = (*DIFFERENTIATORS, "savgol", "butterworth")
+FILTERING_SCHEMES = ("savgol", "butterworth")
+SCHEMES = (*DIFFERENTIATORS, *FILTERING_SCHEMES)
 """Differentiation schemes by name: plain differences, then the filtering ones (module docstring)."""
 
 

@@ -110,6 +110,34 @@ class StanceModel:
         tau = np.asarray(tau).reshape(self.model.nv, n)
         return (tau[self.v_index].T * self.sign), tau[:6].T.copy()
 
+    def joint_mass_matrix(self, angles: np.ndarray, joints: np.ndarray) -> np.ndarray:
+        """Joint-space mass matrix of the tree rooted at the (welded) contact frame.
+
+        With the stance foot fixed, and the accelerations of the other actuated joints
+        prescribed, the block of the chosen joints is ``M_mod`` of (5.12)-(5.13): the
+        operator that maps their acceleration difference to friction,
+        ``tau_f = M_mod Delta qdd``. It does not depend on the root's pose.
+
+        Args:
+            angles: joint positions of the actuated joints (N, n_act) [rad].
+            joints: indices into :attr:`Robot.actuated` of the block's joints (m,).
+
+        Returns:
+            (N, m, m) [kg·m^2], symmetric positive definite, in the original model's
+            joint signs.
+        """
+        q = self.layout.configuration(angles, None, self.sign)
+        data = self.model.createData()
+        cols = self.v_index[joints]
+        flip = np.outer(self.sign[joints], self.sign[joints])
+        out = np.empty((angles.shape[0], len(cols), len(cols)))
+        for k in range(angles.shape[0]):
+            M = pin.crba(self.model, data, q[k])
+            out[k] = M[np.ix_(cols, cols)]
+        out *= flip
+        # crba fills the upper triangle only
+        return np.triu(out) + np.swapaxes(np.triu(out, 1), 1, 2)
+
 
 def build_stance_model(robot: Robot, frame: str) -> StanceModel:
     """Re-root ``robot.model`` at contact frame ``frame`` (see module docstring).
