@@ -105,4 +105,4 @@ def test_rotational_error_splits_the_branches_without_shifting(talos, sensitivit
         assert abs(high.shift) < high.split
         assert abs(high.shift) < 0.1 * abs(mass[j].shift)
         if not j.endswith("_1_joint"):  # hip roll, hip pitch, knee (the hip yaw moves little in swing)
-            assert high.split > 0.02 and abs(high.shift) < 0.3 * high.split
+            assert high.split > 0.02 and abs(high.shift) < 0.5 * high.split
