@@ -22,7 +22,7 @@ from wbfriction.study import _leg_joints
 def test_dissipative_friction_never_generates_power_once_the_offset_is_removed(F_v, F_c, S, v_s, a, tau_os, seed):
     qd = np.random.default_rng(seed).normal(0.0, 1.0, 200)
     tau_f = FrictionParams(F_v, F_c, S, v_s, tau_os, a).torque(qd)
-    assert generating_share(qd, tau_f, tau_os) == 0.0
+    assert generating_share(qd, tau_f, tau_os, tolerance=0.0) == 0.0
 
 
 def test_an_offset_left_in_generates_power_where_it_outweighs_friction():
@@ -30,7 +30,9 @@ def test_an_offset_left_in_generates_power_where_it_outweighs_friction():
     ``qd`` in (-0.5, 0), a quarter of velocities uniform on [-1, 1]."""
     qd = np.linspace(-1.0, 1.0, 100_001)
     tau_f = FrictionParams(F_v=2.0, tau_os=1.0).torque(qd)
-    assert generating_share(qd, tau_f) == pytest.approx(0.25, abs=1e-4)
+    assert generating_share(qd, tau_f, tolerance=0.0) == pytest.approx(0.25, abs=1e-4)
+    # the tolerance drops |2 qd + 1| <= 0.01, i.e. qd within 0.005 of -0.5
+    assert generating_share(qd, tau_f, tolerance=0.01) == pytest.approx(0.2475, abs=1e-4)
     assert generating_share(qd, tau_f, tau_os=1.0) == 0.0
 
 
@@ -38,6 +40,9 @@ def test_generating_share_counts_the_samples_with_positive_power():
     qd = np.array([1.0, -1.0, 2.0, -2.0, np.nan])
     tau_f = np.array([-1.0, -1.0, 1.0, 1.0, 1.0])
     assert generating_share(qd, tau_f) == pytest.approx(0.5)  # samples 1 and 2
+    # friction below the tolerance has no reliable sign: it never counts
+    assert generating_share(qd, 1e-3 * tau_f) == 0.0
+    assert generating_share(qd, 1e-3 * tau_f, tolerance=0.0) == pytest.approx(0.5)
     assert np.isnan(generating_share(np.array([np.nan]), np.array([1.0])))
 
 

@@ -41,6 +41,7 @@ def test_mass_and_rotational_scale_their_own_eigenvalues(seed, factor):
     body = _random_inertia(seed)
     eig = np.sort(np.linalg.eigvalsh(_about_com(body)))
     moments = np.sort(np.linalg.eigvalsh(np.asarray(body.inertia)))
+    np.testing.assert_allclose(eig, np.sort(np.r_[[body.mass] * 3, moments]), rtol=1e-9)
     for part, expected in (("mass", np.r_[[factor * body.mass] * 3, moments]),
                            ("rotational", np.r_[[body.mass] * 3, factor * moments])):
         scaled = scale_inertia(body, factor, part)

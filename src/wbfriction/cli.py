@@ -1,15 +1,14 @@
 """Command-line interface: a thin layer over the library.
 
-Commands: ``simulate`` (a walk in the ideal simulator, with known friction), ``estimate``
-(friction per sample), ``fit`` (model 3.5 per joint), ``demo`` (the thesis's simulation
-study on the built-in TALOS).
+Commands: ``simulate`` (a walk with known friction), ``estimate`` (friction per sample),
+``fit`` (model 3.5 per joint), ``report`` (one HTML file), ``sensitivity`` (inertia-model
+errors), ``spectrum``, ``demo`` and ``study-filters`` (the thesis's studies).
 Bad input prints one line naming the file, column, row or option at fault and exits
 with status 2.
 """
 
 from __future__ import annotations
 
-import hashlib
 import json
 import sys
 import time
@@ -25,13 +24,14 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from . import __version__
-from .estimate import EstimateOptions, estimate_log
+from .energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, energy_consistency
+from .estimate import EstimateOptions, estimate_from_table, estimate_log
 from .exceptions import InputError, WbfrictionError
 from .friction import PARAM_NAMES, load_friction_toml
 from .sim.sensors import load_sensors_toml
-from .identify import FitResult, fit_friction_table
+from .identify import FitResult, fit_table_estimate
 from .kinematics import FilterOptions
-from .log import read_log, read_table, write_atomic, write_log, write_table
+from .log import file_sha256, read_log, read_table, write_atomic, write_log, write_table
 from .robot import Robot, load_robot
 from .sim import IdealOptions, MujocoOptions, SensorNoise, simulate_ideal, simulate_mujoco
 from .walking import GaitOptions, walking_reference
@@ -42,6 +42,10 @@ console = Console(stderr=True)
 out = Console(width=max(Console().width, 150))
 
 RobotOpt = typer.Option("talos", "--robot", help="Built-in robot name.")
+EnergyThresholdOpt = typer.Option(DEFAULT_THRESHOLD, help="Share of power-generating samples (eq. 7.9) above "
+                                                          "which a joint is flagged.")
+EnergyToleranceOpt = typer.Option(DEFAULT_TOLERANCE, help="Smallest friction torque that counts as generating "
+                                                          "power [N·m] (the torque sensor's resolution).")
 UrdfOpt = typer.Option(None, "--urdf", help="URDF of another robot (with --config).")
 ConfigOpt = typer.Option(None, "--config", help="Robot TOML: contact_frames, position_controlled, groups.")
 
@@ -56,10 +60,6 @@ def _progress(total: int, label: str):
 
 def _robot(robot: str, urdf: Optional[Path], config: Optional[Path]) -> Robot:
     return load_robot(robot, urdf=urdf, config=config)
-
-
-def _sha256(path: Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
 def _fit_rows(results: list[FitResult]) -> Table:
@@ -87,11 +87,36 @@ def _fit_rows(results: list[FitResult]) -> Table:
     return table
 
 
-def _write_params(results: list[FitResult], path: Path, provenance: dict) -> None:
+def _write_params(results: list[FitResult], path: Path, provenance: dict, energy: dict | None = None) -> None:
+    joints = {r.joint: r.to_dict() for r in results}
+    for joint, e in (energy or {}).items():
+        if joint in joints:
+            joints[joint]["energy"] = {"generating_share": None if not np.isfinite(e.generating_share)
+                                       else e.generating_share, "tau_os_removed": e.tau_os,
+                                       "threshold": e.threshold, "flagged": e.flagged}
     doc = {"provenance": provenance, "sign_convention": "tau_f = -f(qd); fit of f (eq. 3.5) to -tau_f",
-           "joints": {r.joint: r.to_dict() for r in results}}
+           "joints": joints}
     text = json.dumps(doc, indent=2, sort_keys=False)
     write_atomic(path, lambda tmp: tmp.write_text(text))
+
+
+def _warn_energy(energy) -> None:
+    """Print the energy-consistency warnings (eq. 7.9) of the flagged joints."""
+    for e in energy:
+        if e.flagged:
+            console.print(f"[yellow]warning:[/] {escape(e.warning())}", highlight=False, soft_wrap=True)
+
+
+def _joint_list(r: Robot, joints: Optional[str]) -> list[str]:
+    """``--joints`` as a list (checked), or by default the legs' torque-controlled joints, else all of them."""
+    if joints is None:
+        legs = [j for f in r.contact_frames for j in r.limb(f) if j in r.torque_controlled]
+        return legs or list(r.torque_controlled)
+    names = [j.strip() for j in joints.split(",") if j.strip()]
+    unknown = [j for j in names if j not in r.torque_controlled]
+    if unknown or not names:
+        raise InputError(f"--joints: '{unknown[0] if unknown else joints}' is not a torque-controlled joint of {r.name}")
+    return names
 
 
 _E = EstimateOptions()  # one source of defaults: the library's
@@ -126,8 +151,8 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
 def _run_estimate(r: Robot, log: Path, output: Path, opts: EstimateOptions) -> None:
     data = read_log(log, r)
     with _progress(len(data), "estimate") as advance:
-        est = estimate_log(r, data, opts, progress=advance)
-    est.metadata["provenance"] = {"log": str(log), "log_sha256": _sha256(log), "robot": r.name,
+        est = estimate_log(r, data, opts, progress=advance, companion=True)
+    est.metadata["provenance"] = {"log": str(log), "log_sha256": file_sha256(log), "robot": r.name,
                                   "urdf": str(r.urdf), "wbfriction": __version__}
     write_table(est.to_table(), output)
     n_valid = int(est.valid.any(axis=1).sum())
@@ -135,11 +160,15 @@ def _run_estimate(r: Robot, log: Path, output: Path, opts: EstimateOptions) -> N
                   f"{n_valid} with a valid joint")
 
 
-def _run_fit(friction: Path, output: Path, min_samples: int) -> None:
-    results = fit_friction_table(read_table(friction), min_samples=min_samples, source=str(friction))
-    _write_params(results, output, {"friction": str(friction), "friction_sha256": _sha256(friction),
-                                    "wbfriction": __version__})
+def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, tolerance: float) -> None:
+    est = estimate_from_table(read_table(friction), str(friction))
+    results = fit_table_estimate(est, min_samples=min_samples)
+    tau_os = {r.joint: r.params.tau_os for r in results if r.params is not None}
+    energy = energy_consistency(est, tau_os, threshold, tolerance)
+    _write_params(results, output, {"friction": str(friction), "friction_sha256": file_sha256(friction),
+                                    "wbfriction": __version__}, {e.joint: e for e in energy})
     out.print(_fit_rows(results))
+    _warn_energy(energy)
     console.print(f"wrote {output}")
 
 
@@ -225,9 +254,71 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
 @app.command()
 def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wbfriction estimate'."),
         output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
-        min_samples: int = typer.Option(_MIN_SAMPLES, help="Joints with fewer valid samples are not fitted.")) -> None:
-    """Identify the friction model (3.5) of every joint, with standard errors."""
-    _run_fit(friction, output, min_samples)
+        min_samples: int = typer.Option(_MIN_SAMPLES, help="Joints with fewer valid samples are not fitted."),
+        energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt) -> None:
+    """Identify the friction model (3.5) of every joint, with standard errors; warn about
+    joints whose friction generates power (eq. 7.9)."""
+    _run_fit(friction, output, min_samples, energy_threshold, energy_tolerance)
+
+
+@app.command()
+def report(friction: Path = typer.Argument(..., help="Friction table written by 'wbfriction estimate'."),
+           output: Path = typer.Option(Path("report.html"), "-o", "--output", help="HTML file to write."),
+           params: Optional[Path] = typer.Option(None, help="Parameters written by 'wbfriction fit' (default: "
+                                                            "fitted here)."),
+           energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt) -> None:
+    """One self-contained HTML report: friction clouds and fits, parameters, energy consistency,
+    per-joint time series, Fig. 7.4, spectra, provenance."""
+    from .report import make_report, write_report
+
+    with console.status("building the report"):
+        rep = make_report(friction, params, energy_threshold, energy_tolerance)
+        write_report(rep, output)
+    _warn_energy(rep.energy.values())
+    console.print(f"wrote {output} ({len(rep.est.joints)} joints, {len(rep.flagged)} flagged)")
+
+
+@app.command()
+def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the wbfriction format."),
+                output: Path = typer.Option(Path("sensitivity.png"), "-o", "--output", help="Figure to write (PNG)."),
+                robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+                factors: str = typer.Option("0.9,0.95,1.05,1.1", help="Comma-separated inertia scaling factors."),
+                part: str = typer.Option("all", help="all (the whole 6x6 inertia), mass or rotational (its mass or "
+                                                     "principal-moment eigenvalues only)."),
+                joints: Optional[str] = typer.Option(None, help="Comma-separated joints to plot (default: the "
+                                                                "legs' joints)."),
+                diff: str = typer.Option(_E.diff, help="Differentiation scheme (see 'estimate')."),
+                mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate').")) -> None:
+    """Re-run the estimate with every body's inertia scaled (thesis 7.2, Fig. 7.5/7.6): how the
+    friction curves shift (mass) and split into branches (rotational inertia)."""
+    from .kinematics import measure
+    from .plots import save_png, sensitivity_figure
+    from .sensitivity import PARTS, inertia_sensitivity, parse_factors
+
+    if part not in PARTS:
+        raise InputError(f"--part must be one of {', '.join(PARTS)}, got '{part}'")
+    values = parse_factors(factors)
+    r = _robot(robot, urdf, config)
+    opts = EstimateOptions(diff=diff, mask=mask)
+    kin = measure(read_log(log, r), diff)
+    with console.status("") as status:
+        sens = inertia_sensitivity(r, kin, values, part, opts, progress=lambda label: status.update(label))
+    names = _joint_list(r, joints)
+    table = Table(title=f"Change of the friction estimate with {part} inertia scaled, against the model as given",
+                  caption="shift: mean change over the valid samples; split: mean change on rising minus falling "
+                          "velocity; gen: share of valid samples generating power (offset not removed)", box=None)
+    table.add_column("joint")
+    for f in sens.factors[1:]:
+        table.add_column(f"x{f:g} shift [N·m]", justify="right")
+        table.add_column("split", justify="right")
+        table.add_column("gen [%]", justify="right")
+    for j in names:
+        cells = [c for js in sens.joint(j) for c in (f"{js.shift:+.3f}", f"{js.split:+.3f}",
+                                                      f"{100 * js.generating_share:.1f}")]
+        table.add_row(j, *cells)
+    out.print(table)
+    save_png(sensitivity_figure(sens, names), output)
+    console.print(f"wrote {output}")
 
 
 def _study_table(rows, title: str, params=PARAM_NAMES) -> Table:
@@ -313,11 +404,7 @@ def spectrum(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
 
     r = _robot(robot, urdf, config)
     data = read_log(log, r)
-    if joints is None:
-        legs = [j for f in r.contact_frames for j in r.limb(f) if j in r.torque_controlled]
-        names = legs or list(r.torque_controlled)
-    else:
-        names = [j.strip() for j in joints.split(",") if j.strip()]
+    names = _joint_list(r, joints)
     with _progress(len(data), "dynamics") as advance:
         spec = acceleration_spectrum(r, data, names, tail=tail, progress=advance)
     table = Table(title=f"Estimated acceleration (5.10), {spec.span[0]:.2f}-{spec.span[1]:.2f} s", box=None)

@@ -9,7 +9,9 @@ own velocity. The thesis found estimates on the real robot that generate power, 
 find them in simulation with the exact model, and traced them to inertia-model errors
 (:mod:`wbfriction.sensitivity`). This module measures, per joint:
 
-* the **share of power-generating samples**: valid samples with ``qd (tau_f + tau_os) > 0``.
+* the **share of power-generating samples**: valid samples with ``qd (tau_f + tau_os) > 0``
+  and ``|tau_f + tau_os|`` above a tolerance (a torque sensor's resolution: an estimate of
+  nearly no friction has a random sign).
   ``tau_os`` is the torque offset of model (3.5) (sign convention of
   :mod:`wbfriction.friction`: ``tau_f = -f(qd)``, so ``tau_f + tau_os`` is minus the
   dissipative part). It is a sensor offset, not friction (thesis 7.2), and it would make even
@@ -36,19 +38,29 @@ models give well under 1 % (the remainder: velocity sign errors of the different
 around reversals, measured on the ideal simulator's combined walk)."""
 
 
-def generating_share(qd: np.ndarray, tau_f: np.ndarray, tau_os: float = 0.0) -> float:
-    """Share of the samples whose friction generates power, ``qd (tau_f + tau_os) > 0``.
+DEFAULT_TOLERANCE = 0.01
+"""Friction torques smaller than this do not count as generating power [N·m]."""
+
+
+def generating_share(qd: np.ndarray, tau_f: np.ndarray, tau_os: float = 0.0,
+                     tolerance: float = DEFAULT_TOLERANCE) -> float:
+    """Share of the samples whose friction generates power: ``qd (tau_f + tau_os) > 0`` with
+    ``|tau_f + tau_os| > tolerance``.
 
     Args:
         qd: joint velocities (N,) [rad/s]; tau_f: friction on the joint (N,) [N·m] (NaN
-            samples are left out); tau_os: the model's torque offset [N·m], removed first.
+            samples are left out); tau_os: the model's torque offset [N·m], removed first;
+        tolerance: smallest friction torque that counts [N·m].
 
     Returns:
-        A share in [0, 1]; NaN without a finite sample.
+        A share in [0, 1] of the finite samples; NaN without one.
     """
-    power = np.asarray(qd, dtype=float) * (np.asarray(tau_f, dtype=float) + tau_os)
-    power = power[np.isfinite(power)]
-    return float(np.mean(power > 0)) if power.size else float("nan")
+    friction = np.asarray(tau_f, dtype=float) + tau_os
+    power = np.asarray(qd, dtype=float) * friction
+    finite = np.isfinite(power)
+    if not finite.any():
+        return float("nan")
+    return float(np.mean((power[finite] > 0) & (np.abs(friction[finite]) > tolerance)))
 
 
 def zero_crossings(time: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -117,8 +129,8 @@ class JointEnergy:
                 f"torque-sensor offset or the filtering is likely off (thesis 7.2)")
 
 
-def energy_consistency(est, tau_os: dict[str, float] | None = None,
-                       threshold: float = DEFAULT_THRESHOLD) -> list[JointEnergy]:
+def energy_consistency(est, tau_os: dict[str, float] | None = None, threshold: float = DEFAULT_THRESHOLD,
+                       tolerance: float = DEFAULT_TOLERANCE) -> list[JointEnergy]:
     """Energy consistency of every joint of a :class:`~wbfriction.estimate.FrictionEstimate`
     on its valid samples.
 
@@ -126,6 +138,7 @@ def energy_consistency(est, tau_os: dict[str, float] | None = None,
         est: the estimate (``delta_qdd`` optional).
         tau_os: identified torque offset per joint name [N·m] (default 0 for every joint).
         threshold: share above which a joint is flagged.
+        tolerance: smallest friction torque that counts as generating power [N·m].
     """
     tau_os = tau_os or {}
     out = []
@@ -143,6 +156,6 @@ def energy_consistency(est, tau_os: dict[str, float] | None = None,
             lag = float(np.nanmedian(np.abs(lags))) if np.isfinite(lags).any() else float("nan")
             prod = (qd * d)[np.isfinite(qd * d)]
             opposite = float(np.mean(prod < 0)) if prod.size else float("nan")
-        out.append(JointEnergy(joint, int(v.sum()), generating_share(est.qd[v, i], est.tau_f[v, i], os_i), os_i,
+        out.append(JointEnergy(joint, int(v.sum()), generating_share(est.qd[v, i], est.tau_f[v, i], os_i, tolerance), os_i,
                                vel, delta_crossings, lag, opposite, threshold))
     return out

@@ -99,6 +99,27 @@ class FitResult:
         return d
 
 
+    @classmethod
+    def from_dict(cls, joint: str, d: dict) -> "FitResult":
+        """Inverse of :meth:`to_dict` (a ``null`` standard error reads back as ``inf``: not identifiable).
+
+        Raises:
+            ValueError: unknown parameter names, or a value that is not a number.
+        """
+        unknown = lambda x: float("inf") if x is None else float(x)  # noqa: E731
+        res = cls(joint=joint, n_samples=int(d.get("n_samples", 0)), success=bool(d.get("success", False)),
+                  message=str(d.get("message", "")), rms_residual=unknown(d.get("rms_residual")))
+        if d.get("params") is not None:
+            res.params = FrictionParams.from_dict(d["params"])
+            res.stderr = {k: unknown(v) for k, v in (d.get("stderr") or {}).items()}
+        if d.get("target") is not None:
+            res.target = FrictionParams.from_dict(d["target"])
+        if "rms_error_vs_true" in d:
+            res.rms_error_vs_true = unknown(d["rms_error_vs_true"])
+            res.rms_model_vs_true = unknown(d.get("rms_model_vs_true"))
+        return res
+
+
 def _model(x: np.ndarray, qd: np.ndarray, delta_s: float) -> np.ndarray:
     return smooth(qd, x[0], x[1], x[2], x[3], x[4], x[5], delta_s)
 
@@ -318,16 +339,19 @@ def fit_estimate(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *
 
 def fit_friction_table(table, *, delta_s: float = 2.0, min_samples: int = 20, source: str = "<table>") -> list[FitResult]:
     """Fit every joint of a friction table written by ``wbfriction estimate``
-    (:func:`~wbfriction.estimate.estimate_from_table`).
-
-    Optional ``tau_f_true.<j>`` columns and ``friction_true`` metadata give the errors against truth.
+    (:func:`~wbfriction.estimate.estimate_from_table`, then :func:`fit_table_estimate`).
 
     Raises:
         InputError: a joint with some but not all of its columns, or no joint at all.
     """
     from .estimate import estimate_from_table
 
-    est = estimate_from_table(table, source)
+    return fit_table_estimate(estimate_from_table(table, source), delta_s=delta_s, min_samples=min_samples)
+
+
+def fit_table_estimate(est, *, delta_s: float = 2.0, min_samples: int = 20) -> list[FitResult]:
+    """Fit every joint of an estimate read back from a table; its ``tau_f_true`` columns and
+    ``friction_true`` metadata, when present, give the errors against truth."""
     targets = {j: FrictionParams.from_dict(p) for j, p in est.metadata.get("friction_true", {}).items()}
     return fit_estimate(est.joints, est.qd, est.tau_f, est.valid, tau_f_true=est.tau_f_true, targets=targets,
                         delta_s=delta_s, min_samples=min_samples, smoother=est.smoother)

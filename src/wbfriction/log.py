@@ -25,6 +25,7 @@ through, e.g. the friction parameters a simulator injected.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import tempfile
@@ -235,6 +236,11 @@ def read_log(path: str | Path, robot: Robot) -> Log:
 
 
 # ------------------------------------------------------------------- writing
+def file_sha256(path: str | Path) -> str:
+    """SHA-256 of a file's bytes (hex), for provenance records."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
 def write_atomic(path: str | Path, write) -> None:
     """Write a file whole or not at all.
 

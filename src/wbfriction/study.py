@@ -7,7 +7,8 @@
    show the sensitivity to phase delays, largest while the leg is in stance (Fig. 6.2, 6.3).
 2. **Identification** (6.2.2; Tables 6.1, 6.2): the combined walk (forward, sideways and
    turning) with the targets of Table 6.1 on every leg joint; central differences; the
-   fit of (3.5) per leg joint on its swing-phase samples.
+   fit of (3.5) per leg joint on its swing-phase samples; the HTML report of that estimate
+   (:mod:`wbfriction.report`).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from .friction import PARAM_NAMES, THESIS_TARGETS, FrictionParams
 from .identify import FitResult, fit_estimate
 from .log import write_atomic, write_log, write_table
 from .plots import derivative_schemes_figure, friction_curves_figure, support_phases_figure
+from .report import make_report, write_report
 from .robot import Robot
 from .sim import IdealOptions, SimulationResult, simulate_ideal
 from .thesis import TABLE_6_1, TABLE_6_2, thesis_number
@@ -133,7 +135,7 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
     walk = _simulate(robot, GaitOptions(gait="combined", steps=steps), friction)
     write_log(walk.log, robot, output_dir / "walk_log.parquet")
     say("estimating (central differences)")
-    est = estimate_log(robot, walk.log, EstimateOptions())
+    est = estimate_log(robot, walk.log, EstimateOptions(), companion=True)
     write_table(est.to_table(), output_dir / "walk_friction.parquet")
     say("fitting the friction model of every leg joint")
     idx = [est.joints.index(j) for j, _, _ in legs]
@@ -147,8 +149,11 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
                                 "thesis_error_percent_table_6_2": r.thesis_6_2} for r in rows}}
     write_atomic(output_dir / "walk_params.json", lambda tmp: tmp.write_text(json.dumps(doc, indent=2)))
     friction_curves_figure(est, fits, output_dir / "friction_curves.png")
+    say("writing the report")
+    write_report(make_report(output_dir / "walk_friction.parquet", output_dir / "walk_params.json"),
+                 output_dir / "report.html")
     files += [output_dir / n for n in ("walk_log.parquet", "walk_friction.parquet", "walk_params.json",
-                                       "friction_curves.png")]
+                                       "friction_curves.png", "report.html")]
     pulls = sum(p.samples for p in knee_sim.pulls() + walk.pulls())
     return StudyResult(rows, truth_err, knee_rms, pulls, files)
 
