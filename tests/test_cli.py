@@ -56,8 +56,9 @@ def test_demo_prints_the_thesis_table_and_writes_figures(tmp_path):
     res = run("demo", "-o", tmp_path, "--steps", "2")
     assert res.returncode == 0, res.stderr
     assert "T6.2 [%]" in res.stdout and "leg_right_4_joint (knee)" in res.stdout
+    assert "friction generating power (eq. 7.9), leg joints in swing: at most" in res.stdout
     for name in ("fig6_1_support_phases.png", "fig6_2_schemes_time.png", "fig6_3_schemes_velocity.png",
-                 "friction_curves.png", "walk_params.json", "walk_friction.parquet"):
+                 "friction_curves.png", "walk_params.json", "walk_friction.parquet", "report.html"):
         assert (tmp_path / name).stat().st_size > 1000, name
     assert not list(tmp_path.glob(".*.tmp")), "temporary files left behind"
 
@@ -151,6 +152,44 @@ def test_spectrum_command(demo_dir, tmp_path):
     assert (tmp_path / "s.png").stat().st_size > 1000
     _assert_one_line_error(run("spectrum", out / "log.parquet", "--joints", "head_1_joint"),
                            "'head_1_joint' is not a torque-controlled joint")
+
+
+def test_report_and_sensitivity_commands(demo_dir, tmp_path):
+    out, _ = demo_dir
+    res = run("report", out / "friction.parquet", "--params", out / "params.json", "-o", tmp_path / "r.html")
+    assert res.returncode == 0, res.stderr
+    text = (tmp_path / "r.html").read_text()
+    assert "leg_right_4_joint" in text and "params.json (sha256" in text
+    res = run("sensitivity", out / "log.parquet", "--factors", "0.9,1.1", "--part", "mass", "--joints",
+              "leg_right_4_joint,leg_right_3_joint", "-o", tmp_path / "s.png")
+    assert res.returncode == 0, res.stderr
+    assert "x1.1 shift" in res.stdout and "leg_right_3_joint" in res.stdout
+    assert (tmp_path / "s.png").stat().st_size > 1000
+    _assert_one_line_error(run("sensitivity", out / "log.parquet", "--part", "inertia"), "--part must be one of")
+    _assert_one_line_error(run("sensitivity", out / "log.parquet", "--factors", "0.9,big"), "--factors")
+    _assert_one_line_error(run("report", out / "friction.parquet", "--params", out / "log.parquet",
+                               "-o", tmp_path / "x.html"), "not JSON")
+    _assert_one_line_error(run("report", out / "log.parquet", "-o", tmp_path / "x.html"), "no 'tau_f.<joint>' column")
+    assert not (tmp_path / "x.html").exists()
+
+
+def test_fit_warns_about_friction_that_generates_power(demo_dir, tmp_path):
+    """A friction table whose knee estimate is turned against its velocity: fit says so, and
+    records it in the parameters."""
+    import pyarrow as pa
+
+    out, _ = demo_dir
+    table = pq.read_table(out / "friction.parquet")
+    i = table.column_names.index("tau_f.leg_right_4_joint")
+    flipped = table.set_column(i, "tau_f.leg_right_4_joint", pa.array(-table.column(i).to_numpy()))
+    pq.write_table(flipped.replace_schema_metadata(table.schema.metadata), tmp_path / "f.parquet")
+    res = run("fit", tmp_path / "f.parquet", "-o", tmp_path / "p.json")
+    assert res.returncode == 0, res.stderr
+    assert "warning: leg_right_4_joint:" in res.stderr and "generates power" in res.stderr
+    energy = json.loads((tmp_path / "p.json").read_text())["joints"]["leg_right_4_joint"]["energy"]
+    assert energy["flagged"] and energy["generating_share"] > 0.5
+    ok = json.loads((out / "params.json").read_text())["joints"]["leg_right_4_joint"]["energy"]
+    assert not ok["flagged"] and ok["generating_share"] < 0.01
 
 
 def test_simulate_on_mujoco_with_sensors_from_toml(talos, tmp_path):

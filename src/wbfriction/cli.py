@@ -24,12 +24,12 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from . import __version__
-from .energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, energy_consistency
+from .energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, energy_consistency, generating_share
 from .estimate import EstimateOptions, estimate_from_table, estimate_log
 from .exceptions import InputError, WbfrictionError
 from .friction import PARAM_NAMES, load_friction_toml
 from .sim.sensors import load_sensors_toml
-from .identify import FitResult, fit_table_estimate
+from .identify import FitResult, fit_estimate, fit_table_estimate
 from .kinematics import FilterOptions
 from .log import file_sha256, read_log, read_table, write_atomic, write_log, write_table
 from .robot import Robot, load_robot
@@ -304,18 +304,27 @@ def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in 
     with console.status("") as status:
         sens = inertia_sensitivity(r, kin, values, part, opts, progress=lambda label: status.update(label))
     names = _joint_list(r, joints)
+    ref = sens.reference
+    idx = [ref.joints.index(j) for j in names]
+    with console.status("fitting the offsets of the model as given"):
+        fits = fit_estimate(names, ref.qd[:, idx], ref.tau_f[:, idx], ref.valid[:, idx])
+    tau_os = {f.joint: f.params.tau_os if f.params is not None else 0.0 for f in fits}
     table = Table(title=f"Change of the friction estimate with {part} inertia scaled, against the model as given",
                   caption="shift: mean change over the valid samples; split: mean change on rising minus falling "
-                          "velocity; gen: share of valid samples generating power (offset not removed)", box=None)
+                          "velocity; gen: share of valid samples generating power (eq. 7.9), the offset tau_os "
+                          "identified with the model as given removed", box=None)
     table.add_column("joint")
+    table.add_column("x1 gen [%]", justify="right")
     for f in sens.factors[1:]:
         table.add_column(f"x{f:g} shift [N·m]", justify="right")
         table.add_column("split", justify="right")
         table.add_column("gen [%]", justify="right")
-    for j in names:
-        cells = [c for js in sens.joint(j) for c in (f"{js.shift:+.3f}", f"{js.split:+.3f}",
-                                                      f"{100 * js.generating_share:.1f}")]
-        table.add_row(j, *cells)
+    for j, i in zip(names, idx):
+        m = ref.valid[:, i]
+        base = generating_share(ref.qd[m, i], ref.tau_f[m, i], tau_os[j])
+        cells = [c for js in sens.joint(j, tau_os[j]) for c in (f"{js.shift:+.3f}", f"{js.split:+.3f}",
+                                                                 f"{100 * js.generating_share:.1f}")]
+        table.add_row(j, f"{100 * base:.1f}", *cells)
     out.print(table)
     save_png(sensitivity_figure(sens, names), output)
     console.print(f"wrote {output}")
@@ -385,6 +394,9 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
     out.print("right knee, RMS error [N·m] with the leg in swing / in stance: " + "; ".join(
         f"{k} {a:.4f} / {b:.4f}" for k, (a, b) in result.knee_rms.items()))
     out.print(f"samples where a welded foot pulled on the ground: {result.pulls}")
+    worst_joint = max(result.generating_share, key=result.generating_share.get)
+    out.print(f"friction generating power (eq. 7.9), leg joints in swing: at most "
+              f"{100 * result.generating_share[worst_joint]:.2f} % of the samples ({worst_joint})")
     for f in result.files:
         console.print(f"wrote {f}")
     console.print(f"demo finished in {time.perf_counter() - start:.1f} s")

@@ -230,14 +230,14 @@ def friction_overview_figure(est: FrictionEstimate, joints: list[str], fits: dic
     return fig
 
 
-def longest_run(mask: np.ndarray) -> slice:
-    """The longest stretch of consecutive True values (empty slice if none)."""
+def widest_run(mask: np.ndarray, x: np.ndarray) -> slice:
+    """The stretch of consecutive True values of ``mask`` over which ``x`` spans the widest
+    range (empty slice if none): for Fig. 7.4, the swing phase where the joint moves most."""
     edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(np.int8), 0]))
     if edges.size == 0:
         return slice(0, 0)
-    starts, ends = edges[::2], edges[1::2]
-    k = int(np.argmax(ends - starts))
-    return slice(int(starts[k]), int(ends[k]))
+    runs = [slice(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2])]
+    return max(runs, key=lambda r: float(np.nanmax(x[r]) - np.nanmin(x[r])) if np.isfinite(x[r]).any() else -1.0)
 
 
 def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, target: FrictionParams | None,
@@ -247,15 +247,15 @@ def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, targe
     (a) the friction cloud with the fitted model and the target;
     (b) ``tau_f`` over time coloured by support phase (valid samples dark);
     (c) Fig. 7.4: ``Delta qdd`` through the estimate's scheme and through the companion scheme,
-        with ``qd`` (right axis), over the joint's longest valid stretch: with an exact model they
-        cross zero together with opposite signs;
+        with ``qd`` (right axis), over the valid stretch where the joint moves most: with an exact
+        model they cross zero together with opposite signs;
     (d) Fig. 7.1: the amplitude spectrum of ``qdd_est = qdd - Delta qdd`` and its suggested cutoff
         (``spectrum = (freq, amplitude, cutoff)``), when computed.
     """
     i = est.joints.index(joint)
     # a fixed layout: constrained layout would cost most of the time of a report's many figures
     fig = Figure(figsize=(14, 2.7))
-    ax_c, ax_t, ax_e, ax_s = fig.subplots(1, 4, gridspec_kw={"width_ratios": [1, 1.6, 1.6, 1], "wspace": 0.32,
+    ax_c, ax_t, ax_e, ax_s = fig.subplots(1, 4, gridspec_kw={"width_ratios": [1, 1.6, 1.6, 1], "wspace": 0.42,
                                                                "left": 0.05, "right": 0.99, "bottom": 0.17,
                                                                "top": 0.9})
     _cloud(ax_c, est, i, fit, target)
@@ -277,7 +277,7 @@ def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, targe
         lim = 1.5 * float(np.max(np.abs(valid_tau))) + 1e-6
         ax_t.set_ylim(-lim, lim)
     ax_t.legend(fontsize=6, ncol=4, loc="upper right")
-    run = longest_run(est.valid[:, i])
+    run = widest_run(est.valid[:, i], est.qd[:, i])
     if est.delta_qdd is not None and run.stop > run.start:
         t = est.time[run]
         ax_e.plot(t, est.delta_qdd[run, i], color="C0", lw=1, label=f"Δqdd ({est.metadata.get('estimate_options', {}).get('diff', 'estimate')})")
@@ -297,14 +297,14 @@ def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, targe
     else:
         ax_e.text(0.5, 0.5, "no acceleration difference in the table", ha="center", va="center", fontsize=8,
                   transform=ax_e.transAxes)
-    ax_e.set_title("(c) Fig. 7.4: Δqdd and velocity, longest valid stretch", fontsize=9)
+    ax_e.set_title("(c) Fig. 7.4: Δqdd and velocity, one valid stretch", fontsize=9)
     if spectrum is not None:
         freq, amp, cutoff = spectrum
         keep = (freq > 0) & (freq <= max_freq)
         ax_s.semilogy(freq[keep], amp[keep], lw=0.7, color="C0")
         ax_s.axvline(cutoff, color="C1", ls="--", lw=1)
         ax_s.set_xlim(0, max_freq)
-        ax_s.set_title(f"(d) spectrum of qdd_est, content ends at {cutoff:.1f} Hz", fontsize=9)
+        ax_s.set_title(f"(d) qdd_est spectrum, ends at {cutoff:.1f} Hz", fontsize=9)
         ax_s.set_xlabel("frequency [Hz]")
     else:
         ax_s.set_visible(False)

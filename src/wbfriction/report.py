@@ -169,7 +169,7 @@ th, td { padding: 3px 8px; text-align: right; border-bottom: 1px solid #eceff2; 
 th { background: #f5f7f9; } td:first-child, th:first-child { text-align: left; }
 tr.flag td { background: #fff1f0; } tr.target td, tr.err td { color: #6b7580; }
 img { max-width: 100%; height: auto; display: block; }
-nav a { margin-right: 10px; font-size: 0.85rem; }
+nav { display: flex; flex-wrap: wrap; gap: 4px 12px; font-size: 0.85rem; }
 dl { display: grid; grid-template-columns: max-content 1fr; gap: 2px 16px; font-size: 0.82rem; }
 dt { color: #5a6570; } dd { margin: 0; word-break: break-all; font-family: ui-monospace, monospace; }
 section.joint { margin-top: 18px; }

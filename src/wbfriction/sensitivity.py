@@ -94,7 +94,7 @@ class JointSensitivity:
         split: mean of that change over samples of rising velocity minus its mean over
             samples of falling velocity [N·m]: how far the branches separate (Fig. 7.6).
         generating_share: share of valid samples whose friction generates power
-            (:func:`wbfriction.energy.generating_share`, no offset removed).
+            (:func:`wbfriction.energy.generating_share`, the given offset removed).
     """
 
     joint: str
@@ -122,8 +122,10 @@ class Sensitivity:
     def reference(self) -> FrictionEstimate:
         return self.estimates[0]
 
-    def joint(self, joint: str) -> list[JointSensitivity]:
-        """:class:`JointSensitivity` of ``joint`` for every factor but the reference."""
+    def joint(self, joint: str, tau_os: float = 0.0) -> list[JointSensitivity]:
+        """:class:`JointSensitivity` of ``joint`` for every factor but the reference; ``tau_os``:
+        the torque offset [N·m] removed before the power check (e.g. the one identified on the
+        reference: an offset refitted per factor would absorb the mass error's shift)."""
         from .energy import generating_share
 
         ref = self.reference
@@ -136,7 +138,7 @@ class Sensitivity:
             up, down = valid & rising, valid & ~rising
             split = float(np.mean(change[up]) - np.mean(change[down])) if up.any() and down.any() else float("nan")
             out.append(JointSensitivity(joint, f, float(np.mean(change[valid])) if valid.any() else float("nan"),
-                                        split, generating_share(est.qd[valid, i], est.tau_f[valid, i])))
+                                        split, generating_share(est.qd[valid, i], est.tau_f[valid, i], tau_os)))
         return out
 
 

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .energy import energy_consistency
 from .estimate import EstimateOptions, estimate_log
 from .friction import PARAM_NAMES, THESIS_TARGETS, FrictionParams
 from .identify import FitResult, fit_estimate
@@ -71,6 +72,7 @@ class StudyResult:
     knee_rms: dict[str, float]  # RMS error of the right knee per scheme, leg in swing / stance [N·m]
     pulls: int  # samples where a welded foot pulled on the ground, both walks
     files: list[Path] = field(default_factory=list)
+    generating_share: dict[str, float] = field(default_factory=dict)  # per leg joint, swing phase (eq. 7.9)
 
 
 def _leg_joints(robot: Robot) -> list[tuple[str, str, str]]:
@@ -155,7 +157,10 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
     files += [output_dir / n for n in ("walk_log.parquet", "walk_friction.parquet", "walk_params.json",
                                        "friction_curves.png", "report.html")]
     pulls = sum(p.samples for p in knee_sim.pulls() + walk.pulls())
-    return StudyResult(rows, truth_err, knee_rms, pulls, files)
+    energy = energy_consistency(est, {f.joint: f.params.tau_os for f in fits if f.params is not None})
+    legs_only = {j for j, _, _ in legs}
+    share = {e.joint: e.generating_share for e in energy if e.joint in legs_only}
+    return StudyResult(rows, truth_err, knee_rms, pulls, files, share)
 
 
 def worst_errors(rows: list[LegRow]) -> dict[str, float]:
