@@ -65,12 +65,15 @@ def main() -> None:
     robot = load_robot("talos")
     kin, angles, qd = samples(robot, args.samples)
     opts = EstimateOptions(lift_off_skip=0.0, touch_down_skip=0.0)
+    bare = EstimateOptions(lift_off_skip=0.0, touch_down_skip=0.0, acceleration_difference=False)
     estimate_friction(robot, kin, opts)  # warm-up: builds and caches the stance model
     t_est = min(_timed(lambda: estimate_friction(robot, kin, opts)) for _ in range(args.repeat))
+    t_tau = min(_timed(lambda: estimate_friction(robot, kin, bare)) for _ in range(args.repeat))
     t_bare = min(bare_constraint_dynamics(robot, angles, qd) for _ in range(args.repeat))
     n = args.samples
     print(f"TALOS, {n} single-support samples, best of {args.repeat}, one thread")
     print(f"  wbfriction.estimate_friction : {n / t_est:10.0f} samples/s  ({1e6 * t_est / n:6.2f} us/sample)")
+    print(f"    without Delta qdd (tau_f only): {n / t_tau:7.0f} samples/s  ({1e6 * t_tau / n:6.2f} us/sample)")
     print(f"  bare pin.constraintDynamics  : {n / t_bare:10.0f} samples/s  ({1e6 * t_bare / n:6.2f} us/sample)")
     print(f"  time per sample, estimator / bare loop: {t_est / t_bare:.3f}")
 

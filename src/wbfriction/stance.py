@@ -128,15 +128,11 @@ class StanceModel:
         """
         q = self.layout.configuration(angles, None, self.sign)
         data = self.model.createData()
-        cols = self.v_index[joints]
-        flip = np.outer(self.sign[joints], self.sign[joints])
-        out = np.empty((angles.shape[0], len(cols), len(cols)))
+        full = np.empty((angles.shape[0], self.model.nv, self.model.nv))
         for k in range(angles.shape[0]):
-            M = pin.crba(self.model, data, q[k])
-            out[k] = M[np.ix_(cols, cols)]
-        out *= flip
-        # crba fills the upper triangle only
-        return np.triu(out) + np.swapaxes(np.triu(out, 1), 1, 2)
+            full[k] = pin.crba(self.model, data, q[k])  # Pinocchio 4: the whole symmetric matrix
+        cols = self.v_index[joints]
+        return full[:, cols[:, None], cols[None, :]] * np.outer(self.sign[joints], self.sign[joints])
 
 
 def build_stance_model(robot: Robot, frame: str) -> StanceModel:
