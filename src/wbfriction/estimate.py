@@ -170,10 +170,12 @@ def _float_column(table: pa.Table, name: str) -> np.ndarray:
 def estimate_from_table(table: pa.Table, source: str = "<table>") -> FrictionEstimate:
     """Read back a friction table written by ``wbfriction estimate`` (:meth:`FrictionEstimate.to_table`).
 
-    The joints are those with a ``tau_f.<j>`` column; each needs ``qd.<j>`` and ``valid.<j>``.
-    ``time`` and ``phase`` are needed; the contact flags, ``qdd``, ``delta_qdd``, the
-    companion and ``tau_f_true`` columns are optional (older tables, or tables of other
-    tools). The smoother is rebuilt from the ``estimate_options`` metadata.
+    The joints are those with a ``tau_f.<j>`` column; each needs ``qd.<j>`` and ``valid.<j>``,
+    and the table ``time``. The other columns are optional (older tables, or tables of other
+    tools): without ``phase`` every sample counts as single support; without ``unique``, the
+    single-support ones are unique; the contact flags, ``qdd``, ``delta_qdd``, the companion
+    and ``tau_f_true`` are then None. The smoother is rebuilt from the ``estimate_options``
+    metadata.
 
     Raises:
         InputError: no joint, or a missing column (named with ``source``).

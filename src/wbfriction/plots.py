@@ -255,7 +255,7 @@ def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, targe
     i = est.joints.index(joint)
     # a fixed layout: constrained layout would cost most of the time of a report's many figures
     fig = Figure(figsize=(14, 2.7))
-    ax_c, ax_t, ax_e, ax_s = fig.subplots(1, 4, gridspec_kw={"width_ratios": [1, 1.6, 1.6, 1], "wspace": 0.42,
+    ax_c, ax_t, ax_e, ax_s = fig.subplots(1, 4, gridspec_kw={"width_ratios": [1, 1.6, 1.6, 1], "wspace": 0.5,
                                                                "left": 0.05, "right": 0.99, "bottom": 0.17,
                                                                "top": 0.9})
     _cloud(ax_c, est, i, fit, target)
@@ -304,7 +304,7 @@ def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, targe
         ax_s.semilogy(freq[keep], amp[keep], lw=0.7, color="C0")
         ax_s.axvline(cutoff, color="C1", ls="--", lw=1)
         ax_s.set_xlim(0, max_freq)
-        ax_s.set_title(f"(d) qdd_est spectrum, ends at {cutoff:.1f} Hz", fontsize=9)
+        ax_s.set_title(f"(d) spectrum of qdd_est: {cutoff:.1f} Hz", fontsize=9)
         ax_s.set_xlabel("frequency [Hz]")
     else:
         ax_s.set_visible(False)
