@@ -48,6 +48,14 @@ EnergyToleranceOpt = typer.Option(DEFAULT_TOLERANCE, help="Smallest friction tor
                                                           "power [N·m] (the torque sensor's resolution).")
 UrdfOpt = typer.Option(None, "--urdf", help="URDF of another robot (with --config).")
 ConfigOpt = typer.Option(None, "--config", help="Robot TOML: contact_frames, position_controlled, groups.")
+MapOpt = typer.Option(None, "--map", help="Topic map TOML of a ROS 2 bag log (see 'wbfriction convert').")
+
+
+def _read_log(path: Path, r: Robot, bag_map: Optional[Path]):
+    """A log file, or a ROS 2 bag through its topic map."""
+    from .bags import load_bag_map
+
+    return read_log(path, r, None if bag_map is None else load_bag_map(bag_map))
 
 
 @contextmanager
@@ -148,8 +156,8 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
                       f"({p.samples} samples, down to {p.min_force:.1f} N)", highlight=False)
 
 
-def _run_estimate(r: Robot, log: Path, output: Path, opts: EstimateOptions) -> None:
-    data = read_log(log, r)
+def _run_estimate(r: Robot, log: Path, output: Path, opts: EstimateOptions, bag_map: Optional[Path] = None) -> None:
+    data = _read_log(log, r, bag_map)
     with _progress(len(data), "estimate") as advance:
         est = estimate_log(r, data, opts, progress=advance, companion=True)
     est.metadata["provenance"] = {"log": str(log), "log_sha256": file_sha256(log), "robot": r.name,
@@ -219,9 +227,11 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
 
 
 @app.command()
-def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the wbfriction format."),
+def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the wbfriction format, or a ROS 2 "
+                                                 "bag with --map."),
              output: Path = typer.Option(..., "-o", "--output", help="Friction table to write."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             bag_map: Optional[Path] = MapOpt,
              diff: str = typer.Option(_E.diff, help="Differentiation: central (6.2), backward (6.3), savgol "
                                                     "(Savitzky-Golay, 7.1.1), butterworth (7.1.2) or true."),
              window: int = typer.Option(_F.window, help="savgol: window length L (odd) [samples]."),
@@ -248,7 +258,20 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
                            ds_regularization=ds_regularization, condition_number=cond, method=method,
                            filtering=FilterOptions(window=window, poly_order=poly_order, weights=weights,
                                                    cutoff=cutoff, butter_order=butter_order))
-    _run_estimate(_robot(robot, urdf, config), log, output, opts)
+    _run_estimate(_robot(robot, urdf, config), log, output, opts, bag_map)
+
+
+@app.command()
+def convert(bag: Path = typer.Argument(..., help="ROS 2 bag (folder with metadata.yaml; MCAP or sqlite3)."),
+            bag_map: Path = typer.Option(..., "--map", help="Topic map TOML: [joint_states], [[contacts]], [base]."),
+            output: Path = typer.Option(..., "-o", "--output", help="Log to write (.parquet or .csv)."),
+            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt) -> None:
+    """Convert a ROS 2 bag into a wbfriction log: joint states, contacts (zero-order hold) and
+    base pose (linear + slerp) aligned on the joint-state stamps, checked against the robot."""
+    r = _robot(robot, urdf, config)
+    data = _read_log(bag, r, bag_map)
+    write_log(data, r, output)
+    console.print(f"wrote {output} ({len(data)} samples, {data.time[-1]:.2f} s)")
 
 
 @app.command()

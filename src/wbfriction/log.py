@@ -226,19 +226,39 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>") -> Lo
                qd_true=truth.get("qd_true"), qdd_true=truth.get("qdd_true"))
 
 
-def read_log(path: str | Path, robot: Robot) -> Log:
-    """Read and validate a log file (see module docstring for the format).
+def read_log(path: str | Path, robot: Robot, bag_map=None) -> Log:
+    """Read and validate a log: a Parquet or CSV file in the format of the module docstring,
+    or a ROS 2 bag with its topic map (:mod:`wbfriction.bags`).
+
+    Args:
+        path: the file (or bag folder).
+        robot: the robot whose names the columns must match.
+        bag_map: a :class:`~wbfriction.bags.BagMap` (needed for a bag).
 
     Raises:
-        InputError: see :func:`log_from_table`; messages start with the file name.
+        InputError: see :func:`log_from_table` and :func:`~wbfriction.bags.read_bag`;
+            messages start with the file name.
     """
+    from .bags import is_bag, read_bag
+
+    if is_bag(path):
+        if bag_map is None:
+            raise InputError(f"{path}: a ROS 2 bag needs a topic map (--map MAP.toml)")
+        return log_from_table(read_bag(path, bag_map), robot, source=str(path))
     return log_from_table(read_table(path), robot, source=str(path))
 
 
 # ------------------------------------------------------------------- writing
 def file_sha256(path: str | Path) -> str:
-    """SHA-256 of a file's bytes (hex), for provenance records."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    """SHA-256 of a file's bytes (hex), for provenance records; of a folder (a ROS 2 bag),
+    over its files' relative names and bytes in name order."""
+    path = Path(path)
+    if not path.is_dir():
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    digest = hashlib.sha256()
+    for f in sorted(p for p in path.rglob("*") if p.is_file()):
+        digest.update(str(f.relative_to(path)).encode() + b"\0" + f.read_bytes())
+    return digest.hexdigest()
 
 
 def write_atomic(path: str | Path, write) -> None:

@@ -1,0 +1,181 @@
+"""ROS 2 bags written with rosbags' own writer (MCAP and sqlite3) and read back as logs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from wbfriction.bags import BagMap, ContactTopic, load_bag_map, read_bag
+from wbfriction.estimate import EstimateOptions, estimate_log
+from wbfriction.exceptions import InputError
+from wbfriction.log import log_from_table, read_log
+
+T0 = 1_700_000_000_000_000_000  # an absolute stamp [ns], as robots write them
+
+
+def _time(ts, ns: int):
+    return ts.types["builtin_interfaces/msg/Time"](sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+
+
+def write_bag(path, log, robot, storage: str = "mcap", wrench_every: int = 2, odom_every: int = 5,
+              shuffle: bool = True, rename: dict | None = None):
+    """The log as a bag: JointState at every sample (names in a different order in every
+    message), the left sole's contact as a 400 N WrenchStamped every ``wrench_every`` samples,
+    the right one as a Bool, the base as Odometry every ``odom_every`` samples."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    T = ts.types
+    rng = np.random.default_rng(0)
+    rename = rename or {}
+    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+    names = list(robot.actuated)
+    with Writer(path, version=9, storage_plugin=plugin) as w:
+        c_js = w.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=ts)
+        c_lf = w.add_connection("/left_ft", "geometry_msgs/msg/WrenchStamped", typestore=ts)
+        c_rf = w.add_connection("/right_contact", "std_msgs/msg/Bool", typestore=ts)
+        c_od = w.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=ts)
+        tau_all = np.zeros((len(log), len(names)))
+        tau_all[:, robot.tc_index] = log.tau
+        for k in range(len(log)):
+            ns = T0 + int(round(log.time[k] * 1e9))
+            header = T["std_msgs/msg/Header"](stamp=_time(ts, ns), frame_id="")
+            order = rng.permutation(len(names)) if shuffle else np.arange(len(names))
+            js = T["sensor_msgs/msg/JointState"](
+                header=header, name=[rename.get(names[i], names[i]) for i in order],
+                position=log.q[k, order].astype(np.float64), velocity=np.zeros(0),
+                effort=tau_all[k, order].astype(np.float64))
+            w.write(c_js, ns, ts.serialize_cdr(js, "sensor_msgs/msg/JointState"))
+            if k % wrench_every == 0:
+                f = 400.0 if log.contact[k, 0] else 3.0
+                wr = T["geometry_msgs/msg/WrenchStamped"](header=header, wrench=T["geometry_msgs/msg/Wrench"](
+                    force=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=-f),
+                    torque=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)))
+                w.write(c_lf, ns, ts.serialize_cdr(wr, "geometry_msgs/msg/WrenchStamped"))
+            if k == 0 or log.contact[k, 1] != log.contact[k - 1, 1]:  # a state topic: on change only
+                w.write(c_rf, ns, ts.serialize_cdr(T["std_msgs/msg/Bool"](data=bool(log.contact[k, 1])),
+                                                   "std_msgs/msg/Bool"))
+            if k % odom_every == 0:
+                b = log.base[k]
+                pose = T["geometry_msgs/msg/Pose"](
+                    position=T["geometry_msgs/msg/Point"](x=b[0], y=b[1], z=b[2]),
+                    orientation=T["geometry_msgs/msg/Quaternion"](x=b[3], y=b[4], z=b[5], w=b[6]))
+                odom = T["nav_msgs/msg/Odometry"](
+                    header=header, child_frame_id="base_link",
+                    pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=np.zeros(36)),
+                    twist=T["geometry_msgs/msg/TwistWithCovariance"](
+                        twist=T["geometry_msgs/msg/Twist"](linear=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0),
+                                                           angular=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)),
+                        covariance=np.zeros(36)))
+                w.write(c_od, ns, ts.serialize_cdr(odom, "nav_msgs/msg/Odometry"))
+
+
+def bag_map(robot, **kw) -> BagMap:
+    left, right = robot.contact_frames
+    return BagMap("/joint_states", (ContactTopic(left, "/left_ft", 50.0), ContactTopic(right, "/right_contact")),
+                  base="/odom", **kw)
+
+
+@pytest.fixture(scope="module")
+def short_log(talos, combined_walk):
+    """2.5 s of the combined walk (with two contact changes per foot at least)."""
+    log = combined_walk.log
+    n = 2500
+    return log_from_table(log.to_table(talos).slice(0, n), talos, "walk")
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_bag_reads_back_as_the_log(talos, short_log, tmp_path, storage):
+    log = short_log
+    write_bag(tmp_path / "bag", log, talos, storage, wrench_every=3)
+    back = log_from_table(read_bag(tmp_path / "bag", bag_map(talos)), talos, "bag")
+    # the log spans the stamps where every topic has data: from the first sample to the last
+    # odometry message (every 5th sample), after which the base cannot be interpolated
+    n = (len(log) - 1) // 5 * 5 + 1
+    assert len(back) == n
+    log = log_from_table(log.to_table(talos).slice(0, n), talos, "walk")
+    np.testing.assert_allclose(back.time, log.time - log.time[0], atol=1e-9)
+    np.testing.assert_array_equal(back.q, log.q)  # float64 through CDR: bit for bit
+    np.testing.assert_array_equal(back.tau, log.tau)
+    # right foot (Bool on change): exact; left foot (wrench every 3rd sample, zero-order hold):
+    # off only on the (at most 2) samples after a change that fell between two wrench messages
+    np.testing.assert_array_equal(back.contact[:, 1], log.contact[:, 1])
+    wrong = np.flatnonzero(back.contact[:, 0] != log.contact[:, 0])
+    changes = np.flatnonzero(np.diff(log.contact[:, 0].astype(int))) + 1
+    assert changes.size >= 1 and wrong.size >= 1
+    assert set(wrong) <= set(changes) | set(changes + 1)
+    # base: odometry every 5th sample, linear + slerp in between
+    # (exact on the messages' stamps; between them the error of a chord over 5 ms)
+    np.testing.assert_allclose(back.base[::5, :3], log.base[::5, :3], atol=1e-12)
+    assert np.abs(back.base[:, :3] - log.base[:, :3]).max() < 1e-3
+    dots = np.abs(np.sum(back.base[:, 3:] * log.base[:, 3:], axis=1))
+    assert np.degrees(2 * np.arccos(np.clip(dots, -1, 1))).max() < 0.05
+
+
+def test_estimate_from_a_bag_equals_estimate_from_its_conversion(talos, short_log, tmp_path):
+    """'estimate BAG --map' and 'convert' then 'estimate' are one computation."""
+    write_bag(tmp_path / "bag", short_log, talos, wrench_every=1, odom_every=1)
+    (tmp_path / "map.toml").write_text(
+        '[joint_states]\ntopic = "/joint_states"\n'
+        f'[[contacts]]\nframe = "{talos.contact_frames[0]}"\ntopic = "/left_ft"\nthreshold = 50\n'
+        f'[[contacts]]\nframe = "{talos.contact_frames[1]}"\ntopic = "/right_contact"\n'
+        '[base]\ntopic = "/odom"\n')
+    m = load_bag_map(tmp_path / "map.toml")
+    direct = estimate_log(talos, read_log(tmp_path / "bag", talos, m), EstimateOptions())
+    from wbfriction.log import write_log
+
+    write_log(read_log(tmp_path / "bag", talos, m), talos, tmp_path / "log.parquet")
+    converted = estimate_log(talos, read_log(tmp_path / "log.parquet", talos), EstimateOptions())
+    np.testing.assert_array_equal(direct.tau_f, converted.tau_f)
+    ref = estimate_log(talos, short_log, EstimateOptions())
+    assert np.nanmax(np.abs(direct.tau_f - ref.tau_f)) < 1e-6
+
+
+def test_renamed_joints_and_bag_errors(talos, short_log, tmp_path):
+    rename = {"leg_left_4_joint": "LLeg_knee"}
+    write_bag(tmp_path / "bag", short_log, talos, "sqlite3", rename=rename)
+    back = log_from_table(read_bag(tmp_path / "bag", bag_map(talos, rename={"LLeg_knee": "leg_left_4_joint"})),
+                          talos, "bag")
+    np.testing.assert_array_equal(back.q, short_log.q[:len(back)])
+    # without the rename the model's knee is missing and the bag's name is unknown
+    with pytest.raises(InputError, match="unknown joint 'LLeg_knee'"):
+        log_from_table(read_bag(tmp_path / "bag", bag_map(talos)), talos, "bag")
+    missing = BagMap("/joint_states", (ContactTopic(talos.contact_frames[0], "/nope"),))
+    with pytest.raises(InputError, match="no topic '/nope' in the bag"):
+        read_bag(tmp_path / "bag", missing)
+    wrong = BagMap("/odom", bag_map(talos).contacts)
+    with pytest.raises(InputError, match="carries nav_msgs/msg/Odometry, expected sensor_msgs/msg/JointState"):
+        read_bag(tmp_path / "bag", wrong)
+    no_threshold = BagMap("/joint_states", (ContactTopic(talos.contact_frames[0], "/left_ft"),))
+    with pytest.raises(InputError, match="give its threshold"):
+        read_bag(tmp_path / "bag", no_threshold)
+    with pytest.raises(InputError, match="needs a topic map"):
+        read_log(tmp_path / "bag", talos)
+    (tmp_path / "junk").mkdir()
+    (tmp_path / "junk" / "metadata.yaml").write_text("not: a bag\n")
+    with pytest.raises(InputError, match="not a readable ROS 2 bag"):
+        read_bag(tmp_path / "junk", bag_map(talos))
+    (tmp_path / "bad.toml").write_text('[joint_states]\ntopic = "/js"\n')
+    with pytest.raises(InputError, match="no \\[\\[contacts\\]\\] entry"):
+        load_bag_map(tmp_path / "bad.toml")
+
+
+def test_convert_and_estimate_commands_take_a_bag(talos, short_log, tmp_path):
+    from test_cli import _assert_one_line_error, run
+
+    write_bag(tmp_path / "bag", short_log, talos, odom_every=1)
+    left, right = talos.contact_frames
+    (tmp_path / "map.toml").write_text(
+        f'[joint_states]\ntopic = "/joint_states"\n[[contacts]]\nframe = "{left}"\ntopic = "/left_ft"\n'
+        f'threshold = 50\n[[contacts]]\nframe = "{right}"\ntopic = "/right_contact"\n[base]\ntopic = "/odom"\n')
+    res = run("convert", tmp_path / "bag", "--map", tmp_path / "map.toml", "-o", tmp_path / "log.parquet")
+    assert res.returncode == 0, res.stderr
+    assert len(read_log(tmp_path / "log.parquet", talos)) == len(short_log)
+    res = run("estimate", tmp_path / "bag", "--map", tmp_path / "map.toml", "-o", tmp_path / "f.parquet")
+    assert res.returncode == 0, res.stderr
+    _assert_one_line_error(run("estimate", tmp_path / "bag", "-o", tmp_path / "x.parquet"), "needs a topic map")
+    (tmp_path / "bad.toml").write_text('[joint_states]\ntopic = "/nope"\n[[contacts]]\nframe = "x"\ntopic = "/y"\n')
+    _assert_one_line_error(run("convert", tmp_path / "bag", "--map", tmp_path / "bad.toml", "-o",
+                               tmp_path / "x.parquet"), "no topic '/nope' in the bag")
+    assert not (tmp_path / "x.parquet").exists()
