@@ -1,6 +1,7 @@
 """The wbfriction log format: reading, validation, and atomic writing of tables.
 
-A log is a Parquet file (or CSV with the same columns), one row per sample:
+A log is a Parquet file (or CSV with the same columns, or HDF5: :mod:`wbfriction.hdf5`),
+one row per sample:
 
 =====================  ==========  ==================================================
 column                 unit        content
@@ -38,6 +39,8 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from .exceptions import InputError
+from .hdf5 import SUFFIXES as HDF5_SUFFIXES
+from .hdf5 import read_hdf5, write_hdf5
 from .robot import Robot
 
 BASE_COLUMNS = ("base.x", "base.y", "base.z", "base.qx", "base.qy", "base.qz", "base.qw")
@@ -121,6 +124,8 @@ def read_table(path: str | Path) -> pa.Table:
     if not path.is_file():
         raise InputError(f"{path}: file not found")
     suffix = path.suffix.lower()
+    if suffix in HDF5_SUFFIXES:
+        return read_hdf5(path)
     try:
         if suffix in (".parquet", ".pq"):
             return pq.read_table(path)
@@ -128,7 +133,7 @@ def read_table(path: str | Path) -> pa.Table:
             return pacsv.read_csv(path)
     except (pa.ArrowException, OSError) as exc:
         raise InputError(f"{path}: cannot be read: {str(exc).splitlines()[0]}") from exc
-    raise InputError(f"{path}: unknown file type '{suffix}' (expected .parquet or .csv)")
+    raise InputError(f"{path}: unknown file type '{suffix}' (expected .parquet, .csv or .h5)")
 
 
 def _column(table: pa.Table, name: str, source: str) -> np.ndarray:
@@ -282,10 +287,12 @@ def write_atomic(path: str | Path, write) -> None:
 
 
 def write_table(table: pa.Table, path: str | Path) -> None:
-    """Write an Arrow table as Parquet (or CSV if ``path`` ends in .csv), atomically."""
+    """Write an Arrow table as Parquet (CSV if ``path`` ends in .csv, HDF5 in .h5 or .hdf5), atomically."""
     path = Path(path)
     if path.suffix.lower() == ".csv":
         write_atomic(path, lambda tmp: pacsv.write_csv(table, tmp))
+    elif path.suffix.lower() in HDF5_SUFFIXES:
+        write_atomic(path, lambda tmp: write_hdf5(table, tmp))
     else:
         write_atomic(path, lambda tmp: pq.write_table(table, tmp))
 
