@@ -31,7 +31,7 @@ from .friction import PARAM_NAMES, load_friction_toml
 from .sim.sensors import load_sensors_toml
 from .identify import FitResult, fit_estimate, fit_table_estimate
 from .kinematics import FilterOptions
-from .log import file_sha256, read_log, read_table, write_atomic, write_log, write_table
+from .log import LIMIT_MARGIN, MAX_GAP, file_sha256, read_log, read_table, write_atomic, write_log, write_table
 from .robot import Robot, load_robot
 from .sim import IdealOptions, MujocoOptions, SensorNoise, simulate_ideal, simulate_mujoco
 from .walking import GaitOptions, walking_reference
@@ -51,11 +51,18 @@ ConfigOpt = typer.Option(None, "--config", help="Robot TOML: contact_frames, pos
 MapOpt = typer.Option(None, "--map", help="Topic map TOML of a ROS 2 bag log (see 'wbfriction convert').")
 
 
-def _read_log(path: Path, r: Robot, bag_map: Optional[Path]):
+MaxGapOpt = typer.Option(MAX_GAP, help="Time steps of at least this many sampling periods split the log into "
+                                        "segments, estimated apart.")
+LimitMarginOpt = typer.Option(LIMIT_MARGIN, help="Positions beyond the URDF limits by more than this [rad] are "
+                                                 "refused (wrong units).")
+
+
+def _read_log(path: Path, r: Robot, bag_map: Optional[Path], max_gap: float = MAX_GAP,
+              limit_margin: float = LIMIT_MARGIN):
     """A log file, or a ROS 2 bag through its topic map."""
     from .bags import load_bag_map
 
-    return read_log(path, r, None if bag_map is None else load_bag_map(bag_map))
+    return read_log(path, r, None if bag_map is None else load_bag_map(bag_map), max_gap, limit_margin)
 
 
 @contextmanager
@@ -156,8 +163,12 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
                       f"({p.samples} samples, down to {p.min_force:.1f} N)", highlight=False)
 
 
-def _run_estimate(r: Robot, log: Path, output: Path, opts: EstimateOptions, bag_map: Optional[Path] = None) -> None:
-    data = _read_log(log, r, bag_map)
+def _run_estimate(r: Robot, log: Path, output: Path, opts: EstimateOptions, bag_map: Optional[Path] = None,
+                  max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN) -> None:
+    data = _read_log(log, r, bag_map, max_gap, limit_margin)
+    if data.segments and len(data.segments) > 1:
+        console.print(f"{log}: {len(data.segments) - 1} time gap(s): {len(data.segments)} segments estimated apart",
+                      highlight=False)
     with _progress(len(data), "estimate") as advance:
         est = estimate_log(r, data, opts, progress=advance, companion=True)
     est.metadata["provenance"] = {"log": str(log), "log_sha256": file_sha256(log), "robot": r.name,
@@ -231,7 +242,7 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
                                                  "bag with --map."),
              output: Path = typer.Option(..., "-o", "--output", help="Friction table to write."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
-             bag_map: Optional[Path] = MapOpt,
+             bag_map: Optional[Path] = MapOpt, max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt,
              diff: str = typer.Option(_E.diff, help="Differentiation: central (6.2), backward (6.3), savgol "
                                                     "(Savitzky-Golay, 7.1.1), butterworth (7.1.2) or true."),
              window: int = typer.Option(_F.window, help="savgol: window length L (odd) [samples]."),
@@ -258,18 +269,19 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
                            ds_regularization=ds_regularization, condition_number=cond, method=method,
                            filtering=FilterOptions(window=window, poly_order=poly_order, weights=weights,
                                                    cutoff=cutoff, butter_order=butter_order))
-    _run_estimate(_robot(robot, urdf, config), log, output, opts, bag_map)
+    _run_estimate(_robot(robot, urdf, config), log, output, opts, bag_map, max_gap, limit_margin)
 
 
 @app.command()
 def convert(bag: Path = typer.Argument(..., help="ROS 2 bag (folder with metadata.yaml; MCAP or sqlite3)."),
             bag_map: Path = typer.Option(..., "--map", help="Topic map TOML: [joint_states], [[contacts]], [base]."),
             output: Path = typer.Option(..., "-o", "--output", help="Log to write (.parquet or .csv)."),
-            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt) -> None:
+            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+            max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt) -> None:
     """Convert a ROS 2 bag into a wbfriction log: joint states, contacts (zero-order hold) and
     base pose (linear + slerp) aligned on the joint-state stamps, checked against the robot."""
     r = _robot(robot, urdf, config)
-    data = _read_log(bag, r, bag_map)
+    data = _read_log(bag, r, bag_map, max_gap, limit_margin)
     write_log(data, r, output)
     console.print(f"wrote {output} ({len(data)} samples, {data.time[-1]:.2f} s)")
 

@@ -20,7 +20,7 @@ Sign convention: ``tau_f`` is the torque friction exerts on the joint,
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 
 import numpy as np
 import pinocchio as pin
@@ -327,7 +327,9 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     phases: Phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip)
     usable = kin.valid & (phases.n_contacts > 0)
     if not np.any(usable & phases.single):
-        raise InputError("the log has no single-support sample (exactly one contact flag set) with defined derivatives")
+        raise InputError(f"{kin.metadata.get('source', 'the log')}: no single-support sample (exactly one of the "
+                         f"columns {', '.join('contact.' + f for f in robot.contact_frames)} set) with defined "
+                         "derivatives")
     cond = np.full(n, np.nan) if options.condition_number else None
     tc = robot.tc_index
     ss = usable & phases.single
@@ -375,10 +377,35 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
                  companion: bool = False) -> FrictionEstimate:
     """Differentiate a log (:func:`~wbfriction.kinematics.measure`) and estimate its friction.
 
+    A log with time gaps (:attr:`~wbfriction.log.Log.segments`) is estimated segment by
+    segment, never differentiated or filtered across a gap; a segment too short for the
+    scheme, or without single support, gives NaN, invalid rows.
+
     With ``companion``, the single-support acceleration difference is also computed through
     :func:`companion_scheme` (:attr:`FrictionEstimate.companion_delta_qdd`; one more
     inverse-dynamics pass over the single-support samples).
+
+    Raises:
+        InputError: what :func:`~wbfriction.kinematics.measure` and :func:`estimate_friction`
+            raise, for a log of one segment or when no segment can be estimated.
     """
+    parts = log.parts()
+    if len(parts) == 1:
+        return _estimate_segment(robot, log, options, progress, companion)
+    done, first_error = [], None
+    for part in parts:
+        try:
+            done.append(_estimate_segment(robot, part, options, progress, companion))
+        except InputError as exc:
+            first_error = first_error or exc
+            done.append(None)
+    if all(d is None for d in done):
+        raise first_error
+    template = next(d for d in done if d is not None)
+    return concat_estimates([d if d is not None else _blank(template, part) for d, part in zip(done, parts)])
+
+
+def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress, companion: bool) -> FrictionEstimate:
     kin = measure(log, options.diff, compensate_delay=options.compensate_delay,
                   torque_alignment=options.torque_alignment, filtering=options.filtering)
     kin.metadata.update(robot=robot.name, source=log.source)
@@ -391,3 +418,33 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
         _, est.companion_delta_qdd = single_support(robot, kin2, kin2.valid & phases.single, phases.stance)
         est.companion_diff = other
     return est
+
+
+def _blank(template: FrictionEstimate, log: Log) -> FrictionEstimate:
+    """An estimate of ``log``'s rows with nothing estimated (NaN, invalid), shaped like ``template``."""
+    n = len(log.time)
+    nan = lambda x: None if x is None else np.full((n, *np.shape(x)[1:]), np.nan)  # noqa: E731
+    return FrictionEstimate(
+        joints=template.joints, time=log.time, qd=nan(template.qd), tau_f=nan(template.tau_f),
+        valid=np.zeros((n, len(template.joints)), dtype=bool), phase=segment(log.time, log.contact).labels(),
+        unique=np.zeros(n, dtype=bool), contact=log.contact, contact_frames=template.contact_frames,
+        qdd=nan(template.qdd), delta_qdd=nan(template.delta_qdd), cond=nan(template.cond),
+        tau_f_true=log.tau_f_true, metadata=template.metadata, smoother=template.smoother,
+        companion_delta_qdd=nan(template.companion_delta_qdd), companion_diff=template.companion_diff)
+
+
+def concat_estimates(parts: list[FrictionEstimate]) -> FrictionEstimate:
+    """Estimates of consecutive stretches of one log as one (arrays stacked along time;
+    names, metadata and smoother of the first)."""
+    first = parts[0]
+    out = {}
+    for f in fields(FrictionEstimate):
+        values = [getattr(p, f.name) for p in parts]
+        if isinstance(values[0], np.ndarray) or (values[0] is None and any(isinstance(v, np.ndarray) for v in values)):
+            if any(v is None for v in values):
+                values = [np.full((len(p.time), *np.shape(next(v for v in values if v is not None))[1:]), np.nan)
+                          if v is None else v for v, p in zip(values, parts)]
+            out[f.name] = np.concatenate(values)
+        else:
+            out[f.name] = getattr(first, f.name)
+    return FrictionEstimate(**out)

@@ -63,6 +63,7 @@ class Log:
         source: file the log came from.
         qd_true, qdd_true: true joint velocities [rad/s] and accelerations [rad/s^2]
             (N, n_act) (simulations only, for evaluation), or None.
+        segments: row ranges between time gaps (:func:`check_time`); None: one segment.
     """
 
     time: np.ndarray
@@ -75,11 +76,26 @@ class Log:
     source: str = "<memory>"
     qd_true: np.ndarray | None = None
     qdd_true: np.ndarray | None = None
+    segments: list[tuple[int, int]] | None = None
 
     @property
     def dt(self) -> float:
         """Sampling period [s] (median time step)."""
         return float(np.median(np.diff(self.time)))
+
+    def parts(self) -> list["Log"]:
+        """The log's segments (split at its time gaps, :func:`check_time`) as logs of their own."""
+        bounds = self.segments or [(0, len(self.time))]
+        if len(bounds) == 1:
+            return [self]
+        return [self.rows(a, b) for a, b in bounds]
+
+    def rows(self, start: int, stop: int) -> "Log":
+        """The rows ``[start, stop)`` as a log (arrays are views)."""
+        cut = lambda x: None if x is None else x[start:stop]  # noqa: E731
+        return Log(self.time[start:stop], self.q[start:stop], self.tau[start:stop], self.contact[start:stop],
+                   cut(self.base), cut(self.tau_f_true), self.metadata, self.source, cut(self.qd_true),
+                   cut(self.qdd_true), None)
 
     def __len__(self) -> int:
         return len(self.time)
@@ -148,32 +164,83 @@ def _column(table: pa.Table, name: str, source: str) -> np.ndarray:
     return values
 
 
-def check_time(time: np.ndarray, source: str, rel_tol: float = 0.05) -> None:
-    """Check that ``time`` is strictly increasing and uniformly sampled.
+MAX_GAP = 2.0
+"""Default gap [sampling periods]: a time step at least this long splits a log into segments."""
+JITTER = 0.05
+"""Tolerated deviation of a time step from the median step, relative."""
+LIMIT_MARGIN = 0.2
+"""How far a position may pass its URDF limits before the log is refused [rad or m]."""
+
+
+def check_time(time: np.ndarray, source: str, max_gap: float = MAX_GAP,
+               rel_tol: float = JITTER) -> list[tuple[int, int]]:
+    """Check a time column and split it at its gaps.
+
+    A step within ``rel_tol`` of the median step ``dt`` is regular; a step of at least
+    ``max_gap`` periods (less the tolerance) is a gap, which ends a segment (a log with
+    dropped samples or pauses is estimated segment by segment, never differentiated
+    across a gap); anything else is irregular sampling and refused.
+
+    Returns:
+        The segments as half-open row ranges ``[(a, b), ...]`` covering every row.
 
     Raises:
-        InputError: naming the first row at fault.
+        InputError: fewer than 5 rows, a duplicated or decreasing stamp, or an irregular
+            step, naming the first row at fault.
     """
     if time.size < 5:
         raise InputError(f"{source}: only {time.size} rows; at least 5 samples are needed")
     step = np.diff(time)
     bad = np.flatnonzero(step <= 0)
     if bad.size:
-        raise InputError(f"{source}: column 'time' is not strictly increasing at row {bad[0] + 1}")
+        k = bad[0] + 1
+        what = "duplicated" if step[bad[0]] == 0 else "decreasing"
+        raise InputError(f"{source}: column 'time' has a {what} stamp at row {k} ({time[k]:.9g} s after "
+                         f"{time[k - 1]:.9g} s)")
     dt = np.median(step)
-    bad = np.flatnonzero(np.abs(step - dt) > rel_tol * dt)
+    gap = step >= (max_gap - rel_tol) * dt
+    bad = np.flatnonzero(~gap & (np.abs(step - dt) > rel_tol * dt))
     if bad.size:
         raise InputError(f"{source}: column 'time' is irregular at row {bad[0] + 1} "
-                         f"(step {step[bad[0]]:.6g} s, median {dt:.6g} s)")
+                         f"(step {step[bad[0]]:.6g} s, median {dt:.6g} s; gaps of {max_gap:g} periods or more "
+                         f"split the log)")
+    cuts = np.flatnonzero(gap) + 1
+    edges = [0, *cuts.tolist(), time.size]
+    return list(zip(edges[:-1], edges[1:]))
 
 
-def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>") -> Log:
+def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT_MARGIN) -> None:
+    """Refuse positions beyond the URDF limits by more than ``margin`` (degrees logged as
+    radians, millimetres as metres); joints without finite limits are not checked.
+
+    Raises:
+        InputError: naming the column, the row and the limits.
+    """
+    lower, upper = robot.angle_limits
+    for i, name in enumerate(robot.actuated):
+        lo, hi = lower[i], upper[i]
+        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
+            continue
+        out = np.flatnonzero((q[:, i] < lo - margin) | (q[:, i] > hi + margin))
+        if out.size:
+            k = out[0]
+            raise InputError(f"{source}: column 'q.{name}' is {q[k, i]:.6g} at row {k}, beyond its URDF limits "
+                             f"[{lo:.4g}, {hi:.4g}] by more than {margin:g}: wrong units (degrees for radians)?")
+
+
+def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_gap: float = MAX_GAP,
+                   limit_margin: float = LIMIT_MARGIN) -> Log:
     """Validate an Arrow table against ``robot`` and map its columns by joint name.
+
+    Args:
+        max_gap: time steps of at least this many periods split the log (:func:`check_time`).
+        limit_margin: tolerance on the URDF joint limits (:func:`check_limits`).
 
     Raises:
         InputError: missing ``time``, a missing or unknown joint/frame column, NaN, a
-            non-monotonic or irregular time column, contact flags other than 0/1, a
-            partial base pose, or a non-unit quaternion.
+            duplicated, decreasing or irregular time column, positions far beyond the
+            joint limits, contact flags other than 0/1, a partial base pose, or a
+            non-unit quaternion.
     """
     names = set(table.column_names)
     if "time" not in names:
@@ -192,8 +259,9 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>") -> Lo
         if col not in names:
             raise InputError(f"{source}: missing column '{col}'")
     time = _column(table, "time", source)
-    check_time(time, source)
+    segments = check_time(time, source, max_gap)
     q = np.column_stack([_column(table, f"q.{n}", source) for n in robot.actuated])
+    check_limits(q, robot, source, limit_margin)
     tau = np.column_stack([_column(table, f"tau.{n}", source) for n in robot.torque_controlled])
     contact_cols = []
     for f in robot.contact_frames:
@@ -228,10 +296,11 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>") -> Lo
                 raise InputError(f"{source}: missing column '{prefix}.{missing[0]}'")
             truth[prefix] = np.column_stack([_column(table, f"{prefix}.{n}", source) for n in robot.actuated])
     return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table), source,
-               qd_true=truth.get("qd_true"), qdd_true=truth.get("qdd_true"))
+               qd_true=truth.get("qd_true"), qdd_true=truth.get("qdd_true"), segments=segments)
 
 
-def read_log(path: str | Path, robot: Robot, bag_map=None) -> Log:
+def read_log(path: str | Path, robot: Robot, bag_map=None, max_gap: float = MAX_GAP,
+             limit_margin: float = LIMIT_MARGIN) -> Log:
     """Read and validate a log: a Parquet or CSV file in the format of the module docstring,
     or a ROS 2 bag with its topic map (:mod:`wbfriction.bags`).
 
@@ -239,6 +308,7 @@ def read_log(path: str | Path, robot: Robot, bag_map=None) -> Log:
         path: the file (or bag folder).
         robot: the robot whose names the columns must match.
         bag_map: a :class:`~wbfriction.bags.BagMap` (needed for a bag).
+        max_gap, limit_margin: see :func:`log_from_table`.
 
     Raises:
         InputError: see :func:`log_from_table` and :func:`~wbfriction.bags.read_bag`;
@@ -249,8 +319,10 @@ def read_log(path: str | Path, robot: Robot, bag_map=None) -> Log:
     if is_bag(path):
         if bag_map is None:
             raise InputError(f"{path}: a ROS 2 bag needs a topic map (--map MAP.toml)")
-        return log_from_table(read_bag(path, bag_map), robot, source=str(path))
-    return log_from_table(read_table(path), robot, source=str(path))
+        table = read_bag(path, bag_map)
+    else:
+        table = read_table(path)
+    return log_from_table(table, robot, str(path), max_gap, limit_margin)
 
 
 # ------------------------------------------------------------------- writing
