@@ -196,7 +196,7 @@ def estimate_from_table(table: pa.Table, source: str = "<table>") -> FrictionEst
              else np.full(len(time), "single"))
     unique = (np.asarray(table.column("unique").to_numpy(zero_copy_only=False), dtype=bool) if "unique" in names
               else phase == "single")
-    meta = read_metadata(table)
+    meta = read_metadata(table, source)
     smoother = None
     if "estimate_options" in meta and len(time) > 1:
         opts = meta["estimate_options"]

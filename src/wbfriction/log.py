@@ -123,15 +123,23 @@ def with_metadata(table: pa.Table, metadata: dict) -> pa.Table:
     return table.replace_schema_metadata({META_KEY: json.dumps(metadata, sort_keys=True).encode()})
 
 
-def read_metadata(table: pa.Table) -> dict:
+def read_metadata(table: pa.Table, source: str = "<table>") -> dict:
     """The ``wbfriction`` metadata of a table ({} if none)."""
     meta = table.schema.metadata or {}
-    return json.loads(meta[META_KEY]) if META_KEY in meta else {}
+    if META_KEY not in meta:
+        return {}
+    try:
+        doc = json.loads(meta[META_KEY])
+    except ValueError:
+        raise InputError(f"{source}: the 'wbfriction' metadata is not JSON") from None
+    if not isinstance(doc, dict):
+        raise InputError(f"{source}: the 'wbfriction' metadata is not a JSON object")
+    return doc
 
 
 # ------------------------------------------------------------------- reading
 def read_table(path: str | Path) -> pa.Table:
-    """Read a Parquet or CSV file into an Arrow table.
+    """Read a Parquet, CSV or HDF5 file into an Arrow table.
 
     Raises:
         InputError: missing file, unknown extension, or unreadable content.
@@ -142,14 +150,15 @@ def read_table(path: str | Path) -> pa.Table:
     suffix = path.suffix.lower()
     if suffix in HDF5_SUFFIXES:
         return read_hdf5(path)
+    readers = {".parquet": pq.read_table, ".pq": pq.read_table, ".csv": pacsv.read_csv}
+    if suffix not in readers:
+        raise InputError(f"{path}: unknown file type '{suffix}' (expected .parquet, .csv or .h5)")
     try:
-        if suffix in (".parquet", ".pq"):
-            return pq.read_table(path)
-        if suffix == ".csv":
-            return pacsv.read_csv(path)
-    except (pa.ArrowException, OSError) as exc:
-        raise InputError(f"{path}: cannot be read: {str(exc).splitlines()[0]}") from exc
-    raise InputError(f"{path}: unknown file type '{suffix}' (expected .parquet, .csv or .h5)")
+        table = readers[suffix](path)
+        _ = table.column_names  # decoded lazily: a damaged header fails here
+        return table
+    except (pa.ArrowException, OSError, ValueError) as exc:  # ValueError: e.g. damaged UTF-8 in the footer
+        raise InputError(f"{path}: cannot be read: {(str(exc).splitlines() or [repr(exc)])[0]}") from exc
 
 
 def _column(table: pa.Table, name: str, source: str) -> np.ndarray:
@@ -295,7 +304,7 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
             if missing:
                 raise InputError(f"{source}: missing column '{prefix}.{missing[0]}'")
             truth[prefix] = np.column_stack([_column(table, f"{prefix}.{n}", source) for n in robot.actuated])
-    return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table), source,
+    return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
                qd_true=truth.get("qd_true"), qdd_true=truth.get("qdd_true"), segments=segments)
 
 
