@@ -163,20 +163,28 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
                       f"({p.samples} samples, down to {p.min_force:.1f} N)", highlight=False)
 
 
-def _run_estimate(r: Robot, log: Path, output: Path, opts: EstimateOptions, bag_map: Optional[Path] = None,
-                  max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN) -> None:
-    data = _read_log(log, r, bag_map, max_gap, limit_margin)
-    if data.segments and len(data.segments) > 1:
-        console.print(f"{log}: {len(data.segments) - 1} time gap(s): {len(data.segments)} segments estimated apart",
-                      highlight=False)
-    with _progress(len(data), "estimate") as advance:
-        est = estimate_log(r, data, opts, progress=advance, companion=True)
-    est.metadata["provenance"] = {"log": str(log), "log_sha256": file_sha256(log), "robot": r.name,
-                                  "urdf": str(r.urdf), "wbfriction": __version__}
-    write_table(est.to_table(), output)
-    n_valid = int(est.valid.any(axis=1).sum())
-    console.print(f"wrote {output}: {len(est.time)} samples, {int(est.unique.sum())} in single support, "
-                  f"{n_valid} with a valid joint")
+def _run_estimate(spec, log: Path, output: Path, opts: EstimateOptions, bag_map: Optional[Path] = None,
+                  max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN, workers: int = 2,
+                  chunk_rows: int = 50_000) -> None:
+    from .bags import is_bag
+    from .chunked import Chunking, estimate_file
+
+    provenance = {"provenance": {"log": str(log), "log_sha256": file_sha256(log), "robot": spec.name or "custom",
+                                 "urdf": str(spec.urdf or spec.load().urdf), "wbfriction": __version__}}
+    if is_bag(log):  # read whole: the bag's topics are aligned over the whole recording
+        r = spec.load()
+        data = _read_log(log, r, bag_map, max_gap, limit_margin)
+        with _progress(len(data), "estimate") as advance:
+            est = estimate_log(r, data, opts, progress=advance, companion=True)
+        est.metadata.update(provenance)
+        write_table(est.to_table(), output)
+        rows = len(est.time)
+    else:
+        with _progress(0, "estimate") as _:
+            result = estimate_file(spec, log, output, opts, chunking=Chunking(rows=chunk_rows, workers=workers),
+                                   max_gap=max_gap, limit_margin=limit_margin, extra_metadata=provenance)
+        rows = result.rows
+    console.print(f"wrote {output}: {rows} samples")
 
 
 def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, tolerance: float) -> None:
@@ -243,6 +251,8 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
              output: Path = typer.Option(..., "-o", "--output", help="Friction table to write."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              bag_map: Optional[Path] = MapOpt, max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt,
+             workers: int = typer.Option(2, help="Processes estimating chunks of a long log."),
+             chunk_rows: int = typer.Option(50_000, help="Rows per chunk (cut at the next contact change)."),
              diff: str = typer.Option(_E.diff, help="Differentiation: central (6.2), backward (6.3), savgol "
                                                     "(Savitzky-Golay, 7.1.1), butterworth (7.1.2) or true."),
              window: int = typer.Option(_F.window, help="savgol: window length L (odd) [samples]."),
@@ -269,7 +279,12 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
                            ds_regularization=ds_regularization, condition_number=cond, method=method,
                            filtering=FilterOptions(window=window, poly_order=poly_order, weights=weights,
                                                    cutoff=cutoff, butter_order=butter_order))
-    _run_estimate(_robot(robot, urdf, config), log, output, opts, bag_map, max_gap, limit_margin)
+    from .chunked import RobotSpec
+
+    spec = RobotSpec(None if urdf else robot, None if urdf is None else str(urdf),
+                     None if config is None else str(config))
+    _robot(robot, urdf, config)  # a bad robot is refused before the log is read
+    _run_estimate(spec, log, output, opts, bag_map, max_gap, limit_margin, workers, chunk_rows)
 
 
 @app.command()

@@ -132,7 +132,7 @@ class FrictionEstimate:
         ``contact.<frame>``, and per joint ``qd.<j>``, ``tau_f.<j>``, ``valid.<j>``,
         ``qdd.<j>``, ``delta_qdd.<j>``, [``delta_qdd_companion.<j>``], [``tau_f_true.<j>``];
         the companion's scheme is the metadata key ``companion_diff``."""
-        cols: dict[str, object] = {"time": self.time, "phase": pa.array(self.phase.astype(str)).dictionary_encode(),
+        cols: dict[str, object] = {"time": self.time, "phase": pa.array(self.phase.astype(str)),
                                    "unique": self.unique}
         if self.cond is not None:
             cols["cond"] = self.cond
@@ -305,8 +305,14 @@ def regularised_least_squares(Mmod_inv: np.ndarray, delta_qdd: np.ndarray, weigh
     return np.linalg.solve(lhs, rhs)[..., 0]
 
 
+def no_single_support(robot: Robot, source: str) -> InputError:
+    """The error of a log without a single-support sample, naming it and its contact columns."""
+    return InputError(f"{source}: no single-support sample (exactly one of the columns "
+                      f"{', '.join('contact.' + f for f in robot.contact_frames)} set) with defined derivatives")
+
+
 def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOptions = EstimateOptions(),
-                      progress=None) -> FrictionEstimate:
+                      progress=None, require_single_support: bool = True) -> FrictionEstimate:
     """Estimate the friction torque of every torque-controlled joint at every sample.
 
     Args:
@@ -314,6 +320,8 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
         kin: measured kinematics (:func:`wbfriction.kinematics.measure`).
         options: :class:`EstimateOptions`.
         progress: optional callable receiving numbers of samples processed.
+        require_single_support: refuse kinematics without a single-support sample (off for
+            a stretch of a longer log, which is checked as a whole).
 
     Returns:
         :class:`FrictionEstimate`.
@@ -326,10 +334,8 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     n, n_tc = len(kin.time), len(robot.torque_controlled)
     phases: Phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip)
     usable = kin.valid & (phases.n_contacts > 0)
-    if not np.any(usable & phases.single):
-        raise InputError(f"{kin.metadata.get('source', 'the log')}: no single-support sample (exactly one of the "
-                         f"columns {', '.join('contact.' + f for f in robot.contact_frames)} set) with defined "
-                         "derivatives")
+    if require_single_support and not np.any(usable & phases.single):
+        raise no_single_support(robot, kin.metadata.get('source', 'the log'))
     cond = np.full(n, np.nan) if options.condition_number else None
     tc = robot.tc_index
     ss = usable & phases.single
@@ -374,12 +380,12 @@ def companion_scheme(diff: str) -> str:
 
 
 def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOptions(), progress=None,
-                 companion: bool = False) -> FrictionEstimate:
+                 companion: bool = False, require_single_support: bool = True) -> FrictionEstimate:
     """Differentiate a log (:func:`~wbfriction.kinematics.measure`) and estimate its friction.
 
     A log with time gaps (:attr:`~wbfriction.log.Log.segments`) is estimated segment by
     segment, never differentiated or filtered across a gap; a segment too short for the
-    scheme, or without single support, gives NaN, invalid rows.
+    scheme gives NaN, invalid rows.
 
     With ``companion``, the single-support acceleration difference is also computed through
     :func:`companion_scheme` (:attr:`FrictionEstimate.companion_delta_qdd`; one more
@@ -387,29 +393,34 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
 
     Raises:
         InputError: what :func:`~wbfriction.kinematics.measure` and :func:`estimate_friction`
-            raise, for a log of one segment or when no segment can be estimated.
+            raise (no segment can be estimated; with ``require_single_support``, no
+            single-support sample in the whole log).
     """
     parts = log.parts()
     if len(parts) == 1:
-        return _estimate_segment(robot, log, options, progress, companion)
+        return _estimate_segment(robot, log, options, progress, companion, require_single_support)
     done, first_error = [], None
     for part in parts:
         try:
-            done.append(_estimate_segment(robot, part, options, progress, companion))
+            done.append(_estimate_segment(robot, part, options, progress, companion, False))
         except InputError as exc:
             first_error = first_error or exc
             done.append(None)
     if all(d is None for d in done):
         raise first_error
     template = next(d for d in done if d is not None)
-    return concat_estimates([d if d is not None else _blank(template, part) for d, part in zip(done, parts)])
+    est = concat_estimates([d if d is not None else _blank(template, part) for d, part in zip(done, parts)])
+    if require_single_support and not est.unique.any():
+        raise no_single_support(robot, log.source)
+    return est
 
 
-def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress, companion: bool) -> FrictionEstimate:
+def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress, companion: bool,
+                      require_single_support: bool) -> FrictionEstimate:
     kin = measure(log, options.diff, compensate_delay=options.compensate_delay,
                   torque_alignment=options.torque_alignment, filtering=options.filtering)
     kin.metadata.update(robot=robot.name, source=log.source)
-    est = estimate_friction(robot, kin, options, progress)
+    est = estimate_friction(robot, kin, options, progress, require_single_support)
     if companion:
         other = companion_scheme(options.diff)
         kin2 = measure(log, other, compensate_delay=options.compensate_delay,

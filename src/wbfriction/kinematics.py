@@ -189,7 +189,7 @@ def _filtered(log: Log, tau: np.ndarray, smoother: Smoother, filtering: FilterOp
     a row :func:`straddling` a contact change are NaN, except ``q`` (raw there)."""
     blank = straddling(log.contact)[:, None]
     qd_c, qdd_c, _ = central_differences(log.q, log.dt)
-    qd_c = np.where(blank, np.nan, qd_c)
+    qd_c, qdd_c = np.where(blank, np.nan, qd_c), np.where(blank, np.nan, qdd_c)
     if isinstance(smoother, SavgolSmoother):  # derivatives of one local fit (7.1-7.8)
         q_s, qd_s, qdd = savgol_differentiate(np.where(blank, np.nan, log.q), log.dt, filtering.window,
                                               filtering.poly_order, filtering.weights)

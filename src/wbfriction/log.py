@@ -64,6 +64,9 @@ class Log:
         qd_true, qdd_true: true joint velocities [rad/s] and accelerations [rad/s^2]
             (N, n_act) (simulations only, for evaluation), or None.
         segments: row ranges between time gaps (:func:`check_time`); None: one segment.
+        period: the sampling period of the log this one was cut from [s] (its segments, a
+            chunk of a long log), so that every stretch is differentiated with the same one;
+            None: the median step of ``time``.
     """
 
     time: np.ndarray
@@ -77,11 +80,12 @@ class Log:
     qd_true: np.ndarray | None = None
     qdd_true: np.ndarray | None = None
     segments: list[tuple[int, int]] | None = None
+    period: float | None = None
 
     @property
     def dt(self) -> float:
-        """Sampling period [s] (median time step)."""
-        return float(np.median(np.diff(self.time)))
+        """Sampling period [s]: :attr:`period` if set, else the median time step."""
+        return self.period if self.period is not None else float(np.median(np.diff(self.time)))
 
     def parts(self) -> list["Log"]:
         """The log's segments (split at its time gaps, :func:`check_time`) as logs of their own."""
@@ -95,7 +99,7 @@ class Log:
         cut = lambda x: None if x is None else x[start:stop]  # noqa: E731
         return Log(self.time[start:stop], self.q[start:stop], self.tau[start:stop], self.contact[start:stop],
                    cut(self.base), cut(self.tau_f_true), self.metadata, self.source, cut(self.qd_true),
-                   cut(self.qdd_true), None)
+                   cut(self.qdd_true), None, self.dt)
 
     def __len__(self) -> int:
         return len(self.time)
@@ -161,7 +165,7 @@ def read_table(path: str | Path) -> pa.Table:
         raise InputError(f"{path}: cannot be read: {(str(exc).splitlines() or [repr(exc)])[0]}") from exc
 
 
-def _column(table: pa.Table, name: str, source: str) -> np.ndarray:
+def _column(table: pa.Table, name: str, source: str, first_row: int = 0) -> np.ndarray:
     try:
         col = table.column(name)
         values = col.to_numpy(zero_copy_only=False).astype(float)
@@ -169,7 +173,7 @@ def _column(table: pa.Table, name: str, source: str) -> np.ndarray:
         raise InputError(f"{source}: column '{name}' is not numeric") from exc
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
-        raise InputError(f"{source}: column '{name}' has a non-finite value (NaN or inf) at row {bad[0]}")
+        raise InputError(f"{source}: column '{name}' has a non-finite value (NaN or inf) at row {first_row + bad[0]}")
     return values
 
 
@@ -182,7 +186,7 @@ LIMIT_MARGIN = 0.2
 
 
 def check_time(time: np.ndarray, source: str, max_gap: float = MAX_GAP,
-               rel_tol: float = JITTER) -> list[tuple[int, int]]:
+               rel_tol: float = JITTER, first_row: int = 0) -> list[tuple[int, int]]:
     """Check a time column and split it at its gaps.
 
     A step within ``rel_tol`` of the median step ``dt`` is regular; a step of at least
@@ -195,7 +199,7 @@ def check_time(time: np.ndarray, source: str, max_gap: float = MAX_GAP,
 
     Raises:
         InputError: fewer than 5 rows, a duplicated or decreasing stamp, or an irregular
-            step, naming the first row at fault.
+            step, naming the first row at fault (counted from ``first_row``).
     """
     if time.size < 5:
         raise InputError(f"{source}: only {time.size} rows; at least 5 samples are needed")
@@ -204,13 +208,13 @@ def check_time(time: np.ndarray, source: str, max_gap: float = MAX_GAP,
     if bad.size:
         k = bad[0] + 1
         what = "duplicated" if step[bad[0]] == 0 else "decreasing"
-        raise InputError(f"{source}: column 'time' has a {what} stamp at row {k} ({time[k]:.9g} s after "
+        raise InputError(f"{source}: column 'time' has a {what} stamp at row {first_row + k} ({time[k]:.9g} s after "
                          f"{time[k - 1]:.9g} s)")
     dt = np.median(step)
     gap = step >= (max_gap - rel_tol) * dt
     bad = np.flatnonzero(~gap & (np.abs(step - dt) > rel_tol * dt))
     if bad.size:
-        raise InputError(f"{source}: column 'time' is irregular at row {bad[0] + 1} "
+        raise InputError(f"{source}: column 'time' is irregular at row {first_row + bad[0] + 1} "
                          f"(step {step[bad[0]]:.6g} s, median {dt:.6g} s; gaps of {max_gap:g} periods or more "
                          f"split the log)")
     cuts = np.flatnonzero(gap) + 1
@@ -218,7 +222,7 @@ def check_time(time: np.ndarray, source: str, max_gap: float = MAX_GAP,
     return list(zip(edges[:-1], edges[1:]))
 
 
-def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT_MARGIN) -> None:
+def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT_MARGIN, first_row: int = 0) -> None:
     """Refuse positions beyond the URDF limits by more than ``margin`` (degrees logged as
     radians, millimetres as metres); joints without finite limits are not checked.
 
@@ -233,17 +237,20 @@ def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT
         out = np.flatnonzero((q[:, i] < lo - margin) | (q[:, i] > hi + margin))
         if out.size:
             k = out[0]
-            raise InputError(f"{source}: column 'q.{name}' is {q[k, i]:.6g} at row {k}, beyond its URDF limits "
+            raise InputError(f"{source}: column 'q.{name}' is {q[k, i]:.6g} at row {first_row + k}, beyond its URDF limits "
                              f"[{lo:.4g}, {hi:.4g}] by more than {margin:g}: wrong units (degrees for radians)?")
 
 
 def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_gap: float = MAX_GAP,
-                   limit_margin: float = LIMIT_MARGIN) -> Log:
+                   limit_margin: float = LIMIT_MARGIN, first_row: int = 0, period: float | None = None) -> Log:
     """Validate an Arrow table against ``robot`` and map its columns by joint name.
 
     Args:
         max_gap: time steps of at least this many periods split the log (:func:`check_time`).
         limit_margin: tolerance on the URDF joint limits (:func:`check_limits`).
+        first_row: row number of the table's first row in its file (a chunk of a long log),
+            for the messages.
+        period: the sampling period of the whole log, for a chunk of it (:attr:`Log.period`).
 
     Raises:
         InputError: missing ``time``, a missing or unknown joint/frame column, NaN, a
@@ -267,17 +274,17 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
                 + [f"contact.{f}" for f in robot.contact_frames]):
         if col not in names:
             raise InputError(f"{source}: missing column '{col}'")
-    time = _column(table, "time", source)
-    segments = check_time(time, source, max_gap)
-    q = np.column_stack([_column(table, f"q.{n}", source) for n in robot.actuated])
-    check_limits(q, robot, source, limit_margin)
-    tau = np.column_stack([_column(table, f"tau.{n}", source) for n in robot.torque_controlled])
+    time = _column(table, "time", source, first_row)
+    segments = check_time(time, source, max_gap, first_row=first_row)
+    q = np.column_stack([_column(table, f"q.{n}", source, first_row) for n in robot.actuated])
+    check_limits(q, robot, source, limit_margin, first_row)
+    tau = np.column_stack([_column(table, f"tau.{n}", source, first_row) for n in robot.torque_controlled])
     contact_cols = []
     for f in robot.contact_frames:
-        c = _column(table, f"contact.{f}", source)
+        c = _column(table, f"contact.{f}", source, first_row)
         bad = np.flatnonzero((c != 0) & (c != 1))
         if bad.size:
-            raise InputError(f"{source}: column 'contact.{f}' must hold 0 or 1, found {c[bad[0]]:g} at row {bad[0]}")
+            raise InputError(f"{source}: column 'contact.{f}' must hold 0 or 1, found {c[bad[0]]:g} at row {first_row + bad[0]}")
         contact_cols.append(c.astype(bool))
     contact = np.column_stack(contact_cols)
     base = None
@@ -286,16 +293,16 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
         missing = [c for c in BASE_COLUMNS if c not in names]
         if missing:
             raise InputError(f"{source}: base pose is partial: missing column '{missing[0]}'")
-        base = np.column_stack([_column(table, c, source) for c in BASE_COLUMNS])
+        base = np.column_stack([_column(table, c, source, first_row) for c in BASE_COLUMNS])
         norm = np.linalg.norm(base[:, 3:], axis=1)
         bad = np.flatnonzero(np.abs(norm - 1.0) > 1e-3)
         if bad.size:
-            raise InputError(f"{source}: base quaternion is not unit at row {bad[0]} (norm {norm[bad[0]]:.6g})")
+            raise InputError(f"{source}: base quaternion is not unit at row {first_row + bad[0]} (norm {norm[bad[0]]:.6g})")
         base[:, 3:] /= norm[:, None]
     tau_f_true = None
     if any(c.startswith("tau_f_true.") for c in names):
         tau_f_true = np.column_stack([
-            _column(table, f"tau_f_true.{n}", source) if f"tau_f_true.{n}" in names else np.full(len(time), np.nan)
+            _column(table, f"tau_f_true.{n}", source, first_row) if f"tau_f_true.{n}" in names else np.full(len(time), np.nan)
             for n in robot.torque_controlled])
     truth = {}
     for prefix in ("qd_true", "qdd_true"):
@@ -303,9 +310,9 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
             missing = [n for n in robot.actuated if f"{prefix}.{n}" not in names]
             if missing:
                 raise InputError(f"{source}: missing column '{prefix}.{missing[0]}'")
-            truth[prefix] = np.column_stack([_column(table, f"{prefix}.{n}", source) for n in robot.actuated])
+            truth[prefix] = np.column_stack([_column(table, f"{prefix}.{n}", source, first_row) for n in robot.actuated])
     return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
-               qd_true=truth.get("qd_true"), qdd_true=truth.get("qdd_true"), segments=segments)
+               qd_true=truth.get("qd_true"), qdd_true=truth.get("qdd_true"), segments=segments, period=period)
 
 
 def read_log(path: str | Path, robot: Robot, bag_map=None, max_gap: float = MAX_GAP,

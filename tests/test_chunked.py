@@ -1,0 +1,82 @@
+"""Long logs in chunks: the same numbers as the whole-log estimate, rows named as in the file,
+outputs whole or not at all, and the same bytes on a re-run."""
+
+from __future__ import annotations
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from wbfriction.chunked import CONTEXT, Chunking, RobotSpec, estimate_file, plan_chunks
+from wbfriction.estimate import EstimateOptions, estimate_from_table, estimate_log
+from wbfriction.exceptions import InputError
+from wbfriction.kinematics import FilterOptions
+from wbfriction.log import read_log, read_table, write_log, write_table
+
+
+@settings(max_examples=60, deadline=None)
+@given(flags=st.lists(st.sampled_from([(1, 0), (1, 1), (0, 1)]), min_size=1, max_size=400),
+       runs=st.integers(1, 30), rows=st.integers(5, 200))
+def test_chunks_cover_the_log_and_cut_at_contact_changes(flags, runs, rows):
+    contact = np.repeat(np.array(flags, dtype=bool), runs, axis=0)
+    chunking = Chunking(rows=rows, overlap=7)
+    chunks = plan_chunks(contact, chunking)
+    assert chunks[0].start == 0 and chunks[-1].stop == len(contact)
+    n = len(contact)
+    for a, b in zip(chunks[:-1], chunks[1:]):
+        assert a.stop == b.start
+        changed = bool(np.any(contact[b.start] != contact[b.start - 1]))
+        context = CONTEXT if changed else 7
+        assert b.read_start == max(0, b.start - context) and a.read_stop == min(n, b.start + context)
+        if not changed:  # a forced cut only where no contact change comes within twice the length
+            window = contact[a.start:a.start + 2 * rows + 1]
+            assert not np.any(np.any(window[1:] != window[:-1], axis=1)[rows - 1:])
+    for c in chunks:
+        assert c.read_start <= c.start < c.stop <= c.read_stop
+
+
+@pytest.fixture(scope="module")
+def walk_file(talos, combined_walk, tmp_path_factory):
+    path = tmp_path_factory.mktemp("chunked") / "walk.parquet"
+    write_log(combined_walk.log, talos, path)
+    return path
+
+
+@pytest.mark.parametrize("diff,workers", [("central", 1), ("savgol", 2), ("butterworth", 1)])
+def test_chunked_estimate_equals_the_whole_log_estimate(talos, walk_file, tmp_path, diff, workers):
+    opts = EstimateOptions(diff=diff, filtering=FilterOptions(cutoff=20.0))
+    result = estimate_file(RobotSpec("talos"), walk_file, tmp_path / "f.parquet", opts,
+                           chunking=Chunking(rows=1500, workers=workers))
+    assert result.chunks > 5 and result.forced_cuts == 0
+    chunked = estimate_from_table(read_table(tmp_path / "f.parquet"))
+    whole = estimate_log(talos, read_log(walk_file, talos), opts, companion=True)
+    for name in ("tau_f", "qd", "qdd", "delta_qdd", "companion_delta_qdd"):
+        a, b = getattr(chunked, name), getattr(whole, name)
+        np.testing.assert_array_equal(np.isnan(a), np.isnan(b), err_msg=name)
+        assert np.nanmax(np.abs(a - b)) <= 1e-9, name
+    np.testing.assert_array_equal(chunked.valid, whole.valid)
+    np.testing.assert_array_equal(chunked.phase, whole.phase)
+
+
+def test_rows_are_named_as_in_the_file_and_nothing_is_written(talos, combined_walk, walk_file, tmp_path):
+    out = tmp_path / "f.parquet"
+    out.write_bytes(b"previous result")
+    table = pq.read_table(walk_file)
+    col = table.column_names.index("q.leg_left_4_joint")
+    values = table.column(col).to_numpy().copy()
+    values[9000] = np.nan  # in a late chunk: earlier chunks are estimated before it is read
+    bad = tmp_path / "bad.parquet"
+    write_table(table.set_column(col, "q.leg_left_4_joint", pa.array(values)), bad)
+    with pytest.raises(InputError, match="column 'q.leg_left_4_joint' has a non-finite value .* at row 9000"):
+        estimate_file(RobotSpec("talos"), bad, out, chunking=Chunking(rows=1500, workers=1))
+    assert out.read_bytes() == b"previous result"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.parquet", "f.parquet"]
+
+
+def test_same_input_same_bytes(walk_file, tmp_path):
+    for name in ("a.parquet", "b.parquet"):
+        estimate_file(RobotSpec("talos"), walk_file, tmp_path / name, chunking=Chunking(rows=4000, workers=1))
+    assert (tmp_path / "a.parquet").read_bytes() == (tmp_path / "b.parquet").read_bytes()
