@@ -80,3 +80,26 @@ def test_same_input_same_bytes(walk_file, tmp_path):
     for name in ("a.parquet", "b.parquet"):
         estimate_file(RobotSpec("talos"), walk_file, tmp_path / name, chunking=Chunking(rows=4000, workers=1))
     assert (tmp_path / "a.parquet").read_bytes() == (tmp_path / "b.parquet").read_bytes()
+
+
+def test_a_run_stopped_midway_leaves_the_previous_output(walk_file, tmp_path):
+    """SIGTERM while chunks are being written: the previous result stays, no partial file is left."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "f.parquet"
+    out.write_bytes(b"previous result")
+    proc = subprocess.Popen([sys.executable, "-m", "wbfriction", "estimate", str(walk_file), "-o", str(out),
+                             "--chunk-rows", "300", "--workers", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 120
+    while not list(tmp_path.glob(".f.parquet.*.tmp")) and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert proc.poll() is None, "finished before it could be stopped"
+    time.sleep(0.5)  # a few chunks written
+    os.kill(proc.pid, signal.SIGTERM)
+    assert proc.wait(60) == 128 + signal.SIGTERM
+    assert out.read_bytes() == b"previous result"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.parquet"]

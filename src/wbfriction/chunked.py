@@ -53,7 +53,7 @@ class Chunking:
         workers: processes estimating chunks (1: in this process).
     """
 
-    rows: int = 50_000
+    rows: int = 10_000
     overlap: int = 2_000
     workers: int = 2
 
@@ -110,9 +110,10 @@ class _RowReader:
         suffix = path.suffix.lower()
         try:
             if suffix in (".parquet", ".pq"):
-                self._file = pq.ParquetFile(path)
+                # without pre-buffering: pyarrow would otherwise keep whole column chunks read ahead
+                self._file = pq.ParquetFile(path, pre_buffer=False)
                 self.metadata = self._file.schema_arrow.metadata
-                self._batches = self._file.iter_batches(batch_size=batch_rows)
+                self._batches = self._file.iter_batches(batch_size=batch_rows, use_threads=False)
             elif suffix == ".csv":
                 self._file = pacsv.open_csv(path, read_options=pacsv.ReadOptions(block_size=1 << 24))
                 self.metadata = None
@@ -149,13 +150,18 @@ def _plan_columns(path: Path, robot: Robot) -> tuple[np.ndarray, float]:
     """The contact columns (N, n_contacts), to plan the chunks, and the sampling period of
     the whole log (the median time step) [s], read alone."""
     columns = ["time"] + [f"contact.{f}" for f in robot.contact_frames]
-    if path.suffix.lower() in (".parquet", ".pq"):
-        try:
+    suffix = path.suffix.lower()
+    try:
+        if suffix in (".parquet", ".pq"):
             table = pq.read_table(path, columns=[c for c in columns if c in pq.ParquetFile(path).schema_arrow.names])
-        except (pa.ArrowException, OSError, ValueError) as exc:
-            raise InputError(f"{path}: cannot be read: {(str(exc).splitlines() or [repr(exc)])[0]}") from exc
-    else:
-        table = read_table(path)
+        elif suffix == ".csv":
+            names = pacsv.open_csv(path).schema.names
+            table = pacsv.read_csv(path, convert_options=pacsv.ConvertOptions(
+                include_columns=[c for c in columns if c in names]))
+        else:
+            table = read_table(path)
+    except (pa.ArrowException, OSError, ValueError) as exc:
+        raise InputError(f"{path}: cannot be read: {(str(exc).splitlines() or [repr(exc)])[0]}") from exc
     for c in columns:
         if c not in table.column_names:
             raise InputError(f"{path}: missing column '{c}'")
@@ -241,7 +247,7 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
             pending: deque = deque()
             for c in chunks:
                 pending.append(pool.submit(_in_worker, args(c)))
-                if len(pending) > 2 * chunking.workers:  # bounded read-ahead: bounded memory
+                if len(pending) > chunking.workers:  # bounded read-ahead: bounded memory
                     yield pending.popleft().result()
             while pending:
                 yield pending.popleft().result()

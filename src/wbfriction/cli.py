@@ -10,6 +10,7 @@ with status 2.
 from __future__ import annotations
 
 import json
+import signal
 import sys
 import time
 from contextlib import contextmanager
@@ -163,16 +164,27 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
                       f"({p.samples} samples, down to {p.min_force:.1f} N)", highlight=False)
 
 
-def _run_estimate(spec, log: Path, output: Path, opts: EstimateOptions, bag_map: Optional[Path] = None,
+def _row_count(path: Path) -> int:
+    """Rows of a Parquet log from its footer (0 when not known cheaply: no progress bar)."""
+    import pyarrow.parquet as pq
+
+    try:
+        return pq.ParquetFile(path).metadata.num_rows if path.suffix.lower() in (".parquet", ".pq") else 0
+    except Exception:  # an unreadable file is reported by the estimate itself
+        return 0
+
+
+def _run_estimate(r: Robot, spec, log: Path, output: Path, opts: EstimateOptions, bag_map: Optional[Path] = None,
                   max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN, workers: int = 2,
-                  chunk_rows: int = 50_000) -> None:
+                  chunk_rows: int = 10_000) -> None:
+    """Estimate a log file in chunks on ``workers`` processes (which load the robot from
+    ``spec``), or a ROS 2 bag whole; write the friction table with its provenance."""
     from .bags import is_bag
     from .chunked import Chunking, estimate_file
 
-    provenance = {"provenance": {"log": str(log), "log_sha256": file_sha256(log), "robot": spec.name or "custom",
-                                 "urdf": str(spec.urdf or spec.load().urdf), "wbfriction": __version__}}
+    provenance = {"provenance": {"log": str(log), "log_sha256": file_sha256(log), "robot": r.name,
+                                 "urdf": str(r.urdf), "wbfriction": __version__}}
     if is_bag(log):  # read whole: the bag's topics are aligned over the whole recording
-        r = spec.load()
         data = _read_log(log, r, bag_map, max_gap, limit_margin)
         with _progress(len(data), "estimate") as advance:
             est = estimate_log(r, data, opts, progress=advance, companion=True)
@@ -180,9 +192,10 @@ def _run_estimate(spec, log: Path, output: Path, opts: EstimateOptions, bag_map:
         write_table(est.to_table(), output)
         rows = len(est.time)
     else:
-        with _progress(0, "estimate") as _:
+        with _progress(_row_count(log), "estimate") as advance:
             result = estimate_file(spec, log, output, opts, chunking=Chunking(rows=chunk_rows, workers=workers),
-                                   max_gap=max_gap, limit_margin=limit_margin, extra_metadata=provenance)
+                                   max_gap=max_gap, limit_margin=limit_margin, extra_metadata=provenance,
+                                   progress=advance)
         rows = result.rows
     console.print(f"wrote {output}: {rows} samples")
 
@@ -252,7 +265,7 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              bag_map: Optional[Path] = MapOpt, max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt,
              workers: int = typer.Option(2, help="Processes estimating chunks of a long log."),
-             chunk_rows: int = typer.Option(50_000, help="Rows per chunk (cut at the next contact change)."),
+             chunk_rows: int = typer.Option(10_000, help="Rows per chunk (cut at the next contact change)."),
              diff: str = typer.Option(_E.diff, help="Differentiation: central (6.2), backward (6.3), savgol "
                                                     "(Savitzky-Golay, 7.1.1), butterworth (7.1.2) or true."),
              window: int = typer.Option(_F.window, help="savgol: window length L (odd) [samples]."),
@@ -283,8 +296,8 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
 
     spec = RobotSpec(None if urdf else robot, None if urdf is None else str(urdf),
                      None if config is None else str(config))
-    _robot(robot, urdf, config)  # a bad robot is refused before the log is read
-    _run_estimate(spec, log, output, opts, bag_map, max_gap, limit_margin, workers, chunk_rows)
+    _run_estimate(_robot(robot, urdf, config), spec, log, output, opts, bag_map, max_gap, limit_margin, workers,
+                  chunk_rows)
 
 
 @app.command()
@@ -523,7 +536,9 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
 
 
 def main() -> None:
-    """Entry point: run the app, turning wbfriction errors into one line and exit status 2."""
+    """Entry point: run the app, turning wbfriction errors into one line and exit status 2.
+    SIGTERM ends it like Ctrl-C: a partly written output is removed, the previous one kept."""
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     try:
         app(standalone_mode=False)
     except WbfrictionError as exc:

@@ -346,11 +346,14 @@ def file_sha256(path: str | Path) -> str:
     """SHA-256 of a file's bytes (hex), for provenance records; of a folder (a ROS 2 bag),
     over its files' relative names and bytes in name order."""
     path = Path(path)
-    if not path.is_dir():
-        return hashlib.sha256(path.read_bytes()).hexdigest()
     digest = hashlib.sha256()
-    for f in sorted(p for p in path.rglob("*") if p.is_file()):
-        digest.update(str(f.relative_to(path)).encode() + b"\0" + f.read_bytes())
+    files = [path] if not path.is_dir() else sorted(p for p in path.rglob("*") if p.is_file())
+    for f in files:
+        if f != path:
+            digest.update(str(f.relative_to(path)).encode() + b"\0")
+        with open(f, "rb") as handle:  # in blocks: a log of an hour is gigabytes
+            for block in iter(lambda: handle.read(1 << 20), b""):
+                digest.update(block)
     return digest.hexdigest()
 
 
