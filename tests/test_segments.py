@@ -40,17 +40,20 @@ def test_gapped_log_is_its_segments_estimated_apart(talos, combined_walk, diff):
 
 
 def test_a_segment_that_cannot_be_estimated_is_left_blank(talos, combined_walk):
-    """A 30-sample segment in double support has no single-support sample: its rows are NaN and
-    invalid; the rest is estimated. A log of such segments only is refused."""
+    """A 30-sample segment is too short for a 151-sample Savitzky-Golay window: its rows are NaN
+    and invalid, the rest is estimated. Through central differences the same segment (double
+    support) is estimated, not unique, never valid. A log of double support only is refused."""
     log = combined_walk.log
     ds = int(np.flatnonzero(log.contact.all(axis=1))[0])  # double support at the start
     table = log.to_table(talos)
     rows = np.r_[np.arange(ds, ds + 30), np.arange(3000, 6000)]
     gapped = log_from_table(table.take(pa.array(rows)), talos, "gapped")
     assert gapped.segments == [(0, 30), (30, 3030)]
-    est = estimate_log(talos, gapped, EstimateOptions())
+    est = estimate_log(talos, gapped, EstimateOptions(diff="savgol"))
     assert np.isnan(est.tau_f[:30]).all() and not est.valid[:30].any()
     assert est.valid[30:].any()
+    central = estimate_log(talos, gapped, EstimateOptions())
+    assert np.isfinite(central.tau_f[1:29]).all() and not central.unique[:30].any() and not central.valid[:30].any()
     only = log_from_table(table.take(pa.array(np.r_[np.arange(ds, ds + 30), np.arange(ds + 100, ds + 130)])),
                           talos, "gapped")
     with pytest.raises(InputError, match="gapped: no single-support sample"):
