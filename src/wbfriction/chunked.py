@@ -181,8 +181,7 @@ def _init_worker(spec: RobotSpec) -> None:
 
 def _estimate_chunk(robot: Robot, table: pa.Table, chunk: Chunk, source: str, options: EstimateOptions,
                     companion: bool, max_gap: float, limit_margin: float, period: float) -> pa.Table:
-    log = log_from_table(table, robot, source, max_gap, limit_margin, first_row=chunk.read_start,
-                         period=period if len(table) != 0 else None)
+    log = log_from_table(table, robot, source, max_gap, limit_margin, first_row=chunk.read_start, period=period)
     est = estimate_log(robot, log, options, companion=companion, require_single_support=False)
     return est.to_table().slice(chunk.start - chunk.read_start, chunk.stop - chunk.start)
 
@@ -204,7 +203,7 @@ class ChunkedResult:
 def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options: EstimateOptions = EstimateOptions(),
                   *, chunking: Chunking = Chunking(), companion: bool = True, max_gap: float = MAX_GAP,
                   limit_margin: float = LIMIT_MARGIN, extra_metadata: dict | None = None,
-                  progress=None) -> ChunkedResult:
+                  progress=None, robot: Robot | None = None) -> ChunkedResult:
     """Estimate a log file chunk by chunk into ``output`` (Parquet or CSV), whole or not at all.
 
     Args:
@@ -216,6 +215,7 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
         max_gap, limit_margin: as :func:`~wbfriction.log.log_from_table`.
         extra_metadata: merged into the table's metadata (provenance).
         progress: optional callable receiving numbers of rows done.
+        robot: ``spec`` already loaded in this process, if the caller has it.
 
     Raises:
         InputError: what reading, validating and estimating raise, naming the file and row;
@@ -224,7 +224,7 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     path, output = Path(path), Path(output)
     if output.suffix.lower() not in (".parquet", ".pq", ".csv"):
         raise InputError(f"{output}: friction tables are written as .parquet or .csv")
-    robot = spec.load()
+    robot = robot if robot is not None else spec.load()
     contact, period = _plan_columns(path, robot)
     n = len(contact)
     chunks = plan_chunks(contact, chunking)
@@ -233,6 +233,9 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     source = str(path)
     meta_bytes = reader.metadata or {}
     first_meta: dict = {}
+
+    def with_meta(table: pa.Table) -> pa.Table:
+        return table.replace_schema_metadata(meta_bytes) if meta_bytes else table
 
     def tables():
         args = lambda c: (with_meta(reader.rows(c.read_start, c.read_stop)), c, source, options, companion,  # noqa: E731
@@ -251,9 +254,6 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
                     yield pending.popleft().result()
             while pending:
                 yield pending.popleft().result()
-
-    def with_meta(table: pa.Table) -> pa.Table:
-        return table.replace_schema_metadata(meta_bytes) if meta_bytes else table
 
     def write(tmp: Path) -> None:
         writer, single = None, False

@@ -25,12 +25,12 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from . import __version__
-from .energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, energy_consistency, generating_share
+from .energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, energy_consistency
 from .estimate import EstimateOptions, estimate_from_table, estimate_log
 from .exceptions import InputError, WbfrictionError
 from .friction import PARAM_NAMES, load_friction_toml
 from .sim.sensors import load_sensors_toml
-from .identify import FitResult, fit_estimate, fit_table_estimate
+from .identify import FitResult, fit_table_estimate, fitted_offsets
 from .kinematics import FilterOptions
 from .log import LIMIT_MARGIN, MAX_GAP, file_sha256, read_log, read_table, write_atomic, write_log, write_table
 from .robot import Robot, load_robot
@@ -195,7 +195,7 @@ def _run_estimate(r: Robot, spec, log: Path, output: Path, opts: EstimateOptions
         with _progress(_row_count(log), "estimate") as advance:
             result = estimate_file(spec, log, output, opts, chunking=Chunking(rows=chunk_rows, workers=workers),
                                    max_gap=max_gap, limit_margin=limit_margin, extra_metadata=provenance,
-                                   progress=advance)
+                                   progress=advance, robot=r)
         rows = result.rows
     console.print(f"wrote {output}: {rows} samples")
 
@@ -203,8 +203,7 @@ def _run_estimate(r: Robot, spec, log: Path, output: Path, opts: EstimateOptions
 def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, tolerance: float) -> None:
     est = estimate_from_table(read_table(friction), str(friction))
     results = fit_table_estimate(est, min_samples=min_samples)
-    tau_os = {r.joint: r.params.tau_os for r in results if r.params is not None}
-    energy = energy_consistency(est, tau_os, threshold, tolerance)
+    energy = energy_consistency(est, fitted_offsets(results), threshold, tolerance)
     _write_params(results, output, {"friction": str(friction), "friction_sha256": file_sha256(friction),
                                     "wbfriction": __version__}, {e.joint: e for e in energy})
     out.print(_fit_rows(results))
@@ -367,11 +366,8 @@ def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in 
     with console.status("") as status:
         sens = inertia_sensitivity(r, kin, values, part, opts, progress=lambda label: status.update(label))
     names = _joint_list(r, joints)
-    ref = sens.reference
-    idx = [ref.joints.index(j) for j in names]
     with console.status("fitting the offsets of the model as given"):
-        fits = fit_estimate(names, ref.qd[:, idx], ref.tau_f[:, idx], ref.valid[:, idx])
-    tau_os = {f.joint: f.params.tau_os if f.params is not None else 0.0 for f in fits}
+        tau_os = sens.reference_offsets(names)
     table = Table(title=f"Change of the friction estimate with {part} inertia scaled, against the model as given",
                   caption="shift: mean change over the valid samples; split: mean change on rising minus falling "
                           "velocity; gen: share of valid samples generating power (eq. 7.9), the offset tau_os "
@@ -382,9 +378,8 @@ def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in 
         table.add_column(f"x{f:g} shift [N·m]", justify="right")
         table.add_column("split", justify="right")
         table.add_column("gen [%]", justify="right")
-    for j, i in zip(names, idx):
-        m = ref.valid[:, i]
-        base = generating_share(ref.qd[m, i], ref.tau_f[m, i], tau_os[j])
+    for j in names:
+        base = sens.reference_share(j, tau_os[j])
         cells = [c for js in sens.joint(j, tau_os[j]) for c in (f"{js.shift:+.3f}", f"{js.split:+.3f}",
                                                                  f"{100 * js.generating_share:.1f}")]
         table.add_row(j, f"{100 * base:.1f}", *cells)

@@ -451,11 +451,10 @@ def concat_estimates(parts: list[FrictionEstimate]) -> FrictionEstimate:
     out = {}
     for f in fields(FrictionEstimate):
         values = [getattr(p, f.name) for p in parts]
-        if isinstance(values[0], np.ndarray) or (values[0] is None and any(isinstance(v, np.ndarray) for v in values)):
-            if any(v is None for v in values):
-                values = [np.full((len(p.time), *np.shape(next(v for v in values if v is not None))[1:]), np.nan)
-                          if v is None else v for v, p in zip(values, parts)]
-            out[f.name] = np.concatenate(values)
+        arrays = [v for v in values if isinstance(v, np.ndarray)]
+        if arrays:  # a part without the array (e.g. no companion) gets NaN rows
+            out[f.name] = np.concatenate([v if v is not None else np.full((len(p.time), *arrays[0].shape[1:]), np.nan)
+                                          for v, p in zip(values, parts)])
         else:
             out[f.name] = getattr(first, f.name)
     return FrictionEstimate(**out)

@@ -120,6 +120,12 @@ class FitResult:
         return res
 
 
+def fitted_offsets(fits) -> dict[str, float]:
+    """The identified torque offset ``tau_os`` [N·m] of every fitted joint, by name (joints
+    without parameters left out): what :func:`~wbfriction.energy.energy_consistency` removes."""
+    return {f.joint: f.params.tau_os for f in fits if f.params is not None}
+
+
 def _model(x: np.ndarray, qd: np.ndarray, delta_s: float) -> np.ndarray:
     return smooth(qd, x[0], x[1], x[2], x[3], x[4], x[5], delta_s)
 

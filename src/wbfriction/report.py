@@ -33,7 +33,7 @@ from .estimate import FrictionEstimate, estimate_from_table
 from .exceptions import InputError
 from .filters import amplitude_spectrum, finite_runs, suggest_cutoff
 from .friction import PARAM_NAMES
-from .identify import FitResult, fit_table_estimate
+from .identify import FitResult, fit_table_estimate, fitted_offsets
 from .log import file_sha256, read_table, write_atomic
 from .plots import friction_overview_figure, joint_figure, png_bytes
 
@@ -122,8 +122,7 @@ def make_report(friction: str | Path, params: str | Path | None = None,
         fits = load_params(params)
     else:
         fits = {f.joint: f for f in fit_table_estimate(est)}
-    tau_os = {j: f.params.tau_os for j, f in fits.items() if f.params is not None}
-    energy = {e.joint: e for e in energy_consistency(est, tau_os, threshold, tolerance)}
+    energy = {e.joint: e for e in energy_consistency(est, fitted_offsets(fits.values()), threshold, tolerance)}
     meta = est.metadata
     prov: list[tuple[str, str]] = [("friction table", f"{friction} (sha256 {file_sha256(friction)})")]
     if params is not None:

@@ -122,6 +122,25 @@ class Sensitivity:
     def reference(self) -> FrictionEstimate:
         return self.estimates[0]
 
+    def reference_offsets(self, joints: list[str]) -> dict[str, float]:
+        """The torque offset ``tau_os`` of model (3.5) fitted to the reference estimate of each
+        joint [N·m] (0 where too few samples): the offset to remove before the power check
+        of every factor (:meth:`joint`)."""
+        from .identify import fit_estimate, fitted_offsets
+
+        ref = self.reference
+        idx = [ref.joints.index(j) for j in joints]
+        fits = fit_estimate(joints, ref.qd[:, idx], ref.tau_f[:, idx], ref.valid[:, idx])
+        return {j: 0.0 for j in joints} | fitted_offsets(fits)
+
+    def reference_share(self, joint: str, tau_os: float = 0.0) -> float:
+        """Share of the reference estimate's valid samples of ``joint`` that generate power."""
+        from .energy import generating_share
+
+        ref = self.reference
+        i = ref.joints.index(joint)
+        return generating_share(ref.qd[ref.valid[:, i], i], ref.tau_f[ref.valid[:, i], i], tau_os)
+
     def joint(self, joint: str, tau_os: float = 0.0) -> list[JointSensitivity]:
         """:class:`JointSensitivity` of ``joint`` for every factor but the reference; ``tau_os``:
         the torque offset [N·m] removed before the power check (e.g. the one identified on the

@@ -22,7 +22,7 @@ import numpy as np
 from .energy import energy_consistency
 from .estimate import EstimateOptions, estimate_log
 from .friction import PARAM_NAMES, THESIS_TARGETS, FrictionParams
-from .identify import FitResult, fit_estimate
+from .identify import FitResult, fit_estimate, fitted_offsets
 from .log import write_atomic, write_log, write_table
 from .plots import derivative_schemes_figure, friction_curves_figure, support_phases_figure
 from .report import make_report, write_report
@@ -157,7 +157,7 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
     files += [output_dir / n for n in ("walk_log.parquet", "walk_friction.parquet", "walk_params.json",
                                        "friction_curves.png", "report.html")]
     pulls = sum(p.samples for p in knee_sim.pulls() + walk.pulls())
-    energy = energy_consistency(est, {f.joint: f.params.tau_os for f in fits if f.params is not None})
+    energy = energy_consistency(est, fitted_offsets(fits))
     legs_only = {j for j, _, _ in legs}
     share = {e.joint: e.generating_share for e in energy if e.joint in legs_only}
     return StudyResult(rows, truth_err, knee_rms, pulls, files, share)
