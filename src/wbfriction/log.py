@@ -346,6 +346,8 @@ def file_sha256(path: str | Path) -> str:
     """SHA-256 of a file's bytes (hex), for provenance records; of a folder (a ROS 2 bag),
     over its files' relative names and bytes in name order."""
     path = Path(path)
+    if not path.exists():
+        raise InputError(f"{path}: file not found")
     digest = hashlib.sha256()
     files = [path] if not path.is_dir() else sorted(p for p in path.rglob("*") if p.is_file())
     for f in files:
