@@ -7,6 +7,7 @@ exception is a failure. The budget is hypothesis's example count (a few seconds 
 
 from __future__ import annotations
 
+import json
 import shutil
 
 import numpy as np
@@ -14,14 +15,18 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from wbfriction.energy import energy_consistency
+from wbfriction.estimate import EstimateOptions, estimate_from_table, estimate_log
 from wbfriction.exceptions import InputError
-from wbfriction.log import Log, read_log, write_log
+from wbfriction.identify import fit_table_estimate, fitted_offsets
+from wbfriction.kinematics import FilterOptions
+from wbfriction.log import Log, read_log, read_table, with_metadata, write_log, write_table
 
 from test_bags import bag_map, write_bag
 
 BUDGET = settings(max_examples=150, deadline=None, derandomize=True,
                   suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
-
+FIT_BUDGET = settings(BUDGET, max_examples=50)  # each example fits two joints
 
 @pytest.fixture(scope="module")
 def seeds(talos, tmp_path_factory):
@@ -38,7 +43,45 @@ def seeds(talos, tmp_path_factory):
     for name in ("log.parquet", "log.csv", "log.h5"):
         write_log(log, talos, out / name)
     write_bag(out / "bag", log, talos, "mcap", odom_every=1)
+    _friction_seed(talos, out)
     return out
+
+
+FITTED = ("leg_left_4_joint", "leg_right_3_joint")
+
+
+def _friction_seed(talos, out) -> None:
+    """A friction table as ``estimate`` writes it (two joints kept, Savitzky-Golay options and
+    true-friction targets in its metadata), in every format ``fit`` and ``report`` read."""
+    n = 80
+    t = np.arange(n) * 1e-3
+    contact = np.zeros((n, 2), dtype=bool)
+    contact[: n // 2, 0] = True
+    contact[n // 2:, 1] = True
+    q = np.mean(talos.angle_limits, axis=0) + 0.1 * np.sin(2 * np.pi * 3 * t)[:, None]
+    log = Log(time=t, q=q, tau=np.random.default_rng(1).normal(0, 1, (n, len(talos.torque_controlled))),
+              contact=contact)
+    options = EstimateOptions(diff="savgol", mask="single", lift_off_skip=0.0, touch_down_skip=0.0,
+                              filtering=FilterOptions(window=11, poly_order=3))
+    table = estimate_log(talos, log, options, companion=True).to_table()
+    per_joint = ("qd.", "tau_f.", "valid.", "qdd.", "delta_qdd.", "delta_qdd_companion.")
+    table = table.select([c for c in table.column_names
+                          if not c.startswith(per_joint) or c.endswith(FITTED)])
+    meta = json.loads(table.schema.metadata[b"wbfriction"])
+    meta["friction_true"] = {FITTED[0]: {"F_v": 0.2, "F_c": 1.0}}
+    table = with_metadata(table, meta)
+    for name in ("friction.parquet", "friction.csv", "friction.h5"):
+        write_table(table, out / name)
+
+
+def _fit_or_refuse(path) -> None:
+    """What ``fit`` and ``report`` do with a friction table before plotting."""
+    try:
+        est = estimate_from_table(read_table(path), str(path))
+        fits = fit_table_estimate(est, min_samples=5)
+        energy_consistency(est, fitted_offsets(fits))
+    except InputError:
+        pass
 
 
 damage = st.lists(st.tuples(st.sampled_from(["flip", "cut", "insert", "zero"]), st.floats(0, 1),
@@ -110,5 +153,57 @@ def test_damaged_bags_are_read_or_refused(talos, seeds, tmp_path, part):
         for n, data in files.items():
             (bag / n).write_bytes(_damaged(data, edits) if n == target else data)
         _read_or_refuse(bag, talos, bag_map=bag_map(talos))
+
+    check()
+
+
+def test_the_friction_seed_is_fitted(seeds):
+    """The control: the undamaged friction tables are read and both joints fitted."""
+    for name in ("friction.parquet", "friction.csv", "friction.h5"):
+        est = estimate_from_table(read_table(seeds / name), name)
+        assert est.joints == FITTED and est.valid.sum() > 40
+        fits = fit_table_estimate(est, min_samples=5)
+        assert all(f.params is not None for f in fits)
+        if name != "friction.csv":  # CSV has no place for the metadata (filter options, targets)
+            assert est.smoother is not None and fits[0].target.F_c == 1.0
+
+
+@pytest.mark.parametrize("name", ["friction.parquet", "friction.csv", "friction.h5"])
+def test_damaged_friction_tables_are_read_or_refused(seeds, tmp_path, name):
+    original = (seeds / name).read_bytes()
+
+    @FIT_BUDGET
+    @given(edits=damage)
+    def check(edits):
+        path = tmp_path / name
+        path.write_bytes(_damaged(original, edits))
+        _fit_or_refuse(path)
+
+    check()
+
+
+json_values = st.recursive(st.none() | st.booleans() | st.integers(-10**6, 10**6) | st.floats() | st.text(max_size=8),
+                           lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=8), inner,
+                                                                                      max_size=3), max_leaves=8)
+
+
+@pytest.mark.parametrize("key", ["estimate_options", "friction_true", "companion_diff"])
+def test_friction_tables_with_odd_metadata_are_read_or_refused(seeds, tmp_path, key):
+    """The metadata ``fit`` and ``report`` use (the filter to rebuild, the targets) replaced
+    by random JSON, or with one of its entries replaced."""
+    table = read_table(seeds / "friction.parquet")
+    meta = json.loads(table.schema.metadata[b"wbfriction"])
+
+    @FIT_BUDGET
+    @given(value=json_values, inner=st.booleans())
+    def check(value, inner):
+        doc = json.loads(json.dumps(meta))
+        if inner and isinstance(doc.get(key), dict) and doc[key]:
+            doc[key][sorted(doc[key])[0]] = value
+        else:
+            doc[key] = value
+        path = tmp_path / "friction.parquet"
+        write_table(with_metadata(table, doc), path)
+        _fit_or_refuse(path)
 
     check()

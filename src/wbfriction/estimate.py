@@ -28,8 +28,9 @@ import pyarrow as pa
 
 from .dynamics import constrained_dynamics
 from .exceptions import InputError
-from .kinematics import FILTERING_SCHEMES, FilterOptions, MeasuredKinematics, Smoother, make_smoother, measure
-from .log import Log, read_metadata, with_metadata
+from .friction import FrictionParams
+from .kinematics import FILTERING_SCHEMES, SCHEMES, FilterOptions, MeasuredKinematics, Smoother, make_smoother, measure
+from .log import Log, numeric_column, read_metadata, with_metadata
 from .phases import Phases, joint_mask, segment
 from .robot import Robot
 from .stance import StanceModel, stance_model
@@ -154,17 +155,54 @@ class FrictionEstimate:
         return with_metadata(pa.table(cols), metadata)
 
 
-def _optional_columns(table: pa.Table, prefix: str, joints) -> np.ndarray | None:
+def _optional_columns(table: pa.Table, prefix: str, joints, source: str) -> np.ndarray | None:
     """(N, n) of ``<prefix>.<joint>`` columns, NaN for a missing one; None if all are missing."""
     names = set(table.column_names)
     if not any(f"{prefix}.{j}" in names for j in joints):
         return None
-    return np.column_stack([_float_column(table, f"{prefix}.{j}") if f"{prefix}.{j}" in names
+    return np.column_stack([_float_column(table, f"{prefix}.{j}", source) if f"{prefix}.{j}" in names
                             else np.full(table.num_rows, np.nan) for j in joints])
 
 
-def _float_column(table: pa.Table, name: str) -> np.ndarray:
-    return table.column(name).to_numpy(zero_copy_only=False).astype(float)
+def _float_column(table: pa.Table, name: str, source: str) -> np.ndarray:
+    """A column that may hold NaN (what could not be estimated)."""
+    return numeric_column(table, name, source, finite=False)
+
+
+def _table_smoother(meta: dict, time: np.ndarray, source: str) -> Smoother | None:
+    """The estimate's filter, rebuilt from the ``estimate_options`` metadata (None without one)."""
+    opts = meta.get("estimate_options")
+    if opts is None or len(time) < 2:
+        return None
+    bad = InputError(f"{source}: the metadata's estimate_options are not those of 'wbfriction estimate'")
+    if not isinstance(opts, dict) or not isinstance(opts.get("filtering", {}), dict):
+        raise bad
+    diff = opts.get("diff", "central")
+    if diff not in (*SCHEMES, "true"):
+        raise InputError(f"{source}: the metadata's estimate_options name an unknown scheme {diff!r}")
+    try:
+        filtering = FilterOptions(**opts.get("filtering", {}))
+    except TypeError:
+        raise bad from None
+    for f in fields(filtering):
+        value, default = getattr(filtering, f.name), getattr(FilterOptions(), f.name)
+        if type(value) is not type(default) and not (isinstance(default, float) and type(value) is int):
+            raise InputError(f"{source}: the metadata's estimate_options.filtering.{f.name} is {value!r}")
+    return make_smoother(diff, filtering, float(np.median(np.diff(time))))
+
+
+def _check_targets(meta: dict, source: str) -> None:
+    """The ``friction_true`` metadata (simulations): joint -> parameters of (3.5)."""
+    targets = meta.get("friction_true", {})
+    if not isinstance(targets, dict):
+        raise InputError(f"{source}: the metadata's friction_true is not a table of joints")
+    for joint, params in targets.items():
+        try:
+            if not isinstance(params, dict):
+                raise TypeError("not a table of parameters")
+            FrictionParams.from_dict(params)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"{source}: the metadata's friction_true of '{joint}': {exc}") from None
 
 
 def estimate_from_table(table: pa.Table, source: str = "<table>") -> FrictionEstimate:
@@ -187,29 +225,33 @@ def estimate_from_table(table: pa.Table, source: str = "<table>") -> FrictionEst
     for c in ("time", *[f"{p}{j}" for j in joints for p in ("qd.", "valid.")]):
         if c not in names:
             raise InputError(f"{source}: missing column '{c}'")
-    time = _float_column(table, "time")
-    stack = lambda prefix: np.column_stack([_float_column(table, f"{prefix}.{j}") for j in joints])  # noqa: E731
+    time = numeric_column(table, "time", source)
+    stack = lambda prefix, finite=False: np.column_stack(  # noqa: E731
+        [numeric_column(table, f"{prefix}.{j}", source, finite=finite) for j in joints])
     frames = tuple(c[len("contact."):] for c in names if c.startswith("contact."))
-    contact = (np.column_stack([_float_column(table, f"contact.{f}") for f in frames]).astype(bool) if frames
-               else np.zeros((len(time), 0), dtype=bool))
-    phase = (np.asarray(table.column("phase").to_pylist(), dtype=str) if "phase" in names
-             else np.full(len(time), "single"))
-    unique = (np.asarray(table.column("unique").to_numpy(zero_copy_only=False), dtype=bool) if "unique" in names
-              else phase == "single")
+    contact = (np.column_stack([numeric_column(table, f"contact.{f}", source) for f in frames]).astype(bool)
+               if frames else np.zeros((len(time), 0), dtype=bool))
+    try:
+        phase = (np.asarray(table.column("phase").to_pylist(), dtype=str) if "phase" in names
+                 else np.full(len(time), "single"))
+    except (pa.ArrowException, ValueError):  # text is decoded lazily: damaged UTF-8 fails here
+        raise InputError(f"{source}: column 'phase' is not text") from None
+    unique = (numeric_column(table, "unique", source).astype(bool) if "unique" in names else phase == "single")
     meta = read_metadata(table, source)
-    smoother = None
-    if "estimate_options" in meta and len(time) > 1:
-        opts = meta["estimate_options"]
-        smoother = make_smoother(opts.get("diff", "central"), FilterOptions(**opts.get("filtering", {})),
-                                 float(np.median(np.diff(time))))
+    smoother = _table_smoother(meta, time, source)
+    _check_targets(meta, source)
+    companion_diff = meta.get("companion_diff")
+    if companion_diff is not None and companion_diff not in SCHEMES:
+        raise InputError(f"{source}: the metadata's companion_diff is {companion_diff!r}, not a scheme")
     return FrictionEstimate(
-        joints=joints, time=time, qd=stack("qd"), tau_f=stack("tau_f"), valid=stack("valid").astype(bool),
+        joints=joints, time=time, qd=stack("qd"), tau_f=stack("tau_f"), valid=stack("valid", True).astype(bool),
         phase=phase, unique=unique, contact=contact, contact_frames=frames,
-        qdd=_optional_columns(table, "qdd", joints), delta_qdd=_optional_columns(table, "delta_qdd", joints),
-        cond=_float_column(table, "cond") if "cond" in names else None,
-        tau_f_true=_optional_columns(table, "tau_f_true", joints), metadata=meta, smoother=smoother,
-        companion_delta_qdd=_optional_columns(table, "delta_qdd_companion", joints),
-        companion_diff=meta.get("companion_diff"))
+        qdd=_optional_columns(table, "qdd", joints, source),
+        delta_qdd=_optional_columns(table, "delta_qdd", joints, source),
+        cond=_float_column(table, "cond", source) if "cond" in names else None,
+        tau_f_true=_optional_columns(table, "tau_f_true", joints, source), metadata=meta, smoother=smoother,
+        companion_delta_qdd=_optional_columns(table, "delta_qdd_companion", joints, source),
+        companion_diff=companion_diff)
 
 
 def _stance_frame_pose(robot: Robot, stance: StanceModel, angles: np.ndarray, base: np.ndarray | None) -> np.ndarray:

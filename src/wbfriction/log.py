@@ -165,14 +165,20 @@ def read_table(path: str | Path) -> pa.Table:
         raise InputError(f"{path}: cannot be read: {(str(exc).splitlines() or [repr(exc)])[0]}") from exc
 
 
-def _column(table: pa.Table, name: str, source: str, first_row: int = 0) -> np.ndarray:
+def numeric_column(table: pa.Table, name: str, source: str, first_row: int = 0, finite: bool = True) -> np.ndarray:
+    """Column ``name`` as float64 (N,).
+
+    Raises:
+        InputError: a column that is not numeric, or (``finite``) holds NaN or inf, naming
+            ``source``, the column and the first bad row (counted from ``first_row``).
+    """
     try:
         col = table.column(name)
         values = col.to_numpy(zero_copy_only=False).astype(float)
     except (pa.ArrowException, ValueError, TypeError) as exc:
         raise InputError(f"{source}: column '{name}' is not numeric") from exc
-    bad = np.flatnonzero(~np.isfinite(values))
-    if bad.size:
+    bad = np.flatnonzero(~np.isfinite(values)) if finite else ()
+    if len(bad):
         raise InputError(f"{source}: column '{name}' has a non-finite value (NaN or inf) at row {first_row + bad[0]}")
     return values
 
@@ -274,14 +280,14 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
                 + [f"contact.{f}" for f in robot.contact_frames]):
         if col not in names:
             raise InputError(f"{source}: missing column '{col}'")
-    time = _column(table, "time", source, first_row)
+    time = numeric_column(table, "time", source, first_row)
     segments = check_time(time, source, max_gap, first_row=first_row)
-    q = np.column_stack([_column(table, f"q.{n}", source, first_row) for n in robot.actuated])
+    q = np.column_stack([numeric_column(table, f"q.{n}", source, first_row) for n in robot.actuated])
     check_limits(q, robot, source, limit_margin, first_row)
-    tau = np.column_stack([_column(table, f"tau.{n}", source, first_row) for n in robot.torque_controlled])
+    tau = np.column_stack([numeric_column(table, f"tau.{n}", source, first_row) for n in robot.torque_controlled])
     contact_cols = []
     for f in robot.contact_frames:
-        c = _column(table, f"contact.{f}", source, first_row)
+        c = numeric_column(table, f"contact.{f}", source, first_row)
         bad = np.flatnonzero((c != 0) & (c != 1))
         if bad.size:
             raise InputError(f"{source}: column 'contact.{f}' must hold 0 or 1, found {c[bad[0]]:g} at row {first_row + bad[0]}")
@@ -293,7 +299,7 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
         missing = [c for c in BASE_COLUMNS if c not in names]
         if missing:
             raise InputError(f"{source}: base pose is partial: missing column '{missing[0]}'")
-        base = np.column_stack([_column(table, c, source, first_row) for c in BASE_COLUMNS])
+        base = np.column_stack([numeric_column(table, c, source, first_row) for c in BASE_COLUMNS])
         norm = np.linalg.norm(base[:, 3:], axis=1)
         bad = np.flatnonzero(np.abs(norm - 1.0) > 1e-3)
         if bad.size:
@@ -302,7 +308,7 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
     tau_f_true = None
     if any(c.startswith("tau_f_true.") for c in names):
         tau_f_true = np.column_stack([
-            _column(table, f"tau_f_true.{n}", source, first_row) if f"tau_f_true.{n}" in names else np.full(len(time), np.nan)
+            numeric_column(table, f"tau_f_true.{n}", source, first_row) if f"tau_f_true.{n}" in names else np.full(len(time), np.nan)
             for n in robot.torque_controlled])
     truth = {}
     for prefix in ("qd_true", "qdd_true"):
@@ -310,7 +316,7 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
             missing = [n for n in robot.actuated if f"{prefix}.{n}" not in names]
             if missing:
                 raise InputError(f"{source}: missing column '{prefix}.{missing[0]}'")
-            truth[prefix] = np.column_stack([_column(table, f"{prefix}.{n}", source, first_row) for n in robot.actuated])
+            truth[prefix] = np.column_stack([numeric_column(table, f"{prefix}.{n}", source, first_row) for n in robot.actuated])
     return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
                qd_true=truth.get("qd_true"), qdd_true=truth.get("qdd_true"), segments=segments, period=period)
 
