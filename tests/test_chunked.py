@@ -103,3 +103,30 @@ def test_a_run_stopped_midway_leaves_the_previous_output(walk_file, tmp_path):
     assert proc.wait(60) == 128 + signal.SIGTERM
     assert out.read_bytes() == b"previous result"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["f.parquet"]
+
+
+def test_every_log_format_is_chunked_to_the_same_table(talos, combined_walk, walk_file, tmp_path):
+    """CSV and both HDF5 layouts, read chunk by chunk, give the Parquet log's friction table."""
+    import h5py
+
+    from wbfriction.hdf5 import read_hdf5
+
+    table = pq.read_table(walk_file)
+    write_table(table, tmp_path / "walk.csv")
+    write_table(table, tmp_path / "walk.h5")
+    with h5py.File(tmp_path / "walk2d.h5", "w") as f:
+        ds = f.create_dataset("log", data=np.column_stack([table.column(c).to_numpy() for c in table.column_names]))
+        ds.attrs["names"] = table.column_names
+    part = read_hdf5(tmp_path / "walk2d.h5", columns=["time", "q.leg_left_4_joint"], start=1000, stop=1200)
+    assert part.column_names == ["time", "q.leg_left_4_joint"]
+    np.testing.assert_array_equal(part.column("q.leg_left_4_joint").to_numpy(),
+                                  table.column("q.leg_left_4_joint").to_numpy()[1000:1200])
+    chunking = Chunking(rows=1500, workers=1)
+    estimate_file(RobotSpec("talos"), walk_file, tmp_path / "ref.parquet", chunking=chunking)
+    ref = pq.read_table(tmp_path / "ref.parquet")
+    for name in ("walk.csv", "walk.h5", "walk2d.h5"):
+        estimate_file(RobotSpec("talos"), tmp_path / name, tmp_path / "f.parquet", chunking=chunking)
+        got = pq.read_table(tmp_path / "f.parquet")
+        for c in ("tau_f.leg_left_4_joint", "delta_qdd.leg_right_1_joint", "valid.leg_right_3_joint", "phase"):
+            np.testing.assert_array_equal(got.column(c).to_numpy(zero_copy_only=False),
+                                          ref.column(c).to_numpy(zero_copy_only=False), err_msg=(name, c))

@@ -35,6 +35,7 @@ import pyarrow.parquet as pq
 
 from .estimate import EstimateOptions, no_single_support, estimate_log
 from .exceptions import InputError
+from .hdf5 import SUFFIXES as HDF5_SUFFIXES, read_hdf5
 from .log import LIMIT_MARGIN, MAX_GAP, log_from_table, read_metadata, read_table, write_atomic, with_metadata
 from .robot import Robot, load_robot
 
@@ -103,25 +104,25 @@ def plan_chunks(contact: np.ndarray, chunking: Chunking = Chunking()) -> list[Ch
 
 class _RowReader:
     """Row ranges of a Parquet or CSV file, read forwards with a rolling buffer (the memory
-    it holds is one chunk and its context); other formats are read whole."""
+    it holds is one chunk and its context); of an HDF5 file, read by slicing its datasets."""
 
     def __init__(self, path: Path, batch_rows: int):
         self.path = path
         suffix = path.suffix.lower()
+        self._hdf5 = suffix in HDF5_SUFFIXES
+        if self._hdf5:
+            self.metadata = read_hdf5(path, columns=[], stop=0).schema.metadata
+            return
         try:
             if suffix in (".parquet", ".pq"):
                 # without pre-buffering: pyarrow would otherwise keep whole column chunks read ahead
                 self._file = pq.ParquetFile(path, pre_buffer=False)
                 self.metadata = self._file.schema_arrow.metadata
                 self._batches = self._file.iter_batches(batch_size=batch_rows, use_threads=False)
-            elif suffix == ".csv":
+            else:
                 self._file = pacsv.open_csv(path, read_options=pacsv.ReadOptions(block_size=1 << 24))
                 self.metadata = None
                 self._batches = iter(self._file)
-            else:
-                whole = read_table(path)
-                self.metadata = whole.schema.metadata
-                self._batches = iter(whole.to_batches(max_chunksize=batch_rows))
         except (pa.ArrowException, OSError, ValueError) as exc:
             raise InputError(f"{path}: cannot be read: {(str(exc).splitlines() or [repr(exc)])[0]}") from exc
         self._buffer: list[pa.RecordBatch] = []
@@ -130,6 +131,8 @@ class _RowReader:
 
     def rows(self, start: int, stop: int) -> pa.Table:
         """Rows ``[start, stop)`` (``start`` never below an earlier call's)."""
+        if self._hdf5:
+            return read_hdf5(self.path, start=start, stop=stop)
         while self._stop < stop:
             try:
                 batch = next(self._batches)
@@ -158,8 +161,10 @@ def _plan_columns(path: Path, robot: Robot) -> tuple[np.ndarray, float]:
             names = pacsv.open_csv(path).schema.names
             table = pacsv.read_csv(path, convert_options=pacsv.ConvertOptions(
                 include_columns=[c for c in columns if c in names]))
+        elif suffix in HDF5_SUFFIXES:
+            table = read_hdf5(path, columns=columns)
         else:
-            table = read_table(path)
+            table = read_table(path)  # refuses the file type
     except (pa.ArrowException, OSError, ValueError) as exc:
         raise InputError(f"{path}: cannot be read: {(str(exc).splitlines() or [repr(exc)])[0]}") from exc
     for c in columns:
@@ -208,7 +213,7 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
 
     Args:
         spec: the robot, as worker processes load it.
-        path: the log (Parquet and CSV are streamed; other formats are read whole first).
+        path: the log (Parquet, CSV or HDF5, read chunk by chunk).
         output: the friction table to write (:meth:`~wbfriction.estimate.FrictionEstimate.to_table`).
         options, companion: as :func:`~wbfriction.estimate.estimate_log`.
         chunking: chunk length, overlap at forced cuts, processes.
