@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
+import pyarrow as pa
 import pytest
 
-from wbfriction.bags import BagMap, ContactTopic, load_bag_map, read_bag
+from wbfriction.bags import BagMap, ContactTopic, iter_bag, load_bag_map, read_bag
 from wbfriction.estimate import EstimateOptions, estimate_log
 from wbfriction.exceptions import InputError
 from wbfriction.log import log_from_table, read_log
@@ -18,10 +21,14 @@ def _time(ts, ns: int):
 
 
 def write_bag(path, log, robot, storage: str = "mcap", wrench_every: int = 2, odom_every: int = 5,
-              shuffle: bool = True, rename: dict | None = None):
+              shuffle: bool = True, rename: dict | None = None, delay_ns: dict | None = None, stamp=None):
     """The log as a bag: JointState at every sample (names in a different order in every
     message), the left sole's contact as a 400 N WrenchStamped every ``wrench_every`` samples,
-    the right one as a Bool, the base as Odometry every ``odom_every`` samples."""
+    the right one as a Bool, the base as Odometry every ``odom_every`` samples.
+
+    ``delay_ns``: topic -> how much later than its stamp a message is received [ns] (the
+    bag's order is the receive time). ``stamp(topic, k, ns)``: the header stamp written
+    for sample ``k`` (default ``ns``)."""
     from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.typesys import Stores, get_typestore
 
@@ -31,6 +38,9 @@ def write_bag(path, log, robot, storage: str = "mcap", wrench_every: int = 2, od
     rename = rename or {}
     plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
     names = list(robot.actuated)
+    delay_ns = delay_ns or {}
+    stamp = stamp or (lambda topic, k, ns: ns)
+    messages = []  # (receive time, connection, bytes), written in receive order
     with Writer(path, version=9, storage_plugin=plugin) as w:
         c_js = w.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=ts)
         c_lf = w.add_connection("/left_ft", "geometry_msgs/msg/WrenchStamped", typestore=ts)
@@ -40,35 +50,37 @@ def write_bag(path, log, robot, storage: str = "mcap", wrench_every: int = 2, od
         tau_all[:, robot.tc_index] = log.tau
         for k in range(len(log)):
             ns = T0 + int(round(log.time[k] * 1e9))
-            header = T["std_msgs/msg/Header"](stamp=_time(ts, ns), frame_id="")
+            header = lambda topic: T["std_msgs/msg/Header"](stamp=_time(ts, stamp(topic, k, ns)), frame_id="")  # noqa: E731, B023
+            write = lambda c, data: messages.append((ns + delay_ns.get(c.topic, 0), len(messages), c, data))  # noqa: E731, B023
             order = rng.permutation(len(names)) if shuffle else np.arange(len(names))
             js = T["sensor_msgs/msg/JointState"](
-                header=header, name=[rename.get(names[i], names[i]) for i in order],
+                header=header("/joint_states"), name=[rename.get(names[i], names[i]) for i in order],
                 position=log.q[k, order].astype(np.float64), velocity=np.zeros(0),
                 effort=tau_all[k, order].astype(np.float64))
-            w.write(c_js, ns, ts.serialize_cdr(js, "sensor_msgs/msg/JointState"))
+            write(c_js, ts.serialize_cdr(js, "sensor_msgs/msg/JointState"))
             if k % wrench_every == 0:
                 f = 400.0 if log.contact[k, 0] else 3.0
-                wr = T["geometry_msgs/msg/WrenchStamped"](header=header, wrench=T["geometry_msgs/msg/Wrench"](
+                wr = T["geometry_msgs/msg/WrenchStamped"](header=header("/left_ft"), wrench=T["geometry_msgs/msg/Wrench"](
                     force=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=-f),
                     torque=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)))
-                w.write(c_lf, ns, ts.serialize_cdr(wr, "geometry_msgs/msg/WrenchStamped"))
+                write(c_lf, ts.serialize_cdr(wr, "geometry_msgs/msg/WrenchStamped"))
             if k == 0 or log.contact[k, 1] != log.contact[k - 1, 1]:  # a state topic: on change only
-                w.write(c_rf, ns, ts.serialize_cdr(T["std_msgs/msg/Bool"](data=bool(log.contact[k, 1])),
-                                                   "std_msgs/msg/Bool"))
+                write(c_rf, ts.serialize_cdr(T["std_msgs/msg/Bool"](data=bool(log.contact[k, 1])), "std_msgs/msg/Bool"))
             if k % odom_every == 0:
                 b = log.base[k]
                 pose = T["geometry_msgs/msg/Pose"](
                     position=T["geometry_msgs/msg/Point"](x=b[0], y=b[1], z=b[2]),
                     orientation=T["geometry_msgs/msg/Quaternion"](x=b[3], y=b[4], z=b[5], w=b[6]))
                 odom = T["nav_msgs/msg/Odometry"](
-                    header=header, child_frame_id="base_link",
+                    header=header("/odom"), child_frame_id="base_link",
                     pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=np.zeros(36)),
                     twist=T["geometry_msgs/msg/TwistWithCovariance"](
                         twist=T["geometry_msgs/msg/Twist"](linear=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0),
                                                            angular=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)),
                         covariance=np.zeros(36)))
-                w.write(c_od, ns, ts.serialize_cdr(odom, "nav_msgs/msg/Odometry"))
+                write(c_od, ts.serialize_cdr(odom, "nav_msgs/msg/Odometry"))
+        for received, _, c, data in sorted(messages, key=lambda m: m[:2]):
+            w.write(c, received, data)
 
 
 def bag_map(robot, **kw) -> BagMap:
@@ -111,6 +123,55 @@ def test_bag_reads_back_as_the_log(talos, short_log, tmp_path, storage):
     assert np.abs(back.base[:, :3] - log.base[:, :3]).max() < 1e-3
     dots = np.abs(np.sum(back.base[:, 3:] * log.base[:, 3:], axis=1))
     assert np.degrees(2 * np.arccos(np.clip(dots, -1, 1))).max() < 0.05
+
+
+def test_a_bag_is_streamed_in_blocks_with_late_topics(talos, short_log, tmp_path):
+    """Read in blocks of 50 samples while the odometry arrives 30 ms and the wrenches 7 ms
+    after their stamps: the same table as the on-time bag read whole, bit for bit, and no
+    block holds more than the block plus the samples the late topics hold back."""
+    write_bag(tmp_path / "on_time", short_log, talos, wrench_every=3)
+    write_bag(tmp_path / "late", short_log, talos, wrench_every=3,
+              delay_ns={"/odom": 30_000_000, "/left_ft": 7_000_000})
+    whole = read_bag(tmp_path / "on_time", bag_map(talos))
+    blocks = list(iter_bag(tmp_path / "late", bag_map(talos), block_rows=50))
+    assert len(blocks) > len(short_log) // 100
+    assert max(b.num_rows for b in blocks) <= 50 + 31 + 5  # + the odometry's lag and its period
+    streamed = pa.concat_tables(blocks)
+    assert streamed.column_names == whole.column_names
+    for name in whole.column_names:
+        np.testing.assert_array_equal(streamed.column(name).to_numpy(), whole.column(name).to_numpy(), err_msg=name)
+    meta = lambda t: {k: v for k, v in json.loads(t.schema.metadata[b"wbfriction"]).items() if k != "source_bag"}  # noqa: E731
+    assert meta(blocks[0]) == meta(whole) and meta(whole)["time_origin_ns"] == T0
+
+
+def test_bag_stamps_that_go_back_and_joints_that_appear_are_refused(talos, short_log, tmp_path):
+    back = lambda topic, k, ns: ns - 6_000_000 if (topic, k) == ("/odom", 100) else ns  # noqa: E731
+    write_bag(tmp_path / "a", short_log, talos, stamp=back)
+    with pytest.raises(InputError, match="topic '/odom': the stamp of message 21 goes back in time"):
+        read_bag(tmp_path / "a", bag_map(talos))
+    js_back = lambda topic, k, ns: ns - 2_000_000 if (topic, k) == ("/joint_states", 40) else ns  # noqa: E731
+    write_bag(tmp_path / "b", short_log, talos, stamp=js_back)
+    with pytest.raises(InputError, match="topic '/joint_states': the stamp of message 41 goes back in time"):
+        read_bag(tmp_path / "b", bag_map(talos))
+    # a joint-state message naming a joint the first one did not
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    with Writer(tmp_path / "e", version=9) as w:
+        conns = {t: w.add_connection(t, m, typestore=ts) for t, m in (
+            ("/joint_states", "sensor_msgs/msg/JointState"), ("/right_contact", "std_msgs/msg/Bool"))}
+        for k, names in enumerate((["a", "b"], ["a", "c"])):
+            ns = T0 + k * 1_000_000
+            js = ts.types["sensor_msgs/msg/JointState"](
+                header=ts.types["std_msgs/msg/Header"](stamp=_time(ts, ns), frame_id=""), name=names,
+                position=np.zeros(2), velocity=np.zeros(0), effort=np.zeros(2))
+            w.write(conns["/right_contact"], ns - 1, ts.serialize_cdr(ts.types["std_msgs/msg/Bool"](data=True),
+                                                                      "std_msgs/msg/Bool"))
+            w.write(conns["/joint_states"], ns, ts.serialize_cdr(js, "sensor_msgs/msg/JointState"))
+    two = BagMap("/joint_states", (ContactTopic("right_sole_link", "/right_contact"),))
+    with pytest.raises(InputError, match="joint-state message 2 names joint 'c', which the first message did not"):
+        read_bag(tmp_path / "e", two)
 
 
 def test_estimate_from_a_bag_equals_estimate_from_its_conversion(talos, short_log, tmp_path):

@@ -95,7 +95,7 @@ def test_a_run_stopped_midway_leaves_the_previous_output(walk_file, tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "wbfriction", "estimate", str(walk_file), "-o", str(out),
                              "--chunk-rows", "300", "--workers", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 120
-    while not list(tmp_path.glob(".f.parquet.*.tmp")) and proc.poll() is None and time.monotonic() < deadline:
+    while not list(tmp_path.glob(".f.parquet.*.tmp*")) and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
     assert proc.poll() is None, "finished before it could be stopped"
     time.sleep(0.5)  # a few chunks written

@@ -60,7 +60,7 @@ def test_demo_prints_the_thesis_table_and_writes_figures(tmp_path):
     for name in ("fig6_1_support_phases.png", "fig6_2_schemes_time.png", "fig6_3_schemes_velocity.png",
                  "friction_curves.png", "walk_params.json", "walk_friction.parquet", "report.html"):
         assert (tmp_path / name).stat().st_size > 1000, name
-    assert not list(tmp_path.glob(".*.tmp")), "temporary files left behind"
+    assert not list(tmp_path.glob(".*.tmp*")), "temporary files left behind"
 
 
 def test_estimate_and_fit_commands_with_options(demo_dir, tmp_path):

@@ -11,11 +11,12 @@ from __future__ import annotations
 import sys
 
 import numpy as np
+import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
 from wbfriction import cli
-from wbfriction.log import Log, read_log, write_log, write_table
+from wbfriction.log import Log, log_from_table, read_log, write_log, write_table
 from wbfriction.hdf5 import write_hdf5
 
 PREVIOUS = b"the previous output"
@@ -55,8 +56,6 @@ def _columns(log: Log, robot) -> dict[str, np.ndarray]:
 
 
 def _write(cols: dict[str, np.ndarray], path) -> None:
-    import pyarrow as pa
-
     table = pa.table(cols)
     if path.suffix == ".h5":
         write_hdf5(table, path)  # write_table's atomic wrapper is not needed for a test input
@@ -173,3 +172,31 @@ def test_a_time_gap_splits_the_log_instead_of_failing(talos, good, tmp_path, cap
     assert np.isfinite(results["a"]).sum() > 10 and np.isfinite(results["b"]).sum() > 10
     # equal up to the rounding of the sampling period (each log's median time step)
     np.testing.assert_allclose(results["gap"], np.concatenate([results["a"], results["b"]]), rtol=1e-12)
+
+
+@pytest.mark.parametrize("command", ["convert", "estimate"])
+def test_bad_bags_write_nothing(talos, combined_walk, tmp_path, capsys, command):
+    """A bag streamed into a temporary log and checked: its faults name the bag, the previous
+    output stays, and neither the temporary log nor its folder is left behind."""
+    from test_bags import write_bag
+
+    walk = combined_walk.log.to_table(talos).slice(0, 1500)
+    degrees = walk.set_column(walk.column_names.index("q.leg_left_4_joint"), "q.leg_left_4_joint",
+                              pa.array(np.degrees(walk.column("q.leg_left_4_joint").to_numpy())))
+    write_bag(tmp_path / "bag", log_from_table(degrees, talos, "walk", limit_margin=np.inf), talos)
+    left, right = talos.contact_frames
+    topics = (f'[joint_states]\ntopic = "/joint_states"\n[[contacts]]\nframe = "{left}"\ntopic = "/left_ft"\n'
+              f'threshold = 50\n')
+    (tmp_path / "map.toml").write_text(topics + f'[[contacts]]\nframe = "{right}"\ntopic = "/right_contact"\n')
+    (tmp_path / "one_foot.toml").write_text(topics)
+    output = tmp_path / "out.parquet"
+    output.write_bytes(PREVIOUS)
+    before = sorted(p.name for p in tmp_path.iterdir())
+    for map_file, needle in (("map.toml", "column 'q.leg_left_4_joint' is "),
+                             ("one_foot.toml", f"missing column 'contact.{right}'")):
+        code, err = run_cli(capsys, command, tmp_path / "bag", "--map", tmp_path / map_file, "-o", output)
+        lines = [ln for ln in err.strip().splitlines() if ln.strip()]
+        assert code == 2 and len(lines) == 1, err
+        assert f"{tmp_path / 'bag'}: " in lines[0] and needle in lines[0], lines[0]
+        assert output.read_bytes() == PREVIOUS
+        assert sorted(p.name for p in tmp_path.iterdir()) == before

@@ -37,6 +37,8 @@ source has data).
 
 from __future__ import annotations
 
+from bisect import bisect_right
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -133,13 +135,22 @@ def _stamp(msg) -> int:
     return int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
 
 
-def _read_topics(path: Path, topics: dict[str, tuple[str, ...]]) -> dict[str, list]:
-    """Messages of each topic as (stamp_ns, message), checking the message types."""
+BLOCK_ROWS = 10_000
+"""Joint-state samples aligned and handed on at a time by :func:`iter_bag`."""
+
+
+def _unreadable(path: Path, exc: Exception) -> InputError:
+    text = str(exc).strip().splitlines()[0] if str(exc).strip() else repr(exc)
+    return InputError(f"{path}: not a readable ROS 2 bag: {text}")
+
+
+def _messages(path: Path, topics: dict[str, tuple[str, ...]]) -> Iterator[tuple[str, str, int, object]]:
+    """(topic, message type, receive time [ns], message) of the mapped topics, in the bag's
+    order (receive time), after checking that every topic exists with an expected type."""
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
 
     folder = path if path.is_dir() else path.parent
-    out: dict[str, list] = {t: [] for t in topics}
     try:
         with AnyReader([folder], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
             conns = {c.topic: c for c in reader.connections}
@@ -151,73 +162,75 @@ def _read_topics(path: Path, topics: dict[str, tuple[str, ...]]) -> dict[str, li
                                      f"{' or '.join(types)}")
             wanted = [c for c in reader.connections if c.topic in topics]
             for conn, received, raw in reader.messages(connections=wanted):
-                msg = reader.deserialize(raw, conn.msgtype)
-                out[conn.topic].append((received if conn.msgtype == BOOL else _stamp(msg), msg))
+                yield conn.topic, conn.msgtype, received, reader.deserialize(raw, conn.msgtype)
     except InputError:
         raise
     except Exception as exc:  # rosbags raises its own reader and deserialisation errors
-        raise InputError(f"{path}: not a readable ROS 2 bag: {str(exc).strip().splitlines()[0] if str(exc) else exc!r}") from None
-    for topic, msgs in out.items():
-        if not msgs:
-            raise InputError(f"{path}: topic '{topic}' has no message")
-        msgs.sort(key=lambda m: m[0])
-    return out
+        raise _unreadable(path, exc) from None
 
 
-def _joint_columns(msgs: list, rename: dict[str, str]) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """Stamps (N,) and ``q.<joint>``/``tau.<joint>`` columns from JointState messages,
-    by name in each message (NaN where a message lacks the joint)."""
-    stamps = np.array([s for s, _ in msgs], dtype=np.int64)
-    names: dict[str, int] = {}
-    for _, m in msgs:
-        for n in m.name:
-            names.setdefault(rename.get(n, n), len(names))
-    q = np.full((len(msgs), len(names)), np.nan)
-    tau = np.full((len(msgs), len(names)), np.nan)
-    for k, (_, m) in enumerate(msgs):
-        cols = [names[rename.get(n, n)] for n in m.name]
-        if len(m.position) == len(cols):
-            q[k, cols] = m.position
-        if len(m.effort) == len(cols):
-            tau[k, cols] = m.effort
-    columns = {}
-    for n, i in names.items():
-        columns[f"q.{n}"] = q[:, i]
-        if np.isfinite(tau[:, i]).any():
-            columns[f"tau.{n}"] = tau[:, i]
-    return stamps, columns
+@dataclass
+class _Series:
+    """One aligned topic's messages not yet needed any more: stamps [ns] and values."""
+
+    topic: str
+    by_receive: bool = False  # stamped with the receive time (std_msgs/Bool has no header)
+    stamps: list[int] = field(default_factory=list)
+    values: list = field(default_factory=list)
+    count: int = 0  # messages seen
+    first: int | None = None
+
+    def add(self, path: Path, stamp: int, value) -> None:
+        self.count += 1
+        if self.stamps and stamp < self.stamps[-1]:
+            raise InputError(f"{path}: topic '{self.topic}': the stamp of message {self.count} goes back in time "
+                             f"({(self.stamps[-1] - stamp) * 1e-6:.3f} ms)")
+        if self.stamps and stamp == self.stamps[-1]:  # the later of two messages with one stamp
+            self.values[-1] = value
+            return
+        self.first = stamp if self.first is None else self.first
+        self.stamps.append(stamp)
+        self.values.append(value)
+
+    def trim(self, before: int) -> None:
+        """Forget the messages older than the last one at or before ``before``."""
+        k = max(bisect_right(self.stamps, before) - 1, 0)
+        del self.stamps[:k], self.values[:k]
 
 
-def _hold(stamps: np.ndarray, at: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Zero-order hold of ``values`` (at ``stamps``) at the times ``at`` (all >= stamps[0])."""
-    return values[np.searchsorted(stamps, at, side="right") - 1]
+def _interpolate_pose(stamps: np.ndarray, poses: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Base poses (M, 7: x y z qx qy qz qw) at ``at`` [ns] from poses at ``stamps`` (K,):
+    linear in the position, slerp in the orientation, between the two messages around each
+    stamp (``stamps[0] <= at <= stamps[-1]``). Fractions come from integer nanoseconds, so
+    the result does not depend on which messages are at hand."""
+    from scipy.spatial.transform import Rotation
+
+    quat = poses[:, 3:] / np.linalg.norm(poses[:, 3:], axis=1, keepdims=True)
+    if len(stamps) == 1:
+        return np.column_stack([np.repeat(poses[:, :3], len(at), axis=0), np.repeat(quat, len(at), axis=0)])
+    i = np.clip(np.searchsorted(stamps, at, side="right") - 1, 0, len(stamps) - 2)
+    alpha = ((at - stamps[i]) / (stamps[i + 1] - stamps[i]))[:, None]
+    xyz = poses[i, :3] + alpha * (poses[i + 1, :3] - poses[i, :3])
+    r0, r1 = Rotation.from_quat(quat[i]), Rotation.from_quat(quat[i + 1])
+    rot = r0 * Rotation.from_rotvec(alpha * (r0.inv() * r1).as_rotvec())
+    return np.column_stack([xyz, rot.as_quat()])
 
 
-def _base_columns(stamps: np.ndarray, msgs: list, at: np.ndarray) -> dict[str, np.ndarray]:
-    from scipy.spatial.transform import Rotation, Slerp
+def iter_bag(path: str | Path, bag_map: BagMap, block_rows: int = BLOCK_ROWS) -> Iterator[pa.Table]:
+    """A ROS 2 bag as consecutive tables in the log format (:mod:`wbfriction.log`) of about
+    ``block_rows`` rows, aligned on the joint-state stamps (module docstring), read in one
+    pass: memory holds a block and the messages that arrive ahead of it, not the bag.
 
-    poses = [m.pose.pose if hasattr(m.pose, "pose") else m.pose for _, m in msgs]
-    pos = np.array([[p.position.x, p.position.y, p.position.z] for p in poses])
-    quat = np.array([[p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w] for p in poses])
-    t = (stamps - stamps[0]) * 1e-9
-    x = (at - stamps[0]) * 1e-9
-    xyz = np.column_stack([np.interp(x, t, pos[:, i]) for i in range(3)])
-    if len(t) > 1:
-        rot = Slerp(t, Rotation.from_quat(quat))(x).as_quat()
-    else:
-        rot = np.repeat(quat / np.linalg.norm(quat), len(x), axis=0)
-    return dict(zip(BASE_COLUMNS, [*xyz.T, *rot.T]))
-
-
-def read_bag(path: str | Path, bag_map: BagMap) -> pa.Table:
-    """A ROS 2 bag as a table in the log format (:mod:`wbfriction.log`), aligned on the
-    joint-state stamps (module docstring). Validation against a robot is left to
-    :func:`~wbfriction.log.log_from_table`.
+    A sample is handed on once every aligned topic has a message after it (with a stamp at
+    or after it for the base pose), so a topic that stops publishing holds samples back
+    until the end of the bag. The first table's metadata records the bag and the absolute
+    first stamp (``time_origin_ns``); ``time`` counts from it in every table.
 
     Raises:
         InputError: unreadable bag, a missing or empty topic, a topic of another type, a
-            wrench topic without a threshold, or no joint-state sample where every topic
-            has data.
+            wrench topic without a threshold, a joint-state message naming a joint that
+            the first one did not, stamps that go back in time within a topic, or no
+            joint-state sample where every topic has data.
     """
     path = Path(path)
     topics = {bag_map.joint_states: (JOINT_STATE,)}
@@ -225,29 +238,126 @@ def read_bag(path: str | Path, bag_map: BagMap) -> pa.Table:
         topics[c.topic] = (WRENCH, BOOL)
     if bag_map.base:
         topics[bag_map.base] = (ODOMETRY, POSE)
-    msgs = _read_topics(path, topics)
-    stamps, columns = _joint_columns(msgs[bag_map.joint_states], bag_map.rename)
-    first = max(m[0][0] for m in msgs.values())
-    last = msgs[bag_map.base][-1][0] if bag_map.base else stamps[-1]
-    keep = (stamps >= first) & (stamps <= last)
-    if keep.sum() < 2:
-        raise InputError(f"{path}: no joint-state sample lies where every mapped topic has data")
-    stamps = stamps[keep]
-    table = {"time": (stamps - stamps[0]) * 1e-9}
-    table.update({k: v[keep] for k, v in columns.items()})
-    for c in bag_map.contacts:
-        cm = msgs[c.topic]
-        ts = np.array([s for s, _ in cm], dtype=np.int64)
-        if hasattr(cm[0][1], "wrench"):
-            if c.threshold is None:
-                raise InputError(f"{path}: contact topic '{c.topic}' is a wrench: give its threshold [N] in the map")
-            force = np.array([abs(getattr(m.wrench.force, c.axis)) for _, m in cm])
-            flag = force > c.threshold
+    contacts = {c.topic: _Series(c.topic) for c in bag_map.contacts}
+    base = _Series(bag_map.base) if bag_map.base else None
+    series = [*contacts.values(), *([base] if base else [])]
+    by_topic = {c.topic: c for c in bag_map.contacts}
+    columns: dict[str, int] = {}  # model joint -> column, from the first joint-state message
+    has_effort = False
+    js_count = 0
+    pending: list[tuple[int, np.ndarray, np.ndarray]] = []  # joint-state samples: stamp [ns], q, tau
+    received = -1  # the latest receive time: no Bool message before it is still to come
+    origin: int | None = None
+    rows = 0
+
+    def horizon() -> float:
+        """Samples stamped before this can be aligned now [ns]."""
+        h = float("inf")
+        for s in series:
+            if not s.stamps:
+                return -1.0
+            h = min(h, received if s.by_receive else s.stamps[-1])
+        return h
+
+    def emit(final: bool) -> pa.Table | None:
+        nonlocal origin, rows
+        stamps = np.array([p[0] for p in pending], dtype=np.int64)
+        ready = len(stamps) if final else int(np.searchsorted(stamps >= horizon(), True))
+        if ready == 0:
+            return None
+        at = stamps[:ready]
+        q = np.array([p[1] for p in pending[:ready]])
+        tau = np.array([p[2] for p in pending[:ready]])
+        del pending[:ready]
+        keep = np.ones(ready, dtype=bool)
+        for s in series:
+            keep &= at >= (s.first if s.first is not None else np.iinfo(np.int64).max)
+        if final and base is not None and base.stamps:
+            keep &= at <= base.stamps[-1]
+        at, q, tau = at[keep], q[keep], tau[keep]
+        if len(at) == 0:
+            return None
+        origin = int(at[0]) if origin is None else origin
+        table = {"time": (at - origin) * 1e-9}
+        for name, i in columns.items():
+            table[f"q.{name}"] = q[:, i]
+        if has_effort:
+            for name, i in columns.items():
+                table[f"tau.{name}"] = tau[:, i]
+        for c in bag_map.contacts:
+            s = contacts[c.topic]
+            flags = np.array([bool(v) for v in s.values], dtype=np.int8)
+            table[f"contact.{c.frame}"] = flags[np.searchsorted(np.array(s.stamps), at, side="right") - 1]
+        if base is not None:
+            pose = _interpolate_pose(np.array(base.stamps, dtype=np.int64), np.array(base.values), at)
+            table.update(dict(zip(BASE_COLUMNS, pose.T)))
+        for s in series:
+            s.trim(int(at[-1]))
+        out = pa.table(table)
+        if rows == 0:
+            out = with_metadata(out, {"source_bag": str(path), "time_origin_ns": origin,
+                                      "alignment": "contacts: zero-order hold; base: linear + slerp"})
+        rows += len(at)
+        return out
+
+    for topic, msgtype, recv, msg in _messages(path, topics):
+        received = max(received, recv)
+        if topic == bag_map.joint_states:
+            names = [bag_map.rename.get(n, n) for n in msg.name]
+            if not columns:
+                columns = {n: i for i, n in enumerate(dict.fromkeys(names))}
+                has_effort = len(msg.effort) == len(names)
+            js_count += 1
+            unknown = next((n for n in names if n not in columns), None)
+            if unknown is not None:
+                raise InputError(f"{path}: joint-state message {js_count} names joint '{unknown}', which the "
+                                 "first message did not")
+            stamp = _stamp(msg)
+            if pending and stamp < pending[-1][0]:
+                raise InputError(f"{path}: topic '{topic}': the stamp of message {js_count} goes back in time")
+            q = np.full(len(columns), np.nan)
+            tau = np.full(len(columns), np.nan)
+            idx = [columns[n] for n in names]
+            if len(msg.position) == len(idx):
+                q[idx] = msg.position
+            if len(msg.effort) == len(idx):
+                tau[idx] = msg.effort
+            pending.append((stamp, q, tau))
+            if len(pending) >= block_rows:
+                block = emit(final=False)
+                if block is not None:
+                    yield block
+        elif topic in by_topic:
+            c = by_topic[topic]
+            if msgtype == BOOL:
+                contacts[topic].by_receive = True
+                contacts[topic].add(path, recv, bool(msg.data))
+            else:
+                if c.threshold is None:
+                    raise InputError(f"{path}: contact topic '{topic}' is a wrench: give its threshold [N] in the map")
+                contacts[topic].add(path, _stamp(msg), abs(getattr(msg.wrench.force, c.axis)) > c.threshold)
         else:
-            flag = np.array([bool(m.data) for _, m in cm])
-        table[f"contact.{c.frame}"] = _hold(ts, stamps, flag).astype(np.int8)
-    if bag_map.base:
-        bm = msgs[bag_map.base]
-        table.update(_base_columns(np.array([s for s, _ in bm], dtype=np.int64), bm, stamps))
-    return with_metadata(pa.table(table), {"source_bag": str(path), "time_origin_ns": int(stamps[0]),
-                                           "alignment": "contacts: zero-order hold; base: linear + slerp"})
+            p = msg.pose.pose if hasattr(msg.pose, "pose") else msg.pose
+            base.add(path, _stamp(msg), (p.position.x, p.position.y, p.position.z, p.orientation.x,
+                                          p.orientation.y, p.orientation.z, p.orientation.w))
+    if js_count == 0:
+        raise InputError(f"{path}: topic '{bag_map.joint_states}' has no message")
+    for s in series:
+        if s.count == 0:
+            raise InputError(f"{path}: topic '{s.topic}' has no message")
+    block = emit(final=True)
+    if block is not None:
+        yield block
+    if rows < 2:
+        raise InputError(f"{path}: no joint-state sample lies where every mapped topic has data")
+
+
+def read_bag(path: str | Path, bag_map: BagMap) -> pa.Table:
+    """A ROS 2 bag as one table in the log format (:func:`iter_bag`). Validation against a
+    robot is left to :func:`~wbfriction.log.log_from_table`.
+
+    Raises:
+        InputError: see :func:`iter_bag`.
+    """
+    blocks = list(iter_bag(path, bag_map))
+    return pa.concat_tables(blocks).replace_schema_metadata(blocks[0].schema.metadata)

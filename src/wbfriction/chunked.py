@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import multiprocessing
 from collections import deque
+from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,7 +37,8 @@ import pyarrow.parquet as pq
 from .estimate import EstimateOptions, no_single_support, estimate_log
 from .exceptions import InputError
 from .hdf5 import SUFFIXES as HDF5_SUFFIXES, read_hdf5
-from .log import LIMIT_MARGIN, MAX_GAP, log_from_table, read_metadata, read_table, write_atomic, with_metadata
+from .log import (LIMIT_MARGIN, MAX_GAP, log_from_table, read_metadata, read_table, table_suffix, with_metadata,
+                  write_tables)
 from .robot import Robot, load_robot
 
 CONTEXT = 3
@@ -108,7 +110,7 @@ class _RowReader:
 
     def __init__(self, path: Path, batch_rows: int):
         self.path = path
-        suffix = path.suffix.lower()
+        suffix = table_suffix(path)
         self._hdf5 = suffix in HDF5_SUFFIXES
         if self._hdf5:
             self.metadata = read_hdf5(path, columns=[], stop=0).schema.metadata
@@ -130,7 +132,7 @@ class _RowReader:
         self._stop = 0
 
     def rows(self, start: int, stop: int) -> pa.Table:
-        """Rows ``[start, stop)`` (``start`` never below an earlier call's)."""
+        """Rows ``[start, stop)`` (``start`` never below an earlier call's), with the file's metadata."""
         if self._hdf5:
             return read_hdf5(self.path, start=start, stop=stop)
         while self._stop < stop:
@@ -146,10 +148,11 @@ class _RowReader:
         while self._buffer and self._start + self._buffer[0].num_rows <= start:  # drop what is behind
             self._start += self._buffer.pop(0).num_rows
         table = pa.Table.from_batches(self._buffer) if self._buffer else pa.table({})
-        return table.slice(start - self._start, stop - start)
+        table = table.slice(start - self._start, stop - start)
+        return table.replace_schema_metadata(self.metadata) if self.metadata else table
 
 
-def _plan_columns(path: Path, robot: Robot) -> tuple[np.ndarray, float]:
+def _plan_columns(path: Path, robot: Robot, source: str) -> tuple[np.ndarray, float]:
     """The contact columns (N, n_contacts), to plan the chunks, and the sampling period of
     the whole log (the median time step) [s], read alone."""
     columns = ["time"] + [f"contact.{f}" for f in robot.contact_frames]
@@ -169,11 +172,48 @@ def _plan_columns(path: Path, robot: Robot) -> tuple[np.ndarray, float]:
         raise InputError(f"{path}: cannot be read: {(str(exc).splitlines() or [repr(exc)])[0]}") from exc
     for c in columns:
         if c not in table.column_names:
-            raise InputError(f"{path}: missing column '{c}'")
+            raise InputError(f"{source}: missing column '{c}'")
     flags = np.column_stack([table.column(c).to_numpy(zero_copy_only=False) for c in columns[1:]])
     time = table.column("time").to_numpy(zero_copy_only=False).astype(float)
     period = float(np.median(np.diff(time))) if len(time) > 1 else float("nan")
     return np.nan_to_num(flags.astype(float)) != 0, period
+
+
+def iter_file(path: str | Path, block_rows: int = 10_000) -> Iterator[pa.Table]:
+    """A Parquet, CSV or HDF5 log as consecutive tables of ``block_rows`` rows (with the
+    file's metadata), never read whole.
+
+    Raises:
+        InputError: an unreadable file, naming it and the row.
+    """
+    path = Path(path)
+    reader = _RowReader(path, block_rows)
+    start = 0
+    while True:
+        table = reader.rows(start, start + block_rows)
+        if table.num_rows == 0:
+            return
+        yield table
+        start += table.num_rows
+
+
+def check_file(robot: Robot, path: str | Path, source: str | None = None, chunking: Chunking = Chunking(),
+               max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN) -> int:
+    """Validate a log file against ``robot`` chunk by chunk, as :func:`estimate_file` does
+    before estimating (:func:`~wbfriction.log.log_from_table`), in bounded memory. Returns
+    its rows.
+
+    Raises:
+        InputError: the first fault, naming ``source`` (default ``path``), column and row.
+    """
+    path = Path(path)
+    source = source or str(path)
+    contact, period = _plan_columns(path, robot, source)
+    reader = _RowReader(path, max(1024, min(chunking.rows, 65_536)))
+    for c in plan_chunks(contact, chunking):
+        log_from_table(reader.rows(c.read_start, c.read_stop), robot, source, max_gap, limit_margin,
+                       first_row=c.read_start, period=period)
+    return len(contact)
 
 
 # worker state: the robot, loaded once per process
@@ -208,7 +248,7 @@ class ChunkedResult:
 def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options: EstimateOptions = EstimateOptions(),
                   *, chunking: Chunking = Chunking(), companion: bool = True, max_gap: float = MAX_GAP,
                   limit_margin: float = LIMIT_MARGIN, extra_metadata: dict | None = None,
-                  progress=None, robot: Robot | None = None) -> ChunkedResult:
+                  progress=None, robot: Robot | None = None, source: str | None = None) -> ChunkedResult:
     """Estimate a log file chunk by chunk into ``output`` (Parquet or CSV), whole or not at all.
 
     Args:
@@ -221,6 +261,8 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
         extra_metadata: merged into the table's metadata (provenance).
         progress: optional callable receiving numbers of rows done.
         robot: ``spec`` already loaded in this process, if the caller has it.
+        source: the name messages give the log (default ``path``; a bag converted to a
+            temporary file is named as the bag).
 
     Raises:
         InputError: what reading, validating and estimating raise, naming the file and row;
@@ -229,21 +271,17 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     path, output = Path(path), Path(output)
     if output.suffix.lower() not in (".parquet", ".pq", ".csv"):
         raise InputError(f"{output}: friction tables are written as .parquet or .csv")
+    source = source or str(path)
     robot = robot if robot is not None else spec.load()
-    contact, period = _plan_columns(path, robot)
+    contact, period = _plan_columns(path, robot, source)
     n = len(contact)
     chunks = plan_chunks(contact, chunking)
     del contact
     reader = _RowReader(path, max(1024, min(chunking.rows, 65_536)))
-    source = str(path)
-    meta_bytes = reader.metadata or {}
     first_meta: dict = {}
 
-    def with_meta(table: pa.Table) -> pa.Table:
-        return table.replace_schema_metadata(meta_bytes) if meta_bytes else table
-
     def tables():
-        args = lambda c: (with_meta(reader.rows(c.read_start, c.read_stop)), c, source, options, companion,  # noqa: E731
+        args = lambda c: (reader.rows(c.read_start, c.read_stop), c, source, options, companion,  # noqa: E731
                           max_gap, limit_margin, period)
         if chunking.workers <= 1 or len(chunks) == 1:
             for c in chunks:
@@ -260,26 +298,20 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
             while pending:
                 yield pending.popleft().result()
 
-    def write(tmp: Path) -> None:
-        writer, single = None, False
-        try:
-            for k, table in enumerate(tables()):
-                single = single or bool(pc.any(table.column("unique")).as_py())
-                if writer is None:
-                    meta = read_metadata(table, source)
-                    meta.update(extra_metadata or {})
-                    first_meta.update(meta)
-                    schema = with_metadata(table, meta).schema
-                    writer = (pacsv.CSVWriter(tmp, schema) if output.suffix.lower() == ".csv"
-                              else pq.ParquetWriter(tmp, schema))
-                writer.write_table(table.cast(schema) if table.schema != schema else table)
-                if progress is not None:
-                    progress(chunks[k].stop - chunks[k].start)
-            if not single:  # raised before the rename: nothing is written
-                raise no_single_support(robot, source)
-        finally:
-            if writer is not None:
-                writer.close()
+    def with_provenance():
+        single = False
+        for k, table in enumerate(tables()):
+            single = single or bool(pc.any(table.column("unique")).as_py())
+            if k == 0:
+                meta = read_metadata(table, source)
+                meta.update(extra_metadata or {})
+                first_meta.update(meta)
+                table = with_metadata(table, meta)
+            yield table
+            if progress is not None:
+                progress(chunks[k].stop - chunks[k].start)
+        if not single:  # raised before the rename: nothing is written
+            raise no_single_support(robot, source)
 
-    write_atomic(output, write)
+    write_tables(output, with_provenance())
     return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta)

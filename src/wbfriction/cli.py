@@ -26,13 +26,13 @@ from rich.table import Table
 
 from . import __version__
 from .energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, energy_consistency
-from .estimate import EstimateOptions, estimate_from_table, estimate_log
+from .estimate import EstimateOptions, estimate_from_table
 from .exceptions import InputError, WbfrictionError
 from .friction import PARAM_NAMES, load_friction_toml
 from .sim.sensors import load_sensors_toml
 from .identify import FitResult, fit_table_estimate, fitted_offsets
 from .kinematics import FilterOptions
-from .log import LIMIT_MARGIN, MAX_GAP, file_sha256, read_log, read_table, write_atomic, write_log, write_table
+from .log import LIMIT_MARGIN, MAX_GAP, file_sha256, read_log, read_table, write_atomic, write_log, write_tables
 from .robot import Robot, load_robot
 from .sim import IdealOptions, MujocoOptions, SensorNoise, simulate_ideal, simulate_mujoco
 from .walking import GaitOptions, walking_reference
@@ -56,14 +56,6 @@ MaxGapOpt = typer.Option(MAX_GAP, help="Time steps of at least this many samplin
                                         "segments, estimated apart.")
 LimitMarginOpt = typer.Option(LIMIT_MARGIN, help="Positions beyond the URDF limits by more than this [rad] are "
                                                  "refused (wrong units).")
-
-
-def _read_log(path: Path, r: Robot, bag_map: Optional[Path], max_gap: float = MAX_GAP,
-              limit_margin: float = LIMIT_MARGIN):
-    """A log file, or a ROS 2 bag through its topic map."""
-    from .bags import load_bag_map
-
-    return read_log(path, r, None if bag_map is None else load_bag_map(bag_map), max_gap, limit_margin)
 
 
 @contextmanager
@@ -174,30 +166,42 @@ def _row_count(path: Path) -> int:
         return 0
 
 
+def _log_tables(path: Path, bag_map: Optional[Path]):
+    """A log file or a ROS 2 bag (through its topic map) as a stream of log-format tables."""
+    from .bags import is_bag, iter_bag, load_bag_map
+    from .chunked import iter_file
+
+    if is_bag(path):
+        if bag_map is None:
+            raise InputError(f"{path}: a ROS 2 bag needs a topic map (--map MAP.toml)")
+        return iter_bag(path, load_bag_map(bag_map))
+    return iter_file(path)
+
+
 def _run_estimate(r: Robot, spec, log: Path, output: Path, opts: EstimateOptions, bag_map: Optional[Path] = None,
                   max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN, workers: int = 2,
                   chunk_rows: int = 10_000) -> None:
     """Estimate a log file in chunks on ``workers`` processes (which load the robot from
-    ``spec``), or a ROS 2 bag whole; write the friction table with its provenance."""
+    ``spec``); a ROS 2 bag is first streamed into a temporary Parquet log beside the output.
+    Write the friction table with its provenance."""
+    import tempfile
+
     from .bags import is_bag
     from .chunked import Chunking, estimate_file
 
     provenance = {"provenance": {"log": str(log), "log_sha256": file_sha256(log), "robot": r.name,
                                  "urdf": str(r.urdf), "wbfriction": __version__}}
-    if is_bag(log):  # read whole: the bag's topics are aligned over the whole recording
-        data = _read_log(log, r, bag_map, max_gap, limit_margin)
-        with _progress(len(data), "estimate") as advance:
-            est = estimate_log(r, data, opts, progress=advance, companion=True)
-        est.metadata.update(provenance)
-        write_table(est.to_table(), output)
-        rows = len(est.time)
-    else:
-        with _progress(_row_count(log), "estimate") as advance:
-            result = estimate_file(spec, log, output, opts, chunking=Chunking(rows=chunk_rows, workers=workers),
+    with tempfile.TemporaryDirectory(prefix=".wbfriction-", dir=output.parent if output.parent.exists() else None) as tmp:
+        source = log
+        if is_bag(log):
+            source = Path(tmp) / "log.parquet"
+            with console.status(f"reading {log}"):
+                write_tables(source, _log_tables(log, bag_map))
+        with _progress(_row_count(source), "estimate") as advance:
+            result = estimate_file(spec, source, output, opts, chunking=Chunking(rows=chunk_rows, workers=workers),
                                    max_gap=max_gap, limit_margin=limit_margin, extra_metadata=provenance,
-                                   progress=advance, robot=r)
-        rows = result.rows
-    console.print(f"wrote {output}: {rows} samples")
+                                   progress=advance, robot=r, source=str(log))
+    console.print(f"wrote {output}: {result.rows} samples")
 
 
 def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, tolerance: float) -> None:
@@ -300,17 +304,23 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
 
 
 @app.command()
-def convert(bag: Path = typer.Argument(..., help="ROS 2 bag (folder with metadata.yaml; MCAP or sqlite3)."),
-            bag_map: Path = typer.Option(..., "--map", help="Topic map TOML: [joint_states], [[contacts]], [base]."),
+def convert(bag: Path = typer.Argument(..., help="ROS 2 bag (folder with metadata.yaml; MCAP or sqlite3), or a "
+                                                 "Parquet, CSV or HDF5 log."),
+            bag_map: Optional[Path] = typer.Option(None, "--map", help="Topic map TOML of a bag: [joint_states], "
+                                                                        "[[contacts]], [base]."),
             output: Path = typer.Option(..., "-o", "--output", help="Log to write (.parquet or .csv)."),
             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
             max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt) -> None:
-    """Convert a ROS 2 bag into a wbfriction log: joint states, contacts (zero-order hold) and
-    base pose (linear + slerp) aligned on the joint-state stamps, checked against the robot."""
+    """Convert a ROS 2 bag (or another log file) into a wbfriction log: joint states, contacts
+    (zero-order hold) and base pose (linear + slerp) aligned on the joint-state stamps,
+    streamed, and checked against the robot before it is renamed into place."""
+    from .chunked import check_file
+
     r = _robot(robot, urdf, config)
-    data = _read_log(bag, r, bag_map, max_gap, limit_margin)
-    write_log(data, r, output)
-    console.print(f"wrote {output} ({len(data)} samples, {data.time[-1]:.2f} s)")
+    with console.status(f"reading {bag}"):
+        rows = write_tables(output, _log_tables(bag, bag_map),
+                            check=lambda tmp: check_file(r, tmp, str(bag), max_gap=max_gap, limit_margin=limit_margin))
+    console.print(f"wrote {output} ({rows} samples)")
 
 
 @app.command()

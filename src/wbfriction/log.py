@@ -30,6 +30,7 @@ import hashlib
 import json
 import os
 import tempfile
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -142,6 +143,23 @@ def read_metadata(table: pa.Table, source: str = "<table>") -> dict:
 
 
 # ------------------------------------------------------------------- reading
+TABLE_SUFFIXES = (".parquet", ".pq", ".csv", *HDF5_SUFFIXES)
+
+
+def table_suffix(path: Path) -> str:
+    """The file type of an existing table file (lower-case suffix).
+
+    Raises:
+        InputError: a missing file, or a type that is not Parquet, CSV or HDF5.
+    """
+    if not path.is_file():
+        raise InputError(f"{path}: file not found")
+    suffix = path.suffix.lower()
+    if suffix not in TABLE_SUFFIXES:
+        raise InputError(f"{path}: unknown file type '{suffix}' (expected .parquet, .csv or .h5)")
+    return suffix
+
+
 def read_table(path: str | Path) -> pa.Table:
     """Read a Parquet, CSV or HDF5 file into an Arrow table.
 
@@ -149,14 +167,10 @@ def read_table(path: str | Path) -> pa.Table:
         InputError: missing file, unknown extension, or unreadable content.
     """
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: file not found")
-    suffix = path.suffix.lower()
+    suffix = table_suffix(path)
     if suffix in HDF5_SUFFIXES:
         return read_hdf5(path)
     readers = {".parquet": pq.read_table, ".pq": pq.read_table, ".csv": pacsv.read_csv}
-    if suffix not in readers:
-        raise InputError(f"{path}: unknown file type '{suffix}' (expected .parquet, .csv or .h5)")
     try:
         table = readers[suffix](path)
         _ = table.column_names  # decoded lazily: a damaged header fails here
@@ -375,7 +389,8 @@ def write_atomic(path: str | Path, write) -> None:
     path = Path(path)
     if path.parent and not path.parent.exists():
         raise InputError(f"{path}: output directory {path.parent} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
+    # the temporary name ends like the destination: ``write`` may read it back by its type
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{path.suffix}", dir=path.parent or ".")
     os.close(fd)
     try:
         write(Path(tmp))
@@ -394,6 +409,44 @@ def write_table(table: pa.Table, path: str | Path) -> None:
         write_atomic(path, lambda tmp: write_hdf5(table, tmp))
     else:
         write_atomic(path, lambda tmp: pq.write_table(table, tmp))
+
+
+def write_tables(path: str | Path, tables: Iterable[pa.Table], check=None) -> int:
+    """Stream tables with the same columns into one Parquet or CSV file, whole or not at
+    all: the first table gives the schema and its metadata (later ones are cast to it);
+    ``check(tmp_path)``, if given, runs on the complete temporary file before the rename and
+    may raise to keep the previous output. Returns the rows written.
+
+    Raises:
+        InputError: an output that is neither .parquet nor .csv, or no table at all; what
+            the tables' source or ``check`` raises.
+    """
+    path = Path(path)
+    if path.suffix.lower() not in (".parquet", ".pq", ".csv"):
+        raise InputError(f"{path}: tables are streamed as .parquet or .csv")
+    rows = 0
+
+    def write(tmp: Path) -> None:
+        nonlocal rows
+        writer = None
+        try:
+            for table in tables:
+                if writer is None:
+                    schema = table.schema
+                    writer = (pacsv.CSVWriter(tmp, schema) if path.suffix.lower() == ".csv"
+                              else pq.ParquetWriter(tmp, schema))
+                writer.write_table(table.cast(schema) if table.schema != schema else table)
+                rows += table.num_rows
+        finally:
+            if writer is not None:
+                writer.close()
+        if writer is None:
+            raise InputError(f"{path}: nothing to write")
+        if check is not None:
+            check(tmp)
+
+    write_atomic(path, write)
+    return rows
 
 
 def write_log(log: Log, robot: Robot, path: str | Path) -> None:
