@@ -254,7 +254,7 @@ def estimate_from_table(table: pa.Table, source: str = "<table>") -> FrictionEst
         companion_diff=companion_diff)
 
 
-def _stance_frame_pose(robot: Robot, stance: StanceModel, angles: np.ndarray, base: np.ndarray | None) -> np.ndarray:
+def stance_frame_pose(robot: Robot, stance: StanceModel, angles: np.ndarray, base: np.ndarray | None) -> np.ndarray:
     """World pose of the stance frame: identity (flat, at the origin) or from the logged base."""
     n = angles.shape[0]
     pose = np.zeros((n, 7))
@@ -296,7 +296,7 @@ def single_support_friction_rnea(robot: Robot, contact_index: int, angles: np.nd
     delta = np.full_like(tau_tc, np.nan, dtype=float)
     for start in range(0, angles.shape[0], CHUNK):
         sl = slice(start, start + CHUNK)
-        pose = _stance_frame_pose(robot, stance, angles[sl], None if base is None else base[sl])
+        pose = stance_frame_pose(robot, stance, angles[sl], None if base is None else base[sl])
         tau_joint, _ = stance.inverse_dynamics(pose, angles[sl], qd[sl], qdd[sl])
         tau_f[sl] = tau_joint[:, robot.tc_index] - tau_tc[sl]
         if with_delta:

@@ -55,7 +55,8 @@ def _graph_joint(joint: pin.JointModel):
     raise ModelError(f"joint type {short} is not supported by the stance models")
 
 
-def _body(j: int) -> str:
+def body_frame(j: int) -> str:
+    """Name of the frame that marks body ``j`` of the original model in a stance-rooted model."""
     return f"__wbf_body_{j}"
 
 
@@ -145,12 +146,12 @@ def build_stance_model(robot: Robot, frame: str) -> StanceModel:
     model = robot.model
     graph = _G.ModelGraph()
     for j in range(1, model.njoints):
-        graph.addBody(_body(j), model.inertias[j])
+        graph.addBody(body_frame(j), model.inertias[j])
     for j in range(2, model.njoints):
-        graph.addJoint(model.names[j], _graph_joint(model.joints[j]), _body(model.parents[j]),
-                       model.jointPlacements[j], _body(j), pin.SE3.Identity())
+        graph.addJoint(model.names[j], _graph_joint(model.joints[j]), body_frame(model.parents[j]),
+                       model.jointPlacements[j], body_frame(j), pin.SE3.Identity())
     fr = model.frames[model.getFrameId(frame)]
-    rooted = _G.buildModel(graph, _body(fr.parentJoint), fr.placement.inverse(), _G.JointFreeFlyer())
+    rooted = _G.buildModel(graph, body_frame(fr.parentJoint), fr.placement.inverse(), _G.JointFreeFlyer())
     # pin.graph places the root joint at the foot body, the contact frame's offset in the
     # root joint's placement, i.e. on the universe side of the root's motion: the root
     # configuration would then not be the contact frame's pose (rotations compose in the
@@ -169,7 +170,7 @@ def build_stance_model(robot: Robot, frame: str) -> StanceModel:
     # reached through a reversed joint with an offset placement in the wrong frame.)
     carriers = set()
     for j in range(1, model.njoints):
-        body = rooted.frames[rooted.getFrameId(_body(j))]
+        body = rooted.frames[rooted.getFrameId(body_frame(j))]
         if body.parentJoint in carriers:  # pragma: no cover - would break the one-body-per-joint invariant
             raise ModelError("re-rooted model merges two bodies into one joint")
         carriers.add(body.parentJoint)
@@ -203,6 +204,6 @@ def _check_kinematics(robot: Robot, stance: StanceModel, seed: int = 0) -> None:
     f_m = dm.oMf[m.getFrameId(stance.frame)]
     for j in range(1, m.njoints):
         rel_m = f_m.actInv(dm.oMi[j])
-        rel_r = dr.oMf[r.getFrameId(_body(j))]  # root frame is the contact frame at identity
+        rel_r = dr.oMf[r.getFrameId(body_frame(j))]  # root frame is the contact frame at identity
         if not np.allclose(rel_m.homogeneous, rel_r.homogeneous, atol=1e-9):
             raise ModelError(f"re-rooted model at '{stance.frame}' disagrees with the original at body of '{m.names[j]}'")

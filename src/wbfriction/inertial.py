@@ -1,0 +1,563 @@
+"""The inertia model and the friction identified together from walking logs (thesis 2.4, ch. 8).
+
+The thesis found its real-robot friction estimates limited by an inaccurate inertia
+model, and proposed a direct identification of the dynamic parameters. The inverse
+dynamics are linear in the bodies' inertial parameters
+``pi_b = (m, m c_x, m c_y, m c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz)`` (about the body's
+joint frame; ``pin.Inertia.toDynamicParameters`` order) and, for a fixed tanh slope
+``a``, in the Coulomb, viscous and offset parameters of the friction model (3.5)
+without its Stribeck term.
+
+**The equations that hold without the contact forces.** In single support the stance
+foot is welded to the ground and the robot is a fixed-base tree rooted at it
+(:mod:`wbfriction.stance`); every joint row of that tree's inverse dynamics is free of
+the contact wrench (which acts at the root). That is the floating-base dynamics
+projected into the null space of the stance foot's Jacobian, in the coordinates of the
+joint velocities. For torque-controlled joint ``i``:
+
+.. math::
+
+    Y_i(q, \\dot q, \\ddot q)\\,\\pi + F_{v,i}\\,\\dot q_i + F_{c,i}\\tanh(a\\,\\dot q_i) + \\tau_{os,i}
+    = \\tau_i - I_{a,i}\\,\\ddot q_i
+
+(``Y`` from ``pin.computeJointTorqueRegressor`` on the stance-rooted tree, its columns
+mapped back to the original bodies; ``I_a`` the armature; ``tau_f = -f(qd)`` as in
+:mod:`wbfriction.friction`). Position-controlled joints' rows are left out: their
+torques are not logged. Stacked over the samples, the system is compressed as it is
+built (a QR factorization of the rows seen so far), so long logs need memory of the
+size of the parameter vector only.
+
+**Base parameters.** A walk does not excite every parameter; the identifiable
+combinations are found numerically by QR with column pivoting of the compressed
+regressor (:func:`base_parameters`).
+
+**Physical consistency and prior.** Each body's parameters are written through the
+log-Cholesky parametrisation (Rucker & Wensing, *Smooth parameterization of rigid-body
+inertia*, IEEE RA-L 2022; ``pin.LogCholeskyParameters``), so every estimate is a
+physical rigid body (positive mass, positive-definite pseudo-inertia: the triangle
+inequalities hold). A Tikhonov prior pulls toward the given model where the data say
+nothing: its weight is ``prior`` times the largest squared singular value of the
+scaled regressor, so only directions weaker than ``sqrt(prior)`` of the best-excited
+one follow the prior. The problem is solved with ``scipy.optimize.least_squares``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+import scipy.linalg
+from scipy.optimize import least_squares
+
+from .estimate import EstimateOptions, stance_frame_pose
+from .exceptions import InputError
+from .kinematics import MeasuredKinematics, measure
+from .log import Log
+from .phases import segment
+from .robot import Robot
+from .stance import StanceModel, body_frame, stance_model
+
+PARAMS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
+"""The ten inertial parameters of a body, in ``pin.Inertia.toDynamicParameters`` order
+[kg, kg·m, kg·m^2]: mass, first moments, rotational inertia about the joint frame."""
+FRICTION = ("F_v", "F_c", "tau_os")
+"""Friction parameters identified per torque-controlled joint (3.5 without Stribeck)."""
+STRIBECK = "F_s"
+"""With a fixed Stribeck velocity ``v_s``, the Stribeck term's height ``F_s = S F_c`` [N·m] too."""
+
+
+def body_parameters(model: pin.Model) -> np.ndarray:
+    """The inertial parameters of every body (joint) of ``model``, (n_bodies, 10)."""
+    return np.array([model.inertias[j].toDynamicParameters() for j in range(1, model.njoints)])
+
+
+def with_body_parameters(model: pin.Model, pi: np.ndarray) -> pin.Model:
+    """A copy of ``model`` with body ``j``'s inertia from row ``j - 1`` of ``pi`` (n_bodies, 10)."""
+    out = pin.Model(model)
+    for j in range(1, model.njoints):
+        out.inertias[j] = pin.Inertia.FromDynamicParameters(np.asarray(pi[j - 1], dtype=float))
+    return out
+
+
+def act_matrix(placement: pin.SE3) -> np.ndarray:
+    """The linear map (10, 10) of ``placement.act`` on dynamic parameters: the parameters
+    of a body expressed in a frame whose pose in the current one is ``placement``...
+    i.e. ``toDynamicParameters(placement.act(I)) = A @ toDynamicParameters(I)``."""
+    ref = np.array([1.0, 0, 0, 0, 1, 0, 1, 0, 0, 1])  # unit mass, unit inertia: the map is affine-free
+    base = placement.act(pin.Inertia.FromDynamicParameters(ref)).toDynamicParameters()
+    cols = []
+    for k in range(10):
+        e = ref.copy()
+        e[k] += 1.0
+        cols.append(placement.act(pin.Inertia.FromDynamicParameters(e)).toDynamicParameters() - base)
+    return np.array(cols).T
+
+
+@dataclass
+class StanceRegressor:
+    """Joint-torque regressor of the robot standing on one contact frame.
+
+    The regressor of the stance-rooted tree is in the parameters of its own bodies, each
+    expressed in the frame of the rooted joint that carries it; :attr:`to_rooted` maps the
+    original model's parameters to those (a fixed linear map, so that a least-squares
+    system built in rooted parameters is mapped once, not row by row).
+
+    Attributes:
+        stance: the stance-rooted model (:mod:`wbfriction.stance`).
+        to_rooted: (10 n_bodies, 10 n_bodies): ``pi_rooted = to_rooted @ pi.ravel()``.
+    """
+
+    stance: StanceModel
+    to_rooted: np.ndarray
+    data: pin.Data = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.data = self.stance.model.createData()
+
+    def joint_rows(self, frame_pose: np.ndarray, angles: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """``Y`` with ``Y @ to_rooted @ pi.ravel() = S (M qdd + h - J^T lambda)`` (without the
+        armature): the generalized forces of the actuated joints, for each sample.
+
+        Args:
+            frame_pose: world pose of the stance frame (N, 7) (x, y, z, qx, qy, qz, qw).
+            angles, qd, qdd: actuated joints' positions, velocities, accelerations (N, n_act).
+
+        Returns:
+            (N, n_act, 10 n_bodies), in the original joints' signs.
+        """
+        model, st = self.stance.model, self.stance
+        q = st.layout.configuration(angles, frame_pose, st.sign)
+        n = angles.shape[0]
+        Y = np.empty((n, len(st.v_index), 10 * (model.njoints - 1)))
+        v = np.zeros(model.nv)
+        a = np.zeros(model.nv)
+        for k in range(n):
+            v[st.v_index] = qd[k] * st.sign
+            a[st.v_index] = qdd[k] * st.sign
+            Y[k] = pin.computeJointTorqueRegressor(model, self.data, q[k], v, a)[st.v_index]
+        return Y * st.sign[None, :, None]
+
+
+def stance_regressor(robot: Robot, contact_index: int) -> StanceRegressor:
+    """The regressor of ``robot`` standing on contact ``contact_index`` (built once)."""
+    key = ("regressor", contact_index)
+    if key not in robot.cache:
+        stance = stance_model(robot, contact_index)
+        nb = robot.model.njoints - 1
+        T = np.zeros((10 * nb, 10 * nb))
+        for j in range(1, robot.model.njoints):
+            f = stance.model.frames[stance.model.getFrameId(body_frame(j))]
+            c = f.parentJoint - 1
+            T[10 * c:10 * c + 10, 10 * (j - 1):10 * j] = act_matrix(f.placement)
+        robot.cache[key] = StanceRegressor(stance, T)
+    return robot.cache[key]
+
+
+class CompressedLeastSquares:
+    """``min |A x - b|^2`` over rows added block by block, kept as the triangular factor
+    ``R`` (p, p) and ``z`` (p,) of the rows seen so far (``|A x - b|^2 = |R x - z|^2 + const``):
+    memory of the size of ``x``, not of the data."""
+
+    def __init__(self, n_params: int):
+        self.n = n_params
+        self._Rz = np.zeros((0, n_params + 1))
+        self.rows = 0
+
+    def add(self, A: np.ndarray, b: np.ndarray) -> None:
+        """Append rows ``A`` (m, p) with right-hand sides ``b`` (m,)."""
+        stacked = np.vstack([self._Rz, np.column_stack([A, b])])
+        self._Rz = scipy.linalg.qr(stacked, mode="r", overwrite_a=True, check_finite=False)[0][: self.n + 1]
+        self.rows += len(b)
+
+    @property
+    def R(self) -> np.ndarray:
+        return np.triu(self._Rz[: self.n, : self.n])
+
+    @property
+    def z(self) -> np.ndarray:
+        return self._Rz[: self.n, self.n]
+
+
+
+@dataclass(frozen=True)
+class BaseParameters:
+    """The identifiable combinations of the parameters (base parameters).
+
+    Attributes:
+        independent: indices of the parameters chosen as base parameters (r,), the pivots
+            of a QR factorization with column pivoting of the regressor.
+        combination: (r, p): base parameter ``k`` is ``combination[k] @ x``, i.e. its
+            independent parameter plus the dependent ones it absorbs.
+        condition: condition number of the regressor's base-parameter columns.
+        rank_tolerance: relative size of a pivot below which a column counts as dependent.
+    """
+
+    independent: np.ndarray
+    combination: np.ndarray
+    condition: float
+    rank_tolerance: float
+
+    @property
+    def count(self) -> int:
+        return len(self.independent)
+
+
+def base_parameters(R: np.ndarray, rank_tolerance: float = 1e-8) -> BaseParameters:
+    """Base parameters of a regressor given by its triangular factor ``R`` (p, p)
+    (:class:`CompressedLeastSquares`; ``R`` and the stacked regressor have the same
+    column dependencies), by QR with column pivoting: ``R P = Q [R1 R2]``, rank ``r`` where
+    ``|R1_kk| > rank_tolerance |R1_11|``; the dependent columns are ``R1^-1 R2`` times
+    the independent ones, so the base parameters are ``x_indep + R1^-1 R2 x_dep``.
+
+    Columns are scaled to unit norm first, so the rank does not depend on units.
+    """
+    norms = np.linalg.norm(R, axis=0)
+    scale = np.where(norms > 0, norms, 1.0)
+    _, r_fac, perm = scipy.linalg.qr(R / scale, mode="economic", pivoting=True)
+    diag = np.abs(np.diag(r_fac))
+    rank = int(np.sum(diag > rank_tolerance * diag[0])) if diag.size and diag[0] > 0 else 0
+    R1, R2 = r_fac[:rank, :rank], r_fac[:rank, rank:]
+    K = scipy.linalg.solve_triangular(R1, R2)  # scaled dependent -> independent
+    combination = np.zeros((rank, R.shape[1]))
+    ind, dep = perm[:rank], perm[rank:]
+    combination[np.arange(rank), ind] = 1.0
+    combination[:, dep] = K * scale[dep][None, :] / scale[ind][:, None]
+    s = np.linalg.svd(R[:, ind], compute_uv=False)
+    return BaseParameters(np.sort(ind), combination[np.argsort(ind)], float(s[0] / s[-1]) if rank else np.inf,
+                          rank_tolerance)
+
+
+def log_cholesky(pi: np.ndarray, min_mass: float = 1e-3) -> np.ndarray:
+    """Log-Cholesky parameters (10,) of a body with dynamic parameters ``pi`` (10,), in
+    ``pin.LogCholeskyParameters`` order ``(alpha, d1, d2, d3, s12, s23, s13, t1, t2, t3)``:
+    the pseudo-inertia ``J = U U^T`` with ``U = e^alpha [[e^d1, s12, s13, t1], [0, e^d2,
+    s23, t2], [0, 0, e^d3, t3], [0, 0, 0, 1]]`` (Rucker & Wensing 2022).
+
+    A body without mass or with a singular pseudo-inertia (a point or a rod) has none: it
+    is replaced by a solid sphere of ``min_mass`` [kg] and 1 cm radius at its centre of
+    mass (or origin), the nearest start a physical parametrisation can take.
+    """
+    J = pin.PseudoInertia.FromDynamicParameters(np.asarray(pi, dtype=float)).toMatrix()
+    flip = np.eye(4)[::-1]
+    try:
+        U = flip @ np.linalg.cholesky(flip @ J @ flip) @ flip
+    except np.linalg.LinAlgError:
+        m = max(float(pi[0]), min_mass)
+        c = np.asarray(pi[1:4]) / pi[0] if pi[0] > 0 else np.zeros(3)
+        sphere = pin.Inertia(m, c, np.eye(3) * 0.4 * m * 0.01 ** 2)
+        return log_cholesky(sphere.toDynamicParameters(), min_mass)
+    alpha = np.log(U[3, 3])
+    Un = U / U[3, 3]
+    return np.array([alpha, *np.log(np.diag(Un)[:3]), Un[0, 1], Un[1, 2], Un[0, 2], *Un[:3, 3]])
+
+
+def _parameters(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Dynamic parameters (nb, 10) of log-Cholesky parameters (nb, 10), and their Jacobians (nb, 10, 10)."""
+    pi, jac = np.empty_like(theta), np.empty((len(theta), 10, 10))
+    for b, t in enumerate(theta):
+        lc = pin.LogCholeskyParameters(t)
+        pi[b] = lc.toDynamicParameters()
+        jac[b] = lc.calculateJacobian()
+    return pi, jac
+
+
+def parameter_scales(pi0: np.ndarray, min_mass: float = 1e-3, length: float = 0.1) -> np.ndarray:
+    """Scale of each inertial parameter (nb, 10), for the prior and for the rank test:
+    ``m``, ``m length``, ``m length^2`` with ``m`` the body's given mass (at least ``min_mass``)
+    and ``length`` a body size [m]."""
+    m = np.maximum(pi0[:, 0], min_mass)[:, None]
+    return np.hstack([m, np.repeat(m * length, 3, axis=1), np.repeat(m * length ** 2, 6, axis=1)])
+
+
+@dataclass(frozen=True)
+class ConsistentFit:
+    """Result of :func:`fit_consistent`: inertial parameters (nb, 10), physically consistent;
+    friction parameters (n_tc, 3) (``F_v, F_c, tau_os``); the optimizer's message."""
+
+    pi: np.ndarray
+    friction: np.ndarray
+    cost: float
+    message: str
+
+
+def is_consistent(pi: np.ndarray, margin: float = 0.0) -> np.ndarray:
+    """Physical consistency of bodies (nb, 10) -> (nb,): a positive-definite pseudo-inertia
+    (positive mass and principal moments that satisfy the triangle inequalities; Wensing et
+    al., *Linear matrix inequalities for physically consistent inertial parameter
+    identification*, IEEE RA-L 2018), its smallest eigenvalue above ``margin`` times its largest."""
+    out = np.empty(len(pi), dtype=bool)
+    for b, p in enumerate(pi):
+        ev = np.linalg.eigvalsh(pin.PseudoInertia.FromDynamicParameters(np.asarray(p, dtype=float)).toMatrix())
+        out[b] = ev[0] > margin * max(ev[-1], 0.0) and ev[-1] > 0
+    return out
+
+
+def fit_consistent(R: np.ndarray, z: np.ndarray, pi0: np.ndarray, friction0: np.ndarray, prior: float = 1e-9,
+                   min_mass: float = 1e-3) -> ConsistentFit:
+    """Solve ``min |R x - z|^2 + lambda |D (x - x0)|^2`` over physically consistent bodies.
+
+    ``x = (pi.ravel(), friction.ravel())``; ``x0`` is the given model (``pi0``,
+    ``friction0``); ``D`` divides by :func:`parameter_scales` (1 for friction);
+    ``lambda = prior * sigma_max(R D^-1)^2``. The linear least-squares solution is taken
+    when every body it gives is physically consistent (:func:`is_consistent`); otherwise
+    each body is written through its log-Cholesky parameters (so that every iterate is a
+    rigid body) and the problem is solved by ``scipy.optimize.least_squares``, from the
+    linear solution's consistent bodies and the given model's others.
+
+    Args:
+        R, z: the compressed regressor (p, p) and right-hand side (p,), columns ordered as ``x``.
+        pi0: given inertial parameters (nb, 10); friction0: starting friction (n_tc, k).
+        prior: relative weight of the prior.
+        min_mass: smallest mass of a body's starting point [kg] (:func:`log_cholesky`).
+    """
+    nb, nf = len(pi0), friction0.size
+    x0 = np.concatenate([pi0.ravel(), friction0.ravel()])
+    d = 1.0 / np.concatenate([parameter_scales(pi0, min_mass).ravel(), np.ones(nf)])
+    sigma = np.linalg.norm(R / d[None, :], 2)
+    w = np.sqrt(prior) * sigma * d
+    x_lin = np.linalg.lstsq(np.vstack([R, np.diag(w)]), np.concatenate([z, w * x0]), rcond=None)[0]
+    pi_lin = x_lin[: 10 * nb].reshape(nb, 10)
+    ok = is_consistent(pi_lin, 1e-12)
+    if ok.all():
+        r = np.concatenate([R @ x_lin - z, w * (x_lin - x0)])
+        return ConsistentFit(pi_lin, x_lin[10 * nb:].reshape(friction0.shape), 0.5 * float(r @ r),
+                             "the linear least-squares solution is physically consistent")
+
+    def unpack(v):
+        pi, jac = _parameters(v[: 10 * nb].reshape(nb, 10))
+        return np.concatenate([pi.ravel(), v[10 * nb:]]), jac
+
+    def fun(v):
+        x, _ = unpack(v)
+        return np.concatenate([R @ x - z, w * (x - x0)])
+
+    def jac(v):
+        _, jb = unpack(v)
+        dx = scipy.linalg.block_diag(*jb, np.eye(nf))
+        return np.vstack([R @ dx, w[:, None] * dx])
+
+    start = np.where(ok[:, None], pi_lin, pi0)
+    theta0 = np.array([log_cholesky(p, min_mass) for p in start])
+    res = least_squares(fun, np.concatenate([theta0.ravel(), x_lin[10 * nb:]]), jac=jac, method="trf",
+                        x_scale="jac", max_nfev=200)
+    x, _ = unpack(res.x)
+    return ConsistentFit(x[: 10 * nb].reshape(nb, 10), x[10 * nb:].reshape(friction0.shape), float(res.cost),
+                         f"{int((~ok).sum())} bodies of the linear solution were not physical: {res.message}")
+
+
+@dataclass(frozen=True)
+class InertialOptions:
+    """Options of :func:`identify_inertia`.
+
+    Attributes:
+        tanh_slope: ``a`` of the Coulomb term ``F_c tanh(a qd)`` [s/rad].
+        stribeck_velocity: ``v_s`` [rad/s] of a Stribeck term ``F_s tanh(a qd) exp(-(qd/v_s)^2)``
+            identified with the others (3.5 with ``delta_s = 2``; ``F_s = S F_c``), for
+            example the one the acceleration route's fit found; None: no Stribeck term.
+        stride: every ``stride``-th single-support sample enters the regression (1 kHz
+            logs are far denser than the dynamics need).
+        holdout: share of the log, at its end, kept out of the regression to compare the
+            models' torque predictions.
+        prior: relative weight of the prior toward the given model (:func:`fit_consistent`).
+        rank_tolerance: relative pivot below which a parameter is not identifiable
+            (:func:`base_parameters`).
+        min_mass: smallest mass a body's starting point gets [kg].
+        block: samples per block of the compressed regression.
+    """
+
+    tanh_slope: float = 40.0
+    stribeck_velocity: float | None = None
+    stride: int = 5
+    holdout: float = 0.2
+    prior: float = 1e-9
+    rank_tolerance: float = 1e-8
+    min_mass: float = 1e-3
+    block: int = 200
+
+
+@dataclass
+class TorqueFit:
+    """RMS of measured minus predicted joint torques per torque-controlled joint [N·m]."""
+
+    given: np.ndarray
+    given_with_friction: np.ndarray
+    identified: np.ndarray
+    samples: int
+
+
+@dataclass
+class InertialIdentification:
+    """What :func:`identify_inertia` found.
+
+    Attributes:
+        robot: the robot with the identified inertias (same structure as the given one).
+        bodies: body names (the Pinocchio joint carrying each body) (nb,).
+        pi_given, pi: inertial parameters of the given and identified model (nb, 10).
+        friction_names: the friction parameters (:func:`friction_names`), k of them.
+        friction: identified friction parameters per torque-controlled joint (n_tc, k).
+        friction_given_model: the friction that best explains the data with the given
+            inertias (n_tc, k).
+        base: the base parameters, over ``(pi.ravel(), friction.ravel())``.
+        holdout: torque predictions on the held-out samples; ``training`` on the others.
+        samples: single-support samples in the regression.
+        message: the optimizer's.
+    """
+
+    robot: Robot
+    bodies: tuple[str, ...]
+    pi_given: np.ndarray
+    pi: np.ndarray
+    friction_names: tuple[str, ...]
+    friction: np.ndarray
+    friction_given_model: np.ndarray
+    base: BaseParameters
+    holdout: TorqueFit
+    training: TorqueFit
+    samples: int
+    message: str
+
+
+def friction_names(options: "InertialOptions") -> tuple[str, ...]:
+    """The friction parameters identified per joint with ``options``."""
+    return FRICTION + ((STRIBECK,) if options.stribeck_velocity is not None else ())
+
+
+def _friction_columns(qd_tc: np.ndarray, options: "InertialOptions") -> np.ndarray:
+    """(N, n_tc, k n_tc): joint ``i``'s row holds ``qd_i, tanh(a qd_i), 1`` (and the Stribeck
+    column ``tanh(a qd_i) exp(-(qd_i / v_s)^2)``) in its ``k`` columns, ``f(qd) = columns @ params``."""
+    n, m = qd_tc.shape
+    k = len(friction_names(options))
+    out = np.zeros((n, m, k * m))
+    idx = np.arange(m)
+    coulomb = np.tanh(options.tanh_slope * qd_tc)
+    out[:, idx, k * idx] = qd_tc
+    out[:, idx, k * idx + 1] = coulomb
+    out[:, idx, k * idx + 2] = 1.0
+    if k == 4:
+        out[:, idx, k * idx + 3] = coulomb * np.exp(-(qd_tc / options.stribeck_velocity) ** 2)
+    return out
+
+
+def _split(robot: Robot, log: Log, est: EstimateOptions, opts: InertialOptions):
+    """Per log part: its kinematics and the training / held-out single-support rows."""
+    cut = log.time[0] + (1.0 - opts.holdout) * (log.time[-1] - log.time[0])
+    out = []
+    for part in log.parts():
+        try:
+            kin = measure(part, est.diff, compensate_delay=est.compensate_delay,
+                          torque_alignment=est.torque_alignment, filtering=est.filtering)
+        except InputError:
+            continue  # too short for the scheme: nothing to learn from it
+        phases = segment(kin.time, kin.contact, est.lift_off_skip, est.touch_down_skip)
+        use = kin.valid & phases.keep
+        train = np.zeros_like(use)
+        idx = np.flatnonzero(use & (part.time < cut))
+        train[idx[:: opts.stride]] = True
+        held = use & (part.time >= cut)
+        out.append((kin, phases.stance, train, held))
+    return out
+
+
+def _rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int, options: InertialOptions):
+    """Regressor rows (rooted parameters), friction columns and right-hand side of samples ``r``."""
+    reg = stance_regressor(robot, c)
+    tc = robot.tc_index
+    pose = stance_frame_pose(robot, reg.stance, kin.q[r], None if kin.base is None else kin.base[r])
+    Y = reg.joint_rows(pose, kin.q[r], kin.qd[r], kin.qdd[r])[:, tc]
+    F = _friction_columns(kin.qd[r][:, tc], options)
+    arm = robot.model.armature[robot.act_v_index][tc]
+    b = kin.tau[r] - arm * kin.qdd[r][:, tc]
+    return Y, F, b
+
+
+def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions = EstimateOptions(),
+                     options: InertialOptions = InertialOptions(), progress=None) -> InertialIdentification:
+    """Identify every body's inertial parameters and the joints' Coulomb, viscous and
+    offset friction from a walking log (module docstring), starting from and regularised
+    toward ``robot``'s model.
+
+    Args:
+        robot: the given model.
+        log: a log with single-support stretches.
+        estimate_options: differentiation, torque alignment and phase margins, as for the
+            friction estimate (:class:`~wbfriction.estimate.EstimateOptions`).
+        options: :class:`InertialOptions`.
+        progress: optional callable receiving numbers of samples done.
+
+    Returns:
+        :class:`InertialIdentification`.
+
+    Raises:
+        InputError: no single-support sample to learn from, or none held out.
+    """
+    parts = _split(robot, log, estimate_options, options)
+    nb, n_tc = robot.model.njoints - 1, len(robot.torque_controlled)
+    k = len(friction_names(options))
+    p_in, p = 10 * nb, 10 * nb + k * n_tc
+    systems = {c: CompressedLeastSquares(p) for c in range(len(robot.contact_frames))}
+    samples = 0
+    for kin, stance, train, _ in parts:
+        for c, system in systems.items():
+            r = np.flatnonzero(train & (stance == c))
+            for start in range(0, r.size, options.block):
+                rr = r[start:start + options.block]
+                Y, F, b = _rows(robot, kin, rr, c, options)
+                system.add(np.concatenate([Y, F], axis=2).reshape(-1, p), b.ravel())
+                samples += rr.size
+                if progress is not None:
+                    progress(rr.size)
+    if samples == 0:
+        raise InputError(f"{log.source}: no single-support sample to identify the inertia model from")
+    # the stances' systems in the original bodies' parameters, stacked and compressed again
+    total = CompressedLeastSquares(p)
+    for c, system in systems.items():
+        if system.rows:
+            T = scipy.linalg.block_diag(stance_regressor(robot, c).to_rooted, np.eye(k * n_tc))
+            total.add(system.R @ T, system.z)
+    R, z = total.R, total.z
+    pi0 = body_parameters(robot.model)
+    # friction that best explains the data with the given inertias: the start, and the given model's best case
+    friction0 = np.linalg.lstsq(R[:, p_in:], z - R[:, :p_in] @ pi0.ravel(), rcond=None)[0].reshape(n_tc, k)
+    scales = np.concatenate([parameter_scales(pi0, options.min_mass).ravel(), np.ones(k * n_tc)])
+    base = base_parameters(R * scales[None, :], options.rank_tolerance)
+    base = BaseParameters(base.independent, base.combination / scales[None, :] * scales[base.independent][:, None],
+                          base.condition, base.rank_tolerance)
+    fit = fit_consistent(R, z, pi0, friction0, options.prior, options.min_mass)
+    identified = _with_inertias(robot, fit.pi)
+    holdout = _torque_fit(robot, parts, 3, pi0, friction0, fit, options)
+    training = _torque_fit(robot, parts, 2, pi0, friction0, fit, options)
+    if holdout.samples == 0:
+        raise InputError(f"{log.source}: no single-support sample in the held-out {options.holdout:.0%} of the log")
+    return InertialIdentification(identified, tuple(robot.model.names[1:]), pi0, fit.pi, friction_names(options),
+                                  fit.friction, friction0, base, holdout, training, samples, fit.message)
+
+
+def _with_inertias(robot: Robot, pi: np.ndarray) -> Robot:
+    import dataclasses
+
+    return dataclasses.replace(robot, model=with_body_parameters(robot.model, pi), cache={})
+
+
+def _torque_fit(robot: Robot, parts, which: int, pi0: np.ndarray, friction0: np.ndarray, fit: ConsistentFit,
+                options: InertialOptions) -> TorqueFit:
+    """RMS torque errors of the given model (without and with its best friction) and of the
+    identified one on the training (``which = 2``) or held-out (3) samples."""
+    n_tc = len(robot.torque_controlled)
+    sq = np.zeros((3, n_tc))
+    count = 0
+    for part in parts:
+        kin, stance, rows = part[0], part[1], part[which]
+        for c in range(len(robot.contact_frames)):
+            r = np.flatnonzero(rows & (stance == c))
+            for start in range(0, r.size, 1000):
+                rr = r[start:start + 1000]
+                Y, F, b = _rows(robot, kin, rr, c, options)
+                T = stance_regressor(robot, c).to_rooted
+                given = Y @ (T @ pi0.ravel())
+                preds = (given, given + F @ friction0.ravel(), Y @ (T @ fit.pi.ravel()) + F @ fit.friction.ravel())
+                for k, pred in enumerate(preds):
+                    sq[k] += np.sum((pred - b) ** 2, axis=0)
+                count += rr.size
+    rms = np.sqrt(sq / max(count, 1))
+    return TorqueFit(rms[0], rms[1], rms[2], count)
