@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -25,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench_long_log import tree_rss
+from bench_long_log import measure
 from wbfriction.friction import THESIS_TARGETS
 from wbfriction.robot import load_robot
 from wbfriction.sim import simulate_ideal
@@ -101,19 +100,6 @@ def build_bag(path: Path, minutes: float) -> int:
         for item in late:
             w.write(c_od, *item)
     return total
-
-
-def measure(cmd: list[str]) -> tuple[float, int]:
-    """Wall time [s] and peak resident memory of the command's process tree [bytes]."""
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    peak = 0
-    while proc.poll() is None:
-        peak = max(peak, tree_rss(proc.pid))
-        time.sleep(0.2)
-    if proc.returncode != 0:
-        raise SystemExit(proc.stderr.read())
-    return time.perf_counter() - t0, peak
 
 
 def main() -> None:

@@ -73,6 +73,20 @@ def tree_rss(pid: int) -> int:
     return total
 
 
+def measure(cmd: list[str]) -> tuple[float, int]:
+    """Run ``cmd``: its wall time [s] and the peak resident memory of its process tree [bytes]
+    (sampled every 0.2 s). Exits with the command's error output if it fails."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    peak = 0
+    while proc.poll() is None:
+        peak = max(peak, tree_rss(proc.pid))
+        time.sleep(0.2)
+    if proc.returncode != 0:
+        raise SystemExit(proc.stderr.read())
+    return time.perf_counter() - t0, peak
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=60.0)
@@ -91,14 +105,8 @@ def main() -> None:
         # sampled as the sum of the resident sets of the process and its workers
         cmd = [sys.executable, "-m", "wbfriction", "estimate", str(log), "-o", str(folder / "long_friction.parquet"),
                "--workers", str(args.workers), "--chunk-rows", str(args.chunk_rows)]
-        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        peak = 0
-        while proc.poll() is None:
-            peak = max(peak, tree_rss(proc.pid))
-            time.sleep(0.2)
-        t2 = time.perf_counter()
-        if proc.returncode != 0:
-            raise SystemExit(proc.stderr.read())
+        seconds, peak = measure(cmd)
+        t2 = t1 + seconds
         largest = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
         print(f"log: {rows} rows ({rows / 1000 / 60:.1f} min at 1 kHz), {log.stat().st_size / 2**30:.2f} GiB, "
               f"built in {t1 - t0:.0f} s")
