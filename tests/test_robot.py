@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 
 from wbfriction.exceptions import InputError
-from wbfriction.robot import build_robot
+from wbfriction.robot import build_robot, load_robot
 from wbfriction.stance import stance_model
 
 
@@ -74,3 +74,16 @@ def test_stance_wrench_is_the_contact_wrench_in_the_contact_frame(robot_name, re
     tau_joint, wrench = stance_model(robot, 1).inverse_dynamics(pose, robot.angles(q)[None], v[iv][None], a[iv][None])
     np.testing.assert_allclose(tau_joint[0], tau[iv], atol=1e-8)
     np.testing.assert_allclose(wrench[0], lam, atol=1e-8 * (1 + np.abs(lam).max()))
+
+
+def test_a_built_in_robot_on_another_urdf(talos, tmp_path):
+    """``--robot talos --urdf FILE``: TALOS's configuration on another URDF of it (as an
+    identified model is written); a URDF of another robot is refused by name."""
+    other = load_robot("talos", urdf=talos.urdf)
+    assert other.actuated == talos.actuated and other.torque_controlled == talos.torque_controlled
+    assert other.contact_frames == talos.contact_frames and other.groups == talos.groups
+    (tmp_path / "small.urdf").write_text("<robot name='x'><link name='a'/></robot>")
+    with pytest.raises(InputError, match="unknown"):
+        load_robot("talos", urdf=tmp_path / "small.urdf")
+    with pytest.raises(InputError, match="--config needs the robot's --urdf"):
+        load_robot("talos", config=tmp_path / "c.toml")

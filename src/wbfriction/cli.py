@@ -47,7 +47,8 @@ EnergyThresholdOpt = typer.Option(DEFAULT_THRESHOLD, help="Share of power-genera
                                                           "which a joint is flagged.")
 EnergyToleranceOpt = typer.Option(DEFAULT_TOLERANCE, help="Smallest friction torque that counts as generating "
                                                           "power [N·m] (the torque sensor's resolution).")
-UrdfOpt = typer.Option(None, "--urdf", help="URDF of another robot (with --config).")
+UrdfOpt = typer.Option(None, "--urdf", help="URDF of another robot (with --config), or another URDF of the "
+                                             "built-in --robot (e.g. identified inertias).")
 ConfigOpt = typer.Option(None, "--config", help="Robot TOML: contact_frames, position_controlled, groups.")
 MapOpt = typer.Option(None, "--map", help="Topic map TOML of a ROS 2 bag log (see 'wbfriction convert').")
 
@@ -297,7 +298,7 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
                                                    cutoff=cutoff, butter_order=butter_order))
     from .chunked import RobotSpec
 
-    spec = RobotSpec(None if urdf else robot, None if urdf is None else str(urdf),
+    spec = RobotSpec(None if config else robot, None if urdf is None else str(urdf),
                      None if config is None else str(config))
     _run_estimate(_robot(robot, urdf, config), spec, log, output, opts, bag_map, max_gap, limit_margin, workers,
                   chunk_rows)

@@ -390,13 +390,17 @@ def load_robot(name: str | None = "talos", *, urdf: str | Path | None = None,
     Examples:
         >>> robot = load_robot("talos")                                  # doctest: +SKIP
         >>> robot = load_robot(urdf="my.urdf", config="my_robot.toml")   # doctest: +SKIP
+        >>> robot = load_robot("talos", urdf="talos_identified.urdf")    # doctest: +SKIP
+
+    ``urdf`` without ``config`` gives the built-in robot ``name``'s configuration (contact
+    frames, joint roles, groups) on another URDF of the same robot.
 
     Raises:
         InputError: unknown built-in name, missing files, or a bad configuration.
     """
-    if urdf is not None or config is not None:
-        if urdf is None or config is None:
-            raise InputError("--urdf and --config must be given together")
+    if config is not None:
+        if urdf is None:
+            raise InputError("--config needs the robot's --urdf")
         cfg_path = Path(config)
         cfg = read_toml(cfg_path)
         cfg["_dir"] = str(cfg_path.parent)
@@ -406,4 +410,6 @@ def load_robot(name: str | None = "talos", *, urdf: str | Path | None = None,
                          "otherwise give --urdf and --config")
     text = resources.files("wbfriction.robots").joinpath(f"{name}.toml").read_text()
     cfg = tomllib.loads(text)  # the package's own file
+    if urdf is not None:  # the built-in robot's configuration on another URDF of it (identified inertias)
+        return build_robot(Path(urdf), cfg, source=f"built-in robot '{name}' on {urdf}")
     return build_robot(_resolve(cfg["urdf"], Path(".")), cfg, source=f"built-in robot '{name}'")
