@@ -24,12 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from bench_long_log import measure
-from wbfriction.friction import THESIS_TARGETS
+from bench_long_log import measure, walk_log
 from wbfriction.robot import load_robot
-from wbfriction.sim import simulate_ideal
-from wbfriction.study import _leg_joints
-from wbfriction.walking import GaitOptions, walking_reference
 
 T0 = 1_700_000_000_000_000_000
 MAP = """[joint_states]
@@ -52,8 +48,7 @@ def build_bag(path: Path, minutes: float) -> int:
     from rosbags.typesys import Stores, get_typestore
 
     robot = load_robot("talos")
-    friction = {j: THESIS_TARGETS[g] for j, _, g in _leg_joints(robot)}
-    log = simulate_ideal(robot, walking_reference(robot, GaitOptions(gait="combined", steps=3)), friction).log
+    log = walk_log(robot)
     ts = get_typestore(Stores.ROS2_HUMBLE)
     T = ts.types
     names = list(robot.actuated)

@@ -32,14 +32,20 @@ from wbfriction.study import _leg_joints
 from wbfriction.walking import GaitOptions, walking_reference
 
 
+def walk_log(robot):
+    """The tile both long-input benchmarks repeat: a 3-step combined walk of the ideal
+    simulator with Table 6.1 friction on the legs."""
+    friction = {j: THESIS_TARGETS[g] for j, _, g in _leg_joints(robot)}
+    return simulate_ideal(robot, walking_reference(robot, GaitOptions(gait="combined", steps=3)), friction).log
+
+
 def build_log(path: Path, minutes: float) -> int:
     robot = load_robot("talos")
-    friction = {j: THESIS_TARGETS[g] for j, _, g in _leg_joints(robot)}
-    walk = simulate_ideal(robot, walking_reference(robot, GaitOptions(gait="combined", steps=3)), friction)
-    tile = walk.log.to_table(robot)
-    period = float(np.median(np.diff(walk.log.time)))
-    span = walk.log.time[-1] - walk.log.time[0] + 0.5  # a 0.5 s gap between repetitions
-    rows, total, k = len(walk.log), int(minutes * 60 / period), 0
+    log = walk_log(robot)
+    tile = log.to_table(robot)
+    period = float(np.median(np.diff(log.time)))
+    span = log.time[-1] - log.time[0] + 0.5  # a 0.5 s gap between repetitions
+    rows, total, k = len(log), int(minutes * 60 / period), 0
     with pq.ParquetWriter(path, tile.schema) as writer:
         while k * rows < total:
             t = tile.column("time").to_numpy() + k * span

@@ -43,6 +43,7 @@ one follow the prior. The problem is solved with ``scipy.optimize.least_squares`
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -189,7 +190,8 @@ class BaseParameters:
             of a QR factorization with column pivoting of the regressor.
         combination: (r, p): base parameter ``k`` is ``combination[k] @ x``, i.e. its
             independent parameter plus the dependent ones it absorbs.
-        condition: condition number of the regressor's base-parameter columns.
+        condition: condition number of the regressor's base-parameter columns, each scaled to
+            unit norm (so that it does not depend on units).
         rank_tolerance: relative size of a pivot below which a column counts as dependent.
     """
 
@@ -223,7 +225,7 @@ def base_parameters(R: np.ndarray, rank_tolerance: float = 1e-8) -> BaseParamete
     ind, dep = perm[:rank], perm[rank:]
     combination[np.arange(rank), ind] = 1.0
     combination[:, dep] = K * scale[dep][None, :] / scale[ind][:, None]
-    s = np.linalg.svd(R[:, ind], compute_uv=False)
+    s = np.linalg.svd((R / scale)[:, ind], compute_uv=False)
     return BaseParameters(np.sort(ind), combination[np.argsort(ind)], float(s[0] / s[-1]) if rank else np.inf,
                           rank_tolerance)
 
@@ -399,7 +401,7 @@ class InertialIdentification:
         friction_given_model: the friction that best explains the data with the given
             inertias (n_tc, k).
         base: the base parameters, over ``(pi.ravel(), friction.ravel())``.
-        holdout: torque predictions on the held-out samples; ``training`` on the others.
+        holdout: torque predictions on the held-out samples.
         samples: single-support samples in the regression.
         message: the optimizer's.
     """
@@ -413,7 +415,6 @@ class InertialIdentification:
     friction_given_model: np.ndarray
     base: BaseParameters
     holdout: TorqueFit
-    training: TorqueFit
     samples: int
     message: str
 
@@ -519,35 +520,25 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
     pi0 = body_parameters(robot.model)
     # friction that best explains the data with the given inertias: the start, and the given model's best case
     friction0 = np.linalg.lstsq(R[:, p_in:], z - R[:, :p_in] @ pi0.ravel(), rcond=None)[0].reshape(n_tc, k)
-    scales = np.concatenate([parameter_scales(pi0, options.min_mass).ravel(), np.ones(k * n_tc)])
-    base = base_parameters(R * scales[None, :], options.rank_tolerance)
-    base = BaseParameters(base.independent, base.combination / scales[None, :] * scales[base.independent][:, None],
-                          base.condition, base.rank_tolerance)
+    base = base_parameters(R, options.rank_tolerance)
     fit = fit_consistent(R, z, pi0, friction0, options.prior, options.min_mass)
-    identified = _with_inertias(robot, fit.pi)
-    holdout = _torque_fit(robot, parts, 3, pi0, friction0, fit, options)
-    training = _torque_fit(robot, parts, 2, pi0, friction0, fit, options)
+    identified = dataclasses.replace(robot, model=with_body_parameters(robot.model, fit.pi), cache={})
+    holdout = _torque_fit(robot, parts, pi0, friction0, fit, options)
     if holdout.samples == 0:
         raise InputError(f"{log.source}: no single-support sample in the held-out {options.holdout:.0%} of the log")
     return InertialIdentification(identified, tuple(robot.model.names[1:]), pi0, fit.pi, friction_names(options),
-                                  fit.friction, friction0, base, holdout, training, samples, fit.message)
+                                  fit.friction, friction0, base, holdout, samples, fit.message)
 
 
-def _with_inertias(robot: Robot, pi: np.ndarray) -> Robot:
-    import dataclasses
-
-    return dataclasses.replace(robot, model=with_body_parameters(robot.model, pi), cache={})
-
-
-def _torque_fit(robot: Robot, parts, which: int, pi0: np.ndarray, friction0: np.ndarray, fit: ConsistentFit,
+def _torque_fit(robot: Robot, parts, pi0: np.ndarray, friction0: np.ndarray, fit: ConsistentFit,
                 options: InertialOptions) -> TorqueFit:
     """RMS torque errors of the given model (without and with its best friction) and of the
-    identified one on the training (``which = 2``) or held-out (3) samples."""
+    identified one on the held-out samples."""
     n_tc = len(robot.torque_controlled)
     sq = np.zeros((3, n_tc))
     count = 0
     for part in parts:
-        kin, stance, rows = part[0], part[1], part[which]
+        kin, stance, _, rows = part
         for c in range(len(robot.contact_frames)):
             r = np.flatnonzero(rows & (stance == c))
             for start in range(0, r.size, 1000):
