@@ -1,7 +1,8 @@
 """Command-line interface: a thin layer over the library.
 
 Commands: ``simulate`` (a walk with known friction), ``estimate`` (friction per sample),
-``fit`` (model 3.5 per joint), ``report`` (one HTML file), ``sensitivity`` (inertia-model
+``fit`` (model 3.5 per joint), ``identify`` (inertia model and friction together,
+corrected URDF), ``report`` (one HTML file), ``sensitivity`` (inertia-model
 errors), ``spectrum``, ``demo`` and ``study-filters`` (the thesis's studies).
 Bad input prints one line naming the file, column, row or option at fault and exits
 with status 2.
@@ -30,6 +31,7 @@ from .estimate import EstimateOptions, estimate_from_table
 from .exceptions import InputError, WbfrictionError
 from .friction import PARAM_NAMES, load_friction_toml
 from .sim.sensors import load_sensors_toml
+from .inertial import InertialOptions
 from .identify import FitResult, fit_table_estimate, fitted_offsets
 from .kinematics import FilterOptions
 from .log import LIMIT_MARGIN, MAX_GAP, file_sha256, read_log, read_table, write_atomic, write_log, write_tables
@@ -133,6 +135,7 @@ _F = FilterOptions()
 _G = GaitOptions()
 _I = IdealOptions()
 _M = MujocoOptions()
+_N = InertialOptions()
 SIMULATORS = ("ideal", "mujoco")
 _MIN_SAMPLES = 20
 
@@ -339,13 +342,16 @@ def report(friction: Path = typer.Argument(..., help="Friction table written by 
            output: Path = typer.Option(Path("report.html"), "-o", "--output", help="HTML file to write."),
            params: Optional[Path] = typer.Option(None, help="Parameters written by 'wbfriction fit' (default: "
                                                             "fitted here)."),
+           identification: Optional[Path] = typer.Option(None, help="JSON written by 'wbfriction identify --json': "
+                                                                    "adds the held-out torque RMS, both routes' "
+                                                                    "friction and the body changes."),
            energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt) -> None:
     """One self-contained HTML report: friction clouds and fits, parameters, energy consistency,
     per-joint time series, Fig. 7.4, spectra, provenance."""
     from .report import make_report, write_report
 
     with console.status("building the report"):
-        rep = make_report(friction, params, energy_threshold, energy_tolerance)
+        rep = make_report(friction, params, energy_threshold, energy_tolerance, identification)
         write_report(rep, output)
     _warn_energy(rep.energy.values())
     console.print(f"wrote {output} ({len(rep.est.joints)} joints, {len(rep.flagged)} flagged)")
@@ -396,6 +402,113 @@ def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in 
         table.add_row(j, f"{100 * base:.1f}", *cells)
     out.print(table)
     save_png(sensitivity_figure(sens, names), output)
+    console.print(f"wrote {output}")
+
+
+def _identify_tables(doc: dict) -> list[Table]:
+    """The tables of ``wbfriction identify``: body changes, both routes' friction, held-out RMS."""
+    bodies = Table(title="Inertia model: given -> identified (bodies with mass)", box=None,
+                   caption="COM shift [mm]; principal moments about the centre of mass, ascending: change [%]")
+    for col in ("body", "mass given [kg]", "mass [kg]", "change [%]", "COM shift [mm]", "I1 [%]", "I2 [%]", "I3 [%]"):
+        bodies.add_column(col, justify="left" if col == "body" else "right")
+    for b in doc["bodies"]:
+        if max(b["mass_given"], b["mass"]) <= 0:
+            continue
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dm = 100 * (np.array(b["moments"]) / np.array(b["moments_given"]) - 1)
+        bodies.add_row(b["body"], f"{b['mass_given']:.4f}", f"{b['mass']:.4f}",
+                       f"{100 * (b['mass'] / b['mass_given'] - 1):+.2f}" if b["mass_given"] > 0 else "new",
+                       f"{1e3 * b['com_shift']:.2f}", *[f"{x:+.1f}" for x in dm])
+    names = list(next(iter(doc["joints"].values()))["identified"])
+    friction = Table(title="Friction: this route (torques, identified jointly) and the acceleration route "
+                           "(5.10, identified model)", box=None,
+                     caption="gen: share of valid samples whose friction generates power (eq. 7.9), given model "
+                             "-> identified model; target: the simulator's, when the log has it")
+    friction.add_column("joint")
+    for n in names:
+        friction.add_column(f"{n}", justify="right")
+    for n in ("F_v", "F_c", "tau_os"):
+        friction.add_column(f"accel. {n}", justify="right")
+    friction.add_column("gen [%]", justify="right")
+    pct = lambda x: "—" if x is None else f"{100 * x:.1f}"  # noqa: E731
+    for joint, j in doc["joints"].items():
+        accel = (j["acceleration_route"]["params"] or {})
+        friction.add_row(joint, *[f"{j['identified'][n]:.4g}" for n in names],
+                         *[f"{accel[n]:.4g}" if n in accel else "—" for n in ("F_v", "F_c", "tau_os")],
+                         f"{pct(j['generating_share_given_model'])} -> {pct(j['generating_share'])}")
+        target = j["acceleration_route"].get("target")
+        if target:
+            f_s = {"F_s-F_c": target["S"] * target["F_c"]}
+            friction.add_row("  target", *[f"{target.get(n, f_s.get(n)):.4g}" for n in names],
+                             *[f"{target[n]:.4g}" for n in ("F_v", "F_c", "tau_os")], "", style="dim")
+    rms = Table(title=f"Held-out torques ({doc['holdout_samples']} single-support samples at the end of the log): "
+                      "RMS of measured - predicted [N·m]", box=None)
+    for col in ("joint", "given model", "given + its best friction", "identified"):
+        rms.add_column(col, justify="left" if col == "joint" else "right")
+    for joint, j in doc["joints"].items():
+        h = j["holdout_rms"]
+        rms.add_row(joint, f"{h['given']:.4f}", f"{h['given_with_friction']:.4f}", f"{h['identified']:.4f}")
+    return [bodies, friction, rms]
+
+
+@app.command()
+def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) in the wbfriction format."),
+             output: Path = typer.Option(..., "-o", "--output", help="Corrected URDF to write (the given one's "
+                                                                    "structure, identified inertias)."),
+             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             json_output: Optional[Path] = typer.Option(None, "--json", help="Also write every figure as JSON "
+                                                                             "(for 'wbfriction report --identification')."),
+             stribeck_velocity: str = typer.Option("auto", help="v_s of the Stribeck term [rad/s]: auto (from the "
+                                                                "acceleration route, refined each pass), a number, "
+                                                                "or none."),
+             passes: int = typer.Option(2, min=1, help="Identifications with --stribeck-velocity auto."),
+             holdout: float = typer.Option(_N.holdout, help="Share of the log, at its end, kept out to compare "
+                                                            "torque predictions."),
+             stride: int = typer.Option(_N.stride, min=1, help="Every stride-th single-support sample is used."),
+             prior: float = typer.Option(_N.prior, help="Relative weight of the prior toward the given model."),
+             tanh_slope: float = typer.Option(_N.tanh_slope, help="a of the Coulomb term tanh(a qd) [s/rad]."),
+             diff: str = typer.Option(_E.diff, help="Differentiation scheme (see 'estimate')."),
+             mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate').")) -> None:
+    """Identify the inertia model and the friction together from the joint torques of single
+    support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
+    with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
+    from .closed_loop import identify_and_estimate, loop_document
+    from .urdf import inertia_changes, write_urdf
+
+    vs_text = stribeck_velocity.strip().lower()
+    try:
+        stribeck = None if vs_text == "none" else "auto" if vs_text == "auto" else float(vs_text)
+    except ValueError:
+        raise InputError(f"--stribeck-velocity must be auto, none or a number, got '{stribeck_velocity}'") from None
+    if not 0.0 < holdout < 1.0:
+        raise InputError(f"--holdout must be between 0 and 1, got {holdout}")
+    r = _robot(robot, urdf, config)
+    data = read_log(log, r)
+    opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior)
+    with console.status("") as status:
+        loop = identify_and_estimate(r, data, EstimateOptions(diff=diff, mask=mask), opts, stribeck, passes,
+                                     progress=lambda label: status.update(label))
+    ident = loop.final.identification
+    changes = inertia_changes(ident.bodies, ident.pi_given, ident.pi)
+    doc = loop_document(loop, changes)
+    doc["provenance"] = {"log": str(log), "log_sha256": file_sha256(log), "robot": r.name, "urdf": str(r.urdf),
+                         "wbfriction": __version__}
+    for p in doc["passes"]:
+        out.print(f"v_s {p['stribeck_velocity']}: {p['samples']} samples, {p['base_parameters']} base parameters of "
+                  f"{p['parameters']}, condition {p['condition']:.3g}, prior {p['prior']:g}; {p['message']}",
+                  highlight=False)
+    for table in _identify_tables(doc):
+        out.print(table)
+    moved = write_urdf(r, ident.pi, output)
+    if moved:
+        doc["moved_to_child_link"] = list(moved)
+        console.print(f"[yellow]note:[/] the whole identified body went to the child link of {', '.join(moved)} "
+                      "(lighter than the links merged with it)")
+    if json_output is not None:
+        text = json.dumps(doc, indent=2)
+        write_atomic(json_output, lambda tmp: tmp.write_text(text))
+        console.print(f"wrote {json_output}")
+    _warn_energy(loop.final.route.energy)
     console.print(f"wrote {output}")
 
 

@@ -39,6 +39,17 @@ inequalities hold). A Tikhonov prior pulls toward the given model where the data
 nothing: its weight is ``prior`` times the largest squared singular value of the
 scaled regressor, so only directions weaker than ``sqrt(prior)`` of the best-excited
 one follow the prior. The problem is solved with ``scipy.optimize.least_squares``.
+
+**Choosing the prior.** Too weak a prior lets the barely excited bodies (arms that
+hardly move in a walk) take any value that fits the noise of the model; too strong a
+one keeps the model error. By default the weight is chosen from :data:`PRIOR_GRID` by
+validation: fitted on the training samples but the last ``validation`` share of their
+time span, scored by the torque residual on that share (contiguous in time, so that
+neighbouring, correlated samples do not score their own fit), then refitted on all of
+them. The compressed systems give every score without another pass over the log. The
+weights are tried from strong to weak, and the search stops at the first weight that
+scores worse than the best. (Each fit starts from the linear solution: started from a
+neighbouring weight's, the non-linear solve stalls short of it.)
 """
 
 from __future__ import annotations
@@ -64,8 +75,11 @@ PARAMS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
 [kg, kg·m, kg·m^2]: mass, first moments, rotational inertia about the joint frame."""
 FRICTION = ("F_v", "F_c", "tau_os")
 """Friction parameters identified per torque-controlled joint (3.5 without Stribeck)."""
-STRIBECK = "F_s"
-"""With a fixed Stribeck velocity ``v_s``, the Stribeck term's height ``F_s = S F_c`` [N·m] too."""
+PRIOR_GRID = (1e-10, 1e-9, 1e-8, 1e-7, 1e-6)
+"""Relative prior weights tried when :attr:`InertialOptions.prior` is None."""
+STRIBECK = "F_s-F_c"
+"""With a fixed Stribeck velocity ``v_s``, the Stribeck term's height ``F_s - F_c = S F_c`` [N·m]
+too (``F_s`` the static friction of 3.4, ``S`` that of :func:`wbfriction.friction.smooth`)."""
 
 
 def body_parameters(model: pin.Model) -> np.ndarray:
@@ -163,6 +177,7 @@ class CompressedLeastSquares:
     def __init__(self, n_params: int):
         self.n = n_params
         self._Rz = np.zeros((0, n_params + 1))
+        self._floor = 0.0
         self.rows = 0
 
     def add(self, A: np.ndarray, b: np.ndarray) -> None:
@@ -170,6 +185,25 @@ class CompressedLeastSquares:
         stacked = np.vstack([self._Rz, np.column_stack([A, b])])
         self._Rz = scipy.linalg.qr(stacked, mode="r", overwrite_a=True, check_finite=False)[0][: self.n + 1]
         self.rows += len(b)
+
+    def absorb(self, other: "CompressedLeastSquares", T: np.ndarray | None = None) -> None:
+        """Append the rows of ``other`` (whose parameters are ``T @ x``, (p_other, p); identity if None)."""
+        if other.rows == 0:
+            return
+        self.add(other.R if T is None else other.R @ T, other.z)
+        self.rows += other.rows - other.n
+        self._floor += other.residual_floor
+
+    @property
+    def residual_floor(self) -> float:
+        """The smallest ``|A x - b|^2`` (so ``|A x - b|^2 = |R x - z|^2 + residual_floor``)."""
+        corner = self._Rz[self.n, self.n] if self._Rz.shape[0] > self.n else 0.0
+        return float(corner ** 2) + self._floor
+
+    def rms(self, x: np.ndarray) -> float:
+        """RMS of ``A x - b`` over the rows added."""
+        r = self.R @ x - self.z
+        return float(np.sqrt((r @ r + self.residual_floor) / max(self.rows, 1)))
 
     @property
     def R(self) -> np.ndarray:
@@ -295,6 +329,17 @@ def is_consistent(pi: np.ndarray, margin: float = 0.0) -> np.ndarray:
     return out
 
 
+def _regularised(R: np.ndarray, z: np.ndarray, pi0: np.ndarray, friction0: np.ndarray, prior: float,
+                 min_mass: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The linear solution of :func:`fit_consistent`'s problem without the consistency
+    constraint, the prior's centre ``x0`` and its row weights ``w``."""
+    x0 = np.concatenate([pi0.ravel(), friction0.ravel()])
+    d = 1.0 / np.concatenate([parameter_scales(pi0, min_mass).ravel(), np.ones(friction0.size)])
+    w = np.sqrt(prior) * np.linalg.norm(R / d[None, :], 2) * d
+    x_lin = np.linalg.lstsq(np.vstack([R, np.diag(w)]), np.concatenate([z, w * x0]), rcond=None)[0]
+    return x_lin, x0, w
+
+
 def fit_consistent(R: np.ndarray, z: np.ndarray, pi0: np.ndarray, friction0: np.ndarray, prior: float = 1e-9,
                    min_mass: float = 1e-3) -> ConsistentFit:
     """Solve ``min |R x - z|^2 + lambda |D (x - x0)|^2`` over physically consistent bodies.
@@ -314,11 +359,7 @@ def fit_consistent(R: np.ndarray, z: np.ndarray, pi0: np.ndarray, friction0: np.
         min_mass: smallest mass of a body's starting point [kg] (:func:`log_cholesky`).
     """
     nb, nf = len(pi0), friction0.size
-    x0 = np.concatenate([pi0.ravel(), friction0.ravel()])
-    d = 1.0 / np.concatenate([parameter_scales(pi0, min_mass).ravel(), np.ones(nf)])
-    sigma = np.linalg.norm(R / d[None, :], 2)
-    w = np.sqrt(prior) * sigma * d
-    x_lin = np.linalg.lstsq(np.vstack([R, np.diag(w)]), np.concatenate([z, w * x0]), rcond=None)[0]
+    x_lin, x0, w = _regularised(R, z, pi0, friction0, prior, min_mass)
     pi_lin = x_lin[: 10 * nb].reshape(nb, 10)
     ok = is_consistent(pi_lin, 1e-12)
     if ok.all():
@@ -339,10 +380,10 @@ def fit_consistent(R: np.ndarray, z: np.ndarray, pi0: np.ndarray, friction0: np.
         dx = scipy.linalg.block_diag(*jb, np.eye(nf))
         return np.vstack([R @ dx, w[:, None] * dx])
 
-    start = np.where(ok[:, None], pi_lin, pi0)
-    theta0 = np.array([log_cholesky(p, min_mass) for p in start])
-    res = least_squares(fun, np.concatenate([theta0.ravel(), x_lin[10 * nb:]]), jac=jac, method="trf",
-                        x_scale="jac", max_nfev=200)
+    theta0 = np.array([log_cholesky(p, min_mass) for p in np.where(ok[:, None], pi_lin, pi0)])
+    with np.errstate(over="ignore", invalid="ignore"):  # trial steps may overflow exp(): trf then shrinks them
+        res = least_squares(fun, np.concatenate([theta0.ravel(), x_lin[10 * nb:]]), jac=jac, method="trf",
+                            x_scale="jac", max_nfev=200)
     x, _ = unpack(res.x)
     return ConsistentFit(x[: 10 * nb].reshape(nb, 10), x[10 * nb:].reshape(friction0.shape), float(res.cost),
                          f"{int((~ok).sum())} bodies of the linear solution were not physical: {res.message}")
@@ -354,14 +395,20 @@ class InertialOptions:
 
     Attributes:
         tanh_slope: ``a`` of the Coulomb term ``F_c tanh(a qd)`` [s/rad].
-        stribeck_velocity: ``v_s`` [rad/s] of a Stribeck term ``F_s tanh(a qd) exp(-(qd/v_s)^2)``
-            identified with the others (3.5 with ``delta_s = 2``; ``F_s = S F_c``), for
+        stribeck_velocity: ``v_s`` [rad/s] of a Stribeck term ``(F_s - F_c) tanh(a qd) exp(-(qd/v_s)^2)``
+            identified with the others (3.5 with ``delta_s = 2``; ``F_s - F_c = S F_c``), for
             example the one the acceleration route's fit found; None: no Stribeck term.
+        stribeck_joints: the joints given the Stribeck term (None: every torque-controlled
+            one). A joint that never moves faster than ``v_s`` cannot tell it from Coulomb
+            friction: their columns would cancel with huge opposite values.
         stride: every ``stride``-th single-support sample enters the regression (1 kHz
             logs are far denser than the dynamics need).
         holdout: share of the log, at its end, kept out of the regression to compare the
             models' torque predictions.
-        prior: relative weight of the prior toward the given model (:func:`fit_consistent`).
+        prior: relative weight of the prior toward the given model (:func:`fit_consistent`);
+            None: chosen from :data:`PRIOR_GRID` by validation (module docstring).
+        validation: share of the training samples' time span, at its end, that scores
+            the priors of the grid.
         rank_tolerance: relative pivot below which a parameter is not identifiable
             (:func:`base_parameters`).
         min_mass: smallest mass a body's starting point gets [kg].
@@ -370,9 +417,11 @@ class InertialOptions:
 
     tanh_slope: float = 40.0
     stribeck_velocity: float | None = None
+    stribeck_joints: tuple[str, ...] | None = None
     stride: int = 5
     holdout: float = 0.2
-    prior: float = 1e-9
+    prior: float | None = None
+    validation: float = 0.25
     rank_tolerance: float = 1e-8
     min_mass: float = 1e-3
     block: int = 200
@@ -404,6 +453,9 @@ class InertialIdentification:
         holdout: torque predictions on the held-out samples.
         samples: single-support samples in the regression.
         message: the optimizer's.
+        prior: the prior's relative weight used.
+        prior_scores: with the prior chosen by validation, the RMS torque residual on the
+            validation samples for each weight tried [N·m].
     """
 
     robot: Robot
@@ -417,6 +469,8 @@ class InertialIdentification:
     holdout: TorqueFit
     samples: int
     message: str
+    prior: float
+    prior_scores: dict[float, float] = field(default_factory=dict)
 
 
 def friction_names(options: "InertialOptions") -> tuple[str, ...]:
@@ -424,9 +478,10 @@ def friction_names(options: "InertialOptions") -> tuple[str, ...]:
     return FRICTION + ((STRIBECK,) if options.stribeck_velocity is not None else ())
 
 
-def _friction_columns(qd_tc: np.ndarray, options: "InertialOptions") -> np.ndarray:
+def _friction_columns(qd_tc: np.ndarray, options: "InertialOptions", stribeck: np.ndarray | None = None) -> np.ndarray:
     """(N, n_tc, k n_tc): joint ``i``'s row holds ``qd_i, tanh(a qd_i), 1`` (and the Stribeck
-    column ``tanh(a qd_i) exp(-(qd_i / v_s)^2)``) in its ``k`` columns, ``f(qd) = columns @ params``."""
+    column ``tanh(a qd_i) exp(-(qd_i / v_s)^2)`` where ``stribeck[i]``, else zero) in its ``k``
+    columns, ``f(qd) = columns @ params``."""
     n, m = qd_tc.shape
     k = len(friction_names(options))
     out = np.zeros((n, m, k * m))
@@ -436,13 +491,17 @@ def _friction_columns(qd_tc: np.ndarray, options: "InertialOptions") -> np.ndarr
     out[:, idx, k * idx + 1] = coulomb
     out[:, idx, k * idx + 2] = 1.0
     if k == 4:
-        out[:, idx, k * idx + 3] = coulomb * np.exp(-(qd_tc / options.stribeck_velocity) ** 2)
+        on = np.ones(m, dtype=bool) if stribeck is None else stribeck
+        out[:, idx, k * idx + 3] = coulomb * np.exp(-(qd_tc / options.stribeck_velocity) ** 2) * on
     return out
 
 
 def _split(robot: Robot, log: Log, est: EstimateOptions, opts: InertialOptions):
-    """Per log part: its kinematics and the training / held-out single-support rows."""
-    cut = log.time[0] + (1.0 - opts.holdout) * (log.time[-1] - log.time[0])
+    """Per log part: its kinematics, stance, and the training, validation and held-out
+    single-support rows."""
+    span = log.time[-1] - log.time[0]
+    cut = log.time[0] + (1.0 - opts.holdout) * span
+    cut_validation = log.time[0] + (1.0 - opts.holdout) * (1.0 - opts.validation) * span
     out = []
     for part in log.parts():
         try:
@@ -456,7 +515,8 @@ def _split(robot: Robot, log: Log, est: EstimateOptions, opts: InertialOptions):
         idx = np.flatnonzero(use & (part.time < cut))
         train[idx[:: opts.stride]] = True
         held = use & (part.time >= cut)
-        out.append((kin, phases.stance, train, held))
+        validation = train & (part.time >= cut_validation)
+        out.append((kin, phases.stance, train & ~validation, validation, held))
     return out
 
 
@@ -466,7 +526,8 @@ def _rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int, options:
     tc = robot.tc_index
     pose = stance_frame_pose(robot, reg.stance, kin.q[r], None if kin.base is None else kin.base[r])
     Y = reg.joint_rows(pose, kin.q[r], kin.qd[r], kin.qdd[r])[:, tc]
-    F = _friction_columns(kin.qd[r][:, tc], options)
+    stribeck = None if options.stribeck_joints is None else np.isin(robot.torque_controlled, options.stribeck_joints)
+    F = _friction_columns(kin.qd[r][:, tc], options, stribeck)
     arm = robot.model.armature[robot.act_v_index][tc]
     b = kin.tau[r] - arm * kin.qdd[r][:, tc]
     return Y, F, b
@@ -495,39 +556,62 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
     parts = _split(robot, log, estimate_options, options)
     nb, n_tc = robot.model.njoints - 1, len(robot.torque_controlled)
     k = len(friction_names(options))
-    p_in, p = 10 * nb, 10 * nb + k * n_tc
-    systems = {c: CompressedLeastSquares(p) for c in range(len(robot.contact_frames))}
-    samples = 0
-    for kin, stance, train, _ in parts:
-        for c, system in systems.items():
-            r = np.flatnonzero(train & (stance == c))
-            for start in range(0, r.size, options.block):
-                rr = r[start:start + options.block]
-                Y, F, b = _rows(robot, kin, rr, c, options)
-                system.add(np.concatenate([Y, F], axis=2).reshape(-1, p), b.ravel())
-                samples += rr.size
-                if progress is not None:
-                    progress(rr.size)
+    p_in = 10 * nb
+    fitting = _system(robot, parts, 2, options, progress)
+    validating = _system(robot, parts, 3, options, progress)
+    samples = (fitting.rows + validating.rows) // n_tc
     if samples == 0:
         raise InputError(f"{log.source}: no single-support sample to identify the inertia model from")
-    # the stances' systems in the original bodies' parameters, stacked and compressed again
-    total = CompressedLeastSquares(p)
-    for c, system in systems.items():
-        if system.rows:
-            T = scipy.linalg.block_diag(stance_regressor(robot, c).to_rooted, np.eye(k * n_tc))
-            total.add(system.R @ T, system.z)
+    total = CompressedLeastSquares(fitting.n)
+    for system in (fitting, validating):
+        total.absorb(system)
     R, z = total.R, total.z
     pi0 = body_parameters(robot.model)
     # friction that best explains the data with the given inertias: the start, and the given model's best case
     friction0 = np.linalg.lstsq(R[:, p_in:], z - R[:, :p_in] @ pi0.ravel(), rcond=None)[0].reshape(n_tc, k)
     base = base_parameters(R, options.rank_tolerance)
-    fit = fit_consistent(R, z, pi0, friction0, options.prior, options.min_mass)
+    prior, scores = options.prior, {}
+    if prior is None:
+        if fitting.rows == 0 or validating.rows == 0:
+            raise InputError(f"{log.source}: too few single-support samples to choose the prior by validation "
+                             "(give one)")
+        for weight in sorted(PRIOR_GRID, reverse=True):  # strong to weak
+            trial = fit_consistent(fitting.R, fitting.z, pi0, friction0, weight, options.min_mass)
+            scores[weight] = validating.rms(np.concatenate([trial.pi.ravel(), trial.friction.ravel()]))
+            if scores[weight] > min(scores.values()):
+                break  # past the best weight: weaker priors only fit the noise more closely
+        prior = min(scores, key=scores.get)
+    fit = fit_consistent(R, z, pi0, friction0, prior, options.min_mass)
     identified = dataclasses.replace(robot, model=with_body_parameters(robot.model, fit.pi), cache={})
     holdout = _torque_fit(robot, parts, pi0, friction0, fit, options)
     if holdout.samples == 0:
         raise InputError(f"{log.source}: no single-support sample in the held-out {options.holdout:.0%} of the log")
     return InertialIdentification(identified, tuple(robot.model.names[1:]), pi0, fit.pi, friction_names(options),
-                                  fit.friction, friction0, base, holdout, samples, fit.message)
+                                  fit.friction, friction0, base, holdout, samples, fit.message, prior, scores)
+
+
+def _system(robot: Robot, parts, which: int, options: InertialOptions, progress=None) -> CompressedLeastSquares:
+    """The compressed system of the rows ``part[which]`` of every part (:func:`_split`), in
+    the original bodies' parameters: per stance, built in its rooted parameters, then mapped."""
+    nb, n_tc = robot.model.njoints - 1, len(robot.torque_controlled)
+    k = len(friction_names(options))
+    p = 10 * nb + k * n_tc
+    systems = {c: CompressedLeastSquares(p) for c in range(len(robot.contact_frames))}
+    for part in parts:
+        kin, stance, rows = part[0], part[1], part[which]
+        for c, system in systems.items():
+            r = np.flatnonzero(rows & (stance == c))
+            for start in range(0, r.size, options.block):
+                rr = r[start:start + options.block]
+                Y, F, b = _rows(robot, kin, rr, c, options)
+                system.add(np.concatenate([Y, F], axis=2).reshape(-1, p), b.ravel())
+                if progress is not None:
+                    progress(rr.size)
+    total = CompressedLeastSquares(p)
+    for c, system in systems.items():
+        if system.rows:
+            total.absorb(system, scipy.linalg.block_diag(stance_regressor(robot, c).to_rooted, np.eye(k * n_tc)))
+    return total
 
 
 def _torque_fit(robot: Robot, parts, pi0: np.ndarray, friction0: np.ndarray, fit: ConsistentFit,
@@ -538,7 +622,7 @@ def _torque_fit(robot: Robot, parts, pi0: np.ndarray, friction0: np.ndarray, fit
     sq = np.zeros((3, n_tc))
     count = 0
     for part in parts:
-        kin, stance, _, rows = part
+        kin, stance, *_, rows = part
         for c in range(len(robot.contact_frames)):
             r = np.flatnonzero(rows & (stance == c))
             for start in range(0, r.size, 1000):

@@ -83,6 +83,39 @@ def acceleration_spectra(est: FrictionEstimate, tail: float = 0.01) -> dict[str,
     return {j: (freq, amp[:, i], suggest_cutoff(freq, amp[:, i], tail)) for i, j in enumerate(est.joints)}
 
 
+def load_identification(path: str | Path) -> dict:
+    """What ``wbfriction identify --json`` wrote (:func:`wbfriction.closed_loop.loop_document`).
+
+    Raises:
+        InputError: a file that is not such JSON (named with the key at fault).
+    """
+    path = Path(path)
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(f"{path}: not an identification written by 'wbfriction identify --json' ({exc})") from None
+
+    def need(ok: bool, key: str) -> None:
+        if not ok:
+            raise InputError(f"{path}: '{key}' is missing or malformed (not written by 'wbfriction identify --json'?)")
+
+    need(isinstance(doc, dict) and isinstance(doc.get("joints"), dict) and doc["joints"], "joints")
+    for joint, j in doc["joints"].items():
+        need(isinstance(j, dict) and isinstance(j.get("holdout_rms"), dict)
+             and all(isinstance(j["holdout_rms"].get(k), (int, float))
+                     for k in ("given", "given_with_friction", "identified")), f"joints.{joint}.holdout_rms")
+        need(isinstance(j.get("identified"), dict)
+             and all(isinstance(v, (int, float)) for v in j["identified"].values()), f"joints.{joint}.identified")
+    need(isinstance(doc.get("bodies"), list) and all(
+        isinstance(b, dict) and isinstance(b.get("body"), str)
+        and all(isinstance(b.get(k), (int, float)) for k in ("mass_given", "mass", "com_shift"))
+        for b in doc["bodies"]), "bodies")
+    need(isinstance(doc.get("passes"), list) and doc["passes"] and all(isinstance(p, dict) for p in doc["passes"]),
+         "passes")
+    need(isinstance(doc.get("holdout_samples"), int), "holdout_samples")
+    return doc
+
+
 @dataclass
 class Report:
     """What a report shows, computed; :meth:`html` renders it.
@@ -93,6 +126,7 @@ class Report:
         energy: energy consistency by joint.
         provenance: (label, value) pairs.
         threshold: share of power-generating samples above which a joint is flagged.
+        identification: what ``wbfriction identify --json`` wrote, or None.
     """
 
     est: FrictionEstimate
@@ -100,6 +134,7 @@ class Report:
     energy: dict[str, JointEnergy]
     provenance: list[tuple[str, str]]
     threshold: float
+    identification: dict | None = None
 
     @property
     def flagged(self) -> list[JointEnergy]:
@@ -110,13 +145,16 @@ class Report:
 
 
 def make_report(friction: str | Path, params: str | Path | None = None,
-                threshold: float = DEFAULT_THRESHOLD, tolerance: float = DEFAULT_TOLERANCE) -> Report:
-    """Read a friction table (and parameters, else fit them) and compute the report.
+                threshold: float = DEFAULT_THRESHOLD, tolerance: float = DEFAULT_TOLERANCE,
+                identification: str | Path | None = None) -> Report:
+    """Read a friction table (and parameters, else fit them; and an identification of the
+    inertia model, :func:`load_identification`) and compute the report.
 
     Raises:
         InputError: unreadable inputs.
     """
     friction = Path(friction)
+    ident = None if identification is None else load_identification(identification)
     est = estimate_from_table(read_table(friction), str(friction))
     if params is not None:
         fits = load_params(params)
@@ -145,7 +183,9 @@ def make_report(friction: str | Path, params: str | Path | None = None,
         prov.append(("estimated with", f"wbfriction {source['wbfriction']}"))
     prov.append(("report", f"wbfriction {__version__}; energy threshold {100 * threshold:g} %, "
                                f"tolerance {tolerance:g} N·m"))
-    return Report(est, fits, energy, prov, threshold)
+    if identification is not None:
+        prov.append(("inertia identification", f"{identification} (sha256 {file_sha256(identification)})"))
+    return Report(est, fits, energy, prov, threshold, ident)
 
 
 def write_report(report: Report, output: str | Path) -> None:
@@ -215,6 +255,43 @@ def _params_table(joints: list[str], fits: dict[str, FitResult]) -> str:
             + "".join(rows) + "</table>")
 
 
+def _identification_section(doc: dict) -> str:
+    """The inertia-model identification: held-out torque RMS, both routes' friction, body changes."""
+    passes = "; ".join(f"v_s {p.get('stribeck_velocity')}: {p.get('samples')} samples, {p.get('base_parameters')} "
+                       f"base parameters of {p.get('parameters')}, condition {p.get('condition')}, prior "
+                       f"{p.get('prior')}" for p in doc["passes"])
+    rms = "".join(f"<tr><td>{html.escape(j)}</td>" + "".join(
+        f"<td>{d['holdout_rms'][k]:.4f}</td>" for k in ("given", "given_with_friction", "identified"))
+        + "</tr>" for j, d in doc["joints"].items())
+    names = list(next(iter(doc["joints"].values()))["identified"])
+    accel = ("F_v", "F_c", "tau_os")
+    rows = []
+    for j, d in doc["joints"].items():
+        route = ((d.get("acceleration_route") or {}).get("params")) or {}
+        rows.append(f"<tr><td>{html.escape(j)}</td>" + "".join(f"<td>{_fmt(d['identified'][n])}</td>" for n in names)
+                    + "".join(f"<td>{_fmt(route.get(n))}</td>" for n in accel) + "</tr>")
+    bodies = []
+    for b in doc["bodies"]:
+        if max(b["mass_given"], b["mass"]) <= 0:
+            continue
+        change = f"{100 * (b['mass'] / b['mass_given'] - 1):+.2f}" if b["mass_given"] > 0 else "new"
+        bodies.append(f"<tr><td>{html.escape(b['body'])}</td><td>{b['mass_given']:.4f}</td><td>{b['mass']:.4f}</td>"
+                      f"<td>{change}</td><td>{1e3 * b['com_shift']:.2f}</td></tr>")
+    return f"""<h2>Inertia model identified from the torques (thesis 2.4, ch. 8)</h2>
+<p class="sub">{html.escape(passes)}. Held out: the last {doc['holdout_samples']} single-support samples of the log,
+not used to identify.</p>
+<h3>Held-out joint torques: RMS of measured − predicted [N·m]</h3>
+<table id="holdout-rms"><tr><th>joint</th><th>given model</th><th>given + its best friction</th><th>identified</th></tr>
+{rms}</table>
+<h3>Friction of this route and of the acceleration route with the identified model</h3>
+<table id="identified-friction"><tr><th>joint</th>{''.join(f"<th>{html.escape(n)}</th>" for n in names)}
+{''.join(f"<th>accel. {n}</th>" for n in accel)}</tr>{''.join(rows)}</table>
+<h3>Bodies: given → identified</h3>
+<table id="inertia-changes"><tr><th>body</th><th>mass given [kg]</th><th>mass [kg]</th><th>change [%]</th>
+<th>COM shift [mm]</th></tr>{''.join(bodies)}</table>
+"""
+
+
 def _energy_row(e: JointEnergy) -> str:
     pct = lambda x: "—" if x is None or not np.isfinite(x) else f"{100 * x:.2f}"  # noqa: E731
     lag = "—" if not np.isfinite(e.median_lag) else f"{1e3 * e.median_lag:.1f}"
@@ -282,6 +359,7 @@ exerts on the joint (dissipative: qd·τ_f ≤ 0); the model f(qd) of eq. (3.5) 
 identified offset τ_os is a sensor offset, not friction); zero crossings of the acceleration difference Δqdd against those of the velocity within valid stretches,
 and the median time from each velocity crossing to the nearest Δqdd crossing.</p>
 {_energy_table(joints, r.energy)}
+{"" if r.identification is None else _identification_section(r.identification)}
 <h2>Joints</h2>
 <nav>{nav}</nav>
 {''.join(sections)}
