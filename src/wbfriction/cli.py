@@ -405,6 +405,11 @@ def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in 
     console.print(f"wrote {output}")
 
 
+def _change(x: float | None, digits: int) -> str:
+    """A relative change as a signed percentage; ``new`` for a body the given model had none of."""
+    return "new" if x is None else f"{100 * x:+.{digits}f}"
+
+
 def _identify_tables(doc: dict) -> list[Table]:
     """The tables of ``wbfriction identify``: body changes, both routes' friction, held-out RMS."""
     bodies = Table(title="Inertia model: given -> identified (bodies with mass)", box=None,
@@ -414,11 +419,8 @@ def _identify_tables(doc: dict) -> list[Table]:
     for b in doc["bodies"]:
         if max(b["mass_given"], b["mass"]) <= 0:
             continue
-        with np.errstate(divide="ignore", invalid="ignore"):
-            dm = 100 * (np.array(b["moments"]) / np.array(b["moments_given"]) - 1)
-        bodies.add_row(b["body"], f"{b['mass_given']:.4f}", f"{b['mass']:.4f}",
-                       f"{100 * (b['mass'] / b['mass_given'] - 1):+.2f}" if b["mass_given"] > 0 else "new",
-                       f"{1e3 * b['com_shift']:.2f}", *[f"{x:+.1f}" for x in dm])
+        bodies.add_row(b["body"], f"{b['mass_given']:.4f}", f"{b['mass']:.4f}", _change(b["mass_change"], 2),
+                       f"{1e3 * b['com_shift']:.2f}", *[_change(x, 1) for x in b["moments_change"]])
     names = list(next(iter(doc["joints"].values()))["identified"])
     friction = Table(title="Friction: this route (torques, identified jointly) and the acceleration route "
                            "(5.10, identified model)", box=None,
@@ -473,7 +475,7 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
     support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
     with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
     from .closed_loop import identify_and_estimate, loop_document
-    from .urdf import inertia_changes, write_urdf
+    from .urdf import write_urdf
 
     vs_text = stribeck_velocity.strip().lower()
     try:
@@ -488,9 +490,8 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
     with console.status("") as status:
         loop = identify_and_estimate(r, data, EstimateOptions(diff=diff, mask=mask), opts, stribeck, passes,
                                      progress=lambda label: status.update(label))
-    ident = loop.final.identification
-    changes = inertia_changes(ident.bodies, ident.pi_given, ident.pi)
-    doc = loop_document(loop, changes)
+    moved = write_urdf(r, loop.final.identification.pi, output)
+    doc = loop_document(loop, moved)
     doc["provenance"] = {"log": str(log), "log_sha256": file_sha256(log), "robot": r.name, "urdf": str(r.urdf),
                          "wbfriction": __version__}
     for p in doc["passes"]:
@@ -499,9 +500,7 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
                   highlight=False)
     for table in _identify_tables(doc):
         out.print(table)
-    moved = write_urdf(r, ident.pi, output)
     if moved:
-        doc["moved_to_child_link"] = list(moved)
         console.print(f"[yellow]note:[/] the whole identified body went to the child link of {', '.join(moved)} "
                       "(lighter than the links merged with it)")
     if json_output is not None:

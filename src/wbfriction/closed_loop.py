@@ -26,6 +26,7 @@ from .identify import FitResult, fit_table_estimate, fitted_offsets
 from .inertial import InertialIdentification, InertialOptions, identify_inertia
 from .log import Log
 from .robot import Robot
+from .urdf import inertia_changes
 
 
 @dataclass
@@ -128,13 +129,15 @@ def _finite(x: float) -> float | None:
     return float(x) if np.isfinite(x) else None
 
 
-def loop_document(loop: ClosedLoop, changes: list | None = None, moved: tuple[str, ...] = ()) -> dict:
+def loop_document(loop: ClosedLoop, moved: tuple[str, ...] = ()) -> dict:
     """The loop as a JSON-ready dict (``wbfriction identify --json``, read by the report):
     per pass the identification's size and condition; per body the changes
     (:func:`wbfriction.urdf.inertia_changes`); per torque-controlled joint the friction of
-    both routes, the power-generating shares before and after, and the held-out torque RMS."""
+    both routes, the power-generating shares before and after, and the held-out torque RMS.
+    ``moved``: what :func:`wbfriction.urdf.write_urdf` returned."""
     final = loop.final
     ident = final.identification
+    changes = inertia_changes(ident.bodies, ident.pi_given, ident.pi)
     energy_given = {e.joint: e for e in loop.given.energy}
     energy = {e.joint: e for e in final.route.energy}
     joints = {}
@@ -162,8 +165,8 @@ def loop_document(loop: ClosedLoop, changes: list | None = None, moved: tuple[st
                     "message": p.identification.message} for p in loop.passes],
         "holdout_samples": ident.holdout.samples,
         "moved_to_child_link": list(moved),
-        "bodies": [{"body": c.body, "mass_given": c.mass_given, "mass": c.mass, "com_shift": c.com_shift,
-                    "moments_given": c.moments_given.tolist(), "moments": c.moments.tolist()}
-                   for c in (changes or [])],
+        "bodies": [{"body": c.body, "mass_given": c.mass_given, "mass": c.mass, "mass_change": _finite(c.mass_change),
+                    "com_shift": c.com_shift, "moments_given": c.moments_given.tolist(), "moments": c.moments.tolist(),
+                    "moments_change": [_finite(x) for x in c.moments_change]} for c in changes],
         "joints": joints,
     }

@@ -274,7 +274,7 @@ def _identification_section(doc: dict) -> str:
     for b in doc["bodies"]:
         if max(b["mass_given"], b["mass"]) <= 0:
             continue
-        change = f"{100 * (b['mass'] / b['mass_given'] - 1):+.2f}" if b["mass_given"] > 0 else "new"
+        change = "new" if b.get("mass_change") is None else f"{100 * b['mass_change']:+.2f}"
         bodies.append(f"<tr><td>{html.escape(b['body'])}</td><td>{b['mass_given']:.4f}</td><td>{b['mass']:.4f}</td>"
                       f"<td>{change}</td><td>{1e3 * b['com_shift']:.2f}</td></tr>")
     return f"""<h2>Inertia model identified from the torques (thesis 2.4, ch. 8)</h2>

@@ -28,7 +28,7 @@ import pinocchio as pin
 from lxml import etree as ET
 
 from .exceptions import InputError
-from .inertial import is_consistent
+from .inertial import body_parameters, is_consistent
 from .log import write_atomic
 from .robot import Robot
 
@@ -128,7 +128,7 @@ def write_urdf(robot: Robot, pi: np.ndarray, path: str | Path) -> tuple[str, ...
     tree = _parse(robot.urdf)
     links = {link.get("name"): link for link in tree.getroot().findall("link")}
     moved = []
-    given = np.array([robot.model.inertias[j].toDynamicParameters() for j in range(1, robot.model.njoints)])
+    given = body_parameters(robot.model)
     for b, body in enumerate(body_links(robot, tree)):
         if np.array_equal(pi[b], given[b]):
             continue  # unchanged: the URDF's own text kept
