@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 
 from wbfriction.friction import FrictionParams, coulomb, friction_torque, smooth, stribeck, viscous
-from wbfriction.identify import _jacobian, fit_friction, standard_errors
+from wbfriction.identify import _jacobian, fit_estimate, fit_friction, standard_errors
 
 pos = st.floats(0.01, 10.0)
 vel = st.floats(-20.0, 20.0).filter(lambda x: abs(x) > 1e-2)
@@ -75,6 +75,25 @@ def test_fit_recovers_noiseless_parameters(F_v, F_c, S, v_s, tau_os, a):
     assert res.success
     np.testing.assert_allclose(res.params.as_vector(), truth.as_vector(), rtol=1e-4, atol=1e-6)
     assert res.rms_residual < 1e-6
+
+
+def test_joints_fitted_side_by_side_equal_the_serial_fits():
+    """Three joints with different friction, one without any: workers change nothing, and
+    each joint gets its own truth back."""
+    rng = np.random.default_rng(3)
+    truths = [FrictionParams(0.2, 0.8, 0.2, 0.2, 0.8, 40.0), FrictionParams(0.1, 0.3, 0.5, 0.1, -0.2, 60.0),
+              FrictionParams(0.0, 0.0, 0.0, 0.1, 0.0, 40.0)]
+    qd = rng.uniform(-2.0, 2.0, (3000, 3))
+    tau_f = np.column_stack([t.torque(qd[:, i]) for i, t in enumerate(truths)]) + rng.normal(0, 0.01, qd.shape)
+    valid = np.ones(qd.shape, dtype=bool)
+    serial = fit_estimate(["a", "b", "c"], qd, tau_f, valid)
+    parallel = fit_estimate(["a", "b", "c"], qd, tau_f, valid, workers=2)
+    for s, p in zip(serial, parallel):
+        assert s.joint == p.joint
+        np.testing.assert_array_equal(s.params.as_vector(), p.params.as_vector())
+    for res, t in zip(serial[:2], truths):
+        np.testing.assert_allclose(res.params.as_vector()[[0, 1, 4]], t.as_vector()[[0, 1, 4]], rtol=0.05, atol=0.01)
+    assert abs(serial[2].params.F_c) < 0.01 and abs(serial[2].params.tau_os) < 0.01
 
 
 def test_fit_marks_unidentifiable_parameters():

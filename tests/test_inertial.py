@@ -12,8 +12,9 @@ from hypothesis import strategies as st
 
 from wbfriction.estimate import EstimateOptions
 from wbfriction.friction import THESIS_TARGETS
-from wbfriction.inertial import (CompressedLeastSquares, InertialOptions, act_matrix, base_parameters,
-                                 body_parameters, identify_inertia, is_consistent, log_cholesky, stance_regressor)
+from wbfriction.inertial import (CompressedLeastSquares, InertialOptions, _regularised, act_matrix, base_parameters,
+                                 body_parameters, fit_consistent, identify_inertia, is_consistent, log_cholesky,
+                                 nearest_consistent, stance_regressor)
 from wbfriction.sensitivity import scaled_robot
 from wbfriction.stance import stance_model
 from wbfriction.study import _leg_joints
@@ -60,6 +61,9 @@ def test_log_cholesky_round_trip_and_consistency(inertia):
     # a body whose principal moments break the triangle inequality is not physical
     bad = pin.Inertia(inertia.mass, inertia.lever, np.diag([1.0, 1.0, 3.0]) * inertia.mass).toDynamicParameters()
     assert not is_consistent(bad[None])[0]
+    # the nearest consistent body: a physical one unchanged, the other brought inside
+    assert np.allclose(nearest_consistent(pi[None])[0], pi, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(pi).max()))
+    assert is_consistent(nearest_consistent(bad[None]))[0]
 
 
 @settings(max_examples=40, deadline=None)
@@ -91,6 +95,54 @@ def test_compressed_least_squares_and_base_parameters():
     expected = np.array([x[0] + x[4], x[1] + 2.0 * x[4], x[2], x[3]])
     assert np.allclose(base.combination @ x, expected, atol=1e-9)
     assert np.allclose(base.combination @ ref, expected, atol=1e-2)
+
+
+def _slow_joint(body: pin.Inertia, seed: int, triangle: bool):
+    """Rows of one body and one joint that never leaves the linear part of tanh (its viscous
+    and Coulomb columns nearly collinear), with a true friction; with ``triangle`` the data
+    ask for a rotational inertia beyond the triangle inequality."""
+    rng = np.random.default_rng(seed)
+    pi_true = body.toDynamicParameters()
+    friction_true = np.array([[0.3, 0.2, -0.1]])  # F_v, F_c, tau_os
+    n = 400
+    qd = rng.uniform(-4e-3, 4e-3, n)
+    F = np.column_stack([qd, np.tanh(40.0 * qd), np.ones(n)])
+    Y = rng.normal(size=(n, 10)) * np.concatenate([[1.0], [0.1] * 3, [0.01] * 6])
+    b = Y @ pi_true + F @ friction_true[0] + rng.normal(0, 1e-3, n)
+    if triangle:
+        bad = pin.Inertia(body.mass, body.lever, np.diag([1.0, 1.0, 3.0]) * body.mass).toDynamicParameters()
+        b = b + Y @ (bad - pi_true)
+    ls = CompressedLeastSquares(13)
+    ls.add(np.column_stack([Y, F]), b)
+    return ls, pi_true[None], friction_true
+
+
+@settings(max_examples=25, deadline=None)
+@given(body=inertias, seed=st.integers(0, 2**32 - 1), triangle=st.booleans())
+def test_consistent_fit_keeps_friction_physical_and_beats_the_truth(body, seed, triangle):
+    """The fit keeps F_v, F_c >= 0 and the body physical (through the non-linear,
+    log-Cholesky route with ``triangle``), and its objective is no worse than the truth's,
+    a feasible point."""
+    ls, pi_true, friction_true = _slow_joint(body, seed, triangle)
+    pi0, friction0 = pi_true * 1.05, np.zeros((1, 3))
+    fit = fit_consistent(ls.R, ls.z, pi0, friction0, prior=1e-9)
+    assert fit.friction[0, 0] >= 0 and fit.friction[0, 1] >= 0
+    assert is_consistent(fit.pi).all()
+    lower = np.concatenate([np.full(10, -np.inf), [0.0, 0.0, -np.inf]])
+    _, A, c = _regularised(ls.R, ls.z, pi0, friction0, 1e-9, 1e-3, lower)
+
+    def objective(pi, friction):
+        return float(np.sum((A @ np.concatenate([pi.ravel(), friction.ravel()]) - c) ** 2))
+
+    assert objective(fit.pi, fit.friction) <= objective(pi_true, friction_true) * (1 + 1e-6)
+    assert fit.cost == pytest.approx(0.5 * objective(fit.pi, fit.friction), rel=1e-4)
+
+
+def test_unbounded_friction_of_a_slow_joint_cancels():
+    """The premise of the test above: without the bounds, F_v and F_c take opposite signs."""
+    ls, *_ = _slow_joint(pin.Inertia.FromBox(2.0, 0.2, 0.1, 0.3), 0, False)
+    unbounded = np.linalg.lstsq(ls.R, ls.z, rcond=None)[0]
+    assert min(unbounded[10], unbounded[11]) < 0
 
 
 def test_identification_recovers_model_and_friction_from_a_walk_with_a_wrong_model(talos, combined_walk):

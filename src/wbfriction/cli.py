@@ -52,6 +52,7 @@ EnergyToleranceOpt = typer.Option(DEFAULT_TOLERANCE, help="Smallest friction tor
 UrdfOpt = typer.Option(None, "--urdf", help="URDF of another robot (with --config), or another URDF of the "
                                              "built-in --robot (e.g. identified inertias).")
 ConfigOpt = typer.Option(None, "--config", help="Robot TOML: contact_frames, position_controlled, groups.")
+FitWorkersOpt = typer.Option(2, min=1, help="Processes fitting joints side by side.")
 MapOpt = typer.Option(None, "--map", help="Topic map TOML of a ROS 2 bag log (see 'wbfriction convert').")
 
 
@@ -208,9 +209,10 @@ def _run_estimate(r: Robot, spec, log: Path, output: Path, opts: EstimateOptions
     console.print(f"wrote {output}: {result.rows} samples")
 
 
-def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, tolerance: float) -> None:
+def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, tolerance: float,
+             workers: int) -> None:
     est = estimate_from_table(read_table(friction), str(friction))
-    results = fit_table_estimate(est, min_samples=min_samples)
+    results = fit_table_estimate(est, min_samples=min_samples, workers=workers)
     energy = energy_consistency(est, fitted_offsets(results), threshold, tolerance)
     _write_params(results, output, {"friction": str(friction), "friction_sha256": file_sha256(friction),
                                     "wbfriction": __version__}, {e.joint: e for e in energy})
@@ -331,10 +333,11 @@ def convert(bag: Path = typer.Argument(..., help="ROS 2 bag (folder with metadat
 def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wbfriction estimate'."),
         output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
         min_samples: int = typer.Option(_MIN_SAMPLES, help="Joints with fewer valid samples are not fitted."),
-        energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt) -> None:
+        energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt,
+        workers: int = FitWorkersOpt) -> None:
     """Identify the friction model (3.5) of every joint, with standard errors; warn about
     joints whose friction generates power (eq. 7.9)."""
-    _run_fit(friction, output, min_samples, energy_threshold, energy_tolerance)
+    _run_fit(friction, output, min_samples, energy_threshold, energy_tolerance, workers)
 
 
 @app.command()
@@ -470,7 +473,8 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
              prior: float = typer.Option(_N.prior, help="Relative weight of the prior toward the given model."),
              tanh_slope: float = typer.Option(_N.tanh_slope, help="a of the Coulomb term tanh(a qd) [s/rad]."),
              diff: str = typer.Option(_E.diff, help="Differentiation scheme (see 'estimate')."),
-             mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate').")) -> None:
+             mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate')."),
+             workers: int = FitWorkersOpt) -> None:
     """Identify the inertia model and the friction together from the joint torques of single
     support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
     with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
@@ -489,7 +493,7 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior)
     with console.status("") as status:
         loop = identify_and_estimate(r, data, EstimateOptions(diff=diff, mask=mask), opts, stribeck, passes,
-                                     progress=lambda label: status.update(label))
+                                     progress=lambda label: status.update(label), workers=workers)
     moved = write_urdf(r, loop.final.identification.pi, output)
     doc = loop_document(loop, moved)
     doc["provenance"] = {"log": str(log), "log_sha256": file_sha256(log), "robot": r.name, "urdf": str(r.urdf),

@@ -64,10 +64,12 @@ class ClosedLoop:
         return self.passes[-1]
 
 
-def acceleration_route(robot: Robot, log: Log, options: EstimateOptions, min_samples: int = 20) -> Route:
-    """Estimate (5.10-5.13) and fit (3.5) every torque-controlled joint, and check energy (7.9)."""
+def acceleration_route(robot: Robot, log: Log, options: EstimateOptions, min_samples: int = 20,
+                       workers: int = 1) -> Route:
+    """Estimate (5.10-5.13) and fit (3.5) every torque-controlled joint (on ``workers``
+    processes), and check energy (7.9)."""
     est = estimate_log(robot, log, options)
-    fits = fit_table_estimate(est, min_samples=min_samples)
+    fits = fit_table_estimate(est, min_samples=min_samples, workers=workers)
     return Route(est, fits, energy_consistency(est, fitted_offsets(fits)))
 
 
@@ -86,7 +88,7 @@ def stribeck_velocity(fits: list[FitResult], max_relative_error: float = 0.5) ->
 def identify_and_estimate(robot: Robot, log: Log, estimate_options: EstimateOptions = EstimateOptions(),
                           options: InertialOptions = InertialOptions(),
                           stribeck: float | Literal["auto"] | None = "auto", passes: int = 2,
-                          progress: Callable[[str], None] | None = None) -> ClosedLoop:
+                          progress: Callable[[str], None] | None = None, workers: int = 1) -> ClosedLoop:
     """Run the loop (module docstring).
 
     Args:
@@ -99,6 +101,7 @@ def identify_and_estimate(robot: Robot, log: Log, estimate_options: EstimateOpti
             [rad/s]: that ``v_s``, one pass; None: no Stribeck term, one pass.
         passes: identifications with ``"auto"`` (at least 1).
         progress: called with a label as each stage starts.
+        workers: processes fitting the joints of the acceleration route side by side.
 
     Raises:
         InputError: what :func:`~wbfriction.estimate.estimate_log` and
@@ -106,7 +109,7 @@ def identify_and_estimate(robot: Robot, log: Log, estimate_options: EstimateOpti
     """
     say = progress or (lambda label: None)
     say("acceleration route with the given model")
-    given = acceleration_route(robot, log, estimate_options)
+    given = acceleration_route(robot, log, estimate_options, workers=workers)
     if stribeck != "auto":
         passes = 1
     v_s, joints = stribeck_velocity(given.fits) if stribeck == "auto" else (stribeck, None)
@@ -116,7 +119,7 @@ def identify_and_estimate(robot: Robot, log: Log, estimate_options: EstimateOpti
         ident = identify_inertia(robot, log, estimate_options,
                                  replace(options, stribeck_velocity=v_s, stribeck_joints=joints))
         say(f"acceleration route with the identified model (pass {k + 1})")
-        route = acceleration_route(ident.robot, log, estimate_options)
+        route = acceleration_route(ident.robot, log, estimate_options, workers=workers)
         done.append(LoopPass(v_s, joints, ident, route))
         if stribeck == "auto":
             found = stribeck_velocity(route.fits)

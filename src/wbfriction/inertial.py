@@ -35,10 +35,15 @@ regressor (:func:`base_parameters`).
 log-Cholesky parametrisation (Rucker & Wensing, *Smooth parameterization of rigid-body
 inertia*, IEEE RA-L 2022; ``pin.LogCholeskyParameters``), so every estimate is a
 physical rigid body (positive mass, positive-definite pseudo-inertia: the triangle
-inequalities hold). A Tikhonov prior pulls toward the given model where the data say
-nothing: its weight is ``prior`` times the largest squared singular value of the
-scaled regressor, so only directions weaker than ``sqrt(prior)`` of the best-excited
-one follow the prior. The problem is solved with ``scipy.optimize.least_squares``.
+inequalities hold). A Tikhonov prior pulls the inertias toward the given model where
+the data say nothing: its weight is ``prior`` times the largest squared singular value
+of the scaled regressor, so only directions weaker than ``sqrt(prior)`` of the
+best-excited one follow the prior. The URDF says nothing of friction: the friction
+parameters get only the vanishing weight :data:`FRICTION_PRIOR` (which fixes those of a
+joint that never moves). Pulled as hard as the inertias toward the friction that best
+explains the data with the given model, they kept that model's error: on the demo's
+walk, a 5.4 % error of an ankle's offset became 2.3 % without it. The problem is solved
+with ``scipy.optimize.least_squares``.
 
 **Choosing the prior.** Too weak a prior lets the barely excited bodies (arms that
 hardly move in a walk) take any value that fits the noise of the model; too strong a
@@ -60,7 +65,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 import scipy.linalg
-from scipy.optimize import least_squares
+from scipy.optimize import least_squares, lsq_linear
 
 from .estimate import EstimateOptions, stance_frame_pose
 from .exceptions import InputError
@@ -77,9 +82,14 @@ FRICTION = ("F_v", "F_c", "tau_os")
 """Friction parameters identified per torque-controlled joint (3.5 without Stribeck)."""
 PRIOR_GRID = (1e-10, 1e-9, 1e-8, 1e-7, 1e-6)
 """Relative prior weights tried when :attr:`InertialOptions.prior` is None."""
+FRICTION_PRIOR = 1e-12
+"""Relative weight of the friction parameters' prior (module docstring)."""
 STRIBECK = "F_s-F_c"
 """With a fixed Stribeck velocity ``v_s``, the Stribeck term's height ``F_s - F_c = S F_c`` [N·m]
 too (``F_s`` the static friction of 3.4, ``S`` that of :func:`wbfriction.friction.smooth`)."""
+FRICTION_LOWER = {"F_v": 0.0, "F_c": 0.0, "tau_os": -np.inf, STRIBECK: 0.0}
+"""Physical friction: dissipative viscous and Coulomb parts, static friction at least the
+Coulomb level (the bounds of :data:`wbfriction.identify.LOWER`); the offset is free."""
 
 
 def body_parameters(model: pin.Model) -> np.ndarray:
@@ -329,63 +339,109 @@ def is_consistent(pi: np.ndarray, margin: float = 0.0) -> np.ndarray:
     return out
 
 
+def nearest_consistent(pi: np.ndarray, margin: float = 1e-12) -> np.ndarray:
+    """Bodies (nb, 10) with every pseudo-inertia eigenvalue raised to at least ``margin`` times
+    the largest (the nearest such pseudo-inertia in the Frobenius norm): a body that rounding
+    left just outside the physical set (an optimum on its boundary, a thin plate or a rod)
+    comes back inside; a physical one is unchanged."""
+    out = np.array(pi, dtype=float)
+    for b, p in enumerate(out):
+        J = pin.PseudoInertia.FromDynamicParameters(p).toMatrix()
+        ev, V = np.linalg.eigh(J)
+        floor = margin * max(ev[-1], 0.0)
+        if ev[-1] > 0 and ev[0] <= floor:
+            J = (V * np.maximum(ev, floor)) @ V.T
+            out[b] = pin.PseudoInertia.FromMatrix(0.5 * (J + J.T)).toDynamicParameters()
+    return out
+
+
+def _friction_lower(k: int, n_tc: int) -> np.ndarray:
+    """Lower bounds (k n_tc,) of the friction parameters, the first ``k`` of ``(F_v, F_c, tau_os, F_s-F_c)``
+    per joint (:data:`FRICTION_LOWER`)."""
+    return np.tile([FRICTION_LOWER[n] for n in (*FRICTION, STRIBECK)[:k]], n_tc)
+
+
 def _regularised(R: np.ndarray, z: np.ndarray, pi0: np.ndarray, friction0: np.ndarray, prior: float,
-                 min_mass: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The linear solution of :func:`fit_consistent`'s problem without the consistency
-    constraint, the prior's centre ``x0`` and its row weights ``w``."""
+                 min_mass: float, lower: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`fit_consistent`'s objective ``|A x - c|^2`` (``A`` (2p, p), ``c`` (2p,)) and
+    its minimum ``x_lin`` without the bodies' consistency constraint, with the friction
+    bounds ``lower`` (a bounded linear least squares)."""
     x0 = np.concatenate([pi0.ravel(), friction0.ravel()])
     d = 1.0 / np.concatenate([parameter_scales(pi0, min_mass).ravel(), np.ones(friction0.size)])
-    w = np.sqrt(prior) * np.linalg.norm(R / d[None, :], 2) * d
-    x_lin = np.linalg.lstsq(np.vstack([R, np.diag(w)]), np.concatenate([z, w * x0]), rcond=None)[0]
-    return x_lin, x0, w
+    relative = np.concatenate([np.full(pi0.size, prior), np.full(friction0.size, FRICTION_PRIOR)])
+    w = np.sqrt(relative) * np.linalg.norm(R / d[None, :], 2) * d
+    A, c = np.vstack([R, np.diag(w)]), np.concatenate([z, w * x0])
+    scaled = A / d[None, :]  # in the parameters times d: columns of comparable size
+    if np.isfinite(lower).any():
+        x_lin = lsq_linear(scaled, c, bounds=(lower * d, np.inf), method="bvls").x / d
+    else:
+        x_lin = np.linalg.lstsq(scaled, c, rcond=None)[0] / d
+    return x_lin, A, c
 
 
 def fit_consistent(R: np.ndarray, z: np.ndarray, pi0: np.ndarray, friction0: np.ndarray, prior: float = 1e-9,
                    min_mass: float = 1e-3) -> ConsistentFit:
-    """Solve ``min |R x - z|^2 + lambda |D (x - x0)|^2`` over physically consistent bodies.
+    """Solve ``min |R x - z|^2 + |W D (x - x0)|^2`` over physically consistent bodies and
+    friction (:data:`FRICTION_LOWER`).
 
     ``x = (pi.ravel(), friction.ravel())``; ``x0`` is the given model (``pi0``,
     ``friction0``); ``D`` divides by :func:`parameter_scales` (1 for friction);
-    ``lambda = prior * sigma_max(R D^-1)^2``. The linear least-squares solution is taken
-    when every body it gives is physically consistent (:func:`is_consistent`); otherwise
-    each body is written through its log-Cholesky parameters (so that every iterate is a
-    rigid body) and the problem is solved by ``scipy.optimize.least_squares``, from the
-    linear solution's consistent bodies and the given model's others.
+    ``W^2 = sigma_max(R D^-1)^2`` times ``prior`` on the inertial parameters and
+    :data:`FRICTION_PRIOR` on the friction ones. The friction is bounded (a joint that
+    never leaves the linear part of ``tanh`` cannot tell its viscous from its Coulomb
+    friction: unbounded, they cancel with huge opposite values). The linear solution with
+    these bounds (``scipy.optimize.lsq_linear``) is taken when every body it gives is
+    physically consistent (:func:`is_consistent`); otherwise each body is written through
+    its log-Cholesky parameters (so that every iterate is a rigid body) and the problem is
+    solved by ``scipy.optimize.least_squares``, from the linear solution's consistent
+    bodies and friction and the given model's other bodies (trust-region steps by LSMR, on
+    the problem compressed to ``p`` rows; stopped after 200 evaluations: on the demo's
+    walk, 2000 lower the cost by 0.2 %); a body that rounding leaves on the boundary of
+    the physical set is then brought inside (:func:`nearest_consistent`).
 
     Args:
         R, z: the compressed regressor (p, p) and right-hand side (p,), columns ordered as ``x``.
-        pi0: given inertial parameters (nb, 10); friction0: starting friction (n_tc, k).
-        prior: relative weight of the prior.
+        pi0: given inertial parameters (nb, 10); friction0: starting friction (n_tc, k), its
+            columns the first ``k`` of ``(F_v, F_c, tau_os, F_s-F_c)``.
+        prior: relative weight of the inertial parameters' prior.
         min_mass: smallest mass of a body's starting point [kg] (:func:`log_cholesky`).
     """
-    nb, nf = len(pi0), friction0.size
-    x_lin, x0, w = _regularised(R, z, pi0, friction0, prior, min_mass)
+    nb = len(pi0)
+    lower = np.concatenate([np.full(10 * nb, -np.inf), _friction_lower(*friction0.shape[::-1])])
+    x_lin, A, c = _regularised(R, z, pi0, friction0, prior, min_mass, lower)
     pi_lin = x_lin[: 10 * nb].reshape(nb, 10)
     ok = is_consistent(pi_lin, 1e-12)
     if ok.all():
-        r = np.concatenate([R @ x_lin - z, w * (x_lin - x0)])
+        r = A @ x_lin - c
         return ConsistentFit(pi_lin, x_lin[10 * nb:].reshape(friction0.shape), 0.5 * float(r @ r),
                              "the linear least-squares solution is physically consistent")
+    # |A x - c|^2 = |T x - e|^2 + floor (A = Q T): the same problem in half the rows
+    Q, T = scipy.linalg.qr(A, mode="economic")
+    e = Q.T @ c
+    floor = float(c @ c - e @ e)
 
     def unpack(v):
         pi, jac = _parameters(v[: 10 * nb].reshape(nb, 10))
         return np.concatenate([pi.ravel(), v[10 * nb:]]), jac
 
     def fun(v):
-        x, _ = unpack(v)
-        return np.concatenate([R @ x - z, w * (x - x0)])
+        return T @ unpack(v)[0] - e
 
     def jac(v):
-        _, jb = unpack(v)
-        dx = scipy.linalg.block_diag(*jb, np.eye(nf))
-        return np.vstack([R @ dx, w[:, None] * dx])
+        jb = unpack(v)[1]  # d pi_b / d theta_b (nb, 10, 10); friction enters as itself
+        out = T.copy()
+        out[:, : 10 * nb] = np.einsum("rbi,bij->rbj", T[:, : 10 * nb].reshape(-1, nb, 10), jb).reshape(-1, 10 * nb)
+        return out
 
-    theta0 = np.array([log_cholesky(p, min_mass) for p in np.where(ok[:, None], pi_lin, pi0)])
+    nearest = nearest_consistent(pi_lin, 1e-4)
+    theta0 = np.array([log_cholesky(p, min_mass) for p in np.where(ok[:, None], pi_lin, nearest)])
+    start = np.concatenate([theta0.ravel(), np.maximum(x_lin[10 * nb:], lower[10 * nb:])])  # max: bvls rounding
     with np.errstate(over="ignore", invalid="ignore"):  # trial steps may overflow exp(): trf then shrinks them
-        res = least_squares(fun, np.concatenate([theta0.ravel(), x_lin[10 * nb:]]), jac=jac, method="trf",
-                            x_scale="jac", max_nfev=200)
+        res = least_squares(fun, start, jac=jac, bounds=(lower, np.inf), method="trf", x_scale="jac",
+                            tr_solver="lsmr", max_nfev=200)
     x, _ = unpack(res.x)
-    return ConsistentFit(x[: 10 * nb].reshape(nb, 10), x[10 * nb:].reshape(friction0.shape), float(res.cost),
+    return ConsistentFit(nearest_consistent(x[: 10 * nb].reshape(nb, 10)), x[10 * nb:].reshape(friction0.shape),
+                         float(res.cost + 0.5 * floor),
                          f"{int((~ok).sum())} bodies of the linear solution were not physical: {res.message}")
 
 
@@ -447,8 +503,8 @@ class InertialIdentification:
         pi_given, pi: inertial parameters of the given and identified model (nb, 10).
         friction_names: the friction parameters (:func:`friction_names`), k of them.
         friction: identified friction parameters per torque-controlled joint (n_tc, k).
-        friction_given_model: the friction that best explains the data with the given
-            inertias (n_tc, k).
+        friction_given_model: the physical friction (:data:`FRICTION_LOWER`) that best
+            explains the data with the given inertias (n_tc, k).
         base: the base parameters, over ``(pi.ravel(), friction.ravel())``.
         holdout: torque predictions on the held-out samples.
         samples: single-support samples in the regression.
@@ -567,8 +623,9 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
         total.absorb(system)
     R, z = total.R, total.z
     pi0 = body_parameters(robot.model)
-    # friction that best explains the data with the given inertias: the start, and the given model's best case
-    friction0 = np.linalg.lstsq(R[:, p_in:], z - R[:, :p_in] @ pi0.ravel(), rcond=None)[0].reshape(n_tc, k)
+    # physical friction that best explains the data with the given inertias: the start, and the given model's best case
+    friction0 = lsq_linear(R[:, p_in:], z - R[:, :p_in] @ pi0.ravel(), bounds=(_friction_lower(k, n_tc), np.inf),
+                           method="bvls").x.reshape(n_tc, k)
     base = base_parameters(R, options.rank_tolerance)
     prior, scores = options.prior, {}
     if prior is None:
@@ -582,6 +639,8 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
                 break  # past the best weight: weaker priors only fit the noise more closely
         prior = min(scores, key=scores.get)
     fit = fit_consistent(R, z, pi0, friction0, prior, options.min_mass)
+    if k == len(FRICTION) + 1 and options.stribeck_joints is not None:  # no column: no Stribeck term, not a bound
+        fit.friction[~np.isin(robot.torque_controlled, options.stribeck_joints), -1] = 0.0
     identified = dataclasses.replace(robot, model=with_body_parameters(robot.model, fit.pi), cache={})
     holdout = _torque_fit(robot, parts, pi0, friction0, fit, options)
     if holdout.samples == 0:
