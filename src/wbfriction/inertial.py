@@ -42,7 +42,7 @@ best-excited one follow the prior. The URDF says nothing of friction: the fricti
 parameters get only the vanishing weight :data:`FRICTION_PRIOR` (which fixes those of a
 joint that never moves). Pulled as hard as the inertias toward the friction that best
 explains the data with the given model, they kept that model's error: on the demo's
-walk, a 5.4 % error of an ankle's offset became 2.3 % without it. The problem is solved
+walk, a 5.4 % error of an ankle's offset became 2.4 % without it. The problem is solved
 with ``scipy.optimize.least_squares``.
 
 **Choosing the prior.** Too weak a prior lets the barely excited bodies (arms that
