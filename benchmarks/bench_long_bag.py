@@ -18,13 +18,12 @@ from __future__ import annotations
 import argparse
 import shutil
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-from bench_long_log import measure, walk_log
+from bench_long_log import measure, walk_log, work_folder
 from wbfriction.robot import load_robot
 
 T0 = 1_700_000_000_000_000_000
@@ -103,9 +102,7 @@ def main() -> None:
     parser.add_argument("--estimate", action="store_true", help="Also run 'wbfriction estimate' on the bag.")
     parser.add_argument("--keep", type=Path, default=None, help="Folder to keep the bag and the outputs in.")
     args = parser.parse_args()
-    folder = Path(tempfile.mkdtemp(prefix="wbf-bag-")) if args.keep is None else args.keep
-    folder.mkdir(parents=True, exist_ok=True)
-    try:
+    with work_folder(args.keep, "wbf-bag-") as folder:
         bag = folder / "bag"
         shutil.rmtree(bag, ignore_errors=True)
         t0 = time.perf_counter()
@@ -124,9 +121,6 @@ def main() -> None:
                                      "-o", str(folder / "friction.parquet")])
             print(f"wbfriction estimate (bag): {seconds:.0f} s, {rows / seconds:.0f} samples/s, peak "
                   f"{peak / 2**20:.0f} MiB resident in all (the command and its 2 workers)")
-    finally:
-        if args.keep is None:
-            shutil.rmtree(folder, ignore_errors=True)
 
 
 if __name__ == "__main__":

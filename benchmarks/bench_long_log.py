@@ -12,6 +12,7 @@ of the command and its workers together.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import resource
 import shutil
 import subprocess
@@ -93,6 +94,18 @@ def measure(cmd: list[str]) -> tuple[float, int]:
     return time.perf_counter() - t0, peak
 
 
+@contextlib.contextmanager
+def work_folder(keep: Path | None, prefix: str):
+    """A folder for a benchmark's files: ``keep`` (kept), or a temporary one removed afterwards."""
+    folder = Path(tempfile.mkdtemp(prefix=prefix)) if keep is None else keep
+    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        yield folder
+    finally:
+        if keep is None:
+            shutil.rmtree(folder, ignore_errors=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=60.0)
@@ -100,9 +113,7 @@ def main() -> None:
     parser.add_argument("--chunk-rows", type=int, default=Chunking().rows)
     parser.add_argument("--keep", type=Path, default=None, help="Folder to keep the log and the estimate in.")
     args = parser.parse_args()
-    folder = Path(tempfile.mkdtemp(prefix="wbf-long-")) if args.keep is None else args.keep
-    folder.mkdir(parents=True, exist_ok=True)
-    try:
+    with work_folder(args.keep, "wbf-long-") as folder:
         log = folder / "long_log.parquet"
         t0 = time.perf_counter()
         rows = build_log(log, args.minutes)
@@ -120,9 +131,6 @@ def main() -> None:
         print(f"output: {(folder / 'long_friction.parquet').stat().st_size / 2**30:.2f} GiB")
         print(f"peak memory: {peak / 2**20:.0f} MiB resident in all (the command and its workers, sampled every "
               f"0.2 s); largest single process {largest:.0f} MiB")
-    finally:
-        if args.keep is None:
-            shutil.rmtree(folder, ignore_errors=True)
 
 
 if __name__ == "__main__":
