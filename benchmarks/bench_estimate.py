@@ -20,9 +20,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 
-from wbfriction.estimate import EstimateOptions, estimate_friction  # noqa: E402
-from wbfriction.kinematics import MeasuredKinematics  # noqa: E402
-from wbfriction.robot import load_robot  # noqa: E402
+from wbfriction.friction.estimate import EstimateOptions, estimate_friction  # noqa: E402
+from wbfriction.model.loading import load_robot  # noqa: E402
+from wbfriction.signals.kinematics import MeasuredKinematics  # noqa: E402
 
 
 def samples(robot, n: int, seed: int = 0) -> tuple[MeasuredKinematics, np.ndarray, np.ndarray]:

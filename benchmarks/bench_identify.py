@@ -13,12 +13,12 @@ from __future__ import annotations
 import argparse
 import time
 
-from wbfriction.closed_loop import identify_and_estimate
-from wbfriction.friction import THESIS_TARGETS
-from wbfriction.robot import load_robot
-from wbfriction.sensitivity import scaled_robot
+from wbfriction.friction.targets import THESIS_TARGETS
+from wbfriction.inertia.closed_loop import identify
+from wbfriction.inertia.sensitivity import scaled_robot
+from wbfriction.model.loading import load_robot
 from wbfriction.sim import simulate_ideal
-from wbfriction.study import SIMULATOR, _leg_joints
+from wbfriction.studies.common import SIMULATOR, leg_joints
 from wbfriction.walking import GaitOptions, walking_reference
 
 
@@ -30,7 +30,7 @@ def main() -> None:
     args = parser.parse_args()
 
     talos = load_robot("talos")
-    legs = _leg_joints(talos)
+    legs = leg_joints(talos)
     t = time.perf_counter()
     ref = walking_reference(talos, GaitOptions(gait="combined", steps=args.steps))
     log = simulate_ideal(talos, ref, {j: THESIS_TARGETS[g] for j, _, g in legs}, SIMULATOR).log
@@ -45,7 +45,7 @@ def main() -> None:
         print(f"{now - start:7.1f} s (+{now - last:5.1f}) {label}", flush=True)
         last = now
 
-    loop = identify_and_estimate(wrong, log, passes=args.passes, progress=stage, workers=args.workers)
+    loop = identify(wrong, log, passes=args.passes, progress=stage, workers=args.workers)
     stage("done")
     names = {j for j, _, _ in legs}
     for label, route in (("given model", loop.given), ("identified model", loop.final.route)):

@@ -4,7 +4,7 @@ Writes an MCAP bag of ``--minutes`` for TALOS by repeating a simulated combined 
 ``sensor_msgs/JointState`` at 1 kHz (32 joints), the left sole's ``WrenchStamped`` at 1 kHz,
 the right sole's contact as a ``Bool`` on change, ``nav_msgs/Odometry`` at 200 Hz arriving
 10 ms after its stamp. Then runs ``wbfriction convert`` on it (streamed,
-:func:`wbfriction.bags.iter_bag`, then checked in chunks) and, with ``--estimate``,
+:func:`wbfriction.logs.bags.iter_bag`, then checked in chunks) and, with ``--estimate``,
 ``wbfriction estimate`` on the bag, and prints rows per second and the peak resident memory
 of each command's process tree. Run it for two lengths to see that memory does not grow
 with the bag:
@@ -22,9 +22,9 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 from bench_long_log import measure, walk_log, work_folder
-from wbfriction.robot import load_robot
+
+from wbfriction.model.loading import load_robot
 
 T0 = 1_700_000_000_000_000_000
 MAP = """[joint_states]

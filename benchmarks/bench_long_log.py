@@ -3,7 +3,7 @@
 Builds a log of ``--minutes`` at 1 kHz for TALOS by repeating a simulated combined walk
 (with a 0.5 s time gap between repetitions, so that the log has segments as real logs with
 pauses do), written tile by tile (never held whole), then runs ``wbfriction estimate`` on it
-(chunked, :mod:`wbfriction.chunked`) and prints rows per second and the peak resident memory
+(chunked, :mod:`wbfriction.pipeline.chunked`) and prints rows per second and the peak resident memory
 of the command and its workers together.
 
     python benchmarks/bench_long_log.py --minutes 60 --workers 2
@@ -25,18 +25,18 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from wbfriction.chunked import Chunking
-from wbfriction.friction import THESIS_TARGETS
-from wbfriction.robot import load_robot
+from wbfriction.friction.targets import THESIS_TARGETS
+from wbfriction.model.loading import load_robot
+from wbfriction.pipeline.chunks import Chunking
 from wbfriction.sim import simulate_ideal
-from wbfriction.study import _leg_joints
+from wbfriction.studies.common import leg_joints
 from wbfriction.walking import GaitOptions, walking_reference
 
 
 def walk_log(robot):
     """The tile both long-input benchmarks repeat: a 3-step combined walk of the ideal
     simulator with Table 6.1 friction on the legs."""
-    friction = {j: THESIS_TARGETS[g] for j, _, g in _leg_joints(robot)}
+    friction = {j: THESIS_TARGETS[g] for j, _, g in leg_joints(robot)}
     return simulate_ideal(robot, walking_reference(robot, GaitOptions(gait="combined", steps=3)), friction).log
 
 

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import time
 
-from wbfriction.realistic_study import NOISE
-from wbfriction.robot import load_robot
+from wbfriction.model.loading import load_robot
 from wbfriction.sim import MujocoOptions, simulate_mujoco
 from wbfriction.sim.mujoco_model import build_mujoco_robot
+from wbfriction.studies.realistic import NOISE
 from wbfriction.walking import GaitOptions, walking_reference
 
 

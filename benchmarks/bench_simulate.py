@@ -13,9 +13,9 @@ import sys
 import tempfile
 import time
 
-from wbfriction.robot import load_robot
+from wbfriction.model.loading import load_robot
 from wbfriction.sim import IdealOptions, simulate_ideal
-from wbfriction.study import SIMULATOR
+from wbfriction.studies.common import SIMULATOR
 from wbfriction.walking import GaitOptions, walking_reference
 
 

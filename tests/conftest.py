@@ -6,8 +6,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from wbfriction.kinematics import MeasuredKinematics
-from wbfriction.robot import Robot, load_robot
+from wbfriction.model.loading import load_robot
+from wbfriction.model.robot import Robot
+from wbfriction.signals.kinematics import MeasuredKinematics
 
 
 @pytest.fixture(scope="session")
@@ -83,7 +84,7 @@ def truth_samples(robot: Robot, n: int, support: str, seed: int, friction_joints
     n_tc = len(robot.torque_controlled)
     inject = np.array([j in friction_joints for j in robot.torque_controlled])
     rows = dict(q=[], qd=[], qdd=[], tau=[], contact=[], base=[], tau_f=[])
-    for k in range(n):
+    for _ in range(n):
         if support == "single":
             active = [int(rng.integers(len(robot.contact_frames)))]
         else:
@@ -115,11 +116,11 @@ def truth_samples(robot: Robot, n: int, support: str, seed: int, friction_joints
 def combined_walk(talos):
     """The demo's combined walk (forward, sideways, turning), 3 steps per direction, Table 6.1
     friction on every leg joint, the demo's simulator (physics at 10 kHz)."""
-    from wbfriction.friction import THESIS_TARGETS
+    from wbfriction.friction.targets import THESIS_TARGETS
     from wbfriction.sim import simulate_ideal
-    from wbfriction.study import SIMULATOR, _leg_joints
+    from wbfriction.studies.common import SIMULATOR, leg_joints
     from wbfriction.walking import GaitOptions, walking_reference
 
-    friction = {j: THESIS_TARGETS[g] for j, _, g in _leg_joints(talos)}
+    friction = {j: THESIS_TARGETS[g] for j, _, g in leg_joints(talos)}
     ref = walking_reference(talos, GaitOptions(gait="combined", steps=3))
     return simulate_ideal(talos, ref, friction, SIMULATOR)

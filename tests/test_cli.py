@@ -3,20 +3,14 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from wbfriction.log import read_log, write_log
-
-
-def run(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "wbfriction", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd, env=dict(os.environ, COLUMNS="200"))
+from helpers import assert_one_line_error, run
+from wbfriction.logs.log import write_log
+from wbfriction.logs.source import read_log
 
 
 @pytest.fixture(scope="module")
@@ -77,12 +71,6 @@ def test_estimate_and_fit_commands_with_options(demo_dir, tmp_path):
     assert json.loads((tmp_path / "p.json").read_text())["joints"]["leg_left_4_joint"]["n_samples"] > 0
 
 
-def _assert_one_line_error(res, needle):
-    assert res.returncode == 2
-    lines = [ln for ln in res.stderr.strip().splitlines() if ln.strip()]
-    assert len(lines) == 1 and needle in lines[0], res.stderr
-
-
 def test_bad_inputs_exit_2_with_one_line(talos, demo_dir, tmp_path):
     out, _ = demo_dir
     log = read_log(out / "log.parquet", talos)
@@ -90,22 +78,22 @@ def test_bad_inputs_exit_2_with_one_line(talos, demo_dir, tmp_path):
     bad = read_log(out / "log.parquet", talos)
     bad.q[5, 3] = np.nan
     write_log(bad, talos, tmp_path / "nan.parquet")
-    _assert_one_line_error(run("estimate", tmp_path / "nan.parquet", "-o", tmp_path / "x.parquet"),
+    assert_one_line_error(run("estimate", tmp_path / "nan.parquet", "-o", tmp_path / "x.parquet"),
                            f"column 'q.{talos.actuated[3]}' has a non-finite value (NaN or inf) at row 5")
     # no single-support sample
     log.contact[:] = True
     write_log(log, talos, tmp_path / "ds.parquet")
-    _assert_one_line_error(run("estimate", tmp_path / "ds.parquet", "-o", tmp_path / "x.parquet"),
+    assert_one_line_error(run("estimate", tmp_path / "ds.parquet", "-o", tmp_path / "x.parquet"),
                            "no single-support sample")
     assert not (tmp_path / "x.parquet").exists()
     # a URDF that does not load
     (tmp_path / "broken.urdf").write_text("<robot name='x'><link name='a'/><joint/></robot>")
     (tmp_path / "r.toml").write_text('contact_frames = ["a"]\n')
-    _assert_one_line_error(run("estimate", out / "log.parquet", "--urdf", tmp_path / "broken.urdf", "--config",
+    assert_one_line_error(run("estimate", out / "log.parquet", "--urdf", tmp_path / "broken.urdf", "--config",
                                tmp_path / "r.toml", "-o", tmp_path / "x.parquet"), "URDF does not load")
-    _assert_one_line_error(run("estimate", out / "log.parquet", "--robot", "asimo", "-o", tmp_path / "x.parquet"),
+    assert_one_line_error(run("estimate", out / "log.parquet", "--robot", "asimo", "-o", tmp_path / "x.parquet"),
                            "unknown robot 'asimo'")
-    _assert_one_line_error(run("fit", out / "log.parquet", "-o", tmp_path / "p.json"), "no 'tau_f.<joint>' column")
+    assert_one_line_error(run("fit", out / "log.parquet", "-o", tmp_path / "p.json"), "no 'tau_f.<joint>' column")
 
 
 def test_any_robot_from_urdf_and_toml(talos, demo_dir, tmp_path):
@@ -121,7 +109,7 @@ def test_any_robot_from_urdf_and_toml(talos, demo_dir, tmp_path):
     np.testing.assert_array_equal(a, b)
     # an unknown joint in the TOML is named
     cfg.write_text('position_controlled = ["neck_joint"]\ncontact_frames = ["left_sole_link"]\n')
-    _assert_one_line_error(run("estimate", out / "log.parquet", "--urdf", talos.urdf, "--config", cfg, "-o",
+    assert_one_line_error(run("estimate", out / "log.parquet", "--urdf", talos.urdf, "--config", cfg, "-o",
                                tmp_path / "g.parquet"), "unknown position-controlled joint 'neck_joint'")
 
 
@@ -137,9 +125,9 @@ def test_filtering_schemes_from_the_command_line(demo_dir, tmp_path):
         assert res.returncode == 0, res.stderr
         knee = json.loads((tmp_path / "p.json").read_text())["joints"]["leg_right_4_joint"]
         assert knee["error_percent"]["F_c"] < 5 and knee["error_percent"]["tau_os"] < 5, (args, knee)
-    _assert_one_line_error(run("estimate", out / "log.parquet", "-o", tmp_path / "x.parquet", "--diff", "savgol",
+    assert_one_line_error(run("estimate", out / "log.parquet", "-o", tmp_path / "x.parquet", "--diff", "savgol",
                                "--window", "50"), "window must be odd")
-    _assert_one_line_error(run("estimate", out / "log.parquet", "-o", tmp_path / "x.parquet", "--diff",
+    assert_one_line_error(run("estimate", out / "log.parquet", "-o", tmp_path / "x.parquet", "--diff",
                                "butterworth", "--cutoff", "600"), "Nyquist")
 
 
@@ -150,7 +138,7 @@ def test_spectrum_command(demo_dir, tmp_path):
     assert res.returncode == 0, res.stderr
     assert "suggested cutoff" in res.stdout and "leg_right_3_joint" in res.stdout
     assert (tmp_path / "s.png").stat().st_size > 1000
-    _assert_one_line_error(run("spectrum", out / "log.parquet", "--joints", "head_1_joint"),
+    assert_one_line_error(run("spectrum", out / "log.parquet", "--joints", "head_1_joint"),
                            "'head_1_joint' is not a torque-controlled joint")
 
 
@@ -165,11 +153,11 @@ def test_report_and_sensitivity_commands(demo_dir, tmp_path):
     assert res.returncode == 0, res.stderr
     assert "x1.1 shift" in res.stdout and "leg_right_3_joint" in res.stdout
     assert (tmp_path / "s.png").stat().st_size > 1000
-    _assert_one_line_error(run("sensitivity", out / "log.parquet", "--part", "inertia"), "--part must be one of")
-    _assert_one_line_error(run("sensitivity", out / "log.parquet", "--factors", "0.9,big"), "--factors")
-    _assert_one_line_error(run("report", out / "friction.parquet", "--params", out / "log.parquet",
+    assert_one_line_error(run("sensitivity", out / "log.parquet", "--part", "inertia"), "--part must be one of")
+    assert_one_line_error(run("sensitivity", out / "log.parquet", "--factors", "0.9,big"), "--factors")
+    assert_one_line_error(run("report", out / "friction.parquet", "--params", out / "log.parquet",
                                "-o", tmp_path / "x.html"), "not JSON")
-    _assert_one_line_error(run("report", out / "log.parquet", "-o", tmp_path / "x.html"), "no 'tau_f.<joint>' column")
+    assert_one_line_error(run("report", out / "log.parquet", "-o", tmp_path / "x.html"), "no 'tau_f.<joint>' column")
     assert not (tmp_path / "x.html").exists()
 
 
@@ -208,10 +196,10 @@ def test_simulate_on_mujoco_with_sensors_from_toml(talos, tmp_path):
     assert log.metadata["contact_source"].startswith("sole normal force") and log.tau_f_true is not None
     (tmp_path / "bad.toml").write_text("[sensors]\nposition_noise = 1e-4\n")
     bad = tmp_path / "bad.parquet"
-    _assert_one_line_error(run("simulate", "--simulator", "mujoco", "--steps", "1", "-o", bad, "--sensors",
+    assert_one_line_error(run("simulate", "--simulator", "mujoco", "--steps", "1", "-o", bad, "--sensors",
                                tmp_path / "bad.toml"), "[sensors] has unknown key(s) position_noise")
-    _assert_one_line_error(run("simulate", "--simulator", "mujoco", "--steps", "1", "-o", bad, "--delay", "0.5"),
+    assert_one_line_error(run("simulate", "--simulator", "mujoco", "--steps", "1", "-o", bad, "--delay", "0.5"),
                            "must be a multiple of the control period")
-    _assert_one_line_error(run("simulate", "--simulator", "mujoco", "--steps", "1", "-o", bad, "--mujoco-friction",
+    assert_one_line_error(run("simulate", "--simulator", "mujoco", "--steps", "1", "-o", bad, "--mujoco-friction",
                                "coulomb"), "friction must be one of model, mujoco")
     assert not bad.exists()

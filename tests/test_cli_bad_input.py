@@ -8,16 +8,16 @@ the logs are short, so the estimate runs as a single chunk without worker proces
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from wbfriction import cli
-from wbfriction.log import Log, log_from_table, read_log, write_log, write_table
-from wbfriction.hdf5 import write_hdf5
+from helpers import run_cli, write_bag
+from wbfriction.logs.hdf5 import write_hdf5
+from wbfriction.logs.log import Log, log_from_table, write_log
+from wbfriction.logs.source import read_log
+from wbfriction.logs.tables import write_table
 
 PREVIOUS = b"the previous output"
 FORMATS = ("parquet", "csv", "h5")
@@ -34,20 +34,6 @@ def good(talos) -> Log:
     q = lo + (hi - lo) * rng.uniform(0.3, 0.7, talos.n_act) + rng.normal(0, 1e-3, (n, talos.n_act))
     return Log(time=np.arange(n) * 1e-3, q=q, tau=rng.normal(0, 1, (n, len(talos.torque_controlled))),
                contact=contact)
-
-
-def run_cli(capsys, *args) -> tuple[int, str]:
-    """``wbfriction ARGS`` in this process: (exit status, standard error)."""
-    argv = sys.argv
-    sys.argv = ["wbfriction", *map(str, args)]
-    try:
-        cli.main()
-        code = 0
-    except SystemExit as exc:
-        code = exc.code
-    finally:
-        sys.argv = argv
-    return code, capsys.readouterr().err
 
 
 def _columns(log: Log, robot) -> dict[str, np.ndarray]:
@@ -178,7 +164,6 @@ def test_a_time_gap_splits_the_log_instead_of_failing(talos, good, tmp_path, cap
 def test_bad_bags_write_nothing(talos, combined_walk, tmp_path, capsys, command):
     """A bag streamed into a temporary log and checked: its faults name the bag, the previous
     output stays, and neither the temporary log nor its folder is left behind."""
-    from test_bags import write_bag
 
     walk = combined_walk.log.to_table(talos).slice(0, 1500)
     degrees = walk.set_column(walk.column_names.index("q.leg_left_4_joint"), "q.leg_left_4_joint",

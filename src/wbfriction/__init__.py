@@ -1,30 +1,42 @@
 """wbfriction: whole-body joint friction estimation for torque-controlled legged robots.
 
-Data flow: log (:mod:`~wbfriction.log`) -> measured kinematics
-(:mod:`~wbfriction.kinematics`, zero-phase filters in :mod:`~wbfriction.filters`) -> constrained dynamics (:mod:`~wbfriction.dynamics`,
-:mod:`~wbfriction.stance`) -> friction estimate (:mod:`~wbfriction.estimate`) ->
-identification (:mod:`~wbfriction.identify`). Beside it, :mod:`~wbfriction.walking`
-plans walks and :mod:`~wbfriction.sim` simulates them, writing logs in the same format;
-:mod:`~wbfriction.study` runs the thesis's simulation study (chapter 6) and
-:mod:`~wbfriction.filter_study` its filter study (chapter 7).
+The package follows the data flow, one subpackage per stage, each importing only those before it:
+
+* :mod:`wbfriction.model`: the robot (URDF, joint roles, contact frames), its stance-rooted
+  trees and constrained dynamics;
+* :mod:`wbfriction.logs`: logs as files (Parquet, CSV, HDF5, ROS 2 bags), validated;
+* :mod:`wbfriction.signals`: log -> signals: differentiation, zero-phase filters, support phases, spectra;
+* :mod:`wbfriction.friction`: the friction models (thesis ch. 3), the estimate (5.10-5.13, 6.1),
+  the fit (6.4), the energy check (7.9) and their documents;
+* :mod:`wbfriction.inertia`: the inertia model identified from the same logs, sensitivity, URDF writing;
+* :mod:`wbfriction.pipeline`: files in, files out (long logs in chunks, provenance);
+* :mod:`wbfriction.report`: figures and the HTML report.
+
+Beside them, :mod:`wbfriction.walking` plans walks and :mod:`wbfriction.sim` simulates them,
+writing logs in the same format; :mod:`wbfriction.studies` reproduces the thesis's studies;
+:mod:`wbfriction.cli` is the command line.
 
 Sign convention: ``tau_f`` is the torque friction exerts on the joint,
 ``M qdd + h = S^T (tau + tau_f) + J^T lambda``; the model ``f(qd)`` of thesis eq. (3.5) is
 fitted to ``-tau_f``.
 """
 
-__version__ = "0.1.0"
-
-from .estimate import EstimateOptions, FrictionEstimate, estimate_friction, estimate_log  # noqa: E402
-from .exceptions import InputError, ModelError, WbfrictionError  # noqa: E402
-from .friction import FrictionParams  # noqa: E402
-from .identify import FitResult, fit_estimate, fit_friction  # noqa: E402
-from .kinematics import FilterOptions, MeasuredKinematics, measure  # noqa: E402
-from .log import Log, read_log, write_log  # noqa: E402
-from .robot import Robot, load_robot  # noqa: E402
+from wbfriction.exceptions import ColumnError, InputError, ModelError, SimulationError, WbfrictionError
+from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_friction, estimate_log
+from wbfriction.friction.fit import FitResult, fit_estimate, fit_friction, fit_joints
+from wbfriction.friction.io import friction_table, read_friction_file, read_params, write_params
+from wbfriction.friction.models import FrictionParams
+from wbfriction.logs.log import Log, write_log
+from wbfriction.logs.source import open_log, read_log
+from wbfriction.model.loading import load_robot
+from wbfriction.model.robot import Robot
+from wbfriction.signals.kinematics import FilterOptions, MeasuredKinematics, measure
+from wbfriction.version import __version__
 
 __all__ = [
-    "EstimateOptions", "FilterOptions", "FitResult", "FrictionEstimate", "FrictionParams", "InputError",
-    "Log", "MeasuredKinematics", "ModelError", "Robot", "WbfrictionError", "estimate_friction", "estimate_log",
-    "fit_estimate", "fit_friction", "load_robot", "measure", "read_log", "write_log",
+    "ColumnError", "EstimateOptions", "FilterOptions", "FitResult", "FrictionEstimate", "FrictionParams",
+    "InputError", "Log", "MeasuredKinematics", "ModelError", "Robot", "SimulationError", "WbfrictionError",
+    "__version__", "estimate_friction", "estimate_log", "fit_estimate", "fit_friction", "fit_joints",
+    "friction_table", "load_robot", "measure", "open_log", "read_friction_file", "read_log", "read_params",
+    "write_log", "write_params",
 ]

@@ -1,3 +1,3 @@
-from .cli import main
+from wbfriction.cli import main
 
 main()

@@ -10,11 +10,10 @@ with status 2.
 
 from __future__ import annotations
 
-import json
 import signal
 import sys
 import time
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager, nullcontext
 from pathlib import Path
 from typing import Optional
 
@@ -25,19 +24,27 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
-from . import __version__
-from .energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, energy_consistency
-from .estimate import EstimateOptions, estimate_from_table
-from .exceptions import InputError, WbfrictionError
-from .friction import PARAM_NAMES, load_friction_toml
-from .sim.sensors import load_sensors_toml
-from .inertial import InertialOptions
-from .identify import FitResult, fit_table_estimate, fitted_offsets
-from .kinematics import FilterOptions
-from .log import LIMIT_MARGIN, MAX_GAP, file_sha256, read_log, read_table, write_atomic, write_log, write_tables
-from .robot import Robot, load_robot
-from .sim import IdealOptions, MujocoOptions, SensorNoise, simulate_ideal, simulate_mujoco
-from .walking import GaitOptions, walking_reference
+from wbfriction.exceptions import InputError, WbfrictionError
+from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
+from wbfriction.friction.estimate import EstimateOptions
+from wbfriction.friction.fit import FitResult
+from wbfriction.friction.models import PARAM_NAMES
+from wbfriction.friction.targets import load_friction_toml
+from wbfriction.inertia.identification import InertialOptions
+from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, write_log
+from wbfriction.logs.source import open_log, read_log
+from wbfriction.logs.tables import TableFile
+from wbfriction.model.loading import load_robot
+from wbfriction.model.robot import Robot
+from wbfriction.pipeline.chunks import Chunking
+from wbfriction.pipeline.convert import convert_log
+from wbfriction.pipeline.estimate import RobotSpec, estimate_file, table_log
+from wbfriction.pipeline.fit import fit_file
+from wbfriction.pipeline.provenance import log_provenance
+from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.sim import IdealOptions, MujocoOptions, SensorNoise, simulate_ideal, simulate_mujoco
+from wbfriction.sim.sensors import load_sensors_toml
+from wbfriction.walking import GaitOptions, walking_reference
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Whole-body joint friction estimation for torque-controlled legged robots.")
@@ -99,19 +106,6 @@ def _fit_rows(results: list[FitResult]) -> Table:
     return table
 
 
-def _write_params(results: list[FitResult], path: Path, provenance: dict, energy: dict | None = None) -> None:
-    joints = {r.joint: r.to_dict() for r in results}
-    for joint, e in (energy or {}).items():
-        if joint in joints:
-            joints[joint]["energy"] = {"generating_share": None if not np.isfinite(e.generating_share)
-                                       else e.generating_share, "tau_os_removed": e.tau_os,
-                                       "threshold": e.threshold, "flagged": e.flagged}
-    doc = {"provenance": provenance, "sign_convention": "tau_f = -f(qd); fit of f (eq. 3.5) to -tau_f",
-           "joints": joints}
-    text = json.dumps(doc, indent=2, sort_keys=False)
-    write_atomic(path, lambda tmp: tmp.write_text(text))
-
-
 def _warn_energy(energy) -> None:
     """Print the energy-consistency warnings (eq. 7.9) of the flagged joints."""
     for e in energy:
@@ -161,49 +155,18 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
                       f"({p.samples} samples, down to {p.min_force:.1f} N)", highlight=False)
 
 
-def _row_count(path: Path) -> int:
-    """Rows of a Parquet log from its footer (0 when not known cheaply: no progress bar)."""
-    import pyarrow.parquet as pq
-
-    try:
-        return pq.ParquetFile(path).metadata.num_rows if path.suffix.lower() in (".parquet", ".pq") else 0
-    except Exception:  # an unreadable file is reported by the estimate itself
-        return 0
-
-
-def _log_tables(path: Path, bag_map: Optional[Path]):
-    """A log file or a ROS 2 bag (through its topic map) as a stream of log-format tables."""
-    from .bags import is_bag, iter_bag, load_bag_map
-    from .chunked import iter_file
-
-    if is_bag(path):
-        if bag_map is None:
-            raise InputError(f"{path}: a ROS 2 bag needs a topic map (--map MAP.toml)")
-        return iter_bag(path, load_bag_map(bag_map))
-    return iter_file(path)
-
-
-def _run_estimate(r: Robot, spec, log: Path, output: Path, opts: EstimateOptions, bag_map: Optional[Path] = None,
-                  max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN, workers: int = 2,
-                  chunk_rows: int = 10_000) -> None:
+def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: EstimateOptions,
+                  bag_map: Optional[Path] = None, max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN,
+                  workers: int = 2, chunk_rows: int = 10_000) -> None:
     """Estimate a log file in chunks on ``workers`` processes (which load the robot from
-    ``spec``); a ROS 2 bag is first streamed into a temporary Parquet log beside the output.
-    Write the friction table with its provenance."""
-    import tempfile
-
-    from .bags import is_bag
-    from .chunked import Chunking, estimate_file
-
-    provenance = {"provenance": {"log": str(log), "log_sha256": file_sha256(log), "robot": r.name,
-                                 "urdf": str(r.urdf), "wbfriction": __version__}}
-    with tempfile.TemporaryDirectory(prefix=".wbfriction-", dir=output.parent if output.parent.exists() else None) as tmp:
-        source = log
-        if is_bag(log):
-            source = Path(tmp) / "log.parquet"
-            with console.status(f"reading {log}"):
-                write_tables(source, _log_tables(log, bag_map))
-        with _progress(_row_count(source), "estimate") as advance:
-            result = estimate_file(spec, source, output, opts, chunking=Chunking(rows=chunk_rows, workers=workers),
+    ``spec``); a ROS 2 bag is first streamed into a temporary Parquet log beside the output."""
+    source = open_log(log, bag_map)
+    provenance = {"provenance": log_provenance(log, r)}
+    with ExitStack() as stack:
+        with console.status(f"reading {log}") if source.is_bag else nullcontext():
+            table = stack.enter_context(table_log(source, output))
+        with _progress(TableFile(table).row_count(), "estimate") as advance:
+            result = estimate_file(spec, table, output, opts, chunking=Chunking(rows=chunk_rows, workers=workers),
                                    max_gap=max_gap, limit_margin=limit_margin, extra_metadata=provenance,
                                    progress=advance, robot=r, source=str(log))
     console.print(f"wrote {output}: {result.rows} samples")
@@ -211,13 +174,10 @@ def _run_estimate(r: Robot, spec, log: Path, output: Path, opts: EstimateOptions
 
 def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, tolerance: float,
              workers: int) -> None:
-    est = estimate_from_table(read_table(friction), str(friction))
-    results = fit_table_estimate(est, min_samples=min_samples, workers=workers)
-    energy = energy_consistency(est, fitted_offsets(results), threshold, tolerance)
-    _write_params(results, output, {"friction": str(friction), "friction_sha256": file_sha256(friction),
-                                    "wbfriction": __version__}, {e.joint: e for e in energy})
-    out.print(_fit_rows(results))
-    _warn_energy(energy)
+    fitted = fit_file(friction, output, min_samples=min_samples, threshold=threshold, tolerance=tolerance,
+                      workers=workers)
+    out.print(_fit_rows(fitted.fits))
+    _warn_energy(fitted.energy)
     console.print(f"wrote {output}")
 
 
@@ -301,8 +261,6 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
                            ds_regularization=ds_regularization, condition_number=cond, method=method,
                            filtering=FilterOptions(window=window, poly_order=poly_order, weights=weights,
                                                    cutoff=cutoff, butter_order=butter_order))
-    from .chunked import RobotSpec
-
     spec = RobotSpec(None if config else robot, None if urdf is None else str(urdf),
                      None if config is None else str(config))
     _run_estimate(_robot(robot, urdf, config), spec, log, output, opts, bag_map, max_gap, limit_margin, workers,
@@ -320,12 +278,9 @@ def convert(bag: Path = typer.Argument(..., help="ROS 2 bag (folder with metadat
     """Convert a ROS 2 bag (or another log file) into a wbfriction log: joint states, contacts
     (zero-order hold) and base pose (linear + slerp) aligned on the joint-state stamps,
     streamed, and checked against the robot before it is renamed into place."""
-    from .chunked import check_file
-
     r = _robot(robot, urdf, config)
     with console.status(f"reading {bag}"):
-        rows = write_tables(output, _log_tables(bag, bag_map),
-                            check=lambda tmp: check_file(r, tmp, str(bag), max_gap=max_gap, limit_margin=limit_margin))
+        rows = convert_log(r, bag, output, bag_map, max_gap=max_gap, limit_margin=limit_margin)
     console.print(f"wrote {output} ({rows} samples)")
 
 
@@ -351,7 +306,8 @@ def report(friction: Path = typer.Argument(..., help="Friction table written by 
            energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt) -> None:
     """One self-contained HTML report: friction clouds and fits, parameters, energy consistency,
     per-joint time series, Fig. 7.4, spectra, provenance."""
-    from .report import make_report, write_report
+    from wbfriction.report.build import make_report
+    from wbfriction.report.html import write_report
 
     with console.status("building the report"):
         rep = make_report(friction, params, energy_threshold, energy_tolerance, identification)
@@ -373,9 +329,9 @@ def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in 
                 mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate').")) -> None:
     """Re-run the estimate with every body's inertia scaled (thesis 7.2, Fig. 7.5/7.6): how the
     friction curves shift (mass) and split into branches (rotational inertia)."""
-    from .kinematics import measure
-    from .plots import save_png, sensitivity_figure
-    from .sensitivity import PARTS, inertia_sensitivity, parse_factors
+    from wbfriction.inertia.sensitivity import PARTS, inertia_sensitivity, parse_factors
+    from wbfriction.report.figures import save_png, sensitivity_figure
+    from wbfriction.signals.kinematics import measure
 
     if part not in PARTS:
         raise InputError(f"--part must be one of {', '.join(PARTS)}, got '{part}'")
@@ -478,9 +434,6 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
     """Identify the inertia model and the friction together from the joint torques of single
     support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
     with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
-    from .closed_loop import identify_and_estimate, loop_document
-    from .urdf import write_urdf
-
     vs_text = stribeck_velocity.strip().lower()
     try:
         stribeck = None if vs_text == "none" else "auto" if vs_text == "auto" else float(vs_text)
@@ -488,16 +441,14 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
         raise InputError(f"--stribeck-velocity must be auto, none or a number, got '{stribeck_velocity}'") from None
     if not 0.0 < holdout < 1.0:
         raise InputError(f"--holdout must be between 0 and 1, got {holdout}")
+    from wbfriction.pipeline.identify import identify_file
+
     r = _robot(robot, urdf, config)
-    data = read_log(log, r)
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior)
     with console.status("") as status:
-        loop = identify_and_estimate(r, data, EstimateOptions(diff=diff, mask=mask), opts, stribeck, passes,
-                                     progress=lambda label: status.update(label), workers=workers)
-    moved = write_urdf(r, loop.final.identification.pi, output)
-    doc = loop_document(loop, moved)
-    doc["provenance"] = {"log": str(log), "log_sha256": file_sha256(log), "robot": r.name, "urdf": str(r.urdf),
-                         "wbfriction": __version__}
+        done = identify_file(r, log, output, json_output, estimate_options=EstimateOptions(diff=diff, mask=mask),
+                             options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers)
+    doc, moved = done.document, done.moved
     for p in doc["passes"]:
         out.print(f"v_s {p['stribeck_velocity']}: {p['samples']} samples, {p['base_parameters']} base parameters of "
                   f"{p['parameters']}, condition {p['condition']:.3g}, prior {p['prior']:g}; {p['message']}",
@@ -508,10 +459,8 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
         console.print(f"[yellow]note:[/] the whole identified body went to the child link of {', '.join(moved)} "
                       "(lighter than the links merged with it)")
     if json_output is not None:
-        text = json.dumps(doc, indent=2)
-        write_atomic(json_output, lambda tmp: tmp.write_text(text))
         console.print(f"wrote {json_output}")
-    _warn_energy(loop.final.route.energy)
+    _warn_energy(done.loop.final.route.energy)
     console.print(f"wrote {output}")
 
 
@@ -539,7 +488,7 @@ def _study_table(rows, title: str, params=PARAM_NAMES) -> Table:
 
 
 def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
-    from .realistic_study import run_realistic_study, worst_scored
+    from wbfriction.studies.realistic import run_realistic_study, worst_scored
 
     with console.status("") as status:
         result = run_realistic_study(r, output_dir, steps=steps, progress=lambda label: status.update(label))
@@ -559,7 +508,8 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
          simulator: str = typer.Option("ideal", help="ideal: Tables 6.1/6.2, Fig. 6.1-6.3; mujoco: the realistic "
                                                      "simulator's study, Fig. 6.4-6.5.")) -> None:
     """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.5."""
-    from .study import run_study, worst_errors
+    from wbfriction.studies.common import worst_errors
+    from wbfriction.studies.simulation import run_study
 
     start = time.perf_counter()
     _check_simulator(simulator)
@@ -596,8 +546,8 @@ def spectrum(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
              tail: float = typer.Option(0.01, help="Share of the power (above the noise floor) left above the "
                                                    "suggested cutoff.")) -> None:
     """Spectrum of the estimated acceleration (Fig. 7.1) and the Butterworth cutoff it suggests."""
-    from .plots import spectrum_figure
-    from .spectrum import acceleration_spectrum
+    from wbfriction.report.figures import spectrum_figure
+    from wbfriction.signals.spectrum import acceleration_spectrum
 
     r = _robot(robot, urdf, config)
     data = read_log(log, r)
@@ -628,7 +578,7 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
                   seed: int = typer.Option(0, help="Noise seed."),
                   workers: Optional[int] = typer.Option(None, help="Processes (default: up to 2).")) -> None:
     """Score the differentiation schemes on noisy logs (thesis 7.2, Fig. 7.2)."""
-    from .filter_study import LEVELS, run_filter_study
+    from wbfriction.studies.filters import LEVELS, run_filter_study
 
     start = time.perf_counter()
     r = _robot(robot, None, None)

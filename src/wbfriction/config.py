@@ -5,7 +5,7 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from .exceptions import InputError
+from wbfriction.exceptions import InputError
 
 
 def read_toml(path: str | Path) -> dict:

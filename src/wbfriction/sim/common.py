@@ -6,11 +6,12 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..exceptions import InputError
-from ..friction import FrictionParams, friction_by_group, smooth, stack_params
-from ..log import Log
-from ..robot import Robot
-from ..walking import WalkingReference
+from wbfriction.exceptions import InputError
+from wbfriction.friction.models import FrictionParams, coulomb_viscous_stribeck, stack_params
+from wbfriction.friction.targets import friction_by_group
+from wbfriction.logs.log import Log
+from wbfriction.model.robot import Robot
+from wbfriction.walking import WalkingReference
 
 
 @dataclass
@@ -37,9 +38,9 @@ class InjectedFriction:
 
         The simulators call this at every physics step: with the Gaussian Stribeck exponent
         (``delta_s = 2``, the thesis's) it runs in place on (n_f,) buffers, the same
-        numbers as :func:`~wbfriction.friction.smooth` in fewer operations."""
+        numbers as :func:`~wbfriction.friction.models.coulomb_viscous_stribeck` in fewer operations."""
         if qd.ndim != 1 or not self._gaussian:
-            return -smooth(qd, **self._stacked)
+            return -coulomb_viscous_stribeck(qd, **self._stacked)
         p, FcS, inv_vs = self._c
         e = np.multiply(qd, inv_vs)
         np.square(e, out=e)

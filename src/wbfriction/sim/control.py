@@ -23,9 +23,9 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from ..robot import Robot
-from ..stance import stance_model
-from ..walking import WalkingReference
+from wbfriction.model.robot import Robot
+from wbfriction.model.stance import stance_model
+from wbfriction.walking import WalkingReference
 
 
 def contact_jacobian(robot: Robot, data: pin.Data, contacts: np.ndarray) -> np.ndarray:
@@ -53,7 +53,7 @@ def feedforward(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, conta
     """Joint torques and contact wrenches of a reference motion (module docstring).
 
     Single-support samples are computed in one batched RNEA pass on the robot re-rooted at
-    the stance sole (:mod:`wbfriction.stance`: the same solution, since the reference keeps
+    the stance sole (:mod:`wbfriction.model.stance`: the same solution, since the reference keeps
     the stance sole still), double-support samples one by one with the weighted sharing.
 
     Args:

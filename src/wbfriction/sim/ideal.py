@@ -33,20 +33,23 @@ foot's zero acceleration in the estimator assumes.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal, get_args
 
 import numpy as np
 import pinocchio as pin
 
-from ..exceptions import InputError
-from ..friction import FrictionParams
-from ..progress import counted
-from ..robot import Robot
-from ..walking import WalkingReference
-from ..walking.swing import foot_placement
-from .common import SimulationResult, injected_friction, simulated_log
-from .control import contact_jacobian, gain_schedule, pd_gains, reference_feedforward
+from wbfriction.exceptions import InputError
+from wbfriction.friction.models import FrictionParams
+from wbfriction.model.robot import Robot
+from wbfriction.progress import counted
+from wbfriction.sim.common import SimulationResult, injected_friction, simulated_log
+from wbfriction.sim.control import contact_jacobian, gain_schedule, pd_gains, reference_feedforward
+from wbfriction.walking import WalkingReference
+from wbfriction.walking.swing import foot_placement
 
-INTEGRATORS = ("semi-implicit", "explicit")
+Integrator = Literal["semi-implicit", "explicit"]
+"""Euler integration of the ideal simulator."""
+INTEGRATORS: tuple[Integrator, ...] = get_args(Integrator)
 
 
 @dataclass(frozen=True)
@@ -55,7 +58,7 @@ class IdealOptions:
 
     Attributes:
         substeps: physics steps per control period (the study uses 10: see
-            :data:`wbfriction.study.SIMULATOR`).
+            :data:`wbfriction.studies.simulation.SIMULATOR`).
         integrator: one of :data:`INTEGRATORS`. With one explicit Euler step per sample
             the central second difference at ``k`` is the acceleration of sample ``k - 1``,
             which no torque alignment matches (the thesis's setting: F_v up to 25 % off in
@@ -73,7 +76,7 @@ class IdealOptions:
     """
 
     substeps: int = 1
-    integrator: str = "semi-implicit"
+    integrator: Integrator = "semi-implicit"
     bandwidth: float = 15.0
     damping: float = 0.9
     gain_blend: float = 0.1

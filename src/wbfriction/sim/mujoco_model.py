@@ -26,8 +26,8 @@ import numpy as np
 import pinocchio as pin
 from scipy.spatial.transform import Rotation
 
-from ..exceptions import ModelError
-from ..robot import Robot
+from wbfriction.exceptions import ModelError
+from wbfriction.model.robot import Robot
 
 SOLE_THICKNESS = 0.01  # [m], the contact boxes' height, their bottom face on the contact frame's plane
 TOUCH_MARGIN = 0.005  # [m], how far beyond the sole's edges its touch sensor reaches

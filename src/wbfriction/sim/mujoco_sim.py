@@ -52,23 +52,27 @@ from __future__ import annotations
 import copy
 import dataclasses
 from dataclasses import dataclass
+from typing import Literal, get_args
 
 import mujoco
 import numpy as np
 import pinocchio as pin
 from scipy.spatial.transform import Rotation
 
-from ..exceptions import InputError, SimulationError
-from ..friction import FrictionParams, friction_by_group
-from ..progress import counted
-from ..robot import Robot
-from ..walking import WalkingReference
-from .common import InjectedFriction, SimulationResult, injected_friction, simulated_log
-from .control import attitude_ankle_torques, pd_from_inertia, pd_gains, ramp_gains, reference_feedforward
-from .mujoco_model import MujocoRobot, build_mujoco_robot
-from .sensors import SensorNoise
+from wbfriction.exceptions import InputError, SimulationError
+from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.targets import friction_by_group
+from wbfriction.model.robot import Robot
+from wbfriction.progress import counted
+from wbfriction.sim.common import InjectedFriction, SimulationResult, injected_friction, simulated_log
+from wbfriction.sim.control import attitude_ankle_torques, pd_from_inertia, pd_gains, ramp_gains, reference_feedforward
+from wbfriction.sim.mujoco_model import MujocoRobot, build_mujoco_robot
+from wbfriction.sim.sensors import SensorNoise
+from wbfriction.walking import WalkingReference
 
-FRICTION_MODES = ("model", "mujoco")
+FrictionMode = Literal["model", "mujoco"]
+"""How the MuJoCo simulator applies friction (module docstring)."""
+FRICTION_MODES: tuple[FrictionMode, ...] = get_args(FrictionMode)
 
 
 @dataclass(frozen=True)
@@ -88,7 +92,7 @@ class MujocoOptions:
             whole number of control periods.
         balance: (K [N·m/rad], D [N·m·s/rad]) of the base-attitude stabiliser on the
             stance ankles (:func:`~wbfriction.sim.control.attitude_ankle_torques`); None:
-            the robot's :attr:`~wbfriction.robot.Robot.balance_gains`.
+            the robot's :attr:`~wbfriction.model.robot.Robot.balance_gains`.
         fall_height: the simulation stops with an error when the base drops below this
             share of its initial height.
         log_base: write the base pose to the log.
@@ -100,7 +104,7 @@ class MujocoOptions:
     max_gains: tuple[float, float] = (3000.0, 60.0)
     gain_blend: float = 0.1
     contact_threshold: float = 50.0
-    friction: str = "model"
+    friction: FrictionMode = "model"
     sensors: SensorNoise = SensorNoise()
     delay: float = 0.0
     balance: tuple[float, float] | None = None
@@ -130,7 +134,7 @@ class MujocoOptions:
         return int(round(d))
 
 
-def _set_mujoco_friction(model: mujoco.MjModel, dofs: np.ndarray, injected: InjectedFriction) -> None:
+def set_mujoco_friction(model: mujoco.MjModel, dofs: np.ndarray, injected: InjectedFriction) -> None:
     """Set MuJoCo's ``frictionloss`` and ``damping`` of ``dofs`` from (3.5) parameters."""
     for dof, (joint, p) in zip(dofs, injected.params.items()):
         if p.S != 0 or p.tau_os != 0:
@@ -187,7 +191,7 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
     joints_f = injected.joints
     dof_f = mjr.dof_index[tc][joints_f]
     if native:
-        _set_mujoco_friction(model, dof_f, injected)
+        set_mujoco_friction(model, dof_f, injected)
     data = mujoco.MjData(model)
 
     # base-attitude stabiliser: each leg's last two joints (the ankle), the reference base attitude

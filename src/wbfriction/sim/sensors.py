@@ -17,8 +17,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..exceptions import InputError
-from ..log import Log
+from wbfriction.exceptions import InputError
+from wbfriction.logs.log import Log
 
 
 @dataclass(frozen=True)
@@ -94,7 +94,7 @@ def load_sensors_toml(path) -> dict:
     Raises:
         InputError: unreadable file, no ``[sensors]`` table, an unknown key.
     """
-    from ..config import toml_table
+    from wbfriction.config import toml_table
 
     table = toml_table(path, "sensors")
     unknown = sorted(set(table) - set(SENSOR_KEYS))

@@ -22,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
-from .footsteps import FootstepPlan
+from wbfriction.walking.footsteps import FootstepPlan
 
 GRAVITY = 9.81
 

@@ -25,12 +25,15 @@ Contact indices follow :attr:`Robot.contact_frames`: the plan needs two (left, r
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal, get_args
 
 import numpy as np
 
-from ..exceptions import InputError
+from wbfriction.exceptions import InputError
 
-GAITS = ("forward", "sideways", "turning", "both", "combined")
+Gait = Literal["forward", "sideways", "turning", "both", "combined"]
+"""A walk of the footstep planner (:class:`GaitOptions`)."""
+GAITS: tuple[Gait, ...] = get_args(Gait)
 
 
 @dataclass(frozen=True)
@@ -55,7 +58,7 @@ class GaitOptions:
         pc_amplitude: amplitude of a slow sine on the position-controlled joints [rad].
     """
 
-    gait: str = "forward"
+    gait: Gait = "forward"
     steps: int = 10
     step_length: float = 0.3
     step_width: float = 0.25

@@ -22,12 +22,12 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ..exceptions import InputError, ModelError
-from ..progress import counted
-from ..robot import Robot
-from .com import lipm_com, zmp_reference
-from .footsteps import FootstepPlan, GaitOptions, plan_footsteps
-from .swing import feet_trajectory, foot_placement, quintic
+from wbfriction.exceptions import InputError, ModelError
+from wbfriction.model.robot import Robot
+from wbfriction.progress import counted
+from wbfriction.walking.com import lipm_com, zmp_reference
+from wbfriction.walking.footsteps import FootstepPlan, GaitOptions, plan_footsteps
+from wbfriction.walking.swing import feet_trajectory, foot_placement, quintic
 
 LWA = pin.LOCAL_WORLD_ALIGNED
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from .footsteps import FootstepPlan
+from wbfriction.walking.footsteps import FootstepPlan
 
 
 def foot_placement(pose: np.ndarray) -> pin.SE3:

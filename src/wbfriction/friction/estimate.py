@@ -1,0 +1,370 @@
+"""Joint friction estimation from measured kinematics (thesis 5.11-5.13, 6.1).
+
+The acceleration difference of the torque-controlled joints is caused by friction:
+
+.. math:: \\Delta\\ddot q_{tc} = \\ddot q_{msr,tc} - \\ddot q_{est,tc} = M_{mod}^{-1} \\tau_f. \\qquad (5.12)
+
+* **Single support** (one contact): ``M_mod^{-1}`` is invertible and
+  ``tau_f = M_mod Delta qdd_tc`` (5.13) is exact. The default route computes it with one
+  recursive Newton-Euler pass on the robot re-rooted at the stance foot
+  (:mod:`wbfriction.model.stance`), batched in C++ (``pin.rneaInParallel``); ``method="kkt"``
+  forms (5.10)-(5.13) explicitly (:mod:`wbfriction.model.dynamics`). Both agree to 1e-9.
+* **Double support**: ``M_mod^{-1}`` is singular; the regularised weighted least squares
+  (6.1) ``min 1/2 |Delta - M_mod^{-1} tau_f|_W^2 + 1/2 tau_f^T Lambda tau_f`` gives
+  ``tau_f = (A^T W A + Lambda)^{-1} A^T W Delta`` with ``A = M_mod^{-1}``. Such samples
+  are flagged ``unique = False`` and never valid.
+
+Sign convention: ``tau_f`` is the torque friction exerts on the joint,
+``M qdd + h = S^T (tau + tau_f) + J^T lambda``; dissipative friction has ``qd tau_f <= 0``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, fields
+from typing import Literal, get_args
+
+import numpy as np
+
+from wbfriction.exceptions import InputError
+from wbfriction.logs.log import Log
+from wbfriction.model.dynamics import constrained_dynamics
+from wbfriction.model.robot import Robot
+from wbfriction.model.stance import stance_frame_pose, stance_model
+from wbfriction.signals.kinematics import (
+    FILTERING_SCHEMES,
+    Diff,
+    FilterOptions,
+    MeasuredKinematics,
+    Scheme,
+    Smoother,
+    TorqueAlignment,
+    measure,
+)
+from wbfriction.signals.phases import Mask, Phases, joint_mask, segment
+
+CHUNK = 4096
+Method = Literal["rnea", "kkt"]
+"""The single-support route: one RNEA pass on the stance-rooted tree, or the KKT system (5.10-5.13)."""
+METHODS: tuple[Method, ...] = get_args(Method)
+
+
+@dataclass(frozen=True)
+class EstimateOptions:
+    """Options of the estimator (defaults from the thesis).
+
+    Attributes:
+        diff: differentiation scheme: ``central``, ``backward``, ``savgol``, ``butterworth``
+            (:mod:`~wbfriction.signals.kinematics`, :mod:`~wbfriction.signals.filters`) or ``true``.
+        compensate_delay: shift the derivatives by their delay (6.1.2).
+        torque_alignment: ``zoh`` (mean of tau[k-1], tau[k]), ``sample``, or ``auto``
+            (what the log's metadata declares, else ``zoh``).
+        lift_off_skip: seconds dropped after a lift-off [s] (6.2.1: 0.10).
+        touch_down_skip: seconds dropped before a touch-down [s] (6.2.1: 0.05).
+        mask: ``swing`` (a leg joint counts only while its leg swings) or ``single``.
+        ds_weight: diagonal of W in (6.1), scalar or (n_tc,): relative weights of the
+            joints' acceleration residuals (dimensionless).
+        ds_regularization: diagonal of Lambda in (6.1), scalar or (n_tc,)
+            [(rad/s^2)^2 / (N·m)^2 with W = 1]; it competes with ``A^T W A``, whose
+            entries are of the order of (1 / joint inertia)^2.
+        condition_number: report cond(M_mod^{-1}) per sample (one KKT inverse per sample).
+        method: single-support route, ``rnea`` (default) or ``kkt``.
+        filtering: parameters of the ``savgol`` and ``butterworth`` schemes.
+        acceleration_difference: also give ``Delta qdd`` (5.12) in single support
+            (``M_mod^{-1} tau_f``, one mass matrix per sample: about 20 us per sample on
+            TALOS on top of 8 us); the KKT route always has it.
+    """
+
+    diff: Diff = "central"
+    compensate_delay: bool = True
+    torque_alignment: TorqueAlignment | Literal["auto"] = "auto"
+    lift_off_skip: float = 0.10
+    touch_down_skip: float = 0.05
+    mask: Mask = "swing"
+    ds_weight: float | tuple[float, ...] = 1.0
+    ds_regularization: float | tuple[float, ...] = 1e-3
+    condition_number: bool = False
+    method: Method = "rnea"
+    filtering: FilterOptions = FilterOptions()
+    acceleration_difference: bool = True
+
+
+@dataclass
+class FrictionEstimate:
+    """Per-sample friction estimate of the torque-controlled joints.
+
+    Attributes:
+        joints: torque-controlled joint names (n_tc,).
+        time: (N,) [s].
+        qd: joint velocities (N, n_tc) [rad/s] (same differentiation as ``qdd_msr``).
+        tau_f: estimated friction torque (N, n_tc) [N·m]; NaN where not estimated.
+        qdd: measured accelerations ``qdd_msr`` (N, n_tc) [rad/s^2].
+        delta_qdd: acceleration difference (5.12) ``qdd_msr - qdd_est`` (N, n_tc)
+            [rad/s^2]; NaN where not estimated. ``qdd - delta_qdd`` is the estimated
+            acceleration ``qdd_est`` (5.10).
+        valid: (N, n_tc) samples to trust (single support, margins, mask).
+        phase: (N,) ``single`` / ``double`` / ``flight``.
+        unique: (N,) the estimate is the exact unique solution (single support).
+        cond: (N,) condition number of ``M_mod^{-1}`` (NaN where not computed), or None.
+        contact: (N, n_contacts) flags; ``contact_frames`` their names.
+        tau_f_true: (N, n_tc) true friction if the log had it, else None.
+        metadata: carried from the log, plus the options used.
+        companion_delta_qdd: the single-support acceleration difference through the other
+            kind of scheme (N, n_tc) [rad/s^2] (NaN elsewhere), or None: unfiltered
+            (central differences) for a filtering scheme, Savitzky-Golay filtered otherwise;
+            so that Fig. 7.4 can show the difference with and without filtering.
+            ``companion_diff`` names its scheme.
+        smoother: the zero-phase smoother the estimate went through (filtering schemes),
+            or None; the fit passes the model through it too
+            (:func:`~wbfriction.friction.fit.fit_friction`). A table records it as the
+            ``estimate_options`` of its metadata.
+    """
+
+    joints: tuple[str, ...]
+    time: np.ndarray
+    qd: np.ndarray
+    tau_f: np.ndarray
+    valid: np.ndarray
+    phase: np.ndarray
+    unique: np.ndarray
+    contact: np.ndarray
+    contact_frames: tuple[str, ...]
+    qdd: np.ndarray | None = None
+    delta_qdd: np.ndarray | None = None
+    cond: np.ndarray | None = None
+    tau_f_true: np.ndarray | None = None
+    metadata: dict = field(default_factory=dict)
+    smoother: Smoother | None = None
+    companion_delta_qdd: np.ndarray | None = None
+    companion_diff: str | None = None
+
+
+def single_support_friction_rnea(robot: Robot, contact_index: int, angles: np.ndarray, qd: np.ndarray,
+                                 qdd: np.ndarray, tau_tc: np.ndarray, base: np.ndarray | None = None,
+                                 progress=None, with_delta: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Single-support friction (5.13) by inverse dynamics on the stance-rooted tree.
+
+    Args:
+        robot: the robot.
+        contact_index: stance contact frame (index into ``robot.contact_frames``).
+        angles, qd, qdd: joint positions, velocities, measured accelerations (N, n_act).
+        tau_tc: torques of the torque-controlled joints (N, n_tc) [N·m].
+        base: logged base poses (N, 7) or None (stance foot flat).
+        progress: optional callable receiving numbers of samples done.
+        with_delta: compute ``delta_qdd`` (else NaN).
+
+    Returns:
+        ``(tau_f, delta_qdd)``: friction (N, n_tc) [N·m], sign convention of
+        :mod:`wbfriction.friction.models`, and the acceleration difference (5.12)
+        ``Delta qdd_tc = qdd_msr - qdd_est = M_mod^{-1} tau_f`` (N, n_tc) [rad/s^2],
+        with ``M_mod`` the stance-rooted mass matrix of the torque-controlled joints
+        (:meth:`~wbfriction.model.stance.StanceModel.joint_mass_matrix`).
+    """
+    stance = stance_model(robot, contact_index)
+    tau_f = np.empty_like(tau_tc, dtype=float)
+    delta = np.full_like(tau_tc, np.nan, dtype=float)
+    for start in range(0, angles.shape[0], CHUNK):
+        sl = slice(start, start + CHUNK)
+        pose = stance_frame_pose(robot, stance, angles[sl], None if base is None else base[sl])
+        tau_joint, _ = stance.inverse_dynamics(pose, angles[sl], qd[sl], qdd[sl])
+        tau_f[sl] = tau_joint[:, robot.tc_index] - tau_tc[sl]
+        if with_delta:
+            M_mod = stance.joint_mass_matrix(angles[sl], robot.tc_index)
+            delta[sl] = np.linalg.solve(M_mod, tau_f[sl][..., None])[..., 0]
+        if progress is not None:
+            progress(len(tau_f[sl]))
+    return tau_f, delta
+
+
+def single_support(robot: Robot, kin: MeasuredKinematics, rows: np.ndarray, stance: np.ndarray,
+                   progress=None, with_delta: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`single_support_friction_rnea` on the rows ``rows`` (N,) of ``kin``, each on its
+    stance contact ``stance`` (N,); returns ``(tau_f, delta_qdd)`` (N, n_tc), NaN elsewhere."""
+    n, n_tc = len(kin.time), len(robot.torque_controlled)
+    tau_f, delta = np.full((n, n_tc), np.nan), np.full((n, n_tc), np.nan)
+    for c in range(len(robot.contact_frames)):
+        r = np.flatnonzero(rows & (stance == c))
+        if r.size:
+            tau_f[r], delta[r] = single_support_friction_rnea(
+                robot, c, kin.q[r], kin.qd[r], kin.qdd[r], kin.tau[r], None if kin.base is None else kin.base[r],
+                progress, with_delta)
+    return tau_f, delta
+
+
+def _diag(value, n: int) -> np.ndarray:
+    d = np.broadcast_to(np.asarray(value, dtype=float), (n,))
+    return np.diag(d)
+
+
+def regularised_least_squares(Mmod_inv: np.ndarray, delta_qdd: np.ndarray, weight, regularization) -> np.ndarray:
+    """Solve (6.1) for a stack of samples.
+
+    Args:
+        Mmod_inv: (N, n, n) operators ``A``.
+        delta_qdd: (N, n) acceleration differences.
+        weight: diagonal of W (scalar or (n,)).
+        regularization: diagonal of Lambda (scalar or (n,)).
+
+    Returns:
+        tau_f (N, n) minimising ``1/2 |Delta - A tau_f|_W^2 + 1/2 tau_f^T Lambda tau_f``.
+    """
+    n = delta_qdd.shape[1]
+    W, L = _diag(weight, n), _diag(regularization, n)
+    At = np.swapaxes(Mmod_inv, 1, 2)
+    lhs = At @ W @ Mmod_inv + L
+    rhs = (At @ W @ delta_qdd[..., None])
+    return np.linalg.solve(lhs, rhs)[..., 0]
+
+
+def no_single_support(robot: Robot, source: str) -> InputError:
+    """The error of a log without a single-support sample, naming it and its contact columns."""
+    return InputError(f"{source}: no single-support sample (exactly one of the columns "
+                      f"{', '.join('contact.' + f for f in robot.contact_frames)} set) with defined derivatives")
+
+
+def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOptions = EstimateOptions(),
+                      progress=None, require_single_support: bool = True) -> FrictionEstimate:
+    """Estimate the friction torque of every torque-controlled joint at every sample.
+
+    Args:
+        robot: the robot.
+        kin: measured kinematics (:func:`wbfriction.signals.kinematics.measure`).
+        options: :class:`EstimateOptions`.
+        progress: optional callable receiving numbers of samples processed.
+        require_single_support: refuse kinematics without a single-support sample (off for
+            a stretch of a longer log, which is checked as a whole).
+
+    Returns:
+        :class:`FrictionEstimate`.
+
+    Raises:
+        InputError: no single-support sample, unknown method or mask.
+    """
+    if options.method not in METHODS:
+        raise InputError(f"unknown method '{options.method}': choose one of {', '.join(METHODS)}")
+    n, n_tc = len(kin.time), len(robot.torque_controlled)
+    phases: Phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip)
+    usable = kin.valid & (phases.n_contacts > 0)
+    if require_single_support and not np.any(usable & phases.single):
+        raise no_single_support(robot, kin.metadata.get('source', 'the log'))
+    cond = np.full(n, np.nan) if options.condition_number else None
+    tc = robot.tc_index
+    ss = usable & phases.single
+    # the KKT route (one Pinocchio call per sample) serves double support, and single
+    # support when asked for it or for the condition number
+    kkt_in_single = options.method == "kkt" or options.condition_number
+    need_kkt = usable & (phases.double | (phases.single & kkt_in_single))
+    if options.method == "rnea":
+        rnea_progress = None if kkt_in_single else progress  # counted by the KKT pass then
+        tau_f, delta = single_support(robot, kin, ss, phases.stance, rnea_progress, options.acceleration_difference)
+    else:
+        tau_f, delta = np.full((n, n_tc), np.nan), np.full((n, n_tc), np.nan)
+    rows = np.flatnonzero(need_kkt)
+    for start in range(0, rows.size, CHUNK):
+        r = rows[start:start + CHUNK]
+        dyn = constrained_dynamics(robot, kin.q[r], kin.qd[r], kin.qdd[r], kin.tau[r], kin.contact[r],
+                                   None if kin.base is None else kin.base[r], with_Mmod_inv=True, progress=progress)
+        d = kin.qdd[r][:, tc] - dyn.qdd_est[:, tc]
+        is_ss = phases.single[r]
+        if options.method == "kkt" and np.any(is_ss):
+            tau_f[r[is_ss]] = np.linalg.solve(dyn.Mmod_inv[is_ss], d[is_ss][..., None])[..., 0]
+            delta[r[is_ss]] = d[is_ss]
+        if np.any(~is_ss):
+            tau_f[r[~is_ss]] = regularised_least_squares(dyn.Mmod_inv[~is_ss], d[~is_ss],
+                                                         options.ds_weight, options.ds_regularization)
+            delta[r[~is_ss]] = d[~is_ss]
+        if cond is not None:
+            cond[r] = np.linalg.cond(dyn.Mmod_inv)
+    valid = joint_mask(phases, robot.limb_mask, options.mask) & usable[:, None] & np.isfinite(tau_f)
+    metadata = dict(kin.metadata)
+    metadata["estimate_options"] = asdict(options)
+    return FrictionEstimate(
+        joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
+        phase=phases.labels(), unique=ss.copy(), contact=kin.contact, contact_frames=robot.contact_frames,
+        qdd=kin.qdd[:, tc], delta_qdd=delta, cond=cond, tau_f_true=kin.tau_f_true, metadata=metadata, smoother=kin.smoother)
+
+
+def companion_scheme(diff: Diff) -> Scheme:
+    """The scheme of the other kind (Fig. 7.4): ``central`` for a filtering scheme,
+    ``savgol`` for the others."""
+    return "central" if diff in FILTERING_SCHEMES else "savgol"
+
+
+def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOptions(), progress=None,
+                 companion: bool = False, require_single_support: bool = True) -> FrictionEstimate:
+    """Differentiate a log (:func:`~wbfriction.signals.kinematics.measure`) and estimate its friction.
+
+    A log with time gaps (:attr:`~wbfriction.logs.log.Log.segments`) is estimated segment by
+    segment, never differentiated or filtered across a gap; a segment too short for the
+    scheme gives NaN, invalid rows.
+
+    With ``companion``, the single-support acceleration difference is also computed through
+    :func:`companion_scheme` (:attr:`FrictionEstimate.companion_delta_qdd`; one more
+    inverse-dynamics pass over the single-support samples).
+
+    Raises:
+        InputError: what :func:`~wbfriction.signals.kinematics.measure` and :func:`estimate_friction`
+            raise (no segment can be estimated; with ``require_single_support``, no
+            single-support sample in the whole log).
+    """
+    parts = log.parts()
+    if len(parts) == 1:
+        return _estimate_segment(robot, log, options, progress, companion, require_single_support)
+    done, first_error = [], None
+    for part in parts:
+        try:
+            done.append(_estimate_segment(robot, part, options, progress, companion, False))
+        except InputError as exc:
+            first_error = first_error or exc
+            done.append(None)
+    if all(d is None for d in done):
+        raise first_error
+    template = next(d for d in done if d is not None)
+    est = concat_estimates([d if d is not None else _blank(template, part) for d, part in zip(done, parts)])
+    if require_single_support and not est.unique.any():
+        raise no_single_support(robot, log.source)
+    return est
+
+
+def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress, companion: bool,
+                      require_single_support: bool) -> FrictionEstimate:
+    kin = measure(log, options.diff, compensate_delay=options.compensate_delay,
+                  torque_alignment=options.torque_alignment, filtering=options.filtering)
+    kin.metadata.update(robot=robot.name, source=log.source)
+    est = estimate_friction(robot, kin, options, progress, require_single_support)
+    if companion:
+        other = companion_scheme(options.diff)
+        kin2 = measure(log, other, compensate_delay=options.compensate_delay,
+                       torque_alignment=options.torque_alignment, filtering=options.filtering)
+        phases = segment(kin2.time, kin2.contact, options.lift_off_skip, options.touch_down_skip)
+        _, est.companion_delta_qdd = single_support(robot, kin2, kin2.valid & phases.single, phases.stance)
+        est.companion_diff = other
+    return est
+
+
+def _blank(template: FrictionEstimate, log: Log) -> FrictionEstimate:
+    """An estimate of ``log``'s rows with nothing estimated (NaN, invalid), shaped like ``template``."""
+    n = len(log.time)
+    nan = lambda x: None if x is None else np.full((n, *np.shape(x)[1:]), np.nan)  # noqa: E731
+    return FrictionEstimate(
+        joints=template.joints, time=log.time, qd=nan(template.qd), tau_f=nan(template.tau_f),
+        valid=np.zeros((n, len(template.joints)), dtype=bool), phase=segment(log.time, log.contact).labels(),
+        unique=np.zeros(n, dtype=bool), contact=log.contact, contact_frames=template.contact_frames,
+        qdd=nan(template.qdd), delta_qdd=nan(template.delta_qdd), cond=nan(template.cond),
+        tau_f_true=log.tau_f_true, metadata=template.metadata, smoother=template.smoother,
+        companion_delta_qdd=nan(template.companion_delta_qdd), companion_diff=template.companion_diff)
+
+
+def concat_estimates(parts: list[FrictionEstimate]) -> FrictionEstimate:
+    """Estimates of consecutive stretches of one log as one (arrays stacked along time;
+    names, metadata and smoother of the first)."""
+    first = parts[0]
+    out = {}
+    for f in fields(FrictionEstimate):
+        values = [getattr(p, f.name) for p in parts]
+        arrays = [v for v in values if isinstance(v, np.ndarray)]
+        if arrays:  # a part without the array (e.g. no companion) gets NaN rows
+            out[f.name] = np.concatenate([v if v is not None else np.full((len(p.time), *arrays[0].shape[1:]), np.nan)
+                                          for v, p in zip(values, parts)])
+        else:
+            out[f.name] = getattr(first, f.name)
+    return FrictionEstimate(**out)

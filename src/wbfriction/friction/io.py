@@ -1,0 +1,262 @@
+"""The friction estimate's documents: the friction table and the parameters JSON (one writer, one reader each).
+
+* The **friction table** (Parquet, CSV or HDF5) holds a
+  :class:`~wbfriction.friction.estimate.FrictionEstimate` sample by sample:
+  :func:`friction_table` writes it, :func:`read_friction_table` reads it back (the estimate's
+  options, and so its smoother, ride in the table's metadata).
+* The **parameters JSON** holds the fitted model (3.5) per joint with standard errors
+  (:class:`~wbfriction.friction.fit.FitResult`): :func:`write_params` writes it (``wbfriction fit``
+  and the studies), :func:`read_params` reads it (``wbfriction report --params``). A standard
+  error that is not finite (not identifiable) is written as ``null`` and read back as ``inf``.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable, Mapping
+from dataclasses import fields
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+
+from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.friction.energy import JointEnergy
+from wbfriction.friction.estimate import FrictionEstimate
+from wbfriction.friction.fit import FitResult
+from wbfriction.friction.models import FrictionParams
+from wbfriction.logs.tables import numeric_column, read_metadata, read_table, with_metadata, write_atomic
+from wbfriction.signals.kinematics import SCHEMES, FilterOptions, Smoother, make_smoother
+
+SIGN_CONVENTION = "tau_f = -f(qd); fit of f (eq. 3.5) to -tau_f"
+"""What the parameters JSON of ``wbfriction fit`` states of its sign."""
+
+
+# ------------------------------------------------------------------ friction table
+def friction_table(est: FrictionEstimate) -> pa.Table:
+    """The estimate as an Arrow table: ``time``, ``phase``, ``unique``, [``cond``],
+    ``contact.<frame>``, and per joint ``qd.<j>``, ``tau_f.<j>``, ``valid.<j>``,
+    ``qdd.<j>``, ``delta_qdd.<j>``, [``delta_qdd_companion.<j>``], [``tau_f_true.<j>``];
+    the companion's scheme is the metadata key ``companion_diff``."""
+    cols: dict[str, object] = {"time": est.time, "phase": pa.array(est.phase.astype(str)),
+                               "unique": est.unique}
+    if est.cond is not None:
+        cols["cond"] = est.cond
+    for i, f in enumerate(est.contact_frames):
+        cols[f"contact.{f}"] = est.contact[:, i].astype(np.int8)
+    for i, j in enumerate(est.joints):
+        cols[f"qd.{j}"] = est.qd[:, i]
+        cols[f"tau_f.{j}"] = est.tau_f[:, i]
+        cols[f"valid.{j}"] = est.valid[:, i]
+        for name, arr in (("qdd", est.qdd), ("delta_qdd", est.delta_qdd),
+                          ("delta_qdd_companion", est.companion_delta_qdd)):
+            if arr is not None:
+                cols[f"{name}.{j}"] = arr[:, i]
+        if est.tau_f_true is not None and not np.all(np.isnan(est.tau_f_true[:, i])):
+            cols[f"tau_f_true.{j}"] = est.tau_f_true[:, i]
+    metadata = dict(est.metadata)
+    if est.companion_diff is not None:
+        metadata["companion_diff"] = est.companion_diff
+    return with_metadata(pa.table(cols), metadata)
+
+
+
+
+# ------------------------------------------------------------------ reading it back
+def _optional_columns(table: pa.Table, prefix: str, joints, source: str) -> np.ndarray | None:
+    """(N, n) of ``<prefix>.<joint>`` columns, NaN for a missing one; None if all are missing."""
+    names = set(table.column_names)
+    if not any(f"{prefix}.{j}" in names for j in joints):
+        return None
+    return np.column_stack([_float_column(table, f"{prefix}.{j}", source) if f"{prefix}.{j}" in names
+                            else np.full(table.num_rows, np.nan) for j in joints])
+
+
+def _float_column(table: pa.Table, name: str, source: str) -> np.ndarray:
+    """A column that may hold NaN (what could not be estimated)."""
+    return numeric_column(table, name, source, finite=False)
+
+
+def _table_smoother(meta: dict, time: np.ndarray, source: str) -> Smoother | None:
+    """The estimate's filter, rebuilt from the ``estimate_options`` metadata (None without one)."""
+    opts = meta.get("estimate_options")
+    if opts is None or len(time) < 2:
+        return None
+    bad = InputError(f"{source}: the metadata's estimate_options are not those of 'wbfriction estimate'")
+    if not isinstance(opts, dict) or not isinstance(opts.get("filtering", {}), dict):
+        raise bad
+    diff = opts.get("diff", "central")
+    if diff not in (*SCHEMES, "true"):
+        raise InputError(f"{source}: the metadata's estimate_options name an unknown scheme {diff!r}")
+    try:
+        filtering = FilterOptions(**opts.get("filtering", {}))
+    except TypeError:
+        raise bad from None
+    for f in fields(filtering):
+        value, default = getattr(filtering, f.name), getattr(FilterOptions(), f.name)
+        if type(value) is not type(default) and not (isinstance(default, float) and type(value) is int):
+            raise InputError(f"{source}: the metadata's estimate_options.filtering.{f.name} is {value!r}")
+    return make_smoother(diff, filtering, float(np.median(np.diff(time))))
+
+
+def _check_targets(meta: dict, source: str) -> None:
+    """The ``friction_true`` metadata (simulations): joint -> parameters of (3.5)."""
+    targets = meta.get("friction_true", {})
+    if not isinstance(targets, dict):
+        raise InputError(f"{source}: the metadata's friction_true is not a table of joints")
+    for joint, params in targets.items():
+        try:
+            if not isinstance(params, dict):
+                raise TypeError("not a table of parameters")
+            FrictionParams.from_dict(params)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"{source}: the metadata's friction_true of '{joint}': {exc}") from None
+
+
+def read_friction_table(table: pa.Table, source: str = "<table>") -> FrictionEstimate:
+    """Read back a friction table written by ``wbfriction estimate`` (:func:`friction_table`).
+
+    The joints are those with a ``tau_f.<j>`` column; each needs ``qd.<j>`` and ``valid.<j>``,
+    and the table ``time``. The other columns are optional (older tables, or tables of other
+    tools): without ``phase`` every sample counts as single support; without ``unique``, the
+    single-support ones are unique; the contact flags, ``qdd``, ``delta_qdd``, the companion
+    and ``tau_f_true`` are then None. The smoother is rebuilt from the ``estimate_options``
+    metadata.
+
+    Raises:
+        InputError: no joint, or a missing column (named with ``source``).
+    """
+    names = table.column_names
+    joints = tuple(c[len("tau_f."):] for c in names if c.startswith("tau_f."))
+    if not joints:
+        raise InputError(f"{source}: no 'tau_f.<joint>' column: not a friction table from 'wbfriction estimate'")
+    for c in ("time", *[f"{p}{j}" for j in joints for p in ("qd.", "valid.")]):
+        if c not in names:
+            raise ColumnError(source, c, None, f"missing column '{c}'")
+    time = numeric_column(table, "time", source)
+    stack = lambda prefix, finite=False: np.column_stack(  # noqa: E731
+        [numeric_column(table, f"{prefix}.{j}", source, finite=finite) for j in joints])
+    frames = tuple(c[len("contact."):] for c in names if c.startswith("contact."))
+    contact = (np.column_stack([numeric_column(table, f"contact.{f}", source) for f in frames]).astype(bool)
+               if frames else np.zeros((len(time), 0), dtype=bool))
+    try:
+        phase = (np.asarray(table.column("phase").to_pylist(), dtype=str) if "phase" in names
+                 else np.full(len(time), "single"))
+    except (pa.ArrowException, ValueError):  # text is decoded lazily: damaged UTF-8 fails here
+        raise ColumnError(source, "phase", None, "column 'phase' is not text") from None
+    unique = (numeric_column(table, "unique", source).astype(bool) if "unique" in names else phase == "single")
+    meta = read_metadata(table, source)
+    smoother = _table_smoother(meta, time, source)
+    _check_targets(meta, source)
+    companion_diff = meta.get("companion_diff")
+    if companion_diff is not None and companion_diff not in SCHEMES:
+        raise InputError(f"{source}: the metadata's companion_diff is {companion_diff!r}, not a scheme")
+    return FrictionEstimate(
+        joints=joints, time=time, qd=stack("qd"), tau_f=stack("tau_f"), valid=stack("valid", True).astype(bool),
+        phase=phase, unique=unique, contact=contact, contact_frames=frames,
+        qdd=_optional_columns(table, "qdd", joints, source),
+        delta_qdd=_optional_columns(table, "delta_qdd", joints, source),
+        cond=_float_column(table, "cond", source) if "cond" in names else None,
+        tau_f_true=_optional_columns(table, "tau_f_true", joints, source), metadata=meta, smoother=smoother,
+        companion_delta_qdd=_optional_columns(table, "delta_qdd_companion", joints, source),
+        companion_diff=companion_diff)
+
+
+def read_friction_file(path: str | Path) -> FrictionEstimate:
+    """:func:`read_friction_table` of a Parquet, CSV or HDF5 file.
+
+    Raises:
+        InputError: an unreadable file, or what :func:`read_friction_table` raises (named with the file).
+    """
+    return read_friction_table(read_table(path), str(path))
+
+
+# ------------------------------------------------------------------ parameters JSON
+def _finite_or_none(x: float | None) -> float | None:
+    return None if x is None or not np.isfinite(x) else float(x)
+
+
+def fit_to_dict(fit: FitResult) -> dict[str, Any]:
+    """One joint's entry of the parameters JSON (a standard error that is not finite: ``null``)."""
+    clean = _finite_or_none
+    d: dict[str, Any] = {"n_samples": fit.n_samples, "success": fit.success, "message": fit.message,
+                         "rms_residual": clean(fit.rms_residual),
+                         "params": None if fit.params is None else fit.params.to_dict(),
+                         "stderr": {k: clean(v) for k, v in fit.stderr.items()}}
+    if fit.rms_error_vs_true is not None:
+        d["rms_error_vs_true"] = clean(fit.rms_error_vs_true)
+        d["rms_model_vs_true"] = clean(fit.rms_model_vs_true)
+    if fit.target is not None:
+        d["target"] = fit.target.to_dict()
+        d["error_percent"] = {k: clean(v) for k, v in (fit.error_percent() or {}).items()}
+    return d
+
+
+def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
+    """Inverse of :func:`fit_to_dict` (a ``null`` standard error reads back as ``inf``: not identifiable).
+
+    Raises:
+        InputError: unknown parameter names, or a value that is not a number.
+    """
+    unknown = lambda x: float("inf") if x is None else float(x)  # noqa: E731
+    try:
+        res = FitResult(joint=joint, n_samples=int(d.get("n_samples", 0)), success=bool(d.get("success", False)),
+                        message=str(d.get("message", "")), rms_residual=unknown(d.get("rms_residual")))
+        if d.get("params") is not None:
+            res.params = FrictionParams.from_dict(d["params"])
+            res.stderr = {k: unknown(v) for k, v in (d.get("stderr") or {}).items()}
+        if d.get("target") is not None:
+            res.target = FrictionParams.from_dict(d["target"])
+        if "rms_error_vs_true" in d:
+            res.rms_error_vs_true = unknown(d["rms_error_vs_true"])
+            res.rms_model_vs_true = unknown(d.get("rms_model_vs_true"))
+    except (TypeError, ValueError) as exc:
+        raise InputError(str(exc)) from None
+    return res
+
+
+def energy_to_dict(energy: JointEnergy) -> dict[str, Any]:
+    """The energy check of one joint (eq. 7.9) as the parameters JSON records it."""
+    return {"generating_share": _finite_or_none(energy.generating_share), "tau_os_removed": energy.tau_os,
+            "threshold": energy.threshold, "flagged": energy.flagged}
+
+
+def write_params(path: str | Path, fits: Iterable[FitResult], header: Mapping[str, Any] | None = None,
+                 extra: Mapping[str, Mapping[str, Any]] | None = None) -> None:
+    """Write the parameters JSON, whole or not at all: the ``header`` keys (provenance, sign
+    convention, a study's robot and gait...), then ``joints``: per joint :func:`fit_to_dict` and
+    its ``extra`` keys (energy check, thesis numbering...).
+
+    Raises:
+        InputError: an output folder that does not exist.
+    """
+    extra = extra or {}
+    doc = {**(header or {}), "joints": {f.joint: {**fit_to_dict(f), **extra.get(f.joint, {})} for f in fits}}
+    text = json.dumps(doc, indent=2)
+    write_atomic(path, lambda tmp: tmp.write_text(text))
+
+
+def read_params(path: str | Path) -> dict[str, FitResult]:
+    """Fitted parameters written by :func:`write_params` (``wbfriction fit``, the demo), by joint name.
+
+    Raises:
+        InputError: a file that is not such JSON (named with the key at fault).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: file not found")
+    try:
+        doc = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: not JSON: {exc}") from None
+    joints = doc.get("joints") if isinstance(doc, dict) else None
+    if not isinstance(joints, dict):
+        raise InputError(f"{path}: no 'joints' object: not a parameter file from 'wbfriction fit'")
+    out = {}
+    for joint, d in joints.items():
+        try:
+            out[joint] = fit_from_dict(joint, d)
+        except (InputError, AttributeError) as exc:
+            raise InputError(f"{path}: joint '{joint}': {exc}") from None
+    return out

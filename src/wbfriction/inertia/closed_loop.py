@@ -1,0 +1,128 @@
+"""The loop the thesis proposed (ch. 8): identify the inertia model, then estimate the friction with it.
+
+1. The acceleration route with the given model (:func:`~wbfriction.friction.estimate.estimate_log`,
+   fit of (3.5) per joint) gives a first Stribeck velocity ``v_s``: the median over the
+   joints whose fit determines it.
+2. The inertia model and the friction are identified together from the torques
+   (:func:`~wbfriction.inertia.identification.identify_inertia`, prior toward the given model), with
+   the Stribeck term's ``v_s`` held at that value (it enters non-linearly).
+3. The acceleration route is run again with the identified model. Its fits give a better
+   ``v_s``, and step 2 is repeated from the given model with it, ``passes`` times in all.
+
+Each pass is kept, so that a user sees both routes' friction side by side and how the
+identification moved between passes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import Literal
+
+import numpy as np
+
+from wbfriction.friction.energy import JointEnergy, energy_consistency
+from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_log
+from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
+from wbfriction.inertia.identification import InertialIdentification, InertialOptions, identify_inertia
+from wbfriction.logs.log import Log
+from wbfriction.model.robot import Robot
+
+
+@dataclass
+class Route:
+    """The acceleration route (thesis ch. 5) on one model: estimate, fits and energy check."""
+
+    estimate: FrictionEstimate
+    fits: list[FitResult]
+    energy: list[JointEnergy]
+
+    def fit(self, joint: str) -> FitResult:
+        return next(f for f in self.fits if f.joint == joint)
+
+
+@dataclass
+class LoopPass:
+    """One identification (its ``v_s``, and the joints given a Stribeck term: None for all)
+    and the acceleration route with its model."""
+
+    stribeck_velocity: float | None
+    stribeck_joints: tuple[str, ...] | None
+    identification: InertialIdentification
+    route: Route
+
+
+@dataclass
+class ClosedLoop:
+    """Result of :func:`identify`: the given model's route, then each pass."""
+
+    given: Route
+    passes: list[LoopPass]
+
+    @property
+    def final(self) -> LoopPass:
+        return self.passes[-1]
+
+
+def acceleration_route(robot: Robot, log: Log, options: EstimateOptions, min_samples: int = 20,
+                       workers: int = 1) -> Route:
+    """Estimate (5.10-5.13) and fit (3.5) every torque-controlled joint (on ``workers``
+    processes), and check energy (7.9)."""
+    est = estimate_log(robot, log, options)
+    fits = fit_estimate(est, min_samples=min_samples, workers=workers)
+    return Route(est, fits, energy_consistency(est, fitted_offsets(fits)))
+
+
+def stribeck_velocity(fits: list[FitResult], max_relative_error: float = 0.5) -> tuple[float | None, tuple[str, ...]]:
+    """The joints whose fit determines a Stribeck effect (``v_s``, ``F_c`` and the height ``S``
+    with standard errors below ``max_relative_error`` of their values), and their median
+    Stribeck velocity [rad/s] (None if there are none)."""
+    def determined(f: FitResult) -> bool:
+        p = f.params
+        return p is not None and all(getattr(p, n) > 0 and f.stderr.get(n, np.inf) < max_relative_error * getattr(p, n)
+                                     for n in ("v_s", "F_c", "S"))
+    good = [f for f in fits if determined(f)]
+    return (float(np.median([f.params.v_s for f in good])) if good else None), tuple(f.joint for f in good)
+
+
+def identify(robot: Robot, log: Log, estimate_options: EstimateOptions = EstimateOptions(),
+                          options: InertialOptions = InertialOptions(),
+                          stribeck: float | Literal["auto"] | None = "auto", passes: int = 2,
+                          progress: Callable[[str], None] | None = None, workers: int = 1) -> ClosedLoop:
+    """Run the loop (module docstring).
+
+    Args:
+        robot: the given model (its URDF's inertias).
+        log: a walking log with single-support stretches.
+        estimate_options: the acceleration route's options; the identification differentiates alike.
+        options: the identification's (:class:`~wbfriction.inertia.identification.InertialOptions`; its
+            ``stribeck_velocity`` is set here).
+        stribeck: ``"auto"``: ``v_s`` from the acceleration route, ``passes`` times; a number
+            [rad/s]: that ``v_s``, one pass; None: no Stribeck term, one pass.
+        passes: identifications with ``"auto"`` (at least 1).
+        progress: called with a label as each stage starts.
+        workers: processes fitting the joints of the acceleration route side by side.
+
+    Raises:
+        InputError: what :func:`~wbfriction.friction.estimate.estimate_log` and
+            :func:`~wbfriction.inertia.identification.identify_inertia` raise.
+    """
+    say = progress or (lambda label: None)
+    say("acceleration route with the given model")
+    given = acceleration_route(robot, log, estimate_options, workers=workers)
+    if stribeck != "auto":
+        passes = 1
+    v_s, joints = stribeck_velocity(given.fits) if stribeck == "auto" else (stribeck, None)
+    done: list[LoopPass] = []
+    for k in range(max(passes, 1)):
+        say(f"identifying the inertia model (pass {k + 1}, v_s = {v_s if v_s is None else round(v_s, 4)})")
+        ident = identify_inertia(robot, log, estimate_options,
+                                 replace(options, stribeck_velocity=v_s, stribeck_joints=joints))
+        say(f"acceleration route with the identified model (pass {k + 1})")
+        route = acceleration_route(ident.robot, log, estimate_options, workers=workers)
+        done.append(LoopPass(v_s, joints, ident, route))
+        if stribeck == "auto":
+            found = stribeck_velocity(route.fits)
+            if found[0] is not None:
+                v_s, joints = found
+    return ClosedLoop(given, done)

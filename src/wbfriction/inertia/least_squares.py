@@ -1,0 +1,107 @@
+"""Least squares over long logs in memory of the size of the parameters, and the identifiable combinations.
+
+:class:`CompressedLeastSquares` keeps the triangular factor of the rows seen so far;
+:func:`base_parameters` finds the base parameters of a regressor by QR with column pivoting.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+
+class CompressedLeastSquares:
+    """``min |A x - b|^2`` over rows added block by block, kept as the triangular factor
+    ``R`` (p, p) and ``z`` (p,) of the rows seen so far (``|A x - b|^2 = |R x - z|^2 + const``):
+    memory of the size of ``x``, not of the data."""
+
+    def __init__(self, n_params: int):
+        self.n = n_params
+        self._Rz = np.zeros((0, n_params + 1))
+        self._floor = 0.0
+        self.rows = 0
+
+    def add(self, A: np.ndarray, b: np.ndarray) -> None:
+        """Append rows ``A`` (m, p) with right-hand sides ``b`` (m,)."""
+        stacked = np.vstack([self._Rz, np.column_stack([A, b])])
+        self._Rz = scipy.linalg.qr(stacked, mode="r", overwrite_a=True, check_finite=False)[0][: self.n + 1]
+        self.rows += len(b)
+
+    def absorb(self, other: CompressedLeastSquares, T: np.ndarray | None = None) -> None:
+        """Append the rows of ``other`` (whose parameters are ``T @ x``, (p_other, p); identity if None)."""
+        if other.rows == 0:
+            return
+        self.add(other.R if T is None else other.R @ T, other.z)
+        self.rows += other.rows - other.n
+        self._floor += other.residual_floor
+
+    @property
+    def residual_floor(self) -> float:
+        """The smallest ``|A x - b|^2`` (so ``|A x - b|^2 = |R x - z|^2 + residual_floor``)."""
+        corner = self._Rz[self.n, self.n] if self._Rz.shape[0] > self.n else 0.0
+        return float(corner ** 2) + self._floor
+
+    def rms(self, x: np.ndarray) -> float:
+        """RMS of ``A x - b`` over the rows added."""
+        r = self.R @ x - self.z
+        return float(np.sqrt((r @ r + self.residual_floor) / max(self.rows, 1)))
+
+    @property
+    def R(self) -> np.ndarray:
+        return np.triu(self._Rz[: self.n, : self.n])
+
+    @property
+    def z(self) -> np.ndarray:
+        return self._Rz[: self.n, self.n]
+
+
+
+@dataclass(frozen=True)
+class BaseParameters:
+    """The identifiable combinations of the parameters (base parameters).
+
+    Attributes:
+        independent: indices of the parameters chosen as base parameters (r,), the pivots
+            of a QR factorization with column pivoting of the regressor.
+        combination: (r, p): base parameter ``k`` is ``combination[k] @ x``, i.e. its
+            independent parameter plus the dependent ones it absorbs.
+        condition: condition number of the regressor's base-parameter columns, each scaled to
+            unit norm (so that it does not depend on units).
+        rank_tolerance: relative size of a pivot below which a column counts as dependent.
+    """
+
+    independent: np.ndarray
+    combination: np.ndarray
+    condition: float
+    rank_tolerance: float
+
+    @property
+    def count(self) -> int:
+        return len(self.independent)
+
+
+def base_parameters(R: np.ndarray, rank_tolerance: float = 1e-8) -> BaseParameters:
+    """Base parameters of a regressor given by its triangular factor ``R`` (p, p)
+    (:class:`CompressedLeastSquares`; ``R`` and the stacked regressor have the same
+    column dependencies), by QR with column pivoting: ``R P = Q [R1 R2]``, rank ``r`` where
+    ``|R1_kk| > rank_tolerance |R1_11|``; the dependent columns are ``R1^-1 R2`` times
+    the independent ones, so the base parameters are ``x_indep + R1^-1 R2 x_dep``.
+
+    Columns are scaled to unit norm first, so the rank does not depend on units.
+    """
+    norms = np.linalg.norm(R, axis=0)
+    scale = np.where(norms > 0, norms, 1.0)
+    _, r_fac, perm = scipy.linalg.qr(R / scale, mode="economic", pivoting=True)
+    diag = np.abs(np.diag(r_fac))
+    rank = int(np.sum(diag > rank_tolerance * diag[0])) if diag.size and diag[0] > 0 else 0
+    R1, R2 = r_fac[:rank, :rank], r_fac[:rank, rank:]
+    K = scipy.linalg.solve_triangular(R1, R2)  # scaled dependent -> independent
+    combination = np.zeros((rank, R.shape[1]))
+    ind, dep = perm[:rank], perm[rank:]
+    combination[np.arange(rank), ind] = 1.0
+    combination[:, dep] = K * scale[dep][None, :] / scale[ind][:, None]
+    s = np.linalg.svd((R / scale)[:, ind], compute_uv=False)
+    return BaseParameters(np.sort(ind), combination[np.argsort(ind)], float(s[0] / s[-1]) if rank else np.inf,
+                          rank_tolerance)

@@ -1,0 +1,127 @@
+"""HDF5 logs (``h5py``): the log format's columns in an HDF5 file.
+
+Two layouts are read (the first that applies):
+
+1. **One 2-D dataset with a names attribute**: a dataset of shape (N, C) whose attribute
+   ``names`` (or ``columns``) lists the C column names of the log format (``time``,
+   ``q.<joint>``, ...).
+2. **One 1-D dataset per column**: every 1-D dataset of length N in the file is a column;
+   its path names it, with ``/`` read as ``.`` (so ``q/leg_left_1_joint`` and a dataset
+   named ``q.leg_left_1_joint`` are the same column).
+
+A JSON string in the file attribute ``wbfriction`` is the log's metadata. :func:`write_hdf5`
+writes layout 2, one dataset per column.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+
+from wbfriction.exceptions import InputError
+
+SUFFIXES = (".h5", ".hdf5", ".he5")
+NAMES_ATTRS = ("names", "columns")
+
+
+def _names(attr) -> list[str]:
+    return [n.decode() if isinstance(n, bytes) else str(n) for n in np.atleast_1d(attr)]
+
+
+def _layout(f, path: Path) -> tuple[dict[str, tuple[object, int | None]], str | None]:
+    """Column name -> (dataset, column index in a 2-D dataset or None), and the metadata."""
+    import h5py
+
+    meta = f.attrs.get("wbfriction")
+    datasets: list[tuple[str, object]] = []
+    f.visititems(lambda name, obj: datasets.append((name, obj)) if isinstance(obj, h5py.Dataset) else None)
+    cols: dict[str, tuple[object, int | None]] = {}
+    for name, ds in datasets:
+        attr = next((ds.attrs[a] for a in NAMES_ATTRS if a in ds.attrs), None)
+        if attr is not None and ds.ndim == 2:
+            names = _names(attr)
+            if len(names) != ds.shape[1]:
+                raise InputError(f"{path}: dataset '{name}' has {ds.shape[1]} columns but its names "
+                                 f"attribute lists {len(names)}")
+            cols = {n: (ds, i) for i, n in enumerate(names)}
+            break
+    else:
+        for name, ds in datasets:
+            if ds.ndim != 1 or ds.dtype.kind not in "biuf":
+                continue
+            col = name.replace("/", ".")
+            if col in cols:
+                raise InputError(f"{path}: column '{col}' is given twice")
+            cols[col] = (ds, None)
+    if not cols:
+        raise InputError(f"{path}: no 1-D numeric dataset and no 2-D dataset with a 'names' attribute")
+    lengths = {n: ds.shape[0] for n, (ds, _) in cols.items()}
+    first = next(iter(lengths))
+    odd = next((n for n, k in lengths.items() if k != lengths[first]), None)
+    if odd is not None:
+        raise InputError(f"{path}: column '{odd}' has {lengths[odd]} rows, column '{first}' {lengths[first]}")
+    return cols, (meta.decode() if isinstance(meta, bytes) else meta) if meta is not None else None
+
+
+def read_hdf5(path: str | Path, columns: list[str] | None = None, start: int = 0, stop: int | None = None) -> pa.Table:
+    """An HDF5 log as an Arrow table (module docstring for the layouts), or a part of it.
+
+    Args:
+        path: the file.
+        columns: the columns to read (those present; default all).
+        start, stop: the rows to read, ``[start, stop)`` (default all): a long log is read in
+            chunks without loading the rest.
+
+    Raises:
+        InputError: unreadable file, no usable dataset, a names attribute that does not
+            match its dataset, columns of different lengths, or a column named twice.
+    """
+    import h5py
+
+    path = Path(path)
+    try:
+        with h5py.File(path, "r") as f:
+            layout, metadata = _layout(f, path)
+            wanted = [c for c in layout if columns is None or c in columns]
+            rows = slice(start, stop)
+            blocks: dict[int, np.ndarray] = {}  # a 2-D dataset is read once per call
+            cols: dict[str, np.ndarray] = {}
+            for c in wanted:
+                ds, i = layout[c]
+                if i is None:
+                    cols[c] = np.asarray(ds[rows], dtype=float)
+                else:
+                    if id(ds) not in blocks:
+                        blocks[id(ds)] = np.asarray(ds[rows], dtype=float)
+                    cols[c] = blocks[id(ds)][:, i]
+    except InputError:
+        raise
+    except (OSError, ValueError, TypeError, KeyError, RuntimeError) as exc:
+        raise InputError(f"{path}: not a readable HDF5 log: {str(exc).splitlines()[0] if str(exc) else exc!r}") from None
+    table = pa.table(cols)
+    if metadata:
+        try:
+            json.loads(metadata)
+        except (json.JSONDecodeError, TypeError):
+            raise InputError(f"{path}: the 'wbfriction' attribute is not JSON") from None
+        table = table.replace_schema_metadata({b"wbfriction": metadata.encode()})
+    return table
+
+
+def write_hdf5(table: pa.Table, path: str | Path) -> None:
+    """Write a table as HDF5, one dataset per column (layout 2), metadata as the file
+    attribute ``wbfriction``. Not atomic by itself: use :func:`~wbfriction.logs.tables.write_table`."""
+    import h5py
+
+    with h5py.File(path, "w") as f:
+        for name in table.column_names:
+            data = table.column(name).to_numpy(zero_copy_only=False)
+            if data.dtype == object:  # strings (a friction table's phase): fixed-length bytes
+                data = data.astype(str).astype("S")
+            f.create_dataset(name, data=data, track_times=False)  # no timestamps: same input, same bytes
+        meta = (table.schema.metadata or {}).get(b"wbfriction")
+        if meta is not None:
+            f.attrs["wbfriction"] = meta.decode()

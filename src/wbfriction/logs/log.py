@@ -1,0 +1,258 @@
+"""The wbfriction log format: reading, validation, and atomic writing of tables.
+
+A log is a Parquet file (or CSV with the same columns, or HDF5: :mod:`wbfriction.logs.hdf5`),
+one row per sample:
+
+=====================  ==========  ==================================================
+column                 unit        content
+=====================  ==========  ==================================================
+``time``               s           strictly increasing, uniformly sampled
+``q.<joint>``          rad (m)     position of every actuated joint
+``tau.<joint>``        N·m (N)     measured torque of every torque-controlled joint
+``contact.<frame>``    0 / 1       contact flag of every contact frame
+``base.x`` ... ``base.qw``  m, -   optional world pose of the root (unit quaternion
+                                   x, y, z, w)
+``tau_f_true.<joint>`` N·m         optional true friction (simulations only; never
+                                   used by the estimator)
+``qd_true.<joint>``    rad/s       optional true velocity of every actuated joint
+``qdd_true.<joint>``   rad/s²      optional true acceleration (simulations only;
+                                   used only with ``diff="true"``)
+=====================  ==========  ==================================================
+
+Names are those of the model. ``tau.<joint>`` of a position-controlled joint is
+allowed and ignored. Schema metadata under the key ``wbfriction`` (JSON) is carried
+through, e.g. the friction parameters a simulator injected.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+
+from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.logs.tables import numeric_column, read_metadata, with_metadata, write_table
+from wbfriction.model.robot import Robot
+
+BASE_COLUMNS = ("base.x", "base.y", "base.z", "base.qx", "base.qy", "base.qz", "base.qw")
+
+
+@dataclass
+class Log:
+    """A validated log, with columns mapped to the robot's joints by name.
+
+    Attributes:
+        time: sample times (N,) [s].
+        q: joint positions (N, n_act) in :attr:`Robot.actuated` order [rad].
+        tau: torques of the torque-controlled joints (N, n_tc) [N·m].
+        contact: contact flags (N, n_contacts) in :attr:`Robot.contact_frames` order.
+        base: root poses (N, 7) (x, y, z, qx, qy, qz, qw), or None if not logged.
+        tau_f_true: true friction (N, n_tc) [N·m] with NaN columns for joints not
+            logged, or None if no such column.
+        metadata: the JSON metadata stored with the log.
+        source: file the log came from.
+        qd_true, qdd_true: true joint velocities [rad/s] and accelerations [rad/s^2]
+            (N, n_act) (simulations only, for evaluation), or None.
+        segments: row ranges between time gaps (:func:`check_time`); None: one segment.
+        period: the sampling period of the log this one was cut from [s] (its segments, a
+            chunk of a long log), so that every stretch is differentiated with the same one;
+            None: the median step of ``time``.
+    """
+
+    time: np.ndarray
+    q: np.ndarray
+    tau: np.ndarray
+    contact: np.ndarray
+    base: np.ndarray | None = None
+    tau_f_true: np.ndarray | None = None
+    metadata: dict = field(default_factory=dict)
+    source: str = "<memory>"
+    qd_true: np.ndarray | None = None
+    qdd_true: np.ndarray | None = None
+    segments: list[tuple[int, int]] | None = None
+    period: float | None = None
+
+    @property
+    def dt(self) -> float:
+        """Sampling period [s]: :attr:`period` if set, else the median time step."""
+        return self.period if self.period is not None else float(np.median(np.diff(self.time)))
+
+    def parts(self) -> list[Log]:
+        """The log's segments (split at its time gaps, :func:`check_time`) as logs of their own."""
+        bounds = self.segments or [(0, len(self.time))]
+        if len(bounds) == 1:
+            return [self]
+        return [self.rows(a, b) for a, b in bounds]
+
+    def rows(self, start: int, stop: int) -> Log:
+        """The rows ``[start, stop)`` as a log (arrays are views)."""
+        cut = lambda x: None if x is None else x[start:stop]  # noqa: E731
+        return Log(self.time[start:stop], self.q[start:stop], self.tau[start:stop], self.contact[start:stop],
+                   cut(self.base), cut(self.tau_f_true), self.metadata, self.source, cut(self.qd_true),
+                   cut(self.qdd_true), None, self.dt)
+
+    def __len__(self) -> int:
+        return len(self.time)
+
+    def to_table(self, robot: Robot) -> pa.Table:
+        """The log as an Arrow table in the log format."""
+        cols: dict[str, np.ndarray] = {"time": self.time}
+        cols.update({f"q.{n}": self.q[:, i] for i, n in enumerate(robot.actuated)})
+        cols.update({f"tau.{n}": self.tau[:, i] for i, n in enumerate(robot.torque_controlled)})
+        cols.update({f"contact.{n}": self.contact[:, i].astype(np.int8) for i, n in enumerate(robot.contact_frames)})
+        if self.base is not None:
+            cols.update({c: self.base[:, i] for i, c in enumerate(BASE_COLUMNS)})
+        if self.tau_f_true is not None:
+            cols.update({f"tau_f_true.{n}": self.tau_f_true[:, i] for i, n in enumerate(robot.torque_controlled)
+                         if not np.all(np.isnan(self.tau_f_true[:, i]))})
+        for prefix, x in (("qd_true", self.qd_true), ("qdd_true", self.qdd_true)):
+            if x is not None:
+                cols.update({f"{prefix}.{n}": x[:, i] for i, n in enumerate(robot.actuated)})
+        return with_metadata(pa.table(cols), self.metadata)
+
+
+MAX_GAP = 2.0
+"""Default gap [sampling periods]: a time step at least this long splits a log into segments."""
+JITTER = 0.05
+"""Tolerated deviation of a time step from the median step, relative."""
+LIMIT_MARGIN = 0.2
+"""How far a position may pass its URDF limits before the log is refused [rad or m]."""
+
+
+def check_time(time: np.ndarray, source: str, max_gap: float = MAX_GAP,
+               rel_tol: float = JITTER, first_row: int = 0) -> list[tuple[int, int]]:
+    """Check a time column and split it at its gaps.
+
+    A step within ``rel_tol`` of the median step ``dt`` is regular; a step of at least
+    ``max_gap`` periods (less the tolerance) is a gap, which ends a segment (a log with
+    dropped samples or pauses is estimated segment by segment, never differentiated
+    across a gap); anything else is irregular sampling and refused.
+
+    Returns:
+        The segments as half-open row ranges ``[(a, b), ...]`` covering every row.
+
+    Raises:
+        InputError: fewer than 5 rows, a duplicated or decreasing stamp, or an irregular
+            step, naming the first row at fault (counted from ``first_row``).
+    """
+    if time.size < 5:
+        raise InputError(f"{source}: only {time.size} rows; at least 5 samples are needed")
+    step = np.diff(time)
+    bad = np.flatnonzero(step <= 0)
+    if bad.size:
+        k = bad[0] + 1
+        what = "duplicated" if step[bad[0]] == 0 else "decreasing"
+        raise ColumnError(source, "time", int(first_row + k), f"column 'time' has a {what} stamp at row {first_row + k} ({time[k]:.9g} s after "
+                         f"{time[k - 1]:.9g} s)")
+    dt = np.median(step)
+    gap = step >= (max_gap - rel_tol) * dt
+    bad = np.flatnonzero(~gap & (np.abs(step - dt) > rel_tol * dt))
+    if bad.size:
+        raise ColumnError(source, "time", int(first_row + bad[0] + 1), f"column 'time' is irregular at row {first_row + bad[0] + 1} "
+                         f"(step {step[bad[0]]:.6g} s, median {dt:.6g} s; gaps of {max_gap:g} periods or more "
+                         f"split the log)")
+    cuts = np.flatnonzero(gap) + 1
+    edges = [0, *cuts.tolist(), time.size]
+    return list(zip(edges[:-1], edges[1:]))
+
+
+def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT_MARGIN, first_row: int = 0) -> None:
+    """Refuse positions beyond the URDF limits by more than ``margin`` (degrees logged as
+    radians, millimetres as metres); joints without finite limits are not checked.
+
+    Raises:
+        InputError: naming the column, the row and the limits.
+    """
+    lower, upper = robot.angle_limits
+    for i, name in enumerate(robot.actuated):
+        lo, hi = lower[i], upper[i]
+        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
+            continue
+        out = np.flatnonzero((q[:, i] < lo - margin) | (q[:, i] > hi + margin))
+        if out.size:
+            k = out[0]
+            raise ColumnError(source, f"q.{name}", int(first_row + k), f"column 'q.{name}' is {q[k, i]:.6g} at row {first_row + k}, beyond its URDF limits "
+                             f"[{lo:.4g}, {hi:.4g}] by more than {margin:g}: wrong units (degrees for radians)?")
+
+
+def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_gap: float = MAX_GAP,
+                   limit_margin: float = LIMIT_MARGIN, first_row: int = 0, period: float | None = None) -> Log:
+    """Validate an Arrow table against ``robot`` and map its columns by joint name.
+
+    Args:
+        max_gap: time steps of at least this many periods split the log (:func:`check_time`).
+        limit_margin: tolerance on the URDF joint limits (:func:`check_limits`).
+        first_row: row number of the table's first row in its file (a chunk of a long log),
+            for the messages.
+        period: the sampling period of the whole log, for a chunk of it (:attr:`Log.period`).
+
+    Raises:
+        InputError: missing ``time``, a missing or unknown joint/frame column, NaN, a
+            duplicated, decreasing or irregular time column, positions far beyond the
+            joint limits, contact flags other than 0/1, a partial base pose, or a
+            non-unit quaternion.
+    """
+    names = set(table.column_names)
+    if "time" not in names:
+        raise ColumnError(source, "time", None, "missing column 'time'")
+    act, tc = set(robot.actuated), set(robot.torque_controlled)
+    frames = set(robot.contact_frames)
+    for col in table.column_names:
+        prefix, _, item = col.partition(".")
+        known = {"q": act, "tau": act, "tau_f_true": tc, "contact": frames, "qd_true": act,
+                 "qdd_true": act}.get(prefix)
+        if known is not None and item not in known:
+            what = "contact frame" if prefix == "contact" else "joint"
+            raise ColumnError(source, col, None, f"column '{col}' names an unknown {what} '{item}' of robot '{robot.name}'")
+    for col in ([f"q.{n}" for n in robot.actuated] + [f"tau.{n}" for n in robot.torque_controlled]
+                + [f"contact.{f}" for f in robot.contact_frames]):
+        if col not in names:
+            raise ColumnError(source, col, None, f"missing column '{col}'")
+    time = numeric_column(table, "time", source, first_row)
+    segments = check_time(time, source, max_gap, first_row=first_row)
+    q = np.column_stack([numeric_column(table, f"q.{n}", source, first_row) for n in robot.actuated])
+    check_limits(q, robot, source, limit_margin, first_row)
+    tau = np.column_stack([numeric_column(table, f"tau.{n}", source, first_row) for n in robot.torque_controlled])
+    contact_cols = []
+    for f in robot.contact_frames:
+        c = numeric_column(table, f"contact.{f}", source, first_row)
+        bad = np.flatnonzero((c != 0) & (c != 1))
+        if bad.size:
+            raise ColumnError(source, f"contact.{f}", int(first_row + bad[0]),
+                              f"column 'contact.{f}' must hold 0 or 1, found {c[bad[0]]:g} at row {first_row + bad[0]}")
+        contact_cols.append(c.astype(bool))
+    contact = np.column_stack(contact_cols)
+    base = None
+    present = [c for c in BASE_COLUMNS if c in names]
+    if present:
+        missing = [c for c in BASE_COLUMNS if c not in names]
+        if missing:
+            raise ColumnError(source, missing[0], None, f"base pose is partial: missing column '{missing[0]}'")
+        base = np.column_stack([numeric_column(table, c, source, first_row) for c in BASE_COLUMNS])
+        norm = np.linalg.norm(base[:, 3:], axis=1)
+        bad = np.flatnonzero(np.abs(norm - 1.0) > 1e-3)
+        if bad.size:
+            raise ColumnError(source, "base.qw", int(first_row + bad[0]),
+                              f"base quaternion is not unit at row {first_row + bad[0]} (norm {norm[bad[0]]:.6g})")
+        base[:, 3:] /= norm[:, None]
+    tau_f_true = None
+    if any(c.startswith("tau_f_true.") for c in names):
+        tau_f_true = np.column_stack([
+            numeric_column(table, f"tau_f_true.{n}", source, first_row) if f"tau_f_true.{n}" in names else np.full(len(time), np.nan)
+            for n in robot.torque_controlled])
+    truth = {}
+    for prefix in ("qd_true", "qdd_true"):
+        if any(c.startswith(prefix + ".") for c in names):
+            missing = [n for n in robot.actuated if f"{prefix}.{n}" not in names]
+            if missing:
+                raise ColumnError(source, f"{prefix}.{missing[0]}", None, f"missing column '{prefix}.{missing[0]}'")
+            truth[prefix] = np.column_stack([numeric_column(table, f"{prefix}.{n}", source, first_row) for n in robot.actuated])
+    return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
+               qd_true=truth.get("qd_true"), qdd_true=truth.get("qdd_true"), segments=segments, period=period)
+
+
+def write_log(log: Log, robot: Robot, path: str | Path) -> None:
+    """Write ``log`` in the log format (Parquet, or CSV by extension), atomically."""
+    write_table(log.to_table(robot), path)

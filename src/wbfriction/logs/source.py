@@ -1,0 +1,108 @@
+"""Where a log comes from: a table file (Parquet, CSV, HDF5) or a ROS 2 bag, decided once.
+
+:func:`open_log` looks at a path once and says what it is (:data:`LogFormat`); the rest of
+the package reads the log through the :class:`LogSource` it returns, whole
+(:meth:`LogSource.read`, :func:`read_log`) or block by block (:meth:`LogSource.blocks`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+import pyarrow as pa
+
+from wbfriction.exceptions import InputError
+from wbfriction.logs.bags import BagMap, is_bag, iter_bag, load_bag_map, read_bag
+from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, Log, log_from_table
+from wbfriction.logs.tables import TableFile
+from wbfriction.model.robot import Robot
+
+LogFormat = Literal["parquet", "csv", "hdf5", "bag"]
+"""The formats a log can come in."""
+
+
+@dataclass(frozen=True)
+class LogSource:
+    """A log file or bag whose format is known.
+
+    Attributes:
+        path: the file (or a bag's folder).
+        format: ``parquet``, ``csv``, ``hdf5`` or ``bag``.
+        bag_map: the topic map of a bag (None for a table file).
+    """
+
+    path: Path
+    format: LogFormat
+    bag_map: BagMap | None = None
+
+    @property
+    def is_bag(self) -> bool:
+        return self.format == "bag"
+
+    def table_file(self) -> TableFile:
+        """The table file (not for a bag).
+
+        Raises:
+            InputError: a bag.
+        """
+        if self.is_bag:
+            raise InputError(f"{self.path}: a ROS 2 bag is not a table file: convert it first ('wbfriction convert')")
+        return TableFile(self.path)
+
+    def read(self) -> pa.Table:
+        """The whole log as one table in the log format (:mod:`wbfriction.logs.log`), not validated.
+
+        Raises:
+            InputError: an unreadable file or bag.
+        """
+        if self.bag_map is not None:
+            return read_bag(self.path, self.bag_map)
+        return self.table_file().read()
+
+    def blocks(self, block_rows: int = 10_000) -> Iterator[pa.Table]:
+        """The log as consecutive tables of about ``block_rows`` rows, never read whole (a bag
+        aligned as it is read, :func:`~wbfriction.logs.bags.iter_bag`).
+
+        Raises:
+            InputError: an unreadable file or bag, naming it (and the row where it can).
+        """
+        if self.bag_map is not None:
+            return iter_bag(self.path, self.bag_map, block_rows)
+        return self.table_file().blocks(block_rows)
+
+
+def open_log(path: str | Path, bag_map: BagMap | str | Path | None = None) -> LogSource:
+    """What ``path`` is: a ROS 2 bag (a folder with ``metadata.yaml``, or a ``.mcap``/``.db3``
+    file, :func:`~wbfriction.logs.bags.is_bag`) read through its topic map ``bag_map`` (a
+    :class:`~wbfriction.logs.bags.BagMap` or its TOML file), else a table file.
+
+    Raises:
+        InputError: a bag without a map, an unreadable map, a missing file or an unknown file type.
+    """
+    path = Path(path)
+    if is_bag(path):
+        if bag_map is None:
+            raise InputError(f"{path}: a ROS 2 bag needs a topic map (--map MAP.toml)")
+        return LogSource(path, "bag", bag_map if isinstance(bag_map, BagMap) else load_bag_map(bag_map))
+    return LogSource(path, TableFile(path).format)
+
+
+def read_log(path: str | Path, robot: Robot, bag_map: BagMap | str | Path | None = None, max_gap: float = MAX_GAP,
+             limit_margin: float = LIMIT_MARGIN) -> Log:
+    """Read and validate a log: a table file in the log format (:mod:`wbfriction.logs.log`), or
+    a ROS 2 bag with its topic map (:mod:`wbfriction.logs.bags`).
+
+    Args:
+        path: the file (or bag folder).
+        robot: the robot whose names the columns must match.
+        bag_map: a :class:`~wbfriction.logs.bags.BagMap` or its TOML file (needed for a bag).
+        max_gap, limit_margin: see :func:`~wbfriction.logs.log.log_from_table`.
+
+    Raises:
+        InputError: see :func:`open_log`, :func:`~wbfriction.logs.log.log_from_table` and
+            :func:`~wbfriction.logs.bags.read_bag`; messages start with the file name.
+    """
+    return log_from_table(open_log(path, bag_map).read(), robot, str(path), max_gap, limit_margin)

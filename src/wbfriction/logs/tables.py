@@ -1,0 +1,316 @@
+"""Table files: Parquet, CSV and HDF5 read and written whole or in row ranges, their metadata, atomic writes.
+
+A table file's format is decided once, from its suffix (:class:`TableFile`): ``.parquet``/``.pq``
+(Apache Parquet), ``.csv``, ``.h5``/``.hdf5``/``.he5`` (:mod:`wbfriction.logs.hdf5`). Every table
+carries its JSON metadata under the schema key ``wbfriction`` (:func:`with_metadata`,
+:func:`read_metadata`). Every output is written whole or not at all (:func:`write_atomic`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+import pyarrow.parquet as pq
+
+from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.logs.hdf5 import SUFFIXES as HDF5_SUFFIXES
+from wbfriction.logs.hdf5 import read_hdf5, write_hdf5
+
+META_KEY = b"wbfriction"
+TableFormat = Literal["parquet", "csv", "hdf5"]
+"""The formats of a table file."""
+
+
+# ------------------------------------------------------------------ metadata
+def with_metadata(table: pa.Table, metadata: dict) -> pa.Table:
+    """Attach ``metadata`` (JSON-serialisable) to ``table`` under the ``wbfriction`` key."""
+    return table.replace_schema_metadata({META_KEY: json.dumps(metadata, sort_keys=True).encode()})
+
+
+def read_metadata(table: pa.Table, source: str = "<table>") -> dict:
+    """The ``wbfriction`` metadata of a table ({} if none)."""
+    meta = table.schema.metadata or {}
+    if META_KEY not in meta:
+        return {}
+    try:
+        doc = json.loads(meta[META_KEY])
+    except ValueError:
+        raise InputError(f"{source}: the 'wbfriction' metadata is not JSON") from None
+    if not isinstance(doc, dict):
+        raise InputError(f"{source}: the 'wbfriction' metadata is not a JSON object")
+    return doc
+
+
+# ------------------------------------------------------------------- reading
+TABLE_SUFFIXES = (".parquet", ".pq", ".csv", *HDF5_SUFFIXES)
+_FORMATS: dict[str, TableFormat] = {".parquet": "parquet", ".pq": "parquet", ".csv": "csv",
+                                     **{s: "hdf5" for s in HDF5_SUFFIXES}}
+
+
+def table_format(path: str | Path) -> TableFormat:
+    """The format of an existing table file, from its suffix.
+
+    Raises:
+        InputError: a missing file, or a type that is not Parquet, CSV or HDF5.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: file not found")
+    suffix = path.suffix.lower()
+    if suffix not in _FORMATS:
+        raise InputError(f"{path}: unknown file type '{suffix}' (expected .parquet, .csv or .h5)")
+    return _FORMATS[suffix]
+
+
+def _unreadable(path: Path, exc: BaseException, row: int | None = None) -> InputError:
+    at = "" if row is None else f" at row {row}"
+    return InputError(f"{path}: cannot be read{at}: {(str(exc).splitlines() or [repr(exc)])[0]}")
+
+
+class TableFile:
+    """A Parquet, CSV or HDF5 table file (format decided once, :func:`table_format`).
+
+    Attributes:
+        path: the file.
+        format: ``parquet``, ``csv`` or ``hdf5``.
+
+    Raises:
+        InputError: a missing file or an unknown type (at construction).
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self.format: TableFormat = table_format(self.path)
+
+    def read(self, columns: list[str] | None = None) -> pa.Table:
+        """The whole table, or only those of ``columns`` that it has (others are skipped).
+
+        Raises:
+            InputError: unreadable content, naming the file.
+        """
+        path = self.path
+        if self.format == "hdf5":
+            return read_hdf5(path, columns=columns)
+        try:
+            if self.format == "parquet":
+                if columns is None:
+                    table = pq.read_table(path)
+                else:
+                    names = pq.ParquetFile(path).schema_arrow.names
+                    table = pq.read_table(path, columns=[c for c in columns if c in names])
+            elif columns is None:
+                table = pacsv.read_csv(path)
+            else:
+                names = pacsv.open_csv(path).schema.names
+                table = pacsv.read_csv(path, convert_options=pacsv.ConvertOptions(
+                    include_columns=[c for c in columns if c in names]))
+            _ = table.column_names  # decoded lazily: a damaged header fails here
+            return table
+        except (pa.ArrowException, OSError, ValueError) as exc:  # ValueError: e.g. damaged UTF-8 in the footer
+            raise _unreadable(path, exc) from exc
+
+    def row_count(self) -> int:
+        """Rows of a Parquet file, from its footer; 0 when not known without reading the file."""
+        if self.format != "parquet":
+            return 0
+        try:
+            return pq.ParquetFile(self.path).metadata.num_rows
+        except (pa.ArrowException, OSError, ValueError):  # an unreadable file is reported when it is read
+            return 0
+
+    def row_reader(self, batch_rows: int) -> RowReader:
+        """A reader of row ranges, forwards, in bounded memory (:class:`RowReader`)."""
+        return RowReader(self, batch_rows)
+
+    def blocks(self, block_rows: int = 10_000) -> Iterator[pa.Table]:
+        """The table as consecutive tables of ``block_rows`` rows (with the file's metadata),
+        never read whole.
+
+        Raises:
+            InputError: an unreadable file, naming it and the row.
+        """
+        reader = self.row_reader(block_rows)
+        start = 0
+        while True:
+            table = reader.rows(start, start + block_rows)
+            if table.num_rows == 0:
+                return
+            yield table
+            start += table.num_rows
+
+
+class RowReader:
+    """Row ranges of a Parquet or CSV file, read forwards with a rolling buffer (the memory it
+    holds is one range and what was read ahead of it); of an HDF5 file, read by slicing its
+    datasets.
+
+    Raises:
+        InputError: an unreadable file (at construction or at the row where it fails).
+    """
+
+    def __init__(self, file: TableFile, batch_rows: int):
+        self.path = file.path
+        self._hdf5 = file.format == "hdf5"
+        self.metadata: dict[bytes, bytes] | None
+        if self._hdf5:
+            self.metadata = read_hdf5(self.path, columns=[], stop=0).schema.metadata
+            return
+        try:
+            if file.format == "parquet":
+                # without pre-buffering: pyarrow would otherwise keep whole column chunks read ahead
+                parquet = pq.ParquetFile(self.path, pre_buffer=False)
+                self.metadata = parquet.schema_arrow.metadata
+                self._batches: Iterator[pa.RecordBatch] = parquet.iter_batches(batch_size=batch_rows,
+                                                                               use_threads=False)
+            else:
+                self.metadata = None
+                self._batches = iter(pacsv.open_csv(self.path, read_options=pacsv.ReadOptions(block_size=1 << 24)))
+        except (pa.ArrowException, OSError, ValueError) as exc:
+            raise _unreadable(self.path, exc) from exc
+        self._buffer: list[pa.RecordBatch] = []
+        self._start = 0  # file row of the buffer's first row
+        self._stop = 0
+
+    def rows(self, start: int, stop: int) -> pa.Table:
+        """Rows ``[start, stop)`` (``start`` never below an earlier call's), with the file's metadata."""
+        if self._hdf5:
+            return read_hdf5(self.path, start=start, stop=stop)
+        while self._stop < stop:
+            try:
+                batch = next(self._batches)
+            except StopIteration:
+                break
+            except (pa.ArrowException, OSError, ValueError) as exc:
+                raise _unreadable(self.path, exc, self._stop) from exc
+            self._buffer.append(batch)
+            self._stop += batch.num_rows
+        while self._buffer and self._start + self._buffer[0].num_rows <= start:  # drop what is behind
+            self._start += self._buffer.pop(0).num_rows
+        table = pa.Table.from_batches(self._buffer) if self._buffer else pa.table({})
+        table = table.slice(start - self._start, stop - start)
+        return table.replace_schema_metadata(self.metadata) if self.metadata else table
+
+
+def read_table(path: str | Path) -> pa.Table:
+    """Read a Parquet, CSV or HDF5 file into an Arrow table (:meth:`TableFile.read`).
+
+    Raises:
+        InputError: missing file, unknown extension, or unreadable content.
+    """
+    return TableFile(path).read()
+
+
+def numeric_column(table: pa.Table, name: str, source: str, first_row: int = 0, finite: bool = True) -> np.ndarray:
+    """Column ``name`` as float64 (N,).
+
+    Raises:
+        InputError: a column that is not numeric, or (``finite``) holds NaN or inf, naming
+            ``source``, the column and the first bad row (counted from ``first_row``).
+    """
+    try:
+        col = table.column(name)
+        values = col.to_numpy(zero_copy_only=False).astype(float)
+    except (pa.ArrowException, ValueError, TypeError) as exc:
+        raise ColumnError(source, name, None, f"column '{name}' is not numeric") from exc
+    bad = np.flatnonzero(~np.isfinite(values)) if finite else ()
+    if len(bad):
+        raise ColumnError(source, name, int(first_row + bad[0]),
+                          f"column '{name}' has a non-finite value (NaN or inf) at row {first_row + bad[0]}")
+    return values
+
+
+# ------------------------------------------------------------------- writing
+def file_sha256(path: str | Path) -> str:
+    """SHA-256 of a file's bytes (hex), for provenance records; of a folder (a ROS 2 bag),
+    over its files' relative names and bytes in name order."""
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"{path}: file not found")
+    digest = hashlib.sha256()
+    files = [path] if not path.is_dir() else sorted(p for p in path.rglob("*") if p.is_file())
+    for f in files:
+        if f != path:
+            digest.update(str(f.relative_to(path)).encode() + b"\0")
+        with open(f, "rb") as handle:  # in blocks: a log of an hour is gigabytes
+            for block in iter(lambda: handle.read(1 << 20), b""):
+                digest.update(block)
+    return digest.hexdigest()
+
+
+def write_atomic(path: str | Path, write) -> None:
+    """Write a file whole or not at all.
+
+    ``write(tmp_path)`` writes to a temporary file in the destination directory, which
+    is then renamed onto ``path`` (atomic on POSIX). On any error the temporary file is
+    removed and ``path`` is left untouched.
+    """
+    path = Path(path)
+    if path.parent and not path.parent.exists():
+        raise InputError(f"{path}: output directory {path.parent} does not exist")
+    # the temporary name ends like the destination: ``write`` may read it back by its type
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{path.suffix}", dir=path.parent or ".")
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def write_table(table: pa.Table, path: str | Path) -> None:
+    """Write an Arrow table as Parquet (CSV if ``path`` ends in .csv, HDF5 in .h5 or .hdf5), atomically."""
+    path = Path(path)
+    if path.suffix.lower() == ".csv":
+        write_atomic(path, lambda tmp: pacsv.write_csv(table, tmp))
+    elif path.suffix.lower() in HDF5_SUFFIXES:
+        write_atomic(path, lambda tmp: write_hdf5(table, tmp))
+    else:
+        write_atomic(path, lambda tmp: pq.write_table(table, tmp))
+
+
+def write_tables(path: str | Path, tables: Iterable[pa.Table], check=None) -> int:
+    """Stream tables with the same columns into one Parquet or CSV file, whole or not at
+    all: the first table gives the schema and its metadata (later ones are cast to it);
+    ``check(tmp_path)``, if given, runs on the complete temporary file before the rename and
+    may raise to keep the previous output. Returns the rows written.
+
+    Raises:
+        InputError: an output that is neither .parquet nor .csv, or no table at all; what
+            the tables' source or ``check`` raises.
+    """
+    path = Path(path)
+    if path.suffix.lower() not in (".parquet", ".pq", ".csv"):
+        raise InputError(f"{path}: tables are streamed as .parquet or .csv")
+    rows = 0
+
+    def write(tmp: Path) -> None:
+        nonlocal rows
+        writer = None
+        try:
+            for table in tables:
+                if writer is None:
+                    schema = table.schema
+                    writer = (pacsv.CSVWriter(tmp, schema) if path.suffix.lower() == ".csv"
+                              else pq.ParquetWriter(tmp, schema))
+                writer.write_table(table.cast(schema) if table.schema != schema else table)
+                rows += table.num_rows
+        finally:
+            if writer is not None:
+                writer.close()
+        if writer is None:
+            raise InputError(f"{path}: nothing to write")
+        if check is not None:
+            check(tmp)
+
+    write_atomic(path, write)
+    return rows

@@ -1,0 +1,171 @@
+"""Robot model: a URDF with a free-flyer root, its joint groups and contact frames.
+
+The model is Pinocchio's (``pin.buildModelFromUrdf`` with ``pin.JointModelFreeFlyer``):
+configuration ``q`` (size ``nq``: base position [m], base orientation as a unit
+quaternion (x, y, z, w), then the joint coordinates) and velocity ``v`` (size ``nv``:
+base twist in the base frame [m/s, rad/s], then joint velocities [rad/s]).
+
+Joints are split as in the thesis (eq. 5.3) into
+
+* torque-controlled joints (``tc``): their torque ``tau`` is logged and their friction
+  ``tau_f`` is estimated;
+* position-controlled joints (``pc``, TORO's neck, TALOS's head): their acceleration is
+  constrained to the measured one (eq. 5.4c), their torque is an unknown multiplier.
+
+Joints are always addressed by name, never by order: a log's columns, a TOML file's
+groups and the model are matched name by name.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from wbfriction.exceptions import ModelError
+from wbfriction.model.layout import JointLayout, joint_layout
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A floating-base robot model with its joint groups and contact frames.
+
+    Attributes:
+        name: robot name.
+        model: Pinocchio model with a free-flyer root joint named ``root_joint``.
+        urdf: path of the URDF the model was built from.
+        actuated: names of all actuated (single-DoF) joints, in model order.
+        torque_controlled: names of the torque-controlled joints, in model order.
+        position_controlled: names of the position-controlled joints, in model order.
+        contact_frames: names of the 6D contact frames (feet soles), as configured.
+        groups: named joint groups (e.g. ``knee``), used to set friction per group.
+        q_reference: a standing configuration (nq,), e.g. TALOS's ``half_sitting``.
+        balance_gains: (K [N·m/rad], D [N·m·s/rad]) of the MuJoCo walking controller's
+            base-attitude stabiliser (:func:`wbfriction.sim.control.attitude_ankle_torques`);
+            a property of the simulated robot, not used by the estimator.
+    """
+
+    name: str
+    model: pin.Model
+    urdf: Path
+    actuated: tuple[str, ...]
+    torque_controlled: tuple[str, ...]
+    position_controlled: tuple[str, ...]
+    contact_frames: tuple[str, ...]
+    groups: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    q_reference: np.ndarray | None = None
+    balance_gains: tuple[float, float] = (0.0, 0.0)
+    cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
+    """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.stance`)."""
+
+    # ----------------------------------------------------------------- indices
+    @cached_property
+    def n_act(self) -> int:
+        """Number of actuated joints."""
+        return len(self.actuated)
+
+    @cached_property
+    def tc_index(self) -> np.ndarray:
+        """Positions of the torque-controlled joints within :attr:`actuated` (n_tc,)."""
+        pos = {name: i for i, name in enumerate(self.actuated)}
+        return np.array([pos[n] for n in self.torque_controlled], dtype=int)
+
+    @cached_property
+    def pc_index(self) -> np.ndarray:
+        """Positions of the position-controlled joints within :attr:`actuated` (n_pc,)."""
+        pos = {name: i for i, name in enumerate(self.actuated)}
+        return np.array([pos[n] for n in self.position_controlled], dtype=int)
+
+    @cached_property
+    def act_v_index(self) -> np.ndarray:
+        """Velocity indices (into ``v``) of the actuated joints (n_act,)."""
+        return np.array([self.model.idx_vs[self.model.getJointId(n)] for n in self.actuated], dtype=int)
+
+    @cached_property
+    def act_q_index(self) -> np.ndarray:
+        """Configuration indices (into ``q``) of the actuated joints (n_act,), for robots whose
+        actuated joints all have one coordinate (revolute or prismatic).
+
+        Raises:
+            ModelError: an actuated joint with more coordinates (a continuous joint).
+        """
+        if len(self.layout.q2_joint):
+            raise ModelError(f"robot '{self.name}': continuous joints are not supported here")
+        return np.array([self.model.idx_qs[self.model.getJointId(n)] for n in self.actuated], dtype=int)
+
+    @cached_property
+    def contact_frame_ids(self) -> tuple[int, ...]:
+        """Pinocchio frame ids of :attr:`contact_frames`."""
+        return tuple(int(self.model.getFrameId(f)) for f in self.contact_frames)
+
+    def limb(self, frame: str) -> tuple[str, ...]:
+        """Actuated joints on the kinematic path from the root to contact frame ``frame``.
+
+        For a sole frame this is the leg: the joints that a stance foot's contact wrench
+        acts on directly, and that the thesis's "swing only" mask excludes while that
+        foot is on the ground (section 6.2.1).
+        """
+        joint_id = self.model.frames[self.model.getFrameId(frame)].parentJoint
+        path = set(self.model.supports[joint_id])
+        return tuple(n for n in self.actuated if self.model.getJointId(n) in path)
+
+    def contact_of(self, joint: str) -> int | None:
+        """Index of the contact frame whose :meth:`limb` holds ``joint`` (a leg joint's
+        foot), or None."""
+        return next((c for c, f in enumerate(self.contact_frames) if joint in self.limb(f)), None)
+
+    @cached_property
+    def limb_mask(self) -> np.ndarray:
+        """Boolean (n_contacts, n_tc): torque-controlled joint ``j`` lies on contact ``c``'s limb."""
+        mask = np.zeros((len(self.contact_frames), len(self.torque_controlled)), dtype=bool)
+        for c, frame in enumerate(self.contact_frames):
+            limb = set(self.limb(frame))
+            mask[c] = [n in limb for n in self.torque_controlled]
+        return mask
+
+    def group_of(self, joint: str) -> str | None:
+        """Name of the first group that contains ``joint``, or None."""
+        for group, joints in self.groups.items():
+            if joint in joints:
+                return group
+        return None
+
+    # ----------------------------------------------------------- configuration
+    def configuration(self, angles: np.ndarray, base: np.ndarray | None = None) -> np.ndarray:
+        """Pinocchio configurations from joint angles.
+
+        Args:
+            angles: joint positions [rad or m] in :attr:`actuated` order, shape (n_act,) or (N, n_act).
+            base: base poses (x, y, z, qx, qy, qz, qw), shape (7,) or (N, 7); identity if None.
+
+        Returns:
+            q of shape (nq,) or (N, nq). Continuous joints get (cos, sin) coordinates.
+        """
+        return self.layout.configuration(angles, base)
+
+    def angles(self, q: np.ndarray) -> np.ndarray:
+        """Joint positions in :attr:`actuated` order from configurations (N, nq) or (nq,)."""
+        return self.layout.angles(q)
+
+    @cached_property
+    def layout(self) -> JointLayout:
+        """Configuration layout of :attr:`actuated` in :attr:`model`."""
+        return joint_layout(self.model, self.actuated)
+
+    @cached_property
+    def reference_angles(self) -> np.ndarray:
+        """Joint positions of :attr:`q_reference` (zeros if there is none), (n_act,)."""
+        return np.zeros(self.n_act) if self.q_reference is None else self.angles(self.q_reference)
+
+    @cached_property
+    def angle_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper joint position limits (n_act,) [rad]; +-inf for continuous joints."""
+        lo, hi = np.full(self.n_act, -np.inf), np.full(self.n_act, np.inf)
+        lay = self.layout
+        lo[lay.q1_joint] = self.model.lowerPositionLimit[lay.q1_index]
+        hi[lay.q1_joint] = self.model.upperPositionLimit[lay.q1_index]
+        return lo, hi

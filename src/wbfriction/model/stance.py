@@ -1,0 +1,234 @@
+"""Stance models: the robot re-rooted at a contact frame, for single-support inverse dynamics.
+
+In single support the stance foot is welded to the ground, so the floating-base robot
+is a fixed-base tree rooted at that foot. With every joint acceleration measured, the
+constrained dynamics (thesis 5.4-5.13) then reduce to one recursive Newton-Euler pass
+on the re-rooted tree:
+
+.. math::
+
+    \\mathrm{RNEA}_F(q, \\dot q, \\ddot q_{msr}) =
+    \\begin{bmatrix} \\lambda_F \\\\ S^T(\\tau + \\tau_f) \\end{bmatrix},
+
+where the root rows are the contact wrench :math:`\\lambda_F` at the contact frame F
+(expressed in F) and the joint rows the generalized joint forces. For a
+position-controlled joint the row is its (unknown) torque; for a torque-controlled
+joint ``tau_f = row - tau``. This is (5.13) with no matrix inverse: the unique
+solution of (5.12) when ``qdd_msr`` is used for every joint and the base acceleration
+is the one the contact constraint implies (tests check both routes agree to 1e-9).
+
+The re-rooted model comes from Pinocchio's model graph (``pin.graph``). A joint on the
+path from the old root to the foot is reversed; its coordinate keeps its value with a
+sign (``sign = -1``), so its generalized force changes sign too (the power
+``qd * tau`` is the same in both trees).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from wbfriction.exceptions import ModelError
+from wbfriction.model.layout import JointLayout, joint_layout
+from wbfriction.model.robot import Robot
+
+_G = pin.graph
+_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+
+
+def _graph_joint(joint: pin.JointModel):
+    """Graph joint equivalent to a Pinocchio 1-DoF joint model."""
+    short = joint.shortname()
+    if short in ("JointModelRX", "JointModelRY", "JointModelRZ"):
+        return _G.JointRevolute(np.array(_AXES[short[-1]]))
+    if short in ("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ"):
+        return _G.JointRevoluteUnbounded(np.array(_AXES[short[-1]]))
+    if short in ("JointModelPX", "JointModelPY", "JointModelPZ"):
+        return _G.JointPrismatic(np.array(_AXES[short[-1]]))
+    if short == "JointModelRevoluteUnaligned":
+        return _G.JointRevolute(np.array(joint.extract().axis))
+    if short == "JointModelRevoluteUnboundedUnaligned":
+        return _G.JointRevoluteUnbounded(np.array(joint.extract().axis))
+    if short == "JointModelPrismaticUnaligned":
+        return _G.JointPrismatic(np.array(joint.extract().axis))
+    raise ModelError(f"joint type {short} is not supported by the stance models")
+
+
+def body_frame(j: int) -> str:
+    """Name of the frame that marks body ``j`` of the original model in a stance-rooted model."""
+    return f"__wbf_body_{j}"
+
+
+@dataclass
+class StanceModel:
+    """The robot rooted at one contact frame, with a free-flyer root.
+
+    Attributes:
+        frame: name of the contact frame the tree is rooted at.
+        model: the re-rooted Pinocchio model; its root configuration is the world
+            pose of the contact frame and its root velocity the frame's twist (zero
+            for a stance foot).
+        v_index: velocity index in ``model`` of each actuated joint (n_act,).
+        sign: +1 or -1 per actuated joint: rooted coordinate = sign * original.
+        layout: configuration layout of the rooted model.
+    """
+
+    frame: str
+    model: pin.Model
+    v_index: np.ndarray
+    sign: np.ndarray
+    layout: JointLayout
+    pool: pin.ModelPool = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.pool = pin.ModelPool(self.model, 1)  # one thread: rneaInParallel as a C++ batch loop
+
+    def inverse_dynamics(self, frame_pose: np.ndarray, angles: np.ndarray, qd: np.ndarray,
+                         qdd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Joint forces and contact wrench of a stance on this frame, batched over samples.
+
+        Args:
+            frame_pose: world pose of the contact frame (x, y, z, qx, qy, qz, qw), (N, 7).
+                With a flat foot its orientation is the identity (or a yaw, which does
+                not change the result).
+            angles, qd, qdd: joint positions [rad], velocities [rad/s] and accelerations
+                [rad/s^2] of the actuated joints, in :attr:`Robot.actuated` order, (N, n_act).
+
+        Returns:
+            ``(tau_joint, wrench)``: the generalized forces of the actuated joints in the
+            original model's sign, (N, n_act) [N·m], i.e. ``S (M qdd + h - J^T lambda)``,
+            and the contact wrench lambda on the foot, (N, 6) [N, N·m], expressed in the
+            contact frame (linear part first).
+        """
+        n = angles.shape[0]
+        q = self.layout.configuration(angles, frame_pose, self.sign).T
+        v = np.zeros((self.model.nv, n))
+        a = np.zeros((self.model.nv, n))
+        v[self.v_index] = (qd * self.sign).T
+        a[self.v_index] = (qdd * self.sign).T
+        tau = pin.rneaInParallel(1, self.pool, np.asfortranarray(q), np.asfortranarray(v), np.asfortranarray(a))
+        tau = np.asarray(tau).reshape(self.model.nv, n)
+        return (tau[self.v_index].T * self.sign), tau[:6].T.copy()
+
+    def joint_mass_matrix(self, angles: np.ndarray, joints: np.ndarray) -> np.ndarray:
+        """Joint-space mass matrix of the tree rooted at the (welded) contact frame.
+
+        With the stance foot fixed, and the accelerations of the other actuated joints
+        prescribed, the block of the chosen joints is ``M_mod`` of (5.12)-(5.13): the
+        operator that maps their acceleration difference to friction,
+        ``tau_f = M_mod Delta qdd``. It does not depend on the root's pose.
+
+        Args:
+            angles: joint positions of the actuated joints (N, n_act) [rad].
+            joints: indices into :attr:`Robot.actuated` of the block's joints (m,).
+
+        Returns:
+            (N, m, m) [kg·m^2], symmetric positive definite, in the original model's
+            joint signs.
+        """
+        q = self.layout.configuration(angles, None, self.sign)
+        data = self.model.createData()
+        full = np.empty((angles.shape[0], self.model.nv, self.model.nv))
+        for k in range(angles.shape[0]):
+            full[k] = pin.crba(self.model, data, q[k])  # Pinocchio 4: the whole symmetric matrix
+        cols = self.v_index[joints]
+        return full[:, cols[:, None], cols[None, :]] * np.outer(self.sign[joints], self.sign[joints])
+
+
+def build_stance_model(robot: Robot, frame: str) -> StanceModel:
+    """Re-root ``robot.model`` at contact frame ``frame`` (see module docstring).
+
+    Raises:
+        ModelError: a joint type the graph conversion does not support, or a
+            re-rooted model whose kinematics disagree with the original one.
+    """
+    model = robot.model
+    graph = _G.ModelGraph()
+    for j in range(1, model.njoints):
+        graph.addBody(body_frame(j), model.inertias[j])
+    for j in range(2, model.njoints):
+        graph.addJoint(model.names[j], _graph_joint(model.joints[j]), body_frame(model.parents[j]),
+                       model.jointPlacements[j], body_frame(j), pin.SE3.Identity())
+    fr = model.frames[model.getFrameId(frame)]
+    rooted = _G.buildModel(graph, body_frame(fr.parentJoint), fr.placement.inverse(), _G.JointFreeFlyer())
+    # pin.graph places the root joint at the foot body, the contact frame's offset in the
+    # root joint's placement, i.e. on the universe side of the root's motion: the root
+    # configuration would then not be the contact frame's pose (rotations compose in the
+    # wrong order) and the root wrench would act at the body origin. Move the offset to the
+    # child side, so that the root joint frame *is* the contact frame.
+    offset = rooted.jointPlacements[1].copy()
+    rooted.jointPlacements[1] = pin.SE3.Identity()
+    for j in range(2, rooted.njoints):
+        if rooted.parents[j] == 1:
+            rooted.jointPlacements[j] = offset * rooted.jointPlacements[j]
+    for f in rooted.frames:
+        if f.parentJoint == 1 and f.name != "root_joint":
+            f.placement = offset * f.placement
+    # Body inertias: set each one from the original body, re-expressed in the frame of the
+    # joint that carries it in the rooted tree. (pin.graph 4.1 leaves the inertia of a body
+    # reached through a reversed joint with an offset placement in the wrong frame.)
+    carriers = set()
+    for j in range(1, model.njoints):
+        body = rooted.frames[rooted.getFrameId(body_frame(j))]
+        if body.parentJoint in carriers:  # pragma: no cover - would break the one-body-per-joint invariant
+            raise ModelError("re-rooted model merges two bodies into one joint")
+        carriers.add(body.parentJoint)
+        rooted.inertias[body.parentJoint] = body.placement.act(model.inertias[j])
+    rooted.gravity = model.gravity
+    v_index = np.array([rooted.idx_vs[rooted.getJointId(n)] for n in robot.actuated], dtype=int)
+    rooted.armature[v_index] = model.armature[robot.act_v_index]
+    reversed_joints = set(model.supports[fr.parentJoint])
+    sign = np.array([-1.0 if model.getJointId(n) in reversed_joints else 1.0 for n in robot.actuated])
+    stance = StanceModel(frame, rooted, v_index, sign, joint_layout(rooted, robot.actuated))
+    _check_kinematics(robot, stance)
+    return stance
+
+
+def stance_model(robot: Robot, contact_index: int) -> StanceModel:
+    """The model of ``robot`` rooted at contact frame number ``contact_index`` (built once)."""
+    key = ("stance", contact_index)
+    if key not in robot.cache:
+        robot.cache[key] = build_stance_model(robot, robot.contact_frames[contact_index])
+    return robot.cache[key]
+
+
+def _check_kinematics(robot: Robot, stance: StanceModel, seed: int = 0) -> None:
+    """Check that both trees place every body alike relative to the contact frame."""
+    rng = np.random.default_rng(seed)
+    angles = rng.uniform(-1.0, 1.0, robot.n_act)
+    m, r = robot.model, stance.model
+    dm, dr = m.createData(), r.createData()
+    pin.framesForwardKinematics(m, dm, robot.configuration(angles))
+    pin.framesForwardKinematics(r, dr, stance.layout.configuration(angles, None, stance.sign))
+    f_m = dm.oMf[m.getFrameId(stance.frame)]
+    for j in range(1, m.njoints):
+        rel_m = f_m.actInv(dm.oMi[j])
+        rel_r = dr.oMf[r.getFrameId(body_frame(j))]  # root frame is the contact frame at identity
+        if not np.allclose(rel_m.homogeneous, rel_r.homogeneous, atol=1e-9):
+            raise ModelError(f"re-rooted model at '{stance.frame}' disagrees with the original at body of '{m.names[j]}'")
+
+
+def stance_frame_pose(robot: Robot, stance: StanceModel, angles: np.ndarray, base: np.ndarray | None) -> np.ndarray:
+    """World pose of the stance frame (x, y, z, qx, qy, qz, qw), (N, 7): the identity (the sole
+    flat at the origin, as the estimator reconstructs it without a logged base) or, with the
+    logged base poses ``base`` (N, 7), the frame's pose by forward kinematics.
+
+    Args:
+        robot: the robot; stance: its model rooted at the stance frame (:func:`stance_model`).
+        angles: joint positions of the actuated joints (N, n_act) [rad].
+        base: logged base poses (N, 7) or None.
+    """
+    n = angles.shape[0]
+    pose = np.zeros((n, 7))
+    pose[:, 6] = 1.0
+    if base is None:
+        return pose
+    model, data = robot.model, robot.model.createData()
+    fid = model.getFrameId(stance.frame)
+    q = robot.configuration(angles, base)
+    for k in range(n):
+        pin.forwardKinematics(model, data, q[k])
+        pose[k] = pin.SE3ToXYZQUAT(pin.updateFramePlacement(model, data, fid))
+    return pose

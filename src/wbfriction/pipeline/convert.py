@@ -1,0 +1,28 @@
+"""Files in, files out: a ROS 2 bag (or another log file) converted into a log file, checked against the robot."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from wbfriction.logs.bags import BagMap
+from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP
+from wbfriction.logs.source import open_log
+from wbfriction.logs.tables import write_tables
+from wbfriction.model.robot import Robot
+from wbfriction.pipeline.estimate import check_file
+
+
+def convert_log(robot: Robot, log: str | Path, output: str | Path, bag_map: BagMap | str | Path | None = None, *,
+                max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN) -> int:
+    """Stream a log (a ROS 2 bag through its topic map, or a table file) into ``output`` (Parquet
+    or CSV) in the log format, check it against ``robot`` chunk by chunk
+    (:func:`~wbfriction.pipeline.estimate.check_file`) and only then rename it into place.
+    Returns the rows written.
+
+    Raises:
+        InputError: an unreadable log or map, an output that is neither .parquet nor .csv, or
+            what the check raises (naming ``log``, the column and the row). Nothing is written then.
+    """
+    source = open_log(log, bag_map)
+    return write_tables(output, source.blocks(),
+                        check=lambda tmp: check_file(robot, tmp, str(log), max_gap=max_gap, limit_margin=limit_margin))

@@ -1,0 +1,55 @@
+"""Files in, files out: a log's inertia model and friction identified together (the closed loop of
+:func:`wbfriction.inertia.closed_loop.identify`), the corrected URDF and the identification JSON written."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+from wbfriction.friction.estimate import EstimateOptions
+from wbfriction.inertia.closed_loop import ClosedLoop, identify
+from wbfriction.inertia.identification import InertialOptions
+from wbfriction.inertia.io import identification_document, write_identification
+from wbfriction.inertia.urdf import write_urdf
+from wbfriction.logs.source import read_log
+from wbfriction.model.robot import Robot
+from wbfriction.pipeline.provenance import log_provenance
+from wbfriction.progress import StageProgress
+
+
+@dataclass
+class IdentifiedFile:
+    """What :func:`identify_file` did.
+
+    Attributes:
+        loop: the closed loop's routes and passes.
+        document: the identification JSON's content (:func:`~wbfriction.inertia.io.identification_document`).
+        moved: the joints whose whole identified body went to their child link
+            (:func:`~wbfriction.inertia.urdf.write_urdf`).
+    """
+
+    loop: ClosedLoop
+    document: dict[str, Any]
+    moved: tuple[str, ...]
+
+
+def identify_file(robot: Robot, log: str | Path, urdf_output: str | Path, json_output: str | Path | None = None, *,
+                  estimate_options: EstimateOptions = EstimateOptions(), options: InertialOptions = InertialOptions(),
+                  stribeck: float | Literal["auto"] | None = "auto", passes: int = 2,
+                  progress: StageProgress | None = None, workers: int = 1) -> IdentifiedFile:
+    """Identify the inertia model and the friction of ``robot`` from a log file (the closed loop,
+    :func:`~wbfriction.inertia.closed_loop.identify`), write the corrected URDF to ``urdf_output``
+    and, if given, the identification JSON to ``json_output``, each whole or not at all.
+
+    Raises:
+        InputError: an unreadable or invalid log, what the identification raises, an output
+            folder that does not exist.
+    """
+    data = read_log(log, robot)
+    loop = identify(robot, data, estimate_options, options, stribeck, passes, progress=progress, workers=workers)
+    moved = write_urdf(robot, loop.final.identification.pi, urdf_output)
+    doc = identification_document(loop, moved, log_provenance(log, robot))
+    if json_output is not None:
+        write_identification(json_output, doc)
+    return IdentifiedFile(loop, doc, moved)

@@ -1,0 +1,118 @@
+"""The report computed: ``wbfriction report`` reads a friction table (and parameters, an identification), fits
+and checks what is not given, and gathers what the HTML shows (:mod:`wbfriction.report.html` renders it).
+
+The report shows, for a person to judge a friction table at a glance:
+
+* a summary with the energy-consistency warnings (:mod:`wbfriction.friction.energy`, eq. 7.9);
+* the friction clouds of every joint as small multiples on shared axes, with the fitted
+  model (3.5) and the target where known;
+* the identified parameters with their standard errors (6.2.2), and the errors against the
+  targets of a simulated log;
+* the energy-consistency table (share of power-generating samples, zero crossings of
+  ``Delta qdd`` against those of the velocity, Fig. 7.4);
+* per joint: the cloud, ``tau_f`` over time by support phase, Fig. 7.4 with and without
+  filtering, and the spectrum of the estimated acceleration (Fig. 7.1);
+* the inertia identification of ``wbfriction identify --json``, when given;
+* the provenance: input files with their SHA-256, robot, options, package versions.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, JointEnergy, energy_consistency
+from wbfriction.friction.estimate import FrictionEstimate
+from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
+from wbfriction.friction.io import read_friction_file, read_params
+from wbfriction.inertia.io import read_identification
+from wbfriction.logs.tables import file_sha256
+from wbfriction.signals.spectrum import MIN_SAMPLES, joint_spectra, longest_run
+from wbfriction.version import __version__
+
+
+def acceleration_spectra(est: FrictionEstimate, tail: float = 0.01) -> dict[str, tuple[np.ndarray, np.ndarray, float]]:
+    """Spectrum of the estimated acceleration ``qdd_est = qdd - Delta qdd`` (5.10) of every joint
+    over the longest stretch where it is defined for all joints, and its suggested cutoff
+    (Fig. 7.1, :func:`~wbfriction.signals.spectrum.suggest_cutoff`); {} when the table lacks the columns
+    or the stretch is shorter than 64 samples."""
+    if est.qdd is None or est.delta_qdd is None:
+        return {}
+    qdd_est = est.qdd - est.delta_qdd
+    a, b = longest_run(np.isfinite(qdd_est).all(axis=1))
+    if b - a < MIN_SAMPLES:
+        return {}
+    freq, amp, cutoff = joint_spectra(qdd_est[a:b], float(np.median(np.diff(est.time))), tail)
+    return {j: (freq, amp[:, i], float(cutoff[i])) for i, j in enumerate(est.joints)}
+
+
+@dataclass
+class Report:
+    """What a report shows, computed; :meth:`html` renders it.
+
+    Attributes:
+        est: the estimate read from the friction table.
+        fits: fitted parameters by joint (from ``--params`` or fitted here).
+        energy: energy consistency by joint.
+        provenance: (label, value) pairs.
+        threshold: share of power-generating samples above which a joint is flagged.
+        identification: what ``wbfriction identify --json`` wrote, or None.
+    """
+
+    est: FrictionEstimate
+    fits: dict[str, FitResult]
+    energy: dict[str, JointEnergy]
+    provenance: list[tuple[str, str]]
+    threshold: float
+    identification: dict | None = None
+
+    @property
+    def flagged(self) -> list[JointEnergy]:
+        return [e for e in self.energy.values() if e.flagged]
+
+
+def make_report(friction: str | Path, params: str | Path | None = None,
+                threshold: float = DEFAULT_THRESHOLD, tolerance: float = DEFAULT_TOLERANCE,
+                identification: str | Path | None = None) -> Report:
+    """Read a friction table (and parameters, else fit them; and an identification of the
+    inertia model, :func:`~wbfriction.inertia.io.read_identification`) and compute the report.
+
+    Raises:
+        InputError: unreadable inputs.
+    """
+    friction = Path(friction)
+    ident = None if identification is None else read_identification(identification)
+    est = read_friction_file(friction)
+    if params is not None:
+        fits = read_params(params)
+    else:
+        fits = {f.joint: f for f in fit_estimate(est)}
+    energy = {e.joint: e for e in energy_consistency(est, fitted_offsets(fits.values()), threshold, tolerance)}
+    meta = est.metadata
+    prov: list[tuple[str, str]] = [("friction table", f"{friction} (sha256 {file_sha256(friction)})")]
+    if params is not None:
+        prov.append(("parameters", f"{params} (sha256 {file_sha256(params)})"))
+    else:
+        prov.append(("parameters", "fitted by the report (no --params given)"))
+    source = dict(meta.get("provenance", {}))
+    if source.get("log"):
+        prov.append(("log", f"{source['log']} (sha256 {source.get('log_sha256', '?')})"))
+    elif meta.get("source"):
+        prov.append(("log", str(meta["source"])))
+    prov.append(("robot", str(source.get("robot") or meta.get("robot", "?"))))
+    if source.get("urdf"):
+        prov.append(("URDF", str(source["urdf"])))
+    if "estimate_options" in meta:
+        prov.append(("estimate options", json.dumps(meta["estimate_options"], sort_keys=True)))
+    if est.companion_diff:
+        prov.append(("companion scheme (Fig. 7.4)", est.companion_diff))
+    if source.get("wbfriction"):
+        prov.append(("estimated with", f"wbfriction {source['wbfriction']}"))
+    prov.append(("report", f"wbfriction {__version__}; energy threshold {100 * threshold:g} %, "
+                               f"tolerance {tolerance:g} N·m"))
+    if identification is not None:
+        prov.append(("inertia identification", f"{identification} (sha256 {file_sha256(identification)})"))
+    return Report(est, fits, energy, prov, threshold, ident)

@@ -1,0 +1,352 @@
+"""Figures of the simulation study (thesis Fig. 6.1-6.3) and friction curves, as PNG files.
+
+Uses matplotlib's object API (``matplotlib.figure.Figure``), so no display or global
+backend is needed. Friction is plotted in the project's sign convention: ``tau_f``, the
+torque friction exerts on the joint [N·m] (negative of the model f of eq. 3.5).
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from wbfriction.friction.estimate import FrictionEstimate
+from wbfriction.friction.fit import FitResult
+from wbfriction.friction.models import FrictionParams
+from wbfriction.logs.tables import write_atomic
+
+_DOUBLE_SUPPORT_COLOR = "#dddddd"
+
+
+def _save(fig: Figure, path: str | Path) -> None:
+    write_atomic(path, lambda tmp: fig.savefig(tmp, format="png", dpi=110))
+
+
+def png_bytes(fig: Figure, dpi: int = 90) -> bytes:
+    """The figure as PNG bytes (no timestamp in the file: the same figure gives the same bytes)."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi, metadata={"Software": None})
+    return buf.getvalue()
+
+
+def _shade_double_support(ax, est: FrictionEstimate) -> None:
+    ds = est.contact.all(axis=1)
+    edges = np.flatnonzero(np.diff(np.r_[0, ds.astype(np.int8), 0]))
+    for s, e in zip(edges[::2], edges[1::2]):
+        ax.axvspan(est.time[s], est.time[e - 1], color=_DOUBLE_SUPPORT_COLOR, lw=0)
+
+
+def support_phases_figure(est: FrictionEstimate, joints: list[str], path: str | Path,
+                          title: str = "Fig. 6.1: estimated friction, single and double support") -> None:
+    """Estimated (all samples, single and double support) vs true friction over time, one
+    panel per joint; double support shaded grey."""
+    fig = Figure(figsize=(11, 1.6 * len(joints) + 0.8), layout="constrained")
+    axes = fig.subplots(len(joints), 1, sharex=True, squeeze=False)[:, 0]
+    for ax, joint in zip(axes, joints):
+        i = est.joints.index(joint)
+        _shade_double_support(ax, est)
+        if est.tau_f_true is not None:
+            ax.plot(est.time, est.tau_f_true[:, i], color="k", lw=2.5, alpha=0.35, label="target")
+        ax.plot(est.time, est.tau_f[:, i], color="C0", lw=0.8, label="estimate")
+        ax.set_ylabel(joint.replace("_joint", ""), fontsize=8)
+    axes[0].legend(loc="upper right", fontsize=8)
+    axes[-1].set_xlabel("time [s] (grey: double support)")
+    fig.suptitle(title)
+    _save(fig, path)
+
+
+def derivative_schemes_figure(estimates: dict[str, FrictionEstimate], joint: str, foot: int,
+                              path_time: str | Path, path_velocity: str | Path) -> None:
+    """Fig. 6.2 (over time) and Fig. 6.3 (over the joint velocity) of one joint for several
+    differentiation schemes, in its valid single-support samples, split by whether the
+    joint's leg (the one ending at contact ``foot``) swings or stands."""
+    fig_t = Figure(figsize=(11, 4), layout="constrained")
+    ax_t = fig_t.subplots()
+    fig_v = Figure(figsize=(11, 3.6), layout="constrained")
+    axes_v = fig_v.subplots(1, len(estimates), sharex=True, sharey=True, squeeze=False)[0]
+    first = next(iter(estimates.values()))
+    i = first.joints.index(joint)
+    _shade_double_support(ax_t, first)
+    if first.tau_f_true is not None:
+        ax_t.plot(first.time, first.tau_f_true[:, i], color="k", lw=2.5, alpha=0.35, label="target")
+    for c, (label, est) in enumerate(estimates.items()):
+        tau = np.where(est.unique, est.tau_f[:, i], np.nan)
+        ax_t.plot(est.time, tau, lw=0.8, color=f"C{c}", label=label)
+        ax = axes_v[c]
+        swing = est.valid[:, i] & ~est.contact[:, foot]
+        stance = est.valid[:, i] & est.contact[:, foot]
+        ax.plot(est.qd[stance, i], est.tau_f[stance, i], ".", ms=1.5, color="C3", label="leg in stance")
+        ax.plot(est.qd[swing, i], est.tau_f[swing, i], ".", ms=1.5, color="C0", label="leg in swing")
+        if est.tau_f_true is not None:
+            order = np.argsort(est.qd[est.unique, i])
+            ax.plot(est.qd[est.unique, i][order], est.tau_f_true[est.unique, i][order], color="k", lw=1,
+                    label="target")
+        ax.set_title(label, fontsize=9)
+        ax.set_xlabel("qd [rad/s]")
+    axes_v[0].set_ylabel("tau_f [N·m]")
+    axes_v[0].legend(fontsize=7, markerscale=4)
+    lim = np.nanpercentile(np.abs(first.tau_f_true[:, i]), 100) * 3 if first.tau_f_true is not None else None
+    if lim:
+        ax_t.set_ylim(-lim, lim)
+        axes_v[0].set_ylim(-lim, lim)
+    ax_t.set_xlabel("time [s] (grey: double support; single support only)")
+    ax_t.set_ylabel(f"tau_f {joint} [N·m]")
+    ax_t.legend(fontsize=8, loc="upper right")
+    fig_t.suptitle(f"Fig. 6.2: differentiation schemes over time, {joint}")
+    fig_v.suptitle(f"Fig. 6.3: differentiation schemes over velocity, {joint}")
+    _save(fig_t, path_time)
+    _save(fig_v, path_velocity)
+
+
+def friction_curves_figure(est: FrictionEstimate, fits: list[FitResult], path: str | Path,
+                           columns: int = 6) -> None:
+    """Small multiples: per joint the valid estimates over velocity, the fitted model and the
+    target (when known), shared axes (:func:`friction_overview_figure`)."""
+    fig = friction_overview_figure(est, [f.joint for f in fits], {f.joint: f for f in fits},
+                                   {f.joint: f.target for f in fits if f.target is not None}, columns=columns,
+                                   title="Friction over velocity: valid estimates, fitted model (3.5), target")
+    _save(fig, path)
+
+
+def filter_curves_figure(curves: dict[str, dict], joint: str, target, position_std: float | None,
+                         path: str | Path) -> None:
+    """Fig. 7.2 kind: one joint's valid estimates over velocity for several filters (one
+    panel each, shared axes), with the target and the model fitted through the filter."""
+    n = max(len(curves), 1)
+    columns = min(n, 4)
+    rows = int(np.ceil(n / columns))
+    fig = Figure(figsize=(3.2 * columns, 2.7 * rows + 0.7), layout="constrained")
+    axes = fig.subplots(rows, columns, sharex=True, sharey=True, squeeze=False).ravel()
+    for ax, (label, c) in zip(axes, curves.items()):
+        ax.plot(c["qd"], c["tau_f"], ".", ms=1, color="C0", alpha=0.3)
+        if len(c["qd"]):
+            v = np.linspace(np.min(c["qd"]), np.max(c["qd"]), 400)
+            ax.plot(v, target.torque(v), color="k", lw=2.5, alpha=0.35, label="target")
+            if c["fit"] is not None:
+                ax.plot(v, FrictionParams.from_dict(c["fit"]).torque(v), color="C1", lw=1, label="fit")
+        ax.set_title(label, fontsize=9)
+        ax.tick_params(labelsize=7)
+    for ax in axes[len(curves):]:
+        ax.set_visible(False)
+    axes[0].legend(fontsize=7)
+    lim = 3 * float(np.max(np.abs(target.torque(np.linspace(-1, 1, 50)))))
+    axes[0].set_ylim(-lim, lim)
+    fig.supxlabel("qd [rad/s]")
+    fig.supylabel("tau_f [N·m]")
+    noise = "exact log" if position_std is None else f"position noise {position_std:g} rad"
+    fig.suptitle(f"Fig. 7.2: {joint} over velocity through each filter ({noise})")
+    _save(fig, path)
+
+
+def spectrum_figure(spec, path: str | Path, max_freq: float = 50.0, columns: int = 4) -> None:
+    """Fig. 7.1 kind: amplitude spectrum of the estimated acceleration per joint (log scale,
+    shared axes), the suggested cutoff of each joint dashed, the overall one solid."""
+    n = len(spec.joints)
+    columns = min(columns, n)
+    rows = int(np.ceil(n / columns))
+    fig = Figure(figsize=(3.0 * columns, 2.2 * rows + 0.7), layout="constrained")
+    axes = fig.subplots(rows, columns, sharex=True, sharey=True, squeeze=False).ravel()
+    keep = (spec.freq > 0) & (spec.freq <= max_freq)
+    for i, (ax, joint) in enumerate(zip(axes, spec.joints)):
+        ax.semilogy(spec.freq[keep], spec.amplitude[keep, i], lw=0.7, color="C0")
+        ax.axvline(spec.cutoff[i], color="C1", ls="--", lw=1)
+        ax.axvline(spec.suggestion, color="C3", lw=1)
+        ax.set_title(f"{joint.replace('_joint', '')}: {spec.cutoff[i]:.1f} Hz", fontsize=8)
+        ax.tick_params(labelsize=7)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    fig.supxlabel("frequency [Hz]")
+    fig.supylabel("amplitude of qdd_est [rad/s²]")
+    fig.suptitle(f"Fig. 7.1: spectrum of the estimated acceleration; suggested cutoff {spec.suggestion:.1f} Hz "
+                 f"(dashed: each joint's; the median of them)")
+    _save(fig, path)
+
+
+def velocity_panels_figure(panels: list[tuple[str, FrictionEstimate, np.ndarray]], joint: str,
+                           target: FrictionParams | None, path: str | Path, title: str) -> None:
+    """Friction of one joint over its velocity, one panel per (label, estimate, samples mask),
+    on shared axes, with the target curve (Fig. 6.4, 6.5)."""
+    fig = Figure(figsize=(5.0 * len(panels), 3.8), layout="constrained")
+    axes = fig.subplots(1, len(panels), sharex=True, sharey=True, squeeze=False)[0]
+    for ax, (label, est, mask) in zip(axes, panels):
+        i = est.joints.index(joint)
+        ax.plot(est.qd[mask, i], est.tau_f[mask, i], ".", ms=1.5, alpha=0.4, color="C0", label="estimate")
+        if target is not None:
+            v = np.linspace(np.nanmin(est.qd[mask, i]), np.nanmax(est.qd[mask, i]), 400)
+            ax.plot(v, target.torque(v), color="k", lw=2, alpha=0.6, label="target")
+        ax.set_title(f"{label} ({int(mask.sum())} samples)", fontsize=9)
+        ax.set_xlabel(f"{joint.replace('_joint', '')} velocity [rad/s]")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("tau_f [N·m]")
+    axes[0].legend(loc="upper right", fontsize=8, markerscale=6)
+    fig.suptitle(title)
+    _save(fig, path)
+
+
+PHASE_COLORS = {"single": "C0", "double": "#9a9a9a", "flight": "C3"}
+
+
+def _short(joint: str) -> str:
+    return joint.replace("_joint", "")
+
+
+def _cloud(ax, est: FrictionEstimate, i: int, fit: FitResult | None, target: FrictionParams | None) -> None:
+    m = est.valid[:, i]
+    ax.plot(est.qd[m, i], est.tau_f[m, i], ".", ms=1, color="C0", alpha=0.3)
+    if m.any():
+        v = np.linspace(est.qd[m, i].min(), est.qd[m, i].max(), 400)
+        if target is not None:
+            ax.plot(v, target.torque(v), color="k", lw=2.5, alpha=0.35, label="target")
+        if fit is not None and fit.params is not None:
+            ax.plot(v, fit.params.torque(v), color="C1", lw=1.2, label="fit (3.5)")
+    ax.axhline(0, color="k", lw=0.4)
+    ax.axvline(0, color="k", lw=0.4)
+
+
+def friction_overview_figure(est: FrictionEstimate, joints: list[str], fits: dict[str, FitResult],
+                             targets: dict[str, FrictionParams], flagged: set[str] = frozenset(),
+                             columns: int = 6, title: str = "Friction over velocity, valid samples, shared axes "
+                                                             "(red: power-generating share over threshold)") -> Figure:
+    """Small multiples on shared axes: per joint the valid estimates over velocity, the fitted
+    model and the target; titles of joints flagged by the energy check in red."""
+    n = max(len(joints), 1)
+    columns = min(columns, n)
+    rows = int(np.ceil(n / columns))
+    fig = Figure(figsize=(2.4 * columns, 2.0 * rows + 0.7), layout="constrained")
+    axes = fig.subplots(rows, columns, sharex=True, sharey=True, squeeze=False).ravel()
+    for ax, joint in zip(axes, joints):
+        _cloud(ax, est, est.joints.index(joint), fits.get(joint), targets.get(joint))
+        ax.set_title(_short(joint), fontsize=8, color="C3" if joint in flagged else "k")
+        ax.tick_params(labelsize=7)
+    for ax in axes[len(joints):]:
+        ax.set_visible(False)
+    axes[0].legend(fontsize=6, loc="upper right")
+    fig.supxlabel("qd [rad/s]")
+    fig.supylabel("tau_f [N·m]")
+    fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def widest_run(mask: np.ndarray, x: np.ndarray) -> slice:
+    """The stretch of consecutive True values of ``mask`` over which ``x`` spans the widest
+    range (empty slice if none): for Fig. 7.4, the swing phase where the joint moves most."""
+    edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(np.int8), 0]))
+    if edges.size == 0:
+        return slice(0, 0)
+    runs = [slice(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2])]
+    return max(runs, key=lambda r: float(np.nanmax(x[r]) - np.nanmin(x[r])) if np.isfinite(x[r]).any() else -1.0)
+
+
+def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, target: FrictionParams | None,
+                 spectrum: tuple[np.ndarray, np.ndarray, float] | None = None, max_freq: float = 50.0) -> Figure:
+    """One joint at a glance, four panels:
+
+    (a) the friction cloud with the fitted model and the target;
+    (b) ``tau_f`` over time coloured by support phase (valid samples dark);
+    (c) Fig. 7.4: ``Delta qdd`` through the estimate's scheme and through the companion scheme,
+        with ``qd`` (right axis), over the valid stretch where the joint moves most: with an exact
+        model they cross zero together with opposite signs;
+    (d) Fig. 7.1: the amplitude spectrum of ``qdd_est = qdd - Delta qdd`` and its suggested cutoff
+        (``spectrum = (freq, amplitude, cutoff)``), when computed.
+    """
+    i = est.joints.index(joint)
+    # a fixed layout: constrained layout would cost most of the time of a report's many figures
+    fig = Figure(figsize=(14, 2.7))
+    ax_c, ax_t, ax_e, ax_s = fig.subplots(1, 4, gridspec_kw={"width_ratios": [1, 1.6, 1.6, 1], "wspace": 0.5,
+                                                               "left": 0.05, "right": 0.99, "bottom": 0.17,
+                                                               "top": 0.9})
+    _cloud(ax_c, est, i, fit, target)
+    ax_c.set_xlabel("qd [rad/s]")
+    ax_c.set_ylabel("tau_f [N·m]")
+    ax_c.set_title("(a) friction over velocity", fontsize=9)
+    if ax_c.get_legend_handles_labels()[0]:
+        ax_c.legend(fontsize=7)
+    for phase, color in PHASE_COLORS.items():
+        sel = est.phase == phase
+        if sel.any():
+            ax_t.plot(est.time, np.where(sel, est.tau_f[:, i], np.nan), lw=0.5, color=color, alpha=0.45,
+                      label=phase)
+    ax_t.plot(est.time, np.where(est.valid[:, i], est.tau_f[:, i], np.nan), lw=0.8, color="C1", label="valid")
+    ax_t.set_xlabel("time [s]")
+    ax_t.set_title("(b) tau_f over time by support phase", fontsize=9)
+    valid_tau = est.tau_f[est.valid[:, i], i]
+    if valid_tau.size:
+        lim = 1.5 * float(np.max(np.abs(valid_tau))) + 1e-6
+        ax_t.set_ylim(-lim, lim)
+    ax_t.legend(fontsize=6, ncol=4, loc="upper right")
+    run = widest_run(est.valid[:, i], est.qd[:, i])
+    if est.delta_qdd is not None and run.stop > run.start:
+        t = est.time[run]
+        ax_e.plot(t, est.delta_qdd[run, i], color="C0", lw=1, label=f"Δqdd ({est.metadata.get('estimate_options', {}).get('diff', 'estimate')})")
+        if est.companion_delta_qdd is not None:
+            ax_e.plot(t, est.companion_delta_qdd[run, i], color="C2", lw=0.7, alpha=0.8,
+                      label=f"Δqdd ({est.companion_diff or 'companion'})")
+        ax_e.axhline(0, color="k", lw=0.4)
+        ax_e.set_ylabel("Δqdd [rad/s²]")
+        ax_v = ax_e.twinx()
+        ax_v.plot(t, est.qd[run, i], color="C3", lw=1, label="qd")
+        ax_v.set_ylabel("qd [rad/s]", color="C3")
+        for ax in (ax_e, ax_v):  # both zero lines at mid-height: the crossings line up by eye
+            top = float(np.nanmax(np.abs(ax.get_ylim())))
+            ax.set_ylim(-top, top)
+        ax_e.legend(fontsize=6, loc="upper left")
+        ax_e.set_xlabel("time [s]")
+    else:
+        ax_e.text(0.5, 0.5, "no acceleration difference in the table", ha="center", va="center", fontsize=8,
+                  transform=ax_e.transAxes)
+    ax_e.set_title("(c) Fig. 7.4: Δqdd and velocity, one valid stretch", fontsize=9)
+    if spectrum is not None:
+        freq, amp, cutoff = spectrum
+        keep = (freq > 0) & (freq <= max_freq)
+        ax_s.semilogy(freq[keep], amp[keep], lw=0.7, color="C0")
+        ax_s.axvline(cutoff, color="C1", ls="--", lw=1)
+        ax_s.set_xlim(0, max_freq)
+        ax_s.set_title(f"(d) spectrum of qdd_est: {cutoff:.1f} Hz", fontsize=9)
+        ax_s.set_xlabel("frequency [Hz]")
+    else:
+        ax_s.set_visible(False)
+    for ax in (ax_c, ax_t, ax_e, ax_s):
+        ax.tick_params(labelsize=7)
+    return fig
+
+
+def sensitivity_figure(sens, joints: list[str], columns: int = 4) -> Figure:
+    """Fig. 7.5 / 7.6 kind: per joint the valid estimates over velocity for every inertia factor
+    (lines through consecutive samples, so that the branches of rising and falling velocity
+    show), small multiples with a shared velocity axis."""
+    from matplotlib import colormaps
+
+    n = max(len(joints), 1)
+    columns = min(columns, n)
+    rows = int(np.ceil(n / columns))
+    fig = Figure(figsize=(3.3 * columns, 2.6 * rows + 0.8), layout="constrained")
+    axes = fig.subplots(rows, columns, sharex=True, squeeze=False).ravel()
+    others = sorted(f for f in sens.factors if f != 1.0)
+    span = max([abs(f - 1.0) for f in others] + [1e-9])
+    cmap = colormaps["coolwarm"]
+    for ax, joint in zip(axes, joints):
+        for f, est in sorted(zip(sens.factors, sens.estimates), key=lambda x: x[0]):
+            i = est.joints.index(joint)
+            m = est.valid[:, i]
+            color = "k" if f == 1.0 else cmap(0.5 + 0.5 * (f - 1.0) / span)
+            ax.plot(np.where(m, est.qd[:, i], np.nan), np.where(m, est.tau_f[:, i], np.nan), lw=0.6,
+                    color=color, alpha=0.9 if f == 1.0 else 0.7, label=f"x {f:g}")
+        ax.set_title(_short(joint), fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.axhline(0, color="k", lw=0.3)
+    for ax in axes[len(joints):]:
+        ax.set_visible(False)
+    axes[0].legend(fontsize=6, loc="upper left")
+    fig.supxlabel("qd [rad/s]")
+    fig.supylabel("tau_f [N·m]")
+    fig.suptitle(f"Friction estimate with every body's inertia scaled ({sens.part}; black: the model as given)",
+                 fontsize=10)
+    return fig
+
+
+def save_png(fig: Figure, path: str | Path) -> None:
+    """Write a figure as a PNG file, whole or not at all."""
+    _save(fig, path)

@@ -1,0 +1,160 @@
+"""The thesis's realistic-simulator study (6.2, Fig. 6.4-6.5) on MuJoCo: ``wbfriction demo --simulator mujoco``.
+
+The estimator meets a world it did not write: soft foot contacts, contact flags from
+measured forces, and (last case) sensor noise that the controller acts on.
+
+1. **Swing and stance** (Fig. 6.4): a forward walk with friction (3.5) on the right knee
+   only; the knee's estimate over the whole single-support time (its leg standing too) and
+   over its swing phase only.
+2. **No interference** (Fig. 6.5): the same walk with friction on every leg joint; the
+   right knee's swing-phase estimate is unchanged.
+3. **Identification** on the combined walk, swing-phase samples, per leg joint:
+
+   * friction (3.5) with Table 6.1's targets, noise off, central differences;
+   * MuJoCo's own ``frictionloss`` and ``damping`` (Table 6.1's F_c and F_v), a Coulomb-viscous
+     model fitted (S, v_s and tau_os held at 0, 0.1, 0);
+   * friction (3.5) with the filter study's default sensor noise (1e-4 rad, 19-bit encoder,
+     0.05 N·m) in the loop and its best filter (Savitzky-Golay, L = 151, k = 4).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_log
+from wbfriction.friction.io import write_params
+from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.targets import THESIS_TARGETS
+from wbfriction.logs.log import write_log
+from wbfriction.model.robot import Robot
+from wbfriction.report.figures import friction_curves_figure, velocity_panels_figure
+from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.sim import MujocoOptions, SensorNoise, simulate_mujoco
+from wbfriction.sim.mujoco_model import build_mujoco_robot
+from wbfriction.studies.common import (
+    ENCODER_BITS,
+    TORQUE_STD,
+    LegRow,
+    fit_legs,
+    leg_joints,
+    leg_params_extra,
+    leg_rows,
+    worst_errors,
+)
+from wbfriction.walking import GaitOptions, walking_reference
+
+NOISE = SensorNoise(position_std=1e-4, encoder_bits=ENCODER_BITS, torque_std=TORQUE_STD, seed=0)
+"""The filter study's default noise level (its 1e-4 rad row)."""
+BEST_FILTER = EstimateOptions(diff="savgol", filtering=FilterOptions(window=151, poly_order=4))
+"""The filter study's best scheme at that level."""
+COULOMB_VISCOUS = {"S": 0.0, "v_s": 0.1, "tau_os": 0.0}
+"""Parameters held in the fit of MuJoCo's own friction, which has no Stribeck term or offset."""
+
+
+@dataclass
+class Case:
+    """One identification of the leg joints on the combined walk."""
+
+    name: str
+    label: str
+    rows: list[LegRow]
+    scored: tuple[str, ...]  # the parameters the case's targets are about
+
+
+@dataclass
+class RealisticResult:
+    """What :func:`run_realistic_study` measured; files written are listed in ``files``."""
+
+    cases: list[Case]
+    knee_rms: dict[str, float]  # RMS error of the right knee [N·m]: whole single-support time, swing only
+    files: list[Path] = field(default_factory=list)
+
+
+def _swing(est: FrictionEstimate, robot: Robot, joint: str) -> np.ndarray:
+    """Valid samples of ``joint`` while its leg swings."""
+    return est.valid[:, est.joints.index(joint)] & ~est.contact[:, robot.contact_of(joint)]
+
+
+def run_realistic_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int = 5,
+                        options: MujocoOptions = MujocoOptions(), progress=None) -> RealisticResult:
+    """Run the study (module docstring) and write its parameters and figures to ``output_dir``.
+
+    Args:
+        robot: a biped with thesis joint groups.
+        steps: steps per direction of the combined walk.
+        knee_steps: steps of the forward walk of Fig. 6.4 and 6.5.
+        options: the simulator's options (friction mode and sensors are set per case).
+        progress: optional callable(label) called as each stage starts.
+
+    Raises:
+        SimulationError: the robot fell in one of the walks.
+    """
+    say = progress or (lambda label: None)
+    output_dir.mkdir(parents=True, exist_ok=True)
+    files: list[Path] = []
+    legs = leg_joints(robot)
+    knee = next(j for j, side, g in legs if side == "right" and g == "knee")
+    table_6_1 = {j: THESIS_TARGETS[g] for j, _, g in legs}
+    mjr = build_mujoco_robot(robot)
+
+    def simulate(gait: GaitOptions, friction: dict[str, FrictionParams], opts: MujocoOptions):
+        return simulate_mujoco(robot, walking_reference(robot, gait), friction, opts, mjr=mjr)
+
+    # 1-2. right knee only, then every leg joint: Fig. 6.4, 6.5
+    forward = GaitOptions(gait="forward", steps=knee_steps)
+    whole = EstimateOptions(mask="single")
+    say("MuJoCo: a forward walk, friction on the right knee")
+    knee_only = estimate_log(robot, simulate(forward, {knee: table_6_1[knee]}, options).log, whole)
+    say("MuJoCo: the same walk, friction on every leg joint")
+    all_legs = estimate_log(robot, simulate(forward, table_6_1, options).log, whole)
+    i = knee_only.joints.index(knee)
+    standing, swinging = knee_only.valid[:, i], _swing(knee_only, robot, knee)
+    err = knee_only.tau_f[:, i] - knee_only.tau_f_true[:, i]
+    knee_rms = {"whole step": float(np.sqrt(np.mean(err[standing] ** 2))),
+                "swing only": float(np.sqrt(np.mean(err[swinging] ** 2)))}
+    velocity_panels_figure([("whole step (single support)", knee_only, standing), ("swing phase only", knee_only, swinging)],
+                           knee, table_6_1[knee], output_dir / "fig6_4_knee_swing_stance.png",
+                           "Fig. 6.4 (MuJoCo): right knee friction, central differences")
+    velocity_panels_figure([("friction on the right knee only", knee_only, swinging),
+                            ("friction on every leg joint", all_legs, _swing(all_legs, robot, knee))],
+                           knee, table_6_1[knee], output_dir / "fig6_5_knee_interference.png",
+                           "Fig. 6.5 (MuJoCo): right knee friction in swing, alone and with every leg joint's")
+    files += [output_dir / "fig6_4_knee_swing_stance.png", output_dir / "fig6_5_knee_interference.png"]
+
+    # 3. identification on the combined walk
+    combined = GaitOptions(gait="combined", steps=steps)
+    native = {j: dataclasses.replace(p, S=0.0, tau_os=0.0) for j, p in table_6_1.items()}
+    cases = [
+        ("model", "friction (3.5), noise off, central differences", table_6_1, options,
+         EstimateOptions(), None, ("F_c", "F_v", "tau_os")),
+        ("mujoco", "MuJoCo frictionloss + damping, noise off, central differences, Coulomb-viscous fit", native,
+         dataclasses.replace(options, friction="mujoco"), EstimateOptions(), COULOMB_VISCOUS, ("F_c", "F_v")),
+        ("noisy", "friction (3.5), sensor noise 1e-4 rad / 19 bit / 0.05 N·m, Savitzky-Golay L=151 k=4", table_6_1,
+         dataclasses.replace(options, sensors=NOISE), BEST_FILTER, None, ("F_c", "F_v", "tau_os")),
+    ]
+    results = []
+    for name, label, friction, opts, est_opts, fixed, scored in cases:
+        say(f"MuJoCo: the combined walk ({steps} steps per direction), {label}")
+        sim = simulate(combined, friction, opts)
+        est = estimate_log(robot, sim.log, est_opts)
+        fits = fit_legs(est, legs, friction, fixed)
+        rows = leg_rows(legs, fits)
+        results.append(Case(name, label, rows, scored))
+        log_path, params_path = output_dir / f"mujoco_{name}_log.parquet", output_dir / f"mujoco_{name}_params.json"
+        write_log(sim.log, robot, log_path)
+        write_params(params_path, fits, {"robot": robot.name, "case": label, "gait": dataclasses.asdict(combined)},
+                     leg_params_extra(rows, thesis_errors=False))
+        files += [log_path, params_path]
+        if name == "model":
+            friction_curves_figure(est, fits, output_dir / "mujoco_friction_curves.png")
+            files.append(output_dir / "mujoco_friction_curves.png")
+    return RealisticResult(results, knee_rms, files)
+
+
+def worst_scored(case: Case) -> dict[str, float]:
+    """Largest error [%] over the leg joints of each parameter the case is scored on."""
+    return worst_errors(case.rows, case.scored)

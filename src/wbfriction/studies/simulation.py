@@ -1,0 +1,124 @@
+"""The thesis's simulation study (ch. 6) on a built-in robot: ``wbfriction demo``.
+
+1. **Support phases and derivative schemes** (6.1.1, 6.1.2; Fig. 6.1-6.3): a forward walk
+   with friction on the right knee only. The estimate with the true accelerations
+   recovers it exactly in single support and is not unique in double support (Fig. 6.1);
+   central differences, and backward differences with and without delay compensation,
+   show the sensitivity to phase delays, largest while the leg is in stance (Fig. 6.2, 6.3).
+2. **Identification** (6.2.2; Tables 6.1, 6.2): the combined walk (forward, sideways and
+   turning) with the targets of Table 6.1 on every leg joint; central differences; the
+   fit of (3.5) per leg joint on its swing-phase samples; the HTML report of that estimate
+   (:mod:`wbfriction.report.html`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from wbfriction.friction.energy import energy_consistency
+from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.fit import fitted_offsets
+from wbfriction.friction.io import friction_table, write_params
+from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.targets import THESIS_TARGETS
+from wbfriction.logs.log import write_log
+from wbfriction.logs.tables import write_table
+from wbfriction.model.robot import Robot
+from wbfriction.report.build import make_report
+from wbfriction.report.figures import derivative_schemes_figure, friction_curves_figure, support_phases_figure
+from wbfriction.report.html import write_report
+from wbfriction.sim import SimulationResult, simulate_ideal
+from wbfriction.studies.common import SIMULATOR, LegRow, fit_legs, leg_joints, leg_params_extra, leg_rows
+from wbfriction.walking import GaitOptions, walking_reference
+
+DERIVATIVE_SCHEMES = {
+    "true acceleration": EstimateOptions(diff="true", mask="single"),
+    "central (6.2)": EstimateOptions(diff="central", mask="single"),
+    "backward, delay compensated": EstimateOptions(diff="backward", compensate_delay=True, mask="single"),
+    "backward, not compensated": EstimateOptions(diff="backward", compensate_delay=False, mask="single"),
+}
+
+@dataclass
+class StudyResult:
+    """What :func:`run_study` measured; files written are listed in ``files``."""
+
+    rows: list[LegRow]
+    truth_max_error: float  # max |tau_f - tau_f_true| in single support with true accelerations [N·m]
+    knee_rms: dict[str, float]  # RMS error of the right knee per scheme, leg in swing / stance [N·m]
+    pulls: int  # samples where a welded foot pulled on the ground, both walks
+    files: list[Path] = field(default_factory=list)
+    generating_share: dict[str, float] = field(default_factory=dict)  # per leg joint, swing phase (eq. 7.9)
+
+
+def _simulate(robot: Robot, gait: GaitOptions, friction: dict[str, FrictionParams], progress=None) -> SimulationResult:
+    ref = walking_reference(robot, gait)
+    return simulate_ideal(robot, ref, friction, SIMULATOR, progress=progress)
+
+
+def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int = 5,
+              progress=None) -> StudyResult:
+    """Run the study and write its logs, estimates, parameters and figures to ``output_dir``.
+
+    Args:
+        robot: a biped with thesis joint groups (``hip_roll`` ... ``ankle_pitch``).
+        steps: steps per direction of the combined walk.
+        knee_steps: steps of the right-knee walk (Fig. 6.1-6.3).
+        progress: optional callable(label) called as each stage starts.
+    """
+    say = progress or (lambda label: None)
+    output_dir.mkdir(parents=True, exist_ok=True)
+    files: list[Path] = []
+    legs = leg_joints(robot)
+    knee = next(j for j, side, g in legs if side == "right" and g == "knee")
+
+    # 1. right knee only: Fig. 6.1-6.3
+    say("simulating a forward walk, friction on the right knee")
+    knee_sim = _simulate(robot, GaitOptions(gait="forward", steps=knee_steps), {knee: THESIS_TARGETS["knee"]})
+    write_log(knee_sim.log, robot, output_dir / "knee_log.parquet")
+    say("estimating with four differentiation schemes")
+    schemes = {label: estimate_log(robot, knee_sim.log, opts) for label, opts in DERIVATIVE_SCHEMES.items()}
+    truth = schemes["true acceleration"]
+    truth_err = float(np.nanmax(np.abs(truth.tau_f - truth.tau_f_true)[truth.unique]))
+    i_knee = truth.joints.index(knee)
+    foot = robot.contact_of(knee)
+    # valid single-support samples (skip windows applied), same for every scheme
+    swing_k = truth.valid[:, i_knee] & ~truth.contact[:, foot]
+    stance_k = truth.valid[:, i_knee] & truth.contact[:, foot]
+    knee_rms = {}
+    for label, est in schemes.items():
+        e = est.tau_f[:, i_knee] - est.tau_f_true[:, i_knee]
+        knee_rms[label] = (float(np.sqrt(np.nanmean(e[swing_k] ** 2))), float(np.sqrt(np.nanmean(e[stance_k] ** 2))))
+    support_phases_figure(truth, [j for j, side, _ in legs if side == "right"], output_dir / "fig6_1_support_phases.png")
+    derivative_schemes_figure(schemes, knee, foot, output_dir / "fig6_2_schemes_time.png",
+                              output_dir / "fig6_3_schemes_velocity.png")
+    files += [output_dir / n for n in ("knee_log.parquet", "fig6_1_support_phases.png",
+                                       "fig6_2_schemes_time.png", "fig6_3_schemes_velocity.png")]
+
+    # 2. combined walk, Table 6.1 friction on all leg joints: identification
+    say(f"simulating the combined walk ({steps} steps forward, sideways, turning)")
+    friction = {j: THESIS_TARGETS[g] for j, _, g in legs}
+    walk = _simulate(robot, GaitOptions(gait="combined", steps=steps), friction)
+    write_log(walk.log, robot, output_dir / "walk_log.parquet")
+    say("estimating (central differences)")
+    est = estimate_log(robot, walk.log, EstimateOptions(), companion=True)
+    write_table(friction_table(est), output_dir / "walk_friction.parquet")
+    say("fitting the friction model of every leg joint")
+    fits = fit_legs(est, legs, friction)
+    rows = leg_rows(legs, fits)
+    write_params(output_dir / "walk_params.json", fits,
+                 {"robot": robot.name, "gait": asdict(GaitOptions(gait="combined", steps=steps))},
+                 leg_params_extra(rows))
+    friction_curves_figure(est, fits, output_dir / "friction_curves.png")
+    say("writing the report")
+    write_report(make_report(output_dir / "walk_friction.parquet", output_dir / "walk_params.json"),
+                 output_dir / "report.html")
+    files += [output_dir / n for n in ("walk_log.parquet", "walk_friction.parquet", "walk_params.json",
+                                       "friction_curves.png", "report.html")]
+    pulls = sum(p.samples for p in knee_sim.pulls() + walk.pulls())
+    energy = energy_consistency(est, fitted_offsets(fits))
+    legs_only = {j for j, _, _ in legs}
+    share = {e.joint: e.generating_share for e in energy if e.joint in legs_only}
+    return StudyResult(rows, truth_err, knee_rms, pulls, files, share)

@@ -1,0 +1,60 @@
+"""Logs with time gaps are estimated segment by segment, never differentiated across a gap."""
+
+from __future__ import annotations
+
+import numpy as np
+import pyarrow as pa
+import pytest
+
+from wbfriction.exceptions import InputError
+from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.logs.log import log_from_table
+
+
+def _drop(talos, log, start: int, stop: int, n: int):
+    """The first ``n`` rows of ``log`` without rows [start, stop): a gap in the time column."""
+    table = log.to_table(talos).slice(0, n)
+    keep = np.r_[np.arange(start), np.arange(stop, n)]
+    return log_from_table(table.take(pa.array(keep)), talos, "gapped")
+
+
+@pytest.mark.parametrize("diff", ["central", "savgol"])
+def test_gapped_log_is_its_segments_estimated_apart(talos, combined_walk, diff):
+    n, a, b = 6000, 3000, 3040  # 40 ms of dropped samples
+    log = _drop(talos, combined_walk.log, a, b, n)
+    assert log.segments == [(0, a), (a, n - (b - a))]
+    opts = EstimateOptions(diff=diff)
+    whole = estimate_log(talos, log, opts)
+    first, second = (estimate_log(talos, part, opts) for part in log.parts())
+    for name in ("tau_f", "qd", "delta_qdd"):
+        got, parts = getattr(whole, name), np.concatenate([getattr(first, name), getattr(second, name)])
+        np.testing.assert_array_equal(got, parts)
+    np.testing.assert_array_equal(whole.valid, np.concatenate([first.valid, second.valid]))
+    # nothing differentiated across the gap: the rows at its edges have no derivative
+    assert np.isnan(whole.qd[a - 1]).all() and np.isnan(whole.qd[a]).all()
+    # and the estimate away from the gap is that of the log without a gap
+    ref = estimate_log(talos, log_from_table(combined_walk.log.to_table(talos).slice(0, n), talos, "x"), opts)
+    # (to rounding: the sampling period is the median step of each segment's own stamps)
+    np.testing.assert_allclose(whole.tau_f[:a - 200], ref.tau_f[:a - 200], atol=1e-9, rtol=1e-9)
+    np.testing.assert_allclose(whole.tau_f[-500:], ref.tau_f[-500:], atol=1e-9, rtol=1e-9)
+
+
+def test_a_segment_that_cannot_be_estimated_is_left_blank(talos, combined_walk):
+    """A 30-sample segment is too short for a 151-sample Savitzky-Golay window: its rows are NaN
+    and invalid, the rest is estimated. Through central differences the same segment (double
+    support) is estimated, not unique, never valid. A log of double support only is refused."""
+    log = combined_walk.log
+    ds = int(np.flatnonzero(log.contact.all(axis=1))[0])  # double support at the start
+    table = log.to_table(talos)
+    rows = np.r_[np.arange(ds, ds + 30), np.arange(3000, 6000)]
+    gapped = log_from_table(table.take(pa.array(rows)), talos, "gapped")
+    assert gapped.segments == [(0, 30), (30, 3030)]
+    est = estimate_log(talos, gapped, EstimateOptions(diff="savgol"))
+    assert np.isnan(est.tau_f[:30]).all() and not est.valid[:30].any()
+    assert est.valid[30:].any()
+    central = estimate_log(talos, gapped, EstimateOptions())
+    assert np.isfinite(central.tau_f[1:29]).all() and not central.unique[:30].any() and not central.valid[:30].any()
+    only = log_from_table(table.take(pa.array(np.r_[np.arange(ds, ds + 30), np.arange(ds + 100, ds + 130)])),
+                          talos, "gapped")
+    with pytest.raises(InputError, match="gapped: no single-support sample"):
+        estimate_log(talos, only, EstimateOptions())

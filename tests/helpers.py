@@ -1,0 +1,114 @@
+"""Helpers shared by several test modules: running the command line, writing ROS 2 bags."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+from wbfriction import cli
+from wbfriction.logs.bags import BagMap, ContactTopic
+
+T0 = 1_700_000_000_000_000_000  # an absolute stamp [ns], as robots write them
+
+
+def run(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "wbfriction", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, env=dict(os.environ, COLUMNS="200"))
+
+
+def assert_one_line_error(res, needle):
+    assert res.returncode == 2
+    lines = [ln for ln in res.stderr.strip().splitlines() if ln.strip()]
+    assert len(lines) == 1 and needle in lines[0], res.stderr
+
+
+def run_cli(capsys, *args) -> tuple[int, str]:
+    """``wbfriction ARGS`` in this process: (exit status, standard error)."""
+    argv = sys.argv
+    sys.argv = ["wbfriction", *map(str, args)]
+    try:
+        cli.main()
+        code = 0
+    except SystemExit as exc:
+        code = exc.code
+    finally:
+        sys.argv = argv
+    return code, capsys.readouterr().err
+
+
+def ros_time(ts, ns: int):
+    return ts.types["builtin_interfaces/msg/Time"](sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+
+
+def write_bag(path, log, robot, storage: str = "mcap", wrench_every: int = 2, odom_every: int = 5,
+              shuffle: bool = True, rename: dict | None = None, delay_ns: dict | None = None, stamp=None):
+    """The log as a bag: JointState at every sample (names in a different order in every
+    message), the left sole's contact as a 400 N WrenchStamped every ``wrench_every`` samples,
+    the right one as a Bool, the base as Odometry every ``odom_every`` samples.
+
+    ``delay_ns``: topic -> how much later than its stamp a message is received [ns] (the
+    bag's order is the receive time). ``stamp(topic, k, ns)``: the header stamp written
+    for sample ``k`` (default ``ns``)."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    T = ts.types
+    rng = np.random.default_rng(0)
+    rename = rename or {}
+    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+    names = list(robot.actuated)
+    delay_ns = delay_ns or {}
+    stamp = stamp or (lambda topic, k, ns: ns)
+    messages = []  # (receive time, connection, bytes), written in receive order
+    with Writer(path, version=9, storage_plugin=plugin) as w:
+        c_js = w.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=ts)
+        c_lf = w.add_connection("/left_ft", "geometry_msgs/msg/WrenchStamped", typestore=ts)
+        c_rf = w.add_connection("/right_contact", "std_msgs/msg/Bool", typestore=ts)
+        c_od = w.add_connection("/odom", "nav_msgs/msg/Odometry", typestore=ts)
+        tau_all = np.zeros((len(log), len(names)))
+        tau_all[:, robot.tc_index] = log.tau
+        for k in range(len(log)):
+            ns = T0 + int(round(log.time[k] * 1e9))
+            header = lambda topic: T["std_msgs/msg/Header"](stamp=ros_time(ts, stamp(topic, k, ns)), frame_id="")  # noqa: E731, B023
+            write = lambda c, data: messages.append((ns + delay_ns.get(c.topic, 0), len(messages), c, data))  # noqa: E731, B023
+            order = rng.permutation(len(names)) if shuffle else np.arange(len(names))
+            js = T["sensor_msgs/msg/JointState"](
+                header=header("/joint_states"), name=[rename.get(names[i], names[i]) for i in order],
+                position=log.q[k, order].astype(np.float64), velocity=np.zeros(0),
+                effort=tau_all[k, order].astype(np.float64))
+            write(c_js, ts.serialize_cdr(js, "sensor_msgs/msg/JointState"))
+            if k % wrench_every == 0:
+                f = 400.0 if log.contact[k, 0] else 3.0
+                wr = T["geometry_msgs/msg/WrenchStamped"](header=header("/left_ft"), wrench=T["geometry_msgs/msg/Wrench"](
+                    force=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=-f),
+                    torque=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)))
+                write(c_lf, ts.serialize_cdr(wr, "geometry_msgs/msg/WrenchStamped"))
+            if k == 0 or log.contact[k, 1] != log.contact[k - 1, 1]:  # a state topic: on change only
+                write(c_rf, ts.serialize_cdr(T["std_msgs/msg/Bool"](data=bool(log.contact[k, 1])), "std_msgs/msg/Bool"))
+            if k % odom_every == 0:
+                b = log.base[k]
+                pose = T["geometry_msgs/msg/Pose"](
+                    position=T["geometry_msgs/msg/Point"](x=b[0], y=b[1], z=b[2]),
+                    orientation=T["geometry_msgs/msg/Quaternion"](x=b[3], y=b[4], z=b[5], w=b[6]))
+                odom = T["nav_msgs/msg/Odometry"](
+                    header=header("/odom"), child_frame_id="base_link",
+                    pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=np.zeros(36)),
+                    twist=T["geometry_msgs/msg/TwistWithCovariance"](
+                        twist=T["geometry_msgs/msg/Twist"](linear=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0),
+                                                           angular=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)),
+                        covariance=np.zeros(36)))
+                write(c_od, ts.serialize_cdr(odom, "nav_msgs/msg/Odometry"))
+        for received, _, c, data in sorted(messages, key=lambda m: m[:2]):
+            w.write(c, received, data)
+
+
+def bag_map(robot, **kw) -> BagMap:
+    left, right = robot.contact_frames
+    return BagMap("/joint_states", (ContactTopic(left, "/left_ft", 50.0), ContactTopic(right, "/right_contact")),
+                  base="/odom", **kw)
+
+

@@ -1,0 +1,177 @@
+"""Inertia-model identification (thesis 2.4, ch. 8): the regressor against inverse dynamics,
+the compressed least squares, base parameters, the log-Cholesky parametrisation, and the
+model and friction recovered from a simulated walk given a wrong model."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from wbfriction.friction.estimate import EstimateOptions
+from wbfriction.friction.targets import THESIS_TARGETS
+from wbfriction.inertia.consistency import (
+    fit_consistent,
+    is_consistent,
+    log_cholesky,
+    nearest_consistent,
+    regularised_problem,
+)
+from wbfriction.inertia.identification import InertialOptions, identify_inertia
+from wbfriction.inertia.least_squares import CompressedLeastSquares, base_parameters
+from wbfriction.inertia.regressor import act_matrix, body_parameters, stance_regressor
+from wbfriction.inertia.sensitivity import scaled_robot
+from wbfriction.model.stance import stance_model
+from wbfriction.studies.common import leg_joints
+
+
+@pytest.mark.parametrize("contact", [0, 1])
+def test_regressor_times_parameters_is_the_stance_inverse_dynamics(talos, contact):
+    """Two routes: Y(q, qd, qdd) @ to_rooted @ pi (+ armature) equals the stance-rooted RNEA."""
+    rng = np.random.default_rng(contact)
+    n = 30
+    lo, hi = talos.angle_limits
+    angles = rng.uniform(lo, hi, (n, talos.n_act))
+    qd, qdd = rng.normal(0, 1, (n, talos.n_act)), rng.normal(0, 5, (n, talos.n_act))
+    pose = np.zeros((n, 7))
+    pose[:, :3] = rng.normal(size=(n, 3))
+    pose[:, 3:] = rng.normal(size=(n, 4))
+    pose[:, 3:] /= np.linalg.norm(pose[:, 3:], axis=1, keepdims=True)
+    reg = stance_regressor(talos, contact)
+    Y = reg.joint_rows(pose, angles, qd, qdd)
+    tau, _ = stance_model(talos, contact).inverse_dynamics(pose, angles, qd, qdd)
+    pred = Y @ (reg.to_rooted @ body_parameters(talos.model).ravel()) + talos.model.armature[talos.act_v_index] * qdd
+    assert np.abs(pred - tau).max() < 1e-9 * np.abs(tau).max()
+
+
+def _physical_inertia(draw_values) -> pin.Inertia:
+    m, a, b, c, x, y, z, rx, ry, rz = draw_values
+    box = pin.Inertia.FromBox(m, a, b, c)  # a solid box: physically consistent
+    placement = pin.SE3(pin.rpy.rpyToMatrix(rx, ry, rz), np.array([x, y, z]))
+    return placement.act(box)
+
+
+inertias = st.tuples(st.floats(0.05, 50), st.floats(0.01, 1), st.floats(0.01, 1), st.floats(0.01, 1),
+                     *[st.floats(-1, 1)] * 3, *[st.floats(-3, 3)] * 3).map(_physical_inertia)
+
+
+@settings(max_examples=60, deadline=None)
+@given(inertia=inertias)
+def test_log_cholesky_round_trip_and_consistency(inertia):
+    pi = inertia.toDynamicParameters()
+    theta = log_cholesky(pi)
+    back = pin.LogCholeskyParameters(theta).toDynamicParameters()
+    assert np.allclose(back, pi, rtol=1e-9, atol=1e-9 * max(1.0, np.abs(pi).max()))
+    assert is_consistent(pi[None])[0]
+    # a body whose principal moments break the triangle inequality is not physical
+    bad = pin.Inertia(inertia.mass, inertia.lever, np.diag([1.0, 1.0, 3.0]) * inertia.mass).toDynamicParameters()
+    assert not is_consistent(bad[None])[0]
+    # the nearest consistent body: a physical one unchanged, the other brought inside
+    assert np.allclose(nearest_consistent(pi[None])[0], pi, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(pi).max()))
+    assert is_consistent(nearest_consistent(bad[None]))[0]
+
+
+@settings(max_examples=40, deadline=None)
+@given(inertia=inertias, move=inertias)
+def test_act_matrix_is_the_rigid_transform_of_the_parameters(inertia, move):
+    placement = pin.SE3(pin.rpy.rpyToMatrix(*move.lever), move.lever[::-1].copy())
+    A = act_matrix(placement)
+    assert np.allclose(A @ inertia.toDynamicParameters(), placement.act(inertia).toDynamicParameters(),
+                       rtol=1e-9, atol=1e-9 * max(1.0, inertia.mass))
+
+
+def test_compressed_least_squares_and_base_parameters():
+    """Rows added in blocks give the least-squares solution of all rows; a column that is a
+    combination of others is found dependent and absorbed into their base parameters."""
+    rng = np.random.default_rng(0)
+    A = rng.normal(size=(900, 6))
+    A[:, 4] = A[:, 0] + 2.0 * A[:, 1]  # parameter 4 only ever acts with 0 and 1
+    A[:, 5] = 0.0  # parameter 5 never acts
+    x = rng.normal(size=6)
+    b = A @ x + rng.normal(0, 1e-3, 900)
+    ls = CompressedLeastSquares(6)
+    for k in range(0, 900, 128):
+        ls.add(A[k:k + 128], b[k:k + 128])
+    ref = np.linalg.lstsq(A, b, rcond=None)[0]
+    sol = np.linalg.lstsq(ls.R, ls.z, rcond=None)[0]
+    assert np.allclose(A @ sol, A @ ref, atol=1e-9)
+    base = base_parameters(ls.R)
+    assert base.count == 4 and list(base.independent) == [0, 1, 2, 3]
+    expected = np.array([x[0] + x[4], x[1] + 2.0 * x[4], x[2], x[3]])
+    assert np.allclose(base.combination @ x, expected, atol=1e-9)
+    assert np.allclose(base.combination @ ref, expected, atol=1e-2)
+
+
+def _slow_joint(body: pin.Inertia, seed: int, triangle: bool):
+    """Rows of one body and one joint that never leaves the linear part of tanh (its viscous
+    and Coulomb columns nearly collinear), with a true friction; with ``triangle`` the data
+    ask for a rotational inertia beyond the triangle inequality."""
+    rng = np.random.default_rng(seed)
+    pi_true = body.toDynamicParameters()
+    friction_true = np.array([[0.3, 0.2, -0.1]])  # F_v, F_c, tau_os
+    n = 400
+    qd = rng.uniform(-4e-3, 4e-3, n)
+    F = np.column_stack([qd, np.tanh(40.0 * qd), np.ones(n)])
+    Y = rng.normal(size=(n, 10)) * np.concatenate([[1.0], [0.1] * 3, [0.01] * 6])
+    b = Y @ pi_true + F @ friction_true[0] + rng.normal(0, 1e-3, n)
+    if triangle:
+        bad = pin.Inertia(body.mass, body.lever, np.diag([1.0, 1.0, 3.0]) * body.mass).toDynamicParameters()
+        b = b + Y @ (bad - pi_true)
+    ls = CompressedLeastSquares(13)
+    ls.add(np.column_stack([Y, F]), b)
+    return ls, pi_true[None], friction_true
+
+
+@settings(max_examples=25, deadline=None)
+@given(body=inertias, seed=st.integers(0, 2**32 - 1), triangle=st.booleans())
+def test_consistent_fit_keeps_friction_physical_and_beats_the_truth(body, seed, triangle):
+    """The fit keeps F_v, F_c >= 0 and the body physical (through the non-linear,
+    log-Cholesky route with ``triangle``), and its objective is no worse than the truth's,
+    a feasible point."""
+    ls, pi_true, friction_true = _slow_joint(body, seed, triangle)
+    pi0, friction0 = pi_true * 1.05, np.zeros((1, 3))
+    fit = fit_consistent(ls.R, ls.z, pi0, friction0, prior=1e-9)
+    assert fit.friction[0, 0] >= 0 and fit.friction[0, 1] >= 0
+    assert is_consistent(fit.pi).all()
+    lower = np.concatenate([np.full(10, -np.inf), [0.0, 0.0, -np.inf]])
+    _, A, c = regularised_problem(ls.R, ls.z, pi0, friction0, 1e-9, 1e-3, lower)
+
+    def objective(pi, friction):
+        return float(np.sum((A @ np.concatenate([pi.ravel(), friction.ravel()]) - c) ** 2))
+
+    assert objective(fit.pi, fit.friction) <= objective(pi_true, friction_true) * (1 + 1e-6)
+    assert fit.cost == pytest.approx(0.5 * objective(fit.pi, fit.friction), rel=1e-4)
+
+
+def test_unbounded_friction_of_a_slow_joint_cancels():
+    """The premise of the test above: without the bounds, F_v and F_c take opposite signs."""
+    ls, *_ = _slow_joint(pin.Inertia.FromBox(2.0, 0.2, 0.1, 0.3), 0, False)
+    unbounded = np.linalg.lstsq(ls.R, ls.z, rcond=None)[0]
+    assert min(unbounded[10], unbounded[11]) < 0
+
+
+def test_identification_recovers_model_and_friction_from_a_walk_with_a_wrong_model(talos, combined_walk):
+    """The combined walk (Table 6.1 friction) seen through a model with every body's
+    principal moments x1.1 and mass x1.05: identification gives back the total mass, the
+    base parameters and the friction (the Stribeck velocity given), and predicts held-out
+    torques far better than the given model, every body staying physical."""
+    wrong = scaled_robot(scaled_robot(talos, 1.1, "rotational"), 1.05, "mass")
+    res = identify_inertia(wrong, combined_walk.log, EstimateOptions(), InertialOptions(stribeck_velocity=0.2, prior=1e-9))
+    true = body_parameters(talos.model)
+    assert abs(res.pi[:, 0].sum() - true[:, 0].sum()) < 0.01 * true[:, 0].sum() < abs(res.pi_given[:, 0].sum() - true[:, 0].sum())
+    assert is_consistent(res.pi).all()
+    K = res.base.combination[:, :true.size]
+    rel = lambda pi: np.linalg.norm(K @ (pi.ravel() - true.ravel())) / np.linalg.norm(K @ true.ravel())  # noqa: E731
+    assert rel(res.pi) < 0.2 * rel(res.pi_given)
+    legs = {j: THESIS_TARGETS[g] for j, _, g in leg_joints(talos)}
+    names = list(res.friction_names)
+    for i, joint in enumerate(talos.torque_controlled):
+        if joint in legs:
+            t = legs[joint]
+            f = dict(zip(names, res.friction[i]))
+            assert abs(f["F_c"] - t.F_c) < 0.05 * t.F_c, (joint, f)
+            assert abs(f["tau_os"] - t.tau_os) < 0.05 * max(t.tau_os, 0.2), (joint, f)
+    assert np.all(res.holdout.identified < 0.2 * np.maximum(res.holdout.given, 0.05))
+    assert np.median(res.holdout.identified) < 0.01

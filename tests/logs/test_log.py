@@ -1,0 +1,117 @@
+"""The log format: round trip, and one clear error for each kind of bad input."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+from wbfriction.exceptions import InputError
+from wbfriction.logs.log import Log, log_from_table, write_log
+from wbfriction.logs.source import read_log
+from wbfriction.logs.tables import write_table
+
+
+@pytest.fixture(scope="module")
+def good(talos):
+    n = 50
+    rng = np.random.default_rng(0)
+    contact = np.zeros((n, 2), dtype=bool)
+    contact[:, 0] = True
+    q = np.clip(rng.normal(0, 0.1, (n, talos.n_act)), *talos.angle_limits)
+    return Log(time=np.arange(n) * 1e-3, q=q,
+               tau=rng.normal(0, 1, (n, len(talos.torque_controlled))), contact=contact,
+               metadata={"friction_true": {"leg_right_4_joint": {"F_c": 1.0}}})
+
+
+def test_round_trip_parquet_and_csv(talos, good, tmp_path):
+    for name in ("log.parquet", "log.csv"):
+        write_log(good, talos, tmp_path / name)
+        back = read_log(tmp_path / name, talos)
+        np.testing.assert_array_equal(back.q, good.q)
+        np.testing.assert_array_equal(back.tau, good.tau)
+        np.testing.assert_array_equal(back.contact, good.contact)
+    assert read_log(tmp_path / "log.parquet", talos).metadata == good.metadata
+
+
+def test_columns_are_mapped_by_name_not_order(talos, good):
+    table = good.to_table(talos)
+    shuffled = table.select(list(reversed(table.column_names)))
+    back = log_from_table(shuffled, talos)
+    np.testing.assert_array_equal(back.q, good.q)
+
+
+def _bad(talos, good, edit):
+    cols = {n: good.to_table(talos).column(n).to_numpy().copy() for n in good.to_table(talos).column_names}
+    edit(cols)
+    return pa.table(cols)
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda c: c.pop("q.leg_left_4_joint"), "missing column 'q.leg_left_4_joint'"),
+    (lambda c: c.pop("tau.arm_left_1_joint"), "missing column 'tau.arm_left_1_joint'"),
+    (lambda c: c.pop("contact.right_sole_link"), "missing column 'contact.right_sole_link'"),
+    (lambda c: c.pop("time"), "missing column 'time'"),
+    (lambda c: c.__setitem__("q.leg_middle_1_joint", c["time"]), "unknown joint 'leg_middle_1_joint'"),
+    (lambda c: c.__setitem__("contact.nose", c["time"]), "unknown contact frame 'nose'"),
+    (lambda c: c["time"].__setitem__(10, c["time"][9]), "duplicated stamp at row 10"),
+    (lambda c: c["time"].__setitem__(10, c["time"][9] - 1e-4), "decreasing stamp at row 10"),
+    (lambda c: c["time"].__setitem__(slice(20, None), c["time"][20:] + 0.5e-3), "irregular at row 20"),
+    (lambda c: c["q.leg_left_4_joint"].__setitem__(12, 57.3), "column 'q.leg_left_4_joint' is 57.3 at row 12, "
+                                                              "beyond its URDF limits [0, 2.618]"),
+    (lambda c: c["q.leg_left_4_joint"].__setitem__(7, np.nan), "'q.leg_left_4_joint' has a non-finite value (NaN or inf) at row 7"),
+    (lambda c: c["contact.left_sole_link"].__setitem__(3, 2), "must hold 0 or 1, found 2 at row 3"),
+    (lambda c: c.__setitem__("base.x", c["time"]), "base pose is partial"),
+])
+def test_bad_input_names_the_fault(talos, good, edit, message):
+    with pytest.raises(InputError, match=re.escape(message)):
+        log_from_table(_bad(talos, good, edit), talos, source="x.parquet")
+
+
+@pytest.mark.parametrize("step", [2, 3, 500])
+def test_time_gaps_split_the_log_into_segments(talos, good, step):
+    """A step of two periods or more (a dropped sample, a pause) ends a segment."""
+    table = _bad(talos, good, lambda c: c["time"].__setitem__(slice(20, None), c["time"][20:] + (step - 1) * 1e-3))
+    log = log_from_table(table, talos, source="x.parquet")
+    assert log.segments == [(0, 20), (20, 50)]
+    a, b = log.parts()
+    np.testing.assert_array_equal(b.q, good.q[20:])
+    assert len(a.time) == 20 and b.time[0] == pytest.approx(0.019 + step * 1e-3)
+    # with a larger max_gap, the same step is irregular sampling
+    if step < 5:
+        with pytest.raises(InputError, match="irregular at row 20"):
+            log_from_table(table, talos, source="x.parquet", max_gap=5)
+
+
+def test_unreadable_and_missing_files(talos, tmp_path):
+    with pytest.raises(InputError, match="file not found"):
+        read_log(tmp_path / "none.parquet", talos)
+    (tmp_path / "junk.parquet").write_text("not parquet")
+    with pytest.raises(InputError, match="cannot be read"):
+        read_log(tmp_path / "junk.parquet", talos)
+    (tmp_path / "x.txt").write_text("")
+    with pytest.raises(InputError, match="unknown file type"):
+        read_log(tmp_path / "x.txt", talos)
+
+
+def test_outputs_are_written_whole_or_not_at_all(tmp_path, monkeypatch):
+    target = tmp_path / "out.parquet"
+    target.write_bytes(b"previous")
+    table = pa.table({"a": [1, 2]})
+    original = pq.write_table
+
+    def half_written(tbl, path):
+        original(tbl, path)
+        raise OSError("disk full")
+
+    monkeypatch.setattr(pq, "write_table", half_written)
+    with pytest.raises(OSError):
+        write_table(table, target)
+    monkeypatch.undo()
+    assert target.read_bytes() == b"previous"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.parquet"]
+    write_table(table, target)
+    assert pq.read_table(target).num_rows == 2

@@ -1,0 +1,169 @@
+"""The HTML report: its content from a simulated walk, and how it renders in a real browser
+(headless Chromium, Debian's ``chromium`` and ``chromium-driver``, which ``.ci/run`` installs)."""
+
+from __future__ import annotations
+
+import base64
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from wbfriction.exceptions import InputError
+from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.fit import fit_estimate
+from wbfriction.friction.io import fit_to_dict, friction_table, read_params
+from wbfriction.inertia.sensitivity import inertia_sensitivity
+from wbfriction.logs.tables import write_table
+from wbfriction.report.build import acceleration_spectra, make_report
+from wbfriction.report.html import render_html, write_report
+from wbfriction.signals.kinematics import measure
+
+CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
+
+
+@pytest.fixture(scope="module")
+def tables(talos, combined_walk, tmp_path_factory):
+    """The walk's friction table with the true model, and with every body's rotational inertia x 1.1."""
+    out = tmp_path_factory.mktemp("report")
+    est = estimate_log(talos, combined_walk.log, EstimateOptions(), companion=True)
+    true_model = out / "friction.parquet"
+    write_table(friction_table(est), true_model)
+    kin = measure(combined_walk.log, "central")
+    scaled = inertia_sensitivity(talos, kin, [1.1], "rotational").estimates[1]
+    scaled.metadata = est.metadata
+    rotational = out / "friction_rot11.parquet"
+    write_table(friction_table(scaled), rotational)
+    return out, true_model, rotational
+
+
+@pytest.fixture(scope="module")
+def true_report(tables):
+    return make_report(tables[1])
+
+
+@pytest.fixture(scope="module")
+def report_file(tables, true_report):
+    path = tables[0] / "report.html"
+    write_report(true_report, path)
+    return path
+
+
+def _images(text: str) -> dict[str, bytes]:
+    return {m.group(1): base64.b64decode(m.group(2))
+            for m in re.finditer(r'<img id="([^"]+)"[^>]*src="data:image/png;base64,([^"]+)"', text)}
+
+
+def test_report_is_self_contained_and_complete(talos, report_file):
+    text = report_file.read_text()
+    images = _images(text)
+    for joint in talos.torque_controlled:
+        png = images[f"fig-joint-{joint.replace('_', '-')}"]
+        assert png.startswith(b"\x89PNG")
+    assert "overview" in images
+    # nothing fetched from elsewhere: no external source, stylesheet or script
+    assert not re.search(r'(src|href)="(?!data:|#)', text)
+    assert "<script" not in text
+    assert 'id="energy-ok"' in text and 'id="energy-warning"' not in text
+    assert "sha256" in text and "estimate options" in text
+
+
+def test_report_warns_when_rotational_inertia_is_off(tables, true_report):
+    """With every principal moment of inertia 10 % too large the share of power-generating samples
+    rises (on this walk a hip yaw, the joint with the smallest friction torques in swing, passes
+    5 %), and the report says so."""
+    before, after = true_report, make_report(tables[2])
+    legs = [j for j in before.energy if j.startswith("leg_")]
+    assert max(before.energy[j].generating_share for j in legs) < 0.01
+    assert sum(after.energy[j].generating_share for j in legs) > 3 * sum(before.energy[j].generating_share
+                                                                          for j in legs)
+    flagged = {e.joint for e in after.flagged}
+    assert flagged & {"leg_left_1_joint", "leg_right_1_joint"}  # a hip yaw
+    text = render_html(after)
+    assert 'id="energy-warning"' in text
+    for joint in flagged:
+        assert f"{joint}: " in text
+
+
+def test_same_input_same_bytes(tables, report_file, tmp_path):
+    _, true_model, _ = tables
+    again = tmp_path / "again.html"
+    write_report(make_report(true_model), again)
+    assert again.read_bytes() == report_file.read_bytes()
+
+
+def test_params_file_round_trip_and_errors(tables, tmp_path):
+    """Parameters written by 'wbfriction fit' read back as they were fitted."""
+    import json
+
+    from wbfriction.friction.io import read_friction_table
+    from wbfriction.logs.tables import read_table
+
+    _, true_model, _ = tables
+    fits = fit_estimate(read_friction_table(read_table(true_model)))
+    path = tmp_path / "params.json"
+    path.write_text(json.dumps({"joints": {f.joint: fit_to_dict(f) for f in fits}}))
+    back = read_params(path)
+    for f in fits:
+        if f.params is not None:
+            assert back[f.joint].params == f.params
+            for name, se in f.stderr.items():
+                assert back[f.joint].stderr[name] == pytest.approx(se) or not np.isfinite(se)
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"joints": {"knee": {"params": {"F_x": 1}}}}')
+    with pytest.raises(InputError, match="bad.json: joint 'knee'"):
+        read_params(bad)
+    bad.write_text("[1, 2]")
+    with pytest.raises(InputError, match="no 'joints'"):
+        read_params(bad)
+
+
+def test_spectrum_is_that_of_the_estimated_acceleration(talos, combined_walk, tables):
+    """qdd - delta_qdd is qdd_est of (5.10): the report's spectrum equals the spectrum command's
+    (the constrained dynamics of the log) where both look at the same stretch."""
+    from wbfriction.friction.io import read_friction_table
+    from wbfriction.logs.tables import read_table
+    from wbfriction.signals.spectrum import acceleration_spectrum
+
+    _, true_model, _ = tables
+    est = read_friction_table(read_table(true_model))
+    dyn_spec = acceleration_spectrum(talos, combined_walk.log, ["leg_left_4_joint"])
+    ours = acceleration_spectra(est)["leg_left_4_joint"]
+    # both take the longest stretch with a foot on the ground and defined derivatives
+    assert len(ours[0]) == len(dyn_spec.freq)
+    np.testing.assert_allclose(ours[1], dyn_spec.amplitude[:, 0], rtol=1e-6, atol=1e-9)
+
+
+@pytest.mark.skipif(not (Path(CHROMIUM).exists() and Path(CHROMEDRIVER).exists()) and shutil.which("chromium") is None,
+                    reason="Debian's chromium and chromium-driver are not installed (.ci/run installs them)")
+def test_report_renders_in_headless_chromium(talos, report_file, tmp_path):
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    options = webdriver.ChromeOptions()
+    options.binary_location = CHROMIUM
+    for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                 "--disable-dev-shm-usage", f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1500,1200"):
+        options.add_argument(flag)
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    driver = webdriver.Chrome(service=Service(executable_path=CHROMEDRIVER), options=options)
+    try:
+        driver.get(report_file.as_uri())
+        assert driver.execute_script("return document.readyState") == "complete"
+        assert "wbfriction report" in driver.title
+        severe = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+        assert not severe, severe
+        for joint in talos.torque_controlled:
+            img = driver.find_element("id", f"fig-joint-{joint.replace('_', '-')}")
+            loaded = driver.execute_script("return arguments[0].complete && arguments[0].naturalWidth", img)
+            assert loaded and loaded > 500, joint
+            driver.execute_script("arguments[0].scrollIntoView()", img)
+            assert img.is_displayed() and img.size["height"] > 100, joint
+        overview = driver.find_element("id", "overview")
+        assert driver.execute_script("return arguments[0].naturalWidth", overview) > 500
+        driver.save_screenshot(str(tmp_path / "report.png"))
+    finally:
+        driver.quit()

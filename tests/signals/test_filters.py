@@ -1,0 +1,197 @@
+"""Zero-phase filters (thesis 7.1): exact on polynomials, zero delay, noise as designed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.signal import freqz, savgol_coeffs, sosfreqz
+
+from wbfriction.exceptions import InputError
+from wbfriction.logs.log import Log
+from wbfriction.signals.filters import (
+    SavgolSmoother,
+    ZeroPhaseLowpass,
+    amplitude_spectrum,
+    savgol_differentiate,
+    savgol_kernels,
+    savgol_weights,
+    suggest_cutoff,
+)
+from wbfriction.signals.kinematics import FilterOptions, central_differences, measure, straddling
+
+DT = 1e-3
+
+
+def _phase_and_gain(y: np.ndarray, t: np.ndarray, f: float) -> tuple[float, float]:
+    """Phase [rad] and amplitude of ``y`` against sin(2 pi f t), by least squares."""
+    A = np.column_stack([np.sin(2 * np.pi * f * t), np.cos(2 * np.pi * f * t)])
+    (a, b), *_ = np.linalg.lstsq(A, y, rcond=None)
+    return float(np.arctan2(b, a)), float(np.hypot(a, b))
+
+
+@given(half=st.integers(2, 40), order=st.integers(2, 6), weights=st.sampled_from(["uniform", "gaussian"]),
+       coefs=st.lists(st.floats(-2, 2), min_size=7, max_size=7))
+@settings(max_examples=40, deadline=None)
+def test_savgol_is_exact_on_polynomials_of_its_order(half, order, weights, coefs):
+    window = 2 * half + 1
+    if order >= window:
+        return
+    t = np.arange(300) * DT - 0.15
+    c = np.array(coefs[:order + 1])
+    p = np.polynomial.Polynomial(c)
+    x_s, xd, xdd = savgol_differentiate(p(t), DT, window, order, weights)
+    inner = slice(half, len(t) - half)
+    scale = 1 + np.abs(c).sum() * 1e3  # derivatives of t^k grow with 1/dt
+    assert np.allclose(x_s[inner], p(t)[inner], atol=1e-9 * scale)
+    assert np.allclose(xd[inner], p.deriv(1)(t)[inner], atol=1e-7 * scale)
+    assert np.allclose(xdd[inner], p.deriv(2)(t)[inner], atol=1e-4 * scale)
+    # edges: no full window, no value (never extrapolated)
+    assert np.all(np.isnan(x_s[:half])) and np.all(np.isnan(xdd[-half:]))
+
+
+@pytest.mark.parametrize("window,order", [(5, 2), (21, 4), (151, 4), (31, 6)])
+def test_weighted_route_equals_scipy_for_uniform_weights(window, order):
+    """(7.5)-(7.6) written out, with W = I, against scipy.signal.savgol_coeffs."""
+    ones = np.ones(window)  # an explicit array takes the weighted route
+    for d in range(3):
+        ours = savgol_kernels(window, order, DT, ones)[d]
+        ref = savgol_coeffs(window, order, deriv=d, delta=DT, use="dot")
+        assert np.allclose(ours, ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
+
+
+def test_savgol_weights_must_keep_zero_phase():
+    with pytest.raises(InputError, match="symmetric"):
+        savgol_weights(5, np.array([1, 2, 3, 4, 5.0]))
+    with pytest.raises(InputError, match="odd"):
+        savgol_kernels(10, 2, DT)
+    with pytest.raises(InputError, match="order"):
+        savgol_kernels(5, 1, DT)
+
+
+def test_butterworth_differentiates_cubics_exactly_away_from_the_edges():
+    """Central differences are exact for the velocity of a quadratic and the acceleration of
+    a cubic (linear); a zero-phase low-pass with unit gain at 0 Hz keeps a line unchanged."""
+    t = np.arange(4000) * DT
+    q = 0.3 + 0.5 * t - 0.7 * t**2 + 0.4 * t**3
+    lowpass = ZeroPhaseLowpass(10.0, 6, DT)
+    qd_c, qdd_c, _ = central_differences(q, DT)
+    qdd, qd = lowpass(qdd_c), lowpass(qd_c)
+    hw = lowpass.half_width
+    assert np.all(np.isnan(qdd[:hw + 1])) and np.all(np.isnan(qdd[-hw - 1:]))
+    inner = slice(3 * hw, len(t) - 3 * hw)  # away from the edges: the padding's start-up has settled
+    assert np.abs(qdd[inner] - (-1.4 + 2.4 * t[inner])).max() < 1e-6
+    q2 = 0.3 + 0.5 * t - 0.7 * t**2
+    assert np.abs(lowpass(central_differences(q2, DT)[0])[inner] - (0.5 - 1.4 * t[inner])).max() < 1e-9
+    assert np.isfinite(qd[hw + 1])
+
+
+@pytest.mark.parametrize("smoother", [SavgolSmoother(151, 4, DT), SavgolSmoother(101, 4, DT, "gaussian"),
+                                      ZeroPhaseLowpass(10.0, 6, DT), ZeroPhaseLowpass(20.0, 4, DT)],
+                         ids=["savgol", "savgol-gaussian", "butter-10", "butter-20"])
+def test_a_sine_below_the_cutoff_keeps_phase_and_the_designed_gain(smoother):
+    t = np.arange(20000) * DT
+    f = 1.7  # Hz, a walking-like frequency
+    y = smoother(np.sin(2 * np.pi * f * t))
+    inner = np.zeros_like(t, dtype=bool)
+    inner[3 * smoother.half_width:-3 * smoother.half_width] = True  # away from the edges
+    phase, gain = _phase_and_gain(y[inner], t[inner], f)
+    assert abs(phase) < 1e-9
+    if isinstance(smoother, SavgolSmoother):
+        _, H = freqz(smoother.kernel(), worN=[f], fs=1 / DT)
+        designed = abs(H[0])
+    else:
+        _, H = sosfreqz(smoother.sos, worN=[f], fs=1 / DT)
+        designed = abs(H[0]) ** 2  # forward and backward
+    assert abs(gain - designed) < 1e-6 and designed > 0.99
+
+
+@pytest.mark.parametrize("smoother", [SavgolSmoother(51, 4, DT), ZeroPhaseLowpass(10.0, 6, DT)],
+                         ids=["savgol", "butterworth"])
+def test_white_noise_is_attenuated_as_designed(smoother):
+    rng = np.random.default_rng(0)
+    x = rng.normal(0.0, 1.0, 400_000)
+    y = smoother(x)
+    measured = np.nanstd(y)
+    if isinstance(smoother, SavgolSmoother):
+        designed = np.sqrt(np.sum(smoother.kernel() ** 2))
+    else:
+        _, H = sosfreqz(smoother.sos, worN=8192, fs=1 / DT)
+        designed = np.sqrt(np.mean(np.abs(H) ** 4))  # |H|^2 per pass, two passes
+    assert abs(measured / designed - 1) < 0.03
+
+
+def test_savgol_second_derivative_noise_gain():
+    """Differentiating noise: std(x_dd) = sigma * |h_2| (the thesis's 1/dt^2 growth, tamed)."""
+    rng = np.random.default_rng(1)
+    sigma = 1e-4
+    x = rng.normal(0.0, sigma, 200_000)
+    _, _, xdd = savgol_differentiate(x, DT, 151, 4)
+    designed = sigma * np.linalg.norm(savgol_kernels(151, 4, DT)[2])
+    assert abs(np.nanstd(xdd) / designed - 1) < 0.03
+    _, qdd_c, _ = central_differences(x[:, None], DT)
+    assert np.nanstd(qdd_c) > 1000 * designed  # what central differences would give
+
+
+def test_filters_never_cross_a_gap():
+    t = np.arange(3000) * DT
+    x = np.sin(2 * np.pi * 2 * t)
+    x[1500] = np.nan
+    lowpass = ZeroPhaseLowpass(20.0, 6, DT)
+    y = lowpass(x)
+    hw = lowpass.half_width
+    assert np.all(np.isnan(y[1500 - hw:1501 + hw])) and np.isfinite(y[1500 - hw - 1]) and np.isfinite(y[1501 + hw])
+    s = SavgolSmoother(51, 4, DT)(x)
+    assert np.all(np.isnan(s[1500 - 25:1501 + 25])) and np.isfinite(s[1500 - 26]) and np.isfinite(s[1501 + 25])
+
+
+def test_amplitude_spectrum_and_cutoff_suggestion():
+    rng = np.random.default_rng(2)
+    t = np.arange(60_000) * DT
+    # a step-frequency fundamental and harmonics up to 8 Hz (power 100 / k), then white noise
+    x = sum(10.0 / np.sqrt(k) * np.sin(2 * np.pi * k * 1.0 * t + k) for k in range(1, 9)) + rng.normal(0, 0.5, t.size)
+    freq, amp = amplitude_spectrum(x, DT)
+    assert abs(amp[np.argmin(np.abs(freq - 1.0))] - 10.0) < 0.05
+    assert suggest_cutoff(freq, amp) == pytest.approx(8.0, abs=0.05)  # the last harmonic holds 4.6 %
+    assert suggest_cutoff(freq, amp, tail=0.05) == pytest.approx(7.0, abs=0.05)  # 8 Hz alone is under 5 %
+
+
+def _log_with_contacts(q: np.ndarray, switch: int) -> Log:
+    n = len(q)
+    contact = np.zeros((n, 2), dtype=bool)
+    contact[:, 0] = True
+    contact[:switch, 1] = True
+    return Log(np.arange(n) * DT, q, np.zeros((n, 1)), contact)
+
+
+def test_filtering_schemes_leave_out_windows_across_a_contact_change():
+    """An impact-like kink at a contact change must not leak into rows whose window would
+    span it: those rows are NaN, the others exact on a polynomial."""
+    n, switch = 2000, 1000
+    t = np.arange(n) * DT
+    q = (0.2 * t**2 + np.where(t >= switch * DT, 0.05 * (t - switch * DT), 0.0))[:, None]
+    assert straddling(_log_with_contacts(q, switch).contact).sum() == 2
+    kin = measure(_log_with_contacts(q, switch), "savgol", filtering=FilterOptions(window=51, poly_order=4))
+    bad = np.flatnonzero(~np.isfinite(kin.qdd[:, 0]))
+    assert set(range(switch - 1 - 25, switch + 1 + 25)) <= set(bad)
+    ok = np.isfinite(kin.qdd[:, 0])
+    assert np.allclose(kin.qdd[ok, 0], 0.4, atol=1e-6)
+
+
+def test_filter_study_writes_its_table_and_figure(talos, tmp_path):
+    """A small study (2 steps, exact and 1e-4 rad, two schemes): rows for every pair, the
+    noisy central differences far worse than the smoothed ones, files written."""
+    import pyarrow.parquet as pq
+
+    from wbfriction.studies.filters import Scheme, run_filter_study
+
+    schemes = (Scheme("central", "central"), Scheme("savgol 101", "savgol", FilterOptions(window=101)))
+    result = run_filter_study(talos, tmp_path, steps=2, levels=(None, 1e-4), schemes=schemes, workers=1)
+    assert [(r.position_std, r.scheme) for r in result.rows] == [(None, "central"), (None, "savgol 101"),
+                                                                 (1e-4, "central"), (1e-4, "savgol 101")]
+    noisy = {r.scheme: r for r in result.rows if r.position_std == 1e-4}
+    assert noisy["central"].rms_error > 20 * noisy["savgol 101"].rms_error
+    assert result.best(1e-4).scheme == "savgol 101"
+    assert pq.read_table(tmp_path / "filter_study.parquet").num_rows == 4
+    assert (tmp_path / "filter_curves.png").stat().st_size > 1000
