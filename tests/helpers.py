@@ -83,7 +83,8 @@ def write_bag(path, log, robot, storage: str = "mcap", wrench_every: int = 2, od
             write(c_js, ts.serialize_cdr(js, "sensor_msgs/msg/JointState"))
             if k % wrench_every == 0:
                 f = 400.0 if log.contact[k, 0] else 3.0
-                wr = T["geometry_msgs/msg/WrenchStamped"](header=header("/left_ft"), wrench=T["geometry_msgs/msg/Wrench"](
+                wr = T["geometry_msgs/msg/WrenchStamped"](
+                    header=header("/left_ft"), wrench=T["geometry_msgs/msg/Wrench"](
                     force=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=-f),
                     torque=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)))
                 write(c_lf, ts.serialize_cdr(wr, "geometry_msgs/msg/WrenchStamped"))

@@ -15,7 +15,7 @@ import sys
 import time
 from contextlib import ExitStack, contextmanager, nullcontext
 from pathlib import Path
-from typing import Optional
+from typing import Literal, Optional, cast
 
 import numpy as np
 import typer
@@ -26,7 +26,7 @@ from rich.table import Table
 
 from wbfriction.exceptions import InputError, WbfrictionError
 from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
-from wbfriction.friction.estimate import EstimateOptions
+from wbfriction.friction.estimate import EstimateOptions, Method
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import PARAM_NAMES
 from wbfriction.friction.targets import load_friction_toml
@@ -41,10 +41,15 @@ from wbfriction.pipeline.convert import convert_log
 from wbfriction.pipeline.estimate import RobotSpec, estimate_file, table_log
 from wbfriction.pipeline.fit import fit_file
 from wbfriction.pipeline.provenance import log_provenance
-from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.signals.filters import SavgolWeights
+from wbfriction.signals.kinematics import Diff, FilterOptions, TorqueAlignment
+from wbfriction.signals.phases import Mask
 from wbfriction.sim import IdealOptions, MujocoOptions, SensorNoise, simulate_ideal, simulate_mujoco
+from wbfriction.sim.ideal import Integrator
+from wbfriction.sim.mujoco_sim import FrictionMode
 from wbfriction.sim.sensors import load_sensors_toml
 from wbfriction.walking import GaitOptions, walking_reference
+from wbfriction.walking.footsteps import Gait
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Whole-body joint friction estimation for torque-controlled legged robots.")
@@ -121,7 +126,8 @@ def _joint_list(r: Robot, joints: Optional[str]) -> list[str]:
     names = [j.strip() for j in joints.split(",") if j.strip()]
     unknown = [j for j in names if j not in r.torque_controlled]
     if unknown or not names:
-        raise InputError(f"--joints: '{unknown[0] if unknown else joints}' is not a torque-controlled joint of {r.name}")
+        bad = unknown[0] if unknown else joints
+        raise InputError(f"--joints: '{bad}' is not a torque-controlled joint of {r.name}")
     return names
 
 
@@ -145,9 +151,11 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
     params = None if friction is None else load_friction_toml(friction, r.groups, r.torque_controlled)
     with console.status(f"planning {gait.steps} steps ({gait.gait})"):
         ref = walking_reference(r, gait)
-    run = simulate_mujoco if isinstance(options, MujocoOptions) else simulate_ideal
     with _progress(len(ref), "simulate") as advance:
-        result = run(r, ref, params, options, progress=advance)
+        if isinstance(options, MujocoOptions):
+            result = simulate_mujoco(r, ref, params, options, progress=advance)
+        else:
+            result = simulate_ideal(r, ref, params, options, progress=advance)
     write_log(result.log, r, output)
     console.print(f"wrote {output} ({len(result.log)} samples, {result.log.time[-1]:.1f} s)")
     for p in result.pulls():
@@ -198,8 +206,9 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              substeps: Optional[int] = typer.Option(None, help=f"Physics steps per 1 ms control period (default: "
                                                               f"{_I.substeps} ideal, {_M.substeps} mujoco)."),
              integrator: str = typer.Option(_I.integrator, help="ideal: semi-implicit or explicit Euler."),
-             mujoco_friction: str = typer.Option(_M.friction, help="mujoco: model (eq. 3.5 as a joint torque) or "
-                                                                   "mujoco (MuJoCo's frictionloss = F_c, damping = F_v)."),
+             mujoco_friction: str = typer.Option(_M.friction, help="mujoco: model (eq. 3.5 as a joint torque) "
+                                                                   "or mujoco (MuJoCo's frictionloss = F_c, damping "
+                                                                   "= F_v)."),
              sensors: Optional[Path] = typer.Option(None, help="mujoco: TOML with a [sensors] table (position_std, "
                                                                "encoder_bits, torque_std, seed, delay); the options "
                                                                "below override it."),
@@ -211,18 +220,20 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                                                               "control periods."),
              log_base: bool = typer.Option(_I.log_base, help="Write the base pose to the log.")) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic)."""
-    gait_opts = GaitOptions(gait=gait, steps=steps, step_length=step_length, step_width=step_width,
+    gait_opts = GaitOptions(gait=cast(Gait, gait), steps=steps, step_length=step_length, step_width=step_width,
                             turn_angle=turn_angle, lift_height=lift_height)
     _check_simulator(simulator)
+    options: IdealOptions | MujocoOptions
     if simulator == "ideal":
-        options = IdealOptions(substeps=substeps or _I.substeps, integrator=integrator, log_base=log_base)
+        options = IdealOptions(substeps=substeps or _I.substeps, integrator=cast(Integrator, integrator),
+                               log_base=log_base)
     else:
         table = load_sensors_toml(sensors) if sensors is not None else {}
         given = {"position_std": position_noise, "encoder_bits": encoder_bits, "torque_std": torque_noise,
                  "seed": noise_seed, "delay": None if delay is None else delay * 1e-3}
         table.update({k: v for k, v in given.items() if v is not None})
         lag = float(table.pop("delay", 0.0))
-        options = MujocoOptions(substeps=substeps or _M.substeps, friction=mujoco_friction,
+        options = MujocoOptions(substeps=substeps or _M.substeps, friction=cast(FrictionMode, mujoco_friction),
                                 sensors=SensorNoise(**table), delay=lag, log_base=log_base)
     _run_simulate(_robot(robot, urdf, config), output, gait_opts, options, friction)
 
@@ -254,12 +265,15 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
                                                      help="Lambda of the double-support problem (6.1)."),
              cond: bool = typer.Option(_E.condition_number, "--cond",
                                        help="Report cond(M_mod^-1) per sample (slower)."),
-             method: str = typer.Option(_E.method, help="Single-support route: rnea (fast) or kkt (5.10-5.13).")) -> None:
+             method: str = typer.Option(_E.method, help="Single-support route: rnea (fast) or kkt "
+                                                        "(5.10-5.13).")) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
-    opts = EstimateOptions(diff=diff, compensate_delay=delay_compensation, torque_alignment=torque_alignment,
-                           mask=mask, lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
-                           ds_regularization=ds_regularization, condition_number=cond, method=method,
-                           filtering=FilterOptions(window=window, poly_order=poly_order, weights=weights,
+    opts = EstimateOptions(diff=cast(Diff, diff), compensate_delay=delay_compensation,
+                           torque_alignment=cast(TorqueAlignment, torque_alignment), mask=cast(Mask, mask),
+                           lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
+                           ds_regularization=ds_regularization, condition_number=cond, method=cast(Method, method),
+                           filtering=FilterOptions(window=window, poly_order=poly_order,
+                                                   weights=cast(SavgolWeights, weights),
                                                    cutoff=cutoff, butter_order=butter_order))
     spec = RobotSpec(None if config else robot, None if urdf is None else str(urdf),
                      None if config is None else str(config))
@@ -329,7 +343,7 @@ def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in 
                 mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate').")) -> None:
     """Re-run the estimate with every body's inertia scaled (thesis 7.2, Fig. 7.5/7.6): how the
     friction curves shift (mass) and split into branches (rotational inertia)."""
-    from wbfriction.inertia.sensitivity import PARTS, inertia_sensitivity, parse_factors
+    from wbfriction.inertia.sensitivity import PARTS, InertiaPart, inertia_sensitivity, parse_factors
     from wbfriction.report.figures import save_png, sensitivity_figure
     from wbfriction.signals.kinematics import measure
 
@@ -337,10 +351,10 @@ def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in 
         raise InputError(f"--part must be one of {', '.join(PARTS)}, got '{part}'")
     values = parse_factors(factors)
     r = _robot(robot, urdf, config)
-    opts = EstimateOptions(diff=diff, mask=mask)
-    kin = measure(read_log(log, r), diff)
+    opts = EstimateOptions(diff=cast(Diff, diff), mask=cast(Mask, mask))
+    kin = measure(read_log(log, r), opts.diff)
     with console.status("") as status:
-        sens = inertia_sensitivity(r, kin, values, part, opts, progress=lambda label: status.update(label))
+        sens = inertia_sensitivity(r, kin, values, cast(InertiaPart, part), opts, progress=status.update)
     names = _joint_list(r, joints)
     with console.status("fitting the offsets of the model as given"):
         tau_os = sens.reference_offsets(names)
@@ -417,8 +431,9 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
              output: Path = typer.Option(..., "-o", "--output", help="Corrected URDF to write (the given one's "
                                                                     "structure, identified inertias)."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
-             json_output: Optional[Path] = typer.Option(None, "--json", help="Also write every figure as JSON "
-                                                                             "(for 'wbfriction report --identification')."),
+             json_output: Optional[Path] = typer.Option(None, "--json", help="Also write every figure as "
+                                                                             "JSON (for 'wbfriction report "
+                                                                             "--identification')."),
              stribeck_velocity: str = typer.Option("auto", help="v_s of the Stribeck term [rad/s]: auto (from the "
                                                                 "acceleration route, refined each pass), a number, "
                                                                 "or none."),
@@ -436,7 +451,8 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
     with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
     vs_text = stribeck_velocity.strip().lower()
     try:
-        stribeck = None if vs_text == "none" else "auto" if vs_text == "auto" else float(vs_text)
+        stribeck: float | Literal["auto"] | None = (None if vs_text == "none" else "auto" if vs_text == "auto"
+                                                    else float(vs_text))
     except ValueError:
         raise InputError(f"--stribeck-velocity must be auto, none or a number, got '{stribeck_velocity}'") from None
     if not 0.0 < holdout < 1.0:
@@ -446,7 +462,8 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
     r = _robot(robot, urdf, config)
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior)
     with console.status("") as status:
-        done = identify_file(r, log, output, json_output, estimate_options=EstimateOptions(diff=diff, mask=mask),
+        estimate_options = EstimateOptions(diff=cast(Diff, diff), mask=cast(Mask, mask))
+        done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
                              options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers)
     doc, moved = done.document, done.moved
     for p in doc["passes"]:
@@ -529,7 +546,7 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
     out.print("right knee, RMS error [N·m] with the leg in swing / in stance: " + "; ".join(
         f"{k} {a:.4f} / {b:.4f}" for k, (a, b) in result.knee_rms.items()))
     out.print(f"samples where a welded foot pulled on the ground: {result.pulls}")
-    worst_joint = max(result.generating_share, key=result.generating_share.get)
+    worst_joint = max(result.generating_share, key=lambda j: result.generating_share[j])
     out.print(f"friction generating power (eq. 7.9), leg joints in swing: at most "
               f"{100 * result.generating_share[worst_joint]:.2f} % of the samples ({worst_joint})")
     for f in result.files:
@@ -621,7 +638,8 @@ def main() -> None:
     except (typer.Abort, KeyboardInterrupt):  # pragma: no cover
         sys.exit(130)
     except Exception as exc:  # usage errors: click's (typer vendors its own copy in newer releases)
-        if callable(getattr(exc, "show", None)) and isinstance(getattr(exc, "exit_code", None), int):
-            exc.show()
-            sys.exit(exc.exit_code)
+        show, code = getattr(exc, "show", None), getattr(exc, "exit_code", None)
+        if callable(show) and isinstance(code, int):
+            show()
+            sys.exit(code)
         raise

@@ -109,7 +109,8 @@ def test_fit_marks_unidentifiable_parameters():
     qd = np.linspace(-2, 2, 1001)
     truth = FrictionParams(0.2, 0.8, 0.0, 0.2, 0.1, 40.0)
     rng = np.random.default_rng(0)
-    res = fit_friction(qd, truth.torque(qd) + rng.normal(0, 0.01, qd.size), x0=np.array([0.2, 0.8, 0.0, 0.2, 0.1, 40.0]))
+    res = fit_friction(qd, truth.torque(qd) + rng.normal(0, 0.01, qd.size),
+                       x0=np.array([0.2, 0.8, 0.0, 0.2, 0.1, 40.0]))
     assert res.params.S < 0.05 or res.stderr["v_s"] > 1.0
     # a column of zeros in the Jacobian is an unidentifiable direction
     J = model_jacobian(np.array([0.2, 0.8, 0.0, 0.2, 0.1, 40.0]), qd, 2.0)

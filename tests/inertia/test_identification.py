@@ -158,9 +158,11 @@ def test_identification_recovers_model_and_friction_from_a_walk_with_a_wrong_mod
     base parameters and the friction (the Stribeck velocity given), and predicts held-out
     torques far better than the given model, every body staying physical."""
     wrong = scaled_robot(scaled_robot(talos, 1.1, "rotational"), 1.05, "mass")
-    res = identify_inertia(wrong, combined_walk.log, EstimateOptions(), InertialOptions(stribeck_velocity=0.2, prior=1e-9))
+    res = identify_inertia(wrong, combined_walk.log, EstimateOptions(),
+                           InertialOptions(stribeck_velocity=0.2, prior=1e-9))
     true = body_parameters(talos.model)
-    assert abs(res.pi[:, 0].sum() - true[:, 0].sum()) < 0.01 * true[:, 0].sum() < abs(res.pi_given[:, 0].sum() - true[:, 0].sum())
+    assert (abs(res.pi[:, 0].sum() - true[:, 0].sum()) < 0.01 * true[:, 0].sum()
+            < abs(res.pi_given[:, 0].sum() - true[:, 0].sum()))
     assert is_consistent(res.pi).all()
     K = res.base.combination[:, :true.size]
     rel = lambda pi: np.linalg.norm(K @ (pi.ravel() - true.ravel())) / np.linalg.norm(K @ true.ravel())  # noqa: E731

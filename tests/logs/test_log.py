@@ -62,7 +62,8 @@ def _bad(talos, good, edit):
     (lambda c: c["time"].__setitem__(slice(20, None), c["time"][20:] + 0.5e-3), "irregular at row 20"),
     (lambda c: c["q.leg_left_4_joint"].__setitem__(12, 57.3), "column 'q.leg_left_4_joint' is 57.3 at row 12, "
                                                               "beyond its URDF limits [0, 2.618]"),
-    (lambda c: c["q.leg_left_4_joint"].__setitem__(7, np.nan), "'q.leg_left_4_joint' has a non-finite value (NaN or inf) at row 7"),
+    (lambda c: c["q.leg_left_4_joint"].__setitem__(7, np.nan),
+     "'q.leg_left_4_joint' has a non-finite value (NaN or inf) at row 7"),
     (lambda c: c["contact.left_sole_link"].__setitem__(3, 2), "must hold 0 or 1, found 2 at row 3"),
     (lambda c: c.__setitem__("base.x", c["time"]), "base pose is partial"),
 ])

@@ -13,13 +13,12 @@ from wbfriction.logs.log import Log
 from wbfriction.signals.filters import (
     SavgolSmoother,
     ZeroPhaseLowpass,
-    amplitude_spectrum,
     savgol_differentiate,
     savgol_kernels,
     savgol_weights,
-    suggest_cutoff,
 )
 from wbfriction.signals.kinematics import FilterOptions, central_differences, measure, straddling
+from wbfriction.signals.spectrum import amplitude_spectrum, suggest_cutoff
 
 DT = 1e-3
 
@@ -177,21 +176,3 @@ def test_filtering_schemes_leave_out_windows_across_a_contact_change():
     assert set(range(switch - 1 - 25, switch + 1 + 25)) <= set(bad)
     ok = np.isfinite(kin.qdd[:, 0])
     assert np.allclose(kin.qdd[ok, 0], 0.4, atol=1e-6)
-
-
-def test_filter_study_writes_its_table_and_figure(talos, tmp_path):
-    """A small study (2 steps, exact and 1e-4 rad, two schemes): rows for every pair, the
-    noisy central differences far worse than the smoothed ones, files written."""
-    import pyarrow.parquet as pq
-
-    from wbfriction.studies.filters import Scheme, run_filter_study
-
-    schemes = (Scheme("central", "central"), Scheme("savgol 101", "savgol", FilterOptions(window=101)))
-    result = run_filter_study(talos, tmp_path, steps=2, levels=(None, 1e-4), schemes=schemes, workers=1)
-    assert [(r.position_std, r.scheme) for r in result.rows] == [(None, "central"), (None, "savgol 101"),
-                                                                 (1e-4, "central"), (1e-4, "savgol 101")]
-    noisy = {r.scheme: r for r in result.rows if r.position_std == 1e-4}
-    assert noisy["central"].rms_error > 20 * noisy["savgol 101"].rms_error
-    assert result.best(1e-4).scheme == "savgol 101"
-    assert pq.read_table(tmp_path / "filter_study.parquet").num_rows == 4
-    assert (tmp_path / "filter_curves.png").stat().st_size > 1000

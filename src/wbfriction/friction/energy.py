@@ -156,6 +156,6 @@ def energy_consistency(est, tau_os: dict[str, float] | None = None, threshold: f
             lag = float(np.nanmedian(np.abs(lags))) if np.isfinite(lags).any() else float("nan")
             prod = (qd * d)[np.isfinite(qd * d)]
             opposite = float(np.mean(prod < 0)) if prod.size else float("nan")
-        out.append(JointEnergy(joint, int(v.sum()), generating_share(est.qd[v, i], est.tau_f[v, i], os_i, tolerance), os_i,
-                               vel, delta_crossings, lag, opposite, threshold))
+        share = generating_share(est.qd[v, i], est.tau_f[v, i], os_i, tolerance)
+        out.append(JointEnergy(joint, int(v.sum()), share, os_i, vel, delta_crossings, lag, opposite, threshold))
     return out

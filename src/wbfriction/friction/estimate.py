@@ -21,7 +21,7 @@ Sign convention: ``tau_f`` is the torque friction exerts on the joint,
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, fields
-from typing import Literal, get_args
+from typing import Any, Literal, cast, get_args
 
 import numpy as np
 
@@ -30,6 +30,7 @@ from wbfriction.logs.log import Log
 from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
 from wbfriction.model.stance import stance_frame_pose, stance_model
+from wbfriction.progress import Progress
 from wbfriction.signals.kinematics import (
     FILTERING_SCHEMES,
     Diff,
@@ -140,7 +141,8 @@ class FrictionEstimate:
 
 def single_support_friction_rnea(robot: Robot, contact_index: int, angles: np.ndarray, qd: np.ndarray,
                                  qdd: np.ndarray, tau_tc: np.ndarray, base: np.ndarray | None = None,
-                                 progress=None, with_delta: bool = True) -> tuple[np.ndarray, np.ndarray]:
+                                 progress: Progress | None = None,
+                                 with_delta: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """Single-support friction (5.13) by inverse dynamics on the stance-rooted tree.
 
     Args:
@@ -176,7 +178,7 @@ def single_support_friction_rnea(robot: Robot, contact_index: int, angles: np.nd
 
 
 def single_support(robot: Robot, kin: MeasuredKinematics, rows: np.ndarray, stance: np.ndarray,
-                   progress=None, with_delta: bool = True) -> tuple[np.ndarray, np.ndarray]:
+                   progress: Progress | None = None, with_delta: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """:func:`single_support_friction_rnea` on the rows ``rows`` (N,) of ``kin``, each on its
     stance contact ``stance`` (N,); returns ``(tau_f, delta_qdd)`` (N, n_tc), NaN elsewhere."""
     n, n_tc = len(kin.time), len(robot.torque_controlled)
@@ -222,7 +224,7 @@ def no_single_support(robot: Robot, source: str) -> InputError:
 
 
 def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOptions = EstimateOptions(),
-                      progress=None, require_single_support: bool = True) -> FrictionEstimate:
+                      progress: Progress | None = None, require_single_support: bool = True) -> FrictionEstimate:
     """Estimate the friction torque of every torque-controlled joint at every sample.
 
     Args:
@@ -243,6 +245,7 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
         raise InputError(f"unknown method '{options.method}': choose one of {', '.join(METHODS)}")
     n, n_tc = len(kin.time), len(robot.torque_controlled)
     phases: Phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip)
+    assert kin.valid is not None  # set by MeasuredKinematics.__post_init__
     usable = kin.valid & (phases.n_contacts > 0)
     if require_single_support and not np.any(usable & phases.single):
         raise no_single_support(robot, kin.metadata.get('source', 'the log'))
@@ -263,6 +266,7 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
         r = rows[start:start + CHUNK]
         dyn = constrained_dynamics(robot, kin.q[r], kin.qd[r], kin.qdd[r], kin.tau[r], kin.contact[r],
                                    None if kin.base is None else kin.base[r], with_Mmod_inv=True, progress=progress)
+        assert dyn.Mmod_inv is not None  # with_Mmod_inv
         d = kin.qdd[r][:, tc] - dyn.qdd_est[:, tc]
         is_ss = phases.single[r]
         if options.method == "kkt" and np.any(is_ss):
@@ -280,7 +284,8 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     return FrictionEstimate(
         joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
         phase=phases.labels(), unique=ss.copy(), contact=kin.contact, contact_frames=robot.contact_frames,
-        qdd=kin.qdd[:, tc], delta_qdd=delta, cond=cond, tau_f_true=kin.tau_f_true, metadata=metadata, smoother=kin.smoother)
+        qdd=kin.qdd[:, tc], delta_qdd=delta, cond=cond, tau_f_true=kin.tau_f_true, metadata=metadata,
+        smoother=kin.smoother)
 
 
 def companion_scheme(diff: Diff) -> Scheme:
@@ -289,7 +294,7 @@ def companion_scheme(diff: Diff) -> Scheme:
     return "central" if diff in FILTERING_SCHEMES else "savgol"
 
 
-def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOptions(), progress=None,
+def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOptions(), progress: Progress | None = None,
                  companion: bool = False, require_single_support: bool = True) -> FrictionEstimate:
     """Differentiate a log (:func:`~wbfriction.signals.kinematics.measure`) and estimate its friction.
 
@@ -309,7 +314,8 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
     parts = log.parts()
     if len(parts) == 1:
         return _estimate_segment(robot, log, options, progress, companion, require_single_support)
-    done, first_error = [], None
+    done: list[FrictionEstimate | None] = []
+    first_error: InputError | None = None
     for part in parts:
         try:
             done.append(_estimate_segment(robot, part, options, progress, companion, False))
@@ -317,6 +323,7 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
             first_error = first_error or exc
             done.append(None)
     if all(d is None for d in done):
+        assert first_error is not None  # every part raised one
         raise first_error
     template = next(d for d in done if d is not None)
     est = concat_estimates([d if d is not None else _blank(template, part) for d, part in zip(done, parts)])
@@ -346,7 +353,8 @@ def _blank(template: FrictionEstimate, log: Log) -> FrictionEstimate:
     n = len(log.time)
     nan = lambda x: None if x is None else np.full((n, *np.shape(x)[1:]), np.nan)  # noqa: E731
     return FrictionEstimate(
-        joints=template.joints, time=log.time, qd=nan(template.qd), tau_f=nan(template.tau_f),
+        joints=template.joints, time=log.time, qd=cast(np.ndarray, nan(template.qd)),
+        tau_f=cast(np.ndarray, nan(template.tau_f)),
         valid=np.zeros((n, len(template.joints)), dtype=bool), phase=segment(log.time, log.contact).labels(),
         unique=np.zeros(n, dtype=bool), contact=log.contact, contact_frames=template.contact_frames,
         qdd=nan(template.qdd), delta_qdd=nan(template.delta_qdd), cond=nan(template.cond),
@@ -358,7 +366,7 @@ def concat_estimates(parts: list[FrictionEstimate]) -> FrictionEstimate:
     """Estimates of consecutive stretches of one log as one (arrays stacked along time;
     names, metadata and smoother of the first)."""
     first = parts[0]
-    out = {}
+    out: dict[str, Any] = {}  # field values by name
     for f in fields(FrictionEstimate):
         values = [getattr(p, f.name) for p in parts]
         arrays = [v for v in values if isinstance(v, np.ndarray)]

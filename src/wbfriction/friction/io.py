@@ -26,7 +26,7 @@ from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import FrictionParams
-from wbfriction.logs.tables import numeric_column, read_metadata, read_table, with_metadata, write_atomic
+from wbfriction.logs.tables import numeric_column, read_metadata, read_table, with_metadata, write_json
 from wbfriction.signals.kinematics import SCHEMES, FilterOptions, Smoother, make_smoother
 
 SIGN_CONVENTION = "tau_f = -f(qd); fit of f (eq. 3.5) to -tau_f"
@@ -232,9 +232,8 @@ def write_params(path: str | Path, fits: Iterable[FitResult], header: Mapping[st
         InputError: an output folder that does not exist.
     """
     extra = extra or {}
-    doc = {**(header or {}), "joints": {f.joint: {**fit_to_dict(f), **extra.get(f.joint, {})} for f in fits}}
-    text = json.dumps(doc, indent=2)
-    write_atomic(path, lambda tmp: tmp.write_text(text))
+    joints = {f.joint: {**fit_to_dict(f), **extra.get(f.joint, {})} for f in fits}
+    write_json(path, {**(header or {}), "joints": joints})
 
 
 def read_params(path: str | Path) -> dict[str, FitResult]:

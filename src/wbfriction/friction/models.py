@@ -18,7 +18,9 @@ S and delta_s dimensionless.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass, fields
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -27,6 +29,9 @@ from wbfriction.exceptions import InputError
 
 PARAM_NAMES = ("F_v", "F_c", "S", "v_s", "tau_os", "a")
 """Names of the fitted parameters of model (3.5), in the order used by the fit."""
+
+ParamLike = float | np.ndarray
+"""A model parameter: one value, or an array of them broadcastable to ``qd`` (e.g. one per joint)."""
 
 
 def coulomb(qd: ArrayLike, F_c: ArrayLike) -> np.ndarray:
@@ -39,8 +44,8 @@ def viscous(qd: ArrayLike, F_v: ArrayLike) -> np.ndarray:
     return np.asarray(F_v) * np.asarray(qd)
 
 
-def stribeck(qd: ArrayLike, F_c: ArrayLike, F_s: ArrayLike, v_s: ArrayLike,
-             delta_s: ArrayLike = 2.0) -> np.ndarray:
+def stribeck(qd: ArrayLike, F_c: ParamLike, F_s: ParamLike, v_s: ParamLike,
+             delta_s: ParamLike = 2.0) -> np.ndarray:
     """Coulomb friction with the Stribeck effect, eq. (3.3).
 
     ``f = sgn(qd) (F_c + (F_s - F_c) exp(-|qd / v_s|^delta_s))``, with static friction
@@ -50,8 +55,8 @@ def stribeck(qd: ArrayLike, F_c: ArrayLike, F_s: ArrayLike, v_s: ArrayLike,
     return np.sign(qd) * (F_c + (np.asarray(F_s) - F_c) * np.exp(-np.abs(qd / v_s) ** delta_s))
 
 
-def coulomb_viscous_stribeck(qd: ArrayLike, F_v: ArrayLike, F_c: ArrayLike, S: ArrayLike, v_s: ArrayLike,
-           tau_os: ArrayLike, a: ArrayLike, delta_s: ArrayLike = 2.0) -> np.ndarray:
+def coulomb_viscous_stribeck(qd: ArrayLike, F_v: ParamLike, F_c: ParamLike, S: ParamLike, v_s: ParamLike,
+           tau_os: ParamLike, a: ParamLike, delta_s: ParamLike = 2.0) -> np.ndarray:
     """Smooth Coulomb-viscous-Stribeck model with offset, eq. (3.5).
 
     ``f = F_v qd + F_c tanh(a qd) (1 + S exp(-|qd / v_s|^delta_s)) + tau_os``
@@ -89,9 +94,11 @@ class FrictionParams:
         return np.array([getattr(self, n) for n in PARAM_NAMES])
 
     @classmethod
-    def from_vector(cls, x: ArrayLike, delta_s: float = 2.0) -> FrictionParams:
+    def from_vector(cls, x: Iterable[float], delta_s: float = 2.0) -> FrictionParams:
         """Parameters from the six fitted values in :data:`PARAM_NAMES` order."""
-        return cls(*map(float, x), delta_s=delta_s)
+        # the six positional fields (PARAM_NAMES): delta_s is given by keyword
+        six = cast(tuple[float, float, float, float, float, float], tuple(map(float, x)))
+        return cls(*six, delta_s=delta_s)
 
     def to_dict(self) -> dict[str, float]:
         """Every parameter by name (the inverse of :meth:`from_dict`)."""
@@ -127,10 +134,10 @@ def friction_torque(qd: np.ndarray, params: list[FrictionParams]) -> np.ndarray:
     return -coulomb_viscous_stribeck(qd, **stack_params(params))
 
 
-def stack_params(params: list[FrictionParams]) -> dict[str, np.ndarray]:
+def stack_params(params: list[FrictionParams]) -> dict[str, ParamLike]:
     """Keyword arguments of :func:`coulomb_viscous_stribeck` for several joints: each parameter as an (n_joints,)
     array, or as a float when every joint has the same value (cheaper to broadcast)."""
-    out = {}
+    out: dict[str, ParamLike] = {}
     for name in PARAM_NAMES + ("delta_s",):
         values = np.array([getattr(p, name) for p in params], dtype=float)
         out[name] = float(values[0]) if values.size and np.all(values == values[0]) else values

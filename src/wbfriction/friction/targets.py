@@ -28,7 +28,8 @@ def friction_by_group(groups: dict[str, tuple[str, ...]],
     return {joint: targets[g] for g, joints in groups.items() if g in targets for joint in joints}
 
 
-def load_friction_toml(path: str | Path, groups: dict[str, tuple[str, ...]], joints: tuple[str, ...]) -> dict[str, FrictionParams]:
+def load_friction_toml(path: str | Path, groups: dict[str, tuple[str, ...]],
+                       joints: tuple[str, ...]) -> dict[str, FrictionParams]:
     """Friction parameters per joint from a TOML file.
 
     Each table under ``[friction]`` is named after a joint group or a joint and gives the

@@ -15,7 +15,6 @@ identification moved between passes.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Literal
 
@@ -27,6 +26,7 @@ from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
 from wbfriction.inertia.identification import InertialIdentification, InertialOptions, identify_inertia
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
+from wbfriction.progress import StageProgress
 
 
 @dataclass
@@ -82,13 +82,14 @@ def stribeck_velocity(fits: list[FitResult], max_relative_error: float = 0.5) ->
         return p is not None and all(getattr(p, n) > 0 and f.stderr.get(n, np.inf) < max_relative_error * getattr(p, n)
                                      for n in ("v_s", "F_c", "S"))
     good = [f for f in fits if determined(f)]
-    return (float(np.median([f.params.v_s for f in good])) if good else None), tuple(f.joint for f in good)
+    return (float(np.median([f.params.v_s for f in good if f.params is not None])) if good else None,
+            tuple(f.joint for f in good))
 
 
 def identify(robot: Robot, log: Log, estimate_options: EstimateOptions = EstimateOptions(),
                           options: InertialOptions = InertialOptions(),
                           stribeck: float | Literal["auto"] | None = "auto", passes: int = 2,
-                          progress: Callable[[str], None] | None = None, workers: int = 1) -> ClosedLoop:
+                          progress: StageProgress | None = None, workers: int = 1) -> ClosedLoop:
     """Run the loop (module docstring).
 
     Args:

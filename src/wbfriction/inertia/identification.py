@@ -39,7 +39,7 @@ inequalities hold). A Tikhonov prior pulls the inertias toward the given model w
 the data say nothing: its weight is ``prior`` times the largest squared singular value
 of the scaled regressor, so only directions weaker than ``sqrt(prior)`` of the
 best-excited one follow the prior. The URDF says nothing of friction: the friction
-parameters get only the vanishing weight :data:`FRICTION_PRIOR` (which fixes those of a
+parameters get only the vanishing weight :data:`~wbfriction.inertia.consistency.FRICTION_PRIOR` (which fixes those of a
 joint that never moves). Pulled as hard as the inertias toward the friction that best
 explains the data with the given model, they kept that model's error: on the demo's
 walk, a 5.4 % error of an ankle's offset became 2.4 % without it. The problem is solved
@@ -74,6 +74,7 @@ from wbfriction.inertia.regressor import body_parameters, stance_regressor, with
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
 from wbfriction.model.stance import stance_frame_pose
+from wbfriction.progress import Progress
 from wbfriction.signals.kinematics import MeasuredKinematics, measure
 from wbfriction.signals.phases import segment
 
@@ -139,7 +140,7 @@ class InertialIdentification:
         pi_given, pi: inertial parameters of the given and identified model (nb, 10).
         friction_names: the friction parameters (:func:`friction_names`), k of them.
         friction: identified friction parameters per torque-controlled joint (n_tc, k).
-        friction_given_model: the physical friction (:data:`FRICTION_LOWER`) that best
+        friction_given_model: the physical friction (:data:`~wbfriction.inertia.consistency.FRICTION_LOWER`) that best
             explains the data with the given inertias (n_tc, k).
         base: the base parameters, over ``(pi.ravel(), friction.ravel())``.
         holdout: torque predictions on the held-out samples.
@@ -226,7 +227,8 @@ def _rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int, options:
 
 
 def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions = EstimateOptions(),
-                     options: InertialOptions = InertialOptions(), progress=None) -> InertialIdentification:
+                     options: InertialOptions = InertialOptions(),
+                     progress: Progress | None = None) -> InertialIdentification:
     """Identify every body's inertial parameters and the joints' Coulomb, viscous and
     offset friction from a walking log (module docstring), starting from and regularised
     toward ``robot``'s model.
@@ -273,7 +275,7 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
             scores[weight] = validating.rms(np.concatenate([trial.pi.ravel(), trial.friction.ravel()]))
             if scores[weight] > min(scores.values()):
                 break  # past the best weight: weaker priors only fit the noise more closely
-        prior = min(scores, key=scores.get)
+        prior = min(scores, key=scores.__getitem__)
     fit = fit_consistent(R, z, pi0, friction0, prior, options.min_mass)
     if k == len(FRICTION) + 1 and options.stribeck_joints is not None:  # no column: no Stribeck term, not a bound
         fit.friction[~np.isin(robot.torque_controlled, options.stribeck_joints), -1] = 0.0
@@ -285,7 +287,8 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
                                   fit.friction, friction0, base, holdout, samples, fit.message, prior, scores)
 
 
-def _system(robot: Robot, parts, which: int, options: InertialOptions, progress=None) -> CompressedLeastSquares:
+def _system(robot: Robot, parts, which: int, options: InertialOptions,
+            progress: Progress | None = None) -> CompressedLeastSquares:
     """The compressed system of the rows ``part[which]`` of every part (:func:`_split`), in
     the original bodies' parameters: per stance, built in its rooted parameters, then mapped."""
     nb, n_tc = robot.model.njoints - 1, len(robot.torque_controlled)

@@ -19,7 +19,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.friction.io import fit_to_dict
 from wbfriction.inertia.closed_loop import ClosedLoop
 from wbfriction.inertia.urdf import inertia_changes
-from wbfriction.logs.tables import write_atomic
+from wbfriction.logs.tables import write_json
 
 
 def _finite(x: float) -> float | None:
@@ -51,7 +51,8 @@ def identification_document(loop: ClosedLoop, moved: tuple[str, ...] = (),
                             "identified": float(ident.holdout.identified[i])},
         }
     doc = {
-        "sign_convention": "tau_f = -f(qd); f = F_v qd + F_c tanh(a qd) (+ (F_s - F_c) tanh(a qd) exp(-(qd/v_s)^2)) + tau_os",
+        "sign_convention": ("tau_f = -f(qd); f = F_v qd + F_c tanh(a qd) (+ (F_s - F_c) tanh(a qd) exp(-(qd/v_s)^2))"
+                            " + tau_os"),
         "passes": [{"stribeck_velocity": p.stribeck_velocity,
                     "stribeck_joints": None if p.stribeck_joints is None else list(p.stribeck_joints),
                     "samples": p.identification.samples,
@@ -79,8 +80,7 @@ def write_identification(path: str | Path, doc: dict[str, Any]) -> None:
     Raises:
         InputError: an output folder that does not exist.
     """
-    text = json.dumps(doc, indent=2)
-    write_atomic(path, lambda tmp: tmp.write_text(text))
+    write_json(path, doc)
 
 
 def read_identification(path: str | Path) -> dict[str, Any]:

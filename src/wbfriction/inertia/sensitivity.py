@@ -36,6 +36,7 @@ import pinocchio as pin
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_friction
 from wbfriction.model.robot import Robot
+from wbfriction.progress import StageProgress
 from wbfriction.signals.kinematics import MeasuredKinematics
 
 InertiaPart = Literal["all", "mass", "rotational"]
@@ -180,7 +181,8 @@ def parse_factors(text: str) -> tuple[float, ...]:
 
 
 def inertia_sensitivity(robot: Robot, kin: MeasuredKinematics, factors, part: InertiaPart = "all",
-                        options: EstimateOptions = EstimateOptions(), progress=None) -> Sensitivity:
+                        options: EstimateOptions = EstimateOptions(),
+                        progress: StageProgress | None = None) -> Sensitivity:
     """Re-run the estimate of measured kinematics with every body's inertia scaled.
 
     Args:

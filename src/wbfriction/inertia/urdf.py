@@ -145,7 +145,8 @@ def write_urdf(robot: Robot, pi: np.ndarray, path: str | Path) -> tuple[str, ...
         X = body.placements[body.child].inverse()
         _set_inertial(links[body.child], X.act(pin.Inertia.FromDynamicParameters(rest)))
     root = tree.getroot()
-    prolog = [ET.tostring(node, encoding="unicode").strip() for node in reversed(list(root.itersiblings(preceding=True)))]
+    siblings = reversed(list(root.itersiblings(preceding=True)))
+    prolog = [ET.tostring(node, encoding="unicode").strip() for node in siblings]
     text = "\n".join(['<?xml version="1.0" encoding="utf-8"?>', *prolog, ET.tostring(root, encoding="unicode")]) + "\n"
     write_atomic(Path(path), lambda tmp: tmp.write_text(text, encoding="utf-8"))
     return tuple(moved)

@@ -41,6 +41,7 @@ from bisect import bisect_right
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pyarrow as pa
@@ -157,7 +158,8 @@ def _messages(path: Path, topics: dict[str, tuple[str, ...]]) -> Iterator[tuple[
             conns = {c.topic: c for c in reader.connections}
             for topic, types in topics.items():
                 if topic not in conns:
-                    raise InputError(f"{path}: no topic '{topic}' in the bag (it has {', '.join(sorted(conns)) or 'none'})")
+                    raise InputError(f"{path}: no topic '{topic}' in the bag "
+                                     f"(it has {', '.join(sorted(conns)) or 'none'})")
                 if conns[topic].msgtype not in types:
                     raise InputError(f"{path}: topic '{topic}' carries {conns[topic].msgtype}, expected "
                                      f"{' or '.join(types)}")
@@ -217,6 +219,185 @@ def _interpolate_pose(stamps: np.ndarray, poses: np.ndarray, at: np.ndarray) -> 
     return np.column_stack([xyz, rot.as_quat()])
 
 
+def _topics(bag_map: BagMap) -> dict[str, tuple[str, ...]]:
+    """The mapped topics and the message types each may carry."""
+    topics: dict[str, tuple[str, ...]] = {bag_map.joint_states: (JOINT_STATE,)}
+    for c in bag_map.contacts:
+        topics[c.topic] = (WRENCH, BOOL)
+    if bag_map.base:
+        topics[bag_map.base] = (ODOMETRY, POSE)
+    return topics
+
+
+class _BagAligner:
+    """A bag's messages aligned on its joint-state stamps, handed on in blocks (:func:`iter_bag`).
+
+    Holds the joint-state samples not yet handed on (stamp [ns], q, tau), the aligned
+    topics' messages still needed (:class:`_Series`), and what the blocks share (the
+    joint columns, the time origin, the rows handed on so far).
+    """
+
+    def __init__(self, path: Path, bag_map: BagMap, block_rows: int) -> None:
+        self.path = path
+        self.bag_map = bag_map
+        self.block_rows = block_rows
+        self.topics = _topics(bag_map)
+        self.contacts = {c.topic: _Series(c.topic) for c in bag_map.contacts}
+        self.base = _Series(bag_map.base) if bag_map.base else None
+        self.series = [*self.contacts.values(), *([self.base] if self.base else [])]
+        self.by_topic = {c.topic: c for c in bag_map.contacts}
+        self.columns: dict[str, int] = {}  # model joint -> column, from the first joint-state message
+        self.has_effort = False
+        self.js_count = 0
+        self.pending: list[tuple[int, np.ndarray, np.ndarray]] = []  # joint-state samples: stamp [ns], q, tau
+        self.received = -1  # the latest receive time: no Bool message before it is still to come
+        self.origin: int | None = None
+        self.rows = 0
+
+    # ------------------------------------------------------------- messages in
+    def add(self, topic: str, msgtype: str, recv: int, msg: Any) -> pa.Table | None:
+        """Take one message of the bag; the block it completes (a joint-state message filling one), if any."""
+        self.received = max(self.received, recv)
+        if topic == self.bag_map.joint_states:
+            self.add_joint_state(topic, msg)
+            return self.block() if len(self.pending) >= self.block_rows else None
+        if topic in self.by_topic:
+            self.add_contact(topic, msgtype, recv, msg)
+        else:
+            self.add_base(msg)
+        return None
+
+    def add_joint_state(self, topic: str, msg: Any) -> None:
+        """Queue a joint-state message as a sample: its stamp, q and tau by model joint (NaN where absent)."""
+        names = [self.bag_map.rename.get(n, n) for n in msg.name]
+        if not self.columns:
+            self.columns = {n: i for i, n in enumerate(dict.fromkeys(names))}
+            self.has_effort = len(msg.effort) == len(names)
+        self.js_count += 1
+        unknown = next((n for n in names if n not in self.columns), None)
+        if unknown is not None:
+            raise InputError(f"{self.path}: joint-state message {self.js_count} names joint '{unknown}', which the "
+                             "first message did not")
+        stamp = _stamp(msg)
+        if self.pending and stamp < self.pending[-1][0]:
+            raise InputError(f"{self.path}: topic '{topic}': the stamp of message {self.js_count} goes back in time")
+        q = np.full(len(self.columns), np.nan)
+        tau = np.full(len(self.columns), np.nan)
+        idx = [self.columns[n] for n in names]
+        if len(msg.position) == len(idx):
+            q[idx] = msg.position
+        if len(msg.effort) == len(idx):
+            tau[idx] = msg.effort
+        self.pending.append((stamp, q, tau))
+
+    def add_contact(self, topic: str, msgtype: str, recv: int, msg: Any) -> None:
+        """Record a contact flag: a ``Bool`` at its receive time, a wrench's force over the threshold at its stamp."""
+        c = self.by_topic[topic]
+        if msgtype == BOOL:
+            self.contacts[topic].by_receive = True
+            self.contacts[topic].add(self.path, recv, bool(msg.data))
+        else:
+            if c.threshold is None:
+                raise InputError(f"{self.path}: contact topic '{topic}' is a wrench: give its threshold [N] in the map")
+            self.contacts[topic].add(self.path, _stamp(msg), abs(getattr(msg.wrench.force, c.axis)) > c.threshold)
+
+    def add_base(self, msg: Any) -> None:
+        """Record a base pose (x y z qx qy qz qw) of an ``Odometry`` or ``PoseStamped`` message at its stamp."""
+        p = msg.pose.pose if hasattr(msg.pose, "pose") else msg.pose
+        assert self.base is not None  # only the mapped base topic's messages come here
+        self.base.add(self.path, _stamp(msg), (p.position.x, p.position.y, p.position.z, p.orientation.x,
+                                               p.orientation.y, p.orientation.z, p.orientation.w))
+
+    # ------------------------------------------------------------- blocks out
+    def block(self) -> pa.Table | None:
+        """The block that can be handed on now (the samples every topic has data after), if any."""
+        return self.emit(final=False)
+
+    def last_block(self) -> pa.Table | None:
+        """The block left at the end of the bag, after checking that every topic had a message."""
+        if self.js_count == 0:
+            raise InputError(f"{self.path}: topic '{self.bag_map.joint_states}' has no message")
+        for s in self.series:
+            if s.count == 0:
+                raise InputError(f"{self.path}: topic '{s.topic}' has no message")
+        return self.emit(final=True)
+
+    def check_rows(self) -> None:
+        """Refuse a bag of which fewer than two samples could be aligned."""
+        if self.rows < 2:
+            raise InputError(f"{self.path}: no joint-state sample lies where every mapped topic has data")
+
+    def horizon(self) -> float:
+        """Samples stamped before this can be aligned now [ns]."""
+        h = float("inf")
+        for s in self.series:
+            if not s.stamps:
+                return -1.0
+            h = min(h, self.received if s.by_receive else s.stamps[-1])
+        return h
+
+    def emit(self, final: bool) -> pa.Table | None:
+        """The pending samples that can be aligned (all of them at the end, ``final``) as a table, if any."""
+        taken = self._take(final)
+        if taken is None:
+            return None
+        at, q, tau = taken
+        self.origin = int(at[0]) if self.origin is None else self.origin
+        table = {"time": (at - self.origin) * 1e-9, **self._joint_columns(q, tau), **self._contact_columns(at)}
+        if self.base is not None:
+            table.update(self._base_columns(at))
+        for s in self.series:
+            s.trim(int(at[-1]))
+        out = pa.table(table)
+        if self.rows == 0:
+            out = with_metadata(out, {"source_bag": str(self.path), "time_origin_ns": self.origin,
+                                      "alignment": "contacts: zero-order hold; base: linear + slerp"})
+        self.rows += len(at)
+        return out
+
+    def _take(self, final: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """Remove the ready samples from the pending ones: stamps [ns], q, tau of those every topic covers."""
+        stamps = np.array([p[0] for p in self.pending], dtype=np.int64)
+        ready = len(stamps) if final else int(np.searchsorted(stamps >= self.horizon(), True))
+        if ready == 0:
+            return None
+        at = stamps[:ready]
+        q = np.array([p[1] for p in self.pending[:ready]])
+        tau = np.array([p[2] for p in self.pending[:ready]])
+        del self.pending[:ready]
+        keep = np.ones(ready, dtype=bool)
+        for s in self.series:
+            keep &= at >= (s.first if s.first is not None else np.iinfo(np.int64).max)
+        if final and self.base is not None and self.base.stamps:
+            keep &= at <= self.base.stamps[-1]
+        at, q, tau = at[keep], q[keep], tau[keep]
+        if len(at) == 0:
+            return None
+        return at, q, tau
+
+    def _joint_columns(self, q: np.ndarray, tau: np.ndarray) -> dict[str, np.ndarray]:
+        """The ``q.<joint>`` columns, then the ``tau.<joint>`` ones if the messages carry efforts."""
+        table = {f"q.{name}": q[:, i] for name, i in self.columns.items()}
+        if self.has_effort:
+            table.update({f"tau.{name}": tau[:, i] for name, i in self.columns.items()})
+        return table
+
+    def _contact_columns(self, at: np.ndarray) -> dict[str, np.ndarray]:
+        """The ``contact.<frame>`` flags at the stamps ``at`` [ns]: the latest message at or before each."""
+        table = {}
+        for c in self.bag_map.contacts:
+            s = self.contacts[c.topic]
+            flags = np.array([bool(v) for v in s.values], dtype=np.int8)
+            table[f"contact.{c.frame}"] = flags[np.searchsorted(np.array(s.stamps), at, side="right") - 1]
+        return table
+
+    def _base_columns(self, at: np.ndarray) -> dict[str, np.ndarray]:
+        """The ``base.*`` columns at the stamps ``at`` [ns], interpolated between the base poses."""
+        assert self.base is not None  # called when the map has a base topic
+        pose = _interpolate_pose(np.array(self.base.stamps, dtype=np.int64), np.array(self.base.values), at)
+        return dict(zip(BASE_COLUMNS, pose.T))
+
+
 def iter_bag(path: str | Path, bag_map: BagMap, block_rows: int = BLOCK_ROWS) -> Iterator[pa.Table]:
     """A ROS 2 bag as consecutive tables in the log format (:mod:`wbfriction.logs.log`) of about
     ``block_rows`` rows, aligned on the joint-state stamps (module docstring), read in one
@@ -234,123 +415,15 @@ def iter_bag(path: str | Path, bag_map: BagMap, block_rows: int = BLOCK_ROWS) ->
             joint-state sample where every topic has data.
     """
     path = Path(path)
-    topics = {bag_map.joint_states: (JOINT_STATE,)}
-    for c in bag_map.contacts:
-        topics[c.topic] = (WRENCH, BOOL)
-    if bag_map.base:
-        topics[bag_map.base] = (ODOMETRY, POSE)
-    contacts = {c.topic: _Series(c.topic) for c in bag_map.contacts}
-    base = _Series(bag_map.base) if bag_map.base else None
-    series = [*contacts.values(), *([base] if base else [])]
-    by_topic = {c.topic: c for c in bag_map.contacts}
-    columns: dict[str, int] = {}  # model joint -> column, from the first joint-state message
-    has_effort = False
-    js_count = 0
-    pending: list[tuple[int, np.ndarray, np.ndarray]] = []  # joint-state samples: stamp [ns], q, tau
-    received = -1  # the latest receive time: no Bool message before it is still to come
-    origin: int | None = None
-    rows = 0
-
-    def horizon() -> float:
-        """Samples stamped before this can be aligned now [ns]."""
-        h = float("inf")
-        for s in series:
-            if not s.stamps:
-                return -1.0
-            h = min(h, received if s.by_receive else s.stamps[-1])
-        return h
-
-    def emit(final: bool) -> pa.Table | None:
-        nonlocal origin, rows
-        stamps = np.array([p[0] for p in pending], dtype=np.int64)
-        ready = len(stamps) if final else int(np.searchsorted(stamps >= horizon(), True))
-        if ready == 0:
-            return None
-        at = stamps[:ready]
-        q = np.array([p[1] for p in pending[:ready]])
-        tau = np.array([p[2] for p in pending[:ready]])
-        del pending[:ready]
-        keep = np.ones(ready, dtype=bool)
-        for s in series:
-            keep &= at >= (s.first if s.first is not None else np.iinfo(np.int64).max)
-        if final and base is not None and base.stamps:
-            keep &= at <= base.stamps[-1]
-        at, q, tau = at[keep], q[keep], tau[keep]
-        if len(at) == 0:
-            return None
-        origin = int(at[0]) if origin is None else origin
-        table = {"time": (at - origin) * 1e-9}
-        for name, i in columns.items():
-            table[f"q.{name}"] = q[:, i]
-        if has_effort:
-            for name, i in columns.items():
-                table[f"tau.{name}"] = tau[:, i]
-        for c in bag_map.contacts:
-            s = contacts[c.topic]
-            flags = np.array([bool(v) for v in s.values], dtype=np.int8)
-            table[f"contact.{c.frame}"] = flags[np.searchsorted(np.array(s.stamps), at, side="right") - 1]
-        if base is not None:
-            pose = _interpolate_pose(np.array(base.stamps, dtype=np.int64), np.array(base.values), at)
-            table.update(dict(zip(BASE_COLUMNS, pose.T)))
-        for s in series:
-            s.trim(int(at[-1]))
-        out = pa.table(table)
-        if rows == 0:
-            out = with_metadata(out, {"source_bag": str(path), "time_origin_ns": origin,
-                                      "alignment": "contacts: zero-order hold; base: linear + slerp"})
-        rows += len(at)
-        return out
-
-    for topic, msgtype, recv, msg in _messages(path, topics):
-        received = max(received, recv)
-        if topic == bag_map.joint_states:
-            names = [bag_map.rename.get(n, n) for n in msg.name]
-            if not columns:
-                columns = {n: i for i, n in enumerate(dict.fromkeys(names))}
-                has_effort = len(msg.effort) == len(names)
-            js_count += 1
-            unknown = next((n for n in names if n not in columns), None)
-            if unknown is not None:
-                raise InputError(f"{path}: joint-state message {js_count} names joint '{unknown}', which the "
-                                 "first message did not")
-            stamp = _stamp(msg)
-            if pending and stamp < pending[-1][0]:
-                raise InputError(f"{path}: topic '{topic}': the stamp of message {js_count} goes back in time")
-            q = np.full(len(columns), np.nan)
-            tau = np.full(len(columns), np.nan)
-            idx = [columns[n] for n in names]
-            if len(msg.position) == len(idx):
-                q[idx] = msg.position
-            if len(msg.effort) == len(idx):
-                tau[idx] = msg.effort
-            pending.append((stamp, q, tau))
-            if len(pending) >= block_rows:
-                block = emit(final=False)
-                if block is not None:
-                    yield block
-        elif topic in by_topic:
-            c = by_topic[topic]
-            if msgtype == BOOL:
-                contacts[topic].by_receive = True
-                contacts[topic].add(path, recv, bool(msg.data))
-            else:
-                if c.threshold is None:
-                    raise InputError(f"{path}: contact topic '{topic}' is a wrench: give its threshold [N] in the map")
-                contacts[topic].add(path, _stamp(msg), abs(getattr(msg.wrench.force, c.axis)) > c.threshold)
-        else:
-            p = msg.pose.pose if hasattr(msg.pose, "pose") else msg.pose
-            base.add(path, _stamp(msg), (p.position.x, p.position.y, p.position.z, p.orientation.x,
-                                          p.orientation.y, p.orientation.z, p.orientation.w))
-    if js_count == 0:
-        raise InputError(f"{path}: topic '{bag_map.joint_states}' has no message")
-    for s in series:
-        if s.count == 0:
-            raise InputError(f"{path}: topic '{s.topic}' has no message")
-    block = emit(final=True)
+    aligner = _BagAligner(path, bag_map, block_rows)
+    for topic, msgtype, recv, msg in _messages(path, aligner.topics):
+        block = aligner.add(topic, msgtype, recv, msg)
+        if block is not None:
+            yield block
+    block = aligner.last_block()
     if block is not None:
         yield block
-    if rows < 2:
-        raise InputError(f"{path}: no joint-state sample lies where every mapped topic has data")
+    aligner.check_rows()
 
 
 def read_bag(path: str | Path, bag_map: BagMap) -> pa.Table:

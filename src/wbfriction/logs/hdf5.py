@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pyarrow as pa
@@ -31,14 +32,14 @@ def _names(attr) -> list[str]:
     return [n.decode() if isinstance(n, bytes) else str(n) for n in np.atleast_1d(attr)]
 
 
-def _layout(f, path: Path) -> tuple[dict[str, tuple[object, int | None]], str | None]:
+def _layout(f, path: Path) -> tuple[dict[str, tuple[Any, int | None]], str | None]:
     """Column name -> (dataset, column index in a 2-D dataset or None), and the metadata."""
     import h5py
 
     meta = f.attrs.get("wbfriction")
-    datasets: list[tuple[str, object]] = []
+    datasets: list[tuple[str, Any]] = []  # h5py.Dataset (h5py has no type hints)
     f.visititems(lambda name, obj: datasets.append((name, obj)) if isinstance(obj, h5py.Dataset) else None)
-    cols: dict[str, tuple[object, int | None]] = {}
+    cols: dict[str, tuple[Any, int | None]] = {}
     for name, ds in datasets:
         attr = next((ds.attrs[a] for a in NAMES_ATTRS if a in ds.attrs), None)
         if attr is not None and ds.ndim == 2:
@@ -100,7 +101,8 @@ def read_hdf5(path: str | Path, columns: list[str] | None = None, start: int = 0
     except InputError:
         raise
     except (OSError, ValueError, TypeError, KeyError, RuntimeError) as exc:
-        raise InputError(f"{path}: not a readable HDF5 log: {str(exc).splitlines()[0] if str(exc) else exc!r}") from None
+        raise InputError(f"{path}: not a readable HDF5 log: "
+                         f"{str(exc).splitlines()[0] if str(exc) else exc!r}") from None
     table = pa.table(cols)
     if metadata:
         try:

@@ -144,15 +144,17 @@ def check_time(time: np.ndarray, source: str, max_gap: float = MAX_GAP,
     if bad.size:
         k = bad[0] + 1
         what = "duplicated" if step[bad[0]] == 0 else "decreasing"
-        raise ColumnError(source, "time", int(first_row + k), f"column 'time' has a {what} stamp at row {first_row + k} ({time[k]:.9g} s after "
-                         f"{time[k - 1]:.9g} s)")
+        raise ColumnError(source, "time", int(first_row + k),
+                          f"column 'time' has a {what} stamp at row {first_row + k} ({time[k]:.9g} s after "
+                          f"{time[k - 1]:.9g} s)")
     dt = np.median(step)
     gap = step >= (max_gap - rel_tol) * dt
     bad = np.flatnonzero(~gap & (np.abs(step - dt) > rel_tol * dt))
     if bad.size:
-        raise ColumnError(source, "time", int(first_row + bad[0] + 1), f"column 'time' is irregular at row {first_row + bad[0] + 1} "
-                         f"(step {step[bad[0]]:.6g} s, median {dt:.6g} s; gaps of {max_gap:g} periods or more "
-                         f"split the log)")
+        raise ColumnError(source, "time", int(first_row + bad[0] + 1),
+                          f"column 'time' is irregular at row {first_row + bad[0] + 1} "
+                          f"(step {step[bad[0]]:.6g} s, median {dt:.6g} s; gaps of {max_gap:g} periods or more "
+                          f"split the log)")
     cuts = np.flatnonzero(gap) + 1
     edges = [0, *cuts.tolist(), time.size]
     return list(zip(edges[:-1], edges[1:]))
@@ -173,8 +175,9 @@ def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT
         out = np.flatnonzero((q[:, i] < lo - margin) | (q[:, i] > hi + margin))
         if out.size:
             k = out[0]
-            raise ColumnError(source, f"q.{name}", int(first_row + k), f"column 'q.{name}' is {q[k, i]:.6g} at row {first_row + k}, beyond its URDF limits "
-                             f"[{lo:.4g}, {hi:.4g}] by more than {margin:g}: wrong units (degrees for radians)?")
+            raise ColumnError(source, f"q.{name}", int(first_row + k),
+                              f"column 'q.{name}' is {q[k, i]:.6g} at row {first_row + k}, beyond its URDF limits "
+                              f"[{lo:.4g}, {hi:.4g}] by more than {margin:g}: wrong units (degrees for radians)?")
 
 
 def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_gap: float = MAX_GAP,
@@ -194,6 +197,19 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
             joint limits, contact flags other than 0/1, a partial base pose, or a
             non-unit quaternion.
     """
+    _check_column_names(table, robot, source)
+    time, segments, q, tau = _read_motion(table, robot, source, max_gap, limit_margin, first_row)
+    contact = _read_contact(table, robot, source, first_row)
+    base = _read_base(table, source, first_row)
+    tau_f_true = _read_tau_f_true(table, robot, len(time), source, first_row)
+    qd_true = _read_true_rates(table, "qd_true", robot, source, first_row)
+    qdd_true = _read_true_rates(table, "qdd_true", robot, source, first_row)
+    return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
+               qd_true=qd_true, qdd_true=qdd_true, segments=segments, period=period)
+
+
+def _check_column_names(table: pa.Table, robot: Robot, source: str) -> None:
+    """Refuse a table without ``time``, with a column naming an unknown joint or frame, or missing a required one."""
     names = set(table.column_names)
     if "time" not in names:
         raise ColumnError(source, "time", None, "missing column 'time'")
@@ -205,16 +221,32 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
                  "qdd_true": act}.get(prefix)
         if known is not None and item not in known:
             what = "contact frame" if prefix == "contact" else "joint"
-            raise ColumnError(source, col, None, f"column '{col}' names an unknown {what} '{item}' of robot '{robot.name}'")
+            raise ColumnError(source, col, None,
+                              f"column '{col}' names an unknown {what} '{item}' of robot '{robot.name}'")
     for col in ([f"q.{n}" for n in robot.actuated] + [f"tau.{n}" for n in robot.torque_controlled]
                 + [f"contact.{f}" for f in robot.contact_frames]):
         if col not in names:
             raise ColumnError(source, col, None, f"missing column '{col}'")
+
+
+def _stack(table: pa.Table, columns: list[str], source: str, first_row: int) -> np.ndarray:
+    """The numeric ``columns`` of ``table`` side by side (N, len(columns))."""
+    return np.column_stack([numeric_column(table, c, source, first_row) for c in columns])
+
+
+def _read_motion(table: pa.Table, robot: Robot, source: str, max_gap: float, limit_margin: float,
+                 first_row: int) -> tuple[np.ndarray, list[tuple[int, int]], np.ndarray, np.ndarray]:
+    """Time [s] (checked, and its segments), q [rad] (checked against the limits) and tau [N·m]."""
     time = numeric_column(table, "time", source, first_row)
     segments = check_time(time, source, max_gap, first_row=first_row)
-    q = np.column_stack([numeric_column(table, f"q.{n}", source, first_row) for n in robot.actuated])
+    q = _stack(table, [f"q.{n}" for n in robot.actuated], source, first_row)
     check_limits(q, robot, source, limit_margin, first_row)
-    tau = np.column_stack([numeric_column(table, f"tau.{n}", source, first_row) for n in robot.torque_controlled])
+    tau = _stack(table, [f"tau.{n}" for n in robot.torque_controlled], source, first_row)
+    return time, segments, q, tau
+
+
+def _read_contact(table: pa.Table, robot: Robot, source: str, first_row: int) -> np.ndarray:
+    """The contact flags (N, n_contacts) as booleans, refusing values other than 0 and 1."""
     contact_cols = []
     for f in robot.contact_frames:
         c = numeric_column(table, f"contact.{f}", source, first_row)
@@ -223,34 +255,48 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
             raise ColumnError(source, f"contact.{f}", int(first_row + bad[0]),
                               f"column 'contact.{f}' must hold 0 or 1, found {c[bad[0]]:g} at row {first_row + bad[0]}")
         contact_cols.append(c.astype(bool))
-    contact = np.column_stack(contact_cols)
-    base = None
+    return np.column_stack(contact_cols)
+
+
+def _read_base(table: pa.Table, source: str, first_row: int) -> np.ndarray | None:
+    """The base poses (N, 7) with unit quaternions, or None if not logged; refuses a partial or non-unit pose."""
+    names = set(table.column_names)
     present = [c for c in BASE_COLUMNS if c in names]
-    if present:
-        missing = [c for c in BASE_COLUMNS if c not in names]
-        if missing:
-            raise ColumnError(source, missing[0], None, f"base pose is partial: missing column '{missing[0]}'")
-        base = np.column_stack([numeric_column(table, c, source, first_row) for c in BASE_COLUMNS])
-        norm = np.linalg.norm(base[:, 3:], axis=1)
-        bad = np.flatnonzero(np.abs(norm - 1.0) > 1e-3)
-        if bad.size:
-            raise ColumnError(source, "base.qw", int(first_row + bad[0]),
-                              f"base quaternion is not unit at row {first_row + bad[0]} (norm {norm[bad[0]]:.6g})")
-        base[:, 3:] /= norm[:, None]
-    tau_f_true = None
-    if any(c.startswith("tau_f_true.") for c in names):
-        tau_f_true = np.column_stack([
-            numeric_column(table, f"tau_f_true.{n}", source, first_row) if f"tau_f_true.{n}" in names else np.full(len(time), np.nan)
-            for n in robot.torque_controlled])
-    truth = {}
-    for prefix in ("qd_true", "qdd_true"):
-        if any(c.startswith(prefix + ".") for c in names):
-            missing = [n for n in robot.actuated if f"{prefix}.{n}" not in names]
-            if missing:
-                raise ColumnError(source, f"{prefix}.{missing[0]}", None, f"missing column '{prefix}.{missing[0]}'")
-            truth[prefix] = np.column_stack([numeric_column(table, f"{prefix}.{n}", source, first_row) for n in robot.actuated])
-    return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
-               qd_true=truth.get("qd_true"), qdd_true=truth.get("qdd_true"), segments=segments, period=period)
+    if not present:
+        return None
+    missing = [c for c in BASE_COLUMNS if c not in names]
+    if missing:
+        raise ColumnError(source, missing[0], None, f"base pose is partial: missing column '{missing[0]}'")
+    base = _stack(table, list(BASE_COLUMNS), source, first_row)
+    norm = np.linalg.norm(base[:, 3:], axis=1)
+    bad = np.flatnonzero(np.abs(norm - 1.0) > 1e-3)
+    if bad.size:
+        raise ColumnError(source, "base.qw", int(first_row + bad[0]),
+                          f"base quaternion is not unit at row {first_row + bad[0]} (norm {norm[bad[0]]:.6g})")
+    base[:, 3:] /= norm[:, None]
+    return base
+
+
+def _read_tau_f_true(table: pa.Table, robot: Robot, rows: int, source: str, first_row: int) -> np.ndarray | None:
+    """The true friction (N, n_tc) [N·m], NaN for joints not logged, or None if no such column."""
+    names = set(table.column_names)
+    if not any(c.startswith("tau_f_true.") for c in names):
+        return None
+    return np.column_stack([
+        numeric_column(table, f"tau_f_true.{n}", source, first_row) if f"tau_f_true.{n}" in names
+        else np.full(rows, np.nan)
+        for n in robot.torque_controlled])
+
+
+def _read_true_rates(table: pa.Table, prefix: str, robot: Robot, source: str, first_row: int) -> np.ndarray | None:
+    """The true ``qd_true`` or ``qdd_true`` columns (N, n_act), all of them, or None if none is logged."""
+    names = set(table.column_names)
+    if not any(c.startswith(prefix + ".") for c in names):
+        return None
+    missing = [n for n in robot.actuated if f"{prefix}.{n}" not in names]
+    if missing:
+        raise ColumnError(source, f"{prefix}.{missing[0]}", None, f"missing column '{prefix}.{missing[0]}'")
+    return _stack(table, [f"{prefix}.{n}" for n in robot.actuated], source, first_row)
 
 
 def write_log(log: Log, robot: Robot, path: str | Path) -> None:

@@ -12,7 +12,7 @@ import hashlib
 import json
 import os
 import tempfile
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import Literal
 
@@ -195,8 +195,9 @@ class RowReader:
             self._stop += batch.num_rows
         while self._buffer and self._start + self._buffer[0].num_rows <= start:  # drop what is behind
             self._start += self._buffer.pop(0).num_rows
-        table = pa.Table.from_batches(self._buffer) if self._buffer else pa.table({})
-        table = table.slice(start - self._start, stop - start)
+        if not self._buffer:  # past the end (a table without columns would slice to any length)
+            return pa.table({})
+        table = pa.Table.from_batches(self._buffer).slice(start - self._start, stop - start)
         return table.replace_schema_metadata(self.metadata) if self.metadata else table
 
 
@@ -221,7 +222,7 @@ def numeric_column(table: pa.Table, name: str, source: str, first_row: int = 0, 
         values = col.to_numpy(zero_copy_only=False).astype(float)
     except (pa.ArrowException, ValueError, TypeError) as exc:
         raise ColumnError(source, name, None, f"column '{name}' is not numeric") from exc
-    bad = np.flatnonzero(~np.isfinite(values)) if finite else ()
+    bad: np.ndarray | Sequence[int] = np.flatnonzero(~np.isfinite(values)) if finite else ()
     if len(bad):
         raise ColumnError(source, name, int(first_row + bad[0]),
                           f"column '{name}' has a non-finite value (NaN or inf) at row {first_row + bad[0]}")
@@ -265,6 +266,16 @@ def write_atomic(path: str | Path, write) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def write_json(path: str | Path, doc: object) -> None:
+    """Write a JSON document (indented by 2, keys in their order), whole or not at all.
+
+    Raises:
+        InputError: an output folder that does not exist.
+    """
+    text = json.dumps(doc, indent=2)
+    write_atomic(path, lambda tmp: tmp.write_text(text))
 
 
 def write_table(table: pa.Table, path: str | Path) -> None:

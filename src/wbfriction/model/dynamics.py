@@ -28,13 +28,15 @@ solves ``J v = 0`` for the contacts on the ground (least squares in double suppo
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import SupportsIndex
 
 import numpy as np
 import pinocchio as pin
 
 from wbfriction.model.robot import Robot
-from wbfriction.progress import counted
+from wbfriction.progress import Progress, counted
 
 
 @dataclass
@@ -54,7 +56,8 @@ class ConstrainedDynamics:
 
 
 def floating_base_state(robot: Robot, data: pin.Data, angles: np.ndarray, qd: np.ndarray,
-                        active: list[int], base: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+                        active: Sequence[SupportsIndex],
+                        base: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
     """Full ``q``, ``v`` of one sample, and the LOCAL Jacobians of the active contacts.
 
     Args:
@@ -86,7 +89,7 @@ def floating_base_state(robot: Robot, data: pin.Data, angles: np.ndarray, qd: np
 
 def constrained_dynamics(robot: Robot, angles: np.ndarray, qd: np.ndarray, qdd_msr: np.ndarray,
                          tau_tc: np.ndarray, contact: np.ndarray, base: np.ndarray | None = None,
-                         with_Mmod_inv: bool = True, progress=None) -> ConstrainedDynamics:
+                         with_Mmod_inv: bool = True, progress: Progress | None = None) -> ConstrainedDynamics:
     """Acceleration estimate (5.10) and ``M_mod^{-1}`` (5.12), one Pinocchio call per sample.
 
     Args:

@@ -11,7 +11,7 @@ import importlib.metadata
 import os
 import sys
 import tomllib
-from collections.abc import Iterator
+from collections.abc import Collection, Iterator
 from contextlib import contextmanager
 from importlib import resources
 from pathlib import Path
@@ -98,18 +98,50 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
             listed both as torque- and position-controlled, a multi-DoF actuated joint.
     """
     urdf = Path(urdf)
+    model = _load_urdf(urdf)
+    actuated = _actuated_joints(model, urdf)
+    pc, tc_cfg = _joint_roles(config, actuated, source)
+    frames = _contact_frames(config, model, urdf, source)
+    groups = _groups(config, actuated, source)
+    q_ref = _reference_configuration(model, config, actuated, source)
+    return Robot(
+        name=str(config.get("name", urdf.stem)),
+        model=model,
+        urdf=urdf,
+        actuated=tuple(actuated),
+        torque_controlled=_in_model_order(actuated, tc_cfg),
+        position_controlled=_in_model_order(actuated, pc),
+        contact_frames=tuple(frames),
+        groups=groups,
+        q_reference=q_ref,
+        balance_gains=_balance_gains(config.get("balance_gains", (0.0, 0.0)), source),
+    )
+
+
+def _load_urdf(urdf: Path) -> pin.Model:
+    """The Pinocchio model of a URDF file, on a free-flyer root joint."""
     if not urdf.is_file():
         raise InputError(f"{urdf}: URDF file not found")
     try:
         with _quiet_stderr():
-            model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+            return pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
     except Exception as exc:  # Pinocchio raises plain RuntimeError/ValueError
         raise InputError(f"{urdf}: URDF does not load: {str(exc).strip().splitlines()[0]}") from exc
+
+
+def _actuated_joints(model: pin.Model, urdf: Path) -> list[str]:
+    """The joints after the root, in model order; each must have one DoF."""
     actuated = []
     for jid in range(2, model.njoints):
         if model.nvs[jid] != 1:
-            raise InputError(f"{urdf}: joint '{model.names[jid]}' has {model.nvs[jid]} DoF; only 1-DoF joints are supported")
+            raise InputError(f"{urdf}: joint '{model.names[jid]}' has {model.nvs[jid]} DoF; "
+                             "only 1-DoF joints are supported")
         actuated.append(model.names[jid])
+    return actuated
+
+
+def _joint_roles(config: dict, actuated: list[str], source: str) -> tuple[list[str], Collection[str]]:
+    """The position- and torque-controlled joints as configured (torque: all the others by default)."""
     known = set(actuated)
     pc = list(config.get("position_controlled", []))
     _check_names(pc, known, "position-controlled joint", source)
@@ -120,17 +152,32 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
     both = set(pc) & set(tc_cfg)
     if both:
         raise InputError(f"{source}: joint '{sorted(both)[0]}' is both torque- and position-controlled")
+    return pc, tc_cfg
+
+
+def _contact_frames(config: dict, model: pin.Model, urdf: Path, source: str) -> list[str]:
+    """The configured contact frames: at least one, each a frame of the model."""
     frames = list(config.get("contact_frames", []))
     if not frames:
         raise InputError(f"{source}: 'contact_frames' is missing or empty")
     for f in frames:
         if not model.existFrame(f):
             raise InputError(f"{source}: unknown contact frame '{f}' (not a frame of {urdf.name})")
+    return frames
+
+
+def _groups(config: dict, actuated: list[str], source: str) -> dict[str, tuple[str, ...]]:
+    """The configured joint groups: group name -> joints."""
+    known = set(actuated)
     groups = {}
     for gname, joints in dict(config.get("groups", {})).items():
         _check_names(joints, known, f"joint in group '{gname}'", source)
         groups[gname] = tuple(joints)
-    in_model_order = lambda names: tuple(n for n in actuated if n in set(names))  # noqa: E731
+    return groups
+
+
+def _reference_configuration(model: pin.Model, config: dict, actuated: list[str], source: str) -> np.ndarray | None:
+    """The SRDF posture ``reference_configuration``, with ``reference_angles`` [rad] set over it, or None."""
     q_ref = None
     srdf = config.get("srdf")
     if srdf:
@@ -141,22 +188,16 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
             q_ref = np.array(model.referenceConfigurations[ref], dtype=float)
     angles = dict(config.get("reference_angles", {}))
     if angles:
-        _check_names(list(angles), known, "joint in reference_angles", source)
+        _check_names(list(angles), set(actuated), "joint in reference_angles", source)
         q_ref = pin.neutral(model) if q_ref is None else q_ref
         for name, angle in angles.items():
             q_ref[model.idx_qs[model.getJointId(name)]] = float(angle)
-    return Robot(
-        name=str(config.get("name", urdf.stem)),
-        model=model,
-        urdf=urdf,
-        actuated=tuple(actuated),
-        torque_controlled=in_model_order(tc_cfg),
-        position_controlled=in_model_order(pc),
-        contact_frames=tuple(frames),
-        groups=groups,
-        q_reference=q_ref,
-        balance_gains=_balance_gains(config.get("balance_gains", (0.0, 0.0)), source),
-    )
+    return q_ref
+
+
+def _in_model_order(actuated: list[str], names: Collection[str]) -> tuple[str, ...]:
+    """The joints ``names`` in the order of ``actuated`` (the model's)."""
+    return tuple(n for n in actuated if n in set(names))
 
 
 def _balance_gains(value, source: str) -> tuple[float, float]:

@@ -207,7 +207,8 @@ def _check_kinematics(robot: Robot, stance: StanceModel, seed: int = 0) -> None:
         rel_m = f_m.actInv(dm.oMi[j])
         rel_r = dr.oMf[r.getFrameId(body_frame(j))]  # root frame is the contact frame at identity
         if not np.allclose(rel_m.homogeneous, rel_r.homogeneous, atol=1e-9):
-            raise ModelError(f"re-rooted model at '{stance.frame}' disagrees with the original at body of '{m.names[j]}'")
+            raise ModelError(f"re-rooted model at '{stance.frame}' disagrees with the original at body of "
+                             f"'{m.names[j]}'")
 
 
 def stance_frame_pose(robot: Robot, stance: StanceModel, angles: np.ndarray, base: np.ndarray | None) -> np.ndarray:

@@ -28,7 +28,7 @@ from wbfriction.friction.estimate import EstimateOptions, estimate_log, no_singl
 from wbfriction.friction.io import friction_table
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, log_from_table
 from wbfriction.logs.source import LogSource
-from wbfriction.logs.tables import TableFile, read_metadata, with_metadata, write_tables
+from wbfriction.logs.tables import RowReader, TableFile, read_metadata, with_metadata, write_tables
 from wbfriction.model.loading import load_robot
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import CONTEXT, Chunk, Chunking, plan_chunks, plan_columns
@@ -85,6 +85,43 @@ def _in_worker(args) -> pa.Table:
     return _estimate_chunk(_ROBOT["robot"], *args)
 
 
+def _chunk_tables(spec: RobotSpec, robot: Robot, reader: RowReader, chunks: list[Chunk], workers: int,
+                  settings: tuple) -> Iterator[pa.Table]:
+    """Each chunk's friction table in order, estimated in this process or on ``workers`` processes."""
+    args = lambda c: (reader.rows(c.read_start, c.read_stop), c, *settings)  # noqa: E731
+    if workers <= 1 or len(chunks) == 1:
+        for c in chunks:
+            yield _estimate_chunk(robot, *args(c))
+        return
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(workers, mp_context=ctx, initializer=_init_worker, initargs=(spec,)) as pool:
+        pending: deque = deque()
+        for c in chunks:
+            pending.append(pool.submit(_in_worker, args(c)))
+            if len(pending) > workers:  # bounded read-ahead: bounded memory
+                yield pending.popleft().result()
+        while pending:
+            yield pending.popleft().result()
+
+
+def _with_provenance(tables: Iterator[pa.Table], chunks: list[Chunk], robot: Robot, source: str,
+                     extra_metadata: dict | None, progress: Progress | None, first_meta: dict) -> Iterator[pa.Table]:
+    """``tables`` with provenance in the first one's metadata (kept in ``first_meta``), counted to ``progress``."""
+    single = False
+    for k, table in enumerate(tables):
+        single = single or bool(pc.any(table.column("unique")).as_py())
+        if k == 0:
+            meta = read_metadata(table, source)
+            meta.update(extra_metadata or {})
+            first_meta.update(meta)
+            table = with_metadata(table, meta)
+        yield table
+        if progress is not None:
+            progress(chunks[k].stop - chunks[k].start)
+    if not single:  # raised before the rename: nothing is written
+        raise no_single_support(robot, source)
+
+
 @dataclass
 class ChunkedResult:
     """What :func:`estimate_file` did: rows, chunks, and their contact-change cuts."""
@@ -131,41 +168,9 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     del contact
     reader = file.row_reader(max(1024, min(chunking.rows, 65_536)))
     first_meta: dict = {}
-
-    def tables():
-        args = lambda c: (reader.rows(c.read_start, c.read_stop), c, source, options, companion,  # noqa: E731
-                          max_gap, limit_margin, period)
-        if chunking.workers <= 1 or len(chunks) == 1:
-            for c in chunks:
-                yield _estimate_chunk(robot, *args(c))
-            return
-        ctx = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(chunking.workers, mp_context=ctx, initializer=_init_worker,
-                                 initargs=(spec,)) as pool:
-            pending: deque = deque()
-            for c in chunks:
-                pending.append(pool.submit(_in_worker, args(c)))
-                if len(pending) > chunking.workers:  # bounded read-ahead: bounded memory
-                    yield pending.popleft().result()
-            while pending:
-                yield pending.popleft().result()
-
-    def with_provenance():
-        single = False
-        for k, table in enumerate(tables()):
-            single = single or bool(pc.any(table.column("unique")).as_py())
-            if k == 0:
-                meta = read_metadata(table, source)
-                meta.update(extra_metadata or {})
-                first_meta.update(meta)
-                table = with_metadata(table, meta)
-            yield table
-            if progress is not None:
-                progress(chunks[k].stop - chunks[k].start)
-        if not single:  # raised before the rename: nothing is written
-            raise no_single_support(robot, source)
-
-    write_tables(output, with_provenance())
+    settings = (source, options, companion, max_gap, limit_margin, period)
+    write_tables(output, _with_provenance(_chunk_tables(spec, robot, reader, chunks, chunking.workers, settings),
+                                          chunks, robot, source, extra_metadata, progress, first_meta))
     return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta)
 
 

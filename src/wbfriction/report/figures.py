@@ -8,9 +8,11 @@ torque friction exerts on the joint [N·m] (negative of the model f of eq. 3.5).
 from __future__ import annotations
 
 import io
+from collections.abc import Set as AbstractSet
 from pathlib import Path
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from wbfriction.friction.estimate import FrictionEstimate
@@ -207,7 +209,7 @@ def _cloud(ax, est: FrictionEstimate, i: int, fit: FitResult | None, target: Fri
 
 
 def friction_overview_figure(est: FrictionEstimate, joints: list[str], fits: dict[str, FitResult],
-                             targets: dict[str, FrictionParams], flagged: set[str] = frozenset(),
+                             targets: dict[str, FrictionParams], flagged: AbstractSet[str] = frozenset(),
                              columns: int = 6, title: str = "Friction over velocity, valid samples, shared axes "
                                                              "(red: power-generating share over threshold)") -> Figure:
     """Small multiples on shared axes: per joint the valid estimates over velocity, the fitted
@@ -240,6 +242,74 @@ def widest_run(mask: np.ndarray, x: np.ndarray) -> slice:
     return max(runs, key=lambda r: float(np.nanmax(x[r]) - np.nanmin(x[r])) if np.isfinite(x[r]).any() else -1.0)
 
 
+def _cloud_panel(ax: Axes, est: FrictionEstimate, i: int, fit: FitResult | None,
+                 target: FrictionParams | None) -> None:
+    """Panel (a) of :func:`joint_figure`: the friction cloud with the fitted model and the target."""
+    _cloud(ax, est, i, fit, target)
+    ax.set_xlabel("qd [rad/s]")
+    ax.set_ylabel("tau_f [N·m]")
+    ax.set_title("(a) friction over velocity", fontsize=9)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7)
+
+
+def _phase_panel(ax: Axes, est: FrictionEstimate, i: int) -> None:
+    """Panel (b) of :func:`joint_figure`: ``tau_f`` over time coloured by support phase, valid samples dark."""
+    for phase, color in PHASE_COLORS.items():
+        sel = est.phase == phase
+        if sel.any():
+            ax.plot(est.time, np.where(sel, est.tau_f[:, i], np.nan), lw=0.5, color=color, alpha=0.45,
+                    label=phase)
+    ax.plot(est.time, np.where(est.valid[:, i], est.tau_f[:, i], np.nan), lw=0.8, color="C1", label="valid")
+    ax.set_xlabel("time [s]")
+    ax.set_title("(b) tau_f over time by support phase", fontsize=9)
+    valid_tau = est.tau_f[est.valid[:, i], i]
+    if valid_tau.size:
+        lim = 1.5 * float(np.max(np.abs(valid_tau))) + 1e-6
+        ax.set_ylim(-lim, lim)
+    ax.legend(fontsize=6, ncol=4, loc="upper right")
+
+
+def _delta_panel(ax: Axes, est: FrictionEstimate, i: int) -> None:
+    """Panel (c) of :func:`joint_figure` (Fig. 7.4): both schemes' ``Delta qdd`` and ``qd`` over one valid stretch."""
+    run = widest_run(est.valid[:, i], est.qd[:, i])
+    if est.delta_qdd is not None and run.stop > run.start:
+        t = est.time[run]
+        diff = est.metadata.get("estimate_options", {}).get("diff", "estimate")
+        ax.plot(t, est.delta_qdd[run, i], color="C0", lw=1, label=f"Δqdd ({diff})")
+        if est.companion_delta_qdd is not None:
+            ax.plot(t, est.companion_delta_qdd[run, i], color="C2", lw=0.7, alpha=0.8,
+                    label=f"Δqdd ({est.companion_diff or 'companion'})")
+        ax.axhline(0, color="k", lw=0.4)
+        ax.set_ylabel("Δqdd [rad/s²]")
+        ax_v = ax.twinx()
+        ax_v.plot(t, est.qd[run, i], color="C3", lw=1, label="qd")
+        ax_v.set_ylabel("qd [rad/s]", color="C3")
+        for a in (ax, ax_v):  # both zero lines at mid-height: the crossings line up by eye
+            top = float(np.nanmax(np.abs(a.get_ylim())))
+            a.set_ylim(-top, top)
+        ax.legend(fontsize=6, loc="upper left")
+        ax.set_xlabel("time [s]")
+    else:
+        ax.text(0.5, 0.5, "no acceleration difference in the table", ha="center", va="center", fontsize=8,
+                transform=ax.transAxes)
+    ax.set_title("(c) Fig. 7.4: Δqdd and velocity, one valid stretch", fontsize=9)
+
+
+def _spectrum_panel(ax: Axes, spectrum: tuple[np.ndarray, np.ndarray, float] | None, max_freq: float) -> None:
+    """Panel (d) of :func:`joint_figure` (Fig. 7.1): the spectrum of ``qdd_est`` and its cutoff, hidden without one."""
+    if spectrum is not None:
+        freq, amp, cutoff = spectrum
+        keep = (freq > 0) & (freq <= max_freq)
+        ax.semilogy(freq[keep], amp[keep], lw=0.7, color="C0")
+        ax.axvline(cutoff, color="C1", ls="--", lw=1)
+        ax.set_xlim(0, max_freq)
+        ax.set_title(f"(d) spectrum of qdd_est: {cutoff:.1f} Hz", fontsize=9)
+        ax.set_xlabel("frequency [Hz]")
+    else:
+        ax.set_visible(False)
+
+
 def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, target: FrictionParams | None,
                  spectrum: tuple[np.ndarray, np.ndarray, float] | None = None, max_freq: float = 50.0) -> Figure:
     """One joint at a glance, four panels:
@@ -258,56 +328,10 @@ def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, targe
     ax_c, ax_t, ax_e, ax_s = fig.subplots(1, 4, gridspec_kw={"width_ratios": [1, 1.6, 1.6, 1], "wspace": 0.5,
                                                                "left": 0.05, "right": 0.99, "bottom": 0.17,
                                                                "top": 0.9})
-    _cloud(ax_c, est, i, fit, target)
-    ax_c.set_xlabel("qd [rad/s]")
-    ax_c.set_ylabel("tau_f [N·m]")
-    ax_c.set_title("(a) friction over velocity", fontsize=9)
-    if ax_c.get_legend_handles_labels()[0]:
-        ax_c.legend(fontsize=7)
-    for phase, color in PHASE_COLORS.items():
-        sel = est.phase == phase
-        if sel.any():
-            ax_t.plot(est.time, np.where(sel, est.tau_f[:, i], np.nan), lw=0.5, color=color, alpha=0.45,
-                      label=phase)
-    ax_t.plot(est.time, np.where(est.valid[:, i], est.tau_f[:, i], np.nan), lw=0.8, color="C1", label="valid")
-    ax_t.set_xlabel("time [s]")
-    ax_t.set_title("(b) tau_f over time by support phase", fontsize=9)
-    valid_tau = est.tau_f[est.valid[:, i], i]
-    if valid_tau.size:
-        lim = 1.5 * float(np.max(np.abs(valid_tau))) + 1e-6
-        ax_t.set_ylim(-lim, lim)
-    ax_t.legend(fontsize=6, ncol=4, loc="upper right")
-    run = widest_run(est.valid[:, i], est.qd[:, i])
-    if est.delta_qdd is not None and run.stop > run.start:
-        t = est.time[run]
-        ax_e.plot(t, est.delta_qdd[run, i], color="C0", lw=1, label=f"Δqdd ({est.metadata.get('estimate_options', {}).get('diff', 'estimate')})")
-        if est.companion_delta_qdd is not None:
-            ax_e.plot(t, est.companion_delta_qdd[run, i], color="C2", lw=0.7, alpha=0.8,
-                      label=f"Δqdd ({est.companion_diff or 'companion'})")
-        ax_e.axhline(0, color="k", lw=0.4)
-        ax_e.set_ylabel("Δqdd [rad/s²]")
-        ax_v = ax_e.twinx()
-        ax_v.plot(t, est.qd[run, i], color="C3", lw=1, label="qd")
-        ax_v.set_ylabel("qd [rad/s]", color="C3")
-        for ax in (ax_e, ax_v):  # both zero lines at mid-height: the crossings line up by eye
-            top = float(np.nanmax(np.abs(ax.get_ylim())))
-            ax.set_ylim(-top, top)
-        ax_e.legend(fontsize=6, loc="upper left")
-        ax_e.set_xlabel("time [s]")
-    else:
-        ax_e.text(0.5, 0.5, "no acceleration difference in the table", ha="center", va="center", fontsize=8,
-                  transform=ax_e.transAxes)
-    ax_e.set_title("(c) Fig. 7.4: Δqdd and velocity, one valid stretch", fontsize=9)
-    if spectrum is not None:
-        freq, amp, cutoff = spectrum
-        keep = (freq > 0) & (freq <= max_freq)
-        ax_s.semilogy(freq[keep], amp[keep], lw=0.7, color="C0")
-        ax_s.axvline(cutoff, color="C1", ls="--", lw=1)
-        ax_s.set_xlim(0, max_freq)
-        ax_s.set_title(f"(d) spectrum of qdd_est: {cutoff:.1f} Hz", fontsize=9)
-        ax_s.set_xlabel("frequency [Hz]")
-    else:
-        ax_s.set_visible(False)
+    _cloud_panel(ax_c, est, i, fit, target)
+    _phase_panel(ax_t, est, i)
+    _delta_panel(ax_e, est, i)
+    _spectrum_panel(ax_s, spectrum, max_freq)
     for ax in (ax_c, ax_t, ax_e, ax_s):
         ax.tick_params(labelsize=7)
     return fig

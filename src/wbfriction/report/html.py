@@ -14,7 +14,7 @@ import numpy as np
 
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.fit import FitResult
-from wbfriction.friction.models import PARAM_NAMES
+from wbfriction.friction.models import PARAM_NAMES, FrictionParams
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
 from wbfriction.report.figures import friction_overview_figure, joint_figure, png_bytes
@@ -39,6 +39,13 @@ section.joint { margin-top: 18px; }
 """
 
 
+_ENERGY_NOTE = ("Share of valid samples with qd·(τ_f + τ_os) &gt; 0 and |τ_f + τ_os| above the tolerance (the\n"
+                "identified offset τ_os is a sensor offset, not friction); zero crossings of the acceleration "
+                "difference Δqdd against those of the velocity within valid stretches,\n"
+                "and the median time from each velocity crossing to the nearest Δqdd crossing.")
+"""The energy section's introduction (HTML)."""
+
+
 def _img(fig, alt: str, id_: str, cls: str) -> str:
     data = base64.b64encode(png_bytes(fig)).decode("ascii")
     return f'<img id="{html.escape(id_)}" class="{cls}" alt="{html.escape(alt)}" src="data:image/png;base64,{data}">'
@@ -48,7 +55,7 @@ def _anchor(joint: str) -> str:
     return "joint-" + "".join(c if c.isalnum() else "-" for c in joint)
 
 
-def _fmt(value: float, se: float | None = None) -> str:
+def _fmt(value: float | None, se: float | None = None) -> str:
     if value is None or not np.isfinite(value):
         return "—"
     if se is None:
@@ -132,36 +139,40 @@ def _energy_table(joints: list[str], energy: dict[str, JointEnergy]) -> str:
             + "".join(_energy_row(energy[j]) for j in joints) + "</table>")
 
 
-def render_html(r: Report) -> str:
-    """The report as one self-contained HTML page."""
-    est = r.est
-    joints = list(est.joints)
-    targets = {j: f.target for j, f in r.fits.items() if f.target is not None}
+def _summary_box(r: Report, n_joints: int) -> str:
+    """The box atop the report: the joints whose friction generates power, or the worst one's share."""
     flagged = r.flagged
-    robot = dict(r.provenance).get("robot", "?")
     if flagged:
-        items = "".join(f"<li>{html.escape(e.warning())}</li>" for e in flagged)
-        summary = (f'<div class="box warn" id="energy-warning"><b>{len(flagged)} of {len(joints)} joints generate '
-                   f"power</b> in more than {100 * r.threshold:g} % of their valid samples (eq. 7.9). Friction "
-                   f"dissipates energy; estimates that generate it point at the inertia model (try "
-                   f"<code>wbfriction sensitivity</code>), a torque-sensor offset or the filtering "
-                   f"(thesis 7.2).<ul>{items}</ul></div>")
-    else:
-        worst = max(r.energy.values(), key=lambda e: e.generating_share if np.isfinite(e.generating_share) else -1)
-        summary = (f'<div class="box ok" id="energy-ok">Every joint\'s friction dissipates energy: at most '
-                   f"{100 * worst.generating_share:.2f} % of a joint's valid samples generate power "
-                   f"({html.escape(worst.joint)}; threshold {100 * r.threshold:g} %).</div>")
-    spectra = acceleration_spectra(est)
-    overview = _img(friction_overview_figure(est, joints, r.fits, targets, {e.joint for e in flagged}),
-                    "friction of every joint over velocity", "overview", "overview-figure")
+        items = "".join(f"<li>{html.escape(e.warning() or '')}</li>" for e in flagged)
+        return (f'<div class="box warn" id="energy-warning"><b>{len(flagged)} of {n_joints} joints generate '
+                f"power</b> in more than {100 * r.threshold:g} % of their valid samples (eq. 7.9). Friction "
+                f"dissipates energy; estimates that generate it point at the inertia model (try "
+                f"<code>wbfriction sensitivity</code>), a torque-sensor offset or the filtering "
+                f"(thesis 7.2).<ul>{items}</ul></div>")
+    worst = max(r.energy.values(), key=lambda e: e.generating_share if np.isfinite(e.generating_share) else -1)
+    return (f'<div class="box ok" id="energy-ok">Every joint\'s friction dissipates energy: at most '
+            f"{100 * worst.generating_share:.2f} % of a joint's valid samples generate power "
+            f"({html.escape(worst.joint)}; threshold {100 * r.threshold:g} %).</div>")
+
+
+def _joint_sections(r: Report, joints: list[str], targets: dict[str, FrictionParams],
+                    spectra: dict[str, tuple[np.ndarray, np.ndarray, float]]) -> list[str]:
+    """One section per joint: its energy note and its :func:`~wbfriction.report.figures.joint_figure`."""
     sections = []
     for j in joints:
         e = r.energy[j]
-        fig = joint_figure(est, j, r.fits.get(j), targets.get(j), spectra.get(j))
+        fig = joint_figure(r.est, j, r.fits.get(j), targets.get(j), spectra.get(j))
         note = (f"{e.n_samples} valid samples; {100 * e.generating_share:.2f} % generate power"
                 if np.isfinite(e.generating_share) else "no valid sample")
         sections.append(f'<section class="joint" id="{_anchor(j)}"><h3>{html.escape(j)}</h3>'
                         f'<p class="sub">{note}</p>{_img(fig, j, "fig-" + _anchor(j), "joint-figure")}</section>')
+    return sections
+
+
+def _page(r: Report, joints: list[str], summary: str, overview: str, sections: list[str]) -> str:
+    """The page around the summary box, the overview figure and the joints' sections."""
+    est = r.est
+    robot = dict(r.provenance).get("robot", "?")
     nav = "".join(f'<a href="#{_anchor(j)}">{html.escape(j)}</a>' for j in joints)
     prov = "".join(f"<dt>{html.escape(k)}</dt><dd>{html.escape(v)}</dd>" for k, v in r.provenance)
     n_valid = int(est.valid.any(axis=1).sum())
@@ -180,9 +191,7 @@ exerts on the joint (dissipative: qd·τ_f ≤ 0); the model f(qd) of eq. (3.5) 
 <p class="sub">Units: F_v N·m·s/rad, F_c and τ_os N·m, v_s rad/s, a s/rad. n.i.: not identifiable from these data.</p>
 {_params_table(joints, r.fits)}
 <h2>Energy consistency (eq. 7.9, Fig. 7.4)</h2>
-<p class="sub">Share of valid samples with qd·(τ_f + τ_os) &gt; 0 and |τ_f + τ_os| above the tolerance (the
-identified offset τ_os is a sensor offset, not friction); zero crossings of the acceleration difference Δqdd against those of the velocity within valid stretches,
-and the median time from each velocity crossing to the nearest Δqdd crossing.</p>
+<p class="sub">{_ENERGY_NOTE}</p>
 {_energy_table(joints, r.energy)}
 {"" if r.identification is None else _identification_section(r.identification)}
 <h2>Joints</h2>
@@ -192,6 +201,18 @@ and the median time from each velocity crossing to the nearest Δqdd crossing.</
 <dl id="provenance">{prov}</dl>
 </body></html>
 """
+
+
+def render_html(r: Report) -> str:
+    """The report as one self-contained HTML page."""
+    est = r.est
+    joints = list(est.joints)
+    targets = {j: f.target for j, f in r.fits.items() if f.target is not None}
+    summary = _summary_box(r, len(joints))
+    spectra = acceleration_spectra(est)
+    overview = _img(friction_overview_figure(est, joints, r.fits, targets, {e.joint for e in r.flagged}),
+                    "friction of every joint over velocity", "overview", "overview-figure")
+    return _page(r, joints, summary, overview, _joint_sections(r, joints, targets, spectra))
 
 
 def write_report(report: Report, output: str | Path) -> None:

@@ -71,7 +71,8 @@ class FilterOptions:
     Attributes:
         window: Savitzky-Golay window length L (odd) [samples].
         poly_order: Savitzky-Golay polynomial order k (>= 2).
-        weights: Savitzky-Golay weights, ``uniform`` or ``gaussian`` (:func:`~wbfriction.signals.filters.savgol_weights`).
+        weights: Savitzky-Golay weights, ``uniform`` or ``gaussian``
+            (:func:`~wbfriction.signals.filters.savgol_weights`).
         cutoff: Butterworth cutoff [Hz] (one pass, -3 dB).
         butter_order: Butterworth order n.
     """
@@ -124,7 +125,7 @@ TorqueAlignment = Literal["zoh", "sample"]
 TORQUE_ALIGNMENTS: tuple[TorqueAlignment, ...] = get_args(TorqueAlignment)
 
 
-def align_torque(tau: np.ndarray, alignment: TorqueAlignment = "zoh") -> np.ndarray:
+def align_torque(tau: np.ndarray, alignment: TorqueAlignment | str = "zoh") -> np.ndarray:
     """Torques as seen by a central second difference at each row.
 
     Args:

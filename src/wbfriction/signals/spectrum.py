@@ -17,6 +17,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.logs.log import Log
 from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
+from wbfriction.progress import Progress
 from wbfriction.signals.filters import finite_runs
 from wbfriction.signals.kinematics import measure
 
@@ -114,7 +115,7 @@ class AccelerationSpectrum:
 
 
 def acceleration_spectrum(robot: Robot, log: Log, joints: list[str] | None = None, tail: float = 0.01,
-                          progress=None) -> AccelerationSpectrum:
+                          progress: Progress | None = None) -> AccelerationSpectrum:
     """Spectrum of ``qdd_est`` (5.10) per joint over the longest stretch with a foot on the ground.
 
     Args:
@@ -132,6 +133,7 @@ def acceleration_spectrum(robot: Robot, log: Log, joints: list[str] | None = Non
     if unknown:
         raise InputError(f"{log.source}: '{unknown[0]}' is not a torque-controlled joint of {robot.name}")
     kin = measure(log, "central")
+    assert kin.valid is not None  # set by MeasuredKinematics.__post_init__
     a, b = longest_run(kin.valid & kin.contact.any(axis=1))
     if b - a < MIN_SAMPLES:
         raise InputError(f"{log.source}: fewer than 64 consecutive samples with a foot on the ground")

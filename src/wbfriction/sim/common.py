@@ -1,4 +1,4 @@
-"""What both simulators share: the injected friction, the result, and the log they write."""
+"""What both simulators share: the injected friction, the result, the log they write and its recording."""
 
 from __future__ import annotations
 
@@ -41,6 +41,7 @@ class InjectedFriction:
         numbers as :func:`~wbfriction.friction.models.coulomb_viscous_stribeck` in fewer operations."""
         if qd.ndim != 1 or not self._gaussian:
             return -coulomb_viscous_stribeck(qd, **self._stacked)
+        assert self._c is not None  # set whenever there are joints, the only case the simulators call this in
         p, FcS, inv_vs = self._c
         e = np.multiply(qd, inv_vs)
         np.square(e, out=e)
@@ -124,3 +125,37 @@ def simulated_log(robot: Robot, reference: WalkingReference, Q: np.ndarray, V: n
             "friction_true": {j: p.to_dict() for j, p in friction.params.items()}, **metadata}
     return Log(reference.time.copy(), Q[:, iq], tau, contact, Q[:, :7].copy() if log_base else None, tau_f, meta,
                source=generator.rsplit(".", 1)[-1], qd_true=V[:, iv], qdd_true=A[:, iv])
+
+
+class Recording:
+    """The signals both simulators log at every sample, and the result they make at the end.
+
+    Attributes:
+        tau: measured torques of the torque-controlled joints (N, n_tc) [N·m].
+        tau_f: friction applied to them (N, n_tc) [N·m], zero on the joints without.
+        wrench: contact wrenches (N, n_contacts, 6), as :attr:`SimulationResult.wrench`.
+    """
+
+    def __init__(self, robot: Robot, reference: WalkingReference, friction: InjectedFriction) -> None:
+        """Empty buffers for the ``len(reference)`` samples of a walk of ``robot``."""
+        n, n_tc = len(reference), robot.tc_index.size
+        self.robot, self.reference, self.friction = robot, reference, friction
+        self.tau = np.empty((n, n_tc))
+        self.tau_f = np.zeros((n, n_tc))
+        self.wrench = np.zeros((n, len(robot.contact_frames), 6))
+
+    def record_torques(self, k: int, tau: np.ndarray, tau_f: np.ndarray | None) -> None:
+        """Log sample ``k``'s measured torques and the friction of the joints that have some."""
+        self.tau[k] = tau
+        if self.friction.joints:
+            self.tau_f[k, self.friction.joints] = tau_f
+
+    def result(self, Q: np.ndarray, V: np.ndarray, A: np.ndarray, contact: np.ndarray, generator: str, options,
+               *, Q_log: np.ndarray | None = None, tau_noise: np.ndarray | None = None,
+               **metadata) -> SimulationResult:
+        """The :func:`simulated_log` of the true states ``Q``, ``V``, ``A`` (its configurations ``Q_log`` if
+        given, its torques plus ``tau_noise`` if given) and the :class:`SimulationResult` around it."""
+        tau = self.tau if tau_noise is None else self.tau + tau_noise
+        log = simulated_log(self.robot, self.reference, Q if Q_log is None else Q_log, V, A, tau, self.tau_f, contact,
+                            self.friction, generator, options, options.log_base, **metadata)
+        return SimulationResult(log, self.wrench, Q, V, self.reference, tuple(self.robot.contact_frames))

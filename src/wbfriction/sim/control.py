@@ -7,7 +7,8 @@ Feed-forward (thesis 4.4 with the contact wrench as unknown): for the reference
 unique; in double support the wrench is shared between the feet by the weighted
 minimum norm
 
-.. math:: \\lambda = W^{-1} J_b (J_b^T W^{-1} J_b)^{-1} b_{base}, \\quad W = \\mathrm{diag}(I_6/\\alpha_L, I_6/\\alpha_R),
+.. math:: \\lambda = W^{-1} J_b (J_b^T W^{-1} J_b)^{-1} b_{base},
+          \\quad W = \\mathrm{diag}(I_6/\\alpha_L, I_6/\\alpha_R),
 
 with ``alpha`` the share of each foot, from the position of the ZMP reference between
 the feet (1 on the foot the ZMP is over, 0 on the other). The joint torques are then
@@ -23,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from wbfriction.exceptions import InputError
 from wbfriction.model.robot import Robot
 from wbfriction.model.stance import stance_model
 from wbfriction.walking import WalkingReference
@@ -75,7 +77,7 @@ def feedforward(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, conta
     n, nc = len(q), len(robot.contact_frames)
     n_active = contact.sum(axis=1)
     if np.any(n_active == 0):
-        raise ValueError(f"feed-forward: no foot in contact at sample {int(np.argmin(n_active))}")
+        raise InputError(f"feed-forward: no foot in contact at sample {int(np.argmin(n_active))}")
     tau = np.zeros((n, robot.n_act))
     wrench = np.zeros((n, nc, 6))
     for c in range(nc):
@@ -189,7 +191,8 @@ def ramp_gains(current: tuple[np.ndarray, np.ndarray], target: tuple[np.ndarray,
 
 
 def attitude_ankle_torques(R: np.ndarray, omega: np.ndarray, R_ref: np.ndarray, omega_ref: np.ndarray,
-                           gains: tuple[float, float], ankle_axes: list[np.ndarray], load: np.ndarray) -> list[np.ndarray]:
+                           gains: tuple[float, float], ankle_axes: list[np.ndarray],
+                           load: np.ndarray) -> list[np.ndarray]:
     """Torques of the stance ankles that right the base (an ankle strategy on the IMU).
 
     The base's tilt error ``e = log(R R_ref^T)`` and rate error ``omega - omega_ref`` (both

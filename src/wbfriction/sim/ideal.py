@@ -41,8 +41,8 @@ import pinocchio as pin
 from wbfriction.exceptions import InputError
 from wbfriction.friction.models import FrictionParams
 from wbfriction.model.robot import Robot
-from wbfriction.progress import counted
-from wbfriction.sim.common import SimulationResult, injected_friction, simulated_log
+from wbfriction.progress import Progress, counted
+from wbfriction.sim.common import InjectedFriction, Recording, SimulationResult, injected_friction
 from wbfriction.sim.control import contact_jacobian, gain_schedule, pd_gains, reference_feedforward
 from wbfriction.walking import WalkingReference
 from wbfriction.walking.swing import foot_placement
@@ -103,7 +103,7 @@ def _project_configuration(robot: Robot, data: pin.Data, q: np.ndarray, contacts
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
         active = np.flatnonzero(contacts)
-        e = np.concatenate([pin.log6(anchors[c].actInv(data.oMf[robot.contact_frame_ids[c]])).vector
+        e = np.concatenate([pin.log6(anchors[int(c)].actInv(data.oMf[robot.contact_frame_ids[c]])).vector
                             for c in active])
         J = contact_jacobian(robot, data, contacts)
         dq = np.zeros(model.nv)
@@ -125,12 +125,13 @@ def _solve_small(A: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _constraints(robot: Robot, data: pin.Data, active: np.ndarray, anchors: dict[int, pin.SE3],
-                 baumgarte: tuple[float, float]):
+                 baumgarte: tuple[float, float]) -> tuple[list, list]:
+    """6D rigid constraints welding the ``active`` soles to their anchors, initialised in ``data``."""
     models = []
     for c in np.flatnonzero(active):
         fr = robot.model.frames[robot.contact_frame_ids[c]]
         cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_6D, robot.model, fr.parentJoint, fr.placement,
-                                      0, anchors[c], pin.LOCAL)
+                                      0, anchors[int(c)], pin.LOCAL)
         cm.setBaumgarteCorrectorParameters(pin.BaumgarteCorrectorParameters(*baumgarte))
         models.append(cm)
     datas = [cm.createData() for cm in models]
@@ -138,9 +139,146 @@ def _constraints(robot: Robot, data: pin.Data, active: np.ndarray, anchors: dict
     return models, datas
 
 
+class _IdealRun:
+    """One run of :func:`simulate_ideal`: the model, the controller, the contacts, the state and the log."""
+
+    def __init__(self, robot: Robot, reference: WalkingReference, injected: InjectedFriction,
+                 options: IdealOptions) -> None:
+        """Set up the controller, the reference per sample, the initial state and the log buffers."""
+        self.robot, self.ref, self.injected, self.options = robot, reference, injected, options
+        self.model = robot.model
+        self.data = self.model.createData()
+        n, dt = len(reference), reference.dt
+        self.h = dt / options.substeps
+
+        tau_ff = reference_feedforward(robot, reference)
+        gains = pd_gains(robot, reference.q[0], options.bandwidth, options.damping)
+        self.kp_all, self.kd_all = gain_schedule(gains, reference.contact, dt, options.gain_blend)
+        self.bkp, self.bkd = options.baumgarte
+
+        iv, iq = robot.act_v_index, robot.act_q_index
+        tc, self.pc = robot.tc_index, robot.pc_index
+        self.iv_tc, self.iv_pc, self.iq_tc, self.iq_pc = iv[tc], iv[self.pc], iq[tc], iq[self.pc]
+        self.joints_f = injected.joints
+        self.iv_f = self.iv_tc[self.joints_f]
+        self.settings = pin.ProximalSettings(1e-12, 1e-10, 50)
+        self.semi_implicit = options.integrator == "semi-implicit"
+        self.project_every_sample = options.projection == "sample"
+        # the reference, contiguous per sample
+        ref = reference
+        self.ff_tc = np.ascontiguousarray(tau_ff[:, tc])
+        self.q_ref_tc = np.ascontiguousarray(ref.q[:, self.iq_tc])
+        self.v_ref_tc = np.ascontiguousarray(ref.v[:, self.iv_tc])
+        self.q_ref_pc, self.v_ref_pc, self.a_ref_pc = ref.q[:, self.iq_pc], ref.v[:, self.iv_pc], ref.a[:, self.iv_pc]
+        self.switches = set(np.flatnonzero(np.any(np.diff(ref.contact, axis=0, prepend=False), axis=1)).tolist())
+
+        self.Q = np.empty((n, self.model.nq))
+        self.V = np.empty((n, self.model.nv))
+        self.A = np.empty((n, self.model.nv))
+        self.recording = Recording(robot, reference, injected)
+        self.q, self.v = ref.q[0].copy(), ref.v[0].copy()
+        self.anchors: dict[int, pin.SE3] = {}
+        self.active = np.zeros(len(robot.contact_frames), bool)
+        self.tau_pc = tau_ff[0, self.pc].copy()
+        self.tau = np.zeros(self.model.nv)
+        self.tau_f: np.ndarray | None = None
+
+    def sample(self, k: int) -> None:
+        """Run the control period of sample ``k``: contact changes, projection, control, physics steps."""
+        switch = k in self.switches
+        if switch:
+            self.switch_contacts(k)
+        # velocity onto the constraints (plastic impact at touch-down, drift otherwise)
+        if switch or self.project_every_sample:
+            self.v = pin.impulseDynamics(self.model, self.data, self.q, self.v, self.cmodels, self.cdatas, 0.0,
+                                         self.settings).copy()
+        tau_cmd = self.control(k)
+        for s in range(self.options.substeps):
+            self.step(k, s == 0, tau_cmd)
+
+    def switch_contacts(self, k: int) -> None:
+        """Anchor the feet landing at sample ``k``, project onto them, and rebuild the contact constraints."""
+        ref = self.ref
+        landing = ref.contact[k] & ~self.active
+        for c in np.flatnonzero(landing):
+            self.anchors[int(c)] = foot_placement(ref.feet[k, c])  # planned footprint, flat, z = 0
+        self.active = ref.contact[k].copy()
+        if landing.any():
+            self.q = _project_configuration(self.robot, self.data, self.q, self.active, self.anchors)
+        self.cmodels, self.cdatas = _constraints(self.robot, self.data, self.active, self.anchors,
+                                                 self.options.baumgarte)
+        self.n_lam = 6 * int(self.active.sum())
+        # one right-hand side per position-controlled joint (unit torque) and one for
+        # the contacts' Baumgarte term
+        self.rhs = np.zeros((self.n_lam + self.model.nv, self.pc.size + 1))
+        self.rhs[self.n_lam + self.iv_pc, np.arange(self.pc.size)] = 1.0
+
+    def control(self, k: int) -> np.ndarray:
+        """The torque command of the torque-controlled joints at sample ``k``: feed-forward plus PD."""
+        return (self.ff_tc[k] + self.kp_all[k] * (self.q_ref_tc[k] - self.q[self.iq_tc])
+                + self.kd_all[k] * (self.v_ref_tc[k] - self.v[self.iv_tc]))
+
+    def step(self, k: int, first: bool, tau_cmd: np.ndarray) -> None:
+        """One physics step of period ``k`` under ``tau_cmd``; the ``first`` one is the logged sample."""
+        a, X, lam = self.dynamics(first, tau_cmd)
+        if self.pc.size:  # position-controlled joints: acceleration = reference, stabilised
+            lam = self.position_control(k, a, X, lam)
+        if first:
+            self.record(k, tau_cmd, a, X, lam)
+        h = self.h
+        if self.semi_implicit:
+            self.v = self.v + h * a
+            self.q = pin.integrate(self.model, self.q, h * self.v)
+        else:
+            self.q = pin.integrate(self.model, self.q, h * self.v)
+            self.v = self.v + h * a
+
+    def dynamics(self, first: bool, tau_cmd: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Constrained forward dynamics with friction: the acceleration, the KKT solves, the contact forces."""
+        tau = self.tau
+        tau[self.iv_tc] = tau_cmd
+        if self.joints_f:
+            self.tau_f = self.injected.torque(self.v[self.iv_f])
+            tau[self.iv_f] += self.tau_f
+        tau[self.iv_pc] = self.tau_pc
+        a = pin.constraintDynamics(self.model, self.data, self.q, self.v, tau, self.cmodels, self.cdatas,
+                                   self.settings).copy()
+        if first:
+            self.rhs[:self.n_lam, -1] = np.concatenate([self.bkp * cd.contact_placement_error.vector
+                                                        + self.bkd * cd.contact_velocity_error.vector
+                                                        for cd in self.cdatas])
+        X = self.data.constraint_chol.solve(self.rhs)
+        return a, X, self.data.lambda_c
+
+    def position_control(self, k: int, a: np.ndarray, X: np.ndarray, lam: np.ndarray) -> np.ndarray:
+        """Give the position-controlled joints the reference acceleration (``a`` in place); the new forces."""
+        n_lam, iv_pc = self.n_lam, self.iv_pc
+        a_des = (self.a_ref_pc[k] + self.bkd * (self.v_ref_pc[k] - self.v[iv_pc])
+                 + self.bkp * (self.q_ref_pc[k] - self.q[self.iq_pc]))
+        delta = _solve_small(X[n_lam + iv_pc, :-1], a_des - a[iv_pc])
+        a += X[n_lam:, :-1] @ delta
+        lam = lam - X[:n_lam, :-1] @ delta
+        self.tau_pc = self.tau_pc + delta
+        return lam
+
+    def record(self, k: int, tau_cmd: np.ndarray, a: np.ndarray, X: np.ndarray, lam: np.ndarray) -> None:
+        """Log sample ``k``: the state, the true acceleration (without the Baumgarte term), torques, wrenches."""
+        self.Q[k], self.V[k], self.A[k] = self.q, self.v, a + X[self.n_lam:, -1]
+        self.recording.record_torques(k, tau_cmd, self.tau_f)
+        self.recording.wrench[k, self.active] = lam.reshape(-1, 6)
+
+    def result(self) -> SimulationResult:
+        """The log (planned contacts) and the result of the run."""
+        # semi-implicit Euler at the log rate: the central second difference at k is the
+        # acceleration tau[k] caused; otherwise the torque is held over several steps
+        alignment = "sample" if self.semi_implicit and self.options.substeps == 1 else "zoh"
+        return self.recording.result(self.Q, self.V, self.A, self.ref.contact.copy(),
+                                     "wbfriction.sim.ideal.simulate_ideal", self.options, torque_alignment=alignment)
+
+
 def simulate_ideal(robot: Robot, reference: WalkingReference,
                    friction: dict[str, FrictionParams] | None = None,
-                   options: IdealOptions = IdealOptions(), progress=None) -> SimulationResult:
+                   options: IdealOptions = IdealOptions(), progress: Progress | None = None) -> SimulationResult:
     """Simulate a walk in the ideal simulator (module docstring).
 
     Args:
@@ -157,98 +295,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
     Raises:
         InputError: a friction entry for a joint that is not torque-controlled.
     """
-    injected = injected_friction(robot, friction)
-    model = robot.model
-    data = model.createData()
-    ref = reference
-    n, dt = len(ref), ref.dt
-    h = dt / options.substeps
-    nc = len(robot.contact_frames)
-
-    tau_ff = reference_feedforward(robot, ref)
-    gains = pd_gains(robot, ref.q[0], options.bandwidth, options.damping)
-    kp_all, kd_all = gain_schedule(gains, ref.contact, dt, options.gain_blend)
-    bkp, bkd = options.baumgarte
-
-    iv, iq = robot.act_v_index, robot.act_q_index
-    tc, pc = robot.tc_index, robot.pc_index
-    iv_tc, iv_pc, iq_tc, iq_pc = iv[tc], iv[pc], iq[tc], iq[pc]
-    joints_f = injected.joints
-    iv_f = iv_tc[joints_f]
-    settings = pin.ProximalSettings(1e-12, 1e-10, 50)
-    semi_implicit = options.integrator == "semi-implicit"
-    project_every_sample = options.projection == "sample"
-    # the reference, contiguous per sample
-    ff_tc = np.ascontiguousarray(tau_ff[:, tc])
-    q_ref_tc, v_ref_tc = np.ascontiguousarray(ref.q[:, iq_tc]), np.ascontiguousarray(ref.v[:, iv_tc])
-    q_ref_pc, v_ref_pc, a_ref_pc = ref.q[:, iq_pc], ref.v[:, iv_pc], ref.a[:, iv_pc]
-    switches = set(np.flatnonzero(np.any(np.diff(ref.contact, axis=0, prepend=False), axis=1)).tolist())
-
-    Q = np.empty((n, model.nq))
-    V = np.empty((n, model.nv))
-    A = np.empty((n, model.nv))
-    tau_log = np.empty((n, tc.size))
-    tau_f_log = np.zeros((n, tc.size))
-    wrench = np.zeros((n, nc, 6))
-    q, v = ref.q[0].copy(), ref.v[0].copy()
-    anchors: dict[int, pin.SE3] = {}
-    active = np.zeros(nc, bool)
-    tau_pc = tau_ff[0, pc].copy()
-    tau = np.zeros(model.nv)
-    for k in counted(n, progress):
-        switch = k in switches
-        if switch:
-            landing = ref.contact[k] & ~active
-            for c in np.flatnonzero(landing):
-                anchors[c] = foot_placement(ref.feet[k, c])  # planned footprint, flat, z = 0
-            active = ref.contact[k].copy()
-            if landing.any():
-                q = _project_configuration(robot, data, q, active, anchors)
-            cmodels, cdatas = _constraints(robot, data, active, anchors, options.baumgarte)
-            n_lam = 6 * int(active.sum())
-            # one right-hand side per position-controlled joint (unit torque) and one for
-            # the contacts' Baumgarte term
-            rhs = np.zeros((n_lam + model.nv, pc.size + 1))
-            rhs[n_lam + iv_pc, np.arange(pc.size)] = 1.0
-        # velocity onto the constraints (plastic impact at touch-down, drift otherwise)
-        if switch or project_every_sample:
-            v = pin.impulseDynamics(model, data, q, v, cmodels, cdatas, 0.0, settings).copy()
-        tau_cmd = ff_tc[k] + kp_all[k] * (q_ref_tc[k] - q[iq_tc]) + kd_all[k] * (v_ref_tc[k] - v[iv_tc])
-        for s in range(options.substeps):
-            first = s == 0
-            tau[iv_tc] = tau_cmd
-            if joints_f:
-                tau_f = injected.torque(v[iv_f])
-                tau[iv_f] += tau_f
-            tau[iv_pc] = tau_pc
-            a = pin.constraintDynamics(model, data, q, v, tau, cmodels, cdatas, settings).copy()
-            if first:
-                rhs[:n_lam, -1] = np.concatenate([bkp * cd.contact_placement_error.vector
-                                                  + bkd * cd.contact_velocity_error.vector for cd in cdatas])
-            X = data.constraint_chol.solve(rhs)
-            lam = data.lambda_c
-            if pc.size:  # position-controlled joints: acceleration = reference, stabilised
-                a_des = a_ref_pc[k] + bkd * (v_ref_pc[k] - v[iv_pc]) + bkp * (q_ref_pc[k] - q[iq_pc])
-                delta = _solve_small(X[n_lam + iv_pc, :-1], a_des - a[iv_pc])
-                a += X[n_lam:, :-1] @ delta
-                lam = lam - X[:n_lam, :-1] @ delta
-                tau_pc = tau_pc + delta
-            if first:  # the logged sample; true acceleration: without the Baumgarte term
-                Q[k], V[k], A[k] = q, v, a + X[n_lam:, -1]
-                tau_log[k] = tau_cmd
-                if joints_f:
-                    tau_f_log[k, joints_f] = tau_f
-                wrench[k, active] = lam.reshape(-1, 6)
-            if semi_implicit:
-                v = v + h * a
-                q = pin.integrate(model, q, h * v)
-            else:
-                q = pin.integrate(model, q, h * v)
-                v = v + h * a
-
-    # semi-implicit Euler at the log rate: the central second difference at k is the
-    # acceleration tau[k] caused; otherwise the torque is held over several steps
-    alignment = "sample" if semi_implicit and options.substeps == 1 else "zoh"
-    log = simulated_log(robot, ref, Q, V, A, tau_log, tau_f_log, ref.contact.copy(), injected,
-                        "wbfriction.sim.ideal.simulate_ideal", options, options.log_base, torque_alignment=alignment)
-    return SimulationResult(log, wrench, Q, V, ref, tuple(robot.contact_frames))
+    run = _IdealRun(robot, reference, injected_friction(robot, friction), options)
+    for k in counted(len(reference), progress):
+        run.sample(k)
+    return run.result()

@@ -20,6 +20,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 import mujoco
 import numpy as np
@@ -80,12 +81,13 @@ def sole_footprint(robot: Robot, frame: str, urdf_root: ET.Element | None = None
 def _collision_vertices(col: ET.Element, urdf: Path) -> np.ndarray | None:
     """Vertices (n, 3) of a URDF collision element in its link's frame: a binary STL mesh's,
     or a box's corners; None for other shapes."""
+    # a mesh's filename and a box's size are required by URDF (cast, not checked: a missing one fails on None)
     mesh, box = col.find("geometry/mesh"), col.find("geometry/box")
     if mesh is not None:
         scale = np.array([float(s) for s in (mesh.get("scale") or "1 1 1").split()])
-        v = _read_stl(_resolve_mesh(mesh.get("filename"), urdf)) * scale
+        v = _read_stl(_resolve_mesh(cast(str, mesh.get("filename")), urdf)) * scale
     elif box is not None:
-        half = np.array([float(s) for s in box.get("size").split()]) / 2
+        half = np.array([float(s) for s in cast(str, box.get("size")).split()]) / 2
         v = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
     else:
         return None
@@ -187,6 +189,19 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
     """
     root = ET.parse(robot.urdf).getroot()
     footprints = [sole_footprint(robot, f, root) for f in robot.contact_frames]
+    spec = _urdf_spec(robot, root, timestep)
+    _add_soles(spec, robot, footprints)
+    _add_motors(spec, robot)
+    try:
+        mj = spec.compile()
+    except Exception as exc:
+        raise ModelError(f"{robot.urdf}: MuJoCo cannot compile the model: {exc}") from None
+    return _mujoco_robot(robot, mj)
+
+
+def _urdf_spec(robot: Robot, root: ET.Element, timestep: float) -> mujoco.MjSpec:
+    """The MuJoCo spec of the URDF ``root`` (changed: stripped of meshes, dynamics, Gazebo and
+    transmission tags), with a free joint at the root and a floor."""
     for link in root.findall("link"):
         for tag in ("visual", "collision"):
             for e in link.findall(tag):
@@ -206,6 +221,11 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
     spec.option.timestep = timestep
     spec.worldbody.first_body().add_freejoint()
     spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1])
+    return spec
+
+
+def _add_soles(spec: mujoco.MjSpec, robot: Robot, footprints: list[tuple[np.ndarray, np.ndarray]]) -> None:
+    """One box per contact frame on its footprint (centre, half sizes), with a touch sensor."""
     model = robot.model
     for frame, (centre, half) in zip(robot.contact_frames, footprints):
         fr = model.frames[model.getFrameId(frame)]
@@ -223,6 +243,11 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
                       quat=pin.Quaternion(fr.placement.rotation).coeffs()[[3, 0, 1, 2]])
         spec.add_sensor(name=f"touch_{frame}", type=mujoco.mjtSensor.mjSENS_TOUCH,
                         objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"touch_{frame}")
+
+
+def _add_motors(spec: mujoco.MjSpec, robot: Robot) -> None:
+    """One motor per actuated joint, its torque clipped at the URDF's effort limit (if any)."""
+    model = robot.model
     for name in robot.actuated:
         jid = model.getJointId(name)
         effort = float(model.effortLimit[model.joints[jid].idx_v])
@@ -231,10 +256,10 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
         if np.isfinite(effort) and effort > 0:
             motor.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
             motor.forcerange = [-effort, effort]
-    try:
-        mj = spec.compile()
-    except Exception as exc:
-        raise ModelError(f"{robot.urdf}: MuJoCo cannot compile the model: {exc}") from None
+
+
+def _mujoco_robot(robot: Robot, mj: mujoco.MjModel) -> MujocoRobot:
+    """The :class:`MujocoRobot` of a compiled model: the addresses of the joints, soles and sensors."""
     qpos_index, dof_index, joint_ids = [], [], []
     for name in robot.actuated:
         jid = mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_JOINT, name)

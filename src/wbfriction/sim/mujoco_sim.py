@@ -63,8 +63,8 @@ from wbfriction.exceptions import InputError, SimulationError
 from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.targets import friction_by_group
 from wbfriction.model.robot import Robot
-from wbfriction.progress import counted
-from wbfriction.sim.common import InjectedFriction, SimulationResult, injected_friction, simulated_log
+from wbfriction.progress import Progress, counted
+from wbfriction.sim.common import InjectedFriction, Recording, SimulationResult, injected_friction
 from wbfriction.sim.control import attitude_ankle_torques, pd_from_inertia, pd_gains, ramp_gains, reference_feedforward
 from wbfriction.sim.mujoco_model import MujocoRobot, build_mujoco_robot
 from wbfriction.sim.sensors import SensorNoise
@@ -154,9 +154,177 @@ def mujoco_friction_torque(data: mujoco.MjData, dofs: np.ndarray) -> np.ndarray:
     return force[dofs]
 
 
+class _MujocoRun:
+    """One run of :func:`simulate_mujoco`: the MuJoCo model and data, the controller, the state and the log."""
+
+    def __init__(self, robot: Robot, reference: WalkingReference, friction: dict[str, FrictionParams] | None,
+                 options: MujocoOptions, mjr: MujocoRobot | None) -> None:
+        """Set up the model (friction), the stabiliser, the controller, the initial state and the log buffers."""
+        self.native = native = options.friction == "mujoco"
+        if friction is None and native:
+            friction = {j: dataclasses.replace(p, S=0.0, tau_os=0.0)
+                        for j, p in friction_by_group(robot.groups).items()}
+        self.injected = injected_friction(robot, friction)
+        self.robot, self.ref, self.options = robot, reference, options
+        self.n, self.dt = len(reference), reference.dt
+        self.delay = options.delay_periods(self.dt)
+        self.mjr = mjr or build_mujoco_robot(robot)
+        self.model = copy.copy(self.mjr.model)  # the settings below must not leak into a shared model
+        self.model.opt.timestep = self.dt / options.substeps
+        self.tc, self.pc = robot.tc_index, robot.pc_index
+        self.nc, self.n_act = len(robot.contact_frames), len(robot.actuated)
+        self.joints_f = self.injected.joints
+        self.dof_f = self.mjr.dof_index[self.tc][self.joints_f]
+        if native:
+            set_mujoco_friction(self.model, self.dof_f, self.injected)
+        self.data = mujoco.MjData(self.model)
+        self._setup_stabiliser()
+        self._setup_controller()
+        self._setup_state()
+
+    def _setup_stabiliser(self) -> None:
+        """The base-attitude stabiliser: each leg's last two joints (the ankle), the reference base attitude."""
+        robot, ref = self.robot, self.ref
+        self.balance = robot.balance_gains if self.options.balance is None else self.options.balance
+        self.stabilise = any(self.balance)
+        if self.stabilise:
+            self.ankles = [np.array([robot.actuated.index(j) for j in robot.limb(f)[-2:]])
+                           for f in robot.contact_frames]
+            self.ankle_jnt = [self.mjr.joint_ids[a] for a in self.ankles]
+            self.R_ref = Rotation.from_quat(ref.q[:, 3:7]).as_matrix()
+            self.w_ref = np.einsum("nij,nj->ni", self.R_ref, ref.v[:, 3:6])  # world frame
+
+    def _setup_controller(self) -> None:
+        """The controller: feed-forward, PD gains per contact state (capped), the sensor noise."""
+        robot, ref, options, dt, tc, pc = self.robot, self.ref, self.options, self.dt, self.tc, self.pc
+        iq, iv = robot.act_q_index, robot.act_v_index
+        self.tau_ff = reference_feedforward(robot, ref)
+        free = np.diag(pin.crba(robot.model, robot.model.createData(), ref.q[0]))[iv]  # inertia, upstream held
+        kp_max = np.minimum(options.max_gains[0], free[tc] / dt**2)
+        kd_max = np.minimum(options.max_gains[1], free[tc] / dt)
+        self.gains = {state: (np.minimum(kp, kp_max), np.minimum(kd, kd_max))
+                      for state, (kp, kd) in pd_gains(robot, ref.q[0], options.bandwidth, options.damping).items()}
+        self.kp_act, self.kd_act = np.zeros(self.n_act), np.zeros(self.n_act)
+        self.kp_act[pc], self.kd_act[pc] = pd_from_inertia(free[pc], options.bandwidth, options.damping)
+        self.q_ref, self.v_ref = ref.q[:, iq], ref.v[:, iv]
+        self.eps_q, self.eps_tau = options.sensors.draw(self.n, self.n_act, tc.size)
+
+    def _setup_state(self) -> None:
+        """The initial state (the reference's first sample), the log buffers, the controller's state."""
+        data, mjr, ref, n, nc, n_act = self.data, self.mjr, self.ref, self.n, self.nc, self.n_act
+        data.qpos[:] = mjr.qpos(ref.q[0])
+        data.qvel[:] = mjr.velocity_map(ref.q[0]) @ ref.v[0]
+        mujoco.mj_forward(self.model, data)
+        self.z0 = data.qpos[2]
+
+        self.qpos, self.qvel = np.empty((n, self.model.nq)), np.empty((n, self.model.nv))
+        self.q_meas, self.qdd = np.empty((n, n_act)), np.empty((n, n_act))
+        self.recording = Recording(self.robot, ref, self.injected)
+        self.contact, self.force = np.zeros((n, nc), dtype=bool), np.zeros((n, nc))
+        self.commands = np.zeros((self.delay + 1, n_act))  # ring buffer: the command of period k acts at k + delay
+        self.state: tuple[bool, ...] | None  # the contact state the gains are scheduled for
+        self.before: tuple[np.ndarray, np.ndarray] | None  # the gains (kp, kd) when it began, at period k_switch
+        self.state, self.k_switch, self.before = None, 0, None
+        self.kp_act[self.tc], self.kd_act[self.tc] = self.gains[tuple(bool(x) for x in ref.contact[0])]
+        self.tau_f = np.zeros(len(self.joints_f))
+        self.torque_friction = bool(self.joints_f) and not self.native  # (3.5) applied by us at every physics step
+        self.bad_qacc = int(mujoco.mjtWarning.mjWARN_BADQACC)
+
+    def sample(self, k: int) -> None:
+        """Run the control period of sample ``k``: measure, command, step the physics, sense the contacts."""
+        qd_meas = self.measure(k)
+        self.actuate(k, self.control(k, qd_meas))
+        for s in range(self.options.substeps):
+            self.step(k, s == 0)
+        self.sense_contacts(k)
+
+    def actuate(self, k: int, command: np.ndarray) -> None:
+        """Queue the command of period ``k`` and give the motors the one ``delay`` periods old."""
+        d = self.delay
+        self.commands[k % (d + 1)] = command
+        self.data.ctrl[:] = self.commands[(k - d) % (d + 1)] if k >= d else self.tau_ff[k]  # at first: feed-forward
+
+    def measure(self, k: int) -> np.ndarray:
+        """Log the state at the start of period ``k`` and the measured positions; the measured velocities."""
+        data = self.data
+        self.qpos[k], self.qvel[k] = data.qpos, data.qvel
+        self.q_meas[k] = self.options.sensors.encoder(data.qpos[self.mjr.qpos_index] + self.eps_q[k])
+        return (self.q_meas[k] - self.q_meas[k - 1]) / self.dt if k > 0 else self.v_ref[0]
+
+    def control(self, k: int, qd_meas: np.ndarray) -> np.ndarray:
+        """The command of period ``k``: feed-forward, PD on the measurements, the attitude stabiliser."""
+        # the controller knows the contact measured over the last period (the plan at first)
+        last = self.contact[k - 1] if k > 0 and self.contact[k - 1].any() else self.ref.contact[k]
+        self.schedule_gains(k, tuple(bool(x) for x in last))
+        command = (self.tau_ff[k] + self.kp_act * (self.q_ref[k] - self.q_meas[k])
+                   + self.kd_act * (self.v_ref[k] - qd_meas))
+        if self.stabilise:
+            data = self.data
+            R = data.xmat[self.mjr.base_body].reshape(3, 3)
+            load = (self.force[k - 1] if k > 0 else np.ones(self.nc)) * last
+            torques = attitude_ankle_torques(R, R @ data.qvel[3:6], self.R_ref[k], self.w_ref[k], self.balance,
+                                             [data.xaxis[j] for j in self.ankle_jnt], load)
+            for a, t in zip(self.ankles, torques):
+                command[a] += t
+        return command
+
+    def schedule_gains(self, k: int, measured: tuple[bool, ...]) -> None:
+        """The torque-controlled joints' gains at period ``k``, ramping since the last change of ``measured``."""
+        tc, dt, blend = self.tc, self.dt, self.options.gain_blend
+        if measured != self.state:
+            self.state, self.k_switch, self.before = measured, k, (self.kp_act[tc].copy(), self.kd_act[tc].copy())
+        assert self.state is not None and self.before is not None  # set above at the first call
+        if (k - self.k_switch) * dt <= blend + dt:
+            self.kp_act[tc], self.kd_act[tc] = ramp_gains(self.before, self.gains[self.state],
+                                                          (k - self.k_switch) * dt, blend)
+
+    def step(self, k: int, first: bool) -> None:
+        """One physics step of period ``k`` with the friction of eq. (3.5) if ours; the ``first`` one is logged."""
+        if self.torque_friction:
+            self.tau_f = self.injected.torque(self.data.qvel[self.dof_f])
+            self.data.qfrc_applied[self.dof_f] = self.tau_f
+        mujoco.mj_step(self.model, self.data)
+        if first:
+            self.record(k)
+
+    def record(self, k: int) -> None:
+        """Log the period's first physics step: joint accelerations, motor torques, friction applied."""
+        data = self.data
+        self.qdd[k] = data.qacc[self.mjr.dof_index]
+        tau_f = mujoco_friction_torque(data, self.dof_f) if self.native else self.tau_f
+        self.recording.record_torques(k, data.actuator_force[self.tc], tau_f)
+
+    def sense_contacts(self, k: int) -> None:
+        """The soles' normal forces over period ``k``, from its last step, and the contacts; stop at a fall.
+
+        Raises:
+            SimulationError: the robot fell or the simulation diverged.
+        """
+        data = self.data
+        self.force[k] = data.sensordata[self.mjr.touch_index]
+        self.contact[k] = self.force[k] > self.options.contact_threshold
+        if (not np.isfinite(data.qpos).all() or data.qpos[2] < self.options.fall_height * self.z0
+                or data.warning.number[self.bad_qacc] > 0):
+            raise SimulationError(f"the robot fell (or the simulation diverged) at t = {self.ref.time[k]:.3f} s")
+
+    def result(self) -> SimulationResult:
+        """The log (measured positions and contacts, noisy torques) and the result of the run."""
+        robot, mjr = self.robot, self.mjr
+        Q, V = mjr.q(self.qpos), mjr.v(self.qpos, self.qvel)
+        Q_meas = Q.copy()
+        Q_meas[:, robot.act_q_index] = self.q_meas
+        A = np.full((self.n, robot.model.nv), np.nan)
+        A[:, robot.act_v_index] = self.qdd
+        self.recording.wrench[:, :, 2] = self.force
+        return self.recording.result(Q, V, A, self.contact, "wbfriction.sim.mujoco_sim.simulate_mujoco", self.options,
+                                     Q_log=Q_meas, tau_noise=self.eps_tau,
+                                     torque_alignment="zoh",  # the torque is held over the substeps of each period
+                                     contact_source=f"sole normal force > {self.options.contact_threshold:g} N")
+
+
 def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[str, FrictionParams] | None = None,
                     options: MujocoOptions = MujocoOptions(), mjr: MujocoRobot | None = None,
-                    progress=None) -> SimulationResult:
+                    progress: Progress | None = None) -> SimulationResult:
     """Simulate a walk on MuJoCo (module docstring).
 
     Args:
@@ -177,104 +345,7 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
             parameters with MuJoCo's friction; a delay that is not whole periods.
         SimulationError: the robot fell (the message gives the time).
     """
-    native = options.friction == "mujoco"
-    if friction is None and native:
-        friction = {j: dataclasses.replace(p, S=0.0, tau_os=0.0) for j, p in friction_by_group(robot.groups).items()}
-    injected = injected_friction(robot, friction)
-    ref, n, dt = reference, len(reference), reference.dt
-    delay = options.delay_periods(dt)
-    mjr = mjr or build_mujoco_robot(robot)
-    model = copy.copy(mjr.model)  # the settings below must not leak into a shared model
-    model.opt.timestep = dt / options.substeps
-    iq, iv, tc, pc = robot.act_q_index, robot.act_v_index, robot.tc_index, robot.pc_index
-    nc, n_act = len(robot.contact_frames), len(robot.actuated)
-    joints_f = injected.joints
-    dof_f = mjr.dof_index[tc][joints_f]
-    if native:
-        set_mujoco_friction(model, dof_f, injected)
-    data = mujoco.MjData(model)
-
-    # base-attitude stabiliser: each leg's last two joints (the ankle), the reference base attitude
-    balance = robot.balance_gains if options.balance is None else options.balance
-    stabilise = any(balance)
-    if stabilise:
-        ankles = [np.array([robot.actuated.index(j) for j in robot.limb(f)[-2:]]) for f in robot.contact_frames]
-        ankle_jnt = [mjr.joint_ids[a] for a in ankles]
-        R_ref = Rotation.from_quat(ref.q[:, 3:7]).as_matrix()
-        w_ref = np.einsum("nij,nj->ni", R_ref, ref.v[:, 3:6])  # world frame
-
-    # the controller: feed-forward, PD gains per contact state
-    tau_ff = reference_feedforward(robot, ref)
-    free = np.diag(pin.crba(robot.model, robot.model.createData(), ref.q[0]))[iv]  # inertia, upstream held
-    kp_max = np.minimum(options.max_gains[0], free[tc] / dt**2)
-    kd_max = np.minimum(options.max_gains[1], free[tc] / dt)
-    gains = {state: (np.minimum(kp, kp_max), np.minimum(kd, kd_max))
-             for state, (kp, kd) in pd_gains(robot, ref.q[0], options.bandwidth, options.damping).items()}
-    kp_act, kd_act = np.zeros(n_act), np.zeros(n_act)
-    kp_act[pc], kd_act[pc] = pd_from_inertia(free[pc], options.bandwidth, options.damping)
-    q_ref, v_ref = ref.q[:, iq], ref.v[:, iv]
-    eps_q, eps_tau = options.sensors.draw(n, n_act, tc.size)
-
-    data.qpos[:] = mjr.qpos(ref.q[0])
-    data.qvel[:] = mjr.velocity_map(ref.q[0]) @ ref.v[0]
-    mujoco.mj_forward(model, data)
-    z0 = data.qpos[2]
-
-    qpos, qvel = np.empty((n, model.nq)), np.empty((n, model.nv))
-    q_meas, qdd = np.empty((n, n_act)), np.empty((n, n_act))
-    tau_log, tau_f_log = np.empty((n, tc.size)), np.zeros((n, tc.size))
-    contact, force = np.zeros((n, nc), dtype=bool), np.zeros((n, nc))
-    commands = np.zeros((delay + 1, n_act))  # ring buffer: the command of period k acts at k + delay
-    state, k_switch, before = None, 0, None
-    kp_act[tc], kd_act[tc] = gains[tuple(bool(x) for x in ref.contact[0])]
-    tau_f = np.zeros(len(joints_f))
-    torque_friction = bool(joints_f) and not native  # (3.5) applied by us at every physics step
-    bad_qacc = int(mujoco.mjtWarning.mjWARN_BADQACC)
-    for k in counted(n, progress):
-        qpos[k], qvel[k] = data.qpos, data.qvel
-        q_meas[k] = options.sensors.encoder(data.qpos[mjr.qpos_index] + eps_q[k])
-        qd_meas = (q_meas[k] - q_meas[k - 1]) / dt if k > 0 else v_ref[0]
-        # the controller knows the contact measured over the last period (the plan at first)
-        last = contact[k - 1] if k > 0 and contact[k - 1].any() else ref.contact[k]
-        measured = tuple(bool(x) for x in last)
-        if measured != state:
-            state, k_switch, before = measured, k, (kp_act[tc].copy(), kd_act[tc].copy())
-        if (k - k_switch) * dt <= options.gain_blend + dt:
-            kp_act[tc], kd_act[tc] = ramp_gains(before, gains[state], (k - k_switch) * dt, options.gain_blend)
-        command = tau_ff[k] + kp_act * (q_ref[k] - q_meas[k]) + kd_act * (v_ref[k] - qd_meas)
-        if stabilise:
-            R = data.xmat[mjr.base_body].reshape(3, 3)
-            load = (force[k - 1] if k > 0 else np.ones(nc)) * last
-            for a, t in zip(ankles, attitude_ankle_torques(R, R @ data.qvel[3:6], R_ref[k], w_ref[k], balance,
-                                                           [data.xaxis[j] for j in ankle_jnt], load)):
-                command[a] += t
-        commands[k % (delay + 1)] = command
-        data.ctrl[:] = commands[(k - delay) % (delay + 1)] if k >= delay else tau_ff[k]  # at first: feed-forward
-        for s in range(options.substeps):
-            if torque_friction:
-                tau_f = injected.torque(data.qvel[dof_f])
-                data.qfrc_applied[dof_f] = tau_f
-            mujoco.mj_step(model, data)
-            if s == 0:
-                qdd[k] = data.qacc[mjr.dof_index]
-                tau_log[k] = data.actuator_force[tc]
-                tau_f_log[k, joints_f] = mujoco_friction_torque(data, dof_f) if native else tau_f
-        # the soles' normal forces over this period, from its last step
-        force[k] = data.sensordata[mjr.touch_index]
-        contact[k] = force[k] > options.contact_threshold
-        if (not np.isfinite(data.qpos).all() or data.qpos[2] < options.fall_height * z0
-                or data.warning.number[bad_qacc] > 0):
-            raise SimulationError(f"the robot fell (or the simulation diverged) at t = {ref.time[k]:.3f} s")
-
-    Q, V = mjr.q(qpos), mjr.v(qpos, qvel)
-    Q_meas = Q.copy()
-    Q_meas[:, iq] = q_meas
-    A = np.full((n, robot.model.nv), np.nan)
-    A[:, iv] = qdd
-    log = simulated_log(robot, ref, Q_meas, V, A, tau_log + eps_tau, tau_f_log, contact, injected,
-                        "wbfriction.sim.mujoco_sim.simulate_mujoco", options, options.log_base,
-                        torque_alignment="zoh",  # the torque is held over the substeps of each period
-                        contact_source=f"sole normal force > {options.contact_threshold:g} N")
-    wrench = np.zeros((n, nc, 6))
-    wrench[:, :, 2] = force
-    return SimulationResult(log, wrench, Q, V, ref, tuple(robot.contact_frames))
+    run = _MujocoRun(robot, reference, friction, options, mjr)
+    for k in counted(len(reference), progress):
+        run.sample(k)
+    return run.result()

@@ -65,6 +65,11 @@ def leg_joints(robot: Robot) -> list[LegJoint]:
     return sorted(out, key=lambda x: thesis_number(x[1], x[2]) if x[1] in ("left", "right") else 0)
 
 
+def right_knee(legs: list[LegJoint]) -> str:
+    """The right knee among the leg joints: the joint the studies' figures follow."""
+    return next(j for j, side, g in legs if side == "right" and g == "knee")
+
+
 def fit_legs(est: FrictionEstimate, legs: list[LegJoint], targets: dict[str, FrictionParams] | None = None,
              fixed: dict[str, float] | None = None) -> list[FitResult]:
     """Fit model (3.5) to every leg joint of an estimate on its valid samples
@@ -89,10 +94,13 @@ def leg_params_extra(rows: list[LegRow], thesis_errors: bool = True) -> dict[str
     for r in rows:
         out[r.joint] = {"thesis_number": r.number, "group": r.group}
         if thesis_errors:
-            out[r.joint].update(thesis_error_percent_table_6_1=r.thesis_6_1, thesis_error_percent_table_6_2=r.thesis_6_2)
+            out[r.joint].update(thesis_error_percent_table_6_1=r.thesis_6_1,
+                                thesis_error_percent_table_6_2=r.thesis_6_2)
     return out
 
 
 def worst_errors(rows: list[LegRow], params: tuple[str, ...] = PARAM_NAMES) -> dict[str, float]:
     """Largest error [%] of each of ``params`` over the leg joints (every row needs a fit and a target)."""
-    return {n: max(r.fit.error_percent()[n] for r in rows) for n in params}
+    errors = [r.fit.error_percent() for r in rows]
+    assert all(e is not None for e in errors), "a study's leg joints all have a fit and a target"
+    return {n: max(e[n] for e in errors if e is not None) for n in params}

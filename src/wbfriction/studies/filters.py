@@ -12,7 +12,6 @@ reports (relative to its estimate): what a user without the truth would see.
 
 from __future__ import annotations
 
-import json
 import multiprocessing
 import os
 from concurrent.futures import ProcessPoolExecutor
@@ -24,15 +23,16 @@ import pyarrow as pa
 
 from wbfriction.friction.estimate import EstimateOptions, estimate_log
 from wbfriction.friction.fit import fit_joints
-from wbfriction.friction.models import PARAM_NAMES
+from wbfriction.friction.models import PARAM_NAMES, FrictionParams
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import Log
-from wbfriction.logs.tables import write_atomic, write_table
+from wbfriction.logs.tables import write_json, write_table
 from wbfriction.model.robot import Robot
+from wbfriction.progress import StageProgress
 from wbfriction.report.figures import filter_curves_figure
-from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.signals.kinematics import Diff, FilterOptions
 from wbfriction.sim import SensorNoise, apply_sensor_noise, simulate_ideal
-from wbfriction.studies.common import ENCODER_BITS, SIMULATOR, TORQUE_STD, leg_joints
+from wbfriction.studies.common import ENCODER_BITS, SIMULATOR, TORQUE_STD, leg_joints, right_knee
 from wbfriction.walking import GaitOptions, walking_reference
 
 LEVELS: tuple[float | None, ...] = (None, 0.0, 1e-5, 1e-4, 1e-3)
@@ -45,7 +45,7 @@ class Scheme:
     """A differentiation scheme with its parameters, as the study names it."""
 
     label: str
-    diff: str
+    diff: Diff
     filtering: FilterOptions = FilterOptions()
 
     def options(self) -> EstimateOptions:
@@ -56,7 +56,8 @@ SCHEMES: tuple[Scheme, ...] = (
     Scheme("central", "central"),
     *(Scheme(f"savgol L={n} k=4", "savgol", FilterOptions(window=n, poly_order=4)) for n in (51, 101, 151, 201)),
     Scheme("savgol L=151 k=4 gaussian", "savgol", FilterOptions(window=151, poly_order=4, weights="gaussian")),
-    *(Scheme(f"butterworth {fc:g} Hz n=6", "butterworth", FilterOptions(cutoff=fc, butter_order=6)) for fc in (10.0, 20.0)),
+    *(Scheme(f"butterworth {fc:g} Hz n=6", "butterworth", FilterOptions(cutoff=fc, butter_order=6))
+      for fc in (10.0, 20.0)),
 )
 
 
@@ -87,6 +88,10 @@ class FilterStudyResult:
         return min((r for r in self.rows if r.position_std == position_std), key=lambda r: r.score)
 
 
+_Task = tuple[int, int, int, str | None]
+"""One run of the grid: level index, scheme index, seed, the joint whose curve to keep (or None)."""
+
+
 _STATE: dict = {}  # the robot, log and targets, shared with the worker processes (fork)
 
 
@@ -97,7 +102,7 @@ def _noisy(level: float | None, seed: int) -> Log:
     return apply_sensor_noise(log, SensorNoise(level, ENCODER_BITS, TORQUE_STD, seed=seed))
 
 
-def _run(task: tuple[int, int, int, str | None]) -> tuple[FilterStudyRow, dict | None]:
+def _run(task: _Task) -> tuple[FilterStudyRow, dict | None]:
     i_level, i_scheme, seed, curve_joint = task
     robot, legs, targets = _STATE["robot"], _STATE["legs"], _STATE["targets"]
     level, scheme = _STATE["levels"][i_level], _STATE["schemes"][i_scheme]
@@ -122,35 +127,9 @@ def _run(task: tuple[int, int, int, str | None]) -> tuple[FilterStudyRow, dict |
     return row, curve
 
 
-def run_filter_study(robot: Robot, output_dir: Path, steps: int = 10, levels: tuple[float | None, ...] = LEVELS,
-                     schemes: tuple[Scheme, ...] = SCHEMES, curve_level: float | None = 1e-4, seed: int = 0,
-                     workers: int | None = None, progress=None) -> FilterStudyResult:
-    """Run the study and write ``filter_study.parquet``, ``filter_study.json`` and the
-    Fig. 7.2-kind ``filter_curves.png`` (right knee at ``curve_level``) to ``output_dir``.
-
-    Args:
-        robot: a biped with thesis joint groups.
-        steps: steps per direction of the combined walk.
-        levels: position-noise levels (:data:`LEVELS`); schemes: :data:`SCHEMES`.
-        seed: noise seed (level ``i`` uses ``seed + i``): the same seed, the same study.
-        workers: processes (default: the CPUs available, at most 2 per the project's plan).
-        progress: optional callable(label) called as stages start and runs end.
-    """
-    say = progress or (lambda label: None)
-    output_dir.mkdir(parents=True, exist_ok=True)
-    legs3 = leg_joints(robot)
-    legs = [j for j, _, _ in legs3]
-    targets = {j: THESIS_TARGETS[g] for j, _, g in legs3}
-    knee = next(j for j, side, g in legs3 if side == "right" and g == "knee")
-    say(f"simulating the combined walk ({steps} steps per direction)")
-    ref = walking_reference(robot, GaitOptions(gait="combined", steps=steps))
-    log = simulate_ideal(robot, ref, targets, SIMULATOR).log
-    _STATE.update(robot=robot, log=log, legs=legs, targets=targets, levels=levels, schemes=schemes)
-    tasks = [(il, isc, seed, knee if levels[il] == curve_level else None)
-             for il in range(len(levels)) for isc in range(len(schemes))]
-    workers = workers or min(2, len(os.sched_getaffinity(0)))
+def _run_grid(tasks: list[_Task], workers: int, say: StageProgress) -> list[tuple[FilterStudyRow, dict | None]]:
+    """Every run of ``tasks`` in their order, on ``workers`` forked processes or (1) in this one."""
     results: list = [None] * len(tasks)
-    say(f"estimating and fitting: {len(levels)} noise levels x {len(schemes)} schemes")
     if workers > 1:
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
             for k, res in enumerate(pool.map(_run, tasks)):
@@ -160,11 +139,12 @@ def run_filter_study(robot: Robot, output_dir: Path, steps: int = 10, levels: tu
         for k, task in enumerate(tasks):
             results[k] = _run(task)
             say(f"{k + 1}/{len(tasks)} runs done")
-    _STATE.clear()
-    rows = [r for r, _ in results]
-    curves = {schemes[t[1]].label: c for t, (_, c) in zip(tasks, results) if c is not None}
+    return results
 
-    table = pa.table({
+
+def _table(rows: list[FilterStudyRow]) -> pa.Table:
+    """The rows as the study's Parquet table."""
+    return pa.table({
         "position_std": pa.array([r.position_std for r in rows], pa.float64()),
         "exact_log": [r.position_std is None for r in rows],
         "scheme": [r.scheme for r in rows],
@@ -173,13 +153,55 @@ def run_filter_study(robot: Robot, output_dir: Path, steps: int = 10, levels: tu
         **{f"worst_{n}_percent": [r.worst[n] for r in rows] for n in PARAM_NAMES},
         "worst_stderr_F_v_percent": [r.worst_se_F_v for r in rows],
     })
+
+
+def _write_outputs(output_dir: Path, robot: Robot, steps: int, seed: int, schemes: tuple[Scheme, ...],
+                   rows: list[FilterStudyRow], curves: dict[str, dict], knee: str, target: FrictionParams,
+                   curve_level: float | None) -> list[Path]:
+    """Write the study's table, JSON document and Fig. 7.2-kind curves; the files written."""
     files = [output_dir / "filter_study.parquet", output_dir / "filter_study.json", output_dir / "filter_curves.png"]
-    write_table(table, files[0])
+    write_table(_table(rows), files[0])
     doc = {"robot": robot.name, "gait": asdict(GaitOptions(gait="combined", steps=steps)),
            "sensor": {"encoder_bits": ENCODER_BITS, "torque_std": TORQUE_STD, "seed": seed},
            "schemes": {s.label: {"diff": s.diff, "filtering": asdict(s.filtering)} for s in schemes},
            "rows": [asdict(r) for r in rows]}
-    write_atomic(files[1], lambda tmp: tmp.write_text(json.dumps(doc, indent=2)))
-    filter_curves_figure(curves, knee, targets[knee], curve_level, files[2])
-    return FilterStudyResult(rows, files)
+    write_json(files[1], doc)
+    filter_curves_figure(curves, knee, target, curve_level, files[2])
+    return files
 
+
+def run_filter_study(robot: Robot, output_dir: Path, steps: int = 10, levels: tuple[float | None, ...] = LEVELS,
+                     schemes: tuple[Scheme, ...] = SCHEMES, curve_level: float | None = 1e-4, seed: int = 0,
+                     workers: int | None = None,
+                     progress: StageProgress | None = None) -> FilterStudyResult:
+    """Run the study and write ``filter_study.parquet``, ``filter_study.json`` and the
+    Fig. 7.2-kind ``filter_curves.png`` (right knee at ``curve_level``) to ``output_dir``.
+
+    Args:
+        robot: a biped with thesis joint groups.
+        steps: steps per direction of the combined walk.
+        levels: position-noise levels (:data:`LEVELS`); schemes: :data:`SCHEMES`.
+        seed: noise seed (level ``i`` uses ``seed + i``): the same seed, the same study.
+        workers: processes (default: the CPUs available, at most 2 per the project's plan).
+        progress: called with a label as stages start and runs end (:data:`~wbfriction.progress.StageProgress`).
+    """
+    say = progress or (lambda label: None)
+    output_dir.mkdir(parents=True, exist_ok=True)
+    legs3 = leg_joints(robot)
+    legs = [j for j, _, _ in legs3]
+    targets = {j: THESIS_TARGETS[g] for j, _, g in legs3}
+    knee = right_knee(legs3)
+    say(f"simulating the combined walk ({steps} steps per direction)")
+    ref = walking_reference(robot, GaitOptions(gait="combined", steps=steps))
+    log = simulate_ideal(robot, ref, targets, SIMULATOR).log
+    _STATE.update(robot=robot, log=log, legs=legs, targets=targets, levels=levels, schemes=schemes)
+    tasks = [(il, isc, seed, knee if levels[il] == curve_level else None)
+             for il in range(len(levels)) for isc in range(len(schemes))]
+    workers = workers or min(2, len(os.sched_getaffinity(0)))
+    say(f"estimating and fitting: {len(levels)} noise levels x {len(schemes)} schemes")
+    results = _run_grid(tasks, workers, say)
+    _STATE.clear()
+    rows = [r for r, _ in results]
+    curves = {schemes[t[1]].label: c for t, (_, c) in zip(tasks, results) if c is not None}
+    files = _write_outputs(output_dir, robot, steps, seed, schemes, rows, curves, knee, targets[knee], curve_level)
+    return FilterStudyResult(rows, files)

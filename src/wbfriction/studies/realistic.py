@@ -31,18 +31,21 @@ from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import write_log
 from wbfriction.model.robot import Robot
+from wbfriction.progress import StageProgress
 from wbfriction.report.figures import friction_curves_figure, velocity_panels_figure
 from wbfriction.signals.kinematics import FilterOptions
-from wbfriction.sim import MujocoOptions, SensorNoise, simulate_mujoco
-from wbfriction.sim.mujoco_model import build_mujoco_robot
+from wbfriction.sim import MujocoOptions, SensorNoise, SimulationResult, simulate_mujoco
+from wbfriction.sim.mujoco_model import MujocoRobot, build_mujoco_robot
 from wbfriction.studies.common import (
     ENCODER_BITS,
     TORQUE_STD,
+    LegJoint,
     LegRow,
     fit_legs,
     leg_joints,
     leg_params_extra,
     leg_rows,
+    right_knee,
     worst_errors,
 )
 from wbfriction.walking import GaitOptions, walking_reference
@@ -79,8 +82,90 @@ def _swing(est: FrictionEstimate, robot: Robot, joint: str) -> np.ndarray:
     return est.valid[:, est.joints.index(joint)] & ~est.contact[:, robot.contact_of(joint)]
 
 
+@dataclass(frozen=True)
+class _CaseSpec:
+    """One identification case to run: the simulated friction and options, the fit's held parameters."""
+
+    name: str
+    label: str
+    friction: dict[str, FrictionParams]
+    options: MujocoOptions
+    estimate: EstimateOptions
+    fixed: dict[str, float] | None
+    scored: tuple[str, ...]
+
+
+def _simulate(robot: Robot, mjr: MujocoRobot, gait: GaitOptions, friction: dict[str, FrictionParams],
+              options: MujocoOptions) -> SimulationResult:
+    """Walk ``gait`` on MuJoCo with ``friction``."""
+    return simulate_mujoco(robot, walking_reference(robot, gait), friction, options, mjr=mjr)
+
+
+def _swing_and_stance(robot: Robot, mjr: MujocoRobot, knee: str, table_6_1: dict[str, FrictionParams],
+                      knee_steps: int, options: MujocoOptions, output_dir: Path,
+                      say: StageProgress) -> tuple[dict[str, float], list[Path]]:
+    """Fig. 6.4 and 6.5 (steps 1-2 of the module docstring): the right knee's RMS error and the figures written."""
+    forward = GaitOptions(gait="forward", steps=knee_steps)
+    whole = EstimateOptions(mask="single")
+    say("MuJoCo: a forward walk, friction on the right knee")
+    knee_only = estimate_log(robot, _simulate(robot, mjr, forward, {knee: table_6_1[knee]}, options).log, whole)
+    say("MuJoCo: the same walk, friction on every leg joint")
+    all_legs = estimate_log(robot, _simulate(robot, mjr, forward, table_6_1, options).log, whole)
+    i = knee_only.joints.index(knee)
+    standing, swinging = knee_only.valid[:, i], _swing(knee_only, robot, knee)
+    assert knee_only.tau_f_true is not None  # simulated: the log has the true friction
+    err = knee_only.tau_f[:, i] - knee_only.tau_f_true[:, i]
+    knee_rms = {"whole step": float(np.sqrt(np.mean(err[standing] ** 2))),
+                "swing only": float(np.sqrt(np.mean(err[swinging] ** 2)))}
+    fig_6_4, fig_6_5 = output_dir / "fig6_4_knee_swing_stance.png", output_dir / "fig6_5_knee_interference.png"
+    velocity_panels_figure([("whole step (single support)", knee_only, standing),
+                            ("swing phase only", knee_only, swinging)],
+                           knee, table_6_1[knee], fig_6_4,
+                           "Fig. 6.4 (MuJoCo): right knee friction, central differences")
+    velocity_panels_figure([("friction on the right knee only", knee_only, swinging),
+                            ("friction on every leg joint", all_legs, _swing(all_legs, robot, knee))],
+                           knee, table_6_1[knee], fig_6_5,
+                           "Fig. 6.5 (MuJoCo): right knee friction in swing, alone and with every leg joint's")
+    return knee_rms, [fig_6_4, fig_6_5]
+
+
+def _case_specs(table_6_1: dict[str, FrictionParams], options: MujocoOptions) -> list[_CaseSpec]:
+    """The identification cases of step 3 of the module docstring, in order."""
+    native = {j: dataclasses.replace(p, S=0.0, tau_os=0.0) for j, p in table_6_1.items()}
+    return [
+        _CaseSpec("model", "friction (3.5), noise off, central differences", table_6_1, options,
+                  EstimateOptions(), None, ("F_c", "F_v", "tau_os")),
+        _CaseSpec("mujoco", "MuJoCo frictionloss + damping, noise off, central differences, Coulomb-viscous fit",
+                  native, dataclasses.replace(options, friction="mujoco"), EstimateOptions(), COULOMB_VISCOUS,
+                  ("F_c", "F_v")),
+        _CaseSpec("noisy", "friction (3.5), sensor noise 1e-4 rad / 19 bit / 0.05 N·m, Savitzky-Golay L=151 k=4",
+                  table_6_1, dataclasses.replace(options, sensors=NOISE), BEST_FILTER, None,
+                  ("F_c", "F_v", "tau_os")),
+    ]
+
+
+def _identify(robot: Robot, mjr: MujocoRobot, legs: list[LegJoint], spec: _CaseSpec, combined: GaitOptions,
+              output_dir: Path) -> tuple[Case, list[Path]]:
+    """One identification case on the combined walk: its fitted legs and the files written."""
+    sim = _simulate(robot, mjr, combined, spec.friction, spec.options)
+    est = estimate_log(robot, sim.log, spec.estimate)
+    fits = fit_legs(est, legs, spec.friction, spec.fixed)
+    rows = leg_rows(legs, fits)
+    log_path = output_dir / f"mujoco_{spec.name}_log.parquet"
+    params_path = output_dir / f"mujoco_{spec.name}_params.json"
+    write_log(sim.log, robot, log_path)
+    write_params(params_path, fits, {"robot": robot.name, "case": spec.label, "gait": dataclasses.asdict(combined)},
+                 leg_params_extra(rows, thesis_errors=False))
+    files = [log_path, params_path]
+    if spec.name == "model":
+        friction_curves_figure(est, fits, output_dir / "mujoco_friction_curves.png")
+        files.append(output_dir / "mujoco_friction_curves.png")
+    return Case(spec.name, spec.label, rows, spec.scored), files
+
+
 def run_realistic_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int = 5,
-                        options: MujocoOptions = MujocoOptions(), progress=None) -> RealisticResult:
+                        options: MujocoOptions = MujocoOptions(),
+                        progress: StageProgress | None = None) -> RealisticResult:
     """Run the study (module docstring) and write its parameters and figures to ``output_dir``.
 
     Args:
@@ -88,70 +173,29 @@ def run_realistic_study(robot: Robot, output_dir: Path, steps: int = 10, knee_st
         steps: steps per direction of the combined walk.
         knee_steps: steps of the forward walk of Fig. 6.4 and 6.5.
         options: the simulator's options (friction mode and sensors are set per case).
-        progress: optional callable(label) called as each stage starts.
+        progress: called with a label as each stage starts (:data:`~wbfriction.progress.StageProgress`).
 
     Raises:
         SimulationError: the robot fell in one of the walks.
     """
     say = progress or (lambda label: None)
     output_dir.mkdir(parents=True, exist_ok=True)
-    files: list[Path] = []
     legs = leg_joints(robot)
-    knee = next(j for j, side, g in legs if side == "right" and g == "knee")
+    knee = right_knee(legs)
     table_6_1 = {j: THESIS_TARGETS[g] for j, _, g in legs}
     mjr = build_mujoco_robot(robot)
 
-    def simulate(gait: GaitOptions, friction: dict[str, FrictionParams], opts: MujocoOptions):
-        return simulate_mujoco(robot, walking_reference(robot, gait), friction, opts, mjr=mjr)
-
     # 1-2. right knee only, then every leg joint: Fig. 6.4, 6.5
-    forward = GaitOptions(gait="forward", steps=knee_steps)
-    whole = EstimateOptions(mask="single")
-    say("MuJoCo: a forward walk, friction on the right knee")
-    knee_only = estimate_log(robot, simulate(forward, {knee: table_6_1[knee]}, options).log, whole)
-    say("MuJoCo: the same walk, friction on every leg joint")
-    all_legs = estimate_log(robot, simulate(forward, table_6_1, options).log, whole)
-    i = knee_only.joints.index(knee)
-    standing, swinging = knee_only.valid[:, i], _swing(knee_only, robot, knee)
-    err = knee_only.tau_f[:, i] - knee_only.tau_f_true[:, i]
-    knee_rms = {"whole step": float(np.sqrt(np.mean(err[standing] ** 2))),
-                "swing only": float(np.sqrt(np.mean(err[swinging] ** 2)))}
-    velocity_panels_figure([("whole step (single support)", knee_only, standing), ("swing phase only", knee_only, swinging)],
-                           knee, table_6_1[knee], output_dir / "fig6_4_knee_swing_stance.png",
-                           "Fig. 6.4 (MuJoCo): right knee friction, central differences")
-    velocity_panels_figure([("friction on the right knee only", knee_only, swinging),
-                            ("friction on every leg joint", all_legs, _swing(all_legs, robot, knee))],
-                           knee, table_6_1[knee], output_dir / "fig6_5_knee_interference.png",
-                           "Fig. 6.5 (MuJoCo): right knee friction in swing, alone and with every leg joint's")
-    files += [output_dir / "fig6_4_knee_swing_stance.png", output_dir / "fig6_5_knee_interference.png"]
+    knee_rms, files = _swing_and_stance(robot, mjr, knee, table_6_1, knee_steps, options, output_dir, say)
 
     # 3. identification on the combined walk
     combined = GaitOptions(gait="combined", steps=steps)
-    native = {j: dataclasses.replace(p, S=0.0, tau_os=0.0) for j, p in table_6_1.items()}
-    cases = [
-        ("model", "friction (3.5), noise off, central differences", table_6_1, options,
-         EstimateOptions(), None, ("F_c", "F_v", "tau_os")),
-        ("mujoco", "MuJoCo frictionloss + damping, noise off, central differences, Coulomb-viscous fit", native,
-         dataclasses.replace(options, friction="mujoco"), EstimateOptions(), COULOMB_VISCOUS, ("F_c", "F_v")),
-        ("noisy", "friction (3.5), sensor noise 1e-4 rad / 19 bit / 0.05 N·m, Savitzky-Golay L=151 k=4", table_6_1,
-         dataclasses.replace(options, sensors=NOISE), BEST_FILTER, None, ("F_c", "F_v", "tau_os")),
-    ]
     results = []
-    for name, label, friction, opts, est_opts, fixed, scored in cases:
-        say(f"MuJoCo: the combined walk ({steps} steps per direction), {label}")
-        sim = simulate(combined, friction, opts)
-        est = estimate_log(robot, sim.log, est_opts)
-        fits = fit_legs(est, legs, friction, fixed)
-        rows = leg_rows(legs, fits)
-        results.append(Case(name, label, rows, scored))
-        log_path, params_path = output_dir / f"mujoco_{name}_log.parquet", output_dir / f"mujoco_{name}_params.json"
-        write_log(sim.log, robot, log_path)
-        write_params(params_path, fits, {"robot": robot.name, "case": label, "gait": dataclasses.asdict(combined)},
-                     leg_params_extra(rows, thesis_errors=False))
-        files += [log_path, params_path]
-        if name == "model":
-            friction_curves_figure(est, fits, output_dir / "mujoco_friction_curves.png")
-            files.append(output_dir / "mujoco_friction_curves.png")
+    for spec in _case_specs(table_6_1, options):
+        say(f"MuJoCo: the combined walk ({steps} steps per direction), {spec.label}")
+        case, written = _identify(robot, mjr, legs, spec, combined, output_dir)
+        results.append(case)
+        files += written
     return RealisticResult(results, knee_rms, files)
 
 

@@ -27,11 +27,21 @@ from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import write_log
 from wbfriction.logs.tables import write_table
 from wbfriction.model.robot import Robot
+from wbfriction.progress import Progress, StageProgress
 from wbfriction.report.build import make_report
 from wbfriction.report.figures import derivative_schemes_figure, friction_curves_figure, support_phases_figure
 from wbfriction.report.html import write_report
-from wbfriction.sim import SimulationResult, simulate_ideal
-from wbfriction.studies.common import SIMULATOR, LegRow, fit_legs, leg_joints, leg_params_extra, leg_rows
+from wbfriction.sim import Pull, SimulationResult, simulate_ideal
+from wbfriction.studies.common import (
+    SIMULATOR,
+    LegJoint,
+    LegRow,
+    fit_legs,
+    leg_joints,
+    leg_params_extra,
+    leg_rows,
+    right_knee,
+)
 from wbfriction.walking import GaitOptions, walking_reference
 
 DERIVATIVE_SCHEMES = {
@@ -47,34 +57,21 @@ class StudyResult:
 
     rows: list[LegRow]
     truth_max_error: float  # max |tau_f - tau_f_true| in single support with true accelerations [N·m]
-    knee_rms: dict[str, float]  # RMS error of the right knee per scheme, leg in swing / stance [N·m]
+    knee_rms: dict[str, tuple[float, float]]  # RMS error of the right knee per scheme: leg in swing, stance [N·m]
     pulls: int  # samples where a welded foot pulled on the ground, both walks
     files: list[Path] = field(default_factory=list)
     generating_share: dict[str, float] = field(default_factory=dict)  # per leg joint, swing phase (eq. 7.9)
 
 
-def _simulate(robot: Robot, gait: GaitOptions, friction: dict[str, FrictionParams], progress=None) -> SimulationResult:
+def _simulate(robot: Robot, gait: GaitOptions, friction: dict[str, FrictionParams],
+              progress: Progress | None = None) -> SimulationResult:
     ref = walking_reference(robot, gait)
     return simulate_ideal(robot, ref, friction, SIMULATOR, progress=progress)
 
 
-def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int = 5,
-              progress=None) -> StudyResult:
-    """Run the study and write its logs, estimates, parameters and figures to ``output_dir``.
-
-    Args:
-        robot: a biped with thesis joint groups (``hip_roll`` ... ``ankle_pitch``).
-        steps: steps per direction of the combined walk.
-        knee_steps: steps of the right-knee walk (Fig. 6.1-6.3).
-        progress: optional callable(label) called as each stage starts.
-    """
-    say = progress or (lambda label: None)
-    output_dir.mkdir(parents=True, exist_ok=True)
-    files: list[Path] = []
-    legs = leg_joints(robot)
-    knee = next(j for j, side, g in legs if side == "right" and g == "knee")
-
-    # 1. right knee only: Fig. 6.1-6.3
+def _derivative_schemes(robot: Robot, legs: list[LegJoint], knee: str, knee_steps: int, output_dir: Path,
+                        say: StageProgress) -> tuple[float, dict[str, tuple[float, float]], list[Pull], list[Path]]:
+    """Sub-study 1 (Fig. 6.1-6.3): the truth's error, the knee's RMS per scheme, the walk's pulls, the files written."""
     say("simulating a forward walk, friction on the right knee")
     knee_sim = _simulate(robot, GaitOptions(gait="forward", steps=knee_steps), {knee: THESIS_TARGETS["knee"]})
     write_log(knee_sim.log, robot, output_dir / "knee_log.parquet")
@@ -87,17 +84,24 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
     # valid single-support samples (skip windows applied), same for every scheme
     swing_k = truth.valid[:, i_knee] & ~truth.contact[:, foot]
     stance_k = truth.valid[:, i_knee] & truth.contact[:, foot]
-    knee_rms = {}
+    assert truth.tau_f_true is not None and foot is not None  # a simulated log; a leg joint
+    knee_rms: dict[str, tuple[float, float]] = {}
     for label, est in schemes.items():
+        assert est.tau_f_true is not None
         e = est.tau_f[:, i_knee] - est.tau_f_true[:, i_knee]
         knee_rms[label] = (float(np.sqrt(np.nanmean(e[swing_k] ** 2))), float(np.sqrt(np.nanmean(e[stance_k] ** 2))))
-    support_phases_figure(truth, [j for j, side, _ in legs if side == "right"], output_dir / "fig6_1_support_phases.png")
+    support_phases_figure(truth, [j for j, side, _ in legs if side == "right"],
+                          output_dir / "fig6_1_support_phases.png")
     derivative_schemes_figure(schemes, knee, foot, output_dir / "fig6_2_schemes_time.png",
                               output_dir / "fig6_3_schemes_velocity.png")
-    files += [output_dir / n for n in ("knee_log.parquet", "fig6_1_support_phases.png",
-                                       "fig6_2_schemes_time.png", "fig6_3_schemes_velocity.png")]
+    files = [output_dir / n for n in ("knee_log.parquet", "fig6_1_support_phases.png",
+                                      "fig6_2_schemes_time.png", "fig6_3_schemes_velocity.png")]
+    return truth_err, knee_rms, knee_sim.pulls(), files
 
-    # 2. combined walk, Table 6.1 friction on all leg joints: identification
+
+def _identification(robot: Robot, legs: list[LegJoint], steps: int, output_dir: Path,
+                    say: StageProgress) -> tuple[list[LegRow], list[Pull], dict[str, float], list[Path]]:
+    """Sub-study 2 (Tables 6.1, 6.2, report): the rows, the walk's pulls, the legs' power shares, the files written."""
     say(f"simulating the combined walk ({steps} steps forward, sideways, turning)")
     friction = {j: THESIS_TARGETS[g] for j, _, g in legs}
     walk = _simulate(robot, GaitOptions(gait="combined", steps=steps), friction)
@@ -115,10 +119,31 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
     say("writing the report")
     write_report(make_report(output_dir / "walk_friction.parquet", output_dir / "walk_params.json"),
                  output_dir / "report.html")
-    files += [output_dir / n for n in ("walk_log.parquet", "walk_friction.parquet", "walk_params.json",
-                                       "friction_curves.png", "report.html")]
-    pulls = sum(p.samples for p in knee_sim.pulls() + walk.pulls())
+    files = [output_dir / n for n in ("walk_log.parquet", "walk_friction.parquet", "walk_params.json",
+                                      "friction_curves.png", "report.html")]
     energy = energy_consistency(est, fitted_offsets(fits))
     legs_only = {j for j, _, _ in legs}
     share = {e.joint: e.generating_share for e in energy if e.joint in legs_only}
-    return StudyResult(rows, truth_err, knee_rms, pulls, files, share)
+    return rows, walk.pulls(), share, files
+
+
+def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int = 5,
+              progress: StageProgress | None = None) -> StudyResult:
+    """Run the study and write its logs, estimates, parameters and figures to ``output_dir``.
+
+    Args:
+        robot: a biped with thesis joint groups (``hip_roll`` ... ``ankle_pitch``).
+        steps: steps per direction of the combined walk.
+        knee_steps: steps of the right-knee walk (Fig. 6.1-6.3).
+        progress: called with a label as each stage starts (:data:`~wbfriction.progress.StageProgress`).
+    """
+    say = progress or (lambda label: None)
+    output_dir.mkdir(parents=True, exist_ok=True)
+    legs = leg_joints(robot)
+    knee = right_knee(legs)
+    # 1. right knee only: Fig. 6.1-6.3
+    truth_err, knee_rms, knee_pulls, knee_files = _derivative_schemes(robot, legs, knee, knee_steps, output_dir, say)
+    # 2. combined walk, Table 6.1 friction on all leg joints: identification
+    rows, walk_pulls, share, walk_files = _identification(robot, legs, steps, output_dir, say)
+    pulls = sum(p.samples for p in knee_pulls + walk_pulls)
+    return StudyResult(rows, truth_err, knee_rms, pulls, knee_files + walk_files, share)

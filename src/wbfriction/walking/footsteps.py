@@ -194,10 +194,10 @@ def plan_footsteps(initial_feet: np.ndarray, options: GaitOptions = GaitOptions(
                 targets += _walk_targets(_mid_frame(now()), half_width, n,
                                          np.array([o.turn_length, 0.0, angle]), first=1 if angle >= 0 else 0)
 
-    steps, t, now = [], o.initial, feet.copy()
+    steps, t, placed = [], o.initial, feet.copy()  # the feet as placed so far
     for foot, target in targets:
-        steps.append(Step(foot, now[foot].copy(), target, t, t + o.single_support))
-        now[foot] = target
+        steps.append(Step(foot, placed[foot].copy(), target, t, t + o.single_support))
+        placed[foot] = target
         t += o.single_support + o.double_support
     duration = t - o.double_support + o.final
     return FootstepPlan(feet, tuple(steps), duration, o)

@@ -24,7 +24,7 @@ import pinocchio as pin
 
 from wbfriction.exceptions import InputError, ModelError
 from wbfriction.model.robot import Robot
-from wbfriction.progress import counted
+from wbfriction.progress import Progress, counted
 from wbfriction.walking.com import lipm_com, zmp_reference
 from wbfriction.walking.footsteps import FootstepPlan, GaitOptions, plan_footsteps
 from wbfriction.walking.swing import feet_trajectory, foot_placement, quintic
@@ -130,8 +130,8 @@ class _WholeBodyIK:
         if self.sel.size != 18:
             raise ModelError(f"robot '{robot.name}': walking IK needs 6 joints per leg, got {self.sel.size - 6}")
 
-    def _jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Task Jacobian (18, nv) and task values: sole poses, centre of mass, base rotation."""
+    def _jacobian(self, q: np.ndarray) -> np.ndarray:
+        """Task Jacobian (18, nv): sole poses, centre of mass, base rotation."""
         model, data = self.model, self.data
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
@@ -195,7 +195,7 @@ class _WholeBodyIK:
 
 
 def walking_reference(robot: Robot, options: GaitOptions = GaitOptions(), dt: float = 1e-3,
-                      progress=None) -> WalkingReference:
+                      progress: Progress | None = None) -> WalkingReference:
     """Plan a walk and sample its whole-body reference at the control rate.
 
     Args:

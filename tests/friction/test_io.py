@@ -1,0 +1,71 @@
+"""The friction table and the parameters JSON: what is written reads back the same (one writer, one reader)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from wbfriction.exceptions import InputError
+from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.fit import FitResult
+from wbfriction.friction.io import (
+    fit_from_dict,
+    fit_to_dict,
+    friction_table,
+    read_friction_file,
+    read_params,
+    write_params,
+)
+from wbfriction.friction.models import FrictionParams
+from wbfriction.logs.tables import write_table
+from wbfriction.signals.filters import SavgolSmoother
+from wbfriction.signals.kinematics import FilterOptions
+
+
+@pytest.mark.parametrize("suffix", [".parquet", ".h5"])
+def test_friction_table_reads_back_as_the_estimate(talos, combined_walk, tmp_path, suffix):
+    options = EstimateOptions(diff="savgol", filtering=FilterOptions(window=51))
+    est = estimate_log(talos, combined_walk.log.rows(0, 3000), options, companion=True)
+    write_table(friction_table(est), tmp_path / f"f{suffix}")
+    back = read_friction_file(tmp_path / f"f{suffix}")
+    # HDF5 keeps its datasets in name order: joints and frames are matched by name, not by position
+    assert sorted(back.joints) == sorted(est.joints) and sorted(back.contact_frames) == sorted(est.contact_frames)
+    j = [back.joints.index(n) for n in est.joints]
+    c = [back.contact_frames.index(n) for n in est.contact_frames]
+    np.testing.assert_array_equal(back.time, est.time)
+    np.testing.assert_array_equal(back.unique, est.unique)
+    np.testing.assert_array_equal(back.contact[:, c], est.contact)
+    for name in ("qd", "tau_f", "valid", "qdd", "delta_qdd", "companion_delta_qdd"):
+        np.testing.assert_array_equal(getattr(back, name)[:, j], getattr(est, name), err_msg=name)
+    if suffix == ".parquet":  # the HDF5 reader keeps numeric datasets only: the phase text does not come back
+        assert list(back.phase) == list(est.phase)
+    assert back.companion_diff == "central"
+    assert isinstance(back.smoother, SavgolSmoother) and back.smoother.window == 51  # the fit filters its model alike
+
+
+def test_parameters_read_back_with_unidentifiable_ones_infinite(tmp_path):
+    fit = FitResult("knee", 120, params=FrictionParams(0.2, 1.0, 0.2, 0.2, 1.0, 40.0),
+                    stderr={"F_v": 0.01, "F_c": 0.02, "S": np.inf, "v_s": np.inf, "tau_os": 0.0, "a": 3.0},
+                    rms_residual=0.05, success=True, message="ok", target=FrictionParams(0.2, 1.0, 0.2, 0.2, 1.0, 40.0))
+    write_params(tmp_path / "p.json", [fit], {"provenance": {"x": 1}}, {"knee": {"group": "knee"}})
+    doc = json.loads((tmp_path / "p.json").read_text())
+    assert list(doc) == ["provenance", "joints"] and doc["joints"]["knee"]["stderr"]["S"] is None
+    assert doc["joints"]["knee"]["group"] == "knee" and doc["joints"]["knee"]["error_percent"]["F_v"] == 0.0
+    back = read_params(tmp_path / "p.json")["knee"]
+    assert back.params == fit.params and back.target == fit.target and back.stderr == fit.stderr
+    assert fit_to_dict(back) == fit_to_dict(fit)
+
+
+def test_malformed_parameters_name_the_file_and_the_joint(tmp_path):
+    with pytest.raises(InputError, match="unknown friction parameter"):
+        fit_from_dict("knee", {"params": {"F_x": 1.0}})
+    (tmp_path / "p.json").write_text(json.dumps({"joints": {"knee": {"params": {"F_v": "fast"}}}}))
+    with pytest.raises(InputError, match=r"p.json: joint 'knee'"):
+        read_params(tmp_path / "p.json")
+    (tmp_path / "q.json").write_text("[1, 2]")
+    with pytest.raises(InputError, match="no 'joints' object"):
+        read_params(tmp_path / "q.json")
+    with pytest.raises(InputError, match="file not found"):
+        read_params(tmp_path / "missing.json")

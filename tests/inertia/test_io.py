@@ -1,0 +1,45 @@
+"""The identification JSON: its reader refuses what its writer would not have written, naming the key."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from wbfriction.exceptions import InputError
+from wbfriction.inertia.io import read_identification, write_identification
+
+DOC = {
+    "passes": [{"stribeck_velocity": 0.2, "samples": 100}],
+    "holdout_samples": 20,
+    "bodies": [{"body": "root_joint", "mass_given": 10.0, "mass": 9.5, "com_shift": 0.001}],
+    "joints": {"knee": {"holdout_rms": {"given": 1.0, "given_with_friction": 0.5, "identified": 0.01},
+                        "identified": {"F_v": 0.2, "F_c": 1.0, "tau_os": 0.9}}},
+}
+
+
+def test_what_is_written_reads_back(tmp_path):
+    write_identification(tmp_path / "i.json", DOC)
+    assert read_identification(tmp_path / "i.json") == DOC
+
+
+@pytest.mark.parametrize(("damage", "key"), [
+    (lambda d: d.pop("joints"), "joints"),
+    (lambda d: d["joints"]["knee"]["holdout_rms"].pop("identified"), "joints.knee.holdout_rms"),
+    (lambda d: d["joints"]["knee"]["identified"].update(F_v="x"), "joints.knee.identified"),
+    (lambda d: d["bodies"][0].pop("mass"), "bodies"),
+    (lambda d: d.update(passes=[]), "passes"),
+    (lambda d: d.update(holdout_samples=1.5), "holdout_samples"),
+])
+def test_a_damaged_document_names_its_key(tmp_path, damage, key):
+    doc = json.loads(json.dumps(DOC))
+    damage(doc)
+    (tmp_path / "i.json").write_text(json.dumps(doc))
+    with pytest.raises(InputError, match=f"'{key}' is missing or malformed"):
+        read_identification(tmp_path / "i.json")
+
+
+def test_not_json_at_all(tmp_path):
+    (tmp_path / "i.json").write_bytes(b"\xff\xfe")
+    with pytest.raises(InputError, match="not an identification written by 'wbfriction identify --json'"):
+        read_identification(tmp_path / "i.json")

@@ -1,0 +1,66 @@
+"""Table files read whole, by columns and by row ranges alike; documents written whole or not at all."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pyarrow as pa
+import pytest
+
+from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.logs.hdf5 import write_hdf5
+from wbfriction.logs.tables import TableFile, numeric_column, read_metadata, with_metadata, write_json, write_table
+
+
+@pytest.fixture(params=[".parquet", ".csv", ".h5"])
+def table_file(request, tmp_path) -> tuple[TableFile, pa.Table]:
+    rng = np.random.default_rng(0)
+    table = with_metadata(pa.table({"time": np.arange(1000) * 1e-3, "a": rng.normal(size=1000),
+                                    "b": rng.normal(size=1000)}), {"robot": "x"})
+    path = tmp_path / f"t{request.param}"
+    if request.param == ".h5":
+        write_hdf5(table, path)
+    else:
+        write_table(table, path)
+    return TableFile(path), table
+
+
+def test_row_ranges_are_slices_of_the_whole(table_file):
+    file, table = table_file
+    whole = file.read()
+    reader = file.row_reader(128)
+    for start, stop in ((0, 10), (5, 300), (300, 301), (900, 1200)):
+        part = reader.rows(start, stop)
+        assert part.num_rows == min(stop, 1000) - start
+        np.testing.assert_array_equal(part.column("a").to_numpy(), whole.column("a").to_numpy()[start:stop])
+    assert sum(b.num_rows for b in file.blocks(300)) == 1000
+    if file.format != "csv":  # CSV keeps no metadata
+        assert read_metadata(whole) == {"robot": "x"}
+        assert read_metadata(file.row_reader(10).rows(0, 5)) == {"robot": "x"}
+
+
+def test_columns_read_alone(table_file):
+    file, _ = table_file
+    assert sorted(file.read(["b", "time", "missing"]).column_names) == ["b", "time"]
+    assert file.row_count() == (1000 if file.format == "parquet" else 0)
+
+
+def test_a_bad_column_names_its_file_column_and_row():
+    table = pa.table({"x": [0.0, 1.0, np.nan], "s": ["a", "b", "c"]})
+    with pytest.raises(ColumnError) as err:
+        numeric_column(table, "x", "f.parquet", first_row=10)
+    assert (err.value.source, err.value.column, err.value.row) == ("f.parquet", "x", 12)
+    assert str(err.value) == "f.parquet: column 'x' has a non-finite value (NaN or inf) at row 12"
+    with pytest.raises(ColumnError, match="column 's' is not numeric") as err:
+        numeric_column(table, "s", "f.parquet")
+    assert err.value.row is None and isinstance(err.value, InputError)
+
+
+def test_json_documents_are_written_whole(tmp_path):
+    write_json(tmp_path / "d.json", {"b": 1, "a": [1.5, None]})
+    assert json.loads((tmp_path / "d.json").read_text()) == {"b": 1, "a": [1.5, None]}
+    with pytest.raises(TypeError):
+        write_json(tmp_path / "d.json", {"x": object()})  # not serialisable: the previous file is kept
+    assert json.loads((tmp_path / "d.json").read_text()) == {"b": 1, "a": [1.5, None]}
+    assert [p.name for p in tmp_path.iterdir()] == ["d.json"]

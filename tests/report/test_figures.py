@@ -1,0 +1,81 @@
+"""The figures: PNG files that are the same bytes for the same input, the panels each figure promises, and
+the helpers they are drawn with."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from wbfriction.friction.estimate import FrictionEstimate
+from wbfriction.friction.fit import fit_estimate
+from wbfriction.friction.models import FrictionParams
+from wbfriction.report.figures import (
+    friction_curves_figure,
+    friction_overview_figure,
+    joint_figure,
+    png_bytes,
+    save_png,
+    widest_run,
+)
+
+TRUE = FrictionParams(F_v=0.2, F_c=1.0, S=0.2, v_s=0.2, tau_os=0.5, a=40.0)
+
+
+@pytest.fixture(scope="module")
+def estimate() -> FrictionEstimate:
+    """Two joints over 4 s at 1 kHz: 'moving' follows model (3.5) in its valid samples (single support,
+    1-3 s); 'still' has no valid sample."""
+    t = np.arange(4000) * 1e-3
+    qd = np.column_stack([np.sin(2 * np.pi * 0.5 * t), np.zeros_like(t)])
+    tau_f = np.column_stack([TRUE.torque(qd[:, 0]), np.zeros_like(t)])
+    single = (t >= 1.0) & (t < 3.0)
+    valid = np.column_stack([single, np.zeros_like(single)])
+    contact = np.column_stack([np.ones_like(t, dtype=bool), ~single])
+    return FrictionEstimate(joints=("moving", "still"), time=t, qd=qd, tau_f=tau_f, valid=valid,
+                            phase=np.where(single, "single", "double"), unique=single, contact=contact,
+                            contact_frames=("left", "right"), qdd=np.zeros_like(qd), delta_qdd=np.zeros_like(qd),
+                            tau_f_true=tau_f.copy())
+
+
+def test_png_bytes_are_a_png_and_the_same_for_the_same_figure(estimate):
+    fits = {f.joint: f for f in fit_estimate(estimate, min_samples=20)}
+    one = png_bytes(joint_figure(estimate, "moving", fits["moving"], TRUE))
+    two = png_bytes(joint_figure(estimate, "moving", fits["moving"], TRUE))
+    assert one[:8] == b"\x89PNG\r\n\x1a\n"
+    assert one == two
+
+
+def test_joint_figure_has_its_four_panels_even_without_valid_samples(estimate):
+    fig = joint_figure(estimate, "moving", None, TRUE, (np.linspace(0, 50, 11), np.ones(11), 10.0))
+    assert len(fig.axes) >= 4  # (d) may add a twin axis for qd
+    titles = [ax.get_title() for ax in fig.axes]
+    assert any(t.startswith("(a)") for t in titles) and any(t.startswith("(b)") for t in titles)
+    fig = joint_figure(estimate, "still", None, None)  # nothing valid: drawn, not raised
+    assert len(fig.axes) >= 4
+
+
+def test_overview_marks_flagged_joints_and_shares_axes(estimate):
+    fig = friction_overview_figure(estimate, ["moving", "still"], {}, {"moving": TRUE}, flagged={"still"})
+    visible = [ax for ax in fig.axes if ax.get_visible()]
+    assert [ax.get_title() for ax in visible] == ["moving", "still"]
+    red = visible[1].title.get_color()
+    assert red != visible[0].title.get_color()
+    assert visible[0].get_shared_x_axes().joined(visible[0], visible[1])
+
+
+def test_files_are_written_whole(estimate, tmp_path):
+    fits = fit_estimate(estimate, min_samples=20)
+    friction_curves_figure(estimate, fits, tmp_path / "curves.png")
+    assert (tmp_path / "curves.png").read_bytes()[:4] == b"\x89PNG"
+    with pytest.raises(Exception, match="does not exist"):
+        save_png(joint_figure(estimate, "moving", None, None), tmp_path / "missing" / "x.png")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["curves.png"]  # no temporary file left
+
+
+@pytest.mark.parametrize(("mask", "x", "expected"), [
+    ([0, 1, 1, 0, 1, 1, 1, 0], [0, 0, 5, 0, 0, 1, 2, 0], slice(1, 3)),  # widest range of x, not the longest run
+    ([1, 1, 1, 0, 1], [0, 1, 2, 0, 9], slice(0, 3)),  # a run of one sample spans no range
+    ([0, 0, 0], [1, 2, 3], slice(0, 0)),
+])
+def test_widest_run(mask, x, expected):
+    assert widest_run(np.array(mask, dtype=bool), np.array(x, dtype=float)) == expected

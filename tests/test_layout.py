@@ -1,0 +1,147 @@
+"""The package's layout, read from the source (no code run): subpackages along the data flow, each importing
+only those before it, no circle between modules, no private name used outside its module, and the README's
+file map naming what is there."""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "src" / "wbfriction"
+
+LAYERS = [
+    {"version", "exceptions", "progress", "config"},
+    {"model"},
+    {"logs"},
+    {"signals"},
+    {"friction"},
+    {"inertia"},
+    {"pipeline"},
+    {"walking"},
+    {"sim"},
+    {"report"},
+    {"studies"},
+    {"cli", "__main__", "__init__"},
+]
+"""The top-level modules and subpackages in data-flow order: each may import only from its own layer
+or earlier ones (the package's ``__init__`` re-exports, so it sits last)."""
+
+
+def module_name(package: Path, path: Path) -> str:
+    parts = list(path.relative_to(package.parent).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def imports_of(package: Path, path: Path) -> set[str]:
+    """Every package module a file imports, at any depth (function-level imports included)."""
+    me = module_name(package, path).split(".")
+    here = me if path.name == "__init__.py" else me[:-1]
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names if a.name.split(".")[0] == package.name}
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                base = ".".join(here[: len(here) - node.level + 1] + ([base] if base else []))
+            if base.split(".")[0] != package.name:
+                continue
+            for alias in node.names:  # "from wbfriction.x import y": y may be a module
+                candidate = f"{base}.{alias.name}"
+                out.add(candidate if is_module(package, candidate) else base)
+    return out
+
+
+def is_module(package: Path, name: str) -> bool:
+    rel = Path(*name.split(".")[1:])
+    return (package / rel).with_suffix(".py").is_file() or (package / rel / "__init__.py").is_file()
+
+
+def import_graph(package: Path) -> dict[str, set[str]]:
+    return {module_name(package, p): imports_of(package, p) for p in sorted(package.rglob("*.py"))}
+
+
+def layer(module: str) -> int:
+    top = module.split(".")[1] if "." in module else "__init__"
+    return next(i for i, names in enumerate(LAYERS) if top in names)
+
+
+def layer_breaches(package: Path) -> list[str]:
+    """Imports of a later stage than the importer's."""
+    return [f"{m} imports {i}" for m, deps in import_graph(package).items() for i in sorted(deps)
+            if layer(i) > layer(m)]
+
+
+def import_cycle(package: Path) -> list[str]:
+    """One circle of module imports (empty if there is none); a package's ``__init__`` importing its
+    own modules is how it re-exports, not a circle."""
+    g = import_graph(package)
+    g = {m: {d for d in deps if d in g and d != m and not d.startswith(m + ".")} for m, deps in g.items()}
+    state: dict[str, int] = {}
+
+    def visit(m: str, path: list[str]) -> list[str]:
+        state[m] = 1
+        for d in sorted(g[m]):
+            if state.get(d) == 1:
+                return path[path.index(d):] + [d]
+            if d not in state and (found := visit(d, path + [d])):
+                return found
+        state[m] = 2
+        return []
+
+    for m in sorted(g):
+        if m not in state and (found := visit(m, [m])):
+            return found
+    return []
+
+
+def test_every_module_sits_in_a_layer():
+    for module in import_graph(PACKAGE):
+        layer(module)  # StopIteration for a module outside the layout
+
+
+def test_no_module_imports_a_later_stage():
+    assert not (bad := layer_breaches(PACKAGE)), "\n".join(bad)
+
+
+def test_no_import_circle():
+    assert not (cycle := import_cycle(PACKAGE)), " -> ".join(cycle)
+
+
+def test_the_checks_see_a_circle_and_a_later_stage(tmp_path):
+    """The two checks can fail: a made-up package with a circle (one import inside a function) and a
+    model module importing the report."""
+    pkg = tmp_path / "wbfriction"
+    (pkg / "model").mkdir(parents=True)
+    for f in ("__init__.py", "model/__init__.py", "report.py"):
+        (pkg / f).write_text("")
+    (pkg / "model" / "a.py").write_text("from wbfriction.model.b import x\n")
+    (pkg / "model" / "b.py").write_text("from wbfriction.report import z\n\n\ndef f():\n    from .a import y\n")
+    assert layer_breaches(pkg) == ["wbfriction.model.b imports wbfriction.report"]
+    assert import_cycle(pkg) == ["wbfriction.model.a", "wbfriction.model.b", "wbfriction.model.a"]
+
+
+def test_no_private_name_crosses_a_module():
+    """``from wbfriction.x import _y`` nowhere: not in the package, the tests, the benchmarks, the examples."""
+    bad = []
+    for folder in ("src", "tests", "benchmarks", "examples"):
+        for path in (ROOT / folder).rglob("*.py"):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("wbfriction"):
+                    bad += [f"{path.relative_to(ROOT)}: {node.module}.{a.name}" for a in node.names
+                            if a.name.startswith("_") and not a.name.startswith("__")]
+    assert not bad, "\n".join(bad)
+
+
+def test_readme_file_map_matches_the_code():
+    """The README's file map lists every subpackage and top-level module of the package, and nothing else."""
+    text = (ROOT / "README.md").read_text()
+    block = re.search(r"<!-- file map -->\n```text\n(.*?)```", text, re.S)
+    assert block, "README: no file map block"
+    named = set(re.findall(r"^[│├└─ ]*([a-z_]+(?:/|\.py))\s", block.group(1), re.M))
+    present = {p.name + "/" for p in PACKAGE.iterdir() if (p / "__init__.py").exists()}
+    present |= {p.name for p in PACKAGE.glob("*.py") if p.name not in ("__init__.py", "__main__.py")}
+    assert named == present, (f"README lists {sorted(named - present)} that the code has not; "
+                              f"misses {sorted(present - named)}")
