@@ -9,7 +9,13 @@ column                 unit        content
 ``time``               s           strictly increasing, uniformly sampled
 ``q.<joint>``          rad (m)     position of every actuated joint
 ``tau.<joint>``        N·m (N)     measured torque of every torque-controlled joint
-``contact.<frame>``    0 / 1       contact flag of every contact frame
+                                   (joint torque sensor), or else:
+``current.<joint>``    A           motor current of every torque-controlled joint,
+                                   times the robot's ``[torque_constants]``
+``contact.<frame>``    0 / 1       contact flag of every contact frame (floating
+                                   base only: a fixed base is always welded)
+``qd.<joint>``         rad/s       optional velocity as the robot logged it (used
+                                   with ``--velocity logged``)
 ``base.x`` ... ``base.qw``  m, -   optional world pose of the root (unit quaternion
                                    x, y, z, w)
 ``tau_f_true.<joint>`` N·m         optional true friction (simulations only; never
@@ -28,6 +34,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 import pyarrow as pa
@@ -35,6 +42,9 @@ import pyarrow as pa
 from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.logs.tables import numeric_column, read_metadata, with_metadata, write_table
 from wbfriction.model.robot import Robot
+
+TorqueSource = Literal["sensor", "current"]
+"""Where a log's torques were measured (:attr:`Log.torque_source`)."""
 
 BASE_COLUMNS = ("base.x", "base.y", "base.z", "base.qx", "base.qy", "base.qz", "base.qw")
 
@@ -59,6 +69,12 @@ class Log:
         period: the sampling period of the log this one was cut from [s] (its segments, a
             chunk of a long log), so that every stretch is differentiated with the same one;
             None: the median step of ``time``.
+        qd_logged: joint velocities as the robot logged them (``qd.<joint>`` columns)
+            (N, n_act) [rad/s], or None; used with ``--velocity logged`` only.
+        torque_source: where ``tau`` was measured: ``"sensor"`` (link-side joint torque
+            sensors: only the friction after the sensor is in it) or ``"current"`` (motor
+            current x torque constant: the whole drive's friction and the rotor inertia are
+            in it).
     """
 
     time: np.ndarray
@@ -73,6 +89,8 @@ class Log:
     qdd_true: np.ndarray | None = None
     segments: list[tuple[int, int]] | None = None
     period: float | None = None
+    qd_logged: np.ndarray | None = None
+    torque_source: TorqueSource = "sensor"
 
     @property
     def dt(self) -> float:
@@ -91,7 +109,7 @@ class Log:
         cut = lambda x: None if x is None else x[start:stop]  # noqa: E731
         return Log(self.time[start:stop], self.q[start:stop], self.tau[start:stop], self.contact[start:stop],
                    cut(self.base), cut(self.tau_f_true), self.metadata, self.source, cut(self.qd_true),
-                   cut(self.qdd_true), None, self.dt)
+                   cut(self.qdd_true), None, self.dt, cut(self.qd_logged), self.torque_source)
 
     def __len__(self) -> int:
         return len(self.time)
@@ -100,14 +118,20 @@ class Log:
         """The log as an Arrow table in the log format."""
         cols: dict[str, np.ndarray] = {"time": self.time}
         cols.update({f"q.{n}": self.q[:, i] for i, n in enumerate(robot.actuated)})
-        cols.update({f"tau.{n}": self.tau[:, i] for i, n in enumerate(robot.torque_controlled)})
-        cols.update({f"contact.{n}": self.contact[:, i].astype(np.int8) for i, n in enumerate(robot.contact_frames)})
+        if self.torque_source == "current":
+            cols.update({f"current.{n}": self.tau[:, i] / robot.torque_constants[n]
+                         for i, n in enumerate(robot.torque_controlled)})
+        else:
+            cols.update({f"tau.{n}": self.tau[:, i] for i, n in enumerate(robot.torque_controlled)})
+        if robot.floating_base:
+            cols.update({f"contact.{n}": self.contact[:, i].astype(np.int8)
+                         for i, n in enumerate(robot.contact_frames)})
         if self.base is not None:
             cols.update({c: self.base[:, i] for i, c in enumerate(BASE_COLUMNS)})
         if self.tau_f_true is not None:
             cols.update({f"tau_f_true.{n}": self.tau_f_true[:, i] for i, n in enumerate(robot.torque_controlled)
                          if not np.all(np.isnan(self.tau_f_true[:, i]))})
-        for prefix, x in (("qd_true", self.qd_true), ("qdd_true", self.qdd_true)):
+        for prefix, x in (("qd", self.qd_logged), ("qd_true", self.qd_true), ("qdd_true", self.qdd_true)):
             if x is not None:
                 cols.update({f"{prefix}.{n}": x[:, i] for i, n in enumerate(robot.actuated)})
         return with_metadata(pa.table(cols), self.metadata)
@@ -198,14 +222,17 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
             non-unit quaternion.
     """
     _check_column_names(table, robot, source)
-    time, segments, q, tau = _read_motion(table, robot, source, max_gap, limit_margin, first_row)
+    time, segments, q = _read_motion(table, robot, source, max_gap, limit_margin, first_row)
+    tau, torque_source = _read_torque(table, robot, source, first_row)
     contact = _read_contact(table, robot, source, first_row)
     base = _read_base(table, source, first_row)
     tau_f_true = _read_tau_f_true(table, robot, len(time), source, first_row)
     qd_true = _read_true_rates(table, "qd_true", robot, source, first_row)
     qdd_true = _read_true_rates(table, "qdd_true", robot, source, first_row)
+    qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
     return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
-               qd_true=qd_true, qdd_true=qdd_true, segments=segments, period=period)
+               qd_true=qd_true, qdd_true=qdd_true, segments=segments, period=period, qd_logged=qd_logged,
+               torque_source=torque_source)
 
 
 def _check_column_names(table: pa.Table, robot: Robot, source: str) -> None:
@@ -218,15 +245,22 @@ def _check_column_names(table: pa.Table, robot: Robot, source: str) -> None:
     for col in table.column_names:
         prefix, _, item = col.partition(".")
         known = {"q": act, "tau": act, "tau_f_true": tc, "contact": frames, "qd_true": act,
-                 "qdd_true": act}.get(prefix)
+                 "qdd_true": act, "qd": act, "current": act}.get(prefix)
         if known is not None and item not in known:
             what = "contact frame" if prefix == "contact" else "joint"
             raise ColumnError(source, col, None,
                               f"column '{col}' names an unknown {what} '{item}' of robot '{robot.name}'")
-    for col in ([f"q.{n}" for n in robot.actuated] + [f"tau.{n}" for n in robot.torque_controlled]
-                + [f"contact.{f}" for f in robot.contact_frames]):
+    contact = [f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else []
+    for col in [f"q.{n}" for n in robot.actuated] + contact:
         if col not in names:
             raise ColumnError(source, col, None, f"missing column '{col}'")
+    for n in robot.torque_controlled:
+        if f"tau.{n}" not in names and f"current.{n}" not in names:
+            raise ColumnError(source, f"tau.{n}", None, f"missing column 'tau.{n}' (or 'current.{n}' with a "
+                              f"torque constant for '{n}' in the robot's [torque_constants])")
+        if f"tau.{n}" not in names and n not in robot.torque_constants:
+            raise ColumnError(source, f"current.{n}", None, f"column 'current.{n}' needs a torque constant: add "
+                              f"'{n}' [N·m/A] to the robot's [torque_constants]")
 
 
 def _stack(table: pa.Table, columns: list[str], source: str, first_row: int) -> np.ndarray:
@@ -235,18 +269,37 @@ def _stack(table: pa.Table, columns: list[str], source: str, first_row: int) -> 
 
 
 def _read_motion(table: pa.Table, robot: Robot, source: str, max_gap: float, limit_margin: float,
-                 first_row: int) -> tuple[np.ndarray, list[tuple[int, int]], np.ndarray, np.ndarray]:
-    """Time [s] (checked, and its segments), q [rad] (checked against the limits) and tau [N·m]."""
+                 first_row: int) -> tuple[np.ndarray, list[tuple[int, int]], np.ndarray]:
+    """Time [s] (checked, and its segments) and q [rad] (checked against the limits)."""
     time = numeric_column(table, "time", source, first_row)
     segments = check_time(time, source, max_gap, first_row=first_row)
     q = _stack(table, [f"q.{n}" for n in robot.actuated], source, first_row)
     check_limits(q, robot, source, limit_margin, first_row)
-    tau = _stack(table, [f"tau.{n}" for n in robot.torque_controlled], source, first_row)
-    return time, segments, q, tau
+    return time, segments, q
+
+
+def _read_torque(table: pa.Table, robot: Robot, source: str, first_row: int) -> tuple[np.ndarray, TorqueSource]:
+    """The torques of the torque-controlled joints (N, n_tc) [N·m] and where they were measured:
+    ``tau.<joint>`` columns (joint torque sensors), or else ``current.<joint>`` [A] times the joint's
+    torque constant [N·m/A] (:attr:`Robot.torque_constants`). One source for every joint."""
+    names = set(table.column_names)
+    from_sensor = [f"tau.{n}" in names for n in robot.torque_controlled]
+    if all(from_sensor):
+        return _stack(table, [f"tau.{n}" for n in robot.torque_controlled], source, first_row), "sensor"
+    if any(from_sensor):
+        n = robot.torque_controlled[from_sensor.index(False)]
+        raise ColumnError(source, f"tau.{n}", None, f"missing column 'tau.{n}': torques come from tau.* columns "
+                          "for some joints and current.* for others; log one kind for every joint")
+    current = _stack(table, [f"current.{n}" for n in robot.torque_controlled], source, first_row)
+    k = np.array([robot.torque_constants[n] for n in robot.torque_controlled])
+    return current * k, "current"
 
 
 def _read_contact(table: pa.Table, robot: Robot, source: str, first_row: int) -> np.ndarray:
-    """The contact flags (N, n_contacts) as booleans, refusing values other than 0 and 1."""
+    """The contact flags (N, n_contacts) as booleans, refusing values other than 0 and 1; on a fixed
+    base, the weld: always in contact."""
+    if not robot.floating_base:
+        return np.ones((table.num_rows, 1), dtype=bool)
     contact_cols = []
     for f in robot.contact_frames:
         c = numeric_column(table, f"contact.{f}", source, first_row)

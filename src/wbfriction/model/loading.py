@@ -87,23 +87,36 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
     Args:
         urdf: URDF file. A free-flyer root joint is added (a URDF-declared floating
             joint is ignored by Pinocchio's parser, so the result is the same).
-        config: keys ``name``, ``contact_frames`` (required), ``position_controlled``,
-            ``torque_controlled``, ``groups``, ``srdf``/``reference_configuration`` (an SRDF
-            posture), ``reference_angles`` (joint name -> angle [rad], set over it),
-            ``balance_gains`` (:attr:`Robot.balance_gains`).
+        config: keys ``name``; ``floating_base`` (default true; false: the URDF's root link
+            is welded to the world, as an arm's or a humanoid hanging in its gantry);
+            ``contact_frames`` (required on a floating base, refused on a fixed one);
+            ``position_controlled``, ``torque_controlled``, ``groups``,
+            ``srdf``/``reference_configuration`` (an SRDF posture), ``reference_angles``
+            (joint name -> angle [rad], set over it), ``locked_joints`` (joint name -> angle
+            [rad or m]: removed from the model at that position, Pinocchio's reduced model:
+            fingers, joints a log does not have), ``torque_constants`` (joint name -> N·m/A at
+            the joint, gear ratio included: ``current.<joint>`` columns give ``tau``),
+            ``armature`` (joint name -> reflected rotor inertia [kg·m^2], in the dynamics
+            through ``model.armature``), ``balance_gains`` (:attr:`Robot.balance_gains`).
         source: file name used in error messages.
 
     Raises:
         InputError: URDF that does not load, unknown joint or frame names, a joint
-            listed both as torque- and position-controlled, a multi-DoF actuated joint.
+            listed both as torque- and position-controlled, a multi-DoF actuated joint,
+            contact frames on a fixed base, a non-positive torque constant, a negative armature.
     """
     urdf = Path(urdf)
+    floating = _floating_base(config, source)
     model = _load_urdf(urdf)
+    q_ref = _reference_configuration(model, config, _actuated_joints(model, urdf, allow_locked=True), source)
+    model, q_ref, locked = _lock_joints(model, config, q_ref, source)
     actuated = _actuated_joints(model, urdf)
     pc, tc_cfg = _joint_roles(config, actuated, source)
-    frames = _contact_frames(config, model, urdf, source)
-    groups = _groups(config, actuated, source)
-    q_ref = _reference_configuration(model, config, actuated, source)
+    frames = _contact_frames(config, model, urdf, source) if floating else [_root_frame(model)]
+    if not floating and config.get("contact_frames"):
+        raise InputError(f"{source}: 'contact_frames' has no meaning with floating_base = false "
+                         "(the root link is welded to the world)")
+    _set_armature(model, config, actuated, source)
     return Robot(
         name=str(config.get("name", urdf.stem)),
         model=model,
@@ -112,10 +125,80 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
         torque_controlled=_in_model_order(actuated, tc_cfg),
         position_controlled=_in_model_order(actuated, pc),
         contact_frames=tuple(frames),
-        groups=groups,
+        groups=_groups(config, actuated, source),
         q_reference=q_ref,
         balance_gains=_balance_gains(config.get("balance_gains", (0.0, 0.0)), source),
+        floating_base=floating,
+        locked_joints=locked,
+        torque_constants=_joint_values(config, "torque_constants", actuated, source, positive=True),
     )
+
+
+def _floating_base(config: dict, source: str) -> bool:
+    value = config.get("floating_base", True)
+    if not isinstance(value, bool):
+        raise InputError(f"{source}: 'floating_base' must be true or false, got {value!r}")
+    return value
+
+
+def _root_frame(model: pin.Model) -> str:
+    """The body frame of the URDF's root link (on the root joint): a fixed base's weld."""
+    return next(f.name for f in model.frames if f.parentJoint == 1 and f.type == pin.FrameType.BODY)
+
+
+def _joint_values(config: dict, key: str, actuated: list[str], source: str, positive: bool = False) -> dict[str, float]:
+    """A ``[key]`` table of joint name -> number, checked against the model's joints."""
+    table = config.get(key, {})
+    if not isinstance(table, dict):
+        raise InputError(f"{source}: '[{key}]' must be a table of joint = number")
+    _check_names(list(table), set(actuated), f"joint in [{key}]", source)
+    out = {}
+    for name, value in table.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+            raise InputError(f"{source}: [{key}] {name} must be a number, got {value!r}")
+        if (value <= 0) if positive else (value < 0):
+            raise InputError(f"{source}: [{key}] {name} must be {'> 0' if positive else '>= 0'}, got {value!r}")
+        out[name] = float(value)
+    return out
+
+
+def _set_armature(model: pin.Model, config: dict, actuated: list[str], source: str) -> None:
+    """Set ``model.armature`` of the joints in ``[armature]`` [kg·m^2] (rnea and crba include it)."""
+    armature = model.armature.copy()
+    for name, value in _joint_values(config, "armature", actuated, source).items():
+        armature[model.idx_vs[model.getJointId(name)]] = value
+    model.armature = armature
+
+
+def _lock_joints(model: pin.Model, config: dict, q_ref: np.ndarray | None,
+                 source: str) -> tuple[pin.Model, np.ndarray | None, dict[str, float]]:
+    """The model with the ``[locked_joints]`` removed at their given positions (``pin.buildReducedModel``),
+    its reference configuration, and the locked joints' positions."""
+    locked = config.get("locked_joints", {})
+    if not locked:
+        return model, q_ref, {}
+    if not isinstance(locked, dict):
+        raise InputError(f"{source}: '[locked_joints]' must be a table of joint = position")
+    names = [model.names[j] for j in range(2, model.njoints)]
+    _check_names(list(locked), set(names), "joint in [locked_joints]", source)
+    q_lock = pin.neutral(model) if q_ref is None else q_ref.copy()
+    values = {}
+    for name, value in locked.items():
+        jid = model.getJointId(name)
+        if model.nqs[jid] != 1 or isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise InputError(f"{source}: [locked_joints] {name} must be a number for a 1-DoF joint, got {value!r}")
+        q_lock[model.idx_qs[jid]] = float(value)
+        values[name] = float(value)
+    reduced = pin.buildReducedModel(model, [model.getJointId(n) for n in locked], q_lock)
+    if q_ref is None:
+        return reduced, None, values
+    q_red = pin.neutral(reduced)
+    q_red[:7] = q_ref[:7]
+    for j in range(2, reduced.njoints):
+        src = model.getJointId(reduced.names[j])
+        q_red[reduced.idx_qs[j]:reduced.idx_qs[j] + reduced.nqs[j]] = \
+            q_ref[model.idx_qs[src]:model.idx_qs[src] + model.nqs[src]]
+    return reduced, q_red, values
 
 
 def _load_urdf(urdf: Path) -> pin.Model:
@@ -129,11 +212,12 @@ def _load_urdf(urdf: Path) -> pin.Model:
         raise InputError(f"{urdf}: URDF does not load: {str(exc).strip().splitlines()[0]}") from exc
 
 
-def _actuated_joints(model: pin.Model, urdf: Path) -> list[str]:
-    """The joints after the root, in model order; each must have one DoF."""
+def _actuated_joints(model: pin.Model, urdf: Path, allow_locked: bool = False) -> list[str]:
+    """The joints after the root, in model order; each must have one DoF (``allow_locked``:
+    any, for joints that may still be locked)."""
     actuated = []
     for jid in range(2, model.njoints):
-        if model.nvs[jid] != 1:
+        if model.nvs[jid] != 1 and not allow_locked:
             raise InputError(f"{urdf}: joint '{model.names[jid]}' has {model.nvs[jid]} DoF; "
                              "only 1-DoF joints are supported")
         actuated.append(model.names[jid])

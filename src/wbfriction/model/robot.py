@@ -1,5 +1,8 @@
 """Robot model: a URDF with a free-flyer root, its joint groups and contact frames.
 
+A fixed-base robot (an arm) has the same free-flyer root, welded to the world at the
+identity through one permanent contact at its root link (:attr:`Robot.floating_base`).
+
 The model is Pinocchio's (``pin.buildModelFromUrdf`` with ``pin.JointModelFreeFlyer``):
 configuration ``q`` (size ``nq``: base position [m], base orientation as a unit
 quaternion (x, y, z, w), then the joint coordinates) and velocity ``v`` (size ``nv``:
@@ -47,6 +50,16 @@ class Robot:
         balance_gains: (K [N·m/rad], D [N·m·s/rad]) of the MuJoCo walking controller's
             base-attitude stabiliser (:func:`wbfriction.sim.control.attitude_ankle_torques`);
             a property of the simulated robot, not used by the estimator.
+        floating_base: False for a robot whose root link is welded to the world (an arm, a
+            humanoid hanging in its gantry). The model keeps its free-flyer root and
+            :attr:`contact_frames` is the root link's frame, always in contact: a fixed base
+            is a permanent single support with the weld at the root (thesis 5.13 with the base
+            welded: ``tau_f = M qdd + h - tau``, every sample unique). Logs need no
+            ``contact.*`` columns.
+        locked_joints: joints removed from the model at a fixed position [rad or m]
+            (Pinocchio's reduced model): not in :attr:`actuated`, not needed in a log.
+        torque_constants: joint -> torque constant [N·m/A] at the joint (gear ratio
+            included), for logs that record motor currents ``current.<joint>`` [A].
     """
 
     name: str
@@ -59,6 +72,9 @@ class Robot:
     groups: dict[str, tuple[str, ...]] = field(default_factory=dict)
     q_reference: np.ndarray | None = None
     balance_gains: tuple[float, float] = (0.0, 0.0)
+    floating_base: bool = True
+    locked_joints: dict[str, float] = field(default_factory=dict)
+    torque_constants: dict[str, float] = field(default_factory=dict)
     cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
     """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.stance`)."""
 

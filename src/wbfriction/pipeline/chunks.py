@@ -87,12 +87,13 @@ def plan_columns(file: TableFile, robot: Robot, source: str) -> tuple[np.ndarray
     Raises:
         InputError: an unreadable file; ColumnError: a missing ``time`` or contact column.
     """
-    columns = ["time"] + [f"contact.{f}" for f in robot.contact_frames]
+    columns = ["time"] + ([f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else [])
     table = file.read(columns)
     for c in columns:
         if c not in table.column_names:
             raise ColumnError(source, c, None, f"missing column '{c}'")
-    flags = np.column_stack([table.column(c).to_numpy(zero_copy_only=False) for c in columns[1:]])
+    flags = (np.column_stack([table.column(c).to_numpy(zero_copy_only=False) for c in columns[1:]])
+             if robot.floating_base else np.ones((table.num_rows, 1)))  # a fixed base: always welded
     time = table.column("time").to_numpy(zero_copy_only=False).astype(float)
     period = float(np.median(np.diff(time))) if len(time) > 1 else float("nan")
     return np.nan_to_num(flags.astype(float)) != 0, period

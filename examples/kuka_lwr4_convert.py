@@ -1,0 +1,55 @@
+"""Convert a KUKA LWR4+ recording (FloBaRoID's ``measurements_*.npz``) into the wbfriction log format.
+
+The recording holds ``times`` (Unix epoch [s], as the recorder stamped them), ``positions`` [rad],
+``torques`` [N·m] (the joint torque sensors), ``velocities`` [rad/s] (filtered by the controller)
+and the controller's targets, for the joints ``lwr_0_joint`` ... ``lwr_6_joint`` in order. The log
+keeps the stamps untouched (wbfriction decides how to read them) and writes
+
+    time, q.<joint>, tau.<joint>, qd.<joint>
+
+Nothing else is changed: no filter, no resampling. Usage::
+
+    python examples/kuka_lwr4_convert.py ../shared/real-data/kuka_lwr4/measurements_1.npz -o run1.parquet
+    wbfriction estimate run1.parquet --urdf ../shared/real-data/kuka_lwr4/kuka_lwr4.urdf \\
+        --config examples/kuka_lwr4.toml -o run1_friction.parquet
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+
+from wbfriction.logs import write_table
+
+JOINTS = tuple(f"lwr_{i}_joint" for i in range(7))
+
+
+def convert(npz: Path) -> pa.Table:
+    """The recording ``npz`` as a log table (columns above), one row per recorded sample."""
+    data = np.load(npz)
+    columns = {"time": np.asarray(data["times"], dtype=np.float64)}
+    for prefix, key in (("q", "positions"), ("tau", "torques"), ("qd", "velocities")):
+        values = np.asarray(data[key], dtype=np.float64)
+        if values.shape != (len(columns["time"]), len(JOINTS)):
+            raise SystemExit(f"{npz}: '{key}' has shape {values.shape}, expected ({len(columns['time'])}, 7)")
+        columns.update({f"{prefix}.{j}": values[:, i] for i, j in enumerate(JOINTS)})
+    return pa.table(columns)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("npz", type=Path, help="a measurements_*.npz recording")
+    parser.add_argument("-o", "--output", type=Path, required=True, help="log to write (.parquet or .csv)")
+    args = parser.parse_args()
+    table = convert(args.npz)
+    write_table(table, args.output)
+    step = np.diff(table["time"].to_numpy())
+    print(f"{args.output}: {table.num_rows} rows, {len(JOINTS)} joints, time steps {step.min() * 1e3:.2f} to "
+          f"{step.max() * 1e3:.2f} ms (median {np.median(step) * 1e3:.2f} ms), stamps kept as recorded")
+
+
+if __name__ == "__main__":
+    main()
