@@ -60,8 +60,6 @@ CASES = {  # case: (edit of the columns, what the line must say)
             "column 'tau.arm_right_2_joint' has a non-finite value (NaN or inf) at row 11"),
     "duplicated stamp": (lambda c: c["time"].__setitem__(10, c["time"][9]), "duplicated stamp at row 10"),
     "decreasing stamp": (lambda c: c["time"].__setitem__(10, c["time"][9] - 1e-4), "decreasing stamp at row 10"),
-    "irregular sampling": (lambda c: c["time"].__setitem__(slice(20, None), c["time"][20:] + 0.5e-3),
-                           "irregular at row 20"),
     "missing joint": (lambda c: c.pop("q.leg_right_2_joint"), "missing column 'q.leg_right_2_joint'"),
     "missing torque": (lambda c: c.pop("tau.leg_right_2_joint"), "missing column 'tau.leg_right_2_joint'"),
     "unknown joint": (lambda c: c.__setitem__("q.leg_middle_1_joint", c["time"]), "unknown joint 'leg_middle_1_joint'"),

@@ -18,6 +18,7 @@ LAYERS = [
     {"signals"},
     {"friction"},
     {"inertia"},
+    {"export"},
     {"pipeline"},
     {"walking"},
     {"sim"},

@@ -27,10 +27,11 @@ from rich.table import Table
 from wbfriction.exceptions import InputError, WbfrictionError
 from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
 from wbfriction.friction.estimate import EstimateOptions, Method
-from wbfriction.friction.fit import FitResult
-from wbfriction.friction.models import PARAM_NAMES
+from wbfriction.friction.fit import FitResult, ModelChoice
+from wbfriction.friction.models import ALL_PARAM_NAMES, PARAM_NAMES
 from wbfriction.friction.targets import load_friction_toml
 from wbfriction.inertia.identification import InertialOptions
+from wbfriction.logs.clock import TimeBase
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, write_log
 from wbfriction.logs.source import open_log, read_log
 from wbfriction.logs.tables import TableFile
@@ -42,7 +43,7 @@ from wbfriction.pipeline.estimate import RobotSpec, estimate_file, table_log
 from wbfriction.pipeline.fit import fit_file
 from wbfriction.pipeline.provenance import log_provenance
 from wbfriction.signals.filters import SavgolWeights
-from wbfriction.signals.kinematics import Diff, FilterOptions, TorqueAlignment
+from wbfriction.signals.kinematics import Diff, FilterOptions, TorqueAlignment, Velocity
 from wbfriction.signals.phases import Mask
 from wbfriction.sim import IdealOptions, MujocoOptions, SensorNoise, simulate_ideal, simulate_mujoco
 from wbfriction.sim.ideal import Integrator
@@ -68,8 +69,12 @@ FitWorkersOpt = typer.Option(2, min=1, help="Processes fitting joints side by si
 MapOpt = typer.Option(None, "--map", help="Topic map TOML of a ROS 2 bag log (see 'wbfriction convert').")
 
 
-MaxGapOpt = typer.Option(MAX_GAP, help="Time steps of at least this many sampling periods split the log into "
-                                        "segments, estimated apart.")
+MaxGapOpt = typer.Option(MAX_GAP, help="Time steps of at least this many local median steps split the log "
+                                        "into segments, estimated apart.")
+TimeBaseOpt = typer.Option("auto", help="Time base the positions are differentiated on: auto (decided from the "
+                                         "data and printed), recorded (the stamps as they are: a clock that "
+                                         "skips samples) or regularised (a uniform clock fitted to "
+                                         "receive-time stamps).")
 LimitMarginOpt = typer.Option(LIMIT_MARGIN, help="Positions beyond the URDF limits by more than this [rad] are "
                                                  "refused (wrong units).")
 
@@ -87,27 +92,38 @@ def _robot(robot: str, urdf: Optional[Path], config: Optional[Path]) -> Robot:
 
 
 def _fit_rows(results: list[FitResult]) -> Table:
-    """One row per joint: each parameter as value(standard error); ``n.i.``: not identifiable."""
-    table = Table(title="Friction model (3.5): f(qd) fitted to -tau_f, value ±standard error",
-                  caption="n.i.: not identifiable from these data (infinite standard error)", box=None)
-    table.add_column("joint")
-    table.add_column("N", justify="right")
-    for name in PARAM_NAMES:
+    """One row per joint: its model and each of its parameters as value ±standard error (``n.i.``:
+    not identifiable; ``(bound)``: at a bound of the fit); blank: not a parameter of its model."""
+    names = [n for n in ALL_PARAM_NAMES if any(r.params is not None and n in r.params.names for r in results)]
+    table = Table(title="Friction model per joint: f(qd) fitted to -tau_f, value ±standard error",
+                  caption="n.i.: not identifiable from these data (infinite standard error); "
+                          "(bound): at a bound of the fit, the bound's value, not the data's", box=None)
+    for col in ("joint", "model", "N"):
+        table.add_column(col, justify="right" if col == "N" else "left")
+    for name in names:
         table.add_column(name, justify="right")
     has_true = any(r.rms_error_vs_true is not None for r in results)
     if has_true:
         table.add_column("RMS est-true", justify="right")
-    fmt = lambda v, s: f"{v:.4g} ±{'n.i.' if not np.isfinite(s) else f'{s:.1g}'}"  # noqa: E731
     pad = [""] if has_true else []
+
+    def cell(r: FitResult, n: str) -> str:
+        if r.params is None or n not in r.params.names:
+            return "—" if r.params is None else ""
+        s = r.stderr[n]
+        return (f"{getattr(r.params, n):.4g} ±{'n.i.' if not np.isfinite(s) else f'{s:.1g}'}"
+                + (" (bound)" if r.at_bound.get(n) else ""))
+
     for r in results:
-        cells = (["—"] * len(PARAM_NAMES) if r.params is None
-                 else [fmt(getattr(r.params, n), r.stderr[n]) for n in PARAM_NAMES])
         rms = [f"{r.rms_error_vs_true:.4f}" if r.rms_error_vs_true is not None else ""] if has_true else []
-        table.add_row(r.joint, str(r.n_samples), *cells, *rms)
+        table.add_row(r.joint, r.model, str(r.n_samples), *[cell(r, n) for n in names], *rms)
         err = r.error_percent()
-        if err is not None:
-            table.add_row("  target", "", *[f"{getattr(r.target, n):.4g}" for n in PARAM_NAMES], *pad, style="dim")
-            table.add_row("  error [%]", "", *[f"{err[n]:.2f}" for n in PARAM_NAMES], *pad, style="dim")
+        if err is not None and r.target is not None:
+            target = r.target.values_in(r.model)
+            table.add_row("  target", "", "", *[f"{target[n]:.4g}" if n in target else "" for n in names], *pad,
+                          style="dim")
+            table.add_row("  error [%]", "", "", *[f"{err[n]:.2f}" if n in err else "" for n in names], *pad,
+                          style="dim")
     return table
 
 
@@ -165,7 +181,7 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
 
 def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: EstimateOptions,
                   bag_map: Optional[Path] = None, max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN,
-                  workers: int = 2, chunk_rows: int = 10_000) -> None:
+                  workers: int = 2, chunk_rows: int = 10_000, time_base: TimeBase = "auto") -> None:
     """Estimate a log file in chunks on ``workers`` processes (which load the robot from
     ``spec``); a ROS 2 bag is first streamed into a temporary Parquet log beside the output."""
     source = open_log(log, bag_map)
@@ -176,15 +192,22 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
         with _progress(TableFile(table).row_count(), "estimate") as advance:
             result = estimate_file(spec, table, output, opts, chunking=Chunking(rows=chunk_rows, workers=workers),
                                    max_gap=max_gap, limit_margin=limit_margin, extra_metadata=provenance,
-                                   progress=advance, robot=r, source=str(log))
+                                   progress=advance, robot=r, source=str(log), time_base=time_base)
+    console.print(escape(result.clock), highlight=False, soft_wrap=True)
+    if opts.velocity == "logged":
+        velocity = result.metadata.get("velocity", {})  # measured on the first chunk
+        console.print(f"velocity: {escape(velocity.get('reason', 'logged'))} (not compensated)", highlight=False)
     console.print(f"wrote {output}: {result.rows} samples")
 
 
 def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, tolerance: float,
-             workers: int) -> None:
+             workers: int, model: ModelChoice = "auto", selection_tolerance: float = 0.02) -> None:
     fitted = fit_file(friction, output, min_samples=min_samples, threshold=threshold, tolerance=tolerance,
-                      workers=workers)
+                      workers=workers, model=model, selection_tolerance=selection_tolerance)
     out.print(_fit_rows(fitted.fits))
+    for r in fitted.fits:
+        if r.selection is not None:
+            out.print(f"{r.joint}: {escape(r.selection.reason)}", highlight=False, soft_wrap=True)
     _warn_energy(fitted.energy)
     console.print(f"wrote {output}")
 
@@ -266,19 +289,24 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
              cond: bool = typer.Option(_E.condition_number, "--cond",
                                        help="Report cond(M_mod^-1) per sample (slower)."),
              method: str = typer.Option(_E.method, help="Single-support route: rnea (fast) or kkt "
-                                                        "(5.10-5.13).")) -> None:
+                                                        "(5.10-5.13)."),
+             time_base: str = TimeBaseOpt,
+             velocity: str = typer.Option(_E.velocity, help="Joint velocities: differentiated (by --diff) or "
+                                                            "logged (the log's qd.<joint> columns; their lag "
+                                                            "is measured and printed).")) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
     opts = EstimateOptions(diff=cast(Diff, diff), compensate_delay=delay_compensation,
                            torque_alignment=cast(TorqueAlignment, torque_alignment), mask=cast(Mask, mask),
                            lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
                            ds_regularization=ds_regularization, condition_number=cond, method=cast(Method, method),
+                           velocity=cast(Velocity, velocity),
                            filtering=FilterOptions(window=window, poly_order=poly_order,
                                                    weights=cast(SavgolWeights, weights),
                                                    cutoff=cutoff, butter_order=butter_order))
     spec = RobotSpec(None if config else robot, None if urdf is None else str(urdf),
                      None if config is None else str(config))
     _run_estimate(_robot(robot, urdf, config), spec, log, output, opts, bag_map, max_gap, limit_margin, workers,
-                  chunk_rows)
+                  chunk_rows, cast(TimeBase, time_base))
 
 
 @app.command()
@@ -303,10 +331,52 @@ def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wb
         output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
         min_samples: int = typer.Option(_MIN_SAMPLES, help="Joints with fewer valid samples are not fitted."),
         energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt,
-        workers: int = FitWorkersOpt) -> None:
-    """Identify the friction model (3.5) of every joint, with standard errors; warn about
-    joints whose friction generates power (eq. 7.9)."""
-    _run_fit(friction, output, min_samples, energy_threshold, energy_tolerance, workers)
+        workers: int = FitWorkersOpt,
+        model: str = typer.Option("auto", "--model", help="Friction model per joint: auto (the simplest whose "
+                                                          "held-out RMS is within --selection-tolerance of the "
+                                                          "best), coulomb-viscous (3.1 + 3.2), stribeck (3.3 + "
+                                                          "3.2) or thesis (3.5); each with an offset tau_os."),
+        selection_tolerance: float = typer.Option(0.02, help="With --model auto: relative excess of held-out RMS "
+                                                             "within which the simpler model is chosen.")) -> None:
+    """Identify a friction model of every joint, with standard errors and the parameters left
+    at a bound; warn about joints whose friction generates power (eq. 7.9)."""
+    _run_fit(friction, output, min_samples, energy_threshold, energy_tolerance, workers,
+             cast(ModelChoice, model), selection_tolerance)
+
+
+@app.command()
+def export(params: Path = typer.Argument(..., help="Parameters written by 'wbfriction fit'."),
+           outputs: list[Path] = typer.Option(..., "-o", "--output",
+                                              help="File to write, format by name: .urdf (<dynamics damping "
+                                                   "friction>), .xml (MuJoCo MJCF: damping, frictionloss, "
+                                                   "armature) or .yaml (Isaac Lab actuators); repeat -o for "
+                                                   "several."),
+           robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt) -> None:
+    """Write the fitted friction where simulators read it. F_v -> damping, F_c -> Coulomb
+    friction (MuJoCo frictionloss); the Stribeck bump, the tanh and tau_os have no simulator field
+    and are dropped. Inertias are the URDF's: give --urdf IDENTIFIED.urdf to export identified ones."""
+    from wbfriction.pipeline.export import export_files
+
+    for path, fmt in export_files(_robot(robot, urdf, config), params, outputs):
+        console.print(f"wrote {path} ({fmt})")
+
+
+@app.command()
+def predict(friction: Path = typer.Argument(..., help="Friction table of a held-out log ('wbfriction estimate' "
+                                                      "with the URDF under test)."),
+            params: Path = typer.Option(..., "--params", help="Parameters fitted on other logs estimated with "
+                                                              "the same URDF ('wbfriction fit').")) -> None:
+    """How well a model predicts torques it was not fitted on: per joint, the RMS of measured minus
+    predicted torque, tau - (M qdd + h + f(qd)), with the friction model and without it."""
+    from wbfriction.pipeline.predict import predict_file
+
+    pred = predict_file(friction, params)
+    table = Table(title=f"Torque prediction on {friction.name}: RMS of measured - predicted [N·m]", box=None)
+    for col in ("joint", "samples", "rigid body only", "with friction"):
+        table.add_column(col, justify="left" if col == "joint" else "right")
+    for j, n, rigid, full in zip(pred.joints, pred.samples, pred.rms_rigid_body, pred.rms):
+        table.add_row(j, str(n), f"{rigid:.4g}", "—" if not np.isfinite(full) else f"{full:.4g}")
+    out.print(table)
 
 
 @app.command()

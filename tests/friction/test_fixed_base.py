@@ -145,3 +145,30 @@ def test_a_log_without_torque_or_current_names_the_column(tmp_path, panda_log):
     tab = table(t, q, qd, qdd, tau, currents=True)
     with pytest.raises(ValueError, match="'current.panda_joint1' needs a torque constant"):
         log_from_table(tab, robot)
+
+
+class _Truth:
+    """The injected friction as a model: ``f(qd)`` of joint ``i``."""
+
+    def __init__(self, i: int) -> None:
+        self.i = i
+
+    def f(self, qd):
+        full = np.zeros((len(qd), 7))
+        full[:, self.i] = qd
+        return -friction_truth(full)[:, self.i]
+
+
+def test_the_true_model_predicts_the_torques(tmp_path, panda_log):
+    """Torque prediction (friction.predict): the injected friction predicts the torques exactly,
+    the rigid-body model alone misses them by the friction's RMS."""
+    from wbfriction.friction.predict import predict_torques
+
+    t, q, qd, qdd, tau_f, tau = panda_log
+    robot = load_robot(urdf=example_robot_data_dir() / PANDA, config=config(tmp_path))
+    est = estimate_log(robot, log_from_table(table(t, q, qd, qdd, tau), robot), EstimateOptions(diff="true"))
+    pred = predict_torques(est, {j: _Truth(i) for i, j in enumerate(JOINTS[:6])}, tau)
+    assert np.all(pred.rms[:6] < 1e-9) and np.isnan(pred.rms[6])  # the last joint has no model
+    assert np.allclose(pred.rms_rigid_body, np.sqrt(np.mean(tau_f**2, axis=0)), rtol=1e-9)
+    assert np.allclose(pred.rms_torque, np.sqrt(np.mean(tau**2, axis=0)), rtol=1e-12)
+    assert np.all(pred.samples == len(t))

@@ -3,16 +3,25 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from wbfriction.friction.fit import fit_friction, fit_joints, model_jacobian, standard_errors
+from wbfriction.exceptions import InputError
+from wbfriction.friction.fit import fit_friction, fit_joints, model_jacobian, model_values, standard_errors
 from wbfriction.friction.models import (
+    MODEL_NAMES,
+    MODEL_PARAMS,
+    CoulombViscousParams,
     FrictionParams,
+    StribeckParams,
     coulomb,
+    coulomb_viscous,
     coulomb_viscous_stribeck,
     friction_torque,
+    params_from_dict,
     stribeck,
+    stribeck_viscous,
     viscous,
 )
 
@@ -50,6 +59,43 @@ def test_dissipative_without_offset(qd, F_v, F_c, S, v_s, a):
     assert qd * p.torque(qd) <= 0.0
 
 
+@given(vel, pos, pos, st.floats(-1.0, 1.0))
+def test_coulomb_viscous_is_the_stribeck_model_without_a_stribeck_drop(qd, F_v, F_c, tau_os):
+    """(3.1) + (3.2): the (3.3) + (3.2) model with F_s = F_c, and the sum of its parts."""
+    expected = coulomb(qd, F_c) + viscous(qd, F_v) + tau_os
+    assert np.isclose(coulomb_viscous(qd, F_v, F_c, tau_os), expected, rtol=1e-12, atol=1e-12)
+    assert np.isclose(stribeck_viscous(qd, F_v, F_c, F_c, 0.3, tau_os), expected, rtol=1e-12, atol=1e-12)
+
+
+@given(vel, pos, pos, st.floats(0.0, 5.0), st.floats(0.01, 2.0), st.floats(-1.0, 1.0))
+def test_stribeck_model_is_the_thesis_model_with_a_sharp_tanh(qd, F_v, F_c, S, v_s, tau_os):
+    """(3.5) with tanh(a qd) -> sgn(qd) is (3.3) + (3.2) with F_s = (1 + S) F_c, as
+    ``FrictionParams.values_in`` writes it."""
+    thesis = FrictionParams(F_v, F_c, S, v_s, tau_os, BIG_A)
+    same = StribeckParams(**thesis.values_in("stribeck"))
+    assert np.isclose(same.f(qd), thesis.f(qd), rtol=1e-12, atol=1e-12)
+
+
+@given(st.floats(-20.0, 20.0), pos, pos, st.floats(0.0, 5.0), st.floats(0.01, 2.0))
+def test_new_models_are_dissipative_without_offset(qd, F_v, F_c, drop, v_s):
+    assert qd * CoulombViscousParams(F_v, F_c).torque(qd) <= 0.0
+    assert qd * StribeckParams(F_v, F_c, F_c + drop, v_s).torque(qd) <= 0.0
+
+
+@pytest.mark.parametrize("model", MODEL_NAMES)
+def test_parameters_convert_to_vectors_and_dicts_and_back(model):
+    cls = MODEL_PARAMS[model]
+    x = np.arange(1.0, len(cls.names) + 1)
+    p = cls.from_vector(x, delta_s=1.5)
+    assert p.model == model and np.array_equal(p.as_vector(), x)
+    assert params_from_dict(model, p.to_dict()) == p
+    assert getattr(p, "delta_s", 1.5) == 1.5
+    with pytest.raises(InputError, match=f"unknown friction parameter.*{model}"):
+        params_from_dict(model, {"F_x": 1.0})
+    with pytest.raises(InputError, match="model must be one of"):
+        params_from_dict("lugre", {})
+
+
 def test_friction_torque_vectorised_matches_per_joint():
     rng = np.random.default_rng(0)
     params = [FrictionParams(0.2, 0.8, 0.2, 0.2, 0.8, 40.0), FrictionParams(0.1, 0.1, 0.5, 0.1, -0.1, 20.0)]
@@ -59,17 +105,23 @@ def test_friction_torque_vectorised_matches_per_joint():
         np.testing.assert_allclose(out[:, j], p.torque(qd[:, j]), rtol=1e-14)
 
 
-def test_analytic_jacobian_matches_finite_differences():
+@pytest.mark.parametrize(("model", "x"), [("thesis", [0.2, 0.8, 0.3, 0.25, 0.1, 30.0]),
+                                          ("stribeck", [0.2, 0.8, 1.3, 0.25, 0.1]),
+                                          ("coulomb-viscous", [0.2, 0.8, 0.1])])
+def test_analytic_jacobian_matches_finite_differences(model, x):
     rng = np.random.default_rng(1)
     qd = rng.uniform(-2, 2, 200)
-    x = np.array([0.2, 0.8, 0.3, 0.25, 0.1, 30.0])
-    J = model_jacobian(x, qd, 2.0)
-    for i in range(6):
+    x = np.array(x)
+    f = lambda x: MODEL_PARAMS[model].from_vector(x, delta_s=2.0).f(qd)  # noqa: E731
+    J = model_jacobian(x, qd, 2.0, model)
+    assert J.shape == (qd.size, x.size)
+    np.testing.assert_array_equal(model_values(x, qd, 2.0, model), f(x))
+    for i in range(x.size):
         h = 1e-6 * max(1.0, abs(x[i]))
         xp, xm = x.copy(), x.copy()
         xp[i] += h
         xm[i] -= h
-        fd = (coulomb_viscous_stribeck(qd, *xp) - coulomb_viscous_stribeck(qd, *xm)) / (2 * h)
+        fd = (f(xp) - f(xm)) / (2 * h)
         np.testing.assert_allclose(J[:, i], fd, rtol=1e-5, atol=1e-7)
 
 
@@ -131,8 +183,6 @@ def test_fit_standard_errors_cover_truth_with_noise():
 def test_standard_errors_account_for_correlated_residuals():
     """Residuals correlated over ~100 samples (a filtered estimate): the Newey-West standard
     errors cover the truth about as often as they should, the white-noise formula does not."""
-    from wbfriction.friction.fit import model_values
-
     truth = FrictionParams(0.2, 0.8, 0.2, 0.2, 0.8, 40.0)
     t = np.arange(6000) * 1e-3
     qd = 1.2 * np.sin(2 * np.pi * 0.7 * t) + 0.3 * np.sin(2 * np.pi * 1.9 * t)

@@ -59,7 +59,6 @@ def _bad(talos, good, edit):
     (lambda c: c.__setitem__("contact.nose", c["time"]), "unknown contact frame 'nose'"),
     (lambda c: c["time"].__setitem__(10, c["time"][9]), "duplicated stamp at row 10"),
     (lambda c: c["time"].__setitem__(10, c["time"][9] - 1e-4), "decreasing stamp at row 10"),
-    (lambda c: c["time"].__setitem__(slice(20, None), c["time"][20:] + 0.5e-3), "irregular at row 20"),
     (lambda c: c["q.leg_left_4_joint"].__setitem__(12, 57.3), "column 'q.leg_left_4_joint' is 57.3 at row 12, "
                                                               "beyond its URDF limits [0, 2.618]"),
     (lambda c: c["q.leg_left_4_joint"].__setitem__(7, np.nan),
@@ -81,10 +80,39 @@ def test_time_gaps_split_the_log_into_segments(talos, good, step):
     a, b = log.parts()
     np.testing.assert_array_equal(b.q, good.q[20:])
     assert len(a.time) == 20 and b.time[0] == pytest.approx(0.019 + step * 1e-3)
-    # with a larger max_gap, the same step is irregular sampling
+    # with a larger max_gap, the same step is a clock that skipped samples: one segment,
+    # differentiated on the stamps as recorded
     if step < 5:
-        with pytest.raises(InputError, match="irregular at row 20"):
-            log_from_table(table, talos, source="x.parquet", max_gap=5)
+        log = log_from_table(table, talos, source="x.parquet", max_gap=5)
+        assert log.segments == [(0, 50)] and log.clock.kind == "skipping"
+        assert log.clock.lattice == pytest.approx(1e-3)
+        np.testing.assert_array_equal(log.clock.t, log.time - log.time[0])
+
+
+def test_irregular_steps_are_read_with_the_clock_that_explains_them(talos, good):
+    """Steps that are not uniform are no longer refused: the log is read whole and its clock says
+    what it found (here exact stamps of a 0.5 ms clock: steps of 1 and 1.5 ms)."""
+    table = _bad(talos, good, lambda c: c["time"].__setitem__(slice(20, None), c["time"][20:] + 0.5e-3))
+    log = log_from_table(table, talos, source="x.parquet")
+    assert log.segments == [(0, 50)] and log.clock.kind == "skipping"
+    assert "exact stamps of a 0.5 ms clock skipping samples (steps 1-1.5 ms = 2-3 ticks)" in log.clock.reason
+    assert log.dt == pytest.approx(1e-3)
+    forced = log_from_table(table, talos, source="x.parquet", time_base="regularised")
+    assert forced.clock.kind == "jittered" and "as asked" in forced.clock.reason
+
+
+def test_integer_nanosecond_stamps(talos, good):
+    """An integer ``time`` column is nanoseconds (epoch): read as seconds, its clock exact."""
+    ns = 1_700_000_000_123_456_789 + np.arange(len(good.time), dtype=np.int64) * 1_000_000
+    table = _bad(talos, good, lambda c: c.__setitem__("time", ns))
+    log = log_from_table(table, talos, source="x.parquet")
+    assert log.clock.kind == "uniform" and log.dt == 1e-3 and log.clock.t0 == pytest.approx(1.7e9)
+    np.testing.assert_allclose(log.clock.t, good.time, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(log.time, ns * 1e-9, rtol=1e-15)
+    dup = ns.copy()
+    dup[10] = dup[9]
+    with pytest.raises(InputError, match="duplicated stamp at row 10"):
+        log_from_table(_bad(talos, good, lambda c: c.__setitem__("time", dup)), talos, source="x.parquet")
 
 
 def test_unreadable_and_missing_files(talos, tmp_path):

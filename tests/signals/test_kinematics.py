@@ -8,8 +8,10 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
+from wbfriction.logs.clock import read_clock
 from wbfriction.logs.log import Log
-from wbfriction.signals.kinematics import align_torque, central_differences, measure
+from wbfriction.signals.kinematics import FilterOptions, align_torque, central_differences, measure
+from wbfriction.signals.nonuniform import three_point_differences
 from wbfriction.signals.phases import joint_mask, segment
 
 DT = 1e-3
@@ -94,3 +96,139 @@ def test_segment_does_not_trim_at_log_edges():
     contact = np.zeros((100, 2), dtype=bool)
     contact[:, 0] = True
     assert segment(t, contact).keep.all()
+
+
+# ------------------------------------------------------------- non-uniform sample times
+def _motion(t):
+    """A smooth motion of three joints: q, qd, qdd at times t (N,)."""
+    w, a = np.array([2.1, 5.3, 0.7]), np.array([0.5, 0.2, 1.0])
+    phase = w * t[:, None] + 1.0
+    return a * np.sin(phase), a * w * np.cos(phase), -a * w**2 * np.sin(phase)
+
+
+def _clocked(stamps, q, tau=None, **kw):
+    n = len(stamps)
+    clock = read_clock(stamps, "test", q=q, **kw)
+    return Log(time=np.asarray(stamps, dtype=float), q=q, tau=np.zeros((n, 1)) if tau is None else tau,
+               contact=np.ones((n, 1), dtype=bool), clock=clock)
+
+
+def _rms(x):
+    return float(np.sqrt(np.mean(np.square(x))))
+
+
+FILTERS = FilterOptions(window=51, cutoff=20.0)
+
+
+def test_zoh_alignment_on_non_uniform_steps_matches_held_torque():
+    """A double integrator driven by a held input over uneven periods: the three-point second
+    difference sees each torque weighed by how long it was held."""
+    rng = np.random.default_rng(1)
+    h = rng.uniform(0.5, 2.0, 99) * DT
+    t = np.concatenate([[0.0], np.cumsum(h)])
+    u = rng.normal(0, 1, 100)
+    q, v = [0.0], 0.0
+    for k in range(99):
+        q.append(q[-1] + v * h[k] + 0.5 * u[k] * h[k] ** 2)
+        v += u[k] * h[k]
+    _, qdd, _ = three_point_differences(np.array(q)[:, None], t)
+    np.testing.assert_allclose(qdd[1:-1, 0], align_torque(u[:, None], "zoh", t)[1:-1, 0], atol=1e-6)
+    assert np.abs(qdd[1:-1, 0] - align_torque(u[:, None], "zoh")[1:-1, 0]).max() > 0.1  # the plain mean is wrong
+
+
+@pytest.mark.parametrize("diff", ["central", "backward", "savgol", "butterworth"])
+def test_samples_at_jittered_instants_stamped_exactly(diff):
+    """Kind (a): samples taken 0.7-1.3 ms apart and stamped exactly are differentiated on their
+    stamps; the derivatives equal those of the same motion logged uniformly (which are the
+    motion's own, checked too) within 1 % RMS. Differentiated with a constant period, they would not be."""
+    rng = np.random.default_rng(2)
+    t = np.concatenate([[0.0], np.cumsum(rng.uniform(0.7, 1.3, 3999))]) * DT
+    q, qd, qdd = _motion(t)
+    log = _clocked(t, q)
+    assert log.clock.kind == "skipping" and "differentiating on the stamps as recorded" in log.clock.reason
+    m = measure(log, diff, filtering=FILTERS)
+    tu = np.arange(4000) * DT
+    _, qd_u, qdd_u = _motion(tu)
+    u = measure(Log(time=tu, q=_motion(tu)[0], tau=np.zeros((4000, 1)), contact=np.ones((4000, 1), dtype=bool)),
+                diff, filtering=FILTERS)
+    ok, ok_u = np.isfinite(m.qdd).all(axis=1), np.isfinite(u.qdd).all(axis=1)
+    assert ok.sum() > 3500
+    assert _rms(u.qdd[ok_u] - qdd_u[ok_u]) < 1e-3 * _rms(qdd_u)  # the uniform log: the motion's derivatives
+    tol = 1e-2 if diff != "backward" else 2e-2  # backward: a velocity half a step late, as on uniform samples
+    assert _rms(m.qd[ok] - qd[ok]) < tol * _rms(qd[ok])
+    assert _rms(m.qdd[ok] - qdd[ok]) < 1e-2 * _rms(qdd[ok])
+    naive = measure(Log(time=t, q=q, tau=log.tau, contact=log.contact), diff, filtering=FILTERS)
+    ok = np.isfinite(naive.qdd).all(axis=1)
+    assert _rms(naive.qdd[ok] - qdd[ok]) > 0.1 * _rms(qdd[ok])
+
+
+@pytest.mark.parametrize("diff", ["central", "savgol", "butterworth"])
+def test_uniform_samples_with_receive_time_stamps(diff):
+    """Kind (b): uniform 5 ms samples stamped on arrival, 0-1.8 ms late (Unix epoch), are
+    differentiated on the regularised clock: the derivatives equal those of the same samples
+    logged uniformly within 1 % RMS; on the stamps as recorded they would be far off."""
+    rng = np.random.default_rng(3)
+    k = np.arange(3000)
+    q, _, _ = _motion(k * 5e-3)
+    stamps = 1.46e9 + k * 5e-3 + rng.uniform(0.0, 1.8e-3, k.size)
+    log = _clocked(stamps, q)
+    assert log.clock.kind == "jittered" and "regularised clock" in log.clock.reason
+    assert log.dt == pytest.approx(5e-3, rel=1e-5)
+    m = measure(log, diff, filtering=FILTERS)
+    u = measure(Log(time=k * 5e-3, q=q, tau=log.tau, contact=log.contact), diff, filtering=FILTERS)
+    ok = np.isfinite(m.qdd).all(axis=1) & np.isfinite(u.qdd).all(axis=1)
+    assert ok.sum() > 2500
+    assert _rms(m.qd[ok] - u.qd[ok]) < 1e-2 * _rms(u.qd[ok])
+    assert _rms(m.qdd[ok] - u.qdd[ok]) < 1e-2 * _rms(u.qdd[ok])
+    recorded = measure(_clocked(stamps, q, time_base="recorded"), diff, filtering=FILTERS)
+    assert recorded.metadata["clock"]["kind"] == "skipping"
+    ok = np.isfinite(recorded.qdd).all(axis=1) & np.isfinite(u.qdd).all(axis=1)
+    assert _rms(recorded.qdd[ok] - u.qdd[ok]) > 2e-2 * _rms(u.qdd[ok])
+
+
+@pytest.mark.parametrize("diff", ["central", "backward", "savgol", "butterworth"])
+def test_a_uniform_clock_changes_nothing(diff):
+    """A uniform clock is differentiated with its constant period, bit for bit as a log without one."""
+    rng = np.random.default_rng(4)
+    t = np.arange(2000) * DT
+    q = _motion(t)[0] + rng.normal(0, 1e-6, (2000, 3))
+    tau = rng.normal(0, 1, (2000, 3))
+    clocked = _clocked(t, q, tau)
+    assert clocked.clock.kind == "uniform"
+    a = measure(clocked, diff, filtering=FILTERS)
+    b = measure(Log(time=t, q=q, tau=tau, contact=clocked.contact), diff, filtering=FILTERS)
+    for name in ("q", "qd", "qdd", "tau"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    assert a.metadata == b.metadata and a.smoother == b.smoother
+
+
+@pytest.mark.parametrize("kind", ["skipping", "jittered"])
+@pytest.mark.parametrize("diff", ["central", "savgol", "butterworth"])
+def test_chunks_of_a_non_uniform_log_equal_the_whole(kind, diff):
+    """A chunk cut at contact changes (as the long-log pipeline cuts them), given its rows of the
+    whole log's clock (Clock.rows) and 3 rows of context, gives the whole log's derivatives to
+    1e-10; a chunk's own regularised clock would not."""
+    rng = np.random.default_rng(5)
+    n = 3000
+    if kind == "skipping":
+        stamps = np.concatenate([[0.0], np.cumsum(rng.choice([10e-3, 12e-3], n - 1))])
+        q = _motion(stamps)[0]
+    else:
+        stamps = 1.46e9 + np.arange(n) * 5e-3 + rng.uniform(0.0, 1.8e-3, n)
+        q = _motion(np.arange(n) * 5e-3)[0]
+    a, b, context = 1000, 2000, 3
+    whole = _clocked(stamps, q)
+    whole.contact = np.ones((n, 2), dtype=bool)
+    whole.contact[a:b, 1] = False  # contact changes at rows a and b
+    assert whole.clock.kind == kind
+    ref = measure(whole, diff, filtering=FILTERS)
+    chunk = measure(whole.rows(a - context, b + context), diff, filtering=FILTERS)
+    for name in ("qd", "qdd"):
+        got, want = getattr(chunk, name)[context:-context], getattr(ref, name)[a:b]
+        ok = np.isfinite(want)
+        assert ok.sum() > 600
+        np.testing.assert_array_equal(np.isfinite(got), ok)
+        np.testing.assert_allclose(got[ok], want[ok], rtol=1e-10, atol=1e-10 * np.abs(want[ok]).max())
+    if kind == "jittered":
+        own = read_clock(stamps[a - context:b + context], "chunk", q=q[a - context:b + context])
+        assert np.abs(np.diff(own.t) - np.diff(whole.clock.t[a - context:b + context])).max() > 1e-9

@@ -39,6 +39,8 @@ from wbfriction.signals.kinematics import (
     Scheme,
     Smoother,
     TorqueAlignment,
+    Velocity,
+    joined_smoother,
     measure,
 )
 from wbfriction.signals.phases import Mask, Phases, joint_mask, segment
@@ -70,6 +72,8 @@ class EstimateOptions:
         condition_number: report cond(M_mod^{-1}) per sample (one KKT inverse per sample).
         method: single-support route, ``rnea`` (default) or ``kkt``.
         filtering: parameters of the ``savgol`` and ``butterworth`` schemes.
+        velocity: ``differentiated`` or ``logged`` (the log's ``qd.<joint>``:
+            :func:`~wbfriction.signals.kinematics.measure`).
         acceleration_difference: also give ``Delta qdd`` (5.12) in single support
             (``M_mod^{-1} tau_f``, one mass matrix per sample: about 20 us per sample on
             TALOS on top of 8 us); the KKT route always has it.
@@ -87,6 +91,7 @@ class EstimateOptions:
     method: Method = "rnea"
     filtering: FilterOptions = FilterOptions()
     acceleration_difference: bool = True
+    velocity: Velocity = "differentiated"
 
 
 @dataclass
@@ -335,7 +340,7 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
 def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress, companion: bool,
                       require_single_support: bool) -> FrictionEstimate:
     kin = measure(log, options.diff, compensate_delay=options.compensate_delay,
-                  torque_alignment=options.torque_alignment, filtering=options.filtering)
+                  torque_alignment=options.torque_alignment, filtering=options.filtering, velocity=options.velocity)
     kin.metadata.update(robot=robot.name, source=log.source)
     est = estimate_friction(robot, kin, options, progress, require_single_support)
     if companion:
@@ -363,8 +368,8 @@ def _blank(template: FrictionEstimate, log: Log) -> FrictionEstimate:
 
 
 def concat_estimates(parts: list[FrictionEstimate]) -> FrictionEstimate:
-    """Estimates of consecutive stretches of one log as one (arrays stacked along time;
-    names, metadata and smoother of the first)."""
+    """Estimates of consecutive stretches of one log as one (arrays stacked along time; names and
+    metadata of the first; the smoothers joined, :func:`~wbfriction.signals.kinematics.joined_smoother`)."""
     first = parts[0]
     out: dict[str, Any] = {}  # field values by name
     for f in fields(FrictionEstimate):
@@ -375,4 +380,5 @@ def concat_estimates(parts: list[FrictionEstimate]) -> FrictionEstimate:
                                           for v, p in zip(values, parts)])
         else:
             out[f.name] = getattr(first, f.name)
+    out["smoother"] = joined_smoother([p.smoother for p in parts], [len(p.time) for p in parts])
     return FrictionEstimate(**out)

@@ -1,16 +1,37 @@
-"""Identification of the friction model (3.5) from estimated friction (thesis 6.2.2, eq. 6.4).
+"""Identification of a friction model from estimated friction (thesis 6.2.2, eq. 6.4), and the
+choice among the models by held-out error.
 
-Per joint, ``scipy.optimize.least_squares(method="trf")`` fits the characteristic
-``f(qd; p)`` of eq. (3.5) to ``-tau_f`` over the valid samples (sign convention of
-:mod:`wbfriction.friction.models`), with bounds, from several starts. Each parameter gets a
-standard error from the Jacobian at the solution,
+Per joint, ``scipy.optimize.least_squares(method="trf")`` fits the characteristic ``f(qd; p)``
+of one of the models of :mod:`wbfriction.friction.models` (``coulomb-viscous``, ``stribeck``
+or the thesis's (3.5)) to ``-tau_f`` over the valid samples (sign convention of that module),
+with bounds, from several starts. Each parameter gets a standard error from the Jacobian at
+the solution,
 
-.. math:: \\operatorname{cov}(\\hat p) = s^2 (J^T J)^{-1}, \\qquad s^2 = \\frac{\\|r\\|^2}{N - 6},
+.. math:: \\operatorname{cov}(\\hat p) = s^2 (J^T J)^{-1}, \\qquad s^2 = \\frac{\\|r\\|^2}{N - p},
 
 computed through the SVD of J, with a Newey-West correction for residuals correlated in
 time (filtered estimates above all; :func:`standard_errors`); a parameter with a component
 in the numerical null space of J (e.g. ``v_s`` when ``S = 0``, or the Stribeck parameters when the data never
 leave the Stribeck region) gets an infinite standard error: the data cannot identify it.
+
+The bounds (:func:`model_bounds`) keep friction dissipative (F_v, F_c >= 0) and the Stribeck
+effect a drop from static to Coulomb friction: (3.5)'s ``S >= 0``, and the Stribeck model's
+``F_s >= F_c``, fitted as ``F_s - F_c >= 0`` (its standard error is F_s's own). A parameter that
+ends on one of its bounds (e.g. ``S = 50`` with ``F_c -> 0``, what (3.5) gives on a real arm's
+noisy log and on any friction whose static level decays to no Coulomb level; the Stribeck
+model's F_s at F_c: no Stribeck drop) is flagged in :attr:`FitResult.at_bound`: its value is
+the bound's, not the data's.
+
+**Model choice** (``model="auto"``): the valid samples are cut into :data:`HELD_OUT_BLOCKS`
+contiguous blocks in time; every :data:`HELD_OUT_PERIOD`-th (the 2nd, 5th, 8th) is held out
+(:func:`held_out_split`, deterministic), every model is fitted on the others, and its RMS error
+on the held-out blocks compared (:func:`held_out_rms`). The simplest model whose held-out RMS
+is within ``selection_tolerance`` (relative, default :data:`SELECTION_TOLERANCE`) of the best
+is chosen (:func:`choose_model`, the reason recorded in :class:`ModelSelection`) and fitted
+again on every valid sample, as if it had been named. Whole blocks, not scattered samples, are
+held out: residuals correlated in time (filtered estimates) would otherwise let the held-out
+error see the fit's noise. With too few samples to hold a block out (fewer than
+``min_samples`` on either side), the simplest model is fitted.
 
 Filtered estimates (thesis 7.1) are compared with the model filtered the same way: when
 the friction went through a zero-phase smoother ``H``, the fit minimises
@@ -27,6 +48,7 @@ import itertools
 import multiprocessing
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
+from typing import Generic, Literal, get_args
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -34,43 +56,161 @@ from threadpoolctl import threadpool_limits
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.models import PARAM_NAMES, FrictionParams, coulomb_viscous_stribeck
+from wbfriction.friction.models import (
+    MODEL_NAMES,
+    MODEL_PARAMS,
+    FrictionParams,
+    ModelName,
+    ModelParamsBase,
+    ParamsT,
+    check_model,
+    coulomb_viscous,
+    coulomb_viscous_stribeck,
+    stribeck_viscous,
+)
+
+ModelChoice = Literal["auto", "coulomb-viscous", "stribeck", "thesis"]
+"""The model to fit: one of :data:`~wbfriction.friction.models.ModelName`, or ``auto``: the
+simplest whose held-out error is within a tolerance of the best (module docstring)."""
+
+MODEL_CHOICES: tuple[ModelChoice, ...] = get_args(ModelChoice)
+
+SELECTION_TOLERANCE = 0.02
+"""Relative excess of held-out RMS over the best model's within which a simpler model is chosen."""
+
+HELD_OUT_BLOCKS = 10
+"""Contiguous blocks (in time) the valid samples are cut into for the model choice."""
+
+HELD_OUT_PERIOD = 3
+"""Block ``k`` is held out when ``k % HELD_OUT_PERIOD == 1`` (blocks 1, 4, 7 of 0..9: 30 %)."""
+
+AT_BOUND_RTOL = 1e-6
+"""A parameter within ``AT_BOUND_RTOL * max(1, |bound|)`` of a bound is at it."""
+
+AT_BOUND_SSR = 0.01
+"""An identifiable parameter is also at a bound when moving it there raises the sum of squared
+residuals by less than ``AT_BOUND_SSR`` residual variances (for a linear model: it is less than
+``sqrt(AT_BOUND_SSR) = 0.1`` standard errors from it); the solver's iterates stay strictly inside
+the bounds and may stop short of one in a flat direction (e.g. S = 49.97 of 50)."""
+
+AT_BOUND_NEAR = 1e-3
+"""A parameter the data do not identify (infinite standard error) is at a bound within
+``AT_BOUND_NEAR * max(1, |bound|)`` of it."""
 
 LOWER = np.array([0.0, 0.0, 0.0, 1e-4, -np.inf, 1e-2])
 UPPER = np.array([np.inf, np.inf, 50.0, 100.0, np.inf, 1e4])
-"""Bounds of (F_v, F_c, S, v_s, tau_os, a): dissipative viscous and Coulomb parts, static
+"""Bounds of (F_v, F_c, S, v_s, tau_os, a) of model (3.5): dissipative viscous and Coulomb parts, static
 friction at least the Coulomb level (S >= 0: the Stribeck effect is a drop from static to
 Coulomb friction), positive Stribeck velocity and tanh slope. The fit further bounds ``v_s``
 by the largest speed in the data: a Stribeck velocity beyond it is not identifiable, and
 the Stribeck term would otherwise mimic viscous friction (S < 0, v_s large)."""
 
+_BOUNDS: dict[ModelName, tuple[np.ndarray, np.ndarray]] = {
+    "coulomb-viscous": (np.array([0.0, 0.0, -np.inf]), np.array([np.inf, np.inf, np.inf])),
+    # the fit's coordinates: F_s is fitted as the Stribeck drop F_s - F_c >= 0 (module docstring)
+    "stribeck": (np.array([0.0, 0.0, 0.0, 1e-4, -np.inf]), np.array([np.inf, np.inf, np.inf, 100.0, np.inf])),
+    "thesis": (LOWER, UPPER),
+}
+_V_S = {"coulomb-viscous": None, "stribeck": 3, "thesis": 3}  # position of v_s, bounded by the data's speed
 
-def _bounds(qd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    upper = UPPER.copy()
-    upper[3] = max(float(np.max(np.abs(qd))), 2 * LOWER[3])
-    return LOWER, upper
+
+def model_bounds(qd: np.ndarray, model: ModelName = "thesis") -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds of ``model``'s parameters, in the fit's coordinates, for velocities
+    ``qd`` (N,) [rad/s]: :data:`LOWER`, :data:`UPPER` for (3.5); for ``coulomb-viscous``
+    F_v, F_c >= 0; for ``stribeck`` F_v, F_c >= 0, ``F_s >= F_c`` (its coordinate is F_s - F_c >= 0)
+    and v_s in [1e-4, 100]; ``v_s`` at most the largest speed in ``qd``."""
+    lower, upper = (b.copy() for b in _BOUNDS[model])
+    i = _V_S[model]
+    if i is not None:
+        upper[i] = max(float(np.max(np.abs(qd))), 2 * lower[i])
+    return lower, upper
+
+
+def _to_fit(model: ModelName, x: np.ndarray) -> np.ndarray:
+    """The fit's coordinates of the parameters ``x`` (as the model names them): the Stribeck
+    model's F_s becomes F_s - F_c, so that ``F_s >= F_c`` is a bound."""
+    z = np.array(x, dtype=float)
+    if model == "stribeck":
+        z[2] = x[2] - x[1]
+    return z
+
+
+def _from_fit(model: ModelName, z: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`_to_fit`."""
+    x = np.array(z, dtype=float)
+    if model == "stribeck":
+        x[2] = z[1] + z[2]
+    return x
+
+
+def _fit_jacobian(model: ModelName, jac: np.ndarray) -> np.ndarray:
+    """The Jacobian in the fit's coordinates from the one in the model's (chain rule of :func:`_from_fit`)."""
+    if model == "stribeck":
+        jac = jac.copy()
+        jac[:, 1] += jac[:, 2]
+    return jac
+
+
+@dataclass(frozen=True)
+class HeldOutScore:
+    """One model's fit on the training blocks, scored on the held-out ones.
+
+    Attributes:
+        model: the model.
+        held_out_rms: RMS of (model - estimate) over the held-out samples [N·m] (NaN: no fit).
+        at_bound: the parameters that fit left at a bound.
+    """
+
+    model: ModelName
+    held_out_rms: float
+    at_bound: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class ModelSelection:
+    """How ``model="auto"`` chose a joint's model (module docstring).
+
+    Attributes:
+        chosen: the model fitted.
+        reason: why, in one sentence.
+        scores: every candidate's held-out score, simplest model first (empty when too few samples).
+        tolerance: relative excess over the best held-out RMS within which a simpler model wins.
+        n_train, n_held_out: samples the candidates were fitted on and scored on.
+    """
+
+    chosen: ModelName
+    reason: str
+    scores: tuple[HeldOutScore, ...] = ()
+    tolerance: float = SELECTION_TOLERANCE
+    n_train: int = 0
+    n_held_out: int = 0
 
 
 @dataclass
-class FitResult:
+class FitResult(Generic[ParamsT]):
     """Identified parameters of one joint.
 
     Attributes:
         joint: joint name.
         n_samples: number of samples used.
-        params: identified :class:`FrictionParams`, or None if too few samples.
+        params: identified parameters of :attr:`model` (:class:`~wbfriction.friction.models.FrictionParams`
+            for (3.5)), or None if too few samples.
         stderr: standard error of each parameter (``inf``: not identifiable).
         rms_residual: RMS of the fit residual [N·m].
         success, message: from ``least_squares``.
         rms_error_vs_true: RMS of (estimated - true) friction over the samples used [N·m],
             when the log had ``tau_f_true``.
         rms_model_vs_true: RMS of (fitted model torque - true friction) [N·m], likewise.
-        target: the friction parameters injected by a simulator, when known.
+        target: the friction parameters (3.5) injected by a simulator, when known.
+        model: the model fitted (that of :attr:`params` when there are any).
+        at_bound: per parameter, whether the fit left it on one of its bounds (its value is
+            then the bound's, not the data's; held parameters are not).
+        selection: how ``model="auto"`` chose the model, or None.
     """
 
     joint: str
     n_samples: int
-    params: FrictionParams | None = None
+    params: ParamsT | None = None
     stderr: dict[str, float] = field(default_factory=dict)
     rms_residual: float = float("nan")
     success: bool = False
@@ -78,14 +218,28 @@ class FitResult:
     rms_error_vs_true: float | None = None
     rms_model_vs_true: float | None = None
     target: FrictionParams | None = None
+    model: ModelName = "thesis"
+    at_bound: dict[str, bool] = field(default_factory=dict)
+    selection: ModelSelection | None = None
+
+    def __post_init__(self) -> None:
+        if self.params is not None:
+            self.model = self.params.model
+
+    def bounded(self) -> tuple[str, ...]:
+        """Names of the parameters at a bound (:attr:`at_bound`)."""
+        return tuple(n for n, at in self.at_bound.items() if at)
 
     def error_percent(self) -> dict[str, float] | None:
-        """Relative error of each parameter against :attr:`target` [%] (Tables 6.1, 6.2)."""
+        """Relative error of each parameter against :attr:`target` [%] (Tables 6.1, 6.2); for a
+        model other than (3.5), against the target's values under its names
+        (:meth:`~wbfriction.friction.models.FrictionParams.values_in`)."""
         if self.params is None or self.target is None:
             return None
+        target = self.target.values_in(self.model)
         out = {}
-        for name in PARAM_NAMES:
-            t, p = getattr(self.target, name), getattr(self.params, name)
+        for name in self.params.names:
+            t, p = target[name], getattr(self.params, name)
             out[name] = 100.0 * abs(p - t) / abs(t) if t != 0 else float("nan")
         return out
 
@@ -96,14 +250,27 @@ def fitted_offsets(fits) -> dict[str, float]:
     return {f.joint: f.params.tau_os for f in fits if f.params is not None}
 
 
-def model_values(x: np.ndarray, qd: np.ndarray, delta_s: float) -> np.ndarray:
-    """Model (3.5) ``f(qd)`` [N·m] for the parameter vector ``x`` (6,) in
-    :data:`~wbfriction.friction.models.PARAM_NAMES` order, ``qd`` (N,) [rad/s]."""
+def model_values(x: np.ndarray, qd: np.ndarray, delta_s: float, model: ModelName = "thesis") -> np.ndarray:
+    """``model``'s ``f(qd)`` [N·m] for the parameter vector ``x`` in the order of its names
+    (:data:`~wbfriction.friction.models.PARAM_NAMES` for (3.5)), ``qd`` (N,) [rad/s]."""
+    if model == "coulomb-viscous":
+        return coulomb_viscous(qd, x[0], x[1], x[2])
+    if model == "stribeck":
+        return stribeck_viscous(qd, x[0], x[1], x[2], x[3], x[4], delta_s)
     return coulomb_viscous_stribeck(qd, x[0], x[1], x[2], x[3], x[4], x[5], delta_s)
 
 
-def model_jacobian(x: np.ndarray, qd: np.ndarray, delta_s: float) -> np.ndarray:
-    """Jacobian (N, 6) of :func:`model_values` with respect to ``x``, analytic."""
+def model_jacobian(x: np.ndarray, qd: np.ndarray, delta_s: float, model: ModelName = "thesis") -> np.ndarray:
+    """Jacobian (N, p) of :func:`model_values` with respect to ``x``, analytic."""
+    if model == "coulomb-viscous":
+        return np.column_stack([qd, np.sign(qd), np.ones_like(qd)])
+    if model == "stribeck":
+        _, F_c, F_s, v_s, _ = x
+        sgn = np.sign(qd)
+        u = np.abs(qd / v_s)
+        e = np.exp(-u**delta_s)
+        return np.column_stack([qd, sgn * (1.0 - e), sgn * e, sgn * (F_s - F_c) * e * delta_s * u**delta_s / v_s,
+                                np.ones_like(qd)])
     F_v, F_c, S, v_s, _, a = x
     th = np.tanh(a * qd)
     u = np.abs(qd / v_s)
@@ -172,17 +339,86 @@ def correlation_lag(residual: np.ndarray, rows: np.ndarray, threshold: float = 0
     return max(rule, 2 * cap)
 
 
-def initial_guesses(qd: np.ndarray, y: np.ndarray) -> list[np.ndarray]:
-    """Starting points: a linear Coulomb-viscous-offset fit times a grid of (S, v_s, a)."""
+def initial_guesses(qd: np.ndarray, y: np.ndarray, model: ModelName = "thesis") -> list[np.ndarray]:
+    """Starting points (the model's parameters, in the order of its names): a linear
+    Coulomb-viscous-offset fit, for ``stribeck`` times a grid of (F_s / F_c, v_s), for (3.5)
+    times a grid of (S, v_s, a)."""
     A = np.column_stack([qd, np.sign(qd), np.ones_like(qd)])
     (F_v, F_c, tau_os), *_ = np.linalg.lstsq(A, y, rcond=None)
     F_v, F_c = max(F_v, 0.0), max(F_c, 1e-3)
     scale = max(np.percentile(np.abs(qd), 90), 1e-3)
+    lower, upper = _BOUNDS[model]
+    if model == "coulomb-viscous":
+        return [np.clip([F_v, F_c, tau_os], lower + 1e-9, upper - 1e-9)]
+    if model == "stribeck":
+        return [_from_fit(model, np.clip([F_v, F_c, S * F_c, vs_frac * scale, tau_os], lower + 1e-9, upper - 1e-9))
+                for S, vs_frac in itertools.product((0.2, 1.0), (0.05, 0.2, 0.5))]
     starts = []
     for S, vs_frac, a_mul in itertools.product((0.2, 1.0), (0.05, 0.2, 0.5), (5.0, 50.0)):
         a = min(max(a_mul / scale, LOWER[5] * 10), UPPER[5] / 10)
         starts.append(np.clip([F_v, F_c, S, vs_frac * scale, tau_os, a], LOWER + 1e-9, UPPER - 1e-9))
     return starts
+
+
+def held_out_split(use: np.ndarray, n_blocks: int = HELD_OUT_BLOCKS,
+                   period: int = HELD_OUT_PERIOD) -> tuple[np.ndarray, np.ndarray]:
+    """Training and held-out samples for the model choice (module docstring).
+
+    The samples ``use`` (N,) bool, in time order, are cut into ``n_blocks`` contiguous blocks of
+    (nearly) equal counts; block ``k`` is held out when ``k % period == 1``.
+
+    Returns:
+        (train, held_out): (N,) bool masks, disjoint, whose union is ``use``.
+    """
+    rows = np.flatnonzero(use)
+    block = np.arange(rows.size) * n_blocks // max(rows.size, 1)
+    train, held_out = np.zeros(len(use), dtype=bool), np.zeros(len(use), dtype=bool)
+    out = block % period == 1
+    held_out[rows[out]] = True
+    train[rows[~out]] = True
+    return train, held_out
+
+
+def held_out_rms(params: ModelParamsBase, qd: np.ndarray, tau_f: np.ndarray, rows: np.ndarray, smoother=None) -> float:
+    """RMS [N·m] of (model friction torque - ``tau_f``) over the samples ``rows`` ((N,) bool).
+
+    Args:
+        params: a model's parameters (:data:`~wbfriction.friction.models.ModelParams`).
+        qd, tau_f: the whole time series (N,) [rad/s], [N·m].
+        rows: the samples scored.
+        smoother: the estimate's smoother or None; the model goes through it along the whole
+            series before it is scored, as in the fit.
+    """
+    f = params.f(np.asarray(qd, dtype=float))
+    if smoother is not None:
+        f = smoother(f)
+    r = (f + np.asarray(tau_f, dtype=float))[np.asarray(rows, dtype=bool)]
+    return float(np.sqrt(np.mean(r**2))) if r.size else float("nan")
+
+
+def choose_model(scores: tuple[HeldOutScore, ...], tolerance: float = SELECTION_TOLERANCE) -> tuple[ModelName, str]:
+    """The simplest model (first in ``scores``) whose held-out RMS is within ``tolerance``
+    (relative) of the smallest, and the reason, one sentence.
+
+    Raises:
+        InputError: no score is finite.
+    """
+    finite = [s for s in scores if np.isfinite(s.held_out_rms)]
+    if not finite:
+        raise InputError("no model could be scored on held-out samples")
+    best = min(finite, key=lambda s: s.held_out_rms)
+    chosen = next(s for s in finite if s.held_out_rms <= (1.0 + tolerance) * best.held_out_rms)
+    rms = "held-out RMS [N·m]: " + ", ".join(f"{s.model} {s.held_out_rms:.4g}" for s in scores)
+    if chosen is best:
+        reason = f"{chosen.model}: the smallest held-out RMS"
+        if scores.index(chosen) > 0:
+            reason += f"; simpler models exceed it by more than {100 * tolerance:g} %"
+    else:
+        excess = 100.0 * (chosen.held_out_rms / best.held_out_rms - 1.0)
+        reason = (f"{chosen.model}: the simplest model within {100 * tolerance:g} % of the smallest held-out RMS "
+                  f"({best.model}'s; +{excess:.2g} %)")
+    reason += f"; {rms}"
+    return chosen.model, reason
 
 
 def _solve(residual, jacobian, start, bounds, max_nfev):
@@ -191,12 +427,13 @@ def _solve(residual, jacobian, start, bounds, max_nfev):
                          ftol=1e-10, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev)
 
 
-def _filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, delta_s: float):
-    """Residual and Jacobian of the model passed through ``smoother``, on the rows ``use``."""
+def _filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, delta_s: float,
+                      model: ModelName = "thesis"):
+    """Residual and Jacobian (the model's coordinates) of the model passed through ``smoother``, on the rows ``use``."""
     rows = np.flatnonzero(use)
 
     def both(x):
-        cols = np.column_stack([model_values(x, qd, delta_s), model_jacobian(x, qd, delta_s)])
+        cols = np.column_stack([model_values(x, qd, delta_s, model), model_jacobian(x, qd, delta_s, model)])
         return smoother(cols)[rows]
 
     cache: dict[bytes, np.ndarray] = {}
@@ -211,18 +448,48 @@ def _filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, 
     return (lambda x: values(x)[:, 0] - y[rows]), (lambda x: values(x)[:, 1:])
 
 
+def _at_bound(z: np.ndarray, bounds: tuple[np.ndarray, np.ndarray], residual, identifiable: np.ndarray
+              ) -> np.ndarray:
+    """(p,) bool: which of the fitted ``z`` (the fit's coordinates) are at a bound: within
+    :data:`AT_BOUND_RTOL` of it, or so close that moving it onto the bound (the others kept)
+    raises the sum of squared residuals by less than :data:`AT_BOUND_SSR` residual variances;
+    a parameter the data do not identify (``identifiable`` False: it changes no residual
+    wherever it is) when within :data:`AT_BOUND_NEAR` of it."""
+    lower, upper = bounds
+    r = residual(z)
+    ssr = float(r @ r)
+    s2 = ssr / max(r.size - z.size, 1)
+    out = np.zeros(z.size, dtype=bool)
+    for i in range(z.size):
+        near = [b for b in (lower[i], upper[i]) if np.isfinite(b)]
+        if not near:
+            continue
+        b = min(near, key=lambda b: abs(z[i] - b))
+        scale = max(1.0, abs(b))
+        if abs(z[i] - b) <= (AT_BOUND_RTOL if identifiable[i] else AT_BOUND_NEAR) * scale:
+            out[i] = True
+        elif identifiable[i]:
+            snapped = z.copy()
+            snapped[i] = b
+            r = residual(snapped)
+            out[i] = bool(float(r @ r) - ssr <= AT_BOUND_SSR * s2)
+    return out
+
+
 def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joint: str = "",
                  x0: np.ndarray | None = None, min_samples: int = 20, mask: np.ndarray | None = None,
-                 smoother=None, fixed: dict[str, float] | None = None) -> FitResult:
-    """Fit model (3.5) to friction estimates of one joint (eq. 6.4).
+                 smoother=None, fixed: dict[str, float] | None = None, model: ModelChoice = "thesis",
+                 selection_tolerance: float = SELECTION_TOLERANCE) -> FitResult:
+    """Fit a friction model to friction estimates of one joint (eq. 6.4).
 
     Args:
         qd: joint velocities (N,) [rad/s].
         tau_f: friction torques on the joint (N,) [N·m] (``tau_f = -f(qd)``).
         delta_s: Stribeck exponent, fixed (thesis: 2).
         joint: name, for the result.
-        x0: a starting point (6,) in :data:`~wbfriction.friction.models.PARAM_NAMES` order; by
-            default several (:func:`initial_guesses`), the best fit is kept.
+        x0: a starting point in the order of the model's names
+            (:data:`~wbfriction.friction.models.PARAM_NAMES` for (3.5)); by default several
+            (:func:`initial_guesses`), the best fit is kept. Not with ``model="auto"``.
         min_samples: fewer samples give a result without parameters.
         mask: (N,) samples to fit (default: every finite one).
         smoother: the zero-phase smoother ``tau_f`` went through
@@ -232,37 +499,22 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
             compared (module docstring). Samples where the smoothed model is undefined are
             not used.
         fixed: parameters held at a value instead of fitted (standard error 0), e.g.
-            ``{"S": 0, "v_s": 0.1, "tau_os": 0}`` for a Coulomb-viscous model.
+            ``{"S": 0, "v_s": 0.1, "tau_os": 0}`` for a Coulomb-viscous model (3.5). With
+            ``model="auto"`` each candidate holds those it has.
+        model: the model (:data:`ModelChoice`): ``thesis`` (3.5), ``stribeck``,
+            ``coulomb-viscous``, or ``auto`` (chosen by held-out error, module docstring).
+        selection_tolerance: with ``auto``, the relative excess of held-out RMS over the best
+            within which the simpler model is chosen.
 
     Returns:
         :class:`FitResult`.
 
     Raises:
-        InputError: an unknown name in ``fixed``.
+        InputError: an unknown model, a name in ``fixed`` that is not the model's (for
+            ``auto``: no model's), ``x0`` with ``auto``, a ``stribeck`` F_s held without F_c.
     """
-    # One BLAS thread: the solver's many small (N x 6) factorizations run several times
-    # slower on OpenBLAS's threads than on one (30 TALOS joints of a 10-step walk: 78 s
-    # against 14 s on 2 cores); fit joints side by side instead (fit_estimate's workers).
-    with threadpool_limits(1, user_api="blas"):
-        return _fit_friction(qd, tau_f, delta_s=delta_s, joint=joint, x0=x0, min_samples=min_samples, mask=mask,
-                             smoother=smoother, fixed=fixed)
-
-
-def _fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joint: str = "",
-                 x0: np.ndarray | None = None, min_samples: int = 20, mask: np.ndarray | None = None,
-                 smoother=None, fixed: dict[str, float] | None = None) -> FitResult:
-    """:func:`fit_friction`, on the threads it is given."""
-    fixed = dict(fixed or {})
-    if set(fixed) - set(PARAM_NAMES):
-        raise InputError(f"unknown parameter(s) to fix: {', '.join(sorted(set(fixed) - set(PARAM_NAMES)))}")
-    free = np.array([name not in fixed for name in PARAM_NAMES])
-    held = np.array([float(fixed.get(name, 0.0)) for name in PARAM_NAMES])
-
-    def full(z: np.ndarray) -> np.ndarray:
-        x = held.copy()
-        x[free] = z
-        return x
-
+    if model not in MODEL_CHOICES:
+        raise InputError(f"model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
     qd = np.asarray(qd, dtype=float)
     y = -np.asarray(tau_f, dtype=float)
     use = np.isfinite(qd) & np.isfinite(y)
@@ -270,32 +522,102 @@ def _fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, jo
         use &= np.asarray(mask, dtype=bool)
     if smoother is not None:
         use &= np.isfinite(smoother(qd))
+    # One BLAS thread: the solver's many small (N x p) factorizations run several times
+    # slower on OpenBLAS's threads than on one (30 TALOS joints of a 10-step walk: 78 s
+    # against 14 s on 2 cores); fit joints side by side instead (fit_estimate's workers).
+    with threadpool_limits(1, user_api="blas"):
+        if model == "auto":
+            if x0 is not None:
+                raise InputError("x0 needs a named model, not 'auto'")
+            return _fit_auto(qd, y, use, delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother,
+                             fixed=fixed, tolerance=selection_tolerance)
+        return _fit_model(check_model(model), qd, y, use, delta_s=delta_s, joint=joint, x0=x0,
+                          min_samples=min_samples, smoother=smoother, fixed=fixed)
+
+
+def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float, joint: str, min_samples: int,
+              smoother, fixed: dict[str, float] | None, tolerance: float) -> FitResult:
+    """``fit_friction(model="auto")`` on the usable samples ``use`` (module docstring)."""
+    fixed = dict(fixed or {})
+    known = {n for m in MODEL_NAMES for n in MODEL_PARAMS[m].names}
+    if set(fixed) - known:
+        raise InputError(f"unknown parameter(s) to fix: {', '.join(sorted(set(fixed) - known))}")
+    held = {m: {k: v for k, v in fixed.items() if k in MODEL_PARAMS[m].names} for m in MODEL_NAMES}
+    kwargs = dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother)
+    train, held_out = held_out_split(use)
+    n_train, n_held_out = int(train.sum()), int(held_out.sum())
+    if min(n_train, n_held_out) < max(min_samples, 7):
+        simplest = MODEL_NAMES[0]
+        res = _fit_model(simplest, qd, y, use, fixed=held[simplest], **kwargs)
+        res.selection = ModelSelection(simplest, f"{simplest}: too few samples ({int(use.sum())}) to hold any out",
+                                       (), tolerance, n_train, n_held_out)
+        return res
+    trained = {m: _fit_model(m, qd, y, train, fixed=held[m], **kwargs) for m in MODEL_NAMES}
+    scores = tuple(HeldOutScore(m, held_out_rms(r.params, qd, -y, held_out, smoother) if r.params is not None
+                                else float("nan"), r.bounded()) for m, r in trained.items())
+    chosen, reason = choose_model(scores, tolerance)
+    res = _fit_model(chosen, qd, y, use, fixed=held[chosen], **kwargs)  # as if the model had been named
+    if res.bounded():
+        reason += f"; at a bound: {', '.join(res.bounded())}"
+    res.selection = ModelSelection(chosen, reason, scores, tolerance, n_train, n_held_out)
+    return res
+
+
+def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float = 2.0,
+               joint: str = "", x0: np.ndarray | None = None, min_samples: int = 20, smoother=None,
+               fixed: dict[str, float] | None = None) -> FitResult:
+    """:func:`fit_friction` of one model to ``y = -tau_f`` on the usable samples ``use``, on the threads it is given."""
+    names = MODEL_PARAMS[model].names
+    fixed = dict(fixed or {})
+    if set(fixed) - set(names):
+        raise InputError(f"unknown parameter(s) of the {model} model to fix: "
+                         f"{', '.join(sorted(set(fixed) - set(names)))}")
+    if model == "stribeck" and "F_s" in fixed and "F_c" not in fixed:
+        raise InputError("the stribeck model's F_s can be held only with F_c held too")
+    free = np.array([name not in fixed for name in names])
+    held = _to_fit(model, np.array([float(fixed.get(name, 0.0)) for name in names]))
+
+    def full(z: np.ndarray) -> np.ndarray:
+        """The model's parameters from the free ones in the fit's coordinates."""
+        x = held.copy()
+        x[free] = z
+        return _from_fit(model, x)
+
     n = int(use.sum())
-    if n < max(min_samples, 7):
-        return FitResult(joint, n, message=f"only {n} valid samples")
+    if n < max(min_samples, len(names) + 1):
+        return FitResult(joint, n, message=f"only {n} valid samples", model=model)
     v, yu = qd[use], y[use]
-    starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(v, yu)
+    starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(v, yu, model)
+    starts = [_to_fit(model, x) for x in starts]
     starts = list({tuple(x[free]): x[free] for x in starts}.values())  # distinct over the free ones
-    residual = lambda z: model_values(full(z), v, delta_s) - yu  # noqa: E731
-    jacobian = lambda z: model_jacobian(full(z), v, delta_s)[:, free]  # noqa: E731
-    bounds = tuple(b[free] for b in _bounds(v))
+    residual = lambda z: model_values(full(z), v, delta_s, model) - yu  # noqa: E731
+    jacobian = lambda z: _fit_jacobian(model, model_jacobian(full(z), v, delta_s, model))[:, free]  # noqa: E731
+    bounds = tuple(b[free] for b in model_bounds(v, model))
     # a short run from every start, then the two best refined
     if len(starts) > 1:
         short = sorted((_solve(residual, jacobian, s, bounds, 30) for s in starts), key=lambda r: r.cost)
         starts = [r.x for r in short[:2]]
     best = min((_solve(residual, jacobian, s, bounds, 300) for s in starts), key=lambda r: r.cost)
+    natural_jacobian = lambda z: model_jacobian(full(z), v, delta_s, model)[:, free]  # noqa: E731
     if smoother is not None:
-        f_residual, f_jacobian = _filtered_problem(qd, y, use, smoother, delta_s)
-        residual, jacobian = (lambda z: f_residual(full(z))), (lambda z: f_jacobian(full(z))[:, free])
+        f_residual, f_jacobian = _filtered_problem(qd, y, use, smoother, delta_s, model)
+        residual = lambda z: f_residual(full(z))  # noqa: E731
+        jacobian = lambda z: _fit_jacobian(model, f_jacobian(full(z)))[:, free]  # noqa: E731
+        natural_jacobian = lambda z: f_jacobian(full(z))[:, free]  # noqa: E731
         best = _solve(residual, jacobian, best.x, bounds, 200)
-    # residuals correlated over the filter's window, or over the span of a model error
+    # residuals correlated over the filter's window, or over the span of a model error;
+    # standard errors of the model's own parameters (F_s, not F_s - F_c)
     rows = np.flatnonzero(use)
-    se = np.zeros(len(PARAM_NAMES))
-    se[free] = standard_errors(jacobian(best.x), best.fun, rows=rows, max_lag=correlation_lag(best.fun, rows))
+    se = np.zeros(len(names))
+    se[free] = standard_errors(natural_jacobian(best.x), best.fun, rows=rows,
+                               max_lag=correlation_lag(best.fun, rows))
+    at_bound = np.zeros(len(names), dtype=bool)
+    at_bound[free] = _at_bound(best.x, bounds, residual, np.isfinite(se[free]))
     return FitResult(
-        joint=joint, n_samples=n, params=FrictionParams.from_vector(full(best.x), delta_s),
-        stderr=dict(zip(PARAM_NAMES, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
-        success=bool(best.success), message=str(best.message))
+        joint=joint, n_samples=n, params=MODEL_PARAMS[model].from_vector(full(best.x), delta_s),
+        stderr=dict(zip(names, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
+        success=bool(best.success), message=str(best.message), model=model,
+        at_bound=dict(zip(names, map(bool, at_bound))))
 
 
 def _fit_column(args: tuple) -> FitResult:
@@ -304,9 +626,10 @@ def _fit_column(args: tuple) -> FitResult:
 
 
 def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
-                 tau_f_true: np.ndarray | None = None, targets: dict[str, FrictionParams] | None = None,
-                 delta_s: float = 2.0, min_samples: int = 20, smoother=None,
-                 fixed: dict[str, float] | None = None, workers: int = 1) -> list[FitResult]:
+               tau_f_true: np.ndarray | None = None, targets: dict[str, FrictionParams] | None = None,
+               delta_s: float = 2.0, min_samples: int = 20, smoother=None,
+               fixed: dict[str, float] | None = None, workers: int = 1, model: ModelChoice = "thesis",
+               selection_tolerance: float = SELECTION_TOLERANCE) -> list[FitResult]:
     """Fit every joint of a friction estimate on its valid samples.
 
     Args:
@@ -314,14 +637,19 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
         qd, tau_f, valid: (N, n) arrays of a :class:`~wbfriction.friction.estimate.FrictionEstimate`
             (the whole time series: with ``smoother`` the model is filtered along it).
         tau_f_true: (N, n) true friction (NaN columns for unknown) or None.
-        targets: true parameters per joint name, when known.
+        targets: true parameters (3.5) per joint name, when known.
         smoother: the estimate's smoother (``FrictionEstimate.smoother``) or None.
         fixed: parameters held instead of fitted (:func:`fit_friction`).
         workers: processes fitting joints side by side (each fit is independent of the
             others: the results do not depend on it).
+        model, selection_tolerance: the model, or ``auto`` and its tolerance (:func:`fit_friction`).
+
+    Raises:
+        InputError: what :func:`fit_friction` raises.
     """
     tasks = [(qd[:, i], tau_f[:, i], valid[:, i],
-              dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, fixed=fixed))
+              dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, fixed=fixed, model=model,
+                   selection_tolerance=selection_tolerance))
              for i, joint in enumerate(joints)]
     if workers > 1 and len(tasks) > 1:
         with ProcessPoolExecutor(min(workers, len(tasks)), mp_context=multiprocessing.get_context("fork")) as pool:
@@ -342,14 +670,16 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
 
 
 def fit_estimate(est: FrictionEstimate, *, delta_s: float = 2.0, min_samples: int = 20,
-                 workers: int = 1) -> list[FitResult]:
+                 workers: int = 1, model: ModelChoice = "thesis",
+                 selection_tolerance: float = SELECTION_TOLERANCE) -> list[FitResult]:
     """Fit every joint of an estimate (:func:`fit_joints` on its valid samples, on ``workers``
     processes); its ``tau_f_true`` and ``friction_true`` metadata, when present (simulated
     logs), give the errors against truth.
 
     Raises:
-        InputError: ``friction_true`` metadata that are not parameters of (3.5).
+        InputError: ``friction_true`` metadata that are not parameters of (3.5); an unknown model.
     """
     targets = {j: FrictionParams.from_dict(p) for j, p in est.metadata.get("friction_true", {}).items()}
     return fit_joints(est.joints, est.qd, est.tau_f, est.valid, tau_f_true=est.tau_f_true, targets=targets,
-                      delta_s=delta_s, min_samples=min_samples, smoother=est.smoother, workers=workers)
+                      delta_s=delta_s, min_samples=min_samples, smoother=est.smoother, workers=workers, model=model,
+                      selection_tolerance=selection_tolerance)

@@ -4,10 +4,13 @@
   :class:`~wbfriction.friction.estimate.FrictionEstimate` sample by sample:
   :func:`friction_table` writes it, :func:`read_friction_table` reads it back (the estimate's
   options, and so its smoother, ride in the table's metadata).
-* The **parameters JSON** holds the fitted model (3.5) per joint with standard errors
-  (:class:`~wbfriction.friction.fit.FitResult`): :func:`write_params` writes it (``wbfriction fit``
+* The **parameters JSON** holds the fitted model per joint (:class:`~wbfriction.friction.fit.FitResult`):
+  its name (``model``: ``coulomb-viscous``, ``stribeck`` or ``thesis`` (3.5)), parameters,
+  standard errors, which parameters ended at a bound (``at_bound``) and, when the model was
+  chosen by held-out error, how (``selection``). :func:`write_params` writes it (``wbfriction fit``
   and the studies), :func:`read_params` reads it (``wbfriction report --params``). A standard
   error that is not finite (not identifiable) is written as ``null`` and read back as ``inf``.
+  Files written before the model choice (no ``model`` key) hold model (3.5) and read back so.
 """
 
 from __future__ import annotations
@@ -24,12 +27,13 @@ import pyarrow as pa
 from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import FitResult
-from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.fit import FitResult, HeldOutScore, ModelSelection
+from wbfriction.friction.models import FrictionParams, check_model, params_from_dict
+from wbfriction.logs.clock import read_clock
 from wbfriction.logs.tables import numeric_column, read_metadata, read_table, with_metadata, write_json
 from wbfriction.signals.kinematics import SCHEMES, FilterOptions, Smoother, make_smoother
 
-SIGN_CONVENTION = "tau_f = -f(qd); fit of f (eq. 3.5) to -tau_f"
+SIGN_CONVENTION = "tau_f = -f(qd); fit of f (the joint's model, eqs. 3.1-3.5) to -tau_f"
 """What the parameters JSON of ``wbfriction fit`` states of its sign."""
 
 
@@ -97,7 +101,15 @@ def _table_smoother(meta: dict, time: np.ndarray, source: str) -> Smoother | Non
         value, default = getattr(filtering, f.name), getattr(FilterOptions(), f.name)
         if type(value) is not type(default) and not (isinstance(default, float) and type(value) is int):
             raise InputError(f"{source}: the metadata's estimate_options.filtering.{f.name} is {value!r}")
-    return make_smoother(diff, filtering, float(np.median(np.diff(time))))
+    dt = float(np.median(np.diff(time)))
+    clock = meta.get("clock", {})
+    kind = clock.get("kind") if isinstance(clock, dict) else None
+    if kind == "skipping":  # differentiated on the stamps as recorded
+        return make_smoother(diff, filtering, dt, t=time - time[0])
+    if kind == "jittered":  # differentiated on the regularised clock: rebuilt from the same stamps
+        regular = read_clock(time, source, time_base="regularised")
+        return make_smoother(diff, filtering, regular.period, t=regular.t)
+    return make_smoother(diff, filtering, dt)
 
 
 def _check_targets(meta: dict, source: str) -> None:
@@ -177,13 +189,48 @@ def _finite_or_none(x: float | None) -> float | None:
     return None if x is None or not np.isfinite(x) else float(x)
 
 
+def _number(x: Any) -> float:
+    """A number of the JSON; ``null`` (written for a value that is not finite) as ``inf``."""
+    return float("inf") if x is None else float(x)
+
+
+def selection_to_dict(selection: ModelSelection) -> dict[str, Any]:
+    """How a joint's model was chosen, as the parameters JSON records it (a held-out RMS that is
+    not finite: ``null``)."""
+    return {"chosen": selection.chosen, "reason": selection.reason, "tolerance": selection.tolerance,
+            "n_train": selection.n_train, "n_held_out": selection.n_held_out,
+            "scores": [{"model": c.model, "held_out_rms": _finite_or_none(c.held_out_rms),
+                        "at_bound": list(c.at_bound)} for c in selection.scores]}
+
+
+def selection_from_dict(d: Mapping[str, Any]) -> ModelSelection:
+    """Inverse of :func:`selection_to_dict` (a ``null`` held-out RMS reads back as NaN).
+
+    Raises:
+        InputError: a missing key, an unknown model, a value of the wrong kind.
+    """
+    try:
+        scores = tuple(HeldOutScore(check_model(c["model"], "selection.scores.model"),
+                                    float("nan") if c.get("held_out_rms") is None else float(c["held_out_rms"]),
+                                    tuple(map(str, c.get("at_bound", ())))) for c in d.get("scores", ()))
+        return ModelSelection(check_model(d["chosen"], "selection.chosen"), str(d.get("reason", "")), scores,
+                              float(d["tolerance"]), int(d.get("n_train", 0)), int(d.get("n_held_out", 0)))
+    except KeyError as exc:
+        raise InputError(f"selection: missing key {exc}") from None
+    except (TypeError, ValueError, AttributeError) as exc:
+        raise InputError(f"selection: {exc}") from None
+
+
 def fit_to_dict(fit: FitResult) -> dict[str, Any]:
     """One joint's entry of the parameters JSON (a standard error that is not finite: ``null``)."""
     clean = _finite_or_none
     d: dict[str, Any] = {"n_samples": fit.n_samples, "success": fit.success, "message": fit.message,
-                         "rms_residual": clean(fit.rms_residual),
+                         "rms_residual": clean(fit.rms_residual), "model": fit.model,
                          "params": None if fit.params is None else fit.params.to_dict(),
-                         "stderr": {k: clean(v) for k, v in fit.stderr.items()}}
+                         "stderr": {k: clean(v) for k, v in fit.stderr.items()},
+                         "at_bound": dict(fit.at_bound)}
+    if fit.selection is not None:
+        d["selection"] = selection_to_dict(fit.selection)
     if fit.rms_error_vs_true is not None:
         d["rms_error_vs_true"] = clean(fit.rms_error_vs_true)
         d["rms_model_vs_true"] = clean(fit.rms_model_vs_true)
@@ -194,24 +241,35 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
 
 
 def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
-    """Inverse of :func:`fit_to_dict` (a ``null`` standard error reads back as ``inf``: not identifiable).
+    """Inverse of :func:`fit_to_dict` (a ``null`` standard error reads back as ``inf``: not
+    identifiable). Without ``model`` (files of earlier versions) the parameters are those of (3.5);
+    without ``at_bound``, no parameter is known to be at a bound (an empty table).
 
     Raises:
-        InputError: unknown parameter names, or a value that is not a number.
+        InputError: an unknown model, unknown parameter names (or ``at_bound`` names that are not
+            the model's), a value that is not a number.
     """
-    unknown = lambda x: float("inf") if x is None else float(x)  # noqa: E731
     try:
-        res = FitResult(joint=joint, n_samples=int(d.get("n_samples", 0)), success=bool(d.get("success", False)),
-                        message=str(d.get("message", "")), rms_residual=unknown(d.get("rms_residual")))
+        model = check_model(str(d.get("model", "thesis")))
+        res: FitResult = FitResult(joint=joint, n_samples=int(d.get("n_samples", 0)),
+                                   success=bool(d.get("success", False)), message=str(d.get("message", "")),
+                                   rms_residual=_number(d.get("rms_residual")), model=model)
         if d.get("params") is not None:
-            res.params = FrictionParams.from_dict(d["params"])
-            res.stderr = {k: unknown(v) for k, v in (d.get("stderr") or {}).items()}
+            res.params = params_from_dict(model, d["params"])
+            res.stderr = {k: _number(v) for k, v in (d.get("stderr") or {}).items()}
+        at_bound = d.get("at_bound") or {}
+        unknown = set(at_bound) - set(res.params.names if res.params is not None else at_bound)
+        if unknown:
+            raise InputError(f"at_bound names {', '.join(sorted(unknown))}: not parameters of the {model} model")
+        res.at_bound = {str(k): bool(v) for k, v in at_bound.items()}
+        if d.get("selection") is not None:
+            res.selection = selection_from_dict(d["selection"])
         if d.get("target") is not None:
             res.target = FrictionParams.from_dict(d["target"])
         if "rms_error_vs_true" in d:
-            res.rms_error_vs_true = unknown(d["rms_error_vs_true"])
-            res.rms_model_vs_true = unknown(d.get("rms_model_vs_true"))
-    except (TypeError, ValueError) as exc:
+            res.rms_error_vs_true = _number(d["rms_error_vs_true"])
+            res.rms_model_vs_true = _number(d.get("rms_model_vs_true"))
+    except (TypeError, ValueError, AttributeError) as exc:
         raise InputError(str(exc)) from None
     return res
 

@@ -9,6 +9,18 @@ Sign convention (the one used everywhere in wbfriction):
   along the velocity: ``tau_f = -f(qd)``. Fitted parameters are therefore positive for
   dissipative friction (F_c, F_v > 0), as in the thesis's Tables 6.1 and 6.2.
 
+Three models are fitted (:data:`MODEL_NAMES`, simplest first), each with the offset
+``tau_os`` of (3.4) (calibration errors of the torque sensing):
+
+* ``coulomb-viscous``: Coulomb (3.1) plus viscous (3.2) friction,
+  ``f = F_v qd + F_c sgn(qd) + tau_os`` (:class:`CoulombViscousParams`);
+* ``stribeck``: Coulomb friction with the Stribeck effect (3.3) plus viscous friction,
+  ``f = F_v qd + sgn(qd) (F_c + (F_s - F_c) exp(-|qd / v_s|^delta_s)) + tau_os``
+  (:class:`StribeckParams`; F_s the static friction, the level at rest);
+* ``thesis``: the smooth model (3.5) the thesis simulates and fits, which writes the static
+  friction ``F_s = (1 + S) F_c`` and replaces ``sgn(qd)`` by ``tanh(a qd)``
+  (:class:`FrictionParams`).
+
 All functions broadcast: ``qd`` may be (N,), (N, n_joints), ...; parameters are scalars
 or arrays broadcastable to ``qd`` (e.g. shape (n_joints,)).
 
@@ -18,17 +30,33 @@ S and delta_s dimensionless.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, fields
-from typing import cast
+from typing import ClassVar, Literal, TypeVar, cast, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from wbfriction.exceptions import InputError
 
+ModelName = Literal["coulomb-viscous", "stribeck", "thesis"]
+"""A friction model: Coulomb-viscous (3.1 + 3.2), Coulomb-Stribeck-viscous (3.3 + 3.2), or the
+thesis's smooth model (3.5); each with an offset ``tau_os`` (module docstring)."""
+
+MODEL_NAMES: tuple[ModelName, ...] = get_args(ModelName)
+"""The models, simplest (fewest parameters) first."""
+
 PARAM_NAMES = ("F_v", "F_c", "S", "v_s", "tau_os", "a")
 """Names of the fitted parameters of model (3.5), in the order used by the fit."""
+
+COULOMB_VISCOUS_NAMES = ("F_v", "F_c", "tau_os")
+"""Names of the parameters of the Coulomb-viscous model, in the order used by the fit."""
+
+STRIBECK_NAMES = ("F_v", "F_c", "F_s", "v_s", "tau_os")
+"""Names of the parameters of the Coulomb-Stribeck-viscous model, in the order used by the fit."""
+
+ALL_PARAM_NAMES = ("F_v", "F_c", "F_s", "S", "v_s", "tau_os", "a")
+"""Every model's parameter names, in one order (e.g. the columns of a table of several models)."""
 
 ParamLike = float | np.ndarray
 """A model parameter: one value, or an array of them broadcastable to ``qd`` (e.g. one per joint)."""
@@ -69,9 +97,117 @@ def coulomb_viscous_stribeck(qd: ArrayLike, F_v: ParamLike, F_c: ParamLike, S: P
             + tau_os)
 
 
+def coulomb_viscous(qd: ArrayLike, F_v: ParamLike, F_c: ParamLike, tau_os: ParamLike) -> np.ndarray:
+    """Coulomb (3.1) plus viscous (3.2) friction with offset: ``f = F_v qd + F_c sgn(qd) + tau_os``
+    (``sgn(0) = 0``)."""
+    return viscous(qd, F_v) + coulomb(qd, F_c) + np.asarray(tau_os)
+
+
+def stribeck_viscous(qd: ArrayLike, F_v: ParamLike, F_c: ParamLike, F_s: ParamLike, v_s: ParamLike,
+                     tau_os: ParamLike, delta_s: ParamLike = 2.0) -> np.ndarray:
+    """Coulomb friction with the Stribeck effect (3.3) plus viscous friction (3.2), with offset:
+    ``f = F_v qd + sgn(qd) (F_c + (F_s - F_c) exp(-|qd / v_s|^delta_s)) + tau_os``."""
+    return viscous(qd, F_v) + stribeck(qd, F_c, F_s, v_s, delta_s) + np.asarray(tau_os)
+
+
+ParamsT = TypeVar("ParamsT", bound="ModelParamsBase")
+"""Any of the models' parameter classes."""
+
+
 @dataclass(frozen=True)
-class FrictionParams:
+class ModelParamsBase:
+    """What the parameter sets of the models share: their model's name, their fitted
+    parameters' names (in the fit's order), ``f``, ``torque`` and conversions."""
+
+    model: ClassVar[ModelName]
+    names: ClassVar[tuple[str, ...]]
+
+    def f(self, qd: ArrayLike) -> np.ndarray:
+        """Friction characteristic ``f(qd)`` [N·m] (``qd`` [rad/s], any shape)."""
+        raise NotImplementedError
+
+    def torque(self, qd: ArrayLike) -> np.ndarray:
+        """Torque friction exerts on the joint, ``tau_f = -f(qd)`` [N·m]."""
+        return -self.f(qd)
+
+    def as_vector(self) -> np.ndarray:
+        """The fitted parameters in :attr:`names` order."""
+        return np.array([getattr(self, n) for n in self.names])
+
+    @classmethod
+    def from_vector(cls: type[ParamsT], x: Iterable[float], delta_s: float = 2.0) -> ParamsT:
+        """Parameters from the fitted values in :attr:`names` order (and the Stribeck exponent
+        ``delta_s``, for the models that have one)."""
+        values = dict(zip(cls.names, map(float, x), strict=True))
+        if "delta_s" in {f.name for f in fields(cls)}:
+            values["delta_s"] = float(delta_s)
+        return cls(**values)
+
+    def to_dict(self) -> dict[str, float]:
+        """Every parameter by name (the inverse of :meth:`from_dict`)."""
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls: type[ParamsT], d: Mapping[str, object]) -> ParamsT:
+        """Parameters from a mapping of their names (missing ones take the defaults).
+
+        Raises:
+            InputError: an unknown name, or a value that is not a number.
+        """
+        names = {f.name for f in fields(cls)}
+        unknown = set(d) - names
+        if unknown:
+            raise InputError(f"unknown friction parameter(s) of the {cls.model} model: {', '.join(sorted(unknown))}")
+        try:
+            return cls(**{k: float(cast(float, v)) for k, v in d.items()})
+        except (TypeError, ValueError) as exc:
+            raise InputError(str(exc)) from None
+
+
+@dataclass(frozen=True)
+class CoulombViscousParams(ModelParamsBase):
+    """Parameters of the Coulomb-viscous model with offset, (3.1) + (3.2), for one joint
+    (units in the module docstring)."""
+
+    model: ClassVar[ModelName] = "coulomb-viscous"
+    names: ClassVar[tuple[str, ...]] = COULOMB_VISCOUS_NAMES
+
+    F_v: float = 0.0
+    F_c: float = 0.0
+    tau_os: float = 0.0
+
+    def f(self, qd: ArrayLike) -> np.ndarray:
+        """Friction characteristic ``f(qd) = F_v qd + F_c sgn(qd) + tau_os`` [N·m]."""
+        return coulomb_viscous(qd, self.F_v, self.F_c, self.tau_os)
+
+
+@dataclass(frozen=True)
+class StribeckParams(ModelParamsBase):
+    """Parameters of the Coulomb-Stribeck-viscous model with offset, (3.3) + (3.2), for one
+    joint: static friction ``F_s`` (at rest), Coulomb friction ``F_c`` (beyond the Stribeck
+    velocity ``v_s``), viscous ``F_v``, offset ``tau_os`` (units in the module docstring)."""
+
+    model: ClassVar[ModelName] = "stribeck"
+    names: ClassVar[tuple[str, ...]] = STRIBECK_NAMES
+
+    F_v: float = 0.0
+    F_c: float = 0.0
+    F_s: float = 0.0
+    v_s: float = 0.1
+    tau_os: float = 0.0
+    delta_s: float = 2.0
+
+    def f(self, qd: ArrayLike) -> np.ndarray:
+        """Friction characteristic f(qd) of (3.3) + (3.2) with offset [N·m]."""
+        return stribeck_viscous(qd, self.F_v, self.F_c, self.F_s, self.v_s, self.tau_os, self.delta_s)
+
+
+@dataclass(frozen=True)
+class FrictionParams(ModelParamsBase):
     """Parameters of model (3.5) for one joint (units in the module docstring)."""
+
+    model: ClassVar[ModelName] = "thesis"
+    names: ClassVar[tuple[str, ...]] = PARAM_NAMES
 
     F_v: float = 0.0
     F_c: float = 0.0
@@ -85,40 +221,42 @@ class FrictionParams:
         """Friction characteristic f(qd) of eq. (3.5) [N·m]."""
         return coulomb_viscous_stribeck(qd, self.F_v, self.F_c, self.S, self.v_s, self.tau_os, self.a, self.delta_s)
 
-    def torque(self, qd: ArrayLike) -> np.ndarray:
-        """Torque friction exerts on the joint, ``tau_f = -f(qd)`` [N·m]."""
-        return -self.f(qd)
+    def values_in(self, model: ModelName) -> dict[str, float]:
+        """These parameters under the names of ``model``'s parameters, those it shares with
+        (3.5): F_v, F_c, tau_os, and for ``stribeck`` v_s and the static friction
+        ``F_s = (1 + S) F_c`` (what a fit of ``model`` is compared with, e.g. against injected
+        friction). The smoothing ``tanh(a qd)`` has no counterpart in the other models."""
+        values = {"F_v": self.F_v, "F_c": self.F_c, "F_s": (1.0 + self.S) * self.F_c, "S": self.S,
+                  "v_s": self.v_s, "tau_os": self.tau_os, "a": self.a}
+        return {n: values[n] for n in MODEL_PARAMS[model].names}
 
-    def as_vector(self) -> np.ndarray:
-        """The six fitted parameters in :data:`PARAM_NAMES` order."""
-        return np.array([getattr(self, n) for n in PARAM_NAMES])
 
-    @classmethod
-    def from_vector(cls, x: Iterable[float], delta_s: float = 2.0) -> FrictionParams:
-        """Parameters from the six fitted values in :data:`PARAM_NAMES` order."""
-        # the six positional fields (PARAM_NAMES): delta_s is given by keyword
-        six = cast(tuple[float, float, float, float, float, float], tuple(map(float, x)))
-        return cls(*six, delta_s=delta_s)
+ModelParams = CoulombViscousParams | StribeckParams | FrictionParams
+"""The parameters of one joint under any of the models."""
 
-    def to_dict(self) -> dict[str, float]:
-        """Every parameter by name (the inverse of :meth:`from_dict`)."""
-        return asdict(self)
+MODEL_PARAMS: dict[ModelName, type[ModelParams]] = {
+    "coulomb-viscous": CoulombViscousParams, "stribeck": StribeckParams, "thesis": FrictionParams}
+"""The parameter class of each model."""
 
-    @classmethod
-    def from_dict(cls, d: dict) -> FrictionParams:
-        """Parameters from a mapping of their names (missing ones take the defaults).
 
-        Raises:
-            InputError: an unknown name, or a value that is not a number.
-        """
-        names = {f.name for f in fields(cls)}
-        unknown = set(d) - names
-        if unknown:
-            raise InputError(f"unknown friction parameter(s): {', '.join(sorted(unknown))}")
-        try:
-            return cls(**{k: float(v) for k, v in d.items()})
-        except (TypeError, ValueError) as exc:
-            raise InputError(str(exc)) from None
+def check_model(model: str, what: str = "model") -> ModelName:
+    """``model`` as a :data:`ModelName`.
+
+    Raises:
+        InputError: not one of :data:`MODEL_NAMES` (named as ``what``).
+    """
+    if model not in MODEL_NAMES:
+        raise InputError(f"{what} must be one of {', '.join(MODEL_NAMES)}, got '{model}'")
+    return cast(ModelName, model)
+
+
+def params_from_dict(model: str, d: Mapping[str, object]) -> ModelParams:
+    """Parameters of ``model`` from a mapping of their names (:meth:`ModelParamsBase.from_dict`).
+
+    Raises:
+        InputError: an unknown model, an unknown parameter name, a value that is not a number.
+    """
+    return MODEL_PARAMS[check_model(model)].from_dict(d)
 
 
 def friction_torque(qd: np.ndarray, params: list[FrictionParams]) -> np.ndarray:

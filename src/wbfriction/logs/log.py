@@ -6,7 +6,8 @@ one row per sample:
 =====================  ==========  ==================================================
 column                 unit        content
 =====================  ==========  ==================================================
-``time``               s           strictly increasing, uniformly sampled
+``time``               s           strictly increasing (float s, or integer ns); uniform,
+                                   skipping or jittered (:mod:`wbfriction.logs.clock`)
 ``q.<joint>``          rad (m)     position of every actuated joint
 ``tau.<joint>``        N·m (N)     measured torque of every torque-controlled joint
                                    (joint torque sensor), or else:
@@ -40,6 +41,7 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.logs.clock import JITTER, MAX_GAP, Clock, TimeBase, read_clock, split_at_gaps, table_stamps
 from wbfriction.logs.tables import numeric_column, read_metadata, with_metadata, write_table
 from wbfriction.model.robot import Robot
 
@@ -54,7 +56,8 @@ class Log:
     """A validated log, with columns mapped to the robot's joints by name.
 
     Attributes:
-        time: sample times (N,) [s].
+        time: sample times (N,) [s], as recorded (absolute, e.g. Unix epoch); the time base
+            derivatives are taken on is :attr:`clock`'s.
         q: joint positions (N, n_act) in :attr:`Robot.actuated` order [rad].
         tau: torques of the torque-controlled joints (N, n_tc) [N·m].
         contact: contact flags (N, n_contacts) in :attr:`Robot.contact_frames` order.
@@ -68,13 +71,16 @@ class Log:
         segments: row ranges between time gaps (:func:`check_time`); None: one segment.
         period: the sampling period of the log this one was cut from [s] (its segments, a
             chunk of a long log), so that every stretch is differentiated with the same one;
-            None: the median step of ``time``.
+            None: the clock's nominal step, else the median step of ``time``.
         qd_logged: joint velocities as the robot logged them (``qd.<joint>`` columns)
             (N, n_act) [rad/s], or None; used with ``--velocity logged`` only.
         torque_source: where ``tau`` was measured: ``"sensor"`` (link-side joint torque
             sensors: only the friction after the sensor is in it) or ``"current"`` (motor
             current x torque constant: the whole drive's friction and the rotor inertia are
             in it).
+        clock: what wrote the stamps and the time base derivatives are taken on
+            (:class:`~wbfriction.logs.clock.Clock`: uniform, skipping samples, or receive-time
+            jitter regularised), or None: uniform (a log built in memory).
     """
 
     time: np.ndarray
@@ -91,11 +97,19 @@ class Log:
     period: float | None = None
     qd_logged: np.ndarray | None = None
     torque_source: TorqueSource = "sensor"
+    clock: Clock | None = None
+
+    def __post_init__(self) -> None:
+        if self.segments is None and self.clock is not None and len(self.clock.segments) > 1:
+            self.segments = list(self.clock.segments)  # a clock's gaps split the log
 
     @property
     def dt(self) -> float:
-        """Sampling period [s]: :attr:`period` if set, else the median time step."""
-        return self.period if self.period is not None else float(np.median(np.diff(self.time)))
+        """Sampling period [s]: :attr:`period` if set, else the clock's nominal step
+        (:attr:`Clock.step <wbfriction.logs.clock.Clock.step>`), else the median time step."""
+        if self.period is not None:
+            return self.period
+        return self.clock.step if self.clock is not None else float(np.median(np.diff(self.time)))
 
     def parts(self) -> list[Log]:
         """The log's segments (split at its time gaps, :func:`check_time`) as logs of their own."""
@@ -109,7 +123,8 @@ class Log:
         cut = lambda x: None if x is None else x[start:stop]  # noqa: E731
         return Log(self.time[start:stop], self.q[start:stop], self.tau[start:stop], self.contact[start:stop],
                    cut(self.base), cut(self.tau_f_true), self.metadata, self.source, cut(self.qd_true),
-                   cut(self.qdd_true), None, self.dt, cut(self.qd_logged), self.torque_source)
+                   cut(self.qdd_true), None, self.dt, cut(self.qd_logged), self.torque_source,
+                   clock=None if self.clock is None else self.clock.rows(start, stop))
 
     def __len__(self) -> int:
         return len(self.time)
@@ -137,51 +152,30 @@ class Log:
         return with_metadata(pa.table(cols), self.metadata)
 
 
-MAX_GAP = 2.0
-"""Default gap [sampling periods]: a time step at least this long splits a log into segments."""
-JITTER = 0.05
-"""Tolerated deviation of a time step from the median step, relative."""
 LIMIT_MARGIN = 0.2
 """How far a position may pass its URDF limits before the log is refused [rad or m]."""
 
 
 def check_time(time: np.ndarray, source: str, max_gap: float = MAX_GAP,
                rel_tol: float = JITTER, first_row: int = 0) -> list[tuple[int, int]]:
-    """Check a time column and split it at its gaps.
+    """Check a time column and split it at its gaps (:func:`~wbfriction.logs.clock.split_at_gaps`).
 
-    A step within ``rel_tol`` of the median step ``dt`` is regular; a step of at least
-    ``max_gap`` periods (less the tolerance) is a gap, which ends a segment (a log with
-    dropped samples or pauses is estimated segment by segment, never differentiated
-    across a gap); anything else is irregular sampling and refused.
+    A step of at least ``max_gap`` times the local median step (less ``rel_tol``) is a gap,
+    which ends a segment (a log with dropped samples or pauses is estimated segment by
+    segment, never differentiated across a gap). Irregular steps are accepted: what kind of
+    clock wrote them is :func:`~wbfriction.logs.clock.read_clock`'s to decide.
+
+    Args:
+        time: stamps (N,): float seconds or integer nanoseconds.
 
     Returns:
         The segments as half-open row ranges ``[(a, b), ...]`` covering every row.
 
     Raises:
-        InputError: fewer than 5 rows, a duplicated or decreasing stamp, or an irregular
-            step, naming the first row at fault (counted from ``first_row``).
+        InputError: fewer than 5 rows; ColumnError: a non-finite, duplicated or decreasing
+            stamp, naming column ``time`` and the first row at fault (counted from ``first_row``).
     """
-    if time.size < 5:
-        raise InputError(f"{source}: only {time.size} rows; at least 5 samples are needed")
-    step = np.diff(time)
-    bad = np.flatnonzero(step <= 0)
-    if bad.size:
-        k = bad[0] + 1
-        what = "duplicated" if step[bad[0]] == 0 else "decreasing"
-        raise ColumnError(source, "time", int(first_row + k),
-                          f"column 'time' has a {what} stamp at row {first_row + k} ({time[k]:.9g} s after "
-                          f"{time[k - 1]:.9g} s)")
-    dt = np.median(step)
-    gap = step >= (max_gap - rel_tol) * dt
-    bad = np.flatnonzero(~gap & (np.abs(step - dt) > rel_tol * dt))
-    if bad.size:
-        raise ColumnError(source, "time", int(first_row + bad[0] + 1),
-                          f"column 'time' is irregular at row {first_row + bad[0] + 1} "
-                          f"(step {step[bad[0]]:.6g} s, median {dt:.6g} s; gaps of {max_gap:g} periods or more "
-                          f"split the log)")
-    cuts = np.flatnonzero(gap) + 1
-    edges = [0, *cuts.tolist(), time.size]
-    return list(zip(edges[:-1], edges[1:]))
+    return split_at_gaps(time, source, max_gap, rel_tol, first_row)
 
 
 def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT_MARGIN, first_row: int = 0) -> None:
@@ -205,7 +199,8 @@ def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT
 
 
 def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_gap: float = MAX_GAP,
-                   limit_margin: float = LIMIT_MARGIN, first_row: int = 0, period: float | None = None) -> Log:
+                   limit_margin: float = LIMIT_MARGIN, first_row: int = 0, period: float | None = None,
+                   *, clock: Clock | None = None, time_base: TimeBase = "auto") -> Log:
     """Validate an Arrow table against ``robot`` and map its columns by joint name.
 
     Args:
@@ -214,6 +209,11 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
         first_row: row number of the table's first row in its file (a chunk of a long log),
             for the messages.
         period: the sampling period of the whole log, for a chunk of it (:attr:`Log.period`).
+        clock: the whole log's clock cut to this chunk's rows
+            (:meth:`Clock.rows <wbfriction.logs.clock.Clock.rows>`), so that a log estimated in
+            chunks is the whole log's; None: read from this table's stamps and positions
+            (:func:`~wbfriction.logs.clock.read_clock`).
+        time_base: ``auto``, ``recorded`` or ``regularised`` (:data:`~wbfriction.logs.clock.TimeBase`).
 
     Raises:
         InputError: missing ``time``, a missing or unknown joint/frame column, NaN, a
@@ -222,7 +222,7 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
             non-unit quaternion.
     """
     _check_column_names(table, robot, source)
-    time, segments, q = _read_motion(table, robot, source, max_gap, limit_margin, first_row)
+    time, clock, q = _read_motion(table, robot, source, max_gap, limit_margin, first_row, clock, time_base)
     tau, torque_source = _read_torque(table, robot, source, first_row)
     contact = _read_contact(table, robot, source, first_row)
     base = _read_base(table, source, first_row)
@@ -231,8 +231,8 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
     qdd_true = _read_true_rates(table, "qdd_true", robot, source, first_row)
     qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
     return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
-               qd_true=qd_true, qdd_true=qdd_true, segments=segments, period=period, qd_logged=qd_logged,
-               torque_source=torque_source)
+               qd_true=qd_true, qdd_true=qdd_true, segments=clock.segments, period=period, qd_logged=qd_logged,
+               torque_source=torque_source, clock=clock)
 
 
 def _check_column_names(table: pa.Table, robot: Robot, source: str) -> None:
@@ -269,13 +269,21 @@ def _stack(table: pa.Table, columns: list[str], source: str, first_row: int) -> 
 
 
 def _read_motion(table: pa.Table, robot: Robot, source: str, max_gap: float, limit_margin: float,
-                 first_row: int) -> tuple[np.ndarray, list[tuple[int, int]], np.ndarray]:
-    """Time [s] (checked, and its segments) and q [rad] (checked against the limits)."""
-    time = numeric_column(table, "time", source, first_row)
-    segments = check_time(time, source, max_gap, first_row=first_row)
+                 first_row: int, clock: Clock | None = None,
+                 time_base: TimeBase = "auto") -> tuple[np.ndarray, Clock, np.ndarray]:
+    """Time [s] (checked: float seconds, integer nanoseconds converted), its clock (``clock``,
+    the whole log's cut to these rows, else read from the stamps and positions) and q [rad]
+    (checked against the limits)."""
+    stamps = table_stamps(table, source, first_row)
+    check_time(stamps, source, max_gap, first_row=first_row)
     q = _stack(table, [f"q.{n}" for n in robot.actuated], source, first_row)
     check_limits(q, robot, source, limit_margin, first_row)
-    return time, segments, q
+    if clock is None:
+        clock = read_clock(stamps, source, max_gap=max_gap, first_row=first_row, q=q, time_base=time_base)
+    elif len(clock) != len(stamps):
+        raise InputError(f"{source}: a clock of {len(clock)} rows for a table of {len(stamps)} rows")
+    time = stamps * 1e-9 if np.issubdtype(stamps.dtype, np.integer) else stamps
+    return time, clock, q
 
 
 def _read_torque(table: pa.Table, robot: Robot, source: str, first_row: int) -> tuple[np.ndarray, TorqueSource]:

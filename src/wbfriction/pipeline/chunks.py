@@ -12,11 +12,15 @@ one (:func:`~wbfriction.signals.kinematics.straddling`), and the support phases 
 lift-off / touch-down margins (:func:`~wbfriction.signals.phases.segment`) are bounded by them.
 So a chunk cut at a contact change, read with :data:`CONTEXT` rows of context (the
 previous phase's last rows, the next phase's first), gives exactly the rows of the
-whole-log estimate (tests: to 1e-9 N·m; the only difference is the rounding of the
-sampling period, the median of the chunk's own time steps). A stretch with no contact
-change for twice the chunk length is cut where it must, with ``overlap`` rows of context:
-exact for the finite-window schemes when ``overlap`` exceeds the window, within the
-Butterworth filter's decay otherwise.
+whole-log estimate. A stretch with no contact change for twice the chunk length is cut
+where it must, with ``overlap`` rows of context: exact for the finite-window schemes when
+``overlap`` exceeds the window, within the Butterworth filter's decay otherwise.
+
+**One clock for the whole log.** The stamps are read once, whole (:func:`plan_columns`), and
+their clock decided once (:func:`~wbfriction.logs.clock.read_clock`, on the positions of the
+first :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS` rows): its sampling period, gaps, and
+regularised times are the whole log's, and each chunk is given its rows of it
+(:meth:`Clock.rows <wbfriction.logs.clock.Clock.rows>`).
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wbfriction.exceptions import ColumnError
+from wbfriction.logs.clock import MAX_GAP, ROUGHNESS_ROWS, Clock, TimeBase, read_clock, table_stamps
 from wbfriction.logs.tables import TableFile
 from wbfriction.model.robot import Robot
 
@@ -80,12 +85,16 @@ def plan_chunks(contact: np.ndarray, chunking: Chunking = Chunking()) -> list[Ch
             for i, (a, b) in enumerate(zip(cuts[:-1], cuts[1:]))]
 
 
-def plan_columns(file: TableFile, robot: Robot, source: str) -> tuple[np.ndarray, float]:
+def plan_columns(file: TableFile, robot: Robot, source: str, max_gap: float = MAX_GAP,
+                 time_base: TimeBase = "auto") -> tuple[np.ndarray, Clock]:
     """The contact columns of a log file (N, n_contacts), read alone to plan its chunks, and the
-    sampling period of the whole log (the median time step) [s].
+    whole log's clock (:func:`~wbfriction.logs.clock.read_clock`: its stamps, and the positions of
+    its first :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS` rows when they are finite).
 
     Raises:
-        InputError: an unreadable file; ColumnError: a missing ``time`` or contact column.
+        InputError: an unreadable file, a time column that :func:`~wbfriction.logs.clock.read_clock`
+            refuses (rows numbered from the file's first); ColumnError: a missing ``time`` or
+            contact column.
     """
     columns = ["time"] + ([f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else [])
     table = file.read(columns)
@@ -94,6 +103,20 @@ def plan_columns(file: TableFile, robot: Robot, source: str) -> tuple[np.ndarray
             raise ColumnError(source, c, None, f"missing column '{c}'")
     flags = (np.column_stack([table.column(c).to_numpy(zero_copy_only=False) for c in columns[1:]])
              if robot.floating_base else np.ones((table.num_rows, 1)))  # a fixed base: always welded
-    time = table.column("time").to_numpy(zero_copy_only=False).astype(float)
-    period = float(np.median(np.diff(time))) if len(time) > 1 else float("nan")
-    return np.nan_to_num(flags.astype(float)) != 0, period
+    stamps = table_stamps(table, source)
+    return np.nan_to_num(flags.astype(float)) != 0, read_clock(stamps, source, max_gap=max_gap,
+                                                               q=_first_positions(file, robot), time_base=time_base)
+
+
+def _first_positions(file: TableFile, robot: Robot) -> np.ndarray | None:
+    """The positions of the first :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS` rows (M, n_act), or
+    None when a column is missing or not finite (the chunk that holds it says so)."""
+    table = file.row_reader(ROUGHNESS_ROWS).rows(0, ROUGHNESS_ROWS)
+    names = [f"q.{n}" for n in robot.actuated]
+    if any(n not in table.column_names for n in names):
+        return None
+    try:
+        q = np.column_stack([table.column(n).to_numpy(zero_copy_only=False).astype(float) for n in names])
+    except (ValueError, TypeError):
+        return None
+    return q if np.all(np.isfinite(q)) else None

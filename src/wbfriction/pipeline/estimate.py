@@ -26,6 +26,7 @@ import pyarrow.compute as pc
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import EstimateOptions, estimate_log, no_single_support
 from wbfriction.friction.io import friction_table
+from wbfriction.logs.clock import Clock, TimeBase
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, log_from_table
 from wbfriction.logs.source import LogSource
 from wbfriction.logs.tables import RowReader, TableFile, read_metadata, with_metadata, write_tables
@@ -48,7 +49,7 @@ class RobotSpec:
 
 
 def check_file(robot: Robot, path: str | Path, source: str | None = None, chunking: Chunking = Chunking(),
-               max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN) -> int:
+               max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN, time_base: TimeBase = "auto") -> int:
     """Validate a log file against ``robot`` chunk by chunk, as :func:`estimate_file` does
     before estimating (:func:`~wbfriction.logs.log.log_from_table`), in bounded memory. Returns
     its rows.
@@ -58,11 +59,11 @@ def check_file(robot: Robot, path: str | Path, source: str | None = None, chunki
     """
     file = TableFile(path)
     source = source or str(file.path)
-    contact, period = plan_columns(file, robot, source)
+    contact, clock = plan_columns(file, robot, source, max_gap, time_base)
     reader = file.row_reader(max(1024, min(chunking.rows, 65_536)))
     for c in plan_chunks(contact, chunking):
         log_from_table(reader.rows(c.read_start, c.read_stop), robot, source, max_gap, limit_margin,
-                       first_row=c.read_start, period=period)
+                       first_row=c.read_start, period=clock.step, clock=clock.rows(c.read_start, c.read_stop))
     return len(contact)
 
 
@@ -74,9 +75,11 @@ def _init_worker(spec: RobotSpec) -> None:
     _ROBOT["robot"] = spec.load()
 
 
-def _estimate_chunk(robot: Robot, table: pa.Table, chunk: Chunk, source: str, options: EstimateOptions,
-                    companion: bool, max_gap: float, limit_margin: float, period: float) -> pa.Table:
-    log = log_from_table(table, robot, source, max_gap, limit_margin, first_row=chunk.read_start, period=period)
+def _estimate_chunk(robot: Robot, table: pa.Table, chunk: Chunk, clock: Clock, source: str, options: EstimateOptions,
+                    companion: bool, max_gap: float, limit_margin: float) -> pa.Table:
+    """The friction table of a chunk's own rows; ``clock``: the whole log's, cut to the rows read."""
+    log = log_from_table(table, robot, source, max_gap, limit_margin, first_row=chunk.read_start, period=clock.step,
+                         clock=clock)
     est = estimate_log(robot, log, options, companion=companion, require_single_support=False)
     return friction_table(est).slice(chunk.start - chunk.read_start, chunk.stop - chunk.start)
 
@@ -85,10 +88,12 @@ def _in_worker(args) -> pa.Table:
     return _estimate_chunk(_ROBOT["robot"], *args)
 
 
-def _chunk_tables(spec: RobotSpec, robot: Robot, reader: RowReader, chunks: list[Chunk], workers: int,
+def _chunk_tables(spec: RobotSpec, robot: Robot, reader: RowReader, chunks: list[Chunk], clock: Clock, workers: int,
                   settings: tuple) -> Iterator[pa.Table]:
-    """Each chunk's friction table in order, estimated in this process or on ``workers`` processes."""
-    args = lambda c: (reader.rows(c.read_start, c.read_stop), c, *settings)  # noqa: E731
+    """Each chunk's friction table in order, estimated in this process or on ``workers`` processes
+    (each given its rows of the whole log's ``clock``)."""
+    args = lambda c: (reader.rows(c.read_start, c.read_stop), c, clock.rows(c.read_start, c.read_stop),  # noqa: E731
+                      *settings)
     if workers <= 1 or len(chunks) == 1:
         for c in chunks:
             yield _estimate_chunk(robot, *args(c))
@@ -124,19 +129,22 @@ def _with_provenance(tables: Iterator[pa.Table], chunks: list[Chunk], robot: Rob
 
 @dataclass
 class ChunkedResult:
-    """What :func:`estimate_file` did: rows, chunks, and their contact-change cuts."""
+    """What :func:`estimate_file` did: rows, chunks, and their contact-change cuts; ``clock``: the
+    one line saying what the stamps are and which time base was used (:attr:`Clock.reason
+    <wbfriction.logs.clock.Clock.reason>`)."""
 
     rows: int
     chunks: int
     forced_cuts: int
     metadata: dict
+    clock: str = ""
 
 
 def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options: EstimateOptions = EstimateOptions(),
                   *, chunking: Chunking = Chunking(), companion: bool = True, max_gap: float = MAX_GAP,
                   limit_margin: float = LIMIT_MARGIN, extra_metadata: dict | None = None,
                   progress: Progress | None = None, robot: Robot | None = None,
-                  source: str | None = None) -> ChunkedResult:
+                  source: str | None = None, time_base: TimeBase = "auto") -> ChunkedResult:
     """Estimate a log file chunk by chunk into ``output`` (Parquet or CSV), whole or not at all.
 
     Args:
@@ -151,6 +159,8 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
         robot: ``spec`` already loaded in this process, if the caller has it.
         source: the name messages give the log (default ``path``; a bag converted to a
             temporary file is named as the bag).
+        time_base: ``auto``, ``recorded`` or ``regularised``
+            (:func:`~wbfriction.logs.clock.read_clock`, decided once for the whole log).
 
     Raises:
         InputError: what reading, validating and estimating raise, naming the file and row;
@@ -162,16 +172,18 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     source = source or str(path)
     robot = robot if robot is not None else spec.load()
     file = TableFile(path)
-    contact, period = plan_columns(file, robot, source)
+    contact, clock = plan_columns(file, robot, source, max_gap, time_base)
     n = len(contact)
     chunks = plan_chunks(contact, chunking)
     del contact
     reader = file.row_reader(max(1024, min(chunking.rows, 65_536)))
     first_meta: dict = {}
-    settings = (source, options, companion, max_gap, limit_margin, period)
-    write_tables(output, _with_provenance(_chunk_tables(spec, robot, reader, chunks, chunking.workers, settings),
+    settings = (source, options, companion, max_gap, limit_margin)
+    write_tables(output, _with_provenance(_chunk_tables(spec, robot, reader, chunks, clock, chunking.workers,
+                                                        settings),
                                           chunks, robot, source, extra_metadata, progress, first_meta))
-    return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta)
+    return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta,
+                         clock.reason)
 
 
 @contextmanager

@@ -5,8 +5,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from wbfriction.exceptions import InputError
 from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, JointEnergy, energy_consistency
-from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
+from wbfriction.friction.fit import (
+    MODEL_CHOICES,
+    SELECTION_TOLERANCE,
+    FitResult,
+    ModelChoice,
+    fit_estimate,
+    fitted_offsets,
+)
 from wbfriction.friction.io import SIGN_CONVENTION, energy_to_dict, read_friction_file, write_params
 from wbfriction.pipeline.provenance import file_provenance
 
@@ -19,19 +27,41 @@ class FittedFile:
     energy: list[JointEnergy]
 
 
-def fit_file(friction: str | Path, output: str | Path, *, min_samples: int = 20,
+def fit_file(friction: str | Path, output: str | Path, *, model: ModelChoice = "auto",
+             selection_tolerance: float = SELECTION_TOLERANCE, min_samples: int = 20,
              threshold: float = DEFAULT_THRESHOLD, tolerance: float = DEFAULT_TOLERANCE,
              workers: int = 1) -> FittedFile:
-    """Fit model (3.5) to every joint of a friction table (:func:`~wbfriction.friction.fit.fit_joints`,
+    """Fit a friction model to every joint of a friction table (:func:`~wbfriction.friction.fit.fit_joints`,
     on ``workers`` processes), check energy (eq. 7.9), and write the parameters JSON with its
-    provenance, whole or not at all.
+    provenance and the model asked for, whole or not at all.
+
+    Args:
+        friction: the friction table (``wbfriction estimate``).
+        output: the parameters JSON to write.
+        model: ``auto`` (default: per joint the simplest model whose held-out RMS is within
+            ``selection_tolerance`` of the best, the reason recorded; see
+            :mod:`wbfriction.friction.fit`), or ``coulomb-viscous``, ``stribeck``, ``thesis`` (3.5).
+        selection_tolerance: relative excess of held-out RMS within which ``auto`` takes the
+            simpler model (e.g. 0.02: 2 %).
+        min_samples: joints with fewer valid samples get no parameters.
+        threshold, tolerance: of the energy check (:func:`~wbfriction.friction.energy.energy_consistency`).
+        workers: processes fitting joints side by side.
 
     Raises:
-        InputError: an unreadable or malformed friction table, an output folder that does not exist.
+        InputError: an unknown ``--model`` or a negative ``--selection-tolerance``, an unreadable
+            or malformed friction table, an output folder that does not exist.
     """
+    if model not in MODEL_CHOICES:
+        raise InputError(f"--model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
+    if not selection_tolerance >= 0:
+        raise InputError(f"--selection-tolerance must be at least 0, got {selection_tolerance}")
     est = read_friction_file(friction)
-    fits = fit_estimate(est, min_samples=min_samples, workers=workers)
+    fits = fit_estimate(est, min_samples=min_samples, workers=workers, model=model,
+                        selection_tolerance=selection_tolerance)
     energy = energy_consistency(est, fitted_offsets(fits), threshold, tolerance)
-    header = {"provenance": file_provenance("friction", friction), "sign_convention": SIGN_CONVENTION}
+    header: dict[str, object] = {"provenance": file_provenance("friction", friction),
+                                 "sign_convention": SIGN_CONVENTION, "model": model}
+    if model == "auto":
+        header["selection_tolerance"] = selection_tolerance
     write_params(output, fits, header, {e.joint: {"energy": energy_to_dict(e)} for e in energy})
     return FittedFile(fits, energy)

@@ -203,7 +203,7 @@ def _cloud(ax, est: FrictionEstimate, i: int, fit: FitResult | None, target: Fri
         if target is not None:
             ax.plot(v, target.torque(v), color="k", lw=2.5, alpha=0.35, label="target")
         if fit is not None and fit.params is not None:
-            ax.plot(v, fit.params.torque(v), color="C1", lw=1.2, label="fit (3.5)")
+            ax.plot(v, fit.params.torque(v), color="C1", lw=1.2, label=f"fit ({fit.model})")
     ax.axhline(0, color="k", lw=0.4)
     ax.axvline(0, color="k", lw=0.4)
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.fit import FitResult
-from wbfriction.friction.models import PARAM_NAMES, FrictionParams
+from wbfriction.friction.models import ALL_PARAM_NAMES, FrictionParams
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
 from wbfriction.report.figures import friction_overview_figure, joint_figure, png_bytes
@@ -64,25 +64,37 @@ def _fmt(value: float | None, se: float | None = None) -> str:
 
 
 def _params_table(joints: list[str], fits: dict[str, FitResult]) -> str:
-    head = "".join(f"<th>{n}</th>" for n in PARAM_NAMES)
+    """Each joint's model and parameters (value ±standard error; "(bound)": at a bound of the fit);
+    blank where a parameter is not one of the joint's model."""
+    names = [n for n in ALL_PARAM_NAMES if any(f.params is not None and n in f.params.names for f in fits.values())]
+    head = "".join(f"<th>{n}</th>" for n in names)
     rows = []
+
+    def cell(fit: FitResult, n: str) -> str:
+        if fit.params is None or n not in fit.params.names:
+            return "<td></td>"
+        bound = " (bound)" if fit.at_bound.get(n) else ""
+        return f"<td>{_fmt(getattr(fit.params, n), fit.stderr.get(n))}{bound}</td>"
+
     for j in joints:
         fit = fits.get(j)
         if fit is None or fit.params is None:
             n = "—" if fit is None else str(fit.n_samples)
-            rows.append(f"<tr><td>{html.escape(j)}</td><td>{n}</td>" + "<td>—</td>" * (len(PARAM_NAMES) + 1)
+            rows.append(f"<tr><td>{html.escape(j)}</td><td></td><td>{n}</td>" + "<td>—</td>" * (len(names) + 1)
                         + "</tr>")
             continue
-        cells = "".join(f"<td>{_fmt(getattr(fit.params, n), fit.stderr.get(n))}</td>" for n in PARAM_NAMES)
-        rows.append(f"<tr><td>{html.escape(j)}</td><td>{fit.n_samples}</td>{cells}"
+        cells = "".join(cell(fit, n) for n in names)
+        rows.append(f"<tr><td>{html.escape(j)}</td><td>{html.escape(fit.model)}</td><td>{fit.n_samples}</td>{cells}"
                     f"<td>{_fmt(fit.rms_residual)}</td></tr>")
         err = fit.error_percent()
-        if err is not None:
-            rows.append('<tr class="target"><td>&nbsp;&nbsp;target</td><td></td>'
-                        + "".join(f"<td>{_fmt(getattr(fit.target, n))}</td>" for n in PARAM_NAMES) + "<td></td></tr>")
-            rows.append('<tr class="err"><td>&nbsp;&nbsp;error [%]</td><td></td>'
-                        + "".join(f"<td>{err[n]:.2f}</td>" for n in PARAM_NAMES) + "<td></td></tr>")
-    return (f'<table id="parameters"><tr><th>joint</th><th>N</th>{head}<th>RMS residual [N·m]</th></tr>'
+        if err is not None and fit.target is not None:
+            target = fit.target.values_in(fit.model)
+            rows.append('<tr class="target"><td>&nbsp;&nbsp;target</td><td></td><td></td>'
+                        + "".join(f"<td>{_fmt(target[n]) if n in target else ''}</td>" for n in names)
+                        + "<td></td></tr>")
+            rows.append('<tr class="err"><td>&nbsp;&nbsp;error [%]</td><td></td><td></td>'
+                        + "".join(f"<td>{f'{err[n]:.2f}' if n in err else ''}</td>" for n in names) + "<td></td></tr>")
+    return (f'<table id="parameters"><tr><th>joint</th><th>model</th><th>N</th>{head}<th>RMS residual [N·m]</th></tr>'
             + "".join(rows) + "</table>")
 
 

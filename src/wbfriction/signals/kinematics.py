@@ -22,6 +22,13 @@ gravity terms), and the identification passes its model through the same smoothe
 (:mod:`wbfriction.friction.fit`). No filter window spans a contact change: the rows whose
 central stencil does (:func:`straddling`: an impact, a touch-down) are left out of every
 filter, so that the rows within a window of them are NaN.
+
+Non-uniform samples: a log whose clock is not uniform (:class:`~wbfriction.logs.clock.Clock`:
+exact stamps that skip samples, or receive-time stamps regularised) is differentiated on its
+time base ``log.clock.t``, never with a constant period: the same schemes in their non-uniform
+forms (:mod:`wbfriction.signals.nonuniform`: three-point differences, Savitzky-Golay fits on the
+actual times, Butterworth through a uniform grid), and the ``zoh`` torque alignment weighs the
+two held torques by how long each was held.
 """
 
 from __future__ import annotations
@@ -33,7 +40,10 @@ import numpy as np
 
 from wbfriction.exceptions import InputError
 from wbfriction.logs.log import Log
+from wbfriction.signals import nonuniform
 from wbfriction.signals.filters import SavgolSmoother, SavgolWeights, ZeroPhaseLowpass, savgol_differentiate
+from wbfriction.signals.nonuniform import NonUniformSavgol, ResampledLowpass
+from wbfriction.signals.velocity import velocity_lag
 
 
 def central_differences(q: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, int]:
@@ -84,19 +94,63 @@ class FilterOptions:
     butter_order: int = 6
 
 
-Smoother = SavgolSmoother | ZeroPhaseLowpass
+@dataclass(frozen=True, eq=False)
+class PiecewiseSmoother:
+    """The smoothers of consecutive stretches of one log (its segments), each on its own rows:
+    what the non-uniform smoothers, tied to their samples' times, become when the stretches'
+    estimates are joined (:func:`joined_smoother`).
+
+    Attributes:
+        parts: ``(start, stop, smoother)`` of each stretch's rows.
+    """
+
+    parts: tuple[tuple[int, int, Smoother | None], ...]
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """Each stretch of ``x`` (N, ...) through its own smoother (NaN without one)."""
+        x = np.asarray(x, dtype=float)
+        out = np.full_like(x, np.nan)
+        for a, b, smoother in self.parts:
+            if smoother is not None:
+                out[a:b] = smoother(x[a:b])
+        return out
 
 
-def make_smoother(diff: Diff, filtering: FilterOptions, dt: float) -> Smoother | None:
+Smoother = SavgolSmoother | ZeroPhaseLowpass | NonUniformSavgol | ResampledLowpass | PiecewiseSmoother
+
+
+def joined_smoother(smoothers: list[Smoother | None], lengths: list[int]) -> Smoother | None:
+    """One smoother for estimates of consecutive stretches joined along time: the first when every
+    one is the same time-invariant filter (uniform samples, as before), else a
+    :class:`PiecewiseSmoother` applying each to its own rows; None when none has one."""
+    present = [s for s in smoothers if s is not None]
+    if not present:
+        return None
+    first = present[0]
+    if isinstance(first, SavgolSmoother | ZeroPhaseLowpass) and all(s == first for s in present):
+        return first
+    edges = np.cumsum([0, *lengths]).tolist()
+    return PiecewiseSmoother(tuple((a, b, s) for a, b, s in zip(edges[:-1], edges[1:], smoothers)))
+
+
+def make_smoother(diff: Diff, filtering: FilterOptions, dt: float, t: np.ndarray | None = None) -> Smoother | None:
     """The zero-phase smoother of a filtering scheme (``savgol``, ``butterworth``), else None.
+
+    Args:
+        dt: the sampling period [s] (non-uniform samples: the Butterworth grid's step).
+        t: non-uniform sample times (N,) [s] (:attr:`~wbfriction.logs.clock.Clock.t`): the
+            smoothers of :mod:`~wbfriction.signals.nonuniform` on them; None: uniform samples.
 
     Raises:
         InputError: filter parameters that make no filter.
     """
     if diff == "savgol":
+        if t is not None:
+            return NonUniformSavgol(t, filtering.window, filtering.poly_order, filtering.weights)
         return SavgolSmoother(filtering.window, filtering.poly_order, dt, filtering.weights)
     if diff == "butterworth":
-        return ZeroPhaseLowpass(filtering.cutoff, filtering.butter_order, dt)
+        lowpass = ZeroPhaseLowpass(filtering.cutoff, filtering.butter_order, dt)
+        return lowpass if t is None else ResampledLowpass(t, lowpass)
     return None
 
 
@@ -105,6 +159,9 @@ Scheme = Literal["central", "backward", "savgol", "butterworth"]
 Diff = Literal["central", "backward", "savgol", "butterworth", "true"]
 """A scheme, or ``true``: the simulators' logged true velocities and accelerations."""
 DIFFERENTIATORS = {"central": central_differences, "backward": backward_differences}
+NONUNIFORM_DIFFERENTIATORS = {"central": nonuniform.three_point_differences,
+                              "backward": nonuniform.backward_differences}
+"""The same schemes on non-uniform sample times ``(q, t)`` (:mod:`~wbfriction.signals.nonuniform`)."""
 FILTERING_SCHEMES: tuple[Scheme, ...] = ("savgol", "butterworth")
 SCHEMES: tuple[Scheme, ...] = get_args(Scheme)
 """Differentiation schemes by name: plain differences, then the filtering ones (module docstring)."""
@@ -125,13 +182,17 @@ TorqueAlignment = Literal["zoh", "sample"]
 TORQUE_ALIGNMENTS: tuple[TorqueAlignment, ...] = get_args(TorqueAlignment)
 
 
-def align_torque(tau: np.ndarray, alignment: TorqueAlignment | str = "zoh") -> np.ndarray:
+def align_torque(tau: np.ndarray, alignment: TorqueAlignment | str = "zoh", t: np.ndarray | None = None) -> np.ndarray:
     """Torques as seen by a central second difference at each row.
 
     Args:
         tau: torques (N, n) [N·m], ``tau[k]`` held over ``[t_k, t_k+1)`` for ``"zoh"``.
         alignment: ``"zoh"``: mean of ``tau[k-1]`` and ``tau[k]`` (row 0 is NaN);
             ``"sample"``: ``tau[k]`` itself.
+        t: non-uniform sample times (N,) [s], or None. With ``"zoh"``, the three-point second
+            difference at ``k`` sees ``(h1 tau[k-1] + h2 tau[k]) / (h1 + h2)``, each torque
+            weighed by how long it was held (``h1 = t_k - t_k-1``, ``h2 = t_k+1 - t_k``: exact
+            for a double integrator); the first and last rows are NaN.
 
     Raises:
         InputError: unknown alignment.
@@ -140,7 +201,11 @@ def align_torque(tau: np.ndarray, alignment: TorqueAlignment | str = "zoh") -> n
         return np.array(tau, dtype=float)
     if alignment == "zoh":
         out = np.full_like(tau, np.nan, dtype=float)
-        out[1:] = 0.5 * (tau[1:] + tau[:-1])
+        if t is None:
+            out[1:] = 0.5 * (tau[1:] + tau[:-1])
+        else:
+            h = np.diff(np.asarray(t, dtype=float)).reshape((-1,) + (1,) * (np.ndim(tau) - 1))
+            out[1:-1] = (h[:-1] * tau[:-2] + h[1:] * tau[1:-1]) / (h[:-1] + h[1:])
         return out
     raise InputError(f"unknown torque alignment '{alignment}': choose one of {', '.join(TORQUE_ALIGNMENTS)}")
 
@@ -196,24 +261,34 @@ def _filtered(log: Log, tau: np.ndarray, smoother: Smoother, filtering: FilterOp
     """``q, qd, qdd, tau`` of a filtering scheme (module docstring); rows whose window reaches
     a row :func:`straddling` a contact change are NaN, except ``q`` (raw there)."""
     blank = straddling(log.contact)[:, None]
-    qd_c, qdd_c, _ = central_differences(log.q, log.dt)
-    qd_c, qdd_c = np.where(blank, np.nan, qd_c), np.where(blank, np.nan, qdd_c)
-    if isinstance(smoother, SavgolSmoother):  # derivatives of one local fit (7.1-7.8)
+    if isinstance(smoother, NonUniformSavgol | ResampledLowpass):  # on the actual times (nonuniform)
+        q_s, qd_s, qdd = smoother.differentiate(np.where(blank, np.nan, log.q))
+    elif isinstance(smoother, SavgolSmoother):  # derivatives of one local fit (7.1-7.8)
         q_s, qd_s, qdd = savgol_differentiate(np.where(blank, np.nan, log.q), log.dt, filtering.window,
                                               filtering.poly_order, filtering.weights)
     else:  # central differences through the zero-phase low-pass (7.1.2)
+        qd_c, qdd_c, _ = central_differences(log.q, log.dt)
+        qd_c, qdd_c = np.where(blank, np.nan, qd_c), np.where(blank, np.nan, qdd_c)
         q_s, qd_s, qdd = smoother(np.where(blank, np.nan, log.q)), smoother(qd_c), smoother(qdd_c)
     tau = smoother(np.where(blank, np.nan, tau))
     return np.where(np.isfinite(q_s), q_s, log.q), qd_s, qdd, tau
 
 
+Velocity = Literal["differentiated", "logged"]
+"""Where the joint velocities come from: the positions differentiated by the scheme, or the
+log's own ``qd.<joint>`` columns (:func:`measure`)."""
+VELOCITIES: tuple[Velocity, ...] = get_args(Velocity)
+
+
 def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
             torque_alignment: TorqueAlignment | Literal["auto"] = "auto",
-            filtering: FilterOptions = FilterOptions()) -> MeasuredKinematics:
+            filtering: FilterOptions = FilterOptions(), velocity: Velocity = "differentiated") -> MeasuredKinematics:
     """Differentiate a log's joint positions and align the other signals (6.1.2, 7.1).
 
     Args:
-        log: a validated :class:`~wbfriction.logs.log.Log`.
+        log: a validated :class:`~wbfriction.logs.log.Log`; when its clock is not uniform
+            (:attr:`~wbfriction.logs.log.Log.clock`), differentiated on ``log.clock.t`` (module
+            docstring) and the clock's kind and reason are added to the metadata (``clock``).
         diff: differentiation scheme, one of :data:`SCHEMES`, or ``"true"``: the log's
             true velocities and accelerations (simulated logs), with the torques as logged
             (``torque_alignment``, delays and filters do not apply).
@@ -222,13 +297,21 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
         torque_alignment: see :func:`align_torque`; ``"auto"``: the log's metadata key
             ``torque_alignment`` when a simulator wrote one, else ``"zoh"``.
         filtering: parameters of the ``savgol`` and ``butterworth`` schemes.
+        velocity: ``differentiated`` (the scheme's), or ``logged``: the log's ``qd.<joint>``
+            columns as they are (the accelerations stay the scheme's); how late they are
+            against the differentiated ones (:func:`~wbfriction.signals.velocity.velocity_lag`)
+            is measured and stated in the metadata (``velocity``), not compensated.
 
     Raises:
-        InputError: unknown scheme or alignment, filter parameters that make no filter, a
-            log too short for the filter; ``"true"`` on a log without
-            ``qd_true``/``qdd_true`` columns.
+        InputError: unknown scheme, alignment or velocity source, filter parameters that make
+            no filter, a log too short for the filter; ``"true"`` on a log without
+            ``qd_true``/``qdd_true`` columns; ``logged`` on a log without ``qd.<joint>`` columns.
     """
-    q, smoother = log.q, None
+    if velocity not in VELOCITIES:
+        raise InputError(f"unknown velocity source '{velocity}': choose one of {', '.join(VELOCITIES)}")
+    if velocity == "logged" and log.qd_logged is None:
+        raise InputError(f"{log.source}: --velocity logged needs the columns qd.<joint> of every actuated joint")
+    q, smoother, metadata = log.q, None, dict(log.metadata)
     if diff == "true":
         if log.qd_true is None or log.qdd_true is None:
             raise InputError(f"{log.source}: diff 'true' needs the columns qd_true.* and qdd_true.* "
@@ -239,14 +322,39 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
             raise InputError(f"unknown differentiation scheme '{diff}': choose one of {', '.join(SCHEMES)}, true")
         if torque_alignment == "auto":
             torque_alignment = log.metadata.get("torque_alignment", "zoh")
-        smoother = make_smoother(diff, filtering, log.dt)
-        tau = align_torque(log.tau, torque_alignment)
+        t = time_base(log)
+        if t is not None and log.clock is not None:
+            metadata["clock"] = {"kind": log.clock.kind, "reason": log.clock.reason}
+        smoother = make_smoother(diff, filtering, log.dt, t)
+        tau = align_torque(log.tau, torque_alignment, t)
         if smoother is None:
-            qd, qdd, delay = DIFFERENTIATORS[diff](log.q, log.dt)
+            qd, qdd, delay = (DIFFERENTIATORS[diff](log.q, log.dt) if t is None
+                              else NONUNIFORM_DIFFERENTIATORS[diff](log.q, t))
             if compensate_delay:
                 qd, qdd = _shift_back(qd, delay), _shift_back(qdd, delay)
         else:
             q, qd, qdd, tau = _filtered(log, tau, smoother, filtering)
+    if velocity == "logged":
+        assert log.qd_logged is not None  # checked above
+        lag = velocity_lag(log.qd_logged, qd, log.dt)
+        metadata["velocity"] = {"source": "logged", "lag_s": lag.seconds, "correlation": lag.correlation,
+                                "reason": lag.describe()}
+        qd = np.where(np.isfinite(qd), log.qd_logged, np.nan)
     return MeasuredKinematics(
         time=log.time, q=q, qd=qd, qdd=qdd, tau=tau, contact=log.contact, base=log.base,
-        tau_f_true=log.tau_f_true, metadata=dict(log.metadata), smoother=smoother)
+        tau_f_true=log.tau_f_true, metadata=metadata, smoother=smoother)
+
+
+def time_base(log: Log) -> np.ndarray | None:
+    """The non-uniform time base a log is differentiated on (N,) [s]: ``log.clock.t`` when its
+    clock is not uniform; None (a constant period, ``log.dt``) otherwise.
+
+    Raises:
+        InputError: a clock of another length than the log.
+    """
+    clock = log.clock
+    if clock is None or clock.uniform:
+        return None
+    if len(clock.t) != len(log.time):
+        raise InputError(f"{log.source}: a clock of {len(clock.t)} samples for a log of {len(log.time)}")
+    return clock.t

@@ -1,0 +1,289 @@
+"""A MuJoCo model (MJCF) of the robot with the identified friction, armature and inertias.
+
+Built from the robot's URDF by MuJoCo's own URDF import (:func:`urdf_spec`): visual and
+collision geometry dropped (no ``package://`` path to resolve, no contact), the URDF's
+``<dynamics>`` dropped (the friction is the exported one only), static links fused into their
+bodies as Pinocchio merges them. A floating-base robot gets a free joint at its root link; a
+fixed-base one (:attr:`Robot.floating_base` false, e.g. the KUKA LWR4+) has its root link welded
+to the world where the URDF puts it. The robot's locked joints (:attr:`Robot.locked_joints`) are
+welded at their positions, so that the joints are :attr:`Robot.actuated`, as in the Pinocchio model.
+
+Per actuated joint (:mod:`wbfriction.export.mapping`): ``damping = F_v`` [N·m·s/rad],
+``frictionloss = F_c`` [N·m], ``armature`` [kg·m^2] (the given one, else the robot model's
+``armature``, zero unless its configuration sets one); a joint without identified friction has
+none. Identified inertias (a ``pin.Model`` of the robot) go through
+:func:`wbfriction.inertia.urdf.write_urdf` into the URDF the model is built from.
+
+What ``mujoco.mj_inverse`` returns with these fields (MuJoCo 4 defaults: continuous-time inverse,
+``invdiscrete`` off; no contact since there is no geometry; joint limits inactive inside them):
+
+.. math::
+
+    \\texttt{qfrc\\_inverse} = M(q)\\,\\ddot q + c(q, \\dot q) + \\texttt{damping}\\,\\dot q - f_{loss},
+    \\qquad f_{loss} = \\operatorname{clip}\\Big(-\\frac{\\ddot q + b\\,\\dot q}{R},\\,
+                     -\\texttt{frictionloss},\\, \\texttt{frictionloss}\\Big)
+
+with ``M`` including the armature on its diagonal (as Pinocchio's ``rnea`` with ``model.armature``),
+``f_loss`` the friction-loss constraint force (``efc_force`` of the rows with ``efc_type ==
+mjCNSTR_FRICTION_DOF``). MuJoCo's soft-constraint inverse (computation chapter, "Dual problem":
+``f = argmin_{|f| <= frictionloss} R f^2 / 2 + f (a_c - a_ref)``) gives it analytically, with
+``a_c = qdd`` and the reference acceleration ``a_ref = -b qd`` of a friction row (no position
+residual): ``b = 2 / (solimp[1] solref[0])`` (default ``2 / (0.95 * 0.02) = 105.3 1/s``) and
+``R = (1 - solimp[0]) / solimp[0] * dof_invweight0`` (default ``solimp[0] = 0.9``; MuJoCo's
+diagonal approximation of ``M^-1``, frozen at ``qpos0``). So mj_inverse's dry friction is
+
+* ``frictionloss * sgn(qdd + b qd)`` outside a narrow band ``|qdd + b qd| < frictionloss * R``:
+  Coulomb friction whose sign follows ``qd + qdd / b``, i.e. it reverses about ``qdd / b`` before
+  the velocity does (at 5 rad/s² that is 0.05 rad/s), where model (3.5) reverses with ``tanh(a qd)``;
+* linear, ``(qdd + b qd) / R``, inside the band; zero at rest (``qd = qdd = 0``: mj_inverse holds
+  no static friction).
+
+Compared with the torque of model (3.5), ``tau = rnea + F_v qd + F_c tanh(a qd)(1 + S e^...) + tau_os``,
+the MuJoCo model keeps ``F_v qd`` exactly and ``F_c`` away from reversals, and drops the
+Stribeck bump, the tanh and ``tau_os`` (:mod:`wbfriction.export.mapping`).
+
+The written MJCF (:func:`write_mjcf`) is MuJoCo's own ``MjSpec.to_xml``, whose numbers have 6
+significant digits, with every number of the bodies, inertials and joints rewritten from the
+compiled model at full precision (and the frames MuJoCo writes for fused links folded into the
+bodies' placements): it reloads to the same model.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Mapping
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+from lxml import etree as ET
+
+from wbfriction.exceptions import ModelError
+from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports
+from wbfriction.export.urdf import identified_parameters, read_urdf
+from wbfriction.inertia.urdf import write_urdf
+from wbfriction.logs.tables import write_atomic
+from wbfriction.model.robot import Robot
+
+DROPPED_TAGS = ("gazebo", "transmission", "mujoco")
+"""Top-level URDF elements :func:`urdf_spec` removes (simulator extensions; its own ``<mujoco>`` block replaces any)."""
+
+
+def urdf_spec(urdf: str | Path, free_joint: bool = True) -> mujoco.MjSpec:
+    """The MuJoCo spec of a URDF's kinematic tree and inertias (module docstring).
+
+    Visual and collision geometry, ``<dynamics>``, Gazebo, transmission and MuJoCo extension tags
+    are removed; of an element a joint repeats (a second ``<origin>``), the first is kept, as
+    Pinocchio's parser does. MuJoCo compiles it with ``fusestatic`` (links on fixed joints fused
+    into their parent body) and ``balanceinertia`` off (inertias as given).
+
+    Args:
+        urdf: the URDF file.
+        free_joint: add a free joint at the root link (unless it has one): a floating base.
+            Otherwise the root link is welded to the world at the origin.
+
+    Raises:
+        InputError: an unreadable URDF.
+        ModelError: a URDF MuJoCo cannot read.
+    """
+    root = read_urdf(urdf).getroot()
+    for link in root.findall("link"):
+        for e in [*link.findall("visual"), *link.findall("collision")]:
+            link.remove(e)
+    for joint in root.findall("joint"):
+        seen: set[str] = set()
+        for e in list(joint):
+            if e.tag == "dynamics" or e.tag in seen:
+                joint.remove(e)
+            elif isinstance(e.tag, str):
+                seen.add(e.tag)
+    for e in [e for tag in DROPPED_TAGS for e in root.findall(tag)]:
+        root.remove(e)
+    extension = ET.SubElement(root, "mujoco")
+    ET.SubElement(extension, "compiler", discardvisual="true", fusestatic="true", balanceinertia="false")
+    try:
+        spec = mujoco.MjSpec.from_string(ET.tostring(root, encoding="unicode"))
+    except Exception as exc:  # mujoco raises ValueError with its parser's message
+        raise ModelError(f"{urdf}: MuJoCo cannot read the URDF: {exc}") from None
+    base = spec.worldbody.first_body()
+    if free_joint and base is not None and not any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in base.joints):
+        base.add_freejoint()
+    return spec
+
+
+def _lock_joint(spec: mujoco.MjSpec, name: str, value: float) -> None:
+    """Weld a hinge or slide joint at ``value`` [rad or m]: its body placed there, the joint deleted."""
+    joint = spec.joint(name)
+    if joint is None:
+        raise ModelError(f"MuJoCo model has no joint '{name}' to lock")
+    body = joint.parent
+    flat = np.zeros(9)
+    mujoco.mju_quat2Mat(flat, np.asarray(body.quat, dtype=float))
+    rot = flat.reshape(3, 3)
+    axis = np.asarray(joint.axis, dtype=float) / np.linalg.norm(joint.axis)
+    if joint.type == mujoco.mjtJoint.mjJNT_HINGE:
+        dq, q, turn = np.zeros(4), np.zeros(4), np.zeros(9)
+        mujoco.mju_axisAngle2Quat(dq, axis, value)
+        mujoco.mju_quat2Mat(turn, dq)
+        p = np.asarray(joint.pos, dtype=float)  # the rotation is about the axis through the joint's position
+        body.pos = np.asarray(body.pos, dtype=float) + rot @ (p - turn.reshape(3, 3) @ p)
+        mujoco.mju_mulQuat(q, np.asarray(body.quat, dtype=float), dq)
+        body.quat = q
+    elif joint.type == mujoco.mjtJoint.mjJNT_SLIDE:
+        body.pos = np.asarray(body.pos, dtype=float) + rot @ axis * value
+    else:
+        raise ModelError(f"locked joint '{name}' is neither a hinge nor a slide in MuJoCo")
+    spec.delete(joint)
+
+
+def _armature(robot: Robot, name: str, exp: JointExport | None) -> float:
+    if exp is not None and exp.armature is not None:
+        return exp.armature
+    model = robot.model
+    return float(model.armature[model.idx_vs[model.getJointId(name)]])
+
+
+def mujoco_spec(robot: Robot, friction: Mapping[str, FrictionLike], armature: Mapping[str, float] | None = None,
+                inertias: pin.Model | None = None) -> mujoco.MjSpec:
+    """The MuJoCo spec of ``robot`` with the identified friction and armature (module docstring).
+
+    Args:
+        robot: the robot; its URDF is read, :attr:`Robot.floating_base` decides the free joint.
+        friction: joint -> fitted friction of model (3.5) (:func:`wbfriction.friction.io.read_params`).
+        armature: joint -> reflected rotor inertia [kg·m^2]; a joint not in it keeps the robot
+            model's ``armature``.
+        inertias: a model of ``robot`` with identified inertias, or None (the URDF's).
+
+    Raises:
+        InputError: friction that is not dissipative, a joint the robot does not actuate, an
+            inertia model of another robot.
+        ModelError: a URDF MuJoCo cannot read, or whose joints are not the robot's.
+    """
+    joints = joint_exports(friction, armature, robot)
+    if inertias is None:
+        spec = urdf_spec(robot.urdf, robot.floating_base)
+    else:
+        pi = identified_parameters(robot, inertias)
+        with tempfile.TemporaryDirectory(prefix="wbfriction-mjcf-") as tmp:
+            path = Path(tmp) / Path(robot.urdf).name
+            write_urdf(robot, pi, path)
+            spec = urdf_spec(path, robot.floating_base)
+    for name, value in robot.locked_joints.items():
+        _lock_joint(spec, name, value)
+    names = {j.name for j in spec.joints if j.type != mujoco.mjtJoint.mjJNT_FREE}
+    if names != set(robot.actuated):
+        odd = sorted(names.symmetric_difference(robot.actuated))
+        raise ModelError(f"{robot.urdf}: the MuJoCo model's joints are not robot '{robot.name}''s "
+                         f"(e.g. '{odd[0]}')")
+    for name in robot.actuated:
+        joint, exp = spec.joint(name), joints.get(name)
+        damping = np.zeros_like(np.asarray(joint.damping, dtype=float))
+        damping[0] = exp.viscous if exp is not None and exp.viscous is not None else 0.0
+        joint.damping = damping
+        joint.frictionloss = exp.coulomb if exp is not None and exp.coulomb is not None else 0.0
+        joint.armature = _armature(robot, name, exp)
+    return spec
+
+
+def compile_spec(spec: mujoco.MjSpec, source: str | Path = "MJCF") -> mujoco.MjModel:
+    """``spec.compile()``, its errors as :class:`ModelError` (named with ``source``)."""
+    try:
+        return spec.compile()
+    except Exception as exc:  # mujoco raises ValueError with the compiler's message
+        raise ModelError(f"{source}: MuJoCo cannot compile the model: {exc}") from None
+
+
+def mujoco_model(robot: Robot, friction: Mapping[str, FrictionLike], armature: Mapping[str, float] | None = None,
+                 inertias: pin.Model | None = None) -> mujoco.MjModel:
+    """The compiled MuJoCo model of :func:`mujoco_spec` (same arguments and errors).
+
+    Joints are addressed by name (``mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)``,
+    ``model.jnt_dofadr``): MuJoCo orders them by its own tree traversal.
+
+    Examples:
+        >>> mj = mujoco_model(robot, read_params("params.json"), {"lwr_0_joint": 0.01})  # doctest: +SKIP
+        >>> mj0 = mujoco_model(robot, {})  # the same robot without friction (nor given armature)  # doctest: +SKIP
+    """
+    return compile_spec(mujoco_spec(robot, friction, armature, inertias), robot.urdf)
+
+
+def _num(values) -> str:
+    """Numbers as the shortest text that reads back to the same doubles."""
+    return " ".join(repr(float(x)) for x in np.atleast_1d(values))
+
+
+def _unwrap_frames(root: ET._Element) -> None:
+    """Replace every ``<frame>`` by its children (deepest first): the bodies' placements are then
+    set from the compiled model, relative to their parent body."""
+    for frame in reversed(list(root.iter("frame"))):
+        parent = frame.getparent()
+        index = parent.index(frame)
+        for child in reversed(list(frame)):
+            parent.insert(index, child)
+        parent.remove(frame)
+
+
+def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel) -> str:
+    """The MJCF text of ``spec`` (compiled as ``model``) at full precision (module docstring): the
+    bodies' ``pos``, ``quat`` and ``<inertial>``, the joints' ``pos``, ``axis``, ``range``,
+    ``actuatorfrcrange``, ``damping``, ``frictionloss`` and ``armature`` from ``model``.
+
+    Raises:
+        ModelError: a body or joint of the text that ``model`` does not have by name.
+    """
+    root = ET.fromstring(spec.to_xml().encode())
+    _unwrap_frames(root)
+
+    def ident(kind: mujoco.mjtObj, name: str | None) -> int:
+        i = mujoco.mj_name2id(model, kind, name or "")
+        if i < 0:
+            raise ModelError(f"the MJCF's {kind.name} '{name}' is not in the compiled model")
+        return i
+
+    for body in root.iter("body"):
+        b = ident(mujoco.mjtObj.mjOBJ_BODY, body.get("name"))
+        body.set("pos", _num(model.body_pos[b]))
+        body.set("quat", _num(model.body_quat[b]))
+        inertial = body.find("inertial")
+        if inertial is not None:
+            for key in ("fullinertia", "diaginertia"):
+                inertial.attrib.pop(key, None)
+            inertial.set("pos", _num(model.body_ipos[b]))
+            inertial.set("quat", _num(model.body_iquat[b]))
+            inertial.set("mass", _num(model.body_mass[b]))
+            inertial.set("diaginertia", _num(model.body_inertia[b]))
+        for joint in body.findall("joint"):
+            if joint.get("type") == "free":
+                continue
+            j = ident(mujoco.mjtObj.mjOBJ_JOINT, joint.get("name"))
+            dof = model.jnt_dofadr[j]
+            joint.set("pos", _num(model.jnt_pos[j]))
+            joint.set("axis", _num(model.jnt_axis[j]))
+            if "range" in joint.attrib:
+                joint.set("range", _num(model.jnt_range[j]))
+            if "actuatorfrcrange" in joint.attrib:
+                joint.set("actuatorfrcrange", _num(model.jnt_actfrcrange[j]))
+            poly = model.dof_dampingpoly[dof]
+            joint.set("damping", _num([model.dof_damping[dof], *poly] if np.any(poly) else model.dof_damping[dof]))
+            joint.set("frictionloss", _num(model.dof_frictionloss[dof]))
+            joint.set("armature", _num(model.dof_armature[dof]))
+    ET.indent(root, "  ")
+    return ET.tostring(root, encoding="unicode") + "\n"
+
+
+def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | Path,
+               armature: Mapping[str, float] | None = None, inertias: pin.Model | None = None) -> mujoco.MjModel:
+    """Write the MJCF of :func:`mujoco_spec` at full precision (:func:`mjcf_xml`), atomically.
+
+    Returns:
+        the compiled model the file holds.
+
+    Raises:
+        what :func:`mujoco_spec` raises; InputError: an output folder that does not exist.
+    """
+    spec = mujoco_spec(robot, friction, armature, inertias)
+    model = compile_spec(spec, robot.urdf)
+    text = mjcf_xml(spec, model)
+    write_atomic(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return model

@@ -1,0 +1,112 @@
+"""The robot's URDF with the identified friction in ``<dynamics>``, and identified inertias if given.
+
+Each exported joint gets ``<dynamics damping="F_v" friction="F_c"/>`` (:mod:`wbfriction.export.mapping`:
+viscous [N·m·s/rad] and Coulomb [N·m] friction of model (3.5); the Stribeck bump, its tanh slope
+and the offset tau_os have no URDF field). URDF has no armature field either: the armature is not
+written (MJCF and Isaac Lab hold it). Everything else is the given URDF's: other joints keep their
+``<dynamics>``, comments and meshes stay. Identified inertias go in through
+:func:`wbfriction.inertia.urdf.write_urdf` (bodies merged by Pinocchio split back over their links).
+
+Pinocchio reads the written file's ``<dynamics>`` into ``model.damping`` and ``model.friction``
+(no algorithm of Pinocchio uses them); MuJoCo's URDF import into ``damping`` and ``frictionloss``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+from lxml import etree as ET
+
+from wbfriction.exceptions import InputError
+from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports
+from wbfriction.inertia.regressor import body_parameters
+from wbfriction.inertia.urdf import write_urdf
+from wbfriction.logs.tables import write_atomic
+from wbfriction.model.robot import Robot
+
+
+def identified_parameters(robot: Robot, inertias: pin.Model) -> np.ndarray:
+    """The body parameters (n_bodies, 10) of ``inertias``, a model of ``robot`` with identified
+    inertias (e.g. :func:`wbfriction.inertia.regressor.with_body_parameters` of it).
+
+    Raises:
+        InputError: a model whose joints are not ``robot.model``'s.
+    """
+    if list(inertias.names) != list(robot.model.names):
+        raise InputError(f"inertias: the model's joints are not those of robot '{robot.name}'")
+    return body_parameters(inertias)
+
+
+def read_urdf(path: str | Path) -> ET._ElementTree:
+    """The URDF's XML tree (lxml: comments kept).
+
+    Raises:
+        InputError: a file that cannot be read or is not XML.
+    """
+    try:
+        return ET.parse(str(path))
+    except (OSError, ET.XMLSyntaxError) as exc:
+        raise InputError(f"{path}: not a readable URDF ({exc})") from None
+
+
+def set_dynamics(root: ET._Element, joints: Mapping[str, JointExport]) -> None:
+    """Set ``<dynamics damping friction>`` of every joint of ``joints`` with friction (in place),
+    after its other children for a joint that had none.
+
+    Raises:
+        InputError: a joint the URDF does not have.
+    """
+    elements = {j.get("name"): j for j in root.findall("joint")}
+    for name, exp in joints.items():
+        if not exp.has_friction:
+            continue
+        joint = elements.get(name)
+        if joint is None:
+            raise InputError(f"the URDF has no joint '{name}'")
+        dyn = joint.find("dynamics")
+        if dyn is None:
+            dyn = ET.SubElement(joint, "dynamics")
+            previous = dyn.getprevious()
+            if previous is not None:  # indented as the joint's other children
+                dyn.tail, previous.tail = previous.tail, joint.text
+        dyn.set("damping", repr(float(exp.viscous or 0.0)))
+        dyn.set("friction", repr(float(exp.coulomb or 0.0)))
+
+
+def write_friction_urdf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | Path,
+                        armature: Mapping[str, float] | None = None,
+                        inertias: pin.Model | None = None) -> tuple[str, ...]:
+    """Write ``robot``'s URDF with the identified friction (module docstring), atomically.
+
+    Args:
+        robot: the robot (its :attr:`Robot.urdf` is the file rewritten).
+        friction: joint -> fitted friction of model (3.5) (:func:`wbfriction.friction.io.read_params`).
+        path: the URDF to write.
+        armature: joint -> [kg·m^2]: only checked (URDF has no field for it).
+        inertias: a model of ``robot`` with identified inertias, or None (the URDF's kept).
+
+    Returns:
+        what :func:`wbfriction.inertia.urdf.write_urdf` returns with ``inertias`` (the joints whose
+        body went whole to the child link), else ().
+
+    Raises:
+        InputError: friction that is not dissipative, a joint the robot does not actuate, an
+            inertia model of another robot, an unreadable URDF, an output folder that does not exist.
+    """
+    joints = joint_exports(friction, armature, robot)
+    pi = None if inertias is None else identified_parameters(robot, inertias)
+    moved: tuple[str, ...] = ()
+
+    def write(tmp: Path) -> None:
+        nonlocal moved
+        if pi is not None:
+            moved = write_urdf(robot, pi, tmp)
+        tree = read_urdf(tmp if pi is not None else robot.urdf)
+        set_dynamics(tree.getroot(), joints)
+        tree.write(str(tmp), xml_declaration=True, encoding="utf-8")
+
+    write_atomic(path, write)
+    return moved

@@ -1,0 +1,87 @@
+"""Torques predicted by an inertia model and a friction model, against the measured ones.
+
+A model of the robot's dynamics (the URDF's inertias, armature included) and of its friction
+predicts each joint's torque from the measured motion,
+
+.. math:: \\tau_{pred} = M(q)\\ddot q + h(q, \\dot q) - \\tau_{f,model}(\\dot q)
+          = M(q)\\ddot q + h(q, \\dot q) + f(\\dot q),
+
+(sign convention of :mod:`wbfriction.friction.models`: ``tau_f = -f(qd)``). The estimate
+(5.13) is ``tau_f = M qdd + h - tau``, so the prediction error is the estimated friction less
+the model's, ``tau - tau_pred = -(tau_f - tau_f,model)``: on a log the model was not fitted
+on (held-out data), its RMS says how well the model *predicts*, the test a real robot's model
+must pass (thesis ch. 7: exact in simulation, unphysical on the robot).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from wbfriction.friction.estimate import FrictionEstimate
+
+
+class FrictionCurve(Protocol):
+    """Anything that gives the friction characteristic ``f(qd)`` [N·m] (a model's parameters)."""
+
+    def f(self, qd: ArrayLike) -> np.ndarray: ...
+
+
+@dataclass(frozen=True)
+class TorquePrediction:
+    """How well a model predicts a log's torques, per joint.
+
+    Attributes:
+        joints: joint names (n,).
+        samples: valid samples per joint (n,).
+        rms: RMS of measured - predicted torque with the friction model [N·m] (n,); NaN for a
+            joint without a friction model or without a valid sample.
+        rms_rigid_body: the same with the rigid-body model alone (no friction) [N·m] (n,).
+        rms_torque: RMS of the measured torque itself [N·m] (n,), for scale.
+    """
+
+    joints: tuple[str, ...]
+    samples: np.ndarray
+    rms: np.ndarray
+    rms_rigid_body: np.ndarray
+    rms_torque: np.ndarray
+
+
+def _rms(x: np.ndarray, valid: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(x[valid] ** 2))) if valid.any() else float("nan")
+
+
+def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve],
+                    tau: np.ndarray | None = None) -> TorquePrediction:
+    """Torque prediction errors of a model on the valid samples of an estimate made with its inertias.
+
+    Args:
+        est: the friction estimate of a log, made with the model's URDF (its ``tau_f`` is
+            ``M qdd + h - tau``); with a filtering scheme, the model goes through its smoother.
+        friction: joint -> friction model (its ``f(qd)``), e.g. the fitted parameters of
+            :func:`~wbfriction.friction.io.read_params`; joints without one get NaN.
+        tau: the measured torques (N, n) [N·m], for :attr:`TorquePrediction.rms_torque` only
+            (NaN if None).
+
+    Returns:
+        :class:`TorquePrediction`.
+    """
+    n = len(est.joints)
+    rms, rigid, scale = np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan)
+    samples = est.valid.sum(axis=0)
+    for i, joint in enumerate(est.joints):
+        valid = est.valid[:, i] & np.isfinite(est.tau_f[:, i])
+        rigid[i] = _rms(est.tau_f[:, i], valid)
+        if joint in friction:
+            model = -friction[joint].f(est.qd[:, i])
+            if est.smoother is not None:  # the estimate is the friction seen through the filter: so is the model
+                model = est.smoother(np.where(valid, model, np.nan)[:, None])[:, 0]
+                valid &= np.isfinite(model)
+            rms[i] = _rms(est.tau_f[:, i] - model, valid)
+        if tau is not None:
+            scale[i] = _rms(tau[:, i], valid)
+    return TorquePrediction(tuple(est.joints), samples, rms, rigid, scale)

@@ -1,0 +1,27 @@
+"""Files in, numbers out: how well a model (the URDF a friction table was estimated with, and fitted
+friction parameters) predicts the torques of a log, typically one it was not fitted on."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from wbfriction.friction.io import read_friction_file, read_params
+from wbfriction.friction.predict import TorquePrediction, predict_torques
+
+
+def predict_file(friction: str | Path, params: str | Path) -> TorquePrediction:
+    """Torque prediction errors (:func:`~wbfriction.friction.predict.predict_torques`) of the friction
+    model ``params`` on the friction table ``friction``.
+
+    Args:
+        friction: a friction table (``wbfriction estimate`` of the held-out log, with the URDF
+            whose inertias are tested).
+        params: the parameters JSON (``wbfriction fit`` of the training logs' table, estimated
+            with the same URDF).
+
+    Raises:
+        InputError: what reading either file raises.
+    """
+    fits = read_params(params)
+    est = read_friction_file(friction)
+    return predict_torques(est, {j: f.params for j, f in fits.items() if f.params is not None})

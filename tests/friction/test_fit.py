@@ -1,0 +1,231 @@
+"""The fit of each friction model, the flags of parameters at their bounds, and the choice of
+model by held-out error (wbfriction.friction.fit)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from wbfriction.exceptions import InputError
+from wbfriction.friction.fit import (
+    UPPER,
+    HeldOutScore,
+    choose_model,
+    fit_friction,
+    fit_joints,
+    held_out_rms,
+    held_out_split,
+)
+from wbfriction.friction.models import CoulombViscousParams, FrictionParams, StribeckParams
+from wbfriction.signals.filters import SavgolSmoother
+
+DT = 2e-3
+T = np.arange(4000) * DT
+QD = 1.2 * np.sin(2 * np.pi * 0.31 * T) + 0.4 * np.sin(2 * np.pi * 1.7 * T + 0.5)
+"""A joint's velocity over 8 s [rad/s]: slow and fast swings, reversals at several accelerations."""
+
+
+def _truth(model: str, rng: np.random.Generator):
+    F_v, F_c, tau_os = rng.uniform(0.05, 1.0), rng.uniform(0.2, 2.0), rng.uniform(-1.0, 1.0)
+    if model == "coulomb-viscous":
+        return CoulombViscousParams(F_v, F_c, tau_os)
+    if model == "stribeck":
+        return StribeckParams(F_v, F_c, F_c * rng.uniform(1.3, 2.0), rng.uniform(0.1, 0.3), tau_os)
+    return FrictionParams(F_v, F_c, rng.uniform(0.3, 1.0), rng.uniform(0.1, 0.3), tau_os, rng.uniform(10.0, 60.0))
+
+
+@settings(max_examples=10, deadline=None)
+@given(st.sampled_from(["coulomb-viscous", "stribeck"]), st.integers(0, 2**16))
+def test_each_model_recovers_its_injected_parameters_noise_free(model, seed):
+    """Data made by a model, fitted with that model: its parameters come back, none at a bound."""
+    truth = _truth(model, np.random.default_rng(seed))
+    res = fit_friction(QD, truth.torque(QD), model=model)
+    assert res.success and res.model == model and isinstance(res.params, type(truth))
+    np.testing.assert_allclose(res.params.as_vector(), truth.as_vector(), rtol=1e-5, atol=1e-7)
+    assert res.rms_residual < 1e-6 and res.bounded() == ()
+
+
+@pytest.mark.parametrize("model", ["coulomb-viscous", "stribeck", "thesis"])
+def test_each_model_recovers_its_injected_parameters_with_noise(model):
+    """Noise 0.03 N·m: every parameter within 5 standard errors (and 10 %) of the injected one."""
+    for seed in range(2):
+        rng = np.random.default_rng(seed)
+        truth = _truth(model, rng)
+        res = fit_friction(QD, truth.torque(QD) + rng.normal(0.0, 0.03, QD.size), model=model)
+        assert res.model == model and res.bounded() == (), res
+        for name in truth.names:
+            est, true, se = getattr(res.params, name), getattr(truth, name), res.stderr[name]
+            assert abs(est - true) < 5 * se and abs(est - true) < 0.1 * max(abs(true), 0.1), (name, est, true, se)
+
+
+def test_coulomb_viscous_truth_runs_the_thesis_fit_into_bounds_and_auto_takes_coulomb_viscous():
+    """(3.5) holds Coulomb friction only as a -> infinity: fitted to exact sgn data its slope
+    ends at the bound, and says so; ``auto`` fits the model that made the data, off its bounds."""
+    truth = CoulombViscousParams(F_v=0.3, F_c=0.8, tau_os=0.2)
+    thesis = fit_friction(QD, truth.torque(QD), model="thesis")
+    assert thesis.at_bound["a"] and thesis.params.a > 0.999 * UPPER[5]
+    for seed in range(3):
+        rng = np.random.default_rng(seed)
+        tau_f = truth.torque(QD) + rng.normal(0.0, 0.05, QD.size)
+        auto = fit_friction(QD, tau_f, model="auto")
+        assert auto.model == "coulomb-viscous" and auto.selection.chosen == "coulomb-viscous"
+        assert auto.bounded() == () and not any(auto.at_bound.values())
+        np.testing.assert_allclose(auto.params.as_vector(), truth.as_vector(), atol=0.01)
+        assert [s.model for s in auto.selection.scores] == ["coulomb-viscous", "stribeck", "thesis"]
+        assert auto.selection.reason.startswith("coulomb-viscous:")
+
+
+def test_stribeck_truth_without_coulomb_level_is_the_real_arm_symptom():
+    """Static friction that decays to no Coulomb level (F_c = 0): (3.5) can only write it as
+    F_c -> 0 with S at its bound 50 (what a real arm's log gave); it is flagged, and ``auto``
+    takes the Stribeck model, which holds it exactly."""
+    truth = StribeckParams(F_v=0.4, F_c=0.0, F_s=1.0, v_s=0.15, tau_os=0.3)
+    rng = np.random.default_rng(4)
+    tau_f = truth.torque(QD) + rng.normal(0.0, 0.03, QD.size)
+    thesis = fit_friction(QD, tau_f, model="thesis")
+    assert thesis.at_bound["S"] and thesis.params.S == pytest.approx(50.0) and thesis.params.F_c < 0.05
+    auto = fit_friction(QD, tau_f, model="auto")
+    assert auto.model == "stribeck"
+    assert abs(auto.params.F_s - 1.0) < 0.05 and abs(auto.params.v_s - 0.15) < 0.02 and auto.params.F_c < 0.05
+
+
+@pytest.mark.parametrize("truth", [StribeckParams(F_v=0.3, F_c=0.6, F_s=1.2, v_s=0.15, tau_os=-0.2),
+                                   FrictionParams(F_v=0.3, F_c=0.6, S=1.0, v_s=0.15, tau_os=-0.2, a=30.0)])
+def test_stribeck_truth_makes_auto_pick_a_stribeck_model(truth):
+    rng = np.random.default_rng(1)
+    tau_f = truth.torque(QD) + rng.normal(0.0, 0.05, QD.size)
+    auto = fit_friction(QD, tau_f, model="auto")
+    assert auto.model in ("stribeck", "thesis")
+    cv = next(s for s in auto.selection.scores if s.model == "coulomb-viscous")
+    assert cv.held_out_rms > 1.5 * min(s.held_out_rms for s in auto.selection.scores)
+    values = truth.values_in(auto.model) if isinstance(truth, FrictionParams) else truth.to_dict()
+    for name in ("F_c", "v_s", "tau_os"):
+        assert abs(getattr(auto.params, name) - values[name]) < 0.1 * abs(values[name]), name
+
+
+def test_held_out_blocks_are_contiguous_disjoint_and_cover_the_valid_samples():
+    use = np.ones(1000, dtype=bool)
+    use[[3, 500, 501, 977]] = False
+    train, held_out = held_out_split(use)
+    assert not (train & held_out).any() and np.array_equal(train | held_out, use)
+    # three held-out blocks of a tenth each: three runs of held-out samples among the usable
+    # ones in time order, the first block trained on
+    flags = held_out[np.flatnonzero(use)].astype(int)
+    starts, ends = np.flatnonzero(np.diff(flags) == 1) + 1, np.flatnonzero(np.diff(flags) == -1) + 1
+    assert len(starts) == len(ends) == 3 and flags[0] == 0
+    assert all(abs((e - b) - 99.6) <= 1 for b, e in zip(starts, ends))
+    assert all(abs(b - k * 99.6) <= 1 for b, k in zip(starts, (1, 4, 7)))
+
+
+def test_held_out_errors_come_from_samples_the_fits_did_not_see():
+    """Wrecking the held-out samples' estimates changes no candidate's fit: each score is the
+    training fit (identical to a fit on the clean data) evaluated on the wrecked samples."""
+    truth = StribeckParams(F_v=0.3, F_c=0.6, F_s=1.0, v_s=0.15, tau_os=0.1)
+    rng = np.random.default_rng(2)
+    tau_f = truth.torque(QD) + rng.normal(0.0, 0.05, QD.size)
+    use = np.ones(QD.size, dtype=bool)
+    train, held_out = held_out_split(use)
+    wrecked = tau_f.copy()
+    wrecked[held_out] = rng.normal(0.0, 50.0, held_out.sum())
+    auto = fit_friction(QD, wrecked, model="auto", selection_tolerance=0.0)
+    assert auto.selection.n_train == train.sum() and auto.selection.n_held_out == held_out.sum()
+    for score in auto.selection.scores:
+        clean = fit_friction(QD, tau_f, mask=train, model=score.model)
+        assert score.held_out_rms == pytest.approx(held_out_rms(clean.params, QD, wrecked, held_out), rel=1e-9)
+        assert score.held_out_rms > 40.0  # scored on the wrecked samples, fitted without them
+
+
+def test_auto_fits_the_chosen_model_as_if_it_had_been_named():
+    truth = FrictionParams(F_v=0.2, F_c=0.5, S=0.8, v_s=0.2, tau_os=0.1, a=20.0)
+    rng = np.random.default_rng(3)
+    tau_f = truth.torque(QD) + rng.normal(0.0, 0.05, QD.size)
+    auto = fit_friction(QD, tau_f, model="auto")
+    named = fit_friction(QD, tau_f, model=auto.model)
+    assert auto.params == named.params and auto.stderr == named.stderr and auto.at_bound == named.at_bound
+    assert auto.n_samples == QD.size and named.selection is None
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.lists(st.floats(0.01, 10.0), min_size=3, max_size=3), st.floats(0.0, 0.5))
+def test_choose_model_takes_the_simplest_within_tolerance_of_the_best(rms, tolerance):
+    scores = tuple(HeldOutScore(m, r) for m, r in zip(("coulomb-viscous", "stribeck", "thesis"), rms))
+    chosen, reason = choose_model(scores, tolerance)
+    i = [s.model for s in scores].index(chosen)
+    assert rms[i] <= (1 + tolerance) * min(rms)
+    assert all(r > (1 + tolerance) * min(rms) for r in rms[:i])
+    assert reason.startswith(f"{chosen}:")
+
+
+def test_choose_model_by_hand():
+    scores = (HeldOutScore("coulomb-viscous", 1.015), HeldOutScore("stribeck", 1.0), HeldOutScore("thesis", 0.999))
+    assert choose_model(scores, 0.02)[0] == "coulomb-viscous"
+    assert choose_model(scores, 0.01)[0] == "stribeck"
+    assert choose_model(scores, 0.0)[0] == "thesis"
+    assert choose_model((HeldOutScore("coulomb-viscous", np.nan), HeldOutScore("stribeck", 2.0)))[0] == "stribeck"
+    with pytest.raises(InputError, match="no model"):
+        choose_model((HeldOutScore("thesis", np.nan),))
+
+
+def test_parameters_pressed_against_a_bound_are_flagged():
+    """Friction with a negative viscous slope: the fit's F_v stops at its bound 0 and is flagged;
+    a pure viscous friction leaves F_c at 0, flagged; friction inside the bounds flags nothing."""
+    rng = np.random.default_rng(0)
+    noise = rng.normal(0.0, 0.02, QD.size)
+    negative = fit_friction(QD, -(-0.3 * QD + 0.8 * np.sign(QD)) + noise, model="coulomb-viscous")
+    assert negative.at_bound == {"F_v": True, "F_c": False, "tau_os": False} and negative.params.F_v < 1e-6
+    viscous = fit_friction(QD, CoulombViscousParams(0.3, 0.0, 0.1).torque(QD), model="coulomb-viscous")
+    assert viscous.bounded() == ("F_c",)
+    inside = fit_friction(QD, CoulombViscousParams(0.3, 0.5, 0.1).torque(QD) + noise, model="coulomb-viscous")
+    assert inside.bounded() == ()
+    # the Stribeck model's static friction is bounded below by the Coulomb level
+    flat = fit_friction(QD, CoulombViscousParams(0.3, 0.5, 0.1).torque(QD), model="stribeck")
+    assert flat.at_bound["F_s"] and flat.params.F_s == pytest.approx(flat.params.F_c, abs=1e-6)
+
+
+def test_stribeck_model_through_the_estimate_smoother():
+    """A smoothed estimate is fitted by the model smoothed alike: the injected parameters come back."""
+    truth = StribeckParams(F_v=0.3, F_c=0.6, F_s=1.0, v_s=0.15, tau_os=0.1)
+    smoother = SavgolSmoother(51, 3, DT)
+    res = fit_friction(QD, smoother(truth.torque(QD)), smoother=smoother, model="stribeck")
+    np.testing.assert_allclose(res.params.as_vector(), truth.as_vector(), rtol=1e-4, atol=1e-6)
+    assert res.n_samples == QD.size - 50  # the smoother's half windows at both ends
+
+
+def test_error_percent_compares_each_model_with_the_targets_values_under_its_names():
+    target = FrictionParams(F_v=0.2, F_c=1.0, S=0.5, v_s=0.2, tau_os=0.4, a=40.0)
+    fit = fit_joints(["j"], QD[:, None], StribeckParams(0.22, 1.0, 1.65, 0.2, 0.4).torque(QD)[:, None],
+                     np.ones((QD.size, 1), dtype=bool), targets={"j": target}, model="stribeck")[0]
+    err = fit.error_percent()
+    assert set(err) == {"F_v", "F_c", "F_s", "v_s", "tau_os"}
+    assert err["F_s"] == pytest.approx(10.0, rel=1e-4) and err["F_v"] == pytest.approx(10.0, rel=1e-4)
+    assert err["F_c"] == pytest.approx(0.0, abs=1e-3)
+
+
+def test_bad_model_options_are_refused():
+    tau_f = -QD
+    with pytest.raises(InputError, match="model must be one of"):
+        fit_friction(QD, tau_f, model="lugre")
+    with pytest.raises(InputError, match="x0"):
+        fit_friction(QD, tau_f, model="auto", x0=np.zeros(3))
+    with pytest.raises(InputError, match="F_s can be held only with F_c"):
+        fit_friction(QD, tau_f, model="stribeck", fixed={"F_s": 1.0})
+    with pytest.raises(InputError, match="unknown parameter"):
+        fit_friction(QD, tau_f, model="coulomb-viscous", fixed={"S": 0.0})
+    with pytest.raises(InputError, match="unknown parameter"):
+        fit_friction(QD, tau_f, model="auto", fixed={"b": 0.0})
+
+
+def test_auto_holds_in_each_candidate_the_parameters_it_has():
+    truth = CoulombViscousParams(F_v=0.3, F_c=0.8, tau_os=0.0)
+    rng = np.random.default_rng(5)
+    res = fit_friction(QD, truth.torque(QD) + rng.normal(0, 0.02, QD.size), model="auto",
+                       fixed={"tau_os": 0.0, "S": 0.0})
+    assert res.params.tau_os == 0.0 and res.stderr["tau_os"] == 0.0 and not res.at_bound["tau_os"]
+
+
+def test_too_few_samples_to_hold_out_fit_the_simplest_model():
+    res = fit_friction(QD[:40], -QD[:40], model="auto", min_samples=20)
+    assert res.model == "coulomb-viscous" and "too few samples" in res.selection.reason
+    assert res.selection.scores == ()
