@@ -10,6 +10,10 @@ from pathlib import Path
 
 import pytest
 
+from helpers import KUKA, KUKA_CONFIG, KUKA_URDF, needs_kuka
+from wbfriction.logs.source import read_log
+from wbfriction.model import load_robot
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
@@ -61,3 +65,16 @@ def test_identify_inertia():
     true, _, ident = numbers(r"true ([\d.]+), given ([\d.]+), identified ([\d.]+)", out)
     assert ident == pytest.approx(true, rel=0.01)
     assert "wrote" in out and Path(out.split("wrote ")[1].split(" ")[0]).is_file()
+
+
+@needs_kuka
+def test_kuka_lwr4_convert(tmp_path):
+    """The real KUKA LWR4+ recordings into the log format, stamps untouched; the log then reads."""
+    out = tmp_path / "runs12.parquet"
+    text = run_example("kuka_lwr4_convert.py", str(KUKA / "measurements_1.npz"), str(KUKA / "measurements_2.npz"),
+                       "-o", str(out))
+    assert "10054 rows from 2 recording(s), 7 joints" in text and "stamps kept as recorded" in text
+    robot = load_robot(urdf=KUKA_URDF, config=KUKA_CONFIG)
+    log = read_log(out, robot)
+    assert log.segments == [(0, 5027), (5027, 10054)]  # the half hour between the runs is a gap
+    assert log.clock is not None and log.clock.kind == "jittered"

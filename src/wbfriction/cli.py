@@ -26,15 +26,15 @@ from rich.table import Table
 
 from wbfriction.exceptions import InputError, WbfrictionError
 from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
-from wbfriction.friction.estimate import EstimateOptions, Method
+from wbfriction.friction.estimate import EstimateOptions, Method, resolve_differentiation
 from wbfriction.friction.fit import FitResult, ModelChoice
 from wbfriction.friction.models import ALL_PARAM_NAMES, PARAM_NAMES
 from wbfriction.friction.targets import load_friction_toml
-from wbfriction.inertia.identification import InertialOptions
+from wbfriction.inertia.identification import ArmatureMode, InertialOptions
 from wbfriction.logs.clock import TimeBase
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, write_log
 from wbfriction.logs.source import open_log, read_log
-from wbfriction.logs.tables import TableFile
+from wbfriction.logs.tables import TableFile, write_table
 from wbfriction.model.loading import load_robot
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import Chunking
@@ -46,6 +46,7 @@ from wbfriction.signals.filters import SavgolWeights
 from wbfriction.signals.kinematics import Diff, FilterOptions, TorqueAlignment, Velocity
 from wbfriction.signals.phases import Mask
 from wbfriction.sim import IdealOptions, MujocoOptions, SensorNoise, simulate_ideal, simulate_mujoco
+from wbfriction.sim.arm import ArmOptions, default_arm_friction, simulate_arm
 from wbfriction.sim.ideal import Integrator
 from wbfriction.sim.mujoco_sim import FrictionMode
 from wbfriction.sim.sensors import load_sensors_toml
@@ -179,6 +180,15 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
                       f"({p.samples} samples, down to {p.min_force:.1f} N)", highlight=False)
 
 
+def _run_simulate_arm(r: Robot, output: Path, options: ArmOptions, friction: Optional[Path]) -> None:
+    params = (load_friction_toml(friction, r.groups, r.torque_controlled) if friction is not None
+              else default_arm_friction(r))
+    with _progress(int(options.duration * options.rate), "simulate") as advance:
+        result = simulate_arm(r, params, options=options, progress=advance)
+    write_table(result.table, output)
+    console.print(f"wrote {output} ({result.table.num_rows} samples, {options.duration:g} s, motor currents)")
+
+
 def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: EstimateOptions,
                   bag_map: Optional[Path] = None, max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN,
                   workers: int = 2, chunk_rows: int = 10_000, time_base: TimeBase = "auto") -> None:
@@ -194,6 +204,8 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
                                    max_gap=max_gap, limit_margin=limit_margin, extra_metadata=provenance,
                                    progress=advance, robot=r, source=str(log), time_base=time_base)
     console.print(escape(result.clock), highlight=False, soft_wrap=True)
+    if result.differentiation:
+        console.print(f"differentiation: {escape(result.differentiation)}", highlight=False, soft_wrap=True)
     if opts.velocity == "logged":
         velocity = result.metadata.get("velocity", {})  # measured on the first chunk
         console.print(f"velocity: {escape(velocity.get('reason', 'logged'))} (not compensated)", highlight=False)
@@ -241,8 +253,17 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              noise_seed: Optional[int] = typer.Option(None, help="mujoco: seed of the sensor noise."),
              delay: Optional[float] = typer.Option(None, help="mujoco: measurement-to-command delay [ms], whole "
                                                               "control periods."),
-             log_base: bool = typer.Option(_I.log_base, help="Write the base pose to the log.")) -> None:
-    """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic)."""
+             log_base: bool = typer.Option(_I.log_base, help="Write the base pose to the log."),
+             duration: float = typer.Option(10.0, help="Fixed-base robot (an arm): seconds of excitation "
+                                                       "trajectory.")) -> None:
+    """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
+    fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents."""
+    r = _robot(robot, urdf, config)
+    if not r.floating_base:
+        arm = ArmOptions(duration=duration, encoder_bits=19 if encoder_bits is None else encoder_bits,
+                         torque_std=torque_noise or 0.0, seed=noise_seed or 0)
+        _run_simulate_arm(r, output, arm, friction)
+        return
     gait_opts = GaitOptions(gait=cast(Gait, gait), steps=steps, step_length=step_length, step_width=step_width,
                             turn_angle=turn_angle, lift_height=lift_height)
     _check_simulator(simulator)
@@ -258,7 +279,7 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
         lag = float(table.pop("delay", 0.0))
         options = MujocoOptions(substeps=substeps or _M.substeps, friction=cast(FrictionMode, mujoco_friction),
                                 sensors=SensorNoise(**table), delay=lag, log_base=log_base)
-    _run_simulate(_robot(robot, urdf, config), output, gait_opts, options, friction)
+    _run_simulate(r, output, gait_opts, options, friction)
 
 
 @app.command()
@@ -269,8 +290,9 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
              bag_map: Optional[Path] = MapOpt, max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt,
              workers: int = typer.Option(2, help="Processes estimating chunks of a long log."),
              chunk_rows: int = typer.Option(10_000, help="Rows per chunk (cut at the next contact change)."),
-             diff: str = typer.Option(_E.diff, help="Differentiation: central (6.2), backward (6.3), savgol "
-                                                    "(Savitzky-Golay, 7.1.1), butterworth (7.1.2) or true."),
+             diff: str = typer.Option("auto", help="Differentiation: auto (scheme and window chosen from the "
+                                                   "positions' noise, printed), central (6.2), backward (6.3), "
+                                                   "savgol (Savitzky-Golay, 7.1.1), butterworth (7.1.2) or true."),
              window: int = typer.Option(_F.window, help="savgol: window length L (odd) [samples]."),
              poly_order: int = typer.Option(_F.poly_order, help="savgol: polynomial order k."),
              weights: str = typer.Option(_F.weights, help="savgol: uniform or gaussian weights."),
@@ -295,7 +317,7 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
                                                             "logged (the log's qd.<joint> columns; their lag "
                                                             "is measured and printed).")) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
-    opts = EstimateOptions(diff=cast(Diff, diff), compensate_delay=delay_compensation,
+    opts = EstimateOptions(diff=cast(Diff | Literal["auto"], diff), compensate_delay=delay_compensation,
                            torque_alignment=cast(TorqueAlignment, torque_alignment), mask=cast(Mask, mask),
                            lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
                            ds_regularization=ds_regularization, condition_number=cond, method=cast(Method, method),
@@ -409,7 +431,7 @@ def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in 
                                                      "principal-moment eigenvalues only)."),
                 joints: Optional[str] = typer.Option(None, help="Comma-separated joints to plot (default: the "
                                                                 "legs' joints)."),
-                diff: str = typer.Option(_E.diff, help="Differentiation scheme (see 'estimate')."),
+                diff: str = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
                 mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate').")) -> None:
     """Re-run the estimate with every body's inertia scaled (thesis 7.2, Fig. 7.5/7.6): how the
     friction curves shift (mass) and split into branches (rotational inertia)."""
@@ -421,8 +443,10 @@ def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in 
         raise InputError(f"--part must be one of {', '.join(PARTS)}, got '{part}'")
     values = parse_factors(factors)
     r = _robot(robot, urdf, config)
-    opts = EstimateOptions(diff=cast(Diff, diff), mask=cast(Mask, mask))
-    kin = measure(read_log(log, r), opts.diff)
+    data = read_log(log, r)
+    opts, _ = resolve_differentiation(EstimateOptions(diff=cast(Diff | Literal["auto"], diff), mask=cast(Mask, mask)),
+                                      data)
+    kin = measure(data, cast(Diff, opts.diff), filtering=opts.filtering)
     with console.status("") as status:
         sens = inertia_sensitivity(r, kin, values, cast(InertiaPart, part), opts, progress=status.update)
     names = _joint_list(r, joints)
@@ -511,9 +535,15 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
              holdout: float = typer.Option(_N.holdout, help="Share of the log, at its end, kept out to compare "
                                                             "torque predictions."),
              stride: int = typer.Option(_N.stride, min=1, help="Every stride-th single-support sample is used."),
-             prior: float = typer.Option(_N.prior, help="Relative weight of the prior toward the given model."),
+             prior: Optional[float] = typer.Option(_N.prior, help="Weight of the prior toward the given model, in "
+                                                                  "units of the residual variance; default: chosen "
+                                                                  "by validation from 1e4 down to 1."),
+             armature: str = typer.Option(_N.armature, help="Rotor inertia: known (the TOML's [armature]), "
+                                                            "identify (one per joint, with the friction; for "
+                                                            "motor-current torques) or none (link-side "
+                                                            "torque sensors)."),
              tanh_slope: float = typer.Option(_N.tanh_slope, help="a of the Coulomb term tanh(a qd) [s/rad]."),
-             diff: str = typer.Option(_E.diff, help="Differentiation scheme (see 'estimate')."),
+             diff: str = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
              mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate')."),
              workers: int = FitWorkersOpt) -> None:
     """Identify the inertia model and the friction together from the joint torques of single
@@ -530,18 +560,27 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
     from wbfriction.pipeline.identify import identify_file
 
     r = _robot(robot, urdf, config)
-    opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior)
+    opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior,
+                           armature=cast(ArmatureMode, armature))
     with console.status("") as status:
-        estimate_options = EstimateOptions(diff=cast(Diff, diff), mask=cast(Mask, mask))
+        estimate_options = EstimateOptions(diff=cast(Diff | Literal["auto"], diff), mask=cast(Mask, mask))
         done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
                              options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers)
     doc, moved = done.document, done.moved
     for p in doc["passes"]:
         out.print(f"v_s {p['stribeck_velocity']}: {p['samples']} samples, {p['base_parameters']} base parameters of "
                   f"{p['parameters']}, condition {p['condition']:.3g}, prior {p['prior']:g}; {p['message']}",
-                  highlight=False)
+                  highlight=False, soft_wrap=True)
+        unexcited = p.get("not_excited") or []
+        if unexcited:
+            out.print(f"not excited by this log, kept at the given model: {len(unexcited)} parameters ("
+                      + ", ".join(str(u.get("parameter", u)) if isinstance(u, dict) else str(u) for u in unexcited[:8])
+                      + (", ..." if len(unexcited) > 8 else "") + ")", highlight=False, soft_wrap=True)
     for table in _identify_tables(doc):
         out.print(table)
+    toml = done.armature_toml()
+    if toml is not None:
+        out.print("identified armature [kg·m^2], for the robot's TOML:\n" + escape(toml), highlight=False)
     if moved:
         console.print(f"[yellow]note:[/] the whole identified body went to the child link of {', '.join(moved)} "
                       "(lighter than the links merged with it)")

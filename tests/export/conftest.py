@@ -1,62 +1,50 @@
-"""The KUKA LWR4+ of the real data (a fixed-base arm), built here as a Robot without the project's loader;
-random friction and identified-like inertias."""
+"""The KUKA LWR4+ of the real data (a fixed-base arm), loaded with examples/kuka_lwr4.toml; random friction
+and identified-like inertias."""
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pinocchio as pin
 import pytest
 
+from helpers import KUKA_CONFIG, KUKA_URDF
 from wbfriction.friction.models import FrictionParams
+from wbfriction.model import load_robot
 from wbfriction.model.robot import Robot
 
-REPO = Path(__file__).resolve().parents[2]
 
+def kuka_robot(locked: dict[str, float] | None = None) -> Robot:
+    """The LWR4+ as the project loads a fixed base (examples/kuka_lwr4.toml), with ``locked`` joints
+    removed from the model at their positions."""
+    if not locked:
+        return load_robot(urdf=KUKA_URDF, config=KUKA_CONFIG)
+    import tempfile
 
-def real_data() -> Path | None:
-    """The real-data folder (env WBFRICTION_REAL_DATA, else ``../shared/real-data`` beside the checkout)."""
-    folder = Path(os.environ.get("WBFRICTION_REAL_DATA", REPO / ".." / "shared" / "real-data"))
-    return folder if folder.is_dir() else None
-
-
-def kuka_robot(urdf: Path, locked: dict[str, float] | None = None) -> Robot:
-    """The LWR4+ as the project models a fixed base: a free-flyer root welded at the identity
-    (the root link's frame its contact), every revolute joint actuated; ``locked`` joints removed
-    from the model at their positions (Pinocchio's reduced model)."""
-    model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
-    locked = locked or {}
-    if locked:
-        q = pin.neutral(model)
-        for name, value in locked.items():
-            q[model.idx_qs[model.getJointId(name)]] = value
-        model = pin.buildReducedModel(model, [model.getJointId(n) for n in locked], q)
-    actuated = tuple(model.names[2:])
-    root = next(f.name for f in model.frames if f.parentJoint == 1 and f.type == pin.FrameType.BODY)
-    return Robot(name="kuka_lwr4", model=model, urdf=urdf, actuated=actuated, torque_controlled=actuated,
-                 position_controlled=(), contact_frames=(root,), floating_base=False, locked_joints=dict(locked))
+    with tempfile.TemporaryDirectory() as folder:
+        cfg = Path(folder) / "kuka.toml"
+        cfg.write_text('name = "kuka_lwr4"\nfloating_base = false\n[locked_joints]\n'
+                       + "".join(f"{n} = {v!r}\n" for n, v in locked.items()))
+        return load_robot(urdf=KUKA_URDF, config=cfg)
 
 
 @pytest.fixture(scope="session")
 def kuka_urdf() -> Path:
-    folder = real_data()
-    path = None if folder is None else folder / "kuka_lwr4" / "kuka_lwr4.urdf"
-    if path is None or not path.is_file():
-        pytest.skip("no real data: set WBFRICTION_REAL_DATA or put shared/real-data beside the checkout "
-                    "(needs kuka_lwr4/kuka_lwr4.urdf)")
-    return path
+    if not KUKA_URDF.is_file():
+        pytest.skip(f"no real data at {KUKA_URDF}: set WBFRICTION_REAL_DATA or put shared/real-data beside the "
+                    "checkout")
+    return KUKA_URDF
 
 
 @pytest.fixture(scope="session")
 def kuka(kuka_urdf) -> Robot:
-    return kuka_robot(kuka_urdf)
+    return kuka_robot()
 
 
 @pytest.fixture(scope="session")
 def make_kuka(kuka_urdf):
     """``make_kuka(locked)``: the LWR4+ with some joints locked (:func:`kuka_robot`)."""
-    return lambda locked=None: kuka_robot(kuka_urdf, locked)
+    return lambda locked=None: kuka_robot(locked)
 
 
 def _random_friction(joints, rng) -> dict[str, FrictionParams]:

@@ -10,11 +10,13 @@ from wbfriction.exceptions import InputError
 from wbfriction.inertia.io import read_identification, write_identification
 
 DOC = {
-    "passes": [{"stribeck_velocity": 0.2, "samples": 100}],
+    "passes": [{"stribeck_velocity": 0.2, "samples": 100,
+                "not_excited": [{"parameter": "hand.m", "information": 0.0, "partners": {"wrist.c_z": -0.3}}]}],
     "holdout_samples": 20,
     "bodies": [{"body": "root_joint", "mass_given": 10.0, "mass": 9.5, "com_shift": 0.001}],
     "joints": {"knee": {"holdout_rms": {"given": 1.0, "given_with_friction": 0.5, "identified": 0.01},
-                        "identified": {"F_v": 0.2, "F_c": 1.0, "tau_os": 0.9}}},
+                        "identified": {"F_v": 0.2, "F_c": 1.0, "tau_os": 0.9},
+                        "armature": {"given": 0.0, "identified": 0.3}}},
 }
 
 
@@ -30,6 +32,8 @@ def test_what_is_written_reads_back(tmp_path):
     (lambda d: d["bodies"][0].pop("mass"), "bodies"),
     (lambda d: d.update(passes=[]), "passes"),
     (lambda d: d.update(holdout_samples=1.5), "holdout_samples"),
+    (lambda d: d["joints"]["knee"]["armature"].pop("identified"), "joints.knee.armature"),
+    (lambda d: d["passes"][0]["not_excited"][0].update(partners=None), r"passes\[0\].not_excited"),
 ])
 def test_a_damaged_document_names_its_key(tmp_path, damage, key):
     doc = json.loads(json.dumps(DOC))

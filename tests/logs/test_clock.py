@@ -5,23 +5,17 @@ uniformly."""
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
 import numpy as np
 import pyarrow as pa
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from helpers import KUKA
 from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.friction.estimate import EstimateOptions, estimate_log
 from wbfriction.logs.clock import VERDICT, lattice_period, read_clock, split_at_gaps
 from wbfriction.logs.log import log_from_table
-
-REAL_DATA = Path(os.environ.get("WBFRICTION_REAL_DATA",
-                                Path(__file__).resolve().parents[2] / ".." / "shared" / "real-data"))
-KUKA = REAL_DATA / "kuka_lwr4"
 
 
 def _motion(t):

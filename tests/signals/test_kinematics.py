@@ -232,3 +232,33 @@ def test_chunks_of_a_non_uniform_log_equal_the_whole(kind, diff):
     if kind == "jittered":
         own = read_clock(stamps[a - context:b + context], "chunk", q=q[a - context:b + context])
         assert np.abs(np.diff(own.t) - np.diff(whole.clock.t[a - context:b + context])).max() > 1e-9
+
+
+@pytest.mark.parametrize("diff, filtering", [("savgol", FilterOptions(window=51, poly_order=4)),
+                                             ("butterworth", FilterOptions(cutoff=20.0, butter_order=4))])
+def test_filter_wiring_around_a_contact_change(diff, filtering):
+    """Which signals a filtering scheme filters (issue 20's measurement, pinned): q, qdd and tau
+    through the smoother; qd the filter's, but the raw central difference within the filter's
+    margin of a contact change (where the filtered signals are NaN), NaN only on the rows whose
+    stencil straddles it."""
+    dt, n, k = 1e-3, 1200, 600
+    t = np.arange(n) * dt
+    rng = np.random.default_rng(2)
+    q = np.column_stack([np.sin(2 * np.pi * 1.3 * t), 0.5 * np.cos(2 * np.pi * 0.7 * t)]) + rng.normal(0, 1e-6, (n, 2))
+    tau = rng.normal(0, 1.0, (n, 2))
+    contact = np.zeros((n, 1), dtype=bool)
+    contact[k:] = True
+    kin = measure(Log(t, q, tau, contact), diff, filtering=filtering, torque_alignment="sample")
+    hw = kin.smoother.half_width
+    qd_c = central_differences(q, dt)[0]
+    straddle = np.array([k - 1, k])
+    assert np.all(np.isnan(kin.qd[straddle]))
+    margin = np.r_[k - 1 - hw:k - 1, k + 1:k + 1 + hw]
+    assert np.all(np.isnan(kin.qdd[margin])) and np.all(np.isnan(kin.tau[margin]))
+    assert np.allclose(kin.qd[margin], qd_c[margin], rtol=0, atol=1e-12)  # raw velocity in the margins
+    inner = np.r_[2 * hw + 5:k - 2 * hw, k + 2 * hw:n - 2 * hw]
+    assert np.all(np.isfinite(kin.qdd[inner])) and np.all(np.isfinite(kin.tau[inner]))
+    assert not np.allclose(kin.qd[inner], qd_c[inner], rtol=0, atol=1e-9)  # the filter's velocity away from it
+    smoothed = kin.smoother(np.where(np.arange(n)[:, None] < k - 1, tau, np.nan))
+    first = np.r_[2 * hw + 5:k - 2 * hw]
+    assert np.allclose(kin.tau[first], smoothed[first], rtol=0, atol=1e-12)  # the torque is filtered

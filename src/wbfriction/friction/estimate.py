@@ -20,7 +20,7 @@ Sign convention: ``tau_f`` is the torque friction exerts on the joint,
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any, Literal, cast, get_args
 
 import numpy as np
@@ -31,6 +31,7 @@ from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
 from wbfriction.model.stance import stance_frame_pose, stance_model
 from wbfriction.progress import Progress
+from wbfriction.signals.choice import DiffChoice, choose_differentiation
 from wbfriction.signals.kinematics import (
     FILTERING_SCHEMES,
     Diff,
@@ -57,7 +58,9 @@ class EstimateOptions:
 
     Attributes:
         diff: differentiation scheme: ``central``, ``backward``, ``savgol``, ``butterworth``
-            (:mod:`~wbfriction.signals.kinematics`, :mod:`~wbfriction.signals.filters`) or ``true``.
+            (:mod:`~wbfriction.signals.kinematics`, :mod:`~wbfriction.signals.filters`), ``true``,
+            or ``auto``: chosen from the log's positions with its window or cutoff
+            (:func:`resolve_differentiation`; the command line's default), once per log.
         compensate_delay: shift the derivatives by their delay (6.1.2).
         torque_alignment: ``zoh`` (mean of tau[k-1], tau[k]), ``sample``, or ``auto``
             (what the log's metadata declares, else ``zoh``).
@@ -79,7 +82,7 @@ class EstimateOptions:
             TALOS on top of 8 us); the KKT route always has it.
     """
 
-    diff: Diff = "central"
+    diff: Diff | Literal["auto"] = "central"
     compensate_delay: bool = True
     torque_alignment: TorqueAlignment | Literal["auto"] = "auto"
     lift_off_skip: float = 0.10
@@ -316,6 +319,38 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
             raise (no segment can be estimated; with ``require_single_support``, no
             single-support sample in the whole log).
     """
+    options, choice = resolve_differentiation(options, log)
+    est = _estimate_parts(robot, log, options, progress, companion, require_single_support)
+    if choice is not None:
+        est.metadata["differentiation"] = choice.to_dict()
+    return est
+
+
+def resolve_differentiation(options: EstimateOptions, source: Log | np.ndarray | None,
+                            dt: float | None = None) -> tuple[EstimateOptions, DiffChoice | None]:
+    """``options`` with ``diff="auto"`` replaced by the scheme and filter chosen from the positions
+    (:func:`~wbfriction.signals.choice.choose_differentiation`), and that choice; other options as
+    they are, and None.
+
+    Args:
+        source: the log, or positions (N, n_act) [rad] sampled every ``dt`` [s] (the first rows
+            of a long log); None: nothing to choose from (central differences, no choice).
+
+    A log too short to measure its noise gets central differences, and a choice that says why.
+    """
+    if options.diff != "auto":
+        return options, None
+    if source is None:
+        return replace(options, diff="central"), None
+    try:
+        choice = choose_differentiation(source, dt)
+    except InputError as exc:  # too short a log to measure its noise: say so, differentiate it plainly
+        choice = DiffChoice.fallback(f"central differences: {exc}")
+    return replace(options, diff=choice.scheme, filtering=choice.filtering), choice
+
+
+def _estimate_parts(robot: Robot, log: Log, options: EstimateOptions, progress: Progress | None,
+                    companion: bool, require_single_support: bool) -> FrictionEstimate:
     parts = log.parts()
     if len(parts) == 1:
         return _estimate_segment(robot, log, options, progress, companion, require_single_support)
@@ -339,6 +374,8 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
 
 def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress, companion: bool,
                       require_single_support: bool) -> FrictionEstimate:
+    if options.diff == "auto":
+        raise InputError("diff 'auto' is resolved once per log (resolve_differentiation), not per segment")
     kin = measure(log, options.diff, compensate_delay=options.compensate_delay,
                   torque_alignment=options.torque_alignment, filtering=options.filtering, velocity=options.velocity)
     kin.metadata.update(robot=robot.name, source=log.source)

@@ -10,7 +10,8 @@
    ``v_s``, and step 2 is repeated from the given model with it, ``passes`` times in all.
 
 Each pass is kept, so that a user sees both routes' friction side by side and how the
-identification moved between passes.
+identification moved between passes. An armature identified in step 2 is the identified model's
+(``model.armature``): step 3's acceleration route uses it.
 """
 
 from __future__ import annotations

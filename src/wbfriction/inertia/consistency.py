@@ -5,7 +5,28 @@ parameterization of rigid-body inertia*, IEEE RA-L 2022; ``pin.LogCholeskyParame
 every estimate is a physical rigid body (positive mass, positive-definite pseudo-inertia: the
 triangle inequalities hold). :func:`fit_consistent` solves the regularised least squares of
 the identification (:mod:`wbfriction.inertia.identification`) over such bodies, with the
-friction parameters bounded to physical values.
+friction parameters and the armature bounded to physical values.
+
+**The prior** (:class:`PriorUncertainty`, :func:`prior_model`) is a Gaussian one around the given
+model, stated where a model's uncertainty is known: per body, its mass (relative), its centre of
+mass (a length) and its rotational inertia about the centre of mass (relative to the body's
+largest principal moment); per joint, its armature (relative to the robot's joint inertias) and
+its friction (relative to the torques the joint sees: the URDF says nothing of friction, so this
+prior is weak; it keeps a joint that hardly moves from taking a friction that its motion
+elsewhere would contradict). It is linearised at the given model: ``|L (x - x0)|^2`` counts
+standard deviations.
+
+Why a real arm's masses ran to -100 % before (the KUKA LWR4+ logs of ``../shared/real-data``):
+the prior was scaled per parameter about the joint frame (mass in kg, first moments with 0.1 m,
+inertias with 0.01 m^2). A lever arm ``d`` makes a body's mass act like ``d^2`` of rotational
+inertia, so the mass was the cheapest carrier of every change the data asked of the combinations
+it enters (Khalil's regrouped base parameters), and ran to the boundary first; the prior's weight
+(1e-9 of the largest squared singular value) held nothing the data touched; and most of what the
+data asked was noise: central differences of those logs put three quarters of the accelerations'
+power above a quarter of the sampling rate, and noise in the regressor shrinks inertias (errors
+in variables; :attr:`wbfriction.inertia.identification.InertialIdentification.acceleration_noise`
+flags it). In physical parameters a mass cannot carry such changes without moving many standard
+deviations.
 """
 
 from __future__ import annotations
@@ -17,16 +38,23 @@ import pinocchio as pin
 import scipy.linalg
 from scipy.optimize import least_squares, lsq_linear
 
+from wbfriction.exceptions import InputError
+
 FRICTION = ("F_v", "F_c", "tau_os")
 """Friction parameters identified per torque-controlled joint (3.5 without Stribeck)."""
-FRICTION_PRIOR = 1e-12
-"""Relative weight of the friction parameters' prior (module docstring)."""
 STRIBECK = "F_s-F_c"
 """With a fixed Stribeck velocity ``v_s``, the Stribeck term's height ``F_s - F_c = S F_c`` [N·m]
 too (``F_s`` the static friction of 3.4, ``S`` that of :func:`wbfriction.friction.models.coulomb_viscous_stribeck`)."""
 FRICTION_LOWER = {"F_v": 0.0, "F_c": 0.0, "tau_os": -np.inf, STRIBECK: 0.0}
 """Physical friction: dissipative viscous and Coulomb parts, static friction at least the
 Coulomb level (the bounds of :data:`wbfriction.friction.fit.LOWER`); the offset is free."""
+PHYSICAL = ("m", "c_x", "c_y", "c_z", "I_xx", "I_xy", "I_yy", "I_xz", "I_yz", "I_zz")
+"""A body's physical parameters: mass [kg], centre of mass in the joint frame [m], rotational
+inertia about the centre of mass in the joint frame's axes [kg·m^2] (the prior's coordinates)."""
+EXACT_STEPS = 200
+"""Up to this many parameters (an arm's), the non-linear solve's trust-region steps come from an SVD
+of the Jacobian; above (a humanoid's), from LSMR iterations (faster there)."""
+_PAIRS = ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2))  # the inertia entries in PHYSICAL / pin order
 
 
 def log_cholesky(pi: np.ndarray, min_mass: float = 1e-3) -> np.ndarray:
@@ -44,13 +72,17 @@ def log_cholesky(pi: np.ndarray, min_mass: float = 1e-3) -> np.ndarray:
     try:
         U = flip @ np.linalg.cholesky(flip @ J @ flip) @ flip
     except np.linalg.LinAlgError:
-        m = max(float(pi[0]), min_mass)
-        c = np.asarray(pi[1:4]) / pi[0] if pi[0] > 0 else np.zeros(3)
-        sphere = pin.Inertia(m, c, np.eye(3) * 0.4 * m * 0.01 ** 2)
-        return log_cholesky(sphere.toDynamicParameters(), min_mass)
+        return log_cholesky(_sphere(pi, min_mass), min_mass)
     alpha = np.log(U[3, 3])
     Un = U / U[3, 3]
     return np.array([alpha, *np.log(np.diag(Un)[:3]), Un[0, 1], Un[1, 2], Un[0, 2], *Un[:3, 3]])
+
+
+def _sphere(pi: np.ndarray, min_mass: float) -> np.ndarray:
+    """A solid sphere of 1 cm radius, at least ``min_mass`` [kg], at the body's centre of mass (or origin)."""
+    m = max(float(pi[0]), min_mass)
+    c = np.asarray(pi[1:4]) / pi[0] if pi[0] > 0 else np.zeros(3)
+    return pin.Inertia(m, c, np.eye(3) * 0.4 * m * 0.01 ** 2).toDynamicParameters()
 
 
 def _dynamic_parameters(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -63,23 +95,123 @@ def _dynamic_parameters(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return pi, jac
 
 
-def parameter_scales(pi0: np.ndarray, min_mass: float = 1e-3, length: float = 0.1) -> np.ndarray:
-    """Scale of each inertial parameter (nb, 10), for the prior and for the rank test:
-    ``m``, ``m length``, ``m length^2`` with ``m`` the body's given mass (at least ``min_mass``)
-    and ``length`` a body size [m]."""
-    m = np.maximum(pi0[:, 0], min_mass)[:, None]
-    return np.hstack([m, np.repeat(m * length, 3, axis=1), np.repeat(m * length ** 2, 6, axis=1)])
+@dataclass(frozen=True)
+class PriorUncertainty:
+    """Standard deviations of the prior toward the given model (module docstring).
+
+    Attributes:
+        mass: of each body's mass, relative to it.
+        com: of each coordinate of each body's centre of mass [m].
+        inertia: of each entry of each body's rotational inertia about its centre of mass,
+            relative to its largest principal moment (at least that of a 1 cm sphere of its mass).
+        armature: of each joint's armature, relative to the larger of its given armature and the
+            largest diagonal entry of the given model's joint-space inertia at the reference
+            configuration (:func:`wbfriction.inertia.identification.armature_scale`).
+        friction: of each joint's Coulomb, Stribeck and offset friction, relative to the RMS of its
+            torque in the log [N·m]; of its viscous friction, that over its velocity limit [rad/s].
+    """
+
+    mass: float = 0.1
+    com: float = 0.05
+    inertia: float = 0.5
+    armature: float = 1.0
+    friction: float = 1.0
+
+    def __post_init__(self) -> None:
+        if min(self.mass, self.com, self.inertia, self.armature, self.friction) <= 0:
+            raise InputError(f"prior uncertainties must be > 0, got {self}")
+
+
+def physical_jacobian(pi: np.ndarray) -> np.ndarray:
+    """``d pi / d phi`` (10, 10) at a body with dynamic parameters ``pi`` (10,), ``phi`` its
+    :data:`PHYSICAL` parameters: ``pi = (m, m c, I_c + m (|c|^2 1 - c c^T))``."""
+    inertia = pin.Inertia.FromDynamicParameters(np.asarray(pi, dtype=float))
+    m, c = inertia.mass, np.asarray(inertia.lever)
+
+    def vec(S: np.ndarray) -> np.ndarray:
+        return np.array([S[i, j] for i, j in _PAIRS])
+
+    J = np.zeros((10, 10))
+    J[0, 0], J[1:4, 0], J[4:, 0] = 1.0, c, vec((c @ c) * np.eye(3) - np.outer(c, c))
+    for i in range(3):
+        e = np.eye(3)[i]
+        J[1 + i, 1 + i] = m
+        J[4:, 1 + i] = m * vec(2.0 * c[i] * np.eye(3) - np.outer(e, c) - np.outer(c, e))
+    J[4:, 4:] = np.eye(6)
+    return J
+
+
+def body_prior(pi: np.ndarray, uncertainty: PriorUncertainty = PriorUncertainty(),
+               min_mass: float = 1e-3) -> tuple[np.ndarray, np.ndarray]:
+    """The prior of a body with given dynamic parameters ``pi`` (10,): the standard deviations (10,) of
+    its physical parameters (:data:`PHYSICAL`, :class:`PriorUncertainty`), and the square root of the
+    prior's information ``L`` (10, 10): ``|L dpi|`` is a change ``dpi`` of its dynamic parameters in
+    standard deviations of the physical ones, to first order. A massless or flat body is measured at
+    a ``min_mass`` [kg] sphere of 1 cm radius (:func:`log_cholesky`'s start)."""
+    pi = np.asarray(pi, dtype=float)
+    if pi[0] < min_mass or not is_consistent(pi[None], 1e-12)[0]:
+        pi = _sphere(pi, min_mass)
+    inertia = pin.Inertia.FromDynamicParameters(pi)
+    m = inertia.mass
+    moment = max(float(np.linalg.eigvalsh(inertia.inertia)[-1]), 0.4 * m * 0.01 ** 2)
+    std = np.array([uncertainty.mass * m] + [uncertainty.com] * 3 + [uncertainty.inertia * moment] * 6)
+    return std, np.linalg.solve(physical_jacobian(pi), np.eye(10)) / std[:, None]
+
+
+@dataclass(frozen=True)
+class Prior:
+    """A Gaussian prior over the identification's parameters ``x = (pi.ravel(), rest)``: the bodies'
+    dynamic parameters (10 per body) then the joints' friction and armature.
+
+    Attributes:
+        x0: the given model (p,).
+        bodies: square roots of the bodies' prior information (nb, 10, 10) (:func:`body_prior`).
+        body_std: standard deviations of the bodies' physical parameters (nb, 10) (:data:`PHYSICAL`).
+        std: standard deviations of the other parameters (p - 10 nb,).
+    """
+
+    x0: np.ndarray
+    bodies: np.ndarray
+    body_std: np.ndarray
+    std: np.ndarray
+
+    @property
+    def nb(self) -> int:
+        return len(self.bodies)
+
+    @property
+    def L(self) -> np.ndarray:
+        """The square root of the prior's information (p, p), block diagonal."""
+        return scipy.linalg.block_diag(*self.bodies, np.diag(1.0 / self.std))
+
+    @property
+    def L_inv(self) -> np.ndarray:
+        """``L^-1`` (p, p): the map from standard deviations to parameters."""
+        return scipy.linalg.block_diag(*(np.linalg.inv(B) for B in self.bodies), np.diag(self.std))
+
+
+def prior_model(pi0: np.ndarray, rest0: np.ndarray, rest_std: np.ndarray,
+                uncertainty: PriorUncertainty = PriorUncertainty(), min_mass: float = 1e-3) -> Prior:
+    """The prior of given bodies ``pi0`` (nb, 10) and other parameters ``rest0`` with standard deviations
+    ``rest_std`` (k,)."""
+    stds, roots = zip(*(body_prior(p, uncertainty, min_mass) for p in pi0))
+    return Prior(np.concatenate([np.asarray(pi0, dtype=float).ravel(), rest0]), np.array(roots), np.array(stds),
+                 np.asarray(rest_std, dtype=float))
 
 
 @dataclass(frozen=True)
 class ConsistentFit:
-    """Result of :func:`fit_consistent`: inertial parameters (nb, 10), physically consistent;
-    friction parameters (n_tc, 3) (``F_v, F_c, tau_os``); the optimizer's message."""
+    """Result of :func:`fit_consistent`: inertial parameters (nb, 10), physically consistent; the
+    other parameters (friction, armature) (k,); half the objective; the optimizer's message."""
 
     pi: np.ndarray
-    friction: np.ndarray
+    rest: np.ndarray
     cost: float
     message: str
+
+    @property
+    def x(self) -> np.ndarray:
+        return np.concatenate([self.pi.ravel(), self.rest])
 
 
 def is_consistent(pi: np.ndarray, margin: float = 0.0) -> np.ndarray:
@@ -116,85 +248,84 @@ def friction_lower_bounds(k: int, n_tc: int) -> np.ndarray:
     return np.tile([FRICTION_LOWER[n] for n in (*FRICTION, STRIBECK)[:k]], n_tc)
 
 
-def regularised_problem(R: np.ndarray, z: np.ndarray, pi0: np.ndarray, friction0: np.ndarray, prior: float,
-                 min_mass: float, lower: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`fit_consistent`'s objective ``|A x - c|^2`` (``A`` (2p, p), ``c`` (2p,)) and
-    its minimum ``x_lin`` without the bodies' consistency constraint, with the friction
-    bounds ``lower`` (a bounded linear least squares)."""
-    x0 = np.concatenate([pi0.ravel(), friction0.ravel()])
-    d = 1.0 / np.concatenate([parameter_scales(pi0, min_mass).ravel(), np.ones(friction0.size)])
-    relative = np.concatenate([np.full(pi0.size, prior), np.full(friction0.size, FRICTION_PRIOR)])
-    w = np.sqrt(relative) * np.linalg.norm(R / d[None, :], 2) * d
-    A, c = np.vstack([R, np.diag(w)]), np.concatenate([z, w * x0])
-    scaled = A / d[None, :]  # in the parameters times d: columns of comparable size
-    if np.isfinite(lower).any():
-        x_lin = lsq_linear(scaled, c, bounds=(lower * d, np.inf), method="bvls").x / d
+def regularised_problem(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float,
+                        lower: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`fit_consistent`'s objective ``|A x - c|^2`` (``A`` (2p, p), ``c`` (2p,)) and its minimum
+    ``x_lin`` without the bodies' consistency constraint, with the bounds ``lower`` (p,) on the
+    parameters after the bodies' (a bounded linear least squares, solved in standard deviations of
+    the prior: ``x = x0 + L^-1 y``)."""
+    L, L_inv = prior.L, prior.L_inv
+    w = np.sqrt(weight)
+    A, c = np.vstack([R, w * L]), np.concatenate([z, w * (L @ prior.x0)])
+    Ay = np.vstack([R @ L_inv, w * np.eye(len(prior.x0))])
+    cy = c - A @ prior.x0
+    n_in = 10 * prior.nb
+    lo = np.full(len(prior.x0), -np.inf)
+    lo[n_in:] = (lower[n_in:] - prior.x0[n_in:]) / prior.std
+    if np.isfinite(lo).any():
+        y = lsq_linear(Ay, cy, bounds=(lo, np.inf), method="bvls").x
     else:
-        x_lin = np.linalg.lstsq(scaled, c, rcond=None)[0] / d
-    return x_lin, A, c
+        y = np.linalg.lstsq(Ay, cy, rcond=None)[0]
+    return prior.x0 + L_inv @ y, A, c
 
 
-def fit_consistent(R: np.ndarray, z: np.ndarray, pi0: np.ndarray, friction0: np.ndarray, prior: float = 1e-9,
+def fit_consistent(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float, lower: np.ndarray,
                    min_mass: float = 1e-3) -> ConsistentFit:
-    """Solve ``min |R x - z|^2 + |W D (x - x0)|^2`` over physically consistent bodies and
-    friction (:data:`FRICTION_LOWER`).
+    """Solve ``min |R x - z|^2 + weight |L (x - x0)|^2`` over physically consistent bodies and
+    bounded other parameters (friction: :data:`FRICTION_LOWER`; armature: >= 0).
 
-    ``x = (pi.ravel(), friction.ravel())``; ``x0`` is the given model (``pi0``,
-    ``friction0``); ``D`` divides by :func:`parameter_scales` (1 for friction);
-    ``W^2 = sigma_max(R D^-1)^2`` times ``prior`` on the inertial parameters and
-    :data:`FRICTION_PRIOR` on the friction ones. The friction is bounded (a joint that
-    never leaves the linear part of ``tanh`` cannot tell its viscous from its Coulomb
-    friction: unbounded, they cancel with huge opposite values). The linear solution with
-    these bounds (``scipy.optimize.lsq_linear``) is taken when every body it gives is
-    physically consistent (:func:`is_consistent`); otherwise each body is written through
-    its log-Cholesky parameters (so that every iterate is a rigid body) and the problem is
-    solved by ``scipy.optimize.least_squares``, from the linear solution's consistent
-    bodies and friction and the given model's other bodies (trust-region steps by LSMR, on
-    the problem compressed to ``p`` rows; stopped after 200 evaluations: on the demo's
-    walk, 2000 lower the cost by 0.2 %); a body that rounding leaves on the boundary of
-    the physical set is then brought inside (:func:`nearest_consistent`).
+    ``x = (pi.ravel(), rest)``; ``x0``, ``L``: the :class:`Prior`. The linear solution with the
+    bounds (:func:`regularised_problem`) is taken when every body it gives is physically
+    consistent (:func:`is_consistent`); otherwise each body is written through its log-Cholesky
+    parameters (so that every iterate is a rigid body) and the problem is solved by
+    ``scipy.optimize.least_squares``, from the linear solution's consistent bodies and the given
+    model's other bodies (trust-region steps by SVD or, above :data:`EXACT_STEPS` parameters, LSMR,
+    on the problem compressed to ``p`` rows; stopped after 200 evaluations); a body that rounding
+    leaves on the boundary of the physical set is then brought inside (:func:`nearest_consistent`).
 
     Args:
         R, z: the compressed regressor (p, p) and right-hand side (p,), columns ordered as ``x``.
-        pi0: given inertial parameters (nb, 10); friction0: starting friction (n_tc, k), its
-            columns the first ``k`` of ``(F_v, F_c, tau_os, F_s-F_c)``.
-        prior: relative weight of the inertial parameters' prior.
+        prior: the given model and its uncertainty.
+        weight: the prior's weight (the data's residual variance times the prior's relative weight,
+            :mod:`wbfriction.inertia.identification`).
+        lower: lower bounds (p,) (those of the bodies' parameters are ignored).
         min_mass: smallest mass of a body's starting point [kg] (:func:`log_cholesky`).
     """
-    nb = len(pi0)
-    lower = np.concatenate([np.full(10 * nb, -np.inf), friction_lower_bounds(*friction0.shape[::-1])])
-    x_lin, A, c = regularised_problem(R, z, pi0, friction0, prior, min_mass, lower)
-    pi_lin = x_lin[: 10 * nb].reshape(nb, 10)
+    nb, n_in = prior.nb, 10 * prior.nb
+    x_lin, A, c = regularised_problem(R, z, prior, weight, lower)
+    pi_lin = x_lin[:n_in].reshape(nb, 10)
     ok = is_consistent(pi_lin, 1e-12)
     if ok.all():
         r = A @ x_lin - c
-        return ConsistentFit(pi_lin, x_lin[10 * nb:].reshape(friction0.shape), 0.5 * float(r @ r),
+        return ConsistentFit(pi_lin, x_lin[n_in:], 0.5 * float(r @ r),
                              "the linear least-squares solution is physically consistent")
     # |A x - c|^2 = |T x - e|^2 + floor (A = Q T): the same problem in half the rows
     Q, T = scipy.linalg.qr(A, mode="economic")
     e = Q.T @ c
-    floor = float(c @ c - e @ e)
+    rest_lower = lower[n_in:]
 
     def unpack(v):
-        pi, jac = _dynamic_parameters(v[: 10 * nb].reshape(nb, 10))
-        return np.concatenate([pi.ravel(), v[10 * nb:]]), jac
+        pi, jac = _dynamic_parameters(v[:n_in].reshape(nb, 10))
+        return np.concatenate([pi.ravel(), v[n_in:]]), jac
 
     def fun(v):
         return T @ unpack(v)[0] - e
 
     def jac(v):
-        jb = unpack(v)[1]  # d pi_b / d theta_b (nb, 10, 10); friction enters as itself
+        jb = unpack(v)[1]  # d pi_b / d theta_b (nb, 10, 10); the other parameters enter as themselves
         out = T.copy()
-        out[:, : 10 * nb] = np.einsum("rbi,bij->rbj", T[:, : 10 * nb].reshape(-1, nb, 10), jb).reshape(-1, 10 * nb)
+        out[:, :n_in] = np.einsum("rbi,bij->rbj", T[:, :n_in].reshape(-1, nb, 10), jb).reshape(-1, n_in)
         return out
 
     nearest = nearest_consistent(pi_lin, 1e-4)
     theta0 = np.array([log_cholesky(p, min_mass) for p in np.where(ok[:, None], pi_lin, nearest)])
-    start = np.concatenate([theta0.ravel(), np.maximum(x_lin[10 * nb:], lower[10 * nb:])])  # max: bvls rounding
+    start = np.concatenate([theta0.ravel(), np.maximum(x_lin[n_in:], rest_lower)])  # max: bvls rounding
+    bounds = (np.concatenate([np.full(n_in, -np.inf), rest_lower]), np.inf)
     with np.errstate(over="ignore", invalid="ignore"):  # trial steps may overflow exp(): trf then shrinks them
-        res = least_squares(fun, start, jac=jac, bounds=(lower, np.inf), method="trf", x_scale="jac",
-                            tr_solver="lsmr", max_nfev=200)
+        res = least_squares(fun, start, jac=jac, bounds=bounds, method="trf", x_scale="jac",
+                            tr_solver="exact" if len(start) <= EXACT_STEPS else "lsmr", max_nfev=200)
     x, _ = unpack(res.x)
-    return ConsistentFit(nearest_consistent(x[: 10 * nb].reshape(nb, 10)), x[10 * nb:].reshape(friction0.shape),
-                         float(res.cost + 0.5 * floor),
+    x[:n_in] = nearest_consistent(x[:n_in].reshape(nb, 10)).ravel()
+    r = A @ x - c
+    return ConsistentFit(x[:n_in].reshape(nb, 10), x[n_in:], 0.5 * float(r @ r),
                          f"{int((~ok).sum())} bodies of the linear solution were not physical: {res.message}")

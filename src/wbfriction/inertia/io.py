@@ -1,8 +1,9 @@
 """The identification's document: the JSON of ``wbfriction identify --json`` (one writer, one reader).
 
 :func:`identification_document` builds it from a :class:`~wbfriction.inertia.closed_loop.ClosedLoop`
-(per pass the identification's size and condition; per body the changes; per torque-controlled
-joint the friction of both routes, the power-generating shares and the held-out torque RMS),
+(per pass the identification's size and condition, its prior and the parameters the data did not
+determine; per body the changes; per torque-controlled joint the friction of both routes, the armature,
+the power-generating shares and the held-out torque RMS),
 :func:`write_identification` writes it, :func:`read_identification` reads and checks it
 (``wbfriction report --identification``).
 """
@@ -29,10 +30,15 @@ def _finite(x: float) -> float | None:
 def identification_document(loop: ClosedLoop, moved: tuple[str, ...] = (),
                             provenance: dict[str, Any] | None = None) -> dict[str, Any]:
     """The loop as a JSON-ready dict (``wbfriction identify --json``, read by the report):
-    per pass the identification's size and condition; per body the changes
-    (:func:`wbfriction.inertia.urdf.inertia_changes`); per torque-controlled joint the friction of
-    both routes, the power-generating shares before and after, and the held-out torque RMS.
-    ``moved``: what :func:`wbfriction.inertia.urdf.write_urdf` returned; ``provenance``: recorded last."""
+    per pass the identification's size and condition, its prior's weight and the residual it is
+    measured in, and the parameters the data did not determine (``not_excited``: each with the
+    ones it acts with, :func:`~wbfriction.inertia.excitation.unexcited_parameters`); per body the
+    changes (:func:`wbfriction.inertia.urdf.inertia_changes`); per torque-controlled joint the
+    friction of both routes, the armature (``armature``: ``given`` and ``identified`` [kg·m^2],
+    and how it was treated, ``armature_mode``), the share of its acceleration's power that is
+    noise (``acceleration_noise``: :class:`~wbfriction.inertia.identification.InertialIdentification`),
+    the power-generating shares before and after, and the held-out torque RMS. ``moved``: what
+    :func:`wbfriction.inertia.urdf.write_urdf` returned; ``provenance``: recorded last."""
     final = loop.final
     ident = final.identification
     changes = inertia_changes(ident.bodies, ident.pi_given, ident.pi)
@@ -44,6 +50,8 @@ def identification_document(loop: ClosedLoop, moved: tuple[str, ...] = (),
             "identified": dict(zip(ident.friction_names, map(float, ident.friction[i]))),
             "acceleration_route": fit_to_dict(final.route.fit(joint)),
             "acceleration_route_given_model": fit_to_dict(loop.given.fit(joint)),
+            "armature": {"given": float(ident.armature_given[i]), "identified": float(ident.armature[i])},
+            "acceleration_noise": float(ident.acceleration_noise[i]),
             "generating_share_given_model": _finite(energy_given[joint].generating_share),
             "generating_share": _finite(energy[joint].generating_share),
             "holdout_rms": {"given": float(ident.holdout.given[i]),
@@ -61,7 +69,11 @@ def identification_document(loop: ClosedLoop, moved: tuple[str, ...] = (),
                     "condition": _finite(p.identification.base.condition),
                     "prior": p.identification.prior,
                     "prior_scores": {f"{w:g}": v for w, v in p.identification.prior_scores.items()},
+                    "residual_std": _finite(p.identification.residual_std),
+                    "not_excited": [{"parameter": u.parameter, "information": _finite(u.information),
+                                     "partners": u.partners} for u in p.identification.unexcited],
                     "message": p.identification.message} for p in loop.passes],
+        "armature_mode": ident.armature_mode,
         "holdout_samples": ident.holdout.samples,
         "moved_to_child_link": list(moved),
         "bodies": [{"body": c.body, "mass_given": c.mass_given, "mass": c.mass, "mass_change": _finite(c.mass_change),
@@ -106,11 +118,18 @@ def read_identification(path: str | Path) -> dict[str, Any]:
                      for k in ("given", "given_with_friction", "identified")), f"joints.{joint}.holdout_rms")
         need(isinstance(j.get("identified"), dict)
              and all(isinstance(v, (int, float)) for v in j["identified"].values()), f"joints.{joint}.identified")
+        need("armature" not in j or (isinstance(j["armature"], dict) and all(
+            isinstance(j["armature"].get(k), (int, float)) for k in ("given", "identified"))),
+             f"joints.{joint}.armature")
     need(isinstance(doc.get("bodies"), list) and all(
         isinstance(b, dict) and isinstance(b.get("body"), str)
         and all(isinstance(b.get(k), (int, float)) for k in ("mass_given", "mass", "com_shift"))
         for b in doc["bodies"]), "bodies")
     need(isinstance(doc.get("passes"), list) and doc["passes"] and all(isinstance(p, dict) for p in doc["passes"]),
          "passes")
+    for k, p in enumerate(doc["passes"]):
+        need("not_excited" not in p or (isinstance(p["not_excited"], list) and all(
+            isinstance(u, dict) and isinstance(u.get("parameter"), str) and isinstance(u.get("partners"), dict)
+            for u in p["not_excited"])), f"passes[{k}].not_excited")
     need(isinstance(doc.get("holdout_samples"), int), "holdout_samples")
     return doc

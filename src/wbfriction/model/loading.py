@@ -23,7 +23,7 @@ from wbfriction.config import read_toml
 from wbfriction.exceptions import InputError
 from wbfriction.model.robot import Robot
 
-BUILTIN_ROBOTS = ("talos", "toro")
+BUILTIN_ROBOTS = ("talos", "toro", "panda")
 _ERD_PREFIX = "example-robot-data:"
 _GENERATED = "wbfriction:"  # a URDF this package generates: "wbfriction:<name>" (robots/<name>.py)
 

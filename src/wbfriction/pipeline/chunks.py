@@ -105,12 +105,13 @@ def plan_columns(file: TableFile, robot: Robot, source: str, max_gap: float = MA
              if robot.floating_base else np.ones((table.num_rows, 1)))  # a fixed base: always welded
     stamps = table_stamps(table, source)
     return np.nan_to_num(flags.astype(float)) != 0, read_clock(stamps, source, max_gap=max_gap,
-                                                               q=_first_positions(file, robot), time_base=time_base)
+                                                               q=first_positions(file, robot), time_base=time_base)
 
 
-def _first_positions(file: TableFile, robot: Robot) -> np.ndarray | None:
-    """The positions of the first :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS` rows (M, n_act), or
-    None when a column is missing or not finite (the chunk that holds it says so)."""
+def first_positions(file: TableFile, robot: Robot) -> np.ndarray | None:
+    """The positions of the first :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS` rows (M, n_act), from
+    which the clock and the differentiation are decided, or None when a column is missing or not
+    finite (the chunk that holds it says so)."""
     table = file.row_reader(ROUGHNESS_ROWS).rows(0, ROUGHNESS_ROWS)
     names = [f"q.{n}" for n in robot.actuated]
     if any(n not in table.column_names for n in names):

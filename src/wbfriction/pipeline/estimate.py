@@ -24,7 +24,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimate import EstimateOptions, estimate_log, no_single_support
+from wbfriction.friction.estimate import EstimateOptions, estimate_log, no_single_support, resolve_differentiation
 from wbfriction.friction.io import friction_table
 from wbfriction.logs.clock import Clock, TimeBase
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, log_from_table
@@ -32,7 +32,7 @@ from wbfriction.logs.source import LogSource
 from wbfriction.logs.tables import RowReader, TableFile, read_metadata, with_metadata, write_tables
 from wbfriction.model.loading import load_robot
 from wbfriction.model.robot import Robot
-from wbfriction.pipeline.chunks import CONTEXT, Chunk, Chunking, plan_chunks, plan_columns
+from wbfriction.pipeline.chunks import CONTEXT, Chunk, Chunking, first_positions, plan_chunks, plan_columns
 from wbfriction.progress import Progress
 
 
@@ -131,13 +131,15 @@ def _with_provenance(tables: Iterator[pa.Table], chunks: list[Chunk], robot: Rob
 class ChunkedResult:
     """What :func:`estimate_file` did: rows, chunks, and their contact-change cuts; ``clock``: the
     one line saying what the stamps are and which time base was used (:attr:`Clock.reason
-    <wbfriction.logs.clock.Clock.reason>`)."""
+    <wbfriction.logs.clock.Clock.reason>`); ``differentiation``: the line saying which scheme ``diff="auto"``
+    chose and why (:class:`~wbfriction.signals.choice.DiffChoice`), or ""."""
 
     rows: int
     chunks: int
     forced_cuts: int
     metadata: dict
     clock: str = ""
+    differentiation: str = ""
 
 
 def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options: EstimateOptions = EstimateOptions(),
@@ -173,6 +175,9 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     robot = robot if robot is not None else spec.load()
     file = TableFile(path)
     contact, clock = plan_columns(file, robot, source, max_gap, time_base)
+    options, choice = resolve_differentiation(options, first_positions(file, robot), clock.step)
+    if choice is not None:
+        extra_metadata = {**(extra_metadata or {}), "differentiation": choice.to_dict()}
     n = len(contact)
     chunks = plan_chunks(contact, chunking)
     del contact
@@ -183,7 +188,7 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
                                                         settings),
                                           chunks, robot, source, extra_metadata, progress, first_meta))
     return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta,
-                         clock.reason)
+                         clock.reason, "" if choice is None else choice.reason)
 
 
 @contextmanager

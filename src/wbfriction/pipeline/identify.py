@@ -1,5 +1,8 @@
 """Files in, files out: a log's inertia model and friction identified together (the closed loop of
-:func:`wbfriction.inertia.closed_loop.identify`), the corrected URDF and the identification JSON written."""
+:func:`wbfriction.inertia.closed_loop.identify`), the corrected URDF and the identification JSON written.
+
+A URDF has no place for the drives' rotor inertia: an identified armature is in the JSON and in
+:attr:`IdentifiedFile.armature`, as the ``[armature]`` table of the robot's TOML would hold it."""
 
 from __future__ import annotations
 
@@ -27,11 +30,20 @@ class IdentifiedFile:
         document: the identification JSON's content (:func:`~wbfriction.inertia.io.identification_document`).
         moved: the joints whose whole identified body went to their child link
             (:func:`~wbfriction.inertia.urdf.write_urdf`).
+        armature: with ``options.armature = "identify"``, the identified armature per
+            torque-controlled joint [kg·m^2] (the robot TOML's ``[armature]``); else None.
     """
 
     loop: ClosedLoop
     document: dict[str, Any]
     moved: tuple[str, ...]
+    armature: dict[str, float] | None = None
+
+    def armature_toml(self) -> str | None:
+        """The identified armature as a TOML ``[armature]`` table (None if it was not identified)."""
+        if self.armature is None:
+            return None
+        return "[armature]\n" + "".join(f"{joint} = {value!r}\n" for joint, value in self.armature.items())
 
 
 def identify_file(robot: Robot, log: str | Path, urdf_output: str | Path, json_output: str | Path | None = None, *,
@@ -52,4 +64,7 @@ def identify_file(robot: Robot, log: str | Path, urdf_output: str | Path, json_o
     doc = identification_document(loop, moved, log_provenance(log, robot))
     if json_output is not None:
         write_identification(json_output, doc)
-    return IdentifiedFile(loop, doc, moved)
+    ident = loop.final.identification
+    armature = (dict(zip(robot.torque_controlled, map(float, ident.armature)))
+                if ident.armature_mode == "identify" else None)
+    return IdentifiedFile(loop, doc, moved, armature)

@@ -28,6 +28,7 @@ import pinocchio as pin
 from scipy.spatial.transform import Rotation
 
 from wbfriction.exceptions import ModelError
+from wbfriction.export.mjcf import urdf_spec
 from wbfriction.model.robot import Robot
 
 SOLE_THICKNESS = 0.01  # [m], the contact boxes' height, their bottom face on the contact frame's plane
@@ -189,7 +190,7 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
     """
     root = ET.parse(robot.urdf).getroot()
     footprints = [sole_footprint(robot, f, root) for f in robot.contact_frames]
-    spec = _urdf_spec(robot, root, timestep)
+    spec = _urdf_spec(robot, timestep)
     _add_soles(spec, robot, footprints)
     _add_motors(spec, robot)
     try:
@@ -199,27 +200,11 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
     return _mujoco_robot(robot, mj)
 
 
-def _urdf_spec(robot: Robot, root: ET.Element, timestep: float) -> mujoco.MjSpec:
-    """The MuJoCo spec of the URDF ``root`` (changed: stripped of meshes, dynamics, Gazebo and
-    transmission tags), with a free joint at the root and a floor."""
-    for link in root.findall("link"):
-        for tag in ("visual", "collision"):
-            for e in link.findall(tag):
-                link.remove(e)
-    for joint in root.findall("joint"):
-        for e in joint.findall("dynamics"):
-            joint.remove(e)
-    for tag in ("gazebo", "transmission"):
-        for e in root.findall(tag):
-            root.remove(e)
-    extension = ET.SubElement(root, "mujoco")
-    ET.SubElement(extension, "compiler", discardvisual="true", fusestatic="true", balanceinertia="false")
-    try:
-        spec = mujoco.MjSpec.from_string(ET.tostring(root, encoding="unicode"))
-    except Exception as exc:  # mujoco raises ValueError with its parser's message
-        raise ModelError(f"{robot.urdf}: MuJoCo cannot read the URDF: {exc}") from None
+def _urdf_spec(robot: Robot, timestep: float) -> mujoco.MjSpec:
+    """The MuJoCo spec of the robot's URDF (:func:`wbfriction.export.mjcf.urdf_spec`: kinematic tree and
+    inertias only), with a free joint at the root, the physics step and a floor."""
+    spec = urdf_spec(robot.urdf, free_joint=True)
     spec.option.timestep = timestep
-    spec.worldbody.first_body().add_freejoint()
     spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1])
     return spec
 

@@ -1,0 +1,437 @@
+"""Choosing the differentiation from the data: the scheme, its window or cutoff, and why (thesis 7.1, Fig. 7.1).
+
+A fixed default fails on some log: central differences (6.2) drown a noisy 1 kHz encoder's
+acceleration in noise, a long filter costs samples at every contact change and bends a fast
+motion. :func:`choose_differentiation` reads the positions and decides, deterministically:
+
+1. **Content and noise.** The acceleration of the positions by central second differences
+   holds the motion at low frequencies and the position noise above it: white position noise
+   of standard deviation ``sigma`` [rad] leaves the second difference with the amplitude
+   ``sigma |G(f)|``, ``G(f) = 4 sin^2(pi f dt) / dt^2``, which rises as ``f^2``. The amplitude
+   spectrum (:func:`~wbfriction.signals.spectrum.amplitude_spectrum`) is averaged in power
+   over half-overlapping Hann-tapered segments (Welch's method), so that a noise bin rarely
+   stands out; the noise level ``sigma`` is read from the median of ``amplitude / |G|`` over
+   the upper half of the band; what stands above :data:`NOISE_MARGIN` times that noise model
+   is the content, and :func:`~wbfriction.signals.spectrum.suggest_cutoff` finds where it ends
+   (all but ``tail`` of its power below): where the spectrum meets the noise floor.
+2. **Noise left.** Each scheme leaves ``sigma`` times its noise gain in the acceleration (RMS):
+   ``sqrt(6) / dt^2`` for central differences, the norm of the Savitzky-Golay second-derivative
+   kernel (7.7-7.8), the forward-backward Butterworth's (7.1.2) ``|B(f)|^2`` over the central
+   difference integrated over the band.
+3. **The choice.** Central differences when they leave at most ``target`` (default
+   :data:`NOISE_TARGET`); else the least filtering that does: the shortest Savitzky-Golay window
+   (order ``k``) or the highest Butterworth cutoff (one pass, -3 dB). The window's -3 dB
+   frequency is computed from its impulse response (:func:`savgol_cutoff`; Schafer's
+   ``f_3dB ~ (k + 1) / (3.2 L - 4.6) fs`` is the start of :func:`savgol_window`: R. W.
+   Schafer, "What is a Savitzky-Golay filter?", IEEE Signal Processing Magazine 28(4), 2011).
+   Savitzky-Golay is the default family: at the same -3 dB frequency its window is about three
+   times shorter than the Butterworth's impulse response (the 1 % tail of
+   :attr:`~wbfriction.signals.filters.ZeroPhaseLowpass.half_width`: 240 samples at 10 Hz and
+   1 kHz against 76), so it loses fewer samples at every contact change, and the Butterworth's
+   padding at the ends of every run lets the position noise in there.
+
+The content's end is reported, not obeyed: cutting at it, the first design, measured worse.
+On the simulated combined walk (TALOS, 10 steps per direction, Table 6.1 friction on the leg
+joints, 1 kHz, 19-bit encoders, 0.05 N·m torque noise; the velocity filtered and central
+differences in the filter's margins; worst leg F_v error, mean over noise seeds 3-5) the
+simulator's torques, held over each 1 ms step, put real content up to 100 Hz,
+and the window cut there (17 samples) gave 9.9 %, against 5.8 / 4.2 / 4.1 % for 31 / 51 / 101
+samples; with 1e-4 rad of position noise, windows of 101 / 151 / 171 / 201 / 251 samples
+(noise left 0.092 / 0.034 / 0.025 / 0.016 / 0.009 rad/s^2) gave 42 / 16 / 25 / 27 / 42 %: too
+little filtering lets noise in, more loses samples and bends the motion. The noise target of
+0.03 rad/s^2 picks 159 and 39 samples there (19.8 % and 4.8 %), 65 samples with 1e-5 rad
+(5.2 %), and a 7-sample window on the exact log (0.9 %, as central differences).
+
+Every choice is printable (:attr:`DiffChoice.reason`), carries the numbers behind it
+(:meth:`DiffChoice.to_dict`), and is overridden by passing the scheme and its options explicitly.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, fields, replace
+from typing import Any, Literal, get_args
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+from scipy.optimize import brentq
+from scipy.signal import sosfreqz
+from scipy.signal.windows import hann
+
+from wbfriction.exceptions import InputError
+from wbfriction.logs.log import Log
+from wbfriction.signals.filters import SavgolWeights, ZeroPhaseLowpass, savgol_kernels
+from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.signals.spectrum import amplitude_spectrum, longest_run, suggest_cutoff
+
+ChosenScheme = Literal["central", "savgol", "butterworth"]
+"""What :func:`choose_differentiation` picks."""
+Preference = Literal["auto", "savgol", "butterworth"]
+"""The filter family to use when a filter is needed; ``auto``: Savitzky-Golay (module docstring)."""
+PREFERENCES: tuple[Preference, ...] = get_args(Preference)
+
+SEGMENT = 1.0
+"""Length of the averaged spectrum's segments [s] (its frequency resolution: 1 / SEGMENT)."""
+MIN_SEGMENT = 64
+"""Fewest samples per segment."""
+MIN_SEGMENTS = 7
+"""Fewest half-overlapping segments averaged (the segment is shortened to reach it)."""
+NOISE_MARGIN = 2.0
+"""Content is the amplitude above this many times the noise model (averaged over 7 or more
+segments, a noise bin's power exceeds 4 times its mean with a probability below 1e-4)."""
+NOISE_TARGET = 0.03
+"""Most RMS noise a scheme may leave in the acceleration [rad/s^2] (module docstring: measured;
+through a joint inertia of 1 kg·m^2 it is 0.03 N·m, below the studies' torque-sensor noise of 0.05 N·m)."""
+
+
+# ------------------------------------------------------------------ the positions' spectrum
+def second_difference_gain(freq: np.ndarray, dt: float) -> np.ndarray:
+    """Amplitude gain ``|G(f)| = 4 sin^2(pi f dt) / dt^2`` [1/s^2] of the central second
+    difference (6.2) at ``freq`` (F,) [Hz]: white position noise of standard deviation
+    ``sigma`` comes out with the amplitude ``sigma |G|`` (up to the spectrum's scale)."""
+    return 4.0 * np.sin(np.pi * np.asarray(freq, dtype=float) * dt) ** 2 / dt**2
+
+
+@dataclass
+class AccelerationContent:
+    """The averaged acceleration spectrum of some positions, split into content and noise.
+
+    Attributes:
+        freq: frequencies (F,) [Hz].
+        amplitude: power-averaged amplitude spectrum of the central second difference (F, n)
+            [rad/s^2] (Hann-tapered segments: a sine of amplitude A shows as about A / 2).
+        noise: the white-noise model's amplitude (F, n) [rad/s^2].
+        excess: the content: amplitude above ``margin`` times the noise model (F, n) [rad/s^2].
+        content_end: where each joint's content ends (n,) [Hz] (the Nyquist frequency for a
+            joint without content).
+        position_noise: standard deviation of the white position noise (n,) [rad].
+        moving: joints with content (n,).
+        segment: samples per segment; n_segments: segments averaged.
+    """
+
+    freq: np.ndarray
+    amplitude: np.ndarray
+    noise: np.ndarray
+    excess: np.ndarray
+    content_end: np.ndarray
+    position_noise: np.ndarray
+    moving: np.ndarray
+    segment: int
+    n_segments: int
+
+
+def _segment_length(n: int, dt: float, segment: float) -> int:
+    want = max(int(round(segment / dt)), MIN_SEGMENT)
+    fit = 2 * n // (MIN_SEGMENTS + 1)  # half-overlapping: 2 n / L - 1 segments
+    length = min(want, fit)
+    return length - length % 2
+
+
+def acceleration_content(q: np.ndarray, dt: float, tail: float = 0.01, segment: float = SEGMENT,
+                         margin: float = NOISE_MARGIN) -> AccelerationContent:
+    """Content and noise of the acceleration of positions ``q`` (N, n) or (N,) [rad] sampled
+    every ``dt`` [s] (module docstring, step 1), over their longest run of finite rows.
+
+    Raises:
+        InputError: fewer than ``MIN_SEGMENT (MIN_SEGMENTS + 1) / 2 + 2`` = 258 finite rows
+            in a row, a non-positive ``dt`` or ``segment``, ``tail`` outside (0, 1).
+    """
+    q = np.asarray(q, dtype=float)
+    if q.ndim == 1:
+        q = q[:, None]
+    if not (dt > 0 and segment > 0):
+        raise InputError(f"differentiation choice: the sample period and segment must be > 0, got {dt}, {segment}")
+    a, b = longest_run(np.all(np.isfinite(q), axis=1))
+    seg = _segment_length(b - a - 2, dt, segment)
+    if seg < MIN_SEGMENT:
+        raise InputError(f"differentiation choice: {b - a} consecutive finite samples, need at least "
+                         f"{MIN_SEGMENT * (MIN_SEGMENTS + 1) // 2 + 2}")
+    x = q[a:b]
+    acc = (x[2:] - 2.0 * x[1:-1] + x[:-2]) / dt**2
+    windows = sliding_window_view(acc, seg, axis=0)[::seg // 2]  # (M, n, seg)
+    tapered = np.moveaxis(windows, -1, 0) * hann(seg, sym=False)[:, None, None]
+    freq, amp = amplitude_spectrum(tapered, dt)  # (F, M, n)
+    amp = np.sqrt(np.mean(amp**2, axis=1))
+    gain = second_difference_gain(freq, dt)
+    upper = freq >= freq[-1] / 2
+    level = np.median(amp[upper] / gain[upper, None], axis=0)  # (n,)
+    noise = level[None, :] * gain[:, None]
+    excess = np.sqrt(np.clip(amp**2 - (margin * noise) ** 2, 0.0, None))
+    moving = np.sum(excess**2, axis=0) > 0
+    ends = np.array([suggest_cutoff(freq, excess[:, i], tail) if moving[i] else float(freq[-1])
+                     for i in range(amp.shape[1])])
+    # E amp^2 of white noise through a Hann taper: 4 sigma^2 |G|^2 sum(w^2) / L^2, sum(w^2) = 3 L / 8
+    sigma = level * math.sqrt(seg / 1.5)
+    return AccelerationContent(freq, amp, noise, excess, ends, sigma, moving, seg, windows.shape[0])
+
+
+# ---------------------------------------------------------------------- schemes' noise gains
+def central_noise_gain(dt: float) -> float:
+    """RMS acceleration [1/s^2] the central second difference (6.2) makes of unit white position
+    noise: ``sqrt(1 + 4 + 1) / dt^2``."""
+    return math.sqrt(6.0) / dt**2
+
+
+def savgol_noise_gain(window: int, order: int, dt: float, weights: SavgolWeights = "uniform") -> float:
+    """RMS acceleration [1/s^2] the Savitzky-Golay second derivative (7.7-7.8) makes of unit
+    white position noise: the norm of its kernel."""
+    return float(np.linalg.norm(savgol_kernels(window, order, dt, weights)[2]))
+
+
+def butterworth_noise_gain(cutoff: float, order: int, dt: float, n_freq: int = 4097) -> float:
+    """RMS acceleration [1/s^2] the ``butterworth`` scheme (the central second difference run
+    forward and backward through the low-pass, 7.1.2) makes of unit white position noise:
+    ``sqrt(2 dt int_0^{fs/2} (|B(f)|^2 |G(f)|)^2 df)`` on ``n_freq`` frequencies (trapezoids)."""
+    freq = np.linspace(0.0, 0.5 / dt, n_freq)
+    _, b = sosfreqz(ZeroPhaseLowpass(cutoff, order, dt).sos, worN=freq, fs=1.0 / dt)
+    power = (np.abs(b) ** 2 * second_difference_gain(freq, dt)) ** 2
+    return math.sqrt(2.0 * dt * float(np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(freq))))
+
+
+# --------------------------------------------------------------------- Savitzky-Golay windows
+def savgol_cutoff(window: int, order: int, dt: float, weights: SavgolWeights = "uniform") -> float:
+    """-3 dB frequency [Hz] of the Savitzky-Golay smoother (value at the centre of the local fit,
+    7.7-7.8), from its impulse response: the first frequency where its gain falls to 1/sqrt(2)
+    (the Nyquist frequency if it never does).
+
+    Raises:
+        InputError: a window, order or weights that make no filter.
+    """
+    h = savgol_kernels(window, order, dt, weights, max_deriv=0)[0]
+    m = np.arange(len(h)) - len(h) // 2
+    half_power = 1.0 / math.sqrt(2.0)
+
+    def gain(f: np.ndarray | float) -> np.ndarray:  # the symmetric kernel's response is real
+        return np.cos(2.0 * np.pi * np.multiply.outer(f, m) * dt) @ h
+
+    nyquist = 0.5 / dt
+    top = min(nyquist, 4.0 * (order + 1) / (window * dt))  # beyond Schafer's estimate, well past -3 dB
+    grid = np.linspace(0.0, top, 257)
+    below = np.flatnonzero(gain(grid) < half_power)
+    if below.size == 0:
+        if top >= nyquist:
+            return nyquist
+        grid = np.linspace(0.0, nyquist, 16 * window + 1)
+        below = np.flatnonzero(gain(grid) < half_power)
+        if below.size == 0:
+            return nyquist
+    i = int(below[0])
+    return float(brentq(lambda f: float(gain(f)) - half_power, grid[i - 1], grid[i], xtol=1e-9 * nyquist))
+
+
+def schafer_window(cutoff: float, order: int, dt: float) -> float:
+    """Window length (real) whose -3 dB frequency Schafer's approximation puts at ``cutoff``
+    [Hz]: ``cutoff dt = (k + 1) / (3.2 L - 4.6)`` (even k; module docstring)."""
+    return ((order + 1) / (cutoff * dt) + 4.6) / 3.2
+
+
+def savgol_window(cutoff: float, order: int, dt: float, weights: SavgolWeights = "uniform",
+                  max_window: int | None = None) -> int:
+    """The odd Savitzky-Golay window whose -3 dB frequency (:func:`savgol_cutoff`) is nearest
+    ``cutoff`` [Hz] (in ratio; the shorter on a tie), at least ``order + 2`` (rounded up to odd)
+    and at most ``max_window``: from Schafer's estimate (:func:`schafer_window`), step by 2
+    while that gets nearer (the -3 dB frequency falls as the window grows).
+
+    Raises:
+        InputError: a non-positive cutoff or one at or above the Nyquist frequency.
+    """
+    if not 0 < cutoff < 0.5 / dt:
+        raise InputError(f"Savitzky-Golay cutoff must be between 0 and the Nyquist frequency {0.5 / dt:g} Hz, "
+                         f"got {cutoff:g}")
+    smallest = order + 2 + (order + 1) % 2
+    largest = max(smallest, (max_window or 2**31) - (1 - (max_window or 1) % 2))
+
+    def score(w: int) -> tuple[float, int]:  # nearer in ratio, then shorter
+        return abs(math.log(savgol_cutoff(w, order, dt, weights) / cutoff)), w
+
+    w = int(round(schafer_window(cutoff, order, dt)))
+    w = min(max(w + (1 - w % 2), smallest), largest)
+    best = score(w)
+    while True:
+        nearest = min((score(x) for x in (w - 2, w + 2) if smallest <= x <= largest), default=best)
+        if nearest >= best:
+            return w
+        best, w = nearest, nearest[1]
+
+
+def _shortest(ok: Callable[[int], bool], lo: int, hi: int) -> int | None:
+    """The smallest odd ``w`` in ``[lo, hi]`` (odd bounds) with ``ok(w)``, by bisection
+    (``ok`` monotone), or None."""
+    if not ok(hi):
+        return None
+    while hi - lo > 2:
+        mid = lo + 2 * ((hi - lo) // 4)
+        lo, hi = (lo, mid) if ok(mid) else (mid, hi)
+    return lo if ok(lo) else hi
+
+
+# ------------------------------------------------------------------------------- the choice
+@dataclass(frozen=True)
+class DiffChoice:
+    """A differentiation scheme chosen from the data, and why.
+
+    Attributes:
+        scheme: ``central``, ``savgol`` or ``butterworth`` (what ``measure(diff=...)`` takes).
+        filtering: the filter's options (``window``/``poly_order``/``weights`` or
+            ``cutoff``/``butter_order`` set; defaults elsewhere).
+        reason: one printable line: what was chosen and why.
+        content_end: where the positions' acceleration content ends [Hz] (median over the
+            moving joints; NaN if none moves): reported.
+        content_ends: the same per joint [Hz] (n,).
+        position_noise: white position noise ``sigma`` [rad] (median over the moving joints).
+        target: the noise target [rad/s^2].
+        noise_central: RMS noise central differences leave in the acceleration [rad/s^2].
+        noise_left: the same for the chosen scheme [rad/s^2].
+        filter_cutoff: -3 dB frequency of the chosen filter [Hz] (NaN for central differences).
+        reached: whether the chosen scheme meets the target (False: the longest window or
+            lowest cutoff allowed).
+        sample_rate: 1 / dt [Hz].
+        n_joints: joints analysed; n_moving: those with content.
+    """
+
+    scheme: ChosenScheme
+    filtering: FilterOptions
+    reason: str
+    content_end: float
+    content_ends: tuple[float, ...]
+    position_noise: float
+    target: float
+    noise_central: float
+    noise_left: float
+    filter_cutoff: float
+    reached: bool
+    sample_rate: float
+    n_joints: int
+    n_moving: int
+
+    def __str__(self) -> str:
+        return self.reason
+
+    @classmethod
+    def fallback(cls, reason: str) -> DiffChoice:
+        """Central differences without a measurement (a log too short to measure its noise), saying why."""
+        nan = float("nan")
+        return cls("central", FilterOptions(), reason, nan, (), nan, NOISE_TARGET, nan, nan, nan, False, nan, 0, 0)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready record (for a log's or a table's metadata): every field, ``filtering`` as a
+        dict; NaN and inf as None."""
+        out: dict[str, Any] = {}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, FilterOptions):
+                value = asdict(value)
+            elif isinstance(value, tuple):
+                value = [v if math.isfinite(v) else None for v in value]
+            elif isinstance(value, float) and not math.isfinite(value):
+                value = None
+            out[f.name] = value
+        return out
+
+
+def _positions(source: Log | np.ndarray, dt: float | None) -> tuple[np.ndarray, float]:
+    if isinstance(source, Log):
+        rows = max(source.segments or [(0, len(source.time))], key=lambda r: r[1] - r[0])
+        return source.q[rows[0]:rows[1]], source.dt if dt is None else dt
+    if dt is None:
+        raise InputError("differentiation choice: positions given as an array need the sample period dt")
+    return np.asarray(source, dtype=float), dt
+
+
+def _savgol(sigma: float, dt: float, order: int, weights: SavgolWeights, target: float,
+            longest: int) -> tuple[FilterOptions, float, bool]:
+    """The shortest window whose noise left meets the target (bisection: the kernel's norm
+    falls as the window grows), else the longest."""
+    smallest = order + 2 + (order + 1) % 2
+    left = lambda w: sigma * savgol_noise_gain(w, order, dt, weights)  # noqa: E731
+    window = _shortest(lambda w: left(w) <= target, smallest, max(smallest, longest))
+    reached = window is not None
+    window = window if window is not None else max(smallest, longest)
+    return FilterOptions(window=window, poly_order=order, weights=weights), left(window), reached
+
+
+def _butterworth(sigma: float, dt: float, order: int, target: float, lowest: float
+                 ) -> tuple[FilterOptions, float, bool]:
+    """The highest cutoff (4 significant digits) whose noise left meets the target, else ``lowest``."""
+    left = lambda fc: sigma * butterworth_noise_gain(fc, order, dt)  # noqa: E731
+    if left(lowest) > target:
+        return FilterOptions(cutoff=lowest, butter_order=order), left(lowest), False
+    lo, hi = math.log(lowest), math.log(0.499 / dt)  # left(exp(lo)) <= target
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if left(math.exp(mid)) <= target else (lo, mid)
+    cutoff = float(f"{math.exp(lo):.4g}")
+    if left(cutoff) > target:  # rounding went up
+        cutoff = float(f"{cutoff * (1 - 1e-3):.4g}")
+    return FilterOptions(cutoff=cutoff, butter_order=order), left(cutoff), True
+
+
+def choose_differentiation(source: Log | np.ndarray, dt: float | None = None, *, prefer: Preference = "auto",
+                           columns: Sequence[int] | None = None, target: float = NOISE_TARGET,
+                           tail: float = 0.01, segment: float = SEGMENT, poly_order: int = 4,
+                           weights: SavgolWeights = "uniform", butter_order: int = 6) -> DiffChoice:
+    """Choose the differentiation scheme and its window or cutoff from the positions (module docstring).
+
+    Deterministic: the same positions give the same choice.
+
+    Args:
+        source: a :class:`~wbfriction.logs.log.Log` (its positions ``q``, longest segment, and
+            its ``dt``) or positions (N, n) or (N,) [rad].
+        dt: sampling period [s] (required for an array; overrides the log's).
+        prefer: the filter family when a filter is needed (``auto``: Savitzky-Golay).
+        columns: the joints (columns of ``q``) to analyse; default all.
+        target: most RMS noise left in the acceleration [rad/s^2].
+        tail: share of the content's power left above its end
+            (:func:`~wbfriction.signals.spectrum.suggest_cutoff`).
+        segment: length of the averaged spectrum's segments [s].
+        poly_order, weights: the Savitzky-Golay fit's; butter_order: the Butterworth's.
+
+    Raises:
+        InputError: an unknown preference or column, a non-positive target, too few samples
+            (:func:`acceleration_content`).
+    """
+    if prefer not in PREFERENCES:
+        raise InputError(f"unknown filter preference '{prefer}': choose one of {', '.join(PREFERENCES)}")
+    if not target > 0:
+        raise InputError(f"differentiation choice: the noise target must be > 0 rad/s^2, got {target}")
+    q, dt = _positions(source, dt)
+    if q.ndim == 1:
+        q = q[:, None]
+    if columns is not None:
+        bad = [c for c in columns if not -q.shape[1] <= c < q.shape[1]]
+        if bad:
+            raise InputError(f"differentiation choice: column {bad[0]} is not one of the {q.shape[1]} joints")
+        q = q[:, list(columns)]
+    content = acceleration_content(q, dt, tail, segment)
+    fs, m = 1.0 / dt, content.moving
+    if not m.any():
+        sigma = float(np.median(content.position_noise))
+        return DiffChoice("central", FilterOptions(), "central differences: the positions hold no motion above "
+                          "their noise", math.nan, tuple(float(c) for c in content.content_end), sigma, target,
+                          sigma * central_noise_gain(dt), sigma * central_noise_gain(dt), math.nan, True, fs,
+                          int(q.shape[1]), 0)
+    sigma = float(np.median(content.position_noise[m]))
+    end = float(np.median(content.content_end[m]))
+    central = sigma * central_noise_gain(dt)
+    choice = DiffChoice("central", FilterOptions(), "", end, tuple(float(c) for c in content.content_end), sigma,
+                        target, central, central, math.nan, True, fs, int(q.shape[1]), int(m.sum()))
+    facts = (f"position noise {sigma:.2g} rad at {fs:.4g} Hz; the acceleration's content ends at {end:.3g} Hz "
+             f"(median of {choice.n_moving} joints, {content.content_end[m].min():.3g}-"
+             f"{content.content_end[m].max():.3g} Hz)")
+    if central <= target:
+        return replace(choice, reason=f"central differences: they leave {central:.2g} rad/s^2 of noise in the "
+                                      f"acceleration (target {target:g}); {facts}")
+    if prefer == "butterworth":
+        options, left, reached = _butterworth(sigma, dt, butter_order, target, lowest=float(content.freq[1]))
+        f3, label = options.cutoff, f"butterworth {options.cutoff:.4g} Hz order {butter_order}"
+    else:
+        options, left, reached = _savgol(sigma, dt, poly_order, weights, target, longest=len(q) // 2 * 2 - 1)
+        f3 = savgol_cutoff(options.window, poly_order, dt, weights)
+        label = (f"savgol L={options.window} k={poly_order}" + ("" if weights == "uniform" else f" {weights}")
+                 + f" (-3 dB at {f3:.3g} Hz)")
+    why = "the least filtering that meets the noise target" if reached else "the most filtering allowed"
+    return replace(choice, scheme="butterworth" if prefer == "butterworth" else "savgol", filtering=options,
+                   noise_left=left, filter_cutoff=f3, reached=reached,
+                   reason=f"{label}, {why}: it leaves {left:.2g} rad/s^2 of noise in the acceleration (target "
+                          f"{target:g}; central differences {central:.3g}); {facts}")

@@ -1,0 +1,191 @@
+"""The whole path on a real robot's logs: a KUKA LWR4+ (FloBaRoID's recordings, ../shared/real-data).
+
+Three runs, link-side joint torque sensors, receive-time stamps scattered around a 5 ms clock; runs
+1 and 2 repeat one trajectory, run 3 moves differently. There is no ground-truth friction: what
+must hold is what a real robot's model must do, predict torques it was not fitted on (run 3),
+against the given URDF and against the peer's (FloBaRoID's) identified URDF.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+import pyarrow.parquet as pq
+import pytest
+
+from helpers import KUKA, KUKA_CONFIG, KUKA_URDF, kuka_table, needs_kuka
+from wbfriction.export.mjcf import write_mjcf
+from wbfriction.export.urdf import write_friction_urdf
+from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.fit import fit_estimate
+from wbfriction.friction.predict import predict_torques
+from wbfriction.inertia.identification import InertialOptions
+from wbfriction.logs.clock import read_clock
+from wbfriction.logs.log import log_from_table
+from wbfriction.model import load_robot
+from wbfriction.pipeline.estimate import RobotSpec, estimate_file
+from wbfriction.pipeline.fit import fit_file
+from wbfriction.pipeline.identify import identify_file
+from wbfriction.signals.kinematics import measure
+
+pytestmark = needs_kuka
+OPTIONS = EstimateOptions(diff="auto")
+
+
+@pytest.fixture(scope="module")
+def logs(tmp_path_factory) -> dict[str, Path]:
+    """The runs in the log format, as the example converts them (stamps untouched)."""
+    folder = tmp_path_factory.mktemp("kuka")
+    out = {}
+    for name, runs in (("run1", (1,)), ("run2", (2,)), ("run3", (3,)), ("runs12", (1, 2))):
+        out[name] = folder / f"{name}.parquet"
+        pq.write_table(kuka_table(*runs), out[name])
+    return out
+
+
+def robot(urdf: Path):
+    return load_robot(urdf=urdf, config=KUKA_CONFIG)
+
+
+def flobaroid_urdf(folder: Path) -> Path:
+    """FloBaRoID's identified URDF without its <dynamics> tags (negative friction: Pinocchio refuses it)."""
+    path = folder / "flobaroid.urdf"
+    path.write_text(re.sub(r"<dynamics[^>]*/>", "", (KUKA / "kuka_lwr4_identified.urdf").read_text()))
+    return path
+
+
+@pytest.fixture(scope="module")
+def identified(logs, tmp_path_factory) -> Path:
+    """Inertias and friction identified on runs 1 and 2 (link-side sensors: no armature)."""
+    out = tmp_path_factory.mktemp("identified") / "kuka_identified.urdf"
+    identify_file(robot(KUKA_URDF), logs["runs12"], out, options=InertialOptions(armature="none", stride=1))
+    return out
+
+
+def trained(urdf: Path, logs: dict[str, Path]):
+    """A model: ``urdf``'s inertias and the friction fitted (``auto``) on runs 1-2 estimated with them;
+    returns the robot, the fits by joint and run 3's estimate with the same inertias."""
+    r = robot(urdf)
+    train = estimate_log(r, log_from_table(pq.read_table(logs["runs12"]), r, "runs12"), OPTIONS)
+    fits = {f.joint: f for f in fit_estimate(train, model="auto")}
+    test = estimate_log(r, log_from_table(pq.read_table(logs["run3"]), r, "run3"), OPTIONS)
+    return r, fits, test
+
+
+def test_stamps_are_read_as_receive_time_stamps_of_a_5_ms_clock(logs):
+    for name in ("run1", "run2", "run3"):
+        time = pq.read_table(logs[name], columns=["time"]).column("time").to_numpy()
+        step = np.diff(time)
+        assert step.min() < 3.5e-3 and step.max() > 6.4e-3  # as recorded: not uniform
+        q = pq.read_table(logs[name], columns=[f"q.lwr_{i}_joint" for i in range(7)])
+        clock = read_clock(time, name, q=np.column_stack([c.to_numpy() for c in q.columns]))
+        assert clock.kind == "jittered" and "regularised" in clock.reason
+        assert clock.period == pytest.approx(5e-3, rel=1e-4)
+
+
+def test_estimate_and_fit_run_on_each_run(logs, tmp_path):
+    spec = RobotSpec(None, str(KUKA_URDF), str(KUKA_CONFIG))
+    for name in ("run1", "run2", "run3"):
+        out = tmp_path / f"{name}_friction.parquet"
+        result = estimate_file(spec, logs[name], out, OPTIONS)
+        assert result.rows == 5027 and "regularised" in result.clock and result.differentiation
+        fitted = fit_file(out, tmp_path / f"{name}_params.json")
+        assert len(fitted.fits) == 7 and all(f.params is not None for f in fitted.fits)
+        for f in fitted.fits:  # dissipative where it is identified
+            assert f.params.F_c >= 0 and f.params.F_v >= 0
+
+
+def test_logged_velocities_lag_by_what_the_controller_filter_adds(logs):
+    r = robot(KUKA_URDF)
+    log = log_from_table(pq.read_table(logs["run1"]), r, "run1")
+    kin = measure(log, "central", velocity="logged")
+    lag = kin.metadata["velocity"]
+    assert 1e-3 < lag["lag_s"] < 3e-3 and lag["correlation"] > 0.99  # about 2 ms, stated
+
+
+def test_the_identified_model_predicts_the_held_out_run(logs, identified):
+    """Run 3's torques (a trajectory none of the models was fitted on), RMS per joint [N·m]."""
+    def held_out(urdf: Path):
+        _, fits, test = trained(urdf, logs)
+        return predict_torques(test, {j: f.params for j, f in fits.items()})
+
+    given, flo, ident = held_out(KUKA_URDF), held_out(flobaroid_urdf(identified.parent)), held_out(identified)
+    overall = lambda p: float(np.sqrt(np.mean(p.rms**2)))  # noqa: E731
+    print("\nheld-out RMS [N·m]  given", np.round(given.rms, 3), "FloBaRoID", np.round(flo.rms, 3),
+          "identified", np.round(ident.rms, 3))
+    assert np.all(ident.rms < given.rms)  # every joint better than the given URDF with its best friction
+    assert overall(ident) < 0.6 * overall(given)
+    assert overall(ident) < overall(flo)  # better than the peer's identified URDF, overall
+    assert np.sum(ident.rms < flo.rms) >= 5  # and on 5 of the 7 joints (not lwr_3, lwr_5: see the issue note)
+
+
+def test_identified_friction_dissipates(logs, identified):
+    """Eq. 7.9 after identification: the share of samples whose friction generates power falls
+    under 5 % on the joints whose friction stands above the model's residual."""
+    from wbfriction.friction.energy import generating_share
+
+    r = robot(identified)
+    est = estimate_log(r, log_from_table(pq.read_table(logs["runs12"]), r, "runs12"), OPTIONS)
+    fits = {f.joint: f for f in fit_estimate(est, model="auto")}
+    share = {j: generating_share(est.qd[est.valid[:, i], i], est.tau_f[est.valid[:, i], i], fits[j].params.tau_os)
+             for i, j in enumerate(est.joints)}
+    print("\ngenerating share after identification", {j: round(100 * s, 1) for j, s in share.items()})
+    assert all(share[j] < 0.05 for j in ("lwr_0_joint", "lwr_1_joint", "lwr_3_joint", "lwr_4_joint", "lwr_5_joint"))
+
+
+def test_repeated_runs_agree_where_their_torques_do(logs, identified):
+    """Runs 1 and 2 repeat one trajectory: the wrist joints' friction curves agree within 5 % RMS over
+    their common velocity range. (Joints 0-3 do not: their measured torques themselves differ by
+    0.19-0.26 N·m RMS, all below 2 Hz, with the same motion: the robot changed between the runs.)"""
+    r = robot(identified)
+    ests = [estimate_log(r, log_from_table(pq.read_table(logs[n]), r, n), OPTIONS) for n in ("run1", "run2")]
+    fits = [{f.joint: f.params for f in fit_estimate(e, model="auto")} for e in ests]
+    for k, j in enumerate(r.torque_controlled):
+        if j not in ("lwr_5_joint", "lwr_6_joint"):
+            continue
+        v = np.linspace(max(np.nanmin(e.qd[:, k]) for e in ests), min(np.nanmax(e.qd[:, k]) for e in ests), 401)
+        a, b = fits[0][j].f(v), fits[1][j].f(v)
+        assert np.sqrt(np.mean((a - b) ** 2)) < 0.05 * np.sqrt(np.mean(((a + b) / 2) ** 2)), j
+
+
+def test_the_exported_mjcf_predicts_run3_with_its_friction(logs, identified, tmp_path):
+    """MuJoCo's own inverse dynamics (mj_inverse) on run 3's measured motion, with the MJCF written for
+    the identified model: its damping and frictionloss make the torques closer to the measured ones."""
+    r, fits, _ = trained(identified, logs)
+    friction = {j: f for j, f in fits.items() if f.params is not None}
+    log = log_from_table(pq.read_table(logs["run3"]), r, "run3")
+    kin = measure(log, "central")
+    rms = {}
+    for label, fr in (("with", friction), ("without", {})):
+        model = write_mjcf(r, fr, tmp_path / f"kuka_{label}.xml")
+        data = mujoco.MjData(model)
+        ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in r.actuated]
+        dof, qpos = [model.jnt_dofadr[i] for i in ids], [model.jnt_qposadr[i] for i in ids]
+        rows = np.flatnonzero(kin.valid)
+        pred = np.empty((len(rows), len(ids)))
+        for n, k in enumerate(rows):
+            data.qpos[qpos], data.qvel[dof], data.qacc[dof] = kin.q[k], kin.qd[k], kin.qdd[k]
+            mujoco.mj_inverse(model, data)
+            pred[n] = data.qfrc_inverse[dof]
+        rms[label] = np.sqrt(np.mean((kin.tau[rows] - pred) ** 2, axis=0))
+    print("\nmj_inverse on run 3, RMS [N·m]: with friction", np.round(rms["with"], 3), "without",
+          np.round(rms["without"], 3))
+    assert np.sqrt(np.mean(rms["with"] ** 2)) < 0.9 * np.sqrt(np.mean(rms["without"] ** 2))
+
+
+def test_the_exported_urdf_reloads_as_the_identified_model(logs, identified, tmp_path):
+    r, fits, _ = trained(identified, logs)
+    out = tmp_path / "kuka_friction.urdf"
+    write_friction_urdf(r, {j: f for j, f in fits.items() if f.params is not None}, out)
+    back = pin.buildModelFromUrdf(str(out))
+    ref = pin.buildModelFromUrdf(str(identified))
+    for j in range(1, ref.njoints):
+        assert np.allclose(back.inertias[j].toDynamicParameters(), ref.inertias[j].toDynamicParameters(), atol=1e-9)
+    for j, f in fits.items():
+        v = back.idx_vs[back.getJointId(j)]
+        assert back.damping[v] == pytest.approx(f.params.F_v, rel=1e-9, abs=1e-12)
+        assert back.friction[v] == pytest.approx(f.params.F_c, rel=1e-9, abs=1e-12)
