@@ -89,6 +89,11 @@ def test_stamps_are_read_as_receive_time_stamps_of_a_5_ms_clock(logs):
 
 def test_estimate_and_fit_run_on_each_run(logs, tmp_path):
     spec = RobotSpec(None, str(KUKA_URDF), str(KUKA_CONFIG))
+    both = estimate_file(spec, logs["runs12"], tmp_path / "runs12_friction.parquet", OPTIONS)
+    assert "1 gap(s) split it into 2 segments" in both.clock
+    # the jump between the two recordings is not noise: the same choice as on one recording (smooth
+    # positions: central differences)
+    assert both.differentiation.startswith("central differences")
     for name in ("run1", "run2", "run3"):
         out = tmp_path / f"{name}_friction.parquet"
         result = estimate_file(spec, logs[name], out, OPTIONS)

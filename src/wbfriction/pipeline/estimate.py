@@ -20,6 +20,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
@@ -127,6 +128,15 @@ def _with_provenance(tables: Iterator[pa.Table], chunks: list[Chunk], robot: Rob
         raise no_single_support(robot, source)
 
 
+def _longest_segment(q: np.ndarray | None, clock: Clock) -> np.ndarray | None:
+    """The rows of ``q`` (the first rows of a log) in its longest segment: a gap between two recordings
+    is no noise to measure."""
+    if q is None:
+        return None
+    a, b = max(((a, min(b, len(q))) for a, b in clock.segments if a < len(q)), key=lambda s: s[1] - s[0])
+    return q[a:b]
+
+
 @dataclass
 class ChunkedResult:
     """What :func:`estimate_file` did: rows, chunks, and their contact-change cuts; ``clock``: the
@@ -175,7 +185,8 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     robot = robot if robot is not None else spec.load()
     file = TableFile(path)
     contact, clock = plan_columns(file, robot, source, max_gap, time_base)
-    options, choice = resolve_differentiation(options, first_positions(file, robot), clock.step)
+    first = _longest_segment(first_positions(file, robot), clock)
+    options, choice = resolve_differentiation(options, first, clock.step)
     if choice is not None:
         extra_metadata = {**(extra_metadata or {}), "differentiation": choice.to_dict()}
     n = len(contact)
