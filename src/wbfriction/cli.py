@@ -580,7 +580,7 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
         out.print(table)
     toml = done.armature_toml()
     if toml is not None:
-        out.print("identified armature [kg·m^2], for the robot's TOML:\n" + escape(toml), highlight=False)
+        out.print(escape("identified armature [kg·m^2], for the robot's TOML:\n" + toml), highlight=False)
     if moved:
         console.print(f"[yellow]note:[/] the whole identified body went to the child link of {', '.join(moved)} "
                       "(lighter than the links merged with it)")
