@@ -9,6 +9,7 @@ against the given URDF and against the peer's (FloBaRoID's) identified URDF.
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
@@ -20,13 +21,13 @@ import pytest
 from helpers import KUKA, KUKA_CONFIG, KUKA_URDF, kuka_table, needs_kuka
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.export.urdf import write_friction_urdf
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
-from wbfriction.friction.fit import fit_estimate
+from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_log
+from wbfriction.friction.fit import FitResult, fit_estimate
 from wbfriction.friction.predict import predict_torques
 from wbfriction.inertia.identification import InertialOptions
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.log import log_from_table
-from wbfriction.model import load_robot
+from wbfriction.model import Robot, load_robot
 from wbfriction.pipeline.estimate import RobotSpec, estimate_file
 from wbfriction.pipeline.fit import fit_file
 from wbfriction.pipeline.identify import identify_file
@@ -66,14 +67,27 @@ def identified(logs, tmp_path_factory) -> Path:
     return out
 
 
-def trained(urdf: Path, logs: dict[str, Path]):
-    """A model: ``urdf``'s inertias and the friction fitted (``auto``) on runs 1-2 estimated with them;
-    returns the robot, the fits by joint and run 3's estimate with the same inertias."""
+@dataclass
+class Trained:
+    """A model: a URDF's inertias and the friction fitted (``auto``) on runs 1-2 estimated with them;
+    ``train`` that estimate, ``test`` run 3's with the same inertias."""
+
+    robot: Robot
+    train: FrictionEstimate
+    fits: dict[str, FitResult]
+    test: FrictionEstimate
+
+
+def trained(urdf: Path, logs: dict[str, Path]) -> Trained:
     r = robot(urdf)
     train = estimate_log(r, log_from_table(pq.read_table(logs["runs12"]), r, "runs12"), OPTIONS)
-    fits = {f.joint: f for f in fit_estimate(train, model="auto")}
     test = estimate_log(r, log_from_table(pq.read_table(logs["run3"]), r, "run3"), OPTIONS)
-    return r, fits, test
+    return Trained(r, train, {f.joint: f for f in fit_estimate(train, model="auto")}, test)
+
+
+@pytest.fixture(scope="module")
+def identified_model(logs, identified) -> Trained:
+    return trained(identified, logs)
 
 
 def test_stamps_are_read_as_receive_time_stamps_of_a_5_ms_clock(logs):
@@ -112,13 +126,13 @@ def test_logged_velocities_lag_by_what_the_controller_filter_adds(logs):
     assert 1e-3 < lag["lag_s"] < 3e-3 and lag["correlation"] > 0.99  # about 2 ms, stated
 
 
-def test_the_identified_model_predicts_the_held_out_run(logs, identified):
+def test_the_identified_model_predicts_the_held_out_run(logs, identified, identified_model):
     """Run 3's torques (a trajectory none of the models was fitted on), RMS per joint [N·m]."""
-    def held_out(urdf: Path):
-        _, fits, test = trained(urdf, logs)
-        return predict_torques(test, {j: f.params for j, f in fits.items()})
+    def held_out(model: Trained):
+        return predict_torques(model.test, {j: f.params for j, f in model.fits.items()})
 
-    given, flo, ident = held_out(KUKA_URDF), held_out(flobaroid_urdf(identified.parent)), held_out(identified)
+    given, flo = held_out(trained(KUKA_URDF, logs)), held_out(trained(flobaroid_urdf(identified.parent), logs))
+    ident = held_out(identified_model)
     overall = lambda p: float(np.sqrt(np.mean(p.rms**2)))  # noqa: E731
     print("\nheld-out RMS [N·m]  given", np.round(given.rms, 3), "FloBaRoID", np.round(flo.rms, 3),
           "identified", np.round(ident.rms, 3))
@@ -128,14 +142,12 @@ def test_the_identified_model_predicts_the_held_out_run(logs, identified):
     assert np.sum(ident.rms < flo.rms) >= 5  # and on 5 of the 7 joints (not lwr_3, lwr_5: see the issue note)
 
 
-def test_identified_friction_dissipates(logs, identified):
+def test_identified_friction_dissipates(identified_model):
     """Eq. 7.9 after identification: the share of samples whose friction generates power falls
     under 5 % on the joints whose friction stands above the model's residual."""
     from wbfriction.friction.energy import generating_share
 
-    r = robot(identified)
-    est = estimate_log(r, log_from_table(pq.read_table(logs["runs12"]), r, "runs12"), OPTIONS)
-    fits = {f.joint: f for f in fit_estimate(est, model="auto")}
+    est, fits = identified_model.train, identified_model.fits
     share = {j: generating_share(est.qd[est.valid[:, i], i], est.tau_f[est.valid[:, i], i], fits[j].params.tau_os)
              for i, j in enumerate(est.joints)}
     print("\ngenerating share after identification", {j: round(100 * s, 1) for j, s in share.items()})
@@ -157,10 +169,10 @@ def test_repeated_runs_agree_where_their_torques_do(logs, identified):
         assert np.sqrt(np.mean((a - b) ** 2)) < 0.05 * np.sqrt(np.mean(((a + b) / 2) ** 2)), j
 
 
-def test_the_exported_mjcf_predicts_run3_with_its_friction(logs, identified, tmp_path):
+def test_the_exported_mjcf_predicts_run3_with_its_friction(logs, identified_model, tmp_path):
     """MuJoCo's own inverse dynamics (mj_inverse) on run 3's measured motion, with the MJCF written for
     the identified model: its damping and frictionloss make the torques closer to the measured ones."""
-    r, fits, _ = trained(identified, logs)
+    r, fits = identified_model.robot, identified_model.fits
     friction = {j: f for j, f in fits.items() if f.params is not None}
     log = log_from_table(pq.read_table(logs["run3"]), r, "run3")
     kin = measure(log, "central")
@@ -182,8 +194,8 @@ def test_the_exported_mjcf_predicts_run3_with_its_friction(logs, identified, tmp
     assert np.sqrt(np.mean(rms["with"] ** 2)) < 0.9 * np.sqrt(np.mean(rms["without"] ** 2))
 
 
-def test_the_exported_urdf_reloads_as_the_identified_model(logs, identified, tmp_path):
-    r, fits, _ = trained(identified, logs)
+def test_the_exported_urdf_reloads_as_the_identified_model(identified, identified_model, tmp_path):
+    r, fits = identified_model.robot, identified_model.fits
     out = tmp_path / "kuka_friction.urdf"
     write_friction_urdf(r, {j: f for j, f in fits.items() if f.params is not None}, out)
     back = pin.buildModelFromUrdf(str(out))

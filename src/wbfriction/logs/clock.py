@@ -181,6 +181,12 @@ def _segments(gap: np.ndarray, n: int) -> list[tuple[int, int]]:
     return list(zip(edges[:-1], edges[1:]))
 
 
+def longest_segment(segments: list[tuple[int, int]] | None, rows: int) -> tuple[int, int]:
+    """The longest of ``segments`` (half-open row ranges; None: one segment) within the first ``rows`` rows."""
+    clipped = [(a, min(b, rows)) for a, b in segments or [(0, rows)] if a < rows]
+    return max(clipped, key=lambda s: s[1] - s[0]) if clipped else (0, 0)
+
+
 def split_at_gaps(stamps: np.ndarray, source: str, max_gap: float = MAX_GAP, rel_tol: float = JITTER,
                   first_row: int = 0) -> list[tuple[int, int]]:
     """Check a time column and split it at its gaps: steps of at least ``max_gap`` (less

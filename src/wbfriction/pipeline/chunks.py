@@ -86,10 +86,11 @@ def plan_chunks(contact: np.ndarray, chunking: Chunking = Chunking()) -> list[Ch
 
 
 def plan_columns(file: TableFile, robot: Robot, source: str, max_gap: float = MAX_GAP,
-                 time_base: TimeBase = "auto") -> tuple[np.ndarray, Clock]:
-    """The contact columns of a log file (N, n_contacts), read alone to plan its chunks, and the
-    whole log's clock (:func:`~wbfriction.logs.clock.read_clock`: its stamps, and the positions of
-    its first :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS` rows when they are finite).
+                 time_base: TimeBase = "auto") -> tuple[np.ndarray, Clock, np.ndarray | None]:
+    """The contact columns of a log file (N, n_contacts), read alone to plan its chunks, the whole
+    log's clock (:func:`~wbfriction.logs.clock.read_clock`: its stamps, and the positions of its
+    first :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS` rows when they are finite), and those
+    positions (:func:`first_positions`, None when not finite).
 
     Raises:
         InputError: an unreadable file, a time column that :func:`~wbfriction.logs.clock.read_clock`
@@ -103,9 +104,9 @@ def plan_columns(file: TableFile, robot: Robot, source: str, max_gap: float = MA
             raise ColumnError(source, c, None, f"missing column '{c}'")
     flags = (np.column_stack([table.column(c).to_numpy(zero_copy_only=False) for c in columns[1:]])
              if robot.floating_base else np.ones((table.num_rows, 1)))  # a fixed base: always welded
-    stamps = table_stamps(table, source)
-    return np.nan_to_num(flags.astype(float)) != 0, read_clock(stamps, source, max_gap=max_gap,
-                                                               q=first_positions(file, robot), time_base=time_base)
+    first = first_positions(file, robot)
+    clock = read_clock(table_stamps(table, source), source, max_gap=max_gap, q=first, time_base=time_base)
+    return np.nan_to_num(flags.astype(float)) != 0, clock, first
 
 
 def first_positions(file: TableFile, robot: Robot) -> np.ndarray | None:

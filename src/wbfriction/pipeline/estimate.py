@@ -20,20 +20,19 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import EstimateOptions, estimate_log, no_single_support, resolve_differentiation
 from wbfriction.friction.io import friction_table
-from wbfriction.logs.clock import Clock, TimeBase
+from wbfriction.logs.clock import Clock, TimeBase, longest_segment
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, log_from_table
 from wbfriction.logs.source import LogSource
 from wbfriction.logs.tables import RowReader, TableFile, read_metadata, with_metadata, write_tables
 from wbfriction.model.loading import load_robot
 from wbfriction.model.robot import Robot
-from wbfriction.pipeline.chunks import CONTEXT, Chunk, Chunking, first_positions, plan_chunks, plan_columns
+from wbfriction.pipeline.chunks import CONTEXT, Chunk, Chunking, plan_chunks, plan_columns
 from wbfriction.progress import Progress
 
 
@@ -60,7 +59,7 @@ def check_file(robot: Robot, path: str | Path, source: str | None = None, chunki
     """
     file = TableFile(path)
     source = source or str(file.path)
-    contact, clock = plan_columns(file, robot, source, max_gap, time_base)
+    contact, clock, _ = plan_columns(file, robot, source, max_gap, time_base)
     reader = file.row_reader(max(1024, min(chunking.rows, 65_536)))
     for c in plan_chunks(contact, chunking):
         log_from_table(reader.rows(c.read_start, c.read_stop), robot, source, max_gap, limit_margin,
@@ -128,15 +127,6 @@ def _with_provenance(tables: Iterator[pa.Table], chunks: list[Chunk], robot: Rob
         raise no_single_support(robot, source)
 
 
-def _longest_segment(q: np.ndarray | None, clock: Clock) -> np.ndarray | None:
-    """The rows of ``q`` (the first rows of a log) in its longest segment: a gap between two recordings
-    is no noise to measure."""
-    if q is None:
-        return None
-    a, b = max(((a, min(b, len(q))) for a, b in clock.segments if a < len(q)), key=lambda s: s[1] - s[0])
-    return q[a:b]
-
-
 @dataclass
 class ChunkedResult:
     """What :func:`estimate_file` did: rows, chunks, and their contact-change cuts; ``clock``: the
@@ -184,8 +174,10 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     source = source or str(path)
     robot = robot if robot is not None else spec.load()
     file = TableFile(path)
-    contact, clock = plan_columns(file, robot, source, max_gap, time_base)
-    first = _longest_segment(first_positions(file, robot), clock)
+    contact, clock, first = plan_columns(file, robot, source, max_gap, time_base)
+    if first is not None:  # the noise is measured on one segment: a gap between two recordings is no noise
+        a, b = longest_segment(clock.segments, len(first))
+        first = first[a:b]
     options, choice = resolve_differentiation(options, first, clock.step)
     if choice is not None:
         extra_metadata = {**(extra_metadata or {}), "differentiation": choice.to_dict()}

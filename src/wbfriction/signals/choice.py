@@ -60,6 +60,7 @@ from scipy.signal import sosfreqz
 from scipy.signal.windows import hann
 
 from wbfriction.exceptions import InputError
+from wbfriction.logs.clock import longest_segment
 from wbfriction.logs.log import Log
 from wbfriction.signals.filters import SavgolWeights, ZeroPhaseLowpass, savgol_kernels
 from wbfriction.signals.kinematics import FilterOptions
@@ -332,8 +333,8 @@ class DiffChoice:
 
 def _positions(source: Log | np.ndarray, dt: float | None) -> tuple[np.ndarray, float]:
     if isinstance(source, Log):
-        rows = max(source.segments or [(0, len(source.time))], key=lambda r: r[1] - r[0])
-        return source.q[rows[0]:rows[1]], source.dt if dt is None else dt
+        a, b = longest_segment(source.segments, len(source.time))
+        return source.q[a:b], source.dt if dt is None else dt
     if dt is None:
         raise InputError("differentiation choice: positions given as an array need the sample period dt")
     return np.asarray(source, dtype=float), dt

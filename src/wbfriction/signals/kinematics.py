@@ -272,19 +272,18 @@ def _filtered(log: Log, tau: np.ndarray, smoother: Smoother, filtering: FilterOp
     leg F_v 15.6 % with the velocity NaN in the margins, 6.0 % with it filled)."""
     blank = straddling(log.contact)[:, None]
     t = time_base(log)
-    qd_raw = (central_differences(log.q, log.dt) if t is None else NONUNIFORM_DIFFERENTIATORS["central"](log.q, t))[0]
-    qd_raw = np.where(blank, np.nan, qd_raw)
+    qd_c, qdd_c, _ = (central_differences(log.q, log.dt) if t is None
+                      else NONUNIFORM_DIFFERENTIATORS["central"](log.q, t))
+    qd_c, qdd_c = np.where(blank, np.nan, qd_c), np.where(blank, np.nan, qdd_c)
     if isinstance(smoother, NonUniformSavgol | ResampledLowpass):  # on the actual times (nonuniform)
         q_s, qd_s, qdd = smoother.differentiate(np.where(blank, np.nan, log.q))
     elif isinstance(smoother, SavgolSmoother):  # derivatives of one local fit (7.1-7.8)
         q_s, qd_s, qdd = savgol_differentiate(np.where(blank, np.nan, log.q), log.dt, filtering.window,
                                               filtering.poly_order, filtering.weights)
-    else:  # central differences through the zero-phase low-pass (7.1.2)
-        qd_c, qdd_c, _ = central_differences(log.q, log.dt)
-        qd_c, qdd_c = np.where(blank, np.nan, qd_c), np.where(blank, np.nan, qdd_c)
+    else:  # central differences through the zero-phase low-pass (7.1.2), uniform samples
         q_s, qd_s, qdd = smoother(np.where(blank, np.nan, log.q)), smoother(qd_c), smoother(qdd_c)
     tau = smoother(np.where(blank, np.nan, tau))
-    return np.where(np.isfinite(q_s), q_s, log.q), np.where(np.isfinite(qd_s), qd_s, qd_raw), qdd, tau
+    return np.where(np.isfinite(q_s), q_s, log.q), np.where(np.isfinite(qd_s), qd_s, qd_c), qdd, tau
 
 
 Velocity = Literal["differentiated", "logged"]
