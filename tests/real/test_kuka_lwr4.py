@@ -142,9 +142,12 @@ def test_the_identified_model_predicts_the_held_out_run(logs, identified, identi
     assert np.sum(ident.rms < flo.rms) >= 5  # and on 5 of the 7 joints (not lwr_3, lwr_5: see the issue note)
 
 
-def test_identified_friction_dissipates(identified_model):
+def test_identified_friction_dissipates(identified_model, logs):
     """Eq. 7.9 after identification: the share of samples whose friction generates power falls
-    under 5 % on the joints whose friction stands above the model's residual."""
+    under 5 % on the joints whose friction stands above the model's residual. Not on lwr_6: its
+    friction (about 0.04 N·m) is a fifth of a torque periodic in its own angle (harmonics 1 and 2,
+    about 0.2 N·m: torque sensing or transmission ripple, neither friction nor inertia), which,
+    learned on runs 1-2, predicts run 3's residual: the 52 % is that torque, not friction."""
     from wbfriction.friction.energy import generating_share
 
     est, fits = identified_model.train, identified_model.fits
@@ -153,20 +156,79 @@ def test_identified_friction_dissipates(identified_model):
     print("\ngenerating share after identification", {j: round(100 * s, 1) for j, s in share.items()})
     assert all(share[j] < 0.05 for j in ("lwr_0_joint", "lwr_1_joint", "lwr_3_joint", "lwr_4_joint", "lwr_5_joint"))
 
+    k, joint = 6, "lwr_6_joint"
+    params = fits[joint].params
 
-def test_repeated_runs_agree_where_their_torques_do(logs, identified):
-    """Runs 1 and 2 repeat one trajectory: the wrist joints' friction curves agree within 5 % RMS over
-    their common velocity range. (Joints 0-3 do not: their measured torques themselves differ by
-    0.19-0.26 N·m RMS, all below 2 Hz, with the same motion: the robot changed between the runs.)"""
+    def residual_and_harmonics(e: FrictionEstimate, log: str):
+        use = e.valid[:, k]
+        q = pq.read_table(logs[log]).column(f"q.{joint}").to_numpy()[use]
+        harmonics = np.column_stack([np.ones_like(q), np.sin(q), np.cos(q), np.sin(2 * q), np.cos(2 * q)])
+        return -e.tau_f[use, k] - params.f(e.qd[use, k]), harmonics
+
+    rms = lambda x: float(np.sqrt(np.mean(x**2)))  # noqa: E731
+    train, h_train = residual_and_harmonics(est, "runs12")
+    test, h_test = residual_and_harmonics(identified_model.test, "run3")
+    c, *_ = np.linalg.lstsq(h_train, train, rcond=None)
+    friction = rms(params.f(est.qd[est.valid[:, k], k]) - params.tau_os)
+    print(f"lwr_6: friction {friction:.3f} N·m, residual {rms(train):.3f}; run 3's residual {rms(test):.3f}, "
+          f"{rms(test - h_test @ c):.3f} without the periodic torque learned on runs 1-2")
+    assert share[joint] > 0.2 and friction < 0.25 * rms(train)
+    assert rms(test - h_test @ c) < 0.35 * rms(test)
+
+
+def measured_disagreement(velocity_range: np.ndarray, bins: int = 20) -> np.ndarray:
+    """How much runs 1 and 2 themselves disagree, per joint [N·m], with no model: run 2 aligned on
+    run 1 (the fractional sample shift that best matches their positions: they repeat one
+    trajectory), the difference of their measured torques averaged in bins of velocity over
+    ``velocity_range`` (2, 7), and the RMS of those bin means. With the same motion, the inertial
+    and gravity torques cancel: what is left is friction (or torque sensing) that changed."""
+    from scipy.interpolate import CubicSpline
+
+    one, two = (np.load(KUKA / f"measurements_{i}.npz") for i in (1, 2))
+    n = len(one["times"])
+    rows, inner = np.arange(n), slice(20, n - 20)
+
+    def two_at(shift: float, key: str) -> np.ndarray:
+        return CubicSpline(rows, two[key], axis=0)(np.clip(rows + shift, 0, n - 1))[inner]
+
+    shifts = np.linspace(-3, 3, 601)
+    shift = min(shifts, key=lambda s: float(np.mean((one["positions"][inner] - two_at(s, "positions")) ** 2)))
+    assert np.sqrt(np.mean((one["positions"][inner] - two_at(shift, "positions")) ** 2)) < 2e-4  # the same motion
+    dtau = one["torques"][inner] - two_at(shift, "torques")
+    v = (one["velocities"][inner] + two_at(shift, "velocities")) / 2
+    out = np.empty(v.shape[1])
+    for k in range(v.shape[1]):
+        edges = np.linspace(velocity_range[0, k], velocity_range[1, k], bins + 1)
+        b = np.digitize(v[:, k], edges) - 1
+        out[k] = np.sqrt(np.mean([dtau[b == i, k].mean() ** 2 for i in range(bins) if np.sum(b == i) >= 20]))
+    return out
+
+
+def test_repeated_runs_agree_as_far_as_their_torques_do(logs, identified):
+    """Runs 1 and 2 repeat one trajectory: their friction curves agree within 5 % RMS over their
+    common velocity range, or, where the measured torques themselves changed between the runs
+    (the same motion, 29 min apart), by not much more than they changed: within 1.25 times the
+    velocity-binned difference of the two runs' measured torques (:func:`measured_disagreement`;
+    the fits' own scatter adds to it), both relative to the curve. (Measured: that change is
+    10-27 % of the curve on joints 0-3, so 5 % is out of reach of any friction model that is a
+    function of velocity on these logs.)"""
     r = robot(identified)
     ests = [estimate_log(r, log_from_table(pq.read_table(logs[n]), r, n), OPTIONS) for n in ("run1", "run2")]
     fits = [{f.joint: f.params for f in fit_estimate(e, model="auto")} for e in ests]
+    common = np.array([np.max([np.nanquantile(e.qd, 0.01, axis=0) for e in ests], axis=0),
+                       np.min([np.nanquantile(e.qd, 0.99, axis=0) for e in ests], axis=0)])
+    floor = measured_disagreement(common)
+    rows = []
     for k, j in enumerate(r.torque_controlled):
-        if j not in ("lwr_5_joint", "lwr_6_joint"):
-            continue
-        v = np.linspace(max(np.nanmin(e.qd[:, k]) for e in ests), min(np.nanmax(e.qd[:, k]) for e in ests), 401)
+        v = np.linspace(common[0, k], common[1, k], 401)
         a, b = fits[0][j].f(v), fits[1][j].f(v)
-        assert np.sqrt(np.mean((a - b) ** 2)) < 0.05 * np.sqrt(np.mean(((a + b) / 2) ** 2)), j
+        scale = np.sqrt(np.mean(((a + b) / 2) ** 2))
+        rows.append((j, 100 * np.sqrt(np.mean((a - b) ** 2)) / scale, 100 * floor[k] / scale))
+    print("\nrun 1 vs run 2 [% of the curve]: fitted curves, measured torques",
+          [(j, round(float(c), 1), round(float(m), 1)) for j, c, m in rows])
+    for j, curves, measured in rows:
+        assert curves < max(5.0, 1.25 * measured), (j, curves, measured)
+    assert sum(c < 5.0 for _, c, _ in rows) >= 2  # the wrist joints, where the torques repeat
 
 
 def test_the_exported_mjcf_predicts_run3_with_its_friction(logs, identified_model, tmp_path):
