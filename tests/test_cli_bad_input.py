@@ -141,21 +141,35 @@ def test_usage_errors_exit_2_with_the_usage(capsys, tmp_path):
 
 
 def test_a_time_gap_splits_the_log_instead_of_failing(talos, good, tmp_path, capsys):
-    """A dropped stretch (12 ms) is no error: the two sides are estimated apart, exactly as
-    the two halves written as logs of their own."""
+    """A dropped stretch (12 ms) is no error: the two sides are estimated apart, exactly as the
+    two halves written as logs of their own, except that the lift-off and touch-down margins
+    apply at the gap (what the feet did during it is not known): the rows within them are
+    dropped from the gapped log and kept in the halves, which have no gap."""
     cols = _columns(good, talos)
     cols["time"][30:] += 0.012
     _write(cols, tmp_path / "gap.parquet")
     for half, rows in (("a", slice(0, 30)), ("b", slice(30, None))):
         _write({k: v[rows] for k, v in cols.items()}, tmp_path / f"{half}.parquet")
-    results = {}
-    for name in ("gap", "a", "b"):
-        code, err = run_cli(capsys, "estimate", tmp_path / f"{name}.parquet", "-o", tmp_path / f"f_{name}.parquet")
-        assert code == 0, err
-        results[name] = pq.read_table(tmp_path / f"f_{name}.parquet").column("tau_f.leg_left_4_joint").to_numpy()
-    assert np.isfinite(results["a"]).sum() > 10 and np.isfinite(results["b"]).sum() > 10
-    # equal up to the rounding of the sampling period (each log's median time step)
-    np.testing.assert_allclose(results["gap"], np.concatenate([results["a"], results["b"]]), rtol=1e-12)
+    for margins in (("0", "0"), ("0.01", "0.005")):
+        results = {}
+        for name in ("gap", "a", "b"):
+            code, err = run_cli(capsys, "estimate", tmp_path / f"{name}.parquet", "-o", tmp_path / f"f_{name}.parquet",
+                                "--lift-off", margins[0], "--touch-down", margins[1])
+            assert code == 0, err
+            table = pq.read_table(tmp_path / f"f_{name}.parquet")
+            results[name] = (table.column("tau_f.leg_right_4_joint").to_numpy(),  # the swinging leg
+                             table.column("valid.leg_right_4_joint").to_numpy())
+        tau_f = np.concatenate([results["a"][0], results["b"][0]])
+        valid = np.concatenate([results["a"][1], results["b"][1]])
+        assert results["a"][1].sum() > 10 and results["b"][1].sum() > 10
+        dropped = np.zeros(len(tau_f), dtype=bool)
+        if margins != ("0", "0"):
+            dropped[25:30] = dropped[30:40] = True  # 5 ms before the gap, 10 ms after it
+        inner = ~np.isin(np.arange(60), (0, 29, 30, 59))  # the stencils at the ends of each half
+        assert not results["gap"][1][dropped].any() and valid[dropped & inner].all()
+        np.testing.assert_array_equal(results["gap"][1][~dropped], valid[~dropped])
+        # equal up to the rounding of the sampling period (each log's median time step)
+        np.testing.assert_allclose(results["gap"][0], tau_f, rtol=1e-12)
 
 
 @pytest.mark.parametrize("command", ["convert", "estimate"])

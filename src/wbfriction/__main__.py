@@ -1,3 +1,6 @@
-from wbfriction.cli import main
+"""``python -m wbfriction``: the command line, its signals handled first (:mod:`wbfriction.entry`)."""
 
-main()
+from wbfriction.entry import main
+
+if __name__ == "__main__":
+    main()

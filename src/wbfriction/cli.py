@@ -31,7 +31,7 @@ from wbfriction.friction.fit import FitResult, ModelChoice
 from wbfriction.friction.models import ALL_PARAM_NAMES, PARAM_NAMES
 from wbfriction.friction.targets import load_friction_toml
 from wbfriction.inertia.identification import ArmatureMode, InertialOptions
-from wbfriction.logs.clock import TimeBase
+from wbfriction.logs.clock import TIME_UNITS, TimeBase, TimeUnit
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, write_log
 from wbfriction.logs.source import open_log, read_log
 from wbfriction.logs.tables import TableFile, write_table
@@ -41,6 +41,7 @@ from wbfriction.pipeline.chunks import Chunking
 from wbfriction.pipeline.convert import convert_log
 from wbfriction.pipeline.estimate import RobotSpec, estimate_file, table_log
 from wbfriction.pipeline.fit import fit_file
+from wbfriction.pipeline.paths import check_paths
 from wbfriction.pipeline.provenance import log_provenance
 from wbfriction.signals.filters import SavgolWeights
 from wbfriction.signals.kinematics import Diff, FilterOptions, TorqueAlignment, Velocity
@@ -59,25 +60,29 @@ console = Console(stderr=True)
 out = Console(width=max(Console().width, 150))
 
 RobotOpt = typer.Option("talos", "--robot", help="Built-in robot name.")
-EnergyThresholdOpt = typer.Option(DEFAULT_THRESHOLD, help="Share of power-generating samples (eq. 7.9) above "
-                                                          "which a joint is flagged.")
-EnergyToleranceOpt = typer.Option(DEFAULT_TOLERANCE, help="Smallest friction torque that counts as generating "
-                                                          "power [N·m] (the torque sensor's resolution).")
+EnergyThresholdOpt = typer.Option(DEFAULT_THRESHOLD, min=0.0, max=1.0,
+                                  help="Share of power-generating samples (eq. 7.9) above which a joint is flagged.")
+EnergyToleranceOpt = typer.Option(DEFAULT_TOLERANCE, min=0.0,
+                                  help="Smallest friction torque that counts as generating power [N·m] (the torque "
+                                       "sensor's resolution).")
 UrdfOpt = typer.Option(None, "--urdf", help="URDF of another robot (with --config), or another URDF of the "
                                              "built-in --robot (e.g. identified inertias).")
 ConfigOpt = typer.Option(None, "--config", help="Robot TOML: contact_frames, position_controlled, groups.")
 FitWorkersOpt = typer.Option(2, min=1, help="Processes fitting joints side by side.")
+TimeUnitOpt = typer.Option(None, help="Unit of a numeric time column: s, ms, us or ns (needed for integer stamps; "
+                                      "float stamps are seconds unless said otherwise; timestamps carry theirs).")
 MapOpt = typer.Option(None, "--map", help="Topic map TOML of a ROS 2 bag log (see 'wbfriction convert').")
 
 
-MaxGapOpt = typer.Option(MAX_GAP, help="Time steps of at least this many local median steps split the log "
+MaxGapOpt = typer.Option(MAX_GAP, min=1.5, help="Time steps of at least this many local median steps split the log "
                                         "into segments, estimated apart.")
 TimeBaseOpt = typer.Option("auto", help="Time base the positions are differentiated on: auto (decided from the "
                                          "data and printed), recorded (the stamps as they are: a clock that "
                                          "skips samples) or regularised (a uniform clock fitted to "
                                          "receive-time stamps).")
-LimitMarginOpt = typer.Option(LIMIT_MARGIN, help="Positions beyond the URDF limits by more than this [rad] are "
-                                                 "refused (wrong units).")
+LimitMarginOpt = typer.Option(LIMIT_MARGIN, min=0.0,
+                              help="Positions beyond the URDF limits by more than this [rad] are refused (wrong "
+                                   "units).")
 
 
 @contextmanager
@@ -98,7 +103,8 @@ def _fit_rows(results: list[FitResult]) -> Table:
     names = [n for n in ALL_PARAM_NAMES if any(r.params is not None and n in r.params.names for r in results)]
     table = Table(title="Friction model per joint: f(qd) fitted to -tau_f, value ±standard error",
                   caption="n.i.: not identifiable from these data (infinite standard error); "
-                          "(bound): at a bound of the fit, the bound's value, not the data's", box=None)
+                          "(bound): at a bound of the fit, the bound's value, not the data's; screened: gross "
+                          "outliers left out (beyond 50 median absolute deviations)", box=None)
     for col in ("joint", "model", "N"):
         table.add_column(col, justify="right" if col == "N" else "left")
     for name in names:
@@ -110,14 +116,17 @@ def _fit_rows(results: list[FitResult]) -> Table:
 
     def cell(r: FitResult, n: str) -> str:
         if r.params is None or n not in r.params.names:
-            return "—" if r.params is None else ""
+            return ""
         s = r.stderr[n]
         return (f"{getattr(r.params, n):.4g} ±{'n.i.' if not np.isfinite(s) else f'{s:.1g}'}"
                 + (" (bound)" if r.at_bound.get(n) else ""))
 
     for r in results:
         rms = [f"{r.rms_error_vs_true:.4f}" if r.rms_error_vs_true is not None else ""] if has_true else []
-        table.add_row(r.joint, r.model, str(r.n_samples), *[cell(r, n) for n in names], *rms)
+        model = r.model if r.params is not None else f"not fitted: {r.message}"
+        screened = f" (-{r.n_screened} screened)" if r.n_screened else ""
+        table.add_row(r.joint, model, f"{r.n_samples}{screened}", *[cell(r, n) for n in names], *rms,
+                      style=None if r.params is not None else "yellow")
         err = r.error_percent()
         if err is not None and r.target is not None:
             target = r.target.values_in(r.model)
@@ -126,6 +135,18 @@ def _fit_rows(results: list[FitResult]) -> Table:
             table.add_row("  error [%]", "", "", *[f"{err[n]:.2f}" if n in err else "" for n in names], *pad,
                           style="dim")
     return table
+
+
+def _warn(warnings) -> None:
+    """Print warnings, one line each."""
+    for w in warnings:
+        console.print(f"[yellow]warning:[/] {escape(w)}", highlight=False, soft_wrap=True)
+
+
+def _time_unit(unit: Optional[str]) -> TimeUnit | None:
+    if unit is not None and unit not in TIME_UNITS:
+        raise InputError(f"--time-unit must be one of {', '.join(TIME_UNITS)}, got '{unit}'")
+    return cast(Optional[TimeUnit], unit)
 
 
 def _warn_energy(energy) -> None:
@@ -191,19 +212,23 @@ def _run_simulate_arm(r: Robot, output: Path, options: ArmOptions, friction: Opt
 
 def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: EstimateOptions,
                   bag_map: Optional[Path] = None, max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN,
-                  workers: int = 2, chunk_rows: int = 10_000, time_base: TimeBase = "auto") -> None:
+                  workers: int = 2, chunk_rows: int = 10_000, time_base: TimeBase = "auto",
+                  time_unit: TimeUnit | None = None) -> None:
     """Estimate a log file in chunks on ``workers`` processes (which load the robot from
     ``spec``); a ROS 2 bag is first streamed into a temporary Parquet log beside the output."""
+    chunking = Chunking(rows=chunk_rows, workers=workers)
     source = open_log(log, bag_map)
     provenance = {"provenance": log_provenance(log, r)}
     with ExitStack() as stack:
         with console.status(f"reading {log}") if source.is_bag else nullcontext():
             table = stack.enter_context(table_log(source, output))
         with _progress(TableFile(table).row_count(), "estimate") as advance:
-            result = estimate_file(spec, table, output, opts, chunking=Chunking(rows=chunk_rows, workers=workers),
+            result = estimate_file(spec, table, output, opts, chunking=chunking,
                                    max_gap=max_gap, limit_margin=limit_margin, extra_metadata=provenance,
-                                   progress=advance, robot=r, source=str(log), time_base=time_base)
+                                   progress=advance, robot=r, source=str(log), time_base=time_base,
+                                   time_unit=time_unit)
     console.print(escape(result.clock), highlight=False, soft_wrap=True)
+    _warn(result.warnings)
     if result.differentiation:
         console.print(f"differentiation: {escape(result.differentiation)}", highlight=False, soft_wrap=True)
     if opts.velocity == "logged":
@@ -258,6 +283,7 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                                                        "trajectory.")) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents."""
+    check_paths({"--urdf": urdf, "--config": config, "--friction": friction, "--sensors": sensors}, {"-o": output})
     r = _robot(robot, urdf, config)
     if not r.floating_base:
         arm = ArmOptions(duration=duration, encoder_bits=19 if encoder_bits is None else encoder_bits,
@@ -288,35 +314,38 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
              output: Path = typer.Option(..., "-o", "--output", help="Friction table to write."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              bag_map: Optional[Path] = MapOpt, max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt,
-             workers: int = typer.Option(2, help="Processes estimating chunks of a long log."),
-             chunk_rows: int = typer.Option(10_000, help="Rows per chunk (cut at the next contact change)."),
+             workers: int = typer.Option(2, min=1, help="Processes estimating chunks of a long log."),
+             chunk_rows: int = typer.Option(10_000, min=200, help="Rows per chunk (cut at the next contact "
+                                                                   "change)."),
              diff: str = typer.Option("auto", help="Differentiation: auto (scheme and window chosen from the "
                                                    "positions' noise, printed), central (6.2), backward (6.3), "
                                                    "savgol (Savitzky-Golay, 7.1.1), butterworth (7.1.2) or true."),
-             window: int = typer.Option(_F.window, help="savgol: window length L (odd) [samples]."),
-             poly_order: int = typer.Option(_F.poly_order, help="savgol: polynomial order k."),
+             window: int = typer.Option(_F.window, help="savgol: window length L (odd, at least 3) [samples]."),
+             poly_order: int = typer.Option(_F.poly_order, help="savgol: polynomial order k (at least 2, below L)."),
              weights: str = typer.Option(_F.weights, help="savgol: uniform or gaussian weights."),
              cutoff: float = typer.Option(_F.cutoff, help="butterworth: cutoff [Hz] (see 'wbfriction spectrum')."),
-             butter_order: int = typer.Option(_F.butter_order, help="butterworth: filter order."),
+             butter_order: int = typer.Option(_F.butter_order, min=1, help="butterworth: filter order."),
              delay_compensation: bool = typer.Option(_E.compensate_delay,
                                                      help="Shift derivatives by their delay (6.1.2)."),
              torque_alignment: str = typer.Option(_E.torque_alignment,
                                                   help="zoh: mean of tau[k-1], tau[k]; sample: tau[k]."),
              mask: str = typer.Option(_E.mask, help="swing: leg joints only while their leg swings; single."),
-             lift_off: float = typer.Option(_E.lift_off_skip, help="Seconds dropped after a lift-off."),
-             touch_down: float = typer.Option(_E.touch_down_skip, help="Seconds dropped before a touch-down."),
-             ds_weight: float = typer.Option(_E.ds_weight, help="W of the double-support problem (6.1)."),
-             ds_regularization: float = typer.Option(_E.ds_regularization,
+             lift_off: float = typer.Option(_E.lift_off_skip, min=0.0, help="Seconds dropped after a lift-off."),
+             touch_down: float = typer.Option(_E.touch_down_skip, min=0.0, help="Seconds dropped before a "
+                                                                                "touch-down."),
+             ds_weight: float = typer.Option(_E.ds_weight, min=1e-12, help="W of the double-support problem (6.1)."),
+             ds_regularization: float = typer.Option(_E.ds_regularization, min=0.0,
                                                      help="Lambda of the double-support problem (6.1)."),
              cond: bool = typer.Option(_E.condition_number, "--cond",
                                        help="Report cond(M_mod^-1) per sample (slower)."),
              method: str = typer.Option(_E.method, help="Single-support route: rnea (fast) or kkt "
                                                         "(5.10-5.13)."),
-             time_base: str = TimeBaseOpt,
+             time_base: str = TimeBaseOpt, time_unit: Optional[str] = TimeUnitOpt,
              velocity: str = typer.Option(_E.velocity, help="Joint velocities: differentiated (by --diff) or "
                                                             "logged (the log's qd.<joint> columns; their lag "
                                                             "is measured and printed).")) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
+    check_paths({"LOG": log, "--map": bag_map, "--urdf": urdf, "--config": config}, {"-o": output})
     opts = EstimateOptions(diff=cast(Diff | Literal["auto"], diff), compensate_delay=delay_compensation,
                            torque_alignment=cast(TorqueAlignment, torque_alignment), mask=cast(Mask, mask),
                            lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
@@ -328,7 +357,7 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
     spec = RobotSpec(None if config else robot, None if urdf is None else str(urdf),
                      None if config is None else str(config))
     _run_estimate(_robot(robot, urdf, config), spec, log, output, opts, bag_map, max_gap, limit_margin, workers,
-                  chunk_rows, cast(TimeBase, time_base))
+                  chunk_rows, cast(TimeBase, time_base), _time_unit(time_unit))
 
 
 @app.command()
@@ -342,6 +371,7 @@ def convert(bag: Path = typer.Argument(..., help="ROS 2 bag (folder with metadat
     """Convert a ROS 2 bag (or another log file) into a wbfriction log: joint states, contacts
     (zero-order hold) and base pose (linear + slerp) aligned on the joint-state stamps,
     streamed, and checked against the robot before it is renamed into place."""
+    check_paths({"BAG": bag, "--map": bag_map, "--urdf": urdf, "--config": config}, {"-o": output})
     r = _robot(robot, urdf, config)
     with console.status(f"reading {bag}"):
         rows = convert_log(r, bag, output, bag_map, max_gap=max_gap, limit_margin=limit_margin)
@@ -351,17 +381,19 @@ def convert(bag: Path = typer.Argument(..., help="ROS 2 bag (folder with metadat
 @app.command()
 def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wbfriction estimate'."),
         output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
-        min_samples: int = typer.Option(_MIN_SAMPLES, help="Joints with fewer valid samples are not fitted."),
+        min_samples: int = typer.Option(_MIN_SAMPLES, min=1, help="Joints with fewer valid samples are not fitted."),
         energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt,
         workers: int = FitWorkersOpt,
         model: str = typer.Option("auto", "--model", help="Friction model per joint: auto (the simplest whose "
                                                           "held-out RMS is within --selection-tolerance of the "
                                                           "best), coulomb-viscous (3.1 + 3.2), stribeck (3.3 + "
                                                           "3.2) or thesis (3.5); each with an offset tau_os."),
-        selection_tolerance: float = typer.Option(0.02, help="With --model auto: relative excess of held-out RMS "
-                                                             "within which the simpler model is chosen.")) -> None:
+        selection_tolerance: float = typer.Option(0.02, min=0.0, help="With --model auto: relative excess of "
+                                                                      "held-out RMS within which the simpler model "
+                                                                      "is chosen.")) -> None:
     """Identify a friction model of every joint, with standard errors and the parameters left
     at a bound; warn about joints whose friction generates power (eq. 7.9)."""
+    check_paths({"FRICTION": friction}, {"-o": output})
     _run_fit(friction, output, min_samples, energy_threshold, energy_tolerance, workers,
              cast(ModelChoice, model), selection_tolerance)
 
@@ -379,6 +411,8 @@ def export(params: Path = typer.Argument(..., help="Parameters written by 'wbfri
     and are dropped. Inertias are the URDF's: give --urdf IDENTIFIED.urdf to export identified ones."""
     from wbfriction.pipeline.export import export_files
 
+    check_paths({"PARAMS": params, "--urdf": urdf, "--config": config},
+                {f"-o {o}": o for o in outputs})
     for path, fmt in export_files(_robot(robot, urdf, config), params, outputs):
         console.print(f"wrote {path} ({fmt})")
 
@@ -392,6 +426,7 @@ def predict(friction: Path = typer.Argument(..., help="Friction table of a held-
     predicted torque, tau - (M qdd + h + f(qd)), with the friction model and without it."""
     from wbfriction.pipeline.predict import predict_file
 
+    check_paths({"FRICTION": friction, "--params": params}, {})
     pred = predict_file(friction, params)
     table = Table(title=f"Torque prediction on {friction.name}: RMS of measured - predicted [N·m]", box=None)
     for col in ("joint", "samples", "rigid body only", "with friction"):
@@ -415,6 +450,8 @@ def report(friction: Path = typer.Argument(..., help="Friction table written by 
     from wbfriction.report.build import make_report
     from wbfriction.report.html import write_report
 
+    check_paths({"FRICTION": friction, "--params": params, "--identification": identification}, {"-o": output})
+
     with console.status("building the report"):
         rep = make_report(friction, params, energy_threshold, energy_tolerance, identification)
         write_report(rep, output)
@@ -432,18 +469,21 @@ def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in 
                 joints: Optional[str] = typer.Option(None, help="Comma-separated joints to plot (default: the "
                                                                 "legs' joints)."),
                 diff: str = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
-                mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate').")) -> None:
+                mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate')."),
+                time_unit: Optional[str] = TimeUnitOpt) -> None:
     """Re-run the estimate with every body's inertia scaled (thesis 7.2, Fig. 7.5/7.6): how the
     friction curves shift (mass) and split into branches (rotational inertia)."""
     from wbfriction.inertia.sensitivity import PARTS, InertiaPart, inertia_sensitivity, parse_factors
     from wbfriction.report.figures import save_png, sensitivity_figure
     from wbfriction.signals.kinematics import measure
 
+    check_paths({"LOG": log, "--urdf": urdf, "--config": config}, {"-o": output})
     if part not in PARTS:
         raise InputError(f"--part must be one of {', '.join(PARTS)}, got '{part}'")
     values = parse_factors(factors)
     r = _robot(robot, urdf, config)
-    data = read_log(log, r)
+    data = read_log(log, r, time_unit=_time_unit(time_unit))
+    _warn(data.warnings)
     opts, _ = resolve_differentiation(EstimateOptions(diff=cast(Diff | Literal["auto"], diff), mask=cast(Mask, mask)),
                                       data)
     kin = measure(data, cast(Diff, opts.diff), filtering=opts.filtering)
@@ -533,22 +573,25 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
                                                                 "or none."),
              passes: int = typer.Option(2, min=1, help="Identifications with --stribeck-velocity auto."),
              holdout: float = typer.Option(_N.holdout, help="Share of the log, at its end, kept out to compare "
-                                                            "torque predictions."),
+                                                            "torque predictions (between 0 and 1)."),
              stride: int = typer.Option(_N.stride, min=1, help="Every stride-th single-support sample is used."),
-             prior: Optional[float] = typer.Option(_N.prior, help="Weight of the prior toward the given model, in "
-                                                                  "units of the residual variance; default: chosen "
-                                                                  "by validation from 1e4 down to 1."),
+             prior: Optional[float] = typer.Option(_N.prior, min=0.0, help="Weight of the prior toward the given "
+                                                                          "model, in units of the residual variance; "
+                                                                          "default: chosen by validation from 1e4 "
+                                                                          "down to 1."),
              armature: str = typer.Option(_N.armature, help="Rotor inertia: known (the TOML's [armature]), "
                                                             "identify (one per joint, with the friction; for "
                                                             "motor-current torques) or none (link-side "
                                                             "torque sensors)."),
-             tanh_slope: float = typer.Option(_N.tanh_slope, help="a of the Coulomb term tanh(a qd) [s/rad]."),
+             tanh_slope: float = typer.Option(_N.tanh_slope, min=1e-12,
+                                              help="a of the Coulomb term tanh(a qd) [s/rad]."),
              diff: str = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
              mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate')."),
-             workers: int = FitWorkersOpt) -> None:
+             workers: int = FitWorkersOpt, time_unit: Optional[str] = TimeUnitOpt) -> None:
     """Identify the inertia model and the friction together from the joint torques of single
     support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
     with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
+    check_paths({"LOG": log, "--urdf": urdf, "--config": config}, {"-o": output, "--json": json_output})
     vs_text = stribeck_velocity.strip().lower()
     try:
         stribeck: float | Literal["auto"] | None = (None if vs_text == "none" else "auto" if vs_text == "auto"
@@ -565,7 +608,8 @@ def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) i
     with console.status("") as status:
         estimate_options = EstimateOptions(diff=cast(Diff | Literal["auto"], diff), mask=cast(Mask, mask))
         done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
-                             options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers)
+                             options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers,
+                             time_unit=_time_unit(time_unit))
     doc, moved = done.document, done.moved
     for p in doc["passes"]:
         out.print(f"v_s {p['stribeck_velocity']}: {p['samples']} samples, {p['base_parameters']} base parameters of "
@@ -669,14 +713,17 @@ def spectrum(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              joints: Optional[str] = typer.Option(None, help="Comma-separated joints (default: the legs' joints, "
                                                              "else every torque-controlled one)."),
-             tail: float = typer.Option(0.01, help="Share of the power (above the noise floor) left above the "
-                                                   "suggested cutoff.")) -> None:
+             tail: float = typer.Option(0.01, min=0.0, max=1.0, help="Share of the power (above the noise floor) "
+                                                                     "left above the suggested cutoff."),
+             time_unit: Optional[str] = TimeUnitOpt) -> None:
     """Spectrum of the estimated acceleration (Fig. 7.1) and the Butterworth cutoff it suggests."""
     from wbfriction.report.figures import spectrum_figure
     from wbfriction.signals.spectrum import acceleration_spectrum
 
+    check_paths({"LOG": log, "--urdf": urdf, "--config": config}, {"-o": output})
     r = _robot(robot, urdf, config)
-    data = read_log(log, r)
+    data = read_log(log, r, time_unit=_time_unit(time_unit))
+    _warn(data.warnings)
     names = _joint_list(r, joints)
     with _progress(len(data), "dynamics") as advance:
         spec = acceleration_spectrum(r, data, names, tail=tail, progress=advance)
@@ -747,8 +794,8 @@ def main() -> None:
     except (typer.Abort, KeyboardInterrupt):  # pragma: no cover
         sys.exit(130)
     except Exception as exc:  # usage errors: click's (typer vendors its own copy in newer releases)
-        show, code = getattr(exc, "show", None), getattr(exc, "exit_code", None)
-        if callable(show) and isinstance(code, int):
-            show()
+        message, code = getattr(exc, "format_message", None), getattr(exc, "exit_code", None)
+        if callable(message) and isinstance(code, int):  # one line, as every other error
+            console.print(f"[bold red]error:[/] {escape(str(message()))}", highlight=False, soft_wrap=True)
             sys.exit(code)
         raise

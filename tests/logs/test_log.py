@@ -102,17 +102,21 @@ def test_irregular_steps_are_read_with_the_clock_that_explains_them(talos, good)
 
 
 def test_integer_nanosecond_stamps(talos, good):
-    """An integer ``time`` column is nanoseconds (epoch): read as seconds, its clock exact."""
+    """An integer ``time`` column needs its unit: refused without one; in nanoseconds (epoch),
+    read as seconds, its clock exact."""
     ns = 1_700_000_000_123_456_789 + np.arange(len(good.time), dtype=np.int64) * 1_000_000
     table = _bad(talos, good, lambda c: c.__setitem__("time", ns))
-    log = log_from_table(table, talos, source="x.parquet")
+    with pytest.raises(InputError, match="holds integers .* --time-unit"):
+        log_from_table(table, talos, source="x.parquet")
+    log = log_from_table(table, talos, source="x.parquet", time_unit="ns")
     assert log.clock.kind == "uniform" and log.dt == 1e-3 and log.clock.t0 == pytest.approx(1.7e9)
     np.testing.assert_allclose(log.clock.t, good.time, rtol=0, atol=1e-15)
     np.testing.assert_allclose(log.time, ns * 1e-9, rtol=1e-15)
     dup = ns.copy()
     dup[10] = dup[9]
     with pytest.raises(InputError, match="duplicated stamp at row 10"):
-        log_from_table(_bad(talos, good, lambda c: c.__setitem__("time", dup)), talos, source="x.parquet")
+        log_from_table(_bad(talos, good, lambda c: c.__setitem__("time", dup)), talos, source="x.parquet",
+                       time_unit="ns")
 
 
 def test_unreadable_and_missing_files(talos, tmp_path):

@@ -228,11 +228,14 @@ def regularised_least_squares(Mmod_inv: np.ndarray, delta_qdd: np.ndarray, weigh
 def no_single_support(robot: Robot, source: str) -> InputError:
     """The error of a log without a single-support sample, naming it and its contact columns."""
     return InputError(f"{source}: no single-support sample (exactly one of the columns "
-                      f"{', '.join('contact.' + f for f in robot.contact_frames)} set) with defined derivatives")
+                      f"{', '.join('contact.' + f for f in robot.contact_frames)} set) with defined derivatives "
+                      "outside the lift-off and touch-down margins (--lift-off, --touch-down) and the "
+                      "differentiation's window (--window, --cutoff)")
 
 
 def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOptions = EstimateOptions(),
-                      progress: Progress | None = None, require_single_support: bool = True) -> FrictionEstimate:
+                      progress: Progress | None = None, require_single_support: bool = True,
+                      gaps: tuple[bool, bool] = (False, False)) -> FrictionEstimate:
     """Estimate the friction torque of every torque-controlled joint at every sample.
 
     Args:
@@ -242,6 +245,8 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
         progress: optional callable receiving numbers of samples processed.
         require_single_support: refuse kinematics without a single-support sample (off for
             a stretch of a longer log, which is checked as a whole).
+        gaps: a time gap before the first and after the last sample (a segment of a log cut at
+            its gaps): the lift-off and touch-down margins apply there (:func:`~wbfriction.signals.phases.segment`).
 
     Returns:
         :class:`FrictionEstimate`.
@@ -252,7 +257,7 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     if options.method not in METHODS:
         raise InputError(f"unknown method '{options.method}': choose one of {', '.join(METHODS)}")
     n, n_tc = len(kin.time), len(robot.torque_controlled)
-    phases: Phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip)
+    phases: Phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip, gaps)
     assert kin.valid is not None  # set by MeasuredKinematics.__post_init__
     usable = kin.valid & (phases.n_contacts > 0)
     if require_single_support and not np.any(usable & phases.single):
@@ -356,9 +361,10 @@ def _estimate_parts(robot: Robot, log: Log, options: EstimateOptions, progress: 
         return _estimate_segment(robot, log, options, progress, companion, require_single_support)
     done: list[FrictionEstimate | None] = []
     first_error: InputError | None = None
-    for part in parts:
+    for k, part in enumerate(parts):
         try:
-            done.append(_estimate_segment(robot, part, options, progress, companion, False))
+            done.append(_estimate_segment(robot, part, options, progress, companion, False,
+                                          (k > 0, k < len(parts) - 1)))
         except InputError as exc:
             first_error = first_error or exc
             done.append(None)
@@ -373,18 +379,18 @@ def _estimate_parts(robot: Robot, log: Log, options: EstimateOptions, progress: 
 
 
 def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress, companion: bool,
-                      require_single_support: bool) -> FrictionEstimate:
+                      require_single_support: bool, gaps: tuple[bool, bool] = (False, False)) -> FrictionEstimate:
     if options.diff == "auto":
         raise InputError("diff 'auto' is resolved once per log (resolve_differentiation), not per segment")
     kin = measure(log, options.diff, compensate_delay=options.compensate_delay,
                   torque_alignment=options.torque_alignment, filtering=options.filtering, velocity=options.velocity)
     kin.metadata.update(robot=robot.name, source=log.source)
-    est = estimate_friction(robot, kin, options, progress, require_single_support)
+    est = estimate_friction(robot, kin, options, progress, require_single_support, gaps)
     if companion:
         other = companion_scheme(options.diff)
         kin2 = measure(log, other, compensate_delay=options.compensate_delay,
                        torque_alignment=options.torque_alignment, filtering=options.filtering)
-        phases = segment(kin2.time, kin2.contact, options.lift_off_skip, options.touch_down_skip)
+        phases = segment(kin2.time, kin2.contact, options.lift_off_skip, options.touch_down_skip, gaps)
         _, est.companion_delta_qdd = single_support(robot, kin2, kin2.valid & phases.single, phases.stance)
         est.companion_diff = other
     return est

@@ -45,8 +45,6 @@ gives the starting point.
 from __future__ import annotations
 
 import itertools
-import multiprocessing
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from typing import Generic, Literal, get_args
 
@@ -68,6 +66,8 @@ from wbfriction.friction.models import (
     coulomb_viscous_stribeck,
     stribeck_viscous,
 )
+from wbfriction.friction.screen import gross_outliers
+from wbfriction.workers import process_pool
 
 ModelChoice = Literal["auto", "coulomb-viscous", "stribeck", "thesis"]
 """The model to fit: one of :data:`~wbfriction.friction.models.ModelName`, or ``auto``: the
@@ -206,6 +206,8 @@ class FitResult(Generic[ParamsT]):
         at_bound: per parameter, whether the fit left it on one of its bounds (its value is
             then the bound's, not the data's; held parameters are not).
         selection: how ``model="auto"`` chose the model, or None.
+        n_screened: valid samples left out as gross outliers
+            (:func:`~wbfriction.friction.screen.gross_outliers`), not in :attr:`n_samples`.
     """
 
     joint: str
@@ -221,6 +223,7 @@ class FitResult(Generic[ParamsT]):
     model: ModelName = "thesis"
     at_bound: dict[str, bool] = field(default_factory=dict)
     selection: ModelSelection | None = None
+    n_screened: int = 0
 
     def __post_init__(self) -> None:
         if self.params is not None:
@@ -491,7 +494,9 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
             (:data:`~wbfriction.friction.models.PARAM_NAMES` for (3.5)); by default several
             (:func:`initial_guesses`), the best fit is kept. Not with ``model="auto"``.
         min_samples: fewer samples give a result without parameters.
-        mask: (N,) samples to fit (default: every finite one).
+        mask: (N,) samples to fit (default: every finite one); gross outliers among them are
+            left out and counted (:func:`~wbfriction.friction.screen.gross_outliers`,
+            :attr:`FitResult.n_screened`).
         smoother: the zero-phase smoother ``tau_f`` went through
             (:attr:`~wbfriction.friction.estimate.FrictionEstimate.smoother`), or None; ``qd`` and
             ``tau_f`` are then whole time series, ``qd`` NaN where the estimate was left out
@@ -520,6 +525,8 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
     use = np.isfinite(qd) & np.isfinite(y)
     if mask is not None:
         use &= np.asarray(mask, dtype=bool)
+    screened = gross_outliers(y, use)
+    use &= ~screened
     if smoother is not None:
         use &= np.isfinite(smoother(qd))
     # One BLAS thread: the solver's many small (N x p) factorizations run several times
@@ -529,10 +536,13 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         if model == "auto":
             if x0 is not None:
                 raise InputError("x0 needs a named model, not 'auto'")
-            return _fit_auto(qd, y, use, delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother,
-                             fixed=fixed, tolerance=selection_tolerance)
-        return _fit_model(check_model(model), qd, y, use, delta_s=delta_s, joint=joint, x0=x0,
-                          min_samples=min_samples, smoother=smoother, fixed=fixed)
+            res = _fit_auto(qd, y, use, delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother,
+                            fixed=fixed, tolerance=selection_tolerance)
+        else:
+            res = _fit_model(check_model(model), qd, y, use, delta_s=delta_s, joint=joint, x0=x0,
+                             min_samples=min_samples, smoother=smoother, fixed=fixed)
+    res.n_screened = int(screened.sum())
+    return res
 
 
 def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float, joint: str, min_samples: int,
@@ -652,7 +662,7 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
                    selection_tolerance=selection_tolerance))
              for i, joint in enumerate(joints)]
     if workers > 1 and len(tasks) > 1:
-        with ProcessPoolExecutor(min(workers, len(tasks)), mp_context=multiprocessing.get_context("fork")) as pool:
+        with process_pool(min(workers, len(tasks)), "fork") as pool:
             fitted = list(pool.map(_fit_column, tasks))
     else:
         fitted = [_fit_column(task) for task in tasks]

@@ -30,7 +30,7 @@ from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult, HeldOutScore, ModelSelection
 from wbfriction.friction.models import FrictionParams, check_model, params_from_dict
 from wbfriction.logs.clock import read_clock
-from wbfriction.logs.tables import numeric_column, read_metadata, read_table, with_metadata, write_json
+from wbfriction.logs.tables import file_sha256, numeric_column, read_metadata, read_table, with_metadata, write_json
 from wbfriction.signals.kinematics import SCHEMES, FilterOptions, Smoother, make_smoother
 
 SIGN_CONVENTION = "tau_f = -f(qd); fit of f (the joint's model, eqs. 3.1-3.5) to -tau_f"
@@ -224,7 +224,8 @@ def selection_from_dict(d: Mapping[str, Any]) -> ModelSelection:
 def fit_to_dict(fit: FitResult) -> dict[str, Any]:
     """One joint's entry of the parameters JSON (a standard error that is not finite: ``null``)."""
     clean = _finite_or_none
-    d: dict[str, Any] = {"n_samples": fit.n_samples, "success": fit.success, "message": fit.message,
+    d: dict[str, Any] = {"n_samples": fit.n_samples, "n_screened": fit.n_screened, "fitted": fit.params is not None,
+                         "success": fit.success, "message": fit.message,
                          "rms_residual": clean(fit.rms_residual), "model": fit.model,
                          "params": None if fit.params is None else fit.params.to_dict(),
                          "stderr": {k: clean(v) for k, v in fit.stderr.items()},
@@ -252,6 +253,7 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
     try:
         model = check_model(str(d.get("model", "thesis")))
         res: FitResult = FitResult(joint=joint, n_samples=int(d.get("n_samples", 0)),
+                                   n_screened=int(d.get("n_screened", 0)),
                                    success=bool(d.get("success", False)), message=str(d.get("message", "")),
                                    rms_residual=_number(d.get("rms_residual")), model=model)
         if d.get("params") is not None:
@@ -317,3 +319,31 @@ def read_params(path: str | Path) -> dict[str, FitResult]:
         except (InputError, AttributeError) as exc:
             raise InputError(f"{path}: joint '{joint}': {exc}") from None
     return out
+
+
+def check_params_source(params: str | Path, est: FrictionEstimate, table: str | Path | None = None) -> None:
+    """Refuse a parameters file that does not belong with a friction table: fitted for another
+    robot (the robots both record, :func:`~wbfriction.pipeline.provenance.log_provenance`), sharing
+    none of its joints, or, with ``table`` (the file ``est`` was read from: a report of the table
+    the parameters were fitted on), fitted on another table (its recorded SHA-256 differs).
+
+    Raises:
+        InputError: naming the parameters file and what does not match.
+    """
+    path = Path(params)
+    try:
+        doc = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot be read: {exc}") from None
+    prov = doc.get("provenance", {}) if isinstance(doc, dict) else {}
+    prov = prov if isinstance(prov, dict) else {}
+    robot, table_robot = prov.get("robot"), est.metadata.get("provenance", {}).get("robot")
+    if robot is not None and table_robot is not None and robot != table_robot:
+        raise InputError(f"{path}: parameters of robot '{robot}', not of the table's robot '{table_robot}'")
+    joints = doc.get("joints", {}) if isinstance(doc, dict) else {}
+    if not set(joints) & set(est.joints):
+        raise InputError(f"{path}: none of its joints is a joint of the friction table")
+    digest = prov.get("friction_sha256")
+    if table is not None and digest is not None and digest != file_sha256(table):
+        raise InputError(f"{path}: fitted on {prov.get('friction', 'another table')}, not on {table} (their "
+                         "SHA-256 differ): fit this table, or give its own parameters")

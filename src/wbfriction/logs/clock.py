@@ -21,7 +21,8 @@ stamps that are all whole multiples of a base period (:func:`lattice_period`: a 
 taken as recorded, stamps that stay within half a period of a straight line as receive times.
 :attr:`Clock.reason` says in one line what was found and assumed; ``time_base`` overrides it.
 
-Stamps are seconds (float64) or integer nanoseconds (int64, as ROS and most loggers write them).
+Stamps are seconds (float64), Arrow timestamps, or integers in a unit the user states
+(:func:`table_stamps`: ``--time-unit``; integers are kept as nanoseconds).
 Epoch stamps (about 1.5e9 s) keep their precision: the clock works on stamps relative to the
 first one (integers are subtracted as integers first).
 """
@@ -117,20 +118,57 @@ class Clock:
 
 
 # ------------------------------------------------------------------------- the stamps
-def table_stamps(table: pa.Table, source: str, first_row: int = 0) -> np.ndarray:
-    """The ``time`` column of a table: float64 seconds, or int64 nanoseconds for an integer or
-    timestamp column (kept as integers, :func:`relative_stamps`).
+TimeUnit = Literal["s", "ms", "us", "ns"]
+"""The unit of a numeric ``time`` column (``--time-unit``)."""
+TIME_UNITS: tuple[TimeUnit, ...] = get_args(TimeUnit)
+_NS_PER = {"s": 10**9, "ms": 10**6, "us": 10**3, "ns": 1}
+SECONDS_STEP = (1e-6, 0.5)
+"""Median step [s] of a float ``time`` column read as seconds without a stated unit: outside it,
+the column is refused (milliseconds or nanoseconds read as seconds would be off by 1e3 or 1e9)."""
+
+
+def table_stamps(table: pa.Table, source: str, first_row: int = 0, unit: TimeUnit | None = None) -> np.ndarray:
+    """The ``time`` column of a table as float64 seconds, or int64 nanoseconds (kept as integers,
+    :func:`relative_stamps`), its unit checked:
+
+    * an Arrow timestamp: its own unit, converted exactly to nanoseconds;
+    * integers: ``unit`` must be given (no integer unit is safe to guess: ROS writes nanoseconds,
+      many loggers milliseconds), converted exactly to nanoseconds;
+    * floats: seconds, or ``unit``; without a unit, a median step outside :data:`SECONDS_STEP`
+      is refused (it is not seconds).
 
     Raises:
-        ColumnError: a missing, non-numeric or non-finite column.
+        ColumnError: a missing, non-numeric or non-finite column, integers without ``unit``,
+            float stamps that are not seconds, integers that overflow 64-bit nanoseconds.
+        InputError: an unknown ``unit``.
     """
-    if "time" in table.column_names:
-        col = table.column("time")
-        if col.null_count == 0 and (pa.types.is_integer(col.type) or pa.types.is_timestamp(col.type)):
-            if pa.types.is_timestamp(col.type):
-                col = col.cast(pa.timestamp("ns")).cast(pa.int64())
-            return col.to_numpy(zero_copy_only=False).astype(np.int64)
-    return numeric_column(table, "time", source, first_row)
+    if unit is not None and unit not in TIME_UNITS:
+        raise InputError(f"--time-unit must be one of {', '.join(TIME_UNITS)}, got '{unit}'")
+    if "time" not in table.column_names:
+        raise ColumnError(source, "time", None, "missing column 'time'")
+    col = table.column("time")
+    if col.null_count == 0 and pa.types.is_timestamp(col.type):
+        return col.cast(pa.timestamp("ns")).cast(pa.int64()).to_numpy(zero_copy_only=False).astype(np.int64)
+    if col.null_count == 0 and pa.types.is_integer(col.type):
+        if unit is None:
+            raise ColumnError(source, "time", None, f"column 'time' holds integers ({col.type}) whose unit is not "
+                              "known: give it with --time-unit s, ms, us or ns")
+        values = col.to_numpy(zero_copy_only=False).astype(np.int64)
+        factor = _NS_PER[unit]
+        if values.size and np.abs(values).max() > np.iinfo(np.int64).max // factor:
+            raise ColumnError(source, "time", None, f"column 'time' in {unit} overflows 64-bit nanoseconds")
+        return values * factor
+    seconds = numeric_column(table, "time", source, first_row)
+    if unit is not None and unit != "s":
+        return seconds * (1e-9 * _NS_PER[unit])
+    if unit is None:
+        step = np.diff(seconds[:ROUGHNESS_ROWS])
+        step = step[step > 0]
+        median = float(np.median(step)) if step.size else float("nan")
+        if step.size and not SECONDS_STEP[0] <= median <= SECONDS_STEP[1]:
+            raise ColumnError(source, "time", None, f"column 'time' steps by {median:.6g} (median): not seconds? "
+                              "give its unit with --time-unit ms, us or ns (or --time-unit s if it is seconds)")
+    return seconds
 
 
 def relative_stamps(stamps: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:

@@ -41,7 +41,16 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError, InputError
-from wbfriction.logs.clock import JITTER, MAX_GAP, Clock, TimeBase, read_clock, split_at_gaps, table_stamps
+from wbfriction.logs.clock import (
+    JITTER,
+    MAX_GAP,
+    Clock,
+    TimeBase,
+    TimeUnit,
+    read_clock,
+    split_at_gaps,
+    table_stamps,
+)
 from wbfriction.logs.tables import numeric_column, read_metadata, with_metadata, write_table
 from wbfriction.model.robot import Robot
 
@@ -81,6 +90,8 @@ class Log:
         clock: what wrote the stamps and the time base derivatives are taken on
             (:class:`~wbfriction.logs.clock.Clock`: uniform, skipping samples, or receive-time
             jitter regularised), or None: uniform (a log built in memory).
+        warnings: what reading the log found that costs accuracy without making it wrong (e.g.
+            float32 columns, :func:`check_schema`), one line each.
     """
 
     time: np.ndarray
@@ -98,6 +109,7 @@ class Log:
     qd_logged: np.ndarray | None = None
     torque_source: TorqueSource = "sensor"
     clock: Clock | None = None
+    warnings: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.segments is None and self.clock is not None and len(self.clock.segments) > 1:
@@ -124,7 +136,7 @@ class Log:
         return Log(self.time[start:stop], self.q[start:stop], self.tau[start:stop], self.contact[start:stop],
                    cut(self.base), cut(self.tau_f_true), self.metadata, self.source, cut(self.qd_true),
                    cut(self.qdd_true), None, self.dt, cut(self.qd_logged), self.torque_source,
-                   clock=None if self.clock is None else self.clock.rows(start, stop))
+                   clock=None if self.clock is None else self.clock.rows(start, stop), warnings=self.warnings)
 
     def __len__(self) -> int:
         return len(self.time)
@@ -198,9 +210,37 @@ def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT
                               f"[{lo:.4g}, {hi:.4g}] by more than {margin:g}: wrong units (degrees for radians)?")
 
 
+def unwrap_positions(q: np.ndarray, robot: Robot, source: str, segments: list[tuple[int, int]],
+                     first_row: int = 0) -> np.ndarray:
+    """Positions (N, n_act) [rad] with every continuous joint (unbounded revolute) unwrapped
+    within each segment (a logger writes its angle in (-pi, pi]: a jump of 2 pi between two
+    samples is a wrap, not motion; differentiated across it, it is a 1e5 N·m friction).
+
+    Raises:
+        ColumnError: another joint whose position jumps by more than pi between two samples of
+            a segment (a wrapped angle, or a glitch), naming the column and the row.
+    """
+    continuous = np.zeros(q.shape[1], dtype=bool)
+    continuous[robot.layout.q2_joint] = True
+    out = q.copy() if continuous.any() else q
+    for a, b in segments:
+        if continuous.any():
+            out[a:b, continuous] = np.unwrap(q[a:b, continuous], axis=0)
+        jump = np.abs(np.diff(out[a:b], axis=0)) > np.pi
+        if jump.any():
+            k, i = np.argwhere(jump)[0]
+            name = robot.actuated[i]
+            raise ColumnError(source, f"q.{name}", int(first_row + a + k + 1),
+                              f"column 'q.{name}' jumps by {out[a + k + 1, i] - out[a + k, i]:.4g} rad at row "
+                              f"{first_row + a + k + 1}: a wrapped angle of a joint the URDF does not make "
+                              "continuous, or a glitch")
+    return out
+
+
 def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_gap: float = MAX_GAP,
                    limit_margin: float = LIMIT_MARGIN, first_row: int = 0, period: float | None = None,
-                   *, clock: Clock | None = None, time_base: TimeBase = "auto") -> Log:
+                   *, clock: Clock | None = None, time_base: TimeBase = "auto", time_unit: TimeUnit | None = None
+                   ) -> Log:
     """Validate an Arrow table against ``robot`` and map its columns by joint name.
 
     Args:
@@ -214,15 +254,18 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
             chunks is the whole log's; None: read from this table's stamps and positions
             (:func:`~wbfriction.logs.clock.read_clock`).
         time_base: ``auto``, ``recorded`` or ``regularised`` (:data:`~wbfriction.logs.clock.TimeBase`).
+        time_unit: the unit of a numeric ``time`` column (:func:`~wbfriction.logs.clock.table_stamps`:
+            needed for integers; floats are seconds by default).
 
     Raises:
-        InputError: missing ``time``, a missing or unknown joint/frame column, NaN, a
-            duplicated, decreasing or irregular time column, positions far beyond the
-            joint limits, contact flags other than 0/1, a partial base pose, or a
-            non-unit quaternion.
+        InputError: what :func:`check_schema` refuses, NaN, a duplicated or decreasing time
+            column or one whose unit is unknown, positions far beyond the joint limits or that
+            jump by more than pi between two samples (a wrapped angle), contact flags other than
+            0/1, a partial base pose, or a non-unit quaternion.
     """
-    _check_column_names(table, robot, source)
-    time, clock, q = _read_motion(table, robot, source, max_gap, limit_margin, first_row, clock, time_base)
+    warnings = check_schema(table.schema, robot, source)
+    time, clock, q = _read_motion(table, robot, source, max_gap, limit_margin, first_row, clock, time_base,
+                                  time_unit)
     tau, torque_source = _read_torque(table, robot, source, first_row)
     contact = _read_contact(table, robot, source, first_row)
     base = _read_base(table, source, first_row)
@@ -232,17 +275,37 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
     qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
     return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
                qd_true=qd_true, qdd_true=qdd_true, segments=clock.segments, period=period, qd_logged=qd_logged,
-               torque_source=torque_source, clock=clock)
+               torque_source=torque_source, clock=clock, warnings=warnings)
 
 
-def _check_column_names(table: pa.Table, robot: Robot, source: str) -> None:
-    """Refuse a table without ``time``, with a column naming an unknown joint or frame, or missing a required one."""
-    names = set(table.column_names)
-    if "time" not in names:
+NUMERIC_PREFIXES = ("q", "tau", "current", "qd", "qd_true", "qdd_true", "tau_f_true", "base")
+"""Column prefixes whose values must be numbers."""
+
+
+def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...]:
+    """Check a log's columns against ``robot`` from its schema alone, before any row is read:
+    names (no duplicate, none naming an unknown joint or frame, none required missing) and
+    types (numbers; contact flags as numbers or booleans; ``time`` as numbers or timestamps).
+
+    Returns:
+        Warnings, one line each: float32 columns (7 significant digits: the accelerations
+        differentiated from such positions are noisier; nothing is refused).
+
+    Raises:
+        ColumnError: a duplicated column name, a missing ``time`` or required column, a column
+            naming an unknown joint or contact frame, a column of a type that is not a number.
+    """
+    names = list(schema.names)
+    seen: set[str] = set()
+    for col in names:
+        if col in seen:
+            raise ColumnError(source, col, None, f"column '{col}' appears {names.count(col)} times")
+        seen.add(col)
+    if "time" not in seen:
         raise ColumnError(source, "time", None, "missing column 'time'")
     act, tc = set(robot.actuated), set(robot.torque_controlled)
     frames = set(robot.contact_frames)
-    for col in table.column_names:
+    for col in names:
         prefix, _, item = col.partition(".")
         known = {"q": act, "tau": act, "tau_f_true": tc, "contact": frames, "qd_true": act,
                  "qdd_true": act, "qd": act, "current": act}.get(prefix)
@@ -252,15 +315,38 @@ def _check_column_names(table: pa.Table, robot: Robot, source: str) -> None:
                               f"column '{col}' names an unknown {what} '{item}' of robot '{robot.name}'")
     contact = [f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else []
     for col in [f"q.{n}" for n in robot.actuated] + contact:
-        if col not in names:
+        if col not in seen:
             raise ColumnError(source, col, None, f"missing column '{col}'")
     for n in robot.torque_controlled:
-        if f"tau.{n}" not in names and f"current.{n}" not in names:
+        if f"tau.{n}" not in seen and f"current.{n}" not in seen:
             raise ColumnError(source, f"tau.{n}", None, f"missing column 'tau.{n}' (or 'current.{n}' with a "
                               f"torque constant for '{n}' in the robot's [torque_constants])")
-        if f"tau.{n}" not in names and n not in robot.torque_constants:
+        if f"tau.{n}" not in seen and n not in robot.torque_constants:
             raise ColumnError(source, f"current.{n}", None, f"column 'current.{n}' needs a torque constant: add "
                               f"'{n}' [N·m/A] to the robot's [torque_constants]")
+    single = []
+    for f in schema:
+        prefix = f.name.partition(".")[0]
+        number = pa.types.is_integer(f.type) or pa.types.is_floating(f.type)
+        if f.name == "time":
+            ok = number or pa.types.is_timestamp(f.type)
+        elif prefix == "contact":
+            ok = number or pa.types.is_boolean(f.type)
+        elif prefix in NUMERIC_PREFIXES:
+            ok = number
+        else:
+            continue  # a column the log format does not use
+        if not ok:
+            hint = "; contact flags are 0/1 (integers) or booleans" if prefix == "contact" else ""
+            raise ColumnError(source, f.name, None, f"column '{f.name}' holds {f.type} values, not numbers{hint}")
+        if pa.types.is_floating(f.type) and f.type.bit_width < 64:
+            single.append(f.name)
+    if not single:
+        return ()
+    shown = ", ".join(single[:3]) + (f" and {len(single) - 3} more" if len(single) > 3 else "")
+    return (f"{source}: {shown} are float{schema.field(single[0]).type.bit_width}: "
+            "about 7 significant digits (2.4e-7 rad at 2 rad), whose rounding the differentiated "
+            "accelerations amplify; log float64",)
 
 
 def _stack(table: pa.Table, columns: list[str], source: str, first_row: int) -> np.ndarray:
@@ -269,15 +355,16 @@ def _stack(table: pa.Table, columns: list[str], source: str, first_row: int) -> 
 
 
 def _read_motion(table: pa.Table, robot: Robot, source: str, max_gap: float, limit_margin: float,
-                 first_row: int, clock: Clock | None = None,
-                 time_base: TimeBase = "auto") -> tuple[np.ndarray, Clock, np.ndarray]:
-    """Time [s] (checked: float seconds, integer nanoseconds converted), its clock (``clock``,
-    the whole log's cut to these rows, else read from the stamps and positions) and q [rad]
-    (checked against the limits)."""
-    stamps = table_stamps(table, source, first_row)
-    check_time(stamps, source, max_gap, first_row=first_row)
+                 first_row: int, clock: Clock | None = None, time_base: TimeBase = "auto",
+                 time_unit: TimeUnit | None = None) -> tuple[np.ndarray, Clock, np.ndarray]:
+    """Time [s] (checked, its unit too: :func:`~wbfriction.logs.clock.table_stamps`), its clock
+    (``clock``, the whole log's cut to these rows, else read from the stamps and positions) and
+    q [rad] (checked against the limits; continuous joints unwrapped, :func:`unwrap_positions`)."""
+    stamps = table_stamps(table, source, first_row, time_unit)
+    segments = check_time(stamps, source, max_gap, first_row=first_row)
     q = _stack(table, [f"q.{n}" for n in robot.actuated], source, first_row)
-    check_limits(q, robot, source, limit_margin, first_row)
+    check_limits(q, robot, source, limit_margin, first_row)  # before the jumps: degrees say so first
+    q = unwrap_positions(q, robot, source, segments, first_row)
     if clock is None:
         clock = read_clock(stamps, source, max_gap=max_gap, first_row=first_row, q=q, time_base=time_base)
     elif len(clock) != len(stamps):

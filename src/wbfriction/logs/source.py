@@ -16,7 +16,7 @@ import pyarrow as pa
 
 from wbfriction.exceptions import InputError
 from wbfriction.logs.bags import BagMap, is_bag, iter_bag, load_bag_map, read_bag
-from wbfriction.logs.clock import TimeBase
+from wbfriction.logs.clock import TimeBase, TimeUnit
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, Log, log_from_table
 from wbfriction.logs.tables import TableFile
 from wbfriction.model.robot import Robot
@@ -92,7 +92,8 @@ def open_log(path: str | Path, bag_map: BagMap | str | Path | None = None) -> Lo
 
 
 def read_log(path: str | Path, robot: Robot, bag_map: BagMap | str | Path | None = None, max_gap: float = MAX_GAP,
-             limit_margin: float = LIMIT_MARGIN, time_base: TimeBase = "auto") -> Log:
+             limit_margin: float = LIMIT_MARGIN, time_base: TimeBase = "auto", time_unit: TimeUnit | None = None
+             ) -> Log:
     """Read and validate a log: a table file in the log format (:mod:`wbfriction.logs.log`), or
     a ROS 2 bag with its topic map (:mod:`wbfriction.logs.bags`).
 
@@ -100,11 +101,11 @@ def read_log(path: str | Path, robot: Robot, bag_map: BagMap | str | Path | None
         path: the file (or bag folder).
         robot: the robot whose names the columns must match.
         bag_map: a :class:`~wbfriction.logs.bags.BagMap` or its TOML file (needed for a bag).
-        max_gap, limit_margin, time_base: see :func:`~wbfriction.logs.log.log_from_table`.
+        max_gap, limit_margin, time_base, time_unit: see :func:`~wbfriction.logs.log.log_from_table`.
 
     Raises:
         InputError: see :func:`open_log`, :func:`~wbfriction.logs.log.log_from_table` and
             :func:`~wbfriction.logs.bags.read_bag`; messages start with the file name.
     """
     return log_from_table(open_log(path, bag_map).read(), robot, str(path), max_gap, limit_margin,
-                          time_base=time_base)
+                          time_base=time_base, time_unit=time_unit)

@@ -11,8 +11,13 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
+import secrets
+import shutil
+import socket
 import tempfile
 from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Literal
 
@@ -31,6 +36,35 @@ TableFormat = Literal["parquet", "csv", "hdf5"]
 
 
 # ------------------------------------------------------------------ metadata
+CSV_METADATA = b"#wbfriction "
+"""A CSV file's first line when it carries the ``wbfriction`` metadata (a CSV has no other place for
+it: without it, a log's torque alignment, a table's smoother and provenance would be lost)."""
+
+
+def _csv_metadata(path: Path) -> tuple[int, dict[bytes, bytes] | None]:
+    """Rows to skip at the top of a CSV file and the metadata its first line carries (0, None: none)."""
+    try:
+        with open(path, "rb") as handle:
+            first = handle.readline()
+    except OSError as exc:
+        raise _unreadable(path, exc) from exc
+    if first.startswith(CSV_METADATA):
+        return 1, {META_KEY: first[len(CSV_METADATA):].strip()}
+    return 0, None
+
+
+def _csv_options(path: Path, **kwargs) -> tuple[pacsv.ReadOptions, dict[bytes, bytes] | None]:
+    skip, meta = _csv_metadata(path)
+    return pacsv.ReadOptions(skip_rows=skip, **kwargs), meta
+
+
+def _write_csv_header(handle, schema: pa.Schema) -> None:
+    """The metadata line of a CSV file (:data:`CSV_METADATA`), if the table has metadata."""
+    meta = (schema.metadata or {}).get(META_KEY)
+    if meta is not None:
+        handle.write(CSV_METADATA + meta.replace(b"\n", b" ") + b"\n")
+
+
 def with_metadata(table: pa.Table, metadata: dict) -> pa.Table:
     """Attach ``metadata`` (JSON-serialisable) to ``table`` under the ``wbfriction`` key."""
     return table.replace_schema_metadata({META_KEY: json.dumps(metadata, sort_keys=True).encode()})
@@ -63,6 +97,8 @@ def table_format(path: str | Path) -> TableFormat:
         InputError: a missing file, or a type that is not Parquet, CSV or HDF5.
     """
     path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder, not a table file (a ROS 2 bag folder needs --map)")
     if not path.is_file():
         raise InputError(f"{path}: file not found")
     suffix = path.suffix.lower()
@@ -107,16 +143,36 @@ class TableFile:
                 else:
                     names = pq.ParquetFile(path).schema_arrow.names
                     table = pq.read_table(path, columns=[c for c in columns if c in names])
-            elif columns is None:
-                table = pacsv.read_csv(path)
             else:
-                names = pacsv.open_csv(path).schema.names
-                table = pacsv.read_csv(path, convert_options=pacsv.ConvertOptions(
-                    include_columns=[c for c in columns if c in names]))
+                options, meta = _csv_options(path)
+                if columns is None:
+                    table = pacsv.read_csv(path, read_options=options)
+                else:
+                    names = pacsv.open_csv(path, read_options=options).schema.names
+                    table = pacsv.read_csv(path, read_options=options, convert_options=pacsv.ConvertOptions(
+                        include_columns=[c for c in columns if c in names]))
+                if meta is not None:
+                    table = table.replace_schema_metadata(meta)
             _ = table.column_names  # decoded lazily: a damaged header fails here
             return table
         except (pa.ArrowException, OSError, ValueError) as exc:  # ValueError: e.g. damaged UTF-8 in the footer
             raise _unreadable(path, exc) from exc
+
+    def schema(self) -> pa.Schema:
+        """The table's columns and their types, without reading its rows (a CSV's types as inferred
+        from its first block).
+
+        Raises:
+            InputError: unreadable content, naming the file.
+        """
+        if self.format == "hdf5":
+            return read_hdf5(self.path, stop=0).schema
+        try:
+            if self.format == "parquet":
+                return pq.ParquetFile(self.path).schema_arrow
+            return pacsv.open_csv(self.path, read_options=_csv_options(self.path)[0]).schema
+        except (pa.ArrowException, OSError, ValueError) as exc:
+            raise _unreadable(self.path, exc) from exc
 
     def row_count(self) -> int:
         """Rows of a Parquet file, from its footer; 0 when not known without reading the file."""
@@ -172,8 +228,8 @@ class RowReader:
                 self._batches: Iterator[pa.RecordBatch] = parquet.iter_batches(batch_size=batch_rows,
                                                                                use_threads=False)
             else:
-                self.metadata = None
-                self._batches = iter(pacsv.open_csv(self.path, read_options=pacsv.ReadOptions(block_size=1 << 24)))
+                options, self.metadata = _csv_options(self.path, block_size=1 << 24)
+                self._batches = iter(pacsv.open_csv(self.path, read_options=options))
         except (pa.ArrowException, OSError, ValueError) as exc:
             raise _unreadable(self.path, exc) from exc
         self._buffer: list[pa.RecordBatch] = []
@@ -247,24 +303,111 @@ def file_sha256(path: str | Path) -> str:
     return digest.hexdigest()
 
 
+# ----------------------------------------------------------- temporary files
+_TEMPORARY = re.compile(r"\.(?:.+\.)?wbfriction-(?P<host>[A-Za-z0-9]*)-(?P<pid>\d+)-[0-9a-f]{8}(?:\.tmp.*)?", re.S)
+"""The names of this tool's temporary files (``.{name}.wbfriction-{host}-{pid}-{token}.tmp{suffix}``)
+and folders (``.wbfriction-{host}-{pid}-{token}``)."""
+
+
+def _host() -> str:
+    """This machine's name, letters and digits only (a folder may be shared between machines)."""
+    return re.sub(r"[^A-Za-z0-9]", "", socket.gethostname())[:32]
+
+
+def _temporary_name(folder: Path, stem: str = "", suffix: str = "") -> Path:
+    """A fresh name in ``folder`` marked with this machine and process (:data:`_TEMPORARY`)."""
+    return folder / f".{stem}wbfriction-{_host()}-{os.getpid()}-{secrets.token_hex(4)}{suffix}"
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` of this machine exists (True when it cannot be told)."""
+    if pid <= 0 or pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (OSError, OverflowError):  # PermissionError: another user's, alive
+        return True
+    return True
+
+
+def remove_stale_temporaries(folder: str | Path) -> list[Path]:
+    """Remove the temporary files and folders that this tool left in ``folder`` (not below) when
+    a process writing them was killed (SIGKILL, power loss): those whose name carries this
+    machine's name and the id of a process that no longer exists. Another machine's, or a live
+    process's, are never touched (a process id used again keeps a stale file: the safe side).
+    Returns the paths removed; a path that cannot be removed is left as it is.
+    """
+    folder = Path(folder)
+    host = _host()
+    try:
+        names = [e.name for e in os.scandir(folder)]
+    except OSError:
+        return []
+    removed = []
+    for name in names:
+        m = _TEMPORARY.fullmatch(name)
+        if m is None or m["host"] != host or _alive(int(m["pid"])):
+            continue
+        path = folder / name
+        try:
+            if path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path)
+            else:
+                path.unlink()
+        except OSError:
+            continue
+        removed.append(path)
+    return removed
+
+
+@contextmanager
+def scratch_folder(near: str | Path | None = None) -> Iterator[Path]:
+    """A new temporary folder ``.wbfriction-{host}-{pid}-{token}`` in folder ``near`` (the system's
+    temporary folder if None), removed with its content on leaving, whatever the way out; those
+    of killed processes are removed on entering (:func:`remove_stale_temporaries`).
+
+    Raises:
+        InputError: a folder ``near`` that does not exist.
+    """
+    folder = Path(tempfile.gettempdir() if near is None else near)
+    if not folder.is_dir():
+        raise InputError(f"{folder}: folder does not exist")
+    remove_stale_temporaries(folder)
+    path = _temporary_name(folder)
+    path.mkdir()
+    try:
+        yield path
+    finally:
+        shutil.rmtree(path, ignore_errors=True)
+
+
 def write_atomic(path: str | Path, write) -> None:
     """Write a file whole or not at all.
 
-    ``write(tmp_path)`` writes to a temporary file in the destination directory, which
-    is then renamed onto ``path`` (atomic on POSIX). On any error the temporary file is
-    removed and ``path`` is left untouched.
+    ``write(tmp_path)`` writes to a temporary file in the destination folder,
+    ``.{name}.wbfriction-{host}-{pid}-{token}.tmp{suffix}`` (it ends like the destination: ``write``
+    may read it back by its type), which is then renamed onto ``path`` (atomic on POSIX). On any
+    error or interruption the temporary file is removed and ``path`` is left untouched; one left by
+    a killed process is removed by a later write into the folder (:func:`remove_stale_temporaries`).
+    The file is created with mode 0o666 less the umask (as ``open`` creates files), so colleagues
+    read it when the umask allows.
+
+    Raises:
+        InputError: an output folder that does not exist.
     """
     path = Path(path)
-    if path.parent and not path.parent.exists():
+    if not path.parent.exists():
         raise InputError(f"{path}: output directory {path.parent} does not exist")
-    # the temporary name ends like the destination: ``write`` may read it back by its type
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{path.suffix}", dir=path.parent or ".")
-    os.close(fd)
+    remove_stale_temporaries(path.parent)
+    tmp = _temporary_name(path.parent, f"{path.name[:100]}.", f".tmp{path.suffix}")
     try:
-        write(Path(tmp))
+        os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))  # the umask applies
+        write(tmp)
         os.replace(tmp, path)
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        tmp.unlink(missing_ok=True)
         raise
 
 
@@ -279,10 +422,16 @@ def write_json(path: str | Path, doc: object) -> None:
 
 
 def write_table(table: pa.Table, path: str | Path) -> None:
-    """Write an Arrow table as Parquet (CSV if ``path`` ends in .csv, HDF5 in .h5 or .hdf5), atomically."""
+    """Write an Arrow table as Parquet (CSV if ``path`` ends in .csv, its metadata in a first line
+    :data:`CSV_METADATA`; HDF5 in .h5 or .hdf5), atomically."""
     path = Path(path)
     if path.suffix.lower() == ".csv":
-        write_atomic(path, lambda tmp: pacsv.write_csv(table, tmp))
+        def write_csv(tmp: Path) -> None:
+            with open(tmp, "wb") as handle:
+                _write_csv_header(handle, table.schema)
+                pacsv.write_csv(table, handle)
+
+        write_atomic(path, write_csv)
     elif path.suffix.lower() in HDF5_SUFFIXES:
         write_atomic(path, lambda tmp: write_hdf5(table, tmp))
     else:
@@ -307,17 +456,24 @@ def write_tables(path: str | Path, tables: Iterable[pa.Table], check=None) -> in
     def write(tmp: Path) -> None:
         nonlocal rows
         writer = None
+        handle = None
         try:
             for table in tables:
                 if writer is None:
                     schema = table.schema
-                    writer = (pacsv.CSVWriter(tmp, schema) if path.suffix.lower() == ".csv"
-                              else pq.ParquetWriter(tmp, schema))
+                    if path.suffix.lower() == ".csv":
+                        handle = open(tmp, "wb")  # noqa: SIM115 - closed below, after the writer
+                        _write_csv_header(handle, schema)
+                        writer = pacsv.CSVWriter(handle, schema)
+                    else:
+                        writer = pq.ParquetWriter(tmp, schema)
                 writer.write_table(table.cast(schema) if table.schema != schema else table)
                 rows += table.num_rows
         finally:
             if writer is not None:
                 writer.close()
+            if handle is not None:
+                handle.close()
         if writer is None:
             raise InputError(f"{path}: nothing to write")
         if check is not None:

@@ -29,9 +29,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wbfriction.exceptions import ColumnError
-from wbfriction.logs.clock import MAX_GAP, ROUGHNESS_ROWS, Clock, TimeBase, read_clock, table_stamps
-from wbfriction.logs.tables import TableFile
+from wbfriction.exceptions import InputError
+from wbfriction.logs.clock import MAX_GAP, ROUGHNESS_ROWS, Clock, TimeBase, TimeUnit, read_clock, table_stamps
+from wbfriction.logs.log import check_schema
+from wbfriction.logs.tables import TableFile, numeric_column
 from wbfriction.model.robot import Robot
 
 CONTEXT = 3
@@ -45,13 +46,27 @@ class Chunking:
 
     Attributes:
         rows: target rows per chunk (the cut is at the first contact change after it).
-        overlap: rows of context at a forced cut (no contact change within ``2 rows``).
+        overlap: rows of context at a forced cut (no contact change within ``2 rows``); never
+            reaching before the previous chunk's first row read (the log is read forwards,
+            once): chunks shorter than the overlap get less context.
         workers: processes estimating chunks (1: in this process).
+
+    Raises:
+        InputError: ``rows`` or ``workers`` below 1 (named ``--chunk-rows``, ``--workers``), a
+            negative ``overlap``.
     """
 
     rows: int = 10_000
     overlap: int = 2_000
     workers: int = 2
+
+    def __post_init__(self) -> None:
+        if self.rows < 1:
+            raise InputError(f"--chunk-rows must be at least 1, got {self.rows}")
+        if self.overlap < 0:
+            raise InputError(f"the overlap of chunks must be at least 0 rows, got {self.overlap}")
+        if self.workers < 1:
+            raise InputError(f"--workers must be at least 1, got {self.workers}")
 
 
 @dataclass(frozen=True)
@@ -81,32 +96,53 @@ def plan_chunks(contact: np.ndarray, chunking: Chunking = Chunking()) -> list[Ch
     cuts.append(n)
     forced.append(False)
     context = [chunking.overlap if f else CONTEXT for f in forced]
-    return [Chunk(a, b, max(0, a - context[i]), min(n, b + context[i + 1]))
-            for i, (a, b) in enumerate(zip(cuts[:-1], cuts[1:]))]
+    chunks: list[Chunk] = []
+    for i, (a, b) in enumerate(zip(cuts[:-1], cuts[1:])):
+        start = max(0, a - context[i], chunks[-1].read_start if chunks else 0)  # read forwards
+        chunks.append(Chunk(a, b, start, min(n, b + context[i + 1])))
+    return chunks
+
+
+@dataclass(frozen=True, eq=False)
+class ColumnPlan:
+    """What is read of a log file before it is cut into chunks (:func:`plan_columns`).
+
+    Attributes:
+        contact: contact flags (N, n_contacts) (a fixed base: always welded).
+        clock: the whole log's clock (:func:`~wbfriction.logs.clock.read_clock`).
+        first_positions: the positions of its first rows (:func:`first_positions`), or None.
+        warnings: what its schema costs in accuracy (:func:`~wbfriction.logs.log.check_schema`).
+    """
+
+    contact: np.ndarray
+    clock: Clock
+    first_positions: np.ndarray | None
+    warnings: tuple[str, ...] = ()
 
 
 def plan_columns(file: TableFile, robot: Robot, source: str, max_gap: float = MAX_GAP,
-                 time_base: TimeBase = "auto") -> tuple[np.ndarray, Clock, np.ndarray | None]:
-    """The contact columns of a log file (N, n_contacts), read alone to plan its chunks, the whole
-    log's clock (:func:`~wbfriction.logs.clock.read_clock`: its stamps, and the positions of its
-    first :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS` rows when they are finite), and those
-    positions (:func:`first_positions`, None when not finite).
+                 time_base: TimeBase = "auto", time_unit: TimeUnit | None = None) -> ColumnPlan:
+    """Check a log file's schema against ``robot`` (:func:`~wbfriction.logs.log.check_schema`:
+    names and types, before any row is estimated), then read its contact columns alone to plan
+    its chunks, the whole log's clock (:func:`~wbfriction.logs.clock.read_clock`: its stamps, in
+    ``time_unit``, and the positions of its first :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS`
+    rows when they are finite), and those positions (:func:`first_positions`, None when not finite).
 
     Raises:
-        InputError: an unreadable file, a time column that :func:`~wbfriction.logs.clock.read_clock`
-            refuses (rows numbered from the file's first); ColumnError: a missing ``time`` or
-            contact column.
+        InputError: an unreadable file, what :func:`~wbfriction.logs.log.check_schema` refuses,
+            a time column that :func:`~wbfriction.logs.clock.table_stamps` or
+            :func:`~wbfriction.logs.clock.read_clock` refuses (rows numbered from the file's
+            first), contact flags that are not numbers.
     """
+    warnings = check_schema(file.schema(), robot, source)
     columns = ["time"] + ([f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else [])
     table = file.read(columns)
-    for c in columns:
-        if c not in table.column_names:
-            raise ColumnError(source, c, None, f"missing column '{c}'")
-    flags = (np.column_stack([table.column(c).to_numpy(zero_copy_only=False) for c in columns[1:]])
+    flags = (np.column_stack([numeric_column(table, c, source) for c in columns[1:]])
              if robot.floating_base else np.ones((table.num_rows, 1)))  # a fixed base: always welded
     first = first_positions(file, robot)
-    clock = read_clock(table_stamps(table, source), source, max_gap=max_gap, q=first, time_base=time_base)
-    return np.nan_to_num(flags.astype(float)) != 0, clock, first
+    clock = read_clock(table_stamps(table, source, unit=time_unit), source, max_gap=max_gap, q=first,
+                       time_base=time_base)
+    return ColumnPlan(flags != 0, clock, first, warnings)
 
 
 def first_positions(file: TableFile, robot: Robot) -> np.ndarray | None:

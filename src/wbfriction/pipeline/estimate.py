@@ -11,11 +11,9 @@ temporary Parquet log beside the output (:func:`table_log`).
 
 from __future__ import annotations
 
-import multiprocessing
 import tempfile
 from collections import deque
 from collections.abc import Iterator
-from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,7 +24,7 @@ import pyarrow.compute as pc
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import EstimateOptions, estimate_log, no_single_support, resolve_differentiation
 from wbfriction.friction.io import friction_table
-from wbfriction.logs.clock import Clock, TimeBase, longest_segment
+from wbfriction.logs.clock import Clock, TimeBase, TimeUnit, longest_segment
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, log_from_table
 from wbfriction.logs.source import LogSource
 from wbfriction.logs.tables import RowReader, TableFile, read_metadata, with_metadata, write_tables
@@ -34,6 +32,7 @@ from wbfriction.model.loading import load_robot
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import CONTEXT, Chunk, Chunking, plan_chunks, plan_columns
 from wbfriction.progress import Progress
+from wbfriction.workers import process_pool
 
 
 @dataclass(frozen=True)
@@ -49,7 +48,8 @@ class RobotSpec:
 
 
 def check_file(robot: Robot, path: str | Path, source: str | None = None, chunking: Chunking = Chunking(),
-               max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN, time_base: TimeBase = "auto") -> int:
+               max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN, time_base: TimeBase = "auto",
+               time_unit: TimeUnit | None = None) -> int:
     """Validate a log file against ``robot`` chunk by chunk, as :func:`estimate_file` does
     before estimating (:func:`~wbfriction.logs.log.log_from_table`), in bounded memory. Returns
     its rows.
@@ -59,12 +59,14 @@ def check_file(robot: Robot, path: str | Path, source: str | None = None, chunki
     """
     file = TableFile(path)
     source = source or str(file.path)
-    contact, clock, _ = plan_columns(file, robot, source, max_gap, time_base)
+    plan = plan_columns(file, robot, source, max_gap, time_base, time_unit)
+    clock = plan.clock
     reader = file.row_reader(max(1024, min(chunking.rows, 65_536)))
-    for c in plan_chunks(contact, chunking):
+    for c in plan_chunks(plan.contact, chunking):
         log_from_table(reader.rows(c.read_start, c.read_stop), robot, source, max_gap, limit_margin,
-                       first_row=c.read_start, period=clock.step, clock=clock.rows(c.read_start, c.read_stop))
-    return len(contact)
+                       first_row=c.read_start, period=clock.step, clock=clock.rows(c.read_start, c.read_stop),
+                       time_unit=time_unit)
+    return len(plan.contact)
 
 
 # worker state: the robot, loaded once per process
@@ -76,10 +78,10 @@ def _init_worker(spec: RobotSpec) -> None:
 
 
 def _estimate_chunk(robot: Robot, table: pa.Table, chunk: Chunk, clock: Clock, source: str, options: EstimateOptions,
-                    companion: bool, max_gap: float, limit_margin: float) -> pa.Table:
+                    companion: bool, max_gap: float, limit_margin: float, time_unit: TimeUnit | None) -> pa.Table:
     """The friction table of a chunk's own rows; ``clock``: the whole log's, cut to the rows read."""
     log = log_from_table(table, robot, source, max_gap, limit_margin, first_row=chunk.read_start, period=clock.step,
-                         clock=clock)
+                         clock=clock, time_unit=time_unit)
     est = estimate_log(robot, log, options, companion=companion, require_single_support=False)
     return friction_table(est).slice(chunk.start - chunk.read_start, chunk.stop - chunk.start)
 
@@ -98,8 +100,7 @@ def _chunk_tables(spec: RobotSpec, robot: Robot, reader: RowReader, chunks: list
         for c in chunks:
             yield _estimate_chunk(robot, *args(c))
         return
-    ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(workers, mp_context=ctx, initializer=_init_worker, initargs=(spec,)) as pool:
+    with process_pool(workers, "spawn", _init_worker, (spec,)) as pool:
         pending: deque = deque()
         for c in chunks:
             pending.append(pool.submit(_in_worker, args(c)))
@@ -110,11 +111,17 @@ def _chunk_tables(spec: RobotSpec, robot: Robot, reader: RowReader, chunks: list
 
 
 def _with_provenance(tables: Iterator[pa.Table], chunks: list[Chunk], robot: Robot, source: str,
-                     extra_metadata: dict | None, progress: Progress | None, first_meta: dict) -> Iterator[pa.Table]:
-    """``tables`` with provenance in the first one's metadata (kept in ``first_meta``), counted to ``progress``."""
+                     extra_metadata: dict | None, progress: Progress | None, first_meta: dict,
+                     valid: dict[str, int]) -> Iterator[pa.Table]:
+    """``tables`` with provenance in the first one's metadata (kept in ``first_meta``), counted to
+    ``progress``, their valid samples per joint counted into ``valid``; a log without a
+    single-support sample, or without a valid sample, is an error raised after the last table,
+    before the output is renamed into place (nothing is written)."""
     single = False
     for k, table in enumerate(tables):
         single = single or bool(pc.any(table.column("unique")).as_py())
+        for j in robot.torque_controlled:
+            valid[j] = valid.get(j, 0) + int(pc.sum(table.column(f"valid.{j}")).as_py() or 0)
         if k == 0:
             meta = read_metadata(table, source)
             meta.update(extra_metadata or {})
@@ -123,8 +130,19 @@ def _with_provenance(tables: Iterator[pa.Table], chunks: list[Chunk], robot: Rob
         yield table
         if progress is not None:
             progress(chunks[k].stop - chunks[k].start)
-    if not single:  # raised before the rename: nothing is written
+    if not single:
         raise no_single_support(robot, source)
+    if not any(valid.values()):
+        raise InputError(f"{source}: no valid sample for any joint (the --mask leaves none)")
+
+
+def no_valid_warnings(source: str, valid: dict[str, int]) -> tuple[str, ...]:
+    """One warning per joint left without a valid sample (not fitted: nothing to fit it on)."""
+    empty = [j for j, n in valid.items() if n == 0]
+    if not empty:
+        return ()
+    shown = ", ".join(empty[:4]) + (f" and {len(empty) - 4} more" if len(empty) > 4 else "")
+    return (f"{source}: no valid sample for {shown} (never in a phase the --mask keeps)",)
 
 
 @dataclass
@@ -140,13 +158,15 @@ class ChunkedResult:
     metadata: dict
     clock: str = ""
     differentiation: str = ""
+    warnings: tuple[str, ...] = ()
 
 
 def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options: EstimateOptions = EstimateOptions(),
                   *, chunking: Chunking = Chunking(), companion: bool = True, max_gap: float = MAX_GAP,
                   limit_margin: float = LIMIT_MARGIN, extra_metadata: dict | None = None,
                   progress: Progress | None = None, robot: Robot | None = None,
-                  source: str | None = None, time_base: TimeBase = "auto") -> ChunkedResult:
+                  source: str | None = None, time_base: TimeBase = "auto",
+                  time_unit: TimeUnit | None = None) -> ChunkedResult:
     """Estimate a log file chunk by chunk into ``output`` (Parquet or CSV), whole or not at all.
 
     Args:
@@ -163,10 +183,12 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
             temporary file is named as the bag).
         time_base: ``auto``, ``recorded`` or ``regularised``
             (:func:`~wbfriction.logs.clock.read_clock`, decided once for the whole log).
+        time_unit: the unit of a numeric ``time`` column (:func:`~wbfriction.logs.clock.table_stamps`).
 
     Raises:
         InputError: what reading, validating and estimating raise, naming the file and row;
-            an output that is neither .parquet nor .csv. Nothing is written then.
+            an output that is neither .parquet nor .csv; a log that leaves no valid sample
+            (:func:`no_valid_sample`). Nothing is written then.
     """
     path, output = Path(path), Path(output)
     if output.suffix.lower() not in (".parquet", ".pq", ".csv"):
@@ -174,7 +196,8 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     source = source or str(path)
     robot = robot if robot is not None else spec.load()
     file = TableFile(path)
-    contact, clock, first = plan_columns(file, robot, source, max_gap, time_base)
+    plan = plan_columns(file, robot, source, max_gap, time_base, time_unit)
+    contact, clock, first = plan.contact, plan.clock, plan.first_positions
     if first is not None:  # the noise is measured on one segment: a gap between two recordings is no noise
         a, b = longest_segment(clock.segments, len(first))
         first = first[a:b]
@@ -186,12 +209,14 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     del contact
     reader = file.row_reader(max(1024, min(chunking.rows, 65_536)))
     first_meta: dict = {}
-    settings = (source, options, companion, max_gap, limit_margin)
+    valid: dict[str, int] = {}
+    settings = (source, options, companion, max_gap, limit_margin, time_unit)
     write_tables(output, _with_provenance(_chunk_tables(spec, robot, reader, chunks, clock, chunking.workers,
                                                         settings),
-                                          chunks, robot, source, extra_metadata, progress, first_meta))
+                                          chunks, robot, source, extra_metadata, progress, first_meta, valid))
     return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta,
-                         clock.reason, "" if choice is None else choice.reason)
+                         clock.reason, "" if choice is None else choice.reason,
+                         plan.warnings + no_valid_warnings(source, valid))
 
 
 @contextmanager

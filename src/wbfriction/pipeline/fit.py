@@ -49,7 +49,8 @@ def fit_file(friction: str | Path, output: str | Path, *, model: ModelChoice = "
 
     Raises:
         InputError: an unknown ``--model`` or a negative ``--selection-tolerance``, an unreadable
-            or malformed friction table, an output folder that does not exist.
+            or malformed friction table, a table where no joint has ``min_samples`` valid samples
+            (nothing is written), an output folder that does not exist.
     """
     if model not in MODEL_CHOICES:
         raise InputError(f"--model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
@@ -58,8 +59,13 @@ def fit_file(friction: str | Path, output: str | Path, *, model: ModelChoice = "
     est = read_friction_file(friction)
     fits = fit_estimate(est, min_samples=min_samples, workers=workers, model=model,
                         selection_tolerance=selection_tolerance)
+    if not any(f.params is not None for f in fits):
+        raise InputError(f"{friction}: no joint could be fitted (each has fewer than --min-samples {min_samples} "
+                         "valid samples); nothing written")
     energy = energy_consistency(est, fitted_offsets(fits), threshold, tolerance)
-    header: dict[str, object] = {"provenance": file_provenance("friction", friction),
+    log = est.metadata.get("provenance", {})
+    header: dict[str, object] = {"provenance": {**file_provenance("friction", friction),
+                                                **{k: log[k] for k in ("robot", "urdf") if k in log}},
                                  "sign_convention": SIGN_CONVENTION, "model": model}
     if model == "auto":
         header["selection_tolerance"] = selection_tolerance

@@ -15,8 +15,10 @@ from wbfriction.inertia.closed_loop import ClosedLoop, identify
 from wbfriction.inertia.identification import InertialOptions
 from wbfriction.inertia.io import identification_document, write_identification
 from wbfriction.inertia.urdf import write_urdf
+from wbfriction.logs.clock import TimeUnit
 from wbfriction.logs.source import read_log
 from wbfriction.model.robot import Robot
+from wbfriction.pipeline.paths import check_paths
 from wbfriction.pipeline.provenance import log_provenance
 from wbfriction.progress import StageProgress
 
@@ -49,16 +51,21 @@ class IdentifiedFile:
 def identify_file(robot: Robot, log: str | Path, urdf_output: str | Path, json_output: str | Path | None = None, *,
                   estimate_options: EstimateOptions = EstimateOptions(), options: InertialOptions = InertialOptions(),
                   stribeck: float | Literal["auto"] | None = "auto", passes: int = 2,
-                  progress: StageProgress | None = None, workers: int = 1) -> IdentifiedFile:
+                  progress: StageProgress | None = None, workers: int = 1,
+                  time_unit: TimeUnit | None = None) -> IdentifiedFile:
     """Identify the inertia model and the friction of ``robot`` from a log file (the closed loop,
     :func:`~wbfriction.inertia.closed_loop.identify`), write the corrected URDF to ``urdf_output``
-    and, if given, the identification JSON to ``json_output``, each whole or not at all.
+    and, if given, the identification JSON to ``json_output``, each whole or not at all; the
+    outputs are checked before the work (:func:`~wbfriction.pipeline.paths.check_paths`).
+    ``time_unit``: the unit of a numeric time column (:func:`~wbfriction.logs.source.read_log`).
 
     Raises:
-        InputError: an unreadable or invalid log, what the identification raises, an output
-            folder that does not exist.
+        InputError: an output that cannot be written or is the log, an unreadable or invalid
+            log, what the identification raises.
     """
-    data = read_log(log, robot)
+    check_paths({"log": Path(log)}, {"urdf_output": Path(urdf_output),
+                                     "json_output": None if json_output is None else Path(json_output)})
+    data = read_log(log, robot, time_unit=time_unit)
     loop = identify(robot, data, estimate_options, options, stribeck, passes, progress=progress, workers=workers)
     moved = write_urdf(robot, loop.final.identification.pi, urdf_output)
     doc = identification_document(loop, moved, log_provenance(log, robot))

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from wbfriction.friction.io import read_friction_file, read_params
+from wbfriction.friction.io import check_params_source, read_friction_file, read_params
 from wbfriction.friction.predict import TorquePrediction, predict_torques
 
 
@@ -20,8 +20,10 @@ def predict_file(friction: str | Path, params: str | Path) -> TorquePrediction:
             with the same URDF).
 
     Raises:
-        InputError: what reading either file raises.
+        InputError: what reading either file raises; parameters for another robot or none of
+            the table's joints (:func:`~wbfriction.friction.io.check_params_source`).
     """
     fits = read_params(params)
     est = read_friction_file(friction)
+    check_params_source(params, est)
     return predict_torques(est, {j: f.params for j, f in fits.items() if f.params is not None})

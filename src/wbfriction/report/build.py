@@ -27,7 +27,7 @@ import numpy as np
 from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, JointEnergy, energy_consistency
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
-from wbfriction.friction.io import read_friction_file, read_params
+from wbfriction.friction.io import check_params_source, read_friction_file, read_params
 from wbfriction.inertia.io import read_identification
 from wbfriction.logs.tables import file_sha256
 from wbfriction.signals.spectrum import MIN_SAMPLES, joint_spectra, longest_run
@@ -81,12 +81,14 @@ def make_report(friction: str | Path, params: str | Path | None = None,
     inertia model, :func:`~wbfriction.inertia.io.read_identification`) and compute the report.
 
     Raises:
-        InputError: unreadable inputs.
+        InputError: unreadable inputs; parameters fitted on another table or for another robot
+            (:func:`~wbfriction.friction.io.check_params_source`).
     """
     friction = Path(friction)
     ident = None if identification is None else read_identification(identification)
     est = read_friction_file(friction)
     if params is not None:
+        check_params_source(params, est, friction)
         fits = read_params(params)
     else:
         fits = {f.joint: f for f in fit_estimate(est)}

@@ -76,9 +76,10 @@ def savgol_weights(window: int, weights: SavgolWeights | np.ndarray = "uniform")
 
 def _check_savgol(window: int, order: int, deriv: int) -> None:
     if window < 3 or window % 2 == 0:
-        raise InputError(f"Savitzky-Golay window must be odd and at least 3, got {window}")
+        raise InputError(f"Savitzky-Golay window (--window) must be odd and at least 3, got {window}")
     if not deriv <= order < window:
-        raise InputError(f"Savitzky-Golay order must be at least {deriv} (the derivative) and below the window "
+        raise InputError(f"Savitzky-Golay order (--poly-order) must be at least {deriv} (the derivative) and below "
+                         f"the window "
                          f"{window}, got {order}")
 
 
@@ -148,10 +149,11 @@ class ZeroPhaseLowpass:
     def __post_init__(self) -> None:
         nyquist = 0.5 / self.dt
         if not 0 < self.cutoff < nyquist:
-            raise InputError(f"Butterworth cutoff must be between 0 and the Nyquist frequency {nyquist:g} Hz, "
+            raise InputError(f"Butterworth cutoff (--cutoff) must be between 0 and the Nyquist frequency "
+                             f"{nyquist:g} Hz, "
                              f"got {self.cutoff:g}")
         if self.order < 1:
-            raise InputError(f"Butterworth order must be at least 1, got {self.order}")
+            raise InputError(f"Butterworth order (--butter-order) must be at least 1, got {self.order}")
 
     @cached_property
     def sos(self) -> np.ndarray:

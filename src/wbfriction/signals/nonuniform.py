@@ -120,9 +120,10 @@ def savgol_responses(t: np.ndarray, window: int, order: int, weights: SavgolWeig
         InputError: a window, order or weights that do not make a filter.
     """
     if window < 3 or window % 2 == 0:
-        raise InputError(f"Savitzky-Golay window must be odd and at least 3, got {window}")
+        raise InputError(f"Savitzky-Golay window (--window) must be odd and at least 3, got {window}")
     if not max_deriv <= order < window:
-        raise InputError(f"Savitzky-Golay order must be at least {max_deriv} (the derivative) and below the window "
+        raise InputError(f"Savitzky-Golay order (--poly-order) must be at least {max_deriv} (the derivative) and below "
+                         f"the window "
                          f"{window}, got {order}")
     t = np.asarray(t, dtype=float)
     w = np.sqrt(savgol_weights(window, weights))

@@ -70,7 +70,7 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 def segment(time: np.ndarray, contact: np.ndarray, lift_off_skip: float = 0.10,
-            touch_down_skip: float = 0.05) -> Phases:
+            touch_down_skip: float = 0.05, gaps: tuple[bool, bool] = (False, False)) -> Phases:
     """Support phases and the single-support samples kept for estimation.
 
     Args:
@@ -80,9 +80,12 @@ def segment(time: np.ndarray, contact: np.ndarray, lift_off_skip: float = 0.10,
             run (thesis: 0.10 s).
         touch_down_skip: seconds dropped before each touch-down that ends one
             (thesis: 0.05 s).
+        gaps: whether a time gap comes before the first row and after the last (a segment of a
+            log cut at its gaps): what happened in a gap is not known, so a run that starts
+            (ends) there is trimmed as if a lift-off (touch-down) had just happened.
 
     A single-support run that starts (ends) at the first (last) row of the log has no
-    observed lift-off (touch-down) and is not trimmed on that side.
+    observed lift-off (touch-down) and is not trimmed on that side, unless a gap is there.
     """
     if lift_off_skip < 0 or touch_down_skip < 0:
         raise InputError("lift-off and touch-down margins must be >= 0 s")
@@ -98,10 +101,12 @@ def segment(time: np.ndarray, contact: np.ndarray, lift_off_skip: float = 0.10,
         for s in np.unique(run_id[start:stop]):
             idx = np.flatnonzero(run_id[start:stop] == s) + start
             a, b = idx[0], idx[-1] + 1
-            if a > 0:
+            if a > 0 or gaps[0]:
                 keep[a:b] &= time[a:b] - time[a] >= lift_off_skip - 1e-9
-            if b < len(time):
-                keep[a:b] &= time[b] - time[a:b] > touch_down_skip + 1e-9
+            if b < len(time) or gaps[1]:
+                # at a gap: as if the touch-down were the next sample, one step after the last
+                end = time[b] if b < len(time) else 2 * time[b - 1] - time[max(b - 2, 0)]
+                keep[a:b] &= end - time[a:b] > touch_down_skip + 1e-9
     return Phases(n_contacts, stance, keep)
 
 

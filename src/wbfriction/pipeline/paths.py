@@ -1,0 +1,64 @@
+"""Where a command reads and writes, checked before any work: inputs exist, outputs can be
+written whole and never replace an input.
+
+Every output is written whole or not at all (:func:`~wbfriction.logs.tables.write_atomic`),
+but a run that can only fail at its end (an output folder that does not exist, or that cannot
+be written) wastes the user's time, and one whose output is its own input destroys the data.
+:func:`check_paths` refuses both before anything is read.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+from wbfriction.exceptions import InputError
+
+
+def _same(a: Path, b: Path) -> bool:
+    """``a`` and ``b`` are one file (the same path, or two names of one existing file)."""
+    if a.resolve() == b.resolve():
+        return True
+    try:
+        return a.exists() and b.exists() and os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def check_paths(inputs: Mapping[str, Path | None], outputs: Mapping[str, Path | None]) -> None:
+    """Refuse, before any work, a missing input, an output that cannot be written whole, and an
+    output that is an input or another output.
+
+    Args:
+        inputs: the files read, by the argument or option that names them (e.g.
+            ``{"LOG": log, "--params": params}``; None: not given).
+        outputs: the files written, likewise (e.g. ``{"-o": output, "--json": json}``).
+
+    Raises:
+        InputError: naming the option and the path: an input that does not exist; an output
+            that is a folder, in a folder that does not exist or cannot be written, equal to an
+            input (inputs are never overwritten) or to another output.
+    """
+    given_in = {k: Path(v) for k, v in inputs.items() if v is not None}
+    given_out = {k: Path(v) for k, v in outputs.items() if v is not None}
+    for label, path in given_in.items():
+        if not path.exists():
+            raise InputError(f"{path}: file not found ({label})")
+    seen: dict[str, Path] = {}
+    for label, path in given_out.items():
+        if path.is_dir():
+            raise InputError(f"{label} {path}: is a folder; give the file to write")
+        folder = path.parent
+        if not folder.is_dir():
+            raise InputError(f"{label} {path}: folder '{folder}' does not exist")
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise InputError(f"{label} {path}: folder '{folder}' cannot be written")
+        for in_label, source in given_in.items():
+            if _same(path, source):
+                raise InputError(f"{label} {path}: is the input {in_label}; write to another file "
+                                 "(inputs are never overwritten)")
+        for other_label, other in seen.items():
+            if _same(path, other):
+                raise InputError(f"{label} {path}: is also the output {other_label}")
+        seen[label] = path

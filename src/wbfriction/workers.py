@@ -1,0 +1,141 @@
+"""Worker processes that end with the process that started them, whatever ends it.
+
+:func:`process_pool` is the one way the package starts processes. Its workers
+
+* end when their parent ends, SIGKILL included: on Linux the kernel sends them SIGKILL when the
+  parent dies (``prctl(PR_SET_PDEATHSIG)``); elsewhere a thread in each worker polls its parent
+  (:func:`end_with_parent`). A worker whose parent died before it could arrange this leaves at once.
+  Multiprocessing's resource tracker, which ends when the last process holding its pipe has
+  ended, then ends too;
+* leave the signals that end a command to the parent: a worker ignores SIGINT (the terminal
+  sends Ctrl-C to every process of the job; the parent decides) and dies quietly of SIGTERM or
+  SIGHUP, and these signals are held back while a worker starts, so that it never prints a
+  traceback of its own;
+* are killed at once when the ``with`` block is left by an exception (an interruption, an error,
+  a generator closed early) instead of being waited for: only a normal exit waits for the work
+  submitted.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import multiprocessing
+import os
+import pickle
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+from concurrent.futures import Future, ProcessPoolExecutor
+from contextlib import contextmanager
+from typing import Literal, ParamSpec, TypeVar
+
+StartMethod = Literal["spawn", "fork"]
+"""How workers start: ``spawn`` (a fresh interpreter: safe beside threads) or ``fork`` (a copy of
+the parent: fast, shares its memory; only from a parent without threads that hold locks)."""
+Mechanism = Literal["prctl", "poll"]
+"""How a worker learns that its parent ended: the kernel's parent-death signal (Linux) or a thread
+polling the parent's process id (any POSIX system, within :data:`POLL_PERIOD`)."""
+
+POLL_PERIOD = 0.2
+"""Seconds between two looks at the parent's process id (:func:`end_with_parent` by ``poll``)."""
+PR_SET_PDEATHSIG = 1
+"""``prctl`` option: the signal a process receives when its parent thread ends (linux/prctl.h)."""
+_HELD = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
+"""The signals that end a command: held back while a worker starts (it inherits the mask)."""
+
+P = ParamSpec("P")
+T = TypeVar("T")
+
+
+def end_with_parent(parent: int, mechanism: Mechanism | None = None) -> None:
+    """Make the calling process end when process ``parent`` (its parent) ends.
+
+    Args:
+        parent: the process id of the caller's parent, read in the parent before the caller
+            started (read here, it could already be the process that adopted an orphan).
+        mechanism: ``prctl`` (SIGKILL from the kernel at once; Linux only), ``poll`` (a daemon
+            thread that calls ``os._exit(1)`` within :data:`POLL_PERIOD` seconds), or None: ``prctl``
+            on Linux, else ``poll``.
+
+    The parent-death signal comes when the *thread* that started the caller ends: start
+    workers from a thread that outlives them (the main thread). If ``parent`` has already
+    ended, the caller leaves at once (``os._exit(1)``).
+
+    Raises:
+        OSError: ``prctl`` refused.
+    """
+    mechanism = mechanism or ("prctl" if sys.platform.startswith("linux") else "poll")
+    if mechanism == "prctl":
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(PR_SET_PDEATHSIG, ctypes.c_ulong(signal.SIGKILL), ctypes.c_ulong(0), ctypes.c_ulong(0),
+                      ctypes.c_ulong(0)) != 0:
+            errno = ctypes.get_errno()
+            raise OSError(errno, f"prctl(PR_SET_PDEATHSIG): {os.strerror(errno)}")
+    else:
+        threading.Thread(target=_poll_parent, args=(parent,), name="end-with-parent", daemon=True).start()
+    if os.getppid() != parent:  # the parent ended before the signal was armed
+        os._exit(1)
+
+
+def _poll_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(POLL_PERIOD)
+    os._exit(1)
+
+
+def _start_worker(parent: int, job: bytes) -> None:
+    """A worker's first act: tied to its parent, the command-ending signals left to the parent, then
+    the caller's initializer (unpickled only now: its imports may take seconds)."""
+    end_with_parent(parent)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    for sig in _HELD - {signal.SIGINT}:
+        signal.signal(sig, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD)
+    initializer, initargs = pickle.loads(job)
+    if initializer is not None:
+        initializer(*initargs)
+
+
+class _Pool(ProcessPoolExecutor):
+    """A pool whose processes start (at a submission) with the command-ending signals held back."""
+
+    def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
+        held = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+        try:
+            return super().submit(fn, *args, **kwargs)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, held)
+
+
+@contextmanager
+def process_pool(workers: int, context: StartMethod, initializer: Callable[..., object] | None = None,
+                 initargs: tuple = ()) -> Iterator[ProcessPoolExecutor]:
+    """A :class:`~concurrent.futures.ProcessPoolExecutor` of ``workers`` processes that end with
+    this one (see the module's description).
+
+    Args:
+        workers: processes (>= 1).
+        context: how they start (:data:`StartMethod`).
+        initializer, initargs: called as ``initializer(*initargs)`` in each worker once it is
+            tied to this process; both must pickle.
+
+    Leaving the block normally waits for the submitted work; leaving it by an exception
+    cancels what has not started and kills the workers (no wait).
+    """
+    before = set(multiprocessing.active_children())
+    pool = _Pool(workers, mp_context=multiprocessing.get_context(context), initializer=_start_worker,
+                 initargs=(os.getpid(), pickle.dumps((initializer, initargs))))
+    try:
+        yield pool
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        mine = set(multiprocessing.active_children()) - before
+        for process in mine:
+            process.kill()
+        for process in mine:
+            process.join(5.0)
+        pool.shutdown(wait=True)  # the pool's thread sees its workers gone and ends
+        raise
+    pool.shutdown(wait=True)
