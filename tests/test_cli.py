@@ -126,7 +126,7 @@ def test_filtering_schemes_from_the_command_line(demo_dir, tmp_path):
         knee = json.loads((tmp_path / "p.json").read_text())["joints"]["leg_right_4_joint"]
         assert knee["error_percent"]["F_c"] < 5 and knee["error_percent"]["tau_os"] < 5, (args, knee)
     assert_one_line_error(run("estimate", out / "log.parquet", "-o", tmp_path / "x.parquet", "--diff", "savgol",
-                               "--window", "50"), "window must be odd")
+                               "--window", "50"), "(--window) must be odd")
     assert_one_line_error(run("estimate", out / "log.parquet", "-o", tmp_path / "x.parquet", "--diff",
                                "butterworth", "--cutoff", "600"), "Nyquist")
 

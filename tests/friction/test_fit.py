@@ -128,13 +128,13 @@ def test_held_out_errors_come_from_samples_the_fits_did_not_see():
     use = np.ones(QD.size, dtype=bool)
     train, held_out = held_out_split(use)
     wrecked = tau_f.copy()
-    wrecked[held_out] = rng.normal(0.0, 50.0, held_out.sum())
+    wrecked[held_out] = rng.normal(0.0, 5.0, held_out.sum())  # wrecked, yet no gross outlier (screened)
     auto = fit_friction(QD, wrecked, model="auto", selection_tolerance=0.0)
     assert auto.selection.n_train == train.sum() and auto.selection.n_held_out == held_out.sum()
     for score in auto.selection.scores:
         clean = fit_friction(QD, tau_f, mask=train, model=score.model)
         assert score.held_out_rms == pytest.approx(held_out_rms(clean.params, QD, wrecked, held_out), rel=1e-9)
-        assert score.held_out_rms > 40.0  # scored on the wrecked samples, fitted without them
+        assert score.held_out_rms > 4.0  # scored on the wrecked samples, fitted without them
 
 
 def test_auto_fits_the_chosen_model_as_if_it_had_been_named():

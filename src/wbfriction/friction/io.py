@@ -331,10 +331,8 @@ def check_params_source(params: str | Path, est: FrictionEstimate, table: str | 
         InputError: naming the parameters file and what does not match.
     """
     path = Path(params)
-    try:
-        doc = json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: cannot be read: {exc}") from None
+    read_params(path)  # a file that is not a parameters file is refused as such
+    doc = json.loads(path.read_text())
     prov = doc.get("provenance", {}) if isinstance(doc, dict) else {}
     prov = prov if isinstance(prov, dict) else {}
     robot, table_robot = prov.get("robot"), est.metadata.get("provenance", {}).get("robot")
