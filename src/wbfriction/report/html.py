@@ -78,13 +78,16 @@ def _params_table(joints: list[str], fits: dict[str, FitResult]) -> str:
 
     for j in joints:
         fit = fits.get(j)
-        if fit is None or fit.params is None:
+        if fit is None or fit.params is None:  # said, not printed as parameters
             n = "—" if fit is None else str(fit.n_samples)
-            rows.append(f"<tr><td>{html.escape(j)}</td><td></td><td>{n}</td>" + "<td>—</td>" * (len(names) + 1)
-                        + "</tr>")
+            why = "not fitted" + ("" if fit is None or not fit.message else f": {fit.message}")
+            rows.append(f'<tr class="unfitted"><td>{html.escape(j)}</td><td>{html.escape(why)}</td><td>{n}</td>'
+                        + "<td></td>" * (len(names) + 1) + "</tr>")
             continue
         cells = "".join(cell(fit, n) for n in names)
-        rows.append(f"<tr><td>{html.escape(j)}</td><td>{html.escape(fit.model)}</td><td>{fit.n_samples}</td>{cells}"
+        screened = f" (−{fit.n_screened} screened)" if fit.n_screened else ""
+        rows.append(f"<tr><td>{html.escape(j)}</td><td>{html.escape(fit.model)}</td><td>{fit.n_samples}{screened}</td>"
+                    f"{cells}"
                     f"<td>{_fmt(fit.rms_residual)}</td></tr>")
         err = fit.error_percent()
         if err is not None and fit.target is not None:
