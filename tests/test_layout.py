@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "src" / "wbfriction"
 
 LAYERS = [
-    {"version", "exceptions", "progress", "config"},
+    {"version", "exceptions", "progress", "config", "workers"},
     {"model"},
     {"logs"},
     {"signals"},
@@ -24,7 +24,7 @@ LAYERS = [
     {"sim"},
     {"report"},
     {"studies"},
-    {"cli", "__main__", "__init__"},
+    {"cli", "__main__", "__init__", "entry"},
 ]
 """The top-level modules and subpackages in data-flow order: each may import only from its own layer
 or earlier ones (the package's ``__init__`` re-exports, so it sits last)."""

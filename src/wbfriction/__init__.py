@@ -21,17 +21,22 @@ Sign convention: ``tau_f`` is the torque friction exerts on the joint,
 fitted to ``-tau_f``.
 """
 
-from wbfriction.exceptions import ColumnError, InputError, ModelError, SimulationError, WbfrictionError
-from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_friction, estimate_log
-from wbfriction.friction.fit import FitResult, fit_estimate, fit_friction, fit_joints
-from wbfriction.friction.io import friction_table, read_friction_file, read_params, write_params
-from wbfriction.friction.models import FrictionParams
-from wbfriction.logs.log import Log, write_log
-from wbfriction.logs.source import open_log, read_log
-from wbfriction.model.loading import load_robot
-from wbfriction.model.robot import Robot
-from wbfriction.signals.kinematics import FilterOptions, MeasuredKinematics, measure
+from importlib import import_module
+from typing import TYPE_CHECKING
+
 from wbfriction.version import __version__
+
+if TYPE_CHECKING:
+    from wbfriction.exceptions import ColumnError, InputError, ModelError, SimulationError, WbfrictionError
+    from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_friction, estimate_log
+    from wbfriction.friction.fit import FitResult, fit_estimate, fit_friction, fit_joints
+    from wbfriction.friction.io import friction_table, read_friction_file, read_params, write_params
+    from wbfriction.friction.models import FrictionParams
+    from wbfriction.logs.log import Log, write_log
+    from wbfriction.logs.source import open_log, read_log
+    from wbfriction.model.loading import load_robot
+    from wbfriction.model.robot import Robot
+    from wbfriction.signals.kinematics import FilterOptions, MeasuredKinematics, measure
 
 __all__ = [
     "ColumnError", "EstimateOptions", "FilterOptions", "FitResult", "FrictionEstimate", "FrictionParams",
@@ -40,3 +45,29 @@ __all__ = [
     "friction_table", "load_robot", "measure", "open_log", "read_friction_file", "read_log", "read_params",
     "write_log", "write_params",
 ]
+
+
+_HOMES = {
+    **dict.fromkeys(("ColumnError", "InputError", "ModelError", "SimulationError", "WbfrictionError"),
+                    "wbfriction.exceptions"),
+    **dict.fromkeys(("EstimateOptions", "FrictionEstimate", "estimate_friction", "estimate_log"),
+                    "wbfriction.friction.estimate"),
+    **dict.fromkeys(("FitResult", "fit_estimate", "fit_friction", "fit_joints"), "wbfriction.friction.fit"),
+    **dict.fromkeys(("friction_table", "read_friction_file", "read_params", "write_params"), "wbfriction.friction.io"),
+    "FrictionParams": "wbfriction.friction.models",
+    **dict.fromkeys(("Log", "write_log"), "wbfriction.logs.log"),
+    **dict.fromkeys(("open_log", "read_log"), "wbfriction.logs.source"),
+    "load_robot": "wbfriction.model.loading",
+    "Robot": "wbfriction.model.robot",
+    **dict.fromkeys(("FilterOptions", "MeasuredKinematics", "measure"), "wbfriction.signals.kinematics"),
+}
+"""Where each public name lives: imported on first use (PEP 562), so that ``import wbfriction``
+(and the command's entry point, :mod:`wbfriction.entry`) loads no NumPy, Pinocchio or SciPy."""
+
+
+def __getattr__(name: str) -> object:
+    if name not in _HOMES:
+        raise AttributeError(f"module 'wbfriction' has no attribute {name!r}")
+    value = getattr(import_module(_HOMES[name]), name)
+    globals()[name] = value
+    return value

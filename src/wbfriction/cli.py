@@ -10,7 +10,6 @@ with status 2.
 
 from __future__ import annotations
 
-import signal
 import sys
 import time
 from contextlib import ExitStack, contextmanager, nullcontext
@@ -782,10 +781,9 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
 
 def main() -> None:
     """Entry point: run the app, turning wbfriction errors into one line and exit status 2.
-    SIGTERM ends it like Ctrl-C: a partly written output is removed, the previous one kept."""
-    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
+    Interruptions (Ctrl-C, SIGTERM) are :mod:`wbfriction.entry`'s, which calls this."""
     try:
-        app(standalone_mode=False)
+        status = app(standalone_mode=False)
     except WbfrictionError as exc:
         console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
         sys.exit(2)
@@ -799,3 +797,5 @@ def main() -> None:
             console.print(f"[bold red]error:[/] {escape(str(message()))}", highlight=False, soft_wrap=True)
             sys.exit(code)
         raise
+    if isinstance(status, int) and status:
+        sys.exit(status)

@@ -7,7 +7,11 @@ Ctrl-C (SIGINT), SIGTERM and SIGHUP end the command with status 128 + the signal
 while a log is read, estimated or written. The handler raises :class:`Interrupted` in the main
 thread; on its way up it removes a partly written output (the previous one stays:
 :func:`wbfriction.logs.tables.write_atomic`) and kills the worker processes
-(:func:`wbfriction.workers.process_pool`). A second signal while the command ends ends it at once.
+(:func:`wbfriction.workers.process_pool`). Code that swallows the exception cannot turn the
+status into 0; one raised inside an object's ``__del__`` (where Python could only print it) is
+sent again. A second signal while the command ends ends it at once.
+
+Before the first line of Python runs (the interpreter's start, ~40 ms) a Ctrl-C is Python's own.
 
 This module imports only the standard library at its top: the console script and
 ``python -m wbfriction`` reach :func:`main` before NumPy, Pinocchio or SciPy are loaded (provided
@@ -20,6 +24,7 @@ import gc
 import os
 import signal
 import sys
+import threading
 from types import FrameType
 from typing import NoReturn
 
@@ -68,11 +73,24 @@ def _on_signal(signum: int, frame: FrameType | None) -> None:
     raise Interrupted(signum)
 
 
+def _unraisable(hook: sys.UnraisableHookArgs) -> None:
+    """An interruption raised where it cannot go on (an object's ``__del__``, a callback of the
+    garbage collector): no traceback; the signal is sent again to this (the main) thread in a
+    moment, from another thread (sent from here, it would be handled here, and lost again)."""
+    if isinstance(hook.exc_value, Interrupted):
+        again = threading.Timer(0.01, signal.pthread_kill, (threading.get_ident(), hook.exc_value.signum))
+        again.daemon = True
+        again.start()
+        return
+    sys.__unraisablehook__(hook)
+
+
 def main() -> NoReturn:
     """Run the command line with the ending signals handled (see the module's description); exit
     with the command's status, or 128 + the signal's number if one ended it."""
     for sig in ENDING_SIGNALS:
         signal.signal(sig, _on_signal)
+    sys.unraisablehook = _unraisable
     status: int | str | None = 0
     try:
         from wbfriction.cli import main as cli_main

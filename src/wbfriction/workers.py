@@ -98,15 +98,37 @@ def _start_worker(parent: int, job: bytes) -> None:
         initializer(*initargs)
 
 
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """The command-ending signals held back: blocked (a process started here inherits the mask)
+    and, in the main thread, their Python handlers deferred to the end of the block (a handler
+    that raised between the start of a spawned worker and the data sent to it would leave the
+    worker to die with a traceback)."""
+    caught: list[int] = []
+    deferred = {}
+    mask = None
+    try:
+        if threading.current_thread() is threading.main_thread():
+            for sig in _HELD:
+                if signal.getsignal(sig) is not None:  # None: a handler set outside Python, left alone
+                    deferred[sig] = signal.signal(sig, lambda signum, frame: caught.append(signum))
+        mask = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+        yield
+    finally:
+        if mask is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+        for sig, handler in deferred.items():
+            signal.signal(sig, handler)
+        for signum in caught:  # delivered again, to the handler restored
+            signal.raise_signal(signum)
+
+
 class _Pool(ProcessPoolExecutor):
     """A pool whose processes start (at a submission) with the command-ending signals held back."""
 
     def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
-        held = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
-        try:
+        with _signals_held():
             return super().submit(fn, *args, **kwargs)
-        finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, held)
 
 
 @contextmanager
@@ -125,17 +147,21 @@ def process_pool(workers: int, context: StartMethod, initializer: Callable[..., 
     cancels what has not started and kills the workers (no wait).
     """
     before = set(multiprocessing.active_children())
-    pool = _Pool(workers, mp_context=multiprocessing.get_context(context), initializer=_start_worker,
-                 initargs=(os.getpid(), pickle.dumps((initializer, initargs))))
+    job = pickle.dumps((initializer, initargs))
+    pool = None
     try:
+        with _signals_held():  # a pool half made (its queues, its resource tracker) would not be undone
+            pool = _Pool(workers, mp_context=multiprocessing.get_context(context), initializer=_start_worker,
+                         initargs=(os.getpid(), job))
         yield pool
     except BaseException:
-        pool.shutdown(wait=False, cancel_futures=True)
-        mine = set(multiprocessing.active_children()) - before
-        for process in mine:
-            process.kill()
-        for process in mine:
-            process.join(5.0)
-        pool.shutdown(wait=True)  # the pool's thread sees its workers gone and ends
+        with _signals_held():  # a second Ctrl-C waits until the workers are gone
+            mine = set(multiprocessing.active_children()) - before
+            for process in mine:
+                process.kill()
+            for process in mine:
+                process.join(5.0)
+            if pool is not None:  # its thread sees the workers gone, fails the futures left and ends
+                pool.shutdown(wait=True, cancel_futures=True)
         raise
     pool.shutdown(wait=True)

@@ -11,7 +11,6 @@ temporary Parquet log beside the output (:func:`table_log`).
 
 from __future__ import annotations
 
-import tempfile
 from collections import deque
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -27,7 +26,7 @@ from wbfriction.friction.io import friction_table
 from wbfriction.logs.clock import Clock, TimeBase, TimeUnit, longest_segment
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, log_from_table
 from wbfriction.logs.source import LogSource
-from wbfriction.logs.tables import RowReader, TableFile, read_metadata, with_metadata, write_tables
+from wbfriction.logs.tables import RowReader, TableFile, read_metadata, scratch_folder, with_metadata, write_tables
 from wbfriction.model.loading import load_robot
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import CONTEXT, Chunk, Chunking, plan_chunks, plan_columns
@@ -232,7 +231,7 @@ def table_log(log: LogSource, near: Path) -> Iterator[Path]:
         yield log.path
         return
     folder = near.parent if near.parent.exists() else None
-    with tempfile.TemporaryDirectory(prefix=".wbfriction-", dir=folder) as tmp:
+    with scratch_folder(folder) as tmp:
         converted = Path(tmp) / "log.parquet"
         write_tables(converted, log.blocks())
         yield converted

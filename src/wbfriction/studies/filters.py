@@ -12,9 +12,7 @@ reports (relative to its estimate): what a user without the truth would see.
 
 from __future__ import annotations
 
-import multiprocessing
 import os
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -34,6 +32,7 @@ from wbfriction.signals.kinematics import Diff, FilterOptions
 from wbfriction.sim import SensorNoise, apply_sensor_noise, simulate_ideal
 from wbfriction.studies.common import ENCODER_BITS, SIMULATOR, TORQUE_STD, leg_joints, right_knee
 from wbfriction.walking import GaitOptions, walking_reference
+from wbfriction.workers import process_pool
 
 LEVELS: tuple[float | None, ...] = (None, 0.0, 1e-5, 1e-4, 1e-3)
 """Position noise standard deviations [rad]; None: an exact log (no sensor model at all);
@@ -131,7 +130,7 @@ def _run_grid(tasks: list[_Task], workers: int, say: StageProgress) -> list[tupl
     """Every run of ``tasks`` in their order, on ``workers`` forked processes or (1) in this one."""
     results: list = [None] * len(tasks)
     if workers > 1:
-        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
+        with process_pool(workers, "fork") as pool:
             for k, res in enumerate(pool.map(_run, tasks)):
                 results[k] = res
                 say(f"{k + 1}/{len(tasks)} runs done")

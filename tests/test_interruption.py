@@ -1,0 +1,207 @@
+"""Interruptions (issue 21, class 3): a command ended by Ctrl-C exits 130, by SIGTERM 143, with one
+line on stderr, its output absent or the previous one kept, no traceback, even while it imports
+its libraries; a command killed by SIGKILL leaves no process behind, and the temporary file it
+left is removed by the next write into the folder.
+
+Mechanisms: :mod:`wbfriction.entry` (signals handled before anything is imported),
+:mod:`wbfriction.workers` (workers end with their parent), :func:`wbfriction.logs.tables.write_atomic`.
+Every run is a real ``python -m wbfriction`` process, signalled as a terminal or a supervisor would.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from helpers import run
+from wbfriction.logs.tables import write_json
+
+ESTIMATE = ("estimate", "--workers", "2", "--chunk-rows", "4000")
+"""A chunked estimate on two spawned workers (the simulated log has two chunks)."""
+
+
+@pytest.fixture(scope="module")
+def walk_log(tmp_path_factory) -> Path:
+    """A simulated walk of 7.8 s (7801 samples)."""
+    path = tmp_path_factory.mktemp("interruption") / "walk.parquet"
+    res = run("simulate", "-o", path, "--gait", "combined", "--steps", "2")
+    assert res.returncode == 0, res.stderr
+    return path
+
+
+# ------------------------------------------------------------------ processes, read from /proc
+def _stat(pid: int) -> tuple[str, int, str] | None:
+    """(state, parent id, start time) of a process, None if there is none."""
+    try:
+        text = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    fields = text.rsplit(")", 1)[1].split()
+    return fields[0], int(fields[1]), fields[19]
+
+
+def _children(pid: int) -> dict[int, str]:
+    """The processes whose parent is ``pid``, with their start times (a process id used again is
+    another process)."""
+    out = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit() and (s := _stat(int(entry.name))) is not None and s[1] == pid:
+            out[int(entry.name)] = s[2]
+    return out
+
+
+def _alive(processes: dict[int, str]) -> list[int]:
+    return [p for p, start in processes.items() if (s := _stat(p)) is not None and s[0] != "Z" and s[2] == start]
+
+
+def _wait_gone(processes: dict[int, str], limit: float) -> float:
+    """Seconds until none of ``processes`` is alive (at most ``limit``)."""
+    t0 = time.monotonic()
+    while _alive(processes) and time.monotonic() - t0 < limit:
+        time.sleep(0.01)
+    return time.monotonic() - t0
+
+
+def _caught(pid: int, signum: int) -> bool:
+    """Whether process ``pid`` has a handler for ``signum`` (SigCgt of /proc/PID/status)."""
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("SigCgt:"):
+            return bool(int(line.split()[1], 16) >> (signum - 1) & 1)
+    return False
+
+
+def _start(*args, cwd: Path) -> subprocess.Popen:
+    """``wbfriction ARGS`` in a process group of its own (as a shell starts a job)."""
+    return subprocess.Popen([sys.executable, "-m", "wbfriction", *map(str, args)], cwd=cwd, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+
+
+def _mid_run(proc: subprocess.Popen, folder: Path, output: str) -> dict[int, str]:
+    """Wait until the output is being written and both workers run; their ids (and the resource
+    tracker's)."""
+    deadline = time.monotonic() + 60
+    while proc.poll() is None and time.monotonic() < deadline:
+        if list(folder.glob(f".{output}.*.tmp*")) and len(kids := _children(proc.pid)) >= 3:
+            return kids
+        time.sleep(0.02)
+    pytest.fail(f"the run ended or stalled before it could be interrupted: {proc.poll()}")
+
+
+def _stderr_lines(text: str) -> list[str]:
+    return [line for line in text.splitlines() if line.strip()]
+
+
+# ------------------------------------------------------------------ tests
+@pytest.mark.parametrize(("signum", "group"), [(signal.SIGINT, True), (signal.SIGTERM, False)],
+                         ids=["ctrl-c to the job", "sigterm to the command"])
+def test_a_signal_mid_run_exits_128_plus_its_number_and_keeps_the_previous_output(walk_log, tmp_path, signum,
+                                                                                  group):
+    """Ctrl-C reaches every process of the job (the workers too), SIGTERM only the command: either
+    way status 128 + n, one line, the previous output byte for byte, no temporary file, no worker."""
+    out = tmp_path / "f.parquet"
+    out.write_bytes(b"previous result")
+    proc = _start(*ESTIMATE, walk_log, "-o", out, cwd=tmp_path)
+    kids = _mid_run(proc, tmp_path, out.name)
+    (os.killpg if group else os.kill)(proc.pid, signum)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 128 + signum, err
+    assert _stderr_lines(err) == [f"interrupted ({signal.Signals(signum).name})"], err
+    assert out.read_bytes() == b"previous result"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.parquet"]
+    assert _wait_gone(kids, 5.0) < 5.0, f"left alive: {_alive(kids)}"
+
+
+def test_ctrl_c_while_the_libraries_load_exits_130_without_a_traceback(tmp_path):
+    """The command handles the signals before it loads NumPy or Pinocchio (seconds): a Ctrl-C then
+    is one line and status 130."""
+    proc = _start(*ESTIMATE, tmp_path / "missing.parquet", "-o", tmp_path / "f.parquet", cwd=tmp_path)
+    deadline = time.monotonic() + 30
+    while not _caught(proc.pid, signal.SIGTERM) and time.monotonic() < deadline:
+        time.sleep(0.002)
+    maps = Path(f"/proc/{proc.pid}/maps").read_text()
+    assert "pinocchio" not in maps, "the signals were handled only after the heavy imports"
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130, err
+    assert _stderr_lines(err) == ["interrupted (SIGINT)"], err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_sigkill_leaves_no_process_and_the_next_write_removes_its_file(walk_log, tmp_path):
+    """SIGKILL of the command mid-run: its workers and multiprocessing's resource tracker are gone
+    within 5 s; its half-written temporary file is removed by the next write into the folder."""
+    out = tmp_path / "f.parquet"
+    proc = _start(*ESTIMATE, walk_log, "-o", out, cwd=tmp_path)
+    kids = _mid_run(proc, tmp_path, out.name)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.communicate(timeout=30)
+    waited = _wait_gone(kids, 5.0)
+    assert not _alive(kids), f"alive 5 s after SIGKILL: {_alive(kids)}"
+    print(f"{len(kids)} children gone {waited:.3f} s after SIGKILL")
+    left = [p.name for p in tmp_path.iterdir()]
+    assert len(left) == 1 and left[0].startswith(".f.parquet.") and f"-{proc.pid}-" in left[0], left
+    write_json(tmp_path / "next.json", {})
+    assert [p.name for p in tmp_path.iterdir()] == ["next.json"]
+
+
+# ------------------------------------------------------------------ the entry point alone, on a stand-in command line
+STAND_IN = """
+import os, signal, sys, time, types
+cli = types.ModuleType("wbfriction.cli")
+
+class Bomb:
+    def __del__(self):
+        os.kill(os.getpid(), signal.SIGINT)
+        len("a call: the handler runs here, inside __del__")
+
+def main():
+    case = sys.argv[1]
+    if case == "swallowed":
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(5)
+        except BaseException:
+            pass
+    elif case == "in __del__":
+        Bomb()
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 5:
+            pass
+    elif case == "status":
+        sys.exit(3)
+    elif case == "error":
+        raise ValueError("a bug")
+    print("finished")
+
+cli.main = main
+sys.modules["wbfriction.cli"] = cli
+from wbfriction.entry import main
+main()
+"""
+
+
+@pytest.mark.parametrize(("case", "status", "stderr"), [
+    ("swallowed", 143, ["interrupted (SIGTERM)"]),
+    ("in __del__", 130, ["interrupted (SIGINT)"]),
+    ("status", 3, []),
+    ("error", 1, None),
+])
+def test_the_entry_point_reports_every_signal_and_nothing_else(case, status, stderr):
+    """A signal whose exception some code swallowed still ends in 128 + n; one raised inside an
+    object's ``__del__`` (where Python can only print it) stops the command all the same, without
+    a traceback; a command's own status and its errors pass through unchanged."""
+    res = subprocess.run([sys.executable, "-c", textwrap.dedent(STAND_IN), case], capture_output=True, text=True,
+                         timeout=60)
+    assert res.returncode == status, res.stderr
+    if stderr is None:
+        assert "Traceback" in res.stderr and "ValueError: a bug" in res.stderr
+    else:
+        assert _stderr_lines(res.stderr) == stderr
+    assert ("finished" in res.stdout) == (case == "swallowed")
