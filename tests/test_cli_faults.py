@@ -303,4 +303,8 @@ def test_one_fault_anywhere_ends_in_one_line(walk, tmp_path_factory, capsys, fau
     pq.write_table(pa.table(cols).replace_schema_metadata(table.schema.metadata), log)
     if fault == "output is input":
         out = log
+    import time
+
+    start_time = time.perf_counter()
     _refused(capsys, tmp, [log], ("estimate", log, "-o", out, "--diff", "central", *extra), "")
+    assert time.perf_counter() - start_time < 30.0  # refused before any long work: never a hang

@@ -669,6 +669,7 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
     out = []
     for i, (joint, res) in enumerate(zip(joints, fitted)):
         m = valid[:, i] & np.isfinite(tau_f[:, i]) & np.isfinite(qd[:, i])
+        m &= ~gross_outliers(-tau_f[:, i], m)  # the samples the fit used
         if tau_f_true is not None and np.isfinite(tau_f_true[m, i]).all() and m.any():
             res.rms_error_vs_true = float(np.sqrt(np.mean((tau_f[m, i] - tau_f_true[m, i]) ** 2)))
             if res.params is not None:
