@@ -322,17 +322,17 @@ def read_params(path: str | Path) -> dict[str, FitResult]:
 
 
 def check_params_source(params: str | Path, est: FrictionEstimate, table: str | Path | None = None) -> None:
-    """Refuse a parameters file that does not belong with a friction table: fitted for another
-    robot (the robots both record, :func:`~wbfriction.pipeline.provenance.log_provenance`), sharing
-    none of its joints, or, with ``table`` (the file ``est`` was read from: a report of the table
-    the parameters were fitted on), fitted on another table (its recorded SHA-256 differs).
+    """Refuse a parameters file (one :func:`read_params` has read) that does not belong with a
+    friction table: fitted for another robot (the robots both record,
+    :func:`~wbfriction.pipeline.provenance.log_provenance`), sharing none of its joints, or, with
+    ``table`` (the file ``est`` was read from: a report of the table the parameters were fitted
+    on), fitted on another table (its recorded SHA-256 differs).
 
     Raises:
         InputError: naming the parameters file and what does not match.
     """
     path = Path(params)
-    read_params(path)  # a file that is not a parameters file is refused as such
-    doc = json.loads(path.read_text())
+    doc = json.loads(path.read_text())  # read by read_params first: a parameters file
     prov = doc.get("provenance", {}) if isinstance(doc, dict) else {}
     prov = prov if isinstance(prov, dict) else {}
     robot, table_robot = prov.get("robot"), est.metadata.get("provenance", {}).get("robot")

@@ -88,8 +88,8 @@ def make_report(friction: str | Path, params: str | Path | None = None,
     ident = None if identification is None else read_identification(identification)
     est = read_friction_file(friction)
     if params is not None:
-        check_params_source(params, est, friction)
         fits = read_params(params)
+        check_params_source(params, est, friction)
     else:
         fits = {f.joint: f for f in fit_estimate(est)}
     energy = {e.joint: e for e in energy_consistency(est, fitted_offsets(fits.values()), threshold, tolerance)}
