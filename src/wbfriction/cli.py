@@ -27,6 +27,7 @@ from wbfriction.exceptions import InputError, WbfrictionError
 from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
 from wbfriction.friction.estimate import EstimateOptions, Method, resolve_differentiation
 from wbfriction.friction.fit import FitResult, ModelChoice
+from wbfriction.friction.measured import BaseMotion
 from wbfriction.friction.models import ALL_PARAM_NAMES, PARAM_NAMES
 from wbfriction.friction.targets import load_friction_toml
 from wbfriction.inertia.identification import ArmatureMode, InertialOptions
@@ -232,6 +233,10 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     if opts.velocity == "logged":
         velocity = result.metadata.get("velocity", {})  # measured on the first chunk
         console.print(f"velocity: {escape(velocity.get('reason', 'logged'))} (not compensated)", highlight=False)
+    routes = result.metadata.get("base_motion")
+    if routes:  # decided on the first chunk
+        console.print(f"base motion: {routes['base']}" + ("; wrenches: every joint in every phase"
+                                                          if routes["wrenches"] else ""), highlight=False)
     console.print(f"wrote {output}: {result.rows} samples")
 
 
@@ -277,6 +282,8 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              delay: Optional[float] = typer.Option(None, help="mujoco: measurement-to-command delay [ms], whole "
                                                               "control periods."),
              log_base: bool = typer.Option(_I.log_base, help="Write the base pose to the log."),
+             force_torque: bool = typer.Option(_I.force_torque, help="ideal: write what the robot's force-torque "
+                                                                     "sensors measure (wrench.<sensor>.* columns)."),
              duration: float = typer.Option(10.0, help="Fixed-base robot (an arm): seconds of excitation "
                                                        "trajectory.")) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
@@ -294,7 +301,7 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
     options: IdealOptions | MujocoOptions
     if simulator == "ideal":
         options = IdealOptions(substeps=substeps or _I.substeps, integrator=cast(Integrator, integrator),
-                               log_base=log_base)
+                               log_base=log_base, force_torque=force_torque)
     else:
         table = load_sensors_toml(sensors) if sensors is not None else {}
         given = {"position_std": position_noise, "encoder_bits": encoder_bits, "torque_std": torque_noise,
@@ -346,14 +353,22 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
              companion: bool = typer.Option(False, "--companion",
                                             help="Also write delta_qdd_companion.<joint>: the acceleration "
                                                  "difference through the other kind of scheme, for the report's "
-                                                 "Fig. 7.4 (one more pass).")) -> None:
+                                                 "Fig. 7.4 (one more pass)."),
+             base_motion: str = typer.Option(_E.base_motion, help="Base motion: contact (rigid stance foot, "
+                                                                  "thesis 5.4), logged (the base.* pose "
+                                                                  "differentiated like the joints) or auto "
+                                                                  "(logged with wrenches, else contact; printed)."),
+             wrenches: bool = typer.Option(_E.wrenches, help="Use the force-torque sensors' wrench.<sensor>.* "
+                                                             "columns where logged: every joint's friction in "
+                                                             "every phase.")) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
     check_paths({"LOG": log, "--map": bag_map, "--urdf": urdf, "--config": config}, {"-o": output})
     opts = EstimateOptions(diff=cast(Diff | Literal["auto"], diff), compensate_delay=delay_compensation,
                            torque_alignment=cast(TorqueAlignment, torque_alignment), mask=cast(Mask, mask),
                            lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
                            ds_regularization=ds_regularization, condition_number=cond, method=cast(Method, method),
-                           velocity=cast(Velocity, velocity),
+                           velocity=cast(Velocity, velocity), base_motion=cast(BaseMotion, base_motion),
+                           wrenches=wrenches,
                            filtering=FilterOptions(window=window, poly_order=poly_order,
                                                    weights=cast(SavgolWeights, weights),
                                                    cutoff=cutoff, butter_order=butter_order))

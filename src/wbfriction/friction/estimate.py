@@ -26,6 +26,7 @@ from typing import Any, Literal, cast, get_args
 import numpy as np
 
 from wbfriction.exceptions import InputError
+from wbfriction.friction.measured import BASE_MOTIONS, BaseMotion, base_route, resolve_base_motion, wrench_route
 from wbfriction.logs.log import Log
 from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
@@ -80,6 +81,11 @@ class EstimateOptions:
         acceleration_difference: also give ``Delta qdd`` (5.12) in single support
             (``M_mod^{-1} tau_f``, one ``crba`` per sample on the stance-rooted tree and a
             batched solve); the KKT route always has it.
+        base_motion: where the base's motion comes from (:data:`~wbfriction.friction.measured.BaseMotion`):
+            ``contact`` (rigid contacts), ``logged`` (the base pose differentiated like the joints),
+            ``auto`` (:func:`~wbfriction.friction.measured.resolve_base_motion`).
+        wrenches: use the force-torque sensors' wrenches where the log has them: every joint's
+            friction in every phase (:func:`~wbfriction.friction.measured.wrench_route`).
     """
 
     diff: Diff | Literal["auto"] = "central"
@@ -95,6 +101,12 @@ class EstimateOptions:
     filtering: FilterOptions = FilterOptions()
     acceleration_difference: bool = True
     velocity: Velocity = "differentiated"
+    base_motion: BaseMotion = "auto"
+    wrenches: bool = True
+
+    def __post_init__(self) -> None:
+        if self.base_motion not in BASE_MOTIONS:
+            raise InputError(f"unknown base motion '{self.base_motion}': choose one of {', '.join(BASE_MOTIONS)}")
 
 
 @dataclass
@@ -126,6 +138,9 @@ class FrictionEstimate:
             or None; the fit passes the model through it too
             (:func:`~wbfriction.friction.fit.fit_friction`). A table records it as the
             ``estimate_options`` of its metadata.
+        route: (N,) how each sample was estimated (:data:`~wbfriction.friction.measured.Route`):
+            ``contact`` (rigid contacts), ``base`` (measured base motion), ``wrench`` (measured
+            wrenches), ``none``; or None (a table that does not say: rigid contacts).
     """
 
     joints: tuple[str, ...]
@@ -145,6 +160,7 @@ class FrictionEstimate:
     smoother: Smoother | None = None
     companion_delta_qdd: np.ndarray | None = None
     companion_diff: str | None = None
+    route: np.ndarray | None = None
 
 
 def single_support_friction_rnea(robot: Robot, contact_index: int, angles: np.ndarray, qd: np.ndarray,
@@ -259,7 +275,8 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     phases: Phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip, gaps)
     assert kin.valid is not None  # set by MeasuredKinematics.__post_init__
     usable = kin.valid & (phases.n_contacts > 0)
-    if require_single_support and not np.any(usable & phases.single):
+    with_wrenches = options.wrenches and kin.wrench is not None
+    if require_single_support and not with_wrenches and not np.any(usable & phases.single):
         raise no_single_support(robot, kin.metadata.get('source', 'the log'))
     cond = np.full(n, np.nan) if options.condition_number else None
     tc = robot.tc_index
@@ -291,13 +308,30 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
         if cond is not None:
             cond[r] = np.linalg.cond(dyn.Mmod_inv)
     valid = joint_mask(phases, robot.limb_mask, options.mask) & usable[:, None] & np.isfinite(tau_f)
+    unique = ss.copy()
+    route = np.where(np.any(np.isfinite(tau_f), axis=1), "contact", "none").astype("<U7")
+    if with_wrenches:  # every joint, every phase
+        tau_m, done = wrench_route(robot, kin, kin.valid, kin.base_qd is not None)
+        valid[done] = np.isfinite(tau_m[done])
+        _measured(tau_f, delta, unique, route, tau_m, done, "wrench")
+    elif kin.base_qdd is not None:  # every joint in single support; the mask stays
+        tau_m, done = base_route(robot, kin, usable & phases.single)
+        valid[done] = (joint_mask(phases, robot.limb_mask, options.mask) & np.isfinite(tau_m))[done]
+        _measured(tau_f, delta, unique, route, tau_m, done, "base")
     metadata = dict(kin.metadata)
     metadata["estimate_options"] = asdict(options)
     return FrictionEstimate(
         joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
-        phase=phases.labels(), unique=ss.copy(), contact=kin.contact, contact_frames=robot.contact_frames,
+        phase=phases.labels(), unique=unique, contact=kin.contact, contact_frames=robot.contact_frames,
         qdd=kin.qdd[:, tc], delta_qdd=delta, cond=cond, tau_f_true=kin.tau_f_true, metadata=metadata,
-        smoother=kin.smoother)
+        smoother=kin.smoother, route=route)
+
+
+def _measured(tau_f: np.ndarray, delta: np.ndarray, unique: np.ndarray, route: np.ndarray, tau_m: np.ndarray,
+              done: np.ndarray, name: str) -> None:
+    """Put a measured route's friction ``tau_m`` in place of the rigid-contact route's on the rows ``done``
+    (its acceleration difference is not computed: NaN)."""
+    tau_f[done], delta[done], unique[done], route[done] = tau_m[done], np.nan, True, name
 
 
 def companion_scheme(diff: Diff) -> Scheme:
@@ -381,9 +415,13 @@ def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress
                       require_single_support: bool, gaps: tuple[bool, bool] = (False, False)) -> FrictionEstimate:
     if options.diff == "auto":
         raise InputError("diff 'auto' is resolved once per log (resolve_differentiation), not per segment")
+    has_wrench = options.wrenches and log.wrench is not None
+    base_motion = resolve_base_motion(options.base_motion, log.base is not None, has_wrench)
     kin = measure(log, options.diff, compensate_delay=options.compensate_delay,
-                  torque_alignment=options.torque_alignment, filtering=options.filtering, velocity=options.velocity)
+                  torque_alignment=options.torque_alignment, filtering=options.filtering, velocity=options.velocity,
+                  base_motion=base_motion == "logged")
     kin.metadata.update(robot=robot.name, source=log.source)
+    kin.metadata["base_motion"] = {"base": base_motion, "wrenches": has_wrench}
     est = estimate_friction(robot, kin, options, progress, require_single_support, gaps)
     if companion:
         other = companion_scheme(options.diff)
@@ -406,7 +444,8 @@ def _blank(template: FrictionEstimate, log: Log) -> FrictionEstimate:
         unique=np.zeros(n, dtype=bool), contact=log.contact, contact_frames=template.contact_frames,
         qdd=nan(template.qdd), delta_qdd=nan(template.delta_qdd), cond=nan(template.cond),
         tau_f_true=log.tau_f_true, metadata=template.metadata, smoother=template.smoother,
-        companion_delta_qdd=nan(template.companion_delta_qdd), companion_diff=template.companion_diff)
+        companion_delta_qdd=nan(template.companion_delta_qdd), companion_diff=template.companion_diff,
+        route=None if template.route is None else np.full(n, "none", dtype=template.route.dtype))
 
 
 def concat_estimates(parts: list[FrictionEstimate]) -> FrictionEstimate:

@@ -39,12 +39,14 @@ SIGN_CONVENTION = "tau_f = -f(qd); fit of f (the joint's model, eqs. 3.1-3.5) to
 
 # ------------------------------------------------------------------ friction table
 def friction_table(est: FrictionEstimate) -> pa.Table:
-    """The estimate as an Arrow table: ``time``, ``phase``, ``unique``, [``cond``],
+    """The estimate as an Arrow table: ``time``, ``phase``, ``unique``, [``route``], [``cond``],
     ``contact.<frame>``, and per joint ``qd.<j>``, ``tau_f.<j>``, ``valid.<j>``,
     ``qdd.<j>``, ``delta_qdd.<j>``, [``delta_qdd_companion.<j>``], [``tau_f_true.<j>``];
     the companion's scheme is the metadata key ``companion_diff``."""
     cols: dict[str, object] = {"time": est.time, "phase": pa.array(est.phase.astype(str)),
                                "unique": est.unique}
+    if est.route is not None:
+        cols["route"] = pa.array(est.route.astype(str))
     if est.cond is not None:
         cols["cond"] = est.cond
     for i, f in enumerate(est.contact_frames):
@@ -158,6 +160,10 @@ def read_friction_table(table: pa.Table, source: str = "<table>") -> FrictionEst
     except (pa.ArrowException, ValueError):  # text is decoded lazily: damaged UTF-8 fails here
         raise ColumnError(source, "phase", None, "column 'phase' is not text") from None
     unique = (numeric_column(table, "unique", source).astype(bool) if "unique" in names else phase == "single")
+    try:
+        route = np.asarray(table.column("route").to_pylist(), dtype=str) if "route" in names else None
+    except (pa.ArrowException, ValueError):
+        raise ColumnError(source, "route", None, "column 'route' is not text") from None
     meta = read_metadata(table, source)
     smoother = _table_smoother(meta, time, source)
     _check_targets(meta, source)
@@ -172,7 +178,7 @@ def read_friction_table(table: pa.Table, source: str = "<table>") -> FrictionEst
         cond=_float_column(table, "cond", source) if "cond" in names else None,
         tau_f_true=_optional_columns(table, "tau_f_true", joints, source), metadata=meta, smoother=smoother,
         companion_delta_qdd=_optional_columns(table, "delta_qdd_companion", joints, source),
-        companion_diff=companion_diff)
+        companion_diff=companion_diff, route=route)
 
 
 def read_friction_file(path: str | Path) -> FrictionEstimate:

@@ -58,6 +58,10 @@ TorqueSource = Literal["sensor", "current"]
 """Where a log's torques were measured (:attr:`Log.torque_source`)."""
 
 BASE_COLUMNS = ("base.x", "base.y", "base.z", "base.qx", "base.qy", "base.qz", "base.qw")
+BASE_TWIST_AXES = ("vx", "vy", "vz", "wx", "wy", "wz")
+"""Components of a base twist (Pinocchio's free-flyer ``v[:6]``): linear [m/s], then angular [rad/s], base frame."""
+BASE_QD_TRUE_COLUMNS = tuple(f"base_qd_true.{a}" for a in BASE_TWIST_AXES)
+BASE_QDD_TRUE_COLUMNS = tuple(f"base_qdd_true.{a}" for a in BASE_TWIST_AXES)
 
 
 @dataclass
@@ -87,6 +91,12 @@ class Log:
             sensors: only the friction after the sensor is in it) or ``"current"`` (motor
             current x torque constant: the whole drive's friction and the rotor inertia are
             in it).
+        wrench: measured wrenches of the robot's force-torque sensors (N, n_sensors, 6) in
+            :attr:`Robot.ft_sensors <wbfriction.model.robot.Robot.ft_sensors>` order, each in its
+            sensor frame [N, N·m] (columns ``wrench.<sensor>.fx`` ... ``.tz``,
+            :mod:`wbfriction.model.force_torque`), or None if not logged.
+        base_qd_true, base_qdd_true: the base's true twist and its derivative (N, 6) in the base
+            frame (Pinocchio's free-flyer ``v[:6]`` and ``a[:6]``, simulations only), or None.
         clock: what wrote the stamps and the time base derivatives are taken on
             (:class:`~wbfriction.logs.clock.Clock`: uniform, skipping samples, or receive-time
             jitter regularised), or None: uniform (a log built in memory).
@@ -110,6 +120,9 @@ class Log:
     torque_source: TorqueSource = "sensor"
     clock: Clock | None = None
     warnings: tuple[str, ...] = ()
+    wrench: np.ndarray | None = None
+    base_qd_true: np.ndarray | None = None
+    base_qdd_true: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.segments is None and self.clock is not None and len(self.clock.segments) > 1:
@@ -136,7 +149,9 @@ class Log:
         return Log(self.time[start:stop], self.q[start:stop], self.tau[start:stop], self.contact[start:stop],
                    cut(self.base), cut(self.tau_f_true), self.metadata, self.source, cut(self.qd_true),
                    cut(self.qdd_true), None, self.dt, cut(self.qd_logged), self.torque_source,
-                   clock=None if self.clock is None else self.clock.rows(start, stop), warnings=self.warnings)
+                   clock=None if self.clock is None else self.clock.rows(start, stop), warnings=self.warnings,
+                   wrench=cut(self.wrench), base_qd_true=cut(self.base_qd_true),
+                   base_qdd_true=cut(self.base_qdd_true))
 
     def __len__(self) -> int:
         return len(self.time)
@@ -153,8 +168,13 @@ class Log:
         if robot.floating_base:
             cols.update({f"contact.{n}": self.contact[:, i].astype(np.int8)
                          for i, n in enumerate(robot.contact_frames)})
-        if self.base is not None:
-            cols.update({c: self.base[:, i] for i, c in enumerate(BASE_COLUMNS)})
+        for names, x in ((BASE_COLUMNS, self.base), (BASE_QD_TRUE_COLUMNS, self.base_qd_true),
+                         (BASE_QDD_TRUE_COLUMNS, self.base_qdd_true)):
+            if x is not None:
+                cols.update({c: x[:, i] for i, c in enumerate(names)})
+        if self.wrench is not None:
+            cols.update({c: self.wrench[:, s, i] for s, sensor in enumerate(robot.ft_sensors)
+                         for i, c in enumerate(sensor.columns())})
         if self.tau_f_true is not None:
             cols.update({f"tau_f_true.{n}": self.tau_f_true[:, i] for i, n in enumerate(robot.torque_controlled)
                          if not np.all(np.isnan(self.tau_f_true[:, i]))})
@@ -273,12 +293,17 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
     qd_true = _read_true_rates(table, "qd_true", robot, source, first_row)
     qdd_true = _read_true_rates(table, "qdd_true", robot, source, first_row)
     qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
+    wrench = _read_wrench(table, robot, source, first_row)
+    base_qd_true = _read_group(table, BASE_QD_TRUE_COLUMNS, source, first_row, "true base twist")
+    base_qdd_true = _read_group(table, BASE_QDD_TRUE_COLUMNS, source, first_row, "true base acceleration")
     return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
                qd_true=qd_true, qdd_true=qdd_true, segments=clock.segments, period=period, qd_logged=qd_logged,
-               torque_source=torque_source, clock=clock, warnings=warnings)
+               torque_source=torque_source, clock=clock, warnings=warnings, wrench=wrench,
+               base_qd_true=base_qd_true, base_qdd_true=base_qdd_true)
 
 
-NUMERIC_PREFIXES = ("q", "tau", "current", "qd", "qd_true", "qdd_true", "tau_f_true", "base")
+NUMERIC_PREFIXES = ("q", "tau", "current", "qd", "qd_true", "qdd_true", "tau_f_true", "base", "wrench",
+                    "base_qd_true", "base_qdd_true")
 """Column prefixes whose values must be numbers."""
 
 
@@ -305,12 +330,13 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
         raise ColumnError(source, "time", None, "missing column 'time'")
     act, tc = set(robot.actuated), set(robot.torque_controlled)
     frames = set(robot.contact_frames)
+    wrenches = {c.partition(".")[2] for s in robot.ft_sensors for c in s.columns()}
     for col in names:
         prefix, _, item = col.partition(".")
         known = {"q": act, "tau": act, "tau_f_true": tc, "contact": frames, "qd_true": act,
-                 "qdd_true": act, "qd": act, "current": act}.get(prefix)
+                 "qdd_true": act, "qd": act, "current": act, "wrench": wrenches}.get(prefix)
         if known is not None and item not in known:
-            what = "contact frame" if prefix == "contact" else "joint"
+            what = {"contact": "contact frame", "wrench": "force-torque sensor (or axis)"}.get(prefix, "joint")
             raise ColumnError(source, col, None,
                               f"column '{col}' names an unknown {what} '{item}' of robot '{robot.name}'")
     contact = [f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else []
@@ -406,16 +432,38 @@ def _read_contact(table: pa.Table, robot: Robot, source: str, first_row: int) ->
     return np.column_stack(contact_cols)
 
 
+def _read_group(table: pa.Table, columns: tuple[str, ...] | list[str], source: str, first_row: int,
+                what: str) -> np.ndarray | None:
+    """The ``columns`` side by side (N, len(columns)), or None if none of them is logged; refuses a part."""
+    names = set(table.column_names)
+    if not any(c in names for c in columns):
+        return None
+    missing = [c for c in columns if c not in names]
+    if missing:
+        raise ColumnError(source, missing[0], None, f"{what} is partial: missing column '{missing[0]}'")
+    return _stack(table, list(columns), source, first_row)
+
+
+def _read_wrench(table: pa.Table, robot: Robot, source: str, first_row: int) -> np.ndarray | None:
+    """The force-torque sensors' wrenches (N, n_sensors, 6), or None if no sensor is logged; refuses a
+    partial wrench and a log with some sensors but not all, naming the first column missing."""
+    per_sensor = [_read_group(table, s.columns(), source, first_row, f"wrench of sensor '{s.name}'")
+                  for s in robot.ft_sensors]
+    if all(w is None for w in per_sensor):
+        return None
+    absent = next((s for s, w in zip(robot.ft_sensors, per_sensor) if w is None), None)
+    if absent is not None:
+        raise ColumnError(source, absent.columns()[0], None,
+                          f"missing column '{absent.columns()[0]}': the log has other sensors' wrenches but not "
+                          f"that of sensor '{absent.name}'")
+    return np.stack([w for w in per_sensor if w is not None], axis=1)
+
+
 def _read_base(table: pa.Table, source: str, first_row: int) -> np.ndarray | None:
     """The base poses (N, 7) with unit quaternions, or None if not logged; refuses a partial or non-unit pose."""
-    names = set(table.column_names)
-    present = [c for c in BASE_COLUMNS if c in names]
-    if not present:
+    base = _read_group(table, BASE_COLUMNS, source, first_row, "base pose")
+    if base is None:
         return None
-    missing = [c for c in BASE_COLUMNS if c not in names]
-    if missing:
-        raise ColumnError(source, missing[0], None, f"base pose is partial: missing column '{missing[0]}'")
-    base = _stack(table, list(BASE_COLUMNS), source, first_row)
     norm = np.linalg.norm(base[:, 3:], axis=1)
     bad = np.flatnonzero(np.abs(norm - 1.0) > 1e-3)
     if bad.size:

@@ -21,6 +21,7 @@ import pinocchio as pin
 
 from wbfriction.config import read_toml
 from wbfriction.exceptions import InputError
+from wbfriction.model.force_torque import parse_sensors
 from wbfriction.model.robot import Robot
 
 BUILTIN_ROBOTS = ("talos", "toro", "panda")
@@ -97,7 +98,8 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
             fingers, joints a log does not have), ``torque_constants`` (joint name -> N·m/A at
             the joint, gear ratio included: ``current.<joint>`` columns give ``tau``),
             ``armature`` (joint name -> reflected rotor inertia [kg·m^2], in the dynamics
-            through ``model.armature``), ``balance_gains`` (:attr:`Robot.balance_gains`).
+            through ``model.armature``), ``force_torque`` (six-axis sensors above the contacts:
+            :func:`~wbfriction.model.force_torque.parse_sensors`), ``balance_gains`` (:attr:`Robot.balance_gains`).
         source: file name used in error messages.
 
     Raises:
@@ -131,6 +133,7 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
         floating_base=floating,
         locked_joints=locked,
         torque_constants=_joint_values(config, "torque_constants", actuated, source, positive=True),
+        ft_sensors=parse_sensors(model, config.get("force_torque"), frames, source),
     )
 
 

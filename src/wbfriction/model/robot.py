@@ -30,6 +30,7 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import ModelError
+from wbfriction.model.force_torque import ForceTorqueSensor
 from wbfriction.model.layout import JointLayout, joint_layout
 
 
@@ -60,6 +61,8 @@ class Robot:
             (Pinocchio's reduced model): not in :attr:`actuated`, not needed in a log.
         torque_constants: joint -> torque constant [N·m/A] at the joint (gear ratio
             included), for logs that record motor currents ``current.<joint>`` [A].
+        ft_sensors: six-axis force-torque sensors, one per contact at most
+            (:mod:`wbfriction.model.force_torque`; ``[force_torque.<name>]`` in the TOML).
     """
 
     name: str
@@ -75,6 +78,7 @@ class Robot:
     floating_base: bool = True
     locked_joints: dict[str, float] = field(default_factory=dict)
     torque_constants: dict[str, float] = field(default_factory=dict)
+    ft_sensors: tuple[ForceTorqueSensor, ...] = ()
     cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
     """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.stance`)."""
 

@@ -39,7 +39,7 @@ two held torques by how long each was held.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal, get_args
 
 import numpy as np
@@ -47,6 +47,7 @@ import numpy as np
 from wbfriction.exceptions import InputError
 from wbfriction.logs.log import Log
 from wbfriction.signals import nonuniform
+from wbfriction.signals.base_motion import base_twist_and_acceleration, continuous_quaternions
 from wbfriction.signals.filters import SavgolSmoother, SavgolWeights, ZeroPhaseLowpass, savgol_differentiate
 from wbfriction.signals.nonuniform import NonUniformSavgol, ResampledLowpass
 from wbfriction.signals.velocity import velocity_lag
@@ -242,6 +243,11 @@ class MeasuredKinematics:
         metadata: carried from the log.
         smoother: the filtering scheme's zero-phase smoother, which every signal went
             through, or None (the identification filters the model with it).
+        base_qd, base_qdd: the base's twist and acceleration (N, 6) in the base frame, from its
+            logged pose differentiated like the joints (:mod:`~wbfriction.signals.base_motion`;
+            ``measure(..., base_motion=True)``), or None.
+        wrench: the force-torque sensors' wrenches (N, n_sensors, 6) [N, N·m], aligned and
+            filtered as the torques, or None.
     """
 
     time: np.ndarray
@@ -255,6 +261,9 @@ class MeasuredKinematics:
     tau_f_true: np.ndarray | None = None
     metadata: dict = field(default_factory=dict)
     smoother: Smoother | None = None
+    base_qd: np.ndarray | None = None
+    base_qdd: np.ndarray | None = None
+    wrench: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.valid is None:
@@ -294,7 +303,8 @@ VELOCITIES: tuple[Velocity, ...] = get_args(Velocity)
 
 def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
             torque_alignment: TorqueAlignment | Literal["auto"] = "auto",
-            filtering: FilterOptions = FilterOptions(), velocity: Velocity = "differentiated") -> MeasuredKinematics:
+            filtering: FilterOptions = FilterOptions(), velocity: Velocity = "differentiated",
+            base_motion: bool = False) -> MeasuredKinematics:
     """Differentiate a log's joint positions and align the other signals (6.1.2, 7.1).
 
     Args:
@@ -313,39 +323,50 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
             columns as they are (the accelerations stay the scheme's); how late they are
             against the differentiated ones (:func:`~wbfriction.signals.velocity.velocity_lag`)
             is measured and stated in the metadata (``velocity``), not compensated.
+        base_motion: also differentiate the logged base pose with the joints' scheme and filter
+            (:mod:`~wbfriction.signals.base_motion`; ``"true"``: the log's ``base_qd_true`` and
+            ``base_qdd_true``). The force-torque sensors' wrenches, when logged, are always
+            aligned and filtered as the torques are.
 
     Raises:
         InputError: unknown scheme, alignment or velocity source, filter parameters that make
             no filter, a log too short for the filter; ``"true"`` on a log without
-            ``qd_true``/``qdd_true`` columns; ``logged`` on a log without ``qd.<joint>`` columns.
+            ``qd_true``/``qdd_true`` columns; ``logged`` on a log without ``qd.<joint>`` columns;
+            ``base_motion`` on a log without a base pose (with ``"true"``: without its true rates).
     """
     if velocity not in VELOCITIES:
         raise InputError(f"unknown velocity source '{velocity}': choose one of {', '.join(VELOCITIES)}")
     if velocity == "logged" and log.qd_logged is None:
         raise InputError(f"{log.source}: --velocity logged needs the columns qd.<joint> of every actuated joint")
-    q, smoother, metadata = log.q, None, dict(log.metadata)
+    if base_motion and log.base is None:
+        raise InputError(f"{log.source}: a measured base motion needs the base pose columns base.x ... base.qw")
     if diff == "true":
         if log.qd_true is None or log.qdd_true is None:
             raise InputError(f"{log.source}: diff 'true' needs the columns qd_true.* and qdd_true.* "
                              "(written by the simulators)")
-        qd, qdd, tau = log.qd_true, log.qdd_true, log.tau
-    else:
-        if diff not in SCHEMES:
-            raise InputError(f"unknown differentiation scheme '{diff}': choose one of {', '.join(SCHEMES)}, true")
-        if torque_alignment == "auto":
-            torque_alignment = log.metadata.get("torque_alignment", "zoh")
-        t = time_base(log)
-        if t is not None and log.clock is not None:
-            metadata["clock"] = {"kind": log.clock.kind, "reason": log.clock.reason}
-        smoother = make_smoother(diff, filtering, log.dt, t)
-        tau = align_torque(log.tau, torque_alignment, t)
-        if smoother is None:
-            qd, qdd, delay = (DIFFERENTIATORS[diff](log.q, log.dt) if t is None
-                              else NONUNIFORM_DIFFERENTIATORS[diff](log.q, t))
-            if compensate_delay:
-                qd, qdd = _shift_back(qd, delay), _shift_back(qdd, delay)
-        else:
-            q, qd, qdd, tau = _filtered(log, tau, smoother, filtering)
+        if base_motion and (log.base_qd_true is None or log.base_qdd_true is None):
+            raise InputError(f"{log.source}: diff 'true' with a measured base motion needs the columns "
+                             "base_qd_true.* and base_qdd_true.* (written by the simulators)")
+        return MeasuredKinematics(
+            time=log.time, q=log.q, qd=log.qd_true, qdd=log.qdd_true, tau=log.tau, contact=log.contact,
+            base=log.base, tau_f_true=log.tau_f_true, metadata=dict(log.metadata), wrench=log.wrench,
+            base_qd=log.base_qd_true if base_motion else None, base_qdd=log.base_qdd_true if base_motion else None)
+    if diff not in SCHEMES:
+        raise InputError(f"unknown differentiation scheme '{diff}': choose one of {', '.join(SCHEMES)}, true")
+    n, n_act, n_tc = len(log.time), log.q.shape[1], log.tau.shape[1]
+    # the base pose and the wrenches go through the joints' path, as more columns
+    extended = log
+    if base_motion:
+        assert log.base is not None  # checked above
+        extended = replace(extended, q=np.hstack([log.q, continuous_quaternions(log.base)]))
+    if log.wrench is not None:
+        extended = replace(extended, tau=np.hstack([log.tau, log.wrench.reshape(n, -1)]))
+    q, qd, qdd, tau, smoother, metadata = _derivatives(extended, diff, compensate_delay, torque_alignment, filtering)
+    base_qd = base_qdd = None
+    if base_motion:
+        base_qd, base_qdd = base_twist_and_acceleration(q[:, n_act:], qd[:, n_act:], qdd[:, n_act:])
+    wrench = None if log.wrench is None else tau[:, n_tc:].reshape(n, -1, 6)
+    q, qd, qdd, tau = q[:, :n_act], qd[:, :n_act], qdd[:, :n_act], tau[:, :n_tc]
     if velocity == "logged":
         assert log.qd_logged is not None  # checked above
         lag = velocity_lag(log.qd_logged, qd, log.dt)
@@ -354,7 +375,30 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
         qd = np.where(np.isfinite(qd), log.qd_logged, np.nan)
     return MeasuredKinematics(
         time=log.time, q=q, qd=qd, qdd=qdd, tau=tau, contact=log.contact, base=log.base,
-        tau_f_true=log.tau_f_true, metadata=metadata, smoother=smoother)
+        tau_f_true=log.tau_f_true, metadata=metadata, smoother=smoother, base_qd=base_qd, base_qdd=base_qdd,
+        wrench=wrench)
+
+
+def _derivatives(log: Log, diff: Diff, compensate_delay: bool, torque_alignment: TorqueAlignment | Literal["auto"],
+                 filtering: FilterOptions) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, Smoother | None,
+                                                    dict]:
+    """``q, qd, qdd, tau``, the smoother and the metadata of :func:`measure` for a scheme of :data:`SCHEMES`."""
+    q, smoother, metadata = log.q, None, dict(log.metadata)
+    if torque_alignment == "auto":
+        torque_alignment = log.metadata.get("torque_alignment", "zoh")
+    t = time_base(log)
+    if t is not None and log.clock is not None:
+        metadata["clock"] = {"kind": log.clock.kind, "reason": log.clock.reason}
+    smoother = make_smoother(diff, filtering, log.dt, t)
+    tau = align_torque(log.tau, torque_alignment, t)
+    if smoother is None:
+        qd, qdd, delay = (DIFFERENTIATORS[diff](log.q, log.dt) if t is None
+                          else NONUNIFORM_DIFFERENTIATORS[diff](log.q, t))
+        if compensate_delay:
+            qd, qdd = _shift_back(qd, delay), _shift_back(qdd, delay)
+    else:
+        q, qd, qdd, tau = _filtered(log, tau, smoother, filtering)
+    return q, qd, qdd, tau, smoother, metadata
 
 
 def time_base(log: Log) -> np.ndarray | None:

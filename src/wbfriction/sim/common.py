@@ -10,6 +10,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.friction.models import FrictionParams, coulomb_viscous_stribeck, stack_params
 from wbfriction.friction.targets import friction_by_group
 from wbfriction.logs.log import Log
+from wbfriction.model.force_torque import sensor_readings
 from wbfriction.model.robot import Robot
 from wbfriction.walking import WalkingReference
 
@@ -115,16 +116,19 @@ class SimulationResult:
 
 def simulated_log(robot: Robot, reference: WalkingReference, Q: np.ndarray, V: np.ndarray, A: np.ndarray,
                   tau: np.ndarray, tau_f: np.ndarray, contact: np.ndarray, friction: InjectedFriction,
-                  generator: str, options, log_base: bool, **metadata) -> Log:
+                  generator: str, options, log_base: bool, wrench: np.ndarray | None = None, **metadata) -> Log:
     """A simulated walk in the log format: joint angles and the true joint velocities and
     accelerations from the full states ``Q`` (N, nq), ``V``, ``A`` (N, nv), torques and
-    friction of the torque-controlled joints, contact flags, the base pose if ``log_base``;
+    friction of the torque-controlled joints, contact flags, the base pose and its true twist and
+    acceleration if ``log_base``, the force-torque sensors' ``wrench`` (N, n_sensors, 6) if given;
     metadata: the generator, its options, the gait, the true friction, and ``metadata``."""
     iq, iv = robot.act_q_index, robot.act_v_index
     meta = {"generator": generator, "options": asdict(options), "gait": asdict(reference.plan.options),
             "friction_true": {j: p.to_dict() for j, p in friction.params.items()}, **metadata}
-    return Log(reference.time.copy(), Q[:, iq], tau, contact, Q[:, :7].copy() if log_base else None, tau_f, meta,
-               source=generator.rsplit(".", 1)[-1], qd_true=V[:, iv], qdd_true=A[:, iv])
+    base = (Q[:, :7].copy(), V[:, :6].copy(), A[:, :6].copy()) if log_base else (None, None, None)
+    return Log(reference.time.copy(), Q[:, iq], tau, contact, base[0], tau_f, meta,
+               source=generator.rsplit(".", 1)[-1], qd_true=V[:, iv], qdd_true=A[:, iv], wrench=wrench,
+               base_qd_true=base[1], base_qdd_true=base[2])
 
 
 class Recording:
@@ -151,11 +155,18 @@ class Recording:
             self.tau_f[k, self.friction.joints] = tau_f
 
     def result(self, Q: np.ndarray, V: np.ndarray, A: np.ndarray, contact: np.ndarray, generator: str, options,
-               *, Q_log: np.ndarray | None = None, tau_noise: np.ndarray | None = None,
+               *, Q_log: np.ndarray | None = None, tau_noise: np.ndarray | None = None, log_sensors: bool = False,
                **metadata) -> SimulationResult:
         """The :func:`simulated_log` of the true states ``Q``, ``V``, ``A`` (its configurations ``Q_log`` if
-        given, its torques plus ``tau_noise`` if given) and the :class:`SimulationResult` around it."""
+        given, its torques plus ``tau_noise`` if given) and the :class:`SimulationResult` around it.
+        With ``log_sensors``, the log carries what the robot's force-torque sensors measure
+        (:func:`~wbfriction.model.force_torque.sensor_readings` of :attr:`wrench`, which must then be
+        the contact wrenches that go with ``A``)."""
         tau = self.tau if tau_noise is None else self.tau + tau_noise
+        wrench = None
+        if log_sensors and self.robot.ft_sensors:
+            wrench = sensor_readings(self.robot.model, self.robot.ft_sensors, self.robot.contact_frames, Q, V, A,
+                                     self.wrench)
         log = simulated_log(self.robot, self.reference, Q if Q_log is None else Q_log, V, A, tau, self.tau_f, contact,
-                            self.friction, generator, options, options.log_base, **metadata)
+                            self.friction, generator, options, options.log_base, wrench, **metadata)
         return SimulationResult(log, self.wrench, Q, V, self.reference, tuple(self.robot.contact_frames))

@@ -68,7 +68,11 @@ class IdealOptions:
             (a landing leg's small tracking error times the stance gains would
             otherwise pull the foot on the ground); falling gains apply at once.
         baumgarte: (Kp [1/s^2], Kd [1/s]) of the contact and position-control constraints.
-        log_base: write the base pose to the log.
+        log_base: write the base pose to the log (and its true twist and acceleration).
+        force_torque: write what the robot's force-torque sensors measure
+            (:attr:`~wbfriction.model.robot.Robot.ft_sensors`, columns ``wrench.<sensor>.*``: the
+            contact wrenches and the motion of the part below each sensor,
+            :func:`~wbfriction.model.force_torque.sensor_readings`).
         projection: ``"sample"``: project the velocity onto the constraints at every
             logged sample (the logged state satisfies ``J v = 0`` exactly: ground truth to
             1e-9 N·m); ``"touch-down"``: only at contact changes, Baumgarte correcting the
@@ -83,6 +87,7 @@ class IdealOptions:
     baumgarte: tuple[float, float] = (400.0, 40.0)
     log_base: bool = True
     projection: str = "sample"
+    force_torque: bool = False
 
     def __post_init__(self) -> None:
         if self.integrator not in INTEGRATORS:
@@ -265,7 +270,8 @@ class _IdealRun:
         """Log sample ``k``: the state, the true acceleration (without the Baumgarte term), torques, wrenches."""
         self.Q[k], self.V[k], self.A[k] = self.q, self.v, a + X[self.n_lam:, -1]
         self.recording.record_torques(k, tau_cmd, self.tau_f)
-        self.recording.wrench[k, self.active] = lam.reshape(-1, 6)
+        # the wrenches that go with that acceleration (the Baumgarte term taken off both)
+        self.recording.wrench[k, self.active] = (lam - X[:self.n_lam, -1]).reshape(-1, 6)
 
     def result(self) -> SimulationResult:
         """The log (planned contacts) and the result of the run."""
@@ -273,7 +279,8 @@ class _IdealRun:
         # acceleration tau[k] caused; otherwise the torque is held over several steps
         alignment = "sample" if self.semi_implicit and self.options.substeps == 1 else "zoh"
         return self.recording.result(self.Q, self.V, self.A, self.ref.contact.copy(),
-                                     "wbfriction.sim.ideal.simulate_ideal", self.options, torque_alignment=alignment)
+                                     "wbfriction.sim.ideal.simulate_ideal", self.options, torque_alignment=alignment,
+                                     log_sensors=self.options.force_torque)
 
 
 def simulate_ideal(robot: Robot, reference: WalkingReference,
