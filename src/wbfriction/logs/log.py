@@ -51,6 +51,7 @@ from wbfriction.logs.clock import (
     split_at_gaps,
     table_stamps,
 )
+from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, sensed_contacts
 from wbfriction.logs.tables import numeric_column, read_metadata, with_metadata, write_table
 from wbfriction.model.robot import Robot
 
@@ -287,13 +288,13 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
     time, clock, q = _read_motion(table, robot, source, max_gap, limit_margin, first_row, clock, time_base,
                                   time_unit)
     tau, torque_source = _read_torque(table, robot, source, first_row)
-    contact = _read_contact(table, robot, source, first_row)
+    wrench = _read_wrench(table, robot, source, first_row)
+    contact = _read_contact(table, robot, source, first_row, wrench)
     base = _read_base(table, source, first_row)
     tau_f_true = _read_tau_f_true(table, robot, len(time), source, first_row)
     qd_true = _read_true_rates(table, "qd_true", robot, source, first_row)
     qdd_true = _read_true_rates(table, "qdd_true", robot, source, first_row)
     qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
-    wrench = _read_wrench(table, robot, source, first_row)
     base_qd_true = _read_group(table, BASE_QD_TRUE_COLUMNS, source, first_row, "true base twist")
     base_qdd_true = _read_group(table, BASE_QDD_TRUE_COLUMNS, source, first_row, "true base acceleration")
     return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
@@ -340,6 +341,8 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
             raise ColumnError(source, col, None,
                               f"column '{col}' names an unknown {what} '{item}' of robot '{robot.name}'")
     contact = [f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else []
+    if contact and not any(c in seen for c in contact) and forces_give_contacts(robot, seen):
+        contact = []  # flags from the measured forces (wbfriction.logs.contacts)
     for col in [f"q.{n}" for n in robot.actuated] + contact:
         if col not in seen:
             raise ColumnError(source, col, None, f"missing column '{col}'")
@@ -416,11 +419,27 @@ def _read_torque(table: pa.Table, robot: Robot, source: str, first_row: int) -> 
     return current * k, "current"
 
 
-def _read_contact(table: pa.Table, robot: Robot, source: str, first_row: int) -> np.ndarray:
+def forces_give_contacts(robot: Robot, columns: set[str] | list[str]) -> bool:
+    """Whether a log with these columns and no ``contact.*`` column has its contact flags from the
+    measured forces: every contact frame is sensed and every sensor's columns are there."""
+    return sensed_contacts(robot) and all(c in columns for s in robot.ft_sensors for c in s.columns())
+
+
+def contact_flags_from_forces(robot: Robot, wrench: np.ndarray) -> np.ndarray:
+    """Contact flags (N, n_contacts) from the sensors' wrenches (N, n_sensors, 6): the soles' normal
+    forces through the robot's thresholds with hysteresis (:mod:`wbfriction.logs.contacts`)."""
+    on, off = default_thresholds(robot)
+    return hysteresis(normal_forces(robot, wrench), on, off)
+
+
+def _read_contact(table: pa.Table, robot: Robot, source: str, first_row: int,
+                  wrench: np.ndarray | None = None) -> np.ndarray:
     """The contact flags (N, n_contacts) as booleans, refusing values other than 0 and 1; on a fixed
-    base, the weld: always in contact."""
+    base, the weld: always in contact; without ``contact.*`` columns, from the measured forces."""
     if not robot.floating_base:
         return np.ones((table.num_rows, 1), dtype=bool)
+    if wrench is not None and not any(f"contact.{f}" in table.column_names for f in robot.contact_frames):
+        return contact_flags_from_forces(robot, wrench)
     contact_cols = []
     for f in robot.contact_frames:
         c = numeric_column(table, f"contact.{f}", source, first_row)

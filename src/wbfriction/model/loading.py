@@ -99,7 +99,9 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
             the joint, gear ratio included: ``current.<joint>`` columns give ``tau``),
             ``armature`` (joint name -> reflected rotor inertia [kg·m^2], in the dynamics
             through ``model.armature``), ``force_torque`` (six-axis sensors above the contacts:
-            :func:`~wbfriction.model.force_torque.parse_sensors`), ``balance_gains`` (:attr:`Robot.balance_gains`).
+            :func:`~wbfriction.model.force_torque.parse_sensors`), ``contact_force`` ([on, off] [N]:
+            contact flags from those sensors, :mod:`wbfriction.logs.contacts`), ``balance_gains``
+            (:attr:`Robot.balance_gains`).
         source: file name used in error messages.
 
     Raises:
@@ -134,7 +136,21 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
         locked_joints=locked,
         torque_constants=_joint_values(config, "torque_constants", actuated, source, positive=True),
         ft_sensors=parse_sensors(model, config.get("force_torque"), frames, source),
+        contact_force=_contact_force(config.get("contact_force"), source),
     )
+
+
+def _contact_force(value, source: str) -> tuple[float, float] | None:
+    """``contact_force = [on, off]`` [N], with ``on >= off >= 0``, or None."""
+    if value is None:
+        return None
+    try:
+        on, off = (float(x) for x in value)
+    except (TypeError, ValueError):
+        raise InputError(f"{source}: 'contact_force' must be two numbers [on, off] [N], got {value!r}") from None
+    if not (on >= off >= 0):
+        raise InputError(f"{source}: 'contact_force' [on, off] needs on >= off >= 0 [N], got {value!r}")
+    return on, off
 
 
 def _floating_base(config: dict, source: str) -> bool:

@@ -63,6 +63,9 @@ class Robot:
             included), for logs that record motor currents ``current.<joint>`` [A].
         ft_sensors: six-axis force-torque sensors, one per contact at most
             (:mod:`wbfriction.model.force_torque`; ``[force_torque.<name>]`` in the TOML).
+        contact_force: ``(on, off)`` [N]: the normal forces above which a sensed sole comes into
+            contact and below which it leaves it, for logs without ``contact.*`` columns
+            (:mod:`wbfriction.logs.contacts`); None: shares of the robot's weight.
     """
 
     name: str
@@ -79,6 +82,7 @@ class Robot:
     locked_joints: dict[str, float] = field(default_factory=dict)
     torque_constants: dict[str, float] = field(default_factory=dict)
     ft_sensors: tuple[ForceTorqueSensor, ...] = ()
+    contact_force: tuple[float, float] | None = None
     cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
     """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.stance`)."""
 

@@ -28,11 +28,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pyarrow as pa
 
 from wbfriction.exceptions import InputError
 from wbfriction.logs.clock import MAX_GAP, ROUGHNESS_ROWS, Clock, TimeBase, TimeUnit, read_clock, table_stamps
-from wbfriction.logs.log import check_schema
-from wbfriction.logs.tables import TableFile, numeric_column
+from wbfriction.logs.log import check_schema, contact_flags_from_forces
+from wbfriction.logs.tables import RowReader, TableFile, numeric_column
 from wbfriction.model.robot import Robot
 
 CONTEXT = 3
@@ -124,12 +125,27 @@ class ColumnPlan:
         clock: the whole log's clock (:func:`~wbfriction.logs.clock.read_clock`).
         first_positions: the positions of its first rows (:func:`first_positions`), or None.
         warnings: what its schema costs in accuracy (:func:`~wbfriction.logs.log.check_schema`).
+        contact_from_forces: the flags come from the measured forces, not from ``contact.*`` columns
+            (:mod:`wbfriction.logs.contacts`): the chunks are given them as columns
+            (:func:`with_contact_columns`), so that the hysteresis runs once, over the whole log.
     """
 
     contact: np.ndarray
     clock: Clock
     first_positions: np.ndarray | None
     warnings: tuple[str, ...] = ()
+    contact_from_forces: bool = False
+
+
+def chunk_rows(reader: RowReader, robot: Robot, plan: ColumnPlan, chunk: Chunk) -> pa.Table:
+    """The rows a chunk reads, with the whole log's contact flags as ``contact.<frame>`` columns when
+    they come from the measured forces (:attr:`ColumnPlan.contact_from_forces`)."""
+    table = reader.rows(chunk.read_start, chunk.read_stop)
+    if plan.contact_from_forces:
+        for i, f in enumerate(robot.contact_frames):
+            flags = plan.contact[chunk.read_start:chunk.read_stop, i].astype(np.int8)
+            table = table.append_column(f"contact.{f}", pa.array(flags))
+    return table
 
 
 def plan_columns(file: TableFile, robot: Robot, source: str, max_gap: float = MAX_GAP,
@@ -146,15 +162,24 @@ def plan_columns(file: TableFile, robot: Robot, source: str, max_gap: float = MA
             :func:`~wbfriction.logs.clock.read_clock` refuses (rows numbered from the file's
             first), contact flags that are not numbers.
     """
-    warnings = check_schema(file.schema(), robot, source)
-    columns = ["time"] + ([f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else [])
+    schema = file.schema()
+    warnings = check_schema(schema, robot, source)
+    from_forces = robot.floating_base and not any(f"contact.{f}" in schema.names for f in robot.contact_frames)
+    if from_forces:  # no contact column: the flags from the measured forces (check_schema made sure)
+        columns = ["time"] + [c for s in robot.ft_sensors for c in s.columns()]
+    else:
+        columns = ["time"] + ([f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else [])
     table = file.read(columns)
-    flags = (np.column_stack([numeric_column(table, c, source) for c in columns[1:]])
-             if robot.floating_base else np.ones((table.num_rows, 1)))  # a fixed base: always welded
+    if from_forces:
+        wrench = np.column_stack([numeric_column(table, c, source) for c in columns[1:]])
+        flags = contact_flags_from_forces(robot, wrench.reshape(len(wrench), -1, 6))
+    else:
+        flags = (np.column_stack([numeric_column(table, c, source) for c in columns[1:]])
+                 if robot.floating_base else np.ones((table.num_rows, 1)))  # a fixed base: always welded
     first = first_positions(file, robot)
     clock = read_clock(table_stamps(table, source, unit=time_unit), source, max_gap=max_gap, q=first,
                        time_base=time_base)
-    return ColumnPlan(flags != 0, clock, first, warnings)
+    return ColumnPlan(flags != 0, clock, first, warnings, from_forces)
 
 
 def first_positions(file: TableFile, robot: Robot) -> np.ndarray | None:

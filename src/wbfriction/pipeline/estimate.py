@@ -12,9 +12,10 @@ temporary Parquet log beside the output (:func:`table_log`).
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -27,10 +28,10 @@ from wbfriction.friction.io import friction_table
 from wbfriction.logs.clock import Clock, TimeBase, TimeUnit, longest_segment
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, log_from_table
 from wbfriction.logs.source import LogSource
-from wbfriction.logs.tables import RowReader, TableFile, read_metadata, scratch_folder, with_metadata, write_tables
+from wbfriction.logs.tables import TableFile, read_metadata, scratch_folder, with_metadata, write_tables
 from wbfriction.model.loading import load_robot
 from wbfriction.model.robot import Robot
-from wbfriction.pipeline.chunks import CONTEXT, Chunk, Chunking, plan_chunks, plan_columns
+from wbfriction.pipeline.chunks import CONTEXT, Chunk, Chunking, chunk_rows, plan_chunks, plan_columns
 from wbfriction.progress import Progress
 from wbfriction.workers import process_pool
 
@@ -63,7 +64,7 @@ def check_file(robot: Robot, path: str | Path, source: str | None = None, chunki
     clock = plan.clock
     reader = file.row_reader(max(1024, min(chunking.rows, 65_536)))
     for c in plan_chunks(plan.contact, chunking):
-        log_from_table(reader.rows(c.read_start, c.read_stop), robot, source, max_gap, limit_margin,
+        log_from_table(chunk_rows(reader, robot, plan, c), robot, source, max_gap, limit_margin,
                        first_row=c.read_start, period=clock.step, clock=clock.rows(c.read_start, c.read_stop),
                        time_unit=time_unit)
     return len(plan.contact)
@@ -90,11 +91,11 @@ def _in_worker(args) -> pa.Table:
     return _estimate_chunk(_ROBOT["robot"], *args)
 
 
-def _chunk_tables(spec: RobotSpec, robot: Robot, reader: RowReader, chunks: list[Chunk], clock: Clock, workers: int,
-                  settings: tuple) -> Iterator[pa.Table]:
+def _chunk_tables(spec: RobotSpec, robot: Robot, rows: Callable[[Chunk], pa.Table], chunks: list[Chunk], clock: Clock,
+                  workers: int, settings: tuple) -> Iterator[pa.Table]:
     """Each chunk's friction table in order, estimated in this process or on ``workers`` processes
     (each given its rows of the whole log's ``clock``)."""
-    args = lambda c: (reader.rows(c.read_start, c.read_stop), c, clock.rows(c.read_start, c.read_stop),  # noqa: E731
+    args = lambda c: (rows(c), c, clock.rows(c.read_start, c.read_stop),  # noqa: E731
                       *settings)
     if workers <= 1 or len(chunks) == 1:
         for c in chunks:
@@ -214,7 +215,8 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     first_meta: dict = {}
     valid: dict[str, int] = {}
     settings = (source, options, companion, max_gap, limit_margin, time_unit)
-    write_tables(output, _with_provenance(_chunk_tables(spec, robot, reader, chunks, clock,
+    rows = partial(chunk_rows, reader, robot, plan)
+    write_tables(output, _with_provenance(_chunk_tables(spec, robot, rows, chunks, clock,
                                                         chunking.processes(len(chunks)),
                                                         settings),
                                           chunks, robot, source, extra_metadata, progress, first_meta, valid))
