@@ -8,6 +8,7 @@ import pinocchio as pin
 import pytest
 
 from wbfriction.friction.models import FrictionParams
+from wbfriction.logs.contacts import normal_forces
 from wbfriction.sim.mujoco_model import SOLE_THICKNESS, build_mujoco_robot, sole_footprint
 
 
@@ -156,7 +157,7 @@ def test_swing_estimate_is_reliable_and_stance_is_not_on_mujoco(talos, mj_talos)
     ref = walking_reference(talos, GaitOptions(gait="forward", steps=4))
     log = simulate_mujoco(talos, ref, {knee: THESIS_TARGETS["knee"]}, mjr=mj_talos).log
     assert log.metadata["contact_source"].startswith("sole normal force")
-    est = estimate_log(talos, log, EstimateOptions(mask="single"))
+    est = estimate_log(talos, log, EstimateOptions(mask="single", wrenches=False))  # the thesis's route
     i = est.joints.index(knee)
     err = est.tau_f[:, i] - est.tau_f_true[:, i]
     right = talos.contact_of(knee)
@@ -164,8 +165,12 @@ def test_swing_estimate_is_reliable_and_stance_is_not_on_mujoco(talos, mj_talos)
     stance = est.valid[:, i] & est.contact[:, right]
     rms = lambda m: float(np.sqrt(np.mean(err[m] ** 2)))  # noqa: E731
     assert swing.sum() > 1000 and stance.sum() > 1000
-    assert rms(swing) < 0.1 * THESIS_TARGETS["knee"].F_c  # measured 0.03 N·m
-    assert rms(stance) > 10 * rms(swing)  # measured 3 N·m
+    # the rows where the landing foot already pushes (below the 50 N of its touch flag) are the
+    # flags' lag, not the swing estimate: what the measured force says of them is left out
+    pushing = normal_forces(talos, log.wrench)[:, right] > 0  # in the air: minus the plate's weight
+    assert np.mean(pushing[swing]) < 0.02
+    assert rms(swing & ~pushing) < 0.1 * THESIS_TARGETS["knee"].F_c  # measured 0.03 N·m
+    assert rms(stance) > 10 * rms(swing & ~pushing)  # measured 3 N·m
 
 
 def test_sensor_noise_quantisation_and_delay_in_the_loop(talos, mj_talos):

@@ -156,14 +156,15 @@ class Recording:
 
     def result(self, Q: np.ndarray, V: np.ndarray, A: np.ndarray, contact: np.ndarray, generator: str, options,
                *, Q_log: np.ndarray | None = None, tau_noise: np.ndarray | None = None, log_sensors: bool = False,
-               **metadata) -> SimulationResult:
+               sensor_wrench: np.ndarray | None = None, **metadata) -> SimulationResult:
         """The :func:`simulated_log` of the true states ``Q``, ``V``, ``A`` (its configurations ``Q_log`` if
         given, its torques plus ``tau_noise`` if given) and the :class:`SimulationResult` around it.
         With ``log_sensors``, the log carries what the robot's force-torque sensors measure
         (:func:`~wbfriction.model.force_torque.sensor_readings` of :attr:`wrench`, which must then be
-        the contact wrenches that go with ``A``)."""
+        the contact wrenches that go with ``A``); ``sensor_wrench`` (N, n_sensors, 6), what a simulator's own
+        sensors measured, is logged as it is."""
         tau = self.tau if tau_noise is None else self.tau + tau_noise
-        wrench = None
+        wrench = sensor_wrench if sensor_wrench is not None and sensor_wrench.shape[1] else None
         if log_sensors and self.robot.ft_sensors:
             wrench = sensor_readings(self.robot.model, self.robot.ft_sensors, self.robot.contact_frames, Q, V, A,
                                      self.wrench)

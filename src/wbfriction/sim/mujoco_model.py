@@ -125,6 +125,9 @@ class MujocoRobot:
         dof_index: MuJoCo ``qvel`` address of each actuated joint.
         sole_geoms: geom id of each contact frame's box, in :attr:`Robot.contact_frames` order.
         touch_index: ``sensordata`` address of each sole's touch sensor (normal force [N]).
+        ft_index: ``sensordata`` addresses (n_sensors, 6) of each force-torque sensor's force and torque,
+            in :attr:`Robot.ft_sensors <wbfriction.model.robot.Robot.ft_sensors>` order (the sign of
+            MuJoCo's turned into :mod:`wbfriction.model.force_torque`'s by :meth:`wrenches`).
         joint_ids: MuJoCo joint id of each actuated joint.
         base_body: body id of the floating base (the free joint's body).
 
@@ -140,6 +143,13 @@ class MujocoRobot:
     touch_index: np.ndarray
     joint_ids: np.ndarray
     base_body: int
+    ft_index: np.ndarray
+
+    def wrenches(self, sensordata: np.ndarray) -> np.ndarray:
+        """The force-torque sensors' wrenches (n_sensors, 6) in :mod:`wbfriction.model.force_torque`'s
+        convention (the plate's push on the link, sensor frame) from MuJoCo's ``sensordata``, whose
+        force and torque sensors give the link's push on the plate."""
+        return -sensordata[self.ft_index]
 
     def qpos(self, q: np.ndarray) -> np.ndarray:
         """MuJoCo ``qpos`` (nq,) of a Pinocchio configuration (nq,)."""
@@ -168,6 +178,18 @@ class MujocoRobot:
         out[..., 3:6] = qvel[..., 3:6]
         out[..., self.robot.act_v_index] = qvel[..., self.dof_index]
         return out
+
+    def base_acceleration(self, qpos: np.ndarray, qvel: np.ndarray, qacc: np.ndarray) -> np.ndarray:
+        """Pinocchio's free-flyer acceleration (..., 6) (the time derivative of the base-frame twist) from
+        MuJoCo's free joint's ``qpos``, ``qvel`` and ``qacc`` (..., 6): world-frame ``p_ddot`` turned into
+        the base frame, less ``omega x v`` (:mod:`wbfriction.signals.base_motion`)."""
+        from scipy.spatial.transform import Rotation
+        qpos, qvel, qacc = np.asarray(qpos), np.asarray(qvel), np.asarray(qacc)
+        R_inv = Rotation.from_quat(qpos.reshape(-1, qpos.shape[-1])[:, [4, 5, 6, 3]]).inv()
+        v_lin = R_inv.apply(qvel.reshape(-1, qvel.shape[-1])[:, :3])
+        omega = qvel.reshape(-1, qvel.shape[-1])[:, 3:6]
+        a_lin = R_inv.apply(qacc.reshape(-1, 6)[:, :3]) - np.cross(omega, v_lin)
+        return np.hstack([a_lin, qacc.reshape(-1, 6)[:, 3:6]]).reshape(qacc.shape[:-1] + (6,))
 
     def velocity_map(self, q: np.ndarray) -> np.ndarray:
         """``T`` (nv, nv) with ``qvel = T v`` at configuration ``q`` (Pinocchio's): the base
@@ -199,7 +221,20 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
         mj = spec.compile()
     except Exception as exc:
         raise ModelError(f"{robot.urdf}: MuJoCo cannot compile the model: {exc}") from None
+    _plates_weigh_as_their_links(mj, robot)
     return _mujoco_robot(robot, mj)
+
+
+def _plates_weigh_as_their_links(mj: mujoco.MjModel, robot: Robot) -> None:
+    """Give each sole plate the ``body_invweight0`` of its link. MuJoCo scales a contact's softness by
+    it (the constraint regulariser ``R`` is proportional to an approximation of ``J M^-1 J^T`` built from
+    the bodies' ``invweight0``): a plate, a light body of its own, would otherwise make the sole 1.8
+    times softer than the same sole on the link (measured on TALOS; the combined walk then fell at
+    6.9 s). The plate is welded to its link, so they are one rigid body: the same weight is right."""
+    import mujoco
+    for s in robot.ft_sensors:
+        plate = mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_BODY, f"ft_{s.name}")
+        mj.body_invweight0[plate] = mj.body_invweight0[mj.body_parentid[plate]]
 
 
 def _urdf_spec(robot: Robot, timestep: float) -> mujoco.MjSpec:
@@ -213,25 +248,84 @@ def _urdf_spec(robot: Robot, timestep: float) -> mujoco.MjSpec:
 
 
 def _add_soles(spec: mujoco.MjSpec, robot: Robot, footprints: list[tuple[np.ndarray, np.ndarray]]) -> None:
-    """One box per contact frame on its footprint (centre, half sizes), with a touch sensor."""
+    """One box per contact frame on its footprint (centre, half sizes), with a touch sensor; on the sole
+    plate below the contact's force-torque sensor, if it has one (:func:`_add_sensor_plates`)."""
     import mujoco
     model = robot.model
+    plates = _add_sensor_plates(spec, robot)
     for frame, (centre, half) in zip(robot.contact_frames, footprints):
         fr = model.frames[model.getFrameId(frame)]
         body = spec.body(_body_of_joint(model, fr.parentJoint))
         if body is None:
             raise ModelError(f"MuJoCo has no body for the link carrying '{frame}'")
-        pos = fr.placement.act(np.array([centre[0], centre[1], SOLE_THICKNESS / 2]))
+        placement = fr.placement  # the contact frame in the body's frame
+        if frame in plates:
+            body, in_body = plates[frame]
+            placement = in_body.actInv(fr.placement)
+        pos = placement.act(np.array([centre[0], centre[1], SOLE_THICKNESS / 2]))
+        quat = pin.Quaternion(placement.rotation).coeffs()[[3, 0, 1, 2]]
         body.add_geom(name=f"sole_{frame}", type=mujoco.mjtGeom.mjGEOM_BOX,
-                      size=[half[0], half[1], SOLE_THICKNESS / 2], pos=pos,
-                      quat=pin.Quaternion(fr.placement.rotation).coeffs()[[3, 0, 1, 2]],
+                      size=[half[0], half[1], SOLE_THICKNESS / 2], pos=pos, quat=quat,
                       condim=4, friction=list(SOLE_FRICTION))
         # the touch sensor counts the contacts whose point lies in its site: the sole, grown
         body.add_site(name=f"touch_{frame}", type=mujoco.mjtGeom.mjGEOM_BOX, pos=pos,
-                      size=[half[0] + TOUCH_MARGIN, half[1] + TOUCH_MARGIN, SOLE_THICKNESS],
-                      quat=pin.Quaternion(fr.placement.rotation).coeffs()[[3, 0, 1, 2]])
+                      size=[half[0] + TOUCH_MARGIN, half[1] + TOUCH_MARGIN, SOLE_THICKNESS], quat=quat)
         spec.add_sensor(name=f"touch_{frame}", type=mujoco.mjtSensor.mjSENS_TOUCH,
                         objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"touch_{frame}")
+
+
+def _add_sensor_plates(spec: mujoco.MjSpec, robot: Robot) -> dict[str, tuple[mujoco.MjsBody, pin.SE3]]:
+    """For each force-torque sensor (:mod:`wbfriction.model.force_torque`): its link's body keeps the part
+    above the sensor, and a child body without a joint, at the sensor frame, the sole plate below it, with
+    a site and MuJoCo ``force`` and ``torque`` sensors on it (``ft_<name>``): they measure the interaction
+    between the plate and the link. Returns the plate body and its placement in the link's body, per
+    contact frame."""
+    import mujoco
+    model = robot.model
+    plates = {}
+    for s in robot.ft_sensors:
+        body = spec.body(_body_of_joint(model, s.joint))
+        if body is None:
+            raise ModelError(f"MuJoCo has no body for the link of force-torque sensor '{s.name}'")
+        # the body's own inertia, less the plate's (the URDF's fixed links below it are fused in later,
+        # by MuJoCo: Pinocchio's joint inertia, which holds them already, would count them twice)
+        above = pin.Inertia.FromDynamicParameters(_spec_inertia(body).toDynamicParameters()
+                                                  - s.below_in_joint.toDynamicParameters())
+        _set_inertia(body, above)
+        plate = body.add_body(name=f"ft_{s.name}", pos=s.placement.translation,
+                              quat=pin.Quaternion(s.placement.rotation).coeffs()[[3, 0, 1, 2]])
+        _set_inertia(plate, s.below)
+        plate.add_site(name=f"ft_{s.name}")
+        for kind in (mujoco.mjtSensor.mjSENS_FORCE, mujoco.mjtSensor.mjSENS_TORQUE):
+            spec.add_sensor(name=f"ft_{s.name}_{'force' if kind == mujoco.mjtSensor.mjSENS_FORCE else 'torque'}",
+                            type=kind, objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"ft_{s.name}")
+        plates[s.contact] = (plate, s.placement)
+    return plates
+
+
+def _spec_inertia(body: mujoco.MjsBody) -> pin.Inertia:
+    """The explicit inertia of a MuJoCo spec body (from its URDF ``<inertial>``) as Pinocchio's, in its frame."""
+    if np.isfinite(body.fullinertia[0]):
+        xx, yy, zz, xy, xz, yz = body.fullinertia
+        inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    else:
+        R = pin.Quaternion(*body.iquat).toRotationMatrix()  # (w, x, y, z)
+        inertia = R @ np.diag(body.inertia) @ R.T
+    return pin.Inertia(float(body.mass), np.array(body.ipos), inertia)
+
+
+def _set_inertia(body: mujoco.MjsBody, inertia: pin.Inertia) -> None:
+    """Give a MuJoCo body Pinocchio's spatial ``inertia`` (in the body's frame): mass, centre of mass, and
+    the principal moments about it with their axes."""
+    moments, axes = np.linalg.eigh(inertia.inertia)
+    if np.linalg.det(axes) < 0:
+        axes[:, 0] *= -1
+    body.explicitinertial = True
+    body.mass = max(inertia.mass, 1e-9)
+    body.ipos = inertia.lever
+    body.iquat = pin.Quaternion(axes).coeffs()[[3, 0, 1, 2]]
+    body.inertia = np.maximum(moments, 1e-12)
+    body.fullinertia = [np.nan, 0, 0, 0, 0, 0]  # unset: the principal moments above hold
 
 
 def _add_motors(spec: mujoco.MjSpec, robot: Robot) -> None:
@@ -263,7 +357,11 @@ def _mujoco_robot(robot: Robot, mj: mujoco.MjModel) -> MujocoRobot:
     touch = np.array([mj.sensor_adr[mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_SENSOR, f"touch_{f}")]
                       for f in robot.contact_frames])
     base = int(mj.jnt_bodyid[np.flatnonzero(mj.jnt_type == mujoco.mjtJoint.mjJNT_FREE)[0]])
-    return MujocoRobot(robot, mj, np.array(qpos_index), np.array(dof_index), soles, touch, np.array(joint_ids), base)
+    ft = np.array([np.r_[[mj.sensor_adr[mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_SENSOR, f"ft_{s.name}_{kind}")] + i
+                          for kind in ("force", "torque") for i in range(3)]] for s in robot.ft_sensors],
+                  dtype=int).reshape(len(robot.ft_sensors), 6)
+    return MujocoRobot(robot, mj, np.array(qpos_index), np.array(dof_index), soles, touch, np.array(joint_ids), base,
+                       ft)
 
 
 def _body_of_joint(model: pin.Model, joint: int) -> str:

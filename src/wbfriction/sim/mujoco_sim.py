@@ -96,7 +96,11 @@ class MujocoOptions:
             the robot's :attr:`~wbfriction.model.robot.Robot.balance_gains`.
         fall_height: the simulation stops with an error when the base drops below this
             share of its initial height.
-        log_base: write the base pose to the log.
+        log_base: write the base pose to the log (and its true twist and acceleration).
+        force_torque: write what the robot's force-torque sensors measure (``wrench.<sensor>.*``):
+            MuJoCo's ``force`` and ``torque`` sensors between each sensor's link and the sole plate
+            below it (:func:`~wbfriction.sim.mujoco_model.build_mujoco_robot`), at the period's first
+            physics step, as the torques.
     """
 
     substeps: int = 4
@@ -111,6 +115,7 @@ class MujocoOptions:
     balance: tuple[float, float] | None = None
     fall_height: float = 0.5
     log_base: bool = True
+    force_torque: bool = True
 
     def __post_init__(self) -> None:
         if self.substeps < 1:
@@ -225,6 +230,8 @@ class _MujocoRun:
 
         self.qpos, self.qvel = np.empty((n, self.model.nq)), np.empty((n, self.model.nv))
         self.q_meas, self.qdd = np.empty((n, n_act)), np.empty((n, n_act))
+        self.base_qacc = np.empty((n, 6))
+        self.ft = np.empty((n, len(self.robot.ft_sensors), 6))
         self.recording = Recording(self.robot, ref, self.injected)
         self.contact, self.force = np.zeros((n, nc), dtype=bool), np.zeros((n, nc))
         self.commands = np.zeros((self.delay + 1, n_act))  # ring buffer: the command of period k acts at k + delay
@@ -298,6 +305,8 @@ class _MujocoRun:
         """Log the period's first physics step: joint accelerations, motor torques, friction applied."""
         data = self.data
         self.qdd[k] = data.qacc[self.mjr.dof_index]
+        self.base_qacc[k] = data.qacc[:6]
+        self.ft[k] = self.mjr.wrenches(data.sensordata)  # computed with qacc, before the step's integration
         tau_f = mujoco_friction_torque(data, self.dof_f) if self.native else self.tau_f
         self.recording.record_torques(k, data.actuator_force[self.tc], tau_f)
 
@@ -322,9 +331,11 @@ class _MujocoRun:
         Q_meas[:, robot.act_q_index] = self.q_meas
         A = np.full((self.n, robot.model.nv), np.nan)
         A[:, robot.act_v_index] = self.qdd
+        A[:, :6] = mjr.base_acceleration(self.qpos, self.qvel, self.base_qacc)
         self.recording.wrench[:, :, 2] = self.force
         return self.recording.result(Q, V, A, self.contact, "wbfriction.sim.mujoco_sim.simulate_mujoco", self.options,
                                      Q_log=Q_meas, tau_noise=self.eps_tau,
+                                     sensor_wrench=self.ft if self.options.force_torque else None,
                                      torque_alignment="zoh",  # the torque is held over the substeps of each period
                                      contact_source=f"sole normal force > {self.options.contact_threshold:g} N")
 

@@ -29,7 +29,8 @@ from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, esti
 from wbfriction.friction.io import write_params
 from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.targets import THESIS_TARGETS
-from wbfriction.logs.log import write_log
+from wbfriction.logs.contacts import normal_forces, sensed_contacts
+from wbfriction.logs.log import Log, write_log
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
 from wbfriction.report.figures import friction_curves_figure, velocity_panels_figure
@@ -50,9 +51,12 @@ from wbfriction.studies.common import (
 )
 from wbfriction.walking import GaitOptions, walking_reference
 
+THESIS_ROUTE = EstimateOptions(wrenches=False)
+"""The thesis's route: base motion from the rigid stance contact, the ankle sensors' wrenches left
+out (the study reproduces 6.2; :mod:`wbfriction.friction.measured` is the route that uses them)."""
 NOISE = SensorNoise(position_std=1e-4, encoder_bits=ENCODER_BITS, torque_std=TORQUE_STD, seed=0)
 """The filter study's default noise level (its 1e-4 rad row)."""
-BEST_FILTER = EstimateOptions(diff="savgol", filtering=FilterOptions(window=151, poly_order=4))
+BEST_FILTER = EstimateOptions(diff="savgol", filtering=FilterOptions(window=151, poly_order=4), wrenches=False)
 """The filter study's best scheme at that level."""
 COULOMB_VISCOUS = {"S": 0.0, "v_s": 0.1, "tau_os": 0.0}
 """Parameters held in the fit of MuJoCo's own friction, which has no Stribeck term or offset."""
@@ -77,9 +81,15 @@ class RealisticResult:
     files: list[Path] = field(default_factory=list)
 
 
-def _swing(est: FrictionEstimate, robot: Robot, joint: str) -> np.ndarray:
-    """Valid samples of ``joint`` while its leg swings."""
-    return est.valid[:, est.joints.index(joint)] & ~est.contact[:, robot.contact_of(joint)]
+def _swing(est: FrictionEstimate, robot: Robot, joint: str, log: Log | None = None) -> np.ndarray:
+    """Valid samples of ``joint`` while its leg swings: its foot's contact flag off and, when ``log`` has the
+    ankle sensors' wrenches, the ground not pushing its sole (a landing foot can carry up to the flag's
+    threshold, 50 N, for tens of milliseconds before its flag rises: that is the flag's lag, not the swing)."""
+    c = robot.contact_of(joint)
+    swing = est.valid[:, est.joints.index(joint)] & ~est.contact[:, c]
+    if log is not None and log.wrench is not None and sensed_contacts(robot):
+        swing &= normal_forces(robot, log.wrench)[:, c] <= 0.0  # in the air: minus the plate's weight
+    return swing
 
 
 @dataclass(frozen=True)
@@ -106,13 +116,15 @@ def _swing_and_stance(robot: Robot, mjr: MujocoRobot, knee: str, table_6_1: dict
                       say: StageProgress) -> tuple[dict[str, float], list[Path]]:
     """Fig. 6.4 and 6.5 (steps 1-2 of the module docstring): the right knee's RMS error and the figures written."""
     forward = GaitOptions(gait="forward", steps=knee_steps)
-    whole = EstimateOptions(mask="single")
+    whole = EstimateOptions(mask="single", wrenches=False)
     say("MuJoCo: a forward walk, friction on the right knee")
-    knee_only = estimate_log(robot, _simulate(robot, mjr, forward, {knee: table_6_1[knee]}, options).log, whole)
+    knee_log = _simulate(robot, mjr, forward, {knee: table_6_1[knee]}, options).log
+    knee_only = estimate_log(robot, knee_log, whole)
     say("MuJoCo: the same walk, friction on every leg joint")
-    all_legs = estimate_log(robot, _simulate(robot, mjr, forward, table_6_1, options).log, whole)
+    legs_log = _simulate(robot, mjr, forward, table_6_1, options).log
+    all_legs = estimate_log(robot, legs_log, whole)
     i = knee_only.joints.index(knee)
-    standing, swinging = knee_only.valid[:, i], _swing(knee_only, robot, knee)
+    standing, swinging = knee_only.valid[:, i], _swing(knee_only, robot, knee, knee_log)
     assert knee_only.tau_f_true is not None  # simulated: the log has the true friction
     err = knee_only.tau_f[:, i] - knee_only.tau_f_true[:, i]
     knee_rms = {"whole step": float(np.sqrt(np.mean(err[standing] ** 2))),
@@ -123,7 +135,7 @@ def _swing_and_stance(robot: Robot, mjr: MujocoRobot, knee: str, table_6_1: dict
                            knee, table_6_1[knee], fig_6_4,
                            "Fig. 6.4 (MuJoCo): right knee friction, central differences")
     velocity_panels_figure([("friction on the right knee only", knee_only, swinging),
-                            ("friction on every leg joint", all_legs, _swing(all_legs, robot, knee))],
+                            ("friction on every leg joint", all_legs, _swing(all_legs, robot, knee, legs_log))],
                            knee, table_6_1[knee], fig_6_5,
                            "Fig. 6.5 (MuJoCo): right knee friction in swing, alone and with every leg joint's")
     return knee_rms, [fig_6_4, fig_6_5]
@@ -134,9 +146,9 @@ def _case_specs(table_6_1: dict[str, FrictionParams], options: MujocoOptions) ->
     native = {j: dataclasses.replace(p, S=0.0, tau_os=0.0) for j, p in table_6_1.items()}
     return [
         _CaseSpec("model", "friction (3.5), noise off, central differences", table_6_1, options,
-                  EstimateOptions(), None, ("F_c", "F_v", "tau_os")),
+                  THESIS_ROUTE, None, ("F_c", "F_v", "tau_os")),
         _CaseSpec("mujoco", "MuJoCo frictionloss + damping, noise off, central differences, Coulomb-viscous fit",
-                  native, dataclasses.replace(options, friction="mujoco"), EstimateOptions(), COULOMB_VISCOUS,
+                  native, dataclasses.replace(options, friction="mujoco"), THESIS_ROUTE, COULOMB_VISCOUS,
                   ("F_c", "F_v")),
         _CaseSpec("noisy", "friction (3.5), sensor noise 1e-4 rad / 19 bit / 0.05 N·m, Savitzky-Golay L=151 k=4",
                   table_6_1, dataclasses.replace(options, sensors=NOISE), BEST_FILTER, None,

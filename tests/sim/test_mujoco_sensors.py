@@ -1,0 +1,70 @@
+"""MuJoCo's ankle force-torque sensors: the plate split off its link changes nothing of the robot, the
+wrenches follow the project's convention, and with them the estimate is exact on soft contacts."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.targets import THESIS_TARGETS
+from wbfriction.sim import MujocoOptions, simulate_mujoco
+from wbfriction.sim.mujoco_model import build_mujoco_robot
+from wbfriction.studies.common import leg_joints
+from wbfriction.walking import GaitOptions, walking_reference
+
+
+def test_the_plates_change_neither_the_mass_nor_the_contacts(talos):
+    plain = build_mujoco_robot(dataclasses.replace(talos, ft_sensors=(), cache={}))
+    split = build_mujoco_robot(talos)
+    assert split.model.body_mass.sum() == pytest.approx(pin.computeTotalMass(talos.model), abs=1e-9)
+    assert split.model.body_mass.sum() == pytest.approx(plain.model.body_mass.sum(), abs=1e-9)
+    for s in talos.ft_sensors:
+        plate = mujoco.mj_name2id(split.model, mujoco.mjtObj.mjOBJ_BODY, f"ft_{s.name}")
+        assert split.model.body_mass[plate] == pytest.approx(0.4)
+        link = split.model.body_parentid[plate]
+        np.testing.assert_array_equal(split.model.body_invweight0[plate], split.model.body_invweight0[link])
+    # the soles where they were, on the plates
+    d_plain, d_split = mujoco.MjData(plain.model), mujoco.MjData(split.model)
+    d_plain.qpos[:], d_split.qpos[:] = plain.qpos(talos.q_reference), split.qpos(talos.q_reference)
+    mujoco.mj_forward(plain.model, d_plain)
+    mujoco.mj_forward(split.model, d_split)
+    for g_plain, g_split in zip(plain.sole_geoms, split.sole_geoms):
+        np.testing.assert_allclose(d_split.geom_xpos[g_split], d_plain.geom_xpos[g_plain], atol=1e-12)
+        np.testing.assert_allclose(d_split.geom_xmat[g_split], d_plain.geom_xmat[g_plain], atol=1e-12)
+
+
+@pytest.fixture(scope="module")
+def mujoco_walk(talos):
+    """Two forward steps on MuJoCo's soft contacts, Table 6.1 friction on every leg joint, sensors logged."""
+    friction = {j: THESIS_TARGETS[g] for j, _, g in leg_joints(talos)}
+    ref = walking_reference(talos, GaitOptions(gait="forward", steps=2))
+    return simulate_mujoco(talos, ref, friction, MujocoOptions()).log
+
+
+def test_standing_the_ankles_read_the_weight_above_the_plates(talos, mujoco_walk):
+    """Sign and scale: from 0.1 to 0.4 s, both feet down and the robot nearly still (the first 0.1 s, it
+    settles on its soft soles), the two sensors' fz add up to the weight of everything above the plates
+    (+: the plates push the robot up)."""
+    above = (pin.computeTotalMass(talos.model) - 0.8) * 9.81
+    assert mujoco_walk.contact[100:400].all()
+    fz = mujoco_walk.wrench[100:400, :, 2].sum(axis=1)
+    assert np.all(np.abs(fz - above) < 0.005 * above)
+
+
+def test_with_the_sensors_every_leg_joint_is_exact_on_soft_contacts(talos, mujoco_walk):
+    """True derivatives: the wrench route recovers the friction applied at every leg joint in every phase
+    (MuJoCo's solver tolerance aside), where the rigid-contact route, whose welded sole MuJoCo's soft
+    contact is not, misses it by up to newton-metres."""
+    legs = [talos.torque_controlled.index(j) for j, _, _ in leg_joints(talos)]
+    wrench = estimate_log(talos, mujoco_walk, EstimateOptions(diff="true", base_motion="logged"))
+    contact = estimate_log(talos, mujoco_walk, EstimateOptions(diff="true", wrenches=False))
+    err_w = np.abs(wrench.tau_f - wrench.tau_f_true)[:, legs]
+    err_c = np.abs(contact.tau_f - contact.tau_f_true)[:, legs]
+    assert wrench.valid[:, legs].all()
+    assert np.median(err_w) < 1e-9 and err_w.max() < 1e-2
+    assert np.nanmax(np.where(contact.valid[:, legs], err_c, np.nan)) > 20 * err_w.max()
