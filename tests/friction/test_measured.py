@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
-
 from tests.helpers import run_cli
+
 from wbfriction.exceptions import ColumnError
 from wbfriction.friction.estimate import EstimateOptions, estimate_log
 from wbfriction.friction.targets import THESIS_TARGETS
