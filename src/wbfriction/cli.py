@@ -283,7 +283,16 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                                                               "control periods."),
              log_base: bool = typer.Option(_I.log_base, help="Write the base pose to the log."),
              force_torque: bool = typer.Option(_I.force_torque, help="ideal: write what the robot's force-torque "
-                                                                     "sensors measure (wrench.<sensor>.* columns)."),
+                                                                     "sensors measure (wrench.<sensor>.* columns; "
+                                                                     "mujoco always does)."),
+             sole_timeconst: Optional[float] = typer.Option(None, help="mujoco: the soles' contact time constant "
+                                                                       "(s; default MuJoCo's 0.02, larger is "
+                                                                       "softer: a compliant sole)."),
+             torque_drift: float = typer.Option(_M.torque_drift, min=0.0, help="mujoco: drift rate of each torque "
+                                                                               "sensor's offset (N·m/s)."),
+             ft_offset: tuple[float, float] = typer.Option(_M.ft_offset, help="mujoco: standard deviations of the "
+                                                                               "force-torque sensors' constant "
+                                                                               "offsets: force (N), torque (N·m)."),
              duration: float = typer.Option(10.0, help="Fixed-base robot (an arm): seconds of excitation "
                                                        "trajectory.")) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
@@ -309,7 +318,8 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
         table.update({k: v for k, v in given.items() if v is not None})
         lag = float(table.pop("delay", 0.0))
         options = MujocoOptions(substeps=substeps or _M.substeps, friction=cast(FrictionMode, mujoco_friction),
-                                sensors=SensorNoise(**table), delay=lag, log_base=log_base)
+                                sensors=SensorNoise(**table), delay=lag, log_base=log_base,
+                                sole_timeconst=sole_timeconst, torque_drift=torque_drift, ft_offset=ft_offset)
     _run_simulate(r, output, gait_opts, options, friction)
 
 

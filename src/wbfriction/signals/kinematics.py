@@ -246,8 +246,8 @@ class MeasuredKinematics:
         base_qd, base_qdd: the base's twist and acceleration (N, 6) in the base frame, from its
             logged pose differentiated like the joints (:mod:`~wbfriction.signals.base_motion`;
             ``measure(..., base_motion=True)``), or None.
-        wrench: the force-torque sensors' wrenches (N, n_sensors, 6) [N, N·m], filtered as the torques
-            (not aligned: samples at the rows' instants), or None.
+        wrench: the force-torque sensors' wrenches (N, n_sensors, 6) [N, N·m], aligned and filtered as
+            the torques, or None.
     """
 
     time: np.ndarray
@@ -325,9 +325,9 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
             is measured and stated in the metadata (``velocity``), not compensated.
         base_motion: also differentiate the logged base pose with the joints' scheme and filter
             (:mod:`~wbfriction.signals.base_motion`; ``"true"``: the log's ``base_qd_true`` and
-            ``base_qdd_true``). The force-torque sensors' wrenches, when logged, are filtered as the
-            torques are, but not aligned as a held torque command: they are samples of a continuous
-            force at the rows' instants, as the positions are.
+            ``base_qdd_true``). The force-torque sensors' wrenches, when logged, are aligned and
+            filtered as the torques are: a sensor's reading is its mean over the sampling period (its
+            anti-aliasing), as a held torque is the period's torque.
 
     Raises:
         InputError: unknown scheme, alignment or velocity source, filter parameters that make
@@ -360,8 +360,9 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
     if base_motion:
         assert log.base is not None  # checked above
         extended = replace(extended, q=np.hstack([log.q, continuous_quaternions(log.base)]))
-    q, qd, qdd, tau, smoother, metadata = _derivatives(extended, diff, compensate_delay, torque_alignment, filtering,
-                                                       None if log.wrench is None else log.wrench.reshape(n, -1))
+    if log.wrench is not None:
+        extended = replace(extended, tau=np.hstack([log.tau, log.wrench.reshape(n, -1)]))
+    q, qd, qdd, tau, smoother, metadata = _derivatives(extended, diff, compensate_delay, torque_alignment, filtering)
     base_qd = base_qdd = None
     if base_motion:
         base_qd, base_qdd = base_twist_and_acceleration(q[:, n_act:], qd[:, n_act:], qdd[:, n_act:])
@@ -380,12 +381,9 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
 
 
 def _derivatives(log: Log, diff: Diff, compensate_delay: bool, torque_alignment: TorqueAlignment | Literal["auto"],
-                 filtering: FilterOptions, samples: np.ndarray | None = None
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, Smoother | None, dict]:
-    """``q, qd, qdd, tau``, the smoother and the metadata of :func:`measure` for a scheme of :data:`SCHEMES`;
-    ``samples`` (N, m), signals sampled at the rows' instants as the positions are (not held over a period
-    as a torque command is: the measured wrenches), are filtered as the torques but not aligned, and come
-    back as ``tau``'s last ``m`` columns."""
+                 filtering: FilterOptions) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, Smoother | None,
+                                                    dict]:
+    """``q, qd, qdd, tau``, the smoother and the metadata of :func:`measure` for a scheme of :data:`SCHEMES`."""
     q, smoother, metadata = log.q, None, dict(log.metadata)
     if torque_alignment == "auto":
         torque_alignment = log.metadata.get("torque_alignment", "zoh")
@@ -394,8 +392,6 @@ def _derivatives(log: Log, diff: Diff, compensate_delay: bool, torque_alignment:
         metadata["clock"] = {"kind": log.clock.kind, "reason": log.clock.reason}
     smoother = make_smoother(diff, filtering, log.dt, t)
     tau = align_torque(log.tau, torque_alignment, t)
-    if samples is not None:
-        tau = np.hstack([tau, samples])
     if smoother is None:
         qd, qdd, delay = (DIFFERENTIATORS[diff](log.q, log.dt) if t is None
                           else NONUNIFORM_DIFFERENTIATORS[diff](log.q, t))
