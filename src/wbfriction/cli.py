@@ -773,6 +773,32 @@ def _percent(x: float) -> str:
     return f"{x:.1f}" if x < 1e4 else ("inf" if not np.isfinite(x) else ">1e4")
 
 
+@app.command("study-sensors")
+def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-o", "--output-dir",
+                                                  help="Where to write."),
+                  robot: str = RobotOpt,
+                  steps: int = typer.Option(3, min=1, help="Steps per direction of the combined walk."),
+                  diff: str = typer.Option("central", help="Differentiation: central, savgol, butterworth or true."),
+                  window: int = typer.Option(151, help="savgol: window length L (odd) [samples]."),
+                  noise: bool = typer.Option(False, "--noise", help="The studies' sensor noise in the loop (1e-4 "
+                                                                    "rad, 19-bit encoders, 0.05 N·m torques).")
+                  ) -> None:
+    """What the ankle force-torque sensors and the base pose change, on MuJoCo's soft contacts (issue 23)."""
+    from wbfriction.studies.realistic import NOISE
+    from wbfriction.studies.sensors import run_sensors_study, sensors_markdown
+
+    r = _robot(robot, None, None)
+    if not r.ft_sensors:
+        raise InputError(f"--robot {robot}: the robot has no force-torque sensors ([force_torque.<name>] in its TOML)")
+    with console.status("") as status:
+        result = run_sensors_study(r, output_dir, steps=steps, diff=cast(Diff, diff),
+                                   filtering=FilterOptions(window=window), noise=NOISE if noise else SensorNoise(),
+                                   progress=lambda label: status.update(label))
+    out.print(escape(sensors_markdown(result)), highlight=False, soft_wrap=True)
+    for f in result.files:
+        console.print(f"wrote {f}")
+
+
 @app.command("study-filters")
 def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-o", "--output-dir",
                                                   help="Where to write."),

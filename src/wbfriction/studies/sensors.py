@@ -1,0 +1,172 @@
+"""The sensors a humanoid carries, on MuJoCo (issue 23): ``wbfriction study-sensors``.
+
+The combined walk on MuJoCo's soft contacts, Table 6.1 friction (3.5) on every leg joint, sensor noise
+off, the ankle force-torque sensors and the base pose logged. Each leg joint's model is fitted twice
+per route, on its swing samples (its foot in the air) and, separately, on its stance samples (its foot on
+the ground):
+
+* ``contact``: the thesis's route (rigid stance contact, swing-only single support), as in Table 6.2;
+* ``wrench``: the ankle wrenches and the logged base (:mod:`wbfriction.friction.measured`).
+
+A joint pressed against its URDF position limit receives the stop's torque, which no friction model has:
+the samples where a leg joint is within :data:`AT_LIMIT` of a limit are left out and counted (the
+combined walk's reference takes the right hip roll 0.0175 rad beyond its limit, and MuJoCo holds it there).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_log
+from wbfriction.friction.targets import THESIS_TARGETS
+from wbfriction.logs.log import Log, write_log
+from wbfriction.model.robot import Robot
+from wbfriction.progress import StageProgress
+from wbfriction.signals.kinematics import Diff, FilterOptions
+from wbfriction.sim import MujocoOptions, SensorNoise, simulate_mujoco
+from wbfriction.studies.common import LegJoint, fit_legs, leg_joints
+from wbfriction.studies.thesis import TABLE_6_2
+from wbfriction.walking import GaitOptions, walking_reference
+
+AT_LIMIT = 1e-3
+"""How close to a URDF position limit a leg joint's sample is left out [rad]."""
+SCORED = ("F_c", "F_v", "tau_os")
+"""The parameters the study scores."""
+
+
+@dataclass(frozen=True)
+class SensorsRow:
+    """One leg joint: its error [%] per parameter of :data:`SCORED` and its samples, per route and part.
+
+    Attributes:
+        joint, side, group: the leg joint.
+        errors: ``(route, part) -> {parameter: |error| [%]}``, ``part`` ``swing`` or ``stance``.
+        samples: ``(route, part) -> samples fitted``.
+        usable: ``route -> share of the walk's samples with a valid estimate``.
+    """
+
+    joint: str
+    side: str
+    group: str
+    errors: dict[tuple[str, str], dict[str, float]]
+    samples: dict[tuple[str, str], int]
+    usable: dict[str, float]
+
+
+@dataclass(frozen=True)
+class SensorsResult:
+    """What :func:`run_sensors_study` measured: one :class:`SensorsRow` per leg joint, the rows left out at a
+    joint limit, the differentiation scheme, and the files written."""
+
+    rows: list[SensorsRow]
+    at_limit: int
+    diff: str
+    files: list[Path]
+
+    def worst(self, route: str, part: str) -> dict[str, float]:
+        """The largest error [%] of each scored parameter over the leg joints, for one route and part."""
+        return {n: max(r.errors[(route, part)][n] for r in self.rows) for n in SCORED}
+
+
+PARTS = {"contact": ("swing",), "wrench": ("swing", "stance")}
+"""The parts each route is scored on: the thesis's route has no stance estimate."""
+
+
+def run_sensors_study(robot: Robot, output_dir: Path, steps: int = 3, diff: Diff = "central",
+                      filtering: FilterOptions = FilterOptions(), noise: SensorNoise = SensorNoise(),
+                      progress: StageProgress | None = None) -> SensorsResult:
+    """Simulate, estimate by both routes, fit swing and stance (module docstring); write the log, a JSON of the
+    table and ``sensors.md`` into ``output_dir``. ``noise``: the sensors' noise in the loop (off by
+    default), ``diff`` and ``filtering`` the differentiation.
+
+    Raises:
+        SimulationError: the robot fell.
+    """
+    say = progress or (lambda label: None)
+    output_dir.mkdir(parents=True, exist_ok=True)
+    legs = leg_joints(robot)
+    friction = {j: THESIS_TARGETS[g] for j, _, g in legs}
+    say(f"MuJoCo: the combined walk, {steps} steps per direction, the ankle sensors logged")
+    log = simulate_mujoco(robot, walking_reference(robot, GaitOptions(gait="combined", steps=steps)), friction,
+                          MujocoOptions(sensors=noise)).log
+    free = _off_limits(robot, log, legs)
+    estimates = {}
+    for route, options in (("contact", EstimateOptions(diff=diff, filtering=filtering, wrenches=False)),
+                           ("wrench", EstimateOptions(diff=diff, filtering=filtering, base_motion="logged"))):
+        say(f"estimate: the {route} route")
+        estimates[route] = estimate_log(robot, log, options)
+    errors: dict[str, dict] = {j: {} for j, _, _ in legs}
+    samples: dict[str, dict] = {j: {} for j, _, _ in legs}
+    for route, est in estimates.items():
+        for part in PARTS[route]:
+            say(f"fit: the {route} route, {part} samples")
+            part_est = dataclasses.replace(est, valid=est.valid & _foot_down(robot, est, part == "stance")
+                                           & free[:, None])
+            for (joint, _, _), fit in zip(legs, fit_legs(part_est, legs, friction)):
+                e = fit.error_percent() or {}
+                errors[joint][(route, part)] = {n: abs(e.get(n, np.inf)) for n in SCORED}
+                samples[joint][(route, part)] = fit.n_samples
+    rows = [SensorsRow(j, side, g, errors[j], samples[j],
+                       {route: float(est.valid[:, est.joints.index(j)].mean()) for route, est in estimates.items()})
+            for j, side, g in legs]
+    label = diff + (f" L={filtering.window}" if diff == "savgol" else "")
+    label += "" if not noise.active else f", sensor noise {noise.position_std:g} rad / {noise.encoder_bits} bit"
+    result = SensorsResult(rows, int((~free).sum()), label, [])
+    files = [output_dir / "mujoco_sensors_walk.parquet", output_dir / "sensors.json", output_dir / "sensors.md"]
+    write_log(log, robot, files[0])
+    files[1].write_text(json.dumps(_as_json(result), indent=1))
+    files[2].write_text(sensors_markdown(result))
+    return dataclasses.replace(result, files=files)
+
+
+def _off_limits(robot: Robot, log: Log, legs: list[LegJoint]) -> np.ndarray:
+    """(N,) the rows where no leg joint is within :data:`AT_LIMIT` of its URDF position limit."""
+    lo, hi = robot.angle_limits
+    i = [robot.actuated.index(j) for j, _, _ in legs]
+    return ~np.any((log.q[:, i] < lo[i] + AT_LIMIT) | (log.q[:, i] > hi[i] - AT_LIMIT), axis=1)
+
+
+def _foot_down(robot: Robot, est: FrictionEstimate, down: bool) -> np.ndarray:
+    """(N, n_tc) a joint's foot on the ground (``down``) or in the air; joints of no foot: False."""
+    out = np.zeros(est.valid.shape, dtype=bool)
+    for i, joint in enumerate(est.joints):
+        c = robot.contact_of(joint)
+        if c is not None:
+            out[:, i] = est.contact[:, c] == down
+    return out
+
+
+def _as_json(result: SensorsResult) -> dict:
+    return {"diff": result.diff, "rows_at_a_limit": result.at_limit,
+            "joints": {r.joint: {"side": r.side, "group": r.group, "usable_share": r.usable,
+                                 **{f"{route}_{part}": {"error_percent": r.errors[(route, part)],
+                                                        "samples": r.samples[(route, part)]}
+                                    for route, parts in PARTS.items() for part in parts}}
+                       for r in result.rows}}
+
+
+def sensors_markdown(result: SensorsResult) -> str:
+    """The study's tables in Markdown: per leg joint the |error| [%] of F_c / F_v / tau_os by route and
+    part, the thesis's Table 6.2 beside them, and the share of usable samples."""
+    head = ["joint", "Table 6.2 (thesis)", "contact, swing", "wrench, swing", "wrench, stance"]
+    lines = [f"Errors [%] of F_c / F_v / tau_os ({result.diff}; {result.at_limit} rows with a "
+             "leg joint at its position limit left out)", "", "| " + " | ".join(head) + " |",
+             "|" + "---|" * len(head)]
+    names = ("F_c", "F_v", "tau_os")
+    index = {"F_v": 0, "F_c": 1, "tau_os": 4}  # in the thesis's order (F_v, F_c, S, v_s, tau_os, a)
+    for r in result.rows:
+        thesis = TABLE_6_2.get((r.side, r.group))
+        cells = [r.joint, " / ".join(f"{thesis[index[n]]:.2f}" for n in names) if thesis else "-"]
+        cells += [" / ".join(f"{r.errors[(route, part)][n]:.2f}" for n in names)
+                  for route, parts in PARTS.items() for part in parts]
+        lines.append("| " + " | ".join(cells) + " |")
+    lines += ["", "Share of the walk's samples with a valid estimate", "", "| joint | contact | wrench |",
+              "|---|---|---|"]
+    lines += [f"| {r.joint} | {100 * r.usable['contact']:.1f} % | {100 * r.usable['wrench']:.1f} % |"
+              for r in result.rows]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,36 @@
+"""The sensors study (issue 23) on a short combined walk: both routes scored, the files written."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from wbfriction.studies.sensors import PARTS, run_sensors_study
+
+
+@pytest.fixture(scope="module")
+def study(talos, tmp_path_factory):
+    out = tmp_path_factory.mktemp("sensors")
+    return out, run_sensors_study(talos, out, steps=1)
+
+
+def test_the_wrenches_use_every_sample_and_beat_the_rigid_route(study):
+    _, result = study
+    assert len(result.rows) == 12
+    for row in result.rows:
+        assert row.usable["wrench"] > 0.99 and row.usable["contact"] < 0.35  # all but the first and last rows
+        assert row.samples[("wrench", "stance")] > row.samples[("wrench", "swing")] > 0
+    contact, wrench = result.worst("contact", "swing"), result.worst("wrench", "swing")
+    assert all(wrench[n] < contact[n] for n in ("F_c", "F_v", "tau_os"))
+    assert result.worst("wrench", "stance")["tau_os"] < 5.0
+
+
+def test_the_files_hold_the_table(study):
+    out, result = study
+    assert [f.name for f in result.files] == ["mujoco_sensors_walk.parquet", "sensors.json", "sensors.md"]
+    table = json.loads((out / "sensors.json").read_text())
+    assert set(table["joints"]) == {r.joint for r in result.rows}
+    first = table["joints"][result.rows[0].joint]
+    assert {f"{route}_{part}" for route, parts in PARTS.items() for part in parts} <= set(first)
+    assert (out / "sensors.md").read_text().count("| leg_") == 24  # both tables
