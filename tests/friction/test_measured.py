@@ -3,6 +3,8 @@ exact data: every joint in every phase with the wrenches, every joint in single 
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
@@ -22,10 +24,10 @@ EXACT = 1e-6  # [N·m], the issue's bound; the routes reach about 1e-12
 
 @pytest.fixture(scope="module")
 def ft_walk(talos):
-    """Two forward steps, Table 6.1 friction on every leg joint, the force-torque sensors logged."""
+    """Two forward steps, Table 6.1 friction on every leg joint, the force-torque sensors and the IMU logged."""
     friction = {j: THESIS_TARGETS[g] for j, _, g in leg_joints(talos)}
     ref = walking_reference(talos, GaitOptions(gait="forward", steps=2))
-    options = IdealOptions(substeps=SIMULATOR.substeps, force_torque=True)
+    options = IdealOptions(substeps=SIMULATOR.substeps, force_torque=True, imu=True)
     return simulate_ideal(talos, ref, friction, options).log
 
 
@@ -33,7 +35,7 @@ def _errors(est, rows):
     return np.abs(est.tau_f[rows] - est.tau_f_true[rows])
 
 
-@pytest.mark.parametrize("base_motion", ["contact", "logged"])
+@pytest.mark.parametrize("base_motion", ["contact", "logged", "imu"])
 def test_with_wrenches_every_joint_is_exact_in_every_phase(talos, ft_walk, base_motion):
     est = estimate_log(talos, ft_walk, EstimateOptions(diff="true", base_motion=base_motion))
     single, double = est.phase == "single", est.phase == "double"
@@ -56,9 +58,36 @@ def test_with_the_base_measured_every_joint_is_exact_in_single_support(talos, ft
     np.testing.assert_allclose(est.tau_f[base], contact.tau_f[base], atol=EXACT)  # two routes agree
 
 
+def test_auto_takes_the_imu_and_the_wrenches_and_says_so(talos, ft_walk):
+    est = estimate_log(talos, ft_walk, EstimateOptions(diff="true"))
+    assert est.metadata["base_motion"] == {"base": "imu", "wrenches": True}
+    no_imu = estimate_log(talos, dataclasses.replace(ft_walk, imu=None), EstimateOptions(diff="true"))
+    assert no_imu.metadata["base_motion"] == {"base": "logged", "wrenches": True}
+    bare = dataclasses.replace(ft_walk, imu=None, wrench=None)
+    assert estimate_log(talos, bare, EstimateOptions(diff="true")).metadata["base_motion"]["base"] == "contact"
+
+
+def test_central_differences_with_the_wrenches_beat_the_rigid_route(talos):
+    """The ideal walk (one physics step per period: the sensors' instant is the period's) through central
+    differences: the wrench route, every joint in every phase but the touch-downs, against the rigid-contact
+    route's swing samples (measured: max 6e-3 N·m against 8e-3, RMS 5.7e-4 against 1.8e-3)."""
+    friction = {j: THESIS_TARGETS[g] for j, _, g in leg_joints(talos)}
+    ref = walking_reference(talos, GaitOptions(gait="forward", steps=2))
+    log = simulate_ideal(talos, ref, friction, IdealOptions(force_torque=True)).log
+    legs = [talos.torque_controlled.index(j) for j, _, _ in leg_joints(talos)]
+    wrench = estimate_log(talos, log, EstimateOptions(diff="central"))
+    rigid = estimate_log(talos, log, EstimateOptions(diff="central", base_motion="contact", wrenches=False))
+    def rms(est):
+        valid = est.valid[:, legs]
+        return float(np.sqrt(np.mean((est.tau_f - est.tau_f_true)[:, legs][valid] ** 2)))
+    assert wrench.valid[:, legs].mean() > 0.95 > 0.3 > rigid.valid[:, legs].mean()
+    assert rms(wrench) < 0.5 * rms(rigid) < 1e-3
+
+
 def test_the_wrenches_make_every_sample_usable(talos, ft_walk):
     """The share of samples giving a valid estimate per joint: swing-only single support before, all after."""
-    before = estimate_log(talos, ft_walk, EstimateOptions(diff="true", wrenches=False)).valid.mean(axis=0)
+    rigid = EstimateOptions(diff="true", base_motion="contact", wrenches=False)
+    before = estimate_log(talos, ft_walk, rigid).valid.mean(axis=0)
     after = estimate_log(talos, ft_walk, EstimateOptions(diff="true")).valid.mean(axis=0)
     legs = talos.limb_mask.any(axis=0)
     assert np.all(before[legs] < 0.3) and np.all(after == 1.0)
@@ -89,7 +118,7 @@ def test_estimate_says_which_base_motion_it_used(talos, ft_walk, tmp_path, capsy
     write_log(ft_walk, talos, tmp_path / "walk.parquet")
     code, err = run_cli(capsys, "estimate", tmp_path / "walk.parquet", "-o", tmp_path / "f.parquet", "--diff",
                         "true")
-    assert code == 0 and "base motion: logged; wrenches: every joint in every phase" in err
+    assert code == 0 and "base motion: imu; wrenches: every joint in every phase" in err
     routes = pq.read_table(tmp_path / "f.parquet", columns=["route"]).column("route").to_pylist()
     assert set(routes) == {"wrench"}
     code, err = run_cli(capsys, "estimate", tmp_path / "walk.parquet", "-o", tmp_path / "g.parquet",

@@ -157,7 +157,7 @@ def test_swing_estimate_is_reliable_and_stance_is_not_on_mujoco(talos, mj_talos)
     ref = walking_reference(talos, GaitOptions(gait="forward", steps=4))
     log = simulate_mujoco(talos, ref, {knee: THESIS_TARGETS["knee"]}, mjr=mj_talos).log
     assert log.metadata["contact_source"].startswith("sole normal force")
-    est = estimate_log(talos, log, EstimateOptions(mask="single", wrenches=False))  # the thesis's route
+    est = estimate_log(talos, log, EstimateOptions(mask="single", base_motion="contact", wrenches=False))  # thesis
     i = est.joints.index(knee)
     err = est.tau_f[:, i] - est.tau_f_true[:, i]
     right = talos.contact_of(knee)

@@ -64,7 +64,7 @@ def test_with_the_sensors_every_leg_joint_is_exact_on_soft_contacts(talos, mujoc
     contact is not, misses it by up to newton-metres."""
     legs = [talos.torque_controlled.index(j) for j, _, _ in leg_joints(talos)]
     wrench = estimate_log(talos, mujoco_walk, EstimateOptions(diff="true", base_motion="logged"))
-    contact = estimate_log(talos, mujoco_walk, EstimateOptions(diff="true", wrenches=False))
+    contact = estimate_log(talos, mujoco_walk, EstimateOptions(diff="true", base_motion="contact", wrenches=False))
     err_w = np.abs(wrench.tau_f - wrench.tau_f_true)[:, legs]
     err_c = np.abs(contact.tau_f - contact.tau_f_true)[:, legs]
     assert wrench.valid[:, legs].all()
@@ -88,7 +88,7 @@ def test_a_compliant_sole_leaves_the_measured_route_and_degrades_the_rigid_one(t
     friction = {j: THESIS_TARGETS[g] for j, _, g in leg_joints(talos)}
     ref = walking_reference(talos, GaitOptions(gait="forward", steps=4))
     measured = EstimateOptions(diff="central", base_motion="logged")
-    rigid = EstimateOptions(diff="central", wrenches=False)
+    rigid = EstimateOptions(diff="central", base_motion="contact", wrenches=False)
     shares = {}
     for timeconst in (None, 0.04):
         log = simulate_mujoco(talos, ref, friction, MujocoOptions(sole_timeconst=timeconst)).log

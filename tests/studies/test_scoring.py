@@ -55,11 +55,17 @@ def _no_file(*args, **kwargs) -> None:
     """A figure or log writer that writes nothing (the test is about the scores)."""
 
 
+class _FrictionLog(dict):
+    """The friction injected, standing in for the simulated log (no sensors logged)."""
+
+    wrench = None
+
+
 def test_realistic_study_scores_each_leg_joint_against_its_own_friction(talos, tmp_path, monkeypatch):
     # the simulator hands the friction it was asked to inject to the estimator, which returns it exactly
     monkeypatch.setattr(realistic, "build_mujoco_robot", lambda robot: None)
     monkeypatch.setattr(realistic, "_simulate", lambda robot, mjr, gait, friction, options:
-                        SimpleNamespace(log=friction))
+                        SimpleNamespace(log=_FrictionLog(friction)))
     monkeypatch.setattr(realistic, "estimate_log", lambda robot, friction, options: exact_estimate(robot, friction))
     for name in ("write_log", "velocity_panels_figure", "friction_curves_figure"):
         monkeypatch.setattr(realistic, name, _no_file)

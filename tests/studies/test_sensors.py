@@ -19,7 +19,7 @@ def test_the_wrenches_use_every_sample_and_beat_the_rigid_route(study):
     _, result = study
     assert len(result.rows) == 12
     for row in result.rows:
-        assert row.usable["wrench"] > 0.99 and row.usable["contact"] < 0.35  # all but the first and last rows
+        assert row.usable["wrench"] > 0.95 and row.usable["contact"] < 0.35  # all but the touch-downs' 20 ms
         assert row.samples[("wrench", "stance")] > row.samples[("wrench", "swing")] > 0
     contact, wrench = result.worst("contact", "swing"), result.worst("wrench", "swing")
     assert all(wrench[n] < contact[n] for n in ("F_c", "F_v", "tau_os"))

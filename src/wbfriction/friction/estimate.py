@@ -26,7 +26,15 @@ from typing import Any, Literal, cast, get_args
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.measured import BASE_MOTIONS, BaseMotion, base_route, resolve_base_motion, wrench_route
+from wbfriction.friction.measured import (
+    BASE_MOTIONS,
+    BaseMotion,
+    base_route,
+    impacts,
+    measured_base,
+    resolve_base_motion,
+    wrench_route,
+)
 from wbfriction.logs.log import Log
 from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
@@ -44,6 +52,7 @@ from wbfriction.signals.kinematics import (
     Velocity,
     joined_smoother,
     measure,
+    straddling,
 )
 from wbfriction.signals.phases import Mask, Phases, joint_mask, segment
 
@@ -311,10 +320,13 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     unique = ss.copy()
     route = np.where(np.any(np.isfinite(tau_f), axis=1), "contact", "none").astype("<U7")
     if with_wrenches:  # every joint, every phase
-        tau_m, done = wrench_route(robot, kin, kin.valid, kin.base_qd is not None)
+        rows = kin.valid
+        if options.diff != "true":  # not across a touch-down: its impact is smeared by the differentiation
+            rows = rows & ~straddling(kin.contact) & ~impacts(robot, kin)
+        tau_m, done = wrench_route(robot, kin, rows)
         valid[done] = np.isfinite(tau_m[done])
         _measured(tau_f, delta, unique, route, tau_m, done, "wrench")
-    elif kin.base_qdd is not None:  # every joint in single support; the mask stays
+    elif measured_base(kin) != "contact":  # every joint in single support; the mask stays
         tau_m, done = base_route(robot, kin, usable & phases.single)
         valid[done] = (joint_mask(phases, robot.limb_mask, options.mask) & np.isfinite(tau_m))[done]
         _measured(tau_f, delta, unique, route, tau_m, done, "base")
@@ -416,10 +428,14 @@ def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress
     if options.diff == "auto":
         raise InputError("diff 'auto' is resolved once per log (resolve_differentiation), not per segment")
     has_wrench = options.wrenches and log.wrench is not None
-    base_motion = resolve_base_motion(options.base_motion, log.base is not None, has_wrench)
+    has_imu = log.imu is not None and robot.imu is not None
+    base_motion = resolve_base_motion(options.base_motion, log.base is not None, has_wrench, has_imu)
+    if base_motion == "imu" and (robot.imu is None or log.base is None):
+        raise InputError(f"{log.source}: --base-motion imu needs the robot's [imu] (its TOML) and the base "
+                         "orientation columns base.qx ... base.qw")
     kin = measure(log, options.diff, compensate_delay=options.compensate_delay,
                   torque_alignment=options.torque_alignment, filtering=options.filtering, velocity=options.velocity,
-                  base_motion=base_motion == "logged")
+                  base_motion=base_motion == "logged", imu=base_motion == "imu")
     kin.metadata.update(robot=robot.name, source=log.source)
     kin.metadata["base_motion"] = {"base": base_motion, "wrenches": has_wrench}
     est = estimate_friction(robot, kin, options, progress, require_single_support, gaps)

@@ -6,11 +6,13 @@ Two routes beside the rigid-contact one of :mod:`wbfriction.friction.estimate`, 
 * ``wrench``: the force-torque sensors' wrenches close the base's six equations, so ``tau_f`` is
   unique for **every** torque-controlled joint in **every** phase (stance leg, double support, flight).
   The base's orientation and angular velocity come from the logged base pose (``base_motion =
-  "logged"``) or, from the stance contacts as in the rigid-contact route (``"contact"``: a foot on the
-  ground, flat, not moving); its acceleration from the base rows.
-* ``base``: the base's acceleration measured (its logged pose differentiated on SO(3)), no wrench: in
-  single support the stance contact's wrench follows from the base's six rows, so ``tau_f`` is unique
-  for every joint (the stance leg's included); in double support it is not.
+  "logged"``), from the IMU's gyro and the logged orientation (``"imu"``), or from the stance contacts
+  as in the rigid-contact route (``"contact"``: a foot on the ground, flat, not moving); its
+  acceleration from the base rows.
+* ``base``: the base's acceleration measured (its logged pose differentiated on SO(3), or the IMU's
+  gyro differentiated once and its accelerometer, :func:`~wbfriction.model.imu.base_motion_from_imu`),
+  no wrench: in single support the stance contact's wrench follows from the base's six rows, so
+  ``tau_f`` is unique for every joint (the stance leg's included); in double support it is not.
 
 Sign convention: ``tau_f = tau_joint - tau``, the torque friction exerts on the joint.
 """
@@ -21,50 +23,78 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, sensed_contacts
 from wbfriction.model.dynamics import floating_base_state
+from wbfriction.model.imu import base_motion_from_imu
 from wbfriction.model.measured_dynamics import measured_inverse_dynamics
 from wbfriction.model.robot import Robot
 from wbfriction.signals.kinematics import MeasuredKinematics
 
-BaseMotion = Literal["auto", "contact", "logged"]
+BaseMotion = Literal["auto", "contact", "logged", "imu"]
 """Where the base's motion comes from: the rigid contacts (the thesis's route), the logged base pose
-differentiated like the joints, or ``auto``: logged where the log has a base pose and the sensors'
-wrenches, contact otherwise (:func:`resolve_base_motion`)."""
+differentiated like the joints, the IMU (its gyro and accelerometer, the logged base orientation), or
+``auto`` (:func:`resolve_base_motion`)."""
 BASE_MOTIONS: tuple[BaseMotion, ...] = get_args(BaseMotion)
 
 Route = Literal["contact", "base", "wrench", "none"]
 """How a sample's friction was estimated: rigid contacts, measured base motion, measured wrenches, or not."""
 
 
-def resolve_base_motion(choice: BaseMotion, has_base: bool, has_wrench: bool) -> Literal["contact", "logged"]:
-    """The base motion ``auto`` stands for: ``logged`` with a logged base pose and wrenches (the base's
-    orientation and angular velocity measured rather than assumed from a flat, still stance foot),
-    ``contact`` otherwise (a log's base pose alone is often the output of a state estimator that
-    assumes the same rigid contact, and differentiating it twice adds its noise)."""
+def resolve_base_motion(choice: BaseMotion, has_base: bool, has_wrench: bool, has_imu: bool = False
+                        ) -> Literal["contact", "logged", "imu"]:
+    """The base motion ``auto`` stands for: ``imu`` with an IMU and a logged base orientation (measured
+    rates, one differentiation); else ``logged`` with a logged base pose and wrenches (the base's
+    orientation and angular velocity measured rather than assumed from a flat, still stance foot); else
+    ``contact`` (a log's base pose alone is often the output of a state estimator that assumes the
+    same rigid contact, and differentiating it twice adds its noise)."""
     if choice != "auto":
         return choice
+    if has_imu and has_base:
+        return "imu"
     return "logged" if has_base and has_wrench else "contact"
 
 
-def wrench_route(robot: Robot, kin: MeasuredKinematics, rows: np.ndarray, logged_base: bool
-                 ) -> tuple[np.ndarray, np.ndarray]:
-    """Friction from the measured wrenches (module docstring) on the rows ``rows`` (N,) of ``kin``.
+IMPACT_SKIP = 0.02
+"""Seconds left out from a sole's first touch of the ground (its normal force over 1 % of the robot's
+weight, before its contact flag rises; from two rows before): the impact's jerk, which differentiated
+accelerations smear over their stencil while the sensors read it at its instants (MuJoCo, central
+differences: up to 0.9 N·m)."""
+
+
+def impacts(robot: Robot, kin: MeasuredKinematics, skip: float = IMPACT_SKIP) -> np.ndarray:
+    """(N,) the rows from two before a sole's first touch (:data:`IMPACT_SKIP`) to ``skip`` seconds after it,
+    from the measured wrenches of the sensed contacts (:func:`~wbfriction.logs.contacts.normal_forces`);
+    all False without wrenches."""
+    out = np.zeros(len(kin.time), dtype=bool)
+    if kin.wrench is None or not sensed_contacts(robot):
+        return out
+    on, _ = default_thresholds(robot)
+    touching = hysteresis(normal_forces(robot, kin.wrench), 0.1 * on, 0.05 * on)  # 1 % and 0.5 % of the weight
+    for c in range(touching.shape[1]):
+        for k in np.flatnonzero(touching[1:, c] & ~touching[:-1, c]) + 1:
+            out[max(k - 2, 0):np.searchsorted(kin.time, kin.time[k] + skip, side="right")] = True
+    return out
+
+
+def measured_base(kin: MeasuredKinematics) -> Literal["contact", "logged", "imu"]:
+    """Where ``kin``'s base motion comes from: its IMU rates, its differentiated base pose, or neither."""
+    return "imu" if kin.imu is not None else "logged" if kin.base_qd is not None else "contact"
+
+
+def wrench_route(robot: Robot, kin: MeasuredKinematics, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Friction from the measured wrenches (module docstring) on the rows ``rows`` (N,) of ``kin``, the base's
+    orientation and angular velocity from :func:`measured_base`.
 
     Returns:
         ``(tau_f, done)``: (N, n_tc) [N·m], NaN where not estimated, and (N,) the rows estimated: those
-        of ``rows`` whose wrenches (and, with ``logged_base``, base twist) are finite and, with the
-        base from the contacts, that have a foot on the ground.
+        of ``rows`` whose wrenches (and measured base rates) are finite and, with the base from the
+        contacts, that have a foot on the ground.
     """
     assert kin.wrench is not None
     n = len(kin.time)
-    ok = rows & np.all(np.isfinite(kin.wrench.reshape(n, -1)), axis=1)
-    if logged_base:
-        assert kin.base_qd is not None and kin.base is not None
-        ok &= np.all(np.isfinite(kin.base_qd), axis=1)
-    else:
-        ok &= kin.contact.any(axis=1)
+    ok = rows & np.all(np.isfinite(kin.wrench.reshape(n, -1)), axis=1) & _finite_base(kin)
     r = np.flatnonzero(ok)
-    q, v = _base_state(robot, kin, r, logged_base)
+    q, v, _ = _base_state(robot, kin, r)
     dyn = measured_inverse_dynamics(robot, q, v, kin.qdd[r], wrench=kin.wrench[r])
     tau_f = np.full((n, robot.tc_index.size), np.nan)
     tau_f[r] = dyn.tau[:, robot.tc_index] - kin.tau[r]
@@ -74,32 +104,53 @@ def wrench_route(robot: Robot, kin: MeasuredKinematics, rows: np.ndarray, logged
 def base_route(robot: Robot, kin: MeasuredKinematics, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Friction from the measured base acceleration, no wrench (module docstring), on the rows ``rows``
     (N,) of ``kin`` that have at most one contact; returns ``(tau_f, done)`` as :func:`wrench_route`."""
-    assert kin.base_qd is not None and kin.base_qdd is not None
     n = len(kin.time)
-    ok = (rows & (kin.contact.sum(axis=1) <= 1) & np.all(np.isfinite(kin.base_qd), axis=1)
-          & np.all(np.isfinite(kin.base_qdd), axis=1))
+    ok = rows & (kin.contact.sum(axis=1) <= 1) & _finite_base(kin)
     r = np.flatnonzero(ok)
-    q, v = _base_state(robot, kin, r, True)
-    dyn = measured_inverse_dynamics(robot, q, v, kin.qdd[r], base_acceleration=kin.base_qdd[r],
-                                    contact=kin.contact[r])
+    q, v, a_b = _base_state(robot, kin, r)
+    assert a_b is not None  # a measured base
+    dyn = measured_inverse_dynamics(robot, q, v, kin.qdd[r], base_acceleration=a_b, contact=kin.contact[r])
     tau_f = np.full((n, robot.tc_index.size), np.nan)
     tau_f[r] = dyn.tau[:, robot.tc_index] - kin.tau[r]
     return tau_f, ok
 
 
-def _base_state(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, logged_base: bool
-                ) -> tuple[np.ndarray, np.ndarray]:
-    """Full ``q`` (len(r), nq) and ``v`` (len(r), nv) of the rows ``r``: the logged base pose and its
-    differentiated twist, or the stance contacts' (flat, not moving: :func:`floating_base_state`)."""
-    if logged_base:
-        assert kin.base is not None and kin.base_qd is not None
+def _finite_base(kin: MeasuredKinematics) -> np.ndarray:
+    """(N,) the rows whose base motion is known: measured rates finite, or a foot on the ground."""
+    source = measured_base(kin)
+    if source == "imu":
+        assert kin.imu is not None and kin.base is not None
+        return np.asarray(np.all(np.isfinite(kin.imu), axis=1))
+    if source == "logged":
+        assert kin.base_qd is not None and kin.base_qdd is not None
+        return np.asarray(np.all(np.isfinite(kin.base_qd), axis=1) & np.all(np.isfinite(kin.base_qdd), axis=1))
+    return np.asarray(kin.contact.any(axis=1))
+
+
+def _base_state(robot: Robot, kin: MeasuredKinematics, r: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """Full ``q`` (len(r), nq), ``v`` (len(r), nv) and the base's measured acceleration (len(r), 6) of the rows
+    ``r``, from :func:`measured_base`: the logged base pose and its differentiated twist, the IMU's rates
+    (:func:`~wbfriction.model.imu.base_motion_from_imu`, the base's linear velocity zero), or the stance
+    contacts' (flat, not moving: :func:`floating_base_state`; no acceleration)."""
+    source = measured_base(kin)
+    if source in ("logged", "imu"):
+        assert kin.base is not None
         q = robot.configuration(kin.q[r], kin.base[r])
         v = np.zeros((r.size, robot.model.nv))
-        v[:, :6], v[:, robot.act_v_index] = kin.base_qd[r], kin.qd[r]
-        return q, v
+        v[:, robot.act_v_index] = kin.qd[r]
+        if source == "logged":
+            assert kin.base_qd is not None and kin.base_qdd is not None
+            v[:, :6] = kin.base_qd[r]
+            return q, v, kin.base_qdd[r]
+        assert kin.imu is not None and robot.imu is not None
+        imu = kin.imu[r]
+        v[:, :6], a_b = base_motion_from_imu(robot.model, robot.imu, q, robot.act_v_index, kin.qd[r], kin.qdd[r],
+                                             imu[:, :3], imu[:, 3:6], imu[:, 6:])
+        return q, v, a_b
     data = robot.model.createData()
     q, v = np.empty((r.size, robot.model.nq)), np.empty((r.size, robot.model.nv))
     for i, k in enumerate(r):
         q[i], v[i], _ = floating_base_state(robot, data, kin.q[k], kin.qd[k], np.flatnonzero(kin.contact[k]).tolist(),
                                             None if kin.base is None else kin.base[k])
-    return q, v
+    return q, v, None

@@ -61,6 +61,8 @@ TorqueSource = Literal["sensor", "current"]
 BASE_COLUMNS = ("base.x", "base.y", "base.z", "base.qx", "base.qy", "base.qz", "base.qw")
 BASE_TWIST_AXES = ("vx", "vy", "vz", "wx", "wy", "wz")
 """Components of a base twist (Pinocchio's free-flyer ``v[:6]``): linear [m/s], then angular [rad/s], base frame."""
+IMU_COLUMNS = tuple(f"imu.{a}" for a in ("gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z"))
+"""An IMU's columns (:mod:`wbfriction.model.imu`): angular velocity [rad/s], specific force [m/s^2], IMU frame."""
 BASE_QD_TRUE_COLUMNS = tuple(f"base_qd_true.{a}" for a in BASE_TWIST_AXES)
 BASE_QDD_TRUE_COLUMNS = tuple(f"base_qdd_true.{a}" for a in BASE_TWIST_AXES)
 
@@ -96,6 +98,8 @@ class Log:
             :attr:`Robot.ft_sensors <wbfriction.model.robot.Robot.ft_sensors>` order, each in its
             sensor frame [N, N·m] (columns ``wrench.<sensor>.fx`` ... ``.tz``,
             :mod:`wbfriction.model.force_torque`), or None if not logged.
+        imu: the IMU's readings (N, 6): angular velocity [rad/s] and specific force [m/s^2] in its frame
+            (columns ``imu.gyro_x`` ... ``imu.acc_z``, :mod:`wbfriction.model.imu`), or None.
         base_qd_true, base_qdd_true: the base's true twist and its derivative (N, 6) in the base
             frame (Pinocchio's free-flyer ``v[:6]`` and ``a[:6]``, simulations only), or None.
         clock: what wrote the stamps and the time base derivatives are taken on
@@ -124,6 +128,7 @@ class Log:
     wrench: np.ndarray | None = None
     base_qd_true: np.ndarray | None = None
     base_qdd_true: np.ndarray | None = None
+    imu: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.segments is None and self.clock is not None and len(self.clock.segments) > 1:
@@ -152,7 +157,7 @@ class Log:
                    cut(self.qdd_true), None, self.dt, cut(self.qd_logged), self.torque_source,
                    clock=None if self.clock is None else self.clock.rows(start, stop), warnings=self.warnings,
                    wrench=cut(self.wrench), base_qd_true=cut(self.base_qd_true),
-                   base_qdd_true=cut(self.base_qdd_true))
+                   base_qdd_true=cut(self.base_qdd_true), imu=cut(self.imu))
 
     def __len__(self) -> int:
         return len(self.time)
@@ -170,7 +175,7 @@ class Log:
             cols.update({f"contact.{n}": self.contact[:, i].astype(np.int8)
                          for i, n in enumerate(robot.contact_frames)})
         for names, x in ((BASE_COLUMNS, self.base), (BASE_QD_TRUE_COLUMNS, self.base_qd_true),
-                         (BASE_QDD_TRUE_COLUMNS, self.base_qdd_true)):
+                         (BASE_QDD_TRUE_COLUMNS, self.base_qdd_true), (IMU_COLUMNS, self.imu)):
             if x is not None:
                 cols.update({c: x[:, i] for i, c in enumerate(names)})
         if self.wrench is not None:
@@ -297,14 +302,15 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
     qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
     base_qd_true = _read_group(table, BASE_QD_TRUE_COLUMNS, source, first_row, "true base twist")
     base_qdd_true = _read_group(table, BASE_QDD_TRUE_COLUMNS, source, first_row, "true base acceleration")
+    imu = _read_group(table, IMU_COLUMNS, source, first_row, "the IMU's reading")
     return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
                qd_true=qd_true, qdd_true=qdd_true, segments=clock.segments, period=period, qd_logged=qd_logged,
                torque_source=torque_source, clock=clock, warnings=warnings, wrench=wrench,
-               base_qd_true=base_qd_true, base_qdd_true=base_qdd_true)
+               base_qd_true=base_qd_true, base_qdd_true=base_qdd_true, imu=imu)
 
 
 NUMERIC_PREFIXES = ("q", "tau", "current", "qd", "qd_true", "qdd_true", "tau_f_true", "base", "wrench",
-                    "base_qd_true", "base_qdd_true")
+                    "base_qd_true", "base_qdd_true", "imu")
 """Column prefixes whose values must be numbers."""
 
 
@@ -335,9 +341,11 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
     for col in names:
         prefix, _, item = col.partition(".")
         known = {"q": act, "tau": act, "tau_f_true": tc, "contact": frames, "qd_true": act,
-                 "qdd_true": act, "qd": act, "current": act, "wrench": wrenches}.get(prefix)
+                 "qdd_true": act, "qd": act, "current": act, "wrench": wrenches,
+                 "imu": {c.partition(".")[2] for c in IMU_COLUMNS}}.get(prefix)
         if known is not None and item not in known:
-            what = {"contact": "contact frame", "wrench": "force-torque sensor (or axis)"}.get(prefix, "joint")
+            what = {"contact": "contact frame", "wrench": "force-torque sensor (or axis)",
+                    "imu": "IMU axis"}.get(prefix, "joint")
             raise ColumnError(source, col, None,
                               f"column '{col}' names an unknown {what} '{item}' of robot '{robot.name}'")
     contact = [f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else []

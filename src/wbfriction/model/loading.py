@@ -22,6 +22,7 @@ import pinocchio as pin
 from wbfriction.config import read_toml
 from wbfriction.exceptions import InputError
 from wbfriction.model.force_torque import parse_sensors
+from wbfriction.model.imu import add_imu_frame
 from wbfriction.model.robot import Robot
 
 BUILTIN_ROBOTS = ("talos", "toro", "panda")
@@ -100,7 +101,8 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
             ``armature`` (joint name -> reflected rotor inertia [kg·m^2], in the dynamics
             through ``model.armature``), ``force_torque`` (six-axis sensors above the contacts:
             :func:`~wbfriction.model.force_torque.parse_sensors`), ``contact_force`` ([on, off] [N]:
-            contact flags from those sensors, :mod:`wbfriction.logs.contacts`), ``balance_gains``
+            contact flags from those sensors, :mod:`wbfriction.logs.contacts`), ``imu`` (link, xyz, rpy:
+            :mod:`wbfriction.model.imu`), ``balance_gains``
             (:attr:`Robot.balance_gains`).
         source: file name used in error messages.
 
@@ -137,6 +139,7 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
         torque_constants=_joint_values(config, "torque_constants", actuated, source, positive=True),
         ft_sensors=parse_sensors(model, config.get("force_torque"), frames, source),
         contact_force=_contact_force(config.get("contact_force"), source),
+        imu=add_imu_frame(model, config.get("imu"), source),
     )
 
 

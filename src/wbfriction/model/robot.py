@@ -31,6 +31,7 @@ import pinocchio as pin
 
 from wbfriction.exceptions import ModelError
 from wbfriction.model.force_torque import ForceTorqueSensor
+from wbfriction.model.imu import Imu
 from wbfriction.model.layout import JointLayout, joint_layout
 
 
@@ -63,6 +64,7 @@ class Robot:
             included), for logs that record motor currents ``current.<joint>`` [A].
         ft_sensors: six-axis force-torque sensors, one per contact at most
             (:mod:`wbfriction.model.force_torque`; ``[force_torque.<name>]`` in the TOML).
+        imu: the inertial measurement unit (:mod:`wbfriction.model.imu`; ``[imu]`` in the TOML), or None.
         contact_force: ``(on, off)`` [N]: the normal forces above which a sensed sole comes into
             contact and below which it leaves it, for logs without ``contact.*`` columns
             (:mod:`wbfriction.logs.contacts`); None: shares of the robot's weight.
@@ -83,6 +85,7 @@ class Robot:
     torque_constants: dict[str, float] = field(default_factory=dict)
     ft_sensors: tuple[ForceTorqueSensor, ...] = ()
     contact_force: tuple[float, float] | None = None
+    imu: Imu | None = None
     cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
     """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.stance`)."""
 

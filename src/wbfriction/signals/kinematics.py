@@ -248,6 +248,8 @@ class MeasuredKinematics:
             ``measure(..., base_motion=True)``), or None.
         wrench: the force-torque sensors' wrenches (N, n_sensors, 6) [N, N·m], aligned and filtered as
             the torques, or None.
+        imu: with ``measure(..., imu=True)``, the IMU's angular velocity, its time derivative and its
+            specific force (N, 9) [rad/s, rad/s^2, m/s^2] in its frame, through the joints' scheme; or None.
     """
 
     time: np.ndarray
@@ -264,6 +266,7 @@ class MeasuredKinematics:
     base_qd: np.ndarray | None = None
     base_qdd: np.ndarray | None = None
     wrench: np.ndarray | None = None
+    imu: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.valid is None:
@@ -304,7 +307,7 @@ VELOCITIES: tuple[Velocity, ...] = get_args(Velocity)
 def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
             torque_alignment: TorqueAlignment | Literal["auto"] = "auto",
             filtering: FilterOptions = FilterOptions(), velocity: Velocity = "differentiated",
-            base_motion: bool = False) -> MeasuredKinematics:
+            base_motion: bool = False, imu: bool = False) -> MeasuredKinematics:
     """Differentiate a log's joint positions and align the other signals (6.1.2, 7.1).
 
     Args:
@@ -328,12 +331,18 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
             ``base_qdd_true``). The force-torque sensors' wrenches, when logged, are aligned and
             filtered as the torques are: a sensor's reading is its mean over the sampling period (its
             anti-aliasing), as a held torque is the period's torque.
+        imu: also pass the log's IMU readings through: the gyro differentiated once with the joints'
+            scheme and filter (the scheme is applied to its running integral, so that its rate and its
+            derivative come out of the same filter as the joints' ``qd`` and ``qdd``), the specific force
+            aligned and filtered as the torques; ``"true"``: the gyro as logged, its derivative by
+            central differences.
 
     Raises:
         InputError: unknown scheme, alignment or velocity source, filter parameters that make
             no filter, a log too short for the filter; ``"true"`` on a log without
             ``qd_true``/``qdd_true`` columns; ``logged`` on a log without ``qd.<joint>`` columns;
-            ``base_motion`` on a log without a base pose (with ``"true"``: without its true rates).
+            ``base_motion`` on a log without a base pose (with ``"true"``: without its true rates);
+            ``imu`` on a log without ``imu.*`` columns.
     """
     if velocity not in VELOCITIES:
         raise InputError(f"unknown velocity source '{velocity}': choose one of {', '.join(VELOCITIES)}")
@@ -341,6 +350,8 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
         raise InputError(f"{log.source}: --velocity logged needs the columns qd.<joint> of every actuated joint")
     if base_motion and log.base is None:
         raise InputError(f"{log.source}: a measured base motion needs the base pose columns base.x ... base.qw")
+    if imu and log.imu is None:
+        raise InputError(f"{log.source}: --base-motion imu needs the columns imu.gyro_x ... imu.acc_z")
     if diff == "true":
         if log.qd_true is None or log.qdd_true is None:
             raise InputError(f"{log.source}: diff 'true' needs the columns qd_true.* and qdd_true.* "
@@ -348,25 +359,35 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
         if base_motion and (log.base_qd_true is None or log.base_qdd_true is None):
             raise InputError(f"{log.source}: diff 'true' with a measured base motion needs the columns "
                              "base_qd_true.* and base_qdd_true.* (written by the simulators)")
+        imu_rates = None
+        if imu:
+            assert log.imu is not None  # checked above
+            imu_rates = np.hstack([log.imu[:, :3], np.gradient(log.imu[:, :3], log.time, axis=0), log.imu[:, 3:]])
         return MeasuredKinematics(
             time=log.time, q=log.q, qd=log.qd_true, qdd=log.qdd_true, tau=log.tau, contact=log.contact,
             base=log.base, tau_f_true=log.tau_f_true, metadata=dict(log.metadata), wrench=log.wrench,
-            base_qd=log.base_qd_true if base_motion else None, base_qdd=log.base_qdd_true if base_motion else None)
+            base_qd=log.base_qd_true if base_motion else None, base_qdd=log.base_qdd_true if base_motion else None,
+            imu=imu_rates)
     if diff not in SCHEMES:
         raise InputError(f"unknown differentiation scheme '{diff}': choose one of {', '.join(SCHEMES)}, true")
     n, n_act, n_tc = len(log.time), log.q.shape[1], log.tau.shape[1]
-    # the base pose and the wrenches go through the joints' path, as more columns
-    extended = log
-    if base_motion:
-        assert log.base is not None  # checked above
-        extended = replace(extended, q=np.hstack([log.q, continuous_quaternions(log.base)]))
-    if log.wrench is not None:
-        extended = replace(extended, tau=np.hstack([log.tau, log.wrench.reshape(n, -1)]))
+    # the base pose, the gyro's integral, the wrenches and the specific force go through the joints' path,
+    # as more columns: positions [joints, base pose, gyro integral], torques [joints, wrenches, acc]
+    extra_q = ([continuous_quaternions(log.base)] if base_motion and log.base is not None else []) + \
+        ([_running_integral(log.imu[:, :3], _times(log))] if imu and log.imu is not None else [])
+    extra_tau = ([log.wrench.reshape(n, -1)] if log.wrench is not None else []) + \
+        ([log.imu[:, 3:]] if imu and log.imu is not None else [])
+    extended = replace(log, q=np.hstack([log.q, *extra_q]), tau=np.hstack([log.tau, *extra_tau]))
     q, qd, qdd, tau, smoother, metadata = _derivatives(extended, diff, compensate_delay, torque_alignment, filtering)
-    base_qd = base_qdd = None
+    base_qd = base_qdd = imu_rates = None
     if base_motion:
-        base_qd, base_qdd = base_twist_and_acceleration(q[:, n_act:], qd[:, n_act:], qdd[:, n_act:])
-    wrench = None if log.wrench is None else tau[:, n_tc:].reshape(n, -1, 6)
+        base_qd, base_qdd = base_twist_and_acceleration(q[:, n_act:n_act + 7], qd[:, n_act:n_act + 7],
+                                                        qdd[:, n_act:n_act + 7])
+    n_w = 0 if log.wrench is None else log.wrench.shape[1] * 6
+    wrench = None if log.wrench is None else tau[:, n_tc:n_tc + n_w].reshape(n, -1, 6)
+    if imu:
+        g = slice(q.shape[1] - 3, q.shape[1])
+        imu_rates = np.hstack([qd[:, g], qdd[:, g], tau[:, n_tc + n_w:n_tc + n_w + 3]])
     q, qd, qdd, tau = q[:, :n_act], qd[:, :n_act], qdd[:, :n_act], tau[:, :n_tc]
     if velocity == "logged":
         assert log.qd_logged is not None  # checked above
@@ -377,7 +398,20 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
     return MeasuredKinematics(
         time=log.time, q=q, qd=qd, qdd=qdd, tau=tau, contact=log.contact, base=log.base,
         tau_f_true=log.tau_f_true, metadata=metadata, smoother=smoother, base_qd=base_qd, base_qdd=base_qdd,
-        wrench=wrench)
+        wrench=wrench, imu=imu_rates)
+
+
+def _times(log: Log) -> np.ndarray:
+    """The times (N,) [s] the log is differentiated on: its non-uniform time base, or its constant period's."""
+    t = time_base(log)
+    return log.dt * np.arange(len(log.time)) if t is None else t
+
+
+def _running_integral(x: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The trapezoidal running integral of ``x`` (N, m) over the times ``t`` (N,), zero at the first row."""
+    out = np.zeros_like(x, dtype=float)
+    out[1:] = np.cumsum(0.5 * (x[1:] + x[:-1]) * np.diff(t)[:, None], axis=0)
+    return out
 
 
 def _derivatives(log: Log, diff: Diff, compensate_delay: bool, torque_alignment: TorqueAlignment | Literal["auto"],

@@ -11,6 +11,7 @@ from wbfriction.friction.models import FrictionParams, coulomb_viscous_stribeck,
 from wbfriction.friction.targets import friction_by_group
 from wbfriction.logs.log import Log
 from wbfriction.model.force_torque import sensor_readings
+from wbfriction.model.imu import imu_readings
 from wbfriction.model.robot import Robot
 from wbfriction.walking import WalkingReference
 
@@ -116,11 +117,13 @@ class SimulationResult:
 
 def simulated_log(robot: Robot, reference: WalkingReference, Q: np.ndarray, V: np.ndarray, A: np.ndarray,
                   tau: np.ndarray, tau_f: np.ndarray, contact: np.ndarray, friction: InjectedFriction,
-                  generator: str, options, log_base: bool, wrench: np.ndarray | None = None, **metadata) -> Log:
+                  generator: str, options, log_base: bool, wrench: np.ndarray | None = None,
+                  imu: np.ndarray | None = None, **metadata) -> Log:
     """A simulated walk in the log format: joint angles and the true joint velocities and
     accelerations from the full states ``Q`` (N, nq), ``V``, ``A`` (N, nv), torques and
     friction of the torque-controlled joints, contact flags, the base pose and its true twist and
-    acceleration if ``log_base``, the force-torque sensors' ``wrench`` (N, n_sensors, 6) if given;
+    acceleration if ``log_base``, the force-torque sensors' ``wrench`` (N, n_sensors, 6) and the ``imu``'s
+    readings (N, 6) if given;
     metadata: the generator, its options, the gait, the true friction, and ``metadata``."""
     iq, iv = robot.act_q_index, robot.act_v_index
     meta = {"generator": generator, "options": asdict(options), "gait": asdict(reference.plan.options),
@@ -128,7 +131,7 @@ def simulated_log(robot: Robot, reference: WalkingReference, Q: np.ndarray, V: n
     base = (Q[:, :7].copy(), V[:, :6].copy(), A[:, :6].copy()) if log_base else (None, None, None)
     return Log(reference.time.copy(), Q[:, iq], tau, contact, base[0], tau_f, meta,
                source=generator.rsplit(".", 1)[-1], qd_true=V[:, iv], qdd_true=A[:, iv], wrench=wrench,
-               base_qd_true=base[1], base_qdd_true=base[2])
+               base_qd_true=base[1], base_qdd_true=base[2], imu=imu)
 
 
 class Recording:
@@ -156,18 +159,22 @@ class Recording:
 
     def result(self, Q: np.ndarray, V: np.ndarray, A: np.ndarray, contact: np.ndarray, generator: str, options,
                *, Q_log: np.ndarray | None = None, tau_noise: np.ndarray | None = None, log_sensors: bool = False,
-               sensor_wrench: np.ndarray | None = None, **metadata) -> SimulationResult:
+               log_imu: bool = False, sensor_wrench: np.ndarray | None = None, imu: np.ndarray | None = None,
+               **metadata) -> SimulationResult:
         """The :func:`simulated_log` of the true states ``Q``, ``V``, ``A`` (its configurations ``Q_log`` if
         given, its torques plus ``tau_noise`` if given) and the :class:`SimulationResult` around it.
         With ``log_sensors``, the log carries what the robot's force-torque sensors measure
         (:func:`~wbfriction.model.force_torque.sensor_readings` of :attr:`wrench`, which must then be
-        the contact wrenches that go with ``A``); ``sensor_wrench`` (N, n_sensors, 6), what a simulator's own
-        sensors measured, is logged as it is."""
+        the contact wrenches that go with ``A``); with ``log_imu``, what the robot's IMU reads
+        (:func:`~wbfriction.model.imu.imu_readings`); ``sensor_wrench`` (N, n_sensors, 6) and ``imu`` (N, 6),
+        what a simulator's own sensors measured, are logged as they are."""
         tau = self.tau if tau_noise is None else self.tau + tau_noise
         wrench = sensor_wrench if sensor_wrench is not None and sensor_wrench.shape[1] else None
         if log_sensors and self.robot.ft_sensors:
             wrench = sensor_readings(self.robot.model, self.robot.ft_sensors, self.robot.contact_frames, Q, V, A,
                                      self.wrench)
+        if log_imu and self.robot.imu is not None:
+            imu = imu_readings(self.robot.model, self.robot.imu, Q, V, A)
         log = simulated_log(self.robot, self.reference, Q if Q_log is None else Q_log, V, A, tau, self.tau_f, contact,
-                            self.friction, generator, options, options.log_base, wrench, **metadata)
+                            self.friction, generator, options, options.log_base, wrench, imu, **metadata)
         return SimulationResult(log, self.wrench, Q, V, self.reference, tuple(self.robot.contact_frames))

@@ -73,6 +73,8 @@ class IdealOptions:
             (:attr:`~wbfriction.model.robot.Robot.ft_sensors`, columns ``wrench.<sensor>.*``: the
             contact wrenches and the motion of the part below each sensor,
             :func:`~wbfriction.model.force_torque.sensor_readings`).
+        imu: write what the robot's IMU reads (:attr:`~wbfriction.model.robot.Robot.imu`, columns
+            ``imu.*``, :func:`~wbfriction.model.imu.imu_readings`).
         projection: ``"sample"``: project the velocity onto the constraints at every
             logged sample (the logged state satisfies ``J v = 0`` exactly: ground truth to
             1e-9 N·m); ``"touch-down"``: only at contact changes, Baumgarte correcting the
@@ -88,6 +90,7 @@ class IdealOptions:
     log_base: bool = True
     projection: str = "sample"
     force_torque: bool = False
+    imu: bool = False
 
     def __post_init__(self) -> None:
         if self.integrator not in INTEGRATORS:
@@ -280,7 +283,7 @@ class _IdealRun:
         alignment = "sample" if self.semi_implicit and self.options.substeps == 1 else "zoh"
         return self.recording.result(self.Q, self.V, self.A, self.ref.contact.copy(),
                                      "wbfriction.sim.ideal.simulate_ideal", self.options, torque_alignment=alignment,
-                                     log_sensors=self.options.force_torque)
+                                     log_sensors=self.options.force_torque, log_imu=self.options.imu)
 
 
 def simulate_ideal(robot: Robot, reference: WalkingReference,

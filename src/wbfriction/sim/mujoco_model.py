@@ -128,6 +128,7 @@ class MujocoRobot:
         ft_index: ``sensordata`` addresses (n_sensors, 6) of each force-torque sensor's force and torque,
             in :attr:`Robot.ft_sensors <wbfriction.model.robot.Robot.ft_sensors>` order (the sign of
             MuJoCo's turned into :mod:`wbfriction.model.force_torque`'s by :meth:`wrenches`).
+        imu_index: ``sensordata`` addresses (6,) of the IMU's gyro and accelerometer, or empty.
         joint_ids: MuJoCo joint id of each actuated joint.
         base_body: body id of the floating base (the free joint's body).
 
@@ -144,6 +145,7 @@ class MujocoRobot:
     joint_ids: np.ndarray
     base_body: int
     ft_index: np.ndarray
+    imu_index: np.ndarray
 
     def wrenches(self, sensordata: np.ndarray) -> np.ndarray:
         """The force-torque sensors' wrenches (n_sensors, 6) in :mod:`wbfriction.model.force_torque`'s
@@ -216,6 +218,7 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
     footprints = [sole_footprint(robot, f, root) for f in robot.contact_frames]
     spec = _urdf_spec(robot, timestep)
     _add_soles(spec, robot, footprints)
+    _add_imu(spec, robot)
     _add_motors(spec, robot)
     try:
         mj = spec.compile()
@@ -303,6 +306,23 @@ def _add_sensor_plates(spec: mujoco.MjSpec, robot: Robot) -> dict[str, tuple[muj
     return plates
 
 
+def _add_imu(spec: mujoco.MjSpec, robot: Robot) -> None:
+    """The robot's IMU (:mod:`wbfriction.model.imu`), if any: a site at its frame with MuJoCo's ``gyro`` and
+    ``accelerometer`` sensors (``imu_gyro``, ``imu_acc``: angular velocity and specific force, site frame)."""
+    import mujoco
+    if robot.imu is None:
+        return
+    model = robot.model
+    frame = model.frames[robot.imu.frame]
+    body = spec.body(_body_of_joint(model, frame.parentJoint))
+    if body is None:
+        raise ModelError("MuJoCo has no body for the link carrying the IMU")
+    body.add_site(name="imu", pos=frame.placement.translation,
+                  quat=pin.Quaternion(frame.placement.rotation).coeffs()[[3, 0, 1, 2]])
+    for name, kind in (("imu_gyro", mujoco.mjtSensor.mjSENS_GYRO), ("imu_acc", mujoco.mjtSensor.mjSENS_ACCELEROMETER)):
+        spec.add_sensor(name=name, type=kind, objtype=mujoco.mjtObj.mjOBJ_SITE, objname="imu")
+
+
 def _spec_inertia(body: mujoco.MjsBody) -> pin.Inertia:
     """The explicit inertia of a MuJoCo spec body (from its URDF ``<inertial>``) as Pinocchio's, in its frame."""
     if np.isfinite(body.fullinertia[0]):
@@ -360,8 +380,11 @@ def _mujoco_robot(robot: Robot, mj: mujoco.MjModel) -> MujocoRobot:
     ft = np.array([np.r_[[mj.sensor_adr[mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_SENSOR, f"ft_{s.name}_{kind}")] + i
                           for kind in ("force", "torque") for i in range(3)]] for s in robot.ft_sensors],
                   dtype=int).reshape(len(robot.ft_sensors), 6)
+    imu = (np.r_[[mj.sensor_adr[mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_SENSOR, name)] + i
+                  for name in ("imu_gyro", "imu_acc") for i in range(3)]].astype(int)
+           if robot.imu is not None else np.zeros(0, dtype=int))
     return MujocoRobot(robot, mj, np.array(qpos_index), np.array(dof_index), soles, touch, np.array(joint_ids), base,
-                       ft)
+                       ft, imu)
 
 
 def _body_of_joint(model: pin.Model, joint: int) -> str:

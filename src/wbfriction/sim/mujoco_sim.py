@@ -109,6 +109,10 @@ class MujocoOptions:
             (the sign per joint drawn from ``sensors.seed``): a slow sensor drift, off by default.
         ft_offset: standard deviations of constant offsets of the force-torque sensors' forces [N] and
             torques [N·m], drawn per sensor and axis from ``sensors.seed``; off by default.
+        imu: write what the robot's IMU reads (``imu.*``: MuJoCo's ``gyro`` and ``accelerometer`` at its
+            frame, averaged over the period's physics steps).
+        imu_noise: standard deviations of the gyro's [rad/s] and the accelerometer's [m/s^2] white noise.
+        imu_bias: standard deviations of their constant biases, drawn per axis from ``sensors.seed``.
     """
 
     substeps: int = 4
@@ -127,6 +131,9 @@ class MujocoOptions:
     sole_timeconst: float | None = None
     torque_drift: float = 0.0
     ft_offset: tuple[float, float] = (0.0, 0.0)
+    imu: bool = True
+    imu_noise: tuple[float, float] = (0.0, 0.0)
+    imu_bias: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
         if self.substeps < 1:
@@ -139,8 +146,16 @@ class MujocoOptions:
             raise InputError(f"the delay must be >= 0 s, got {self.delay}")
         if self.sole_timeconst is not None and not self.sole_timeconst > 0:
             raise InputError(f"the soles' contact time constant must be > 0 s, got {self.sole_timeconst}")
-        if self.torque_drift < 0 or min(self.ft_offset) < 0:
-            raise InputError("the torque drift rate and the force-torque offsets' standard deviations must be >= 0")
+        if self.torque_drift < 0 or min(self.ft_offset) < 0 or min(self.imu_noise) < 0 or min(self.imu_bias) < 0:
+            raise InputError("the torque drift rate and the standard deviations of the force-torque offsets and "
+                             "of the IMU's noise and biases must be >= 0")
+
+    def imu_errors(self, n: int) -> np.ndarray:
+        """The IMU's white noise plus constant biases over ``n`` periods (n, 6): gyro [rad/s], accelerometer
+        [m/s^2], from :attr:`imu_noise`, :attr:`imu_bias` and the sensors' seed (zeros where off)."""
+        rng = np.random.default_rng([self.sensors.seed, 6])
+        noise = rng.normal(0.0, 1.0, (n, 6)) * np.repeat(np.asarray(self.imu_noise, dtype=float), 3)
+        return noise + rng.normal(0.0, 1.0, 6) * np.repeat(np.asarray(self.imu_bias, dtype=float), 3)
 
     def imperfections(self, n: int, dt: float, n_tau: int, n_sensors: int) -> tuple[np.ndarray, np.ndarray]:
         """The torque sensors' drifting offsets (n, n_tau) [N·m] over ``n`` periods of ``dt`` and the force-torque
@@ -258,6 +273,7 @@ class _MujocoRun:
         self.q_meas, self.qdd = np.empty((n, n_act)), np.empty((n, n_act))
         self.base_qacc = np.empty((n, 6))
         self.ft = np.empty((n, len(self.robot.ft_sensors), 6))
+        self.imu = np.empty((n, self.mjr.imu_index.size))
         self.recording = Recording(self.robot, ref, self.injected)
         self.contact, self.force = np.zeros((n, nc), dtype=bool), np.zeros((n, nc))
         self.commands = np.zeros((self.delay + 1, n_act))  # ring buffer: the command of period k acts at k + delay
@@ -327,9 +343,11 @@ class _MujocoRun:
         mujoco.mj_step(self.model, self.data)
         if first:
             self.record(k)
-            self.ft[k] = 0.0
+            self.ft[k], self.imu[k] = 0.0, 0.0
         if self.ft.shape[1]:  # computed with the step's qacc, before its integration
             self.ft[k] += self.mjr.wrenches(self.data.sensordata) / self.options.substeps
+        if self.imu.shape[1]:
+            self.imu[k] += self.data.sensordata[self.mjr.imu_index] / self.options.substeps
 
     def record(self, k: int) -> None:
         """Log the period's first physics step: joint accelerations, motor torques, friction applied."""
@@ -363,9 +381,11 @@ class _MujocoRun:
         A[:, :6] = mjr.base_acceleration(self.qpos, self.qvel, self.base_qacc)
         self.recording.wrench[:, :, 2] = self.force
         drift, ft_offset = self.options.imperfections(self.n, self.dt, self.tc.size, len(robot.ft_sensors))
+        imu = self.imu + self.options.imu_errors(self.n) if self.imu.shape[1] and self.options.imu else None
         return self.recording.result(Q, V, A, self.contact, "wbfriction.sim.mujoco_sim.simulate_mujoco", self.options,
                                      Q_log=Q_meas, tau_noise=self.eps_tau + drift,
                                      sensor_wrench=self.ft + ft_offset if self.options.force_torque else None,
+                                     imu=imu,
                                      torque_alignment="zoh",  # the torque is held over the substeps of each period
                                      contact_source=f"sole normal force > {self.options.contact_threshold:g} N")
 

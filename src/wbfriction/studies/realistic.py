@@ -51,12 +51,12 @@ from wbfriction.studies.common import (
 )
 from wbfriction.walking import GaitOptions, walking_reference
 
-THESIS_ROUTE = EstimateOptions(wrenches=False)
+THESIS_ROUTE = EstimateOptions(base_motion="contact", wrenches=False)
 """The thesis's route: base motion from the rigid stance contact, the ankle sensors' wrenches left
 out (the study reproduces 6.2; :mod:`wbfriction.friction.measured` is the route that uses them)."""
 NOISE = SensorNoise(position_std=1e-4, encoder_bits=ENCODER_BITS, torque_std=TORQUE_STD, seed=0)
 """The filter study's default noise level (its 1e-4 rad row)."""
-BEST_FILTER = EstimateOptions(diff="savgol", filtering=FilterOptions(window=151, poly_order=4), wrenches=False)
+BEST_FILTER = dataclasses.replace(THESIS_ROUTE, diff="savgol", filtering=FilterOptions(window=151, poly_order=4))
 """The filter study's best scheme at that level."""
 COULOMB_VISCOUS = {"S": 0.0, "v_s": 0.1, "tau_os": 0.0}
 """Parameters held in the fit of MuJoCo's own friction, which has no Stribeck term or offset."""
@@ -116,7 +116,7 @@ def _swing_and_stance(robot: Robot, mjr: MujocoRobot, knee: str, table_6_1: dict
                       say: StageProgress) -> tuple[dict[str, float], list[Path]]:
     """Fig. 6.4 and 6.5 (steps 1-2 of the module docstring): the right knee's RMS error and the figures written."""
     forward = GaitOptions(gait="forward", steps=knee_steps)
-    whole = EstimateOptions(mask="single", wrenches=False)
+    whole = dataclasses.replace(THESIS_ROUTE, mask="single")
     say("MuJoCo: a forward walk, friction on the right knee")
     knee_log = _simulate(robot, mjr, forward, {knee: table_6_1[knee]}, options).log
     knee_only = estimate_log(robot, knee_log, whole)

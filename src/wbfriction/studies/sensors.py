@@ -96,7 +96,8 @@ def run_sensors_study(robot: Robot, output_dir: Path, steps: int = 3, diff: Diff
                           MujocoOptions(sensors=noise)).log
     free = _off_limits(robot, log, legs)
     estimates = {}
-    for route, options in (("contact", EstimateOptions(diff=diff, filtering=filtering, wrenches=False)),
+    for route, options in (("contact", EstimateOptions(diff=diff, filtering=filtering, base_motion="contact",
+                                                       wrenches=False)),
                            ("wrench", EstimateOptions(diff=diff, filtering=filtering, base_motion="logged"))):
         say(f"estimate: the {route} route")
         estimates[route] = estimate_log(robot, log, options)
