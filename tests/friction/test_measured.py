@@ -122,5 +122,5 @@ def test_estimate_says_which_base_motion_it_used(talos, ft_walk, tmp_path, capsy
     routes = pq.read_table(tmp_path / "f.parquet", columns=["route"]).column("route").to_pylist()
     assert set(routes) == {"wrench"}
     code, err = run_cli(capsys, "estimate", tmp_path / "walk.parquet", "-o", tmp_path / "g.parquet",
-                        "--base-motion", "imu")
-    assert code == 2 and "unknown base motion 'imu'" in err and not (tmp_path / "g.parquet").exists()
+                        "--base-motion", "gps")
+    assert code == 2 and "unknown base motion 'gps'" in err and not (tmp_path / "g.parquet").exists()
