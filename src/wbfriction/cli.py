@@ -283,8 +283,8 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                                                               "control periods."),
              log_base: bool = typer.Option(_I.log_base, help="Write the base pose to the log."),
              force_torque: bool = typer.Option(_I.force_torque, help="ideal: write what the robot's force-torque "
-                                                                     "sensors measure (wrench.<sensor>.* columns; "
-                                                                     "mujoco always does)."),
+                                                                     "sensors and IMU measure (wrench.<sensor>.*, "
+                                                                     "imu.* columns; mujoco always does)."),
              sole_timeconst: Optional[float] = typer.Option(None, help="mujoco: the soles' contact time constant "
                                                                        "(s; default MuJoCo's 0.02, larger is "
                                                                        "softer: a compliant sole)."),
@@ -310,7 +310,7 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
     options: IdealOptions | MujocoOptions
     if simulator == "ideal":
         options = IdealOptions(substeps=substeps or _I.substeps, integrator=cast(Integrator, integrator),
-                               log_base=log_base, force_torque=force_torque)
+                               log_base=log_base, force_torque=force_torque, imu=force_torque)
     else:
         table = load_sensors_toml(sensors) if sensors is not None else {}
         given = {"position_std": position_noise, "encoder_bits": encoder_bits, "torque_std": torque_noise,
@@ -366,8 +366,10 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
                                                  "Fig. 7.4 (one more pass)."),
              base_motion: str = typer.Option(_E.base_motion, help="Base motion: contact (rigid stance foot, "
                                                                   "thesis 5.4), logged (the base.* pose "
-                                                                  "differentiated like the joints) or auto "
-                                                                  "(logged with wrenches, else contact; printed)."),
+                                                                  "differentiated like the joints), imu (the "
+                                                                  "imu.* gyro and accelerometer, the base.q* "
+                                                                  "orientation) or auto (imu, else logged with "
+                                                                  "wrenches, else contact; printed)."),
              wrenches: bool = typer.Option(_E.wrenches, help="Use the force-torque sensors' wrench.<sensor>.* "
                                                              "columns where logged: every joint's friction in "
                                                              "every phase.")) -> None:
