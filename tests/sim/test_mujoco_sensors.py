@@ -84,7 +84,7 @@ def _error_share(robot, log, options) -> float:
 def test_a_compliant_sole_leaves_the_measured_route_and_degrades_the_rigid_one(talos):
     """MuJoCo's default soles, then soles twice as soft (contact time constant 0.04 s): with the ankle
     wrenches and the logged base (central differences, noise off) the error changes by less than 2 % of
-    the friction; the rigid-contact route's grows (measured 5.2 -> 5.2 % against 7.7 -> 14.5 %)."""
+    the friction; the rigid-contact route's grows (measured 5.0 -> 4.9 % against 7.7 -> 14.5 %)."""
     friction = {j: THESIS_TARGETS[g] for j, _, g in leg_joints(talos)}
     ref = walking_reference(talos, GaitOptions(gait="forward", steps=4))
     measured = EstimateOptions(diff="central", base_motion="logged")
