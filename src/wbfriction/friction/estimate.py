@@ -147,6 +147,9 @@ class FrictionEstimate:
             or None; the fit passes the model through it too
             (:func:`~wbfriction.friction.fit.fit_friction`). A table records it as the
             ``estimate_options`` of its metadata.
+        disagreement: (N, n_tc) ``tau_f`` of the measured route less the rigid-contact route's where both
+            estimated the sample (single support) [N·m], NaN elsewhere; None without a measured route
+            (:mod:`wbfriction.friction.cross_check`).
         route: (N,) how each sample was estimated (:data:`~wbfriction.friction.measured.Route`):
             ``contact`` (rigid contacts), ``base`` (measured base motion), ``wrench`` (measured
             wrenches), ``none``; or None (a table that does not say: rigid contacts).
@@ -170,6 +173,7 @@ class FrictionEstimate:
     companion_delta_qdd: np.ndarray | None = None
     companion_diff: str | None = None
     route: np.ndarray | None = None
+    disagreement: np.ndarray | None = None
 
 
 def single_support_friction_rnea(robot: Robot, contact_index: int, angles: np.ndarray, qd: np.ndarray,
@@ -319,31 +323,37 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     valid = joint_mask(phases, robot.limb_mask, options.mask) & usable[:, None] & np.isfinite(tau_f)
     unique = ss.copy()
     route = np.where(np.any(np.isfinite(tau_f), axis=1), "contact", "none").astype("<U7")
+    disagreement = None
     if with_wrenches:  # every joint, every phase
         rows = kin.valid
         if options.diff != "true":  # not across a touch-down: its impact is smeared by the differentiation
             rows = rows & ~straddling(kin.contact) & ~impacts(robot, kin)
         tau_m, done = wrench_route(robot, kin, rows)
         valid[done] = np.isfinite(tau_m[done])
-        _measured(tau_f, delta, unique, route, tau_m, done, "wrench")
+        disagreement = _measured(tau_f, delta, unique, route, tau_m, done, "wrench")
     elif measured_base(kin) != "contact":  # every joint in single support; the mask stays
         tau_m, done = base_route(robot, kin, usable & phases.single)
         valid[done] = (joint_mask(phases, robot.limb_mask, options.mask) & np.isfinite(tau_m))[done]
-        _measured(tau_f, delta, unique, route, tau_m, done, "base")
+        disagreement = _measured(tau_f, delta, unique, route, tau_m, done, "base")
     metadata = dict(kin.metadata)
     metadata["estimate_options"] = asdict(options)
     return FrictionEstimate(
         joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
         phase=phases.labels(), unique=unique, contact=kin.contact, contact_frames=robot.contact_frames,
         qdd=kin.qdd[:, tc], delta_qdd=delta, cond=cond, tau_f_true=kin.tau_f_true, metadata=metadata,
-        smoother=kin.smoother, route=route)
+        smoother=kin.smoother, route=route, disagreement=disagreement)
 
 
 def _measured(tau_f: np.ndarray, delta: np.ndarray, unique: np.ndarray, route: np.ndarray, tau_m: np.ndarray,
-              done: np.ndarray, name: str) -> None:
+              done: np.ndarray, name: str) -> np.ndarray:
     """Put a measured route's friction ``tau_m`` in place of the rigid-contact route's on the rows ``done``
-    (its acceleration difference is not computed: NaN)."""
+    (its acceleration difference is not computed: NaN); return their disagreement where both estimated a
+    single-support sample (:attr:`FrictionEstimate.disagreement`)."""
+    both = done & unique  # unique so far: the rigid route's single support
+    disagreement = np.full_like(tau_f, np.nan)
+    disagreement[both] = tau_m[both] - tau_f[both]
     tau_f[done], delta[done], unique[done], route[done] = tau_m[done], np.nan, True, name
+    return disagreement
 
 
 def companion_scheme(diff: Diff) -> Scheme:
@@ -461,6 +471,7 @@ def _blank(template: FrictionEstimate, log: Log) -> FrictionEstimate:
         qdd=nan(template.qdd), delta_qdd=nan(template.delta_qdd), cond=nan(template.cond),
         tau_f_true=log.tau_f_true, metadata=template.metadata, smoother=template.smoother,
         companion_delta_qdd=nan(template.companion_delta_qdd), companion_diff=template.companion_diff,
+        disagreement=nan(template.disagreement),
         route=None if template.route is None else np.full(n, "none", dtype=template.route.dtype))
 
 

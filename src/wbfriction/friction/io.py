@@ -41,7 +41,7 @@ SIGN_CONVENTION = "tau_f = -f(qd); fit of f (the joint's model, eqs. 3.1-3.5) to
 def friction_table(est: FrictionEstimate) -> pa.Table:
     """The estimate as an Arrow table: ``time``, ``phase``, ``unique``, [``route``], [``cond``],
     ``contact.<frame>``, and per joint ``qd.<j>``, ``tau_f.<j>``, ``valid.<j>``,
-    ``qdd.<j>``, ``delta_qdd.<j>``, [``delta_qdd_companion.<j>``], [``tau_f_true.<j>``];
+    ``qdd.<j>``, ``delta_qdd.<j>``, [``delta_qdd_companion.<j>``], [``disagreement.<j>``], [``tau_f_true.<j>``];
     the companion's scheme is the metadata key ``companion_diff``."""
     cols: dict[str, object] = {"time": est.time, "phase": pa.array(est.phase.astype(str)),
                                "unique": est.unique}
@@ -56,7 +56,7 @@ def friction_table(est: FrictionEstimate) -> pa.Table:
         cols[f"tau_f.{j}"] = est.tau_f[:, i]
         cols[f"valid.{j}"] = est.valid[:, i]
         for name, arr in (("qdd", est.qdd), ("delta_qdd", est.delta_qdd),
-                          ("delta_qdd_companion", est.companion_delta_qdd)):
+                          ("delta_qdd_companion", est.companion_delta_qdd), ("disagreement", est.disagreement)):
             if arr is not None:
                 cols[f"{name}.{j}"] = arr[:, i]
         if est.tau_f_true is not None and not np.all(np.isnan(est.tau_f_true[:, i])):
@@ -178,7 +178,8 @@ def read_friction_table(table: pa.Table, source: str = "<table>") -> FrictionEst
         cond=_float_column(table, "cond", source) if "cond" in names else None,
         tau_f_true=_optional_columns(table, "tau_f_true", joints, source), metadata=meta, smoother=smoother,
         companion_delta_qdd=_optional_columns(table, "delta_qdd_companion", joints, source),
-        companion_diff=companion_diff, route=route)
+        companion_diff=companion_diff, route=route,
+        disagreement=_optional_columns(table, "disagreement", joints, source))
 
 
 def read_friction_file(path: str | Path) -> FrictionEstimate:

@@ -12,7 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
+from wbfriction.friction.cross_check import LARGE, MIN_SAMPLES, cross_check
 from wbfriction.friction.energy import JointEnergy
+from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import ALL_PARAM_NAMES, FrictionParams
 from wbfriction.logs.tables import write_atomic
@@ -155,6 +157,24 @@ def _energy_table(joints: list[str], energy: dict[str, JointEnergy]) -> str:
             + "".join(_energy_row(energy[j]) for j in joints) + "</table>")
 
 
+def _routes_section(est: FrictionEstimate) -> str:
+    """The measured route against the rigid-contact one where both estimated a sample
+    (:func:`~wbfriction.friction.cross_check.cross_check`); "" without a measured route."""
+    if est.disagreement is None:
+        return ""
+    checks = [c for c in cross_check(est.joints, est.disagreement, est.tau_f, est.qdd) if c.samples >= MIN_SAMPLES]
+    if not checks:
+        return ""
+    rows = "".join(f'<tr class="{"flag" if c.cause else ""}"><td>{html.escape(c.joint)}</td><td>{c.samples}</td>'
+                   f"<td>{c.rms:.3g}</td><td>{c.mean:.3g}</td><td>{100 * c.share:.1f}</td>"
+                   f"<td>{html.escape(c.cause)}</td></tr>" for c in checks)
+    return ("<h2>Routes cross-checked: the sensors' route against the rigid contact</h2>"
+            '<p class="sub">Single-support samples estimated by both routes: τ_f(measured) − τ_f(rigid contact). '
+            f"A disagreement above {100 * LARGE:g} % of the friction's RMS is given its likely cause.</p>"
+            '<table id="routes"><tr><th>joint</th><th>samples</th><th>RMS [N·m]</th><th>mean [N·m]</th>'
+            f"<th>share of τ_f [%]</th><th>likely cause</th></tr>{rows}</table>")
+
+
 def _summary_box(r: Report, n_joints: int) -> str:
     """The box atop the report: the joints whose friction generates power, or the worst one's share."""
     flagged = r.flagged
@@ -234,6 +254,7 @@ exerts on the joint (dissipative: qd·τ_f ≤ 0); the model f(qd) of eq. (3.5) 
 <h2>Energy consistency (eq. 7.9, Fig. 7.4)</h2>
 <p class="sub">{_ENERGY_NOTE}</p>
 {_energy_table(joints, r.energy)}
+{_routes_section(est)}
 {"" if r.identification is None else _identification_section(r.identification)}
 <h2>Joints</h2>
 <nav>{nav}</nav>
