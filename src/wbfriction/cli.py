@@ -237,7 +237,23 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     if routes:  # decided on the first chunk
         console.print(f"base motion: {routes['base']}" + ("; wrenches: every joint in every phase"
                                                           if routes["wrenches"] else ""), highlight=False)
+        _print_cross_check(output)
     console.print(f"wrote {output}: {result.rows} samples")
+
+
+def _print_cross_check(friction: Path) -> None:
+    """The joints whose measured and rigid-contact routes disagree, with the likely cause."""
+    from wbfriction.friction.cross_check import LARGE, cross_check_file
+
+    checks = cross_check_file(friction)
+    large = [c for c in checks if c.cause]
+    if checks:
+        console.print(f"routes cross-checked on {max(c.samples for c in checks)} single-support samples: "
+                      f"{len(large)} of {len(checks)} joints disagree by more than {100 * LARGE:g} % of their "
+                      "friction's RMS", highlight=False)
+    for c in sorted(large, key=lambda c: -c.rms):
+        console.print(f"  {c.joint}: {c.rms:.2g} N·m RMS against {c.rms / c.share:.2g} of friction; likely "
+                      f"{escape(c.cause)}", highlight=False, soft_wrap=True)
 
 
 def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, tolerance: float,
@@ -783,11 +799,14 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
                   diff: str = typer.Option("central", help="Differentiation: central, savgol, butterworth or true."),
                   window: int = typer.Option(151, help="savgol: window length L (odd) [samples]."),
                   noise: bool = typer.Option(False, "--noise", help="The studies' sensor noise in the loop (1e-4 "
-                                                                    "rad, 19-bit encoders, 0.05 N·m torques).")
+                                                                    "rad, 19-bit encoders, 0.05 N·m torques)."),
+                  substeps: Optional[int] = typer.Option(None, min=1,
+                                                         help="MuJoCo physics steps per 1 ms control period "
+                                                              "(default 16: friction lags half a step).")
                   ) -> None:
     """What the ankle force-torque sensors and the base pose change, on MuJoCo's soft contacts (issue 23)."""
     from wbfriction.studies.realistic import NOISE
-    from wbfriction.studies.sensors import run_sensors_study, sensors_markdown
+    from wbfriction.studies.sensors import SUBSTEPS, run_sensors_study, sensors_markdown
 
     r = _robot(robot, None, None)
     if not r.ft_sensors:
@@ -795,7 +814,7 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
     with console.status("") as status:
         result = run_sensors_study(r, output_dir, steps=steps, diff=cast(Diff, diff),
                                    filtering=FilterOptions(window=window), noise=NOISE if noise else SensorNoise(),
-                                   progress=lambda label: status.update(label))
+                                   substeps=substeps or SUBSTEPS, progress=lambda label: status.update(label))
     out.print(escape(sensors_markdown(result)), highlight=False, soft_wrap=True)
     for f in result.files:
         console.print(f"wrote {f}")

@@ -65,3 +65,23 @@ def test_the_report_shows_the_routes_cross_checked(talos, tmp_path):
     write_table(friction_table(est), tmp_path / "f.parquet")
     page = render_html(make_report(tmp_path / "f.parquet"))
     assert 'id="routes"' in page and "an offset" in page
+
+
+def test_the_file_and_the_command_give_the_same_check(talos, tmp_path):
+    """The table file's cross-check (three columns per joint) equals the in-memory one; ``estimate`` prints the
+    joints whose routes disagree with their cause (a 20 N / 2 N·m force-torque offset: "an offset")."""
+    from helpers import run
+    from wbfriction.friction.cross_check import cross_check_file
+    from wbfriction.friction.io import friction_table
+    from wbfriction.logs.log import write_log
+    from wbfriction.logs.tables import write_table
+
+    ref = walking_reference(talos, GaitOptions(gait="forward", steps=1))
+    log = simulate_mujoco(talos, ref, None, MujocoOptions(ft_offset=(20.0, 2.0))).log
+    est = estimate_log(talos, log, EstimateOptions(diff="central", base_motion="logged"))
+    write_table(friction_table(est), tmp_path / "f.parquet")
+    assert cross_check_file(tmp_path / "f.parquet") == cross_check(est.joints, est.disagreement, est.tau_f, est.qdd)
+    write_log(log, talos, tmp_path / "log.parquet")
+    res = run("estimate", tmp_path / "log.parquet", "-o", tmp_path / "cli.parquet", "--base-motion", "logged")
+    assert res.returncode == 0, res.stderr
+    assert "routes cross-checked on" in res.stderr and "likely an offset" in res.stderr

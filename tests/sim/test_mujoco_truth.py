@@ -3,8 +3,10 @@
 With the robot in the air (the walking reference lifted 1 m: no contact), each logged sample's friction
 must equal ``M qacc + c - actuator force`` on its joint, with ``M`` from ``mujoco.mj_fullM`` and ``c`` =
 ``qfrc_bias`` at the logged state, ``qacc`` the logged joint accelerations (the free joint's from its own
-rows, which no force but gravity and inertia acts on), the actuator force the logged torque. Joints held by
-a limit constraint at a sample (the grippers) are left out there.
+rows, which no force but gravity and inertia acts on), the actuator force the motors' torque. Joints held by
+a limit constraint at a sample (the grippers) are left out there. The motors' torques are the truth
+(``tau_motor``): the logged ``tau`` is what a torque sensor read of them
+(:func:`~wbfriction.sim.mujoco_sim.matched_weights`).
 """
 
 from __future__ import annotations
@@ -52,7 +54,7 @@ def friction_from_the_dynamics(talos, mjr, res) -> tuple[np.ndarray, np.ndarray]
         qacc = np.zeros(m.nv)
         qacc[mjr.dof_index] = log.qdd_true[k]
         qacc[:6] = np.linalg.solve(M[:6, :6], -d.qfrc_bias[:6] - M[:6, joints] @ qacc[joints])
-        out[k] = (M @ qacc + d.qfrc_bias)[dofs] - log.tau[k]
+        out[k] = (M @ qacc + d.qfrc_bias)[dofs] - res.tau_motor[k]
         limited = d.efc_id[:d.nefc][d.efc_type[:d.nefc] == mujoco.mjtConstraint.mjCNSTR_LIMIT_JOINT]
         free[k] = ~np.isin(dofs, m.jnt_dofadr[limited])
     return out, free

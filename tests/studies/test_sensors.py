@@ -1,4 +1,5 @@
-"""The sensors study (issue 23) on a short combined walk: both routes scored, the files written."""
+"""The sensors study (issue 23) on the combined walk: both routes scored against the injected friction, the files
+written."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from wbfriction.studies.sensors import PARTS, run_sensors_study
 @pytest.fixture(scope="module")
 def study(talos, tmp_path_factory):
     out = tmp_path_factory.mktemp("sensors")
-    return out, run_sensors_study(talos, out, steps=1)
+    return out, run_sensors_study(talos, out, steps=3)
 
 
 def test_the_wrenches_use_every_sample_and_beat_the_rigid_route(study):
@@ -23,7 +24,17 @@ def test_the_wrenches_use_every_sample_and_beat_the_rigid_route(study):
         assert row.samples[("wrench", "stance")] > row.samples[("wrench", "swing")] > 0
     contact, wrench = result.worst("contact", "swing"), result.worst("wrench", "swing")
     assert all(wrench[n] < contact[n] for n in ("F_c", "F_v", "tau_os"))
-    assert result.worst("wrench", "stance")["tau_os"] < 5.0
+
+
+def test_with_the_wrenches_every_leg_parameter_is_within_5_percent(study):
+    """Issue 23's target, noise off, central differences: F_c, F_v and tau_os of every leg joint within 5 % of
+    the injected (Table 6.1) values on its swing samples and, separately, on its stance samples (measured:
+    worst 0.45 / 4.29 / 0.04 % in swing, the right hip yaw's F_v; 0.18 / 1.77 / 0.01 % in stance); the rigid
+    contact's route misses the hip yaw's F_v by over 1000 %."""
+    _, result = study
+    for part in ("swing", "stance"):
+        assert max(result.worst("wrench", part).values()) < 5.0, part
+    assert result.worst("contact", "swing")["F_v"] > 1000
 
 
 def test_the_files_hold_the_table(study):

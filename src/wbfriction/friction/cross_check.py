@@ -20,6 +20,7 @@ disagreement (RMS above :data:`LARGE` of the friction's own RMS) is given its li
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -79,4 +80,25 @@ def cross_check(joints: tuple[str, ...], disagreement: np.ndarray, tau_f: np.nda
         if share > LARGE:
             cause = likely_cause(d, qdd[both, i] if qdd is not None else np.zeros_like(d))
         out.append(RouteCheck(joint, int(d.size), rms, float(np.mean(d)), share, cause))
+    return out
+
+
+def cross_check_file(path: str | Path) -> list[RouteCheck]:
+    """:func:`cross_check` of a friction table file (Parquet, CSV or HDF5) written with a measured route,
+    reading three columns of one joint at a time (bounded memory in the log's length); [] when the table has
+    no ``disagreement.<joint>`` column.
+
+    Raises:
+        InputError: an unreadable file, naming it.
+    """
+    from wbfriction.logs.tables import TableFile
+
+    table = TableFile(path)
+    joints = tuple(c.removeprefix("disagreement.") for c in table.schema().names if c.startswith("disagreement."))
+    out = []
+    for joint in joints:
+        cols = table.read([f"disagreement.{joint}", f"tau_f.{joint}", f"qdd.{joint}"])
+        x = {n.split(".", 1)[0]: cols.column(n).to_numpy(zero_copy_only=False).astype(float)[:, None]
+             for n in cols.column_names}
+        out += cross_check((joint,), x["disagreement"], x["tau_f"], x.get("qdd"))
     return out

@@ -94,6 +94,8 @@ class SimulationResult:
             zero off contact; ``wrench[..., 2]`` is the normal force.
         q: simulated configurations (N, nq); v: velocities (N, nv).
         reference: the walking reference.
+        tau_motor: the torques the motors applied (N, n_tc) [N·m], truth: held over each period; the log's
+            ``tau`` is them plus sensor noise, or what a torque sensor read of them (MuJoCo).
     """
 
     log: Log
@@ -102,6 +104,7 @@ class SimulationResult:
     v: np.ndarray
     reference: WalkingReference
     contact_frames: tuple[str, ...] = field(default_factory=tuple)
+    tau_motor: np.ndarray | None = None
 
     def pulls(self, threshold: float = 0.0) -> list[Pull]:
         """Intervals where a foot in contact had a normal force below ``threshold`` [N]."""
@@ -160,15 +163,17 @@ class Recording:
     def result(self, Q: np.ndarray, V: np.ndarray, A: np.ndarray, contact: np.ndarray, generator: str, options,
                *, Q_log: np.ndarray | None = None, tau_noise: np.ndarray | None = None, log_sensors: bool = False,
                log_imu: bool = False, sensor_wrench: np.ndarray | None = None, imu: np.ndarray | None = None,
-               **metadata) -> SimulationResult:
+               tau_sensed: np.ndarray | None = None, **metadata) -> SimulationResult:
         """The :func:`simulated_log` of the true states ``Q``, ``V``, ``A`` (its configurations ``Q_log`` if
-        given, its torques plus ``tau_noise`` if given) and the :class:`SimulationResult` around it.
+        given, its torques, or the torque sensors' readings ``tau_sensed`` of them, plus ``tau_noise`` if
+        given) and the :class:`SimulationResult` around it.
         With ``log_sensors``, the log carries what the robot's force-torque sensors measure
         (:func:`~wbfriction.model.force_torque.sensor_readings` of :attr:`wrench`, which must then be
         the contact wrenches that go with ``A``); with ``log_imu``, what the robot's IMU reads
         (:func:`~wbfriction.model.imu.imu_readings`); ``sensor_wrench`` (N, n_sensors, 6) and ``imu`` (N, 6),
         what a simulator's own sensors measured, are logged as they are."""
-        tau = self.tau if tau_noise is None else self.tau + tau_noise
+        tau = self.tau if tau_sensed is None else tau_sensed
+        tau = tau if tau_noise is None else tau + tau_noise
         wrench = sensor_wrench if sensor_wrench is not None and sensor_wrench.shape[1] else None
         if log_sensors and self.robot.ft_sensors:
             wrench = sensor_readings(self.robot.model, self.robot.ft_sensors, self.robot.contact_frames, Q, V, A,
@@ -177,4 +182,5 @@ class Recording:
             imu = imu_readings(self.robot.model, self.robot.imu, Q, V, A)
         log = simulated_log(self.robot, self.reference, Q if Q_log is None else Q_log, V, A, tau, self.tau_f, contact,
                             self.friction, generator, options, options.log_base, wrench, imu, **metadata)
-        return SimulationResult(log, self.wrench, Q, V, self.reference, tuple(self.robot.contact_frames))
+        return SimulationResult(log, self.wrench, Q, V, self.reference, tuple(self.robot.contact_frames),
+                                self.tau.copy())
