@@ -35,7 +35,7 @@ from wbfriction.logs.clock import TimeBase, TimeUnit
 from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, write_log
 from wbfriction.logs.source import open_log, read_log
 from wbfriction.logs.tables import TableFile, write_table
-from wbfriction.model.loading import load_robot
+from wbfriction.model.loading import BUILTIN_ROBOTS, load_robot
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import Chunking
 from wbfriction.pipeline.convert import convert_log
@@ -51,15 +51,21 @@ from wbfriction.sim.arm import ArmOptions, default_arm_friction, simulate_arm
 from wbfriction.sim.ideal import Integrator
 from wbfriction.sim.mujoco_sim import FrictionMode
 from wbfriction.sim.sensors import load_sensors_toml
+from wbfriction.version import __version__
 from wbfriction.walking import GaitOptions, walking_reference
 from wbfriction.walking.footsteps import Gait
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
-                  help="Whole-body joint friction estimation for torque-controlled legged robots.")
+# rich_markup_mode=None: click's plain help, so that units in brackets ([m], [rad/s], [friction.<group>]) are
+# printed as written (Rich markup would take them for tags and delete them)
+app = typer.Typer(add_completion=False, rich_markup_mode=None)
 console = Console(stderr=True)
 out = Console(width=max(Console().width, 150))
 
-RobotOpt = typer.Option("talos", "--robot", help="Built-in robot name.")
+RobotOpt = typer.Option("talos", "--robot", help=f"Built-in robot: {', '.join(BUILTIN_ROBOTS)}.")
+LOG_FORMATS = "Parquet (.parquet), CSV (.csv) or HDF5 (.h5, .hdf5)"
+"""The log file formats every command reads (a ROS 2 bag too, where a command takes --map)."""
+LogArg = typer.Argument(..., metavar="LOG", help=f"Log in the wbfriction format: {LOG_FORMATS}.")
+FrictionArg = typer.Argument(..., metavar="FRICTION", help="Friction table written by 'wbfriction estimate'.")
 EnergyThresholdOpt = typer.Option(DEFAULT_THRESHOLD, min=0.0, max=1.0,
                                   help="Share of power-generating samples (eq. 7.9) above which a joint is flagged.")
 EnergyToleranceOpt = typer.Option(DEFAULT_TOLERANCE, min=0.0,
@@ -269,7 +275,7 @@ def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, t
 
 
 @app.command()
-def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write (.parquet or .csv)."),
+def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write: .parquet, .csv or .h5."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              gait: str = typer.Option(_G.gait, help="forward, sideways, turning, both (forward + sideways) or "
                                                     "combined (all three)."),
@@ -340,9 +346,10 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
 
 
 @app.command()
-def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the wbfriction format, or a ROS 2 "
-                                                 "bag with --map."),
-             output: Path = typer.Option(..., "-o", "--output", help="Friction table to write."),
+def estimate(log: Path = typer.Argument(..., metavar="LOG",
+                                        help=f"Log in the wbfriction format: {LOG_FORMATS}; or a ROS 2 bag (--map)."),
+             output: Path = typer.Option(..., "-o", "--output", help="Friction table to write: .parquet, .csv or "
+                                                                     ".h5."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              bag_map: Optional[Path] = MapOpt, max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt,
              workers: int = typer.Option(2, min=1, help="Processes estimating chunks of a long log (started when "
@@ -407,11 +414,11 @@ def estimate(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
 
 
 @app.command()
-def convert(bag: Path = typer.Argument(..., help="ROS 2 bag (folder with metadata.yaml; MCAP or sqlite3), or a "
-                                                 "Parquet, CSV or HDF5 log."),
+def convert(bag: Path = typer.Argument(..., metavar="BAG", help="ROS 2 bag (folder with metadata.yaml; MCAP or "
+                                                                "sqlite3), or a Parquet, CSV or HDF5 log."),
             bag_map: Optional[Path] = typer.Option(None, "--map", help="Topic map TOML of a bag: [joint_states], "
                                                                         "[[contacts]], [base]."),
-            output: Path = typer.Option(..., "-o", "--output", help="Log to write (.parquet or .csv)."),
+            output: Path = typer.Option(..., "-o", "--output", help="Log to write: .parquet or .csv."),
             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
             max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt) -> None:
     """Convert a ROS 2 bag (or another log file) into a wbfriction log: joint states, contacts
@@ -425,7 +432,7 @@ def convert(bag: Path = typer.Argument(..., help="ROS 2 bag (folder with metadat
 
 
 @app.command()
-def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wbfriction estimate'."),
+def fit(friction: Path = FrictionArg,
         output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
         min_samples: int = typer.Option(_MIN_SAMPLES, min=1, help="Joints with fewer valid samples are not fitted."),
         energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt,
@@ -445,7 +452,7 @@ def fit(friction: Path = typer.Argument(..., help="Friction table written by 'wb
 
 
 @app.command()
-def export(params: Path = typer.Argument(..., help="Parameters written by 'wbfriction fit'."),
+def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters written by 'wbfriction fit'."),
            outputs: list[Path] = typer.Option(..., "-o", "--output",
                                               help="File to write, format by name: .urdf (<dynamics damping "
                                                    "friction>), .xml (MuJoCo MJCF: damping, frictionloss, "
@@ -464,8 +471,9 @@ def export(params: Path = typer.Argument(..., help="Parameters written by 'wbfri
 
 
 @app.command()
-def predict(friction: Path = typer.Argument(..., help="Friction table of a held-out log ('wbfriction estimate' "
-                                                      "with the URDF under test)."),
+def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
+                                            help="Friction table of a held-out log ('wbfriction estimate' with the URDF"
+                                                 " under test)."),
             params: Path = typer.Option(..., "--params", help="Parameters fitted on other logs estimated with "
                                                               "the same URDF ('wbfriction fit').")) -> None:
     """How well a model predicts torques it was not fitted on: per joint, the RMS of measured minus
@@ -483,7 +491,7 @@ def predict(friction: Path = typer.Argument(..., help="Friction table of a held-
 
 
 @app.command()
-def report(friction: Path = typer.Argument(..., help="Friction table written by 'wbfriction estimate'."),
+def report(friction: Path = FrictionArg,
            output: Path = typer.Option(Path("report.html"), "-o", "--output", help="HTML file to write."),
            params: Optional[Path] = typer.Option(None, help="Parameters written by 'wbfriction fit' (default: "
                                                             "fitted here)."),
@@ -508,7 +516,7 @@ def report(friction: Path = typer.Argument(..., help="Friction table written by 
 
 
 @app.command()
-def sensitivity(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the wbfriction format."),
+def sensitivity(log: Path = LogArg,
                 output: Path = typer.Option(Path("sensitivity.png"), "-o", "--output", help="Figure to write (PNG)."),
                 robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
                 factors: str = typer.Option("0.9,0.95,1.05,1.1", help="Comma-separated inertia scaling factors."),
@@ -568,9 +576,9 @@ def _change(x: float | None, digits: int) -> str:
 def _identify_tables(doc: dict) -> list[Table]:
     """The tables of ``wbfriction identify``: body changes, both routes' friction, held-out RMS."""
     bodies = Table(title="Inertia model: given -> identified (bodies with mass)", box=None,
-                   caption="COM shift [mm]; principal moments about the centre of mass, ascending: change [%]")
+                   caption=escape("COM shift [mm]; principal moments about the centre of mass, ascending: change [%]"))
     for col in ("body", "mass given [kg]", "mass [kg]", "change [%]", "COM shift [mm]", "I1 [%]", "I2 [%]", "I3 [%]"):
-        bodies.add_column(col, justify="left" if col == "body" else "right")
+        bodies.add_column(escape(col), justify="left" if col == "body" else "right")  # units kept: not markup
     for b in doc["bodies"]:
         if max(b["mass_given"], b["mass"]) <= 0:
             continue
@@ -609,7 +617,7 @@ def _identify_tables(doc: dict) -> list[Table]:
 
 
 @app.command()
-def identify(log: Path = typer.Argument(..., help="Log (.parquet, .csv or .h5) in the wbfriction format."),
+def identify(log: Path = LogArg,
              output: Path = typer.Option(..., "-o", "--output", help="Corrected URDF to write (the given one's "
                                                                     "structure, identified inertias)."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
@@ -756,7 +764,7 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
 
 
 @app.command()
-def spectrum(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the wbfriction format."),
+def spectrum(log: Path = LogArg,
              output: Path = typer.Option(Path("spectrum.png"), "-o", "--output", help="Figure to write (PNG)."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              joints: Optional[str] = typer.Option(None, help="Comma-separated joints (default: the legs' joints, "
@@ -764,7 +772,7 @@ def spectrum(log: Path = typer.Argument(..., help="Log (.parquet or .csv) in the
              tail: float = typer.Option(0.01, min=0.0, max=1.0, help="Share of the power (above the noise floor) "
                                                                      "left above the suggested cutoff."),
              time_unit: Optional[str] = TimeUnitOpt) -> None:
-    """Spectrum of the estimated acceleration (Fig. 7.1) and the Butterworth cutoff it suggests."""
+    """The estimated acceleration's spectrum and the Butterworth cutoff it suggests (thesis Fig. 7.1)."""
     from wbfriction.report.figures import spectrum_figure
     from wbfriction.signals.spectrum import acceleration_spectrum
 
@@ -855,6 +863,24 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
     for f in result.files:
         console.print(f"wrote {f}")
     console.print(f"study finished in {time.perf_counter() - start:.1f} s")
+
+
+def _version(value: bool) -> None:
+    if value:
+        out.print(f"wbfriction {__version__}", highlight=False)
+        raise typer.Exit()
+
+
+@app.callback(invoke_without_command=True)
+def overview(ctx: typer.Context,
+             version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                          help="Print the version and exit.")) -> None:
+    """Whole-body joint friction estimation for torque-controlled legged robots: estimate the friction torque of
+    every joint from a log, fit a friction model, check it, export it. Run 'wbfriction demo' to see it on a
+    simulated walk, 'wbfriction COMMAND --help' for a command."""
+    if ctx.invoked_subcommand is None:  # 'wbfriction' alone: the overview, successfully
+        out.print(ctx.get_help(), highlight=False, markup=False)
+        raise typer.Exit()
 
 
 def main() -> None:
