@@ -191,3 +191,16 @@ def test_sensor_noise_quantisation_and_delay_in_the_loop(talos, mj_talos):
     np.testing.assert_array_equal(again.log.tau, res.log.tau)  # seeded: the same run twice
     with pytest.raises(InputError, match="multiple of the control period"):
         simulate_mujoco(talos, ref, options=MujocoOptions(delay=0.0015), mjr=mj_talos)
+
+
+def test_mujoco_warnings_go_to_the_logger_not_to_a_file(talos, tmp_path, monkeypatch, caplog):
+    """An unstable step's warning reaches the ``wbfriction.mujoco`` logger; no ``MUJOCO_LOG.TXT`` is written in
+    the working directory (MuJoCo's default)."""
+    monkeypatch.chdir(tmp_path)
+    mjr = build_mujoco_robot(talos)
+    data = mujoco.MjData(mjr.model)
+    data.qvel[:] = 1e20
+    with caplog.at_level("WARNING", logger="wbfriction.mujoco"):
+        mujoco.mj_step(mjr.model, data)
+    assert any("unstable" in r.getMessage() for r in caplog.records)
+    assert list(tmp_path.iterdir()) == []

@@ -17,6 +17,7 @@ joint's linear velocity in the world frame where Pinocchio gives it in the base 
 
 from __future__ import annotations
 
+import logging
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -204,6 +205,23 @@ class MujocoRobot:
         return T
 
 
+LOG = logging.getLogger("wbfriction.mujoco")
+"""Where MuJoCo's warnings go (:func:`route_mujoco_warnings`)."""
+
+
+def route_mujoco_warnings() -> None:
+    """Send MuJoCo's warnings ("Nan, Inf or huge value in QACC ...") to the ``wbfriction.mujoco`` logger
+    instead of MuJoCo's default: stdout and a ``MUJOCO_LOG.TXT`` appended in the working directory, which a
+    library must not write where it is run. The simulators still stop on an unstable step (they read
+    MuJoCo's warning counters: :class:`~wbfriction.exceptions.SimulationError`)."""
+    import mujoco
+    mujoco.set_mju_user_warning(_log_warning)
+
+
+def _log_warning(message: str) -> None:
+    LOG.warning("MuJoCo: %s", message)
+
+
 def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
     """Build the MuJoCo model of ``robot`` (module docstring).
 
@@ -214,6 +232,7 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
     Raises:
         ModelError: the URDF does not compile in MuJoCo, a joint missing, no sole mesh.
     """
+    route_mujoco_warnings()
     root = ET.parse(robot.urdf).getroot()
     footprints = [sole_footprint(robot, f, root) for f in robot.contact_frames]
     spec = _urdf_spec(robot, timestep)
