@@ -36,6 +36,7 @@ def test_main_job_steps_write_log_friction_and_params(demo_dir):
     assert knee["n_samples"] > 1000
     assert abs(knee["params"]["F_c"] - 1.0) < 0.05 and abs(knee["params"]["tau_os"] - 1.0) < 0.05
     assert knee["error_percent"]["F_c"] < 5
+    assert knee["status"] == "ok" and knee["status_reason"] == ""  # a verdict for every fit (issue 24)
     # the joint's own TOML table overrides its group's
     assert params["joints"]["leg_left_4_joint"]["target"]["F_c"] == 0.5
     assert params["joints"]["leg_left_4_joint"]["target"]["F_v"] == 0.0

@@ -104,14 +104,15 @@ def _robot(robot: str, urdf: Optional[Path], config: Optional[Path]) -> Robot:
 
 
 def _fit_rows(results: list[FitResult]) -> Table:
-    """One row per joint: its model and each of its parameters as value ±standard error (``n.i.``:
-    not identifiable; ``(bound)``: at a bound of the fit); blank: not a parameter of its model."""
+    """One row per joint: its model, its fit's status (:mod:`~wbfriction.friction.status`; a fit that is not
+    ``ok`` greyed) and each of its parameters as value ±standard error (``n.i.``: not identifiable;
+    ``(bound)``: at a bound of the fit); blank: not a parameter of its model."""
     names = [n for n in ALL_PARAM_NAMES if any(r.params is not None and n in r.params.names for r in results)]
     table = Table(title="Friction model per joint: f(qd) fitted to -tau_f, value ±standard error",
                   caption="n.i.: not identifiable from these data (infinite standard error); "
                           "(bound): at a bound of the fit, the bound's value, not the data's; screened: gross "
                           "outliers left out (beyond 50 median absolute deviations)", box=None)
-    for col in ("joint", "model", "N"):
+    for col in ("joint", "model", "status", "N"):
         table.add_column(col, justify="right" if col == "N" else "left")
     for name in names:
         table.add_column(name, justify="right")
@@ -129,18 +130,27 @@ def _fit_rows(results: list[FitResult]) -> Table:
 
     for r in results:
         rms = [f"{r.rms_error_vs_true:.4f}" if r.rms_error_vs_true is not None else ""] if has_true else []
-        model = r.model if r.params is not None else f"not fitted: {r.message}"
+        verdict = r.verdict()
         screened = f" (-{r.n_screened} screened)" if r.n_screened else ""
-        table.add_row(r.joint, model, f"{r.n_samples}{screened}", *[cell(r, n) for n in names], *rms,
-                      style=None if r.params is not None else "yellow")
+        table.add_row(r.joint, r.model if r.params is not None else "—", verdict.status,
+                      f"{r.n_samples}{screened}", *[cell(r, n) for n in names], *rms,
+                      style=None if verdict.ok else "dim")  # numbers not to be used: greyed
         err = r.error_percent()
         if err is not None and r.target is not None:
             target = r.target.values_in(r.model)
-            table.add_row("  target", "", "", *[f"{target[n]:.4g}" if n in target else "" for n in names], *pad,
-                          style="dim")
-            table.add_row("  error [%]", "", "", *[f"{err[n]:.2f}" if n in err else "" for n in names], *pad,
+            table.add_row("  target", "", "", "", *[f"{target[n]:.4g}" if n in target else "" for n in names],
+                          *pad, style="dim")
+            table.add_row("  error [%]", "", "", "", *[f"{err[n]:.2f}" if n in err else "" for n in names], *pad,
                           style="dim")
     return table
+
+
+def _print_verdicts(results: list[FitResult]) -> None:
+    """One line per fit that is not ``ok``: its status and why."""
+    for r in results:
+        verdict = r.verdict()
+        if not verdict.ok:
+            out.print(f"{r.joint}: {escape(str(verdict))}", highlight=False, soft_wrap=True)
 
 
 def _warn(warnings) -> None:
@@ -267,6 +277,7 @@ def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, t
     fitted = fit_file(friction, output, min_samples=min_samples, threshold=threshold, tolerance=tolerance,
                       workers=workers, model=model, selection_tolerance=selection_tolerance)
     out.print(_fit_rows(fitted.fits))
+    _print_verdicts(fitted.fits)
     for r in fitted.fits:
         if r.selection is not None:
             out.print(f"{r.joint}: {escape(r.selection.reason)}", highlight=False, soft_wrap=True)

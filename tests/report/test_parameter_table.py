@@ -58,9 +58,10 @@ def table() -> list[list[str]]:
                            contact=np.ones((len(t), 1), dtype=bool), contact_frames=("sole",))
     stderr = {"F_v": 0.0011, "F_c": 0.0022, "S": 0.0033, "v_s": 0.00044, "tau_os": 0.0055, "a": 0.66}
     fits: dict[str, FitResult] = {
-        "knee": FitResult("knee", 2000, params=THESIS, stderr=stderr, rms_residual=0.0123, target=TARGET),
+        "knee": FitResult("knee", 2000, params=THESIS, stderr=stderr, rms_residual=0.0123, target=TARGET,
+                          success=True, speed=1.0),
         "ankle": FitResult("ankle", 1999, params=SIMPLE, stderr={"F_v": 0.01, "F_c": 0.02, "tau_os": 0.03},
-                           rms_residual=0.0456)}
+                           rms_residual=0.0456, success=True, speed=0.01)}
     energy = {e.joint: e for e in energy_consistency(est, fitted_offsets(fits.values()))}
     parser = _Table()
     parser.feed(render_html(Report(est, fits, energy, [("robot", "test")], 0.05)))
@@ -73,25 +74,27 @@ def _value(cell: str) -> float:
 
 def test_each_column_shows_its_own_parameter(table):
     head = table[0]
-    names = head[3:-1]
-    assert head[:3] == ["joint", "model", "N"] and set(names) == {"F_v", "F_c", "S", "v_s", "tau_os", "a"}
+    names = head[4:-1]
+    assert head[:4] == ["joint", "model", "status", "N"] and set(names) == {"F_v", "F_c", "S", "v_s", "tau_os", "a"}
     rows = {r[0].strip(): r for r in table[1:]}
     knee, ankle = rows["knee"], rows["ankle"]
-    for i, n in enumerate(names, start=3):
+    for i, n in enumerate(names, start=4):
         assert _value(knee[i]) == pytest.approx(getattr(THESIS, n), rel=1e-3), n
         if n in SIMPLE.names:
             assert _value(ankle[i]) == pytest.approx(getattr(SIMPLE, n), rel=1e-3), n
         else:  # not a parameter of the Coulomb-viscous model: blank
             assert ankle[i].strip() == "", n
-    assert (knee[1], knee[2], ankle[1], ankle[2]) == ("thesis", "2000", "coulomb-viscous", "1999")
+    assert (knee[1], knee[3], ankle[1], ankle[3]) == ("thesis", "2000", "coulomb-viscous", "1999")
+    # the ankle moved at most 0.01 rad/s: its numbers are shown greyed, with the reason
+    assert knee[2] == "ok" and ankle[2].startswith("not excited: it hardly moved")
     assert _value(knee[-1]) == pytest.approx(0.0123, rel=1e-3) and _value(ankle[-1]) == pytest.approx(0.0456, rel=1e-3)
 
 
 def test_target_and_error_rows_are_the_joints_own(table):
-    names = table[0][3:-1]
+    names = table[0][4:-1]
     target = next(r for r in table if r[0].strip() == "target")
     error = next(r for r in table if r[0].strip() == "error [%]")
-    for i, n in enumerate(names, start=3):
+    for i, n in enumerate(names, start=4):
         t, p = getattr(TARGET, n), getattr(THESIS, n)
         assert _value(target[i]) == pytest.approx(t, rel=1e-3), n
         assert _value(error[i]) == pytest.approx(100 * abs(p - t) / abs(t), abs=0.006), n

@@ -65,6 +65,7 @@ from wbfriction.friction.models import (
     stribeck_viscous,
 )
 from wbfriction.friction.screen import gross_outliers
+from wbfriction.friction.status import FitVerdict, fit_verdict
 from wbfriction.workers import process_pool
 
 ModelChoice = Literal["auto", "coulomb-viscous", "stribeck", "thesis"]
@@ -206,6 +207,8 @@ class FitResult(Generic[ParamsT]):
         selection: how ``model="auto"`` chose the model, or None.
         n_screened: valid samples left out as gross outliers
             (:func:`~wbfriction.friction.screen.gross_outliers`), not in :attr:`n_samples`.
+        speed: the 95th percentile of ``|qd|`` over the samples used [rad/s] (how much the joint moved), or
+            None (not known: a parameters file of an earlier version).
     """
 
     joint: str
@@ -222,6 +225,7 @@ class FitResult(Generic[ParamsT]):
     at_bound: dict[str, bool] = field(default_factory=dict)
     selection: ModelSelection | None = None
     n_screened: int = 0
+    speed: float | None = None
 
     def __post_init__(self) -> None:
         if self.params is not None:
@@ -230,6 +234,11 @@ class FitResult(Generic[ParamsT]):
     def bounded(self) -> tuple[str, ...]:
         """Names of the parameters at a bound (:attr:`at_bound`)."""
         return tuple(n for n, at in self.at_bound.items() if at)
+
+    def verdict(self) -> FitVerdict:
+        """Whether these numbers can be used: ``ok``, ``weak``, ``at bound``, ``not excited`` or ``failed``,
+        and why (:func:`~wbfriction.friction.status.fit_verdict`)."""
+        return fit_verdict(self)
 
     def error_percent(self) -> dict[str, float] | None:
         """Relative error of each parameter against :attr:`target` [%] (Tables 6.1, 6.2); for a
@@ -617,9 +626,10 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
         return _from_fit(model, x)
 
     n = int(use.sum())
-    if n < max(min_samples, len(names) + 1):
-        return FitResult(joint, n, message=f"only {n} valid samples", model=model)
     v, yu = qd[use], y[use]
+    speed = float(np.percentile(np.abs(v), 95)) if n else 0.0
+    if n < max(min_samples, len(names) + 1):
+        return FitResult(joint, n, message=f"only {n} valid samples", model=model, speed=speed)
     starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(v, yu, model)
     starts = [_to_fit(model, x) for x in starts]
     starts = list({tuple(x[free]): x[free] for x in starts}.values())  # distinct over the free ones
@@ -650,7 +660,7 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
         joint=joint, n_samples=n, params=MODEL_PARAMS[model].from_vector(full(best.x), delta_s),
         stderr=dict(zip(names, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
         success=bool(best.success), message=str(best.message), model=model,
-        at_bound=dict(zip(names, map(bool, at_bound))))
+        at_bound=dict(zip(names, map(bool, at_bound))), speed=speed)
 
 
 def _fit_column(args: tuple) -> FitResult:

@@ -236,7 +236,9 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
                          "rms_residual": clean(fit.rms_residual), "model": fit.model,
                          "params": None if fit.params is None else fit.params.to_dict(),
                          "stderr": {k: clean(v) for k, v in fit.stderr.items()},
-                         "at_bound": dict(fit.at_bound)}
+                         "at_bound": dict(fit.at_bound), "speed": fit.speed}
+    verdict = fit.verdict()
+    d["status"], d["status_reason"] = verdict.status, verdict.reason
     if fit.selection is not None:
         d["selection"] = selection_to_dict(fit.selection)
     if fit.rms_error_vs_true is not None:
@@ -251,7 +253,9 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
 def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
     """Inverse of :func:`fit_to_dict` (a ``null`` standard error reads back as ``inf``: not
     identifiable). Without ``model`` (files of earlier versions) the parameters are those of (3.5);
-    without ``at_bound``, no parameter is known to be at a bound (an empty table).
+    without ``at_bound``, no parameter is known to be at a bound (an empty table); without ``speed``, how much
+    the joint moved is not known. ``status`` is not read: it follows from the rest
+    (:meth:`~wbfriction.friction.fit.FitResult.verdict`).
 
     Raises:
         InputError: an unknown model, unknown parameter names (or ``at_bound`` names that are not
@@ -262,7 +266,8 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
         res: FitResult = FitResult(joint=joint, n_samples=int(d.get("n_samples", 0)),
                                    n_screened=int(d.get("n_screened", 0)),
                                    success=bool(d.get("success", False)), message=str(d.get("message", "")),
-                                   rms_residual=_number(d.get("rms_residual")), model=model)
+                                   rms_residual=_number(d.get("rms_residual")), model=model,
+                                   speed=None if d.get("speed") is None else _number(d["speed"]))
         if d.get("params") is not None:
             res.params = params_from_dict(model, d["params"])
             res.stderr = {k: _number(v) for k, v in (d.get("stderr") or {}).items()}

@@ -34,6 +34,8 @@ table { border-collapse: collapse; font-size: 0.82rem; font-variant-numeric: tab
 th, td { padding: 3px 8px; text-align: right; border-bottom: 1px solid #eceff2; white-space: nowrap; }
 th { background: #f5f7f9; } td:first-child, th:first-child { text-align: left; }
 tr.flag td { background: #fff1f0; } tr.target td, tr.err td { color: #6b7580; }
+tr.notok td { color: #9aa3ad; } tr.notok td.status { color: #a4520a; white-space: normal; text-align: left; }
+td.status { text-align: left; }
 img { max-width: 100%; height: auto; display: block; }
 nav { display: flex; flex-wrap: wrap; gap: 4px 12px; font-size: 0.85rem; }
 dl { display: grid; grid-template-columns: max-content 1fr; gap: 2px 16px; font-size: 0.82rem; }
@@ -67,8 +69,9 @@ def _fmt(value: float | None, se: float | None = None) -> str:
 
 
 def _params_table(joints: list[str], fits: dict[str, FitResult]) -> str:
-    """Each joint's model and parameters (value ±standard error; "(bound)": at a bound of the fit);
-    blank where a parameter is not one of the joint's model."""
+    """Each joint's model, its fit's status and parameters (value ±standard error; "(bound)": at a bound of
+    the fit); blank where a parameter is not one of the joint's model. A fit that is not ``ok``
+    (:mod:`~wbfriction.friction.status`) is greyed, its status cell giving the reason."""
     names = [n for n in ALL_PARAM_NAMES if any(f.params is not None and n in f.params.names for f in fits.values())]
     head = "".join(f"<th>{n}</th>" for n in names)
     rows = []
@@ -81,26 +84,32 @@ def _params_table(joints: list[str], fits: dict[str, FitResult]) -> str:
 
     for j in joints:
         fit = fits.get(j)
-        if fit is None or fit.params is None:  # said, not printed as parameters
-            n = "—" if fit is None else str(fit.n_samples)
-            why = "not fitted" + ("" if fit is None or not fit.message else f": {fit.message}")
-            rows.append(f'<tr class="unfitted"><td>{html.escape(j)}</td><td>{html.escape(why)}</td><td>{n}</td>'
+        if fit is None:
+            rows.append(f'<tr class="notok"><td>{html.escape(j)}</td><td>—</td><td class="status">not fitted</td>'
+                        "<td>—</td>" + "<td></td>" * (len(names) + 1) + "</tr>")
+            continue
+        verdict = fit.verdict()
+        status = f'<td class="status">{html.escape(str(verdict))}</td>'
+        if fit.params is None:  # said, not printed as parameters
+            rows.append(f'<tr class="notok"><td>{html.escape(j)}</td><td>—</td>{status}<td>{fit.n_samples}</td>'
                         + "<td></td>" * (len(names) + 1) + "</tr>")
             continue
         cells = "".join(cell(fit, n) for n in names)
         screened = f" (−{fit.n_screened} screened)" if fit.n_screened else ""
-        rows.append(f"<tr><td>{html.escape(j)}</td><td>{html.escape(fit.model)}</td><td>{fit.n_samples}{screened}</td>"
-                    f"{cells}"
+        tr = "<tr>" if verdict.ok else '<tr class="notok">'
+        rows.append(f"{tr}<td>{html.escape(j)}</td>"
+                    f"<td>{html.escape(fit.model)}</td>{status}<td>{fit.n_samples}{screened}</td>{cells}"
                     f"<td>{_fmt(fit.rms_residual)}</td></tr>")
         err = fit.error_percent()
         if err is not None and fit.target is not None:
             target = fit.target.values_in(fit.model)
-            rows.append('<tr class="target"><td>&nbsp;&nbsp;target</td><td></td><td></td>'
+            rows.append('<tr class="target"><td>&nbsp;&nbsp;target</td><td></td><td></td><td></td>'
                         + "".join(f"<td>{_fmt(target[n]) if n in target else ''}</td>" for n in names)
                         + "<td></td></tr>")
-            rows.append('<tr class="err"><td>&nbsp;&nbsp;error [%]</td><td></td><td></td>'
+            rows.append('<tr class="err"><td>&nbsp;&nbsp;error [%]</td><td></td><td></td><td></td>'
                         + "".join(f"<td>{f'{err[n]:.2f}' if n in err else ''}</td>" for n in names) + "<td></td></tr>")
-    return (f'<table id="parameters"><tr><th>joint</th><th>model</th><th>N</th>{head}<th>RMS residual [N·m]</th></tr>'
+    return (f'<table id="parameters"><tr><th>joint</th><th>model</th><th>status</th><th>N</th>{head}'
+            '<th>RMS residual [N·m]</th></tr>'
             + "".join(rows) + "</table>")
 
 

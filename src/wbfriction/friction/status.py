@@ -1,0 +1,97 @@
+"""A verdict on every fit (issue 24): whether its numbers can be used, and why not in one phrase.
+
+A fit that failed must not print as a result. Each :class:`~wbfriction.friction.fit.FitResult` gets one
+status, the first that applies:
+
+* ``not excited``: too few valid samples to fit, or the joint hardly moved (95th percentile of ``|qd|``
+  below :data:`MIN_SPEED`): its friction is not in these data;
+* ``failed``: the solver stopped without converging (its message translated, :func:`solver_phrase`);
+* ``at bound``: a parameter was left on a bound of the fit's search (its value is the bound's, not the
+  data's), named. A magnitude at its floor of zero (F_c, F_v, S, F_s = 0: no such friction found) is a
+  result, not a bound of the search;
+* ``weak``: a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error above
+  :data:`WEAK` of its (non-zero) value, or is not identifiable (infinite standard error);
+* ``ok``: none of these.
+
+The table, the parameters JSON (``status``, ``status_reason``) and the report show it; a fit that is not
+``ok`` is shown dimmed there, with its reason.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Literal, get_args
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from wbfriction.friction.fit import FitResult
+
+FitStatus = Literal["ok", "weak", "at bound", "not excited", "failed"]
+"""A fit's verdict (module docstring)."""
+FIT_STATUSES: tuple[FitStatus, ...] = get_args(FitStatus)
+MIN_SPEED = 0.02
+"""A joint whose 95th percentile of ``|qd|`` over the fitted samples is below this [rad/s] is not excited."""
+WEAK = 0.5
+"""A user-facing parameter whose standard error exceeds this share of its value makes a fit weak."""
+READ = ("F_c", "F_v")
+"""The magnitudes a user reads off a fit (tau_os is judged against F_c: it may be zero)."""
+ZERO_FLOOR = ("F_v", "F_c", "S", "F_s")
+"""Magnitudes whose lower bound is zero: there, the data say "none of this friction"."""
+ZERO = 1e-6
+"""A magnitude below this (in its unit) is at its floor of zero."""
+
+
+@dataclass(frozen=True)
+class FitVerdict:
+    """A fit's status and the reason, one phrase ("" when ``ok``)."""
+
+    status: FitStatus
+    reason: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    def __str__(self) -> str:
+        return self.status + (f": {self.reason}" if self.reason else "")
+
+
+def solver_phrase(message: str) -> str:
+    """What ``scipy.optimize.least_squares``' message means for the result, in one phrase."""
+    text = message.strip().rstrip(".")
+    if "maximum number of function evaluations" in text.lower():
+        return "the solver ran out of iterations before it converged"
+    if not text:
+        return "the solver did not converge"
+    return "the solver stopped: " + text[0].lower() + text[1:]
+
+
+def fit_verdict(fit: FitResult) -> FitVerdict:
+    """The status of ``fit`` and its reason (module docstring)."""
+    if fit.params is None:
+        return FitVerdict("not excited", fit.message or "not fitted")
+    if fit.speed is not None and fit.speed < MIN_SPEED:
+        return FitVerdict("not excited", f"it hardly moved (|qd| at most {fit.speed:.2g} rad/s on 95 % of "
+                                         "its samples)")
+    if not fit.success:
+        return FitVerdict("failed", solver_phrase(fit.message))
+    values = fit.params.to_dict()
+    bounded = [n for n in fit.bounded() if not (n in ZERO_FLOOR and abs(values[n]) < ZERO)]
+    if bounded:
+        return FitVerdict("at bound", "at a bound of the fit: " + ", ".join(bounded))
+    weak = []
+    for name in (n for n in READ if n in fit.stderr and abs(values[n]) >= ZERO):
+        se, value = fit.stderr[name], abs(values[name])
+        if not np.isfinite(se):
+            weak.append(f"{name} not identifiable")
+        elif se > WEAK * value:
+            weak.append(f"{name} ±{100 * se / value:.0f} %")
+    se_os, scale = fit.stderr.get("tau_os", 0.0), abs(values.get("F_c", 0.0))
+    if not np.isfinite(se_os):
+        weak.append("tau_os not identifiable")
+    elif scale >= ZERO and se_os > WEAK * scale:
+        weak.append(f"tau_os ±{se_os:.2g} N·m against F_c {scale:.2g}")
+    if weak:
+        return FitVerdict("weak", "large standard errors: " + ", ".join(weak))
+    return FitVerdict("ok")
