@@ -29,3 +29,11 @@ def test_help_of_every_command_imports_no_heavy_library():
             "    assert r.exit_code == 0, (c, r.output)")
     loaded = _modules_after(code)
     assert [m for m in loaded if m.split(".")[0] in HEAVY] == []
+
+
+def test_import_loads_nothing_heavy_and_every_public_name_resolves():
+    """``import wbfriction`` loads no NumPy or Pinocchio; each name of ``__all__`` (the estimator, the fit and
+    its verdict, saving and loading parameters, the simulators) is reachable from the package."""
+    assert not [m for m in _modules_after("import wbfriction") if m.split(".")[0] in ("numpy", "pinocchio")]
+    import wbfriction
+    assert [n for n in wbfriction.__all__ if getattr(wbfriction, n, None) is None] == []

@@ -36,14 +36,20 @@ if TYPE_CHECKING:
     from wbfriction.logs.source import open_log, read_log
     from wbfriction.model.loading import load_robot
     from wbfriction.model.robot import Robot
+    from wbfriction.friction.status import FitVerdict
     from wbfriction.signals.kinematics import FilterOptions, MeasuredKinematics, measure
+    from wbfriction.sim.ideal import IdealOptions, simulate_ideal
+    from wbfriction.sim.mujoco_sim import MujocoOptions, simulate_mujoco
+    from wbfriction.walking.footsteps import GaitOptions
+    from wbfriction.walking.reference import walking_reference
 
 __all__ = [
-    "ColumnError", "EstimateOptions", "FilterOptions", "FitResult", "FrictionEstimate", "FrictionParams",
-    "InputError", "Log", "MeasuredKinematics", "ModelError", "Robot", "SimulationError", "WbfrictionError",
-    "__version__", "estimate_friction", "estimate_log", "fit_estimate", "fit_friction", "fit_joints",
-    "friction_table", "load_robot", "measure", "open_log", "read_friction_file", "read_log", "read_params",
-    "write_log", "write_params",
+    "ColumnError", "EstimateOptions", "FilterOptions", "FitResult", "FitVerdict", "FrictionEstimate",
+    "FrictionParams", "GaitOptions", "IdealOptions", "InputError", "Log", "MeasuredKinematics", "ModelError",
+    "MujocoOptions", "Robot", "SimulationError", "WbfrictionError", "__version__", "estimate_friction",
+    "estimate_log", "fit_estimate", "fit_friction", "fit_joints", "friction_table", "load_robot", "measure",
+    "open_log", "read_friction_file", "read_log", "read_params", "simulate_ideal", "simulate_mujoco",
+    "walking_reference", "write_log", "write_params",
 ]
 
 
@@ -60,6 +66,11 @@ _HOMES = {
     "load_robot": "wbfriction.model.loading",
     "Robot": "wbfriction.model.robot",
     **dict.fromkeys(("FilterOptions", "MeasuredKinematics", "measure"), "wbfriction.signals.kinematics"),
+    "FitVerdict": "wbfriction.friction.status",
+    **dict.fromkeys(("IdealOptions", "simulate_ideal"), "wbfriction.sim.ideal"),
+    **dict.fromkeys(("MujocoOptions", "simulate_mujoco"), "wbfriction.sim.mujoco_sim"),
+    "GaitOptions": "wbfriction.walking.footsteps",
+    "walking_reference": "wbfriction.walking.reference",
 }
 """Where each public name lives: imported on first use (PEP 562), so that ``import wbfriction``
 (and the command's entry point, :mod:`wbfriction.entry`) loads no NumPy, Pinocchio or SciPy."""
