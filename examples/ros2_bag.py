@@ -1,6 +1,7 @@
 """A ROS 2 bag as a log: a topic map names the joint states and the contact topics; no ROS installation.
 
     python examples/ros2_bag.py                       # writes a small bag from a simulated walk, then reads it
+    python examples/ros2_bag.py --write robot_bag     # only writes it (its map: examples/inputs/bag_map.toml)
     python examples/ros2_bag.py my_bag/ --map map.toml
 
 The samples are the joint-state messages at their header stamps; each contact flag is the latest
@@ -22,18 +23,8 @@ from wbfriction.pipeline import convert_log
 from wbfriction.sim import IdealOptions, simulate_ideal
 from wbfriction.walking import GaitOptions, walking_reference
 
-MAP_TOML = """\
-[joint_states]                   # sensor_msgs/JointState: position and effort by joint name
-topic = "/joint_states"
-
-[[contacts]]                     # std_msgs/Bool, one topic per contact frame of the robot
-frame = "left_sole_link"
-topic = "/left_foot_contact"
-
-[[contacts]]
-frame = "right_sole_link"
-topic = "/right_foot_contact"
-"""
+MAP_TOML = Path(__file__).with_name("inputs") / "bag_map.toml"
+"""The topic map of the bags this example writes (:func:`write_bag`)."""
 
 
 def write_bag(path: Path, log: wbfriction.Log, robot: wbfriction.Robot) -> None:
@@ -68,6 +59,7 @@ def main() -> None:
     parser.add_argument("bag", nargs="?", type=Path, help="a ROS 2 bag folder (default: write one)")
     parser.add_argument("--map", type=Path, help="its topic map TOML (default: the one of the written bag)")
     parser.add_argument("--steps", type=int, default=2, help="steps of the simulated walk")
+    parser.add_argument("--write", type=Path, help="only write the simulated walk's bag into this new folder")
     args = parser.parse_args()
     robot = wbfriction.load_robot("talos")
     out = Path(tempfile.mkdtemp(prefix="wbfriction-bag-"))
@@ -76,9 +68,11 @@ def main() -> None:
         reference = walking_reference(robot, GaitOptions(gait="forward", steps=args.steps))
         friction = friction_by_group(robot.groups, THESIS_TARGETS)
         walk = simulate_ideal(robot, reference, friction, IdealOptions(substeps=10))
-        bag, topic_map = out / "walk_bag", out / "map.toml"
+        bag, topic_map = args.write or out / "walk_bag", MAP_TOML
         write_bag(bag, walk.log, robot)
-        topic_map.write_text(MAP_TOML)
+        if args.write:
+            print(f"wrote {bag} ({len(walk.log)} samples; its topic map: {MAP_TOML})")
+            return
 
     source = wbfriction.open_log(bag, topic_map)  # decides once: a bag, read through its map
     print(f"{bag}: a {source.format} log")

@@ -47,6 +47,7 @@ def test_main_job_steps_write_log_friction_and_params(demo_dir):
         assert col in table.column_names
 
 
+@pytest.mark.slow
 def test_demo_prints_the_thesis_table_and_writes_figures(tmp_path):
     res = run("demo", "-o", tmp_path, "--steps", "2")
     assert res.returncode == 0, res.stderr
@@ -114,6 +115,7 @@ def test_any_robot_from_urdf_and_toml(talos, demo_dir, tmp_path):
                                tmp_path / "g.parquet"), "unknown position-controlled joint 'neck_joint'")
 
 
+@pytest.mark.slow
 def test_filtering_schemes_from_the_command_line(demo_dir, tmp_path):
     """estimate --diff savgol/butterworth, then fit: the fit filters its model like the
     estimate (options read back from the table's metadata) and recovers the knee."""
@@ -143,6 +145,7 @@ def test_spectrum_command(demo_dir, tmp_path):
                            "'head_1_joint' is not a torque-controlled joint")
 
 
+@pytest.mark.slow
 def test_report_and_sensitivity_commands(demo_dir, tmp_path):
     out, _ = demo_dir
     res = run("report", out / "friction.parquet", "--params", out / "params.json", "-o", tmp_path / "r.html")

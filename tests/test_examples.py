@@ -35,6 +35,7 @@ def test_every_example_is_run_here():
     assert tested == {p.name for p in EXAMPLES.glob("*.py")}
 
 
+@pytest.mark.slow
 def test_estimate_a_log():
     out = run_example("estimate_a_log.py", "--steps", "2")
     F_v, F_c, tau_os = numbers(r"leg_right_4_joint +\d+ +([\d.]+) ± +\S+ +([\d.]+) ± +\S+ +([\d.]+)", out)
@@ -57,6 +58,7 @@ def test_ros2_bag():
     assert diff < 1e-9  # the bag carries the log's samples: the same estimate
 
 
+@pytest.mark.slow
 def test_identify_inertia():
     out = run_example("identify_inertia.py", "--steps", "2")
     given, with_friction, identified = numbers(r"given model ([\d.]+), given \+ its best friction ([\d.]+), "

@@ -32,11 +32,11 @@ if TYPE_CHECKING:
     from wbfriction.friction.fit import FitResult, fit_estimate, fit_friction, fit_joints
     from wbfriction.friction.io import friction_table, read_friction_file, read_params, write_params
     from wbfriction.friction.models import FrictionParams
+    from wbfriction.friction.status import FitVerdict
     from wbfriction.logs.log import Log, write_log
     from wbfriction.logs.source import open_log, read_log
     from wbfriction.model.loading import load_robot
     from wbfriction.model.robot import Robot
-    from wbfriction.friction.status import FitVerdict
     from wbfriction.signals.kinematics import FilterOptions, MeasuredKinematics, measure
     from wbfriction.sim.ideal import IdealOptions, simulate_ideal
     from wbfriction.sim.mujoco_sim import MujocoOptions, simulate_mujoco

@@ -73,7 +73,8 @@ EnergyToleranceOpt = typer.Option(DEFAULT_TOLERANCE, min=0.0,
                                        "sensor's resolution).")
 UrdfOpt = typer.Option(None, "--urdf", help="URDF of another robot (with --config), or another URDF of the "
                                              "built-in --robot (e.g. identified inertias).")
-ConfigOpt = typer.Option(None, "--config", help="Robot TOML: contact_frames, position_controlled, groups.")
+ConfigOpt = typer.Option(None, "--config", help="Robot TOML: urdf (else give --urdf), contact_frames, "
+                                                  "position_controlled, groups.")
 FitWorkersOpt = typer.Option(2, min=1, help="Processes fitting joints side by side.")
 TimeUnitOpt = typer.Option(None, help="Unit of a numeric time column: s, ms, us or ns (needed for integer stamps; "
                                       "float stamps are seconds unless said otherwise; timestamps carry theirs).")

@@ -53,6 +53,7 @@ def test_mujoco_imperfections_are_named(talos, options, cause, at_least):
     assert sum(c.cause.startswith(cause) for c in checks) >= at_least
 
 
+@pytest.mark.slow
 def test_the_report_shows_the_routes_cross_checked(talos, tmp_path):
     from wbfriction.friction.io import friction_table
     from wbfriction.logs.tables import write_table

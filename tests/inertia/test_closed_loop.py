@@ -47,6 +47,7 @@ def test_stribeck_velocity_is_the_median_of_the_determined_joints():
     assert stribeck_velocity(fits[3:]) == (None, ())
 
 
+@pytest.mark.slow
 def test_identify_command_closes_the_loop(talos, wrong, combined_walk, tmp_path, capsys):
     """``identify`` on the combined walk seen through the wrong model (one pass, the Stribeck
     velocity given): the leg joints' friction moves back toward the truth (F_c and tau_os

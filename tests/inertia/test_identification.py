@@ -157,6 +157,7 @@ def test_unbounded_friction_of_a_slow_joint_cancels():
     assert min(unbounded[10], unbounded[11]) < 0
 
 
+@pytest.mark.slow
 def test_identification_recovers_model_and_friction_from_a_walk_with_a_wrong_model(talos, combined_walk):
     """The combined walk (Table 6.1 friction) seen through a model with every body's
     principal moments x1.1 and mass x1.05: identification gives back the total mass, the

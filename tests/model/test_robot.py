@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 
@@ -43,5 +45,21 @@ def test_a_built_in_robot_on_another_urdf(talos, tmp_path):
     (tmp_path / "small.urdf").write_text("<robot name='x'><link name='a'/></robot>")
     with pytest.raises(InputError, match="unknown"):
         load_robot("talos", urdf=tmp_path / "small.urdf")
-    with pytest.raises(InputError, match="--config needs the robot's --urdf"):
-        load_robot("talos", config=tmp_path / "c.toml")
+    (tmp_path / "c.toml").write_text('contact_frames = ["left_sole_link", "right_sole_link"]\n')
+    with pytest.raises(InputError, match="no 'urdf' in the robot TOML: give the robot's --urdf"):
+        load_robot(config=tmp_path / "c.toml")
+
+
+def test_a_robot_toml_that_names_its_urdf(talos, tmp_path):
+    """``--config`` alone: the TOML's ``urdf``, relative to the TOML or in ``example-robot-data``, is loaded
+    with that TOML's roles (here TALOS's own TOML, written elsewhere: the built-in robot again)."""
+    from importlib import resources
+    text = resources.files("wbfriction.model.robots").joinpath("talos.toml").read_text()
+    (tmp_path / "package.toml").write_text(text)
+    relative = os.path.relpath(talos.urdf, tmp_path)
+    (tmp_path / "relative.toml").write_text(text.replace(
+        'urdf = "example-robot-data:talos_data/robots/talos_reduced.urdf"', f'urdf = "{relative}"'))
+    for name in ("package.toml", "relative.toml"):
+        robot = load_robot(config=tmp_path / name)
+        assert robot.actuated == talos.actuated and robot.torque_controlled == talos.torque_controlled
+        assert robot.contact_frames == talos.contact_frames and robot.groups == talos.groups

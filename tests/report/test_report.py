@@ -21,6 +21,8 @@ from wbfriction.report.build import acceleration_spectra, make_report
 from wbfriction.report.html import render_html, write_report
 from wbfriction.signals.kinematics import measure
 
+pytestmark = pytest.mark.slow  # module fixtures of 30-55 s (the quick subset: -m "not slow")
+
 CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
 
 

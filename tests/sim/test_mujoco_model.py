@@ -81,6 +81,7 @@ def test_urdf_friction_and_damping_are_dropped(mj_talos):
     assert np.all(mj_talos.model.dof_damping == 0) and np.all(mj_talos.model.dof_frictionloss == 0)
 
 
+@pytest.mark.slow
 def test_talos_walks_forward_and_sideways_on_mujoco(talos, mj_talos):
     """10 steps forward then 10 sideways on real contacts: no fall, joints on their
     reference, contact flags from the soles' normal forces (they differ from the plan only

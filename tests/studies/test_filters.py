@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import pyarrow.parquet as pq
+import pytest
 
 from wbfriction.signals.kinematics import FilterOptions
 from wbfriction.studies.filters import Scheme, run_filter_study
 
 
+@pytest.mark.slow
 def test_filter_study_writes_its_table_and_figure(talos, tmp_path):
     """A small study (2 steps, exact and 1e-4 rad, two schemes): rows for every pair, the
     noisy central differences far worse than the smoothed ones, files written."""

@@ -8,6 +8,8 @@ import pytest
 from wbfriction.friction.io import read_params
 from wbfriction.studies.realistic import run_realistic_study, worst_scored
 
+pytestmark = pytest.mark.slow  # module fixtures of 30-55 s (the quick subset: -m "not slow")
+
 
 @pytest.fixture(scope="module")
 def study(talos, tmp_path_factory):

@@ -9,6 +9,8 @@ import pytest
 
 from wbfriction.studies.sensors import PARTS, run_sensors_study
 
+pytestmark = pytest.mark.slow  # module fixtures of 30-55 s (the quick subset: -m "not slow")
+
 
 @pytest.fixture(scope="module")
 def study(talos, tmp_path_factory):

@@ -8,6 +8,8 @@ import pytest
 from wbfriction.friction.io import read_params
 from wbfriction.studies.simulation import run_study
 
+pytestmark = pytest.mark.slow  # module fixtures of 30-55 s (the quick subset: -m "not slow")
+
 
 @pytest.fixture(scope="module")
 def study(talos, tmp_path_factory):

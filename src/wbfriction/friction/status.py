@@ -20,12 +20,9 @@ The table, the parameters JSON (``status``, ``status_reason``) and the report sh
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal, get_args
+from typing import Any, Literal, Protocol, get_args
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from wbfriction.friction.fit import FitResult
 
 FitStatus = Literal["ok", "weak", "at bound", "not excited", "failed"]
 """A fit's verdict (module docstring)."""
@@ -40,6 +37,18 @@ ZERO_FLOOR = ("F_v", "F_c", "S", "F_s")
 """Magnitudes whose lower bound is zero: there, the data say "none of this friction"."""
 ZERO = 1e-6
 """A magnitude below this (in its unit) is at its floor of zero."""
+
+
+class Fit(Protocol):
+    """What a verdict reads of a fit (:class:`~wbfriction.friction.fit.FitResult`)."""
+
+    params: Any
+    success: bool
+    message: str
+    stderr: dict[str, float]
+    speed: float | None
+
+    def bounded(self) -> tuple[str, ...]: ...
 
 
 @dataclass(frozen=True)
@@ -67,7 +76,7 @@ def solver_phrase(message: str) -> str:
     return "the solver stopped: " + text[0].lower() + text[1:]
 
 
-def fit_verdict(fit: FitResult) -> FitVerdict:
+def fit_verdict(fit: Fit) -> FitVerdict:
     """The status of ``fit`` and its reason (module docstring)."""
     if fit.params is None:
         return FitVerdict("not excited", fit.message or "not fitted")

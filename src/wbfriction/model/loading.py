@@ -326,17 +326,21 @@ def load_robot(name: str | None = "talos", *, urdf: str | Path | None = None,
         >>> robot = load_robot("talos", urdf="talos_identified.urdf")    # doctest: +SKIP
 
     ``urdf`` without ``config`` gives the built-in robot ``name``'s configuration (contact
-    frames, joint roles, groups) on another URDF of the same robot.
+    frames, joint roles, groups) on another URDF of the same robot; ``config`` without ``urdf`` takes the URDF
+    its ``urdf`` key names (a path relative to the TOML, or ``example-robot-data:<path in the package>``).
 
     Raises:
-        InputError: unknown built-in name, missing files, or a bad configuration.
+        InputError: unknown built-in name, missing files, a ``config`` without ``urdf`` that names none, or a
+            bad configuration.
     """
     if config is not None:
-        if urdf is None:
-            raise InputError("--config needs the robot's --urdf")
         cfg_path = Path(config)
         cfg = read_toml(cfg_path)
         cfg["_dir"] = str(cfg_path.parent)
+        if urdf is None:  # the TOML may name its URDF (relative to itself, or "example-robot-data:<path>")
+            if not isinstance(cfg.get("urdf"), str):
+                raise InputError(f"{cfg_path}: no 'urdf' in the robot TOML: give the robot's --urdf")
+            urdf = _resolve(cfg["urdf"], cfg_path.parent)
         return build_robot(Path(urdf), cfg, source=str(cfg_path))
     if name not in BUILTIN_ROBOTS:
         raise InputError(f"unknown robot '{name}': built-in robots are {', '.join(BUILTIN_ROBOTS)}; "
