@@ -27,6 +27,21 @@ def test_one_dataset_per_column_round_trip(talos, log, tmp_path):
     assert (tmp_path / "log.h5").read_bytes() == (tmp_path / "again.h5").read_bytes()
 
 
+def test_metadata_as_fixed_length_bytes_or_as_an_attribute(talos, log, tmp_path):
+    """The metadata is written where a damaged file cannot make HDF5 loop (a fixed-length string, no
+    global heap); a file that carries it as a variable-length attribute (older files) still gives it."""
+    write_log(log, talos, tmp_path / "log.h5")
+    with h5py.File(tmp_path / "log.h5", "r") as f:
+        assert "wbfriction" not in f.attrs
+        stored = f["wbfriction"]
+        assert stored.ndim == 0 and h5py.check_string_dtype(stored.dtype).length is not None
+    with h5py.File(tmp_path / "log.h5", "a") as f:  # as older files have it
+        text = f["wbfriction"][()].decode()
+        del f["wbfriction"]
+        f.attrs["wbfriction"] = text
+    assert read_log(tmp_path / "log.h5", talos).metadata == log.metadata
+
+
 def test_groups_and_a_two_dimensional_dataset(talos, log, tmp_path):
     table = log.to_table(talos)
     names = table.column_names

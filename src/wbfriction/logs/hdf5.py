@@ -9,8 +9,14 @@ Two layouts are read (the first that applies):
    its path names it, with ``/`` read as ``.`` (so ``q/leg_left_1_joint`` and a dataset
    named ``q.leg_left_1_joint`` are the same column).
 
-A JSON string in the file attribute ``wbfriction`` is the log's metadata. :func:`write_hdf5`
-writes layout 2, one dataset per column.
+A JSON string is the log's metadata: the scalar dataset ``wbfriction`` (a fixed-length byte string,
+what :func:`write_hdf5` writes), else the file attribute ``wbfriction`` (older files, other writers).
+:func:`write_hdf5` writes layout 2, one dataset per column.
+
+Why a fixed-length string in a dataset: a variable-length string lives in the file's global heap, and
+HDF5 reading one from a damaged heap can loop for ever (seen with h5py 3 on a file with bytes flipped
+in its heap: ``f.attrs["wbfriction"]`` never returned); a fixed-length one is read as its bytes, and a
+dataset has no 64 KiB limit as an attribute does.
 """
 
 from __future__ import annotations
@@ -26,6 +32,8 @@ from wbfriction.exceptions import InputError
 
 SUFFIXES = (".h5", ".hdf5", ".he5")
 NAMES_ATTRS = ("names", "columns")
+META = "wbfriction"
+"""Name of the metadata's scalar dataset (and of the attribute older files carry)."""
 
 
 def _names(attr) -> list[str]:
@@ -36,7 +44,8 @@ def _layout(f, path: Path) -> tuple[dict[str, tuple[Any, int | None]], str | Non
     """Column name -> (dataset, column index in a 2-D dataset or None), and the metadata."""
     import h5py
 
-    meta = f.attrs.get("wbfriction")
+    stored = f.get(META)
+    meta = stored[()] if isinstance(stored, h5py.Dataset) and stored.ndim == 0 else f.attrs.get(META)
     datasets: list[tuple[str, Any]] = []  # h5py.Dataset (h5py has no type hints)
     f.visititems(lambda name, obj: datasets.append((name, obj)) if isinstance(obj, h5py.Dataset) else None)
     cols: dict[str, tuple[Any, int | None]] = {}
@@ -126,4 +135,4 @@ def write_hdf5(table: pa.Table, path: str | Path) -> None:
             f.create_dataset(name, data=data, track_times=False)  # no timestamps: same input, same bytes
         meta = (table.schema.metadata or {}).get(b"wbfriction")
         if meta is not None:
-            f.attrs["wbfriction"] = meta.decode()
+            f.create_dataset(META, data=np.bytes_(meta), track_times=False)
