@@ -59,8 +59,10 @@ def test_a_solver_that_did_not_converge_failed_and_says_why():
     fit = dataclasses.replace(fit_friction(*_data(1.0)), success=False,
                               message="The maximum number of function evaluations is exceeded.")
     assert fit.verdict().status == "failed"
-    assert fit.verdict().reason == "the solver ran out of iterations before it converged"
-    assert solver_phrase("`xtol` termination condition is satisfied.").startswith("the solver stopped: `xtol`")
+    assert fit.verdict().reason == ("the solver stopped at its evaluation limit before converging: the parameters "
+                                    "are not a minimum of the fit")
+    assert solver_phrase("Something new.") == ("the solver stopped (the solver said: Something new); whether at a "
+                                               "minimum is not known")
 
 
 def test_zero_friction_found_is_a_result_not_a_bound():

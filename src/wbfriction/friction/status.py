@@ -24,6 +24,8 @@ from typing import Any, Literal, Protocol, get_args
 
 import numpy as np
 
+from wbfriction.friction.solver import explain_solver
+
 FitStatus = Literal["ok", "weak", "at bound", "not excited", "failed"]
 """A fit's verdict (module docstring)."""
 FIT_STATUSES: tuple[FitStatus, ...] = get_args(FitStatus)
@@ -67,13 +69,9 @@ class FitVerdict:
 
 
 def solver_phrase(message: str) -> str:
-    """What ``scipy.optimize.least_squares``' message means for the result, in one phrase."""
-    text = message.strip().rstrip(".")
-    if "maximum number of function evaluations" in text.lower():
-        return "the solver ran out of iterations before it converged"
-    if not text:
-        return "the solver did not converge"
-    return "the solver stopped: " + text[0].lower() + text[1:]
+    """What ``scipy.optimize.least_squares``' message means for the result, in one phrase: "the solver "
+    and :func:`~wbfriction.friction.solver.explain_solver`'s meaning."""
+    return "the solver " + explain_solver(message).meaning
 
 
 def fit_verdict(fit: Fit) -> FitVerdict:

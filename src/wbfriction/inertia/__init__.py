@@ -2,7 +2,8 @@
 :mod:`.regressor`, :mod:`.least_squares`, :mod:`.consistency`, :mod:`.identification`), the loop
 that re-estimates the friction with it (:mod:`.closed_loop`), the sensitivity of the estimate to
 inertia errors (:mod:`.sensitivity`, 7.2), the corrected URDF (:mod:`.urdf`) and the
-identification JSON (:mod:`.io`)."""
+identification JSON (:mod:`.io`); the identified limbs kept only where held-out torques are
+predicted better (:mod:`.validation`); solvers' stopping messages in words (:mod:`.solver`)."""
 
 from wbfriction.inertia.closed_loop import ClosedLoop, identify
 from wbfriction.inertia.identification import InertialIdentification, InertialOptions, identify_inertia

@@ -202,12 +202,18 @@ def prior_model(pi0: np.ndarray, rest0: np.ndarray, rest_std: np.ndarray,
 @dataclass(frozen=True)
 class ConsistentFit:
     """Result of :func:`fit_consistent`: inertial parameters (nb, 10), physically consistent; the
-    other parameters (friction, armature) (k,); half the objective; the optimizer's message."""
+    other parameters (friction, armature) (k,); half the objective; what happened, in words; and, when
+    the non-linear solve ran, ``scipy.optimize.least_squares``' status and raw message
+    (:func:`~wbfriction.friction.solver.explain_solver` translates them) and the number of bodies of
+    the linear solution that were not physical (None, "" and 0 otherwise)."""
 
     pi: np.ndarray
     rest: np.ndarray
     cost: float
     message: str
+    status: int | None = None
+    solver_message: str = ""
+    unphysical: int = 0
 
     @property
     def x(self) -> np.ndarray:
@@ -331,4 +337,5 @@ def fit_consistent(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float, lo
     x[:n_in] = nearest_consistent(x[:n_in].reshape(nb, 10)).ravel()
     r = A @ x - c
     return ConsistentFit(x[:n_in].reshape(nb, 10), x[n_in:], 0.5 * float(r @ r),
-                         f"{int((~ok).sum())} bodies of the linear solution were not physical: {res.message}")
+                         f"{int((~ok).sum())} bodies of the linear solution were not physical: {res.message}",
+                         int(res.status), str(res.message), int((~ok).sum()))

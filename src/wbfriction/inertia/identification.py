@@ -70,6 +70,15 @@ The compressed systems give every score without another pass over the log. The w
 from strong to weak, and the search stops at the first weight that scores worse than the best.
 (Each fit starts from the linear solution: started from a neighbouring weight's, the non-linear
 solve stalls short of it.)
+
+**Kept only where held-out data improve** (issue 24). On a log the given model already explains, the fit
+moves the model by noise, and predicted held-out torques worse on most leg joints of a simulated walk. The
+identified inertias are therefore kept per limb (an unbranched chain of bodies) only where the model predicts
+the held-out samples better than the given model with its best friction (by 1 % over all joints, no
+joint more than 5 % worse: :mod:`~wbfriction.inertia.validation`); the other limbs stay as given, and the
+friction (and armature) is the one that best explains the training data with the inertias kept. The
+solver's stopping message is translated (:mod:`~wbfriction.friction.solver`): a solve stopped at its
+evaluation limit is not a minimum, and the gate is what keeps its result honest.
 """
 
 from __future__ import annotations
@@ -83,10 +92,10 @@ import pinocchio as pin
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import EstimateOptions, resolve_differentiation
+from wbfriction.friction.solver import SolverOutcome, explain_solver
 from wbfriction.inertia.consistency import (
     FRICTION,
     STRIBECK,
-    ConsistentFit,
     Prior,
     PriorUncertainty,
     fit_consistent,
@@ -96,6 +105,7 @@ from wbfriction.inertia.consistency import (
 from wbfriction.inertia.excitation import Unexcited, parameter_names, unexcited_parameters
 from wbfriction.inertia.least_squares import BaseParameters, CompressedLeastSquares, base_parameters
 from wbfriction.inertia.regressor import body_parameters, stance_regressor, with_body_parameters
+from wbfriction.inertia.validation import Validation, limbs, validate_groups
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
 from wbfriction.model.stance import stance_frame_pose
@@ -169,12 +179,17 @@ class InertialOptions:
 
 @dataclass
 class TorqueFit:
-    """RMS of measured minus predicted joint torques per torque-controlled joint [N·m]."""
+    """RMS of measured minus predicted held-out joint torques per torque-controlled joint [N·m] (n_tc,):
+    the given model (its armature included, no friction), the given model with its best friction (the
+    physical friction, and armature when identified, that best explains the training data with the given
+    inertias), the identified model (the fit's inertias and friction) and the validated one (the inertias
+    the gate kept, :mod:`~wbfriction.inertia.validation`, with their best friction: the model written)."""
 
     given: np.ndarray
     given_with_friction: np.ndarray
     identified: np.ndarray
     samples: int
+    validated: np.ndarray | None = None
 
 
 @dataclass
@@ -182,18 +197,25 @@ class InertialIdentification:
     """What :func:`identify_inertia` found.
 
     Attributes:
-        robot: the robot with the identified inertias (same structure as the given one) and, with
-            ``armature = "identify"``, the identified armature in its ``model.armature``.
+        robot: the robot with the validated inertias (same structure as the given one: the identified
+            ones of the limbs the held-out data kept, the given ones elsewhere,
+            :mod:`~wbfriction.inertia.validation`) and, with ``armature = "identify"``, the validated
+            model's armature in its ``model.armature``.
         bodies: body names (the Pinocchio joint carrying each body) (nb,).
-        pi_given, pi: inertial parameters of the given and identified model (nb, 10).
+        pi_given, pi: inertial parameters of the given and the validated model (nb, 10) (about each
+            body's joint frame, :func:`~wbfriction.inertia.regressor.body_parameters` order; kg, kg·m,
+            kg·m^2): what is written to the URDF.
         friction_names: the friction parameters (:func:`friction_names`), k of them.
-        friction: identified friction parameters per torque-controlled joint (n_tc, k).
+        friction: the validated model's friction per torque-controlled joint (n_tc, k): the physical
+            friction that best explains the training data with its inertias (all limbs kept: the
+            identified inertias'; none: :attr:`friction_given_model`).
         friction_given_model: the physical friction (:data:`~wbfriction.inertia.consistency.FRICTION_LOWER`) that best
             explains the data with the given inertias (n_tc, k).
         base: the base parameters, over ``(pi.ravel(), friction.ravel()[, armature])``.
         holdout: torque predictions on the held-out samples.
         samples: single-support samples in the regression.
-        message: the optimizer's.
+        message: how the fit went, in words (the non-linear solver's stopping message translated,
+            :func:`~wbfriction.friction.solver.explain_solver`, and the accelerations' noise).
         prior: the prior's weight used (in units of the residual variance).
         prior_scores: with the prior chosen by validation, the RMS torque residual on the
             validation samples for each weight tried [N·m].
@@ -208,6 +230,10 @@ class InertialIdentification:
             is noise in the regressor: least squares then shrinks every inertia toward zero (errors
             in variables); above :data:`NOISY_ACCELERATION` the message says so (filter them:
             ``diff = "auto"`` or ``"butterworth"``).
+        pi_fit, friction_fit: the fit's inertial parameters (nb, 10) and friction (n_tc, k) before the gate.
+        validation: the gate's decision per limb (:func:`~wbfriction.inertia.validation.validate_groups`).
+        solver: why the non-linear solver stopped (:class:`~wbfriction.friction.solver.SolverOutcome`;
+            ``raw`` empty when the linear solution was physical and no solver ran).
     """
 
     robot: Robot
@@ -229,6 +255,10 @@ class InertialIdentification:
     unexcited: tuple[Unexcited, ...] = ()
     residual_std: float = float("nan")
     acceleration_noise: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    pi_fit: np.ndarray = field(default_factory=lambda: np.zeros((0, 10)))
+    friction_fit: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    validation: Validation | None = None
+    solver: SolverOutcome | None = None
 
 
 def friction_names(options: InertialOptions) -> tuple[str, ...]:
@@ -400,12 +430,13 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
         progress: optional callable receiving numbers of samples done.
 
     Returns:
-        :class:`InertialIdentification`.
+        :class:`InertialIdentification`: its ``robot``/``pi``/``friction`` are the validated model's (the
+        identified limbs that predict held-out torques better, the given ones elsewhere; module docstring),
+        ``pi_fit``/``friction_fit`` the fit's, ``validation`` the decision per limb.
 
     Raises:
         InputError: no single-support sample to learn from, or none held out.
     """
-    from scipy.optimize import lsq_linear
     parts = _split(robot, log, estimate_options, options)
     nb, n_tc = robot.model.njoints - 1, len(robot.torque_controlled)
     k = len(friction_names(options))
@@ -424,9 +455,8 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
                             np.zeros(fitting.n - p_in - k * n_tc)])  # armature >= 0
     # physical friction (and armature) that best explains the data with the given inertias: the start,
     # and the given model's best case
-    rest_best = lsq_linear(R[:, p_in:], z - R[:, :p_in] @ pi0.ravel(), bounds=(lower[p_in:], np.inf),
-                           method="bvls").x
-    friction0 = rest_best[:k * n_tc].reshape(n_tc, k)
+    best_rest_of = _BestRest(R, z, lower, p_in, n_tc, k, options.armature == "identify")
+    friction0 = best_rest_of(pi0)[:k * n_tc].reshape(n_tc, k)
     prior_of = _prior(robot, pi0, friction0, _torque_rms(robot, parts), options)
     base = base_parameters(R, options.rank_tolerance)
     prior, scores = options.prior, {}
@@ -443,33 +473,98 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
         prior = min(scores, key=scores.__getitem__)
     variance = residual_variance(total)
     fit = fit_consistent(R, z, prior_of, prior * variance, lower, options.min_mass)
-    friction = fit.rest[:k * n_tc].reshape(n_tc, k)
+    bodies = tuple(robot.model.names[1:])
+    groups = limbs(robot.model)
+    held = _held_out(robot, parts, pi0, fit.pi, groups, options)
+    if held.samples == 0:
+        raise InputError(f"{log.source}: no single-support sample in the held-out {options.holdout:.0%} of the log")
+    best_rest: dict[tuple[bool, ...], np.ndarray] = {}
+
+    def model_of(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The inertias with the limbs ``mask`` identified, the others given, and their best friction."""
+        key = tuple(bool(x) for x in mask)
+        pi = pi0.copy()
+        for g in np.flatnonzero(mask):
+            pi[list(groups[g].bodies)] = fit.pi[list(groups[g].bodies)]
+        if key not in best_rest:
+            best_rest[key] = best_rest_of(pi)
+        return pi, best_rest[key]
+
+    validation = validate_groups(groups, bodies, robot.torque_controlled, held.measured,
+                                 lambda mask: held.predict(mask, model_of(mask)[1]))
+    pi_valid, rest_valid = model_of(validation.kept)
+    rest_best = model_of(np.zeros(len(groups), dtype=bool))[1]
+    friction0 = rest_best[:k * n_tc].reshape(n_tc, k)
+    holdout = held.torque_fit(rest_best, fit.rest, validation.kept, rest_valid)
+    friction_fit = fit.rest[:k * n_tc].reshape(n_tc, k).copy()
+    friction = rest_valid[:k * n_tc].reshape(n_tc, k).copy()
     if k == len(FRICTION) + 1 and options.stribeck_joints is not None:  # no column: no Stribeck term, not a bound
-        friction[~np.isin(robot.torque_controlled, options.stribeck_joints), -1] = 0.0
+        for f in (friction, friction_fit):
+            f[~np.isin(robot.torque_controlled, options.stribeck_joints), -1] = 0.0
     arm_given = given_armature(robot)
-    armature = {"identify": fit.rest[k * n_tc:], "known": arm_given, "none": np.zeros(n_tc)}[options.armature]
-    model = with_body_parameters(robot.model, fit.pi)
+    armature = {"identify": rest_valid[k * n_tc:], "known": arm_given, "none": np.zeros(n_tc)}[options.armature]
+    model = with_body_parameters(robot.model, pi_valid)
     if options.armature == "identify":
         full = model.armature.copy()
         full[robot.act_v_index[robot.tc_index]] = armature
         model.armature = full
     identified = dataclasses.replace(robot, model=model, cache={})
-    holdout = _torque_fit(robot, parts, pi0, rest_best, fit, options)
-    if holdout.samples == 0:
-        raise InputError(f"{log.source}: no single-support sample in the held-out {options.holdout:.0%} of the log")
-    bodies = tuple(robot.model.names[1:])
     names = parameter_names(bodies, _rest_names(robot, options))
     unexcited = unexcited_parameters(R, prior_of, prior * variance, names)
     noise = acceleration_noise([(part.kin, part.use) for part in parts], robot.tc_index)
-    message = fit.message
+    solver = explain_solver(fit.solver_message, fit.status) if fit.status is not None else SolverOutcome(
+        "", None, True, "not needed: the linear least-squares solution is physically consistent")
+    if fit.status is None:
+        message = "the linear least-squares solution is physically consistent"
+    else:
+        message = (f"{fit.unphysical} bodies of the linear solution were not physical; the non-linear solve "
+                   f"{solver.meaning}")
+        if not solver.converged:
+            message += "; kept only where held-out data improve"
     if np.any(noise > NOISY_ACCELERATION):
         worst = int(np.argmax(noise))
         message += (f"; noisy accelerations ({robot.torque_controlled[worst]}: {noise[worst]:.0%} of their power "
                     f"above {0.25 / log.dt:.0f} Hz) shrink the identified inertias: filter them (diff 'auto' or "
                     "'butterworth')")
-    return InertialIdentification(identified, bodies, pi0, fit.pi, friction_names(options), friction, friction0, base,
-                                  holdout, samples, message, prior, scores, options.armature, arm_given,
-                                  np.array(armature, dtype=float), unexcited, float(np.sqrt(variance)), noise)
+    return InertialIdentification(
+        identified, bodies, pi0, pi_valid, friction_names(options), friction, friction0, base, holdout, samples,
+        message, prior, scores, options.armature, arm_given, np.array(armature, dtype=float), unexcited,
+        float(np.sqrt(variance)), noise, pi_fit=fit.pi, friction_fit=friction_fit, validation=validation,
+        solver=solver)
+
+
+class _BestRest:
+    """The physical friction (and armature when identified) that best explains the compressed system
+    ``R`` (p, p), ``z`` (p,) with given inertias: ``min |R_rest x - (z - R_in pi)|`` over ``x >= lower``.
+
+    The problem splits by joint: a joint's friction and armature columns act on its own rows only, so
+    the columns of two joints are orthogonal (``R_i^T R_j = A_i^T A_j = 0``) and each joint's
+    parameters solve a bounded least squares of their own, here reduced to k x k (``R_j = Q_j T_j``):
+    the same minimum as the whole bounded problem, for a few k x k solves instead of a p x (k n_tc)
+    one per candidate model."""
+
+    def __init__(self, R: np.ndarray, z: np.ndarray, lower: np.ndarray, p_in: int, n_tc: int, k: int,
+                 armature: bool):
+        import scipy.linalg
+        self.R, self.z, self.p_in = R, z, p_in
+        n_rest = R.shape[1] - p_in
+        self.columns = [np.array([k * i + c for c in range(k)] + ([k * n_tc + i] if armature else []))
+                        for i in range(n_tc)]
+        self.n_rest = n_rest
+        self.lower = lower[p_in:]
+        self.factors = [scipy.linalg.qr(R[:, p_in + cols], mode="economic") for cols in self.columns]
+
+    def __call__(self, pi: np.ndarray) -> np.ndarray:
+        """The best rest parameters (k n_tc [+ n_tc],) for the inertias ``pi`` (nb, 10)."""
+        from scipy.optimize import lsq_linear
+        rhs = self.z - self.R[:, :self.p_in] @ pi.ravel()
+        out = np.zeros(self.n_rest)
+        for cols, (Q, T) in zip(self.columns, self.factors):
+            y, lo = Q.T @ rhs, self.lower[cols]
+            if not np.any(T):
+                continue  # a joint without rows: nothing to fit
+            out[cols] = lsq_linear(T, y, bounds=(lo, np.full(len(cols), np.inf)), method="bvls").x
+        return out
 
 
 def acceleration_noise(stretches: list[tuple[MeasuredKinematics, np.ndarray]], columns: np.ndarray) -> np.ndarray:
@@ -532,13 +627,67 @@ def _system(robot: Robot, parts: list[_Part], which: Literal["train", "validatio
     return total
 
 
-def _torque_fit(robot: Robot, parts: list[_Part], pi0: np.ndarray, rest_best: np.ndarray, fit: ConsistentFit,
-                options: InertialOptions) -> TorqueFit:
-    """RMS torque errors of the given model (its armature included; without and with its best
-    friction) and of the identified one on the held-out samples."""
+@dataclass
+class _HeldOut:
+    """The held-out samples, stacked, in the form every candidate model's prediction needs [N·m]: the
+    measured torques (less a known armature's share) ``measured`` (N, n_tc); the given inertias'
+    prediction ``given`` (N, n_tc) and the given armature's share ``given_armature`` (N, n_tc, zeros
+    unless identified); each limb's identified change of the prediction ``effects`` (n_groups, N, n_tc)
+    (the torques are linear in the inertias); each joint's own friction (and armature) columns
+    ``features`` (N, n_tc, k[+1]) (:func:`_friction_columns`, :func:`_armature_columns`)."""
+
+    measured: np.ndarray
+    given: np.ndarray
+    effects: np.ndarray
+    features: np.ndarray
+    given_armature: np.ndarray
+    armature: bool
+
+    @property
+    def samples(self) -> int:
+        return int(self.measured.shape[0])
+
+    def friction(self, rest: np.ndarray) -> np.ndarray:
+        """The torques (N, n_tc) of the friction (and armature) ``rest`` (k per joint, then one armature
+        per joint when identified: the regression's order)."""
+        n_tc, kk = self.features.shape[1:]
+        k = kk - int(self.armature)
+        per_joint = rest[:k * n_tc].reshape(n_tc, k)
+        if self.armature:
+            per_joint = np.column_stack([per_joint, rest[k * n_tc:]])
+        return np.einsum("nik,ik->ni", self.features, per_joint)
+
+    def predict(self, mask: np.ndarray, rest: np.ndarray) -> np.ndarray:
+        """The held-out torques (N, n_tc) of the given inertias with the limbs ``mask`` (n_groups,) identified,
+        and the friction ``rest``."""
+        return self.given + self.effects[np.asarray(mask, dtype=bool)].sum(axis=0) + self.friction(rest)
+
+    def torque_fit(self, rest_best: np.ndarray, rest_fit: np.ndarray, kept: np.ndarray,
+                   rest_valid: np.ndarray) -> TorqueFit:
+        """Per joint RMS of the given model, it with ``rest_best``, the identified one (every limb, the fit's
+        ``rest_fit``) and the validated one (the limbs ``kept``, ``rest_valid``)."""
+        G = self.effects.shape[0]
+        rms = lambda pred: np.sqrt(np.mean((pred - self.measured) ** 2, axis=0))  # noqa: E731
+        return TorqueFit(rms(self.given + self.given_armature), rms(self.predict(np.zeros(G, bool), rest_best)),
+                         rms(self.predict(np.ones(G, bool), rest_fit)), self.samples,
+                         rms(self.predict(kept, rest_valid)))
+
+
+def _held_out(robot: Robot, parts: list[_Part], pi0: np.ndarray, pi_fit: np.ndarray, groups,
+              options: InertialOptions) -> _HeldOut:
+    """The held-out samples' arrays (:class:`_HeldOut`)."""
     n_tc = len(robot.torque_controlled)
-    sq = np.zeros((3, n_tc))
-    count = 0
+    k = len(friction_names(options))
+    arm = options.armature == "identify"
+    cols = np.array([[k * i + c for c in range(k)] + ([k * n_tc + i] if arm else []) for i in range(n_tc)])
+    idx = np.arange(n_tc)[:, None]
+    deltas = []
+    for g in groups:
+        d = np.zeros_like(pi0)
+        d[list(g.bodies)] = pi_fit[list(g.bodies)] - pi0[list(g.bodies)]
+        deltas.append(d.ravel())
+    D = np.array(deltas).T if deltas else np.zeros((pi0.size, 0))  # (10 nb, G)
+    out: dict[str, list[np.ndarray]] = {"measured": [], "given": [], "effects": [], "features": [], "arm": []}
     for part in parts:
         kin, stance, rows = part.kin, part.stance, part.held
         for c in range(len(robot.contact_frames)):
@@ -547,12 +696,16 @@ def _torque_fit(robot: Robot, parts: list[_Part], pi0: np.ndarray, rest_best: np
                 rr = r[start:start + 1000]
                 Y, C, b = _rows(robot, kin, rr, c, options)
                 T = stance_regressor(robot, c).to_rooted
-                given = Y @ (T @ pi0.ravel())
-                if options.armature == "identify":
-                    given = given + given_armature(robot) * kin.qdd[rr][:, robot.tc_index]
-                preds = (given, Y @ (T @ pi0.ravel()) + C @ rest_best, Y @ (T @ fit.pi.ravel()) + C @ fit.rest)
-                for j, pred in enumerate(preds):
-                    sq[j] += np.sum((pred - b) ** 2, axis=0)
-                count += rr.size
-    rms = np.sqrt(sq / max(count, 1))
-    return TorqueFit(rms[0], rms[1], rms[2], count)
+                out["measured"].append(b)
+                out["given"].append(Y @ (T @ pi0.ravel()))
+                out["effects"].append(np.moveaxis(Y @ (T @ D), 2, 0))
+                out["features"].append(C[:, idx, cols])
+                qdd = kin.qdd[rr][:, robot.tc_index]
+                out["arm"].append(given_armature(robot) * qdd if arm else np.zeros_like(qdd))
+    kk = cols.shape[1]
+    if not out["measured"]:
+        empty = np.zeros((0, n_tc))
+        return _HeldOut(empty, empty, np.zeros((len(groups), 0, n_tc)), np.zeros((0, n_tc, kk)), empty, arm)
+    return _HeldOut(np.concatenate(out["measured"]), np.concatenate(out["given"]),
+                    np.concatenate(out["effects"], axis=1), np.concatenate(out["features"]),
+                    np.concatenate(out["arm"]), arm)

@@ -38,7 +38,17 @@ def identification_document(loop: ClosedLoop, moved: tuple[str, ...] = (),
     and how it was treated, ``armature_mode``), the share of its acceleration's power that is
     noise (``acceleration_noise``: :class:`~wbfriction.inertia.identification.InertialIdentification`),
     the power-generating shares before and after, and the held-out torque RMS. ``moved``: what
-    :func:`wbfriction.inertia.urdf.write_urdf` returned; ``provenance``: recorded last."""
+    :func:`wbfriction.inertia.urdf.write_urdf` returned; ``provenance``: recorded last.
+
+    The gate (:mod:`~wbfriction.inertia.validation`): per pass ``verdict`` (one line), ``validation``
+    (per limb ``kept``, ``reason``, ``joints``, ``rms_before``/``rms_after`` [N·m]; the held-out RMS over
+    all joints and per joint of the given model with its best friction, the identified and the validated
+    model) and ``solver`` (``converged``, ``meaning``, ``raw_message``, ``status``:
+    :func:`~wbfriction.friction.solver.explain_solver`; ``message`` says it in words). ``bodies``
+    describe the validated model (the one written), each with ``kept``, its ``limb`` and what the fit
+    proposed (``identified``: mass, centre-of-mass shift, principal moments); per joint ``identified``
+    is the validated model's friction, ``identified_before_validation`` the fit's, and ``holdout_rms``
+    gains ``validated``."""
     final = loop.final
     ident = final.identification
     changes = inertia_changes(ident.bodies, ident.pi_given, ident.pi)
@@ -56,8 +66,17 @@ def identification_document(loop: ClosedLoop, moved: tuple[str, ...] = (),
             "generating_share": _finite(energy[joint].generating_share),
             "holdout_rms": {"given": float(ident.holdout.given[i]),
                             "given_with_friction": float(ident.holdout.given_with_friction[i]),
-                            "identified": float(ident.holdout.identified[i])},
+                            "identified": float(ident.holdout.identified[i]),
+                            **({} if ident.holdout.validated is None
+                               else {"validated": float(ident.holdout.validated[i])})},
+            "identified_before_validation": dict(zip(ident.friction_names, map(float, ident.friction_fit[i])))
+            if len(ident.friction_fit) else None,
         }
+    kept = {}
+    if ident.validation is not None:
+        kept = {b: (g.kept, g.name) for g in ident.validation.groups for b in g.bodies}
+    fit_changes = {c.body: c for c in inertia_changes(ident.bodies, ident.pi_given, ident.pi_fit)} \
+        if len(ident.pi_fit) else {}
     doc = {
         "sign_convention": ("tau_f = -f(qd); f = F_v qd + F_c tanh(a qd) (+ (F_s - F_c) tanh(a qd) exp(-(qd/v_s)^2))"
                             " + tau_os"),
@@ -72,18 +91,36 @@ def identification_document(loop: ClosedLoop, moved: tuple[str, ...] = (),
                     "residual_std": _finite(p.identification.residual_std),
                     "not_excited": [{"parameter": u.parameter, "information": _finite(u.information),
                                      "partners": u.partners} for u in p.identification.unexcited],
-                    "message": p.identification.message} for p in loop.passes],
+                    "message": p.identification.message,
+                    "solver": None if p.identification.solver is None else p.identification.solver.to_dict(),
+                    "verdict": None if p.identification.validation is None
+                    else p.identification.validation.verdict(f"pass {k + 1}"),
+                    "validation": None if p.identification.validation is None
+                    else p.identification.validation.to_dict()} for k, p in enumerate(loop.passes)],
         "armature_mode": ident.armature_mode,
         "holdout_samples": ident.holdout.samples,
         "moved_to_child_link": list(moved),
         "bodies": [{"body": c.body, "mass_given": c.mass_given, "mass": c.mass, "mass_change": _finite(c.mass_change),
                     "com_shift": c.com_shift, "moments_given": c.moments_given.tolist(), "moments": c.moments.tolist(),
-                    "moments_change": [_finite(x) for x in c.moments_change]} for c in changes],
+                    "moments_change": [_finite(x) for x in c.moments_change],
+                    **_fit_entry(c.body, kept, fit_changes)} for c in changes],
         "joints": joints,
     }
     if provenance is not None:
         doc["provenance"] = provenance
     return doc
+
+
+def _fit_entry(body: str, kept: dict, fit_changes: dict) -> dict[str, Any]:
+    """A body's gate decision (``kept``, ``limb``) and what the fit proposed for it (``identified``)."""
+    out: dict[str, Any] = {}
+    if body in kept:
+        out["kept"], out["limb"] = kept[body]
+    c = fit_changes.get(body)
+    if c is not None:
+        out["identified"] = {"mass": c.mass, "mass_change": _finite(c.mass_change), "com_shift": c.com_shift,
+                             "moments": c.moments.tolist(), "moments_change": [_finite(x) for x in c.moments_change]}
+    return out
 
 
 def write_identification(path: str | Path, doc: dict[str, Any]) -> None:
