@@ -136,3 +136,57 @@ def bag_map(robot, **kw) -> BagMap:
                   base="/odom", **kw)
 
 
+
+
+def drawn_texts(fig) -> list:
+    """Every text a matplotlib figure draws (tick labels, titles, legends...), as (text, window extent [px],
+    font size [px]): recorded while the figure is drawn on the Agg canvas, so texts that are not drawn (ticks
+    outside the view) are not counted."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    renderer = canvas.get_renderer()
+    seen: dict[int, tuple] = {}
+    draw_text = renderer.draw_text
+
+    def record(gc, x, y, s, prop, angle, ismath=False, mtext=None):
+        if mtext is not None and s.strip() and id(mtext) not in seen:
+            seen[id(mtext)] = (mtext.get_text(), mtext.get_window_extent(renderer),
+                               mtext.get_fontsize() * fig.dpi / 72)
+        return draw_text(gc, x, y, s, prop, angle, ismath=ismath, mtext=mtext)
+
+    renderer.draw_text = record
+    fig.draw(renderer)
+    return list(seen.values())
+
+
+def text_overlaps(texts: list, tolerance: float = 1.0) -> list[tuple[str, str]]:
+    """Pairs of texts (:func:`drawn_texts`) whose boxes, shrunk by ``tolerance`` px on every side, intersect."""
+    pairs = []
+    for k, (a, box_a, _) in enumerate(texts):
+        for b, box_b, _ in texts[k + 1:]:
+            w = min(box_a.x1, box_b.x1) - max(box_a.x0, box_b.x0) - 2 * tolerance
+            h = min(box_a.y1, box_b.y1) - max(box_a.y0, box_b.y0) - 2 * tolerance
+            if w > 0 and h > 0:
+                pairs.append((a, b))
+    return pairs
+
+
+MAP_RENAME = {"leg_left_4_joint": "LLeg_knee", "leg_right_4_joint": "RLeg_knee", "torso_1_joint": "waist_yaw"}
+
+
+def mapped_copy(table: pa.Table, frames: tuple[str, ...]) -> tuple[pa.Table, str]:
+    """``table`` with some joints under other names and each contact flag replaced by a force column
+    (300 N in contact, 2 N off it), and the map TOML that undoes it."""
+    back = {v: k for k, v in MAP_RENAME.items()}
+    names = []
+    for name in table.column_names:
+        kind, dot, item = name.partition(".")
+        names.append(f"{kind}.{MAP_RENAME[item]}" if dot and item in MAP_RENAME else name)
+    out = table.rename_columns(names)
+    toml = "[joint_states]\nrename = { " + ", ".join(f'{k} = "{v}"' for k, v in back.items()) + " }\n"
+    for k, frame in enumerate(frames):
+        flags = out.column(f"contact.{frame}").to_numpy()
+        out = out.drop_columns([f"contact.{frame}"]).append_column(f"foot{k}.fz", pa.array(-(2.0 + 298.0 * flags)))
+        toml += f'[[contacts]]\nframe = "{frame}"\ncolumn = "foot{k}.fz"\nthreshold = 50.0\n'
+    return out.replace_schema_metadata(table.schema.metadata), toml

@@ -73,12 +73,15 @@ EnergyToleranceOpt = typer.Option(DEFAULT_TOLERANCE, min=0.0,
                                        "sensor's resolution).")
 UrdfOpt = typer.Option(None, "--urdf", help="URDF of another robot (with --config), or another URDF of the "
                                              "built-in --robot (e.g. identified inertias).")
-ConfigOpt = typer.Option(None, "--config", help="Robot TOML: urdf (else give --urdf), contact_frames, "
-                                                  "position_controlled, groups.")
+ConfigOpt = typer.Option(None, "--config", help="Robot TOML: urdf or mjcf (else give --urdf or --mjcf), "
+                                                  "contact_frames, position_controlled, groups.")
+MjcfOpt = typer.Option(None, "--mjcf", help="MuJoCo MJCF of the robot instead of its URDF (with --config, or the "
+                                             "built-in --robot's configuration); not with --urdf.")
 FitWorkersOpt = typer.Option(2, min=1, help="Processes fitting joints side by side.")
 TimeUnitOpt = typer.Option(None, help="Unit of a numeric time column: s, ms, us or ns (needed for integer stamps; "
                                       "float stamps are seconds unless said otherwise; timestamps carry theirs).")
-MapOpt = typer.Option(None, "--map", help="Topic map TOML of a ROS 2 bag log (see 'wbfriction convert').")
+MapOpt = typer.Option(None, "--map", help="Topic map TOML of a ROS 2 bag log (see 'wbfriction convert'); with a "
+                                           "table log: its [joint_states] rename and [[contacts]] column, threshold.")
 
 
 MaxGapOpt = typer.Option(MAX_GAP, min=1.5, help="Time steps of at least this many local median steps split the log "
@@ -100,8 +103,8 @@ def _progress(total: int, label: str):
         yield lambda n: bar.advance(task, n)
 
 
-def _robot(robot: str, urdf: Optional[Path], config: Optional[Path]) -> Robot:
-    return load_robot(robot, urdf=urdf, config=config)
+def _robot(robot: str, urdf: Optional[Path], config: Optional[Path], mjcf: Optional[Path] = None) -> Robot:
+    return load_robot(robot, urdf=urdf, config=config, mjcf=mjcf)
 
 
 def _fit_rows(results: list[FitResult]) -> Table:
@@ -233,7 +236,7 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     """Estimate a log file in chunks on ``workers`` processes (which load the robot from
     ``spec``); a ROS 2 bag is first streamed into a temporary Parquet log beside the output."""
     chunking = Chunking(rows=chunk_rows, workers=workers)
-    source = open_log(log, bag_map)
+    source = open_log(log, bag_map, r)
     provenance = {"provenance": log_provenance(log, r)}
     with ExitStack() as stack:
         with console.status(f"reading {log}") if source.is_bag else nullcontext():
@@ -289,6 +292,7 @@ def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, t
 @app.command()
 def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write: .parquet, .csv or .h5."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             mjcf: Optional[Path] = MjcfOpt,
              gait: str = typer.Option(_G.gait, help="forward, sideways, turning, both (forward + sideways) or "
                                                     "combined (all three)."),
              steps: int = typer.Option(_G.steps, help="Number of steps (per direction for both/combined)."),
@@ -331,8 +335,9 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                                                        "trajectory.")) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents."""
-    check_paths({"--urdf": urdf, "--config": config, "--friction": friction, "--sensors": sensors}, {"-o": output})
-    r = _robot(robot, urdf, config)
+    check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors},
+                {"-o": output})
+    r = _robot(robot, urdf, config, mjcf)
     if not r.floating_base:
         arm = ArmOptions(duration=duration, encoder_bits=19 if encoder_bits is None else encoder_bits,
                          torque_std=torque_noise or 0.0, seed=noise_seed or 0)
@@ -363,6 +368,7 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
              output: Path = typer.Option(..., "-o", "--output", help="Friction table to write: .parquet, .csv or "
                                                                      ".h5."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             mjcf: Optional[Path] = MjcfOpt,
              bag_map: Optional[Path] = MapOpt, max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt,
              workers: int = typer.Option(2, min=1, help="Processes estimating chunks of a long log (started when "
                                                        "each gets at least 4 chunks)."),
@@ -409,7 +415,7 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                                                              "columns where logged: every joint's friction in "
                                                              "every phase.")) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
-    check_paths({"LOG": log, "--map": bag_map, "--urdf": urdf, "--config": config}, {"-o": output})
+    check_paths({"LOG": log, "--map": bag_map, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
     opts = EstimateOptions(diff=cast(Diff | Literal["auto"], diff), compensate_delay=delay_compensation,
                            torque_alignment=cast(TorqueAlignment, torque_alignment), mask=cast(Mask, mask),
                            lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
@@ -420,8 +426,8 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                                                    weights=cast(SavgolWeights, weights),
                                                    cutoff=cutoff, butter_order=butter_order))
     spec = RobotSpec(None if config else robot, None if urdf is None else str(urdf),
-                     None if config is None else str(config))
-    _run_estimate(_robot(robot, urdf, config), spec, log, output, opts, bag_map, max_gap, limit_margin, workers,
+                     None if config is None else str(config), None if mjcf is None else str(mjcf))
+    _run_estimate(_robot(robot, urdf, config, mjcf), spec, log, output, opts, bag_map, max_gap, limit_margin, workers,
                   chunk_rows, cast(TimeBase, time_base), _time_unit(time_unit), companion)
 
 
@@ -429,15 +435,18 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
 def convert(bag: Path = typer.Argument(..., metavar="BAG", help="ROS 2 bag (folder with metadata.yaml; MCAP or "
                                                                 "sqlite3), or a Parquet, CSV or HDF5 log."),
             bag_map: Optional[Path] = typer.Option(None, "--map", help="Topic map TOML of a bag: [joint_states], "
-                                                                        "[[contacts]], [base]."),
+                                                                        "[[contacts]], [base]; of a table log: "
+                                                                        "[joint_states] rename, [[contacts]] "
+                                                                        "column, threshold."),
             output: Path = typer.Option(..., "-o", "--output", help="Log to write: .parquet or .csv."),
             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+            mjcf: Optional[Path] = MjcfOpt,
             max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt) -> None:
     """Convert a ROS 2 bag (or another log file) into a wbfriction log: joint states, contacts
     (zero-order hold) and base pose (linear + slerp) aligned on the joint-state stamps,
     streamed, and checked against the robot before it is renamed into place."""
-    check_paths({"BAG": bag, "--map": bag_map, "--urdf": urdf, "--config": config}, {"-o": output})
-    r = _robot(robot, urdf, config)
+    check_paths({"BAG": bag, "--map": bag_map, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
+    r = _robot(robot, urdf, config, mjcf)
     with console.status(f"reading {bag}"):
         rows = convert_log(r, bag, output, bag_map, max_gap=max_gap, limit_margin=limit_margin)
     console.print(f"wrote {output} ({rows} samples)")
@@ -470,15 +479,16 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
                                                    "friction>), .xml (MuJoCo MJCF: damping, frictionloss, "
                                                    "armature) or .yaml (Isaac Lab actuators); repeat -o for "
                                                    "several."),
-           robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt) -> None:
+           robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+           mjcf: Optional[Path] = MjcfOpt) -> None:
     """Write the fitted friction where simulators read it. F_v -> damping, F_c -> Coulomb
     friction (MuJoCo frictionloss); the Stribeck bump, the tanh and tau_os have no simulator field
     and are dropped. Inertias are the URDF's: give --urdf IDENTIFIED.urdf to export identified ones."""
     from wbfriction.pipeline.export import export_files
 
-    check_paths({"PARAMS": params, "--urdf": urdf, "--config": config},
+    check_paths({"PARAMS": params, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
                 {f"-o {o}": o for o in outputs})
-    for path, fmt in export_files(_robot(robot, urdf, config), params, outputs):
+    for path, fmt in export_files(_robot(robot, urdf, config, mjcf), params, outputs):
         console.print(f"wrote {path} ({fmt})")
 
 
@@ -531,6 +541,7 @@ def report(friction: Path = FrictionArg,
 def sensitivity(log: Path = LogArg,
                 output: Path = typer.Option(Path("sensitivity.png"), "-o", "--output", help="Figure to write (PNG)."),
                 robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+                mjcf: Optional[Path] = MjcfOpt,
                 factors: str = typer.Option("0.9,0.95,1.05,1.1", help="Comma-separated inertia scaling factors."),
                 part: str = typer.Option("all", help="all (the whole 6x6 inertia), mass or rotational (its mass or "
                                                      "principal-moment eigenvalues only)."),
@@ -545,11 +556,11 @@ def sensitivity(log: Path = LogArg,
     from wbfriction.report.figures import save_png, sensitivity_figure
     from wbfriction.signals.kinematics import measure
 
-    check_paths({"LOG": log, "--urdf": urdf, "--config": config}, {"-o": output})
+    check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
     if part not in PARTS:
         raise InputError(f"--part must be one of {', '.join(PARTS)}, got '{part}'")
     values = parse_factors(factors)
-    r = _robot(robot, urdf, config)
+    r = _robot(robot, urdf, config, mjcf)
     data = read_log(log, r, time_unit=_time_unit(time_unit))
     _warn(data.warnings)
     opts, _ = resolve_differentiation(EstimateOptions(diff=cast(Diff | Literal["auto"], diff), mask=cast(Mask, mask)),
@@ -587,18 +598,21 @@ def _change(x: float | None, digits: int) -> str:
 
 def _identify_tables(doc: dict) -> list[Table]:
     """The tables of ``wbfriction identify``: body changes, both routes' friction, held-out RMS."""
-    bodies = Table(title="Inertia model: given -> identified (bodies with mass)", box=None,
-                   caption=escape("COM shift [mm]; principal moments about the centre of mass, ascending: change [%]"))
-    for col in ("body", "mass given [kg]", "mass [kg]", "change [%]", "COM shift [mm]", "I1 [%]", "I2 [%]", "I3 [%]"):
+    bodies = Table(title="Inertia model: given -> written (bodies with mass)", box=None,
+                   caption=escape("COM shift [mm]; principal moments about the centre of mass, ascending: change [%]; "
+                                  "kept: the identified body predicted held-out torques better (else as given)"))
+    for col in ("body", "mass given [kg]", "mass [kg]", "change [%]", "COM shift [mm]", "I1 [%]", "I2 [%]", "I3 [%]",
+                "kept"):
         bodies.add_column(escape(col), justify="left" if col == "body" else "right")  # units kept: not markup
     for b in doc["bodies"]:
         if max(b["mass_given"], b["mass"]) <= 0:
             continue
         bodies.add_row(b["body"], f"{b['mass_given']:.4f}", f"{b['mass']:.4f}", _change(b["mass_change"], 2),
-                       f"{1e3 * b['com_shift']:.2f}", *[_change(x, 1) for x in b["moments_change"]])
+                       f"{1e3 * b['com_shift']:.2f}", *[_change(x, 1) for x in b["moments_change"]],
+                       {True: "yes", False: "no"}.get(b.get("kept"), "—"))
     names = list(next(iter(doc["joints"].values()))["identified"])
-    friction = Table(title="Friction: this route (torques, identified jointly) and the acceleration route "
-                           "(5.10, identified model)", box=None,
+    friction = Table(title="Friction: this route (torques, with the inertias written) and the acceleration route "
+                           "(5.10, the model written)", box=None,
                      caption="gen: share of valid samples whose friction generates power (eq. 7.9), given model "
                              "-> identified model; target: the simulator's, when the log has it")
     friction.add_column("joint")
@@ -620,11 +634,12 @@ def _identify_tables(doc: dict) -> list[Table]:
                              *[f"{target[n]:.4g}" for n in ("F_v", "F_c", "tau_os")], "", style="dim")
     rms = Table(title=f"Held-out torques ({doc['holdout_samples']} single-support samples at the end of the log): "
                       "RMS of measured - predicted [N·m]", box=None)
-    for col in ("joint", "given model", "given + its best friction", "identified"):
+    for col in ("joint", "given model", "given + its best friction", "identified", "validated (written)"):
         rms.add_column(col, justify="left" if col == "joint" else "right")
     for joint, j in doc["joints"].items():
         h = j["holdout_rms"]
-        rms.add_row(joint, f"{h['given']:.4f}", f"{h['given_with_friction']:.4f}", f"{h['identified']:.4f}")
+        rms.add_row(joint, f"{h['given']:.4f}", f"{h['given_with_friction']:.4f}", f"{h['identified']:.4f}",
+                    f"{h['validated']:.4f}" if "validated" in h else "—")
     return [bodies, friction, rms]
 
 
@@ -633,6 +648,7 @@ def identify(log: Path = LogArg,
              output: Path = typer.Option(..., "-o", "--output", help="Corrected URDF to write (the given one's "
                                                                     "structure, identified inertias)."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             mjcf: Optional[Path] = MjcfOpt,
              json_output: Optional[Path] = typer.Option(None, "--json", help="Also write every figure as "
                                                                              "JSON (for 'wbfriction report "
                                                                              "--identification')."),
@@ -659,7 +675,7 @@ def identify(log: Path = LogArg,
     """Identify the inertia model and the friction together from the joint torques of single
     support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
     with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
-    check_paths({"LOG": log, "--urdf": urdf, "--config": config}, {"-o": output, "--json": json_output})
+    check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output, "--json": json_output})
     vs_text = stribeck_velocity.strip().lower()
     try:
         stribeck: float | Literal["auto"] | None = (None if vs_text == "none" else "auto" if vs_text == "auto"
@@ -670,7 +686,8 @@ def identify(log: Path = LogArg,
         raise InputError(f"--holdout must be between 0 and 1, got {holdout}")
     from wbfriction.pipeline.identify import identify_file
 
-    r = _robot(robot, urdf, config)
+    r = _robot(robot, urdf, config, mjcf)
+    r.require_urdf("identify (it writes the corrected URDF)")
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior,
                            armature=cast(ArmatureMode, armature))
     with console.status("") as status:
@@ -683,6 +700,8 @@ def identify(log: Path = LogArg,
         out.print(f"v_s {p['stribeck_velocity']}: {p['samples']} samples, {p['base_parameters']} base parameters of "
                   f"{p['parameters']}, condition {p['condition']:.3g}, prior {p['prior']:g}; {p['message']}",
                   highlight=False, soft_wrap=True)
+        if p.get("verdict"):
+            out.print(p["verdict"], highlight=False, soft_wrap=True)
         unexcited = p.get("not_excited") or []
         if unexcited:
             out.print(f"not excited by this log, kept at the given model: {len(unexcited)} parameters ("
@@ -703,26 +722,55 @@ def identify(log: Path = LogArg,
 
 
 def _study_table(rows, title: str, params=PARAM_NAMES) -> Table:
-    """Tables 6.1/6.2 layout: per leg joint (thesis numbering) target, estimate, error, thesis errors."""
+    """Tables 6.1/6.2 layout: per leg joint (thesis numbering) the fit's status, target, estimate, error,
+    thesis errors."""
     table = Table(title=title, box=None,
                   caption="err: error to the target [%]; T6.1 / T6.2: the thesis's errors for the same joint "
                           "(TORO, straight / straight and sideways)")
     table.add_column("#", justify="right")
     table.add_column("joint")
+    table.add_column("status")
     for name in params:
         table.add_column(name, justify="right")
     cols = [PARAM_NAMES.index(n) for n in params]
     for row in rows:
         fit = row.fit
         err = fit.error_percent() or {}
-        table.add_row(str(row.number), f"{row.joint} ({row.group})",
-                      *[f"{getattr(fit.params, n):.4f}" if fit.params else "—" for n in params])
-        table.add_row("", "  target", *[f"{getattr(fit.target, n):.4g}" for n in params], style="dim")
-        table.add_row("", "  err [%]", *[f"{err.get(n, float('nan')):.2f}" for n in params], style="bold")
+        status = fit.verdict().status
+        table.add_row(str(row.number), f"{row.joint} ({row.group})", status,
+                      *[f"{getattr(fit.params, n):.4f}" if fit.params else "—" for n in params],
+                      style=None if status == "ok" else "dim")
+        table.add_row("", "  target", "", *[f"{getattr(fit.target, n):.4g}" for n in params], style="dim")
+        table.add_row("", "  err [%]", "", *[f"{err.get(n, float('nan')):.2f}" for n in params], style="bold")
         for label, ref in (("  T6.1 [%]", row.thesis_6_1), ("  T6.2 [%]", row.thesis_6_2)):
             if ref is not None:
-                table.add_row("", label, *[f"{ref[c]:.2f}" for c in cols], style="dim")
+                table.add_row("", label, "", *[f"{ref[c]:.2f}" for c in cols], style="dim")
     return table
+
+
+def _print_not_ok(rows) -> None:
+    """Say which rows of a study table are not ``ok`` fits and why: their errors measure the walk's excitation
+    (or the fit's trouble), not the estimate."""
+    from wbfriction.studies.common import not_ok
+
+    for row in not_ok(rows):
+        verdict = row.fit.verdict()
+        why = ("this walk hardly moved it (a short walk hardly turns the hip yaws: try more --steps)"
+               if verdict.status == "not excited" else "its parameters are not determined by these samples")
+        out.print(f"  not an ok fit: {row.joint} ({row.group}), {verdict}. Its error measures the walk, not the "
+                  f"estimate: {why}.")
+
+
+def _pulls_note(pulls: int, in_double: int) -> str:
+    """The demo's count of samples where a welded foot pulled, and what it means."""
+    if not pulls:
+        return "no welded foot pulled on the ground (the walk is one a real sole could make)"
+    return (f"samples where a welded foot pulled on the ground: {pulls}, {in_double} of them in double support. "
+            "The ideal simulator welds a standing sole (a bilateral contact): just after a touch-down the weld "
+            "stops the landing foot and shares the load with the other by pulling, where a real sole would "
+            "bounce or roll. Double-support samples are never valid for the estimate, so its numbers are not "
+            "touched" + ("." if in_double == pulls else "; the others are single-support samples: there the "
+                         "walk asks more of the ground than it can give."))
 
 
 def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
@@ -734,6 +782,7 @@ def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
         out.print(_study_table(case.rows, f"MuJoCo, combined walk, swing phase: {case.label}", case.scored))
         worst = worst_scored(case)
         out.print("worst error over the leg joints [%]: " + ", ".join(f"{n} {v:.2f}" for n, v in worst.items()))
+        _print_not_ok(case.rows)
     out.print("right knee alone, RMS error [N·m] (central differences): " + "; ".join(
         f"{k} {v:.4f}" for k, v in result.knee_rms.items()))
     return result.files
@@ -763,10 +812,11 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
                                         "central differences"))
     worst = worst_errors(result.rows)
     out.print("worst error over the leg joints [%]: " + ", ".join(f"{n} {worst[n]:.2f}" for n in PARAM_NAMES))
+    _print_not_ok(result.rows)
     out.print(f"true accelerations: max |tau_f - tau_f_true| in single support = {result.truth_max_error:.2e} N·m")
     out.print("right knee, RMS error [N·m] with the leg in swing / in stance: " + "; ".join(
         f"{k} {a:.4f} / {b:.4f}" for k, (a, b) in result.knee_rms.items()))
-    out.print(f"samples where a welded foot pulled on the ground: {result.pulls}")
+    out.print(_pulls_note(result.pulls, result.pulls_double_support))
     worst_joint = max(result.generating_share, key=lambda j: result.generating_share[j])
     out.print(f"friction generating power (eq. 7.9), leg joints in swing: at most "
               f"{100 * result.generating_share[worst_joint]:.2f} % of the samples ({worst_joint})")
@@ -779,6 +829,7 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
 def spectrum(log: Path = LogArg,
              output: Path = typer.Option(Path("spectrum.png"), "-o", "--output", help="Figure to write (PNG)."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             mjcf: Optional[Path] = MjcfOpt,
              joints: Optional[str] = typer.Option(None, help="Comma-separated joints (default: the legs' joints, "
                                                              "else every torque-controlled one)."),
              tail: float = typer.Option(0.01, min=0.0, max=1.0, help="Share of the power (above the noise floor) "
@@ -788,8 +839,8 @@ def spectrum(log: Path = LogArg,
     from wbfriction.report.figures import spectrum_figure
     from wbfriction.signals.spectrum import acceleration_spectrum
 
-    check_paths({"LOG": log, "--urdf": urdf, "--config": config}, {"-o": output})
-    r = _robot(robot, urdf, config)
+    check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
+    r = _robot(robot, urdf, config, mjcf)
     data = read_log(log, r, time_unit=_time_unit(time_unit))
     _warn(data.warnings)
     names = _joint_list(r, joints)

@@ -6,10 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from helpers import drawn_texts, text_overlaps
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import fit_estimate
 from wbfriction.friction.models import FrictionParams
 from wbfriction.report.figures import (
+    REPORT_DPI,
     friction_curves_figure,
     friction_overview_figure,
     joint_figure,
@@ -54,13 +56,14 @@ def test_joint_figure_has_its_four_panels_even_without_valid_samples(estimate):
     assert len(fig.axes) >= 4
 
 
-def test_overview_marks_flagged_joints_and_shares_axes(estimate):
-    fig = friction_overview_figure(estimate, ["moving", "still"], {}, {"moving": TRUE}, flagged={"still"})
+def test_overview_marks_flagged_joints_each_on_its_own_axes(estimate):
+    fig = friction_overview_figure(estimate, ["moving", "still"], {}, {"moving": TRUE}, flagged={"still"},
+                                   labels={"moving": "right knee"})
     visible = [ax for ax in fig.axes if ax.get_visible()]
-    assert [ax.get_title() for ax in visible] == ["moving", "still"]
+    assert [ax.get_title() for ax in visible] == ["right knee", "still"]
     red = visible[1].title.get_color()
     assert red != visible[0].title.get_color()
-    assert visible[0].get_shared_x_axes().joined(visible[0], visible[1])
+    assert not visible[0].get_shared_y_axes().joined(visible[0], visible[1])  # a knee does not squash an ankle
 
 
 def test_files_are_written_whole(estimate, tmp_path):
@@ -79,3 +82,30 @@ def test_files_are_written_whole(estimate, tmp_path):
 ])
 def test_widest_run(mask, x, expected):
     assert widest_run(np.array(mask, dtype=bool), np.array(x, dtype=float)) == expected
+
+
+def test_report_figures_are_readable_at_their_own_size(estimate):
+    """The report's figures at 1400 px (shown at their own width, REPORT_WIDTH x REPORT_DPI px): every text at
+    least 11 px high, no two texts overlapping (tick labels, titles, legends, axis labels), no offset text."""
+    fits = {f.joint: f for f in fit_estimate(estimate, min_samples=20)}
+    spectrum = (np.linspace(0, 500, 501), np.exp(-np.linspace(0, 5, 501)), 262.0)  # a cutoff beyond 50 Hz
+    for fig in (joint_figure(estimate, "moving", fits["moving"], TRUE, spectrum),
+                joint_figure(estimate, "still", None, None),
+                friction_overview_figure(estimate, ["moving", "still", "moving"], fits, {"moving": TRUE},
+                                         labels={"moving": "right knee"})):
+        assert fig.get_figwidth() * REPORT_DPI <= 1200
+        fig.set_dpi(REPORT_DPI)
+        texts = drawn_texts(fig)
+        assert texts
+        small = [(t, round(px, 1)) for t, _, px in texts if px < 11]
+        assert not small, small
+        assert not text_overlaps(texts), text_overlaps(texts)
+        assert not [t for t, _, _ in texts if t.startswith(("1e", "+", "−1e"))], "an offset text"
+
+
+def test_the_spectrum_panel_reaches_a_cutoff_beyond_50_hz(estimate):
+    spectrum = (np.linspace(0, 500, 501), np.ones(501), 262.0)
+    fig = joint_figure(estimate, "moving", None, None, spectrum)
+    panel = next(ax for ax in fig.axes if ax.get_title().startswith("(d)"))
+    assert panel.get_xlim()[1] >= 262.0
+    assert "amplitude [rad/s²]" == panel.get_ylabel()

@@ -58,13 +58,27 @@ def _images(text: str) -> dict[str, bytes]:
             for m in re.finditer(r'<img id="([^"]+)"[^>]*src="data:image/png;base64,([^"]+)"', text)}
 
 
+def _walking_and_still(talos) -> tuple[list[str], list[str]]:
+    """Joints that move in the walk (the legs but the hip yaws, which turn only in part of it) and joints the
+    walking controller holds still (arms, grippers)."""
+    legs = [j for j in talos.torque_controlled if j.startswith("leg_") and not j.endswith("_1_joint")]
+    held = [j for j in talos.torque_controlled if j.startswith(("arm_", "gripper_"))]
+    return legs, held
+
+
 def test_report_is_self_contained_and_complete(talos, report_file):
+    """Every joint that walks has its figure, every joint held still none (they are named in one line); labels
+    from the robot TOML; nothing fetched from elsewhere."""
     text = report_file.read_text()
     images = _images(text)
-    for joint in talos.torque_controlled:
-        png = images[f"fig-joint-{joint.replace('_', '-')}"]
-        assert png.startswith(b"\x89PNG")
+    walking, held = _walking_and_still(talos)
+    for joint in walking:
+        assert images[f"fig-joint-{joint.replace('_', '-')}"].startswith(b"\x89PNG")
+    assert not any(f"fig-joint-{joint.replace('_', '-')}" in images for joint in held)
     assert "overview" in images
+    still = re.search(r'<tr class="still">(.*?)</tr>', text, re.S)
+    assert still and all(talos.label(j) in still.group(1) for j in held)
+    assert "right knee" in text and "left ankle roll" in text
     # nothing fetched from elsewhere: no external source, stylesheet or script
     assert not re.search(r'(src|href)="(?!data:|#)', text)
     assert "<script" not in text
@@ -139,9 +153,45 @@ def test_spectrum_is_that_of_the_estimated_acceleration(talos, combined_walk, ta
     np.testing.assert_allclose(ours[1], dyn_spec.amplitude[:, 0], rtol=1e-6, atol=1e-9)
 
 
+_PAGE_TEXT = """
+const rects = [], small = [];
+const walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+let node, k = 0;
+while ((node = walker.nextNode())) {
+  const text = node.textContent.trim();
+  const el = node.parentElement;
+  if (!text || !el.checkVisibility()) continue;
+  const size = parseFloat(getComputedStyle(el).fontSize);
+  if (size < 11) small.push([text.slice(0, 40), size]);
+  const range = document.createRange();
+  range.selectNodeContents(node);
+  for (const r of range.getClientRects())
+    if (r.width > 0 && r.height > 0)
+      rects.push([k, r.left, r.top + scrollY, r.right, r.bottom + scrollY, text.slice(0, 40)]);
+  k++;
+}
+rects.sort((a, b) => a[2] - b[2]);
+const overlaps = [];
+for (let i = 0; i < rects.length; i++)
+  for (let j = i + 1; j < rects.length && rects[j][2] < rects[i][4] - 1; j++) {
+    const a = rects[i], b = rects[j];
+    if (a[0] === b[0]) continue;
+    const w = Math.min(a[3], b[3]) - Math.max(a[1], b[1]), h = Math.min(a[4], b[4]) - Math.max(a[2], b[2]);
+    if (w > 1 && h > 1) overlaps.push([a[5], b[5]]);
+  }
+const images = [...document.images].map(im => [im.id, im.complete, im.naturalWidth, im.getBoundingClientRect().width]);
+return {small, overlaps, texts: rects.length, images, width: document.documentElement.scrollWidth};
+"""
+"""What the page shows at 1400 px, measured in the browser: texts under 11 px, pairs of texts whose boxes overlap,
+the images (id, loaded, natural width, width shown) and the page's width."""
+
+
 @pytest.mark.skipif(not (Path(CHROMIUM).exists() and Path(CHROMEDRIVER).exists()) and shutil.which("chromium") is None,
                     reason="Debian's chromium and chromium-driver are not installed (.ci/run installs them)")
 def test_report_renders_in_headless_chromium(talos, report_file, tmp_path):
+    """At 1400 px in headless Chromium: every figure loads and is shown at its own size (its fonts, at least
+    11 px, stay so), no text of the page is under 11 px, no two texts overlap, nothing is wider than the
+    window; a joint that moved has its figure, one that did not has none. Screenshots go to ``tmp_path``."""
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
 
@@ -149,7 +199,8 @@ def test_report_renders_in_headless_chromium(talos, report_file, tmp_path):
     options.binary_location = CHROMIUM
     for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                 "--disable-dev-shm-usage", f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1500,1200"):
+                 "--disable-dev-shm-usage", f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1400,1000",
+                 "--hide-scrollbars"):
         options.add_argument(flag)
     options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     driver = webdriver.Chrome(service=Service(executable_path=CHROMEDRIVER), options=options)
@@ -159,14 +210,20 @@ def test_report_renders_in_headless_chromium(talos, report_file, tmp_path):
         assert "wbfriction report" in driver.title
         severe = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
         assert not severe, severe
-        for joint in talos.torque_controlled:
-            img = driver.find_element("id", f"fig-joint-{joint.replace('_', '-')}")
-            loaded = driver.execute_script("return arguments[0].complete && arguments[0].naturalWidth", img)
-            assert loaded and loaded > 500, joint
-            driver.execute_script("arguments[0].scrollIntoView()", img)
-            assert img.is_displayed() and img.size["height"] > 100, joint
-        overview = driver.find_element("id", "overview")
-        assert driver.execute_script("return arguments[0].naturalWidth", overview) > 500
-        driver.save_screenshot(str(tmp_path / "report.png"))
+        page = driver.execute_script(_PAGE_TEXT)
+        assert page["texts"] > 500
+        assert not page["small"], page["small"][:10]
+        assert not page["overlaps"], page["overlaps"][:10]
+        assert page["width"] <= 1400
+        images = {i: (loaded, natural, shown) for i, loaded, natural, shown in page["images"]}
+        for i, (loaded, natural, shown) in images.items():
+            assert loaded and natural >= 1000 and shown == natural, (i, natural, shown)
+        walking, held = _walking_and_still(talos)
+        assert all(f"fig-joint-{j.replace('_', '-')}" in images for j in walking)
+        assert not any(f"fig-joint-{j.replace('_', '-')}" in images for j in held)
+        assert "overview" in images
+        for k, y in enumerate(range(0, driver.execute_script("return document.body.scrollHeight"), 900)):
+            driver.execute_script(f"window.scrollTo(0, {y})")
+            driver.save_screenshot(str(tmp_path / f"report_{k:02d}.png"))
     finally:
         driver.quit()

@@ -3,7 +3,10 @@
 Built from the robot's URDF by MuJoCo's own URDF import (:func:`urdf_spec`): visual and
 collision geometry dropped (no ``package://`` path to resolve, no contact), the URDF's
 ``<dynamics>`` dropped (the friction is the exported one only), static links fused into their
-bodies as Pinocchio merges them. A floating-base robot gets a free joint at its root link; a
+bodies as Pinocchio merges them, each such link kept as a ``<site>`` of its name at its frame (a
+sole, an IMU: the frames a robot TOML names; Pinocchio's MJCF parser reads sites as frames). A
+robot loaded from an MJCF (:attr:`Robot.model_format`) starts from that file as it is. A
+floating-base robot gets a free joint at its root link; a
 fixed-base one (:attr:`Robot.floating_base` false, e.g. the KUKA LWR4+) has its root link welded
 to the world where the URDF puts it. The robot's locked joints (:attr:`Robot.locked_joints`) are
 welded at their positions, so that the joints are :attr:`Robot.actuated`, as in the Pinocchio model.
@@ -43,15 +46,17 @@ the MuJoCo model keeps ``F_v qd`` exactly and ``F_c`` away from reversals, and d
 Stribeck bump, the tanh and ``tau_os`` (:mod:`wbfriction.export.mapping`).
 
 The written MJCF (:func:`write_mjcf`) is MuJoCo's own ``MjSpec.to_xml``, whose numbers have 6
-significant digits, with every number of the bodies, inertials and joints rewritten from the
+significant digits, with every number of the bodies, inertials, joints and sites rewritten from the
 compiled model at full precision (and the frames MuJoCo writes for fused links folded into the
-bodies' placements): it reloads to the same model.
+bodies' placements), and its sibling bodies in the robot model's joint order: it reloads to the same
+model, and Pinocchio reads it (``wbfriction ... --mjcf``) with the joints in the URDF model's order and
+the same mass matrix and gravity to rounding.
 """
 
 from __future__ import annotations
 
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -116,6 +121,38 @@ def urdf_spec(urdf: str | Path, free_joint: bool = True) -> mujoco.MjSpec:
     return spec
 
 
+def robot_spec(robot: Robot) -> mujoco.MjSpec:
+    """The MuJoCo spec of ``robot``'s own description: :func:`urdf_spec` of its URDF, or its MJCF as it
+    is (with a free joint added at its top body if it is a floating base that has none).
+
+    Raises:
+        ModelError: a file MuJoCo cannot read.
+    """
+    import mujoco
+    if robot.model_format == "urdf":
+        return urdf_spec(robot.urdf, robot.floating_base)
+    try:
+        spec = mujoco.MjSpec.from_file(str(robot.urdf))
+    except Exception as exc:  # mujoco raises ValueError with its parser's message
+        raise ModelError(f"{robot.urdf}: MuJoCo cannot read the MJCF: {exc}") from None
+    base = spec.worldbody.first_body()
+    if robot.floating_base and base is not None and not any(j.type == mujoco.mjtJoint.mjJNT_FREE
+                                                            for j in base.joints):
+        base.add_freejoint()
+    return spec
+
+
+def _add_link_sites(spec: mujoco.MjSpec) -> None:
+    """A ``<site>`` at the origin of every body MuJoCo fuses into its parent (``fusestatic``: a URDF link on
+    a fixed joint, a sole, an IMU link; a locked joint's link), named as the body: the fused site keeps the
+    link's frame, which a robot TOML may name (contact frames, sensors)."""
+    compiled = compile_spec(spec.copy())  # compiling fuses the static bodies of the spec it compiles
+    kept = {compiled.body(i).name for i in range(compiled.nbody)}
+    for body in spec.bodies:
+        if body.name and body.name not in kept:
+            body.add_site(name=body.name)
+
+
 def _lock_joint(spec: mujoco.MjSpec, name: str, value: float) -> None:
     """Weld a hinge or slide joint at ``value`` [rad or m]: its body placed there, the joint deleted."""
     import mujoco
@@ -154,7 +191,8 @@ def mujoco_spec(robot: Robot, friction: Mapping[str, FrictionLike], armature: Ma
     """The MuJoCo spec of ``robot`` with the identified friction and armature (module docstring).
 
     Args:
-        robot: the robot; its URDF is read, :attr:`Robot.floating_base` decides the free joint.
+        robot: the robot; its URDF (or MJCF) is read (:func:`robot_spec`), :attr:`Robot.floating_base` decides
+            the free joint.
         friction: joint -> fitted friction of model (3.5) (:func:`wbfriction.friction.io.read_params`).
         armature: joint -> reflected rotor inertia [kg·m^2]; a joint not in it keeps the robot
             model's ``armature``.
@@ -162,14 +200,15 @@ def mujoco_spec(robot: Robot, friction: Mapping[str, FrictionLike], armature: Ma
 
     Raises:
         InputError: friction that is not dissipative, a joint the robot does not actuate, an
-            inertia model of another robot.
+            inertia model of another robot, inertias of a robot loaded from an MJCF.
         ModelError: a URDF MuJoCo cannot read, or whose joints are not the robot's.
     """
     import mujoco
     joints = joint_exports(friction, armature, robot)
     if inertias is None:
-        spec = urdf_spec(robot.urdf, robot.floating_base)
+        spec = robot_spec(robot)
     else:
+        robot.require_urdf("exporting identified inertias")
         pi = identified_parameters(robot, inertias)
         with tempfile.TemporaryDirectory(prefix="wbfriction-mjcf-") as tmp:
             path = Path(tmp) / Path(robot.urdf).name
@@ -182,6 +221,7 @@ def mujoco_spec(robot: Robot, friction: Mapping[str, FrictionLike], armature: Ma
         odd = sorted(names.symmetric_difference(robot.actuated))
         raise ModelError(f"{robot.urdf}: the MuJoCo model's joints are not robot '{robot.name}''s "
                          f"(e.g. '{odd[0]}')")
+    _add_link_sites(spec)
     for name in robot.actuated:
         joint, exp = spec.joint(name), joints.get(name)
         damping = np.zeros_like(np.asarray(joint.damping, dtype=float))
@@ -230,10 +270,32 @@ def _unwrap_frames(root: ET._Element) -> None:
         parent.remove(frame)
 
 
-def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel) -> str:
+def _order_bodies(root: ET._Element, joints: Sequence[str]) -> bool:
+    """Put the sibling ``<body>`` elements in the order of ``joints`` (each ranked by the first of its
+    subtree's joints; bodies after the other children), so that a depth-first reader (MuJoCo, Pinocchio)
+    meets the joints in that order. Returns whether anything moved."""
+    rank = {name: i for i, name in enumerate(joints)}
+
+    def key(body: ET._Element) -> int:
+        return min((rank.get(j.get("name") or "", len(rank)) for j in body.iter("joint")), default=len(rank))
+
+    moved = False
+    for parent in [*root.iter("worldbody"), *root.iter("body")]:
+        children = [c for c in parent if c.tag == "body"]
+        ordered = sorted(children, key=key)
+        if ordered != children:
+            moved = True
+            for child in children:
+                parent.remove(child)
+            parent.extend(ordered)
+    return moved
+
+
+def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] = ()) -> str:
     """The MJCF text of ``spec`` (compiled as ``model``) at full precision (module docstring): the
     bodies' ``pos``, ``quat`` and ``<inertial>``, the joints' ``pos``, ``axis``, ``range``,
-    ``actuatorfrcrange``, ``damping``, ``frictionloss`` and ``armature`` from ``model``.
+    ``actuatorfrcrange``, ``damping``, ``frictionloss`` and ``armature``, the sites' ``pos`` and ``quat``
+    from ``model``; sibling bodies in the order of the joint names ``joints`` (:func:`_order_bodies`).
 
     Raises:
         ModelError: a body or joint of the text that ``model`` does not have by name.
@@ -275,13 +337,20 @@ def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel) -> str:
             joint.set("damping", _num([model.dof_damping[dof], *poly] if np.any(poly) else model.dof_damping[dof]))
             joint.set("frictionloss", _num(model.dof_frictionloss[dof]))
             joint.set("armature", _num(model.dof_armature[dof]))
+        for site in body.findall("site"):
+            if site.get("name"):
+                s = ident(mujoco.mjtObj.mjOBJ_SITE, site.get("name"))
+                site.set("pos", _num(model.site_pos[s]))
+                site.set("quat", _num(model.site_quat[s]))
+    _order_bodies(root, joints)
     ET.indent(root, "  ")
     return ET.tostring(root, encoding="unicode") + "\n"
 
 
 def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | Path,
                armature: Mapping[str, float] | None = None, inertias: pin.Model | None = None) -> mujoco.MjModel:
-    """Write the MJCF of :func:`mujoco_spec` at full precision (:func:`mjcf_xml`), atomically.
+    """Write the MJCF of :func:`mujoco_spec` at full precision, its joints in :attr:`Robot.actuated`
+    order (:func:`mjcf_xml`), atomically.
 
     Returns:
         the compiled model the file holds.
@@ -289,8 +358,12 @@ def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | P
     Raises:
         what :func:`mujoco_spec` raises; InputError: an output folder that does not exist.
     """
+    import mujoco
     spec = mujoco_spec(robot, friction, armature, inertias)
     model = compile_spec(spec, robot.urdf)
-    text = mjcf_xml(spec, model)
+    text = mjcf_xml(spec, model, robot.actuated)
     write_atomic(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    if [model.joint(j).name for j in range(model.njnt) if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE] \
+            != list(robot.actuated):  # bodies reordered in the file: its model, in its order
+        model = compile_spec(mujoco.MjSpec.from_file(str(path)), path)
     return model

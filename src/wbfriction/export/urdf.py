@@ -94,8 +94,10 @@ def write_friction_urdf(robot: Robot, friction: Mapping[str, FrictionLike], path
 
     Raises:
         InputError: friction that is not dissipative, a joint the robot does not actuate, an
-            inertia model of another robot, an unreadable URDF, an output folder that does not exist.
+            inertia model of another robot, an unreadable URDF (or a robot loaded from an MJCF), an output
+            folder that does not exist.
     """
+    robot.require_urdf("a .urdf export (the robot's URDF with <dynamics>)")
     joints = joint_exports(friction, armature, robot)
     pi = None if inertias is None else identified_parameters(robot, inertias)
     moved: tuple[str, ...] = ()

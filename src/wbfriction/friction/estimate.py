@@ -337,6 +337,7 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
         disagreement = _measured(tau_f, delta, unique, route, tau_m, done, "base")
     metadata = dict(kin.metadata)
     metadata["estimate_options"] = asdict(options)
+    metadata["joint_labels"] = {j: robot.label(j) for j in robot.torque_controlled}
     return FrictionEstimate(
         joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
         phase=phases.labels(), unique=unique, contact=kin.contact, contact_frames=robot.contact_frames,

@@ -1,4 +1,4 @@
-"""Loading robots: a URDF and a TOML configuration, or a built-in robot (TALOS, the TORO-like one).
+"""Loading robots: a URDF or an MJCF and a TOML configuration, or a built-in robot (TALOS, the TORO-like one).
 
 A built-in robot's configuration ships with the package (``model/robots/<name>.toml``); its
 URDF comes from the installed ``example-robot-data`` package (``example-robot-data:<path>``)
@@ -23,11 +23,14 @@ from wbfriction.config import read_toml
 from wbfriction.exceptions import InputError
 from wbfriction.model.force_torque import parse_sensors
 from wbfriction.model.imu import add_imu_frame
-from wbfriction.model.robot import Robot
+from wbfriction.model.labels import parse_labels
+from wbfriction.model.robot import ModelFormat, Robot
 
 BUILTIN_ROBOTS = ("talos", "toro", "panda")
 _ERD_PREFIX = "example-robot-data:"
 _GENERATED = "wbfriction:"  # a URDF this package generates: "wbfriction:<name>" (robots/<name>.py)
+ROOT_JOINT = "root_joint"
+"""Name of the free-flyer root joint of every model (an MJCF's own free joint is renamed to it)."""
 
 
 def example_robot_data_dir() -> Path:
@@ -83,12 +86,13 @@ def _check_names(names, known, what: str, source: str) -> None:
             raise InputError(f"{source}: unknown {what} '{n}' (not in the model)")
 
 
-def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
-    """Build a :class:`Robot` from a URDF and a configuration mapping.
+def build_robot(urdf: Path, config: dict, source: str = "config", model_format: ModelFormat = "urdf") -> Robot:
+    """Build a :class:`Robot` from a URDF (or an MJCF) and a configuration mapping.
 
     Args:
-        urdf: URDF file. A free-flyer root joint is added (a URDF-declared floating
-            joint is ignored by Pinocchio's parser, so the result is the same).
+        urdf: the robot description file: a URDF, or an MJCF with ``model_format="mjcf"``
+            (:func:`build_model`). Either way the model's root is a free-flyer joint named
+            ``root_joint``.
         config: keys ``name``; ``floating_base`` (default true; false: the URDF's root link
             is welded to the world, as an arm's or a humanoid hanging in its gantry);
             ``contact_frames`` (required on a floating base, refused on a fixed one);
@@ -102,18 +106,20 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
             through ``model.armature``), ``force_torque`` (six-axis sensors above the contacts:
             :func:`~wbfriction.model.force_torque.parse_sensors`), ``contact_force`` ([on, off] [N]:
             contact flags from those sensors, :mod:`wbfriction.logs.contacts`), ``imu`` (link, xyz, rpy:
-            :mod:`wbfriction.model.imu`), ``balance_gains``
+            :mod:`wbfriction.model.imu`), ``labels`` (joint name -> what a person reads,
+            :mod:`wbfriction.model.labels`), ``balance_gains``
             (:attr:`Robot.balance_gains`).
         source: file name used in error messages.
+        model_format: ``"urdf"`` or ``"mjcf"``: how ``urdf`` is read.
 
     Raises:
-        InputError: URDF that does not load, unknown joint or frame names, a joint
+        InputError: a URDF or MJCF that does not load, unknown joint or frame names, a joint
             listed both as torque- and position-controlled, a multi-DoF actuated joint,
             contact frames on a fixed base, a non-positive torque constant, a negative armature.
     """
     urdf = Path(urdf)
     floating = _floating_base(config, source)
-    model = _load_urdf(urdf)
+    model = build_model(urdf, model_format)
     q_ref = _reference_configuration(model, config, _actuated_joints(model, urdf, allow_locked=True), source)
     model, q_ref, locked = _lock_joints(model, config, q_ref, source)
     actuated = _actuated_joints(model, urdf)
@@ -127,6 +133,7 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
         name=str(config.get("name", urdf.stem)),
         model=model,
         urdf=urdf,
+        model_format=model_format,
         actuated=tuple(actuated),
         torque_controlled=_in_model_order(actuated, tc_cfg),
         position_controlled=_in_model_order(actuated, pc),
@@ -140,6 +147,7 @@ def build_robot(urdf: Path, config: dict, source: str = "config") -> Robot:
         ft_sensors=parse_sensors(model, config.get("force_torque"), frames, source),
         contact_force=_contact_force(config.get("contact_force"), source),
         imu=add_imu_frame(model, config.get("imu"), source),
+        labels=parse_labels(config.get("labels"), actuated, source),
     )
 
 
@@ -223,15 +231,50 @@ def _lock_joints(model: pin.Model, config: dict, q_ref: np.ndarray | None,
     return reduced, q_red, values
 
 
-def _load_urdf(urdf: Path) -> pin.Model:
-    """The Pinocchio model of a URDF file, on a free-flyer root joint."""
-    if not urdf.is_file():
-        raise InputError(f"{urdf}: URDF file not found")
+def build_model(path: Path, model_format: ModelFormat = "urdf", free_flyer: bool = True) -> pin.Model:
+    """The Pinocchio model of a URDF or MJCF file: the one place where the two formats differ.
+
+    Args:
+        path: the file.
+        model_format: ``"urdf"`` (``pin.buildModelFromUrdf``; a URDF-declared ``floating`` joint is
+            ignored by Pinocchio's parser) or ``"mjcf"`` (``pin.buildModelFromMJCFAndRootJoint``: a
+            MuJoCo model; its top body's ``<freejoint>`` is kept as the free flyer, else one is added;
+            hinge and slide joints become 1-DoF joints, an unlimited hinge a revolute joint with
+            infinite limits; ``<site>`` elements and bodies without joints become frames, the latter's
+            inertia merged into their parent's; ``armature`` [kg·m^2] is read into ``model.armature``,
+            ``damping`` and ``frictionloss`` into ``model.damping``/``model.friction``, which no
+            algorithm uses; ``range`` in the ``<compiler angle>`` unit, degrees by default).
+        free_flyer: a free-flyer root joint named ``root_joint`` (the robots of :func:`build_robot`);
+            False: the file's root welded to the world (a fixed-base model as the file has it).
+
+    Raises:
+        InputError: a missing file, one that does not load, or (``free_flyer``) an MJCF whose root
+            joint is not free (a hinge at its top body).
+    """
+    kind = model_format.upper()
+    if not path.is_file():
+        raise InputError(f"{path}: {kind} file not found")
     try:
         with _quiet_stderr():
-            return pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+            if model_format == "urdf":
+                if free_flyer:
+                    return pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+                return pin.buildModelFromUrdf(str(path))
+            if not free_flyer:
+                return pin.buildModelFromMJCF(str(path))
+            model = pin.buildModelFromMJCFAndRootJoint(str(path), pin.JointModelFreeFlyer(), ROOT_JOINT)
     except Exception as exc:  # Pinocchio raises plain RuntimeError/ValueError
-        raise InputError(f"{urdf}: URDF does not load: {str(exc).strip().splitlines()[0]}") from exc
+        raise InputError(f"{path}: {kind} does not load: {str(exc).strip().splitlines()[0]}") from exc
+    if model.njoints < 2 or model.joints[1].shortname() != "JointModelFreeFlyer":
+        raise InputError(f"{path}: the MJCF's root joint '{model.names[1] if model.njoints > 1 else ''}' is not "
+                         "free: give its top body a <freejoint/> or no joint (a fixed base: floating_base = false)")
+    if model.names[1] != ROOT_JOINT:  # the MJCF's own <freejoint name=...>: named as a URDF's root
+        fid = model.getFrameId(model.names[1], pin.FrameType.JOINT)
+        frame = model.frames[fid]
+        frame.name = ROOT_JOINT
+        model.frames[fid] = frame
+        model.names[1] = ROOT_JOINT
+    return model
 
 
 def _actuated_joints(model: pin.Model, urdf: Path, allow_locked: bool = False) -> list[str]:
@@ -317,36 +360,47 @@ def _balance_gains(value, source: str) -> tuple[float, float]:
 
 
 def load_robot(name: str | None = "talos", *, urdf: str | Path | None = None,
-               config: str | Path | None = None) -> Robot:
-    """Load a built-in robot by name, or any robot from ``urdf`` and a ``config`` TOML.
+               config: str | Path | None = None, mjcf: str | Path | None = None) -> Robot:
+    """Load a built-in robot by name, or any robot from ``urdf`` (or ``mjcf``) and a ``config`` TOML.
 
     Examples:
         >>> robot = load_robot("talos")                                  # doctest: +SKIP
         >>> robot = load_robot(urdf="my.urdf", config="my_robot.toml")   # doctest: +SKIP
+        >>> robot = load_robot(mjcf="my.xml", config="my_robot.toml")    # doctest: +SKIP
         >>> robot = load_robot("talos", urdf="talos_identified.urdf")    # doctest: +SKIP
 
-    ``urdf`` without ``config`` gives the built-in robot ``name``'s configuration (contact
-    frames, joint roles, groups) on another URDF of the same robot; ``config`` without ``urdf`` takes the URDF
-    its ``urdf`` key names (a path relative to the TOML, or ``example-robot-data:<path in the package>``).
+    ``urdf`` or ``mjcf`` (a MuJoCo model, :func:`build_model`) without ``config`` gives the built-in robot
+    ``name``'s configuration (contact frames, joint roles, groups) on another model of the same robot;
+    ``config`` without either takes the file its ``urdf`` or ``mjcf`` key names (a path relative to the TOML,
+    or ``example-robot-data:<path in the package>``).
 
     Raises:
-        InputError: unknown built-in name, missing files, a ``config`` without ``urdf`` that names none, or a
-            bad configuration.
+        InputError: unknown built-in name, missing files, both ``urdf`` and ``mjcf`` (or a TOML naming both), a
+            ``config`` without either that names none, or a bad configuration.
     """
+    if urdf is not None and mjcf is not None:
+        raise InputError("give the robot's --urdf or its --mjcf, not both")
+    model_format: ModelFormat = "mjcf" if mjcf is not None else "urdf"
+    given = mjcf if mjcf is not None else urdf
     if config is not None:
         cfg_path = Path(config)
         cfg = read_toml(cfg_path)
         cfg["_dir"] = str(cfg_path.parent)
-        if urdf is None:  # the TOML may name its URDF (relative to itself, or "example-robot-data:<path>")
-            if not isinstance(cfg.get("urdf"), str):
-                raise InputError(f"{cfg_path}: no 'urdf' in the robot TOML: give the robot's --urdf")
-            urdf = _resolve(cfg["urdf"], cfg_path.parent)
-        return build_robot(Path(urdf), cfg, source=str(cfg_path))
+        if given is None:  # the TOML may name its URDF or MJCF (relative to itself, or "example-robot-data:<path>")
+            named = [k for k in ("urdf", "mjcf") if k in cfg]
+            if len(named) > 1:
+                raise InputError(f"{cfg_path}: the robot TOML names both 'urdf' and 'mjcf': keep one")
+            if not named or not isinstance(cfg[named[0]], str):
+                raise InputError(f"{cfg_path}: no 'urdf' in the robot TOML: give the robot's --urdf (or its "
+                                 "'mjcf' or --mjcf)")
+            model_format = "mjcf" if named[0] == "mjcf" else "urdf"
+            given = _resolve(cfg[named[0]], cfg_path.parent)
+        return build_robot(Path(given), cfg, source=str(cfg_path), model_format=model_format)
     if name not in BUILTIN_ROBOTS:
         raise InputError(f"unknown robot '{name}': built-in robots are {', '.join(BUILTIN_ROBOTS)}; "
                          "otherwise give --urdf and --config")
     text = resources.files("wbfriction.model.robots").joinpath(f"{name}.toml").read_text()
     cfg = tomllib.loads(text)  # the package's own file
-    if urdf is not None:  # the built-in robot's configuration on another URDF of it (identified inertias)
-        return build_robot(Path(urdf), cfg, source=f"built-in robot '{name}' on {urdf}")
+    if given is not None:  # the built-in robot's configuration on another model of it (identified inertias)
+        return build_robot(Path(given), cfg, source=f"built-in robot '{name}' on {given}", model_format=model_format)
     return build_robot(_resolve(cfg["urdf"], Path(".")), cfg, source=f"built-in robot '{name}'")

@@ -1,9 +1,10 @@
-"""Robot model: a URDF with a free-flyer root, its joint groups and contact frames.
+"""Robot model: a URDF (or an MJCF) with a free-flyer root, its joint groups and contact frames.
 
 A fixed-base robot (an arm) has the same free-flyer root, welded to the world at the
 identity through one permanent contact at its root link (:attr:`Robot.floating_base`).
 
-The model is Pinocchio's (``pin.buildModelFromUrdf`` with ``pin.JointModelFreeFlyer``):
+The model is Pinocchio's (``pin.buildModelFromUrdf`` with ``pin.JointModelFreeFlyer``, or
+``pin.buildModelFromMJCFAndRootJoint``: :func:`wbfriction.model.loading.build_model`):
 configuration ``q`` (size ``nq``: base position [m], base orientation as a unit
 quaternion (x, y, z, w), then the joint coordinates) and velocity ``v`` (size ``nv``:
 base twist in the base frame [m/s, rad/s], then joint velocities [rad/s]).
@@ -24,15 +25,19 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import pinocchio as pin
 
-from wbfriction.exceptions import ModelError
+from wbfriction.exceptions import InputError, ModelError
 from wbfriction.model.force_torque import ForceTorqueSensor
 from wbfriction.model.imu import Imu
+from wbfriction.model.labels import default_label
 from wbfriction.model.layout import JointLayout, joint_layout
+
+ModelFormat = Literal["urdf", "mjcf"]
+"""The robot description formats a model is built from (:func:`wbfriction.model.loading.build_model`)."""
 
 
 @dataclass(frozen=True)
@@ -42,7 +47,8 @@ class Robot:
     Attributes:
         name: robot name.
         model: Pinocchio model with a free-flyer root joint named ``root_joint``.
-        urdf: path of the URDF the model was built from.
+        urdf: path of the robot description the model was built from: a URDF, or an MJCF where
+            :attr:`model_format` is ``"mjcf"`` (what needs a URDF asks :meth:`require_urdf`).
         actuated: names of all actuated (single-DoF) joints, in model order.
         torque_controlled: names of the torque-controlled joints, in model order.
         position_controlled: names of the position-controlled joints, in model order.
@@ -65,6 +71,9 @@ class Robot:
         ft_sensors: six-axis force-torque sensors, one per contact at most
             (:mod:`wbfriction.model.force_torque`; ``[force_torque.<name>]`` in the TOML).
         imu: the inertial measurement unit (:mod:`wbfriction.model.imu`; ``[imu]`` in the TOML), or None.
+        labels: joint -> the label a person reads ("right knee"; ``[labels]`` in the TOML,
+            :mod:`wbfriction.model.labels`); :meth:`label` falls back to the joint's name.
+        model_format: ``"urdf"`` or ``"mjcf"``: the format of :attr:`urdf`.
         contact_force: ``(on, off)`` [N]: the normal forces above which a sensed sole comes into
             contact and below which it leaves it, for logs without ``contact.*`` columns
             (:mod:`wbfriction.logs.contacts`); None: shares of the robot's weight.
@@ -78,6 +87,7 @@ class Robot:
     position_controlled: tuple[str, ...]
     contact_frames: tuple[str, ...]
     groups: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    model_format: ModelFormat = "urdf"
     q_reference: np.ndarray | None = None
     balance_gains: tuple[float, float] = (0.0, 0.0)
     floating_base: bool = True
@@ -86,8 +96,20 @@ class Robot:
     ft_sensors: tuple[ForceTorqueSensor, ...] = ()
     contact_force: tuple[float, float] | None = None
     imu: Imu | None = None
+    labels: dict[str, str] = field(default_factory=dict)
     cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
     """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.stance`)."""
+
+    def require_urdf(self, purpose: str) -> Path:
+        """The robot's URDF, for ``purpose`` (rewriting it, a simulator built from its geometry).
+
+        Raises:
+            InputError: a robot loaded from an MJCF.
+        """
+        if self.model_format != "urdf":
+            raise InputError(f"{self.urdf}: {purpose} needs the robot's URDF (give --urdf): this robot was loaded "
+                             "from an MJCF")
+        return self.urdf
 
     # ----------------------------------------------------------------- indices
     @cached_property
@@ -160,6 +182,10 @@ class Robot:
             if joint in joints:
                 return group
         return None
+
+    def label(self, joint: str) -> str:
+        """The label a person reads for ``joint`` (:attr:`labels`, else its name, :func:`~.labels.default_label`)."""
+        return self.labels.get(joint) or default_label(joint)
 
     # ----------------------------------------------------------- configuration
     def configuration(self, angles: np.ndarray, base: np.ndarray | None = None) -> np.ndarray:

@@ -14,7 +14,8 @@ from wbfriction.pipeline.estimate import check_file
 
 def convert_log(robot: Robot, log: str | Path, output: str | Path, bag_map: BagMap | str | Path | None = None, *,
                 max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN) -> int:
-    """Stream a log (a ROS 2 bag through its topic map, or a table file) into ``output`` (Parquet
+    """Stream a log (a ROS 2 bag through its topic map, or a table file,
+    through the same map TOML if given: joint renaming, contact flags) into ``output`` (Parquet
     or CSV) in the log format, check it against ``robot`` chunk by chunk
     (:func:`~wbfriction.pipeline.estimate.check_file`) and only then rename it into place.
     Returns the rows written.
@@ -23,6 +24,6 @@ def convert_log(robot: Robot, log: str | Path, output: str | Path, bag_map: BagM
         InputError: an unreadable log or map, an output that is neither .parquet nor .csv, or
             what the check raises (naming ``log``, the column and the row). Nothing is written then.
     """
-    source = open_log(log, bag_map)
+    source = open_log(log, bag_map, robot)
     return write_tables(output, source.blocks(),
                         check=lambda tmp: check_file(robot, tmp, str(log), max_gap=max_gap, limit_margin=limit_margin))

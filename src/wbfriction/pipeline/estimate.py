@@ -43,9 +43,10 @@ class RobotSpec:
     name: str | None = "talos"
     urdf: str | None = None
     config: str | None = None
+    mjcf: str | None = None
 
     def load(self) -> Robot:
-        return load_robot(self.name, urdf=self.urdf, config=self.config)
+        return load_robot(self.name, urdf=self.urdf, config=self.config, mjcf=self.mjcf)
 
 
 def check_file(robot: Robot, path: str | Path, source: str | None = None, chunking: Chunking = Chunking(),
@@ -227,14 +228,14 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
 
 @contextmanager
 def table_log(log: LogSource, near: Path) -> Iterator[Path]:
-    """The log as a table file for :func:`estimate_file`: a table file as it is; a ROS 2 bag
-    streamed into a temporary Parquet log in a temporary folder beside ``near`` (the output),
-    removed on leaving.
+    """The log as a table file for :func:`estimate_file`: a table file as it is; a ROS 2 bag, or a
+    table file read through a map (:mod:`wbfriction.logs.table_map`), streamed into a temporary
+    Parquet log in a temporary folder beside ``near`` (the output), removed on leaving.
 
     Raises:
-        InputError: what reading the bag raises.
+        InputError: what reading the bag (or mapped table) raises.
     """
-    if not log.is_bag:
+    if not log.is_mapped:
         yield log.path
         return
     folder = near.parent if near.parent.exists() else None

@@ -45,12 +45,14 @@ def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path]
         the outputs and their formats, in order.
 
     Raises:
-        InputError: an unknown suffix, unreadable parameters, friction that is not dissipative
-            (:mod:`wbfriction.export.mapping`), a joint the robot does not actuate.
+        InputError: an unknown suffix, a .urdf output for a robot loaded from an MJCF, unreadable parameters,
+            friction that is not dissipative (:mod:`wbfriction.export.mapping`), a joint the robot does not actuate.
     """
     if not outputs:
         raise InputError("export: give at least one output (-o FILE.urdf, .xml or .yaml)")
     formats = [export_format(p) for p in outputs]
+    if "urdf" in formats:
+        robot.require_urdf("a .urdf export (the robot's URDF with <dynamics>)")
     fits = read_params(params)
     friction = {j: f for j, f in fits.items() if f.params is not None}
     done = []

@@ -6,6 +6,10 @@ file or a report can be traced to the bytes of its inputs (SHA-256) and the pack
 
 from __future__ import annotations
 
+import os
+import platform
+import time
+from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -32,3 +36,27 @@ def file_provenance(key: str, path: str | Path) -> dict[str, Any]:
         InputError: a missing file.
     """
     return {key: str(path), f"{key}_sha256": file_sha256(path), "wbfriction": __version__}
+
+
+DEPENDENCIES = ("pin", "mujoco", "numpy", "scipy", "pyarrow", "matplotlib", "example-robot-data", "typer")
+"""The distributions whose versions an output's provenance names (PyPI names)."""
+
+
+def dependency_versions() -> list[tuple[str, str]]:
+    """(name, version) of wbfriction, Python and every distribution of :data:`DEPENDENCIES` as installed
+    ("not installed" for one that is not), read from the installed metadata without importing them."""
+    versions = [("wbfriction", __version__), ("Python", platform.python_version())]
+    for name in DEPENDENCIES:
+        try:
+            versions.append((name, metadata.version(name)))
+        except metadata.PackageNotFoundError:
+            versions.append((name, "not installed"))
+    return versions
+
+
+def output_date() -> str:
+    """The date an output is made, ISO 8601 (UTC): that of ``SOURCE_DATE_EPOCH`` when set (the reproducible-builds
+    convention: the same inputs then give the same bytes on any day), else today's."""
+    epoch = os.environ.get("SOURCE_DATE_EPOCH", "").strip()
+    seconds = float(epoch) if epoch.isdigit() else time.time()
+    return time.strftime("%Y-%m-%d", time.gmtime(seconds))

@@ -3,9 +3,11 @@ and checks what is not given, and gathers what the HTML shows (:mod:`wbfriction.
 
 The report shows, for a person to judge a friction table at a glance:
 
-* a summary with the energy-consistency warnings (:mod:`wbfriction.friction.energy`, eq. 7.9);
-* the friction clouds of every joint as small multiples on shared axes, with the fitted
-  model (3.5) and the target where known;
+* a summary: one row per joint that moved (its label, fit status, F_c, F_v, tau_os with standard errors,
+  energy share, valid samples, verdict), the joints that did not move in one line, and the
+  energy-consistency warnings (:mod:`wbfriction.friction.energy`, eq. 7.9);
+* the friction clouds of the joints that moved as small multiples, each on its own axes, with the
+  fitted model (3.5) and the target where known;
 * the identified parameters with their standard errors (6.2.2), and the errors against the
   targets of a simulated log;
 * the energy-consistency table (share of power-generating samples, zero crossings of
@@ -13,13 +15,16 @@ The report shows, for a person to judge a friction table at a glance:
 * per joint: the cloud, ``tau_f`` over time by support phase, Fig. 7.4 with and without
   filtering, and the spectrum of the estimated acceleration (Fig. 7.1);
 * the inertia identification of ``wbfriction identify --json``, when given;
-* the provenance: input files with their SHA-256, robot, options, package versions.
+* the provenance: input files with their SHA-256, robot, options, every dependency's version, the date.
+
+Joints are named by their labels (``[labels]`` of the robot TOML, recorded in the friction table by
+``estimate``; :mod:`wbfriction.model.labels`).
 """
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -28,8 +33,11 @@ from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, Joi
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
 from wbfriction.friction.io import check_params_source, read_friction_file, read_params
+from wbfriction.friction.status import MIN_SPEED
 from wbfriction.inertia.io import read_identification
 from wbfriction.logs.tables import file_sha256
+from wbfriction.model.labels import default_label
+from wbfriction.pipeline.provenance import dependency_versions, output_date
 from wbfriction.signals.spectrum import MIN_SAMPLES, joint_spectra, longest_run
 from wbfriction.version import __version__
 
@@ -49,6 +57,21 @@ def acceleration_spectra(est: FrictionEstimate, tail: float = 0.01) -> dict[str,
     return {j: (freq, amp[:, i], float(cutoff[i])) for i, j in enumerate(est.joints)}
 
 
+def joint_moved(est: FrictionEstimate, joint: str) -> bool:
+    """Whether ``joint`` moved in its valid samples: the 95th percentile of ``|qd|`` there at least
+    :data:`~wbfriction.friction.status.MIN_SPEED` (the fit's "not excited" criterion)."""
+    i = est.joints.index(joint)
+    qd = np.abs(est.qd[est.valid[:, i], i])
+    return bool(qd.size) and float(np.percentile(qd, 95)) >= MIN_SPEED
+
+
+def _options_text(options: dict) -> str:
+    """Options as ``name value`` pairs, comma separated, nested ones in parentheses (what a person reads, not
+    JSON)."""
+    return ", ".join(f"{k} ({_options_text(v)})" if isinstance(v, dict) else f"{k} {v}"
+                     for k, v in sorted(options.items()) if v is not None)
+
+
 @dataclass
 class Report:
     """What a report shows, computed; :meth:`html` renders it.
@@ -57,9 +80,12 @@ class Report:
         est: the estimate read from the friction table.
         fits: fitted parameters by joint (from ``--params`` or fitted here).
         energy: energy consistency by joint.
-        provenance: (label, value) pairs.
+        provenance: (label, value) pairs: inputs, robot, options.
         threshold: share of power-generating samples above which a joint is flagged.
         identification: what ``wbfriction identify --json`` wrote, or None.
+        labels: joint -> the label a person reads.
+        versions: (name, version) of wbfriction, Python and the dependencies.
+        date: the date the report was made (:func:`~wbfriction.pipeline.provenance.output_date`).
     """
 
     est: FrictionEstimate
@@ -68,10 +94,28 @@ class Report:
     provenance: list[tuple[str, str]]
     threshold: float
     identification: dict | None = None
+    labels: dict[str, str] | None = None
+    versions: tuple[tuple[str, str], ...] = ()
+    date: str = ""
 
     @property
     def flagged(self) -> list[JointEnergy]:
-        return [e for e in self.energy.values() if e.flagged]
+        return [e for e in self.energy.values() if e.flagged and e.joint in self.moved]
+
+    @cached_property
+    def moved(self) -> tuple[str, ...]:
+        """The joints that moved (:func:`joint_moved`), in table order: those the report shows."""
+        return tuple(j for j in self.est.joints if joint_moved(self.est, j))
+
+    @property
+    def still(self) -> tuple[str, ...]:
+        """The joints that did not move: one line in the report."""
+        moved = set(self.moved)
+        return tuple(j for j in self.est.joints if j not in moved)
+
+    def label(self, joint: str) -> str:
+        """What a person reads for ``joint``."""
+        return (self.labels or {}).get(joint) or default_label(joint)
 
 
 def make_report(friction: str | Path, params: str | Path | None = None,
@@ -106,9 +150,9 @@ def make_report(friction: str | Path, params: str | Path | None = None,
         prov.append(("log", str(meta["source"])))
     prov.append(("robot", str(source.get("robot") or meta.get("robot", "?"))))
     if source.get("urdf"):
-        prov.append(("URDF", str(source["urdf"])))
+        prov.append(("robot model (URDF or MJCF)", str(source["urdf"])))
     if "estimate_options" in meta:
-        prov.append(("estimate options", json.dumps(meta["estimate_options"], sort_keys=True)))
+        prov.append(("estimate options", _options_text(meta["estimate_options"])))
     if est.companion_diff:
         prov.append(("companion scheme (Fig. 7.4)", est.companion_diff))
     if source.get("wbfriction"):
@@ -117,4 +161,6 @@ def make_report(friction: str | Path, params: str | Path | None = None,
                                f"tolerance {tolerance:g} N·m"))
     if identification is not None:
         prov.append(("inertia identification", f"{identification} (sha256 {file_sha256(identification)})"))
-    return Report(est, fits, energy, prov, threshold, ident)
+    labels = meta.get("joint_labels")
+    return Report(est, fits, energy, prov, threshold, ident, dict(labels) if isinstance(labels, dict) else None,
+                  tuple(dependency_versions()), output_date())

@@ -10,8 +10,10 @@ from __future__ import annotations
 import io
 from collections.abc import Set as AbstractSet
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from matplotlib import rc_context
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
@@ -21,13 +23,22 @@ from wbfriction.friction.models import FrictionParams
 from wbfriction.logs.tables import write_atomic
 
 _DOUBLE_SUPPORT_COLOR = "#dddddd"
+REPORT_DPI = 100
+"""Pixels per inch of the report's figures: they are at most :data:`REPORT_WIDTH` inches wide, so a page 1400 px
+wide shows them at their own size and a font of :data:`READABLE` points is at least 11 px."""
+REPORT_WIDTH = 12.0
+"""Width of the report's figures [in] (1200 px at :data:`REPORT_DPI`)."""
+READABLE: dict[Any, Any] = {"font.size": 10.0, "axes.titlesize": 10.5, "axes.labelsize": 10.0, "xtick.labelsize": 9.0,
+                            "ytick.labelsize": 9.0, "legend.fontsize": 8.5, "figure.titlesize": 11.0,
+                            "axes.formatter.useoffset": False}
+"""Font sizes [pt] of the report's figures: the smallest, 8.5 pt, is 11.8 px at :data:`REPORT_DPI`."""
 
 
 def _save(fig: Figure, path: str | Path) -> None:
     write_atomic(path, lambda tmp: fig.savefig(tmp, format="png", dpi=110))
 
 
-def png_bytes(fig: Figure, dpi: int = 90) -> bytes:
+def png_bytes(fig: Figure, dpi: int = REPORT_DPI) -> bytes:
     """The figure as PNG bytes (no timestamp in the file: the same figure gives the same bytes)."""
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi, metadata={"Software": None})
@@ -190,45 +201,50 @@ def velocity_panels_figure(panels: list[tuple[str, FrictionEstimate, np.ndarray]
 
 PHASE_COLORS = {"single": "C0", "double": "#9a9a9a", "flight": "C3"}
 
-
 def _short(joint: str) -> str:
     return joint.replace("_joint", "")
 
 
 def _cloud(ax, est: FrictionEstimate, i: int, fit: FitResult | None, target: FrictionParams | None) -> None:
+    """The valid estimates of joint ``i`` over its velocity, under the target (wide, grey) and over which the
+    fitted model runs dashed, so that neither hides the cloud."""
     m = est.valid[:, i]
-    ax.plot(est.qd[m, i], est.tau_f[m, i], ".", ms=1, color="C0", alpha=0.3)
+    ax.plot(est.qd[m, i], est.tau_f[m, i], ".", ms=1.5, color="C0", alpha=0.35, zorder=2, rasterized=True)
     if m.any():
         v = np.linspace(est.qd[m, i].min(), est.qd[m, i].max(), 400)
         if target is not None:
-            ax.plot(v, target.torque(v), color="k", lw=2.5, alpha=0.35, label="target")
+            ax.plot(v, target.torque(v), color="k", lw=3, alpha=0.25, zorder=1, label="target")
         if fit is not None and fit.params is not None:
-            ax.plot(v, fit.params.torque(v), color="C1", lw=1.2, label=f"fit ({fit.model})")
-    ax.axhline(0, color="k", lw=0.4)
-    ax.axvline(0, color="k", lw=0.4)
+            ax.plot(v, fit.params.torque(v), color="C1", lw=1.6, ls="--", zorder=3, label=f"fit ({fit.model})")
+    ax.axhline(0, color="k", lw=0.4, zorder=0)
+    ax.axvline(0, color="k", lw=0.4, zorder=0)
 
 
 def friction_overview_figure(est: FrictionEstimate, joints: list[str], fits: dict[str, FitResult],
                              targets: dict[str, FrictionParams], flagged: AbstractSet[str] = frozenset(),
-                             columns: int = 6, title: str = "Friction over velocity, valid samples, shared axes "
-                                                             "(red: power-generating share over threshold)") -> Figure:
-    """Small multiples on shared axes: per joint the valid estimates over velocity, the fitted
-    model and the target; titles of joints flagged by the energy check in red."""
+                             columns: int = 4, title: str = "Friction over velocity, valid samples (each joint on "
+                                                            "its own axes; red: generates power)",
+                             labels: dict[str, str] | None = None) -> Figure:
+    """Small multiples, each joint on its own axes (a knee's newton-metres do not squash an ankle's): per
+    joint the valid estimates over velocity, the fitted model and the target; titles of joints flagged by
+    the energy check in red. ``labels``: joint -> title (default: the name without ``_joint``)."""
     n = max(len(joints), 1)
     columns = min(columns, n)
     rows = int(np.ceil(n / columns))
-    fig = Figure(figsize=(2.4 * columns, 2.0 * rows + 0.7), layout="constrained")
-    axes = fig.subplots(rows, columns, sharex=True, sharey=True, squeeze=False).ravel()
-    for ax, joint in zip(axes, joints):
-        _cloud(ax, est, est.joints.index(joint), fits.get(joint), targets.get(joint))
-        ax.set_title(_short(joint), fontsize=8, color="C3" if joint in flagged else "k")
-        ax.tick_params(labelsize=7)
-    for ax in axes[len(joints):]:
-        ax.set_visible(False)
-    axes[0].legend(fontsize=6, loc="upper right")
-    fig.supxlabel("qd [rad/s]")
-    fig.supylabel("tau_f [N·m]")
-    fig.suptitle(title, fontsize=10)
+    with rc_context(READABLE):
+        fig = Figure(figsize=(REPORT_WIDTH * columns / 4, 2.6 * rows + 0.9), layout="constrained")
+        axes = fig.subplots(rows, columns, squeeze=False).ravel()
+        for ax, joint in zip(axes, joints):
+            _cloud(ax, est, est.joints.index(joint), fits.get(joint), targets.get(joint))
+            ax.set_title((labels or {}).get(joint) or _short(joint), color="C3" if joint in flagged else "k")
+        for ax in axes[len(joints):]:
+            ax.set_visible(False)
+        handles, names = axes[0].get_legend_handles_labels()
+        if handles:  # under the panels, where it hides no sample
+            fig.legend(handles, names, loc="outside lower right", ncols=len(handles))
+        fig.supxlabel("qd [rad/s]")
+        fig.supylabel("tau_f [N·m]")
+        fig.suptitle(title)
     return fig
 
 
@@ -248,26 +264,31 @@ def _cloud_panel(ax: Axes, est: FrictionEstimate, i: int, fit: FitResult | None,
     _cloud(ax, est, i, fit, target)
     ax.set_xlabel("qd [rad/s]")
     ax.set_ylabel("tau_f [N·m]")
-    ax.set_title("(a) friction over velocity", fontsize=9)
+    ax.set_title("(a) friction over velocity, valid samples")
     if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize=7)
+        ax.legend(loc="upper right")
 
 
 def _phase_panel(ax: Axes, est: FrictionEstimate, i: int) -> None:
-    """Panel (b) of :func:`joint_figure`: ``tau_f`` over time coloured by support phase, valid samples dark."""
+    """Panel (b) of :func:`joint_figure`: ``tau_f`` over time coloured by support phase, valid samples dark;
+    the axis spans the valid samples (a double-support estimate, never valid, may leave it: said in the title)."""
+    clipped = False
+    valid_tau = est.tau_f[est.valid[:, i], i]
+    lim = 1.5 * float(np.max(np.abs(valid_tau))) + 1e-6 if valid_tau.size else None
     for phase, color in PHASE_COLORS.items():
         sel = est.phase == phase
         if sel.any():
-            ax.plot(est.time, np.where(sel, est.tau_f[:, i], np.nan), lw=0.5, color=color, alpha=0.45,
-                    label=phase)
-    ax.plot(est.time, np.where(est.valid[:, i], est.tau_f[:, i], np.nan), lw=0.8, color="C1", label="valid")
+            y = np.where(sel, est.tau_f[:, i], np.nan)
+            ax.plot(est.time, y, lw=0.5, color=color, alpha=0.45, label=phase)
+            clipped |= lim is not None and bool(np.nanmax(np.abs(y), initial=0.0) > lim)
+    ax.plot(est.time, np.where(est.valid[:, i], est.tau_f[:, i], np.nan), lw=0.9, color="C1", label="valid")
     ax.set_xlabel("time [s]")
-    ax.set_title("(b) tau_f over time by support phase", fontsize=9)
-    valid_tau = est.tau_f[est.valid[:, i], i]
-    if valid_tau.size:
-        lim = 1.5 * float(np.max(np.abs(valid_tau))) + 1e-6
+    ax.set_ylabel("tau_f [N·m]")
+    ax.set_title("(b) tau_f over time by support phase" + (" (axis: valid samples; others clipped)"
+                                                           if clipped else ""))
+    if lim is not None:
         ax.set_ylim(-lim, lim)
-    ax.legend(fontsize=6, ncol=4, loc="upper right")
+    ax.legend(ncol=4, loc="upper right")
 
 
 def _delta_panel(ax: Axes, est: FrictionEstimate, i: int) -> None:
@@ -278,7 +299,7 @@ def _delta_panel(ax: Axes, est: FrictionEstimate, i: int) -> None:
         diff = est.metadata.get("estimate_options", {}).get("diff", "estimate")
         ax.plot(t, est.delta_qdd[run, i], color="C0", lw=1, label=f"Δqdd ({diff})")
         if est.companion_delta_qdd is not None:
-            ax.plot(t, est.companion_delta_qdd[run, i], color="C2", lw=0.7, alpha=0.8,
+            ax.plot(t, est.companion_delta_qdd[run, i], color="C2", lw=0.8, alpha=0.8,
                     label=f"Δqdd ({est.companion_diff or 'companion'})")
         ax.axhline(0, color="k", lw=0.4)
         ax.set_ylabel("Δqdd [rad/s²]")
@@ -288,31 +309,36 @@ def _delta_panel(ax: Axes, est: FrictionEstimate, i: int) -> None:
         for a in (ax, ax_v):  # both zero lines at mid-height: the crossings line up by eye
             top = float(np.nanmax(np.abs(a.get_ylim())))
             a.set_ylim(-top, top)
-        ax.legend(fontsize=6, loc="upper left")
+        ax.legend(loc="upper left")
         ax.set_xlabel("time [s]")
     else:
-        ax.text(0.5, 0.5, "no acceleration difference in the table", ha="center", va="center", fontsize=8,
+        ax.text(0.5, 0.5, "no acceleration difference in the table", ha="center", va="center",
                 transform=ax.transAxes)
-    ax.set_title("(c) Fig. 7.4: Δqdd and velocity, one valid stretch", fontsize=9)
+    ax.set_title("(c) Fig. 7.4: Δqdd and qd, one valid stretch")
 
 
 def _spectrum_panel(ax: Axes, spectrum: tuple[np.ndarray, np.ndarray, float] | None, max_freq: float) -> None:
-    """Panel (d) of :func:`joint_figure` (Fig. 7.1): the spectrum of ``qdd_est`` and its cutoff, hidden without one."""
+    """Panel (d) of :func:`joint_figure` (Fig. 7.1): the spectrum of ``qdd_est`` and its cutoff, hidden without
+    one. The axis reaches the cutoff when it lies beyond ``max_freq`` (up to the spectrum's last frequency)."""
     if spectrum is not None:
         freq, amp, cutoff = spectrum
-        keep = (freq > 0) & (freq <= max_freq)
+        top = min(max(max_freq, 1.15 * cutoff), float(freq[-1]))
+        keep = (freq > 0) & (freq <= top)
         ax.semilogy(freq[keep], amp[keep], lw=0.7, color="C0")
-        ax.axvline(cutoff, color="C1", ls="--", lw=1)
-        ax.set_xlim(0, max_freq)
-        ax.set_title(f"(d) spectrum of qdd_est: {cutoff:.1f} Hz", fontsize=9)
+        ax.axvline(cutoff, color="C1", ls="--", lw=1.2, label=f"cutoff {cutoff:.1f} Hz")
+        ax.set_xlim(0, top)
+        ax.set_title("(d) Fig. 7.1: spectrum of qdd_est")
         ax.set_xlabel("frequency [Hz]")
+        ax.set_ylabel("amplitude [rad/s²]")
+        ax.legend(loc="upper right")
     else:
         ax.set_visible(False)
 
 
 def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, target: FrictionParams | None,
                  spectrum: tuple[np.ndarray, np.ndarray, float] | None = None, max_freq: float = 50.0) -> Figure:
-    """One joint at a glance, four panels:
+    """One joint at a glance, four panels in two rows, :data:`REPORT_WIDTH` inches wide with fonts of
+    :data:`READABLE` size:
 
     (a) the friction cloud with the fitted model and the target;
     (b) ``tau_f`` over time coloured by support phase (valid samples dark);
@@ -323,17 +349,16 @@ def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, targe
         (``spectrum = (freq, amplitude, cutoff)``), when computed.
     """
     i = est.joints.index(joint)
-    # a fixed layout: constrained layout would cost most of the time of a report's many figures
-    fig = Figure(figsize=(14, 2.7))
-    ax_c, ax_t, ax_e, ax_s = fig.subplots(1, 4, gridspec_kw={"width_ratios": [1, 1.6, 1.6, 1], "wspace": 0.5,
-                                                               "left": 0.05, "right": 0.99, "bottom": 0.17,
-                                                               "top": 0.9})
-    _cloud_panel(ax_c, est, i, fit, target)
-    _phase_panel(ax_t, est, i)
-    _delta_panel(ax_e, est, i)
-    _spectrum_panel(ax_s, spectrum, max_freq)
-    for ax in (ax_c, ax_t, ax_e, ax_s):
-        ax.tick_params(labelsize=7)
+    with rc_context(READABLE):
+        # a fixed layout: constrained layout would cost most of the time of a report's many figures
+        fig = Figure(figsize=(REPORT_WIDTH, 6.4))
+        (ax_c, ax_t), (ax_e, ax_s) = fig.subplots(2, 2, gridspec_kw={
+            "width_ratios": [1, 1.3], "wspace": 0.3, "hspace": 0.5, "left": 0.075, "right": 0.985,
+            "bottom": 0.09, "top": 0.95})
+        _cloud_panel(ax_c, est, i, fit, target)
+        _phase_panel(ax_t, est, i)
+        _delta_panel(ax_e, est, i)
+        _spectrum_panel(ax_s, spectrum, max_freq)
     return fig
 
 

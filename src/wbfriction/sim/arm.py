@@ -53,6 +53,7 @@ import pyarrow as pa
 from wbfriction.exceptions import InputError
 from wbfriction.friction.models import FrictionParams
 from wbfriction.logs.tables import with_metadata
+from wbfriction.model.loading import build_model
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.sim.common import InjectedFriction
@@ -200,13 +201,13 @@ class ArmSimulation:
 
 
 def arm_model(robot: Robot) -> pin.Model:
-    """The fixed-base Pinocchio model of ``robot``'s URDF (no free flyer), its locked joints removed
+    """The fixed-base Pinocchio model of ``robot``'s URDF or MJCF (no free flyer), its locked joints removed
     at their positions, its joints in :attr:`Robot.actuated` order, without armature.
 
     Raises:
         InputError: a URDF whose joints (after locking) are not the robot's actuated ones.
     """
-    model = pin.buildModelFromUrdf(str(robot.urdf))
+    model = build_model(robot.urdf, robot.model_format, free_flyer=False)
     if robot.locked_joints:
         q = pin.neutral(model)
         for name, value in robot.locked_joints.items():

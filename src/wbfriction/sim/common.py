@@ -82,6 +82,7 @@ class Pull:
     end: float
     samples: int
     min_force: float  # [N]
+    double_support: int = 0  # of the samples, those with every foot in contact
 
 
 @dataclass
@@ -114,7 +115,7 @@ class SimulationResult:
             edges = np.flatnonzero(np.diff(np.r_[0, bad.astype(np.int8), 0]))
             for s, e in zip(edges[::2], edges[1::2]):
                 out.append(Pull(frame, float(self.log.time[s]), float(self.log.time[e - 1]), int(e - s),
-                                float(self.wrench[s:e, c, 2].min())))
+                                float(self.wrench[s:e, c, 2].min()), int(self.log.contact[s:e].all(axis=1).sum())))
         return out
 
 

@@ -230,10 +230,12 @@ def build_mujoco_robot(robot: Robot, timestep: float = 1e-4) -> MujocoRobot:
         timestep: physics step [s].
 
     Raises:
+        InputError: a robot loaded from an MJCF (:meth:`Robot.require_urdf`).
         ModelError: the URDF does not compile in MuJoCo, a joint missing, no sole mesh.
     """
     route_mujoco_warnings()
-    root = ET.parse(robot.urdf).getroot()
+    urdf = robot.require_urdf("the MuJoCo simulator (soles from the URDF's collision geometry)")
+    root = ET.parse(urdf).getroot()
     footprints = [sole_footprint(robot, f, root) for f in robot.contact_frames]
     spec = _urdf_spec(robot, timestep)
     _add_soles(spec, robot, footprints)

@@ -104,3 +104,10 @@ def worst_errors(rows: list[LegRow], params: tuple[str, ...] = PARAM_NAMES) -> d
     errors = [r.fit.error_percent() for r in rows]
     assert all(e is not None for e in errors), "a study's leg joints all have a fit and a target"
     return {n: max(e[n] for e in errors if e is not None) for n in params}
+
+
+def not_ok(rows: list[LegRow]) -> list[LegRow]:
+    """The rows whose fit's status is not ``ok`` (:mod:`wbfriction.friction.status`): a short walk that did not
+    excite a joint (the hip yaws of a 2-step combined walk hardly turn) makes its error a statement about the
+    walk, not about the estimate."""
+    return [r for r in rows if not r.fit.verdict().ok]

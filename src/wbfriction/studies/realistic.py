@@ -15,6 +15,8 @@ measured forces, and (last case) sensor noise that the controller acts on.
      model fitted (S, v_s and tau_os held at 0, 0.1, 0);
    * friction (3.5) with the filter study's default sensor noise (1e-4 rad, 19-bit encoder,
      0.05 N·m) in the loop and its best filter (Savitzky-Golay, L = 151, k = 4).
+
+The first case's friction table and HTML report (``report.html``) are written as a user would make them.
 """
 
 from __future__ import annotations
@@ -26,14 +28,17 @@ from pathlib import Path
 import numpy as np
 
 from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_log
-from wbfriction.friction.io import write_params
+from wbfriction.friction.io import friction_table, write_params
 from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.contacts import normal_forces, sensed_contacts
 from wbfriction.logs.log import Log, write_log
+from wbfriction.logs.tables import write_table
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
+from wbfriction.report.build import make_report
 from wbfriction.report.figures import friction_curves_figure, velocity_panels_figure
+from wbfriction.report.html import write_report
 from wbfriction.signals.kinematics import FilterOptions
 from wbfriction.sim import MujocoOptions, SensorNoise, SimulationResult, simulate_mujoco
 from wbfriction.sim.mujoco_model import MujocoRobot, build_mujoco_robot
@@ -169,9 +174,12 @@ def _identify(robot: Robot, mjr: MujocoRobot, legs: list[LegJoint], spec: _CaseS
     write_params(params_path, fits, {"robot": robot.name, "case": spec.label, "gait": dataclasses.asdict(combined)},
                  leg_params_extra(rows, thesis_errors=False))
     files = [log_path, params_path]
-    if spec.name == "model":
+    if spec.name == "model":  # the figure and the report a user would make of this log
         friction_curves_figure(est, fits, output_dir / "mujoco_friction_curves.png")
-        files.append(output_dir / "mujoco_friction_curves.png")
+        friction_path, report_path = output_dir / "mujoco_model_friction.parquet", output_dir / "report.html"
+        write_table(friction_table(est), friction_path)
+        write_report(make_report(friction_path, params_path), report_path)
+        files += [output_dir / "mujoco_friction_curves.png", friction_path, report_path]
     return Case(spec.name, spec.label, rows, spec.scored), files
 
 

@@ -61,6 +61,7 @@ class StudyResult:
     pulls: int  # samples where a welded foot pulled on the ground, both walks
     files: list[Path] = field(default_factory=list)
     generating_share: dict[str, float] = field(default_factory=dict)  # per leg joint, swing phase (eq. 7.9)
+    pulls_double_support: int = 0  # of the pulls' samples, those in double support (never valid: not estimated)
 
 
 def _simulate(robot: Robot, gait: GaitOptions, friction: dict[str, FrictionParams],
@@ -146,4 +147,5 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
     # 2. combined walk, Table 6.1 friction on all leg joints: identification
     rows, walk_pulls, share, walk_files = _identification(robot, legs, steps, output_dir, say)
     pulls = sum(p.samples for p in knee_pulls + walk_pulls)
-    return StudyResult(rows, truth_err, knee_rms, pulls, knee_files + walk_files, share)
+    in_double = sum(p.double_support for p in knee_pulls + walk_pulls)
+    return StudyResult(rows, truth_err, knee_rms, pulls, knee_files + walk_files, share, in_double)

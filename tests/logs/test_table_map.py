@@ -1,0 +1,63 @@
+"""A table log read through the --map TOML: joints renamed, contact flags from force columns with a threshold,
+gives the original log's arrays; bad map entries name the map file and the key."""
+
+from __future__ import annotations
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+from helpers import mapped_copy
+from wbfriction.exceptions import InputError
+from wbfriction.logs.source import open_log, read_log
+
+
+@pytest.fixture(scope="module")
+def walk_log(talos, tmp_path_factory):
+    from wbfriction.logs.log import write_log
+    from wbfriction.sim import simulate_ideal
+    from wbfriction.walking import GaitOptions, walking_reference
+
+    sim = simulate_ideal(talos, walking_reference(talos, GaitOptions(gait="forward", steps=1)))
+    path = tmp_path_factory.mktemp("walk") / "walk.parquet"
+    write_log(sim.log, talos, path)
+    return path
+
+
+def test_mapped_table_log_gives_the_same_log(talos, walk_log, tmp_path):
+    table = pq.read_table(walk_log)
+    mapped, toml = mapped_copy(table, talos.contact_frames)
+    pq.write_table(mapped, tmp_path / "mapped.parquet")
+    (tmp_path / "map.toml").write_text(toml)
+    a = read_log(walk_log, talos)
+    b = read_log(tmp_path / "mapped.parquet", talos, tmp_path / "map.toml")
+    for name in ("time", "q", "tau", "contact", "base", "tau_f_true"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    blocks = list(open_log(tmp_path / "mapped.parquet", tmp_path / "map.toml", talos).blocks(700))
+    assert pa.concat_tables(blocks).column("q.leg_left_4_joint").equals(table.column("q.leg_left_4_joint"))
+    assert blocks[0].schema.metadata == table.schema.metadata
+
+
+def test_bad_map_entries_name_the_map_and_key(talos, walk_log, tmp_path):
+    table = pq.read_table(walk_log)
+    mapped, toml = mapped_copy(table, talos.contact_frames)
+    log = tmp_path / "mapped.parquet"
+    pq.write_table(mapped, log)
+    cases = {
+        toml.replace("LLeg_knee = ", "LLeg_kne = "): r"map.toml: \[joint_states\] rename LLeg_kne: no column",
+        toml.replace('"leg_left_4_joint"', '"leg_left_9_joint"'):
+            r"map.toml: \[joint_states\] rename LLeg_knee = 'leg_left_9_joint': not a joint of robot 'talos'",
+        toml.replace('column = "foot1.fz"', 'column = "foot1.fx"'):
+            r"map.toml: \[\[contacts\]\] entry 2: column 'foot1.fx' is not in",
+        toml.replace('frame = "left_sole_link"', 'frame = "left_hand"'):
+            r"map.toml: \[\[contacts\]\] entry 1: frame 'left_hand' is not a contact frame of robot 'talos'",
+        toml.replace('column = "foot0.fz"\n', ''): r"map.toml: \[\[contacts\]\] entry 1 \(frame 'left_sole_link'\)"
+                                                    r": a table log needs column",
+        toml.replace("threshold = 50.0", 'threshold = "high"', 1): r"entry 1: threshold must be a number",
+    }
+    for text, message in cases.items():
+        (tmp_path / "map.toml").write_text(text)
+        with pytest.raises(InputError, match=message) as info:
+            read_log(log, talos, tmp_path / "map.toml")
+        assert "\n" not in str(info.value)
