@@ -697,7 +697,8 @@ def identify(log: Path = LogArg,
                              time_unit=_time_unit(time_unit))
     doc, moved = done.document, done.moved
     for p in doc["passes"]:
-        out.print(f"v_s {p['stribeck_velocity']}: {p['samples']} samples, {p['base_parameters']} base parameters of "
+        vs = "none" if p["stribeck_velocity"] is None else f"{p['stribeck_velocity']:.4g} rad/s"
+        out.print(f"v_s {vs}: {p['samples']} samples, {p['base_parameters']} base parameters of "
                   f"{p['parameters']}, condition {p['condition']:.3g}, prior {p['prior']:g}; {p['message']}",
                   highlight=False, soft_wrap=True)
         if p.get("verdict"):
