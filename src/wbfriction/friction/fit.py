@@ -65,7 +65,7 @@ from wbfriction.friction.models import (
     stribeck_viscous,
 )
 from wbfriction.friction.screen import gross_outliers
-from wbfriction.friction.status import FitVerdict, fit_verdict
+from wbfriction.friction.status import FitVerdict, fit_verdict, joint_speed
 from wbfriction.workers import process_pool
 
 ModelChoice = Literal["auto", "coulomb-viscous", "stribeck", "thesis"]
@@ -627,7 +627,7 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
 
     n = int(use.sum())
     v, yu = qd[use], y[use]
-    speed = float(np.percentile(np.abs(v), 95)) if n else 0.0
+    speed = joint_speed(v)
     if n < max(min_samples, len(names) + 1):
         return FitResult(joint, n, message=f"only {n} valid samples", model=model, speed=speed)
     starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(v, yu, model)

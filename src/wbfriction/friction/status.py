@@ -31,6 +31,13 @@ FitStatus = Literal["ok", "weak", "at bound", "not excited", "failed"]
 FIT_STATUSES: tuple[FitStatus, ...] = get_args(FitStatus)
 MIN_SPEED = 0.02
 """A joint whose 95th percentile of ``|qd|`` over the fitted samples is below this [rad/s] is not excited."""
+
+
+def joint_speed(qd: np.ndarray) -> float:
+    """How much a joint moved: the 95th percentile of ``|qd|`` over samples ``qd`` (n,) [rad/s]; 0 for none.
+    Below :data:`MIN_SPEED` the joint is not excited (the fit's status, the report's joints that did not move)."""
+    qd = np.asarray(qd, dtype=float)
+    return float(np.percentile(np.abs(qd), 95)) if qd.size else 0.0
 WEAK = 0.5
 """A user-facing parameter whose standard error exceeds this share of its value makes a fit weak."""
 READ = ("F_c", "F_v")

@@ -33,7 +33,7 @@ from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, Joi
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
 from wbfriction.friction.io import check_params_source, read_friction_file, read_params
-from wbfriction.friction.status import MIN_SPEED
+from wbfriction.friction.status import MIN_SPEED, joint_speed
 from wbfriction.inertia.io import read_identification
 from wbfriction.logs.tables import file_sha256
 from wbfriction.model.labels import default_label
@@ -61,8 +61,7 @@ def joint_moved(est: FrictionEstimate, joint: str) -> bool:
     """Whether ``joint`` moved in its valid samples: the 95th percentile of ``|qd|`` there at least
     :data:`~wbfriction.friction.status.MIN_SPEED` (the fit's "not excited" criterion)."""
     i = est.joints.index(joint)
-    qd = np.abs(est.qd[est.valid[:, i], i])
-    return bool(qd.size) and float(np.percentile(qd, 95)) >= MIN_SPEED
+    return joint_speed(est.qd[est.valid[:, i], i]) >= MIN_SPEED
 
 
 def _options_text(options: dict) -> str:

@@ -75,12 +75,13 @@ def _joint_cell(r: Report, joint: str) -> str:
     return f'<td><a href="#{_anchor(joint)}">{html.escape(label)}</a>{name}</td>'
 
 
-def _fmt(value: float | None, se: float | None = None) -> str:
+def _fmt(value: float | None, se: float | None = None, digits: int = 4) -> str:
+    """``value`` to ``digits`` significant digits, ``± se`` when given ("n.i.": not identifiable); "—" for none."""
     if value is None or not np.isfinite(value):
         return "—"
     if se is None:
-        return f"{value:.4g}"
-    return f"{value:.4g} ± {'n.i.' if not np.isfinite(se) else f'{se:.2g}'}"
+        return f"{value:.{digits}g}"
+    return f"{value:.{digits}g} ± {'n.i.' if not np.isfinite(se) else f'{se:.2g}'}"
 
 
 def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> str:
@@ -254,11 +255,9 @@ def _pm(fit: FitResult, name: str, digits: int = 3) -> str:
     """``value ± se`` of one parameter of ``fit``, "—" when it is not in the fit's model."""
     if fit.params is None or name not in fit.params.names:
         return "—"
-    value, se = getattr(fit.params, name), fit.stderr.get(name)
+    value = getattr(fit.params, name)
     value = 0.0 if abs(value) < 1e-9 else value  # a magnitude at its floor of zero, not 2.4e-15
-    if se is None:
-        return f"{value:.{digits}g}"
-    return f"{value:.{digits}g} ± {'n.i.' if not np.isfinite(se) else f'{se:.2g}'}"
+    return _fmt(value, fit.stderr.get(name), digits)
 
 
 def _summary_table(r: Report) -> str:
