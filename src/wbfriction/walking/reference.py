@@ -26,7 +26,8 @@ from wbfriction.exceptions import InputError, ModelError
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.walking.com import lipm_com, zmp_reference
-from wbfriction.walking.footsteps import FootstepPlan, GaitOptions, plan_footsteps
+from wbfriction.walking.footsteps import FootstepPlan, plan_footsteps
+from wbfriction.walking.options import GaitOptions
 from wbfriction.walking.swing import feet_trajectory, foot_placement, quintic
 
 LWA = pin.LOCAL_WORLD_ALIGNED
