@@ -351,6 +351,8 @@ class _MujocoRun:
         self.state, self.k_switch, self.before = None, 0, None
         self.kp_act[self.tc], self.kd_act[self.tc] = self.gains[tuple(bool(x) for x in ref.contact[0])]
         self.torque_friction = bool(self.joints_f) and not self.native  # (3.5) applied by us at every physics step
+        self.measured = tuple(bool(x) for x in ref.contact[0])  # the contacts sensed over the last period
+        self.noisy_q = bool(self.eps_q.any())
         self.qpos_act = index_or_slice(mjr.qpos_index)
         self.touch = index_or_slice(mjr.touch_index)
         self.bad_qacc = data.warning.number[int(mujoco.mjtWarning.mjWARN_BADQACC):][:1]  # a view: the count
@@ -370,23 +372,24 @@ class _MujocoRun:
 
     def measure(self, k: int) -> np.ndarray:
         """Log the state at the start of period ``k`` and the measured positions; the measured velocities."""
-        data = self.data
-        self.qpos[k], self.qvel[k] = data.qpos, data.qvel
-        q = self.q_meas[k]
-        q[:] = self.options.sensors.encoder(data.qpos[self.qpos_act] + self.eps_q[k])
+        data, q = self.data, self.q_meas[k]
+        self.qpos[k], self.qvel[k], q[:] = data.qpos, data.qvel, data.qpos[self.qpos_act]
+        if self.noisy_q:
+            q += self.eps_q[k]
+        q[:] = self.options.sensors.encoder(q)
         return (q - self.q_meas[k - 1]) / self.dt if k > 0 else self.v_ref[0]
 
     def control(self, k: int, qd_meas: np.ndarray) -> np.ndarray:
         """The command of period ``k``: feed-forward, PD on the measurements, the attitude stabiliser."""
         # the controller knows the contact measured over the last period (the plan at first)
-        last = self.contact[k - 1] if k > 0 and self.contact[k - 1].any() else self.ref.contact[k]
-        self.schedule_gains(k, tuple(last.tolist()))
+        last = self.measured if k > 0 and any(self.measured) else tuple(self.ref.contact[k].tolist())
+        self.schedule_gains(k, last)
         command = (self.tau_ff[k] + self.kp_act * (self.q_ref[k] - self.q_meas[k])
                    + self.kd_act * (self.v_ref[k] - qd_meas))
         if self.stabilise:
             data = self.data
             R = data.xmat[self.mjr.base_body].reshape(3, 3)
-            load = (self.force[k - 1] if k > 0 else np.ones(self.nc)) * last
+            load = (self.force[k - 1] if k > 0 else np.ones(self.nc)) * np.array(last)
             torques = attitude_ankle_torques(R, R @ data.qvel[3:6], self.R_ref[k], self.w_ref[k], self.balance,
                                              [data.xaxis[j] for j in self.ankle_jnt], load)
             for a, t in zip(self.ankles, torques):
@@ -438,10 +441,10 @@ class _MujocoRun:
         Raises:
             SimulationError: the robot fell or the simulation diverged.
         """
-        data = self.data
-        force = self.force[k]
+        data, force, contact = self.data, self.force[k], self.contact[k]
         force[:] = data.sensordata[self.touch]
-        np.greater(force, self.options.contact_threshold, out=self.contact[k])
+        np.greater(force, self.options.contact_threshold, out=contact)
+        self.measured = tuple(contact.tolist())
         if (not np.isfinite(data.qpos).all() or data.qpos[2] < self.options.fall_height * self.z0
                 or self.bad_qacc[0] > 0):
             raise SimulationError(f"the robot fell (or the simulation diverged) at t = {self.ref.time[k]:.3f} s")
