@@ -288,9 +288,10 @@ class _MujocoRun:
         self.tc, self.pc = robot.tc_index, robot.pc_index
         self.nc, self.n_act = len(robot.contact_frames), len(robot.actuated)
         self.joints_f = self.injected.joints
-        self.dof_f = index_or_slice(self.mjr.dof_index[self.tc][self.joints_f])
+        dof_f = self.mjr.dof_index[self.tc][self.joints_f]
+        self.dof_f = index_or_slice(dof_f)
         if native:
-            set_mujoco_friction(self.model, self.mjr.dof_index[self.tc][self.joints_f], self.injected)
+            set_mujoco_friction(self.model, dof_f, self.injected)
         if options.sole_timeconst is not None:
             self.model.geom_solref[list(self.mjr.sole_geoms), 0] = options.sole_timeconst
         self.data = mujoco.MjData(self.model)
@@ -338,11 +339,11 @@ class _MujocoRun:
         self.qpos, self.qvel = np.empty((n, model.nq)), np.empty((n, model.nv))
         self.q_meas = np.empty((n, n_act))
         self.qacc = np.empty((n, model.nv))  # at each period's first physics step
-        self.motor = np.empty((n, model.nu))  # the motors' torques (actuator order = Robot.actuated), held
+        self.tau_motor = np.empty((n, model.nu))  # the motors' torques (actuators in Robot.actuated order), held
         self.tau_f_first = np.zeros((n, len(self.joints_f)))  # friction applied at each period's first step
-        # what the sensors (MuJoCo's sensordata: touch, force-torque, IMU) and the torque sensors read, averaged
-        self.sensed = MatchedMeans(n, self.options.substeps, model.nsensordata)
-        self.torques = MatchedMeans(n, self.options.substeps, model.nu)
+        # what MuJoCo's sensors (sensordata: touch, force-torque, IMU) and the torque sensors read, averaged
+        self.sensor_means = MatchedMeans(n, self.options.substeps, model.nsensordata)
+        self.motor_means = MatchedMeans(n, self.options.substeps, model.nu)
         self.recording = Recording(self.robot, ref, self.injected)
         self.contact, self.force = np.zeros((n, nc), dtype=bool), np.zeros((n, nc))
         self.commands = np.zeros((self.delay + 1, n_act))  # ring buffer: the command of period k acts at k + delay
@@ -413,7 +414,7 @@ class _MujocoRun:
         import mujoco
         model, data, step = self.model, self.data, mujoco.mj_step
         qvel, applied, sensordata, motor = data.qvel, data.qfrc_applied, data.sensordata, data.actuator_force
-        sensed, torques = self.sensed.period(k), self.torques.period(k)
+        sensed, motors = self.sensor_means.period(k), self.motor_means.period(k)
         friction, dof_f, torque = self.torque_friction, self.dof_f, self.injected.torque
         for s in range(len(sensed)):
             if friction:
@@ -424,14 +425,14 @@ class _MujocoRun:
             step(model, data)  # the sensors are computed with the step's qacc, before its integration
             if s == 0:
                 self.record(k)
-            sensed[s], torques[s] = sensordata, motor
-        self.sensed.done(k)
-        self.torques.done(k)
+            sensed[s], motors[s] = sensordata, motor
+        self.sensor_means.done(k)
+        self.motor_means.done(k)
 
     def record(self, k: int) -> None:
         """Log the period's first physics step: accelerations, motor torques, MuJoCo's friction if used."""
         data = self.data
-        self.qacc[k], self.motor[k] = data.qacc, data.actuator_force
+        self.qacc[k], self.tau_motor[k] = data.qacc, data.actuator_force
         if self.native:
             self.tau_f_first[k] = mujoco_friction_torque(data, self.dof_f)
 
@@ -453,10 +454,12 @@ class _MujocoRun:
         """The log (measured positions and contacts, noisy torques) and the result of the run."""
         robot, mjr, recording = self.robot, self.mjr, self.recording
         Q, V = mjr.q(self.qpos), mjr.v(self.qpos, self.qvel)
-        recording.tau[:] = self.motor[:, self.tc]
+        # what Recording.record_torques would have logged sample by sample
+        recording.tau[:] = self.tau_motor[:, self.tc]
         recording.tau_f[:, self.joints_f] = self.tau_f_first
-        first = self.sensed.weights[:, 0].sum()  # sample 0 has no period before it: its readings' weights sum to this
-        sensed, tau_sensed = self.sensed.out, self.torques.out[:, self.tc]
+        # sample 0 has no period before it: its readings' weights sum to this
+        first = matched_weights(self.options.substeps)[:, 0].sum()
+        sensed, tau_sensed = self.sensor_means.out, self.motor_means.out[:, self.tc]
         sensed[0] /= first
         tau_sensed[0] /= first
         ft, imu_read = mjr.wrenches(sensed), sensed[:, mjr.imu_index]
