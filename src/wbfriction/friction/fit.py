@@ -111,6 +111,10 @@ _BOUNDS: dict[ModelName, tuple[np.ndarray, np.ndarray]] = {
     "thesis": (LOWER, UPPER),
 }
 _V_S = {"coulomb-viscous": None, "stribeck": 3, "thesis": 3}  # position of v_s, bounded by the data's speed
+_FIXED_COLUMNS: dict[ModelName, tuple[int, ...]] = {
+    "coulomb-viscous": (0, 1, 2), "stribeck": (0, 4), "thesis": (0, 4)}
+"""Columns of :func:`model_jacobian` that do not depend on the parameters: the model is linear in
+those (F_v: ``qd``; F_c of the Coulomb-viscous model: ``sgn(qd)``; tau_os: 1)."""
 
 
 def model_bounds(qd: np.ndarray, model: ModelName = "thesis") -> tuple[np.ndarray, np.ndarray]:
@@ -272,26 +276,28 @@ def model_values(x: np.ndarray, qd: np.ndarray, delta_s: float, model: ModelName
 
 def model_jacobian(x: np.ndarray, qd: np.ndarray, delta_s: float, model: ModelName = "thesis") -> np.ndarray:
     """Jacobian (N, p) of :func:`model_values` with respect to ``x``, analytic."""
+    J = np.empty((qd.size, len(MODEL_PARAMS[model].names)))
+    J[:, 0] = qd  # F_v
+    J[:, -1 if model == "coulomb-viscous" else 4] = 1.0  # tau_os
     if model == "coulomb-viscous":
-        return np.column_stack([qd, np.sign(qd), np.ones_like(qd)])
+        J[:, 1] = np.sign(qd)
+        return J
+    u = np.abs(qd / x[3])  # |qd / v_s|
+    ud = u**delta_s
+    e = np.exp(-ud)
     if model == "stribeck":
         _, F_c, F_s, v_s, _ = x
         sgn = np.sign(qd)
-        u = np.abs(qd / v_s)
-        e = np.exp(-u**delta_s)
-        return np.column_stack([qd, sgn * (1.0 - e), sgn * e, sgn * (F_s - F_c) * e * delta_s * u**delta_s / v_s,
-                                np.ones_like(qd)])
-    F_v, F_c, S, v_s, _, a = x
+        J[:, 1] = sgn * (1.0 - e)
+        J[:, 2] = sgn * e
+        J[:, 3] = sgn * (F_s - F_c) * e * delta_s * ud / v_s
+        return J
+    _, F_c, S, v_s, _, a = x
     th = np.tanh(a * qd)
-    u = np.abs(qd / v_s)
-    e = np.exp(-u**delta_s)
-    J = np.empty((qd.size, 6))
-    J[:, 0] = qd
     J[:, 1] = th * (1.0 + S * e)
     J[:, 2] = F_c * th * e
     # d/dv_s of exp(-(|qd|/v_s)^d) = e * d * u^d / v_s
-    J[:, 3] = F_c * th * S * e * delta_s * u**delta_s / v_s
-    J[:, 4] = 1.0
+    J[:, 3] = F_c * th * S * e * delta_s * ud / v_s
     J[:, 5] = F_c * (1.0 - th**2) * qd * (1.0 + S * e)
     return J
 
@@ -463,23 +469,32 @@ def _solve(residual, jacobian, start, bounds, max_nfev):
 
 def _filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, delta_s: float,
                       model: ModelName = "thesis"):
-    """Residual and Jacobian (the model's coordinates) of the model passed through ``smoother``, on the rows ``use``."""
+    """Residual (n_use,) and Jacobian (n_use, p) (the model's coordinates) of the model passed through
+    ``smoother`` along the whole series ``qd`` (N,), on the rows ``use`` (module docstring).
+
+    The smoother is linear and filters each column alone, so the columns of the Jacobian that do
+    not depend on the parameters (:data:`_FIXED_COLUMNS`: the regressors ``qd``, ``sgn(qd)``, 1) are
+    filtered once, the others at every call; the residual filters the model's values alone."""
     rows = np.flatnonzero(use)
+    fixed_columns = list(_FIXED_COLUMNS[model])
+    filtered_fixed: list[np.ndarray] = []  # the smoothed fixed columns, on the rows used
 
-    def both(x):
-        cols = np.column_stack([model_values(x, qd, delta_s, model), model_jacobian(x, qd, delta_s, model)])
-        return smoother(cols)[rows]
+    def residual(x: np.ndarray) -> np.ndarray:
+        return smoother(model_values(x, qd, delta_s, model))[rows] - y[rows]
 
-    cache: dict[bytes, np.ndarray] = {}
+    def jacobian(x: np.ndarray) -> np.ndarray:
+        jac = model_jacobian(x, qd, delta_s, model)
+        varying = np.ones(jac.shape[1], dtype=bool)
+        varying[fixed_columns] = False
+        if not filtered_fixed:
+            filtered_fixed.append(smoother(jac[:, fixed_columns])[rows])
+        out = np.empty((rows.size, jac.shape[1]))
+        out[:, fixed_columns] = filtered_fixed[0]
+        if varying.any():
+            out[:, varying] = smoother(jac[:, varying])[rows]
+        return out
 
-    def values(x):
-        key = x.tobytes()
-        if key not in cache:
-            cache.clear()
-            cache[key] = both(x)
-        return cache[key]
-
-    return (lambda x: values(x)[:, 0] - y[rows]), (lambda x: values(x)[:, 1:])
+    return residual, jacobian
 
 
 def _at_bound(z: np.ndarray, bounds: tuple[np.ndarray, np.ndarray], residual, identifiable: np.ndarray
