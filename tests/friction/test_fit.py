@@ -229,3 +229,26 @@ def test_too_few_samples_to_hold_out_fit_the_simplest_model():
     res = fit_friction(QD[:40], -QD[:40], model="auto", min_samples=20)
     assert res.model == "coulomb-viscous" and "too few samples" in res.selection.reason
     assert res.selection.scores == ()
+
+
+_POINTS = {"coulomb-viscous": [0.3, 0.5, 0.05], "stribeck": [0.3, 0.5, 0.9, 0.15, 0.05],
+           "thesis": [0.3, 0.5, 0.4, 0.15, 0.05, 30.0]}
+
+
+@pytest.mark.parametrize("model", ["coulomb-viscous", "stribeck", "thesis"])
+def test_filtered_problem_smooths_what_changes_only(model):
+    """The filtered fit's residual and Jacobian equal the model and its whole Jacobian smoothed
+    together, bit for bit, although the parameter-free columns are smoothed once."""
+    from wbfriction.friction.fit import _filtered_problem, model_jacobian, model_values
+    smoother = SavgolSmoother(11, 4, DT)
+    qd = QD.copy()
+    qd[1000:1010] = np.nan  # a gap the smoother leaves out
+    y = smoother(model_values(1.1 * np.array(_POINTS[model]), qd, 2.0, model))
+    use = np.isfinite(y)
+    residual, jacobian = _filtered_problem(qd, y, use, smoother, 2.0, model)
+    rows = np.flatnonzero(use)
+    for scale in (1.0, 1.3, 0.7):  # several points: the fixed columns are cached at the first
+        x = scale * np.array(_POINTS[model])
+        both = smoother(np.column_stack([model_values(x, qd, 2.0, model), model_jacobian(x, qd, 2.0, model)]))[rows]
+        np.testing.assert_array_equal(residual(x), both[:, 0] - y[rows])
+        np.testing.assert_array_equal(jacobian(x), both[:, 1:])
