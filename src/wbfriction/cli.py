@@ -548,8 +548,9 @@ def report(friction: Path = FrictionArg,
                                                                     "adds the held-out torque RMS, both routes' "
                                                                     "friction and the body changes."),
            energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt,
-           workers: int = typer.Option(2, min=1, help="Processes rendering the joints' figures (the same "
-                                                     "report for any number).")) -> None:
+           workers: int = typer.Option(2, min=1, help="Processes fitting the joints (without --params) and "
+                                                     "rendering their figures (the same report for any "
+                                                     "number).")) -> None:
     """One self-contained HTML report: friction clouds and fits, parameters, energy consistency,
     per-joint time series, Fig. 7.4, spectra, provenance."""
     from wbfriction.report.build import make_report
@@ -558,7 +559,7 @@ def report(friction: Path = FrictionArg,
     check_paths({"FRICTION": friction, "--params": params, "--identification": identification}, {"-o": output})
 
     with console.status("building the report"):
-        rep = make_report(friction, params, energy_threshold, energy_tolerance, identification)
+        rep = make_report(friction, params, energy_threshold, energy_tolerance, identification, workers)
         write_report(rep, output, workers)
     _warn_energy(rep.energy.values())
     console.print(f"wrote {output} ({len(rep.est.joints)} joints, {len(rep.flagged)} flagged)")

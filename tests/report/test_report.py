@@ -105,10 +105,11 @@ def test_report_warns_when_rotational_inertia_is_off(tables, true_report):
 
 
 def test_same_input_same_bytes(tables, report_file, tmp_path):
-    """Built again from the same table, its figures rendered on two processes instead of one: the same bytes."""
+    """Built again from the same table, its joints fitted and its figures rendered on two processes instead of
+    one: the same bytes."""
     _, true_model, _ = tables
     again = tmp_path / "again.html"
-    write_report(make_report(true_model), again, workers=2)
+    write_report(make_report(true_model, workers=2), again, workers=2)
     assert again.read_bytes() == report_file.read_bytes()
 
 

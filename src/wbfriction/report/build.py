@@ -120,9 +120,10 @@ class Report:
 
 def make_report(friction: str | Path, params: str | Path | None = None,
                 threshold: float = DEFAULT_THRESHOLD, tolerance: float = DEFAULT_TOLERANCE,
-                identification: str | Path | None = None) -> Report:
-    """Read a friction table (and parameters, else fit them; and an identification of the
-    inertia model, :func:`~wbfriction.inertia.io.read_identification`) and compute the report.
+                identification: str | Path | None = None, workers: int = 1) -> Report:
+    """Read a friction table (and parameters, else fit them on ``workers`` processes,
+    :func:`~wbfriction.friction.fit.fit_estimate`; and an identification of the inertia model,
+    :func:`~wbfriction.inertia.io.read_identification`) and compute the report.
 
     Raises:
         InputError: unreadable inputs; parameters fitted on another table or for another robot
@@ -135,7 +136,7 @@ def make_report(friction: str | Path, params: str | Path | None = None,
         fits = read_params(params)
         check_params_source(params, est, friction)
     else:
-        fits = {f.joint: f for f in fit_estimate(est)}
+        fits = {f.joint: f for f in fit_estimate(est, workers=workers)}
     energy = {e.joint: e for e in energy_consistency(est, fitted_offsets(fits.values()), threshold, tolerance)}
     meta = est.metadata
     prov: list[tuple[str, str]] = [("friction table", f"{friction} (sha256 {file_sha256(friction)})")]
