@@ -45,6 +45,7 @@ from wbfriction.progress import Progress, counted
 from wbfriction.sim.common import InjectedFriction, Recording, SimulationResult, injected_friction
 from wbfriction.sim.control import contact_jacobian, gain_schedule, pd_gains, reference_feedforward
 from wbfriction.walking import WalkingReference
+from wbfriction.walking.indexing import as_slice
 from wbfriction.walking.swing import foot_placement
 
 Integrator = Literal["semi-implicit", "explicit"]
@@ -153,14 +154,6 @@ def _constraints(robot: Robot, data: pin.Data, active: np.ndarray, anchors: dict
     return models, datas
 
 
-def _contiguous(index: np.ndarray) -> slice | np.ndarray:
-    """``index`` as a slice if it is a run of consecutive indices (a view: cheaper than fancy
-    indexing in the per-sample loop), else unchanged."""
-    if index.size and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
-        return slice(int(index[0]), int(index[0]) + index.size)
-    return index
-
-
 def _unstack_wrenches(stacked: np.ndarray, contact: np.ndarray, wrench: np.ndarray) -> None:
     """Write the wrenches of the active feet, stacked in contact order per sample (N, 6 n_contacts),
     into ``wrench`` (N, n_contacts, 6) at their feet (the rows of inactive feet untouched)."""
@@ -190,10 +183,10 @@ class _IdealRun:
 
         iv, iq = robot.act_v_index, robot.act_q_index
         tc, self.pc = robot.tc_index, robot.pc_index
-        self.iv_tc, self.iv_pc, self.iq_tc, self.iq_pc = (_contiguous(iv[tc]), _contiguous(iv[self.pc]),
-                                                          _contiguous(iq[tc]), _contiguous(iq[self.pc]))
+        self.iv_tc, self.iv_pc, self.iq_tc, self.iq_pc = (as_slice(iv[tc]), as_slice(iv[self.pc]),
+                                                          as_slice(iq[tc]), as_slice(iq[self.pc]))
         self.joints_f = injected.joints
-        self.iv_f = _contiguous(iv[tc][self.joints_f])
+        self.iv_f = as_slice(iv[tc][self.joints_f])
         self.settings = pin.ProximalSettings(1e-12, 1e-10, 50)
         self.semi_implicit = options.integrator == "semi-implicit"
         self.project_every_sample = options.projection == "sample"
@@ -299,8 +292,9 @@ class _IdealRun:
         # one right-hand side per position-controlled joint (unit torque) and one for
         # the contacts' Baumgarte term
         self.rhs = np.zeros((self.n_lam + self.model.nv, self.pc.size + 1))
-        self.rows_pc = self.n_lam + self.robot.act_v_index[self.pc]  # KKT rows of their accelerations
-        self.rhs[self.rows_pc, np.arange(self.pc.size)] = 1.0
+        rows_pc = self.n_lam + self.robot.act_v_index[self.pc]  # KKT rows of their accelerations
+        self.rhs[rows_pc, np.arange(self.pc.size)] = 1.0
+        self.rows_pc = as_slice(rows_pc)
         # each contact's data (a reference: iterating Pinocchio's vector costs microseconds) and
         # its rows of the Baumgarte right-hand side (a view)
         self.baumgarte_rhs = [(self.cdatas[i], self.rhs[6 * i:6 * i + 6, -1]) for i in range(len(self.cdatas))]

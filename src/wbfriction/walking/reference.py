@@ -28,6 +28,7 @@ from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.walking.com import lipm_com, zmp_reference
 from wbfriction.walking.footsteps import FootstepPlan, GaitOptions, plan_footsteps
+from wbfriction.walking.indexing import as_slice
 from wbfriction.walking.swing import feet_trajectory, quintic
 
 LWA = pin.LOCAL_WORLD_ALIGNED
@@ -177,9 +178,9 @@ class _WholeBodyIK:
         if len(legs) + 6 != 18:
             raise ModelError(f"robot '{robot.name}': walking IK needs 6 joints per leg, got {len(legs)}")
         # slices where the indices are consecutive (views: cheaper in the per-sample loop)
-        self.sel = _contiguous(np.concatenate([np.arange(6), iv[self.solved_act]]))
-        self.rest = _contiguous(iv[self.free_act])
-        self.iq_free = _contiguous(robot.act_q_index[self.free_act])
+        self.sel = as_slice(np.concatenate([np.arange(6), iv[self.solved_act]]))
+        self.rest = as_slice(iv[self.free_act])
+        self.iq_free = as_slice(robot.act_q_index[self.free_act])
         self.frames = robot.contact_frame_ids
         self._J = np.empty((18, self.model.nv))
         self._e = np.empty(18)
@@ -244,13 +245,6 @@ class _WholeBodyIK:
         a[rest] = free_qdd
         a[sel] = Js_inv @ (tasks.xdd[k] - drift - Jr @ free_qdd)
         return q, v, a
-
-
-def _contiguous(index: np.ndarray) -> slice | np.ndarray:
-    """``index`` as a slice if it is a run of consecutive indices, else unchanged."""
-    if index.size and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
-        return slice(int(index[0]), int(index[0]) + index.size)
-    return index
 
 
 def walking_reference(robot: Robot, options: GaitOptions = GaitOptions(), dt: float = 1e-3,
