@@ -178,25 +178,26 @@ class _IdealRun:
 
         tau_ff = reference_feedforward(robot, reference)
         gains = pd_gains(robot, reference.q[0], options.bandwidth, options.damping)
-        self.kp_all, self.kd_all = gain_schedule(gains, reference.contact, dt, options.gain_blend)
+        kp, kd = gain_schedule(gains, reference.contact, dt, options.gain_blend)
         self.bkp, self.bkd = options.baumgarte
 
         iv, iq = robot.act_v_index, robot.act_q_index
         tc, self.pc = robot.tc_index, robot.pc_index
-        self.iv_tc, self.iv_pc, self.iq_tc, self.iq_pc = (as_slice(iv[tc]), as_slice(iv[self.pc]),
-                                                          as_slice(iq[tc]), as_slice(iq[self.pc]))
+        self.iv_tc, self.iv_pc = as_slice(iv[tc]), as_slice(iv[self.pc])
         self.joints_f = injected.joints
         self.iv_f = as_slice(iv[tc][self.joints_f])
         self.settings = pin.ProximalSettings(1e-12, 1e-10, 50)
         self.semi_implicit = options.integrator == "semi-implicit"
         self.project_every_sample = options.projection == "sample"
-        # the reference, contiguous per sample
-        ref = reference
-        self.ff_tc = np.ascontiguousarray(tau_ff[:, tc])
-        self.q_ref_tc = np.ascontiguousarray(ref.q[:, iq[tc]])
-        self.v_ref_tc = np.ascontiguousarray(ref.v[:, iv[tc]])
-        self.q_ref_pc, self.v_ref_pc, self.a_ref_pc = (np.ascontiguousarray(x) for x in (
-            ref.q[:, iq[self.pc]], ref.v[:, iv[self.pc]], ref.a[:, iv[self.pc]]))
+        # one PD law per sample on the actuated joints, torque-controlled then position-controlled:
+        # u = offset + kp (q_ref - q) + kd (v_ref - v); for the former the torque command
+        # (feed-forward plus PD), for the latter the stabilised reference acceleration (the
+        # Baumgarte gains). The reference and gains are contiguous per sample.
+        ref, act, ones = reference, np.concatenate([tc, self.pc]), np.ones((n, self.pc.size))
+        self.iq_act, self.iv_act = as_slice(iq[act]), as_slice(iv[act])
+        self.pd_offset = np.hstack([tau_ff[:, tc], ref.a[:, iv[self.pc]]])
+        self.pd_kp, self.pd_kd = np.hstack([kp, self.bkp * ones]), np.hstack([kd, self.bkd * ones])
+        self.pd_q, self.pd_v = np.ascontiguousarray(ref.q[:, iq[act]]), np.ascontiguousarray(ref.v[:, iv[act]])
         self.switches = set(np.flatnonzero(np.any(np.diff(ref.contact, axis=0, prepend=False), axis=1)).tolist())
 
         self.Q = np.empty((n, self.model.nq))
@@ -225,10 +226,9 @@ class _IdealRun:
         model, data, settings, opts = self.model, self.data, self.settings, self.options
         impulse_dynamics, constraint_dynamics, integrate = pin.impulseDynamics, pin.constraintDynamics, pin.integrate
         add, negative, subtract = np.add, np.negative, np.subtract
-        iq_tc, iv_tc, iq_pc, iv_pc, iv_f = self.iq_tc, self.iv_tc, self.iq_pc, self.iv_pc, self.iv_f
-        ff, kp, kd, q_ref, v_ref = self.ff_tc, self.kp_all, self.kd_all, self.q_ref_tc, self.v_ref_tc
-        q_ref_pc, v_ref_pc, a_ref_pc = self.q_ref_pc, self.v_ref_pc, self.a_ref_pc
-        bkp, bkd, h, friction = self.bkp, self.bkd, self.h, self.injected.torque if self.joints_f else None
+        iv_tc, iv_pc, iv_f, iq_act, iv_act = self.iv_tc, self.iv_pc, self.iv_f, self.iq_act, self.iv_act
+        offset, kp, kd, q_ref, v_ref = self.pd_offset, self.pd_kp, self.pd_kd, self.pd_q, self.pd_v
+        n_tc, h, friction = self.robot.tc_index.size, self.h, self.injected.torque if self.joints_f else None
         position_controlled, semi_implicit, project = self.pc.size > 0, self.semi_implicit, self.project_every_sample
         Q, V, A, lam_log, record_torques = self.Q, self.V, self.A, self.lam, self.recording.record_torques
         switches, tau, tau_pc, tau_f = self.switches, self.tau, self.tau_pc, self.tau_f
@@ -244,8 +244,10 @@ class _IdealRun:
             # velocity onto the constraints (plastic impact at touch-down, drift otherwise)
             if switch or project:
                 v = impulse_dynamics(model, data, q, v, cmodels, cdatas, 0.0, settings).copy()
-            tau_cmd = ff[k] + kp[k] * (q_ref[k] - q[iq_tc]) + kd[k] * (v_ref[k] - v[iv_tc])
             for s in range(opts.substeps):
+                u = offset[k] + kp[k] * (q_ref[k] - q[iq_act]) + kd[k] * (v_ref[k] - v[iv_act])
+                if s == 0:  # the torque command, held over the period
+                    tau_cmd = u[:n_tc]
                 tau[iv_tc] = tau_cmd
                 if friction is not None:
                     tau_f = friction(v[iv_f])
@@ -258,9 +260,8 @@ class _IdealRun:
                         negative(cd.contact_acceleration_error.np, out=out)
                 # unit-torque responses of the position-controlled joints, and the Baumgarte term's
                 X = data.constraint_chol.solve(rhs)
-                if position_controlled:  # acceleration = reference, stabilised
-                    a_des = a_ref_pc[k] + bkd * (v_ref_pc[k] - v[iv_pc]) + bkp * (q_ref_pc[k] - q[iq_pc])
-                    delta = _solve_small(X[rows_pc, :-1], a_des - a[iv_pc])
+                if position_controlled:  # acceleration = reference, stabilised (u's last entries)
+                    delta = _solve_small(X[rows_pc, :-1], u[n_tc:] - a[iv_pc])
                     dX = X[:, :-1] @ delta  # the response: forces, then accelerations
                     a, lam = a + dX[kkt_rows_a], lam - dX[kkt_rows_f]
                     tau_pc = tau_pc + delta
