@@ -189,11 +189,10 @@ class _WholeBodyIK:
 
     def _jacobian(self, q: np.ndarray) -> np.ndarray:
         """Task Jacobian (18, nv): sole poses, centre of mass, base rotation (a buffer, overwritten
-        by the next call); leaves the frame placements and the centre of mass in ``data``."""
+        by the next call); leaves the soles' placements and the centre of mass in ``data``."""
         model, data, J = self.model, self.data, self._J
         pin.computeJointJacobians(model, data, q)
-        pin.updateFramePlacements(model, data)
-        for i, f in enumerate(self.frames):
+        for i, f in enumerate(self.frames):  # getFrameJacobian also places the frame (data.oMf[f])
             J[6 * i:6 * i + 6] = pin.getFrameJacobian(model, data, f, LWA)
         J[12:15] = pin.jacobianCenterOfMass(model, data, True)
         J[15:18] = pin.getJointJacobian(model, data, 1, LWA)[3:]
