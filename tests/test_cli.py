@@ -212,7 +212,8 @@ def test_simulate_on_mujoco_with_sensors_from_toml(talos, tmp_path):
 def test_companion_scheme_only_on_request(talos, demo_dir, tmp_path):
     """estimate writes Fig. 7.4's companion difference only with --companion, then equal to the library's
     (estimate_log(companion=True)); without it, a savgol window the companion would need is not asked for."""
-    from wbfriction.friction.estimate import EstimateOptions, estimate_log
+    from wbfriction.friction.estimate import estimate_log
+    from wbfriction.friction.options import EstimateOptions
 
     out, _ = demo_dir
     res = run("estimate", out / "log.parquet", "-o", tmp_path / "plain.parquet", "--diff", "central", "--window", "4")

@@ -25,7 +25,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from helpers import run_cli
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import log_from_table
 from wbfriction.logs.tables import write_table
 from wbfriction.model import load_robot

@@ -11,7 +11,7 @@ import typer.main
 import typer.testing
 
 from wbfriction.cli import app
-from wbfriction.model.loading import BUILTIN_ROBOTS
+from wbfriction.model.robots import BUILTIN_ROBOTS
 
 GROUP = typer.main.get_command(app)
 COMMANDS = sorted(GROUP.commands)  # type: ignore[attr-defined]

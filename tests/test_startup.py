@@ -1,6 +1,7 @@
 """Start-up (issue 22): the command line imports only what a command uses. Loading the CLI (what
-``wbfriction --help`` and every command pay before they start) imports neither SciPy, MuJoCo nor
-matplotlib; they are imported inside the functions that use them."""
+``wbfriction --help`` and every command pay before they start) imports the options modules (whose defaults
+the help shows) and none of NumPy, Pinocchio, pyarrow, SciPy, MuJoCo or matplotlib: each command imports
+them when it runs."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import json
 import subprocess
 import sys
 
-HEAVY = ("scipy", "mujoco", "matplotlib")
+HEAVY = ("numpy", "pinocchio", "pyarrow", "scipy", "mujoco", "matplotlib")
 
 
 def _modules_after(code: str) -> list[str]:
@@ -37,3 +38,47 @@ def test_import_loads_nothing_heavy_and_every_public_name_resolves():
     assert not [m for m in _modules_after("import wbfriction") if m.split(".")[0] in ("numpy", "pinocchio")]
     import wbfriction
     assert [n for n in wbfriction.__all__ if getattr(wbfriction, n, None) is None] == []
+
+
+def test_every_subpackage_name_resolves_on_first_use():
+    """The subpackages load their names on first use (``lazy_loader`` stubs, ``__init__.pyi``): each name
+    the stub declares resolves, from the module the stub says."""
+    import importlib
+
+    for pkg in ("export", "friction", "inertia", "logs", "model", "pipeline", "signals", "sim", "walking"):
+        module = importlib.import_module(f"wbfriction.{pkg}")
+        assert module.__all__, pkg
+        assert [n for n in module.__all__ if getattr(module, n, None) is None] == [], pkg
+
+
+def test_the_options_modules_code_uses_only_names_they_define():
+    """The options modules import NumPy only for type checking (their methods import it when they run): no
+    function or method of theirs reads a global name the module does not define at run time."""
+    import builtins
+    import dis
+    import importlib
+    import types
+
+    def code_objects(obj):
+        if isinstance(obj, types.FunctionType):
+            yield obj.__code__
+        elif isinstance(obj, property) and obj.fget is not None:
+            yield obj.fget.__code__
+        elif isinstance(obj, type):
+            for value in vars(obj).values():
+                yield from code_objects(value)
+
+    missing = []
+    for stage in ("signals", "friction", "walking", "sim", "inertia", "logs"):
+        module = importlib.import_module(f"wbfriction.{stage}.options")
+        for obj in vars(module).values():
+            if getattr(obj, "__module__", None) != module.__name__:
+                continue
+            stack = list(code_objects(obj))
+            while stack:
+                code = stack.pop()
+                stack += [c for c in code.co_consts if isinstance(c, types.CodeType)]
+                names = {i.argval for i in dis.get_instructions(code) if i.opname == "LOAD_GLOBAL"}
+                missing += [(stage, code.co_qualname, n) for n in names
+                            if n not in vars(module) and not hasattr(builtins, n) and code.co_name != "wrapper"]
+    assert missing == []

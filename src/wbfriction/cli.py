@@ -14,46 +14,40 @@ import sys
 import time
 from contextlib import ExitStack, contextmanager, nullcontext
 from pathlib import Path
-from typing import Literal, Optional, cast
+from typing import TYPE_CHECKING, Literal, Optional, cast
 
-import numpy as np
 import typer
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
+# Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
+# options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError, WbfrictionError
-from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
-from wbfriction.friction.estimate import EstimateOptions, Method, resolve_differentiation
-from wbfriction.friction.fit import FitResult, ModelChoice
-from wbfriction.friction.measured import BaseMotion
-from wbfriction.friction.models import ALL_PARAM_NAMES, PARAM_NAMES
-from wbfriction.friction.targets import load_friction_toml
-from wbfriction.inertia.identification import ArmatureMode, InertialOptions
-from wbfriction.logs.clock import TimeBase, TimeUnit
-from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, write_log
-from wbfriction.logs.source import open_log, read_log
-from wbfriction.logs.tables import TableFile, write_table
-from wbfriction.model.loading import BUILTIN_ROBOTS, load_robot
-from wbfriction.model.robot import Robot
-from wbfriction.pipeline.chunks import Chunking
-from wbfriction.pipeline.convert import convert_log
-from wbfriction.pipeline.estimate import RobotSpec, estimate_file, table_log
-from wbfriction.pipeline.fit import fit_file
+from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, EstimateOptions
+from wbfriction.inertia.options import InertialOptions
+from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
+from wbfriction.model.robots import BUILTIN_ROBOTS
 from wbfriction.pipeline.paths import check_paths
-from wbfriction.pipeline.provenance import log_provenance
-from wbfriction.signals.filters import SavgolWeights
-from wbfriction.signals.kinematics import Diff, FilterOptions, TorqueAlignment, Velocity
-from wbfriction.signals.phases import Mask
-from wbfriction.sim import IdealOptions, MujocoOptions, SensorNoise, simulate_ideal, simulate_mujoco
-from wbfriction.sim.arm import ArmOptions, default_arm_friction, simulate_arm
-from wbfriction.sim.ideal import Integrator
-from wbfriction.sim.mujoco_sim import FrictionMode
-from wbfriction.sim.sensors import load_sensors_toml
+from wbfriction.signals.options import FilterOptions
+from wbfriction.sim.options import IdealOptions, MujocoOptions, SensorNoise
 from wbfriction.version import __version__
-from wbfriction.walking import GaitOptions, walking_reference
-from wbfriction.walking.footsteps import Gait
+from wbfriction.walking.options import GaitOptions
+
+if TYPE_CHECKING:
+    from wbfriction.friction.fit import FitResult, ModelChoice
+    from wbfriction.friction.options import BaseMotion, Method
+    from wbfriction.inertia.options import ArmatureMode
+    from wbfriction.logs.clock import TimeBase, TimeUnit
+    from wbfriction.model.robot import Robot
+    from wbfriction.pipeline.estimate import RobotSpec
+    from wbfriction.signals.filters import SavgolWeights
+    from wbfriction.signals.kinematics import Diff, TorqueAlignment, Velocity
+    from wbfriction.signals.phases import Mask
+    from wbfriction.sim.arm import ArmOptions
+    from wbfriction.sim.options import FrictionMode, Integrator
+    from wbfriction.walking.options import Gait
 
 # rich_markup_mode=None: click's plain help, so that units in brackets ([m], [rad/s], [friction.<group>]) are
 # printed as written (Rich markup would take them for tags and delete them)
@@ -104,6 +98,8 @@ def _progress(total: int, label: str):
 
 
 def _robot(robot: str, urdf: Optional[Path], config: Optional[Path], mjcf: Optional[Path] = None) -> Robot:
+    from wbfriction.model.loading import load_robot
+
     return load_robot(robot, urdf=urdf, config=config, mjcf=mjcf)
 
 
@@ -111,6 +107,10 @@ def _fit_rows(results: list[FitResult]) -> Table:
     """One row per joint: its model, its fit's status (:mod:`~wbfriction.friction.status`; a fit that is not
     ``ok`` greyed) and each of its parameters as value ±standard error (``n.i.``: not identifiable;
     ``(bound)``: at a bound of the fit); blank: not a parameter of its model."""
+    import numpy as np
+
+    from wbfriction.friction.models import ALL_PARAM_NAMES
+
     names = [n for n in ALL_PARAM_NAMES if any(r.params is not None and n in r.params.names for r in results)]
     table = Table(title="Friction model per joint: f(qd) fitted to -tau_f, value ±standard error",
                   caption="n.i.: not identifiable from these data (infinite standard error); "
@@ -165,7 +165,7 @@ def _warn(warnings) -> None:
 
 def _time_unit(unit: Optional[str]) -> TimeUnit | None:
     """``--time-unit`` as given (checked where the stamps are read, :func:`~wbfriction.logs.clock.table_stamps`)."""
-    return cast(Optional[TimeUnit], unit)
+    return cast("TimeUnit | None", unit)
 
 
 def _warn_energy(energy) -> None:
@@ -205,6 +205,12 @@ def _check_simulator(simulator: str) -> None:
 
 def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptions | MujocoOptions,
                   friction: Optional[Path]) -> None:
+    from wbfriction.friction.targets import load_friction_toml
+    from wbfriction.logs.log import write_log
+    from wbfriction.sim.ideal import simulate_ideal
+    from wbfriction.sim.mujoco_sim import simulate_mujoco
+    from wbfriction.walking.reference import walking_reference
+
     params = None if friction is None else load_friction_toml(friction, r.groups, r.torque_controlled)
     with console.status(f"planning {gait.steps} steps ({gait.gait})"):
         ref = walking_reference(r, gait)
@@ -221,6 +227,10 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
 
 
 def _run_simulate_arm(r: Robot, output: Path, options: ArmOptions, friction: Optional[Path]) -> None:
+    from wbfriction.friction.targets import load_friction_toml
+    from wbfriction.logs.tables import write_table
+    from wbfriction.sim.arm import default_arm_friction, simulate_arm
+
     params = (load_friction_toml(friction, r.groups, r.torque_controlled) if friction is not None
               else default_arm_friction(r))
     with _progress(int(options.duration * options.rate), "simulate") as advance:
@@ -235,6 +245,12 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
                   time_unit: TimeUnit | None = None, companion: bool = False) -> None:
     """Estimate a log file in chunks on ``workers`` processes (which load the robot from
     ``spec``); a ROS 2 bag is first streamed into a temporary Parquet log beside the output."""
+    from wbfriction.logs.source import open_log
+    from wbfriction.logs.tables import TableFile
+    from wbfriction.pipeline.chunks import Chunking
+    from wbfriction.pipeline.estimate import estimate_file, table_log
+    from wbfriction.pipeline.provenance import log_provenance
+
     chunking = Chunking(rows=chunk_rows, workers=workers)
     source = open_log(log, bag_map, r)
     provenance = {"provenance": log_provenance(log, r)}
@@ -278,6 +294,8 @@ def _print_cross_check(friction: Path) -> None:
 
 def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, tolerance: float,
              workers: int, model: ModelChoice = "auto", selection_tolerance: float = 0.02) -> None:
+    from wbfriction.pipeline.fit import fit_file
+
     fitted = fit_file(friction, output, min_samples=min_samples, threshold=threshold, tolerance=tolerance,
                       workers=workers, model=model, selection_tolerance=selection_tolerance)
     out.print(_fit_rows(fitted.fits))
@@ -335,6 +353,9 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                                                        "trajectory.")) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents."""
+    from wbfriction.sim.arm import ArmOptions
+    from wbfriction.sim.sensors import load_sensors_toml
+
     check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors},
                 {"-o": output})
     r = _robot(robot, urdf, config, mjcf)
@@ -343,12 +364,12 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                          torque_std=torque_noise or 0.0, seed=noise_seed or 0)
         _run_simulate_arm(r, output, arm, friction)
         return
-    gait_opts = GaitOptions(gait=cast(Gait, gait), steps=steps, step_length=step_length, step_width=step_width,
+    gait_opts = GaitOptions(gait=cast("Gait", gait), steps=steps, step_length=step_length, step_width=step_width,
                             turn_angle=turn_angle, lift_height=lift_height)
     _check_simulator(simulator)
     options: IdealOptions | MujocoOptions
     if simulator == "ideal":
-        options = IdealOptions(substeps=substeps or _I.substeps, integrator=cast(Integrator, integrator),
+        options = IdealOptions(substeps=substeps or _I.substeps, integrator=cast("Integrator", integrator),
                                log_base=log_base, force_torque=force_torque, imu=force_torque)
     else:
         table = load_sensors_toml(sensors) if sensors is not None else {}
@@ -356,7 +377,7 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                  "seed": noise_seed, "delay": None if delay is None else delay * 1e-3}
         table.update({k: v for k, v in given.items() if v is not None})
         lag = float(table.pop("delay", 0.0))
-        options = MujocoOptions(substeps=substeps or _M.substeps, friction=cast(FrictionMode, mujoco_friction),
+        options = MujocoOptions(substeps=substeps or _M.substeps, friction=cast("FrictionMode", mujoco_friction),
                                 sensors=SensorNoise(**table), delay=lag, log_base=log_base,
                                 sole_timeconst=sole_timeconst, torque_drift=torque_drift, ft_offset=ft_offset)
     _run_simulate(r, output, gait_opts, options, friction)
@@ -415,20 +436,22 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                                                              "columns where logged: every joint's friction in "
                                                              "every phase.")) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
+    from wbfriction.pipeline.estimate import RobotSpec
+
     check_paths({"LOG": log, "--map": bag_map, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
-    opts = EstimateOptions(diff=cast(Diff | Literal["auto"], diff), compensate_delay=delay_compensation,
-                           torque_alignment=cast(TorqueAlignment, torque_alignment), mask=cast(Mask, mask),
+    opts = EstimateOptions(diff=cast("Diff | Literal['auto']", diff), compensate_delay=delay_compensation,
+                           torque_alignment=cast("TorqueAlignment", torque_alignment), mask=cast("Mask", mask),
                            lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
-                           ds_regularization=ds_regularization, condition_number=cond, method=cast(Method, method),
-                           velocity=cast(Velocity, velocity), base_motion=cast(BaseMotion, base_motion),
+                           ds_regularization=ds_regularization, condition_number=cond, method=cast("Method", method),
+                           velocity=cast("Velocity", velocity), base_motion=cast("BaseMotion", base_motion),
                            wrenches=wrenches,
                            filtering=FilterOptions(window=window, poly_order=poly_order,
-                                                   weights=cast(SavgolWeights, weights),
+                                                   weights=cast("SavgolWeights", weights),
                                                    cutoff=cutoff, butter_order=butter_order))
     spec = RobotSpec(None if config else robot, None if urdf is None else str(urdf),
                      None if config is None else str(config), None if mjcf is None else str(mjcf))
     _run_estimate(_robot(robot, urdf, config, mjcf), spec, log, output, opts, bag_map, max_gap, limit_margin, workers,
-                  chunk_rows, cast(TimeBase, time_base), _time_unit(time_unit), companion)
+                  chunk_rows, cast("TimeBase", time_base), _time_unit(time_unit), companion)
 
 
 @app.command()
@@ -445,6 +468,8 @@ def convert(bag: Path = typer.Argument(..., metavar="BAG", help="ROS 2 bag (fold
     """Convert a ROS 2 bag (or another log file) into a wbfriction log: joint states, contacts
     (zero-order hold) and base pose (linear + slerp) aligned on the joint-state stamps,
     streamed, and checked against the robot before it is renamed into place."""
+    from wbfriction.pipeline.convert import convert_log
+
     check_paths({"BAG": bag, "--map": bag_map, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
     r = _robot(robot, urdf, config, mjcf)
     with console.status(f"reading {bag}"):
@@ -469,7 +494,7 @@ def fit(friction: Path = FrictionArg,
     at a bound; warn about joints whose friction generates power (eq. 7.9)."""
     check_paths({"FRICTION": friction}, {"-o": output})
     _run_fit(friction, output, min_samples, energy_threshold, energy_tolerance, workers,
-             cast(ModelChoice, model), selection_tolerance)
+             cast("ModelChoice", model), selection_tolerance)
 
 
 @app.command()
@@ -500,6 +525,8 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
                                                               "the same URDF ('wbfriction fit').")) -> None:
     """How well a model predicts torques it was not fitted on: per joint, the RMS of measured minus
     predicted torque, tau - (M qdd + h + f(qd)), with the friction model and without it."""
+    import numpy as np
+
     from wbfriction.pipeline.predict import predict_file
 
     check_paths({"FRICTION": friction, "--params": params}, {})
@@ -552,7 +579,9 @@ def sensitivity(log: Path = LogArg,
                 time_unit: Optional[str] = TimeUnitOpt) -> None:
     """Re-run the estimate with every body's inertia scaled (thesis 7.2, Fig. 7.5/7.6): how the
     friction curves shift (mass) and split into branches (rotational inertia)."""
+    from wbfriction.friction.estimate import resolve_differentiation
     from wbfriction.inertia.sensitivity import PARTS, InertiaPart, inertia_sensitivity, parse_factors
+    from wbfriction.logs.source import read_log
     from wbfriction.report.figures import save_png, sensitivity_figure
     from wbfriction.signals.kinematics import measure
 
@@ -563,9 +592,9 @@ def sensitivity(log: Path = LogArg,
     r = _robot(robot, urdf, config, mjcf)
     data = read_log(log, r, time_unit=_time_unit(time_unit))
     _warn(data.warnings)
-    opts, _ = resolve_differentiation(EstimateOptions(diff=cast(Diff | Literal["auto"], diff), mask=cast(Mask, mask)),
-                                      data)
-    kin = measure(data, cast(Diff, opts.diff), filtering=opts.filtering)
+    opts, _ = resolve_differentiation(
+        EstimateOptions(diff=cast("Diff | Literal['auto']", diff), mask=cast("Mask", mask)), data)
+    kin = measure(data, cast("Diff", opts.diff), filtering=opts.filtering)
     with console.status("") as status:
         sens = inertia_sensitivity(r, kin, values, cast(InertiaPart, part), opts, progress=status.update)
     names = _joint_list(r, joints)
@@ -689,9 +718,9 @@ def identify(log: Path = LogArg,
     r = _robot(robot, urdf, config, mjcf)
     r.require_urdf("identify (it writes the corrected URDF)")
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior,
-                           armature=cast(ArmatureMode, armature))
+                           armature=cast("ArmatureMode", armature))
     with console.status("") as status:
-        estimate_options = EstimateOptions(diff=cast(Diff | Literal["auto"], diff), mask=cast(Mask, mask))
+        estimate_options = EstimateOptions(diff=cast("Diff | Literal['auto']", diff), mask=cast("Mask", mask))
         done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
                              options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers,
                              time_unit=_time_unit(time_unit))
@@ -722,9 +751,12 @@ def identify(log: Path = LogArg,
     console.print(f"wrote {output}")
 
 
-def _study_table(rows, title: str, params=PARAM_NAMES) -> Table:
+def _study_table(rows, title: str, params: tuple[str, ...] | None = None) -> Table:
     """Tables 6.1/6.2 layout: per leg joint (thesis numbering) the fit's status, target, estimate, error,
-    thesis errors."""
+    thesis errors; ``params``: the parameters shown (default: every one of model 3.5)."""
+    from wbfriction.friction.models import PARAM_NAMES
+
+    params = PARAM_NAMES if params is None else params
     table = Table(title=title, box=None,
                   caption="err: error to the target [%]; T6.1 / T6.2: the thesis's errors for the same joint "
                           "(TORO, straight / straight and sideways)")
@@ -796,6 +828,7 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
          simulator: str = typer.Option("ideal", help="ideal: Tables 6.1/6.2, Fig. 6.1-6.3; mujoco: the realistic "
                                                      "simulator's study, Fig. 6.4-6.5.")) -> None:
     """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.5."""
+    from wbfriction.friction.models import PARAM_NAMES
     from wbfriction.studies.common import worst_errors
     from wbfriction.studies.simulation import run_study
 
@@ -837,6 +870,7 @@ def spectrum(log: Path = LogArg,
                                                                      "left above the suggested cutoff."),
              time_unit: Optional[str] = TimeUnitOpt) -> None:
     """The estimated acceleration's spectrum and the Butterworth cutoff it suggests (thesis Fig. 7.1)."""
+    from wbfriction.logs.source import read_log
     from wbfriction.report.figures import spectrum_figure
     from wbfriction.signals.spectrum import acceleration_spectrum
 
@@ -860,6 +894,8 @@ def spectrum(log: Path = LogArg,
 
 
 def _percent(x: float) -> str:
+    import numpy as np
+
     return f"{x:.1f}" if x < 1e4 else ("inf" if not np.isfinite(x) else ">1e4")
 
 
@@ -884,7 +920,7 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
     if not r.ft_sensors:
         raise InputError(f"--robot {robot}: the robot has no force-torque sensors ([force_torque.<name>] in its TOML)")
     with console.status("") as status:
-        result = run_sensors_study(r, output_dir, steps=steps, diff=cast(Diff, diff),
+        result = run_sensors_study(r, output_dir, steps=steps, diff=cast("Diff", diff),
                                    filtering=FilterOptions(window=window), noise=NOISE if noise else SensorNoise(),
                                    substeps=substeps or SUBSTEPS, progress=lambda label: status.update(label))
     out.print(escape(sensors_markdown(result)), highlight=False, soft_wrap=True)
@@ -900,6 +936,7 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
                   seed: int = typer.Option(0, help="Noise seed."),
                   workers: Optional[int] = typer.Option(None, help="Processes (default: up to 2).")) -> None:
     """Score the differentiation schemes on noisy logs (thesis 7.2, Fig. 7.2)."""
+    from wbfriction.friction.models import PARAM_NAMES
     from wbfriction.studies.filters import LEVELS, run_filter_study
 
     start = time.perf_counter()

@@ -9,7 +9,8 @@ import pinocchio as pin
 import pytest
 
 from conftest import truth_samples
-from wbfriction.friction.estimate import EstimateOptions, estimate_friction
+from wbfriction.friction.estimate import estimate_friction
+from wbfriction.friction.options import EstimateOptions
 
 NO_MARGIN = dict(lift_off_skip=0.0, touch_down_skip=0.0)
 

@@ -8,7 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wbfriction.friction.cross_check import MIN_SAMPLES, cross_check, likely_cause
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.sim import IdealOptions, MujocoOptions, simulate_ideal, simulate_mujoco
 from wbfriction.walking import GaitOptions, walking_reference
 

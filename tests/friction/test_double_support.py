@@ -12,7 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import truth_samples
-from wbfriction.friction.estimate import EstimateOptions, estimate_friction, regularised_least_squares
+from wbfriction.friction.estimate import estimate_friction, regularised_least_squares
+from wbfriction.friction.options import EstimateOptions
 
 NO_MARGIN = dict(lift_off_skip=0.0, touch_down_skip=0.0)
 

@@ -8,9 +8,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wbfriction.friction.energy import crossing_lags, energy_consistency, generating_share, zero_crossings
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.fit import fit_joints
 from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.sensitivity import inertia_sensitivity
 from wbfriction.signals.kinematics import measure
 from wbfriction.studies.common import leg_joints

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from conftest import truth_samples
-from wbfriction.friction.estimate import EstimateOptions, estimate_friction, regularised_least_squares
+from wbfriction.friction.estimate import estimate_friction, regularised_least_squares
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.model.dynamics import constrained_dynamics
 
 NO_MARGIN = dict(lift_off_skip=0.0, touch_down_skip=0.0)

@@ -14,8 +14,9 @@ import pinocchio as pin
 import pyarrow as pa
 import pytest
 
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.models import coulomb_viscous_stribeck
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import log_from_table
 from wbfriction.model import load_robot
 from wbfriction.model.loading import example_robot_data_dir

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.fit import FitResult, HeldOutScore, ModelSelection
 from wbfriction.friction.io import (
     fit_from_dict,
@@ -19,9 +19,10 @@ from wbfriction.friction.io import (
     write_params,
 )
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams, StribeckParams
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.tables import write_table
 from wbfriction.signals.filters import SavgolSmoother
-from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.signals.options import FilterOptions
 
 
 @pytest.mark.parametrize("suffix", [".parquet", ".h5"])

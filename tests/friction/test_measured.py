@@ -11,7 +11,8 @@ import pytest
 from tests.helpers import run_cli
 
 from wbfriction.exceptions import ColumnError
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import write_log
 from wbfriction.logs.source import read_log

@@ -7,7 +7,8 @@ import pyarrow as pa
 import pytest
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import log_from_table
 
 

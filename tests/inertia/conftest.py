@@ -9,8 +9,9 @@ import pytest
 
 from wbfriction.friction.models import FrictionParams
 from wbfriction.logs.log import Log, log_from_table
-from wbfriction.model.loading import BUILTIN_ROBOTS, example_robot_data_dir, load_robot
+from wbfriction.model.loading import example_robot_data_dir, load_robot
 from wbfriction.model.robot import Robot
+from wbfriction.model.robots import BUILTIN_ROBOTS
 from wbfriction.sim.arm import ArmOptions, ExcitationOptions, simulate_arm
 
 

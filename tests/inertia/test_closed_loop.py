@@ -12,20 +12,20 @@ import numpy as np
 import pytest
 
 from helpers import run_cli
-from wbfriction.friction.estimate import EstimateOptions
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.closed_loop import stribeck_velocity
 from wbfriction.inertia.consistency import is_consistent
-from wbfriction.inertia.identification import InertialOptions
 from wbfriction.inertia.io import read_identification
+from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import body_parameters
 from wbfriction.inertia.sensitivity import scaled_robot
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.log import write_log
 from wbfriction.model.loading import load_robot
 from wbfriction.pipeline.identify import identify_file
-from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.signals.options import FilterOptions
 from wbfriction.studies.common import leg_joints
 
 

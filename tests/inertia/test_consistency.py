@@ -9,7 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from wbfriction.inertia.consistency import PHYSICAL, PriorUncertainty, body_prior, physical_jacobian
+from wbfriction.inertia.consistency import PHYSICAL, body_prior, physical_jacobian
+from wbfriction.inertia.options import PriorUncertainty
 
 _PAIRS = ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2))
 

@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from wbfriction.friction.estimate import EstimateOptions
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.inertia.consistency import (
     PHYSICAL,
@@ -23,12 +23,13 @@ from wbfriction.inertia.consistency import (
     prior_model,
     regularised_problem,
 )
-from wbfriction.inertia.identification import InertialOptions, identify_inertia
+from wbfriction.inertia.identification import identify_inertia
 from wbfriction.inertia.least_squares import CompressedLeastSquares, base_parameters
+from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import act_matrix, body_parameters, stance_regressor
 from wbfriction.inertia.sensitivity import scaled_robot
 from wbfriction.model.stance import stance_model
-from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.signals.options import FilterOptions
 from wbfriction.studies.common import leg_joints
 
 

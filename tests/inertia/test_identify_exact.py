@@ -10,13 +10,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from wbfriction.friction.estimate import EstimateOptions
-from wbfriction.inertia.identification import InertialOptions
+from wbfriction.friction.options import EstimateOptions
+from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import body_parameters
 from wbfriction.logs.log import write_log
 from wbfriction.model.loading import load_robot
 from wbfriction.pipeline.identify import identify_file
-from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.signals.options import FilterOptions
 
 ESTIMATE = EstimateOptions(diff="butterworth", filtering=FilterOptions(cutoff=20.0))
 

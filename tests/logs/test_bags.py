@@ -10,7 +10,8 @@ import pytest
 
 from helpers import assert_one_line_error, bag_map, ros_time, run, write_bag
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.bags import BagMap, ContactTopic, iter_bag, load_bag_map, read_bag
 from wbfriction.logs.log import log_from_table
 from wbfriction.logs.source import read_log

@@ -13,7 +13,8 @@ from hypothesis import strategies as st
 
 from helpers import KUKA
 from wbfriction.exceptions import ColumnError, InputError
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.clock import VERDICT, lattice_period, read_clock, split_at_gaps
 from wbfriction.logs.log import log_from_table
 

@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from wbfriction.friction.estimate import EstimateOptions
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces
 from wbfriction.logs.log import write_log
 from wbfriction.logs.source import read_log

@@ -18,13 +18,14 @@ from hypothesis import strategies as st
 from helpers import bag_map, write_bag
 from wbfriction.exceptions import InputError
 from wbfriction.friction.energy import energy_consistency
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.fit import fit_estimate, fitted_offsets
 from wbfriction.friction.io import friction_table, read_friction_table
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import Log, write_log
 from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import read_table, with_metadata, write_table
-from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.signals.options import FilterOptions
 
 BUDGET = settings(max_examples=150, deadline=None, derandomize=True,
                   suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])

@@ -11,14 +11,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.io import read_friction_table
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import write_log
 from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import read_table, write_table
 from wbfriction.pipeline.chunks import CHUNKS_PER_WORKER, CONTEXT, Chunking, plan_chunks
 from wbfriction.pipeline.estimate import RobotSpec, estimate_file
-from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.signals.options import FilterOptions
 
 
 @settings(max_examples=60, deadline=None)

@@ -21,10 +21,11 @@ import pytest
 from helpers import KUKA, KUKA_CONFIG, KUKA_URDF, kuka_table, needs_kuka
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.export.urdf import write_friction_urdf
-from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_log
+from wbfriction.friction.estimate import FrictionEstimate, estimate_log
 from wbfriction.friction.fit import FitResult, fit_estimate
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.predict import predict_torques
-from wbfriction.inertia.identification import InertialOptions
+from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.log import log_from_table
 from wbfriction.model import Robot, load_robot

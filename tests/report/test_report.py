@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.fit import fit_estimate
 from wbfriction.friction.io import fit_to_dict, friction_table, read_params
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.sensitivity import inertia_sensitivity
 from wbfriction.logs.tables import write_table
 from wbfriction.report.build import acceleration_spectra, make_report

@@ -198,7 +198,7 @@ def test_kuka_runs_of_the_same_trajectory_get_the_same_choice():
 def test_record_is_json_ready_and_rebuilds_the_options():
     import json
 
-    from wbfriction.signals.kinematics import FilterOptions
+    from wbfriction.signals.options import FilterOptions
 
     for q in (sines(10.0), sines(10.0, sigma=0.0)):
         choice = choose_differentiation(q, DT)

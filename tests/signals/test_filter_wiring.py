@@ -22,7 +22,8 @@ from numpy.lib.stride_tricks import sliding_window_view
 from scipy.signal import butter, filtfilt
 
 from wbfriction.logs.log import Log
-from wbfriction.signals.kinematics import FilterOptions, measure
+from wbfriction.signals.kinematics import measure
+from wbfriction.signals.options import FilterOptions
 
 DT, N, K = 1e-3, 1200, 600  # period [s], samples, first sample of the new contact state
 

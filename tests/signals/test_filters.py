@@ -18,7 +18,8 @@ from wbfriction.signals.filters import (
     savgol_kernels,
     savgol_weights,
 )
-from wbfriction.signals.kinematics import FilterOptions, central_differences, measure, straddling
+from wbfriction.signals.kinematics import central_differences, measure, straddling
+from wbfriction.signals.options import FilterOptions
 from wbfriction.signals.spectrum import amplitude_spectrum, suggest_cutoff
 
 DT = 1e-3

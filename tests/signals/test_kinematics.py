@@ -10,8 +10,9 @@ from hypothesis import strategies as st
 from wbfriction.exceptions import InputError
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.log import Log
-from wbfriction.signals.kinematics import FilterOptions, align_torque, central_differences, measure
+from wbfriction.signals.kinematics import align_torque, central_differences, measure
 from wbfriction.signals.nonuniform import three_point_differences
+from wbfriction.signals.options import FilterOptions
 from wbfriction.signals.phases import joint_mask, segment
 
 DT = 1e-3

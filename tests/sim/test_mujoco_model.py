@@ -149,7 +149,8 @@ def test_swing_estimate_is_reliable_and_stance_is_not_on_mujoco(talos, mj_talos)
     """Thesis 6.2 (Fig. 6.4): on real (soft) contacts the right knee's friction, estimated
     with central differences, is close to the truth while its leg swings, and far off while
     it stands; contact flags come from measured forces."""
-    from wbfriction.friction.estimate import EstimateOptions, estimate_log
+    from wbfriction.friction.estimate import estimate_log
+    from wbfriction.friction.options import EstimateOptions
     from wbfriction.friction.targets import THESIS_TARGETS
     from wbfriction.sim.mujoco_sim import simulate_mujoco
     from wbfriction.walking import GaitOptions, walking_reference

@@ -12,11 +12,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.sim import MujocoOptions, simulate_mujoco
 from wbfriction.sim.mujoco_model import build_mujoco_robot
-from wbfriction.sim.mujoco_sim import matched_weights
+from wbfriction.sim.mujoco_sim import MatchedMeans, index_or_slice, matched_weights
 from wbfriction.studies.common import leg_joints
 from wbfriction.walking import GaitOptions, walking_reference
 
@@ -145,6 +146,38 @@ def test_matched_weights_are_what_the_central_second_difference_sees(n, seed):
     central = (q[2:] - 2 * q[1:-1] + q[:-2]) / dt**2
     np.testing.assert_allclose(central, sample[1:periods], rtol=1e-9, atol=1e-9)
     assert w[:, 0].sum() + w[:, 1].sum() == pytest.approx(1.0)
+
+
+@settings(max_examples=50, deadline=None)
+@given(n=st.integers(1, 40), substeps=st.integers(1, 6), block=st.integers(1, 9), seed=st.integers(0, 2**32 - 1))
+def test_matched_means_are_the_running_sums_bit_for_bit(n, substeps, block, seed):
+    """:class:`MatchedMeans`, reduced in blocks, gives the very numbers of a running sum over the physics steps
+    (each step's ``weight * reading`` added to its sample and the next as it comes), for any block size."""
+    rng = np.random.default_rng(seed)
+    readings = rng.normal(size=(n, substeps, 3)) * 10.0 ** rng.integers(-3, 4, size=(n, substeps, 3))
+    w = matched_weights(substeps)
+    running = np.zeros((n, 3))
+    for k in range(n):
+        for s in range(substeps):
+            running[k] += w[s, 0] * readings[k, s]
+            if k + 1 < n:
+                running[k + 1] += w[s, 1] * readings[k, s]
+    means = MatchedMeans(n, substeps, 3, block=block)
+    for k in range(n):
+        means.period(k)[:] = readings[k]
+        means.done(k)
+    assert np.array_equal(means.out, running)
+
+
+def test_index_or_slice():
+    """Runs of consecutive indices become slices (the same elements); other indices stay as they are."""
+    x = np.arange(10.0) * 3
+    for index in ([2, 3, 4], [0], [7, 8, 9]):
+        sl = index_or_slice(np.array(index))
+        assert isinstance(sl, slice) and np.array_equal(x[sl], x[index])
+    for index in ([3, 2], [1, 3], [0, 1, 1]):
+        assert not isinstance(index_or_slice(np.array(index)), slice)
+    assert not isinstance(index_or_slice(np.zeros(0, dtype=int)), slice)
 
 
 def test_the_logged_torque_is_the_matched_mean_of_the_motors(talos, mujoco_walk_4):

@@ -6,11 +6,12 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.fit import fit_joints
 from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
-from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.signals.options import FilterOptions
 from wbfriction.sim import IdealOptions, SensorNoise, apply_sensor_noise, simulate_ideal
 from wbfriction.studies.common import SIMULATOR
 from wbfriction.walking import GaitOptions, walking_reference

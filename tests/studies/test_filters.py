@@ -5,7 +5,7 @@ from __future__ import annotations
 import pyarrow.parquet as pq
 import pytest
 
-from wbfriction.signals.kinematics import FilterOptions
+from wbfriction.signals.options import FilterOptions
 from wbfriction.studies.filters import Scheme, run_filter_study
 
 

@@ -3,13 +3,6 @@
 the fit of model (3.5) with standard errors (:mod:`.fit`, 6.4), the energy check
 (:mod:`.energy`, 7.9), and the friction table and parameters JSON (:mod:`.io`)."""
 
-from wbfriction.friction.energy import JointEnergy, energy_consistency
-from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_friction, estimate_log
-from wbfriction.friction.fit import FitResult, fit_estimate, fit_friction, fit_joints
-from wbfriction.friction.io import friction_table, read_friction_file, read_friction_table, read_params, write_params
-from wbfriction.friction.models import PARAM_NAMES, FrictionParams, coulomb_viscous_stribeck
+import lazy_loader
 
-__all__ = ["PARAM_NAMES", "EstimateOptions", "FitResult", "FrictionEstimate", "FrictionParams", "JointEnergy",
-           "coulomb_viscous_stribeck", "energy_consistency", "estimate_friction", "estimate_log", "fit_estimate",
-           "fit_friction", "fit_joints", "friction_table", "read_friction_file", "read_friction_table",
-           "read_params", "write_params"]
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

@@ -30,16 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
 from wbfriction.signals.filters import finite_runs
-
-DEFAULT_THRESHOLD = 0.05
-"""Share of power-generating samples above which an estimate is flagged (5 %): exact
-models give well under 1 % (the remainder: velocity sign errors of the differentiation
-around reversals, measured on the ideal simulator's combined walk)."""
-
-
-DEFAULT_TOLERANCE = 0.01
-"""Friction torques smaller than this do not count as generating power [N·m]."""
 
 
 def generating_share(qd: np.ndarray, tau_f: np.ndarray, tau_os: float = 0.0,

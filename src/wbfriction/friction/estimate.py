@@ -21,20 +21,19 @@ Sign convention: ``tau_f`` is the torque friction exerts on the joint,
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, fields, replace
-from typing import Any, Literal, cast, get_args
+from typing import Any, cast
 
 import numpy as np
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.measured import (
-    BASE_MOTIONS,
-    BaseMotion,
     base_route,
     impacts,
     measured_base,
     resolve_base_motion,
     wrench_route,
 )
+from wbfriction.friction.options import METHODS, EstimateOptions
 from wbfriction.logs.log import Log
 from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
@@ -44,80 +43,16 @@ from wbfriction.signals.choice import DiffChoice, choose_differentiation
 from wbfriction.signals.kinematics import (
     FILTERING_SCHEMES,
     Diff,
-    FilterOptions,
     MeasuredKinematics,
     Scheme,
     Smoother,
-    TorqueAlignment,
-    Velocity,
     joined_smoother,
     measure,
     straddling,
 )
-from wbfriction.signals.phases import Mask, Phases, joint_mask, segment
+from wbfriction.signals.phases import Phases, joint_mask, segment
 
 CHUNK = 4096
-Method = Literal["rnea", "kkt"]
-"""The single-support route: one RNEA pass on the stance-rooted tree, or the KKT system (5.10-5.13)."""
-METHODS: tuple[Method, ...] = get_args(Method)
-
-
-@dataclass(frozen=True)
-class EstimateOptions:
-    """Options of the estimator (defaults from the thesis).
-
-    Attributes:
-        diff: differentiation scheme: ``central``, ``backward``, ``savgol``, ``butterworth``
-            (:mod:`~wbfriction.signals.kinematics`, :mod:`~wbfriction.signals.filters`), ``true``,
-            or ``auto``: chosen from the log's positions with its window or cutoff
-            (:func:`resolve_differentiation`; the command line's default), once per log.
-        compensate_delay: shift the derivatives by their delay (6.1.2).
-        torque_alignment: ``zoh`` (mean of tau[k-1], tau[k]), ``sample``, or ``auto``
-            (what the log's metadata declares, else ``zoh``).
-        lift_off_skip: seconds dropped after a lift-off [s] (6.2.1: 0.10).
-        touch_down_skip: seconds dropped before a touch-down [s] (6.2.1: 0.05).
-        mask: ``swing`` (a leg joint counts only while its leg swings) or ``single``.
-        ds_weight: diagonal of W in (6.1), scalar or (n_tc,): relative weights of the
-            joints' acceleration residuals (dimensionless).
-        ds_regularization: diagonal of Lambda in (6.1), scalar or (n_tc,)
-            [(rad/s^2)^2 / (N·m)^2 with W = 1]; it competes with ``A^T W A``, whose
-            entries are of the order of (1 / joint inertia)^2.
-        condition_number: report cond(M_mod^{-1}) per sample (one KKT inverse per sample).
-        method: single-support route, ``rnea`` (default) or ``kkt``.
-        filtering: parameters of the ``savgol`` and ``butterworth`` schemes.
-        velocity: ``differentiated`` or ``logged`` (the log's ``qd.<joint>``:
-            :func:`~wbfriction.signals.kinematics.measure`).
-        acceleration_difference: also give ``Delta qdd`` (5.12) in single support
-            (``M_mod^{-1} tau_f``, one ``crba`` per sample on the stance-rooted tree and a
-            batched solve); the KKT route always has it.
-        base_motion: where the base's motion comes from (:data:`~wbfriction.friction.measured.BaseMotion`):
-            ``contact`` (rigid contacts), ``logged`` (the base pose differentiated like the joints),
-            ``auto`` (:func:`~wbfriction.friction.measured.resolve_base_motion`).
-        wrenches: use the force-torque sensors' wrenches where the log has them: every joint's
-            friction in every phase (:func:`~wbfriction.friction.measured.wrench_route`).
-    """
-
-    diff: Diff | Literal["auto"] = "central"
-    compensate_delay: bool = True
-    torque_alignment: TorqueAlignment | Literal["auto"] = "auto"
-    lift_off_skip: float = 0.10
-    touch_down_skip: float = 0.05
-    mask: Mask = "swing"
-    ds_weight: float | tuple[float, ...] = 1.0
-    ds_regularization: float | tuple[float, ...] = 1e-3
-    condition_number: bool = False
-    method: Method = "rnea"
-    filtering: FilterOptions = FilterOptions()
-    acceleration_difference: bool = True
-    velocity: Velocity = "differentiated"
-    base_motion: BaseMotion = "auto"
-    wrenches: bool = True
-
-    def __post_init__(self) -> None:
-        if self.base_motion not in BASE_MOTIONS:
-            raise InputError(f"unknown base motion '{self.base_motion}': choose one of {', '.join(BASE_MOTIONS)}")
-
-
 @dataclass
 class FrictionEstimate:
     """Per-sample friction estimate of the torque-controlled joints.

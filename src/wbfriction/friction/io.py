@@ -31,7 +31,8 @@ from wbfriction.friction.fit import FitResult, HeldOutScore, ModelSelection
 from wbfriction.friction.models import FrictionParams, check_model, params_from_dict
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.tables import file_sha256, numeric_column, read_metadata, read_table, with_metadata, write_json
-from wbfriction.signals.kinematics import SCHEMES, FilterOptions, Smoother, make_smoother
+from wbfriction.signals.kinematics import SCHEMES, Smoother, make_smoother
+from wbfriction.signals.options import FilterOptions
 
 SIGN_CONVENTION = "tau_f = -f(qd); fit of f (the joint's model, eqs. 3.1-3.5) to -tau_f"
 """What the parameters JSON of ``wbfriction fit`` states of its sign."""

@@ -19,22 +19,17 @@ Sign convention: ``tau_f = tau_joint - tau``, the torque friction exerts on the 
 
 from __future__ import annotations
 
-from typing import Literal, get_args
+from typing import Literal
 
 import numpy as np
 
+from wbfriction.friction.options import BaseMotion
 from wbfriction.logs.contacts import default_thresholds, normal_forces, sensed_contacts
 from wbfriction.model.dynamics import floating_base_state
 from wbfriction.model.imu import base_motion_from_imu
 from wbfriction.model.measured_dynamics import measured_inverse_dynamics
 from wbfriction.model.robot import Robot
 from wbfriction.signals.kinematics import MeasuredKinematics
-
-BaseMotion = Literal["auto", "contact", "logged", "imu"]
-"""Where the base's motion comes from: the rigid contacts (the thesis's route), the logged base pose
-differentiated like the joints, the IMU (its gyro and accelerometer, the logged base orientation), or
-``auto`` (:func:`resolve_base_motion`)."""
-BASE_MOTIONS: tuple[BaseMotion, ...] = get_args(BaseMotion)
 
 Route = Literal["contact", "base", "wrench", "none"]
 """How a sample's friction was estimated: rigid contacts, measured base motion, measured wrenches, or not."""

@@ -5,11 +5,6 @@ inertia errors (:mod:`.sensitivity`, 7.2), the corrected URDF (:mod:`.urdf`) and
 identification JSON (:mod:`.io`); the identified limbs kept only where held-out torques are
 predicted better (:mod:`.validation`); solvers' stopping messages in words (:mod:`.solver`)."""
 
-from wbfriction.inertia.closed_loop import ClosedLoop, identify
-from wbfriction.inertia.identification import InertialIdentification, InertialOptions, identify_inertia
-from wbfriction.inertia.io import read_identification
-from wbfriction.inertia.sensitivity import inertia_sensitivity, scaled_robot
-from wbfriction.inertia.urdf import write_urdf
+import lazy_loader
 
-__all__ = ["ClosedLoop", "InertialIdentification", "InertialOptions", "identify", "identify_inertia",
-           "inertia_sensitivity", "read_identification", "scaled_robot", "write_urdf"]
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

@@ -22,9 +22,11 @@ from typing import Literal
 import numpy as np
 
 from wbfriction.friction.energy import JointEnergy, energy_consistency
-from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_log
+from wbfriction.friction.estimate import FrictionEstimate, estimate_log
 from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
-from wbfriction.inertia.identification import InertialIdentification, InertialOptions, identify_inertia
+from wbfriction.friction.options import EstimateOptions
+from wbfriction.inertia.identification import InertialIdentification, identify_inertia
+from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from wbfriction.exceptions import InputError
+from wbfriction.inertia.options import PriorUncertainty
 
 FRICTION = ("F_v", "F_c", "tau_os")
 """Friction parameters identified per torque-controlled joint (3.5 without Stribeck)."""
@@ -91,33 +91,6 @@ def _dynamic_parameters(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         pi[b] = lc.toDynamicParameters()
         jac[b] = lc.calculateJacobian()
     return pi, jac
-
-
-@dataclass(frozen=True)
-class PriorUncertainty:
-    """Standard deviations of the prior toward the given model (module docstring).
-
-    Attributes:
-        mass: of each body's mass, relative to it.
-        com: of each coordinate of each body's centre of mass [m].
-        inertia: of each entry of each body's rotational inertia about its centre of mass,
-            relative to its largest principal moment (at least that of a 1 cm sphere of its mass).
-        armature: of each joint's armature, relative to the larger of its given armature and the
-            largest diagonal entry of the given model's joint-space inertia at the reference
-            configuration (:func:`wbfriction.inertia.identification.armature_scale`).
-        friction: of each joint's Coulomb, Stribeck and offset friction, relative to the RMS of its
-            torque in the log [N·m]; of its viscous friction, that over its velocity limit [rad/s].
-    """
-
-    mass: float = 0.1
-    com: float = 0.05
-    inertia: float = 0.5
-    armature: float = 1.0
-    friction: float = 1.0
-
-    def __post_init__(self) -> None:
-        if min(self.mass, self.com, self.inertia, self.armature, self.friction) <= 0:
-            raise InputError(f"prior uncertainties must be > 0, got {self}")
 
 
 def physical_jacobian(pi: np.ndarray) -> np.ndarray:

@@ -85,25 +85,26 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Literal, get_args
+from typing import Literal
 
 import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimate import EstimateOptions, resolve_differentiation
+from wbfriction.friction.estimate import resolve_differentiation
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.solver import SolverOutcome, explain_solver
 from wbfriction.inertia.consistency import (
     FRICTION,
     STRIBECK,
     Prior,
-    PriorUncertainty,
     fit_consistent,
     friction_lower_bounds,
     prior_model,
 )
 from wbfriction.inertia.excitation import Unexcited, parameter_names, unexcited_parameters
 from wbfriction.inertia.least_squares import BaseParameters, CompressedLeastSquares, base_parameters
+from wbfriction.inertia.options import ArmatureMode, InertialOptions
 from wbfriction.inertia.regressor import body_parameters, stance_regressor, with_body_parameters
 from wbfriction.inertia.validation import Validation, limbs, validate_groups
 from wbfriction.logs.log import Log
@@ -121,62 +122,6 @@ NOISY_ACCELERATION = 0.1
 """Share of a joint's acceleration power in the upper half of the band (above a quarter of the sampling
 rate, where a robot's motion has next to none) from which the accelerations count as noisy
 (:attr:`InertialIdentification.acceleration_noise`)."""
-ArmatureMode = Literal["known", "identify", "none"]
-"""How the identification treats the drives' reflected rotor inertia (module docstring)."""
-ARMATURE_MODES: tuple[ArmatureMode, ...] = get_args(ArmatureMode)
-
-
-@dataclass(frozen=True)
-class InertialOptions:
-    """Options of :func:`identify_inertia`.
-
-    Attributes:
-        tanh_slope: ``a`` of the Coulomb term ``F_c tanh(a qd)`` [s/rad].
-        stribeck_velocity: ``v_s`` [rad/s] of a Stribeck term ``(F_s - F_c) tanh(a qd) exp(-(qd/v_s)^2)``
-            identified with the others (3.5 with ``delta_s = 2``; ``F_s - F_c = S F_c``), for
-            example the one the acceleration route's fit found; None: no Stribeck term.
-        stribeck_joints: the joints given the Stribeck term (None: every torque-controlled
-            one). A joint that never moves faster than ``v_s`` cannot tell it from Coulomb
-            friction: their columns would cancel with huge opposite values.
-        stride: every ``stride``-th single-support sample enters the regression (1 kHz
-            logs are far denser than the dynamics need).
-        holdout: share of the log's recorded time (gaps left out), at its end, kept out of the
-            regression to compare the models' torque predictions.
-        prior: weight of the prior toward the given model, in units of the data's residual
-            variance (module docstring); None: chosen from :data:`PRIOR_GRID` by validation.
-        uncertainty: the prior's standard deviations
-            (:class:`~wbfriction.inertia.consistency.PriorUncertainty`).
-        armature: ``"known"`` (the model's, the robot's ``[armature]``), ``"identify"`` (one
-            parameter per torque-controlled joint, >= 0, prior toward the model's) or ``"none"``
-            (torques that do not see the rotors: link-side sensors).
-        validation: share of the training samples' time span, at its end, that scores
-            the priors of the grid.
-        rank_tolerance: relative pivot below which a parameter is not identifiable
-            (:func:`base_parameters`).
-        min_mass: smallest mass a body's starting point gets [kg].
-        block: samples per block of the compressed regression.
-    """
-
-    tanh_slope: float = 40.0
-    stribeck_velocity: float | None = None
-    stribeck_joints: tuple[str, ...] | None = None
-    stride: int = 5
-    holdout: float = 0.2
-    prior: float | None = None
-    uncertainty: PriorUncertainty = PriorUncertainty()
-    armature: ArmatureMode = "known"
-    validation: float = 0.25
-    rank_tolerance: float = 1e-8
-    min_mass: float = 1e-3
-    block: int = 200
-
-    def __post_init__(self) -> None:
-        if self.armature not in ARMATURE_MODES:
-            raise InputError(f"unknown armature mode '{self.armature}': choose one of {', '.join(ARMATURE_MODES)}")
-        if self.prior is not None and not self.prior > 0:
-            raise InputError(f"the prior's weight must be > 0, got {self.prior}")
-
-
 @dataclass
 class TorqueFit:
     """RMS of measured minus predicted held-out joint torques per torque-controlled joint [N·m] (n_tc,):

@@ -34,7 +34,8 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_friction
+from wbfriction.friction.estimate import FrictionEstimate, estimate_friction
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
 from wbfriction.signals.kinematics import MeasuredKinematics

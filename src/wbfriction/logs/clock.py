@@ -37,6 +37,7 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.logs.options import MAX_GAP
 from wbfriction.logs.tables import numeric_column
 
 ClockKind = Literal["uniform", "skipping", "jittered"]
@@ -47,9 +48,6 @@ TimeBase = Literal["auto", "recorded", "regularised"]
 recorded, or a regularised clock (:func:`regularise`)."""
 TIME_BASES: tuple[TimeBase, ...] = get_args(TimeBase)
 
-MAX_GAP = 2.0
-"""Default gap [sampling periods]: a time step at least this long (against the median of the
-steps around it) splits a log into segments."""
 JITTER = 0.05
 """Steps within this share of their median are a uniform clock."""
 LATTICE_TOL = 0.05

@@ -41,17 +41,9 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError, InputError
-from wbfriction.logs.clock import (
-    JITTER,
-    MAX_GAP,
-    Clock,
-    TimeBase,
-    TimeUnit,
-    read_clock,
-    split_at_gaps,
-    table_stamps,
-)
+from wbfriction.logs.clock import JITTER, Clock, TimeBase, TimeUnit, read_clock, split_at_gaps, table_stamps
 from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, sensed_contacts
+from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
 from wbfriction.logs.tables import numeric_column, read_metadata, with_metadata, write_table
 from wbfriction.model.robot import Robot
 
@@ -188,10 +180,6 @@ class Log:
             if x is not None:
                 cols.update({f"{prefix}.{n}": x[:, i] for i, n in enumerate(robot.actuated)})
         return with_metadata(pa.table(cols), self.metadata)
-
-
-LIMIT_MARGIN = 0.2
-"""How far a position may pass its URDF limits before the log is refused [rad or m]."""
 
 
 def check_time(time: np.ndarray, source: str, max_gap: float = MAX_GAP,

@@ -19,7 +19,8 @@ import pyarrow as pa
 from wbfriction.exceptions import InputError
 from wbfriction.logs.bags import BagMap, is_bag, iter_bag, load_bag_map, read_bag
 from wbfriction.logs.clock import TimeBase, TimeUnit
-from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, Log, log_from_table
+from wbfriction.logs.log import Log, log_from_table
+from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
 from wbfriction.logs.table_map import TableMap, load_table_map
 from wbfriction.logs.tables import TableFile
 from wbfriction.model.robot import Robot

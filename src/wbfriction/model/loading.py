@@ -25,8 +25,8 @@ from wbfriction.model.force_torque import parse_sensors
 from wbfriction.model.imu import add_imu_frame
 from wbfriction.model.labels import parse_labels
 from wbfriction.model.robot import ModelFormat, Robot
+from wbfriction.model.robots import BUILTIN_ROBOTS
 
-BUILTIN_ROBOTS = ("talos", "toro", "panda")
 _ERD_PREFIX = "example-robot-data:"
 _GENERATED = "wbfriction:"  # a URDF this package generates: "wbfriction:<name>" (robots/<name>.py)
 ROOT_JOINT = "root_joint"

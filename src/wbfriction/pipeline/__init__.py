@@ -4,12 +4,6 @@ inertia identification (:mod:`.identify`), torque prediction on held-out logs (:
 exports (:mod:`.export`), bag conversion (:mod:`.convert`), each output with
 its provenance (:mod:`.provenance`)."""
 
-from wbfriction.pipeline.chunks import Chunking
-from wbfriction.pipeline.convert import convert_log
-from wbfriction.pipeline.estimate import RobotSpec, check_file, estimate_file, table_log
-from wbfriction.pipeline.fit import fit_file
-from wbfriction.pipeline.identify import identify_file
-from wbfriction.pipeline.predict import predict_file
+import lazy_loader
 
-__all__ = ["Chunking", "RobotSpec", "check_file", "convert_log", "estimate_file", "fit_file", "identify_file",
-           "predict_file", "table_log"]
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

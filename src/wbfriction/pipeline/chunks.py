@@ -31,8 +31,9 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import InputError
-from wbfriction.logs.clock import MAX_GAP, ROUGHNESS_ROWS, Clock, TimeBase, TimeUnit, read_clock, table_stamps
+from wbfriction.logs.clock import ROUGHNESS_ROWS, Clock, TimeBase, TimeUnit, read_clock, table_stamps
 from wbfriction.logs.log import check_schema, contact_flags_from_forces
+from wbfriction.logs.options import MAX_GAP
 from wbfriction.logs.tables import RowReader, TableFile, numeric_column
 from wbfriction.model.robot import Robot
 

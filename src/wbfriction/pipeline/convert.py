@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from wbfriction.logs.bags import BagMap
-from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP
+from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
 from wbfriction.logs.source import open_log
 from wbfriction.logs.tables import write_tables
 from wbfriction.model.robot import Robot

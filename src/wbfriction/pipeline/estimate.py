@@ -23,10 +23,12 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimate import EstimateOptions, estimate_log, no_single_support, resolve_differentiation
+from wbfriction.friction.estimate import estimate_log, no_single_support, resolve_differentiation
 from wbfriction.friction.io import friction_table
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.clock import Clock, TimeBase, TimeUnit, longest_segment
-from wbfriction.logs.log import LIMIT_MARGIN, MAX_GAP, log_from_table
+from wbfriction.logs.log import log_from_table
+from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
 from wbfriction.logs.source import LogSource
 from wbfriction.logs.tables import TableFile, read_metadata, scratch_folder, with_metadata, write_tables
 from wbfriction.model.loading import load_robot

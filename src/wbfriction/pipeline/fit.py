@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, JointEnergy, energy_consistency
+from wbfriction.friction.energy import JointEnergy, energy_consistency
 from wbfriction.friction.fit import (
     MODEL_CHOICES,
     SELECTION_TOLERANCE,
@@ -16,6 +16,7 @@ from wbfriction.friction.fit import (
     fitted_offsets,
 )
 from wbfriction.friction.io import SIGN_CONVENTION, energy_to_dict, read_friction_file, write_params
+from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
 from wbfriction.pipeline.provenance import file_provenance
 
 

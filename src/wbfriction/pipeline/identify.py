@@ -10,10 +10,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-from wbfriction.friction.estimate import EstimateOptions
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.closed_loop import ClosedLoop, identify
-from wbfriction.inertia.identification import InertialOptions
 from wbfriction.inertia.io import identification_document, write_identification
+from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.clock import TimeUnit
 from wbfriction.logs.source import read_log

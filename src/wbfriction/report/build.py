@@ -29,10 +29,11 @@ from pathlib import Path
 
 import numpy as np
 
-from wbfriction.friction.energy import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, JointEnergy, energy_consistency
+from wbfriction.friction.energy import JointEnergy, energy_consistency
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
 from wbfriction.friction.io import check_params_source, read_friction_file, read_params
+from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
 from wbfriction.friction.status import MIN_SPEED, joint_speed
 from wbfriction.inertia.io import read_identification
 from wbfriction.logs.tables import file_sha256

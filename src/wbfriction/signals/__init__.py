@@ -2,9 +2,6 @@
 zero-phase filters (:mod:`.filters`, 7.1), support phases and masks (:mod:`.phases`, 5.3, 6.2.1),
 and spectra (:mod:`.spectrum`, Fig. 7.1)."""
 
-from wbfriction.signals.kinematics import FilterOptions, MeasuredKinematics, measure
-from wbfriction.signals.phases import Phases, joint_mask, segment
-from wbfriction.signals.spectrum import AccelerationSpectrum, acceleration_spectrum
+import lazy_loader
 
-__all__ = ["AccelerationSpectrum", "FilterOptions", "MeasuredKinematics", "Phases", "acceleration_spectrum",
-           "joint_mask", "measure", "segment"]
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

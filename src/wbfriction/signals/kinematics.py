@@ -48,8 +48,9 @@ from wbfriction.exceptions import InputError
 from wbfriction.logs.log import Log
 from wbfriction.signals import nonuniform
 from wbfriction.signals.base_motion import base_twist_and_acceleration, continuous_quaternions
-from wbfriction.signals.filters import SavgolSmoother, SavgolWeights, ZeroPhaseLowpass, savgol_differentiate
+from wbfriction.signals.filters import SavgolSmoother, ZeroPhaseLowpass, savgol_differentiate
 from wbfriction.signals.nonuniform import NonUniformSavgol, ResampledLowpass
+from wbfriction.signals.options import FilterOptions
 from wbfriction.signals.velocity import velocity_lag
 
 
@@ -79,26 +80,6 @@ def backward_differences(q: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarr
     qd[1:] = (q[1:] - q[:-1]) / dt
     qdd[2:] = (qd[2:] - qd[1:-1]) / dt
     return qd, qdd, 1
-
-
-@dataclass(frozen=True)
-class FilterOptions:
-    """Parameters of the filtering schemes (thesis 7.1; defaults: the thesis's).
-
-    Attributes:
-        window: Savitzky-Golay window length L (odd) [samples].
-        poly_order: Savitzky-Golay polynomial order k (>= 2).
-        weights: Savitzky-Golay weights, ``uniform`` or ``gaussian``
-            (:func:`~wbfriction.signals.filters.savgol_weights`).
-        cutoff: Butterworth cutoff [Hz] (one pass, -3 dB).
-        butter_order: Butterworth order n.
-    """
-
-    window: int = 151
-    poly_order: int = 4
-    weights: SavgolWeights = "uniform"
-    cutoff: float = 10.0
-    butter_order: int = 6
 
 
 @dataclass(frozen=True, eq=False)

@@ -57,7 +57,7 @@ from wbfriction.model.loading import build_model
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.sim.common import InjectedFriction
-from wbfriction.sim.sensors import SensorNoise
+from wbfriction.sim.options import SensorNoise
 
 GENERATOR = "wbfriction.sim.arm.simulate_arm"
 

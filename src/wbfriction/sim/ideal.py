@@ -32,74 +32,18 @@ foot's zero acceleration in the estimator assumes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Literal, get_args
-
 import numpy as np
 import pinocchio as pin
 
-from wbfriction.exceptions import InputError
 from wbfriction.friction.models import FrictionParams
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.sim.common import InjectedFriction, Recording, SimulationResult, injected_friction
 from wbfriction.sim.control import contact_jacobian, gain_schedule, pd_gains, reference_feedforward
+from wbfriction.sim.options import IdealOptions
 from wbfriction.walking import WalkingReference
 from wbfriction.walking.indexing import as_slice
 from wbfriction.walking.swing import foot_placement
-
-Integrator = Literal["semi-implicit", "explicit"]
-"""Euler integration of the ideal simulator."""
-INTEGRATORS: tuple[Integrator, ...] = get_args(Integrator)
-
-
-@dataclass(frozen=True)
-class IdealOptions:
-    """Parameters of :func:`simulate_ideal`.
-
-    Attributes:
-        substeps: physics steps per control period (the study uses 10: see
-            :data:`wbfriction.studies.simulation.SIMULATOR`).
-        integrator: one of :data:`INTEGRATORS`. With one explicit Euler step per sample
-            the central second difference at ``k`` is the acceleration of sample ``k - 1``,
-            which no torque alignment matches (the thesis's setting: F_v up to 25 % off in
-            the study); with several substeps the log approaches continuous time.
-        bandwidth: joint PD bandwidth [Hz]; damping: its damping ratio.
-        gain_blend: time over which PD gains rise to those of a new contact state [s]
-            (a landing leg's small tracking error times the stance gains would
-            otherwise pull the foot on the ground); falling gains apply at once.
-        baumgarte: (Kp [1/s^2], Kd [1/s]) of the contact and position-control constraints.
-        log_base: write the base pose to the log (and its true twist and acceleration).
-        force_torque: write what the robot's force-torque sensors measure
-            (:attr:`~wbfriction.model.robot.Robot.ft_sensors`, columns ``wrench.<sensor>.*``: the
-            contact wrenches and the motion of the part below each sensor,
-            :func:`~wbfriction.model.force_torque.sensor_readings`).
-        imu: write what the robot's IMU reads (:attr:`~wbfriction.model.robot.Robot.imu`, columns
-            ``imu.*``, :func:`~wbfriction.model.imu.imu_readings`).
-        projection: ``"sample"``: project the velocity onto the constraints at every
-            logged sample (the logged state satisfies ``J v = 0`` exactly: ground truth to
-            1e-9 N·m); ``"touch-down"``: only at contact changes, Baumgarte correcting the
-            drift (truth to about 1e-4 N·m).
-    """
-
-    substeps: int = 1
-    integrator: Integrator = "semi-implicit"
-    bandwidth: float = 15.0
-    damping: float = 0.9
-    gain_blend: float = 0.1
-    baumgarte: tuple[float, float] = (400.0, 40.0)
-    log_base: bool = True
-    projection: str = "sample"
-    force_torque: bool = False
-    imu: bool = False
-
-    def __post_init__(self) -> None:
-        if self.integrator not in INTEGRATORS:
-            raise InputError(f"unknown integrator '{self.integrator}': choose one of {', '.join(INTEGRATORS)}")
-        if self.projection not in ("sample", "touch-down"):
-            raise InputError(f"unknown projection '{self.projection}': choose sample or touch-down")
-        if self.substeps < 1:
-            raise InputError(f"substeps must be at least 1, got {self.substeps}")
 
 
 def _project_configuration(robot: Robot, data: pin.Data, q: np.ndarray, contacts: np.ndarray,

@@ -149,10 +149,10 @@ class MujocoRobot:
     imu_index: np.ndarray
 
     def wrenches(self, sensordata: np.ndarray) -> np.ndarray:
-        """The force-torque sensors' wrenches (n_sensors, 6) in :mod:`wbfriction.model.force_torque`'s
-        convention (the plate's push on the link, sensor frame) from MuJoCo's ``sensordata``, whose
-        force and torque sensors give the link's push on the plate."""
-        return -sensordata[self.ft_index]
+        """The force-torque sensors' wrenches (..., n_sensors, 6) in :mod:`wbfriction.model.force_torque`'s
+        convention (the plate's push on the link, sensor frame) from MuJoCo's ``sensordata`` (..., nsensordata),
+        whose force and torque sensors give the link's push on the plate."""
+        return -sensordata[..., self.ft_index]
 
     def qpos(self, q: np.ndarray) -> np.ndarray:
         """MuJoCo ``qpos`` (nq,) of a Pinocchio configuration (nq,)."""

@@ -53,8 +53,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal, get_args
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
@@ -67,119 +66,11 @@ from wbfriction.progress import Progress, counted
 from wbfriction.sim.common import InjectedFriction, Recording, SimulationResult, injected_friction
 from wbfriction.sim.control import attitude_ankle_torques, pd_from_inertia, pd_gains, ramp_gains, reference_feedforward
 from wbfriction.sim.mujoco_model import MujocoRobot, build_mujoco_robot
-from wbfriction.sim.sensors import SensorNoise
+from wbfriction.sim.options import MujocoOptions
 from wbfriction.walking import WalkingReference
 
 if TYPE_CHECKING:
     import mujoco
-
-FrictionMode = Literal["model", "mujoco"]
-"""How the MuJoCo simulator applies friction (module docstring)."""
-FRICTION_MODES: tuple[FrictionMode, ...] = get_args(FrictionMode)
-
-
-@dataclass(frozen=True)
-class MujocoOptions:
-    """Parameters of :func:`simulate_mujoco`.
-
-    Attributes:
-        substeps: physics steps per control period (the physics step is ``dt / substeps``).
-        bandwidth: PD bandwidth [Hz]; damping: its damping ratio.
-        max_gains: (kp [N·m/rad], kd [N·m·s/rad]) caps of every joint's gains.
-        gain_blend: time over which rising gains ramp to a new contact state's [s].
-        contact_threshold: normal force above which a sole counts as in contact [N].
-        friction: ``"model"`` (eq. 3.5 as a joint torque) or ``"mujoco"`` (MuJoCo's
-            ``frictionloss`` and ``damping``), module docstring.
-        sensors: sensor noise of the controller's and the log's measurements.
-        delay: time from a measurement to the command computed from it acting [s], a
-            whole number of control periods.
-        balance: (K [N·m/rad], D [N·m·s/rad]) of the base-attitude stabiliser on the
-            stance ankles (:func:`~wbfriction.sim.control.attitude_ankle_torques`); None:
-            the robot's :attr:`~wbfriction.model.robot.Robot.balance_gains`.
-        fall_height: the simulation stops with an error when the base drops below this
-            share of its initial height.
-        log_base: write the base pose to the log (and its true twist and acceleration).
-        force_torque: write what the robot's force-torque sensors measure (``wrench.<sensor>.*``):
-            MuJoCo's ``force`` and ``torque`` sensors between each sensor's link and the sole plate
-            below it (:func:`~wbfriction.sim.mujoco_model.build_mujoco_robot`), averaged over the
-            physics steps around the sample (:func:`matched_weights`), as a sensor that filters before it
-            samples (a soft contact's force varies within a period: its reading at one step, against
-            accelerations differentiated over two periods, was 6 times further off, 0.155 against
-            0.025 N·m median RMS, measured).
-        sole_timeconst: the soles' contact time constant [s] (MuJoCo's ``solref[0]``: how soft the
-            contact is); None: MuJoCo's default (0.02 s). A compliant rubber sole: larger.
-        torque_drift: rate [N·m/s] at which each torque sensor's offset drifts from zero over the walk
-            (the sign per joint drawn from ``sensors.seed``): a slow sensor drift, off by default.
-        ft_offset: standard deviations of constant offsets of the force-torque sensors' forces [N] and
-            torques [N·m], drawn per sensor and axis from ``sensors.seed``; off by default.
-        imu: write what the robot's IMU reads (``imu.*``: MuJoCo's ``gyro`` and ``accelerometer`` at its
-            frame, averaged over the physics steps around the sample as the wrenches).
-        imu_noise: standard deviations of the gyro's [rad/s] and the accelerometer's [m/s^2] white noise.
-        imu_bias: standard deviations of their constant biases, drawn per axis from ``sensors.seed``.
-    """
-
-    substeps: int = 4
-    bandwidth: float = 10.0
-    damping: float = 0.9
-    max_gains: tuple[float, float] = (3000.0, 60.0)
-    gain_blend: float = 0.1
-    contact_threshold: float = 50.0
-    friction: FrictionMode = "model"
-    sensors: SensorNoise = SensorNoise()
-    delay: float = 0.0
-    balance: tuple[float, float] | None = None
-    fall_height: float = 0.5
-    log_base: bool = True
-    force_torque: bool = True
-    sole_timeconst: float | None = None
-    torque_drift: float = 0.0
-    ft_offset: tuple[float, float] = (0.0, 0.0)
-    imu: bool = True
-    imu_noise: tuple[float, float] = (0.0, 0.0)
-    imu_bias: tuple[float, float] = (0.0, 0.0)
-
-    def __post_init__(self) -> None:
-        if self.substeps < 1:
-            raise InputError(f"substeps must be at least 1, got {self.substeps}")
-        if self.contact_threshold <= 0:
-            raise InputError("the contact threshold must be a positive force [N]")
-        if self.friction not in FRICTION_MODES:
-            raise InputError(f"friction must be one of {', '.join(FRICTION_MODES)}, got '{self.friction}'")
-        if self.delay < 0:
-            raise InputError(f"the delay must be >= 0 s, got {self.delay}")
-        if self.sole_timeconst is not None and not self.sole_timeconst > 0:
-            raise InputError(f"the soles' contact time constant must be > 0 s, got {self.sole_timeconst}")
-        if self.torque_drift < 0 or min(self.ft_offset) < 0 or min(self.imu_noise) < 0 or min(self.imu_bias) < 0:
-            raise InputError("the torque drift rate and the standard deviations of the force-torque offsets and "
-                             "of the IMU's noise and biases must be >= 0")
-
-    def imu_errors(self, n: int) -> np.ndarray:
-        """The IMU's white noise plus constant biases over ``n`` periods (n, 6): gyro [rad/s], accelerometer
-        [m/s^2], from :attr:`imu_noise`, :attr:`imu_bias` and the sensors' seed (zeros where off)."""
-        rng = np.random.default_rng([self.sensors.seed, 6])
-        noise = rng.normal(0.0, 1.0, (n, 6)) * np.repeat(np.asarray(self.imu_noise, dtype=float), 3)
-        return noise + rng.normal(0.0, 1.0, 6) * np.repeat(np.asarray(self.imu_bias, dtype=float), 3)
-
-    def imperfections(self, n: int, dt: float, n_tau: int, n_sensors: int) -> tuple[np.ndarray, np.ndarray]:
-        """The torque sensors' drifting offsets (n, n_tau) [N·m] over ``n`` periods of ``dt`` and the force-torque
-        sensors' constant offsets (n_sensors, 6) [N, N·m], from :attr:`torque_drift`, :attr:`ft_offset` and the
-        sensors' seed (zeros where off)."""
-        rng = np.random.default_rng([self.sensors.seed, 23])
-        drift = np.arange(n)[:, None] * dt * self.torque_drift * rng.choice([-1.0, 1.0], n_tau)
-        scale = np.repeat(np.asarray(self.ft_offset, dtype=float), 3)
-        return drift, rng.normal(0.0, 1.0, (n_sensors, 6)) * scale
-
-    def delay_periods(self, dt: float) -> int:
-        """:attr:`delay` in control periods of ``dt`` seconds.
-
-        Raises:
-            InputError: the delay is not a whole number of periods.
-        """
-        d = self.delay / dt
-        if abs(d - round(d)) > 1e-6:
-            raise InputError(f"the delay ({self.delay * 1e3:g} ms) must be a multiple of the control period "
-                             f"({dt * 1e3:g} ms)")
-        return int(round(d))
 
 
 def matched_weights(substeps: int) -> np.ndarray:
@@ -211,7 +102,7 @@ def set_mujoco_friction(model: mujoco.MjModel, dofs: np.ndarray, injected: Injec
     model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)
 
 
-def mujoco_friction_torque(data: mujoco.MjData, dofs: np.ndarray) -> np.ndarray:
+def mujoco_friction_torque(data: mujoco.MjData, dofs: np.ndarray | slice) -> np.ndarray:
     """Joint friction MuJoCo applied on ``dofs`` at the last step [N·m]: the friction-loss
     constraint forces (rows ``mjCNSTR_FRICTION_DOF``, whose Jacobian is the dof's unit
     vector) plus the damper forces."""
@@ -220,6 +111,51 @@ def mujoco_friction_torque(data: mujoco.MjData, dofs: np.ndarray) -> np.ndarray:
     force = data.qfrc_damper.copy()
     force[data.efc_id[rows]] += data.efc_force[rows]
     return force[dofs]
+
+
+def index_or_slice(index: np.ndarray) -> np.ndarray | slice:
+    """``index`` as a slice if it is a run of consecutive increasing integers (a slice reads a view and
+    writes without a gather: cheaper at every physics step), else unchanged."""
+    index = np.asarray(index)
+    if index.size and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
+        return slice(int(index[0]), int(index[0]) + index.size)
+    return index
+
+
+class MatchedMeans:
+    """The :func:`matched_weights` means (n, m) of a signal read at every physics step, reduced in blocks.
+
+    The simulation writes each period's readings into :meth:`period`'s rows (substeps, m); every
+    ``block`` periods (and at the last one) they are reduced at once. The sums add the terms in the order
+    a running sum over the steps would (sample ``k``: the previous period's steps, then its own, each
+    ``weight * reading``), so the means are the same numbers, with one array copy per step in Python.
+    Memory: ``block + 1`` periods of readings.
+    """
+
+    def __init__(self, n: int, substeps: int, m: int, block: int = 1024) -> None:
+        """Means of ``n`` periods of ``substeps`` readings of ``m`` values."""
+        self.weights = matched_weights(substeps)
+        self.out = np.zeros((n, m))
+        self.block = min(block, n)
+        self.raw = np.zeros((self.block + 1, substeps, m))  # row 0: the period before the block's first
+        self.start = 0
+
+    def period(self, k: int) -> np.ndarray:
+        """Where the readings of period ``k``'s physics steps go (substeps, m): a view to write into."""
+        return self.raw[k - self.start + 1]
+
+    def done(self, k: int) -> None:
+        """Period ``k``'s readings are in: reduce the block if it is full or ``k`` is the last period."""
+        stop = k + 1
+        if stop - self.start == self.block or stop == len(self.out):
+            raw = self.raw[:stop - self.start + 1]
+            acc = self.out[self.start:stop]
+            for s, w in enumerate(self.weights[:, 1]):  # the previous period's steps, in order
+                acc += w * raw[:-1, s]
+            for s, w in enumerate(self.weights[:, 0]):  # then the period's own
+                acc += w * raw[1:, s]
+            self.raw[0] = raw[-1]
+            self.start = stop
 
 
 class _MujocoRun:
@@ -243,9 +179,10 @@ class _MujocoRun:
         self.tc, self.pc = robot.tc_index, robot.pc_index
         self.nc, self.n_act = len(robot.contact_frames), len(robot.actuated)
         self.joints_f = self.injected.joints
-        self.dof_f = self.mjr.dof_index[self.tc][self.joints_f]
+        dof_f = self.mjr.dof_index[self.tc][self.joints_f]
+        self.dof_f = index_or_slice(dof_f)
         if native:
-            set_mujoco_friction(self.model, self.dof_f, self.injected)
+            set_mujoco_friction(self.model, dof_f, self.injected)
         if options.sole_timeconst is not None:
             self.model.geom_solref[list(self.mjr.sole_geoms), 0] = options.sole_timeconst
         self.data = mujoco.MjData(self.model)
@@ -284,19 +221,20 @@ class _MujocoRun:
     def _setup_state(self) -> None:
         """The initial state (the reference's first sample), the log buffers, the controller's state."""
         import mujoco
-        data, mjr, ref, n, nc, n_act = self.data, self.mjr, self.ref, self.n, self.nc, self.n_act
+        model, data, mjr, ref, n, nc, n_act = self.model, self.data, self.mjr, self.ref, self.n, self.nc, self.n_act
         data.qpos[:] = mjr.qpos(ref.q[0])
         data.qvel[:] = mjr.velocity_map(ref.q[0]) @ ref.v[0]
-        mujoco.mj_forward(self.model, data)
+        mujoco.mj_forward(model, data)
         self.z0 = data.qpos[2]
 
-        self.qpos, self.qvel = np.empty((n, self.model.nq)), np.empty((n, self.model.nv))
-        self.q_meas, self.qdd = np.empty((n, n_act)), np.empty((n, n_act))
-        self.base_qacc = np.empty((n, 6))
-        self.tau_sensed = np.zeros((n, self.tc.size))
-        self.ft = np.zeros((n, len(self.robot.ft_sensors), 6))
-        self.imu = np.zeros((n, self.mjr.imu_index.size))
-        self.weights = matched_weights(self.options.substeps)
+        self.qpos, self.qvel = np.empty((n, model.nq)), np.empty((n, model.nv))
+        self.q_meas = np.empty((n, n_act))
+        self.qacc = np.empty((n, model.nv))  # at each period's first physics step
+        self.tau_motor = np.empty((n, model.nu))  # the motors' torques (actuators in Robot.actuated order), held
+        self.tau_f_first = np.zeros((n, len(self.joints_f)))  # friction applied at each period's first step
+        # what MuJoCo's sensors (sensordata: touch, force-torque, IMU) and the torque sensors read, averaged
+        self.sensor_means = MatchedMeans(n, self.options.substeps, model.nsensordata)
+        self.motor_means = MatchedMeans(n, self.options.substeps, model.nu)
         self.recording = Recording(self.robot, ref, self.injected)
         self.contact, self.force = np.zeros((n, nc), dtype=bool), np.zeros((n, nc))
         self.commands = np.zeros((self.delay + 1, n_act))  # ring buffer: the command of period k acts at k + delay
@@ -304,16 +242,18 @@ class _MujocoRun:
         self.before: tuple[np.ndarray, np.ndarray] | None  # the gains (kp, kd) when it began, at period k_switch
         self.state, self.k_switch, self.before = None, 0, None
         self.kp_act[self.tc], self.kd_act[self.tc] = self.gains[tuple(bool(x) for x in ref.contact[0])]
-        self.tau_f = np.zeros(len(self.joints_f))
         self.torque_friction = bool(self.joints_f) and not self.native  # (3.5) applied by us at every physics step
-        self.bad_qacc = int(mujoco.mjtWarning.mjWARN_BADQACC)
+        self.measured = tuple(bool(x) for x in ref.contact[0])  # the contacts sensed over the last period
+        self.noisy_q = bool(self.eps_q.any())
+        self.qpos_act = index_or_slice(mjr.qpos_index)
+        self.touch = index_or_slice(mjr.touch_index)
+        self.bad_qacc = data.warning.number[int(mujoco.mjtWarning.mjWARN_BADQACC):][:1]  # a view: the count
 
     def sample(self, k: int) -> None:
         """Run the control period of sample ``k``: measure, command, step the physics, sense the contacts."""
         qd_meas = self.measure(k)
         self.actuate(k, self.control(k, qd_meas))
-        for s in range(self.options.substeps):
-            self.step(k, s)
+        self.physics(k)
         self.sense_contacts(k)
 
     def actuate(self, k: int, command: np.ndarray) -> None:
@@ -324,22 +264,24 @@ class _MujocoRun:
 
     def measure(self, k: int) -> np.ndarray:
         """Log the state at the start of period ``k`` and the measured positions; the measured velocities."""
-        data = self.data
-        self.qpos[k], self.qvel[k] = data.qpos, data.qvel
-        self.q_meas[k] = self.options.sensors.encoder(data.qpos[self.mjr.qpos_index] + self.eps_q[k])
-        return (self.q_meas[k] - self.q_meas[k - 1]) / self.dt if k > 0 else self.v_ref[0]
+        data, q = self.data, self.q_meas[k]
+        self.qpos[k], self.qvel[k], q[:] = data.qpos, data.qvel, data.qpos[self.qpos_act]
+        if self.noisy_q:
+            q += self.eps_q[k]
+        q[:] = self.options.sensors.encoder(q)
+        return (q - self.q_meas[k - 1]) / self.dt if k > 0 else self.v_ref[0]
 
     def control(self, k: int, qd_meas: np.ndarray) -> np.ndarray:
         """The command of period ``k``: feed-forward, PD on the measurements, the attitude stabiliser."""
         # the controller knows the contact measured over the last period (the plan at first)
-        last = self.contact[k - 1] if k > 0 and self.contact[k - 1].any() else self.ref.contact[k]
-        self.schedule_gains(k, tuple(bool(x) for x in last))
+        last = self.measured if k > 0 and any(self.measured) else tuple(self.ref.contact[k].tolist())
+        self.schedule_gains(k, last)
         command = (self.tau_ff[k] + self.kp_act * (self.q_ref[k] - self.q_meas[k])
                    + self.kd_act * (self.v_ref[k] - qd_meas))
         if self.stabilise:
             data = self.data
             R = data.xmat[self.mjr.base_body].reshape(3, 3)
-            load = (self.force[k - 1] if k > 0 else np.ones(self.nc)) * last
+            load = (self.force[k - 1] if k > 0 else np.ones(self.nc)) * np.array(last)
             torques = attitude_ankle_torques(R, R @ data.qvel[3:6], self.R_ref[k], self.w_ref[k], self.balance,
                                              [data.xaxis[j] for j in self.ankle_jnt], load)
             for a, t in zip(self.ankles, torques):
@@ -356,32 +298,34 @@ class _MujocoRun:
             self.kp_act[tc], self.kd_act[tc] = ramp_gains(self.before, self.gains[self.state],
                                                           (k - self.k_switch) * dt, blend)
 
-    def step(self, k: int, s: int) -> None:
-        """Physics step ``s`` of period ``k`` with the friction of eq. (3.5) if ours; the first one is logged.
-        The sensors' readings of the step (motor torques, wrenches, IMU) go to samples ``k`` and ``k + 1`` with
-        the weights of :func:`matched_weights`."""
+    def physics(self, k: int) -> None:
+        """The physics steps of period ``k``, with the friction of eq. (3.5) if ours; the first one is logged
+        (:meth:`record`). Every step's sensor readings (MuJoCo's sensors, the motor torques) go to the
+        matched means (:class:`MatchedMeans`)."""
         import mujoco
-        if self.torque_friction:
-            self.tau_f = self.injected.torque(self.data.qvel[self.dof_f])
-            self.data.qfrc_applied[self.dof_f] = self.tau_f
-        mujoco.mj_step(self.model, self.data)  # the sensors are computed with the step's qacc, before its integration
-        if s == 0:
-            self.record(k)
-        now, nxt = self.weights[s]
-        readings = (self.data.actuator_force[self.tc], self.mjr.wrenches(self.data.sensordata),
-                    self.data.sensordata[self.mjr.imu_index])
-        for buffer, reading in zip((self.tau_sensed, self.ft, self.imu), readings):
-            buffer[k] += now * reading
-            if k + 1 < self.n:
-                buffer[k + 1] += nxt * reading
+        model, data, step = self.model, self.data, mujoco.mj_step
+        qvel, applied, sensordata, motor = data.qvel, data.qfrc_applied, data.sensordata, data.actuator_force
+        sensed, motors = self.sensor_means.period(k), self.motor_means.period(k)
+        friction, dof_f, torque = self.torque_friction, self.dof_f, self.injected.torque
+        for s in range(len(sensed)):
+            if friction:
+                tau_f = torque(qvel[dof_f])
+                applied[dof_f] = tau_f
+                if s == 0:
+                    self.tau_f_first[k] = tau_f
+            step(model, data)  # the sensors are computed with the step's qacc, before its integration
+            if s == 0:
+                self.record(k)
+            sensed[s], motors[s] = sensordata, motor
+        self.sensor_means.done(k)
+        self.motor_means.done(k)
 
     def record(self, k: int) -> None:
-        """Log the period's first physics step: joint accelerations, motor torques, friction applied."""
+        """Log the period's first physics step: accelerations, motor torques, MuJoCo's friction if used."""
         data = self.data
-        self.qdd[k] = data.qacc[self.mjr.dof_index]
-        self.base_qacc[k] = data.qacc[:6]
-        tau_f = mujoco_friction_torque(data, self.dof_f) if self.native else self.tau_f
-        self.recording.record_torques(k, data.actuator_force[self.tc], tau_f)
+        self.qacc[k], self.tau_motor[k] = data.qacc, data.actuator_force
+        if self.native:
+            self.tau_f_first[k] = mujoco_friction_torque(data, self.dof_f)
 
     def sense_contacts(self, k: int) -> None:
         """The soles' normal forces over period ``k``, from its last step, and the contacts; stop at a fall.
@@ -389,34 +333,41 @@ class _MujocoRun:
         Raises:
             SimulationError: the robot fell or the simulation diverged.
         """
-        data = self.data
-        self.force[k] = data.sensordata[self.mjr.touch_index]
-        self.contact[k] = self.force[k] > self.options.contact_threshold
+        data, force, contact = self.data, self.force[k], self.contact[k]
+        force[:] = data.sensordata[self.touch]
+        np.greater(force, self.options.contact_threshold, out=contact)
+        self.measured = tuple(contact.tolist())
         if (not np.isfinite(data.qpos).all() or data.qpos[2] < self.options.fall_height * self.z0
-                or data.warning.number[self.bad_qacc] > 0):
+                or self.bad_qacc[0] > 0):
             raise SimulationError(f"the robot fell (or the simulation diverged) at t = {self.ref.time[k]:.3f} s")
 
     def result(self) -> SimulationResult:
         """The log (measured positions and contacts, noisy torques) and the result of the run."""
-        robot, mjr = self.robot, self.mjr
+        robot, mjr, recording = self.robot, self.mjr, self.recording
         Q, V = mjr.q(self.qpos), mjr.v(self.qpos, self.qvel)
-        first = self.weights[:, 0].sum()  # sample 0 has no period before it: its readings' weights sum to this
-        for buffer in (self.tau_sensed, self.ft, self.imu):
-            buffer[0] /= first
+        # what Recording.record_torques would have logged sample by sample
+        recording.tau[:] = self.tau_motor[:, self.tc]
+        recording.tau_f[:, self.joints_f] = self.tau_f_first
+        # sample 0 has no period before it: its readings' weights sum to this
+        first = matched_weights(self.options.substeps)[:, 0].sum()
+        sensed, tau_sensed = self.sensor_means.out, self.motor_means.out[:, self.tc]
+        sensed[0] /= first
+        tau_sensed[0] /= first
+        ft, imu_read = mjr.wrenches(sensed), sensed[:, mjr.imu_index]
         Q_meas = Q.copy()
         Q_meas[:, robot.act_q_index] = self.q_meas
         A = np.full((self.n, robot.model.nv), np.nan)
-        A[:, robot.act_v_index] = self.qdd
-        A[:, :6] = mjr.base_acceleration(self.qpos, self.qvel, self.base_qacc)
-        self.recording.wrench[:, :, 2] = self.force
+        A[:, robot.act_v_index] = self.qacc[:, mjr.dof_index]
+        A[:, :6] = mjr.base_acceleration(self.qpos, self.qvel, self.qacc[:, :6])
+        recording.wrench[:, :, 2] = self.force
         drift, ft_offset = self.options.imperfections(self.n, self.dt, self.tc.size, len(robot.ft_sensors))
-        imu = self.imu + self.options.imu_errors(self.n) if self.imu.shape[1] and self.options.imu else None
-        return self.recording.result(Q, V, A, self.contact, "wbfriction.sim.mujoco_sim.simulate_mujoco", self.options,
-                                     Q_log=Q_meas, tau_noise=self.eps_tau + drift,
-                                     sensor_wrench=self.ft + ft_offset if self.options.force_torque else None,
-                                     imu=imu, tau_sensed=self.tau_sensed,
-                                     torque_alignment="sample",  # readings matched to the positions' sampling
-                                     contact_source=f"sole normal force > {self.options.contact_threshold:g} N")
+        imu = imu_read + self.options.imu_errors(self.n) if imu_read.shape[1] and self.options.imu else None
+        return recording.result(Q, V, A, self.contact, "wbfriction.sim.mujoco_sim.simulate_mujoco", self.options,
+                                Q_log=Q_meas, tau_noise=self.eps_tau + drift,
+                                sensor_wrench=ft + ft_offset if self.options.force_torque else None,
+                                imu=imu, tau_sensed=tau_sensed,
+                                torque_alignment="sample",  # readings matched to the positions' sampling
+                                contact_source=f"sole normal force > {self.options.contact_threshold:g} N")
 
 
 def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[str, FrictionParams] | None = None,

@@ -13,58 +13,11 @@ scored against ``tau_f_true`` on realistic data (thesis ch. 7). The true columns
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import asdict, dataclass
-
-import numpy as np
+from dataclasses import asdict
 
 from wbfriction.exceptions import InputError
 from wbfriction.logs.log import Log
-
-
-@dataclass(frozen=True)
-class SensorNoise:
-    """Sensor imperfections (all off by default).
-
-    Attributes:
-        position_std: standard deviation of the joint-position noise [rad].
-        encoder_bits: encoder resolution in bits per turn (e.g. 19), or None for none.
-        torque_std: standard deviation of the torque-sensor noise [N·m].
-        seed: seed of the noise generator (same seed, same noise).
-    """
-
-    position_std: float = 0.0
-    encoder_bits: int | None = None
-    torque_std: float = 0.0
-    seed: int = 0
-
-    def __post_init__(self) -> None:
-        if self.position_std < 0 or self.torque_std < 0:
-            raise InputError("sensor noise standard deviations must be >= 0")
-        if self.encoder_bits is not None and not 1 <= self.encoder_bits <= 52:
-            raise InputError(f"encoder bits must be between 1 and 52, got {self.encoder_bits}")
-
-    @property
-    def resolution(self) -> float | None:
-        """Encoder step [rad], or None."""
-        return None if self.encoder_bits is None else 2.0 * np.pi / 2.0**self.encoder_bits
-
-
-    @property
-    def active(self) -> bool:
-        """Whether the sensors change anything."""
-        return self.position_std > 0 or self.encoder_bits is not None or self.torque_std > 0
-
-    def draw(self, n: int, n_q: int, n_tau: int) -> tuple[np.ndarray, np.ndarray]:
-        """The position (n, n_q) [rad] and torque (n, n_tau) [N·m] noise of ``n`` samples,
-        from :attr:`seed` (zeros where a noise is off)."""
-        rng = np.random.default_rng(self.seed)
-        eps_q = rng.normal(0.0, self.position_std, (n, n_q)) if self.position_std > 0 else np.zeros((n, n_q))
-        eps_tau = rng.normal(0.0, self.torque_std, (n, n_tau)) if self.torque_std > 0 else np.zeros((n, n_tau))
-        return eps_q, eps_tau
-
-    def encoder(self, q: np.ndarray) -> np.ndarray:
-        """Positions [rad] as the encoder reads them: rounded to its resolution, if any."""
-        return q if self.resolution is None else np.round(q / self.resolution) * self.resolution
+from wbfriction.sim.options import SensorNoise
 
 
 def apply_sensor_noise(log: Log, noise: SensorNoise) -> Log:

@@ -16,7 +16,7 @@ from wbfriction.friction.fit import FitResult, fit_joints
 from wbfriction.friction.models import PARAM_NAMES, FrictionParams
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.model.robot import Robot
-from wbfriction.sim import IdealOptions
+from wbfriction.sim.options import IdealOptions
 from wbfriction.studies.thesis import TABLE_6_1, TABLE_6_2, thesis_number
 
 SIMULATOR = IdealOptions(substeps=10)

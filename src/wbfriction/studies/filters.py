@@ -19,19 +19,23 @@ from pathlib import Path
 import numpy as np
 import pyarrow as pa
 
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.fit import fit_joints
 from wbfriction.friction.models import PARAM_NAMES, FrictionParams
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import Log
 from wbfriction.logs.tables import write_json, write_table
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
 from wbfriction.report.figures import filter_curves_figure
-from wbfriction.signals.kinematics import Diff, FilterOptions
-from wbfriction.sim import SensorNoise, apply_sensor_noise, simulate_ideal
+from wbfriction.signals.kinematics import Diff
+from wbfriction.signals.options import FilterOptions
+from wbfriction.sim import apply_sensor_noise, simulate_ideal
+from wbfriction.sim.options import SensorNoise
 from wbfriction.studies.common import ENCODER_BITS, SIMULATOR, TORQUE_STD, leg_joints, right_knee
-from wbfriction.walking import GaitOptions, walking_reference
+from wbfriction.walking import walking_reference
+from wbfriction.walking.options import GaitOptions
 from wbfriction.workers import process_pool
 
 LEVELS: tuple[float | None, ...] = (None, 0.0, 1e-5, 1e-4, 1e-3)

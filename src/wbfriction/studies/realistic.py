@@ -27,9 +27,10 @@ from pathlib import Path
 
 import numpy as np
 
-from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_log
+from wbfriction.friction.estimate import FrictionEstimate, estimate_log
 from wbfriction.friction.io import friction_table, write_params
 from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.contacts import normal_forces, sensed_contacts
 from wbfriction.logs.log import Log, write_log
@@ -39,9 +40,10 @@ from wbfriction.progress import StageProgress
 from wbfriction.report.build import make_report
 from wbfriction.report.figures import friction_curves_figure, velocity_panels_figure
 from wbfriction.report.html import write_report
-from wbfriction.signals.kinematics import FilterOptions
-from wbfriction.sim import MujocoOptions, SensorNoise, SimulationResult, simulate_mujoco
+from wbfriction.signals.options import FilterOptions
+from wbfriction.sim import SimulationResult, simulate_mujoco
 from wbfriction.sim.mujoco_model import MujocoRobot, build_mujoco_robot
+from wbfriction.sim.options import MujocoOptions, SensorNoise
 from wbfriction.studies.common import (
     ENCODER_BITS,
     TORQUE_STD,
@@ -54,7 +56,8 @@ from wbfriction.studies.common import (
     right_knee,
     worst_errors,
 )
-from wbfriction.walking import GaitOptions, walking_reference
+from wbfriction.walking import walking_reference
+from wbfriction.walking.options import GaitOptions
 
 THESIS_ROUTE = EstimateOptions(base_motion="contact", wrenches=False)
 """The thesis's route: base motion from the rigid stance contact, the ankle sensors' wrenches left

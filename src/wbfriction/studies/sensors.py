@@ -22,16 +22,20 @@ from pathlib import Path
 
 import numpy as np
 
-from wbfriction.friction.estimate import EstimateOptions, FrictionEstimate, estimate_log
+from wbfriction.friction.estimate import FrictionEstimate, estimate_log
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import Log, write_log
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
-from wbfriction.signals.kinematics import Diff, FilterOptions
-from wbfriction.sim import MujocoOptions, SensorNoise, simulate_mujoco
+from wbfriction.signals.kinematics import Diff
+from wbfriction.signals.options import FilterOptions
+from wbfriction.sim import simulate_mujoco
+from wbfriction.sim.options import MujocoOptions, SensorNoise
 from wbfriction.studies.common import LegJoint, fit_legs, leg_joints
 from wbfriction.studies.thesis import TABLE_6_2
-from wbfriction.walking import GaitOptions, walking_reference
+from wbfriction.walking import walking_reference
+from wbfriction.walking.options import GaitOptions
 
 SUBSTEPS = 16
 """MuJoCo physics steps per control period in this study. The simulator applies friction (3.5) from each

@@ -19,10 +19,11 @@ from pathlib import Path
 import numpy as np
 
 from wbfriction.friction.energy import energy_consistency
-from wbfriction.friction.estimate import EstimateOptions, estimate_log
+from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.fit import fitted_offsets
 from wbfriction.friction.io import friction_table, write_params
 from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import write_log
 from wbfriction.logs.tables import write_table
@@ -42,7 +43,8 @@ from wbfriction.studies.common import (
     leg_rows,
     right_knee,
 )
-from wbfriction.walking import GaitOptions, walking_reference
+from wbfriction.walking import walking_reference
+from wbfriction.walking.options import GaitOptions
 
 DERIVATIVE_SCHEMES = {
     "true acceleration": EstimateOptions(diff="true", mask="single"),

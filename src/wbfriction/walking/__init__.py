@@ -1,7 +1,5 @@
 """Walking reference for a biped: footsteps, ZMP and LIPM centre of mass, swing feet, whole-body IK."""
 
-from wbfriction.walking.footsteps import GAITS, FootstepPlan, GaitOptions, Step, plan_footsteps
-from wbfriction.walking.reference import WalkingReference, standing_configuration, walking_reference
+import lazy_loader
 
-__all__ = ["GAITS", "FootstepPlan", "GaitOptions", "Step", "plan_footsteps", "WalkingReference",
-           "standing_configuration", "walking_reference"]
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

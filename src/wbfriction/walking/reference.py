@@ -27,8 +27,9 @@ from wbfriction.exceptions import InputError, ModelError
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.walking.com import lipm_com, zmp_reference
-from wbfriction.walking.footsteps import FootstepPlan, GaitOptions, plan_footsteps
+from wbfriction.walking.footsteps import FootstepPlan, plan_footsteps
 from wbfriction.walking.indexing import as_slice
+from wbfriction.walking.options import GaitOptions
 from wbfriction.walking.swing import feet_trajectory, quintic
 
 LWA = pin.LOCAL_WORLD_ALIGNED

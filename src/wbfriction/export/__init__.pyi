@@ -1,0 +1,12 @@
+"""Names of :mod:`wbfriction.export`, imported on first use (:func:`lazy_loader.attach_stub`)."""
+
+from .isaac import isaac_actuator_dict as isaac_actuator_dict
+from .isaac import write_isaac_yaml as write_isaac_yaml
+from .mapping import JointExport as JointExport
+from .mapping import joint_export as joint_export
+from .mapping import joint_exports as joint_exports
+from .mjcf import mujoco_model as mujoco_model
+from .mjcf import mujoco_spec as mujoco_spec
+from .mjcf import urdf_spec as urdf_spec
+from .mjcf import write_mjcf as write_mjcf
+from .urdf import write_friction_urdf as write_friction_urdf

@@ -1,0 +1,90 @@
+"""The choices a user makes about the friction estimate and its checks, in a module that imports nothing
+heavy: the command line shows their defaults in its help without loading NumPy, SciPy or Pinocchio."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Literal, get_args
+
+from wbfriction.exceptions import InputError
+from wbfriction.signals.options import FilterOptions
+
+if TYPE_CHECKING:
+    from wbfriction.signals.kinematics import Diff, TorqueAlignment, Velocity
+    from wbfriction.signals.phases import Mask
+
+BaseMotion = Literal["auto", "contact", "logged", "imu"]
+"""Where the base's motion comes from: the rigid contacts (the thesis's route), the logged base pose
+differentiated like the joints, the IMU (its gyro and accelerometer, the logged base orientation), or
+``auto`` (:func:`~wbfriction.friction.measured.resolve_base_motion`)."""
+BASE_MOTIONS: tuple[BaseMotion, ...] = get_args(BaseMotion)
+
+Method = Literal["rnea", "kkt"]
+"""The single-support route: one RNEA pass on the stance-rooted tree, or the KKT system (5.10-5.13)."""
+METHODS: tuple[Method, ...] = get_args(Method)
+
+
+@dataclass(frozen=True)
+class EstimateOptions:
+    """Options of the estimator (defaults from the thesis).
+
+    Attributes:
+        diff: differentiation scheme: ``central``, ``backward``, ``savgol``, ``butterworth``
+            (:mod:`~wbfriction.signals.kinematics`, :mod:`~wbfriction.signals.filters`), ``true``,
+            or ``auto``: chosen from the log's positions with its window or cutoff
+            (:func:`~wbfriction.friction.estimate.resolve_differentiation`; the command line's default), once per log.
+        compensate_delay: shift the derivatives by their delay (6.1.2).
+        torque_alignment: ``zoh`` (mean of tau[k-1], tau[k]), ``sample``, or ``auto``
+            (what the log's metadata declares, else ``zoh``).
+        lift_off_skip: seconds dropped after a lift-off [s] (6.2.1: 0.10).
+        touch_down_skip: seconds dropped before a touch-down [s] (6.2.1: 0.05).
+        mask: ``swing`` (a leg joint counts only while its leg swings) or ``single``.
+        ds_weight: diagonal of W in (6.1), scalar or (n_tc,): relative weights of the
+            joints' acceleration residuals (dimensionless).
+        ds_regularization: diagonal of Lambda in (6.1), scalar or (n_tc,)
+            [(rad/s^2)^2 / (N·m)^2 with W = 1]; it competes with ``A^T W A``, whose
+            entries are of the order of (1 / joint inertia)^2.
+        condition_number: report cond(M_mod^{-1}) per sample (one KKT inverse per sample).
+        method: single-support route, ``rnea`` (default) or ``kkt``.
+        filtering: parameters of the ``savgol`` and ``butterworth`` schemes.
+        velocity: ``differentiated`` or ``logged`` (the log's ``qd.<joint>``:
+            :func:`~wbfriction.signals.kinematics.measure`).
+        acceleration_difference: also give ``Delta qdd`` (5.12) in single support
+            (``M_mod^{-1} tau_f``, one ``crba`` per sample on the stance-rooted tree and a
+            batched solve); the KKT route always has it.
+        base_motion: where the base's motion comes from (:data:`~wbfriction.friction.measured.BaseMotion`):
+            ``contact`` (rigid contacts), ``logged`` (the base pose differentiated like the joints),
+            ``auto`` (:func:`~wbfriction.friction.measured.resolve_base_motion`).
+        wrenches: use the force-torque sensors' wrenches where the log has them: every joint's
+            friction in every phase (:func:`~wbfriction.friction.measured.wrench_route`).
+    """
+
+    diff: Diff | Literal["auto"] = "central"
+    compensate_delay: bool = True
+    torque_alignment: TorqueAlignment | Literal["auto"] = "auto"
+    lift_off_skip: float = 0.10
+    touch_down_skip: float = 0.05
+    mask: Mask = "swing"
+    ds_weight: float | tuple[float, ...] = 1.0
+    ds_regularization: float | tuple[float, ...] = 1e-3
+    condition_number: bool = False
+    method: Method = "rnea"
+    filtering: FilterOptions = FilterOptions()
+    acceleration_difference: bool = True
+    velocity: Velocity = "differentiated"
+    base_motion: BaseMotion = "auto"
+    wrenches: bool = True
+
+    def __post_init__(self) -> None:
+        if self.base_motion not in BASE_MOTIONS:
+            raise InputError(f"unknown base motion '{self.base_motion}': choose one of {', '.join(BASE_MOTIONS)}")
+
+
+DEFAULT_THRESHOLD = 0.05
+"""Share of power-generating samples above which an estimate is flagged (5 %): exact
+models give well under 1 % (the remainder: velocity sign errors of the differentiation
+around reversals, measured on the ideal simulator's combined walk)."""
+
+
+DEFAULT_TOLERANCE = 0.01
+"""Friction torques smaller than this do not count as generating power [N·m]."""

@@ -1,0 +1,12 @@
+"""Names of :mod:`wbfriction.model`, imported on first use (:func:`lazy_loader.attach_stub`)."""
+
+from .dynamics import ConstrainedDynamics as ConstrainedDynamics
+from .dynamics import constrained_dynamics as constrained_dynamics
+from .layout import JointLayout as JointLayout
+from .loading import build_robot as build_robot
+from .loading import load_robot as load_robot
+from .robot import Robot as Robot
+from .robots import BUILTIN_ROBOTS as BUILTIN_ROBOTS
+from .stance import StanceModel as StanceModel
+from .stance import stance_frame_pose as stance_frame_pose
+from .stance import stance_model as stance_model
