@@ -14,6 +14,7 @@ from wbfriction.model.force_torque import sensor_readings
 from wbfriction.model.imu import imu_readings
 from wbfriction.model.robot import Robot
 from wbfriction.walking import WalkingReference
+from wbfriction.walking.indexing import as_slice
 
 
 @dataclass
@@ -154,12 +155,13 @@ class Recording:
         self.tau = np.empty((n, n_tc))
         self.tau_f = np.zeros((n, n_tc))
         self.wrench = np.zeros((n, len(robot.contact_frames), 6))
+        self._friction_columns = as_slice(friction.joints)
 
     def record_torques(self, k: int, tau: np.ndarray, tau_f: np.ndarray | None) -> None:
         """Log sample ``k``'s measured torques and the friction of the joints that have some."""
         self.tau[k] = tau
         if self.friction.joints:
-            self.tau_f[k, self.friction.joints] = tau_f
+            self.tau_f[k, self._friction_columns] = tau_f
 
     def result(self, Q: np.ndarray, V: np.ndarray, A: np.ndarray, contact: np.ndarray, generator: str, options,
                *, Q_log: np.ndarray | None = None, tau_noise: np.ndarray | None = None, log_sensors: bool = False,

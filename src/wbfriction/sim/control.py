@@ -72,7 +72,6 @@ def feedforward(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, conta
     Raises:
         ValueError: a sample with no foot in contact.
     """
-    model, data = robot.model, robot.model.createData()
     iv, iq = robot.act_v_index, robot.act_q_index
     n, nc = len(q), len(robot.contact_frames)
     n_active = contact.sum(axis=1)
@@ -86,19 +85,46 @@ def feedforward(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, conta
             sole_pose = np.tile([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0], (rows.size, 1))  # flat; the result is invariant
             tau[rows], wrench[rows, c] = stance_model(robot, c).inverse_dynamics(
                 sole_pose, q[rows][:, iq], v[rows][:, iv], a[rows][:, iv])
-    for k in np.flatnonzero(n_active > 1):
-        b = pin.rnea(model, data, q[k], v[k], a[k])
-        pin.computeJointJacobians(model, data, q[k])
-        pin.updateFramePlacements(model, data)
-        active = np.flatnonzero(contact[k])
-        Jc = contact_jacobian(robot, data, contact[k])
-        Jb = Jc[:, :6]
-        w_inv = np.repeat(np.maximum(share[k, active], min_share), 6)
-        JW = Jb * w_inv[:, None]
-        lam = JW @ np.linalg.solve(Jb.T @ JW, b[:6])
-        tau[k] = b[iv] - Jc[:, iv].T @ lam
-        wrench[k, active] = lam.reshape(-1, 6)
+    double = np.flatnonzero(n_active > 1)
+    if double.size:
+        tau[double], wrench[double] = _shared_wrench_dynamics(robot, q[double], v[double], a[double],
+                                                              contact[double], share[double], min_share)
     return tau, wrench
+
+
+def _shared_wrench_dynamics(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, contact: np.ndarray,
+                            share: np.ndarray, min_share: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`feedforward` of samples with several feet in contact: the weighted minimum-norm
+    sharing of the module docstring.
+
+    ``b = M a + h`` comes from one batched RNEA (``pin.rneaInParallel``), the contact
+    Jacobians (LOCAL) from Pinocchio sample by sample, the sharing from batched linear algebra.
+
+    Args:
+        q (n, nq), v, a (n, nv): reference states; contact: active contacts (n, n_contacts);
+        share: each foot's share (n, n_contacts), floored at ``min_share``.
+
+    Returns:
+        tau (n, n_act) [N·m] and wrenches (n, n_contacts, 6), zero for feet not in contact.
+    """
+    model, data = robot.model, robot.model.createData()
+    iv = robot.act_v_index
+    n, nc = len(q), len(robot.contact_frames)
+    b = pin.rneaInParallel(1, pin.ModelPool(model, 1), q.T, v.T, a.T).T  # (n, nv)
+    # stacked Jacobians of all feet (n, 6 n_contacts, nv), those not in contact zeroed
+    Jc = np.zeros((n, 6 * nc, model.nv))
+    feet = [[(slice(6 * c, 6 * c + 6), robot.contact_frame_ids[c]) for c in np.flatnonzero(row)] for row in contact]
+    for k in range(n):
+        pin.computeJointJacobians(model, data, q[k])  # getFrameJacobian places the frame from its joint
+        for rows, f in feet[k]:
+            Jc[k, rows] = pin.getFrameJacobian(model, data, f, pin.LOCAL)
+    Jb = Jc[:, :, :6]
+    w_inv = np.repeat(np.where(contact, np.maximum(share, min_share), 0.0), 6, axis=1)  # (n, 6 nc)
+    JW = Jb * w_inv[:, :, None]
+    mu = np.linalg.solve(np.einsum("nij,nik->njk", Jb, JW), b[:, :6, None])  # (n, 6, 1)
+    lam = (JW @ mu)[:, :, 0]  # (n, 6 nc), zero off contact
+    tau = b[:, iv] - np.einsum("nij,ni->nj", Jc[:, :, iv], lam)
+    return tau, lam.reshape(n, nc, 6)
 
 
 def constrained_inverse_inertia(robot: Robot, data: pin.Data, q: np.ndarray, contacts: np.ndarray) -> np.ndarray:

@@ -42,6 +42,7 @@ from wbfriction.sim.common import InjectedFriction, Recording, SimulationResult,
 from wbfriction.sim.control import contact_jacobian, gain_schedule, pd_gains, reference_feedforward
 from wbfriction.sim.options import IdealOptions
 from wbfriction.walking import WalkingReference
+from wbfriction.walking.indexing import as_slice
 from wbfriction.walking.swing import foot_placement
 
 
@@ -77,18 +78,34 @@ def _solve_small(A: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _constraints(robot: Robot, data: pin.Data, active: np.ndarray, anchors: dict[int, pin.SE3],
-                 baumgarte: tuple[float, float]) -> tuple[list, list]:
-    """6D rigid constraints welding the ``active`` soles to their anchors, initialised in ``data``."""
-    models = []
+                 baumgarte: tuple[float, float]
+                 ) -> tuple[pin.StdVec_RigidConstraintModel, pin.StdVec_RigidConstraintData]:
+    """6D rigid constraints welding the ``active`` soles to their anchors, initialised in ``data``.
+
+    Returned as Pinocchio's own vectors: a Python list would be converted (copied) at every
+    dynamics call, a third of ``constraintDynamics``'s time on TALOS."""
+    models = pin.StdVec_RigidConstraintModel()
     for c in np.flatnonzero(active):
         fr = robot.model.frames[robot.contact_frame_ids[c]]
         cm = pin.RigidConstraintModel(pin.ContactType.CONTACT_6D, robot.model, fr.parentJoint, fr.placement,
                                       0, anchors[int(c)], pin.LOCAL)
         cm.setBaumgarteCorrectorParameters(pin.BaumgarteCorrectorParameters(*baumgarte))
         models.append(cm)
-    datas = [cm.createData() for cm in models]
+    datas = pin.StdVec_RigidConstraintData()
+    for cm in models:
+        datas.append(cm.createData())
     pin.initConstraintDynamics(robot.model, data, models, datas)
     return models, datas
+
+
+def _unstack_wrenches(stacked: np.ndarray, contact: np.ndarray, wrench: np.ndarray) -> None:
+    """Write the wrenches of the active feet, stacked in contact order per sample (N, 6 n_contacts),
+    into ``wrench`` (N, n_contacts, 6) at their feet (the rows of inactive feet untouched)."""
+    slot = np.cumsum(contact, axis=1) - 1  # position of each active foot in the stack
+    stacked = stacked.reshape(len(stacked), -1, 6)
+    for c in range(contact.shape[1]):
+        rows = np.flatnonzero(contact[:, c])
+        wrench[rows, c] = stacked[rows, slot[rows, c]]
 
 
 class _IdealRun:
@@ -105,28 +122,32 @@ class _IdealRun:
 
         tau_ff = reference_feedforward(robot, reference)
         gains = pd_gains(robot, reference.q[0], options.bandwidth, options.damping)
-        self.kp_all, self.kd_all = gain_schedule(gains, reference.contact, dt, options.gain_blend)
+        kp, kd = gain_schedule(gains, reference.contact, dt, options.gain_blend)
         self.bkp, self.bkd = options.baumgarte
 
         iv, iq = robot.act_v_index, robot.act_q_index
         tc, self.pc = robot.tc_index, robot.pc_index
-        self.iv_tc, self.iv_pc, self.iq_tc, self.iq_pc = iv[tc], iv[self.pc], iq[tc], iq[self.pc]
+        self.iv_tc, self.iv_pc = as_slice(iv[tc]), as_slice(iv[self.pc])
         self.joints_f = injected.joints
-        self.iv_f = self.iv_tc[self.joints_f]
+        self.iv_f = as_slice(iv[tc][self.joints_f])
         self.settings = pin.ProximalSettings(1e-12, 1e-10, 50)
         self.semi_implicit = options.integrator == "semi-implicit"
         self.project_every_sample = options.projection == "sample"
-        # the reference, contiguous per sample
-        ref = reference
-        self.ff_tc = np.ascontiguousarray(tau_ff[:, tc])
-        self.q_ref_tc = np.ascontiguousarray(ref.q[:, self.iq_tc])
-        self.v_ref_tc = np.ascontiguousarray(ref.v[:, self.iv_tc])
-        self.q_ref_pc, self.v_ref_pc, self.a_ref_pc = ref.q[:, self.iq_pc], ref.v[:, self.iv_pc], ref.a[:, self.iv_pc]
+        # one PD law per sample on the actuated joints, torque-controlled then position-controlled:
+        # u = offset + kp (q_ref - q) + kd (v_ref - v); for the former the torque command
+        # (feed-forward plus PD), for the latter the stabilised reference acceleration (the
+        # Baumgarte gains). The reference and gains are contiguous per sample.
+        ref, act, ones = reference, np.concatenate([tc, self.pc]), np.ones((n, self.pc.size))
+        self.iq_act, self.iv_act = as_slice(iq[act]), as_slice(iv[act])
+        self.pd_offset = np.hstack([tau_ff[:, tc], ref.a[:, iv[self.pc]]])
+        self.pd_kp, self.pd_kd = np.hstack([kp, self.bkp * ones]), np.hstack([kd, self.bkd * ones])
+        self.pd_q, self.pd_v = np.ascontiguousarray(ref.q[:, iq[act]]), np.ascontiguousarray(ref.v[:, iv[act]])
         self.switches = set(np.flatnonzero(np.any(np.diff(ref.contact, axis=0, prepend=False), axis=1)).tolist())
 
         self.Q = np.empty((n, self.model.nq))
         self.V = np.empty((n, self.model.nv))
         self.A = np.empty((n, self.model.nv))
+        self.lam = np.zeros((n, 6 * len(robot.contact_frames)))  # logged wrenches of the active feet, stacked
         self.recording = Recording(robot, reference, injected)
         self.q, self.v = ref.q[0].copy(), ref.v[0].copy()
         self.anchors: dict[int, pin.SE3] = {}
@@ -135,18 +156,71 @@ class _IdealRun:
         self.tau = np.zeros(self.model.nv)
         self.tau_f: np.ndarray | None = None
 
-    def sample(self, k: int) -> None:
-        """Run the control period of sample ``k``: contact changes, projection, control, physics steps."""
-        switch = k in self.switches
-        if switch:
-            self.switch_contacts(k)
-        # velocity onto the constraints (plastic impact at touch-down, drift otherwise)
-        if switch or self.project_every_sample:
-            self.v = pin.impulseDynamics(self.model, self.data, self.q, self.v, self.cmodels, self.cdatas, 0.0,
-                                         self.settings).copy()
-        tau_cmd = self.control(k)
-        for s in range(self.options.substeps):
-            self.step(k, s == 0, tau_cmd)
+    def run(self, progress: Progress | None = None) -> None:
+        """Simulate every sample: contact changes, velocity projection, control, physics steps, log.
+
+        Per control period ``k`` (the module docstring): the velocity is projected onto the
+        contacts, the controller's torque (feed-forward plus PD) is held over the
+        ``substeps`` physics steps; each step solves the constrained dynamics with friction,
+        gives the position-controlled joints their reference acceleration (stabilised) from
+        the same KKT factorisation, and integrates; the first step of the period is logged.
+        The loop runs a thousand times per simulated second: the state, the buffers and
+        Pinocchio's functions are held in locals.
+        """
+        model, data, settings, opts = self.model, self.data, self.settings, self.options
+        impulse_dynamics, constraint_dynamics, integrate = pin.impulseDynamics, pin.constraintDynamics, pin.integrate
+        add, negative, subtract = np.add, np.negative, np.subtract
+        iv_tc, iv_pc, iv_f, iq_act, iv_act = self.iv_tc, self.iv_pc, self.iv_f, self.iq_act, self.iv_act
+        offset, kp, kd, q_ref, v_ref = self.pd_offset, self.pd_kp, self.pd_kd, self.pd_q, self.pd_v
+        n_tc, h, friction = self.robot.tc_index.size, self.h, self.injected.torque if self.joints_f else None
+        position_controlled, semi_implicit, project = self.pc.size > 0, self.semi_implicit, self.project_every_sample
+        Q, V, A, lam_log, record_torques = self.Q, self.V, self.A, self.lam, self.recording.record_torques
+        switches, tau, tau_pc, tau_f = self.switches, self.tau, self.tau_pc, self.tau_f
+        q, v = self.q, self.v
+        for k in counted(len(self.ref), progress):
+            switch = k in switches
+            if switch:
+                self.q = q
+                self.switch_contacts(k)
+                q, cmodels, cdatas, n_lam, rows_pc, rhs, baumgarte = (
+                    self.q, self.cmodels, self.cdatas, self.n_lam, self.rows_pc, self.rhs, self.baumgarte_rhs)
+                kkt_rows_f, kkt_rows_a = slice(0, n_lam), slice(n_lam, None)
+            # velocity onto the constraints (plastic impact at touch-down, drift otherwise)
+            if switch or project:
+                v = impulse_dynamics(model, data, q, v, cmodels, cdatas, 0.0, settings).copy()
+            for s in range(opts.substeps):
+                u = offset[k] + kp[k] * (q_ref[k] - q[iq_act]) + kd[k] * (v_ref[k] - v[iv_act])
+                if s == 0:  # the torque command, held over the period
+                    tau_cmd = u[:n_tc]
+                tau[iv_tc] = tau_cmd
+                if friction is not None:
+                    tau_f = friction(v[iv_f])
+                    tau[iv_f] += tau_f
+                tau[iv_pc] = tau_pc
+                a = constraint_dynamics(model, data, q, v, tau, cmodels, cdatas, settings)
+                lam = data.lambda_c
+                if s == 0:  # Pinocchio's contact_acceleration_error is -(Kp placement + Kd velocity error)
+                    for cd, out in baumgarte:
+                        negative(cd.contact_acceleration_error.np, out=out)
+                # unit-torque responses of the position-controlled joints, and the Baumgarte term's
+                X = data.constraint_chol.solve(rhs)
+                if position_controlled:  # acceleration = reference, stabilised (u's last entries)
+                    delta = _solve_small(X[rows_pc, :-1], u[n_tc:] - a[iv_pc])
+                    dX = X[:, :-1] @ delta  # the response: forces, then accelerations
+                    a, lam = a + dX[kkt_rows_a], lam - dX[kkt_rows_f]
+                    tau_pc = tau_pc + delta
+                if s == 0:  # log: the true acceleration and wrenches (the Baumgarte term taken off both)
+                    Q[k], V[k] = q, v
+                    add(a, X[kkt_rows_a, -1], out=A[k])
+                    subtract(lam, X[kkt_rows_f, -1], out=lam_log[k, :n_lam])
+                    record_torques(k, tau_cmd, tau_f)
+                if semi_implicit:
+                    v = v + h * a
+                    q = integrate(model, q, h * v)
+                else:
+                    q = integrate(model, q, h * v)
+                    v = v + h * a
+        self.q, self.v, self.tau_pc, self.tau_f = q, v, tau_pc, tau_f
 
     def switch_contacts(self, k: int) -> None:
         """Anchor the feet landing at sample ``k``, project onto them, and rebuild the contact constraints."""
@@ -163,65 +237,16 @@ class _IdealRun:
         # one right-hand side per position-controlled joint (unit torque) and one for
         # the contacts' Baumgarte term
         self.rhs = np.zeros((self.n_lam + self.model.nv, self.pc.size + 1))
-        self.rhs[self.n_lam + self.iv_pc, np.arange(self.pc.size)] = 1.0
-
-    def control(self, k: int) -> np.ndarray:
-        """The torque command of the torque-controlled joints at sample ``k``: feed-forward plus PD."""
-        return (self.ff_tc[k] + self.kp_all[k] * (self.q_ref_tc[k] - self.q[self.iq_tc])
-                + self.kd_all[k] * (self.v_ref_tc[k] - self.v[self.iv_tc]))
-
-    def step(self, k: int, first: bool, tau_cmd: np.ndarray) -> None:
-        """One physics step of period ``k`` under ``tau_cmd``; the ``first`` one is the logged sample."""
-        a, X, lam = self.dynamics(first, tau_cmd)
-        if self.pc.size:  # position-controlled joints: acceleration = reference, stabilised
-            lam = self.position_control(k, a, X, lam)
-        if first:
-            self.record(k, tau_cmd, a, X, lam)
-        h = self.h
-        if self.semi_implicit:
-            self.v = self.v + h * a
-            self.q = pin.integrate(self.model, self.q, h * self.v)
-        else:
-            self.q = pin.integrate(self.model, self.q, h * self.v)
-            self.v = self.v + h * a
-
-    def dynamics(self, first: bool, tau_cmd: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Constrained forward dynamics with friction: the acceleration, the KKT solves, the contact forces."""
-        tau = self.tau
-        tau[self.iv_tc] = tau_cmd
-        if self.joints_f:
-            self.tau_f = self.injected.torque(self.v[self.iv_f])
-            tau[self.iv_f] += self.tau_f
-        tau[self.iv_pc] = self.tau_pc
-        a = pin.constraintDynamics(self.model, self.data, self.q, self.v, tau, self.cmodels, self.cdatas,
-                                   self.settings).copy()
-        if first:
-            self.rhs[:self.n_lam, -1] = np.concatenate([self.bkp * cd.contact_placement_error.vector
-                                                        + self.bkd * cd.contact_velocity_error.vector
-                                                        for cd in self.cdatas])
-        X = self.data.constraint_chol.solve(self.rhs)
-        return a, X, self.data.lambda_c
-
-    def position_control(self, k: int, a: np.ndarray, X: np.ndarray, lam: np.ndarray) -> np.ndarray:
-        """Give the position-controlled joints the reference acceleration (``a`` in place); the new forces."""
-        n_lam, iv_pc = self.n_lam, self.iv_pc
-        a_des = (self.a_ref_pc[k] + self.bkd * (self.v_ref_pc[k] - self.v[iv_pc])
-                 + self.bkp * (self.q_ref_pc[k] - self.q[self.iq_pc]))
-        delta = _solve_small(X[n_lam + iv_pc, :-1], a_des - a[iv_pc])
-        a += X[n_lam:, :-1] @ delta
-        lam = lam - X[:n_lam, :-1] @ delta
-        self.tau_pc = self.tau_pc + delta
-        return lam
-
-    def record(self, k: int, tau_cmd: np.ndarray, a: np.ndarray, X: np.ndarray, lam: np.ndarray) -> None:
-        """Log sample ``k``: the state, the true acceleration (without the Baumgarte term), torques, wrenches."""
-        self.Q[k], self.V[k], self.A[k] = self.q, self.v, a + X[self.n_lam:, -1]
-        self.recording.record_torques(k, tau_cmd, self.tau_f)
-        # the wrenches that go with that acceleration (the Baumgarte term taken off both)
-        self.recording.wrench[k, self.active] = (lam - X[:self.n_lam, -1]).reshape(-1, 6)
+        rows_pc = self.n_lam + self.robot.act_v_index[self.pc]  # KKT rows of their accelerations
+        self.rhs[rows_pc, np.arange(self.pc.size)] = 1.0
+        self.rows_pc = as_slice(rows_pc)
+        # each contact's data (a reference: iterating Pinocchio's vector costs microseconds) and
+        # its rows of the Baumgarte right-hand side (a view)
+        self.baumgarte_rhs = [(self.cdatas[i], self.rhs[6 * i:6 * i + 6, -1]) for i in range(len(self.cdatas))]
 
     def result(self) -> SimulationResult:
         """The log (planned contacts) and the result of the run."""
+        _unstack_wrenches(self.lam, self.ref.contact, self.recording.wrench)
         # semi-implicit Euler at the log rate: the central second difference at k is the
         # acceleration tau[k] caused; otherwise the torque is held over several steps
         alignment = "sample" if self.semi_implicit and self.options.substeps == 1 else "zoh"
@@ -250,6 +275,5 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
         InputError: a friction entry for a joint that is not torque-controlled.
     """
     run = _IdealRun(robot, reference, injected_friction(robot, friction), options)
-    for k in counted(len(reference), progress):
-        run.sample(k)
+    run.run(progress)
     return run.result()

@@ -21,14 +21,16 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from numpy.linalg import _umath_linalg
 
 from wbfriction.exceptions import InputError, ModelError
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.walking.com import lipm_com, zmp_reference
 from wbfriction.walking.footsteps import FootstepPlan, plan_footsteps
+from wbfriction.walking.indexing import as_slice
 from wbfriction.walking.options import GaitOptions
-from wbfriction.walking.swing import feet_trajectory, foot_placement, quintic
+from wbfriction.walking.swing import feet_trajectory, quintic
 
 LWA = pin.LOCAL_WORLD_ALIGNED
 
@@ -114,6 +116,55 @@ def _prescribed(robot: Robot, time: np.ndarray, amplitude: float, period: float 
     return q, qd, qdd
 
 
+@dataclass
+class _Tasks:
+    """The IK's targets at every sample (N samples), in the row order of :meth:`_WholeBodyIK._jacobian`.
+
+    Attributes:
+        sole_R: sole rotations (N, 2, 3, 3), flat with the planned yaw; sole_p: positions (N, 2, 3) [m].
+        com: centre of mass (N, 3) [m]; base_R: base rotation (N, 3, 3), upright with the feet's mean yaw.
+        xd: task velocities (N, 18) (feet: linear [m/s], angular [rad/s]; centre of mass; base angular);
+        xdd: task accelerations (N, 18).
+        free: angles (N, n_free), velocities and accelerations of the joints the IK does not solve.
+    """
+
+    sole_R: np.ndarray
+    sole_p: np.ndarray
+    com: np.ndarray
+    base_R: np.ndarray
+    xd: np.ndarray
+    xdd: np.ndarray
+    free: tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+def _yaw_rotations(yaw: np.ndarray) -> np.ndarray:
+    """Rotations (..., 3, 3) about the vertical by ``yaw`` (...) [rad], as
+    :func:`~wbfriction.walking.swing.foot_placement`'s."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    R = np.zeros(yaw.shape + (3, 3))
+    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1], R[..., 2, 2] = c, -s, s, c, 1.0
+    return R
+
+
+def _task_rates(feet: np.ndarray, com: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    """Task velocities or accelerations (N, 18) from the feet's x, y, z, yaw rates (N, 2, 4), the
+    centre of mass's (N, 3) and the base yaw's (N,): feet and base turn about the vertical only."""
+    x = np.zeros((len(com), 18))
+    for i in range(2):
+        x[:, 6 * i:6 * i + 3] = feet[:, i, :3]
+        x[:, 6 * i + 5] = feet[:, i, 3]
+    x[:, 12:15] = com
+    x[:, 17] = yaw
+    return x
+
+
+def _solve(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``A^-1 b`` for one small square system: the LAPACK routine of ``np.linalg.solve`` without
+    its per-call checks (half its time at 18 x 18; a singular ``A`` gives inf or nan, which
+    the IK's convergence test then reports)."""
+    return _umath_linalg.solve1(A, b)
+
+
 class _WholeBodyIK:
     """The square IK of the module docstring for one robot."""
 
@@ -125,73 +176,74 @@ class _WholeBodyIK:
         self.solved_act = np.array(legs, dtype=int)
         self.free_act = np.array([i for i in range(robot.n_act) if i not in legs], dtype=int)
         iv = robot.act_v_index
-        self.sel = np.concatenate([np.arange(6), iv[self.solved_act]])
-        self.rest = iv[self.free_act]
-        self.iq_free = robot.act_q_index[self.free_act]
-        if self.sel.size != 18:
-            raise ModelError(f"robot '{robot.name}': walking IK needs 6 joints per leg, got {self.sel.size - 6}")
+        if len(legs) + 6 != 18:
+            raise ModelError(f"robot '{robot.name}': walking IK needs 6 joints per leg, got {len(legs)}")
+        # slices where the indices are consecutive (views: cheaper in the per-sample loop)
+        self.sel = as_slice(np.concatenate([np.arange(6), iv[self.solved_act]]))
+        self.rest = as_slice(iv[self.free_act])
+        self.iq_free = as_slice(robot.act_q_index[self.free_act])
+        self.frames = robot.contact_frame_ids
+        self._J = np.empty((18, self.model.nv))
+        self._e = np.empty(18)
+        self._drift = np.zeros(18)
+        self._zero = np.zeros(self.model.nv)
 
     def _jacobian(self, q: np.ndarray) -> np.ndarray:
-        """Task Jacobian (18, nv): sole poses, centre of mass, base rotation."""
-        model, data = self.model, self.data
+        """Task Jacobian (18, nv): sole poses, centre of mass, base rotation (a buffer, overwritten
+        by the next call); leaves the soles' placements and the centre of mass in ``data``."""
+        model, data, J = self.model, self.data, self._J
         pin.computeJointJacobians(model, data, q)
-        pin.updateFramePlacements(model, data)
-        J = np.empty((18, model.nv))
-        for i, f in enumerate(self.robot.contact_frame_ids):
+        for i, f in enumerate(self.frames):  # getFrameJacobian also places the frame (data.oMf[f])
             J[6 * i:6 * i + 6] = pin.getFrameJacobian(model, data, f, LWA)
         J[12:15] = pin.jacobianCenterOfMass(model, data, True)
         J[15:18] = pin.getJointJacobian(model, data, 1, LWA)[3:]
         return J
 
-    def _error(self, targets: list[pin.SE3], com: np.ndarray, base_R: np.ndarray) -> np.ndarray:
-        data = self.data
-        e = np.empty(18)
-        for i, f in enumerate(self.robot.contact_frame_ids):
-            M = data.oMf[f]
-            e[6 * i:6 * i + 3] = targets[i].translation - M.translation
-            e[6 * i + 3:6 * i + 6] = pin.log3(targets[i].rotation @ M.rotation.T)
-        e[12:15] = com - data.com[0]
-        e[15:18] = pin.log3(base_R @ data.oMi[1].rotation.T)
+    def _error(self, tasks: _Tasks, k: int) -> np.ndarray:
+        """Task error (18,) at sample ``k`` after :meth:`_jacobian` (a buffer, overwritten by the next call)."""
+        data, e, oMf = self.data, self._e, self.data.oMf
+        sole_R, sole_p = tasks.sole_R[k], tasks.sole_p[k]
+        for i, f in enumerate(self.frames):
+            M = oMf[f]
+            e[6 * i:6 * i + 3] = sole_p[i] - M.translation
+            e[6 * i + 3:6 * i + 6] = pin.log3(sole_R[i] @ M.rotation.T)
+        e[12:15] = tasks.com[k] - data.com[0]
+        e[15:18] = pin.log3(tasks.base_R[k] @ data.oMi[1].rotation.T)
         return e
 
-    def solve(self, q_guess: np.ndarray, free: tuple[np.ndarray, np.ndarray, np.ndarray],
-              feet: np.ndarray, feet_d: np.ndarray, feet_dd: np.ndarray, com: tuple,
-              yaw: tuple[float, float, float], tol: float = 1e-11, max_iter: int = 20):
-        """Configuration, velocity and acceleration at one sample (see module docstring)."""
-        model, data = self.model, self.data
-        q = q_guess.copy()
-        q[self.iq_free] = free[0]
-        targets = [foot_placement(feet[i]) for i in range(2)]
-        base_R = foot_placement(np.array([0.0, 0.0, 0.0, yaw[0]])).rotation
+    def solve(self, q_guess: np.ndarray, tasks: _Tasks, k: int, tol: float = 1e-11, max_iter: int = 20
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Configuration (nq,), velocity and acceleration (nv,) at sample ``k`` (see module docstring),
+        by Newton iterations from ``q_guess`` (overwritten)."""
+        model, data, sel, rest = self.model, self.data, self.sel, self.rest
+        free_q, free_qd, free_qdd = (x[k] for x in tasks.free)
+        q = q_guess
+        q[self.iq_free] = free_q
         for _ in range(max_iter):
             J = self._jacobian(q)
-            e = self._error(targets, com[0], base_R)
-            if np.max(np.abs(e)) < tol:
+            e = self._error(tasks, k)
+            if abs(e).max() < tol:
                 break
             dv = np.zeros(model.nv)
-            dv[self.sel] = np.linalg.solve(J[:, self.sel], e)
+            dv[sel] = _solve(J[:, sel], e)
             q = pin.integrate(model, q, dv)
         else:
             raise ModelError(f"whole-body IK did not converge (residual {np.max(np.abs(e)):.2e}): "
                              "is the step reachable?")
-        Js, Jr = J[:, self.sel], J[:, self.rest]
-        Js_inv = np.linalg.inv(Js)
-        xd = np.concatenate([feet_d[0, :3], [0, 0, feet_d[0, 3]], feet_d[1, :3], [0, 0, feet_d[1, 3]],
-                             com[1], [0, 0, yaw[1]]])
+        Js, Jr = J[:, sel], J[:, rest]
+        Js_inv = _umath_linalg.inv(Js)
         v = np.zeros(model.nv)
-        v[self.rest] = free[1]
-        v[self.sel] = Js_inv @ (xd - Jr @ free[1])
+        v[rest] = free_qd
+        v[sel] = Js_inv @ (tasks.xd[k] - Jr @ free_qd)
         # drift Jd v: classical accelerations at zero joint acceleration
-        pin.centerOfMass(model, data, q, v, np.zeros(model.nv))
-        drift = np.zeros(18)
-        for i, f in enumerate(self.robot.contact_frame_ids):
+        pin.centerOfMass(model, data, q, v, self._zero)
+        drift = self._drift
+        for i, f in enumerate(self.frames):
             drift[6 * i:6 * i + 6] = pin.getFrameClassicalAcceleration(model, data, f, LWA).vector
         drift[12:15] = data.acom[0]
-        xdd = np.concatenate([feet_dd[0, :3], [0, 0, feet_dd[0, 3]], feet_dd[1, :3], [0, 0, feet_dd[1, 3]],
-                              com[2], [0, 0, yaw[2]]])
         a = np.zeros(model.nv)
-        a[self.rest] = free[2]
-        a[self.sel] = Js_inv @ (xdd - drift - Jr @ free[2])
+        a[rest] = free_qdd
+        a[sel] = Js_inv @ (tasks.xdd[k] - drift - Jr @ free_qdd)
         return q, v, a
 
 
@@ -230,14 +282,15 @@ def walking_reference(robot: Robot, options: GaitOptions = GaitOptions(), dt: fl
     free_q, free_qd, free_qdd = _prescribed(robot, time, options.pc_amplitude)
 
     ik = _WholeBodyIK(robot)
+    tasks = _Tasks(_yaw_rotations(feet[:, :, 3]), feet[:, :, :3], com, _yaw_rotations(yaw[0]),
+                   _task_rates(feet_d, com_d, yaw[1]), _task_rates(feet_dd, com_dd, yaw[2]),
+                   (free_q[:, ik.free_act], free_qd[:, ik.free_act], free_qdd[:, ik.free_act]))
     Q = np.empty((n, model.nq))
     V = np.empty((n, model.nv))
     A = np.empty((n, model.nv))
     q, v, a = q0, np.zeros(model.nv), np.zeros(model.nv)
-    for k in counted(n, progress):
-        guess = pin.integrate(model, q, v * dt + 0.5 * a * dt**2)
-        free = (free_q[k, ik.free_act], free_qd[k, ik.free_act], free_qdd[k, ik.free_act])
-        q, v, a = ik.solve(guess, free, feet[k], feet_d[k], feet_dd[k], (com[k], com_d[k], com_dd[k]),
-                           (yaw[0][k], yaw[1][k], yaw[2][k]))
+    dt2 = dt**2
+    for k in counted(n, progress):  # each sample starts from the previous one's motion
+        q, v, a = ik.solve(pin.integrate(model, q, v * dt + 0.5 * a * dt2), tasks, k)
         Q[k], V[k], A[k] = q, v, a
     return WalkingReference(time, Q, V, A, plan.contact(time), feet, com, zmp, plan)
