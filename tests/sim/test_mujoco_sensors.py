@@ -17,7 +17,7 @@ from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.sim import MujocoOptions, simulate_mujoco
 from wbfriction.sim.mujoco_model import build_mujoco_robot
-from wbfriction.sim.mujoco_sim import MatchedMeans, index_or_slice, matched_weights
+from wbfriction.sim.mujoco_sim import MatchedMeans, matched_weights
 from wbfriction.studies.common import leg_joints
 from wbfriction.walking import GaitOptions, walking_reference
 
@@ -167,17 +167,6 @@ def test_matched_means_are_the_running_sums_bit_for_bit(n, substeps, block, seed
         means.period(k)[:] = readings[k]
         means.done(k)
     assert np.array_equal(means.out, running)
-
-
-def test_index_or_slice():
-    """Runs of consecutive indices become slices (the same elements); other indices stay as they are."""
-    x = np.arange(10.0) * 3
-    for index in ([2, 3, 4], [0], [7, 8, 9]):
-        sl = index_or_slice(np.array(index))
-        assert isinstance(sl, slice) and np.array_equal(x[sl], x[index])
-    for index in ([3, 2], [1, 3], [0, 1, 1]):
-        assert not isinstance(index_or_slice(np.array(index)), slice)
-    assert not isinstance(index_or_slice(np.zeros(0, dtype=int)), slice)
 
 
 def test_the_logged_torque_is_the_matched_mean_of_the_motors(talos, mujoco_walk_4):

@@ -68,6 +68,7 @@ from wbfriction.sim.control import attitude_ankle_torques, pd_from_inertia, pd_g
 from wbfriction.sim.mujoco_model import MujocoRobot, build_mujoco_robot
 from wbfriction.sim.options import MujocoOptions
 from wbfriction.walking import WalkingReference
+from wbfriction.walking.indexing import as_slice
 
 if TYPE_CHECKING:
     import mujoco
@@ -111,15 +112,6 @@ def mujoco_friction_torque(data: mujoco.MjData, dofs: np.ndarray | slice) -> np.
     force = data.qfrc_damper.copy()
     force[data.efc_id[rows]] += data.efc_force[rows]
     return force[dofs]
-
-
-def index_or_slice(index: np.ndarray) -> np.ndarray | slice:
-    """``index`` as a slice if it is a run of consecutive increasing integers (a slice reads a view and
-    writes without a gather: cheaper at every physics step), else unchanged."""
-    index = np.asarray(index)
-    if index.size and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
-        return slice(int(index[0]), int(index[0]) + index.size)
-    return index
 
 
 class MatchedMeans:
@@ -180,7 +172,7 @@ class _MujocoRun:
         self.nc, self.n_act = len(robot.contact_frames), len(robot.actuated)
         self.joints_f = self.injected.joints
         dof_f = self.mjr.dof_index[self.tc][self.joints_f]
-        self.dof_f = index_or_slice(dof_f)
+        self.dof_f = as_slice(dof_f)
         if native:
             set_mujoco_friction(self.model, dof_f, self.injected)
         if options.sole_timeconst is not None:
@@ -245,8 +237,8 @@ class _MujocoRun:
         self.torque_friction = bool(self.joints_f) and not self.native  # (3.5) applied by us at every physics step
         self.measured = tuple(bool(x) for x in ref.contact[0])  # the contacts sensed over the last period
         self.noisy_q = bool(self.eps_q.any())
-        self.qpos_act = index_or_slice(mjr.qpos_index)
-        self.touch = index_or_slice(mjr.touch_index)
+        self.qpos_act = as_slice(mjr.qpos_index)
+        self.touch = as_slice(mjr.touch_index)
         self.bad_qacc = data.warning.number[int(mujoco.mjtWarning.mjWARN_BADQACC):][:1]  # a view: the count
 
     def sample(self, k: int) -> None:
