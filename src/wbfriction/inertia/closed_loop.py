@@ -11,9 +11,9 @@
 
 Each pass is kept, so that a user sees both routes' friction side by side and how the
 identification moved between passes. What does not depend on the model or on ``v_s`` is done once:
-the choice of differentiation (``diff = "auto"``), the split of the log's samples and the regressor rows
-of the given model (:func:`~wbfriction.inertia.identification.log_samples`). An armature identified in
-step 2 is the identified model's (``model.armature``): step 3's acceleration route uses it.
+the choice of differentiation (``diff = "auto"``) and the log's kinematics and split of its samples
+(:func:`~wbfriction.inertia.identification.log_samples`). An armature identified in step 2 is the
+identified model's (``model.armature``): step 3's acceleration route uses it.
 """
 
 from __future__ import annotations

@@ -366,24 +366,21 @@ def _active_time(log: Log) -> np.ndarray:
 @dataclass
 class LogSamples:
     """What the identifications of one log with one given model share (the closed loop's passes differ
-    only in the Stribeck term): the log's parts (:func:`_split`) and, per block of samples, the regressor
-    rows of the stance-rooted tree (N, n_tc, 10 nb) (rooted parameters), so that
-    ``pin.computeJointTorqueRegressor`` runs once per sample, not once per pass. Made by
-    :func:`log_samples`; the rows are filled as the first identification asks for them.
+    only in the Stribeck term): the log's kinematics and its training, validation and held-out samples
+    (:func:`_split`), made once by :func:`log_samples`. (The regressor rows are not kept: a long log's
+    would need memory of the size of the data, which the compressed least squares avoids.)
 
     Attributes:
-        robot: the given model (the regressor is the same for every inertia model: it is that of the tree).
+        robot: the given model.
         log: the log.
         key: the options the parts were split with (differentiation, holdout, validation, stride).
         parts: :func:`_split`'s parts.
-        regressor_rows: per (part, stance, samples) the rows ``Y`` (:func:`_regressor_rows`).
     """
 
     robot: Robot
     log: Log
     key: tuple
     parts: list[_Part]
-    regressor_rows: dict[tuple[int, int, bytes], np.ndarray] = field(default_factory=dict)
 
     def matches(self, robot: Robot, log: Log, estimate_options: EstimateOptions, options: InertialOptions) -> bool:
         """Whether these are the samples :func:`identify_inertia` would split from its arguments."""
@@ -404,27 +401,13 @@ def log_samples(robot: Robot, log: Log, estimate_options: EstimateOptions = Esti
                       _split(robot, log, estimate_options, options))
 
 
-def _regressor_rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int) -> np.ndarray:
-    """The torque-controlled joints' regressor rows (rooted parameters) of samples ``r`` standing on
-    contact ``c`` (len(r), n_tc, 10 nb)."""
-    reg = stance_regressor(robot, c)
-    pose = stance_frame_pose(robot, reg.stance, kin.q[r], None if kin.base is None else kin.base[r])
-    return reg.joint_rows(pose, kin.q[r], kin.qd[r], kin.qdd[r])[:, robot.tc_index]
-
-
-def _rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int, options: InertialOptions,
-          samples: LogSamples | None = None, part: int = 0):
+def _rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int, options: InertialOptions):
     """Regressor rows (rooted parameters), columns of the other parameters (friction, armature when
-    identified) and right-hand side of samples ``r`` (of part ``part`` of ``samples``, whose regressor
-    rows are kept there when given)."""
+    identified) and right-hand side of samples ``r``."""
+    reg = stance_regressor(robot, c)
     tc = robot.tc_index
-    if samples is None:
-        Y = _regressor_rows(robot, kin, r, c)
-    else:
-        key = (part, c, r.tobytes())
-        if key not in samples.regressor_rows:
-            samples.regressor_rows[key] = _regressor_rows(robot, kin, r, c)
-        Y = samples.regressor_rows[key]
+    pose = stance_frame_pose(robot, reg.stance, kin.q[r], None if kin.base is None else kin.base[r])
+    Y = reg.joint_rows(pose, kin.q[r], kin.qd[r], kin.qdd[r])[:, tc]
     stribeck = None if options.stribeck_joints is None else np.isin(robot.torque_controlled, options.stribeck_joints)
     C = _friction_columns(kin.qd[r][:, tc], options, stribeck)
     qdd_tc = kin.qdd[r][:, tc]
@@ -671,13 +654,13 @@ def _system(robot: Robot, samples: LogSamples, which: Literal["train", "validati
     n_rest = len(_rest_names(robot, options))
     p = 10 * nb + n_rest
     systems = {c: CompressedLeastSquares(p) for c in range(len(robot.contact_frames))}
-    for i, part in enumerate(samples.parts):
+    for part in samples.parts:
         kin, stance, rows = part.kin, part.stance, getattr(part, which)
         for c, system in systems.items():
             r = np.flatnonzero(rows & (stance == c))
             for start in range(0, r.size, options.block):
                 rr = r[start:start + options.block]
-                Y, C, b = _rows(robot, kin, rr, c, options, samples, i)
+                Y, C, b = _rows(robot, kin, rr, c, options)
                 system.add(np.concatenate([Y, C], axis=2).reshape(-1, p), b.ravel())
                 if progress is not None:
                     progress(rr.size)
@@ -749,13 +732,13 @@ def _held_out(robot: Robot, samples: LogSamples, pi0: np.ndarray, pi_fit: np.nda
         deltas.append(d.ravel())
     D = np.array(deltas).T if deltas else np.zeros((pi0.size, 0))  # (10 nb, G)
     out: dict[str, list[np.ndarray]] = {"measured": [], "given": [], "effects": [], "features": [], "arm": []}
-    for i, part in enumerate(samples.parts):
+    for part in samples.parts:
         kin, stance, rows = part.kin, part.stance, part.held
         for c in range(len(robot.contact_frames)):
             r = np.flatnonzero(rows & (stance == c))
             for start in range(0, r.size, 1000):
                 rr = r[start:start + 1000]
-                Y, C, b = _rows(robot, kin, rr, c, options, samples, i)
+                Y, C, b = _rows(robot, kin, rr, c, options)
                 T = stance_regressor(robot, c).to_rooted
                 out["measured"].append(b)
                 out["given"].append(Y @ (T @ pi0.ravel()))
