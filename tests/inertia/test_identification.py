@@ -6,6 +6,8 @@ motion does not excite kept at the prior and reported."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -23,7 +25,7 @@ from wbfriction.inertia.consistency import (
     prior_model,
     regularised_problem,
 )
-from wbfriction.inertia.identification import identify_inertia
+from wbfriction.inertia.identification import identify_inertia, log_samples
 from wbfriction.inertia.least_squares import CompressedLeastSquares, base_parameters
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import act_matrix, body_parameters, stance_regressor
@@ -224,6 +226,25 @@ def test_arm_identification_recovers_friction_and_armature(panda, panda_friction
     reported = [u for u in res.unexcited if u.parameter in pair]
     assert len(reported) == 1 and set(reported[0].partners) & pair, reported
     assert next(iter(reported[0].partners.values())) == pytest.approx(-1.0, rel=1e-6)
+
+
+def test_shared_samples_give_the_same_identification(panda, panda_friction, panda_log):
+    """The closed loop's passes share the log's kinematics and split (:func:`log_samples`): a second
+    identification with another Stribeck velocity, from the samples the first used, is bit for bit the one
+    made from scratch; samples split with other options are refused."""
+    options = _options(panda_friction)
+    shared = log_samples(panda, panda_log, ARM_ESTIMATE, options)
+    identify_inertia(panda, panda_log, ARM_ESTIMATE, options, shared=shared)
+    other = dataclasses.replace(options, stribeck_velocity=0.08)
+    reused = identify_inertia(panda, panda_log, ARM_ESTIMATE, other, shared=shared)
+    fresh = identify_inertia(panda, panda_log, ARM_ESTIMATE, other)
+    for name in ("pi", "friction", "pi_fit", "friction_fit", "armature"):
+        assert np.array_equal(getattr(reused, name), getattr(fresh, name)), name
+    for name in ("given", "given_with_friction", "identified", "validated"):
+        assert np.array_equal(getattr(reused.holdout, name), getattr(fresh.holdout, name)), name
+    assert (reused.message, reused.residual_std, reused.prior) == (fresh.message, fresh.residual_std, fresh.prior)
+    with pytest.raises(ValueError):
+        identify_inertia(panda, panda_log, ARM_ESTIMATE, dataclasses.replace(options, stride=2), shared=shared)
 
 
 def test_known_armature_reproduces_the_injected_friction(panda, panda_friction, panda_log):

@@ -10,8 +10,10 @@
    ``v_s``, and step 2 is repeated from the given model with it, ``passes`` times in all.
 
 Each pass is kept, so that a user sees both routes' friction side by side and how the
-identification moved between passes. An armature identified in step 2 is the identified model's
-(``model.armature``): step 3's acceleration route uses it.
+identification moved between passes. What does not depend on the model or on ``v_s`` is done once:
+the choice of differentiation (``diff = "auto"``) and the log's kinematics and split of its samples
+(:func:`~wbfriction.inertia.identification.log_samples`). An armature identified in step 2 is the
+identified model's (``model.armature``): step 3's acceleration route uses it.
 """
 
 from __future__ import annotations
@@ -22,14 +24,15 @@ from typing import Literal
 import numpy as np
 
 from wbfriction.friction.energy import JointEnergy, energy_consistency
-from wbfriction.friction.estimate import FrictionEstimate, estimate_log
+from wbfriction.friction.estimate import FrictionEstimate, estimate_log, resolve_differentiation
 from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.inertia.identification import InertialIdentification, identify_inertia
+from wbfriction.inertia.identification import InertialIdentification, identify_inertia, log_samples
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
+from wbfriction.signals.choice import DiffChoice
 
 
 @dataclass
@@ -68,10 +71,14 @@ class ClosedLoop:
 
 
 def acceleration_route(robot: Robot, log: Log, options: EstimateOptions, min_samples: int = 20,
-                       workers: int = 1) -> Route:
+                       workers: int = 1, choice: DiffChoice | None = None) -> Route:
     """Estimate (5.10-5.13) and fit (3.5) every torque-controlled joint (on ``workers``
-    processes), and check energy (7.9)."""
+    processes), and check energy (7.9). ``choice``: how ``options``' differentiation was chosen
+    (:func:`~wbfriction.friction.estimate.resolve_differentiation`, done once for several routes),
+    recorded in the estimate's metadata as :func:`~wbfriction.friction.estimate.estimate_log` does."""
     est = estimate_log(robot, log, options)
+    if choice is not None:
+        est.metadata["differentiation"] = choice.to_dict()
     fits = fit_estimate(est, min_samples=min_samples, workers=workers)
     return Route(est, fits, energy_consistency(est, fitted_offsets(fits)))
 
@@ -112,18 +119,20 @@ def identify(robot: Robot, log: Log, estimate_options: EstimateOptions = Estimat
             :func:`~wbfriction.inertia.identification.identify_inertia` raise.
     """
     say = progress or (lambda label: None)
+    estimate_options, choice = resolve_differentiation(estimate_options, log)  # once for every route and pass
     say("acceleration route with the given model")
-    given = acceleration_route(robot, log, estimate_options, workers=workers)
+    given = acceleration_route(robot, log, estimate_options, workers=workers, choice=choice)
     if stribeck != "auto":
         passes = 1
     v_s, joints = stribeck_velocity(given.fits) if stribeck == "auto" else (stribeck, None)
     done: list[LoopPass] = []
+    samples = log_samples(robot, log, estimate_options, options)  # the passes differ in v_s only
     for k in range(max(passes, 1)):
         say(f"identifying the inertia model (pass {k + 1}, v_s = {v_s if v_s is None else round(v_s, 4)})")
         ident = identify_inertia(robot, log, estimate_options,
-                                 replace(options, stribeck_velocity=v_s, stribeck_joints=joints))
+                                 replace(options, stribeck_velocity=v_s, stribeck_joints=joints), shared=samples)
         say(f"acceleration route with the identified model (pass {k + 1})")
-        route = acceleration_route(ident.robot, log, estimate_options, workers=workers)
+        route = acceleration_route(ident.robot, log, estimate_options, workers=workers, choice=choice)
         done.append(LoopPass(v_s, joints, ident, route))
         if stribeck == "auto":
             found = stribeck_velocity(route.fits)

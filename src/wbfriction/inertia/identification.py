@@ -308,6 +308,44 @@ def _active_time(log: Log) -> np.ndarray:
     return active
 
 
+@dataclass
+class LogSamples:
+    """What the identifications of one log with one given model share (the closed loop's passes differ
+    only in the Stribeck term): the log's kinematics and its training, validation and held-out samples
+    (:func:`_split`), made once by :func:`log_samples`. (The regressor rows are not kept: a long log's
+    would need memory of the size of the data, which the compressed least squares avoids.)
+
+    Attributes:
+        robot: the given model.
+        log: the log.
+        key: the options the parts were split with (differentiation, holdout, validation, stride).
+        parts: :func:`_split`'s parts.
+    """
+
+    robot: Robot
+    log: Log
+    key: tuple
+    parts: list[_Part]
+
+    def matches(self, robot: Robot, log: Log, estimate_options: EstimateOptions, options: InertialOptions) -> bool:
+        """Whether these are the samples :func:`identify_inertia` would split from its arguments."""
+        return self.robot is robot and self.log is log and self.key == _split_key(estimate_options, options)
+
+
+def _split_key(estimate_options: EstimateOptions, options: InertialOptions) -> tuple:
+    """The options :func:`_split` depends on."""
+    return estimate_options, options.holdout, options.validation, options.stride
+
+
+def log_samples(robot: Robot, log: Log, estimate_options: EstimateOptions = EstimateOptions(),
+                options: InertialOptions = InertialOptions()) -> LogSamples:
+    """The samples several :func:`identify_inertia` calls on ``log`` with the given model ``robot`` share
+    (:class:`LogSamples`); ``options``' Stribeck term may differ between the calls, not its holdout,
+    validation or stride."""
+    return LogSamples(robot, log, _split_key(estimate_options, options),
+                      _split(robot, log, estimate_options, options))
+
+
 def _rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int, options: InertialOptions):
     """Regressor rows (rooted parameters), columns of the other parameters (friction, armature when
     identified) and right-hand side of samples ``r``."""
@@ -361,7 +399,7 @@ def _prior(robot: Robot, pi0: np.ndarray, friction0: np.ndarray, torque_rms: np.
 
 def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions = EstimateOptions(),
                      options: InertialOptions = InertialOptions(),
-                     progress: Progress | None = None) -> InertialIdentification:
+                     progress: Progress | None = None, shared: LogSamples | None = None) -> InertialIdentification:
     """Identify every body's inertial parameters, the joints' Coulomb, viscous and offset friction
     and, if asked, their armature from a log with single-support stretches (a walk) or of a fixed-base
     robot (module docstring), starting from and regularised toward ``robot``'s model.
@@ -373,6 +411,8 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
             friction estimate (:class:`~wbfriction.friction.estimate.EstimateOptions`).
         options: :class:`InertialOptions`.
         progress: optional callable receiving numbers of samples done.
+        shared: the log's samples shared with other identifications of the same log and given model
+            (:func:`log_samples`: the closed loop's passes); None: split here.
 
     Returns:
         :class:`InertialIdentification`: its ``robot``/``pi``/``friction`` are the validated model's (the
@@ -382,12 +422,16 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
     Raises:
         InputError: no single-support sample to learn from, or none held out.
     """
-    parts = _split(robot, log, estimate_options, options)
+    if shared is None:
+        shared = log_samples(robot, log, estimate_options, options)
+    elif not shared.matches(robot, log, estimate_options, options):
+        raise ValueError("samples split from another robot, log or options")
+    parts = shared.parts
     nb, n_tc = robot.model.njoints - 1, len(robot.torque_controlled)
     k = len(friction_names(options))
     p_in = 10 * nb
-    fitting = _system(robot, parts, "train", options, progress)
-    validating = _system(robot, parts, "validation", options, progress)
+    fitting = _system(robot, shared, "train", options, progress)
+    validating = _system(robot, shared, "validation", options, progress)
     samples = (fitting.rows + validating.rows) // n_tc
     if samples == 0:
         raise InputError(f"{log.source}: no single-support sample to identify the inertia model from")
@@ -420,7 +464,7 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
     fit = fit_consistent(R, z, prior_of, prior * variance, lower, options.min_mass)
     bodies = tuple(robot.model.names[1:])
     groups = limbs(robot.model)
-    held = _held_out(robot, parts, pi0, fit.pi, groups, options)
+    held = _held_out(robot, shared, pi0, fit.pi, groups, options)
     if held.samples == 0:
         raise InputError(f"{log.source}: no single-support sample in the held-out {options.holdout:.0%} of the log")
     best_rest: dict[tuple[bool, ...], np.ndarray] = {}
@@ -546,16 +590,16 @@ def _rest_names(robot: Robot, options: InertialOptions) -> tuple[str, ...]:
     return names
 
 
-def _system(robot: Robot, parts: list[_Part], which: Literal["train", "validation"], options: InertialOptions,
+def _system(robot: Robot, samples: LogSamples, which: Literal["train", "validation"], options: InertialOptions,
             progress: Progress | None = None) -> CompressedLeastSquares:
-    """The compressed system of the rows ``which`` of every part (:func:`_split`), in
+    """The compressed system of the rows ``which`` of every part of ``samples`` (:func:`_split`), in
     the original bodies' parameters: per stance, built in its rooted parameters, then mapped."""
     import scipy.linalg
     nb = robot.model.njoints - 1
     n_rest = len(_rest_names(robot, options))
     p = 10 * nb + n_rest
     systems = {c: CompressedLeastSquares(p) for c in range(len(robot.contact_frames))}
-    for part in parts:
+    for part in samples.parts:
         kin, stance, rows = part.kin, part.stance, getattr(part, which)
         for c, system in systems.items():
             r = np.flatnonzero(rows & (stance == c))
@@ -618,9 +662,9 @@ class _HeldOut:
                          rms(self.predict(kept, rest_valid)))
 
 
-def _held_out(robot: Robot, parts: list[_Part], pi0: np.ndarray, pi_fit: np.ndarray, groups,
+def _held_out(robot: Robot, samples: LogSamples, pi0: np.ndarray, pi_fit: np.ndarray, groups,
               options: InertialOptions) -> _HeldOut:
-    """The held-out samples' arrays (:class:`_HeldOut`)."""
+    """The held-out samples' arrays (:class:`_HeldOut`) of the parts of ``samples``."""
     n_tc = len(robot.torque_controlled)
     k = len(friction_names(options))
     arm = options.armature == "identify"
@@ -633,7 +677,7 @@ def _held_out(robot: Robot, parts: list[_Part], pi0: np.ndarray, pi_fit: np.ndar
         deltas.append(d.ravel())
     D = np.array(deltas).T if deltas else np.zeros((pi0.size, 0))  # (10 nb, G)
     out: dict[str, list[np.ndarray]] = {"measured": [], "given": [], "effects": [], "features": [], "arm": []}
-    for part in parts:
+    for part in samples.parts:
         kin, stance, rows = part.kin, part.stance, part.held
         for c in range(len(robot.contact_frames)):
             r = np.flatnonzero(rows & (stance == c))
