@@ -17,7 +17,7 @@ import time
 from wbfriction.model.loading import load_robot
 from wbfriction.sim import MujocoOptions
 from wbfriction.sim.mujoco_model import build_mujoco_robot
-from wbfriction.sim.mujoco_sim import _MujocoRun
+from wbfriction.sim.mujoco_sim import MujocoRun
 from wbfriction.studies.realistic import NOISE
 from wbfriction.walking import GaitOptions, walking_reference
 
@@ -39,7 +39,7 @@ def main() -> None:
                            ("MuJoCo frictionloss + damping", MujocoOptions(friction="mujoco")),
                            ("friction (3.5), sensor noise, 2 ms delay", MujocoOptions(sensors=NOISE, delay=0.002))):
         clock = [_clock()]
-        run = _MujocoRun(robot, ref, None, options, mjr)  # what simulate_mujoco does, timed part by part
+        run = MujocoRun(robot, ref, None, options, mjr)  # what simulate_mujoco does, timed part by part
         clock.append(_clock())
         for k in range(len(ref)):
             run.sample(k)

@@ -239,13 +239,13 @@ _POINTS = {"coulomb-viscous": [0.3, 0.5, 0.05], "stribeck": [0.3, 0.5, 0.9, 0.15
 def test_filtered_problem_smooths_what_changes_only(model):
     """The filtered fit's residual and Jacobian equal the model and its whole Jacobian smoothed
     together, bit for bit, although the parameter-free columns are smoothed once."""
-    from wbfriction.friction.fit import _filtered_problem, model_jacobian, model_values
+    from wbfriction.friction.fit import filtered_problem, model_jacobian, model_values
     smoother = SavgolSmoother(11, 4, DT)
     qd = QD.copy()
     qd[1000:1010] = np.nan  # a gap the smoother leaves out
     y = smoother(model_values(1.1 * np.array(_POINTS[model]), qd, 2.0, model))
     use = np.isfinite(y)
-    residual, jacobian = _filtered_problem(qd, y, use, smoother, 2.0, model)
+    residual, jacobian = filtered_problem(qd, y, use, smoother, 2.0, model)
     rows = np.flatnonzero(use)
     for scale in (1.0, 1.3, 0.7):  # several points: the fixed columns are cached at the first
         x = scale * np.array(_POINTS[model])

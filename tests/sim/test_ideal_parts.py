@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from wbfriction.sim.ideal import _constraints, _unstack_wrenches
+from wbfriction.sim.ideal import contact_constraints, unstack_wrenches
 from wbfriction.walking import standing_configuration
 from wbfriction.walking.indexing import as_slice
-from wbfriction.walking.reference import _yaw_rotations
+from wbfriction.walking.reference import yaw_rotations
 from wbfriction.walking.swing import foot_placement
 
 
@@ -29,7 +29,7 @@ def test_baumgarte_term_is_minus_the_contact_acceleration_error(talos):
                for c, f in enumerate(talos.contact_frame_ids)}
     settings = pin.ProximalSettings(1e-12, 1e-10, 50)
     for active in ([True, True], [False, True]):
-        models, datas = _constraints(talos, data, np.array(active), anchors, (400.0, 40.0))
+        models, datas = contact_constraints(talos, data, np.array(active), anchors, (400.0, 40.0))
         a = pin.constraintDynamics(model, data, q, v, tau, models, datas, settings).copy()
         for cd in datas:
             term = 400.0 * cd.contact_placement_error.vector + 40.0 * cd.contact_velocity_error.vector
@@ -44,7 +44,7 @@ def test_wrenches_unstack_to_their_feet():
     contact = np.array([[True, True], [False, True], [True, False], [True, True]])
     stacked = np.arange(4 * 12, dtype=float).reshape(4, 12)
     wrench = np.zeros((4, 2, 6))
-    _unstack_wrenches(stacked, contact, wrench)
+    unstack_wrenches(stacked, contact, wrench)
     for k in range(4):  # the per-sample assignment it replaces
         expected = np.zeros((2, 6))
         expected[contact[k]] = stacked[k, :6 * contact[k].sum()].reshape(-1, 6)
@@ -53,7 +53,7 @@ def test_wrenches_unstack_to_their_feet():
 
 def test_yaw_rotations_are_the_foot_placements_rotations():
     yaw = np.linspace(-4.0, 4.0, 101)
-    R = _yaw_rotations(yaw)
+    R = yaw_rotations(yaw)
     assert all(np.array_equal(R[k], foot_placement(np.array([0.0, 0.0, 0.0, y])).rotation) for k, y in enumerate(yaw))
 
 

@@ -467,7 +467,7 @@ def _solve(residual, jacobian, start, bounds, max_nfev):
                          ftol=1e-10, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev)
 
 
-def _filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, delta_s: float,
+def filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, delta_s: float,
                       model: ModelName = "thesis"):
     """Residual (n_use,) and Jacobian (n_use, p) (the model's coordinates) of the model passed through
     ``smoother`` along the whole series ``qd`` (N,), on the rows ``use`` (module docstring).
@@ -658,7 +658,7 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     best = min((_solve(residual, jacobian, s, bounds, 300) for s in starts), key=lambda r: r.cost)
     natural_jacobian = lambda z: model_jacobian(full(z), v, delta_s, model)[:, free]  # noqa: E731
     if smoother is not None:
-        f_residual, f_jacobian = _filtered_problem(qd, y, use, smoother, delta_s, model)
+        f_residual, f_jacobian = filtered_problem(qd, y, use, smoother, delta_s, model)
         residual = lambda z: f_residual(full(z))  # noqa: E731
         jacobian = lambda z: _fit_jacobian(model, f_jacobian(full(z)))[:, free]  # noqa: E731
         natural_jacobian = lambda z: f_jacobian(full(z))[:, free]  # noqa: E731

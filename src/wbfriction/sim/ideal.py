@@ -77,9 +77,9 @@ def _solve_small(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.linalg.solve(A, b)
 
 
-def _constraints(robot: Robot, data: pin.Data, active: np.ndarray, anchors: dict[int, pin.SE3],
-                 baumgarte: tuple[float, float]
-                 ) -> tuple[pin.StdVec_RigidConstraintModel, pin.StdVec_RigidConstraintData]:
+def contact_constraints(robot: Robot, data: pin.Data, active: np.ndarray, anchors: dict[int, pin.SE3],
+                        baumgarte: tuple[float, float]
+                        ) -> tuple[pin.StdVec_RigidConstraintModel, pin.StdVec_RigidConstraintData]:
     """6D rigid constraints welding the ``active`` soles to their anchors, initialised in ``data``.
 
     Returned as Pinocchio's own vectors: a Python list would be converted (copied) at every
@@ -98,7 +98,7 @@ def _constraints(robot: Robot, data: pin.Data, active: np.ndarray, anchors: dict
     return models, datas
 
 
-def _unstack_wrenches(stacked: np.ndarray, contact: np.ndarray, wrench: np.ndarray) -> None:
+def unstack_wrenches(stacked: np.ndarray, contact: np.ndarray, wrench: np.ndarray) -> None:
     """Write the wrenches of the active feet, stacked in contact order per sample (N, 6 n_contacts),
     into ``wrench`` (N, n_contacts, 6) at their feet (the rows of inactive feet untouched)."""
     slot = np.cumsum(contact, axis=1) - 1  # position of each active foot in the stack
@@ -231,7 +231,7 @@ class _IdealRun:
         self.active = ref.contact[k].copy()
         if landing.any():
             self.q = _project_configuration(self.robot, self.data, self.q, self.active, self.anchors)
-        self.cmodels, self.cdatas = _constraints(self.robot, self.data, self.active, self.anchors,
+        self.cmodels, self.cdatas = contact_constraints(self.robot, self.data, self.active, self.anchors,
                                                  self.options.baumgarte)
         self.n_lam = 6 * int(self.active.sum())
         # one right-hand side per position-controlled joint (unit torque) and one for
@@ -246,7 +246,7 @@ class _IdealRun:
 
     def result(self) -> SimulationResult:
         """The log (planned contacts) and the result of the run."""
-        _unstack_wrenches(self.lam, self.ref.contact, self.recording.wrench)
+        unstack_wrenches(self.lam, self.ref.contact, self.recording.wrench)
         # semi-implicit Euler at the log rate: the central second difference at k is the
         # acceleration tau[k] caused; otherwise the torque is held over several steps
         alignment = "sample" if self.semi_implicit and self.options.substeps == 1 else "zoh"

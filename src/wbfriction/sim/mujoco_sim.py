@@ -150,7 +150,7 @@ class MatchedMeans:
             self.start = stop
 
 
-class _MujocoRun:
+class MujocoRun:
     """One run of :func:`simulate_mujoco`: the MuJoCo model and data, the controller, the state and the log."""
 
     def __init__(self, robot: Robot, reference: WalkingReference, friction: dict[str, FrictionParams] | None,
@@ -385,7 +385,7 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[st
             parameters with MuJoCo's friction; a delay that is not whole periods.
         SimulationError: the robot fell (the message gives the time).
     """
-    run = _MujocoRun(robot, reference, friction, options, mjr)
+    run = MujocoRun(robot, reference, friction, options, mjr)
     for k in counted(len(reference), progress):
         run.sample(k)
     return run.result()

@@ -137,7 +137,7 @@ class _Tasks:
     free: tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
-def _yaw_rotations(yaw: np.ndarray) -> np.ndarray:
+def yaw_rotations(yaw: np.ndarray) -> np.ndarray:
     """Rotations (..., 3, 3) about the vertical by ``yaw`` (...) [rad], as
     :func:`~wbfriction.walking.swing.foot_placement`'s."""
     c, s = np.cos(yaw), np.sin(yaw)
@@ -282,7 +282,7 @@ def walking_reference(robot: Robot, options: GaitOptions = GaitOptions(), dt: fl
     free_q, free_qd, free_qdd = _prescribed(robot, time, options.pc_amplitude)
 
     ik = _WholeBodyIK(robot)
-    tasks = _Tasks(_yaw_rotations(feet[:, :, 3]), feet[:, :, :3], com, _yaw_rotations(yaw[0]),
+    tasks = _Tasks(yaw_rotations(feet[:, :, 3]), feet[:, :, :3], com, yaw_rotations(yaw[0]),
                    _task_rates(feet_d, com_d, yaw[1]), _task_rates(feet_dd, com_dd, yaw[2]),
                    (free_q[:, ik.free_act], free_qd[:, ik.free_act], free_qdd[:, ik.free_act]))
     Q = np.empty((n, model.nq))
