@@ -232,7 +232,7 @@ class _IdealRun:
         if landing.any():
             self.q = _project_configuration(self.robot, self.data, self.q, self.active, self.anchors)
         self.cmodels, self.cdatas = contact_constraints(self.robot, self.data, self.active, self.anchors,
-                                                 self.options.baumgarte)
+                                                        self.options.baumgarte)
         self.n_lam = 6 * int(self.active.sum())
         # one right-hand side per position-controlled joint (unit torque) and one for
         # the contacts' Baumgarte term
