@@ -1,0 +1,58 @@
+"""The fleet's results dataset (issue 25): one row per log and joint, what :mod:`wbfriction.fleet.batch` writes
+and :mod:`wbfriction.fleet.trends` reads.
+
+The dataset is a folder of Parquet files partitioned by robot, in the Hive layout every Parquet reader knows
+(``pyarrow.dataset``, pandas, Polars, DuckDB, Spark)::
+
+    RESULTS/
+      robot_id=<id>/<key>.parquet      one file per processed log: its joints' rows (:data:`RESULT_SCHEMA`)
+      failed/<key>.json                one file per log that failed: its entry and one-line error
+      tables/robot_id=<id>/<key>.parquet   the log's friction table, when asked for
+
+``key`` names what was computed: the SHA-256 of the log's content, the robot model's files and the options
+(:func:`~wbfriction.fleet.task.log_key`). A log with a result file under its key is not processed again.
+
+Sign convention: as everywhere in wbfriction, ``tau_f`` is the torque friction exerts on the joint, and the
+model ``f(qd)`` is fitted to ``-tau_f`` (positive ``F_c``, ``F_v``: friction opposing the motion).
+``f_at_<v>`` is the model's dissipative friction at speed ``v``: ``(f(+v) - f(-v)) / 2`` [N·m], free of the
+offset ``tau_os`` and robust where the model's parameters trade off against each other; NaN where the joint
+did not reach ``v`` in the log (an extrapolation is no measurement).
+"""
+
+from __future__ import annotations
+
+import pyarrow as pa
+
+REFERENCE_SPEEDS: tuple[float, ...] = (0.1, 0.3, 1.0)
+"""The speeds [rad/s] at which each fit's friction ``f_at_<v>`` is reported."""
+TREND_PARAMS: tuple[str, ...] = ("F_c", "F_v", "tau_os")
+"""The model parameters followed over time, each with its standard error ``<name>_se``."""
+
+
+def speed_column(v: float) -> str:
+    """The column of the friction at reference speed ``v`` [rad/s], e.g. ``f_at_0.3``."""
+    return f"f_at_{v:g}"
+
+
+RESULT_SCHEMA = pa.schema([
+    ("robot_id", pa.string()),            # the robot, as the manifest names it
+    ("log", pa.string()),                 # the log's path, as the manifest gives it
+    ("start_time", pa.timestamp("ns", tz="UTC")),  # when the log started
+    ("key", pa.string()),                 # SHA-256 hex of log content + robot model + options
+    ("log_sha256", pa.string()),
+    ("robot_sha256", pa.string()),
+    ("options_sha256", pa.string()),
+    ("joint", pa.string()),
+    ("model", pa.string()),               # the fitted model: thesis, stribeck, coulomb-viscous
+    ("status", pa.string()),              # the fit's verdict: ok, weak, at bound, not excited, failed
+    ("n_samples", pa.int64()),            # valid samples fitted
+    ("qd_min", pa.float64()),             # [rad/s] over the fitted samples
+    ("qd_max", pa.float64()),
+    ("qd_p95", pa.float64()),             # 95th percentile of |qd| [rad/s]
+    *[(name, pa.float64()) for p in TREND_PARAMS for name in (p, f"{p}_se")],  # [N·m], [N·m·s/rad]
+    *[(name, pa.float64()) for v in REFERENCE_SPEEDS for name in (speed_column(v), speed_column(v) + "_se")],
+    ("energy_share", pa.float64()),       # share of friction power that generates energy (eq. 7.9), in [0, 1]
+    ("rms_residual", pa.float64()),       # [N·m]
+    ("version", pa.string()),             # wbfriction's version
+])
+"""One row per log and torque-controlled joint (module docstring). Missing values are NaN (floats) or null."""
