@@ -64,6 +64,7 @@ from wbfriction.friction.models import (
     coulomb_viscous_stribeck,
     stribeck_viscous,
 )
+from wbfriction.friction.options import SELECTION_TOLERANCE
 from wbfriction.friction.screen import gross_outliers
 from wbfriction.friction.status import FitVerdict, fit_verdict, joint_speed
 from wbfriction.workers import process_pool
@@ -73,9 +74,6 @@ ModelChoice = Literal["auto", "coulomb-viscous", "stribeck", "thesis"]
 simplest whose held-out error is within a tolerance of the best (module docstring)."""
 
 MODEL_CHOICES: tuple[ModelChoice, ...] = get_args(ModelChoice)
-
-SELECTION_TOLERANCE = 0.02
-"""Relative excess of held-out RMS over the best model's within which a simpler model is chosen."""
 
 HELD_OUT_BLOCKS = 10
 """Contiguous blocks (in time) the valid samples are cut into for the model choice."""
@@ -213,6 +211,9 @@ class FitResult(Generic[ParamsT]):
             (:func:`~wbfriction.friction.screen.gross_outliers`), not in :attr:`n_samples`.
         speed: the 95th percentile of ``|qd|`` over the samples used [rad/s] (how much the joint moved), or
             None (not known: a parameters file of an earlier version).
+        covariance: the parameters' covariance (p, p) in :attr:`params`' order (held ones: 0; ``inf`` rows
+            for one that is not identifiable; :func:`parameter_covariance`), or None (not fitted, or read
+            from a parameters file, which keeps only the standard errors).
     """
 
     joint: str
@@ -230,6 +231,7 @@ class FitResult(Generic[ParamsT]):
     selection: ModelSelection | None = None
     n_screened: int = 0
     speed: float | None = None
+    covariance: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if self.params is not None:
@@ -302,9 +304,9 @@ def model_jacobian(x: np.ndarray, qd: np.ndarray, delta_s: float, model: ModelNa
     return J
 
 
-def standard_errors(jac: np.ndarray, residual: np.ndarray, rtol: float = 1e-9, rows: np.ndarray | None = None,
-                    max_lag: int = 0) -> np.ndarray:
-    """Standard errors from the Jacobian at a least-squares solution (module docstring).
+def parameter_covariance(jac: np.ndarray, residual: np.ndarray, rtol: float = 1e-9, rows: np.ndarray | None = None,
+                         max_lag: int = 0) -> np.ndarray:
+    """Covariance (p, p) of the parameters from the Jacobian at a least-squares solution (module docstring).
 
     With ``max_lag > 0`` the residuals may be correlated in time (a filtered estimate, or
     model error that varies slowly): the covariance is the Newey-West sandwich
@@ -313,8 +315,8 @@ def standard_errors(jac: np.ndarray, residual: np.ndarray, rtol: float = 1e-9, r
     time series (``rows``: their indices in it; only truly consecutive pairs count).
 
     Returns:
-        (p,) standard errors; ``inf`` for a parameter with a component in the numerical
-        null space of ``J`` (not identifiable).
+        (p, p) covariance; the rows and columns of a parameter with a component in the numerical
+        null space of ``J`` (not identifiable) are ``inf``.
     """
     n, p = jac.shape
     _, sv, Vt = np.linalg.svd(jac, full_matrices=False)
@@ -322,17 +324,25 @@ def standard_errors(jac: np.ndarray, residual: np.ndarray, rtol: float = 1e-9, r
     V = Vt.T
     null = V[:, ~keep]
     unidentifiable = (np.abs(null) > 1e-6).any(axis=1) if null.size else np.zeros(p, dtype=bool)
+    bread = (V[:, keep] / sv[keep] ** 2) @ V[:, keep].T  # (J^T J)^+
     if max_lag <= 0:
-        s2 = float(residual @ residual) / max(n - p, 1)
-        var = (V[:, keep] ** 2 / sv[keep] ** 2).sum(axis=1) * s2
+        cov = bread * (float(residual @ residual) / max(n - p, 1))
     else:
         rows = np.arange(n) if rows is None else np.asarray(rows)
         g = jac * residual[:, None] * np.sqrt(n / max(n - p, 1))
         lagged = lagged_products(g, rows, max_lag)
         meat = g.T @ g + lagged + lagged.T
-        bread = (V[:, keep] / sv[keep] ** 2) @ V[:, keep].T  # (J^T J)^+
-        var = np.clip(np.diag(bread @ meat @ bread), 0.0, None)
-    return np.where(unidentifiable, np.inf, np.sqrt(var))
+        cov = bread @ meat @ bread
+    cov[unidentifiable, :] = np.inf
+    cov[:, unidentifiable] = np.inf
+    return cov
+
+
+def standard_errors(jac: np.ndarray, residual: np.ndarray, rtol: float = 1e-9, rows: np.ndarray | None = None,
+                    max_lag: int = 0) -> np.ndarray:
+    """Standard errors (p,) from the Jacobian at a least-squares solution: the square roots of the diagonal of
+    :func:`parameter_covariance` (``inf`` for a parameter that is not identifiable)."""
+    return np.sqrt(np.clip(np.diag(parameter_covariance(jac, residual, rtol, rows, max_lag)), 0.0, None))
 
 
 def lagged_products(g: np.ndarray, rows: np.ndarray, max_lag: int) -> np.ndarray:
@@ -666,16 +676,17 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     # residuals correlated over the filter's window, or over the span of a model error;
     # standard errors of the model's own parameters (F_s, not F_s - F_c)
     rows = np.flatnonzero(use)
-    se = np.zeros(len(names))
-    se[free] = standard_errors(natural_jacobian(best.x), best.fun, rows=rows,
-                               max_lag=correlation_lag(best.fun, rows))
+    cov = np.zeros((len(names), len(names)))
+    cov[np.ix_(free, free)] = parameter_covariance(natural_jacobian(best.x), best.fun, rows=rows,
+                                                   max_lag=correlation_lag(best.fun, rows))
+    se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     at_bound = np.zeros(len(names), dtype=bool)
     at_bound[free] = _at_bound(best.x, bounds, residual, np.isfinite(se[free]))
     return FitResult(
         joint=joint, n_samples=n, params=MODEL_PARAMS[model].from_vector(full(best.x), delta_s),
         stderr=dict(zip(names, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
         success=bool(best.success), message=str(best.message), model=model,
-        at_bound=dict(zip(names, map(bool, at_bound))), speed=speed)
+        at_bound=dict(zip(names, map(bool, at_bound))), speed=speed, covariance=cov)
 
 
 def _fit_column(args: tuple) -> FitResult:

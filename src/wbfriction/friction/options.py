@@ -86,5 +86,10 @@ models give well under 1 % (the remainder: velocity sign errors of the different
 around reversals, measured on the ideal simulator's combined walk)."""
 
 
+SELECTION_TOLERANCE = 0.02
+"""Relative excess of held-out RMS over the best model's within which a simpler model is chosen
+(:func:`~wbfriction.friction.fit.choose_model`)."""
+
+
 DEFAULT_TOLERANCE = 0.01
 """Friction torques smaller than this do not count as generating power [N·m]."""

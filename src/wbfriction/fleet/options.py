@@ -1,0 +1,41 @@
+"""The choices of a batch (issue 25), in a module that imports only the standard library (the CLI's help reads
+them without loading the library)."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, SELECTION_TOLERANCE, EstimateOptions
+
+
+@dataclass(frozen=True)
+class BatchOptions:
+    """What every log of a batch is processed with: ``wbfriction estimate``'s and ``wbfriction fit``'s options.
+
+    Attributes:
+        estimate: the estimate's options (default: those of ``wbfriction estimate``, ``diff = "auto"``).
+        model: the friction model fitted (``auto``, ``thesis``, ``stribeck``, ``coulomb-viscous``).
+        selection_tolerance: ``auto``'s tolerance on held-out error.
+        min_samples: joints with fewer valid samples get no parameters.
+        energy_threshold, energy_tolerance: of the energy check (eq. 7.9).
+        chunk_rows: rows per chunk of the estimate.
+    """
+
+    estimate: EstimateOptions = field(default_factory=lambda: EstimateOptions(diff="auto"))
+    model: str = "auto"
+    selection_tolerance: float = SELECTION_TOLERANCE
+    min_samples: int = 20
+    energy_threshold: float = DEFAULT_THRESHOLD
+    energy_tolerance: float = DEFAULT_TOLERANCE
+    chunk_rows: int = 10_000
+
+    def for_entry(self, overrides: dict[str, Any]) -> BatchOptions:
+        """These options with a manifest row's own (``diff``, ``model``) applied."""
+        out = self
+        if "diff" in overrides:
+            out = dataclasses.replace(out, estimate=dataclasses.replace(out.estimate, diff=overrides["diff"]))
+        if "model" in overrides:
+            out = dataclasses.replace(out, model=overrides["model"])
+        return out

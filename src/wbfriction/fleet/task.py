@@ -1,0 +1,190 @@
+"""One log of a batch (issue 25): estimate, fit, energy check, and the rows of the results dataset.
+
+:func:`process_log` is what a Dask task runs, and what the serial run calls in order: the same function, so the
+results are the same bytes. It does what ``wbfriction estimate LOG`` and ``wbfriction fit`` do with the same
+options (:func:`~wbfriction.pipeline.estimate.estimate_file` on one process, then
+:func:`~wbfriction.friction.fit.fit_estimate` and :func:`~wbfriction.friction.energy.energy_consistency`).
+
+Sign convention: ``tau_f`` is the torque friction exerts on the joint; the model ``f(qd)`` is fitted to
+``-tau_f`` (:mod:`wbfriction.fleet.schema`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from dataclasses import dataclass
+from datetime import UTC, datetime, timedelta
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+from threadpoolctl import threadpool_limits
+
+from wbfriction.exceptions import WbfrictionError
+from wbfriction.fleet.manifest import LogEntry
+from wbfriction.fleet.options import BatchOptions
+from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
+from wbfriction.friction.energy import JointEnergy, energy_consistency
+from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets, model_jacobian
+from wbfriction.friction.io import read_friction_file
+from wbfriction.logs.tables import file_sha256, scratch_folder
+from wbfriction.model.robot import Robot
+from wbfriction.pipeline.chunks import Chunking
+from wbfriction.pipeline.estimate import RobotSpec, estimate_file
+from wbfriction.version import __version__
+
+
+@dataclass(frozen=True)
+class LogKey:
+    """What a log's result is computed from, as SHA-256 hex digests: the log's bytes, the robot model's files,
+    the options; :attr:`key` digests the three (the result file's name)."""
+
+    log_sha256: str
+    robot_sha256: str
+    options_sha256: str
+
+    @property
+    def key(self) -> str:
+        return hashlib.sha256(f"{self.log_sha256}:{self.robot_sha256}:{self.options_sha256}".encode()).hexdigest()
+
+
+@dataclass(frozen=True)
+class LogOutcome:
+    """What :func:`process_log` gives back: the log's rows (:data:`~wbfriction.fleet.schema.RESULT_SCHEMA`), or
+    the one-line error that stopped it; and where its friction table was written, if asked for."""
+
+    entry: LogEntry
+    key: LogKey
+    rows: pa.Table | None = None
+    error: str = ""
+    table: Path | None = None
+
+    @property
+    def failed(self) -> bool:
+        return self.rows is None
+
+
+def robot_sha256(spec: RobotSpec, robot: Robot) -> str:
+    """SHA-256 over what defines a robot model: its URDF (or MJCF) file and its configuration (the TOML given,
+    or the built-in robot's packaged TOML)."""
+    digest = hashlib.sha256(file_sha256(robot.urdf).encode())
+    if spec.config is not None:
+        digest.update(file_sha256(spec.config).encode())
+    else:
+        text = resources.files("wbfriction.model.robots").joinpath(f"{robot.name}.toml").read_bytes()
+        digest.update(hashlib.sha256(text).hexdigest().encode())
+    return digest.hexdigest()
+
+
+def options_sha256(options: BatchOptions) -> str:
+    """SHA-256 of the options, as canonical JSON (every field, sorted keys)."""
+    return hashlib.sha256(json.dumps(dataclasses.asdict(options), sort_keys=True, default=str).encode()).hexdigest()
+
+
+def log_key(entry: LogEntry, robot_hash: str, options: BatchOptions) -> LogKey:
+    """The key of ``entry`` processed with ``options`` on the robot whose :func:`robot_sha256` is ``robot_hash``.
+
+    Raises:
+        InputError: a missing log.
+    """
+    return LogKey(file_sha256(entry.log), robot_hash, options_sha256(options))
+
+
+# the robots a worker process has loaded, by how they are loaded
+_ROBOTS: dict[RobotSpec, Robot] = {}
+
+
+def worker_robot(spec: RobotSpec) -> Robot:
+    """The robot of ``spec``, loaded once per process (a worker processes many logs of one robot)."""
+    if spec not in _ROBOTS:
+        _ROBOTS[spec] = spec.load()
+    return _ROBOTS[spec]
+
+
+def process_log(entry: LogEntry, key: LogKey, options: BatchOptions, scratch: Path,
+                table: Path | None = None) -> LogOutcome:
+    """Estimate, fit and check one log (module docstring); never raises for a fault of the log or its robot.
+
+    Args:
+        entry: the log.
+        key: its :func:`log_key` (recorded in every row).
+        options: the batch's options with the entry's own applied (:meth:`BatchOptions.for_entry`).
+        scratch: a folder for the friction table while it is fitted (removed after).
+        table: where to keep the friction table, or None.
+
+    Returns:
+        The outcome: rows on success; else the error's one line (a
+        :class:`~wbfriction.exceptions.WbfrictionError`'s message, or the exception's type and message).
+    """
+    try:
+        robot = worker_robot(entry.robot)
+        with threadpool_limits(1), scratch_folder(scratch) as folder:
+            friction = table if table is not None else folder / "friction.parquet"
+            estimate_file(entry.robot, entry.log, friction, options.estimate, chunking=Chunking(
+                rows=options.chunk_rows, workers=1), robot=robot)
+            est = read_friction_file(friction)
+            fits = fit_estimate(est, min_samples=options.min_samples, model=options.model,
+                                selection_tolerance=options.selection_tolerance)
+            energy = energy_consistency(est, fitted_offsets(fits), options.energy_threshold, options.energy_tolerance)
+        return LogOutcome(entry, key, result_rows(entry, key, fits, energy, est.qd, est.valid), table=table)
+    except WbfrictionError as exc:
+        return LogOutcome(entry, key, error=str(exc))
+    except Exception as exc:  # a fault of this log must not stop the others: recorded, with its type
+        return LogOutcome(entry, key, error=f"{entry.log}: {type(exc).__name__}: {exc}")
+
+
+def reference_friction(fit: FitResult, v: float) -> tuple[float, float]:
+    """The fitted model's dissipative friction at speed ``v`` [rad/s], ``(f(+v) - f(-v)) / 2`` [N·m], and its
+    standard error from the parameters' covariance (delta method); NaN without a fit or a covariance."""
+    if fit.params is None:
+        return float("nan"), float("nan")
+    x, model = fit.params.as_vector(), fit.params.model
+    delta_s = getattr(fit.params, "delta_s", 2.0)
+    qd = np.array([v, -v])
+    value = 0.5 * float(np.subtract(*fit.params.f(qd)))
+    if fit.covariance is None or not np.all(np.isfinite(fit.covariance)):
+        return value, float("nan") if fit.covariance is None else float("inf")
+    J = model_jacobian(x, qd, delta_s, model)
+    g = 0.5 * (J[0] - J[1])
+    return value, float(np.sqrt(max(float(g @ fit.covariance @ g), 0.0)))
+
+
+def result_rows(entry: LogEntry, key: LogKey, fits: list[FitResult], energy: list[JointEnergy],
+                qd: np.ndarray, valid: np.ndarray) -> pa.Table:
+    """The rows of one log (:data:`~wbfriction.fleet.schema.RESULT_SCHEMA`), one per joint of ``fits``;
+    ``qd`` (N, n_tc) [rad/s] and ``valid`` (N, n_tc) of the estimate give each joint's velocity range."""
+    shares = {e.joint: e.generating_share for e in energy}
+    columns: dict[str, list] = {name: [] for name in RESULT_SCHEMA.names}
+    for i, fit in enumerate(fits):
+        v = qd[valid[:, i] & np.isfinite(qd[:, i]), i]
+        values = fit.params.to_dict() if fit.params is not None else {}
+        row = {"robot_id": entry.robot_id, "log": str(entry.log), "start_time": _utc(entry.start_time),
+               "key": key.key, "log_sha256": key.log_sha256, "robot_sha256": key.robot_sha256,
+               "options_sha256": key.options_sha256, "joint": fit.joint, "model": fit.model,
+               "status": fit.verdict().status, "n_samples": fit.n_samples,
+               "qd_min": float(v.min()) if v.size else float("nan"),
+               "qd_max": float(v.max()) if v.size else float("nan"),
+               "qd_p95": float(np.percentile(np.abs(v), 95)) if v.size else float("nan"),
+               "energy_share": float(shares.get(fit.joint, float("nan"))),
+               "rms_residual": float(fit.rms_residual), "version": __version__}
+        for p in TREND_PARAMS:
+            row[p] = float(values.get(p, float("nan")))
+            row[f"{p}_se"] = float(fit.stderr.get(p, float("nan")))
+        reach = float(np.max(np.abs(v))) if v.size else 0.0
+        for s in REFERENCE_SPEEDS:
+            f, se = reference_friction(fit, s) if s <= reach else (float("nan"), float("nan"))
+            row[speed_column(s)], row[speed_column(s) + "_se"] = f, se
+        for name in RESULT_SCHEMA.names:
+            columns[name].append(row[name])
+    return pa.Table.from_pydict(columns, schema=RESULT_SCHEMA)
+
+
+def _utc(t: datetime) -> int:
+    """Nanoseconds since the epoch of an aware time (exact: a datetime has microseconds)."""
+    return (t - EPOCH) // timedelta(microseconds=1) * 1000
+
+
+EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
