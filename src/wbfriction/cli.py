@@ -967,6 +967,66 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
     console.print(f"study finished in {time.perf_counter() - start:.1f} s")
 
 
+@app.command()
+def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
+                                        help="Manifest (CSV or Parquet; columns log, robot_id, start_time [ISO 8601 "
+                                             "with zone], robot or urdf/config, optional diff and model), or a "
+                                             "folder of <robot_id>/<log> files (with --robot or --urdf/--config)."),
+          output: Path = typer.Option(..., "-o", "--output", help="Results folder: a Parquet dataset partitioned "
+                                                                  "by robot; logs whose results are there are "
+                                                                  "skipped."),
+          robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+          workers: int = typer.Option(2, min=1, help="Worker processes of the local Dask cluster."),
+          scheduler: Optional[str] = typer.Option(None, help="Address of a running Dask scheduler "
+                                                             "(tcp://host:8786) instead of a local cluster; its "
+                                                             "workers must see the logs and the results."),
+          serial: bool = typer.Option(False, "--serial", help="One log after the other in this process, without "
+                                                              "Dask (the reference the cluster's results equal)."),
+          tables: bool = typer.Option(False, "--tables", help="Also keep each log's friction table "
+                                                              "(RESULTS/tables/)."),
+          diff: str = typer.Option("auto", help="Differentiation, as 'wbfriction estimate --diff' (a manifest's "
+                                                "diff column overrides it per log)."),
+          model: str = typer.Option("auto", help="Friction model, as 'wbfriction fit --model' (a manifest's model "
+                                                 "column overrides it per log)."),
+          min_samples: int = typer.Option(20, min=1, help="Joints with fewer valid samples get no parameters.")
+          ) -> None:
+    """Estimate, fit and check every log of a fleet on Dask, into one results dataset (exit status 1 when a log
+    failed: it is listed, the others are done)."""
+    import dataclasses
+
+    from wbfriction.fleet.batch import run_batch
+    from wbfriction.fleet.manifest import DIFF_CHOICES, read_manifest, scan_folder
+    from wbfriction.fleet.options import BatchOptions
+    from wbfriction.friction.fit import MODEL_CHOICES
+    from wbfriction.pipeline.estimate import RobotSpec
+
+    if diff not in DIFF_CHOICES:
+        raise InputError(f"--diff must be one of {', '.join(DIFF_CHOICES)}, got '{diff}'")
+    if model not in MODEL_CHOICES:
+        raise InputError(f"--model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
+    if output.exists() and not output.is_dir():
+        raise InputError(f"-o {output}: not a folder (the results are a folder)")
+    start = time.perf_counter()
+    if source.is_dir():
+        entries = scan_folder(source, RobotSpec(None if config else robot, None if urdf is None else str(urdf),
+                                                None if config is None else str(config)))
+    else:
+        entries = read_manifest(source)
+    options = BatchOptions(estimate=dataclasses.replace(EstimateOptions(), diff=cast("Diff", diff)),
+                           model=model, min_samples=min_samples)
+    with Progress(TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console,
+                  transient=True) as bar:
+        task = bar.add_task("batch", total=len(entries))
+        summary = run_batch(entries, output, options, engine="serial" if serial else "dask", workers=workers,
+                            scheduler=scheduler, tables=tables, progress=lambda outcome: bar.advance(task, 1))
+    for entry, error in summary.failed:
+        console.print(f"[bold red]failed:[/] {escape(error)}", highlight=False, soft_wrap=True)
+    console.print(f"{summary.processed} logs processed ({len(summary.failed)} failed), {summary.skipped} already "
+                  f"done; results in {output} ({time.perf_counter() - start:.1f} s)")
+    if summary.failed:
+        raise typer.Exit(1)
+
+
 def _version(value: bool) -> None:
     if value:
         out.print(f"wbfriction {__version__}", highlight=False)

@@ -143,10 +143,12 @@ def log_start_time(log: Path) -> datetime:
 
 def _start_times(column: pa.ChunkedArray, path: Path) -> list[datetime]:
     """Every row's start time (UTC), from ISO 8601 strings with a zone or timestamps."""
+    if pa.types.is_timestamp(column.type) and column.type.tz is None:  # a CSV's dates without a zone, inferred
+        raise InputError(f"{path}: row 0, column 'start_time': dates without a time zone (add +00:00 for UTC)")
     out = []
     for row, value in enumerate(column.to_pylist()):
         if isinstance(value, datetime):
-            t = value if value.tzinfo is not None else value.replace(tzinfo=UTC)
+            t = value
         else:
             try:
                 t = datetime.fromisoformat(str(value).strip())

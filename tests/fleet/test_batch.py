@@ -1,0 +1,136 @@
+"""The batch (issue 25): injected friction recovered per log, the serial and the Dask runs the same bytes, the
+same numbers as ``wbfriction estimate`` + ``wbfriction fit``, resumable, failures recorded, a killed worker
+losing nothing."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pyarrow.compute as pc
+import pytest
+
+from wbfriction.fleet.batch import plan_batch, run_batch
+from wbfriction.fleet.manifest import read_manifest
+from wbfriction.fleet.options import BatchOptions
+from wbfriction.fleet.results import read_failures, read_results
+from wbfriction.fleet.schema import REFERENCE_SPEEDS, speed_column
+
+
+def _files(results: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(results)): p.read_bytes() for p in sorted(results.glob("robot_id=*/*.parquet"))}
+
+
+@pytest.fixture(scope="module")
+def serial(arm_fleet, tmp_path_factory) -> Path:
+    folder, _ = arm_fleet
+    results = tmp_path_factory.mktemp("serial")
+    summary = run_batch(read_manifest(folder / "manifest.csv"), results, engine="serial")
+    assert (summary.processed, summary.skipped, summary.failed) == (3, 0, [])
+    return results
+
+
+def test_each_log_gives_its_injected_friction(serial, arm_fleet):
+    _, truth = arm_fleet
+    table = read_results(serial)
+    assert table.num_rows == 3 * 7
+    for row in table.to_pylist():
+        true = truth[Path(row["log"]).name][row["joint"]]
+        assert row["status"] == "ok", row
+        assert row["F_c"] == pytest.approx(true.F_c, rel=0.02), row
+        assert abs(row["F_c"] - true.F_c) < 5 * row["F_c_se"] + 1e-3
+        assert row["tau_os"] == pytest.approx(true.tau_os, abs=0.01)
+        for v in REFERENCE_SPEEDS:  # the model's friction at v, free of the offset, against the true model's
+            if np.isfinite(row[speed_column(v)]):
+                assert row[speed_column(v)] == pytest.approx(0.5 * float(np.subtract(*true.f(np.array([v, -v])))),
+                                                             rel=0.02)
+    # the robots and start times as the manifest gave them (arm-2's 09:30+01:00 is 08:30 UTC)
+    assert table.column("robot_id").to_pylist() == ["arm-1"] * 14 + ["arm-2"] * 7
+    assert str(pc.min(table.column("start_time")).as_py()) == "2026-03-01 08:00:00+00:00"
+    assert table.filter(pc.equal(table.column("robot_id"), "arm-2"))["start_time"][0].as_py().hour == 8
+
+
+def test_rows_equal_the_estimate_and_fit_commands(serial, arm_fleet, tmp_path):
+    folder, _ = arm_fleet
+    friction, params = tmp_path / "f.parquet", tmp_path / "p.json"
+    for argv in (["estimate", str(folder / "b1.parquet"), "-o", str(friction), "--robot", "panda"],
+                 ["fit", str(friction), "-o", str(params)]):
+        subprocess.run([sys.executable, "-m", "wbfriction", *argv], check=True, capture_output=True)
+    fits = json.loads(params.read_text())["joints"]
+    table = read_results(serial)
+    for row in table.filter(pc.equal(table.column("robot_id"), "arm-2")).to_pylist():
+        fit = fits[row["joint"]]
+        for name in ("F_c", "F_v", "tau_os"):
+            assert row[name] == pytest.approx(fit["params"][name], rel=1e-9, abs=1e-12)
+            assert row[f"{name}_se"] == pytest.approx(fit["stderr"][name], rel=1e-6)
+        assert row["n_samples"] == fit["n_samples"]
+
+
+def test_dask_gives_the_serial_bytes(serial, arm_fleet, tmp_path):
+    from distributed import Client, LocalCluster
+
+    folder, _ = arm_fleet
+    with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=":0") as cluster, \
+            Client(cluster) as client:
+        summary = run_batch(read_manifest(folder / "manifest.csv"), tmp_path, client=client)
+    assert summary.processed == 3 and not summary.failed
+    assert _files(tmp_path) == _files(serial)
+
+
+def test_a_batch_resumes_and_skips_what_it_did(arm_fleet, tmp_path):
+    folder, _ = arm_fleet
+    entries = read_manifest(folder / "manifest.csv")
+
+    def stop_after_first(outcome):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_batch(entries, tmp_path, engine="serial", progress=stop_after_first)
+    assert len(_files(tmp_path)) == 1  # the one finished, whole
+    summary = run_batch(entries, tmp_path, engine="serial")
+    assert (summary.processed, summary.skipped) == (2, 1)
+    assert plan_batch(entries, tmp_path).todo == []
+    # other options are another result: computed again
+    other = BatchOptions(model="coulomb-viscous")
+    assert len(plan_batch(entries, tmp_path, other).todo) == 3
+
+
+def test_a_corrupted_log_is_listed_with_its_reason(arm_fleet, tmp_path):
+    folder, _ = arm_fleet
+    shutil.copy(folder / "a1.parquet", tmp_path / "a1.parquet")
+    (tmp_path / "broken.parquet").write_bytes((folder / "a2.parquet").read_bytes()[:5000])
+    (tmp_path / "m.csv").write_text("log,robot_id,start_time,robot\n"
+                                    "broken.parquet,arm-1,2026-03-01T08:00:00Z,panda\n"
+                                    "a1.parquet,arm-1,2026-03-02T08:00:00Z,panda\n")
+    summary = run_batch(read_manifest(tmp_path / "m.csv"), tmp_path / "out", engine="serial")
+    assert summary.processed == 2 and len(summary.failed) == 1
+    (failure,) = read_failures(tmp_path / "out")
+    assert failure["manifest_row"] == 0 and "broken.parquet" in failure["error"] and "\n" not in failure["error"]
+    assert read_results(tmp_path / "out").num_rows == 7
+
+
+@pytest.mark.slow
+def test_a_killed_worker_loses_no_result(arm_fleet, serial, tmp_path):
+    from distributed import Client, LocalCluster
+
+    folder, _ = arm_fleet
+    entries = read_manifest(folder / "manifest.csv")
+    with LocalCluster(n_workers=2, processes=True, threads_per_worker=1, dashboard_address=":0") as cluster, \
+            Client(cluster) as client:
+        pids = list(client.run(os.getpid).values())
+        killed = []
+
+        def kill_one(outcome):
+            if not killed:  # one log done: kill a worker while the others run
+                os.kill(pids[0], signal.SIGKILL)
+                killed.append(pids[0])
+
+        summary = run_batch(entries, tmp_path, client=client, progress=kill_one)
+    assert killed and summary.processed == 3 and not summary.failed
+    assert _files(tmp_path) == _files(serial)
