@@ -22,6 +22,7 @@ LAYERS = [
     {"pipeline"},
     {"walking"},
     {"sim"},
+    {"fleet"},
     {"report"},
     {"studies"},
     {"cli", "__main__", "__init__", "entry"},

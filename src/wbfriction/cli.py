@@ -1019,7 +1019,7 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
         task = bar.add_task("batch", total=len(entries))
         summary = run_batch(entries, output, options, engine="serial" if serial else "dask", workers=workers,
                             scheduler=scheduler, tables=tables, progress=lambda outcome: bar.advance(task, 1))
-    for entry, error in summary.failed:
+    for _, error in summary.failed:
         console.print(f"[bold red]failed:[/] {escape(error)}", highlight=False, soft_wrap=True)
     console.print(f"{summary.processed} logs processed ({len(summary.failed)} failed), {summary.skipped} already "
                   f"done; results in {output} ({time.perf_counter() - start:.1f} s)")

@@ -67,7 +67,8 @@ def plan_batch(entries: list[LogEntry], results: str | Path, options: BatchOptio
     results = Path(results)
     robot_hashes: dict[Any, str] = {}
     done = done_keys(results)
-    todo, skipped = [], []
+    todo: list[PlannedLog] = []
+    skipped: list[PlannedLog] = []
     for entry in entries:
         if entry.robot not in robot_hashes:
             try:
@@ -117,9 +118,8 @@ def run_batch(entries: list[LogEntry], results: str | Path, options: BatchOption
 
     args = [(p.entry, p.key, p.options, results,
              table_path(results, p.entry.robot_id, p.key.key) if tables else None) for p in plan.todo]
-    if tables:
-        for a in args:
-            a[4].parent.mkdir(parents=True, exist_ok=True)
+    for robot_id in {p.entry.robot_id for p in plan.todo} if tables else ():
+        table_path(results, robot_id, "").parent.mkdir(parents=True, exist_ok=True)
     if engine == "serial":
         for a in args:
             record(process_log(*a))

@@ -94,7 +94,8 @@ def read_manifest(path: str | Path) -> list[LogEntry]:
         raise InputError(f"{path}: the manifest lists no log")
     starts = _start_times(table.column("start_time"), path)
     columns = {c: table.column(c).to_pylist() for c in names if c != "start_time"}
-    entries, seen = [], {}
+    entries: list[LogEntry] = []
+    seen: dict[Path, int] = {}
     for row in range(table.num_rows):
         cell = {c: ("" if columns[c][row] is None else str(columns[c][row]).strip()) for c in columns}
         entry = _entry(path, row, cell, starts[row])

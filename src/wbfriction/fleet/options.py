@@ -5,7 +5,10 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from wbfriction.friction.fit import ModelChoice
 
 from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, SELECTION_TOLERANCE, EstimateOptions
 
@@ -24,7 +27,7 @@ class BatchOptions:
     """
 
     estimate: EstimateOptions = field(default_factory=lambda: EstimateOptions(diff="auto"))
-    model: str = "auto"
+    model: ModelChoice = "auto"
     selection_tolerance: float = SELECTION_TOLERANCE
     min_samples: int = 20
     energy_threshold: float = DEFAULT_THRESHOLD
