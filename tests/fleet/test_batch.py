@@ -134,3 +134,20 @@ def test_a_killed_worker_loses_no_result(arm_fleet, serial, tmp_path):
         summary = run_batch(entries, tmp_path, client=client, progress=kill_one)
     assert killed and summary.processed == 3 and not summary.failed
     assert _files(tmp_path) == _files(serial)
+
+
+def test_a_long_logs_chunks_are_tasks_of_the_cluster(arm_fleet, tmp_path):
+    """With 300-row chunks a 3000-row log has 10 chunks: they run as tasks of the cluster, and the results are
+    the serial run's bytes."""
+    from distributed import Client, LocalCluster, get_task_stream
+
+    folder, _ = arm_fleet
+    entries = read_manifest(folder / "manifest.csv")[:1]
+    options = BatchOptions(chunk_rows=300)
+    run_batch(entries, tmp_path / "serial", options, engine="serial")
+    with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=":0") as cluster, \
+            Client(cluster) as client, get_task_stream(client) as stream:
+        run_batch(entries, tmp_path / "dask", options, client=client)
+    chunks = [t for t in stream.data if str(t["key"]).startswith("chunk_on_one_thread")]
+    assert len(chunks) == 10
+    assert _files(tmp_path / "dask") == _files(tmp_path / "serial")

@@ -20,11 +20,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
+from threadpoolctl import threadpool_limits
+
 from wbfriction.exceptions import InputError
 from wbfriction.fleet.manifest import LogEntry
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.results import done_keys, table_path, write_outcome
-from wbfriction.fleet.task import LogKey, LogOutcome, log_key, process_log, robot_sha256, worker_robot
+from wbfriction.fleet.task import LogKey, LogOutcome, log_key, process_log, robot_sha256
+from wbfriction.pipeline.estimate import worker_robot
 
 Engine = Literal["dask", "serial"]
 """Where the tasks run: on a Dask cluster, or one after the other in this process."""
@@ -128,6 +131,35 @@ def run_batch(entries: list[LogEntry], results: str | Path, options: BatchOption
     return BatchSummary(len(plan.todo), len(plan.skipped), failed, results)
 
 
+class DaskChunks:
+    """A long log's chunks as tasks of the cluster its log's task runs on (a
+    :class:`~wbfriction.pipeline.estimate.ChunkExecutor`): submitted from inside the task through
+    ``distributed.worker_client``, which frees the task's thread while its chunks run."""
+
+    def __init__(self, client: Any):
+        self.client = client
+
+    def submit(self, fn: Callable, /, *args: Any) -> Any:
+        return self.client.submit(chunk_on_one_thread, fn, *args, pure=False)
+
+
+def chunk_on_one_thread(fn: Callable, *args: Any) -> Any:
+    """``fn(*args)`` with its linear algebra on one BLAS thread, as every task of a batch."""
+    with threadpool_limits(1):
+        return fn(*args)
+
+
+def log_task(entry: LogEntry, key: LogKey, options: BatchOptions, scratch: Path, table: Path | None) -> LogOutcome:
+    """One log's task on a Dask worker: :func:`~wbfriction.fleet.task.process_log` with its chunks handed to the
+    cluster (its workers, at most, at a time) when the log is long enough to pay for it
+    (:meth:`~wbfriction.pipeline.chunks.Chunking.processes`)."""
+    from distributed import worker_client
+
+    with worker_client(separate_thread=False) as client:
+        workers = max(1, sum(client.nthreads().values()))
+        return process_log(entry, key, options, scratch, table, executor=DaskChunks(client), chunk_workers=workers)
+
+
 def _run_on_dask(args: list[tuple], record: Callable[[LogOutcome], None], workers: int, scheduler: str | None,
                  client: Any) -> None:
     """Submit one task per log and record each outcome as it completes; a task Dask gave up on (its workers
@@ -143,7 +175,7 @@ def _run_on_dask(args: list[tuple], record: Callable[[LogOutcome], None], worker
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
             client = Client(cluster)
     try:
-        futures = {client.submit(process_log, *a, key=f"wbfriction-log-{a[1].key}", pure=False): a for a in args}
+        futures = {client.submit(log_task, *a, key=f"wbfriction-log-{a[1].key}", pure=False): a for a in args}
         for future in as_completed(futures):
             a = futures[future]
             try:

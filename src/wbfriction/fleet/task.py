@@ -33,7 +33,7 @@ from wbfriction.friction.io import read_friction_file
 from wbfriction.logs.tables import file_sha256, scratch_folder
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import Chunking
-from wbfriction.pipeline.estimate import RobotSpec, estimate_file
+from wbfriction.pipeline.estimate import ChunkExecutor, RobotSpec, estimate_file, worker_robot
 from wbfriction.version import __version__
 
 
@@ -93,19 +93,9 @@ def log_key(entry: LogEntry, robot_hash: str, options: BatchOptions) -> LogKey:
     return LogKey(file_sha256(entry.log), robot_hash, options_sha256(options))
 
 
-# the robots a worker process has loaded, by how they are loaded
-_ROBOTS: dict[RobotSpec, Robot] = {}
-
-
-def worker_robot(spec: RobotSpec) -> Robot:
-    """The robot of ``spec``, loaded once per process (a worker processes many logs of one robot)."""
-    if spec not in _ROBOTS:
-        _ROBOTS[spec] = spec.load()
-    return _ROBOTS[spec]
-
-
 def process_log(entry: LogEntry, key: LogKey, options: BatchOptions, scratch: Path,
-                table: Path | None = None) -> LogOutcome:
+                table: Path | None = None, executor: ChunkExecutor | None = None,
+                chunk_workers: int = 1) -> LogOutcome:
     """Estimate, fit and check one log (module docstring); never raises for a fault of the log or its robot.
 
     Args:
@@ -114,6 +104,8 @@ def process_log(entry: LogEntry, key: LogKey, options: BatchOptions, scratch: Pa
         options: the batch's options with the entry's own applied (:meth:`BatchOptions.for_entry`).
         scratch: a folder for the friction table while it is fitted (removed after).
         table: where to keep the friction table, or None.
+        executor, chunk_workers: where a long log's chunks go, ``chunk_workers`` at a time
+            (:func:`~wbfriction.pipeline.estimate.estimate_file`); None: all in this process.
 
     Returns:
         The outcome: rows on success; else the error's one line (a
@@ -124,7 +116,8 @@ def process_log(entry: LogEntry, key: LogKey, options: BatchOptions, scratch: Pa
         with threadpool_limits(1), scratch_folder(scratch) as folder:
             friction = table if table is not None else folder / "friction.parquet"
             estimate_file(entry.robot, entry.log, friction, options.estimate, chunking=Chunking(
-                rows=options.chunk_rows, workers=1), robot=robot)
+                rows=options.chunk_rows, workers=chunk_workers if executor is not None else 1), robot=robot,
+                executor=executor)
             est = read_friction_file(friction)
             fits = fit_estimate(est, min_samples=options.min_samples, model=options.model,
                                 selection_tolerance=options.selection_tolerance)

@@ -13,10 +13,11 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
+from typing import Any, Protocol
 
 import numpy as np
 import pyarrow as pa
@@ -73,12 +74,16 @@ def check_file(robot: Robot, path: str | Path, source: str | None = None, chunki
     return len(plan.contact)
 
 
-# worker state: the robot, loaded once per process
-_ROBOT: dict[str, Robot] = {}
+# worker state: the robots a process has loaded, by how they are loaded
+_ROBOTS: dict[RobotSpec, Robot] = {}
 
 
-def _init_worker(spec: RobotSpec) -> None:
-    _ROBOT["robot"] = spec.load()
+def worker_robot(spec: RobotSpec) -> Robot:
+    """The robot of ``spec``, loaded once per process (a worker estimates many chunks, or many logs, of one
+    robot)."""
+    if spec not in _ROBOTS:
+        _ROBOTS[spec] = spec.load()
+    return _ROBOTS[spec]
 
 
 def _estimate_chunk(robot: Robot, table: pa.Table, chunk: Chunk, clock: Clock, source: str, options: EstimateOptions,
@@ -90,26 +95,36 @@ def _estimate_chunk(robot: Robot, table: pa.Table, chunk: Chunk, clock: Clock, s
     return friction_table(est).slice(chunk.start - chunk.read_start, chunk.stop - chunk.start)
 
 
-def _in_worker(args) -> pa.Table:
-    return _estimate_chunk(_ROBOT["robot"], *args)
+def estimate_chunk_task(spec: RobotSpec, args: tuple) -> pa.Table:
+    """One chunk's friction table, as a worker computes it: ``args`` as :func:`estimate_file` sends them (the
+    chunk's rows, the chunk, its clock and the settings); the robot loaded once per process."""
+    return _estimate_chunk(worker_robot(spec), *args)
+
+
+class ChunkExecutor(Protocol):
+    """Where chunks go when not in this process: anything with ``submit(fn, *args)`` returning a future whose
+    ``result()`` is ``fn(*args)`` (a :class:`concurrent.futures.Executor`, a Dask client's adapter)."""
+
+    def submit(self, fn: Callable, /, *args: Any) -> Any: ...
 
 
 def _chunk_tables(spec: RobotSpec, robot: Robot, rows: Callable[[Chunk], pa.Table], chunks: list[Chunk], clock: Clock,
-                  workers: int, settings: tuple) -> Iterator[pa.Table]:
-    """Each chunk's friction table in order, estimated in this process or on ``workers`` processes
-    (each given its rows of the whole log's ``clock``)."""
+                  workers: int, settings: tuple, executor: ChunkExecutor | None = None) -> Iterator[pa.Table]:
+    """Each chunk's friction table in order, estimated in this process or, ``workers`` at a time, on
+    ``executor`` (default: a pool of ``workers`` processes), each given its rows of the whole log's ``clock``."""
     args = lambda c: (rows(c), c, clock.rows(c.read_start, c.read_stop),  # noqa: E731
                       *settings)
     if workers <= 1 or len(chunks) == 1:
         for c in chunks:
             yield _estimate_chunk(robot, *args(c))
         return
-    with process_pool(workers, "spawn", _init_worker, (spec,)) as pool:
+    with (nullcontext(executor) if executor is not None
+          else process_pool(workers, "spawn", worker_robot, (spec,))) as pool:
         pending: deque = deque()
         for c in chunks:
             table, *rest = args(c)
             # a slice of the reader's batches pickles with the whole batches behind it: send a copy of its rows
-            pending.append(pool.submit(_in_worker, (table.take(np.arange(table.num_rows)), *rest)))
+            pending.append(pool.submit(estimate_chunk_task, spec, (table.take(np.arange(table.num_rows)), *rest)))
             if len(pending) > workers:  # bounded read-ahead: bounded memory
                 yield pending.popleft().result()
         while pending:
@@ -172,7 +187,7 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
                   limit_margin: float = LIMIT_MARGIN, extra_metadata: dict | None = None,
                   progress: Progress | None = None, robot: Robot | None = None,
                   source: str | None = None, time_base: TimeBase = "auto",
-                  time_unit: TimeUnit | None = None) -> ChunkedResult:
+                  time_unit: TimeUnit | None = None, executor: ChunkExecutor | None = None) -> ChunkedResult:
     """Estimate a log file chunk by chunk into ``output`` (Parquet or CSV), whole or not at all.
 
     Args:
@@ -191,6 +206,9 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
         time_base: ``auto``, ``recorded`` or ``regularised``
             (:func:`~wbfriction.logs.clock.read_clock`, decided once for the whole log).
         time_unit: the unit of a numeric ``time`` column (:func:`~wbfriction.logs.clock.table_stamps`).
+        executor: where the chunks go instead of a pool of ``chunking.workers`` processes (e.g. a Dask cluster,
+            :mod:`wbfriction.fleet.batch`), ``chunking.workers`` at a time, when the log has enough chunks
+            (:meth:`~wbfriction.pipeline.chunks.Chunking.processes`). The table is the same.
 
     Raises:
         InputError: what reading, validating and estimating raise, naming the file and row;
@@ -221,7 +239,7 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     rows = partial(chunk_rows, reader, robot, plan)
     write_tables(output, _with_provenance(_chunk_tables(spec, robot, rows, chunks, clock,
                                                         chunking.processes(len(chunks)),
-                                                        settings),
+                                                        settings, executor),
                                           chunks, robot, source, extra_metadata, progress, first_meta, valid))
     return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta,
                          clock.reason, "" if choice is None else choice.reason,
