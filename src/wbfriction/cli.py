@@ -929,6 +929,35 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
         console.print(f"wrote {f}")
 
 
+@app.command("study-fleet")
+def study_fleet(output_dir: Path = typer.Option(Path("wbfriction-fleet"), "-o", "--output-dir", help="Where to write."),
+                robots: int = typer.Option(4, min=1, help="Robots of the fleet."),
+                logs: int = typer.Option(25, min=12, help="Logs per robot (one a day)."),
+                workers: int = typer.Option(2, min=1, help="Worker processes of the local Dask cluster.")) -> None:
+    """A simulated TALOS fleet whose friction drifts on two joints (issue 25): batch, trends, and the joints
+    flagged against the truth."""
+    import dataclasses
+
+    from wbfriction.studies.fleet import FleetPlan, run_fleet_study
+
+    plan = dataclasses.replace(FleetPlan(), robots=robots, logs=logs)
+    if robots < 3:
+        plan = dataclasses.replace(plan, drifts=tuple(d for d in plan.drifts if d.robot_id in plan.robot_ids))
+    with console.status("") as status:
+        study = run_fleet_study(_robot("talos", None, None), output_dir, plan, workers,
+                                progress=lambda label: status.update(label))
+    s = study.score
+    for robot_id, joint, quantity, onset in study.flagged:
+        console.print(f"flagged: {robot_id} {joint} ({quantity}, onset at log {onset})", highlight=False)
+    console.print(f"drifts found {len(s.found)} of {len(plan.drifts)} (onset errors in logs: "
+                  f"{', '.join(str(e) for e in s.found.values()) or '-'}), missed {len(s.missed)}, false alarms "
+                  f"{len(s.false_alarms)} of {s.series} robot-joint series; simulate "
+                  f"{study.seconds['simulate']:.0f} s, batch {study.seconds['batch']:.0f} s, trends "
+                  f"{study.seconds['trends']:.1f} s")
+    for f in study.files:
+        console.print(f"wrote {f}")
+
+
 @app.command("study-filters")
 def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-o", "--output-dir",
                                                   help="Where to write."),
@@ -1025,6 +1054,40 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
                   f"done; results in {output} ({time.perf_counter() - start:.1f} s)")
     if summary.failed:
         raise typer.Exit(1)
+
+
+@app.command()
+def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results folder written by 'wbfriction "
+                                                                       "batch'."),
+           output: Path = typer.Option(..., "-o", "--output", help="HTML page to write (.html)."),
+           table: Optional[Path] = typer.Option(None, "--table", help="Also write the trends as a table "
+                                                                      "(.parquet or .csv)."),
+           alpha: float = typer.Option(1e-3, min=1e-6, max=0.5, help="False-alarm probability per joint."),
+           min_change: float = typer.Option(0.10, min=0.0, help="Smallest change flagged, relative to the "
+                                                                "baseline (0.1: 10 %)."),
+           title: str = typer.Option("Friction trends", help="The page's title.")) -> None:
+    """Friction over time per robot and joint, and the joints whose friction drifted (a hinge change detector
+    weighted by the fits' standard errors), as one HTML page."""
+    from wbfriction.fleet.results import read_results
+    from wbfriction.fleet.trends import TrendOptions, fleet_trends
+    from wbfriction.logs.tables import write_table
+    from wbfriction.report.trends import write_trends_html
+
+    if output.suffix.lower() not in (".html", ".htm"):
+        raise InputError(f"-o {output}: the trends page is written as .html")
+    if table is not None and table.suffix.lower() not in (".parquet", ".pq", ".csv"):
+        raise InputError(f"--table {table}: written as .parquet or .csv")
+    check_paths({"RESULTS": results}, {"-o": output, **({"--table": table} if table is not None else {})})
+    found = fleet_trends(read_results(results), TrendOptions(alpha=alpha, min_change=min_change))
+    write_trends_html(found, output, title)
+    if table is not None:
+        write_table(found.to_table(), table)
+    for j in found.flagged:
+        cp = j.drifts[0]
+        console.print(f"drift: {j.robot_id} {j.joint}: {cp.quantity} {100 * cp.relative:+.1f} % from "
+                      f"{cp.onset_time:%Y-%m-%d} (p {cp.p_value:.2g})", highlight=False)
+    console.print(f"{len(found.flagged)} of {len(found.joints)} robot joints drifted; wrote {output}"
+                  + (f" and {table}" if table is not None else ""))
 
 
 def _version(value: bool) -> None:

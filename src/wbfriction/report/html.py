@@ -24,7 +24,7 @@ from wbfriction.report.build import Report, acceleration_spectra
 from wbfriction.report.figures import friction_overview_figure, joint_figure, png_bytes
 from wbfriction.workers import process_pool
 
-_CSS = """
+PAGE_CSS = """
 body { font-family: system-ui, -apple-system, "Segoe UI", sans-serif; margin: 0 auto; max-width: 1480px;
        padding: 0 24px 48px; color: #1d232a; font-size: 15px; line-height: 1.45; }
 h1 { font-size: 1.6rem; margin: 24px 0 4px; } h2 { font-size: 1.25rem; margin-top: 36px;
@@ -370,7 +370,7 @@ def _page(r: Report, overview: str, sections: list[str]) -> str:
                  f'<p class="sub">{", ".join(html.escape(r.label(j)) for j in r.still)}</p></details>')
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
-<title>wbfriction report: {html.escape(robot)}</title><style>{_CSS}</style></head>
+<title>wbfriction report: {html.escape(robot)}</title><style>{PAGE_CSS}</style></head>
 <body>
 <h1>Joint friction report: {html.escape(robot)}</h1>
 <p class="sub">{len(est.time)} samples, {est.time[-1] - est.time[0]:.1f} s, {int(est.unique.sum())} in single support,

@@ -1,0 +1,339 @@
+"""Friction over time, per robot and joint, and the joints whose friction drifted (issue 25).
+
+Each robot's joint gives one series per followed quantity (:data:`~wbfriction.fleet.schema.TREND_PARAMS` and
+the friction at the reference speeds), one point per log: the value and its standard error. A log whose fit is
+not usable (``not excited``, ``failed``) or whose value or standard error is not finite gives no point; nor, for
+a model parameter, a log fitted with another model than the joint's most frequent one (``fit --model auto``
+may choose per log, and F_c of the Coulomb-viscous model is not F_c of (3.5)). The friction at a reference
+speed is the same quantity in every model: every usable log gives a point.
+
+**The change detector** is a generalised likelihood-ratio test of a constant against a constant followed by
+a linear drift from an unknown onset (a hinge, or "broken-stick", regression: Hinkley 1971, "Inference in
+two-phase regression", JASA 66; the weighted form of Julious 2001, "Inference and estimation in a changepoint
+regression problem", The Statistician 50), weighted by the standard errors:
+
+* points ``y_i`` at times ``t_i`` [days], errors ``e_i ~ N(0, phi se_i^2)`` with an unknown scale ``phi``
+  (the fits' standard errors may be off by a common factor: Newey-West, a model that trades parameters);
+* for each candidate onset ``k`` (at least :attr:`TrendOptions.min_before` points before, at least
+  :attr:`TrendOptions.min_after` from it on), the hinge regressor ``x_i = max(0, t_i - t_{k-1})`` (zero up to
+  the last log before the onset, growing from the first drifted log on);
+* the statistic ``F_k = (RSS_0 - RSS_k) / (RSS_k / (n - 2))`` with weighted residual sums of squares; the
+  onset is the ``k`` of the largest ``F_k``;
+* its p-value, exact for this model whatever ``phi`` (``F_k`` does not depend on it): the share of
+  :attr:`TrendOptions.replicates` series of pure noise ``se_i z_i`` (seeded: the same input gives the same
+  output) whose largest ``F_k`` reaches the observed one, on the same times and weights;
+* a joint is flagged when one of its quantities has a p-value below ``alpha / m`` (Bonferroni over its ``m``
+  quantities with enough points) **and** a change at the last log of at least
+  :attr:`TrendOptions.min_change` of its baseline (F_c's for ``tau_os``, which may be zero): a significant
+  change too small to matter is not a drift.
+
+Sign convention: the values are those of the results dataset (:mod:`wbfriction.fleet.schema`): ``F_c``,
+``F_v`` and ``f_at_<v>`` positive for friction opposing the motion.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from datetime import UTC, datetime, timedelta
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
+
+from wbfriction.exceptions import InputError
+from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
+
+QUANTITIES: tuple[str, ...] = (*TREND_PARAMS, *[speed_column(v) for v in REFERENCE_SPEEDS])
+"""The quantities followed over time: the model's parameters and the friction at the reference speeds."""
+USABLE = ("ok", "weak", "at bound")
+"""The fit statuses whose values are points of a series (``not excited`` and ``failed`` fits have none)."""
+DAY = 86_400.0
+"""Seconds per day: the series' time unit."""
+
+
+@dataclass(frozen=True)
+class TrendOptions:
+    """The change detector's settings (module docstring).
+
+    Attributes:
+        alpha: the false-alarm probability per joint (Bonferroni over its quantities).
+        min_points: fewer points: no test.
+        min_before, min_after: points before the onset, and from it on.
+        min_change: the smallest change at the last log that is flagged, relative to the baseline.
+        replicates: noise series of the p-value's Monte Carlo (the smallest p-value is ``1 / (replicates + 1)``).
+        seed: of those series.
+        quantities: the quantities tested.
+    """
+
+    alpha: float = 1e-3
+    min_points: int = 8
+    min_before: int = 3
+    min_after: int = 3
+    min_change: float = 0.10
+    replicates: int = 20_000
+    seed: int = 0
+    quantities: tuple[str, ...] = QUANTITIES
+
+    def __post_init__(self) -> None:
+        if not 0 < self.alpha < 1:
+            raise InputError(f"alpha must be in (0, 1), got {self.alpha}")
+        need = int(np.ceil(len(self.quantities) / self.alpha))  # the smallest p-value below alpha / m
+        if self.replicates < max(2 * FIRST_PASS, need):
+            raise InputError(f"{self.replicates} replicates cannot resolve alpha {self.alpha} over "
+                             f"{len(self.quantities)} quantities: give at least {max(2 * FIRST_PASS, need)}")
+        unknown = set(self.quantities) - set(QUANTITIES)
+        if unknown:
+            raise InputError(f"unknown quantities {sorted(unknown)}: choose from {', '.join(QUANTITIES)}")
+
+
+@dataclass(frozen=True)
+class Series:
+    """One quantity of one joint over time.
+
+    Attributes:
+        quantity: its name (:data:`QUANTITIES`).
+        time: (n,) the logs' start times (UTC).
+        value, se: (n,) values and standard errors [N·m, N·m·s/rad], NaN where the log gave no point.
+        used: (n,) the logs that are points of the series.
+    """
+
+    quantity: str
+    time: list[datetime]
+    value: np.ndarray
+    se: np.ndarray
+    used: np.ndarray
+
+
+@dataclass(frozen=True)
+class ChangePoint:
+    """The best hinge of one series (module docstring).
+
+    Attributes:
+        quantity: the series' quantity.
+        onset: index (into the series' logs) of the first drifted log; onset_time: its start time.
+        baseline: the fitted value before the onset.
+        change, change_se: the fitted change at the last log, and its standard error (same unit).
+        statistic: the largest ``F_k``; p_value: its Monte Carlo p-value.
+        relative: ``change`` over the baseline (over F_c's baseline for ``tau_os``).
+    """
+
+    quantity: str
+    onset: int
+    onset_time: datetime
+    baseline: float
+    change: float
+    change_se: float
+    statistic: float
+    p_value: float
+    relative: float
+
+
+@dataclass(frozen=True)
+class JointTrend:
+    """One robot's joint over time: its series, each series' best hinge, and the drifts found.
+
+    Attributes:
+        robot_id, joint: which.
+        series: quantity -> :class:`Series`.
+        tests: quantity -> its best hinge (quantities with too few points have none).
+        drifts: the hinges that are flagged, most significant first.
+    """
+
+    robot_id: str
+    joint: str
+    series: dict[str, Series]
+    tests: dict[str, ChangePoint] = field(default_factory=dict)
+    drifts: tuple[ChangePoint, ...] = ()
+
+    @property
+    def flagged(self) -> bool:
+        return bool(self.drifts)
+
+    @property
+    def onset_time(self) -> datetime | None:
+        """When the most significant drift started, or None."""
+        return self.drifts[0].onset_time if self.drifts else None
+
+
+@dataclass(frozen=True)
+class FleetTrends:
+    """Every robot's joints over time: flagged ones first (earliest onset first), then by robot and joint."""
+
+    joints: list[JointTrend]
+    options: TrendOptions
+
+    @property
+    def flagged(self) -> list[JointTrend]:
+        return [j for j in self.joints if j.flagged]
+
+    def to_table(self) -> pa.Table:
+        """One row per robot, joint and tested quantity: the best hinge, whether it is a flagged drift."""
+        rows: dict[str, list] = {k: [] for k in ("robot_id", "joint", "quantity", "points", "flagged", "onset_time",
+                                                 "baseline", "change", "change_se", "relative_change", "p_value",
+                                                 "last_value")}
+        for j in self.joints:
+            for q, cp in j.tests.items():
+                s = j.series[q]
+                rows["robot_id"].append(j.robot_id)
+                rows["joint"].append(j.joint)
+                rows["quantity"].append(q)
+                rows["points"].append(int(s.used.sum()))
+                rows["flagged"].append(cp in j.drifts)
+                rows["onset_time"].append(cp.onset_time)
+                rows["baseline"].append(cp.baseline)
+                rows["change"].append(cp.change)
+                rows["change_se"].append(cp.change_se)
+                rows["relative_change"].append(cp.relative)
+                rows["p_value"].append(cp.p_value)
+                rows["last_value"].append(float(s.value[s.used][-1]))
+        schema = pa.schema([("robot_id", pa.string()), ("joint", pa.string()), ("quantity", pa.string()),
+                            ("points", pa.int64()), ("flagged", pa.bool_()),
+                            ("onset_time", pa.timestamp("us", tz="UTC")),
+                            *[(n, pa.float64()) for n in ("baseline", "change", "change_se", "relative_change",
+                                                         "p_value", "last_value")]])
+        return pa.Table.from_pydict(rows, schema=schema)
+
+
+def hinge_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, min_after: int
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The statistics ``F_k`` of every candidate onset (module docstring) for the columns of ``y``.
+
+    Args:
+        t: (n,) increasing times [days]; y: (n,) or (n, r) values; se: (n,) standard errors (> 0).
+
+    Returns:
+        ``(onsets, F, fits)``: the candidate onsets (c,), ``F`` (c,) or (c, r), and per onset the weighted
+        least-squares coefficients (c, 2) or (c, 2, r) of ``[1, x_k]`` (baseline, slope per day).
+    """
+    n = t.size
+    w = 1.0 / se
+    Y = (y if y.ndim == 2 else y[:, None]) * w[:, None]
+    # RSS_0: the weighted mean removed
+    q0 = w / np.linalg.norm(w)
+    r0 = Y - np.outer(q0, q0 @ Y)
+    rss0 = np.einsum("ij,ij->j", r0, r0)
+    yy = np.einsum("ij,ij->j", Y, Y)
+    onsets = np.arange(min_before, n - min_after + 1)
+    F = np.empty((onsets.size, Y.shape[1]))
+    coef = np.empty((onsets.size, 2, Y.shape[1]))
+    for c, k in enumerate(onsets):
+        X = np.column_stack([w, np.maximum(0.0, t - t[k - 1]) * w])
+        Q, R = np.linalg.qr(X)
+        QtY = Q.T @ Y
+        rss = np.maximum(yy - np.einsum("ij,ij->j", QtY, QtY), 1e-300)
+        F[c] = (rss0 - rss) / (rss / (n - 2))
+        coef[c] = np.linalg.solve(R, QtY)
+    if y.ndim == 1:
+        return onsets, F[:, 0], coef[:, :, 0]
+    return onsets, F, coef
+
+
+FIRST_PASS = 1000
+"""Noise series of the p-value's first pass: a statistic that :data:`CLEAR` of them reach is no drift, and the
+full :attr:`TrendOptions.replicates` are drawn only for the others (most series of a fleet are constant)."""
+CLEAR = 20
+
+
+def null_p_value(t: np.ndarray, se: np.ndarray, statistic: float, options: TrendOptions) -> float:
+    """The share of series of pure noise ``se_i z_i`` on times ``t`` whose largest ``F_k`` reaches ``statistic``
+    (seeded by :attr:`TrendOptions.seed`; ``(1 + hits) / (1 + draws)``)."""
+    rng = np.random.default_rng(options.seed)
+    hits, draws = 0, 0
+    for size in (FIRST_PASS, options.replicates - FIRST_PASS):
+        noise = se[:, None] * rng.standard_normal((t.size, size))
+        _, F_null, _ = hinge_scan(t, noise, se, options.min_before, options.min_after)
+        hits += int(np.sum(F_null.max(axis=0) >= statistic))
+        draws += size
+        if hits >= CLEAR:
+            break
+    return (1 + hits) / (1 + draws)
+
+
+def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity: str = "",
+                  options: TrendOptions = TrendOptions(), scale: float | None = None) -> ChangePoint | None:
+    """The best hinge of a series and its p-value (module docstring); None with too few finite points.
+
+    Args:
+        time: (n,) the points' times, increasing; y, se: (n,) values and standard errors (non-finite ones and
+            non-positive standard errors are left out).
+        quantity: the series' name, recorded.
+        scale: the baseline the relative change is measured against (default: the fitted baseline).
+    """
+    ok = np.isfinite(y) & np.isfinite(se) & (se > 0)
+    idx = np.flatnonzero(ok)
+    if idx.size < max(options.min_points, options.min_before + options.min_after):
+        return None
+    t0 = time[idx[0]]
+    t = np.array([(time[i] - t0).total_seconds() / DAY for i in idx])
+    yy, ss = y[idx], se[idx]
+    onsets, F, coef = hinge_scan(t, yy, ss, options.min_before, options.min_after)
+    best = int(np.argmax(F))
+    p = null_p_value(t, ss, float(F[best]), options)
+    k = int(onsets[best])
+    base, slope = coef[best]
+    span = t[-1] - t[k - 1]
+    # the change at the last log and its standard error, the residual scale phi estimated
+    w = 1.0 / ss
+    X = np.column_stack([w, np.maximum(0.0, t - t[k - 1]) * w])
+    resid = yy * w - X @ coef[best]
+    phi = float(resid @ resid) / max(idx.size - 2, 1)
+    cov = phi * np.linalg.inv(X.T @ X)
+    change = float(slope * span)
+    ref = abs(base) if scale is None else abs(scale)
+    return ChangePoint(quantity, int(idx[k]), time[idx[k]], float(base), change,
+                       float(np.sqrt(cov[1, 1]) * span), float(F[best]), float(p),
+                       change / ref if ref > 0 else float("inf"))
+
+
+def joint_trend(robot_id: str, joint: str, rows: pa.Table, options: TrendOptions = TrendOptions()) -> JointTrend:
+    """One joint's series (its rows of the results, one per log, in time order) and the drifts found."""
+    rows = rows.take(pc.sort_indices(rows, sort_keys=[("start_time", "ascending"), ("log", "ascending")]))
+    time = [t.astimezone(UTC) for t in rows.column("start_time").to_pylist()]
+    usable = np.isin(np.array(rows.column("status").to_pylist(), dtype=object), USABLE)
+    models = np.array(rows.column("model").to_pylist(), dtype=object)
+    dominant = max(sorted(set(models[usable])), key=lambda m: int(np.sum(models[usable] == m)), default=None)
+    series = {}
+    for q in options.quantities:
+        # a parameter means one thing in one model: its series keeps the logs fitted with the joint's most
+        # frequent model; the friction at a speed is the same quantity whatever the model
+        same = usable if q.startswith("f_at_") else usable & (models == dominant)
+        value = np.asarray(rows.column(q).to_numpy(zero_copy_only=False), dtype=float)
+        se = np.asarray(rows.column(q + "_se").to_numpy(zero_copy_only=False), dtype=float)
+        used = same & np.isfinite(value) & np.isfinite(se) & (se > 0)
+        series[q] = Series(q, time, np.where(used, value, np.nan), np.where(used, se, np.nan), used)
+    tests: dict[str, ChangePoint] = {}
+    for q, s in series.items():
+        scale = None
+        if q == "tau_os":  # an offset may be zero: its change is measured against the Coulomb friction
+            f_c = series.get("F_c")
+            scale = float(np.nanmedian(f_c.value)) if f_c is not None and f_c.used.any() else None
+        cp = detect_change(time, s.value, s.se, q, options, scale)
+        if cp is not None:
+            tests[q] = cp
+    m = max(len(tests), 1)
+    drifts = sorted((cp for cp in tests.values()
+                     if cp.p_value < options.alpha / m and abs(cp.relative) >= options.min_change),
+                    key=lambda cp: (cp.p_value, -cp.statistic))
+    return JointTrend(robot_id, joint, series, tests, tuple(drifts))
+
+
+def fleet_trends(table: pa.Table, options: TrendOptions = TrendOptions()) -> FleetTrends:
+    """Every robot's joints over time (:func:`joint_trend`), from the results dataset
+    (:func:`~wbfriction.fleet.results.read_results`).
+
+    Raises:
+        InputError: a table without the results' columns, or with no row.
+    """
+    missing = [n for n in RESULT_SCHEMA.names if n not in table.column_names]
+    if missing:
+        raise InputError(f"not a fleet's results: no column {missing[0]!r}")
+    if table.num_rows == 0:
+        raise InputError("the results hold no log")
+    out = []
+    keys = sorted(set(zip(table.column("robot_id").to_pylist(), table.column("joint").to_pylist())))
+    for robot_id, joint in keys:
+        mask = pc.and_(pc.equal(table.column("robot_id"), robot_id), pc.equal(table.column("joint"), joint))
+        out.append(joint_trend(robot_id, joint, table.filter(mask), options))
+    far = datetime.max.replace(tzinfo=UTC) - timedelta(days=1)
+    out.sort(key=lambda j: (not j.flagged, j.onset_time or far, j.robot_id, j.joint))
+    return FleetTrends(out, options)
