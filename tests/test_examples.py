@@ -43,6 +43,18 @@ def test_estimate_a_log():
     assert tau_os == pytest.approx(1.0, rel=0.02)
 
 
+@pytest.mark.slow
+def test_fleet_trends(tmp_path):
+    """Two simulated arms, 12 logs each, on Dask: arm 1's joint 4 alone flagged, from the day its wear began."""
+    out = run_example("fleet_trends.py", "--output", str(tmp_path))
+    assert "24 logs processed on Dask" in out
+    flagged = re.findall(r"drift: (\S+) (\S+) \S+ \+\d+ % from (\S+)", out)
+    assert [f[:2] for f in flagged] == [("arm-1", "panda_joint4")]
+    onset = int(flagged[0][2].split("-")[2])  # the first worn log is the 8th, on January 12
+    assert abs(onset - 12) <= 2
+    assert "1 of 14 joints drifted" in out and (tmp_path / "trends.html").is_file()
+
+
 def test_your_own_robot():
     out = run_example("your_own_robot.py", "--steps", "2")
     assert "16 torque-controlled joints, 16 position-controlled" in out

@@ -1,24 +1,21 @@
 """The change detector (issue 25): analytic hinges, false alarms on constant series, drifts found with their
-onset, invariance to a common scale of the standard errors; end to end on a simulated arm fleet."""
+onset, invariance to a common scale of the standard errors; the trends of a results table and their page (end to
+end on simulated arms: tests/test_examples.py, fleet_trends.py)."""
 
 from __future__ import annotations
 
-import dataclasses
 from datetime import UTC, datetime, timedelta
 
 import numpy as np
+import pyarrow as pa
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from wbfriction.fleet.batch import run_batch
-from wbfriction.fleet.manifest import read_manifest
-from wbfriction.fleet.results import read_results
+from wbfriction.exceptions import InputError
+from wbfriction.fleet.schema import RESULT_SCHEMA
 from wbfriction.fleet.trends import TrendOptions, detect_change, fleet_trends
-from wbfriction.logs.tables import write_table
-from wbfriction.model.loading import load_robot
 from wbfriction.report.trends import write_trends_html
-from wbfriction.sim.arm import ArmOptions, default_arm_friction, simulate_arm
 
 DAYS = [datetime(2026, 1, 1, tzinfo=UTC) + timedelta(days=i) for i in range(25)]
 FAST = TrendOptions(replicates=10_000)
@@ -82,29 +79,44 @@ def test_points_without_value_or_error_are_left_out():
     assert detect_change(DAYS[:5], y[:5], se[:5], "F_c", FAST) is None  # too few points
 
 
-@pytest.mark.slow
-def test_an_arm_fleet_flags_the_joint_that_drifted(tmp_path):
-    """Two simulated Panda arms, 12 logs each: the fourth joint of arm-1 gets F_c +40 % over its last 5 logs.
-    The trends flag that joint alone (of 14), with the onset within 2 logs; the page is the same bytes twice."""
-    robot = load_robot("panda")
-    base = default_arm_friction(robot)
-    lines = ["log,robot_id,start_time,robot"]
-    for r in range(2):
-        for i in range(12):
-            friction = dict(base)
-            if r == 1:
-                p = base["panda_joint4"]
-                friction["panda_joint4"] = dataclasses.replace(p, F_c=p.F_c * (1 + ramp(12, 5, 0.4)[i]))
-            sim = simulate_arm(robot, friction, options=ArmOptions(duration=3.0, seed=100 * r + i, torque_std=0.01))
-            write_table(sim.table, tmp_path / f"{r}_{i}.parquet")
-            lines.append(f"{r}_{i}.parquet,arm-{r},{DAYS[i].isoformat()},panda")
-    (tmp_path / "m.csv").write_text("\n".join(lines) + "\n")
-    run_batch(read_manifest(tmp_path / "m.csv"), tmp_path / "results", engine="serial")
-    trends = fleet_trends(read_results(tmp_path / "results"))
-    assert [(j.robot_id, j.joint) for j in trends.flagged] == [("arm-1", "panda_joint4")]
-    assert abs(trends.flagged[0].drifts[0].onset - 7) <= 2
+def synthetic_results(drift: float) -> pa.Table:
+    """A results table of 2 robots x 2 joints x 25 logs, constant but for robot r1's j1, whose F_c and friction at
+    0.3 rad/s grow by ``drift`` over the last 10 logs."""
+    rng = np.random.default_rng(11)
+    rows: dict[str, list] = {n: [] for n in RESULT_SCHEMA.names}
+    for robot_id in ("r0", "r1"):
+        for joint in ("j0", "j1"):
+            grow = 1.0 + (ramp(25, 10, drift) if (robot_id, joint) == ("r1", "j1") else np.zeros(25))
+            for i, t in enumerate(DAYS):
+                values = {"F_c": 1.0 * grow[i], "F_v": 0.2, "tau_os": 0.1, "f_at_0.1": 1.02 * grow[i],
+                          "f_at_0.3": 1.06 * grow[i], "f_at_1": float("nan")}
+                row = {n: float("nan") for n in RESULT_SCHEMA.names}
+                row.update(robot_id=robot_id, log=f"{robot_id}/{i}", start_time=t, key=f"{robot_id}{i}",
+                           log_sha256="", robot_sha256="", options_sha256="", joint=joint, model="thesis",
+                           status="ok", n_samples=1000, version="test")
+                for q, v in values.items():
+                    row[q] = v + 0.02 * v * rng.standard_normal()
+                    row[q + "_se"] = 0.02 * v
+                for n in RESULT_SCHEMA.names:
+                    rows[n].append(row[n])
+    return pa.Table.from_pydict(rows, schema=RESULT_SCHEMA)
+
+
+def test_fleet_trends_flag_the_drifted_joint_first_and_the_page_is_reproducible(tmp_path):
+    trends = fleet_trends(synthetic_results(0.3), FAST)
+    assert [(j.robot_id, j.joint) for j in trends.flagged] == [("r1", "j1")]
+    assert (trends.joints[0].robot_id, trends.joints[0].joint) == ("r1", "j1")  # flagged first
+    assert abs(trends.flagged[0].drifts[0].onset - 15) <= 3
+    table = trends.to_table()
+    assert table.num_rows == 4 * 5  # 4 joints x 5 quantities with points (f_at_1 has none)
     write_trends_html(trends, tmp_path / "a.html")
-    write_trends_html(fleet_trends(read_results(tmp_path / "results")), tmp_path / "b.html")
-    page = (tmp_path / "a.html").read_text()
+    write_trends_html(fleet_trends(synthetic_results(0.3), FAST), tmp_path / "b.html")
     assert (tmp_path / "a.html").read_bytes() == (tmp_path / "b.html").read_bytes()
-    assert page.index("arm-1") < page.index("panda_joint4") and "<script" not in page
+    page = (tmp_path / "a.html").read_text()
+    assert "<script" not in page and page.index("r1 j1") < page.index('id="r0"')
+    assert fleet_trends(synthetic_results(0.0), FAST).flagged == []
+
+
+def test_a_table_that_is_not_results_is_refused():
+    with pytest.raises(InputError, match="not a fleet's results: no column"):
+        fleet_trends(pa.table({"robot_id": ["a"]}))

@@ -1,0 +1,13 @@
+"""Names of :mod:`wbfriction.fleet`, imported on first use (:func:`lazy_loader.attach_stub`)."""
+
+from .batch import BatchSummary as BatchSummary
+from .batch import run_batch as run_batch
+from .manifest import LogEntry as LogEntry
+from .manifest import read_manifest as read_manifest
+from .manifest import scan_folder as scan_folder
+from .options import BatchOptions as BatchOptions
+from .results import read_failures as read_failures
+from .results import read_results as read_results
+from .trends import FleetTrends as FleetTrends
+from .trends import TrendOptions as TrendOptions
+from .trends import fleet_trends as fleet_trends
