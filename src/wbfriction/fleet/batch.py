@@ -15,6 +15,7 @@ tried again by the next run.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -170,14 +171,15 @@ def local_cluster(workers: int) -> Any:
     ``MALLOC_TRIM_THRESHOLD_=65536`` for them: it turns off glibc's adaptive mmap threshold, so that every
     NumPy array above 64 KiB is mapped and unmapped afresh, and a log's task took 1.5-2x as long as in this
     process (measured: 6 Panda logs, 3.3-6.1 s per task against 2.3-3.5 s). The cluster's dashboard is on any
-    free port."""
+    free port; its workers log errors only (a worker that takes over 4 s to close is not the user's concern)."""
     import dask
     from distributed import LocalCluster
 
     environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
                if k != "MALLOC_TRIM_THRESHOLD_"}
     with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
-        return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
+        return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0",
+                            silence_logs=logging.ERROR)
 
 
 def _run_on_dask(args: list[tuple], record: Callable[[LogOutcome], None], workers: int, scheduler: str | None,
