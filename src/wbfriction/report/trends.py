@@ -25,6 +25,9 @@ from wbfriction.report.html import PAGE_CSS
 SHOWN = ("F_c", "F_v", "f_at_0.3")
 """The quantities each joint's panel shows (every tested quantity is in the table)."""
 COLORS = {"F_c": "C0", "F_v": "C1", "f_at_0.3": "C2"}
+UNREADABLE = 0.5
+"""A series whose median standard error exceeds this share of its baseline is left out of its panel (its numbers
+stay in the table): a parameter near zero, such as the viscous friction of a joint that barely moves."""
 
 
 def _relative(j: JointTrend, q: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -40,7 +43,8 @@ def _relative(j: JointTrend, q: str) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 def joints_figure(joints: list[JointTrend], title: str, columns: int = 4) -> Figure:
     """Small multiples, one joint per axes: :data:`SHOWN` over time relative to their baselines, ± one
-    standard error; a flagged joint's title in red and its drift's onset a dashed line."""
+    standard error (a series of :data:`UNREADABLE` precision left out); a flagged joint's title in red and its
+    drift's onset a dashed line."""
     n = max(len(joints), 1)
     columns = min(columns, n)
     rows = int(np.ceil(n / columns))
@@ -51,7 +55,13 @@ def joints_figure(joints: list[JointTrend], title: str, columns: int = 4) -> Fig
             for q in SHOWN:
                 if q in j.series and j.series[q].used.any():
                     t, y, e = _relative(j, q)
+                    if np.median(e) > UNREADABLE:  # a value near zero: its ratio would flatten the others
+                        continue
                     ax.errorbar(t, y, yerr=e, fmt="o-", ms=3, lw=0.8, color=COLORS[q], label=q, capsize=0)
+            if not ax.lines:
+                ax.text(0.5, 0.5, "no quantity precise\nenough to draw:\nsee the table", ha="center", va="center",
+                        transform=ax.transAxes, color="#5f6b76")
+                ax.set_yticks([])
             for cp in j.drifts[:1]:
                 ax.axvline(cp.onset_time, color="C3", ls="--", lw=1.0)  # type: ignore[arg-type]
             ax.axhline(1.0, color="#888888", lw=0.6)
@@ -60,9 +70,13 @@ def joints_figure(joints: list[JointTrend], title: str, columns: int = 4) -> Fig
             ax.tick_params(axis="x", labelrotation=30)
         for ax in axes[len(joints):]:
             ax.set_visible(False)
-        handles, names = axes[0].get_legend_handles_labels()
-        if handles:
-            fig.legend(handles, names, loc="outside lower right", ncols=len(handles))
+        legend = {}
+        for ax in axes:  # every quantity shown somewhere, once
+            for handle, name in zip(*ax.get_legend_handles_labels()):
+                legend.setdefault(name, handle)
+        if legend:
+            names = [q for q in SHOWN if q in legend]
+            fig.legend([legend[q] for q in names], names, loc="outside lower right", ncols=len(names))
         fig.supylabel("value / baseline")
         fig.suptitle(title)
     return fig
