@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib import rc_context
+from matplotlib.artist import Artist
 from matplotlib.figure import Figure
 
 from wbfriction.fleet.trends import FleetTrends, JointTrend
@@ -63,14 +64,14 @@ def joints_figure(joints: list[JointTrend], title: str, columns: int = 4) -> Fig
                         transform=ax.transAxes, color="#5f6b76")
                 ax.set_yticks([])
             for cp in j.drifts[:1]:
-                ax.axvline(cp.onset_time, color="C3", ls="--", lw=1.0)  # type: ignore[arg-type]
+                ax.axvline(cp.onset_time, color="C3", ls="--", lw=1.0)
             ax.axhline(1.0, color="#888888", lw=0.6)
             ax.set_title(j.joint.removesuffix("_joint") + (f"  drift: {j.drifts[0].quantity}" if j.flagged else ""),
                          color="C3" if j.flagged else "k")
             ax.tick_params(axis="x", labelrotation=30)
         for ax in axes[len(joints):]:
             ax.set_visible(False)
-        legend = {}
+        legend: dict[str, Artist] = {}
         for ax in axes:  # every quantity shown somewhere, once
             for handle, name in zip(*ax.get_legend_handles_labels()):
                 legend.setdefault(name, handle)
