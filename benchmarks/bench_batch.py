@@ -1,6 +1,7 @@
 """The batch on Dask against the serial run, and the trend report (issue 25).
 
-Makes ``--logs`` logs (a simulated Panda arm, ``--seconds`` each, a different noise seed per log) or takes a
+Makes ``--logs`` logs (two simulated Panda arms, ``--seconds`` each, a different noise seed per log:
+:func:`~wbfriction.studies.fleet.simulate_arm_fleet`) or takes a
 ``--manifest``, then, in this one run, processes them serially (the reference) and on a local Dask cluster of
 ``--workers`` processes, and prints for each: logs per minute, rows per second, and the Dask run's overhead per
 task (``(workers * wall_dask - wall_serial) / logs``: what the cluster costs beyond dividing the work), the
@@ -16,7 +17,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
-from datetime import UTC, datetime, timedelta
+from datetime import timedelta
 from pathlib import Path
 
 import pyarrow as pa
@@ -26,24 +27,7 @@ import pyarrow.parquet as pq
 from wbfriction.fleet.batch import local_cluster, run_batch
 from wbfriction.fleet.manifest import read_manifest
 from wbfriction.fleet.results import read_results
-from wbfriction.logs.tables import write_table
-from wbfriction.model.loading import load_robot
-from wbfriction.sim.arm import ArmOptions, default_arm_friction, simulate_arm
-
-
-def make_logs(folder: Path, logs: int, seconds: float) -> Path:
-    """``logs`` simulated Panda logs of two robots and their manifest in ``folder``."""
-    robot = load_robot("panda")
-    friction = default_arm_friction(robot)
-    lines = ["log,robot_id,start_time,robot"]
-    start = datetime(2026, 1, 1, tzinfo=UTC)
-    for i in range(logs):
-        name = f"log{i:03d}.parquet"
-        sim = simulate_arm(robot, friction, options=ArmOptions(duration=seconds, seed=i, torque_std=0.01))
-        write_table(sim.table, folder / name)
-        lines.append(f"{name},arm-{i % 2},{(start + timedelta(days=i // 2)).isoformat()},panda")
-    (folder / "manifest.csv").write_text("\n".join(lines) + "\n")
-    return folder / "manifest.csv"
+from wbfriction.studies.fleet import simulate_arm_fleet
 
 
 def files(results: Path) -> dict[str, bytes]:
@@ -83,7 +67,8 @@ def main() -> None:
 
     with tempfile.TemporaryDirectory() as tmp:
         tmp_path = Path(tmp)
-        manifest = args.manifest or make_logs(tmp_path, args.logs, args.seconds)
+        manifest = args.manifest or simulate_arm_fleet(tmp_path, robots=2, logs=(args.logs + 1) // 2,
+                                                       seconds=args.seconds)
         entries = read_manifest(manifest)
         rows = sum(pq.ParquetFile(e.log).metadata.num_rows for e in entries)
         serial = timed(lambda: run_batch(entries, tmp_path / "serial", engine="serial"))

@@ -1021,8 +1021,6 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
           ) -> None:
     """Estimate, fit and check every log of a fleet on Dask, into one results dataset (exit status 1 when a log
     failed: it is listed, the others are done)."""
-    import dataclasses
-
     from wbfriction.fleet.batch import run_batch
     from wbfriction.fleet.manifest import DIFF_CHOICES, read_manifest, scan_folder
     from wbfriction.fleet.options import BatchOptions
@@ -1041,8 +1039,8 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
                                                 None if config is None else str(config)))
     else:
         entries = read_manifest(source)
-    options = BatchOptions(estimate=dataclasses.replace(EstimateOptions(), diff=cast("Diff", diff)),
-                           model=model, min_samples=min_samples)
+    options = BatchOptions(estimate=EstimateOptions(diff=cast("Diff", diff)), model=cast("ModelChoice", model),
+                           min_samples=min_samples)
     with Progress(TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console,
                   transient=True) as bar:
         task = bar.add_task("batch", total=len(entries))

@@ -3,7 +3,7 @@
 :func:`process_log` is what a Dask task runs, and what the serial run calls in order: the same function, so the
 results are the same bytes. It does what ``wbfriction estimate LOG`` and ``wbfriction fit`` do with the same
 options (:func:`~wbfriction.pipeline.estimate.estimate_file` on one process, then
-:func:`~wbfriction.friction.fit.fit_estimate` and :func:`~wbfriction.friction.energy.energy_consistency`).
+:func:`~wbfriction.pipeline.fit.fit_table`, what ``fit`` runs before it writes).
 
 Sign convention: ``tau_f`` is the torque friction exerts on the joint; the model ``f(qd)`` is fitted to
 ``-tau_f`` (:mod:`wbfriction.fleet.schema`).
@@ -27,13 +27,13 @@ from wbfriction.exceptions import WbfrictionError
 from wbfriction.fleet.manifest import LogEntry
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
-from wbfriction.friction.energy import JointEnergy, energy_consistency
-from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets, model_jacobian
-from wbfriction.friction.io import read_friction_file
+from wbfriction.friction.energy import JointEnergy
+from wbfriction.friction.fit import FitResult, model_jacobian
 from wbfriction.logs.tables import file_sha256, scratch_folder
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import Chunking
 from wbfriction.pipeline.estimate import ChunkExecutor, RobotSpec, estimate_file, worker_robot
+from wbfriction.pipeline.fit import fit_table
 from wbfriction.version import __version__
 
 
@@ -118,11 +118,11 @@ def process_log(entry: LogEntry, key: LogKey, options: BatchOptions, scratch: Pa
             estimate_file(entry.robot, entry.log, friction, options.estimate, chunking=Chunking(
                 rows=options.chunk_rows, workers=chunk_workers if executor is not None else 1), robot=robot,
                 executor=executor)
-            est = read_friction_file(friction)
-            fits = fit_estimate(est, min_samples=options.min_samples, model=options.model,
-                                selection_tolerance=options.selection_tolerance)
-            energy = energy_consistency(est, fitted_offsets(fits), options.energy_threshold, options.energy_tolerance)
-        return LogOutcome(entry, key, result_rows(entry, key, fits, energy, est.qd, est.valid), table=table)
+            fitted = fit_table(friction, model=options.model, selection_tolerance=options.selection_tolerance,
+                               min_samples=options.min_samples, threshold=options.energy_threshold,
+                               tolerance=options.energy_tolerance)
+        rows = result_rows(entry, key, fitted.fits, fitted.energy, fitted.est.qd, fitted.est.valid)
+        return LogOutcome(entry, key, rows, table=table)
     except WbfrictionError as exc:
         return LogOutcome(entry, key, error=str(exc))
     except Exception as exc:  # a fault of this log must not stop the others: recorded, with its type

@@ -342,7 +342,12 @@ def standard_errors(jac: np.ndarray, residual: np.ndarray, rtol: float = 1e-9, r
                     max_lag: int = 0) -> np.ndarray:
     """Standard errors (p,) from the Jacobian at a least-squares solution: the square roots of the diagonal of
     :func:`parameter_covariance` (``inf`` for a parameter that is not identifiable)."""
-    return np.sqrt(np.clip(np.diag(parameter_covariance(jac, residual, rtol, rows, max_lag)), 0.0, None))
+    return covariance_errors(parameter_covariance(jac, residual, rtol, rows, max_lag))
+
+
+def covariance_errors(cov: np.ndarray) -> np.ndarray:
+    """Standard errors (p,): the square roots of a covariance's diagonal (``inf`` stays ``inf``)."""
+    return np.sqrt(np.clip(np.diag(cov), 0.0, None))
 
 
 def lagged_products(g: np.ndarray, rows: np.ndarray, max_lag: int) -> np.ndarray:
@@ -679,7 +684,7 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     cov = np.zeros((len(names), len(names)))
     cov[np.ix_(free, free)] = parameter_covariance(natural_jacobian(best.x), best.fun, rows=rows,
                                                    max_lag=correlation_lag(best.fun, rows))
-    se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    se = covariance_errors(cov)
     at_bound = np.zeros(len(names), dtype=bool)
     at_bound[free] = _at_bound(best.x, bounds, residual, np.isfinite(se[free]))
     return FitResult(

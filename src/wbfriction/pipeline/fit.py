@@ -7,25 +7,47 @@ from pathlib import Path
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.energy import JointEnergy, energy_consistency
+from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import (
     MODEL_CHOICES,
-    SELECTION_TOLERANCE,
     FitResult,
     ModelChoice,
     fit_estimate,
     fitted_offsets,
 )
 from wbfriction.friction.io import SIGN_CONVENTION, energy_to_dict, read_friction_file, write_params
-from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
+from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, SELECTION_TOLERANCE
 from wbfriction.pipeline.provenance import file_provenance
 
 
 @dataclass
 class FittedFile:
-    """What :func:`fit_file` fitted and checked (per torque-controlled joint of the table)."""
+    """What :func:`fit_file` fitted and checked (per torque-controlled joint of the table), and the table read."""
 
     fits: list[FitResult]
     energy: list[JointEnergy]
+    est: FrictionEstimate
+
+
+def fit_table(friction: str | Path, *, model: ModelChoice = "auto", selection_tolerance: float = SELECTION_TOLERANCE,
+              min_samples: int = 20, threshold: float = DEFAULT_THRESHOLD, tolerance: float = DEFAULT_TOLERANCE,
+              workers: int = 1) -> FittedFile:
+    """:func:`fit_file` without writing: the table read, every joint fitted, the energy checked.
+
+    Raises:
+        InputError: as :func:`fit_file`.
+    """
+    if model not in MODEL_CHOICES:
+        raise InputError(f"--model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
+    if not selection_tolerance >= 0:
+        raise InputError(f"--selection-tolerance must be at least 0, got {selection_tolerance}")
+    est = read_friction_file(friction)
+    fits = fit_estimate(est, min_samples=min_samples, workers=workers, model=model,
+                        selection_tolerance=selection_tolerance)
+    if not any(f.params is not None for f in fits):
+        raise InputError(f"{friction}: no joint could be fitted (each has fewer than --min-samples {min_samples} "
+                         "valid samples); nothing written")
+    return FittedFile(fits, energy_consistency(est, fitted_offsets(fits), threshold, tolerance), est)
 
 
 def fit_file(friction: str | Path, output: str | Path, *, model: ModelChoice = "auto",
@@ -53,22 +75,13 @@ def fit_file(friction: str | Path, output: str | Path, *, model: ModelChoice = "
             or malformed friction table, a table where no joint has ``min_samples`` valid samples
             (nothing is written), an output folder that does not exist.
     """
-    if model not in MODEL_CHOICES:
-        raise InputError(f"--model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
-    if not selection_tolerance >= 0:
-        raise InputError(f"--selection-tolerance must be at least 0, got {selection_tolerance}")
-    est = read_friction_file(friction)
-    fits = fit_estimate(est, min_samples=min_samples, workers=workers, model=model,
-                        selection_tolerance=selection_tolerance)
-    if not any(f.params is not None for f in fits):
-        raise InputError(f"{friction}: no joint could be fitted (each has fewer than --min-samples {min_samples} "
-                         "valid samples); nothing written")
-    energy = energy_consistency(est, fitted_offsets(fits), threshold, tolerance)
-    log = est.metadata.get("provenance", {})
+    fitted = fit_table(friction, model=model, selection_tolerance=selection_tolerance, min_samples=min_samples,
+                       threshold=threshold, tolerance=tolerance, workers=workers)
+    log = fitted.est.metadata.get("provenance", {})
     header: dict[str, object] = {"provenance": {**file_provenance("friction", friction),
                                                 **{k: log[k] for k in ("robot", "urdf") if k in log}},
                                  "sign_convention": SIGN_CONVENTION, "model": model}
     if model == "auto":
         header["selection_tolerance"] = selection_tolerance
-    write_params(output, fits, header, {e.joint: {"energy": energy_to_dict(e)} for e in energy})
-    return FittedFile(fits, energy)
+    write_params(output, fitted.fits, header, {e.joint: {"energy": energy_to_dict(e)} for e in fitted.energy})
+    return fitted

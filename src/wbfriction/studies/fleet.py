@@ -140,6 +140,36 @@ def simulate_fleet(robot: Robot, output_dir: Path, plan: FleetPlan = FleetPlan()
     return FleetSimulation(manifest, logs, plan)
 
 
+def simulate_arm_fleet(folder: Path, robots: int = 2, logs: int = 12, seconds: float = 3.0,
+                       drifts: tuple[Drift, ...] = (), start: datetime = datetime(2026, 1, 5, 8, tzinfo=UTC),
+                       spacing: timedelta = timedelta(days=1)) -> Path:
+    """A small, fast fleet: ``robots`` simulated Panda arms (``arm-0``, ...) with ``wbfriction simulate``'s
+    default arm friction, ``logs`` excitation runs of ``seconds`` each per arm (torque noise 0.01 N·m, seed
+    ``100 r + i``), ``drifts`` applied; the logs and ``manifest.csv`` go into ``folder``. Returns the manifest."""
+    from wbfriction.logs.tables import write_table
+    from wbfriction.model.loading import load_robot
+    from wbfriction.sim.arm import ArmOptions, default_arm_friction, simulate_arm
+
+    robot = load_robot("panda")
+    base = default_arm_friction(robot)
+    lines = ["log,robot_id,start_time,robot"]
+    for r in range(robots):
+        for i in range(logs):
+            friction = dict(base)
+            for d in drifts:
+                if d.robot_id == f"arm-{r}":
+                    p = friction[d.joint]
+                    friction[d.joint] = dataclasses.replace(p, **{d.parameter: getattr(p, d.parameter)
+                                                                  * d.factor(i, logs)})
+            sim = simulate_arm(robot, friction, options=ArmOptions(duration=seconds, seed=100 * r + i,
+                                                                   torque_std=0.01))
+            name = f"arm{r}_{i:02d}.parquet"
+            write_table(sim.table, folder / name)
+            lines.append(f"{name},arm-{r},{(start + i * spacing).isoformat()},panda")
+    (folder / "manifest.csv").write_text("\n".join(lines) + "\n")
+    return folder / "manifest.csv"
+
+
 @dataclass(frozen=True)
 class FleetScore:
     """Flagged joints against the drifts.
