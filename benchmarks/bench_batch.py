@@ -31,7 +31,7 @@ from wbfriction.studies.fleet import simulate_arm_fleet
 
 
 def files(results: Path) -> dict[str, bytes]:
-    return {str(p.relative_to(results)): p.read_bytes() for p in sorted(results.glob("robot_id=*/*.parquet"))}
+    return {str(p.relative_to(results)): p.read_bytes() for p in sorted(results.glob("*/*.parquet"))}
 
 
 def timed(run) -> tuple[float, float]:
@@ -94,7 +94,7 @@ def main() -> None:
             from wbfriction.report.trends import write_trends_html
         except ImportError:
             return
-        table = repeated(read_results(tmp_path / "serial"), args.trend_logs)
+        table = repeated(read_results(tmp_path / "serial").table, args.trend_logs)
         robots = len(set(table.column("robot_id").to_pylist()))
         wall, _ = timed(lambda: write_trends_html(fleet_trends(table), tmp_path / "trends.html"))
         print(f"trend report: {robots} robots x {args.trend_logs} logs, {table.num_rows} rows: {wall:.2f} s")

@@ -33,13 +33,13 @@ def main() -> None:
         manifest = simulate_arm_fleet(folder, robots=2, logs=12, drifts=(WORN,))
         summary = run_batch(read_manifest(manifest), folder / "results", workers=2)
         print(f"{summary.processed} logs processed on Dask, {summary.skipped} already done")
-        trends = fleet_trends(read_results(folder / "results"))
+        trends = fleet_trends(read_results(folder / "results").table)
         write_trends_html(trends, folder / "trends.html")
         for joint in trends.flagged:
             drift = joint.drifts[0]
             print(f"drift: {joint.robot_id} {joint.joint} {drift.quantity} {100 * drift.relative:+.0f} % from "
                   f"{drift.onset_time:%Y-%m-%d}")
-        print(f"{len(trends.flagged)} of {len(trends.joints)} joints drifted; wrote {folder / 'trends.html'}")
+        print(f"{trends.summary()}; wrote {folder / 'trends.html'}")
 
 
 if __name__ == "__main__":

@@ -52,7 +52,7 @@ def test_fleet_trends(tmp_path):
     assert [f[:2] for f in flagged] == [("arm-1", "panda_joint4")]
     onset = int(flagged[0][2].split("-")[2])  # the first worn log is the 8th, on January 12
     assert abs(onset - 12) <= 2
-    assert "1 of 14 joints drifted" in out and (tmp_path / "trends.html").is_file()
+    assert "1 of 14 tested robot joints drifted" in out and (tmp_path / "trends.html").is_file()
 
 
 def test_your_own_robot():

@@ -1001,18 +1001,22 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
                                         help="Manifest (CSV or Parquet; columns log, robot_id, start_time [ISO 8601 "
                                              "with zone], robot or urdf/config, optional diff and model), or a "
                                              "folder of <robot_id>/<log> files (with --robot or --urdf/--config)."),
-          output: Path = typer.Option(..., "-o", "--output", help="Results folder: a Parquet dataset partitioned "
-                                                                  "by robot; logs whose results are there are "
-                                                                  "skipped."),
+          output: Path = typer.Option(..., "-o", "--output", help="Results folder: a Parquet dataset, a folder per "
+                                                                  "robot; logs whose results are there are "
+                                                                  "skipped, results of a log listed with anything "
+                                                                  "changed are replaced. Failures go beside it "
+                                                                  "(RESULTS-failed)."),
           robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
-          workers: int = typer.Option(2, min=1, help="Worker processes of the local Dask cluster."),
+          workers: Optional[int] = typer.Option(None, min=1, help="Worker processes of the local Dask cluster "
+                                                                  "[default: 2]."),
           scheduler: Optional[str] = typer.Option(None, help="Address of a running Dask scheduler "
                                                              "(tcp://host:8786) instead of a local cluster; its "
                                                              "workers must see the logs and the results."),
           serial: bool = typer.Option(False, "--serial", help="One log after the other in this process, without "
                                                               "Dask (the reference the cluster's results equal)."),
-          tables: bool = typer.Option(False, "--tables", help="Also keep each log's friction table "
-                                                              "(RESULTS/tables/)."),
+          tables: Optional[Path] = typer.Option(None, "--tables",
+                                                help="Also keep each log's friction table in this folder "
+                                                     "(TABLES/<robot_id>/<key>.parquet)."),
           diff: str = typer.Option("auto", help="Differentiation, as 'wbfriction estimate --diff' (a manifest's "
                                                 "diff column overrides it per log)."),
           model: str = typer.Option("auto", help="Friction model, as 'wbfriction fit --model' (a manifest's model "
@@ -1021,9 +1025,10 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
           ) -> None:
     """Estimate, fit and check every log of a fleet on Dask, into one results dataset (exit status 1 when a log
     failed: it is listed, the others are done)."""
-    from wbfriction.fleet.batch import run_batch
+    from wbfriction.fleet.batch import check_outputs, run_batch
     from wbfriction.fleet.manifest import DIFF_CHOICES, read_manifest, scan_folder
     from wbfriction.fleet.options import BatchOptions
+    from wbfriction.fleet.results import failures_folder
     from wbfriction.friction.fit import MODEL_CHOICES
     from wbfriction.pipeline.estimate import RobotSpec
 
@@ -1031,12 +1036,16 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
         raise InputError(f"--diff must be one of {', '.join(DIFF_CHOICES)}, got '{diff}'")
     if model not in MODEL_CHOICES:
         raise InputError(f"--model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
-    if output.exists() and not output.is_dir():
-        raise InputError(f"-o {output}: not a folder (the results are a folder)")
+    check_paths({"MANIFEST": source}, {})
+    check_outputs(output, tables)
     start = time.perf_counter()
     if source.is_dir():
-        entries = scan_folder(source, RobotSpec(None if config else robot, None if urdf is None else str(urdf),
-                                                None if config is None else str(config)))
+        scan = scan_folder(source, RobotSpec(None if config else robot, None if urdf is None else str(urdf),
+                                             None if config is None else str(config)),
+                           exclude=[p for p in (output, failures_folder(output), tables) if p is not None])
+        for skipped in scan.skipped:
+            console.print(f"[yellow]skipped:[/] {escape(str(skipped))}", highlight=False, soft_wrap=True)
+        entries = scan.entries
     else:
         entries = read_manifest(source)
     options = BatchOptions(estimate=EstimateOptions(diff=cast("Diff", diff)), model=cast("ModelChoice", model),
@@ -1046,11 +1055,20 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
         task = bar.add_task("batch", total=len(entries))
         summary = run_batch(entries, output, options, engine="serial" if serial else "dask", workers=workers,
                             scheduler=scheduler, tables=tables, progress=lambda outcome: bar.advance(task, 1))
+    for a, b in summary.copies:
+        console.print(f"[yellow]note:[/] {escape(b.where)} has the same bytes as {escape(a.where)}: two results",
+                      highlight=False, soft_wrap=True)
+    for note in (*summary.stale, *summary.foreign):
+        console.print(f"[yellow]note:[/] {escape(str(note))}", highlight=False, soft_wrap=True)
     for _, error in summary.failed:
         console.print(f"[bold red]failed:[/] {escape(error)}", highlight=False, soft_wrap=True)
-    console.print(f"{summary.processed} logs processed ({len(summary.failed)} failed), {summary.skipped} already "
-                  f"done; results in {output} ({time.perf_counter() - start:.1f} s)")
+    why = "".join(f"; {n} {reason}" for reason, n in sorted(summary.reasons.items()) if reason != "new")
+    kept = f", {summary.kept} of logs not listed kept" if summary.kept else ""
+    console.print(f"{summary.processed} logs processed ({len(summary.failed)} failed{why}), {summary.skipped} already "
+                  f"done{kept}; results in {output} ({time.perf_counter() - start:.1f} s)", highlight=False,
+                  soft_wrap=True)
     if summary.failed:
+        console.print(f"failures recorded in {failures_folder(output)}", highlight=False, soft_wrap=True)
         raise typer.Exit(1)
 
 
@@ -1061,13 +1079,17 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
            table: Optional[Path] = typer.Option(None, "--table", help="Also write the trends as a table "
                                                                       "(.parquet or .csv)."),
            alpha: float = typer.Option(1e-3, min=1e-6, max=0.5, help="False-alarm probability per joint."),
+           replicates: Optional[int] = typer.Option(None, min=1, help="Noise series of the p-values' Monte Carlo "
+                                                                      "[default: 20000, more for a small --alpha]."),
            min_change: float = typer.Option(0.10, min=0.0, help="Smallest change flagged, relative to the "
                                                                 "baseline (0.1: 10 %)."),
            title: str = typer.Option("Friction trends", help="The page's title.")) -> None:
     """Friction over time per robot and joint, and the joints whose friction drifted (a hinge change detector
     weighted by the fits' standard errors), as one HTML page."""
+    import math
+
     from wbfriction.fleet.results import read_results
-    from wbfriction.fleet.trends import TrendOptions, fleet_trends
+    from wbfriction.fleet.trends import UNITS, TrendOptions, fleet_trends
     from wbfriction.logs.tables import write_table
     from wbfriction.report.trends import write_trends_html
 
@@ -1076,16 +1098,22 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
     if table is not None and table.suffix.lower() not in (".parquet", ".pq", ".csv"):
         raise InputError(f"--table {table}: written as .parquet or .csv")
     check_paths({"RESULTS": results}, {"-o": output, **({"--table": table} if table is not None else {})})
-    found = fleet_trends(read_results(results), TrendOptions(alpha=alpha, min_change=min_change))
+    options = TrendOptions(alpha=alpha, min_change=min_change, replicates=replicates)
+    dataset = read_results(results)
+    for left in dataset.left_out:
+        console.print(f"[yellow]left out:[/] {escape(str(left))}", highlight=False, soft_wrap=True)
+    found = fleet_trends(dataset.table, options)
     write_trends_html(found, output, title)
     if table is not None:
         write_table(found.to_table(), table)
     for j in found.flagged:
         cp = j.drifts[0]
-        console.print(f"drift: {j.robot_id} {j.joint}: {cp.quantity} {100 * cp.relative:+.1f} % from "
-                      f"{cp.onset_time:%Y-%m-%d} (p {cp.p_value:.2g})", highlight=False)
-    console.print(f"{len(found.flagged)} of {len(found.joints)} robot joints drifted; wrote {output}"
-                  + (f" and {table}" if table is not None else ""))
+        size = (f"{100 * cp.relative:+.1f} %" if not math.isnan(cp.relative)
+                else f"{cp.change:+.3g} {UNITS[cp.quantity]} from a baseline not told from zero")
+        console.print(f"drift: {j.robot_id} {j.joint}: {cp.quantity} {size} from {cp.onset_time:%Y-%m-%d} "
+                      f"(p {cp.p_value:.2g})", highlight=False)
+    console.print(f"{found.summary()}; wrote {output}" + (f" and {table}" if table is not None else ""),
+                  highlight=False)
 
 
 def _version(value: bool) -> None:

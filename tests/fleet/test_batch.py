@@ -24,7 +24,7 @@ from wbfriction.fleet.schema import REFERENCE_SPEEDS, speed_column
 
 
 def _files(results: Path) -> dict[str, bytes]:
-    return {str(p.relative_to(results)): p.read_bytes() for p in sorted(results.glob("robot_id=*/*.parquet"))}
+    return {str(p.relative_to(results)): p.read_bytes() for p in sorted(results.glob("*/*.parquet"))}
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +38,7 @@ def serial(arm_fleet, tmp_path_factory) -> Path:
 
 def test_each_log_gives_its_injected_friction(serial, arm_fleet):
     _, truth = arm_fleet
-    table = read_results(serial)
+    table = read_results(serial).table
     assert table.num_rows == 3 * 7
     for row in table.to_pylist():
         true = truth[Path(row["log"]).name][row["joint"]]
@@ -63,7 +63,7 @@ def test_rows_equal_the_estimate_and_fit_commands(serial, arm_fleet, tmp_path):
                  ["fit", str(friction), "-o", str(params)]):
         subprocess.run([sys.executable, "-m", "wbfriction", *argv], check=True, capture_output=True)
     fits = json.loads(params.read_text())["joints"]
-    table = read_results(serial)
+    table = read_results(serial).table
     for row in table.filter(pc.equal(table.column("robot_id"), "arm-2")).to_pylist():
         fit = fits[row["joint"]]
         for name in ("F_c", "F_v", "tau_os"):
@@ -112,7 +112,7 @@ def test_a_corrupted_log_is_listed_with_its_reason(arm_fleet, tmp_path):
     assert summary.processed == 2 and len(summary.failed) == 1
     (failure,) = read_failures(tmp_path / "out")
     assert failure["manifest_row"] == 0 and "broken.parquet" in failure["error"] and "\n" not in failure["error"]
-    assert read_results(tmp_path / "out").num_rows == 7
+    assert read_results(tmp_path / "out").table.num_rows == 7
 
 
 @pytest.mark.slow
@@ -151,3 +151,65 @@ def test_a_long_logs_chunks_are_tasks_of_the_cluster(arm_fleet, tmp_path):
     chunks = [t for t in stream.data if str(t["key"]).startswith("chunk_on_one_thread")]
     assert len(chunks) == 10
     assert _files(tmp_path / "dask") == _files(tmp_path / "serial")
+
+
+def test_two_rows_with_the_same_bytes_are_two_results(arm_fleet, tmp_path):
+    """Issue 37: two rows whose logs have identical bytes shared one Dask key; Dask kept one, printed '2 logs
+    processed', and every later run called both done."""
+    from distributed import Client, LocalCluster
+
+    folder, _ = arm_fleet
+    shutil.copy(folder / "a1.parquet", tmp_path / "a1.parquet")
+    shutil.copy(folder / "a1.parquet", tmp_path / "copy.parquet")
+    (tmp_path / "m.csv").write_text("log,robot_id,start_time,robot\n"
+                                    "a1.parquet,arm-1,2026-03-01T08:00:00Z,panda\n"
+                                    "copy.parquet,arm-2,2026-03-01T08:00:00Z,panda\n")
+    entries = read_manifest(tmp_path / "m.csv")
+    with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=":0") as cluster, \
+            Client(cluster) as client:
+        summary = run_batch(entries, tmp_path / "results", client=client)
+    assert summary.processed == 2 and summary.copies == ((entries[0], entries[1]),)
+    table = read_results(tmp_path / "results").table
+    one, two = (table.filter(pc.equal(table.column("robot_id"), r)) for r in ("arm-1", "arm-2"))
+    assert one.num_rows == two.num_rows == 7
+    assert one.column("F_c").to_pylist() == two.column("F_c").to_pylist()  # the same log, the same numbers
+    assert len(_files(tmp_path / "results")) == 2 and plan_batch(entries, tmp_path / "results").todo == []
+
+
+def test_a_corrected_manifest_replaces_what_changed(serial, arm_fleet, tmp_path):
+    """Issue 37: a manifest corrected after a run (start time, robot id) was 'already done', and the old date and
+    partition stayed."""
+    folder, _ = arm_fleet
+    results = tmp_path / "results"
+    shutil.copytree(serial, results)
+    (folder / "corrected.csv").write_text(
+        "log,robot_id,start_time,robot\n"
+        "a1.parquet,arm-1,2026-03-01T08:00:00+00:00,panda\n"
+        "a2.parquet,arm-1,2026-03-05T08:00:00+00:00,panda\n"
+        "b1.parquet,arm-3,2026-03-01T09:30:00+01:00,panda\n")
+    entries = read_manifest(folder / "corrected.csv")
+    summary = run_batch(entries, results, engine="serial")
+    assert (summary.processed, summary.skipped) == (2, 1)
+    assert summary.reasons == {"start time corrected": 1, "robot id corrected": 1}
+    table = read_results(results).table
+    assert table.num_rows == 21 and not list((results / "arm-2").glob("*.parquet"))
+    by_log = {Path(r["log"]).name: r for r in table.filter(pc.equal(table.column("joint"), "panda_joint1")).to_pylist()}
+    assert by_log["b1.parquet"]["robot_id"] == "arm-3" and by_log["a2.parquet"]["start_time"].day == 5
+    before = read_results(serial).table
+    assert table.filter(pc.equal(table.column("robot_id"), "arm-3")).column("F_c").to_pylist() == \
+        before.filter(pc.equal(before.column("robot_id"), "arm-2")).column("F_c").to_pylist()
+    assert plan_batch(entries, results).todo == []
+
+
+def test_other_options_replace_the_earlier_rows(serial, arm_fleet, tmp_path):
+    """Issue 37: a second run with other options added a second set of rows, and trends counted each log twice."""
+    folder, _ = arm_fleet
+    results = tmp_path / "results"
+    shutil.copytree(serial, results)
+    summary = run_batch(read_manifest(folder / "manifest.csv")[:1], results, BatchOptions(model="coulomb-viscous"),
+                        engine="serial")
+    assert summary.reasons == {"options changed": 1}
+    table = read_results(results).table
+    assert table.num_rows == 21 and len(set(table.column("key").to_pylist())) == 3
+    a1 = table.filter(pc.equal(table.column("log"), str(folder / "a1.parquet")))
+    assert set(a1.column("model").to_pylist()) == {"coulomb-viscous"}

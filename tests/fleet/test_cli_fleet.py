@@ -19,7 +19,7 @@ def wbfriction(*args: str, cwd: Path) -> subprocess.CompletedProcess:
     ("log,robot_id,start_time,robot\na.parquet,r1,2026-03-01T08:00:00,talos\n",
      "row 0, column 'start_time'"),
     ("log,robot_id,start_time,robot\nmissing.parquet,r1,2026-03-01T08:00:00Z,talos\n", "row 0, column 'log'"),
-    ("log,robot_id,start_time,robot\na.parquet,r1,2026-03-01T08:00:00Z,atlas\n", "manifest row 0: "),
+    ("log,robot_id,start_time,robot\na.parquet,r1,2026-03-01T08:00:00Z,atlas\n", "manifest row 0 (a.parquet): "),
 ])
 def test_a_bad_manifest_is_one_line_and_nothing_is_written(tmp_path, manifest, message):
     (tmp_path / "a.parquet").write_bytes(b"")
@@ -37,3 +37,63 @@ def test_trends_need_results_and_an_html_page(tmp_path):
     res = wbfriction("trends", "empty", "-o", "t.txt", cwd=tmp_path)
     assert res.returncode == 2 and "-o t.txt: the trends page is written as .html" in res.stderr
     assert not (tmp_path / "t.html").exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--serial", "--scheduler", "tcp://127.0.0.1:8786"], "--scheduler and --serial: "),
+    (["--serial", "--workers", "3"], "--workers: the local cluster's, not used with --serial"),
+    (["--scheduler", "foo bar"], "--scheduler 'foo bar': not a scheduler's address"),
+    (["--scheduler", "tcp://127.0.0.1:9"], "--scheduler tcp://127.0.0.1:9: no Dask scheduler answered within 10 s"),
+    (["-o", "file.txt/results"], "-o file.txt/results: under file.txt, which is a file, not a folder"),
+    (["-o", "file.txt"], "-o file.txt: not a folder"),
+])
+def test_batch_faults_are_one_line_within_seconds(arm_fleet, tmp_path, args, message):
+    """Issue 37: --scheduler was ignored with --serial; a wrong scheduler address raised OSError after 30 s or
+    ValueError; -o under a file raised NotADirectoryError."""
+    folder, _ = arm_fleet
+    (tmp_path / "file.txt").write_text("x")
+    argv = ["batch", str(folder / "manifest.csv"), *args]
+    if "-o" not in args:
+        argv += ["-o", "results"]
+    res = wbfriction(*argv, cwd=tmp_path)
+    assert res.returncode == 2 and message in res.stderr, res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1 and "Traceback" not in res.stderr
+    assert not (tmp_path / "results").exists()
+    assert (tmp_path / "file.txt").read_text() == "x"
+
+
+def test_trends_say_what_they_leave_out(tmp_path, synthetic_results):
+    """A truncated part (issue 37: ArrowInvalid) and a stray Parquet file (TypeError) are named, one line each;
+    the trends of the rest are written."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    parts = synthetic_results(tmp_path / "results", 10)
+    parts[3].write_bytes(parts[3].read_bytes()[:100])
+    pq.write_table(pa.table({"x": [1]}), tmp_path / "results" / "r1" / "stray.parquet")
+    res = wbfriction("trends", "results", "-o", "t.html", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    left = [line for line in res.stderr.splitlines() if line.startswith("left out:")]
+    assert len(left) == 2 and "unreadable" in left[0] and "stray.parquet: not a result" in left[1]
+    assert "0 of 2 tested robot joints drifted" in res.stderr and (tmp_path / "t.html").exists()
+
+
+def test_trends_that_cannot_test_say_so(tmp_path, synthetic_results):
+    """Issue 37: '0 of 14 robot joints drifted' was printed when none could be tested."""
+    synthetic_results(tmp_path / "results", 3)
+    res = wbfriction("trends", "results", "-o", "t.html", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "none of the 2 robot joints could be tested (each has fewer than 8 usable logs)" in res.stderr
+
+
+def test_an_absent_scheduler_is_said_within_its_timeout():
+    """Issue 37: an address where no scheduler listens raised OSError after Dask's 30 s."""
+    import time
+
+    from wbfriction.exceptions import InputError
+    from wbfriction.fleet.batch import connect
+
+    start = time.monotonic()
+    with pytest.raises(InputError, match="no Dask scheduler answered within 1 s"):
+        connect("tcp://127.0.0.1:9", timeout=1.0)
+    assert time.monotonic() - start < 10  # the timeout given, not Dask's 30 s

@@ -75,9 +75,83 @@ def test_a_folder_is_scanned_by_robot(tmp_path):
         t = pa.array([datetime(2026, 3, 1, 8, tzinfo=UTC), datetime(2026, 3, 1, 9, tzinfo=UTC)],
                      pa.timestamp("ns", tz="UTC"))
         pq.write_table(pa.table({"time": t}), tmp_path / robot_id / name)
-    entries = scan_folder(tmp_path, RobotSpec("talos"))
+    entries = scan_folder(tmp_path, RobotSpec("talos")).entries
     assert [(e.robot_id, e.log.name, e.start_time.hour) for e in entries] == [("r1", "x.parquet", 8),
                                                                              ("r2", "y.parquet", 8)]
     pq.write_table(pa.table({"time": [0.0, 0.001]}), tmp_path / "r2" / "z.parquet")
     with pytest.raises(InputError, match="z.parquet: column 'time' holds no dates"):
+        scan_folder(tmp_path, RobotSpec("talos"))
+
+
+def test_robot_ids_are_text_as_written(folder):
+    """Issue 37: a CSV reader made '001' and '1' one robot, and '007' the float 7.0 once an id parsed as a
+    float."""
+    for name in ("c.parquet", "d.parquet", "e.parquet"):
+        (folder / name).write_bytes(b"")
+    path = _manifest(folder, "a.parquet,001,2026-03-01T08:00:00Z,talos", "b.csv,1,2026-03-01T08:00:00Z,talos",
+                     "c.parquet,007,2026-03-01T08:00:00Z,talos", "d.parquet,2.5,2026-03-01T08:00:00Z,talos",
+                     "e.parquet,1e3,2026-03-01T08:00:00Z,talos")
+    assert [e.robot_id for e in read_manifest(path)] == ["001", "1", "007", "2.5", "1e3"]
+
+
+def test_a_parquet_manifest_of_numeric_ids(folder):
+    t = pa.array([datetime(2026, 3, 1, 8, tzinfo=UTC)], pa.timestamp("ns", tz="UTC"))
+    for ids, expected in ((pa.array([7], pa.int64()), "7"), (pa.array([7.0]), None)):
+        pq.write_table(pa.table({"log": ["a.parquet"], "robot_id": ids, "start_time": t, "robot": ["talos"]}),
+                       folder / "m.parquet")
+        if expected is not None:
+            assert read_manifest(folder / "m.parquet")[0].robot_id == expected
+        else:
+            with pytest.raises(InputError, match="column 'robot_id' holds double values, not text"):
+                read_manifest(folder / "m.parquet")
+
+
+@pytest.mark.parametrize("rows, head, message", [
+    (["a.parquet,r1,2026-03-01T08:00:00Z,talos,panda.toml"], HEAD + ",config",
+     "row 0, columns 'robot' and 'config': give a built-in robot ('talos') or a robot TOML ('panda.toml'), not both"),
+    (["a.parquet,r1,2026-03-01T08:00:00Z,talos", "b.csv,r1,2300-01-01T00:00:00Z,talos"], HEAD,
+     "row 1, column 'start_time': 2300-01-01T00:00:00+00:00 is out of range (1970 to 2262)"),
+    (["a.parquet,r1,2026-03-01T08:00:00Z,talos", "b.csv,r1,2026-03-01 08:00:00,talos"], HEAD,
+     "row 1, column 'start_time': '2026-03-01 08:00:00' has no time zone"),
+])
+def test_conflicting_or_impossible_rows_are_refused(folder, rows, head, message):
+    (folder / "panda.toml").write_text("")
+    with pytest.raises(InputError) as err:
+        read_manifest(_manifest(folder, *rows, head=head))
+    assert message in str(err.value) and "\n" not in str(err.value)
+
+
+def _dated_log(path: Path, hour: int = 8) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    t = pa.array([datetime(2026, 3, 1, hour, tzinfo=UTC)] * 2, pa.timestamp("ns", tz="UTC"))
+    pq.write_table(pa.table({"time": t}), path)
+
+
+def test_every_file_or_folder_a_scan_passes_over_is_said(tmp_path):
+    """Issue 37: a scan skipped robot folders whose names fail the id pattern ('arm 1', 'armé') without a word,
+    and a results folder inside the scanned one was read as a robot's logs by the next scan."""
+    from wbfriction.logs.tables import with_metadata, write_table
+
+    _dated_log(tmp_path / "r1" / "x.parquet")
+    _dated_log(tmp_path / "arm 1" / "y.parquet")
+    _dated_log(tmp_path / "armé" / "y.parquet")
+    _dated_log(tmp_path / "loose.parquet")
+    (tmp_path / "r1" / "notes.txt").write_text("")
+    write_table(with_metadata(pa.table({"time": [0.0]}), {"estimate_options": {}}), tmp_path / "r1" / "f.parquet")
+    _dated_log(tmp_path / "results" / "r1" / "k.parquet")
+    _dated_log(tmp_path / ".hidden" / "z.parquet")
+    scan = scan_folder(tmp_path, RobotSpec("talos"), exclude=[tmp_path / "results"])
+    assert [(e.robot_id, e.log.name) for e in scan.entries] == [("r1", "x.parquet")]
+    said = {p.path.relative_to(tmp_path).as_posix(): p.reason for p in scan.skipped}
+    assert set(said) == {"arm 1", "armé", "loose.parquet", "r1/notes.txt", "r1/f.parquet", "results"}
+    assert "not a robot id" in said["arm 1"] and "not a robot id" in said["armé"]
+    assert "not in a robot's folder" in said["loose.parquet"] and "friction table" in said["r1/f.parquet"]
+    assert said["results"] == "this batch's output, not logs"
+
+
+def test_a_scanned_log_dated_beyond_2262_is_refused(tmp_path):
+    (tmp_path / "r1").mkdir()
+    t = pa.array([datetime(2300, 1, 1, tzinfo=UTC)], pa.timestamp("s", tz="UTC"))
+    pq.write_table(pa.table({"time": t}), tmp_path / "r1" / "x.parquet")
+    with pytest.raises(InputError, match=r"x.parquet: column 'time': 2300-01-01T00:00:00\+00:00 is out of range"):
         scan_folder(tmp_path, RobotSpec("talos"))

@@ -120,3 +120,94 @@ def test_fleet_trends_flag_the_drifted_joint_first_and_the_page_is_reproducible(
 def test_a_table_that_is_not_results_is_refused():
     with pytest.raises(InputError, match="not a fleet's results: no column"):
         fleet_trends(pa.table({"robot_id": ["a"]}))
+
+
+def _series_table(values: dict[str, np.ndarray], se: float = 0.02, times: list[datetime] | None = None
+                  ) -> pa.Table:
+    """One robot's joint over ``len(values[q])`` logs: the quantities given (standard error ``se``),
+    the others absent (NaN)."""
+    n = len(next(iter(values.values())))
+    times = times or DAYS[:n]
+    rows: dict[str, list] = {name: [] for name in RESULT_SCHEMA.names}
+    for i in range(n):
+        row = {name: float("nan") for name in RESULT_SCHEMA.names}
+        row.update(robot_id="r", log=f"log{i}", start_time=times[i], key=f"k{i}", log_sha256=f"h{i}",
+                   robot_sha256="", options_sha256="", joint="j", model="thesis", status="ok", n_samples=1000,
+                   version="test")
+        for q, v in values.items():
+            row[q], row[q + "_se"] = float(v[i]), se
+        for name in RESULT_SCHEMA.names:
+            rows[name].append(row[name])
+    return pa.Table.from_pydict(rows, schema=RESULT_SCHEMA)
+
+
+def test_a_joint_is_flagged_against_alpha_over_its_quantities():
+    """Bonferroni (issue 37: flagging at p < alpha passed every test): a drift of one quantity among m with
+    alpha / m <= p < alpha is not flagged; the same drift is with alpha m times larger."""
+    options = TrendOptions(replicates=10_000, min_change=0.0)
+    rng = np.random.default_rng(5)
+    quiet = {q: 1.0 + 0.02 * rng.standard_normal(25) for q in ("F_v", "tau_os", "f_at_0.1", "f_at_0.3")}
+    m = 1 + len(quiet)
+    noise = 0.02 * rng.standard_normal(25)
+    lo, hi = 0.0, 0.2  # drift sizes: p >= alpha at lo, p < alpha / m at hi; bisected into the band between
+    for _ in range(40):
+        change = 0.5 * (lo + hi)
+        y = 1.0 + ramp(25, 10, change) + noise
+        cp = detect_change(DAYS, y, np.full(25, 0.02), "F_c", options)
+        assert cp is not None
+        if cp.p_value >= 1e-3:
+            lo = change
+        elif cp.p_value < 1e-3 / m:
+            hi = change
+        else:
+            break
+    else:
+        pytest.fail("no series with a p-value between alpha / m and alpha")
+    table = _series_table({"F_c": y, **quiet})
+    (joint,) = fleet_trends(table, options).joints
+    assert len(joint.tests) == m and joint.tests["F_c"].p_value == cp.p_value
+    assert not joint.flagged
+    assert fleet_trends(table, TrendOptions(alpha=1e-3 * m, replicates=10_000, min_change=0.0)).joints[0].flagged
+
+
+def test_logs_at_one_start_time_are_no_hinge():
+    """Issue 37: four or more logs of a series with one start time raised LinAlgError."""
+    one = [DAYS[0]] * 10
+    rng = np.random.default_rng(2)
+    assert detect_change(one, 1.0 + 0.01 * rng.standard_normal(10), np.full(10, 0.01), "F_c", FAST) is None
+    times = DAYS[:8] + [DAYS[8]] * 6  # the last six at one time: onsets within them have no hinge
+    y = np.r_[np.ones(8), np.full(6, 1.5)] + 0.01 * rng.standard_normal(14)
+    cp = detect_change(times, y, np.full(14, 0.01), "F_c", FAST)
+    assert cp is not None and cp.onset == 8 and cp.p_value < 1e-3
+    trends = fleet_trends(_series_table({"F_c": 1.0 + 0.01 * rng.standard_normal(10)}, times=one), FAST)
+    assert trends.tested == [] and "none of the 1 robot joints could be tested" in trends.summary()
+
+
+def test_a_change_from_a_baseline_of_zero_has_no_relative_size():
+    """Issue 37: a relative change was printed as +2437644803610612224.0 % when F_c was about 0."""
+    rng = np.random.default_rng(4)
+    y = 1e-19 * rng.standard_normal(25) + ramp(25, 10, 0.5) + 0.01 * rng.standard_normal(25)
+    cp = detect_change(DAYS, y, np.full(25, 0.01), "F_c", FAST)
+    assert cp is not None and np.isnan(cp.relative) and cp.change == pytest.approx(0.5, abs=5 * cp.change_se)
+    (joint,) = fleet_trends(_series_table({"F_c": y}, se=0.01), FAST).joints
+    assert joint.flagged  # significant, from zero: a drift whatever its relative size
+    constant = 2.0 + 0.01 * rng.standard_normal(25)
+    assert detect_change(DAYS, constant, np.full(25, 0.01), "F_c", FAST).relative == pytest.approx(0.0, abs=0.02)
+
+
+def test_a_small_alpha_draws_enough_noise_series():
+    """Issue 37: --alpha below about 3e-4 was refused for 'replicates' with no option to set them."""
+    assert TrendOptions().draws() == 20_000
+    small = TrendOptions(alpha=1e-5)
+    assert small.draws() >= 3 * 6 / 1e-5
+    with pytest.raises(InputError, match="--replicates 50000 cannot resolve --alpha 1e-05 over 6 quantities: give "
+                                         "at least 600000"):
+        TrendOptions(alpha=1e-5, replicates=50_000)
+    y = 1.0 + ramp(25, 10, 0.3) + 0.01 * np.random.default_rng(1).standard_normal(25)
+    cp = detect_change(DAYS, y, np.full(25, 0.01), "F_c", small)
+    assert cp is not None and cp.p_value < 1e-5 / 6  # resolved below alpha / m
+
+
+def test_the_summary_counts_tested_joints():
+    trends = fleet_trends(synthetic_results(0.3), FAST)
+    assert trends.summary() == "1 of 4 tested robot joints drifted"

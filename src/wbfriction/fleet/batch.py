@@ -1,137 +1,340 @@
-"""Many logs, on Dask (issue 25): ``wbfriction batch MANIFEST -o RESULTS/``.
+"""Many logs, on Dask (issue 25, issue 37): ``wbfriction batch MANIFEST -o RESULTS/``.
 
 Every log is one task (:func:`~wbfriction.fleet.task.process_log`) on a ``dask.distributed`` cluster: a
 :class:`~distributed.LocalCluster` of worker processes by default, or an existing cluster's scheduler
 (``scheduler="tcp://host:8786"``; its workers must see the logs and the results folder at the same paths).
 Scheduling, retries of tasks whose worker died and the transfer of results are Dask's; wbfriction writes
 each result as it arrives (:func:`~wbfriction.fleet.results.write_outcome`), so a batch stopped at any moment
-keeps what it finished, and the next run skips the logs whose key (log bytes, robot model, options) has a
-result. ``engine="serial"`` runs the same tasks one after the other in this process: the reference the
-distributed run equals, bit for bit (each task runs its linear algebra on one BLAS thread, whatever the engine).
+keeps what it finished. ``engine="serial"`` runs the same tasks one after the other in this process: the
+reference the distributed run equals, bit for bit (each task runs its linear algebra on one BLAS thread,
+whatever the engine).
 
-A log that fails is recorded with its one line (``RESULTS/failed/<key>.json``) and the batch goes on; it is
-tried again by the next run.
+**What a run does with what is there** (:func:`plan_batch`). Each listed log has a key
+(:class:`~wbfriction.fleet.task.ResultKey`: robot id, start time, path, bytes, robot model, options) and holds
+one result at most:
+
+* a whole result under its key: the log is done, skipped;
+* a result of the same log under another key (a row corrected, other options, the log changed), or of a log
+  no longer listed whose bytes a listed log has (the same data moved or saved again), or a damaged file: the
+  log is computed again, and the earlier files are removed when its outcome is written (the reason is said);
+* results of logs not listed, and not theirs by bytes: kept as they are (counted);
+* files that are not results (no result metadata): left as they are (named).
+
+So the folder after any sequence of runs holds what one run of the last manifest into an empty folder writes,
+plus the results of logs it no longer lists. Two rows whose logs have the same bytes are two results (named).
+
+A log that fails is recorded with its one line (``RESULTS-failed/<key>.json``, beside the dataset) and the
+batch goes on; it is tried again by the next run.
 """
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
+import os
+from collections import Counter, defaultdict
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from datetime import UTC
 from pathlib import Path
 from typing import Any, Literal
 
 from threadpoolctl import threadpool_limits
 
 from wbfriction.exceptions import InputError
-from wbfriction.fleet.manifest import LogEntry
+from wbfriction.fleet.manifest import LogEntry, Skipped
 from wbfriction.fleet.options import BatchOptions
-from wbfriction.fleet.results import done_keys, table_path, write_outcome
-from wbfriction.fleet.task import LogKey, LogOutcome, log_key, process_log, robot_sha256
-from wbfriction.logs.tables import TableFile
+from wbfriction.fleet.results import Part, failures_folder, read_parts, table_path, write_outcome
+from wbfriction.fleet.task import LogOutcome, ResultKey, process_log, result_key, robot_sha256
+from wbfriction.logs.tables import TableFile, file_sha256, remove_stale_temporaries
 from wbfriction.pipeline.chunks import CHUNKS_PER_WORKER
 from wbfriction.pipeline.estimate import worker_robot
 
 Engine = Literal["dask", "serial"]
 """Where the tasks run: on a Dask cluster, or one after the other in this process."""
+LOCAL_WORKERS = 2
+"""Worker processes of the local cluster, by default."""
+CONNECT_TIMEOUT = 10.0
+"""Seconds a batch waits for the Dask scheduler it is given to answer."""
 
 
 @dataclass(frozen=True)
 class PlannedLog:
-    """A log to process: its entry, key and effective options."""
+    """A listed log, keyed: its entry, key, effective options; for a log to compute, the files of its earlier
+    results and failures it replaces and why it is computed (``new``, ``options changed``, ...)."""
 
     entry: LogEntry
-    key: LogKey
+    key: ResultKey
     options: BatchOptions
+    replaces: tuple[Path, ...] = ()
+    reason: str = "new"
 
 
 @dataclass(frozen=True)
 class BatchPlan:
-    """What a batch will do: the logs to process, and those whose results are already there."""
+    """What a batch will do (module docstring).
+
+    Attributes:
+        todo: the logs to compute.
+        skipped: the logs whose whole result is there.
+        stale: files removed before any work: earlier results and failures of logs already done, damaged files
+            no listed log's key names (each with why).
+        kept: the results of logs not listed (kept as they are).
+        foreign: files in the results folder that are not results (left as they are).
+        copies: pairs of listed logs with the same bytes (two results).
+    """
 
     todo: list[PlannedLog]
     skipped: list[PlannedLog]
+    stale: tuple[Skipped, ...] = ()
+    kept: int = 0
+    foreign: tuple[Skipped, ...] = ()
+    copies: tuple[tuple[LogEntry, LogEntry], ...] = ()
 
 
 @dataclass(frozen=True)
 class BatchSummary:
-    """What a batch did: logs processed, skipped (results already there) and failed (entry, one-line error)."""
+    """What a batch did: logs processed (and why, by reason), skipped (results already there) and failed
+    (entry, one-line error); the plan's notes (:class:`BatchPlan`)."""
 
     processed: int
     skipped: int
     failed: list[tuple[LogEntry, str]] = field(default_factory=list)
     results: Path = Path()
+    reasons: dict[str, int] = field(default_factory=dict)
+    stale: tuple[Skipped, ...] = ()
+    kept: int = 0
+    foreign: tuple[Skipped, ...] = ()
+    copies: tuple[tuple[LogEntry, LogEntry], ...] = ()
+
+
+def _changes(earlier: Part, key: ResultKey) -> str:
+    """What differs between an earlier result of a log and its key now, in words."""
+    changed = [what for what, column, now in (
+        ("the log changed", "log_sha256", key.log_sha256), ("robot id corrected", "robot_id", key.robot_id),
+        ("start time corrected", "start_time", key.start_time.astimezone(UTC)),
+        ("robot model changed", "robot_sha256", key.robot_sha256), ("options changed", "options_sha256",
+                                                                     key.options_sha256))
+        if earlier.first(column) != now]
+    return ", ".join(changed) or "another version's key"
+
+
+def _keys(entries: list[LogEntry], options: BatchOptions) -> list[PlannedLog]:
+    """Every entry keyed: its robot model loaded once per robot (a bad one is an error now), its log hashed."""
+    robot_hashes: dict[Any, str] = {}
+    keyed = []
+    for entry in entries:
+        try:
+            if entry.robot not in robot_hashes:
+                robot_hashes[entry.robot] = robot_sha256(entry.robot, worker_robot(entry.robot))
+            log_hash = file_sha256(entry.log)
+        except InputError as exc:
+            raise InputError(f"{entry.where}: {exc}") from None
+        opts = options.for_entry(entry.options)
+        keyed.append(PlannedLog(entry, result_key(entry, log_hash, robot_hashes[entry.robot], opts), opts))
+    return keyed
 
 
 def plan_batch(entries: list[LogEntry], results: str | Path, options: BatchOptions = BatchOptions()) -> BatchPlan:
-    """Load every robot model once (a bad one is an error now, before any work), key every log, and split the
-    logs into those to process and those already done.
+    """Key every log (:func:`~wbfriction.fleet.task.result_key`), read what ``results`` holds
+    (:func:`~wbfriction.fleet.results.read_parts`, the failure records beside it) and decide what is done, what is
+    computed and which files it replaces (module docstring). Reads only.
 
     Raises:
-        InputError: a robot model that does not load (naming the manifest row), an unreadable log.
+        InputError: a robot model that does not load, an unreadable log (naming the manifest row); a results
+            folder of the earlier layout.
     """
     results = Path(results)
-    robot_hashes: dict[Any, str] = {}
-    done = done_keys(results)
-    todo: list[PlannedLog] = []
-    skipped: list[PlannedLog] = []
-    for entry in entries:
-        if entry.robot not in robot_hashes:
-            try:
-                robot_hashes[entry.robot] = robot_sha256(entry.robot, worker_robot(entry.robot))
-            except InputError as exc:
-                where = f"manifest row {entry.row}: " if entry.row is not None else ""
-                raise InputError(f"{where}{exc}") from None
-        opts = options.for_entry(entry.options)
-        planned = PlannedLog(entry, log_key(entry, robot_hashes[entry.robot], opts), opts)
-        (skipped if planned.key.key in done else todo).append(planned)
-    return BatchPlan(todo, skipped)
+    keyed = _keys(entries, options)
+    by_path = {str(p.entry.log): i for i, p in enumerate(keyed)}
+    by_bytes: dict[str, list[int]] = defaultdict(list)
+    for i, p in enumerate(keyed):
+        by_bytes[p.key.log_sha256].append(i)
+    by_key = {p.key.key: i for i, p in enumerate(keyed)}
+
+    def owner(log: str, log_sha256: str | None) -> int | None:
+        """The listed log whose earlier result a file is: the same path, else the same bytes."""
+        if log in by_path:
+            return by_path[log]
+        same = by_bytes.get(log_sha256 or "")
+        return same[0] if same else None
+
+    done: set[int] = set()
+    files: dict[int, list[Path]] = defaultdict(list)
+    why: dict[int, str] = {}
+    stale, foreign, kept = [], [], 0
+    for part in read_parts(results):
+        if part.foreign:
+            foreign.append(Skipped(part.path, f"{part.problem}: left as it is"))
+            continue
+        if part.rows is None:  # damaged: its name is all that is left of its key
+            named = by_key.get(part.key)
+            if named is None:
+                stale.append(Skipped(part.path, f"{part.problem}: removed (no listed log has its key)"))
+            else:
+                files[named].append(part.path)
+                why[named] = f"its result was {part.problem}"
+            continue
+        of = owner(part.first("log"), part.first("log_sha256"))
+        if of is None:
+            kept += 1
+        elif part.key == keyed[of].key.key:
+            done.add(of)
+        else:
+            files[of].append(part.path)
+            why.setdefault(of, _changes(part, keyed[of].key) if part.first("log") == str(keyed[of].entry.log)
+                           else f"the same log (same bytes) as {part.first('log')}, listed at another path")
+    for path, record in _failure_records(results):
+        of = owner(str(record.get("log", "")), record.get("log_sha256"))
+        if of is not None:
+            files[of].append(path)
+            why.setdefault(of, "failed before")
+    todo, skipped = [], []
+    for i, p in enumerate(keyed):
+        if i in done:
+            skipped.append(p)
+            stale += [Skipped(f, f"an earlier result of {p.entry.where}, whose result is there: removed")
+                      for f in files[i]]
+        else:
+            todo.append(PlannedLog(p.entry, p.key, p.options, tuple(files[i]), why.get(i, "new")))
+    copies = tuple((keyed[group[0]].entry, keyed[j].entry) for group in by_bytes.values() for j in group[1:])
+    return BatchPlan(todo, skipped, tuple(stale), kept, tuple(foreign), copies)
+
+
+def _failure_records(results: Path) -> Iterator[tuple[Path, dict]]:
+    """The failure records beside ``results`` (an unreadable one is left out: the log it names is retried)."""
+    import json
+
+    for path in sorted(failures_folder(results).glob("*.json")):
+        try:
+            record = json.loads(path.read_text())
+        except (OSError, ValueError):
+            continue
+        if isinstance(record, dict):
+            yield path, record
+
+
+def check_outputs(results: Path, tables: Path | None = None) -> None:
+    """Refuse, before any work, a results (or tables) folder that cannot be one: a file, a path under a file, a
+    folder that cannot be written.
+
+    Raises:
+        InputError: naming the option (``-o``, ``--tables``) and the path.
+    """
+    for label, folder in (("-o", results), ("--tables", tables)):
+        if folder is None:
+            continue
+        existing = folder
+        while not existing.exists() and existing != existing.parent:
+            existing = existing.parent
+        if existing == folder and not folder.is_dir():
+            raise InputError(f"{label} {folder}: not a folder (the results are a folder)")
+        if not existing.is_dir():
+            raise InputError(f"{label} {folder}: under {existing}, which is a file, not a folder")
+        if not os.access(existing, os.W_OK | os.X_OK):
+            raise InputError(f"{label} {folder}: {existing} cannot be written")
+
+
+def connect(scheduler: str, timeout: float = CONNECT_TIMEOUT) -> Any:
+    """A ``distributed.Client`` of the scheduler at ``scheduler``.
+
+    Raises:
+        InputError: an address that is not one, or no scheduler answering within ``timeout`` seconds.
+    """
+    from distributed import Client
+
+    try:
+        return Client(scheduler, timeout=timeout)
+    except ValueError as exc:
+        raise InputError(f"--scheduler {scheduler!r}: not a scheduler's address ({exc}; e.g. tcp://host:8786)"
+                         ) from None
+    except OSError:
+        raise InputError(f"--scheduler {scheduler}: no Dask scheduler answered within {timeout:g} s") from None
 
 
 def run_batch(entries: list[LogEntry], results: str | Path, options: BatchOptions = BatchOptions(), *,
-              engine: Engine = "dask", workers: int = 2, scheduler: str | None = None, client: Any = None,
-              tables: bool = False, progress: Callable[[LogOutcome], None] | None = None) -> BatchSummary:
-    """Process every log not yet in ``results`` (module docstring) and write its rows there.
+              engine: Engine = "dask", workers: int | None = None, scheduler: str | None = None, client: Any = None,
+              tables: str | Path | None = None, progress: Callable[[LogOutcome], None] | None = None
+              ) -> BatchSummary:
+    """Compute every listed log whose whole result is not in ``results`` (module docstring), writing each result
+    as it arrives and removing the files it replaces.
 
     Args:
         entries: the logs (:func:`~wbfriction.fleet.manifest.read_manifest`,
             :func:`~wbfriction.fleet.manifest.scan_folder`).
-        results: the results folder (created; results already in it are kept).
+        results: the results folder (created; results already in it are kept or replaced as the module says).
         options: the batch's options (a manifest row's ``diff`` and ``model`` override them).
         engine: ``dask`` (default) or ``serial``.
-        workers: worker processes of the local cluster (ignored with ``scheduler`` or ``client``).
+        workers: worker processes of the local cluster (default :data:`LOCAL_WORKERS`; not with ``scheduler``,
+            ``client`` or the serial engine).
         scheduler: address of an existing Dask scheduler, or None for a local cluster.
         client: a ``distributed.Client`` to use as it is (tests run one in-process).
-        tables: also keep each log's friction table (``RESULTS/tables/``).
+        tables: a folder where each computed log's friction table is kept (``TABLES/<robot_id>/<key>.parquet``),
+            or None.
         progress: called with each log's outcome as it is written.
 
     Raises:
-        InputError: what :func:`plan_batch` raises, before any log is processed; ``workers`` below 1.
+        InputError: what :func:`check_outputs`, :func:`connect` and :func:`plan_batch` raise, before any log is
+            processed; ``workers`` below 1, or given where no local cluster runs; ``scheduler`` with the serial
+            engine or a ``client``.
     """
-    if workers < 1:
+    if engine == "serial" and scheduler is not None:
+        raise InputError("--scheduler and --serial: a serial batch runs in this process, without a scheduler")
+    if scheduler is not None and client is not None:
+        raise InputError("a scheduler's address and a client: give one")
+    if workers is not None and (engine == "serial" or scheduler is not None or client is not None):
+        raise InputError(f"--workers: the local cluster's, not used with "
+                         f"{'--serial' if engine == 'serial' else '--scheduler'}")
+    if workers is not None and workers < 1:
         raise InputError(f"--workers must be at least 1, got {workers}")
     results = Path(results)
-    plan = plan_batch(entries, results, options)
-    results.mkdir(parents=True, exist_ok=True)
-    failed: list[tuple[LogEntry, str]] = []
+    tables = Path(tables) if tables is not None else None
+    check_outputs(results, tables)
+    with _cluster_client(engine, scheduler, client) as connected:
+        plan = plan_batch(entries, results, options)
+        results.mkdir(parents=True, exist_ok=True)
+        for folder in [results, *(p for p in results.iterdir() if p.is_dir())]:
+            remove_stale_temporaries(folder)  # those a killed batch left
+        for s in plan.stale:
+            s.path.unlink(missing_ok=True)
+        failed: list[tuple[LogEntry, str]] = []
+        planned = {p.key.key: p for p in plan.todo}
+        if len(planned) != len(plan.todo):  # the keys name the tasks and files: one per listed log
+            raise AssertionError("two logs of one batch with one key")
 
-    def record(outcome: LogOutcome) -> None:
-        write_outcome(results, outcome)
-        if outcome.failed:
-            failed.append((outcome.entry, outcome.error))
-        if progress is not None:
-            progress(outcome)
+        def record(outcome: LogOutcome) -> None:
+            write_outcome(results, outcome, planned[outcome.key.key].replaces)
+            if outcome.failed:
+                failed.append((outcome.entry, outcome.error))
+            if progress is not None:
+                progress(outcome)
 
-    args = [(p.entry, p.key, p.options, results,
-             table_path(results, p.entry.robot_id, p.key.key) if tables else None) for p in plan.todo]
-    for robot_id in {p.entry.robot_id for p in plan.todo} if tables else ():
-        table_path(results, robot_id, "").parent.mkdir(parents=True, exist_ok=True)
-    if engine == "serial":
+        args = [(p.entry, p.key, p.options, results,
+                 table_path(tables, p.entry.robot_id, p.key.key) if tables is not None else None) for p in plan.todo]
         for a in args:
-            record(process_log(*a))
-    elif args:
-        _run_on_dask(args, record, workers, scheduler, client)
-    return BatchSummary(len(plan.todo), len(plan.skipped), failed, results)
+            if a[4] is not None:
+                a[4].parent.mkdir(parents=True, exist_ok=True)
+        if engine == "serial":
+            for a in args:
+                record(process_log(*a))
+        elif args:
+            _run_on_dask(args, record, workers or LOCAL_WORKERS, connected)
+    return BatchSummary(len(plan.todo), len(plan.skipped), failed, results, dict(Counter(p.reason for p in plan.todo)),
+                        plan.stale, plan.kept, plan.foreign, plan.copies)
+
+
+@contextmanager
+def _cluster_client(engine: Engine, scheduler: str | None, client: Any) -> Iterator[Any]:
+    """The client given, or one connected now to ``scheduler`` (before any other work: a wrong address is said
+    within seconds) and closed after; None for the serial engine or a local cluster (started when there is work)."""
+    if engine == "serial" or client is not None or scheduler is None:
+        yield client
+        return
+    own = connect(scheduler)
+    try:
+        yield own
+    finally:
+        own.close()
 
 
 class DaskChunks:
@@ -152,7 +355,7 @@ def chunk_on_one_thread(fn: Callable, *args: Any) -> Any:
         return fn(*args)
 
 
-def log_task(entry: LogEntry, key: LogKey, options: BatchOptions, scratch: Path, table: Path | None) -> LogOutcome:
+def log_task(entry: LogEntry, key: ResultKey, options: BatchOptions, scratch: Path, table: Path | None) -> LogOutcome:
     """One log's task on a Dask worker: :func:`~wbfriction.fleet.task.process_log` with its chunks handed to the
     cluster (its workers, at most, at a time) when the log is long enough to pay for it
     (:meth:`~wbfriction.pipeline.chunks.Chunking.processes`; a task that hands out chunks leaves its thread to
@@ -182,20 +385,17 @@ def local_cluster(workers: int) -> Any:
                             silence_logs=logging.ERROR)
 
 
-def _run_on_dask(args: list[tuple], record: Callable[[LogOutcome], None], workers: int, scheduler: str | None,
-                 client: Any) -> None:
+def _run_on_dask(args: list[tuple], record: Callable[[LogOutcome], None], workers: int, client: Any) -> None:
     """Submit one task per log and record each outcome as it completes; a task Dask gave up on (its workers
-    died each time it ran) is recorded as the log's failure."""
+    died each time it ran) is recorded as the log's failure. Without ``client``, on a local cluster of
+    ``workers`` processes started here."""
     from distributed import Client, as_completed
 
-    own = client is None
     cluster = None
+    own = client is None
     if own:
-        if scheduler is not None:
-            client = Client(scheduler)
-        else:
-            cluster = local_cluster(workers)
-            client = Client(cluster)
+        cluster = local_cluster(workers)
+        client = Client(cluster)
     try:
         futures = {client.submit(log_task, *a, key=f"wbfriction-log-{a[1].key}", pure=False): a for a in args}
         for future in as_completed(futures):

@@ -6,18 +6,24 @@ A manifest is a CSV or Parquet table, one row per log:
 column         meaning
 =============  ========================================================================================
 ``log``        the log's path (Parquet, CSV or HDF5), relative to the manifest's folder or absolute
-``robot_id``   the robot that wrote it (letters, digits, ``.``, ``_``, ``-``): the results' partition
+``robot_id``   the robot that wrote it, as text (letters, digits, ``.``, ``_``, ``-``): ``007`` and ``7``
+               are two robots, whatever a CSV reader would infer; it names the robot's results folder
 ``start_time`` when the log started: ISO 8601 with a time zone (``2026-03-01T08:00:00+00:00``), or a
-               Parquet timestamp
-``robot``      a built-in robot (``talos``, ...), or empty with ``urdf`` and/or ``config`` (paths, relative
-               to the manifest) for any other robot (:func:`~wbfriction.model.loading.load_robot`)
+               Parquet timestamp; between 1970 and 2262 (the results' nanosecond timestamps)
+``robot``      a built-in robot (``talos``, ...), optionally with ``urdf`` (another model of it, e.g.
+               identified inertias); or empty with ``urdf`` and/or ``config`` (paths, relative to the
+               manifest) for any other robot (:func:`~wbfriction.model.loading.load_robot`); not both
+               ``robot`` and ``config`` (the configuration defines the robot)
 ``diff``       optional: the differentiation of this log (``auto``, ``central``, ``savgol``, ...)
 ``model``      optional: the friction model fitted (``auto``, ``thesis``, ``stribeck``, ``coulomb-viscous``)
 =============  ========================================================================================
 
 A folder is scanned as ``FOLDER/<robot_id>/**/<log>`` (``.parquet``, ``.csv``, ``.h5``), every log with the
 robot given on the command line, its start time from its ``time`` column when that holds dates (a Parquet
-timestamp); a log whose time stamps are relative needs a manifest row.
+timestamp); a log whose time stamps are relative needs a manifest row. Every file or folder the scan passes
+over is said (:attr:`FolderScan.skipped`), but hidden ones (a name starting with ``.``): a folder whose name is
+not a robot id, a file outside any robot's folder or of another type, a table that wbfriction wrote (a
+friction table, a batch's result) and the batch's own output folders.
 
 Everything is checked here, before any log is processed: a fault is one :class:`~wbfriction.exceptions.InputError`
 naming the manifest, its row and column.
@@ -26,6 +32,7 @@ naming the manifest, its row and column.
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -35,8 +42,9 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from wbfriction.exceptions import InputError
+from wbfriction.fleet.schema import RESULT_DOCUMENT
 from wbfriction.friction.fit import MODEL_CHOICES
-from wbfriction.logs.tables import TableFile, table_format
+from wbfriction.logs.tables import TableFile, read_metadata, table_format
 from wbfriction.pipeline.estimate import RobotSpec
 from wbfriction.signals.kinematics import Diff
 
@@ -50,6 +58,10 @@ DIFF_CHOICES: tuple[str, ...] = ("auto", *get_args(Diff))
 """The values of a manifest's ``diff`` column."""
 ROBOT_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
 """What a robot id may be: it names a folder of the results."""
+EARLIEST = datetime(1970, 1, 1, tzinfo=UTC)
+LATEST = datetime(2262, 1, 1, tzinfo=UTC)
+"""The start times a log may have: the results store them as nanoseconds since 1970 in 64 bits (up to April
+2262)."""
 
 
 @dataclass(frozen=True)
@@ -58,7 +70,7 @@ class LogEntry:
 
     Attributes:
         log: the log's path (absolute).
-        robot_id: the robot that wrote it.
+        robot_id: the robot that wrote it (text, as the manifest or the folder's name gives it).
         start_time: when it started (UTC, aware).
         robot: how to load its robot model.
         options: per-log options (``diff``, ``model``) that override the batch's.
@@ -72,16 +84,40 @@ class LogEntry:
     options: dict[str, str] = field(default_factory=dict)
     row: int | None = None
 
+    @property
+    def where(self) -> str:
+        """How a message names this log: its manifest row, or its path for a scanned log."""
+        return f"manifest row {self.row} ({self.log.name})" if self.row is not None else str(self.log)
+
+
+@dataclass(frozen=True)
+class Skipped:
+    """A file or folder a scan passed over, and why (one line)."""
+
+    path: Path
+    reason: str
+
+    def __str__(self) -> str:
+        return f"{self.path}: {self.reason}"
+
+
+@dataclass(frozen=True)
+class FolderScan:
+    """What a scanned folder holds: its logs (:class:`LogEntry`, in path order) and what was passed over."""
+
+    entries: list[LogEntry]
+    skipped: list[Skipped]
+
 
 def read_manifest(path: str | Path) -> list[LogEntry]:
-    """The logs a manifest lists (module docstring), checked: columns, robot ids, start times, option values,
-    the logs' existence and format, and no log listed twice.
+    """The logs a manifest lists (module docstring), checked: columns, robot ids, start times, robot columns,
+    option values, the logs' existence and format, and no log listed twice.
 
     Raises:
         InputError: the first fault, naming the manifest, the row (0-based, as the file's data rows) and column.
     """
     path = Path(path)
-    table = TableFile(path).read()
+    table = TableFile(path).read(text_columns=REQUIRED + OPTIONAL)
     names = table.column_names
     missing = [c for c in REQUIRED if c not in names]
     if missing:
@@ -93,11 +129,11 @@ def read_manifest(path: str | Path) -> list[LogEntry]:
     if table.num_rows == 0:
         raise InputError(f"{path}: the manifest lists no log")
     starts = _start_times(table.column("start_time"), path)
-    columns = {c: table.column(c).to_pylist() for c in names if c != "start_time"}
+    columns = {c: _text_column(table.column(c), c, path) for c in names if c != "start_time"}
     entries: list[LogEntry] = []
     seen: dict[Path, int] = {}
     for row in range(table.num_rows):
-        cell = {c: ("" if columns[c][row] is None else str(columns[c][row]).strip()) for c in columns}
+        cell = {c: (columns[c][row] or "").strip() for c in columns}
         entry = _entry(path, row, cell, starts[row])
         if entry.log in seen:
             raise InputError(f"{path}: row {row}, column 'log': {entry.log} is listed twice (first in row "
@@ -107,29 +143,81 @@ def read_manifest(path: str | Path) -> list[LogEntry]:
     return entries
 
 
-def scan_folder(folder: str | Path, robot: RobotSpec) -> list[LogEntry]:
-    """The logs of ``FOLDER/<robot_id>/**`` (module docstring), each with ``robot``, in path order.
+def scan_folder(folder: str | Path, robot: RobotSpec, exclude: Sequence[str | Path] = ()) -> FolderScan:
+    """The logs of ``FOLDER/<robot_id>/**`` (module docstring), each with ``robot``, in path order, and every
+    file or folder passed over, with why.
+
+    Args:
+        folder: the folder scanned.
+        robot: every log's robot.
+        exclude: folders that are not scanned (the batch's own outputs, when they lie in ``folder``).
 
     Raises:
-        InputError: an empty folder, a robot id that cannot name a folder, a log without dates in its ``time``.
+        InputError: a folder without any log, a log without dates in its ``time`` column or one out of range.
     """
     folder = Path(folder)
-    entries = []
-    for sub in sorted(p for p in folder.iterdir() if p.is_dir()):
-        if not ROBOT_ID.match(sub.name):
-            continue  # the results' own folders, hidden folders
-        for log in sorted(p for p in sub.rglob("*") if p.is_file() and p.suffix.lower() in LOG_SUFFIXES):
-            entries.append(LogEntry(log.resolve(), sub.name, log_start_time(log), robot))
+    excluded = {Path(p).resolve() for p in exclude}
+    entries: list[LogEntry] = []
+    skipped: list[Skipped] = []
+    for sub in sorted(p for p in folder.iterdir() if not p.name.startswith(".")):
+        if sub.resolve() in excluded:
+            skipped.append(Skipped(sub, "this batch's output, not logs"))
+        elif not sub.is_dir():
+            if sub.suffix.lower() in LOG_SUFFIXES:
+                skipped.append(Skipped(sub, f"not in a robot's folder ({folder}/<robot_id>/<log>)"))
+        elif not ROBOT_ID.match(sub.name):
+            skipped.append(Skipped(sub, "not a robot id (letters, digits, '.', '_', '-'; it names a results "
+                                        "folder): rename the folder or list its logs in a manifest"))
+        else:
+            _scan_robot(sub, robot, excluded, entries, skipped)
     if not entries:
-        raise InputError(f"{folder}: no log found as {folder}/<robot_id>/<log>.parquet|.csv|.h5")
-    return entries
+        raise InputError(f"{folder}: no log found as {folder}/<robot_id>/<log>.parquet|.csv|.h5"
+                         + (f" ({len(skipped)} passed over, e.g. {skipped[0]})" if skipped else ""))
+    return FolderScan(entries, skipped)
+
+
+def _scan_robot(sub: Path, robot: RobotSpec, excluded: set[Path], entries: list[LogEntry],
+                skipped: list[Skipped]) -> None:
+    """The logs of one robot's folder (recursively, hidden names left out) into ``entries``; what is not a log
+    into ``skipped``."""
+    for path in sorted(sub.rglob("*")):
+        if any(p.startswith(".") for p in path.relative_to(sub).parts):
+            continue  # hidden
+        resolved = path.resolve()
+        if resolved in excluded:
+            skipped.append(Skipped(path, "this batch's output, not logs"))
+            continue
+        if not path.is_file() or any(resolved.is_relative_to(e) for e in excluded):
+            continue  # a folder (its files are scanned); or inside an output (said once, for the output)
+        if path.suffix.lower() not in LOG_SUFFIXES:
+            skipped.append(Skipped(path, f"not a log ({', '.join(LOG_SUFFIXES)})"))
+            continue
+        written = _written_by_wbfriction(path)
+        if written:
+            skipped.append(Skipped(path, written))
+            continue
+        entries.append(LogEntry(path.resolve(), sub.name, log_start_time(path), robot))
+
+
+def _written_by_wbfriction(path: Path) -> str:
+    """Why a table file is not a log when wbfriction wrote it (a friction table, a batch's result), else ''."""
+    try:
+        meta = read_metadata(TableFile(path).schema().empty_table(), str(path))
+    except InputError:
+        return ""  # unreadable: reported as the log it claims to be
+    if "estimate_options" in meta:
+        return "a friction table ('wbfriction estimate' wrote it), not a log"
+    if meta.get("document") == RESULT_DOCUMENT:
+        return "a batch's result, not a log"
+    return ""
 
 
 def log_start_time(log: Path) -> datetime:
     """When a log started, from its ``time`` column if that holds dates (a timestamp column).
 
     Raises:
-        InputError: a ``time`` column of relative seconds (the log then needs a manifest row).
+        InputError: a ``time`` column of relative seconds (the log then needs a manifest row), or a date out of
+            :data:`EARLIEST`-:data:`LATEST`.
     """
     time = TableFile(log).read(["time"])
     if "time" not in time.column_names or time.num_rows == 0:
@@ -138,28 +226,49 @@ def log_start_time(log: Path) -> datetime:
     if not pa.types.is_timestamp(column.type):
         raise InputError(f"{log}: column 'time' holds no dates ({column.type}): give the log's start_time in a "
                          "manifest")
-    first = pc.min(column).as_py()
-    return first.replace(tzinfo=first.tzinfo or UTC).astimezone(UTC)
+    try:
+        first = pc.min(column).as_py()
+    except (ValueError, OverflowError) as exc:  # a date Python's datetime cannot hold
+        raise InputError(f"{log}: column 'time': {exc}") from None
+    return _in_range(first.replace(tzinfo=first.tzinfo or UTC).astimezone(UTC), f"{log}: column 'time'")
+
+
+def _in_range(t: datetime, where: str) -> datetime:
+    if not EARLIEST <= t < LATEST:
+        raise InputError(f"{where}: {t.isoformat()} is out of range ({EARLIEST:%Y} to {LATEST:%Y})")
+    return t
+
+
+def _text_column(column: pa.ChunkedArray, name: str, path: Path) -> list[str | None]:
+    """A manifest column's cells as text. A Parquet manifest's integer column reads as its decimal digits; any
+    other type that is not text is refused (a robot id stored as a float has lost its own spelling)."""
+    if pa.types.is_string(column.type) or pa.types.is_large_string(column.type) or pa.types.is_null(column.type):
+        return column.to_pylist()
+    if pa.types.is_integer(column.type):
+        return [None if v is None else str(v) for v in column.to_pylist()]
+    raise InputError(f"{path}: column {name!r} holds {column.type} values, not text: store it as strings (an id "
+                     "such as '007' read as a number is another id)")
 
 
 def _start_times(column: pa.ChunkedArray, path: Path) -> list[datetime]:
     """Every row's start time (UTC), from ISO 8601 strings with a zone or timestamps."""
-    if pa.types.is_timestamp(column.type) and column.type.tz is None:  # a CSV's dates without a zone, inferred
-        raise InputError(f"{path}: row 0, column 'start_time': dates without a time zone (add +00:00 for UTC)")
+    if pa.types.is_timestamp(column.type) and column.type.tz is None:
+        raise InputError(f"{path}: column 'start_time': timestamps without a time zone (store them as UTC)")
     out = []
-    for row, value in enumerate(column.to_pylist()):
+    for row, value in enumerate(column.to_pylist() if pa.types.is_timestamp(column.type)
+                                else _text_column(column, "start_time", path)):
+        where = f"{path}: row {row}, column 'start_time'"
         if isinstance(value, datetime):
             t = value
         else:
             try:
                 t = datetime.fromisoformat(str(value).strip())
             except ValueError:
-                raise InputError(f"{path}: row {row}, column 'start_time': {value!r} is not an ISO 8601 date "
-                                 "(e.g. 2026-03-01T08:00:00+00:00)") from None
+                raise InputError(f"{where}: {value!r} is not an ISO 8601 date (e.g. 2026-03-01T08:00:00+00:00)"
+                                 ) from None
             if t.tzinfo is None:
-                raise InputError(f"{path}: row {row}, column 'start_time': {value!r} has no time zone "
-                                 "(add +00:00 for UTC)")
-        out.append(t.astimezone(UTC))
+                raise InputError(f"{where}: {value!r} has no time zone (add +00:00 for UTC)")
+        out.append(_in_range(t.astimezone(UTC), where))
     return out
 
 
@@ -181,6 +290,9 @@ def _entry(path: Path, row: int, cell: dict[str, str], start: datetime) -> LogEn
     name, urdf, config = cell.get("robot", ""), cell.get("urdf", ""), cell.get("config", "")
     if not (name or urdf or config):
         raise InputError(f"{where}: no robot (give column 'robot', a built-in name, or 'urdf' and 'config')")
+    if name and config:
+        raise InputError(f"{where}, columns 'robot' and 'config': give a built-in robot ({name!r}) or a robot "
+                         f"TOML ({config!r}), not both")
     for column, value in (("urdf", urdf), ("config", config)):
         if value and not (path.parent / value).exists():
             raise InputError(f"{where}, column '{column}': {(path.parent / value).resolve()} not found")

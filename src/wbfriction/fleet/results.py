@@ -1,16 +1,19 @@
-"""The results dataset on disk (issue 25; layout in :mod:`wbfriction.fleet.schema`): written one log at a time,
-whole or not at all, read back as one table.
+"""The results dataset on disk (issue 25, issue 37; layout in :mod:`wbfriction.fleet.schema`): written one log at a
+time, whole or not at all, each file checked when it is read back.
 
-A log's file is written only when its result is complete (:func:`~wbfriction.logs.tables.write_table` writes a
-temporary file and renames it), so a batch stopped at any moment leaves only whole results, and the next run
-skips them (:func:`done_keys`). The files do not repeat ``robot_id``: their folder's name gives it (Hive
-partitioning), so that readers which add partition columns (``pyarrow.dataset`` with ``partitioning="hive"``,
-pandas, Polars, DuckDB, Spark) see it once.
+A log's file is written only when its result is complete (:func:`~wbfriction.logs.tables.write_atomic` writes a
+temporary file and renames it), so a batch stopped at any moment leaves only whole results. Each file carries
+the SHA-256 of its rows (:func:`rows_sha256`) in its ``wbfriction`` metadata; :func:`read_part` checks it, the
+columns, and that the file's name and folder are its rows' key and robot id, so that a truncated, altered or
+stray file is found and named (:class:`Part`), never read as a result. Failures live beside the dataset
+(:func:`failures_folder`), never inside it: the folder stays a dataset any Parquet reader opens.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -19,77 +22,201 @@ import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 from wbfriction.exceptions import InputError
-from wbfriction.fleet.schema import RESULT_SCHEMA
-from wbfriction.fleet.task import LogOutcome
-from wbfriction.logs.tables import write_json, write_table
+from wbfriction.fleet.manifest import Skipped
+from wbfriction.fleet.schema import RESULT_DOCUMENT, RESULT_SCHEMA
+from wbfriction.fleet.task import LogOutcome, ResultKey
+from wbfriction.logs.tables import META_KEY, with_metadata, write_json, write_table
 
-FILE_SCHEMA = pa.schema([f for f in RESULT_SCHEMA if f.name != "robot_id"])
-"""The schema of one log's file: :data:`~wbfriction.fleet.schema.RESULT_SCHEMA` without ``robot_id``."""
-PARTITION = "robot_id="
-"""The prefix of a robot's folder."""
 SORT = [("robot_id", "ascending"), ("start_time", "ascending"), ("log", "ascending"), ("joint", "ascending")]
 """The order :func:`read_results` gives the rows in."""
+FAILED = "-failed"
+"""The suffix of the failures' folder, beside the results': ``RESULTS-failed``."""
+EARLIER_LAYOUT = "robot_id="
+"""The prefix of a robot's folder in the layout of wbfriction before issue 37 (Hive partitions, failures inside)."""
+
+
+def failures_folder(results: str | Path) -> Path:
+    """Where the failures of the batch writing ``results`` are recorded: the folder ``RESULTS-failed`` beside it."""
+    results = Path(results).absolute()
+    return results.parent / f"{results.name}{FAILED}"
 
 
 def result_path(results: Path, robot_id: str, key: str) -> Path:
     """Where the rows of the log of ``key`` go."""
-    return results / f"{PARTITION}{robot_id}" / f"{key}.parquet"
+    return results / robot_id / f"{key}.parquet"
 
 
 def failure_path(results: Path, key: str) -> Path:
     """Where the failure of the log of ``key`` is recorded."""
-    return results / "failed" / f"{key}.json"
+    return failures_folder(results) / f"{key}.json"
 
 
-def table_path(results: Path, robot_id: str, key: str) -> Path:
-    """Where the friction table of the log of ``key`` goes, when asked for."""
-    return results / "tables" / f"{PARTITION}{robot_id}" / f"{key}.parquet"
+def table_path(tables: Path, robot_id: str, key: str) -> Path:
+    """Where the friction table of the log of ``key`` goes, in the folder of tables asked for."""
+    return tables / robot_id / f"{key}.parquet"
 
 
-def done_keys(results: Path) -> set[str]:
-    """The keys of the logs whose results are in ``results`` (none for a new folder)."""
-    return {p.stem for p in results.glob(f"{PARTITION}*/*.parquet")} if results.is_dir() else set()
+def rows_sha256(rows: pa.Table) -> str:
+    """SHA-256 of a result's rows as canonical JSON (column names and values in the schema's order, floats as
+    their shortest exact repr, timestamps as integer nanoseconds): the same rows give the same digest however
+    the file stores them."""
+    columns = {}
+    for name in rows.column_names:
+        column = rows.column(name)
+        if pa.types.is_timestamp(column.type):
+            column = column.cast(pa.int64())
+        columns[name] = column.to_pylist()
+    return hashlib.sha256(json.dumps(columns, allow_nan=True).encode()).hexdigest()
 
 
-def write_outcome(results: Path, outcome: LogOutcome) -> None:
-    """Record one log's outcome: its rows (and its failure record removed), or its failure (entry and error)."""
-    key = outcome.key.key
-    failure = failure_path(results, key)
-    if outcome.rows is not None:
-        path = result_path(results, outcome.entry.robot_id, key)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        write_table(outcome.rows.drop_columns(["robot_id"]).cast(FILE_SCHEMA), path)
-        failure.unlink(missing_ok=True)
-        return
-    failure.parent.mkdir(parents=True, exist_ok=True)
-    write_json(failure, {"log": str(outcome.entry.log), "robot_id": outcome.entry.robot_id,
-                         "start_time": outcome.entry.start_time.isoformat(), "manifest_row": outcome.entry.row,
-                         "key": key, "error": outcome.error})
+@dataclass(frozen=True)
+class Part:
+    """One file of a results folder, as read back: its rows when it is a whole result, else why not.
+
+    Attributes:
+        path: the file.
+        rows: its rows (:data:`~wbfriction.fleet.schema.RESULT_SCHEMA`, at least one), or None.
+        problem: why it is not a result (one line): ``""`` for a whole result.
+        foreign: it is not a file of wbfriction's (no result metadata): left as it is, never removed.
+    """
+
+    path: Path
+    rows: pa.Table | None = None
+    problem: str = ""
+    foreign: bool = False
+
+    @property
+    def key(self) -> str:
+        """The key its name says it holds."""
+        return self.path.stem
+
+    def first(self, column: str) -> Any:
+        """A column's value in its first row (every row of a result has the same key fields)."""
+        assert self.rows is not None
+        return self.rows.column(column)[0].as_py()
 
 
-def read_results(results: str | Path) -> pa.Table:
-    """Every log's rows (:data:`~wbfriction.fleet.schema.RESULT_SCHEMA`), sorted by robot, start time, log and
-    joint.
+def write_part(results: Path, rows: pa.Table) -> Path:
+    """Write one log's rows (one key, one robot) with the digest of its rows; the file's path."""
+    key, robot_id = rows.column("key")[0].as_py(), rows.column("robot_id")[0].as_py()
+    path = result_path(results, robot_id, key)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    rows = rows.cast(RESULT_SCHEMA)
+    write_table(with_metadata(rows, {"document": RESULT_DOCUMENT, "rows_sha256": rows_sha256(rows)}), path)
+    return path
+
+
+def read_part(path: Path) -> Part:
+    """One file of a results folder, checked: readable, a result (its metadata), this version's columns, rows
+    matching their digest, and its name and folder those of its rows' key and robot id."""
+    try:
+        table = pq.read_table(path)
+    except (pa.ArrowException, OSError, ValueError) as exc:
+        return Part(path, problem=f"unreadable ({(str(exc).splitlines() or [type(exc).__name__])[0]})")
+    raw = (table.schema.metadata or {}).get(META_KEY)
+    try:
+        meta = json.loads(raw) if raw is not None else {}
+    except ValueError:
+        meta = {}
+    if not isinstance(meta, dict) or meta.get("document") != RESULT_DOCUMENT:
+        return Part(path, problem="not a result of 'wbfriction batch' (no result metadata)", foreign=True)
+    rows = table.replace_schema_metadata(None)
+    if not rows.schema.equals(RESULT_SCHEMA):
+        return Part(path, problem="its columns are not those of this version's results")
+    if rows.num_rows == 0 or rows_sha256(rows) != meta.get("rows_sha256"):
+        return Part(path, problem="damaged: its rows do not match their SHA-256")
+    if set(rows.column("key").to_pylist()) != {path.stem} or \
+            set(rows.column("robot_id").to_pylist()) != {path.parent.name}:
+        return Part(path, problem="moved: its name and folder are not its rows' key and robot id")
+    return Part(path, rows)
+
+
+def read_parts(results: str | Path) -> list[Part]:
+    """Every Parquet file of a results folder (:func:`read_part`; hidden files left out), in path order; none
+    for a folder that does not exist.
 
     Raises:
-        InputError: a folder that is not a results dataset (no ``robot_id=<id>`` folder of results).
+        InputError: a folder of the layout before issue 37 (``robot_id=<id>`` folders).
     """
     results = Path(results)
-    parts = sorted(results.glob(f"{PARTITION}*")) if results.is_dir() else []
-    if not parts:
-        raise InputError(f"{results}: no results (a folder written by 'wbfriction batch', with robot_id=<id> "
-                         "folders)")
+    if not results.is_dir():
+        return []
+    if any(p.name.startswith(EARLIER_LAYOUT) for p in results.iterdir()):
+        raise InputError(f"{results}: results of an earlier wbfriction ({EARLIER_LAYOUT}<id> folders): run the "
+                         "batch into a new folder")
+    files = sorted(p for p in results.rglob("*.parquet")
+                   if not any(s.startswith(".") for s in p.relative_to(results).parts))
+    return [read_part(p) if p.parent.parent == results else
+            Part(p, problem="not in a robot's folder (RESULTS/<robot_id>/<key>.parquet)", foreign=True)
+            for p in files]
+
+
+@dataclass(frozen=True)
+class ResultsDataset:
+    """A results folder read back (:func:`read_results`).
+
+    Attributes:
+        table: the rows (:data:`~wbfriction.fleet.schema.RESULT_SCHEMA`) of every whole result, one result
+            per log: of a robot's logs with the same bytes (a copy) only the first (by start time, then path);
+            sorted by robot, start time, log and joint.
+        left_out: the files whose rows are not in ``table``, with why (damaged, not a result, a copy).
+    """
+
+    table: pa.Table
+    left_out: tuple[Skipped, ...] = ()
+
+
+def read_results(results: str | Path) -> ResultsDataset:
+    """Every whole result of a results folder (:class:`ResultsDataset`): each file checked (:func:`read_part`),
+    each robot's log counted once.
+
+    Raises:
+        InputError: a folder without any result (naming what it holds instead), or of the earlier layout.
+    """
+    results = Path(results)
+    parts = read_parts(results)
+    whole = [p for p in parts if p.rows is not None]
+    left_out = [Skipped(p.path, p.problem) for p in parts if p.rows is None]
+    if not whole:
+        raise InputError(f"{results}: no results (a folder written by 'wbfriction batch', RESULTS/<robot_id>/"
+                         f"<key>.parquet)" + (f"; {left_out[0]}" if left_out else ""))
+    counted: dict[tuple[str, str], Part] = {}
     tables = []
-    for part in parts:
-        robot_id = part.name[len(PARTITION):]
-        for file in sorted(part.glob("*.parquet")):
-            t = pq.read_table(file, schema=FILE_SCHEMA)
-            tables.append(t.add_column(0, "robot_id", pa.array([robot_id] * t.num_rows, pa.string())))
-    table = pa.concat_tables(tables).cast(RESULT_SCHEMA) if tables else RESULT_SCHEMA.empty_table()
-    return table.take(pc.sort_indices(table, sort_keys=SORT))
+    for part in sorted(whole, key=lambda p: (p.first("robot_id"), p.first("start_time"), p.first("log"))):
+        same = (part.first("robot_id"), part.first("log_sha256"))
+        if same in counted:
+            left_out.append(Skipped(part.path, f"the log {part.first('log')} has the same bytes as "
+                                               f"{counted[same].first('log')}: counted once"))
+            continue
+        counted[same] = part
+        assert part.rows is not None
+        tables.append(part.rows)
+    table = pa.concat_tables(tables)
+    return ResultsDataset(table.take(pc.sort_indices(table, sort_keys=SORT)), tuple(left_out))
+
+
+def failure_record(outcome: LogOutcome) -> dict[str, Any]:
+    """What a failure's file holds: the log's key fields, its manifest row and the one-line error."""
+    k: ResultKey = outcome.key
+    return {"log": k.log, "robot_id": k.robot_id, "start_time": k.start_time.isoformat(),
+            "manifest_row": outcome.entry.row, "key": k.key, "log_sha256": k.log_sha256,
+            "robot_sha256": k.robot_sha256, "options_sha256": k.options_sha256, "error": outcome.error}
+
+
+def write_outcome(results: Path, outcome: LogOutcome, replaces: tuple[Path, ...] = ()) -> None:
+    """Record one log's outcome: the files of its earlier results and failures (``replaces``) removed first,
+    then its rows, or its failure record (:func:`failure_record`)."""
+    for path in replaces:
+        path.unlink(missing_ok=True)
+    if outcome.rows is not None:
+        write_part(results, outcome.rows)
+        return
+    failure = failure_path(results, outcome.key.key)
+    failure.parent.mkdir(parents=True, exist_ok=True)
+    write_json(failure, failure_record(outcome))
 
 
 def read_failures(results: str | Path) -> list[dict[str, Any]]:
-    """The failure records (log, robot_id, start_time, manifest_row, key, error) of ``results``, by log."""
-    files = sorted((Path(results) / "failed").glob("*.json"))
+    """The failure records of the batch writing ``results`` (:func:`failure_record`), by log."""
+    files = sorted(failures_folder(results).glob("*.json"))
     return sorted((json.loads(f.read_text()) for f in files), key=lambda d: d["log"])

@@ -1,16 +1,20 @@
-"""The fleet's results dataset (issue 25): one row per log and joint, what :mod:`wbfriction.fleet.batch` writes
-and :mod:`wbfriction.fleet.trends` reads.
+"""The fleet's results dataset (issue 25, issue 37): one row per log and joint, what :mod:`wbfriction.fleet.batch`
+writes and :mod:`wbfriction.fleet.trends` reads.
 
-The dataset is a folder of Parquet files partitioned by robot, in the Hive layout every Parquet reader knows
-(``pyarrow.dataset``, pandas, Polars, DuckDB, Spark)::
+The dataset is a folder of Parquet files, one per log, in a folder per robot; every file holds the whole
+:data:`RESULT_SCHEMA` (``robot_id`` included, as text), so that any Parquet reader opens the folder as one
+table (``pandas.read_parquet``, ``pyarrow.parquet.read_table``, ``pyarrow.dataset``, Polars, DuckDB with
+``RESULTS/*/*.parquet``) and reads the ids as they were written (``007`` stays ``007``)::
 
-    RESULTS/
-      robot_id=<id>/<key>.parquet      one file per processed log: its joints' rows (:data:`RESULT_SCHEMA`)
-      failed/<key>.json                one file per log that failed: its entry and one-line error
-      tables/robot_id=<id>/<key>.parquet   the log's friction table, when asked for
+    RESULTS/<robot_id>/<key>.parquet          one file per log: its joints' rows
+    RESULTS-failed/<key>.json                 beside it: one file per log that failed, its entry and error
+    TABLES/<robot_id>/<key>.parquet           where asked (``--tables TABLES``): the log's friction table
 
-``key`` names what was computed: the SHA-256 of the log's content, the robot model's files and the options
-(:func:`~wbfriction.fleet.task.log_key`). A log with a result file under its key is not processed again.
+``key`` names what the rows describe (:class:`~wbfriction.fleet.task.ResultKey`): the log (its path and the
+SHA-256 of its bytes), the robot id and start time it was listed with, the robot model and the options. A log
+has one file at most: a batch that lists it again with anything changed replaces its file. Each file carries
+the SHA-256 of its rows in its metadata (:data:`RESULT_DOCUMENT`), so that a damaged file is found
+(:mod:`wbfriction.fleet.results`).
 
 Sign convention: as everywhere in wbfriction, ``tau_f`` is the torque friction exerts on the joint, and the
 model ``f(qd)`` is fitted to ``-tau_f`` (positive ``F_c``, ``F_v``: friction opposing the motion).
@@ -23,6 +27,9 @@ from __future__ import annotations
 
 import pyarrow as pa
 
+RESULT_DOCUMENT = "wbfriction fleet result"
+"""The ``document`` named in a result file's ``wbfriction`` metadata (with ``rows_sha256``, the digest of its
+rows): what tells a result from any other Parquet file."""
 REFERENCE_SPEEDS: tuple[float, ...] = (0.1, 0.3, 1.0)
 """The speeds [rad/s] at which each fit's friction ``f_at_<v>`` is reported."""
 TREND_PARAMS: tuple[str, ...] = ("F_c", "F_v", "tau_os")
@@ -36,9 +43,9 @@ def speed_column(v: float) -> str:
 
 RESULT_SCHEMA = pa.schema([
     ("robot_id", pa.string()),            # the robot, as the manifest names it
-    ("log", pa.string()),                 # the log's path, as the manifest gives it
+    ("log", pa.string()),                 # the log's path (absolute)
     ("start_time", pa.timestamp("ns", tz="UTC")),  # when the log started
-    ("key", pa.string()),                 # SHA-256 hex of log content + robot model + options
+    ("key", pa.string()),                 # SHA-256 hex of what the rows describe (ResultKey)
     ("log_sha256", pa.string()),
     ("robot_sha256", pa.string()),
     ("options_sha256", pa.string()),

@@ -38,17 +38,25 @@ from wbfriction.version import __version__
 
 
 @dataclass(frozen=True)
-class LogKey:
-    """What a log's result is computed from, as SHA-256 hex digests: the log's bytes, the robot model's files,
-    the options; :attr:`key` digests the three (the result file's name)."""
+class ResultKey:
+    """What a log's rows describe (issue 37): the log as listed (its robot id, start time and path) and what its
+    result is computed from (the SHA-256 hex digests of the log's bytes, the robot model's files and the
+    options). :attr:`key` digests them all: the result file's name. Two rows of a manifest are two keys, even
+    when their logs have the same bytes; a row corrected (robot id, start time) or other options are another
+    key, and the log's earlier result is replaced (:mod:`wbfriction.fleet.batch`)."""
 
+    robot_id: str
+    start_time: datetime
+    log: str
     log_sha256: str
     robot_sha256: str
     options_sha256: str
 
     @property
     def key(self) -> str:
-        return hashlib.sha256(f"{self.log_sha256}:{self.robot_sha256}:{self.options_sha256}".encode()).hexdigest()
+        fields = (self.robot_id, self.start_time.astimezone(UTC).isoformat(), self.log, self.log_sha256,
+                  self.robot_sha256, self.options_sha256)
+        return hashlib.sha256(json.dumps(fields).encode()).hexdigest()
 
 
 @dataclass(frozen=True)
@@ -57,7 +65,7 @@ class LogOutcome:
     the one-line error that stopped it; and where its friction table was written, if asked for."""
 
     entry: LogEntry
-    key: LogKey
+    key: ResultKey
     rows: pa.Table | None = None
     error: str = ""
     table: Path | None = None
@@ -84,23 +92,20 @@ def options_sha256(options: BatchOptions) -> str:
     return hashlib.sha256(json.dumps(dataclasses.asdict(options), sort_keys=True, default=str).encode()).hexdigest()
 
 
-def log_key(entry: LogEntry, robot_hash: str, options: BatchOptions) -> LogKey:
-    """The key of ``entry`` processed with ``options`` on the robot whose :func:`robot_sha256` is ``robot_hash``.
-
-    Raises:
-        InputError: a missing log.
-    """
-    return LogKey(file_sha256(entry.log), robot_hash, options_sha256(options))
+def result_key(entry: LogEntry, log_hash: str, robot_hash: str, options: BatchOptions) -> ResultKey:
+    """The key of ``entry``, whose log's SHA-256 is ``log_hash``, processed with ``options`` on the robot whose
+    :func:`robot_sha256` is ``robot_hash``."""
+    return ResultKey(entry.robot_id, entry.start_time, str(entry.log), log_hash, robot_hash, options_sha256(options))
 
 
-def process_log(entry: LogEntry, key: LogKey, options: BatchOptions, scratch: Path,
+def process_log(entry: LogEntry, key: ResultKey, options: BatchOptions, scratch: Path,
                 table: Path | None = None, executor: ChunkExecutor | None = None,
                 chunk_workers: int = 1) -> LogOutcome:
     """Estimate, fit and check one log (module docstring); never raises for a fault of the log or its robot.
 
     Args:
         entry: the log.
-        key: its :func:`log_key` (recorded in every row).
+        key: its :func:`result_key` (recorded in every row).
         options: the batch's options with the entry's own applied (:meth:`BatchOptions.for_entry`).
         scratch: a folder for the friction table while it is fitted (removed after).
         table: where to keep the friction table, or None.
@@ -121,7 +126,7 @@ def process_log(entry: LogEntry, key: LogKey, options: BatchOptions, scratch: Pa
             fitted = fit_table(friction, model=options.model, selection_tolerance=options.selection_tolerance,
                                min_samples=options.min_samples, threshold=options.energy_threshold,
                                tolerance=options.energy_tolerance)
-        rows = result_rows(entry, key, fitted.fits, fitted.energy, fitted.est.qd, fitted.est.valid)
+        rows = result_rows(key, fitted.fits, fitted.energy, fitted.est.qd, fitted.est.valid)
         return LogOutcome(entry, key, rows, table=table)
     except WbfrictionError as exc:
         return LogOutcome(entry, key, error=str(exc))
@@ -145,16 +150,16 @@ def reference_friction(fit: FitResult, v: float) -> tuple[float, float]:
     return value, float(np.sqrt(max(float(g @ fit.covariance @ g), 0.0)))
 
 
-def result_rows(entry: LogEntry, key: LogKey, fits: list[FitResult], energy: list[JointEnergy],
-                qd: np.ndarray, valid: np.ndarray) -> pa.Table:
-    """The rows of one log (:data:`~wbfriction.fleet.schema.RESULT_SCHEMA`), one per joint of ``fits``;
+def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy], qd: np.ndarray,
+                valid: np.ndarray) -> pa.Table:
+    """The rows of the log of ``key`` (:data:`~wbfriction.fleet.schema.RESULT_SCHEMA`), one per joint of ``fits``;
     ``qd`` (N, n_tc) [rad/s] and ``valid`` (N, n_tc) of the estimate give each joint's velocity range."""
     shares = {e.joint: e.generating_share for e in energy}
     columns: dict[str, list] = {name: [] for name in RESULT_SCHEMA.names}
     for i, fit in enumerate(fits):
         v = qd[valid[:, i] & np.isfinite(qd[:, i]), i]
         values = fit.params.to_dict() if fit.params is not None else {}
-        row = {"robot_id": entry.robot_id, "log": str(entry.log), "start_time": _utc(entry.start_time),
+        row = {"robot_id": key.robot_id, "log": key.log, "start_time": _utc(key.start_time),
                "key": key.key, "log_sha256": key.log_sha256, "robot_sha256": key.robot_sha256,
                "options_sha256": key.options_sha256, "joint": fit.joint, "model": fit.model,
                "status": fit.verdict().status, "n_samples": fit.n_samples,

@@ -20,12 +20,13 @@ regression problem", The Statistician 50), weighted by the standard errors:
 * the statistic ``F_k = (RSS_0 - RSS_k) / (RSS_k / (n - 2))`` with weighted residual sums of squares; the
   onset is the ``k`` of the largest ``F_k``;
 * its p-value, exact for this model whatever ``phi`` (``F_k`` does not depend on it): the share of
-  :attr:`TrendOptions.replicates` series of pure noise ``se_i z_i`` (seeded: the same input gives the same
+  :meth:`TrendOptions.draws` series of pure noise ``se_i z_i`` (seeded: the same input gives the same
   output) whose largest ``F_k`` reaches the observed one, on the same times and weights;
 * a joint is flagged when one of its quantities has a p-value below ``alpha / m`` (Bonferroni over its ``m``
   quantities with enough points) **and** a change at the last log of at least
   :attr:`TrendOptions.min_change` of its baseline (F_c's for ``tau_os``, which may be zero): a significant
-  change too small to matter is not a drift.
+  change too small to matter is not a drift. A significant change from a baseline that is not told from zero
+  is one whatever its size (its relative change is undefined: NaN).
 
 Sign convention: the values are those of the results dataset (:mod:`wbfriction.fleet.schema`): ``F_c``,
 ``F_v`` and ``f_at_<v>`` positive for friction opposing the motion.
@@ -45,6 +46,8 @@ from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAM
 
 QUANTITIES: tuple[str, ...] = (*TREND_PARAMS, *[speed_column(v) for v in REFERENCE_SPEEDS])
 """The quantities followed over time: the model's parameters and the friction at the reference speeds."""
+UNITS = {"F_c": "N·m", "F_v": "N·m·s/rad", "tau_os": "N·m", **{speed_column(v): "N·m" for v in REFERENCE_SPEEDS}}
+"""The unit of each quantity."""
 USABLE = ("ok", "weak", "at bound")
 """The fit statuses whose values are points of a series (``not excited`` and ``failed`` fits have none)."""
 DAY = 86_400.0
@@ -60,9 +63,14 @@ class TrendOptions:
         min_points: fewer points: no test.
         min_before, min_after: points before the onset, and from it on.
         min_change: the smallest change at the last log that is flagged, relative to the baseline.
-        replicates: noise series of the p-value's Monte Carlo (the smallest p-value is ``1 / (replicates + 1)``).
+        replicates: noise series of the p-value's Monte Carlo (the smallest p-value is ``1 / (replicates + 1)``);
+            None: :meth:`draws` chooses enough for ``alpha``.
         seed: of those series.
         quantities: the quantities tested.
+
+    Raises:
+        InputError: ``alpha`` out of (0, 1), ``replicates`` too few to reach ``alpha / m`` (naming
+            ``--replicates``), an unknown quantity.
     """
 
     alpha: float = 1e-3
@@ -70,20 +78,38 @@ class TrendOptions:
     min_before: int = 3
     min_after: int = 3
     min_change: float = 0.10
-    replicates: int = 20_000
+    replicates: int | None = None
     seed: int = 0
     quantities: tuple[str, ...] = QUANTITIES
 
     def __post_init__(self) -> None:
         if not 0 < self.alpha < 1:
-            raise InputError(f"alpha must be in (0, 1), got {self.alpha}")
-        need = int(np.ceil(len(self.quantities) / self.alpha))  # the smallest p-value below alpha / m
-        if self.replicates < max(2 * FIRST_PASS, need):
-            raise InputError(f"{self.replicates} replicates cannot resolve alpha {self.alpha} over "
-                             f"{len(self.quantities)} quantities: give at least {max(2 * FIRST_PASS, need)}")
+            raise InputError(f"--alpha must be in (0, 1), got {self.alpha}")
         unknown = set(self.quantities) - set(QUANTITIES)
         if unknown:
             raise InputError(f"unknown quantities {sorted(unknown)}: choose from {', '.join(QUANTITIES)}")
+        need = self.least_replicates()
+        if self.replicates is not None and self.replicates < need:
+            raise InputError(f"--replicates {self.replicates} cannot resolve --alpha {self.alpha:g} over "
+                             f"{len(self.quantities)} quantities: give at least {need}")
+
+    def least_replicates(self) -> int:
+        """The fewest noise series whose smallest p-value is below ``alpha / m`` (``m`` the quantities)."""
+        return max(2 * FIRST_PASS, int(np.ceil(len(self.quantities) / self.alpha)))
+
+    def draws(self) -> int:
+        """The noise series drawn: :attr:`replicates`, or :data:`REPLICATES` and at least
+        :data:`RESOLUTION` times :meth:`least_replicates`."""
+        if self.replicates is not None:
+            return self.replicates
+        return max(REPLICATES, RESOLUTION * self.least_replicates())
+
+
+REPLICATES = 20_000
+"""The noise series of the p-value by default (:meth:`TrendOptions.draws`)."""
+RESOLUTION = 3
+"""Times the fewest noise series that resolve ``alpha / m`` the default draws at least, so that a p-value near
+the threshold is told from it."""
 
 
 @dataclass(frozen=True)
@@ -114,7 +140,9 @@ class ChangePoint:
         baseline: the fitted value before the onset.
         change, change_se: the fitted change at the last log, and its standard error (same unit).
         statistic: the largest ``F_k``; p_value: its Monte Carlo p-value.
-        relative: ``change`` over the baseline (over F_c's baseline for ``tau_os``).
+        relative: ``change`` over the baseline (over F_c's baseline for ``tau_os``); NaN where the baseline is
+            not told from zero (within two of its standard errors): a relative change is then meaningless, and
+            :attr:`change` (in the quantity's unit, :data:`UNITS`) says it.
     """
 
     quantity: str
@@ -166,6 +194,20 @@ class FleetTrends:
     def flagged(self) -> list[JointTrend]:
         return [j for j in self.joints if j.flagged]
 
+    @property
+    def tested(self) -> list[JointTrend]:
+        """The joints with at least one quantity tested (enough usable points)."""
+        return [j for j in self.joints if j.tests]
+
+    def summary(self) -> str:
+        """One sentence: how many of the tested joints drifted, and how many could not be tested."""
+        n, tested = len(self.joints), len(self.tested)
+        if tested == 0:
+            return (f"none of the {n} robot joints could be tested (each has fewer than {self.options.min_points} "
+                    "usable logs): no drift can be told")
+        untested = f" ({n - tested} not tested: fewer than {self.options.min_points} usable logs)" if n > tested else ""
+        return f"{len(self.flagged)} of {tested} tested robot joints drifted{untested}"
+
     def to_table(self) -> pa.Table:
         """One row per robot, joint and tested quantity: the best hinge, whether it is a flagged drift."""
         rows: dict[str, list] = {k: [] for k in ("robot_id", "joint", "quantity", "points", "flagged", "onset_time",
@@ -203,7 +245,9 @@ def hinge_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, mi
 
     Returns:
         ``(onsets, F, fits)``: the candidate onsets (c,), ``F`` (c,) or (c, r), and per onset the weighted
-        least-squares coefficients (c, 2) or (c, 2, r) of ``[1, x_k]`` (baseline, slope per day).
+        least-squares coefficients (c, 2) or (c, 2, r) of ``[1, x_k]`` (baseline, slope per day). An onset
+        whose hinge would be zero at every log (no log after the time of the one before it) is no candidate:
+        ``c`` may be 0.
     """
     n = t.size
     w = 1.0 / se
@@ -214,6 +258,7 @@ def hinge_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, mi
     rss0 = np.einsum("ij,ij->j", r0, r0)
     yy = np.einsum("ij,ij->j", Y, Y)
     onsets = np.arange(min_before, n - min_after + 1)
+    onsets = onsets[t[-1] > t[onsets - 1]]  # a hinge from the last log's time is no regressor (logs at one time)
     F = np.empty((onsets.size, Y.shape[1]))
     coef = np.empty((onsets.size, 2, Y.shape[1]))
     for c, k in enumerate(onsets):
@@ -230,23 +275,29 @@ def hinge_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, mi
 
 FIRST_PASS = 1000
 """Noise series of the p-value's first pass: a statistic that :data:`CLEAR` of them reach is no drift, and the
-full :attr:`TrendOptions.replicates` are drawn only for the others (most series of a fleet are constant)."""
+full :meth:`TrendOptions.draws` are drawn only for the others (most series of a fleet are constant)."""
 CLEAR = 20
 
 
 def null_p_value(t: np.ndarray, se: np.ndarray, statistic: float, options: TrendOptions) -> float:
     """The share of series of pure noise ``se_i z_i`` on times ``t`` whose largest ``F_k`` reaches ``statistic``
-    (seeded by :attr:`TrendOptions.seed`; ``(1 + hits) / (1 + draws)``)."""
+    (seeded by :attr:`TrendOptions.seed`; ``(1 + hits) / (1 + draws)``): :data:`FIRST_PASS` series first, the
+    rest of :meth:`TrendOptions.draws` only when fewer than :data:`CLEAR` of them reached it, in blocks of
+    :data:`BLOCK` series (memory bounded whatever the number)."""
     rng = np.random.default_rng(options.seed)
+    total = options.draws()
     hits, draws = 0, 0
-    for size in (FIRST_PASS, options.replicates - FIRST_PASS):
+    while draws < total and not (draws >= FIRST_PASS and hits >= CLEAR):
+        size = min(FIRST_PASS if draws == 0 else BLOCK, total - draws)
         noise = se[:, None] * rng.standard_normal((t.size, size))
         _, F_null, _ = hinge_scan(t, noise, se, options.min_before, options.min_after)
         hits += int(np.sum(F_null.max(axis=0) >= statistic))
         draws += size
-        if hits >= CLEAR:
-            break
     return (1 + hits) / (1 + draws)
+
+
+BLOCK = 50_000
+"""Noise series drawn at a time after the first pass."""
 
 
 def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity: str = "",
@@ -267,6 +318,8 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
     t = np.array([(time[i] - t0).total_seconds() / DAY for i in idx])
     yy, ss = y[idx], se[idx]
     onsets, F, coef = hinge_scan(t, yy, ss, options.min_before, options.min_after)
+    if onsets.size == 0:  # the logs after the first candidate onset all at one time
+        return None
     best = int(np.argmax(F))
     p = null_p_value(t, ss, float(F[best]), options)
     k = int(onsets[best])
@@ -279,10 +332,13 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
     phi = float(resid @ resid) / max(idx.size - 2, 1)
     cov = phi * np.linalg.inv(X.T @ X)
     change = float(slope * span)
-    ref = abs(base) if scale is None else abs(scale)
+    if scale is None:  # against the fitted baseline, where it is told from zero
+        ref = abs(float(base)) if abs(float(base)) > 2 * np.sqrt(cov[0, 0]) else 0.0
+    else:
+        ref = abs(scale) if np.isfinite(scale) else 0.0
     return ChangePoint(quantity, int(idx[k]), time[idx[k]], float(base), change,
                        float(np.sqrt(cov[1, 1]) * span), float(F[best]), float(p),
-                       change / ref if ref > 0 else float("inf"))
+                       change / ref if ref > 0 else float("nan"))
 
 
 def joint_trend(robot_id: str, joint: str, rows: pa.Table, options: TrendOptions = TrendOptions()) -> JointTrend:
@@ -311,8 +367,8 @@ def joint_trend(robot_id: str, joint: str, rows: pa.Table, options: TrendOptions
         if cp is not None:
             tests[q] = cp
     m = max(len(tests), 1)
-    drifts = sorted((cp for cp in tests.values()
-                     if cp.p_value < options.alpha / m and abs(cp.relative) >= options.min_change),
+    drifts = sorted((cp for cp in tests.values() if cp.p_value < options.alpha / m
+                     and (np.isnan(cp.relative) or abs(cp.relative) >= options.min_change)),
                     key=lambda cp: (cp.p_value, -cp.statistic))
     return JointTrend(robot_id, joint, series, tests, tuple(drifts))
 

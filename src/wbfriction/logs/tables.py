@@ -127,8 +127,14 @@ class TableFile:
         self.path = Path(path)
         self.format: TableFormat = table_format(self.path)
 
-    def read(self, columns: list[str] | None = None) -> pa.Table:
+    def read(self, columns: list[str] | None = None, text_columns: Sequence[str] = ()) -> pa.Table:
         """The whole table, or only those of ``columns`` that it has (others are skipped).
+
+        Args:
+            columns: the columns to read (None: all).
+            text_columns: columns a CSV file's cells are read from as text, as written (no type inference:
+                an id ``007`` stays ``"007"``, not ``7``); ignored for Parquet and HDF5, whose columns carry
+                their types.
 
         Raises:
             InputError: unreadable content, naming the file.
@@ -145,12 +151,14 @@ class TableFile:
                     table = pq.read_table(path, columns=[c for c in columns if c in names])
             else:
                 options, meta = _csv_options(path)
+                types = {c: pa.string() for c in text_columns}
                 if columns is None:
-                    table = pacsv.read_csv(path, read_options=options)
+                    table = pacsv.read_csv(path, read_options=options,
+                                           convert_options=pacsv.ConvertOptions(column_types=types))
                 else:
                     names = pacsv.open_csv(path, read_options=options).schema.names
                     table = pacsv.read_csv(path, read_options=options, convert_options=pacsv.ConvertOptions(
-                        include_columns=[c for c in columns if c in names]))
+                        include_columns=[c for c in columns if c in names], column_types=types))
                 if meta is not None:
                     table = table.replace_schema_metadata(meta)
             _ = table.column_names  # decoded lazily: a damaged header fails here
@@ -159,8 +167,8 @@ class TableFile:
             raise _unreadable(path, exc) from exc
 
     def schema(self) -> pa.Schema:
-        """The table's columns and their types, without reading its rows (a CSV's types as inferred
-        from its first block).
+        """The table's columns and their types, and its metadata, without reading its rows (a CSV's
+        types as inferred from its first block).
 
         Raises:
             InputError: unreadable content, naming the file.
@@ -170,7 +178,9 @@ class TableFile:
         try:
             if self.format == "parquet":
                 return pq.ParquetFile(self.path).schema_arrow
-            return pacsv.open_csv(self.path, read_options=_csv_options(self.path)[0]).schema
+            options, meta = _csv_options(self.path)
+            schema = pacsv.open_csv(self.path, read_options=options).schema
+            return schema.with_metadata(meta) if meta is not None else schema
         except (pa.ArrowException, OSError, ValueError) as exc:
             raise _unreadable(self.path, exc) from exc
 

@@ -18,7 +18,7 @@ from matplotlib import rc_context
 from matplotlib.artist import Artist
 from matplotlib.figure import Figure
 
-from wbfriction.fleet.trends import FleetTrends, JointTrend
+from wbfriction.fleet.trends import ChangePoint, FleetTrends, JointTrend
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.figures import READABLE, REPORT_WIDTH, png_bytes
 from wbfriction.report.html import PAGE_CSS
@@ -96,12 +96,17 @@ def _num(x: float, digits: int = 4) -> str:
     return "–" if not np.isfinite(x) else f"{x:.{digits}g}"
 
 
+def _relative_change(cp: ChangePoint) -> str:
+    """A relative change in percent; "–" where the baseline is not told from zero (undefined)."""
+    return "–" if not np.isfinite(cp.relative) else f"{100 * cp.relative:+.1f} %"
+
+
 def _drifts_table(joints: list[JointTrend]) -> str:
     head = ("joint", "quantity", "onset", "change at the last log", "relative", "p-value")
     rows = "".join(
         f'<tr class="flag"><td>{html.escape(j.joint)}</td><td>{html.escape(cp.quantity)}</td>'
         f"<td>{_date(cp.onset_time)}</td><td>{_num(cp.change)} ± {_num(cp.change_se, 2)}</td>"
-        f"<td>{100 * cp.relative:+.1f} %</td><td>{cp.p_value:.2g}</td></tr>"
+        f"<td>{_relative_change(cp)}</td><td>{cp.p_value:.2g}</td></tr>"
         for j in joints for cp in j.drifts)
     return ('<div class="scroll"><table><tr>' + "".join(f"<th>{h}</th>" for h in head) + f"</tr>{rows}</table></div>")
 
@@ -119,7 +124,7 @@ def _tests_table(joints: list[JointTrend]) -> str:
                         f"<td>{html.escape(q)}</td><td>{int(s.used.sum())}</td>"
                         f"<td>{_num(float(s.value[s.used][-1]))}</td><td>{_num(cp.baseline)}</td>"
                         f"<td>{_date(cp.onset_time)}</td><td>{_num(cp.change)} ± {_num(cp.change_se, 2)}</td>"
-                        f"<td>{100 * cp.relative:+.1f} %</td><td>{cp.p_value:.2g}</td>"
+                        f"<td>{_relative_change(cp)}</td><td>{cp.p_value:.2g}</td>"
                         f"<td>{'yes' if flag else ''}</td></tr>")
     return ('<details><summary>Every tested quantity</summary><div class="scroll"><table><tr>'
             + "".join(f"<th>{h}</th>" for h in head) + "</tr>" + "".join(rows) + "</table></div></details>")
@@ -130,8 +135,8 @@ def render_trends(trends: FleetTrends, title: str = "Friction trends") -> str:
     robots = sorted({j.robot_id for j in trends.joints})
     o = trends.options
     flagged = trends.flagged
-    summary = (f'<div class="box {"warn" if flagged else "ok"}">{len(flagged)} of {len(trends.joints)} robot '
-               f"joints drifted: " + (", ".join(f"{html.escape(j.robot_id)} {html.escape(j.joint)} "
+    summary = (f'<div class="box {"warn" if flagged or not trends.tested else "ok"}">'
+               f"{html.escape(trends.summary())}: " + (", ".join(f"{html.escape(j.robot_id)} {html.escape(j.joint)} "
                                                f"({html.escape(j.drifts[0].quantity)} from "
                                                f"{_date(j.onset_time)})" for j in flagged) or "none") + "</div>")
     sections = []
@@ -152,7 +157,7 @@ def render_trends(trends: FleetTrends, title: str = "Friction trends") -> str:
         sections.append("\n".join(part))
     method = (f"A drift is a hinge (a constant, then a linear change from an onset) that fits a quantity's series "
               f"better than a constant, weighted by the fits' standard errors, with a p-value below {o.alpha:g} per "
-              f"joint (Bonferroni over its quantities; Monte Carlo, {o.replicates} noise series) and a change of at "
+              f"joint (Bonferroni over its quantities; Monte Carlo, {o.draws()} noise series) and a change of at "
               f"least {100 * o.min_change:.0f} % at the last log. Sign convention: F_c, F_v and f_at_v are "
               f"positive for friction opposing the motion (f_at_v = (f(v) − f(−v)) / 2 [N·m], v in rad/s).")
     return f"""<!DOCTYPE html>

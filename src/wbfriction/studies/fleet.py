@@ -240,7 +240,7 @@ def run_fleet_study(robot: Robot, output_dir: Path, plan: FleetPlan = FleetPlan(
     seconds["batch"] = time.perf_counter() - t
     say("trends")
     t = time.perf_counter()
-    trends = fleet_trends(read_results(output_dir / "results"))
+    trends = fleet_trends(read_results(output_dir / "results").table)
     files = [output_dir / "trends.html", output_dir / "trends.parquet"]
     write_trends_html(trends, files[0], "Friction trends of a simulated fleet")
     write_table(trends.to_table(), files[1])
