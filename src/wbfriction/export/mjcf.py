@@ -9,7 +9,9 @@ robot loaded from an MJCF (:attr:`Robot.model_format`) starts from that file as 
 floating-base robot gets a free joint at its root link; a
 fixed-base one (:attr:`Robot.floating_base` false, e.g. the KUKA LWR4+) has its root link welded
 to the world where the URDF puts it. The robot's locked joints (:attr:`Robot.locked_joints`) are
-welded at their positions, so that the joints are :attr:`Robot.actuated`, as in the Pinocchio model.
+welded at their positions, so that the joints are :attr:`Robot.actuated`, as in the Pinocchio model; the
+equality constraints, actuators and sensors on a locked joint go with it (the Panda's fingers: the URDF's
+``<mimic>`` of ``panda_finger_joint2`` is such a constraint).
 
 Per actuated joint (:mod:`wbfriction.export.mapping`): ``damping = F_v`` [N·m·s/rad],
 ``frictionloss = F_c`` [N·m], ``armature`` [kg·m^2] (the given one, else the robot model's
@@ -153,8 +155,27 @@ def _add_link_sites(spec: mujoco.MjSpec) -> None:
             body.add_site(name=body.name)
 
 
+def _drop_references(spec: mujoco.MjSpec, name: str) -> None:
+    """Delete what refers to joint ``name`` by name: joint equality constraints (MuJoCo's URDF import turns a
+    ``<mimic>`` into one: the Panda's ``panda_finger_joint2`` follows ``panda_finger_joint1``), actuators
+    that drive it, sensors that read it. A welded joint has nothing left to couple, drive or read, and
+    Pinocchio's model (``buildModelFromUrdf`` without ``mimic``, then ``buildReducedModel``) has no such
+    coupling either: the joint that was coupled to it moves freely in both."""
+    import mujoco
+    for eq in list(spec.equalities):
+        if eq.type == mujoco.mjtEq.mjEQ_JOINT and name in (eq.name1, eq.name2):
+            spec.delete(eq)
+    for act in list(spec.actuators):
+        if act.trntype == mujoco.mjtTrn.mjTRN_JOINT and act.target == name:
+            spec.delete(act)
+    for sensor in list(spec.sensors):
+        if sensor.objtype == mujoco.mjtObj.mjOBJ_JOINT and sensor.objname == name:
+            spec.delete(sensor)
+
+
 def _lock_joint(spec: mujoco.MjSpec, name: str, value: float) -> None:
-    """Weld a hinge or slide joint at ``value`` [rad or m]: its body placed there, the joint deleted."""
+    """Weld a hinge or slide joint at ``value`` [rad or m]: its body placed there, the joint deleted with
+    what refers to it (:func:`_drop_references`)."""
     import mujoco
     joint = spec.joint(name)
     if joint is None:
@@ -176,6 +197,7 @@ def _lock_joint(spec: mujoco.MjSpec, name: str, value: float) -> None:
         body.pos = np.asarray(body.pos, dtype=float) + rot @ axis * value
     else:
         raise ModelError(f"locked joint '{name}' is neither a hinge nor a slide in MuJoCo")
+    _drop_references(spec, name)
     spec.delete(joint)
 
 
