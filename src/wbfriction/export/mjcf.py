@@ -15,8 +15,10 @@ equality constraints, actuators and sensors on a locked joint go with it (the Pa
 
 Per actuated joint (:mod:`wbfriction.export.mapping`): ``damping = F_v`` [N·m·s/rad],
 ``frictionloss = F_c`` [N·m], ``armature`` [kg·m^2] (the given one, else the robot model's
-``armature``, zero unless its configuration sets one); a joint without identified friction has
-none. Identified inertias (a ``pin.Model`` of the robot) go through
+``armature``, zero unless its configuration sets one); a joint without identified friction keeps the
+model file's ``damping`` and ``frictionloss`` (none from a URDF, whose ``<dynamics>`` are dropped; a
+robot's MJCF's own). The written file has a comment before each joint with friction from a fit, its
+status (:func:`~wbfriction.export.mapping.status_note`). Identified inertias (a ``pin.Model`` of the robot) go through
 :func:`wbfriction.inertia.urdf.write_urdf` into the URDF the model is built from.
 
 What ``mujoco.mj_inverse`` returns with these fields (MuJoCo 4 defaults: continuous-time inverse,
@@ -67,7 +69,7 @@ import pinocchio as pin
 from lxml import etree as ET
 
 from wbfriction.exceptions import ModelError
-from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports
+from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.export.urdf import identified_parameters, read_urdf
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.tables import write_atomic
@@ -225,8 +227,12 @@ def mujoco_spec(robot: Robot, friction: Mapping[str, FrictionLike], armature: Ma
             inertia model of another robot, inertias of a robot loaded from an MJCF.
         ModelError: a URDF MuJoCo cannot read, or whose joints are not the robot's.
     """
+    return _spec(robot, joint_exports(friction, armature, robot), inertias)
+
+
+def _spec(robot: Robot, joints: Mapping[str, JointExport], inertias: pin.Model | None) -> mujoco.MjSpec:
+    """:func:`mujoco_spec` of the joints' simulator parameters (:func:`joint_exports`)."""
     import mujoco
-    joints = joint_exports(friction, armature, robot)
     if inertias is None:
         spec = robot_spec(robot)
     else:
@@ -246,10 +252,11 @@ def mujoco_spec(robot: Robot, friction: Mapping[str, FrictionLike], armature: Ma
     _add_link_sites(spec)
     for name in robot.actuated:
         joint, exp = spec.joint(name), joints.get(name)
-        damping = np.zeros_like(np.asarray(joint.damping, dtype=float))
-        damping[0] = exp.viscous if exp is not None and exp.viscous is not None else 0.0
-        joint.damping = damping
-        joint.frictionloss = exp.coulomb if exp is not None and exp.coulomb is not None else 0.0
+        if exp is not None and exp.viscous is not None and exp.coulomb is not None:
+            damping = np.zeros_like(np.asarray(joint.damping, dtype=float))
+            damping[0] = exp.viscous
+            joint.damping = damping
+            joint.frictionloss = exp.coulomb
         joint.armature = _armature(robot, name, exp)
     return spec
 
@@ -313,11 +320,13 @@ def _order_bodies(root: ET._Element, joints: Sequence[str]) -> bool:
     return moved
 
 
-def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] = ()) -> str:
+def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] = (),
+             notes: Mapping[str, str] | None = None) -> str:
     """The MJCF text of ``spec`` (compiled as ``model``) at full precision (module docstring): the
     bodies' ``pos``, ``quat`` and ``<inertial>``, the joints' ``pos``, ``axis``, ``range``,
     ``actuatorfrcrange``, ``damping``, ``frictionloss`` and ``armature``, the sites' ``pos`` and ``quat``
-    from ``model``; sibling bodies in the order of the joint names ``joints`` (:func:`_order_bodies`).
+    from ``model``; sibling bodies in the order of the joint names ``joints`` (:func:`_order_bodies`);
+    ``notes`` (joint -> one line) as a comment before each joint named.
 
     Raises:
         ModelError: a body or joint of the text that ``model`` does not have by name.
@@ -359,6 +368,9 @@ def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] =
             joint.set("damping", _num([model.dof_damping[dof], *poly] if np.any(poly) else model.dof_damping[dof]))
             joint.set("frictionloss", _num(model.dof_frictionloss[dof]))
             joint.set("armature", _num(model.dof_armature[dof]))
+            note = (notes or {}).get(joint.get("name") or "")
+            if note is not None:
+                joint.addprevious(ET.Comment(f" {note} "))
         for site in body.findall("site"):
             if site.get("name"):
                 s = ident(mujoco.mjtObj.mjOBJ_SITE, site.get("name"))
@@ -372,7 +384,7 @@ def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] =
 def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | Path,
                armature: Mapping[str, float] | None = None, inertias: pin.Model | None = None) -> mujoco.MjModel:
     """Write the MJCF of :func:`mujoco_spec` at full precision, its joints in :attr:`Robot.actuated`
-    order (:func:`mjcf_xml`), atomically.
+    order, each joint with friction from a fit after a comment of its status (:func:`mjcf_xml`), atomically.
 
     Returns:
         the compiled model the file holds.
@@ -381,9 +393,11 @@ def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | P
         what :func:`mujoco_spec` raises; InputError: an output folder that does not exist.
     """
     import mujoco
-    spec = mujoco_spec(robot, friction, armature, inertias)
+    joints = joint_exports(friction, armature, robot)
+    spec = _spec(robot, joints, inertias)
     model = compile_spec(spec, robot.urdf)
-    text = mjcf_xml(spec, model, robot.actuated)
+    notes = {name: note for name, exp in joints.items() if (note := status_note(exp)) is not None}
+    text = mjcf_xml(spec, model, robot.actuated, notes)
     write_atomic(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     if [model.joint(j).name for j in range(model.njnt) if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE] \
             != list(robot.actuated):  # bodies reordered in the file: its model, in its order
