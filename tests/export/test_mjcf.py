@@ -8,8 +8,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from wbfriction.exceptions import InputError
-from wbfriction.export.mjcf import mujoco_model, write_mjcf
+from wbfriction.exceptions import InputError, ModelError
+from wbfriction.export.mjcf import compile_spec, mujoco_model, write_mjcf
 from wbfriction.friction.models import FrictionParams
 from wbfriction.model import load_robot
 
@@ -220,6 +220,16 @@ def test_what_refers_to_a_locked_joint_goes_with_it(tmp_path):
     assert (mj.neq, mj.nu, mj.nsensor) == (0, 1, 1)
     assert mj.joint(mj.actuator_trnid[0, 0]).name == mj.joint(mj.sensor_objid[0]).name == "gripper_right_joint"
     assert mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_JOINT, "gripper_left_joint") == -1
+
+
+def test_mujoco_errors_are_one_line():
+    """MuJoCo's compiler adds a line ("Element name '', id 0"): the error is one line."""
+    spec = mujoco.MjSpec.from_string("<mujoco><worldbody><body><joint name='a'/><geom size='.1'/></body></worldbody>"
+                                     "<equality><joint joint1='a' joint2='gone'/></equality></mujoco>")
+    with pytest.raises(ModelError) as err:
+        compile_spec(spec, "x.xml")
+    assert str(err.value).startswith("x.xml: MuJoCo cannot compile the model: Error: unknown element 'gone'")
+    assert "\n" not in str(err.value) and "Element name '', id 0" in str(err.value)
 
 
 def test_refused_input(kuka, tmp_path):

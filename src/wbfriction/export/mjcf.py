@@ -82,6 +82,11 @@ DROPPED_TAGS = ("gazebo", "transmission", "mujoco")
 """Top-level URDF elements :func:`urdf_spec` removes (simulator extensions; its own ``<mujoco>`` block replaces any)."""
 
 
+def _one_line(exc: Exception) -> str:
+    """MuJoCo's message on one line (its parser and compiler add lines such as "Element name '', id 0")."""
+    return " ".join(str(exc).split())
+
+
 def urdf_spec(urdf: str | Path, free_joint: bool = True) -> mujoco.MjSpec:
     """The MuJoCo spec of a URDF's kinematic tree and inertias (module docstring).
 
@@ -118,7 +123,7 @@ def urdf_spec(urdf: str | Path, free_joint: bool = True) -> mujoco.MjSpec:
     try:
         spec = mujoco.MjSpec.from_string(ET.tostring(root, encoding="unicode"))
     except Exception as exc:  # mujoco raises ValueError with its parser's message
-        raise ModelError(f"{urdf}: MuJoCo cannot read the URDF: {exc}") from None
+        raise ModelError(f"{urdf}: MuJoCo cannot read the URDF: {_one_line(exc)}") from None
     base = spec.worldbody.first_body()
     if free_joint and base is not None and not any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in base.joints):
         base.add_freejoint()
@@ -138,7 +143,7 @@ def robot_spec(robot: Robot) -> mujoco.MjSpec:
     try:
         spec = mujoco.MjSpec.from_file(str(robot.urdf))
     except Exception as exc:  # mujoco raises ValueError with its parser's message
-        raise ModelError(f"{robot.urdf}: MuJoCo cannot read the MJCF: {exc}") from None
+        raise ModelError(f"{robot.urdf}: MuJoCo cannot read the MJCF: {_one_line(exc)}") from None
     base = spec.worldbody.first_body()
     if robot.floating_base and base is not None and not any(j.type == mujoco.mjtJoint.mjJNT_FREE
                                                             for j in base.joints):
@@ -262,11 +267,11 @@ def _spec(robot: Robot, joints: Mapping[str, JointExport], inertias: pin.Model |
 
 
 def compile_spec(spec: mujoco.MjSpec, source: str | Path = "MJCF") -> mujoco.MjModel:
-    """``spec.compile()``, its errors as :class:`ModelError` (named with ``source``)."""
+    """``spec.compile()``, its errors as :class:`ModelError` (named with ``source``, on one line)."""
     try:
         return spec.compile()
     except Exception as exc:  # mujoco raises ValueError with the compiler's message
-        raise ModelError(f"{source}: MuJoCo cannot compile the model: {exc}") from None
+        raise ModelError(f"{source}: MuJoCo cannot compile the model: {_one_line(exc)}") from None
 
 
 def mujoco_model(robot: Robot, friction: Mapping[str, FrictionLike], armature: Mapping[str, float] | None = None,
