@@ -9,7 +9,7 @@ import json
 import mujoco
 import pytest
 
-from helpers import run_cli
+from helpers import run, run_cli
 from wbfriction.friction.io import write_params
 
 PREVIOUS = b"the previous output"
@@ -79,3 +79,27 @@ def test_refused_in_one_line_nothing_written(panda_params, tmp_path, capsys, cas
                         *args)
     assert code == 2 and lines(err) == [f"error: {needle}"], err
     assert out.read_bytes() == PREVIOUS and sorted(p.name for p in tmp_path.iterdir()) == ["p.json", "p.xml"]
+
+
+@pytest.mark.slow
+def test_panda_from_a_simulated_log_to_mujoco(tmp_path):
+    """The issue's repro as the user ran it: simulate, estimate, fit, export --robot panda -o p.xml. The MJCF
+    loads in MuJoCo and each joint whose status in the parameters JSON is ok carries its F_v and F_c as
+    damping and frictionloss; the others none."""
+    steps = [("simulate", "--robot", "panda", "-o", "arm.parquet", "--duration", "6"),
+             ("estimate", "arm.parquet", "--robot", "panda", "-o", "arm_friction.parquet"),
+             ("fit", "arm_friction.parquet", "-o", "p.json"),
+             ("export", "p.json", "--robot", "panda", "-o", "p.xml")]
+    for args in steps:
+        res = run(*args, cwd=tmp_path)
+        assert res.returncode == 0, f"{args}: {res.stderr[-2000:]}"
+    truth = json.loads((tmp_path / "p.json").read_text())["joints"]
+    ok = {j: d["params"] for j, d in truth.items() if d["status"] == "ok"}
+    assert ok
+    mj = mujoco.MjModel.from_xml_path(str(tmp_path / "p.xml"))
+    assert mj.neq == 0 and mj.nv == 7
+    for i in range(1, 8):
+        j = f"panda_joint{i}"
+        dof = mj.joint(j).dofadr[0]
+        want = (ok[j]["F_v"], ok[j]["F_c"]) if j in ok else (0.0, 0.0)
+        assert (mj.dof_damping[dof], mj.dof_frictionloss[dof]) == want, j
