@@ -515,15 +515,13 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
     F_c -> Coulomb friction (MuJoCo frictionloss); the Stribeck bump, the tanh and tau_os have no
     simulator field and are dropped. Inertias are the URDF's: give --urdf IDENTIFIED.urdf to export
     identified ones."""
-    from collections import Counter
-
     from wbfriction.pipeline.export import export_files
 
     check_paths({"PARAMS": params, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
                 {f"-o {o}": o for o in outputs})
     result = export_files(_robot(robot, urdf, config, mjcf), params, outputs,
                           include=[c.strip() for c in include.split(",") if c.strip()])
-    counts = Counter(f.verdict().status for f in result.selection.exported.values())
+    counts = result.selection.exported_statuses
     console.print(f"exported the friction of {sum(counts.values())} joints ("
                   + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")", highlight=False)
     for status, joints in result.selection.left_out.items():

@@ -47,7 +47,7 @@ def test_by_default_only_ok_fits_are_exported(panda, fit_of):
             j[3]: fit_of(j[3], "not excited"), j[4]: fit_of(j[4], "failed"), j[5]: fit_of(j[5], "ok"),
             j[6]: FitResult(j[6], 3, message="not fitted: 3 valid samples")}
     sel = select_fits(fits, panda)
-    assert list(sel.exported) == [j[0], j[5]]
+    assert list(sel.exported) == [j[0], j[5]] and sel.exported_statuses == {"ok": 2}
     assert dict(sel.left_out) == {"weak": (j[1],), "at bound": (j[2],), "not excited": (j[3], j[6]),
                                   "failed": (j[4],)}
     del fits[j[6]]
@@ -70,6 +70,7 @@ def test_selection_partitions_the_joints_and_never_exports_what_the_data_do_not_
         return
     sel = select_fits(fits, panda, include)
     assert list(sel.exported) == expected
+    assert sum(sel.exported_statuses.values()) == len(expected) and set(sel.exported_statuses) <= wanted
     left = [j for joints in sel.left_out.values() for j in joints]
     assert sorted(left + expected) == sorted(panda.actuated) and len(set(left)) == len(left)
     for status, joints in sel.left_out.items():

@@ -122,6 +122,11 @@ class FitSelection:
     left_out: Mapping[str, tuple[str, ...]]
     include: tuple[Include, ...] = ()
 
+    @property
+    def exported_statuses(self) -> dict[str, int]:
+        """Status -> how many exported fits have it, in the order met."""
+        return dict(Counter(fit.verdict().status for fit in self.exported.values()))
+
 
 def select_fits(fits: Mapping[str, FitResult], robot: Robot, include: Iterable[str] = (),
                 source: str = "parameters") -> FitSelection:
