@@ -504,16 +504,29 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
                                                    "friction>), .xml (MuJoCo MJCF: damping, frictionloss, "
                                                    "armature) or .yaml (Isaac Lab actuators); repeat -o for "
                                                    "several."),
+           include: str = typer.Option("", "--include",
+                                       help="Fit statuses exported besides ok, comma-separated: weak (large "
+                                            "standard errors), at-bound (a parameter at a bound of the fit). "
+                                            "Fits not excited or failed are never exported."),
            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
            mjcf: Optional[Path] = MjcfOpt) -> None:
-    """Write the fitted friction where simulators read it. F_v -> damping, F_c -> Coulomb
-    friction (MuJoCo frictionloss); the Stribeck bump, the tanh and tau_os have no simulator field
-    and are dropped. Inertias are the URDF's: give --urdf IDENTIFIED.urdf to export identified ones."""
+    """Write the fitted friction where simulators read it: the fits whose status is ok (and --include),
+    each with its status in a comment; the other joints keep what the model file has. F_v -> damping,
+    F_c -> Coulomb friction (MuJoCo frictionloss); the Stribeck bump, the tanh and tau_os have no
+    simulator field and are dropped. Inertias are the URDF's: give --urdf IDENTIFIED.urdf to export
+    identified ones."""
     from wbfriction.pipeline.export import export_files
 
     check_paths({"PARAMS": params, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
                 {f"-o {o}": o for o in outputs})
-    for path, fmt in export_files(_robot(robot, urdf, config, mjcf), params, outputs):
+    result = export_files(_robot(robot, urdf, config, mjcf), params, outputs,
+                          include=[c.strip() for c in include.split(",") if c.strip()])
+    counts = result.selection.exported_statuses
+    console.print(f"exported the friction of {sum(counts.values())} joints ("
+                  + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")", highlight=False)
+    for status, joints in result.selection.left_out.items():
+        console.print(f"not exported, {status}: {', '.join(joints)}", highlight=False, soft_wrap=True)
+    for path, fmt in result.outputs:
         console.print(f"wrote {path} ({fmt})")
 
 

@@ -9,6 +9,7 @@ import pinocchio as pin
 import pytest
 
 from helpers import KUKA_CONFIG, KUKA_URDF
+from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import FrictionParams
 from wbfriction.model import load_robot
 from wbfriction.model.robot import Robot
@@ -74,3 +75,30 @@ def random_friction():
 def identified():
     """``identified(model, rng)``: the model with every body changed as an identification would."""
     return _identified
+
+
+def _fit_of(joint: str, status: str, F_v: float = 0.2, F_c: float = 1.0) -> FitResult:
+    """A fit whose verdict is ``status`` by the rules of :mod:`wbfriction.friction.status`: a joint that moved
+    (95th percentile of |qd| 1 rad/s), a converged solver and standard errors of 5 % (ok); F_v's standard
+    error 3 times its value (weak); v_s left on a bound (at bound); |qd| at most 0.0025 rad/s (not excited);
+    a solver that did not converge (failed)."""
+    params = FrictionParams(F_v=F_v, F_c=F_c, S=0.3, v_s=0.05, tau_os=0.01)
+    stderr = {"F_v": 0.05 * F_v, "F_c": 0.05 * F_c, "S": 0.01, "v_s": 0.001, "tau_os": 0.001}
+    fit = FitResult(joint, 2000, params=params, stderr=stderr, success=True, message="`ftol` termination "
+                    "condition is satisfied.", speed=1.0, at_bound={n: False for n in params.names})
+    if status == "weak":
+        fit.stderr["F_v"] = 3.0 * F_v
+    elif status == "at bound":
+        fit.at_bound["v_s"] = True
+    elif status == "not excited":
+        fit.speed = 0.0025
+    elif status == "failed":
+        fit.success, fit.message = False, "The maximum number of function evaluations is exceeded."
+    assert fit.verdict().status == status
+    return fit
+
+
+@pytest.fixture(scope="session")
+def fit_of():
+    """``fit_of(joint, status, F_v=0.2, F_c=1.0)``: a fit whose verdict is ``status`` (:func:`_fit_of`)."""
+    return _fit_of

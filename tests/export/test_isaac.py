@@ -35,7 +35,7 @@ def test_round_trip_and_mapping(tmp_path, random_friction):
     matches its joint in full, and the values are (1 + S) F_c, F_c, F_v and the armature."""
     rng = np.random.default_rng(8)
     joints = ["lwr_0_joint", "lwr_1_joint", "wrist.roll-1"]
-    friction = {n: FitResult(n, 100, params=p) for n, p in random_friction(joints[:2], rng).items()}
+    friction = {n: FitResult(n, 100, params=p, success=True) for n, p in random_friction(joints[:2], rng).items()}
     friction["wrist.roll-1"] = FitResult("wrist.roll-1", 3)  # no parameters: armature only
     armature = {"lwr_1_joint": 1e-5 / 3, "wrist.roll-1": 0.02}
     path = tmp_path / "actuators.yaml"

@@ -51,7 +51,7 @@ def test_the_other_models_map_to_their_limits_too(F_v, F_c, rise, v_s, tau_os):
 def test_fit_results_as_read_from_the_parameters_json():
     """A FitResult's parameters are used; a fit without parameters exports no friction (only an
     armature if one is given), and a joint with neither is left out."""
-    fits = {"a": FitResult("a", 100, params=FrictionParams(F_v=0.2, F_c=1.5, S=0.5)),
+    fits = {"a": FitResult("a", 100, params=FrictionParams(F_v=0.2, F_c=1.5, S=0.5), success=True),
             "b": FitResult("b", 3), "c": FitResult("c", 2)}
     out = joint_exports(fits, {"b": 0.03})
     assert list(out) == ["a", "b"]

@@ -8,9 +8,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from wbfriction.exceptions import InputError
-from wbfriction.export.mjcf import mujoco_model, write_mjcf
+from wbfriction.exceptions import InputError, ModelError
+from wbfriction.export.mjcf import compile_spec, mujoco_model, write_mjcf
 from wbfriction.friction.models import FrictionParams
+from wbfriction.model import load_robot
 
 B_DEFAULT = 2.0 / (0.95 * 0.02)
 """The friction rows' reference damping with MuJoCo's default solref (0.02, 1) and solimp[1] = 0.95 [1/s]."""
@@ -173,6 +174,62 @@ def test_written_mjcf_reloads_to_the_same_model(kuka, tmp_path, random_friction,
         q, qd, qdd = random_state(kuka, rng)
         a, b = inverse(compiled, kuka.actuated, q, qd, qdd), inverse(back, kuka.actuated, q, qd, qdd)
         assert np.allclose(a, b, rtol=1e-12, atol=1e-12)
+
+
+def test_panda_with_its_mimic_finger_locked(tmp_path, random_friction):
+    """Issue 37: the Panda's URDF couples panda_finger_joint2 to panda_finger_joint1 (<mimic>, an equality
+    constraint in MuJoCo's import) and the robot locks both fingers: the constraint goes with the welded
+    joint. The file reloads in MuJoCo with the 7 arm joints, no constraint, the exported damping and
+    frictionloss, the robot's armature, and mj_inverse = the robot model's rnea (armature included) + F_v qd
+    - f_loss."""
+    panda = load_robot("panda")
+    rng = np.random.default_rng(9)
+    friction = random_friction(panda.actuated, rng)
+    path = tmp_path / "panda.xml"
+    write_mjcf(panda, friction, path)
+    mj = mujoco.MjModel.from_xml_path(str(path))
+    assert mj.neq == 0 and mj.nv == panda.n_act == 7
+    d = dofs(mj, panda.actuated)
+    assert np.array_equal(mj.dof_damping[d], [friction[n].F_v for n in panda.actuated])
+    assert np.array_equal(mj.dof_frictionloss[d], [friction[n].F_c for n in panda.actuated])
+    assert np.array_equal(mj.dof_armature[d], panda.model.armature[panda.act_v_index])
+    for _ in range(3):
+        q, qd, qdd = random_state(panda, rng)
+        tau, f_loss = inverse(mj, panda.actuated, q, qd, qdd)
+        v, a = np.zeros(panda.model.nv), np.zeros(panda.model.nv)
+        v[panda.act_v_index], a[panda.act_v_index] = qd, qdd
+        rnea = pin.rnea(panda.model, panda.model.createData(), panda.configuration(q), v, a)[panda.act_v_index]
+        F_v = np.array([friction[n].F_v for n in panda.actuated])
+        assert np.allclose(tau, rnea + F_v * qd - f_loss, rtol=1e-9, atol=1e-9)
+
+
+def test_what_refers_to_a_locked_joint_goes_with_it(tmp_path):
+    """A robot from an MJCF whose locked joint is coupled (joint equality), driven (motor) and read (sensor):
+    those go with the welded joint, the ones on the other gripper stay."""
+    path = tmp_path / "talos.xml"
+    write_mjcf(load_robot("talos"), {}, path)
+    extra = ('<equality><joint joint1="gripper_right_joint" joint2="gripper_left_joint"/></equality>'
+             '<actuator><motor joint="gripper_left_joint"/><motor joint="gripper_right_joint"/></actuator>'
+             '<sensor><jointpos joint="gripper_left_joint"/><jointvel joint="gripper_right_joint"/></sensor>')
+    path.write_text(path.read_text().replace("</mujoco>", extra + "</mujoco>"))
+    config = tmp_path / "locked.toml"
+    config.write_text('name = "talos_locked"\ncontact_frames = ["left_sole_link", "right_sole_link"]\n'
+                      "[locked_joints]\ngripper_left_joint = 0.0\n")
+    robot = load_robot(mjcf=path, config=config)
+    mj = mujoco_model(robot, {})
+    assert (mj.neq, mj.nu, mj.nsensor) == (0, 1, 1)
+    assert mj.joint(mj.actuator_trnid[0, 0]).name == mj.joint(mj.sensor_objid[0]).name == "gripper_right_joint"
+    assert mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_JOINT, "gripper_left_joint") == -1
+
+
+def test_mujoco_errors_are_one_line():
+    """MuJoCo's compiler adds a line ("Element name '', id 0"): the error is one line."""
+    spec = mujoco.MjSpec.from_string("<mujoco><worldbody><body><joint name='a'/><geom size='.1'/></body></worldbody>"
+                                     "<equality><joint joint1='a' joint2='gone'/></equality></mujoco>")
+    with pytest.raises(ModelError) as err:
+        compile_spec(spec, "x.xml")
+    assert str(err.value).startswith("x.xml: MuJoCo cannot compile the model: Error: unknown element 'gone'")
+    assert "\n" not in str(err.value) and "Element name '', id 0" in str(err.value)
 
 
 def test_refused_input(kuka, tmp_path):

@@ -2,9 +2,13 @@
 
 from .isaac import isaac_actuator_dict as isaac_actuator_dict
 from .isaac import write_isaac_yaml as write_isaac_yaml
+from .mapping import FitSelection as FitSelection
 from .mapping import JointExport as JointExport
+from .mapping import check_include as check_include
 from .mapping import joint_export as joint_export
 from .mapping import joint_exports as joint_exports
+from .mapping import select_fits as select_fits
+from .mapping import status_note as status_note
 from .mjcf import mujoco_model as mujoco_model
 from .mjcf import mujoco_spec as mujoco_spec
 from .mjcf import urdf_spec as urdf_spec

@@ -18,8 +18,9 @@ F_s; the ``stribeck`` model's F_s, the ``coulomb-viscous`` model's F_c), ``dynam
 dropped. A joint with F_s < F_c (S < 0: static below Coulomb friction, which PhysX does not allow)
 is refused.
 
-The document: ``joint_names_expr`` (the joints), then one mapping per field, joint -> value, the
-fields without any value left out (Isaac Lab then keeps the USD's). Isaac Lab reads the names as
+The document: ``joint_names_expr`` (the joints, each with friction from a fit followed by a comment of
+its status, :func:`~wbfriction.export.mapping.status_note`), then one mapping per field, joint -> value,
+the fields without any value left out (Isaac Lab then keeps the USD's). Isaac Lab reads the names as
 regular expressions matched in full: they are written ``re.escape``-d (unchanged for names of
 letters, digits and underscores). Use::
 
@@ -39,7 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from wbfriction.exceptions import InputError
-from wbfriction.export.mapping import FrictionLike, joint_exports
+from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.logs.tables import write_atomic
 from wbfriction.model.robot import Robot
 
@@ -61,7 +62,11 @@ def isaac_actuator_dict(friction: Mapping[str, FrictionLike], armature: Mapping[
         InputError: friction that is not dissipative, F_s < F_c (PhysX needs ``dynamic_friction <=
             friction``), a negative armature, a joint ``robot`` does not actuate.
     """
-    joints = joint_exports(friction, armature, robot)
+    return _actuator_dict(joint_exports(friction, armature, robot))
+
+
+def _actuator_dict(joints: Mapping[str, JointExport]) -> dict[str, Any]:
+    """:func:`isaac_actuator_dict` of the joints' simulator parameters (:func:`joint_exports`)."""
     for exp in joints.values():
         if exp.static is not None and exp.coulomb is not None and exp.static < exp.coulomb:
             raise InputError(f"joint '{exp.joint}': static friction F_s = {exp.static:g} N·m below the Coulomb "
@@ -84,15 +89,17 @@ def yaml_float(x: float) -> str:
     return text if "." in mantissa or not e else f"{mantissa}.0e{exponent}"
 
 
-def isaac_yaml(doc: Mapping[str, Any], header: str = "") -> str:
-    """The YAML text of :func:`isaac_actuator_dict`'s document (``header``: comment lines first)."""
+def isaac_yaml(doc: Mapping[str, Any], header: str = "", notes: Mapping[str, str] | None = None) -> str:
+    """The YAML text of :func:`isaac_actuator_dict`'s document (``header``: comment lines first; ``notes``:
+    a one-line comment after each of the ``joint_names_expr`` entries it names)."""
+    notes = notes or {}
     lines = [f"# {line}".rstrip() for line in header.splitlines()]
     for field, value in doc.items():
         lines.append(f"{field}:")
         if isinstance(value, Mapping):
             lines += [f"  {json.dumps(k)}: {yaml_float(v)}" for k, v in value.items()]
         else:
-            lines += [f"  - {json.dumps(k)}" for k in value]
+            lines += [f"  - {json.dumps(k)}" + (f"  # {notes[k]}" if k in notes else "") for k in value]
     return "\n".join(lines) + "\n"
 
 
@@ -105,10 +112,12 @@ Use: ImplicitActuatorCfg(stiffness=..., damping=..., **yaml.safe_load(open(this_
 def write_isaac_yaml(path: str | Path, friction: Mapping[str, FrictionLike],
                      armature: Mapping[str, float] | None = None, robot: Robot | None = None) -> None:
     """Write :func:`isaac_actuator_dict` as YAML (:func:`isaac_yaml`, with a header that says the
-    mapping), atomically.
+    mapping and each joint's fit status after its name), atomically.
 
     Raises:
         what :func:`isaac_actuator_dict` raises; InputError: an output folder that does not exist.
     """
-    text = isaac_yaml(isaac_actuator_dict(friction, armature, robot), HEADER)
+    joints = joint_exports(friction, armature, robot)
+    notes = {re.escape(name): note for name, exp in joints.items() if (note := status_note(exp)) is not None}
+    text = isaac_yaml(_actuator_dict(joints), HEADER, notes)
     write_atomic(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))

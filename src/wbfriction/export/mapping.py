@@ -39,18 +39,29 @@ armature [kg·m^2]    -- (no URDF field)      ``armature``           ``armature`
 
 Friction that is not dissipative (F_c < 0, F_v < 0, or a static level F_s < 0, i.e. S < -1) and
 a negative armature are refused (:class:`~wbfriction.exceptions.InputError`), never exported.
+
+Which fits are exported (:func:`select_fits`) follows their status (:mod:`wbfriction.friction.status`):
+``ok`` always; ``weak`` (large standard errors) and ``at bound`` (a parameter is the bound's value) only
+on request (:data:`Include`, ``export --include weak,at-bound``): numbers of the data, less certain. A fit
+that is ``not excited`` (the joint hardly moved: its friction is not in the data, and the fit's numbers
+are whatever the solver settled on, e.g. F_v 38 N·m·s/rad for a hip yaw of 0.2) or ``failed`` (the solver
+stopped without converging) never is, and :func:`joint_export` refuses one; a joint without a fit (not
+in the parameters file, or without parameters) has no friction to export. Each exported fit's status goes
+into the file beside its joint (:func:`status_note`), the reason when it is not ``ok``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections import Counter
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Literal, Protocol, cast, get_args
 
 import numpy as np
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.fit import FitResult
+from wbfriction.friction.status import FitStatus, FitVerdict
 from wbfriction.model.robot import Robot
 
 
@@ -63,6 +74,97 @@ class FrictionModelParams(Protocol):
 
     @property
     def F_c(self) -> float: ...
+
+
+Include = Literal["weak", "at-bound"]
+"""The statuses besides ``ok`` whose fits are exported on request (``export --include``; module docstring)."""
+INCLUDE_CHOICES: tuple[Include, ...] = get_args(Include)
+INCLUDED_STATUS: dict[Include, FitStatus] = {"weak": "weak", "at-bound": "at bound"}
+"""The fit status each choice of :data:`Include` names."""
+NEVER_EXPORTED: tuple[FitStatus, ...] = ("not excited", "failed")
+"""Statuses whose numbers are not the data's: never exported, whatever is included."""
+NOT_FITTED = "not fitted"
+"""What :class:`FitSelection` calls a robot joint that the parameters file has no fit of."""
+
+
+def check_include(choices: Iterable[str], what: str = "--include") -> tuple[Include, ...]:
+    """``choices`` as :data:`Include` values, in the order given, once each.
+
+    Raises:
+        InputError: a choice that is not one of :data:`INCLUDE_CHOICES` (named as ``what``); the
+            statuses of :data:`NEVER_EXPORTED` are refused with their reason.
+    """
+    out: list[Include] = []
+    for choice in choices:
+        if choice not in INCLUDE_CHOICES:
+            status = choice.replace("-", " ")
+            why = (": fits with status ok are always exported" if status == "ok" else
+                   ": a fit that is not excited, failed or not fitted has no numbers the data carry, never exported"
+                   if status in (*NEVER_EXPORTED, NOT_FITTED) else "")
+            raise InputError(f"{what}: '{choice}' is not one of {', '.join(INCLUDE_CHOICES)}{why}")
+        if choice not in out:
+            out.append(cast(Include, choice))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class FitSelection:
+    """The fits of a parameters file that are exported, and the robot's joints that are not.
+
+    Attributes:
+        exported: joint -> fit to export (status ``ok`` or an included one), in the robot's joint order.
+        left_out: status (a :data:`~wbfriction.friction.status.FitStatus`, or :data:`NOT_FITTED` for a
+            joint the file has no fit of) -> the joints left out with it, in the robot's joint order.
+        include: the statuses exported besides ``ok``.
+    """
+
+    exported: Mapping[str, FitResult]
+    left_out: Mapping[str, tuple[str, ...]]
+    include: tuple[Include, ...] = ()
+
+    @property
+    def exported_statuses(self) -> dict[str, int]:
+        """Status -> how many exported fits have it, in the order met."""
+        return dict(Counter(fit.verdict().status for fit in self.exported.values()))
+
+
+def select_fits(fits: Mapping[str, FitResult], robot: Robot, include: Iterable[str] = (),
+                source: str = "parameters") -> FitSelection:
+    """The fits of ``fits`` that are exported (module docstring): status ``ok``, or one ``include`` names.
+
+    Args:
+        fits: joint -> fit (:func:`wbfriction.friction.io.read_params`); each a joint ``robot`` actuates.
+        robot: the robot exported; its actuated joints without a fit in ``fits`` are :data:`NOT_FITTED`.
+        include: choices of :data:`Include` (:func:`check_include`).
+        source: what names ``fits`` in errors (the parameters file).
+
+    Raises:
+        InputError: an ``include`` choice that is not one (naming ``--include``), a file without joints,
+            a joint ``robot`` does not actuate, or no fit that qualifies (one line counting the statuses).
+    """
+    included = check_include(include)
+    if not fits:
+        raise InputError(f"{source}: no joints: nothing to export")
+    unknown = [n for n in fits if n not in robot.actuated]
+    if unknown:
+        raise InputError(f"{source}: joint '{unknown[0]}' is not an actuated joint of robot '{robot.name}'")
+    wanted: set[str] = {"ok", *(INCLUDED_STATUS[c] for c in included)}
+    exported: dict[str, FitResult] = {}
+    left_out: dict[str, list[str]] = {}
+    for joint in robot.actuated:
+        fit = fits.get(joint)
+        status = NOT_FITTED if fit is None else fit.verdict().status
+        if fit is not None and status in wanted:
+            exported[joint] = fit
+        else:
+            left_out.setdefault(status, []).append(joint)
+    if not exported:
+        counts = Counter(fit.verdict().status for fit in fits.values())
+        hint = [c for c, status in INCLUDED_STATUS.items() if counts[status] and c not in included]
+        raise InputError(f"{source}: no fit qualifies for export ("
+                         + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")"
+                         + (f": --include {','.join(hint)} exports those" if hint else ""))
+    return FitSelection(exported, {status: tuple(joints) for status, joints in left_out.items()}, included)
 
 
 FrictionLike = FitResult | FrictionModelParams
@@ -94,6 +196,7 @@ class JointExport:
             identified friction.
         armature: reflected rotor inertia [kg·m^2] (MJCF and Isaac ``armature``), None when not given.
         params: the model parameters the friction comes from (what is dropped: tau_os, and S, v_s, a of (3.5)).
+        verdict: the status of the fit the friction comes from (:func:`status_note`), None for bare parameters.
 
     Raises:
         InputError: a value that is negative (not dissipative) or not finite, or friction given in part.
@@ -105,6 +208,7 @@ class JointExport:
     static: float | None = None
     armature: float | None = None
     params: FrictionModelParams | None = None
+    verdict: FitVerdict | None = None
 
     def __post_init__(self) -> None:
         given = [x is not None for x in (self.viscous, self.coulomb, self.static)]
@@ -131,19 +235,47 @@ def joint_export(joint: str, friction: FrictionLike | None = None, armature: flo
 
     Args:
         joint: joint name.
-        friction: the joint's fitted friction; None, or a fit without parameters: no friction.
+        friction: the joint's fitted friction (a fit's status is kept, :attr:`JointExport.verdict`); None, or
+            a fit without parameters: no friction.
         armature: [kg·m^2], or None.
 
     Raises:
         InputError: F_c < 0, F_v < 0, F_s < 0 (S < -1 in (3.5)), a negative armature or
-            a value that is not finite: not dissipative, not exported (the message names the joint).
+            a value that is not finite: not dissipative, not exported; a fit whose status is one of
+            :data:`NEVER_EXPORTED` (the message names the joint).
     """
-    params = friction.params if isinstance(friction, FitResult) else friction
+    fit = friction if isinstance(friction, FitResult) else None
+    params: FrictionModelParams | None = fit.params if fit is not None else cast(FrictionModelParams | None, friction)
     if params is None:
         return JointExport(joint, armature=None if armature is None else float(armature))
+    verdict = fit.verdict() if fit is not None else None
+    if verdict is not None and verdict.status in NEVER_EXPORTED:
+        raise InputError(f"joint '{joint}': its fit is {verdict}: numbers the data do not carry are not exported")
     return JointExport(joint, viscous=float(params.F_v), coulomb=float(params.F_c),
                        static=static_level(params),
-                       armature=None if armature is None else float(armature), params=params)
+                       armature=None if armature is None else float(armature), params=params, verdict=verdict)
+
+
+NOTE_PREFIX = "wbfriction fit of"
+"""How every :func:`status_note` begins (an export replaces the notes an earlier one wrote)."""
+
+
+def status_note(exp: JointExport) -> str | None:
+    """The comment every export writes beside a joint whose friction comes from a fit: the fit's status and,
+    when not ``ok``, its reason, on one line that is a valid XML and YAML comment (no ``--``, no line break);
+    None for a joint without (bare parameters, armature only).
+
+    Examples:
+        ``wbfriction fit of knee: ok``, ``wbfriction fit of hip: weak (large standard errors: F_v ±80 %)``
+    """
+    if exp.verdict is None or not exp.has_friction:
+        return None
+    v = exp.verdict
+    text = f"{NOTE_PREFIX} {exp.joint}: {v.status}" + (f" ({v.reason})" if v.reason else "")
+    text = " ".join(text.split())
+    while "--" in text:
+        text = text.replace("--", "- -")
+    return text
 
 
 def joint_exports(friction: Mapping[str, FrictionLike], armature: Mapping[str, float] | None = None,
@@ -151,7 +283,7 @@ def joint_exports(friction: Mapping[str, FrictionLike], armature: Mapping[str, f
     """The simulator parameters of every joint with friction or armature, by name.
 
     Args:
-        friction: joint -> fitted friction (e.g. :func:`wbfriction.friction.io.read_params`).
+        friction: joint -> fitted friction (e.g. :attr:`FitSelection.exported` of :func:`select_fits`).
         armature: joint -> reflected rotor inertia [kg·m^2], or None.
         robot: if given, every joint must be one of its actuated joints; the result is then
             in :attr:`Robot.actuated` order (otherwise: the friction's, then the armature's).

@@ -9,12 +9,16 @@ robot loaded from an MJCF (:attr:`Robot.model_format`) starts from that file as 
 floating-base robot gets a free joint at its root link; a
 fixed-base one (:attr:`Robot.floating_base` false, e.g. the KUKA LWR4+) has its root link welded
 to the world where the URDF puts it. The robot's locked joints (:attr:`Robot.locked_joints`) are
-welded at their positions, so that the joints are :attr:`Robot.actuated`, as in the Pinocchio model.
+welded at their positions, so that the joints are :attr:`Robot.actuated`, as in the Pinocchio model; the
+equality constraints, actuators and sensors on a locked joint go with it (the Panda's fingers: the URDF's
+``<mimic>`` of ``panda_finger_joint2`` is such a constraint).
 
 Per actuated joint (:mod:`wbfriction.export.mapping`): ``damping = F_v`` [N·m·s/rad],
 ``frictionloss = F_c`` [N·m], ``armature`` [kg·m^2] (the given one, else the robot model's
-``armature``, zero unless its configuration sets one); a joint without identified friction has
-none. Identified inertias (a ``pin.Model`` of the robot) go through
+``armature``, zero unless its configuration sets one); a joint without identified friction keeps the
+model file's ``damping`` and ``frictionloss`` (none from a URDF, whose ``<dynamics>`` are dropped; a
+robot's MJCF's own). The written file has a comment before each joint with friction from a fit, its
+status (:func:`~wbfriction.export.mapping.status_note`). Identified inertias (a ``pin.Model`` of the robot) go through
 :func:`wbfriction.inertia.urdf.write_urdf` into the URDF the model is built from.
 
 What ``mujoco.mj_inverse`` returns with these fields (MuJoCo 4 defaults: continuous-time inverse,
@@ -65,7 +69,7 @@ import pinocchio as pin
 from lxml import etree as ET
 
 from wbfriction.exceptions import ModelError
-from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports
+from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.export.urdf import identified_parameters, read_urdf
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.tables import write_atomic
@@ -76,6 +80,11 @@ if TYPE_CHECKING:
 
 DROPPED_TAGS = ("gazebo", "transmission", "mujoco")
 """Top-level URDF elements :func:`urdf_spec` removes (simulator extensions; its own ``<mujoco>`` block replaces any)."""
+
+
+def _one_line(exc: Exception) -> str:
+    """MuJoCo's message on one line (its parser and compiler add lines such as "Element name '', id 0")."""
+    return " ".join(str(exc).split())
 
 
 def urdf_spec(urdf: str | Path, free_joint: bool = True) -> mujoco.MjSpec:
@@ -114,7 +123,7 @@ def urdf_spec(urdf: str | Path, free_joint: bool = True) -> mujoco.MjSpec:
     try:
         spec = mujoco.MjSpec.from_string(ET.tostring(root, encoding="unicode"))
     except Exception as exc:  # mujoco raises ValueError with its parser's message
-        raise ModelError(f"{urdf}: MuJoCo cannot read the URDF: {exc}") from None
+        raise ModelError(f"{urdf}: MuJoCo cannot read the URDF: {_one_line(exc)}") from None
     base = spec.worldbody.first_body()
     if free_joint and base is not None and not any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in base.joints):
         base.add_freejoint()
@@ -134,7 +143,7 @@ def robot_spec(robot: Robot) -> mujoco.MjSpec:
     try:
         spec = mujoco.MjSpec.from_file(str(robot.urdf))
     except Exception as exc:  # mujoco raises ValueError with its parser's message
-        raise ModelError(f"{robot.urdf}: MuJoCo cannot read the MJCF: {exc}") from None
+        raise ModelError(f"{robot.urdf}: MuJoCo cannot read the MJCF: {_one_line(exc)}") from None
     base = spec.worldbody.first_body()
     if robot.floating_base and base is not None and not any(j.type == mujoco.mjtJoint.mjJNT_FREE
                                                             for j in base.joints):
@@ -153,8 +162,27 @@ def _add_link_sites(spec: mujoco.MjSpec) -> None:
             body.add_site(name=body.name)
 
 
+def _drop_references(spec: mujoco.MjSpec, name: str) -> None:
+    """Delete what refers to joint ``name`` by name: joint equality constraints (MuJoCo's URDF import turns a
+    ``<mimic>`` into one: the Panda's ``panda_finger_joint2`` follows ``panda_finger_joint1``), actuators
+    that drive it, sensors that read it. A welded joint has nothing left to couple, drive or read, and
+    Pinocchio's model (``buildModelFromUrdf`` without ``mimic``, then ``buildReducedModel``) has no such
+    coupling either: the joint that was coupled to it moves freely in both."""
+    import mujoco
+    for eq in list(spec.equalities):
+        if eq.type == mujoco.mjtEq.mjEQ_JOINT and name in (eq.name1, eq.name2):
+            spec.delete(eq)
+    for act in list(spec.actuators):
+        if act.trntype == mujoco.mjtTrn.mjTRN_JOINT and act.target == name:
+            spec.delete(act)
+    for sensor in list(spec.sensors):
+        if sensor.objtype == mujoco.mjtObj.mjOBJ_JOINT and sensor.objname == name:
+            spec.delete(sensor)
+
+
 def _lock_joint(spec: mujoco.MjSpec, name: str, value: float) -> None:
-    """Weld a hinge or slide joint at ``value`` [rad or m]: its body placed there, the joint deleted."""
+    """Weld a hinge or slide joint at ``value`` [rad or m]: its body placed there, the joint deleted with
+    what refers to it (:func:`_drop_references`)."""
     import mujoco
     joint = spec.joint(name)
     if joint is None:
@@ -176,6 +204,7 @@ def _lock_joint(spec: mujoco.MjSpec, name: str, value: float) -> None:
         body.pos = np.asarray(body.pos, dtype=float) + rot @ axis * value
     else:
         raise ModelError(f"locked joint '{name}' is neither a hinge nor a slide in MuJoCo")
+    _drop_references(spec, name)
     spec.delete(joint)
 
 
@@ -203,8 +232,12 @@ def mujoco_spec(robot: Robot, friction: Mapping[str, FrictionLike], armature: Ma
             inertia model of another robot, inertias of a robot loaded from an MJCF.
         ModelError: a URDF MuJoCo cannot read, or whose joints are not the robot's.
     """
+    return _spec(robot, joint_exports(friction, armature, robot), inertias)
+
+
+def _spec(robot: Robot, joints: Mapping[str, JointExport], inertias: pin.Model | None) -> mujoco.MjSpec:
+    """:func:`mujoco_spec` of the joints' simulator parameters (:func:`joint_exports`)."""
     import mujoco
-    joints = joint_exports(friction, armature, robot)
     if inertias is None:
         spec = robot_spec(robot)
     else:
@@ -224,20 +257,21 @@ def mujoco_spec(robot: Robot, friction: Mapping[str, FrictionLike], armature: Ma
     _add_link_sites(spec)
     for name in robot.actuated:
         joint, exp = spec.joint(name), joints.get(name)
-        damping = np.zeros_like(np.asarray(joint.damping, dtype=float))
-        damping[0] = exp.viscous if exp is not None and exp.viscous is not None else 0.0
-        joint.damping = damping
-        joint.frictionloss = exp.coulomb if exp is not None and exp.coulomb is not None else 0.0
+        if exp is not None and exp.viscous is not None and exp.coulomb is not None:
+            damping = np.zeros_like(np.asarray(joint.damping, dtype=float))
+            damping[0] = exp.viscous
+            joint.damping = damping
+            joint.frictionloss = exp.coulomb
         joint.armature = _armature(robot, name, exp)
     return spec
 
 
 def compile_spec(spec: mujoco.MjSpec, source: str | Path = "MJCF") -> mujoco.MjModel:
-    """``spec.compile()``, its errors as :class:`ModelError` (named with ``source``)."""
+    """``spec.compile()``, its errors as :class:`ModelError` (named with ``source``, on one line)."""
     try:
         return spec.compile()
     except Exception as exc:  # mujoco raises ValueError with the compiler's message
-        raise ModelError(f"{source}: MuJoCo cannot compile the model: {exc}") from None
+        raise ModelError(f"{source}: MuJoCo cannot compile the model: {_one_line(exc)}") from None
 
 
 def mujoco_model(robot: Robot, friction: Mapping[str, FrictionLike], armature: Mapping[str, float] | None = None,
@@ -291,11 +325,13 @@ def _order_bodies(root: ET._Element, joints: Sequence[str]) -> bool:
     return moved
 
 
-def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] = ()) -> str:
+def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] = (),
+             notes: Mapping[str, str] | None = None) -> str:
     """The MJCF text of ``spec`` (compiled as ``model``) at full precision (module docstring): the
     bodies' ``pos``, ``quat`` and ``<inertial>``, the joints' ``pos``, ``axis``, ``range``,
     ``actuatorfrcrange``, ``damping``, ``frictionloss`` and ``armature``, the sites' ``pos`` and ``quat``
-    from ``model``; sibling bodies in the order of the joint names ``joints`` (:func:`_order_bodies`).
+    from ``model``; sibling bodies in the order of the joint names ``joints`` (:func:`_order_bodies`);
+    ``notes`` (joint -> one line) as a comment before each joint named.
 
     Raises:
         ModelError: a body or joint of the text that ``model`` does not have by name.
@@ -337,6 +373,9 @@ def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] =
             joint.set("damping", _num([model.dof_damping[dof], *poly] if np.any(poly) else model.dof_damping[dof]))
             joint.set("frictionloss", _num(model.dof_frictionloss[dof]))
             joint.set("armature", _num(model.dof_armature[dof]))
+            note = (notes or {}).get(joint.get("name") or "")
+            if note is not None:
+                joint.addprevious(ET.Comment(f" {note} "))
         for site in body.findall("site"):
             if site.get("name"):
                 s = ident(mujoco.mjtObj.mjOBJ_SITE, site.get("name"))
@@ -350,7 +389,7 @@ def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] =
 def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | Path,
                armature: Mapping[str, float] | None = None, inertias: pin.Model | None = None) -> mujoco.MjModel:
     """Write the MJCF of :func:`mujoco_spec` at full precision, its joints in :attr:`Robot.actuated`
-    order (:func:`mjcf_xml`), atomically.
+    order, each joint with friction from a fit after a comment of its status (:func:`mjcf_xml`), atomically.
 
     Returns:
         the compiled model the file holds.
@@ -359,9 +398,11 @@ def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | P
         what :func:`mujoco_spec` raises; InputError: an output folder that does not exist.
     """
     import mujoco
-    spec = mujoco_spec(robot, friction, armature, inertias)
+    joints = joint_exports(friction, armature, robot)
+    spec = _spec(robot, joints, inertias)
     model = compile_spec(spec, robot.urdf)
-    text = mjcf_xml(spec, model, robot.actuated)
+    notes = {name: note for name, exp in joints.items() if (note := status_note(exp)) is not None}
+    text = mjcf_xml(spec, model, robot.actuated, notes)
     write_atomic(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     if [model.joint(j).name for j in range(model.njnt) if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE] \
             != list(robot.actuated):  # bodies reordered in the file: its model, in its order

@@ -2,9 +2,10 @@
 
 Each exported joint gets ``<dynamics damping="F_v" friction="F_c"/>`` (:mod:`wbfriction.export.mapping`:
 viscous [N·m·s/rad] and Coulomb [N·m] friction of model (3.5); the Stribeck bump, its tanh slope
-and the offset tau_os have no URDF field). URDF has no armature field either: the armature is not
-written (MJCF and Isaac Lab hold it). Everything else is the given URDF's: other joints keep their
-``<dynamics>``, comments and meshes stay. Identified inertias go in through
+and the offset tau_os have no URDF field), after a comment with its fit's status when it comes from a fit
+(:func:`~wbfriction.export.mapping.status_note`; one written by an earlier export is replaced). URDF has no
+armature field either: the armature is not written (MJCF and Isaac Lab hold it). Everything else is the
+given URDF's: other joints keep their ``<dynamics>``, comments and meshes stay. Identified inertias go in through
 :func:`wbfriction.inertia.urdf.write_urdf` (bodies merged by Pinocchio split back over their links).
 
 Pinocchio reads the written file's ``<dynamics>`` into ``model.damping`` and ``model.friction``
@@ -21,7 +22,7 @@ import pinocchio as pin
 from lxml import etree as ET
 
 from wbfriction.exceptions import InputError
-from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports
+from wbfriction.export.mapping import NOTE_PREFIX, FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.inertia.regressor import body_parameters
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.tables import write_atomic
@@ -54,7 +55,8 @@ def read_urdf(path: str | Path) -> ET._ElementTree:
 
 def set_dynamics(root: ET._Element, joints: Mapping[str, JointExport]) -> None:
     """Set ``<dynamics damping friction>`` of every joint of ``joints`` with friction (in place),
-    after its other children for a joint that had none.
+    after its other children for a joint that had none, with its :func:`status_note` as a comment
+    before it (replacing one an earlier export wrote in that joint).
 
     Raises:
         InputError: a joint the URDF does not have.
@@ -66,6 +68,8 @@ def set_dynamics(root: ET._Element, joints: Mapping[str, JointExport]) -> None:
         joint = elements.get(name)
         if joint is None:
             raise InputError(f"the URDF has no joint '{name}'")
+        for old in [c for c in joint if c.tag is ET.Comment and (c.text or "").strip().startswith(NOTE_PREFIX)]:
+            joint.remove(old)  # its tail (the indentation after it) goes with it
         dyn = joint.find("dynamics")
         if dyn is None:
             dyn = ET.SubElement(joint, "dynamics")
@@ -74,6 +78,12 @@ def set_dynamics(root: ET._Element, joints: Mapping[str, JointExport]) -> None:
                 dyn.tail, previous.tail = previous.tail, joint.text
         dyn.set("damping", repr(float(exp.viscous or 0.0)))
         dyn.set("friction", repr(float(exp.coulomb or 0.0)))
+        note = status_note(exp)
+        if note is not None:
+            comment = ET.Comment(f" {note} ")
+            previous = dyn.getprevious()
+            comment.tail = previous.tail if previous is not None else joint.text  # indented as <dynamics>
+            dyn.addprevious(comment)
 
 
 def write_friction_urdf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | Path,

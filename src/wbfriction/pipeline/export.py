@@ -3,12 +3,14 @@ format each output's name says (:mod:`wbfriction.export`)."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
 from wbfriction.exceptions import InputError
 from wbfriction.export.isaac import write_isaac_yaml
+from wbfriction.export.mapping import FitSelection, select_fits
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.export.urdf import write_friction_urdf
 from wbfriction.friction.io import read_params
@@ -33,19 +35,29 @@ def export_format(path: str | Path) -> ExportFormat:
     return fmt
 
 
+@dataclass(frozen=True)
+class Exported:
+    """What :func:`export_files` wrote: the outputs and their formats, in order, and which fits went into
+    them (:class:`~wbfriction.export.mapping.FitSelection`: the joints left out, by status)."""
+
+    outputs: tuple[tuple[Path, ExportFormat], ...]
+    selection: FitSelection
+
+
 def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path],
-                 armature: Mapping[str, float] | None = None) -> list[tuple[Path, ExportFormat]]:
+                 armature: Mapping[str, float] | None = None, include: Iterable[str] = ()) -> Exported:
     """Write the fitted friction of ``params`` (``wbfriction fit``) for ``robot`` into each output,
     in the format its suffix names; the robot's inertias are its URDF's (give an identified URDF
     to export identified inertias) and its armature the robot model's unless ``armature`` is given.
 
-    Every output name is checked before anything is written; each file is written whole or not at all.
-
-    Returns:
-        the outputs and their formats, in order.
+    Only fits whose status is ``ok`` are exported, and those ``include`` names (``weak``, ``at-bound``;
+    :func:`~wbfriction.export.mapping.select_fits`); the other joints keep what the robot's model file has.
+    Every output name and the parameters are checked before anything is written; each file is written whole
+    or not at all.
 
     Raises:
         InputError: an unknown suffix, a .urdf output for a robot loaded from an MJCF, unreadable parameters,
+            parameters without joints or without a fit that qualifies, an unknown ``include`` choice,
             friction that is not dissipative (:mod:`wbfriction.export.mapping`), a joint the robot does not actuate.
     """
     if not outputs:
@@ -53,8 +65,8 @@ def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path]
     formats = [export_format(p) for p in outputs]
     if "urdf" in formats:
         robot.require_urdf("a .urdf export (the robot's URDF with <dynamics>)")
-    fits = read_params(params)
-    friction = {j: f for j, f in fits.items() if f.params is not None}
+    selection = select_fits(read_params(params), robot, include, str(params))
+    friction = selection.exported
     done = []
     for path, fmt in zip(outputs, formats):
         if fmt == "urdf":
@@ -64,4 +76,4 @@ def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path]
         else:
             write_isaac_yaml(path, friction, armature, robot)
         done.append((Path(path), fmt))
-    return done
+    return Exported(tuple(done), selection)
