@@ -186,8 +186,9 @@ def process_pool(workers: int, context: StartMethod, initializer: Callable[..., 
         initializer, initargs: called as ``initializer(*initargs)`` in each worker once it is
             tied to this process; both must pickle.
 
-    Leaving the block normally waits for the submitted work; leaving it by an exception
-    cancels what has not started and kills the workers (no wait).
+    Leaving the block normally waits for the submitted work; leaving it by an exception kills
+    the workers (no wait): the futures left end cancelled or failed (``BrokenProcessPool``).
+    Do not cancel a future of the pool yourself (:meth:`_Pool.map` says why).
     """
     before = set(multiprocessing.active_children())
     job = pickle.dumps((initializer, initargs))
