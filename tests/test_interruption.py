@@ -3,8 +3,12 @@ line on stderr, its output absent or the previous one kept, no traceback, even w
 its libraries; a command killed by SIGKILL leaves no process behind, and the temporary file it
 left is removed by the next write into the folder.
 
+A signal while a process pool fits or draws (``fit``, ``report``) ends the command as quickly
+(issue 37: it printed a thread's traceback, then hung).
+
 Mechanisms: :mod:`wbfriction.entry` (signals handled before anything is imported),
-:mod:`wbfriction.workers` (workers end with their parent), :func:`wbfriction.logs.tables.write_atomic`.
+:mod:`wbfriction.workers` (workers end with their parent; a pool's teardown that nothing races),
+:func:`wbfriction.logs.tables.write_atomic`.
 Every run is a real ``python -m wbfriction`` process, signalled as a terminal or a supervisor would.
 """
 
@@ -37,6 +41,15 @@ def walk_log(tmp_path_factory) -> Path:
     return path
 
 
+@pytest.fixture(scope="module")
+def friction_table(walk_log) -> Path:
+    """The walk's friction estimate (30 joints: ``fit`` and ``report`` keep two workers busy for a minute)."""
+    path = walk_log.parent / "friction.parquet"
+    res = run("estimate", walk_log, "--robot", "talos", "-o", path)
+    assert res.returncode == 0, res.stderr
+    return path
+
+
 # ------------------------------------------------------------------ processes, read from /proc
 def _stat(pid: int) -> tuple[str, int, str] | None:
     """(state, parent id, start time) of a process, None if there is none."""
@@ -55,6 +68,28 @@ def _children(pid: int) -> dict[int, str]:
     for entry in Path("/proc").iterdir():
         if entry.name.isdigit() and (s := _stat(int(entry.name))) is not None and s[1] == pid:
             out[int(entry.name)] = s[2]
+    return out
+
+
+def _cpu_ticks(pid: int) -> int:
+    """The CPU time a process has used (user + system), in clock ticks; 0 if it is gone."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0
+    return int(fields[11]) + int(fields[12])
+
+
+def _group(pgid: int) -> list[int]:
+    """The live processes of process group ``pgid``."""
+    out = []
+    for entry in Path("/proc").iterdir():
+        try:
+            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split() if entry.name.isdigit() else None
+        except OSError:
+            continue
+        if fields is not None and int(fields[2]) == pgid and fields[0] != "Z":
+            out.append(int(entry.name))
     return out
 
 
@@ -95,6 +130,18 @@ def _mid_run(proc: subprocess.Popen, folder: Path, output: str) -> dict[int, str
     pytest.fail(f"the run ended or stalled before it could be interrupted: {proc.poll()}")
 
 
+def _pool_busy(proc: subprocess.Popen, workers: int = 2) -> dict[int, str]:
+    """Wait until ``workers`` children of the command have each computed for 50 ms (its pool's tasks
+    are under way, others queued behind them); their ids."""
+    deadline = time.monotonic() + 120
+    while proc.poll() is None and time.monotonic() < deadline:
+        kids = _children(proc.pid)
+        if len(kids) >= workers and sum(_cpu_ticks(p) >= 5 for p in kids) >= workers:
+            return kids
+        time.sleep(0.02)
+    pytest.fail(f"the run ended or stalled before its pool worked: {proc.poll()}")
+
+
 def _stderr_lines(text: str) -> list[str]:
     return [line for line in text.splitlines() if line.strip()]
 
@@ -117,6 +164,39 @@ def test_a_signal_mid_run_exits_128_plus_its_number_and_keeps_the_previous_outpu
     assert out.read_bytes() == b"previous result"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["f.parquet"]
     assert _wait_gone(kids, 5.0) < 5.0, f"left alive: {_alive(kids)}"
+
+
+@pytest.mark.parametrize(("command", "output"), [("fit", "p.json"), ("report", "r.html")])
+@pytest.mark.parametrize(("signum", "group"), [(signal.SIGINT, True), (signal.SIGTERM, False)],
+                         ids=["ctrl-c to the job", "sigterm to the command"])
+def test_a_signal_while_the_pool_works_ends_the_command_within_seconds(friction_table, tmp_path, command, output,
+                                                                       signum, group):
+    """``fit`` and ``report`` interrupted while their two forked workers fit or draw, joints still
+    queued: the command ends within 10 s with 128 + n and the one line (no thread's traceback), no
+    process of its group is left, the previous output is kept byte for byte, nothing else written
+    (issue 37: an ``InvalidStateError`` traceback from the pool's thread, then a hang at exit)."""
+    name = signal.Signals(signum).name
+    out = tmp_path / output
+    out.write_bytes(b"previous result")
+    proc = _start(command, friction_table, "-o", out, "--workers", "2", cwd=tmp_path)
+    kids = _pool_busy(proc)
+    (os.killpg if group else os.kill)(proc.pid, signum)
+    t0 = time.monotonic()
+    try:
+        _, err = proc.communicate(timeout=30)  # its workers hold standard error too
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        _, err = proc.communicate()
+        pytest.fail(f"still running 30 s after {name}: {err}")
+    took = time.monotonic() - t0
+    assert proc.returncode == 128 + signum, err
+    assert _stderr_lines(err) == [f"interrupted ({name})"], err
+    assert took < 10.0, f"ended {took:.1f} s after {name}"
+    assert _wait_gone(kids, 5.0) < 5.0, f"left alive: {_alive(kids)}"
+    assert _group(proc.pid) == []
+    assert out.read_bytes() == b"previous result"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [output]
+    print(f"{command}: ended {took:.2f} s after {name}")
 
 
 def test_ctrl_c_while_the_libraries_load_exits_130_without_a_traceback(tmp_path):

@@ -123,6 +123,23 @@ def test_workers_run_the_initializer_and_leave_ctrl_c_to_the_parent(tmp_path):
     assert squares == [k * k for k in range(50)]
 
 
+def test_map_gives_the_results_in_order_in_chunks_or_not_and_keeps_its_timeout():
+    """The pool's ``map`` (which cancels nothing when left early) keeps the executor's contract: the
+    results in the arguments' order whatever the chunk size, a chunk size below 1 refused, a
+    timeout for all the results raised as TimeoutError (and the block left by it at once)."""
+    with process_pool(2, "fork") as pool:
+        assert list(pool.map(pow, range(50), [2] * 50, chunksize=7)) == [k * k for k in range(50)]
+        assert list(pool.map(divmod, range(5), [3] * 9, chunksize=10)) == [divmod(k, 3) for k in range(5)]
+        assert list(pool.map(abs, [])) == []
+        with pytest.raises(ValueError, match="chunksize"):
+            pool.map(abs, [1], chunksize=0)
+    t0 = time.monotonic()
+    with pytest.raises(TimeoutError):
+        with process_pool(1, "fork") as pool:
+            list(pool.map(time.sleep, [0.0, 30.0], timeout=1.0))
+    assert 1.0 <= time.monotonic() - t0 < 10.0
+
+
 def test_leaving_by_an_exception_kills_busy_workers_at_once():
     """An error (or an interruption) in the block does not wait for the work in progress: the busy
     workers are killed and the error goes on."""
@@ -137,3 +154,48 @@ def test_leaving_by_an_exception_kills_busy_workers_at_once():
     assert time.monotonic() - t0 < 10.0
     assert len(pids) == 2 and not any(_start_time(p) for p in pids if p is not None)
     assert all(f.done() for f in futures)
+
+
+LEFT_EARLY = """
+import signal, sys, time
+from wbfriction.workers import process_pool
+
+def work(blob):
+    time.sleep(30)
+    return len(blob)
+
+def stop(signum, frame):
+    raise KeyboardInterrupt
+
+if __name__ == "__main__":
+    signal.signal(signal.SIGALRM, stop)
+    try:
+        with process_pool(2, sys.argv[1]) as pool:
+            signal.setitimer(signal.ITIMER_REAL, 1.0)
+            print(sum(pool.map(work, [bytes(1 << 20)] * 8)))
+    except KeyboardInterrupt:
+        print("stopped", flush=True)
+"""
+
+
+@pytest.mark.parametrize("context", ["spawn", "fork"])
+def test_leaving_a_map_early_ends_at_once_without_a_thread_traceback(context, tmp_path):
+    """An interruption while ``pool.map`` waits for busy workers, with tasks still queued and arguments
+    larger than a pipe holds (the pool's feeding thread blocked on a pipe that no worker reads any
+    more): the block is left at once, the process exits at once, and no thread prints a traceback
+    (issue 37: Python 3.11's pool thread failed with ``InvalidStateError`` on the futures that
+    ``Executor.map`` had cancelled, before it could unblock the feeding thread; the exit then waited
+    for that thread forever)."""
+    script = tmp_path / "left_early.py"
+    script.write_text(textwrap.dedent(LEFT_EARLY))
+    t0 = time.monotonic()
+    proc = subprocess.Popen([sys.executable, str(script), context], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=20)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, err = proc.communicate()
+        pytest.fail(f"still running 20 s after it started (interrupted after 1 s): {err}")
+    assert (proc.returncode, out, err) == (0, "stopped\n", "")
+    assert time.monotonic() - t0 < 10.0

@@ -13,7 +13,9 @@
   traceback of its own;
 * are killed at once when the ``with`` block is left by an exception (an interruption, an error,
   a generator closed early) instead of being waited for: only a normal exit waits for the work
-  submitted.
+  submitted. The pool's own thread then fails the futures left with ``BrokenProcessPool``, closes
+  the pipe that fed the workers and ends; nothing cancels a future behind its back (see
+  :meth:`_Pool.map`), so that the process ends at once, without a thread's traceback.
 """
 
 from __future__ import annotations
@@ -26,10 +28,12 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from contextlib import contextmanager
-from typing import Literal, ParamSpec, TypeVar
+from itertools import islice
+from typing import Any, Literal, ParamSpec, TypeVar
 
 StartMethod = Literal["spawn", "fork"]
 """How workers start: ``spawn`` (a fresh interpreter: safe beside threads) or ``fork`` (a copy of
@@ -124,11 +128,50 @@ def _signals_held() -> Iterator[None]:
 
 
 class _Pool(ProcessPoolExecutor):
-    """A pool whose processes start (at a submission) with the command-ending signals held back."""
+    """A pool whose processes start (at a submission) with the command-ending signals held back, and
+    whose :meth:`map` cancels no future."""
 
     def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
         with _signals_held():
             return super().submit(fn, *args, **kwargs)
+
+    def map(self, fn: Callable[..., T], *iterables: Iterable[Any], timeout: float | None = None,
+            chunksize: int = 1) -> Iterator[T]:
+        """``fn`` over the iterables, as :meth:`concurrent.futures.Executor.map`: every task submitted at
+        once (``chunksize`` calls to a task), the results in order, :class:`TimeoutError` if they are not
+        all there ``timeout`` seconds after the call; except that an iterator left early cancels
+        nothing: the tasks not started run when the ``with`` block of :func:`process_pool` ends
+        normally, and fail with the workers killed when it ends by an exception.
+
+        Why: the standard iterator, left by an exception, cancels the futures not started; when the
+        block's exit then kills the workers, Python 3.11's pool thread, failing the futures left,
+        raises ``InvalidStateError`` on a cancelled one (CPython gh-107219, mended in 3.12), prints
+        its traceback and dies before it closes the pipe that fed the workers; a task larger than
+        the pipe's buffer keeps the feeding thread blocked on it, and the process's exit waits for
+        that thread forever (issue 37).
+
+        Raises:
+            ValueError: ``chunksize`` below 1.
+        """
+        if chunksize < 1:
+            raise ValueError(f"chunksize must be >= 1, not {chunksize}")
+        end = None if timeout is None else time.monotonic() + timeout
+        calls = zip(*iterables)
+        chunks = iter(lambda: list(islice(calls, chunksize)), [])
+        futures = deque(self.submit(_call_each, fn, chunk) for chunk in chunks)
+        return _in_order(futures, end)
+
+
+def _call_each(fn: Callable[..., T], chunk: list[tuple]) -> list[T]:
+    """A task of :meth:`_Pool.map`: ``fn`` on each tuple of arguments of ``chunk``."""
+    return [fn(*args) for args in chunk]
+
+
+def _in_order(futures: deque[Future[list[T]]], end: float | None) -> Iterator[T]:
+    """The results of the tasks of :meth:`_Pool.map`, in order (popped: no reference kept to a
+    result given); :class:`TimeoutError` at monotonic time ``end``."""
+    while futures:
+        yield from futures.popleft().result(None if end is None else end - time.monotonic())
 
 
 @contextmanager
@@ -143,8 +186,9 @@ def process_pool(workers: int, context: StartMethod, initializer: Callable[..., 
         initializer, initargs: called as ``initializer(*initargs)`` in each worker once it is
             tied to this process; both must pickle.
 
-    Leaving the block normally waits for the submitted work; leaving it by an exception
-    cancels what has not started and kills the workers (no wait).
+    Leaving the block normally waits for the submitted work; leaving it by an exception kills
+    the workers (no wait): the futures left end cancelled or failed (``BrokenProcessPool``).
+    Do not cancel a future of the pool yourself (:meth:`_Pool.map` says why).
     """
     before = set(multiprocessing.active_children())
     job = pickle.dumps((initializer, initargs))
