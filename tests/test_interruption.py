@@ -199,6 +199,50 @@ def test_a_signal_while_the_pool_works_ends_the_command_within_seconds(friction_
     print(f"{command}: ended {took:.2f} s after {name}")
 
 
+@pytest.fixture(scope="module")
+def arm_manifest(tmp_path_factory) -> Path:
+    """A manifest of four simulated Panda logs of 3 s (a batch of them keeps two Dask workers busy)."""
+    from wbfriction.logs.tables import write_table
+    from wbfriction.model.loading import load_robot
+    from wbfriction.sim.arm import ArmOptions, default_arm_friction, simulate_arm
+
+    folder = tmp_path_factory.mktemp("fleet")
+    robot = load_robot("panda")
+    lines = ["log,robot_id,start_time,robot"]
+    for seed in range(4):
+        sim = simulate_arm(robot, default_arm_friction(robot), options=ArmOptions(duration=3.0, seed=seed))
+        write_table(sim.table, folder / f"{seed}.parquet")
+        lines.append(f"{seed}.parquet,arm-{seed % 2},2026-03-0{seed + 1}T08:00:00Z,panda")
+    (folder / "manifest.csv").write_text("\n".join(lines) + "\n")
+    return folder / "manifest.csv"
+
+
+@pytest.mark.parametrize(("signum", "group"), [(signal.SIGINT, True), (signal.SIGTERM, False)],
+                         ids=["ctrl-c to the job", "sigterm to the command"])
+def test_a_signal_while_a_batch_runs_on_dask_ends_it_with_one_line(arm_manifest, tmp_path, signum, group):
+    """``batch`` interrupted while its local Dask cluster's two worker processes start or estimate: 128 + n,
+    the one line (issue 37: each Dask worker printed a KeyboardInterrupt traceback of its own), no process of
+    its group left; a result written is whole (the next run goes on from it)."""
+    name = signal.Signals(signum).name
+    proc = _start("batch", arm_manifest, "-o", tmp_path / "results", cwd=tmp_path)
+    kids = _pool_busy(proc)
+    time.sleep(1.0)
+    (os.killpg if group else os.kill)(proc.pid, signum)
+    try:
+        _, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        _, err = proc.communicate()
+        pytest.fail(f"still running 60 s after {name}: {err}")
+    assert proc.returncode == 128 + signum, err
+    assert _stderr_lines(err) == [f"interrupted ({name})"], err
+    assert _wait_gone(kids, 10.0) < 10.0, f"left alive: {_alive(kids)}"
+    assert _group(proc.pid) == []
+    from wbfriction.fleet.results import read_parts
+
+    assert all(part.rows is not None for part in read_parts(tmp_path / "results"))
+
+
 def test_ctrl_c_while_the_libraries_load_exits_130_without_a_traceback(tmp_path):
     """The command handles the signals before it loads NumPy or Pinocchio (seconds): a Ctrl-C then
     is one line and status 130."""

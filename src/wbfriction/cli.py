@@ -1064,7 +1064,7 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
     options = BatchOptions(estimate=EstimateOptions(diff=cast("Diff", diff)), model=cast("ModelChoice", model),
                            min_samples=min_samples)
     with Progress(TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console,
-                  transient=True) as bar:
+                  transient=True, disable=not console.is_terminal) as bar:
         task = bar.add_task("batch", total=len(entries))
         summary = run_batch(entries, output, options, engine="serial" if serial else "dask", workers=workers,
                             scheduler=scheduler, tables=tables, progress=lambda outcome: bar.advance(task, 1))

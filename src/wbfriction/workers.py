@@ -33,6 +33,7 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from contextlib import contextmanager
 from itertools import islice
+from multiprocessing import resource_tracker
 from typing import Any, Literal, ParamSpec, TypeVar
 
 StartMethod = Literal["spawn", "fork"]
@@ -93,13 +94,51 @@ def _start_worker(parent: int, job: bytes) -> None:
     """A worker's first act: tied to its parent, the command-ending signals left to the parent, then
     the caller's initializer (unpickled only now: its imports may take seconds)."""
     end_with_parent(parent)
+    _leave_signals_to_parent()
+    initializer, initargs = pickle.loads(job)
+    if initializer is not None:
+        initializer(*initargs)
+
+
+def _leave_signals_to_parent() -> None:
+    """In a worker's main thread: SIGINT ignored, SIGTERM and SIGHUP fatal without a word, then these
+    signals let through (they were held back while the worker started)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     for sig in _HELD - {signal.SIGINT}:
         signal.signal(sig, signal.SIG_DFL)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD)
-    initializer, initargs = pickle.loads(job)
-    if initializer is not None:
-        initializer(*initargs)
+
+
+def dask_setup(worker: object) -> None:
+    """Dask's preload hook (``distributed.worker.preload`` naming this module, :data:`DASK_PRELOAD`),
+    run in each worker process of a cluster started by :func:`started_held` before it takes a task:
+    the worker leaves the command-ending signals to the command, as those of :func:`process_pool`
+    do (a Ctrl-C, which the terminal sends to every process of the job, does not make each Dask
+    worker print a ``KeyboardInterrupt`` traceback)."""
+    _leave_signals_to_parent()
+
+
+DASK_PRELOAD = __name__
+"""The module a Dask cluster's ``distributed.worker.preload`` names so that its workers run
+:func:`dask_setup`."""
+
+
+def started_held(start: Callable[[], T], close: Callable[[T], object]) -> T:
+    """``start()`` with the command-ending signals held back (a thread it starts, and a process that
+    thread starts, at once or later, starts with them held: a Dask cluster's event loop and the
+    worker processes it spawns); if one arrived meanwhile, ``close(started)`` and then the signal is
+    raised. Multiprocessing's resource tracker is started before: started inside, it would let the
+    signals through again in this thread (``resource_tracker.ensure_running`` unblocks them)."""
+    resource_tracker.ensure_running()
+    started: list[T] = []
+    try:
+        with _signals_held():
+            started.append(start())
+    except BaseException:
+        for made in started:
+            close(made)
+        raise
+    return started[0]
 
 
 @contextmanager

@@ -49,6 +49,7 @@ from wbfriction.fleet.task import LogOutcome, ResultKey, process_log, result_key
 from wbfriction.logs.tables import TableFile, file_sha256, remove_stale_temporaries
 from wbfriction.pipeline.chunks import CHUNKS_PER_WORKER
 from wbfriction.pipeline.estimate import worker_robot
+from wbfriction.workers import DASK_PRELOAD, started_held
 
 Engine = Literal["dask", "serial"]
 """Where the tasks run: on a Dask cluster, or one after the other in this process."""
@@ -374,15 +375,19 @@ def local_cluster(workers: int) -> Any:
     ``MALLOC_TRIM_THRESHOLD_=65536`` for them: it turns off glibc's adaptive mmap threshold, so that every
     NumPy array above 64 KiB is mapped and unmapped afresh, and a log's task took 1.5-2x as long as in this
     process (measured: 6 Panda logs, 3.3-6.1 s per task against 2.3-3.5 s). The cluster's dashboard is on any
-    free port; its workers log errors only (a worker that takes over 4 s to close is not the user's concern)."""
+    free port; its workers log errors only (a worker that takes over 4 s to close is not the user's concern)
+    and leave the signals that end a command to this process (:func:`~wbfriction.workers.dask_setup`; a
+    signal while it starts closes it, :func:`~wbfriction.workers.started_held`)."""
     import dask
     from distributed import LocalCluster
 
     environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
                if k != "MALLOC_TRIM_THRESHOLD_"}
-    with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
-        return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0",
-                            silence_logs=logging.ERROR)
+    preload = [*dask.config.get("distributed.worker.preload", []), DASK_PRELOAD]
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": environ, "distributed.worker.preload": preload}):
+        return started_held(lambda: LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                                 dashboard_address=":0", silence_logs=logging.ERROR),
+                            lambda cluster: cluster.close())
 
 
 def _run_on_dask(args: list[tuple], record: Callable[[LogOutcome], None], workers: int, client: Any) -> None:
@@ -393,10 +398,10 @@ def _run_on_dask(args: list[tuple], record: Callable[[LogOutcome], None], worker
 
     cluster = None
     own = client is None
-    if own:
-        cluster = local_cluster(workers)
-        client = Client(cluster)
     try:
+        if own:
+            cluster = local_cluster(workers)
+            client = started_held(lambda: Client(cluster), lambda c: c.close())
         futures = {client.submit(log_task, *a, key=f"wbfriction-log-{a[1].key}", pure=False): a for a in args}
         for future in as_completed(futures):
             a = futures[future]
@@ -407,7 +412,7 @@ def _run_on_dask(args: list[tuple], record: Callable[[LogOutcome], None], worker
                                                        f"{type(exc).__name__}: {exc}")
             record(outcome)
     finally:
-        if own:
+        if own and client is not None:
             client.close()
-            if cluster is not None:
-                cluster.close()
+        if cluster is not None:
+            cluster.close()
