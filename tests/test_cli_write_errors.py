@@ -60,25 +60,34 @@ def arm(tmp_path_factory) -> Path:
                   chunking=Chunking(workers=1),
                   extra_metadata={"provenance": log_provenance(folder / "arm.parquet", robot)})
     fit_file(folder / "friction.parquet", folder / "params.json", model="coulomb-viscous")
+    renamed = [n.replace("panda_joint1", "J1") for n in sim.table.column_names]  # a log read through a --map
+    write_table(sim.table.rename_columns(renamed), folder / "renamed.parquet")
+    (folder / "map.toml").write_text('[joint_states]\nrename = { J1 = "panda_joint1" }\n')
     return folder
 
 
-@pytest.mark.parametrize("command", ["estimate", "fit", "report"])
+INPUTS = ("arm.parquet", "friction.parquet", "params.json", "renamed.parquet", "map.toml")
+
+
+@pytest.mark.parametrize("command", ["estimate", "estimate --map", "fit", "report"])
 def test_a_full_disk_is_one_line_and_keeps_the_previous_output(arm, tmp_path, command):
+    """With --map, the log is first streamed into a temporary Parquet log beside the output (as large as the
+    log): the write that fails first, named as the output it was for."""
     folder = tmp_path
-    for name in ("arm.parquet", "friction.parquet", "params.json"):
+    for name in INPUTS:
         (folder / name).write_bytes((arm / name).read_bytes())
     out, args = {
         "estimate": ("out.parquet", ("arm.parquet", "--robot", "panda", "--workers", "1")),
+        "estimate --map": ("out.parquet", ("renamed.parquet", "--map", "map.toml", "--robot", "panda")),
         "fit": ("out.json", ("friction.parquet", "--model", "coulomb-viscous", "--workers", "1")),
         "report": ("out.html", ("friction.parquet", "--params", "params.json")),
     }[command]
     (folder / out).write_bytes(b"previous " + out.encode())
     before = sorted(p.name for p in folder.iterdir())
-    res = _limited(command, *args, "-o", out, cwd=folder)
+    res = _limited(command.split()[0], *args, "-o", out, cwd=folder)
     _refused_write(res, folder, folder / out)
     assert sorted(p.name for p in folder.iterdir()) == before
-    for name in ("arm.parquet", "friction.parquet", "params.json"):
+    for name in INPUTS:
         assert (folder / name).read_bytes() == (arm / name).read_bytes()  # inputs untouched
 
 
