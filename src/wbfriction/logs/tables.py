@@ -411,11 +411,12 @@ def output_error(path: str | Path, exc: OSError, kept: bool = False) -> OutputEr
 def _names_other_file(exc: OSError, own: tuple[Path, ...]) -> bool:
     """``exc`` names a file other than ``own`` (the output, its temporary file, its folder): an
     input that could not be read while the output was written, not a fault of the output."""
+    mine = {os.path.abspath(p) for p in own}
     for name in (exc.filename, exc.filename2):
         if name is None or isinstance(name, int):  # no name, or a file descriptor: the write's
             continue
         try:
-            if Path(os.fsdecode(name)) not in own:
+            if os.path.abspath(os.fsdecode(name)) not in mine:
                 return True
         except (TypeError, ValueError):
             return True
