@@ -67,9 +67,11 @@ def ros_time(ts, ns: int):
 
 
 def write_bag(path, log, robot, storage: str = "mcap", wrench_every: int = 2, odom_every: int = 5,
-              shuffle: bool = True, rename: dict | None = None, delay_ns: dict | None = None, stamp=None):
+              shuffle: bool = True, rename: dict | None = None, delay_ns: dict | None = None, stamp=None,
+              force=None):
     """The log as a bag: JointState at every sample (names in a different order in every
-    message), the left sole's contact as a 400 N WrenchStamped every ``wrench_every`` samples,
+    message), the left sole's contact as a 400 N WrenchStamped every ``wrench_every`` samples
+    (``force(k, f)``: the force written for sample ``k`` instead of ``f``),
     the right one as a Bool, the base as Odometry every ``odom_every`` samples.
 
     ``delay_ns``: topic -> how much later than its stamp a message is received [ns] (the
@@ -106,6 +108,7 @@ def write_bag(path, log, robot, storage: str = "mcap", wrench_every: int = 2, od
             write(c_js, ts.serialize_cdr(js, "sensor_msgs/msg/JointState"))
             if k % wrench_every == 0:
                 f = 400.0 if log.contact[k, 0] else 3.0
+                f = f if force is None else force(k, f)
                 wr = T["geometry_msgs/msg/WrenchStamped"](
                     header=header("/left_ft"), wrench=T["geometry_msgs/msg/Wrench"](
                     force=T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=-f),

@@ -24,7 +24,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from helpers import run_cli
+from helpers import mapped_copy, run_cli
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import log_from_table
@@ -171,6 +171,24 @@ def test_a_csv_log_gives_the_friction_of_its_parquet_copy(walk, tmp_path, capsys
     for log, out in ((walk, "p.parquet"), (tmp_path / "walk.csv", "c.parquet")):
         assert run_cli(capsys, "estimate", log, "-o", tmp_path / out, "--diff", "central", "--workers", "1")[0] == 0
     np.testing.assert_allclose(_tau_f(tmp_path / "c.parquet"), _tau_f(tmp_path / "p.parquet"), rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("command", ["estimate", "convert"])
+def test_a_nan_force_read_through_a_map_is_not_no_contact(talos, walk, tmp_path, capsys, command):
+    """Issue 37: a NaN in a force column that a --map [[contacts]] entry reads was "no contact" (an all-NaN
+    column turned double support into swing samples, then fitted). Sporadic or all NaN: one line naming the
+    log, the column and the first row, exit 2, nothing written."""
+    mapped, toml = mapped_copy(pq.read_table(walk), talos.contact_frames)
+    (tmp_path / "map.toml").write_text(toml)
+    force = mapped.column("foot0.fz").to_numpy()
+    for name, nan_rows, first in (("sporadic", [777, 1500], 777), ("all", slice(None), 0)):
+        values = force.copy()
+        values[nan_rows] = np.nan
+        log = tmp_path / f"{name}.parquet"
+        pq.write_table(mapped.set_column(mapped.column_names.index("foot0.fz"), "foot0.fz", pa.array(values)), log)
+        _refused(capsys, tmp_path, [log, tmp_path / "map.toml"],
+                 (command, log, "--map", tmp_path / "map.toml", "-o", tmp_path / "out.parquet"),
+                 f"{log}: column 'foot0.fz' has a non-finite value (NaN or inf) at row {first}")
 
 
 # ----------------------------------------------------------------- 2. data destroyed

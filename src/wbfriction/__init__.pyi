@@ -5,6 +5,7 @@ SciPy."""
 from .exceptions import ColumnError as ColumnError
 from .exceptions import InputError as InputError
 from .exceptions import ModelError as ModelError
+from .exceptions import OutputError as OutputError
 from .exceptions import SimulationError as SimulationError
 from .exceptions import WbfrictionError as WbfrictionError
 from .friction.estimate import FrictionEstimate as FrictionEstimate

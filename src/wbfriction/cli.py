@@ -1148,13 +1148,17 @@ def overview(ctx: typer.Context,
 
 
 def main() -> None:
-    """Entry point: run the app, turning wbfriction errors into one line and exit status 2.
-    Interruptions (Ctrl-C, SIGTERM) are :mod:`wbfriction.entry`'s, which calls this."""
+    """Entry point: run the app, turning wbfriction errors into one line and exit status 2, or 1
+    for an output the system refused to write (:class:`~wbfriction.exceptions.OutputError`: the
+    environment, not the input). Interruptions (Ctrl-C, SIGTERM) are :mod:`wbfriction.entry`'s,
+    which calls this."""
+    from wbfriction.exceptions import OutputError
+
     try:
         status = app(standalone_mode=False)
     except WbfrictionError as exc:
         console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
-        sys.exit(2)
+        sys.exit(1 if isinstance(exc, OutputError) else 2)
     except typer.Exit as exc:  # pragma: no cover - typer control flow
         sys.exit(exc.exit_code)
     except (typer.Abort, KeyboardInterrupt):  # pragma: no cover

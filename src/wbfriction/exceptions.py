@@ -3,12 +3,14 @@
 Every error the user can fix by changing an input (a log, a URDF, a robot
 configuration, a command-line option) is an :class:`InputError`; the CLI prints
 its one-line message and exits with status 2. Where one column of a table is at fault,
-the error is a :class:`ColumnError` that carries the file, the column and the row.
+the error is a :class:`ColumnError` that carries the file, the column and the row. An output that
+cannot be written (a full disk, a read-only folder, a path under a file) is an :class:`OutputError`:
+the environment, not the input; the CLI prints its one line and exits with status 1.
 """
 
 from __future__ import annotations
 
-__all__ = ["WbfrictionError", "InputError", "ColumnError", "ModelError", "SimulationError"]
+__all__ = ["WbfrictionError", "InputError", "ColumnError", "OutputError", "ModelError", "SimulationError"]
 
 
 class WbfrictionError(Exception):
@@ -39,6 +41,33 @@ class ColumnError(InputError):
 
     def __reduce__(self):  # picklable across worker processes, with its data
         return (type(self), (self.source, self.column, self.row, self.problem))
+
+
+class OutputError(WbfrictionError):
+    """An output that cannot be written, because of where it is written (the environment, not the
+    input): the disk or the quota full, a file larger than the process may write (``ulimit -f``), a
+    folder that is read-only or not writable, a path under a file. Nothing was written: a previous
+    output at ``path`` is as it was. The message is ``{path}: cannot be written: [Errno N] reason``
+    and says whether a previous file is kept.
+
+    Attributes:
+        path: the output (the file the user named, not the temporary file written first).
+        errno: the OS's error number (``errno.ENOSPC``, ``errno.EFBIG``, ...), or None when the
+            library that failed did not say.
+        reason: the OS's reason, e.g. ``[Errno 28] No space left on device``.
+        kept: a previous file at ``path`` is kept (False: there was none).
+    """
+
+    def __init__(self, path: str, errno: int | None, reason: str, kept: bool = False):
+        self.path = path
+        self.errno = errno
+        self.reason = reason
+        self.kept = kept
+        outcome = "the previous file is kept" if kept else "nothing written"
+        super().__init__(f"{path}: cannot be written: {reason} ({outcome})")
+
+    def __reduce__(self):  # picklable across worker processes, with its data
+        return (type(self), (self.path, self.errno, self.reason, self.kept))
 
 
 class ModelError(WbfrictionError):

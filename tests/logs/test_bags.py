@@ -104,6 +104,18 @@ def test_bag_stamps_that_go_back_and_joints_that_appear_are_refused(talos, short
         read_bag(tmp_path / "e", two)
 
 
+@pytest.mark.parametrize("which", ["one", "all"])
+def test_a_nan_wrench_is_refused_not_read_as_no_contact(talos, short_log, tmp_path, which):
+    """A WrenchStamped contact whose force is NaN compared as "no contact" (|NaN| > threshold is False):
+    refused, naming the bag, the topic and the message (the wrench messages are every 2nd sample)."""
+    nan = (lambda k, f: np.nan if k == 600 else f) if which == "one" else (lambda k, f: np.nan)  # noqa: E731
+    write_bag(tmp_path / "bag", short_log, talos, force=nan)
+    message = 301 if which == "one" else 1
+    with pytest.raises(InputError, match=rf"bag: topic '/left_ft': message {message} has a non-finite force.z "
+                                         r"\(nan\): it cannot say whether frame 'left_sole_link' is in contact"):
+        read_bag(tmp_path / "bag", bag_map(talos))
+
+
 def test_estimate_from_a_bag_equals_estimate_from_its_conversion(talos, short_log, tmp_path):
     """'estimate BAG --map' and 'convert' then 'estimate' are one computation."""
     write_bag(tmp_path / "bag", short_log, talos, wrench_every=1, odom_every=1)

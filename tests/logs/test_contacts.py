@@ -75,3 +75,27 @@ def test_flags_from_forces_are_the_same_whole_and_in_chunks(talos, no_flags):
     for name in whole.column_names:
         a, b = whole.column(name).to_numpy(zero_copy_only=False), chunked.column(name).to_numpy(zero_copy_only=False)
         assert np.array_equal(a, b, equal_nan=a.dtype.kind == "f"), name
+
+
+def test_a_nan_wrench_is_refused_where_the_flags_come_from_the_forces(talos, no_flags, tmp_path):
+    """The force-torque route: a NaN in a sensor's force (the flags' only source) is refused with the file,
+    the column and the first row, whole (read_log) and before the chunks (estimate_file's plan), never held
+    as the last flag by the hysteresis."""
+    import pyarrow as pa
+
+    from wbfriction.exceptions import ColumnError
+
+    _, d = no_flags
+    table = pq.read_table(d / "noflags.parquet")
+    column = talos.ft_sensors[1].columns()[2]  # a force: fz of the second sensor
+    values = table.column(column).to_numpy().copy()
+    values[[901, 1700]] = np.nan
+    log = tmp_path / "nan.parquet"
+    pq.write_table(table.set_column(table.column_names.index(column), column, pa.array(values)), log)
+    for read in (lambda: read_log(log, talos),
+                 lambda: estimate_file(RobotSpec("talos"), log, tmp_path / "f.parquet", EstimateOptions(diff="true"),
+                                       chunking=Chunking(rows=1_000, workers=1))):
+        with pytest.raises(ColumnError) as info:
+            read()
+        assert (info.value.source, info.value.column, info.value.row) == (str(log), column, 901)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["nan.parquet"]

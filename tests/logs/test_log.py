@@ -9,7 +9,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import InputError, OutputError
 from wbfriction.logs.log import Log, log_from_table, write_log
 from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import write_table
@@ -141,8 +141,9 @@ def test_outputs_are_written_whole_or_not_at_all(tmp_path, monkeypatch):
         raise OSError("disk full")
 
     monkeypatch.setattr(pq, "write_table", half_written)
-    with pytest.raises(OSError):
+    with pytest.raises(OutputError) as info:
         write_table(table, target)
+    assert str(info.value) == f"{target}: cannot be written: disk full (the previous file is kept)"
     monkeypatch.undo()
     assert target.read_bytes() == b"previous"
     assert [p.name for p in tmp_path.iterdir()] == ["out.parquet"]

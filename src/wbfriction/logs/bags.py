@@ -9,7 +9,7 @@ A small TOML map names the topics and, where they differ, the joints::
     [[contacts]]                    # one per contact frame of the robot
     frame = "left_sole_link"
     topic = "/left_ankle_ft"        # geometry_msgs/WrenchStamped ...
-    threshold = 50.0                # ... in contact while |force.<axis>| > threshold [N]
+    threshold = 50.0                # ... in contact while |force.<axis>| > threshold [N] (NaN: refused)
     axis = "z"                      # optional, default z
 
     [[contacts]]
@@ -299,7 +299,12 @@ class _BagAligner:
         else:
             if c.threshold is None:
                 raise InputError(f"{self.path}: contact topic '{topic}' is a wrench: give its threshold [N] in the map")
-            self.contacts[topic].add(self.path, _stamp(msg), abs(getattr(msg.wrench.force, c.axis)) > c.threshold)
+            force = float(getattr(msg.wrench.force, c.axis))
+            if not np.isfinite(force):  # not measured: neither "contact" nor "no contact"
+                raise InputError(f"{self.path}: topic '{topic}': message {self.contacts[topic].count + 1} has a "
+                                 f"non-finite force.{c.axis} ({force}): it cannot say whether frame '{c.frame}' is "
+                                 "in contact")
+            self.contacts[topic].add(self.path, _stamp(msg), abs(force) > c.threshold)
 
     def add_base(self, msg: Any) -> None:
         """Record a base pose (x y z qx qy qz qw) of an ``Odometry`` or ``PoseStamped`` message at its stamp."""
@@ -410,7 +415,8 @@ def iter_bag(path: str | Path, bag_map: BagMap, block_rows: int = BLOCK_ROWS) ->
 
     Raises:
         InputError: unreadable bag, a missing or empty topic, a topic of another type, a
-            wrench topic without a threshold, a joint-state message naming a joint that
+            wrench topic without a threshold or with a non-finite force (naming the topic and
+            the message), a joint-state message naming a joint that
             the first one did not, stamps that go back in time within a topic, or no
             joint-state sample where every topic has data.
     """

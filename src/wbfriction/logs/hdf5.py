@@ -22,6 +22,8 @@ dataset has no 64 KiB limit as an attribute does.
 from __future__ import annotations
 
 import json
+import os
+import re
 from pathlib import Path
 from typing import Any
 
@@ -124,15 +126,28 @@ def read_hdf5(path: str | Path, columns: list[str] | None = None, start: int = 0
 
 def write_hdf5(table: pa.Table, path: str | Path) -> None:
     """Write a table as HDF5, one dataset per column (layout 2), metadata as the file
-    attribute ``wbfriction``. Not atomic by itself: use :func:`~wbfriction.logs.tables.write_table`."""
+    attribute ``wbfriction``. Not atomic by itself: use :func:`~wbfriction.logs.tables.write_table`.
+
+    Raises:
+        OSError: the system refused the write, with the OS's error number (HDF5 raises a RuntimeError
+            or an OSError without one, the number in its message).
+    """
     import h5py
 
-    with h5py.File(path, "w") as f:
-        for name in table.column_names:
-            data = table.column(name).to_numpy(zero_copy_only=False)
-            if data.dtype == object:  # strings (a friction table's phase): fixed-length bytes
-                data = data.astype(str).astype("S")
-            f.create_dataset(name, data=data, track_times=False)  # no timestamps: same input, same bytes
-        meta = (table.schema.metadata or {}).get(b"wbfriction")
-        if meta is not None:
-            f.create_dataset(META, data=np.bytes_(meta), track_times=False)
+    try:
+        with h5py.File(path, "w") as f:
+            for name in table.column_names:
+                data = table.column(name).to_numpy(zero_copy_only=False)
+                if data.dtype == object:  # strings (a friction table's phase): fixed-length bytes
+                    data = data.astype(str).astype("S")
+                f.create_dataset(name, data=data, track_times=False)  # no timestamps: same input, same bytes
+            meta = (table.schema.metadata or {}).get(b"wbfriction")
+            if meta is not None:
+                f.create_dataset(META, data=np.bytes_(meta), track_times=False)
+    except (OSError, RuntimeError) as exc:  # HDF5 words the OS's error in its message: "errno = 28"
+        number = getattr(exc, "errno", None)
+        found = re.search(r"errno = (\d+)", str(exc))
+        if not isinstance(number, int) and found:
+            number = int(found[1])
+            raise OSError(number, os.strerror(number)) from exc
+        raise

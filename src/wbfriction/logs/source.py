@@ -86,9 +86,16 @@ class LogSource:
         if self.bag_map is not None:
             return iter_bag(self.path, self.bag_map, block_rows)
         if self.table_map is not None:
-            table_map = self.table_map
-            return (table_map.apply(b, self.path) for b in self.table_file().blocks(block_rows))
+            return _mapped(self.table_map, self.table_file().blocks(block_rows), self.path)
         return self.table_file().blocks(block_rows)
+
+
+def _mapped(table_map: TableMap, blocks: Iterator[pa.Table], path: Path) -> Iterator[pa.Table]:
+    """A table file's consecutive ``blocks`` through its map, each told the file row it starts at."""
+    first_row = 0
+    for block in blocks:
+        yield table_map.apply(block, path, first_row)
+        first_row += block.num_rows
 
 
 def open_log(path: str | Path, bag_map: BagMap | str | Path | None = None, robot: Robot | None = None) -> LogSource:

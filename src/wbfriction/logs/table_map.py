@@ -14,7 +14,9 @@ instead of a contact flag, is read through the same map TOML as a ROS 2 bag
 A bag's ``topic`` keys, its ``[[contacts]]`` entries with a ``topic`` and no ``column``, and its ``[base]``
 table are not used for a table (a map may serve both). The
 force column stays in the log (a ``wrench.<sensor>.fz`` column is still a sensor's reading); the derived
-flag is ``contact.<frame>`` (int8, 1 in contact), exactly as a bag's wrench topic gives it.
+flag is ``contact.<frame>`` (int8, 1 in contact), exactly as a bag's wrench topic gives it. A NaN or
+inf in a contact column is refused (a force not measured is not "no contact"), naming the log, the
+column and the row.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.config import read_toml
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.model.robot import Robot
 
 
@@ -94,11 +96,15 @@ class TableMap:
                 raise InputError(f"{self.path}: [[contacts]] entry {k + 1}: {log} has its own column "
                                  f"'contact.{c.frame}' already")
 
-    def apply(self, table: pa.Table, log: str | Path) -> pa.Table:
-        """``table`` (a block of the log) with its columns renamed and the contact flags added (metadata kept).
+    def apply(self, table: pa.Table, log: str | Path, first_row: int = 0) -> pa.Table:
+        """``table`` (a block of the log, starting at the file's row ``first_row``) with its columns renamed
+        and the contact flags added (metadata kept).
 
         Raises:
             InputError: see :meth:`check_columns`; a contact column that is not numbers.
+            ColumnError: a contact column holding NaN or inf (a force that was not measured cannot
+                say "no contact", nor a flag "contact"), naming ``log``, the column and its first such
+                row, counted from the file's first data row.
         """
         names = list(table.column_names)
         self.check_columns(names, log)
@@ -113,6 +119,12 @@ class TableMap:
             except (pa.ArrowException, TypeError, ValueError):
                 raise InputError(f"{self.path}: [[contacts]] entry {k + 1}: column '{c.column}' of {log} is not "
                                  "numbers") from None
+            bad = np.flatnonzero(~np.isfinite(values))
+            if bad.size:
+                row = first_row + int(bad[0])
+                raise ColumnError(str(log), c.column, row, f"column '{c.column}' has a non-finite value (NaN or "
+                                  f"inf) at row {row}: it cannot say whether frame '{c.frame}' is in contact "
+                                  f"({self.path}, [[contacts]] entry {k + 1})")
             flags = (np.abs(values) > c.threshold) if c.threshold is not None else (values != 0)
             out = out.append_column(f"contact.{c.frame}", pa.array(flags.astype(np.int8)))
         return out.replace_schema_metadata(table.schema.metadata)

@@ -3,11 +3,14 @@
 A table file's format is decided once, from its suffix (:class:`TableFile`): ``.parquet``/``.pq``
 (Apache Parquet), ``.csv``, ``.h5``/``.hdf5``/``.he5`` (:mod:`wbfriction.logs.hdf5`). Every table
 carries its JSON metadata under the schema key ``wbfriction`` (:func:`with_metadata`,
-:func:`read_metadata`). Every output is written whole or not at all (:func:`write_atomic`).
+:func:`read_metadata`). Every output is written whole or not at all (:func:`write_atomic`), and an
+output the system refuses to write (a full disk, ``ulimit -f``, a read-only folder, a path under a
+file) is one :class:`~wbfriction.exceptions.OutputError` naming it (:func:`output_error`).
 """
 
 from __future__ import annotations
 
+import errno as errnos
 import hashlib
 import json
 import os
@@ -26,7 +29,7 @@ import pyarrow as pa
 import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
-from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.exceptions import ColumnError, InputError, OutputError
 from wbfriction.logs.hdf5 import SUFFIXES as HDF5_SUFFIXES
 from wbfriction.logs.hdf5 import read_hdf5, write_hdf5
 
@@ -380,17 +383,76 @@ def scratch_folder(near: str | Path | None = None) -> Iterator[Path]:
 
     Raises:
         InputError: a folder ``near`` that does not exist.
+        OutputError: a folder ``near`` in which no folder can be made (read-only, full), naming it.
     """
     folder = Path(tempfile.gettempdir() if near is None else near)
     if not folder.is_dir():
         raise InputError(f"{folder}: folder does not exist")
     remove_stale_temporaries(folder)
     path = _temporary_name(folder)
-    path.mkdir()
+    try:
+        path.mkdir()
+    except OSError as exc:
+        raise output_error(folder, exc) from exc
     try:
         yield path
     finally:
         shutil.rmtree(path, ignore_errors=True)
+
+
+def output_error(path: str | Path, exc: OSError, kept: bool = False) -> OutputError:
+    """The :class:`~wbfriction.exceptions.OutputError` for an OSError raised while writing ``path``:
+    its reason as the OS words it from the error's number (``[Errno 28] No space left on device``,
+    whatever library raised it and whichever temporary file it names), else the error's first line.
+
+    Args:
+        path: the output the user named.
+        exc: what the write raised.
+        kept: a previous file at ``path`` is kept.
+    """
+    number = exc.errno if isinstance(exc.errno, int) else None
+    if number is not None and number in errnos.errorcode:
+        reason = f"[Errno {number}] {os.strerror(number)}"
+    else:
+        reason = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+    return OutputError(str(path), number, reason, kept)
+
+
+def _names_other_file(exc: OSError, own: tuple[Path, ...]) -> bool:
+    """``exc`` names a file other than ``own`` (the output, its temporary file, its folder): an
+    input that could not be read while the output was written, not a fault of the output."""
+    mine = {os.path.abspath(p) for p in own}
+    for name in (exc.filename, exc.filename2):
+        if name is None or isinstance(name, int):  # no name, or a file descriptor: the write's
+            continue
+        try:
+            if os.path.abspath(os.fsdecode(name)) not in mine:
+                return True
+        except (TypeError, ValueError):
+            return True
+    return False
+
+
+def _discard(path: Path) -> None:
+    """Remove a temporary file if it is there (nothing if it cannot be: e.g. a path under a file)."""
+    try:
+        path.unlink(missing_ok=True)
+    except OSError:
+        pass
+
+
+def make_folder(path: str | Path) -> Path:
+    """Make an output folder and its parents (nothing if it exists).
+
+    Raises:
+        OutputError: a folder that cannot be made (under a file, read-only, full), naming it and the OS's reason.
+    """
+    path = Path(path)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise output_error(path, exc, kept=path.is_dir()) from exc
+    return path
 
 
 def write_atomic(path: str | Path, write) -> None:
@@ -406,6 +468,11 @@ def write_atomic(path: str | Path, write) -> None:
 
     Raises:
         InputError: an output folder that does not exist.
+        OutputError: the system refused the write (an OSError while the temporary file was made,
+            written or renamed: a full disk or quota, a file over ``ulimit -f``, a read-only or
+            unwritable folder, a path under a file), naming ``path`` and the OS's reason
+            (:func:`output_error`). An OSError naming another file (an input read by ``write``) is
+            raised as it is.
     """
     path = Path(path)
     if not path.parent.exists():
@@ -416,8 +483,13 @@ def write_atomic(path: str | Path, write) -> None:
         os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))  # the umask applies
         write(tmp)
         os.replace(tmp, path)
+    except OSError as exc:
+        _discard(tmp)
+        if _names_other_file(exc, (tmp, path, path.parent)):
+            raise
+        raise output_error(path, exc, kept=path.is_file()) from exc
     except BaseException:
-        tmp.unlink(missing_ok=True)
+        _discard(tmp)
         raise
 
 
@@ -426,6 +498,7 @@ def write_json(path: str | Path, doc: object) -> None:
 
     Raises:
         InputError: an output folder that does not exist.
+        OutputError: the system refused the write (:func:`write_atomic`).
     """
     text = json.dumps(doc, indent=2)
     write_atomic(path, lambda tmp: tmp.write_text(text))
@@ -433,7 +506,12 @@ def write_json(path: str | Path, doc: object) -> None:
 
 def write_table(table: pa.Table, path: str | Path) -> None:
     """Write an Arrow table as Parquet (CSV if ``path`` ends in .csv, its metadata in a first line
-    :data:`CSV_METADATA`; HDF5 in .h5 or .hdf5), atomically."""
+    :data:`CSV_METADATA`; HDF5 in .h5 or .hdf5), atomically.
+
+    Raises:
+        InputError: an output folder that does not exist.
+        OutputError: the system refused the write (:func:`write_atomic`).
+    """
     path = Path(path)
     if path.suffix.lower() == ".csv":
         def write_csv(tmp: Path) -> None:
@@ -463,6 +541,8 @@ def write_tables(path: str | Path, tables: Iterable[pa.Table], check=None) -> in
     Raises:
         InputError: an output that is neither .parquet nor .csv, or no table at all; what
             the tables' source or ``check`` raises.
+        OutputError: the system refused the write (:func:`write_atomic`); the tables' source is
+            not read further.
     """
     path = Path(path)
     if path.suffix.lower() not in (".parquet", ".pq", ".csv"):

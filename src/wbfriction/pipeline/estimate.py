@@ -23,7 +23,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import InputError, OutputError
 from wbfriction.friction.estimate import estimate_log, no_single_support, resolve_differentiation
 from wbfriction.friction.io import friction_table
 from wbfriction.friction.options import EstimateOptions
@@ -254,6 +254,8 @@ def table_log(log: LogSource, near: Path) -> Iterator[Path]:
 
     Raises:
         InputError: what reading the bag (or mapped table) raises.
+        OutputError: a temporary log the system refuses to write (a full disk: it is as large as the log),
+            naming ``near``, the output that could not be written for it.
     """
     if not log.is_mapped:
         yield log.path
@@ -261,5 +263,8 @@ def table_log(log: LogSource, near: Path) -> Iterator[Path]:
     folder = near.parent if near.parent.exists() else None
     with scratch_folder(folder) as tmp:
         converted = Path(tmp) / "log.parquet"
-        write_tables(converted, log.blocks())
+        try:
+            write_tables(converted, log.blocks())
+        except OutputError as exc:  # the temporary file's name means nothing to the user: the output's does
+            raise OutputError(str(near), exc.errno, exc.reason, near.is_file()) from exc
         yield converted

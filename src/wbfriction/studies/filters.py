@@ -25,7 +25,7 @@ from wbfriction.friction.models import PARAM_NAMES, FrictionParams
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import Log
-from wbfriction.logs.tables import write_json, write_table
+from wbfriction.logs.tables import make_folder, write_json, write_table
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
 from wbfriction.report.figures import filter_curves_figure
@@ -189,7 +189,7 @@ def run_filter_study(robot: Robot, output_dir: Path, steps: int = 10, levels: tu
         progress: called with a label as stages start and runs end (:data:`~wbfriction.progress.StageProgress`).
     """
     say = progress or (lambda label: None)
-    output_dir.mkdir(parents=True, exist_ok=True)
+    make_folder(output_dir)
     legs3 = leg_joints(robot)
     legs = [j for j, _, _ in legs3]
     targets = {j: THESIS_TARGETS[g] for j, _, g in legs3}

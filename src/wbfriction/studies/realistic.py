@@ -34,7 +34,7 @@ from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.contacts import normal_forces, sensed_contacts
 from wbfriction.logs.log import Log, write_log
-from wbfriction.logs.tables import write_table
+from wbfriction.logs.tables import make_folder, write_table
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
 from wbfriction.report.build import make_report
@@ -200,9 +200,10 @@ def run_realistic_study(robot: Robot, output_dir: Path, steps: int = 10, knee_st
 
     Raises:
         SimulationError: the robot fell in one of the walks.
+        OutputError: an output folder or file the system refuses (a path under a file, a full disk).
     """
     say = progress or (lambda label: None)
-    output_dir.mkdir(parents=True, exist_ok=True)
+    make_folder(output_dir)
     legs = leg_joints(robot)
     knee = right_knee(legs)
     table_6_1 = {j: THESIS_TARGETS[g] for j, _, g in legs}

@@ -26,6 +26,7 @@ from wbfriction.friction.estimate import FrictionEstimate, estimate_log
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import Log, write_log
+from wbfriction.logs.tables import make_folder, write_atomic
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
 from wbfriction.signals.kinematics import Diff
@@ -97,9 +98,10 @@ def run_sensors_study(robot: Robot, output_dir: Path, steps: int = 3, diff: Diff
 
     Raises:
         SimulationError: the robot fell.
+        OutputError: an output folder or file the system refuses (a path under a file, a full disk).
     """
     say = progress or (lambda label: None)
-    output_dir.mkdir(parents=True, exist_ok=True)
+    make_folder(output_dir)
     legs = leg_joints(robot)
     friction = {j: THESIS_TARGETS[g] for j, _, g in legs}
     say(f"MuJoCo: the combined walk, {steps} steps per direction, the ankle sensors logged")
@@ -131,8 +133,8 @@ def run_sensors_study(robot: Robot, output_dir: Path, steps: int = 3, diff: Diff
     result = SensorsResult(rows, int((~free).sum()), label, [])
     files = [output_dir / "mujoco_sensors_walk.parquet", output_dir / "sensors.json", output_dir / "sensors.md"]
     write_log(log, robot, files[0])
-    files[1].write_text(json.dumps(_as_json(result), indent=1))
-    files[2].write_text(sensors_markdown(result))
+    for file, text in ((files[1], json.dumps(_as_json(result), indent=1)), (files[2], sensors_markdown(result))):
+        write_atomic(file, lambda tmp, text=text: tmp.write_text(text))
     return dataclasses.replace(result, files=files)
 
 

@@ -26,7 +26,7 @@ from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import write_log
-from wbfriction.logs.tables import write_table
+from wbfriction.logs.tables import make_folder, write_table
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, StageProgress
 from wbfriction.report.build import make_report
@@ -141,7 +141,7 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
         progress: called with a label as each stage starts (:data:`~wbfriction.progress.StageProgress`).
     """
     say = progress or (lambda label: None)
-    output_dir.mkdir(parents=True, exist_ok=True)
+    make_folder(output_dir)
     legs = leg_joints(robot)
     knee = right_knee(legs)
     # 1. right knee only: Fig. 6.1-6.3
