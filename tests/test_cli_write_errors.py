@@ -122,3 +122,17 @@ def test_an_output_folder_under_a_file_is_one_line(tmp_path, capsys):
     assert code == 1 and lines == [f"error: {tmp_path}/notes.txt/demo: cannot be written: [Errno 20] Not a "
                                    "directory (nothing written)"], err
     assert [p.name for p in tmp_path.iterdir()] == ["notes.txt"]
+
+
+@pytest.mark.parametrize("engine", [("--serial",), ()], ids=["serial", "dask"])
+def test_a_batch_on_a_full_disk_stops_with_one_line(arm, tmp_path, engine):
+    """A batch whose results cannot be written (the disk full) stops at once with the one line, status 1,
+    instead of recording every log as failed (a failure record could not be written either)."""
+    (tmp_path / "a1.parquet").write_bytes((arm / "arm.parquet").read_bytes())
+    (tmp_path / "manifest.csv").write_text("log,robot_id,start_time,robot\n"
+                                           "a1.parquet,arm-1,2026-03-01T08:00:00+00:00,panda\n")
+    res = _limited("batch", "manifest.csv", "-o", "results", *engine, cwd=tmp_path)
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert res.returncode == 1 and len(lines) == 1, res.stderr
+    assert lines[0].startswith("error: ") and "cannot be written: [Errno 27] File too large" in lines[0]
+    assert not list((tmp_path / "results").rglob("*.parquet")) and not (tmp_path / "results-failed").exists()

@@ -2,6 +2,7 @@
 ``import wbfriction`` (and the command's entry point, :mod:`wbfriction.entry`) loads no NumPy, Pinocchio or
 SciPy."""
 
+from .exceptions import ClusterError as ClusterError
 from .exceptions import ColumnError as ColumnError
 from .exceptions import InputError as InputError
 from .exceptions import ModelError as ModelError

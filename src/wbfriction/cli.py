@@ -1038,7 +1038,7 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
           ) -> None:
     """Estimate, fit and check every log of a fleet on Dask, into one results dataset (exit status 1 when a log
     failed: it is listed, the others are done)."""
-    from wbfriction.fleet.batch import check_outputs, run_batch
+    from wbfriction.fleet.batch import check_outputs, quiet_dask_logs, run_batch
     from wbfriction.fleet.manifest import DIFF_CHOICES, read_manifest, scan_folder
     from wbfriction.fleet.options import BatchOptions
     from wbfriction.fleet.results import failures_folder
@@ -1051,6 +1051,7 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
         raise InputError(f"--model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
     check_paths({"MANIFEST": source}, {})
     check_outputs(output, tables)
+    quiet_dask_logs()  # its faults are said here, one line each
     start = time.perf_counter()
     if source.is_dir():
         scan = scan_folder(source, RobotSpec(None if config else robot, None if urdf is None else str(urdf),
@@ -1148,17 +1149,15 @@ def overview(ctx: typer.Context,
 
 
 def main() -> None:
-    """Entry point: run the app, turning wbfriction errors into one line and exit status 2, or 1
-    for an output the system refused to write (:class:`~wbfriction.exceptions.OutputError`: the
-    environment, not the input). Interruptions (Ctrl-C, SIGTERM) are :mod:`wbfriction.entry`'s,
-    which calls this."""
-    from wbfriction.exceptions import OutputError
-
+    """Entry point: run the app, turning wbfriction errors into one line and their exit status (2 for
+    the input, 1 for the environment: an output the system refused to write, a cluster gone;
+    :attr:`~wbfriction.exceptions.WbfrictionError.exit_status`). Interruptions (Ctrl-C, SIGTERM)
+    are :mod:`wbfriction.entry`'s, which calls this."""
     try:
         status = app(standalone_mode=False)
     except WbfrictionError as exc:
         console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
-        sys.exit(1 if isinstance(exc, OutputError) else 2)
+        sys.exit(exc.exit_status)
     except typer.Exit as exc:  # pragma: no cover - typer control flow
         sys.exit(exc.exit_code)
     except (typer.Abort, KeyboardInterrupt):  # pragma: no cover

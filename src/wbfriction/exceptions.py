@@ -4,17 +4,25 @@ Every error the user can fix by changing an input (a log, a URDF, a robot
 configuration, a command-line option) is an :class:`InputError`; the CLI prints
 its one-line message and exits with status 2. Where one column of a table is at fault,
 the error is a :class:`ColumnError` that carries the file, the column and the row. An output that
-cannot be written (a full disk, a read-only folder, a path under a file) is an :class:`OutputError`:
-the environment, not the input; the CLI prints its one line and exits with status 1.
+cannot be written (a full disk, a read-only folder, a path under a file) is an :class:`OutputError`, and a
+Dask cluster that cannot go on (its scheduler gone) a :class:`ClusterError`: the environment, not the input;
+the CLI prints their one line and exits with status 1 (each class's :attr:`~WbfrictionError.exit_status`).
 """
 
 from __future__ import annotations
 
-__all__ = ["WbfrictionError", "InputError", "ColumnError", "OutputError", "ModelError", "SimulationError"]
+__all__ = ["WbfrictionError", "InputError", "ColumnError", "OutputError", "ClusterError", "ModelError",
+           "SimulationError"]
 
 
 class WbfrictionError(Exception):
-    """Base class of every exception raised on purpose by wbfriction."""
+    """Base class of every exception raised on purpose by wbfriction.
+
+    Attributes:
+        exit_status: the command's exit status when it ends with this error (2: the input; 1: the environment).
+    """
+
+    exit_status = 2
 
 
 class InputError(WbfrictionError, ValueError):
@@ -58,6 +66,8 @@ class OutputError(WbfrictionError):
         kept: a previous file at ``path`` is kept (False: there was none).
     """
 
+    exit_status = 1
+
     def __init__(self, path: str, errno: int | None, reason: str, kept: bool = False):
         self.path = path
         self.errno = errno
@@ -68,6 +78,13 @@ class OutputError(WbfrictionError):
 
     def __reduce__(self):  # picklable across worker processes, with its data
         return (type(self), (self.path, self.errno, self.reason, self.kept))
+
+
+class ClusterError(WbfrictionError):
+    """A Dask cluster that cannot run the rest of a batch (its scheduler went away): what was done is kept, the
+    message says how much is left; the next run goes on from there."""
+
+    exit_status = 1
 
 
 class ModelError(WbfrictionError):

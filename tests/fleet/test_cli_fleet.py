@@ -3,6 +3,7 @@ nothing written."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -97,3 +98,46 @@ def test_an_absent_scheduler_is_said_within_its_timeout():
     with pytest.raises(InputError, match="no Dask scheduler answered within 1 s"):
         connect("tcp://127.0.0.1:9", timeout=1.0)
     assert time.monotonic() - start < 10  # the timeout given, not Dask's 30 s
+
+
+@pytest.mark.slow
+def test_a_scheduler_that_goes_away_is_one_line(arm_fleet, tmp_path):
+    """A real `dask scheduler` and `dask worker`, the scheduler killed once the first result is written: the
+    batch ends with one line saying how much was done (status 1), instead of a reconnection traceback and a
+    failure per log; the result written is whole, and the next run goes on from it."""
+    import signal
+    import socket
+    import time
+
+    folder, _ = arm_fleet
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    address = f"tcp://127.0.0.1:{port}"
+    bin_dir = Path(sys.executable).parent
+    scheduler = subprocess.Popen([bin_dir / "dask", "scheduler", "--port", str(port), "--dashboard-address", ":0"],
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    worker = subprocess.Popen([bin_dir / "dask", "worker", address, "--nworkers", "1", "--nthreads", "1"],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        batch = subprocess.Popen([sys.executable, "-m", "wbfriction", "batch", str(folder / "manifest.csv"), "-o",
+                                  "results", "--scheduler", address], cwd=tmp_path, stdout=subprocess.PIPE,
+                                 stderr=subprocess.PIPE, text=True)
+        deadline = time.monotonic() + 300
+        while not list((tmp_path / "results").glob("*/*.parquet")) and time.monotonic() < deadline:
+            assert batch.poll() is None, batch.communicate()
+            time.sleep(0.1)
+        os.killpg(scheduler.pid, signal.SIGKILL)
+        _, err = batch.communicate(timeout=120)
+    finally:
+        for p in (scheduler, worker):
+            try:
+                os.killpg(p.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert batch.returncode == 1 and len(lines) == 1, err
+    assert f"error: the Dask scheduler {address} went away: " in lines[0] and "run the batch again" in lines[0]
+    from wbfriction.fleet.results import read_parts
+
+    assert [p.problem for p in read_parts(tmp_path / "results")] == [""] * len(read_parts(tmp_path / "results"))

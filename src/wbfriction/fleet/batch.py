@@ -33,6 +33,7 @@ import logging
 import os
 from collections import Counter, defaultdict
 from collections.abc import Callable, Iterator
+from concurrent.futures import CancelledError
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import UTC
@@ -41,12 +42,12 @@ from typing import Any, Literal
 
 from threadpoolctl import threadpool_limits
 
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import ClusterError, InputError, OutputError
 from wbfriction.fleet.manifest import LogEntry, Skipped
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.results import Part, failures_folder, read_parts, table_path, write_outcome
-from wbfriction.fleet.task import LogOutcome, ResultKey, process_log, result_key, robot_sha256
-from wbfriction.logs.tables import TableFile, file_sha256, remove_stale_temporaries
+from wbfriction.fleet.task import LogOutcome, ResultKey, one_line, process_log, result_key, robot_sha256
+from wbfriction.logs.tables import TableFile, file_sha256, make_folder, remove_file, remove_stale_temporaries
 from wbfriction.pipeline.chunks import CHUNKS_PER_WORKER
 from wbfriction.pipeline.estimate import worker_robot
 from wbfriction.workers import DASK_PRELOAD, started_held
@@ -236,6 +237,17 @@ def check_outputs(results: Path, tables: Path | None = None) -> None:
             raise InputError(f"{label} {folder}: {existing} cannot be written")
 
 
+def quiet_dask_logs() -> None:
+    """Dask's own log records below CRITICAL left unprinted (for the command line, whose batch says every fault
+    in one line: a lost scheduler's reconnection tracebacks are Dask's). Its loggers' levels are set when
+    ``distributed`` is imported, so it is imported first."""
+    import distributed  # noqa: F401
+
+    for name in list(logging.root.manager.loggerDict):
+        if name == "distributed" or name.startswith("distributed."):
+            logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
 def connect(scheduler: str, timeout: float = CONNECT_TIMEOUT) -> Any:
     """A ``distributed.Client`` of the scheduler at ``scheduler``.
 
@@ -278,6 +290,8 @@ def run_batch(entries: list[LogEntry], results: str | Path, options: BatchOption
         InputError: what :func:`check_outputs`, :func:`connect` and :func:`plan_batch` raise, before any log is
             processed; ``workers`` below 1, or given where no local cluster runs; ``scheduler`` with the serial
             engine or a ``client``.
+        OutputError: a result that cannot be written (the batch stops; what was written is kept).
+        ClusterError: the scheduler went away (likewise).
     """
     if engine == "serial" and scheduler is not None:
         raise InputError("--scheduler and --serial: a serial batch runs in this process, without a scheduler")
@@ -288,16 +302,16 @@ def run_batch(entries: list[LogEntry], results: str | Path, options: BatchOption
                          f"{'--serial' if engine == 'serial' else '--scheduler'}")
     if workers is not None and workers < 1:
         raise InputError(f"--workers must be at least 1, got {workers}")
-    results = Path(results)
-    tables = Path(tables) if tables is not None else None
+    results = Path(results).absolute()  # a worker elsewhere (a scheduler's) has another working folder
+    tables = Path(tables).absolute() if tables is not None else None
     check_outputs(results, tables)
     with _cluster_client(engine, scheduler, client) as connected:
         plan = plan_batch(entries, results, options)
-        results.mkdir(parents=True, exist_ok=True)
+        make_folder(results)
         for folder in [results, *(p for p in results.iterdir() if p.is_dir())]:
             remove_stale_temporaries(folder)  # those a killed batch left
         for s in plan.stale:
-            s.path.unlink(missing_ok=True)
+            remove_file(s.path)
         failed: list[tuple[LogEntry, str]] = []
         planned = {p.key.key: p for p in plan.todo}
         if len(planned) != len(plan.todo):  # the keys name the tasks and files: one per listed log
@@ -314,7 +328,7 @@ def run_batch(entries: list[LogEntry], results: str | Path, options: BatchOption
                  table_path(tables, p.entry.robot_id, p.key.key) if tables is not None else None) for p in plan.todo]
         for a in args:
             if a[4] is not None:
-                a[4].parent.mkdir(parents=True, exist_ok=True)
+                make_folder(a[4].parent)
         if engine == "serial":
             for a in args:
                 record(process_log(*a))
@@ -375,7 +389,8 @@ def local_cluster(workers: int) -> Any:
     ``MALLOC_TRIM_THRESHOLD_=65536`` for them: it turns off glibc's adaptive mmap threshold, so that every
     NumPy array above 64 KiB is mapped and unmapped afresh, and a log's task took 1.5-2x as long as in this
     process (measured: 6 Panda logs, 3.3-6.1 s per task against 2.3-3.5 s). The cluster's dashboard is on any
-    free port; its workers log errors only (a worker that takes over 4 s to close is not the user's concern)
+    free port; its workers log critical errors only (a task's error is said by the batch, in one line; a worker
+    that takes over 4 s to close is not the user's concern)
     and leave the signals that end a command to this process (:func:`~wbfriction.workers.dask_setup`; a
     signal while it starts closes it, :func:`~wbfriction.workers.started_held`)."""
     import dask
@@ -386,14 +401,19 @@ def local_cluster(workers: int) -> Any:
     preload = [*dask.config.get("distributed.worker.preload", []), DASK_PRELOAD]
     with dask.config.set({"distributed.nanny.pre-spawn-environ": environ, "distributed.worker.preload": preload}):
         return started_held(lambda: LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                                 dashboard_address=":0", silence_logs=logging.ERROR),
+                                                 dashboard_address=":0", silence_logs=logging.CRITICAL),
                             lambda cluster: cluster.close())
 
 
 def _run_on_dask(args: list[tuple], record: Callable[[LogOutcome], None], workers: int, client: Any) -> None:
     """Submit one task per log and record each outcome as it completes; a task Dask gave up on (its workers
     died each time it ran) is recorded as the log's failure. Without ``client``, on a local cluster of
-    ``workers`` processes started here."""
+    ``workers`` processes started here.
+
+    Raises:
+        ClusterError: the scheduler went away (the tasks left are cancelled): what was recorded is kept.
+        OutputError: a result that cannot be written.
+    """
     from distributed import Client, as_completed
 
     cluster = None
@@ -403,14 +423,22 @@ def _run_on_dask(args: list[tuple], record: Callable[[LogOutcome], None], worker
             cluster = local_cluster(workers)
             client = started_held(lambda: Client(cluster), lambda c: c.close())
         futures = {client.submit(log_task, *a, key=f"wbfriction-log-{a[1].key}", pure=False): a for a in args}
+        done = 0
         for future in as_completed(futures):
             a = futures[future]
             try:
                 outcome = future.result()
+            except OutputError:
+                raise  # the results cannot be written (a task's friction table): the batch stops
             except Exception as exc:  # the task, not the log: e.g. distributed.KilledWorker
-                outcome = LogOutcome(a[0], a[1], error=f"{a[0].log}: the cluster could not run it: "
-                                                       f"{type(exc).__name__}: {exc}")
+                if client.status not in ("running", "connecting") or isinstance(exc, CancelledError):
+                    raise ClusterError(f"the Dask scheduler {client.scheduler.address} went away: {done} of "
+                                       f"{len(args)} logs done, the others not processed (run the batch again)"
+                                       ) from None
+                outcome = LogOutcome(a[0], a[1], error=one_line(f"{a[0].log}: the cluster could not run it: "
+                                                                f"{type(exc).__name__}: {exc}"))
             record(outcome)
+            done += 1
     finally:
         if own and client is not None:
             client.close()

@@ -25,7 +25,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.fleet.manifest import Skipped
 from wbfriction.fleet.schema import RESULT_DOCUMENT, RESULT_SCHEMA
 from wbfriction.fleet.task import LogOutcome, ResultKey
-from wbfriction.logs.tables import META_KEY, with_metadata, write_json, write_table
+from wbfriction.logs.tables import META_KEY, make_folder, remove_file, with_metadata, write_json, write_table
 
 SORT = [("robot_id", "ascending"), ("start_time", "ascending"), ("log", "ascending"), ("joint", "ascending")]
 """The order :func:`read_results` gives the rows in."""
@@ -100,7 +100,7 @@ def write_part(results: Path, rows: pa.Table) -> Path:
     """Write one log's rows (one key, one robot) with the digest of its rows; the file's path."""
     key, robot_id = rows.column("key")[0].as_py(), rows.column("robot_id")[0].as_py()
     path = result_path(results, robot_id, key)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(path.parent)
     rows = rows.cast(RESULT_SCHEMA)
     write_table(with_metadata(rows, {"document": RESULT_DOCUMENT, "rows_sha256": rows_sha256(rows)}), path)
     return path
@@ -205,14 +205,18 @@ def failure_record(outcome: LogOutcome) -> dict[str, Any]:
 
 def write_outcome(results: Path, outcome: LogOutcome, replaces: tuple[Path, ...] = ()) -> None:
     """Record one log's outcome: the files of its earlier results and failures (``replaces``) removed first,
-    then its rows, or its failure record (:func:`failure_record`)."""
+    then its rows, or its failure record (:func:`failure_record`).
+
+    Raises:
+        OutputError: a file that cannot be written or removed, naming it.
+    """
     for path in replaces:
-        path.unlink(missing_ok=True)
+        remove_file(path)
     if outcome.rows is not None:
         write_part(results, outcome.rows)
         return
     failure = failure_path(results, outcome.key.key)
-    failure.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(failure.parent)
     write_json(failure, failure_record(outcome))
 
 

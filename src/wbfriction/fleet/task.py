@@ -23,7 +23,7 @@ import numpy as np
 import pyarrow as pa
 from threadpoolctl import threadpool_limits
 
-from wbfriction.exceptions import WbfrictionError
+from wbfriction.exceptions import OutputError, WbfrictionError
 from wbfriction.fleet.manifest import LogEntry
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
@@ -115,6 +115,10 @@ def process_log(entry: LogEntry, key: ResultKey, options: BatchOptions, scratch:
     Returns:
         The outcome: rows on success; else the error's one line (a
         :class:`~wbfriction.exceptions.WbfrictionError`'s message, or the exception's type and message).
+
+    Raises:
+        OutputError: a file that cannot be written (the friction table kept, the scratch folder): the
+            environment, which no other log escapes.
     """
     try:
         robot = worker_robot(entry.robot)
@@ -128,10 +132,18 @@ def process_log(entry: LogEntry, key: ResultKey, options: BatchOptions, scratch:
                                tolerance=options.energy_tolerance)
         rows = result_rows(key, fitted.fits, fitted.energy, fitted.est.qd, fitted.est.valid)
         return LogOutcome(entry, key, rows, table=table)
+    except OutputError as exc:  # the results cannot be written: no other log's either, the batch stops
+        where = table if table is not None else f"{scratch} (the friction table of {entry.log.name})"
+        raise OutputError(str(where), exc.errno, exc.reason) from None
     except WbfrictionError as exc:
-        return LogOutcome(entry, key, error=str(exc))
+        return LogOutcome(entry, key, error=one_line(str(exc)))
     except Exception as exc:  # a fault of this log must not stop the others: recorded, with its type
-        return LogOutcome(entry, key, error=f"{entry.log}: {type(exc).__name__}: {exc}")
+        return LogOutcome(entry, key, error=one_line(f"{entry.log}: {type(exc).__name__}: {exc}"))
+
+
+def one_line(text: str) -> str:
+    """A message on one line (its whitespace runs, line breaks included, as one space)."""
+    return " ".join(text.split())
 
 
 def reference_friction(fit: FitResult, v: float) -> tuple[float, float]:

@@ -455,6 +455,19 @@ def make_folder(path: str | Path) -> Path:
     return path
 
 
+def remove_file(path: str | Path) -> None:
+    """Remove an output file (nothing if there is none): an earlier output a new one replaces.
+
+    Raises:
+        OutputError: a file that cannot be removed (a read-only folder), naming it and the OS's reason.
+    """
+    path = Path(path)
+    try:
+        path.unlink(missing_ok=True)
+    except OSError as exc:
+        raise output_error(path, exc, kept=path.exists()) from exc
+
+
 def write_atomic(path: str | Path, write) -> None:
     """Write a file whole or not at all.
 
