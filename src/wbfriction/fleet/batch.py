@@ -45,7 +45,7 @@ from threadpoolctl import threadpool_limits
 from wbfriction.exceptions import ClusterError, InputError, OutputError
 from wbfriction.fleet.manifest import LogEntry, Skipped
 from wbfriction.fleet.options import BatchOptions
-from wbfriction.fleet.results import Part, failures_folder, read_parts, table_path, write_outcome
+from wbfriction.fleet.results import Part, failure_files, read_parts, table_path, write_outcome
 from wbfriction.fleet.task import LogOutcome, ResultKey, one_line, process_log, result_key, robot_sha256
 from wbfriction.logs.tables import TableFile, file_sha256, make_folder, remove_file, remove_stale_temporaries
 from wbfriction.pipeline.chunks import CHUNKS_PER_WORKER
@@ -186,7 +186,7 @@ def plan_batch(entries: list[LogEntry], results: str | Path, options: BatchOptio
             files[of].append(part.path)
             why.setdefault(of, _changes(part, keyed[of].key) if part.first("log") == str(keyed[of].entry.log)
                            else f"the same log (same bytes) as {part.first('log')}, listed at another path")
-    for path, record in _failure_records(results):
+    for path, record in failure_files(results):
         of = owner(str(record.get("log", "")), record.get("log_sha256"))
         if of is not None:
             files[of].append(path)
@@ -201,19 +201,6 @@ def plan_batch(entries: list[LogEntry], results: str | Path, options: BatchOptio
             todo.append(PlannedLog(p.entry, p.key, p.options, tuple(files[i]), why.get(i, "new")))
     copies = tuple((keyed[group[0]].entry, keyed[j].entry) for group in by_bytes.values() for j in group[1:])
     return BatchPlan(todo, skipped, tuple(stale), kept, tuple(foreign), copies)
-
-
-def _failure_records(results: Path) -> Iterator[tuple[Path, dict]]:
-    """The failure records beside ``results`` (an unreadable one is left out: the log it names is retried)."""
-    import json
-
-    for path in sorted(failures_folder(results).glob("*.json")):
-        try:
-            record = json.loads(path.read_text())
-        except (OSError, ValueError):
-            continue
-        if isinstance(record, dict):
-            yield path, record
 
 
 def check_outputs(results: Path, tables: Path | None = None) -> None:

@@ -220,7 +220,20 @@ def write_outcome(results: Path, outcome: LogOutcome, replaces: tuple[Path, ...]
     write_json(failure, failure_record(outcome))
 
 
+def failure_files(results: str | Path) -> list[tuple[Path, dict[str, Any]]]:
+    """The failure records of the batch writing ``results`` (:func:`failure_record`) with their files, in file
+    order; an unreadable one is left out (the log it names is tried again anyway)."""
+    out = []
+    for path in sorted(failures_folder(results).glob("*.json")):
+        try:
+            record = json.loads(path.read_text())
+        except (OSError, ValueError):
+            continue
+        if isinstance(record, dict):
+            out.append((path, record))
+    return out
+
+
 def read_failures(results: str | Path) -> list[dict[str, Any]]:
     """The failure records of the batch writing ``results`` (:func:`failure_record`), by log."""
-    files = sorted(failures_folder(results).glob("*.json"))
-    return sorted((json.loads(f.read_text()) for f in files), key=lambda d: d["log"])
+    return sorted((record for _, record in failure_files(results)), key=lambda d: str(d.get("log")))
