@@ -213,7 +213,8 @@ def _written_by_wbfriction(path: Path) -> str:
 
 
 def log_start_time(log: Path) -> datetime:
-    """When a log started, from its ``time`` column if that holds dates (a timestamp column).
+    """When a log started, from its ``time`` column if that holds dates (a timestamp column): its first stamp,
+    to the microsecond below (a ``datetime``'s resolution, whatever reads it).
 
     Raises:
         InputError: a ``time`` column of relative seconds (the log then needs a manifest row), or a date out of
@@ -227,10 +228,16 @@ def log_start_time(log: Path) -> datetime:
         raise InputError(f"{log}: column 'time' holds no dates ({column.type}): give the log's start_time in a "
                          "manifest")
     try:
-        first = pc.min(column).as_py()
-    except (ValueError, OverflowError) as exc:  # a date Python's datetime cannot hold
+        first = pc.min(_to_microseconds(column)).as_py()
+    except (ValueError, OverflowError, pa.ArrowInvalid) as exc:  # a date Python's datetime cannot hold
         raise InputError(f"{log}: column 'time': {exc}") from None
     return _in_range(first.replace(tzinfo=first.tzinfo or UTC).astimezone(UTC), f"{log}: column 'time'")
+
+
+def _to_microseconds(column: pa.ChunkedArray) -> pa.ChunkedArray:
+    """Timestamps to the microsecond below (a ``datetime``'s resolution: Arrow's ``as_py`` would otherwise give
+    pandas' Timestamp or a datetime by what is installed, and keys made of them would differ)."""
+    return pc.cast(column, pa.timestamp("us", tz=column.type.tz), safe=False)
 
 
 def _in_range(t: datetime, where: str) -> datetime:
@@ -255,7 +262,7 @@ def _start_times(column: pa.ChunkedArray, path: Path) -> list[datetime]:
     if pa.types.is_timestamp(column.type) and column.type.tz is None:
         raise InputError(f"{path}: column 'start_time': timestamps without a time zone (store them as UTC)")
     out = []
-    for row, value in enumerate(column.to_pylist() if pa.types.is_timestamp(column.type)
+    for row, value in enumerate(_to_microseconds(column).to_pylist() if pa.types.is_timestamp(column.type)
                                 else _text_column(column, "start_time", path)):
         where = f"{path}: row {row}, column 'start_time'"
         if isinstance(value, datetime):

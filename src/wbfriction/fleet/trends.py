@@ -344,7 +344,8 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
 def joint_trend(robot_id: str, joint: str, rows: pa.Table, options: TrendOptions = TrendOptions()) -> JointTrend:
     """One joint's series (its rows of the results, one per log, in time order) and the drifts found."""
     rows = rows.take(pc.sort_indices(rows, sort_keys=[("start_time", "ascending"), ("log", "ascending")]))
-    time = [t.astimezone(UTC) for t in rows.column("start_time").to_pylist()]
+    time = [t.astimezone(UTC) for t in pc.cast(rows.column("start_time"), pa.timestamp("us", tz="UTC"),
+                                                safe=False).to_pylist()]  # datetimes, whatever is installed
     usable = np.isin(np.array(rows.column("status").to_pylist(), dtype=object), USABLE)
     models = np.array(rows.column("model").to_pylist(), dtype=object)
     dominant = max(sorted(set(models[usable])), key=lambda m: int(np.sum(models[usable] == m)), default=None)
