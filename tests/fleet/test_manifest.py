@@ -155,3 +155,19 @@ def test_a_scanned_log_dated_beyond_2262_is_refused(tmp_path):
     pq.write_table(pa.table({"time": t}), tmp_path / "r1" / "x.parquet")
     with pytest.raises(InputError, match=r"x.parquet: column 'time': 2300-01-01T00:00:00\+00:00 is out of range"):
         scan_folder(tmp_path, RobotSpec("talos"))
+
+
+def test_a_start_time_is_a_datetime_to_the_microsecond_below(tmp_path):
+    """Nanosecond stamps: the start time is a plain datetime floored to the microsecond, whatever is installed
+    (Arrow gives pandas' Timestamp where pandas is, and a key made of it would differ by machine)."""
+    from wbfriction.fleet.manifest import log_start_time
+
+    ns = 1_460_034_856_877_161_999
+    pq.write_table(pa.table({"time": pa.array([ns, ns + 5_000_000], pa.timestamp("ns", tz="UTC"))}),
+                   tmp_path / "x.parquet")
+    t = log_start_time(tmp_path / "x.parquet")
+    assert type(t) is datetime and t == datetime(2016, 4, 7, 13, 14, 16, 877161, tzinfo=UTC)
+    pq.write_table(pa.table({"log": ["x.parquet"], "robot_id": ["r"], "start_time": pa.array([ns], pa.timestamp(
+        "ns", tz="UTC")), "robot": ["talos"]}), tmp_path / "m.parquet")
+    (entry,) = read_manifest(tmp_path / "m.parquet")
+    assert type(entry.start_time) is datetime and entry.start_time == t
