@@ -85,10 +85,10 @@ evaluation limit is not a minimum, and the gate is what keeps its result honest.
 factorizations, the SVDs of the non-linear solve's steps and the long products differently from one
 thread, and round differently: on a TALOS walk the compressed regressor's factor moved by 7 % of its
 largest entry (in the rows of the dependent columns, which rounding sets), the pivoting chose other
-columns among near ties and the non-linear solve, stopped at its evaluation limit, ended 1 % apart, so
-that the URDF and the JSON differed with the thread count. :func:`identify_inertia` therefore runs on one
-BLAS thread (``threadpoolctl``); on 2 cores that is also no slower (the blocks are small: the
-``benchmarks/bench_identify.py`` figures). The figures that rounding alone would set are taken where
+columns among near ties and the fit before the gate ended up to 1.7 % apart, so that the URDF and the
+JSON differed with the thread count. :func:`identify_inertia` therefore runs on one BLAS thread
+(``threadpoolctl``); on a shared 2-core machine that was also several times faster
+(``benchmarks/bench_identify.py --blas``). The figures that rounding alone would set are taken where
 they do not depend on it: the residual over the base parameters, the condition number of the
 identifiable part (:mod:`~wbfriction.inertia.least_squares`), and no information for a parameter
 that acts only with others (:func:`~wbfriction.inertia.excitation.unexcited_parameters`).
