@@ -10,9 +10,9 @@ dependent columns. The smallest residual over all columns (:attr:`CompressedLeas
 is therefore a figure of the rounding (the BLAS thread count changed it by 0.5 % on a TALOS walk) and
 too small (by 5 % on that walk's rows and 14 % on a simulated Panda's, without a Stribeck term); the one
 over the base parameters (:meth:`CompressedLeastSquares.residual`) is that of a well-posed problem, the
-same to 1e-12 whatever the rounding and equal to the stacked rows' least squares. For the same reason the condition number is
-that of the identifiable part (:class:`BaseParameters`), not of the columns the pivoting chose among
-near ties.
+same to 1e-12 whatever the rounding and equal to the stacked rows' least squares. For the same reason
+the condition number is that of the identifiable part (:class:`BaseParameters`), not of the columns
+the pivoting chose among near ties.
 """
 
 from __future__ import annotations
