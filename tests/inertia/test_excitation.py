@@ -36,6 +36,7 @@ def test_dependent_and_silent_parameters_are_named_with_their_partners():
     assert set(found) == {"a", "c"}
     assert found["c"].partners == {} and found["c"].information == 0.0
     assert found["a"].partners == {"b": pytest.approx(-0.5)}
+    assert found["a"].information == 0.0  # it acts only with b: no information of its own, not rounding's
     # the definition: moving a by 1 and b by its coefficient leaves every torque unchanged
     assert np.abs(A[:, 10] + found["a"].partners["b"] * A[:, 11]).max() < 1e-12
     assert np.allclose(physical_std(prior)[10:], 1.0)

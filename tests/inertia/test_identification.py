@@ -25,7 +25,7 @@ from wbfriction.inertia.consistency import (
     prior_model,
     regularised_problem,
 )
-from wbfriction.inertia.identification import identify_inertia, log_samples
+from wbfriction.inertia.identification import identify_inertia, log_samples, residual_variance
 from wbfriction.inertia.least_squares import CompressedLeastSquares, base_parameters
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import act_matrix, body_parameters, stance_regressor
@@ -110,6 +110,57 @@ def test_compressed_least_squares_and_base_parameters():
     expected = np.array([x[0] + x[4], x[1] + 2.0 * x[4], x[2], x[3]])
     assert np.allclose(base.combination @ x, expected, atol=1e-9)
     assert np.allclose(base.combination @ ref, expected, atol=1e-2)
+
+
+def _dependent_rows(rng: np.random.Generator, n: int, p: int, dependent: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rows (n, p) whose last ``dependent`` columns are combinations of the others, scaled over three
+    orders of magnitude (as a body's mass, first moments and inertias), and noisy right-hand sides."""
+    A = rng.normal(size=(n, p)) * np.logspace(0, -3, p)
+    for k in range(dependent):
+        A[:, p - 1 - k] = A[:, :p - dependent] @ rng.normal(size=p - dependent)
+    return A, A @ rng.normal(size=p) + rng.normal(0.0, 0.1, n)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), block=st.integers(8, 500), dependent=st.integers(1, 4))
+def test_residual_variance_is_the_base_parameters_whatever_the_blocks(seed, block, dependent):
+    """Issue 37: the residual variance is that of the stacked rows' least squares over the base parameters
+    (per row beyond them), however the rows were added. (The smallest residual over every column is not:
+    each block hands a rounding-chosen share of its residual to the dependent columns.)"""
+    rng = np.random.default_rng(seed)
+    n, p = 1500, 9
+    A, b = _dependent_rows(rng, n, p, dependent)
+    ls = CompressedLeastSquares(p)
+    for k in range(0, n, block):
+        ls.add(A[k:k + block], b[k:k + block])
+    base = base_parameters(ls.R)
+    assert base.count == p - dependent
+    independent = A[:, base.independent]
+    r = b - independent @ np.linalg.lstsq(independent, b, rcond=None)[0]
+    assert residual_variance(ls, base) == pytest.approx(float(r @ r) / (n - base.count), rel=1e-9)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), order=st.permutations(range(7)))
+def test_condition_is_the_identifiable_parts_whichever_columns_are_chosen(seed, order):
+    """The condition number does not depend on which columns the pivoting chooses among dependent ones
+    (their order here): it is the identifiable part's, the scaled regressor's largest singular value over
+    its rank-th."""
+    rng = np.random.default_rng(seed)
+    A, b = _dependent_rows(rng, 400, 7, 2)
+    reference = base_parameters(CompressedLeastSquares(7).R)  # nothing added: rank 0
+    assert reference.count == 0 and reference.condition == np.inf
+    conditions = []
+    for columns in (np.arange(7), np.array(order)):
+        ls = CompressedLeastSquares(7)
+        ls.add(A[:, columns], b)
+        base = base_parameters(ls.R)
+        assert base.count == 5
+        conditions.append(base.condition)
+    scaled = A / np.linalg.norm(A, axis=0)
+    s = np.linalg.svd(scaled, compute_uv=False)
+    assert conditions[0] == pytest.approx(s[0] / s[4], rel=1e-9)
+    assert conditions[1] == pytest.approx(conditions[0], rel=1e-9)
 
 
 def _slow_joint(body: pin.Inertia, seed: int, triangle: bool):

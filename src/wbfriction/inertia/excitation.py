@@ -35,7 +35,8 @@ class Unexcited:
         parameter: ``<body>.<name>`` (:data:`~wbfriction.inertia.consistency.PHYSICAL`, about the
             body's centre of mass) or ``<joint>.<friction parameter>`` / ``<joint>.armature``.
         information: the pivot ``r_kk / sqrt(weight)``: the data's information on it relative to
-            the prior's (0: no effect on the torques at all).
+            the prior's (0: no effect on the torques of its own: none at all, or only with its partners,
+            a pivot below the rank tolerance, whose value rounding alone would set).
         partners: the parameters the data cannot tell it from, with the change of each per unit
             change of ``parameter`` (physical units; empty: it has no effect on its own).
     """
@@ -64,7 +65,8 @@ def unexcited_parameters(R: np.ndarray, prior: Prior, weight: float, names: tupl
         R: the compressed regressor (p, p) over ``x = (pi.ravel(), rest)`` (its triangular factor).
         prior: the prior of the fit; weight: its weight in the fit.
         names: :func:`parameter_names` (p,).
-        rank_tolerance: pivots below this share of the largest count as zero whatever the weight.
+        rank_tolerance: pivots below this share of the largest count as zero whatever the weight
+            (information 0: a parameter that acts only with others).
 
     Returns:
         One :class:`Unexcited` per parameter not determined, in the order of ``names``.
@@ -82,6 +84,7 @@ def unexcited_parameters(R: np.ndarray, prior: Prior, weight: float, names: tupl
     for c, j in enumerate(perm[rank:]):
         order = [r for r in np.argsort(-np.abs(K[:, c])) if abs(K[r, c]) >= PARTNER_SHARE]
         partners = {names[ind[r]]: float(-K[r, c] * std[ind[r]] / std[j]) for r in order}
-        info = float(diag[rank + c] / np.sqrt(weight)) if weight > 0 else float("inf")
+        pivot = diag[rank + c] if diag[rank + c] > rank_tolerance * diag[0] else 0.0  # below: rounding's
+        info = float(pivot / np.sqrt(weight)) if weight > 0 else float("inf")
         out.append((j, Unexcited(names[j], info, partners)))
     return tuple(u for _, u in sorted(out, key=lambda ju: ju[0]))

@@ -46,7 +46,8 @@ inequalities hold). A Gaussian prior pulls the model toward the given one where 
 little: its standard deviations are stated on each body's mass, centre of mass and rotational
 inertia about the centre of mass, and on each joint's armature and friction
 (:class:`~wbfriction.inertia.consistency.PriorUncertainty`). Its weight is ``prior`` times the
-residual variance of the data (the least-squares residual per row of the unregularised fit):
+residual variance of the data (the least-squares residual per row of the unregularised fit over the base
+parameters, :func:`residual_variance`):
 ``prior = 1`` is the posterior of independent residuals; correlated ones (neighbouring samples, a
 model error) count less, a larger ``prior``. (A prior scaled per parameter about the joint frame,
 and weighted by ``1e-9`` of the largest squared singular value, let a real arm's masses carry
@@ -79,6 +80,18 @@ joint more than 5 % worse: :mod:`~wbfriction.inertia.validation`); the other lim
 friction (and armature) is the one that best explains the training data with the inertias kept. The
 solver's stopping message is translated (:mod:`~wbfriction.friction.solver`): a solve stopped at its
 evaluation limit is not a minimum, and the gate is what keeps its result honest.
+
+**Same bytes whatever the BLAS thread count** (issue 37). OpenBLAS's threads split the blocked QR
+factorizations, the SVDs of the non-linear solve's steps and the long products differently from one
+thread, and round differently: on a TALOS walk the compressed regressor's factor moved by 7 % of its
+largest entry (in the rows of the dependent columns, which rounding sets), the pivoting chose other
+columns among near ties and the fit before the gate ended up to 1.7 % apart, so that the URDF and the
+JSON differed with the thread count. :func:`identify_inertia` therefore runs on one BLAS thread
+(``threadpoolctl``); on a shared 2-core machine that was also several times faster
+(``benchmarks/bench_identify.py --blas``). The figures that rounding alone would set are taken where
+they do not depend on it: the residual over the base parameters, the condition number of the
+identifiable part (:mod:`~wbfriction.inertia.least_squares`), and no information for a parameter
+that acts only with others (:func:`~wbfriction.inertia.excitation.unexcited_parameters`).
 """
 
 from __future__ import annotations
@@ -89,6 +102,7 @@ from typing import Literal
 
 import numpy as np
 import pinocchio as pin
+from threadpoolctl import threadpool_limits
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import resolve_differentiation
@@ -169,7 +183,8 @@ class InertialIdentification:
             identified [kg·m^2] (n_tc,) (zeros with ``"none"``).
         unexcited: the parameters the data do not determine beyond the prior
             (:func:`~wbfriction.inertia.excitation.unexcited_parameters`).
-        residual_std: RMS residual per row of the unregularised least squares [N·m] (the prior's unit).
+        residual_std: RMS residual per row of the unregularised least squares over the base parameters
+            [N·m] (the prior's unit; :func:`residual_variance`).
         acceleration_noise: per torque-controlled joint, the share of its acceleration's power (as
             differentiated) above a quarter of the sampling rate (n_tc,). Noise in the accelerations
             is noise in the regressor: least squares then shrinks every inertia toward zero (errors
@@ -364,13 +379,15 @@ def _rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int, options:
     return Y, C, b
 
 
-def residual_variance(system: CompressedLeastSquares) -> float:
-    """The residual variance per row of the unregularised least squares [N·m^2]: its smallest
-    residual over the rows left after the parameters (at least 1e-12 of the mean square right-hand side)."""
+def residual_variance(system: CompressedLeastSquares, base: BaseParameters) -> float:
+    """The residual variance per row of the unregularised least squares [N·m^2]: the smallest residual
+    over the base parameters ``base`` of ``system`` (:func:`~wbfriction.inertia.least_squares.base_parameters`;
+    :meth:`~wbfriction.inertia.least_squares.CompressedLeastSquares.residual`: not a figure of the rounding)
+    over the rows left after them (at least 1e-12 of the mean square right-hand side)."""
     if system.rows == 0:
         return 0.0
     total = float(system.z @ system.z) + system.residual_floor
-    return max(system.residual_floor / max(system.rows - system.n, 1), 1e-12 * total / system.rows)
+    return max(system.residual(base.independent) / max(system.rows - base.count, 1), 1e-12 * total / system.rows)
 
 
 def friction_scale(robot: Robot, torque_rms: np.ndarray, k: int) -> np.ndarray:
@@ -421,7 +438,16 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
 
     Raises:
         InputError: no single-support sample to learn from, or none held out.
+
+    Runs on one BLAS thread (module docstring, *Same bytes*): the result does not depend on the thread count.
     """
+    with threadpool_limits(1, user_api="blas"):
+        return _identify_inertia(robot, log, estimate_options, options, progress, shared)
+
+
+def _identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions, options: InertialOptions,
+                      progress: Progress | None, shared: LogSamples | None) -> InertialIdentification:
+    """:func:`identify_inertia`, on the BLAS threads it was given."""
     if shared is None:
         shared = log_samples(robot, log, estimate_options, options)
     elif not shared.matches(robot, log, estimate_options, options):
@@ -453,14 +479,14 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
         if fitting.rows == 0 or validating.rows == 0:
             raise InputError(f"{log.source}: too few single-support samples to choose the prior by validation "
                              "(give one)")
-        variance = residual_variance(fitting)
+        variance = residual_variance(fitting, base_parameters(fitting.R, options.rank_tolerance))
         for weight in sorted(PRIOR_GRID, reverse=True):  # strong to weak
             trial = fit_consistent(fitting.R, fitting.z, prior_of, weight * variance, lower, options.min_mass)
             scores[weight] = validating.rms(trial.x)
             if scores[weight] > min(scores.values()):
                 break  # past the best weight: weaker priors only fit the noise more closely
         prior = min(scores, key=scores.__getitem__)
-    variance = residual_variance(total)
+    variance = residual_variance(total, base)
     fit = fit_consistent(R, z, prior_of, prior * variance, lower, options.min_mass)
     bodies = tuple(robot.model.names[1:])
     groups = limbs(robot.model)
