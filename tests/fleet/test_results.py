@@ -4,6 +4,7 @@ checked when read back (a damaged one found, named, recomputed), each robot's lo
 from __future__ import annotations
 
 import shutil
+from datetime import timedelta
 from pathlib import Path
 
 import pyarrow as pa
@@ -120,3 +121,21 @@ def test_the_earlier_layout_is_refused_with_one_line(tmp_path):
     (tmp_path / "robot_id=r1").mkdir()
     with pytest.raises(Exception, match=r"results of an earlier wbfriction \(robot_id=<id> folders\)"):
         read_results(tmp_path)
+
+
+def test_a_robots_log_saved_twice_counts_once(tmp_path, synthetic_results):
+    """Issue 37: the same data saved again under another name gave trends a second point of the same log."""
+    parts = synthetic_results(tmp_path / "results", 3)
+    table = pq.read_table(parts[1]).replace_schema_metadata(None)
+    again = table.set_column(table.schema.get_field_index("log"), "log", pa.array(["/logs/r1/again.parquet"] * 2))
+    again = again.set_column(again.schema.get_field_index("key"), "key", pa.array(["r1-again"] * 2))
+    again = again.set_column(again.schema.get_field_index("start_time"), "start_time",
+                             pc.add(again.column("start_time"), pa.scalar(timedelta(hours=1))))
+    from wbfriction.fleet.results import write_part
+
+    write_part(tmp_path / "results", again)  # the same bytes (log_sha256) as log 1, an hour later
+    dataset = read_results(tmp_path / "results")
+    assert dataset.table.num_rows == 3 * 2 and "/logs/r1/again.parquet" not in dataset.table.column("log").to_pylist()
+    (left,) = dataset.left_out
+    assert left.path.name == "r1-again.parquet"
+    assert left.reason == "the log /logs/r1/again.parquet has the same bytes as /logs/r1/1.parquet: counted once"
