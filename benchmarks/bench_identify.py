@@ -20,7 +20,7 @@ from threadpoolctl import threadpool_info, threadpool_limits
 
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.inertia.closed_loop import identify
-from wbfriction.inertia.identification import _identify_inertia, identify_inertia, log_samples
+from wbfriction.inertia.identification import identify_inertia, log_samples
 from wbfriction.inertia.sensitivity import scaled_robot
 from wbfriction.model.loading import load_robot
 from wbfriction.sim import simulate_ideal
@@ -75,7 +75,7 @@ def main() -> None:
 
 def blas_cost(robot, log, v_s, joints) -> None:
     """The last pass's identification, on one BLAS thread (as it runs) and on every thread available
-    (``_identify_inertia``: the same work without its thread limit); the log's split shared, made once."""
+    (``blas_threads=None``); the log's split shared, made once."""
     from dataclasses import replace
 
     from wbfriction.friction.estimate import resolve_differentiation
@@ -88,7 +88,8 @@ def blas_cost(robot, log, v_s, joints) -> None:
     most = max(int(p["num_threads"]) for p in threadpool_info() if p["user_api"] == "blas")
     runs = {"1 BLAS thread": lambda: identify_inertia(robot, log, estimate, options, shared=shared)}
     with threadpool_limits(most, user_api="blas"):
-        runs[f"{most} BLAS threads"] = lambda: _identify_inertia(robot, log, estimate, options, None, shared)
+        runs[f"{most} BLAS threads"] = lambda: identify_inertia(robot, log, estimate, options, shared=shared,
+                                                                       blas_threads=None)
         for label, run in runs.items():
             wall, cpu = time.perf_counter(), time.process_time()
             run()

@@ -199,3 +199,33 @@ def test_leaving_a_map_early_ends_at_once_without_a_thread_traceback(context, tm
         pytest.fail(f"still running 20 s after it started (interrupted after 1 s): {err}")
     assert (proc.returncode, out, err) == (0, "stopped\n", "")
     assert time.monotonic() - t0 < 10.0
+
+
+def test_a_dask_worker_drops_only_the_finalizer_failure_of_a_client_whose_loop_closed():
+    """An interrupted batch's worker (issue 37): the ``IOLoop is closed`` failure of a
+    ``distributed.Client`` finalizer is not printed; any other unraisable exception still is, a
+    ``Client.__del__`` failing otherwise included."""
+    from types import SimpleNamespace
+
+    from distributed import Client
+
+    from wbfriction.workers import dask_setup
+
+    seen: list[object] = []
+    previous = sys.unraisablehook
+    sys.unraisablehook = seen.append
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, [])
+    handlers = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    try:
+        dask_setup(None)
+        closed = SimpleNamespace(object=Client.__del__, exc_value=RuntimeError("IOLoop is closed"))
+        other_error = SimpleNamespace(object=Client.__del__, exc_value=RuntimeError("something else"))
+        other_object = SimpleNamespace(object=len, exc_value=RuntimeError("IOLoop is closed"))
+        for unraisable in (closed, other_error, other_object):
+            sys.unraisablehook(unraisable)
+    finally:
+        sys.unraisablehook = previous
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
+    assert seen == [other_error, other_object]

@@ -116,6 +116,23 @@ def dask_setup(worker: object) -> None:
     do (a Ctrl-C, which the terminal sends to every process of the job, does not make each Dask
     worker print a ``KeyboardInterrupt`` traceback)."""
     _leave_signals_to_parent()
+    sys.unraisablehook = _quiet_closed_loop_clients(sys.unraisablehook)
+
+
+def _quiet_closed_loop_clients(hook: Callable[[Any], object]) -> Callable[[Any], object]:
+    """``hook`` less the one finalizer failure an interrupted Dask worker meets: a task still running
+    when its worker closed (a thread cannot be stopped) asks for the worker's client
+    (``distributed.get_client``) after the worker's event loop has closed; that client's finalizer,
+    run as the process ends, then fails with ``RuntimeError: IOLoop is closed`` and would print a
+    traceback (the client has nothing left to close: its loop is gone)."""
+    from distributed import Client
+
+    def quiet(unraisable: Any) -> None:
+        if not (getattr(unraisable.object, "__qualname__", None) == Client.__del__.__qualname__
+                and isinstance(unraisable.exc_value, RuntimeError) and "IOLoop is closed" in str(unraisable.exc_value)):
+            hook(unraisable)
+
+    return quiet
 
 
 DASK_PRELOAD = __name__

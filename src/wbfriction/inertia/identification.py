@@ -416,7 +416,8 @@ def _prior(robot: Robot, pi0: np.ndarray, friction0: np.ndarray, torque_rms: np.
 
 def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions = EstimateOptions(),
                      options: InertialOptions = InertialOptions(),
-                     progress: Progress | None = None, shared: LogSamples | None = None) -> InertialIdentification:
+                     progress: Progress | None = None, shared: LogSamples | None = None,
+                     blas_threads: int | None = 1) -> InertialIdentification:
     """Identify every body's inertial parameters, the joints' Coulomb, viscous and offset friction
     and, if asked, their armature from a log with single-support stretches (a walk) or of a fixed-base
     robot (module docstring), starting from and regularised toward ``robot``'s model.
@@ -430,6 +431,9 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
         progress: optional callable receiving numbers of samples done.
         shared: the log's samples shared with other identifications of the same log and given model
             (:func:`log_samples`: the closed loop's passes); None: split here.
+        blas_threads: the BLAS threads the solves run on: 1 (module docstring, *Same bytes*: the result
+            does not depend on the machine), or None: as many as the process has (faster on a large
+            model; the last digits, and a limb's validation near its threshold, may then depend on them).
 
     Returns:
         :class:`InertialIdentification`: its ``robot``/``pi``/``friction`` are the validated model's (the
@@ -439,15 +443,10 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
     Raises:
         InputError: no single-support sample to learn from, or none held out.
 
-    Runs on one BLAS thread (module docstring, *Same bytes*): the result does not depend on the thread count.
     """
-    with threadpool_limits(1, user_api="blas"):
-        return _identify_inertia(robot, log, estimate_options, options, progress, shared)
-
-
-def _identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions, options: InertialOptions,
-                      progress: Progress | None, shared: LogSamples | None) -> InertialIdentification:
-    """:func:`identify_inertia`, on the BLAS threads it was given."""
+    if blas_threads is not None:
+        with threadpool_limits(blas_threads, user_api="blas"):
+            return identify_inertia(robot, log, estimate_options, options, progress, shared, None)
     if shared is None:
         shared = log_samples(robot, log, estimate_options, options)
     elif not shared.matches(robot, log, estimate_options, options):
