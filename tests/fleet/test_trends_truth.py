@@ -212,6 +212,16 @@ def test_the_p_value_counts_the_first_thousand_noise_series_then_stops_at_twenty
     assert null_p_value(P_TIMES, P_SE, np.inf, ONE) == pytest.approx(1 / 2001, rel=1e-12)
 
 
+def test_a_noise_series_that_equals_the_statistic_reaches_it():
+    """Ties count as reaching: the statistic set to exactly the 20th largest of the first thousand noise series'
+    maxima (computed from the same draws as the p-value draws them) stops at the first pass."""
+    rng = np.random.default_rng(0)
+    noise = P_SE[:, None] * rng.standard_normal((P_TIMES.size, 1000))
+    _, F, _ = hinge_scan(P_TIMES, noise, P_SE, 3, 3)
+    twentieth = float(np.sort(F.max(axis=0))[::-1][19])
+    assert null_p_value(P_TIMES, P_SE, twentieth, ONE) == pytest.approx(21 / 1001, rel=1e-12)
+
+
 def test_the_p_value_draws_the_rest_in_blocks_and_follows_the_seed():
     """Past the first pass the series come in blocks of at most 50 000 (here 1000, 50 000, then the 9000 left)."""
     options = TrendOptions(alpha=0.05, quantities=("F_c",), replicates=60_000, seed=5)
