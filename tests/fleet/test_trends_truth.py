@@ -15,7 +15,15 @@ from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
 from wbfriction.fleet.schema import RESULT_SCHEMA
-from wbfriction.fleet.trends import TrendOptions, detect_change, fleet_trends, hinge_scan, joint_trend, null_p_value
+from wbfriction.fleet.trends import (
+    QUANTITIES,
+    TrendOptions,
+    detect_change,
+    fleet_trends,
+    hinge_scan,
+    joint_trend,
+    null_p_value,
+)
 
 T0 = datetime(2026, 1, 1, tzinfo=UTC)
 ONE = TrendOptions(alpha=0.05, quantities=("F_c",), replicates=2000)
@@ -119,6 +127,19 @@ def test_the_best_hinge_its_change_and_standard_error(data, gap):
         assert cp.relative == pytest.approx(ref["change"] / abs(ref["baseline"]), rel=1e-6, abs=1e-12)
     else:
         assert np.isnan(cp.relative)
+
+
+def test_three_points_one_degree_of_freedom():
+    """The residual scale phi is the weighted RSS over n - 2, down to n = 3 (one onset either side)."""
+    t = np.array([0.0, 1.0, 2.0])
+    y = np.array([1.0, 1.02, 1.5])
+    se = np.full(3, 0.01)
+    options = TrendOptions(alpha=0.05, quantities=("F_c",), replicates=2000, min_points=3, min_before=1,
+                           min_after=1)
+    cp = detect_change(days(t), y, se, "F_c", options)
+    ref = reference_change(t, y, se, 1, 1)
+    assert cp is not None and cp.onset == ref["onset"]
+    assert cp.change_se == pytest.approx(ref["change_se"], rel=1e-6)
 
 
 @pytest.mark.parametrize("sigmas, told", [(2.5, True), (1.5, False), (-2.5, True), (-1.5, False)])
@@ -277,6 +298,7 @@ def test_the_points_of_a_series():
     # sorted by time, then path: log9/log8 share day 0 -> log8 first, and so on
     expected = [1, 0, 3, 2, 5, 4, 7, 6, 9, 8]
     assert joint.series["F_c"].time == [rows[i]["start_time"] for i in expected]
+    assert [(q, s.quantity) for q, s in joint.series.items()] == [(q, q) for q in QUANTITIES]
     used_f_c = [i in (0, 1, 2, 9) for i in expected]  # 3-4 not usable, 5 se 0, 6-7 another model, 8 se inf
     used_f_at = [i in (0, 1, 2, 6, 7, 9) for i in expected]
     assert joint.series["F_c"].used.tolist() == used_f_c
