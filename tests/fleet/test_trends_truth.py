@@ -499,6 +499,27 @@ def test_untested_joints_are_counted_apart():
     assert trends.to_table().num_rows == 3
 
 
+def test_the_table_has_its_columns_and_types_when_nothing_was_tested():
+    options = TrendOptions(alpha=0.01, quantities=("F_c",), replicates=2000)
+    full = fleet_trends(results_table(fleet_rows()), options).to_table()
+    empty = fleet_trends(results_table(fleet_rows()[:5]), options).to_table()  # 5 logs: no test
+    assert empty.num_rows == 0 and full.num_rows == 4 and empty.schema == full.schema
+
+
+def test_an_offset_without_coulomb_points_is_measured_against_its_own_baseline():
+    """With F_c not followed, or without a point, tau_os's relative change is over its own fitted baseline
+    (here 1 N·m, told from zero)."""
+    rows = drift_rows()
+    for r in rows:
+        r.update(tau_os=r["tau_os"] + 1.0, F_c=np.nan)
+    tau = np.array([r["tau_os"] for r in rows])
+    ref = reference_change(np.arange(20.0), tau, np.full(20, 0.04))
+    for quantities in (("F_c", "tau_os"), ("tau_os",)):
+        options = TrendOptions(alpha=0.05, quantities=quantities, replicates=2000)
+        cp = joint_trend("r", "j", results_table(rows), options).tests["tau_os"]
+        assert cp.relative == pytest.approx(ref["change"] / abs(ref["baseline"]), rel=1e-9), quantities
+
+
 def test_a_table_missing_one_column_is_refused_naming_it():
     table = results_table(drift_rows())
     with pytest.raises(InputError, match="not a fleet's results: no column 'version'"):
