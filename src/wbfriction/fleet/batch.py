@@ -295,8 +295,8 @@ def run_batch(entries: list[LogEntry], results: str | Path, options: BatchOption
     with _cluster_client(engine, scheduler, client) as connected:
         plan = plan_batch(entries, results, options)
         make_folder(results)
-        for folder in [results, *(p for p in results.iterdir() if p.is_dir())]:
-            remove_stale_temporaries(folder)  # those a killed batch left
+        for folder in [results, *(p for p in results.iterdir() if p.is_dir()), failures_folder(results)]:
+            remove_stale_temporaries(folder)  # those a killed batch left (a failure record half written too)
         for s in plan.stale:
             remove_file(s.path)
         failed: list[tuple[LogEntry, str]] = []
