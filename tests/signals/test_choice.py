@@ -159,6 +159,30 @@ def test_savgol_cutoff_matches_schafer_and_scipy():
             assert schafer_window(f3, order, DT) == pytest.approx(window, rel=0.15)
 
 
+def legendre_smoother(window: int, order: int) -> np.ndarray:
+    """The least-squares smoother's kernel (value at the centre), through an independent route: the
+    pseudo-inverse (SVD) of a Legendre Vandermonde matrix on [-1, 1]."""
+    x = np.linspace(-1.0, 1.0, window)
+    return np.polynomial.legendre.legvander(np.zeros(1), order)[0] @ np.linalg.pinv(
+        np.polynomial.legendre.legvander(x, order))
+
+
+def test_log_stamped_one_microsecond_apart_gets_a_choice_and_its_true_cutoff():
+    """Issue 37: noisy positions stamped 1 us apart (the shortest step read as seconds) need the
+    longest window; ``--diff auto`` then died in brentq (a ValueError traceback) on that window's
+    -3 dB frequency. The choice says the target is not reached, and its -3 dB frequency is that of the
+    true least-squares smoother."""
+    dt, n = 1e-6, 3000
+    t = np.arange(n) * dt
+    q = 0.1 * np.sin(2 * np.pi * 1000.0 * t)[:, None] + np.random.default_rng(1).normal(0.0, 1e-4, (n, 1))
+    choice = choose_differentiation(q, dt)
+    assert choice.scheme == "savgol" and not choice.reached and "the most filtering allowed" in choice.reason
+    window = choice.filtering.window
+    assert window == n - 1  # the longest odd window: 1e-4 rad at 1 MHz is far above the target
+    w, h = freqz(legendre_smoother(window, 4), worN=2**16, fs=1 / dt)
+    assert choice.filter_cutoff == pytest.approx(w[np.argmax(np.abs(h) < 1 / math.sqrt(2))], rel=2e-3)
+
+
 def test_savgol_window_is_the_nearest():
     for cutoff in (3.0, 10.0, 33.0):
         w = savgol_window(cutoff, 4, DT)
