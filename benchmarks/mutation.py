@@ -125,6 +125,12 @@ def _diff_sites(a: object, b: object, chain: Chain = ()) -> Iterator[Chain]:
         x, y = getattr(a, name, None), getattr(b, name, None)
         if isinstance(x, list) and isinstance(y, list):
             if len(x) != len(y):
+                if name == "keywords":  # a keyword argument removed: the place is that keyword
+                    kept = {k.arg for k in (x if len(x) < len(y) else y)}
+                    for i, k in enumerate(x if len(x) > len(y) else y):
+                        if k.arg not in kept:
+                            yield (*chain, (a, name, i), (k, "value", None))
+                    continue
                 yield (*chain, (a, name, None))
                 continue
             for i, (u, v) in enumerate(zip(x, y)):
