@@ -240,15 +240,11 @@ def _function_of(name: str) -> str:
 def dump_mutants(out: Path) -> None:
     """Run in the copy (its ``pyproject.toml`` configures mutmut): every mutant's name, status, original
     and mutated function, as mutmut's ``results --all`` and ``show`` read them, into ``out`` (JSON)."""
+    import difflib
+
     import libcst as cst
     from mutmut.mutation.data import SourceFileMutationData
-    from mutmut.mutation.diff_apply import (
-        get_diff_for_mutant,
-        read_functions_from_index,
-        read_mutant_function,
-        read_mutants_module,
-        read_original_function,
-    )
+    from mutmut.mutation.diff_apply import read_mutant_function, read_mutants_module, read_original_function
     from mutmut.stats import status_by_exit_code
     from mutmut.utils.file_utils import walk_mutatable_files
 
@@ -257,14 +253,14 @@ def dump_mutants(out: Path) -> None:
         data = SourceFileMutationData(path=path)
         data.load()
         module = str(path).split("src/wbfriction/", 1)[-1]
+        tree = read_mutants_module(path)  # parsed once: mutmut's ``show`` parses it for every mutant
         for name, code in data.exit_code_by_key.items():
-            functions = read_functions_from_index(name, path)
-            if functions is None:
-                tree = read_mutants_module(path)
-                functions = (read_original_function(tree, name), read_mutant_function(tree, name))
-            original, mutant = (cst.Module([f]).code for f in functions)
+            original, mutant = (cst.Module([f]).code.strip() for f in (read_original_function(tree, name),
+                                                                       read_mutant_function(tree, name)))
+            diff = "\n".join(difflib.unified_diff(original.split("\n"), mutant.split("\n"), fromfile=str(path),
+                                                  tofile=str(path), lineterm=""))
             records.append(dict(name=name, module=module, status=status_by_exit_code[code], original=original,
-                                mutant=mutant, diff=get_diff_for_mutant(name, path=path)))
+                                mutant=mutant, diff=diff))
     out.write_text(json.dumps(records))
 
 
