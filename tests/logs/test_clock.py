@@ -5,6 +5,8 @@ uniformly."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pyarrow as pa
 import pytest
@@ -403,6 +405,14 @@ def test_regularise_exact_segments_and_late_stamps():
     assert abs(line - period) > 10 * abs(p - period)  # the premise: least squares is tilted
 
 
+def test_regularise_segments_of_one_row():
+    """Every segment a single row: no slope to fit within one; the period is the median step and each
+    row keeps its stamp."""
+    t = np.array([0.0, 0.01, 0.03, 0.04, 0.05])
+    t_reg, p = regularise(t, [(k, k + 1) for k in range(5)])
+    assert p == pytest.approx(0.01) and np.allclose(t_reg, t, rtol=0, atol=1e-15)
+
+
 def test_roughness_by_its_definition():
     """RMS of the increments of the second divided differences, over every segment of at least four
     rows: 0 for a quadratic on any steps; ``6 h`` for t^3 on steps h (its second difference is 6 t)."""
@@ -414,6 +424,9 @@ def test_roughness_by_its_definition():
     q = (t**3)[:, None]
     segments = [(0, 3), (3, 7), (7, 40)]  # 3 rows: no increment; 4 rows: one
     assert roughness(t, q, segments) == pytest.approx(6 * h, rel=1e-6)
+    wide = np.r_[t[:3], t[3:7] * 2.0 - t[3], t[7:] + 3 * h]  # the 4-row segment on steps of 2 h: its increment 12 h
+    expected = math.sqrt((30 * (6 * h) ** 2 + (12 * h) ** 2) / 31)
+    assert roughness(wide, (wide**3)[:, None], segments) == pytest.approx(expected, rel=1e-6)
     assert roughness(t, q, [(0, 7)]) == pytest.approx(6 * h, rel=1e-6)
     assert np.isnan(roughness(t, q, [(0, 3), (3, 6)]))
     assert roughness(t, q[:20], segments) == pytest.approx(6 * h, rel=1e-6)  # positions of the first rows only
