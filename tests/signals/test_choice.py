@@ -340,13 +340,13 @@ def test_savitzky_golay_options_are_kept_and_measured_with_their_weights():
 def test_butterworth_the_lowest_cutoff_when_no_cutoff_meets_the_target():
     """Noise of 0.1 rad: even the lowest cutoff (the spectrum's resolution, 1 Hz) leaves more than the
     target; that cutoff, said."""
-    choice = choose_differentiation(sines(8.0, sigma=0.1, a0=2.0), DT, prefer="butterworth")
-    assert choice.filtering == FilterOptions(cutoff=1.0, butter_order=6) and not choice.reached
-    assert choice.noise_left == pytest.approx(choice.position_noise * butterworth_noise_gain(1.0, 6, DT))
+    choice = choose_differentiation(sines(8.0, sigma=0.1, a0=2.0), DT, prefer="butterworth", butter_order=4)
+    assert choice.filtering == FilterOptions(cutoff=1.0, butter_order=4) and not choice.reached
+    assert choice.noise_left == pytest.approx(choice.position_noise * butterworth_noise_gain(1.0, 4, DT))
     assert choice.noise_left > choice.target and "the most filtering allowed" in choice.reason
 
 
-@pytest.mark.parametrize("sigma", [2e-6, 1.1e-5, 3e-5, 7e-5, 2e-4])
+@pytest.mark.parametrize("sigma", [1.3e-8, 2e-6, 1.1e-5, 3e-5, 7e-5, 2e-4])
 def test_butterworth_the_highest_cutoff_of_four_digits_that_meets_the_target(sigma):
     """The cutoff meets the target and the next four-digit cutoff does not (up to the Nyquist frequency:
     little noise asks little filtering)."""
@@ -407,6 +407,9 @@ def test_a_fallback_says_why_and_measures_nothing():
     expected = DiffChoice("central", FilterOptions(), "central differences: too short", math.nan, (), math.nan,
                           NOISE_TARGET, math.nan, math.nan, math.nan, False, math.nan, 0, 0)
     assert str(choice) == "central differences: too short"
+    measured = (choice.content_end, choice.position_noise, choice.noise_central, choice.noise_left,
+                choice.filter_cutoff, choice.sample_rate)
+    assert all(isinstance(x, float) and math.isnan(x) for x in measured)
     assert choice.to_dict() == {**expected.to_dict()}
     assert choice.to_dict() == {"scheme": "central", "filtering": dataclasses.asdict(FilterOptions()),
                                 "reason": "central differences: too short", "content_end": None, "content_ends": [],
@@ -446,6 +449,11 @@ def test_savgol_window_is_the_nearest_of_all_windows(order):
         nearest = _nearest_window(9.0, order, max_window=max_window)
         assert savgol_window(9.0, order, DT, max_window=max_window) == nearest
     assert savgol_window(17.0, order, DT, "gaussian") == _nearest_window(17.0, order, "gaussian")
+    for cutoff in (9.0, 17.0, 31.0):  # the longest allowed is the nearest, above Schafer's start
+        nearest = _nearest_window(cutoff, order)
+        start = round(schafer_window(cutoff, order, DT))
+        if nearest > start + (1 - start % 2):
+            assert savgol_window(cutoff, order, DT, max_window=nearest) == nearest
 
 
 def test_savgol_window_bounds():
@@ -460,9 +468,9 @@ def test_savgol_window_bounds():
 def test_a_smoother_that_passes_everything_has_its_cutoff_at_nyquist():
     """A fit whose centre weighs 1e6 times its neighbours returns the sample itself: no -3 dB frequency
     below the Nyquist frequency (the answer documented for that case)."""
-    w = np.full(21, 1e-6)
-    w[10] = 1.0
-    assert savgol_cutoff(21, 2, DT, w) == 0.5 / DT  # type: ignore[arg-type]
+    w = np.full(41, 1e-6)  # long enough for the first search (to 12 x Schafer's estimate) to end below Nyquist
+    w[20] = 1.0
+    assert savgol_cutoff(41, 2, DT, w) == 0.5 / DT  # type: ignore[arg-type]
 
 
 def test_the_noise_model_is_what_white_noise_shows_in_every_bin():
