@@ -11,9 +11,11 @@ from hypothesis import strategies as st
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import (
+    LOWER,
     UPPER,
     FitResult,
     HeldOutScore,
+    ModelSelection,
     _fit_jacobian,
     _from_fit,
     _to_fit,
@@ -25,6 +27,7 @@ from wbfriction.friction.fit import (
     fitted_offsets,
     held_out_rms,
     held_out_split,
+    initial_guesses,
     model_bounds,
     model_jacobian,
     model_values,
@@ -443,3 +446,59 @@ def test_fit_estimate_fits_every_joint_with_its_targets_and_options():
     assert [f.params is None for f in fit_estimate(est, min_samples=3800)] == [False, True]
     assert fit_estimate(est) == fit_joints(("a", "b"), qd, tau_f, valid, tau_f_true=truth,
                                            targets={"a": FrictionParams(F_v=0.3, F_c=0.5)})
+
+
+def test_auto_passes_every_option_to_its_candidates():
+    """With a smoother, a joint name, another Stribeck exponent, fewer samples allowed and an offset held,
+    the model chosen is fitted as if it had been named with the same options; every candidate's score is
+    its fit on the training blocks, smoothed alike, with the parameters it left at a bound."""
+    truth = FrictionParams(F_v=0.3, F_c=0.6, S=1.0, v_s=0.15, tau_os=0.1, a=30.0, delta_s=1.5)
+    smooth = SavgolSmoother(31, 2, DT)
+    tau_f = smooth(truth.torque(QD)) + np.random.default_rng(41).normal(0.0, 0.02, QD.size)
+    options = dict(smoother=smooth, joint="k", delta_s=1.5, min_samples=30, fixed={"tau_os": 0.1})
+    auto = fit_friction(QD, tau_f, model="auto", selection_tolerance=0.07, **options)
+    sel = auto.selection
+    assert (auto.joint, sel.chosen, sel.tolerance) == ("k", auto.model, 0.07)
+    named = fit_friction(QD, tau_f, model=auto.model, **options)
+    assert auto.params == named.params and auto.stderr == named.stderr and auto.params.tau_os == 0.1
+    use = np.isfinite(smooth(QD))
+    train, held_out = held_out_split(use)
+    assert (sel.n_train, sel.n_held_out) == (train.sum(), held_out.sum())
+    for score in sel.scores:
+        fit = fit_friction(QD, tau_f, mask=train, model=score.model, **options)
+        assert score.held_out_rms == pytest.approx(held_out_rms(fit.params, QD, tau_f, held_out, smooth), rel=1e-9)
+        assert score.at_bound == fit.bounded()
+    assert sel.reason.startswith(f"{auto.model}: ")
+
+
+def _valid_count_with_smallest_side(side: int) -> int:
+    """A number of valid samples whose smaller split (training or held out) has exactly ``side`` samples."""
+    return next(n for n in range(side, 20 * side) if min(s.sum() for s in held_out_split(np.ones(n, bool))) == side)
+
+
+@pytest.mark.parametrize("min_samples,side", [(20, 20), (5, 7)])
+def test_auto_holds_out_when_each_side_has_enough_samples(min_samples, side):
+    """Each side needs at least max(min_samples, 7) samples: exactly that many is enough; one fewer is not,
+    and then the simplest model is fitted with the options given, said."""
+    for n, enough in ((_valid_count_with_smallest_side(side), True), (_valid_count_with_smallest_side(side - 1),
+                                                                      False)):
+        qd = QD[:n * 10:10]
+        tau_f = CoulombViscousParams(0.3, 0.5, 0.1).torque(qd)
+        res = fit_friction(qd, tau_f, model="auto", min_samples=min_samples, fixed={"tau_os": 0.1}, joint="j",
+                           selection_tolerance=0.05)
+        assert bool(res.selection.scores) == enough, n
+        assert res.params.tau_os == 0.1 and res.joint == "j" and res.selection.tolerance == 0.05
+        if not enough:
+            train, held_out = held_out_split(np.ones(n, bool))
+            assert res.selection == ModelSelection("coulomb-viscous", f"coulomb-viscous: too few samples ({n}) to "
+                                                   "hold any out", (), 0.05, train.sum(), held_out.sum())
+
+
+def test_the_linear_start_is_the_coulomb_viscous_least_squares_fit():
+    """Noise-free Coulomb-viscous friction: the single starting point of that model is the truth (the
+    linear least-squares fit of qd, sgn(qd), 1), even for a slow joint with a small viscous part."""
+    for truth in (CoulombViscousParams(0.3, 0.5, 0.1), CoulombViscousParams(0.02, 0.004, -0.3)):
+        (start,) = initial_guesses(0.1 * QD, truth.f(0.1 * QD), "coulomb-viscous")
+        np.testing.assert_allclose(start, truth.as_vector(), rtol=1e-9, atol=1e-12)
+    starts = initial_guesses(QD, FrictionParams(0.3, 0.5, 0.4, 0.2, 0.1, 40.0).f(QD))
+    assert len(starts) == 12 and all(((s > LOWER) & (s < UPPER)).all() for s in starts)  # (3.5), inside bounds
