@@ -9,16 +9,33 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
+from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import (
+    LOWER,
     UPPER,
+    FitResult,
     HeldOutScore,
+    ModelSelection,
+    _fit_jacobian,
+    _from_fit,
+    _to_fit,
     choose_model,
+    filtered_problem,
+    fit_estimate,
     fit_friction,
     fit_joints,
+    fitted_offsets,
     held_out_rms,
     held_out_split,
+    initial_guesses,
+    model_bounds,
+    model_jacobian,
+    model_values,
+    parameter_covariance,
+    standard_errors,
 )
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams, StribeckParams
+from wbfriction.friction.status import fit_verdict
 from wbfriction.signals.filters import SavgolSmoother
 
 DT = 2e-3
@@ -252,3 +269,236 @@ def test_filtered_problem_smooths_what_changes_only(model):
         both = smoother(np.column_stack([model_values(x, qd, 2.0, model), model_jacobian(x, qd, 2.0, model)]))[rows]
         np.testing.assert_array_equal(residual(x), both[:, 0] - y[rows])
         np.testing.assert_array_equal(jacobian(x), both[:, 1:])
+
+
+# ------------------------------------------------------------- each part at its definition (issue 37)
+def test_a_result_takes_its_models_name_and_offsets_come_from_the_fitted():
+    fit = FitResult("a", 100, CoulombViscousParams(0.1, 0.5, -0.2))
+    assert fit.model == "coulomb-viscous" and FitResult("b", 3).model == "thesis"
+    assert fitted_offsets([fit, FitResult("b", 3)]) == {"a": -0.2}
+    assert fit.verdict() == fit_verdict(fit)
+
+
+def test_error_percent_needs_parameters_and_a_target_and_is_undefined_at_zero():
+    target = FrictionParams(F_v=0.2, F_c=1.0, S=0.0, v_s=0.2, tau_os=0.0, a=40.0)
+    fit = FitResult("j", 100, FrictionParams(0.3, 1.5, 0.1, 0.2, 0.1, 40.0), target=target)
+    err = fit.error_percent()
+    assert err["F_v"] == pytest.approx(50.0) and err["F_c"] == pytest.approx(50.0) and err["a"] == 0.0
+    assert np.isnan(err["S"]) and np.isnan(err["tau_os"])
+    assert FitResult("j", 3, target=target).error_percent() is None
+    assert FitResult("j", 100, FrictionParams(0.3, 1.5, 0.1, 0.2, 0.1, 40.0)).error_percent() is None
+
+
+def test_model_bounds_default_and_the_stribeck_velocity_bound():
+    lower, upper = model_bounds(QD)
+    assert len(lower) == 6 and upper[3] == pytest.approx(np.abs(QD).max())  # (3.5), v_s at most the fastest
+    assert model_bounds(np.full(10, 1e-5), "stribeck")[1][3] == pytest.approx(2e-4)  # at least twice its floor
+    assert np.isinf(model_bounds(QD, "coulomb-viscous")[1]).all()
+
+
+def test_held_out_rms_by_hand():
+    params = CoulombViscousParams(0.3, 0.5, 0.1)
+    tau_f = -params.f(QD) + 0.05 * np.cos(7 * T)
+    smooth = SavgolSmoother(21, 2, DT)
+    rows = ((np.arange(QD.size) % 3 == 1) & np.isfinite(smooth(QD))).astype(int)  # a 0/1 mask given as integers
+    r = (smooth(params.f(QD)) + tau_f)[rows == 1]
+    assert held_out_rms(params, QD, tau_f, rows, smooth) == pytest.approx(np.sqrt(np.mean(r**2)), rel=1e-12)
+    r = (params.f(QD) + tau_f)[rows == 1]
+    assert held_out_rms(params, list(QD), list(tau_f), rows) == pytest.approx(np.sqrt(np.mean(r**2)), rel=1e-12)
+    assert np.isnan(held_out_rms(params, QD, tau_f, np.zeros(QD.size, dtype=bool)))
+
+
+def test_choose_model_says_why_in_numbers():
+    cv, sb, th = "coulomb-viscous", "stribeck", "thesis"
+    model, reason = choose_model((HeldOutScore(cv, 1.05), HeldOutScore(sb, 1.0), HeldOutScore(th, 0.99)), 0.02)
+    assert model == sb
+    assert reason == ("stribeck: the simplest model within 2 % of the smallest held-out RMS (thesis's; +1 %); "
+                      "held-out RMS [N·m]: coulomb-viscous 1.05, stribeck 1, thesis 0.99")
+    model, reason = choose_model((HeldOutScore(cv, 1.1), HeldOutScore(sb, 1.0), HeldOutScore(th, 1.05)), 0.02)
+    assert reason.startswith("stribeck: the smallest held-out RMS; simpler models exceed it by more than 2 %; ")
+    model, reason = choose_model((HeldOutScore(cv, 1.0), HeldOutScore(sb, 1.1), HeldOutScore(th, 1.05)), 0.02)
+    assert reason.startswith("coulomb-viscous: the smallest held-out RMS; held-out RMS")
+
+
+def _covariance_by_hand(J, r, rows, max_lag):
+    """The Newey-West sandwich written out: pairs of samples l rows apart, Bartlett weights."""
+    n, p = J.shape
+    g = J * r[:, None] * np.sqrt(n / (n - p))
+    meat = g.T @ g
+    for a in range(n):
+        for b in range(n):
+            lag = rows[b] - rows[a]
+            if 0 < lag <= max_lag and b - a == lag:  # no row missing between them
+                w = 1.0 - lag / (max_lag + 1.0)
+                meat += w * (np.outer(g[b], g[a]) + np.outer(g[a], g[b]))
+    bread = np.linalg.inv(J.T @ J)
+    return bread @ meat @ bread
+
+
+def test_parameter_covariance_by_its_definition():
+    """s^2 (J^T J)^-1 against numpy's inverse, at any scale of J; the Newey-West sandwich against the sum
+    over pairs; a parameter in the null space of J (a zero column, or two equal columns) infinite, the
+    others not."""
+    rng = np.random.default_rng(30)
+    J, r = rng.normal(size=(40, 3)), rng.normal(size=40)
+    for scale in (1.0, 1e-6):
+        expected = (r @ r) / 37 * np.linalg.inv((scale * J).T @ (scale * J))
+        np.testing.assert_allclose(parameter_covariance(scale * J, r), expected, rtol=1e-9)
+        np.testing.assert_allclose(standard_errors(scale * J, r), np.sqrt(np.diag(expected)), rtol=1e-9)
+    rows = np.r_[np.arange(20), 25 + np.arange(20)]  # a gap: no pair across it
+    for max_lag in (1, 3):
+        np.testing.assert_allclose(parameter_covariance(J, r, rows=rows, max_lag=max_lag),
+                                   _covariance_by_hand(J, r, rows, max_lag), rtol=1e-9)
+        np.testing.assert_allclose(parameter_covariance(J, r, max_lag=max_lag),
+                                   _covariance_by_hand(J, r, np.arange(40), max_lag), rtol=1e-9)
+    for bad, infinite in ((np.c_[J[:, :2], np.zeros(40)], [False, False, True]),
+                          (np.c_[J[:, :2], J[:, 1]], [False, True, True])):
+        se = standard_errors(bad, r)
+        assert list(np.isinf(se)) == infinite
+    assert np.isinf(standard_errors(np.zeros((40, 3)), r)).all()
+
+
+def test_held_parameters_are_the_values_given():
+    """Held values are the model's own (F_s, not F_s - F_c): they come back as given, standard error 0."""
+    truth = StribeckParams(F_v=0.3, F_c=0.6, F_s=1.0, v_s=0.15, tau_os=0.1)
+    res = fit_friction(QD, truth.torque(QD), model="stribeck", fixed={"F_c": 0.6, "F_s": 1.0})
+    assert (res.params.F_c, res.params.F_s) == (0.6, 1.0) and res.stderr["F_s"] == 0.0
+    np.testing.assert_allclose(res.params.as_vector(), truth.as_vector(), rtol=1e-6, atol=1e-8)
+    thesis = FrictionParams(F_v=0.3, F_c=1.0, S=0.5, v_s=0.2, tau_os=0.1, a=40.0)
+    res = fit_friction(QD, thesis.torque(QD), fixed={"F_c": 1.0, "S": 0.5})
+    assert (res.params.F_c, res.params.S) == (1.0, 0.5)
+
+
+@pytest.mark.parametrize("model", ["coulomb-viscous", "stribeck", "thesis"])
+def test_the_jacobian_in_the_fits_coordinates_is_the_derivative_there(model):
+    """Central differences of the model's values in the fit's coordinates (the Stribeck model's F_s - F_c):
+    the Jacobian the solver is given."""
+    x = {"coulomb-viscous": [0.3, 0.5, 0.1], "stribeck": [0.3, 0.6, 1.0, 0.15, 0.1],
+         "thesis": [0.3, 1.0, 0.5, 0.2, 0.1, 40.0]}[model]
+    z = _to_fit(model, np.array(x))
+    jac = _fit_jacobian(model, model_jacobian(_from_fit(model, z), QD, 2.0, model))
+    for i in range(len(z)):
+        h = 1e-6 * max(1.0, abs(z[i]))
+        up, down = z.copy(), z.copy()
+        up[i] += h
+        down[i] -= h
+        numeric = (model_values(_from_fit(model, up), QD, 2.0, model)
+                   - model_values(_from_fit(model, down), QD, 2.0, model)) / (2 * h)
+        np.testing.assert_allclose(jac[:, i], numeric, atol=1e-5 * max(1.0, np.abs(numeric).max()))
+    np.testing.assert_allclose(_from_fit(model, z), x, rtol=1e-15)
+
+
+def test_filtered_problem_of_the_default_model():
+    truth = FrictionParams(F_v=0.3, F_c=1.0, S=0.5, v_s=0.2, tau_os=0.1, a=40.0)
+    smooth = SavgolSmoother(21, 2, DT)
+    use = np.isfinite(smooth(QD))
+    residual, jacobian = filtered_problem(QD, smooth(truth.f(QD)), use, smooth, 2.0)
+    assert np.abs(residual(truth.as_vector())).max() < 1e-12 and jacobian(truth.as_vector()).shape == (use.sum(), 6)
+
+
+def _two_joints():
+    rng = np.random.default_rng(31)
+    params = [CoulombViscousParams(0.3, 0.5, 0.1), CoulombViscousParams(0.1, 0.8, -0.2)]
+    qd = np.column_stack([QD, -0.7 * QD])
+    truth = np.column_stack([p.torque(qd[:, i]) for i, p in enumerate(params)])
+    tau_f = truth + rng.normal(0.0, 0.05, truth.shape)
+    tau_f[100, 0] = 1e6  # a gross outlier: left out of the fit and of the errors
+    valid = np.ones(qd.shape, dtype=bool)
+    valid[:300, 1] = False
+    return qd, tau_f, valid, truth
+
+
+def test_fit_joints_errors_against_truth_on_the_samples_fitted():
+    qd, tau_f, valid, truth = _two_joints()
+    true_nan = truth.copy()
+    true_nan[:, 1] = np.nan  # no truth for the second joint
+    target = CoulombViscousParams(0.3, 0.5, 0.1)
+    fits = fit_joints(["a", "b"], qd, tau_f, valid, tau_f_true=true_nan, model="coulomb-viscous",
+                      targets={"a": FrictionParams(F_v=0.3, F_c=0.5, tau_os=0.1)})
+    used = np.ones(qd.shape[0], dtype=bool)
+    used[100] = False
+    err = tau_f[used, 0] - truth[used, 0]
+    assert fits[0].rms_error_vs_true == pytest.approx(np.sqrt(np.mean(err**2)), rel=1e-12)
+    model_err = fits[0].params.torque(qd[used, 0]) - truth[used, 0]
+    assert fits[0].rms_model_vs_true == pytest.approx(np.sqrt(np.mean(model_err**2)), rel=1e-12)
+    assert fits[1].rms_error_vs_true is None and fits[1].rms_model_vs_true is None
+    assert fits[0].target is not None and fits[0].target.F_c == target.F_c and fits[1].target is None
+    assert fits[0].n_screened == 1 and fits[1].n_samples == qd.shape[0] - 300
+
+
+def test_fit_joints_on_worker_processes_gives_the_same_fits():
+    qd, tau_f, valid, truth = _two_joints()
+    kwargs = dict(tau_f_true=truth, model="coulomb-viscous")
+    assert fit_joints(["a", "b"], qd, tau_f, valid, workers=2, **kwargs) == fit_joints(["a", "b"], qd, tau_f,
+                                                                                         valid, **kwargs)
+
+
+def test_fit_estimate_fits_every_joint_with_its_targets_and_options():
+    qd, tau_f, valid, truth = _two_joints()
+    n = qd.shape[0]
+    est = FrictionEstimate(("a", "b"), T, qd, tau_f, valid, np.zeros(n, dtype=int), np.ones(n, dtype=bool),
+                           np.ones((n, 1), dtype=bool), ("sole",), tau_f_true=truth,
+                           metadata={"friction_true": {"a": FrictionParams(F_v=0.3, F_c=0.5).to_dict()}})
+    options = dict(delta_s=1.5, min_samples=3000, model="auto", selection_tolerance=0.1)
+    expected = fit_joints(("a", "b"), qd, tau_f, valid, tau_f_true=truth, **options,
+                          targets={"a": FrictionParams(F_v=0.3, F_c=0.5)})
+    assert fit_estimate(est, **options) == expected
+    assert [f.params is None for f in fit_estimate(est, min_samples=3800)] == [False, True]
+    assert fit_estimate(est) == fit_joints(("a", "b"), qd, tau_f, valid, tau_f_true=truth,
+                                           targets={"a": FrictionParams(F_v=0.3, F_c=0.5)})
+
+
+def test_auto_passes_every_option_to_its_candidates():
+    """With a smoother, a joint name, another Stribeck exponent, fewer samples allowed and an offset held,
+    the model chosen is fitted as if it had been named with the same options; every candidate's score is
+    its fit on the training blocks, smoothed alike, with the parameters it left at a bound."""
+    truth = FrictionParams(F_v=0.3, F_c=0.6, S=1.0, v_s=0.15, tau_os=0.1, a=30.0, delta_s=1.5)
+    smooth = SavgolSmoother(31, 2, DT)
+    tau_f = smooth(truth.torque(QD)) + np.random.default_rng(41).normal(0.0, 0.02, QD.size)
+    options = dict(smoother=smooth, joint="k", delta_s=1.5, min_samples=30, fixed={"tau_os": 0.1})
+    auto = fit_friction(QD, tau_f, model="auto", selection_tolerance=0.07, **options)
+    sel = auto.selection
+    assert (auto.joint, sel.chosen, sel.tolerance) == ("k", auto.model, 0.07)
+    named = fit_friction(QD, tau_f, model=auto.model, **options)
+    assert auto.params == named.params and auto.stderr == named.stderr and auto.params.tau_os == 0.1
+    use = np.isfinite(smooth(QD))
+    train, held_out = held_out_split(use)
+    assert (sel.n_train, sel.n_held_out) == (train.sum(), held_out.sum())
+    for score in sel.scores:
+        fit = fit_friction(QD, tau_f, mask=train, model=score.model, **options)
+        assert score.held_out_rms == pytest.approx(held_out_rms(fit.params, QD, tau_f, held_out, smooth), rel=1e-9)
+        assert score.at_bound == fit.bounded()
+    assert sel.reason.startswith(f"{auto.model}: ")
+
+
+def _valid_count_with_smallest_side(side: int) -> int:
+    """A number of valid samples whose smaller split (training or held out) has exactly ``side`` samples."""
+    return next(n for n in range(side, 20 * side) if min(s.sum() for s in held_out_split(np.ones(n, bool))) == side)
+
+
+@pytest.mark.parametrize("min_samples,side", [(20, 20), (5, 7)])
+def test_auto_holds_out_when_each_side_has_enough_samples(min_samples, side):
+    """Each side needs at least max(min_samples, 7) samples: exactly that many is enough; one fewer is not,
+    and then the simplest model is fitted with the options given, said."""
+    for n, enough in ((_valid_count_with_smallest_side(side), True), (_valid_count_with_smallest_side(side - 1),
+                                                                      False)):
+        qd = QD[:n * 10:10]
+        tau_f = CoulombViscousParams(0.3, 0.5, 0.1).torque(qd)
+        res = fit_friction(qd, tau_f, model="auto", min_samples=min_samples, fixed={"tau_os": 0.1}, joint="j",
+                           selection_tolerance=0.05)
+        assert bool(res.selection.scores) == enough, n
+        assert res.params.tau_os == 0.1 and res.joint == "j" and res.selection.tolerance == 0.05
+        if not enough:
+            train, held_out = held_out_split(np.ones(n, bool))
+            assert res.selection == ModelSelection("coulomb-viscous", f"coulomb-viscous: too few samples ({n}) to "
+                                                   "hold any out", (), 0.05, train.sum(), held_out.sum())
+
+
+def test_the_linear_start_is_the_coulomb_viscous_least_squares_fit():
+    """Noise-free Coulomb-viscous friction: the single starting point of that model is the truth (the
+    linear least-squares fit of qd, sgn(qd), 1), even for a slow joint with a small viscous part."""
+    for truth in (CoulombViscousParams(0.3, 0.5, 0.1), CoulombViscousParams(0.02, 0.004, -0.3)):
+        (start,) = initial_guesses(0.1 * QD, truth.f(0.1 * QD), "coulomb-viscous")
+        np.testing.assert_allclose(start, truth.as_vector(), rtol=1e-9, atol=1e-12)
+    starts = initial_guesses(QD, FrictionParams(0.3, 0.5, 0.4, 0.2, 0.1, 40.0).f(QD))
+    assert len(starts) == 12 and all(((s > LOWER) & (s < UPPER)).all() for s in starts)  # (3.5), inside bounds

@@ -6,13 +6,22 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wbfriction.friction.fit import FitResult, fit_friction
 from wbfriction.friction.io import fit_from_dict, fit_to_dict
-from wbfriction.friction.models import FrictionParams
-from wbfriction.friction.status import FIT_STATUSES, MIN_SPEED, fit_verdict, solver_phrase
+from wbfriction.friction.models import CoulombViscousParams, FrictionParams
+from wbfriction.friction.status import (
+    FIT_STATUSES,
+    MIN_SPEED,
+    ZERO,
+    FitVerdict,
+    fit_verdict,
+    joint_speed,
+    solver_phrase,
+)
 
 TRUE = FrictionParams(F_v=0.2, F_c=1.0, S=0.2, v_s=0.2, tau_os=0.3, a=40.0)
 
@@ -92,3 +101,52 @@ def test_every_fit_has_one_status_and_a_reason_unless_ok(fitted, success, speed,
     assert verdict.status in FIT_STATUSES and (verdict.reason == "") == verdict.ok
     if verdict.ok:
         assert fitted and success and (speed is None or speed >= MIN_SPEED) and not bound and se <= 0.5 * TRUE.F_v
+
+
+# ---------------------------------------------------------------- each rule at its definition (issue 37)
+def _fit(F_c: float = 1.0, F_v: float = 0.2, se: dict | None = None, at_bound: tuple[str, ...] = (),
+         speed: float = 1.0) -> FitResult:
+    """A converged Coulomb-viscous fit with the given values and standard errors (no solver run)."""
+    params = CoulombViscousParams(F_v=F_v, F_c=F_c, tau_os=0.1)
+    stderr = {"F_v": 0.01, "F_c": 0.01, "tau_os": 0.01} if se is None else se
+    return FitResult("j", 1000, params, stderr, success=True, at_bound={n: n in at_bound for n in params.names},
+                     speed=speed)
+
+
+def test_joint_speed_is_the_95th_percentile_of_the_speed():
+    """|qd| of 0, 0.01, ..., 1 rad/s (either sign): its 95th percentile is 0.95 exactly; no sample, no motion."""
+    qd = np.linspace(0.0, 1.0, 101) * np.where(np.arange(101) % 2, 1.0, -1.0)
+    assert joint_speed(qd) == pytest.approx(0.95, abs=1e-12)
+    assert joint_speed(np.array([])) == 0.0
+
+
+def test_not_excited_means_below_the_minimum_speed():
+    assert _fit(speed=MIN_SPEED).verdict().status == "ok"
+    assert _fit(speed=np.nextafter(MIN_SPEED, 0.0)).verdict().status == "not excited"
+
+
+def test_a_magnitude_at_its_floor_is_below_zero_not_at_it():
+    """F_v on its lower bound: below ZERO it is "no viscous friction" (ok), at ZERO already a bound's value."""
+    assert _fit(F_v=np.nextafter(ZERO, 0.0), at_bound=("F_v",)).verdict().status == "ok"
+    assert _fit(F_v=ZERO, at_bound=("F_v",)).verdict() == FitVerdict("at bound", "at a bound of the fit: F_v")
+
+
+def test_weak_means_a_standard_error_above_half_the_value():
+    """F_v = 2 with a standard error of exactly 1 (50 %) is ok; of 1.5 (75 %) weak, and the reason says 75 %."""
+    assert _fit(F_v=2.0, se={"F_v": 1.0, "F_c": 0.0, "tau_os": 0.0}).verdict().status == "ok"
+    assert _fit(F_v=2.0, se={"F_v": 1.5, "F_c": 0.0, "tau_os": 0.0}).verdict() == FitVerdict(
+        "weak", "large standard errors: F_v ±75 %")
+    # a value at ZERO is still judged (only one below it is "none"), its error against it
+    assert _fit(F_v=ZERO, se={"F_v": 1.0, "F_c": 0.0, "tau_os": 0.0}).verdict().status == "weak"
+
+
+def test_the_offset_is_judged_against_the_coulomb_friction():
+    """tau_os's standard error against F_c (tau_os itself may be 0): above F_c / 2 weak, at it or without a
+    standard error (held) not; F_c at ZERO still a scale."""
+    assert _fit(F_c=2.0, se={"F_v": 0.0, "F_c": 0.0, "tau_os": 1.0}).verdict().status == "ok"
+    assert _fit(F_c=2.0, se={"F_v": 0.0, "F_c": 0.0, "tau_os": 1.2}).verdict() == FitVerdict(
+        "weak", "large standard errors: tau_os ±1.2 N·m against F_c 2")
+    assert _fit(F_c=2.0, se={"F_v": 0.0, "F_c": 0.0}).verdict().status == "ok"
+    assert _fit(F_c=1.0, se={"F_v": 0.0, "F_c": 0.0}).verdict().status == "ok"
+    assert _fit(F_c=ZERO, se={"F_v": 0.0, "F_c": 0.0, "tau_os": 1e-3}).verdict().status == "weak"
+    assert _fit(F_c=0.0, se={"F_v": 0.0, "F_c": 0.0, "tau_os": 1e-3}).verdict().status == "ok"

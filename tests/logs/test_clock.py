@@ -5,6 +5,8 @@ uniformly."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pyarrow as pa
 import pytest
@@ -15,7 +17,17 @@ from helpers import KUKA
 from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.logs.clock import VERDICT, lattice_period, read_clock, split_at_gaps
+from wbfriction.logs.clock import (
+    SECONDS_STEP,
+    VERDICT,
+    lattice_period,
+    longest_segment,
+    read_clock,
+    regularise,
+    roughness,
+    split_at_gaps,
+    table_stamps,
+)
 from wbfriction.logs.log import log_from_table
 
 
@@ -246,3 +258,232 @@ def test_friction_of_a_walk_logged_with_receive_time_stamps(talos, walk_table, d
     recorded = estimate_log(talos, log_from_table(stamped, talos, "b", time_base="recorded"), opts)
     both &= recorded.valid
     assert _rms(recorded.tau_f[both] - u.tau_f[both]) > 2e-2 * _rms(u.tau_f[both])
+
+
+# ------------------------------------------------------------------ the stamps' unit (issue 37)
+def _table(values) -> pa.Table:
+    return pa.table({"time": values})
+
+
+def test_stamps_of_every_unit_become_seconds_or_exact_nanoseconds():
+    """Floats are seconds, or scaled by the unit stated; integers and Arrow timestamps become int64
+    nanoseconds exactly, whatever their unit."""
+    k = np.arange(300)
+    seconds = 1.46e9 + k * 1e-3
+    np.testing.assert_array_equal(table_stamps(_table(seconds), "t"), seconds)
+    np.testing.assert_array_equal(table_stamps(_table(seconds), "t", unit="s"), seconds)
+    for unit, per_second in (("ms", 1e3), ("us", 1e6), ("ns", 1e9)):
+        out = table_stamps(_table(k * 1e-3 * per_second), "t", unit=unit)
+        np.testing.assert_allclose(out, k * 1e-3, rtol=1e-12, atol=0)
+    ticks = (2 * k + 5).astype(np.int64)
+    for unit, ns in (("s", 10**9), ("ms", 10**6), ("us", 10**3), ("ns", 1)):
+        out = table_stamps(_table(ticks), "t", unit=unit)
+        assert out.dtype == np.int64
+        np.testing.assert_array_equal(out, ticks * ns)
+        stamps = pa.array(ticks.astype(f"datetime64[{unit}]"))
+        np.testing.assert_array_equal(table_stamps(_table(stamps), "t"), ticks * ns)
+
+
+def test_float_stamps_are_seconds_only_between_a_microsecond_and_half_a_second():
+    """Without a unit, float stamps whose median step lies outside [1 us, 0.5 s] are refused (one
+    line naming the column and --time-unit); the bounds themselves are seconds."""
+    lo, hi = SECONDS_STEP
+    for step in (lo, hi):
+        t = np.tile([0.0, step], 100)  # steps of exactly +step (and -step, not counted)
+        np.testing.assert_array_equal(table_stamps(_table(t), "t"), t)
+    for step in (np.nextafter(lo, 0.0), np.nextafter(hi, 1.0), 1e-7, 1.0):
+        with pytest.raises(ColumnError, match="--time-unit") as err:
+            table_stamps(_table(np.tile([0.0, step], 100)), "x.csv")
+        assert err.value.column == "time" and err.value.source == "x.csv"
+    np.testing.assert_array_equal(table_stamps(_table(np.arange(10) * 1e-9), "t", unit="s"), np.arange(10) * 1e-9)
+
+
+def test_stamps_that_cannot_be_read_are_refused():
+    with pytest.raises(ColumnError, match="whose unit is not known") as err:
+        table_stamps(_table(np.arange(10)), "x.csv")
+    assert err.value.column == "time"
+    with pytest.raises(InputError, match="--time-unit must be one of s, ms, us, ns"):
+        table_stamps(_table(np.arange(10.0)), "x.csv", unit="min")  # type: ignore[arg-type]
+    with pytest.raises(ColumnError, match="missing column 'time'"):
+        table_stamps(pa.table({"t": np.arange(10.0)}), "x.csv")
+    top = np.iinfo(np.int64).max // 10**9  # the largest second count in 64-bit nanoseconds
+    assert table_stamps(_table(np.array([0, top])), "x", unit="s")[-1] == top * 10**9
+    assert table_stamps(_table(np.array([-top, 0])), "x", unit="s")[0] == -top * 10**9
+    for bad in (np.array([0, top + 1]), np.array([-top - 1, 0])):
+        with pytest.raises(ColumnError, match="overflows 64-bit nanoseconds"):
+            table_stamps(_table(bad), "x", unit="s")
+
+
+def test_the_unit_is_judged_on_the_positive_steps_and_bad_values_are_named():
+    """Repeated or decreasing stamps (refused later, by row) do not make seconds look like another unit;
+    a NaN is named by file, column and row (counted from ``first_row``)."""
+    repeated = np.repeat(np.arange(100) * 1e-3, 2)  # steps 0 and 1 ms: seconds
+    np.testing.assert_array_equal(table_stamps(_table(repeated), "t"), repeated)
+    decreasing = -np.arange(10) * 1e-3  # no positive step: no unit to judge
+    np.testing.assert_array_equal(table_stamps(_table(decreasing), "t"), decreasing)
+    bad = np.arange(10) * 1e-3
+    bad[3] = np.nan
+    for first_row, row in ((None, 3), (100, 103)):
+        with pytest.raises(ColumnError, match=f"row {row}") as err:
+            table_stamps(_table(bad), "x.csv", *(() if first_row is None else (first_row,)))
+        assert (err.value.source, err.value.column, err.value.row) == ("x.csv", "time", row)
+
+
+def test_a_non_finite_stamp_and_a_duplicate_are_named_by_file_and_row():
+    for reader in (read_clock, split_at_gaps):
+        t = np.arange(20) * 1e-3
+        t[7] = np.inf
+        with pytest.raises(ColumnError, match="non-finite value .* at row 7") as err:
+            reader(t, "x.parquet")
+        assert (err.value.source, err.value.row) == ("x.parquet", 7)
+        t[7] = t[6]
+        with pytest.raises(ColumnError, match="duplicated stamp at row 7") as err:
+            reader(t, "x.parquet")
+        assert (err.value.source, err.value.row) == ("x.parquet", 7)
+
+
+def test_the_first_stamp_is_the_logs_origin():
+    """``t0`` is the first stamp (epoch seconds, or integer nanoseconds); ``t`` counts from it."""
+    rng = np.random.default_rng(10)
+    ns = 1_700_000_000_000_000_000 + np.cumsum(rng.choice([10_000_000, 12_000_000], 500))
+    for stamps, t0 in ((ns, ns[0] * 1e-9), (ns * 1e-9, ns[0] * 1e-9)):
+        clock = read_clock(stamps, "o")
+        assert clock.kind == "skipping" and clock.t0 == pytest.approx(t0, abs=1e-6) and clock.t[0] == 0.0
+    jittered = 1.46e9 + np.arange(500) * 5e-3 + rng.uniform(0, 1.8e-3, 500)
+    assert read_clock(jittered, "j").t0 == jittered[0]
+
+
+def test_a_gap_is_a_step_of_at_least_max_gap_less_the_tolerance_times_the_local_median():
+    """Steps of 1 s and one of exactly 2.5 s: with max_gap 3 and a tolerance of 0.5, it is a gap."""
+    t = np.cumsum(np.r_[0.0, np.ones(20), 2.5, np.ones(20)])
+    assert split_at_gaps(t, "g", max_gap=3.0, rel_tol=0.5) == [(0, 21), (21, 42)]
+    assert split_at_gaps(t, "g", max_gap=3.0, rel_tol=0.25) == [(0, 42)]
+
+
+def test_longest_segment():
+    assert longest_segment([(0, 10), (10, 12)], 12) == (0, 10)
+    assert longest_segment([(0, 3), (3, 10), (10, 12)], 12) == (3, 10)
+    assert longest_segment([(0, 5), (5, 20)], 8) == (0, 5)  # cut to the rows there are
+    assert longest_segment(None, 7) == (0, 7)
+    assert longest_segment([(5, 9)], 5) == (0, 0)  # nothing within the rows
+    assert longest_segment([], 0) == (0, 0)
+
+
+def test_lattice_period_by_its_definition():
+    """The longest base period, the median step over 1 ... 12, of which every step is a whole multiple;
+    a step shorter than half the base period is no multiple of it."""
+    ms = 1e-3
+    assert lattice_period(np.array([2.0]) * ms) == pytest.approx(2 * ms)
+    assert lattice_period(np.array([])) is None
+    assert lattice_period(np.array([10, 15, 10, 5]) * ms) == pytest.approx(5 * ms)  # the median over 2
+    assert lattice_period(np.array([12, 12, 12, 13]) * ms) == pytest.approx(1 * ms)  # over 12
+    assert lattice_period(np.array([13, 13, 13, 14]) * ms) is None  # would need 13
+    assert lattice_period(np.array([10, 10, 10, 0.1]) * ms) is None
+
+
+def test_regularise_exact_segments_and_late_stamps():
+    """Stamps exactly on one period, each segment with its own offset: the same stamps and the period
+    back, exactly. Uniform 5 ms samples whose stamps arrive 0-0.5 ms late, 3 % of them 40 ms late (and
+    all of them in the second half): the robust fit still recovers the period and the true instants up
+    to the mean latency (a least-squares line is tilted about 30 times more by the late ones)."""
+    period = 5e-3
+    k = np.arange(1000)
+    t = np.r_[k[:400] * period, 7.3 + k[:600] * period]
+    segments = [(0, 400), (400, 1000)]
+    t_reg, p = regularise(t, segments)
+    assert p == pytest.approx(period, rel=1e-12)
+    np.testing.assert_allclose(t_reg, t, rtol=0, atol=1e-12)
+    rng = np.random.default_rng(12)
+    n = 4000
+    late = rng.uniform(0.0, 0.5e-3, n)
+    late[rng.choice(np.arange(n // 2, n), n * 3 // 100, replace=False)] += 40e-3
+    t_reg, p = regularise(np.arange(n) * period + late, [(0, n)])
+    assert p == pytest.approx(period, rel=1e-5)
+    np.testing.assert_allclose(np.diff(t_reg), p, rtol=1e-9)  # one straight line
+    assert abs(float(np.median(t_reg - np.arange(n) * period)) - 0.25e-3) < 0.05e-3
+    line = np.polyfit(np.arange(n), np.arange(n) * period + late, 1)[0]
+    assert abs(line - period) > 10 * abs(p - period)  # the premise: least squares is tilted
+
+
+def test_regularise_segments_of_one_row():
+    """Every segment a single row: no slope to fit within one; the period is the median step and each
+    row keeps its stamp."""
+    t = np.array([0.0, 0.01, 0.03, 0.04, 0.05])
+    t_reg, p = regularise(t, [(k, k + 1) for k in range(5)])
+    assert p == pytest.approx(0.01) and np.allclose(t_reg, t, rtol=0, atol=1e-15)
+
+
+def test_roughness_by_its_definition():
+    """RMS of the increments of the second divided differences, over every segment of at least four
+    rows: 0 for a quadratic on any steps; ``6 h`` for t^3 on steps h (its second difference is 6 t)."""
+    rng = np.random.default_rng(13)
+    t = np.cumsum(rng.uniform(0.5e-3, 1.5e-3, 300))
+    assert roughness(t, (2.0 + 3.0 * t - 40.0 * t**2)[:, None], [(0, 300)]) < 1e-6
+    h = 1e-3
+    t = np.arange(40) * h
+    q = (t**3)[:, None]
+    segments = [(0, 3), (3, 7), (7, 40)]  # 3 rows: no increment; 4 rows: one
+    assert roughness(t, q, segments) == pytest.approx(6 * h, rel=1e-6)
+    wide = np.r_[t[:3], t[3:7] * 2.0 - t[3], t[7:] + 3 * h]  # the 4-row segment on steps of 2 h: its increment 12 h
+    expected = math.sqrt((30 * (6 * h) ** 2 + (12 * h) ** 2) / 31)
+    assert roughness(wide, (wide**3)[:, None], segments) == pytest.approx(expected, rel=1e-6)
+    assert roughness(t, q, [(0, 7)]) == pytest.approx(6 * h, rel=1e-6)
+    assert np.isnan(roughness(t, q, [(0, 3), (3, 6)]))
+    assert roughness(t, q[:20], segments) == pytest.approx(6 * h, rel=1e-6)  # positions of the first rows only
+
+
+def test_rows_of_a_clock_at_segment_edges():
+    stamps = np.arange(1000) * 5e-3 + np.random.default_rng(14).uniform(0, 1.8e-3, 1000)
+    stamps[600:] += 1.0
+    clock = read_clock(stamps, "r")
+    assert clock.rows(0, 600).segments == [(0, 600)]
+    assert clock.rows(600, 1000).segments == [(0, 400)]
+    beyond = clock.rows(1000, 1200)
+    assert beyond.t.size == 0 and beyond.segments == [(0, 0)]
+
+
+def test_the_reason_says_gaps_jitter_and_the_ratio():
+    t = np.r_[np.arange(300) * 1e-3, 1.0 + np.arange(300) * 1e-3, 2.0 + np.arange(300) * 1e-3]
+    reason = read_clock(t, "g").reason
+    assert reason.endswith("(steps within 5 % of it); 2 gap(s) split it into 3 segments")
+    forced = read_clock(t, "g", time_base="recorded")  # uniform stamps, taken as recorded as asked
+    assert "uniform stamps every 1 ms (steps 1-1 ms)" in forced.reason
+    rng = np.random.default_rng(15)
+    k = np.arange(2000)
+    stamps = k * 5e-3 + rng.uniform(0.0, 1.8e-3, k.size)
+    q = _motion(k * 5e-3)
+    rec, reg = read_clock(stamps, "b", q=q).roughness
+    ratio = rec / reg
+    assert f"second differences {ratio:.0f}x smoother than on the stamps" in read_clock(stamps, "b", q=q).reason
+    assert f"second differences {ratio:.0f}x rougher than on a regularised clock" in read_clock(
+        stamps, "b", q=q, time_base="recorded").reason
+
+
+def test_positions_that_cannot_tell_leave_the_choice_to_the_stamps():
+    """White-noise positions are as rough on either time base (a ratio within VERDICT): no verdict, the
+    reason says so, and stamps within half a period of a line are regularised."""
+    rng = np.random.default_rng(16)
+    k = np.arange(3000)
+    stamps = k * 1e-3 + rng.uniform(-0.1e-3, 0.1e-3, k.size)
+    clock = read_clock(stamps, "n", q=rng.normal(0.0, 1.0, (k.size, 1)))
+    rec, reg = clock.roughness
+    assert 1 / VERDICT < rec / reg < VERDICT  # the premise
+    assert clock.kind == "jittered"
+    assert "(second differences within 20% on both time bases; the stamps within half a period" in clock.reason
+
+
+def test_stamps_that_drift_from_any_line_are_taken_as_recorded():
+    """Stamps up to 1.3 periods off the best line (a slow drift of one period plus 0.3 of scatter), no
+    lattice, no positions: not receive times of a uniform clock."""
+    rng = np.random.default_rng(0)
+    k = np.arange(3000)
+    t = k * 1e-3 + rng.uniform(-0.3e-3, 0.3e-3, k.size) + 1e-3 * np.sin(2 * np.pi * k / k.size)
+    clock = read_clock(t, "d")
+    assert clock.kind == "skipping" and "the stamps drifting from any straight line" in clock.reason
+
+
+def test_a_forced_regular_clock_keeps_the_lattice_found():
+    rng = np.random.default_rng(1)
+    t = np.concatenate([[0.0], np.cumsum(rng.choice([10, 12], 999))]) * 1e-3
+    clock = read_clock(t, "a", time_base="regularised")
+    assert clock.kind == "jittered" and clock.lattice == pytest.approx(2e-3, rel=1e-6)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -60,6 +62,22 @@ def test_weighted_route_equals_scipy_for_uniform_weights(window, order):
         ours = savgol_kernels(window, order, DT, ones)[d]
         ref = savgol_coeffs(window, order, deriv=d, delta=DT, use="dot")
         assert np.allclose(ours, ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
+
+
+@pytest.mark.parametrize("window,order", [(2501, 4), (20001, 4), (501, 6)])
+def test_long_windows_reproduce_polynomials(window, order):
+    """A Savitzky-Golay fit of order k returns any polynomial of degree <= k, its slope and curvature
+    exactly. scipy's ``savgol_coeffs`` on raw indices lost the constant term from about 2 500 samples
+    at order 4 and 500 at order 6 (a smoother of gain 0 at 0 Hz: issue 37, the brentq ValueError of
+    ``--diff auto`` on a log stamped 1 us apart, and silently wrong smoothing with ``--window``)."""
+    for dt in (1e-3, 1e-6):
+        h = savgol_kernels(window, order, dt)
+        t = (np.arange(window) - window // 2) * dt
+        coef = np.random.default_rng(window).normal(0.0, 1.0, order + 1) / (window * dt) ** np.arange(order + 1)
+        p = np.polynomial.Polynomial(coef)
+        for d in range(3):
+            scale = math.factorial(d) / (window * dt) ** d  # of the d-th derivative at the centre
+            assert h[d] @ p(t) == pytest.approx(p.deriv(d)(0.0), rel=1e-8, abs=1e-8 * scale)
 
 
 def test_savgol_weights_must_keep_zero_phase():

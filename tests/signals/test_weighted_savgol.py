@@ -1,7 +1,7 @@
 """The weighted Savitzky-Golay route (thesis 7.4-7.8) against weighted polynomial fits computed in the test.
 
-``test_filters.py`` checks the weighted formulas with all-ones weights (which the filter hands to
-``scipy.signal.savgol_coeffs``) and polynomials with a loose tolerance; here the weights are not uniform
+``test_filters.py`` checks the formulas with all-ones weights against ``scipy.signal.savgol_coeffs``, and
+polynomials with a loose tolerance; here the weights are not uniform
 (``"gaussian"``: a bell of standard deviation N / 2 samples, or an explicit symmetric array), the value and
 derivatives at each window's centre are those of ``numpy.polynomial.Polynomial.fit`` with those weights,
 and polynomials of degree up to k come back to rounding error.

@@ -35,25 +35,29 @@ from wbfriction.model.layout import JointLayout, joint_layout
 from wbfriction.model.robot import Robot
 
 _G = pin.graph
-_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+_GRAPH_JOINTS = {
+    **dict.fromkeys(("JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned"),
+                    (_G.JointRevolute, slice(3, 6))),
+    **dict.fromkeys(("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"),
+                    (_G.JointRevoluteUnbounded, slice(3, 6))),
+    **dict.fromkeys(("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned"),
+                    (_G.JointPrismatic, slice(0, 3))),
+}
+"""Pinocchio's 1-DoF joint models by name: the graph joint that stands for each, and where its axis lies in
+the joint's motion subspace (angular part for a revolute joint, linear part for a prismatic one)."""
 
 
 def _graph_joint(joint: pin.JointModel):
-    """Graph joint equivalent to a Pinocchio 1-DoF joint model."""
+    """Graph joint equivalent to a Pinocchio 1-DoF joint model, its axis read off the joint's motion
+    subspace (the bindings give no axis for an unbounded unaligned joint: a URDF continuous joint whose
+    axis is not x, y or z)."""
     short = joint.shortname()
-    if short in ("JointModelRX", "JointModelRY", "JointModelRZ"):
-        return _G.JointRevolute(np.array(_AXES[short[-1]]))
-    if short in ("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ"):
-        return _G.JointRevoluteUnbounded(np.array(_AXES[short[-1]]))
-    if short in ("JointModelPX", "JointModelPY", "JointModelPZ"):
-        return _G.JointPrismatic(np.array(_AXES[short[-1]]))
-    if short == "JointModelRevoluteUnaligned":
-        return _G.JointRevolute(np.array(joint.extract().axis))
-    if short == "JointModelRevoluteUnboundedUnaligned":
-        return _G.JointRevoluteUnbounded(np.array(joint.extract().axis))
-    if short == "JointModelPrismaticUnaligned":
-        return _G.JointPrismatic(np.array(joint.extract().axis))
-    raise ModelError(f"joint type {short} is not supported by the stance models")
+    if short not in _GRAPH_JOINTS:
+        raise ModelError(f"joint type {short} is not supported by the stance models")
+    kind, part = _GRAPH_JOINTS[short]
+    data = joint.createData()
+    joint.calc(data, np.r_[1.0, np.zeros(joint.nq - 1)])  # any q: a 1-DoF joint's subspace is constant
+    return kind(np.asarray(data.S).reshape(6)[part].copy())
 
 
 def body_frame(j: int) -> str:

@@ -10,9 +10,10 @@ motion. :func:`choose_differentiation` reads the positions and decides, determin
    ``sigma |G(f)|``, ``G(f) = 4 sin^2(pi f dt) / dt^2``, which rises as ``f^2``. The amplitude
    spectrum (:func:`~wbfriction.signals.spectrum.amplitude_spectrum`) is averaged in power
    over half-overlapping Hann-tapered segments (Welch's method), so that a noise bin rarely
-   stands out; the noise level ``sigma`` is read from the median of ``amplitude / |G|`` over
-   the upper half of the band; what stands above :data:`NOISE_MARGIN` times that noise model
-   is the content, and :func:`~wbfriction.signals.spectrum.suggest_cutoff` finds where it ends
+   stands out; the taper mixes each bin with its neighbours (:func:`tapered_gain`: near 0 Hz the
+   noise is not ``sigma |G|``); the noise level ``sigma`` is read from the median of
+   ``amplitude / |G|`` over the upper half of the band; what stands above :data:`NOISE_MARGIN`
+   times that noise model is the content, and :func:`~wbfriction.signals.spectrum.suggest_cutoff` finds where it ends
    (all but ``tail`` of its power below): where the spectrum meets the noise floor.
 2. **Noise left.** Each scheme leaves ``sigma`` times its noise gain in the acceleration (RMS):
    ``sqrt(6) / dt^2`` for central differences, the norm of the Savitzky-Golay second-derivative
@@ -91,6 +92,18 @@ def second_difference_gain(freq: np.ndarray, dt: float) -> np.ndarray:
     return 4.0 * np.sin(np.pi * np.asarray(freq, dtype=float) * dt) ** 2 / dt**2
 
 
+def tapered_gain(gain: np.ndarray) -> np.ndarray:
+    """The amplitude gain ``gain`` (F,) of white noise on the DFT bins 0 ... L/2 of a segment of even
+    length L, as a Hann-tapered spectrum sees it: the periodic Hann window's DFT is L/2 at 0 and -L/4 at
+    +-1 bin, so the expected power of bin k mixes its neighbours,
+    ``sqrt((4 G_k^2 + G_{k-1}^2 + G_{k+1}^2) / 6)`` (the spectrum mirrored at 0 Hz and at the Nyquist
+    frequency). Where ``G`` varies slowly that is ``G``; near 0 Hz, where the second difference's gain
+    rises as ``f^2``, it is not: at 1 bin 1.8 times ``G``, and at 0 Hz not 0."""
+    g2 = np.asarray(gain, dtype=float) ** 2
+    mirrored = np.r_[g2[1], g2, g2[-2]]
+    return np.sqrt((4.0 * g2 + mirrored[:-2] + mirrored[2:]) / 6.0)
+
+
 @dataclass
 class AccelerationContent:
     """The averaged acceleration spectrum of some positions, split into content and noise.
@@ -99,7 +112,7 @@ class AccelerationContent:
         freq: frequencies (F,) [Hz].
         amplitude: power-averaged amplitude spectrum of the central second difference (F, n)
             [rad/s^2] (Hann-tapered segments: a sine of amplitude A shows as about A / 2).
-        noise: the white-noise model's amplitude (F, n) [rad/s^2].
+        noise: the white-noise model's amplitude (F, n) [rad/s^2] (:func:`tapered_gain`).
         excess: the content: amplitude above ``margin`` times the noise model (F, n) [rad/s^2].
         content_end: where each joint's content ends (n,) [Hz] (the Nyquist frequency for a
             joint without content).
@@ -152,7 +165,7 @@ def acceleration_content(q: np.ndarray, dt: float, tail: float = 0.01, segment: 
     tapered = np.moveaxis(windows, -1, 0) * hann(seg, sym=False)[:, None, None]
     freq, amp = amplitude_spectrum(tapered, dt)  # (F, M, n)
     amp = np.sqrt(np.mean(amp**2, axis=1))
-    gain = second_difference_gain(freq, dt)
+    gain = tapered_gain(second_difference_gain(freq, dt))
     upper = freq >= freq[-1] / 2
     level = np.median(amp[upper] / gain[upper, None], axis=0)  # (n,)
     noise = level[None, :] * gain[:, None]
@@ -362,9 +375,8 @@ def _butterworth(sigma: float, dt: float, order: int, target: float, lowest: flo
     for _ in range(40):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if left(math.exp(mid)) <= target else (lo, mid)
-    cutoff = float(f"{math.exp(lo):.4g}")
-    if left(cutoff) > target:  # rounding went up
-        cutoff = float(f"{cutoff * (1 - 1e-3):.4g}")
+    step = 10.0 ** (math.floor(math.log10(math.exp(lo))) - 3)  # of the fourth significant digit
+    cutoff = float(f"{math.floor(math.exp(lo) / step) * step:.4g}")  # rounded down: it meets the target too
     return FilterOptions(cutoff=cutoff, butter_order=order), left(cutoff), True
 
 
