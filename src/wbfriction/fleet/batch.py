@@ -45,7 +45,7 @@ from threadpoolctl import threadpool_limits
 from wbfriction.exceptions import ClusterError, InputError, OutputError
 from wbfriction.fleet.manifest import LogEntry, Skipped
 from wbfriction.fleet.options import BatchOptions
-from wbfriction.fleet.results import Part, failure_files, read_parts, table_path, write_outcome
+from wbfriction.fleet.results import Part, failure_files, failures_folder, read_parts, table_path, write_outcome
 from wbfriction.fleet.task import LogOutcome, ResultKey, one_line, process_log, result_key, robot_sha256
 from wbfriction.logs.tables import TableFile, file_sha256, make_folder, remove_file, remove_stale_temporaries
 from wbfriction.pipeline.chunks import CHUNKS_PER_WORKER
