@@ -20,8 +20,8 @@ only formats text) and the share killed of the others: killed and timed out over
 mutants checked (a mutant no test reaches counts as a survivor); then every survivor, those that change a
 number with their diff (``--all-diffs``: the others' too). ``--json FILE`` writes every mutant's record;
 ``--keep DIR`` keeps the copy (then ``cd DIR && mutmut results`` / ``mutmut show NAME``), and
-``--rerun DIR`` tests that copy's survivors again with the checkout's tests (new truth tests), printing
-the tallies before and after.
+``--rerun DIR`` tests that copy's survivors again with the checkout's tests (new truth tests), and the
+mutants its budget left unchecked, printing the tallies before and after.
 """
 
 from __future__ import annotations
@@ -59,6 +59,9 @@ TESTS: dict[str, tuple[str, ...]] = {
     "friction/status.py": ("tests/friction/test_status.py",),
     "logs/clock.py": ("tests/logs/test_clock.py", "tests/logs/test_log.py"),
     "signals/choice.py": ("tests/signals/test_choice.py",),
+    "fleet/trends.py": ("tests/fleet/test_trends.py", "tests/fleet/test_trends_truth.py"),
+    "fleet/batch.py": ("tests/fleet/test_batch_truth.py", "tests/fleet/test_results.py"),
+    "fleet/task.py": ("tests/fleet/test_task.py", "tests/fleet/test_task_truth.py"),
 }
 """The modules mutated (under ``src/wbfriction``) and the fast tests run against each one's mutants (mutmut
 needs them all green on the unmutated code: it refuses to start otherwise). Tests marked ``slow`` are left out."""
@@ -343,13 +346,14 @@ def environment(copy: Path) -> dict[str, str]:
 
 
 def rerun(copy: Path, max_children: int, timeout: float, all_diffs: bool) -> int:
-    """Bring the checkout's tests into a kept copy and test again the mutants they did not kill (the
-    sources mutated must be unchanged); print the tallies before and after, and the survivors."""
+    """Bring the checkout's tests into a kept copy and test again the mutants they did not kill, and those
+    a budget left unchecked (the sources mutated must be unchanged); print the tallies before and after,
+    and the survivors."""
     env = environment(copy)
     before = read_mutants(copy, env)
     for tests in (copy / "tests", copy / "mutants" / "tests"):
         shutil.copytree(REPO / "tests", tests, ignore=IGNORE, dirs_exist_ok=True)
-    names = [m.name for m in before if m.checked and not m.killed]
+    names = [m.name for m in before if not m.killed]
     start = time.monotonic()
     finished = run_mutmut(copy, env, max_children, timeout, names)
     elapsed = time.monotonic() - start
@@ -372,7 +376,8 @@ def main() -> int:
     parser.add_argument("--json", type=Path, help="write every mutant's record here")
     parser.add_argument("--all-diffs", action="store_true", help="print the diffs of every survivor")
     parser.add_argument("--rerun", type=Path, metavar="DIR",
-                        help="a copy kept by --keep: test its survivors again with the checkout's tests")
+                        help="a copy kept by --keep: test its survivors (and unchecked mutants) again with the "
+                             "checkout's tests")
     parser.add_argument("--dump", type=Path, help=argparse.SUPPRESS)  # run in the copy by read_mutants
     args = parser.parse_args()
     if args.dump is not None:

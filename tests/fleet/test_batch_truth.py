@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
+import socket
 import subprocess
 import sys
 from datetime import UTC, datetime, timedelta
@@ -25,7 +27,6 @@ from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.results import failures_folder, read_failures, read_results, result_path
 from wbfriction.fleet.schema import RESULT_SCHEMA
 from wbfriction.fleet.task import LogOutcome
-from wbfriction.logs.tables import _host
 from wbfriction.pipeline.estimate import RobotSpec
 
 DAY = datetime(2026, 3, 1, 8, tzinfo=UTC)
@@ -214,7 +215,8 @@ def test_a_killed_batchs_temporary_files_are_removed(fleet):
     run_batch([entry(folder, "a", model="stribeck")], results, engine="serial")
     run_batch([entry(folder, "b")], results, engine="serial")
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
-    name = f".x.parquet.wbfriction-{_host()}-{int(dead.stdout)}-0123abcd.tmp.json"
+    host = re.sub(r"[^A-Za-z0-9]", "", socket.gethostname())[:32]  # a temporary's name, as tables.py documents it
+    name = f".x.parquet.wbfriction-{host}-{int(dead.stdout)}-0123abcd.tmp.json"
     for where in (results, results / "r1", failures_folder(results)):
         (where / name).write_bytes(b'{"log": "')
     run_batch([entry(folder, "b")], results, engine="serial")

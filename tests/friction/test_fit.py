@@ -16,15 +16,14 @@ from wbfriction.friction.fit import (
     FitResult,
     HeldOutScore,
     ModelSelection,
-    _fit_jacobian,
-    _from_fit,
-    _to_fit,
     choose_model,
     filtered_problem,
+    fit_coordinates_jacobian,
     fit_estimate,
     fit_friction,
     fit_joints,
     fitted_offsets,
+    from_fit_coordinates,
     held_out_rms,
     held_out_split,
     initial_guesses,
@@ -33,6 +32,7 @@ from wbfriction.friction.fit import (
     model_values,
     parameter_covariance,
     standard_errors,
+    to_fit_coordinates,
 )
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams, StribeckParams
 from wbfriction.friction.status import fit_verdict
@@ -375,17 +375,17 @@ def test_the_jacobian_in_the_fits_coordinates_is_the_derivative_there(model):
     the Jacobian the solver is given."""
     x = {"coulomb-viscous": [0.3, 0.5, 0.1], "stribeck": [0.3, 0.6, 1.0, 0.15, 0.1],
          "thesis": [0.3, 1.0, 0.5, 0.2, 0.1, 40.0]}[model]
-    z = _to_fit(model, np.array(x))
-    jac = _fit_jacobian(model, model_jacobian(_from_fit(model, z), QD, 2.0, model))
+    z = to_fit_coordinates(model, np.array(x))
+    jac = fit_coordinates_jacobian(model, model_jacobian(from_fit_coordinates(model, z), QD, 2.0, model))
     for i in range(len(z)):
         h = 1e-6 * max(1.0, abs(z[i]))
         up, down = z.copy(), z.copy()
         up[i] += h
         down[i] -= h
-        numeric = (model_values(_from_fit(model, up), QD, 2.0, model)
-                   - model_values(_from_fit(model, down), QD, 2.0, model)) / (2 * h)
+        numeric = (model_values(from_fit_coordinates(model, up), QD, 2.0, model)
+                   - model_values(from_fit_coordinates(model, down), QD, 2.0, model)) / (2 * h)
         np.testing.assert_allclose(jac[:, i], numeric, atol=1e-5 * max(1.0, np.abs(numeric).max()))
-    np.testing.assert_allclose(_from_fit(model, z), x, rtol=1e-15)
+    np.testing.assert_allclose(from_fit_coordinates(model, z), x, rtol=1e-15)
 
 
 def test_filtered_problem_of_the_default_model():

@@ -14,7 +14,7 @@ from conftest import constrained_forward, random_state
 from wbfriction.exceptions import ModelError
 from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
-from wbfriction.model.stance import _check_kinematics, body_frame, stance_frame_pose, stance_model
+from wbfriction.model.stance import body_frame, check_kinematics, stance_frame_pose, stance_model
 
 
 @pytest.mark.parametrize("contact", [0, 1])
@@ -158,4 +158,4 @@ def test_a_re_rooted_model_that_misplaces_a_body_is_refused(talos):
     j = broken.model.getJointId(talos.actuated[0])
     broken.model.jointPlacements[j] = broken.model.jointPlacements[j] * pin.SE3(np.eye(3), np.array([0.01, 0, 0]))
     with pytest.raises(ModelError, match=f"re-rooted model at '{st.frame}' disagrees with the original at body"):
-        _check_kinematics(talos, broken)
+        check_kinematics(talos, broken)

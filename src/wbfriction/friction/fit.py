@@ -127,25 +127,27 @@ def model_bounds(qd: np.ndarray, model: ModelName = "thesis") -> tuple[np.ndarra
     return lower, upper
 
 
-def _to_fit(model: ModelName, x: np.ndarray) -> np.ndarray:
-    """The fit's coordinates of the parameters ``x`` (as the model names them): the Stribeck
-    model's F_s becomes F_s - F_c, so that ``F_s >= F_c`` is a bound."""
+def to_fit_coordinates(model: ModelName, x: np.ndarray) -> np.ndarray:
+    """The fit's coordinates of ``model``'s parameters ``x`` (P,) (in the order of its names, e.g.
+    :data:`~wbfriction.friction.models.STRIBECK_NAMES`): the Stribeck model's F_s becomes F_s - F_c, so
+    that ``F_s >= F_c`` is a bound; the others as they are."""
     z = np.array(x, dtype=float)
     if model == "stribeck":
         z[2] = x[2] - x[1]
     return z
 
 
-def _from_fit(model: ModelName, z: np.ndarray) -> np.ndarray:
-    """Inverse of :func:`_to_fit`."""
+def from_fit_coordinates(model: ModelName, z: np.ndarray) -> np.ndarray:
+    """The model's parameters (P,) from the fit's coordinates ``z`` (P,): inverse of :func:`to_fit_coordinates`."""
     x = np.array(z, dtype=float)
     if model == "stribeck":
         x[2] = z[1] + z[2]
     return x
 
 
-def _fit_jacobian(model: ModelName, jac: np.ndarray) -> np.ndarray:
-    """The Jacobian in the fit's coordinates from the one in the model's (chain rule of :func:`_from_fit`)."""
+def fit_coordinates_jacobian(model: ModelName, jac: np.ndarray) -> np.ndarray:
+    """The Jacobian (N, P) in the fit's coordinates from ``jac`` (N, P) in the model's (the chain rule of
+    :func:`from_fit_coordinates`)."""
     if model == "stribeck":
         jac = jac.copy()
         jac[:, 1] += jac[:, 2]
@@ -405,7 +407,8 @@ def initial_guesses(qd: np.ndarray, y: np.ndarray, model: ModelName = "thesis") 
     if model == "coulomb-viscous":
         return [np.clip([F_v, F_c, tau_os], lower + 1e-9, upper - 1e-9)]
     if model == "stribeck":
-        return [_from_fit(model, np.clip([F_v, F_c, S * F_c, vs_frac * scale, tau_os], lower + 1e-9, upper - 1e-9))
+        return [from_fit_coordinates(model, np.clip([F_v, F_c, S * F_c, vs_frac * scale, tau_os],
+                                                    lower + 1e-9, upper - 1e-9))
                 for S, vs_frac in itertools.product((0.2, 1.0), (0.05, 0.2, 0.5))]
     starts = []
     for S, vs_frac, a_mul in itertools.product((0.2, 1.0), (0.05, 0.2, 0.5), (5.0, 50.0)):
@@ -647,13 +650,13 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     if model == "stribeck" and "F_s" in fixed and "F_c" not in fixed:
         raise InputError("the stribeck model's F_s can be held only with F_c held too")
     free = np.array([name not in fixed for name in names])
-    held = _to_fit(model, np.array([float(fixed.get(name, 0.0)) for name in names]))
+    held = to_fit_coordinates(model, np.array([float(fixed.get(name, 0.0)) for name in names]))
 
     def full(z: np.ndarray) -> np.ndarray:
         """The model's parameters from the free ones in the fit's coordinates."""
         x = held.copy()
         x[free] = z
-        return _from_fit(model, x)
+        return from_fit_coordinates(model, x)
 
     n = int(use.sum())
     v, yu = qd[use], y[use]
@@ -661,10 +664,10 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     if n < max(min_samples, len(names) + 1):
         return FitResult(joint, n, message=f"only {n} valid samples", model=model, speed=speed)
     starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(v, yu, model)
-    starts = [_to_fit(model, x) for x in starts]
+    starts = [to_fit_coordinates(model, x) for x in starts]
     starts = list({tuple(x[free]): x[free] for x in starts}.values())  # distinct over the free ones
     residual = lambda z: model_values(full(z), v, delta_s, model) - yu  # noqa: E731
-    jacobian = lambda z: _fit_jacobian(model, model_jacobian(full(z), v, delta_s, model))[:, free]  # noqa: E731
+    jacobian = lambda z: fit_coordinates_jacobian(model, model_jacobian(full(z), v, delta_s, model))[:, free]  # noqa: E731
     bounds = tuple(b[free] for b in model_bounds(v, model))
     # a short run from every start, then the two best refined
     if len(starts) > 1:
@@ -675,7 +678,7 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     if smoother is not None:
         f_residual, f_jacobian = filtered_problem(qd, y, use, smoother, delta_s, model)
         residual = lambda z: f_residual(full(z))  # noqa: E731
-        jacobian = lambda z: _fit_jacobian(model, f_jacobian(full(z)))[:, free]  # noqa: E731
+        jacobian = lambda z: fit_coordinates_jacobian(model, f_jacobian(full(z)))[:, free]  # noqa: E731
         natural_jacobian = lambda z: f_jacobian(full(z))[:, free]  # noqa: E731
         best = _solve(residual, jacobian, best.x, bounds, 200)
     # residuals correlated over the filter's window, or over the span of a model error;

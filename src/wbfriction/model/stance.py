@@ -242,7 +242,7 @@ def build_stance_model(robot: Robot, frame: str) -> StanceModel:
     reversed_joints = set(model.supports[fr.parentJoint])
     sign = np.array([-1.0 if model.getJointId(n) in reversed_joints else 1.0 for n in robot.actuated])
     stance = StanceModel(frame, rooted, v_index, sign, joint_layout(rooted, robot.actuated))
-    _check_kinematics(robot, stance)
+    check_kinematics(robot, stance)
     return stance
 
 
@@ -254,8 +254,14 @@ def stance_model(robot: Robot, contact_index: int) -> StanceModel:
     return robot.cache[key]
 
 
-def _check_kinematics(robot: Robot, stance: StanceModel, seed: int = 0) -> None:
-    """Check that both trees place every body alike relative to the contact frame."""
+def check_kinematics(robot: Robot, stance: StanceModel, seed: int = 0) -> None:
+    """Check that ``stance`` (the tree re-rooted at its contact frame, :func:`stance_model`) places every
+    body of ``robot`` where the original tree does, relative to the contact frame, at joint angles drawn
+    uniformly in [-1, 1] rad with ``seed`` (homogeneous transforms equal to 1e-9).
+
+    Raises:
+        ModelError: a body placed elsewhere, named with the contact frame.
+    """
     rng = np.random.default_rng(seed)
     angles = rng.uniform(-1.0, 1.0, robot.n_act)
     m, r = robot.model, stance.model
