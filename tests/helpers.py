@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -193,3 +194,14 @@ def mapped_copy(table: pa.Table, frames: tuple[str, ...]) -> tuple[pa.Table, str
         out = out.drop_columns([f"contact.{frame}"]).append_column(f"foot{k}.fz", pa.array(-(2.0 + 298.0 * flags)))
         toml += f'[[contacts]]\nframe = "{frame}"\ncolumn = "foot{k}.fz"\nthreshold = 50.0\n'
     return out.replace_schema_metadata(table.schema.metadata), toml
+
+
+def ended_within(proc: subprocess.Popen, seconds: float, after: str) -> tuple[str, str]:
+    """The standard output and error of ``proc`` (started in a session of its own) once it ends; if it is
+    still running ``seconds`` later, its group killed and the test failed, saying so ``after`` what."""
+    try:
+        return proc.communicate(timeout=seconds)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        _, err = proc.communicate()
+        pytest.fail(f"still running {seconds:g} s after {after}: {err}")

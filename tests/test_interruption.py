@@ -24,7 +24,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers import run
+from helpers import ended_within, run
 from wbfriction.logs.tables import write_json
 
 ESTIMATE = ("estimate", "--workers", "2", "--chunk-rows", "800")
@@ -182,12 +182,7 @@ def test_a_signal_while_the_pool_works_ends_the_command_within_seconds(friction_
     kids = _pool_busy(proc)
     (os.killpg if group else os.kill)(proc.pid, signum)
     t0 = time.monotonic()
-    try:
-        _, err = proc.communicate(timeout=30)  # its workers hold standard error too
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        _, err = proc.communicate()
-        pytest.fail(f"still running 30 s after {name}: {err}")
+    _, err = ended_within(proc, 30, name)  # its workers hold standard error too
     took = time.monotonic() - t0
     assert proc.returncode == 128 + signum, err
     assert _stderr_lines(err) == [f"interrupted ({name})"], err
@@ -228,12 +223,7 @@ def test_a_signal_while_a_batch_runs_on_dask_ends_it_with_one_line(arm_manifest,
     kids = _pool_busy(proc)
     time.sleep(1.0)
     (os.killpg if group else os.kill)(proc.pid, signum)
-    try:
-        _, err = proc.communicate(timeout=60)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        _, err = proc.communicate()
-        pytest.fail(f"still running 60 s after {name}: {err}")
+    _, err = ended_within(proc, 60, name)
     assert proc.returncode == 128 + signum, err
     assert _stderr_lines(err) == [f"interrupted ({name})"], err
     assert _wait_gone(kids, 10.0) < 10.0, f"left alive: {_alive(kids)}"

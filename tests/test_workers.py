@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from helpers import ended_within
 from wbfriction.workers import POLL_PERIOD, process_pool
 
 
@@ -191,12 +192,7 @@ def test_leaving_a_map_early_ends_at_once_without_a_thread_traceback(context, tm
     t0 = time.monotonic()
     proc = subprocess.Popen([sys.executable, str(script), context], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, start_new_session=True)
-    try:
-        out, err = proc.communicate(timeout=20)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        out, err = proc.communicate()
-        pytest.fail(f"still running 20 s after it started (interrupted after 1 s): {err}")
+    out, err = ended_within(proc, 20, "it started (interrupted after 1 s)")
     assert (proc.returncode, out, err) == (0, "stopped\n", "")
     assert time.monotonic() - t0 < 10.0
 
