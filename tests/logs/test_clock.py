@@ -227,7 +227,7 @@ def test_friction_of_a_walk_logged_by_a_clock_that_skips_samples(talos, walk_tab
     skipping = log_from_table(walk_table.take(pa.array(2 * np.arange(3000) + late)), talos, "a")
     uniform = log_from_table(walk_table.take(pa.array(2 * np.arange(3000))), talos, "u")
     assert skipping.clock.kind == "skipping" and uniform.clock.kind == "uniform"
-    opts = EstimateOptions(diff=diff)
+    opts = EstimateOptions(diff=diff, route="acceleration")
     a, u = estimate_log(talos, skipping, opts), estimate_log(talos, uniform, opts)
     both = (late == 0)[:, None] & a.valid & u.valid
     assert both.sum() > 10_000

@@ -2,9 +2,9 @@
 
 from .energy import JointEnergy as JointEnergy
 from .energy import energy_consistency as energy_consistency
-from .estimate import FrictionEstimate as FrictionEstimate
 from .estimate import estimate_friction as estimate_friction
 from .estimate import estimate_log as estimate_log
+from .estimated import FrictionEstimate as FrictionEstimate
 from .fit import FitResult as FitResult
 from .fit import fit_estimate as fit_estimate
 from .fit import fit_friction as fit_friction
@@ -17,4 +17,8 @@ from .io import write_params as write_params
 from .models import PARAM_NAMES as PARAM_NAMES
 from .models import FrictionParams as FrictionParams
 from .models import coulomb_viscous_stribeck as coulomb_viscous_stribeck
+from .momentum import momentum_estimate as momentum_estimate
 from .options import EstimateOptions as EstimateOptions
+from .options import MomentumOptions as MomentumOptions
+from .route import RouteDecision as RouteDecision
+from .route import resolve_route as resolve_route

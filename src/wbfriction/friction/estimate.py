@@ -20,12 +20,13 @@ Sign convention: ``tau_f`` is the torque friction exerts on the joint,
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import asdict, fields, replace
 from typing import Any, cast
 
 import numpy as np
 
 from wbfriction.exceptions import InputError
+from wbfriction.friction.estimated import FrictionEstimate, no_single_support
 from wbfriction.friction.measured import (
     base_route,
     impacts,
@@ -33,7 +34,9 @@ from wbfriction.friction.measured import (
     resolve_base_motion,
     wrench_route,
 )
-from wbfriction.friction.options import METHODS, EstimateOptions
+from wbfriction.friction.momentum import momentum_estimate
+from wbfriction.friction.options import METHODS, EstimateOptions, Route
+from wbfriction.friction.route import resolve_route
 from wbfriction.logs.log import Log
 from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
@@ -45,7 +48,6 @@ from wbfriction.signals.kinematics import (
     Diff,
     MeasuredKinematics,
     Scheme,
-    Smoother,
     joined_smoother,
     measure,
     straddling,
@@ -53,64 +55,6 @@ from wbfriction.signals.kinematics import (
 from wbfriction.signals.phases import Phases, joint_mask, segment
 
 CHUNK = 4096
-@dataclass
-class FrictionEstimate:
-    """Per-sample friction estimate of the torque-controlled joints.
-
-    Attributes:
-        joints: torque-controlled joint names (n_tc,).
-        time: (N,) [s].
-        qd: joint velocities (N, n_tc) [rad/s] (same differentiation as ``qdd_msr``).
-        tau_f: estimated friction torque (N, n_tc) [N·m]; NaN where not estimated.
-        qdd: measured accelerations ``qdd_msr`` (N, n_tc) [rad/s^2].
-        delta_qdd: acceleration difference (5.12) ``qdd_msr - qdd_est`` (N, n_tc)
-            [rad/s^2]; NaN where not estimated. ``qdd - delta_qdd`` is the estimated
-            acceleration ``qdd_est`` (5.10).
-        valid: (N, n_tc) samples to trust (single support, margins, mask).
-        phase: (N,) ``single`` / ``double`` / ``flight``.
-        unique: (N,) the estimate is the exact unique solution (single support).
-        cond: (N,) condition number of ``M_mod^{-1}`` (NaN where not computed), or None.
-        contact: (N, n_contacts) flags; ``contact_frames`` their names.
-        tau_f_true: (N, n_tc) true friction if the log had it, else None.
-        metadata: carried from the log, plus the options used.
-        companion_delta_qdd: the single-support acceleration difference through the other
-            kind of scheme (N, n_tc) [rad/s^2] (NaN elsewhere), or None: unfiltered
-            (central differences) for a filtering scheme, Savitzky-Golay filtered otherwise;
-            so that Fig. 7.4 can show the difference with and without filtering.
-            ``companion_diff`` names its scheme.
-        smoother: the zero-phase smoother the estimate went through (filtering schemes),
-            or None; the fit passes the model through it too
-            (:func:`~wbfriction.friction.fit.fit_friction`). A table records it as the
-            ``estimate_options`` of its metadata.
-        disagreement: (N, n_tc) ``tau_f`` of the measured route less the rigid-contact route's where both
-            estimated the sample (single support) [N·m], NaN elsewhere; None without a measured route
-            (:mod:`wbfriction.friction.cross_check`).
-        route: (N,) how each sample was estimated (:data:`~wbfriction.friction.measured.Route`):
-            ``contact`` (rigid contacts), ``base`` (measured base motion), ``wrench`` (measured
-            wrenches), ``none``; or None (a table that does not say: rigid contacts).
-    """
-
-    joints: tuple[str, ...]
-    time: np.ndarray
-    qd: np.ndarray
-    tau_f: np.ndarray
-    valid: np.ndarray
-    phase: np.ndarray
-    unique: np.ndarray
-    contact: np.ndarray
-    contact_frames: tuple[str, ...]
-    qdd: np.ndarray | None = None
-    delta_qdd: np.ndarray | None = None
-    cond: np.ndarray | None = None
-    tau_f_true: np.ndarray | None = None
-    metadata: dict = field(default_factory=dict)
-    smoother: Smoother | None = None
-    companion_delta_qdd: np.ndarray | None = None
-    companion_diff: str | None = None
-    route: np.ndarray | None = None
-    disagreement: np.ndarray | None = None
-
-
 def single_support_friction_rnea(robot: Robot, contact_index: int, angles: np.ndarray, qd: np.ndarray,
                                  qdd: np.ndarray, tau_tc: np.ndarray, base: np.ndarray | None = None,
                                  progress: Progress | None = None,
@@ -186,14 +130,6 @@ def regularised_least_squares(Mmod_inv: np.ndarray, delta_qdd: np.ndarray, weigh
     lhs = At @ W @ Mmod_inv + L
     rhs = (At @ W @ delta_qdd[..., None])
     return np.linalg.solve(lhs, rhs)[..., 0]
-
-
-def no_single_support(robot: Robot, source: str) -> InputError:
-    """The error of a log without a single-support sample, naming it and its contact columns."""
-    return InputError(f"{source}: no single-support sample (exactly one of the columns "
-                      f"{', '.join('contact.' + f for f in robot.contact_frames)} set) with defined derivatives "
-                      "outside the lift-off and touch-down margins (--lift-off, --touch-down) and the "
-                      "differentiation's window (--window, --cutoff)")
 
 
 def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOptions = EstimateOptions(),
@@ -316,9 +252,13 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
             single-support sample in the whole log).
     """
     options, choice = resolve_differentiation(options, log)
+    options, decision = resolve_route(options, log, choice=choice)
     est = _estimate_parts(robot, log, options, progress, companion, require_single_support)
-    if choice is not None:
-        est.metadata["differentiation"] = choice.to_dict()
+    for e in (est, est.route_check):
+        if e is not None and choice is not None:
+            e.metadata["differentiation"] = choice.to_dict()
+        if e is not None and decision is not None:
+            e.metadata["route"] = decision.to_dict()
     return est
 
 
@@ -371,6 +311,22 @@ def _estimate_parts(robot: Robot, log: Log, options: EstimateOptions, progress: 
 
 def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress, companion: bool,
                       require_single_support: bool, gaps: tuple[bool, bool] = (False, False)) -> FrictionEstimate:
+    """One segment by ``options.route``, and by the other route as its check (``options.check_route``)."""
+    if options.route == "auto":
+        raise InputError("route 'auto' is resolved once per log (resolve_route), not per segment")
+    if options.route == "momentum":
+        est = momentum_estimate(robot, log, options, progress, require_single_support, gaps)
+    else:
+        est = _acceleration_segment(robot, log, options, progress, companion, require_single_support, gaps)
+    if options.check_route:
+        other: Route = "acceleration" if options.route == "momentum" else "momentum"
+        est.route_check = _estimate_segment(robot, log, replace(options, route=other, check_route=False), None,
+                                            False, False, gaps)
+    return est
+
+
+def _acceleration_segment(robot: Robot, log: Log, options: EstimateOptions, progress, companion: bool,
+                          require_single_support: bool, gaps: tuple[bool, bool] = (False, False)) -> FrictionEstimate:
     if options.diff == "auto":
         raise InputError("diff 'auto' is resolved once per log (resolve_differentiation), not per segment")
     has_wrench = options.wrenches and log.wrench is not None
@@ -395,8 +351,9 @@ def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress
     return est
 
 
-def _blank(template: FrictionEstimate, log: Log) -> FrictionEstimate:
-    """An estimate of ``log``'s rows with nothing estimated (NaN, invalid), shaped like ``template``."""
+def _blank(template: FrictionEstimate, log: Log | FrictionEstimate) -> FrictionEstimate:
+    """An estimate of the rows of ``log`` (a log, or an estimate of it) with nothing estimated (NaN, invalid), shaped
+    like ``template``."""
     n = len(log.time)
     nan = lambda x: None if x is None else np.full((n, *np.shape(x)[1:]), np.nan)  # noqa: E731
     return FrictionEstimate(
@@ -408,7 +365,8 @@ def _blank(template: FrictionEstimate, log: Log) -> FrictionEstimate:
         tau_f_true=log.tau_f_true, metadata=template.metadata, smoother=template.smoother,
         companion_delta_qdd=nan(template.companion_delta_qdd), companion_diff=template.companion_diff,
         disagreement=nan(template.disagreement),
-        route=None if template.route is None else np.full(n, "none", dtype=template.route.dtype))
+        route=None if template.route is None else np.full(n, "none", dtype=template.route.dtype),
+        route_check=None if template.route_check is None else _blank(template.route_check, log))
 
 
 def concat_estimates(parts: list[FrictionEstimate]) -> FrictionEstimate:
@@ -425,4 +383,8 @@ def concat_estimates(parts: list[FrictionEstimate]) -> FrictionEstimate:
         else:
             out[f.name] = getattr(first, f.name)
     out["smoother"] = joined_smoother([p.smoother for p in parts], [len(p.time) for p in parts])
+    checks = [p.route_check for p in parts]
+    template = next((c for c in checks if c is not None), None)
+    out["route_check"] = None if template is None else concat_estimates(
+        [c if c is not None else _blank(template, p) for c, p in zip(checks, parts)])
     return FrictionEstimate(**out)

@@ -33,17 +33,24 @@ from wbfriction.logs.clock import read_clock
 from wbfriction.logs.tables import file_sha256, numeric_column, read_metadata, read_table, with_metadata, write_json
 from wbfriction.signals.kinematics import SCHEMES, Smoother, make_smoother
 from wbfriction.signals.options import FilterOptions
+from wbfriction.signals.window import MomentumWindow
 
 SIGN_CONVENTION = "tau_f = -f(qd); fit of f (the joint's model, eqs. 3.1-3.5) to -tau_f"
 """What the parameters JSON of ``wbfriction fit`` states of its sign."""
 
 
 # ------------------------------------------------------------------ friction table
+CHECK = "check."
+"""Prefix of the columns of the other route's estimate (:attr:`FrictionEstimate.route_check`): ``check.qd.<j>``,
+``check.tau_f.<j>``, ``check.valid.<j>``; its metadata is the table's key ``route_check``."""
+
+
 def friction_table(est: FrictionEstimate) -> pa.Table:
     """The estimate as an Arrow table: ``time``, ``phase``, ``unique``, [``route``], [``cond``],
     ``contact.<frame>``, and per joint ``qd.<j>``, ``tau_f.<j>``, ``valid.<j>``,
-    ``qdd.<j>``, ``delta_qdd.<j>``, [``delta_qdd_companion.<j>``], [``disagreement.<j>``], [``tau_f_true.<j>``];
-    the companion's scheme is the metadata key ``companion_diff``."""
+    ``qdd.<j>``, ``delta_qdd.<j>``, [``delta_qdd_companion.<j>``], [``disagreement.<j>``], [``tau_f_true.<j>``],
+    [the other route's ``check.qd.<j>``, ``check.tau_f.<j>``, ``check.valid.<j>`` (:data:`CHECK`)];
+    the companion's scheme is the metadata key ``companion_diff``, the other route's metadata ``route_check``."""
     cols: dict[str, object] = {"time": est.time, "phase": pa.array(est.phase.astype(str)),
                                "unique": est.unique}
     if est.route is not None:
@@ -63,6 +70,13 @@ def friction_table(est: FrictionEstimate) -> pa.Table:
         if est.tau_f_true is not None and not np.all(np.isnan(est.tau_f_true[:, i])):
             cols[f"tau_f_true.{j}"] = est.tau_f_true[:, i]
     metadata = dict(est.metadata)
+    check = est.route_check
+    if check is not None:
+        for i, j in enumerate(est.joints):
+            cols.update({f"{CHECK}qd.{j}": check.qd[:, i], f"{CHECK}tau_f.{j}": check.tau_f[:, i],
+                         f"{CHECK}valid.{j}": check.valid[:, i]})
+        metadata["route_check"] = {k: v for k, v in check.metadata.items()
+                                   if k in ("estimate_options", "momentum", "base_motion", "velocity_noise")}
     if est.companion_diff is not None:
         metadata["companion_diff"] = est.companion_diff
     return with_metadata(pa.table(cols), metadata)
@@ -107,12 +121,20 @@ def _table_smoother(meta: dict, time: np.ndarray, source: str) -> Smoother | Non
     dt = float(np.median(np.diff(time)))
     clock = meta.get("clock", {})
     kind = clock.get("kind") if isinstance(clock, dict) else None
+    t = None
     if kind == "skipping":  # differentiated on the stamps as recorded
-        return make_smoother(diff, filtering, dt, t=time - time[0])
-    if kind == "jittered":  # differentiated on the regularised clock: rebuilt from the same stamps
+        t = time - time[0]
+    elif kind == "jittered":  # differentiated on the regularised clock: rebuilt from the same stamps
         regular = read_clock(time, source, time_base="regularised")
-        return make_smoother(diff, filtering, regular.period, t=regular.t)
-    return make_smoother(diff, filtering, dt)
+        dt, t = regular.period, regular.t
+    if opts.get("route", "acceleration") == "momentum":
+        momentum = opts.get("momentum", {})
+        window = momentum.get("window") if isinstance(momentum, dict) else None
+        if not isinstance(window, int) or window < 3 or window % 2 == 0:
+            raise InputError(f"{source}: the metadata's estimate_options.momentum.window is {window!r}, not an odd "
+                             "number of samples")
+        return MomentumWindow(window // 2, dt, t)
+    return make_smoother(diff, filtering, dt, t)
 
 
 def _check_targets(meta: dict, source: str) -> None:
@@ -143,7 +165,7 @@ def read_friction_table(table: pa.Table, source: str = "<table>") -> FrictionEst
         InputError: no joint, or a missing column (named with ``source``).
     """
     names = table.column_names
-    joints = tuple(c[len("tau_f."):] for c in names if c.startswith("tau_f."))
+    joints = tuple(c[len("tau_f."):] for c in names if c.startswith("tau_f."))  # check.tau_f.* start otherwise
     if not joints:
         raise InputError(f"{source}: no 'tau_f.<joint>' column: not a friction table from 'wbfriction estimate'")
     for c in ("time", *[f"{p}{j}" for j in joints for p in ("qd.", "valid.")]):
@@ -171,7 +193,21 @@ def read_friction_table(table: pa.Table, source: str = "<table>") -> FrictionEst
     companion_diff = meta.get("companion_diff")
     if companion_diff is not None and companion_diff not in SCHEMES:
         raise InputError(f"{source}: the metadata's companion_diff is {companion_diff!r}, not a scheme")
+    route_check = None
+    if any(f"{CHECK}tau_f.{j}" in names for j in joints):
+        for c in (f"{CHECK}{p}{j}" for j in joints for p in ("qd.", "tau_f.", "valid.")):
+            if c not in names:
+                raise ColumnError(source, c, None, f"missing column '{c}'")
+        check_meta = meta.get("route_check")
+        if not isinstance(check_meta, dict):
+            raise InputError(f"{source}: columns '{CHECK}*' without the metadata's route_check")
+        route_check = FrictionEstimate(
+            joints=joints, time=time, qd=stack(f"{CHECK}qd"), tau_f=stack(f"{CHECK}tau_f"),
+            valid=stack(f"{CHECK}valid", True).astype(bool), phase=phase, unique=unique, contact=contact,
+            contact_frames=frames, metadata=dict(check_meta), smoother=_table_smoother(
+                {**check_meta, "clock": meta.get("clock", {})}, time, source))
     return FrictionEstimate(
+        route_check=route_check,
         joints=joints, time=time, qd=stack("qd"), tau_f=stack("tau_f"), valid=stack("valid", True).astype(bool),
         phase=phase, unique=unique, contact=contact, contact_frames=frames,
         qdd=_optional_columns(table, "qdd", joints, source),

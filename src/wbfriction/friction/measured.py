@@ -31,7 +31,7 @@ from wbfriction.model.measured_dynamics import measured_inverse_dynamics
 from wbfriction.model.robot import Robot
 from wbfriction.signals.kinematics import MeasuredKinematics
 
-Route = Literal["contact", "base", "wrench", "none"]
+Closure = Literal["contact", "base", "wrench", "none"]
 """How a sample's friction was estimated: rigid contacts, measured base motion, measured wrenches, or not."""
 
 

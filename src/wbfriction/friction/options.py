@@ -19,6 +19,40 @@ differentiated like the joints, the IMU (its gyro and accelerometer, the logged 
 ``auto`` (:func:`~wbfriction.friction.measured.resolve_base_motion`)."""
 BASE_MOTIONS: tuple[BaseMotion, ...] = get_args(BaseMotion)
 
+Route = Literal["acceleration", "momentum"]
+"""How the friction is reached from the motion (issue 38): the thesis's ``acceleration`` route (positions
+differentiated twice, :mod:`~wbfriction.friction.estimate`) or the ``momentum`` route (once,
+:mod:`~wbfriction.friction.momentum`)."""
+ROUTES: tuple[Route, ...] = get_args(Route)
+RouteOption = Literal["auto", "acceleration", "momentum"]
+"""A route, or ``auto``: chosen from the log's position noise (:func:`~wbfriction.friction.route.resolve_route`)."""
+ROUTE_OPTIONS: tuple[RouteOption, ...] = get_args(RouteOption)
+
+
+@dataclass(frozen=True)
+class MomentumOptions:
+    """The momentum route's smoothing (:mod:`~wbfriction.friction.momentum`); None: chosen from the data
+    (:func:`~wbfriction.signals.choice.choose_momentum_smoothing`).
+
+    Attributes:
+        velocity_window: Savitzky-Golay window of the velocity (order 4) [samples, odd, >= 7].
+        window: the momentum window's length ``2m + 1`` [samples, odd, >= 3]
+            (:class:`~wbfriction.signals.window.MomentumWindow`).
+
+    Raises:
+        InputError: a window that is not odd or too short (named by its option).
+    """
+
+    velocity_window: int | None = None
+    window: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.velocity_window is not None and (self.velocity_window < 7 or self.velocity_window % 2 == 0):
+            raise InputError(f"--velocity-window must be odd and at least 7 samples, got {self.velocity_window}")
+        if self.window is not None and (self.window < 3 or self.window % 2 == 0):
+            raise InputError(f"--momentum-window must be odd and at least 3 samples, got {self.window}")
+
+
 Method = Literal["rnea", "kkt"]
 """The single-support route: one RNEA pass on the stance-rooted tree, or the KKT system (5.10-5.13)."""
 METHODS: tuple[Method, ...] = get_args(Method)
@@ -32,7 +66,8 @@ class EstimateOptions:
         diff: differentiation scheme: ``central``, ``backward``, ``savgol``, ``butterworth``
             (:mod:`~wbfriction.signals.kinematics`, :mod:`~wbfriction.signals.filters`), ``true``,
             or ``auto``: chosen from the log's positions with its window or cutoff
-            (:func:`~wbfriction.friction.estimate.resolve_differentiation`; the command line's default), once per log.
+            (:func:`~wbfriction.friction.estimate.resolve_differentiation`; the default, as on the command line), once
+            per log.
         compensate_delay: shift the derivatives by their delay (6.1.2).
         torque_alignment: ``zoh`` (mean of tau[k-1], tau[k]), ``sample``, or ``auto``
             (what the log's metadata declares, else ``zoh``).
@@ -57,9 +92,14 @@ class EstimateOptions:
             ``auto`` (:func:`~wbfriction.friction.measured.resolve_base_motion`).
         wrenches: use the force-torque sensors' wrenches where the log has them: every joint's
             friction in every phase (:func:`~wbfriction.friction.measured.wrench_route`).
+        route: ``acceleration``, ``momentum`` or ``auto`` (:data:`RouteOption`; resolved once per log by
+            :func:`~wbfriction.friction.route.resolve_route`).
+        momentum: the momentum route's windows (:class:`MomentumOptions`).
+        check_route: also estimate the other route, whose fit the status compares
+            (:attr:`~wbfriction.friction.estimate.FrictionEstimate.route_check`).
     """
 
-    diff: Diff | Literal["auto"] = "central"
+    diff: Diff | Literal["auto"] = "auto"
     compensate_delay: bool = True
     torque_alignment: TorqueAlignment | Literal["auto"] = "auto"
     lift_off_skip: float = 0.10
@@ -74,10 +114,15 @@ class EstimateOptions:
     velocity: Velocity = "differentiated"
     base_motion: BaseMotion = "auto"
     wrenches: bool = True
+    route: RouteOption = "auto"
+    momentum: MomentumOptions = MomentumOptions()
+    check_route: bool = True
 
     def __post_init__(self) -> None:
         if self.base_motion not in BASE_MOTIONS:
             raise InputError(f"unknown base motion '{self.base_motion}': choose one of {', '.join(BASE_MOTIONS)}")
+        if self.route not in ROUTE_OPTIONS:
+            raise InputError(f"unknown route '{self.route}': choose one of {', '.join(ROUTE_OPTIONS)}")
 
 
 DEFAULT_THRESHOLD = 0.05

@@ -33,6 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.model.force_torque import above_sensors_model, external_wrenches
+from wbfriction.model.momentum import momentum_and_drift
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
 
@@ -130,3 +131,29 @@ def measured_inverse_dynamics(robot: Robot, q: np.ndarray, v: np.ndarray, qdd: n
     if progress is not None and n % 1024:
         progress(n % 1024)
     return MeasuredDynamics(tau, a_base, residual, unique)
+
+
+def measured_momentum(robot: Robot, q: np.ndarray, v: np.ndarray, wrench: np.ndarray,
+                      progress: Progress | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The generalized momentum of the actuated joints and its rate without friction on the robot above its
+    force-torque sensors, the measured wrenches acting on it (the momentum route's ``wrench`` closure,
+    :mod:`wbfriction.friction.momentum`): ``p = (M v)_j``, ``b = (C^T v - g)_j`` and the sensors' ``e = (sum_s
+    J_s^T f_s)_j`` (:func:`~wbfriction.model.momentum.momentum_and_drift`), so that ``dp/dt = tau + tau_f + b + e``
+    with no unknown wrench, in every phase.
+
+    Args:
+        robot: the robot (its :attr:`~wbfriction.model.robot.Robot.ft_sensors`).
+        q: configurations (N, nq), the base pose included; v: velocities (N, nv), the base twist in the base
+            frame (its linear part too: unlike the accelerations' route, momenta are not the same in every
+            inertial frame, only their balance is).
+        wrench: measured wrenches (N, n_sensors, 6), each in its sensor frame [N, N·m].
+        progress: optional callable receiving numbers of samples done.
+
+    Returns:
+        ``(p, b, e)``, (N, n_act) each [N·m·s], [N·m], [N·m].
+    """
+    model = _above_sensors(robot)
+    p, b, e = momentum_and_drift(model, q, v, fext=lambda k: external_wrenches(model, robot.ft_sensors, wrench[k]),
+                                 progress=progress)
+    iv = robot.act_v_index
+    return p[:, iv], b[:, iv], e[:, iv]

@@ -32,7 +32,9 @@ import pinocchio as pin
 
 from wbfriction.exceptions import ModelError
 from wbfriction.model.layout import JointLayout, joint_layout
+from wbfriction.model.momentum import momentum_and_drift
 from wbfriction.model.robot import Robot
+from wbfriction.progress import Progress
 
 _G = pin.graph
 _GRAPH_JOINTS = {
@@ -159,6 +161,32 @@ class StanceModel:
             B, D = x[:, v_index[joints], 1:], x[:, v_index[held], 1:]
             x_t = x_t - (B @ np.linalg.solve(D, x_p[..., None]))[..., 0]
         return x_t * self.sign[joints]
+
+    def momentum(self, angles: np.ndarray, qd: np.ndarray, frame_pose: np.ndarray | None = None,
+                 progress: Progress | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The generalized momentum ``p = M qd`` and its rate without friction ``b = C^T qd - g`` of the
+        actuated joints on the tree rooted at the welded contact frame
+        (:func:`~wbfriction.model.momentum.momentum_and_drift`): ``dp/dt = tau + tau_f + b`` row by row.
+
+        Args:
+            angles, qd: joint positions [rad] and velocities [rad/s] of the actuated joints (N, n_act).
+            frame_pose: the contact frame's world pose (N, 7) (:func:`stance_frame_pose`): gravity seen by a
+                foot that is not flat; None: flat.
+            progress: optional callable receiving numbers of samples done.
+
+        Returns:
+            ``(p, b)``, (N, n_act) each [N·m·s], [N·m], in the original joints' signs.
+        """
+        model, _, v_index = self._locked_root()
+        q = self.layout.configuration(angles, None, self.sign)[:, self.layout.root_nq:]
+        v = np.zeros((len(angles), model.nv))
+        v[:, v_index] = qd * self.sign
+        gravity = None
+        if frame_pose is not None:  # R^T g: world gravity in the foot's frame
+            R = np.array([pin.XYZQUATToSE3(x).rotation for x in frame_pose])
+            gravity = np.einsum("nji,j->ni", R, self.model.gravity.linear)
+        p, b, _ = momentum_and_drift(model, q, v, gravity=gravity, progress=progress)
+        return p[:, v_index] * self.sign, b[:, v_index] * self.sign
 
     def _locked_root(self) -> tuple[pin.Model, pin.Data, np.ndarray]:
         """The tree with its root joint locked (the contact frame welded), its data, and the velocity

@@ -27,6 +27,7 @@ from wbfriction.exceptions import InputError, OutputError
 from wbfriction.friction.estimate import estimate_log, no_single_support, resolve_differentiation
 from wbfriction.friction.io import friction_table
 from wbfriction.friction.options import EstimateOptions
+from wbfriction.friction.route import resolve_route
 from wbfriction.logs.clock import Clock, TimeBase, TimeUnit, longest_segment
 from wbfriction.logs.log import log_from_table
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
@@ -171,7 +172,8 @@ class ChunkedResult:
     """What :func:`estimate_file` did: rows, chunks, and their contact-change cuts; ``clock``: the
     one line saying what the stamps are and which time base was used (:attr:`Clock.reason
     <wbfriction.logs.clock.Clock.reason>`); ``differentiation``: the line saying which scheme ``diff="auto"``
-    chose and why (:class:`~wbfriction.signals.choice.DiffChoice`), or ""."""
+    chose and why (:class:`~wbfriction.signals.choice.DiffChoice`), or ""; ``route``: the line saying which route
+    ``route="auto"`` took and its windows (:class:`~wbfriction.friction.route.RouteDecision`), or ""."""
 
     rows: int
     chunks: int
@@ -180,6 +182,7 @@ class ChunkedResult:
     clock: str = ""
     differentiation: str = ""
     warnings: tuple[str, ...] = ()
+    route: str = ""
 
 
 def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options: EstimateOptions = EstimateOptions(),
@@ -229,6 +232,9 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     options, choice = resolve_differentiation(options, first, clock.step)
     if choice is not None:
         extra_metadata = {**(extra_metadata or {}), "differentiation": choice.to_dict()}
+    options, decision = resolve_route(options, first, clock.step, choice)
+    if decision is not None:
+        extra_metadata = {**(extra_metadata or {}), "route": decision.to_dict()}
     n = len(contact)
     chunks = plan_chunks(contact, chunking)
     del contact
@@ -243,7 +249,7 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
                                           chunks, robot, source, extra_metadata, progress, first_meta, valid))
     return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta,
                          clock.reason, "" if choice is None else choice.reason,
-                         plan.warnings + no_valid_warnings(source, valid))
+                         plan.warnings + no_valid_warnings(source, valid), "" if decision is None else decision.reason)
 
 
 @contextmanager

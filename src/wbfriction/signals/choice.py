@@ -353,10 +353,11 @@ def _positions(source: Log | np.ndarray, dt: float | None) -> tuple[np.ndarray, 
     return np.asarray(source, dtype=float), dt
 
 
-def _savgol(sigma: float, dt: float, order: int, weights: SavgolWeights, target: float,
-            longest: int) -> tuple[FilterOptions, float, bool]:
-    """The shortest window whose noise left meets the target (bisection: the kernel's norm
-    falls as the window grows), else the longest."""
+def savgol_choice(sigma: float, dt: float, order: int, weights: SavgolWeights, target: float,
+                  longest: int) -> tuple[FilterOptions, float, bool]:
+    """The Savitzky-Golay window (order ``order``) whose second derivative leaves at most ``target`` [rad/s^2]
+    of a white position noise ``sigma`` [rad]: the shortest (bisection: the kernel's norm falls as the window
+    grows), else the ``longest``; returns its options, the noise it leaves and whether it meets the target."""
     smallest = order + 2 + (order + 1) % 2
     left = lambda w: sigma * savgol_noise_gain(w, order, dt, weights)  # noqa: E731
     window = _shortest(lambda w: left(w) <= target, smallest, max(smallest, longest))
@@ -439,7 +440,7 @@ def choose_differentiation(source: Log | np.ndarray, dt: float | None = None, *,
         options, left, reached = _butterworth(sigma, dt, butter_order, target, lowest=float(content.freq[1]))
         f3, label = options.cutoff, f"butterworth {options.cutoff:.4g} Hz order {butter_order}"
     else:
-        options, left, reached = _savgol(sigma, dt, poly_order, weights, target, longest=len(q) // 2 * 2 - 1)
+        options, left, reached = savgol_choice(sigma, dt, poly_order, weights, target, longest=len(q) // 2 * 2 - 1)
         f3 = savgol_cutoff(options.window, poly_order, dt, weights)
         label = (f"savgol L={options.window} k={poly_order}" + ("" if weights == "uniform" else f" {weights}")
                  + f" (-3 dB at {f3:.3g} Hz)")
@@ -448,3 +449,77 @@ def choose_differentiation(source: Log | np.ndarray, dt: float | None = None, *,
                    noise_left=left, filter_cutoff=f3, reached=reached,
                    reason=f"{label}, {why}: it leaves {left:.2g} rad/s^2 of noise in the acceleration (target "
                           f"{target:g}; central differences {central:.3g}); {facts}")
+
+
+# ------------------------------------------------------------- the momentum route's smoothing
+VELOCITY_NOISE_TARGET = 0.002
+"""Most RMS noise the momentum route's velocity filter may leave [rad/s] (issue 38): the velocity is the
+friction model's argument, and a noisy argument inside ``sgn``/``tanh`` biases the fit (errors in variables,
+corrected in :mod:`wbfriction.friction.fit` but only to first order); with 1e-4 rad of position noise at
+1 kHz it picks a 57-sample window (61 measured best in issue 38's study, 0.0018 rad/s)."""
+MOMENTUM_ORDER = 4
+"""Polynomial order of the momentum route's Savitzky-Golay velocity."""
+
+
+def velocity_noise_gain(window: int, dt: float, order: int = MOMENTUM_ORDER) -> float:
+    """RMS velocity [1/s] the Savitzky-Golay first derivative makes of unit white position noise: the norm
+    of its kernel."""
+    return float(np.linalg.norm(savgol_kernels(window, order, dt, "uniform", max_deriv=1)[1]))
+
+
+def momentum_noise_gain(velocity_window: int, half_width: int, dt: float, order: int = MOMENTUM_ORDER) -> float:
+    """RMS acceleration [1/s^2] the momentum route leaves of unit white position noise, per unit inertia: the
+    norm of the Savitzky-Golay velocity kernel convolved with the window's differences,
+    ``-sum (w_i - w_{i-1}) qd_i / sum w dt`` (:mod:`wbfriction.signals.window`)."""
+    from wbfriction.signals.window import hann_steps
+    d1 = savgol_kernels(velocity_window, order, dt, "uniform", max_deriv=1)[1]
+    w = hann_steps(half_width)
+    return float(np.linalg.norm(np.convolve(np.r_[w, 0.0] - np.r_[0.0, w], d1)) / (w.sum() * dt))
+
+
+@dataclass(frozen=True)
+class MomentumSmoothing:
+    """The momentum route's two windows, chosen from the position noise (:func:`choose_momentum_smoothing`).
+
+    Attributes:
+        velocity_window: the Savitzky-Golay window of the velocity [samples, odd] (order :data:`MOMENTUM_ORDER`).
+        window: the momentum window's length ``2m + 1`` [samples, odd] (:mod:`wbfriction.signals.window`).
+        velocity_noise: RMS noise the velocity filter leaves [rad/s].
+        noise_left: RMS acceleration noise the route leaves per unit inertia [rad/s^2].
+        reached: both targets met (False: the longest windows allowed).
+    """
+
+    velocity_window: int
+    window: int
+    velocity_noise: float
+    noise_left: float
+    reached: bool
+
+
+def choose_momentum_smoothing(sigma: float, dt: float, n_samples: int, *,
+                              velocity_target: float = VELOCITY_NOISE_TARGET, target: float = NOISE_TARGET,
+                              velocity_window: int | None = None, window: int | None = None) -> MomentumSmoothing:
+    """The shortest velocity window that leaves at most ``velocity_target`` of a white position noise ``sigma``
+    [rad], then the shortest momentum window that leaves at most ``target`` in the acceleration (both by
+    bisection: the noise left falls as a window grows), each at most half the log; a window given is kept.
+
+    Raises:
+        InputError: a negative ``sigma``, a log too short for the shortest windows.
+    """
+    if not sigma >= 0:
+        raise InputError(f"momentum smoothing: the position noise must be >= 0 rad, got {sigma}")
+    smallest = MOMENTUM_ORDER + 2 + (MOMENTUM_ORDER + 1) % 2
+    longest = max(smallest, (n_samples // 4) * 2 - 1)
+    reached = True
+    if velocity_window is None:
+        found = _shortest(lambda w: sigma * velocity_noise_gain(w, dt) <= velocity_target, smallest, longest)
+        reached &= found is not None
+        velocity_window = found if found is not None else longest
+    longest_half = max(1, (n_samples // 4))
+    if window is None:
+        ok = lambda h: sigma * momentum_noise_gain(velocity_window, h, dt) <= target  # noqa: E731
+        found = _shortest(lambda w: ok((w - 1) // 2), 3, 2 * longest_half + 1)
+        reached &= found is not None
+        window = found if found is not None else 2 * longest_half + 1
+    return MomentumSmoothing(velocity_window, window, sigma * velocity_noise_gain(velocity_window, dt),
+                             sigma * momentum_noise_gain(velocity_window, (window - 1) // 2, dt), reached)

@@ -52,6 +52,7 @@ from wbfriction.signals.filters import SavgolSmoother, ZeroPhaseLowpass, savgol_
 from wbfriction.signals.nonuniform import NonUniformSavgol, ResampledLowpass
 from wbfriction.signals.options import FilterOptions
 from wbfriction.signals.velocity import velocity_lag
+from wbfriction.signals.window import MomentumWindow
 
 
 def central_differences(q: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, int]:
@@ -104,7 +105,7 @@ class PiecewiseSmoother:
         return out
 
 
-Smoother = SavgolSmoother | ZeroPhaseLowpass | NonUniformSavgol | ResampledLowpass | PiecewiseSmoother
+Smoother = SavgolSmoother | ZeroPhaseLowpass | NonUniformSavgol | ResampledLowpass | MomentumWindow | PiecewiseSmoother
 
 
 def joined_smoother(smoothers: list[Smoother | None], lengths: list[int]) -> Smoother | None:
