@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.fit import fit_friction, fit_joints, model_jacobian, model_values, standard_errors
+from wbfriction.friction.fit import fit_friction, fit_joints, standard_errors
 from wbfriction.friction.models import (
     MODEL_NAMES,
     MODEL_PARAMS,
@@ -19,6 +19,8 @@ from wbfriction.friction.models import (
     coulomb_viscous,
     coulomb_viscous_stribeck,
     friction_torque,
+    model_jacobian,
+    model_values,
     params_from_dict,
     stribeck,
     stribeck_viscous,

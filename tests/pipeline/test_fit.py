@@ -10,7 +10,7 @@ import pyarrow as pa
 import pytest
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.fit import fit_friction
+from wbfriction.friction.fit import STICK_FLOOR, fit_friction
 from wbfriction.friction.io import read_params
 from wbfriction.friction.models import CoulombViscousParams, StribeckParams
 from wbfriction.logs.tables import write_table
@@ -63,7 +63,7 @@ def test_named_thesis_model_reports_its_bounds_as_the_library_fit_does(table, tm
     knee = doc["joints"]["knee"]
     assert doc["model"] == "thesis" and "selection_tolerance" not in doc and "selection" not in knee
     assert knee["model"] == "thesis" and knee["at_bound"]["S"] and knee["params"]["S"] == pytest.approx(50.0)
-    direct = fit_friction(qd, cols["tau_f.knee"], model="thesis")
+    direct = fit_friction(qd, cols["tau_f.knee"], model="thesis", stick=STICK_FLOOR, stick_margin=1)
     assert knee["params"] == direct.params.to_dict() and knee["at_bound"] == direct.at_bound
 
 

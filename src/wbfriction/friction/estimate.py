@@ -35,8 +35,10 @@ from wbfriction.friction.measured import (
     wrench_route,
 )
 from wbfriction.friction.momentum import momentum_estimate
+from wbfriction.friction.noise import noise_record
 from wbfriction.friction.options import METHODS, EstimateOptions, Route
 from wbfriction.friction.route import resolve_route
+from wbfriction.logs.clock import longest_segment
 from wbfriction.logs.log import Log
 from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
@@ -246,6 +248,10 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
     :func:`companion_scheme` (:attr:`FrictionEstimate.companion_delta_qdd`; one more
     inverse-dynamics pass over the single-support samples).
 
+    The route (``options.route``, :func:`~wbfriction.friction.route.resolve_route`) and the differentiation
+    (:func:`resolve_differentiation`) are chosen once for the log, and recorded in the metadata (``route``,
+    ``differentiation``) with the noise the fit reads (``noise``, :func:`~wbfriction.friction.noise.noise_record`).
+
     Raises:
         InputError: what :func:`~wbfriction.signals.kinematics.measure` and :func:`estimate_friction`
             raise (no segment can be estimated; with ``require_single_support``, no
@@ -253,12 +259,18 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
     """
     options, choice = resolve_differentiation(options, log)
     options, decision = resolve_route(options, log, choice=choice)
-    est = _estimate_parts(robot, log, options, progress, companion, require_single_support)
+    est = estimate_resolved(robot, log, options, progress, companion, require_single_support)
+    a, b = longest_segment(log.segments, len(log.time))
+    record = noise_record(robot, log.q[a:b], log.dt, options)
     for e in (est, est.route_check):
-        if e is not None and choice is not None:
+        if e is None:
+            continue
+        if choice is not None:
             e.metadata["differentiation"] = choice.to_dict()
-        if e is not None and decision is not None:
+        if decision is not None:
             e.metadata["route"] = decision.to_dict()
+        if record is not None:
+            e.metadata["noise"] = record
     return est
 
 
@@ -285,8 +297,15 @@ def resolve_differentiation(options: EstimateOptions, source: Log | np.ndarray |
     return replace(options, diff=choice.scheme, filtering=choice.filtering), choice
 
 
-def _estimate_parts(robot: Robot, log: Log, options: EstimateOptions, progress: Progress | None,
-                    companion: bool, require_single_support: bool) -> FrictionEstimate:
+def estimate_resolved(robot: Robot, log: Log, options: EstimateOptions, progress: Progress | None = None,
+                      companion: bool = False, require_single_support: bool = True) -> FrictionEstimate:
+    """:func:`estimate_log` with ``options`` already resolved (:func:`resolve_differentiation`,
+    :func:`~wbfriction.friction.route.resolve_route`): each of the log's segments by its route and the other, nothing
+    chosen or measured (a chunk of a long log, whose choices are the whole log's).
+
+    Raises:
+        InputError: options not resolved; what the routes raise.
+    """
     parts = log.parts()
     if len(parts) == 1:
         return _estimate_segment(robot, log, options, progress, companion, require_single_support)

@@ -8,7 +8,7 @@ from typing import cast
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.options import Route
+from wbfriction.friction.options import ROUTES, Route
 from wbfriction.model.robot import Robot
 from wbfriction.signals.kinematics import Smoother
 
@@ -78,7 +78,9 @@ class FrictionEstimate:
     def estimation_route(self) -> Route:
         """The route these estimates took (:data:`~wbfriction.friction.options.Route`), from the options in the
         metadata (an older table: ``acceleration``)."""
-        return cast(Route, self.metadata.get("estimate_options", {}).get("route", "acceleration"))
+        options = self.metadata.get("estimate_options")
+        route = options.get("route") if isinstance(options, dict) else None
+        return cast(Route, route if route in ROUTES else "acceleration")
 
 
 def no_single_support(robot: Robot, source: str) -> InputError:

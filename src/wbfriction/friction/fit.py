@@ -45,13 +45,17 @@ gives the starting point.
 from __future__ import annotations
 
 import itertools
+import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Generic, Literal, get_args
 
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimate import FrictionEstimate
+from wbfriction.friction.bound import BATCH, JointNoise, cramer_rao, torque_noise
+from wbfriction.friction.eiv import expected_jacobian, expected_values
+from wbfriction.friction.estimated import FrictionEstimate
 from wbfriction.friction.models import (
     MODEL_NAMES,
     MODEL_PARAMS,
@@ -60,13 +64,15 @@ from wbfriction.friction.models import (
     ModelParamsBase,
     ParamsT,
     check_model,
-    coulomb_viscous,
-    coulomb_viscous_stribeck,
-    stribeck_viscous,
+    model_jacobian,
+    model_values,
 )
+from wbfriction.friction.noise import joint_noises
 from wbfriction.friction.options import SELECTION_TOLERANCE
 from wbfriction.friction.screen import gross_outliers
 from wbfriction.friction.status import FitVerdict, fit_verdict, joint_speed
+from wbfriction.signals.kinematics import PiecewiseSmoother
+from wbfriction.signals.nonuniform import ResampledLowpass
 from wbfriction.workers import process_pool
 
 ModelChoice = Literal["auto", "coulomb-viscous", "stribeck", "thesis"]
@@ -189,6 +195,63 @@ class ModelSelection:
     n_held_out: int = 0
 
 
+ROUTE_Z = 3.0
+"""Two routes disagree on a parameter beyond this many standard errors of their difference (each route's own,
+combined as if independent: the routes share the data's noise, so the difference's is smaller and the rule errs
+towards agreement)."""
+ROUTE_REL = 0.02
+"""... and beyond this share of the parameter's value: a difference below 2 % is no bias worth a status (the
+routes' own quadratures differ by less)."""
+ROUTE_PARAMS = ("F_c", "F_v")
+"""The parameters the routes are compared on: those a user reads."""
+
+
+@dataclass(frozen=True)
+class RouteCheck:
+    """The same model fitted on the other route's estimate (issue 38).
+
+    Attributes:
+        route: that route (``acceleration`` or ``momentum``).
+        params: its parameters, by name (None: not fitted there).
+        stderr: their standard errors.
+        disagree: the parameters of :data:`ROUTE_PARAMS` on which the routes disagree (:func:`compare_routes`).
+    """
+
+    route: str
+    params: dict[str, float] | None
+    stderr: dict[str, float]
+    disagree: tuple[str, ...] = ()
+
+    def describe(self, fit: FitResult) -> str:
+        """One phrase: each disagreeing parameter with both routes' values and standard errors."""
+        if fit.params is None or self.params is None:
+            return ""
+        mine = fit.params.to_dict()
+        theirs = self.params
+        return "; ".join(f"{n} {mine[n]:.3g} ±{fit.stderr.get(n, np.inf):.2g} ({fit.route}) against "
+                         f"{theirs[n]:.3g} ±{self.stderr.get(n, np.inf):.2g} ({self.route})" for n in self.disagree)
+
+
+def compare_routes(fit: FitResult, other: FitResult) -> RouteCheck:
+    """``other`` (the same joint and model on the other route's estimate) as ``fit``'s :class:`RouteCheck`: a
+    parameter of :data:`ROUTE_PARAMS` disagrees where the two values differ by more than :data:`ROUTE_Z` combined
+    standard errors and more than :data:`ROUTE_REL` of the larger."""
+    if other.params is None:
+        return RouteCheck(other.route, None, {})
+    theirs = other.params.to_dict()
+    disagree: list[str] = []
+    if fit.params is not None:
+        mine = fit.params.to_dict()
+        for n in ROUTE_PARAMS:
+            a, b = mine.get(n), theirs.get(n)
+            if a is None or b is None:
+                continue
+            se = math.hypot(fit.stderr.get(n, np.inf), other.stderr.get(n, np.inf))
+            if abs(a - b) > ROUTE_Z * se and abs(a - b) > ROUTE_REL * max(abs(a), abs(b)):
+                disagree.append(n)
+    return RouteCheck(other.route, theirs, dict(other.stderr), tuple(disagree))
+
+
 @dataclass
 class FitResult(Generic[ParamsT]):
     """Identified parameters of one joint.
@@ -216,6 +279,18 @@ class FitResult(Generic[ParamsT]):
         covariance: the parameters' covariance (p, p) in :attr:`params`' order (held ones: 0; ``inf`` rows
             for one that is not identifiable; :func:`parameter_covariance`), or None (not fitted, or read
             from a parameters file, which keeps only the standard errors).
+        crb: per parameter, the Cramér-Rao bound's standard deviation (:mod:`~wbfriction.friction.bound`: what
+            any unbiased estimator from these data is held to; ``inf``: not identifiable); empty without a noise
+            model.
+        torque_noise: the torque's white noise the bound takes [N·m] (:func:`~wbfriction.friction.bound.torque_noise`),
+            or None.
+        route: the estimate's route (``acceleration`` or ``momentum``).
+        route_check: the same model fitted on the other route's estimate, and where the two disagree
+            (:class:`RouteCheck`), or None.
+        velocity_noise: the velocity noise the model's expectation took [rad/s]
+            (:mod:`~wbfriction.friction.eiv`; 0: the model itself).
+        stick_speed: samples whose window holds a speed below this [rad/s] were left out (:func:`stuck_rows`).
+        n_stuck: valid samples so left out.
     """
 
     joint: str
@@ -234,6 +309,13 @@ class FitResult(Generic[ParamsT]):
     n_screened: int = 0
     speed: float | None = None
     covariance: np.ndarray | None = field(default=None, repr=False, compare=False)
+    crb: dict[str, float] = field(default_factory=dict)
+    torque_noise: float | None = None
+    route: str = "acceleration"
+    route_check: RouteCheck | None = None
+    velocity_noise: float = 0.0
+    stick_speed: float = 0.0
+    n_stuck: int = 0
 
     def __post_init__(self) -> None:
         if self.params is not None:
@@ -266,44 +348,6 @@ def fitted_offsets(fits) -> dict[str, float]:
     """The identified torque offset ``tau_os`` [N·m] of every fitted joint, by name (joints
     without parameters left out): what :func:`~wbfriction.friction.energy.energy_consistency` removes."""
     return {f.joint: f.params.tau_os for f in fits if f.params is not None}
-
-
-def model_values(x: np.ndarray, qd: np.ndarray, delta_s: float, model: ModelName = "thesis") -> np.ndarray:
-    """``model``'s ``f(qd)`` [N·m] for the parameter vector ``x`` in the order of its names
-    (:data:`~wbfriction.friction.models.PARAM_NAMES` for (3.5)), ``qd`` (N,) [rad/s]."""
-    if model == "coulomb-viscous":
-        return coulomb_viscous(qd, x[0], x[1], x[2])
-    if model == "stribeck":
-        return stribeck_viscous(qd, x[0], x[1], x[2], x[3], x[4], delta_s)
-    return coulomb_viscous_stribeck(qd, x[0], x[1], x[2], x[3], x[4], x[5], delta_s)
-
-
-def model_jacobian(x: np.ndarray, qd: np.ndarray, delta_s: float, model: ModelName = "thesis") -> np.ndarray:
-    """Jacobian (N, p) of :func:`model_values` with respect to ``x``, analytic."""
-    J = np.empty((qd.size, len(MODEL_PARAMS[model].names)))
-    J[:, 0] = qd  # F_v
-    J[:, -1 if model == "coulomb-viscous" else 4] = 1.0  # tau_os
-    if model == "coulomb-viscous":
-        J[:, 1] = np.sign(qd)
-        return J
-    u = np.abs(qd / x[3])  # |qd / v_s|
-    ud = u**delta_s
-    e = np.exp(-ud)
-    if model == "stribeck":
-        _, F_c, F_s, v_s, _ = x
-        sgn = np.sign(qd)
-        J[:, 1] = sgn * (1.0 - e)
-        J[:, 2] = sgn * e
-        J[:, 3] = sgn * (F_s - F_c) * e * delta_s * ud / v_s
-        return J
-    _, F_c, S, v_s, _, a = x
-    th = np.tanh(a * qd)
-    J[:, 1] = th * (1.0 + S * e)
-    J[:, 2] = F_c * th * e
-    # d/dv_s of exp(-(|qd|/v_s)^d) = e * d * u^d / v_s
-    J[:, 3] = F_c * th * S * e * delta_s * ud / v_s
-    J[:, 5] = F_c * (1.0 - th**2) * qd * (1.0 + S * e)
-    return J
 
 
 def parameter_covariance(jac: np.ndarray, residual: np.ndarray, rtol: float = 1e-9, rows: np.ndarray | None = None,
@@ -436,8 +480,10 @@ def held_out_split(use: np.ndarray, n_blocks: int = HELD_OUT_BLOCKS,
     return train, held_out
 
 
-def held_out_rms(params: ModelParamsBase, qd: np.ndarray, tau_f: np.ndarray, rows: np.ndarray, smoother=None) -> float:
-    """RMS [N·m] of (model friction torque - ``tau_f``) over the samples ``rows`` ((N,) bool).
+def held_out_residuals(params: ModelParamsBase, qd: np.ndarray, tau_f: np.ndarray, rows: np.ndarray, smoother=None,
+                       velocity_noise: float = 0.0) -> np.ndarray:
+    """(model friction torque - ``tau_f``) [N·m] on the samples ``rows`` ((N,) bool), in time order (the model's
+    torque is ``-f``: the residual is ``f + tau_f``).
 
     Args:
         params: a model's parameters (:data:`~wbfriction.friction.models.ModelParams`).
@@ -445,12 +491,40 @@ def held_out_rms(params: ModelParamsBase, qd: np.ndarray, tau_f: np.ndarray, row
         rows: the samples scored.
         smoother: the estimate's smoother or None; the model goes through it along the whole
             series before it is scored, as in the fit.
+        velocity_noise: the velocity's noise [rad/s]: the model's expectation under it, as in the fit
+            (:mod:`~wbfriction.friction.eiv`).
     """
-    f = params.f(np.asarray(qd, dtype=float))
+    f = expected_values(params.as_vector(), np.asarray(qd, dtype=float), velocity_noise,
+                        getattr(params, "delta_s", 2.0), params.model)
     if smoother is not None:
         f = smoother(f)
-    r = (f + np.asarray(tau_f, dtype=float))[np.asarray(rows, dtype=bool)]
+    return (f + np.asarray(tau_f, dtype=float))[np.asarray(rows, dtype=bool)]
+
+
+def held_out_rms(params: ModelParamsBase, qd: np.ndarray, tau_f: np.ndarray, rows: np.ndarray, smoother=None,
+                 velocity_noise: float = 0.0) -> float:
+    """RMS [N·m] of :func:`held_out_residuals` (NaN for no sample)."""
+    r = held_out_residuals(params, qd, tau_f, rows, smoother, velocity_noise)
     return float(np.sqrt(np.mean(r**2))) if r.size else float("nan")
+
+
+GAIN_Z = 2.0
+"""A model with a parameter at a bound must lower the held-out mean square by more than this many standard errors
+of the lowering to be chosen over a simpler model whose parameters are all interior (:func:`choose_model`)."""
+
+
+def held_out_gain(simpler: np.ndarray, other: np.ndarray, rows: np.ndarray) -> tuple[float, float]:
+    """How much ``other``'s held-out residuals (n,) lower the mean square of ``simpler``'s (n,), on the samples
+    ``rows`` (n,) of the series, and the standard error of that lowering: the mean of ``d = simpler^2 - other^2``
+    and its Newey-West standard error (the residuals are correlated over a filter's window) [N²·m²]."""
+    d = np.asarray(simpler, dtype=float) ** 2 - np.asarray(other, dtype=float) ** 2
+    n = d.size
+    if n < 2:
+        return float("nan"), float("inf")
+    centred = (d - d.mean())[:, None]
+    lag = correlation_lag(centred[:, 0], rows)
+    long_run = float(centred[:, 0] @ centred[:, 0] + 2.0 * lagged_products(centred, rows, lag)[0, 0])
+    return float(d.mean()), math.sqrt(max(long_run, 0.0)) / n
 
 
 def choose_model(scores: tuple[HeldOutScore, ...], tolerance: float = SELECTION_TOLERANCE) -> tuple[ModelName, str]:
@@ -486,9 +560,10 @@ def _solve(residual, jacobian, start, bounds, max_nfev):
 
 
 def filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, delta_s: float,
-                      model: ModelName = "thesis"):
+                     model: ModelName = "thesis", velocity_noise: float = 0.0):
     """Residual (n_use,) and Jacobian (n_use, p) (the model's coordinates) of the model passed through
-    ``smoother`` along the whole series ``qd`` (N,), on the rows ``use`` (module docstring).
+    ``smoother`` along the whole series ``qd`` (N,), on the rows ``use`` (module docstring); with ``velocity_noise``
+    [rad/s] the model's expectation under it (:mod:`~wbfriction.friction.eiv`).
 
     The smoother is linear and filters each column alone, so the columns of the Jacobian that do
     not depend on the parameters (:data:`_FIXED_COLUMNS`: the regressors ``qd``, ``sgn(qd)``, 1) are
@@ -498,10 +573,10 @@ def filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, d
     filtered_fixed: list[np.ndarray] = []  # the smoothed fixed columns, on the rows used
 
     def residual(x: np.ndarray) -> np.ndarray:
-        return smoother(model_values(x, qd, delta_s, model))[rows] - y[rows]
+        return smoother(expected_values(x, qd, velocity_noise, delta_s, model))[rows] - y[rows]
 
     def jacobian(x: np.ndarray) -> np.ndarray:
-        jac = model_jacobian(x, qd, delta_s, model)
+        jac = expected_jacobian(x, qd, velocity_noise, delta_s, model)
         varying = np.ones(jac.shape[1], dtype=bool)
         varying[fixed_columns] = False
         if not filtered_fixed:
@@ -513,6 +588,30 @@ def filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, d
         return out
 
     return residual, jacobian
+
+
+STICK_SIGMAS = 3.0
+"""A joint may stick (its friction any value up to the static level, no function of a velocity) where its
+measured speed is below this many standard deviations of the velocity's noise (:func:`stuck_rows`)."""
+STICK_FLOOR = 1e-3
+"""... and never below this speed [rad/s]: what a sticking joint creeps at, in a simulator's soft constraint."""
+
+
+def stick_speed(velocity_noise: float) -> float:
+    """The speed [rad/s] below which a sample may be sticking: :data:`STICK_SIGMAS` standard deviations of the
+    velocity noise [rad/s], at least :data:`STICK_FLOOR`."""
+    return max(STICK_SIGMAS * velocity_noise, STICK_FLOOR)
+
+
+def stuck_rows(qd: np.ndarray, speed: float, margin: int) -> np.ndarray:
+    """(N,) the samples within ``margin`` rows of one whose speed ``|qd|`` is below ``speed`` [rad/s]: a joint at rest
+    has static friction, any value up to its static level, which no model of the velocity predicts, and a filter
+    spreads it over its window (``margin``: the smoother's and the velocity filter's half widths)."""
+    from scipy.ndimage import maximum_filter1d
+    slow = np.abs(np.nan_to_num(np.asarray(qd, dtype=float), nan=np.inf)) < speed
+    if margin <= 0 or not slow.any():
+        return slow
+    return maximum_filter1d(slow, 2 * margin + 1, mode="constant", cval=False)
 
 
 def _at_bound(z: np.ndarray, bounds: tuple[np.ndarray, np.ndarray], residual, identifiable: np.ndarray
@@ -546,7 +645,8 @@ def _at_bound(z: np.ndarray, bounds: tuple[np.ndarray, np.ndarray], residual, id
 def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joint: str = "",
                  x0: np.ndarray | None = None, min_samples: int = 20, mask: np.ndarray | None = None,
                  smoother=None, fixed: dict[str, float] | None = None, model: ModelChoice = "thesis",
-                 selection_tolerance: float = SELECTION_TOLERANCE) -> FitResult:
+                 selection_tolerance: float = SELECTION_TOLERANCE, velocity_noise: float = 0.0,
+                 stick: float = 0.0, stick_margin: int = 0, noise: JointNoise | None = None) -> FitResult:
     """Fit a friction model to friction estimates of one joint (eq. 6.4).
 
     Args:
@@ -574,6 +674,12 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
             ``coulomb-viscous``, or ``auto`` (chosen by held-out error, module docstring).
         selection_tolerance: with ``auto``, the relative excess of held-out RMS over the best
             within which the simpler model is chosen.
+        velocity_noise: the standard deviation of the noise in ``qd`` [rad/s]: the model compared is its expectation
+            under that noise (errors in variables, :mod:`~wbfriction.friction.eiv`); 0: the model itself.
+        stick, stick_margin: samples within ``stick_margin`` rows of a speed below ``stick`` [rad/s] are left out
+            (:func:`stuck_rows`) and counted (:attr:`FitResult.n_stuck`); 0: none.
+        noise: what is known of the estimate's noise (:class:`~wbfriction.friction.bound.JointNoise`): the fit then
+            carries its Cramér-Rao bound (:attr:`FitResult.crb`); None: no bound.
 
     Returns:
         :class:`FitResult`.
@@ -594,6 +700,8 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
     use &= ~screened
     if smoother is not None:
         use &= np.isfinite(smoother(qd))
+    stuck = stuck_rows(qd, stick, stick_margin) & use if stick > 0 else np.zeros_like(use)
+    use &= ~stuck
     # One BLAS thread: the solver's many small (N x p) factorizations run several times
     # slower on OpenBLAS's threads than on one (30 TALOS joints of a 10-step walk: 78 s
     # against 14 s on 2 cores); fit joints side by side instead (fit_estimate's workers).
@@ -602,45 +710,74 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
             if x0 is not None:
                 raise InputError("x0 needs a named model, not 'auto'")
             res = _fit_auto(qd, y, use, delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother,
-                            fixed=fixed, tolerance=selection_tolerance)
+                            fixed=fixed, tolerance=selection_tolerance, sigma=velocity_noise, noise=noise)
         else:
             res = _fit_model(check_model(model), qd, y, use, delta_s=delta_s, joint=joint, x0=x0,
-                             min_samples=min_samples, smoother=smoother, fixed=fixed)
+                             min_samples=min_samples, smoother=smoother, fixed=fixed, sigma=velocity_noise,
+                             noise=noise)
     res.n_screened = int(screened.sum())
+    res.velocity_noise, res.stick_speed, res.n_stuck = float(velocity_noise), float(stick), int(stuck.sum())
     return res
 
 
 def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float, joint: str, min_samples: int,
-              smoother, fixed: dict[str, float] | None, tolerance: float) -> FitResult:
+              smoother, fixed: dict[str, float] | None, tolerance: float, sigma: float = 0.0,
+              noise: JointNoise | None = None) -> FitResult:
     """``fit_friction(model="auto")`` on the usable samples ``use`` (module docstring)."""
     fixed = dict(fixed or {})
     known = {n for m in MODEL_NAMES for n in MODEL_PARAMS[m].names}
     if set(fixed) - known:
         raise InputError(f"unknown parameter(s) to fix: {', '.join(sorted(set(fixed) - known))}")
     held = {m: {k: v for k, v in fixed.items() if k in MODEL_PARAMS[m].names} for m in MODEL_NAMES}
-    kwargs = dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother)
+    kwargs = dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, sigma=sigma)
     train, held_out = held_out_split(use)
     n_train, n_held_out = int(train.sum()), int(held_out.sum())
     if min(n_train, n_held_out) < max(min_samples, 7):
         simplest = MODEL_NAMES[0]
-        res = _fit_model(simplest, qd, y, use, fixed=held[simplest], **kwargs)
+        res = _fit_model(simplest, qd, y, use, fixed=held[simplest], noise=noise, **kwargs)
         res.selection = ModelSelection(simplest, f"{simplest}: too few samples ({int(use.sum())}) to hold any out",
                                        (), tolerance, n_train, n_held_out)
         return res
     trained = {m: _fit_model(m, qd, y, train, fixed=held[m], **kwargs) for m in MODEL_NAMES}
-    scores = tuple(HeldOutScore(m, held_out_rms(r.params, qd, -y, held_out, smoother) if r.params is not None
-                                else float("nan"), r.bounded()) for m, r in trained.items())
+    residuals = {m: held_out_residuals(r.params, qd, -y, held_out, smoother, sigma) for m, r in trained.items()
+                 if r.params is not None}
+    scores = tuple(HeldOutScore(m, float(np.sqrt(np.mean(residuals[m] ** 2))) if m in residuals else float("nan"),
+                                r.bounded()) for m, r in trained.items())
     chosen, reason = choose_model(scores, tolerance)
-    res = _fit_model(chosen, qd, y, use, fixed=held[chosen], **kwargs)  # as if the model had been named
+    chosen, reason = _interior_over_bound(chosen, reason, scores, residuals, np.flatnonzero(held_out))
+    res = _fit_model(chosen, qd, y, use, fixed=held[chosen], noise=noise, **kwargs)  # as if the model had been named
     if res.bounded():
         reason += f"; at a bound: {', '.join(res.bounded())}"
     res.selection = ModelSelection(chosen, reason, scores, tolerance, n_train, n_held_out)
     return res
 
 
+def _interior_over_bound(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ...],
+                         residuals: dict[ModelName, np.ndarray], rows: np.ndarray) -> tuple[ModelName, str]:
+    """The rule of issue 38: a model chosen with a parameter at a bound gives way to the best-scoring simpler model
+    whose parameters are all interior, unless it lowers the held-out mean square by more than :data:`GAIN_Z`
+    standard errors of that lowering (:func:`held_out_gain`)."""
+    by_model = {s.model: s for s in scores}
+    if not by_model[chosen].at_bound:
+        return chosen, reason
+    simpler = [s for s in scores[:[s.model for s in scores].index(chosen)]
+               if not s.at_bound and s.model in residuals and np.isfinite(s.held_out_rms)]
+    if not simpler:
+        return chosen, reason
+    alternative = min(simpler, key=lambda s: s.held_out_rms)
+    gain, se = held_out_gain(residuals[alternative.model], residuals[chosen], rows)
+    if gain > GAIN_Z * se:
+        return chosen, reason + (f"; its held-out gain over {alternative.model} ({gain:.3g} N²·m², {gain / se:.1f} "
+                                 f"standard errors) outweighs its bound ({', '.join(by_model[chosen].at_bound)})")
+    return alternative.model, (f"{alternative.model}: {chosen} leaves {', '.join(by_model[chosen].at_bound)} at a "
+                               f"bound and lowers the held-out mean square by {gain:.3g} ± {se:.2g} N²·m², within "
+                               f"{GAIN_Z:g} standard errors; " + reason.split("; ", 1)[-1])
+
+
 def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float = 2.0,
                joint: str = "", x0: np.ndarray | None = None, min_samples: int = 20, smoother=None,
-               fixed: dict[str, float] | None = None) -> FitResult:
+               fixed: dict[str, float] | None = None, sigma: float = 0.0,
+               noise: JointNoise | None = None) -> FitResult:
     """:func:`fit_friction` of one model to ``y = -tau_f`` on the usable samples ``use``, on the threads it is given."""
     names = MODEL_PARAMS[model].names
     fixed = dict(fixed or {})
@@ -666,17 +803,22 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(v, yu, model)
     starts = [to_fit_coordinates(model, x) for x in starts]
     starts = list({tuple(x[free]): x[free] for x in starts}.values())  # distinct over the free ones
-    residual = lambda z: model_values(full(z), v, delta_s, model) - yu  # noqa: E731
-    jacobian = lambda z: fit_coordinates_jacobian(model, model_jacobian(full(z), v, delta_s, model))[:, free]  # noqa: E731
+    residual = lambda z: expected_values(full(z), v, sigma, delta_s, model) - yu  # noqa: E731
+    jacobian = lambda z: fit_coordinates_jacobian(  # noqa: E731
+        model, expected_jacobian(full(z), v, sigma, delta_s, model))[:, free]
     bounds = tuple(b[free] for b in model_bounds(v, model))
-    # a short run from every start, then the two best refined
+    # a short run of the model itself from every start, then the two best refined (on its expectation under the
+    # velocity noise, when there is one)
     if len(starts) > 1:
-        short = sorted((_solve(residual, jacobian, s, bounds, 30) for s in starts), key=lambda r: r.cost)
+        plain = lambda z: model_values(full(z), v, delta_s, model) - yu  # noqa: E731
+        plain_jacobian = lambda z: fit_coordinates_jacobian(  # noqa: E731
+            model, model_jacobian(full(z), v, delta_s, model))[:, free]
+        short = sorted((_solve(plain, plain_jacobian, s, bounds, 30) for s in starts), key=lambda r: r.cost)
         starts = [r.x for r in short[:2]]
     best = min((_solve(residual, jacobian, s, bounds, 300) for s in starts), key=lambda r: r.cost)
-    natural_jacobian = lambda z: model_jacobian(full(z), v, delta_s, model)[:, free]  # noqa: E731
+    natural_jacobian = lambda z: expected_jacobian(full(z), v, sigma, delta_s, model)[:, free]  # noqa: E731
     if smoother is not None:
-        f_residual, f_jacobian = filtered_problem(qd, y, use, smoother, delta_s, model)
+        f_residual, f_jacobian = filtered_problem(qd, y, use, smoother, delta_s, model, sigma)
         residual = lambda z: f_residual(full(z))  # noqa: E731
         jacobian = lambda z: fit_coordinates_jacobian(model, f_jacobian(full(z)))[:, free]  # noqa: E731
         natural_jacobian = lambda z: f_jacobian(full(z))[:, free]  # noqa: E731
@@ -690,11 +832,20 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     se = covariance_errors(cov)
     at_bound = np.zeros(len(names), dtype=bool)
     at_bound[free] = _at_bound(best.x, bounds, residual, np.isfinite(se[free]))
-    return FitResult(
+    res = FitResult(
         joint=joint, n_samples=n, params=MODEL_PARAMS[model].from_vector(full(best.x), delta_s),
         stderr=dict(zip(names, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
         success=bool(best.success), message=str(best.message), model=model,
         at_bound=dict(zip(names, map(bool, at_bound))), speed=speed, covariance=cov)
+    if noise is not None:
+        sigma_tau = torque_noise(best.fun, rows, max(BATCH, 4 * (2 * smoother_half_width(smoother) + 1)))
+        res.torque_noise = sigma_tau
+        if np.isfinite(sigma_tau):
+            bound = np.zeros(len(names))
+            exact = model_jacobian(full(best.x), v, delta_s, model)[:, free]  # the bound: velocities known
+            bound[free] = covariance_errors(cramer_rao(exact, rows, noise.with_torque(sigma_tau)))
+            res.crb = dict(zip(names, map(float, bound)))
+    return res
 
 
 def _fit_column(args: tuple) -> FitResult:
@@ -705,8 +856,10 @@ def _fit_column(args: tuple) -> FitResult:
 def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
                tau_f_true: np.ndarray | None = None, targets: dict[str, FrictionParams] | None = None,
                delta_s: float = 2.0, min_samples: int = 20, smoother=None,
-               fixed: dict[str, float] | None = None, workers: int = 1, model: ModelChoice = "thesis",
-               selection_tolerance: float = SELECTION_TOLERANCE) -> list[FitResult]:
+               fixed: dict[str, float] | None = None, workers: int = 1,
+               model: ModelChoice | Sequence[ModelName] = "thesis",
+               selection_tolerance: float = SELECTION_TOLERANCE, noise: Mapping[str, JointNoise] | None = None,
+               stick_margin: int | None = None) -> list[FitResult]:
     """Fit every joint of a friction estimate on its valid samples.
 
     Args:
@@ -719,15 +872,28 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
         fixed: parameters held instead of fitted (:func:`fit_friction`).
         workers: processes fitting joints side by side (each fit is independent of the
             others: the results do not depend on it).
-        model, selection_tolerance: the model, or ``auto`` and its tolerance (:func:`fit_friction`).
+        model, selection_tolerance: the model, or ``auto`` and its tolerance (:func:`fit_friction`); or one model
+            per joint.
+        noise: what is known of each joint's noise (:func:`~wbfriction.friction.noise.joint_noises`): its velocity
+            noise corrects the model (errors in variables) and sets the speed a joint may stick below, and the fit
+            carries its Cramér-Rao bound; a joint without: neither.
+        stick_margin: with it, samples within that many rows of a speed a joint may stick at
+            (:func:`stick_speed`) are left out (:func:`stuck_rows`); None: none.
 
     Raises:
         InputError: what :func:`fit_friction` raises.
     """
-    tasks = [(qd[:, i], tau_f[:, i], valid[:, i],
-              dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, fixed=fixed, model=model,
-                   selection_tolerance=selection_tolerance))
-             for i, joint in enumerate(joints)]
+    noise = noise or {}
+    models = [model] * len(joints) if isinstance(model, str) else list(model)
+    tasks = []
+    for i, joint in enumerate(joints):
+        jn = noise.get(joint)
+        sigma = 0.0 if jn is None else jn.velocity
+        stick = {} if stick_margin is None else {"stick": stick_speed(sigma), "stick_margin": stick_margin}
+        tasks.append((qd[:, i], tau_f[:, i], valid[:, i],
+                      dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, fixed=fixed,
+                           model=models[i], selection_tolerance=selection_tolerance, velocity_noise=sigma, noise=jn,
+                           **stick)))
     if workers > 1 and len(tasks) > 1:
         with process_pool(min(workers, len(tasks)), "fork") as pool:
             fitted = list(pool.map(_fit_column, tasks))
@@ -747,6 +913,29 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
     return out
 
 
+def smoother_half_width(smoother) -> int:
+    """Samples a smoother reaches on each side (0 without one)."""
+    if smoother is None:
+        return 0
+    if isinstance(smoother, PiecewiseSmoother):
+        return max((smoother_half_width(s) for *_, s in smoother.parts), default=0)
+    if isinstance(smoother, ResampledLowpass):
+        return smoother.lowpass.half_width
+    return int(smoother.half_width)
+
+
+def stick_margin(est: FrictionEstimate) -> int:
+    """Rows a sticking sample reaches in ``est``'s fit (:func:`stuck_rows`): its smoother's half width, and the
+    velocity filter's where the velocity went through another one (the momentum route), or the central difference's
+    stencil without a smoother."""
+    margin = smoother_half_width(est.smoother)
+    if est.estimation_route == "momentum":  # the metadata the table was read with (its smoother checked them)
+        margin += int(est.metadata["estimate_options"]["momentum"]["velocity_window"]) // 2
+    elif est.smoother is None:
+        margin += 1
+    return margin
+
+
 def fit_estimate(est: FrictionEstimate, *, delta_s: float = 2.0, min_samples: int = 20,
                  workers: int = 1, model: ModelChoice = "thesis",
                  selection_tolerance: float = SELECTION_TOLERANCE) -> list[FitResult]:
@@ -754,10 +943,30 @@ def fit_estimate(est: FrictionEstimate, *, delta_s: float = 2.0, min_samples: in
     processes); its ``tau_f_true`` and ``friction_true`` metadata, when present (simulated
     logs), give the errors against truth.
 
+    With the estimate's noise record (:func:`~wbfriction.friction.noise.noise_record`), each fit corrects the model
+    for its velocity's noise, leaves out the samples where its joint may stick, and carries its Cramér-Rao bound.
+    With the other route's estimate (:attr:`~wbfriction.friction.estimate.FrictionEstimate.route_check`), each
+    joint's model is fitted there too and the two compared (:attr:`FitResult.route_check`, :func:`compare_routes`).
+
     Raises:
-        InputError: ``friction_true`` metadata that are not parameters of (3.5); an unknown model.
+        InputError: ``friction_true`` metadata that are not parameters of (3.5); an unknown model; a damaged noise
+            record.
     """
     targets = {j: FrictionParams.from_dict(p) for j, p in est.metadata.get("friction_true", {}).items()}
-    return fit_joints(est.joints, est.qd, est.tau_f, est.valid, tau_f_true=est.tau_f_true, targets=targets,
+    record = est.metadata.get("noise")
+    fits = fit_joints(est.joints, est.qd, est.tau_f, est.valid, tau_f_true=est.tau_f_true, targets=targets,
                       delta_s=delta_s, min_samples=min_samples, smoother=est.smoother, workers=workers, model=model,
-                      selection_tolerance=selection_tolerance)
+                      selection_tolerance=selection_tolerance, noise=joint_noises(record, est.estimation_route),
+                      stick_margin=stick_margin(est))
+    for f in fits:
+        f.route = est.estimation_route
+    check = est.route_check
+    if check is not None:
+        others = fit_joints(check.joints, check.qd, check.tau_f, check.valid, delta_s=delta_s,
+                            min_samples=min_samples, smoother=check.smoother, workers=workers,
+                            model=[f.model for f in fits], noise=joint_noises(record, check.estimation_route),
+                            stick_margin=stick_margin(check))
+        for f, other in zip(fits, others):
+            other.route = check.estimation_route
+            f.route_check = compare_routes(f, other)
+    return fits

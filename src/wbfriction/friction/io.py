@@ -4,13 +4,16 @@
   :class:`~wbfriction.friction.estimate.FrictionEstimate` sample by sample:
   :func:`friction_table` writes it, :func:`read_friction_table` reads it back (the estimate's
   options, and so its smoother, ride in the table's metadata).
-* The **parameters JSON** holds the fitted model per joint (:class:`~wbfriction.friction.fit.FitResult`):
-  its name (``model``: ``coulomb-viscous``, ``stribeck`` or ``thesis`` (3.5)), parameters,
-  standard errors, which parameters ended at a bound (``at_bound``) and, when the model was
-  chosen by held-out error, how (``selection``). :func:`write_params` writes it (``wbfriction fit``
-  and the studies), :func:`read_params` reads it (``wbfriction report --params``). A standard
-  error that is not finite (not identifiable) is written as ``null`` and read back as ``inf``.
-  Files written before the model choice (no ``model`` key) hold model (3.5) and read back so.
+* The **parameters JSON** holds the fitted model per joint (:class:`~wbfriction.friction.fit.FitResult`): its
+  name (``model``: ``coulomb-viscous``, ``stribeck`` or ``thesis`` (3.5)), parameters, standard errors, their
+  Cramér-Rao bounds (``crb``) and the torque noise they take (``torque_noise``), which parameters ended at a
+  bound (``at_bound``), the estimate's ``route`` and the same model on the other route (``route_check``: its
+  parameters, standard errors, and those that ``disagree``), the velocity noise the model's expectation took
+  (``velocity_noise``), the samples left out where the joint may stick (``stick_speed``, ``n_stuck``) and, when
+  the model was chosen by held-out error, how (``selection``). :func:`write_params` writes it (``wbfriction
+  fit`` and the studies), :func:`read_params` reads it (``wbfriction report --params``). A standard error that
+  is not finite (not identifiable) is written as ``null`` and read back as ``inf``. Files written before the
+  model choice (no ``model`` key) hold model (3.5) and read back so.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ import json
 from collections.abc import Iterable, Mapping
 from dataclasses import fields
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import pyarrow as pa
@@ -27,8 +30,9 @@ import pyarrow as pa
 from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import FitResult, HeldOutScore, ModelSelection
+from wbfriction.friction.fit import FitResult, HeldOutScore, ModelSelection, RouteCheck
 from wbfriction.friction.models import FrictionParams, check_model, params_from_dict
+from wbfriction.friction.options import ROUTES
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.tables import file_sha256, numeric_column, read_metadata, read_table, with_metadata, write_json
 from wbfriction.signals.kinematics import SCHEMES, Smoother, make_smoother
@@ -76,7 +80,7 @@ def friction_table(est: FrictionEstimate) -> pa.Table:
             cols.update({f"{CHECK}qd.{j}": check.qd[:, i], f"{CHECK}tau_f.{j}": check.tau_f[:, i],
                          f"{CHECK}valid.{j}": check.valid[:, i]})
         metadata["route_check"] = {k: v for k, v in check.metadata.items()
-                                   if k in ("estimate_options", "momentum", "base_motion", "velocity_noise")}
+                                   if k in ("estimate_options", "momentum", "base_motion")}
     if est.companion_diff is not None:
         metadata["companion_diff"] = est.companion_diff
     return with_metadata(pa.table(cols), metadata)
@@ -127,13 +131,16 @@ def _table_smoother(meta: dict, time: np.ndarray, source: str) -> Smoother | Non
     elif kind == "jittered":  # differentiated on the regularised clock: rebuilt from the same stamps
         regular = read_clock(time, source, time_base="regularised")
         dt, t = regular.period, regular.t
-    if opts.get("route", "acceleration") == "momentum":
-        momentum = opts.get("momentum", {})
-        window = momentum.get("window") if isinstance(momentum, dict) else None
-        if not isinstance(window, int) or window < 3 or window % 2 == 0:
-            raise InputError(f"{source}: the metadata's estimate_options.momentum.window is {window!r}, not an odd "
-                             "number of samples")
-        return MomentumWindow(window // 2, dt, t)
+    route = opts.get("route", "acceleration")
+    if route not in ROUTES:
+        raise InputError(f"{source}: the metadata's estimate_options name an unknown route {route!r}")
+    if route == "momentum":
+        momentum = opts.get("momentum")
+        windows = [momentum.get(k) if isinstance(momentum, dict) else None for k in ("velocity_window", "window")]
+        if not all(isinstance(w, int) and not isinstance(w, bool) and w >= 3 and w % 2 == 1 for w in windows):
+            raise InputError(f"{source}: the metadata's estimate_options.momentum is {momentum!r}, not two odd "
+                             "windows in samples")
+        return MomentumWindow(int(cast(int, windows[1])) // 2, dt, t)
     return make_smoother(diff, filtering, dt, t)
 
 
@@ -274,6 +281,14 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
                          "params": None if fit.params is None else fit.params.to_dict(),
                          "stderr": {k: clean(v) for k, v in fit.stderr.items()},
                          "at_bound": dict(fit.at_bound), "speed": fit.speed}
+    d["crb"] = {k: clean(v) for k, v in fit.crb.items()}
+    d["torque_noise"] = fit.torque_noise
+    d["route"] = fit.route
+    if fit.route_check is not None:
+        rc = fit.route_check
+        d["route_check"] = {"route": rc.route, "params": rc.params,
+                            "stderr": {k: clean(v) for k, v in rc.stderr.items()}, "disagree": list(rc.disagree)}
+    d["velocity_noise"], d["stick_speed"], d["n_stuck"] = fit.velocity_noise, fit.stick_speed, fit.n_stuck
     verdict = fit.verdict()
     d["status"], d["status_reason"] = verdict.status, verdict.reason
     if fit.selection is not None:
@@ -315,11 +330,25 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
         res.at_bound = {str(k): bool(v) for k, v in at_bound.items()}
         if d.get("selection") is not None:
             res.selection = selection_from_dict(d["selection"])
+        res.crb = {str(k): _number(v) for k, v in (d.get("crb") or {}).items()}
+        res.torque_noise = None if d.get("torque_noise") is None else float(d["torque_noise"])
+        res.route = str(d.get("route", "acceleration"))
+        if d.get("route_check") is not None:
+            rc = d["route_check"]
+            res.route_check = RouteCheck(str(rc["route"]), None if rc.get("params") is None else
+                                         {str(k): float(v) for k, v in rc["params"].items()},
+                                         {str(k): _number(v) for k, v in (rc.get("stderr") or {}).items()},
+                                         tuple(map(str, rc.get("disagree", ()))))
+        res.velocity_noise = float(d.get("velocity_noise", 0.0))
+        res.stick_speed = float(d.get("stick_speed", 0.0))
+        res.n_stuck = int(d.get("n_stuck", 0))
         if d.get("target") is not None:
             res.target = FrictionParams.from_dict(d["target"])
         if "rms_error_vs_true" in d:
             res.rms_error_vs_true = _number(d["rms_error_vs_true"])
             res.rms_model_vs_true = _number(d.get("rms_model_vs_true"))
+    except KeyError as exc:
+        raise InputError(f"missing key {exc}") from None
     except (TypeError, ValueError, AttributeError) as exc:
         raise InputError(str(exc)) from None
     return res

@@ -110,6 +110,44 @@ def stribeck_viscous(qd: ArrayLike, F_v: ParamLike, F_c: ParamLike, F_s: ParamLi
     return viscous(qd, F_v) + stribeck(qd, F_c, F_s, v_s, delta_s) + np.asarray(tau_os)
 
 
+def model_values(x: np.ndarray, qd: np.ndarray, delta_s: float, model: ModelName = "thesis") -> np.ndarray:
+    """``model``'s ``f(qd)`` [N·m] for the parameter vector ``x`` in the order of its names
+    (:data:`~wbfriction.friction.models.PARAM_NAMES` for (3.5)), ``qd`` (N,) [rad/s]."""
+    if model == "coulomb-viscous":
+        return coulomb_viscous(qd, x[0], x[1], x[2])
+    if model == "stribeck":
+        return stribeck_viscous(qd, x[0], x[1], x[2], x[3], x[4], delta_s)
+    return coulomb_viscous_stribeck(qd, x[0], x[1], x[2], x[3], x[4], x[5], delta_s)
+
+
+def model_jacobian(x: np.ndarray, qd: np.ndarray, delta_s: float, model: ModelName = "thesis") -> np.ndarray:
+    """Jacobian (N, p) of :func:`model_values` with respect to ``x``, analytic."""
+    J = np.empty((qd.size, len(MODEL_PARAMS[model].names)))
+    J[:, 0] = qd  # F_v
+    J[:, -1 if model == "coulomb-viscous" else 4] = 1.0  # tau_os
+    if model == "coulomb-viscous":
+        J[:, 1] = np.sign(qd)
+        return J
+    u = np.abs(qd / x[3])  # |qd / v_s|
+    ud = u**delta_s
+    e = np.exp(-ud)
+    if model == "stribeck":
+        _, F_c, F_s, v_s, _ = x
+        sgn = np.sign(qd)
+        J[:, 1] = sgn * (1.0 - e)
+        J[:, 2] = sgn * e
+        J[:, 3] = sgn * (F_s - F_c) * e * delta_s * ud / v_s
+        return J
+    _, F_c, S, v_s, _, a = x
+    th = np.tanh(a * qd)
+    J[:, 1] = th * (1.0 + S * e)
+    J[:, 2] = F_c * th * e
+    # d/dv_s of exp(-(|qd|/v_s)^d) = e * d * u^d / v_s
+    J[:, 3] = F_c * th * S * e * delta_s * ud / v_s
+    J[:, 5] = F_c * (1.0 - th**2) * qd * (1.0 + S * e)
+    return J
+
+
 ParamsT = TypeVar("ParamsT", bound="ModelParamsBase")
 """Any of the models' parameter classes."""
 

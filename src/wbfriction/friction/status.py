@@ -9,8 +9,16 @@ status, the first that applies:
 * ``at bound``: a parameter was left on a bound of the fit's search (its value is the bound's, not the
   data's), named. A magnitude at its floor of zero (F_c, F_v, S, F_s = 0: no such friction found) is a
   result, not a bound of the search;
-* ``weak``: a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error above
-  :data:`WEAK` of its (non-zero) value, or is not identifiable (infinite standard error);
+* ``routes disagree`` (issue 38): the same model fitted on the other route's estimate (the acceleration
+  route's for the momentum route, and the other way round) differs on F_c or F_v by more than
+  :data:`~wbfriction.friction.fit.ROUTE_Z` combined standard errors and :data:`~wbfriction.friction.fit.ROUTE_REL`
+  of the value: one of them is biased, and the standard errors cannot say which; both values are given;
+* ``weak``: a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error, or a Cramér-Rao bound
+  (:mod:`~wbfriction.friction.bound`: what the data allow any unbiased estimator), above :data:`WEAK` of its
+  (non-zero) value, or is not identifiable (infinite standard error); a magnitude at zero whose standard error
+  or bound stands for more than :data:`WEAK` of the friction the joint shows (``F_c``'s in N·m, ``F_v``'s times
+  the joint's speed, against the friction's odd part at that speed and the residual's RMS: ``F_c = 0 ± 1.1``
+  beside a friction of 1 N·m is no finding);
 * ``ok``: none of these.
 
 The table, the parameters JSON (``status``, ``status_reason``) and the report show it; a fit that is not
@@ -26,7 +34,7 @@ import numpy as np
 
 from wbfriction.friction.solver import explain_solver
 
-FitStatus = Literal["ok", "weak", "at bound", "not excited", "failed"]
+FitStatus = Literal["ok", "weak", "routes disagree", "at bound", "not excited", "failed"]
 """A fit's verdict (module docstring)."""
 FIT_STATUSES: tuple[FitStatus, ...] = get_args(FitStatus)
 MIN_SPEED = 0.02
@@ -56,6 +64,9 @@ class Fit(Protocol):
     message: str
     stderr: dict[str, float]
     speed: float | None
+    crb: dict[str, float]
+    route_check: Any
+    rms_residual: float
 
     def bounded(self) -> tuple[str, ...]: ...
 
@@ -94,18 +105,39 @@ def fit_verdict(fit: Fit) -> FitVerdict:
     bounded = [n for n in fit.bounded() if not (n in ZERO_FLOOR and abs(values[n]) < ZERO)]
     if bounded:
         return FitVerdict("at bound", "at a bound of the fit: " + ", ".join(bounded))
-    weak = []
-    for name in (n for n in READ if n in fit.stderr and abs(values[n]) >= ZERO):
-        se, value = fit.stderr[name], abs(values[name])
-        if not np.isfinite(se):
-            weak.append(f"{name} not identifiable")
-        elif se > WEAK * value:
-            weak.append(f"{name} ±{100 * se / value:.0f} %")
-    se_os, scale = fit.stderr.get("tau_os", 0.0), abs(values.get("F_c", 0.0))
-    if not np.isfinite(se_os):
-        weak.append("tau_os not identifiable")
-    elif scale >= ZERO and se_os > WEAK * scale:
-        weak.append(f"tau_os ±{se_os:.2g} N·m against F_c {scale:.2g}")
+    check = fit.route_check
+    if check is not None and check.disagree:
+        return FitVerdict("routes disagree", check.describe(fit))
+    weak = _weak(fit, values)
     if weak:
         return FitVerdict("weak", "large standard errors: " + ", ".join(weak))
     return FitVerdict("ok")
+
+
+def _weak(fit: Fit, values: dict[str, float]) -> list[str]:
+    """What makes ``fit`` weak (module docstring), one phrase each."""
+    speed = fit.speed or 0.0
+    odd = 0.5 * float(fit.params.f(speed) - fit.params.f(-speed))  # the friction the joint shows at its speed
+    scale = max(abs(odd), fit.rms_residual if np.isfinite(fit.rms_residual) else 0.0)
+    out = []
+    for name in (n for n in READ if n in fit.stderr):
+        value = abs(values[name])
+        for bound, spread in ((False, fit.stderr[name]), (True, fit.crb.get(name, 0.0))):
+            at_best = " at best (Cramér-Rao)" if bound else ""
+            if not np.isfinite(spread):
+                out.append(f"{name} not identifiable{at_best}")
+                break
+            if value >= ZERO and spread > WEAK * value:
+                out.append(f"{name} ±{100 * spread / value:.0f} %{at_best}")
+                break
+            # a magnitude at zero: against the friction it would make at the joint's speed
+            share = spread * (speed if name == "F_v" else 1.0)
+            if value < ZERO and share > WEAK * scale:
+                out.append(f"{name} 0 ±{spread:.2g}{at_best} ({share:.2g} N·m against {scale:.2g} N·m of friction)")
+                break
+    se_os, f_c = fit.stderr.get("tau_os", 0.0), abs(values.get("F_c", 0.0))
+    if not np.isfinite(se_os):
+        out.append("tau_os not identifiable")
+    elif f_c >= ZERO and se_os > WEAK * f_c:
+        out.append(f"tau_os ±{se_os:.2g} N·m against F_c {f_c:.2g}")
+    return out

@@ -24,8 +24,9 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from wbfriction.exceptions import InputError, OutputError
-from wbfriction.friction.estimate import estimate_log, no_single_support, resolve_differentiation
+from wbfriction.friction.estimate import estimate_resolved, no_single_support, resolve_differentiation
 from wbfriction.friction.io import friction_table
+from wbfriction.friction.noise import noise_record
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.route import resolve_route
 from wbfriction.logs.clock import Clock, TimeBase, TimeUnit, longest_segment
@@ -92,7 +93,7 @@ def _estimate_chunk(robot: Robot, table: pa.Table, chunk: Chunk, clock: Clock, s
     """The friction table of a chunk's own rows; ``clock``: the whole log's, cut to the rows read."""
     log = log_from_table(table, robot, source, max_gap, limit_margin, first_row=chunk.read_start, period=clock.step,
                          clock=clock, time_unit=time_unit)
-    est = estimate_log(robot, log, options, companion=companion, require_single_support=False)
+    est = estimate_resolved(robot, log, options, companion=companion, require_single_support=False)
     return friction_table(est).slice(chunk.start - chunk.read_start, chunk.stop - chunk.start)
 
 
@@ -235,6 +236,9 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     options, decision = resolve_route(options, first, clock.step, choice)
     if decision is not None:
         extra_metadata = {**(extra_metadata or {}), "route": decision.to_dict()}
+    record = None if first is None else noise_record(robot, first, clock.step, options)
+    if record is not None:
+        extra_metadata = {**(extra_metadata or {}), "noise": record}
     n = len(contact)
     chunks = plan_chunks(contact, chunking)
     del contact

@@ -202,6 +202,17 @@ def butterworth_noise_gain(cutoff: float, order: int, dt: float, n_freq: int = 4
     return math.sqrt(2.0 * dt * float(np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(freq))))
 
 
+def butterworth_velocity_gain(cutoff: float, order: int, dt: float, n_freq: int = 4097) -> float:
+    """RMS velocity [1/s] the ``butterworth`` scheme (the central first difference through the forward-backward
+    low-pass) makes of unit white position noise: ``sqrt(2 dt int_0^{fs/2} (|B(f)|^2 |D(f)|)^2 df)``,
+    ``|D(f)| = sin(2 pi f dt) / dt``."""
+    from scipy.signal import sosfreqz
+    freq = np.linspace(0.0, 0.5 / dt, n_freq)
+    _, b = sosfreqz(ZeroPhaseLowpass(cutoff, order, dt).sos, worN=freq, fs=1.0 / dt)
+    power = (np.abs(b) ** 2 * np.sin(2.0 * np.pi * freq * dt) / dt) ** 2
+    return math.sqrt(2.0 * dt * float(np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(freq))))
+
+
 # --------------------------------------------------------------------- Savitzky-Golay windows
 def savgol_cutoff(window: int, order: int, dt: float, weights: SavgolWeights = "uniform") -> float:
     """-3 dB frequency [Hz] of the Savitzky-Golay smoother (value at the centre of the local fit,
@@ -461,10 +472,11 @@ MOMENTUM_ORDER = 4
 """Polynomial order of the momentum route's Savitzky-Golay velocity."""
 
 
-def velocity_noise_gain(window: int, dt: float, order: int = MOMENTUM_ORDER) -> float:
+def velocity_noise_gain(window: int, dt: float, order: int = MOMENTUM_ORDER,
+                        weights: SavgolWeights = "uniform") -> float:
     """RMS velocity [1/s] the Savitzky-Golay first derivative makes of unit white position noise: the norm
     of its kernel."""
-    return float(np.linalg.norm(savgol_kernels(window, order, dt, "uniform", max_deriv=1)[1]))
+    return float(np.linalg.norm(savgol_kernels(window, order, dt, weights, max_deriv=1)[1]))
 
 
 def momentum_noise_gain(velocity_window: int, half_width: int, dt: float, order: int = MOMENTUM_ORDER) -> float:
