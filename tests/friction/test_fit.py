@@ -24,11 +24,13 @@ from wbfriction.friction.fit import (
     fit_joints,
     fitted_offsets,
     from_fit_coordinates,
+    held_out_gain,
     held_out_rms,
     held_out_split,
     initial_guesses,
     model_bounds,
     parameter_covariance,
+    prefer_interior,
     standard_errors,
     to_fit_coordinates,
 )
@@ -508,3 +510,36 @@ def test_the_linear_start_is_the_coulomb_viscous_least_squares_fit():
         np.testing.assert_allclose(start, truth.as_vector(), rtol=1e-9, atol=1e-12)
     starts = initial_guesses(QD, FrictionParams(0.3, 0.5, 0.4, 0.2, 0.1, 40.0).f(QD))
     assert len(starts) == 12 and all(((s > LOWER) & (s < UPPER)).all() for s in starts)  # (3.5), inside bounds
+
+
+def test_a_bounded_model_must_beat_a_simpler_interior_one_beyond_the_noise_of_the_comparison():
+    """Issue 38's rule: the tolerance picks the Stribeck model, one of its parameters at a bound; the Coulomb-viscous
+    model, every parameter interior, is taken instead unless the Stribeck model lowers the held-out mean square by
+    more than two standard errors of that lowering (Newey-West over the held-out samples)."""
+    rng = np.random.default_rng(5)
+    rows = np.arange(3000)
+    simple = rng.normal(0.0, 0.1, rows.size)
+    scores = (HeldOutScore("coulomb-viscous", 0.1), HeldOutScore("stribeck", 0.097, ("F_c",)),
+              HeldOutScore("thesis", 0.099, ("S",)))
+    close = simple * 0.999 + rng.normal(0.0, 0.01, rows.size)  # a lowering well within its noise
+    chosen, reason = prefer_interior("stribeck", "stribeck: ...; held-out RMS", scores,
+                                     {"coulomb-viscous": simple, "stribeck": close}, rows)
+    assert chosen == "coulomb-viscous" and reason.startswith("coulomb-viscous: stribeck leaves F_c at a bound")
+    gain, se = held_out_gain(simple, close, rows)
+    assert gain < 2 * se
+    far = simple * 0.7  # a lowering of half the mean square: far beyond its noise
+    chosen, reason = prefer_interior("stribeck", "stribeck: ...", scores, {"coulomb-viscous": simple,
+                                                                           "stribeck": far}, rows)
+    assert chosen == "stribeck" and "outweighs its bound (F_c)" in reason
+    # an interior choice stands as it is
+    assert prefer_interior("coulomb-viscous", "r", scores, {}, rows) == ("coulomb-viscous", "r")
+
+
+def test_the_held_out_gain_and_its_standard_error_by_hand():
+    """White residuals: the mean of the difference of squares and its plain standard error (no correlation to sum)."""
+    rng = np.random.default_rng(6)
+    a, b = rng.normal(0, 1.0, 5000), rng.normal(0, 0.9, 5000)
+    gain, se = held_out_gain(a, b, np.arange(5000))
+    d = a**2 - b**2
+    assert gain == pytest.approx(d.mean(), rel=1e-12)
+    assert se == pytest.approx(d.std() / np.sqrt(d.size), rel=0.2)

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from wbfriction.friction.fit import FitResult, fit_friction
+from wbfriction.friction.fit import FitResult, compare_routes, fit_friction
 from wbfriction.friction.io import fit_from_dict, fit_to_dict
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams
 from wbfriction.friction.status import (
@@ -150,3 +150,63 @@ def test_the_offset_is_judged_against_the_coulomb_friction():
     assert _fit(F_c=1.0, se={"F_v": 0.0, "F_c": 0.0}).verdict().status == "ok"
     assert _fit(F_c=ZERO, se={"F_v": 0.0, "F_c": 0.0, "tau_os": 1e-3}).verdict().status == "weak"
     assert _fit(F_c=0.0, se={"F_v": 0.0, "F_c": 0.0, "tau_os": 1e-3}).verdict().status == "ok"
+
+
+# ------------------------------------------------------------------ issue 38: bias, bounds, zeros
+def _cv_fit(F_v=0.3, F_c=1.0, se=(0.01, 0.02, 0.01), crb=None, speed=1.0, check=None, rms=0.05) -> FitResult:
+    params = CoulombViscousParams(F_v=F_v, F_c=F_c, tau_os=0.1)
+    return FitResult("j", 1000, params=params, stderr=dict(zip(("F_v", "F_c", "tau_os"), se)), rms_residual=rms,
+                     success=True, message="ok", at_bound={"F_v": False, "F_c": False, "tau_os": False}, speed=speed,
+                     crb=crb or {}, route="momentum", route_check=check)
+
+
+def test_two_routes_that_disagree_are_not_ok_and_say_both_values():
+    """F_c 1.0 ± 0.02 against 0.8 ± 0.02: 7 combined standard errors and 20 % apart."""
+    other = _cv_fit(F_c=0.8)
+    other.route = "acceleration"
+    fit = _cv_fit()
+    fit.route_check = compare_routes(fit, other)
+    verdict = fit.verdict()
+    assert fit.route_check.disagree == ("F_c",) and verdict.status == "routes disagree"
+    assert verdict.reason == "F_c 1 ±0.02 (momentum) against 0.8 ±0.02 (acceleration)"
+    # within 3 combined standard errors, or within 2 % of the value, they agree
+    for F_c, se in ((0.92, 0.02), (0.985, 0.001)):
+        near = _cv_fit(F_c=F_c, se=(0.01, se, 0.01))
+        fit.route_check = compare_routes(fit, near)
+        assert fit.route_check.disagree == () and fit.verdict().ok, F_c
+    # a bound comes first: its value is the bound's
+    bounded = _cv_fit()
+    bounded.at_bound["tau_os"] = True
+    bounded.route_check = compare_routes(bounded, other)
+    assert bounded.verdict().status == "at bound"
+
+
+def test_a_bound_beyond_half_the_value_is_weak_whatever_the_standard_error():
+    fit = _cv_fit(crb={"F_v": 0.2, "F_c": 0.01, "tau_os": 0.01})
+    verdict = fit.verdict()
+    assert verdict.status == "weak" and "F_v ±67 % at best (Cramér-Rao)" in verdict.reason
+    assert _cv_fit(crb={"F_v": 0.1, "F_c": 0.01}).verdict().ok
+    assert "F_c not identifiable at best" in _cv_fit(crb={"F_c": np.inf}).verdict().reason
+
+
+def test_a_magnitude_at_zero_is_weak_when_its_spread_outweighs_the_friction():
+    """The KUKA's lwr_3 before issue 38: F_c = 0 ± 1.1 beside 0.5 N·m of friction, F_v = 0 ± 2 at 1 rad/s: no
+    finding; F_c = 0 ± 0.01: one."""
+    verdict = _cv_fit(F_v=0.5, F_c=0.0, se=(0.01, 1.1, 0.01)).verdict()
+    assert verdict.status == "weak" and "F_c 0 ±1.1 (1.1 N·m against 0.5 N·m of friction)" in verdict.reason
+    assert "F_v 0 ±2 (2 N·m" in _cv_fit(F_v=0.0, F_c=0.5, se=(2.0, 0.01, 0.01)).verdict().reason
+    assert _cv_fit(F_v=0.5, F_c=0.0, se=(0.01, 0.01, 0.01)).verdict().ok
+    # a frictionless joint: its residual is the scale
+    assert _cv_fit(F_v=0.0, F_c=0.0, se=(0.001, 0.001, 0.001), rms=0.01).verdict().ok
+
+
+def test_the_new_fields_read_back_from_the_json():
+    other = _cv_fit(F_c=0.8)
+    other.route = "acceleration"
+    fit = _cv_fit(crb={"F_v": 0.004, "F_c": np.inf, "tau_os": 0.002})
+    fit.route_check = compare_routes(fit, other)
+    fit.torque_noise, fit.velocity_noise, fit.stick_speed, fit.n_stuck = 0.05, 0.0018, 0.0054, 321
+    back = fit_from_dict("j", fit_to_dict(fit))
+    for name in ("crb", "route", "route_check", "torque_noise", "velocity_noise", "stick_speed", "n_stuck"):
+        assert getattr(back, name) == getattr(fit, name), name
+    assert back.verdict() == fit.verdict()

@@ -744,7 +744,7 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     scores = tuple(HeldOutScore(m, float(np.sqrt(np.mean(residuals[m] ** 2))) if m in residuals else float("nan"),
                                 r.bounded()) for m, r in trained.items())
     chosen, reason = choose_model(scores, tolerance)
-    chosen, reason = _interior_over_bound(chosen, reason, scores, residuals, np.flatnonzero(held_out))
+    chosen, reason = prefer_interior(chosen, reason, scores, residuals, np.flatnonzero(held_out))
     res = _fit_model(chosen, qd, y, use, fixed=held[chosen], noise=noise, **kwargs)  # as if the model had been named
     if res.bounded():
         reason += f"; at a bound: {', '.join(res.bounded())}"
@@ -752,7 +752,7 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     return res
 
 
-def _interior_over_bound(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ...],
+def prefer_interior(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ...],
                          residuals: dict[ModelName, np.ndarray], rows: np.ndarray) -> tuple[ModelName, str]:
     """The rule of issue 38: a model chosen with a parameter at a bound gives way to the best-scoring simpler model
     whose parameters are all interior, unless it lowers the held-out mean square by more than :data:`GAIN_Z`
