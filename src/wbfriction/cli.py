@@ -25,7 +25,7 @@ from rich.table import Table
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError, WbfrictionError
-from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, EstimateOptions
+from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, EstimateOptions, MomentumOptions
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
 from wbfriction.model.robots import BUILTIN_ROBOTS
@@ -37,7 +37,7 @@ from wbfriction.walking.options import GaitOptions
 
 if TYPE_CHECKING:
     from wbfriction.friction.fit import FitResult, ModelChoice
-    from wbfriction.friction.options import BaseMotion, Method
+    from wbfriction.friction.options import BaseMotion, Method, RouteOption
     from wbfriction.inertia.options import ArmatureMode
     from wbfriction.logs.clock import TimeBase, TimeUnit
     from wbfriction.model.robot import Robot
@@ -72,6 +72,16 @@ ConfigOpt = typer.Option(None, "--config", help="Robot TOML: urdf or mjcf (else 
 MjcfOpt = typer.Option(None, "--mjcf", help="MuJoCo MJCF of the robot instead of its URDF (with --config, or the "
                                              "built-in --robot's configuration); not with --urdf.")
 FitWorkersOpt = typer.Option(2, min=1, help="Processes fitting joints side by side.")
+RouteOpt = typer.Option("auto", "--route", help="How the friction is reached: momentum (positions "
+                                                "differentiated once, generalized momentum), acceleration (twice, "
+                                                "the thesis's) or auto (chosen from the positions' noise, printed); "
+                                                "the other route is estimated too, as a check.")
+VelocityWindowOpt = typer.Option(None, "--velocity-window", help="momentum: the velocity's Savitzky-Golay window "
+                                                                 "(odd, at least 7) [samples]; default: chosen from "
+                                                                 "the noise.")
+MomentumWindowOpt = typer.Option(None, "--momentum-window", help="momentum: the window the friction is averaged "
+                                                                 "over (odd, at least 3) [samples]; default: chosen "
+                                                                 "from the noise.")
 TimeUnitOpt = typer.Option(None, help="Unit of a numeric time column: s, ms, us or ns (needed for integer stamps; "
                                       "float stamps are seconds unless said otherwise; timestamps carry theirs).")
 MapOpt = typer.Option(None, "--map", help="Topic map TOML of a ROS 2 bag log (see 'wbfriction convert'); with a "
@@ -266,6 +276,8 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     _warn(result.warnings)
     if result.differentiation:
         console.print(f"differentiation: {escape(result.differentiation)}", highlight=False, soft_wrap=True)
+    if result.route:
+        console.print(f"route: {escape(result.route)}", highlight=False, soft_wrap=True)
     if opts.velocity == "logged":
         velocity = result.metadata.get("velocity", {})  # measured on the first chunk
         console.print(f"velocity: {escape(velocity.get('reason', 'logged'))} (not compensated)", highlight=False)
@@ -318,7 +330,8 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              step_width: float = typer.Option(_G.step_width, help="Sideways step [m]."),
              turn_angle: float = typer.Option(_G.turn_angle, help="Heading change per turning step [rad]."),
              lift_height: float = typer.Option(_G.lift_height, help="Swing-foot apex [m]."),
-             friction: Optional[Path] = typer.Option(None, help="TOML with [friction.<group or joint>] tables; "
+             friction: Optional[Path] = typer.Option(None, help="TOML with [friction.<group or joint>] tables (a "
+                                                               "model key: coulomb-viscous, stribeck or (3.5)); "
                                                                "default: thesis Table 6.1 on the legs."),
              simulator: str = typer.Option("ideal", help="ideal (rigid contacts, thesis 6.1) or mujoco (soft "
                                                          "contacts, measured contact flags, sensors, thesis 6.2)."),
@@ -331,10 +344,13 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              sensors: Optional[Path] = typer.Option(None, help="mujoco: TOML with a [sensors] table (position_std, "
                                                                "encoder_bits, torque_std, seed, delay); the options "
                                                                "below override it."),
-             position_noise: Optional[float] = typer.Option(None, help="mujoco: joint-position noise std [rad]."),
-             encoder_bits: Optional[int] = typer.Option(None, help="mujoco: encoder resolution [bits per turn]."),
-             torque_noise: Optional[float] = typer.Option(None, help="mujoco: torque-sensor noise std [N·m]."),
-             noise_seed: Optional[int] = typer.Option(None, help="mujoco: seed of the sensor noise."),
+             position_noise: Optional[float] = typer.Option(None, help="mujoco and arms: joint-position noise std "
+                                                                       "[rad]."),
+             encoder_bits: Optional[int] = typer.Option(None, help="mujoco and arms: encoder resolution [bits per "
+                                                                   "turn]."),
+             torque_noise: Optional[float] = typer.Option(None, help="mujoco and arms: torque-sensor noise std "
+                                                                     "[N·m]."),
+             noise_seed: Optional[int] = typer.Option(None, help="mujoco and arms: seed of the sensor noise."),
              delay: Optional[float] = typer.Option(None, help="mujoco: measurement-to-command delay [ms], whole "
                                                               "control periods."),
              log_base: bool = typer.Option(_I.log_base, help="Write the base pose to the log."),
@@ -344,6 +360,10 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              sole_timeconst: Optional[float] = typer.Option(None, help="mujoco: the soles' contact time constant "
                                                                        "(s; default MuJoCo's 0.02, larger is "
                                                                        "softer: a compliant sole)."),
+             friction_timeconst: Optional[float] = typer.Option(None, help="mujoco: the friction-loss constraint's "
+                                                                           "time constant (s; default two physics "
+                                                                           "steps: a joint that sticks; MuJoCo's "
+                                                                           "0.02 leads the velocity by 10 ms)."),
              torque_drift: float = typer.Option(_M.torque_drift, min=0.0, help="mujoco: drift rate of each torque "
                                                                                "sensor's offset (N·m/s)."),
              ft_offset: tuple[float, float] = typer.Option(_M.ft_offset, help="mujoco: standard deviations of the "
@@ -361,7 +381,7 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
     r = _robot(robot, urdf, config, mjcf)
     if not r.floating_base:
         arm = ArmOptions(duration=duration, encoder_bits=19 if encoder_bits is None else encoder_bits,
-                         torque_std=torque_noise or 0.0, seed=noise_seed or 0)
+                         position_std=position_noise or 0.0, torque_std=torque_noise or 0.0, seed=noise_seed or 0)
         _run_simulate_arm(r, output, arm, friction)
         return
     gait_opts = GaitOptions(gait=cast("Gait", gait), steps=steps, step_length=step_length, step_width=step_width,
@@ -379,7 +399,8 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
         lag = float(table.pop("delay", 0.0))
         options = MujocoOptions(substeps=substeps or _M.substeps, friction=cast("FrictionMode", mujoco_friction),
                                 sensors=SensorNoise(**table), delay=lag, log_base=log_base,
-                                sole_timeconst=sole_timeconst, torque_drift=torque_drift, ft_offset=ft_offset)
+                                sole_timeconst=sole_timeconst, friction_timeconst=friction_timeconst,
+                                torque_drift=torque_drift, ft_offset=ft_offset)
     _run_simulate(r, output, gait_opts, options, friction)
 
 
@@ -434,7 +455,9 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                                                                   "wrenches, else contact; printed)."),
              wrenches: bool = typer.Option(_E.wrenches, help="Use the force-torque sensors' wrench.<sensor>.* "
                                                              "columns where logged: every joint's friction in "
-                                                             "every phase.")) -> None:
+                                                             "every phase."),
+             route: str = RouteOpt, velocity_window: Optional[int] = VelocityWindowOpt,
+             momentum_window: Optional[int] = MomentumWindowOpt) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
     from wbfriction.pipeline.estimate import RobotSpec
 
@@ -444,7 +467,8 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                            lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
                            ds_regularization=ds_regularization, condition_number=cond, method=cast("Method", method),
                            velocity=cast("Velocity", velocity), base_motion=cast("BaseMotion", base_motion),
-                           wrenches=wrenches,
+                           wrenches=wrenches, route=cast("RouteOption", route),
+                           momentum=MomentumOptions(velocity_window, momentum_window),
                            filtering=FilterOptions(window=window, poly_order=poly_order,
                                                    weights=cast("SavgolWeights", weights),
                                                    cutoff=cutoff, butter_order=butter_order))
@@ -506,7 +530,8 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
                                                    "several."),
            include: str = typer.Option("", "--include",
                                        help="Fit statuses exported besides ok, comma-separated: weak (large "
-                                            "standard errors), at-bound (a parameter at a bound of the fit). "
+                                            "standard errors), at-bound (a parameter at a bound of the fit), "
+                                            "routes-disagree (the two routes' fits differ: one is biased). "
                                             "Fits not excited or failed are never exported."),
            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
            mjcf: Optional[Path] = MjcfOpt) -> None:
@@ -590,14 +615,13 @@ def sensitivity(log: Path = LogArg,
                                                                 "legs' joints)."),
                 diff: str = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
                 mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate')."),
+                route: str = RouteOpt,
                 time_unit: Optional[str] = TimeUnitOpt) -> None:
     """Re-run the estimate with every body's inertia scaled (thesis 7.2, Fig. 7.5/7.6): how the
     friction curves shift (mass) and split into branches (rotational inertia)."""
-    from wbfriction.friction.estimate import resolve_differentiation
     from wbfriction.inertia.sensitivity import PARTS, InertiaPart, inertia_sensitivity, parse_factors
     from wbfriction.logs.source import read_log
     from wbfriction.report.figures import save_png, sensitivity_figure
-    from wbfriction.signals.kinematics import measure
 
     check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
     if part not in PARTS:
@@ -606,11 +630,10 @@ def sensitivity(log: Path = LogArg,
     r = _robot(robot, urdf, config, mjcf)
     data = read_log(log, r, time_unit=_time_unit(time_unit))
     _warn(data.warnings)
-    opts, _ = resolve_differentiation(
-        EstimateOptions(diff=cast("Diff | Literal['auto']", diff), mask=cast("Mask", mask)), data)
-    kin = measure(data, cast("Diff", opts.diff), filtering=opts.filtering)
+    opts = EstimateOptions(diff=cast("Diff | Literal['auto']", diff), mask=cast("Mask", mask),
+                           route=cast("RouteOption", route))
     with console.status("") as status:
-        sens = inertia_sensitivity(r, kin, values, cast(InertiaPart, part), opts, progress=status.update)
+        sens = inertia_sensitivity(r, data, values, cast(InertiaPart, part), opts, progress=status.update)
     names = _joint_list(r, joints)
     with console.status("fitting the offsets of the model as given"):
         tau_os = sens.reference_offsets(names)
@@ -714,6 +737,7 @@ def identify(log: Path = LogArg,
                                               help="a of the Coulomb term tanh(a qd) [s/rad]."),
              diff: str = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
              mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate')."),
+             route: str = RouteOpt,
              workers: int = FitWorkersOpt, time_unit: Optional[str] = TimeUnitOpt) -> None:
     """Identify the inertia model and the friction together from the joint torques of single
     support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
@@ -734,7 +758,8 @@ def identify(log: Path = LogArg,
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior,
                            armature=cast("ArmatureMode", armature))
     with console.status("") as status:
-        estimate_options = EstimateOptions(diff=cast("Diff | Literal['auto']", diff), mask=cast("Mask", mask))
+        estimate_options = EstimateOptions(diff=cast("Diff | Literal['auto']", diff), mask=cast("Mask", mask),
+                                           route=cast("RouteOption", route))
         done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
                              options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers,
                              time_unit=_time_unit(time_unit))

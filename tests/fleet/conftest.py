@@ -67,6 +67,7 @@ def write_synthetic_results(results: Path, logs: int, robot_id: str = "r1", join
             row.update(robot_id=robot_id, log=f"/logs/{robot_id}/{i}.parquet",
                        start_time=datetime(2026, 1, 1, tzinfo=UTC) + timedelta(days=i), key=f"{robot_id}-{i:04d}",
                        log_sha256=f"{robot_id}{i}", robot_sha256="", options_sha256="", joint=joint, model="thesis",
+                       route="acceleration",
                        status="ok", n_samples=1000, version="test", F_c=F_c(i), F_c_se=0.02 * F_c(i),
                        **{"f_at_0.3": F_c(i), "f_at_0.3_se": 0.02 * F_c(i)})
             for name in RESULT_SCHEMA.names:

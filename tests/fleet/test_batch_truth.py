@@ -45,6 +45,7 @@ def fake_process_log(entry, key, options, scratch, table=None, executor=None, ch
     row = {name: float("nan") for name in RESULT_SCHEMA.names}
     row.update(robot_id=key.robot_id, log=key.log, start_time=key.start_time, key=key.key, log_sha256=key.log_sha256,
                robot_sha256=key.robot_sha256, options_sha256=key.options_sha256, joint="j", model=options.model,
+               route="acceleration",
                status="ok", n_samples=1, version="test", F_c=float(Path(key.log).read_bytes()[0]))
     return LogOutcome(entry, key, pa.Table.from_pydict({k: [v] for k, v in row.items()}, schema=RESULT_SCHEMA),
                       table=table)

@@ -93,6 +93,7 @@ def synthetic_results(drift: float) -> pa.Table:
                 row = {n: float("nan") for n in RESULT_SCHEMA.names}
                 row.update(robot_id=robot_id, log=f"{robot_id}/{i}", start_time=t, key=f"{robot_id}{i}",
                            log_sha256="", robot_sha256="", options_sha256="", joint=joint, model="thesis",
+                           route="acceleration",
                            status="ok", n_samples=1000, version="test")
                 for q, v in values.items():
                     row[q] = v + 0.02 * v * rng.standard_normal()
@@ -132,8 +133,8 @@ def _series_table(values: dict[str, np.ndarray], se: float = 0.02, times: list[d
     for i in range(n):
         row = {name: float("nan") for name in RESULT_SCHEMA.names}
         row.update(robot_id="r", log=f"log{i}", start_time=times[i], key=f"k{i}", log_sha256=f"h{i}",
-                   robot_sha256="", options_sha256="", joint="j", model="thesis", status="ok", n_samples=1000,
-                   version="test")
+                   robot_sha256="", options_sha256="", joint="j", model="thesis", route="acceleration", status="ok",
+                   n_samples=1000, version="test")
         for q, v in values.items():
             row[q], row[q + "_se"] = float(v[i]), se
         for name in RESULT_SCHEMA.names:

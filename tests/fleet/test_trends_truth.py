@@ -276,7 +276,7 @@ def results_table(rows: list[dict]) -> pa.Table:
     for given_row in rows:
         row = {name: float("nan") for name in RESULT_SCHEMA.names}
         row.update(robot_id="r", log="l", key="k", log_sha256="", robot_sha256="", options_sha256="", joint="j",
-                   model="thesis", status="ok", n_samples=100, version="test")
+                   model="thesis", route="acceleration", status="ok", n_samples=100, version="test")
         row.update(given_row)
         for name in RESULT_SCHEMA.names:
             columns[name].append(row[name])

@@ -13,7 +13,6 @@ from wbfriction.friction.fit import fit_joints
 from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.sensitivity import inertia_sensitivity
-from wbfriction.signals.kinematics import measure
 from wbfriction.studies.common import leg_joints
 
 
@@ -60,7 +59,8 @@ def test_zero_crossings_and_lags_of_shifted_sines():
 
 @pytest.fixture(scope="module")
 def walk_estimate(talos, combined_walk):
-    est = estimate_log(talos, combined_walk.log, EstimateOptions(), companion=True)
+    est = estimate_log(talos, combined_walk.log, EstimateOptions(diff="central", route="acceleration"),
+                       companion=True)
     legs = [j for j, _, _ in leg_joints(talos)]
     idx = [est.joints.index(j) for j in legs]
     fits = fit_joints(legs, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx])
@@ -87,8 +87,8 @@ def test_rotational_inertia_error_makes_friction_generate_power(talos, combined_
     """Thesis 7.2: with every body's principal moments of inertia 10 % too large the share of
     power-generating samples rises, and the most affected joint is flagged."""
     est, legs, tau_os = walk_estimate
-    kin = measure(combined_walk.log, "central")
-    scaled = inertia_sensitivity(talos, kin, [1.1], "rotational").estimates[1]
+    scaled = inertia_sensitivity(talos, combined_walk.log, [1.1], "rotational",
+                                 EstimateOptions(diff="central", route="acceleration")).estimates[1]
     before = {e.joint: e for e in energy_consistency(est, tau_os)}
     after = {e.joint: e for e in energy_consistency(scaled, tau_os)}
     print({j: f"{100 * before[j].generating_share:.2f} -> {100 * after[j].generating_share:.2f} %" for j in legs})

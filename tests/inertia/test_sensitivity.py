@@ -10,8 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.sensitivity import inertia_sensitivity, parse_factors, scale_inertia, scaled_robot
-from wbfriction.signals.kinematics import measure
 from wbfriction.studies.common import leg_joints
 
 
@@ -74,8 +74,9 @@ def test_bad_parts_and_factors_are_input_errors():
 
 @pytest.fixture(scope="module")
 def sensitivities(talos, combined_walk):
-    kin = measure(combined_walk.log, "central")
-    return {part: inertia_sensitivity(talos, kin, [0.9, 1.1], part) for part in ("mass", "rotational")}
+    opts = EstimateOptions(diff="central", route="acceleration")
+    return {part: inertia_sensitivity(talos, combined_walk.log, [0.9, 1.1], part, opts) for part in ("mass",
+                                                                                                     "rotational")}
 
 
 def test_mass_error_shifts_the_knee_curve_up_for_more_mass(talos, sensitivities):

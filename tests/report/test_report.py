@@ -20,7 +20,6 @@ from wbfriction.inertia.sensitivity import inertia_sensitivity
 from wbfriction.logs.tables import write_table
 from wbfriction.report.build import acceleration_spectra, make_report
 from wbfriction.report.html import render_html, write_report
-from wbfriction.signals.kinematics import measure
 
 pytestmark = pytest.mark.slow  # module fixtures of 30-55 s (the quick subset: -m "not slow")
 
@@ -34,8 +33,8 @@ def tables(talos, combined_walk, tmp_path_factory):
     est = estimate_log(talos, combined_walk.log, EstimateOptions(), companion=True)
     true_model = out / "friction.parquet"
     write_table(friction_table(est), true_model)
-    kin = measure(combined_walk.log, "central")
-    scaled = inertia_sensitivity(talos, kin, [1.1], "rotational").estimates[1]
+    scaled = inertia_sensitivity(talos, combined_walk.log, [1.1], "rotational",
+                                 EstimateOptions(diff="central", route="acceleration")).estimates[1]
     scaled.metadata = est.metadata
     rotational = out / "friction_rot11.parquet"
     write_table(friction_table(scaled), rotational)

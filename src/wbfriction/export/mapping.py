@@ -76,10 +76,11 @@ class FrictionModelParams(Protocol):
     def F_c(self) -> float: ...
 
 
-Include = Literal["weak", "at-bound"]
+Include = Literal["weak", "at-bound", "routes-disagree"]
 """The statuses besides ``ok`` whose fits are exported on request (``export --include``; module docstring)."""
 INCLUDE_CHOICES: tuple[Include, ...] = get_args(Include)
-INCLUDED_STATUS: dict[Include, FitStatus] = {"weak": "weak", "at-bound": "at bound"}
+INCLUDED_STATUS: dict[Include, FitStatus] = {"weak": "weak", "at-bound": "at bound",
+                                             "routes-disagree": "routes disagree"}
 """The fit status each choice of :data:`Include` names."""
 NEVER_EXPORTED: tuple[FitStatus, ...] = ("not excited", "failed")
 """Statuses whose numbers are not the data's: never exported, whatever is included."""

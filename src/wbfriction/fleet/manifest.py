@@ -15,6 +15,7 @@ column         meaning
                manifest) for any other robot (:func:`~wbfriction.model.loading.load_robot`); not both
                ``robot`` and ``config`` (the configuration defines the robot)
 ``diff``       optional: the differentiation of this log (``auto``, ``central``, ``savgol``, ...)
+``route``      optional: the route of this log (``auto``, ``acceleration``, ``momentum``)
 ``model``      optional: the friction model fitted (``auto``, ``thesis``, ``stribeck``, ``coulomb-viscous``)
 =============  ========================================================================================
 
@@ -44,13 +45,14 @@ import pyarrow.compute as pc
 from wbfriction.exceptions import InputError
 from wbfriction.fleet.schema import RESULT_DOCUMENT
 from wbfriction.friction.fit import MODEL_CHOICES
+from wbfriction.friction.options import ROUTE_OPTIONS
 from wbfriction.logs.tables import TableFile, read_metadata, table_format
 from wbfriction.pipeline.estimate import RobotSpec
 from wbfriction.signals.kinematics import Diff
 
 REQUIRED = ("log", "robot_id", "start_time")
 """The columns every manifest has."""
-OPTIONAL = ("robot", "urdf", "config", "diff", "model")
+OPTIONAL = ("robot", "urdf", "config", "diff", "route", "model")
 """The columns a manifest may have (others are refused: a misspelt option would be silently ignored)."""
 LOG_SUFFIXES = (".parquet", ".pq", ".csv", ".h5", ".hdf5")
 """The files a scanned folder's logs are."""
@@ -73,7 +75,7 @@ class LogEntry:
         robot_id: the robot that wrote it (text, as the manifest or the folder's name gives it).
         start_time: when it started (UTC, aware).
         robot: how to load its robot model.
-        options: per-log options (``diff``, ``model``) that override the batch's.
+        options: per-log options (``diff``, ``route``, ``model``) that override the batch's.
         row: the manifest's row it came from (0-based), or None for a scanned log.
     """
 
@@ -305,8 +307,8 @@ def _entry(path: Path, row: int, cell: dict[str, str], start: datetime) -> LogEn
             raise InputError(f"{where}, column '{column}': {(path.parent / value).resolve()} not found")
     robot = RobotSpec(name or None, str((path.parent / urdf).resolve()) if urdf else None,
                       str((path.parent / config).resolve()) if config else None)
-    options = {c: cell[c] for c in ("diff", "model") if cell.get(c)}
-    for column, choices in (("diff", DIFF_CHOICES), ("model", MODEL_CHOICES)):
+    options = {c: cell[c] for c in ("diff", "route", "model") if cell.get(c)}
+    for column, choices in (("diff", DIFF_CHOICES), ("route", ROUTE_OPTIONS), ("model", MODEL_CHOICES)):
         if column in options and options[column] not in choices:
             raise InputError(f"{where}, column '{column}': {options[column]!r} is not one of {', '.join(choices)}")
     return LogEntry(log, cell["robot_id"], start, robot, options, row)

@@ -35,10 +35,11 @@ class BatchOptions:
     chunk_rows: int = 10_000
 
     def for_entry(self, overrides: dict[str, Any]) -> BatchOptions:
-        """These options with a manifest row's own (``diff``, ``model``) applied."""
+        """These options with a manifest row's own (``diff``, ``route``, ``model``) applied."""
         out = self
-        if "diff" in overrides:
-            out = dataclasses.replace(out, estimate=dataclasses.replace(out.estimate, diff=overrides["diff"]))
+        for name in ("diff", "route"):
+            if name in overrides:
+                out = dataclasses.replace(out, estimate=dataclasses.replace(out.estimate, **{name: overrides[name]}))
         if "model" in overrides:
             out = dataclasses.replace(out, model=overrides["model"])
         return out

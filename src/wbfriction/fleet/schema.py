@@ -33,7 +33,8 @@ rows): what tells a result from any other Parquet file."""
 REFERENCE_SPEEDS: tuple[float, ...] = (0.1, 0.3, 1.0)
 """The speeds [rad/s] at which each fit's friction ``f_at_<v>`` is reported."""
 TREND_PARAMS: tuple[str, ...] = ("F_c", "F_v", "tau_os")
-"""The model parameters followed over time, each with its standard error ``<name>_se``."""
+"""The model parameters followed over time, each with its standard error ``<name>_se`` and its Cramér-Rao bound's
+standard deviation ``<name>_crb`` (:mod:`wbfriction.friction.bound`)."""
 
 
 def speed_column(v: float) -> str:
@@ -51,12 +52,14 @@ RESULT_SCHEMA = pa.schema([
     ("options_sha256", pa.string()),
     ("joint", pa.string()),
     ("model", pa.string()),               # the fitted model: thesis, stribeck, coulomb-viscous
-    ("status", pa.string()),              # the fit's verdict: ok, weak, at bound, not excited, failed
+    ("route", pa.string()),               # the estimate's route: momentum, acceleration
+    ("status", pa.string()),              # the fit's verdict: ok, weak, routes disagree, at bound, not excited, failed
     ("n_samples", pa.int64()),            # valid samples fitted
     ("qd_min", pa.float64()),             # [rad/s] over the fitted samples
     ("qd_max", pa.float64()),
     ("qd_p95", pa.float64()),             # 95th percentile of |qd| [rad/s]
-    *[(name, pa.float64()) for p in TREND_PARAMS for name in (p, f"{p}_se")],  # [N·m], [N·m·s/rad]
+    *[(name, pa.float64()) for p in TREND_PARAMS for name in (p, f"{p}_se", f"{p}_crb")],  # [N·m], [N·m·s/rad]
+    *[(f"{p}_check", pa.float64()) for p in TREND_PARAMS[:2]],  # the same model on the other route (NaN: none)
     *[(name, pa.float64()) for v in REFERENCE_SPEEDS for name in (speed_column(v), speed_column(v) + "_se")],
     ("energy_share", pa.float64()),       # share of friction power that generates energy (eq. 7.9), in [0, 1]
     ("rms_residual", pa.float64()),       # [N·m]

@@ -173,7 +173,7 @@ def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy]
         values = fit.params.to_dict() if fit.params is not None else {}
         row = {"robot_id": key.robot_id, "log": key.log, "start_time": _utc(key.start_time),
                "key": key.key, "log_sha256": key.log_sha256, "robot_sha256": key.robot_sha256,
-               "options_sha256": key.options_sha256, "joint": fit.joint, "model": fit.model,
+               "options_sha256": key.options_sha256, "joint": fit.joint, "model": fit.model, "route": fit.route,
                "status": fit.verdict().status, "n_samples": fit.n_samples,
                "qd_min": float(v.min()) if v.size else float("nan"),
                "qd_max": float(v.max()) if v.size else float("nan"),
@@ -183,6 +183,10 @@ def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy]
         for p in TREND_PARAMS:
             row[p] = float(values.get(p, float("nan")))
             row[f"{p}_se"] = float(fit.stderr.get(p, float("nan")))
+            row[f"{p}_crb"] = float(fit.crb.get(p, float("nan")))
+        check = fit.route_check.params if fit.route_check is not None else None
+        for p in TREND_PARAMS[:2]:
+            row[f"{p}_check"] = float(check.get(p, float("nan"))) if check else float("nan")
         reach = float(np.max(np.abs(v))) if v.size else 0.0
         for s in REFERENCE_SPEEDS:
             f, se = reference_friction(fit, s) if s <= reach else (float("nan"), float("nan"))

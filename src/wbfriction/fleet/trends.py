@@ -49,7 +49,8 @@ QUANTITIES: tuple[str, ...] = (*TREND_PARAMS, *[speed_column(v) for v in REFEREN
 UNITS = {"F_c": "N·m", "F_v": "N·m·s/rad", "tau_os": "N·m", **{speed_column(v): "N·m" for v in REFERENCE_SPEEDS}}
 """The unit of each quantity."""
 USABLE = ("ok", "weak", "at bound")
-"""The fit statuses whose values are points of a series (``not excited`` and ``failed`` fits have none)."""
+"""The fit statuses whose values are points of a series (``not excited`` and ``failed`` fits have none; a fit whose
+two routes disagree is biased one way or the other: its value is no point of a series either)."""
 DAY = 86_400.0
 """Seconds per day: the series' time unit."""
 

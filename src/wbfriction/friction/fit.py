@@ -59,13 +59,14 @@ from wbfriction.friction.estimated import FrictionEstimate
 from wbfriction.friction.models import (
     MODEL_NAMES,
     MODEL_PARAMS,
-    FrictionParams,
     ModelName,
+    ModelParams,
     ModelParamsBase,
     ParamsT,
     check_model,
     model_jacobian,
     model_values,
+    target_from_dict,
 )
 from wbfriction.friction.noise import joint_noises
 from wbfriction.friction.options import SELECTION_TOLERANCE
@@ -267,7 +268,7 @@ class FitResult(Generic[ParamsT]):
         rms_error_vs_true: RMS of (estimated - true) friction over the samples used [N·m],
             when the log had ``tau_f_true``.
         rms_model_vs_true: RMS of (fitted model torque - true friction) [N·m], likewise.
-        target: the friction parameters (3.5) injected by a simulator, when known.
+        target: the friction parameters injected by a simulator (any model's), when known.
         model: the model fitted (that of :attr:`params` when there are any).
         at_bound: per parameter, whether the fit left it on one of its bounds (its value is
             then the bound's, not the data's; held parameters are not).
@@ -302,7 +303,7 @@ class FitResult(Generic[ParamsT]):
     message: str = ""
     rms_error_vs_true: float | None = None
     rms_model_vs_true: float | None = None
-    target: FrictionParams | None = None
+    target: ModelParams | None = None
     model: ModelName = "thesis"
     at_bound: dict[str, bool] = field(default_factory=dict)
     selection: ModelSelection | None = None
@@ -854,7 +855,7 @@ def _fit_column(args: tuple) -> FitResult:
 
 
 def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
-               tau_f_true: np.ndarray | None = None, targets: dict[str, FrictionParams] | None = None,
+               tau_f_true: np.ndarray | None = None, targets: Mapping[str, ModelParams] | None = None,
                delta_s: float = 2.0, min_samples: int = 20, smoother=None,
                fixed: dict[str, float] | None = None, workers: int = 1,
                model: ModelChoice | Sequence[ModelName] = "thesis",
@@ -867,7 +868,7 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
         qd, tau_f, valid: (N, n) arrays of a :class:`~wbfriction.friction.estimate.FrictionEstimate`
             (the whole time series: with ``smoother`` the model is filtered along it).
         tau_f_true: (N, n) true friction (NaN columns for unknown) or None.
-        targets: true parameters (3.5) per joint name, when known.
+        targets: true parameters (any model's) per joint name, when known.
         smoother: the estimate's smoother (``FrictionEstimate.smoother``) or None.
         fixed: parameters held instead of fitted (:func:`fit_friction`).
         workers: processes fitting joints side by side (each fit is independent of the
@@ -949,10 +950,10 @@ def fit_estimate(est: FrictionEstimate, *, delta_s: float = 2.0, min_samples: in
     joint's model is fitted there too and the two compared (:attr:`FitResult.route_check`, :func:`compare_routes`).
 
     Raises:
-        InputError: ``friction_true`` metadata that are not parameters of (3.5); an unknown model; a damaged noise
+        InputError: ``friction_true`` metadata that are not a model's parameters; an unknown model; a damaged noise
             record.
     """
-    targets = {j: FrictionParams.from_dict(p) for j, p in est.metadata.get("friction_true", {}).items()}
+    targets = {j: target_from_dict(p) for j, p in est.metadata.get("friction_true", {}).items()}
     record = est.metadata.get("noise")
     fits = fit_joints(est.joints, est.qd, est.tau_f, est.valid, tau_f_true=est.tau_f_true, targets=targets,
                       delta_s=delta_s, min_samples=min_samples, smoother=est.smoother, workers=workers, model=model,

@@ -31,7 +31,7 @@ from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult, HeldOutScore, ModelSelection, RouteCheck
-from wbfriction.friction.models import FrictionParams, check_model, params_from_dict
+from wbfriction.friction.models import check_model, params_from_dict, target_from_dict
 from wbfriction.friction.options import ROUTES
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.tables import file_sha256, numeric_column, read_metadata, read_table, with_metadata, write_json
@@ -153,7 +153,7 @@ def _check_targets(meta: dict, source: str) -> None:
         try:
             if not isinstance(params, dict):
                 raise TypeError("not a table of parameters")
-            FrictionParams.from_dict(params)
+            target_from_dict(params)
         except (TypeError, ValueError) as exc:
             raise InputError(f"{source}: the metadata's friction_true of '{joint}': {exc}") from None
 
@@ -297,7 +297,7 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
         d["rms_error_vs_true"] = clean(fit.rms_error_vs_true)
         d["rms_model_vs_true"] = clean(fit.rms_model_vs_true)
     if fit.target is not None:
-        d["target"] = fit.target.to_dict()
+        d["target"] = fit.target.to_target()
         d["error_percent"] = {k: clean(v) for k, v in (fit.error_percent() or {}).items()}
     return d
 
@@ -343,7 +343,7 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
         res.stick_speed = float(d.get("stick_speed", 0.0))
         res.n_stuck = int(d.get("n_stuck", 0))
         if d.get("target") is not None:
-            res.target = FrictionParams.from_dict(d["target"])
+            res.target = target_from_dict(d["target"])
         if "rms_error_vs_true" in d:
             res.rms_error_vs_true = _number(d["rms_error_vs_true"])
             res.rms_model_vs_true = _number(d.get("rms_model_vs_true"))

@@ -110,7 +110,7 @@ def stribeck_viscous(qd: ArrayLike, F_v: ParamLike, F_c: ParamLike, F_s: ParamLi
     return viscous(qd, F_v) + stribeck(qd, F_c, F_s, v_s, delta_s) + np.asarray(tau_os)
 
 
-def model_values(x: np.ndarray, qd: np.ndarray, delta_s: float, model: ModelName = "thesis") -> np.ndarray:
+def model_values(x: np.ndarray, qd: np.ndarray, delta_s: ParamLike, model: ModelName = "thesis") -> np.ndarray:
     """``model``'s ``f(qd)`` [N·m] for the parameter vector ``x`` in the order of its names
     (:data:`~wbfriction.friction.models.PARAM_NAMES` for (3.5)), ``qd`` (N,) [rad/s]."""
     if model == "coulomb-viscous":
@@ -163,6 +163,23 @@ class ModelParamsBase:
     def f(self, qd: ArrayLike) -> np.ndarray:
         """Friction characteristic ``f(qd)`` [N·m] (``qd`` [rad/s], any shape)."""
         raise NotImplementedError
+
+    def quantities(self) -> dict[str, float]:
+        """Every model's parameters in this model's terms (:data:`ALL_PARAM_NAMES`): what a fit of any model is
+        compared with (:meth:`values_in`); a quantity this model does not have is NaN (a Stribeck velocity without
+        a Stribeck effect), a jump this model makes is a tanh slope ``a = inf``."""
+        raise NotImplementedError
+
+    def values_in(self, model: ModelName) -> dict[str, float]:
+        """These parameters under the names of ``model``'s (:meth:`quantities`), e.g. an injected friction of one
+        model against a fit of another."""
+        q = self.quantities()
+        return {n: q[n] for n in MODEL_PARAMS[model].names}
+
+    def to_target(self) -> dict[str, float | str]:
+        """These parameters and their model's name, as a simulator's ``friction_true`` metadata holds them
+        (:func:`target_from_dict` reads them back)."""
+        return {"model": self.model, **self.to_dict()}
 
     def torque(self, qd: ArrayLike) -> np.ndarray:
         """Torque friction exerts on the joint, ``tau_f = -f(qd)`` [N·m]."""
@@ -218,6 +235,11 @@ class CoulombViscousParams(ModelParamsBase):
         """Friction characteristic ``f(qd) = F_v qd + F_c sgn(qd) + tau_os`` [N·m]."""
         return coulomb_viscous(qd, self.F_v, self.F_c, self.tau_os)
 
+    def quantities(self) -> dict[str, float]:
+        """:meth:`ModelParamsBase.quantities`: no Stribeck effect (``F_s = F_c``, ``S = 0``), a sign function."""
+        return {"F_v": self.F_v, "F_c": self.F_c, "F_s": self.F_c, "S": 0.0, "v_s": float("nan"),
+                "tau_os": self.tau_os, "a": float("inf")}
+
 
 @dataclass(frozen=True)
 class StribeckParams(ModelParamsBase):
@@ -239,6 +261,12 @@ class StribeckParams(ModelParamsBase):
         """Friction characteristic f(qd) of (3.3) + (3.2) with offset [N·m]."""
         return stribeck_viscous(qd, self.F_v, self.F_c, self.F_s, self.v_s, self.tau_os, self.delta_s)
 
+    def quantities(self) -> dict[str, float]:
+        """:meth:`ModelParamsBase.quantities`: ``S = F_s / F_c - 1``, a sign function."""
+        S = self.F_s / self.F_c - 1.0 if self.F_c != 0 else float("nan")
+        return {"F_v": self.F_v, "F_c": self.F_c, "F_s": self.F_s, "S": S, "v_s": self.v_s, "tau_os": self.tau_os,
+                "a": float("inf")}
+
 
 @dataclass(frozen=True)
 class FrictionParams(ModelParamsBase):
@@ -259,14 +287,11 @@ class FrictionParams(ModelParamsBase):
         """Friction characteristic f(qd) of eq. (3.5) [N·m]."""
         return coulomb_viscous_stribeck(qd, self.F_v, self.F_c, self.S, self.v_s, self.tau_os, self.a, self.delta_s)
 
-    def values_in(self, model: ModelName) -> dict[str, float]:
-        """These parameters under the names of ``model``'s parameters, those it shares with
-        (3.5): F_v, F_c, tau_os, and for ``stribeck`` v_s and the static friction
-        ``F_s = (1 + S) F_c`` (what a fit of ``model`` is compared with, e.g. against injected
-        friction). The smoothing ``tanh(a qd)`` has no counterpart in the other models."""
-        values = {"F_v": self.F_v, "F_c": self.F_c, "F_s": (1.0 + self.S) * self.F_c, "S": self.S,
-                  "v_s": self.v_s, "tau_os": self.tau_os, "a": self.a}
-        return {n: values[n] for n in MODEL_PARAMS[model].names}
+    def quantities(self) -> dict[str, float]:
+        """:meth:`ModelParamsBase.quantities`: the static friction ``F_s = (1 + S) F_c``; the smoothing
+        ``tanh(a qd)`` has no counterpart in the other models."""
+        return {"F_v": self.F_v, "F_c": self.F_c, "F_s": (1.0 + self.S) * self.F_c, "S": self.S,
+                "v_s": self.v_s, "tau_os": self.tau_os, "a": self.a}
 
 
 ModelParams = CoulombViscousParams | StribeckParams | FrictionParams
@@ -295,6 +320,17 @@ def params_from_dict(model: str, d: Mapping[str, object]) -> ModelParams:
         InputError: an unknown model, an unknown parameter name, a value that is not a number.
     """
     return MODEL_PARAMS[check_model(model)].from_dict(d)
+
+
+def target_from_dict(d: Mapping[str, object]) -> ModelParams:
+    """Parameters of any model from a ``friction_true`` entry (:meth:`ModelParamsBase.to_target`); without a
+    ``model`` key (logs of earlier versions), of (3.5).
+
+    Raises:
+        InputError: an unknown model, an unknown parameter name, a value that is not a number.
+    """
+    values = dict(d)
+    return params_from_dict(str(values.pop("model", "thesis")), values)
 
 
 def friction_torque(qd: np.ndarray, params: list[FrictionParams]) -> np.ndarray:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from wbfriction.config import toml_table
 from wbfriction.exceptions import InputError
-from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.models import FrictionParams, ModelParams, target_from_dict
 
 THESIS_TARGETS: dict[str, FrictionParams] = {
     "hip_pitch": FrictionParams(F_v=0.2, F_c=0.8, S=0.2, v_s=0.2, tau_os=0.8, a=40.0),
@@ -29,24 +29,26 @@ def friction_by_group(groups: dict[str, tuple[str, ...]],
 
 
 def load_friction_toml(path: str | Path, groups: dict[str, tuple[str, ...]],
-                       joints: tuple[str, ...]) -> dict[str, FrictionParams]:
+                       joints: tuple[str, ...]) -> dict[str, ModelParams]:
     """Friction parameters per joint from a TOML file.
 
     Each table under ``[friction]`` is named after a joint group or a joint and gives the
-    parameters of (3.5) (missing ones take the :class:`FrictionParams` defaults); a joint's
+    parameters of (3.5), or of the model its ``model`` key names (``coulomb-viscous``: F_v, F_c, tau_os;
+    ``stribeck``: F_v, F_c, F_s, v_s, tau_os); missing ones take the model's defaults. A joint's
     own table overrides its group's::
 
         [friction.knee]
         F_v = 0.2
         F_c = 1.0
         [friction.leg_right_4_joint]
+        model = "coulomb-viscous"
         F_c = 1.5
 
     Raises:
-        InputError: unreadable file, an unknown group, joint or parameter.
+        InputError: unreadable file, an unknown group, joint, model or parameter.
     """
     table = toml_table(path, "friction")
-    out: dict[str, FrictionParams] = {}
+    out: dict[str, ModelParams] = {}
     for is_group in (True, False):  # groups first, joints override
         for name, values in table.items():
             if (name in groups) != is_group:
@@ -54,7 +56,7 @@ def load_friction_toml(path: str | Path, groups: dict[str, tuple[str, ...]],
             if not is_group and name not in joints:
                 raise InputError(f"{path}: [friction.{name}] names neither a joint group nor a joint")
             try:
-                params = FrictionParams.from_dict(values)
+                params = target_from_dict(values) if isinstance(values, dict) else FrictionParams.from_dict(values)
             except InputError as exc:
                 raise InputError(f"{path}: [friction.{name}]: {exc}") from exc
             for joint in (groups[name] if is_group else (name,)):

@@ -34,11 +34,12 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimate import FrictionEstimate, estimate_friction
+from wbfriction.friction.estimate import FrictionEstimate, estimate_resolved, resolve_differentiation
 from wbfriction.friction.options import EstimateOptions
+from wbfriction.friction.route import resolve_route
+from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
-from wbfriction.signals.kinematics import MeasuredKinematics
 
 InertiaPart = Literal["all", "mass", "rotational"]
 """What of a body's inertia is scaled (module docstring)."""
@@ -181,29 +182,33 @@ def parse_factors(text: str) -> tuple[float, ...]:
     return values
 
 
-def inertia_sensitivity(robot: Robot, kin: MeasuredKinematics, factors, part: InertiaPart = "all",
+def inertia_sensitivity(robot: Robot, log: Log, factors, part: InertiaPart = "all",
                         options: EstimateOptions = EstimateOptions(),
                         progress: StageProgress | None = None) -> Sensitivity:
-    """Re-run the estimate of measured kinematics with every body's inertia scaled.
+    """Re-run the estimate of a log with every body's inertia scaled, by the route and differentiation its options
+    resolve to once (:func:`~wbfriction.friction.estimate.resolve_differentiation`,
+    :func:`~wbfriction.friction.route.resolve_route`), without the other route's check.
 
     Args:
         robot: the model as given (factor 1).
-        kin: measured kinematics of the log (:func:`~wbfriction.signals.kinematics.measure`).
+        log: the log.
         factors: scaling factors (> 0); 1.0 is added first as the reference.
         part: ``all``, ``mass`` or ``rotational`` (:func:`scale_inertia`).
         options: estimator options.
         progress: optional callable(label) called before each estimate.
 
     Raises:
-        InputError: bad ``part`` or factors, or what :func:`~wbfriction.friction.estimate.estimate_friction` raises.
+        InputError: bad ``part`` or factors, or what :func:`~wbfriction.friction.estimate.estimate_log` raises.
     """
     if part not in PARTS:
         raise InputError(f"unknown inertia part '{part}': choose one of {', '.join(PARTS)}")
     factors = (1.0, *[float(f) for f in factors if f != 1.0])
+    options, _ = resolve_differentiation(options, log)
+    options, _ = resolve_route(dataclasses.replace(options, check_route=False), log)
     estimates = []
     for f in factors:
         if progress is not None:
             progress(f"estimate with {part} inertia x {f:g}")
         model = robot if f == 1.0 else scaled_robot(robot, f, part)
-        estimates.append(estimate_friction(model, kin, options))
+        estimates.append(estimate_resolved(model, log, options))
     return Sensitivity(part, factors, tuple(estimates))

@@ -8,6 +8,7 @@ torque friction exerts on the joint [N·m] (negative of the model f of eq. 3.5).
 from __future__ import annotations
 
 import io
+from collections.abc import Mapping
 from collections.abc import Set as AbstractSet
 from pathlib import Path
 from typing import Any
@@ -19,7 +20,7 @@ from matplotlib.figure import Figure
 
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult
-from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.models import FrictionParams, ModelParams
 from wbfriction.logs.tables import write_atomic
 
 _DOUBLE_SUPPORT_COLOR = "#dddddd"
@@ -205,7 +206,7 @@ def _short(joint: str) -> str:
     return joint.replace("_joint", "")
 
 
-def _cloud(ax, est: FrictionEstimate, i: int, fit: FitResult | None, target: FrictionParams | None) -> None:
+def _cloud(ax, est: FrictionEstimate, i: int, fit: FitResult | None, target: ModelParams | None) -> None:
     """The valid estimates of joint ``i`` over its velocity, under the target (wide, grey) and over which the
     fitted model runs dashed, so that neither hides the cloud."""
     m = est.valid[:, i]
@@ -221,7 +222,7 @@ def _cloud(ax, est: FrictionEstimate, i: int, fit: FitResult | None, target: Fri
 
 
 def friction_overview_figure(est: FrictionEstimate, joints: list[str], fits: dict[str, FitResult],
-                             targets: dict[str, FrictionParams], flagged: AbstractSet[str] = frozenset(),
+                             targets: Mapping[str, ModelParams], flagged: AbstractSet[str] = frozenset(),
                              columns: int = 4, title: str = "Friction over velocity, valid samples (each joint on "
                                                             "its own axes; red: generates power)",
                              labels: dict[str, str] | None = None) -> Figure:
@@ -259,7 +260,7 @@ def widest_run(mask: np.ndarray, x: np.ndarray) -> slice:
 
 
 def _cloud_panel(ax: Axes, est: FrictionEstimate, i: int, fit: FitResult | None,
-                 target: FrictionParams | None) -> None:
+                 target: ModelParams | None) -> None:
     """Panel (a) of :func:`joint_figure`: the friction cloud with the fitted model and the target."""
     _cloud(ax, est, i, fit, target)
     ax.set_xlabel("qd [rad/s]")

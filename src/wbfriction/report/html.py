@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import base64
 import html
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +18,7 @@ import numpy as np
 from wbfriction.friction.cross_check import LARGE, MIN_SAMPLES, cross_check
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.fit import FitResult
-from wbfriction.friction.models import ALL_PARAM_NAMES, FrictionParams
+from wbfriction.friction.models import ALL_PARAM_NAMES, ModelParams
 from wbfriction.friction.status import MIN_SPEED, FitVerdict
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
@@ -290,7 +291,7 @@ def _summary_table(r: Report) -> str:
             f'<th>valid samples</th><th class="text">verdict</th></tr>{"".join(rows)}</table></div>')
 
 
-def _figures(r: Report, joints: list[str], targets: dict[str, FrictionParams],
+def _figures(r: Report, joints: list[str], targets: Mapping[str, ModelParams],
              spectra: dict[str, tuple[np.ndarray, np.ndarray, float]], workers: int = 1) -> list[str]:
     """The overview figure's ``<img>`` (none without a joint), then each joint's
     (:func:`~wbfriction.report.figures.joint_figure`), rendered on ``workers`` processes (forked: they read the

@@ -34,8 +34,8 @@ second difference over two periods is then exactly ``dt^2`` times the steps' acc
 with triangular weights.
 
 **Log** (1 kHz by default, :mod:`wbfriction.logs.log` format, fixed base: no ``contact.*``, no
-``base.*``): ``time``, ``q.<joint>`` read by encoders of ``encoder_bits`` per turn (rounded to their
-resolution), ``current.<joint>`` = (``tau_m`` + torque noise) / torque constant [A], and the truth:
+``base.*``): ``time``, ``q.<joint>`` with white noise of ``position_std`` read by encoders of ``encoder_bits`` per turn
+(rounded to their resolution), ``current.<joint>`` = (``tau_m`` + torque noise) / torque constant [A], and the truth:
 ``tau_f_true.<joint>``, ``qd_true.<joint>``, ``qdd_true.<joint>`` (the state at the sample, the
 acceleration under the torque held from it). The metadata names the friction, armature and torque
 constants injected.
@@ -43,6 +43,7 @@ constants injected.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -51,7 +52,7 @@ import pinocchio as pin
 import pyarrow as pa
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.models import FrictionParams, ModelParams
 from wbfriction.logs.tables import with_metadata
 from wbfriction.model.loading import build_model
 from wbfriction.model.robot import Robot
@@ -158,6 +159,8 @@ class ArmOptions:
         bandwidth: joint PD bandwidth [Hz]; damping: its damping ratio (gains from the diagonal of
             ``M + diag(armature)`` at the trajectory's start).
         encoder_bits: encoder resolution in bits per turn (None: exact positions).
+        position_std: standard deviation of the white noise on the logged positions [rad] (before the encoder's
+            rounding; the controller tracks the true ones).
         torque_std: standard deviation of the noise on the motor torque [N·m] (logged as current).
         seed: seed of the noise.
         excitation: :class:`ExcitationOptions`.
@@ -169,6 +172,7 @@ class ArmOptions:
     bandwidth: float = 8.0
     damping: float = 1.0
     encoder_bits: int | None = 19
+    position_std: float = 0.0
     torque_std: float = 0.0
     seed: int = 0
     excitation: ExcitationOptions = ExcitationOptions()
@@ -248,7 +252,7 @@ def default_arm_friction(robot: Robot) -> dict[str, FrictionParams]:
             for i, j in enumerate(robot.torque_controlled)}
 
 
-def simulate_arm(robot: Robot, friction: dict[str, FrictionParams], armature: dict[str, float] | None = None,
+def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: dict[str, float] | None = None,
                  options: ArmOptions = ArmOptions(), progress: Progress | None = None) -> ArmSimulation:
     """Simulate ``robot`` as a fixed-base arm tracking an excitation trajectory (module docstring).
 
@@ -307,12 +311,13 @@ def simulate_arm(robot: Robot, friction: dict[str, FrictionParams], armature: di
 
 
 def _table(robot: Robot, time: np.ndarray, Q: np.ndarray, V: np.ndarray, A: np.ndarray, T: np.ndarray,
-           F: np.ndarray, k_t: np.ndarray, armature: np.ndarray, friction: dict[str, FrictionParams],
+           F: np.ndarray, k_t: np.ndarray, armature: np.ndarray, friction: Mapping[str, ModelParams],
            options: ArmOptions) -> pa.Table:
     """The log table of a run: encoder positions, currents of the noisy motor torques, the truth."""
-    noise = SensorNoise(encoder_bits=options.encoder_bits, torque_std=options.torque_std, seed=options.seed)
-    _, eps_tau = noise.draw(len(time), 0, T.shape[1])
-    q_log, current = noise.encoder(Q), (T + eps_tau) / k_t
+    noise = SensorNoise(position_std=options.position_std, encoder_bits=options.encoder_bits,
+                        torque_std=options.torque_std, seed=options.seed)
+    eps_q, eps_tau = noise.draw(len(time), Q.shape[1], T.shape[1])
+    q_log, current = noise.encoder(Q + eps_q), (T + eps_tau) / k_t
     cols: dict[str, np.ndarray] = {"time": time}
     for prefix, x in (("q", q_log), ("current", current), ("tau_f_true", F), ("qd_true", V), ("qdd_true", A)):
         cols.update({f"{prefix}.{j}": x[:, i] for i, j in enumerate(robot.actuated)})
@@ -320,7 +325,7 @@ def _table(robot: Robot, time: np.ndarray, Q: np.ndarray, V: np.ndarray, A: np.n
             "torque_alignment": "zoh",  # the motor torque is held over the substeps of each period
             "dynamics": "(M(q) + diag(armature)) qdd + h(q, qd) = tau_motor + tau_f; tau_f = -f(qd); "
                         "current = (tau_motor + noise) / torque_constant",
-            "friction_true": {j: p.to_dict() for j, p in friction.items()},
+            "friction_true": {j: p.to_target() for j, p in friction.items()},
             "armature_true": dict(zip(robot.actuated, map(float, armature))),
             "torque_constants": dict(zip(robot.actuated, map(float, k_t))),
             "sensor_noise": asdict(noise)}

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
+from typing import cast
 
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.models import FrictionParams, coulomb_viscous_stribeck, stack_params
+from wbfriction.friction.models import MODEL_NAMES, FrictionParams, ModelParams, model_values, stack_params
 from wbfriction.friction.targets import friction_by_group
 from wbfriction.logs.log import Log
 from wbfriction.model.force_torque import sensor_readings
@@ -19,32 +21,44 @@ from wbfriction.walking.indexing import as_slice
 
 @dataclass
 class InjectedFriction:
-    """Friction (3.5) a simulator applies to some torque-controlled joints.
+    """Friction a simulator applies to some torque-controlled joints: (3.5), or any model of
+    :mod:`~wbfriction.friction.models` (a sign function applied as it is: where the joint would stop, the
+    simulator's steps make it chatter about zero velocity, a joint that sticks).
 
     Attributes:
         params: parameters per joint name.
         joints: their indices among the torque-controlled joints.
     """
 
-    params: dict[str, FrictionParams]
+    params: dict[str, ModelParams]
     joints: list[int]
 
     def __post_init__(self) -> None:
-        self._stacked = stack_params(list(self.params.values())) if self.joints else {}
-        n = len(self.joints)
-        p = {k: np.broadcast_to(np.asarray(v, dtype=float), (n,)).copy() for k, v in self._stacked.items()}
-        self._gaussian = bool(np.all(p.get("delta_s", 2.0) == 2.0))
-        self._c = (p, p["F_c"] * p["S"], 1.0 / p["v_s"]) if n else None
+        self._gaussian = bool(self.params) and all(isinstance(p, FrictionParams) and p.delta_s == 2.0
+                                                   for p in self.params.values())
+        if self._gaussian:
+            self._stacked = stack_params(cast(list[FrictionParams], list(self.params.values())))
+            n = len(self.joints)
+            p = {k: np.broadcast_to(np.asarray(v, dtype=float), (n,)).copy() for k, v in self._stacked.items()}
+            self._c = (p, p["F_c"] * p["S"], 1.0 / p["v_s"])
+        # the others: each joint's model, joints of one model at once
+        self._groups = [(np.array([i for i, q in enumerate(self.params.values()) if q.model == m]),
+                         [q for q in self.params.values() if q.model == m]) for m in MODEL_NAMES]
+        self._groups = [(cols, ps) for cols, ps in self._groups if len(cols)]
 
     def torque(self, qd: np.ndarray) -> np.ndarray:
-        """``tau_f = -f(qd)`` (eq. 3.5) of the joints, from their velocities (n_f,) [rad/s].
+        """``tau_f = -f(qd)`` of the joints, from their velocities (n_f,) [rad/s].
 
-        The simulators call this at every physics step: with the Gaussian Stribeck exponent
-        (``delta_s = 2``, the thesis's) it runs in place on (n_f,) buffers, the same
+        The simulators call this at every physics step: with (3.5)'s Gaussian Stribeck exponent
+        (``delta_s = 2``, the thesis's) on every joint it runs in place on (n_f,) buffers, the same
         numbers as :func:`~wbfriction.friction.models.coulomb_viscous_stribeck` in fewer operations."""
-        if qd.ndim != 1 or not self._gaussian:
-            return -coulomb_viscous_stribeck(qd, **self._stacked)
-        assert self._c is not None  # set whenever there are joints, the only case the simulators call this in
+        if not self._gaussian or qd.ndim != 1:
+            out = np.empty_like(qd, dtype=float)
+            for cols, params in self._groups:
+                values = np.array([p.as_vector() for p in params]).T  # (n_params, n_cols): each row broadcasts
+                delta_s = np.array([getattr(p, "delta_s", 2.0) for p in params])
+                out[..., cols] = -model_values(values, qd[..., cols], delta_s, params[0].model)
+            return out
         p, FcS, inv_vs = self._c
         e = np.multiply(qd, inv_vs)
         np.square(e, out=e)
@@ -60,7 +74,7 @@ class InjectedFriction:
         return np.negative(out, out=out)
 
 
-def injected_friction(robot: Robot, friction: dict[str, FrictionParams] | None) -> InjectedFriction:
+def injected_friction(robot: Robot, friction: Mapping[str, ModelParams] | None) -> InjectedFriction:
     """Friction to inject: the given parameters per joint or, by default, the thesis's targets
     (Table 6.1) on the leg joint groups.
 
@@ -132,7 +146,7 @@ def simulated_log(robot: Robot, reference: WalkingReference, Q: np.ndarray, V: n
     metadata: the generator, its options, the gait, the true friction, and ``metadata``."""
     iq, iv = robot.act_q_index, robot.act_v_index
     meta = {"generator": generator, "options": asdict(options), "gait": asdict(reference.plan.options),
-            "friction_true": {j: p.to_dict() for j, p in friction.params.items()}, **metadata}
+            "friction_true": {j: p.to_target() for j, p in friction.params.items()}, **metadata}
     base = (Q[:, :7].copy(), V[:, :6].copy(), A[:, :6].copy()) if log_base else (None, None, None)
     return Log(reference.time.copy(), Q[:, iq], tau, contact, base[0], tau_f, meta,
                source=generator.rsplit(".", 1)[-1], qd_true=V[:, iv], qdd_true=A[:, iv], wrench=wrench,

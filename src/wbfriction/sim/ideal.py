@@ -32,10 +32,12 @@ foot's zero acceleration in the estimator assumes.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import pinocchio as pin
 
-from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.models import ModelParams
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.sim.common import InjectedFriction, Recording, SimulationResult, injected_friction
@@ -256,7 +258,7 @@ class _IdealRun:
 
 
 def simulate_ideal(robot: Robot, reference: WalkingReference,
-                   friction: dict[str, FrictionParams] | None = None,
+                   friction: Mapping[str, ModelParams] | None = None,
                    options: IdealOptions = IdealOptions(), progress: Progress | None = None) -> SimulationResult:
     """Simulate a walk in the ideal simulator (module docstring).
 

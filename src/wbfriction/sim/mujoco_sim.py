@@ -27,12 +27,16 @@ box soles; one motor per joint). Differences forced by real contacts:
 
 Friction, two independent implementations (:data:`FRICTION_MODES`):
 
-* ``"model"``: eq. (3.5) of the given parameters, applied as a generalised force at every
-  physics step from that step's velocity;
+* ``"model"``: eq. (3.5) of the given parameters, or any model of :mod:`~wbfriction.friction.models`, applied as
+  a generalised force at every physics step from that step's velocity (a sign function applied as it is: a joint
+  that would stop chatters about zero velocity, as a sticking joint does);
 * ``"mujoco"``: MuJoCo's own joint friction, ``frictionloss = F_c`` (Coulomb friction
-  solved as a constraint) and ``damping = F_v`` (explicit: ``eulerdamp`` disabled, so the
-  damper force is exactly the one applied); the parameters must have ``S = 0`` and
-  ``tau_os = 0``. ``tau_f_true`` is the friction-loss constraint force plus the damper force.
+  solved as a constraint: a joint sticks) and ``damping = F_v`` (explicit: ``eulerdamp`` disabled, so the
+  damper force is exactly the one applied); the parameters must have no Stribeck term and
+  ``tau_os = 0``. ``tau_f_true`` is the friction-loss constraint force plus the damper force. The constraint's
+  time constant (``friction_timeconst``) is two physics steps by default, not MuJoCo's 0.02 s: with MuJoCo's,
+  the constraint's force follows the sign of ``qd + qdd / b`` (``b`` about 105 1/s), a friction that leads the
+  velocity by 10 ms, which no friction law of the velocity describes.
 
 Sensors (:class:`~wbfriction.sim.sensors.SensorNoise`, off by default): the controller
 and the log see the same noisy, quantised positions, the log noisy torques (the
@@ -53,13 +57,14 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+from collections.abc import Mapping
 from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import InputError, SimulationError
-from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.models import ModelParams
 from wbfriction.friction.targets import friction_by_group
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
@@ -92,14 +97,19 @@ def matched_weights(substeps: int) -> np.ndarray:
     return np.column_stack([substeps - s, s]) / substeps**2
 
 
-def set_mujoco_friction(model: mujoco.MjModel, dofs: np.ndarray, injected: InjectedFriction) -> None:
-    """Set MuJoCo's ``frictionloss`` and ``damping`` of ``dofs`` from (3.5) parameters."""
+def set_mujoco_friction(model: mujoco.MjModel, dofs: np.ndarray, injected: InjectedFriction,
+                        timeconst: float | None = None) -> None:
+    """Set MuJoCo's ``frictionloss`` and ``damping`` of ``dofs`` from Coulomb-viscous parameters (of any model
+    without a Stribeck effect or an offset), and the friction-loss constraint's time constant (``solreffriction``
+    ``timeconst`` [s], damping ratio 1; None: two physics steps, the stiffest MuJoCo integrates stably)."""
     import mujoco
     for dof, (joint, p) in zip(dofs, injected.params.items()):
-        if p.S != 0 or p.tau_os != 0:
-            raise InputError(f"friction of '{joint}': MuJoCo's joint friction has no Stribeck term (S) and "
+        q = p.quantities()
+        if q["S"] != 0 or q["tau_os"] != 0:
+            raise InputError(f"friction of '{joint}': MuJoCo's joint friction has no Stribeck term (S, F_s) and "
                              "no offset (tau_os); give S = 0 and tau_os = 0, or use the 'model' friction")
-        model.dof_frictionloss[dof], model.dof_damping[dof] = p.F_c, p.F_v
+        model.dof_frictionloss[dof], model.dof_damping[dof] = q["F_c"], q["F_v"]
+        model.dof_solref[dof] = (2.0 * model.opt.timestep if timeconst is None else timeconst, 1.0)
     model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)
 
 
@@ -153,7 +163,7 @@ class MatchedMeans:
 class MujocoRun:
     """One run of :func:`simulate_mujoco`: the MuJoCo model and data, the controller, the state and the log."""
 
-    def __init__(self, robot: Robot, reference: WalkingReference, friction: dict[str, FrictionParams] | None,
+    def __init__(self, robot: Robot, reference: WalkingReference, friction: Mapping[str, ModelParams] | None,
                  options: MujocoOptions, mjr: MujocoRobot | None) -> None:
         """Set up the model (friction), the stabiliser, the controller, the initial state and the log buffers."""
         import mujoco
@@ -174,7 +184,7 @@ class MujocoRun:
         dof_f = self.mjr.dof_index[self.tc][self.joints_f]
         self.dof_f = as_slice(dof_f)
         if native:
-            set_mujoco_friction(self.model, dof_f, self.injected)
+            set_mujoco_friction(self.model, dof_f, self.injected, options.friction_timeconst)
         if options.sole_timeconst is not None:
             self.model.geom_solref[list(self.mjr.sole_geoms), 0] = options.sole_timeconst
         self.data = mujoco.MjData(self.model)
@@ -362,7 +372,7 @@ class MujocoRun:
                                 contact_source=f"sole normal force > {self.options.contact_threshold:g} N")
 
 
-def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: dict[str, FrictionParams] | None = None,
+def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: Mapping[str, ModelParams] | None = None,
                     options: MujocoOptions = MujocoOptions(), mjr: MujocoRobot | None = None,
                     progress: Progress | None = None) -> SimulationResult:
     """Simulate a walk on MuJoCo (module docstring).

@@ -152,6 +152,9 @@ class MujocoOptions:
             times further off, 0.155 against 0.025 N·m median RMS, measured).
         sole_timeconst: the soles' contact time constant [s] (MuJoCo's ``solref[0]``: how soft the
             contact is); None: MuJoCo's default (0.02 s). A compliant rubber sole: larger.
+        friction_timeconst: with ``friction = "mujoco"``, the friction-loss constraint's time constant [s]
+            (MuJoCo's ``solreffriction``; :mod:`~wbfriction.sim.mujoco_sim`); None: two physics steps, the stiffest
+            MuJoCo integrates (0.02 s, MuJoCo's default, makes its friction lead the velocity by 10 ms).
         torque_drift: rate [N·m/s] at which each torque sensor's offset drifts from zero over the walk
             (the sign per joint drawn from ``sensors.seed``): a slow sensor drift, off by default.
         ft_offset: standard deviations of constant offsets of the force-torque sensors' forces [N] and
@@ -176,6 +179,7 @@ class MujocoOptions:
     log_base: bool = True
     force_torque: bool = True
     sole_timeconst: float | None = None
+    friction_timeconst: float | None = None
     torque_drift: float = 0.0
     ft_offset: tuple[float, float] = (0.0, 0.0)
     imu: bool = True
@@ -193,6 +197,8 @@ class MujocoOptions:
             raise InputError(f"the delay must be >= 0 s, got {self.delay}")
         if self.sole_timeconst is not None and not self.sole_timeconst > 0:
             raise InputError(f"the soles' contact time constant must be > 0 s, got {self.sole_timeconst}")
+        if self.friction_timeconst is not None and not self.friction_timeconst > 0:
+            raise InputError(f"--friction-timeconst must be > 0 s, got {self.friction_timeconst}")
         if self.torque_drift < 0 or min(self.ft_offset) < 0 or min(self.imu_noise) < 0 or min(self.imu_bias) < 0:
             raise InputError("the torque drift rate and the standard deviations of the force-torque offsets and "
                              "of the IMU's noise and biases must be >= 0")
