@@ -122,9 +122,12 @@ def _fit_rows(results: list[FitResult]) -> Table:
     from wbfriction.friction.models import ALL_PARAM_NAMES
 
     names = [n for n in ALL_PARAM_NAMES if any(r.params is not None and n in r.params.names for r in results)]
-    table = Table(title="Friction model per joint: f(qd) fitted to -tau_f, value ±standard error",
+    routes = sorted({r.route for r in results})
+    table = Table(title="Friction model per joint: f(qd) fitted to -tau_f, value ±standard error "
+                        f"({', '.join(routes)} route)",
                   caption="n.i.: not identifiable from these data (infinite standard error); "
-                          "(bound): at a bound of the fit, the bound's value, not the data's; screened: gross "
+                          "(bound): at a bound of the fit, the bound's value, not the data's; Cramér-Rao: the "
+                          "standard deviation no unbiased estimator from these data goes below; screened: gross "
                           "outliers left out (beyond 50 median absolute deviations)", box=None)
     for col in ("joint", "model", "status", "N"):
         table.add_column(col, justify="right" if col == "N" else "left")
@@ -142,6 +145,11 @@ def _fit_rows(results: list[FitResult]) -> Table:
         return (f"{getattr(r.params, n):.4g} ±{'n.i.' if not np.isfinite(s) else f'{s:.1g}'}"
                 + (" (bound)" if r.at_bound.get(n) else ""))
 
+    def bound(r: FitResult, n: str) -> str:
+        if n not in r.crb:
+            return ""
+        return "n.i." if not np.isfinite(r.crb[n]) else f"±{r.crb[n]:.1g}"
+
     for r in results:
         rms = [f"{r.rms_error_vs_true:.4f}" if r.rms_error_vs_true is not None else ""] if has_true else []
         verdict = r.verdict()
@@ -149,6 +157,8 @@ def _fit_rows(results: list[FitResult]) -> Table:
         table.add_row(r.joint, r.model if r.params is not None else "—", verdict.status,
                       f"{r.n_samples}{screened}", *[cell(r, n) for n in names], *rms,
                       style=None if verdict.ok else "dim")  # numbers not to be used: greyed
+        if r.params is not None and r.crb:
+            table.add_row("  Cramér-Rao", "", "", "", *[bound(r, n) for n in names], *pad, style="dim")
         err = r.error_percent()
         if err is not None and r.target is not None:
             target = r.target.values_in(r.model)
@@ -949,8 +959,8 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
                                                                     "rad, 19-bit encoders, 0.05 N·m torques)."),
                   substeps: Optional[int] = typer.Option(None, min=1,
                                                          help="MuJoCo physics steps per 1 ms control period "
-                                                              "(default 16: friction lags half a step).")
-                  ) -> None:
+                                                              "(default 16: friction lags half a step)."),
+                  route: str = RouteOpt) -> None:
     """What the ankle force-torque sensors and the base pose change, on MuJoCo's soft contacts (issue 23)."""
     from wbfriction.studies.realistic import NOISE
     from wbfriction.studies.sensors import SUBSTEPS, run_sensors_study, sensors_markdown
@@ -961,10 +971,48 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
     with console.status("") as status:
         result = run_sensors_study(r, output_dir, steps=steps, diff=cast("Diff", diff),
                                    filtering=FilterOptions(window=window), noise=NOISE if noise else SensorNoise(),
-                                   substeps=substeps or SUBSTEPS, progress=lambda label: status.update(label))
+                                   substeps=substeps or SUBSTEPS, progress=lambda label: status.update(label),
+                                   route=cast("RouteOption", route))
     out.print(escape(sensors_markdown(result)), highlight=False, soft_wrap=True)
     for f in result.files:
         console.print(f"wrote {f}")
+
+
+@app.command("study-noise")
+def study_noise(output_dir: Path = typer.Option(Path("wbfriction-noise"), "-o", "--output-dir", help="Where to write."),
+                robots: str = typer.Option("panda,talos", help="Comma-separated built-in robots: an arm (panda) "
+                                                               "and a humanoid (talos, on MuJoCo)."),
+                families: str = typer.Option("coulomb-viscous,stribeck,thesis,frictionloss",
+                                             help="Comma-separated frictions: coulomb-viscous, stribeck, thesis "
+                                                  "(3.5), frictionloss (MuJoCo's, the humanoid)."),
+                noises: str = typer.Option("1e-4,3e-4", help="Comma-separated position noises [rad]; the first "
+                                                             "gets every seed."),
+                seeds: int = typer.Option(10, min=1, help="Noise seeds at the first noise level."),
+                duration: float = typer.Option(20.0, min=1.0, help="The arm's excitation [s]."),
+                steps: int = typer.Option(10, min=1, help="The humanoid's combined walk: steps per direction."),
+                workers: int = FitWorkersOpt) -> None:
+    """Every model family on noisy logs, estimated and fitted with the default options (issue 38): errors
+    against the injected friction, the model chosen, and each parameter's RMS error over the seeds against its
+    Cramér-Rao bound."""
+    from wbfriction.studies.noise import FAMILIES, Family, noise_markdown, run_noise_study
+
+    chosen = [f.strip() for f in families.split(",") if f.strip()]
+    unknown = [f for f in chosen if f not in FAMILIES]
+    if unknown:
+        raise InputError(f"--families: unknown friction '{unknown[0]}': choose from {', '.join(FAMILIES)}")
+    try:
+        levels = [float(x) for x in noises.split(",") if x.strip()]
+    except ValueError:
+        raise InputError(f"--noises must be comma-separated numbers [rad], got '{noises}'") from None
+    if not levels or any(not x > 0 for x in levels):
+        raise InputError(f"--noises must be positive numbers [rad], got '{noises}'")
+    loaded = [_robot(name.strip(), None, None) for name in robots.split(",") if name.strip()]
+    with console.status("") as status:
+        rows = run_noise_study(loaded, output_dir, families=cast("list[Family]", chosen), noises=levels, seeds=seeds,
+                               duration=duration, steps=steps, workers=workers,
+                               progress=lambda label: status.update(label))
+    out.print(escape(noise_markdown(rows)), highlight=False, soft_wrap=True)
+    console.print(f"wrote {output_dir / 'noise.md'}, {output_dir / 'noise.json'}")
 
 
 @app.command("study-fleet")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import cast
 
 import numpy as np
@@ -73,6 +73,12 @@ class FrictionEstimate:
     route: np.ndarray | None = None
     disagreement: np.ndarray | None = None
     route_check: FrictionEstimate | None = field(default=None, repr=False)
+
+    def keeping(self, rows: np.ndarray) -> FrictionEstimate:
+        """A copy whose valid samples are only those of ``rows`` ((N, n_tc) or (N, 1) bool), its other route's too
+        (a study's swing or stance samples)."""
+        check = None if self.route_check is None else self.route_check.keeping(rows)
+        return replace(self, valid=self.valid & rows, route_check=check)
 
     @property
     def estimation_route(self) -> Route:

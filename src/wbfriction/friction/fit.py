@@ -48,7 +48,7 @@ import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Generic, Literal, get_args
+from typing import Any, Generic, Literal, get_args
 
 import numpy as np
 
@@ -939,7 +939,9 @@ def stick_margin(est: FrictionEstimate) -> int:
 
 def fit_estimate(est: FrictionEstimate, *, delta_s: float = 2.0, min_samples: int = 20,
                  workers: int = 1, model: ModelChoice = "thesis",
-                 selection_tolerance: float = SELECTION_TOLERANCE) -> list[FitResult]:
+                 selection_tolerance: float = SELECTION_TOLERANCE, joints: Sequence[str] | None = None,
+                 fixed: dict[str, float] | None = None,
+                 targets: Mapping[str, ModelParams] | None = None) -> list[FitResult]:
     """Fit every joint of an estimate (:func:`fit_joints` on its valid samples, on ``workers``
     processes); its ``tau_f_true`` and ``friction_true`` metadata, when present (simulated
     logs), give the errors against truth.
@@ -949,24 +951,36 @@ def fit_estimate(est: FrictionEstimate, *, delta_s: float = 2.0, min_samples: in
     With the other route's estimate (:attr:`~wbfriction.friction.estimate.FrictionEstimate.route_check`), each
     joint's model is fitted there too and the two compared (:attr:`FitResult.route_check`, :func:`compare_routes`).
 
+    Args:
+        joints: the joints to fit (default: every one of the estimate), in this order.
+        fixed: parameters held instead of fitted (:func:`fit_friction`).
+        targets: the true parameters per joint, instead of the metadata's ``friction_true``.
+
     Raises:
-        InputError: ``friction_true`` metadata that are not a model's parameters; an unknown model; a damaged noise
-            record.
+        InputError: ``friction_true`` metadata that are not a model's parameters; an unknown model or joint; a
+            damaged noise record.
     """
-    targets = {j: target_from_dict(p) for j, p in est.metadata.get("friction_true", {}).items()}
+    if targets is None:
+        targets = {j: target_from_dict(p) for j, p in est.metadata.get("friction_true", {}).items()}
+    names = list(est.joints if joints is None else joints)
+    unknown = [j for j in names if j not in est.joints]
+    if unknown:
+        raise InputError(f"no joint '{unknown[0]}' in the friction estimate")
+    idx = [est.joints.index(j) for j in names]
     record = est.metadata.get("noise")
-    fits = fit_joints(est.joints, est.qd, est.tau_f, est.valid, tau_f_true=est.tau_f_true, targets=targets,
-                      delta_s=delta_s, min_samples=min_samples, smoother=est.smoother, workers=workers, model=model,
-                      selection_tolerance=selection_tolerance, noise=joint_noises(record, est.estimation_route),
-                      stick_margin=stick_margin(est))
+    options: dict[str, Any] = dict(delta_s=delta_s, min_samples=min_samples, workers=workers, fixed=fixed)
+    truth = None if est.tau_f_true is None else est.tau_f_true[:, idx]
+    fits = fit_joints(names, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], tau_f_true=truth, targets=targets,
+                      smoother=est.smoother, model=model, selection_tolerance=selection_tolerance,
+                      noise=joint_noises(record, est.estimation_route), stick_margin=stick_margin(est), **options)
     for f in fits:
         f.route = est.estimation_route
     check = est.route_check
     if check is not None:
-        others = fit_joints(check.joints, check.qd, check.tau_f, check.valid, delta_s=delta_s,
-                            min_samples=min_samples, smoother=check.smoother, workers=workers,
-                            model=[f.model for f in fits], noise=joint_noises(record, check.estimation_route),
-                            stick_margin=stick_margin(check))
+        others = fit_joints(names, check.qd[:, idx], check.tau_f[:, idx], check.valid[:, idx],
+                            smoother=check.smoother, model=[f.model for f in fits],
+                            noise=joint_noises(record, check.estimation_route), stick_margin=stick_margin(check),
+                            **options)
         for f, other in zip(fits, others):
             other.route = check.estimation_route
             f.route_check = compare_routes(f, other)

@@ -17,8 +17,8 @@ status, the first that applies:
   (:mod:`~wbfriction.friction.bound`: what the data allow any unbiased estimator), above :data:`WEAK` of its
   (non-zero) value, or is not identifiable (infinite standard error); a magnitude at zero whose standard error
   or bound stands for more than :data:`WEAK` of the friction the joint shows (``F_c``'s in N·m, ``F_v``'s times
-  the joint's speed, against the friction's odd part at that speed and the residual's RMS: ``F_c = 0 ± 1.1``
-  beside a friction of 1 N·m is no finding);
+  the joint's speed or :data:`READ_SPEED`, against the friction's odd part at the joint's speed and the residual's
+  RMS: ``F_c = 0 ± 1.1`` beside a friction of 1 N·m is no finding);
 * ``ok``: none of these.
 
 The table, the parameters JSON (``status``, ``status_reason``) and the report show it; a fit that is not
@@ -54,6 +54,9 @@ ZERO_FLOOR = ("F_v", "F_c", "S", "F_s")
 """Magnitudes whose lower bound is zero: there, the data say "none of this friction"."""
 ZERO = 1e-6
 """A magnitude below this (in its unit) is at its floor of zero."""
+READ_SPEED = 1.0
+"""The speed [rad/s] a viscous coefficient at zero is judged at, or the joint's own if it moved faster: a user
+reads F_v = 0 as no viscous friction at any speed, not only at the few the log saw."""
 
 
 class Fit(Protocol):
@@ -130,8 +133,8 @@ def _weak(fit: Fit, values: dict[str, float]) -> list[str]:
             if value >= ZERO and spread > WEAK * value:
                 out.append(f"{name} ±{100 * spread / value:.0f} %{at_best}")
                 break
-            # a magnitude at zero: against the friction it would make at the joint's speed
-            share = spread * (speed if name == "F_v" else 1.0)
+            # a magnitude at zero: against the friction it would make at the speed a user reads it at
+            share = spread * (max(speed, READ_SPEED) if name == "F_v" else 1.0)
             if value < ZERO and share > WEAK * scale:
                 out.append(f"{name} 0 ±{spread:.2g}{at_best} ({share:.2g} N·m against {scale:.2g} N·m of friction)")
                 break

@@ -85,10 +85,18 @@ def _fmt(value: float | None, se: float | None = None, digits: int = 4) -> str:
     return f"{value:.{digits}g} ± {'n.i.' if not np.isfinite(se) else f'{se:.2g}'}"
 
 
+def _bound(value: float | None) -> str:
+    """A Cramér-Rao standard deviation as a cell's text: ``± b``, "n.i." (not identifiable), "" for none."""
+    if value is None:
+        return ""
+    return "n.i." if not np.isfinite(value) else f"± {value:.2g}"
+
+
 def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> str:
     """Each joint's model, its fit's status and parameters (value ±standard error; "(bound)": at a bound of
-    the fit); blank where a parameter is not one of the joint's model. A fit that is not ``ok``
-    (:mod:`~wbfriction.friction.status`) is greyed, its status cell giving the reason."""
+    the fit), under them their Cramér-Rao bounds and the same model on the other route; blank where a parameter is
+    not one of the joint's model. A fit that is not ``ok`` (:mod:`~wbfriction.friction.status`) is greyed, its
+    status cell giving the reason."""
     names = [n for n in ALL_PARAM_NAMES if any(f.params is not None and n in f.params.names for f in fits.values())]
     head = "".join(f"<th>{n}</th>" for n in names)
     rows = []
@@ -117,6 +125,14 @@ def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> s
         rows.append(f"{tr}{_joint_cell(r, j)}"
                     f"<td>{html.escape(fit.model)}</td>{status}<td>{fit.n_samples}{screened}</td>{cells}"
                     f"<td>{_fmt(fit.rms_residual)}</td></tr>")
+        if fit.crb:
+            rows.append('<tr class="target"><td>&nbsp;&nbsp;Cramér-Rao bound</td><td></td><td></td><td></td>'
+                        + "".join(f"<td>{_bound(fit.crb.get(n))}</td>" for n in names) + "<td></td></tr>")
+        check = fit.route_check
+        if check is not None and check.params is not None:
+            rows.append(f'<tr class="target"><td>&nbsp;&nbsp;{html.escape(check.route)} route</td><td></td><td></td>'
+                        "<td></td>" + "".join(f"<td>{_fmt(check.params[n], check.stderr.get(n))}</td>"
+                                              if n in check.params else "<td></td>" for n in names) + "<td></td></tr>")
         err = fit.error_percent()
         if err is not None and fit.target is not None:
             target = fit.target.values_in(fit.model)

@@ -8,12 +8,13 @@ thesis's numbering (1-6 right leg, 7-12 left leg).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import FitResult, fit_joints
-from wbfriction.friction.models import PARAM_NAMES, FrictionParams
+from wbfriction.friction.fit import FitResult, fit_estimate
+from wbfriction.friction.models import PARAM_NAMES, ModelParams
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.model.robot import Robot
 from wbfriction.sim.options import IdealOptions
@@ -70,15 +71,12 @@ def right_knee(legs: list[LegJoint]) -> str:
     return next(j for j, side, g in legs if side == "right" and g == "knee")
 
 
-def fit_legs(est: FrictionEstimate, legs: list[LegJoint], targets: dict[str, FrictionParams] | None = None,
+def fit_legs(est: FrictionEstimate, legs: list[LegJoint], targets: Mapping[str, ModelParams] | None = None,
              fixed: dict[str, float] | None = None) -> list[FitResult]:
-    """Fit model (3.5) to every leg joint of an estimate on its valid samples
-    (:func:`~wbfriction.friction.fit.fit_joints`), with the estimate's true friction and ``targets``
-    for the errors; ``fixed``: parameters held."""
-    idx = [est.joints.index(j) for j, _, _ in legs]
-    truth = None if est.tau_f_true is None else est.tau_f_true[:, idx]
-    return fit_joints([j for j, _, _ in legs], est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx],
-                      tau_f_true=truth, targets=targets, smoother=est.smoother, fixed=fixed)
+    """Fit model (3.5) to every leg joint of an estimate on its valid samples, as
+    :func:`~wbfriction.friction.fit.fit_estimate` fits every joint (its noise record, the other route), with the
+    estimate's true friction and ``targets`` for the errors; ``fixed``: parameters held."""
+    return fit_estimate(est, joints=[j for j, _, _ in legs], targets=targets or {}, fixed=fixed)
 
 
 def leg_rows(legs: list[LegJoint], fits: list[FitResult]) -> list[LegRow]:

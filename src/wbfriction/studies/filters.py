@@ -52,7 +52,7 @@ class Scheme:
     filtering: FilterOptions = FilterOptions()
 
     def options(self) -> EstimateOptions:
-        return EstimateOptions(diff=self.diff, filtering=self.filtering)
+        return EstimateOptions(diff=self.diff, filtering=self.filtering, route="acceleration", check_route=False)
 
 
 SCHEMES: tuple[Scheme, ...] = (

@@ -14,7 +14,8 @@ measured forces, and (last case) sensor noise that the controller acts on.
    * MuJoCo's own ``frictionloss`` and ``damping`` (Table 6.1's F_c and F_v), a Coulomb-viscous
      model fitted (S, v_s and tau_os held at 0, 0.1, 0);
    * friction (3.5) with the filter study's default sensor noise (1e-4 rad, 19-bit encoder,
-     0.05 N·m) in the loop and its best filter (Savitzky-Golay, L = 151, k = 4).
+     0.05 N·m) in the loop, estimated with the default options: the route the log allows (issue 23's ankle
+     wrenches and IMU, every sample) and the one its noise calls for (issue 38's momentum route).
 
 The first case's friction table and HTML report (``report.html``) are written as a user would make them.
 """
@@ -40,7 +41,6 @@ from wbfriction.progress import StageProgress
 from wbfriction.report.build import make_report
 from wbfriction.report.figures import friction_curves_figure, velocity_panels_figure
 from wbfriction.report.html import write_report
-from wbfriction.signals.options import FilterOptions
 from wbfriction.sim import SimulationResult, simulate_mujoco
 from wbfriction.sim.mujoco_model import MujocoRobot, build_mujoco_robot
 from wbfriction.sim.options import MujocoOptions, SensorNoise
@@ -59,13 +59,14 @@ from wbfriction.studies.common import (
 from wbfriction.walking import walking_reference
 from wbfriction.walking.options import GaitOptions
 
-THESIS_ROUTE = EstimateOptions(base_motion="contact", wrenches=False)
-"""The thesis's route: base motion from the rigid stance contact, the ankle sensors' wrenches left
-out (the study reproduces 6.2; :mod:`wbfriction.friction.measured` is the route that uses them)."""
+THESIS_ROUTE = EstimateOptions(diff="central", route="acceleration", base_motion="contact", wrenches=False)
+"""The thesis's route: central differences of the accelerations, base motion from the rigid stance contact, the
+ankle sensors' wrenches left out (the study reproduces 6.2; :mod:`wbfriction.friction.measured` is the route that
+uses them)."""
 NOISE = SensorNoise(position_std=1e-4, encoder_bits=ENCODER_BITS, torque_std=TORQUE_STD, seed=0)
 """The filter study's default noise level (its 1e-4 rad row)."""
-BEST_FILTER = dataclasses.replace(THESIS_ROUTE, diff="savgol", filtering=FilterOptions(window=151, poly_order=4))
-"""The filter study's best scheme at that level."""
+DEFAULTS = EstimateOptions()
+"""The default options: the noisy case's (the route and closure the log allows, chosen from it)."""
 COULOMB_VISCOUS = {"S": 0.0, "v_s": 0.1, "tau_os": 0.0}
 """Parameters held in the fit of MuJoCo's own friction, which has no Stribeck term or offset."""
 
@@ -158,8 +159,9 @@ def _case_specs(table_6_1: dict[str, FrictionParams], options: MujocoOptions) ->
         _CaseSpec("mujoco", "MuJoCo frictionloss + damping, noise off, central differences, Coulomb-viscous fit",
                   native, dataclasses.replace(options, friction="mujoco"), THESIS_ROUTE, COULOMB_VISCOUS,
                   ("F_c", "F_v")),
-        _CaseSpec("noisy", "friction (3.5), sensor noise 1e-4 rad / 19 bit / 0.05 N·m, Savitzky-Golay L=151 k=4",
-                  table_6_1, dataclasses.replace(options, sensors=NOISE), BEST_FILTER, None,
+        _CaseSpec("noisy", "friction (3.5), sensor noise 1e-4 rad / 19 bit / 0.05 N·m, default options (the "
+                           "momentum route, the ankle wrenches and the IMU)",
+                  table_6_1, dataclasses.replace(options, sensors=NOISE), DEFAULTS, None,
                   ("F_c", "F_v", "tau_os")),
     ]
 

@@ -1,12 +1,15 @@
 """The sensors a humanoid carries, on MuJoCo (issue 23): ``wbfriction study-sensors``.
 
 The combined walk on MuJoCo's soft contacts, Table 6.1 friction (3.5) on every leg joint, sensor noise
-off, the ankle force-torque sensors and the base pose logged. Each leg joint's model is fitted twice
-per route, on its swing samples (its foot in the air) and, separately, on its stance samples (its foot on
-the ground):
+off (``--noise``: the studies' sensor noise in the loop), the ankle force-torque sensors and the base pose
+logged. Each leg joint's model is fitted twice per closure of the base's equations, on its swing samples (its
+foot in the air) and, separately, on its stance samples (its foot on the ground):
 
-* ``contact``: the thesis's route (rigid stance contact, swing-only single support), as in Table 6.2;
+* ``contact``: the thesis's (rigid stance contact, swing-only single support), as in Table 6.2;
 * ``wrench``: the ankle wrenches and the logged base (:mod:`wbfriction.friction.measured`).
+
+Both by the route ``route`` (``auto``: the momentum route where the positions are noisy, issue 38); each fit
+carries its Cramér-Rao bound and its status, so that an error is read against what the walk allows.
 
 A joint pressed against its URDF position limit receives the stop's torque, which no friction model has:
 the samples where a leg joint is within :data:`AT_LIMIT` of a limit are left out and counted (the
@@ -23,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log
-from wbfriction.friction.options import EstimateOptions
+from wbfriction.friction.options import EstimateOptions, RouteOption
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import Log, write_log
 from wbfriction.logs.tables import make_folder, write_atomic
@@ -59,6 +62,9 @@ class SensorsRow:
         errors: ``(route, part) -> {parameter: |error| [%]}``, ``part`` ``swing`` or ``stance``.
         samples: ``(route, part) -> samples fitted``.
         usable: ``route -> share of the walk's samples with a valid estimate``.
+        bounds: ``(route, part) -> {parameter: Cramér-Rao standard deviation [% of the true value]}`` (NaN:
+            no bound).
+        statuses: ``(route, part) -> the fit's status``.
     """
 
     joint: str
@@ -67,6 +73,8 @@ class SensorsRow:
     errors: dict[tuple[str, str], dict[str, float]]
     samples: dict[tuple[str, str], int]
     usable: dict[str, float]
+    bounds: dict[tuple[str, str], dict[str, float]] = dataclasses.field(default_factory=dict)
+    statuses: dict[tuple[str, str], str] = dataclasses.field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -90,10 +98,12 @@ PARTS = {"contact": ("swing",), "wrench": ("swing", "stance")}
 
 def run_sensors_study(robot: Robot, output_dir: Path, steps: int = 3, diff: Diff = "central",
                       filtering: FilterOptions = FilterOptions(), noise: SensorNoise = SensorNoise(),
-                      substeps: int = SUBSTEPS, progress: StageProgress | None = None) -> SensorsResult:
+                      substeps: int = SUBSTEPS, progress: StageProgress | None = None,
+                      route: RouteOption = "auto") -> SensorsResult:
     """Simulate, estimate by both routes, fit swing and stance (module docstring); write the log, a JSON of the
     table and ``sensors.md`` into ``output_dir``. ``noise``: the sensors' noise in the loop (off by
-    default), ``diff`` and ``filtering`` the differentiation, ``substeps`` MuJoCo's physics steps per period
+    default), ``diff`` and ``filtering`` the acceleration route's differentiation, ``route`` the route
+    (:data:`~wbfriction.friction.options.RouteOption`), ``substeps`` MuJoCo's physics steps per period
     (:data:`SUBSTEPS`).
 
     Raises:
@@ -109,26 +119,36 @@ def run_sensors_study(robot: Robot, output_dir: Path, steps: int = 3, diff: Diff
                           MujocoOptions(sensors=noise, substeps=substeps)).log
     free = _off_limits(robot, log, legs)
     estimates = {}
-    for route, options in (("contact", EstimateOptions(diff=diff, filtering=filtering, base_motion="contact",
-                                                       wrenches=False)),
-                           ("wrench", EstimateOptions(diff=diff, filtering=filtering, base_motion="logged"))):
-        say(f"estimate: the {route} route")
-        estimates[route] = estimate_log(robot, log, options)
+    for closure, options in (("contact", EstimateOptions(diff=diff, filtering=filtering, base_motion="contact",
+                                                         wrenches=False, route=route)),
+                             ("wrench", EstimateOptions(diff=diff, filtering=filtering, base_motion="logged",
+                                                        route=route))):
+        say(f"estimate: the {closure} closure")
+        estimates[closure] = estimate_log(robot, log, options)
     errors: dict[str, dict] = {j: {} for j, _, _ in legs}
     samples: dict[str, dict] = {j: {} for j, _, _ in legs}
-    for route, est in estimates.items():
-        for part in PARTS[route]:
-            say(f"fit: the {route} route, {part} samples")
-            part_est = dataclasses.replace(est, valid=est.valid & _foot_down(robot, est, part == "stance")
-                                           & free[:, None])
+    bounds: dict[str, dict] = {j: {} for j, _, _ in legs}
+    statuses: dict[str, dict] = {j: {} for j, _, _ in legs}
+    for closure, est in estimates.items():
+        for part in PARTS[closure]:
+            say(f"fit: the {closure} closure, {part} samples")
+            part_est = est.keeping(_foot_down(robot, est, part == "stance") & free[:, None])
             for (joint, _, _), fit in zip(legs, fit_legs(part_est, legs, friction)):
                 e = fit.error_percent() or {}
-                errors[joint][(route, part)] = {n: abs(e.get(n, np.inf)) for n in SCORED}
-                samples[joint][(route, part)] = fit.n_samples
+                errors[joint][(closure, part)] = {n: abs(e.get(n, np.inf)) for n in SCORED}
+                samples[joint][(closure, part)] = fit.n_samples
+                values = {} if fit.params is None else fit.params.to_dict()
+                bounds[joint][(closure, part)] = {n: 100 * fit.crb.get(n, np.nan) / abs(friction[joint].to_dict()[n])
+                                                  if friction[joint].to_dict()[n] else np.nan for n in SCORED
+                                                  if n in values}
+                statuses[joint][(closure, part)] = fit.verdict().status
     rows = [SensorsRow(j, side, g, errors[j], samples[j],
-                       {route: float(est.valid[:, est.joints.index(j)].mean()) for route, est in estimates.items()})
+                       {c: float(est.valid[:, est.joints.index(j)].mean()) for c, est in estimates.items()},
+                       bounds[j], statuses[j])
             for j, side, g in legs]
-    label = diff + (f" L={filtering.window}" if diff == "savgol" else "")
+    routes = {c: est.estimation_route for c, est in estimates.items()}
+    label = ", ".join(f"{c}: {r} route" for c, r in routes.items()) + "; acceleration: " + diff
+    label += f" L={filtering.window}" if diff == "savgol" else ""
     label += "" if not noise.active else f", sensor noise {noise.position_std:g} rad / {noise.encoder_bits} bit"
     result = SensorsResult(rows, int((~free).sum()), label, [])
     files = [output_dir / "mujoco_sensors_walk.parquet", output_dir / "sensors.json", output_dir / "sensors.md"]
@@ -159,7 +179,9 @@ def _as_json(result: SensorsResult) -> dict:
     return {"diff": result.diff, "rows_at_a_limit": result.at_limit,
             "joints": {r.joint: {"side": r.side, "group": r.group, "usable_share": r.usable,
                                  **{f"{route}_{part}": {"error_percent": r.errors[(route, part)],
-                                                        "samples": r.samples[(route, part)]}
+                                                        "samples": r.samples[(route, part)],
+                                                        "bound_percent": r.bounds.get((route, part), {}),
+                                                        "status": r.statuses.get((route, part))}
                                     for route, parts in PARTS.items() for part in parts}}
                        for r in result.rows}}
 
@@ -179,6 +201,13 @@ def sensors_markdown(result: SensorsResult) -> str:
         cells += [" / ".join(f"{r.errors[(route, part)][n]:.2f}" for n in names)
                   for route, parts in PARTS.items() for part in parts]
         lines.append("| " + " | ".join(cells) + " |")
+    parts = [(c, p) for c, ps in PARTS.items() for p in ps]
+    lines += ["", "Cramér-Rao bound [% of the true value] of F_c / F_v, and the fit's status", "",
+              "| joint | " + " | ".join(f"{c}, {p}" for c, p in parts) + " |", "|" + "---|" * (len(parts) + 1)]
+    for r in result.rows:
+        cells = [" / ".join(f"{r.bounds.get(k, {}).get(n, np.nan):.2f}" for n in ("F_c", "F_v"))
+                 + f" {r.statuses.get(k, '')}" for k in parts]
+        lines.append(f"| {r.joint} | " + " | ".join(cells) + " |")
     lines += ["", "Share of the walk's samples with a valid estimate", "", "| joint | contact | wrench |",
               "|---|---|---|"]
     lines += [f"| {r.joint} | {100 * r.usable['contact']:.1f} % | {100 * r.usable['wrench']:.1f} % |"

@@ -47,10 +47,12 @@ from wbfriction.walking import walking_reference
 from wbfriction.walking.options import GaitOptions
 
 DERIVATIVE_SCHEMES = {
-    "true acceleration": EstimateOptions(diff="true", mask="single"),
-    "central (6.2)": EstimateOptions(diff="central", mask="single"),
-    "backward, delay compensated": EstimateOptions(diff="backward", compensate_delay=True, mask="single"),
-    "backward, not compensated": EstimateOptions(diff="backward", compensate_delay=False, mask="single"),
+    "true acceleration": EstimateOptions(diff="true", mask="single", route="acceleration", check_route=False),
+    "central (6.2)": EstimateOptions(diff="central", mask="single", route="acceleration", check_route=False),
+    "backward, delay compensated": EstimateOptions(diff="backward", compensate_delay=True, mask="single",
+                                                   route="acceleration", check_route=False),
+    "backward, not compensated": EstimateOptions(diff="backward", compensate_delay=False, mask="single",
+                                                 route="acceleration", check_route=False),
 }
 
 @dataclass
@@ -110,7 +112,7 @@ def _identification(robot: Robot, legs: list[LegJoint], steps: int, output_dir: 
     walk = _simulate(robot, GaitOptions(gait="combined", steps=steps), friction)
     write_log(walk.log, robot, output_dir / "walk_log.parquet")
     say("estimating (central differences)")
-    est = estimate_log(robot, walk.log, EstimateOptions(), companion=True)
+    est = estimate_log(robot, walk.log, EstimateOptions(diff="central", route="acceleration"), companion=True)
     write_table(friction_table(est), output_dir / "walk_friction.parquet")
     say("fitting the friction model of every leg joint")
     fits = fit_legs(est, legs, friction)
