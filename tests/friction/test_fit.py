@@ -522,9 +522,10 @@ def test_a_bounded_model_must_beat_a_simpler_interior_one_beyond_the_noise_of_th
     scores = (HeldOutScore("coulomb-viscous", 0.1), HeldOutScore("stribeck", 0.097, ("F_c",)),
               HeldOutScore("thesis", 0.099, ("S",)))
     close = simple * 0.999 + rng.normal(0.0, 0.01, rows.size)  # a lowering well within its noise
-    chosen, reason = prefer_interior("stribeck", "stribeck: ...; held-out RMS", scores,
-                                     {"coulomb-viscous": simple, "stribeck": close}, rows)
+    chosen, reason = prefer_interior("stribeck", "stribeck: the simplest (x; +1 %); held-out RMS [N·m]: a 1, b 2",
+                                     scores, {"coulomb-viscous": simple, "stribeck": close}, rows)
     assert chosen == "coulomb-viscous" and reason.startswith("coulomb-viscous: stribeck leaves F_c at a bound")
+    assert reason.endswith("within 2 standard errors; held-out RMS [N·m]: a 1, b 2")
     gain, se = held_out_gain(simple, close, rows)
     assert gain < 2 * se
     far = simple * 0.7  # a lowering of half the mean square: far beyond its noise

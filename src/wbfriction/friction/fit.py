@@ -770,9 +770,10 @@ def prefer_interior(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, 
     if gain > GAIN_Z * se:
         return chosen, reason + (f"; its held-out gain over {alternative.model} ({gain:.3g} N²·m², {gain / se:.1f} "
                                  f"standard errors) outweighs its bound ({', '.join(by_model[chosen].at_bound)})")
+    scores_text = reason[reason.find("held-out RMS [N·m]:"):] if "held-out RMS [N·m]:" in reason else ""
     return alternative.model, (f"{alternative.model}: {chosen} leaves {', '.join(by_model[chosen].at_bound)} at a "
                                f"bound and lowers the held-out mean square by {gain:.3g} ± {se:.2g} N²·m², within "
-                               f"{GAIN_Z:g} standard errors; " + reason.split("; ", 1)[-1])
+                               f"{GAIN_Z:g} standard errors" + (f"; {scores_text}" if scores_text else ""))
 
 
 def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float = 2.0,
