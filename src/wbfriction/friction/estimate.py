@@ -30,8 +30,8 @@ from wbfriction.friction.estimated import FrictionEstimate, no_single_support
 from wbfriction.friction.measured import (
     base_route,
     impacts,
+    log_base_motion,
     measured_base,
-    resolve_base_motion,
     wrench_route,
 )
 from wbfriction.friction.momentum import momentum_estimate
@@ -348,12 +348,7 @@ def _acceleration_segment(robot: Robot, log: Log, options: EstimateOptions, prog
                           require_single_support: bool, gaps: tuple[bool, bool] = (False, False)) -> FrictionEstimate:
     if options.diff == "auto":
         raise InputError("diff 'auto' is resolved once per log (resolve_differentiation), not per segment")
-    has_wrench = options.wrenches and log.wrench is not None
-    has_imu = log.imu is not None and robot.imu is not None
-    base_motion = resolve_base_motion(options.base_motion, log.base is not None, has_wrench, has_imu)
-    if base_motion == "imu" and (robot.imu is None or log.base is None):
-        raise InputError(f"{log.source}: --base-motion imu needs the robot's [imu] (its TOML) and the base "
-                         "orientation columns base.qx ... base.qw")
+    has_wrench, base_motion = log_base_motion(robot, log, options.base_motion, options.wrenches)
     kin = measure(log, options.diff, compensate_delay=options.compensate_delay,
                   torque_alignment=options.torque_alignment, filtering=options.filtering, velocity=options.velocity,
                   base_motion=base_motion == "logged", imu=base_motion == "imu")

@@ -23,8 +23,10 @@ from typing import Literal
 
 import numpy as np
 
+from wbfriction.exceptions import InputError
 from wbfriction.friction.options import BaseMotion
 from wbfriction.logs.contacts import default_thresholds, normal_forces, sensed_contacts
+from wbfriction.logs.log import Log
 from wbfriction.model.dynamics import floating_base_state
 from wbfriction.model.imu import base_motion_from_imu
 from wbfriction.model.measured_dynamics import measured_inverse_dynamics
@@ -47,6 +49,23 @@ def resolve_base_motion(choice: BaseMotion, has_base: bool, has_wrench: bool, ha
     if has_imu and has_base:
         return "imu"
     return "logged" if has_base and has_wrench else "contact"
+
+
+def log_base_motion(robot: Robot, log: Log, choice: BaseMotion, wrenches: bool
+                    ) -> tuple[bool, Literal["contact", "logged", "imu"]]:
+    """Whether the log's wrenches are used (``wrenches`` and the log has them) and the base motion ``choice`` stands
+    for on this log (:func:`resolve_base_motion`), for either route.
+
+    Raises:
+        InputError: ``imu`` without the robot's IMU or the log's base orientation.
+    """
+    has_wrench = wrenches and log.wrench is not None
+    has_imu = log.imu is not None and robot.imu is not None
+    base_motion = resolve_base_motion(choice, log.base is not None, has_wrench, has_imu)
+    if base_motion == "imu" and (robot.imu is None or log.base is None):
+        raise InputError(f"{log.source}: --base-motion imu needs the robot's [imu] (its TOML) and the base "
+                         "orientation columns base.qx ... base.qw")
+    return has_wrench, base_motion
 
 
 IMPACT_SKIP = 0.02

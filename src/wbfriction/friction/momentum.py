@@ -57,7 +57,7 @@ import numpy as np
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimated import FrictionEstimate, no_single_support
-from wbfriction.friction.measured import impacts, resolve_base_motion
+from wbfriction.friction.measured import impacts, log_base_motion
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import Log
 from wbfriction.model.dynamics import floating_base_state
@@ -163,12 +163,7 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
             the route can estimate (with ``require_single_support``).
     """
     window = momentum_window(options, log)
-    has_wrench = options.wrenches and log.wrench is not None
-    has_imu = log.imu is not None and robot.imu is not None
-    base_motion = resolve_base_motion(options.base_motion, log.base is not None, has_wrench, has_imu)
-    if base_motion == "imu" and (robot.imu is None or log.base is None):
-        raise InputError(f"{log.source}: --base-motion imu needs the robot's [imu] (its TOML) and the base "
-                         "orientation columns base.qx ... base.qw")
+    has_wrench, base_motion = log_base_motion(robot, log, options.base_motion, options.wrenches)
     kin = measure(log, "savgol", compensate_delay=options.compensate_delay, torque_alignment=options.torque_alignment,
                   filtering=velocity_filter(options), velocity=options.velocity,
                   base_motion=has_wrench and log.base is not None, imu=has_wrench and base_motion == "imu")
