@@ -3,6 +3,8 @@ a fit's Monte Carlo spread, and the torque noise read off a residual."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from scipy.linalg import solve_banded
@@ -48,6 +50,17 @@ def test_a_parameter_the_data_cannot_tell_has_an_infinite_bound():
     J = np.column_stack([np.ones(100), np.ones(100), np.arange(100.0)])  # the first two are one parameter
     cov = cramer_rao(J, np.arange(100), NoiseModel(0.05, 0.0, 1.0, DT))
     assert np.isinf(cov[0, 0]) and np.isinf(cov[1, 1]) and np.isfinite(cov[2, 2])
+
+
+def test_a_parameter_with_next_to_no_information_has_an_infinite_bound_and_no_warning():
+    """A column of 1e-160 (a Stribeck height at a velocity far beyond v_s): its bound overflows the floats' range;
+    it is inf, quietly, the others' finite."""
+    x = np.linspace(-1.0, 1.0, 100)
+    J = np.column_stack([1e-160 * x**2, x, np.ones(100)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        cov = cramer_rao(J, np.arange(100), NoiseModel(0.05, 0.0, 1.0, DT))
+    assert np.isinf(cov[0, 0]) and np.all(np.isfinite(cov[1:, 1:]))
 
 
 def test_the_torque_noise_is_the_residuals_spectrum_at_zero_frequency():

@@ -141,7 +141,8 @@ def cramer_rao(jac: np.ndarray, rows: np.ndarray, noise: NoiseModel, rtol: float
     info = info / np.outer(scale, scale)  # unit diagonal: the parameters' units do not decide what is identifiable
     w, V = np.linalg.eigh(info)
     keep = w > rtol * w.max() if w.size and w.max() > 0 else np.zeros_like(w, dtype=bool)
-    cov = (V[:, keep] / w[keep]) @ V[:, keep].T / np.outer(scale, scale)
+    with np.errstate(over="ignore"):  # a parameter with next to no information: a bound of inf, which it is
+        cov = (V[:, keep] / w[keep]) @ V[:, keep].T / np.outer(scale, scale)
     null = V[:, ~keep]
     bad = (np.abs(null) > 1e-6).any(axis=1) if null.size else np.zeros(jac.shape[1], dtype=bool)
     cov[bad, :] = np.inf
