@@ -71,7 +71,7 @@ from wbfriction.friction.models import (
 from wbfriction.friction.noise import joint_noises
 from wbfriction.friction.options import SELECTION_TOLERANCE
 from wbfriction.friction.screen import gross_outliers
-from wbfriction.friction.status import FitVerdict, fit_verdict, joint_speed
+from wbfriction.friction.status import MIN_SPEED, FitVerdict, fit_verdict, joint_speed
 from wbfriction.signals.kinematics import PiecewiseSmoother
 from wbfriction.signals.nonuniform import ResampledLowpass
 from wbfriction.workers import process_pool
@@ -275,7 +275,8 @@ class FitResult(Generic[ParamsT]):
         selection: how ``model="auto"`` chose the model, or None.
         n_screened: valid samples left out as gross outliers
             (:func:`~wbfriction.friction.screen.gross_outliers`), not in :attr:`n_samples`.
-        speed: the 95th percentile of ``|qd|`` over the samples used [rad/s] (how much the joint moved), or
+        speed: the 95th percentile of ``|qd|`` over the samples fitted and those left out as sticking [rad/s]
+            (how much the joint moved), or
             None (not known: a parameters file of an earlier version).
         covariance: the parameters' covariance (p, p) in :attr:`params`' order (held ones: 0; ``inf`` rows
             for one that is not identifiable; :func:`parameter_covariance`), or None (not fitted, or read
@@ -678,7 +679,9 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         velocity_noise: the standard deviation of the noise in ``qd`` [rad/s]: the model compared is its expectation
             under that noise (errors in variables, :mod:`~wbfriction.friction.eiv`); 0: the model itself.
         stick, stick_margin: samples within ``stick_margin`` rows of a speed below ``stick`` [rad/s] are left out
-            (:func:`stuck_rows`) and counted (:attr:`FitResult.n_stuck`); 0: none.
+            (:func:`stuck_rows`) and counted (:attr:`FitResult.n_stuck`); 0: none. Not for a joint that hardly
+            moved (:data:`~wbfriction.friction.status.MIN_SPEED`: ``not excited``), whose every sample gives its
+            offset.
         noise: what is known of the estimate's noise (:class:`~wbfriction.friction.bound.JointNoise`): the fit then
             carries its Cramér-Rao bound (:attr:`FitResult.crb`); None: no bound.
 
@@ -701,7 +704,11 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
     use &= ~screened
     if smoother is not None:
         use &= np.isfinite(smoother(qd))
-    stuck = stuck_rows(qd, stick, stick_margin) & use if stick > 0 else np.zeros_like(use)
+    # how much the joint moved, its slow samples included; one that hardly moved has no velocity model to fit
+    # (status ``not excited``), and every sample gives its offset (the energy check's, eq. 7.9)
+    speed = joint_speed(qd[use])
+    sticks = stick > 0 and speed >= MIN_SPEED
+    stuck = stuck_rows(qd, stick, stick_margin) & use if sticks else np.zeros_like(use)
     use &= ~stuck
     # One BLAS thread: the solver's many small (N x p) factorizations run several times
     # slower on OpenBLAS's threads than on one (30 TALOS joints of a 10-step walk: 78 s
@@ -717,6 +724,7 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
                              min_samples=min_samples, smoother=smoother, fixed=fixed, sigma=velocity_noise,
                              noise=noise)
     res.n_screened = int(screened.sum())
+    res.speed = speed
     res.velocity_noise, res.stick_speed, res.n_stuck = float(velocity_noise), float(stick), int(stuck.sum())
     return res
 

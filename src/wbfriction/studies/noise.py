@@ -223,8 +223,8 @@ def bound_table(rows: Sequence[NoiseRow]) -> list[dict]:
             continue
         for joint in dict.fromkeys(r.joint for r in case):
             runs = [r for r in case if r.joint == joint]
-            first = next(r for r in runs if r.seed == min(seeds))
-            if not first.determined or first.status == "not excited":
+            first = next((r for r in runs if r.seed == min(seeds)), None)
+            if first is None or not first.determined or first.status == "not excited":
                 continue
             entry: dict = {"robot": robot, "family": family, "noise": noise, "joint": joint, "seeds": len(runs)}
             for n in SCORED:
