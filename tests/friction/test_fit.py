@@ -12,6 +12,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import (
     LOWER,
+    STICK_FLOOR,
     UPPER,
     FitResult,
     HeldOutScore,
@@ -32,6 +33,7 @@ from wbfriction.friction.fit import (
     parameter_covariance,
     prefer_interior,
     standard_errors,
+    stick_speed,
     to_fit_coordinates,
 )
 from wbfriction.friction.models import (
@@ -544,3 +546,41 @@ def test_the_held_out_gain_and_its_standard_error_by_hand():
     d = a**2 - b**2
     assert gain == pytest.approx(d.mean(), rel=1e-12)
     assert se == pytest.approx(d.std() / np.sqrt(d.size), rel=0.2)
+
+
+def _stick_slip(seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """A joint that slides (Coulomb-viscous friction F_c 0.8, F_v 0.2 of its velocity) and sticks in turn: 0.4 s
+    sliding at up to 0.5 rad/s, then 0.3 s stuck, chattering at up to 2e-3 rad/s (a sign applied at every
+    physics step) while its friction is anything within the static level 1.2 N·m. Returns (qd, tau_f)."""
+    rng = np.random.default_rng(seed)
+    qd, tau_f = [], []
+    for k in range(40):
+        slide = 0.5 * np.sin(np.pi * np.arange(400) / 400) * (1 if k % 2 else -1)
+        chatter = 2e-3 * rng.uniform(-1.0, 1.0, 300)
+        qd += [slide, chatter]
+        tau_f += [-(0.2 * slide + 0.8 * np.sign(slide)), rng.uniform(-1.2, 1.2, 300)]
+    return np.concatenate(qd), np.concatenate(tau_f)
+
+
+def test_sticking_samples_are_left_out_and_the_sliding_ones_give_the_truth():
+    """Stuck samples (friction any value within the static level) left out: F_c and F_v exact; kept, they bias the
+    fit; the floor of the sticking speed is above a simulator's chatter."""
+    qd, tau_f = _stick_slip()
+    kept = fit_friction(qd, tau_f, model="coulomb-viscous")
+    out = fit_friction(qd, tau_f, model="coulomb-viscous", stick=stick_speed(0.0), stick_margin=1)
+    assert stick_speed(0.0) == STICK_FLOOR > 2e-3
+    assert out.n_samples + out.n_stuck == 28_000  # every chattering sample, and the sliding ones beside them
+    assert 12_000 <= out.n_stuck <= 12_000 + 40 * 4
+    assert out.params.F_c == pytest.approx(0.8, rel=1e-3) and out.params.F_v == pytest.approx(0.2, rel=1e-3)
+    assert abs(kept.params.F_v / 0.2 - 1.0) > 0.05
+
+
+def test_a_joint_that_hardly_moved_keeps_its_slow_samples():
+    """Below the excitation speed there is no velocity model to fit: no sample is left out as sticking (its
+    offset comes from all of them), and its speed counts them."""
+    rng = np.random.default_rng(1)
+    qd = 2e-3 * rng.uniform(-1.0, 1.0, 2000)
+    res = fit_friction(qd, 0.15 + 0.01 * rng.normal(size=qd.size), model="coulomb-viscous",
+                       stick=stick_speed(0.0), stick_margin=1)
+    assert res.n_stuck == 0 and res.n_samples == 2000
+    assert res.verdict().status == "not excited"
