@@ -1,5 +1,5 @@
 """Inertia-model identification (thesis 2.4, ch. 8): the regressor against inverse dynamics,
-the compressed least squares, base parameters, the log-Cholesky parametrisation, the model and
+the compressed least squares, base parameters, physically consistent bodies (the exact conic solve), the model and
 friction recovered from a simulated walk given a wrong model, and from a simulated arm's motor
 currents its friction and rotor inertia (armature), known or identified, with the parameters its
 motion does not excite kept at the prior and reported."""
@@ -20,7 +20,6 @@ from wbfriction.inertia.consistency import (
     PHYSICAL,
     fit_consistent,
     is_consistent,
-    log_cholesky,
     nearest_consistent,
     prior_model,
     regularised_problem,
@@ -67,11 +66,8 @@ inertias = st.tuples(st.floats(0.05, 50), st.floats(0.01, 1), st.floats(0.01, 1)
 
 @settings(max_examples=60, deadline=None)
 @given(inertia=inertias)
-def test_log_cholesky_round_trip_and_consistency(inertia):
+def test_consistency_and_the_nearest_consistent_body(inertia):
     pi = inertia.toDynamicParameters()
-    theta = log_cholesky(pi)
-    back = pin.LogCholeskyParameters(theta).toDynamicParameters()
-    assert np.allclose(back, pi, rtol=1e-9, atol=1e-9 * max(1.0, np.abs(pi).max()))
     assert is_consistent(pi[None])[0]
     # a body whose principal moments break the triangle inequality is not physical
     bad = pin.Inertia(inertia.mass, inertia.lever, np.diag([1.0, 1.0, 3.0]) * inertia.mass).toDynamicParameters()
@@ -186,9 +182,8 @@ def _slow_joint(body: pin.Inertia, seed: int, triangle: bool):
 @settings(max_examples=25, deadline=None)
 @given(body=inertias, seed=st.integers(0, 2**32 - 1), triangle=st.booleans())
 def test_consistent_fit_keeps_friction_physical_and_beats_the_truth(body, seed, triangle):
-    """The fit keeps F_v, F_c >= 0 and the body physical (through the non-linear,
-    log-Cholesky route with ``triangle``), and its objective is no worse than the truth's,
-    a feasible point."""
+    """The fit keeps F_v, F_c >= 0 and the body physical (through the conic solve with ``triangle``), and its
+    objective is no worse than the truth's, a feasible point."""
     ls, pi_true, friction_true = _slow_joint(body, seed, triangle)
     prior = prior_model(pi_true * 1.05, np.zeros(3), np.full(3, 1e4))
     lower = np.concatenate([np.full(10, -np.inf), [0.0, 0.0, -np.inf]])
@@ -202,6 +197,33 @@ def test_consistent_fit_keeps_friction_physical_and_beats_the_truth(body, seed, 
 
     assert objective(fit.pi, fit.rest) <= objective(pi_true, friction_true) * (1 + 1e-6)
     assert fit.cost == pytest.approx(0.5 * objective(fit.pi, fit.rest), rel=1e-4)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_the_conic_solve_is_the_nearest_positive_semidefinite_pseudo_inertia(seed):
+    """An analytic case of the conic solve: data that measure a body's pseudo-inertia entries directly, in the
+    Frobenius norm (``R pi = svec(J(pi))``), asking for an indefinite one ``M``: the minimum over physical
+    bodies is ``M`` with its negative eigenvalues set to zero (the nearest positive-semidefinite matrix), with a
+    prior weight too small to move it."""
+    rng = np.random.default_rng(seed)
+    iu = [(i, j) for j in range(4) for i in range(j + 1)]
+    scale = np.array([1.0 if i == j else np.sqrt(2.0) for i, j in iu])
+
+    def svec(J):
+        return scale * np.array([J[i, j] for i, j in iu])
+
+    R = np.column_stack([svec(pin.PseudoInertia.FromDynamicParameters(e).toMatrix()) for e in np.eye(10)])
+    V = np.linalg.qr(rng.normal(size=(4, 4)))[0]
+    ev = np.array([-rng.uniform(0.05, 1.0), *rng.uniform(0.1, 2.0, 3)])  # one negative eigenvalue
+    M = (V * ev) @ V.T
+    prior = prior_model(pin.Inertia.FromBox(1.0, 0.1, 0.2, 0.3).toDynamicParameters()[None], np.zeros(0),
+                        np.zeros(0))
+    fit = fit_consistent(R, svec(M), prior, 1e-12, np.full(10, -np.inf))
+    assert fit.solver is not None and fit.solver.converged and fit.unphysical == 1
+    J = pin.PseudoInertia.FromDynamicParameters(fit.pi[0]).toMatrix()
+    nearest = (V * np.maximum(ev, 0.0)) @ V.T
+    assert np.abs(J - nearest).max() < 1e-6 * np.abs(M).max()
 
 
 def test_unbounded_friction_of_a_slow_joint_cancels():

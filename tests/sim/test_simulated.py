@@ -8,7 +8,7 @@ import pytest
 
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.fit import fit_joints
-from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.models import target_from_dict
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.signals.options import FilterOptions
@@ -127,7 +127,7 @@ def _leg_fits(talos, log, options=EstimateOptions()):
     est = estimate_log(talos, log, options)
     legs = [j for j in est.joints if j.startswith("leg_")]
     idx = [est.joints.index(j) for j in legs]
-    targets = {j: FrictionParams(**p) for j, p in log.metadata["friction_true"].items()}
+    targets = {j: target_from_dict(p) for j, p in log.metadata["friction_true"].items()}
     fits = fit_joints(legs, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], targets=targets,
                         smoother=est.smoother)
     worst = {n: max(r.error_percent()[n] for r in fits) for n in fits[0].error_percent()}
@@ -144,14 +144,16 @@ def test_combined_walk_identifies_every_leg_joint(talos, combined):
     assert worst["S"] < 5 and worst["v_s"] < 5 and worst["a"] < 5
 
 
-def test_noisy_positions_need_a_zero_phase_filter(talos, combined):
-    """Position noise of 1e-4 rad (19-bit encoder, 0.05 N·m torque noise): central
-    differences fail; Savitzky-Golay (L = 151, k = 4) with its model filtered alike
-    identifies F_c and tau_os of every leg joint within 10 % (issue target; F_v: see the
-    filter study, reached 14-27 % at worst over the 12 joints depending on the noise draw)."""
+def test_noisy_positions_on_the_thesis_route(talos, combined):
+    """Position noise of 1e-4 rad (19-bit encoder, 0.05 N·m torque noise), the thesis's acceleration route:
+    with the fit of issue 38 (the model's expectation under the velocity's noise, the sticking samples left
+    out), central differences and Savitzky-Golay (L = 151, k = 4) alike identify F_c and tau_os of every leg
+    joint within 10 % and F_v within 30 % (measured: central 4.2 / 1.4 / 23.9 %, Savitzky-Golay 4.6 / 1.3 /
+    26.7 %; in the thesis central differences missed F_c by over 100 %). The Stribeck term (S, v_s) is not
+    determined at this noise by either (S off by over 1000 %): the momentum route's study is
+    ``wbfriction study-noise``."""
     noisy = apply_sensor_noise(combined, SensorNoise(1e-4, 19, 0.05, seed=1))
-    _, central = _leg_fits(talos, noisy)
-    assert central["F_c"] > 100
-    _, savgol = _leg_fits(talos, noisy, EstimateOptions(diff="savgol", filtering=FilterOptions(window=151)))
-    print("savgol worst errors [%]", {k: round(v, 1) for k, v in savgol.items()})
-    assert savgol["F_c"] < 10 and savgol["tau_os"] < 10 and savgol["F_v"] < 30
+    for options in (EstimateOptions(route="acceleration"),
+                    EstimateOptions(diff="savgol", filtering=FilterOptions(window=151), route="acceleration")):
+        _, worst = _leg_fits(talos, noisy, options)
+        assert worst["F_c"] < 10 and worst["tau_os"] < 10 and worst["F_v"] < 30, options.diff

@@ -46,4 +46,4 @@ def test_the_files_hold_the_table(study):
     assert set(table["joints"]) == {r.joint for r in result.rows}
     first = table["joints"][result.rows[0].joint]
     assert {f"{route}_{part}" for route, parts in PARTS.items() for part in parts} <= set(first)
-    assert (out / "sensors.md").read_text().count("| leg_") == 24  # both tables
+    assert (out / "sensors.md").read_text().count("| leg_") == 36  # errors, bounds with statuses, usable shares

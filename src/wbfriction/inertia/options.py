@@ -68,7 +68,8 @@ class InertialOptions:
             the priors of the grid.
         rank_tolerance: relative pivot below which a parameter is not identifiable
             (:func:`~wbfriction.inertia.least_squares.base_parameters`).
-        min_mass: smallest mass a body's starting point gets [kg].
+        min_mass: the mass [kg] of the sphere at which a massless or flat body's prior is measured
+            (:func:`~wbfriction.inertia.consistency.body_prior`).
         block: samples per block of the compressed regression.
     """
 
