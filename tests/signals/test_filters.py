@@ -56,12 +56,14 @@ def test_savgol_is_exact_on_polynomials_of_its_order(half, order, weights, coefs
 
 @pytest.mark.parametrize("window,order", [(5, 2), (21, 4), (151, 4), (31, 6)])
 def test_weighted_route_equals_scipy_for_uniform_weights(window, order):
-    """(7.5)-(7.6) written out, with W = I, against scipy.signal.savgol_coeffs."""
+    """(7.5)-(7.6) written out, with W = I, against scipy.signal.savgol_coeffs. SciPy fits on raw sample indices,
+    whose Vandermonde matrix at L = 151, k = 4 has a condition number of 2e7 (ours: the abscissa scaled to
+    [-1, 1]): SciPy 1.17 with NumPy 2.4 is 2e-9 of the largest coefficient off there, hence 1e-8."""
     ones = np.ones(window)  # an explicit array takes the weighted route
     for d in range(3):
         ours = savgol_kernels(window, order, DT, ones)[d]
         ref = savgol_coeffs(window, order, deriv=d, delta=DT, use="dot")
-        assert np.allclose(ours, ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
+        assert np.allclose(ours, ref, rtol=1e-9, atol=1e-8 * np.abs(ref).max())
 
 
 @pytest.mark.parametrize("window,order", [(2501, 4), (20001, 4), (501, 6)])

@@ -554,6 +554,16 @@ def choose_model(scores: tuple[HeldOutScore, ...], tolerance: float = SELECTION_
     return chosen.model, reason
 
 
+def distinct_minima(points: Sequence[np.ndarray], rtol: float = 1e-2) -> list[np.ndarray]:
+    """``points`` (solver results, best first) without those within ``rtol`` of a better one in every coordinate
+    (the fit's coordinates): one per basin."""
+    out: list[np.ndarray] = []
+    for x in points:
+        if not any(np.allclose(x, y, rtol=rtol, atol=1e-9) for y in out):
+            out.append(x)
+    return out
+
+
 def _solve(residual, jacobian, start, bounds, max_nfev):
     from scipy.optimize import least_squares
     start = np.clip(start, bounds[0] + 1e-12, bounds[1] - 1e-12)
@@ -820,22 +830,25 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     jacobian = lambda z: fit_coordinates_jacobian(  # noqa: E731
         model, expected_jacobian(full(z), v, sigma, delta_s, model))[:, free]
     bounds = tuple(b[free] for b in model_bounds(v, model))
-    # a short run of the model itself from every start, then the two best refined (on its expectation under the
-    # velocity noise, when there is one)
+    # a short run of the model itself from every start, then the two best distinct minima refined (on its
+    # expectation under the velocity noise, when there is one, then through the smoother): several starts
+    # often fall into one basin, and the best of the short runs' can be another objective's worse one (a narrow
+    # Stribeck dip that the plain model prefers and the filtered one does not)
     if len(starts) > 1:
         plain = lambda z: model_values(full(z), v, delta_s, model) - yu  # noqa: E731
         plain_jacobian = lambda z: fit_coordinates_jacobian(  # noqa: E731
             model, model_jacobian(full(z), v, delta_s, model))[:, free]
         short = sorted((_solve(plain, plain_jacobian, s, bounds, 30) for s in starts), key=lambda r: r.cost)
-        starts = [r.x for r in short[:2]]
-    best = min((_solve(residual, jacobian, s, bounds, 300) for s in starts), key=lambda r: r.cost)
+        starts = distinct_minima([r.x for r in short])[:2]
+    refined = [_solve(residual, jacobian, s, bounds, 300) for s in starts]
+    best = min(refined, key=lambda r: r.cost)
     natural_jacobian = lambda z: expected_jacobian(full(z), v, sigma, delta_s, model)[:, free]  # noqa: E731
     if smoother is not None:
         f_residual, f_jacobian = filtered_problem(qd, y, use, smoother, delta_s, model, sigma)
         residual = lambda z: f_residual(full(z))  # noqa: E731
         jacobian = lambda z: fit_coordinates_jacobian(model, f_jacobian(full(z)))[:, free]  # noqa: E731
         natural_jacobian = lambda z: f_jacobian(full(z))[:, free]  # noqa: E731
-        best = _solve(residual, jacobian, best.x, bounds, 200)
+        best = min((_solve(residual, jacobian, r.x, bounds, 200) for r in refined), key=lambda r: r.cost)
     # residuals correlated over the filter's window, or over the span of a model error;
     # standard errors of the model's own parameters (F_s, not F_s - F_c)
     rows = np.flatnonzero(use)
