@@ -52,7 +52,7 @@ if TYPE_CHECKING:
 # rich_markup_mode=None: click's plain help, so that units in brackets ([m], [rad/s], [friction.<group>]) are
 # printed as written (Rich markup would take them for tags and delete them)
 app = typer.Typer(add_completion=False, rich_markup_mode=None)
-console = Console(stderr=True)
+console = Console(stderr=True, soft_wrap=True)  # a message is one line, wrapped by the terminal, not cut into lines
 out = Console(width=max(Console().width, 150))
 
 RobotOpt = typer.Option("talos", "--robot", help=f"Built-in robot: {', '.join(BUILTIN_ROBOTS)}.")
