@@ -51,6 +51,12 @@ def assert_one_line_error(res, needle):
 
 def run_cli(capsys, *args) -> tuple[int, str]:
     """``wbfriction ARGS`` in this process: (exit status, standard error)."""
+    code, _, err = run_cli_printed(capsys, *args)
+    return code, err
+
+
+def run_cli_printed(capsys, *args) -> tuple[int, str, str]:
+    """``wbfriction ARGS`` in this process: (exit status, standard output, standard error)."""
     argv = sys.argv
     sys.argv = ["wbfriction", *map(str, args)]
     try:
@@ -60,7 +66,8 @@ def run_cli(capsys, *args) -> tuple[int, str]:
         code = exc.code
     finally:
         sys.argv = argv
-    return code, capsys.readouterr().err
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
 
 
 def ros_time(ts, ns: int):

@@ -24,7 +24,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from helpers import mapped_copy, run_cli
+from helpers import mapped_copy, run_cli, run_cli_printed
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import log_from_table
@@ -327,3 +327,29 @@ def test_one_fault_anywhere_ends_in_one_line(walk, tmp_path_factory, capsys, fau
     start_time = time.perf_counter()
     _refused(capsys, tmp, [log], ("estimate", log, "-o", out, "--diff", "central", *extra), "")
     assert time.perf_counter() - start_time < 30.0  # refused before any long work: never a hang
+
+
+def test_predict_names_each_fit_s_status(walk_friction, tmp_path, capsys):
+    """A prediction is no better than the fit behind it: ``predict`` prints each joint's fit status beside its RMS
+    and says so below the table when one is not ok (the same RMS either way)."""
+    def predict(params: Path) -> tuple[str, str]:
+        code, out, err = run_cli_printed(capsys, "predict", walk_friction, "--params", params)
+        assert code == 0, err
+        return out, err
+
+    params = tmp_path / "p.json"
+    code, err = run_cli(capsys, "fit", walk_friction, "-o", params, "--model", "coulomb-viscous", "--workers", "1")
+    assert code == 0, err
+    doc = json.loads(params.read_text())
+    joint = "leg_right_4_joint"
+    assert doc["joints"][joint]["status"] == "ok"
+    out, err = predict(params)
+    row = next(line for line in out.splitlines() if line.split()[:1] == [joint])
+    assert row.split()[-1] == "ok"
+    doc["joints"][joint]["stderr"]["F_v"] = 3.0 * doc["joints"][joint]["params"]["F_v"]  # weak by its standard error
+    weak = tmp_path / "weak.json"
+    weak.write_text(json.dumps(doc))
+    out, err = predict(weak)
+    weak_row = next(line for line in out.splitlines() if line.split()[:1] == [joint])
+    assert weak_row.split()[-1] == "weak" and weak_row.split()[:-1] == row.split()[:-1]
+    assert "a prediction by a fit that is not ok is no better than that fit" in err

@@ -580,11 +580,15 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
     check_paths({"FRICTION": friction, "--params": params}, {})
     pred = predict_file(friction, params)
     table = Table(title=f"Torque prediction on {friction.name}: RMS of measured - predicted [N·m]", box=None)
-    for col in ("joint", "samples", "rigid body only", "with friction"):
-        table.add_column(col, justify="left" if col == "joint" else "right")
-    for j, n, rigid, full in zip(pred.joints, pred.samples, pred.rms_rigid_body, pred.rms):
-        table.add_row(j, str(n), f"{rigid:.4g}", "—" if not np.isfinite(full) else f"{full:.4g}")
+    for col in ("joint", "samples", "rigid body only", "with friction", "fit"):
+        table.add_column(col, justify="right" if col in ("samples", "rigid body only", "with friction") else "left")
+    statuses = pred.status or ("",) * len(pred.joints)
+    for j, n, rigid, full, status in zip(pred.joints, pred.samples, pred.rms_rigid_body, pred.rms, statuses):
+        table.add_row(j, str(n), f"{rigid:.4g}", "—" if not np.isfinite(full) else f"{full:.4g}", status,
+                      style=None if status in ("ok", "") else "dim")
     out.print(table)
+    if any(status not in ("ok", "") for status in statuses):
+        console.print("a prediction by a fit that is not ok is no better than that fit: see 'fit' for the reason")
 
 
 @app.command()

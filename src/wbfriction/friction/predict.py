@@ -42,6 +42,8 @@ class TorquePrediction:
             joint without a friction model or without a valid sample.
         rms_rigid_body: the same with the rigid-body model alone (no friction) [N·m] (n,).
         rms_torque: RMS of the measured torque itself [N·m] (n,), for scale.
+        status: per joint, the status of the fit whose model predicts (:mod:`~wbfriction.friction.status`; "" when
+            not known): a prediction by a fit that is not ``ok`` is no better than that fit.
     """
 
     joints: tuple[str, ...]
@@ -49,6 +51,7 @@ class TorquePrediction:
     rms: np.ndarray
     rms_rigid_body: np.ndarray
     rms_torque: np.ndarray
+    status: tuple[str, ...] = ()
 
 
 def _rms(x: np.ndarray, valid: np.ndarray) -> float:

@@ -3,6 +3,7 @@ friction parameters) predicts the torques of a log, typically one it was not fit
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 from wbfriction.friction.io import check_params_source, read_friction_file, read_params
@@ -26,4 +27,6 @@ def predict_file(friction: str | Path, params: str | Path) -> TorquePrediction:
     fits = read_params(params)
     est = read_friction_file(friction)
     check_params_source(params, est)
-    return predict_torques(est, {j: f.params for j, f in fits.items() if f.params is not None})
+    pred = predict_torques(est, {j: f.params for j, f in fits.items() if f.params is not None})
+    status = tuple(fits[j].verdict().status if j in fits else "" for j in pred.joints)
+    return dataclasses.replace(pred, status=status)
