@@ -67,6 +67,8 @@ def test_identify_command_closes_the_loop(talos, wrong, combined_walk, tmp_path,
               for n in ("F_v", "F_c", "tau_os")}
     after = {n: max(doc["joints"][j]["acceleration_route"]["error_percent"][n] for j in legs)
              for n in ("F_v", "F_c", "tau_os")}
+    with capsys.disabled():
+        print("\nleg joints' worst errors [%], given model", before, "identified", after)
     assert all(after[n] < 0.5 * before[n] for n in after), (before, after)
     assert after["F_c"] < 5.0 and after["tau_os"] < 5.0, after  # F_v: the hip yaws turn in 3 steps only
     assert max(doc["joints"][j]["generating_share_given_model"] for j in legs) > 0.05
