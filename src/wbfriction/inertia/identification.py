@@ -72,7 +72,7 @@ from strong to weak, and the search stops at the first weight that scores worse 
 chosen is the strongest whose score is within :data:`PRIOR_TOLERANCE` (2 %) of the best. A weaker prior is a
 model further from the given one, and has to earn it, as a richer friction model does under ``--model auto``:
 on the KUKA LWR4+ logs the scores of the weights 10 and 1 differ by less than that, and the weaker prior
-predicted the held-out run worse on three joints (``tests/real/test_kuka_lwr4.py``).
+predicted the held-out run 3 worse on three joints (the README's KUKA commands; derivations 15).
 
 **Kept only where held-out data improve** (issue 24). On a log the given model already explains, the fit
 moves the model by noise, and predicted held-out torques worse on most leg joints of a simulated walk. The
