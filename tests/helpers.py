@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import signal
 import subprocess
@@ -19,23 +18,25 @@ from wbfriction.logs.bags import BagMap, ContactTopic
 T0 = 1_700_000_000_000_000_000  # an absolute stamp [ns], as robots write them
 
 REPO = Path(__file__).resolve().parents[1]
-REAL_DATA = Path(os.environ.get("WBFRICTION_REAL_DATA", REPO / ".." / "shared" / "real-data"))
-"""Logs recorded on real robots (env ``WBFRICTION_REAL_DATA``, else ``../shared/real-data`` beside the checkout)."""
+REAL_DATA = Path(os.environ.get("WBFRICTION_DATA") or os.environ.get("WBFRICTION_REAL_DATA")
+                 or REPO / ".." / "shared" / "real-data")
+"""Logs recorded on real robots: env ``WBFRICTION_DATA`` (what :mod:`wbfriction.datasets` reads), else
+``WBFRICTION_REAL_DATA`` (its former name), else ``../shared/real-data`` beside the checkout."""
 KUKA = REAL_DATA / "kuka_lwr4"
 KUKA_URDF = KUKA / "kuka_lwr4.urdf"
 KUKA_CONFIG = REPO / "examples" / "kuka_lwr4.toml"
 needs_kuka = pytest.mark.skipif(not KUKA.is_dir(), reason=f"the real KUKA LWR4+ logs are not at {KUKA} "
-                                                         "(set WBFRICTION_REAL_DATA)")
+                                                         "(set WBFRICTION_DATA)")
 
 
 def kuka_table(*runs: int) -> pa.Table:
-    """Runs ``measurements_<i>.npz`` of the KUKA LWR4+ in the log format, as the example converts them
-    (``examples/kuka_lwr4_convert.py``: stamps untouched), one after the other."""
-    spec = importlib.util.spec_from_file_location("kuka_lwr4_convert", REPO / "examples" / "kuka_lwr4_convert.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return pa.concat_tables([module.convert(KUKA / f"measurements_{i}.npz") for i in runs])
+    """Runs ``measurements_<i>.npz`` of the KUKA LWR4+ in the log format (stamps untouched), one after the
+    other: :func:`wbfriction.logs.read_npz_recordings`, as ``examples/kuka_lwr4_convert.py`` and
+    ``wbfriction dataset kuka-lwr4`` convert them."""
+    from wbfriction.datasets import KUKA_LWR4_JOINTS
+    from wbfriction.logs import read_npz_recordings
+
+    return read_npz_recordings([KUKA / f"measurements_{i}.npz" for i in runs], KUKA_LWR4_JOINTS)
 
 
 def run(*args, cwd=None):

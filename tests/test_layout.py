@@ -15,6 +15,7 @@ LAYERS = [
     {"version", "exceptions", "progress", "config", "workers"},
     {"model"},
     {"logs"},
+    {"datasets"},
     {"signals"},
     {"friction"},
     {"inertia"},

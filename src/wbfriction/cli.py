@@ -1207,6 +1207,40 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
                   highlight=False)
 
 
+@app.command()
+def dataset(name: str = typer.Argument(..., metavar="NAME",
+                                       help="The dataset: kuka-lwr4 (FloBaRoID's KUKA LWR4+: three runs of 25 s, "
+                                            "link-side joint torque sensors, about 6 MB)."),
+            output_dir: Path = typer.Option(..., "-o", "--output-dir",
+                                            help="Folder to write the logs into (made if missing): runs12.parquet "
+                                                 "(runs 1 and 2) and run3.parquet (run 3, held out).")) -> None:
+    """Fetch a real robot's logs and write them as wbfriction logs: downloaded once into the user's cache,
+    each file checked against its SHA-256, or taken from $WBFRICTION_DATA/<dataset>/ (a local copy, for
+    offline machines, checked the same way). Prints the robot's URDF and configuration and the commands to
+    run next."""
+    import shlex
+
+    from wbfriction.datasets import kuka_lwr4, write_kuka_lwr4_logs
+
+    if name != "kuka-lwr4":
+        raise InputError(f"NAME must be one of kuka-lwr4, got '{name}'")
+    with console.status("fetching the KUKA LWR4+ dataset"):
+        data = kuka_lwr4()
+        logs = write_kuka_lwr4_logs(output_dir, data)
+    console.print(f"wrote {logs.runs12} ({logs.rows[0]} samples: runs 1 and 2) and {logs.run3} ({logs.rows[1]} "
+                  "samples: run 3)", highlight=False, markup=False)
+    robot = f"--urdf {shlex.quote(str(data.urdf))} --config {shlex.quote(str(data.config))}"
+    runs12, run3 = shlex.quote(str(logs.runs12)), shlex.quote(str(logs.run3))
+    lines = [f"URDF:   {data.urdf}", f"config: {data.config}", "next:",
+             f"  wbfriction estimate {runs12} {robot} -o runs12_friction.parquet",
+             "  wbfriction fit runs12_friction.parquet -o runs12_params.json",
+             f"  wbfriction estimate {run3} {robot} -o run3_friction.parquet",
+             "  wbfriction predict run3_friction.parquet --params runs12_params.json",
+             f"  wbfriction identify {runs12} {robot} -o kuka_identified.urdf"]
+    for line in lines:
+        out.print(line, highlight=False, markup=False, soft_wrap=True)
+
+
 def _version(value: bool) -> None:
     if value:
         out.print(f"wbfriction {__version__}", highlight=False)

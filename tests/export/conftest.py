@@ -32,7 +32,7 @@ def kuka_robot(locked: dict[str, float] | None = None) -> Robot:
 @pytest.fixture(scope="session")
 def kuka_urdf() -> Path:
     if not KUKA_URDF.is_file():
-        pytest.skip(f"no real data at {KUKA_URDF}: set WBFRICTION_REAL_DATA or put shared/real-data beside the "
+        pytest.skip(f"no real data at {KUKA_URDF}: set WBFRICTION_DATA or put shared/real-data beside the "
                     "checkout")
     return KUKA_URDF
 

@@ -197,7 +197,7 @@ def test_rows_of_a_clock_keep_the_whole_logs_times():
     assert clock.rows(0, 100).segments == [(0, 100)]
 
 
-@pytest.mark.skipif(not KUKA.is_dir(), reason=f"real KUKA logs not found at {KUKA} (set WBFRICTION_REAL_DATA)")
+@pytest.mark.skipif(not KUKA.is_dir(), reason=f"real KUKA logs not found at {KUKA} (set WBFRICTION_DATA)")
 @pytest.mark.parametrize("run", [1, 2, 3])
 def test_kuka_logs_are_receive_time_stamps(run):
     """The KUKA LWR4+ logs (epoch stamps, 3.2-6.8 ms steps around 5 ms): the positions are far
