@@ -1,10 +1,10 @@
-"""Estimate the joint friction of a log and fit the friction model (3.5) of every leg joint.
+"""Estimate the joint friction of a log and fit a friction model to every joint (chosen per joint on held-out data).
 
     python examples/estimate_a_log.py                 # simulates a short TALOS walk to have a log
     python examples/estimate_a_log.py walk.parquet    # or any log in the wbfriction format
 
 The friction table and the parameters JSON are written beside the log. Sign convention: ``tau_f`` is the
-torque friction exerts on the joint; the model f(qd) of eq. (3.5) is fitted to ``-tau_f``, so F_c, F_v > 0.
+torque friction exerts on the joint; the model f(qd) (e.g. eq. 3.5) is fitted to ``-tau_f``, so F_c, F_v > 0.
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def main() -> None:
     write_table(wbfriction.friction_table(estimate), folder / "friction.parquet")
     wbfriction.write_params(folder / "params.json", fits)
     legs = [j for frame in robot.contact_frames for j in robot.limb(frame)]
-    print(f"{len(log)} samples, {int(estimate.unique.sum())} in single support; fitted model (3.5) of the legs:")
+    print(f"{len(log)} samples, {int(estimate.unique.sum())} in single support; fitted models of the legs:")
     print(f"{'joint':20s} {'N':>6s} {'F_v':>18s} {'F_c':>18s} {'tau_os':>18s}   (value ± standard error)")
     for fit in fits:
         if fit.joint in legs and fit.params is not None:

@@ -205,18 +205,23 @@ def test_simulate_on_mujoco_with_sensors_from_toml(talos, tmp_path):
     assert_one_line_error(run("simulate", "--simulator", "mujoco", "--steps", "1", "-o", bad, "--delay", "0.5"),
                            "must be a multiple of the control period")
     assert_one_line_error(run("simulate", "--simulator", "mujoco", "--steps", "1", "-o", bad, "--mujoco-friction",
-                               "coulomb"), "friction must be one of model, mujoco")
+                               "coulomb"), "'--mujoco-friction'")
     assert not bad.exists()
 
 
 def test_companion_scheme_only_on_request(talos, demo_dir, tmp_path):
     """estimate writes Fig. 7.4's companion difference only with --companion, then equal to the library's
-    (estimate_log(companion=True)); without it, a savgol window the companion would need is not asked for."""
+    (estimate_log(companion=True)); a filter option that is not valid is refused even where the scheme would not
+    use it (checked before any work), and one given with --diff auto is refused rather than dropped."""
     from wbfriction.friction.estimate import estimate_log
     from wbfriction.friction.options import EstimateOptions
 
     out, _ = demo_dir
-    res = run("estimate", out / "log.parquet", "-o", tmp_path / "plain.parquet", "--diff", "central", "--window", "4")
+    assert_one_line_error(run("estimate", out / "log.parquet", "-o", tmp_path / "plain.parquet", "--diff", "central",
+                              "--window", "4"), "--window must be odd and at least 3, got 4")
+    assert_one_line_error(run("estimate", out / "log.parquet", "-o", tmp_path / "plain.parquet", "--poly-order", "3"),
+                          "--poly-order must be given with --diff savgol or butterworth")
+    res = run("estimate", out / "log.parquet", "-o", tmp_path / "plain.parquet", "--diff", "central")
     assert res.returncode == 0, res.stderr
     assert not [c for c in pq.read_table(tmp_path / "plain.parquet").column_names if "companion" in c]
     res = run("estimate", out / "log.parquet", "-o", tmp_path / "both.parquet", "--diff", "central", "--companion")
@@ -226,3 +231,27 @@ def test_companion_scheme_only_on_request(talos, demo_dir, tmp_path):
     for i, j in enumerate(est.joints):
         np.testing.assert_allclose(table.column(f"delta_qdd_companion.{j}").to_numpy(), est.companion_delta_qdd[:, i],
                                    rtol=0, atol=1e-9, err_msg=j)
+
+
+def test_api_and_cli_give_the_same_friction_table_and_fits_with_their_defaults(talos, demo_dir):
+    """One log, one result, whatever the entry point (issue 39): ``estimate_log`` + ``fit_estimate`` with their
+    defaults give the friction table (every column, every value) and the fitted parameters that ``wbfriction
+    estimate`` and ``wbfriction fit`` wrote with theirs; only the provenance in the file's metadata differs."""
+    from wbfriction.friction.estimate import estimate_log
+    from wbfriction.friction.fit import fit_estimate
+    from wbfriction.friction.io import friction_table, read_params
+
+    out, _ = demo_dir
+    est = estimate_log(talos, read_log(out / "log.parquet", talos))
+    api = friction_table(est).replace_schema_metadata(None)
+    cli = pq.read_table(out / "friction.parquet").replace_schema_metadata(None)
+    assert api.column_names == cli.column_names and api.schema == cli.schema
+    for name in api.column_names:  # value for value, NaN where NaN
+        np.testing.assert_array_equal(api.column(name).to_numpy(zero_copy_only=False),
+                                      cli.column(name).to_numpy(zero_copy_only=False), err_msg=name)
+    params = read_params(out / "params.json")
+    fits = fit_estimate(est)
+    assert [f.joint for f in fits] == list(params)
+    for f in fits:
+        back = params[f.joint]
+        assert (f.model, f.params, f.verdict().status) == (back.model, back.params, back.verdict().status)

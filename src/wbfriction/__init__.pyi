@@ -6,6 +6,7 @@ from .exceptions import ClusterError as ClusterError
 from .exceptions import ColumnError as ColumnError
 from .exceptions import InputError as InputError
 from .exceptions import ModelError as ModelError
+from .exceptions import OptionError as OptionError
 from .exceptions import OutputError as OutputError
 from .exceptions import SimulationError as SimulationError
 from .exceptions import WbfrictionError as WbfrictionError
@@ -22,6 +23,7 @@ from .friction.io import read_params as read_params
 from .friction.io import write_params as write_params
 from .friction.models import FrictionParams as FrictionParams
 from .friction.options import EstimateOptions as EstimateOptions
+from .friction.options import FitOptions as FitOptions
 from .friction.status import FitVerdict as FitVerdict
 from .logs.log import Log as Log
 from .logs.log import write_log as write_log

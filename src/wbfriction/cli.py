@@ -25,29 +25,31 @@ from rich.table import Table
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError, WbfrictionError
-from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, EstimateOptions, MomentumOptions
-from wbfriction.inertia.options import InertialOptions
-from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
+from wbfriction.friction.options import (
+    DEFAULT_THRESHOLD,
+    DEFAULT_TOLERANCE,
+    BaseMotion,
+    EstimateOptions,
+    FitOptions,
+    Method,
+    ModelChoice,
+    MomentumOptions,
+    RouteOption,
+)
+from wbfriction.inertia.options import ArmatureMode, InertialOptions, InertiaPart
+from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP, TimeBase, TimeUnit
 from wbfriction.model.robots import BUILTIN_ROBOTS
 from wbfriction.pipeline.paths import check_paths
-from wbfriction.signals.options import FilterOptions
-from wbfriction.sim.options import IdealOptions, MujocoOptions, SensorNoise
+from wbfriction.signals.options import AlignmentOption, Diff, DiffOption, FilterOptions, Mask, SavgolWeights, Velocity
+from wbfriction.sim.options import FrictionMode, IdealOptions, Integrator, MujocoOptions, SensorNoise, Simulator
 from wbfriction.version import __version__
-from wbfriction.walking.options import GaitOptions
+from wbfriction.walking.options import Gait, GaitOptions
 
 if TYPE_CHECKING:
-    from wbfriction.friction.fit import FitResult, ModelChoice
-    from wbfriction.friction.options import BaseMotion, Method, RouteOption
-    from wbfriction.inertia.options import ArmatureMode
-    from wbfriction.logs.clock import TimeBase, TimeUnit
+    from wbfriction.friction.fit import FitResult
     from wbfriction.model.robot import Robot
     from wbfriction.pipeline.estimate import RobotSpec
-    from wbfriction.signals.filters import SavgolWeights
-    from wbfriction.signals.kinematics import Diff, TorqueAlignment, Velocity
-    from wbfriction.signals.phases import Mask
     from wbfriction.sim.arm import ArmOptions
-    from wbfriction.sim.options import FrictionMode, Integrator
-    from wbfriction.walking.options import Gait
 
 # rich_markup_mode=None: click's plain help, so that units in brackets ([m], [rad/s], [friction.<group>]) are
 # printed as written (Rich markup would take them for tags and delete them)
@@ -183,11 +185,6 @@ def _warn(warnings) -> None:
         console.print(f"[yellow]warning:[/] {escape(w)}", highlight=False, soft_wrap=True)
 
 
-def _time_unit(unit: Optional[str]) -> TimeUnit | None:
-    """``--time-unit`` as given (checked where the stamps are read, :func:`~wbfriction.logs.clock.table_stamps`)."""
-    return cast("TimeUnit | None", unit)
-
-
 def _warn_energy(energy) -> None:
     """Print the energy-consistency warnings (eq. 7.9) of the flagged joints."""
     for e in energy:
@@ -214,13 +211,12 @@ _G = GaitOptions()
 _I = IdealOptions()
 _M = MujocoOptions()
 _N = InertialOptions()
-SIMULATORS = ("ideal", "mujoco")
-_MIN_SAMPLES = 20
-
-
-def _check_simulator(simulator: str) -> None:
-    if simulator not in SIMULATORS:
-        raise InputError(f"--simulator must be one of {', '.join(SIMULATORS)}, got '{simulator}'")
+_FIT = FitOptions()
+MinSamplesOpt = typer.Option(_FIT.min_samples, min=1, help="Joints with fewer valid samples are not fitted.")
+ModelOpt = typer.Option(_FIT.model, "--model", help="Friction model per joint: auto (the simplest whose held-out RMS "
+                                                    "is within --selection-tolerance of the best), coulomb-viscous "
+                                                    "(3.1 + 3.2), stribeck (3.3 + 3.2) or thesis (3.5); each with "
+                                                    "an offset tau_os.")
 
 
 def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptions | MujocoOptions,
@@ -314,12 +310,11 @@ def _print_cross_check(friction: Path) -> None:
                       f"{escape(c.cause)}", highlight=False, soft_wrap=True)
 
 
-def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, tolerance: float,
-             workers: int, model: ModelChoice = "auto", selection_tolerance: float = 0.02) -> None:
+def _run_fit(friction: Path, output: Path, options: FitOptions, threshold: float, tolerance: float,
+             workers: int) -> None:
     from wbfriction.pipeline.fit import fit_file
 
-    fitted = fit_file(friction, output, min_samples=min_samples, threshold=threshold, tolerance=tolerance,
-                      workers=workers, model=model, selection_tolerance=selection_tolerance)
+    fitted = fit_file(friction, output, options, threshold=threshold, tolerance=tolerance, workers=workers)
     out.print(_fit_rows(fitted.fits))
     _print_verdicts(fitted.fits)
     for r in fitted.fits:
@@ -333,7 +328,7 @@ def _run_fit(friction: Path, output: Path, min_samples: int, threshold: float, t
 def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write: .parquet, .csv or .h5."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              mjcf: Optional[Path] = MjcfOpt,
-             gait: str = typer.Option(_G.gait, help="forward, sideways, turning, both (forward + sideways) or "
+             gait: Gait = typer.Option(_G.gait, help="forward, sideways, turning, both (forward + sideways) or "
                                                     "combined (all three)."),
              steps: int = typer.Option(_G.steps, help="Number of steps (per direction for both/combined)."),
              step_length: float = typer.Option(_G.step_length, help="Forward distance between footprints [m]."),
@@ -343,12 +338,12 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              friction: Optional[Path] = typer.Option(None, help="TOML with [friction.<group or joint>] tables (a "
                                                                "model key: coulomb-viscous, stribeck or (3.5)); "
                                                                "default: thesis Table 6.1 on the legs."),
-             simulator: str = typer.Option("ideal", help="ideal (rigid contacts, thesis 6.1) or mujoco (soft "
+             simulator: Simulator = typer.Option("ideal", help="ideal (rigid contacts, thesis 6.1) or mujoco (soft "
                                                          "contacts, measured contact flags, sensors, thesis 6.2)."),
              substeps: Optional[int] = typer.Option(None, help=f"Physics steps per 1 ms control period (default: "
                                                               f"{_I.substeps} ideal, {_M.substeps} mujoco)."),
-             integrator: str = typer.Option(_I.integrator, help="ideal: semi-implicit or explicit Euler."),
-             mujoco_friction: str = typer.Option(_M.friction, help="mujoco: model (eq. 3.5 as a joint torque) "
+             integrator: Integrator = typer.Option(_I.integrator, help="ideal: semi-implicit or explicit Euler."),
+             mujoco_friction: FrictionMode = typer.Option(_M.friction, help="mujoco: model (eq. 3.5 as a joint torque) "
                                                                    "or mujoco (MuJoCo's frictionloss = F_c, damping "
                                                                    "= F_v)."),
              sensors: Optional[Path] = typer.Option(None, help="mujoco: TOML with a [sensors] table (position_std, "
@@ -394,12 +389,11 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                          position_std=position_noise or 0.0, torque_std=torque_noise or 0.0, seed=noise_seed or 0)
         _run_simulate_arm(r, output, arm, friction)
         return
-    gait_opts = GaitOptions(gait=cast("Gait", gait), steps=steps, step_length=step_length, step_width=step_width,
+    gait_opts = GaitOptions(gait=gait, steps=steps, step_length=step_length, step_width=step_width,
                             turn_angle=turn_angle, lift_height=lift_height)
-    _check_simulator(simulator)
     options: IdealOptions | MujocoOptions
     if simulator == "ideal":
-        options = IdealOptions(substeps=substeps or _I.substeps, integrator=cast("Integrator", integrator),
+        options = IdealOptions(substeps=substeps or _I.substeps, integrator=integrator,
                                log_base=log_base, force_torque=force_torque, imu=force_torque)
     else:
         table = load_sensors_toml(sensors) if sensors is not None else {}
@@ -407,7 +401,7 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                  "seed": noise_seed, "delay": None if delay is None else delay * 1e-3}
         table.update({k: v for k, v in given.items() if v is not None})
         lag = float(table.pop("delay", 0.0))
-        options = MujocoOptions(substeps=substeps or _M.substeps, friction=cast("FrictionMode", mujoco_friction),
+        options = MujocoOptions(substeps=substeps or _M.substeps, friction=mujoco_friction,
                                 sensors=SensorNoise(**table), delay=lag, log_base=log_base,
                                 sole_timeconst=sole_timeconst, friction_timeconst=friction_timeconst,
                                 torque_drift=torque_drift, ft_offset=ft_offset)
@@ -426,19 +420,19 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                                                        "each gets at least 4 chunks)."),
              chunk_rows: int = typer.Option(10_000, min=200, help="Rows per chunk (cut at the next contact "
                                                                    "change)."),
-             diff: str = typer.Option("auto", help="Differentiation: auto (scheme and window chosen from the "
+             diff: DiffOption = typer.Option("auto", help="Differentiation: auto (scheme and window chosen from the "
                                                    "positions' noise, printed), central (6.2), backward (6.3), "
                                                    "savgol (Savitzky-Golay, 7.1.1), butterworth (7.1.2) or true."),
              window: int = typer.Option(_F.window, help="savgol: window length L (odd, at least 3) [samples]."),
              poly_order: int = typer.Option(_F.poly_order, help="savgol: polynomial order k (at least 2, below L)."),
-             weights: str = typer.Option(_F.weights, help="savgol: uniform or gaussian weights."),
+             weights: SavgolWeights = typer.Option(_F.weights, help="savgol: uniform or gaussian weights."),
              cutoff: float = typer.Option(_F.cutoff, help="butterworth: cutoff [Hz] (see 'wbfriction spectrum')."),
              butter_order: int = typer.Option(_F.butter_order, min=1, help="butterworth: filter order."),
              delay_compensation: bool = typer.Option(_E.compensate_delay,
                                                      help="Shift derivatives by their delay (6.1.2)."),
-             torque_alignment: str = typer.Option(_E.torque_alignment,
+             torque_alignment: AlignmentOption = typer.Option(_E.torque_alignment,
                                                   help="zoh: mean of tau[k-1], tau[k]; sample: tau[k]."),
-             mask: str = typer.Option(_E.mask, help="swing: leg joints only while their leg swings; single."),
+             mask: Mask = typer.Option(_E.mask, help="swing: leg joints only while their leg swings; single."),
              lift_off: float = typer.Option(_E.lift_off_skip, min=0.0, help="Seconds dropped after a lift-off."),
              touch_down: float = typer.Option(_E.touch_down_skip, min=0.0, help="Seconds dropped before a "
                                                                                 "touch-down."),
@@ -447,17 +441,17 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                                                      help="Lambda of the double-support problem (6.1)."),
              cond: bool = typer.Option(_E.condition_number, "--cond",
                                        help="Report cond(M_mod^-1) per sample (slower)."),
-             method: str = typer.Option(_E.method, help="Single-support route: rnea (fast) or kkt "
+             method: Method = typer.Option(_E.method, help="Single-support route: rnea (fast) or kkt "
                                                         "(5.10-5.13)."),
-             time_base: str = TimeBaseOpt, time_unit: Optional[str] = TimeUnitOpt,
-             velocity: str = typer.Option(_E.velocity, help="Joint velocities: differentiated (by --diff) or "
+             time_base: TimeBase = TimeBaseOpt, time_unit: Optional[TimeUnit] = TimeUnitOpt,
+             velocity: Velocity = typer.Option(_E.velocity, help="Joint velocities: differentiated (by --diff) or "
                                                             "logged (the log's qd.<joint> columns; their lag "
                                                             "is measured and printed)."),
              companion: bool = typer.Option(False, "--companion",
                                             help="Also write delta_qdd_companion.<joint>: the acceleration "
                                                  "difference through the other kind of scheme, for the report's "
                                                  "Fig. 7.4 (one more pass)."),
-             base_motion: str = typer.Option(_E.base_motion, help="Base motion: contact (rigid stance foot, "
+             base_motion: BaseMotion = typer.Option(_E.base_motion, help="Base motion: contact (rigid stance foot, "
                                                                   "thesis 5.4), logged (the base.* pose "
                                                                   "differentiated like the joints), imu (the "
                                                                   "imu.* gyro and accelerometer, the base.q* "
@@ -466,26 +460,26 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
              wrenches: bool = typer.Option(_E.wrenches, help="Use the force-torque sensors' wrench.<sensor>.* "
                                                              "columns where logged: every joint's friction in "
                                                              "every phase."),
-             route: str = RouteOpt, velocity_window: Optional[int] = VelocityWindowOpt,
+             route: RouteOption = RouteOpt, velocity_window: Optional[int] = VelocityWindowOpt,
              momentum_window: Optional[int] = MomentumWindowOpt) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
     from wbfriction.pipeline.estimate import RobotSpec
 
     check_paths({"LOG": log, "--map": bag_map, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
-    opts = EstimateOptions(diff=cast("Diff | Literal['auto']", diff), compensate_delay=delay_compensation,
-                           torque_alignment=cast("TorqueAlignment", torque_alignment), mask=cast("Mask", mask),
+    opts = EstimateOptions(diff=diff, compensate_delay=delay_compensation,
+                           torque_alignment=torque_alignment, mask=mask,
                            lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
-                           ds_regularization=ds_regularization, condition_number=cond, method=cast("Method", method),
-                           velocity=cast("Velocity", velocity), base_motion=cast("BaseMotion", base_motion),
-                           wrenches=wrenches, route=cast("RouteOption", route),
+                           ds_regularization=ds_regularization, condition_number=cond, method=method,
+                           velocity=velocity, base_motion=base_motion,
+                           wrenches=wrenches, route=route,
                            momentum=MomentumOptions(velocity_window, momentum_window),
                            filtering=FilterOptions(window=window, poly_order=poly_order,
-                                                   weights=cast("SavgolWeights", weights),
+                                                   weights=weights,
                                                    cutoff=cutoff, butter_order=butter_order))
     spec = RobotSpec(None if config else robot, None if urdf is None else str(urdf),
                      None if config is None else str(config), None if mjcf is None else str(mjcf))
     _run_estimate(_robot(robot, urdf, config, mjcf), spec, log, output, opts, bag_map, max_gap, limit_margin, workers,
-                  chunk_rows, cast("TimeBase", time_base), _time_unit(time_unit), companion)
+                  chunk_rows, time_base, time_unit, companion)
 
 
 @app.command()
@@ -514,21 +508,17 @@ def convert(bag: Path = typer.Argument(..., metavar="BAG", help="ROS 2 bag (fold
 @app.command()
 def fit(friction: Path = FrictionArg,
         output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
-        min_samples: int = typer.Option(_MIN_SAMPLES, min=1, help="Joints with fewer valid samples are not fitted."),
+        min_samples: int = MinSamplesOpt,
         energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt,
-        workers: int = FitWorkersOpt,
-        model: str = typer.Option("auto", "--model", help="Friction model per joint: auto (the simplest whose "
-                                                          "held-out RMS is within --selection-tolerance of the "
-                                                          "best), coulomb-viscous (3.1 + 3.2), stribeck (3.3 + "
-                                                          "3.2) or thesis (3.5); each with an offset tau_os."),
-        selection_tolerance: float = typer.Option(0.02, min=0.0, help="With --model auto: relative excess of "
-                                                                      "held-out RMS within which the simpler model "
-                                                                      "is chosen.")) -> None:
+        workers: int = FitWorkersOpt, model: ModelChoice = ModelOpt,
+        selection_tolerance: float = typer.Option(_FIT.selection_tolerance, min=0.0,
+                                                  help="With --model auto: relative excess of held-out RMS within "
+                                                       "which the simpler model is chosen.")) -> None:
     """Identify a friction model of every joint, with standard errors and the parameters left
     at a bound; warn about joints whose friction generates power (eq. 7.9)."""
     check_paths({"FRICTION": friction}, {"-o": output})
-    _run_fit(friction, output, min_samples, energy_threshold, energy_tolerance, workers,
-             cast("ModelChoice", model), selection_tolerance)
+    _run_fit(friction, output, FitOptions(model=model, selection_tolerance=selection_tolerance,
+                                          min_samples=min_samples), energy_threshold, energy_tolerance, workers)
 
 
 @app.command()
@@ -623,31 +613,29 @@ def sensitivity(log: Path = LogArg,
                 robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
                 mjcf: Optional[Path] = MjcfOpt,
                 factors: str = typer.Option("0.9,0.95,1.05,1.1", help="Comma-separated inertia scaling factors."),
-                part: str = typer.Option("all", help="all (the whole 6x6 inertia), mass or rotational (its mass or "
-                                                     "principal-moment eigenvalues only)."),
+                part: InertiaPart = typer.Option("all", help="all (the whole 6x6 inertia), mass or rotational (its "
+                                                             "mass or principal-moment eigenvalues only)."),
                 joints: Optional[str] = typer.Option(None, help="Comma-separated joints to plot (default: the "
                                                                 "legs' joints)."),
-                diff: str = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
-                mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate')."),
-                route: str = RouteOpt,
-                time_unit: Optional[str] = TimeUnitOpt) -> None:
+                diff: DiffOption = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
+                mask: Mask = typer.Option(_E.mask, help="swing or single (see 'estimate')."),
+                route: RouteOption = RouteOpt,
+                time_unit: Optional[TimeUnit] = TimeUnitOpt) -> None:
     """Re-run the estimate with every body's inertia scaled (thesis 7.2, Fig. 7.5/7.6): how the
     friction curves shift (mass) and split into branches (rotational inertia)."""
-    from wbfriction.inertia.sensitivity import PARTS, InertiaPart, inertia_sensitivity, parse_factors
+    from wbfriction.inertia.sensitivity import inertia_sensitivity, parse_factors
     from wbfriction.logs.source import read_log
     from wbfriction.report.figures import save_png, sensitivity_figure
 
     check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
-    if part not in PARTS:
-        raise InputError(f"--part must be one of {', '.join(PARTS)}, got '{part}'")
     values = parse_factors(factors)
     r = _robot(robot, urdf, config, mjcf)
-    data = read_log(log, r, time_unit=_time_unit(time_unit))
+    data = read_log(log, r, time_unit=time_unit)
     _warn(data.warnings)
-    opts = EstimateOptions(diff=cast("Diff | Literal['auto']", diff), mask=cast("Mask", mask),
-                           route=cast("RouteOption", route))
+    opts = EstimateOptions(diff=diff, mask=mask,
+                           route=route)
     with console.status("") as status:
-        sens = inertia_sensitivity(r, data, values, cast(InertiaPart, part), opts, progress=status.update)
+        sens = inertia_sensitivity(r, data, values, part, opts, progress=status.update)
     names = _joint_list(r, joints)
     with console.status("fitting the offsets of the model as given"):
         tau_os = sens.reference_offsets(names)
@@ -743,16 +731,16 @@ def identify(log: Path = LogArg,
                                                                           "model, in units of the residual variance; "
                                                                           "default: chosen by validation from 1e4 "
                                                                           "down to 1."),
-             armature: str = typer.Option(_N.armature, help="Rotor inertia: known (the TOML's [armature]), "
+             armature: ArmatureMode = typer.Option(_N.armature, help="Rotor inertia: known (the TOML's [armature]), "
                                                             "identify (one per joint, with the friction; for "
                                                             "motor-current torques) or none (link-side "
                                                             "torque sensors)."),
              tanh_slope: float = typer.Option(_N.tanh_slope, min=1e-12,
                                               help="a of the Coulomb term tanh(a qd) [s/rad]."),
-             diff: str = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
-             mask: str = typer.Option(_E.mask, help="swing or single (see 'estimate')."),
-             route: str = RouteOpt,
-             workers: int = FitWorkersOpt, time_unit: Optional[str] = TimeUnitOpt) -> None:
+             diff: DiffOption = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
+             mask: Mask = typer.Option(_E.mask, help="swing or single (see 'estimate')."),
+             route: RouteOption = RouteOpt,
+             workers: int = FitWorkersOpt, time_unit: Optional[TimeUnit] = TimeUnitOpt) -> None:
     """Identify the inertia model and the friction together from the joint torques of single
     support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
     with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
@@ -770,13 +758,13 @@ def identify(log: Path = LogArg,
     r = _robot(robot, urdf, config, mjcf)
     r.require_urdf("identify (it writes the corrected URDF)")
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior,
-                           armature=cast("ArmatureMode", armature))
+                           armature=armature)
     with console.status("") as status:
-        estimate_options = EstimateOptions(diff=cast("Diff | Literal['auto']", diff), mask=cast("Mask", mask),
-                                           route=cast("RouteOption", route))
+        estimate_options = EstimateOptions(diff=diff, mask=mask,
+                                           route=route)
         done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
                              options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers,
-                             time_unit=_time_unit(time_unit))
+                             time_unit=time_unit)
     doc, moved = done.document, done.moved
     for p in doc["passes"]:
         vs = "none" if p["stribeck_velocity"] is None else f"{p['stribeck_velocity']:.4g} rad/s"
@@ -878,7 +866,7 @@ def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
 def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--output-dir", help="Where to write."),
          robot: str = RobotOpt,
          steps: int = typer.Option(_G.steps, help="Steps per direction of the combined walk."),
-         simulator: str = typer.Option("ideal", help="ideal: Tables 6.1/6.2, Fig. 6.1-6.3; mujoco: the realistic "
+         simulator: Simulator = typer.Option("ideal", help="ideal: Tables 6.1/6.2, Fig. 6.1-6.3; mujoco: the realistic "
                                                      "simulator's study, Fig. 6.4-6.5.")) -> None:
     """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.5."""
     from wbfriction.friction.models import PARAM_NAMES
@@ -886,7 +874,6 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
     from wbfriction.studies.simulation import run_study
 
     start = time.perf_counter()
-    _check_simulator(simulator)
     r = _robot(robot, None, None)
     if simulator == "mujoco":
         for f in _demo_mujoco(output_dir, r, steps):
@@ -921,7 +908,7 @@ def spectrum(log: Path = LogArg,
                                                              "else every torque-controlled one)."),
              tail: float = typer.Option(0.01, min=0.0, max=1.0, help="Share of the power (above the noise floor) "
                                                                      "left above the suggested cutoff."),
-             time_unit: Optional[str] = TimeUnitOpt) -> None:
+             time_unit: Optional[TimeUnit] = TimeUnitOpt) -> None:
     """The estimated acceleration's spectrum and the Butterworth cutoff it suggests (thesis Fig. 7.1)."""
     from wbfriction.logs.source import read_log
     from wbfriction.report.figures import spectrum_figure
@@ -929,7 +916,7 @@ def spectrum(log: Path = LogArg,
 
     check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
     r = _robot(robot, urdf, config, mjcf)
-    data = read_log(log, r, time_unit=_time_unit(time_unit))
+    data = read_log(log, r, time_unit=time_unit)
     _warn(data.warnings)
     names = _joint_list(r, joints)
     with _progress(len(data), "dynamics") as advance:
@@ -957,14 +944,14 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
                                                   help="Where to write."),
                   robot: str = RobotOpt,
                   steps: int = typer.Option(3, min=1, help="Steps per direction of the combined walk."),
-                  diff: str = typer.Option("central", help="Differentiation: central, savgol, butterworth or true."),
+                  diff: Diff = typer.Option("central", help="Differentiation: central, savgol, butterworth or true."),
                   window: int = typer.Option(151, help="savgol: window length L (odd) [samples]."),
                   noise: bool = typer.Option(False, "--noise", help="The studies' sensor noise in the loop (1e-4 "
                                                                     "rad, 19-bit encoders, 0.05 N·m torques)."),
                   substeps: Optional[int] = typer.Option(None, min=1,
                                                          help="MuJoCo physics steps per 1 ms control period "
                                                               "(default 16: friction lags half a step)."),
-                  route: str = RouteOpt) -> None:
+                  route: RouteOption = RouteOpt) -> None:
     """What the ankle force-torque sensors and the base pose change, on MuJoCo's soft contacts (issue 23)."""
     from wbfriction.studies.realistic import NOISE
     from wbfriction.studies.sensors import SUBSTEPS, run_sensors_study, sensors_markdown
@@ -973,10 +960,10 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
     if not r.ft_sensors:
         raise InputError(f"--robot {robot}: the robot has no force-torque sensors ([force_torque.<name>] in its TOML)")
     with console.status("") as status:
-        result = run_sensors_study(r, output_dir, steps=steps, diff=cast("Diff", diff),
+        result = run_sensors_study(r, output_dir, steps=steps, diff=diff,
                                    filtering=FilterOptions(window=window), noise=NOISE if noise else SensorNoise(),
                                    substeps=substeps or SUBSTEPS, progress=lambda label: status.update(label),
-                                   route=cast("RouteOption", route))
+                                   route=route)
     out.print(escape(sensors_markdown(result)), highlight=False, soft_wrap=True)
     for f in result.files:
         console.print(f"wrote {f}")
@@ -1107,25 +1094,19 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
           tables: Optional[Path] = typer.Option(None, "--tables",
                                                 help="Also keep each log's friction table in this folder "
                                                      "(TABLES/<robot_id>/<key>.parquet)."),
-          diff: str = typer.Option("auto", help="Differentiation, as 'wbfriction estimate --diff' (a manifest's "
-                                                "diff column overrides it per log)."),
-          model: str = typer.Option("auto", help="Friction model, as 'wbfriction fit --model' (a manifest's model "
-                                                 "column overrides it per log)."),
-          min_samples: int = typer.Option(20, min=1, help="Joints with fewer valid samples get no parameters.")
-          ) -> None:
+          diff: DiffOption = typer.Option(_E.diff, help="Differentiation, as 'wbfriction estimate --diff' (a "
+                                                        "manifest's diff column overrides it per log)."),
+          model: ModelChoice = typer.Option(_FIT.model, help="Friction model, as 'wbfriction fit --model' (a "
+                                                             "manifest's model column overrides it per log)."),
+          min_samples: int = MinSamplesOpt) -> None:
     """Estimate, fit and check every log of a fleet on Dask, into one results dataset (exit status 1 when a log
     failed: it is listed, the others are done)."""
     from wbfriction.fleet.batch import check_outputs, quiet_dask_logs, run_batch
-    from wbfriction.fleet.manifest import DIFF_CHOICES, read_manifest, scan_folder
+    from wbfriction.fleet.manifest import read_manifest, scan_folder
     from wbfriction.fleet.options import BatchOptions
     from wbfriction.fleet.results import failures_folder
-    from wbfriction.friction.fit import MODEL_CHOICES
     from wbfriction.pipeline.estimate import RobotSpec
 
-    if diff not in DIFF_CHOICES:
-        raise InputError(f"--diff must be one of {', '.join(DIFF_CHOICES)}, got '{diff}'")
-    if model not in MODEL_CHOICES:
-        raise InputError(f"--model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
     check_paths({"MANIFEST": source}, {})
     check_outputs(output, tables)
     quiet_dask_logs()  # its faults are said here, one line each
@@ -1139,8 +1120,7 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
         entries = scan.entries
     else:
         entries = read_manifest(source)
-    options = BatchOptions(estimate=EstimateOptions(diff=cast("Diff", diff)), model=cast("ModelChoice", model),
-                           min_samples=min_samples)
+    options = BatchOptions(estimate=EstimateOptions(diff=diff), fit=FitOptions(model=model, min_samples=min_samples))
     with Progress(TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console,
                   transient=True, disable=not console.is_terminal) as bar:
         task = bar.add_task("batch", total=len(entries))

@@ -11,7 +11,7 @@ the CLI prints their one line and exits with status 1 (each class's :attr:`~Wbfr
 
 from __future__ import annotations
 
-__all__ = ["WbfrictionError", "InputError", "ColumnError", "OutputError", "ClusterError", "ModelError",
+__all__ = ["WbfrictionError", "InputError", "OptionError", "ColumnError", "OutputError", "ClusterError", "ModelError",
            "SimulationError"]
 
 
@@ -27,6 +27,25 @@ class WbfrictionError(Exception):
 
 class InputError(WbfrictionError, ValueError):
     """Bad user input: the message names the file, column, row or option at fault."""
+
+
+class OptionError(InputError):
+    """An option's value refused, before any work: one of its choices or its range expected.
+
+    Attributes:
+        option: the option as the command line spells it, e.g. ``--diff`` (the options field ``diff``).
+        value: the value given.
+        expected: what the option takes, e.g. ``one of central, backward, savgol``.
+    """
+
+    def __init__(self, option: str, value: object, expected: str):
+        self.option = option
+        self.value = value
+        self.expected = expected
+        super().__init__(f"{option} must be {expected}, got {value!r}")
+
+    def __reduce__(self):  # picklable across worker processes, with its data
+        return (type(self), (self.option, self.value, self.expected))
 
 
 class ColumnError(InputError):

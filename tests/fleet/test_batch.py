@@ -21,6 +21,7 @@ from wbfriction.fleet.manifest import read_manifest
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.results import read_failures, read_results
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, speed_column
+from wbfriction.friction.options import FitOptions
 
 
 def _files(results: Path) -> dict[str, bytes]:
@@ -97,7 +98,7 @@ def test_a_batch_resumes_and_skips_what_it_did(arm_fleet, tmp_path):
     assert (summary.processed, summary.skipped) == (2, 1)
     assert plan_batch(entries, tmp_path).todo == []
     # other options are another result: computed again
-    other = BatchOptions(model="coulomb-viscous")
+    other = BatchOptions(fit=FitOptions(model="coulomb-viscous"))
     assert len(plan_batch(entries, tmp_path, other).todo) == 3
 
 
@@ -206,8 +207,8 @@ def test_other_options_replace_the_earlier_rows(serial, arm_fleet, tmp_path):
     folder, _ = arm_fleet
     results = tmp_path / "results"
     shutil.copytree(serial, results)
-    summary = run_batch(read_manifest(folder / "manifest.csv")[:1], results, BatchOptions(model="coulomb-viscous"),
-                        engine="serial")
+    summary = run_batch(read_manifest(folder / "manifest.csv")[:1], results,
+                        BatchOptions(fit=FitOptions(model="coulomb-viscous")), engine="serial")
     assert summary.reasons == {"options changed": 1}
     table = read_results(results).table
     assert table.num_rows == 21 and len(set(table.column("key").to_pylist())) == 3

@@ -21,6 +21,7 @@ from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.results import read_results, rows_sha256
 from wbfriction.fleet.schema import RESULT_SCHEMA
 from wbfriction.fleet.task import LogOutcome
+from wbfriction.friction.options import FitOptions
 
 LOGS = ("a", "b", "c")
 """The logs; each has a copy of its bytes, ``<name>-copy.parquet``."""
@@ -30,15 +31,15 @@ MODELS = ("", "thesis", "stribeck", "coulomb-viscous")
 
 def fake_process_log(entry, key, options, scratch, table=None, executor=None, chunk_workers=1) -> LogOutcome:
     """Two joints' rows, a function of the key (log bytes, options); a ``stribeck`` fit always fails."""
-    if options.model == "stribeck":
+    if options.fit.model == "stribeck":
         return LogOutcome(entry, key, error=f"{entry.log}: cannot fit")
     rows: dict[str, list] = {name: [] for name in RESULT_SCHEMA.names}
     for joint in ("j0", "j1"):
         row = {name: float("nan") for name in RESULT_SCHEMA.names}
         row.update(robot_id=key.robot_id, log=key.log, start_time=key.start_time, key=key.key,
                    log_sha256=key.log_sha256, robot_sha256=key.robot_sha256, options_sha256=key.options_sha256,
-                   joint=joint, model=options.model, route="acceleration", status="ok", n_samples=100, version="test",
-                   F_c=int(key.log_sha256[:8], 16) / 1e9 + len(options.model), F_c_se=0.01)
+                   joint=joint, model=options.fit.model, route="acceleration", status="ok", n_samples=100, version="test",
+                   F_c=int(key.log_sha256[:8], 16) / 1e9 + len(options.fit.model), F_c_se=0.01)
         for name in RESULT_SCHEMA.names:
             rows[name].append(row[name])
     return LogOutcome(entry, key, pa.Table.from_pydict(rows, schema=RESULT_SCHEMA))
@@ -92,8 +93,8 @@ def test_any_sequence_of_runs_equals_one_run_of_the_last_manifest(runs, last):
                     raise Stop
 
             try:
-                run_batch(read_manifest(folder / "m.csv"), into, BatchOptions(model=model), engine="serial",
-                          progress=progress)
+                run_batch(read_manifest(folder / "m.csv"), into, BatchOptions(fit=FitOptions(model=model)),
+                          engine="serial", progress=progress)
             except Stop:
                 pass
 

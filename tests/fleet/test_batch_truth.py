@@ -27,6 +27,7 @@ from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.results import failures_folder, read_failures, read_results, result_path
 from wbfriction.fleet.schema import RESULT_SCHEMA
 from wbfriction.fleet.task import LogOutcome
+from wbfriction.friction.options import FitOptions
 from wbfriction.pipeline.estimate import RobotSpec
 
 DAY = datetime(2026, 3, 1, 8, tzinfo=UTC)
@@ -40,11 +41,11 @@ def fake_process_log(entry, key, options, scratch, table=None, executor=None, ch
                       chunk_workers=chunk_workers))
     if entry.log.name.startswith("crash"):
         raise RuntimeError("worker lost")
-    if options.model == "stribeck":
+    if options.fit.model == "stribeck":
         return LogOutcome(entry, key, error=f"{entry.log}: cannot fit")
     row = {name: float("nan") for name in RESULT_SCHEMA.names}
     row.update(robot_id=key.robot_id, log=key.log, start_time=key.start_time, key=key.key, log_sha256=key.log_sha256,
-               robot_sha256=key.robot_sha256, options_sha256=key.options_sha256, joint="j", model=options.model,
+               robot_sha256=key.robot_sha256, options_sha256=key.options_sha256, joint="j", model=options.fit.model,
                route="acceleration",
                status="ok", n_samples=1, version="test", F_c=float(Path(key.log).read_bytes()[0]))
     return LogOutcome(entry, key, pa.Table.from_pydict({k: [v] for k, v in row.items()}, schema=RESULT_SCHEMA),
@@ -99,10 +100,10 @@ def test_each_change_of_a_listed_log_is_computed_again_and_said(fleet):
     models["panda"] = "3" * 64
     plan = plan_batch(second, results)
     assert {p.reason for p in plan.todo} == {"robot model changed"} and len(plan.todo) == 3
-    plan = plan_batch(second[:1], results, BatchOptions(model="thesis"))
+    plan = plan_batch(second[:1], results, BatchOptions(fit=FitOptions(model="thesis")))
     assert [p.reason for p in plan.todo] == ["robot model changed, options changed"]
     models["panda"] = "1" * 64
-    plan = plan_batch(second[:1], results, BatchOptions(model="thesis"))
+    plan = plan_batch(second[:1], results, BatchOptions(fit=FitOptions(model="thesis")))
     assert [p.reason for p in plan.todo] == ["options changed"]
     plan = plan_batch([dataclasses.replace(second[0], start_time=DAY + timedelta(days=1, microseconds=1))], results)
     assert [p.reason for p in plan.todo] == ["start time corrected"]
@@ -141,7 +142,7 @@ def test_what_a_plan_removes_and_what_it_leaves(fleet):
     results, other = folder / "results", folder / "other"
     listed = [entry(folder, "a"), entry(folder, "b", row=1)]
     run_batch(listed, results, engine="serial")
-    run_batch(listed[:1], other, BatchOptions(model="thesis"), engine="serial")
+    run_batch(listed[:1], other, BatchOptions(fit=FitOptions(model="thesis")), engine="serial")
     (earlier,) = (other / "r1").glob("*.parquet")
     (results / "r1" / earlier.name).write_bytes(earlier.read_bytes())  # a's result with other options
     b_file = result_path(results, "r1", plan_batch(listed, results).skipped[1].key.key)
@@ -194,17 +195,17 @@ def test_the_tasks_get_their_key_options_and_table(fleet):
     results, tables = folder / "results", folder / "tables"
     listed = [entry(folder, "a", "r1", model="coulomb-viscous"), entry(folder, "b", "r2", row=1, diff="central")]
     seen = []
-    summary = run_batch(listed, results, BatchOptions(model="thesis"), engine="serial", tables=tables,
+    summary = run_batch(listed, results, BatchOptions(fit=FitOptions(model="thesis")), engine="serial", tables=tables,
                         progress=seen.append)
     assert [o.entry for o in seen] == listed and summary.processed == 2
     a, b = CALLS
-    assert a["options"].model == "coulomb-viscous" and b["options"].model == "thesis"
+    assert a["options"].fit.model == "coulomb-viscous" and b["options"].fit.model == "thesis"
     assert b["options"].estimate.diff == "central" and a["options"].estimate.diff == "auto"
     for call, robot_id in ((a, "r1"), (b, "r2")):
         assert call["scratch"] == results and call["executor"] is None
         assert call["table"] == tables / robot_id / f"{call['key'].key}.parquet" and call["table"].parent.is_dir()
         assert call["key"].robot_id == robot_id and call["key"].log == str(call["entry"].log)
-    run_batch(listed, results, BatchOptions(model="thesis"), engine="serial")
+    run_batch(listed, results, BatchOptions(fit=FitOptions(model="thesis")), engine="serial")
     assert len(CALLS) == 2  # done: no task
 
 

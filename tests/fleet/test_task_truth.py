@@ -32,7 +32,7 @@ from wbfriction.fleet.task import (
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import CoulombViscousParams, StribeckParams
-from wbfriction.friction.options import EstimateOptions
+from wbfriction.friction.options import EstimateOptions, FitOptions
 from wbfriction.pipeline.estimate import RobotSpec
 from wbfriction.version import __version__
 
@@ -59,14 +59,15 @@ def test_options_digest_canonical_json():
     canonical = json.dumps(dataclasses.asdict(options), sort_keys=True, default=str)
     assert options_sha256(options) == hashlib.sha256(canonical.encode()).hexdigest()
     assert options_sha256(BatchOptions()) == options_sha256(options)
-    others = [BatchOptions(model="thesis"), BatchOptions(chunk_rows=9999), BatchOptions(min_samples=21),
-              BatchOptions(estimate=EstimateOptions(diff="savgol")), BatchOptions(energy_threshold=0.3)]
+    others = [BatchOptions(fit=FitOptions(model="thesis")), BatchOptions(chunk_rows=9999),
+              BatchOptions(fit=FitOptions(min_samples=21)), BatchOptions(estimate=EstimateOptions(diff="savgol")),
+              BatchOptions(energy_threshold=0.3)]
     assert len({options_sha256(o) for o in [options, *others]}) == 6
 
 
 def test_a_key_is_made_of_the_entry_and_what_it_is_computed_from():
     entry = LogEntry(Path("/logs/a.parquet"), "007", KEY.start_time, RobotSpec("panda"))
-    options = BatchOptions(model="coulomb-viscous")
+    options = BatchOptions(fit=FitOptions(model="coulomb-viscous"))
     key = result_key(entry, "a" * 64, "b" * 64, options)
     assert key == ResultKey("007", KEY.start_time, "/logs/a.parquet", "a" * 64, "b" * 64, options_sha256(options))
 
@@ -186,8 +187,9 @@ def wiring(monkeypatch, tmp_path):
         if isinstance(calls.get("raise"), Exception):
             raise calls["raise"]
 
-    def fit_table(friction, **kwargs):
-        calls["fit"] = dict(friction=Path(friction), threads={i["num_threads"] for i in threadpool_info()}, **kwargs)
+    def fit_table(friction, options, **kwargs):
+        calls["fit"] = dict(friction=Path(friction), options=options,
+                            threads={i["num_threads"] for i in threadpool_info()}, **kwargs)
         fits, energy, qd, valid, _ = fits_and_samples()
         return SimpleNamespace(fits=fits, energy=energy, est=SimpleNamespace(qd=qd, valid=valid))
 
@@ -200,9 +202,9 @@ def wiring(monkeypatch, tmp_path):
 
 def test_a_task_hands_its_options_to_the_estimate_and_the_fit(wiring, tmp_path):
     calls, robot, entry = wiring
-    options = BatchOptions(estimate=EstimateOptions(diff="savgol", lift_off_skip=0.2), model="coulomb-viscous",
-                           selection_tolerance=0.05, min_samples=33, energy_threshold=0.3, energy_tolerance=0.02,
-                           chunk_rows=777)
+    options = BatchOptions(estimate=EstimateOptions(diff="savgol", lift_off_skip=0.2),
+                           fit=FitOptions(model="coulomb-viscous", selection_tolerance=0.05, min_samples=33),
+                           energy_threshold=0.3, energy_tolerance=0.02, chunk_rows=777)
     scratch = tmp_path / "scratch"
     scratch.mkdir()
     outcome = process_log(entry, KEY, options, scratch, chunk_workers=3)
@@ -211,8 +213,9 @@ def test_a_task_hands_its_options_to_the_estimate_and_the_fit(wiring, tmp_path):
         entry.robot, entry.log, options.estimate, robot, None)
     assert (est["chunking"].rows, est["chunking"].workers) == (777, 1)  # no executor: chunks in this process
     assert est["output"].parent.parent == scratch and fit["friction"] == est["output"]
-    assert {k: fit[k] for k in ("model", "selection_tolerance", "min_samples", "threshold", "tolerance")} == dict(
-        model="coulomb-viscous", selection_tolerance=0.05, min_samples=33, threshold=0.3, tolerance=0.02)
+    assert {k: fit[k] for k in ("options", "threshold", "tolerance")} == dict(
+        options=FitOptions(model="coulomb-viscous", selection_tolerance=0.05, min_samples=33), threshold=0.3,
+        tolerance=0.02)
     assert est["threads"] == fit["threads"] == {1}  # one BLAS thread, whatever the engine
     assert not outcome.failed and outcome.rows.num_rows == 2 and outcome.table is None
     assert outcome.rows.column("key").to_pylist() == [KEY.key] * 2

@@ -43,6 +43,7 @@ from wbfriction.friction.models import (
     model_jacobian,
     model_values,
 )
+from wbfriction.friction.options import FitOptions
 from wbfriction.friction.status import fit_verdict
 from wbfriction.signals.filters import SavgolSmoother
 
@@ -448,13 +449,14 @@ def test_fit_estimate_fits_every_joint_with_its_targets_and_options():
     est = FrictionEstimate(("a", "b"), T, qd, tau_f, valid, np.zeros(n, dtype=int), np.ones(n, dtype=bool),
                            np.ones((n, 1), dtype=bool), ("sole",), tau_f_true=truth,
                            metadata={"friction_true": {"a": FrictionParams(F_v=0.3, F_c=0.5).to_dict()}})
-    options = dict(delta_s=1.5, min_samples=3000, model="auto", selection_tolerance=0.1)
+    options = dict(delta_s=1.5, min_samples=3000, model="thesis", selection_tolerance=0.1)
     # no smoother: a sticking sample reaches one row either side (the central difference's stencil); no noise record
     expected = fit_joints(("a", "b"), qd, tau_f, valid, tau_f_true=truth, **options,
                           targets={"a": FrictionParams(F_v=0.3, F_c=0.5)}, stick_margin=1)
-    assert fit_estimate(est, **options) == expected
-    assert [f.params is None for f in fit_estimate(est, min_samples=3800)] == [False, True]
-    assert fit_estimate(est) == fit_joints(("a", "b"), qd, tau_f, valid, tau_f_true=truth,
+    assert fit_estimate(est, FitOptions(**options)) == expected
+    assert [f.params is None for f in fit_estimate(est, FitOptions(min_samples=3800))] == [False, True]
+    # the default is 'wbfriction fit's: the model chosen per joint on held-out data
+    assert fit_estimate(est) == fit_joints(("a", "b"), qd, tau_f, valid, tau_f_true=truth, model="auto",
                                            targets={"a": FrictionParams(F_v=0.3, F_c=0.5)}, stick_margin=1)
 
 

@@ -141,7 +141,7 @@ def test_the_route_and_its_windows_are_chosen_from_the_noise_and_said(panda):
     assert resolve_route(EstimateOptions(route="momentum", momentum=MomentumOptions(7, 9)), noisy)[1] is None
     with pytest.raises(InputError, match="--momentum-window must be odd"):
         MomentumOptions(window=10)
-    with pytest.raises(InputError, match="unknown route 'fast'"):
+    with pytest.raises(InputError, match="--route must be one of auto, acceleration, momentum, got 'fast'"):
         EstimateOptions(route="fast")  # type: ignore[arg-type]
 
 

@@ -21,7 +21,7 @@ from wbfriction.friction.energy import energy_consistency
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.fit import fit_estimate, fitted_offsets
 from wbfriction.friction.io import friction_table, read_friction_table
-from wbfriction.friction.options import EstimateOptions
+from wbfriction.friction.options import EstimateOptions, FitOptions
 from wbfriction.logs.log import Log, write_log
 from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import read_table, with_metadata, write_table
@@ -81,7 +81,7 @@ def _fit_or_refuse(path) -> None:
     """What ``fit`` and ``report`` do with a friction table before plotting."""
     try:
         est = read_friction_table(read_table(path), str(path))
-        fits = fit_estimate(est, min_samples=5)
+        fits = fit_estimate(est, FitOptions(min_samples=5))
         energy_consistency(est, fitted_offsets(fits))
     except InputError:
         pass
@@ -165,7 +165,7 @@ def test_the_friction_seed_is_fitted(seeds):
     for name in ("friction.parquet", "friction.csv", "friction.h5"):
         est = read_friction_table(read_table(seeds / name), name)
         assert est.joints == FITTED and est.valid.sum() > 40
-        fits = fit_estimate(est, min_samples=5)
+        fits = fit_estimate(est, FitOptions(min_samples=5))
         assert all(f.params is not None for f in fits)
         if name != "friction.csv":  # CSV has no place for the metadata (filter options, targets)
             assert est.smoother is not None and fits[0].target.F_c == 1.0

@@ -13,6 +13,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.friction.fit import STICK_FLOOR, fit_friction
 from wbfriction.friction.io import read_params
 from wbfriction.friction.models import CoulombViscousParams, StribeckParams
+from wbfriction.friction.options import FitOptions
 from wbfriction.logs.tables import write_table
 from wbfriction.pipeline.fit import fit_file
 
@@ -58,7 +59,7 @@ def test_auto_is_the_default_and_records_its_choice(table, tmp_path):
 
 def test_named_thesis_model_reports_its_bounds_as_the_library_fit_does(table, tmp_path):
     path, qd, cols = table
-    fit_file(path, tmp_path / "p.json", model="thesis")
+    fit_file(path, tmp_path / "p.json", FitOptions(model="thesis"))
     doc = json.loads((tmp_path / "p.json").read_text())
     knee = doc["joints"]["knee"]
     assert doc["model"] == "thesis" and "selection_tolerance" not in doc and "selection" not in knee
@@ -70,7 +71,7 @@ def test_named_thesis_model_reports_its_bounds_as_the_library_fit_does(table, tm
 def test_bad_model_options_are_one_line_errors_and_write_nothing(table, tmp_path):
     path, _, _ = table
     with pytest.raises(InputError, match="--model must be one of auto, coulomb-viscous, stribeck, thesis"):
-        fit_file(path, tmp_path / "p.json", model="lugre")
+        fit_file(path, tmp_path / "p.json", FitOptions(model="lugre"))  # type: ignore[arg-type]
     with pytest.raises(InputError, match="--selection-tolerance"):
-        fit_file(path, tmp_path / "p.json", selection_tolerance=-0.1)
+        fit_file(path, tmp_path / "p.json", FitOptions(selection_tolerance=-0.1))
     assert not (tmp_path / "p.json").exists()

@@ -83,7 +83,7 @@ def trained(urdf: Path, logs: dict[str, Path]) -> Trained:
     r = robot(urdf)
     train = estimate_log(r, log_from_table(pq.read_table(logs["runs12"]), r, "runs12"), OPTIONS)
     test = estimate_log(r, log_from_table(pq.read_table(logs["run3"]), r, "run3"), OPTIONS)
-    return Trained(r, train, {f.joint: f for f in fit_estimate(train, model="auto")}, test)
+    return Trained(r, train, {f.joint: f for f in fit_estimate(train)}, test)
 
 
 @pytest.fixture(scope="module")
@@ -215,7 +215,7 @@ def test_repeated_runs_agree_as_far_as_their_torques_do(logs, identified):
     function of velocity on these logs.)"""
     r = robot(identified)
     ests = [estimate_log(r, log_from_table(pq.read_table(logs[n]), r, n), OPTIONS) for n in ("run1", "run2")]
-    fits = [{f.joint: f.params for f in fit_estimate(e, model="auto")} for e in ests]
+    fits = [{f.joint: f.params for f in fit_estimate(e)} for e in ests]
     common = np.array([np.max([np.nanquantile(e.qd, 0.01, axis=0) for e in ests], axis=0),
                        np.min([np.nanquantile(e.qd, 0.99, axis=0) for e in ests], axis=0)])
     floor = measured_disagreement(common)

@@ -40,7 +40,7 @@ def estimate() -> FrictionEstimate:
 
 
 def test_png_bytes_are_a_png_and_the_same_for_the_same_figure(estimate):
-    fits = {f.joint: f for f in fit_estimate(estimate, min_samples=20)}
+    fits = {f.joint: f for f in fit_estimate(estimate)}
     one = png_bytes(joint_figure(estimate, "moving", fits["moving"], TRUE))
     two = png_bytes(joint_figure(estimate, "moving", fits["moving"], TRUE))
     assert one[:8] == b"\x89PNG\r\n\x1a\n"
@@ -67,7 +67,7 @@ def test_overview_marks_flagged_joints_each_on_its_own_axes(estimate):
 
 
 def test_files_are_written_whole(estimate, tmp_path):
-    fits = fit_estimate(estimate, min_samples=20)
+    fits = fit_estimate(estimate)
     friction_curves_figure(estimate, fits, tmp_path / "curves.png")
     assert (tmp_path / "curves.png").read_bytes()[:4] == b"\x89PNG"
     with pytest.raises(Exception, match="does not exist"):
@@ -87,7 +87,7 @@ def test_widest_run(mask, x, expected):
 def test_report_figures_are_readable_at_their_own_size(estimate):
     """The report's figures at 1400 px (shown at their own width, REPORT_WIDTH x REPORT_DPI px): every text at
     least 11 px high, no two texts overlapping (tick labels, titles, legends, axis labels), no offset text."""
-    fits = {f.joint: f for f in fit_estimate(estimate, min_samples=20)}
+    fits = {f.joint: f for f in fit_estimate(estimate)}
     spectrum = (np.linspace(0, 500, 501), np.exp(-np.linspace(0, 5, 501)), 262.0)  # a cutoff beyond 50 Hz
     for fig in (joint_figure(estimate, "moving", fits["moving"], TRUE, spectrum),
                 joint_figure(estimate, "still", None, None),

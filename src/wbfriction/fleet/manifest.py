@@ -37,7 +37,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import get_args
 
 import pyarrow as pa
 import pyarrow.compute as pc
@@ -48,7 +47,7 @@ from wbfriction.friction.fit import MODEL_CHOICES
 from wbfriction.friction.options import ROUTE_OPTIONS
 from wbfriction.logs.tables import TableFile, read_metadata, table_format
 from wbfriction.pipeline.estimate import RobotSpec
-from wbfriction.signals.kinematics import Diff
+from wbfriction.signals.options import DIFF_OPTIONS
 
 REQUIRED = ("log", "robot_id", "start_time")
 """The columns every manifest has."""
@@ -56,8 +55,6 @@ OPTIONAL = ("robot", "urdf", "config", "diff", "route", "model")
 """The columns a manifest may have (others are refused: a misspelt option would be silently ignored)."""
 LOG_SUFFIXES = (".parquet", ".pq", ".csv", ".h5", ".hdf5")
 """The files a scanned folder's logs are."""
-DIFF_CHOICES: tuple[str, ...] = ("auto", *get_args(Diff))
-"""The values of a manifest's ``diff`` column."""
 ROBOT_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
 """What a robot id may be: it names a folder of the results."""
 EARLIEST = datetime(1970, 1, 1, tzinfo=UTC)
@@ -308,7 +305,7 @@ def _entry(path: Path, row: int, cell: dict[str, str], start: datetime) -> LogEn
     robot = RobotSpec(name or None, str((path.parent / urdf).resolve()) if urdf else None,
                       str((path.parent / config).resolve()) if config else None)
     options = {c: cell[c] for c in ("diff", "route", "model") if cell.get(c)}
-    for column, choices in (("diff", DIFF_CHOICES), ("route", ROUTE_OPTIONS), ("model", MODEL_CHOICES)):
+    for column, choices in (("diff", DIFF_OPTIONS), ("route", ROUTE_OPTIONS), ("model", MODEL_CHOICES)):
         if column in options and options[column] not in choices:
             raise InputError(f"{where}, column '{column}': {options[column]!r} is not one of {', '.join(choices)}")
     return LogEntry(log, cell["robot_id"], start, robot, options, row)

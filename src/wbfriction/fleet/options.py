@@ -4,13 +4,10 @@ them without loading the library)."""
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
+from typing import Any
 
-if TYPE_CHECKING:
-    from wbfriction.friction.fit import ModelChoice
-
-from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, SELECTION_TOLERANCE, EstimateOptions
+from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, EstimateOptions, FitOptions
 
 
 @dataclass(frozen=True)
@@ -18,18 +15,14 @@ class BatchOptions:
     """What every log of a batch is processed with: ``wbfriction estimate``'s and ``wbfriction fit``'s options.
 
     Attributes:
-        estimate: the estimate's options (default: those of ``wbfriction estimate``, ``diff = "auto"``).
-        model: the friction model fitted (``auto``, ``thesis``, ``stribeck``, ``coulomb-viscous``).
-        selection_tolerance: ``auto``'s tolerance on held-out error.
-        min_samples: joints with fewer valid samples get no parameters.
+        estimate: the estimate's options (default: those of ``wbfriction estimate``).
+        fit: the fit's options (default: those of ``wbfriction fit``).
         energy_threshold, energy_tolerance: of the energy check (eq. 7.9).
         chunk_rows: rows per chunk of the estimate.
     """
 
-    estimate: EstimateOptions = field(default_factory=lambda: EstimateOptions(diff="auto"))
-    model: ModelChoice = "auto"
-    selection_tolerance: float = SELECTION_TOLERANCE
-    min_samples: int = 20
+    estimate: EstimateOptions = EstimateOptions()
+    fit: FitOptions = FitOptions()
     energy_threshold: float = DEFAULT_THRESHOLD
     energy_tolerance: float = DEFAULT_TOLERANCE
     chunk_rows: int = 10_000
@@ -41,5 +34,5 @@ class BatchOptions:
             if name in overrides:
                 out = dataclasses.replace(out, estimate=dataclasses.replace(out.estimate, **{name: overrides[name]}))
         if "model" in overrides:
-            out = dataclasses.replace(out, model=overrides["model"])
+            out = dataclasses.replace(out, fit=dataclasses.replace(out.fit, model=overrides["model"]))
         return out

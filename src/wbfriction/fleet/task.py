@@ -127,8 +127,7 @@ def process_log(entry: LogEntry, key: ResultKey, options: BatchOptions, scratch:
             estimate_file(entry.robot, entry.log, friction, options.estimate, chunking=Chunking(
                 rows=options.chunk_rows, workers=chunk_workers if executor is not None else 1), robot=robot,
                 executor=executor)
-            fitted = fit_table(friction, model=options.model, selection_tolerance=options.selection_tolerance,
-                               min_samples=options.min_samples, threshold=options.energy_threshold,
+            fitted = fit_table(friction, options.fit, threshold=options.energy_threshold,
                                tolerance=options.energy_tolerance)
         rows = result_rows(key, fitted.fits, fitted.energy, fitted.est.qd, fitted.est.valid)
         return LogOutcome(entry, key, rows, table=table)

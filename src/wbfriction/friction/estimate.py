@@ -45,15 +45,8 @@ from wbfriction.model.robot import Robot
 from wbfriction.model.stance import stance_frame_pose, stance_model
 from wbfriction.progress import Progress
 from wbfriction.signals.choice import DiffChoice, choose_differentiation
-from wbfriction.signals.kinematics import (
-    FILTERING_SCHEMES,
-    Diff,
-    MeasuredKinematics,
-    Scheme,
-    joined_smoother,
-    measure,
-    straddling,
-)
+from wbfriction.signals.kinematics import MeasuredKinematics, joined_smoother, measure, straddling
+from wbfriction.signals.options import FILTERING_SCHEMES, Diff, Scheme
 from wbfriction.signals.phases import Phases, joint_mask, segment
 
 CHUNK = 4096

@@ -48,7 +48,7 @@ import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Generic, Literal, get_args
+from typing import Any, Generic
 
 import numpy as np
 
@@ -69,18 +69,12 @@ from wbfriction.friction.models import (
     target_from_dict,
 )
 from wbfriction.friction.noise import joint_noises
-from wbfriction.friction.options import SELECTION_TOLERANCE
+from wbfriction.friction.options import MODEL_CHOICES, SELECTION_TOLERANCE, FitOptions, ModelChoice
 from wbfriction.friction.screen import gross_outliers
 from wbfriction.friction.status import MIN_SPEED, FitVerdict, fit_verdict, joint_speed
 from wbfriction.signals.kinematics import PiecewiseSmoother
 from wbfriction.signals.nonuniform import ResampledLowpass
 from wbfriction.workers import process_pool
-
-ModelChoice = Literal["auto", "coulomb-viscous", "stribeck", "thesis"]
-"""The model to fit: one of :data:`~wbfriction.friction.models.ModelName`, or ``auto``: the
-simplest whose held-out error is within a tolerance of the best (module docstring)."""
-
-MODEL_CHOICES: tuple[ModelChoice, ...] = get_args(ModelChoice)
 
 HELD_OUT_BLOCKS = 10
 """Contiguous blocks (in time) the valid samples are cut into for the model choice."""
@@ -962,10 +956,8 @@ def stick_margin(est: FrictionEstimate) -> int:
     return margin
 
 
-def fit_estimate(est: FrictionEstimate, *, delta_s: float = 2.0, min_samples: int = 20,
-                 workers: int = 1, model: ModelChoice = "thesis",
-                 selection_tolerance: float = SELECTION_TOLERANCE, joints: Sequence[str] | None = None,
-                 fixed: dict[str, float] | None = None,
+def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, workers: int = 1,
+                 joints: Sequence[str] | None = None, fixed: dict[str, float] | None = None,
                  targets: Mapping[str, ModelParams] | None = None) -> list[FitResult]:
     """Fit every joint of an estimate (:func:`fit_joints` on its valid samples, on ``workers``
     processes); its ``tau_f_true`` and ``friction_true`` metadata, when present (simulated
@@ -977,6 +969,9 @@ def fit_estimate(est: FrictionEstimate, *, delta_s: float = 2.0, min_samples: in
     joint's model is fitted there too and the two compared (:attr:`FitResult.route_check`, :func:`compare_routes`).
 
     Args:
+        options: the model, its choice and the fit's thresholds (:class:`~wbfriction.friction.options.FitOptions`;
+            its defaults are ``wbfriction fit``'s).
+        workers: processes fitting joints side by side.
         joints: the joints to fit (default: every one of the estimate), in this order.
         fixed: parameters held instead of fitted (:func:`fit_friction`).
         targets: the true parameters per joint, instead of the metadata's ``friction_true``.
@@ -993,11 +988,12 @@ def fit_estimate(est: FrictionEstimate, *, delta_s: float = 2.0, min_samples: in
         raise InputError(f"no joint '{unknown[0]}' in the friction estimate")
     idx = [est.joints.index(j) for j in names]
     record = est.metadata.get("noise")
-    options: dict[str, Any] = dict(delta_s=delta_s, min_samples=min_samples, workers=workers, fixed=fixed)
+    common: dict[str, Any] = dict(delta_s=options.delta_s, min_samples=options.min_samples, workers=workers,
+                                  fixed=fixed)
     truth = None if est.tau_f_true is None else est.tau_f_true[:, idx]
     fits = fit_joints(names, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], tau_f_true=truth, targets=targets,
-                      smoother=est.smoother, model=model, selection_tolerance=selection_tolerance,
-                      noise=joint_noises(record, est.estimation_route), stick_margin=stick_margin(est), **options)
+                      smoother=est.smoother, model=options.model, selection_tolerance=options.selection_tolerance,
+                      noise=joint_noises(record, est.estimation_route), stick_margin=stick_margin(est), **common)
     for f in fits:
         f.route = est.estimation_route
     check = est.route_check
@@ -1005,7 +1001,7 @@ def fit_estimate(est: FrictionEstimate, *, delta_s: float = 2.0, min_samples: in
         others = fit_joints(names, check.qd[:, idx], check.tau_f[:, idx], check.valid[:, idx],
                             smoother=check.smoother, model=[f.model for f in fits],
                             noise=joint_noises(record, check.estimation_route), stick_margin=stick_margin(check),
-                            **options)
+                            **common)
         for f, other in zip(fits, others):
             other.route = check.estimation_route
             f.route_check = compare_routes(f, other)

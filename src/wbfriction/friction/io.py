@@ -35,8 +35,8 @@ from wbfriction.friction.models import check_model, params_from_dict, target_fro
 from wbfriction.friction.options import ROUTES
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.tables import file_sha256, numeric_column, read_metadata, read_table, with_metadata, write_json
-from wbfriction.signals.kinematics import SCHEMES, Smoother, make_smoother
-from wbfriction.signals.options import FilterOptions
+from wbfriction.signals.kinematics import Smoother, make_smoother
+from wbfriction.signals.options import SCHEMES, FilterOptions
 from wbfriction.signals.window import MomentumWindow
 
 SIGN_CONVENTION = "tau_f = -f(qd); fit of f (the joint's model, eqs. 3.1-3.5) to -tau_f"

@@ -1,17 +1,26 @@
-"""The choices a user makes about the friction estimate and its checks, in a module that imports nothing
-heavy: the command line shows their defaults in its help without loading NumPy, SciPy or Pinocchio."""
+"""The choices a user makes about the friction estimate, its fit and its checks, in a module that imports
+nothing heavy: the command line shows their defaults in its help without loading NumPy, SciPy or Pinocchio.
+Each choice is checked here, where it is defined: the API and the command line refuse the same values with
+the same line, and share the same defaults."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal, get_args
+from dataclasses import dataclass, fields
+from typing import Literal, get_args
 
-from wbfriction.exceptions import InputError
-from wbfriction.signals.options import FilterOptions
-
-if TYPE_CHECKING:
-    from wbfriction.signals.kinematics import Diff, TorqueAlignment, Velocity
-    from wbfriction.signals.phases import Mask
+from wbfriction.choices import check_choice, check_range, flag
+from wbfriction.exceptions import OptionError
+from wbfriction.signals.options import (
+    ALIGNMENT_OPTIONS,
+    DIFF_OPTIONS,
+    MASKS,
+    VELOCITIES,
+    AlignmentOption,
+    DiffOption,
+    FilterOptions,
+    Mask,
+    Velocity,
+)
 
 BaseMotion = Literal["auto", "contact", "logged", "imu"]
 """Where the base's motion comes from: the rigid contacts (the thesis's route), the logged base pose
@@ -40,7 +49,7 @@ class MomentumOptions:
             (:class:`~wbfriction.signals.window.MomentumWindow`).
 
     Raises:
-        InputError: a window that is not odd or too short (named by its option).
+        OptionError: a window that is not odd or too short (named by its option).
     """
 
     velocity_window: int | None = None
@@ -48,9 +57,9 @@ class MomentumOptions:
 
     def __post_init__(self) -> None:
         if self.velocity_window is not None and (self.velocity_window < 7 or self.velocity_window % 2 == 0):
-            raise InputError(f"--velocity-window must be odd and at least 7 samples, got {self.velocity_window}")
+            raise OptionError("--velocity-window", self.velocity_window, "odd and at least 7 [samples]")
         if self.window is not None and (self.window < 3 or self.window % 2 == 0):
-            raise InputError(f"--momentum-window must be odd and at least 3 samples, got {self.window}")
+            raise OptionError("--momentum-window", self.window, "odd and at least 3 [samples]")
 
 
 Method = Literal["rnea", "kkt"]
@@ -97,11 +106,16 @@ class EstimateOptions:
         momentum: the momentum route's windows (:class:`MomentumOptions`).
         check_route: also estimate the other route, whose fit the status compares
             (:attr:`~wbfriction.friction.estimate.FrictionEstimate.route_check`).
+
+    Raises:
+        OptionError: a value that is not one of its choices or out of its range, named by its command-line
+            option; ``filtering`` set with ``diff="auto"`` (which chooses the filter from the data: it would be
+            dropped).
     """
 
-    diff: Diff | Literal["auto"] = "auto"
+    diff: DiffOption = "auto"
     compensate_delay: bool = True
-    torque_alignment: TorqueAlignment | Literal["auto"] = "auto"
+    torque_alignment: AlignmentOption = "auto"
     lift_off_skip: float = 0.10
     touch_down_skip: float = 0.05
     mask: Mask = "swing"
@@ -119,10 +133,30 @@ class EstimateOptions:
     check_route: bool = True
 
     def __post_init__(self) -> None:
-        if self.base_motion not in BASE_MOTIONS:
-            raise InputError(f"unknown base motion '{self.base_motion}': choose one of {', '.join(BASE_MOTIONS)}")
-        if self.route not in ROUTE_OPTIONS:
-            raise InputError(f"unknown route '{self.route}': choose one of {', '.join(ROUTE_OPTIONS)}")
+        check_choice("diff", self.diff, DIFF_OPTIONS)
+        check_choice("torque_alignment", self.torque_alignment, ALIGNMENT_OPTIONS)
+        check_choice("mask", self.mask, MASKS)
+        check_choice("method", self.method, METHODS)
+        check_choice("velocity", self.velocity, VELOCITIES)
+        check_choice("base_motion", self.base_motion, BASE_MOTIONS)
+        check_choice("route", self.route, ROUTE_OPTIONS)
+        check_range("lift_off_skip", self.lift_off_skip, low=0.0)
+        check_range("touch_down_skip", self.touch_down_skip, low=0.0)
+        for name in ("ds_weight", "ds_regularization"):
+            value = getattr(self, name)
+            for v in value if isinstance(value, tuple) else (value,):
+                check_range(name, v, low=0.0, strict=name == "ds_weight")
+        given = [f.name for f in fields(FilterOptions) if getattr(self.filtering, f.name) != f.default]
+        if self.diff == "auto" and given:
+            raise OptionError(flag(given[0]), getattr(self.filtering, given[0]), "given with --diff savgol or "
+                              "butterworth (--diff auto chooses the filter from the positions' noise and would "
+                              "drop it)")
+
+
+ModelChoice = Literal["auto", "coulomb-viscous", "stribeck", "thesis"]
+"""The model to fit: one of :data:`~wbfriction.friction.models.ModelName`, or ``auto``: the
+simplest whose held-out error is within a tolerance of the best (:mod:`~wbfriction.friction.fit`)."""
+MODEL_CHOICES: tuple[ModelChoice, ...] = get_args(ModelChoice)
 
 
 DEFAULT_THRESHOLD = 0.05
@@ -138,3 +172,33 @@ SELECTION_TOLERANCE = 0.02
 
 DEFAULT_TOLERANCE = 0.01
 """Friction torques smaller than this do not count as generating power [N·m]."""
+
+
+@dataclass(frozen=True)
+class FitOptions:
+    """Options of the friction fit (:func:`~wbfriction.friction.fit.fit_estimate`), the same defaults as
+    ``wbfriction fit``.
+
+    Attributes:
+        model: the model per joint (:data:`ModelChoice`); ``auto``: the simplest whose held-out RMS is within
+            ``selection_tolerance`` of the best.
+        selection_tolerance: relative excess of held-out RMS within which ``auto`` takes the simpler model
+            (dimensionless, >= 0).
+        min_samples: joints with fewer valid samples get no parameters (>= 1).
+        delta_s: the Stribeck exponent of (3.5) (dimensionless, > 0; the thesis's 2).
+
+    Raises:
+        OptionError: a value not one of its choices or out of its range, named by its command-line option.
+    """
+
+    model: ModelChoice = "auto"
+    selection_tolerance: float = SELECTION_TOLERANCE
+    min_samples: int = 20
+    delta_s: float = 2.0
+
+    def __post_init__(self) -> None:
+        check_choice("model", self.model, MODEL_CHOICES)
+        check_range("selection_tolerance", self.selection_tolerance, low=0.0)
+        check_range("min_samples", self.min_samples, low=1)
+        check_range("delta_s", self.delta_s, low=0.0, strict=True)
+

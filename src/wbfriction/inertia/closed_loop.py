@@ -26,7 +26,7 @@ import numpy as np
 from wbfriction.friction.energy import JointEnergy, energy_consistency
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log, resolve_differentiation
 from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
-from wbfriction.friction.options import EstimateOptions
+from wbfriction.friction.options import EstimateOptions, FitOptions
 from wbfriction.inertia.identification import InertialIdentification, identify_inertia, log_samples
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.log import Log
@@ -79,7 +79,7 @@ def acceleration_route(robot: Robot, log: Log, options: EstimateOptions, min_sam
     est = estimate_log(robot, log, options)
     if choice is not None:
         est.metadata["differentiation"] = choice.to_dict()
-    fits = fit_estimate(est, min_samples=min_samples, workers=workers)
+    fits = fit_estimate(est, FitOptions(model="thesis", min_samples=min_samples), workers=workers)
     return Route(est, fits, energy_consistency(est, fitted_offsets(fits)))
 
 

@@ -6,11 +6,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal, get_args
 
+from wbfriction.choices import check_choice
 from wbfriction.exceptions import InputError
 
 ArmatureMode = Literal["known", "identify", "none"]
 """How the identification treats the drives' reflected rotor inertia (:mod:`wbfriction.inertia.identification`)."""
 ARMATURE_MODES: tuple[ArmatureMode, ...] = get_args(ArmatureMode)
+InertiaPart = Literal["all", "mass", "rotational"]
+"""What of a body's inertia ``sensitivity`` scales (:mod:`~wbfriction.inertia.sensitivity`)."""
+PARTS: tuple[InertiaPart, ...] = get_args(InertiaPart)
 
 
 @dataclass(frozen=True)
@@ -87,7 +91,6 @@ class InertialOptions:
     block: int = 200
 
     def __post_init__(self) -> None:
-        if self.armature not in ARMATURE_MODES:
-            raise InputError(f"unknown armature mode '{self.armature}': choose one of {', '.join(ARMATURE_MODES)}")
+        check_choice("armature", self.armature, ARMATURE_MODES)
         if self.prior is not None and not self.prior > 0:
             raise InputError(f"the prior's weight must be > 0, got {self.prior}")

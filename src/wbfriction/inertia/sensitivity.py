@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Literal, get_args
 
 import numpy as np
 import pinocchio as pin
@@ -37,13 +36,10 @@ from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import FrictionEstimate, estimate_resolved, resolve_differentiation
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.route import resolve_route
+from wbfriction.inertia.options import PARTS, InertiaPart
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
-
-InertiaPart = Literal["all", "mass", "rotational"]
-"""What of a body's inertia is scaled (module docstring)."""
-PARTS: tuple[InertiaPart, ...] = get_args(InertiaPart)
 
 
 def principal_inertia(inertia: pin.Inertia) -> tuple[np.ndarray, np.ndarray]:

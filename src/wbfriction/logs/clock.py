@@ -31,22 +31,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Literal, get_args
+from typing import Literal
 
 import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError, InputError
-from wbfriction.logs.options import MAX_GAP
+from wbfriction.logs.options import MAX_GAP, TIME_BASES, TIME_UNITS, TimeBase, TimeUnit
 from wbfriction.logs.tables import numeric_column
 
 ClockKind = Literal["uniform", "skipping", "jittered"]
 """What wrote a log's stamps (module docstring): a uniform clock, exact stamps of non-uniform
 samples (taken as recorded), receive-time stamps of uniform samples (regularised)."""
-TimeBase = Literal["auto", "recorded", "regularised"]
-"""The time base derivatives are taken on: decided from the data (``auto``), the stamps as
-recorded, or a regularised clock (:func:`regularise`)."""
-TIME_BASES: tuple[TimeBase, ...] = get_args(TimeBase)
 
 JITTER = 0.05
 """Steps within this share of their median are a uniform clock."""
@@ -113,9 +109,6 @@ class Clock:
 
 
 # ------------------------------------------------------------------------- the stamps
-TimeUnit = Literal["s", "ms", "us", "ns"]
-"""The unit of a numeric ``time`` column (``--time-unit``)."""
-TIME_UNITS: tuple[TimeUnit, ...] = get_args(TimeUnit)
 _NS_PER = {"s": 10**9, "ms": 10**6, "us": 10**3, "ns": 1}
 SECONDS_STEP = (1e-6, 0.5)
 """Median step [s] of a float ``time`` column read as seconds without a stated unit: outside it,

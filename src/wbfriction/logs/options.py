@@ -1,8 +1,20 @@
 """The choices a user makes about reading a log, in a module that imports nothing heavy: the command line
 shows their defaults in its help without loading NumPy or pyarrow."""
 
+from __future__ import annotations
+
+from typing import Literal, get_args
+
 MAX_GAP = 2.0
 """Default gap [sampling periods]: a time step at least this long (against the median of the
 steps around it) splits a log into segments."""
 LIMIT_MARGIN = 0.2
 """How far a position may pass its URDF limits before the log is refused [rad or m]."""
+
+TimeBase = Literal["auto", "recorded", "regularised"]
+"""The time base derivatives are taken on: decided from the data (``auto``), the stamps as
+recorded, or a regularised clock (:func:`~wbfriction.logs.clock.regularise`)."""
+TIME_BASES: tuple[TimeBase, ...] = get_args(TimeBase)
+TimeUnit = Literal["s", "ms", "us", "ns"]
+"""The unit of a numeric ``time`` column (``--time-unit``)."""
+TIME_UNITS: tuple[TimeUnit, ...] = get_args(TimeUnit)

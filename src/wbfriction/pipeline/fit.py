@@ -8,15 +8,9 @@ from pathlib import Path
 from wbfriction.exceptions import InputError
 from wbfriction.friction.energy import JointEnergy, energy_consistency
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import (
-    MODEL_CHOICES,
-    FitResult,
-    ModelChoice,
-    fit_estimate,
-    fitted_offsets,
-)
+from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
 from wbfriction.friction.io import SIGN_CONVENTION, energy_to_dict, read_friction_file, write_params
-from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, SELECTION_TOLERANCE
+from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions
 from wbfriction.pipeline.provenance import file_provenance
 
 
@@ -29,29 +23,22 @@ class FittedFile:
     est: FrictionEstimate
 
 
-def fit_table(friction: str | Path, *, model: ModelChoice = "auto", selection_tolerance: float = SELECTION_TOLERANCE,
-              min_samples: int = 20, threshold: float = DEFAULT_THRESHOLD, tolerance: float = DEFAULT_TOLERANCE,
-              workers: int = 1) -> FittedFile:
+def fit_table(friction: str | Path, options: FitOptions = FitOptions(), *, threshold: float = DEFAULT_THRESHOLD,
+              tolerance: float = DEFAULT_TOLERANCE, workers: int = 1) -> FittedFile:
     """:func:`fit_file` without writing: the table read, every joint fitted, the energy checked.
 
     Raises:
         InputError: as :func:`fit_file`.
     """
-    if model not in MODEL_CHOICES:
-        raise InputError(f"--model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
-    if not selection_tolerance >= 0:
-        raise InputError(f"--selection-tolerance must be at least 0, got {selection_tolerance}")
     est = read_friction_file(friction)
-    fits = fit_estimate(est, min_samples=min_samples, workers=workers, model=model,
-                        selection_tolerance=selection_tolerance)
+    fits = fit_estimate(est, options, workers=workers)
     if not any(f.params is not None for f in fits):
-        raise InputError(f"{friction}: no joint could be fitted (each has fewer than --min-samples {min_samples} "
-                         "valid samples); nothing written")
+        raise InputError(f"{friction}: no joint could be fitted (each has fewer than --min-samples "
+                         f"{options.min_samples} valid samples); nothing written")
     return FittedFile(fits, energy_consistency(est, fitted_offsets(fits), threshold, tolerance), est)
 
 
-def fit_file(friction: str | Path, output: str | Path, *, model: ModelChoice = "auto",
-             selection_tolerance: float = SELECTION_TOLERANCE, min_samples: int = 20,
+def fit_file(friction: str | Path, output: str | Path, options: FitOptions = FitOptions(), *,
              threshold: float = DEFAULT_THRESHOLD, tolerance: float = DEFAULT_TOLERANCE,
              workers: int = 1) -> FittedFile:
     """Fit a friction model to every joint of a friction table (:func:`~wbfriction.friction.fit.fit_joints`,
@@ -61,27 +48,22 @@ def fit_file(friction: str | Path, output: str | Path, *, model: ModelChoice = "
     Args:
         friction: the friction table (``wbfriction estimate``).
         output: the parameters JSON to write.
-        model: ``auto`` (default: per joint the simplest model whose held-out RMS is within
-            ``selection_tolerance`` of the best, the reason recorded; see
-            :mod:`wbfriction.friction.fit`), or ``coulomb-viscous``, ``stribeck``, ``thesis`` (3.5).
-        selection_tolerance: relative excess of held-out RMS within which ``auto`` takes the
-            simpler model (e.g. 0.02: 2 %).
-        min_samples: joints with fewer valid samples get no parameters.
+        options: the model, its choice and thresholds (:class:`~wbfriction.friction.options.FitOptions`; by
+            default ``auto``: per joint the simplest model whose held-out RMS is within its
+            ``selection_tolerance`` of the best, the reason recorded; see :mod:`wbfriction.friction.fit`).
         threshold, tolerance: of the energy check (:func:`~wbfriction.friction.energy.energy_consistency`).
         workers: processes fitting joints side by side.
 
     Raises:
-        InputError: an unknown ``--model`` or a negative ``--selection-tolerance``, an unreadable
-            or malformed friction table, a table where no joint has ``min_samples`` valid samples
-            (nothing is written), an output folder that does not exist.
+        InputError: an unreadable or malformed friction table, a table where no joint has
+            ``options.min_samples`` valid samples (nothing is written), an output folder that does not exist.
     """
-    fitted = fit_table(friction, model=model, selection_tolerance=selection_tolerance, min_samples=min_samples,
-                       threshold=threshold, tolerance=tolerance, workers=workers)
+    fitted = fit_table(friction, options, threshold=threshold, tolerance=tolerance, workers=workers)
     log = fitted.est.metadata.get("provenance", {})
     header: dict[str, object] = {"provenance": {**file_provenance("friction", friction),
                                                 **{k: log[k] for k in ("robot", "urdf") if k in log}},
-                                 "sign_convention": SIGN_CONVENTION, "model": model}
-    if model == "auto":
-        header["selection_tolerance"] = selection_tolerance
+                                 "sign_convention": SIGN_CONVENTION, "model": options.model}
+    if options.model == "auto":
+        header["selection_tolerance"] = options.selection_tolerance
     write_params(output, fitted.fits, header, {e.joint: {"energy": energy_to_dict(e)} for e in fitted.energy})
     return fitted

@@ -66,8 +66,8 @@ from numpy.lib.stride_tricks import sliding_window_view
 from wbfriction.exceptions import InputError
 from wbfriction.logs.clock import longest_segment
 from wbfriction.logs.log import Log
-from wbfriction.signals.filters import SavgolWeights, ZeroPhaseLowpass, savgol_kernels
-from wbfriction.signals.options import FilterOptions
+from wbfriction.signals.filters import ZeroPhaseLowpass, savgol_kernels
+from wbfriction.signals.options import FilterOptions, SavgolWeights
 from wbfriction.signals.spectrum import amplitude_spectrum, longest_run, suggest_cutoff
 
 ChosenScheme = Literal["central", "savgol", "butterworth"]

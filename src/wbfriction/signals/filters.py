@@ -29,15 +29,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Literal, get_args
 
 import numpy as np
 
 from wbfriction.exceptions import InputError
+from wbfriction.signals.options import WEIGHTS, SavgolWeights
 
-SavgolWeights = Literal["uniform", "gaussian"]
-"""The named weights of a Savitzky-Golay fit (:func:`savgol_weights`)."""
-WEIGHTS: tuple[SavgolWeights, ...] = get_args(SavgolWeights)
 TAIL = 0.01
 """An IIR filter's half-width: where less than this share of its impulse response's
 absolute sum lies beyond (samples closer than that to an edge or a contact change are

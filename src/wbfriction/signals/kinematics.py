@@ -40,7 +40,7 @@ two held torques by how long each was held.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Literal, get_args
+from typing import Literal
 
 import numpy as np
 
@@ -50,7 +50,15 @@ from wbfriction.signals import nonuniform
 from wbfriction.signals.base_motion import base_twist_and_acceleration, continuous_quaternions
 from wbfriction.signals.filters import SavgolSmoother, ZeroPhaseLowpass, savgol_differentiate
 from wbfriction.signals.nonuniform import NonUniformSavgol, ResampledLowpass
-from wbfriction.signals.options import FilterOptions
+from wbfriction.signals.options import (
+    SCHEMES,
+    TORQUE_ALIGNMENTS,
+    VELOCITIES,
+    Diff,
+    FilterOptions,
+    TorqueAlignment,
+    Velocity,
+)
 from wbfriction.signals.velocity import velocity_lag
 from wbfriction.signals.window import MomentumWindow
 
@@ -143,17 +151,10 @@ def make_smoother(diff: Diff, filtering: FilterOptions, dt: float, t: np.ndarray
     return None
 
 
-Scheme = Literal["central", "backward", "savgol", "butterworth"]
-"""A differentiation scheme: plain differences, then the filtering ones (module docstring)."""
-Diff = Literal["central", "backward", "savgol", "butterworth", "true"]
-"""A scheme, or ``true``: the simulators' logged true velocities and accelerations."""
 DIFFERENTIATORS = {"central": central_differences, "backward": backward_differences}
 NONUNIFORM_DIFFERENTIATORS = {"central": nonuniform.three_point_differences,
                               "backward": nonuniform.backward_differences}
 """The same schemes on non-uniform sample times ``(q, t)`` (:mod:`~wbfriction.signals.nonuniform`)."""
-FILTERING_SCHEMES: tuple[Scheme, ...] = ("savgol", "butterworth")
-SCHEMES: tuple[Scheme, ...] = get_args(Scheme)
-"""Differentiation schemes by name: plain differences, then the filtering ones (module docstring)."""
 
 
 def straddling(contact: np.ndarray) -> np.ndarray:
@@ -166,9 +167,6 @@ def straddling(contact: np.ndarray) -> np.ndarray:
     return out
 
 
-TorqueAlignment = Literal["zoh", "sample"]
-"""How torques are aligned with the central second difference (:func:`align_torque`)."""
-TORQUE_ALIGNMENTS: tuple[TorqueAlignment, ...] = get_args(TorqueAlignment)
 
 
 def align_torque(tau: np.ndarray, alignment: TorqueAlignment | str = "zoh", t: np.ndarray | None = None) -> np.ndarray:
@@ -280,10 +278,6 @@ def _filtered(log: Log, tau: np.ndarray, smoother: Smoother, filtering: FilterOp
     return np.where(np.isfinite(q_s), q_s, log.q), np.where(np.isfinite(qd_s), qd_s, qd_c), qdd, tau
 
 
-Velocity = Literal["differentiated", "logged"]
-"""Where the joint velocities come from: the positions differentiated by the scheme, or the
-log's own ``qd.<joint>`` columns (:func:`measure`)."""
-VELOCITIES: tuple[Velocity, ...] = get_args(Velocity)
 
 
 def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,

@@ -41,7 +41,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.signals.filters import SavgolWeights, ZeroPhaseLowpass, finite_runs, savgol_weights
+from wbfriction.signals.filters import ZeroPhaseLowpass, finite_runs, savgol_weights
+from wbfriction.signals.options import SavgolWeights
 
 if TYPE_CHECKING:
     import scipy.sparse as sp

@@ -21,16 +21,13 @@ The dropped intervals are ``[t_lift_off, t_lift_off + lift_off_skip)`` and
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, get_args
 
 import numpy as np
 
 from wbfriction.exceptions import InputError
+from wbfriction.signals.options import MASKS, Mask
 
 FLIGHT, SINGLE, DOUBLE = "flight", "single", "double"
-Mask = Literal["swing", "single"]
-"""Which single-support samples of a joint count (module docstring)."""
-MASKS: tuple[Mask, ...] = get_args(Mask)
 
 
 @dataclass

@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal, get_args
 
+from wbfriction.choices import check_choice
 from wbfriction.exceptions import InputError
 
 if TYPE_CHECKING:
@@ -66,6 +67,9 @@ class SensorNoise:
 Integrator = Literal["semi-implicit", "explicit"]
 """Euler integration of the ideal simulator."""
 INTEGRATORS: tuple[Integrator, ...] = get_args(Integrator)
+Projection = Literal["sample", "touch-down"]
+"""When the ideal simulator projects the state onto the contact constraints (:class:`IdealOptions`)."""
+PROJECTIONS: tuple[Projection, ...] = get_args(Projection)
 
 
 @dataclass(frozen=True)
@@ -104,18 +108,20 @@ class IdealOptions:
     gain_blend: float = 0.1
     baumgarte: tuple[float, float] = (400.0, 40.0)
     log_base: bool = True
-    projection: str = "sample"
+    projection: Projection = "sample"
     force_torque: bool = False
     imu: bool = False
 
     def __post_init__(self) -> None:
-        if self.integrator not in INTEGRATORS:
-            raise InputError(f"unknown integrator '{self.integrator}': choose one of {', '.join(INTEGRATORS)}")
-        if self.projection not in ("sample", "touch-down"):
-            raise InputError(f"unknown projection '{self.projection}': choose sample or touch-down")
+        check_choice("integrator", self.integrator, INTEGRATORS)
+        check_choice("projection", self.projection, PROJECTIONS)
         if self.substeps < 1:
             raise InputError(f"substeps must be at least 1, got {self.substeps}")
 
+
+Simulator = Literal["ideal", "mujoco"]
+"""The humanoid's simulators: ``ideal`` (rigid contacts, thesis 6.1) or ``mujoco`` (soft contacts, sensors, 6.2)."""
+SIMULATORS: tuple[Simulator, ...] = get_args(Simulator)
 
 FrictionMode = Literal["model", "mujoco"]
 """How the MuJoCo simulator applies friction (:mod:`wbfriction.sim.mujoco_sim`)."""
@@ -191,8 +197,7 @@ class MujocoOptions:
             raise InputError(f"substeps must be at least 1, got {self.substeps}")
         if self.contact_threshold <= 0:
             raise InputError("the contact threshold must be a positive force [N]")
-        if self.friction not in FRICTION_MODES:
-            raise InputError(f"friction must be one of {', '.join(FRICTION_MODES)}, got '{self.friction}'")
+        check_choice("mujoco_friction", self.friction, FRICTION_MODES)
         if self.delay < 0:
             raise InputError(f"the delay must be >= 0 s, got {self.delay}")
         if self.sole_timeconst is not None and not self.sole_timeconst > 0:

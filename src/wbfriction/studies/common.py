@@ -15,6 +15,7 @@ from typing import Any
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult, fit_estimate
 from wbfriction.friction.models import PARAM_NAMES, ModelParams
+from wbfriction.friction.options import FitOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.model.robot import Robot
 from wbfriction.sim.options import IdealOptions
@@ -76,7 +77,8 @@ def fit_legs(est: FrictionEstimate, legs: list[LegJoint], targets: Mapping[str, 
     """Fit model (3.5) to every leg joint of an estimate on its valid samples, as
     :func:`~wbfriction.friction.fit.fit_estimate` fits every joint (its noise record, the other route), with the
     estimate's true friction and ``targets`` for the errors; ``fixed``: parameters held."""
-    return fit_estimate(est, joints=[j for j, _, _ in legs], targets=targets or {}, fixed=fixed)
+    return fit_estimate(est, FitOptions(model="thesis"), joints=[j for j, _, _ in legs], targets=targets or {},
+                        fixed=fixed)
 
 
 def leg_rows(legs: list[LegJoint], fits: list[FitResult]) -> list[LegRow]:

@@ -29,8 +29,7 @@ from wbfriction.logs.tables import make_folder, write_json, write_table
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
 from wbfriction.report.figures import filter_curves_figure
-from wbfriction.signals.kinematics import Diff
-from wbfriction.signals.options import FilterOptions
+from wbfriction.signals.options import Diff, FilterOptions
 from wbfriction.sim import apply_sensor_noise, simulate_ideal
 from wbfriction.sim.options import SensorNoise
 from wbfriction.studies.common import ENCODER_BITS, SIMULATOR, TORQUE_STD, leg_joints, right_knee

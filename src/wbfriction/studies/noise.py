@@ -33,9 +33,9 @@ from typing import Literal, cast, get_args
 import numpy as np
 
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.fit import FitResult, ModelChoice, fit_estimate
+from wbfriction.friction.fit import FitResult, fit_estimate
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams, ModelName, ModelParams, StribeckParams
-from wbfriction.friction.options import EstimateOptions
+from wbfriction.friction.options import EstimateOptions, FitOptions, ModelChoice
 from wbfriction.logs.log import Log, log_from_table
 from wbfriction.logs.tables import make_folder, write_atomic
 from wbfriction.model.robot import Robot
@@ -176,7 +176,7 @@ def run_noise_study(robots: Sequence[Robot], output_dir: Path, *, families: Sequ
                     log = simulate_family(robot, family, noise, seed, duration=duration, steps=steps, cache=cache)
                     est = estimate_log(robot, log, EstimateOptions())
                     for choice, model in (("auto", "auto"), ("true", TRUE_MODEL[family])):
-                        fits = fit_estimate(est, model=cast(ModelChoice, model), workers=workers)
+                        fits = fit_estimate(est, FitOptions(model=cast(ModelChoice, model)), workers=workers)
                         rows += [r for f in fits if (r := _row(robot, family, noise, seed, choice, f)) is not None]
     write_atomic(output_dir / "noise.json",
                  lambda tmp: tmp.write_text(json.dumps([dataclasses.asdict(r) for r in rows], indent=1)))

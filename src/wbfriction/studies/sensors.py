@@ -32,8 +32,7 @@ from wbfriction.logs.log import Log, write_log
 from wbfriction.logs.tables import make_folder, write_atomic
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
-from wbfriction.signals.kinematics import Diff
-from wbfriction.signals.options import FilterOptions
+from wbfriction.signals.options import Diff, FilterOptions
 from wbfriction.sim import simulate_mujoco
 from wbfriction.sim.options import MujocoOptions, SensorNoise
 from wbfriction.studies.common import LegJoint, fit_legs, leg_joints

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal, get_args
 
+from wbfriction.choices import check_choice
 from wbfriction.exceptions import InputError
 
 Gait = Literal["forward", "sideways", "turning", "both", "combined"]
@@ -51,8 +52,7 @@ class GaitOptions:
     pc_amplitude: float = 0.2
 
     def __post_init__(self) -> None:
-        if self.gait not in GAITS:
-            raise InputError(f"unknown gait '{self.gait}': choose one of {', '.join(GAITS)}")
+        check_choice("gait", self.gait, GAITS)
         if self.steps < 1:
             raise InputError(f"steps must be at least 1, got {self.steps}")
         for name in ("single_support", "double_support", "initial", "final"):
