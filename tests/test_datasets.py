@@ -201,12 +201,15 @@ def test_the_command_writes_both_logs(tmp_path, capsys, local_copy):
     np.testing.assert_array_equal(runs12["time"].to_numpy(), np.concatenate(runs[:2]))
     np.testing.assert_array_equal(run3["time"].to_numpy(), runs[2])
     assert f"{out / 'runs12.parquet'} ({2 * SAMPLES} samples" in err
-    # the printed commands name the fetched URDF and the packaged configuration, and they load the logs
+    # the printed commands name the configuration written beside the logs, which names the URDF copied there
     estimate = shlex.split(next(line for line in printed.splitlines() if "wbfriction estimate" in line))
-    urdf, config = estimate[estimate.index("--urdf") + 1], estimate[estimate.index("--config") + 1]
-    assert (urdf, config) == (str(KUKA / "kuka_lwr4.urdf"), str(datasets.kuka_lwr4_config()))
+    config = estimate[estimate.index("--config") + 1]
+    assert config == str(out / "kuka_lwr4.toml") and "--urdf" not in estimate
+    assert (out / "kuka_lwr4.urdf").read_bytes() == (KUKA / "kuka_lwr4.urdf").read_bytes()
     assert estimate[2] == str(out / "runs12.parquet")
-    log = read_log(out / "runs12.parquet", load_robot(urdf=urdf, config=config))
+    robot = load_robot(config=config)
+    assert robot.actuated == datasets.KUKA_LWR4_JOINTS and not robot.floating_base
+    log = read_log(out / "runs12.parquet", robot)
     assert log.segments == [(0, SAMPLES), (SAMPLES, 2 * SAMPLES)]  # the half hour between the runs is a gap
 
 
@@ -219,4 +222,4 @@ def test_the_command_refuses_a_damaged_copy_and_an_unknown_dataset(tmp_path, cap
     assert code == 2 and len(lines) == 1 and f"{root / 'kuka_lwr4' / 'kuka_lwr4.urdf'}: SHA-256" in lines[0]
     assert not (tmp_path / "out").exists()  # refused before anything is written
     code, _, err = run_cli_printed(capsys, "dataset", "kuka", "-o", tmp_path / "out")
-    assert code == 2 and "NAME must be one of kuka-lwr4, got 'kuka'" in err
+    assert code == 2 and "'kuka'" in err and "kuka-lwr4" in err and len(err.strip().splitlines()) == 1

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pytest
 
+from helpers import REAL_DATA
+
 REPO = Path(__file__).resolve().parents[1]
 
 
@@ -95,6 +97,8 @@ def test_the_readme_commands_run_as_written(tmp_path):
     (tmp_path / "examples").symlink_to(REPO / "examples")
     bin_dir = str(Path(sys.executable).parent)
     env = dict(os.environ, PATH=bin_dir + os.pathsep + os.environ.get("PATH", ""), MPLBACKEND="Agg")
+    if REAL_DATA.is_dir():  # 'wbfriction dataset' offline: the local copy, checked against the same SHA-256
+        env.setdefault("WBFRICTION_DATA", str(REAL_DATA))
     commands = readme_commands()
     assert all(c.split()[0] in ("wbfriction", "python") for c in commands)
     deps = needs(commands)

@@ -23,7 +23,7 @@ from pathlib import Path
 
 from wbfriction.exceptions import InputError
 from wbfriction.logs.npz import read_npz_recordings
-from wbfriction.logs.tables import file_sha256, make_folder, output_error, write_table
+from wbfriction.logs.tables import file_sha256, make_folder, output_error, write_atomic, write_table
 
 DATA_ENV = "WBFRICTION_DATA"
 """Environment variable: a folder holding local copies of the datasets (``<folder>/kuka_lwr4/<file>``),
@@ -68,6 +68,10 @@ KUKA_LWR4_JOINTS = tuple(f"lwr_{i}_joint" for i in range(7))
 KUKA_LWR4_LOGS = ("runs12.parquet", "run3.parquet")
 """The logs :func:`write_kuka_lwr4_logs` writes: runs 1 and 2 (one log, the half hour between them a gap),
 and run 3 (held out)."""
+KUKA_LWR4_ROBOT = ("kuka_lwr4.urdf", "kuka_lwr4.toml")
+"""The robot files :func:`write_kuka_lwr4_logs` writes beside the logs: FloBaRoID's URDF, and the packaged
+configuration naming it (``urdf = "kuka_lwr4.urdf"``, relative to the TOML), so ``--config <dir>/kuka_lwr4.toml``
+is the whole robot."""
 
 
 @dataclass(frozen=True)
@@ -99,11 +103,13 @@ class KukaLwr4Logs:
         runs12: runs 1 and 2 in the log format, one after the other (a gap between them).
         run3: run 3 in the log format.
         rows: the samples of each, (runs12, run3).
+        config: the robot configuration written beside them, naming the URDF copied there (``--config``).
     """
 
     runs12: Path
     run3: Path
     rows: tuple[int, int]
+    config: Path
 
 
 def kuka_lwr4_config() -> Path:
@@ -200,10 +206,12 @@ def kuka_lwr4() -> KukaLwr4:
 
 def write_kuka_lwr4_logs(directory: str | Path, data: KukaLwr4 | None = None) -> KukaLwr4Logs:
     """Write the KUKA LWR4+ recordings as wbfriction logs (:data:`KUKA_LWR4_LOGS`): ``runs12.parquet`` (runs
-    1 and 2, for estimating and fitting) and ``run3.parquet`` (run 3, held out), stamps untouched.
+    1 and 2, for estimating and fitting) and ``run3.parquet`` (run 3, held out), stamps untouched; and beside
+    them the robot (:data:`KUKA_LWR4_ROBOT`): the URDF and a configuration that names it, so that
+    ``--config <directory>/kuka_lwr4.toml`` loads the robot.
 
     Args:
-        directory: the folder to write into, made if it does not exist; logs already there are replaced,
+        directory: the folder to write into, made if it does not exist; files already there are replaced,
             each written whole or not at all.
         data: the dataset (default: :func:`kuka_lwr4`, fetched or taken from :data:`DATA_ENV`).
 
@@ -221,4 +229,9 @@ def write_kuka_lwr4_logs(directory: str | Path, data: KukaLwr4 | None = None) ->
                                                                                           KUKA_LWR4_JOINTS))
     for table, path in zip(tables, (runs12, run3)):
         write_table(table, path)
-    return KukaLwr4Logs(runs12=runs12, run3=run3, rows=(tables[0].num_rows, tables[1].num_rows))
+    urdf, config = (folder / name for name in KUKA_LWR4_ROBOT)
+    write_atomic(urdf, lambda tmp: tmp.write_bytes(data.urdf.read_bytes()))
+    text = data.config.read_text()
+    write_atomic(config, lambda tmp: tmp.write_text(text.replace('\nname = "kuka_lwr4"\n', '\nname = "kuka_lwr4"\n'
+                                                                 f'urdf = "{urdf.name}"   # beside this file\n', 1)))
+    return KukaLwr4Logs(runs12=runs12, run3=run3, rows=(tables[0].num_rows, tables[1].num_rows), config=config)

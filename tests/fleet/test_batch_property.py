@@ -38,7 +38,8 @@ def fake_process_log(entry, key, options, scratch, table=None, executor=None, ch
         row = {name: float("nan") for name in RESULT_SCHEMA.names}
         row.update(robot_id=key.robot_id, log=key.log, start_time=key.start_time, key=key.key,
                    log_sha256=key.log_sha256, robot_sha256=key.robot_sha256, options_sha256=key.options_sha256,
-                   joint=joint, model=options.fit.model, route="acceleration", status="ok", n_samples=100, version="test",
+                   joint=joint, model=options.fit.model, route="acceleration", status="ok", n_samples=100,
+                   version="test",
                    F_c=int(key.log_sha256[:8], 16) / 1e9 + len(options.fit.model), F_c_se=0.01)
         for name in RESULT_SCHEMA.names:
             rows[name].append(row[name])
