@@ -39,9 +39,15 @@ def kuka_table(*runs: int) -> pa.Table:
     return read_npz_recordings([KUKA / f"measurements_{i}.npz" for i in runs], KUKA_LWR4_JOINTS)
 
 
-def run(*args, cwd=None):
+def run(*args, cwd=None, columns: int = 200):
+    """``python -m wbfriction ARGS`` in a terminal ``columns`` wide."""
     return subprocess.run([sys.executable, "-m", "wbfriction", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd, env=dict(os.environ, COLUMNS="200"))
+                          cwd=cwd, env=dict(os.environ, COLUMNS=str(columns)))
+
+
+def widest_line(text: str) -> int:
+    """The longest line of ``text`` in characters, trailing spaces left out (what a terminal shows)."""
+    return max((len(line.rstrip()) for line in text.splitlines()), default=0)
 
 
 def assert_one_line_error(res, needle):

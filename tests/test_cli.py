@@ -8,7 +8,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from helpers import assert_one_line_error, run
+from helpers import assert_one_line_error, run, widest_line
 from wbfriction.logs.log import write_log
 from wbfriction.logs.source import read_log
 
@@ -255,3 +255,31 @@ def test_api_and_cli_give_the_same_friction_table_and_fits_with_their_defaults(t
     for f in fits:
         back = params[f.joint]
         assert (f.model, f.params, f.verdict().status) == (back.model, back.params, back.verdict().status)
+
+
+def test_fit_prints_tables_that_fit_a_100_column_terminal(demo_dir, tmp_path):
+    """``COLUMNS=100 wbfriction fit``: no line over 100 columns, every joint named whole, each status shown, the
+    joints that did not move in one line; ``--wide`` every parameter in one table, as wide as it takes; ``--verbose``
+    each joint's reason (issue 39)."""
+    out, _ = demo_dir
+    res = run("fit", out / "friction.parquet", "-o", tmp_path / "p.json", columns=100)
+    assert res.returncode == 0, res.stderr
+    assert widest_line(res.stdout) <= 100, res.stdout
+    params = json.loads((tmp_path / "p.json").read_text())["joints"]
+    rows: dict[str, list[str]] = {}
+    for line in res.stdout.splitlines():  # each joint's first row: the main table's
+        if line.split():
+            rows.setdefault(line.split()[0], line.split())
+    for joint in params:
+        assert joint in rows, joint  # named whole, never cut
+    moved = [j for j in params if rows[j][2:4] != ["not", "excited"]]
+    assert moved and all(rows[j][2] in ("ok", "weak", "at", "failed", "routes") for j in moved)
+    still = len(params) - len(moved)
+    assert sum("hardly moved" in line for line in res.stdout.splitlines()) == (1 if still else 0)
+    assert "Against the simulator's friction" in res.stdout  # the walk's log carries the truth
+    wide = run("fit", out / "friction.parquet", "-o", tmp_path / "w.json", "--wide", columns=100)
+    assert wide.returncode == 0 and widest_line(wide.stdout) > 100 and " N " in wide.stdout.splitlines()[1]
+    verbose = run("fit", out / "friction.parquet", "-o", tmp_path / "v.json", "--verbose", columns=100)
+    words = "".join(verbose.stdout.split())  # each reason once, however the terminal's width wrapped it
+    assert words.count("held-outRMS[N·m]:") == len([j for j in params if params[j].get("selection")]) > 0
+    assert widest_line(verbose.stdout) <= 100

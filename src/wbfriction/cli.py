@@ -55,8 +55,11 @@ if TYPE_CHECKING:
 # printed as written (Rich markup would take them for tags and delete them)
 app = typer.Typer(add_completion=False, rich_markup_mode=None)
 console = Console(stderr=True, soft_wrap=True)  # a message is one line, wrapped by the terminal, not cut into lines
-out = Console(width=max(Console().width, 150))
+out = Console()  # as wide as the terminal (COLUMNS); tables fit it (--wide: every column)
 
+WideOpt = typer.Option(False, "--wide", help="Every column in one table, as wide as it takes (default: tables that "
+                                            "fit the terminal).")
+VerboseOpt = typer.Option(False, "--verbose", help="Each joint's own line for the notes shared by several.")
 RobotOpt = typer.Option("talos", "--robot", help=f"Built-in robot: {', '.join(BUILTIN_ROBOTS)}.")
 LOG_FORMATS = "Parquet (.parquet), CSV (.csv) or HDF5 (.h5, .hdf5)"
 """The log file formats every command reads (a ROS 2 bag too, where a command takes --map)."""
@@ -115,68 +118,23 @@ def _robot(robot: str, urdf: Optional[Path], config: Optional[Path], mjcf: Optio
     return load_robot(robot, urdf=urdf, config=config, mjcf=mjcf)
 
 
-def _fit_rows(results: list[FitResult]) -> Table:
-    """One row per joint: its model, its fit's status (:mod:`~wbfriction.friction.status`; a fit that is not
-    ``ok`` greyed) and each of its parameters as value ±standard error (``n.i.``: not identifiable;
-    ``(bound)``: at a bound of the fit); blank: not a parameter of its model."""
-    import numpy as np
+def _print_whole(renderable) -> None:
+    """Print ``renderable`` as wide as it takes, nothing cut or wrapped (``--wide``; the terminal wraps its
+    lines): a console of that width on the same output (``Console.print`` stays within its console's)."""
+    from rich.measure import Measurement
 
-    from wbfriction.friction.models import ALL_PARAM_NAMES
-
-    names = [n for n in ALL_PARAM_NAMES if any(r.params is not None and n in r.params.names for r in results)]
-    routes = sorted({r.route for r in results})
-    table = Table(title="Friction model per joint: f(qd) fitted to -tau_f, value ±standard error "
-                        f"({', '.join(routes)} route)",
-                  caption="n.i.: not identifiable from these data (infinite standard error); "
-                          "(bound): at a bound of the fit, the bound's value, not the data's; Cramér-Rao: the "
-                          "standard deviation no unbiased estimator from these data goes below; screened: gross "
-                          "outliers left out (beyond 50 median absolute deviations)", box=None)
-    for col in ("joint", "model", "status", "N"):
-        table.add_column(col, justify="right" if col == "N" else "left")
-    for name in names:
-        table.add_column(name, justify="right")
-    has_true = any(r.rms_error_vs_true is not None for r in results)
-    if has_true:
-        table.add_column("RMS est-true", justify="right")
-    pad = [""] if has_true else []
-
-    def cell(r: FitResult, n: str) -> str:
-        if r.params is None or n not in r.params.names:
-            return ""
-        s = r.stderr[n]
-        return (f"{getattr(r.params, n):.4g} ±{'n.i.' if not np.isfinite(s) else f'{s:.1g}'}"
-                + (" (bound)" if r.at_bound.get(n) else ""))
-
-    def bound(r: FitResult, n: str) -> str:
-        if n not in r.crb:
-            return ""
-        return "n.i." if not np.isfinite(r.crb[n]) else f"±{r.crb[n]:.1g}"
-
-    for r in results:
-        rms = [f"{r.rms_error_vs_true:.4f}" if r.rms_error_vs_true is not None else ""] if has_true else []
-        verdict = r.verdict()
-        screened = f" (-{r.n_screened} screened)" if r.n_screened else ""
-        table.add_row(r.joint, r.model if r.params is not None else "—", verdict.status,
-                      f"{r.n_samples}{screened}", *[cell(r, n) for n in names], *rms,
-                      style=None if verdict.ok else "dim")  # numbers not to be used: greyed
-        if r.params is not None and r.crb:
-            table.add_row("  Cramér-Rao", "", "", "", *[bound(r, n) for n in names], *pad, style="dim")
-        err = r.error_percent()
-        if err is not None and r.target is not None:
-            target = r.target.values_in(r.model)
-            table.add_row("  target", "", "", "", *[f"{target[n]:.4g}" if n in target else "" for n in names],
-                          *pad, style="dim")
-            table.add_row("  error [%]", "", "", "", *[f"{err[n]:.2f}" if n in err else "" for n in names], *pad,
-                          style="dim")
-    return table
+    width = max(out.width, Measurement.get(out, out.options.update(width=10_000), renderable).maximum)
+    Console(width=width, file=out.file, force_terminal=out.is_terminal, no_color=out.no_color).print(renderable)
 
 
-def _print_verdicts(results: list[FitResult]) -> None:
-    """One line per fit that is not ``ok``: its status and why."""
-    for r in results:
-        verdict = r.verdict()
-        if not verdict.ok:
-            out.print(f"{r.joint}: {escape(str(verdict))}", highlight=False, soft_wrap=True)
+def _print_fits(results: list[FitResult], wide: bool = False, verbose: bool = False) -> None:
+    """The fitted friction's tables and notes (:mod:`~wbfriction.report.terminal`), as wide as the terminal."""
+    from wbfriction.report.terminal import fit_notes, fit_tables
+
+    for table in fit_tables(results, wide):
+        _print_whole(table) if wide else out.print(table)
+    for line in fit_notes(results, verbose):
+        out.print(escape(line), highlight=False)
 
 
 def _warn(warnings) -> None:
@@ -311,15 +269,11 @@ def _print_cross_check(friction: Path) -> None:
 
 
 def _run_fit(friction: Path, output: Path, options: FitOptions, threshold: float, tolerance: float,
-             workers: int) -> None:
+             workers: int, wide: bool = False, verbose: bool = False) -> None:
     from wbfriction.pipeline.fit import fit_file
 
     fitted = fit_file(friction, output, options, threshold=threshold, tolerance=tolerance, workers=workers)
-    out.print(_fit_rows(fitted.fits))
-    _print_verdicts(fitted.fits)
-    for r in fitted.fits:
-        if r.selection is not None:
-            out.print(f"{r.joint}: {escape(r.selection.reason)}", highlight=False, soft_wrap=True)
+    _print_fits(fitted.fits, wide, verbose)
     _warn_energy(fitted.energy)
     console.print(f"wrote {output}")
 
@@ -513,12 +467,14 @@ def fit(friction: Path = FrictionArg,
         workers: int = FitWorkersOpt, model: ModelChoice = ModelOpt,
         selection_tolerance: float = typer.Option(_FIT.selection_tolerance, min=0.0,
                                                   help="With --model auto: relative excess of held-out RMS within "
-                                                       "which the simpler model is chosen.")) -> None:
+                                                       "which the simpler model is chosen."),
+        wide: bool = WideOpt, verbose: bool = VerboseOpt) -> None:
     """Identify a friction model of every joint, with standard errors and the parameters left
     at a bound; warn about joints whose friction generates power (eq. 7.9)."""
     check_paths({"FRICTION": friction}, {"-o": output})
     _run_fit(friction, output, FitOptions(model=model, selection_tolerance=selection_tolerance,
-                                          min_samples=min_samples), energy_threshold, energy_tolerance, workers)
+                                          min_samples=min_samples), energy_threshold, energy_tolerance, workers,
+             wide, verbose)
 
 
 @app.command()

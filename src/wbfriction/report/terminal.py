@@ -1,0 +1,123 @@
+"""The fit as the terminal shows it (issue 39): tables that fit the terminal's width and notes one line per
+family.
+
+:func:`fit_tables` gives the friction table of ``wbfriction fit`` (and of ``identify``'s friction): by default
+one row per joint with its model, its status, F_c and F_v (value ± standard error,
+:func:`~wbfriction.report.numbers.with_error`) and their Cramér-Rao bounds below; the offset tau_os and the
+Stribeck terms (S, v_s, a, for the models that have them) of the fitted joints in a second table; and on
+simulated logs the errors against the truth in a third, the joints that were not excited left out (their
+errors measure nothing): three tables that fit 100 columns. ``wide=True`` gives every parameter in one
+table, as wide as it takes. :func:`fit_notes` says what the statuses and the model choice mean: one line
+per family of joints that share a status or a chosen model, each joint's own reason with ``verbose``.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from collections.abc import Sequence
+
+from rich.table import Table
+
+from wbfriction.friction.fit import FitResult
+from wbfriction.friction.models import ALL_PARAM_NAMES
+from wbfriction.report.numbers import bound_text, with_error
+
+MAIN = ("F_c", "F_v")
+"""The parameters of the main table: the friction every model has."""
+OTHERS = ("tau_os", "S", "v_s", "a")
+"""The offset (every model) and the Stribeck terms (the models that have them), in a second table."""
+CAPTION = ("value ± standard error; Cramér-Rao: the standard deviation no unbiased estimator from these data "
+           "goes below; n.i.: not identifiable; (b): at a bound of the fit, the bound's value, not the data's; "
+           "dim: not to be used (status)")
+NAMES_SHOWN = 6
+"""Joints named in a note before "and N more"."""
+
+
+def _cell(r: FitResult, name: str) -> str:
+    if r.params is None or name not in r.params.names:
+        return ""
+    return with_error(getattr(r.params, name), r.stderr.get(name)) + (" (b)" if r.at_bound.get(name) else "")
+
+
+def _table(title: str, first: Sequence[str], names: Sequence[str], caption: str | None = None) -> Table:
+    table = Table(title=title, caption=caption, box=None, title_justify="left", caption_justify="left",
+                  pad_edge=False)
+    for col in first:
+        table.add_column(col, no_wrap=col != "status", justify="right" if col == "N" else "left")
+    for name in names:
+        table.add_column(name, justify="right", no_wrap=True)
+    return table
+
+
+def fit_tables(results: Sequence[FitResult], wide: bool = False) -> list[Table]:
+    """The fitted friction of ``results`` as tables (module docstring): a fit that is not ``ok`` dimmed, its
+    numbers not to be used; ``wide``: one table with every parameter and the sample counts."""
+    fitted = [r for r in results if r.params is not None]
+    routes = ", ".join(sorted({r.route for r in results}))
+    title = f"Friction per joint: f(qd) fitted to -tau_f ({routes} route)"
+    if wide:
+        names = [n for n in ALL_PARAM_NAMES if any(n in r.params.names for r in fitted if r.params is not None)]
+        return [_rows(_table(title, ("joint", "model", "status", "N"), names, CAPTION), results, names, True)]
+    tables = [_rows(_table(title, ("joint", "model", "status"), MAIN, CAPTION), results, MAIN, False)]
+    others = [n for n in OTHERS if any(n in r.params.names for r in fitted if r.params is not None)]
+    tables.append(_rows(_table("Offset and Stribeck terms", ("joint",), others), fitted, others, False, short=True))
+    truth = [r for r in fitted if r.error_percent() is not None]
+    still = [r.joint for r in truth if r.verdict().status == "not excited"]
+    if truth:
+        table = _table("Against the simulator's friction: error [%]", ("joint", "model"), [*MAIN, *OTHERS, "RMS"],
+                       caption=f"not excited, left out: {', '.join(still)}" if still else None)
+        for r in truth:
+            if r.joint in still:
+                continue
+            err = r.error_percent() or {}
+            rms = "" if r.rms_error_vs_true is None else f"{r.rms_error_vs_true:.2g}"
+            table.add_row(r.joint, r.model, *[f"{err[n]:.2f}" if n in err else "" for n in (*MAIN, *OTHERS)], rms,
+                          style=None if r.verdict().ok else "dim")
+        tables.append(table)
+    return tables
+
+
+def _rows(table: Table, results: Sequence[FitResult], names: Sequence[str], wide: bool,
+          short: bool = False) -> Table:
+    """``results`` as rows of ``table``: value ± standard error, the Cramér-Rao bounds in a dimmed row below
+    (not for a joint that did not move: nothing to bound); ``short``: the joint alone before the values."""
+    for r in results:
+        verdict = r.verdict()
+        first = [r.joint] if short else [r.joint, r.model if r.params is not None else "—", verdict.status]
+        count = [f"{r.n_samples}" + (f" (-{r.n_screened} screened)" if r.n_screened else "")] if wide else []
+        table.add_row(*first, *count, *[_cell(r, n) for n in names], style=None if verdict.ok else "dim")
+        if r.params is not None and verdict.status != "not excited" and any(n in r.crb for n in names):
+            table.add_row("  Cramér-Rao", *[""] * (len(first) + len(count) - 1),
+                          *[bound_text(r.crb.get(n)) for n in names], style="dim")
+    return table
+
+
+def _joints(names: Sequence[str]) -> str:
+    shown = ", ".join(names[:NAMES_SHOWN])
+    return shown + (f" and {len(names) - NAMES_SHOWN} more" if len(names) > NAMES_SHOWN else "")
+
+
+def fit_notes(results: Sequence[FitResult], verbose: bool = False) -> list[str]:
+    """What the table's statuses and models mean, one line each: every fit that is not ``ok`` with its reason,
+    except the joints that did not move, which share one line; the model chosen on held-out data (``--model
+    auto``), one line per model. ``verbose``: each joint's own line for both."""
+    lines = []
+    still = [r.joint for r in results if r.verdict().status == "not excited" and r.params is not None
+             and r.speed is not None]
+    for r in results:
+        verdict = r.verdict()
+        if not verdict.ok and (verbose or r.joint not in still):
+            lines.append(f"{r.joint}: {verdict}")
+    if still and not verbose:
+        lines.append(f"not excited: {len(still)} joints hardly moved ({_joints(still)}); --verbose gives each "
+                     "one's speed")
+    chosen: dict[str, list[str]] = defaultdict(list)
+    for r in results:
+        if r.selection is not None:
+            if verbose:
+                lines.append(f"{r.joint}: {r.selection.reason}")
+            chosen[r.model].append(r.joint)
+    if chosen and not verbose:
+        lines.append("model chosen on held-out data (--verbose gives each joint's reason):")
+        lines += [f"  {model}: {_joints(joints)}" for model, joints in chosen.items()]
+    return lines
