@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -49,9 +50,18 @@ def test_main_job_steps_write_log_friction_and_params(demo_dir):
 
 @pytest.mark.slow
 def test_demo_prints_the_thesis_table_and_writes_figures(tmp_path):
-    res = run("demo", "-o", tmp_path, "--steps", "2")
+    res = run("demo", "-o", tmp_path, "--steps", "2", columns=100)
     assert res.returncode == 0, res.stderr
     assert "T6.2 [%]" in res.stdout and "leg_right_4_joint (knee)" in res.stdout
+    assert widest_line(res.stdout) <= 100, res.stdout
+    # the 2-step walk hardly turns the hip yaws: said before the table, left out of the worst errors
+    table = res.stdout.index("T6.2 [%]")
+    assert res.stdout.index("not an ok fit: leg_right_1_joint (hip_yaw)") < table
+    flat = " ".join(res.stdout.split())  # the line as said, however the terminal's width wrapped it
+    worst = flat[flat.index("worst error over the"):flat.index("true accelerations")]
+    errors = dict(re.findall(r"(\w+) ([\d.]+)", worst.split("[%]:")[1]))
+    assert "leg joints with an ok fit" in worst and set(errors) == {"F_v", "F_c", "S", "v_s", "tau_os", "a"}
+    assert all(float(v) < 50 for v in errors.values()), worst  # a hip yaw that did not turn: 19046 %
     assert "friction generating power (eq. 7.9), leg joints in swing: at most" in res.stdout
     for name in ("fig6_1_support_phases.png", "fig6_2_schemes_time.png", "fig6_3_schemes_velocity.png",
                  "friction_curves.png", "walk_params.json", "walk_friction.parquet", "report.html"):

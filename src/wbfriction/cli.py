@@ -615,58 +615,6 @@ def sensitivity(log: Path = LogArg,
     console.print(f"wrote {output}")
 
 
-def _change(x: float | None, digits: int) -> str:
-    """A relative change as a signed percentage; ``new`` for a body the given model had none of."""
-    return "new" if x is None else f"{100 * x:+.{digits}f}"
-
-
-def _identify_tables(doc: dict) -> list[Table]:
-    """The tables of ``wbfriction identify``: body changes, both routes' friction, held-out RMS."""
-    bodies = Table(title="Inertia model: given -> written (bodies with mass)", box=None,
-                   caption=escape("COM shift [mm]; principal moments about the centre of mass, ascending: change [%]; "
-                                  "kept: the identified body predicted held-out torques better (else as given)"))
-    for col in ("body", "mass given [kg]", "mass [kg]", "change [%]", "COM shift [mm]", "I1 [%]", "I2 [%]", "I3 [%]",
-                "kept"):
-        bodies.add_column(escape(col), justify="left" if col == "body" else "right")  # units kept: not markup
-    for b in doc["bodies"]:
-        if max(b["mass_given"], b["mass"]) <= 0:
-            continue
-        bodies.add_row(b["body"], f"{b['mass_given']:.4f}", f"{b['mass']:.4f}", _change(b["mass_change"], 2),
-                       f"{1e3 * b['com_shift']:.2f}", *[_change(x, 1) for x in b["moments_change"]],
-                       {True: "yes", False: "no"}.get(b.get("kept"), "—"))
-    names = list(next(iter(doc["joints"].values()))["identified"])
-    friction = Table(title="Friction: this route (torques, with the inertias written) and the acceleration route "
-                           "(5.10, the model written)", box=None,
-                     caption="gen: share of valid samples whose friction generates power (eq. 7.9), given model "
-                             "-> identified model; target: the simulator's, when the log has it")
-    friction.add_column("joint")
-    for n in names:
-        friction.add_column(f"{n}", justify="right")
-    for n in ("F_v", "F_c", "tau_os"):
-        friction.add_column(f"accel. {n}", justify="right")
-    friction.add_column("gen [%]", justify="right")
-    pct = lambda x: "—" if x is None else f"{100 * x:.1f}"  # noqa: E731
-    for joint, j in doc["joints"].items():
-        accel = (j["acceleration_route"]["params"] or {})
-        friction.add_row(joint, *[f"{j['identified'][n]:.4g}" for n in names],
-                         *[f"{accel[n]:.4g}" if n in accel else "—" for n in ("F_v", "F_c", "tau_os")],
-                         f"{pct(j['generating_share_given_model'])} -> {pct(j['generating_share'])}")
-        target = j["acceleration_route"].get("target")
-        if target:
-            f_s = {"F_s-F_c": target["S"] * target["F_c"]}
-            friction.add_row("  target", *[f"{target.get(n, f_s.get(n)):.4g}" for n in names],
-                             *[f"{target[n]:.4g}" for n in ("F_v", "F_c", "tau_os")], "", style="dim")
-    rms = Table(title=f"Held-out torques ({doc['holdout_samples']} single-support samples at the end of the log): "
-                      "RMS of measured - predicted [N·m]", box=None)
-    for col in ("joint", "given model", "given + its best friction", "identified", "validated (written)"):
-        rms.add_column(col, justify="left" if col == "joint" else "right")
-    for joint, j in doc["joints"].items():
-        h = j["holdout_rms"]
-        rms.add_row(joint, f"{h['given']:.4f}", f"{h['given_with_friction']:.4f}", f"{h['identified']:.4f}",
-                    f"{h['validated']:.4f}" if "validated" in h else "—")
-    return [bodies, friction, rms]
-
-
 @app.command()
 def identify(log: Path = LogArg,
              output: Path = typer.Option(..., "-o", "--output", help="Corrected URDF to write (the given one's "
@@ -696,7 +644,8 @@ def identify(log: Path = LogArg,
              diff: DiffOption = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
              mask: Mask = typer.Option(_E.mask, help="swing or single (see 'estimate')."),
              route: RouteOption = RouteOpt,
-             workers: int = FitWorkersOpt, time_unit: Optional[TimeUnit] = TimeUnitOpt) -> None:
+             workers: int = FitWorkersOpt, time_unit: Optional[TimeUnit] = TimeUnitOpt,
+             wide: bool = WideOpt) -> None:
     """Identify the inertia model and the friction together from the joint torques of single
     support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
     with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
@@ -710,6 +659,7 @@ def identify(log: Path = LogArg,
     if not 0.0 < holdout < 1.0:
         raise InputError(f"--holdout must be between 0 and 1, got {holdout}")
     from wbfriction.pipeline.identify import identify_file
+    from wbfriction.report.terminal import identification_tables
 
     r = _robot(robot, urdf, config, mjcf)
     r.require_urdf("identify (it writes the corrected URDF)")
@@ -724,18 +674,21 @@ def identify(log: Path = LogArg,
     doc, moved = done.document, done.moved
     for p in doc["passes"]:
         vs = "none" if p["stribeck_velocity"] is None else f"{p['stribeck_velocity']:.4g} rad/s"
-        out.print(f"v_s {vs}: {p['samples']} samples, {p['base_parameters']} base parameters of "
-                  f"{p['parameters']}, condition {p['condition']:.3g}, prior {p['prior']:g}; {p['message']}",
-                  highlight=False, soft_wrap=True)
+        out.print(escape(f"v_s {vs}: {p['samples']} samples, {p['base_parameters']} base parameters of "
+                         f"{p['parameters']}, condition {p['condition']:.3g}, prior {p['prior']:g}; {p['message']}"),
+                  highlight=False)
         if p.get("verdict"):
-            out.print(p["verdict"], highlight=False, soft_wrap=True)
+            out.print(escape(p["verdict"]), highlight=False)
         unexcited = p.get("not_excited") or []
         if unexcited:
-            out.print(f"not excited by this log, kept at the given model: {len(unexcited)} parameters ("
-                      + ", ".join(str(u.get("parameter", u)) if isinstance(u, dict) else str(u) for u in unexcited[:8])
-                      + (", ..." if len(unexcited) > 8 else "") + ")", highlight=False, soft_wrap=True)
-    for table in _identify_tables(doc):
-        out.print(table)
+            names = [str(u.get("parameter", u)) if isinstance(u, dict) else str(u) for u in unexcited]
+            out.print(escape(f"not excited by this log, kept at the given model: {len(names)} parameters ("
+                             + ", ".join(names[:4]) + (", ..." if len(names) > 4 else "") + ")"), highlight=False)
+    tables, notes = identification_tables(doc, wide)
+    for table in tables:
+        _print_whole(table) if wide else out.print(table)
+    for note in notes:
+        out.print(escape(note), highlight=False)
     toml = done.armature_toml()
     if toml is not None:
         out.print(escape("identified armature [kg·m^2], for the robot's TOML:\n" + toml), highlight=False)
@@ -787,8 +740,16 @@ def _print_not_ok(rows) -> None:
         verdict = row.fit.verdict()
         why = ("this walk hardly moved it (a short walk hardly turns the hip yaws: try more --steps)"
                if verdict.status == "not excited" else "its parameters are not determined by these samples")
-        out.print(f"  not an ok fit: {row.joint} ({row.group}), {verdict}. Its error measures the walk, not the "
-                  f"estimate: {why}.")
+        out.print(escape(f"not an ok fit: {row.joint} ({row.group}), {verdict}; its errors below measure the "
+                         f"walk, not the estimate: {why}."), highlight=False)
+
+
+def _print_worst(rows, worst: dict[str, float], params: tuple[str, ...]) -> None:
+    """The worst error of each parameter over the leg joints whose fit is ``ok`` (the others said above)."""
+    ok = sum(row.fit.verdict().ok for row in rows)
+    if ok:
+        out.print(f"worst error over the {ok} leg joints with an ok fit [%]: "
+                  + ", ".join(f"{n} {worst[n]:.2f}" for n in params))
 
 
 def _pulls_note(pulls: int, in_double: int) -> str:
@@ -809,10 +770,10 @@ def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
     with console.status("") as status:
         result = run_realistic_study(r, output_dir, steps=steps, progress=lambda label: status.update(label))
     for case in result.cases:
+        _print_not_ok(case.rows)
         out.print(_study_table(case.rows, f"MuJoCo, combined walk, swing phase: {case.label}", case.scored))
         worst = worst_scored(case)
         out.print("worst error over the leg joints [%]: " + ", ".join(f"{n} {v:.2f}" for n, v in worst.items()))
-        _print_not_ok(case.rows)
     out.print("right knee alone, RMS error [N·m] (central differences): " + "; ".join(
         f"{k} {v:.4f}" for k, v in result.knee_rms.items()))
     return result.files
@@ -838,11 +799,10 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
         return
     with console.status("") as status:
         result = run_study(r, output_dir, steps=steps, progress=lambda label: status.update(label))
+    _print_not_ok(result.rows)  # before the table: its error figures of those joints measure the walk
     out.print(_study_table(result.rows, "Identified friction (3.5) of the leg joints, combined walk, "
                                         "central differences"))
-    worst = worst_errors(result.rows)
-    out.print("worst error over the leg joints [%]: " + ", ".join(f"{n} {worst[n]:.2f}" for n in PARAM_NAMES))
-    _print_not_ok(result.rows)
+    _print_worst(result.rows, worst_errors([row for row in result.rows if row.fit.verdict().ok]), PARAM_NAMES)
     out.print(f"true accelerations: max |tau_f - tau_f_true| in single support = {result.truth_max_error:.2e} N·m")
     out.print("right knee, RMS error [N·m] with the leg in swing / in stance: " + "; ".join(
         f"{k} {a:.4f} / {b:.4f}" for k, (a, b) in result.knee_rms.items()))

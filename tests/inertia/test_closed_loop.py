@@ -11,7 +11,7 @@ import tomllib
 import numpy as np
 import pytest
 
-from helpers import run_cli
+from helpers import run_cli, run_cli_printed, widest_line
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.options import EstimateOptions
@@ -48,19 +48,22 @@ def test_stribeck_velocity_is_the_median_of_the_determined_joints():
 
 
 @pytest.mark.slow
-def test_identify_command_closes_the_loop(talos, wrong, combined_walk, tmp_path, capsys):
+def test_identify_command_closes_the_loop(talos, wrong, combined_walk, tmp_path, capsys, monkeypatch):
     """``identify`` on the combined walk seen through the wrong model (one pass, the Stribeck
     velocity given): the leg joints' friction moves back toward the truth (F_c and tau_os
     within 5 %) and no joint's friction generates power; the held-out torques are predicted
     far better; the URDF reloads as
-    the identified model, ``estimate --urdf`` runs on it, the report shows the RMS table."""
+    the identified model, ``estimate --urdf`` runs on it, the report shows the RMS table. In a 100-column
+    terminal no printed line is wider (issue 39)."""
     log = tmp_path / "walk.parquet"
     write_log(combined_walk.log, talos, log)
     given = tmp_path / "given.urdf"
     write_urdf(talos, body_parameters(wrong.model), given)
-    code, err = run_cli(capsys, "identify", log, "--urdf", given, "-o", tmp_path / "id.urdf",
-                        "--json", tmp_path / "id.json", "--stribeck-velocity", "0.2")
+    monkeypatch.setenv("COLUMNS", "100")  # what the command's console reads as the terminal's width
+    code, printed, err = run_cli_printed(capsys, "identify", log, "--urdf", given, "-o", tmp_path / "id.urdf",
+                                         "--json", tmp_path / "id.json", "--stribeck-velocity", "0.2")
     assert code == 0, err
+    assert widest_line(printed) <= 100 and "Held-out torques" in printed, printed
     doc = json.loads((tmp_path / "id.json").read_text())
     legs = [j for j, _, _ in leg_joints(talos)]
     before = {n: max(doc["joints"][j]["acceleration_route_given_model"]["error_percent"][n] for j in legs)

@@ -121,3 +121,83 @@ def fit_notes(results: Sequence[FitResult], verbose: bool = False) -> list[str]:
         lines.append("model chosen on held-out data (--verbose gives each joint's reason):")
         lines += [f"  {model}: {_joints(joints)}" for model, joints in chosen.items()]
     return lines
+
+
+CHANGED = 1e-4
+"""A body whose mass, centre of mass [m] or principal moments changed by less than this (relative; absolute
+for the centre of mass) is as given: left out of the bodies' table."""
+
+
+def _g(x: float | None) -> str:
+    """A number without a standard error, in three significant digits ("—": none)."""
+    return "—" if x is None else f"{x:.3g}"
+
+
+def _change(x: float | None, digits: int) -> str:
+    """A relative change as a signed percentage; ``new`` for a body the given model had none of."""
+    return "new" if x is None else f"{100 * x:+.{digits}f}"
+
+
+def identification_tables(doc: dict, wide: bool = False) -> tuple[list[Table], list[str]]:
+    """The tables of ``wbfriction identify`` from its document
+    (:func:`~wbfriction.inertia.io.identification_document`)
+    and the notes that stand for the rows left out: the bodies that changed (``wide``: every body with mass),
+    the friction of the joints whose acceleration-route fit moved (both routes, the status of the
+    acceleration route's fit, the power-generating share), and their held-out torques."""
+    notes: list[str] = []
+    bodies = Table(title="Inertia model: given -> written", box=None, title_justify="left", caption_justify="left",
+                   caption="COM: shift [mm]; I1-I3: principal moments about the centre of mass, ascending, change "
+                           "[%]; kept: the identified body predicted held-out torques better (else as given)")
+    for col in ("body", "mass [kg]", "mass [%]", "COM [mm]", "I1 [%]", "I2 [%]", "I3 [%]", "kept"):
+        bodies.add_column(col, justify="left" if col == "body" else "right", no_wrap=True)
+    massive = [b for b in doc["bodies"] if max(b["mass_given"], b["mass"]) > 0]
+    changed = [b for b in massive if wide or b.get("kept") or b["mass_change"] is None
+               or abs(b["mass_change"]) >= CHANGED or b["com_shift"] >= CHANGED
+               or any(abs(x) >= CHANGED for x in b["moments_change"])]
+    for b in changed:
+        bodies.add_row(b["body"], f"{b['mass_given']:.4g} -> {b['mass']:.4g}", _change(b["mass_change"], 2),
+                       f"{1e3 * b['com_shift']:.2f}", *[_change(x, 1) for x in b["moments_change"]],
+                       {True: "yes", False: "no"}.get(b.get("kept"), "—"))
+    if len(changed) < len(massive):
+        notes.append(f"{len(massive) - len(changed)} of {len(massive)} bodies with mass written as given "
+                     "(--wide lists them)")
+    joints = doc["joints"]
+    moved = [j for j, v in joints.items() if wide or v["acceleration_route"].get("status") != "not excited"]
+    names = list(next(iter(joints.values()))["identified"]) if joints else []
+    friction = Table(title="Friction: this route (torques, the inertias written) and the acceleration route (5.10)",
+                     box=None, title_justify="left", caption_justify="left",
+                     caption="status: of the acceleration route's fit; gen: share of valid samples whose friction "
+                             "generates power (eq. 7.9) [%], given model -> identified; target: the simulator's")
+    friction.add_column("joint", no_wrap=True)
+    friction.add_column("status")
+    for n in (*names, "accel. F_v", "accel. F_c", "gen [%]"):
+        friction.add_column(n, justify="right", no_wrap=True)
+    pct = lambda x: "—" if x is None else f"{100 * x:.1f}"  # noqa: E731
+    for joint in moved:
+        j = joints[joint]
+        accel = j["acceleration_route"]
+        params = accel.get("params") or {}
+        status = accel.get("status", "—")
+        friction.add_row(joint, status, *[_g(j["identified"][n]) for n in names],
+                         *[_g(params.get(n)) for n in ("F_v", "F_c")],
+                         f"{pct(j['generating_share_given_model'])}->{pct(j['generating_share'])}",
+                         style=None if status == "ok" else "dim")
+        target = accel.get("target")
+        if target:
+            f_s = {"F_s-F_c": target.get("S", 0.0) * target["F_c"]}
+            friction.add_row("  target", "", *[_g(target.get(n, f_s.get(n))) for n in names],
+                             *[_g(target.get(n)) for n in ("F_v", "F_c")], "", style="dim")
+    if len(moved) < len(joints):
+        still = [j for j in joints if j not in moved]
+        notes.append(f"not excited by this log, friction and held-out torques left out: {len(still)} joints "
+                     f"({', '.join(still[:NAMES_SHOWN])}{' and more' if len(still) > NAMES_SHOWN else ''}); --wide "
+                     "lists them")
+    rms = Table(title=f"Held-out torques ({doc['holdout_samples']} single-support samples at the end of the log): "
+                      "RMS of measured - predicted [N·m]", box=None, title_justify="left")
+    for col in ("joint", "given model", "given + its friction", "identified", "written"):
+        rms.add_column(col, justify="left" if col == "joint" else "right", no_wrap=True)
+    for joint in moved:
+        h = joints[joint]["holdout_rms"]
+        rms.add_row(joint, f"{h['given']:.4f}", f"{h['given_with_friction']:.4f}", f"{h['identified']:.4f}",
+                    f"{h['validated']:.4f}" if "validated" in h else "—")
+    return [t for t in (bodies, friction, rms) if t.row_count], notes

@@ -100,10 +100,11 @@ def leg_params_extra(rows: list[LegRow], thesis_errors: bool = True) -> dict[str
 
 
 def worst_errors(rows: list[LegRow], params: tuple[str, ...] = PARAM_NAMES) -> dict[str, float]:
-    """Largest error [%] of each of ``params`` over the leg joints (every row needs a fit and a target)."""
+    """Largest error [%] of each of ``params`` over the leg joints (every row needs a fit and a target; NaN for
+    no row)."""
     errors = [r.fit.error_percent() for r in rows]
     assert all(e is not None for e in errors), "a study's leg joints all have a fit and a target"
-    return {n: max(e[n] for e in errors if e is not None) for n in params}
+    return {n: max((e[n] for e in errors if e is not None), default=float("nan")) for n in params}
 
 
 def not_ok(rows: list[LegRow]) -> list[LegRow]:
