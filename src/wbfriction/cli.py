@@ -246,7 +246,7 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
         velocity = result.metadata.get("velocity", {})  # measured on the first chunk
         console.print(f"velocity: {escape(velocity.get('reason', 'logged'))} (not compensated)", highlight=False)
     routes = result.metadata.get("base_motion")
-    if routes:  # decided on the first chunk
+    if routes and r.floating_base:  # decided on the first chunk; a fixed base has none
         console.print(f"base motion: {routes['base']}" + ("; wrenches: every joint in every phase"
                                                           if routes["wrenches"] else ""), highlight=False)
         _print_cross_check(output)

@@ -23,6 +23,7 @@ from wbfriction.friction.status import MIN_SPEED, FitVerdict
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
 from wbfriction.report.figures import friction_overview_figure, joint_figure, png_bytes
+from wbfriction.report.numbers import duration_text
 from wbfriction.workers import process_pool
 
 PAGE_CSS = """
@@ -381,6 +382,7 @@ def _page(r: Report, overview: str, sections: list[str]) -> str:
     moved = list(r.moved)
     nav = "".join(f'<a href="#{_anchor(j)}">{html.escape(r.label(j))}</a>' for j in moved)
     n_valid = int(est.valid.any(axis=1).sum())
+    support = f"{int(est.unique.sum())} in single support, " if est.contact_frames else "fixed base, "
     still = ""
     if r.still:
         still = (f'<details class="still"><summary>{len(r.still)} joints did not move: no figure</summary>'
@@ -390,8 +392,8 @@ def _page(r: Report, overview: str, sections: list[str]) -> str:
 <title>wbfriction report: {html.escape(robot)}</title><style>{PAGE_CSS}</style></head>
 <body>
 <h1>Joint friction report: {html.escape(robot)}</h1>
-<p class="sub">{len(est.time)} samples, {est.time[-1] - est.time[0]:.1f} s, {int(est.unique.sum())} in single support,
-{n_valid} with a valid joint; {len(est.joints)} torque-controlled joints, {len(moved)} of which moved. Sign convention:
+<p class="sub">{len(est.time)} samples, {duration_text(est.time)}, {support}{n_valid} with a valid joint;
+{len(est.joints)} torque-controlled joints, {len(moved)} of which moved. Sign convention:
 τ_f is the torque friction exerts on the joint (dissipative: qd·τ_f ≤ 0); the model f(qd) of eq. (3.5) is fitted to
 −τ_f. Made {html.escape(r.date)}.</p>
 {_contents(r)}

@@ -3,11 +3,17 @@ terminal and the report (issue 39).
 
 The standard error is rounded to one significant digit (two when that digit is 1: 0.14, not 0.1, which would
 be off by 30 %), and the value to the same decimal place; down to a last digit of 1e-5 and below 1e5 they are
-written plainly, others with a common power of ten: ``0.180 ± 0.005``, ``38.5 ± 0.1``, ``(3.00 ± 0.10)e-07``."""
+written plainly, others with a common power of ten: ``0.180 ± 0.005``, ``38.5 ± 0.1``, ``(3.00 ± 0.10)e-07``.
+Durations are the time recorded and, across gaps, the span (:func:`duration_text`)."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
 
 PLAIN = (1e-5, 1e5)
 """Magnitudes written without a power of ten: from the smallest decimal shown to the largest value."""
@@ -51,3 +57,32 @@ def bound_text(bound: float | None) -> str:
     if not math.isfinite(bound):
         return "n.i."
     return f"± {bound:.2g}" if bound / 10.0 ** math.floor(math.log10(bound)) < 2.0 else f"± {bound:.1g}"
+
+
+GAP_STEPS = 10.0
+"""A time step longer than this many median steps is a gap between recordings, not recorded time."""
+
+
+def duration_text(time: Sequence[float] | np.ndarray) -> str:
+    """How long a log lasts: the time recorded (the sum of its steps, gaps left out) and, when gaps split it, the
+    span from its first sample to its last and the number of recordings, e.g. ``50.3 s recorded in 2 runs over
+    29.3 min``; time [s], increasing."""
+    import numpy as np
+
+    t = np.asarray(time, dtype=float)
+    if len(t) < 2:
+        return "0 s recorded"
+    steps = np.diff(t)
+    gap = steps > GAP_STEPS * np.median(steps)
+    recorded = float(steps[~gap].sum())
+    if not gap.any():
+        return f"{_seconds(recorded)} recorded"
+    return f"{_seconds(recorded)} recorded in {int(gap.sum()) + 1} runs over {_seconds(float(t[-1] - t[0]))}"
+
+
+def _seconds(s: float) -> str:
+    """A duration in its unit: ``12.5 s``, ``29.3 min``, ``2.4 h``, ``3.1 days``."""
+    for unit, size in (("days", 86400.0), ("h", 3600.0), ("min", 60.0)):
+        if s >= 2 * size:
+            return f"{s / size:.1f} {unit}"
+    return f"{s:.1f} s"
