@@ -353,3 +353,10 @@ def test_predict_names_each_fit_s_status(walk_friction, tmp_path, capsys):
     weak_row = next(line for line in out.splitlines() if line.split()[:1] == [joint])
     assert weak_row.split()[-1] == "weak" and weak_row.split()[:-1] == row.split()[:-1]
     assert "a prediction by a fit that is not ok is no better than that fit" in err
+    # every joint together: the root of the pooled mean square, each joint weighted by its samples
+    rows = [line.split() for line in out.splitlines() if line.split()[:1] in ([j] for j in doc["joints"])]
+    samples = np.array([int(r[1]) for r in rows])
+    rigid = np.array([float(r[2]) for r in rows])
+    total = next(line.split() for line in out.splitlines() if line.split()[:2] == ["all", "joints"])
+    assert int(total[2]) == samples.sum()
+    assert float(total[3]) == pytest.approx(np.sqrt(np.sum(samples * rigid**2) / samples.sum()), rel=2e-3)

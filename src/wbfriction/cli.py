@@ -532,6 +532,9 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
     for j, n, rigid, full, status in zip(pred.joints, pred.samples, pred.rms_rigid_body, pred.rms, statuses):
         table.add_row(j, str(n), f"{rigid:.4g}", "—" if not np.isfinite(full) else f"{full:.4g}", status,
                       style=None if status in ("ok", "") else "dim")
+    rigid, full = pred.overall(pred.rms_rigid_body), pred.overall(pred.rms)
+    table.add_row("all joints", str(int(pred.samples.sum())), f"{rigid:.4g}",
+                  "—" if not np.isfinite(full) else f"{full:.4g}", "", style="bold", end_section=True)
     out.print(table)
     if any(status not in ("ok", "") for status in statuses):
         console.print("a prediction by a fit that is not ok is no better than that fit: see 'fit' for the reason")

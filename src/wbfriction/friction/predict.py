@@ -53,6 +53,15 @@ class TorquePrediction:
     rms_torque: np.ndarray
     status: tuple[str, ...] = ()
 
+    def overall(self, rms: np.ndarray) -> float:
+        """The RMS over every joint's valid samples of one of the per-joint RMS arrays (``rms`` or
+        ``rms_rigid_body``), each joint weighted by its samples: the root of the pooled mean square [N·m]; the
+        joints without a value (NaN) left out, NaN when none has one."""
+        ok = np.isfinite(rms) & (self.samples > 0)
+        if not ok.any():
+            return float("nan")
+        return float(np.sqrt(np.sum(self.samples[ok] * rms[ok] ** 2) / np.sum(self.samples[ok])))
+
 
 def _rms(x: np.ndarray, valid: np.ndarray) -> float:
     return float(np.sqrt(np.mean(x[valid] ** 2))) if valid.any() else float("nan")
