@@ -846,8 +846,14 @@ def spectrum(log: Path = LogArg,
     for j, c in zip(spec.joints, spec.cutoff):
         table.add_row(j, f"{c:.1f}")
     out.print(table)
-    out.print(f"suggested cutoff: {spec.suggestion:.1f} Hz  (wbfriction estimate --diff butterworth "
-              f"--cutoff {spec.suggestion:.0f})")
+    if spec.cutoff_found:
+        out.print(f"suggested cutoff: {spec.suggestion:.1f} Hz  (wbfriction estimate --diff butterworth "
+                  f"--cutoff {spec.suggestion:.0f})")
+    else:
+        out.print(f"no cutoff to suggest: the content reaches {spec.suggestion:.0f} Hz of the {spec.nyquist:.0f} Hz "
+                  "band (broadband: noise, or a vibration the controller makes of it); a low-pass filter would not "
+                  "separate it: 'wbfriction estimate' chooses the route and its smoothing from the noise (--diff "
+                  "auto, --route auto)")
     spectrum_figure(spec, output)
     console.print(f"wrote {output}")
 

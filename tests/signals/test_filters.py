@@ -178,6 +178,25 @@ def test_amplitude_spectrum_and_cutoff_suggestion():
     assert suggest_cutoff(freq, amp, tail=0.05) == pytest.approx(7.0, abs=0.05)  # 8 Hz alone is under 5 %
 
 
+def test_the_cutoff_is_where_the_content_meets_a_broadband_floor():
+    """A walk's content below 8 Hz, a quiet band, then broadband noise from 60 Hz that holds most of the power
+    (what a controller makes of noisy positions; issue 39: the cutoff was suggested at 473 Hz): the content
+    ends inside the quiet band, where the spectrum dips below the floor; the same content without the
+    broadband noise gives the same end."""
+    rng = np.random.default_rng(3)
+    t = np.arange(20_000) * DT
+    content = sum(10.0 / np.sqrt(k) * np.sin(2 * np.pi * k * 1.0 * t + k) for k in range(1, 9))
+    white = rng.normal(0, 1.0, t.size)
+    spectrum = np.fft.rfft(white)
+    spectrum[np.fft.rfftfreq(t.size, DT) < 60.0] *= 0.01  # quiet below 60 Hz
+    broadband = np.fft.irfft(spectrum, t.size) * 40.0
+    freq, amp = amplitude_spectrum(content + broadband, DT)
+    assert np.sum(amp[freq > 60] ** 2) > 2 * np.sum(amp[(freq > 0) & (freq < 9)] ** 2)  # the floor's power rules
+    cutoff = suggest_cutoff(freq, amp)
+    assert 8.0 <= cutoff < 20.0, cutoff
+    assert suggest_cutoff(*amplitude_spectrum(content + 0.01 * broadband, DT)) == pytest.approx(8.0, abs=0.05)
+
+
 def _log_with_contacts(q: np.ndarray, switch: int) -> Log:
     n = len(q)
     contact = np.zeros((n, 2), dtype=bool)

@@ -155,9 +155,13 @@ def filter_curves_figure(curves: dict[str, dict], joint: str, target, position_s
     _save(fig, path)
 
 
-def spectrum_figure(spec, path: str | Path, max_freq: float = 50.0, columns: int = 4) -> None:
+def spectrum_figure(spec, path: str | Path, max_freq: float | None = None, columns: int = 4) -> None:
     """Fig. 7.1 kind: amplitude spectrum of the estimated acceleration per joint (log scale,
-    shared axes), the suggested cutoff of each joint dashed, the overall one solid."""
+    shared axes), the suggested cutoff of each joint dashed, the overall one solid (none when the content is
+    broadband: :attr:`~wbfriction.signals.spectrum.AccelerationSpectrum.cutoff_found`), up to ``max_freq``
+    [Hz] (default: :attr:`~wbfriction.signals.spectrum.AccelerationSpectrum.shown_band`, which every cutoff
+    drawn is inside)."""
+    max_freq = spec.shown_band if max_freq is None else max_freq
     n = len(spec.joints)
     columns = min(columns, n)
     rows = int(np.ceil(n / columns))
@@ -167,15 +171,18 @@ def spectrum_figure(spec, path: str | Path, max_freq: float = 50.0, columns: int
     for i, (ax, joint) in enumerate(zip(axes, spec.joints)):
         ax.semilogy(spec.freq[keep], spec.amplitude[keep, i], lw=0.7, color="C0")
         ax.axvline(spec.cutoff[i], color="C1", ls="--", lw=1)
-        ax.axvline(spec.suggestion, color="C3", lw=1)
+        if spec.cutoff_found:
+            ax.axvline(spec.suggestion, color="C3", lw=1)
         ax.set_title(f"{joint.replace('_joint', '')}: {spec.cutoff[i]:.1f} Hz", fontsize=8)
         ax.tick_params(labelsize=7)
     for ax in axes[n:]:
         ax.set_visible(False)
     fig.supxlabel("frequency [Hz]")
     fig.supylabel("amplitude of qdd_est [rad/s²]")
-    fig.suptitle(f"Fig. 7.1: spectrum of the estimated acceleration; suggested cutoff {spec.suggestion:.1f} Hz "
-                 f"(dashed: each joint's; the median of them)")
+    overall = (f"suggested cutoff {spec.suggestion:.1f} Hz (the median of them)" if spec.cutoff_found else
+               f"no cutoff: the content is broadband (median {spec.suggestion:.0f} Hz of {spec.nyquist:.0f})")
+    fig.suptitle(f"Fig. 7.1: spectrum of the estimated acceleration\ndashed: where each joint's content ends; "
+                 f"{overall}")
     _save(fig, path)
 
 

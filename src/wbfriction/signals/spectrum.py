@@ -37,13 +37,22 @@ def amplitude_spectrum(x: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray
     return np.fft.rfftfreq(n, dt), amp
 
 
+DIP_WIDTH = 2.0
+"""Band [Hz] the spectrum is smoothed over to find where its content dips below a broadband floor."""
+DIP_DEPTH = 0.5
+"""A dip is the smoothed amplitude below this share of the floor (a noisy floor's smoothed amplitude stays near
+it)."""
+
+
 def suggest_cutoff(freq: np.ndarray, amp: np.ndarray, tail: float = 0.01) -> float:
     """Where the content of one amplitude spectrum ends [Hz] (Fig. 7.1): the frequency below
     which all but ``tail`` of its power above the noise floor lies.
 
     The noise floor is the median amplitude over the upper half of the band. Above the
     returned frequency the spectrum holds no distinguishable content: a low-pass cutoff for
-    the measured acceleration. (The thesis read 10 Hz off the spectra of TORO's walk.)
+    the measured acceleration. (The thesis read 10 Hz off the spectra of TORO's walk.) When a broadband
+    floor holds most of the power (a noisy log), the content ends where the smoothed spectrum first dips
+    below half the floor, if it does before.
 
     Args:
         freq, amp: from :func:`amplitude_spectrum` (one joint).
@@ -63,11 +72,19 @@ def suggest_cutoff(freq: np.ndarray, amp: np.ndarray, tail: float = 0.01) -> flo
     total = power.sum()
     if total <= 0:
         return float(freq[-1])
-    return float(freq[np.searchsorted(np.cumsum(power), (1.0 - tail) * total)])
+    end = float(freq[np.searchsorted(np.cumsum(power), (1.0 - tail) * total)])
+    # a broadband floor (noise, or a vibration the controller makes of it) can hold most of the power: the
+    # content then ends where the spectrum, smoothed over DIP_WIDTH, first dips below half the floor
+    bins = max(3, int(round(DIP_WIDTH / (freq[1] - freq[0]))))
+    smooth = np.sqrt(np.convolve(amp**2, np.ones(bins) / bins, mode="same"))
+    dip = np.flatnonzero((smooth < DIP_DEPTH * floor) & (freq > bins * (freq[1] - freq[0])))
+    return min(end, float(freq[dip[0]])) if dip.size else end
 
 
 MIN_SAMPLES = 64
 """Fewest consecutive samples a spectrum is computed over."""
+BROADBAND = 0.5
+"""Share of the Nyquist frequency from which a spectrum's content is broadband: no cutoff to suggest."""
 
 
 def longest_run(mask: np.ndarray) -> tuple[int, int]:
@@ -112,6 +129,24 @@ class AccelerationSpectrum:
         estimated acceleration carries impacts; the thesis read its 10 Hz off representative
         joints, the knee and the hip pitch)."""
         return float(np.median(self.cutoff))
+
+    @property
+    def nyquist(self) -> float:
+        """The highest frequency of the spectra [Hz]."""
+        return float(self.freq[-1])
+
+    @property
+    def cutoff_found(self) -> bool:
+        """Whether the content ends well inside the band (below :data:`BROADBAND` of the Nyquist frequency): a
+        low-pass filter there removes what lies above it. Content that reaches the top of the band (noise the
+        controller turned into motion, a broadband vibration) has no cutoff to suggest."""
+        return self.suggestion < BROADBAND * self.nyquist
+
+    @property
+    def shown_band(self) -> float:
+        """The highest frequency a figure of the spectra shows [Hz]: every joint's cutoff with a margin, at
+        least 50 Hz (the thesis's Fig. 7.1), at most the Nyquist frequency."""
+        return float(min(self.nyquist, max(50.0, 1.25 * float(np.max(self.cutoff)))))
 
 
 def acceleration_spectrum(robot: Robot, log: Log, joints: list[str] | None = None, tail: float = 0.01,
