@@ -12,6 +12,7 @@ joint; F_c > 0 opposes the motion.
 from __future__ import annotations
 
 import argparse
+import sys
 import tempfile
 from pathlib import Path
 
@@ -23,6 +24,11 @@ WORN = Drift("arm-1", "panda_joint4", "F_c", 0.40, 5)
 """Arm 1's fourth joint: its Coulomb friction 40 % higher by its last log, growing over its last 5."""
 
 
+def say(line: str) -> None:
+    """A progress line on standard error (standard output keeps the results)."""
+    print(line, file=sys.stderr, flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--output", type=Path, help="folder to keep (default: a temporary one)")
@@ -30,8 +36,11 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         folder = args.output or Path(tmp)
         folder.mkdir(parents=True, exist_ok=True)
-        manifest = simulate_arm_fleet(folder, robots=2, logs=12, drifts=(WORN,))
-        summary = run_batch(read_manifest(manifest), folder / "results", workers=2)
+        manifest = simulate_arm_fleet(folder, robots=2, logs=12, drifts=(WORN,), progress=say)
+        logs = read_manifest(manifest)
+        done = []
+        summary = run_batch(logs, folder / "results", workers=2, progress=lambda outcome: (
+            done.append(outcome), say(f"batch: {len(done)} of {len(logs)} logs estimated and fitted")))
         print(f"{summary.processed} logs processed on Dask, {summary.skipped} already done")
         trends = fleet_trends(read_results(folder / "results").table)
         write_trends_html(trends, folder / "trends.html")

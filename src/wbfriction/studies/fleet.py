@@ -142,10 +142,11 @@ def simulate_fleet(robot: Robot, output_dir: Path, plan: FleetPlan = FleetPlan()
 
 def simulate_arm_fleet(folder: Path, robots: int = 2, logs: int = 12, seconds: float = 3.0,
                        drifts: tuple[Drift, ...] = (), start: datetime = datetime(2026, 1, 5, 8, tzinfo=UTC),
-                       spacing: timedelta = timedelta(days=1)) -> Path:
+                       spacing: timedelta = timedelta(days=1), progress: StageProgress | None = None) -> Path:
     """A small, fast fleet: ``robots`` simulated Panda arms (``arm-0``, ...) with ``wbfriction simulate``'s
     default arm friction, ``logs`` excitation runs of ``seconds`` each per arm (torque noise 0.01 N·m, seed
-    ``100 r + i``), ``drifts`` applied; the logs and ``manifest.csv`` go into ``folder``. Returns the manifest."""
+    ``100 r + i``), ``drifts`` applied; the logs and ``manifest.csv`` go into ``folder``; ``progress`` is
+    called with a line after each log. Returns the manifest."""
     from wbfriction.logs.tables import write_table
     from wbfriction.model.loading import load_robot
     from wbfriction.sim.arm import ArmOptions, default_arm_friction, simulate_arm
@@ -166,6 +167,8 @@ def simulate_arm_fleet(folder: Path, robots: int = 2, logs: int = 12, seconds: f
             name = f"arm{r}_{i:02d}.parquet"
             write_table(sim.table, folder / name)
             lines.append(f"{name},arm-{r},{(start + i * spacing).isoformat()},panda")
+            if progress is not None:
+                progress(f"simulated arm-{r}'s log {i + 1} of {logs} ({r * logs + i + 1} of {robots * logs})")
     (folder / "manifest.csv").write_text("\n".join(lines) + "\n")
     return folder / "manifest.csv"
 
