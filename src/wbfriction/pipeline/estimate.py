@@ -50,6 +50,14 @@ class RobotSpec:
     config: str | None = None
     mjcf: str | None = None
 
+    @classmethod
+    def given(cls, name: str, urdf: str | Path | None = None, config: str | Path | None = None,
+              mjcf: str | Path | None = None) -> RobotSpec:
+        """The robot a command's ``--robot``, ``--urdf``, ``--config`` and ``--mjcf`` name (a ``--config`` stands
+        for the whole robot: the built-in name is then not used)."""
+        text = lambda p: None if p is None else str(p)  # noqa: E731
+        return cls(None if config else name, text(urdf), text(config), text(mjcf))
+
     def load(self) -> Robot:
         return load_robot(self.name, urdf=self.urdf, config=self.config, mjcf=self.mjcf)
 

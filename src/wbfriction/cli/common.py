@@ -1,0 +1,191 @@
+"""The command line's shared parts: the app, its two consoles (messages on standard error, one line each;
+results on standard output, as wide as the terminal), the options several commands take with the library's
+defaults, the robot from --robot/--urdf/--config/--mjcf, the progress bar and the entry point :func:`main`."""
+from __future__ import annotations
+
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING, Optional
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+# Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
+# options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.exceptions import InputError, WbfrictionError
+from wbfriction.friction.options import (
+    DEFAULT_THRESHOLD,
+    DEFAULT_TOLERANCE,
+    EstimateOptions,
+    FitOptions,
+)
+from wbfriction.inertia.options import InertialOptions
+from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
+from wbfriction.model.robots import BUILTIN_ROBOTS
+from wbfriction.signals.options import FilterOptions
+from wbfriction.sim.options import IdealOptions, MujocoOptions
+from wbfriction.version import __version__
+from wbfriction.walking.options import GaitOptions
+
+if TYPE_CHECKING:
+    from wbfriction.model.robot import Robot
+
+# rich_markup_mode=None: click's plain help, so that units in brackets ([m], [rad/s], [friction.<group>]) are
+# printed as written (Rich markup would take them for tags and delete them)
+app = typer.Typer(add_completion=False, rich_markup_mode=None)
+console = Console(stderr=True, soft_wrap=True)  # a message is one line, wrapped by the terminal, not cut into lines
+out = Console()  # as wide as the terminal (COLUMNS); tables fit it (--wide: every column)
+
+WideOpt = typer.Option(False, "--wide", help="Every column in one table, as wide as it takes (default: tables that "
+                                            "fit the terminal).")
+VerboseOpt = typer.Option(False, "--verbose", help="Each joint's own line for the notes shared by several.")
+RobotOpt = typer.Option("talos", "--robot", help=f"Built-in robot: {', '.join(BUILTIN_ROBOTS)}.")
+LOG_FORMATS = "Parquet (.parquet), CSV (.csv) or HDF5 (.h5, .hdf5)"
+"""The log file formats every command reads (a ROS 2 bag too, where a command takes --map)."""
+LogArg = typer.Argument(..., metavar="LOG", help=f"Log in the wbfriction format: {LOG_FORMATS}.")
+FrictionArg = typer.Argument(..., metavar="FRICTION", help="Friction table written by 'wbfriction estimate'.")
+EnergyThresholdOpt = typer.Option(DEFAULT_THRESHOLD, min=0.0, max=1.0,
+                                  help="Share of power-generating samples (eq. 7.9) above which a joint is flagged.")
+EnergyToleranceOpt = typer.Option(DEFAULT_TOLERANCE, min=0.0,
+                                  help="Smallest friction torque that counts as generating power [N·m] (the torque "
+                                       "sensor's resolution).")
+UrdfOpt = typer.Option(None, "--urdf", help="URDF of another robot (with --config), or another URDF of the "
+                                             "built-in --robot (e.g. identified inertias).")
+ConfigOpt = typer.Option(None, "--config", help="Robot TOML: urdf or mjcf (else give --urdf or --mjcf), "
+                                                  "contact_frames, position_controlled, groups.")
+MjcfOpt = typer.Option(None, "--mjcf", help="MuJoCo MJCF of the robot instead of its URDF (with --config, or the "
+                                             "built-in --robot's configuration); not with --urdf.")
+FitWorkersOpt = typer.Option(2, min=1, help="Processes fitting joints side by side.")
+RouteOpt = typer.Option("auto", "--route", help="How the friction is reached: momentum (positions "
+                                                "differentiated once, generalized momentum), acceleration (twice, "
+                                                "the thesis's) or auto (chosen from the positions' noise, printed); "
+                                                "the other route is estimated too, as a check.")
+VelocityWindowOpt = typer.Option(None, "--velocity-window", help="momentum: the velocity's Savitzky-Golay window "
+                                                                 "(odd, at least 7) [samples]; default: chosen from "
+                                                                 "the noise.")
+MomentumWindowOpt = typer.Option(None, "--momentum-window", help="momentum: the window the friction is averaged "
+                                                                 "over (odd, at least 3) [samples]; default: chosen "
+                                                                 "from the noise.")
+TimeUnitOpt = typer.Option(None, help="Unit of a numeric time column: s, ms, us or ns (needed for integer stamps; "
+                                      "float stamps are seconds unless said otherwise; timestamps carry theirs).")
+MapOpt = typer.Option(None, "--map", help="Topic map TOML of a ROS 2 bag log (see 'wbfriction convert'); with a "
+                                           "table log: its [joint_states] rename and [[contacts]] column, threshold.")
+
+
+MaxGapOpt = typer.Option(MAX_GAP, min=1.5, help="Time steps of at least this many local median steps split the log "
+                                        "into segments, estimated apart.")
+TimeBaseOpt = typer.Option("auto", help="Time base the positions are differentiated on: auto (decided from the "
+                                         "data and printed), recorded (the stamps as they are: a clock that "
+                                         "skips samples) or regularised (a uniform clock fitted to "
+                                         "receive-time stamps).")
+LimitMarginOpt = typer.Option(LIMIT_MARGIN, min=0.0,
+                              help="Positions beyond the URDF limits by more than this [rad] are refused (wrong "
+                                   "units).")
+
+
+@contextmanager
+def progress_bar(total: int, label: str):
+    with Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                  console=console, transient=True, disable=total < 2000) as bar:
+        task = bar.add_task(label, total=total)
+        yield lambda n: bar.advance(task, n)
+
+
+def robot_of(robot: str, urdf: Optional[Path], config: Optional[Path], mjcf: Optional[Path] = None) -> Robot:
+    from wbfriction.model.loading import load_robot
+
+    return load_robot(robot, urdf=urdf, config=config, mjcf=mjcf)
+
+
+def print_whole(renderable) -> None:
+    """Print ``renderable`` as wide as it takes, nothing cut or wrapped (``--wide``; the terminal wraps its
+    lines): a console of that width on the same output (``Console.print`` stays within its console's)."""
+    from rich.measure import Measurement
+
+    width = max(out.width, Measurement.get(out, out.options.update(width=10_000), renderable).maximum)
+    Console(width=width, file=out.file, force_terminal=out.is_terminal, no_color=out.no_color).print(renderable)
+
+
+def warn(warnings) -> None:
+    """Print warnings, one line each."""
+    for w in warnings:
+        console.print(f"[yellow]warning:[/] {escape(w)}", highlight=False, soft_wrap=True)
+
+
+def warn_energy(energy) -> None:
+    """Print the energy-consistency warnings (eq. 7.9) of the flagged joints."""
+    for e in energy:
+        if e.flagged:
+            console.print(f"[yellow]warning:[/] {escape(e.warning())}", highlight=False, soft_wrap=True)
+
+
+def joint_list(r: Robot, joints: Optional[str]) -> list[str]:
+    """``--joints`` as a list (checked), or by default the legs' torque-controlled joints, else all of them."""
+    if joints is None:
+        legs = [j for f in r.contact_frames for j in r.limb(f) if j in r.torque_controlled]
+        return legs or list(r.torque_controlled)
+    names = [j.strip() for j in joints.split(",") if j.strip()]
+    unknown = [j for j in names if j not in r.torque_controlled]
+    if unknown or not names:
+        bad = unknown[0] if unknown else joints
+        raise InputError(f"--joints: '{bad}' is not a torque-controlled joint of {r.name}")
+    return names
+
+
+ESTIMATE = EstimateOptions()  # one source of defaults: the library's
+FILTER = FilterOptions()
+GAIT = GaitOptions()
+IDEAL = IdealOptions()
+MUJOCO = MujocoOptions()
+INERTIAL = InertialOptions()
+FIT = FitOptions()
+MinSamplesOpt = typer.Option(FIT.min_samples, min=1, help="Joints with fewer valid samples are not fitted.")
+ModelOpt = typer.Option(FIT.model, "--model", help="Friction model per joint: auto (the simplest whose held-out RMS "
+                                                    "is within --selection-tolerance of the best), coulomb-viscous "
+                                                    "(3.1 + 3.2), stribeck (3.3 + 3.2) or thesis (3.5); each with "
+                                                    "an offset tau_os.")
+
+
+def _version(value: bool) -> None:
+    if value:
+        out.print(f"wbfriction {__version__}", highlight=False)
+        raise typer.Exit()
+
+
+@app.callback(invoke_without_command=True)
+def overview(ctx: typer.Context,
+             version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                          help="Print the version and exit.")) -> None:
+    """Whole-body joint friction estimation for torque-controlled legged robots: estimate the friction torque of
+    every joint from a log, fit a friction model, check it, export it. Run 'wbfriction demo' to see it on a
+    simulated walk, 'wbfriction COMMAND --help' for a command."""
+    if ctx.invoked_subcommand is None:  # 'wbfriction' alone: the overview, successfully
+        out.print(ctx.get_help(), highlight=False, markup=False)
+        raise typer.Exit()
+
+
+def main() -> None:
+    """Entry point: run the app, turning wbfriction errors into one line and their exit status (2 for
+    the input, 1 for the environment: an output the system refused to write, a cluster gone;
+    :attr:`~wbfriction.exceptions.WbfrictionError.exit_status`). Interruptions (Ctrl-C, SIGTERM)
+    are :mod:`wbfriction.entry`'s, which calls this."""
+    try:
+        status = app(standalone_mode=False)
+    except WbfrictionError as exc:
+        console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
+        sys.exit(exc.exit_status)
+    except typer.Exit as exc:  # pragma: no cover - typer control flow
+        sys.exit(exc.exit_code)
+    except (typer.Abort, KeyboardInterrupt):  # pragma: no cover
+        sys.exit(130)
+    except Exception as exc:  # usage errors: click's (typer vendors its own copy in newer releases)
+        message, code = getattr(exc, "format_message", None), getattr(exc, "exit_code", None)
+        if callable(message) and isinstance(code, int):  # one line, as every other error
+            console.print(f"[bold red]error:[/] {escape(str(message()))}", highlight=False, soft_wrap=True)
+            sys.exit(code)
+        raise
+    if isinstance(status, int) and status:
+        sys.exit(status)

@@ -1,0 +1,172 @@
+"""``wbfriction fit``, ``export``, ``predict`` and ``report``: the friction model of a friction table and where
+it goes."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Optional
+
+import typer
+from rich.markup import escape
+from rich.table import Table
+
+# Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
+# options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.friction.options import (
+    FitOptions,
+    ModelChoice,
+)
+from wbfriction.pipeline.paths import check_paths
+
+if TYPE_CHECKING:
+    from wbfriction.friction.fit import FitResult
+
+from wbfriction.cli.common import (
+    FIT,
+    ConfigOpt,
+    EnergyThresholdOpt,
+    EnergyToleranceOpt,
+    FitWorkersOpt,
+    FrictionArg,
+    MinSamplesOpt,
+    MjcfOpt,
+    ModelOpt,
+    RobotOpt,
+    UrdfOpt,
+    VerboseOpt,
+    WideOpt,
+    app,
+    console,
+    out,
+    print_whole,
+    robot_of,
+    warn_energy,
+)
+
+
+def _print_fits(results: list[FitResult], wide: bool = False, verbose: bool = False) -> None:
+    """The fitted friction's tables and notes (:mod:`~wbfriction.report.terminal`), as wide as the terminal."""
+    from wbfriction.report.terminal import fit_notes, fit_tables
+
+    for table in fit_tables(results, wide):
+        print_whole(table) if wide else out.print(table)
+    for line in fit_notes(results, verbose):
+        out.print(escape(line), highlight=False)
+
+
+def _run_fit(friction: Path, output: Path, options: FitOptions, threshold: float, tolerance: float,
+             workers: int, wide: bool = False, verbose: bool = False) -> None:
+    from wbfriction.pipeline.fit import fit_file
+
+    fitted = fit_file(friction, output, options, threshold=threshold, tolerance=tolerance, workers=workers)
+    _print_fits(fitted.fits, wide, verbose)
+    warn_energy(fitted.energy)
+    console.print(f"wrote {output}")
+
+
+@app.command()
+def fit(friction: Path = FrictionArg,
+        output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
+        min_samples: int = MinSamplesOpt,
+        energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt,
+        workers: int = FitWorkersOpt, model: ModelChoice = ModelOpt,
+        selection_tolerance: float = typer.Option(FIT.selection_tolerance, min=0.0,
+                                                  help="With --model auto: relative excess of held-out RMS within "
+                                                       "which the simpler model is chosen."),
+        wide: bool = WideOpt, verbose: bool = VerboseOpt) -> None:
+    """Identify a friction model of every joint, with standard errors and the parameters left
+    at a bound; warn about joints whose friction generates power (eq. 7.9)."""
+    check_paths({"FRICTION": friction}, {"-o": output})
+    _run_fit(friction, output, FitOptions(model=model, selection_tolerance=selection_tolerance,
+                                          min_samples=min_samples), energy_threshold, energy_tolerance, workers,
+             wide, verbose)
+
+
+@app.command()
+def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters written by 'wbfriction fit'."),
+           outputs: list[Path] = typer.Option(..., "-o", "--output",
+                                              help="File to write, format by name: .urdf (<dynamics damping "
+                                                   "friction>), .xml (MuJoCo MJCF: damping, frictionloss, "
+                                                   "armature) or .yaml (Isaac Lab actuators); repeat -o for "
+                                                   "several."),
+           include: str = typer.Option("", "--include",
+                                       help="Fit statuses exported besides ok, comma-separated: weak (large "
+                                            "standard errors), at-bound (a parameter at a bound of the fit), "
+                                            "routes-disagree (the two routes' fits differ: one is biased). "
+                                            "Fits not excited or failed are never exported."),
+           robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+           mjcf: Optional[Path] = MjcfOpt) -> None:
+    """Write the fitted friction where simulators read it: the fits whose status is ok (and --include),
+    each with its status in a comment; the other joints keep what the model file has. F_v -> damping,
+    F_c -> Coulomb friction (MuJoCo frictionloss); the Stribeck bump, the tanh and tau_os have no
+    simulator field and are dropped. Inertias are the URDF's: give --urdf IDENTIFIED.urdf to export
+    identified ones."""
+    from wbfriction.pipeline.export import export_files
+
+    check_paths({"PARAMS": params, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
+                {f"-o {o}": o for o in outputs})
+    result = export_files(robot_of(robot, urdf, config, mjcf), params, outputs,
+                          include=[c.strip() for c in include.split(",") if c.strip()])
+    counts = result.selection.exported_statuses
+    console.print(f"exported the friction of {sum(counts.values())} joints ("
+                  + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")", highlight=False)
+    for status, joints in result.selection.left_out.items():
+        console.print(f"not exported, {status}: {', '.join(joints)}", highlight=False, soft_wrap=True)
+    for path, fmt in result.outputs:
+        console.print(f"wrote {path} ({fmt})")
+
+
+@app.command()
+def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
+                                            help="Friction table of a held-out log ('wbfriction estimate' with the URDF"
+                                                 " under test)."),
+            params: Path = typer.Option(..., "--params", help="Parameters fitted on other logs estimated with "
+                                                              "the same URDF ('wbfriction fit').")) -> None:
+    """How well a model predicts torques it was not fitted on: per joint, the RMS of measured minus
+    predicted torque, tau - (M qdd + h + f(qd)), with the friction model and without it."""
+    import numpy as np
+
+    from wbfriction.pipeline.predict import predict_file
+
+    check_paths({"FRICTION": friction, "--params": params}, {})
+    pred = predict_file(friction, params)
+    table = Table(title=f"Torque prediction on {friction.name}: RMS of measured - predicted [N·m]", box=None)
+    for col in ("joint", "samples", "rigid body only", "with friction", "fit"):
+        table.add_column(col, justify="right" if col in ("samples", "rigid body only", "with friction") else "left")
+    statuses = pred.status or ("",) * len(pred.joints)
+    for j, n, rigid, full, status in zip(pred.joints, pred.samples, pred.rms_rigid_body, pred.rms, statuses):
+        table.add_row(j, str(n), f"{rigid:.4g}", "—" if not np.isfinite(full) else f"{full:.4g}", status,
+                      style=None if status in ("ok", "") else "dim")
+    rigid, full = pred.overall(pred.rms_rigid_body), pred.overall(pred.rms)
+    table.add_row("all joints", str(int(pred.samples.sum())), f"{rigid:.4g}",
+                  "—" if not np.isfinite(full) else f"{full:.4g}", "", style="bold", end_section=True)
+    out.print(table)
+    if any(status not in ("ok", "") for status in statuses):
+        console.print("a prediction by a fit that is not ok is no better than that fit: see 'fit' for the reason")
+
+
+@app.command()
+def report(friction: Path = FrictionArg,
+           output: Path = typer.Option(Path("report.html"), "-o", "--output", help="HTML file to write."),
+           params: Optional[Path] = typer.Option(None, help="Parameters written by 'wbfriction fit' (default: "
+                                                            "fitted here)."),
+           identification: Optional[Path] = typer.Option(None, help="JSON written by 'wbfriction identify --json': "
+                                                                    "adds the held-out torque RMS, both routes' "
+                                                                    "friction and the body changes."),
+           energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt,
+           workers: int = typer.Option(2, min=1, help="Processes fitting the joints (without --params) and "
+                                                     "rendering their figures (the same report for any "
+                                                     "number).")) -> None:
+    """One self-contained HTML report: friction clouds and fits, parameters, energy consistency,
+    per-joint time series, Fig. 7.4, spectra, provenance."""
+    from wbfriction.report.build import make_report
+    from wbfriction.report.html import write_report
+
+    check_paths({"FRICTION": friction, "--params": params, "--identification": identification}, {"-o": output})
+
+    with console.status("building the report"):
+        rep = make_report(friction, params, energy_threshold, energy_tolerance, identification, workers)
+        write_report(rep, output, workers)
+    warn_energy(rep.energy.values())
+    console.print(f"wrote {output} ({len(rep.est.joints)} joints, {len(rep.flagged)} flagged)")
+
+

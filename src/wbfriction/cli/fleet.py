@@ -1,0 +1,150 @@
+"""``wbfriction batch`` and ``trends``: a fleet's logs on Dask and the drifts of their friction."""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING, Optional
+
+import typer
+from rich.markup import escape
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+# Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
+# options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.exceptions import InputError
+from wbfriction.friction.options import (
+    EstimateOptions,
+    FitOptions,
+    ModelChoice,
+)
+from wbfriction.pipeline.paths import check_paths
+from wbfriction.signals.options import DiffOption
+
+if TYPE_CHECKING:
+    pass
+
+from wbfriction.cli.common import (
+    ESTIMATE,
+    FIT,
+    ConfigOpt,
+    MinSamplesOpt,
+    RobotOpt,
+    UrdfOpt,
+    app,
+    console,
+)
+
+
+@app.command()
+def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
+                                        help="Manifest (CSV or Parquet; columns log, robot_id, start_time [ISO 8601 "
+                                             "with zone], robot or urdf/config, optional diff and model), or a "
+                                             "folder of <robot_id>/<log> files (with --robot or --urdf/--config)."),
+          output: Path = typer.Option(..., "-o", "--output", help="Results folder: a Parquet dataset, a folder per "
+                                                                  "robot; logs whose results are there are "
+                                                                  "skipped, results of a log listed with anything "
+                                                                  "changed are replaced. Failures go beside it "
+                                                                  "(RESULTS-failed)."),
+          robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+          workers: Optional[int] = typer.Option(None, min=1, help="Worker processes of the local Dask cluster "
+                                                                  "[default: 2]."),
+          scheduler: Optional[str] = typer.Option(None, help="Address of a running Dask scheduler "
+                                                             "(tcp://host:8786) instead of a local cluster; its "
+                                                             "workers must see the logs and the results."),
+          serial: bool = typer.Option(False, "--serial", help="One log after the other in this process, without "
+                                                              "Dask (the reference the cluster's results equal)."),
+          tables: Optional[Path] = typer.Option(None, "--tables",
+                                                help="Also keep each log's friction table in this folder "
+                                                     "(TABLES/<robot_id>/<key>.parquet)."),
+          diff: DiffOption = typer.Option(ESTIMATE.diff, help="Differentiation, as 'wbfriction estimate --diff' (a "
+                                                        "manifest's diff column overrides it per log)."),
+          model: ModelChoice = typer.Option(FIT.model, help="Friction model, as 'wbfriction fit --model' (a "
+                                                             "manifest's model column overrides it per log)."),
+          min_samples: int = MinSamplesOpt) -> None:
+    """Estimate, fit and check every log of a fleet on Dask, into one results dataset (exit status 1 when a log
+    failed: it is listed, the others are done)."""
+    from wbfriction.fleet.batch import check_outputs, quiet_dask_logs, run_batch
+    from wbfriction.fleet.manifest import read_manifest, scan_folder
+    from wbfriction.fleet.options import BatchOptions
+    from wbfriction.fleet.results import failures_folder
+    from wbfriction.pipeline.estimate import RobotSpec
+
+    check_paths({"MANIFEST": source}, {})
+    check_outputs(output, tables)
+    quiet_dask_logs()  # its faults are said here, one line each
+    start = time.perf_counter()
+    if source.is_dir():
+        scan = scan_folder(source, RobotSpec.given(robot, urdf, config),
+                           exclude=[p for p in (output, failures_folder(output), tables) if p is not None])
+        for skipped in scan.skipped:
+            console.print(f"[yellow]skipped:[/] {escape(str(skipped))}", highlight=False, soft_wrap=True)
+        entries = scan.entries
+    else:
+        entries = read_manifest(source)
+    options = BatchOptions(estimate=EstimateOptions(diff=diff), fit=FitOptions(model=model, min_samples=min_samples))
+    with Progress(TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console,
+                  transient=True, disable=not console.is_terminal) as bar:
+        task = bar.add_task("batch", total=len(entries))
+        summary = run_batch(entries, output, options, engine="serial" if serial else "dask", workers=workers,
+                            scheduler=scheduler, tables=tables, progress=lambda outcome: bar.advance(task, 1))
+    for a, b in summary.copies:
+        console.print(f"[yellow]note:[/] {escape(b.where)} has the same bytes as {escape(a.where)}: two results",
+                      highlight=False, soft_wrap=True)
+    for note in (*summary.stale, *summary.foreign):
+        console.print(f"[yellow]note:[/] {escape(str(note))}", highlight=False, soft_wrap=True)
+    for _, error in summary.failed:
+        console.print(f"[bold red]failed:[/] {escape(error)}", highlight=False, soft_wrap=True)
+    why = "".join(f"; {n} {reason}" for reason, n in sorted(summary.reasons.items()) if reason != "new")
+    kept = f", {summary.kept} of logs not listed kept" if summary.kept else ""
+    console.print(f"{summary.processed} logs processed ({len(summary.failed)} failed{why}), {summary.skipped} already "
+                  f"done{kept}; results in {output} ({time.perf_counter() - start:.1f} s)", highlight=False,
+                  soft_wrap=True)
+    if summary.failed:
+        console.print(f"failures recorded in {failures_folder(output)}", highlight=False, soft_wrap=True)
+        raise typer.Exit(1)
+
+
+@app.command()
+def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results folder written by 'wbfriction "
+                                                                       "batch'."),
+           output: Path = typer.Option(..., "-o", "--output", help="HTML page to write (.html)."),
+           table: Optional[Path] = typer.Option(None, "--table", help="Also write the trends as a table "
+                                                                      "(.parquet or .csv)."),
+           alpha: float = typer.Option(1e-3, min=1e-6, max=0.5, help="False-alarm probability per joint."),
+           replicates: Optional[int] = typer.Option(None, min=1, help="Noise series of the p-values' Monte Carlo "
+                                                                      "[default: 20000, more for a small --alpha]."),
+           min_change: float = typer.Option(0.10, min=0.0, help="Smallest change flagged, relative to the "
+                                                                "baseline (0.1: 10 %)."),
+           title: str = typer.Option("Friction trends", help="The page's title.")) -> None:
+    """Friction over time per robot and joint, and the joints whose friction drifted (a hinge change detector
+    weighted by the fits' standard errors), as one HTML page."""
+    import math
+
+    from wbfriction.fleet.results import read_results
+    from wbfriction.fleet.trends import UNITS, TrendOptions, fleet_trends
+    from wbfriction.logs.tables import write_table
+    from wbfriction.report.trends import write_trends_html
+
+    if output.suffix.lower() not in (".html", ".htm"):
+        raise InputError(f"-o {output}: the trends page is written as .html")
+    if table is not None and table.suffix.lower() not in (".parquet", ".pq", ".csv"):
+        raise InputError(f"--table {table}: written as .parquet or .csv")
+    check_paths({"RESULTS": results}, {"-o": output, **({"--table": table} if table is not None else {})})
+    options = TrendOptions(alpha=alpha, min_change=min_change, replicates=replicates)
+    dataset = read_results(results)
+    for left in dataset.left_out:
+        console.print(f"[yellow]left out:[/] {escape(str(left))}", highlight=False, soft_wrap=True)
+    found = fleet_trends(dataset.table, options)
+    write_trends_html(found, output, title)
+    if table is not None:
+        write_table(found.to_table(), table)
+    for j in found.flagged:
+        cp = j.drifts[0]
+        size = (f"{100 * cp.relative:+.1f} %" if not math.isnan(cp.relative)
+                else f"{cp.change:+.3g} {UNITS[cp.quantity]} from a baseline not told from zero")
+        console.print(f"drift: {j.robot_id} {j.joint}: {cp.quantity} {size} from {cp.onset_time:%Y-%m-%d} "
+                      f"(p {cp.p_value:.2g})", highlight=False)
+    console.print(f"{found.summary()}; wrote {output}" + (f" and {table}" if table is not None else ""),
+                  highlight=False)
+
+

@@ -1,0 +1,132 @@
+"""``wbfriction identify``: the inertia model and the friction identified together (thesis 2.4, ch. 8)."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Literal, Optional
+
+import typer
+from rich.markup import escape
+
+# Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
+# options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.exceptions import InputError
+from wbfriction.friction.options import (
+    EstimateOptions,
+    RouteOption,
+)
+from wbfriction.inertia.options import ArmatureMode, InertialOptions
+from wbfriction.logs.options import TimeUnit
+from wbfriction.pipeline.paths import check_paths
+from wbfriction.signals.options import DiffOption, Mask
+
+if TYPE_CHECKING:
+    pass
+
+from wbfriction.cli.common import (
+    ESTIMATE,
+    INERTIAL,
+    ConfigOpt,
+    FitWorkersOpt,
+    LogArg,
+    MjcfOpt,
+    RobotOpt,
+    RouteOpt,
+    TimeUnitOpt,
+    UrdfOpt,
+    WideOpt,
+    app,
+    console,
+    out,
+    print_whole,
+    robot_of,
+    warn_energy,
+)
+
+
+@app.command()
+def identify(log: Path = LogArg,
+             output: Path = typer.Option(..., "-o", "--output", help="Corrected URDF to write (the given one's "
+                                                                    "structure, identified inertias)."),
+             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+             mjcf: Optional[Path] = MjcfOpt,
+             json_output: Optional[Path] = typer.Option(None, "--json", help="Also write every figure as "
+                                                                             "JSON (for 'wbfriction report "
+                                                                             "--identification')."),
+             stribeck_velocity: str = typer.Option("auto", help="v_s of the Stribeck term [rad/s]: auto (from the "
+                                                                "acceleration route, refined each pass), a number, "
+                                                                "or none."),
+             passes: int = typer.Option(2, min=1, help="Identifications with --stribeck-velocity auto."),
+             holdout: float = typer.Option(INERTIAL.holdout, help="Share of the log, at its end, kept out to compare "
+                                                            "torque predictions (between 0 and 1)."),
+             stride: int = typer.Option(INERTIAL.stride, min=1, help="Every stride-th single-support sample is used."),
+             prior: Optional[float] = typer.Option(INERTIAL.prior, min=0.0, help="Weight of the prior toward the given "
+                                                                          "model, in units of the residual variance; "
+                                                                          "default: chosen by validation from 1e4 "
+                                                                          "down to 1."),
+             armature: ArmatureMode = typer.Option(INERTIAL.armature,
+                                                   help="Rotor inertia: known (the TOML's [armature]), "
+                                                        "identify (one per joint, with the friction; for "
+                                                        "motor-current torques) or none (link-side "
+                                                        "torque sensors)."),
+             tanh_slope: float = typer.Option(INERTIAL.tanh_slope, min=1e-12,
+                                              help="a of the Coulomb term tanh(a qd) [s/rad]."),
+             diff: DiffOption = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
+             mask: Mask = typer.Option(ESTIMATE.mask, help="swing or single (see 'estimate')."),
+             route: RouteOption = RouteOpt,
+             workers: int = FitWorkersOpt, time_unit: Optional[TimeUnit] = TimeUnitOpt,
+             wide: bool = WideOpt) -> None:
+    """Identify the inertia model and the friction together from the joint torques of single
+    support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
+    with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
+    check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output, "--json": json_output})
+    vs_text = stribeck_velocity.strip().lower()
+    try:
+        stribeck: float | Literal["auto"] | None = (None if vs_text == "none" else "auto" if vs_text == "auto"
+                                                    else float(vs_text))
+    except ValueError:
+        raise InputError(f"--stribeck-velocity must be auto, none or a number, got '{stribeck_velocity}'") from None
+    if not 0.0 < holdout < 1.0:
+        raise InputError(f"--holdout must be between 0 and 1, got {holdout}")
+    from wbfriction.pipeline.identify import identify_file
+    from wbfriction.report.terminal import identification_tables
+
+    r = robot_of(robot, urdf, config, mjcf)
+    r.require_urdf("identify (it writes the corrected URDF)")
+    opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior,
+                           armature=armature)
+    with console.status("") as status:
+        estimate_options = EstimateOptions(diff=diff, mask=mask,
+                                           route=route)
+        done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
+                             options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers,
+                             time_unit=time_unit)
+    doc, moved = done.document, done.moved
+    for p in doc["passes"]:
+        vs = "none" if p["stribeck_velocity"] is None else f"{p['stribeck_velocity']:.4g} rad/s"
+        out.print(escape(f"v_s {vs}: {p['samples']} samples, {p['base_parameters']} base parameters of "
+                         f"{p['parameters']}, condition {p['condition']:.3g}, prior {p['prior']:g}; {p['message']}"),
+                  highlight=False)
+        if p.get("verdict"):
+            out.print(escape(p["verdict"]), highlight=False)
+        unexcited = p.get("not_excited") or []
+        if unexcited:
+            names = [str(u.get("parameter", u)) if isinstance(u, dict) else str(u) for u in unexcited]
+            out.print(escape(f"not excited by this log, kept at the given model: {len(names)} parameters ("
+                             + ", ".join(names[:4]) + (", ..." if len(names) > 4 else "") + ")"), highlight=False)
+    tables, notes = identification_tables(doc, wide)
+    for table in tables:
+        print_whole(table) if wide else out.print(table)
+    for note in notes:
+        out.print(escape(note), highlight=False)
+    toml = done.armature_toml()
+    if toml is not None:
+        out.print(escape("identified armature [kg·m^2], for the robot's TOML:\n" + toml), highlight=False)
+    if moved:
+        console.print(f"[yellow]note:[/] the whole identified body went to the child link of {', '.join(moved)} "
+                      "(lighter than the links merged with it)")
+    if json_output is not None:
+        console.print(f"wrote {json_output}")
+    warn_energy(done.loop.final.route.energy)
+    console.print(f"wrote {output}")
+
+
