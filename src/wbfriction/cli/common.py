@@ -1,6 +1,7 @@
 """The command line's shared parts: the app, its two consoles (messages on standard error, one line each;
 results on standard output, as wide as the terminal), the options several commands take with the library's
 defaults, the robot from --robot/--urdf/--config/--mjcf, the progress bar and the entry point :func:`main`."""
+
 from __future__ import annotations
 
 import sys

@@ -1,4 +1,5 @@
 """``wbfriction dataset``: real robots' logs, fetched and checked, written as logs with the robot beside them."""
+
 from __future__ import annotations
 
 from pathlib import Path

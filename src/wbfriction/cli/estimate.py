@@ -1,4 +1,5 @@
 """``wbfriction estimate``, ``convert``, ``sensitivity`` and ``spectrum``: what is read from a log."""
+
 from __future__ import annotations
 
 from contextlib import ExitStack, nullcontext

@@ -1,5 +1,6 @@
 """``wbfriction fit``, ``export``, ``predict`` and ``report``: the friction model of a friction table and where
 it goes."""
+
 from __future__ import annotations
 
 from pathlib import Path

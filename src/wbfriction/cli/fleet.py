@@ -1,4 +1,5 @@
 """``wbfriction batch`` and ``trends``: a fleet's logs on Dask and the drifts of their friction."""
+
 from __future__ import annotations
 
 import time

@@ -1,4 +1,5 @@
 """``wbfriction identify``: the inertia model and the friction identified together (thesis 2.4, ch. 8)."""
+
 from __future__ import annotations
 
 from pathlib import Path

@@ -1,4 +1,5 @@
 """``wbfriction simulate``: a walk (ideal or MuJoCo) or an arm's excitation with known friction, as a log."""
+
 from __future__ import annotations
 
 from pathlib import Path

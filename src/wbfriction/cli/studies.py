@@ -1,4 +1,5 @@
 """``wbfriction demo`` and the ``study-*`` commands: the thesis's studies and this project's."""
+
 from __future__ import annotations
 
 import time
@@ -104,8 +105,12 @@ def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
     for case in result.cases:
         _print_not_ok(case.rows)
         out.print(_study_table(case.rows, f"MuJoCo, combined walk, swing phase: {case.label}", case.scored))
-        worst = worst_scored(case)
-        out.print("worst error over the leg joints [%]: " + ", ".join(f"{n} {v:.2f}" for n, v in worst.items()))
+        ok = [row for row in case.rows if row.fit.verdict().ok]
+        _print_worst(case.rows, worst_scored(case, ok), case.scored)
+        if case.thesis_rows is not None:  # the thesis's comparison: the same log, rigid contacts, no wrenches
+            thesis = worst_scored(case, [row for row in case.thesis_rows if row.fit.verdict().ok])
+            out.print("  the thesis's route on the same log (rigid stance contact, no wrenches) [%]: "
+                      + ", ".join(f"{n} {thesis[n]:.2f}" for n in case.scored))
     out.print("right knee alone, RMS error [N·m] (central differences): " + "; ".join(
         f"{k} {v:.4f}" for k, v in result.knee_rms.items()))
     return result.files

@@ -8,7 +8,9 @@ measured forces, and (last case) sensor noise that the controller acts on.
    over its swing phase only.
 2. **No interference** (Fig. 6.5): the same walk with friction on every leg joint; the
    right knee's swing-phase estimate is unchanged.
-3. **Identification** on the combined walk, swing-phase samples, per leg joint:
+3. **Identification** on the combined walk, swing-phase samples, per leg joint, on the route the log allows
+   (issue 23: its ankle wrenches and IMU, every sample), the thesis's (rigid stance contact, no wrenches)
+   beside it as the comparison in the first two cases:
 
    * friction (3.5) with Table 6.1's targets, noise off, central differences;
    * MuJoCo's own ``frictionloss`` and ``damping`` (Table 6.1's F_c and F_v), a Coulomb-viscous
@@ -65,6 +67,9 @@ ankle sensors' wrenches left out (the study reproduces 6.2; :mod:`wbfriction.fri
 uses them)."""
 NOISE = SensorNoise(position_std=1e-4, encoder_bits=ENCODER_BITS, torque_std=TORQUE_STD, seed=0)
 """The filter study's default noise level (its 1e-4 rad row)."""
+MEASURED_ROUTE = EstimateOptions(diff="central", route="acceleration")
+"""The route the simulated log allows, noise off: the ankle sensors' wrenches and the IMU (issue 23), central
+differences of the accelerations."""
 DEFAULTS = EstimateOptions()
 """The default options: the noisy case's (the route and closure the log allows, chosen from it)."""
 COULOMB_VISCOUS = {"S": 0.0, "v_s": 0.1, "tau_os": 0.0}
@@ -79,6 +84,7 @@ class Case:
     label: str
     rows: list[LegRow]
     scored: tuple[str, ...]  # the parameters the case's targets are about
+    thesis_rows: list[LegRow] | None = None  # the same log on the thesis's route (rigid contacts), the comparison
 
 
 @dataclass
@@ -112,6 +118,7 @@ class _CaseSpec:
     estimate: EstimateOptions
     fixed: dict[str, float] | None
     scored: tuple[str, ...]
+    compare: bool = False  # also the thesis's route (THESIS_ROUTE) on the same log
 
 
 def _simulate(robot: Robot, mjr: MujocoRobot, gait: GaitOptions, friction: dict[str, FrictionParams],
@@ -154,11 +161,12 @@ def _case_specs(table_6_1: dict[str, FrictionParams], options: MujocoOptions) ->
     """The identification cases of step 3 of the module docstring, in order."""
     native = {j: dataclasses.replace(p, S=0.0, tau_os=0.0) for j, p in table_6_1.items()}
     return [
-        _CaseSpec("model", "friction (3.5), noise off, central differences", table_6_1, options,
-                  THESIS_ROUTE, None, ("F_c", "F_v", "tau_os")),
-        _CaseSpec("mujoco", "MuJoCo frictionloss + damping, noise off, central differences, Coulomb-viscous fit",
-                  native, dataclasses.replace(options, friction="mujoco"), THESIS_ROUTE, COULOMB_VISCOUS,
-                  ("F_c", "F_v")),
+        _CaseSpec("model", "friction (3.5), noise off, central differences, ankle wrenches and IMU", table_6_1,
+                  options, MEASURED_ROUTE, None, ("F_c", "F_v", "tau_os"), compare=True),
+        _CaseSpec("mujoco", "MuJoCo frictionloss + damping, noise off, central differences, ankle wrenches and IMU, "
+                            "Coulomb-viscous fit",
+                  native, dataclasses.replace(options, friction="mujoco"), MEASURED_ROUTE, COULOMB_VISCOUS,
+                  ("F_c", "F_v"), compare=True),
         _CaseSpec("noisy", "friction (3.5), sensor noise 1e-4 rad / 19 bit / 0.05 N·m, default options (the "
                            "momentum route, the ankle wrenches and the IMU)",
                   table_6_1, dataclasses.replace(options, sensors=NOISE), DEFAULTS, None,
@@ -173,6 +181,8 @@ def _identify(robot: Robot, mjr: MujocoRobot, legs: list[LegJoint], spec: _CaseS
     est = estimate_log(robot, sim.log, spec.estimate)
     fits = fit_legs(est, legs, spec.friction, spec.fixed)
     rows = leg_rows(legs, fits)
+    thesis_rows = (leg_rows(legs, fit_legs(estimate_log(robot, sim.log, THESIS_ROUTE), legs, spec.friction,
+                                           spec.fixed)) if spec.compare else None)
     log_path = output_dir / f"mujoco_{spec.name}_log.parquet"
     params_path = output_dir / f"mujoco_{spec.name}_params.json"
     write_log(sim.log, robot, log_path)
@@ -185,7 +195,7 @@ def _identify(robot: Robot, mjr: MujocoRobot, legs: list[LegJoint], spec: _CaseS
         write_table(friction_table(est), friction_path)
         write_report(make_report(friction_path, params_path), report_path)
         files += [output_dir / "mujoco_friction_curves.png", friction_path, report_path]
-    return Case(spec.name, spec.label, rows, spec.scored), files
+    return Case(spec.name, spec.label, rows, spec.scored, thesis_rows), files
 
 
 def run_realistic_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int = 5,
@@ -225,6 +235,7 @@ def run_realistic_study(robot: Robot, output_dir: Path, steps: int = 10, knee_st
     return RealisticResult(results, knee_rms, files)
 
 
-def worst_scored(case: Case) -> dict[str, float]:
-    """Largest error [%] over the leg joints of each parameter the case is scored on."""
-    return worst_errors(case.rows, case.scored)
+def worst_scored(case: Case, rows: list[LegRow] | None = None) -> dict[str, float]:
+    """Largest error [%] over the leg joints (``rows``, default the case's) of each parameter the case is scored
+    on."""
+    return worst_errors(case.rows if rows is None else rows, case.scored)
