@@ -23,7 +23,7 @@ from wbfriction.friction.status import MIN_SPEED, FitVerdict
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
 from wbfriction.report.figures import friction_overview_figure, joint_figure, png_bytes
-from wbfriction.report.numbers import duration_text
+from wbfriction.report.numbers import bound_text, duration_text, with_error
 from wbfriction.workers import process_pool
 
 PAGE_CSS = """
@@ -78,19 +78,13 @@ def _joint_cell(r: Report, joint: str) -> str:
 
 
 def _fmt(value: float | None, se: float | None = None, digits: int = 4) -> str:
-    """``value`` to ``digits`` significant digits, ``± se`` when given ("n.i.": not identifiable); "—" for none."""
+    """``value ± se`` to the digits ``se`` supports (:func:`~wbfriction.report.numbers.with_error`, the terminal's
+    format), ``value`` alone to ``digits`` significant digits without ``se``; "—" for none."""
     if value is None or not np.isfinite(value):
         return "—"
     if se is None:
         return f"{value:.{digits}g}"
-    return f"{value:.{digits}g} ± {'n.i.' if not np.isfinite(se) else f'{se:.2g}'}"
-
-
-def _bound(value: float | None) -> str:
-    """A Cramér-Rao standard deviation as a cell's text: ``± b``, "n.i." (not identifiable), "" for none."""
-    if value is None:
-        return ""
-    return "n.i." if not np.isfinite(value) else f"± {value:.2g}"
+    return with_error(value, se)
 
 
 def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> str:
@@ -128,7 +122,7 @@ def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> s
                     f"<td>{_fmt(fit.rms_residual)}</td></tr>")
         if fit.crb:
             rows.append('<tr class="target"><td>&nbsp;&nbsp;Cramér-Rao bound</td><td></td><td></td><td></td>'
-                        + "".join(f"<td>{_bound(fit.crb.get(n))}</td>" for n in names) + "<td></td></tr>")
+                        + "".join(f"<td>{bound_text(fit.crb.get(n))}</td>" for n in names) + "<td></td></tr>")
         check = fit.route_check
         if check is not None and check.params is not None:
             rows.append(f'<tr class="target"><td>&nbsp;&nbsp;{html.escape(check.route)} route</td><td></td><td></td>'
