@@ -276,14 +276,14 @@ def test_fit_prints_tables_that_fit_a_100_column_terminal(demo_dir, tmp_path):
     assert res.returncode == 0, res.stderr
     assert widest_line(res.stdout) <= 100, res.stdout
     params = json.loads((tmp_path / "p.json").read_text())["joints"]
+    labels = json.loads(pq.read_schema(out / "friction.parquet").metadata[b"wbfriction"])["joint_labels"]
+    assert labels["leg_right_4_joint"] == "right knee"  # the robot TOML's [labels], recorded by estimate
     rows: dict[str, list[str]] = {}
-    for line in res.stdout.splitlines():  # each joint's first row: the main table's
-        if line.split():
-            rows.setdefault(line.split()[0], line.split())
-    for joint in params:
-        assert joint in rows, joint  # named whole, never cut
-    moved = [j for j in params if rows[j][2:4] != ["not", "excited"]]
-    assert moved and all(rows[j][2] in ("ok", "weak", "at", "failed", "routes") for j in moved)
+    for joint in params:  # each joint's first row, the main table's: by its label, whole, never cut
+        line = next(line for line in res.stdout.splitlines() if line.startswith(labels[joint] + " "))
+        rows[joint] = line[len(labels[joint]):].split()
+    moved = [j for j in params if rows[j][1:3] != ["not", "excited"]]
+    assert moved and all(rows[j][1] in ("ok", "weak", "at", "failed", "routes") for j in moved)
     still = len(params) - len(moved)
     assert sum("hardly moved" in line for line in res.stdout.splitlines()) == (1 if still else 0)
     assert "Against the simulator's friction" in res.stdout  # the walk's log carries the truth

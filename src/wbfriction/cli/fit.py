@@ -44,13 +44,15 @@ from wbfriction.cli.common import (
 )
 
 
-def _print_fits(results: list[FitResult], wide: bool = False, verbose: bool = False) -> None:
-    """The fitted friction's tables and notes (:mod:`~wbfriction.report.terminal`), as wide as the terminal."""
+def _print_fits(results: list[FitResult], labels: dict[str, str] | None, wide: bool = False,
+                verbose: bool = False) -> None:
+    """The fitted friction's tables and notes (:mod:`~wbfriction.report.terminal`), as wide as the terminal,
+    the joints by their ``labels``."""
     from wbfriction.report.terminal import fit_notes, fit_tables
 
-    for table in fit_tables(results, wide):
+    for table in fit_tables(results, wide, labels):
         print_whole(table) if wide else out.print(table)
-    for line in fit_notes(results, verbose):
+    for line in fit_notes(results, verbose, labels):
         out.print(escape(line), highlight=False)
 
 
@@ -59,7 +61,7 @@ def _run_fit(friction: Path, output: Path, options: FitOptions, threshold: float
     from wbfriction.pipeline.fit import fit_file
 
     fitted = fit_file(friction, output, options, threshold=threshold, tolerance=tolerance, workers=workers)
-    _print_fits(fitted.fits, wide, verbose)
+    _print_fits(fitted.fits, fitted.est.metadata.get("joint_labels"), wide, verbose)
     warn_energy(fitted.energy)
     console.print(f"wrote {output}")
 

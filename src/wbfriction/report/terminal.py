@@ -14,7 +14,7 @@ per family of joints that share a status or a chosen model, each joint's own rea
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 from rich.table import Table
 
@@ -49,41 +49,46 @@ def _table(title: str, first: Sequence[str], names: Sequence[str], caption: str 
     return table
 
 
-def fit_tables(results: Sequence[FitResult], wide: bool = False) -> list[Table]:
+def fit_tables(results: Sequence[FitResult], wide: bool = False,
+               labels: Mapping[str, str] | None = None) -> list[Table]:
     """The fitted friction of ``results`` as tables (module docstring): a fit that is not ``ok`` dimmed, its
-    numbers not to be used; ``wide``: one table with every parameter and the sample counts."""
+    numbers not to be used; ``wide``: one table with every parameter and the sample counts; ``labels``: joint ->
+    what a person reads (the robot TOML's ``[labels]``, recorded in the friction table), shown for the joint."""
+    label = _labeller(labels)
     fitted = [r for r in results if r.params is not None]
     routes = ", ".join(sorted({r.route for r in results}))
     title = f"Friction per joint: f(qd) fitted to -tau_f ({routes} route)"
     if wide:
         names = [n for n in ALL_PARAM_NAMES if any(n in r.params.names for r in fitted if r.params is not None)]
-        return [_rows(_table(title, ("joint", "model", "status", "N"), names, CAPTION), results, names, True)]
-    tables = [_rows(_table(title, ("joint", "model", "status"), MAIN, CAPTION), results, MAIN, False)]
+        return [_rows(_table(title, ("joint", "model", "status", "N"), names, CAPTION), results, names, label,
+                      True)]
+    tables = [_rows(_table(title, ("joint", "model", "status"), MAIN, CAPTION), results, MAIN, label, False)]
     others = [n for n in OTHERS if any(n in r.params.names for r in fitted if r.params is not None)]
-    tables.append(_rows(_table("Offset and Stribeck terms", ("joint",), others), fitted, others, False, short=True))
+    tables.append(_rows(_table("Offset and Stribeck terms", ("joint",), others), fitted, others, label, False,
+                        short=True))
     truth = [r for r in fitted if r.error_percent() is not None]
     still = [r.joint for r in truth if r.verdict().status == "not excited"]
     if truth:
         table = _table("Against the simulator's friction: error [%]", ("joint", "model"), [*MAIN, *OTHERS, "RMS"],
-                       caption=f"not excited, left out: {', '.join(still)}" if still else None)
+                       caption=f"not excited, left out: {', '.join(label(j) for j in still)}" if still else None)
         for r in truth:
             if r.joint in still:
                 continue
             err = r.error_percent() or {}
             rms = "" if r.rms_error_vs_true is None else f"{r.rms_error_vs_true:.2g}"
-            table.add_row(r.joint, r.model, *[f"{err[n]:.2f}" if n in err else "" for n in (*MAIN, *OTHERS)], rms,
-                          style=None if r.verdict().ok else "dim")
+            cells = [f"{err[n]:.2f}" if n in err else "" for n in (*MAIN, *OTHERS)]
+            table.add_row(label(r.joint), r.model, *cells, rms, style=None if r.verdict().ok else "dim")
         tables.append(table)
     return tables
 
 
-def _rows(table: Table, results: Sequence[FitResult], names: Sequence[str], wide: bool,
-          short: bool = False) -> Table:
+def _rows(table: Table, results: Sequence[FitResult], names: Sequence[str], label: Callable[[str], str],
+          wide: bool, short: bool = False) -> Table:
     """``results`` as rows of ``table``: value ± standard error, the Cramér-Rao bounds in a dimmed row below
     (not for a joint that did not move: nothing to bound); ``short``: the joint alone before the values."""
     for r in results:
         verdict = r.verdict()
-        first = [r.joint] if short else [r.joint, r.model if r.params is not None else "—", verdict.status]
+        first = [label(r.joint)] + ([] if short else [r.model if r.params is not None else "—", verdict.status])
         count = [f"{r.n_samples}" + (f" (-{r.n_screened} screened)" if r.n_screened else "")] if wide else []
         table.add_row(*first, *count, *[_cell(r, n) for n in names], style=None if verdict.ok else "dim")
         if r.params is not None and verdict.status != "not excited" and any(n in r.crb for n in names):
@@ -92,22 +97,29 @@ def _rows(table: Table, results: Sequence[FitResult], names: Sequence[str], wide
     return table
 
 
+def _labeller(labels: Mapping[str, str] | None) -> Callable[[str], str]:
+    """A joint's text in a table or a note: its label when ``labels`` give one, else its name."""
+    return lambda joint: (labels or {}).get(joint) or joint
+
+
 def _joints(names: Sequence[str]) -> str:
     shown = ", ".join(names[:NAMES_SHOWN])
     return shown + (f" and {len(names) - NAMES_SHOWN} more" if len(names) > NAMES_SHOWN else "")
 
 
-def fit_notes(results: Sequence[FitResult], verbose: bool = False) -> list[str]:
+def fit_notes(results: Sequence[FitResult], verbose: bool = False,
+              labels: Mapping[str, str] | None = None) -> list[str]:
     """What the table's statuses and models mean, one line each: every fit that is not ``ok`` with its reason,
     except the joints that did not move, which share one line; the model chosen on held-out data (``--model
-    auto``), one line per model. ``verbose``: each joint's own line for both."""
+    auto``), one line per model. ``verbose``: each joint's own line for both. Joints by their ``labels``."""
+    label = _labeller(labels)
     lines = []
-    still = [r.joint for r in results if r.verdict().status == "not excited" and r.params is not None
+    still = [label(r.joint) for r in results if r.verdict().status == "not excited" and r.params is not None
              and r.speed is not None]
     for r in results:
         verdict = r.verdict()
-        if not verdict.ok and (verbose or r.joint not in still):
-            lines.append(f"{r.joint}: {verdict}")
+        if not verdict.ok and (verbose or label(r.joint) not in still):
+            lines.append(f"{label(r.joint)}: {verdict}")
     if still and not verbose:
         lines.append(f"not excited: {len(still)} joints hardly moved ({_joints(still)}); --verbose gives each "
                      "one's speed")
@@ -115,8 +127,8 @@ def fit_notes(results: Sequence[FitResult], verbose: bool = False) -> list[str]:
     for r in results:
         if r.selection is not None:
             if verbose:
-                lines.append(f"{r.joint}: {r.selection.reason}")
-            chosen[r.model].append(r.joint)
+                lines.append(f"{label(r.joint)}: {r.selection.reason}")
+            chosen[r.model].append(label(r.joint))
     if chosen and not verbose:
         lines.append("model chosen on held-out data (--verbose gives each joint's reason):")
         lines += [f"  {model}: {_joints(joints)}" for model, joints in chosen.items()]
