@@ -44,6 +44,7 @@ def _refused_write(res: subprocess.CompletedProcess, folder: Path, out: Path) ->
 @pytest.fixture(scope="module")
 def arm(tmp_path_factory) -> Path:
     """A folder with a 3 s Panda log, its friction table and its parameters, as the commands write them."""
+    from wbfriction.friction.options import FitOptions
     from wbfriction.logs.tables import write_table
     from wbfriction.model.loading import load_robot
     from wbfriction.pipeline.chunks import Chunking
@@ -59,7 +60,7 @@ def arm(tmp_path_factory) -> Path:
     estimate_file(RobotSpec("panda"), folder / "arm.parquet", folder / "friction.parquet",
                   chunking=Chunking(workers=1),
                   extra_metadata={"provenance": log_provenance(folder / "arm.parquet", robot)})
-    fit_file(folder / "friction.parquet", folder / "params.json", model="coulomb-viscous")
+    fit_file(folder / "friction.parquet", folder / "params.json", FitOptions(model="coulomb-viscous"))
     renamed = [n.replace("panda_joint1", "J1") for n in sim.table.column_names]  # a log read through a --map
     write_table(sim.table.rename_columns(renamed), folder / "renamed.parquet")
     (folder / "map.toml").write_text('[joint_states]\nrename = { J1 = "panda_joint1" }\n')
