@@ -36,11 +36,12 @@ h1 { font-size: 1.6rem; margin: 24px 0 4px; } h2 { font-size: 1.25rem; margin-to
 .warn { background: #fff4e5; border: 1px solid #f0b35a; } .ok { background: #eef8ef; border: 1px solid #8cc79a; }
 .scroll { overflow-x: auto; max-width: 100%; }
 table { border-collapse: collapse; font-size: 0.9rem; font-variant-numeric: tabular-nums; }
-th, td { padding: 4px 9px; text-align: right; border-bottom: 1px solid #eceff2; white-space: nowrap;
+th, td { padding: 4px 6px; text-align: right; border-bottom: 1px solid #eceff2; white-space: nowrap;
          vertical-align: top; }
-th { background: #f5f7f9; } td:first-child, th:first-child, th.text { text-align: left; }
+th { background: #f5f7f9; white-space: normal; max-width: 8em; vertical-align: bottom; }
+td:first-child, th:first-child, th.text { text-align: left; }
 tr.flag td { background: #fff1f0; } tr.target td, tr.err td { color: #5f6b76; }
-tr.notok td { color: #8c96a0; } td.status, td.verdict { text-align: left; white-space: normal; min-width: 9em; }
+tr.notok td { color: #8c96a0; } td.status, td.verdict { text-align: left; white-space: normal; min-width: 8em; }
 tr.notok td.status, td.verdict.bad { color: #a4520a; } td.verdict.good, td.pass { color: #1f7a35; }
 td.fail { color: #b3261e; font-weight: 600; }
 .name { color: #6b7580; font-size: 0.8rem; }
@@ -88,7 +89,7 @@ def _fmt(value: float | None, se: float | None = None, digits: int = 4) -> str:
 
 
 def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> str:
-    """Each joint's model, its fit's status and parameters (value ±standard error; "(bound)": at a bound of
+    """Each joint's model, its fit's status and parameters (value ±standard error; "at a bound": at a bound of
     the fit), under them their Cramér-Rao bounds and the same model on the other route; blank where a parameter is
     not one of the joint's model. A fit that is not ``ok`` (:mod:`~wbfriction.friction.status`) is greyed, its
     status cell giving the reason."""
@@ -99,7 +100,7 @@ def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> s
     def cell(fit: FitResult, n: str) -> str:
         if fit.params is None or n not in fit.params.names:
             return "<td></td>"
-        bound = " (bound)" if fit.at_bound.get(n) else ""
+        bound = '<br><span class="name">at a bound</span>' if fit.at_bound.get(n) else ""
         return f"<td>{_fmt(getattr(fit.params, n), fit.stderr.get(n))}{bound}</td>"
 
     for j in joints:
@@ -115,7 +116,7 @@ def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> s
                         + "<td></td>" * (len(names) + 1) + "</tr>")
             continue
         cells = "".join(cell(fit, n) for n in names)
-        screened = f" (−{fit.n_screened} screened)" if fit.n_screened else ""
+        screened = f'<br><span class="name">−{fit.n_screened} screened</span>' if fit.n_screened else ""
         tr = "<tr>" if verdict.ok else '<tr class="notok">'
         rows.append(f"{tr}{_joint_cell(r, j)}"
                     f"<td>{html.escape(fit.model)}</td>{status}<td>{fit.n_samples}{screened}</td>{cells}"

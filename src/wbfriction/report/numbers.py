@@ -2,8 +2,8 @@
 terminal and the report (issue 39).
 
 The standard error is rounded to one significant digit (two when that digit is 1: 0.14, not 0.1, which would
-be off by 30 %), and the value to the same decimal place; down to a last digit of 1e-5 and below 1e5 they are
-written plainly, others with a common power of ten: ``0.180 ± 0.005``, ``38.5 ± 0.1``, ``(3.00 ± 0.10)e-07``.
+be off by 30 %), and the value to the same decimal place, written plainly or with a common power of ten,
+whichever is shorter: ``0.180 ± 0.005``, ``38.5 ± 0.1``, ``0.099941 ± 0.000018``, ``(3.00 ± 0.10)e-07``.
 Durations are the time recorded and, across gaps, the span (:func:`duration_text`)."""
 
 from __future__ import annotations
@@ -15,8 +15,6 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     import numpy as np
 
-PLAIN = (1e-5, 1e5)
-"""Magnitudes written without a power of ten: from the smallest decimal shown to the largest value."""
 GENERAL_DIGITS = 4
 """Significant digits of a value without a finite standard error."""
 
@@ -39,14 +37,13 @@ def with_error(value: float, se: float | None) -> str:
         return f"{value:.{GENERAL_DIGITS}g} ± n.i."
     se = abs(se)
     place = _error_place(se)
-    top = max(abs(value), se)
-    if 10.0**place >= PLAIN[0] and top < PLAIN[1]:
-        decimals = max(-place, 0)
-        return f"{round(value, -place):.{decimals}f} ± {round(se, -place):.{decimals}f}"
-    power = math.floor(math.log10(top))
-    decimals = max(power - place, 0)
+    decimals = max(-place, 0)
+    plain = f"{round(value, -place):.{decimals}f} ± {round(se, -place):.{decimals}f}"
+    power = math.floor(math.log10(max(abs(value), se)))
+    digits = max(power - place, 0)
     scale = 10.0**power
-    return f"({value / scale:.{decimals}f} ± {se / scale:.{decimals}f})e{power:+03d}"
+    scientific = f"({value / scale:.{digits}f} ± {se / scale:.{digits}f})e{power:+03d}"
+    return plain if len(plain) <= len(scientific) else scientific
 
 
 def bound_text(bound: float | None) -> str:
