@@ -60,7 +60,8 @@ def _run_fit(friction: Path, output: Path, options: FitOptions, threshold: float
              workers: int, wide: bool = False, verbose: bool = False) -> None:
     from wbfriction.pipeline.fit import fit_file
 
-    fitted = fit_file(friction, output, options, threshold=threshold, tolerance=tolerance, workers=workers)
+    with console.status(f"fitting {friction.name} (--model {options.model})"):
+        fitted = fit_file(friction, output, options, threshold=threshold, tolerance=tolerance, workers=workers)
     _print_fits(fitted.fits, fitted.est.metadata.get("joint_labels"), wide, verbose)
     warn_energy(fitted.energy)
     console.print(f"wrote {output}")
@@ -131,7 +132,8 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
     from wbfriction.pipeline.predict import predict_file
 
     check_paths({"FRICTION": friction, "--params": params}, {})
-    pred = predict_file(friction, params)
+    with console.status(f"predicting the torques of {friction.name}"):
+        pred = predict_file(friction, params)
     table = Table(title=f"Torque prediction on {friction.name}: RMS of measured - predicted [N·m]", box=None)
     for col in ("joint", "samples", "rigid body only", "with friction", "fit"):
         table.add_column(col, justify="right" if col in ("samples", "rigid body only", "with friction") else "left")
