@@ -79,7 +79,7 @@ def fit_tables(results: Sequence[FitResult], wide: bool = False,
             cells = [f"{err[n]:.2f}" if n in err else "" for n in (*MAIN, *OTHERS)]
             table.add_row(label(r.joint), r.model, *cells, rms, style=None if r.verdict().ok else "dim")
         tables.append(table)
-    return tables
+    return [t for t in tables if t.row_count]
 
 
 def _rows(table: Table, results: Sequence[FitResult], names: Sequence[str], label: Callable[[str], str],
