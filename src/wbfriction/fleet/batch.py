@@ -29,6 +29,7 @@ batch goes on; it is tried again by the next run.
 
 from __future__ import annotations
 
+import gc
 import logging
 import os
 from collections import Counter, defaultdict
@@ -246,10 +247,14 @@ def connect(scheduler: str, timeout: float = CONNECT_TIMEOUT) -> Any:
     try:
         return Client(scheduler, timeout=timeout)
     except ValueError as exc:
-        raise InputError(f"--scheduler {scheduler!r}: not a scheduler's address ({exc}; e.g. tcp://host:8786)"
-                         ) from None
+        message = f"--scheduler {scheduler!r}: not a scheduler's address ({exc}; e.g. tcp://host:8786)"
     except OSError:
-        raise InputError(f"--scheduler {scheduler}: no Dask scheduler answered within {timeout:g} s") from None
+        message = f"--scheduler {scheduler}: no Dask scheduler answered within {timeout:g} s"
+    # The half-made Client is garbage now: collected here, its __del__ closes its event loop at once. Left to a
+    # later collection, it can run inside the next Client's start, which holds the lock that closing waits for:
+    # the process hangs (seen in the test suite: Client.__init__ -> LoopRunner.start -> Client.__del__).
+    gc.collect()
+    raise InputError(message)
 
 
 def run_batch(entries: list[LogEntry], results: str | Path, options: BatchOptions = BatchOptions(), *,
