@@ -41,7 +41,7 @@ def test_main_job_steps_write_log_friction_and_params(demo_dir):
     # the joint's own TOML table overrides its group's
     assert params["joints"]["leg_left_4_joint"]["target"]["F_c"] == 0.5
     assert params["joints"]["leg_left_4_joint"]["target"]["F_v"] == 0.0
-    assert "leg_right_4_joint" in res.stdout and "error [%]" in res.stdout
+    assert "right knee" in res.stdout and "Against the simulator's friction: error [%]" in res.stdout  # by its label
     table = pq.read_table(out / "friction.parquet")
     for col in ("time", "phase", "unique", "qd.leg_right_4_joint", "tau_f.leg_right_4_joint",
                 "valid.leg_right_4_joint", "tau_f_true.leg_right_4_joint"):
