@@ -130,15 +130,17 @@ def test_identify_an_arm_with_its_rotor_inertia(panda, panda_friction, panda_log
                          estimate_options=EstimateOptions(diff="butterworth", filtering=FilterOptions(cutoff=20.0)),
                          options=InertialOptions(armature="identify", prior=100.0), stribeck=v_s, passes=1)
     doc = read_identification(tmp_path / "arm.json")
-    assert doc["armature_mode"] == "identify" and doc["passes"][0]["not_excited"]
+    assert doc == done.identification
+    assert doc.armature_mode == "identify" and doc.passes[0].not_excited
     truth = dict(zip(panda.actuated, panda.model.armature[panda.act_v_index]))
-    for joint, j in doc["joints"].items():
+    for joint, j in doc.joints.items():
         true = panda_friction[joint]
+        assert j.acceleration_route.params is not None
         for name in ("F_v", "F_c"):
-            assert abs(j["identified"][name] / getattr(true, name) - 1) < 0.05, (joint, name, j["identified"])
-            assert abs(j["acceleration_route"]["params"][name] / getattr(true, name) - 1) < 0.05, (joint, name)
-        assert j["armature"]["given"] == 0.0
-        assert abs(j["armature"]["identified"] / truth[joint] - 1) < 0.05, (joint, j["armature"])
+            assert abs(j.identified[name] / getattr(true, name) - 1) < 0.05, (joint, name, j.identified)
+            assert abs(getattr(j.acceleration_route.params, name) / getattr(true, name) - 1) < 0.05, (joint, name)
+        assert j.armature_given == 0.0 and j.armature is not None
+        assert abs(j.armature / truth[joint] - 1) < 0.05, (joint, j.armature)
     assert is_consistent(done.loop.final.identification.pi).all()
     toml = tomllib.loads(done.armature_toml() or "")
-    assert toml["armature"] == pytest.approx({j: doc["joints"][j]["armature"]["identified"] for j in doc["joints"]})
+    assert toml["armature"] == pytest.approx({j: doc.joints[j].armature for j in doc.joints})

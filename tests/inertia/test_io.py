@@ -1,4 +1,5 @@
-"""The identification JSON: its reader refuses what its writer would not have written, naming the key."""
+"""The identification JSON: what is written reads back as the same typed result; the reader refuses what
+its writer would not have written, naming the key."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import json
 import pytest
 
 from wbfriction.exceptions import InputError
+from wbfriction.inertia.document import Identification
 from wbfriction.inertia.io import read_identification, write_identification
 
 DOC = {
@@ -21,8 +23,24 @@ DOC = {
 
 
 def test_what_is_written_reads_back(tmp_path):
-    write_identification(tmp_path / "i.json", DOC)
-    assert read_identification(tmp_path / "i.json") == DOC
+    """A minimal document reads as the typed result, and that result writes back the same values and
+    reads again to an equal result."""
+    (tmp_path / "i.json").write_text(json.dumps(DOC))
+    result = read_identification(tmp_path / "i.json")
+    assert result.joints["knee"].identified == DOC["joints"]["knee"]["identified"]
+    assert result.joints["knee"].armature == 0.3 and result.joints["knee"].holdout_rms.validated is None
+    assert result.passes[0].not_excited[0].partners == {"wrist.c_z": -0.3}
+    assert result.bodies[0].mass_change is None and result.bodies[0].kept is None
+    write_identification(tmp_path / "j.json", result)
+    again = read_identification(tmp_path / "j.json")
+    assert again == result and isinstance(again, Identification)
+    written = json.loads((tmp_path / "j.json").read_text())
+    for path in (("holdout_samples",), ("joints", "knee", "holdout_rms"), ("joints", "knee", "identified"),
+                 ("bodies", 0, "mass"), ("passes", 0, "not_excited", 0, "partners")):
+        a, b = DOC, written
+        for k in path:
+            a, b = a[k], b[k]
+        assert a == b, path
 
 
 @pytest.mark.parametrize(("damage", "key"), [
@@ -34,6 +52,9 @@ def test_what_is_written_reads_back(tmp_path):
     (lambda d: d.update(holdout_samples=1.5), "holdout_samples"),
     (lambda d: d["joints"]["knee"]["armature"].pop("identified"), "joints.knee.armature"),
     (lambda d: d["passes"][0]["not_excited"][0].update(partners=None), r"passes\[0\].not_excited"),
+    (lambda d: d["passes"][0].pop("samples"), r"passes\[0\].samples"),
+    (lambda d: d["joints"]["knee"].update(acceleration_route={"model": "no such model"}),
+     "joints.knee.acceleration_route"),
 ])
 def test_a_damaged_document_names_its_key(tmp_path, damage, key):
     doc = json.loads(json.dumps(DOC))

@@ -101,20 +101,19 @@ def identify(log: Path = LogArg,
         done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
                              options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers,
                              time_unit=time_unit)
-    doc, moved = done.document, done.moved
-    for p in doc["passes"]:
-        vs = "none" if p["stribeck_velocity"] is None else f"{p['stribeck_velocity']:.4g} rad/s"
-        out.print(escape(f"v_s {vs}: {p['samples']} samples, {p['base_parameters']} base parameters of "
-                         f"{p['parameters']}, condition {p['condition']:.3g}, prior {p['prior']:g}; {p['message']}"),
-                  highlight=False)
-        if p.get("verdict"):
-            out.print(escape(p["verdict"]), highlight=False)
-        unexcited = p.get("not_excited") or []
-        if unexcited:
-            names = [str(u.get("parameter", u)) if isinstance(u, dict) else str(u) for u in unexcited]
+    result, moved = done.identification, done.moved
+    for p in result.passes:
+        vs = "none" if p.stribeck_velocity is None else f"{p.stribeck_velocity:.4g} rad/s"
+        condition = "not finite" if p.condition is None else f"{p.condition:.3g}"
+        out.print(escape(f"v_s {vs}: {p.samples} samples, {p.base_parameters} base parameters of "
+                         f"{p.parameters}, condition {condition}, prior {p.prior:g}; {p.message}"), highlight=False)
+        if p.verdict:
+            out.print(escape(p.verdict), highlight=False)
+        if p.not_excited:
+            names = [u.parameter for u in p.not_excited]
             out.print(escape(f"not excited by this log, kept at the given model: {len(names)} parameters ("
                              + ", ".join(names[:4]) + (", ..." if len(names) > 4 else "") + ")"), highlight=False)
-    tables, notes = identification_tables(doc, wide)
+    tables, notes = identification_tables(result, wide)
     for table in tables:
         print_whole(table) if wide else out.print(table)
     for note in notes:

@@ -2,6 +2,7 @@
 
 from .closed_loop import ClosedLoop as ClosedLoop
 from .closed_loop import identify as identify
+from .document import Identification as Identification
 from .identification import InertialIdentification as InertialIdentification
 from .identification import identify_inertia as identify_inertia
 from .io import read_identification as read_identification

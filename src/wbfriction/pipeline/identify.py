@@ -8,11 +8,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Literal
 
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.closed_loop import ClosedLoop, identify
-from wbfriction.inertia.io import identification_document, write_identification
+from wbfriction.inertia.document import Identification
+from wbfriction.inertia.io import identification_of, write_identification
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.clock import TimeUnit
@@ -29,7 +30,7 @@ class IdentifiedFile:
 
     Attributes:
         loop: the closed loop's routes and passes.
-        document: the identification JSON's content (:func:`~wbfriction.inertia.io.identification_document`).
+        identification: the typed result, the JSON's content (:func:`~wbfriction.inertia.io.identification_of`).
         moved: the joints whose whole identified body went to their child link
             (:func:`~wbfriction.inertia.urdf.write_urdf`).
         armature: with ``options.armature = "identify"``, the identified armature per
@@ -37,7 +38,7 @@ class IdentifiedFile:
     """
 
     loop: ClosedLoop
-    document: dict[str, Any]
+    identification: Identification
     moved: tuple[str, ...]
     armature: dict[str, float] | None = None
 
@@ -68,10 +69,10 @@ def identify_file(robot: Robot, log: str | Path, urdf_output: str | Path, json_o
     data = read_log(log, robot, time_unit=time_unit)
     loop = identify(robot, data, estimate_options, options, stribeck, passes, progress=progress, workers=workers)
     moved = write_urdf(robot, loop.final.identification.pi, urdf_output)
-    doc = identification_document(loop, moved, log_provenance(log, robot))
+    result = identification_of(loop, moved, log_provenance(log, robot))
     if json_output is not None:
-        write_identification(json_output, doc)
+        write_identification(json_output, result)
     ident = loop.final.identification
     armature = (dict(zip(robot.torque_controlled, map(float, ident.armature)))
                 if ident.armature_mode == "identify" else None)
-    return IdentifiedFile(loop, doc, moved, armature)
+    return IdentifiedFile(loop, result, moved, armature)

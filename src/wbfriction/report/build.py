@@ -35,6 +35,7 @@ from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
 from wbfriction.friction.io import check_params_source, read_friction_file, read_params
 from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
 from wbfriction.friction.status import MIN_SPEED, joint_speed
+from wbfriction.inertia.document import Identification
 from wbfriction.inertia.io import read_identification
 from wbfriction.logs.tables import file_sha256
 from wbfriction.model.labels import default_label
@@ -93,7 +94,7 @@ class Report:
     energy: dict[str, JointEnergy]
     provenance: list[tuple[str, str]]
     threshold: float
-    identification: dict | None = None
+    identification: Identification | None = None
     labels: dict[str, str] | None = None
     versions: tuple[tuple[str, str], ...] = ()
     date: str = ""

@@ -20,6 +20,7 @@ from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import ALL_PARAM_NAMES, ModelParams
 from wbfriction.friction.status import MIN_SPEED, FitVerdict
+from wbfriction.inertia.document import Identification
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
 from wbfriction.report.figures import friction_overview_figure, joint_figure, png_bytes
@@ -142,45 +143,46 @@ def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> s
             f'{head}<th>RMS residual [N·m]</th></tr>' + "".join(rows) + "</table></div>")
 
 
-def _identification_section(r: Report, doc: dict) -> str:
+def _identification_section(r: Report, ident: Identification) -> str:
     """The inertia-model identification: each pass's verdict (what the held-out gate kept,
     :mod:`~wbfriction.inertia.validation`) and solver outcome, held-out torque RMS, both routes' friction,
     the bodies as written (kept or given)."""
     passes = []
-    for k, p in enumerate(doc["passes"], start=1):
-        solver = (p.get("solver") or {}).get("meaning") or p.get("message") or ""
-        verdict = p.get("verdict") or f"pass {k}"
-        passes.append(f"<li><b>{html.escape(verdict)}</b><br>v_s {_fmt(p.get('stribeck_velocity'))} rad/s, "
-                      f"{p.get('samples')} samples, {p.get('base_parameters')} base parameters of "
-                      f"{p.get('parameters')}, condition number {_fmt(p.get('condition'))}, prior "
-                      f"{html.escape(str(p.get('prior')))}; {html.escape(solver)}</li>")
-    validated = any("validated" in d["holdout_rms"] for d in doc["joints"].values())
-    columns = ("given", "given_with_friction", "identified") + (("validated",) if validated else ())
+    for k, p in enumerate(ident.passes, start=1):
+        solver = (p.solver or {}).get("meaning") or p.message
+        verdict = p.verdict or f"pass {k}"
+        passes.append(f"<li><b>{html.escape(verdict)}</b><br>v_s {_fmt(p.stribeck_velocity)} rad/s, "
+                      f"{p.samples} samples, {p.base_parameters} base parameters of "
+                      f"{p.parameters}, condition number {_fmt(p.condition)}, prior "
+                      f"{p.prior:g}; {html.escape(solver)}</li>")
+    validated = any(d.holdout_rms.validated is not None for d in ident.joints.values())
     rms = "".join(f"<tr>{_joint_cell(r, j)}" + "".join(
-        f"<td>{d['holdout_rms'][k]:.4f}</td>" if k in d["holdout_rms"] else "<td>—</td>" for k in columns)
-        + "</tr>" for j, d in doc["joints"].items())
-    names = list(next(iter(doc["joints"].values()))["identified"])
+        "<td>—</td>" if x is None else f"<td>{x:.4f}</td>"
+        for x in (d.holdout_rms.given, d.holdout_rms.given_with_friction, d.holdout_rms.identified,
+                  *((d.holdout_rms.validated,) if validated else ())))
+        + "</tr>" for j, d in ident.joints.items())
+    names = ident.friction_names
     accel = ("F_v", "F_c", "tau_os")
     rows = []
-    for j, d in doc["joints"].items():
-        route = ((d.get("acceleration_route") or {}).get("params")) or {}
-        rows.append(f"<tr>{_joint_cell(r, j)}" + "".join(f"<td>{_fmt(d['identified'][n])}</td>" for n in names)
+    for j, d in ident.joints.items():
+        route = {} if d.acceleration_route.params is None else d.acceleration_route.params.to_dict()
+        rows.append(f"<tr>{_joint_cell(r, j)}" + "".join(f"<td>{_fmt(d.identified[n])}</td>" for n in names)
                     + "".join(f"<td>{_fmt(route.get(n))}</td>" for n in accel) + "</tr>")
     bodies = []
-    for b in doc["bodies"]:
-        if max(b["mass_given"], b["mass"]) <= 0:
+    for b in ident.bodies:
+        if not b.has_mass:
             continue
-        change = "new" if b.get("mass_change") is None else f"{100 * b['mass_change']:+.2f}"
-        kept = "" if "kept" not in b else f"<td>{'kept' if b['kept'] else 'given'} ({html.escape(str(b['limb']))})</td>"
-        bodies.append(f"<tr><td>{html.escape(b['body'])}</td>{kept}<td>{b['mass_given']:.4f}</td>"
-                      f"<td>{b['mass']:.4f}</td><td>{change}</td><td>{1e3 * b['com_shift']:.2f}</td></tr>")
-    kept_head = '<th class="text">written (limb)</th>' if any("kept" in b for b in doc["bodies"]) else ""
+        change = "new" if b.mass_change is None else f"{100 * b.mass_change:+.2f}"
+        kept = "" if b.kept is None else f"<td>{'kept' if b.kept else 'given'} ({html.escape(str(b.limb))})</td>"
+        bodies.append(f"<tr><td>{html.escape(b.body)}</td>{kept}<td>{b.mass_given:.4f}</td>"
+                      f"<td>{b.mass:.4f}</td><td>{change}</td><td>{1e3 * b.com_shift:.2f}</td></tr>")
+    kept_head = '<th class="text">written (limb)</th>' if any(b.kept is not None for b in ident.bodies) else ""
     heads = "".join(f"<th>{html.escape(n)}</th>" for n in names) + "".join(f"<th>accel. {n}</th>" for n in accel)
     rms_heads = "<th>given model</th><th>given + its best friction</th><th>identified</th>" + (
         "<th>written (kept where it helps)</th>" if validated else "")
     return f"""<h2 id="identification">Inertia model identified from the torques (thesis 2.4, ch. 8)</h2>
 <ul class="sub">{''.join(passes)}</ul>
-<p class="sub">Held out: the last {doc['holdout_samples']} single-support samples of the log, not used to identify.
+<p class="sub">Held out: the last {ident.holdout_samples} single-support samples of the log, not used to identify.
 The identified inertias are written only for the limbs where they predict these samples better than the given
 model with its best friction; the other limbs stay as given.</p>
 <h3>Held-out joint torques: RMS of measured − predicted [N·m]</h3>

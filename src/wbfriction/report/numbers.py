@@ -21,9 +21,12 @@ GENERAL_DIGITS = 4
 
 def _error_place(se: float) -> int:
     """The decimal exponent of the last digit kept: that of ``se``'s first significant digit, one lower when
-    that digit is 1."""
+    that digit is 1; the digit read once ``se`` is rounded to two (0.196 is 0.20: one digit, 0.2)."""
     exponent = math.floor(math.log10(se))
-    return exponent - 1 if se / 10.0**exponent < 2.0 else exponent
+    leading = round(se / 10.0 ** (exponent - 1))  # two significant digits, 10 to 100
+    if leading >= 100:
+        exponent, leading = exponent + 1, 10
+    return exponent - 1 if leading < 20 else exponent
 
 
 def with_error(value: float, se: float | None) -> str:
@@ -53,7 +56,9 @@ def bound_text(bound: float | None) -> str:
         return ""
     if not math.isfinite(bound):
         return "n.i."
-    return f"± {bound:.2g}" if bound / 10.0 ** math.floor(math.log10(bound)) < 2.0 else f"± {bound:.1g}"
+    place = _error_place(bound)
+    digits = math.floor(math.log10(round(bound, -place))) - place  # 1 after a leading 1, else 0
+    return f"± {round(bound, -place):.{max(-place, 0)}f}" if -4 <= place <= 4 else f"± {bound:.{digits}e}"
 
 
 GAP_STEPS = 10.0

@@ -20,6 +20,7 @@ from rich.table import Table
 
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import ALL_PARAM_NAMES
+from wbfriction.inertia.document import Identification
 from wbfriction.report.numbers import bound_text, with_error
 
 MAIN = ("F_c", "F_v")
@@ -150,9 +151,8 @@ def _change(x: float | None, digits: int) -> str:
     return "new" if x is None else f"{100 * x:+.{digits}f}"
 
 
-def identification_tables(doc: dict, wide: bool = False) -> tuple[list[Table], list[str]]:
-    """The tables of ``wbfriction identify`` from its document
-    (:func:`~wbfriction.inertia.io.identification_document`)
+def identification_tables(result: Identification, wide: bool = False) -> tuple[list[Table], list[str]]:
+    """The tables of ``wbfriction identify`` (:class:`~wbfriction.inertia.document.Identification`)
     and the notes that stand for the rows left out: the bodies that changed (``wide``: every body with mass),
     the friction of the joints whose acceleration-route fit moved (both routes, the status of the
     acceleration route's fit, the power-generating share), and their held-out torques."""
@@ -162,20 +162,20 @@ def identification_tables(doc: dict, wide: bool = False) -> tuple[list[Table], l
                            "[%]; kept: the identified body predicted held-out torques better (else as given)")
     for col in ("body", "mass [kg]", "mass [%]", "COM [mm]", "I1 [%]", "I2 [%]", "I3 [%]", "kept"):
         bodies.add_column(col, justify="left" if col == "body" else "right", no_wrap=True)
-    massive = [b for b in doc["bodies"] if max(b["mass_given"], b["mass"]) > 0]
-    changed = [b for b in massive if wide or b.get("kept") or b["mass_change"] is None
-               or abs(b["mass_change"]) >= CHANGED or b["com_shift"] >= CHANGED
-               or any(abs(x) >= CHANGED for x in b["moments_change"])]
+    massive = [b for b in result.bodies if b.has_mass]
+    changed = [b for b in massive if wide or b.kept or b.mass_change is None
+               or abs(b.mass_change) >= CHANGED or b.com_shift >= CHANGED
+               or any(x is None or abs(x) >= CHANGED for x in b.moments_change)]
     for b in changed:
-        bodies.add_row(b["body"], f"{b['mass_given']:.4g} -> {b['mass']:.4g}", _change(b["mass_change"], 2),
-                       f"{1e3 * b['com_shift']:.2f}", *[_change(x, 1) for x in b["moments_change"]],
-                       {True: "yes", False: "no"}.get(b.get("kept"), "—"))
+        bodies.add_row(b.body, f"{b.mass_given:.4g} -> {b.mass:.4g}", _change(b.mass_change, 2),
+                       f"{1e3 * b.com_shift:.2f}", *[_change(x, 1) for x in b.moments_change],
+                       "—" if b.kept is None else "yes" if b.kept else "no")
     if len(changed) < len(massive):
         notes.append(f"{len(massive) - len(changed)} of {len(massive)} bodies with mass written as given "
                      "(--wide lists them)")
-    joints = doc["joints"]
-    moved = [j for j, v in joints.items() if wide or v["acceleration_route"].get("status") != "not excited"]
-    names = list(next(iter(joints.values()))["identified"]) if joints else []
+    joints = result.joints
+    moved = [j for j, v in joints.items() if wide or v.acceleration_route.verdict().status != "not excited"]
+    names = result.friction_names
     friction = Table(title="Friction: this route (torques, the inertias written) and the acceleration route (5.10)",
                      box=None, title_justify="left", caption_justify="left",
                      caption="status: of the acceleration route's fit; gen: share of valid samples whose friction "
@@ -187,15 +187,15 @@ def identification_tables(doc: dict, wide: bool = False) -> tuple[list[Table], l
     pct = lambda x: "—" if x is None else f"{100 * x:.1f}"  # noqa: E731
     for joint in moved:
         j = joints[joint]
-        accel = j["acceleration_route"]
-        params = accel.get("params") or {}
-        status = accel.get("status", "—")
-        friction.add_row(joint, status, *[_g(j["identified"][n]) for n in names],
+        accel = j.acceleration_route
+        params = {} if accel.params is None else accel.params.to_dict()
+        status = accel.verdict().status
+        friction.add_row(joint, status, *[_g(j.identified[n]) for n in names],
                          *[_g(params.get(n)) for n in ("F_v", "F_c")],
-                         f"{pct(j['generating_share_given_model'])}->{pct(j['generating_share'])}",
+                         f"{pct(j.generating_share_given_model)}->{pct(j.generating_share)}",
                          style=None if status == "ok" else "dim")
-        target = accel.get("target")
-        if target:
+        if accel.target is not None:
+            target = accel.target.to_dict()
             f_s = {"F_s-F_c": target.get("S", 0.0) * target["F_c"]}
             friction.add_row("  target", "", *[_g(target.get(n, f_s.get(n))) for n in names],
                              *[_g(target.get(n)) for n in ("F_v", "F_c")], "", style="dim")
@@ -204,12 +204,12 @@ def identification_tables(doc: dict, wide: bool = False) -> tuple[list[Table], l
         notes.append(f"not excited by this log, friction and held-out torques left out: {len(still)} joints "
                      f"({', '.join(still[:NAMES_SHOWN])}{' and more' if len(still) > NAMES_SHOWN else ''}); --wide "
                      "lists them")
-    rms = Table(title=f"Held-out torques ({doc['holdout_samples']} single-support samples at the end of the log): "
+    rms = Table(title=f"Held-out torques ({result.holdout_samples} single-support samples at the end of the log): "
                       "RMS of measured - predicted [N·m]", box=None, title_justify="left")
     for col in ("joint", "given model", "given + its friction", "identified", "written"):
         rms.add_column(col, justify="left" if col == "joint" else "right", no_wrap=True)
     for joint in moved:
-        h = joints[joint]["holdout_rms"]
-        rms.add_row(joint, f"{h['given']:.4f}", f"{h['given_with_friction']:.4f}", f"{h['identified']:.4f}",
-                    f"{h['validated']:.4f}" if "validated" in h else "—")
+        h = joints[joint].holdout_rms
+        rms.add_row(joint, f"{h.given:.4f}", f"{h.given_with_friction:.4f}", f"{h.identified:.4f}",
+                    "—" if h.validated is None else f"{h.validated:.4f}")
     return [t for t in (bodies, friction, rms) if t.row_count], notes
