@@ -1,7 +1,7 @@
 """The batch on Dask against the serial run, and the trend report (issue 25).
 
 Makes ``--logs`` logs (two simulated Panda arms, ``--seconds`` each, a different noise seed per log:
-:func:`~wbfriction.studies.fleet.simulate_arm_fleet`) or takes a
+:func:`~wbfriction.studies.drifting_fleet.simulate_arm_fleet`) or takes a
 ``--manifest``, then, in this one run, processes them serially (the reference) and on a local Dask cluster of
 ``--workers`` processes, and prints for each: logs per minute, rows per second, and the Dask run's overhead per
 task (``(workers * wall_dask - wall_serial) / logs``: what the cluster costs beyond dividing the work), the
@@ -27,7 +27,7 @@ import pyarrow.parquet as pq
 from wbfriction.fleet.batch import local_cluster, run_batch
 from wbfriction.fleet.manifest import read_manifest
 from wbfriction.fleet.results import read_results
-from wbfriction.studies.fleet import simulate_arm_fleet
+from wbfriction.studies.drifting_fleet import simulate_arm_fleet
 
 
 def files(results: Path) -> dict[str, bytes]:

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from wbfriction.fleet import fleet_trends, read_manifest, read_results, run_batch
 from wbfriction.report.trends import write_trends_html
-from wbfriction.studies.fleet import Drift, simulate_arm_fleet
+from wbfriction.studies.drifting_fleet import Drift, simulate_arm_fleet
 
 WORN = Drift("arm-1", "panda_joint4", "F_c", 0.40, 5)
 """Arm 1's fourth joint: its Coulomb friction 40 % higher by its last log, growing over its last 5."""

@@ -46,7 +46,7 @@ def walk(talos, combined_walk, tmp_path_factory) -> Path:
 def walk_friction(talos, walk, tmp_path_factory) -> Path:
     """Its friction table, as ``wbfriction estimate --diff central`` writes it (with provenance)."""
     from wbfriction.pipeline.chunks import Chunking
-    from wbfriction.pipeline.estimate import RobotSpec, estimate_file
+    from wbfriction.pipeline.estimate_step import RobotSpec, estimate_file
     from wbfriction.pipeline.provenance import log_provenance
 
     out = tmp_path_factory.mktemp("faults_est") / "friction.parquet"

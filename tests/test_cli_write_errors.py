@@ -48,8 +48,8 @@ def arm(tmp_path_factory) -> Path:
     from wbfriction.logs.tables import write_table
     from wbfriction.model.loading import load_robot
     from wbfriction.pipeline.chunks import Chunking
-    from wbfriction.pipeline.estimate import RobotSpec, estimate_file
-    from wbfriction.pipeline.fit import fit_file
+    from wbfriction.pipeline.estimate_step import RobotSpec, estimate_file
+    from wbfriction.pipeline.fit_step import fit_file
     from wbfriction.pipeline.provenance import log_provenance
     from wbfriction.sim.arm import ArmOptions, default_arm_friction, simulate_arm
 

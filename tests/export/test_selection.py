@@ -29,7 +29,7 @@ from wbfriction.friction.io import write_params
 from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.status import FitVerdict
 from wbfriction.model import load_robot
-from wbfriction.pipeline.export import export_files
+from wbfriction.pipeline.export_step import export_files
 
 STATUSES = ("ok", "weak", "at bound", "not excited", "failed")
 

@@ -28,7 +28,7 @@ from wbfriction.fleet.results import failures_folder, read_failures, read_result
 from wbfriction.fleet.schema import RESULT_SCHEMA
 from wbfriction.fleet.task import LogOutcome
 from wbfriction.friction.options import FitOptions
-from wbfriction.pipeline.estimate import RobotSpec
+from wbfriction.pipeline.estimate_step import RobotSpec
 
 DAY = datetime(2026, 3, 1, 8, tzinfo=UTC)
 CALLS: list[dict] = []

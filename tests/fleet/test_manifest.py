@@ -12,7 +12,7 @@ import pytest
 
 from wbfriction.exceptions import InputError
 from wbfriction.fleet.manifest import read_manifest, scan_folder
-from wbfriction.pipeline.estimate import RobotSpec
+from wbfriction.pipeline.estimate_step import RobotSpec
 
 HEAD = "log,robot_id,start_time,robot"
 

@@ -33,7 +33,7 @@ from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import CoulombViscousParams, StribeckParams
 from wbfriction.friction.options import EstimateOptions, FitOptions
-from wbfriction.pipeline.estimate import RobotSpec
+from wbfriction.pipeline.estimate_step import RobotSpec
 from wbfriction.version import __version__
 
 KEY = ResultKey("007", datetime(2026, 3, 1, 9, 30, 0, 123456, tzinfo=timezone(timedelta(hours=1))), "/logs/a.parquet",

@@ -13,8 +13,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
+from wbfriction.fleet.change_point import detect_change
 from wbfriction.fleet.schema import RESULT_SCHEMA
-from wbfriction.fleet.trends import TrendOptions, detect_change, fleet_trends
+from wbfriction.fleet.trends import TrendOptions, fleet_trends
 from wbfriction.report.trends import write_trends_html
 
 DAYS = [datetime(2026, 1, 1, tzinfo=UTC) + timedelta(days=i) for i in range(25)]

@@ -1,7 +1,8 @@
 """The change detector's numbers against independent computations (issue 37, mutation testing of
-``fleet/trends.py``): the hinge statistics and coefficients by ``numpy.linalg.lstsq`` onset by onset, the change's
-standard error from the weighted least-squares covariance written out, the Monte Carlo p-value recounted from the
-documented draws; the decisions (what is a point, what is flagged, in which order) against their rules."""
+``fleet/trends.py``; the test itself now in ``fleet/change_point.py``): the hinge statistics and coefficients by
+``numpy.linalg.lstsq`` onset by onset, the change's standard error from the weighted least-squares covariance
+written out, the Monte Carlo p-value recounted from the documented draws; the decisions (what is a point, what
+is flagged, in which order) against their rules."""
 
 from __future__ import annotations
 
@@ -14,16 +15,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
+from wbfriction.fleet.change_point import detect_change, hinge_scan, null_p_value
 from wbfriction.fleet.schema import RESULT_SCHEMA
-from wbfriction.fleet.trends import (
-    QUANTITIES,
-    TrendOptions,
-    detect_change,
-    fleet_trends,
-    hinge_scan,
-    joint_trend,
-    null_p_value,
-)
+from wbfriction.fleet.trends import QUANTITIES, TrendOptions, fleet_trends, joint_trend
 
 T0 = datetime(2026, 1, 1, tzinfo=UTC)
 ONE = TrendOptions(alpha=0.05, quantities=("F_c",), replicates=2000)

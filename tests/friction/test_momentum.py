@@ -23,7 +23,7 @@ from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import read_table
 from wbfriction.model.loading import load_robot
 from wbfriction.pipeline.chunks import Chunking
-from wbfriction.pipeline.estimate import RobotSpec, estimate_file
+from wbfriction.pipeline.estimate_step import RobotSpec, estimate_file
 from wbfriction.signals.window import MomentumWindow
 from wbfriction.sim.arm import ExcitationOptions, arm_model, excitation_trajectory
 from wbfriction.sim.ideal import simulate_ideal

@@ -14,7 +14,7 @@ from threadpoolctl import threadpool_info, threadpool_limits
 from wbfriction.inertia.identification import identify_inertia
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.log import write_log
-from wbfriction.pipeline.identify import identify_file
+from wbfriction.pipeline.identify_step import identify_file
 
 
 def _blas_threads() -> int:

@@ -24,7 +24,7 @@ from wbfriction.inertia.sensitivity import scaled_robot
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.log import write_log
 from wbfriction.model.loading import load_robot
-from wbfriction.pipeline.identify import identify_file
+from wbfriction.pipeline.identify_step import identify_file
 from wbfriction.signals.options import FilterOptions
 from wbfriction.studies.common import leg_joints
 

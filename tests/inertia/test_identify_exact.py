@@ -1,6 +1,6 @@
 """``wbfriction identify`` on a log simulated with the exact model: nothing to correct, so it must not make
 the model worse. The simulated Panda (the fixture's 8 s log: 19-bit encoders, motor currents with 0.05 N·m
-of noise, the TOML's armature) through :func:`~wbfriction.pipeline.identify.identify_file` with the
+of noise, the TOML's armature) through :func:`~wbfriction.pipeline.identify_step.identify_file` with the
 model that simulated it: the held-out torques are predicted as well as by that model with its best
 friction, the identifiable inertial combinations and the total mass stay the true ones, the friction
 comes back, and the URDF written reads back as the identified model."""
@@ -15,7 +15,7 @@ from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import body_parameters
 from wbfriction.logs.log import write_log
 from wbfriction.model.loading import load_robot
-from wbfriction.pipeline.identify import identify_file
+from wbfriction.pipeline.identify_step import identify_file
 from wbfriction.signals.options import FilterOptions
 
 ESTIMATE = EstimateOptions(diff="butterworth", filtering=FilterOptions(cutoff=20.0))

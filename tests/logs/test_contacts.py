@@ -15,7 +15,7 @@ from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forc
 from wbfriction.logs.log import write_log
 from wbfriction.logs.source import read_log
 from wbfriction.pipeline.chunks import Chunking
-from wbfriction.pipeline.estimate import RobotSpec, estimate_file
+from wbfriction.pipeline.estimate_step import RobotSpec, estimate_file
 from wbfriction.sim import IdealOptions, simulate_ideal
 from wbfriction.walking import GaitOptions, walking_reference
 

@@ -12,7 +12,7 @@ import pytest
 from wbfriction.exceptions import InputError
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.model.loading import load_robot
-from wbfriction.pipeline.export import export_files
+from wbfriction.pipeline.export_step import export_files
 
 
 @pytest.fixture(scope="module")

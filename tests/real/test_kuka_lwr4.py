@@ -29,9 +29,9 @@ from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.log import log_from_table
 from wbfriction.model import Robot, load_robot
-from wbfriction.pipeline.estimate import RobotSpec, estimate_file
-from wbfriction.pipeline.fit import fit_file
-from wbfriction.pipeline.identify import identify_file
+from wbfriction.pipeline.estimate_step import RobotSpec, estimate_file
+from wbfriction.pipeline.fit_step import fit_file
+from wbfriction.pipeline.identify_step import identify_file
 from wbfriction.signals.kinematics import measure
 
 pytestmark = needs_kuka

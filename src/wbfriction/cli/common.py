@@ -5,6 +5,7 @@ defaults, the robot from --robot/--urdf/--config/--mjcf, the progress bar and th
 from __future__ import annotations
 
 import sys
+from collections.abc import Mapping
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional
@@ -116,11 +117,13 @@ def warn(warnings) -> None:
         console.print(f"[yellow]warning:[/] {escape(w)}", highlight=False, soft_wrap=True)
 
 
-def warn_energy(energy) -> None:
-    """Print the energy-consistency warnings (eq. 7.9) of the flagged joints."""
-    for e in energy:
-        if e.flagged:
-            console.print(f"[yellow]warning:[/] {escape(e.warning())}", highlight=False, soft_wrap=True)
+def warn_energy(energy, verbose: bool = False, labels: Mapping[str, str] | None = None) -> None:
+    """Print the energy-consistency warnings (eq. 7.9) of the flagged joints: one line (``verbose``: one per
+    joint; :func:`~wbfriction.report.terminal.energy_notes`)."""
+    from wbfriction.report.terminal import energy_notes
+
+    for line in energy_notes(energy, verbose, labels):
+        console.print(f"[yellow]warning:[/] {escape(line)}", highlight=False, soft_wrap=True)
 
 
 def joint_list(r: Robot, joints: Optional[str]) -> list[str]:

@@ -26,7 +26,7 @@ from wbfriction.signals.options import AlignmentOption, DiffOption, FilterOption
 
 if TYPE_CHECKING:
     from wbfriction.model.robot import Robot
-    from wbfriction.pipeline.estimate import RobotSpec
+    from wbfriction.pipeline.estimate_step import RobotSpec
 
 from wbfriction.cli.common import (
     ESTIMATE,
@@ -64,7 +64,7 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     from wbfriction.logs.source import open_log
     from wbfriction.logs.tables import TableFile
     from wbfriction.pipeline.chunks import Chunking
-    from wbfriction.pipeline.estimate import estimate_file, table_log
+    from wbfriction.pipeline.estimate_step import estimate_file, table_log
     from wbfriction.pipeline.provenance import log_provenance
 
     chunking = Chunking(rows=chunk_rows, workers=workers)
@@ -169,7 +169,7 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
              route: RouteOption = RouteOpt, velocity_window: Optional[int] = VelocityWindowOpt,
              momentum_window: Optional[int] = MomentumWindowOpt) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
-    from wbfriction.pipeline.estimate import RobotSpec
+    from wbfriction.pipeline.estimate_step import RobotSpec
 
     check_paths({"LOG": log, "--map": bag_map, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
     opts = EstimateOptions(diff=diff, compensate_delay=delay_compensation,

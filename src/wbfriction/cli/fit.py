@@ -58,12 +58,13 @@ def _print_fits(results: list[FitResult], labels: dict[str, str] | None, wide: b
 
 def _run_fit(friction: Path, output: Path, options: FitOptions, threshold: float, tolerance: float,
              workers: int, wide: bool = False, verbose: bool = False) -> None:
-    from wbfriction.pipeline.fit import fit_file
+    from wbfriction.pipeline.fit_step import fit_file
 
     with console.status(f"fitting {friction.name} (--model {options.model})"):
         fitted = fit_file(friction, output, options, threshold=threshold, tolerance=tolerance, workers=workers)
-    _print_fits(fitted.fits, fitted.est.metadata.get("joint_labels"), wide, verbose)
-    warn_energy(fitted.energy)
+    labels = fitted.est.metadata.get("joint_labels")
+    _print_fits(fitted.fits, labels, wide, verbose)
+    warn_energy(fitted.energy, verbose, labels)
     console.print(f"wrote {output}")
 
 
@@ -104,7 +105,7 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
     F_c -> Coulomb friction (MuJoCo frictionloss); the Stribeck bump, the tanh and tau_os have no
     simulator field and are dropped. Inertias are the URDF's: give --urdf IDENTIFIED.urdf to export
     identified ones."""
-    from wbfriction.pipeline.export import export_files
+    from wbfriction.pipeline.export_step import export_files
 
     check_paths({"PARAMS": params, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
                 {f"-o {o}": o for o in outputs})
@@ -129,7 +130,7 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
     predicted torque, tau - (M qdd + h + f(qd)), with the friction model and without it."""
     import numpy as np
 
-    from wbfriction.pipeline.predict import predict_file
+    from wbfriction.pipeline.predict_step import predict_file
 
     check_paths({"FRICTION": friction, "--params": params}, {})
     with console.status(f"predicting the torques of {friction.name}"):
@@ -171,7 +172,7 @@ def report(friction: Path = FrictionArg,
     with console.status("building the report"):
         rep = make_report(friction, params, energy_threshold, energy_tolerance, identification, workers)
         write_report(rep, output, workers)
-    warn_energy(rep.energy.values())
+    warn_energy(rep.energy.values(), labels=rep.labels)
     console.print(f"wrote {output} ({len(rep.est.joints)} joints, {len(rep.flagged)} flagged)")
 
 

@@ -68,7 +68,7 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
     from wbfriction.fleet.manifest import read_manifest, scan_folder
     from wbfriction.fleet.options import BatchOptions
     from wbfriction.fleet.results import failures_folder
-    from wbfriction.pipeline.estimate import RobotSpec
+    from wbfriction.pipeline.estimate_step import RobotSpec
 
     check_paths({"MANIFEST": source}, {})
     check_outputs(output, tables)

@@ -88,7 +88,7 @@ def identify(log: Path = LogArg,
         raise InputError(f"--stribeck-velocity must be auto, none or a number, got '{stribeck_velocity}'") from None
     if not 0.0 < holdout < 1.0:
         raise InputError(f"--holdout must be between 0 and 1, got {holdout}")
-    from wbfriction.pipeline.identify import identify_file
+    from wbfriction.pipeline.identify_step import identify_file
     from wbfriction.report.terminal import identification_tables
 
     r = robot_of(robot, urdf, config, mjcf)

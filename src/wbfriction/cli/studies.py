@@ -234,7 +234,7 @@ def study_fleet(output_dir: Path = typer.Option(Path("wbfriction-fleet"), "-o", 
     flagged against the truth."""
     import dataclasses
 
-    from wbfriction.studies.fleet import FleetPlan, run_fleet_study
+    from wbfriction.studies.drifting_fleet import FleetPlan, run_fleet_study
 
     plan = dataclasses.replace(FleetPlan(), robots=robots, logs=logs)
     if robots < 3:

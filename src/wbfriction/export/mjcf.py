@@ -70,65 +70,14 @@ from lxml import etree as ET
 
 from wbfriction.exceptions import ModelError
 from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
-from wbfriction.export.urdf import identified_parameters, read_urdf
+from wbfriction.export.urdf import identified_parameters
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.tables import write_atomic
+from wbfriction.model.mjspec import mujoco_message, urdf_spec
 from wbfriction.model.robot import Robot
 
 if TYPE_CHECKING:
     import mujoco
-
-DROPPED_TAGS = ("gazebo", "transmission", "mujoco")
-"""Top-level URDF elements :func:`urdf_spec` removes (simulator extensions; its own ``<mujoco>`` block replaces any)."""
-
-
-def _one_line(exc: Exception) -> str:
-    """MuJoCo's message on one line (its parser and compiler add lines such as "Element name '', id 0")."""
-    return " ".join(str(exc).split())
-
-
-def urdf_spec(urdf: str | Path, free_joint: bool = True) -> mujoco.MjSpec:
-    """The MuJoCo spec of a URDF's kinematic tree and inertias (module docstring).
-
-    Visual and collision geometry, ``<dynamics>``, Gazebo, transmission and MuJoCo extension tags
-    are removed; of an element a joint repeats (a second ``<origin>``), the first is kept, as
-    Pinocchio's parser does. MuJoCo compiles it with ``fusestatic`` (links on fixed joints fused
-    into their parent body) and ``balanceinertia`` off (inertias as given).
-
-    Args:
-        urdf: the URDF file.
-        free_joint: add a free joint at the root link (unless it has one): a floating base.
-            Otherwise the root link is welded to the world at the origin.
-
-    Raises:
-        InputError: an unreadable URDF.
-        ModelError: a URDF MuJoCo cannot read.
-    """
-    import mujoco
-    root = read_urdf(urdf).getroot()
-    for link in root.findall("link"):
-        for e in [*link.findall("visual"), *link.findall("collision")]:
-            link.remove(e)
-    for joint in root.findall("joint"):
-        seen: set[str] = set()
-        for e in list(joint):
-            if e.tag == "dynamics" or e.tag in seen:
-                joint.remove(e)
-            elif isinstance(e.tag, str):
-                seen.add(e.tag)
-    for e in [e for tag in DROPPED_TAGS for e in root.findall(tag)]:
-        root.remove(e)
-    extension = ET.SubElement(root, "mujoco")
-    ET.SubElement(extension, "compiler", discardvisual="true", fusestatic="true", balanceinertia="false")
-    try:
-        spec = mujoco.MjSpec.from_string(ET.tostring(root, encoding="unicode"))
-    except Exception as exc:  # mujoco raises ValueError with its parser's message
-        raise ModelError(f"{urdf}: MuJoCo cannot read the URDF: {_one_line(exc)}") from None
-    base = spec.worldbody.first_body()
-    if free_joint and base is not None and not any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in base.joints):
-        base.add_freejoint()
-    return spec
-
 
 def robot_spec(robot: Robot) -> mujoco.MjSpec:
     """The MuJoCo spec of ``robot``'s own description: :func:`urdf_spec` of its URDF, or its MJCF as it
@@ -143,7 +92,7 @@ def robot_spec(robot: Robot) -> mujoco.MjSpec:
     try:
         spec = mujoco.MjSpec.from_file(str(robot.urdf))
     except Exception as exc:  # mujoco raises ValueError with its parser's message
-        raise ModelError(f"{robot.urdf}: MuJoCo cannot read the MJCF: {_one_line(exc)}") from None
+        raise ModelError(f"{robot.urdf}: MuJoCo cannot read the MJCF: {mujoco_message(exc)}") from None
     base = spec.worldbody.first_body()
     if robot.floating_base and base is not None and not any(j.type == mujoco.mjtJoint.mjJNT_FREE
                                                             for j in base.joints):
@@ -271,7 +220,7 @@ def compile_spec(spec: mujoco.MjSpec, source: str | Path = "MJCF") -> mujoco.MjM
     try:
         return spec.compile()
     except Exception as exc:  # mujoco raises ValueError with the compiler's message
-        raise ModelError(f"{source}: MuJoCo cannot compile the model: {_one_line(exc)}") from None
+        raise ModelError(f"{source}: MuJoCo cannot compile the model: {mujoco_message(exc)}") from None
 
 
 def mujoco_model(robot: Robot, friction: Mapping[str, FrictionLike], armature: Mapping[str, float] | None = None,

@@ -26,6 +26,7 @@ from wbfriction.export.mapping import NOTE_PREFIX, FrictionLike, JointExport, jo
 from wbfriction.inertia.regressor import body_parameters
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.tables import write_atomic
+from wbfriction.model.mjspec import read_urdf
 from wbfriction.model.robot import Robot
 
 
@@ -39,18 +40,6 @@ def identified_parameters(robot: Robot, inertias: pin.Model) -> np.ndarray:
     if list(inertias.names) != list(robot.model.names):
         raise InputError(f"inertias: the model's joints are not those of robot '{robot.name}'")
     return body_parameters(inertias)
-
-
-def read_urdf(path: str | Path) -> ET._ElementTree:
-    """The URDF's XML tree (lxml: comments kept).
-
-    Raises:
-        InputError: a file that cannot be read or is not XML.
-    """
-    try:
-        return ET.parse(str(path))
-    except (OSError, ET.XMLSyntaxError) as exc:
-        raise InputError(f"{path}: not a readable URDF ({exc})") from None
 
 
 def set_dynamics(root: ET._Element, joints: Mapping[str, JointExport]) -> None:

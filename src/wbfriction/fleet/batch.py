@@ -50,7 +50,7 @@ from wbfriction.fleet.results import Part, failure_files, failures_folder, read_
 from wbfriction.fleet.task import LogOutcome, ResultKey, one_line, process_log, result_key, robot_sha256
 from wbfriction.logs.tables import TableFile, file_sha256, make_folder, remove_file, remove_stale_temporaries
 from wbfriction.pipeline.chunks import CHUNKS_PER_WORKER
-from wbfriction.pipeline.estimate import worker_robot
+from wbfriction.pipeline.estimate_step import worker_robot
 from wbfriction.workers import DASK_PRELOAD, started_held
 
 Engine = Literal["dask", "serial"]
@@ -346,7 +346,7 @@ def _cluster_client(engine: Engine, scheduler: str | None, client: Any) -> Itera
 
 class DaskChunks:
     """A long log's chunks as tasks of the cluster its log's task runs on (a
-    :class:`~wbfriction.pipeline.estimate.ChunkExecutor`): submitted from inside the task through
+    :class:`~wbfriction.pipeline.estimate_step.ChunkExecutor`): submitted from inside the task through
     ``distributed.worker_client``, which frees the task's thread while its chunks run."""
 
     def __init__(self, client: Any):

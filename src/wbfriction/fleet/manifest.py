@@ -46,7 +46,7 @@ from wbfriction.fleet.schema import RESULT_DOCUMENT
 from wbfriction.friction.fit import MODEL_CHOICES
 from wbfriction.friction.options import ROUTE_OPTIONS
 from wbfriction.logs.tables import TableFile, read_metadata, table_format
-from wbfriction.pipeline.estimate import RobotSpec
+from wbfriction.pipeline.estimate_step import RobotSpec
 from wbfriction.signals.options import DIFF_OPTIONS
 
 REQUIRED = ("log", "robot_id", "start_time")

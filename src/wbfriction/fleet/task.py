@@ -2,8 +2,8 @@
 
 :func:`process_log` is what a Dask task runs, and what the serial run calls in order: the same function, so the
 results are the same bytes. It does what ``wbfriction estimate LOG`` and ``wbfriction fit`` do with the same
-options (:func:`~wbfriction.pipeline.estimate.estimate_file` on one process, then
-:func:`~wbfriction.pipeline.fit.fit_table`, what ``fit`` runs before it writes).
+options (:func:`~wbfriction.pipeline.estimate_step.estimate_file` on one process, then
+:func:`~wbfriction.pipeline.fit_step.fit_table`, what ``fit`` runs before it writes).
 
 Sign convention: ``tau_f`` is the torque friction exerts on the joint; the model ``f(qd)`` is fitted to
 ``-tau_f`` (:mod:`wbfriction.fleet.schema`).
@@ -32,8 +32,8 @@ from wbfriction.friction.fit import FitResult, model_jacobian
 from wbfriction.logs.tables import file_sha256, scratch_folder
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import Chunking
-from wbfriction.pipeline.estimate import ChunkExecutor, RobotSpec, estimate_file, worker_robot
-from wbfriction.pipeline.fit import fit_table
+from wbfriction.pipeline.estimate_step import ChunkExecutor, RobotSpec, estimate_file, worker_robot
+from wbfriction.pipeline.fit_step import fit_table
 from wbfriction.version import __version__
 
 
@@ -110,7 +110,7 @@ def process_log(entry: LogEntry, key: ResultKey, options: BatchOptions, scratch:
         scratch: a folder for the friction table while it is fitted (removed after).
         table: where to keep the friction table, or None.
         executor, chunk_workers: where a long log's chunks go, ``chunk_workers`` at a time
-            (:func:`~wbfriction.pipeline.estimate.estimate_file`); None: all in this process.
+            (:func:`~wbfriction.pipeline.estimate_step.estimate_file`); None: all in this process.
 
     Returns:
         The outcome: rows on success; else the error's one line (a

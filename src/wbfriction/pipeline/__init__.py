@@ -1,7 +1,7 @@
 """Files in, files out: what the command line runs on files, for long logs too: the estimate in
-chunks on several processes (:mod:`.chunks`, :mod:`.estimate`), the fit (:mod:`.fit`), the
-inertia identification (:mod:`.identify`), torque prediction on held-out logs (:mod:`.predict`),
-exports (:mod:`.export`), bag conversion (:mod:`.convert`), each output with
+chunks on several processes (:mod:`.chunks`, :mod:`.estimate_step`), the fit (:mod:`.fit_step`), the
+inertia identification (:mod:`.identify_step`), torque prediction on held-out logs (:mod:`.predict_step`),
+exports (:mod:`.export_step`), bag conversion (:mod:`.convert`), each output with
 its provenance (:mod:`.provenance`)."""
 
 import lazy_loader

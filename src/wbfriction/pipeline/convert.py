@@ -9,7 +9,7 @@ from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
 from wbfriction.logs.source import open_log
 from wbfriction.logs.tables import write_tables
 from wbfriction.model.robot import Robot
-from wbfriction.pipeline.estimate import check_file
+from wbfriction.pipeline.estimate_step import check_file
 
 
 def convert_log(robot: Robot, log: str | Path, output: str | Path, bag_map: BagMap | str | Path | None = None, *,
@@ -17,7 +17,7 @@ def convert_log(robot: Robot, log: str | Path, output: str | Path, bag_map: BagM
     """Stream a log (a ROS 2 bag through its topic map, or a table file,
     through the same map TOML if given: joint renaming, contact flags) into ``output`` (Parquet
     or CSV) in the log format, check it against ``robot`` chunk by chunk
-    (:func:`~wbfriction.pipeline.estimate.check_file`) and only then rename it into place.
+    (:func:`~wbfriction.pipeline.estimate_step.check_file`) and only then rename it into place.
     Returns the rows written.
 
     Raises:

@@ -14,10 +14,11 @@ per family of joints that share a status or a chosen model, each joint's own rea
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 
 from rich.table import Table
 
+from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import ALL_PARAM_NAMES
 from wbfriction.inertia.document import Identification
@@ -134,6 +135,22 @@ def fit_notes(results: Sequence[FitResult], verbose: bool = False,
         lines.append("model chosen on held-out data (--verbose gives each joint's reason):")
         lines += [f"  {model}: {_joints(joints)}" for model, joints in chosen.items()]
     return lines
+
+
+def energy_notes(energy: Iterable[JointEnergy], verbose: bool = False,
+                 labels: Mapping[str, str] | None = None) -> list[str]:
+    """The energy check's warnings (eq. 7.9): the joints whose friction generates power on more than the
+    threshold's share of their valid samples, on one line with each one's share, and what is likely off
+    (thesis 7.2); ``verbose``: one line per joint (:meth:`~wbfriction.friction.energy.JointEnergy.warning`).
+    Empty when no joint is flagged."""
+    label = _labeller(labels)
+    flagged = sorted((e for e in energy if e.flagged), key=lambda e: -e.generating_share)
+    if verbose or not flagged:
+        return [f"{label(e.joint)}{(e.warning() or '')[len(e.joint):]}" for e in flagged]
+    shares = [f"{label(e.joint)} {100 * e.generating_share:.0f} %" for e in flagged]
+    return [f"friction generates power on {len(flagged)} joint{'s' if len(flagged) > 1 else ''} (eq. 7.9; share "
+            f"of valid samples, threshold {100 * flagged[0].threshold:.0f} %): {_joints(shares)}: the inertia model, "
+            "a torque-sensor offset or the filtering is likely off (thesis 7.2)"]
 
 
 CHANGED = 1e-4

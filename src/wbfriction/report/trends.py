@@ -18,7 +18,8 @@ from matplotlib import rc_context
 from matplotlib.artist import Artist
 from matplotlib.figure import Figure
 
-from wbfriction.fleet.trends import ChangePoint, FleetTrends, JointTrend
+from wbfriction.fleet.change_point import ChangePoint
+from wbfriction.fleet.trends import FleetTrends, JointTrend
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.figures import READABLE, REPORT_WIDTH, png_bytes
 from wbfriction.report.html import PAGE_CSS

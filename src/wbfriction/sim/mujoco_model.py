@@ -27,7 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import ModelError
-from wbfriction.export.mjcf import urdf_spec
+from wbfriction.model.mjspec import urdf_spec
 from wbfriction.model.robot import Robot
 
 if TYPE_CHECKING:
@@ -262,7 +262,7 @@ def _plates_weigh_as_their_links(mj: mujoco.MjModel, robot: Robot) -> None:
 
 
 def _urdf_spec(robot: Robot, timestep: float) -> mujoco.MjSpec:
-    """The MuJoCo spec of the robot's URDF (:func:`wbfriction.export.mjcf.urdf_spec`: kinematic tree and
+    """The MuJoCo spec of the robot's URDF (:func:`wbfriction.model.mjspec.urdf_spec`: kinematic tree and
     inertias only), with a free joint at the root, the physics step and a floor."""
     import mujoco
     spec = urdf_spec(robot.urdf, free_joint=True)

@@ -18,7 +18,7 @@ from wbfriction.logs.log import write_log
 from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import read_table, write_table
 from wbfriction.pipeline.chunks import CHUNKS_PER_WORKER, CONTEXT, Chunking, plan_chunks
-from wbfriction.pipeline.estimate import RobotSpec, estimate_file
+from wbfriction.pipeline.estimate_step import RobotSpec, estimate_file
 from wbfriction.signals.options import FilterOptions
 
 
@@ -140,7 +140,7 @@ def test_every_log_format_is_chunked_to_the_same_table(talos, combined_walk, wal
 def test_workers_start_only_when_each_gets_enough_chunks(walk_file, tmp_path, monkeypatch):
     """Two workers are started for a log of at least 4 chunks each, none for fewer (their start-up would
     cost more than they save); the friction table is the same either way."""
-    import wbfriction.pipeline.estimate as module
+    import wbfriction.pipeline.estimate_step as module
 
     started: list[int] = []
     real = module.process_pool

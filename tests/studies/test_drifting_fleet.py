@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from wbfriction.friction.targets import THESIS_TARGETS
-from wbfriction.studies.fleet import Drift, FleetPlan, friction_of, score_flags
+from wbfriction.studies.drifting_fleet import Drift, FleetPlan, friction_of, score_flags
 
 
 def test_a_drift_ramps_from_its_onset_to_its_full_change():

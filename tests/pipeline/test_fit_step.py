@@ -15,7 +15,7 @@ from wbfriction.friction.io import read_params
 from wbfriction.friction.models import CoulombViscousParams, StribeckParams
 from wbfriction.friction.options import FitOptions
 from wbfriction.logs.tables import write_table
-from wbfriction.pipeline.fit import fit_file
+from wbfriction.pipeline.fit_step import fit_file
 
 TRUTHS = {"hip": CoulombViscousParams(F_v=0.3, F_c=0.8, tau_os=0.2),
           "knee": StribeckParams(F_v=0.4, F_c=0.0, F_s=1.0, v_s=0.15, tau_os=0.3)}

@@ -1,0 +1,187 @@
+"""Has a series changed, and from when: a generalised likelihood-ratio test of a constant against a constant
+followed by a linear drift from an unknown onset (a hinge, or "broken-stick", regression: Hinkley 1971,
+"Inference in two-phase regression", JASA 66; the weighted form of Julious 2001, "Inference and estimation in a
+changepoint regression problem", The Statistician 50), weighted by the standard errors. The fleet's trends
+(:mod:`wbfriction.fleet.trends`) run it on each joint's quantities over its logs.
+
+* points ``y_i`` at times ``t_i`` [days], errors ``e_i ~ N(0, phi se_i^2)`` with an unknown scale ``phi``
+  (the fits' standard errors may be off by a common factor: Newey-West, a model that trades parameters);
+* for each candidate onset ``k`` (at least :attr:`ChangeSettings.min_before` points before, at least
+  :attr:`ChangeSettings.min_after` from it on), the hinge regressor ``x_i = max(0, t_i - t_{k-1})`` (zero up to
+  the last log before the onset, growing from the first drifted log on);
+* the statistic ``F_k = (RSS_0 - RSS_k) / (RSS_k / (n - 2))`` with weighted residual sums of squares; the
+  onset is the ``k`` of the largest ``F_k``;
+* its p-value, exact for this model whatever ``phi`` (``F_k`` does not depend on it): the share of
+  :meth:`ChangeSettings.draws` series of pure noise ``se_i z_i`` (seeded: the same input gives the same
+  output) whose largest ``F_k`` reaches the observed one, on the same times and weights.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from datetime import datetime
+from typing import Protocol
+
+import numpy as np
+
+DAY = 86_400.0
+"""Seconds per day: the series' time unit."""
+
+
+class ChangeSettings(Protocol):
+    """What the test reads of its options (:class:`~wbfriction.fleet.trends.TrendOptions` has them)."""
+
+    @property
+    def min_points(self) -> int:
+        """Fewer finite points: no test."""
+        ...
+
+    @property
+    def min_before(self) -> int:
+        """Points before a candidate onset."""
+        ...
+
+    @property
+    def min_after(self) -> int:
+        """Points from a candidate onset on."""
+        ...
+
+    @property
+    def seed(self) -> int:
+        """Of the p-value's noise series."""
+        ...
+
+    def draws(self) -> int:
+        """Noise series of the p-value's Monte Carlo."""
+        ...
+
+
+@dataclass(frozen=True)
+class ChangePoint:
+    """The best hinge of one series (module docstring).
+
+    Attributes:
+        quantity: the series' quantity.
+        onset: index (into the series' logs) of the first drifted log; onset_time: its start time.
+        baseline: the fitted value before the onset.
+        change, change_se: the fitted change at the last log, and its standard error (same unit).
+        statistic: the largest ``F_k``; p_value: its Monte Carlo p-value.
+        relative: ``change`` over the baseline (over F_c's baseline for ``tau_os``); NaN where the baseline is
+            not told from zero (within two of its standard errors): a relative change is then meaningless, and
+            :attr:`change` (in the quantity's unit, :data:`UNITS`) says it.
+    """
+
+    quantity: str
+    onset: int
+    onset_time: datetime
+    baseline: float
+    change: float
+    change_se: float
+    statistic: float
+    p_value: float
+    relative: float
+
+
+def hinge_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, min_after: int
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The statistics ``F_k`` of every candidate onset (module docstring) for the columns of ``y``.
+
+    Args:
+        t: (n,) increasing times [days]; y: (n,) or (n, r) values; se: (n,) standard errors (> 0).
+
+    Returns:
+        ``(onsets, F, fits)``: the candidate onsets (c,), ``F`` (c,) or (c, r), and per onset the weighted
+        least-squares coefficients (c, 2) or (c, 2, r) of ``[1, x_k]`` (baseline, slope per day). An onset
+        whose hinge would be zero at every log (no log after the time of the one before it) is no candidate:
+        ``c`` may be 0.
+    """
+    n = t.size
+    w = 1.0 / se
+    Y = (y if y.ndim == 2 else y[:, None]) * w[:, None]
+    # RSS_0: the weighted mean removed
+    q0 = w / np.linalg.norm(w)
+    r0 = Y - np.outer(q0, q0 @ Y)
+    rss0 = np.einsum("ij,ij->j", r0, r0)
+    yy = np.einsum("ij,ij->j", Y, Y)
+    onsets = np.arange(min_before, n - min_after + 1)
+    onsets = onsets[t[-1] > t[onsets - 1]]  # a hinge from the last log's time is no regressor (logs at one time)
+    F = np.empty((onsets.size, Y.shape[1]))
+    coef = np.empty((onsets.size, 2, Y.shape[1]))
+    for c, k in enumerate(onsets):
+        X = np.column_stack([w, np.maximum(0.0, t - t[k - 1]) * w])
+        Q, R = np.linalg.qr(X)
+        QtY = Q.T @ Y
+        rss = np.maximum(yy - np.einsum("ij,ij->j", QtY, QtY), 1e-300)
+        F[c] = (rss0 - rss) / (rss / (n - 2))
+        coef[c] = np.linalg.solve(R, QtY)
+    if y.ndim == 1:
+        return onsets, F[:, 0], coef[:, :, 0]
+    return onsets, F, coef
+
+
+FIRST_PASS = 1000
+"""Noise series of the p-value's first pass: a statistic that :data:`CLEAR` of them reach is no drift, and the
+full :meth:`ChangeSettings.draws` are drawn only for the others (most series of a fleet are constant)."""
+CLEAR = 20
+
+
+def null_p_value(t: np.ndarray, se: np.ndarray, statistic: float, options: ChangeSettings) -> float:
+    """The share of series of pure noise ``se_i z_i`` on times ``t`` whose largest ``F_k`` reaches ``statistic``
+    (seeded by :attr:`ChangeSettings.seed`; ``(1 + hits) / (1 + draws)``): :data:`FIRST_PASS` series first, the
+    rest of :meth:`ChangeSettings.draws` only when fewer than :data:`CLEAR` of them reached it, in blocks of
+    :data:`BLOCK` series (memory bounded whatever the number)."""
+    rng = np.random.default_rng(options.seed)
+    total = options.draws()
+    hits, draws = 0, 0
+    while draws < total and not (draws >= FIRST_PASS and hits >= CLEAR):
+        size = min(FIRST_PASS if draws == 0 else BLOCK, total - draws)
+        noise = se[:, None] * rng.standard_normal((t.size, size))
+        _, F_null, _ = hinge_scan(t, noise, se, options.min_before, options.min_after)
+        hits += int(np.sum(F_null.max(axis=0) >= statistic))
+        draws += size
+    return (1 + hits) / (1 + draws)
+
+
+BLOCK = 50_000
+"""Noise series drawn at a time after the first pass."""
+
+
+def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity: str,
+                  options: ChangeSettings, scale: float | None = None) -> ChangePoint | None:
+    """The best hinge of a series and its p-value (module docstring); None with too few finite points.
+
+    Args:
+        time: (n,) the points' times, increasing; y, se: (n,) values and standard errors (non-finite ones and
+            non-positive standard errors are left out).
+        quantity: the series' name, recorded.
+        scale: the baseline the relative change is measured against (default: the fitted baseline).
+    """
+    ok = np.isfinite(y) & np.isfinite(se) & (se > 0)
+    idx = np.flatnonzero(ok)
+    if idx.size < max(options.min_points, options.min_before + options.min_after):
+        return None
+    t0 = time[idx[0]]
+    t = np.array([(time[i] - t0).total_seconds() / DAY for i in idx])
+    yy, ss = y[idx], se[idx]
+    onsets, F, coef = hinge_scan(t, yy, ss, options.min_before, options.min_after)
+    if onsets.size == 0:  # the logs after the first candidate onset all at one time
+        return None
+    best = int(np.argmax(F))
+    p = null_p_value(t, ss, float(F[best]), options)
+    k = int(onsets[best])
+    base, slope = coef[best]
+    span = t[-1] - t[k - 1]
+    # the change at the last log and its standard error, the residual scale phi estimated
+    w = 1.0 / ss
+    X = np.column_stack([w, np.maximum(0.0, t - t[k - 1]) * w])
+    resid = yy * w - X @ coef[best]
+    phi = float(resid @ resid) / max(idx.size - 2, 1)
+    cov = phi * np.linalg.inv(X.T @ X)
+    change = float(slope * span)
+    if scale is None:  # against the fitted baseline, where it is told from zero
+        ref = abs(float(base)) if abs(float(base)) > 2 * np.sqrt(cov[0, 0]) else 0.0
+    else:
+        ref = abs(scale) if np.isfinite(scale) else 0.0
+    return ChangePoint(quantity, int(idx[k]), time[idx[k]], float(base), change,
+                       float(np.sqrt(cov[1, 1]) * span), float(F[best]), float(p),
+                       change / ref if ref > 0 else float("nan"))
