@@ -17,7 +17,7 @@ from pathlib import Path
 
 import wbfriction
 from wbfriction.friction.targets import THESIS_TARGETS, friction_by_group
-from wbfriction.inertia import identify, scaled_robot, write_urdf
+from wbfriction.inertia import identification_of, identify, scaled_robot, write_urdf
 from wbfriction.sim import IdealOptions, simulate_ideal
 from wbfriction.walking import GaitOptions, walking_reference
 
@@ -34,18 +34,18 @@ def main() -> None:
     wrong = scaled_robot(scaled_robot(true_robot, 1.1, "rotational"), 1.05, "mass")
     loop = identify(wrong, log, stribeck=0.2, passes=1)  # v_s held at 0.2 rad/s: one identification
     final = loop.final
+    result = identification_of(loop)  # the typed result: what `wbfriction identify --json` writes
     knee = "leg_right_4_joint"
-    i = final.identification.robot.torque_controlled.index(knee)
-    h = final.identification.holdout
-    print(f"held-out torque RMS of the right knee [N·m]: given model {h.given[i]:.3f}, "
-          f"given + its best friction {h.given_with_friction[i]:.3f}, identified {h.identified[i]:.4f}")
+    h = result.joints[knee].holdout_rms
+    print(f"held-out torque RMS of the right knee [N·m]: given model {h.given:.3f}, "
+          f"given + its best friction {h.given_with_friction:.3f}, identified {h.identified:.4f}")
     print(f"total mass [kg]: true {sum(b.mass for b in true_robot.model.inertias):.2f}, given "
-          f"{sum(b.mass for b in wrong.model.inertias):.2f}, identified "
-          f"{sum(b.mass for b in final.identification.robot.model.inertias):.2f}")
-    for label, route in (("given model", loop.given), ("identified model", final.route)):
-        p = route.fit(knee).params
+          f"{sum(b.mass_given for b in result.bodies):.2f}, identified {sum(b.mass for b in result.bodies):.2f}")
+    for label, fit in (("given model", result.joints[knee].acceleration_route_given_model),
+                       ("identified model", result.joints[knee].acceleration_route)):
+        p = fit.params
         print(f"right knee friction through the {label}: F_v {p.F_v:.3f}, F_c {p.F_c:.3f}, tau_os {p.tau_os:.3f} "
-              f"(true {friction[knee].F_v}, {friction[knee].F_c}, {friction[knee].tau_os})")
+              f"(true {friction[knee].F_v}, {friction[knee].F_c}, {friction[knee].tau_os}; {fit.verdict().status})")
     out = Path(tempfile.mkdtemp(prefix="wbfriction-identify-")) / "identified.urdf"
     write_urdf(wrong, final.identification.pi, out)
     print(f"wrote {out} (estimate with it: wbfriction estimate LOG --robot talos --urdf {out})")
