@@ -109,8 +109,9 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
 
     check_paths({"PARAMS": params, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
                 {f"-o {o}": o for o in outputs})
-    result = export_files(robot_of(robot, urdf, config, mjcf), params, outputs,
-                          include=[c.strip() for c in include.split(",") if c.strip()])
+    with console.status(f"exporting {params.name} to {len(outputs)} file{'s' if len(outputs) > 1 else ''}"):
+        result = export_files(robot_of(robot, urdf, config, mjcf), params, outputs,
+                              include=[c.strip() for c in include.split(",") if c.strip()])
     counts = result.selection.exported_statuses
     console.print(f"exported the friction of {sum(counts.values())} joints ("
                   + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")", highlight=False)

@@ -132,13 +132,16 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
         raise InputError(f"--table {table}: written as .parquet or .csv")
     check_paths({"RESULTS": results}, {"-o": output, **({"--table": table} if table is not None else {})})
     options = TrendOptions(alpha=alpha, min_change=min_change, replicates=replicates)
-    dataset = read_results(results)
-    for left in dataset.left_out:
-        console.print(f"[yellow]left out:[/] {escape(str(left))}", highlight=False, soft_wrap=True)
-    found = fleet_trends(dataset.table, options)
-    write_trends_html(found, output, title)
-    if table is not None:
-        write_table(found.to_table(), table)
+    with console.status(f"reading {results}") as status:
+        dataset = read_results(results)
+        for left in dataset.left_out:
+            console.print(f"[yellow]left out:[/] {escape(str(left))}", highlight=False, soft_wrap=True)
+        status.update(f"testing {dataset.table.num_rows} rows for drifts ({options.draws()} noise series per test)")
+        found = fleet_trends(dataset.table, options)
+        status.update(f"writing {output}")
+        write_trends_html(found, output, title)
+        if table is not None:
+            write_table(found.to_table(), table)
     for j in found.flagged:
         cp = j.drifts[0]
         size = (f"{100 * cp.relative:+.1f} %" if not math.isnan(cp.relative)

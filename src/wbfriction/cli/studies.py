@@ -71,6 +71,10 @@ def _print_not_ok(rows) -> None:
 
     for row in not_ok(rows):
         verdict = row.fit.verdict()
+        if verdict.status == "at bound":
+            out.print(escape(f"not an ok fit: {row.joint} ({row.group}), {verdict}; a value at a bound is the "
+                             "bound's, not the data's (the others may hold)."), highlight=False)
+            continue
         why = ("this walk hardly moved it (a short walk hardly turns the hip yaws: try more --steps)"
                if verdict.status == "not excited" else "its parameters are not determined by these samples")
         out.print(escape(f"not an ok fit: {row.joint} ({row.group}), {verdict}; its errors below measure the "
@@ -102,7 +106,9 @@ def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
 
     with console.status("") as status:
         result = run_realistic_study(r, output_dir, steps=steps, progress=lambda label: status.update(label))
-    for case in result.cases:
+    for k, case in enumerate(result.cases):
+        if k:
+            out.print()
         _print_not_ok(case.rows)
         out.print(_study_table(case.rows, f"MuJoCo, combined walk, swing phase: {case.label}", case.scored))
         ok = [row for row in case.rows if row.fit.verdict().ok]
