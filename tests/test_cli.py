@@ -57,6 +57,9 @@ def test_demo_prints_the_thesis_table_and_writes_figures(tmp_path):
     # the 2-step walk hardly turns the hip yaws: said before the table, left out of the worst errors
     table = res.stdout.index("T6.2 [%]")
     assert res.stdout.index("not an ok fit: leg_right_1_joint (hip_yaw)") < table
+    yaw = next(line for line in res.stdout.splitlines() if "leg_right_1_joint" in line and "not excited" in line
+               and "not an ok fit" not in line)
+    assert "—" in yaw and not re.search(r"\d\.\d{4}", yaw), yaw  # no value for a joint that did not move
     flat = " ".join(res.stdout.split())  # the line as said, however the terminal's width wrapped it
     worst = flat[flat.index("worst error over the"):flat.index("true accelerations")]
     errors = dict(re.findall(r"(\w+) ([\d.]+)", worst.split("[%]:")[1]))

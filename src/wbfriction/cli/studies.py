@@ -36,7 +36,8 @@ from wbfriction.cli.common import (
 
 def _study_table(rows, title: str, params: tuple[str, ...] | None = None) -> Table:
     """Tables 6.1/6.2 layout: per leg joint (thesis numbering) the fit's status, target, estimate, error,
-    thesis errors; ``params``: the parameters shown (default: every one of model 3.5)."""
+    thesis errors (a joint that did not move: no estimate, no error); ``params``: the parameters shown (default:
+    every one of model 3.5)."""
     from wbfriction.friction.models import PARAM_NAMES
 
     params = PARAM_NAMES if params is None else params
@@ -53,11 +54,13 @@ def _study_table(rows, title: str, params: tuple[str, ...] | None = None) -> Tab
         fit = row.fit
         err = fit.error_percent() or {}
         status = fit.verdict().status
+        shown = fit.params is not None and status != "not excited"  # a joint that did not move: no value to show
         table.add_row(str(row.number), f"{row.joint} ({row.group})", status,
-                      *[f"{getattr(fit.params, n):.4f}" if fit.params else "—" for n in params],
+                      *[f"{getattr(fit.params, n):.4f}" if shown else "—" for n in params],
                       style=None if status == "ok" else "dim")
         table.add_row("", "  target", "", *[f"{getattr(fit.target, n):.4g}" for n in params], style="dim")
-        table.add_row("", "  err [%]", "", *[f"{err.get(n, float('nan')):.2f}" for n in params], style="bold")
+        table.add_row("", "  err [%]", "", *[f"{err.get(n, float('nan')):.2f}" if shown else "—" for n in params],
+                      style="bold")
         for label, ref in (("  T6.1 [%]", row.thesis_6_1), ("  T6.2 [%]", row.thesis_6_2)):
             if ref is not None:
                 table.add_row("", label, "", *[f"{ref[c]:.2f}" for c in cols], style="dim")
@@ -75,10 +78,11 @@ def _print_not_ok(rows) -> None:
             out.print(escape(f"not an ok fit: {row.joint} ({row.group}), {verdict}; a value at a bound is the "
                              "bound's, not the data's (the others may hold)."), highlight=False)
             continue
-        why = ("this walk hardly moved it (a short walk hardly turns the hip yaws: try more --steps)"
-               if verdict.status == "not excited" else "its parameters are not determined by these samples")
-        out.print(escape(f"not an ok fit: {row.joint} ({row.group}), {verdict}; its errors below measure the "
-                         f"walk, not the estimate: {why}."), highlight=False)
+        why = ("this walk hardly moved it: no estimate below (a short walk hardly turns the hip yaws: try more "
+               "--steps)" if verdict.status == "not excited"
+               else "its errors below measure the walk, not the estimate: its parameters are not determined by "
+                    "these samples")
+        out.print(escape(f"not an ok fit: {row.joint} ({row.group}), {verdict}; {why}."), highlight=False)
 
 
 def _print_worst(rows, worst: dict[str, float], params: tuple[str, ...]) -> None:
