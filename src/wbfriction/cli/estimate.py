@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from contextlib import ExitStack, nullcontext
+from contextlib import ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional
 
@@ -61,23 +61,27 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
                   time_unit: TimeUnit | None = None, companion: bool = False) -> None:
     """Estimate a log file in chunks on ``workers`` processes (which load the robot from
     ``spec``); a ROS 2 bag is first streamed into a temporary Parquet log beside the output."""
-    from wbfriction.logs.source import open_log
-    from wbfriction.logs.tables import TableFile
     from wbfriction.pipeline.chunks import Chunking
-    from wbfriction.pipeline.estimate_step import estimate_file, table_log
-    from wbfriction.pipeline.provenance import log_provenance
+    from wbfriction.pipeline.estimate_step import estimate_source
 
-    chunking = Chunking(rows=chunk_rows, workers=workers)
-    source = open_log(log, bag_map, r)
-    provenance = {"provenance": log_provenance(log, r)}
     with ExitStack() as stack:
-        with console.status(f"reading {log}") if source.is_bag else nullcontext():
-            table = stack.enter_context(table_log(source, output))
-        with progress_bar(TableFile(table).row_count(), "estimate") as advance:
-            result = estimate_file(spec, table, output, opts, chunking=chunking, companion=companion,
-                                   max_gap=max_gap, limit_margin=limit_margin, extra_metadata=provenance,
-                                   progress=advance, robot=r, source=str(log), time_base=time_base,
-                                   time_unit=time_unit)
+        status = console.status("")
+
+        def reading(label: str) -> None:
+            status.update(label)
+            status.start()
+
+        def bar(total: int):
+            status.stop()  # one live display at a time
+            return stack.enter_context(progress_bar(total, "estimate"))
+
+        try:
+            result = estimate_source(spec, log, output, opts, bag_map=bag_map, robot=r, stage=reading, progress=bar,
+                                     chunking=Chunking(rows=chunk_rows, workers=workers), companion=companion,
+                                     max_gap=max_gap, limit_margin=limit_margin, time_base=time_base,
+                                     time_unit=time_unit)
+        finally:
+            status.stop()
     console.print(escape(result.clock), highlight=False, soft_wrap=True)
     warn(result.warnings)
     if result.differentiation:

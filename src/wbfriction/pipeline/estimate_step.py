@@ -6,14 +6,15 @@ chunk is read with a few rows of context on either side, validated
 (:func:`~wbfriction.logs.log.log_from_table`, rows numbered as in the file), estimated
 (:func:`~wbfriction.friction.estimate.estimate_log`), and its own rows are appended to the
 output, which is renamed into place once complete. A ROS 2 bag is first streamed into a
-temporary Parquet log beside the output (:func:`table_log`).
+temporary Parquet log beside the output (:func:`table_log`); :func:`estimate_source` takes either, and records
+the log's provenance.
 """
 
 from __future__ import annotations
 
 from collections import deque
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager, nullcontext
+from contextlib import ExitStack, contextmanager, nullcontext
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -32,12 +33,13 @@ from wbfriction.friction.route import resolve_route
 from wbfriction.logs.clock import Clock, TimeBase, TimeUnit, longest_segment
 from wbfriction.logs.log import log_from_table
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
-from wbfriction.logs.source import LogSource
+from wbfriction.logs.source import LogSource, open_log
 from wbfriction.logs.tables import TableFile, read_metadata, scratch_folder, with_metadata, write_tables
 from wbfriction.model.loading import load_robot
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import CONTEXT, Chunk, Chunking, chunk_rows, plan_chunks, plan_columns
-from wbfriction.progress import Progress
+from wbfriction.pipeline.provenance import log_provenance
+from wbfriction.progress import Progress, StageProgress
 from wbfriction.workers import process_pool
 
 
@@ -262,6 +264,38 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta,
                          clock.reason, "" if choice is None else choice.reason,
                          plan.warnings + no_valid_warnings(source, valid), "" if decision is None else decision.reason)
+
+
+def estimate_source(spec: RobotSpec, log: str | Path, output: str | Path,
+                    options: EstimateOptions = EstimateOptions(), *, bag_map: str | Path | None = None,
+                    robot: Robot | None = None, stage: StageProgress | None = None,
+                    progress: Callable[[int], Progress | None] | None = None, **file_options: Any) -> ChunkedResult:
+    """Estimate a log as a user names it (a table file, a ROS 2 bag or a table read through ``bag_map``,
+    :func:`~wbfriction.logs.source.open_log`) into ``output``, its provenance recorded in the table's metadata
+    (:func:`~wbfriction.pipeline.provenance.log_provenance`): a bag is first streamed into a temporary Parquet log
+    beside the output (:func:`table_log`, removed after), then :func:`estimate_file` runs on it.
+
+    Args:
+        spec, output, options: as :func:`estimate_file`; ``robot``: ``spec`` loaded in this process, if the
+            caller has it.
+        log: the log file or bag folder; ``bag_map``: its topic or column map (TOML).
+        stage: told ``reading <log>`` while a bag is converted.
+        progress: called once with the log's row count, returns the per-row progress of :func:`estimate_file`.
+        file_options: the rest of :func:`estimate_file`'s keywords (chunking, companion, max_gap, ...).
+
+    Raises:
+        InputError, OutputError: what opening the log, converting it and :func:`estimate_file` raise.
+    """
+    robot = robot if robot is not None else spec.load()
+    source = open_log(log, bag_map, robot)
+    output = Path(output)
+    with ExitStack() as stack:
+        if source.is_bag and stage is not None:
+            stage(f"reading {log}")
+        table = stack.enter_context(table_log(source, output))
+        advance = None if progress is None else progress(TableFile(table).row_count())
+        return estimate_file(spec, table, output, options, robot=robot, source=str(log), progress=advance,
+                             extra_metadata={"provenance": log_provenance(log, robot)}, **file_options)
 
 
 @contextmanager
