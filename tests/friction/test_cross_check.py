@@ -71,7 +71,7 @@ def test_the_report_shows_the_routes_cross_checked(talos, tmp_path):
 
 def test_the_file_and_the_command_give_the_same_check(talos, tmp_path):
     """The table file's cross-check (three columns per joint) equals the in-memory one; ``estimate`` prints the
-    joints whose routes disagree with their cause (a 20 N / 2 N·m force-torque offset: "an offset")."""
+    joints whose routes disagree, one line per likely cause (a 20 N / 2 N·m force-torque offset: "an offset")."""
     from helpers import run
     from wbfriction.friction.cross_check import cross_check_file
     from wbfriction.friction.io import friction_table
@@ -87,3 +87,5 @@ def test_the_file_and_the_command_give_the_same_check(talos, tmp_path):
     res = run("estimate", tmp_path / "log.parquet", "-o", tmp_path / "cli.parquet", "--base-motion", "logged")
     assert res.returncode == 0, res.stderr
     assert "routes cross-checked on" in res.stderr and "likely an offset" in res.stderr
+    causes = [line for line in res.stderr.splitlines() if line.startswith("  likely ")]
+    assert len(causes) == len(set(causes)) and len(causes) <= 3, res.stderr  # one line per cause, not per joint

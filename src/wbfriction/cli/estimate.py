@@ -100,18 +100,22 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
 
 
 def _print_cross_check(friction: Path) -> None:
-    """The joints whose measured and rigid-contact routes disagree, with the likely cause."""
+    """The joints whose measured and rigid-contact routes disagree: one line per likely cause, the worst first,
+    each joint with its disagreement's RMS against its friction's."""
     from wbfriction.friction.cross_check import LARGE, cross_check_file
+    from wbfriction.report.terminal import NAMES_SHOWN
 
     checks = cross_check_file(friction)
-    large = [c for c in checks if c.cause]
+    large = sorted((c for c in checks if c.cause), key=lambda c: -c.rms)
     if checks:
         console.print(f"routes cross-checked on {max(c.samples for c in checks)} single-support samples: "
                       f"{len(large)} of {len(checks)} joints disagree by more than {100 * LARGE:g} % of their "
                       "friction's RMS", highlight=False)
-    for c in sorted(large, key=lambda c: -c.rms):
-        console.print(f"  {c.joint}: {c.rms:.2g} N·m RMS against {c.rms / c.share:.2g} of friction; likely "
-                      f"{escape(c.cause)}", highlight=False, soft_wrap=True)
+    for cause in dict.fromkeys(c.cause for c in large):
+        joints = [f"{c.joint} {c.rms:.2g}/{c.rms / c.share:.2g} N·m" for c in large if c.cause == cause]
+        more = f" and {len(joints) - NAMES_SHOWN} more" if len(joints) > NAMES_SHOWN else ""
+        console.print(f"  likely {escape(cause)}: {', '.join(joints[:NAMES_SHOWN])}{more} (RMS against friction)",
+                      highlight=False, soft_wrap=True)
 
 
 @app.command()
