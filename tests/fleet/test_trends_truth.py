@@ -20,8 +20,8 @@ from wbfriction.fleet.schema import RESULT_SCHEMA
 from wbfriction.fleet.trends import QUANTITIES, TrendOptions, fleet_trends, joint_trend
 
 T0 = datetime(2026, 1, 1, tzinfo=UTC)
-ONE = TrendOptions(alpha=0.05, quantities=("F_c",), replicates=2000)
-"""One quantity, few noise series: fast, and the p-value still resolves alpha."""
+ONE = TrendOptions(alpha=0.05, quantities=("F_c",), replicates=2000, shapes=("hinge",))
+"""One quantity, the hinge alone, few noise series: fast, and the p-value still resolves alpha."""
 
 
 def reference_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, min_after: int
@@ -239,7 +239,7 @@ def test_a_noise_series_that_equals_the_statistic_reaches_it():
 
 def test_the_p_value_draws_the_rest_in_blocks_and_follows_the_seed():
     """Past the first pass the series come in blocks of at most 50 000 (here 1000, 50 000, then the 9000 left)."""
-    options = TrendOptions(alpha=0.05, quantities=("F_c",), replicates=60_000, seed=5)
+    options = TrendOptions(alpha=0.05, quantities=("F_c",), replicates=60_000, seed=5, shapes=("hinge",))
     maxima = reference_null_maxima(P_TIMES, P_SE, seed=5, blocks=[1000, 50_000, 9000])
     top = np.sort(maxima)[::-1]
     statistic = float(0.5 * (top[2] + top[3]))  # three series reach it
@@ -253,10 +253,10 @@ def test_the_number_of_noise_series():
     assert TrendOptions(alpha=1e-5).draws() == 1_800_000
     assert TrendOptions(alpha=1e-3).draws() == 20_000
     assert TrendOptions(alpha=1e-4, quantities=("F_c", "F_v")).draws() == 60_000
-    assert TrendOptions(alpha=1e-5, replicates=700_000).draws() == 700_000
-    TrendOptions(alpha=1e-5, replicates=600_000)  # enough
+    assert TrendOptions(alpha=1e-5, replicates=700_000, shapes=("hinge",)).draws() == 700_000
+    TrendOptions(alpha=1e-5, replicates=600_000, shapes=("hinge",))  # enough
     with pytest.raises(InputError, match="--replicates 599999 cannot resolve --alpha 1e-05 over 6 quantities"):
-        TrendOptions(alpha=1e-5, replicates=599_999)
+        TrendOptions(alpha=1e-5, replicates=599_999, shapes=("hinge",))
     for alpha in (0.0, 1.0, -0.1, 1.5):
         with pytest.raises(InputError, match="--alpha must be in"):
             TrendOptions(alpha=alpha)
@@ -368,7 +368,8 @@ def test_a_joint_is_flagged_by_its_rule():
     min_change of the baseline in size, most significant first. Random joints of one to three drifting
     quantities, alpha 0.3 so that p-values just below and just above alpha / m are met (checked)."""
     alpha = 0.3
-    options = TrendOptions(alpha=alpha, quantities=("F_c", "F_v", "tau_os"), replicates=2000, min_change=0.02)
+    options = TrendOptions(alpha=alpha, quantities=("F_c", "F_v", "tau_os"), replicates=2000, min_change=0.02,
+                           shapes=("hinge",))
     rng = np.random.default_rng(12)
     seen = set()
     for case in range(45):
@@ -509,7 +510,7 @@ def test_an_offset_without_coulomb_points_is_measured_against_its_own_baseline()
     tau = np.array([r["tau_os"] for r in rows])
     ref = reference_change(np.arange(20.0), tau, np.full(20, 0.04))
     for quantities in (("F_c", "tau_os"), ("tau_os",)):
-        options = TrendOptions(alpha=0.05, quantities=quantities, replicates=2000)
+        options = TrendOptions(alpha=0.05, quantities=quantities, replicates=2000, shapes=("hinge",))
         cp = joint_trend("r", "j", results_table(rows), options).tests["tau_os"]
         assert cp.relative == pytest.approx(ref["change"] / abs(ref["baseline"]), rel=1e-9), quantities
 

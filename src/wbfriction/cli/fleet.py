@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING, Optional, cast
 
 import typer
 from rich.markup import escape
@@ -13,6 +13,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError
+from wbfriction.fleet.options import SHAPES, Shape
 from wbfriction.friction.options import (
     EstimateOptions,
     FitOptions,
@@ -116,9 +117,12 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
                                                                       "[default: 20000, more for a small --alpha]."),
            min_change: float = typer.Option(0.10, min=0.0, help="Smallest change flagged, relative to the "
                                                                 "baseline (0.1: 10 %)."),
+           shapes: str = typer.Option(",".join(SHAPES), help="Shapes of change tested, comma-separated: "
+                                                                   "hinge (a linear drift from an onset), step "
+                                                                   "(a jump at it); the better one per series."),
            title: str = typer.Option("Friction trends", help="The page's title.")) -> None:
-    """Friction over time per robot and joint, and the joints whose friction drifted (a hinge change detector
-    weighted by the fits' standard errors), as one HTML page."""
+    """Friction over time per robot and joint, and the joints whose friction drifted (a hinge or step change
+    detector weighted by the fits' standard errors), as one HTML page."""
     import math
 
     from wbfriction.fleet.results import read_results
@@ -131,7 +135,8 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
     if table is not None and table.suffix.lower() not in (".parquet", ".pq", ".csv"):
         raise InputError(f"--table {table}: written as .parquet or .csv")
     check_paths({"RESULTS": results}, {"-o": output, **({"--table": table} if table is not None else {})})
-    options = TrendOptions(alpha=alpha, min_change=min_change, replicates=replicates)
+    options = TrendOptions(alpha=alpha, min_change=min_change, replicates=replicates,
+                           shapes=tuple(cast("Shape", s.strip()) for s in shapes.split(",") if s.strip()))
     with console.status(f"reading {results}") as status:
         dataset = read_results(results)
         for left in dataset.left_out:
@@ -146,7 +151,7 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
         cp = j.drifts[0]
         size = (f"{100 * cp.relative:+.1f} %" if not math.isnan(cp.relative)
                 else f"{cp.change:+.3g} {UNITS[cp.quantity]} from a baseline not told from zero")
-        console.print(f"drift: {j.robot_id} {j.joint}: {cp.quantity} {size} from {cp.onset_time:%Y-%m-%d} "
+        console.print(f"drift: {j.robot_id} {j.joint}: {cp.quantity} {size} ({cp.shape}) from {cp.onset_time:%Y-%m-%d} "
                       f"(p {cp.p_value:.2g})", highlight=False)
     console.print(f"{found.summary()}; wrote {output}" + (f" and {table}" if table is not None else ""),
                   highlight=False)

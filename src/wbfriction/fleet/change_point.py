@@ -1,19 +1,27 @@
 """Has a series changed, and from when: a generalised likelihood-ratio test of a constant against a constant
-followed by a linear drift from an unknown onset (a hinge, or "broken-stick", regression: Hinkley 1971,
-"Inference in two-phase regression", JASA 66; the weighted form of Julious 2001, "Inference and estimation in a
-changepoint regression problem", The Statistician 50), weighted by the standard errors. The fleet's trends
-(:mod:`wbfriction.fleet.trends`) run it on each joint's quantities over its logs.
+followed by a change from an unknown onset, of one of two shapes (:data:`SHAPES`), weighted by the standard errors.
+The fleet's trends (:mod:`wbfriction.fleet.trends`) run it on each joint's quantities over its logs.
+
+* ``hinge``: a linear drift from the onset (a "broken-stick" regression: Hinkley 1971, "Inference in two-phase
+  regression", JASA 66; the weighted form of Julious 2001, "Inference and estimation in a changepoint regression
+  problem", The Statistician 50): wear that grows;
+* ``step``: a jump at the onset, constant after it (a mean shift: Hinkley 1970, "Inference about the change-point
+  in a sequence of random variables", Biometrika 57): a part replaced, a seal damaged, a gearbox refilled.
+
+Both have two coefficients and one onset: the information criteria (AIC, BIC) of the two, each at its best onset,
+differ only by their residual sums of squares, so the shape chosen is the one with the larger ``F_k``. The test:
 
 * points ``y_i`` at times ``t_i`` [days], errors ``e_i ~ N(0, phi se_i^2)`` with an unknown scale ``phi``
   (the fits' standard errors may be off by a common factor: Newey-West, a model that trades parameters);
 * for each candidate onset ``k`` (at least :attr:`ChangeSettings.min_before` points before, at least
   :attr:`ChangeSettings.min_after` from it on), the hinge regressor ``x_i = max(0, t_i - t_{k-1})`` (zero up to
-  the last log before the onset, growing from the first drifted log on);
+  the last log before the onset, growing from the first drifted log on) or the step regressor ``x_i = [i >= k]``;
 * the statistic ``F_k = (RSS_0 - RSS_k) / (RSS_k / (n - 2))`` with weighted residual sums of squares; the
   onset is the ``k`` of the largest ``F_k``;
 * its p-value, exact for this model whatever ``phi`` (``F_k`` does not depend on it): the share of
   :meth:`ChangeSettings.draws` series of pure noise ``se_i z_i`` (seeded: the same input gives the same
-  output) whose largest ``F_k`` reaches the observed one, on the same times and weights.
+  output) whose largest ``F_k``, over the same shapes and onsets, reaches the observed one, on the same times and
+  weights (the choice of shape paid for in the p-value).
 """
 
 from __future__ import annotations
@@ -24,8 +32,11 @@ from typing import Protocol
 
 import numpy as np
 
+from wbfriction.fleet.options import Shape
+
 DAY = 86_400.0
 """Seconds per day: the series' time unit."""
+
 
 
 class ChangeSettings(Protocol):
@@ -51,6 +62,11 @@ class ChangeSettings(Protocol):
         """Of the p-value's noise series."""
         ...
 
+    @property
+    def shapes(self) -> tuple[Shape, ...]:
+        """The shapes of change tested (:data:`SHAPES`)."""
+        ...
+
     def draws(self) -> int:
         """Noise series of the p-value's Monte Carlo."""
         ...
@@ -58,14 +74,16 @@ class ChangeSettings(Protocol):
 
 @dataclass(frozen=True)
 class ChangePoint:
-    """The best hinge of one series (module docstring).
+    """The best change of one series (module docstring).
 
     Attributes:
         quantity: the series' quantity.
-        onset: index (into the series' logs) of the first drifted log; onset_time: its start time.
+        onset: index (into the series' logs) of the first changed log; onset_time: its start time.
         baseline: the fitted value before the onset.
-        change, change_se: the fitted change at the last log, and its standard error (same unit).
+        change, change_se: the fitted change at the last log (a step's size, a hinge's drift by then), and its
+            standard error (same unit).
         statistic: the largest ``F_k``; p_value: its Monte Carlo p-value.
+        shape: ``hinge`` or ``step``, whichever fits better (module docstring).
         relative: ``change`` over the baseline (over F_c's baseline for ``tau_os``); NaN where the baseline is
             not told from zero (within two of its standard errors): a relative change is then meaningless, and
             :attr:`change` (in the quantity's unit, :data:`UNITS`) says it.
@@ -80,20 +98,29 @@ class ChangePoint:
     statistic: float
     p_value: float
     relative: float
+    shape: Shape = "hinge"
 
 
-def hinge_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, min_after: int
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The statistics ``F_k`` of every candidate onset (module docstring) for the columns of ``y``.
+def _regressor(shape: Shape, t: np.ndarray, k: int) -> np.ndarray:
+    """The change's regressor for an onset at log ``k`` (module docstring)."""
+    if shape == "step":
+        return (np.arange(t.size) >= k).astype(float)
+    return np.maximum(0.0, t - t[k - 1])
+
+
+def change_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, min_after: int,
+                shape: Shape = "hinge") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The statistics ``F_k`` of every candidate onset of one shape (module docstring) for the columns of ``y``.
 
     Args:
         t: (n,) increasing times [days]; y: (n,) or (n, r) values; se: (n,) standard errors (> 0).
+        shape: ``hinge`` or ``step``.
 
     Returns:
         ``(onsets, F, fits)``: the candidate onsets (c,), ``F`` (c,) or (c, r), and per onset the weighted
-        least-squares coefficients (c, 2) or (c, 2, r) of ``[1, x_k]`` (baseline, slope per day). An onset
-        whose hinge would be zero at every log (no log after the time of the one before it) is no candidate:
-        ``c`` may be 0.
+        least-squares coefficients (c, 2) or (c, 2, r) of ``[1, x_k]`` (baseline, and the slope per day of a
+        hinge or the size of a step). An onset whose hinge would be zero at every log (no log after the time of
+        the one before it), or a step between two logs at one time, is no candidate: ``c`` may be 0.
     """
     n = t.size
     w = 1.0 / se
@@ -104,11 +131,14 @@ def hinge_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, mi
     rss0 = np.einsum("ij,ij->j", r0, r0)
     yy = np.einsum("ij,ij->j", Y, Y)
     onsets = np.arange(min_before, n - min_after + 1)
-    onsets = onsets[t[-1] > t[onsets - 1]]  # a hinge from the last log's time is no regressor (logs at one time)
+    if shape == "hinge":
+        onsets = onsets[t[-1] > t[onsets - 1]]  # a hinge from the last log's time is no regressor (logs at one time)
+    else:
+        onsets = onsets[t[onsets] > t[onsets - 1]]  # a step between logs at one time is no change in time
     F = np.empty((onsets.size, Y.shape[1]))
     coef = np.empty((onsets.size, 2, Y.shape[1]))
     for c, k in enumerate(onsets):
-        X = np.column_stack([w, np.maximum(0.0, t - t[k - 1]) * w])
+        X = np.column_stack([w, _regressor(shape, t, int(k)) * w])
         Q, R = np.linalg.qr(X)
         QtY = Q.T @ Y
         rss = np.maximum(yy - np.einsum("ij,ij->j", QtY, QtY), 1e-300)
@@ -119,6 +149,12 @@ def hinge_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, mi
     return onsets, F, coef
 
 
+def hinge_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, min_after: int
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`change_scan` of the hinge."""
+    return change_scan(t, y, se, min_before, min_after, "hinge")
+
+
 FIRST_PASS = 1000
 """Noise series of the p-value's first pass: a statistic that :data:`CLEAR` of them reach is no drift, and the
 full :meth:`ChangeSettings.draws` are drawn only for the others (most series of a fleet are constant)."""
@@ -126,7 +162,8 @@ CLEAR = 20
 
 
 def null_p_value(t: np.ndarray, se: np.ndarray, statistic: float, options: ChangeSettings) -> float:
-    """The share of series of pure noise ``se_i z_i`` on times ``t`` whose largest ``F_k`` reaches ``statistic``
+    """The share of series of pure noise ``se_i z_i`` on times ``t`` whose largest ``F_k`` (over the shapes of
+    :attr:`ChangeSettings.shapes`) reaches ``statistic``
     (seeded by :attr:`ChangeSettings.seed`; ``(1 + hits) / (1 + draws)``): :data:`FIRST_PASS` series first, the
     rest of :meth:`ChangeSettings.draws` only when fewer than :data:`CLEAR` of them reached it, in blocks of
     :data:`BLOCK` series (memory bounded whatever the number)."""
@@ -136,8 +173,12 @@ def null_p_value(t: np.ndarray, se: np.ndarray, statistic: float, options: Chang
     while draws < total and not (draws >= FIRST_PASS and hits >= CLEAR):
         size = min(FIRST_PASS if draws == 0 else BLOCK, total - draws)
         noise = se[:, None] * rng.standard_normal((t.size, size))
-        _, F_null, _ = hinge_scan(t, noise, se, options.min_before, options.min_after)
-        hits += int(np.sum(F_null.max(axis=0) >= statistic))
+        largest = np.full(size, -np.inf)
+        for shape in options.shapes:
+            _, F_null, _ = change_scan(t, noise, se, options.min_before, options.min_after, shape)
+            if F_null.shape[0]:
+                largest = np.maximum(largest, F_null.max(axis=0))
+        hits += int(np.sum(largest >= statistic))
         draws += size
     return (1 + hits) / (1 + draws)
 
@@ -148,7 +189,8 @@ BLOCK = 50_000
 
 def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity: str,
                   options: ChangeSettings, scale: float | None = None) -> ChangePoint | None:
-    """The best hinge of a series and its p-value (module docstring); None with too few finite points.
+    """The best change of a series (over :attr:`ChangeSettings.shapes` and onsets) and its p-value (module
+    docstring); None with too few finite points.
 
     Args:
         time: (n,) the points' times, increasing; y, se: (n,) values and standard errors (non-finite ones and
@@ -163,25 +205,28 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
     t0 = time[idx[0]]
     t = np.array([(time[i] - t0).total_seconds() / DAY for i in idx])
     yy, ss = y[idx], se[idx]
-    onsets, F, coef = hinge_scan(t, yy, ss, options.min_before, options.min_after)
-    if onsets.size == 0:  # the logs after the first candidate onset all at one time
+    best: tuple[float, Shape, int, np.ndarray] | None = None
+    for shape in options.shapes:
+        onsets, F, coef = change_scan(t, yy, ss, options.min_before, options.min_after, shape)
+        if onsets.size and (best is None or float(F.max()) > best[0]):
+            c = int(np.argmax(F))
+            best = (float(F[c]), shape, int(onsets[c]), coef[c])
+    if best is None:  # the logs after the first candidate onset all at one time
         return None
-    best = int(np.argmax(F))
-    p = null_p_value(t, ss, float(F[best]), options)
-    k = int(onsets[best])
-    base, slope = coef[best]
-    span = t[-1] - t[k - 1]
+    statistic, shape, k, (base, size) = best
+    p = null_p_value(t, ss, statistic, options)
     # the change at the last log and its standard error, the residual scale phi estimated
     w = 1.0 / ss
-    X = np.column_stack([w, np.maximum(0.0, t - t[k - 1]) * w])
-    resid = yy * w - X @ coef[best]
+    X = np.column_stack([w, _regressor(shape, t, k) * w])
+    resid = yy * w - X @ np.array([base, size])
     phi = float(resid @ resid) / max(idx.size - 2, 1)
     cov = phi * np.linalg.inv(X.T @ X)
-    change = float(slope * span)
+    at_last = float(X[-1, 1] / w[-1])  # the regressor at the last log: the hinge's span, or 1
+    change = float(size * at_last)
     if scale is None:  # against the fitted baseline, where it is told from zero
         ref = abs(float(base)) if abs(float(base)) > 2 * np.sqrt(cov[0, 0]) else 0.0
     else:
         ref = abs(scale) if np.isfinite(scale) else 0.0
     return ChangePoint(quantity, int(idx[k]), time[idx[k]], float(base), change,
-                       float(np.sqrt(cov[1, 1]) * span), float(F[best]), float(p),
-                       change / ref if ref > 0 else float("nan"))
+                       float(np.sqrt(cov[1, 1]) * at_last), statistic, float(p),
+                       change / ref if ref > 0 else float("nan"), shape)

@@ -5,9 +5,14 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, EstimateOptions, FitOptions
+
+Shape = Literal["hinge", "step"]
+SHAPES: tuple[Shape, ...] = ("hinge", "step")
+"""The shapes of change the trends test (:mod:`wbfriction.fleet.change_point`): a linear drift from an onset, a
+step at it."""
 
 
 @dataclass(frozen=True)

@@ -7,8 +7,8 @@ a model parameter, a log fitted with another model than the joint's most frequen
 may choose per log, and F_c of the Coulomb-viscous model is not F_c of (3.5)). The friction at a reference
 speed is the same quantity in every model: every usable log gives a point.
 
-**The change detector** (:mod:`~wbfriction.fleet.change_point`): for each series, the best hinge (a constant
-followed by a linear drift from an unknown onset) and its exact Monte Carlo p-value;
+**The change detector** (:mod:`~wbfriction.fleet.change_point`): for each series, the best change (a constant
+followed by a linear drift or a step from an unknown onset) and its exact Monte Carlo p-value;
 
 * a joint is flagged when one of its quantities has a p-value below ``alpha / m`` (Bonferroni over its ``m``
   quantities with enough points) **and** a change at the last log of at least
@@ -29,8 +29,10 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from wbfriction.exceptions import InputError
+from wbfriction.choices import check_choice
+from wbfriction.exceptions import InputError, OptionError
 from wbfriction.fleet.change_point import FIRST_PASS, ChangePoint, detect_change
+from wbfriction.fleet.options import SHAPES, Shape
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
 
 QUANTITIES: tuple[str, ...] = (*TREND_PARAMS, *[speed_column(v) for v in REFERENCE_SPEEDS])
@@ -55,6 +57,8 @@ class TrendOptions:
             None: :meth:`draws` chooses enough for ``alpha``.
         seed: of those series.
         quantities: the quantities tested.
+        shapes: the shapes of change tested (:data:`~wbfriction.fleet.change_point.SHAPES`: a linear drift
+            from an onset, a step at it, or both, the better one chosen per series).
 
     Raises:
         InputError: ``alpha`` out of (0, 1), ``replicates`` too few to reach ``alpha / m`` (naming
@@ -69,8 +73,13 @@ class TrendOptions:
     replicates: int | None = None
     seed: int = 0
     quantities: tuple[str, ...] = QUANTITIES
+    shapes: tuple[Shape, ...] = SHAPES
 
     def __post_init__(self) -> None:
+        if not self.shapes:
+            raise OptionError("--shapes", self.shapes, f"one or more of {', '.join(SHAPES)}")
+        for shape in self.shapes:
+            check_choice("shapes", shape, SHAPES)
         if not 0 < self.alpha < 1:
             raise InputError(f"--alpha must be in (0, 1), got {self.alpha}")
         unknown = set(self.quantities) - set(QUANTITIES)
@@ -120,13 +129,13 @@ class Series:
 
 @dataclass(frozen=True)
 class JointTrend:
-    """One robot's joint over time: its series, each series' best hinge, and the drifts found.
+    """One robot's joint over time: its series, each series' best change, and the drifts found.
 
     Attributes:
         robot_id, joint: which.
         series: quantity -> :class:`Series`.
-        tests: quantity -> its best hinge (quantities with too few points have none).
-        drifts: the hinges that are flagged, most significant first.
+        tests: quantity -> its best change (quantities with too few points have none).
+        drifts: the changes that are flagged, most significant first.
     """
 
     robot_id: str
@@ -171,10 +180,11 @@ class FleetTrends:
         return f"{len(self.flagged)} of {tested} tested robot joints drifted{untested}"
 
     def to_table(self) -> pa.Table:
-        """One row per robot, joint and tested quantity: the best hinge, whether it is a flagged drift."""
-        rows: dict[str, list] = {k: [] for k in ("robot_id", "joint", "quantity", "points", "flagged", "onset_time",
-                                                 "baseline", "change", "change_se", "relative_change", "p_value",
-                                                 "last_value")}
+        """One row per robot, joint and tested quantity: the best change (its shape, onset, size, statistic,
+        p-value), whether it is a flagged drift."""
+        rows: dict[str, list] = {k: [] for k in ("robot_id", "joint", "quantity", "points", "flagged", "shape",
+                                                 "onset_time", "baseline", "change", "change_se", "relative_change",
+                                                 "statistic", "p_value", "last_value")}
         for j in self.joints:
             for q, cp in j.tests.items():
                 s = j.series[q]
@@ -183,18 +193,20 @@ class FleetTrends:
                 rows["quantity"].append(q)
                 rows["points"].append(int(s.used.sum()))
                 rows["flagged"].append(cp in j.drifts)
+                rows["shape"].append(cp.shape)
                 rows["onset_time"].append(cp.onset_time)
                 rows["baseline"].append(cp.baseline)
                 rows["change"].append(cp.change)
                 rows["change_se"].append(cp.change_se)
                 rows["relative_change"].append(cp.relative)
+                rows["statistic"].append(cp.statistic)
                 rows["p_value"].append(cp.p_value)
                 rows["last_value"].append(float(s.value[s.used][-1]))
         schema = pa.schema([("robot_id", pa.string()), ("joint", pa.string()), ("quantity", pa.string()),
-                            ("points", pa.int64()), ("flagged", pa.bool_()),
+                            ("points", pa.int64()), ("flagged", pa.bool_()), ("shape", pa.string()),
                             ("onset_time", pa.timestamp("us", tz="UTC")),
                             *[(n, pa.float64()) for n in ("baseline", "change", "change_se", "relative_change",
-                                                         "p_value", "last_value")]])
+                                                         "statistic", "p_value", "last_value")]])
         return pa.Table.from_pydict(rows, schema=schema)
 
 

@@ -1,8 +1,8 @@
 """A fleet's friction trends as one self-contained HTML page (issue 25): ``wbfriction trends RESULTS -o x.html``.
 
 Per robot: the drifts found first (a table), then a small multiple per joint (flagged joints first, each on its
-own axes): each followed quantity over time relative to its baseline, value ± standard error, the fitted hinge
-of a drift and its onset marked; then every tested quantity as a table, the figures' numbers. Figures are PNG
+own axes): each followed quantity over time relative to its baseline, value ± standard error, a drift's onset
+marked; then every tested quantity as a table, the figures' numbers. Figures are PNG
 embedded in the page (no script, no network); the same trends give the same bytes.
 """
 
@@ -103,9 +103,9 @@ def _relative_change(cp: ChangePoint) -> str:
 
 
 def _drifts_table(joints: list[JointTrend]) -> str:
-    head = ("joint", "quantity", "onset", "change at the last log", "relative", "p-value")
+    head = ("joint", "quantity", "shape", "onset", "change at the last log", "relative", "p-value")
     rows = "".join(
-        f'<tr class="flag"><td>{html.escape(j.joint)}</td><td>{html.escape(cp.quantity)}</td>'
+        f'<tr class="flag"><td>{html.escape(j.joint)}</td><td>{html.escape(cp.quantity)}</td><td>{cp.shape}</td>'
         f"<td>{_date(cp.onset_time)}</td><td>{_num(cp.change)} ± {_num(cp.change_se, 2)}</td>"
         f"<td>{_relative_change(cp)}</td><td>{cp.p_value:.2g}</td></tr>"
         for j in joints for cp in j.drifts)
@@ -113,7 +113,7 @@ def _drifts_table(joints: list[JointTrend]) -> str:
 
 
 def _tests_table(joints: list[JointTrend]) -> str:
-    head = ("joint", "quantity", "points", "last value", "baseline", "best onset", "change ± se", "relative",
+    head = ("joint", "quantity", "points", "last value", "baseline", "shape", "best onset", "change ± se", "relative",
             "p-value", "drift")
     rows = []
     for j in joints:
@@ -124,7 +124,8 @@ def _tests_table(joints: list[JointTrend]) -> str:
             rows.append(f"<tr{cls}><td>{html.escape(j.joint)}</td>"
                         f"<td>{html.escape(q)}</td><td>{int(s.used.sum())}</td>"
                         f"<td>{_num(float(s.value[s.used][-1]))}</td><td>{_num(cp.baseline)}</td>"
-                        f"<td>{_date(cp.onset_time)}</td><td>{_num(cp.change)} ± {_num(cp.change_se, 2)}</td>"
+                        f"<td>{cp.shape}</td><td>{_date(cp.onset_time)}</td>"
+                        f"<td>{_num(cp.change)} ± {_num(cp.change_se, 2)}</td>"
                         f"<td>{_relative_change(cp)}</td><td>{cp.p_value:.2g}</td>"
                         f"<td>{'yes' if flag else ''}</td></tr>")
     return ('<details><summary>Every tested quantity</summary><div class="scroll"><table><tr>'
@@ -156,7 +157,8 @@ def render_trends(trends: FleetTrends, title: str = "Friction trends") -> str:
             part.append(f'<p class="sub">Too few usable logs to follow: {html.escape(", ".join(still))}</p>')
         part.append(_tests_table(shown))
         sections.append("\n".join(part))
-    method = (f"A drift is a hinge (a constant, then a linear change from an onset) that fits a quantity's series "
+    method = (f"A drift is a change of shape {' or '.join(o.shapes)} (hinge: a constant, then a linear change "
+              f"from an onset; step: a jump at the onset; the better fit chosen) that fits a quantity's series "
               f"better than a constant, weighted by the fits' standard errors, with a p-value below {o.alpha:g} per "
               f"joint (Bonferroni over its quantities; Monte Carlo, {o.draws()} noise series) and a change of at "
               f"least {100 * o.min_change:.0f} % at the last log. Sign convention: F_c, F_v and f_at_v are "
