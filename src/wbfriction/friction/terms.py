@@ -1,0 +1,355 @@
+"""Friction beyond velocity (issue 40): terms in the joint's load, angle, direction of motion and temperature, each
+kept only where held-out samples say it predicts better.
+
+The thesis's models (:mod:`~wbfriction.friction.models`) are functions of the velocity alone. Real joints are not:
+the friction of a gear grows with the load its teeth carry, a torque sensor or transmission adds a torque periodic
+in the joint's angle, the Coulomb level may differ by direction, and warm grease drags less than cold (Bittencourt &
+Axelsson, "Modeling and experiment design for identification of wear in a robot joint under load and temperature
+uncertainties based on friction data", IEEE/ASME Trans. Mechatronics 19(5), 2014: load and temperature change
+friction more than wear does). With the velocity model's non-linear parameters held at their fit (the tanh slope
+``a``, the Stribeck velocity ``v_s``), the model and every term below are linear in their coefficients: one
+weighted least-squares solve fits them together (:func:`fit_terms`). ``g(qd)`` is the model's Coulomb shape,
+``sgn(qd)`` or ``tanh(a qd)`` (:func:`coulomb_shape`):
+
+* ``load``: load-dependent Coulomb friction ``F_c (1 + k_L |tau_load|) g(qd)``, ``tau_load`` the joint's rigid-body
+  torque [N·m] (gear-tooth load): coefficient ``F_L = F_c k_L`` on ``|tau_load| g``; ``k_L`` [1/(N·m)].
+* ``direction``: the viscous level by direction of motion, ``F_v± = F_v ± dF_v``: coefficient ``dF_v`` on ``|qd|``.
+  The Coulomb level by direction needs no term: away from rest ``F_c± = F_c ± tau_os`` (the offset of (3.4) is the
+  half-difference of the two levels, which no moving sample tells apart from a sensor offset), reported with it.
+* ``ripple``: a torque periodic in the joint's angle ``q`` [rad], ``sum_h s_h sin(h q) + c_h cos(h q)`` for
+  ``h = 1..H`` (``H`` chosen on held-out samples, at most :attr:`TermOptions.max_harmonic`): torque sensing or
+  transmission ripple, neither friction nor inertia. It is not dissipative: it is reported apart, left out of the
+  energy check (eq. 7.9) and of the exports; predictions include it.
+* ``temperature``: ``F_c (1 + k_Tc (T - T_ref))`` and ``F_v (1 + k_Tv (T - T_ref))`` (the linear form of
+  Bittencourt's decrease), ``T`` the logged joint temperature [°C], ``T_ref`` the reference temperature every output
+  states: coefficients ``F_cT = F_c k_Tc`` on ``(T - T_ref) g`` and ``F_vT = F_v k_Tv`` on ``(T - T_ref) qd``.
+
+**Which terms are kept**: stepwise selection on blocked held-out samples (the split of the model choice,
+:func:`~wbfriction.friction.fit.held_out_split`), with the model choice's rule: forward, the term that lowers the
+held-out RMS most joins while it lowers it by more than :attr:`TermOptions.tolerance`; backward, a term whose
+leaving raises it by less leaves (a load term that stood in for a ripple, their regressors alike); the ripple's
+number of harmonics is the fewest whose held-out RMS is within the tolerance of the smallest. Then every coefficient is fitted on every sample,
+with standard errors from the fit's Newey-West sandwich.
+
+Sign convention: as everywhere, the characteristic ``f`` points along the velocity and ``tau_f = -f``; a term's
+coefficients are positive where it adds friction opposing the motion (``F_L``, ``F_cT``, ``F_vT`` > 0: more friction
+under load or warm; ``k_Tc < 0``: less friction warm). The ripple's sign is that of ``f``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Literal, get_args
+
+import numpy as np
+
+from wbfriction.choices import check_choice, check_range
+from wbfriction.friction.fit import correlation_lag, held_out_split, standard_errors
+from wbfriction.friction.models import CoulombViscousParams, FrictionParams, ModelParams, StribeckParams
+from wbfriction.friction.options import SELECTION_TOLERANCE
+
+Term = Literal["load", "direction", "ripple", "temperature"]
+"""A term beyond velocity (module docstring)."""
+TERMS: tuple[Term, ...] = get_args(Term)
+"""Every term, in the order they are reported."""
+NOT_DISSIPATIVE: tuple[Term, ...] = ("ripple",)
+"""Terms that are not friction: left out of the energy check and of the exports."""
+
+
+@dataclass(frozen=True)
+class TermSignals:
+    """What the terms are functions of, per sample of one joint, the same rows as its ``qd``; None: not logged.
+
+    Attributes:
+        q: joint angle (N,) [rad] (``ripple``).
+        tau_load: the joint's rigid-body torque (N,) [N·m] (``load``).
+        temperature: the joint's motor or gear temperature (N,) [°C] (``temperature``).
+    """
+
+    q: np.ndarray | None = None
+    tau_load: np.ndarray | None = None
+    temperature: np.ndarray | None = None
+
+    def logged(self) -> tuple[Term, ...]:
+        """The terms these signals allow (``direction`` always)."""
+        have = {"load": self.tau_load is not None, "direction": True, "ripple": self.q is not None,
+                "temperature": self.temperature is not None}
+        return tuple(t for t in TERMS if have[t])
+
+
+@dataclass(frozen=True)
+class TermOptions:
+    """Which terms are tried and how.
+
+    Attributes:
+        terms: the candidates (those whose signals are logged are tried).
+        max_harmonic: the ripple's highest harmonic tried.
+        reference_temperature: ``T_ref`` [°C]; None: the median temperature of the samples fitted.
+        tolerance: a term is kept when it lowers the held-out RMS by more than this share (the model choice's,
+            :data:`~wbfriction.friction.options.SELECTION_TOLERANCE`).
+
+    Raises:
+        OptionError: an unknown term, ``max_harmonic`` below 1 or above 20, ``tolerance`` outside (0, 1).
+    """
+
+    terms: tuple[Term, ...] = TERMS
+    max_harmonic: int = 4
+    reference_temperature: float | None = None
+    tolerance: float = SELECTION_TOLERANCE
+
+    def __post_init__(self) -> None:
+        for term in self.terms:
+            check_choice("terms", term, TERMS)
+        check_range("max_harmonic", self.max_harmonic, low=1, high=20)
+        check_range("tolerance", self.tolerance, low=0.0, high=1.0, strict=True)
+
+
+def coulomb_shape(params: ModelParams, qd: np.ndarray) -> np.ndarray:
+    """``g(qd)``: the model's Coulomb shape, ``tanh(a qd)`` for (3.5), ``sgn(qd)`` for the others (N,)."""
+    if isinstance(params, FrictionParams):
+        return np.tanh(params.a * qd)
+    return np.sign(qd)
+
+
+def velocity_basis(params: ModelParams, qd: np.ndarray) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
+    """The velocity model as linear in its coefficients, its non-linear parameters held (``a``, ``v_s``,
+    ``delta_s``): ``f(qd) = B c`` exactly.
+
+    Returns:
+        ``(names, B, c)``: the coefficients' names, the regressors (N, k) and the coefficients (k,) of ``params``:
+        ``F_v, F_c, tau_os`` (Coulomb-viscous), ``F_v, F_c, F_s, tau_os`` (Stribeck), ``F_v, F_c, F_cS, tau_os``
+        with ``F_cS = F_c S`` (3.5).
+    """
+    qd = np.asarray(qd, dtype=float)
+    one = np.ones_like(qd)
+    if isinstance(params, CoulombViscousParams):
+        return ("F_v", "F_c", "tau_os"), np.column_stack([qd, np.sign(qd), one]), \
+            np.array([params.F_v, params.F_c, params.tau_os])
+    e = np.exp(-np.abs(qd / params.v_s) ** params.delta_s)
+    if isinstance(params, StribeckParams):
+        s = np.sign(qd)
+        return ("F_v", "F_c", "F_s", "tau_os"), np.column_stack([qd, s * (1 - e), s * e, one]), \
+            np.array([params.F_v, params.F_c, params.F_s, params.tau_os])
+    th = np.tanh(params.a * qd)
+    return ("F_v", "F_c", "F_cS", "tau_os"), np.column_stack([qd, th, th * e, one]), \
+        np.array([params.F_v, params.F_c, params.F_c * params.S, params.tau_os])
+
+
+def with_coefficients(params: ModelParams, c: np.ndarray) -> ModelParams:
+    """``params`` with the linear coefficients ``c`` of :func:`velocity_basis` (the non-linear ones kept)."""
+    if isinstance(params, CoulombViscousParams):
+        return replace(params, F_v=float(c[0]), F_c=float(c[1]), tau_os=float(c[2]))
+    if isinstance(params, StribeckParams):
+        return replace(params, F_v=float(c[0]), F_c=float(c[1]), F_s=float(c[2]), tau_os=float(c[3]))
+    S = float(c[2] / c[1]) if c[1] != 0 else 0.0
+    return replace(params, F_v=float(c[0]), F_c=float(c[1]), S=S, tau_os=float(c[3]))
+
+
+def term_basis(term: Term, params: ModelParams, qd: np.ndarray, signals: TermSignals, *, harmonics: int = 1,
+               reference_temperature: float = 0.0) -> tuple[tuple[str, ...], np.ndarray]:
+    """One term's coefficient names and regressors (N, k) (module docstring).
+
+    Raises:
+        ValueError: a term whose signal is not in ``signals``.
+    """
+    qd = np.asarray(qd, dtype=float)
+    g = coulomb_shape(params, qd)
+    if term == "direction":
+        return ("dF_v",), np.abs(qd)[:, None]
+    if term == "load":
+        if signals.tau_load is None:
+            raise ValueError("the load term needs the joint's rigid-body torque")
+        return ("F_L",), (np.abs(signals.tau_load) * g)[:, None]
+    if term == "ripple":
+        if signals.q is None:
+            raise ValueError("the ripple term needs the joint's angle")
+        h = np.arange(1, harmonics + 1)
+        angle = np.asarray(signals.q, dtype=float)[:, None] * h
+        names = tuple(n for k in h for n in (f"ripple_sin{k}", f"ripple_cos{k}"))
+        return names, np.column_stack([c for k in range(harmonics) for c in (np.sin(angle[:, k]),
+                                                                             np.cos(angle[:, k]))])
+    if term == "temperature":
+        if signals.temperature is None:
+            raise ValueError("the temperature term needs the joint's temperature")
+        dT = np.asarray(signals.temperature, dtype=float) - reference_temperature
+        return ("F_cT", "F_vT"), np.column_stack([dT * g, dT * qd])
+    raise ValueError(f"unknown term {term!r}")
+
+
+@dataclass(frozen=True)
+class TermFit:
+    """The velocity model refitted with the terms kept.
+
+    Attributes:
+        params: the velocity model's parameters, their linear coefficients refitted with the terms (the non-linear
+            ones as given); the given ones when no term is kept.
+        kept: the terms kept, in :data:`TERMS` order; ``harmonics``: the ripple's ``H`` (0: no ripple).
+        coefficients, stderr: every term coefficient (module docstring) and its standard error, by name.
+        derived: the physical parameters the coefficients give, by name (``k_L`` [1/(N·m)], ``F_v+``, ``F_v-``,
+            ``F_c+ = F_c + tau_os``, ``F_c- = F_c - tau_os``, ``k_Tc``, ``k_Tv`` [1/°C], ``ripple_amplitude``: the
+            root sum of squares of the harmonics' amplitudes [N·m]).
+        reference_temperature: ``T_ref`` [°C] (None: no temperature term tried).
+        reasons: per term tried, why it was kept or not (one sentence).
+        held_out_rms: the held-out RMS [N·m] of the velocity model alone and with the terms kept.
+    """
+
+    params: ModelParams
+    kept: tuple[Term, ...] = ()
+    harmonics: int = 0
+    coefficients: dict[str, float] = field(default_factory=dict)
+    stderr: dict[str, float] = field(default_factory=dict)
+    derived: dict[str, float] = field(default_factory=dict)
+    reference_temperature: float | None = None
+    reasons: dict[str, str] = field(default_factory=dict)
+    held_out_rms: tuple[float, float] = (float("nan"), float("nan"))
+
+    def friction(self, qd: np.ndarray, signals: TermSignals) -> np.ndarray:
+        """The dissipative part ``f`` [N·m] (N,): the velocity model and every kept term but the ripple."""
+        return self._value(qd, signals, dissipative=True)
+
+    def ripple(self, qd: np.ndarray, signals: TermSignals) -> np.ndarray:
+        """The position ripple [N·m] (N,) (zero without one)."""
+        return self._value(qd, signals, dissipative=False) - self._value(qd, signals, dissipative=True)
+
+    def torque(self, qd: np.ndarray, signals: TermSignals) -> np.ndarray:
+        """What the model predicts of the estimate ``tau_f`` [N·m] (N,): ``-(friction + ripple)``."""
+        return -self._value(qd, signals, dissipative=False)
+
+    def _value(self, qd: np.ndarray, signals: TermSignals, dissipative: bool) -> np.ndarray:
+        f = self.params.f(qd)
+        for term in self.kept:
+            if dissipative and term in NOT_DISSIPATIVE:
+                continue
+            names, X = term_basis(term, self.params, qd, signals, harmonics=self.harmonics,
+                                  reference_temperature=self.reference_temperature or 0.0)
+            f = f + X @ np.array([self.coefficients[n] for n in names])
+        return f
+
+
+def _design(params: ModelParams, qd: np.ndarray, signals: TermSignals, terms: tuple[Term, ...], harmonics: int,
+            t_ref: float) -> tuple[tuple[str, ...], np.ndarray, int]:
+    """The joint design ``[B | Phi_1 | ...]`` (N, k + m), its names, and ``k`` (the velocity model's count)."""
+    names, B, _ = velocity_basis(params, qd)
+    blocks, all_names = [B], list(names)
+    for term in terms:
+        n, X = term_basis(term, params, qd, signals, harmonics=harmonics, reference_temperature=t_ref)
+        blocks.append(X)
+        all_names += n
+    return tuple(all_names), np.column_stack(blocks), len(names)
+
+
+def _solve(X: np.ndarray, y: np.ndarray) -> np.ndarray:
+    return np.linalg.lstsq(X, y, rcond=None)[0]
+
+
+def _held_out(params: ModelParams, qd: np.ndarray, y: np.ndarray, signals: TermSignals, terms: tuple[Term, ...],
+              harmonics: int, t_ref: float, train: np.ndarray, test: np.ndarray) -> np.ndarray:
+    """Residuals on ``test`` of the model fitted on ``train``."""
+    _, X, _ = _design(params, qd, signals, terms, harmonics, t_ref)
+    coef = _solve(X[train], y[train])
+    return y[test] - X[test] @ coef
+
+
+def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.ndarray, signals: TermSignals,
+              options: TermOptions = TermOptions()) -> TermFit:
+    """The terms beyond velocity that held-out samples support, fitted with the velocity model's linear
+    coefficients (module docstring).
+
+    Args:
+        params: the velocity model's fit (:attr:`~wbfriction.friction.fit.FitResult.params`).
+        qd: joint velocity (N,) [rad/s]; tau_f: the friction estimate (N,) [N·m] (``tau_f = -f``).
+        use: (N,) samples to fit (finite, valid, not stuck), in time order.
+        signals: the terms' signals, the same rows.
+        options: which terms to try.
+
+    Returns:
+        the :class:`TermFit`; with no term kept, ``params`` unchanged.
+    """
+    qd = np.asarray(qd, dtype=float)
+    y = -np.asarray(tau_f, dtype=float)
+    use = np.asarray(use, dtype=bool) & np.isfinite(qd) & np.isfinite(y)
+    for s in (signals.q, signals.tau_load, signals.temperature):
+        if s is not None:
+            use &= np.isfinite(s)
+    qd_, y_ = np.where(use, qd, 0.0), np.where(use, y, 0.0)
+    candidates = tuple(t for t in options.terms if t in signals.logged())
+    t_ref = None
+    if "temperature" in candidates and signals.temperature is not None:
+        t_ref = (float(np.median(signals.temperature[use])) if options.reference_temperature is None
+                 else options.reference_temperature)
+    train, test = held_out_split(use)
+
+    def score(terms: tuple[Term, ...], h: int) -> float:
+        r = _held_out(params, qd_, y_, signals, terms, h, t_ref or 0.0, train, test)
+        return float(np.sqrt(np.mean(r**2))) if r.size else float("nan")
+
+    def best_harmonics(terms: tuple[Term, ...]) -> tuple[float, int]:
+        """The held-out RMS of ``terms`` and the ripple's ``H`` that gives it (0 without a ripple)."""
+        if "ripple" not in terms:
+            return score(terms, 0), 0
+        scores = [score(terms, h) for h in range(1, options.max_harmonic + 1)]
+        h = next(k for k, r in enumerate(scores, 1) if r <= (1.0 + options.tolerance) * min(scores))
+        return scores[h - 1], h  # the fewest harmonics within the tolerance of the best
+
+    base_rms = score((), 0)
+    tol = options.tolerance
+    kept: list[Term] = []
+    current, harmonics = base_rms, 0
+    remaining = list(candidates)
+    while remaining:  # forward: the term that lowers the held-out RMS most, while it lowers it by more than tol
+        trials = {term: best_harmonics((*kept, term)) for term in remaining}
+        best = min(trials, key=lambda t: trials[t][0])
+        if not trials[best][0] < (1.0 - tol) * current:
+            break
+        kept.append(best)
+        current, harmonics = trials[best]
+        remaining.remove(best)
+    while len(kept) > 1:  # backward: a term another has made redundant leaves (a load that stood for a ripple)
+        without = {term: best_harmonics(tuple(t for t in kept if t != term)) for term in kept}
+        weakest = min(without, key=lambda t: without[t][0])
+        if not without[weakest][0] < (1.0 + tol) * current:
+            break
+        kept.remove(weakest)
+        current, harmonics = without[weakest]
+    reasons: dict[str, str] = {}
+    for term in candidates:
+        if term in kept:
+            rms_without = best_harmonics(tuple(t for t in kept if t != term))[0]
+            reasons[term] = (f"kept: held-out RMS {current:.4g} N·m with it, {rms_without:.4g} without "
+                             f"(+{100 * (rms_without / current - 1):.2g} %)"
+                             + (f"; {harmonics} harmonics" if term == "ripple" else ""))
+        else:
+            rms_with = best_harmonics((*kept, term))[0]
+            reasons[term] = (f"not kept: held-out RMS {current:.4g} N·m without it, {rms_with:.4g} with "
+                             f"({100 * (rms_with / current - 1):+.2g} %; kept from -{100 * tol:g} %)")
+    kept_sorted = tuple(t for t in TERMS if t in kept)
+    if not kept_sorted:
+        return TermFit(params, reference_temperature=t_ref, reasons=reasons, held_out_rms=(base_rms, base_rms))
+    names, X, k = _design(params, qd_, signals, kept_sorted, harmonics, t_ref or 0.0)
+    coef = _solve(X[use], y_[use])
+    residual = y_[use] - X[use] @ coef
+    rows_used = np.flatnonzero(use)  # residuals correlated over a filter's window: Newey-West, as the fit's
+    errors = standard_errors(X[use], residual, rows=rows_used, max_lag=correlation_lag(residual, rows_used))
+    refitted = with_coefficients(params, coef[:k])
+    coefficients = dict(zip(names[k:], map(float, coef[k:])))
+    stderr = dict(zip(names, map(float, errors)))
+    return TermFit(refitted, kept_sorted, harmonics, coefficients, stderr, _derived(refitted, coefficients), t_ref,
+                   reasons, (base_rms, current))
+
+
+def _derived(params: ModelParams, c: dict[str, float]) -> dict[str, float]:
+    """The physical parameters of the coefficients (:attr:`TermFit.derived`)."""
+    out: dict[str, float] = {}
+    F_c, F_v = params.F_c, params.F_v
+    if "F_L" in c:
+        out["k_L"] = c["F_L"] / F_c if F_c else float("nan")
+    if "dF_v" in c:
+        out.update({"F_v+": F_v + c["dF_v"], "F_v-": F_v - c["dF_v"], "F_c+": F_c + params.tau_os,
+                    "F_c-": F_c - params.tau_os})
+    if "F_cT" in c:
+        out["k_Tc"] = c["F_cT"] / F_c if F_c else float("nan")
+        out["k_Tv"] = c["F_vT"] / F_v if F_v else float("nan")
+    sines = [n for n in c if n.startswith("ripple_sin")]
+    if sines:
+        out["ripple_amplitude"] = float(np.sqrt(sum(c[n] ** 2 + c[n.replace("sin", "cos")] ** 2 for n in sines)))
+    return out
