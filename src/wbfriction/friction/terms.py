@@ -27,9 +27,9 @@ weighted least-squares solve fits them together (:func:`fit_terms`). ``g(qd)`` i
 **Which terms are kept**: stepwise selection on blocked held-out samples (the split of the model choice,
 :func:`~wbfriction.friction.fit.held_out_split`), with the model choice's rule: forward, the term that lowers the
 held-out RMS most joins while it lowers it by more than :attr:`TermOptions.tolerance`; backward, a term whose
-leaving raises it by less leaves (a load term that stood in for a ripple, their regressors alike); the ripple's
-number of harmonics is the fewest whose held-out RMS is within the tolerance of the smallest. Then every coefficient is fitted on every sample,
-with standard errors from the fit's Newey-West sandwich.
+leaving raises it by less leaves (a load term that stood in for a ripple, their regressors alike); the ripple has
+the fewest harmonics whose held-out RMS is within the tolerance of the smallest. Then every coefficient is fitted
+on every sample, with standard errors from the fit's Newey-West sandwich.
 
 Sign convention: as everywhere, the characteristic ``f`` points along the velocity and ``tau_f = -f``; a term's
 coefficients are positive where it adds friction opposing the motion (``F_L``, ``F_cT``, ``F_vT`` > 0: more friction
