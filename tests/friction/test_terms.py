@@ -149,6 +149,20 @@ def test_the_ripple_is_not_friction():
     assert fit.derived["ripple_amplitude"] == pytest.approx(np.sqrt(sum(v**2 for v in PHYSICAL["ripple"])), rel=0.05)
 
 
+def test_the_ripple_is_held_outside_the_angles_it_was_fitted_on():
+    """A ripple fitted on part of a turn predicts nothing new beyond it: outside its angles it is held at the value
+    at the nearest one (a Fourier series would run away there)."""
+    qd, tau_f, s = joint(0, ("ripple",))
+    use = (np.abs(qd) > 0.02) & (np.abs(s.q) < 1.0)
+    base = fit_friction(qd, tau_f, model="coulomb-viscous", mask=use)
+    fit = fit_terms(base.params, qd, tau_f, use, s)
+    assert "ripple" in fit.kept and fit.q_range is not None and -1.0 <= fit.q_range[0] < fit.q_range[1] <= 1.0
+    far = TermSignals(q=np.array([-3.0, -1.0, 1.0, 3.0]))
+    ripple = fit.ripple(np.ones(4), far)
+    assert ripple[0] == pytest.approx(fit.ripple(np.ones(1), TermSignals(q=np.array([fit.q_range[0]])))[0])
+    assert ripple[3] == pytest.approx(fit.ripple(np.ones(1), TermSignals(q=np.array([fit.q_range[1]])))[0])
+
+
 def test_options_are_checked_where_they_are_defined():
     with pytest.raises(OptionError, match="--terms"):
         TermOptions(terms=("wear",))  # type: ignore[arg-type]

@@ -19,7 +19,9 @@ weighted least-squares solve fits them together (:func:`fit_terms`). ``g(qd)`` i
 * ``ripple``: a torque periodic in the joint's angle ``q`` [rad], ``sum_h s_h sin(h q) + c_h cos(h q)`` for
   ``h = 1..H`` (``H`` chosen on held-out samples, at most :attr:`TermOptions.max_harmonic`): torque sensing or
   transmission ripple, neither friction nor inertia. It is not dissipative: it is reported apart, left out of the
-  energy check (eq. 7.9) and of the exports; predictions include it.
+  energy check (eq. 7.9) and of the exports; predictions include it, within the angles it was fitted on (outside,
+  it is held at its value at the nearest fitted angle: a Fourier series fitted on less than a turn is not known
+  beyond its data, and would run away there).
 * ``temperature``: ``F_c (1 + k_Tc (T - T_ref))`` and ``F_v (1 + k_Tv (T - T_ref))`` (the linear form of
   Bittencourt's decrease), ``T`` the logged joint temperature [°C], ``T_ref`` the reference temperature every output
   states: coefficients ``F_cT = F_c k_Tc`` on ``(T - T_ref) g`` and ``F_vT = F_v k_Tv`` on ``(T - T_ref) qd``.
@@ -189,6 +191,7 @@ class TermFit:
             ``F_c+ = F_c + tau_os``, ``F_c- = F_c - tau_os``, ``k_Tc``, ``k_Tv`` [1/°C], ``ripple_amplitude``: the
             root sum of squares of the harmonics' amplitudes [N·m]).
         reference_temperature: ``T_ref`` [°C] (None: no temperature term tried).
+        q_range: the angles the ripple was fitted on, ``(q_min, q_max)`` [rad] (None: no ripple).
         reasons: per term tried, why it was kept or not (one sentence).
         held_out_rms: the held-out RMS [N·m] of the velocity model alone and with the terms kept.
     """
@@ -200,6 +203,7 @@ class TermFit:
     stderr: dict[str, float] = field(default_factory=dict)
     derived: dict[str, float] = field(default_factory=dict)
     reference_temperature: float | None = None
+    q_range: tuple[float, float] | None = None
     reasons: dict[str, str] = field(default_factory=dict)
     held_out_rms: tuple[float, float] = (float("nan"), float("nan"))
 
@@ -217,6 +221,8 @@ class TermFit:
 
     def _value(self, qd: np.ndarray, signals: TermSignals, dissipative: bool) -> np.ndarray:
         f = self.params.f(qd)
+        if self.q_range is not None and signals.q is not None:  # the ripple is known on its fitted angles only
+            signals = replace(signals, q=np.clip(signals.q, *self.q_range))
         for term in self.kept:
             if dissipative and term in NOT_DISSIPATIVE:
                 continue
@@ -333,8 +339,12 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     refitted = with_coefficients(params, coef[:k])
     coefficients = dict(zip(names[k:], map(float, coef[k:])))
     stderr = dict(zip(names, map(float, errors)))
+    q_range = None
+    if "ripple" in kept_sorted and signals.q is not None:
+        q_used = np.asarray(signals.q, dtype=float)[use]
+        q_range = (float(q_used.min()), float(q_used.max()))
     return TermFit(refitted, kept_sorted, harmonics, coefficients, stderr, _derived(refitted, coefficients), t_ref,
-                   reasons, (base_rms, current))
+                   q_range, reasons, (base_rms, current))
 
 
 def _derived(params: ModelParams, c: dict[str, float]) -> dict[str, float]:
