@@ -146,7 +146,7 @@ def test_the_ripple_is_not_friction():
     assert np.sqrt(np.mean((ripple - truth) ** 2)) < 0.01 * np.sqrt(np.mean(truth**2)) + 2e-3
     assert fit.friction(qd, s) == pytest.approx(fit.params.f(qd))  # the dissipative part: the velocity model
     assert fit.torque(qd, s) == pytest.approx(-(fit.params.f(qd) + ripple))
-    assert fit.derived["ripple_amplitude"] == pytest.approx(np.sqrt(sum(v**2 for v in PHYSICAL["ripple"])), rel=0.05)
+    assert fit.derived["ripple_rms"] == pytest.approx(np.std(truth[use]), rel=0.05)
 
 
 def test_the_ripple_is_held_outside_the_angles_it_was_fitted_on():
