@@ -346,13 +346,13 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         return cache[friction]
 
     def best_harmonics(terms: tuple[Term, ...]) -> tuple[float, int]:
-        """The held-out RMS of ``terms`` and the ripple's ``H`` that gives it (0 without a ripple; NaN when no count
-        holds whichever way the joint moves)."""
+        """The held-out RMS of ``terms`` and the ripple's ``H`` that gives it (0 without a ripple, or when no count
+        holds whichever way the joint moves: then the terms' without it)."""
         if "ripple" not in terms:
             return score(terms, 0), 0
         allowed = [h for h, g in direction_gains(terms).items() if g > options.tolerance]
-        if not allowed:
-            return float("nan"), 0
+        if not allowed:  # no ripple holds here: the terms without it
+            return score(tuple(t for t in terms if t != "ripple"), 0), 0
         scores: dict[int, float] = {h: score(terms, h) for h in allowed}
         best_rms = min(scores.values())
         h: int = min(count for count, rms in scores.items() if rms <= (1.0 + options.tolerance) * best_rms)
@@ -365,7 +365,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     remaining = list(candidates)
     while remaining:  # forward: the term that lowers the held-out RMS most, while it lowers it by more than tol
         trials = {term: best_harmonics((*kept, term)) for term in remaining}
-        best = min(trials, key=lambda t: np.inf if np.isnan(trials[t][0]) else trials[t][0])
+        best = min(trials, key=lambda t: trials[t][0])
         if not trials[best][0] < (1.0 - tol) * current:
             break
         kept.append(best)
@@ -373,7 +373,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         remaining.remove(best)
     while len(kept) > 1:  # backward: a term another has made redundant leaves (a load that stood for a ripple)
         without = {term: best_harmonics(tuple(t for t in kept if t != term)) for term in kept}
-        weakest = min(without, key=lambda t: np.inf if np.isnan(without[t][0]) else without[t][0])
+        weakest = min(without, key=lambda t: without[t][0])
         if not without[weakest][0] < (1.0 + tol) * current:
             break
         kept.remove(weakest)

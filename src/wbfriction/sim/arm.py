@@ -53,7 +53,8 @@ import pyarrow as pa
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.models import FrictionParams, ModelParams
-from wbfriction.logs.tables import with_metadata
+from wbfriction.friction.terms import TermFit, TermSignals
+from wbfriction.logs.tables import read_metadata, with_metadata
 from wbfriction.model.loading import build_model
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
@@ -164,6 +165,9 @@ class ArmOptions:
         torque_std: standard deviation of the noise on the motor torque [N·m] (logged as current).
         seed: seed of the noise.
         excitation: :class:`ExcitationOptions`.
+        temperature: the joints' temperature at the log's start and end [°C], a linear warm-up logged as
+            ``temperature.<joint>`` (what a ``temperature`` term of :func:`simulate_arm`'s ``terms`` sees); None: not
+            logged.
     """
 
     duration: float = 10.0
@@ -176,6 +180,7 @@ class ArmOptions:
     torque_std: float = 0.0
     seed: int = 0
     excitation: ExcitationOptions = ExcitationOptions()
+    temperature: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         if self.duration <= 0 or self.rate <= 0 or self.substeps < 1:
@@ -253,7 +258,8 @@ def default_arm_friction(robot: Robot) -> dict[str, FrictionParams]:
 
 
 def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: dict[str, float] | None = None,
-                 options: ArmOptions = ArmOptions(), progress: Progress | None = None) -> ArmSimulation:
+                 options: ArmOptions = ArmOptions(), progress: Progress | None = None,
+                 terms: Mapping[str, TermFit] | None = None) -> ArmSimulation:
     """Simulate ``robot`` as a fixed-base arm tracking an excitation trajectory (module docstring).
 
     Args:
@@ -263,19 +269,28 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
             robot's own (its ``[armature]``).
         options: :class:`ArmOptions`.
         progress: optional callable receiving numbers of samples done.
+        terms: friction beyond velocity per joint (:class:`~wbfriction.friction.terms.TermFit`: its velocity model
+            and its terms, the load being the joint's motor torque, the angle its true one, the temperature
+            :attr:`ArmOptions.temperature`'s); it replaces ``friction`` for the joints it names. Recorded in the
+            metadata's ``terms_true``.
 
     Returns:
         :class:`ArmSimulation` with ``round(duration * rate)`` samples.
 
     Raises:
-        InputError: a floating-base robot, a joint without torque constant, friction or armature for
-            an unknown joint, a negative armature.
+        InputError: a floating-base robot, a joint without torque constant, friction, terms or armature for
+            an unknown joint, a negative armature, a temperature term without :attr:`ArmOptions.temperature`.
     """
     if robot.floating_base:
         raise InputError(f"robot '{robot.name}' has a floating base: simulate_arm needs floating_base = false")
-    unknown = sorted(set(friction) - set(robot.actuated))
+    terms = dict(terms or {})
+    unknown = sorted((set(friction) | set(terms)) - set(robot.actuated))
     if unknown:
         raise InputError(f"friction given for '{unknown[0]}', which is not a joint of {robot.name}")
+    if options.temperature is None and any("temperature" in t.kept for t in terms.values()):
+        raise InputError("a temperature term needs the joints' temperature: give ArmOptions.temperature")
+    friction = {j: p for j, p in friction.items() if j not in terms}
+    beyond = [(robot.actuated.index(j), t) for j, t in terms.items()]
     model = arm_model(robot)
     model.armature = _armature(robot, armature)
     k_t = _torque_constants(robot)
@@ -296,18 +311,33 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
     Q, V, A, T, F = (np.empty((n, nv)) for _ in range(5))
     q, v = q_ref[0].copy(), qd_ref[0].copy()
     tau_f = np.zeros(nv)
+    warm = (None if options.temperature is None
+            else np.linspace(options.temperature[0], options.temperature[1], n))
     for k in counted(n, progress):
         tau = ff[k] + kp * (q_ref[k] - q) + kd * (qd_ref[k] - v)
         for s in range(options.substeps):
             if injected.joints:
                 tau_f[injected.joints] = injected.torque(v[injected.joints])
+            for i, truth in beyond:
+                here = TermSignals(q=q[i:i + 1], tau_load=tau[i:i + 1],
+                                   temperature=None if warm is None else warm[k:k + 1])
+                tau_f[i] = truth.torque(v[i:i + 1], here)[0]
             a = pin.aba(model, data, q, v, tau + tau_f)
             if s == 0:
                 Q[k], V[k], A[k], T[k], F[k] = q, v, a, tau, tau_f
             v = v + h * a
             q = q + h * v
-    return ArmSimulation(_table(robot, time, Q, V, A, T, F, k_t, model.armature, friction, options),
-                         traj, Q, V, A, T, F)
+    table = _table(robot, time, Q, V, A, T, F, k_t, model.armature, friction, options)
+    meta = read_metadata(table)
+    if warm is not None:
+        for j in robot.actuated:
+            table = table.append_column(f"temperature.{j}", pa.array(warm))
+    if terms:
+        meta["friction_true"].update({j: t.params.to_target() for j, t in terms.items()})
+        meta["terms_true"] = {j: {"kept": list(t.kept), "harmonics": t.harmonics, "coefficients": t.coefficients,
+                                  "reference_temperature": t.reference_temperature} for j, t in terms.items()}
+    table = with_metadata(table, meta)
+    return ArmSimulation(table, traj, Q, V, A, T, F)
 
 
 def _table(robot: Robot, time: np.ndarray, Q: np.ndarray, V: np.ndarray, A: np.ndarray, T: np.ndarray,
