@@ -152,6 +152,13 @@ def with_coefficients(params: ModelParams, c: np.ndarray) -> ModelParams:
     return replace(params, F_v=float(c[0]), F_c=float(c[1]), S=S, tau_os=float(c[3]))
 
 
+def fourier(q: np.ndarray, harmonics: int, constant: bool = False) -> np.ndarray:
+    """``[sin q, cos q, ..., sin Hq, cos Hq]`` (N, 2H), after a column of ones with ``constant``."""
+    angle = np.asarray(q, dtype=float)
+    columns = [f(h * angle) for h in range(1, harmonics + 1) for f in (np.sin, np.cos)]
+    return np.column_stack(([np.ones_like(angle)] if constant else []) + columns)
+
+
 def term_basis(term: Term, params: ModelParams, qd: np.ndarray, signals: TermSignals, *, harmonics: int = 1,
                reference_temperature: float = 0.0) -> tuple[tuple[str, ...], np.ndarray]:
     """One term's coefficient names and regressors (N, k) (module docstring).
@@ -170,11 +177,8 @@ def term_basis(term: Term, params: ModelParams, qd: np.ndarray, signals: TermSig
     if term == "ripple":
         if signals.q is None:
             raise ValueError("the ripple term needs the joint's angle")
-        h = np.arange(1, harmonics + 1)
-        angle = np.asarray(signals.q, dtype=float)[:, None] * h
-        names = tuple(n for k in h for n in (f"ripple_sin{k}", f"ripple_cos{k}"))
-        return names, np.column_stack([c for k in range(harmonics) for c in (np.sin(angle[:, k]),
-                                                                             np.cos(angle[:, k]))])
+        names = tuple(n for k in range(1, harmonics + 1) for n in (f"ripple_sin{k}", f"ripple_cos{k}"))
+        return names, fourier(signals.q, harmonics)
     if term == "temperature":
         if signals.temperature is None:
             raise ValueError("the temperature term needs the joint's temperature")
@@ -257,9 +261,7 @@ amplitudes of hundreds of N·m that cancel."""
 
 def ripple_condition(q: np.ndarray, harmonics: int) -> float:
     """The condition number of ``[1, sin q, cos q, ..., sin Hq, cos Hq]`` (columns scaled to unit norm) on ``q``."""
-    angle = np.asarray(q, dtype=float)
-    F = np.column_stack([np.ones_like(angle)] + [f(h * angle) for h in range(1, harmonics + 1)
-                                                  for f in (np.sin, np.cos)])
+    F = fourier(q, harmonics, constant=True)
     return float(np.linalg.cond(F / np.maximum(np.linalg.norm(F, axis=0), 1e-300)))
 
 
@@ -269,9 +271,7 @@ def direction_gain(residual: np.ndarray, qd: np.ndarray, use: np.ndarray, q: np.
     relative, 1: all of it). A torque periodic in the angle is the same whichever way the joint moves; a residual
     that follows the trajectory (a model error, a log that repeats one motion) is not, and does not carry over: its
     gain is about zero or negative."""
-    angle = np.asarray(q, dtype=float)
-    F = np.column_stack([np.ones_like(angle)] + [f(h * angle) for h in range(1, harmonics + 1)
-                                                  for f in (np.sin, np.cos)])
+    F = fourier(q, harmonics, constant=True)
     gains = []
     moving = use & (np.abs(qd) > MIN_SPEED)  # a sample at rest has no direction
     for train, test in ((moving & (qd > 0), moving & (qd < 0)), (moving & (qd < 0), moving & (qd > 0))):
