@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from wbfriction.exceptions import OptionError
 from wbfriction.friction.fit import fit_friction
@@ -161,6 +163,20 @@ def test_the_ripple_is_held_outside_the_angles_it_was_fitted_on():
     ripple = fit.ripple(np.ones(4), far)
     assert ripple[0] == pytest.approx(fit.ripple(np.ones(1), TermSignals(q=np.array([fit.q_range[0]])))[0])
     assert ripple[3] == pytest.approx(fit.ripple(np.ones(1), TermSignals(q=np.array([fit.q_range[1]])))[0])
+
+
+@given(st.floats(-3, 3), st.floats(-4, 4), st.floats(-50, 50), st.floats(0, 80))
+@settings(max_examples=200, deadline=None)
+def test_one_sample_in_floats_is_the_model(qd, q, tau_load, temperature):
+    """What a simulator's physics step calls (:meth:`TermFit.torque_at`) is :meth:`TermFit.torque` of that sample,
+    for the tanh model with every term, the ripple held at its angles' edge."""
+    fit = TermFit(FrictionParams(F_v=0.2, F_c=1.0, S=0.3, v_s=0.1, tau_os=0.05, a=30.0), TERMS, 2,
+                  {"F_L": 0.02, "dF_v": 0.03, "ripple_sin1": 0.1, "ripple_cos1": -0.05, "ripple_sin2": 0.02,
+                   "ripple_cos2": 0.01, "F_cT": -0.008, "F_vT": -0.002}, reference_temperature=40.0,
+                  q_range=(-2.0, 2.5))
+    s = TermSignals(q=np.array([q]), tau_load=np.array([tau_load]), temperature=np.array([temperature]))
+    assert fit.torque_at(qd, q, tau_load, temperature) == pytest.approx(fit.torque(np.array([qd]), s)[0],
+                                                                         rel=1e-12, abs=1e-12)
 
 
 def test_options_are_checked_where_they_are_defined():

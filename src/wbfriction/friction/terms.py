@@ -44,6 +44,7 @@ under load or warm; ``k_Tc < 0``: less friction warm). The ripple's sign is that
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import Literal, get_args
 
@@ -227,6 +228,25 @@ class TermFit:
     def torque(self, qd: np.ndarray, signals: TermSignals) -> np.ndarray:
         """What the model predicts of the estimate ``tau_f`` [N·m] (N,): ``-(friction + ripple)``."""
         return -self._value(qd, signals, dissipative=False)
+
+    def torque_at(self, qd: float, q: float = 0.0, tau_load: float = 0.0, temperature: float = 0.0) -> float:
+        """:meth:`torque` of one sample, in plain floats (a simulator's physics step): velocity [rad/s], angle
+        [rad], load [N·m], temperature [°C]."""
+        p, c = self.params, self.coefficients
+        f = float(p.f(qd))
+        g = math.tanh(p.a * qd) if isinstance(p, FrictionParams) else math.copysign(1.0, qd) if qd else 0.0
+        for term in self.kept:
+            if term == "load":
+                f += c["F_L"] * abs(tau_load) * g
+            elif term == "direction":
+                f += c["dF_v"] * abs(qd)
+            elif term == "temperature":
+                f += (c["F_cT"] * g + c["F_vT"] * qd) * (temperature - (self.reference_temperature or 0.0))
+            else:
+                angle = q if self.q_range is None else min(max(q, self.q_range[0]), self.q_range[1])
+                f += sum(c[f"ripple_sin{h}"] * math.sin(h * angle) + c[f"ripple_cos{h}"] * math.cos(h * angle)
+                         for h in range(1, self.harmonics + 1))
+        return -f
 
     def _value(self, qd: np.ndarray, signals: TermSignals, dissipative: bool) -> np.ndarray:
         f = self.params.f(qd)

@@ -53,7 +53,7 @@ import pyarrow as pa
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.models import FrictionParams, ModelParams
-from wbfriction.friction.terms import TermFit, TermSignals
+from wbfriction.friction.terms import TermFit
 from wbfriction.logs.tables import read_metadata, with_metadata
 from wbfriction.model.loading import build_model
 from wbfriction.model.robot import Robot
@@ -319,9 +319,7 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
             if injected.joints:
                 tau_f[injected.joints] = injected.torque(v[injected.joints])
             for i, truth in beyond:
-                here = TermSignals(q=q[i:i + 1], tau_load=tau[i:i + 1],
-                                   temperature=None if warm is None else warm[k:k + 1])
-                tau_f[i] = truth.torque(v[i:i + 1], here)[0]
+                tau_f[i] = truth.torque_at(v[i], q[i], tau[i], 0.0 if warm is None else warm[k])
             a = pin.aba(model, data, q, v, tau + tau_f)
             if s == 0:
                 Q[k], V[k], A[k], T[k], F[k] = q, v, a, tau, tau_f
