@@ -30,27 +30,30 @@ viscous level 25 % higher one way than the other on the shoulder; a ripple of 0.
 span 2 rad)."""
 
 
-def run(seed: int) -> dict[str, TermFit]:
+def run(seed: int, noisy: bool = False) -> dict[str, TermFit]:
     """60 s of the Panda's excitation, 5 physics steps per sample (with 2, the friction from each step's starting
-    velocity biases dF_v by 9 %), 0.05 N·m of torque noise (exact positions: the estimate needs no smoothing, whose
-    passing of the terms through it is not built yet), every joint's terms fitted on the estimate."""
+    velocity biases dF_v by 9 %), 0.05 N·m of torque noise and exact positions (central differences: no smoothing),
+    every joint's terms fitted on the estimate. ``noisy``: the
+    studies' sensor noise (1e-4 rad, 19-bit encoders) and the default route (the momentum route's window), the
+    velocity model and the terms passed through the estimate's smoother."""
     from wbfriction.model import load_robot
 
     robot = load_robot("panda")
     others = {j: VELOCITY for j in robot.actuated if j not in TRUTH}
-    sim = simulate_arm(robot, others, options=ArmOptions(duration=60.0, substeps=5, torque_std=0.05, encoder_bits=None,
-                                                        seed=seed, temperature=(25.0, 55.0)), terms=TRUTH)
-    est = estimate_log(robot, log_from_table(sim.table, robot, "arm"), EstimateOptions(diff="central",
-                                                                                       route="acceleration"))
+    noise = {"position_std": 1e-4, "encoder_bits": 19} if noisy else {"encoder_bits": None}
+    sim = simulate_arm(robot, others, options=ArmOptions(duration=60.0, substeps=5, torque_std=0.05, seed=seed,
+                                                        temperature=(25.0, 55.0), **noise), terms=TRUTH)
+    options = EstimateOptions() if noisy else EstimateOptions(diff="central", route="acceleration")
+    est = estimate_log(robot, log_from_table(sim.table, robot, "arm"), options)
     out = {}
     for i, joint in enumerate(est.joints):
         use = est.valid[:, i] & np.isfinite(est.tau_f[:, i]) & (np.abs(est.qd[:, i]) > 0.02)
         signals = TermSignals(q=sim.table.column(f"q.{joint}").to_numpy(), tau_load=sim.tau_motor[:, i],
                               temperature=sim.table.column(f"temperature.{joint}").to_numpy())
-        base = fit_friction(est.qd[:, i], est.tau_f[:, i], model="coulomb-viscous", mask=use)
+        base = fit_friction(est.qd[:, i], est.tau_f[:, i], model="coulomb-viscous", mask=use, smoother=est.smoother)
         assert base.params is not None
         out[joint] = fit_terms(base.params, est.qd[:, i], est.tau_f[:, i], use, signals,
-                               TermOptions(reference_temperature=T_REF))
+                               TermOptions(reference_temperature=T_REF), smoother=est.smoother)
     return out
 
 
@@ -71,6 +74,21 @@ def test_the_simulated_terms_are_recovered_and_no_other():
                 assert abs(fit.coefficients[name] - value) < tolerance, (seed, joint, name, fit.coefficients)
             assert fit.params.F_c == pytest.approx(1.0, rel=0.05) and fit.params.F_v == pytest.approx(0.2, rel=0.05)
     print("\nworst relative error over 10 seeds", {k: f"{100 * v:.2f} %" for k, v in worst.items()})
+
+
+@pytest.mark.slow
+def test_through_the_estimates_smoother_on_noisy_positions():
+    """The studies' sensor noise and the momentum route (its window the estimate's smoother): no term where there is
+    none; the load, temperature and ripple terms recovered within 5 %. The viscous level by direction (dF_v 25 % of
+    F_v) is not kept: its held-out gain under this noise stays below the 2 % rule (issue 40's note)."""
+    fits = run(0, noisy=True)
+    for joint, fit in fits.items():
+        truth = TRUTH.get(joint)
+        assert set(fit.kept) <= (set() if truth is None else set(truth.kept)), (joint, fit.reasons)
+    for joint in ("panda_joint4", "panda_joint6"):
+        assert set(fits[joint].kept) == set(TRUTH[joint].kept), fits[joint].reasons
+        for name, value in TRUTH[joint].coefficients.items():
+            assert fits[joint].coefficients[name] == pytest.approx(value, rel=0.05), (joint, name)
 
 
 def test_a_temperature_term_needs_the_temperature_and_joints_are_checked():

@@ -262,7 +262,7 @@ class TermFit:
 
 
 def _design(params: ModelParams, qd: np.ndarray, signals: TermSignals, terms: tuple[Term, ...], harmonics: int,
-            t_ref: float) -> tuple[tuple[str, ...], np.ndarray, int]:
+            t_ref: float, smoother=None) -> tuple[tuple[str, ...], np.ndarray, int]:
     """The joint design ``[B | Phi_1 | ...]`` (N, k + m), its names, and ``k`` (the velocity model's count)."""
     names, B, _ = velocity_basis(params, qd)
     blocks, all_names = [B], list(names)
@@ -270,7 +270,10 @@ def _design(params: ModelParams, qd: np.ndarray, signals: TermSignals, terms: tu
         n, X = term_basis(term, params, qd, signals, harmonics=harmonics, reference_temperature=t_ref)
         blocks.append(X)
         all_names += n
-    return tuple(all_names), np.column_stack(blocks), len(names)
+    X = np.column_stack(blocks)
+    if smoother is not None:  # the estimate went through it: so does the model, along the whole series
+        X = smoother(X)
+    return tuple(all_names), X, len(names)
 
 
 MAX_CONDITION = 1e3
@@ -285,13 +288,16 @@ def ripple_condition(q: np.ndarray, harmonics: int) -> float:
     return float(np.linalg.cond(F / np.maximum(np.linalg.norm(F, axis=0), 1e-300)))
 
 
-def direction_gain(residual: np.ndarray, qd: np.ndarray, use: np.ndarray, q: np.ndarray, harmonics: int) -> float:
+def direction_gain(residual: np.ndarray, qd: np.ndarray, use: np.ndarray, q: np.ndarray, harmonics: int,
+                   smoother=None) -> float:
     """How much a ripple of ``harmonics`` harmonics, fitted on the friction's residual ``y - f`` (N,) [N·m] of the
     samples moving one way, lowers the residual's RMS on those moving the other way (the smaller of the two ways;
     relative, 1: all of it). A torque periodic in the angle is the same whichever way the joint moves; a residual
     that follows the trajectory (a model error, a log that repeats one motion) is not, and does not carry over: its
-    gain is about zero or negative."""
+    gain is about zero or negative. ``smoother``: the estimate's (the ripple goes through it as the model does)."""
     F = fourier(q, harmonics, constant=True)
+    if smoother is not None:
+        F = np.nan_to_num(smoother(F))
     gains = []
     moving = use & (np.abs(qd) > MIN_SPEED)  # a sample at rest has no direction
     for train, test in ((moving & (qd > 0), moving & (qd < 0)), (moving & (qd < 0), moving & (qd > 0))):
@@ -309,15 +315,15 @@ def _solve(X: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def _held_out(params: ModelParams, qd: np.ndarray, y: np.ndarray, signals: TermSignals, terms: tuple[Term, ...],
-              harmonics: int, t_ref: float, train: np.ndarray, test: np.ndarray) -> np.ndarray:
+              harmonics: int, t_ref: float, train: np.ndarray, test: np.ndarray, smoother=None) -> np.ndarray:
     """Residuals on ``test`` of the model fitted on ``train``."""
-    _, X, _ = _design(params, qd, signals, terms, harmonics, t_ref)
+    _, X, _ = _design(params, qd, signals, terms, harmonics, t_ref, smoother)
     coef = _solve(X[train], y[train])
     return y[test] - X[test] @ coef
 
 
 def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.ndarray, signals: TermSignals,
-              options: TermOptions = TermOptions()) -> TermFit:
+              options: TermOptions = TermOptions(), smoother=None) -> TermFit:
     """The terms beyond velocity that held-out samples support, fitted with the velocity model's linear
     coefficients (module docstring).
 
@@ -327,6 +333,10 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         use: (N,) samples to fit (finite, valid, not stuck), in time order.
         signals: the terms' signals, the same rows.
         options: which terms to try.
+        smoother: the zero-phase smoother the estimate went through
+            (:attr:`~wbfriction.friction.estimated.FrictionEstimate.smoother`), or None: ``qd``, ``tau_f`` and the
+            signals are then whole time series and the model's regressors go through it before they are compared
+            (as the fit's model does); the samples where they are undefined are not used.
 
     Returns:
         the :class:`TermFit`; with no term kept, ``params`` unchanged.
@@ -337,7 +347,14 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     for s in (signals.q, signals.tau_load, signals.temperature):
         if s is not None:
             use &= np.isfinite(s)
-    qd_, y_ = np.where(use, qd, 0.0), np.where(use, y, 0.0)
+    if smoother is None:
+        qd_ = np.where(use, qd, 0.0)
+    else:  # the whole series through the smoother: rows it leaves undefined are not used
+        qd_ = qd
+        _, X0, _ = _design(params, qd_, signals, tuple(t for t in signals.logged() if t in options.terms), 1, 0.0,
+                           smoother)
+        use &= np.isfinite(X0).all(axis=1)
+    y_ = np.where(use, y, 0.0)
     candidates = tuple(t for t in options.terms if t in signals.logged())
     t_ref = None
     if "temperature" in candidates and signals.temperature is not None:
@@ -346,7 +363,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     train, test = held_out_split(use)
 
     def score(terms: tuple[Term, ...], h: int) -> float:
-        r = _held_out(params, qd_, y_, signals, terms, h, t_ref or 0.0, train, test)
+        r = _held_out(params, qd_, y_, signals, terms, h, t_ref or 0.0, train, test, smoother)
         return float(np.sqrt(np.mean(r**2))) if r.size else float("nan")
 
     counts: tuple[int, ...] = ()  # the ripple's harmonic counts its angles tell apart
@@ -360,9 +377,10 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         (:func:`direction_gain`) on what the friction with the friction terms of ``terms`` leaves."""
         friction = tuple(t for t in terms if t != "ripple")
         if friction not in cache:
-            _, X, _ = _design(params, qd_, signals, friction, 0, t_ref or 0.0)
+            _, X, _ = _design(params, qd_, signals, friction, 0, t_ref or 0.0, smoother)
+            X = np.nan_to_num(X)
             left = y_ - X @ _solve(X[use], y_[use])
-            cache[friction] = {h: direction_gain(left, qd_, use, np.asarray(signals.q), h) for h in counts}
+            cache[friction] = {h: direction_gain(left, qd_, use, np.asarray(signals.q), h, smoother) for h in counts}
         return cache[friction]
 
     def best_harmonics(terms: tuple[Term, ...]) -> tuple[float, int]:
@@ -400,7 +418,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         current, harmonics = without[weakest]
     reasons: dict[str, str] = {}
     while True:  # a friction term that makes the friction generate power (eq. 7.9) on the samples is not friction
-        names, X, k = _design(params, qd_, signals, tuple(kept), harmonics, t_ref or 0.0)
+        names, X, k = _design(params, qd_, signals, tuple(kept), harmonics, t_ref or 0.0, smoother)
         coef = _solve(X[use], y_[use])
         bad = _unphysical(with_coefficients(params, coef[:k]), dict(zip(names[k:], map(float, coef[k:]))), qd_,
                           signals, use, t_ref or 0.0)
@@ -430,7 +448,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     kept_sorted = tuple(t for t in TERMS if t in kept)
     if not kept_sorted:
         return TermFit(params, reference_temperature=t_ref, reasons=reasons, held_out_rms=(base_rms, base_rms))
-    names, X, k = _design(params, qd_, signals, kept_sorted, harmonics, t_ref or 0.0)
+    names, X, k = _design(params, qd_, signals, kept_sorted, harmonics, t_ref or 0.0, smoother)
     coef = _solve(X[use], y_[use])
     residual = y_[use] - X[use] @ coef
     rows_used = np.flatnonzero(use)  # residuals correlated over a filter's window: Newey-West, as the fit's
