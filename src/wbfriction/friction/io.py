@@ -236,7 +236,8 @@ def read_friction_file(path: str | Path) -> FrictionEstimate:
 
 
 # ------------------------------------------------------------------ parameters JSON
-def _finite_or_none(x: float | None) -> float | None:
+def finite_or_none(x: float | None) -> float | None:
+    """A number as the JSON files hold it: ``null`` for one that is not finite (or none)."""
     return None if x is None or not np.isfinite(x) else float(x)
 
 
@@ -250,7 +251,7 @@ def selection_to_dict(selection: ModelSelection) -> dict[str, Any]:
     not finite: ``null``)."""
     return {"chosen": selection.chosen, "reason": selection.reason, "tolerance": selection.tolerance,
             "n_train": selection.n_train, "n_held_out": selection.n_held_out,
-            "scores": [{"model": c.model, "held_out_rms": _finite_or_none(c.held_out_rms),
+            "scores": [{"model": c.model, "held_out_rms": finite_or_none(c.held_out_rms),
                         "at_bound": list(c.at_bound)} for c in selection.scores]}
 
 
@@ -274,7 +275,7 @@ def selection_from_dict(d: Mapping[str, Any]) -> ModelSelection:
 
 def fit_to_dict(fit: FitResult) -> dict[str, Any]:
     """One joint's entry of the parameters JSON (a standard error that is not finite: ``null``)."""
-    clean = _finite_or_none
+    clean = finite_or_none
     d: dict[str, Any] = {"n_samples": fit.n_samples, "n_screened": fit.n_screened, "fitted": fit.params is not None,
                          "success": fit.success, "message": fit.message,
                          "rms_residual": clean(fit.rms_residual), "model": fit.model,
@@ -356,7 +357,7 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
 
 def energy_to_dict(energy: JointEnergy) -> dict[str, Any]:
     """The energy check of one joint (eq. 7.9) as the parameters JSON records it."""
-    return {"generating_share": _finite_or_none(energy.generating_share), "tau_os_removed": energy.tau_os,
+    return {"generating_share": finite_or_none(energy.generating_share), "tau_os_removed": energy.tau_os,
             "threshold": energy.threshold, "flagged": energy.flagged}
 
 

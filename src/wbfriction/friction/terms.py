@@ -314,14 +314,6 @@ def _solve(X: np.ndarray, y: np.ndarray) -> np.ndarray:
     return np.linalg.lstsq(X, y, rcond=None)[0]
 
 
-def _held_out(params: ModelParams, qd: np.ndarray, y: np.ndarray, signals: TermSignals, terms: tuple[Term, ...],
-              harmonics: int, t_ref: float, train: np.ndarray, test: np.ndarray, smoother=None) -> np.ndarray:
-    """Residuals on ``test`` of the model fitted on ``train``."""
-    _, X, _ = _design(params, qd, signals, terms, harmonics, t_ref, smoother)
-    coef = _solve(X[train], y[train])
-    return y[test] - X[test] @ coef
-
-
 def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.ndarray, signals: TermSignals,
               options: TermOptions = TermOptions(), smoother=None) -> TermFit:
     """The terms beyond velocity that held-out samples support, fitted with the velocity model's linear
@@ -361,9 +353,19 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         t_ref = (float(np.median(signals.temperature[use])) if options.reference_temperature is None
                  else options.reference_temperature)
     train, test = held_out_split(use)
+    designs: dict[tuple[tuple[Term, ...], int], tuple[tuple[str, ...], np.ndarray, int]] = {}
+
+    def design(terms: tuple[Term, ...], h: int) -> tuple[tuple[str, ...], np.ndarray, int]:
+        """:func:`_design` of ``terms`` (in :data:`TERMS` order) with ``h`` harmonics, built (and smoothed) once."""
+        key = (tuple(t for t in TERMS if t in terms), h if "ripple" in terms else 0)
+        if key not in designs:
+            designs[key] = _design(params, qd_, signals, key[0], key[1], t_ref or 0.0, smoother)
+        return designs[key]
 
     def score(terms: tuple[Term, ...], h: int) -> float:
-        r = _held_out(params, qd_, y_, signals, terms, h, t_ref or 0.0, train, test, smoother)
+        """The held-out RMS of the model of ``terms`` fitted on the training samples."""
+        _, X, _ = design(terms, h)
+        r = y_[test] - X[test] @ _solve(X[train], y_[train])
         return float(np.sqrt(np.mean(r**2))) if r.size else float("nan")
 
     counts: tuple[int, ...] = ()  # the ripple's harmonic counts its angles tell apart
@@ -377,8 +379,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         (:func:`direction_gain`) on what the friction with the friction terms of ``terms`` leaves."""
         friction = tuple(t for t in terms if t != "ripple")
         if friction not in cache:
-            _, X, _ = _design(params, qd_, signals, friction, 0, t_ref or 0.0, smoother)
-            X = np.nan_to_num(X)
+            X = np.nan_to_num(design(friction, 0)[1])
             left = y_ - X @ _solve(X[use], y_[use])
             cache[friction] = {h: direction_gain(left, qd_, use, np.asarray(signals.q), h, smoother) for h in counts}
         return cache[friction]
@@ -418,10 +419,10 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         current, harmonics = without[weakest]
     reasons: dict[str, str] = {}
     while True:  # a friction term that makes the friction generate power (eq. 7.9) on the samples is not friction
-        names, X, k = _design(params, qd_, signals, tuple(kept), harmonics, t_ref or 0.0, smoother)
+        names, X, k = design(tuple(kept), harmonics)
         coef = _solve(X[use], y_[use])
-        bad = _unphysical(with_coefficients(params, coef[:k]), dict(zip(names[k:], map(float, coef[k:]))), qd_,
-                          signals, use, t_ref or 0.0)
+        bad = _unphysical(with_coefficients(params, coef[:k]), dict(zip(names[k:], map(float, coef[k:]))), signals,
+                          use, t_ref or 0.0)
         if bad is None:
             break
         kept.remove(bad[0])
@@ -448,7 +449,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     kept_sorted = tuple(t for t in TERMS if t in kept)
     if not kept_sorted:
         return TermFit(params, reference_temperature=t_ref, reasons=reasons, held_out_rms=(base_rms, base_rms))
-    names, X, k = _design(params, qd_, signals, kept_sorted, harmonics, t_ref or 0.0, smoother)
+    names, X, k = design(kept_sorted, harmonics)
     coef = _solve(X[use], y_[use])
     residual = y_[use] - X[use] @ coef
     rows_used = np.flatnonzero(use)  # residuals correlated over a filter's window: Newey-West, as the fit's
@@ -457,19 +458,17 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     coefficients = dict(zip(names[k:], map(float, coef[k:])))
     stderr = dict(zip(names, map(float, errors)))
     q_range = None
+    derived = _derived(refitted, coefficients)
     if "ripple" in kept_sorted and signals.q is not None:
         q_used = np.asarray(signals.q, dtype=float)[use]
         q_range = (float(q_used.min()), float(q_used.max()))
-    derived = _derived(refitted, coefficients)
-    if "ripple" in kept_sorted and signals.q is not None:  # its size where it was fitted (harmonics may cancel)
-        names_r, R = term_basis("ripple", params, qd_, signals, harmonics=harmonics)
-        ripple = (R[use] @ np.array([coefficients[n] for n in names_r]))
-        derived["ripple_rms"] = float(np.std(ripple))
+        ripple = fourier(q_used, harmonics) @ np.array([coefficients[n] for n in names if n.startswith("ripple")])
+        derived["ripple_rms"] = float(np.std(ripple))  # its size where it was fitted (harmonics may cancel)
     return TermFit(refitted, kept_sorted, harmonics, coefficients, stderr, derived, t_ref, q_range, reasons,
                    (base_rms, current))
 
 
-def _unphysical(params: ModelParams, c: dict[str, float], qd: np.ndarray, signals: TermSignals, use: np.ndarray,
+def _unphysical(params: ModelParams, c: dict[str, float], signals: TermSignals, use: np.ndarray,
                 t_ref: float) -> tuple[Term, str] | None:
     """The first friction term whose levels go below zero on the samples (a viscous level in a direction, a Coulomb
     level under a load met, a level at a temperature met) and what goes below; None when all stay physical."""

@@ -21,7 +21,7 @@ from typing import Any
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.fit import FitResult
-from wbfriction.friction.io import fit_from_dict, fit_to_dict
+from wbfriction.friction.io import finite_or_none, fit_from_dict, fit_to_dict
 from wbfriction.inertia.excitation import Unexcited
 
 SIGN_CONVENTION = ("tau_f = -f(qd); f = F_v qd + F_c tanh(a qd) (+ (F_s - F_c) tanh(a qd) exp(-(qd/v_s)^2))"
@@ -50,11 +50,6 @@ def _optional(d: Mapping[str, Any], name: str, key: str) -> float | None:
     x = d.get(name)
     _need(x is None or _is_number(x), key)
     return None if x is None else float(x)
-
-
-def _finite(x: float) -> float | None:
-    """A number as JSON holds it: None for one that is not finite."""
-    return float(x) if math.isfinite(x) else None
 
 
 def _read_finite(x: Any) -> float:
@@ -108,7 +103,7 @@ class PassSummary:
                 "samples": self.samples, "base_parameters": self.base_parameters, "parameters": self.parameters,
                 "condition": self.condition, "prior": self.prior, "prior_scores": dict(self.prior_scores),
                 "residual_std": self.residual_std,
-                "not_excited": [{"parameter": u.parameter, "information": _finite(u.information),
+                "not_excited": [{"parameter": u.parameter, "information": finite_or_none(u.information),
                                  "partners": u.partners} for u in self.not_excited],
                 "message": self.message, "solver": self.solver, "verdict": self.verdict,
                 "validation": self.validation}

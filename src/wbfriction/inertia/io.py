@@ -11,9 +11,8 @@ import json
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from wbfriction.exceptions import InputError
+from wbfriction.friction.io import finite_or_none
 from wbfriction.inertia.closed_loop import ClosedLoop
 from wbfriction.inertia.document import (
     BodyProposal,
@@ -25,10 +24,6 @@ from wbfriction.inertia.document import (
 )
 from wbfriction.inertia.urdf import BodyChange, inertia_changes
 from wbfriction.logs.tables import write_json
-
-
-def _finite(x: float) -> float | None:
-    return float(x) if np.isfinite(x) else None
 
 
 def identification_of(loop: ClosedLoop, moved: tuple[str, ...] = (),
@@ -55,8 +50,8 @@ def identification_of(loop: ClosedLoop, moved: tuple[str, ...] = (),
             acceleration_route=final.route.fit(joint), acceleration_route_given_model=loop.given.fit(joint),
             armature_given=float(ident.armature_given[i]), armature=float(ident.armature[i]),
             acceleration_noise=float(ident.acceleration_noise[i]),
-            generating_share_given_model=_finite(energy_given[joint].generating_share),
-            generating_share=_finite(energy[joint].generating_share),
+            generating_share_given_model=finite_or_none(energy_given[joint].generating_share),
+            generating_share=finite_or_none(energy[joint].generating_share),
             holdout_rms=HeldOutRms(float(h.given[i]), float(h.given_with_friction[i]), float(h.identified[i]),
                                    None if h.validated is None else float(h.validated[i])),
             identified_before_validation=dict(zip(ident.friction_names, map(float, ident.friction_fit[i])))
@@ -67,9 +62,10 @@ def identification_of(loop: ClosedLoop, moved: tuple[str, ...] = (),
     proposed = {c.body: c for c in inertia_changes(ident.bodies, ident.pi_given, ident.pi_fit)} \
         if len(ident.pi_fit) else {}
     bodies = tuple(BodyWritten(
-        body=c.body, mass_given=c.mass_given, mass=c.mass, mass_change=_finite(c.mass_change), com_shift=c.com_shift,
+        body=c.body, mass_given=c.mass_given, mass=c.mass, mass_change=finite_or_none(c.mass_change),
+        com_shift=c.com_shift,
         moments_given=tuple(c.moments_given.tolist()), moments=tuple(c.moments.tolist()),
-        moments_change=tuple(_finite(x) for x in c.moments_change),
+        moments_change=tuple(finite_or_none(x) for x in c.moments_change),
         kept=kept[c.body][0] if c.body in kept else None, limb=kept[c.body][1] if c.body in kept else None,
         identified=_proposal(proposed.get(c.body))) for c in inertia_changes(ident.bodies, ident.pi_given, ident.pi))
     passes = tuple(PassSummary(
@@ -77,9 +73,9 @@ def identification_of(loop: ClosedLoop, moved: tuple[str, ...] = (),
         stribeck_joints=None if p.stribeck_joints is None else tuple(p.stribeck_joints),
         samples=p.identification.samples, base_parameters=p.identification.base.count,
         parameters=int(p.identification.base.combination.shape[1]),
-        condition=_finite(p.identification.base.condition), prior=p.identification.prior,
+        condition=finite_or_none(p.identification.base.condition), prior=p.identification.prior,
         prior_scores={f"{w:g}": v for w, v in p.identification.prior_scores.items()},
-        residual_std=_finite(p.identification.residual_std), not_excited=tuple(p.identification.unexcited),
+        residual_std=finite_or_none(p.identification.residual_std), not_excited=tuple(p.identification.unexcited),
         message=p.identification.message,
         solver=None if p.identification.solver is None else p.identification.solver.to_dict(),
         verdict=None if p.identification.validation is None
@@ -95,8 +91,9 @@ def _proposal(c: BodyChange | None) -> BodyProposal | None:
     """What the fit proposed for a body (None: nothing known)."""
     if c is None:
         return None
-    return BodyProposal(mass=c.mass, mass_change=_finite(c.mass_change), com_shift=c.com_shift,
-                        moments=tuple(c.moments.tolist()), moments_change=tuple(_finite(x) for x in c.moments_change))
+    return BodyProposal(mass=c.mass, mass_change=finite_or_none(c.mass_change), com_shift=c.com_shift,
+                        moments=tuple(c.moments.tolist()),
+                        moments_change=tuple(finite_or_none(x) for x in c.moments_change))
 
 
 def write_identification(path: str | Path, identification: Identification) -> None:
