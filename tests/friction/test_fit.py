@@ -27,12 +27,9 @@ from wbfriction.friction.fit import (
     from_fit_coordinates,
     held_out_gain,
     held_out_rms,
-    held_out_split,
     initial_guesses,
     model_bounds,
-    parameter_covariance,
     prefer_interior,
-    standard_errors,
     stick_speed,
     to_fit_coordinates,
 )
@@ -44,6 +41,7 @@ from wbfriction.friction.models import (
     model_values,
 )
 from wbfriction.friction.options import FitOptions
+from wbfriction.friction.regression import held_out_split, parameter_covariance, standard_errors
 from wbfriction.friction.status import fit_verdict
 from wbfriction.signals.filters import SavgolSmoother
 

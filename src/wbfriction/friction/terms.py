@@ -51,9 +51,9 @@ from typing import Literal, get_args
 import numpy as np
 
 from wbfriction.choices import check_choice, check_range
-from wbfriction.friction.fit import correlation_lag, held_out_split, standard_errors
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams, ModelParams, StribeckParams
 from wbfriction.friction.options import SELECTION_TOLERANCE
+from wbfriction.friction.regression import correlation_lag, held_out_split, standard_errors
 from wbfriction.friction.status import MIN_SPEED
 
 Term = Literal["load", "direction", "ripple", "temperature"]

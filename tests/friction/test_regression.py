@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from wbfriction.friction.fit import correlation_lag, lagged_products
+from wbfriction.friction.regression import correlation_lag, lagged_products
 
 
 def _pairs(g: np.ndarray, rows: np.ndarray, max_lag: int) -> np.ndarray:
