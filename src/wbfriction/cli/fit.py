@@ -4,7 +4,7 @@ it goes."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING, Optional, cast
 
 import typer
 from rich.markup import escape
@@ -12,10 +12,7 @@ from rich.table import Table
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
-from wbfriction.friction.options import (
-    FitOptions,
-    ModelChoice,
-)
+from wbfriction.friction.options import TERMS, FitOptions, ModelChoice, Term, TermOptions
 from wbfriction.pipeline.paths import check_paths
 
 if TYPE_CHECKING:
@@ -48,11 +45,11 @@ def _print_fits(results: list[FitResult], labels: dict[str, str] | None, wide: b
                 verbose: bool = False) -> None:
     """The fitted friction's tables and notes (:mod:`~wbfriction.report.terminal`), as wide as the terminal,
     the joints by their ``labels``."""
-    from wbfriction.report.terminal import fit_notes, fit_tables
+    from wbfriction.report.terminal import fit_notes, fit_tables, terms_notes
 
     for table in fit_tables(results, wide, labels):
         print_whole(table) if wide else out.print(table)
-    for line in fit_notes(results, verbose, labels):
+    for line in [*fit_notes(results, verbose, labels), *terms_notes(results, verbose, labels)]:
         out.print(escape(line), highlight=False)
 
 
@@ -77,13 +74,24 @@ def fit(friction: Path = FrictionArg,
         selection_tolerance: float = typer.Option(FIT.selection_tolerance, min=0.0,
                                                   help="With --model auto: relative excess of held-out RMS within "
                                                        "which the simpler model is chosen."),
+        terms: str = typer.Option("", help="Terms beyond velocity tried per joint, comma-separated, or all: "
+                                           "load (Coulomb friction growing with the joint's torque), direction "
+                                           "(F_v by direction of motion), ripple (a torque periodic in the "
+                                           "angle, not friction), temperature (needs temperature.<joint> in the "
+                                           "log); each kept where held-out samples improve."),
+        max_harmonic: int = typer.Option(FIT.terms.max_harmonic, help="The ripple's highest harmonic tried."),
+        reference_temperature: Optional[float] = typer.Option(
+            None, help="T_ref [°C] the temperature term's levels are stated at [default: the log's median]."),
         wide: bool = WideOpt, verbose: bool = VerboseOpt) -> None:
     """Identify a friction model of every joint, with standard errors and the parameters left
     at a bound; warn about joints whose friction generates power (eq. 7.9)."""
     check_paths({"FRICTION": friction}, {"-o": output})
+    names = TERMS if terms.strip() == "all" else tuple(t.strip() for t in terms.split(",") if t.strip())
+    term_options = TermOptions(terms=cast("tuple[Term, ...]", names), max_harmonic=max_harmonic,
+                               reference_temperature=reference_temperature)
     _run_fit(friction, output, FitOptions(model=model, selection_tolerance=selection_tolerance,
-                                          min_samples=min_samples), energy_threshold, energy_tolerance, workers,
-             wide, verbose)
+                                          min_samples=min_samples, terms=term_options),
+             energy_threshold, energy_tolerance, workers, wide, verbose)
 
 
 @app.command()
@@ -137,15 +145,20 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
     with console.status(f"predicting the torques of {friction.name}"):
         pred = predict_file(friction, params)
     table = Table(title=f"Torque prediction on {friction.name}: RMS of measured - predicted [N·m]", box=None)
-    for col in ("joint", "samples", "rigid body only", "with friction", "fit"):
+    with_terms = any(pred.terms)
+    columns = ("joint", "samples", "rigid body only", "with friction", "fit", *(("terms",) if with_terms else ()))
+    for col in columns:
         table.add_column(col, justify="right" if col in ("samples", "rigid body only", "with friction") else "left")
     statuses = pred.status or ("",) * len(pred.joints)
-    for j, n, rigid, full, status in zip(pred.joints, pred.samples, pred.rms_rigid_body, pred.rms, statuses):
+    terms = pred.terms or ((),) * len(pred.joints)
+    for j, n, rigid, full, status, kept in zip(pred.joints, pred.samples, pred.rms_rigid_body, pred.rms, statuses,
+                                               terms):
         table.add_row(j, str(n), f"{rigid:.4g}", "—" if not np.isfinite(full) else f"{full:.4g}", status,
-                      style=None if status in ("ok", "") else "dim")
+                      *((", ".join(kept),) if with_terms else ()), style=None if status in ("ok", "") else "dim")
     rigid, full = pred.overall(pred.rms_rigid_body), pred.overall(pred.rms)
     table.add_row("all joints", str(int(pred.samples.sum())), f"{rigid:.4g}",
-                  "—" if not np.isfinite(full) else f"{full:.4g}", "", style="bold", end_section=True)
+                  "—" if not np.isfinite(full) else f"{full:.4g}", "", *(("",) if with_terms else ()), style="bold",
+                  end_section=True)
     out.print(table)
     if any(status not in ("ok", "") for status in statuses):
         console.print("a prediction by a fit that is not ok is no better than that fit: see 'fit' for the reason")

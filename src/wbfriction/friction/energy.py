@@ -26,6 +26,7 @@ find them in simulation with the exact model, and traced them to inertia-model e
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,6 +96,7 @@ class JointEnergy:
         opposite_share: share of valid samples where ``Delta qdd`` and ``qd`` have opposite
             signs (1 for Fig. 7.4a; None without ``delta_qdd``).
         threshold: the share above which the joint is flagged.
+        ripple_removed: whether a fitted position ripple was taken out first (not friction).
     """
 
     joint: str
@@ -106,6 +108,7 @@ class JointEnergy:
     median_lag: float
     opposite_share: float | None
     threshold: float = DEFAULT_THRESHOLD
+    ripple_removed: bool = False
 
     @property
     def flagged(self) -> bool:
@@ -122,7 +125,8 @@ class JointEnergy:
 
 
 def energy_consistency(est, tau_os: dict[str, float] | None = None, threshold: float = DEFAULT_THRESHOLD,
-                       tolerance: float = DEFAULT_TOLERANCE) -> list[JointEnergy]:
+                       tolerance: float = DEFAULT_TOLERANCE,
+                       ripple: Mapping[str, np.ndarray] | None = None) -> list[JointEnergy]:
     """Energy consistency of every joint of a :class:`~wbfriction.friction.estimate.FrictionEstimate`
     on its valid samples.
 
@@ -131,8 +135,12 @@ def energy_consistency(est, tau_os: dict[str, float] | None = None, threshold: f
         tau_os: identified torque offset per joint name [N·m] (default 0 for every joint).
         threshold: share above which a joint is flagged.
         tolerance: smallest friction torque that counts as generating power [N·m].
+        ripple: per joint name, its fitted position ripple over the estimate's rows (N,) [N·m]
+            (:func:`~wbfriction.friction.fit.fitted_ripples`): a torque of the angle, not friction, taken out
+            before the check (``tau_f + ripple``: the ripple's torque is ``-ripple``).
     """
     tau_os = tau_os or {}
+    ripple = ripple or {}
     out = []
     for i, joint in enumerate(est.joints):
         v = est.valid[:, i]
@@ -148,6 +156,8 @@ def energy_consistency(est, tau_os: dict[str, float] | None = None, threshold: f
             lag = float(np.nanmedian(np.abs(lags))) if np.isfinite(lags).any() else float("nan")
             prod = (qd * d)[np.isfinite(qd * d)]
             opposite = float(np.mean(prod < 0)) if prod.size else float("nan")
-        share = generating_share(est.qd[v, i], est.tau_f[v, i], os_i, tolerance)
-        out.append(JointEnergy(joint, int(v.sum()), share, os_i, vel, delta_crossings, lag, opposite, threshold))
+        tau_f = est.tau_f[:, i] + ripple[joint] if joint in ripple else est.tau_f[:, i]
+        share = generating_share(est.qd[v, i], tau_f[v], os_i, tolerance)
+        out.append(JointEnergy(joint, int(v.sum()), share, os_i, vel, delta_crossings, lag, opposite, threshold,
+                               joint in ripple))
     return out

@@ -330,6 +330,7 @@ def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress
         est = momentum_estimate(robot, log, options, progress, require_single_support, gaps)
     else:
         est = _acceleration_segment(robot, log, options, progress, companion, require_single_support, gaps)
+    est.q, est.tau, est.temperature = log.q[:, robot.tc_index], log.tau, log.temperature  # the terms' signals
     if options.check_route:
         other: Route = "acceleration" if options.route == "momentum" else "momentum"
         est.route_check = _estimate_segment(robot, log, replace(options, route=other, check_route=False), None,

@@ -48,6 +48,11 @@ class FrictionEstimate:
         route: (N,) how each sample was estimated (:data:`~wbfriction.friction.measured.Closure`):
             ``contact`` (rigid contacts), ``base`` (measured base motion), ``wrench`` (measured
             wrenches), ``none``; or None (a table that does not say: rigid contacts).
+        q: the joints' positions as logged (N, n_tc) [rad], or None (a table of an earlier version): what the
+            position ripple is a function of (:mod:`~wbfriction.friction.terms`).
+        tau: the joints' measured torques (N, n_tc) [N·m], or None: the load their transmissions carry (the
+            friction beyond the sensor is not in it), what load-dependent friction is a function of.
+        temperature: the joints' logged temperatures (N, n_tc) [°C], NaN for a joint without, or None: none logged.
         route_check: the same samples estimated by the other route (issue 38: the momentum route's for the
             acceleration route's, and the other way round; its ``tau_f``, ``qd``, ``valid`` and ``smoother``),
             whose fit :func:`~wbfriction.friction.fit.fit_estimate` compares with this one's; or None.
@@ -72,6 +77,9 @@ class FrictionEstimate:
     companion_diff: str | None = None
     route: np.ndarray | None = None
     disagreement: np.ndarray | None = None
+    q: np.ndarray | None = None
+    tau: np.ndarray | None = None
+    temperature: np.ndarray | None = None
     route_check: FrictionEstimate | None = field(default=None, repr=False)
 
     def keeping(self, rows: np.ndarray) -> FrictionEstimate:

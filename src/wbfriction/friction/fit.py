@@ -47,7 +47,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Generic
 
 import numpy as np
@@ -78,7 +78,8 @@ from wbfriction.friction.regression import (
     parameter_covariance,
 )
 from wbfriction.friction.screen import gross_outliers
-from wbfriction.friction.status import MIN_SPEED, FitVerdict, fit_verdict, joint_speed
+from wbfriction.friction.status import MIN_SPEED, FitVerdict, fit_verdict, joint_speed, routes_disagree
+from wbfriction.friction.terms import TermFit, fit_terms, refit_terms, term_signals
 from wbfriction.signals.kinematics import PiecewiseSmoother
 from wbfriction.signals.nonuniform import ResampledLowpass
 from wbfriction.workers import process_pool
@@ -191,13 +192,6 @@ class ModelSelection:
     n_held_out: int = 0
 
 
-ROUTE_Z = 3.0
-"""Two routes disagree on a parameter beyond this many standard errors of their difference (each route's own,
-combined as if independent: the routes share the data's noise, so the difference's is smaller and the rule errs
-towards agreement)."""
-ROUTE_REL = 0.02
-"""... and beyond this share of the parameter's value: a difference below 2 % is no bias worth a status (the
-routes' own quadratures differ by less)."""
 ROUTE_PARAMS = ("F_c", "F_v")
 """The parameters the routes are compared on: those a user reads."""
 
@@ -242,8 +236,7 @@ def compare_routes(fit: FitResult, other: FitResult) -> RouteCheck:
             a, b = mine.get(n), theirs.get(n)
             if a is None or b is None:
                 continue
-            se = math.hypot(fit.stderr.get(n, np.inf), other.stderr.get(n, np.inf))
-            if abs(a - b) > ROUTE_Z * se and abs(a - b) > ROUTE_REL * max(abs(a), abs(b)):
+            if routes_disagree(a, fit.stderr.get(n, np.inf), b, other.stderr.get(n, np.inf)):
                 disagree.append(n)
     return RouteCheck(other.route, theirs, dict(other.stderr), tuple(disagree))
 
@@ -288,6 +281,9 @@ class FitResult(Generic[ParamsT]):
             (:mod:`~wbfriction.friction.eiv`; 0: the model itself).
         stick_speed: samples whose window holds a speed below this [rad/s] were left out (:func:`stuck_rows`).
         n_stuck: valid samples so left out.
+        terms: the terms beyond velocity kept with this model (:mod:`~wbfriction.friction.terms`; its
+            :attr:`~wbfriction.friction.terms.TermFit.params` are this model's linear coefficients refitted with
+            them), or None: none tried.
     """
 
     joint: str
@@ -313,6 +309,7 @@ class FitResult(Generic[ParamsT]):
     velocity_noise: float = 0.0
     stick_speed: float = 0.0
     n_stuck: int = 0
+    terms: TermFit | None = None
 
     def __post_init__(self) -> None:
         if self.params is not None:
@@ -343,8 +340,27 @@ class FitResult(Generic[ParamsT]):
 
 def fitted_offsets(fits) -> dict[str, float]:
     """The identified torque offset ``tau_os`` [N·m] of every fitted joint, by name (joints
-    without parameters left out): what :func:`~wbfriction.friction.energy.energy_consistency` removes."""
-    return {f.joint: f.params.tau_os for f in fits if f.params is not None}
+    without parameters left out; with terms, the offset fitted with them): what
+    :func:`~wbfriction.friction.energy.energy_consistency` removes."""
+    return {f.joint: (f.terms.params if f.terms is not None else f.params).tau_os for f in fits
+            if f.params is not None}
+
+
+def fitted_ripples(est: FrictionEstimate, fits, source: str = "the friction table") -> dict[str, np.ndarray]:
+    """The position ripple (:mod:`~wbfriction.friction.terms`) of every joint of ``est`` whose fit kept one, over
+    its rows (N,) [N·m]: not friction, what :func:`~wbfriction.friction.energy.energy_consistency` takes out.
+
+    Raises:
+        InputError: ``est`` (read from ``source``) without the joint's angle.
+    """
+    out = {}
+    for f in fits:
+        if f.terms is not None and "ripple" in f.terms.kept and f.joint in est.joints:
+            i = est.joints.index(f.joint)
+            signals = term_signals(est, i)
+            f.terms.check_signals(signals, f.joint, source)
+            out[f.joint] = f.terms.ripple(est.qd[:, i], signals)
+    return out
 
 
 def initial_guesses(qd: np.ndarray, y: np.ndarray, model: ModelName = "thesis") -> list[np.ndarray]:
@@ -516,6 +532,33 @@ def stuck_rows(qd: np.ndarray, speed: float, margin: int) -> np.ndarray:
     return maximum_filter1d(slow, 2 * margin + 1, mode="constant", cval=False)
 
 
+def fitted_rows(qd: np.ndarray, tau_f: np.ndarray, mask: np.ndarray | None = None, smoother=None,
+                stick: float = 0.0, margin: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The samples a fit uses (:func:`fit_friction`'s arguments), and why the others are not.
+
+    Returns:
+        ``(use, screened, stuck, speed)``: (N,) the samples fitted; the gross outliers left out
+        (:func:`~wbfriction.friction.screen.gross_outliers`); those where the joint may stick (:func:`stuck_rows`,
+        only for a joint that moved); how much the joint moved (:func:`~wbfriction.friction.status.joint_speed`
+        over the samples fitted and the stuck ones) [rad/s].
+    """
+    qd = np.asarray(qd, dtype=float)
+    y = -np.asarray(tau_f, dtype=float)
+    use = np.isfinite(qd) & np.isfinite(y)
+    if mask is not None:
+        use &= np.asarray(mask, dtype=bool)
+    screened = gross_outliers(y, use)
+    use &= ~screened
+    if smoother is not None:
+        use &= np.isfinite(smoother(qd))
+    # how much the joint moved, its slow samples included; one that hardly moved has no velocity model to fit
+    # (status ``not excited``), and every sample gives its offset (the energy check's, eq. 7.9)
+    speed = joint_speed(qd[use])
+    sticks = stick > 0 and speed >= MIN_SPEED
+    stuck = stuck_rows(qd, stick, margin) & use if sticks else np.zeros_like(use)
+    return use & ~stuck, screened, stuck, speed
+
+
 def _at_bound(z: np.ndarray, bounds: tuple[np.ndarray, np.ndarray], residual, identifiable: np.ndarray
               ) -> np.ndarray:
     """(p,) bool: which of the fitted ``z`` (the fit's coordinates) are at a bound: within
@@ -597,19 +640,7 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         raise InputError(f"model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
     qd = np.asarray(qd, dtype=float)
     y = -np.asarray(tau_f, dtype=float)
-    use = np.isfinite(qd) & np.isfinite(y)
-    if mask is not None:
-        use &= np.asarray(mask, dtype=bool)
-    screened = gross_outliers(y, use)
-    use &= ~screened
-    if smoother is not None:
-        use &= np.isfinite(smoother(qd))
-    # how much the joint moved, its slow samples included; one that hardly moved has no velocity model to fit
-    # (status ``not excited``), and every sample gives its offset (the energy check's, eq. 7.9)
-    speed = joint_speed(qd[use])
-    sticks = stick > 0 and speed >= MIN_SPEED
-    stuck = stuck_rows(qd, stick, stick_margin) & use if sticks else np.zeros_like(use)
-    use &= ~stuck
+    use, screened, stuck, speed = fitted_rows(qd, tau_f, mask, smoother, stick, stick_margin)
     # One BLAS thread: the solver's many small (N x p) factorizations run several times
     # slower on OpenBLAS's threads than on one (30 TALOS joints of a 10-step walk: 78 s
     # against 14 s on 2 cores); fit joints side by side instead (fit_estimate's workers).
@@ -890,12 +921,37 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
     for f in fits:
         f.route = est.estimation_route
     check = est.route_check
+    others: Sequence[FitResult | None] = [None] * len(fits)
     if check is not None:
-        others = fit_joints(names, check.qd[:, idx], check.tau_f[:, idx], check.valid[:, idx],
+        checked = fit_joints(names, check.qd[:, idx], check.tau_f[:, idx], check.valid[:, idx],
                             smoother=check.smoother, model=[f.model for f in fits],
                             noise=joint_noises(record, check.estimation_route), stick_margin=stick_margin(check),
                             **common)
-        for f, other in zip(fits, others):
+        for f, other in zip(fits, checked):
             other.route = check.estimation_route
             f.route_check = compare_routes(f, other)
+        others = checked
+    if options.terms.terms:
+        for f, i, maybe in zip(fits, idx, others):
+            f.terms = _joint_terms(est, i, f, maybe, options)
     return fits
+
+
+def _joint_terms(est: FrictionEstimate, i: int, fit: FitResult, other: FitResult | None,
+                 options: FitOptions) -> TermFit | None:
+    """The terms beyond velocity of joint column ``i`` of ``est`` (:func:`~wbfriction.friction.terms.fit_terms`) on
+    the samples its fit used, and refitted on the other route's estimate with that route's model (``other``);
+    None for a joint not fitted or not excited."""
+    if fit.params is None or fit.verdict().status in ("not excited", "failed"):
+        return None
+    signals = term_signals(est, i)
+    use = fitted_rows(est.qd[:, i], est.tau_f[:, i], est.valid[:, i], est.smoother, fit.stick_speed,
+                      stick_margin(est))[0]
+    terms = fit_terms(fit.params, est.qd[:, i], est.tau_f[:, i], use, signals, options.terms, est.smoother)
+    check = est.route_check
+    if check is not None and other is not None and other.params is not None and terms.kept:
+        rows = fitted_rows(check.qd[:, i], check.tau_f[:, i], check.valid[:, i], check.smoother, other.stick_speed,
+                           stick_margin(check))[0]
+        terms = replace(terms, check=refit_terms(terms, other.params, check.qd[:, i], check.tau_f[:, i], rows, signals,
+                                                 check.estimation_route, check.smoother))
+    return terms

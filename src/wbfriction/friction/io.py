@@ -33,6 +33,7 @@ from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult, HeldOutScore, ModelSelection, RouteCheck
 from wbfriction.friction.models import check_model, params_from_dict, target_from_dict
 from wbfriction.friction.options import ROUTES
+from wbfriction.friction.terms import TermFit
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.tables import file_sha256, numeric_column, read_metadata, read_table, with_metadata, write_json
 from wbfriction.signals.kinematics import Smoother, make_smoother
@@ -53,6 +54,7 @@ def friction_table(est: FrictionEstimate) -> pa.Table:
     """The estimate as an Arrow table: ``time``, ``phase``, ``unique``, [``route``], [``cond``],
     ``contact.<frame>``, and per joint ``qd.<j>``, ``tau_f.<j>``, ``valid.<j>``,
     ``qdd.<j>``, ``delta_qdd.<j>``, [``delta_qdd_companion.<j>``], [``disagreement.<j>``], [``tau_f_true.<j>``],
+    the terms' signals [``q.<j>``, ``tau.<j>``, ``temperature.<j>``] (:mod:`~wbfriction.friction.terms`),
     [the other route's ``check.qd.<j>``, ``check.tau_f.<j>``, ``check.valid.<j>`` (:data:`CHECK`)];
     the companion's scheme is the metadata key ``companion_diff``, the other route's metadata ``route_check``."""
     cols: dict[str, object] = {"time": est.time, "phase": pa.array(est.phase.astype(str)),
@@ -68,9 +70,12 @@ def friction_table(est: FrictionEstimate) -> pa.Table:
         cols[f"tau_f.{j}"] = est.tau_f[:, i]
         cols[f"valid.{j}"] = est.valid[:, i]
         for name, arr in (("qdd", est.qdd), ("delta_qdd", est.delta_qdd),
-                          ("delta_qdd_companion", est.companion_delta_qdd), ("disagreement", est.disagreement)):
+                          ("delta_qdd_companion", est.companion_delta_qdd), ("disagreement", est.disagreement),
+                          ("q", est.q), ("tau", est.tau)):
             if arr is not None:
                 cols[f"{name}.{j}"] = arr[:, i]
+        if est.temperature is not None and not np.all(np.isnan(est.temperature[:, i])):
+            cols[f"temperature.{j}"] = est.temperature[:, i]
         if est.tau_f_true is not None and not np.all(np.isnan(est.tau_f_true[:, i])):
             cols[f"tau_f_true.{j}"] = est.tau_f_true[:, i]
     metadata = dict(est.metadata)
@@ -164,9 +169,9 @@ def read_friction_table(table: pa.Table, source: str = "<table>") -> FrictionEst
     The joints are those with a ``tau_f.<j>`` column; each needs ``qd.<j>`` and ``valid.<j>``,
     and the table ``time``. The other columns are optional (older tables, or tables of other
     tools): without ``phase`` every sample counts as single support; without ``unique``, the
-    single-support ones are unique; the contact flags, ``qdd``, ``delta_qdd``, the companion
-    and ``tau_f_true`` are then None. The smoother is rebuilt from the ``estimate_options``
-    metadata.
+    single-support ones are unique; the contact flags, ``qdd``, ``delta_qdd``, the companion,
+    ``tau_f_true`` and the terms' signals (``q``, ``tau``, ``temperature``) are then None. The smoother is
+    rebuilt from the ``estimate_options`` metadata.
 
     Raises:
         InputError: no joint, or a missing column (named with ``source``).
@@ -223,7 +228,9 @@ def read_friction_table(table: pa.Table, source: str = "<table>") -> FrictionEst
         tau_f_true=_optional_columns(table, "tau_f_true", joints, source), metadata=meta, smoother=smoother,
         companion_delta_qdd=_optional_columns(table, "delta_qdd_companion", joints, source),
         companion_diff=companion_diff, route=route,
-        disagreement=_optional_columns(table, "disagreement", joints, source))
+        disagreement=_optional_columns(table, "disagreement", joints, source),
+        q=_optional_columns(table, "q", joints, source), tau=_optional_columns(table, "tau", joints, source),
+        temperature=_optional_columns(table, "temperature", joints, source))
 
 
 def read_friction_file(path: str | Path) -> FrictionEstimate:
@@ -294,6 +301,8 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
     d["status"], d["status_reason"] = verdict.status, verdict.reason
     if fit.selection is not None:
         d["selection"] = selection_to_dict(fit.selection)
+    if fit.terms is not None:
+        d["terms"] = fit.terms.to_dict()
     if fit.rms_error_vs_true is not None:
         d["rms_error_vs_true"] = clean(fit.rms_error_vs_true)
         d["rms_model_vs_true"] = clean(fit.rms_model_vs_true)
@@ -343,6 +352,8 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
         res.velocity_noise = float(d.get("velocity_noise", 0.0))
         res.stick_speed = float(d.get("stick_speed", 0.0))
         res.n_stuck = int(d.get("n_stuck", 0))
+        if d.get("terms") is not None:
+            res.terms = TermFit.from_dict(d["terms"])
         if d.get("target") is not None:
             res.target = target_from_dict(d["target"])
         if "rms_error_vs_true" in d:
@@ -358,7 +369,8 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
 def energy_to_dict(energy: JointEnergy) -> dict[str, Any]:
     """The energy check of one joint (eq. 7.9) as the parameters JSON records it."""
     return {"generating_share": finite_or_none(energy.generating_share), "tau_os_removed": energy.tau_os,
-            "threshold": energy.threshold, "flagged": energy.flagged}
+            "threshold": energy.threshold, "flagged": energy.flagged,
+            **({"ripple_removed": True} if energy.ripple_removed else {})}
 
 
 def write_params(path: str | Path, fits: Iterable[FitResult], header: Mapping[str, Any] | None = None,

@@ -174,6 +174,37 @@ DEFAULT_TOLERANCE = 0.01
 """Friction torques smaller than this do not count as generating power [N·m]."""
 
 
+Term = Literal["load", "direction", "ripple", "temperature"]
+"""A term beyond velocity (module docstring)."""
+TERMS: tuple[Term, ...] = get_args(Term)
+"""Every term, in the order they are reported."""
+@dataclass(frozen=True)
+class TermOptions:
+    """Which terms are tried and how.
+
+    Attributes:
+        terms: the candidates (those whose signals are logged are tried).
+        max_harmonic: the ripple's highest harmonic tried.
+        reference_temperature: ``T_ref`` [°C]; None: the median temperature of the samples fitted.
+        tolerance: a term is kept when it lowers the held-out RMS by more than this share (the model choice's,
+            :data:`~wbfriction.friction.options.SELECTION_TOLERANCE`).
+
+    Raises:
+        OptionError: an unknown term, ``max_harmonic`` below 1 or above 20, ``tolerance`` outside (0, 1).
+    """
+
+    terms: tuple[Term, ...] = TERMS
+    max_harmonic: int = 4
+    reference_temperature: float | None = None
+    tolerance: float = SELECTION_TOLERANCE
+
+    def __post_init__(self) -> None:
+        for term in self.terms:
+            check_choice("terms", term, TERMS)
+        check_range("max_harmonic", self.max_harmonic, low=1, high=20)
+        check_range("tolerance", self.tolerance, low=0.0, high=1.0, strict=True)
+
+
 @dataclass(frozen=True)
 class FitOptions:
     """Options of the friction fit (:func:`~wbfriction.friction.fit.fit_estimate`), the same defaults as
@@ -186,6 +217,8 @@ class FitOptions:
             (dimensionless, >= 0).
         min_samples: joints with fewer valid samples get no parameters (>= 1).
         delta_s: the Stribeck exponent of (3.5) (dimensionless, > 0; the thesis's 2).
+        terms: the terms beyond velocity tried per joint (:mod:`~wbfriction.friction.terms`; by default none: the
+            velocity model alone).
 
     Raises:
         OptionError: a value not one of its choices or out of its range, named by its command-line option.
@@ -195,6 +228,7 @@ class FitOptions:
     selection_tolerance: float = SELECTION_TOLERANCE
     min_samples: int = 20
     delta_s: float = 2.0
+    terms: TermOptions = TermOptions(terms=())
 
     def __post_init__(self) -> None:
         check_choice("model", self.model, MODEL_CHOICES)

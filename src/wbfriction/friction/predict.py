@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wbfriction.friction.estimate import FrictionEstimate
+from wbfriction.friction.terms import TermFit, term_signals
 
 
 class FrictionCurve(Protocol):
@@ -44,6 +45,7 @@ class TorquePrediction:
         rms_torque: RMS of the measured torque itself [N·m] (n,), for scale.
         status: per joint, the status of the fit whose model predicts (:mod:`~wbfriction.friction.status`; "" when
             not known): a prediction by a fit that is not ``ok`` is no better than that fit.
+        terms: per joint, the terms beyond velocity its model predicted with (:mod:`~wbfriction.friction.terms`).
     """
 
     joints: tuple[str, ...]
@@ -52,6 +54,7 @@ class TorquePrediction:
     rms_rigid_body: np.ndarray
     rms_torque: np.ndarray
     status: tuple[str, ...] = ()
+    terms: tuple[tuple[str, ...], ...] = ()
 
     def overall(self, rms: np.ndarray) -> float:
         """The RMS over every joint's valid samples of one of the per-joint RMS arrays (``rms`` or
@@ -67,15 +70,21 @@ def _rms(x: np.ndarray, valid: np.ndarray) -> float:
     return float(np.sqrt(np.mean(x[valid] ** 2))) if valid.any() else float("nan")
 
 
-def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve],
-                    tau: np.ndarray | None = None) -> TorquePrediction:
+def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve | TermFit],
+                    tau: np.ndarray | None = None, source: str = "the friction table") -> TorquePrediction:
     """Torque prediction errors of a model on the valid samples of an estimate made with its inertias.
 
     Args:
         est: the friction estimate of a log, made with the model's URDF (its ``tau_f`` is
             ``M qdd + h - tau``); with a filtering scheme, the model goes through its smoother.
         friction: joint -> friction model (its ``f(qd)``), e.g. the fitted parameters of
-            :func:`~wbfriction.friction.io.read_params`; joints without one get NaN.
+            :func:`~wbfriction.friction.io.read_params`, or a model with terms beyond velocity
+            (:class:`~wbfriction.friction.terms.TermFit`: its torque on ``est``'s angles, torques and temperatures,
+            the ripple included); joints without one get NaN.
+        source: where ``est`` was read from, for the messages.
+
+    Raises:
+        InputError: a model with terms whose signals ``est`` lacks (naming the column).
         tau: the measured torques (N, n) [N·m], for :attr:`TorquePrediction.rms_torque` only
             (NaN if None).
 
@@ -89,11 +98,18 @@ def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve]
         valid = est.valid[:, i] & np.isfinite(est.tau_f[:, i])
         rigid[i] = _rms(est.tau_f[:, i], valid)
         if joint in friction:
-            model = -friction[joint].f(est.qd[:, i])
+            curve = friction[joint]
+            if isinstance(curve, TermFit):  # with its terms beyond velocity, on this log's signals
+                signals = term_signals(est, i)
+                curve.check_signals(signals, joint, source)
+                model = curve.torque(est.qd[:, i], signals)
+            else:
+                model = -curve.f(est.qd[:, i])
             if est.smoother is not None:  # the estimate is the friction seen through the filter: so is the model
                 model = est.smoother(np.where(valid, model, np.nan)[:, None])[:, 0]
                 valid &= np.isfinite(model)
             rms[i] = _rms(est.tau_f[:, i] - model, valid)
         if tau is not None:
             scale[i] = _rms(tau[:, i], valid)
-    return TorquePrediction(tuple(est.joints), samples, rms, rigid, scale)
+    terms = tuple(m.kept if isinstance(m := friction.get(j), TermFit) else () for j in est.joints)
+    return TorquePrediction(tuple(est.joints), samples, rms, rigid, scale, terms=terms)

@@ -11,7 +11,7 @@ status, the first that applies:
   result, not a bound of the search;
 * ``routes disagree`` (issue 38): the same model fitted on the other route's estimate (the acceleration
   route's for the momentum route, and the other way round) differs on F_c or F_v by more than
-  :data:`~wbfriction.friction.fit.ROUTE_Z` combined standard errors and :data:`~wbfriction.friction.fit.ROUTE_REL`
+  :data:`ROUTE_Z` combined standard errors and :data:`ROUTE_REL`
   of the value: one of them is biased, and the standard errors cannot say which; both values are given;
 * ``weak``: a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error, or a Cramér-Rao bound
   (:mod:`~wbfriction.friction.bound`: what the data allow any unbiased estimator), above :data:`WEAK` of its
@@ -27,6 +27,7 @@ The table, the parameters JSON (``status``, ``status_reason``) and the report sh
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Literal, Protocol, get_args
 
@@ -46,6 +47,21 @@ def joint_speed(qd: np.ndarray) -> float:
     Below :data:`MIN_SPEED` the joint is not excited (the fit's status, the report's joints that did not move)."""
     qd = np.asarray(qd, dtype=float)
     return float(np.percentile(np.abs(qd), 95)) if qd.size else 0.0
+ROUTE_Z = 3.0
+"""Two routes disagree on a parameter beyond this many standard errors of their difference (each route's own,
+combined as if independent: the routes share the data's noise, so the difference's is smaller and the rule errs
+towards agreement)."""
+ROUTE_REL = 0.02
+"""... and beyond this share of the parameter's value: a difference below 2 % is no bias worth a status (the
+routes' own quadratures differ by less)."""
+
+
+def routes_disagree(a: float, se_a: float, b: float, se_b: float) -> bool:
+    """Whether two routes' values of one parameter disagree: they differ by more than :data:`ROUTE_Z` combined
+    standard errors and by more than :data:`ROUTE_REL` of the larger."""
+    return abs(a - b) > ROUTE_Z * math.hypot(se_a, se_b) and abs(a - b) > ROUTE_REL * max(abs(a), abs(b))
+
+
 WEAK = 0.5
 """A user-facing parameter whose standard error exceeds this share of its value makes a fit weak."""
 READ = ("F_c", "F_v")

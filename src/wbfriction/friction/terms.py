@@ -45,21 +45,30 @@ under load or warm; ``k_Tc < 0``: less friction warm). The ripple's sign is that
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import Literal, get_args
+from typing import Any, cast
 
 import numpy as np
 
-from wbfriction.choices import check_choice, check_range
-from wbfriction.friction.models import CoulombViscousParams, FrictionParams, ModelParams, StribeckParams
-from wbfriction.friction.options import SELECTION_TOLERANCE
-from wbfriction.friction.regression import correlation_lag, held_out_split, standard_errors
-from wbfriction.friction.status import MIN_SPEED
+from wbfriction.exceptions import InputError
+from wbfriction.friction.estimated import FrictionEstimate
+from wbfriction.friction.models import (
+    CoulombViscousParams,
+    FrictionParams,
+    ModelParams,
+    StribeckParams,
+    params_from_dict,
+)
+from wbfriction.friction.options import TERMS, Term, TermOptions
+from wbfriction.friction.regression import (
+    correlation_lag,
+    covariance_errors,
+    held_out_split,
+    parameter_covariance,
+)
+from wbfriction.friction.status import MIN_SPEED, WEAK, FitVerdict, routes_disagree
 
-Term = Literal["load", "direction", "ripple", "temperature"]
-"""A term beyond velocity (module docstring)."""
-TERMS: tuple[Term, ...] = get_args(Term)
-"""Every term, in the order they are reported."""
 NOT_DISSIPATIVE: tuple[Term, ...] = ("ripple",)
 """Terms that are not friction: left out of the energy check and of the exports."""
 
@@ -85,31 +94,18 @@ class TermSignals:
         return tuple(t for t in TERMS if have[t])
 
 
-@dataclass(frozen=True)
-class TermOptions:
-    """Which terms are tried and how.
+def term_signals(est: FrictionEstimate, joint: int) -> TermSignals:
+    """The terms' signals of column ``joint`` of an estimate (its ``q``, ``tau`` as the load, ``temperature``; a
+    temperature column all NaN: not logged)."""
+    temperature = None if est.temperature is None else est.temperature[:, joint]
+    if temperature is not None and np.all(np.isnan(temperature)):
+        temperature = None
+    return TermSignals(None if est.q is None else est.q[:, joint], None if est.tau is None else est.tau[:, joint],
+                       temperature)
 
-    Attributes:
-        terms: the candidates (those whose signals are logged are tried).
-        max_harmonic: the ripple's highest harmonic tried.
-        reference_temperature: ``T_ref`` [°C]; None: the median temperature of the samples fitted.
-        tolerance: a term is kept when it lowers the held-out RMS by more than this share (the model choice's,
-            :data:`~wbfriction.friction.options.SELECTION_TOLERANCE`).
 
-    Raises:
-        OptionError: an unknown term, ``max_harmonic`` below 1 or above 20, ``tolerance`` outside (0, 1).
-    """
-
-    terms: tuple[Term, ...] = TERMS
-    max_harmonic: int = 4
-    reference_temperature: float | None = None
-    tolerance: float = SELECTION_TOLERANCE
-
-    def __post_init__(self) -> None:
-        for term in self.terms:
-            check_choice("terms", term, TERMS)
-        check_range("max_harmonic", self.max_harmonic, low=1, high=20)
-        check_range("tolerance", self.tolerance, low=0.0, high=1.0, strict=True)
+SIGNAL_COLUMNS: dict[Term, str] = {"load": "tau", "ripple": "q", "temperature": "temperature"}
+"""The friction table's column (``<name>.<joint>``) each term's signal is read from."""
 
 
 def coulomb_shape(params: ModelParams, qd: np.ndarray) -> np.ndarray:
@@ -204,6 +200,9 @@ class TermFit:
         q_range: the angles the ripple was fitted on, ``(q_min, q_max)`` [rad] (None: no ripple).
         reasons: per term tried, why it was kept or not (one sentence).
         held_out_rms: the held-out RMS [N·m] of the velocity model alone and with the terms kept.
+        check: the kept terms refitted on the other route's estimate (:func:`refit_terms`), or None.
+        at_bound: the velocity model's magnitudes held at zero in the refit (:data:`NONNEGATIVE`): with the terms,
+            the data would put them below it (standard error 0: held, not fitted).
     """
 
     params: ModelParams
@@ -216,6 +215,94 @@ class TermFit:
     q_range: tuple[float, float] | None = None
     reasons: dict[str, str] = field(default_factory=dict)
     held_out_rms: tuple[float, float] = (float("nan"), float("nan"))
+    check: TermCheck | None = None
+    at_bound: tuple[str, ...] = ()
+
+    def verdicts(self) -> dict[Term, FitVerdict]:
+        """Per kept term, whether its numbers can be used (``ok``, ``weak``, ``routes disagree``) and why.
+
+        * ``routes disagree``: the other route's estimate gives one of its coefficients (the ripple: its size,
+          :func:`ripple_size`) more than :data:`~wbfriction.friction.status.ROUTE_Z` combined standard errors and
+          :data:`~wbfriction.friction.status.ROUTE_REL` away (:attr:`check`);
+        * ``weak``: a coefficient's (the ripple's size's) standard error above
+          :data:`~wbfriction.friction.status.WEAK` of its value;
+        * ``ok``: neither.
+        """
+        out: dict[Term, FitVerdict] = {}
+        for term in self.kept:
+            mine = self._read(term, self.coefficients, self.stderr)
+            check = self.check
+            theirs = {} if check is None else self._read(term, check.coefficients, check.stderr)
+            off = [f"{n} {v:.3g} ±{se:.2g} against {theirs[n][0]:.3g} ±{theirs[n][1]:.2g} ({check.route})"
+                   for n, (v, se) in mine.items() if check is not None and n in theirs
+                   and routes_disagree(v, se, *theirs[n])]
+            weak = [f"{n} {v:.3g} ±{se:.2g}" for n, (v, se) in mine.items() if not se <= WEAK * abs(v)]
+            out[term] = (FitVerdict("routes disagree", "; ".join(off)) if off
+                         else FitVerdict("weak", "large standard errors: " + ", ".join(weak)) if weak
+                         else FitVerdict("ok"))
+        return out
+
+    def _read(self, term: Term, c: Mapping[str, float], se: Mapping[str, float]) -> dict[str, tuple[float, float]]:
+        """The values a status judges of ``term`` (name -> value, standard error): its coefficients, the ripple's
+        size (:func:`ripple_size`)."""
+        return {n: (c[n], se.get(n, math.inf)) for n in TERM_COEFFICIENTS[term] if n in c}
+
+    def to_dict(self) -> dict[str, Any]:
+        """As the parameters JSON holds it (a value that is not finite: ``null``), with each term's status."""
+        clean = _finite_or_none
+        verdicts = self.verdicts()
+        return {"kept": list(self.kept), "harmonics": self.harmonics, "model": self.params.model,
+                "params": self.params.to_dict(), "coefficients": dict(self.coefficients),
+                "stderr": {k: clean(v) for k, v in self.stderr.items()},
+                "derived": {k: clean(v) for k, v in self.derived.items()},
+                "reference_temperature": self.reference_temperature,
+                "q_range": None if self.q_range is None else list(self.q_range), "reasons": dict(self.reasons),
+                "held_out_rms": [clean(x) for x in self.held_out_rms],
+                "check": None if self.check is None else self.check.to_dict(), "at_bound": list(self.at_bound),
+                "status": {t: v.status for t, v in verdicts.items()},
+                "status_reason": {t: v.reason for t, v in verdicts.items() if v.reason}}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> TermFit:
+        """Inverse of :meth:`to_dict` (``null`` reads back as ``inf`` for a standard error, NaN otherwise; the
+        statuses follow from the rest).
+
+        Raises:
+            InputError: a missing key, an unknown term or model, a value of the wrong kind (named).
+        """
+        try:
+            kept = tuple(check_term(str(t)) for t in d["kept"])
+            rng = d.get("q_range")
+            check = d.get("check")
+            t_ref = d.get("reference_temperature")
+            return cls(params_from_dict(str(d["model"]), d["params"]), kept, int(d.get("harmonics", 0)),
+                       {str(k): float(v) for k, v in d["coefficients"].items()},
+                       {str(k): math.inf if v is None else float(v) for k, v in (d.get("stderr") or {}).items()},
+                       {str(k): _number(v) for k, v in (d.get("derived") or {}).items()},
+                       None if t_ref is None else float(t_ref),
+                       None if rng is None else (float(rng[0]), float(rng[1])),
+                       {str(k): str(v) for k, v in (d.get("reasons") or {}).items()},
+                       tuple(_number(x) for x in d.get("held_out_rms", (None, None))),  # type: ignore[arg-type]
+                       None if check is None else TermCheck.from_dict(check),
+                       tuple(str(n) for n in d.get("at_bound", ())))
+        except KeyError as exc:
+            raise InputError(f"terms: missing key {exc}") from None
+        except (TypeError, ValueError, AttributeError, IndexError) as exc:
+            raise InputError(f"terms: {exc}") from None
+
+    def check_signals(self, signals: TermSignals, joint: str, source: str) -> None:
+        """Refuse signals that lack one a kept term needs (a friction table of an earlier version, a log without
+        the joint's temperature).
+
+        Raises:
+            InputError: naming ``source``, the column and the term.
+        """
+        have = signals.logged()
+        for term in self.kept:
+            if term not in have:
+                column = f"{SIGNAL_COLUMNS[term]}.{joint}"
+                raise InputError(f"{source}: no column '{column}': the fit's {term} term needs it (estimate the "
+                                 "log again with this version; a temperature term needs the log's temperature)")
 
     def friction(self, qd: np.ndarray, signals: TermSignals) -> np.ndarray:
         """The dissipative part ``f`` [N·m] (N,): the velocity model and every kept term but the ripple."""
@@ -259,6 +346,54 @@ class TermFit:
                                   reference_temperature=self.reference_temperature or 0.0)
             f = f + X @ np.array([self.coefficients[n] for n in names])
         return f
+
+
+TERM_COEFFICIENTS: dict[Term, tuple[str, ...]] = {"load": ("F_L",), "direction": ("dF_v",),
+                                                   "temperature": ("F_cT", "F_vT"), "ripple": ("ripple_rms",)}
+"""Each term's values a status judges: its coefficients; for the ripple, its size (:func:`ripple_size`; its
+coefficients are ``ripple_sin<h>``, ``ripple_cos<h>`` for ``h = 1..H``)."""
+
+
+def check_term(term: str) -> Term:
+    """``term`` if it is one of :data:`TERMS`.
+
+    Raises:
+        ValueError: another name, with the choices.
+    """
+    if term not in TERMS:
+        raise ValueError(f"unknown term {term!r}: choose among {', '.join(TERMS)}")
+    return cast(Term, term)
+
+
+def _finite_or_none(x: float | None) -> float | None:
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def _number(x: Any) -> float:
+    return float("nan") if x is None else float(x)
+
+
+@dataclass(frozen=True)
+class TermCheck:
+    """The kept terms refitted on the other route's estimate (issue 38's check, for the terms).
+
+    Attributes:
+        route: that route (``acceleration`` or ``momentum``).
+        coefficients, stderr: its term coefficients and their standard errors, by name.
+    """
+
+    route: str
+    coefficients: dict[str, float]
+    stderr: dict[str, float]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"route": self.route, "coefficients": dict(self.coefficients),
+                "stderr": {k: _finite_or_none(v) for k, v in self.stderr.items()}}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> TermCheck:
+        return cls(str(d["route"]), {str(k): float(v) for k, v in d["coefficients"].items()},
+                   {str(k): math.inf if v is None else float(v) for k, v in (d.get("stderr") or {}).items()})
 
 
 def _design(params: ModelParams, qd: np.ndarray, signals: TermSignals, terms: tuple[Term, ...], harmonics: int,
@@ -420,7 +555,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     reasons: dict[str, str] = {}
     while True:  # a friction term that makes the friction generate power (eq. 7.9) on the samples is not friction
         names, X, k = design(tuple(kept), harmonics)
-        coef = _solve(X[use], y_[use])
+        coef, _ = _nonnegative_solve(X[use], y_[use], names)
         bad = _unphysical(with_coefficients(params, coef[:k]), dict(zip(names[k:], map(float, coef[k:]))), signals,
                           use, t_ref or 0.0)
         if bad is None:
@@ -450,22 +585,95 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     if not kept_sorted:
         return TermFit(params, reference_temperature=t_ref, reasons=reasons, held_out_rms=(base_rms, base_rms))
     names, X, k = design(kept_sorted, harmonics)
-    coef = _solve(X[use], y_[use])
-    residual = y_[use] - X[use] @ coef
-    rows_used = np.flatnonzero(use)  # residuals correlated over a filter's window: Newey-West, as the fit's
-    errors = standard_errors(X[use], residual, rows=rows_used, max_lag=correlation_lag(residual, rows_used))
+    coef, cov, held = _final(X, y_, use, names)
     refitted = with_coefficients(params, coef[:k])
     coefficients = dict(zip(names[k:], map(float, coef[k:])))
-    stderr = dict(zip(names, map(float, errors)))
+    stderr = dict(zip(names, map(float, covariance_errors(cov))))
     q_range = None
     derived = _derived(refitted, coefficients)
     if "ripple" in kept_sorted and signals.q is not None:
         q_used = np.asarray(signals.q, dtype=float)[use]
         q_range = (float(q_used.min()), float(q_used.max()))
-        ripple = fourier(q_used, harmonics) @ np.array([coefficients[n] for n in names if n.startswith("ripple")])
-        derived["ripple_rms"] = float(np.std(ripple))  # its size where it was fitted (harmonics may cancel)
+        derived["ripple_rms"], stderr["ripple_rms"] = ripple_size(q_used, harmonics, names, coef, cov)
     return TermFit(refitted, kept_sorted, harmonics, coefficients, stderr, derived, t_ref, q_range, reasons,
-                   (base_rms, current))
+                   (base_rms, current), at_bound=held)
+
+
+NONNEGATIVE = ("F_v", "F_c", "F_cS")
+"""The velocity model's linear coefficients that are magnitudes (the fit's bounds): refitted with the terms, one
+that would go below zero is held at zero (:attr:`TermFit.at_bound`)."""
+
+
+def _nonnegative_solve(X: np.ndarray, y: np.ndarray, names: tuple[str, ...]) -> tuple[np.ndarray, tuple[str, ...]]:
+    """Least squares with the :data:`NONNEGATIVE` coefficients at zero where they would go below: the most negative
+    held at zero and the rest refitted, until none is; and the names held."""
+    free = np.ones(len(names), dtype=bool)
+    while True:
+        coef = np.zeros(len(names))
+        coef[free] = _solve(X[:, free], y)
+        negative = [i for i, n in enumerate(names) if n in NONNEGATIVE and free[i] and coef[i] < 0]
+        if not negative:
+            return coef, tuple(n for n, f in zip(names, free) if not f)
+        free[min(negative, key=lambda i: coef[i])] = False
+
+
+def _final(X: np.ndarray, y: np.ndarray, use: np.ndarray,
+           names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
+    """The coefficients on every sample ``use`` (:func:`_nonnegative_solve`), their covariance (residuals correlated
+    over a filter's window: Newey-West, as the fit's; zero for one held at zero) and the names held."""
+    coef, held = _nonnegative_solve(X[use], y[use], names)
+    free = np.array([n not in held for n in names])
+    residual = y[use] - X[use] @ coef
+    rows = np.flatnonzero(use)
+    cov = np.zeros((len(names), len(names)))
+    cov[np.ix_(free, free)] = parameter_covariance(X[use][:, free], residual, rows=rows,
+                                                   max_lag=correlation_lag(residual, rows))
+    return coef, cov, held
+
+
+def ripple_size(q: np.ndarray, harmonics: int, names: tuple[str, ...], coef: np.ndarray,
+                cov: np.ndarray) -> tuple[float, float]:
+    """The ripple's standard deviation over the angles ``q`` it was fitted on [N·m], and its standard error (the
+    delta method through the coefficients' covariance): a size its harmonics, correlated over part of a turn, do not
+    blur as their amplitudes' errors do."""
+    at = [names.index(f"ripple_{f}{h}") for h in range(1, harmonics + 1) for f in ("sin", "cos")]
+    F = fourier(q, harmonics)
+    ripple = F @ coef[at]
+    size = float(np.std(ripple))
+    if size == 0.0:
+        return 0.0, math.inf
+    gradient = (F - F.mean(axis=0)).T @ (ripple - ripple.mean()) / (len(q) * size)
+    variance = float(gradient @ cov[np.ix_(at, at)] @ gradient)
+    return size, math.sqrt(max(variance, 0.0)) if np.isfinite(variance) else math.inf
+
+
+def refit_terms(fit: TermFit, params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.ndarray,
+                signals: TermSignals, route: str, smoother=None) -> TermCheck | None:
+    """The terms ``fit`` kept, with its harmonics and reference temperature, fitted with the velocity model
+    ``params`` (the other route's fit of the same joint) on another estimate of the same samples: what
+    :attr:`TermFit.check` compares. Arguments as :func:`fit_terms`'s; None when no term is kept or no sample is
+    left."""
+    if not fit.kept:
+        return None
+    qd = np.asarray(qd, dtype=float)
+    y = -np.asarray(tau_f, dtype=float)
+    use = np.asarray(use, dtype=bool) & np.isfinite(qd) & np.isfinite(y)
+    for sig in (signals.q, signals.tau_load, signals.temperature):
+        if sig is not None:
+            use &= np.isfinite(sig)
+    qd_ = qd if smoother is not None else np.where(use, qd, 0.0)
+    names, X, k = _design(params, qd_, signals, fit.kept, fit.harmonics, fit.reference_temperature or 0.0,
+                          smoother)
+    use &= np.isfinite(X).all(axis=1)
+    if use.sum() <= X.shape[1]:
+        return None
+    coef, cov, _ = _final(X, np.where(use, y, 0.0), use, names)
+    coefficients = dict(zip(names[k:], map(float, coef[k:])))
+    stderr = dict(zip(names[k:], map(float, covariance_errors(cov)[k:])))
+    if "ripple" in fit.kept and signals.q is not None:
+        coefficients["ripple_rms"], stderr["ripple_rms"] = ripple_size(np.asarray(signals.q, dtype=float)[use],
+                                                                      fit.harmonics, names, coef, cov)
+    return TermCheck(route, coefficients, stderr)
 
 
 def _unphysical(params: ModelParams, c: dict[str, float], signals: TermSignals, use: np.ndarray,

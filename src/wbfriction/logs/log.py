@@ -19,6 +19,9 @@ column                 unit        content
                                    with ``--velocity logged``)
 ``base.x`` ... ``base.qw``  m, -   optional world pose of the root (unit quaternion
                                    x, y, z, w)
+``temperature.<joint>`` °C         optional motor or gear temperature of a
+                                   torque-controlled joint (friction's temperature
+                                   term, :mod:`wbfriction.friction.terms`)
 ``tau_f_true.<joint>`` N·m         optional true friction (simulations only; never
                                    used by the estimator)
 ``qd_true.<joint>``    rad/s       optional true velocity of every actuated joint
@@ -92,6 +95,8 @@ class Log:
             :mod:`wbfriction.model.force_torque`), or None if not logged.
         imu: the IMU's readings (N, 6): angular velocity [rad/s] and specific force [m/s^2] in its frame
             (columns ``imu.gyro_x`` ... ``imu.acc_z``, :mod:`wbfriction.model.imu`), or None.
+        temperature: the torque-controlled joints' temperatures (N, n_tc) [°C] (``temperature.<joint>`` columns),
+            NaN for a joint not logged, or None if no such column.
         base_qd_true, base_qdd_true: the base's true twist and its derivative (N, 6) in the base
             frame (Pinocchio's free-flyer ``v[:6]`` and ``a[:6]``, simulations only), or None.
         clock: what wrote the stamps and the time base derivatives are taken on
@@ -121,6 +126,7 @@ class Log:
     base_qd_true: np.ndarray | None = None
     base_qdd_true: np.ndarray | None = None
     imu: np.ndarray | None = None
+    temperature: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.segments is None and self.clock is not None and len(self.clock.segments) > 1:
@@ -149,7 +155,8 @@ class Log:
                    cut(self.qdd_true), None, self.dt, cut(self.qd_logged), self.torque_source,
                    clock=None if self.clock is None else self.clock.rows(start, stop), warnings=self.warnings,
                    wrench=cut(self.wrench), base_qd_true=cut(self.base_qd_true),
-                   base_qdd_true=cut(self.base_qdd_true), imu=cut(self.imu))
+                   base_qdd_true=cut(self.base_qdd_true), imu=cut(self.imu),
+                   temperature=cut(self.temperature))
 
     def __len__(self) -> int:
         return len(self.time)
@@ -173,9 +180,10 @@ class Log:
         if self.wrench is not None:
             cols.update({c: self.wrench[:, s, i] for s, sensor in enumerate(robot.ft_sensors)
                          for i, c in enumerate(sensor.columns())})
-        if self.tau_f_true is not None:
-            cols.update({f"tau_f_true.{n}": self.tau_f_true[:, i] for i, n in enumerate(robot.torque_controlled)
-                         if not np.all(np.isnan(self.tau_f_true[:, i]))})
+        for prefix, x in (("tau_f_true", self.tau_f_true), ("temperature", self.temperature)):
+            if x is not None:
+                cols.update({f"{prefix}.{n}": x[:, i] for i, n in enumerate(robot.torque_controlled)
+                             if not np.all(np.isnan(x[:, i]))})
         for prefix, x in (("qd", self.qd_logged), ("qd_true", self.qd_true), ("qdd_true", self.qdd_true)):
             if x is not None:
                 cols.update({f"{prefix}.{n}": x[:, i] for i, n in enumerate(robot.actuated)})
@@ -284,7 +292,8 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
     wrench = _read_wrench(table, robot, source, first_row)
     contact = _read_contact(table, robot, source, first_row, wrench)
     base = _read_base(table, source, first_row)
-    tau_f_true = _read_tau_f_true(table, robot, len(time), source, first_row)
+    tau_f_true = _read_per_joint(table, "tau_f_true", robot, len(time), source, first_row)
+    temperature = _read_per_joint(table, "temperature", robot, len(time), source, first_row)
     qd_true = _read_true_rates(table, "qd_true", robot, source, first_row)
     qdd_true = _read_true_rates(table, "qdd_true", robot, source, first_row)
     qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
@@ -294,11 +303,11 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
     return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
                qd_true=qd_true, qdd_true=qdd_true, segments=clock.segments, period=period, qd_logged=qd_logged,
                torque_source=torque_source, clock=clock, warnings=warnings, wrench=wrench,
-               base_qd_true=base_qd_true, base_qdd_true=base_qdd_true, imu=imu)
+               base_qd_true=base_qd_true, base_qdd_true=base_qdd_true, imu=imu, temperature=temperature)
 
 
 NUMERIC_PREFIXES = ("q", "tau", "current", "qd", "qd_true", "qdd_true", "tau_f_true", "base", "wrench",
-                    "base_qd_true", "base_qdd_true", "imu")
+                    "base_qd_true", "base_qdd_true", "imu", "temperature")
 """Column prefixes whose values must be numbers."""
 
 
@@ -328,7 +337,7 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
     wrenches = {c.partition(".")[2] for s in robot.ft_sensors for c in s.columns()}
     for col in names:
         prefix, _, item = col.partition(".")
-        known = {"q": act, "tau": act, "tau_f_true": tc, "contact": frames, "qd_true": act,
+        known = {"q": act, "tau": act, "tau_f_true": tc, "temperature": tc, "contact": frames, "qd_true": act,
                  "qdd_true": act, "qd": act, "current": act, "wrench": wrenches,
                  "imu": {c.partition(".")[2] for c in IMU_COLUMNS}}.get(prefix)
         if known is not None and item not in known:
@@ -488,13 +497,15 @@ def _read_base(table: pa.Table, source: str, first_row: int) -> np.ndarray | Non
     return base
 
 
-def _read_tau_f_true(table: pa.Table, robot: Robot, rows: int, source: str, first_row: int) -> np.ndarray | None:
-    """The true friction (N, n_tc) [N·m], NaN for joints not logged, or None if no such column."""
+def _read_per_joint(table: pa.Table, prefix: str, robot: Robot, rows: int, source: str,
+                    first_row: int) -> np.ndarray | None:
+    """The ``<prefix>.<joint>`` columns of the torque-controlled joints (N, n_tc) (the true friction [N·m], the
+    temperature [°C]), NaN for joints not logged, or None if no such column."""
     names = set(table.column_names)
-    if not any(c.startswith("tau_f_true.") for c in names):
+    if not any(c.startswith(prefix + ".") for c in names):
         return None
     return np.column_stack([
-        numeric_column(table, f"tau_f_true.{n}", source, first_row) if f"tau_f_true.{n}" in names
+        numeric_column(table, f"{prefix}.{n}", source, first_row) if f"{prefix}.{n}" in names
         else np.full(rows, np.nan)
         for n in robot.torque_controlled])
 

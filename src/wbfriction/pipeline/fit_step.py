@@ -8,7 +8,7 @@ from pathlib import Path
 from wbfriction.exceptions import InputError
 from wbfriction.friction.energy import JointEnergy, energy_consistency
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
+from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets, fitted_ripples
 from wbfriction.friction.io import SIGN_CONVENTION, energy_to_dict, read_friction_file, write_params
 from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions
 from wbfriction.pipeline.provenance import file_provenance
@@ -35,7 +35,8 @@ def fit_table(friction: str | Path, options: FitOptions = FitOptions(), *, thres
     if not any(f.params is not None for f in fits):
         raise InputError(f"{friction}: no joint could be fitted (each has fewer than --min-samples "
                          f"{options.min_samples} valid samples); nothing written")
-    return FittedFile(fits, energy_consistency(est, fitted_offsets(fits), threshold, tolerance), est)
+    return FittedFile(fits, energy_consistency(est, fitted_offsets(fits), threshold, tolerance,
+                                               fitted_ripples(est, fits)), est)
 
 
 def fit_file(friction: str | Path, output: str | Path, options: FitOptions = FitOptions(), *,

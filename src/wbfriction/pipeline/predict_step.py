@@ -18,7 +18,7 @@ def predict_file(friction: str | Path, params: str | Path) -> TorquePrediction:
         friction: a friction table (``wbfriction estimate`` of the held-out log, with the URDF
             whose inertias are tested).
         params: the parameters JSON (``wbfriction fit`` of the training logs' table, estimated
-            with the same URDF).
+            with the same URDF); a joint's terms beyond velocity, where kept, predict with it (ripple included).
 
     Raises:
         InputError: what reading either file raises; parameters for another robot or none of
@@ -27,6 +27,8 @@ def predict_file(friction: str | Path, params: str | Path) -> TorquePrediction:
     fits = read_params(params)
     est = read_friction_file(friction)
     check_params_source(params, est)
-    pred = predict_torques(est, {j: f.params for j, f in fits.items() if f.params is not None})
+    models = {j: f.terms if f.terms is not None and f.terms.kept else f.params for j, f in fits.items()
+              if f.params is not None}
+    pred = predict_torques(est, models, source=str(friction))
     status = tuple(fits[j].verdict().status if j in fits else "" for j in pred.joints)
     return dataclasses.replace(pred, status=status)

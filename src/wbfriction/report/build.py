@@ -31,7 +31,7 @@ import numpy as np
 
 from wbfriction.friction.energy import JointEnergy, energy_consistency
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
+from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets, fitted_ripples
 from wbfriction.friction.io import check_params_source, read_friction_file, read_params
 from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
 from wbfriction.friction.status import MIN_SPEED, joint_speed
@@ -138,7 +138,8 @@ def make_report(friction: str | Path, params: str | Path | None = None,
         check_params_source(params, est, friction)
     else:
         fits = {f.joint: f for f in fit_estimate(est, workers=workers)}
-    energy = {e.joint: e for e in energy_consistency(est, fitted_offsets(fits.values()), threshold, tolerance)}
+    energy = {e.joint: e for e in energy_consistency(est, fitted_offsets(fits.values()), threshold, tolerance,
+                                                         fitted_ripples(est, fits.values(), str(friction)))}
     meta = est.metadata
     prov: list[tuple[str, str]] = [("friction table", f"{friction} (sha256 {file_sha256(friction)})")]
     if params is not None:

@@ -81,7 +81,65 @@ def fit_tables(results: Sequence[FitResult], wide: bool = False,
             cells = [f"{err[n]:.2f}" if n in err else "" for n in (*MAIN, *OTHERS)]
             table.add_row(label(r.joint), r.model, *cells, rms, style=None if r.verdict().ok else "dim")
         tables.append(table)
-    return [t for t in tables if t.row_count]
+    terms = terms_table(results, label)
+    return [t for t in [*tables, terms] if t is not None and t.row_count]
+
+
+TERM_COLUMNS = ("F_L", "dF_v", "F_cT", "F_vT", "ripple_rms")
+"""The term coefficients the terms' table shows (value ± standard error), those of a term some joint kept."""
+
+
+def terms_table(results: Sequence[FitResult], label: Callable[[str], str] = str) -> Table | None:
+    """The terms beyond velocity (:mod:`~wbfriction.friction.terms`) of the joints whose fit kept some: the terms
+    kept, their worst status (:meth:`~wbfriction.friction.terms.TermFit.verdicts`), F_c and F_v refitted with them
+    (at zero load and the reference temperature), and each kept coefficient ± its standard error; None when no fit
+    kept one."""
+    tried = [r for r in results if r.terms is not None and r.terms.kept]
+    if not tried:
+        return None
+    columns = [n for n in TERM_COLUMNS if any(n in r.terms.coefficients or n in r.terms.derived for r in tried
+                                              if r.terms is not None)]
+    t_ref = next((r.terms.reference_temperature for r in tried if r.terms is not None
+                  and "temperature" in r.terms.kept), None)
+    at = "zero load" + (f", T_ref {t_ref:.3g} °C" if t_ref is not None else "")
+    table = _table(f"Terms beyond velocity (F_c, F_v at {at})", ("joint", "terms", "status"), [*MAIN, *columns],
+                   caption="ripple_rms: the position ripple's size [N·m] (H harmonics), not friction: left out of "
+                           "the energy check and the exports")
+    order = ("routes disagree", "weak", "ok")
+    for r in tried:
+        terms = r.terms
+        assert terms is not None
+        verdicts = terms.verdicts()
+        status = min((v.status for v in verdicts.values()), key=order.index)
+        values = {**terms.coefficients, **terms.derived, **terms.params.to_dict()}
+        cells = ["" if not terms.kept or n not in terms.stderr else
+                 with_error(values[n], terms.stderr[n]) + (" (b)" if n in terms.at_bound else "")
+                 for n in (*MAIN, *columns)]
+        if "ripple" in terms.kept:
+            cells[-1] += f" (H {terms.harmonics})"
+        table.add_row(label(r.joint), ", ".join(terms.kept), status, *cells, style=None if status == "ok" else "dim")
+    return table
+
+
+def terms_notes(results: Sequence[FitResult], verbose: bool = False,
+                labels: Mapping[str, str] | None = None) -> list[str]:
+    """Why each term was kept or not: every joint's reasons with ``verbose``, else each term that is not ``ok``
+    with its reason and one line on where the reasons are."""
+    label = _labeller(labels)
+    lines = []
+    for r in results:
+        if r.terms is None:
+            continue
+        for term, verdict in r.terms.verdicts().items():
+            if not verdict.ok:
+                lines.append(f"{label(r.joint)}: {term} {verdict}")
+        if verbose:
+            lines += [f"{label(r.joint)}: {term} {why}" for term, why in r.terms.reasons.items()]
+    none = [label(r.joint) for r in results if r.terms is not None and not r.terms.kept]
+    if none and not verbose:
+        lines.append(f"no term beyond velocity kept on {len(none)} joint{'s' if len(none) > 1 else ''} "
+                     f"({_joints(none)}): held-out samples do not improve; --verbose gives each joint's reasons")
+    return lines
 
 
 def _rows(table: Table, results: Sequence[FitResult], names: Sequence[str], label: Callable[[str], str],
