@@ -96,3 +96,34 @@ def test_rotational_inertia_error_makes_friction_generate_power(talos, combined_
     assert any(after[j].flagged for j in legs)
     flagged = [after[j] for j in legs if after[j].flagged]
     assert "generates power" in flagged[0].warning()
+
+
+@given(st.floats(0.05, 0.2), st.floats(0.1, 1.0), st.floats(1.5, 4.0), st.integers(0, 2**16))
+@settings(max_examples=25, deadline=None)
+def test_a_ripple_is_left_out_of_the_check(viscous_ratio, F_c, ripple_ratio, seed):
+    """Dissipative friction (``F_v = viscous_ratio F_c`` at speeds up to 1.6 rad/s) plus a position ripple larger
+    than it (``ripple_ratio`` times F_c): with the ripple in,
+    the friction "generates power" on many samples; with the fitted ripple taken out (:func:`fitted_ripples`, the
+    ripple the fit kept), on none: the check of eq. 7.9 judges friction, not a torque of the angle."""
+    from wbfriction.friction.estimated import FrictionEstimate
+    from wbfriction.friction.fit import FitResult, fitted_ripples
+    from wbfriction.friction.models import CoulombViscousParams
+    from wbfriction.friction.terms import TermFit
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 20.0, 1e-3)
+    w, phase = rng.uniform(0.3, 0.8), rng.uniform(0, 2 * np.pi)
+    q = 2.0 * np.sin(w * t + phase)
+    qd = 2.0 * w * np.cos(w * t + phase)
+    params = CoulombViscousParams(F_v=viscous_ratio * F_c, F_c=F_c)
+    c = {"ripple_sin1": ripple_ratio * F_c, "ripple_cos1": 0.0}
+    terms = TermFit(params, ("ripple",), 1, c, {"ripple_sin1": 0.0, "ripple_cos1": 0.0})
+    tau_f = -(params.f(qd) + ripple_ratio * F_c * np.sin(q))
+    n = len(t)
+    est = FrictionEstimate(("j",), t, qd[:, None], tau_f[:, None], np.ones((n, 1), bool), np.full(n, "single"),
+                           np.ones(n, bool), np.zeros((n, 0), bool), (), q=q[:, None])
+    fit = FitResult("j", n, params, terms=terms)
+    with_ripple = energy_consistency(est, {"j": 0.0})[0]
+    without = energy_consistency(est, {"j": 0.0}, ripple=fitted_ripples(est, [fit]))[0]
+    assert with_ripple.generating_share > 0.05 and not with_ripple.ripple_removed
+    assert without.generating_share == 0.0 and without.ripple_removed

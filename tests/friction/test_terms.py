@@ -3,16 +3,19 @@ differences), and on simulated joints with known terms, each coefficient recover
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from wbfriction.exceptions import OptionError
+from wbfriction.exceptions import InputError, OptionError
 from wbfriction.friction.fit import fit_friction
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams
 from wbfriction.friction.terms import (
     TERMS,
+    TermCheck,
     TermFit,
     TermOptions,
     TermSignals,
@@ -184,3 +187,75 @@ def test_options_are_checked_where_they_are_defined():
         TermOptions(terms=("wear",))  # type: ignore[arg-type]
     with pytest.raises(OptionError, match="--max-harmonic"):
         TermOptions(max_harmonic=0)
+
+
+def test_a_fit_reads_back_as_written():
+    """The parameters JSON's ``terms`` (:meth:`TermFit.to_dict`) through JSON text and back: the same fit, and the
+    same statuses."""
+    import json
+
+    qd, tau_f, s = joint(1, ("load", "ripple", "temperature"))
+    use = np.abs(qd) > 0.02
+    base = fit_friction(qd, tau_f, model="coulomb-viscous", mask=use)
+    fit = fit_terms(base.params, qd, tau_f, use, s, TermOptions(reference_temperature=T_REF))
+    back = TermFit.from_dict(json.loads(json.dumps(fit.to_dict())))
+    assert back == fit and back.verdicts() == fit.verdicts()
+    assert fit.to_dict()["status"] == {"load": "ok", "ripple": "ok", "temperature": "ok"}
+    with pytest.raises(InputError, match="unknown term 'wear'"):
+        TermFit.from_dict({**fit.to_dict(), "kept": ["wear"]})
+    with pytest.raises(InputError, match="missing key 'coefficients'"):
+        TermFit.from_dict({k: v for k, v in fit.to_dict().items() if k != "coefficients"})
+
+
+def test_statuses_say_what_the_data_do_not_carry():
+    """A coefficient whose standard error passes half its value is weak; the other route's value beyond three
+    combined standard errors (and 2 %) makes the term's routes disagree, naming both values."""
+    fit = TermFit(CoulombViscousParams(F_v=0.2, F_c=1.0), ("load", "direction"), 0, {"F_L": 0.02, "dF_v": 0.04},
+                  {"F_L": 0.001, "dF_v": 0.03})
+    assert fit.verdicts()["load"].ok
+    assert fit.verdicts()["direction"].status == "weak" and "dF_v" in fit.verdicts()["direction"].reason
+    other = TermCheck("momentum", {"F_L": 0.03, "dF_v": 0.04}, {"F_L": 0.001, "dF_v": 0.03})
+    off = replace(fit, check=other).verdicts()["load"]
+    assert off.status == "routes disagree" and "0.02" in off.reason and "0.03" in off.reason
+    assert "momentum" in off.reason
+    near = TermCheck("momentum", {"F_L": 0.0202, "dF_v": 0.04}, {"F_L": 0.001, "dF_v": 0.03})
+    assert replace(fit, check=near).verdicts()["load"].ok
+
+
+def test_the_ripples_size_has_the_spread_of_its_repeats():
+    """The ripple's size and its standard error (:func:`ripple_size`, the delta method through the coefficients'
+    covariance): over 40 noise draws of one joint whose angles span less than a turn, the sizes' spread is within
+    35 % of the standard error each draw states (white torque noise, so the Newey-West sum adds little)."""
+    from wbfriction.friction.terms import ripple_size
+
+    _, qd, s = trajectory(3, 20.0)
+    assert s.q is not None
+    truth = physical_f(TRUTH, qd, s, ("ripple",), **PHYSICAL)
+    X = np.column_stack([velocity_basis(TRUTH, qd)[1], term_basis("ripple", TRUTH, qd, s, harmonics=2)[1]])
+    names = ("F_v", "F_c", "tau_os", "ripple_sin1", "ripple_cos1", "ripple_sin2", "ripple_cos2")
+    from wbfriction.friction.regression import parameter_covariance
+
+    sizes, errors = [], []
+    rng = np.random.default_rng(0)
+    for _ in range(40):
+        y = truth + 0.3 * rng.standard_normal(qd.size)
+        coef = np.linalg.lstsq(X, y, rcond=None)[0]
+        size, se = ripple_size(s.q, 2, names, coef, parameter_covariance(X, y - X @ coef))
+        sizes.append(size)
+        errors.append(se)
+    assert np.std(sizes) == pytest.approx(np.mean(errors), rel=0.35)
+    assert np.mean(sizes) == pytest.approx(np.std(truth - physical_f(TRUTH, qd, s, ())), rel=0.05)
+
+
+def test_a_magnitude_the_terms_would_drive_negative_is_held_at_zero():
+    """A joint whose estimate has a negative viscous slope (an inertia error, say) and a ripple: the velocity fit
+    puts F_v at its bound of zero; refitted with the ripple, F_v is held there (``at_bound``, standard error 0), not
+    printed below zero as a friction that generates power."""
+    qd, tau_f, s = joint(2, ("ripple",))
+    tau_f = tau_f + (TRUTH.F_v + 0.15) * qd  # f's viscous slope: 0.2 - 0.35 = -0.15 N·m s/rad
+    use = np.abs(qd) > 0.02
+    base = fit_friction(qd, tau_f, model="coulomb-viscous", mask=use)
+    assert base.params is not None and base.params.F_v == pytest.approx(0.0, abs=1e-9)
+    fit = fit_terms(base.params, qd, tau_f, use, s)
+    assert fit.kept == ("ripple",) and fit.params.F_v == 0.0
+    assert fit.at_bound == ("F_v",) and fit.stderr["F_v"] == 0.0 and fit.stderr["F_c"] > 0.0

@@ -13,7 +13,7 @@ from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.fit import fit_friction
 from wbfriction.friction.models import CoulombViscousParams
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.friction.terms import TermFit, TermOptions, TermSignals, fit_terms
+from wbfriction.friction.terms import TermFit, TermOptions, fit_terms, term_signals
 from wbfriction.logs.log import log_from_table
 from wbfriction.sim.arm import ArmOptions, simulate_arm
 
@@ -48,8 +48,7 @@ def run(seed: int, noisy: bool = False) -> dict[str, TermFit]:
     out = {}
     for i, joint in enumerate(est.joints):
         use = est.valid[:, i] & np.isfinite(est.tau_f[:, i]) & (np.abs(est.qd[:, i]) > 0.02)
-        signals = TermSignals(q=sim.table.column(f"q.{joint}").to_numpy(), tau_load=sim.tau_motor[:, i],
-                              temperature=sim.table.column(f"temperature.{joint}").to_numpy())
+        signals = term_signals(est, i)  # the log's angles and temperatures, the model's rigid-body torque
         base = fit_friction(est.qd[:, i], est.tau_f[:, i], model="coulomb-viscous", mask=use, smoother=est.smoother)
         assert base.params is not None
         out[joint] = fit_terms(base.params, est.qd[:, i], est.tau_f[:, i], use, signals,

@@ -79,7 +79,7 @@ class TermSignals:
 
     Attributes:
         q: joint angle (N,) [rad] (``ripple``).
-        tau_load: the joint's rigid-body torque (N,) [N·m] (``load``).
+        tau_load: the joint's rigid-body torque ``M qdd + h`` (N,) [N·m] (``load``).
         temperature: the joint's motor or gear temperature (N,) [°C] (``temperature``).
     """
 
@@ -95,13 +95,15 @@ class TermSignals:
 
 
 def term_signals(est: FrictionEstimate, joint: int) -> TermSignals:
-    """The terms' signals of column ``joint`` of an estimate (its ``q``, ``tau`` as the load, ``temperature``; a
-    temperature column all NaN: not logged)."""
+    """The terms' signals of column ``joint`` of an estimate: its ``q``; the rigid-body torque
+    ``M qdd + h = tau + tau_f`` (the sign convention's, :mod:`~wbfriction.friction.estimate`) as the load (NaN where
+    the friction is not estimated; not the measured torque, which holds the friction itself: a drive's current does);
+    its ``temperature`` (a column all NaN: not logged)."""
     temperature = None if est.temperature is None else est.temperature[:, joint]
     if temperature is not None and np.all(np.isnan(temperature)):
         temperature = None
-    return TermSignals(None if est.q is None else est.q[:, joint], None if est.tau is None else est.tau[:, joint],
-                       temperature)
+    return TermSignals(None if est.q is None else est.q[:, joint],
+                       None if est.tau is None else est.tau[:, joint] + est.tau_f[:, joint], temperature)
 
 
 SIGNAL_COLUMNS: dict[Term, str] = {"load": "tau", "ripple": "q", "temperature": "temperature"}

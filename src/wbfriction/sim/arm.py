@@ -270,7 +270,8 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
         options: :class:`ArmOptions`.
         progress: optional callable receiving numbers of samples done.
         terms: friction beyond velocity per joint (:class:`~wbfriction.friction.terms.TermFit`: its velocity model
-            and its terms, the load being the joint's motor torque, the angle its true one, the temperature
+            and its terms, the load being the joint's rigid-body torque ``M qdd + h = tau_motor + tau_f`` (of the
+            previous physics step), the angle its true one, the temperature
             :attr:`ArmOptions.temperature`'s); it replaces ``friction`` for the joints it names. Recorded in the
             metadata's ``terms_true``.
 
@@ -318,8 +319,8 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
         for s in range(options.substeps):
             if injected.joints:
                 tau_f[injected.joints] = injected.torque(v[injected.joints])
-            for i, truth in beyond:
-                tau_f[i] = truth.torque_at(v[i], q[i], tau[i], 0.0 if warm is None else warm[k])
+            for i, truth in beyond:  # the load: the rigid-body torque M qdd + h = tau + tau_f, of the last step
+                tau_f[i] = truth.torque_at(v[i], q[i], tau[i] + tau_f[i], 0.0 if warm is None else warm[k])
             a = pin.aba(model, data, q, v, tau + tau_f)
             if s == 0:
                 Q[k], V[k], A[k], T[k], F[k] = q, v, a, tau, tau_f

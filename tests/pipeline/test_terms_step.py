@@ -1,0 +1,102 @@
+"""The terms beyond velocity from a log to a prediction, as a user runs them (issue 40): a simulated arm whose joints
+carry a load-dependent and a temperature-dependent Coulomb level and a position ripple, with its temperatures
+logged; ``estimate`` carries the angles, torques and temperatures into the friction table, ``fit --terms all``
+keeps the terms the truth has and writes them with their statuses, ``predict`` uses them on another log."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from helpers import run, run_cli, run_cli_printed
+from wbfriction.friction.io import read_friction_file, read_params
+from wbfriction.friction.models import CoulombViscousParams
+from wbfriction.friction.terms import TermFit
+from wbfriction.logs.tables import write_table
+from wbfriction.sim.arm import ArmOptions, simulate_arm
+
+T_REF = 40.0
+VELOCITY = CoulombViscousParams(F_v=0.2, F_c=1.0, tau_os=0.1)
+TRUTH = {
+    "panda_joint4": TermFit(VELOCITY, ("load", "temperature"), 0, {"F_L": 0.02, "F_cT": -0.008, "F_vT": -0.004},
+                            reference_temperature=T_REF),
+    "panda_joint6": TermFit(VELOCITY, ("ripple",), 1, {"ripple_sin1": 0.1, "ripple_cos1": 0.05}),
+}
+
+
+@pytest.fixture(scope="module")
+def logs(tmp_path_factory):
+    """Two 30 s logs of the Panda (seeds 0 and 1), exact positions, 0.05 N·m of torque noise, warming 25 -> 55 °C,
+    estimated by the CLI with central differences on the acceleration route (no smoothing)."""
+    from wbfriction.model import load_robot
+
+    robot = load_robot("panda")
+    folder = tmp_path_factory.mktemp("terms")
+    others = {j: VELOCITY for j in robot.actuated if j not in TRUTH}
+    out = {}
+    for seed in (0, 1):
+        sim = simulate_arm(robot, others, terms=TRUTH, options=ArmOptions(
+            duration=30.0, substeps=5, torque_std=0.05, seed=seed, temperature=(25.0, 55.0), encoder_bits=None))
+        log, table = folder / f"log{seed}.parquet", folder / f"friction{seed}.parquet"
+        write_table(sim.table, log)
+        res = run("estimate", log, "--robot", "panda", "--diff", "central", "--route", "acceleration", "-o", table)
+        assert res.returncode == 0, res.stderr
+        out[seed] = table
+    return folder, out
+
+
+def test_the_table_carries_the_terms_signals(logs):
+    _, tables = logs
+    est = read_friction_file(tables[0])
+    assert est.q is not None and est.tau is not None and est.temperature is not None
+    names = pq.read_schema(tables[0]).names
+    assert {"q.panda_joint4", "tau.panda_joint4", "temperature.panda_joint4"} <= set(names)
+    assert np.nanmin(est.temperature) == pytest.approx(25.0) and np.nanmax(est.temperature) == pytest.approx(55.0)
+
+
+def test_fit_keeps_the_simulated_terms_and_predict_uses_them(logs, capsys):
+    folder, tables = logs
+    params, plain = folder / "terms.json", folder / "plain.json"
+    code, printed, _ = run_cli_printed(capsys, "fit", tables[0], "-o", params, "--terms", "all",
+                                       "--reference-temperature", T_REF)
+    assert code == 0 and "Terms beyond velocity" in printed and "T_ref 40 °C" in printed
+    assert run_cli(capsys, "fit", tables[0], "-o", plain)[0] == 0
+    fits = read_params(params)
+    for joint, fit in fits.items():
+        truth = TRUTH.get(joint)
+        assert fit.terms is not None
+        assert set(fit.terms.kept) == (set() if truth is None else set(truth.kept)), (joint, fit.terms.reasons)
+        if truth is not None:
+            assert set(fit.terms.verdicts().values()) == {fit.terms.verdicts()[truth.kept[0]]}
+            assert all(v.ok for v in fit.terms.verdicts().values()), fit.terms.verdicts()
+            for name, value in truth.coefficients.items():
+                assert fit.terms.coefficients[name] == pytest.approx(value, rel=0.1), (joint, name)
+    doc = json.loads(params.read_text())["joints"]
+    assert doc["panda_joint4"]["terms"]["reference_temperature"] == T_REF
+    assert doc["panda_joint4"]["terms"]["status"] == {"load": "ok", "temperature": "ok"}
+    code, printed, _ = run_cli_printed(capsys, "predict", tables[1], "--params", params)
+    assert code == 0 and "load, temperature" in printed
+    from wbfriction.pipeline.predict_step import predict_file
+
+    with_terms, without = predict_file(tables[1], params), predict_file(tables[1], plain)
+    for i, joint in enumerate(with_terms.joints):  # every valid sample, those at rest (static friction) too
+        if joint in TRUTH:
+            assert with_terms.rms[i] < (0.5 if joint == "panda_joint4" else 0.97) * without.rms[i], joint
+        else:
+            assert with_terms.rms[i] == without.rms[i]
+
+
+def test_bad_terms_and_missing_signals_are_refused_in_one_line(logs, capsys, tmp_path):
+    folder, tables = logs
+    code, err = run_cli(capsys, "fit", tables[0], "-o", tmp_path / "p.json", "--terms", "load,wear")
+    assert code == 2 and "--terms" in err and "wear" in err and len(err.strip().splitlines()) == 1
+    params = folder / "terms_for_refusal.json"
+    assert run_cli(capsys, "fit", tables[0], "-o", params, "--terms", "ripple")[0] == 0
+    table = pq.read_table(tables[1])
+    old = tmp_path / "old.parquet"
+    pq.write_table(table.drop_columns([c for c in table.column_names if c.startswith("q.")]), old)
+    code, err = run_cli(capsys, "predict", old, "--params", params)
+    assert code == 2 and "q.panda_joint6" in err and "ripple" in err and len(err.strip().splitlines()) == 1
