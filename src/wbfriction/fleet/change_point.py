@@ -16,8 +16,10 @@ differ only by their residual sums of squares, so the shape chosen is the one wi
 * for each candidate onset ``k`` (at least :attr:`ChangeSettings.min_before` points before, at least
   :attr:`ChangeSettings.min_after` from it on), the hinge regressor ``x_i = max(0, t_i - t_{k-1})`` (zero up to
   the last log before the onset, growing from the first drifted log on) or the step regressor ``x_i = [i >= k]``;
-* the statistic ``F_k = (RSS_0 - RSS_k) / (RSS_k / (n - 2))`` with weighted residual sums of squares; the
-  onset is the ``k`` of the largest ``F_k``;
+* the statistic ``F_k = (RSS_0 - RSS_k) / (RSS_k / (n - 2 - m))`` with weighted residual sums of squares, ``m``
+  covariates in both models (the logs' temperatures, where they are known and spread: a value measured warm is
+  compared with one measured cold at one reference temperature, :func:`detect_change`); the onset is the ``k`` of
+  the largest ``F_k``;
 * its p-value, exact for this model whatever ``phi`` (``F_k`` does not depend on it): the share of
   :meth:`ChangeSettings.draws` series of pure noise ``se_i z_i`` (seeded: the same input gives the same
   output) whose largest ``F_k``, over the same shapes and onsets, reaches the observed one, on the same times and
@@ -87,6 +89,10 @@ class ChangePoint:
         relative: ``change`` over the baseline (over F_c's baseline for ``tau_os``); NaN where the baseline is
             not told from zero (within two of its standard errors): a relative change is then meaningless, and
             :attr:`change` (in the quantity's unit, :data:`UNITS`) says it.
+        reference_temperature: the temperature [°C] ``baseline`` and ``change`` are at, where the series' logs'
+            temperatures entered the test (:func:`detect_change`); None: they did not.
+        temperature_slope, temperature_slope_se: the value's change per °C found with the change, and its standard
+            error (NaN without temperatures).
     """
 
     quantity: str
@@ -99,6 +105,9 @@ class ChangePoint:
     p_value: float
     relative: float
     shape: Shape = "hinge"
+    reference_temperature: float | None = None
+    temperature_slope: float = float("nan")
+    temperature_slope_se: float = float("nan")
 
 
 def _regressor(shape: Shape, t: np.ndarray, k: int) -> np.ndarray:
@@ -109,26 +118,32 @@ def _regressor(shape: Shape, t: np.ndarray, k: int) -> np.ndarray:
 
 
 def change_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, min_after: int,
-                shape: Shape = "hinge") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                shape: Shape = "hinge", covariates: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The statistics ``F_k`` of every candidate onset of one shape (module docstring) for the columns of ``y``.
 
     Args:
         t: (n,) increasing times [days]; y: (n,) or (n, r) values; se: (n,) standard errors (> 0).
         shape: ``hinge`` or ``step``.
+        covariates: (n, m) what the values depend on besides the change, in both models (the logs' temperature
+            less a reference: :func:`detect_change`), or None.
 
     Returns:
         ``(onsets, F, fits)``: the candidate onsets (c,), ``F`` (c,) or (c, r), and per onset the weighted
-        least-squares coefficients (c, 2) or (c, 2, r) of ``[1, x_k]`` (baseline, and the slope per day of a
-        hinge or the size of a step). An onset whose hinge would be zero at every log (no log after the time of
-        the one before it), or a step between two logs at one time, is no candidate: ``c`` may be 0.
+        least-squares coefficients (c, 2 + m) or (c, 2 + m, r) of ``[1, covariates, x_k]`` (baseline at zero
+        covariates, the covariates' slopes, and the slope per day of a hinge or the size of a step). An onset whose
+        hinge would be zero at every log (no log after the time of the one before it), or a step between two logs
+        at one time, is no candidate: ``c`` may be 0.
     """
     n = t.size
     w = 1.0 / se
     Y = (y if y.ndim == 2 else y[:, None]) * w[:, None]
-    # RSS_0: the weighted mean removed
-    q0 = w / np.linalg.norm(w)
-    r0 = Y - np.outer(q0, q0 @ Y)
+    Z = np.column_stack([w] + ([] if covariates is None else [c * w for c in np.atleast_2d(covariates.T)]))
+    # RSS_0: the null model's fit (the weighted mean, and the covariates') removed
+    Q0, _ = np.linalg.qr(Z)
+    r0 = Y - Q0 @ (Q0.T @ Y)
     rss0 = np.einsum("ij,ij->j", r0, r0)
+    dof = n - Z.shape[1] - 1
     yy = np.einsum("ij,ij->j", Y, Y)
     onsets = np.arange(min_before, n - min_after + 1)
     if shape == "hinge":
@@ -136,13 +151,13 @@ def change_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, m
     else:
         onsets = onsets[t[onsets] > t[onsets - 1]]  # a step between logs at one time is no change in time
     F = np.empty((onsets.size, Y.shape[1]))
-    coef = np.empty((onsets.size, 2, Y.shape[1]))
+    coef = np.empty((onsets.size, Z.shape[1] + 1, Y.shape[1]))
     for c, k in enumerate(onsets):
-        X = np.column_stack([w, _regressor(shape, t, int(k)) * w])
+        X = np.column_stack([Z, _regressor(shape, t, int(k)) * w])
         Q, R = np.linalg.qr(X)
         QtY = Q.T @ Y
         rss = np.maximum(yy - np.einsum("ij,ij->j", QtY, QtY), 1e-300)
-        F[c] = (rss0 - rss) / (rss / (n - 2))
+        F[c] = (rss0 - rss) / (rss / dof)
         coef[c] = np.linalg.solve(R, QtY)
     if y.ndim == 1:
         return onsets, F[:, 0], coef[:, :, 0]
@@ -161,7 +176,8 @@ full :meth:`ChangeSettings.draws` are drawn only for the others (most series of 
 CLEAR = 20
 
 
-def null_p_value(t: np.ndarray, se: np.ndarray, statistic: float, options: ChangeSettings) -> float:
+def null_p_value(t: np.ndarray, se: np.ndarray, statistic: float, options: ChangeSettings,
+                 covariates: np.ndarray | None = None) -> float:
     """The share of series of pure noise ``se_i z_i`` on times ``t`` whose largest ``F_k`` (over the shapes of
     :attr:`ChangeSettings.shapes`) reaches ``statistic``
     (seeded by :attr:`ChangeSettings.seed`; ``(1 + hits) / (1 + draws)``): :data:`FIRST_PASS` series first, the
@@ -175,7 +191,7 @@ def null_p_value(t: np.ndarray, se: np.ndarray, statistic: float, options: Chang
         noise = se[:, None] * rng.standard_normal((t.size, size))
         largest = np.full(size, -np.inf)
         for shape in options.shapes:
-            _, F_null, _ = change_scan(t, noise, se, options.min_before, options.min_after, shape)
+            _, F_null, _ = change_scan(t, noise, se, options.min_before, options.min_after, shape, covariates)
             if F_null.shape[0]:
                 largest = np.maximum(largest, F_null.max(axis=0))
         hits += int(np.sum(largest >= statistic))
@@ -187,8 +203,14 @@ BLOCK = 50_000
 """Noise series drawn at a time after the first pass."""
 
 
+TEMPERATURE_SPREAD = 1.0
+"""The least standard deviation [°C] of a series' temperatures for them to enter its test as a covariate: logs
+recorded at one temperature say nothing of its effect (and make the covariate the constant's twin)."""
+
+
 def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity: str,
-                  options: ChangeSettings, scale: float | None = None) -> ChangePoint | None:
+                  options: ChangeSettings, scale: float | None = None, temperature: np.ndarray | None = None,
+                  reference_temperature: float | None = None) -> ChangePoint | None:
     """The best change of a series (over :attr:`ChangeSettings.shapes` and onsets) and its p-value (module
     docstring); None with too few finite points.
 
@@ -197,6 +219,11 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
             non-positive standard errors are left out).
         quantity: the series' name, recorded.
         scale: the baseline the relative change is measured against (default: the fitted baseline).
+        temperature: (n,) the temperature [°C] each point's value was measured at, or None. Where every point has
+            one and they spread by :data:`TEMPERATURE_SPREAD` or more, the value's linear dependence on it enters
+            both models (Bittencourt & Axelsson 2014: temperature changes friction more than wear does): the
+            baseline and the change are then those at ``reference_temperature`` (default: the points' median),
+            stated in :attr:`ChangePoint.reference_temperature` with the slope found.
     """
     ok = np.isfinite(y) & np.isfinite(se) & (se > 0)
     idx = np.flatnonzero(ok)
@@ -205,28 +232,36 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
     t0 = time[idx[0]]
     t = np.array([(time[i] - t0).total_seconds() / DAY for i in idx])
     yy, ss = y[idx], se[idx]
+    covariates, t_ref = None, None
+    if temperature is not None and np.all(np.isfinite(temperature[idx])) \
+            and float(np.std(temperature[idx])) >= TEMPERATURE_SPREAD:
+        t_ref = float(np.median(temperature[idx])) if reference_temperature is None else reference_temperature
+        covariates = (temperature[idx] - t_ref)[:, None]
     best: tuple[float, Shape, int, np.ndarray] | None = None
     for shape in options.shapes:
-        onsets, F, coef = change_scan(t, yy, ss, options.min_before, options.min_after, shape)
+        onsets, F, coef = change_scan(t, yy, ss, options.min_before, options.min_after, shape, covariates)
         if onsets.size and (best is None or float(F.max()) > best[0]):
             c = int(np.argmax(F))
             best = (float(F[c]), shape, int(onsets[c]), coef[c])
     if best is None:  # the logs after the first candidate onset all at one time
         return None
-    statistic, shape, k, (base, size) = best
-    p = null_p_value(t, ss, statistic, options)
+    statistic, shape, k, b = best
+    p = null_p_value(t, ss, statistic, options, covariates)
     # the change at the last log and its standard error, the residual scale phi estimated
     w = 1.0 / ss
-    X = np.column_stack([w, _regressor(shape, t, k) * w])
-    resid = yy * w - X @ np.array([base, size])
-    phi = float(resid @ resid) / max(idx.size - 2, 1)
+    X = np.column_stack([w] + ([] if covariates is None else [covariates[:, 0] * w])
+                        + [_regressor(shape, t, k) * w])
+    resid = yy * w - X @ b
+    phi = float(resid @ resid) / max(idx.size - X.shape[1], 1)
     cov = phi * np.linalg.inv(X.T @ X)
-    at_last = float(X[-1, 1] / w[-1])  # the regressor at the last log: the hinge's span, or 1
+    base, size = float(b[0]), float(b[-1])
+    at_last = float(X[-1, -1] / w[-1])  # the regressor at the last log: the hinge's span, or 1
     change = float(size * at_last)
     if scale is None:  # against the fitted baseline, where it is told from zero
         ref = abs(float(base)) if abs(float(base)) > 2 * np.sqrt(cov[0, 0]) else 0.0
     else:
         ref = abs(scale) if np.isfinite(scale) else 0.0
-    return ChangePoint(quantity, int(idx[k]), time[idx[k]], float(base), change,
-                       float(np.sqrt(cov[1, 1]) * at_last), statistic, float(p),
-                       change / ref if ref > 0 else float("nan"), shape)
+    slope = (float(b[1]), float(np.sqrt(cov[1, 1]))) if covariates is not None else (float("nan"), float("nan"))
+    return ChangePoint(quantity, int(idx[k]), time[idx[k]], base, change,
+                       float(np.sqrt(cov[-1, -1]) * at_last), statistic, float(p),
+                       change / ref if ref > 0 else float("nan"), shape, t_ref, *slope)

@@ -20,7 +20,9 @@ Sign convention: as everywhere in wbfriction, ``tau_f`` is the torque friction e
 model ``f(qd)`` is fitted to ``-tau_f`` (positive ``F_c``, ``F_v``: friction opposing the motion).
 ``f_at_<v>`` is the model's dissipative friction at speed ``v``: ``(f(+v) - f(-v)) / 2`` [N·m], free of the
 offset ``tau_os`` and robust where the model's parameters trade off against each other; NaN where the joint
-did not reach ``v`` in the log (an extrapolation is no measurement).
+did not reach ``v`` in the log (an extrapolation is no measurement). Where the fit kept terms beyond velocity
+(:mod:`wbfriction.friction.terms`), the values are its velocity model's refitted with them: at zero load, at the
+reference temperature, without the position ripple; ``temperature`` says at which temperature the values are.
 """
 
 from __future__ import annotations
@@ -61,6 +63,8 @@ RESULT_SCHEMA = pa.schema([
     *[(name, pa.float64()) for p in TREND_PARAMS for name in (p, f"{p}_se", f"{p}_crb")],  # [N·m], [N·m·s/rad]
     *[(f"{p}_check", pa.float64()) for p in TREND_PARAMS[:2]],  # the same model on the other route (NaN: none)
     *[(name, pa.float64()) for v in REFERENCE_SPEEDS for name in (speed_column(v), speed_column(v) + "_se")],
+    ("temperature", pa.float64()),        # [°C] the values' temperature: the fit's T_ref with a temperature term,
+                                          # else the mean over the samples fitted; NaN: not logged
     ("energy_share", pa.float64()),       # share of friction power that generates energy (eq. 7.9), in [0, 1]
     ("rms_residual", pa.float64()),       # [N·m]
     ("version", pa.string()),             # wbfriction's version

@@ -29,6 +29,7 @@ from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.fit import FitResult, model_jacobian
+from wbfriction.friction.terms import TermFit
 from wbfriction.logs.tables import file_sha256, scratch_folder
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import Chunking
@@ -129,7 +130,7 @@ def process_log(entry: LogEntry, key: ResultKey, options: BatchOptions, scratch:
                 executor=executor)
             fitted = fit_table(friction, options.fit, threshold=options.energy_threshold,
                                tolerance=options.energy_tolerance)
-        rows = result_rows(key, fitted.fits, fitted.energy, fitted.est.qd, fitted.est.valid)
+        rows = result_rows(key, fitted.fits, fitted.energy, fitted.est.qd, fitted.est.valid, fitted.est.temperature)
         return LogOutcome(entry, key, rows, table=table)
     except OutputError as exc:  # the results cannot be written: no other log's either, the batch stops
         where = table if table is not None else f"{scratch} (the friction table of {entry.log.name})"
@@ -162,14 +163,21 @@ def reference_friction(fit: FitResult, v: float) -> tuple[float, float]:
 
 
 def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy], qd: np.ndarray,
-                valid: np.ndarray) -> pa.Table:
+                valid: np.ndarray, temperature: np.ndarray | None = None) -> pa.Table:
     """The rows of the log of ``key`` (:data:`~wbfriction.fleet.schema.RESULT_SCHEMA`), one per joint of ``fits``;
-    ``qd`` (N, n_tc) [rad/s] and ``valid`` (N, n_tc) of the estimate give each joint's velocity range."""
+    ``qd`` (N, n_tc) [rad/s] and ``valid`` (N, n_tc) of the estimate give each joint's velocity range,
+    ``temperature`` (N, n_tc) [°C] (or None) its temperature. A fit with terms beyond velocity gives its velocity
+    model refitted with them (at zero load and its reference temperature, without the ripple)."""
     shares = {e.joint: e.generating_share for e in energy}
     columns: dict[str, list] = {name: [] for name in RESULT_SCHEMA.names}
     for i, fit in enumerate(fits):
-        v = qd[valid[:, i] & np.isfinite(qd[:, i]), i]
-        values = fit.params.to_dict() if fit.params is not None else {}
+        rows = valid[:, i] & np.isfinite(qd[:, i])
+        v = qd[rows, i]
+        terms = fit.terms if fit.terms is not None and fit.terms.kept else None
+        params = terms.params if terms is not None else fit.params
+        values = params.to_dict() if params is not None else {}
+        stderr = terms.stderr if terms is not None else fit.stderr
+        crb = {} if terms is not None else fit.crb  # the bound is the velocity model's
         row = {"robot_id": key.robot_id, "log": key.log, "start_time": _utc(key.start_time),
                "key": key.key, "log_sha256": key.log_sha256, "robot_sha256": key.robot_sha256,
                "options_sha256": key.options_sha256, "joint": fit.joint, "model": fit.model, "route": fit.route,
@@ -177,22 +185,39 @@ def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy]
                "qd_min": float(v.min()) if v.size else float("nan"),
                "qd_max": float(v.max()) if v.size else float("nan"),
                "qd_p95": float(np.percentile(np.abs(v), 95)) if v.size else float("nan"),
+               "temperature": _temperature(terms, temperature, i, rows),
                "energy_share": float(shares.get(fit.joint, float("nan"))),
                "rms_residual": float(fit.rms_residual), "version": __version__}
         for p in TREND_PARAMS:
             row[p] = float(values.get(p, float("nan")))
-            row[f"{p}_se"] = float(fit.stderr.get(p, float("nan")))
-            row[f"{p}_crb"] = float(fit.crb.get(p, float("nan")))
-        check = fit.route_check.params if fit.route_check is not None else None
+            row[f"{p}_se"] = float(stderr.get(p, float("nan")))
+            row[f"{p}_crb"] = float(crb.get(p, float("nan")))
+        if terms is not None:
+            check = terms.check.coefficients if terms.check is not None else None
+        else:
+            check = fit.route_check.params if fit.route_check is not None else None
         for p in TREND_PARAMS[:2]:
             row[f"{p}_check"] = float(check.get(p, float("nan"))) if check else float("nan")
         reach = float(np.max(np.abs(v))) if v.size else 0.0
         for s in REFERENCE_SPEEDS:
-            f, se = reference_friction(fit, s) if s <= reach else (float("nan"), float("nan"))
+            nan = (float("nan"), float("nan"))
+            f, se = nan if s > reach else terms.speed_friction(s) if terms is not None else reference_friction(fit, s)
             row[speed_column(s)], row[speed_column(s) + "_se"] = f, se
         for name in RESULT_SCHEMA.names:
             columns[name].append(row[name])
     return pa.Table.from_pydict(columns, schema=RESULT_SCHEMA)
+
+
+def _temperature(terms: TermFit | None, temperature: np.ndarray | None, i: int, rows: np.ndarray) -> float:
+    """The temperature a joint's values are at [°C]: its fit's reference temperature where it kept a temperature
+    term, else the mean over its samples; NaN where not logged."""
+    if terms is not None and "temperature" in terms.kept and terms.reference_temperature is not None:
+        return float(terms.reference_temperature)
+    if temperature is None:
+        return float("nan")
+    t = temperature[rows, i]
+    t = t[np.isfinite(t)]
+    return float(np.mean(t)) if t.size else float("nan")
 
 
 def _utc(t: datetime) -> int:

@@ -16,6 +16,12 @@ followed by a linear drift or a step from an unknown onset) and its exact Monte 
   change too small to matter is not a drift. A significant change from a baseline that is not told from zero
   is one whatever its size (its relative change is undefined: NaN).
 
+**Temperature**: where every point of a series has the temperature it was measured at (the results'
+``temperature``: logs with ``temperature.<joint>``) and they spread, the value's linear dependence on it is
+fitted with the change (:func:`~wbfriction.fleet.change_point.detect_change`): a log recorded warm compares with
+one recorded cold, at the reference temperature the table states (:attr:`TrendOptions.reference_temperature`, or
+the series' median).
+
 Sign convention: the values are those of the results dataset (:mod:`wbfriction.fleet.schema`): ``F_c``,
 ``F_v`` and ``f_at_<v>`` positive for friction opposing the motion.
 """
@@ -59,6 +65,10 @@ class TrendOptions:
         quantities: the quantities tested.
         shapes: the shapes of change tested (:data:`~wbfriction.fleet.change_point.SHAPES`: a linear drift
             from an onset, a step at it, or both, the better one chosen per series).
+        temperature: whether the logs' temperatures (the results' ``temperature``), where every point of a series
+            has one, enter its test (:func:`~wbfriction.fleet.change_point.detect_change`): its values compared at
+            one reference temperature.
+        reference_temperature: that temperature [°C]; None: each series' median.
 
     Raises:
         InputError: ``alpha`` out of (0, 1), ``replicates`` too few to reach ``alpha / m`` (naming
@@ -74,6 +84,8 @@ class TrendOptions:
     seed: int = 0
     quantities: tuple[str, ...] = QUANTITIES
     shapes: tuple[Shape, ...] = SHAPES
+    temperature: bool = True
+    reference_temperature: float | None = None
 
     def __post_init__(self) -> None:
         if not self.shapes:
@@ -118,6 +130,8 @@ class Series:
         time: (n,) the logs' start times (UTC).
         value, se: (n,) values and standard errors [N·m, N·m·s/rad], NaN where the log gave no point.
         used: (n,) the logs that are points of the series.
+        temperature: (n,) the temperature each value was measured at [°C] (the results' ``temperature``), NaN where
+            not logged; None: not read.
     """
 
     quantity: str
@@ -125,6 +139,7 @@ class Series:
     value: np.ndarray
     se: np.ndarray
     used: np.ndarray
+    temperature: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -181,10 +196,12 @@ class FleetTrends:
 
     def to_table(self) -> pa.Table:
         """One row per robot, joint and tested quantity: the best change (its shape, onset, size, statistic,
-        p-value), whether it is a flagged drift."""
+        p-value), whether it is a flagged drift, and the temperature its baseline and size are at with the slope
+        per °C found (null and NaN where the logs' temperatures did not enter the test)."""
         rows: dict[str, list] = {k: [] for k in ("robot_id", "joint", "quantity", "points", "flagged", "shape",
                                                  "onset_time", "baseline", "change", "change_se", "relative_change",
-                                                 "statistic", "p_value", "last_value")}
+                                                 "statistic", "p_value", "last_value", "reference_temperature",
+                                                 "temperature_slope", "temperature_slope_se")}
         for j in self.joints:
             for q, cp in j.tests.items():
                 s = j.series[q]
@@ -202,11 +219,16 @@ class FleetTrends:
                 rows["statistic"].append(cp.statistic)
                 rows["p_value"].append(cp.p_value)
                 rows["last_value"].append(float(s.value[s.used][-1]))
+                rows["reference_temperature"].append(cp.reference_temperature)
+                rows["temperature_slope"].append(cp.temperature_slope)
+                rows["temperature_slope_se"].append(cp.temperature_slope_se)
         schema = pa.schema([("robot_id", pa.string()), ("joint", pa.string()), ("quantity", pa.string()),
                             ("points", pa.int64()), ("flagged", pa.bool_()), ("shape", pa.string()),
                             ("onset_time", pa.timestamp("us", tz="UTC")),
                             *[(n, pa.float64()) for n in ("baseline", "change", "change_se", "relative_change",
-                                                         "statistic", "p_value", "last_value")]])
+                                                         "statistic", "p_value", "last_value",
+                                                         "reference_temperature", "temperature_slope",
+                                                         "temperature_slope_se")]])
         return pa.Table.from_pydict(rows, schema=schema)
 
 
@@ -217,6 +239,8 @@ def joint_trend(robot_id: str, joint: str, rows: pa.Table, options: TrendOptions
                                                 safe=False).to_pylist()]  # datetimes, whatever is installed
     usable = np.isin(np.array(rows.column("status").to_pylist(), dtype=object), USABLE)
     models = np.array(rows.column("model").to_pylist(), dtype=object)
+    temperature = (np.asarray(rows.column("temperature").to_numpy(zero_copy_only=False), dtype=float)
+                   if options.temperature else None)
     dominant = max(sorted(set(models[usable])), key=lambda m: int(np.sum(models[usable] == m)), default=None)
     series = {}
     for q in options.quantities:
@@ -226,14 +250,14 @@ def joint_trend(robot_id: str, joint: str, rows: pa.Table, options: TrendOptions
         value = np.asarray(rows.column(q).to_numpy(zero_copy_only=False), dtype=float)
         se = np.asarray(rows.column(q + "_se").to_numpy(zero_copy_only=False), dtype=float)
         used = same & np.isfinite(value) & np.isfinite(se) & (se > 0)
-        series[q] = Series(q, time, np.where(used, value, np.nan), np.where(used, se, np.nan), used)
+        series[q] = Series(q, time, np.where(used, value, np.nan), np.where(used, se, np.nan), used, temperature)
     tests: dict[str, ChangePoint] = {}
     for q, s in series.items():
         scale = None
         if q == "tau_os":  # an offset may be zero: its change is measured against the Coulomb friction
             f_c = series.get("F_c")
             scale = float(np.nanmedian(f_c.value)) if f_c is not None and f_c.used.any() else None
-        cp = detect_change(time, s.value, s.se, q, options, scale)
+        cp = detect_change(time, s.value, s.se, q, options, scale, s.temperature, options.reference_temperature)
         if cp is not None:
             tests[q] = cp
     m = max(len(tests), 1)

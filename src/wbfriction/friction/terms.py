@@ -210,6 +210,8 @@ class TermFit:
         check: the kept terms refitted on the other route's estimate (:func:`refit_terms`), or None.
         at_bound: the velocity model's magnitudes held at zero in the refit (:data:`NONNEGATIVE`): with the terms,
             the data would put them below it (standard error 0: held, not fitted).
+        covariance: the coefficients' covariance, the velocity model's (:func:`velocity_basis` order) then the
+            terms', or None (read from a parameters file, which keeps the standard errors only).
     """
 
     params: ModelParams
@@ -224,6 +226,7 @@ class TermFit:
     held_out_rms: tuple[float, float] = (float("nan"), float("nan"))
     check: TermCheck | None = None
     at_bound: tuple[str, ...] = ()
+    covariance: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def verdicts(self) -> dict[Term, FitVerdict]:
         """Per kept term, whether its numbers can be used (``ok``, ``weak``, ``routes disagree``) and why.
@@ -311,6 +314,17 @@ class TermFit:
                 raise InputError(f"{source}: no column '{column}': the fit's {term} term needs it (estimate the "
                                  "log again with this version; a temperature term needs the log's temperature)")
 
+    def speed_friction(self, v: float) -> tuple[float, float]:
+        """The dissipative friction at speed ``v`` [rad/s] at the reference conditions (zero load, ``T_ref``, no
+        ripple): ``(f(+v) - f(-v)) / 2`` [N·m], and its standard error from :attr:`covariance` (NaN without)."""
+        _, B, c = velocity_basis(self.params, np.array([v, -v]))
+        g = 0.5 * (B[0] - B[1])
+        value = float(g @ c)
+        if self.covariance is None:
+            return value, float("nan")
+        k = len(c)
+        return value, float(np.sqrt(max(float(g @ self.covariance[:k, :k] @ g), 0.0)))
+
     def friction(self, qd: np.ndarray, signals: TermSignals) -> np.ndarray:
         """The dissipative part ``f`` [N·m] (N,): the velocity model and every kept term but the ripple."""
         return self._value(qd, signals, dissipative=True)
@@ -386,7 +400,8 @@ class TermCheck:
 
     Attributes:
         route: that route (``acceleration`` or ``momentum``).
-        coefficients, stderr: its term coefficients and their standard errors, by name.
+        coefficients, stderr: its coefficients (the velocity model's linear ones, :func:`velocity_basis`, and the
+            terms') and their standard errors, by name.
     """
 
     route: str
@@ -630,7 +645,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         q_range = (float(q_used.min()), float(q_used.max()))
         derived["ripple_rms"], stderr["ripple_rms"] = ripple_size(q_used, harmonics, names, coef, cov)
     return TermFit(refitted, kept_sorted, harmonics, coefficients, stderr, derived, t_ref, q_range, reasons,
-                   (base_rms, current), at_bound=held)
+                   (base_rms, current), at_bound=held, covariance=cov)
 
 
 NONNEGATIVE = ("F_v", "F_c", "F_cS")
@@ -702,8 +717,8 @@ def refit_terms(fit: TermFit, params: ModelParams, qd: np.ndarray, tau_f: np.nda
     if use.sum() <= X.shape[1]:
         return None
     coef, cov, _ = _final(X, np.where(use, y, 0.0), use, names)
-    coefficients = dict(zip(names[k:], map(float, coef[k:])))
-    stderr = dict(zip(names[k:], map(float, covariance_errors(cov)[k:])))
+    coefficients = dict(zip(names, map(float, coef)))
+    stderr = dict(zip(names, map(float, covariance_errors(cov))))
     if "ripple" in fit.kept and signals.q is not None:
         coefficients["ripple_rms"], stderr["ripple_rms"] = ripple_size(np.asarray(signals.q, dtype=float)[use],
                                                                       fit.harmonics, names, coef, cov)
