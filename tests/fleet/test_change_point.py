@@ -126,3 +126,70 @@ def test_the_shapes_are_checked_where_they_are_defined():
     with pytest.raises(OptionError, match="--shapes"):
         TrendOptions(shapes=())
     assert TrendOptions().shapes == SHAPES
+
+
+def temperature_series(rng: np.random.Generator, shape: Shape | None) -> tuple[np.ndarray, np.ndarray, int, float]:
+    """:func:`synthetic`'s series (or a constant one with ``shape`` None), measured at temperatures that rise over the
+    days (a season, 12 °C) and scatter by ±12 °C (duty), the value falling 0.8 %/°C from 35 °C: -20 % to +20 % by
+    temperature alone, more than the changes."""
+    if shape is None:
+        y, onset, size = 1.0 + SE * rng.standard_normal(N), -1, 0.0
+    else:
+        y, onset, size = synthetic(shape, rng)
+    T = 28.0 + 12.0 * np.arange(N) / (N - 1) + rng.uniform(-12.0, 12.0, N)
+    return y * (1 - 0.008 * (T - 35.0)), T, onset, size
+
+
+def test_a_change_is_found_at_a_reference_temperature():
+    """200 steps and 200 hinges of 15-30 %, the values also following the logs' temperatures: with the temperatures
+    as a covariate, the onsets and sizes (at 35 °C) as without any temperature effect, and the slope found
+    (-0.008 per °C) within its standard errors; the size without them is off (what the fleet without
+    temperature columns gives)."""
+    for shape in SHAPES:
+        rng = np.random.default_rng(11)
+        rows, blind = [], []
+        for _ in range(200):
+            y, T, onset, size = temperature_series(rng, shape)
+            cp = detect_change(DAYS, y, np.full(N, SE), "F_c", Settings(), temperature=T, reference_temperature=35.0)
+            plain = detect_change(DAYS, y, np.full(N, SE), "F_c", Settings())
+            assert cp is not None and plain is not None and cp.reference_temperature == 35.0
+            z = (cp.temperature_slope + 0.008) / cp.temperature_slope_se  # the baseline's slope
+            rows.append((cp.onset - onset, cp.change / size - 1, z))
+            blind.append((plain.onset - onset, plain.change / size - 1))
+        r, b = np.array(rows), np.array(blind)
+        rms = (np.sqrt(np.mean(r[:, 1] ** 2)), np.sqrt(np.mean(b[:, 1] ** 2)))
+        print(f"\n{shape}s with temperatures: onset within 1 log {np.mean(np.abs(r[:, 0]) <= 1):.3f}, size bias "
+              f"{100 * r[:, 1].mean():+.2f} %, RMS {100 * rms[0]:.2f} %; without: onset within 1 log "
+              f"{np.mean(np.abs(b[:, 0]) <= 1):.3f}, size RMS {100 * rms[1]:.1f} %")
+        assert np.mean(np.abs(r[:, 0]) <= 1) >= (0.95 if shape == "step" else 0.8)
+        assert abs(r[:, 1].mean()) < 0.02 and np.sqrt(np.mean(r[:, 1] ** 2)) < 0.08
+        assert np.mean(np.abs(r[:, 2]) < 3) >= 0.97  # the slope's z-score: within three standard errors
+        assert np.sqrt(np.mean(b[:, 1] ** 2)) > 2 * np.sqrt(np.mean(r[:, 1] ** 2))
+
+
+def test_temperature_alone_alarms_as_often_as_alpha_says():
+    """200 series that change only with the logs' temperatures (a season's rise and the duty's scatter): with the
+    temperatures as a covariate, p-values below 0.05 as often as a binomial(200, 0.05) allows (99.9 % band); without
+    them, the season looks like wear in most series."""
+    rng = np.random.default_rng(5)
+    p, blind = [], []
+    for _ in range(200):
+        y, T, _, _ = temperature_series(rng, None)
+        p.append(detect_change(DAYS, y, np.full(N, SE), "F_c", Settings(), temperature=T).p_value)
+        blind.append(detect_change(DAYS, y, np.full(N, SE), "F_c", Settings()).p_value)
+    assert 2 <= np.sum(np.array(p) < 0.05) <= 21, np.sum(np.array(p) < 0.05)
+    assert np.mean(np.array(blind) < 0.05) > 0.5
+
+
+def test_temperatures_that_do_not_spread_are_left_out():
+    """Logs recorded at one temperature (within :data:`TEMPERATURE_SPREAD`) say nothing of its effect: the test is
+    the one without it."""
+    from wbfriction.fleet.change_point import TEMPERATURE_SPREAD
+
+    rng = np.random.default_rng(2)
+    y, _, _ = synthetic("step", rng)
+    T = 40.0 + 0.4 * TEMPERATURE_SPREAD * rng.standard_normal(N).clip(-2, 2)
+    with_t = detect_change(DAYS, y, np.full(N, SE), "F_c", Settings(), temperature=T)
+    without = detect_change(DAYS, y, np.full(N, SE), "F_c", Settings())
+    assert with_t is not None and without is not None and with_t.reference_temperature is None
+    assert (with_t.onset, with_t.change, with_t.p_value) == (without.onset, without.change, without.p_value)

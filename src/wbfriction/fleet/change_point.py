@@ -16,10 +16,11 @@ differ only by their residual sums of squares, so the shape chosen is the one wi
 * for each candidate onset ``k`` (at least :attr:`ChangeSettings.min_before` points before, at least
   :attr:`ChangeSettings.min_after` from it on), the hinge regressor ``x_i = max(0, t_i - t_{k-1})`` (zero up to
   the last log before the onset, growing from the first drifted log on) or the step regressor ``x_i = [i >= k]``;
-* the statistic ``F_k = (RSS_0 - RSS_k) / (RSS_k / (n - 2 - m))`` with weighted residual sums of squares, ``m``
+* the statistic ``F_k = (RSS_0 - RSS_k) / (RSS_k / (n - 2 - 2m))`` with weighted residual sums of squares, ``m``
   covariates in both models (the logs' temperatures, where they are known and spread: a value measured warm is
-  compared with one measured cold at one reference temperature, :func:`detect_change`); the onset is the ``k`` of
-  the largest ``F_k``;
+  compared with one measured cold at one reference temperature, :func:`detect_change`), and their products with
+  the change's regressor in the changed one (wear scales a friction level and its temperature slope alike); the
+  onset is the ``k`` of the largest ``F_k``;
 * its p-value, exact for this model whatever ``phi`` (``F_k`` does not depend on it): the share of
   :meth:`ChangeSettings.draws` series of pure noise ``se_i z_i`` (seeded: the same input gives the same
   output) whose largest ``F_k``, over the same shapes and onsets, reaches the observed one, on the same times and
@@ -117,6 +118,15 @@ def _regressor(shape: Shape, t: np.ndarray, k: int) -> np.ndarray:
     return np.maximum(0.0, t - t[k - 1])
 
 
+def _change_columns(shape: Shape, t: np.ndarray, k: int, w: np.ndarray, covariates: np.ndarray | None) -> np.ndarray:
+    """The change's weighted columns for an onset at log ``k``: its regressor ``x_k``, and with covariates their
+    products with it (the change scales what depends on them: a worn joint's friction falls with the temperature in
+    proportion to its level)."""
+    x = _regressor(shape, t, k)
+    columns = [x * w] + ([] if covariates is None else [x * c * w for c in np.atleast_2d(covariates.T)])
+    return np.column_stack(columns)
+
+
 def change_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, min_after: int,
                 shape: Shape = "hinge", covariates: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -130,8 +140,9 @@ def change_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, m
 
     Returns:
         ``(onsets, F, fits)``: the candidate onsets (c,), ``F`` (c,) or (c, r), and per onset the weighted
-        least-squares coefficients (c, 2 + m) or (c, 2 + m, r) of ``[1, covariates, x_k]`` (baseline at zero
-        covariates, the covariates' slopes, and the slope per day of a hinge or the size of a step). An onset whose
+        least-squares coefficients (c, 2 + 2m) or (c, 2 + 2m, r) of ``[1, covariates, x_k, x_k covariates]``
+        (baseline at zero covariates, the covariates' slopes, the slope per day of a hinge or the size of a step, and
+        how the change scales the slopes). An onset whose
         hinge would be zero at every log (no log after the time of the one before it), or a step between two logs
         at one time, is no candidate: ``c`` may be 0.
     """
@@ -143,7 +154,7 @@ def change_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, m
     Q0, _ = np.linalg.qr(Z)
     r0 = Y - Q0 @ (Q0.T @ Y)
     rss0 = np.einsum("ij,ij->j", r0, r0)
-    dof = n - Z.shape[1] - 1
+    dof = n - 2 * Z.shape[1]
     yy = np.einsum("ij,ij->j", Y, Y)
     onsets = np.arange(min_before, n - min_after + 1)
     if shape == "hinge":
@@ -151,9 +162,9 @@ def change_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, m
     else:
         onsets = onsets[t[onsets] > t[onsets - 1]]  # a step between logs at one time is no change in time
     F = np.empty((onsets.size, Y.shape[1]))
-    coef = np.empty((onsets.size, Z.shape[1] + 1, Y.shape[1]))
+    coef = np.empty((onsets.size, 2 * Z.shape[1], Y.shape[1]))  # [1, covariates] and the change's as many
     for c, k in enumerate(onsets):
-        X = np.column_stack([Z, _regressor(shape, t, int(k)) * w])
+        X = np.column_stack([Z, _change_columns(shape, t, int(k), w, covariates)])
         Q, R = np.linalg.qr(X)
         QtY = Q.T @ Y
         rss = np.maximum(yy - np.einsum("ij,ij->j", QtY, QtY), 1e-300)
@@ -249,13 +260,15 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
     p = null_p_value(t, ss, statistic, options, covariates)
     # the change at the last log and its standard error, the residual scale phi estimated
     w = 1.0 / ss
+    m = 0 if covariates is None else covariates.shape[1]
     X = np.column_stack([w] + ([] if covariates is None else [covariates[:, 0] * w])
-                        + [_regressor(shape, t, k) * w])
+                        + [_change_columns(shape, t, k, w, covariates)])
     resid = yy * w - X @ b
     phi = float(resid @ resid) / max(idx.size - X.shape[1], 1)
     cov = phi * np.linalg.inv(X.T @ X)
-    base, size = float(b[0]), float(b[-1])
-    at_last = float(X[-1, -1] / w[-1])  # the regressor at the last log: the hinge's span, or 1
+    at = 1 + m  # the change's coefficient: after the baseline and the slopes
+    base, size = float(b[0]), float(b[at])
+    at_last = float(X[-1, at] / w[-1])  # the regressor at the last log: the hinge's span, or 1
     change = float(size * at_last)
     if scale is None:  # against the fitted baseline, where it is told from zero
         ref = abs(float(base)) if abs(float(base)) > 2 * np.sqrt(cov[0, 0]) else 0.0
@@ -263,5 +276,5 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
         ref = abs(scale) if np.isfinite(scale) else 0.0
     slope = (float(b[1]), float(np.sqrt(cov[1, 1]))) if covariates is not None else (float("nan"), float("nan"))
     return ChangePoint(quantity, int(idx[k]), time[idx[k]], base, change,
-                       float(np.sqrt(cov[-1, -1]) * at_last), statistic, float(p),
+                       float(np.sqrt(cov[at, at]) * at_last), statistic, float(p),
                        change / ref if ref > 0 else float("nan"), shape, t_ref, *slope)
