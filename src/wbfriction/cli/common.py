@@ -8,7 +8,7 @@ import sys
 from collections.abc import Mapping
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING, Optional, cast
 
 import typer
 from rich.console import Console
@@ -21,8 +21,11 @@ from wbfriction.exceptions import InputError, WbfrictionError
 from wbfriction.friction.options import (
     DEFAULT_THRESHOLD,
     DEFAULT_TOLERANCE,
+    TERMS,
     EstimateOptions,
     FitOptions,
+    Term,
+    TermOptions,
 )
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
@@ -151,6 +154,27 @@ ModelOpt = typer.Option(FIT.model, "--model", help="Friction model per joint: au
                                                     "is within --selection-tolerance of the best), coulomb-viscous "
                                                     "(3.1 + 3.2), stribeck (3.3 + 3.2) or thesis (3.5); each with "
                                                     "an offset tau_os.")
+TermsOpt = typer.Option("", "--terms", help="Terms beyond velocity tried per joint, comma-separated, or all: load "
+                                            "(Coulomb friction growing with the joint's rigid-body torque), "
+                                            "direction (F_v by direction of motion), ripple (a torque periodic in "
+                                            "the angle, not friction), temperature (needs temperature.<joint> in "
+                                            "the log); each kept where held-out samples improve.")
+MaxHarmonicOpt = typer.Option(FIT.terms.max_harmonic, "--max-harmonic", help="The ripple's highest harmonic tried.")
+ReferenceTemperatureOpt = typer.Option(None, "--reference-temperature",
+                                       help="T_ref [°C] the temperature term's levels are stated at [default: each "
+                                            "log's median].")
+
+
+def term_options(terms: str, max_harmonic: int, reference_temperature: float | None) -> TermOptions:
+    """The terms' options of ``--terms`` (comma-separated, or ``all``), ``--max-harmonic`` and
+    ``--reference-temperature``.
+
+    Raises:
+        OptionError: an unknown term (:class:`~wbfriction.friction.options.TermOptions`).
+    """
+    names = TERMS if terms.strip() == "all" else tuple(t.strip() for t in terms.split(",") if t.strip())
+    return TermOptions(terms=cast(tuple[Term, ...], names), max_harmonic=max_harmonic,
+                       reference_temperature=reference_temperature)
 
 
 def _version(value: bool) -> None:

@@ -4,7 +4,7 @@ it goes."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Optional, cast
+from typing import TYPE_CHECKING, Optional
 
 import typer
 from rich.markup import escape
@@ -12,7 +12,7 @@ from rich.table import Table
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
-from wbfriction.friction.options import TERMS, FitOptions, ModelChoice, Term, TermOptions
+from wbfriction.friction.options import FitOptions, ModelChoice
 from wbfriction.pipeline.paths import check_paths
 
 if TYPE_CHECKING:
@@ -25,10 +25,13 @@ from wbfriction.cli.common import (
     EnergyToleranceOpt,
     FitWorkersOpt,
     FrictionArg,
+    MaxHarmonicOpt,
     MinSamplesOpt,
     MjcfOpt,
     ModelOpt,
+    ReferenceTemperatureOpt,
     RobotOpt,
+    TermsOpt,
     UrdfOpt,
     VerboseOpt,
     WideOpt,
@@ -37,6 +40,7 @@ from wbfriction.cli.common import (
     out,
     print_whole,
     robot_of,
+    term_options,
     warn_energy,
 )
 
@@ -74,23 +78,15 @@ def fit(friction: Path = FrictionArg,
         selection_tolerance: float = typer.Option(FIT.selection_tolerance, min=0.0,
                                                   help="With --model auto: relative excess of held-out RMS within "
                                                        "which the simpler model is chosen."),
-        terms: str = typer.Option("", help="Terms beyond velocity tried per joint, comma-separated, or all: "
-                                           "load (Coulomb friction growing with the joint's torque), direction "
-                                           "(F_v by direction of motion), ripple (a torque periodic in the "
-                                           "angle, not friction), temperature (needs temperature.<joint> in the "
-                                           "log); each kept where held-out samples improve."),
-        max_harmonic: int = typer.Option(FIT.terms.max_harmonic, help="The ripple's highest harmonic tried."),
-        reference_temperature: Optional[float] = typer.Option(
-            None, help="T_ref [°C] the temperature term's levels are stated at [default: the log's median]."),
+        terms: str = TermsOpt, max_harmonic: int = MaxHarmonicOpt,
+        reference_temperature: Optional[float] = ReferenceTemperatureOpt,
         wide: bool = WideOpt, verbose: bool = VerboseOpt) -> None:
     """Identify a friction model of every joint, with standard errors and the parameters left
     at a bound; warn about joints whose friction generates power (eq. 7.9)."""
     check_paths({"FRICTION": friction}, {"-o": output})
-    names = TERMS if terms.strip() == "all" else tuple(t.strip() for t in terms.split(",") if t.strip())
-    term_options = TermOptions(terms=cast("tuple[Term, ...]", names), max_harmonic=max_harmonic,
-                               reference_temperature=reference_temperature)
     _run_fit(friction, output, FitOptions(model=model, selection_tolerance=selection_tolerance,
-                                          min_samples=min_samples, terms=term_options),
+                                          min_samples=min_samples,
+                                          terms=term_options(terms, max_harmonic, reference_temperature)),
              energy_threshold, energy_tolerance, workers, wide, verbose)
 
 

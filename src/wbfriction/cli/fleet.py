@@ -29,11 +29,15 @@ from wbfriction.cli.common import (
     ESTIMATE,
     FIT,
     ConfigOpt,
+    MaxHarmonicOpt,
     MinSamplesOpt,
+    ReferenceTemperatureOpt,
     RobotOpt,
+    TermsOpt,
     UrdfOpt,
     app,
     console,
+    term_options,
 )
 
 
@@ -62,7 +66,8 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
                                                         "manifest's diff column overrides it per log)."),
           model: ModelChoice = typer.Option(FIT.model, help="Friction model, as 'wbfriction fit --model' (a "
                                                              "manifest's model column overrides it per log)."),
-          min_samples: int = MinSamplesOpt) -> None:
+          min_samples: int = MinSamplesOpt, terms: str = TermsOpt, max_harmonic: int = MaxHarmonicOpt,
+          reference_temperature: Optional[float] = ReferenceTemperatureOpt) -> None:
     """Estimate, fit and check every log of a fleet on Dask, into one results dataset (exit status 1 when a log
     failed: it is listed, the others are done)."""
     from wbfriction.fleet.batch import check_outputs, quiet_dask_logs, run_batch
@@ -83,7 +88,8 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
         entries = scan.entries
     else:
         entries = read_manifest(source)
-    options = BatchOptions(estimate=EstimateOptions(diff=diff), fit=FitOptions(model=model, min_samples=min_samples))
+    options = BatchOptions(estimate=EstimateOptions(diff=diff), fit=FitOptions(
+        model=model, min_samples=min_samples, terms=term_options(terms, max_harmonic, reference_temperature)))
     with Progress(TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console,
                   transient=True, disable=not console.is_terminal) as bar:
         task = bar.add_task("batch", total=len(entries))
@@ -120,6 +126,10 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
            shapes: str = typer.Option(",".join(SHAPES), help="Shapes of change tested, comma-separated: "
                                                                    "hinge (a linear drift from an onset), step "
                                                                    "(a jump at it); the better one per series."),
+           temperature: bool = typer.Option(True, help="Compare each series' values at one temperature where its "
+                                                       "logs record theirs (temperature.<joint>) and they spread."),
+           reference_temperature: Optional[float] = typer.Option(None, help="That temperature [°C] [default: each "
+                                                                            "series' median]."),
            title: str = typer.Option("Friction trends", help="The page's title.")) -> None:
     """Friction over time per robot and joint, and the joints whose friction drifted (a hinge or step change
     detector weighted by the fits' standard errors), as one HTML page."""
@@ -136,7 +146,8 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
         raise InputError(f"--table {table}: written as .parquet or .csv")
     check_paths({"RESULTS": results}, {"-o": output, **({"--table": table} if table is not None else {})})
     options = TrendOptions(alpha=alpha, min_change=min_change, replicates=replicates,
-                           shapes=tuple(cast("Shape", s.strip()) for s in shapes.split(",") if s.strip()))
+                           shapes=tuple(cast("Shape", s.strip()) for s in shapes.split(",") if s.strip()),
+                           temperature=temperature, reference_temperature=reference_temperature)
     with console.status(f"reading {results}") as status:
         dataset = read_results(results)
         for left in dataset.left_out:

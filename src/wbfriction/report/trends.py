@@ -102,12 +102,20 @@ def _relative_change(cp: ChangePoint) -> str:
     return "–" if not np.isfinite(cp.relative) else f"{100 * cp.relative:+.1f} %"
 
 
+def _at(cp: ChangePoint) -> str:
+    """The temperature a change is measured at, and the slope found ("as logged" without temperatures)."""
+    if cp.reference_temperature is None:
+        return "as logged"
+    return (f"{cp.reference_temperature:.3g} °C ({_num(cp.temperature_slope, 2)} ± {_num(cp.temperature_slope_se, 1)}"
+            " per °C)")
+
+
 def _drifts_table(joints: list[JointTrend]) -> str:
-    head = ("joint", "quantity", "shape", "onset", "change at the last log", "relative", "p-value")
+    head = ("joint", "quantity", "shape", "onset", "change at the last log", "relative", "p-value", "at")
     rows = "".join(
         f'<tr class="flag"><td>{html.escape(j.joint)}</td><td>{html.escape(cp.quantity)}</td><td>{cp.shape}</td>'
         f"<td>{_date(cp.onset_time)}</td><td>{_num(cp.change)} ± {_num(cp.change_se, 2)}</td>"
-        f"<td>{_relative_change(cp)}</td><td>{cp.p_value:.2g}</td></tr>"
+        f"<td>{_relative_change(cp)}</td><td>{cp.p_value:.2g}</td><td>{_at(cp)}</td></tr>"
         for j in joints for cp in j.drifts)
     return ('<div class="scroll"><table><tr>' + "".join(f"<th>{h}</th>" for h in head) + f"</tr>{rows}</table></div>")
 
@@ -161,8 +169,13 @@ def render_trends(trends: FleetTrends, title: str = "Friction trends") -> str:
               f"from an onset; step: a jump at the onset; the better fit chosen) that fits a quantity's series "
               f"better than a constant, weighted by the fits' standard errors, with a p-value below {o.alpha:g} per "
               f"joint (Bonferroni over its quantities; Monte Carlo, {o.draws()} noise series) and a change of at "
-              f"least {100 * o.min_change:.0f} % at the last log. Sign convention: F_c, F_v and f_at_v are "
-              f"positive for friction opposing the motion (f_at_v = (f(v) − f(−v)) / 2 [N·m], v in rad/s).")
+              f"least {100 * o.min_change:.0f} % at the last log. "
+              + ("Where a series' logs record the joint's temperature (temperature.<joint>) and it spreads, the "
+                 "values' linear dependence on it is fitted with the change, and the change is stated at one "
+                 "reference temperature (the drifts' last column): friction measured warm compares with friction "
+                 "measured cold. The figures show the values as measured. " if o.temperature else "")
+              + "Sign convention: F_c, F_v and f_at_v are "
+              "positive for friction opposing the motion (f_at_v = (f(v) − f(−v)) / 2 [N·m], v in rad/s).")
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
 <title>{html.escape(title)}</title><style>{PAGE_CSS}</style></head>
