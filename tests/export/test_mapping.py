@@ -87,3 +87,23 @@ def test_bad_armature_is_refused(value):
 def test_friction_given_in_part_is_refused():
     with pytest.raises(InputError, match="go together"):
         JointExport("knee", viscous=1.0)
+
+
+def test_a_fit_with_terms_exports_its_reference_levels_and_says_what_is_dropped():
+    """No simulator holds the terms beyond velocity: a fit that kept some exports its velocity model refitted with
+    them (the levels at zero load and T_ref, not the fit's own levels averaged over the log's conditions), and its
+    note names the terms dropped and those conditions."""
+    from wbfriction.export.mapping import status_note
+    from wbfriction.friction.terms import TermFit
+
+    refitted = CoulombViscousParams(F_v=0.25, F_c=0.8, tau_os=0.1)
+    terms = TermFit(refitted, ("load", "temperature"), 0, {"F_L": 0.02, "F_cT": -0.008, "F_vT": -0.004},
+                    reference_temperature=40.0)
+    fit = FitResult("a", 100, params=CoulombViscousParams(F_v=0.2, F_c=1.1, tau_os=0.1), success=True, terms=terms)
+    exp = joint_export("a", fit)
+    assert (exp.viscous, exp.coulomb, exp.static) == (0.25, 0.8, 0.8) and exp.dropped == ("load", "temperature")
+    note = status_note(exp)
+    assert note is not None and "dropped" in note and "load, temperature" in note
+    assert "zero load, T_ref 40 °C" in note
+    plain = joint_export("a", FitResult("a", 100, params=fit.params, success=True))
+    assert plain.coulomb == 1.1 and plain.dropped == () and "dropped" not in (status_note(plain) or "")

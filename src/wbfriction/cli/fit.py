@@ -121,6 +121,12 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
                   + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")", highlight=False)
     for status, joints in result.selection.left_out.items():
         console.print(f"not exported, {status}: {', '.join(joints)}", highlight=False, soft_wrap=True)
+    with_terms = {j: f.terms.kept for j, f in result.selection.exported.items() if f.terms is not None and f.terms.kept}
+    if with_terms:
+        console.print("no simulator holds the terms beyond velocity: dropped for "
+                      + ", ".join(f"{j} ({', '.join(kept)})" for j, kept in with_terms.items())
+                      + "; their F_c, F_v are at the reference conditions (zero load, T_ref), as each joint's note "
+                        "says", highlight=False, soft_wrap=True)
     for path, fmt in result.outputs:
         console.print(f"wrote {path} ({fmt})")
 

@@ -20,6 +20,10 @@ S, v_s (Stribeck)    dropped                 dropped                shape droppe
 a (tanh slope)       dropped                 dropped                dropped
 tau_os (offset)      dropped                 dropped                dropped
 armature [kg·m^2]    -- (no URDF field)      ``armature``           ``armature``
+load (k_L)           dropped                 dropped                dropped
+direction (dF_v)     dropped                 dropped                dropped
+ripple               dropped                 dropped                dropped
+temperature (k_T)    dropped                 dropped                dropped
 ===================  ======================  =====================  ===================================
 
 (F_s is the ``stribeck`` model's own F_s, and F_c for the ``coulomb-viscous`` model.)
@@ -36,6 +40,11 @@ armature [kg·m^2]    -- (no URDF field)      ``armature``           ``armature`
   friction falls from F_s to F_c (v_s, the Stribeck velocity) has no field anywhere.
 * ``tau_os`` is not friction (a torque sensor's offset, removed before the energy check, thesis
   7.9): it is not exported. Nor is ``a``, a smoothing of the model's sign function.
+* The terms beyond velocity (:mod:`wbfriction.friction.terms`) have no field in any of the three: friction that
+  grows with the load or falls with the temperature, a viscous level per direction, a position ripple (which is
+  not friction). A fit that kept some exports its velocity model refitted with them, at the reference conditions
+  (zero load, the reference temperature ``T_ref``, no ripple), and its note says which terms were dropped and at
+  which conditions the levels are (:func:`status_note`).
 
 Friction that is not dissipative (F_c < 0, F_v < 0, or a static level F_s < 0, i.e. S < -1) and
 a negative armature are refused (:class:`~wbfriction.exceptions.InputError`), never exported.
@@ -198,6 +207,8 @@ class JointExport:
         armature: reflected rotor inertia [kg·m^2] (MJCF and Isaac ``armature``), None when not given.
         params: the model parameters the friction comes from (what is dropped: tau_os, and S, v_s, a of (3.5)).
         verdict: the status of the fit the friction comes from (:func:`status_note`), None for bare parameters.
+        dropped: the terms beyond velocity the fit kept, which no simulator holds (module docstring).
+        conditions: where the fit kept terms, the conditions its levels are at (``zero load, T_ref 40 °C``).
 
     Raises:
         InputError: a value that is negative (not dissipative) or not finite, or friction given in part.
@@ -210,6 +221,8 @@ class JointExport:
     armature: float | None = None
     params: FrictionModelParams | None = None
     verdict: FitVerdict | None = None
+    dropped: tuple[str, ...] = ()
+    conditions: str = ""
 
     def __post_init__(self) -> None:
         given = [x is not None for x in (self.viscous, self.coulomb, self.static)]
@@ -252,9 +265,18 @@ def joint_export(joint: str, friction: FrictionLike | None = None, armature: flo
     verdict = fit.verdict() if fit is not None else None
     if verdict is not None and verdict.status in NEVER_EXPORTED:
         raise InputError(f"joint '{joint}': its fit is {verdict}: numbers the data do not carry are not exported")
+    terms = fit.terms if fit is not None and fit.terms is not None and fit.terms.kept else None
+    dropped: tuple[str, ...] = ()
+    conditions = ""
+    if terms is not None:  # its velocity model refitted with them: the levels at the reference conditions
+        params = terms.params
+        dropped = terms.kept
+        conditions = "zero load" + ("" if terms.reference_temperature is None
+                                    else f", T_ref {terms.reference_temperature:.3g} °C")
     return JointExport(joint, viscous=float(params.F_v), coulomb=float(params.F_c),
                        static=static_level(params),
-                       armature=None if armature is None else float(armature), params=params, verdict=verdict)
+                       armature=None if armature is None else float(armature), params=params, verdict=verdict,
+                       dropped=dropped, conditions=conditions)
 
 
 NOTE_PREFIX = "wbfriction fit of"
@@ -267,12 +289,16 @@ def status_note(exp: JointExport) -> str | None:
     None for a joint without (bare parameters, armature only).
 
     Examples:
-        ``wbfriction fit of knee: ok``, ``wbfriction fit of hip: weak (large standard errors: F_v ±80 %)``
+        ``wbfriction fit of knee: ok``, ``wbfriction fit of hip: weak (large standard errors: F_v ±80 %)``,
+        ``wbfriction fit of wrist: ok; terms beyond velocity dropped (no field here): ripple; levels at zero load``
     """
     if exp.verdict is None or not exp.has_friction:
         return None
     v = exp.verdict
     text = f"{NOTE_PREFIX} {exp.joint}: {v.status}" + (f" ({v.reason})" if v.reason else "")
+    if exp.dropped:
+        text += (f"; terms beyond velocity dropped (no field here): {', '.join(exp.dropped)}; levels at "
+                 f"{exp.conditions}")
     text = " ".join(text.split())
     while "--" in text:
         text = text.replace("--", "- -")
