@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional
 
@@ -34,20 +35,23 @@ from wbfriction.cli.common import (
 
 def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptions | MujocoOptions,
                   friction: Optional[Path]) -> None:
-    from wbfriction.friction.targets import load_friction_toml
+    from wbfriction.friction.targets import load_friction_spec
     from wbfriction.logs.log import write_log
     from wbfriction.sim.ideal import simulate_ideal
     from wbfriction.sim.mujoco_sim import simulate_mujoco
     from wbfriction.walking.reference import walking_reference
 
-    params = None if friction is None else load_friction_toml(friction, r.groups, r.torque_controlled)
+    spec = None if friction is None else load_friction_spec(friction, r.groups, r.torque_controlled)
+    params, terms = (None, None) if spec is None else (spec.params, spec.terms)
+    if spec is not None and spec.temperature is not None:
+        options = dataclasses.replace(options, temperature=spec.temperature)
     with console.status(f"planning {gait.steps} steps ({gait.gait})"):
         ref = walking_reference(r, gait)
     with progress_bar(len(ref), "simulate") as advance:
         if isinstance(options, MujocoOptions):
-            result = simulate_mujoco(r, ref, params, options, progress=advance)
+            result = simulate_mujoco(r, ref, params, options, progress=advance, terms=terms)
         else:
-            result = simulate_ideal(r, ref, params, options, progress=advance)
+            result = simulate_ideal(r, ref, params, options, progress=advance, terms=terms)
     write_log(result.log, r, output)
     console.print(f"wrote {output} ({len(result.log)} samples, {result.log.time[-1]:.1f} s)")
     for p in result.pulls():
@@ -56,14 +60,17 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
 
 
 def _run_simulate_arm(r: Robot, output: Path, options: ArmOptions, friction: Optional[Path]) -> None:
-    from wbfriction.friction.targets import load_friction_toml
+    from wbfriction.friction.targets import load_friction_spec
     from wbfriction.logs.tables import write_table
     from wbfriction.sim.arm import default_arm_friction, simulate_arm
 
-    params = (load_friction_toml(friction, r.groups, r.torque_controlled) if friction is not None
-              else default_arm_friction(r))
+    spec = None if friction is None else load_friction_spec(friction, r.groups, r.torque_controlled)
+    params = default_arm_friction(r) if spec is None else spec.params
+    if spec is not None and spec.temperature is not None:
+        options = dataclasses.replace(options, temperature=spec.temperature)
     with progress_bar(int(options.duration * options.rate), "simulate") as advance:
-        result = simulate_arm(r, params, options=options, progress=advance)
+        result = simulate_arm(r, params, options=options, progress=advance,
+                              terms=None if spec is None else spec.terms)
     write_table(result.table, output)
     console.print(f"wrote {output} ({result.table.num_rows} samples, {options.duration:g} s, motor currents)")
 
@@ -80,8 +87,12 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              turn_angle: float = typer.Option(GAIT.turn_angle, help="Heading change per turning step [rad]."),
              lift_height: float = typer.Option(GAIT.lift_height, help="Swing-foot apex [m]."),
              friction: Optional[Path] = typer.Option(None, help="TOML with [friction.<group or joint>] tables (a "
-                                                               "model key: coulomb-viscous, stribeck or (3.5)); "
-                                                               "default: thesis Table 6.1 on the legs."),
+                                                               "model key: coulomb-viscous, stribeck or (3.5)), "
+                                                               "each with an optional terms table (F_L, dF_v, "
+                                                               "ripple, F_cT, F_vT, reference_temperature), and "
+                                                               "a [temperature] warm-up (start, end [°C]) logged "
+                                                               "as temperature.<joint>; default: thesis Table "
+                                                               "6.1 on the legs."),
              simulator: Simulator = typer.Option("ideal", help="ideal (rigid contacts, thesis 6.1) or mujoco (soft "
                                                          "contacts, measured contact flags, sensors, thesis 6.2)."),
              substeps: Optional[int] = typer.Option(None, help=f"Physics steps per 1 ms control period (default: "

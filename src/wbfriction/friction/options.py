@@ -178,6 +178,11 @@ Term = Literal["load", "direction", "ripple", "temperature"]
 """A term beyond velocity (module docstring)."""
 TERMS: tuple[Term, ...] = get_args(Term)
 """Every term, in the order they are reported."""
+MIN_EFFECT = 0.01
+"""A term beyond velocity whose torque over the samples (RMS) is below this share of the friction's is not kept
+(:mod:`~wbfriction.friction.terms`)."""
+
+
 @dataclass(frozen=True)
 class TermOptions:
     """Which terms are tried and how.
@@ -188,20 +193,25 @@ class TermOptions:
         reference_temperature: ``T_ref`` [°C]; None: the median temperature of the samples fitted.
         tolerance: a term is kept when it lowers the held-out RMS by more than this share (the model choice's,
             :data:`~wbfriction.friction.options.SELECTION_TOLERANCE`).
+        min_effect: a term whose torque (RMS over the samples) is below this share of the friction's is not kept
+            (:data:`MIN_EFFECT`).
 
     Raises:
-        OptionError: an unknown term, ``max_harmonic`` below 1 or above 20, ``tolerance`` outside (0, 1).
+        OptionError: an unknown term, ``max_harmonic`` below 1 or above 20, ``tolerance`` or ``min_effect``
+            outside (0, 1).
     """
 
     terms: tuple[Term, ...] = TERMS
     max_harmonic: int = 4
     reference_temperature: float | None = None
     tolerance: float = SELECTION_TOLERANCE
+    min_effect: float = MIN_EFFECT
 
     def __post_init__(self) -> None:
         for term in self.terms:
             check_choice("terms", term, TERMS)
         check_range("max_harmonic", self.max_harmonic, low=1, high=20)
+        check_range("min_effect", self.min_effect, low=0.0, high=1.0)
         check_range("tolerance", self.tolerance, low=0.0, high=1.0, strict=True)
 
 

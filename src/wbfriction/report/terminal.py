@@ -15,12 +15,14 @@ from __future__ import annotations
 
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Mapping, Sequence
+from functools import partial
 
 from rich.table import Table
 
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import ALL_PARAM_NAMES
+from wbfriction.friction.terms import TERM_COEFFICIENTS, TermFit
 from wbfriction.inertia.document import Identification
 from wbfriction.report.numbers import bound_text, with_error
 
@@ -85,40 +87,40 @@ def fit_tables(results: Sequence[FitResult], wide: bool = False,
     return [t for t in [*tables, terms] if t is not None and t.row_count]
 
 
-TERM_COLUMNS = ("F_L", "dF_v", "F_cT", "F_vT", "ripple_rms")
-"""The term coefficients the terms' table shows (value ± standard error), those of a term some joint kept."""
-
-
 def terms_table(results: Sequence[FitResult], label: Callable[[str], str] = str) -> Table | None:
-    """The terms beyond velocity (:mod:`~wbfriction.friction.terms`) of the joints whose fit kept some: the terms
-    kept, their worst status (:meth:`~wbfriction.friction.terms.TermFit.verdicts`), F_c and F_v refitted with them
-    (at zero load and the reference temperature), and each kept coefficient ± its standard error; None when no fit
-    kept one."""
-    tried = [r for r in results if r.terms is not None and r.terms.kept]
-    if not tried:
+    """The terms beyond velocity (:mod:`~wbfriction.friction.terms`) of the joints whose fit kept some, one row per
+    term (a narrow table whatever the terms): its status (:meth:`~wbfriction.friction.terms.TermFit.verdicts`) and
+    its coefficients ± standard errors, after a row of F_c and F_v refitted with the terms (at zero load and the
+    reference temperature, the ones exports write); None when no fit kept one."""
+    kept = [r for r in results if r.terms is not None and r.terms.kept]
+    if not kept:
         return None
-    columns = [n for n in TERM_COLUMNS if any(n in r.terms.coefficients or n in r.terms.derived for r in tried
-                                              if r.terms is not None)]
-    t_ref = next((r.terms.reference_temperature for r in tried if r.terms is not None
-                  and "temperature" in r.terms.kept), None)
-    at = "zero load" + (f", T_ref {t_ref:.3g} °C" if t_ref is not None else "")
-    table = _table(f"Terms beyond velocity (F_c, F_v at {at})", ("joint", "terms", "status"), [*MAIN, *columns],
-                   caption="ripple_rms: the position ripple's size [N·m] (H harmonics), not friction: left out of "
-                           "the energy check and the exports")
-    order = ("routes disagree", "weak", "ok")
-    for r in tried:
+    table = Table(title="Terms beyond velocity", box=None, title_justify="left", caption_justify="left",
+                  pad_edge=False, caption="ripple: a torque of the angle, not friction (left out of the energy check "
+                                          "and the exports); the velocity row: F_c, F_v refitted with the terms")
+    for col in ("joint", "term", "status", "values"):
+        table.add_column(col, no_wrap=col != "values")
+    for r in kept:
         terms = r.terms
         assert terms is not None
-        verdicts = terms.verdicts()
-        status = min((v.status for v in verdicts.values()), key=order.index)
-        values = {**terms.coefficients, **terms.derived, **terms.params.to_dict()}
-        cells = ["" if not terms.kept or n not in terms.stderr else
-                 with_error(values[n], terms.stderr[n]) + (" (b)" if n in terms.at_bound else "")
-                 for n in (*MAIN, *columns)]
-        if "ripple" in terms.kept:
-            cells[-1] += f" (H {terms.harmonics})"
-        table.add_row(label(r.joint), ", ".join(terms.kept), status, *cells, style=None if status == "ok" else "dim")
+        shown = partial(_term_value, terms)
+        at = "zero load" + ("" if terms.reference_temperature is None or "temperature" not in terms.kept
+                            else f", {terms.reference_temperature:.3g} °C")
+        table.add_row(label(r.joint), "velocity", "", f"{shown('F_c')}, {shown('F_v')} at {at}")
+        for term, verdict in terms.verdicts().items():
+            if term == "ripple":
+                text = (f"size {with_error(terms.derived['ripple_rms'], terms.stderr.get('ripple_rms'))} N·m, "
+                        f"{terms.harmonics} harmonic{'s' if terms.harmonics > 1 else ''}")
+            else:
+                text = ", ".join(shown(n) for n in TERM_COEFFICIENTS[term])
+            table.add_row("", term, verdict.status, text, style=None if verdict.ok else "dim")
     return table
+
+
+def _term_value(terms: TermFit, name: str) -> str:
+    """``name value ± standard error`` of a coefficient of ``terms`` (``(b)``: held at a bound)."""
+    values = {**terms.coefficients, **terms.derived, **terms.params.to_dict()}
+    return f"{name} {with_error(values[name], terms.stderr.get(name))}" + (" (b)" if name in terms.at_bound else "")
 
 
 def terms_notes(results: Sequence[FitResult], verbose: bool = False,

@@ -58,7 +58,7 @@ from wbfriction.logs.tables import read_metadata, with_metadata
 from wbfriction.model.loading import build_model
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
-from wbfriction.sim.common import InjectedFriction
+from wbfriction.sim.common import injected_friction, terms_truth, warm_up
 from wbfriction.sim.options import SensorNoise
 
 GENERATOR = "wbfriction.sim.arm.simulate_arm"
@@ -290,12 +290,10 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
         raise InputError(f"friction given for '{unknown[0]}', which is not a joint of {robot.name}")
     if options.temperature is None and any("temperature" in t.kept for t in terms.values()):
         raise InputError("a temperature term needs the joints' temperature: give ArmOptions.temperature")
-    friction = {j: p for j, p in friction.items() if j not in terms}
-    beyond = [(robot.actuated.index(j), t) for j, t in terms.items()]
     model = arm_model(robot)
     model.armature = _armature(robot, armature)
     k_t = _torque_constants(robot)
-    injected = InjectedFriction(dict(friction), [robot.actuated.index(j) for j in friction])
+    injected = injected_friction(robot, friction, terms, robot.actuated)
     excited = None if options.excitation.excited is None else np.isin(robot.actuated, options.excitation.excited)
     traj = excitation_trajectory(model.lowerPositionLimit, model.upperPositionLimit, model.velocityLimit,
                                  options.excitation, excited)
@@ -312,29 +310,29 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
     Q, V, A, T, F = (np.empty((n, nv)) for _ in range(5))
     q, v = q_ref[0].copy(), qd_ref[0].copy()
     tau_f = np.zeros(nv)
-    warm = (None if options.temperature is None
-            else np.linspace(options.temperature[0], options.temperature[1], n))
+    warm = warm_up(options.temperature, n)
+    f = injected.joints
     for k in counted(n, progress):
         tau = ff[k] + kp * (q_ref[k] - q) + kd * (qd_ref[k] - v)
         for s in range(options.substeps):
-            if injected.joints:
-                tau_f[injected.joints] = injected.torque(v[injected.joints])
-            for i, truth in beyond:  # the load: the rigid-body torque M qdd + h = tau + tau_f, of the last step
-                tau_f[i] = truth.torque_at(v[i], q[i], tau[i] + tau_f[i], 0.0 if warm is None else warm[k])
+            if f:
+                friction_f = injected.torque(v[f])
+                if injected.beyond:  # the load: the rigid-body torque M qdd + h = tau + tau_f, of the last step
+                    friction_f = injected.with_terms(friction_f, v[f], q[f], tau[f] + tau_f[f],
+                                                     0.0 if warm is None else float(warm[k]))
+                tau_f[f] = friction_f
             a = pin.aba(model, data, q, v, tau + tau_f)
             if s == 0:
                 Q[k], V[k], A[k], T[k], F[k] = q, v, a, tau, tau_f
             v = v + h * a
             q = q + h * v
-    table = _table(robot, time, Q, V, A, T, F, k_t, model.armature, friction, options)
+    table = _table(robot, time, Q, V, A, T, F, k_t, model.armature, injected.params, options)
     meta = read_metadata(table)
     if warm is not None:
         for j in robot.actuated:
             table = table.append_column(f"temperature.{j}", pa.array(warm))
     if terms:
-        meta["friction_true"].update({j: t.params.to_target() for j, t in terms.items()})
-        meta["terms_true"] = {j: {"kept": list(t.kept), "harmonics": t.harmonics, "coefficients": t.coefficients,
-                                  "reference_temperature": t.reference_temperature} for j, t in terms.items()}
+        meta["terms_true"] = terms_truth(terms)
     table = with_metadata(table, meta)
     return ArmSimulation(table, traj, Q, V, A, T, F)
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import cast
 
@@ -11,6 +11,7 @@ import numpy as np
 from wbfriction.exceptions import InputError
 from wbfriction.friction.models import MODEL_NAMES, FrictionParams, ModelParams, model_values, stack_params
 from wbfriction.friction.targets import friction_by_group
+from wbfriction.friction.terms import TermFit
 from wbfriction.logs.log import Log
 from wbfriction.model.force_torque import sensor_readings
 from wbfriction.model.imu import imu_readings
@@ -28,12 +29,16 @@ class InjectedFriction:
     Attributes:
         params: parameters per joint name.
         joints: their indices among the torque-controlled joints.
+        terms: per joint with friction beyond velocity (:class:`~wbfriction.friction.terms.TermFit`), its model
+            and terms (:meth:`with_terms`); its ``params`` are the joint's in :attr:`params`.
     """
 
     params: dict[str, ModelParams]
     joints: list[int]
+    terms: dict[str, TermFit] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        self.beyond = [(col, self.terms[joint]) for col, joint in enumerate(self.params) if joint in self.terms]
         self._gaussian = bool(self.params) and all(isinstance(p, FrictionParams) and p.delta_s == 2.0
                                                    for p in self.params.values())
         if self._gaussian:
@@ -74,18 +79,51 @@ class InjectedFriction:
         return np.negative(out, out=out)
 
 
-def injected_friction(robot: Robot, friction: Mapping[str, ModelParams] | None) -> InjectedFriction:
+    def with_terms(self, tau_f: np.ndarray, qd: np.ndarray, q: np.ndarray, load: np.ndarray,
+                   temperature: float) -> np.ndarray:
+        """``tau_f`` (n_f,) of :meth:`torque` with the joints of :attr:`terms` given their whole friction
+        (:meth:`~wbfriction.friction.terms.TermFit.torque_at`), from their velocities, angles [rad], loads (the
+        rigid-body torque ``M qdd + h = tau_motor + tau_f``, the last step's) [N·m] (n_f,) and the temperature
+        [°C]."""
+        for col, fit in self.beyond:
+            tau_f[col] = fit.torque_at(float(qd[col]), float(q[col]), float(load[col]), temperature)
+        return tau_f
+
+
+def injected_friction(robot: Robot, friction: Mapping[str, ModelParams] | None,
+                      terms: Mapping[str, TermFit] | None = None, joints: Sequence[str] | None = None
+                      ) -> InjectedFriction:
     """Friction to inject: the given parameters per joint or, by default, the thesis's targets
-    (Table 6.1) on the leg joint groups.
+    (Table 6.1) on the leg joint groups; ``terms`` per joint replace its parameters by theirs and add friction
+    beyond velocity.
+
+    Args:
+        joints: the joints friction may be injected on (default: the torque-controlled ones); the indices are
+            among them.
 
     Raises:
-        InputError: an entry for a joint that is not torque-controlled.
+        InputError: an entry for a joint that is not one of ``joints``.
     """
-    friction = friction_by_group(robot.groups) if friction is None else friction
+    joints = robot.torque_controlled if joints is None else tuple(joints)
+    friction = dict(friction_by_group(robot.groups) if friction is None else friction)
+    terms = dict(terms or {})
+    friction.update({j: t.params for j, t in terms.items()})
     for joint in friction:
-        if joint not in robot.torque_controlled:
+        if joint not in joints:
             raise InputError(f"friction given for '{joint}', which is not a torque-controlled joint")
-    return InjectedFriction(dict(friction), [robot.torque_controlled.index(j) for j in friction])
+    return InjectedFriction(friction, [joints.index(j) for j in friction], terms)
+
+
+def terms_truth(terms: Mapping[str, TermFit]) -> dict[str, dict]:
+    """The terms a simulator injected, as its log's ``terms_true`` metadata records them."""
+    return {j: {"kept": list(t.kept), "harmonics": t.harmonics, "coefficients": t.coefficients,
+                "reference_temperature": t.reference_temperature} for j, t in terms.items()}
+
+
+def warm_up(temperature: tuple[float, float] | None, n: int) -> np.ndarray | None:
+    """The joints' temperature at each of ``n`` samples [°C]: linear from ``temperature[0]`` to ``[1]``; None
+    without."""
+    return None if temperature is None else np.linspace(temperature[0], temperature[1], n)
 
 
 @dataclass
@@ -162,10 +200,15 @@ class Recording:
         wrench: contact wrenches (N, n_contacts, 6), as :attr:`SimulationResult.wrench`.
     """
 
-    def __init__(self, robot: Robot, reference: WalkingReference, friction: InjectedFriction) -> None:
-        """Empty buffers for the ``len(reference)`` samples of a walk of ``robot``."""
+    def __init__(self, robot: Robot, reference: WalkingReference, friction: InjectedFriction,
+                 temperature: tuple[float, float] | None = None) -> None:
+        """Empty buffers for the ``len(reference)`` samples of a walk of ``robot``; ``temperature``: the joints'
+        warm-up (:func:`warm_up`, its samples :attr:`temperature`)."""
         n, n_tc = len(reference), robot.tc_index.size
         self.robot, self.reference, self.friction = robot, reference, friction
+        self.temperature = warm_up(temperature, n)
+        if self.temperature is None and any("temperature" in t.kept for t in friction.terms.values()):
+            raise InputError("a temperature term needs the joints' temperature: give the options' temperature")
         self.tau = np.empty((n, n_tc))
         self.tau_f = np.zeros((n, n_tc))
         self.wrench = np.zeros((n, len(robot.contact_frames), 6))
@@ -197,7 +240,11 @@ class Recording:
                                      self.wrench)
         if log_imu and self.robot.imu is not None:
             imu = imu_readings(self.robot.model, self.robot.imu, Q, V, A)
+        if self.friction.terms:
+            metadata["terms_true"] = terms_truth(self.friction.terms)
         log = simulated_log(self.robot, self.reference, Q if Q_log is None else Q_log, V, A, tau, self.tau_f, contact,
                             self.friction, generator, options, options.log_base, wrench, imu, **metadata)
+        if self.temperature is not None:
+            log.temperature = np.repeat(self.temperature[:, None], self.tau.shape[1], axis=1)
         return SimulationResult(log, self.wrench, Q, V, self.reference, tuple(self.robot.contact_frames),
                                 self.tau.copy())

@@ -38,6 +38,7 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.friction.models import ModelParams
+from wbfriction.friction.terms import TermFit
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.sim.common import InjectedFriction, Recording, SimulationResult, injected_friction
@@ -132,6 +133,7 @@ class _IdealRun:
         self.iv_tc, self.iv_pc = as_slice(iv[tc]), as_slice(iv[self.pc])
         self.joints_f = injected.joints
         self.iv_f = as_slice(iv[tc][self.joints_f])
+        self.iq_f = as_slice(iq[tc][self.joints_f])
         self.settings = pin.ProximalSettings(1e-12, 1e-10, 50)
         self.semi_implicit = options.integrator == "semi-implicit"
         self.project_every_sample = options.projection == "sample"
@@ -150,7 +152,7 @@ class _IdealRun:
         self.V = np.empty((n, self.model.nv))
         self.A = np.empty((n, self.model.nv))
         self.lam = np.zeros((n, 6 * len(robot.contact_frames)))  # logged wrenches of the active feet, stacked
-        self.recording = Recording(robot, reference, injected)
+        self.recording = Recording(robot, reference, injected, options.temperature)
         self.q, self.v = ref.q[0].copy(), ref.v[0].copy()
         self.anchors: dict[int, pin.SE3] = {}
         self.active = np.zeros(len(robot.contact_frames), bool)
@@ -179,6 +181,10 @@ class _IdealRun:
         Q, V, A, lam_log, record_torques = self.Q, self.V, self.A, self.lam, self.recording.record_torques
         switches, tau, tau_pc, tau_f = self.switches, self.tau, self.tau_pc, self.tau_f
         q, v = self.q, self.v
+        beyond, iq_f, joints_f = (self.injected.with_terms if self.injected.beyond else None), self.iq_f, self.joints_f
+        warm = self.recording.temperature
+        if beyond is not None and tau_f is None:
+            tau_f = np.zeros(len(joints_f))
         for k in counted(len(self.ref), progress):
             switch = k in switches
             if switch:
@@ -196,7 +202,11 @@ class _IdealRun:
                     tau_cmd = u[:n_tc]
                 tau[iv_tc] = tau_cmd
                 if friction is not None:
-                    tau_f = friction(v[iv_f])
+                    if beyond is not None:  # the load: the rigid-body torque tau_motor + tau_f, of the last step
+                        tau_f = beyond(friction(v[iv_f]), v[iv_f], q[iq_f], tau_cmd[joints_f] + tau_f,
+                                       0.0 if warm is None else float(warm[k]))
+                    else:
+                        tau_f = friction(v[iv_f])
                     tau[iv_f] += tau_f
                 tau[iv_pc] = tau_pc
                 a = constraint_dynamics(model, data, q, v, tau, cmodels, cdatas, settings)
@@ -259,7 +269,8 @@ class _IdealRun:
 
 def simulate_ideal(robot: Robot, reference: WalkingReference,
                    friction: Mapping[str, ModelParams] | None = None,
-                   options: IdealOptions = IdealOptions(), progress: Progress | None = None) -> SimulationResult:
+                   options: IdealOptions = IdealOptions(), progress: Progress | None = None,
+                   terms: Mapping[str, TermFit] | None = None) -> SimulationResult:
     """Simulate a walk in the ideal simulator (module docstring).
 
     Args:
@@ -269,13 +280,18 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
             targets (Table 6.1) on the leg joint groups, none elsewhere.
         options: :class:`IdealOptions`.
         progress: optional callable receiving numbers of samples done.
+        terms: friction beyond velocity per torque-controlled joint (:class:`~wbfriction.friction.terms.TermFit`:
+            its model replaces the joint's ``friction``; the load is the joint's rigid-body torque
+            ``tau_motor + tau_f`` of the previous physics step, the angle its true one, the temperature the
+            options' warm-up), logged as the metadata's ``terms_true``.
 
     Returns:
         A :class:`SimulationResult` whose log has ``len(reference)`` samples.
 
     Raises:
-        InputError: a friction entry for a joint that is not torque-controlled.
+        InputError: a friction entry for a joint that is not torque-controlled; a temperature term without the
+            options' temperature.
     """
-    run = _IdealRun(robot, reference, injected_friction(robot, friction), options)
+    run = _IdealRun(robot, reference, injected_friction(robot, friction, terms), options)
     run.run(progress)
     return run.result()

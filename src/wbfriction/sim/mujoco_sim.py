@@ -66,6 +66,7 @@ import pinocchio as pin
 from wbfriction.exceptions import InputError, SimulationError
 from wbfriction.friction.models import ModelParams
 from wbfriction.friction.targets import friction_by_group
+from wbfriction.friction.terms import TermFit
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.sim.common import InjectedFriction, Recording, SimulationResult, injected_friction
@@ -164,14 +165,16 @@ class MujocoRun:
     """One run of :func:`simulate_mujoco`: the MuJoCo model and data, the controller, the state and the log."""
 
     def __init__(self, robot: Robot, reference: WalkingReference, friction: Mapping[str, ModelParams] | None,
-                 options: MujocoOptions, mjr: MujocoRobot | None) -> None:
+                 options: MujocoOptions, mjr: MujocoRobot | None, terms: Mapping[str, TermFit] | None = None) -> None:
         """Set up the model (friction), the stabiliser, the controller, the initial state and the log buffers."""
         import mujoco
         self.native = native = options.friction == "mujoco"
         if friction is None and native:
             friction = {j: dataclasses.replace(p, S=0.0, tau_os=0.0)
                         for j, p in friction_by_group(robot.groups).items()}
-        self.injected = injected_friction(robot, friction)
+        if terms and native:
+            raise InputError("terms beyond velocity need the 'model' friction (MuJoCo's own joint friction has none)")
+        self.injected = injected_friction(robot, friction, terms)
         self.robot, self.ref, self.options = robot, reference, options
         self.n, self.dt = len(reference), reference.dt
         self.delay = options.delay_periods(self.dt)
@@ -183,6 +186,7 @@ class MujocoRun:
         self.joints_f = self.injected.joints
         dof_f = self.mjr.dof_index[self.tc][self.joints_f]
         self.dof_f = as_slice(dof_f)
+        self.qpos_f = as_slice(self.mjr.qpos_index[self.tc][self.joints_f])
         if native:
             set_mujoco_friction(self.model, dof_f, self.injected, options.friction_timeconst)
         if options.sole_timeconst is not None:
@@ -237,7 +241,7 @@ class MujocoRun:
         # what MuJoCo's sensors (sensordata: touch, force-torque, IMU) and the torque sensors read, averaged
         self.sensor_means = MatchedMeans(n, self.options.substeps, model.nsensordata)
         self.motor_means = MatchedMeans(n, self.options.substeps, model.nu)
-        self.recording = Recording(self.robot, ref, self.injected)
+        self.recording = Recording(self.robot, ref, self.injected, self.options.temperature)
         self.contact, self.force = np.zeros((n, nc), dtype=bool), np.zeros((n, nc))
         self.commands = np.zeros((self.delay + 1, n_act))  # ring buffer: the command of period k acts at k + delay
         self.state: tuple[bool, ...] | None  # the contact state the gains are scheduled for
@@ -309,9 +313,14 @@ class MujocoRun:
         qvel, applied, sensordata, motor = data.qvel, data.qfrc_applied, data.sensordata, data.actuator_force
         sensed, motors = self.sensor_means.period(k), self.motor_means.period(k)
         friction, dof_f, torque = self.torque_friction, self.dof_f, self.injected.torque
+        beyond = self.injected.with_terms if self.injected.beyond else None
+        warm = self.recording.temperature
         for s in range(len(sensed)):
             if friction:
                 tau_f = torque(qvel[dof_f])
+                if beyond is not None:  # the load: the rigid-body torque, motor's and friction's, of the last step
+                    tau_f = beyond(tau_f, qvel[dof_f], data.qpos[self.qpos_f],
+                                   data.qfrc_actuator[dof_f] + applied[dof_f], 0.0 if warm is None else float(warm[k]))
                 applied[dof_f] = tau_f
                 if s == 0:
                     self.tau_f_first[k] = tau_f
@@ -374,7 +383,7 @@ class MujocoRun:
 
 def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: Mapping[str, ModelParams] | None = None,
                     options: MujocoOptions = MujocoOptions(), mjr: MujocoRobot | None = None,
-                    progress: Progress | None = None) -> SimulationResult:
+                    progress: Progress | None = None, terms: Mapping[str, TermFit] | None = None) -> SimulationResult:
     """Simulate a walk on MuJoCo (module docstring).
 
     Args:
@@ -385,6 +394,8 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: Mapping
         options: :class:`MujocoOptions`.
         mjr: a prebuilt MuJoCo model (not modified; default: built from ``robot``).
         progress: optional callable receiving numbers of samples done.
+        terms: friction beyond velocity per torque-controlled joint (``options.friction == "model"`` only;
+            :func:`~wbfriction.sim.ideal.simulate_ideal`'s), logged as the metadata's ``terms_true``.
 
     Returns:
         A :class:`~wbfriction.sim.common.SimulationResult`; its ``wrench`` holds the soles'
@@ -392,10 +403,11 @@ def simulate_mujoco(robot: Robot, reference: WalkingReference, friction: Mapping
 
     Raises:
         InputError: friction on a joint that is not torque-controlled; Stribeck or offset
-            parameters with MuJoCo's friction; a delay that is not whole periods.
+            parameters with MuJoCo's friction; terms with MuJoCo's friction, or a temperature term without the
+            options' temperature; a delay that is not whole periods.
         SimulationError: the robot fell (the message gives the time).
     """
-    run = MujocoRun(robot, reference, friction, options, mjr)
+    run = MujocoRun(robot, reference, friction, options, mjr, terms)
     for k in counted(len(reference), progress):
         run.sample(k)
     return run.result()

@@ -99,6 +99,8 @@ class IdealOptions:
             logged sample (the logged state satisfies ``J v = 0`` exactly: ground truth to
             1e-9 N·m); ``"touch-down"``: only at contact changes, Baumgarte correcting the
             drift (truth to about 1e-4 N·m).
+        temperature: the joints' temperature at the log's start and end [°C], a linear warm-up logged as
+            ``temperature.<joint>`` (what a ``temperature`` term of the injected friction sees); None: not logged.
     """
 
     substeps: int = 1
@@ -111,6 +113,7 @@ class IdealOptions:
     projection: Projection = "sample"
     force_torque: bool = False
     imu: bool = False
+    temperature: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         check_choice("integrator", self.integrator, INTEGRATORS)
@@ -169,6 +172,8 @@ class MujocoOptions:
             frame, averaged over the physics steps around the sample as the wrenches).
         imu_noise: standard deviations of the gyro's [rad/s] and the accelerometer's [m/s^2] white noise.
         imu_bias: standard deviations of their constant biases, drawn per axis from ``sensors.seed``.
+        temperature: the joints' temperature at the log's start and end [°C], a linear warm-up logged as
+            ``temperature.<joint>`` (what a ``temperature`` term of the injected friction sees); None: not logged.
     """
 
     substeps: int = 4
@@ -191,6 +196,7 @@ class MujocoOptions:
     imu: bool = True
     imu_noise: tuple[float, float] = (0.0, 0.0)
     imu_bias: tuple[float, float] = (0.0, 0.0)
+    temperature: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         if self.substeps < 1:
