@@ -194,7 +194,8 @@ class TermOptions:
         tolerance: a term is kept when it lowers the held-out RMS by more than this share (the model choice's,
             :data:`~wbfriction.friction.options.SELECTION_TOLERANCE`).
         min_effect: a term whose torque (RMS over the samples) is below this share of the friction's is not kept
-            (:data:`MIN_EFFECT`).
+            (:data:`MIN_EFFECT`), nor one below ``min_torque`` [N·m] (a torque sensor's resolution: on a joint
+            with almost no friction, a share of it is nothing; :data:`DEFAULT_TOLERANCE`).
 
     Raises:
         OptionError: an unknown term, ``max_harmonic`` below 1 or above 20, ``tolerance`` or ``min_effect``
@@ -206,12 +207,14 @@ class TermOptions:
     reference_temperature: float | None = None
     tolerance: float = SELECTION_TOLERANCE
     min_effect: float = MIN_EFFECT
+    min_torque: float = DEFAULT_TOLERANCE
 
     def __post_init__(self) -> None:
         for term in self.terms:
             check_choice("terms", term, TERMS)
         check_range("max_harmonic", self.max_harmonic, low=1, high=20)
         check_range("min_effect", self.min_effect, low=0.0, high=1.0)
+        check_range("min_torque", self.min_torque, low=0.0)
         check_range("tolerance", self.tolerance, low=0.0, high=1.0, strict=True)
 
 

@@ -600,7 +600,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         names, X, k = design(tuple(kept), harmonics)
         coef, _ = _nonnegative_solve(X[use], y_[use], names)
         bad = _unphysical(with_coefficients(params, coef[:k]), dict(zip(names[k:], map(float, coef[k:]))), signals,
-                          use, t_ref or 0.0) or _negligible(names, X[use], coef, k, options.min_effect)
+                          use, t_ref or 0.0) or _negligible(names, X[use], coef, k, options)
         if bad is None:
             break
         kept.remove(bad[0])
@@ -753,24 +753,25 @@ def _unphysical(params: ModelParams, c: dict[str, float], signals: TermSignals, 
 
 
 def _negligible(names: tuple[str, ...], X: np.ndarray, coef: np.ndarray, k: int,
-                min_effect: float) -> tuple[Term, str] | None:
-    """The kept term whose torque over the samples (the RMS of its regressors times its coefficients, ``X`` (n, p)
-    the design on them) is the smallest, if it is below ``min_effect`` of the velocity model's friction: a term
-    too small to matter (on noise-free data, the 2 % rule alone keeps terms of a thousandth of the friction);
-    None when every term matters."""
+                options: TermOptions) -> tuple[Term, str] | None:
+    """The kept term whose torque over the samples (the standard deviation of its regressors times its
+    coefficients, ``X`` (n, p) the design on them) is the smallest, if it is below :attr:`TermOptions.min_effect`
+    of the velocity model's friction or below :attr:`TermOptions.min_torque`: a term too small to matter (on
+    noise-free data, the 2 % rule alone keeps terms of a thousandth of the friction); None when every term
+    matters."""
     friction = float(np.sqrt(np.mean((X[:, :k] @ coef[:k]) ** 2)))
     effects: dict[Term, float] = {}
     for term in TERMS:
         cols = [i for i, n in enumerate(names) if i >= k and _term_of(n) == term]
         if cols:
-            effects[term] = float(np.sqrt(np.mean((X[:, cols] @ coef[cols]) ** 2)))
+            effects[term] = float(np.std(X[:, cols] @ coef[cols]))  # its mean is the offset's to take
     if not effects:
         return None
     term = min(effects, key=lambda t: effects[t])
-    if effects[term] >= min_effect * friction:
+    if effects[term] >= max(options.min_effect * friction, options.min_torque):
         return None
-    return term, (f"its torque ({effects[term]:.2g} N·m RMS) is below {100 * min_effect:g} % of the friction's "
-                  f"({friction:.2g} N·m): too small to matter")
+    return term, (f"its torque ({effects[term]:.2g} N·m standard deviation) is below {100 * options.min_effect:g} % of the "
+                  f"friction's ({friction:.2g} N·m) or {options.min_torque:g} N·m: too small to matter")
 
 
 def _term_of(name: str) -> Term:
