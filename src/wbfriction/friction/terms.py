@@ -770,8 +770,9 @@ def _negligible(names: tuple[str, ...], X: np.ndarray, coef: np.ndarray, k: int,
     term = min(effects, key=lambda t: effects[t])
     if effects[term] >= max(options.min_effect * friction, options.min_torque):
         return None
-    return term, (f"its torque ({effects[term]:.2g} N·m standard deviation) is below {100 * options.min_effect:g} % of the "
-                  f"friction's ({friction:.2g} N·m) or {options.min_torque:g} N·m: too small to matter")
+    return term, (f"its torque ({effects[term]:.2g} N·m standard deviation) is below "
+                  f"{100 * options.min_effect:g} % of the friction's ({friction:.2g} N·m) or {options.min_torque:g} "
+                  "N·m: too small to matter")
 
 
 def _term_of(name: str) -> Term:
