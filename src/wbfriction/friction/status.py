@@ -21,6 +21,11 @@ status, the first that applies:
   RMS: ``F_c = 0 ± 1.1`` beside a friction of 1 N·m is no finding);
 * ``ok``: none of these.
 
+A fit that kept terms beyond velocity (:mod:`~wbfriction.friction.terms`) is judged on the model it predicts and
+exports with: its velocity coefficients refitted with the terms (their standard errors; the other route's refit of
+them) and each term's own status; its non-linear parameters (``a``, ``v_s``) are the velocity fit's, at a bound if
+they were.
+
 The table, the parameters JSON (``status``, ``status_reason``) and the report show it; a fit that is not
 ``ok`` is shown dimmed there, with its reason.
 """
@@ -29,7 +34,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Literal, Protocol, get_args
+from types import SimpleNamespace
+from typing import Any, Literal, Protocol, cast, get_args
 
 import numpy as np
 
@@ -120,6 +126,9 @@ def fit_verdict(fit: Fit) -> FitVerdict:
                                          "its samples)")
     if not fit.success:
         return FitVerdict("failed", solver_phrase(fit.message))
+    terms = getattr(fit, "terms", None)
+    if terms is not None and terms.kept:
+        return _with_terms(fit, terms)
     values = fit.params.to_dict()
     bounded = [n for n in fit.bounded() if not (n in ZERO_FLOOR and abs(values[n]) < ZERO)]
     if bounded:
@@ -128,6 +137,41 @@ def fit_verdict(fit: Fit) -> FitVerdict:
     if check is not None and check.disagree:
         return FitVerdict("routes disagree", check.describe(fit))
     weak = _weak(fit, values)
+    if weak:
+        return FitVerdict("weak", "large standard errors: " + ", ".join(weak))
+    return FitVerdict("ok")
+
+
+HELD = ("a", "v_s")
+"""The parameters a refit with terms beyond velocity holds at the velocity fit's values (the non-linear ones): one
+at a bound there is at it in the refit."""
+
+
+def _with_terms(fit: Fit, terms: Any) -> FitVerdict:
+    """The verdict of a fit that kept terms beyond velocity (:class:`~wbfriction.friction.terms.TermFit`): of the
+    model it predicts and exports with, the velocity coefficients refitted with the terms (their standard errors,
+    the other route's refit of them) and each term's own (:meth:`~wbfriction.friction.terms.TermFit.verdicts`)."""
+    values = terms.params.to_dict()
+    bounded = [n for n in fit.bounded() if n in HELD]
+    if bounded:
+        return FitVerdict("at bound", "at a bound of the fit: " + ", ".join(bounded))
+    check = terms.check
+    others = {t: v for t, v in terms.verdicts().items() if not v.ok}
+    disagree = [] if check is None else [
+        f"{n} {values[n]:.3g} ±{terms.stderr.get(n, np.inf):.2g} against {check.coefficients[n]:.3g} "
+        f"±{check.stderr.get(n, np.inf):.2g} ({check.route})" for n in READ
+        if n in check.coefficients and routes_disagree(values[n], terms.stderr.get(n, np.inf), check.coefficients[n],
+                                                       check.stderr.get(n, np.inf))]
+    disagree += [f"{t}: {v.reason}" for t, v in others.items() if v.status == "routes disagree"]
+    if disagree:
+        return FitVerdict("routes disagree", "; ".join(disagree))
+    # over part of a turn a ripple's harmonics have a mean the offset trades with: their sum is determined (the
+    # energy check removes both), the offset alone is not, and it is no friction a user reads
+    judged = [n for n in values if n in terms.stderr and not (n == "tau_os" and "ripple" in terms.kept)]
+    view = SimpleNamespace(params=terms.params, stderr={n: terms.stderr[n] for n in judged}, crb={}, speed=fit.speed,
+                           rms_residual=fit.rms_residual)
+    weak = _weak(cast(Fit, view), values) + [f"{t} {v.reason.removeprefix('large standard errors: ')}"
+                                             for t, v in others.items()]
     if weak:
         return FitVerdict("weak", "large standard errors: " + ", ".join(weak))
     return FitVerdict("ok")
