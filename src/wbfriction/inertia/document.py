@@ -151,6 +151,13 @@ class BodyProposal:
                 "moments": list(self.moments), "moments_change": list(self.moments_change)}
 
 
+COLLAPSED = 0.9
+"""A principal moment about the centre of mass that fell by more than this share makes a written body implausible
+(:meth:`BodyWritten.implausible`)."""
+MASS_CHANGE = 0.5
+"""A mass that changed by more than this share makes a written body implausible."""
+
+
 @dataclass(frozen=True)
 class BodyWritten:
     """A body as given and as written (:func:`~wbfriction.inertia.urdf.inertia_changes`).
@@ -180,6 +187,20 @@ class BodyWritten:
     @property
     def has_mass(self) -> bool:
         return max(self.mass_given, self.mass) > 0
+
+    def implausible(self) -> str:
+        """Why the written body is no plausible link (one phrase), or "": a principal moment that fell by more than
+        :data:`COLLAPSED` (a body collapsing to a rod or a point: physically consistent, the pseudo-inertia
+        semidefinite, yet no link), or a mass changed by more than :data:`MASS_CHANGE`. An arm's torques determine
+        combinations of its bodies (base parameters), not each body: such values carry a combination the held-out
+        torques confirm, not a body's own inertia."""
+        out = []
+        fell = [(k, x) for k, x in enumerate(self.moments_change, 1) if x is not None and x < -COLLAPSED]
+        if fell:
+            out.append("principal moments collapsed (" + ", ".join(f"I{k} {100 * x:+.0f} %" for k, x in fell) + ")")
+        if self.mass_change is not None and abs(self.mass_change) > MASS_CHANGE:
+            out.append(f"mass {100 * self.mass_change:+.0f} %")
+        return "; ".join(out)
 
     def to_dict(self) -> dict[str, Any]:
         d: dict[str, Any] = {"body": self.body, "mass_given": self.mass_given, "mass": self.mass,

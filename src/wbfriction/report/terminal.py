@@ -250,6 +250,11 @@ def identification_tables(result: Identification, wide: bool = False) -> tuple[l
     if len(changed) < len(massive):
         notes.append(f"{len(massive) - len(changed)} of {len(massive)} bodies with mass written as given "
                      "(--wide lists them)")
+    odd = [(b.body, b.implausible()) for b in massive if b.implausible()]
+    if odd:
+        notes.append(f"implausible bodies written ({len(odd)}): " + "; ".join(f"{b}: {why}" for b, why in odd)
+                     + ": the log determines combinations of the bodies (what the held-out torques confirm), not "
+                       "each body: read no link's own inertia off them")
     joints = result.joints
     moved = [j for j, v in joints.items() if wide or v.acceleration_route.verdict().status != "not excited"]
     names = result.friction_names
