@@ -121,7 +121,7 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
                   + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")", highlight=False)
     for status, joints in result.selection.left_out.items():
         console.print(f"not exported, {status}: {', '.join(joints)}", highlight=False, soft_wrap=True)
-    with_terms = {j: f.terms.kept for j, f in result.selection.exported.items() if f.terms is not None and f.terms.kept}
+    with_terms = {j: t.kept for j, f in result.selection.exported.items() if (t := f.kept_terms) is not None}
     if with_terms:
         console.print("no simulator holds the terms beyond velocity: dropped for "
                       + ", ".join(f"{j} ({', '.join(kept)})" for j, kept in with_terms.items())

@@ -265,7 +265,7 @@ def joint_export(joint: str, friction: FrictionLike | None = None, armature: flo
     verdict = fit.verdict() if fit is not None else None
     if verdict is not None and verdict.status in NEVER_EXPORTED:
         raise InputError(f"joint '{joint}': its fit is {verdict}: numbers the data do not carry are not exported")
-    terms = fit.terms if fit is not None and fit.terms is not None and fit.terms.kept else None
+    terms = None if fit is None else fit.kept_terms
     dropped: tuple[str, ...] = ()
     conditions = ""
     if terms is not None:  # its velocity model refitted with them: the levels at the reference conditions

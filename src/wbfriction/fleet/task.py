@@ -173,7 +173,7 @@ def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy]
     for i, fit in enumerate(fits):
         rows = valid[:, i] & np.isfinite(qd[:, i])
         v = qd[rows, i]
-        terms = fit.terms if fit.terms is not None and fit.terms.kept else None
+        terms = fit.kept_terms
         params = terms.params if terms is not None else fit.params
         values = params.to_dict() if params is not None else {}
         stderr = terms.stderr if terms is not None else fit.stderr

@@ -315,6 +315,11 @@ class FitResult(Generic[ParamsT]):
         if self.params is not None:
             self.model = self.params.model
 
+    @property
+    def kept_terms(self) -> TermFit | None:
+        """:attr:`terms` when they kept any (the model predictions and exports use), else None."""
+        return self.terms if self.terms is not None and self.terms.kept else None
+
     def bounded(self) -> tuple[str, ...]:
         """Names of the parameters at a bound (:attr:`at_bound`)."""
         return tuple(n for n, at in self.at_bound.items() if at)

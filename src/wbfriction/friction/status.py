@@ -126,8 +126,8 @@ def fit_verdict(fit: Fit) -> FitVerdict:
                                          "its samples)")
     if not fit.success:
         return FitVerdict("failed", solver_phrase(fit.message))
-    terms = getattr(fit, "terms", None)
-    if terms is not None and terms.kept:
+    terms = getattr(fit, "kept_terms", None)
+    if terms is not None:
         return _with_terms(fit, terms)
     values = fit.params.to_dict()
     bounded = [n for n in fit.bounded() if not (n in ZERO_FLOOR and abs(values[n]) < ZERO)]

@@ -27,7 +27,7 @@ def predict_file(friction: str | Path, params: str | Path) -> TorquePrediction:
     fits = read_params(params)
     est = read_friction_file(friction)
     check_params_source(params, est)
-    models = {j: f.terms if f.terms is not None and f.terms.kept else f.params for j, f in fits.items()
+    models = {j: f.kept_terms or f.params for j, f in fits.items()
               if f.params is not None}
     pred = predict_torques(est, models, source=str(friction))
     status = tuple(fits[j].verdict().status if j in fits else "" for j in pred.joints)

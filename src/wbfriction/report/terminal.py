@@ -92,7 +92,7 @@ def terms_table(results: Sequence[FitResult], label: Callable[[str], str] = str)
     term (a narrow table whatever the terms): its status (:meth:`~wbfriction.friction.terms.TermFit.verdicts`) and
     its coefficients ± standard errors, after a row of F_c and F_v refitted with the terms (at zero load and the
     reference temperature, the ones exports write); None when no fit kept one."""
-    kept = [r for r in results if r.terms is not None and r.terms.kept]
+    kept = [r for r in results if r.kept_terms is not None]
     if not kept:
         return None
     table = Table(title="Terms beyond velocity", box=None, title_justify="left", caption_justify="left",
@@ -101,7 +101,7 @@ def terms_table(results: Sequence[FitResult], label: Callable[[str], str] = str)
     for col in ("joint", "term", "status", "values"):
         table.add_column(col, no_wrap=col != "values")
     for r in kept:
-        terms = r.terms
+        terms = r.kept_terms
         assert terms is not None
         shown = partial(_term_value, terms)
         at = "zero load" + ("" if terms.reference_temperature is None or "temperature" not in terms.kept
