@@ -25,13 +25,13 @@ def read_toml(path: str | Path) -> dict:
         raise InputError(f"{path}: not valid TOML: {exc}") from exc
 
 
-def toml_table(path: str | Path, name: str) -> dict:
-    """The ``[name]`` table of a TOML file.
+def toml_table(path: str | Path, name: str, document: dict | None = None) -> dict:
+    """The ``[name]`` table of a TOML file (of its ``document``, when already read).
 
     Raises:
         InputError: unreadable file, invalid TOML, or no such table.
     """
-    table = read_toml(path).get(name)
+    table = (read_toml(path) if document is None else document).get(name)
     if not isinstance(table, dict):
         raise InputError(f"{path}: no [{name}] table")
     return table

@@ -220,6 +220,12 @@ def test_statuses_say_what_the_data_do_not_carry():
     assert "momentum" in off.reason
     near = TermCheck("momentum", {"F_L": 0.0202, "dF_v": 0.04}, {"F_L": 0.001, "dF_v": 0.03})
     assert replace(fit, check=near).verdicts()["load"].ok
+    ripple = TermFit(CoulombViscousParams(F_v=0.2, F_c=1.0), ("ripple",), 1, {"ripple_sin1": 0.1, "ripple_cos1": 0.0},
+                     {"ripple_rms": 0.004}, {"ripple_rms": 0.07})  # judged by its size
+    assert ripple.verdicts()["ripple"].ok
+    assert replace(ripple, stderr={"ripple_rms": 0.05}).verdicts()["ripple"].status == "weak"
+    other = TermCheck("momentum", {"ripple_rms": 0.03}, {"ripple_rms": 0.004})
+    assert replace(ripple, check=other).verdicts()["ripple"].status == "routes disagree"
 
 
 def test_the_ripples_size_has_the_spread_of_its_repeats():
@@ -259,3 +265,27 @@ def test_a_magnitude_the_terms_would_drive_negative_is_held_at_zero():
     fit = fit_terms(base.params, qd, tau_f, use, s)
     assert fit.kept == ("ripple",) and fit.params.F_v == 0.0
     assert fit.at_bound == ("F_v",) and fit.stderr["F_v"] == 0.0 and fit.stderr["F_c"] > 0.0
+
+
+def test_a_fit_with_terms_reports_the_model_its_status_judges():
+    """A velocity fit that is weak alone (F_c 0.04 ± 0.08, lwr_6's on the KUKA) but well determined once its ripple is
+    fitted (0.061 ± 0.008): its status is the refitted model's, and so are the numbers shown beside it
+    (:meth:`~wbfriction.friction.fit.FitResult.reported`); no Cramér-Rao bound of the other model is shown with
+    them. Without terms kept, the fit reports itself."""
+    from wbfriction.friction.fit import FitResult
+
+    velocity = CoulombViscousParams(F_v=0.0, F_c=0.04, tau_os=-0.1)
+    fit = FitResult("j", 5000, velocity, {"F_v": 0.13, "F_c": 0.08, "tau_os": 0.04}, 0.05, True, "",
+                    at_bound={"F_v": True}, speed=1.0, crb={"F_c": 0.03, "F_v": 0.07})
+    assert fit.verdict().status == "weak" and fit.reported() is fit
+    terms = TermFit(CoulombViscousParams(F_v=0.0, F_c=0.061, tau_os=-0.1), ("ripple",), 1,
+                    {"ripple_sin1": 0.2, "ripple_cos1": 0.1}, {"F_v": 0.0, "F_c": 0.008, "tau_os": 0.6,
+                                                                "ripple_rms": 0.008}, {"ripple_rms": 0.225},
+                    at_bound=("F_v",))
+    with_terms = replace(fit, terms=terms)
+    shown = with_terms.reported()
+    assert with_terms.verdict().ok and shown.verdict() == with_terms.verdict()
+    assert shown.params == terms.params and shown.stderr["F_c"] == 0.008 and shown.crb == {}
+    assert shown.at_bound == {"F_v": True, "F_c": False, "tau_os": False}
+    none_kept = replace(fit, terms=replace(terms, kept=(), harmonics=0))
+    assert none_kept.reported() is none_kept and none_kept.verdict().status == "weak"

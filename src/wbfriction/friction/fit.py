@@ -48,7 +48,7 @@ import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, Generic
+from typing import Any, Generic, cast
 
 import numpy as np
 
@@ -78,7 +78,7 @@ from wbfriction.friction.regression import (
     parameter_covariance,
 )
 from wbfriction.friction.screen import gross_outliers
-from wbfriction.friction.status import MIN_SPEED, FitVerdict, fit_verdict, joint_speed, routes_disagree
+from wbfriction.friction.status import HELD, MIN_SPEED, FitVerdict, fit_verdict, joint_speed, routes_disagree
 from wbfriction.friction.terms import TermFit, fit_terms, refit_terms, term_signals
 from wbfriction.signals.kinematics import PiecewiseSmoother
 from wbfriction.signals.nonuniform import ResampledLowpass
@@ -319,6 +319,25 @@ class FitResult(Generic[ParamsT]):
     def kept_terms(self) -> TermFit | None:
         """:attr:`terms` when they kept any (the model predictions and exports use), else None."""
         return self.terms if self.terms is not None and self.terms.kept else None
+
+    def reported(self) -> FitResult:
+        """This fit as its numbers are shown: with terms kept (:attr:`kept_terms`), the model its status judges and
+        predictions and exports use, its velocity model refitted with them (at zero load and ``T_ref``, without the
+        ripple), their standard errors, the velocity fit's bounds on the parameters the refit holds (``a``,
+        ``v_s``) and the refit's zeros, the other route's refit, no Cramér-Rao bound (the velocity model's alone);
+        else itself. Its :meth:`verdict` is this fit's."""
+        terms = self.kept_terms
+        if terms is None:
+            return self
+        names = terms.params.names
+        check = terms.check
+        return replace(self, params=cast(ParamsT, terms.params),
+                       stderr={n: terms.stderr[n] for n in names if n in terms.stderr},
+                       at_bound={n: bool(self.at_bound.get(n)) if n in HELD else n in terms.at_bound for n in names},
+                       crb={}, covariance=None,
+                       route_check=None if check is None else RouteCheck(
+                           check.route, {n: v for n, v in check.coefficients.items() if n in names},
+                           {n: v for n, v in check.stderr.items() if n in names}))
 
     def bounded(self) -> tuple[str, ...]:
         """Names of the parameters at a bound (:attr:`at_bound`)."""

@@ -114,7 +114,8 @@ def load_friction_spec(path: str | Path, groups: dict[str, tuple[str, ...]],
         InputError: unreadable file, an unknown group, joint, model, parameter or term key; a temperature term
             without the ``[temperature]`` table.
     """
-    table = toml_table(path, "friction")
+    document = read_toml(path)
+    table = toml_table(path, "friction", document)
     params: dict[str, ModelParams] = {}
     terms: dict[str, TermFit] = {}
     for is_group in (True, False):  # groups first, joints override
@@ -136,7 +137,7 @@ def load_friction_spec(path: str | Path, groups: dict[str, tuple[str, ...]],
                     terms[joint] = t
                 else:
                     terms.pop(joint, None)
-    temperature = read_toml(path).get("temperature")
+    temperature = document.get("temperature")
     warm = None
     if temperature is not None:
         try:
@@ -147,12 +148,3 @@ def load_friction_spec(path: str | Path, groups: dict[str, tuple[str, ...]],
         raise InputError(f"{path}: a temperature term needs a [temperature] table (start, end [°C])")
     return FrictionSpec(params, terms, warm)
 
-
-def load_friction_toml(path: str | Path, groups: dict[str, tuple[str, ...]],
-                       joints: tuple[str, ...]) -> dict[str, ModelParams]:
-    """The velocity models of :func:`load_friction_spec` per joint.
-
-    Raises:
-        InputError: as :func:`load_friction_spec`.
-    """
-    return load_friction_spec(path, groups, joints).params

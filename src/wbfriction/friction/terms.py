@@ -240,7 +240,7 @@ class TermFit:
         """
         out: dict[Term, FitVerdict] = {}
         for term in self.kept:
-            mine = self._read(term, self.coefficients, self.stderr)
+            mine = self._read(term, {**self.coefficients, **self.derived}, self.stderr)  # the ripple's size too
             check = self.check
             theirs = {} if check is None else self._read(term, check.coefficients, check.stderr)
             off = [f"{n} {v:.3g} ±{se:.2g} against {theirs[n][0]:.3g} ±{theirs[n][1]:.2g} ({check.route})"

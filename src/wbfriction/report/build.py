@@ -165,5 +165,6 @@ def make_report(friction: str | Path, params: str | Path | None = None,
     if identification is not None:
         prov.append(("inertia identification", f"{identification} (sha256 {file_sha256(identification)})"))
     labels = meta.get("joint_labels")
+    fits = {j: f.reported() for j, f in fits.items()}  # with terms, the refitted model the status is about
     return Report(est, fits, energy, prov, threshold, ident, dict(labels) if isinstance(labels, dict) else None,
                   tuple(dependency_versions()), output_date())

@@ -32,7 +32,7 @@ OTHERS = ("tau_os", "S", "v_s", "a")
 """The offset (every model) and the Stribeck terms (the models that have them), in a second table."""
 CAPTION = ("value ± standard error; Cramér-Rao: the standard deviation no unbiased estimator from these data "
            "goes below; n.i.: not identifiable; (b): at a bound of the fit, the bound's value, not the data's; "
-           "dim: not to be used (status)")
+           "dim: not to be used (status); *: refitted with its terms beyond velocity (the terms' table)")
 NAMES_SHOWN = 6
 """Joints named in a note before "and N more"."""
 
@@ -59,6 +59,7 @@ def fit_tables(results: Sequence[FitResult], wide: bool = False,
     numbers not to be used; ``wide``: one table with every parameter and the sample counts; ``labels``: joint ->
     what a person reads (the robot TOML's ``[labels]``, recorded in the friction table), shown for the joint."""
     label = _labeller(labels)
+    results = [r.reported() for r in results]  # with terms, the refitted model the status is about
     fitted = [r for r in results if r.params is not None]
     routes = ", ".join(sorted({r.route for r in results}))
     title = f"Friction per joint: f(qd) fitted to -tau_f ({routes} route)"
@@ -150,7 +151,8 @@ def _rows(table: Table, results: Sequence[FitResult], names: Sequence[str], labe
     (not for a joint that did not move: nothing to bound); ``short``: the joint alone before the values."""
     for r in results:
         verdict = r.verdict()
-        first = [label(r.joint)] + ([] if short else [r.model if r.params is not None else "—", verdict.status])
+        model = "—" if r.params is None else r.model + ("*" if r.kept_terms is not None else "")
+        first = [label(r.joint)] + ([] if short else [model, verdict.status])
         count = [f"{r.n_samples}" + (f" (-{r.n_screened} screened)" if r.n_screened else "")] if wide else []
         table.add_row(*first, *count, *[_cell(r, n) for n in names], style=None if verdict.ok else "dim")
         if r.params is not None and verdict.status != "not excited" and any(n in r.crb for n in names):

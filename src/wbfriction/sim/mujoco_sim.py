@@ -314,13 +314,13 @@ class MujocoRun:
         sensed, motors = self.sensor_means.period(k), self.motor_means.period(k)
         friction, dof_f, torque = self.torque_friction, self.dof_f, self.injected.torque
         beyond = self.injected.with_terms if self.injected.beyond else None
-        warm = self.recording.temperature
+        warm, qpos, qpos_f, actuated = self.recording.temperature, data.qpos, self.qpos_f, data.qfrc_actuator
         for s in range(len(sensed)):
             if friction:
                 tau_f = torque(qvel[dof_f])
                 if beyond is not None:  # the load: the rigid-body torque, motor's and friction's, of the last step
-                    tau_f = beyond(tau_f, qvel[dof_f], data.qpos[self.qpos_f],
-                                   data.qfrc_actuator[dof_f] + applied[dof_f], 0.0 if warm is None else float(warm[k]))
+                    tau_f = beyond(tau_f, qvel[dof_f], qpos[qpos_f], actuated[dof_f] + applied[dof_f],
+                                   0.0 if warm is None else float(warm[k]))
                 applied[dof_f] = tau_f
                 if s == 0:
                     self.tau_f_first[k] = tau_f
