@@ -98,6 +98,8 @@ def test_identify_command_closes_the_loop(talos, wrong, combined_walk, tmp_path,
 @pytest.mark.parametrize("args, message", [
     (["--stribeck-velocity", "fast"], "--stribeck-velocity must be auto, none or a number"),
     (["--holdout", "1.5"], "--holdout must be between 0 and 1"),
+    (["--link-margin", "1"], "--link-margin must be at least 0 and below 1"),
+    (["--link-margin", "-0.1"], "--link-margin must be at least 0 and below 1"),
 ])
 def test_identify_bad_options(tmp_path, capsys, args, message):
     (tmp_path / "log.parquet").write_bytes(b"")

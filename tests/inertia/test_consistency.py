@@ -67,3 +67,12 @@ def test_one_standard_deviation_of_a_physical_parameter_costs_one(inertia, k):
 def test_a_massless_body_is_measured_at_a_small_sphere():
     std, L = body_prior(np.zeros(10), min_mass=1e-3)
     assert std[0] == pytest.approx(1e-4) and np.all(np.isfinite(L))
+
+
+@pytest.mark.parametrize("margin", [-0.1, 1.0, float("nan")])
+def test_a_link_margin_outside_its_range_is_refused(margin):
+    from wbfriction.exceptions import InputError
+    from wbfriction.inertia.options import InertialOptions
+
+    with pytest.raises(InputError, match="link margin must be in"):
+        InertialOptions(link_margin=margin)

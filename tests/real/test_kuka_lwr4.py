@@ -143,6 +143,30 @@ def test_the_identified_model_predicts_the_held_out_run(logs, identified, identi
     assert np.sum(ident.rms < flo.rms) >= 5  # and on 5 of the 7 joints (not lwr_3, lwr_5: see the issue note)
 
 
+def test_the_identified_bodies_stay_links(identified):
+    """Issue 40: each identified body keeps a quarter of its given pseudo-inertia (``link_margin``), so none collapses
+    to a rod or a point as five of seven did without it (principal moments -97 to -100 %: the base parameters, not
+    each body, are what the torques determine): no principal moment about the centre of mass falls by more than
+    :data:`~wbfriction.inertia.document.COLLAPSED`, no mass changes by more than
+    :data:`~wbfriction.inertia.document.MASS_CHANGE`, and the pseudo-inertia margin holds (its smallest eigenvalue
+    about ``J - 0.25 J_given`` not below zero)."""
+    from wbfriction.inertia.consistency import is_consistent
+    from wbfriction.inertia.document import COLLAPSED, MASS_CHANGE
+    from wbfriction.inertia.options import InertialOptions
+    from wbfriction.inertia.regressor import body_parameters
+    from wbfriction.inertia.urdf import inertia_changes
+
+    given, written = body_parameters(robot(KUKA_URDF).model), body_parameters(robot(identified).model)
+    bodies = list(robot(KUKA_URDF).model.names[1:])
+    changes = inertia_changes(bodies, given, written)
+    moved = [c for c in changes if not np.allclose(c.moments, c.moments_given)]
+    print("\nprincipal moments [%]", {c.body: np.round(100 * c.moments_change, 1).tolist() for c in moved})
+    assert len(moved) >= 5  # identified, not left as given
+    assert all(np.all(c.moments_change > -COLLAPSED) and abs(c.mass_change) < MASS_CHANGE for c in changes)
+    margin = InertialOptions().link_margin
+    assert margin == 0.25 and np.all(is_consistent(written - (margin - 1e-6) * given))
+
+
 def test_identified_friction_dissipates(identified_model, logs):
     """Eq. 7.9 after identification: the share of samples whose friction generates power falls
     under 5 % on the joints whose friction stands above the model's residual. Not on lwr_6: its
@@ -186,10 +210,11 @@ for issue 40."""
 def test_terms_beyond_velocity_predict_the_held_out_run(logs, identified, tmp_path):
     """Issue 40, as a user runs it: runs 1-2 and run 3 estimated with the identified inertias into friction tables,
     ``fit --terms all`` on runs 1-2, ``predict`` on run 3. Run 3's torques are predicted better than with the velocity
-    model alone: the mean per-joint RMS below 0.35 N·m and better than the peer's on five joints. A position ripple is
-    kept on the wrist joints (lwr_5, lwr_6), refused on the upper arm (lwr_1-lwr_3) because fitted on one direction of
-    motion it does not predict the other; with its ripple taken out, lwr_6's friction stops generating power on half
-    its samples (the energy check of the parameters JSON)."""
+    model alone: the mean per-joint RMS below 0.35 N·m and better than the peer's on six joints (not lwr_1, where the
+    fit's viscous level is at its bound). A position ripple is kept on the wrist joints (lwr_5, lwr_6), refused on the
+    upper arm (lwr_1-lwr_3) because fitted on one direction of motion it does not predict the other; with its ripple
+    taken out, lwr_6's friction stops generating power on half its samples (the energy check of the parameters JSON:
+    under the issue's 10 %)."""
     import json
 
     from wbfriction.friction.options import FitOptions, TermOptions
@@ -208,7 +233,7 @@ def test_terms_beyond_velocity_predict_the_held_out_run(logs, identified, tmp_pa
           PEER_RUN3_RMS, {j: t.kept for j, t in kept.items() if t is not None})
     assert np.mean(after.rms) < 0.35 and np.mean(after.rms) < np.mean(before.rms)
     better = [j for j, a, p in zip(after.joints, after.rms, PEER_RUN3_RMS) if a < p]
-    assert len(better) >= 5, better
+    assert len(better) >= 6, better
     assert after.terms[5] == ("ripple",) and after.terms[6] == ("ripple",)
     for joint in ("lwr_1_joint", "lwr_2_joint", "lwr_3_joint"):
         t = kept[joint]
@@ -220,7 +245,7 @@ def test_terms_beyond_velocity_predict_the_held_out_run(logs, identified, tmp_pa
     plain = json.loads(velocity.read_text())["joints"]
     share = (plain["lwr_6_joint"]["energy"]["generating_share"], doc["lwr_6_joint"]["energy"]["generating_share"])
     print(f"lwr_6 power-generating share {100 * share[0]:.1f} % -> {100 * share[1]:.1f} % without its ripple")
-    assert share[0] > 0.4 and share[1] < 0.12 and doc["lwr_6_joint"]["energy"]["ripple_removed"]
+    assert share[0] > 0.4 and share[1] < 0.10 and doc["lwr_6_joint"]["energy"]["ripple_removed"]
     assert doc["lwr_6_joint"]["terms"]["status"] == {"ripple": "ok"}
 
 

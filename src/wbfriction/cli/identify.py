@@ -69,6 +69,9 @@ def identify(log: Path = LogArg,
                                                         "identify (one per joint, with the friction; for "
                                                         "motor-current torques) or none (link-side "
                                                         "torque sensors)."),
+             link_margin: float = typer.Option(INERTIAL.link_margin, help="Share of each given body's "
+                                                    "pseudo-inertia an identified body keeps (mass and second "
+                                                    "moments), in [0, 1); 0: any physical body."),
              tanh_slope: float = typer.Option(INERTIAL.tanh_slope, min=1e-12,
                                               help="a of the Coulomb term tanh(a qd) [s/rad]."),
              diff: DiffOption = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
@@ -88,13 +91,15 @@ def identify(log: Path = LogArg,
         raise InputError(f"--stribeck-velocity must be auto, none or a number, got '{stribeck_velocity}'") from None
     if not 0.0 < holdout < 1.0:
         raise InputError(f"--holdout must be between 0 and 1, got {holdout}")
+    if not 0.0 <= link_margin < 1.0:
+        raise InputError(f"--link-margin must be at least 0 and below 1, got {link_margin}")
     from wbfriction.pipeline.identify_step import identify_file
     from wbfriction.report.terminal import identification_tables
 
     r = robot_of(robot, urdf, config, mjcf)
     r.require_urdf("identify (it writes the corrected URDF)")
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior,
-                           armature=armature)
+                           armature=armature, link_margin=link_margin)
     with console.status("") as status:
         estimate_options = EstimateOptions(diff=diff, mask=mask,
                                            route=route)

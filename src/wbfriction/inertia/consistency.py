@@ -241,10 +241,10 @@ def _svec_pseudo_inertia() -> np.ndarray:
 
 
 def _conic_solve(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float,
-                 lower: np.ndarray) -> tuple[np.ndarray, SolverOutcome]:
+                 lower: np.ndarray, margin: float = 0.0) -> tuple[np.ndarray, SolverOutcome]:
     """The exact minimum of :func:`fit_consistent`'s objective over positive-semidefinite pseudo-inertias and the
     bounds ``lower``: a convex quadratic program with one 4 x 4 semidefinite cone per body (the linear matrix
-    inequality of Wensing et al. 2018), solved by Clarabel's interior-point method in standard deviations of the
+    inequality of Wensing et al. 2018, about ``J(pi) - margin J(pi_0)``), solved by Clarabel's interior-point method in standard deviations of the
     prior (``x = x0 + L^-1 y``; the objective compressed to ``p`` rows by a QR factorization, ``A_y = Q T``)."""
     import clarabel
     import scipy.linalg
@@ -255,11 +255,11 @@ def _conic_solve(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float,
     p, nb = len(prior.x0), prior.nb
     G = _svec_pseudo_inertia()
     blocks, b = [], []
-    for k, root in enumerate(prior.bodies):  # J(pi_b) = J(x0_b) + G L_b^-1 y_b in the cone: -G L_b^-1 y_b + s = J(x0_b)
+    for k, root in enumerate(prior.bodies):  # J(pi_b) - margin J(x0_b) = (1 - margin) J(x0_b) + G L_b^-1 y_b in the cone
         row = np.zeros((10, p))
         row[:, 10 * k:10 * k + 10] = -G @ np.linalg.inv(root)
         blocks.append(row)
-        b.append(G @ prior.x0[10 * k:10 * k + 10])
+        b.append((1.0 - margin) * (G @ prior.x0[10 * k:10 * k + 10]))
     lo = _lower_in_std(prior, lower)
     bounded = np.flatnonzero(np.isfinite(lo))  # y_i >= lo_i: -y_i + s = -lo_i, s >= 0
     blocks.append(-np.eye(p)[bounded])
@@ -278,9 +278,11 @@ def _conic_solve(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float,
     return prior.x0 + prior.L_inv @ np.asarray(solution.x), SolverOutcome(status, None, converged, meaning)
 
 
-def fit_consistent(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float, lower: np.ndarray) -> ConsistentFit:
-    """Solve ``min |R x - z|^2 + weight |L (x - x0)|^2`` over physically consistent bodies and
-    bounded other parameters (friction: :data:`FRICTION_LOWER`; armature: >= 0).
+def fit_consistent(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float, lower: np.ndarray,
+                   margin: float = 0.0) -> ConsistentFit:
+    """Solve ``min |R x - z|^2 + weight |L (x - x0)|^2`` over physically consistent bodies that keep
+    ``margin`` of the given ones (``J(pi) - margin J(pi_0) >= 0``) and bounded other parameters (friction:
+    :data:`FRICTION_LOWER`; armature: >= 0).
 
     ``x = (pi.ravel(), rest)``; ``x0``, ``L``: the :class:`Prior`. The problem is convex: a quadratic
     over each body's pseudo-inertia constrained positive semidefinite (Wensing et al., *Linear matrix
@@ -302,18 +304,26 @@ def fit_consistent(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float, lo
         weight: the prior's weight (the data's residual variance times the prior's relative weight,
             :mod:`wbfriction.inertia.identification`).
         lower: lower bounds (p,) (those of the bodies' parameters are ignored).
+        margin: the share of each given body's pseudo-inertia ``J(pi_0)`` the fit keeps, in [0, 1): its mass, and
+            its mass's second moment along every direction about every point, at least ``margin`` times the given
+            body's (``J`` is linear in ``pi``, so the constraint is the same cone about ``pi - margin pi_0``). 0: any
+            physical body, including the rods and points a base parameter's combination can push a link to
+            (:attr:`~wbfriction.inertia.options.InertialOptions.link_margin`).
     """
     nb, n_in = prior.nb, 10 * prior.nb
     x_lin, A, c = regularised_problem(R, z, prior, weight, lower)
-    ok = is_consistent(x_lin[:n_in].reshape(nb, 10), 1e-12)
+    pi0 = prior.x0[:n_in].reshape(nb, 10)
+    ok = is_consistent(x_lin[:n_in].reshape(nb, 10) - margin * pi0, 1e-12)
     if ok.all():
         r = A @ x_lin - c
         return ConsistentFit(x_lin[:n_in].reshape(nb, 10), x_lin[n_in:], 0.5 * float(r @ r),
                              "the linear least-squares solution is physically consistent")
-    x, outcome = _conic_solve(R, z, prior, weight, lower)
-    x[:n_in] = nearest_consistent(x[:n_in].reshape(nb, 10)).ravel()
+    x, outcome = _conic_solve(R, z, prior, weight, lower, margin)
+    x[:n_in] = (margin * pi0 + nearest_consistent(x[:n_in].reshape(nb, 10) - margin * pi0)).ravel()
     x[n_in:] = np.maximum(x[n_in:], lower[n_in:])  # an interior point's last digits
     r = A @ x - c
     return ConsistentFit(x[:n_in].reshape(nb, 10), x[n_in:], 0.5 * float(r @ r),
-                         f"{int((~ok).sum())} bodies of the linear solution were not physical: {outcome.meaning}",
+                         f"{int((~ok).sum())} bodies of the linear solution were not physical"
+                         + (f" or kept less than {margin:g} of the given pseudo-inertia" if margin else "")
+                         + f": {outcome.meaning}",
                          outcome, int((~ok).sum()))

@@ -40,7 +40,10 @@ armature from its link's inertia about that axis: the two are reported as not ex
 
 **Physical consistency and prior.** Every estimate is a physical rigid body: each body's
 pseudo-inertia is constrained positive semidefinite (positive mass, principal moments that satisfy
-the triangle inequalities; the linear matrix inequality of Wensing et al., IEEE RA-L 2018). A Gaussian
+the triangle inequalities; the linear matrix inequality of Wensing et al., IEEE RA-L 2018), and keeps
+a share of the given body's (``J(pi) - link_margin J(pi_0)`` semidefinite,
+:attr:`~wbfriction.inertia.options.InertialOptions.link_margin`): a link stays a link where its data
+determine only combinations with its neighbours (the base parameters). A Gaussian
 prior pulls the model toward the given one where the data say little: its standard deviations are stated
 on each body's mass, centre of mass and rotational inertia about the centre of mass, and on each joint's
 armature and friction
@@ -486,13 +489,13 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
                              "(give one)")
         variance = residual_variance(fitting, base_parameters(fitting.R, options.rank_tolerance))
         for weight in sorted(PRIOR_GRID, reverse=True):  # strong to weak
-            trial = fit_consistent(fitting.R, fitting.z, prior_of, weight * variance, lower)
+            trial = fit_consistent(fitting.R, fitting.z, prior_of, weight * variance, lower, options.link_margin)
             scores[weight] = validating.rms(trial.x)
             if scores[weight] > min(scores.values()):
                 break  # past the best weight: weaker priors only fit the noise more closely
         prior = max(w for w, score in scores.items() if score <= (1 + PRIOR_TOLERANCE) * min(scores.values()))
     variance = residual_variance(total, base)
-    fit = fit_consistent(R, z, prior_of, prior * variance, lower)
+    fit = fit_consistent(R, z, prior_of, prior * variance, lower, options.link_margin)
     bodies = tuple(robot.model.names[1:])
     groups = limbs(robot.model)
     held = _held_out(robot, shared, pi0, fit.pi, groups, options)
@@ -537,7 +540,9 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
     if fit.solver is None:
         message = "the linear least-squares solution is physically consistent"
     else:
-        message = f"{fit.unphysical} bodies of the linear solution were not physical; the conic solve {solver.meaning}"
+        margin = f" or kept less than {options.link_margin:g} of the given pseudo-inertia" if options.link_margin else ""
+        message = (f"{fit.unphysical} bodies of the linear solution were not physical{margin}; the conic solve "
+                   f"{solver.meaning}")
         if not solver.converged:
             message += "; kept only where held-out data improve"
     if np.any(noise > NOISY_ACCELERATION):
