@@ -289,3 +289,81 @@ def test_a_fit_with_terms_reports_the_model_its_status_judges():
     assert shown.at_bound == {"F_v": True, "F_c": False, "tau_os": False}
     none_kept = replace(fit, terms=replace(terms, kept=(), harmonics=0))
     assert none_kept.reported() is none_kept and none_kept.verdict().status == "weak"
+
+
+RATE_T = -0.015
+"""An exponential temperature law's rate [1/°C]: both levels fall by 1.5 %/°C at T_ref and flatten as the joint
+warms, halving between 20 and 70 °C (Bittencourt's exponential decrease)."""
+
+
+def exponential_joint(seed: int, law_rate: float, noise: float = 0.05):
+    """60 s of a Coulomb-viscous joint warming from 20 to 70 °C whose levels are ``F exp(law_rate (T - T_ref))``
+    (``law_rate`` 0: constant), written in the physical parameters (independently of the module), and its estimate
+    with ``noise`` [N·m]."""
+    t, qd, s = trajectory(seed, 60.0)
+    s = replace(s, temperature=20.0 + 50.0 * t / 60.0)
+    scale = np.exp(law_rate * (s.temperature - T_REF))
+    f = TRUTH.F_c * scale * np.sign(qd) + TRUTH.F_v * scale * qd + TRUTH.tau_os
+    return qd, -f + noise * np.random.default_rng(200 + seed).standard_normal(qd.size), s
+
+
+def test_the_temperature_laws_regressors_and_rate_column_are_the_exponential():
+    """``F + F_T phi(dT)`` with ``F_T = rate F`` is ``F exp(rate dT)``; the rate column is its derivative (central
+    finite differences); rate 0 is the linear law."""
+    from wbfriction.friction.terms import temperature_shape, temperature_shape_rate
+
+    dT = np.linspace(-30.0, 30.0, 61)
+    for rate in (-0.02, -0.005, 0.01):
+        assert 2.0 + 2.0 * rate * temperature_shape(dT, rate) == pytest.approx(2.0 * np.exp(rate * dT), rel=1e-12)
+        h = 1e-7
+        numeric = (temperature_shape(dT, rate + h) - temperature_shape(dT, rate - h)) / (2 * h)
+        assert temperature_shape_rate(dT, rate) == pytest.approx(numeric, rel=1e-6, abs=1e-9)
+    assert np.array_equal(temperature_shape(dT, 0.0), dT)
+    assert temperature_shape_rate(dT, 1e-9) == pytest.approx(temperature_shape_rate(dT, 0.0), rel=1e-6)
+
+
+@pytest.mark.parametrize("law_rate", [RATE_T, 0.0], ids=["exponential", "constant"])
+def test_the_exponential_temperature_law_is_chosen_where_the_truth_has_it(law_rate):
+    """10 seeds, 0.05 N·m of noise: with an exponential truth the exponential law is kept (``auto``), its rate, F_cT =
+    rate F_c and F_vT = rate F_v within 5 %, each within three standard errors; with a linear truth (the case above)
+    the linear law is kept, every seed; with no temperature effect, no temperature term."""
+    for seed in range(10):
+        if law_rate:
+            qd, tau_f, s = exponential_joint(seed, law_rate)
+        else:  # the linear truth of the cases above
+            qd, tau_f, s = joint(seed, ("temperature",))
+        use = np.abs(qd) > 0.02
+        base = fit_friction(qd, tau_f, model="coulomb-viscous", mask=use)
+        assert base.params is not None
+        options = TermOptions(terms=("temperature",), reference_temperature=T_REF)
+        fit = fit_terms(base.params, qd, tau_f, use, s, options)
+        assert fit.kept == ("temperature",), (seed, fit.reasons)
+        if not law_rate:
+            assert fit.temperature_rate == 0.0 and "law linear" in fit.reasons["temperature"], (seed, fit.reasons)
+            continue
+        assert "law exponential" in fit.reasons["temperature"], (seed, fit.reasons)
+        truth = {"rate_T": law_rate, "F_cT": law_rate * TRUTH.F_c, "F_vT": law_rate * TRUTH.F_v}
+        for n, v in truth.items():
+            assert fit.coefficients[n] == pytest.approx(v, rel=0.05), (seed, n, fit.coefficients)
+            assert abs(fit.coefficients[n] - v) < 3 * fit.stderr[n], (seed, n, fit.coefficients[n], fit.stderr[n])
+        assert fit.params.F_c == pytest.approx(TRUTH.F_c, rel=0.05) and fit.verdicts()["temperature"].ok
+        one = TermSignals(temperature=np.array([65.0]))  # the model at one sample, in arrays and in floats
+        expected = -(TRUTH.F_c + TRUTH.F_v * 0.5) * np.exp(law_rate * 25.0) - TRUTH.tau_os
+        assert fit.torque_at(0.5, temperature=65.0) == pytest.approx(fit.torque(np.array([0.5]), one)[0], rel=1e-12)
+        assert fit.torque_at(0.5, temperature=65.0) == pytest.approx(expected, rel=0.03)
+
+
+def test_a_fit_with_the_exponential_law_reads_back_and_the_linear_law_can_be_forced():
+    import json
+
+    qd, tau_f, s = exponential_joint(0, RATE_T)
+    use = np.abs(qd) > 0.02
+    base = fit_friction(qd, tau_f, model="coulomb-viscous", mask=use)
+    fit = fit_terms(base.params, qd, tau_f, use, s, TermOptions(terms=("temperature",), reference_temperature=T_REF))
+    back = TermFit.from_dict(json.loads(json.dumps(fit.to_dict())))
+    assert back == fit and back.temperature_rate == fit.temperature_rate != 0.0
+    linear = fit_terms(base.params, qd, tau_f, use, s, TermOptions(terms=("temperature",), reference_temperature=T_REF,
+                                                                    temperature_law="linear"))
+    assert linear.temperature_rate == 0.0 and "rate_T" not in linear.coefficients
+    with pytest.raises(OptionError, match="--temperature-law"):
+        TermOptions(temperature_law="arrhenius")  # type: ignore[arg-type]

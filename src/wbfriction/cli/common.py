@@ -24,6 +24,7 @@ from wbfriction.friction.options import (
     TERMS,
     EstimateOptions,
     FitOptions,
+    TemperatureLaw,
     Term,
     TermOptions,
 )
@@ -163,18 +164,23 @@ MaxHarmonicOpt = typer.Option(FIT.terms.max_harmonic, "--max-harmonic", help="Th
 ReferenceTemperatureOpt = typer.Option(None, "--reference-temperature",
                                        help="T_ref [°C] the temperature term's levels are stated at [default: each "
                                             "log's median].")
+TemperatureLawOpt = typer.Option(FIT.terms.temperature_law, "--temperature-law",
+                                 help="How the temperature term's levels follow the temperature: linear, exponential "
+                                      "(Bittencourt's decrease) or auto (the exponential where held-out samples "
+                                      "improve).")
 
 
-def term_options(terms: str, max_harmonic: int, reference_temperature: float | None) -> TermOptions:
-    """The terms' options of ``--terms`` (comma-separated, or ``all``), ``--max-harmonic`` and
-    ``--reference-temperature``.
+def term_options(terms: str, max_harmonic: int, reference_temperature: float | None,
+                 temperature_law: TemperatureLaw = "auto") -> TermOptions:
+    """The terms' options of ``--terms`` (comma-separated, or ``all``), ``--max-harmonic``,
+    ``--reference-temperature`` and ``--temperature-law``.
 
     Raises:
         OptionError: an unknown term (:class:`~wbfriction.friction.options.TermOptions`).
     """
     names = TERMS if terms.strip() == "all" else tuple(t.strip() for t in terms.split(",") if t.strip())
     return TermOptions(terms=cast(tuple[Term, ...], names), max_harmonic=max_harmonic,
-                       reference_temperature=reference_temperature)
+                       reference_temperature=reference_temperature, temperature_law=temperature_law)
 
 
 def _version(value: bool) -> None:

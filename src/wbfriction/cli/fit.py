@@ -12,7 +12,7 @@ from rich.table import Table
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
-from wbfriction.friction.options import FitOptions, ModelChoice
+from wbfriction.friction.options import FitOptions, ModelChoice, TemperatureLaw
 from wbfriction.pipeline.paths import check_paths
 
 if TYPE_CHECKING:
@@ -31,6 +31,7 @@ from wbfriction.cli.common import (
     ModelOpt,
     ReferenceTemperatureOpt,
     RobotOpt,
+    TemperatureLawOpt,
     TermsOpt,
     UrdfOpt,
     VerboseOpt,
@@ -80,13 +81,15 @@ def fit(friction: Path = FrictionArg,
                                                        "which the simpler model is chosen."),
         terms: str = TermsOpt, max_harmonic: int = MaxHarmonicOpt,
         reference_temperature: Optional[float] = ReferenceTemperatureOpt,
+        temperature_law: TemperatureLaw = TemperatureLawOpt,
         wide: bool = WideOpt, verbose: bool = VerboseOpt) -> None:
     """Identify a friction model of every joint, with standard errors and the parameters left
     at a bound; warn about joints whose friction generates power (eq. 7.9)."""
     check_paths({"FRICTION": friction}, {"-o": output})
     _run_fit(friction, output, FitOptions(model=model, selection_tolerance=selection_tolerance,
                                           min_samples=min_samples,
-                                          terms=term_options(terms, max_harmonic, reference_temperature)),
+                                          terms=term_options(terms, max_harmonic, reference_temperature,
+                                                             temperature_law)),
              energy_threshold, energy_tolerance, workers, wide, verbose)
 
 

@@ -18,6 +18,7 @@ from wbfriction.friction.options import (
     EstimateOptions,
     FitOptions,
     ModelChoice,
+    TemperatureLaw,
 )
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.signals.options import DiffOption
@@ -33,6 +34,7 @@ from wbfriction.cli.common import (
     MinSamplesOpt,
     ReferenceTemperatureOpt,
     RobotOpt,
+    TemperatureLawOpt,
     TermsOpt,
     UrdfOpt,
     app,
@@ -67,7 +69,8 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
           model: ModelChoice = typer.Option(FIT.model, help="Friction model, as 'wbfriction fit --model' (a "
                                                              "manifest's model column overrides it per log)."),
           min_samples: int = MinSamplesOpt, terms: str = TermsOpt, max_harmonic: int = MaxHarmonicOpt,
-          reference_temperature: Optional[float] = ReferenceTemperatureOpt) -> None:
+          reference_temperature: Optional[float] = ReferenceTemperatureOpt,
+        temperature_law: TemperatureLaw = TemperatureLawOpt) -> None:
     """Estimate, fit and check every log of a fleet on Dask, into one results dataset (exit status 1 when a log
     failed: it is listed, the others are done)."""
     from wbfriction.fleet.batch import check_outputs, quiet_dask_logs, run_batch
@@ -89,7 +92,8 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
     else:
         entries = read_manifest(source)
     options = BatchOptions(estimate=EstimateOptions(diff=diff), fit=FitOptions(
-        model=model, min_samples=min_samples, terms=term_options(terms, max_harmonic, reference_temperature)))
+        model=model, min_samples=min_samples,
+        terms=term_options(terms, max_harmonic, reference_temperature, temperature_law)))
     with Progress(TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console,
                   transient=True, disable=not console.is_terminal) as bar:
         task = bar.add_task("batch", total=len(entries))

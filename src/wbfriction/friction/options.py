@@ -177,6 +177,10 @@ DEFAULT_TOLERANCE = 0.01
 Term = Literal["load", "direction", "ripple", "temperature"]
 """A term beyond velocity (module docstring)."""
 TERMS: tuple[Term, ...] = get_args(Term)
+TemperatureLaw = Literal["auto", "linear", "exponential"]
+"""How a temperature term's levels follow the temperature (:mod:`~wbfriction.friction.terms`): ``linear``,
+``exponential`` (Bittencourt's decrease), or ``auto``: the exponential where held-out samples say it predicts better."""
+TEMPERATURE_LAWS: tuple[TemperatureLaw, ...] = get_args(TemperatureLaw)
 """Every term, in the order they are reported."""
 MIN_EFFECT = 0.01
 """A term beyond velocity whose torque over the samples (RMS) is below this share of the friction's is not kept
@@ -193,13 +197,14 @@ class TermOptions:
         reference_temperature: ``T_ref`` [°C]; None: the median temperature of the samples fitted.
         tolerance: a term is kept when it lowers the held-out RMS by more than this share (the model choice's,
             :data:`~wbfriction.friction.options.SELECTION_TOLERANCE`).
+        temperature_law: how a kept temperature term's levels follow the temperature (:data:`TemperatureLaw`).
         min_effect: a term whose torque (RMS over the samples) is below this share of the friction's is not kept
             (:data:`MIN_EFFECT`), nor one below ``min_torque`` [N·m] (a torque sensor's resolution: on a joint
             with almost no friction, a share of it is nothing; :data:`DEFAULT_TOLERANCE`).
 
     Raises:
-        OptionError: an unknown term, ``max_harmonic`` below 1 or above 20, ``tolerance`` or ``min_effect``
-            outside (0, 1).
+        OptionError: an unknown term or temperature law, ``max_harmonic`` below 1 or above 20, ``tolerance`` or
+            ``min_effect`` outside (0, 1).
     """
 
     terms: tuple[Term, ...] = TERMS
@@ -208,10 +213,12 @@ class TermOptions:
     tolerance: float = SELECTION_TOLERANCE
     min_effect: float = MIN_EFFECT
     min_torque: float = DEFAULT_TOLERANCE
+    temperature_law: TemperatureLaw = "auto"
 
     def __post_init__(self) -> None:
         for term in self.terms:
             check_choice("terms", term, TERMS)
+        check_choice("temperature_law", self.temperature_law, TEMPERATURE_LAWS)
         check_range("max_harmonic", self.max_harmonic, low=1, high=20)
         check_range("min_effect", self.min_effect, low=0.0, high=1.0)
         check_range("min_torque", self.min_torque, low=0.0)

@@ -50,14 +50,15 @@ class FrictionSpec:
     temperature: tuple[float, float] | None = None
 
 
-TERM_KEYS = ("F_L", "dF_v", "F_cT", "F_vT", "reference_temperature", "ripple")
+TERM_KEYS = ("F_L", "dF_v", "F_cT", "F_vT", "rate_T", "reference_temperature", "ripple")
 """The keys of a ``terms`` table (:func:`load_friction_spec`)."""
 
 
 def terms_from_dict(params: ModelParams, d: Mapping[str, object]) -> TermFit:
     """A joint's terms beyond velocity from a ``terms`` table: ``F_L`` (load), ``dF_v`` (direction), ``F_cT`` and
-    ``F_vT`` with ``reference_temperature`` (temperature), ``ripple`` a list of ``[sin, cos]`` amplitudes per
-    harmonic (:mod:`wbfriction.friction.terms` for what each means).
+    ``F_vT`` with ``reference_temperature`` and optionally ``rate_T`` (temperature: linear, or exponential with that
+    rate [1/°C]), ``ripple`` a list of ``[sin, cos]`` amplitudes per harmonic (:mod:`wbfriction.friction.terms` for
+    what each means).
 
     Raises:
         InputError: an unknown key, a value that is not a number, a ripple that is not pairs, temperature
@@ -67,13 +68,13 @@ def terms_from_dict(params: ModelParams, d: Mapping[str, object]) -> TermFit:
     if unknown:
         raise InputError(f"unknown term key '{unknown[0]}': choose among {', '.join(TERM_KEYS)}")
     try:
-        c = {k: float(cast(float, d[k])) for k in ("F_L", "dF_v", "F_cT", "F_vT") if k in d}
+        c = {k: float(cast(float, d[k])) for k in ("F_L", "dF_v", "F_cT", "F_vT", "rate_T") if k in d}
         ripple = [(float(s), float(co)) for s, co in cast(list, d.get("ripple", []))]
         t_ref = None if d.get("reference_temperature") is None else float(cast(float, d["reference_temperature"]))
     except (TypeError, ValueError) as exc:
         raise InputError(f"terms: {exc} (numbers, and ripple as [[sin, cos], ...] per harmonic)") from None
     present = {"load": "F_L" in c, "direction": "dF_v" in c, "ripple": bool(ripple),
-               "temperature": "F_cT" in c or "F_vT" in c}
+               "temperature": "F_cT" in c or "F_vT" in c or "rate_T" in c}
     c.update({f"ripple_{f}{h}": x for h, pair in enumerate(ripple, 1) for f, x in zip(("sin", "cos"), pair)})
     if present["temperature"]:
         if t_ref is None:

@@ -26,9 +26,16 @@ weighted least-squares solve fits them together (:func:`fit_terms`). ``g(qd)`` i
   energy check (eq. 7.9) and of the exports; predictions include it, within the angles it was fitted on (outside,
   it is held at its value at the nearest fitted angle: a Fourier series fitted on less than a turn is not known
   beyond its data, and would run away there).
-* ``temperature``: ``F_c (1 + k_Tc (T - T_ref))`` and ``F_v (1 + k_Tv (T - T_ref))`` (the linear form of
-  Bittencourt's decrease), ``T`` the logged joint temperature [°C], ``T_ref`` the reference temperature every output
-  states: coefficients ``F_cT = F_c k_Tc`` on ``(T - T_ref) g`` and ``F_vT = F_v k_Tv`` on ``(T - T_ref) qd``.
+* ``temperature``: the Coulomb and viscous levels ``F_c + F_cT phi(T - T_ref)`` and ``F_v + F_vT phi(T - T_ref)``,
+  ``T`` the logged joint temperature [°C], ``T_ref`` the reference temperature every output states: coefficients
+  ``F_cT`` on ``phi g`` and ``F_vT`` on ``phi qd``, the levels' slopes at ``T_ref`` [N·m/°C, N·m·s/(rad·°C)]
+  (``k_Tc = F_cT / F_c``, ``k_Tv = F_vT / F_v`` relative [1/°C]). The law ``phi`` (:func:`temperature_shape`) is
+  linear, ``phi(dT) = dT``, or exponential, ``phi(dT) = (exp(r dT) - 1) / r`` with a rate ``r`` [1/°C]
+  (``rate_T``; Bittencourt's exponential decrease of friction with temperature: ``F_c exp(k_Tc dT)`` when
+  ``F_cT = r F_c``, levels that flatten as grease thins); the exponential is kept where held-out samples say it
+  predicts better than the linear (:attr:`~wbfriction.friction.options.TermOptions.temperature_law`), its rate
+  fitted by a bounded scalar search with the coefficients solved at each rate (variable projection) and its
+  standard error from the Jacobian column of the rate.
 
 **Which terms are kept**: stepwise selection on blocked held-out samples (the split of the model choice,
 :func:`~wbfriction.friction.fit.held_out_split`), with the model choice's rule: forward, the term that lowers the
@@ -50,8 +57,9 @@ under load or warm; ``k_Tc < 0``: less friction warm). The ripple's sign is that
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import Any, cast
 
 import numpy as np
@@ -163,8 +171,24 @@ def fourier(q: np.ndarray, harmonics: int, constant: bool = False) -> np.ndarray
     return np.column_stack(([np.ones_like(angle)] if constant else []) + columns)
 
 
+def temperature_shape(dT: np.ndarray, rate: float = 0.0) -> np.ndarray:
+    """The temperature law ``phi`` (N,) of ``dT = T - T_ref`` [°C] (module docstring): ``dT`` (``rate`` 0, linear)
+    or ``(exp(rate dT) - 1) / rate`` (exponential, ``rate`` [1/°C]); slope 1 at ``T_ref`` either way."""
+    dT = np.asarray(dT, dtype=float)
+    return dT if rate == 0.0 else np.expm1(rate * dT) / rate
+
+
+def temperature_shape_rate(dT: np.ndarray, rate: float) -> np.ndarray:
+    """``d phi / d rate`` (N,) of :func:`temperature_shape` [°C^2] (``dT^2 / 2`` at rate 0)."""
+    dT = np.asarray(dT, dtype=float)
+    if rate == 0.0:
+        return 0.5 * dT**2
+    return (rate * dT * np.exp(rate * dT) - np.expm1(rate * dT)) / rate**2
+
+
 def term_basis(term: Term, params: ModelParams, qd: np.ndarray, signals: TermSignals, *, harmonics: int = 1,
-               reference_temperature: float = 0.0) -> tuple[tuple[str, ...], np.ndarray]:
+               reference_temperature: float = 0.0,
+               temperature_rate: float = 0.0) -> tuple[tuple[str, ...], np.ndarray]:
     """One term's coefficient names and regressors (N, k) (module docstring).
 
     Raises:
@@ -186,8 +210,9 @@ def term_basis(term: Term, params: ModelParams, qd: np.ndarray, signals: TermSig
     if term == "temperature":
         if signals.temperature is None:
             raise ValueError("the temperature term needs the joint's temperature")
-        dT = np.asarray(signals.temperature, dtype=float) - reference_temperature
-        return ("F_cT", "F_vT"), np.column_stack([dT * g, dT * qd])
+        phi = temperature_shape(np.asarray(signals.temperature, dtype=float) - reference_temperature,
+                                temperature_rate)
+        return ("F_cT", "F_vT"), np.column_stack([phi * g, phi * qd])
     raise ValueError(f"unknown term {term!r}")
 
 
@@ -228,6 +253,11 @@ class TermFit:
     at_bound: tuple[str, ...] = ()
     covariance: np.ndarray | None = field(default=None, repr=False, compare=False)
 
+    @property
+    def temperature_rate(self) -> float:
+        """The temperature law's rate ``rate_T`` [1/°C] (0: linear; :func:`temperature_shape`)."""
+        return self.coefficients.get("rate_T", 0.0)
+
     def verdicts(self) -> dict[Term, FitVerdict]:
         """Per kept term, whether its numbers can be used (``ok``, ``weak``, ``routes disagree``) and why.
 
@@ -255,7 +285,8 @@ class TermFit:
     def _read(self, term: Term, c: Mapping[str, float], se: Mapping[str, float]) -> dict[str, tuple[float, float]]:
         """The values a status judges of ``term`` (name -> value, standard error): its coefficients, the ripple's
         size (:func:`ripple_size`)."""
-        return {n: (c[n], se.get(n, math.inf)) for n in TERM_COEFFICIENTS[term] if n in c}
+        names = TERM_COEFFICIENTS[term] + (("rate_T",) if term == "temperature" else ())
+        return {n: (c[n], se.get(n, math.inf)) for n in names if n in c}
 
     def to_dict(self) -> dict[str, Any]:
         """As the parameters JSON holds it (a value that is not finite: ``null``), with each term's status."""
@@ -349,7 +380,9 @@ class TermFit:
             elif term == "direction":
                 f += c["dF_v"] * abs(qd)
             elif term == "temperature":
-                f += (c["F_cT"] * g + c["F_vT"] * qd) * (temperature - (self.reference_temperature or 0.0))
+                dT = temperature - (self.reference_temperature or 0.0)
+                rate = self.temperature_rate
+                f += (c["F_cT"] * g + c["F_vT"] * qd) * (dT if rate == 0.0 else math.expm1(rate * dT) / rate)
             else:
                 angle = q if self.q_range is None else min(max(q, self.q_range[0]), self.q_range[1])
                 f += sum(c[f"ripple_sin{h}"] * math.sin(h * angle) + c[f"ripple_cos{h}"] * math.cos(h * angle)
@@ -364,7 +397,8 @@ class TermFit:
             if dissipative and term in NOT_DISSIPATIVE:
                 continue
             names, X = term_basis(term, self.params, qd, signals, harmonics=self.harmonics,
-                                  reference_temperature=self.reference_temperature or 0.0)
+                                  reference_temperature=self.reference_temperature or 0.0,
+                                  temperature_rate=self.temperature_rate)
             f = f + X @ np.array([self.coefficients[n] for n in names])
         return f
 
@@ -419,12 +453,14 @@ class TermCheck:
 
 
 def _design(params: ModelParams, qd: np.ndarray, signals: TermSignals, terms: tuple[Term, ...], harmonics: int,
-            t_ref: float, smoother=None) -> tuple[tuple[str, ...], np.ndarray, int]:
-    """The joint design ``[B | Phi_1 | ...]`` (N, k + m), its names, and ``k`` (the velocity model's count)."""
+            t_ref: float, smoother=None, rate: float = 0.0) -> tuple[tuple[str, ...], np.ndarray, int]:
+    """The joint design ``[B | Phi_1 | ...]`` (N, k + m), its names, and ``k`` (the velocity model's count);
+    ``rate``: the temperature law's (:func:`temperature_shape`)."""
     names, B, _ = velocity_basis(params, qd)
     blocks, all_names = [B], list(names)
     for term in terms:
-        n, X = term_basis(term, params, qd, signals, harmonics=harmonics, reference_temperature=t_ref)
+        n, X = term_basis(term, params, qd, signals, harmonics=harmonics, reference_temperature=t_ref,
+                          temperature_rate=rate)
         blocks.append(X)
         all_names += n
     X = np.column_stack(blocks)
@@ -631,11 +667,18 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     kept_sorted = tuple(t for t in TERMS if t in kept)
     if not kept_sorted:
         return TermFit(params, reference_temperature=t_ref, reasons=reasons, held_out_rms=(base_rms, base_rms))
-    names, X, k = design(kept_sorted, harmonics)
-    coef, cov, held = _final(X, y_, use, names)
+    rate = 0.0
+    if "temperature" in kept_sorted and options.temperature_law != "linear":
+        law = _TemperatureLaw(params, qd_, y_, use, signals, kept_sorted, harmonics, t_ref or 0.0, smoother)
+        rate, note = law.choose(train, test, options)
+        reasons["temperature"] += note
+    names, X, k = _design(params, qd_, signals, kept_sorted, harmonics, t_ref or 0.0, smoother, rate)
+    coef, cov, held = _final(X, y_, use, names, None if rate == 0.0 else partial(law.rate_column, rate, names))
     refitted = with_coefficients(params, coef[:k])
     coefficients = dict(zip(names[k:], map(float, coef[k:])))
     stderr = dict(zip(names, map(float, covariance_errors(cov))))
+    if rate != 0.0:
+        coefficients["rate_T"], stderr["rate_T"] = rate, float(np.sqrt(max(cov[-1, -1], 0.0)))
     q_range = None
     derived = _derived(refitted, coefficients)
     if "ripple" in kept_sorted and signals.q is not None:
@@ -676,18 +719,92 @@ def _moving(use: np.ndarray, qd: np.ndarray, y: np.ndarray, signals: TermSignals
     return use
 
 
-def _final(X: np.ndarray, y: np.ndarray, use: np.ndarray,
-           names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
+def _final(X: np.ndarray, y: np.ndarray, use: np.ndarray, names: tuple[str, ...],
+           rate_column: Callable[[np.ndarray], np.ndarray] | None = None,
+           ) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
     """The coefficients on every sample ``use`` (:func:`_nonnegative_solve`), their covariance (residuals correlated
-    over a filter's window: Newey-West, as the fit's; zero for one held at zero) and the names held."""
+    over a filter's window: Newey-West, as the fit's; zero for one held at zero) and the names held. With
+    ``rate_column`` (the model's derivative (N,) in the temperature law's rate, given the coefficients), the
+    covariance is that of the coefficients and the rate (last): the full Jacobian's, the rate fitted too."""
     coef, held = _nonnegative_solve(X[use], y[use], names)
     free = np.array([n not in held for n in names])
     residual = y[use] - X[use] @ coef
     rows = np.flatnonzero(use)
-    cov = np.zeros((len(names), len(names)))
-    cov[np.ix_(free, free)] = parameter_covariance(X[use][:, free], residual, rows=rows,
+    J = X[use]
+    if rate_column is not None:
+        J = np.column_stack([J, rate_column(coef)[use]])
+        free = np.append(free, True)
+    cov = np.zeros((len(free), len(free)))
+    cov[np.ix_(free, free)] = parameter_covariance(J[:, free], residual, rows=rows,
                                                    max_lag=correlation_lag(residual, rows))
     return coef, cov, held
+
+
+RATE_SPAN = 3.0
+"""The exponential temperature law's rate is searched within ``RATE_SPAN`` over the largest ``|T - T_ref|`` met
+[1/°C]: a level that changes by up to ``e^3`` (20 times) over the temperatures logged, beyond any grease's."""
+
+
+@dataclass(frozen=True)
+class _TemperatureLaw:
+    """The exponential temperature law of a fit's kept terms (:func:`temperature_shape`): its rate found by variable
+    projection (the coefficients solved at each rate) and kept where held-out samples say so."""
+
+    params: ModelParams
+    qd: np.ndarray
+    y: np.ndarray
+    use: np.ndarray
+    signals: TermSignals
+    terms: tuple[Term, ...]
+    harmonics: int
+    t_ref: float
+    smoother: Any = None
+
+    def design(self, rate: float) -> tuple[tuple[str, ...], np.ndarray]:
+        names, X, _ = _design(self.params, self.qd, self.signals, self.terms, self.harmonics, self.t_ref,
+                              self.smoother, rate)
+        return names, np.nan_to_num(X)
+
+    def residual(self, rate: float, train: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """The residual (on ``rows``) of the coefficients fitted on ``train`` at ``rate``."""
+        _, X = self.design(rate)
+        return self.y[rows] - X[rows] @ _solve(X[train], self.y[train])
+
+    def choose(self, train: np.ndarray, test: np.ndarray, options: TermOptions) -> tuple[float, str]:
+        """The rate (0: the linear law) and a phrase for the temperature term's reason: the exponential when
+        ``options.temperature_law`` asks for it, or (``auto``) when fitted on ``train`` it lowers the held-out RMS
+        on ``test`` by more than the tolerance and keeps every level physical."""
+        from scipy.optimize import minimize_scalar
+        dT = np.asarray(self.signals.temperature, dtype=float)[self.use] - self.t_ref
+        span = float(np.max(np.abs(dT))) if dT.size else 0.0
+        if not span > 0.0:
+            return 0.0, ""
+        bound = RATE_SPAN / span
+        found = minimize_scalar(lambda r: float(np.sum(self.residual(r, train, train) ** 2)), bounds=(-bound, bound),
+                                method="bounded", options={"xatol": 1e-6 * bound})
+        rate = float(found.x)
+        rms = {law: float(np.sqrt(np.mean(self.residual(r, train, test) ** 2))) for law, r in
+               (("linear", 0.0), ("exponential", rate))}
+        names, X = self.design(rate)
+        coef, _ = _nonnegative_solve(X[self.use], self.y[self.use], names)
+        k = len(velocity_basis(self.params, self.qd[:1])[0])
+        unphysical = _unphysical(with_coefficients(self.params, coef[:k]), dict(zip(names[k:], map(float, coef[k:]))),
+                                 self.signals, self.use, self.t_ref, rate)
+        versus = (f"held-out RMS {rms['exponential']:.4g} N·m exponential (rate {rate:.3g} /°C), {rms['linear']:.4g} "
+                  "linear")
+        if unphysical is not None:
+            return 0.0, f"; law linear: the exponential's levels go below zero ({versus})"
+        if options.temperature_law == "exponential" or rms["exponential"] < (1.0 - options.tolerance) * rms["linear"]:
+            return rate, f"; law exponential: {versus}"
+        return 0.0, f"; law linear: {versus}"
+
+    def rate_column(self, rate: float, names: tuple[str, ...], coef: np.ndarray) -> np.ndarray:
+        """The model's derivative in the rate (N,), at the coefficients ``coef`` (``names``' order)."""
+        dT = np.asarray(self.signals.temperature, dtype=float) - self.t_ref
+        g = coulomb_shape(self.params, self.qd)
+        c = dict(zip(names, coef))
+        column = (c["F_cT"] * g + c["F_vT"] * self.qd) * temperature_shape_rate(dT, rate)
+        return column if self.smoother is None else np.asarray(self.smoother(column[:, None]))[:, 0]
 
 
 def ripple_size(q: np.ndarray, harmonics: int, names: tuple[str, ...], coef: np.ndarray,
@@ -719,7 +836,7 @@ def refit_terms(fit: TermFit, params: ModelParams, qd: np.ndarray, tau_f: np.nda
     use = _moving(use, qd, y, signals)
     qd_ = qd if smoother is not None else np.where(use, qd, 0.0)
     names, X, k = _design(params, qd_, signals, fit.kept, fit.harmonics, fit.reference_temperature or 0.0,
-                          smoother)
+                          smoother, fit.temperature_rate)
     use &= np.isfinite(X).all(axis=1)
     if use.sum() <= X.shape[1]:
         return None
@@ -733,7 +850,7 @@ def refit_terms(fit: TermFit, params: ModelParams, qd: np.ndarray, tau_f: np.nda
 
 
 def _unphysical(params: ModelParams, c: dict[str, float], signals: TermSignals, use: np.ndarray,
-                t_ref: float) -> tuple[Term, str] | None:
+                t_ref: float, rate: float = 0.0) -> tuple[Term, str] | None:
     """The first friction term whose levels go below zero on the samples (a viscous level in a direction, a Coulomb
     level under a load met, a level at a temperature met) and what goes below; None when all stay physical."""
     F_c, F_v = params.F_c, params.F_v
@@ -745,8 +862,8 @@ def _unphysical(params: ModelParams, c: dict[str, float], signals: TermSignals, 
         if lowest < 0:
             return "load", f"a Coulomb level below zero under the largest load met ({lowest:.3g} N·m): not friction"
     if "F_cT" in c and signals.temperature is not None:
-        dT = np.asarray(signals.temperature, dtype=float)[use] - t_ref
-        levels = (F_c + c["F_cT"] * dT, F_v + c["F_vT"] * dT)
+        phi = temperature_shape(np.asarray(signals.temperature, dtype=float)[use] - t_ref, rate)
+        levels = (F_c + c["F_cT"] * phi, F_v + c["F_vT"] * phi)
         if min(float(np.min(x)) for x in levels) < 0:
             return "temperature", "a Coulomb or viscous level below zero at a temperature met: not friction"
     return None
@@ -779,6 +896,8 @@ def _term_of(name: str) -> Term:
     """The term a coefficient belongs to."""
     if name.startswith("ripple"):
         return "ripple"
+    if name == "rate_T":
+        return "temperature"
     return next(t for t, names in TERM_COEFFICIENTS.items() if name in names)
 
 

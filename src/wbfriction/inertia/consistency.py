@@ -244,8 +244,9 @@ def _conic_solve(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float,
                  lower: np.ndarray, margin: float = 0.0) -> tuple[np.ndarray, SolverOutcome]:
     """The exact minimum of :func:`fit_consistent`'s objective over positive-semidefinite pseudo-inertias and the
     bounds ``lower``: a convex quadratic program with one 4 x 4 semidefinite cone per body (the linear matrix
-    inequality of Wensing et al. 2018, about ``J(pi) - margin J(pi_0)``), solved by Clarabel's interior-point method in standard deviations of the
-    prior (``x = x0 + L^-1 y``; the objective compressed to ``p`` rows by a QR factorization, ``A_y = Q T``)."""
+    inequality of Wensing et al. 2018, about ``J(pi) - margin J(pi_0)``), solved by Clarabel's interior-point method
+    in standard deviations of the prior (``x = x0 + L^-1 y``; the objective compressed to ``p`` rows by a QR
+    factorization, ``A_y = Q T``)."""
     import clarabel
     import scipy.linalg
     import scipy.sparse as sp
@@ -255,7 +256,7 @@ def _conic_solve(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float,
     p, nb = len(prior.x0), prior.nb
     G = _svec_pseudo_inertia()
     blocks, b = [], []
-    for k, root in enumerate(prior.bodies):  # J(pi_b) - margin J(x0_b) = (1 - margin) J(x0_b) + G L_b^-1 y_b in the cone
+    for k, root in enumerate(prior.bodies):  # J(pi_b) - margin J(x0_b) = (1 - margin) J(x0_b) + G L_b^-1 y_b: a cone
         row = np.zeros((10, p))
         row[:, 10 * k:10 * k + 10] = -G @ np.linalg.inv(root)
         blocks.append(row)

@@ -540,7 +540,8 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
     if fit.solver is None:
         message = "the linear least-squares solution is physically consistent"
     else:
-        margin = f" or kept less than {options.link_margin:g} of the given pseudo-inertia" if options.link_margin else ""
+        margin = (f" or kept less than {options.link_margin:g} of the given pseudo-inertia" if options.link_margin
+                  else "")
         message = (f"{fit.unphysical} bodies of the linear solution were not physical{margin}; the conic solve "
                    f"{solver.meaning}")
         if not solver.converged:

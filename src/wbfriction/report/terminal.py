@@ -113,7 +113,8 @@ def terms_table(results: Sequence[FitResult], label: Callable[[str], str] = str)
                 text = (f"size {with_error(terms.derived['ripple_rms'], terms.stderr.get('ripple_rms'))} N·m, "
                         f"{terms.harmonics} harmonic{'s' if terms.harmonics > 1 else ''}")
             else:
-                text = ", ".join(shown(n) for n in TERM_COEFFICIENTS[term])
+                text = ", ".join(shown(n) for n in TERM_COEFFICIENTS[term]
+                                 + (("rate_T",) if term == "temperature" and terms.temperature_rate else ()))
             table.add_row("", term, verdict.status, text, style=None if verdict.ok else "dim")
     return table
 
