@@ -670,8 +670,9 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     rate = 0.0
     if "temperature" in kept_sorted and options.temperature_law != "linear":
         law = _TemperatureLaw(params, qd_, y_, use, signals, kept_sorted, harmonics, t_ref or 0.0, smoother)
-        rate, note = law.choose(train, test, options)
+        rate, note, rms = law.choose(train, test, options)
         reasons["temperature"] += note
+        current = rms if rate else current
     names, X, k = _design(params, qd_, signals, kept_sorted, harmonics, t_ref or 0.0, smoother, rate)
     coef, cov, held = _final(X, y_, use, names, None if rate == 0.0 else partial(law.rate_column, rate, names))
     refitted = with_coefficients(params, coef[:k])
@@ -770,15 +771,16 @@ class _TemperatureLaw:
         _, X = self.design(rate)
         return self.y[rows] - X[rows] @ _solve(X[train], self.y[train])
 
-    def choose(self, train: np.ndarray, test: np.ndarray, options: TermOptions) -> tuple[float, str]:
-        """The rate (0: the linear law) and a phrase for the temperature term's reason: the exponential when
+    def choose(self, train: np.ndarray, test: np.ndarray, options: TermOptions) -> tuple[float, str, float]:
+        """The rate (0: the linear law), a phrase for the temperature term's reason and the exponential's held-out
+        RMS [N·m] (NaN when no rate was searched): the exponential when
         ``options.temperature_law`` asks for it, or (``auto``) when fitted on ``train`` it lowers the held-out RMS
         on ``test`` by more than the tolerance and keeps every level physical."""
         from scipy.optimize import minimize_scalar
         dT = np.asarray(self.signals.temperature, dtype=float)[self.use] - self.t_ref
         span = float(np.max(np.abs(dT))) if dT.size else 0.0
         if not span > 0.0:
-            return 0.0, ""
+            return 0.0, "", float("nan")
         bound = RATE_SPAN / span
         found = minimize_scalar(lambda r: float(np.sum(self.residual(r, train, train) ** 2)), bounds=(-bound, bound),
                                 method="bounded", options={"xatol": 1e-6 * bound})
@@ -793,10 +795,10 @@ class _TemperatureLaw:
         versus = (f"held-out RMS {rms['exponential']:.4g} N·m exponential (rate {rate:.3g} /°C), {rms['linear']:.4g} "
                   "linear")
         if unphysical is not None:
-            return 0.0, f"; law linear: the exponential's levels go below zero ({versus})"
+            return 0.0, f"; law linear: the exponential's levels go below zero ({versus})", rms["exponential"]
         if options.temperature_law == "exponential" or rms["exponential"] < (1.0 - options.tolerance) * rms["linear"]:
-            return rate, f"; law exponential: {versus}"
-        return 0.0, f"; law linear: {versus}"
+            return rate, f"; law exponential: {versus}", rms["exponential"]
+        return 0.0, f"; law linear: {versus}", rms["exponential"]
 
     def rate_column(self, rate: float, names: tuple[str, ...], coef: np.ndarray) -> np.ndarray:
         """The model's derivative in the rate (N,), at the coefficients ``coef`` (``names``' order)."""
