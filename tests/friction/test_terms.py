@@ -13,13 +13,12 @@ from hypothesis import strategies as st
 from wbfriction.exceptions import InputError, OptionError
 from wbfriction.friction.fit import fit_friction
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams
+from wbfriction.friction.options import TERMS, TermOptions
+from wbfriction.friction.term_selection import fit_terms
 from wbfriction.friction.terms import (
-    TERMS,
     TermCheck,
     TermFit,
-    TermOptions,
     TermSignals,
-    fit_terms,
     term_basis,
     velocity_basis,
     with_coefficients,
@@ -232,7 +231,7 @@ def test_the_ripples_size_has_the_spread_of_its_repeats():
     """The ripple's size and its standard error (:func:`ripple_size`, the delta method through the coefficients'
     covariance): over 40 noise draws of one joint whose angles span less than a turn, the sizes' spread is within
     35 % of the standard error each draw states (white torque noise, so the Newey-West sum adds little)."""
-    from wbfriction.friction.terms import ripple_size
+    from wbfriction.friction.term_selection import ripple_size
 
     _, qd, s = trajectory(3, 20.0)
     assert s.q is not None

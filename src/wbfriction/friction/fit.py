@@ -79,7 +79,8 @@ from wbfriction.friction.regression import (
 )
 from wbfriction.friction.screen import gross_outliers
 from wbfriction.friction.status import HELD, MIN_SPEED, FitVerdict, fit_verdict, joint_speed, routes_disagree
-from wbfriction.friction.terms import TermFit, fit_terms, refit_terms, term_signals
+from wbfriction.friction.term_selection import fit_terms, refit_terms
+from wbfriction.friction.terms import TermFit, term_signals
 from wbfriction.signals.kinematics import PiecewiseSmoother
 from wbfriction.signals.nonuniform import ResampledLowpass
 from wbfriction.workers import process_pool
@@ -963,9 +964,9 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
 
 def _joint_terms(est: FrictionEstimate, i: int, fit: FitResult, other: FitResult | None,
                  options: FitOptions) -> TermFit | None:
-    """The terms beyond velocity of joint column ``i`` of ``est`` (:func:`~wbfriction.friction.terms.fit_terms`) on
-    the samples its fit used, and refitted on the other route's estimate with that route's model (``other``);
-    None for a joint not fitted or not excited."""
+    """The terms beyond velocity of joint column ``i`` of ``est``
+    (:func:`~wbfriction.friction.term_selection.fit_terms`) on the samples its fit used, and refitted on the other
+    route's estimate with that route's model (``other``); None for a joint not fitted or not excited."""
     if fit.params is None or fit.verdict().status in ("not excited", "failed"):
         return None
     signals = term_signals(est, i)
