@@ -71,8 +71,8 @@ def test_a_massless_body_is_measured_at_a_small_sphere():
 
 @pytest.mark.parametrize("margin", [-0.1, 1.0, float("nan")])
 def test_a_link_margin_outside_its_range_is_refused(margin):
-    from wbfriction.exceptions import InputError
+    from wbfriction.exceptions import OptionError
     from wbfriction.inertia.options import InertialOptions
 
-    with pytest.raises(InputError, match="link margin must be in"):
+    with pytest.raises(OptionError, match="--link-margin must be at least 0 and below 1"):
         InertialOptions(link_margin=margin)

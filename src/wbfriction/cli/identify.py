@@ -91,8 +91,6 @@ def identify(log: Path = LogArg,
         raise InputError(f"--stribeck-velocity must be auto, none or a number, got '{stribeck_velocity}'") from None
     if not 0.0 < holdout < 1.0:
         raise InputError(f"--holdout must be between 0 and 1, got {holdout}")
-    if not 0.0 <= link_margin < 1.0:
-        raise InputError(f"--link-margin must be at least 0 and below 1, got {link_margin}")
     from wbfriction.pipeline.identify_step import identify_file
     from wbfriction.report.terminal import identification_tables
 

@@ -61,37 +61,32 @@ def _hermite(fn, qd: np.ndarray, sigma: float) -> np.ndarray:
 _TWO_OVER_ROOT_PI = 2.0 / math.sqrt(math.pi)
 
 
-def _gauss_product(mu, sigma: float, v_s):
+def _gauss_product(mu, sigma: float, v_s, derivatives: bool = True):
     """``exp(-u^2 / v_s^2) N(u; mu, sigma^2) = kappa N(u; mu', sigma'^2)`` (module docstring):
-    ``(kappa, mu', sigma'^2)`` and their derivatives in ``v_s``."""
+    ``(kappa, mu', sigma'^2)`` and their derivatives in ``v_s`` (zeros without ``derivatives``: the fit evaluates
+    the model more often than its Jacobian)."""
     A, B = 0.5 * v_s**2, sigma**2
     D = A + B
     kappa = np.sqrt(A / D) * np.exp(-0.5 * mu**2 / D)
+    if not derivatives:
+        return kappa, mu * A / D, A * B / D, 0.0, 0.0, 0.0
     dA = v_s  # dA / dv_s
     d_kappa = kappa * (0.5 / A - 0.5 / D + 0.5 * mu**2 / D**2) * dA
     return kappa, mu * A / D, A * B / D, d_kappa, mu * B / D**2 * dA, B**2 / D**2 * dA
 
 
-def _tanh_value(mu, var, a):
-    """``E[tanh(a u)]``, ``u ~ N(mu, var)``: :func:`_tanh_terms`' value alone, the same operations (the fit
-    evaluates the model more often than its Jacobian)."""
-    value = 0.0
-    for c, b in zip(*TANH_ERF):
-        k = b * a
-        value = value + c * erf(k * mu / np.sqrt(1.0 + 2.0 * k**2 * var))
-    return value
-
-
-def _tanh_terms(mu, var, a):
-    """``E[tanh(a u)]``, ``u ~ N(mu, var)``, through :data:`TANH_ERF`, with its derivatives in ``a``, ``mu``, ``var``:
-    ``E[erf(k u)] = erf(g)``, ``g = k mu / sqrt(1 + 2 k^2 var)``."""
+def _tanh_terms(mu, var, a, derivatives: bool = True):
+    """``E[tanh(a u)]``, ``u ~ N(mu, var)``, through :data:`TANH_ERF`, with its derivatives in ``a``, ``mu``, ``var``
+    (zeros without ``derivatives``): ``E[erf(k u)] = erf(g)``, ``g = k mu / sqrt(1 + 2 k^2 var)``."""
     value = d_a = d_mu = d_var = 0.0
     for c, b in zip(*TANH_ERF):
         k = b * a
         r = 1.0 + 2.0 * k**2 * var
         g = k * mu / np.sqrt(r)
-        slope = c * _TWO_OVER_ROOT_PI * np.exp(-g**2) / np.sqrt(r)
         value = value + c * erf(g)
+        if not derivatives:
+            continue
+        slope = c * _TWO_OVER_ROOT_PI * np.exp(-g**2) / np.sqrt(r)
         d_a = d_a + slope * mu / r * b
         d_mu = d_mu + slope * k
         d_var = d_var - slope * k**3 * mu / r
@@ -126,16 +121,13 @@ def sign_decay_mean(mu, sigma: float, v_s):
 
 def tanh_mean(mu, sigma: float, a):
     """``E[tanh(a u)]``, ``u ~ N(mu, sigma^2)``, through :data:`TANH_ERF`."""
-    return _tanh_value(mu, sigma**2, a)
+    return _tanh_terms(mu, sigma**2, a, derivatives=False)[0]
 
 
 def tanh_decay_mean(mu, sigma: float, a, v_s):
-    """``E[tanh(a u) exp(-u^2 / v_s^2)]``, ``u ~ N(mu, sigma^2)``, through :data:`TANH_ERF` (the operations of
-    :func:`_tanh_decay`'s value)."""
-    A, B = 0.5 * v_s**2, sigma**2
-    D = A + B
-    kappa = np.sqrt(A / D) * np.exp(-0.5 * mu**2 / D)
-    return kappa * _tanh_value(mu * A / D, A * B / D, a)
+    """``E[tanh(a u) exp(-u^2 / v_s^2)]``, ``u ~ N(mu, sigma^2)``, through :data:`TANH_ERF`."""
+    kappa, m, s2, *_ = _gauss_product(mu, sigma, v_s, derivatives=False)
+    return kappa * _tanh_terms(m, s2, a, derivatives=False)[0]
 
 
 def _other_exponent(x: np.ndarray, qd: np.ndarray, sigma: float, delta_s: float, model: ModelName) -> np.ndarray:

@@ -360,14 +360,15 @@ class _TemperatureLaw:
     t_ref: float
     smoother: Any = None
 
-    def design(self, rate: float) -> tuple[tuple[str, ...], np.ndarray]:
-        names, X, _ = _design(self.params, self.qd, self.signals, self.terms, self.harmonics, self.t_ref,
+    def design(self, rate: float) -> tuple[tuple[str, ...], np.ndarray, int]:
+        """:func:`_design` of the kept terms at ``rate``, undefined rows at zero (they are not used)."""
+        names, X, k = _design(self.params, self.qd, self.signals, self.terms, self.harmonics, self.t_ref,
                               self.smoother, rate)
-        return names, np.nan_to_num(X)
+        return names, np.nan_to_num(X), k
 
     def residual(self, rate: float, train: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """The residual (on ``rows``) of the coefficients fitted on ``train`` at ``rate``."""
-        _, X = self.design(rate)
+        _, X, _ = self.design(rate)
         return self.y[rows] - X[rows] @ _solve(X[train], self.y[train])
 
     def choose(self, train: np.ndarray, test: np.ndarray, options: TermOptions) -> tuple[float, str, float]:
@@ -388,9 +389,8 @@ class _TemperatureLaw:
         rate = float(found.x)
         rms = {law: float(np.sqrt(np.mean(self.residual(r, train, test) ** 2))) for law, r in
                (("linear", 0.0), ("exponential", rate))}
-        names, X = self.design(rate)
+        names, X, k = self.design(rate)
         coef, _ = _nonnegative_solve(X[self.use], self.y[self.use], names)
-        k = len(velocity_basis(self.params, self.qd[:1])[0])
         unphysical = _unphysical(with_coefficients(self.params, coef[:k]), dict(zip(names[k:], map(float, coef[k:]))),
                                  self.signals, self.use, self.t_ref, rate)
         versus = (f"held-out RMS {rms['exponential']:.4g} N·m exponential (rate {rate:.3g} /°C), {rms['linear']:.4g} "

@@ -318,7 +318,8 @@ def fit_consistent(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float, lo
     if ok.all():
         r = A @ x_lin - c
         return ConsistentFit(x_lin[:n_in].reshape(nb, 10), x_lin[n_in:], 0.5 * float(r @ r),
-                             "the linear least-squares solution is physically consistent")
+                             "the linear least-squares solution is physically consistent"
+                             + (f" and keeps {margin:g} of the given pseudo-inertias" if margin else ""))
     x, outcome = _conic_solve(R, z, prior, weight, lower, margin)
     x[:n_in] = (margin * pi0 + nearest_consistent(x[:n_in].reshape(nb, 10) - margin * pi0)).ravel()
     x[n_in:] = np.maximum(x[n_in:], lower[n_in:])  # an interior point's last digits
@@ -326,5 +327,5 @@ def fit_consistent(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float, lo
     return ConsistentFit(x[:n_in].reshape(nb, 10), x[n_in:], 0.5 * float(r @ r),
                          f"{int((~ok).sum())} bodies of the linear solution were not physical"
                          + (f" or kept less than {margin:g} of the given pseudo-inertia" if margin else "")
-                         + f": {outcome.meaning}",
+                         + f"; the conic solve {outcome.meaning}",
                          outcome, int((~ok).sum()))

@@ -537,15 +537,9 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
     noise = acceleration_noise([(part.kin, part.use) for part in parts], robot.tc_index)
     solver = fit.solver or SolverOutcome("", None, True,
                                          "not needed: the linear least-squares solution is physically consistent")
-    if fit.solver is None:
-        message = "the linear least-squares solution is physically consistent"
-    else:
-        margin = (f" or kept less than {options.link_margin:g} of the given pseudo-inertia" if options.link_margin
-                  else "")
-        message = (f"{fit.unphysical} bodies of the linear solution were not physical{margin}; the conic solve "
-                   f"{solver.meaning}")
-        if not solver.converged:
-            message += "; kept only where held-out data improve"
+    message = fit.message
+    if not solver.converged:
+        message += "; kept only where held-out data improve"
     if np.any(noise > NOISY_ACCELERATION):
         worst = int(np.argmax(noise))
         message += (f"; noisy accelerations ({robot.torque_controlled[worst]}: {noise[worst]:.0%} of their power "

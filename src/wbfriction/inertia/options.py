@@ -6,8 +6,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal, get_args
 
-from wbfriction.choices import check_choice
-from wbfriction.exceptions import InputError
+from wbfriction.choices import check_choice, flag
+from wbfriction.exceptions import InputError, OptionError
 
 ArmatureMode = Literal["known", "identify", "none"]
 """How the identification treats the drives' reflected rotor inertia (:mod:`wbfriction.inertia.identification`)."""
@@ -102,6 +102,6 @@ class InertialOptions:
     def __post_init__(self) -> None:
         check_choice("armature", self.armature, ARMATURE_MODES)
         if not 0.0 <= self.link_margin < 1.0:
-            raise InputError(f"the link margin must be in [0, 1), got {self.link_margin}")
+            raise OptionError(flag("link_margin"), self.link_margin, "at least 0 and below 1")
         if self.prior is not None and not self.prior > 0:
             raise InputError(f"the prior's weight must be > 0, got {self.prior}")
