@@ -27,7 +27,6 @@ from wbfriction.friction.fit import (
     from_fit_coordinates,
     held_out_gain,
     held_out_rms,
-    initial_guesses,
     model_bounds,
     prefer_interior,
     stick_speed,
@@ -502,16 +501,6 @@ def test_auto_holds_out_when_each_side_has_enough_samples(min_samples, side):
             train, held_out = held_out_split(np.ones(n, bool))
             assert res.selection == ModelSelection("coulomb-viscous", f"coulomb-viscous: too few samples ({n}) to "
                                                    "hold any out", (), 0.05, train.sum(), held_out.sum())
-
-
-def test_the_linear_start_is_the_coulomb_viscous_least_squares_fit():
-    """Noise-free Coulomb-viscous friction: the single starting point of that model is the truth (the
-    linear least-squares fit of qd, sgn(qd), 1), even for a slow joint with a small viscous part."""
-    for truth in (CoulombViscousParams(0.3, 0.5, 0.1), CoulombViscousParams(0.02, 0.004, -0.3)):
-        (start,) = initial_guesses(0.1 * QD, truth.f(0.1 * QD), "coulomb-viscous")
-        np.testing.assert_allclose(start, truth.as_vector(), rtol=1e-9, atol=1e-12)
-    starts = initial_guesses(QD, FrictionParams(0.3, 0.5, 0.4, 0.2, 0.1, 40.0).f(QD))
-    assert len(starts) == 12 and all(((s > LOWER) & (s < UPPER)).all() for s in starts)  # (3.5), inside bounds
 
 
 def test_a_bounded_model_must_beat_a_simpler_interior_one_beyond_the_noise_of_the_comparison():

@@ -37,7 +37,7 @@ import math
 import numpy as np
 from scipy.special import erf
 
-from wbfriction.friction.models import ModelName, model_jacobian, model_values
+from wbfriction.friction.models import ModelName, model_columns, model_jacobian, model_values
 
 TANH_ERF = (
     (0.008807170824, 0.106167958788, 0.312483261569, 0.375288139486, 0.177682048682, 0.01957142065),
@@ -157,6 +157,25 @@ def expected_values(x: np.ndarray, qd: np.ndarray, sigma: float, delta_s: float,
         return F_v * qd + F_c * sign_mean(qd, sigma) + (F_s - F_c) * sign_decay_mean(qd, sigma, v_s) + tau_os
     F_v, F_c, S, v_s, tau_os, a = x
     return F_v * qd + F_c * (tanh_mean(qd, sigma, a) + S * tanh_decay_mean(qd, sigma, a, v_s)) + tau_os
+
+
+def expected_columns(qd: np.ndarray, sigma: float, delta_s: float, model: ModelName, v_s: float = 1.0,
+                     a: float = 1.0) -> np.ndarray:
+    """:func:`~wbfriction.friction.models.model_columns` under a velocity noise of standard deviation ``sigma``
+    [rad/s]: each term's expectation at the measured velocities ``qd`` (N,) (module docstring), (N, K); the model's
+    own columns for ``sigma`` below :data:`SMALL`."""
+    if sigma < SMALL:
+        return model_columns(qd, delta_s, model, v_s, a)
+    one = np.ones_like(qd)
+    if model == "coulomb-viscous":
+        return np.column_stack([qd, sign_mean(qd, sigma), one])
+    jump = sign_mean(qd, sigma) if model == "stribeck" else tanh_mean(qd, sigma, a)
+    if delta_s == 2.0:
+        decay = sign_decay_mean(qd, sigma, v_s) if model == "stribeck" else tanh_decay_mean(qd, sigma, a, v_s)
+    else:  # the jump's expectation less that of its continuous rest (module docstring)
+        shape = np.sign if model == "stribeck" else (lambda u: np.tanh(a * u))
+        decay = jump - _hermite(lambda u: shape(u) * (1.0 - np.exp(-np.abs(u / v_s) ** delta_s)), qd, sigma)
+    return np.column_stack([qd, jump, decay, one])
 
 
 def expected_jacobian(x: np.ndarray, qd: np.ndarray, sigma: float, delta_s: float, model: ModelName) -> np.ndarray:

@@ -4,7 +4,9 @@ choice among the models by held-out error.
 Per joint, ``scipy.optimize.least_squares(method="trf")`` fits the characteristic ``f(qd; p)``
 of one of the models of :mod:`wbfriction.friction.models` (``coulomb-viscous``, ``stribeck``
 or the thesis's (3.5)) to ``-tau_f`` over the valid samples (sign convention of that module),
-with bounds, from several starts. Each parameter gets a standard error from the Jacobian at
+with bounds, from one start: the minimum over the non-linear parameters ``(v_s, a)`` with the linear ones solved
+exactly (variable projection, :mod:`wbfriction.friction.projection`: a coarse grid, then a local search). Each
+parameter gets a standard error from the Jacobian at
 the solution,
 
 .. math:: \\operatorname{cov}(\\hat p) = s^2 (J^T J)^{-1}, \\qquad s^2 = \\frac{\\|r\\|^2}{N - p},
@@ -31,7 +33,9 @@ is chosen (:func:`choose_model`, the reason recorded in :class:`ModelSelection`)
 again on every valid sample, as if it had been named. Whole blocks, not scattered samples, are
 held out: residuals correlated in time (filtered estimates) would otherwise let the held-out
 error see the fit's noise. With too few samples to hold a block out (fewer than
-``min_samples`` on either side), the simplest model is fitted.
+``min_samples`` on either side), or for a joint that hardly moved (below
+:data:`~wbfriction.friction.status.MIN_SPEED`: ``not excited``, no velocity model in its data), the simplest model
+is fitted.
 
 Filtered estimates (thesis 7.1) are compared with the model filtered the same way: when
 the friction went through a zero-phase smoother ``H``, the fit minimises
@@ -44,7 +48,6 @@ gives the starting point.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -65,11 +68,11 @@ from wbfriction.friction.models import (
     ParamsT,
     check_model,
     model_jacobian,
-    model_values,
     target_from_dict,
 )
 from wbfriction.friction.noise import joint_noises
 from wbfriction.friction.options import MODEL_CHOICES, SELECTION_TOLERANCE, FitOptions, ModelChoice
+from wbfriction.friction.projection import Projection, projected_start
 from wbfriction.friction.regression import (
     correlation_lag,
     covariance_errors,
@@ -388,28 +391,6 @@ def fitted_ripples(est: FrictionEstimate, fits, source: str = "the friction tabl
     return out
 
 
-def initial_guesses(qd: np.ndarray, y: np.ndarray, model: ModelName = "thesis") -> list[np.ndarray]:
-    """Starting points (the model's parameters, in the order of its names): a linear
-    Coulomb-viscous-offset fit, for ``stribeck`` times a grid of (F_s / F_c, v_s), for (3.5)
-    times a grid of (S, v_s, a)."""
-    A = np.column_stack([qd, np.sign(qd), np.ones_like(qd)])
-    (F_v, F_c, tau_os), *_ = np.linalg.lstsq(A, y, rcond=None)
-    F_v, F_c = max(F_v, 0.0), max(F_c, 1e-3)
-    scale = max(np.percentile(np.abs(qd), 90), 1e-3)
-    lower, upper = _BOUNDS[model]
-    if model == "coulomb-viscous":
-        return [np.clip([F_v, F_c, tau_os], lower + 1e-9, upper - 1e-9)]
-    if model == "stribeck":
-        return [from_fit_coordinates(model, np.clip([F_v, F_c, S * F_c, vs_frac * scale, tau_os],
-                                                    lower + 1e-9, upper - 1e-9))
-                for S, vs_frac in itertools.product((0.2, 1.0), (0.05, 0.2, 0.5))]
-    starts = []
-    for S, vs_frac, a_mul in itertools.product((0.2, 1.0), (0.05, 0.2, 0.5), (5.0, 50.0)):
-        a = min(max(a_mul / scale, LOWER[5] * 10), UPPER[5] / 10)
-        starts.append(np.clip([F_v, F_c, S, vs_frac * scale, tau_os, a], LOWER + 1e-9, UPPER - 1e-9))
-    return starts
-
-
 def held_out_residuals(params: ModelParamsBase, qd: np.ndarray, tau_f: np.ndarray, rows: np.ndarray, smoother=None,
                        velocity_noise: float = 0.0) -> np.ndarray:
     """(model friction torque - ``tau_f``) [N·m] on the samples ``rows`` ((N,) bool), in time order (the model's
@@ -480,16 +461,6 @@ def choose_model(scores: tuple[HeldOutScore, ...], tolerance: float = SELECTION_
                   f"({best.model}'s; +{excess:.2g} %)")
     reason += f"; {rms}"
     return chosen.model, reason
-
-
-def distinct_minima(points: Sequence[np.ndarray], rtol: float = 1e-2) -> list[np.ndarray]:
-    """``points`` (solver results, best first) without those within ``rtol`` of a better one in every coordinate
-    (the fit's coordinates): one per basin."""
-    out: list[np.ndarray] = []
-    for x in points:
-        if not any(np.allclose(x, y, rtol=rtol, atol=1e-9) for y in out):
-            out.append(x)
-    return out
 
 
 def _solve(residual, jacobian, start, bounds, max_nfev):
@@ -674,7 +645,8 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
             if x0 is not None:
                 raise InputError("x0 needs a named model, not 'auto'")
             res = _fit_auto(qd, y, use, delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother,
-                            fixed=fixed, tolerance=selection_tolerance, sigma=velocity_noise, noise=noise)
+                            fixed=fixed, tolerance=selection_tolerance, sigma=velocity_noise, noise=noise,
+                            speed=speed)
         else:
             res = _fit_model(check_model(model), qd, y, use, delta_s=delta_s, joint=joint, x0=x0,
                              min_samples=min_samples, smoother=smoother, fixed=fixed, sigma=velocity_noise,
@@ -687,8 +659,9 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
 
 def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float, joint: str, min_samples: int,
               smoother, fixed: dict[str, float] | None, tolerance: float, sigma: float = 0.0,
-              noise: JointNoise | None = None) -> FitResult:
-    """``fit_friction(model="auto")`` on the usable samples ``use`` (module docstring)."""
+              noise: JointNoise | None = None, speed: float = np.inf) -> FitResult:
+    """``fit_friction(model="auto")`` on the usable samples ``use`` (module docstring); a joint whose ``speed``
+    [rad/s] (:func:`fitted_rows`) is below :data:`~wbfriction.friction.status.MIN_SPEED` gets the simplest model."""
     fixed = dict(fixed or {})
     known = {n for m in MODEL_NAMES for n in MODEL_PARAMS[m].names}
     if set(fixed) - known:
@@ -697,11 +670,16 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     kwargs = dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, sigma=sigma)
     train, held_out = held_out_split(use)
     n_train, n_held_out = int(train.sum()), int(held_out.sum())
+    simplest = MODEL_NAMES[0]
+    why = None
     if min(n_train, n_held_out) < max(min_samples, 7):
-        simplest = MODEL_NAMES[0]
+        why = f"too few samples ({int(use.sum())}) to hold any out"
+    elif speed < MIN_SPEED:
+        why = (f"the joint hardly moved (|qd| at most {speed:.2g} rad/s on 95 % of its samples): no model can be "
+               "chosen, its offset is what the data give")
+    if why is not None:
         res = _fit_model(simplest, qd, y, use, fixed=held[simplest], noise=noise, **kwargs)
-        res.selection = ModelSelection(simplest, f"{simplest}: too few samples ({int(use.sum())}) to hold any out",
-                                       (), tolerance, n_train, n_held_out)
+        res.selection = ModelSelection(simplest, f"{simplest}: {why}", (), tolerance, n_train, n_held_out)
         return res
     trained = {m: _fit_model(m, qd, y, train, fixed=held[m], **kwargs) for m in MODEL_NAMES}
     residuals = {m: held_out_residuals(r.params, qd, -y, held_out, smoother, sigma) for m, r in trained.items()
@@ -766,37 +744,28 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     speed = joint_speed(v)
     if n < max(min_samples, len(names) + 1):
         return FitResult(joint, n, message=f"only {n} valid samples", model=model, speed=speed)
-    starts = [np.asarray(x0, dtype=float)] if x0 is not None else initial_guesses(v, yu, model)
-    starts = [to_fit_coordinates(model, x) for x in starts]
-    starts = list({tuple(x[free]): x[free] for x in starts}.values())  # distinct over the free ones
-    residual = lambda z: expected_values(full(z), v, sigma, delta_s, model) - yu  # noqa: E731
-    jacobian = lambda z: fit_coordinates_jacobian(  # noqa: E731
-        model, expected_jacobian(full(z), v, sigma, delta_s, model))[:, free]
-    bounds = tuple(b[free] for b in model_bounds(v, model))
-    # a short run of the model itself from every start, then the two best distinct minima refined (on its
-    # expectation under the velocity noise, when there is one, then through the smoother): several starts
-    # often fall into one basin, and the best of the short runs' can be another objective's worse one (a narrow
-    # Stribeck dip that the plain model prefers and the filtered one does not)
-    if len(starts) > 1:
-        plain = lambda z: model_values(full(z), v, delta_s, model) - yu  # noqa: E731
-        plain_jacobian = lambda z: fit_coordinates_jacobian(  # noqa: E731
-            model, model_jacobian(full(z), v, delta_s, model))[:, free]
-        short = sorted((_solve(plain, plain_jacobian, s, bounds, 30) for s in starts), key=lambda r: r.cost)
-        starts = distinct_minima([r.x for r in short])[:2]
-    refined = [_solve(residual, jacobian, s, bounds, 300) for s in starts]
-    best = min(refined, key=lambda r: r.cost)
-    natural_jacobian = lambda z: expected_jacobian(full(z), v, sigma, delta_s, model)[:, free]  # noqa: E731
-    if smoother is not None:
+    lower, upper = model_bounds(v, model)
+    bounds = (lower[free], upper[free])
+    rows = np.flatnonzero(use)
+    if smoother is None:
+        residual = lambda z: expected_values(full(z), v, sigma, delta_s, model) - yu  # noqa: E731
+        model_jac = lambda z: expected_jacobian(full(z), v, sigma, delta_s, model)  # noqa: E731
+        projection = Projection(model, v, yu, np.arange(n), None, sigma, delta_s, held, free, lower, upper)
+    else:
         f_residual, f_jacobian = filtered_problem(qd, y, use, smoother, delta_s, model, sigma)
         residual = lambda z: f_residual(full(z))  # noqa: E731
-        jacobian = lambda z: fit_coordinates_jacobian(model, f_jacobian(full(z)))[:, free]  # noqa: E731
-        natural_jacobian = lambda z: f_jacobian(full(z))[:, free]  # noqa: E731
-        best = min((_solve(residual, jacobian, r.x, bounds, 200) for r in refined), key=lambda r: r.cost)
+        model_jac = lambda z: f_jacobian(full(z))  # noqa: E731
+        projection = Projection(model, qd, y, rows, smoother, sigma, delta_s, held, free, lower, upper)
+    jacobian = lambda z: fit_coordinates_jacobian(model, model_jac(z))[:, free]  # noqa: E731
+    # one start: the given one, or the minimum over the non-linear parameters with the linear ones solved
+    # (variable projection, :mod:`~wbfriction.friction.projection`), then the fit over every free parameter
+    start = to_fit_coordinates(model, np.asarray(x0, dtype=float)) if x0 is not None else projected_start(
+        projection, float(np.percentile(np.abs(v), 90)))
+    best = _solve(residual, jacobian, start[free], bounds, 300)
     # residuals correlated over the filter's window, or over the span of a model error;
     # standard errors of the model's own parameters (F_s, not F_s - F_c)
-    rows = np.flatnonzero(use)
     cov = np.zeros((len(names), len(names)))
-    cov[np.ix_(free, free)] = parameter_covariance(natural_jacobian(best.x), best.fun, rows=rows,
+    cov[np.ix_(free, free)] = parameter_covariance(model_jac(best.x)[:, free], best.fun, rows=rows,
                                                    max_lag=correlation_lag(best.fun, rows))
     se = covariance_errors(cov)
     at_bound = np.zeros(len(names), dtype=bool)

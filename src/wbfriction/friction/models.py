@@ -120,6 +120,26 @@ def model_values(x: np.ndarray, qd: np.ndarray, delta_s: ParamLike, model: Model
     return coulomb_viscous_stribeck(qd, x[0], x[1], x[2], x[3], x[4], x[5], delta_s)
 
 
+def model_columns(qd: np.ndarray, delta_s: float, model: ModelName = "thesis", v_s: float = 1.0,
+                  a: float = 1.0) -> np.ndarray:
+    """The columns (N, K) of ``model``'s terms at velocities ``qd`` (N,) [rad/s]: the model is their sum, each
+    times a product of its linear parameters (:data:`~wbfriction.friction.projection.TERMS`), once the Stribeck
+    velocity ``v_s`` [rad/s] and the tanh slope ``a`` [s/rad] are set (ignored where the model has none):
+
+    * ``coulomb-viscous``: ``qd``, ``sgn(qd)``, 1 (times F_v, F_c, tau_os);
+    * ``stribeck``: ``qd``, ``sgn(qd)``, ``sgn(qd) e``, 1 (times F_v, F_c, F_s - F_c, tau_os);
+    * ``thesis`` (3.5): ``qd``, ``tanh(a qd)``, ``tanh(a qd) e``, 1 (times F_v, F_c, F_c S, tau_os);
+
+    with ``e = exp(-|qd / v_s|^delta_s)``."""
+    qd = np.asarray(qd, dtype=float)
+    one = np.ones_like(qd)
+    if model == "coulomb-viscous":
+        return np.column_stack([qd, np.sign(qd), one])
+    e = np.exp(-np.abs(qd / v_s) ** delta_s)
+    jump = np.sign(qd) if model == "stribeck" else np.tanh(a * qd)
+    return np.column_stack([qd, jump, jump * e, one])
+
+
 def model_jacobian(x: np.ndarray, qd: np.ndarray, delta_s: float, model: ModelName = "thesis") -> np.ndarray:
     """Jacobian (N, p) of :func:`model_values` with respect to ``x``, analytic."""
     J = np.empty((qd.size, len(MODEL_PARAMS[model].names)))
