@@ -11,7 +11,6 @@ from hypothesis import strategies as st
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import (
-    LOWER,
     STICK_FLOOR,
     UPPER,
     FitResult,

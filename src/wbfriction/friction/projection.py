@@ -118,7 +118,7 @@ def bounded_linear_solve(A: np.ndarray, b: np.ndarray, lower: np.ndarray, upper:
     """``argmin |A c - b|`` over ``lower <= c <= upper`` (U,), for ``A`` (n, U): through the triangular factor of
     ``[A b]`` (a U x U problem), the unconstrained solution where it is feasible, else SciPy's bounded-variable
     least squares on the factor."""
-    R = np.linalg.qr(np.column_stack([A, b]), mode="r")
+    R = np.asarray(np.linalg.qr(np.column_stack([A, b]), mode="r"))
     n = A.shape[1]
     R_A, r_b = R[:n, :n], R[:n, n]
     c = np.linalg.lstsq(R_A, r_b, rcond=None)[0]
@@ -214,7 +214,7 @@ def grid_minima(costs: np.ndarray) -> np.ndarray:
     for axis in range(costs.ndim):
         for step in (1, -1):
             neighbour = np.roll(costs, step, axis=axis)
-            edge = [slice(None)] * costs.ndim
+            edge: list[slice | int] = [slice(None)] * costs.ndim
             edge[axis] = 0 if step == 1 else -1
             neighbour[tuple(edge)] = np.inf
             is_min &= costs <= neighbour
