@@ -128,7 +128,8 @@ def test_the_fit_is_the_multi_start_optimum_on_the_studies_joints(talos, combine
     """The studies' joints (the legs of the combined walk, Table 6.1 friction, the studies' position and torque
     noise, the acceleration route with its smoother and the noise expectation): the fit from the projected start
     is the best of a brute-force multi-start (12 starts over (S, v_s, a) around the linear fit, and the truth, each
-    refined over every parameter), every parameter within 1e-6 relative."""
+    refined over every parameter): its cost, and every parameter the data determine within 1e-6 relative or a
+    thousandth of its standard error."""
     from wbfriction.friction.estimate import estimate_log
     from wbfriction.friction.noise import joint_noises
     from wbfriction.friction.options import EstimateOptions
@@ -141,7 +142,7 @@ def test_the_fit_is_the_multi_start_optimum_on_the_studies_joints(talos, combine
                                                             torque_std=TORQUE_STD, seed=3))
     est = estimate_log(talos, log, EstimateOptions())
     noises = joint_noises(est.metadata.get("noise"), est.estimation_route)
-    checked = 0
+    checked, worst, worst_se = 0, 0.0, 0.0
     for joint, _, group in leg_joints(talos):
         i = est.joints.index(joint)
         qd, tau_f = est.qd[:, i], est.tau_f[:, i]
@@ -161,7 +162,17 @@ def test_the_fit_is_the_multi_start_optimum_on_the_studies_joints(talos, combine
         others = [fit_friction(qd, tau_f, x0=s, **kwargs) for s in starts]
         best = min(others, key=lambda r: r.rms_residual)
         assert fit.rms_residual <= best.rms_residual * (1 + 1e-9), joint
-        np.testing.assert_allclose(fit.params.as_vector(), best.params.as_vector(), rtol=1e-6, atol=1e-9,
-                                   err_msg=joint)
+        x, reference = fit.params.as_vector(), best.params.as_vector()
+        se = np.array([fit.stderr[n] for n in fit.params.names])
+        # parameters the data determine (an infinite standard error: a valley of equal cost, e.g. F_c and tau_os of
+        # a joint that turns one way only); the solver's own tolerance (1e-10) along the flat directions of a noisy
+        # fit: a thousandth of a standard error
+        known = np.isfinite(se)
+        assert np.all(np.abs(x - reference)[known] <= (1e-6 * np.abs(reference) + 1e-3 * se)[known]), (
+            joint, x, reference, se)
+        relative = np.abs(x - reference)[known] / np.maximum(np.abs(reference)[known], 1e-12)
+        worst = max(worst, float(np.max(relative)))
+        worst_se = max(worst_se, float(np.max((np.abs(x - reference) / se)[known])))
         checked += 1
     assert checked >= 8
+    print(f"{checked} joints; worst difference {worst:.1e} relative, {worst_se:.1e} standard errors")
