@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.special import erf
+from scipy.special import erf as _scipy_erf
 
 from wbfriction.friction.models import ModelName, model_columns, model_jacobian, model_values
 
@@ -50,6 +50,23 @@ SMALL = 1e-12
 """A velocity noise below this [rad/s] is none: the model itself."""
 
 _HERMITE = np.polynomial.hermite_e.hermegauss(40)
+
+
+ERF_ONE = 6.0
+"""``erf(x)`` is 1.0 exactly in double precision from x = 5.93 on (``1 - erf(x) < 2^-53``): :func:`erf` takes the
+sign there."""
+
+
+def erf(x):
+    """SciPy's ``erf`` with the same bytes, computed only where ``|x| <`` :data:`ERF_ONE` (the sign elsewhere, what
+    SciPy's rounds to): on a fast joint most of the samples' ``a u`` are there, and SciPy's ``erf`` is slowest."""
+    x = np.asarray(x)
+    if x.ndim == 0:
+        return _scipy_erf(x)
+    out = np.sign(x)
+    near = np.flatnonzero(np.abs(x) < ERF_ONE)
+    out[near] = _scipy_erf(x[near])
+    return out
 
 
 def _hermite(fn, qd: np.ndarray, sigma: float) -> np.ndarray:
@@ -160,22 +177,31 @@ def expected_values(x: np.ndarray, qd: np.ndarray, sigma: float, delta_s: float,
 
 
 def expected_columns(qd: np.ndarray, sigma: float, delta_s: float, model: ModelName, v_s: float = 1.0,
-                     a: float = 1.0) -> np.ndarray:
+                     a: float = 1.0, jump: np.ndarray | None = None) -> np.ndarray:
     """:func:`~wbfriction.friction.models.model_columns` under a velocity noise of standard deviation ``sigma``
     [rad/s]: each term's expectation at the measured velocities ``qd`` (N,) (module docstring), (N, K); the model's
-    own columns for ``sigma`` below :data:`SMALL`."""
+    own columns for ``sigma`` below :data:`SMALL`. ``jump``: the jump's column (:func:`expected_jump`) if known."""
     if sigma < SMALL:
-        return model_columns(qd, delta_s, model, v_s, a)
+        return model_columns(qd, delta_s, model, v_s, a, jump)
     one = np.ones_like(qd)
+    if jump is None:
+        jump = expected_jump(qd, sigma, model, a)
     if model == "coulomb-viscous":
-        return np.column_stack([qd, sign_mean(qd, sigma), one])
-    jump = sign_mean(qd, sigma) if model == "stribeck" else tanh_mean(qd, sigma, a)
+        return np.column_stack([qd, jump, one])
     if delta_s == 2.0:
         decay = sign_decay_mean(qd, sigma, v_s) if model == "stribeck" else tanh_decay_mean(qd, sigma, a, v_s)
     else:  # the jump's expectation less that of its continuous rest (module docstring)
         shape = np.sign if model == "stribeck" else (lambda u: np.tanh(a * u))
         decay = jump - _hermite(lambda u: shape(u) * (1.0 - np.exp(-np.abs(u / v_s) ** delta_s)), qd, sigma)
     return np.column_stack([qd, jump, decay, one])
+
+
+def expected_jump(qd: np.ndarray, sigma: float, model: ModelName, a: float = 1.0) -> np.ndarray:
+    """The jump's column of :func:`expected_columns` (N,): ``E[tanh(a u)]`` for (3.5), ``E[sgn(u)]`` otherwise (it
+    depends on ``a`` alone: computed once for several ``v_s``)."""
+    if sigma < SMALL:
+        return np.tanh(a * qd) if model == "thesis" else np.sign(qd)
+    return tanh_mean(qd, sigma, a) if model == "thesis" else sign_mean(qd, sigma)
 
 
 def expected_jacobian(x: np.ndarray, qd: np.ndarray, sigma: float, delta_s: float, model: ModelName) -> np.ndarray:

@@ -791,6 +791,58 @@ def _fit_column(args: tuple) -> FitResult:
     return fit_friction(qd, tau_f, mask=valid, **kwargs)
 
 
+def _fit_routes(args: tuple) -> tuple[FitResult, FitResult | None]:
+    """One joint's fit (a :func:`_column_tasks` task), and its model's fit on the other route's estimate (a task
+    of that route, or None)."""
+    task, other = args
+    fit = _fit_column(task)
+    if other is None:
+        return fit, None
+    qd, tau_f, valid, kwargs = other
+    return fit, _fit_column((qd, tau_f, valid, {**kwargs, "model": fit.model}))
+
+
+def _column_tasks(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, models: Sequence[ModelChoice], *,
+                  delta_s: float, min_samples: int, smoother, fixed: dict[str, float] | None,
+                  selection_tolerance: float, noise: Mapping[str, JointNoise] | None,
+                  stick_margin: int | None) -> list[tuple]:
+    """One :func:`_fit_column` task per joint (:func:`fit_joints`'s arguments)."""
+    noise = noise or {}
+    tasks = []
+    for i, joint in enumerate(joints):
+        jn = noise.get(joint)
+        sigma = 0.0 if jn is None else jn.velocity
+        stick = {} if stick_margin is None else {"stick": stick_speed(sigma), "stick_margin": stick_margin}
+        tasks.append((qd[:, i], tau_f[:, i], valid[:, i],
+                      dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, fixed=fixed,
+                           model=models[i], selection_tolerance=selection_tolerance, velocity_noise=sigma, noise=jn,
+                           **stick)))
+    return tasks
+
+
+def _run(fn, tasks: list, workers: int) -> list:
+    """``fn`` over ``tasks``, on ``workers`` processes side by side (one task at a time to each), in order."""
+    if workers > 1 and len(tasks) > 1:
+        with process_pool(min(workers, len(tasks)), "fork") as pool:
+            return list(pool.map(fn, tasks))
+    return [fn(task) for task in tasks]
+
+
+def _with_truth(joints, fitted: list[FitResult], qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray,
+                tau_f_true: np.ndarray | None, targets: Mapping[str, ModelParams] | None) -> list[FitResult]:
+    """``fitted`` with their errors against the true friction and parameters, where known (:func:`fit_joints`)."""
+    for i, (joint, res) in enumerate(zip(joints, fitted)):
+        m = valid[:, i] & np.isfinite(tau_f[:, i]) & np.isfinite(qd[:, i])
+        m &= ~gross_outliers(-tau_f[:, i], m)  # the samples the fit used
+        if tau_f_true is not None and np.isfinite(tau_f_true[m, i]).all() and m.any():
+            res.rms_error_vs_true = float(np.sqrt(np.mean((tau_f[m, i] - tau_f_true[m, i]) ** 2)))
+            if res.params is not None:
+                res.rms_model_vs_true = float(np.sqrt(np.mean((res.params.torque(qd[m, i]) - tau_f_true[m, i]) ** 2)))
+        if targets and joint in targets:
+            res.target = targets[joint]
+    return fitted
+
+
 def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
                tau_f_true: np.ndarray | None = None, targets: Mapping[str, ModelParams] | None = None,
                delta_s: float = 2.0, min_samples: int = 20, smoother=None,
@@ -821,34 +873,11 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
     Raises:
         InputError: what :func:`fit_friction` raises.
     """
-    noise = noise or {}
     models = [model] * len(joints) if isinstance(model, str) else list(model)
-    tasks = []
-    for i, joint in enumerate(joints):
-        jn = noise.get(joint)
-        sigma = 0.0 if jn is None else jn.velocity
-        stick = {} if stick_margin is None else {"stick": stick_speed(sigma), "stick_margin": stick_margin}
-        tasks.append((qd[:, i], tau_f[:, i], valid[:, i],
-                      dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, fixed=fixed,
-                           model=models[i], selection_tolerance=selection_tolerance, velocity_noise=sigma, noise=jn,
-                           **stick)))
-    if workers > 1 and len(tasks) > 1:
-        with process_pool(min(workers, len(tasks)), "fork") as pool:
-            fitted = list(pool.map(_fit_column, tasks))
-    else:
-        fitted = [_fit_column(task) for task in tasks]
-    out = []
-    for i, (joint, res) in enumerate(zip(joints, fitted)):
-        m = valid[:, i] & np.isfinite(tau_f[:, i]) & np.isfinite(qd[:, i])
-        m &= ~gross_outliers(-tau_f[:, i], m)  # the samples the fit used
-        if tau_f_true is not None and np.isfinite(tau_f_true[m, i]).all() and m.any():
-            res.rms_error_vs_true = float(np.sqrt(np.mean((tau_f[m, i] - tau_f_true[m, i]) ** 2)))
-            if res.params is not None:
-                res.rms_model_vs_true = float(np.sqrt(np.mean((res.params.torque(qd[m, i]) - tau_f_true[m, i]) ** 2)))
-        if targets and joint in targets:
-            res.target = targets[joint]
-        out.append(res)
-    return out
+    tasks = _column_tasks(joints, qd, tau_f, valid, cast(Sequence[ModelChoice], models), delta_s=delta_s,
+                          min_samples=min_samples, smoother=smoother, fixed=fixed,
+                          selection_tolerance=selection_tolerance, noise=noise, stick_margin=stick_margin)
+    return _with_truth(joints, _run(_fit_column, tasks, workers), qd, tau_f, valid, tau_f_true, targets)
 
 
 def smoother_half_width(smoother) -> int:
@@ -906,27 +935,30 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
         raise InputError(f"no joint '{unknown[0]}' in the friction estimate")
     idx = [est.joints.index(j) for j in names]
     record = est.metadata.get("noise")
-    common: dict[str, Any] = dict(delta_s=options.delta_s, min_samples=options.min_samples, workers=workers,
-                                  fixed=fixed)
     truth = None if est.tau_f_true is None else est.tau_f_true[:, idx]
-    fits = fit_joints(names, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], tau_f_true=truth, targets=targets,
-                      smoother=est.smoother, model=options.model, selection_tolerance=options.selection_tolerance,
-                      noise=joint_noises(record, est.estimation_route), stick_margin=stick_margin(est), **common)
-    for f in fits:
-        f.route = est.estimation_route
+    common: dict[str, Any] = dict(delta_s=options.delta_s, min_samples=options.min_samples, fixed=fixed,
+                                  selection_tolerance=options.selection_tolerance)
+    tasks = _column_tasks(names, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], [options.model] * len(idx),
+                          smoother=est.smoother, noise=joint_noises(record, est.estimation_route),
+                          stick_margin=stick_margin(est), **common)
     check = est.route_check
-    others: Sequence[FitResult | None] = [None] * len(fits)
-    if check is not None:
-        checked = fit_joints(names, check.qd[:, idx], check.tau_f[:, idx], check.valid[:, idx],
-                            smoother=check.smoother, model=[f.model for f in fits],
-                            noise=joint_noises(record, check.estimation_route), stick_margin=stick_margin(check),
-                            **common)
-        for f, other in zip(fits, checked):
+    others: Sequence[tuple | None] = [None] * len(idx)
+    if check is not None:  # each joint's model fitted on the other route too, in the same task
+        others = _column_tasks(names, check.qd[:, idx], check.tau_f[:, idx], check.valid[:, idx],
+                               [options.model] * len(idx), smoother=check.smoother,
+                               noise=joint_noises(record, check.estimation_route), stick_margin=stick_margin(check),
+                               **common)
+    pairs = _run(_fit_routes, list(zip(tasks, others)), workers)
+    fits = _with_truth(names, [fit for fit, _ in pairs], est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], truth,
+                       targets)
+    checked = [other for _, other in pairs]
+    for f, other in zip(fits, checked):
+        f.route = est.estimation_route
+        if check is not None and other is not None:
             other.route = check.estimation_route
             f.route_check = compare_routes(f, other)
-        others = checked
     if options.terms.terms:
-        for f, i, maybe in zip(fits, idx, others):
+        for f, i, maybe in zip(fits, idx, checked):
             f.terms = _joint_terms(est, i, f, maybe, options)
     return fits
 

@@ -121,7 +121,7 @@ def model_values(x: np.ndarray, qd: np.ndarray, delta_s: ParamLike, model: Model
 
 
 def model_columns(qd: np.ndarray, delta_s: float, model: ModelName = "thesis", v_s: float = 1.0,
-                  a: float = 1.0) -> np.ndarray:
+                  a: float = 1.0, jump: np.ndarray | None = None) -> np.ndarray:
     """The columns (N, K) of ``model``'s terms at velocities ``qd`` (N,) [rad/s]: the model is their sum, each
     times a product of its linear parameters (:data:`~wbfriction.friction.projection.TERMS`), once the Stribeck
     velocity ``v_s`` [rad/s] and the tanh slope ``a`` [s/rad] are set (ignored where the model has none):
@@ -130,13 +130,14 @@ def model_columns(qd: np.ndarray, delta_s: float, model: ModelName = "thesis", v
     * ``stribeck``: ``qd``, ``sgn(qd)``, ``sgn(qd) e``, 1 (times F_v, F_c, F_s - F_c, tau_os);
     * ``thesis`` (3.5): ``qd``, ``tanh(a qd)``, ``tanh(a qd) e``, 1 (times F_v, F_c, F_c S, tau_os);
 
-    with ``e = exp(-|qd / v_s|^delta_s)``."""
+    with ``e = exp(-|qd / v_s|^delta_s)``; ``jump``: the column of ``sgn(qd)`` or ``tanh(a qd)`` if known."""
     qd = np.asarray(qd, dtype=float)
     one = np.ones_like(qd)
     if model == "coulomb-viscous":
         return np.column_stack([qd, np.sign(qd), one])
     e = np.exp(-np.abs(qd / v_s) ** delta_s)
-    jump = np.sign(qd) if model == "stribeck" else np.tanh(a * qd)
+    if jump is None:
+        jump = np.sign(qd) if model == "stribeck" else np.tanh(a * qd)
     return np.column_stack([qd, jump, jump * e, one])
 
 

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wbfriction.friction.eiv import expected_columns
+from wbfriction.friction.eiv import expected_columns, expected_jump
 from wbfriction.friction.models import ModelName
 
 TERMS: dict[ModelName, tuple[tuple[int, ...], ...]] = {
@@ -43,9 +43,6 @@ product multiplies each column of :func:`~wbfriction.friction.models.model_colum
 
 NONLINEAR: dict[ModelName, tuple[int, ...]] = {"coulomb-viscous": (), "stribeck": (3,), "thesis": (3, 5)}
 """Positions of ``v_s`` and ``a`` (the parameters the columns depend on) in the fit's coordinates."""
-
-_CONSTANT: dict[ModelName, tuple[int, ...]] = {"coulomb-viscous": (0, 1, 2), "stribeck": (0, 1, 3), "thesis": (0, 3)}
-"""Columns that depend on neither ``v_s`` nor ``a``: smoothed once."""
 
 GRID = 6
 """Grid points per non-linear parameter: ``v_s`` from 0.02 to 1 times the joint's speed (the 90th percentile of
@@ -118,9 +115,10 @@ def bounded_linear_solve(A: np.ndarray, b: np.ndarray, lower: np.ndarray, upper:
     """``argmin |A c - b|`` over ``lower <= c <= upper`` (U,), for ``A`` (n, U): through the triangular factor of
     ``[A b]`` (a U x U problem), the unconstrained solution where it is feasible, else SciPy's bounded-variable
     least squares on the factor."""
-    R = np.asarray(np.linalg.qr(np.column_stack([A, b]), mode="r"))
+    from scipy.linalg.lapack import dgeqrf
     n = A.shape[1]
-    R_A, r_b = R[:n, :n], R[:n, n]
+    R = dgeqrf(np.column_stack([A, b]))[0][: n + 1]  # LAPACK's QR alone: R in its upper triangle
+    R_A, r_b = np.triu(R[:n, :n]), R[:n, n]
     c = np.linalg.lstsq(R_A, r_b, rcond=None)[0]
     if np.all(c >= lower) and np.all(c <= upper):
         return c
@@ -154,24 +152,29 @@ class Projection:
         self.part = linear_part(model, held, free, lower, upper)
         self.theta = tuple(i for i in NONLINEAR[model] if free[i])
         self.theta_bounds = (np.log(np.maximum(lower[list(self.theta)], 1e-300)), np.log(upper[list(self.theta)]))
-        self._constant: np.ndarray | None = None
+        self._ends: np.ndarray | None = None  # the columns qd and 1, on the rows (smoothed)
+        self._jump: tuple[float, np.ndarray, np.ndarray] | None = None  # a, its column, on the rows (smoothed)
 
     def _columns(self, log_theta: np.ndarray) -> np.ndarray:
-        """The model's columns (n, K) on the rows fitted at ``log_theta``, smoothed if the fit is."""
+        """The model's columns (n, K) on the rows fitted at ``log_theta``, smoothed if the fit is; the jump column,
+        which depends on ``a`` alone, is kept for the next call (a grid's row, a step in ``v_s``)."""
         z = self.held.copy()
         z[list(self.theta)] = np.exp(log_theta)
         v_s, a = (z[3], z[5]) if self.model == "thesis" else (z[3] if self.model == "stribeck" else 1.0, 1.0)
-        columns = expected_columns(self.qd, self.sigma, self.delta_s, self.model, v_s, a)
+        if self._jump is None or self._jump[0] != a:
+            jump = expected_jump(self.qd, self.sigma, self.model, a)
+            self._jump = (a, jump, jump if self.smoother is None else self.smoother(jump)[self.rows])
+        columns = expected_columns(self.qd, self.sigma, self.delta_s, self.model, v_s, a, jump=self._jump[1])
         if self.smoother is None:
             return columns
-        constant = list(_CONSTANT[self.model])
-        if self._constant is None:
-            self._constant = self.smoother(columns[:, constant])[self.rows]
+        # qd and 1 (the first and last columns) smoothed once, the jump once for each a
+        ends = [0, columns.shape[1] - 1]
+        if self._ends is None:
+            self._ends = self.smoother(columns[:, ends])[self.rows]
         out = np.empty((self.rows.size, columns.shape[1]))
-        out[:, constant] = self._constant
-        varying = [k for k in range(columns.shape[1]) if k not in constant]
-        if varying:
-            out[:, varying] = self.smoother(columns[:, varying])[self.rows]
+        out[:, ends], out[:, 1] = self._ends, self._jump[2]
+        if columns.shape[1] == 4:  # the Stribeck column
+            out[:, 2] = self.smoother(columns[:, 2])[self.rows]
         return out
 
     def solve(self, log_theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -236,7 +239,11 @@ def projected_start(projection: Projection, speed: float) -> np.ndarray:
     from scipy.optimize import least_squares
     axes = theta_axes(projection, max(speed, 1e-3))
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, len(axes))
-    costs = np.array([float(r @ r) for r in map(projection.residual, grid)]).reshape([len(x) for x in axes])
+    costs = np.empty(len(grid))
+    for k in np.argsort(grid[:, -1], kind="stable"):  # a's values in turn: its column computed once for each
+        r = projection.residual(grid[k])
+        costs[k] = float(r @ r)
+    costs = costs.reshape([len(x) for x in axes])
     scale = 1.0 / max(math.sqrt(float(costs.min())), 1e-300)
     best = min((least_squares(lambda t: scale * projection.residual(t), grid[k], bounds=projection.theta_bounds,
                               method="trf", diff_step=1e-7, ftol=1e-12, xtol=1e-10, gtol=1e-14, max_nfev=100)
