@@ -89,3 +89,16 @@ def test_the_correction_removes_the_bias_of_a_noisy_velocity(model):
             assert np.any(np.abs(mean) > 10 * sem), (mean, sem)
         else:
             assert np.all(np.abs(mean) < 3 * sem) and np.all(np.abs(mean) < 0.01 * truth), (mean, sem)
+
+
+def test_erf_is_scipys_to_the_byte():
+    """The erf computed only below ERF_ONE is SciPy's bit for bit: on a dense sweep through the rounding to ±1, at
+    signed zeros, infinities and NaN, and for a scalar."""
+    from scipy.special import erf as scipy_erf
+
+    from wbfriction.friction.eiv import ERF_ONE, erf
+    x = np.concatenate([np.linspace(-3 * ERF_ONE, 3 * ERF_ONE, 600_001), np.linspace(5.8, 6.2, 100_001),
+                        [0.0, -0.0, np.inf, -np.inf, np.nan, 1e300, -1e-300]])
+    assert np.array_equal(erf(x), scipy_erf(x), equal_nan=True)
+    assert np.array_equal(np.signbit(erf(x)), np.signbit(scipy_erf(x)))
+    assert erf(np.float64(0.3)) == scipy_erf(0.3)
