@@ -225,3 +225,27 @@ def test_a_dask_worker_drops_only_the_finalizer_failure_of_a_client_whose_loop_c
         for sig, handler in handlers.items():
             signal.signal(sig, handler)
     assert seen == [other_error, other_object]
+
+
+def test_heap_for_arrays_undoes_dasks_malloc_setting():
+    """A process started as a ``dask worker`` starts its workers (``MALLOC_TRIM_THRESHOLD_=65536``) maps every
+    1 MiB array afresh: its pages fault in each time. After :func:`heap_for_arrays`, the arrays come from the heap
+    and fault once; without the variable there is nothing to undo."""
+    script = textwrap.dedent("""
+        import resource, numpy as np
+        from wbfriction.workers import heap_for_arrays
+        def faults():
+            before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+            for _ in range(200):
+                np.ones(1 << 17).sum()
+            return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
+        first = faults()
+        print(heap_for_arrays(), first, faults(), faults())
+    """)
+    env = {**os.environ, "MALLOC_TRIM_THRESHOLD_": "65536"}
+    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True).stdout
+    undone, mapped, _, heap = out.split()
+    assert undone == "True" and int(mapped) > 200 * 200 and int(heap) < int(mapped) / 20
+    env.pop("MALLOC_TRIM_THRESHOLD_")
+    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True).stdout
+    assert out.split()[0] == "False"

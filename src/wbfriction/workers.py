@@ -109,6 +109,28 @@ def _leave_signals_to_parent() -> None:
     signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD)
 
 
+M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3
+"""``mallopt`` parameters (glibc's malloc.h)."""
+HEAP_THRESHOLD = 32 << 20
+"""Bytes below which glibc's malloc takes blocks from the heap: the ceiling its adaptive mmap threshold grows to
+on a 64-bit system (``DEFAULT_MMAP_THRESHOLD_MAX``); the heap is trimmed above twice this."""
+
+
+def heap_for_arrays() -> bool:
+    """Undo, in this process, what Dask's ``MALLOC_TRIM_THRESHOLD_=65536`` (set by every ``dask worker``'s nanny)
+    does to glibc's malloc: that variable turns off the adaptive mmap threshold, so every NumPy array above 128 KiB
+    is mapped and unmapped afresh, its pages faulted in each time (a log's task 1.5-2x as long as in a plain
+    process, issue 25). Sets the thresholds the adaptive rule would reach (:data:`HEAP_THRESHOLD`). True if it did;
+    False without the variable or glibc (nothing to undo)."""
+    if "MALLOC_TRIM_THRESHOLD_" not in os.environ:
+        return False
+    try:
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):
+        return False
+    return bool(mallopt(M_MMAP_THRESHOLD, HEAP_THRESHOLD)) and bool(mallopt(M_TRIM_THRESHOLD, 2 * HEAP_THRESHOLD))
+
+
 def dask_setup(worker: object) -> None:
     """Dask's preload hook (``distributed.worker.preload`` naming this module, :data:`DASK_PRELOAD`),
     run in each worker process of a cluster started by :func:`started_held` before it takes a task:

@@ -84,6 +84,31 @@ def test_dask_gives_the_serial_bytes(serial, arm_fleet, tmp_path):
     assert _files(tmp_path) == _files(serial)
 
 
+def test_a_clusters_workers_take_arrays_from_the_heap(arm_fleet, tmp_path):
+    """Workers a nanny started (``MALLOC_TRIM_THRESHOLD_`` set, as ``dask worker`` does) map each 1 MiB array
+    afresh until a batch runs on their cluster; after it (its plugin), the arrays come from the heap."""
+    from distributed import Client, LocalCluster
+
+    def faults() -> int:
+        import resource
+
+        import numpy as np
+        before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+        for _ in range(200):
+            np.ones(1 << 17).sum()
+        return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
+
+    folder, _ = arm_fleet
+    entries = read_manifest(folder / "manifest.csv")[:1]
+    with LocalCluster(n_workers=1, processes=True, threads_per_worker=1, dashboard_address=":0") as cluster, \
+            Client(cluster) as client:
+        assert all(client.run(lambda: "MALLOC_TRIM_THRESHOLD_" in os.environ).values())
+        (before,) = client.run(faults).values()
+        run_batch(entries, tmp_path, client=client)
+        (after,) = client.run(faults).values()
+    assert before > 200 * 200 and after < before / 20
+
+
 def test_a_batch_resumes_and_skips_what_it_did(arm_fleet, tmp_path):
     folder, _ = arm_fleet
     entries = read_manifest(folder / "manifest.csv")

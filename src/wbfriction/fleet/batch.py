@@ -414,6 +414,8 @@ def _run_on_dask(args: list[tuple], record: Callable[[LogOutcome], None], worker
         if own:
             cluster = local_cluster(workers)
             client = started_held(lambda: Client(cluster), lambda c: c.close())
+        from wbfriction.fleet.dask_plugin import HeapForArrays
+        client.register_plugin(HeapForArrays())  # a cluster not started here: its workers' malloc as a process's
         futures = {client.submit(log_task, *a, key=f"wbfriction-log-{a[1].key}", pure=False): a for a in args}
         done = 0
         for future in as_completed(futures):
