@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING
 
@@ -197,12 +198,13 @@ class MujocoRun:
         self._setup_state()
 
     def _setup_stabiliser(self) -> None:
-        """The base-attitude stabiliser: each leg's last two joints (the ankle), the reference base attitude."""
-        from scipy.spatial.transform import Rotation
+        """The base-attitude stabiliser: each leg's last two joints (the ankle), the reference base attitude
+        (SciPy's rotations imported only for a robot that has one: 0.2 s of a command's start-up)."""
         robot, ref = self.robot, self.ref
         self.balance = robot.balance_gains if self.options.balance is None else self.options.balance
         self.stabilise = any(self.balance)
         if self.stabilise:
+            from scipy.spatial.transform import Rotation
             self.ankles = [np.array([robot.actuated.index(j) for j in robot.limb(f)[-2:]])
                            for f in robot.contact_frames]
             self.ankle_jnt = [self.mjr.joint_ids[a] for a in self.ankles]
@@ -251,9 +253,12 @@ class MujocoRun:
         self.torque_friction = bool(self.joints_f) and not self.native  # (3.5) applied by us at every physics step
         self.measured = tuple(bool(x) for x in ref.contact[0])  # the contacts sensed over the last period
         self.noisy_q = bool(self.eps_q.any())
+        self.quantised = self.options.sensors.resolution is not None
         self.qpos_act = as_slice(mjr.qpos_index)
         self.touch = as_slice(mjr.touch_index)
         self.bad_qacc = data.warning.number[int(mujoco.mjtWarning.mjWARN_BADQACC):][:1]  # a view: the count
+        # what every physics step uses, fetched once (the loop runs four times per simulated millisecond)
+        self._stepping = (mujoco.mj_step, model, data, data.sensordata, data.actuator_force)
 
     def sample(self, k: int) -> None:
         """Run the control period of sample ``k``: measure, command, step the physics, sense the contacts."""
@@ -274,7 +279,8 @@ class MujocoRun:
         self.qpos[k], self.qvel[k], q[:] = data.qpos, data.qvel, data.qpos[self.qpos_act]
         if self.noisy_q:
             q += self.eps_q[k]
-        q[:] = self.options.sensors.encoder(q)
+        if self.quantised:
+            q[:] = self.options.sensors.encoder(q)
         return (q - self.q_meas[k - 1]) / self.dt if k > 0 else self.v_ref[0]
 
     def control(self, k: int, qd_meas: np.ndarray) -> np.ndarray:
@@ -308,20 +314,12 @@ class MujocoRun:
         """The physics steps of period ``k``, with the friction of eq. (3.5) if ours; the first one is logged
         (:meth:`record`). Every step's sensor readings (MuJoCo's sensors, the motor torques) go to the
         matched means (:class:`MatchedMeans`)."""
-        import mujoco
-        model, data, step = self.model, self.data, mujoco.mj_step
-        qvel, applied, sensordata, motor = data.qvel, data.qfrc_applied, data.sensordata, data.actuator_force
+        step, model, data, sensordata, motor = self._stepping
         sensed, motors = self.sensor_means.period(k), self.motor_means.period(k)
-        friction, dof_f, torque = self.torque_friction, self.dof_f, self.injected.torque
-        beyond = self.injected.with_terms if self.injected.beyond else None
-        warm, qpos, qpos_f, actuated = self.recording.temperature, data.qpos, self.qpos_f, data.qfrc_actuator
+        friction = self.apply_friction if self.torque_friction else None
         for s in range(len(sensed)):
-            if friction:
-                tau_f = torque(qvel[dof_f])
-                if beyond is not None:  # the load: the rigid-body torque, motor's and friction's, of the last step
-                    tau_f = beyond(tau_f, qvel[dof_f], qpos[qpos_f], actuated[dof_f] + applied[dof_f],
-                                   0.0 if warm is None else float(warm[k]))
-                applied[dof_f] = tau_f
+            if friction is not None:
+                tau_f = friction(k)
                 if s == 0:
                     self.tau_f_first[k] = tau_f
             step(model, data)  # the sensors are computed with the step's qacc, before its integration
@@ -330,6 +328,20 @@ class MujocoRun:
             sensed[s], motors[s] = sensordata, motor
         self.sensor_means.done(k)
         self.motor_means.done(k)
+
+    def apply_friction(self, k: int) -> np.ndarray:
+        """Apply the injected friction (n_f,) [N·m] of the velocities of this physics step (period ``k``) as
+        generalised forces (``qfrc_applied``) and return it."""
+        data, dof_f, injected = self.data, self.dof_f, self.injected
+        qvel, applied = data.qvel, data.qfrc_applied
+        tau_f = injected.torque(qvel[dof_f])
+        if injected.beyond:  # the load: the rigid-body torque, motor's and friction's, of the last step
+            warm = self.recording.temperature
+            tau_f = injected.with_terms(tau_f, qvel[dof_f], data.qpos[self.qpos_f],
+                                        data.qfrc_actuator[dof_f] + applied[dof_f],
+                                        0.0 if warm is None else float(warm[k]))
+        applied[dof_f] = tau_f
+        return tau_f
 
     def record(self, k: int) -> None:
         """Log the period's first physics step: accelerations, motor torques, MuJoCo's friction if used."""
@@ -348,8 +360,8 @@ class MujocoRun:
         force[:] = data.sensordata[self.touch]
         np.greater(force, self.options.contact_threshold, out=contact)
         self.measured = tuple(contact.tolist())
-        if (not np.isfinite(data.qpos).all() or data.qpos[2] < self.options.fall_height * self.z0
-                or self.bad_qacc[0] > 0):
+        if (not math.isfinite(data.qpos.sum()) or data.qpos[2] < self.options.fall_height * self.z0
+                or self.bad_qacc[0] > 0):  # a sum is finite only if every term is (or overflows: diverged too)
             raise SimulationError(f"the robot fell (or the simulation diverged) at t = {self.ref.time[k]:.3f} s")
 
     def result(self) -> SimulationResult:
