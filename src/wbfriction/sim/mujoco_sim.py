@@ -118,9 +118,12 @@ def set_mujoco_friction(model: mujoco.MjModel, dofs: np.ndarray, injected: Injec
 def mujoco_friction_torque(data: mujoco.MjData, dofs: np.ndarray | slice) -> np.ndarray:
     """Joint friction MuJoCo applied on ``dofs`` at the last step [N·m]: the friction-loss
     constraint forces (rows ``mjCNSTR_FRICTION_DOF``, whose Jacobian is the dof's unit
-    vector) plus the damper forces."""
+    vector) plus the damper forces.
+
+    The constraint type is compared as an integer: against MuJoCo's enum object NumPy compares element by
+    element in Python (160 us a call, measured; 2 us as an integer), the same rows."""
     import mujoco
-    rows = np.flatnonzero(data.efc_type[:data.nefc] == mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)
+    rows = (data.efc_type[:data.nefc] == int(mujoco.mjtConstraint.mjCNSTR_FRICTION_DOF)).nonzero()[0]
     force = data.qfrc_damper.copy()
     force[data.efc_id[rows]] += data.efc_force[rows]
     return force[dofs]
@@ -199,7 +202,7 @@ class MujocoRun:
 
     def _setup_stabiliser(self) -> None:
         """The base-attitude stabiliser: each leg's last two joints (the ankle), the reference base attitude
-        (SciPy's rotations imported only for a robot that has one: 0.2 s of a command's start-up)."""
+        (SciPy's rotations imported only for a robot that has one)."""
         robot, ref = self.robot, self.ref
         self.balance = robot.balance_gains if self.options.balance is None else self.options.balance
         self.stabilise = any(self.balance)
