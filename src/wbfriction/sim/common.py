@@ -45,39 +45,46 @@ class InjectedFriction:
             self._stacked = stack_params(cast(list[FrictionParams], list(self.params.values())))
             n = len(self.joints)
             p = {k: np.broadcast_to(np.asarray(v, dtype=float), (n,)).copy() for k, v in self._stacked.items()}
-            self._c = (p, p["F_c"] * p["S"], 1.0 / p["v_s"])
+            # (3.5)'s constants, the additive ones negated (tau_f = -f: see torque)
+            self._c = (1.0 / p["v_s"], -(p["F_c"] * p["S"]), -p["F_c"], p["a"], -p["tau_os"], -p["F_v"])
         # the others: each joint's model, joints of one model at once
         self._groups = [(np.array([i for i, q in enumerate(self.params.values()) if q.model == m]),
                          [q for q in self.params.values() if q.model == m]) for m in MODEL_NAMES]
         self._groups = [(cols, ps) for cols, ps in self._groups if len(cols)]
 
     def torque(self, qd: np.ndarray) -> np.ndarray:
-        """``tau_f = -f(qd)`` of the joints, from their velocities (n_f,) [rad/s].
+        """``tau_f = -f(qd)`` of the joints, from their velocities (n_f,) [rad/s] (a new array).
 
         The simulators call this at every physics step: with (3.5)'s Gaussian Stribeck exponent
-        (``delta_s = 2``, the thesis's) on every joint it runs in place on (n_f,) buffers, the same
-        numbers as :func:`~wbfriction.friction.models.coulomb_viscous_stribeck` in fewer operations."""
+        (``delta_s = 2``, the thesis's) on every joint it runs in place on two (n_f,) arrays, the same
+        numbers as :func:`~wbfriction.friction.models.coulomb_viscous_stribeck` in fewer operations:
+        ``-(F_v qd + tanh(a qd) (F_c + F_c S exp(-(qd / v_s)^2)) + tau_os)`` with the sign carried
+        by the constants (``-F_v``, ``-F_c``, ...): a negated factor or term gives the negated product
+        or sum bit for bit (IEEE rounding is symmetric), so no final negation."""
         if not self._gaussian or qd.ndim != 1:
-            out = np.empty_like(qd, dtype=float)
-            for cols, params in self._groups:
-                values = np.array([p.as_vector() for p in params]).T  # (n_params, n_cols): each row broadcasts
-                delta_s = np.array([getattr(p, "delta_s", 2.0) for p in params])
-                out[..., cols] = -model_values(values, qd[..., cols], delta_s, params[0].model)
-            return out
-        p, FcS, inv_vs = self._c
-        e = np.multiply(qd, inv_vs)
+            return self._torque_by_model(qd)
+        inv_vs, m_FcS, m_Fc, a, m_tau_os, m_Fv = self._c
+        multiply, add = np.multiply, np.add
+        e = multiply(qd, inv_vs)
         np.square(e, out=e)
         np.negative(e, out=e)
         np.exp(e, out=e)
-        np.multiply(e, FcS, out=e)
-        np.add(e, p["F_c"], out=e)  # F_c (1 + S exp(-(qd / v_s)^2))
-        out = np.multiply(qd, p["a"])
+        multiply(e, m_FcS, out=e)
+        add(e, m_Fc, out=e)  # -F_c (1 + S exp(-(qd / v_s)^2))
+        out = multiply(qd, a)
         np.tanh(out, out=out)
-        np.multiply(out, e, out=out)
-        np.add(out, p["tau_os"], out=out)
-        np.add(out, np.multiply(qd, p["F_v"], out=e), out=out)
-        return np.negative(out, out=out)
+        multiply(out, e, out=out)
+        add(out, m_tau_os, out=out)
+        return add(out, multiply(qd, m_Fv, out=e), out=out)
 
+    def _torque_by_model(self, qd: np.ndarray) -> np.ndarray:
+        """:meth:`torque` of any models and shapes (..., n_f): each model's joints at once."""
+        out = np.empty_like(qd, dtype=float)
+        for cols, params in self._groups:
+            values = np.array([p.as_vector() for p in params]).T  # (n_params, n_cols): each row broadcasts
+            delta_s = np.array([getattr(p, "delta_s", 2.0) for p in params])
+            out[..., cols] = -model_values(values, qd[..., cols], delta_s, params[0].model)
+        return out
 
     def with_terms(self, tau_f: np.ndarray, qd: np.ndarray, q: np.ndarray, load: np.ndarray,
                    temperature: float) -> np.ndarray:

@@ -113,11 +113,12 @@ def _shared_wrench_dynamics(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.nd
     b = pin.rneaInParallel(1, pin.ModelPool(model, 1), q.T, v.T, a.T).T  # (n, nv)
     # stacked Jacobians of all feet (n, 6 n_contacts, nv), those not in contact zeroed
     Jc = np.zeros((n, 6 * nc, model.nv))
-    feet = [[(slice(6 * c, 6 * c + 6), robot.contact_frame_ids[c]) for c in np.flatnonzero(row)] for row in contact]
-    for k in range(n):
+    feet = [(slice(6 * c, 6 * c + 6), f) for c, f in enumerate(robot.contact_frame_ids)]
+    for k, row in enumerate(contact.tolist()):
         pin.computeJointJacobians(model, data, q[k])  # getFrameJacobian places the frame from its joint
-        for rows, f in feet[k]:
-            Jc[k, rows] = pin.getFrameJacobian(model, data, f, pin.LOCAL)
+        for (rows, f), on in zip(feet, row):
+            if on:
+                Jc[k, rows] = pin.getFrameJacobian(model, data, f, pin.LOCAL)
     Jb = Jc[:, :, :6]
     w_inv = np.repeat(np.where(contact, np.maximum(share, min_share), 0.0), 6, axis=1)  # (n, 6 nc)
     JW = Jb * w_inv[:, :, None]
