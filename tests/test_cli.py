@@ -295,5 +295,7 @@ def test_fit_prints_tables_that_fit_a_100_column_terminal(demo_dir, tmp_path):
     assert wide.returncode == 0 and widest_line(wide.stdout) > 100 and " N " in wide.stdout.splitlines()[1]
     verbose = run("fit", out / "friction.parquet", "-o", tmp_path / "v.json", "--verbose", columns=100)
     words = "".join(verbose.stdout.split())  # each reason once, however the terminal's width wrapped it
-    assert words.count("held-outRMS[N·m]:") == len([j for j in params if params[j].get("selection")]) > 0
+    scored = [j for j in params if (params[j].get("selection") or {}).get("scores")]  # not those that hardly moved
+    assert words.count("held-outRMS[N·m]:") == len(scored) > 0
+    assert words.count("nomodelcanbechosen") == len([j for j in params if params[j].get("selection")]) - len(scored)
     assert widest_line(verbose.stdout) <= 100
