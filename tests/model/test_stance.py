@@ -108,6 +108,43 @@ def test_acceleration_difference_is_the_kkt_operator(talos, contact, n_held):
         np.testing.assert_allclose(got[k], expected, rtol=1e-8, atol=1e-9 * np.abs(expected).max())
 
 
+def _crba_acceleration_difference(robot: Robot, contact: int, angles: np.ndarray, tau_f: np.ndarray) -> np.ndarray:
+    """The crba route Delta qdd replaced (issue 41), as a reference: per sample, the locked-root tree's mass
+    matrix factored (``crba``, sparse Cholesky), ``x = M^{-1} [tau_f; 0]`` and ``M^{-1} e_p`` for each held joint
+    ``p``, the held joints removed by the block-inverse identity."""
+    st = stance_model(robot, contact)
+    model = pin.buildReducedModel(st.model, [1], pin.neutral(st.model))
+    name_of_v = {int(st.model.idx_vs[j]): st.model.names[j] for j in range(2, st.model.njoints)}
+    v_index = np.array([model.idx_vs[model.getJointId(name_of_v[int(v)])] for v in st.v_index])
+    data, tc, pc = model.createData(), v_index[robot.tc_index], v_index[robot.pc_index]
+    q = st.layout.configuration(angles, None, st.sign)[:, st.layout.root_nq:]
+    out = np.empty_like(tau_f)
+    for k in range(len(angles)):
+        pin.crba(model, data, q[k])
+        pin.cholesky.decompose(model, data)
+        u = np.zeros(model.nv)
+        u[tc] = tau_f[k] * st.sign[robot.tc_index]
+        x = pin.cholesky.solve(model, data, u)
+        X = np.column_stack([pin.cholesky.solve(model, data, e) for e in np.eye(model.nv)[pc]])
+        out[k] = (x[tc] - X[tc] @ np.linalg.solve(X[pc], x[pc])) * st.sign[robot.tc_index]
+    return out
+
+
+@pytest.mark.parametrize("contact", [0, 1])
+def test_acceleration_difference_equals_the_crba_route(talos, contact):
+    """Issue 41: Delta qdd by the articulated-body algorithm on the locked tree (the head's position-controlled
+    joints held by armature, at angles that change sample by sample) equals the crba route it replaced to 1e-9
+    relative, on either sole."""
+    assert len(talos.pc_index) == 2  # the premise: TALOS's head joints are position-controlled
+    rng = np.random.default_rng(41 + contact)
+    angles = rng.uniform(*talos.angle_limits, (200, talos.n_act))
+    tau_f = rng.normal(0.0, 5.0, (200, len(talos.tc_index)))
+    got = stance_model(talos, contact).acceleration_difference(angles, tau_f, talos.tc_index)
+    expected = _crba_acceleration_difference(talos, contact, angles, tau_f)
+    relative = np.abs(got - expected).max(axis=1) / np.abs(expected).max(axis=1)  # per sample
+    assert relative.max() < 1e-9
+
+
 def _chain_urdf(rng: np.random.Generator) -> str:
     """A chain of every 1-DoF joint Pinocchio makes of a URDF: revolute, continuous and prismatic joints
     about x, y, z and an axis that is none of them; random placements and bodies; the sole at its end."""
