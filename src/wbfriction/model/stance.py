@@ -32,7 +32,7 @@ import pinocchio as pin
 
 from wbfriction.exceptions import ModelError
 from wbfriction.model.layout import JointLayout, joint_layout
-from wbfriction.model.momentum import momentum_and_drift
+from wbfriction.model.momentum import tree_momentum_and_drift
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
 
@@ -173,8 +173,8 @@ class StanceModel:
     def momentum(self, angles: np.ndarray, qd: np.ndarray, frame_pose: np.ndarray | None = None,
                  progress: Progress | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The generalized momentum ``p = M qd`` and its rate without friction ``b = C^T qd - g`` of the
-        actuated joints on the tree rooted at the welded contact frame
-        (:func:`~wbfriction.model.momentum.momentum_and_drift`): ``dp/dt = tau + tau_f + b`` row by row.
+        actuated joints on the tree rooted at the welded contact frame, all samples at once
+        (:func:`~wbfriction.model.momentum.tree_momentum_and_drift`): ``dp/dt = tau + tau_f + b`` row by row.
 
         Args:
             angles, qd: joint positions [rad] and velocities [rad/s] of the actuated joints (N, n_act).
@@ -190,10 +190,14 @@ class StanceModel:
         v = np.zeros((len(angles), model.nv))
         v[:, v_index] = qd * self.sign
         gravity = None
-        if frame_pose is not None:  # R^T g: world gravity in the foot's frame
-            R = np.array([pin.XYZQUATToSE3(x).rotation for x in frame_pose])
-            gravity = np.einsum("nji,j->ni", R, self.model.gravity.linear)
-        p, b, _ = momentum_and_drift(model, q, v, gravity=gravity, progress=progress)
+        if frame_pose is not None:  # R^T g: world gravity in the foot's frame, R the unit quaternion's rotation
+            axis, w = frame_pose[:, 3:6], frame_pose[:, 6:]
+            g = np.broadcast_to(self.model.gravity.linear, axis.shape)
+            turn = np.cross(axis, g)
+            gravity = g - 2.0 * w * turn + 2.0 * np.cross(axis, turn)
+        p, b = tree_momentum_and_drift(model, q, v, gravity)
+        if progress is not None:
+            progress(len(angles))
         return p[:, v_index] * self.sign, b[:, v_index] * self.sign
 
     def _locked_root(self) -> tuple[pin.Model, np.ndarray]:
