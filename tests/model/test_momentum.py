@@ -7,6 +7,7 @@ import pinocchio as pin
 import pytest
 
 from helpers import chain_urdf
+from wbfriction.model import momentum
 from wbfriction.model.force_torque import above_sensors_model
 from wbfriction.model.measured_dynamics import measured_momentum
 from wbfriction.model.momentum import momentum_and_drift, tree_momentum_and_drift
@@ -110,10 +111,10 @@ def _tree_cases(talos) -> list[tuple[str, pin.Model]]:
 
 
 @pytest.mark.parametrize("case", [0, 1])
-def test_the_batched_tree_terms_are_pinocchios(talos, case):
+def test_the_batched_tree_terms_are_pinocchios(talos, case, monkeypatch):
     """Issue 41: :func:`tree_momentum_and_drift` (all samples at once) gives ``p = M v`` and ``b = C^T v - g`` of
     the per-sample Pinocchio route to 1e-12 relative, with armature on every joint and gravity tilted sample by
-    sample, on TALOS's stance tree and on a chain of every 1-DoF joint type."""
+    sample, on TALOS's stance tree and on a chain of every 1-DoF joint type; in blocks, the same bytes."""
     name, model = _tree_cases(talos)[case]
     rng = np.random.default_rng(41 + case)
     model = pin.Model(model)
@@ -125,3 +126,6 @@ def test_the_batched_tree_terms_are_pinocchios(talos, case):
     for got, ref in ((p, p_ref), (b, b_ref)):
         relative = np.abs(got - ref).max(axis=1) / np.abs(ref).max(axis=1)
         assert relative.max() < 1e-12, name
+    monkeypatch.setattr(momentum, "BLOCK", 16)
+    blocked = tree_momentum_and_drift(model, q, v, gravity)
+    assert blocked[0].tobytes() == p.tobytes() and blocked[1].tobytes() == b.tobytes()

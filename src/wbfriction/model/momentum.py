@@ -148,6 +148,11 @@ def _placement(jt: _Joint, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.broadcast_to(jt.R0[..., None], (3, 3, len(x))), jt.p0[:, None] + (jt.R0 @ jt.lin)[:, None] * x
 
 
+BLOCK = 4096
+"""Samples :func:`tree_momentum_and_drift` takes at once: its arrays, about 8 kB a sample on a humanoid, stay
+near 35 MB however long the stretch."""
+
+
 def tree_momentum_and_drift(model: pin.Model, q: np.ndarray, v: np.ndarray,
                             gravity: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``p = M(q) v`` and ``b = C(q, v)^T v - g(q)`` (module docstring) of a fixed-base tree of 1-DoF joints,
@@ -165,6 +170,16 @@ def tree_momentum_and_drift(model: pin.Model, q: np.ndarray, v: np.ndarray,
         ModelError: a joint that is not a 1-DoF revolute or prismatic joint.
     """
     joints = _joints(model)
+    p, b = np.empty((len(q), model.nv)), np.empty((len(q), model.nv))
+    for start in range(0, len(q), BLOCK):
+        sl = slice(start, start + BLOCK)
+        p[sl], b[sl] = _tree_block(model, joints, q[sl], v[sl], None if gravity is None else gravity[sl])
+    return p, b
+
+
+def _tree_block(model: pin.Model, joints: list[_Joint], q: np.ndarray, v: np.ndarray,
+                gravity: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`tree_momentum_and_drift` of a block of samples, the tree's :func:`_joints` given."""
     n = len(q)
     q, v = q.T, np.ascontiguousarray(v.T)  # component first below: (3, ..., N)
     g = np.broadcast_to(model.gravity.linear[:, None] if gravity is None else gravity.T, (3, n))
