@@ -169,6 +169,7 @@ def _with_provenance(tables: Iterator[pa.Table], chunks: list[Chunk], robot: Rob
             first_meta.update(meta)
             table = with_metadata(table, meta)
         yield table
+        release_freed_memory()  # the chunk just written, its rows read and sent
         if progress is not None:
             progress(chunks[k].stop - chunks[k].start)
     if not single:
