@@ -186,7 +186,8 @@ def plan_columns(file: TableFile, robot: Robot, source: str, max_gap: float = MA
 def release_freed_memory() -> None:
     """Give back to the system what this process has freed but its allocators keep: Arrow's pool and the C
     heap (glibc's ``malloc_trim``; nothing where there is none). Planning an hour-long log reads its whole time
-    and contact columns: about 250 MB that the reading process would otherwise hold while its workers run."""
+    and contact columns: about 250 MB that the reading process would otherwise hold while its workers run; each
+    chunk it reads, sends and writes leaves more."""
     import ctypes
 
     pa.default_memory_pool().release_unused()

@@ -150,10 +150,9 @@ def convolve_same(x: np.ndarray, h: np.ndarray) -> np.ndarray:
     n, m = len(x), len(h)
     if m > n:
         raise ValueError(f"a kernel of {m} taps is longer than the {n} rows it convolves")
-    block = None if n == 1 or m == 1 else _overlap_add_block(n, m, fft)
     if n == 1 or m == 1:  # nothing to convolve along: oaconvolve's plain product
         full = x * h
-    elif block is None:
+    elif (block := _overlap_add_block(n, m, fft)) is None:
         full = _fft_convolve(x, h, fft)
     else:
         step, overlap = block - m + 1, m - 1
