@@ -8,11 +8,13 @@ wbfriction estimate LOG -o OUT --workers 1``, CPU time of the child process and 
 
 next to a Python loop of ``pin.constraintDynamics`` (one 6D contact on the left sole, PROXIMAL
 settings as in Pinocchio's examples) over the same rows, measured in the same run. Prints rows/s
-and the ratio of time per row (command / bare loop), the command's fixed start-up cost
-(``estimate --help``: interpreter, imports) and its marginal cost per row (the same log repeated
-four times, minus once). ``--reference SRC`` also times another checkout's ``src`` (e.g. the code
-before a change) on the same logs. One thread per process; run under ``taskset -c 0`` for a strict
-one-core figure.
+and the speed ratio (command rows/s / bare-loop rows/s: issue 41's figure, target >= 1.0), the
+command's fixed start-up cost (``estimate --help``: interpreter, imports) and its marginal cost per
+row (the same log repeated four times, minus once). Then the cost of each route alone, in this
+process (``estimate_resolved`` without the other route's check, the log already read; issue 41: the
+momentum route at no more than 1.2 times the acceleration route's). ``--reference SRC`` also times
+another checkout's ``src`` (e.g. the code before a change) on the same logs. One thread per process;
+run under ``taskset -c 0`` for a strict one-core figure.
 
     python benchmarks/bench_estimate.py [--repeat 3] [--reference /path/to/old/src] [--keep DIR]
 """
@@ -143,10 +145,42 @@ def main() -> None:
                 bare = min(bare_loop(robot, table) for _ in range(args.repeat))
                 marginal = (cpu4 - cpu) / (3 * n)
                 print(f"  {name}, {n} rows: command {cpu:.2f} s CPU ({wall:.2f} s wall) = {n / cpu:,.0f} rows/s, "
-                      f"{1e6 * cpu / n:.1f} us/row; bare constraintDynamics loop {1e6 * bare / n:.1f} us/row; "
-                      f"ratio command / bare loop {cpu / bare:.2f}")
+                      f"{1e6 * cpu / n:.1f} us/row; bare constraintDynamics loop {n / bare:,.0f} rows/s, "
+                      f"{1e6 * bare / n:.1f} us/row; speed ratio command / bare loop {bare / cpu:.2f}")
                 print(f"    marginal cost per row (x4 log: {4 * n} rows in {cpu4:.2f} s CPU): {1e6 * marginal:.1f} "
-                      f"us/row = {1 / marginal:,.0f} rows/s; ratio to the bare loop {marginal * n / bare:.2f}")
+                      f"us/row = {1 / marginal:,.0f} rows/s; speed ratio to the bare loop {bare / (marginal * n):.2f}")
+        if args.reference is None:
+            print("\nEach route alone, in this process (CPU time, best of the runs):")
+            for name, table in logs.items():
+                cost = route_costs(robot, table, args.repeat)
+                print(f"  {name}: acceleration {cost['acceleration']:.2f} s, momentum {cost['momentum']:.2f} s: "
+                      f"momentum / acceleration {cost['momentum'] / cost['acceleration']:.2f}")
+
+
+def route_costs(robot, table: pa.Table, repeat: int) -> dict[str, float]:
+    """CPU seconds of each route's estimate of the log alone (options resolved once, as the command does; no
+    check by the other route), the least of ``repeat`` runs."""
+    from dataclasses import replace
+
+    from wbfriction.friction.estimate import estimate_resolved, resolve_differentiation
+    from wbfriction.friction.options import EstimateOptions
+    from wbfriction.friction.route import resolve_route
+    from wbfriction.logs.log import log_from_table
+
+    log = log_from_table(table, robot)
+    options, choice = resolve_differentiation(EstimateOptions(), log)
+    options, _ = resolve_route(options, log, choice=choice)
+    costs = {}
+    for route in ("acceleration", "momentum"):
+        chosen = replace(options, route=route, check_route=False)
+        estimate_resolved(robot, log, chosen, require_single_support=False)  # warm: the stance models built
+        times = []
+        for _ in range(repeat):
+            t0 = time.process_time()
+            estimate_resolved(robot, log, chosen, require_single_support=False)
+            times.append(time.process_time() - t0)
+        costs[route] = min(times)
+    return costs
 
 if __name__ == "__main__":
     main()

@@ -3,8 +3,9 @@
 Builds a log of ``--minutes`` at 1 kHz for TALOS by repeating a simulated combined walk
 (with a 0.5 s time gap between repetitions, so that the log has segments as real logs with
 pauses do), written tile by tile (never held whole), then runs ``wbfriction estimate`` on it
-(chunked, :mod:`wbfriction.pipeline.chunked`) and prints rows per second and the peak resident memory
-of the command and its workers together.
+(chunked, :mod:`wbfriction.pipeline.chunked`) and prints rows per second, the CPU time of the command and
+its workers together (what the wall time is on idle cores: the figure that holds on a shared machine)
+and their peak resident memory together.
 
     python benchmarks/bench_long_log.py --minutes 60 --workers 2
 """
@@ -122,12 +123,16 @@ def main() -> None:
         # sampled as the sum of the resident sets of the process and its workers
         cmd = [sys.executable, "-m", "wbfriction", "estimate", str(log), "-o", str(folder / "long_friction.parquet"),
                "--workers", str(args.workers), "--chunk-rows", str(args.chunk_rows)]
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         seconds, peak = measure(cmd)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
         t2 = t1 + seconds
-        largest = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+        largest = after.ru_maxrss / 1024
         print(f"log: {rows} rows ({rows / 1000 / 60:.1f} min at 1 kHz), {log.stat().st_size / 2**30:.2f} GiB, "
               f"built in {t1 - t0:.0f} s")
-        print(f"wbfriction estimate: {args.workers} workers, {t2 - t1:.0f} s: {rows / (t2 - t1):.0f} rows/s")
+        print(f"wbfriction estimate: {args.workers} workers, {t2 - t1:.0f} s: {rows / (t2 - t1):.0f} rows/s; "
+              f"{cpu:.0f} s CPU (the command and its workers: {cpu / args.workers:.0f} s on {args.workers} idle cores)")
         print(f"output: {(folder / 'long_friction.parquet').stat().st_size / 2**30:.2f} GiB")
         print(f"peak memory: {peak / 2**20:.0f} MiB resident in all (the command and its workers, sampled every "
               f"0.2 s); largest single process {largest:.0f} MiB")

@@ -219,3 +219,27 @@ def ended_within(proc: subprocess.Popen, seconds: float, after: str) -> tuple[st
         os.killpg(proc.pid, signal.SIGKILL)
         _, err = proc.communicate()
         pytest.fail(f"still running {seconds:g} s after {after}: {err}")
+
+
+def chain_urdf(rng: np.random.Generator) -> str:
+    """A chain of every 1-DoF joint Pinocchio makes of a URDF: revolute, continuous and prismatic joints
+    about x, y, z and an axis that is none of them; random placements and bodies; the sole at its end."""
+    unaligned = "0.48 0.6 0.64"
+    links, joints, parent = ['<link name="base"><inertial><mass value="3"/><inertia ixx="0.1" iyy="0.2" izz="0.3" '
+                             'ixy="0" ixz="0" iyz="0"/></inertial></link>'], [], "base"
+    kinds = [(t, a) for t in ("revolute", "continuous", "prismatic") for a in ("1 0 0", "0 1 0", "0 0 1", unaligned)]
+    for k, (kind, axis) in enumerate(kinds):
+        m, c = rng.uniform(0.5, 2.0), rng.uniform(-0.1, 0.1, 3)
+        xyz, rpy = rng.uniform(-0.3, 0.3, 3), rng.uniform(-1.0, 1.0, 3)
+        links.append(f'<link name="l{k}"><inertial><origin xyz="{" ".join(map(str, c))}"/><mass value="{m}"/>'
+                     f'<inertia ixx="{0.02 * m}" iyy="{0.03 * m}" izz="{0.025 * m}" ixy="0.001" ixz="0" iyz="0"/>'
+                     f'</inertial></link>')
+        limit = '<limit lower="-2" upper="2" effort="100" velocity="10"/>' if kind != "continuous" else ""
+        joints.append(f'<joint name="j{k}" type="{kind}"><parent link="{parent}"/><child link="l{k}"/>'
+                      f'<origin xyz="{" ".join(map(str, xyz))}" rpy="{" ".join(map(str, rpy))}"/>'
+                      f'<axis xyz="{axis}"/>{limit}</joint>')
+        parent = f"l{k}"
+    links.append('<link name="sole"/>')
+    joints.append(f'<joint name="sole_joint" type="fixed"><parent link="{parent}"/><child link="sole"/>'
+                  '<origin xyz="0.05 0 -0.1" rpy="0.2 0 0"/></joint>')
+    return '<robot name="chain">' + "".join(links + joints) + "</robot>"

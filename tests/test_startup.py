@@ -82,3 +82,21 @@ def test_the_options_modules_code_uses_only_names_they_define():
                 missing += [(stage, code.co_qualname, n) for n in names
                             if n not in vars(module) and not hasattr(builtins, n) and code.co_name != "wrapper"]
     assert missing == []
+
+
+def test_estimate_imports_scipy_signal_only_for_a_butterworth_filter(talos, combined_walk, tmp_path):
+    """Issue 41: ``scipy.signal`` costs about 0.5 s of a process's start; the Savitzky-Golay route (its own
+    weighted fit, FFT overlap-add by ``scipy.fft``), the momentum route and the noise measurement of
+    ``--diff auto`` do without it; a Butterworth filter imports it."""
+    import pyarrow.parquet as pq
+
+    log = tmp_path / "walk.parquet"
+    pq.write_table(combined_walk.log.to_table(talos).slice(0, 4000), log)
+    runs = {("--diff", "savgol", "--route", "acceleration"): False, ("--route", "momentum"): False,
+            ("--diff", "auto",): False, ("--diff", "butterworth", "--route", "acceleration"): True}
+    for k, (args, imported) in enumerate(runs.items()):
+        code = ("import sys\nfrom wbfriction.cli.common import main\n"
+                f"sys.argv = ['wbfriction', 'estimate', {str(log)!r}, '-o', {str(tmp_path / f'{k}.parquet')!r}, "
+                f"'--workers', '1', *{args!r}]\n"
+                "try:\n    main()\nexcept SystemExit as exc:\n    assert not exc.code, exc.code")
+        assert ("scipy.signal" in _modules_after(code)) is imported, args

@@ -14,6 +14,7 @@ from wbfriction.logs.hdf5 import write_hdf5
 from wbfriction.logs.tables import (
     TableFile,
     numeric_column,
+    numeric_columns,
     read_metadata,
     with_metadata,
     write_json,
@@ -89,3 +90,21 @@ def test_float_columns_are_written_without_dictionary_and_read_back_bit_for_bit(
         assert not any("DICTIONARY" in e for e in encodings["x"] + encodings["time"])
         assert any("DICTIONARY" in e for e in encodings["phase"])
         assert pq.read_table(tmp_path / name).equals(table)
+
+
+def test_columns_read_as_one_array_are_the_columns_read_one_by_one():
+    """Issue 41: :func:`numeric_columns` (Arrow casts and copies once) gives the bytes of the columns read one by
+    one (integers, floats with a null, booleans; several chunks), and the same error: the first column at fault,
+    its first bad row."""
+    a = pa.chunked_array([pa.array([1, 2, 3], pa.int32()), pa.array([4], pa.int32())])
+    b = pa.chunked_array([pa.array([0.5, None, 2.5, 3.5])])
+    c = pa.chunked_array([pa.array([True, False]), pa.array([True, True])])
+    table = pa.table({"a": a, "b": b, "c": c})
+    names = ["c", "a", "b"]
+    one_by_one = np.column_stack([numeric_column(table, n, "log", finite=False) for n in names])
+    assert numeric_columns(table, names, "log", finite=False).tobytes() == one_by_one.tobytes()
+    with pytest.raises(InputError) as many:
+        numeric_columns(table, names, "log", first_row=10)
+    with pytest.raises(InputError) as single:
+        numeric_column(table, "b", "log", first_row=10)
+    assert str(many.value) == str(single.value) and "row 11" in str(many.value)

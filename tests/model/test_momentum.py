@@ -6,9 +6,11 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from helpers import chain_urdf
+from wbfriction.model import momentum
 from wbfriction.model.force_torque import above_sensors_model
 from wbfriction.model.measured_dynamics import measured_momentum
-from wbfriction.model.momentum import momentum_and_drift
+from wbfriction.model.momentum import momentum_and_drift, tree_momentum_and_drift
 from wbfriction.model.stance import stance_model
 
 
@@ -97,3 +99,33 @@ def test_a_tilted_foot_sees_gravity_tilted(talos):
     moved = np.abs(flat) > 1e-6
     assert moved.sum() > 5
     np.testing.assert_allclose(turned[moved], -flat[moved], rtol=1e-9)
+
+
+def _tree_cases(talos) -> list[tuple[str, pin.Model]]:
+    """Fixed-base trees: TALOS's stance tree with its root locked (reversed joints, continuous joints none), and a
+    chain of every 1-DoF joint type Pinocchio makes of a URDF (tests/model/test_stance.py)."""
+    stance = stance_model(talos, 1)
+    rooted = pin.buildReducedModel(stance.model, [1], pin.neutral(stance.model))
+    chain = pin.buildModelFromXML(chain_urdf(np.random.default_rng(7)))
+    return [("talos", rooted), ("chain", chain)]
+
+
+@pytest.mark.parametrize("case", [0, 1])
+def test_the_batched_tree_terms_are_pinocchios(talos, case, monkeypatch):
+    """Issue 41: :func:`tree_momentum_and_drift` (all samples at once) gives ``p = M v`` and ``b = C^T v - g`` of
+    the per-sample Pinocchio route to 1e-12 relative, with armature on every joint and gravity tilted sample by
+    sample, on TALOS's stance tree and on a chain of every 1-DoF joint type; in blocks, the same bytes."""
+    name, model = _tree_cases(talos)[case]
+    rng = np.random.default_rng(41 + case)
+    model = pin.Model(model)
+    model.armature[:] = rng.uniform(0.0, 0.3, model.nv)
+    q, v = _states(model, rng, 50)
+    gravity = rng.normal(0.0, 9.81, (50, 3))
+    p, b = tree_momentum_and_drift(model, q, v, gravity)
+    p_ref, b_ref, _ = momentum_and_drift(model, q, v, gravity=gravity)
+    for got, ref in ((p, p_ref), (b, b_ref)):
+        relative = np.abs(got - ref).max(axis=1) / np.abs(ref).max(axis=1)
+        assert relative.max() < 1e-12, name
+    monkeypatch.setattr(momentum, "BLOCK", 16)
+    blocked = tree_momentum_and_drift(model, q, v, gravity)
+    assert blocked[0].tobytes() == p.tobytes() and blocked[1].tobytes() == b.tobytes()

@@ -11,6 +11,7 @@ import pinocchio as pin
 import pytest
 
 from conftest import constrained_forward, random_state
+from helpers import chain_urdf
 from wbfriction.exceptions import ModelError
 from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
@@ -65,10 +66,11 @@ def test_every_body_is_marked_and_the_leg_joints_reversed(talos):
     assert all((s < 0) == (name in leg) for name, s in zip(talos.actuated, st.sign))
 
 
-def test_stance_frame_pose(talos):
+@pytest.mark.parametrize("contact", [0, 1])
+def test_stance_frame_pose(talos, contact):
     """Without a logged base the sole is flat at the origin; with one, the pose is the sole's by forward
-    kinematics of the original model."""
-    st = stance_model(talos, 0)
+    kinematics of the original model, to the last bit (issue 41: computed on the chain to the sole alone)."""
+    st = stance_model(talos, contact)
     rng = np.random.default_rng(4)
     angles = rng.uniform(-0.3, 0.3, (3, talos.n_act))
     np.testing.assert_array_equal(stance_frame_pose(talos, st, angles, None), np.tile([0, 0, 0, 0, 0, 0, 1.0], (3, 1)))
@@ -78,7 +80,7 @@ def test_stance_frame_pose(talos):
     m, d = talos.model, talos.model.createData()
     for k in range(3):
         pin.framesForwardKinematics(m, d, talos.configuration(angles[k], base[k]))
-        np.testing.assert_allclose(pose[k], pin.SE3ToXYZQUAT(d.oMf[talos.contact_frame_ids[0]]), atol=1e-12)
+        assert pose[k].tobytes() == pin.SE3ToXYZQUAT(d.oMf[talos.contact_frame_ids[contact]]).tobytes()
 
 
 
@@ -108,28 +110,41 @@ def test_acceleration_difference_is_the_kkt_operator(talos, contact, n_held):
         np.testing.assert_allclose(got[k], expected, rtol=1e-8, atol=1e-9 * np.abs(expected).max())
 
 
-def _chain_urdf(rng: np.random.Generator) -> str:
-    """A chain of every 1-DoF joint Pinocchio makes of a URDF: revolute, continuous and prismatic joints
-    about x, y, z and an axis that is none of them; random placements and bodies; the sole at its end."""
-    unaligned = "0.48 0.6 0.64"
-    links, joints, parent = ['<link name="base"><inertial><mass value="3"/><inertia ixx="0.1" iyy="0.2" izz="0.3" '
-                             'ixy="0" ixz="0" iyz="0"/></inertial></link>'], [], "base"
-    kinds = [(t, a) for t in ("revolute", "continuous", "prismatic") for a in ("1 0 0", "0 1 0", "0 0 1", unaligned)]
-    for k, (kind, axis) in enumerate(kinds):
-        m, c = rng.uniform(0.5, 2.0), rng.uniform(-0.1, 0.1, 3)
-        xyz, rpy = rng.uniform(-0.3, 0.3, 3), rng.uniform(-1.0, 1.0, 3)
-        links.append(f'<link name="l{k}"><inertial><origin xyz="{" ".join(map(str, c))}"/><mass value="{m}"/>'
-                     f'<inertia ixx="{0.02 * m}" iyy="{0.03 * m}" izz="{0.025 * m}" ixy="0.001" ixz="0" iyz="0"/>'
-                     f'</inertial></link>')
-        limit = '<limit lower="-2" upper="2" effort="100" velocity="10"/>' if kind != "continuous" else ""
-        joints.append(f'<joint name="j{k}" type="{kind}"><parent link="{parent}"/><child link="l{k}"/>'
-                      f'<origin xyz="{" ".join(map(str, xyz))}" rpy="{" ".join(map(str, rpy))}"/>'
-                      f'<axis xyz="{axis}"/>{limit}</joint>')
-        parent = f"l{k}"
-    links.append('<link name="sole"/>')
-    joints.append(f'<joint name="sole_joint" type="fixed"><parent link="{parent}"/><child link="sole"/>'
-                  '<origin xyz="0.05 0 -0.1" rpy="0.2 0 0"/></joint>')
-    return '<robot name="chain">' + "".join(links + joints) + "</robot>"
+def _crba_acceleration_difference(robot: Robot, contact: int, angles: np.ndarray, tau_f: np.ndarray) -> np.ndarray:
+    """The crba route Delta qdd replaced (issue 41), as a reference: per sample, the locked-root tree's mass
+    matrix factored (``crba``, sparse Cholesky), ``x = M^{-1} [tau_f; 0]`` and ``M^{-1} e_p`` for each held joint
+    ``p``, the held joints removed by the block-inverse identity."""
+    st = stance_model(robot, contact)
+    model = pin.buildReducedModel(st.model, [1], pin.neutral(st.model))
+    name_of_v = {int(st.model.idx_vs[j]): st.model.names[j] for j in range(2, st.model.njoints)}
+    v_index = np.array([model.idx_vs[model.getJointId(name_of_v[int(v)])] for v in st.v_index])
+    data, tc, pc = model.createData(), v_index[robot.tc_index], v_index[robot.pc_index]
+    q = st.layout.configuration(angles, None, st.sign)[:, st.layout.root_nq:]
+    out = np.empty_like(tau_f)
+    for k in range(len(angles)):
+        pin.crba(model, data, q[k])
+        pin.cholesky.decompose(model, data)
+        u = np.zeros(model.nv)
+        u[tc] = tau_f[k] * st.sign[robot.tc_index]
+        x = pin.cholesky.solve(model, data, u)
+        X = np.column_stack([pin.cholesky.solve(model, data, e) for e in np.eye(model.nv)[pc]])
+        out[k] = (x[tc] - X[tc] @ np.linalg.solve(X[pc], x[pc])) * st.sign[robot.tc_index]
+    return out
+
+
+@pytest.mark.parametrize("contact", [0, 1])
+def test_acceleration_difference_equals_the_crba_route(talos, contact):
+    """Issue 41: Delta qdd by the articulated-body algorithm on the locked tree (the head's position-controlled
+    joints held by armature, at angles that change sample by sample) equals the crba route it replaced to 1e-9
+    relative, on either sole."""
+    assert len(talos.pc_index) == 2  # the premise: TALOS's head joints are position-controlled
+    rng = np.random.default_rng(41 + contact)
+    angles = rng.uniform(*talos.angle_limits, (200, talos.n_act))
+    tau_f = rng.normal(0.0, 5.0, (200, len(talos.tc_index)))
+    got = stance_model(talos, contact).acceleration_difference(angles, tau_f, talos.tc_index)
+    expected = _crba_acceleration_difference(talos, contact, angles, tau_f)
+    relative = np.abs(got - expected).max(axis=1) / np.abs(expected).max(axis=1)  # per sample
+    assert relative.max() < 1e-9
 
 
 def test_every_one_dof_joint_type_is_re_rooted():
@@ -137,7 +152,7 @@ def test_every_one_dof_joint_type_is_re_rooted():
     RevoluteUnboundedUnaligned, whose bindings give no axis) stopped the stance model with an
     AttributeError. On a chain of all twelve 1-DoF joint types, the stance model's mass matrix is the
     inverse of M_mod^{-1} from the floating-base KKT system (an independent route), sample by sample."""
-    model = pin.buildModelFromXML(_chain_urdf(np.random.default_rng(5)), pin.JointModelFreeFlyer())
+    model = pin.buildModelFromXML(chain_urdf(np.random.default_rng(5)), pin.JointModelFreeFlyer())
     names = tuple(model.names[j] for j in range(2, model.njoints))
     assert len({model.joints[j].shortname() for j in range(2, model.njoints)}) == 12  # the premise
     robot = Robot("chain", model, Path("chain.urdf"), names, names, (), ("sole",))

@@ -233,3 +233,25 @@ def test_fir_is_its_definition(taps):
     got = fir(x, h)
     np.testing.assert_array_equal(np.isnan(got), np.isnan(expected))
     np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)
+
+
+def test_the_overlap_add_and_the_hann_window_are_scipy_signals_to_the_last_bit():
+    """Issue 41: :func:`convolve_same` (without ``scipy.signal``) gives ``oaconvolve(mode="same")``'s bytes on
+    signals short and long (one FFT, overlap-add), 1-D and several columns; :func:`periodic_hann` gives
+    ``windows.hann(sym=False)``'s."""
+    from scipy.signal import oaconvolve
+    from scipy.signal.windows import hann
+
+    from wbfriction.signals.filters import convolve_same
+    from wbfriction.signals.spectrum import periodic_hann
+
+    rng = np.random.default_rng(41)
+    for n in (1, 2, 7, 64, 257, 4096, 4399, 20_000):
+        for m in (1, 2, 5, 31, 161, 401):
+            for shape in ((n,), (n, 7), (n, 3, 2)):
+                if m > n:
+                    continue
+                x, h = rng.normal(size=shape), rng.normal(size=m)
+                expected = oaconvolve(x, h.reshape((-1,) + (1,) * (x.ndim - 1)), mode="same", axes=0)
+                assert convolve_same(x, h).tobytes() == expected.tobytes(), (n, m, shape)
+    assert all(periodic_hann(n).tobytes() == hann(n, sym=False).tobytes() for n in range(2000))

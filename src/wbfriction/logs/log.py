@@ -47,7 +47,7 @@ from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.logs.clock import JITTER, Clock, TimeBase, TimeUnit, read_clock, split_at_gaps, table_stamps
 from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, sensed_contacts
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
-from wbfriction.logs.tables import numeric_column, read_metadata, with_metadata, write_table
+from wbfriction.logs.tables import numeric_column, numeric_columns, read_metadata, with_metadata, write_table
 from wbfriction.model.robot import Robot
 
 TorqueSource = Literal["sensor", "current"]
@@ -384,8 +384,8 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
 
 
 def _stack(table: pa.Table, columns: list[str], source: str, first_row: int) -> np.ndarray:
-    """The numeric ``columns`` of ``table`` side by side (N, len(columns))."""
-    return np.column_stack([numeric_column(table, c, source, first_row) for c in columns])
+    """The numeric ``columns`` of ``table`` side by side (N, len(columns)), read as one array."""
+    return numeric_columns(table, columns, source, first_row)
 
 
 def _read_motion(table: pa.Table, robot: Robot, source: str, max_gap: float, limit_margin: float,

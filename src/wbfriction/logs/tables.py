@@ -279,6 +279,36 @@ def read_table(path: str | Path) -> pa.Table:
     return TableFile(path).read()
 
 
+def numeric_columns(table: pa.Table, names: Sequence[str], source: str, first_row: int = 0,
+                    finite: bool = True) -> np.ndarray:
+    """Columns ``names`` side by side as float64 (N, len(names)), row-major: numeric columns (integers, floats,
+    booleans) cast and copied once by Arrow (``RecordBatch.to_tensor``, nulls as NaN) and checked as one array;
+    others column by column (:func:`numeric_column`, which says which is not numeric). The same values and
+    errors as :func:`numeric_column` for each column in turn.
+
+    Raises:
+        InputError: as :func:`numeric_column`, for the first column (in ``names``' order) at fault.
+    """
+    def is_number(t: pa.DataType) -> bool:
+        return pa.types.is_integer(t) or pa.types.is_floating(t) or pa.types.is_boolean(t)
+
+    if not names:
+        return np.empty((table.num_rows, 0))
+    if not all(n in table.column_names and is_number(table.schema.field(n).type) for n in names):
+        return np.column_stack([numeric_column(table, n, source, first_row, finite) for n in names])
+    if not table.num_rows:
+        return np.empty((0, len(names)))
+    columns = [table.column(n).combine_chunks().cast(pa.float64(), safe=False) for n in names]  # numpy's astype
+    batch = pa.RecordBatch.from_arrays(columns, names=list(names))
+    values = np.asarray(batch.to_tensor(null_to_nan=True, row_major=True))  # row-major, as np.column_stack
+    if finite:
+        bad = ~np.isfinite(values)
+        if bad.any():
+            col = int(np.argmax(bad.any(axis=0)))
+            numeric_column(table, names[col], source, first_row)  # raises, naming the column and the row
+    return values
+
+
 def numeric_column(table: pa.Table, name: str, source: str, first_row: int = 0, finite: bool = True) -> np.ndarray:
     """Column ``name`` as float64 (N,).
 

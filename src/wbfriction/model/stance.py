@@ -32,7 +32,7 @@ import pinocchio as pin
 
 from wbfriction.exceptions import ModelError
 from wbfriction.model.layout import JointLayout, joint_layout
-from wbfriction.model.momentum import momentum_and_drift
+from wbfriction.model.momentum import tree_momentum_and_drift
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
 
@@ -47,6 +47,12 @@ _GRAPH_JOINTS = {
 }
 """Pinocchio's 1-DoF joint models by name: the graph joint that stands for each, and where its axis lies in
 the joint's motion subspace (angular part for a revolute joint, linear part for a prismatic one)."""
+
+
+LOCKED_ARMATURE = 1e30
+"""Armature [kg·m² or kg] that locks a joint in the articulated-body algorithm: its share ``U U^T / D`` of the
+articulated inertia (``D`` = the joint's inertia + armature) is then below the last bit of any body's inertia,
+and its acceleration ``u / D`` zero to machine precision (tests/model/test_stance.py: the crba route to 1e-12)."""
 
 
 def _graph_joint(joint: pin.JointModel):
@@ -87,7 +93,8 @@ class StanceModel:
     sign: np.ndarray
     layout: JointLayout
     pool: pin.ModelPool = field(init=False, repr=False)
-    _locked: tuple[pin.Model, pin.Data, np.ndarray] | None = field(init=False, repr=False, default=None)
+    _locked: tuple[pin.Model, np.ndarray] | None = field(init=False, repr=False, default=None)
+    _held_pools: dict[tuple[int, ...], pin.ModelPool] = field(init=False, repr=False, default_factory=dict)
 
     def __post_init__(self) -> None:
         self.pool = pin.ModelPool(self.model, 1)  # one thread: rneaInParallel as a C++ batch loop
@@ -120,16 +127,16 @@ class StanceModel:
         return (tau[self.v_index].T * self.sign), tau[:6].T.copy()
 
     def acceleration_difference(self, angles: np.ndarray, tau_f: np.ndarray, joints: np.ndarray) -> np.ndarray:
-        """``Delta qdd = M_mod^{-1} tau_f`` (5.12) in single support.
+        """``Delta qdd = M_mod^{-1} tau_f`` (5.12) in single support, batched over samples.
 
         ``M_mod`` is the block of ``joints`` in the mass matrix of the tree rooted at the welded
         contact frame, the other actuated joints held to their measured accelerations
-        (:meth:`joint_mass_matrix`). Per sample, Pinocchio factors the whole mass matrix of the
-        tree with its root locked, exploiting the tree's sparsity (``crba``,
-        ``cholesky.decompose``), and solves ``x = M^{-1} [tau_f; 0]`` and, for each held joint
-        ``p``, ``M^{-1} e_p``; the block-inverse identity
-        ``(M_tt)^{-1} = (M^{-1})_tt - (M^{-1})_tp ((M^{-1})_pp)^{-1} (M^{-1})_pt`` then removes
-        the held joints exactly (one small batched solve).
+        (:meth:`joint_mass_matrix`). With the velocity and gravity zero, the forward dynamics of that
+        tree with the held joints locked gives exactly ``M_mod^{-1} tau_f``: one articulated-body pass
+        per sample (``pin.abaInParallel``, a C++ loop; :meth:`_held_pool`). The held joints are locked
+        where each sample has them (their angles move: a head turns), by an armature so large
+        (:data:`LOCKED_ARMATURE`) that the articulated-body algorithm passes their child's inertia on
+        whole and gives them no acceleration, to machine precision.
 
         Args:
             angles: joint positions of the actuated joints (N, n_act) [rad].
@@ -140,33 +147,34 @@ class StanceModel:
         Returns:
             (N, m) [rad/s^2], original joint signs.
         """
-        model, data, v_index = self._locked_root()
+        model, v_index = self._locked_root()
+        pool = self._held_pool(joints)
         n = angles.shape[0]
-        held = np.setdiff1d(np.arange(len(self.v_index)), joints)
         q = self.layout.configuration(angles, None, self.sign)[:, self.layout.root_nq:]
-        u = np.zeros(model.nv)
-        units = np.eye(model.nv)[v_index[held]]
-        x = np.empty((n, model.nv, 1 + len(held)))
-        signed = tau_f * self.sign[joints]
-        for k in range(n):
-            pin.crba(model, data, q[k])
-            pin.cholesky.decompose(model, data)
-            u[v_index[joints]] = signed[k]
-            x[k, :, 0] = pin.cholesky.solve(model, data, u)
-            for i, e in enumerate(units):
-                x[k, :, 1 + i] = pin.cholesky.solve(model, data, e)
-        x_t = x[:, v_index[joints], 0]
-        if len(held):
-            x_p = x[:, v_index[held], 0]
-            B, D = x[:, v_index[joints], 1:], x[:, v_index[held], 1:]
-            x_t = x_t - (B @ np.linalg.solve(D, x_p[..., None]))[..., 0]
-        return x_t * self.sign[joints]
+        tau = np.zeros((model.nv, n), order="F")
+        tau[v_index[joints]] = (tau_f * self.sign[joints]).T
+        qdd = pin.abaInParallel(1, pool, np.asfortranarray(q.T), np.zeros((model.nv, n), order="F"), tau)
+        return np.asarray(qdd).reshape(model.nv, n)[v_index[joints]].T * self.sign[joints]
+
+    def _held_pool(self, joints: np.ndarray) -> pin.ModelPool:
+        """A one-thread pool of the locked-root tree (:meth:`_locked_root`) without gravity, every actuated
+        joint not in ``joints`` (indices into :attr:`Robot.actuated`) held by :data:`LOCKED_ARMATURE`; built
+        once per set of free joints."""
+        key = tuple(int(j) for j in np.sort(joints))
+        if key not in self._held_pools:
+            locked, v_index = self._locked_root()
+            model = pin.Model(locked)
+            model.gravity = pin.Motion.Zero()
+            held = np.setdiff1d(np.arange(len(self.v_index)), key)
+            model.armature[v_index[held]] = LOCKED_ARMATURE
+            self._held_pools[key] = pin.ModelPool(model, 1)
+        return self._held_pools[key]
 
     def momentum(self, angles: np.ndarray, qd: np.ndarray, frame_pose: np.ndarray | None = None,
                  progress: Progress | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The generalized momentum ``p = M qd`` and its rate without friction ``b = C^T qd - g`` of the
-        actuated joints on the tree rooted at the welded contact frame
-        (:func:`~wbfriction.model.momentum.momentum_and_drift`): ``dp/dt = tau + tau_f + b`` row by row.
+        actuated joints on the tree rooted at the welded contact frame, all samples at once
+        (:func:`~wbfriction.model.momentum.tree_momentum_and_drift`): ``dp/dt = tau + tau_f + b`` row by row.
 
         Args:
             angles, qd: joint positions [rad] and velocities [rad/s] of the actuated joints (N, n_act).
@@ -177,25 +185,29 @@ class StanceModel:
         Returns:
             ``(p, b)``, (N, n_act) each [N·m·s], [N·m], in the original joints' signs.
         """
-        model, _, v_index = self._locked_root()
+        model, v_index = self._locked_root()
         q = self.layout.configuration(angles, None, self.sign)[:, self.layout.root_nq:]
         v = np.zeros((len(angles), model.nv))
         v[:, v_index] = qd * self.sign
         gravity = None
-        if frame_pose is not None:  # R^T g: world gravity in the foot's frame
-            R = np.array([pin.XYZQUATToSE3(x).rotation for x in frame_pose])
-            gravity = np.einsum("nji,j->ni", R, self.model.gravity.linear)
-        p, b, _ = momentum_and_drift(model, q, v, gravity=gravity, progress=progress)
+        if frame_pose is not None:  # R^T g: world gravity in the foot's frame, R the unit quaternion's rotation
+            axis, w = frame_pose[:, 3:6], frame_pose[:, 6:]
+            g = np.broadcast_to(self.model.gravity.linear, axis.shape)
+            turn = np.cross(axis, g)
+            gravity = g - 2.0 * w * turn + 2.0 * np.cross(axis, turn)
+        p, b = tree_momentum_and_drift(model, q, v, gravity)
+        if progress is not None:
+            progress(len(angles))
         return p[:, v_index] * self.sign, b[:, v_index] * self.sign
 
-    def _locked_root(self) -> tuple[pin.Model, pin.Data, np.ndarray]:
-        """The tree with its root joint locked (the contact frame welded), its data, and the velocity
-        index in it of each actuated joint; built once."""
+    def _locked_root(self) -> tuple[pin.Model, np.ndarray]:
+        """The tree with its root joint locked (the contact frame welded) and the velocity index in it of each
+        actuated joint (n_act,); built once."""
         if self._locked is None:
             locked = pin.buildReducedModel(self.model, [1], pin.neutral(self.model))
             name_of_v = {int(self.model.idx_vs[j]): self.model.names[j] for j in range(2, self.model.njoints)}
             v_index = [locked.idx_vs[locked.getJointId(name_of_v[int(v)])] for v in self.v_index]
-            self._locked = (locked, locked.createData(), np.array(v_index, dtype=int))
+            self._locked = (locked, np.array(v_index, dtype=int))
         return self._locked
 
     def joint_mass_matrix(self, angles: np.ndarray, joints: np.ndarray) -> np.ndarray:
@@ -320,10 +332,27 @@ def stance_frame_pose(robot: Robot, stance: StanceModel, angles: np.ndarray, bas
     pose[:, 6] = 1.0
     if base is None:
         return pose
-    model, data = robot.model, robot.model.createData()
-    fid = model.getFrameId(stance.frame)
-    q = robot.configuration(angles, base)
+    model, columns, fid = foot_chain(robot, stance.frame)
+    data = model.createData()
+    q = robot.configuration(angles, base)[:, columns]
     for k in range(n):
         pin.forwardKinematics(model, data, q[k])
         pose[k] = pin.SE3ToXYZQUAT(pin.updateFramePlacement(model, data, fid))
     return pose
+
+
+def foot_chain(robot: Robot, frame: str) -> tuple[pin.Model, np.ndarray, int]:
+    """The chain of ``robot.model`` from its root to contact frame ``frame``: every joint off it locked
+    (``pin.buildReducedModel``; the chain's placements are the model's own, so forward kinematics places the frame
+    to the same bits in a fifth of the time on a humanoid), the columns of a configuration of ``robot`` (nq,) that
+    make one of the chain (its nq,), and the frame's id in it; built once per frame."""
+    key = ("foot chain", frame)
+    if key not in robot.cache:
+        model = robot.model
+        chain = set(model.supports[model.frames[model.getFrameId(frame)].parentJoint])
+        locked = [j for j in range(1, model.njoints) if j not in chain]
+        reduced = pin.buildReducedModel(model, locked, pin.neutral(model))
+        columns = np.concatenate([np.arange(model.idx_qs[j], model.idx_qs[j] + model.nqs[j])
+                                  for j in (model.getJointId(reduced.names[i]) for i in range(1, reduced.njoints))])
+        robot.cache[key] = (reduced, columns, reduced.getFrameId(frame))
+    return robot.cache[key]

@@ -37,7 +37,15 @@ from wbfriction.logs.source import LogSource, open_log
 from wbfriction.logs.tables import TableFile, read_metadata, scratch_folder, with_metadata, write_tables
 from wbfriction.model.loading import load_robot
 from wbfriction.model.robot import Robot
-from wbfriction.pipeline.chunks import CONTEXT, Chunk, Chunking, chunk_rows, plan_chunks, plan_columns
+from wbfriction.pipeline.chunks import (
+    CONTEXT,
+    Chunk,
+    Chunking,
+    chunk_rows,
+    plan_chunks,
+    plan_columns,
+    release_freed_memory,
+)
 from wbfriction.pipeline.provenance import log_provenance
 from wbfriction.progress import Progress, StageProgress
 from wbfriction.workers import process_pool
@@ -161,6 +169,7 @@ def _with_provenance(tables: Iterator[pa.Table], chunks: list[Chunk], robot: Rob
             first_meta.update(meta)
             table = with_metadata(table, meta)
         yield table
+        release_freed_memory()  # the chunk just written, its rows read and sent
         if progress is not None:
             progress(chunks[k].stop - chunks[k].start)
     if not single:
@@ -252,6 +261,7 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     n = len(contact)
     chunks = plan_chunks(contact, chunking)
     del contact
+    release_freed_memory()  # the whole log's columns the plan read
     reader = file.row_reader(max(1024, min(chunking.rows, 65_536)))
     first_meta: dict = {}
     valid: dict[str, int] = {}

@@ -68,7 +68,7 @@ from wbfriction.logs.clock import longest_segment
 from wbfriction.logs.log import Log
 from wbfriction.signals.filters import ZeroPhaseLowpass, savgol_kernels
 from wbfriction.signals.options import FilterOptions, SavgolWeights
-from wbfriction.signals.spectrum import amplitude_spectrum, longest_run, suggest_cutoff
+from wbfriction.signals.spectrum import amplitude_spectrum, longest_run, periodic_hann, suggest_cutoff
 
 ChosenScheme = Literal["central", "savgol", "butterworth"]
 """What :func:`choose_differentiation` picks."""
@@ -121,11 +121,10 @@ def white_position_noise(acc: np.ndarray, dt: float, frame: int = FRAME) -> np.n
     half-overlapping Hann-tapered frame of ``frame`` samples, the median over the upper half of the band of
     ``(amplitude / |G|)^2`` (a white noise's power per bin is exponential: its median is ``ln 2`` times its mean),
     then the median over the frames. Fewer rows than a frame: one frame of them all (even length)."""
-    from scipy.signal.windows import hann
     acc = np.asarray(acc, dtype=float)
     length = min(frame, len(acc) - len(acc) % 2)
     frames = sliding_window_view(acc, length, axis=0)[::length // 2]  # (M, n, L)
-    tapered = np.moveaxis(frames, -1, 0) * hann(length, sym=False)[:, None, None]
+    tapered = np.moveaxis(frames, -1, 0) * periodic_hann(length)[:, None, None]
     freq, amp = amplitude_spectrum(tapered, dt)  # (F, M, n)
     gain = tapered_gain(second_difference_gain(freq, dt))
     upper = freq >= freq[-1] / 2
@@ -179,7 +178,6 @@ def acceleration_content(q: np.ndarray, dt: float, tail: float = 0.01, segment: 
         InputError: fewer than ``MIN_SEGMENT (MIN_SEGMENTS + 1) / 2 + 2`` = 258 finite rows
             in a row, a non-positive ``dt`` or ``segment``, ``tail`` outside (0, 1).
     """
-    from scipy.signal.windows import hann
     q = np.asarray(q, dtype=float)
     if q.ndim == 1:
         q = q[:, None]
@@ -193,7 +191,7 @@ def acceleration_content(q: np.ndarray, dt: float, tail: float = 0.01, segment: 
     x = q[a:b]
     acc = (x[2:] - 2.0 * x[1:-1] + x[:-2]) / dt**2
     windows = sliding_window_view(acc, seg, axis=0)[::seg // 2]  # (M, n, seg)
-    tapered = np.moveaxis(windows, -1, 0) * hann(seg, sym=False)[:, None, None]
+    tapered = np.moveaxis(windows, -1, 0) * periodic_hann(seg)[:, None, None]
     freq, amp = amplitude_spectrum(tapered, dt)  # (F, M, n)
     amp = np.sqrt(np.mean(amp**2, axis=1))
     gain = tapered_gain(second_difference_gain(freq, dt))

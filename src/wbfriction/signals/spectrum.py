@@ -22,6 +22,18 @@ from wbfriction.signals.filters import finite_runs
 from wbfriction.signals.kinematics import measure
 
 
+def periodic_hann(length: int) -> np.ndarray:
+    """The periodic Hann window (length,), ``0.5 - 0.5 cos(2 pi k / length)``: ``scipy.signal.windows.hann(length,
+    sym=False)`` to the last bit (the same operations), without importing ``scipy.signal``."""
+    if length <= 1:
+        return np.ones(max(length, 0))
+    angle = np.linspace(-np.pi, np.pi, length + 1)
+    w = np.zeros(length + 1)
+    for k, a in enumerate((0.5, 0.5)):  # scipy's general cosine window, term by term
+        w += a * np.cos(k * angle)
+    return w[:-1]
+
+
 def amplitude_spectrum(x: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """One-sided amplitude spectrum of ``x`` (N_samples, ...) along axis 0 (Fig. 7.1).
 
