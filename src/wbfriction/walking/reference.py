@@ -171,7 +171,8 @@ class _WholeBodyIK:
     Every per-sample array lives in a buffer made once (the Jacobian, the error, the Newton step, the drift)
     and the task blocks are views into them; the soles' and the base's placements, the centre of mass and its
     acceleration are read through views of ``data`` taken once (Pinocchio fills its containers in place, so
-    the views follow every kinematics call). A sample then costs Pinocchio's kinematics and a few small
+    the views follow every kinematics call; were they ever copies, the error would not fall and the Newton
+    iterations would raise, not mislead). A sample then costs Pinocchio's kinematics and a few small
     products, not allocations, slicing and attribute look-ups. Small matrix products go through
     ``ndarray.dot``, which calls the same BLAS routine as ``@`` without the ``matmul`` ufunc's dispatch (the
     same bits, a fifth of the time at 3 x 3).
@@ -307,7 +308,7 @@ def walking_reference(robot: Robot, options: GaitOptions = GaitOptions(), dt: fl
     V = np.empty((n, model.nv))
     A = np.empty((n, model.nv))
     q, v, a = q0, np.zeros(model.nv), np.zeros(model.nv)
-    half_dt2 = 0.5 * dt**2  # a * (dt^2 / 2) has the bits of (a / 2) * dt^2: both halvings are exact
+    half_dt2 = 0.5 * dt**2  # a * (dt^2 / 2) has the bits of (a / 2) * dt^2: both halvings are exact (no subnormals)
     step = np.empty(model.nv)
     for k in counted(n, progress):  # each sample starts from the previous one's motion
         np.multiply(v, dt, out=step)
