@@ -194,7 +194,7 @@ class _WholeBodyIK:
         self.iq_free = as_slice(robot.act_q_index[self.free_act])
         self.frames = robot.contact_frame_ids
         nv = self.model.nv
-        self._J = np.empty((18, nv))
+        self._J = np.zeros((18, nv))  # the base rows stay zero but for the base's angular columns
         self._e = np.empty(18)
         self._abs_e = np.empty(18)
         self._dv = np.zeros(nv)  # the Newton step: zero on the joints the IK does not solve
@@ -202,25 +202,28 @@ class _WholeBodyIK:
         self._zero = np.zeros(nv)
         J, e, drift = self._J, self._e, self._drift
         self._J_soles = (J[0:6], J[6:12])
-        self._J_com, self._J_base = J[12:15], J[15:18]
+        self._J_com, self._J_base = J[12:15], J[15:18, 3:6]
         self._e_soles = ((e[0:3], e[3:6]), (e[6:9], e[9:12]))
         self._e_com, self._e_base = e[12:15], e[15:18]
         self._drift_soles, self._drift_com = (drift[0:6], drift[6:12]), drift[12:15]
         oMf, data = self.data.oMf, self.data
         # live views: world positions (3,) and transposed rotations (3, 3) of the soles and of the base
         self._soles = tuple((oMf[f].translation, oMf[f].rotation.T) for f in self.frames)
-        self._base_RT = data.oMi[1].rotation.T
+        self._base_R = data.oMi[1].rotation
+        self._base_RT = self._base_R.T
         self._com, self._acom = data.com[0], data.acom[0]
 
     def _jacobian(self) -> np.ndarray:
         """Task Jacobian (18, nv) at the configuration of the last ``computeJointJacobians``: sole poses, centre
         of mass, base rotation (a buffer, overwritten by the next call); places the soles (``data.oMf``) and
-        the centre of mass (``data.com[0]``)."""
+        the centre of mass (``data.com[0]``). The base's angular Jacobian in ``LOCAL_WORLD_ALIGNED`` is
+        ``[0 R 0]`` (the free-flyer's angular velocity is in its own frame, R its rotation): the rotation is
+        copied in, the bits of ``getJointJacobian``'s rows (tests/walking/test_unchanged_route.py)."""
         model, data = self.model, self.data
         for J_f, f in zip(self._J_soles, self.frames):  # getFrameJacobian also places the frame (data.oMf[f])
             J_f[:] = pin.getFrameJacobian(model, data, f, LWA)
         self._J_com[:] = pin.jacobianCenterOfMass(model, data, True)
-        self._J_base[:] = pin.getJointJacobian(model, data, 1, LWA)[3:]
+        self._J_base[:] = self._base_R
         return self._J
 
     def _error(self, tasks: _Tasks, k: int) -> np.ndarray:
