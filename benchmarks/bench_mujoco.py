@@ -11,7 +11,9 @@ every physics step, sensors logged) it prints, in wall and CPU seconds:
   torques and friction, the loop's floor), as the loop's ratio to it;
 * ``wbfriction simulate --gait combined --simulator mujoco``, process start to log written (best CPU of two runs),
   with its real-time factor, against its floor in this run: the reference (plan + IK) plus the physics alone
-  (``--reference SRC`` also times another checkout's ``src``, e.g. the code before a change).
+  (``--reference SRC`` also times another checkout's ``src``, e.g. the code before a change);
+* the reference (plan + IK) in a fresh process against the physics alone and, with ``--reference SRC``, against
+  the other checkout's (:func:`bench_simulate.print_reference_cpu`).
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import time
 from pathlib import Path
 
 import mujoco
-from bench_simulate import command
+from bench_simulate import command, print_reference_cpu
 
 from wbfriction.model.loading import load_robot
 from wbfriction.sim import MujocoOptions
@@ -91,6 +93,7 @@ def main() -> None:
     floor = t1[1] - t0[1] + physics_default
     print(f"wbfriction simulate --gait combined --simulator mujoco, best of 2; its floor in this run: the reference "
           f"plus the physics alone {floor:.2f} s (CPU), real-time factor {sim_time / floor:.1f}")
+    print_reference_cpu(args.reference, ("the physics alone", physics_default))
     codes = {"this checkout": None} if args.reference is None else {"this checkout": None, "reference": args.reference}
     with tempfile.TemporaryDirectory() as out:
         for code, src in codes.items():

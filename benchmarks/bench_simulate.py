@@ -13,6 +13,9 @@ time taken; CPU time is the steadier on a shared machine):
 * ``wbfriction simulate --gait combined`` (31.8 s walked), process start to log written, best CPU of two runs,
   against its floor measured in the same run: the combined walk's reference (plan + IK) plus the bare dynamics of
   its steps (``--reference SRC`` also times another checkout's ``src``, e.g. the code before a change);
+* the combined walk's reference (plan + IK) in a fresh process, CPU per sample, against the simulation of the
+  same walk (its floor's other half, the bare dynamics) and, with ``--reference SRC``, against the other
+  checkout's reference measured the same way (:func:`reference_cpu`);
 * with ``--demo``: the simulation as in the demo (10 physics steps per sample) and ``wbfriction demo``.
 """
 
@@ -63,6 +66,46 @@ def command(args: list[str], src: str | None = None, repeat: int = 2) -> tuple[f
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         runs.append((wall, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime))
     return min(runs, key=lambda r: r[1])
+
+
+REFERENCE_RUN = """
+import time
+from wbfriction.model.loading import load_robot
+from wbfriction.walking import GaitOptions, walking_reference
+robot = load_robot("talos")
+walking_reference(robot, GaitOptions(gait="forward", steps=1))  # imports and first calls out of the timing
+cpu = time.process_time()
+n = len(walking_reference(robot, GaitOptions(gait="combined", steps=10)))
+print(time.process_time() - cpu, n)
+"""
+
+
+def reference_cpu(src: str | None = None, repeat: int = 2) -> tuple[float, int]:
+    """CPU time [s] of the combined walk's reference (10 steps each way: plan, LIPM, whole-body IK) in a fresh
+    process, imports excluded, least of ``repeat``, and its number of samples; ``src``: another checkout's
+    ``src`` folder to run instead of this one."""
+    env = dict(os.environ) if src is None else {**os.environ, "PYTHONPATH": src}
+    runs = []
+    for _ in range(repeat):
+        out = subprocess.run([sys.executable, "-c", REFERENCE_RUN], check=True, capture_output=True, text=True,
+                             env=env).stdout.split()
+        runs.append((float(out[0]), int(out[1])))
+    return min(runs)
+
+
+def print_reference_cpu(src: str | None, versus: tuple[str, float] | None = None) -> None:
+    """Print the combined walk's reference CPU (:func:`reference_cpu`) of this checkout, per sample, against
+    ``versus`` (a label and a CPU time [s] measured in this run) and, given ``src``, against that checkout's."""
+    cpu, n = reference_cpu()
+    line = (f"  reference (plan + IK) of the combined walk, fresh process: {cpu:.2f} s CPU, "
+            f"{cpu / n * 1e6:.0f} us/sample")
+    if versus is not None:
+        line += f"; {cpu / versus[1]:.2f} x {versus[0]}"
+    print(line)
+    if src is not None:
+        before, _ = reference_cpu(src)
+        print(f"  [reference] the same: {before:.2f} s CPU, {before / n * 1e6:.0f} us/sample; this checkout "
+              f"{before / cpu:.2f} x faster")
 
 
 def bare_dynamics(robot: Robot, reference: WalkingReference, result: SimulationResult, impulse: bool = True,
@@ -128,11 +171,13 @@ def main() -> None:
 
     combined, w_cref, c_cref = timed(lambda: walking_reference(robot, GaitOptions(gait="combined", steps=10)))
     span = float(combined.time[-1])
-    w_cb, c_cb = bare_dynamics(robot, combined, simulate_ideal(robot, combined))
+    combined_sim, _, c_sim = timed(lambda: simulate_ideal(robot, combined))
+    w_cb, c_cb = bare_dynamics(robot, combined, combined_sim)
     floor = (w_cref + w_cb, c_cref + c_cb)
     print(f"wbfriction simulate --gait combined ({span:.1f} s walked), best of 2; its floor in this run: the "
           f"reference {w_cref:.2f} / {c_cref:.2f} s + the bare dynamics {w_cb:.2f} / {c_cb:.2f} s")
     report("floor (reference + bare dynamics)", *floor, span=span)
+    print_reference_cpu(args.reference, ("its simulation", c_sim))
     codes = {"this checkout": None} if args.reference is None else {"this checkout": None, "reference": args.reference}
     with tempfile.TemporaryDirectory() as out:
         for code, src in codes.items():

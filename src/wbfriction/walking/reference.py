@@ -166,7 +166,17 @@ def _solve(A: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 class _WholeBodyIK:
-    """The square IK of the module docstring for one robot."""
+    """The square IK of the module docstring for one robot.
+
+    Every per-sample array lives in a buffer made once (the Jacobian, the error, the Newton step, the drift)
+    and the task blocks are views into them; the soles' and the base's placements, the centre of mass and its
+    acceleration are read through views of ``data`` taken once (Pinocchio fills its containers in place, so
+    the views follow every kinematics call; were they ever copies, the error would not fall and the Newton
+    iterations would raise, not mislead). A sample then costs Pinocchio's kinematics and a few small
+    products, not allocations, slicing and attribute look-ups. Small matrix products go through
+    ``ndarray.dot``, which calls the same BLAS routine as ``@`` without the ``matmul`` ufunc's dispatch (the
+    same bits, a fifth of the time at 3 x 3).
+    """
 
     def __init__(self, robot: Robot):
         self.robot = robot
@@ -183,68 +193,80 @@ class _WholeBodyIK:
         self.rest = as_slice(iv[self.free_act])
         self.iq_free = as_slice(robot.act_q_index[self.free_act])
         self.frames = robot.contact_frame_ids
-        self._J = np.empty((18, self.model.nv))
+        nv = self.model.nv
+        self._J = np.zeros((18, nv))  # the base rows stay zero but for the base's angular columns
         self._e = np.empty(18)
+        self._abs_e = np.empty(18)
+        self._dv = np.zeros(nv)  # the Newton step: zero on the joints the IK does not solve
         self._drift = np.zeros(18)
-        self._zero = np.zeros(self.model.nv)
+        self._zero = np.zeros(nv)
+        J, e, drift = self._J, self._e, self._drift
+        self._J_soles = (J[0:6], J[6:12])
+        self._J_com, self._J_base = J[12:15], J[15:18, 3:6]
+        self._e_soles = ((e[0:3], e[3:6]), (e[6:9], e[9:12]))
+        self._e_com, self._e_base = e[12:15], e[15:18]
+        self._drift_soles, self._drift_com = (drift[0:6], drift[6:12]), drift[12:15]
+        oMf, data = self.data.oMf, self.data
+        # live views: world positions (3,) and transposed rotations (3, 3) of the soles and of the base
+        self._soles = tuple((oMf[f].translation, oMf[f].rotation.T) for f in self.frames)
+        self._base_R = data.oMi[1].rotation
+        self._base_RT = self._base_R.T
+        self._com, self._acom = data.com[0], data.acom[0]
 
-    def _jacobian(self, q: np.ndarray) -> np.ndarray:
-        """Task Jacobian (18, nv): sole poses, centre of mass, base rotation (a buffer, overwritten
-        by the next call); leaves the soles' placements and the centre of mass in ``data``."""
-        model, data, J = self.model, self.data, self._J
-        pin.computeJointJacobians(model, data, q)
-        for i, f in enumerate(self.frames):  # getFrameJacobian also places the frame (data.oMf[f])
-            J[6 * i:6 * i + 6] = pin.getFrameJacobian(model, data, f, LWA)
-        J[12:15] = pin.jacobianCenterOfMass(model, data, True)
-        J[15:18] = pin.getJointJacobian(model, data, 1, LWA)[3:]
-        return J
+    def _jacobian(self) -> np.ndarray:
+        """Task Jacobian (18, nv) at the configuration of the last ``computeJointJacobians``: sole poses, centre
+        of mass, base rotation (a buffer, overwritten by the next call); places the soles (``data.oMf``) and
+        the centre of mass (``data.com[0]``). The base's angular Jacobian in ``LOCAL_WORLD_ALIGNED`` is
+        ``[0 R 0]`` (the free-flyer's angular velocity is in its own frame, R its rotation): the rotation is
+        copied in, the bits of ``getJointJacobian``'s rows (tests/walking/test_unchanged_route.py)."""
+        model, data = self.model, self.data
+        for J_f, f in zip(self._J_soles, self.frames):  # getFrameJacobian also places the frame (data.oMf[f])
+            J_f[:] = pin.getFrameJacobian(model, data, f, LWA)
+        self._J_com[:] = pin.jacobianCenterOfMass(model, data, True)
+        self._J_base[:] = self._base_R
+        return self._J
 
     def _error(self, tasks: _Tasks, k: int) -> np.ndarray:
-        """Task error (18,) at sample ``k`` after :meth:`_jacobian` (a buffer, overwritten by the next call)."""
-        data, e, oMf = self.data, self._e, self.data.oMf
-        sole_R, sole_p = tasks.sole_R[k], tasks.sole_p[k]
-        for i, f in enumerate(self.frames):
-            M = oMf[f]
-            e[6 * i:6 * i + 3] = sole_p[i] - M.translation
-            e[6 * i + 3:6 * i + 6] = pin.log3(sole_R[i] @ M.rotation.T)
-        e[12:15] = tasks.com[k] - data.com[0]
-        e[15:18] = pin.log3(tasks.base_R[k] @ data.oMi[1].rotation.T)
-        return e
+        """Task error (18,) at sample ``k`` after :meth:`_jacobian` (a buffer, overwritten by the next call):
+        target minus actual position [m], ``log3(R_target R^T)`` [rad] for the rotations."""
+        for (e_p, e_R), (p, RT), p_ref, R_ref in zip(self._e_soles, self._soles, tasks.sole_p[k], tasks.sole_R[k]):
+            np.subtract(p_ref, p, out=e_p)
+            e_R[:] = pin.log3(R_ref.dot(RT))
+        np.subtract(tasks.com[k], self._com, out=self._e_com)
+        self._e_base[:] = pin.log3(tasks.base_R[k].dot(self._base_RT))
+        return self._e
 
-    def solve(self, q_guess: np.ndarray, tasks: _Tasks, k: int, tol: float = 1e-11, max_iter: int = 20
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Configuration (nq,), velocity and acceleration (nv,) at sample ``k`` (see module docstring),
-        by Newton iterations from ``q_guess`` (overwritten)."""
-        model, data, sel, rest = self.model, self.data, self.sel, self.rest
-        free_q, free_qd, free_qdd = (x[k] for x in tasks.free)
+    def solve(self, q_guess: np.ndarray, tasks: _Tasks, k: int, v: np.ndarray, a: np.ndarray,
+              tol: float = 1e-11, max_iter: int = 20) -> np.ndarray:
+        """Configuration (nq,) at sample ``k`` (see module docstring), by Newton iterations from ``q_guess``
+        (overwritten); its velocity and acceleration (nv,) written into ``v`` and ``a``."""
+        model, data, sel, rest, dv = self.model, self.data, self.sel, self.rest, self._dv
+        free_q, free_qd, free_qdd = tasks.free
         q = q_guess
-        q[self.iq_free] = free_q
+        q[self.iq_free] = free_q[k]
         for _ in range(max_iter):
-            J = self._jacobian(q)
+            pin.computeJointJacobians(model, data, q)
+            J = self._jacobian()
             e = self._error(tasks, k)
-            if abs(e).max() < tol:
+            abs_e = np.abs(e, out=self._abs_e)
+            if abs_e[abs_e.argmax()] < tol:  # max |e| (nan if any is), without ufunc.reduce's set-up
                 break
-            dv = np.zeros(model.nv)
             dv[sel] = _solve(J[:, sel], e)
             q = pin.integrate(model, q, dv)
         else:
             raise ModelError(f"whole-body IK did not converge (residual {np.max(np.abs(e)):.2e}): "
                              "is the step reachable?")
-        Js, Jr = J[:, sel], J[:, rest]
-        Js_inv = _umath_linalg.inv(Js)
-        v = np.zeros(model.nv)
-        v[rest] = free_qd
-        v[sel] = Js_inv @ (tasks.xd[k] - Jr @ free_qd)
+        Js_inv, Jr = _umath_linalg.inv(J[:, sel]), J[:, rest]
+        v[rest] = free_qd[k]
+        v[sel] = Js_inv.dot(tasks.xd[k] - Jr.dot(free_qd[k]))
         # drift Jd v: classical accelerations at zero joint acceleration
         pin.centerOfMass(model, data, q, v, self._zero)
-        drift = self._drift
-        for i, f in enumerate(self.frames):
-            drift[6 * i:6 * i + 6] = pin.getFrameClassicalAcceleration(model, data, f, LWA).vector
-        drift[12:15] = data.acom[0]
-        a = np.zeros(model.nv)
-        a[rest] = free_qdd
-        a[sel] = Js_inv @ (tasks.xdd[k] - drift - Jr @ free_qdd)
-        return q, v, a
+        for d, f in zip(self._drift_soles, self.frames):
+            d[:] = pin.getFrameClassicalAcceleration(model, data, f, LWA).vector
+        self._drift_com[:] = self._acom
+        a[rest] = free_qdd[k]
+        a[sel] = Js_inv.dot(tasks.xdd[k] - self._drift - Jr.dot(free_qdd[k]))
+        return q
 
 
 def walking_reference(robot: Robot, options: GaitOptions = GaitOptions(), dt: float = 1e-3,
@@ -289,8 +311,11 @@ def walking_reference(robot: Robot, options: GaitOptions = GaitOptions(), dt: fl
     V = np.empty((n, model.nv))
     A = np.empty((n, model.nv))
     q, v, a = q0, np.zeros(model.nv), np.zeros(model.nv)
-    dt2 = dt**2
+    half_dt2 = 0.5 * dt**2  # a * (dt^2 / 2) has the bits of (a / 2) * dt^2: both halvings are exact (no subnormals)
+    step = np.empty(model.nv)
     for k in counted(n, progress):  # each sample starts from the previous one's motion
-        q, v, a = ik.solve(pin.integrate(model, q, v * dt + 0.5 * a * dt2), tasks, k)
-        Q[k], V[k], A[k] = q, v, a
+        np.multiply(v, dt, out=step)
+        step += a * half_dt2
+        v, a = V[k], A[k]
+        Q[k] = q = ik.solve(pin.integrate(model, q, step), tasks, k, v, a)
     return WalkingReference(time, Q, V, A, plan.contact(time), feet, com, zmp, plan)
