@@ -8,6 +8,7 @@ Each route that changed is checked against the previous one, recomputed here inl
 * the prior's fits for every weight from one decomposition against the stacked ``2p`` rows (bounded least
   squares, and the conic solve's quadratic form from their QR);
 * the given model's best friction by a triangular solve where it keeps the bounds against BVLS everywhere;
+* the stance regressor's rows (taken into place) against the per-sample loop, to the byte;
 
 and the whole identification with all the previous routes swapped in, on the Panda (armature identified) and on
 a TALOS walk (two stances): the same choices (prior, number of base parameters and of parameters not excited,
@@ -20,6 +21,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+import pinocchio as pin
 import pytest
 import scipy.linalg
 from scipy.optimize import lsq_linear
@@ -143,6 +145,22 @@ def test_joint_compression_has_the_whole_rows_normal_equations(walk_case):
         Y = identification._rows(robot, part.kin, rows, c, options)[0]
         pattern = stance_regressor(robot, c).pattern[robot.tc_index]
         assert not np.any(Y[:, ~pattern])
+
+
+def test_joint_rows_are_the_per_sample_loops_bytes(talos):
+    """The stance regressor's rows taken into place: the bytes of the previous loop (each sample's actuated rows
+    indexed, then the signs)."""
+    reg = stance_regressor(talos, 0)
+    st, rng = reg.stance, np.random.default_rng(0)
+    angles, qd, qdd = (rng.normal(0.0, s, (20, len(talos.actuated))) for s in (0.2, 1.0, 10.0))
+    pose = np.tile([0.1, 0.2, 0.0, 0.0, 0.0, 0.0, 1.0], (20, 1))
+    q = st.layout.configuration(angles, pose, st.sign)
+    previous = np.empty((20, len(st.v_index), 10 * (st.model.njoints - 1)))
+    v, a = np.zeros(st.model.nv), np.zeros(st.model.nv)
+    for k in range(20):
+        v[st.v_index], a[st.v_index] = qd[k] * st.sign, qdd[k] * st.sign
+        previous[k] = pin.computeJointTorqueRegressor(st.model, reg.data, q[k], v, a)[st.v_index]
+    assert np.array_equal(reg.joint_rows(pose, angles, qd, qdd), previous * st.sign[None, :, None])
 
 
 @pytest.mark.parametrize("seed", range(4))

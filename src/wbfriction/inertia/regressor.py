@@ -90,13 +90,14 @@ class StanceRegressor:
         q = st.layout.configuration(angles, frame_pose, st.sign)
         n = angles.shape[0]
         Y = np.empty((n, len(st.v_index), 10 * (model.njoints - 1)))
-        v = np.zeros(model.nv)
-        a = np.zeros(model.nv)
-        for k in range(n):
-            v[st.v_index] = qd[k] * st.sign
-            a[st.v_index] = qdd[k] * st.sign
-            Y[k] = pin.computeJointTorqueRegressor(model, self.data, q[k], v, a)[st.v_index]
-        return Y * st.sign[None, :, None]
+        v = np.zeros((n, model.nv))
+        a = np.zeros((n, model.nv))
+        v[:, st.v_index] = qd * st.sign
+        a[:, st.v_index] = qdd * st.sign
+        for k in range(n):  # the actuated rows taken straight into Y (one copy)
+            np.take(pin.computeJointTorqueRegressor(model, self.data, q[k], v[k], a[k]), st.v_index, axis=0, out=Y[k])
+        Y *= st.sign[None, :, None]
+        return Y
 
 
 def structural_pattern(stance: StanceModel, data: pin.Data, states: int = 3) -> np.ndarray:
