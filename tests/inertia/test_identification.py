@@ -18,11 +18,11 @@ from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.inertia.consistency import (
     PHYSICAL,
+    RegularisedProblem,
     fit_consistent,
     is_consistent,
     nearest_consistent,
     prior_model,
-    regularised_problem,
 )
 from wbfriction.inertia.identification import identify_inertia, log_samples, residual_variance
 from wbfriction.inertia.least_squares import CompressedLeastSquares, base_parameters
@@ -129,7 +129,7 @@ def test_residual_variance_is_the_base_parameters_whatever_the_blocks(seed, bloc
     ls = CompressedLeastSquares(p)
     for k in range(0, n, block):
         ls.add(A[k:k + block], b[k:k + block])
-    base = base_parameters(ls.R)
+    base = ls.base_parameters()
     assert base.count == p - dependent
     independent = A[:, base.independent]
     r = b - independent @ np.linalg.lstsq(independent, b, rcond=None)[0]
@@ -190,10 +190,10 @@ def test_consistent_fit_keeps_friction_physical_and_beats_the_truth(body, seed, 
     fit = fit_consistent(ls.R, ls.z, prior, 1e-6, lower)
     assert fit.rest[0] >= 0 and fit.rest[1] >= 0
     assert is_consistent(fit.pi).all()
-    _, A, c = regularised_problem(ls.R, ls.z, prior, 1e-6, lower)
+    problem = RegularisedProblem(ls.R, ls.z, prior, lower)
 
     def objective(pi, friction):
-        return float(np.sum((A @ np.concatenate([pi.ravel(), friction.ravel()]) - c) ** 2))
+        return problem.objective(np.concatenate([pi.ravel(), friction.ravel()]), 1e-6)
 
     assert objective(fit.pi, fit.rest) <= objective(pi_true, friction_true) * (1 + 1e-6)
     assert fit.cost == pytest.approx(0.5 * objective(fit.pi, fit.rest), rel=1e-4)

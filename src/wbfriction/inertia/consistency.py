@@ -191,31 +191,112 @@ def friction_lower_bounds(k: int, n_tc: int) -> np.ndarray:
     return np.tile([FRICTION_LOWER[n] for n in (*FRICTION, STRIBECK)[:k]], n_tc)
 
 
-def regularised_problem(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float,
-                        lower: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`fit_consistent`'s objective ``|A x - c|^2`` (``A`` (2p, p), ``c`` (2p,)) and its minimum
-    ``x_lin`` without the bodies' consistency constraint, with the bounds ``lower`` (p,) on the
-    parameters after the bodies' (a bounded linear least squares, solved in standard deviations of
-    the prior: ``x = x0 + L^-1 y``)."""
-    from scipy.optimize import lsq_linear
-    A, c, Ay, cy = _standardised(R, z, prior, weight)
-    lo = _lower_in_std(prior, lower)
-    if np.isfinite(lo).any():
-        y = lsq_linear(Ay, cy, bounds=(lo, np.inf), method="bvls").x
-    else:
-        y = np.linalg.lstsq(Ay, cy, rcond=None)[0]
-    return prior.x0 + prior.L_inv @ y, A, c
+class RegularisedProblem:
+    """:func:`fit_consistent`'s objective ``|R x - z|^2 + w |L (x - x0)|^2`` for any prior weight ``w``, set up once.
 
+    In standard deviations of the prior (``x = x0 + L^-1 y``) it is ``|B y - c0|^2 + w |y|^2`` with ``B = R L^-1``
+    and ``c0 = z - R x0``: Tikhonov's standard form. One singular value decomposition ``B = U diag(s) V^T``
+    serves every weight (Hansen, *Rank-Deficient and Discrete Ill-Posed Problems*, SIAM 1998, sec. 4.2; the
+    generalized SVD of the pair ``(R, L)`` in the prior's coordinates): the unbounded minimum is
+    ``y(w) = V diag(s / (s^2 + w)) U^T c0``, and the objective is ``|T_w y - e_w|^2`` plus a constant, with
+    ``T_w = diag(sqrt(s^2 + w)) V^T`` (p, p) and ``e_w = diag(s / sqrt(s^2 + w)) U^T c0``: the bounded and the
+    conic solves of a weight start from these, not from the ``2p`` stacked rows. Choosing the weight by
+    validation (:mod:`wbfriction.inertia.identification`) solves one problem per weight on one decomposition.
 
-def _standardised(R: np.ndarray, z: np.ndarray, prior: Prior,
-                  weight: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The objective ``|A x - c|^2`` and the same in standard deviations of the prior, ``|A_y y - c_y|^2``
-    with ``x = x0 + L^-1 y``."""
-    w = np.sqrt(weight)
-    L = prior.L
-    A, c = np.vstack([R, w * L]), np.concatenate([z, w * (L @ prior.x0)])
-    Ay = np.vstack([R @ prior.L_inv, w * np.eye(len(prior.x0))])
-    return A, c, Ay, c - A @ prior.x0
+    Args:
+        R, z: the compressed regressor (m, p) and right-hand side (m,), columns ordered as ``x``.
+        prior: the given model and its uncertainty.
+        lower: lower bounds (p,) (those of the bodies' parameters are ignored).
+    """
+
+    def __init__(self, R: np.ndarray, z: np.ndarray, prior: Prior, lower: np.ndarray):
+        import scipy.linalg
+        self.R, self.z, self.prior, self.lower = R, z, prior, lower
+        self.L, self.L_inv = prior.L, prior.L_inv
+        B = R @ self.L_inv
+        U, sv, self.Vt = scipy.linalg.svd(B, full_matrices=True)
+        p = len(prior.x0)
+        self.s = np.zeros(p)
+        self.s[:sv.size] = sv
+        self.d = np.zeros(p)  # U^T c0, in the directions of V
+        self.d[:sv.size] = (U.T @ (z - R @ prior.x0))[:sv.size]
+        self.lo = _lower_in_std(prior, lower)
+
+    def compressed(self, weight: float) -> tuple[np.ndarray, np.ndarray]:
+        """``T_w`` (p, p) and ``e_w`` (p,): the objective of weight ``weight`` in standard deviations, up to a
+        constant (class docstring)."""
+        root = np.sqrt(self.s ** 2 + weight)
+        return root[:, None] * self.Vt, self.s * self.d / root
+
+    def linear(self, weight: float) -> np.ndarray:
+        """The minimum ``x`` (p,) without the bodies' consistency constraint, with the bounds on the parameters
+        after the bodies': the unbounded minimum where it keeps them, else a bounded linear least squares on
+        the compressed objective (:meth:`compressed`)."""
+        y = self.Vt.T @ (self.s * self.d / (self.s ** 2 + weight))
+        if np.any(y < self.lo):
+            from scipy.optimize import lsq_linear
+            T, e = self.compressed(weight)
+            y = lsq_linear(T, e, bounds=(self.lo, np.inf), method="bvls").x
+        return self.prior.x0 + self.L_inv @ y
+
+    def objective(self, x: np.ndarray, weight: float) -> float:
+        """``|R x - z|^2 + weight |L (x - x0)|^2``."""
+        r, q = self.R @ x - self.z, self.L @ (x - self.prior.x0)
+        return float(r @ r + weight * (q @ q))
+
+    def conic(self, weight: float, margin: float = 0.0) -> tuple[np.ndarray, SolverOutcome]:
+        """The exact minimum over positive-semidefinite pseudo-inertias and the bounds: a convex quadratic program
+        with one 4 x 4 semidefinite cone per body (the linear matrix inequality of Wensing et al. 2018, about
+        ``J(pi) - margin J(pi_0)``), solved by Clarabel's interior-point method in standard deviations of the
+        prior (its quadratic form ``T_w^T T_w = B^T B + w 1``, :meth:`compressed`)."""
+        import clarabel
+        import scipy.sparse as sp
+        prior = self.prior
+        T, e = self.compressed(weight)
+        p, nb = len(prior.x0), prior.nb
+        G = _svec_pseudo_inertia()
+        blocks, b = [], []
+        for k, root in enumerate(prior.bodies):  # J(pi_b) - margin J(x0_b) = (1 - margin) J(x0_b) + G L_b^-1 y_b
+            row = np.zeros((10, p))
+            row[:, 10 * k:10 * k + 10] = -G @ np.linalg.inv(root)
+            blocks.append(row)
+            b.append((1.0 - margin) * (G @ prior.x0[10 * k:10 * k + 10]))
+        bounded = np.flatnonzero(np.isfinite(self.lo))  # y_i >= lo_i: -y_i + s = -lo_i, s >= 0
+        blocks.append(-np.eye(p)[bounded])
+        b.append(-self.lo[bounded])
+        cones = ([clarabel.PSDTriangleConeT(4)] * nb
+                 + ([clarabel.NonnegativeConeT(len(bounded))] if len(bounded) else []))
+        settings = clarabel.DefaultSettings()
+        settings.verbose = False
+        P = sp.csc_matrix(np.triu(T.T @ T))
+        solution = clarabel.DefaultSolver(P, -(T.T @ e), sp.csc_matrix(np.vstack(blocks)), np.concatenate(b), cones,
+                                          settings).solve()
+        status = str(solution.status)
+        converged = status in ("Solved", "AlmostSolved")
+        meaning = ("converged: the minimum over physical bodies" if status == "Solved" else
+                   "converged to reduced accuracy: its residuals are small but above its tolerance"
+                   if converged else f"stopped without a minimum (Clarabel: {status})")
+        return prior.x0 + self.L_inv @ np.asarray(solution.x), SolverOutcome(status, None, converged, meaning)
+
+    def fit(self, weight: float, margin: float = 0.0) -> ConsistentFit:
+        """:func:`fit_consistent` of this problem with the prior's weight ``weight``."""
+        prior, lower = self.prior, self.lower
+        nb, n_in = prior.nb, 10 * prior.nb
+        x_lin = self.linear(weight)
+        pi0 = prior.x0[:n_in].reshape(nb, 10)
+        ok = is_consistent(x_lin[:n_in].reshape(nb, 10) - margin * pi0, 1e-12)
+        if ok.all():
+            return ConsistentFit(x_lin[:n_in].reshape(nb, 10), x_lin[n_in:], 0.5 * self.objective(x_lin, weight),
+                                 "the linear least-squares solution is physically consistent"
+                                 + (f" and keeps {margin:g} of the given pseudo-inertias" if margin else ""))
+        x, outcome = self.conic(weight, margin)
+        x[:n_in] = (margin * pi0 + nearest_consistent(x[:n_in].reshape(nb, 10) - margin * pi0)).ravel()
+        x[n_in:] = np.maximum(x[n_in:], lower[n_in:])  # an interior point's last digits
+        return ConsistentFit(x[:n_in].reshape(nb, 10), x[n_in:], 0.5 * self.objective(x, weight),
+                             f"{int((~ok).sum())} bodies of the linear solution were not physical"
+                             + (f" or kept less than {margin:g} of the given pseudo-inertia" if margin else "")
+                             + f"; the conic solve {outcome.meaning}",
+                             outcome, int((~ok).sum()))
 
 
 def _lower_in_std(prior: Prior, lower: np.ndarray) -> np.ndarray:
@@ -240,45 +321,6 @@ def _svec_pseudo_inertia() -> np.ndarray:
     return G
 
 
-def _conic_solve(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float,
-                 lower: np.ndarray, margin: float = 0.0) -> tuple[np.ndarray, SolverOutcome]:
-    """The exact minimum of :func:`fit_consistent`'s objective over positive-semidefinite pseudo-inertias and the
-    bounds ``lower``: a convex quadratic program with one 4 x 4 semidefinite cone per body (the linear matrix
-    inequality of Wensing et al. 2018, about ``J(pi) - margin J(pi_0)``), solved by Clarabel's interior-point method
-    in standard deviations of the prior (``x = x0 + L^-1 y``; the objective compressed to ``p`` rows by a QR
-    factorization, ``A_y = Q T``)."""
-    import clarabel
-    import scipy.linalg
-    import scipy.sparse as sp
-    _, _, Ay, cy = _standardised(R, z, prior, weight)
-    Q, T = scipy.linalg.qr(Ay, mode="economic")
-    e = Q.T @ cy
-    p, nb = len(prior.x0), prior.nb
-    G = _svec_pseudo_inertia()
-    blocks, b = [], []
-    for k, root in enumerate(prior.bodies):  # J(pi_b) - margin J(x0_b) = (1 - margin) J(x0_b) + G L_b^-1 y_b: a cone
-        row = np.zeros((10, p))
-        row[:, 10 * k:10 * k + 10] = -G @ np.linalg.inv(root)
-        blocks.append(row)
-        b.append((1.0 - margin) * (G @ prior.x0[10 * k:10 * k + 10]))
-    lo = _lower_in_std(prior, lower)
-    bounded = np.flatnonzero(np.isfinite(lo))  # y_i >= lo_i: -y_i + s = -lo_i, s >= 0
-    blocks.append(-np.eye(p)[bounded])
-    b.append(-lo[bounded])
-    cones = [clarabel.PSDTriangleConeT(4)] * nb + ([clarabel.NonnegativeConeT(len(bounded))] if len(bounded) else [])
-    settings = clarabel.DefaultSettings()
-    settings.verbose = False
-    P = sp.csc_matrix(np.triu(T.T @ T))
-    solution = clarabel.DefaultSolver(P, -(T.T @ e), sp.csc_matrix(np.vstack(blocks)), np.concatenate(b), cones,
-                                      settings).solve()
-    status = str(solution.status)
-    converged = status in ("Solved", "AlmostSolved")
-    meaning = ("converged: the minimum over physical bodies" if status == "Solved" else
-               "converged to reduced accuracy: its residuals are small but above its tolerance"
-               if converged else f"stopped without a minimum (Clarabel: {status})")
-    return prior.x0 + prior.L_inv @ np.asarray(solution.x), SolverOutcome(status, None, converged, meaning)
-
-
 def fit_consistent(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float, lower: np.ndarray,
                    margin: float = 0.0) -> ConsistentFit:
     """Solve ``min |R x - z|^2 + weight |L (x - x0)|^2`` over physically consistent bodies that keep
@@ -288,9 +330,9 @@ def fit_consistent(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float, lo
     ``x = (pi.ravel(), rest)``; ``x0``, ``L``: the :class:`Prior`. The problem is convex: a quadratic
     over each body's pseudo-inertia constrained positive semidefinite (Wensing et al., *Linear matrix
     inequalities for physically consistent inertial parameter identification*, IEEE RA-L 2018) and
-    bounds on the rest. The linear solution with the bounds (:func:`regularised_problem`) is taken when
+    bounds on the rest. The linear solution with the bounds (:meth:`RegularisedProblem.linear`) is taken when
     every body it gives is physically consistent (:func:`is_consistent`; it is then the minimum);
-    otherwise the conic program is solved by Clarabel (:func:`_conic_solve`), and a body left on the
+    otherwise the conic program is solved by Clarabel (:meth:`RegularisedProblem.conic`), and a body left on the
     boundary of the physical set (a flat or a point body, where the minimum often lies) is brought
     just inside (:func:`nearest_consistent`).
 
@@ -311,21 +353,4 @@ def fit_consistent(R: np.ndarray, z: np.ndarray, prior: Prior, weight: float, lo
             physical body, including the rods and points a base parameter's combination can push a link to
             (:attr:`~wbfriction.inertia.options.InertialOptions.link_margin`).
     """
-    nb, n_in = prior.nb, 10 * prior.nb
-    x_lin, A, c = regularised_problem(R, z, prior, weight, lower)
-    pi0 = prior.x0[:n_in].reshape(nb, 10)
-    ok = is_consistent(x_lin[:n_in].reshape(nb, 10) - margin * pi0, 1e-12)
-    if ok.all():
-        r = A @ x_lin - c
-        return ConsistentFit(x_lin[:n_in].reshape(nb, 10), x_lin[n_in:], 0.5 * float(r @ r),
-                             "the linear least-squares solution is physically consistent"
-                             + (f" and keeps {margin:g} of the given pseudo-inertias" if margin else ""))
-    x, outcome = _conic_solve(R, z, prior, weight, lower, margin)
-    x[:n_in] = (margin * pi0 + nearest_consistent(x[:n_in].reshape(nb, 10) - margin * pi0)).ravel()
-    x[n_in:] = np.maximum(x[n_in:], lower[n_in:])  # an interior point's last digits
-    r = A @ x - c
-    return ConsistentFit(x[:n_in].reshape(nb, 10), x[n_in:], 0.5 * float(r @ r),
-                         f"{int((~ok).sum())} bodies of the linear solution were not physical"
-                         + (f" or kept less than {margin:g} of the given pseudo-inertia" if margin else "")
-                         + f"; the conic solve {outcome.meaning}",
-                         outcome, int((~ok).sum()))
+    return RegularisedProblem(R, z, prior, lower).fit(weight, margin)

@@ -25,12 +25,12 @@ root link.) For torque-controlled joint ``i``:
 mapped back to the original bodies; ``I_a`` the armature; ``tau_f = -f(qd)`` as in
 :mod:`wbfriction.friction.models`). Position-controlled joints' rows are left out: their
 torques are not logged. Stacked over the samples, the system is compressed as it is
-built (a QR factorization of the rows seen so far), so long logs need memory of the
-size of the parameter vector only.
+built (a QR factorization of the rows seen so far, each joint's over the columns its rows can
+be non-zero in: :func:`_system`), so long logs need memory of the size of the parameter vector only.
 
 **Base parameters.** A walk does not excite every parameter; the identifiable
 combinations are found numerically by QR with column pivoting of the compressed
-regressor (:func:`base_parameters`).
+regressor (:func:`~wbfriction.inertia.least_squares.base_parameters`).
 
 **Armature.** Torques from motor currents hold the drives' reflected rotor inertia: joint ``i``'s
 row gains ``I_{a,i} qdd_i``. It is known (``model.armature``, the robot's ``[armature]``: moved to
@@ -70,12 +70,13 @@ the noise of the model; too strong a one keeps the model error. By default the w
 from :data:`PRIOR_GRID` by validation: fitted on the training samples but the last ``validation``
 share of their time span, scored by the torque residual on that share (contiguous in time, so
 that neighbouring, correlated samples do not score their own fit), then refitted on all of them.
-The compressed systems give every score without another pass over the log. The weights are tried
-from strong to weak, and the search stops at the first weight that scores worse than the best; the weight
-chosen is the strongest whose score is within :data:`PRIOR_TOLERANCE` (2 %) of the best. A weaker prior is a
-model further from the given one, and has to earn it, as a richer friction model does under ``--model auto``:
-on the KUKA LWR4+ logs the scores of the weights 10 and 1 differ by less than that, and the weaker prior
-predicted the held-out run 3 worse on three joints (the README's KUKA commands; derivations 15).
+The compressed systems give every score without another pass over the log, and one decomposition of the
+training system's gives every weight's fit (:class:`~wbfriction.inertia.consistency.RegularisedProblem`). The
+weights are tried from strong to weak, and the search stops at the first weight that scores worse than the
+best; the weight chosen is the strongest whose score is within :data:`PRIOR_TOLERANCE` (2 %) of the best. A
+weaker prior is a model further from the given one, and has to earn it, as a richer friction model does under
+``--model auto``: on the KUKA LWR4+ logs the scores of the weights 10 and 1 differ by less than that, and the
+weaker prior predicted the held-out run 3 worse on three joints (the README's KUKA commands; derivations 15).
 
 **Kept only where held-out data improve** (issue 24). On a log the given model already explains, the fit
 moves the model by noise, and predicted held-out torques worse on most leg joints of a simulated walk. The
@@ -117,12 +118,12 @@ from wbfriction.inertia.consistency import (
     FRICTION,
     STRIBECK,
     Prior,
-    fit_consistent,
+    RegularisedProblem,
     friction_lower_bounds,
     prior_model,
 )
 from wbfriction.inertia.excitation import Unexcited, parameter_names, unexcited_parameters
-from wbfriction.inertia.least_squares import BaseParameters, CompressedLeastSquares, base_parameters
+from wbfriction.inertia.least_squares import BaseParameters, CompressedLeastSquares
 from wbfriction.inertia.options import ArmatureMode, InertialOptions
 from wbfriction.inertia.regressor import body_parameters, stance_regressor, with_body_parameters
 from wbfriction.inertia.validation import Validation, limbs, validate_groups
@@ -390,13 +391,14 @@ def _rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int, options:
 
 def residual_variance(system: CompressedLeastSquares, base: BaseParameters) -> float:
     """The residual variance per row of the unregularised least squares [N·m^2]: the smallest residual
-    over the base parameters ``base`` of ``system`` (:func:`~wbfriction.inertia.least_squares.base_parameters`;
+    over the base parameters ``base`` of ``system`` (its
+    :meth:`~wbfriction.inertia.least_squares.CompressedLeastSquares.base_parameters`;
     :meth:`~wbfriction.inertia.least_squares.CompressedLeastSquares.residual`: not a figure of the rounding)
     over the rows left after them (at least 1e-12 of the mean square right-hand side)."""
     if system.rows == 0:
         return 0.0
     total = float(system.z @ system.z) + system.residual_floor
-    return max(system.residual(base.independent) / max(system.rows - base.count, 1), 1e-12 * total / system.rows)
+    return max(system.residual(base) / max(system.rows - base.count, 1), 1e-12 * total / system.rows)
 
 
 def friction_scale(robot: Robot, torque_rms: np.ndarray, k: int) -> np.ndarray:
@@ -478,24 +480,25 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
                             np.zeros(fitting.n - p_in - k * n_tc)])  # armature >= 0
     # physical friction (and armature) that best explains the data with the given inertias: the start,
     # and the given model's best case
-    best_rest_of = _BestRest(R, z, lower, p_in, n_tc, k, options.armature == "identify")
+    best_rest_of = _BestRest(R, z, lower, p_in, _own_columns(robot, options))
     friction0 = best_rest_of(pi0)[:k * n_tc].reshape(n_tc, k)
     prior_of = _prior(robot, pi0, friction0, _torque_rms(robot, parts), options)
-    base = base_parameters(R, options.rank_tolerance)
+    base = total.base_parameters(options.rank_tolerance)
     prior, scores = options.prior, {}
     if prior is None:
         if fitting.rows == 0 or validating.rows == 0:
             raise InputError(f"{log.source}: too few single-support samples to choose the prior by validation "
                              "(give one)")
-        variance = residual_variance(fitting, base_parameters(fitting.R, options.rank_tolerance))
+        variance = residual_variance(fitting, fitting.base_parameters(options.rank_tolerance))
+        trials = RegularisedProblem(fitting.R, fitting.z, prior_of, lower)  # one decomposition for every weight
         for weight in sorted(PRIOR_GRID, reverse=True):  # strong to weak
-            trial = fit_consistent(fitting.R, fitting.z, prior_of, weight * variance, lower, options.link_margin)
+            trial = trials.fit(weight * variance, options.link_margin)
             scores[weight] = validating.rms(trial.x)
             if scores[weight] > min(scores.values()):
                 break  # past the best weight: weaker priors only fit the noise more closely
         prior = max(w for w, score in scores.items() if score <= (1 + PRIOR_TOLERANCE) * min(scores.values()))
     variance = residual_variance(total, base)
-    fit = fit_consistent(R, z, prior_of, prior * variance, lower, options.link_margin)
+    fit = RegularisedProblem(R, z, prior_of, lower).fit(prior * variance, options.link_margin)
     bodies = tuple(robot.model.names[1:])
     groups = limbs(robot.model)
     held = _held_out(robot, shared, pi0, fit.pi, groups, options)
@@ -560,21 +563,20 @@ class _BestRest:
     the columns of two joints are orthogonal (``R_i^T R_j = A_i^T A_j = 0``) and each joint's
     parameters solve a bounded least squares of their own, here reduced to k x k (``R_j = Q_j T_j``):
     the same minimum as the whole bounded problem, for a few k x k solves instead of a p x (k n_tc)
-    one per candidate model."""
+    one per candidate model. A joint whose unbounded minimum keeps the bounds (the usual case) takes it
+    by one triangular solve; the others by a bounded least squares (BVLS)."""
 
-    def __init__(self, R: np.ndarray, z: np.ndarray, lower: np.ndarray, p_in: int, n_tc: int, k: int,
-                 armature: bool):
+    def __init__(self, R: np.ndarray, z: np.ndarray, lower: np.ndarray, p_in: int, columns: np.ndarray):
         import scipy.linalg
         self.R, self.z, self.p_in = R, z, p_in
-        n_rest = R.shape[1] - p_in
-        self.columns = [np.array([k * i + c for c in range(k)] + ([k * n_tc + i] if armature else []))
-                        for i in range(n_tc)]
-        self.n_rest = n_rest
+        self.columns = list(columns)  # each joint's own columns (:func:`_own_columns`)
+        self.n_rest = R.shape[1] - p_in
         self.lower = lower[p_in:]
         self.factors = [scipy.linalg.qr(R[:, p_in + cols], mode="economic") for cols in self.columns]
 
     def __call__(self, pi: np.ndarray) -> np.ndarray:
         """The best rest parameters (k n_tc [+ n_tc],) for the inertias ``pi`` (nb, 10)."""
+        import scipy.linalg
         from scipy.optimize import lsq_linear
         rhs = self.z - self.R[:, :self.p_in] @ pi.ravel()
         out = np.zeros(self.n_rest)
@@ -582,6 +584,12 @@ class _BestRest:
             y, lo = Q.T @ rhs, self.lower[cols]
             if not np.any(T):
                 continue  # a joint without rows: nothing to fit
+            pivots = np.abs(np.diag(T))
+            if pivots.min() > 1e-12 * pivots.max():
+                x = scipy.linalg.solve_triangular(T, y, check_finite=False)
+                if np.all(x >= lo):
+                    out[cols] = x
+                    continue
             out[cols] = lsq_linear(T, y, bounds=(lo, np.full(len(cols), np.inf)), method="bvls").x
         return out
 
@@ -620,29 +628,50 @@ def _rest_names(robot: Robot, options: InertialOptions) -> tuple[str, ...]:
     return names
 
 
+def _own_columns(robot: Robot, options: InertialOptions) -> np.ndarray:
+    """Each torque-controlled joint's own columns among the parameters after the bodies' (n_tc, k[+1]):
+    its ``k`` friction parameters, then its armature when identified (:func:`_rest_names`' order)."""
+    n_tc, k = len(robot.torque_controlled), len(friction_names(options))
+    armature = [[k * n_tc + i] for i in range(n_tc)] if options.armature == "identify" else [[]] * n_tc
+    return np.array([[k * i + c for c in range(k)] + armature[i] for i in range(n_tc)], dtype=int)
+
+
 def _system(robot: Robot, samples: LogSamples, which: Literal["train", "validation"], options: InertialOptions,
             progress: Progress | None = None) -> CompressedLeastSquares:
     """The compressed system of the rows ``which`` of every part of ``samples`` (:func:`_split`), in
-    the original bodies' parameters: per stance, built in its rooted parameters, then mapped."""
-    import scipy.linalg
-    nb = robot.model.njoints - 1
-    n_rest = len(_rest_names(robot, options))
-    p = 10 * nb + n_rest
-    systems = {c: CompressedLeastSquares(p) for c in range(len(robot.contact_frames))}
-    for part in samples.parts:
-        kin, stance, rows = part.kin, part.stance, getattr(part, which)
-        for c, system in systems.items():
-            r = np.flatnonzero(rows & (stance == c))
+    the original bodies' parameters.
+
+    Each joint's rows of each stance are compressed on their own, over the columns they can be non-zero in:
+    the rooted bodies' parameters beyond the joint (:attr:`~wbfriction.inertia.regressor.StanceRegressor.pattern`)
+    and its own friction and armature (:func:`_own_columns`). A QR costs the square of its columns per row, and
+    a joint's row is zero in most of them (on TALOS 8 to 317 of the 330 inertial columns, all but 4 of the 120
+    friction ones): about a tenth of the work of compressing the whole rows. The joints' factors are then mapped
+    to the original parameters and merged in one QR (the stacked rows' least squares, the same up to rounding)."""
+    p_in = 10 * (robot.model.njoints - 1)
+    p = p_in + len(_rest_names(robot, options))
+    own = _own_columns(robot, options)
+    merged = []
+    for c in range(len(robot.contact_frames)):
+        reg = stance_regressor(robot, c)
+        inertial = [np.flatnonzero(reg.pattern[i]) for i in robot.tc_index]
+        systems = [CompressedLeastSquares(cols.size + own.shape[1], min_rows=4 * (cols.size + own.shape[1]))
+                   for cols in inertial]
+        for part in samples.parts:
+            r = np.flatnonzero(getattr(part, which) & (part.stance == c))
             for start in range(0, r.size, options.block):
                 rr = r[start:start + options.block]
-                Y, C, b = _rows(robot, kin, rr, c, options)
-                system.add(np.concatenate([Y, C], axis=2).reshape(-1, p), b.ravel())
+                Y, C, b = _rows(robot, part.kin, rr, c, options)
+                for i, system in enumerate(systems):
+                    system.add(np.column_stack([Y[:, i, inertial[i]], C[:, i, own[i]]]), b[:, i])
                 if progress is not None:
                     progress(rr.size)
+        for i, system in enumerate(systems):
+            to_joint = np.zeros((system.n, p))  # the joint's columns from the original parameters
+            to_joint[:inertial[i].size, :p_in] = reg.to_rooted[inertial[i]]
+            to_joint[np.arange(inertial[i].size, system.n), p_in + own[i]] = 1.0
+            merged.append((system, to_joint))
     total = CompressedLeastSquares(p)
-    for c, system in systems.items():
-        if system.rows:
-            total.absorb(system, scipy.linalg.block_diag(stance_regressor(robot, c).to_rooted, np.eye(n_rest)))
+    total.absorb_all(merged)
     return total
 
 
@@ -696,9 +725,8 @@ def _held_out(robot: Robot, samples: LogSamples, pi0: np.ndarray, pi_fit: np.nda
               options: InertialOptions) -> _HeldOut:
     """The held-out samples' arrays (:class:`_HeldOut`) of the parts of ``samples``."""
     n_tc = len(robot.torque_controlled)
-    k = len(friction_names(options))
     arm = options.armature == "identify"
-    cols = np.array([[k * i + c for c in range(k)] + ([k * n_tc + i] if arm else []) for i in range(n_tc)])
+    cols = _own_columns(robot, options)
     idx = np.arange(n_tc)[:, None]
     deltas = []
     for g in groups:

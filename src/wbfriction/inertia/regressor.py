@@ -61,14 +61,19 @@ class StanceRegressor:
     Attributes:
         stance: the stance-rooted model (:mod:`wbfriction.model.stance`).
         to_rooted: (10 n_bodies, 10 n_bodies): ``pi_rooted = to_rooted @ pi.ravel()``.
+        pattern: (n_act, 10 n_bodies), whether an actuated joint's row of :meth:`joint_rows` can be
+            non-zero in a rooted parameter (:func:`structural_pattern`): a joint's torque depends only on
+            the bodies beyond it in the rooted tree.
     """
 
     stance: StanceModel
     to_rooted: np.ndarray
     data: pin.Data = field(init=False, repr=False)
+    pattern: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         self.data = self.stance.model.createData()
+        self.pattern = structural_pattern(self.stance, self.data)
 
     def joint_rows(self, frame_pose: np.ndarray, angles: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """``Y`` with ``Y @ to_rooted @ pi.ravel() = S (M qdd + h - J^T lambda)`` (without the
@@ -85,13 +90,31 @@ class StanceRegressor:
         q = st.layout.configuration(angles, frame_pose, st.sign)
         n = angles.shape[0]
         Y = np.empty((n, len(st.v_index), 10 * (model.njoints - 1)))
-        v = np.zeros(model.nv)
-        a = np.zeros(model.nv)
-        for k in range(n):
-            v[st.v_index] = qd[k] * st.sign
-            a[st.v_index] = qdd[k] * st.sign
-            Y[k] = pin.computeJointTorqueRegressor(model, self.data, q[k], v, a)[st.v_index]
-        return Y * st.sign[None, :, None]
+        v = np.zeros((n, model.nv))
+        a = np.zeros((n, model.nv))
+        v[:, st.v_index] = qd * st.sign
+        a[:, st.v_index] = qdd * st.sign
+        for k in range(n):  # the actuated rows taken straight into Y (one copy)
+            np.take(pin.computeJointTorqueRegressor(model, self.data, q[k], v[k], a[k]), st.v_index, axis=0, out=Y[k])
+        Y *= st.sign[None, :, None]
+        return Y
+
+
+def structural_pattern(stance: StanceModel, data: pin.Data, states: int = 3) -> np.ndarray:
+    """Where the actuated joints' rows of the stance tree's regressor can be non-zero (n_act, 10 n_bodies):
+    the entries non-zero at any of ``states`` random configurations, velocities and accelerations (the
+    root's included, so that no gravity direction or motion is special). An entry zero at a generic state is
+    zero by the tree's structure (the bodies not beyond the joint, the parameters a joint's axis does not
+    see), at every state: a regression may leave such columns out of a joint's rows."""
+    model = stance.model
+    rng = np.random.default_rng(0)
+    out = np.zeros((len(stance.v_index), 10 * (model.njoints - 1)), dtype=bool)
+    for _ in range(states):
+        q = pin.integrate(model, pin.neutral(model), rng.standard_normal(model.nv))
+        Y = pin.computeJointTorqueRegressor(model, data, q, rng.standard_normal(model.nv),
+                                            rng.standard_normal(model.nv))
+        out |= Y[stance.v_index] != 0.0
+    return out
 
 
 def stance_regressor(robot: Robot, contact_index: int) -> StanceRegressor:
