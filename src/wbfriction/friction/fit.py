@@ -72,7 +72,7 @@ from wbfriction.friction.models import (
 )
 from wbfriction.friction.noise import joint_noises
 from wbfriction.friction.options import MODEL_CHOICES, SELECTION_TOLERANCE, FitOptions, ModelChoice
-from wbfriction.friction.projection import Projection, projected_start
+from wbfriction.friction.projection import BASINS, Projection, projected_start
 from wbfriction.friction.regression import (
     correlation_lag,
     covariance_errors,
@@ -760,7 +760,7 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     # one start: the given one, or the minimum over the non-linear parameters with the linear ones solved
     # (variable projection, :mod:`~wbfriction.friction.projection`), then the fit over every free parameter
     start = to_fit_coordinates(model, np.asarray(x0, dtype=float)) if x0 is not None else projected_start(
-        projection, float(np.percentile(np.abs(v), 90)))
+        projection, float(np.percentile(np.abs(v), 90)), BASINS if speed >= MIN_SPEED else 1)
     best = _solve(residual, jacobian, start[free], bounds, 300)
     # residuals correlated over the filter's window, or over the span of a model error;
     # standard errors of the model's own parameters (F_s, not F_s - F_c)

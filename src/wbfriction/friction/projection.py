@@ -225,14 +225,16 @@ def grid_minima(costs: np.ndarray) -> np.ndarray:
     return flat[np.argsort(costs.ravel()[flat], kind="stable")]
 
 
-def projected_start(projection: Projection, speed: float) -> np.ndarray:
-    """The minimum of the variable-projection functional found from the grid's best :data:`BASINS` local minima
+def projected_start(projection: Projection, speed: float, basins: int = BASINS) -> np.ndarray:
+    """The minimum of the variable-projection functional found from the grid's best ``basins`` local minima
     (module docstring), as the fit's coordinates (P,): the start of the fit over every parameter. The search's
     residual is divided by the grid's best (its tolerances relative to it: noise-free data end near zero).
 
     Args:
         projection: the joint's :class:`Projection`.
         speed: the joint's speed [rad/s] (the grid's scale, at least 1e-3).
+        basins: how many of the grid's local minima are refined (:data:`BASINS`; 1 for a joint that hardly moved,
+            whose functional is flat wherever it is not noise).
     """
     if not projection.theta:
         return projection.params(np.empty(0))
@@ -246,7 +248,7 @@ def projected_start(projection: Projection, speed: float) -> np.ndarray:
     costs = costs.reshape([len(x) for x in axes])
     scale = 1.0 / max(math.sqrt(float(costs.min())), 1e-300)
     best = min((least_squares(lambda t: scale * projection.residual(t), grid[k], bounds=projection.theta_bounds,
-                              method="trf", diff_step=1e-7, ftol=1e-12, xtol=1e-10, gtol=1e-14, max_nfev=100)
-                for k in grid_minima(costs)[:BASINS]), key=lambda r: r.cost)
+                              method="trf", diff_step=1e-7, ftol=1e-12, xtol=1e-10, gtol=1e-14, max_nfev=50)
+                for k in grid_minima(costs)[:basins]), key=lambda r: r.cost)
     return projection.params(best.x)
 
