@@ -755,7 +755,8 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
         f_residual, f_jacobian = filtered_problem(qd, y, use, smoother, delta_s, model, sigma)
         residual = lambda z: f_residual(full(z))  # noqa: E731
         model_jac = lambda z: f_jacobian(full(z))  # noqa: E731
-        projection = Projection(model, qd, y, rows, smoother, sigma, delta_s, held, free, lower, upper)
+        support = np.convolve(use, np.ones(2 * smoother_half_width(smoother) + 1), mode="same") > 0
+        projection = Projection(model, qd, y, rows, smoother, sigma, delta_s, held, free, lower, upper, support)
     jacobian = lambda z: fit_coordinates_jacobian(model, model_jac(z))[:, free]  # noqa: E731
     # one start: the given one, or the minimum over the non-linear parameters with the linear ones solved
     # (variable projection, :mod:`~wbfriction.friction.projection`), then the fit over every free parameter

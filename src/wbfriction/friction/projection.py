@@ -142,18 +142,32 @@ class Projection:
         delta_s: the Stribeck exponent.
         held, free: the fit's coordinates (P,) of the held parameters, and which are free (P,) bool.
         lower, upper: the bounds (P,) in the fit's coordinates.
+        support: with a smoother, the samples (N,) bool its output on the rows fitted depends on (the rows widened
+            by its half-width): the columns are computed there alone; None: everywhere.
     """
 
     def __init__(self, model: ModelName, qd: np.ndarray, y: np.ndarray, rows: np.ndarray, smoother, sigma: float,
-                 delta_s: float, held: np.ndarray, free: np.ndarray, lower: np.ndarray, upper: np.ndarray):
-        self.model, self.qd, self.rows, self.smoother = model, qd, rows, smoother
+                 delta_s: float, held: np.ndarray, free: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                 support: np.ndarray | None = None):
+        self.model, self.rows, self.smoother = model, rows, smoother
         self.sigma, self.delta_s, self.held = sigma, delta_s, held
         self.y = y[rows]
+        self.support = support
+        self.qd = qd if support is None else qd[support]
         self.part = linear_part(model, held, free, lower, upper)
         self.theta = tuple(i for i in NONLINEAR[model] if free[i])
         self.theta_bounds = (np.log(np.maximum(lower[list(self.theta)], 1e-300)), np.log(upper[list(self.theta)]))
         self._ends: np.ndarray | None = None  # the columns qd and 1, on the rows (smoothed)
         self._jump: tuple[float, np.ndarray, np.ndarray] | None = None  # a, its column, on the rows (smoothed)
+
+    def _smoothed(self, columns: np.ndarray) -> np.ndarray:
+        """``columns`` (of the samples of :attr:`support`) through the smoother along the whole series (zero
+        elsewhere: the rows fitted do not reach there), on the rows fitted."""
+        if self.support is None:
+            return self.smoother(columns)[self.rows]
+        whole = np.zeros((self.support.size, *columns.shape[1:]))
+        whole[self.support] = columns
+        return self.smoother(whole)[self.rows]
 
     def _columns(self, log_theta: np.ndarray) -> np.ndarray:
         """The model's columns (n, K) on the rows fitted at ``log_theta``, smoothed if the fit is; the jump column,
@@ -163,18 +177,18 @@ class Projection:
         v_s, a = (z[3], z[5]) if self.model == "thesis" else (z[3] if self.model == "stribeck" else 1.0, 1.0)
         if self._jump is None or self._jump[0] != a:
             jump = expected_jump(self.qd, self.sigma, self.model, a)
-            self._jump = (a, jump, jump if self.smoother is None else self.smoother(jump)[self.rows])
+            self._jump = (a, jump, jump if self.smoother is None else self._smoothed(jump))
         columns = expected_columns(self.qd, self.sigma, self.delta_s, self.model, v_s, a, jump=self._jump[1])
         if self.smoother is None:
             return columns
         # qd and 1 (the first and last columns) smoothed once, the jump once for each a
         ends = [0, columns.shape[1] - 1]
         if self._ends is None:
-            self._ends = self.smoother(columns[:, ends])[self.rows]
+            self._ends = self._smoothed(columns[:, ends])
         out = np.empty((self.rows.size, columns.shape[1]))
         out[:, ends], out[:, 1] = self._ends, self._jump[2]
         if columns.shape[1] == 4:  # the Stribeck column
-            out[:, 2] = self.smoother(columns[:, 2])[self.rows]
+            out[:, 2] = self._smoothed(columns[:, 2])
         return out
 
     def solve(self, log_theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
