@@ -17,7 +17,6 @@ command's share of it.
 from __future__ import annotations
 
 import argparse
-import resource
 import subprocess
 import sys
 import tempfile
@@ -26,20 +25,12 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
 from bench_batch import files  # noqa: E402
+from bench_simulate import command  # noqa: E402
 
 from wbfriction.fleet.manifest import read_manifest  # noqa: E402
 from wbfriction.fleet.options import BatchOptions  # noqa: E402
 from wbfriction.fleet.task import process_log, result_key  # noqa: E402
 from wbfriction.studies.drifting_fleet import simulate_arm_fleet  # noqa: E402
-
-
-def command(args: list[str]) -> tuple[float, float]:
-    """Wall and CPU time (this process's children) [s] of ``python -m wbfriction args``."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    wall = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "wbfriction", *args], check=True, capture_output=True)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return time.perf_counter() - wall, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
 
 
 def dask_cluster(folder: Path, workers: int) -> tuple[str, list[subprocess.Popen]]:
@@ -72,13 +63,13 @@ def main() -> None:
         address, processes = dask_cluster(folder, args.workers)
         try:
             common = [str(manifest), "--robot", "panda"]
-            command(["batch", *common, "-o", str(folder / "warm"), "--scheduler", address])
-            on_cluster = command(["batch", *common, "-o", str(folder / "cluster"), "--scheduler", address])
+            command(["batch", *common, "-o", str(folder / "warm"), "--scheduler", address], repeat=1)
+            on_cluster = command(["batch", *common, "-o", str(folder / "cluster"), "--scheduler", address], repeat=1)
         finally:
             for p in processes:
                 p.terminate()
                 p.wait()
-        serial = command(["batch", *common, "-o", str(folder / "serial"), "--serial"])
+        serial = command(["batch", *common, "-o", str(folder / "serial"), "--serial"], repeat=1)
         same = files(folder / "serial") == files(folder / "cluster")
         n = args.logs
         print(f"{n} Panda logs of {args.seconds:g} s; dask scheduler + dask worker --nworkers {args.workers} "
@@ -94,7 +85,8 @@ def main() -> None:
         cpu = time.process_time()
         process_log(entry, key, options, folder / "scratch")
         task = time.process_time() - cpu
-        estimate = command(["estimate", str(entry.log), "--robot", "panda", "-o", str(folder / "one.parquet")])
+        one = ["estimate", str(entry.log), "--robot", "panda", "-o", str(folder / "one.parquet")]
+        estimate = command(one, repeat=1)
         print(f"one fleet task (estimate, fit, check) on a {args.seconds:g} s log: {task:.2f} s CPU (target: under "
               f"3 s); the estimate command alone, start-up included: {estimate[1]:.2f} s CPU")
 
