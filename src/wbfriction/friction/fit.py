@@ -42,8 +42,7 @@ the friction went through a zero-phase smoother ``H``, the fit minimises
 ``|H(f(qd; p))[valid] + tau_f[valid]|^2`` over the whole time series, as in
 the parallel filtering of robot identification (the filter applied to observations and
 model alike), so that the smoothing of the model's jumps at velocity reversals (Coulomb,
-Stribeck) is not mistaken for a different model. The unfiltered fit on the same samples
-gives the starting point.
+Stribeck) is not mistaken for a different model. The start is searched on that same filtered objective.
 """
 
 from __future__ import annotations
