@@ -45,6 +45,21 @@ def test_a_joint_that_hardly_moved_is_not_excited():
     assert verdict.status == "not excited" and "hardly moved" in verdict.reason
 
 
+def test_still_gives_a_joint_that_hardly_moved_the_model_named_for_it_and_its_offset():
+    """``still="coulomb-viscous"`` (the closed loop's): a joint below MIN_SPEED is fitted with that model, and its
+    fit is the named model's on the same data, with the offset that data give; a joint that moved keeps (3.5)."""
+    qd, tau_f = _data(0.5 * MIN_SPEED)
+    fit = fit_friction(qd, tau_f, model="thesis", still="coulomb-viscous", fixed={"S": 0.0, "F_c": 1.0})
+    named = fit_friction(qd, tau_f, model="coulomb-viscous", fixed={"F_c": 1.0})
+    assert fit.model == "coulomb-viscous" and fit.verdict().status == "not excited"
+    assert fit.params == named.params and fit.stderr == named.stderr
+    # least squares with an offset: the model's mean is the data's, and the data's is the true friction's
+    assert abs(np.mean(fit.params.torque(qd)) - np.mean(tau_f)) < 1e-9
+    assert abs(np.mean(fit.params.torque(qd)) - np.mean(TRUE.torque(qd))) < 1e-3
+    moved = fit_friction(*_data(1.0), model="thesis", still="coulomb-viscous")
+    assert moved.model == "thesis" and moved.verdict().status == "ok"
+
+
 def test_too_few_samples_is_not_excited():
     qd, tau_f = _data(1.0, n=10)
     verdict = fit_friction(qd, tau_f).verdict()

@@ -13,7 +13,7 @@ import pytest
 
 from helpers import run_cli, run_cli_printed, widest_line
 from wbfriction.friction.fit import FitResult
-from wbfriction.friction.models import FrictionParams
+from wbfriction.friction.models import CoulombViscousParams, FrictionParams
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.closed_loop import stribeck_velocity
 from wbfriction.inertia.consistency import is_consistent
@@ -42,7 +42,9 @@ def _fit(joint, v_s, se_v_s, F_c=1.0, se=0.01) -> FitResult:
 
 def test_stribeck_velocity_is_the_median_of_the_determined_joints():
     fits = [_fit("a", 0.1, 0.01), _fit("b", 0.2, 0.01), _fit("c", 0.4, 0.01),
-            _fit("d", 5.0, np.inf), _fit("e", 0.3, 0.01, F_c=1e-6, se=1.0), FitResult("f", 3)]
+            _fit("d", 5.0, np.inf), _fit("e", 0.3, 0.01, F_c=1e-6, se=1.0), FitResult("f", 3),
+            FitResult("g", 100, CoulombViscousParams(F_v=0.2, F_c=1.0, tau_os=0.0),
+                      {"F_v": 0.01, "F_c": 0.01, "tau_os": 0.01}, success=True, model="coulomb-viscous")]
     assert stribeck_velocity(fits) == (0.2, ("a", "b", "c"))
     assert stribeck_velocity(fits[3:]) == (None, ())
 

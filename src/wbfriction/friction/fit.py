@@ -586,7 +586,8 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
                  x0: np.ndarray | None = None, min_samples: int = 20, mask: np.ndarray | None = None,
                  smoother=None, fixed: dict[str, float] | None = None, model: ModelChoice = "thesis",
                  selection_tolerance: float = SELECTION_TOLERANCE, velocity_noise: float = 0.0,
-                 stick: float = 0.0, stick_margin: int = 0, noise: JointNoise | None = None) -> FitResult:
+                 stick: float = 0.0, stick_margin: int = 0, noise: JointNoise | None = None,
+                 still: ModelName | None = None) -> FitResult:
     """Fit a friction model to friction estimates of one joint (eq. 6.4).
 
     Args:
@@ -622,6 +623,9 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
             offset.
         noise: what is known of the estimate's noise (:class:`~wbfriction.friction.bound.JointNoise`): the fit then
             carries its Cramér-Rao bound (:attr:`FitResult.crb`); None: no bound.
+        still: the model fitted instead of the one named when the joint hardly moved (status ``not excited``: its
+            data hold no velocity model, only an offset; ``auto`` then takes the simplest model anyway); None: the
+            model named.
 
     Returns:
         :class:`FitResult`.
@@ -647,6 +651,9 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
                             fixed=fixed, tolerance=selection_tolerance, sigma=velocity_noise, noise=noise,
                             speed=speed)
         else:
+            if still is not None and speed < MIN_SPEED:
+                model, x0 = still, None
+                fixed = {k: v for k, v in (fixed or {}).items() if k in MODEL_PARAMS[still].names}
             res = _fit_model(check_model(model), qd, y, use, delta_s=delta_s, joint=joint, x0=x0,
                              min_samples=min_samples, smoother=smoother, fixed=fixed, sigma=velocity_noise,
                              noise=noise)
@@ -805,7 +812,7 @@ def _fit_routes(args: tuple) -> tuple[FitResult, FitResult | None]:
 def _column_tasks(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, models: Sequence[ModelChoice], *,
                   delta_s: float, min_samples: int, smoother, fixed: dict[str, float] | None,
                   selection_tolerance: float, noise: Mapping[str, JointNoise] | None,
-                  stick_margin: int | None) -> list[tuple]:
+                  stick_margin: int | None, still: ModelName | None = None) -> list[tuple]:
     """One :func:`_fit_column` task per joint (:func:`fit_joints`'s arguments)."""
     noise = noise or {}
     tasks = []
@@ -816,7 +823,7 @@ def _column_tasks(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, 
         tasks.append((qd[:, i], tau_f[:, i], valid[:, i],
                       dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, fixed=fixed,
                            model=models[i], selection_tolerance=selection_tolerance, velocity_noise=sigma, noise=jn,
-                           **stick)))
+                           still=still, **stick)))
     return tasks
 
 
@@ -905,7 +912,8 @@ def stick_margin(est: FrictionEstimate) -> int:
 
 def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, workers: int = 1,
                  joints: Sequence[str] | None = None, fixed: dict[str, float] | None = None,
-                 targets: Mapping[str, ModelParams] | None = None) -> list[FitResult]:
+                 targets: Mapping[str, ModelParams] | None = None,
+                 still: ModelName | None = None) -> list[FitResult]:
     """Fit every joint of an estimate (:func:`fit_joints` on its valid samples, on ``workers``
     processes); its ``tau_f_true`` and ``friction_true`` metadata, when present (simulated
     logs), give the errors against truth.
@@ -922,6 +930,7 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
         joints: the joints to fit (default: every one of the estimate), in this order.
         fixed: parameters held instead of fitted (:func:`fit_friction`).
         targets: the true parameters per joint, instead of the metadata's ``friction_true``.
+        still: the model of a joint that hardly moved, instead of ``options``' named model (:func:`fit_friction`).
 
     Raises:
         InputError: ``friction_true`` metadata that are not a model's parameters; an unknown model or joint; a
@@ -937,7 +946,7 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
     record = est.metadata.get("noise")
     truth = None if est.tau_f_true is None else est.tau_f_true[:, idx]
     common: dict[str, Any] = dict(delta_s=options.delta_s, min_samples=options.min_samples, fixed=fixed,
-                                  selection_tolerance=options.selection_tolerance)
+                                  selection_tolerance=options.selection_tolerance, still=still)
     tasks = _column_tasks(names, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], [options.model] * len(idx),
                           smoother=est.smoother, noise=joint_noises(record, est.estimation_route),
                           stick_margin=stick_margin(est), **common)

@@ -1,8 +1,8 @@
 """The loop the thesis proposed (ch. 8): identify the inertia model, then estimate the friction with it.
 
 1. The acceleration route with the given model (:func:`~wbfriction.friction.estimate.estimate_log`,
-   fit of (3.5) per joint) gives a first Stribeck velocity ``v_s``: the median over the
-   joints whose fit determines it.
+   fit of (3.5) per joint, Coulomb-viscous for a joint that hardly moved) gives a first Stribeck velocity
+   ``v_s``: the median over the joints whose fit determines it.
 2. The inertia model and the friction are identified together from the torques
    (:func:`~wbfriction.inertia.identification.identify_inertia`, prior toward the given model), with
    the Stribeck term's ``v_s`` held at that value (it enters non-linearly).
@@ -73,26 +73,28 @@ class ClosedLoop:
 def acceleration_route(robot: Robot, log: Log, options: EstimateOptions, min_samples: int = 20,
                        workers: int = 1, choice: DiffChoice | None = None) -> Route:
     """Estimate (5.10-5.13) and fit (3.5) every torque-controlled joint (on ``workers``
-    processes), and check energy (7.9). ``choice``: how ``options``' differentiation was chosen
+    processes), and check energy (7.9). A joint that hardly moved (status ``not excited``) is given the
+    Coulomb-viscous model instead, as ``wbfriction fit`` gives it: its data hold an offset, no Stribeck term. ``choice``: how ``options``' differentiation was chosen
     (:func:`~wbfriction.friction.estimate.resolve_differentiation`, done once for several routes),
     recorded in the estimate's metadata as :func:`~wbfriction.friction.estimate.estimate_log` does."""
     est = estimate_log(robot, log, options)
     if choice is not None:
         est.metadata["differentiation"] = choice.to_dict()
-    fits = fit_estimate(est, FitOptions(model="thesis", min_samples=min_samples), workers=workers)
+    fits = fit_estimate(est, FitOptions(model="thesis", min_samples=min_samples), workers=workers,
+                        still="coulomb-viscous")
     return Route(est, fits, energy_consistency(est, fitted_offsets(fits)))
 
 
 def stribeck_velocity(fits: list[FitResult], max_relative_error: float = 0.5) -> tuple[float | None, tuple[str, ...]]:
     """The joints whose fit determines a Stribeck effect (``v_s``, ``F_c`` and the height ``S``
-    with standard errors below ``max_relative_error`` of their values), and their median
-    Stribeck velocity [rad/s] (None if there are none)."""
+    with standard errors below ``max_relative_error`` of their values; a fit of a model without them, none), and
+    their median Stribeck velocity [rad/s] (None if there are none)."""
     def determined(f: FitResult) -> bool:
         p = f.params
-        return p is not None and all(getattr(p, n) > 0 and f.stderr.get(n, np.inf) < max_relative_error * getattr(p, n)
-                                     for n in ("v_s", "F_c", "S"))
+        return p is not None and all(getattr(p, n, 0.0) > 0 and f.stderr.get(n, np.inf) < max_relative_error
+                                     * getattr(p, n) for n in ("v_s", "F_c", "S"))
     good = [f for f in fits if determined(f)]
-    return (float(np.median([f.params.v_s for f in good if f.params is not None])) if good else None,
+    return (float(np.median([getattr(f.params, "v_s") for f in good])) if good else None,
             tuple(f.joint for f in good))
 
 
