@@ -47,6 +47,7 @@ Stribeck) is not mistaken for a different model. The start is searched on that s
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -80,11 +81,10 @@ from wbfriction.friction.regression import (
     parameter_covariance,
 )
 from wbfriction.friction.screen import gross_outliers
+from wbfriction.friction.smoothing import row_smoothing, smoother_half_width
 from wbfriction.friction.status import HELD, MIN_SPEED, FitVerdict, fit_verdict, joint_speed, routes_disagree
 from wbfriction.friction.term_selection import fit_terms, refit_terms
 from wbfriction.friction.terms import TermFit, term_signals
-from wbfriction.signals.kinematics import PiecewiseSmoother
-from wbfriction.signals.nonuniform import ResampledLowpass
 from wbfriction.workers import process_pool
 
 AT_BOUND_RTOL = 1e-6
@@ -477,24 +477,27 @@ def filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, d
 
     The smoother is linear and filters each column alone, so the columns of the Jacobian that do
     not depend on the parameters (:data:`_FIXED_COLUMNS`: the regressors ``qd``, ``sgn(qd)``, 1) are
-    filtered once, the others at every call; the residual filters the model's values alone."""
+    filtered once, the others at every call; the residual filters the model's values alone. The model is evaluated
+    on the samples the rows depend on alone (:func:`~wbfriction.friction.smoothing.row_smoothing`)."""
     rows = np.flatnonzero(use)
+    smoothing = row_smoothing(smoother, qd.size, rows)
+    v, y_rows = qd[smoothing.support], y[rows]
     fixed_columns = list(_FIXED_COLUMNS[model])
     filtered_fixed: list[np.ndarray] = []  # the smoothed fixed columns, on the rows used
 
     def residual(x: np.ndarray) -> np.ndarray:
-        return smoother(expected_values(x, qd, velocity_noise, delta_s, model))[rows] - y[rows]
+        return smoothing(expected_values(x, v, velocity_noise, delta_s, model)) - y_rows
 
     def jacobian(x: np.ndarray) -> np.ndarray:
-        jac = expected_jacobian(x, qd, velocity_noise, delta_s, model)
+        jac = expected_jacobian(x, v, velocity_noise, delta_s, model)
         varying = np.ones(jac.shape[1], dtype=bool)
         varying[fixed_columns] = False
         if not filtered_fixed:
-            filtered_fixed.append(smoother(jac[:, fixed_columns])[rows])
+            filtered_fixed.append(smoothing(jac[:, fixed_columns]))
         out = np.empty((rows.size, jac.shape[1]))
         out[:, fixed_columns] = filtered_fixed[0]
         if varying.any():
-            out[:, varying] = smoother(jac[:, varying])[rows]
+            out[:, varying] = smoothing(jac[:, varying])
         return out
 
     return residual, jacobian
@@ -634,7 +637,6 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         InputError: an unknown model, a name in ``fixed`` that is not the model's (for
             ``auto``: no model's), ``x0`` with ``auto``, a ``stribeck`` F_s held without F_c.
     """
-    from threadpoolctl import threadpool_limits
     if model not in MODEL_CHOICES:
         raise InputError(f"model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
     qd = np.asarray(qd, dtype=float)
@@ -643,7 +645,7 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
     # One BLAS thread: the solver's many small (N x p) factorizations run several times
     # slower on OpenBLAS's threads than on one (30 TALOS joints of a 10-step walk: 78 s
     # against 14 s on 2 cores); fit joints side by side instead (fit_estimate's workers).
-    with threadpool_limits(1, user_api="blas"):
+    with blas_controller().limit(limits=1, user_api="blas"):
         if model == "auto":
             if x0 is not None:
                 raise InputError("x0 needs a named model, not 'auto'")
@@ -661,6 +663,17 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
     res.speed = speed
     res.velocity_noise, res.stick_speed, res.n_stuck = float(velocity_noise), float(stick), int(stuck.sum())
     return res
+
+
+@functools.cache
+def blas_controller():
+    """threadpoolctl's view of the BLAS libraries this process has loaded (SciPy's solvers' included), inspected
+    once: each fit limits them to one thread (:func:`fit_friction`), and inspecting them is most of a limit's cost
+    (about 1 ms)."""
+    import scipy.linalg  # noqa: F401  (the LAPACK the fit factorises with, loaded before it is inspected)
+    import scipy.optimize  # noqa: F401
+    from threadpoolctl import ThreadpoolController
+    return ThreadpoolController()
 
 
 def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float, joint: str, min_samples: int,
@@ -761,8 +774,7 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
         f_residual, f_jacobian = filtered_problem(qd, y, use, smoother, delta_s, model, sigma)
         residual = lambda z: f_residual(full(z))  # noqa: E731
         model_jac = lambda z: f_jacobian(full(z))  # noqa: E731
-        support = np.convolve(use, np.ones(2 * smoother_half_width(smoother) + 1), mode="same") > 0
-        projection = Projection(model, qd, y, rows, smoother, sigma, delta_s, held, free, lower, upper, support)
+        projection = Projection(model, qd, y, rows, smoother, sigma, delta_s, held, free, lower, upper)
     jacobian = lambda z: fit_coordinates_jacobian(model, model_jac(z))[:, free]  # noqa: E731
     # one start: the given one, or the minimum over the non-linear parameters with the linear ones solved
     # (variable projection, :mod:`~wbfriction.friction.projection`), then the fit over every free parameter
@@ -885,17 +897,6 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
                           min_samples=min_samples, smoother=smoother, fixed=fixed,
                           selection_tolerance=selection_tolerance, noise=noise, stick_margin=stick_margin)
     return _with_truth(joints, _run(_fit_column, tasks, workers), qd, tau_f, valid, tau_f_true, targets)
-
-
-def smoother_half_width(smoother) -> int:
-    """Samples a smoother reaches on each side (0 without one)."""
-    if smoother is None:
-        return 0
-    if isinstance(smoother, PiecewiseSmoother):
-        return max((smoother_half_width(s) for *_, s in smoother.parts), default=0)
-    if isinstance(smoother, ResampledLowpass):
-        return smoother.lowpass.half_width
-    return int(smoother.half_width)
 
 
 def stick_margin(est: FrictionEstimate) -> int:

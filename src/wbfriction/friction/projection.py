@@ -31,6 +31,7 @@ import numpy as np
 
 from wbfriction.friction.eiv import expected_columns, expected_jump
 from wbfriction.friction.models import ModelName
+from wbfriction.friction.smoothing import row_smoothing
 
 TERMS: dict[ModelName, tuple[tuple[int, ...], ...]] = {
     "coulomb-viscous": ((0,), (1,), (2,)),
@@ -50,6 +51,10 @@ GRID = 6
 
 BASINS = 3
 """The grid's local minima refined, best first."""
+
+GRID_ROWS = 2000
+"""The grid is evaluated on at most this many of the rows fitted, evenly spaced (:meth:`Projection.thinned`): it
+only marks the basins, which the search then refines on every row."""
 
 
 @dataclass(frozen=True)
@@ -142,32 +147,24 @@ class Projection:
         delta_s: the Stribeck exponent.
         held, free: the fit's coordinates (P,) of the held parameters, and which are free (P,) bool.
         lower, upper: the bounds (P,) in the fit's coordinates.
-        support: with a smoother, the samples (N,) bool its output on the rows fitted depends on (the rows widened
-            by its half-width): the columns are computed there alone; None: everywhere.
+
+    With a smoother, the columns are computed on the samples the smoother's output on the rows fitted depends on alone
+    (:func:`~wbfriction.friction.smoothing.row_smoothing`).
     """
 
     def __init__(self, model: ModelName, qd: np.ndarray, y: np.ndarray, rows: np.ndarray, smoother, sigma: float,
-                 delta_s: float, held: np.ndarray, free: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-                 support: np.ndarray | None = None):
+                 delta_s: float, held: np.ndarray, free: np.ndarray, lower: np.ndarray, upper: np.ndarray):
+        self._given = (model, qd, y, smoother, sigma, delta_s, held, free, lower, upper)
         self.model, self.rows, self.smoother = model, rows, smoother
         self.sigma, self.delta_s, self.held = sigma, delta_s, held
         self.y = y[rows]
-        self.support = support
-        self.qd = qd if support is None else qd[support]
+        self.smoothing = None if smoother is None else row_smoothing(smoother, qd.size, rows)
+        self.qd = qd[rows] if self.smoothing is None else qd[self.smoothing.support]
         self.part = linear_part(model, held, free, lower, upper)
         self.theta = tuple(i for i in NONLINEAR[model] if free[i])
         self.theta_bounds = (np.log(np.maximum(lower[list(self.theta)], 1e-300)), np.log(upper[list(self.theta)]))
         self._ends: np.ndarray | None = None  # the columns qd and 1, on the rows (smoothed)
         self._jump: tuple[float, np.ndarray, np.ndarray] | None = None  # a, its column, on the rows (smoothed)
-
-    def _smoothed(self, columns: np.ndarray) -> np.ndarray:
-        """``columns`` (of the samples of :attr:`support`) through the smoother along the whole series (zero
-        elsewhere: the rows fitted do not reach there), on the rows fitted."""
-        if self.support is None:
-            return self.smoother(columns)[self.rows]
-        whole = np.zeros((self.support.size, *columns.shape[1:]))
-        whole[self.support] = columns
-        return self.smoother(whole)[self.rows]
 
     def _columns(self, log_theta: np.ndarray) -> np.ndarray:
         """The model's columns (n, K) on the rows fitted at ``log_theta``, smoothed if the fit is; the jump column,
@@ -177,19 +174,28 @@ class Projection:
         v_s, a = (z[3], z[5]) if self.model == "thesis" else (z[3] if self.model == "stribeck" else 1.0, 1.0)
         if self._jump is None or self._jump[0] != a:
             jump = expected_jump(self.qd, self.sigma, self.model, a)
-            self._jump = (a, jump, jump if self.smoother is None else self._smoothed(jump))
+            self._jump = (a, jump, jump if self.smoothing is None else self.smoothing(jump))
         columns = expected_columns(self.qd, self.sigma, self.delta_s, self.model, v_s, a, jump=self._jump[1])
-        if self.smoother is None:
+        if self.smoothing is None:
             return columns
         # qd and 1 (the first and last columns) smoothed once, the jump once for each a
         ends = [0, columns.shape[1] - 1]
         if self._ends is None:
-            self._ends = self._smoothed(columns[:, ends])
+            self._ends = self.smoothing(columns[:, ends])
         out = np.empty((self.rows.size, columns.shape[1]))
         out[:, ends], out[:, 1] = self._ends, self._jump[2]
         if columns.shape[1] == 4:  # the Stribeck column
-            out[:, 2] = self._smoothed(columns[:, 2])
+            out[:, 2] = self.smoothing(columns[:, 2])
         return out
+
+    def thinned(self, rows: int) -> Projection:
+        """This functional on at most ``rows`` of its rows, evenly spaced (itself if it has no more): the grid's
+        coarse view of the basins."""
+        stride = -(-self.rows.size // rows)
+        if stride <= 1:
+            return self
+        model, qd, y, smoother, sigma, delta_s, held, free, lower, upper = self._given
+        return Projection(model, qd, y, self.rows[::stride], smoother, sigma, delta_s, held, free, lower, upper)
 
     def solve(self, log_theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The unknowns (U,) of the bounded linear solve at ``log_theta`` and the residual (n,) it leaves (model
@@ -256,8 +262,9 @@ def projected_start(projection: Projection, speed: float, basins: int = BASINS) 
     axes = theta_axes(projection, max(speed, 1e-3))
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, len(axes))
     costs = np.empty(len(grid))
+    coarse = projection.thinned(GRID_ROWS)
     for k in np.argsort(grid[:, -1], kind="stable"):  # a's values in turn: its column computed once for each
-        r = projection.residual(grid[k])
+        r = coarse.residual(grid[k])
         costs[k] = float(r @ r)
     costs = costs.reshape([len(x) for x in axes])
     scale = 1.0 / max(math.sqrt(float(costs.min())), 1e-300)

@@ -26,6 +26,7 @@ import numpy as np
 from wbfriction.friction.energy import JointEnergy, energy_consistency
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log, resolve_differentiation
 from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
+from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.options import EstimateOptions, FitOptions
 from wbfriction.inertia.identification import InertialIdentification, identify_inertia, log_samples
 from wbfriction.inertia.options import InertialOptions
@@ -74,7 +75,8 @@ def acceleration_route(robot: Robot, log: Log, options: EstimateOptions, min_sam
                        workers: int = 1, choice: DiffChoice | None = None) -> Route:
     """Estimate (5.10-5.13) and fit (3.5) every torque-controlled joint (on ``workers``
     processes), and check energy (7.9). A joint that hardly moved (status ``not excited``) is given the
-    Coulomb-viscous model instead, as ``wbfriction fit`` gives it: its data hold an offset, no Stribeck term. ``choice``: how ``options``' differentiation was chosen
+    Coulomb-viscous model instead, as ``wbfriction fit`` gives it: its data hold an offset, no Stribeck term.
+    ``choice``: how ``options``' differentiation was chosen
     (:func:`~wbfriction.friction.estimate.resolve_differentiation`, done once for several routes),
     recorded in the estimate's metadata as :func:`~wbfriction.friction.estimate.estimate_log` does."""
     est = estimate_log(robot, log, options)
@@ -89,13 +91,10 @@ def stribeck_velocity(fits: list[FitResult], max_relative_error: float = 0.5) ->
     """The joints whose fit determines a Stribeck effect (``v_s``, ``F_c`` and the height ``S``
     with standard errors below ``max_relative_error`` of their values; a fit of a model without them, none), and
     their median Stribeck velocity [rad/s] (None if there are none)."""
-    def determined(f: FitResult) -> bool:
-        p = f.params
-        return p is not None and all(getattr(p, n, 0.0) > 0 and f.stderr.get(n, np.inf) < max_relative_error
-                                     * getattr(p, n) for n in ("v_s", "F_c", "S"))
-    good = [f for f in fits if determined(f)]
-    return (float(np.median([getattr(f.params, "v_s") for f in good])) if good else None,
-            tuple(f.joint for f in good))
+    good = {f.joint: f.params.v_s for f in fits if isinstance(f.params, FrictionParams)
+            and all(getattr(f.params, n) > 0 and f.stderr.get(n, np.inf) < max_relative_error * getattr(f.params, n)
+                    for n in ("v_s", "F_c", "S"))}
+    return (float(np.median(list(good.values()))) if good else None, tuple(good))
 
 
 def identify(robot: Robot, log: Log, estimate_options: EstimateOptions = EstimateOptions(),
