@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
@@ -131,6 +131,7 @@ def test_analytic_jacobian_matches_finite_differences(model, x):
 @settings(max_examples=25, deadline=None)
 @given(F_v=st.floats(0.0, 1.0), F_c=st.floats(0.1, 2.0), S=st.floats(0.1, 1.0), v_s=st.floats(0.05, 0.5),
        tau_os=st.floats(-1.0, 1.0), a=st.floats(10.0, 100.0))
+@example(F_v=0.5, F_c=0.1015625, S=0.21875, v_s=0.05078125, tau_os=0.0, a=10.0)  # a 6 x 6 grid's miss (issue 41)
 def test_fit_recovers_noiseless_parameters(F_v, F_c, S, v_s, tau_os, a):
     truth = FrictionParams(F_v, F_c, S, v_s, tau_os, a)
     qd = np.linspace(-8 * v_s - 0.5, 8 * v_s + 0.5, 2001)

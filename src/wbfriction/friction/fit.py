@@ -626,9 +626,9 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
             offset.
         noise: what is known of the estimate's noise (:class:`~wbfriction.friction.bound.JointNoise`): the fit then
             carries its Cramér-Rao bound (:attr:`FitResult.crb`); None: no bound.
-        still: the model fitted instead of the one named when the joint hardly moved (status ``not excited``: its
-            data hold no velocity model, only an offset; ``auto`` then takes the simplest model anyway); None: the
-            model named.
+        still: the model fitted instead of the one named (from its own start, not ``x0``) when the joint hardly
+            moved (status ``not excited``: its data hold no velocity model, only an offset; ``auto`` then takes the
+            simplest model anyway); None: the model named.
 
     Returns:
         :class:`FitResult`.

@@ -2,11 +2,11 @@
 
 A fit through a smoother (:func:`~wbfriction.friction.fit.filtered_problem`, the variable projection of
 :mod:`~wbfriction.friction.projection`) compares the data on its rows with the model passed through the smoother
-along the whole series. A Savitzky-Golay fit and the momentum route's
-window are local: their output on a row depends on the samples within their half width of it alone. The model is
-then needed only on the rows widened by that reach (the *support*), zero elsewhere: the same values on the rows,
-to rounding (a Savitzky-Golay filter convolves by FFT), for a fraction of the model's evaluations on a log that
-walks in single support part of the time. A Butterworth filter's response and the cubic splines of
+along the whole series. A Savitzky-Golay fit and the momentum route's window are local: their output on a row
+depends on the samples within their half width of it alone. The model is then needed only on the rows widened by
+that reach (the *support*), zero elsewhere: the same values on the rows, to rounding (a Savitzky-Golay filter
+convolves by FFT), for a fraction of the model's evaluations on a log that walks in single support part of the
+time. A Butterworth filter's response and the cubic splines of
 :class:`~wbfriction.signals.nonuniform.ResampledLowpass` never end: the model is then evaluated everywhere.
 """
 
@@ -17,12 +17,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from wbfriction.signals.filters import SavgolSmoother
-from wbfriction.signals.kinematics import PiecewiseSmoother
+from wbfriction.signals.kinematics import PiecewiseSmoother, Smoother
 from wbfriction.signals.nonuniform import NonUniformSavgol, ResampledLowpass
 from wbfriction.signals.window import MomentumWindow
 
 
-def smoother_half_width(smoother) -> int:
+def smoother_half_width(smoother: Smoother | None) -> int:
     """Samples a smoother reaches on each side (0 without one), on its own grid for a resampling one."""
     if smoother is None:
         return 0
@@ -37,7 +37,7 @@ LOCAL = (SavgolSmoother, NonUniformSavgol, MomentumWindow)
 """The smoothers whose output on a row is a weighted sum of the samples within their half width, exactly."""
 
 
-def smoother_reach(smoother) -> int | None:
+def smoother_reach(smoother: Smoother | None) -> int | None:
     """Samples of the series a smoother's output on one row depends on, on each side (0 without one); None where it
     depends on its whole run: a Butterworth filter's response (:class:`~wbfriction.signals.filters.ZeroPhaseLowpass`,
     whose half width only bounds the bulk of it) and a cubic spline's
@@ -60,7 +60,7 @@ class RowSmoothing:
         support: the samples (N,) bool the output on ``rows`` depends on (:func:`row_smoothing`).
     """
 
-    smoother: object
+    smoother: Smoother
     rows: np.ndarray
     support: np.ndarray
 
@@ -68,18 +68,17 @@ class RowSmoothing:
         """``columns`` (S, ...) given on :attr:`support` through the smoother (zero elsewhere), on the rows (n, ...)."""
         whole = np.zeros((self.support.size, *columns.shape[1:]))
         whole[self.support] = columns
-        return self.smoother(whole)[self.rows]  # type: ignore[operator]
+        return self.smoother(whole)[self.rows]
 
 
-def row_smoothing(smoother, size: int, rows: np.ndarray) -> RowSmoothing:
-    """:class:`RowSmoothing` of ``smoother`` on a series of ``size`` samples for ``rows``: its support is the rows
-    widened by :func:`smoother_reach`, or every sample."""
+def row_smoothing(smoother: Smoother, size: int, rows: np.ndarray) -> RowSmoothing:
+    """:class:`RowSmoothing` of ``smoother`` on a series of ``size`` samples for ``rows`` (increasing): its support
+    is the rows widened by :func:`smoother_reach`, or every sample."""
     reach = smoother_reach(smoother)
     if reach is None:
         return RowSmoothing(smoother, rows, np.ones(size, dtype=bool))
-    before = np.zeros(size + 1, dtype=np.int64)  # rows fitted before each sample (a running count)
-    np.add.at(before, np.asarray(rows) + 1, 1)
-    before = np.cumsum(before)
+    fitted = np.zeros(size + 1, dtype=np.int64)
+    fitted[np.asarray(rows) + 1] = 1
+    before = np.cumsum(fitted)  # rows fitted before each sample
     i = np.arange(size)
-    within = before[np.minimum(i + reach + 1, size)] - before[np.maximum(i - reach, 0)]
-    return RowSmoothing(smoother, rows, within > 0)
+    return RowSmoothing(smoother, rows, before[np.minimum(i + reach + 1, size)] > before[np.maximum(i - reach, 0)])
