@@ -152,7 +152,7 @@ class Projection:
 
     def __init__(self, model: ModelName, qd: np.ndarray, y: np.ndarray, rows: np.ndarray, smoother, sigma: float,
                  delta_s: float, held: np.ndarray, free: np.ndarray, lower: np.ndarray, upper: np.ndarray):
-        self.model, self.rows, self.smoother = model, rows, smoother
+        self.model, self.rows = model, rows
         self.sigma, self.delta_s, self.held = sigma, delta_s, held
         self.y = y[rows]
         self.smoothing = None if smoother is None else row_smoothing(smoother, qd.size, rows)
