@@ -8,16 +8,16 @@ import pinocchio as pin
 import pytest
 from hypothesis import settings
 
+from wbfriction.model.loading import load_robot
+from wbfriction.model.robot import Robot
+from wbfriction.signals.kinematics import MeasuredKinematics
+
 # The property tests draw the same examples on every run (a seed from each test's own code, no example database):
 # the suite's verdict is reproducible, and a red CI is a defect, not a draw. `HYPOTHESIS_PROFILE=explore` draws new
 # examples each run (and replays the failures it saved) to look for defects; pin what it finds with `@example`.
 settings.register_profile("repeatable", derandomize=True, database=None)
 settings.register_profile("explore", derandomize=False)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repeatable"))
-
-from wbfriction.model.loading import load_robot
-from wbfriction.model.robot import Robot
-from wbfriction.signals.kinematics import MeasuredKinematics
 
 
 @pytest.fixture(scope="session")
