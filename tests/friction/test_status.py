@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from wbfriction.exceptions import InputError
 from wbfriction.friction.fit import FitResult, compare_routes, fit_friction
 from wbfriction.friction.io import fit_from_dict, fit_to_dict
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams
@@ -59,6 +60,14 @@ def test_still_gives_a_joint_that_hardly_moved_the_model_named_for_it_and_its_of
     moved = fit_friction(*_data(1.0), model="thesis", still="coulomb-viscous")
     assert moved.model == "thesis" and moved.verdict().status == "ok"
 
+
+
+@pytest.mark.parametrize("speed", [0.5 * MIN_SPEED, 1.0])
+def test_still_checks_the_held_names_against_the_model_named_whether_the_joint_moved_or_not(speed):
+    """A name the model named does not have is refused for a joint that hardly moved as for one that moved, though
+    the model ``still`` gives it would not use it either."""
+    with pytest.raises(InputError, match="unknown parameter.*thesis.*: F_s"):
+        fit_friction(*_data(speed), model="thesis", still="coulomb-viscous", fixed={"F_s": 1.0})
 
 def test_too_few_samples_is_not_excited():
     qd, tau_f = _data(1.0, n=10)

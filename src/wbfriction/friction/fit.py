@@ -653,9 +653,9 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
                             fixed=fixed, tolerance=selection_tolerance, sigma=velocity_noise, noise=noise,
                             speed=speed)
         else:
-            if still is not None and speed < MIN_SPEED:
-                model, x0 = still, None
-                fixed = {k: v for k, v in (fixed or {}).items() if k in MODEL_PARAMS[still].names}
+            if still is not None and speed < MIN_SPEED:  # held names checked against the model named all the same
+                check_fixed(check_model(model), fixed)
+                model, x0, fixed = still, None, model_fixed(still, fixed)
             res = _fit_model(check_model(model), qd, y, use, delta_s=delta_s, joint=joint, x0=x0,
                              min_samples=min_samples, smoother=smoother, fixed=fixed, sigma=velocity_noise,
                              noise=noise)
@@ -663,6 +663,27 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
     res.speed = speed
     res.velocity_noise, res.stick_speed, res.n_stuck = float(velocity_noise), float(stick), int(stuck.sum())
     return res
+
+
+def check_fixed(model: ModelName, fixed: Mapping[str, float] | None) -> dict[str, float]:
+    """``fixed`` (parameter name: value held) as a dict, checked against ``model``'s names.
+
+    Raises:
+        InputError: a name that is not ``model``'s; a ``stribeck`` F_s held without F_c.
+    """
+    fixed = dict(fixed or {})
+    names = MODEL_PARAMS[model].names
+    if set(fixed) - set(names):
+        raise InputError(f"unknown parameter(s) of the {model} model to fix: "
+                         f"{', '.join(sorted(set(fixed) - set(names)))}")
+    if model == "stribeck" and "F_s" in fixed and "F_c" not in fixed:
+        raise InputError("the stribeck model's F_s can be held only with F_c held too")
+    return fixed
+
+
+def model_fixed(model: ModelName, fixed: Mapping[str, float] | None) -> dict[str, float]:
+    """The entries of ``fixed`` that are ``model``'s parameters (``auto``'s candidates, ``still``'s model)."""
+    return {k: v for k, v in (fixed or {}).items() if k in MODEL_PARAMS[model].names}
 
 
 @functools.cache
@@ -685,7 +706,7 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     known = {n for m in MODEL_NAMES for n in MODEL_PARAMS[m].names}
     if set(fixed) - known:
         raise InputError(f"unknown parameter(s) to fix: {', '.join(sorted(set(fixed) - known))}")
-    held = {m: {k: v for k, v in fixed.items() if k in MODEL_PARAMS[m].names} for m in MODEL_NAMES}
+    held = {m: model_fixed(m, fixed) for m in MODEL_NAMES}
     kwargs = dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, sigma=sigma)
     train, held_out = held_out_split(use)
     n_train, n_held_out = int(train.sum()), int(held_out.sum())
@@ -743,12 +764,7 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
                noise: JointNoise | None = None) -> FitResult:
     """:func:`fit_friction` of one model to ``y = -tau_f`` on the usable samples ``use``, on the threads it is given."""
     names = MODEL_PARAMS[model].names
-    fixed = dict(fixed or {})
-    if set(fixed) - set(names):
-        raise InputError(f"unknown parameter(s) of the {model} model to fix: "
-                         f"{', '.join(sorted(set(fixed) - set(names)))}")
-    if model == "stribeck" and "F_s" in fixed and "F_c" not in fixed:
-        raise InputError("the stribeck model's F_s can be held only with F_c held too")
+    fixed = check_fixed(model, fixed)
     free = np.array([name not in fixed for name in names])
     held = to_fit_coordinates(model, np.array([float(fixed.get(name, 0.0)) for name in names]))
 
