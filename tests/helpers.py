@@ -29,6 +29,12 @@ needs_kuka = pytest.mark.skipif(not KUKA.is_dir(), reason=f"the real KUKA LWR4+ 
                                                          "(set WBFRICTION_DATA)")
 
 
+def needs_data(folder: str):
+    """Skip a test without the real dataset's folder ``REAL_DATA/<folder>`` (e.g. ``ur10e``, ``panda``)."""
+    return pytest.mark.skipif(not (REAL_DATA / folder).is_dir(),
+                              reason=f"the real {folder} logs are not at {REAL_DATA / folder} (set WBFRICTION_DATA)")
+
+
 def kuka_table(*runs: int) -> pa.Table:
     """Runs ``measurements_<i>.npz`` of the KUKA LWR4+ in the log format (stamps untouched), one after the
     other: :func:`wbfriction.logs.read_npz_recordings`, as ``examples/kuka_lwr4_convert.py`` and

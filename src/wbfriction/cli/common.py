@@ -106,6 +106,18 @@ def robot_of(robot: str, urdf: Optional[Path], config: Optional[Path], mjcf: Opt
     return load_robot(robot, urdf=urdf, config=config, mjcf=mjcf)
 
 
+def config_text(robot: str, config: Optional[Path]) -> tuple[str, Path]:
+    """The robot's configuration as text and the folder its relative paths start from: ``config``'s, else the
+    built-in ``robot``'s packaged TOML (its paths name the installed example-robot-data)."""
+    from importlib import resources
+
+    if config is not None:
+        return config.read_text(encoding="utf-8"), config.parent
+    if robot not in BUILTIN_ROBOTS:
+        raise InputError(f"unknown robot '{robot}': built-in robots are {', '.join(BUILTIN_ROBOTS)}")
+    return resources.files("wbfriction.model.robots").joinpath(f"{robot}.toml").read_text(), Path(".")
+
+
 def print_whole(renderable) -> None:
     """Print ``renderable`` as wide as it takes, nothing cut or wrapped (``--wide``; the terminal wraps its
     lines): a console of that width on the same output (``Console.print`` stays within its console's)."""

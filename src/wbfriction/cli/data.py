@@ -3,50 +3,40 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Literal
+from typing import Literal
 
 import typer
 
-# Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
-# options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.cli.common import app, console, out
 
-if TYPE_CHECKING:
-    pass
-
-from wbfriction.cli.common import (
-    app,
-    console,
-    out,
-)
+# Loading this module (what `wbfriction --help` and every command pay before they start) imports only typer:
+# the datasets' registry (wbfriction.datasets.DATASETS, which these names equal: tested) is imported when it runs.
+DatasetName = Literal["kuka-lwr4", "panda", "ur10e"]
 
 
 @app.command()
-def dataset(name: Literal["kuka-lwr4"] = typer.Argument(..., metavar="NAME",
-                                                       help="The dataset: kuka-lwr4 (FloBaRoID's KUKA LWR4+: three "
-                                                            "runs of 25 s, link-side joint torque sensors, about "
-                                                            "6 MB)."),
+def dataset(name: DatasetName = typer.Argument(..., metavar="NAME",
+                                               help="The dataset: kuka-lwr4 (FloBaRoID's KUKA LWR4+: three runs of "
+                                                    "25 s, link-side joint torque sensors, about 6 MB), ur10e "
+                                                    "(Mamedov et al.'s UR10e: a 50 s excitation and a joint sweep, "
+                                                    "motor currents at 100 Hz, 1 MB) or panda (Gaz et al.'s Franka "
+                                                    "Panda: 21 s of excitation, link-side torque sensors at 1 kHz, "
+                                                    "9 MB)."),
             output_dir: Path = typer.Option(..., "-o", "--output-dir",
-                                            help="Folder to write into (made if missing): runs12.parquet (runs 1 "
-                                                 "and 2), run3.parquet (run 3, held out), the robot's URDF and "
-                                                 "its configuration kuka_lwr4.toml.")) -> None:
+                                            help="Folder to write into (made if missing): the logs (kuka-lwr4: "
+                                                 "runs12.parquet, run3.parquet held out; ur10e: excitation.parquet, "
+                                                 "joint1.parquet held out; panda: excitation.parquet), the robot's "
+                                                 "URDF where it is the dataset's and its configuration "
+                                                 "<robot>.toml.")) -> None:
     """Fetch a real robot's logs and write them as wbfriction logs with the robot beside them: downloaded once
     into the user's cache, each file checked against its SHA-256, or taken from $WBFRICTION_DATA/<dataset>/ (a
     local copy, for offline machines, checked the same way). Prints the commands to run next."""
-    import shlex
+    from wbfriction.datasets import write_dataset
 
-    from wbfriction.datasets import write_kuka_lwr4_logs
-
-    with console.status("fetching the KUKA LWR4+ dataset"):
-        logs = write_kuka_lwr4_logs(output_dir)
-    console.print(f"wrote {logs.runs12} ({logs.rows[0]} samples: runs 1 and 2), {logs.run3} ({logs.rows[1]} "
-                  f"samples: run 3) and the robot, {logs.config}", highlight=False, markup=False)
-    robot = f"--config {shlex.quote(str(logs.config))}"
-    runs12, run3 = shlex.quote(str(logs.runs12)), shlex.quote(str(logs.run3))
-    for line in ("next:", f"  wbfriction estimate {runs12} {robot} -o runs12_friction.parquet",
-                 "  wbfriction fit runs12_friction.parquet -o runs12_params.json",
-                 f"  wbfriction estimate {run3} {robot} -o run3_friction.parquet",
-                 "  wbfriction predict run3_friction.parquet --params runs12_params.json",
-                 f"  wbfriction identify {runs12} {robot} -o kuka_identified.urdf"):
+    with console.status(f"fetching the {name} dataset"):
+        written = write_dataset(name, output_dir)
+    logs = ", ".join(f"{path} ({written.rows[role]} samples: {written.described.get(role, role)})"
+                     for role, path in written.logs.items())
+    console.print(f"wrote {logs} and the robot, {written.config}", highlight=False, markup=False)
+    for line in ("next:", *(f"  {command}" for command in written.commands)):
         out.print(line, highlight=False, markup=False, soft_wrap=True)
-
-

@@ -36,6 +36,7 @@ from wbfriction.cli.common import (
     UrdfOpt,
     WideOpt,
     app,
+    config_text,
     console,
     out,
     print_whole,
@@ -78,11 +79,17 @@ def identify(log: Path = LogArg,
              mask: Mask = typer.Option(ESTIMATE.mask, help="swing or single (see 'estimate')."),
              route: RouteOption = RouteOpt,
              workers: int = FitWorkersOpt, time_unit: Optional[TimeUnit] = TimeUnitOpt,
+             config_output: Optional[Path] = typer.Option(
+                 None, "--config-output", help="Also write the robot's configuration (TOML) for the identified "
+                                              "model: its urdf the corrected URDF, its [armature] the identified "
+                                              "one (--armature identify), the rest as given; then 'wbfriction "
+                                              "estimate LOG --config THIS'."),
              wide: bool = WideOpt) -> None:
     """Identify the inertia model and the friction together from the joint torques of single
     support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
     with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
-    check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output, "--json": json_output})
+    check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output, "--json": json_output,
+                                                                                "--config-output": config_output})
     vs_text = stribeck_velocity.strip().lower()
     try:
         stribeck: float | Literal["auto"] | None = (None if vs_text == "none" else "auto" if vs_text == "auto"
@@ -91,7 +98,7 @@ def identify(log: Path = LogArg,
         raise InputError(f"--stribeck-velocity must be auto, none or a number, got '{stribeck_velocity}'") from None
     if not 0.0 < holdout < 1.0:
         raise InputError(f"--holdout must be between 0 and 1, got {holdout}")
-    from wbfriction.pipeline.identify_step import identify_file
+    from wbfriction.pipeline.identify_step import identify_file, write_identified_config
     from wbfriction.report.terminal import identification_tables
 
     r = robot_of(robot, urdf, config, mjcf)
@@ -131,5 +138,9 @@ def identify(log: Path = LogArg,
         console.print(f"wrote {json_output}")
     warn_energy(done.loop.final.route.energy)
     console.print(f"wrote {output}")
+    if config_output is not None:
+        text, folder = config_text(robot, config)
+        write_identified_config(text, folder, output, config_output, done.armature)
+        console.print(f"wrote {config_output}")
 
 

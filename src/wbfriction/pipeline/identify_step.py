@@ -2,14 +2,20 @@
 :func:`wbfriction.inertia.closed_loop.identify`), the corrected URDF and the identification JSON written.
 
 A URDF has no place for the drives' rotor inertia: an identified armature is in the JSON and in
-:attr:`IdentifiedFile.armature`, as the ``[armature]`` table of the robot's TOML would hold it."""
+:attr:`IdentifiedFile.armature`, as the ``[armature]`` table of the robot's TOML would hold it, and
+:func:`identified_config` writes the robot's configuration with it and the corrected URDF (``identify
+--config-output``), the one file a later ``estimate --config`` needs."""
 
 from __future__ import annotations
 
+import os
+import re
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
+from wbfriction.exceptions import InputError
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.closed_loop import ClosedLoop, identify
 from wbfriction.inertia.document import Identification
@@ -18,6 +24,7 @@ from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.clock import TimeUnit
 from wbfriction.logs.source import read_log
+from wbfriction.logs.tables import write_atomic
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.pipeline.provenance import log_provenance
@@ -76,3 +83,75 @@ def identify_file(robot: Robot, log: str | Path, urdf_output: str | Path, json_o
     armature = (dict(zip(robot.torque_controlled, map(float, ident.armature)))
                 if ident.armature_mode == "identify" else None)
     return IdentifiedFile(loop, result, moved, armature)
+
+
+MOVED_PATHS = ("srdf",)
+"""Keys of a robot TOML that name a file relative to the TOML: rewritten relative to the configuration written."""
+
+
+def identified_config(text: str, source_dir: Path, urdf: Path, output: Path,
+                      armature: dict[str, float] | None) -> str:
+    """A robot configuration (TOML ``text``, read from the folder ``source_dir``) rewritten for an identified model:
+    its ``urdf`` (or ``mjcf``) key replaced by ``urdf`` (relative to ``output``'s folder), its ``[armature]`` table
+    by ``armature`` (kept as it is when None), the paths of :data:`MOVED_PATHS` made relative to ``output``'s folder;
+    every other line, comments included, as it was.
+
+    Raises:
+        InputError: a configuration whose rewriting does not read back as the same configuration (an armature
+            given as dotted keys or an inline table, say), naming ``output``.
+    """
+    here = output.parent.resolve()
+
+    def relative(path: Path) -> str:
+        return Path(os.path.relpath(path.resolve(), here)).as_posix()
+
+    lines: list[str] = []
+    skipping = False
+    for line in text.splitlines():
+        header = re.match(r"\s*\[([^\]]+)\]", line)
+        if header:
+            skipping = armature is not None and header.group(1).strip() == "armature"
+        if skipping or (not header and re.match(r"\s*(urdf|mjcf)\s*=", line) and not _in_table(lines)):
+            continue
+        path_key = re.match(r"\s*(\w+)\s*=\s*\"([^\"]*)\"", line)
+        if path_key and path_key.group(1) in MOVED_PATHS and not _in_table(lines) and ":" not in path_key.group(2):
+            line = f'{path_key.group(1)} = "{relative(source_dir / path_key.group(2))}"'
+        lines.append(line)
+    out = [f'urdf = "{relative(urdf)}"   # the identified model (wbfriction identify)'] + lines
+    if armature is not None:
+        out += ["", "[armature]   # identified by wbfriction identify --armature identify [kg·m^2]"]
+        out += [f"{joint} = {value!r}" for joint, value in armature.items()]
+    written = "\n".join(out) + "\n"
+    expected: dict[str, Any] = {k: v for k, v in tomllib.loads(text).items() if k not in ("urdf", "mjcf")}
+    expected["urdf"] = relative(urdf)
+    if armature is not None:
+        expected["armature"] = dict(armature)
+    for name in MOVED_PATHS:
+        if isinstance(expected.get(name), str) and ":" not in expected[name]:
+            expected[name] = relative(source_dir / expected[name])
+    try:
+        same = tomllib.loads(written) == expected
+    except tomllib.TOMLDecodeError:
+        same = False
+    if not same:
+        raise InputError(f"{output}: the robot's configuration could not be rewritten line by line (its [armature] "
+                         "or urdf is not a plain table or key): copy the [armature] table printed into it instead")
+    return written
+
+
+def _in_table(lines: list[str]) -> bool:
+    """Whether the lines so far opened a table (a key after them is the table's, not top-level)."""
+    return any(re.match(r"\s*\[", line) for line in lines)
+
+
+def write_identified_config(text: str, source_dir: Path, urdf: Path, output: str | Path,
+                            armature: dict[str, float] | None) -> None:
+    """Write :func:`identified_config` to ``output``, whole or not at all.
+
+    Raises:
+        InputError: what :func:`identified_config` raises.
+        OutputError: the system refused the write.
+    """
+    output = Path(output)
+    written = identified_config(text, source_dir, urdf, output, armature)
+    write_atomic(output, lambda tmp: tmp.write_text(written, encoding="utf-8"))

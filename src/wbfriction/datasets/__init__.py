@@ -1,0 +1,51 @@
+"""Real robots' public logs a user can fetch, as wbfriction logs with the robot beside them, and their references.
+
+Each dataset (:mod:`~wbfriction.datasets.dataset`: one module each, registered in :data:`DATASETS`) names its files
+by repository, commit, path and SHA-256 (:mod:`~wbfriction.datasets.store`): downloaded once with :mod:`pooch` into
+the user's cache, or read from ``$WBFRICTION_DATA/<folder>/`` (:data:`DATA_ENV`) on offline machines, checked the
+same way. ``wbfriction dataset NAME -o DIR`` writes its logs and the robot's configuration (:func:`write_dataset`).
+The published friction each is compared with ships as data (:mod:`~wbfriction.datasets.reference`).
+
+* ``kuka-lwr4`` (:mod:`~wbfriction.datasets.kuka`): FloBaRoID's KUKA LWR4+, link-side torque sensors;
+* ``ur10e`` (:mod:`~wbfriction.datasets.ur10e`): Mamedov et al.'s UR10e, motor currents and drive gains;
+* ``panda`` (:mod:`~wbfriction.datasets.panda`): Gaz et al.'s Franka Panda, link-side torque sensors.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from wbfriction.datasets.dataset import DATASETS, Dataset, WrittenDataset, dataset, register
+from wbfriction.datasets.kuka import (
+    KUKA_LWR4_FILES,
+    KUKA_LWR4_JOINTS,
+    KUKA_LWR4_LOGS,
+    KUKA_LWR4_ROBOT,
+    KukaLwr4,
+    KukaLwr4Dataset,
+    KukaLwr4Logs,
+    kuka_lwr4,
+    kuka_lwr4_config,
+    write_kuka_lwr4_logs,
+)
+from wbfriction.datasets.panda import PandaDataset
+from wbfriction.datasets.reference import Reference, reference
+from wbfriction.datasets.store import DATA_ENV, GITHUB_RAW, RemoteFile, fetch_files
+from wbfriction.datasets.ur10e import Ur10eDataset
+
+
+def write_dataset(name: str, directory: str | Path) -> WrittenDataset:
+    """Fetch the dataset ``name`` and write its logs and robot configuration into ``directory``
+    (:meth:`~wbfriction.datasets.dataset.Dataset.write`).
+
+    Raises:
+        InputError: an unknown name (listing the known ones); a missing, damaged or undownloadable file.
+        OutputError: the folder, the cache or a file cannot be written.
+    """
+    return dataset(name).write(directory)
+
+
+__all__ = ["DATASETS", "DATA_ENV", "Dataset", "GITHUB_RAW", "KUKA_LWR4_FILES", "KUKA_LWR4_JOINTS", "KUKA_LWR4_LOGS",
+           "KUKA_LWR4_ROBOT", "KukaLwr4", "KukaLwr4Dataset", "KukaLwr4Logs", "PandaDataset", "Reference",
+           "RemoteFile", "Ur10eDataset", "WrittenDataset", "dataset", "fetch_files", "kuka_lwr4", "kuka_lwr4_config",
+           "reference", "register", "write_dataset", "write_kuka_lwr4_logs"]
