@@ -244,11 +244,11 @@ def test_the_command_writes_both_kuka_logs(tmp_path, capsys, local_copy):
     np.testing.assert_array_equal(run3["time"].to_numpy(), runs[2])
     assert f"{out / 'runs12.parquet'} ({2 * SAMPLES} samples" in err
     # the printed commands name the configuration written beside the logs, which names the URDF copied there
-    estimate = printed_command(printed, "estimate")
-    config = estimate[estimate.index("--config") + 1]
-    assert config == str(out / "kuka_lwr4.toml") and "--urdf" not in estimate
+    identify = printed_command(printed, "identify")
+    config = identify[identify.index("--config") + 1]
+    assert config == str(out / "kuka_lwr4.toml") and "--urdf" not in identify and "--config-output" in identify
     assert (out / "kuka_lwr4.urdf").read_bytes() == (KUKA / "kuka_lwr4.urdf").read_bytes()
-    assert estimate[2] == str(out / "runs12.parquet")
+    assert identify[2] == str(out / "runs12.parquet")
     robot = load_robot(config=config)
     assert robot.actuated == datasets.KUKA_LWR4_JOINTS and not robot.floating_base
     log = read_log(out / "runs12.parquet", robot)

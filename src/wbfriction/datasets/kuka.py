@@ -126,11 +126,11 @@ class KukaLwr4Dataset(Dataset):
             '\nname = "kuka_lwr4"\n', f'\nname = "kuka_lwr4"\nurdf = "{urdf.name}"   # beside this file\n', 1)))
         robot = f"--config {shlex.quote(str(config))}"
         q12, q3 = shlex.quote(str(runs12)), shlex.quote(str(run3))
-        commands = (f"wbfriction estimate {q12} {robot} -o runs12_friction.parquet",
+        commands = (f"wbfriction identify {q12} {robot} -o kuka_identified.urdf --config-output kuka_identified.toml",
+                    f"wbfriction estimate {q12} --config kuka_identified.toml -o runs12_friction.parquet",
                     "wbfriction fit runs12_friction.parquet -o runs12_params.json",
-                    f"wbfriction estimate {q3} {robot} -o run3_friction.parquet",
-                    "wbfriction predict run3_friction.parquet --params runs12_params.json",
-                    f"wbfriction identify {q12} {robot} -o kuka_identified.urdf")
+                    f"wbfriction estimate {q3} --config kuka_identified.toml -o run3_friction.parquet",
+                    "wbfriction predict run3_friction.parquet --params runs12_params.json")
         return WrittenDataset(self.name, {"train": runs12, "held_out": run3},
                               {"train": tables[0].num_rows, "held_out": tables[1].num_rows}, config, commands,
                               {"train": "runs 1 and 2", "held_out": "run 3"})

@@ -117,8 +117,9 @@ class PandaDataset(Dataset):
         write_table(table, log)
         write_atomic(config, lambda tmp: tmp.write_text(CONFIG))
         q, robot = shlex.quote(str(log)), f"--config {shlex.quote(str(config))}"
-        commands = (f"wbfriction identify {q} {robot} --armature none -o panda_identified.urdf",
-                    f"wbfriction estimate {q} --urdf panda_identified.urdf {robot} -o panda_friction.parquet",
+        commands = (f"wbfriction identify {q} {robot} --armature none -o panda_identified.urdf "
+                    "--config-output panda_identified.toml",
+                    f"wbfriction estimate {q} --config panda_identified.toml -o panda_friction.parquet",
                     "wbfriction fit panda_friction.parquet -o panda_params.json")
         return WrittenDataset(self.name, {"train": log}, {"train": table.num_rows}, config, commands,
                               {"train": "the 21 s excitation"})

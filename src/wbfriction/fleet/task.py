@@ -28,7 +28,7 @@ from wbfriction.fleet.manifest import LogEntry
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
 from wbfriction.friction.energy import JointEnergy
-from wbfriction.friction.fit import FitResult, model_jacobian
+from wbfriction.friction.fit import FitResult
 from wbfriction.friction.terms import TermFit
 from wbfriction.logs.tables import file_sha256, scratch_folder
 from wbfriction.model.robot import Robot
@@ -148,18 +148,10 @@ def one_line(text: str) -> str:
 
 def reference_friction(fit: FitResult, v: float) -> tuple[float, float]:
     """The fitted model's dissipative friction at speed ``v`` [rad/s], ``(f(+v) - f(-v)) / 2`` [N·m], and its
-    standard error from the parameters' covariance (delta method); NaN without a fit or a covariance."""
-    if fit.params is None:
-        return float("nan"), float("nan")
-    x, model = fit.params.as_vector(), fit.params.model
-    delta_s = getattr(fit.params, "delta_s", 2.0)
-    qd = np.array([v, -v])
-    value = 0.5 * float(np.subtract(*fit.params.f(qd)))
-    if fit.covariance is None or not np.all(np.isfinite(fit.covariance)):
-        return value, float("nan") if fit.covariance is None else float("inf")
-    J = model_jacobian(x, qd, delta_s, model)
-    g = 0.5 * (J[0] - J[1])
-    return value, float(np.sqrt(max(float(g @ fit.covariance @ g), 0.0)))
+    standard error from the parameters' covariance (delta method, :meth:`FitResult.dissipative`); NaN without a fit
+    or a covariance."""
+    value, se = fit.dissipative(np.array([v]))
+    return float(value[0]), float(se[0])
 
 
 def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy], qd: np.ndarray,

@@ -54,6 +54,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any, Generic, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.bound import BATCH, JointNoise, cramer_rao, torque_noise
@@ -341,6 +342,26 @@ class FitResult(Generic[ParamsT]):
                        route_check=None if check is None else RouteCheck(
                            check.route, {n: v for n, v in check.coefficients.items() if n in names},
                            {n: v for n, v in check.stderr.items() if n in names}))
+
+    def dissipative(self, v: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """The model's dissipative friction at the speeds ``v`` [rad/s], ``(f(v) - f(-v)) / 2`` [N·m] (free of the
+        offset; positive where friction dissipates), and its standard error from :attr:`covariance` (the delta
+        method), each of ``v``'s shape: NaN without parameters; the error NaN without a covariance, ``inf`` where it
+        is not finite (a parameter not identifiable)."""
+        v = np.asarray(v, dtype=float)
+        if self.params is None:
+            return np.full(v.shape, np.nan), np.full(v.shape, np.nan)
+        x, model = self.params.as_vector(), self.params.model
+        value = 0.5 * (self.params.f(v) - self.params.f(-v))
+        if self.covariance is None:
+            return value, np.full(v.shape, np.nan)
+        if not np.all(np.isfinite(self.covariance)):
+            return value, np.full(v.shape, np.inf)
+        flat = v.ravel()
+        delta_s = getattr(self.params, "delta_s", 2.0)
+        g = 0.5 * (model_jacobian(x, flat, delta_s, model) - model_jacobian(x, -flat, delta_s, model))
+        var = np.einsum("ij,jk,ik->i", g, self.covariance, g)
+        return value, np.sqrt(np.maximum(var, 0.0)).reshape(v.shape)
 
     def bounded(self) -> tuple[str, ...]:
         """Names of the parameters at a bound (:attr:`at_bound`)."""

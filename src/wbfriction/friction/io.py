@@ -280,6 +280,19 @@ def selection_from_dict(d: Mapping[str, Any]) -> ModelSelection:
         raise InputError(f"selection: {exc}") from None
 
 
+def _covariance(rows: Any, p: int) -> np.ndarray:
+    """A parameters JSON's ``covariance`` (p x p, in the parameters' order; ``null`` for ``inf``: a parameter that
+    is not identifiable).
+
+    Raises:
+        ValueError: not a p x p matrix of numbers.
+    """
+    cov = np.array([[_number(x) for x in row] for row in rows], dtype=float)
+    if cov.shape != (p, p):
+        raise ValueError(f"covariance of shape {cov.shape}, expected ({p}, {p}) (one row per parameter)")
+    return cov
+
+
 def fit_to_dict(fit: FitResult) -> dict[str, Any]:
     """One joint's entry of the parameters JSON (a standard error that is not finite: ``null``)."""
     clean = finite_or_none
@@ -289,6 +302,8 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
                          "params": None if fit.params is None else fit.params.to_dict(),
                          "stderr": {k: clean(v) for k, v in fit.stderr.items()},
                          "at_bound": dict(fit.at_bound), "speed": fit.speed}
+    if fit.params is not None and fit.covariance is not None:  # the curve's standard error at any speed
+        d["covariance"] = [[clean(float(x)) for x in row] for row in fit.covariance]
     d["crb"] = {k: clean(v) for k, v in fit.crb.items()}
     d["torque_noise"] = fit.torque_noise
     d["route"] = fit.route
@@ -333,6 +348,8 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
         if d.get("params") is not None:
             res.params = params_from_dict(model, d["params"])
             res.stderr = {k: _number(v) for k, v in (d.get("stderr") or {}).items()}
+            if d.get("covariance") is not None:
+                res.covariance = _covariance(d["covariance"], len(res.params.names))
         at_bound = d.get("at_bound") or {}
         unknown = set(at_bound) - set(res.params.names if res.params is not None else at_bound)
         if unknown:

@@ -1,0 +1,91 @@
+"""Every real dataset through the route the README gives a user, against its published reference (issue 52).
+
+Run it after any change that can move a number, and put its table in the note. For each dataset (``wbfriction
+dataset NAME``; offline, ``WBFRICTION_DATA`` names the local copy, default ``../shared/real-data`` beside the
+checkout), the commands the dataset prints run as a user runs them (each its own process, timed), then per joint:
+
+* ``status``: the fit's;
+* ``curve``: the odd part's relative RMS error against the published curve over ``|qd| >= 0.1`` rad/s (UR10e:
+  Mamedov et al.'s Coulomb-viscous; Panda: Gaz et al.'s sigmoid), and ``sigmas``: that deviation in the fit's own
+  standard errors (honest errors put it within 3);
+* ``held-out``: the torque RMS on the held-out log (KUKA: run 3; UR10e: the shoulder pan's sweep, the other joints
+  at rest there, marked ``still``), and ``peer``: FloBaRoID's method on run 3 (KUKA).
+
+Then one line per dataset with the issue's targets: UR10e every joint within 5 %; Panda every ``ok`` joint within
+15 % and 3 standard errors; KUKA every joint better than the peer.
+
+    python benchmarks/bench_real.py [--datasets kuka-lwr4,ur10e,panda] [--keep DIR]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+from wbfriction.datasets import DATA_ENV, DATASETS
+from wbfriction.studies.real_data import DatasetRun, run_dataset, summarise
+
+REPO = Path(__file__).resolve().parents[1]
+TARGET_ERROR = {"ur10e": 0.05, "panda": 0.15}
+"""The issue's curve targets: every joint (UR10e), every ``ok`` joint (Panda) within this share."""
+
+
+def cell(x: float, fmt: str) -> str:
+    return "–" if not math.isfinite(x) else format(x, fmt)
+
+
+def table(runs: list[DatasetRun]) -> str:
+    """The markdown table of every joint of ``runs``."""
+    lines = ["| dataset | joint | status | model | curve [%] | sigmas | held-out [N·m] | peer [N·m] |",
+             "|---|---|---|---|---|---|---|---|"]
+    for run in runs:
+        if run.failed:
+            lines.append(f"| {run.name} | (failed) | {run.failed} | | | | | |")
+        for j in run.joints:
+            held = cell(j.held_out, ".3f") + ("" if j.held_out_moved or not math.isfinite(j.held_out) else " still")
+            lines.append(f"| {run.name} | {j.joint} | {j.status} | {j.model} | {cell(100 * j.curve_error, '.1f')} | "
+                         f"{cell(j.curve_sigmas, '.1f')} | {held} | {cell(j.peer, '.3f')} |")
+    return "\n".join(lines)
+
+
+def summary(runs: list[DatasetRun]) -> str:
+    lines = ["| dataset | ok | ok within target | ok within 3 SE | worst curve | better than peer | time [s] |",
+             "|---|---|---|---|---|---|---|"]
+    for run in runs:
+        s = summarise(run, TARGET_ERROR.get(run.name, math.inf))
+        target = f"{s.ok_within_error} ({100 * TARGET_ERROR[run.name]:.0f} %)" if run.name in TARGET_ERROR else "–"
+        sigmas = str(s.ok_within_3_sigmas) if run.name in TARGET_ERROR else "–"
+        peer = f"{s.better_than_peer} of {s.peers}" if s.peers else "–"
+        lines.append(f"| {run.name} | {s.ok} of {s.joints} | {target} | {sigmas} | "
+                     f"{cell(100 * s.worst_error, '.1f')} % | {peer} | {s.seconds:.0f} |")
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--datasets", default=",".join(DATASETS), help="comma-separated, of " + ", ".join(DATASETS))
+    parser.add_argument("--keep", type=Path, help="run in this folder and keep what the commands wrote")
+    args = parser.parse_args()
+    os.environ.setdefault(DATA_ENV, str(REPO.parent / "shared" / "real-data"))
+    names = [n.strip() for n in args.datasets.split(",") if n.strip()]
+    unknown = [n for n in names if n not in DATASETS]
+    if unknown:
+        sys.exit(f"--datasets: unknown {', '.join(unknown)} (one of {', '.join(DATASETS)})")
+    with tempfile.TemporaryDirectory(prefix="bench_real-") as scratch:
+        base = args.keep or Path(scratch)
+        runs = []
+        for name in names:
+            print(f"{name}:", flush=True)
+            runs.append(run_dataset(name, base / name, echo=lambda line: print(f"  {line}", flush=True)))
+    print()
+    print(table(runs))
+    print()
+    print(summary(runs))
+
+
+if __name__ == "__main__":
+    main()

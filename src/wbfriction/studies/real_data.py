@@ -1,0 +1,235 @@
+"""Every real dataset through the route a user is given, scored against its published reference (issue 52).
+
+For each dataset of :mod:`wbfriction.datasets`, :func:`run_dataset` does what a user does: ``wbfriction dataset NAME``
+writes the logs, then the commands it prints run one after the other, each as its own process (``python -m
+wbfriction ...``), timed, in a folder of their own. The route is the one those commands give for that kind of robot:
+identify the inertia model (and, for motor currents, the armature) from the torques, estimate the friction with it,
+fit, and predict the held-out log where the dataset has one.
+
+:func:`score` reads what the commands wrote (the parameters JSON of the last ``fit``, its friction table, the held-out
+friction table of ``predict``) and scores every joint (:class:`JointScore`):
+
+* against a published curve (UR10e, Panda: :mod:`wbfriction.datasets.reference`), the odd part's relative RMS
+  error ``|odd_fit - odd_ref| / |odd_ref|`` over the fitted log's valid samples with ``|qd| >= min_speed`` (0.1
+  rad/s), and that deviation in the fit's own standard errors (the RMS over the same samples of the deviation over
+  the curve's standard error, :meth:`~wbfriction.friction.fit.FitResult.dissipative`): a fit whose standard errors
+  are honest about what the data determine lies within 3;
+* on the held-out log, the torque RMS of the model fitted (:func:`~wbfriction.pipeline.predict_step.predict_file`)
+  against the peer's where it is known (KUKA: FloBaRoID's method).
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from wbfriction.datasets import reference, write_dataset
+from wbfriction.datasets.reference import HeldOutRms, Reference
+from wbfriction.exceptions import WbfrictionError
+from wbfriction.friction.fit import FitResult
+from wbfriction.friction.io import read_friction_file, read_params
+from wbfriction.friction.status import MIN_SPEED, joint_speed
+from wbfriction.pipeline.predict_step import predict_file
+
+
+@dataclass(frozen=True)
+class Timed:
+    """One command of a route and the wall time it took [s]."""
+
+    command: str
+    seconds: float
+
+
+@dataclass(frozen=True)
+class JointScore:
+    """One joint of a dataset, as the route left it (NaN where a figure does not apply).
+
+    Attributes:
+        joint: its name.
+        status: the fit's status (:mod:`~wbfriction.friction.status`) and ``reason`` why, when not ``ok``.
+        model: the model family chosen.
+        curve_error: the odd part's relative RMS error against the published curve (a share, 0.05 = 5 %).
+        curve_sigmas: that deviation in the fit's standard errors (RMS over the samples of deviation / error).
+        held_out: the torque RMS on the held-out log [N·m].
+        peer: the peer's held-out torque RMS [N·m].
+        held_out_moved: whether the joint moved in the held-out log (a joint at rest there predicts static
+            friction, which no velocity model holds).
+    """
+
+    joint: str
+    status: str
+    reason: str
+    model: str
+    curve_error: float = float("nan")
+    curve_sigmas: float = float("nan")
+    held_out: float = float("nan")
+    peer: float = float("nan")
+    held_out_moved: bool = False
+
+
+@dataclass(frozen=True)
+class DatasetRun:
+    """A dataset through its route: the commands timed and each joint's score."""
+
+    name: str
+    commands: tuple[Timed, ...]
+    joints: tuple[JointScore, ...] = ()
+    failed: str = ""
+
+    @property
+    def seconds(self) -> float:
+        """The route's wall time, the dataset's conversion included [s]."""
+        return sum(c.seconds for c in self.commands)
+
+    def ok(self) -> tuple[JointScore, ...]:
+        """The joints whose fit is ``ok``."""
+        return tuple(j for j in self.joints if j.status == "ok")
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """Where a route's commands wrote what :func:`score` reads."""
+
+    params: Path
+    friction: Path
+    held_out: Path | None = None
+
+
+def outputs(commands: Sequence[str], folder: Path) -> Outputs:
+    """The parameters JSON and friction table of the last ``fit`` of ``commands``, and the friction table of the
+    last ``predict`` (None without one), as paths in ``folder`` (the commands' working folder)."""
+    fit = predict = None
+    for line in commands:
+        words = shlex.split(line)
+        if words[1:2] == ["fit"]:
+            fit = words
+        elif words[1:2] == ["predict"]:
+            predict = words
+    if fit is None:
+        raise ValueError("the route has no fit")
+    return Outputs(folder / fit[fit.index("-o") + 1], folder / fit[2],
+                   None if predict is None else folder / predict[2])
+
+
+def curve_scores(fit: FitResult, qd: np.ndarray, ref: Reference, joint: str) -> tuple[float, float]:
+    """The fit's odd part against the published one's over the speeds ``qd`` [rad/s] (the fitted samples) with
+    ``|qd| >= ref.min_speed``: (relative RMS error, RMS deviation in the fit's standard errors)."""
+    v = qd[np.abs(qd) >= ref.min_speed]
+    if fit.params is None or v.size == 0:
+        return float("nan"), float("nan")
+    mine, se = fit.reported().dissipative(v)  # with terms kept: the refit's curve, no covariance (NaN)
+    published = ref.odd(joint, v)
+    error = float(np.sqrt(np.mean((mine - published) ** 2) / np.mean(published**2)))
+    sigmas = float(np.sqrt(np.mean(((mine - published) / se) ** 2))) if np.all(se > 0) else float("nan")
+    return error, sigmas
+
+
+def score(name: str, outs: Outputs) -> tuple[JointScore, ...]:
+    """Every joint of the dataset ``name`` from the outputs of its route (module docstring)."""
+    ref = reference(name)
+    fits = read_params(outs.params)
+    est = read_friction_file(outs.friction)
+    prediction = held = None
+    if outs.held_out is not None:
+        prediction = predict_file(outs.held_out, outs.params)
+        held = read_friction_file(outs.held_out)
+    out = []
+    for k, joint in enumerate(est.joints):
+        fit = fits[joint]
+        verdict = fit.verdict()
+        error = sigmas = float("nan")
+        if ref.has_curve:
+            error, sigmas = curve_scores(fit, est.qd[est.valid[:, k], k], ref, joint)
+        held_out = peer = float("nan")
+        moved = False
+        if prediction is not None and held is not None:
+            i = prediction.joints.index(joint)
+            held_out = float(prediction.rms[i])
+            moved = joint_speed(held.qd[held.valid[:, i], i]) >= MIN_SPEED
+        if isinstance(ref, HeldOutRms):
+            peer = ref.held_out(joint)
+        out.append(JointScore(joint, verdict.status, verdict.reason, fit.model, error, sigmas, held_out, peer, moved))
+    return tuple(out)
+
+
+def run_route(commands: Sequence[str], folder: Path, python: str = sys.executable,
+              env: dict[str, str] | None = None, echo: Callable[[str], None] | None = None) -> tuple[Timed, ...]:
+    """Run ``commands`` (``wbfriction ...`` lines) one after the other in ``folder``, each as ``python -m
+    wbfriction ...``, timed.
+
+    Raises:
+        WbfrictionError: a command that failed, with its last line of standard error.
+    """
+    timed = []
+    for line in commands:
+        words = shlex.split(line)
+        if echo is not None:
+            echo(line)
+        start = time.perf_counter()
+        done = subprocess.run([python, "-m", "wbfriction", *words[1:]], cwd=folder, capture_output=True, text=True,
+                              env=env)
+        timed.append(Timed(line, time.perf_counter() - start))
+        if done.returncode != 0:
+            last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
+            raise WbfrictionError(f"{line}: exit status {done.returncode}: {last}")
+    return tuple(timed)
+
+
+def run_dataset(name: str, folder: str | Path, python: str = sys.executable,
+                echo: Callable[[str], None] | None = None) -> DatasetRun:
+    """The dataset ``name`` through its route in ``folder`` (made if missing): written by ``wbfriction dataset``
+    (:func:`~wbfriction.datasets.write_dataset`, timed), its printed commands run (:func:`run_route`), scored
+    (:func:`score`). A route that fails is a run with its message in :attr:`DatasetRun.failed`."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    written = write_dataset(name, folder / "data")
+    convert = Timed(f"wbfriction dataset {name} -o data", time.perf_counter() - start)
+    commands = [c.replace(str(folder) + os.sep, "") for c in written.commands]
+    try:
+        timed = run_route(commands, folder, python, echo=echo)
+    except WbfrictionError as exc:
+        return DatasetRun(name, (convert,), failed=str(exc))
+    return DatasetRun(name, (convert, *timed), score(name, outputs(commands, folder)))
+
+
+@dataclass(frozen=True)
+class Summary:
+    """What the issue asks of each dataset, counted: how many fits are ``ok`` and, of those, how many lie within
+    ``max_error`` of the published curve and within 3 standard errors of it; how many joints predict the held-out
+    log better than the peer."""
+
+    name: str
+    joints: int
+    ok: int
+    ok_within_error: int = 0
+    ok_within_3_sigmas: int = 0
+    worst_error: float = float("nan")
+    better_than_peer: int = 0
+    peers: int = 0
+    seconds: float = float("nan")
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+
+def summarise(run: DatasetRun, max_error: float) -> Summary:
+    """The counts of :class:`Summary` for one run; ``max_error`` the share a curve must be within (0.05, 0.15)."""
+    ok = run.ok()
+    errors = [j.curve_error for j in run.joints if np.isfinite(j.curve_error)]
+    peers = [j for j in run.joints if np.isfinite(j.peer) and np.isfinite(j.held_out)]
+    return Summary(run.name, len(run.joints), len(ok),
+                   sum(1 for j in ok if j.curve_error <= max_error),
+                   sum(1 for j in ok if j.curve_sigmas <= 3.0),
+                   max(errors, default=float("nan")),
+                   sum(1 for j in peers if j.held_out < j.peer), len(peers), run.seconds)
+
+
+__all__ = ["DatasetRun", "JointScore", "Outputs", "Summary", "Timed", "curve_scores", "outputs", "run_dataset",
+           "run_route", "score", "summarise"]
