@@ -115,6 +115,8 @@ _BOUNDS: dict[ModelName, tuple[np.ndarray, np.ndarray]] = {
     "stribeck": (np.array([0.0, 0.0, 0.0, 1e-4, -np.inf]), np.array([np.inf, np.inf, np.inf, 100.0, np.inf])),
     "thesis": (LOWER, UPPER),
 }
+STEP_SLOPES = ("a",)
+"""Slopes whose upper bound means a step (:meth:`FitResult.steps`)."""
 _V_S = {"coulomb-viscous": None, "stribeck": 3, "thesis": 3}  # position of v_s, bounded by the data's speed
 _FIXED_COLUMNS: dict[ModelName, tuple[int, ...]] = {
     "coulomb-viscous": (0, 1, 2), "stribeck": (0, 4), "thesis": (0, 4)}
@@ -355,17 +357,30 @@ class FitResult(Generic[ParamsT]):
         value = 0.5 * (self.params.f(v) - self.params.f(-v))
         if self.covariance is None:
             return value, np.full(v.shape, np.nan)
-        if not np.all(np.isfinite(self.covariance)):
-            return value, np.full(v.shape, np.inf)
         flat = v.ravel()
         delta_s = getattr(self.params, "delta_s", 2.0)
         g = 0.5 * (model_jacobian(x, flat, delta_s, model) - model_jacobian(x, -flat, delta_s, model))
-        var = np.einsum("ij,jk,ik->i", g, self.covariance, g)
-        return value, np.sqrt(np.maximum(var, 0.0)).reshape(v.shape)
+        # a parameter that is not identifiable (infinite variance) counts where the curve depends on it at these
+        # speeds, and makes its error infinite there; elsewhere (a step's slope beyond its first samples) not
+        known = np.isfinite(np.diag(self.covariance))
+        cov = np.where(np.outer(known, known), self.covariance, 0.0)
+        var = np.einsum("ij,jk,ik->i", g, cov, g)
+        unknown = np.any(np.abs(g[:, ~known]) > 1e-12 * (1.0 + np.abs(value.ravel()[:, None])), axis=1)
+        return value, np.where(unknown, np.inf, np.sqrt(np.maximum(var, 0.0))).reshape(v.shape)
 
     def bounded(self) -> tuple[str, ...]:
         """Names of the parameters at a bound (:attr:`at_bound`)."""
         return tuple(n for n, at in self.at_bound.items() if at)
+
+    def steps(self) -> tuple[str, ...]:
+        """The slopes at their upper bound (:data:`STEP_SLOPES`: (3.5)'s tanh slope ``a``): a step sharper than the
+        data resolve, which is Coulomb friction (``sgn``), not a failure of the fit; its status does not count it
+        as a bound (:func:`~wbfriction.friction.status.fit_verdict`) and the tables show it as a step."""
+        if self.params is None:
+            return ()
+        upper = dict(zip(MODEL_PARAMS[self.model].names, _BOUNDS[self.model][1]))
+        return tuple(n for n in STEP_SLOPES if self.at_bound.get(n) and n in upper
+                     and getattr(self.params, n) >= 0.5 * upper[n])
 
     def verdict(self) -> FitVerdict:
         """Whether these numbers can be used: ``ok``, ``weak``, ``at bound``, ``not excited`` or ``failed``,

@@ -8,7 +8,9 @@ status, the first that applies:
 * ``failed``: the solver stopped without converging (its message translated, :func:`solver_phrase`);
 * ``at bound``: a parameter was left on a bound of the fit's search (its value is the bound's, not the
   data's), named. A magnitude at its floor of zero (F_c, F_v, S, F_s = 0: no such friction found) is a
-  result, not a bound of the search;
+  result, not a bound of the search; so is a slope at its upper bound (the tanh slope ``a`` of (3.5)): a step
+  sharper than the data resolve is Coulomb friction (``sgn``), the step is the finding
+  (:meth:`~wbfriction.friction.fit.FitResult.steps`);
 * ``routes disagree`` (issue 38): the same model fitted on the other route's estimate (the acceleration
   route's for the momentum route, and the other way round) differs on F_c or F_v by more than
   :data:`ROUTE_Z` combined standard errors and :data:`ROUTE_REL`
@@ -95,6 +97,8 @@ class Fit(Protocol):
 
     def bounded(self) -> tuple[str, ...]: ...
 
+    def steps(self) -> tuple[str, ...]: ...
+
 
 @dataclass(frozen=True)
 class FitVerdict:
@@ -130,7 +134,7 @@ def fit_verdict(fit: Fit) -> FitVerdict:
     if terms is not None:
         return _with_terms(fit, terms)
     values = fit.params.to_dict()
-    bounded = [n for n in fit.bounded() if not (n in ZERO_FLOOR and abs(values[n]) < ZERO)]
+    bounded = [n for n in fit.bounded() if not (n in ZERO_FLOOR and abs(values[n]) < ZERO) and n not in fit.steps()]
     if bounded:
         return FitVerdict("at bound", "at a bound of the fit: " + ", ".join(bounded))
     check = fit.route_check
@@ -152,7 +156,7 @@ def _with_terms(fit: Fit, terms: Any) -> FitVerdict:
     model it predicts and exports with, the velocity coefficients refitted with the terms (their standard errors,
     the other route's refit of them) and each term's own (:meth:`~wbfriction.friction.terms.TermFit.verdicts`)."""
     values = terms.params.to_dict()
-    bounded = [n for n in fit.bounded() if n in HELD]
+    bounded = [n for n in fit.bounded() if n in HELD and n not in fit.steps()]
     if bounded:
         return FitVerdict("at bound", "at a bound of the fit: " + ", ".join(bounded))
     check = terms.check

@@ -101,6 +101,8 @@ def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> s
     def cell(fit: FitResult, n: str) -> str:
         if fit.params is None or n not in fit.params.names:
             return "<td></td>"
+        if n in fit.steps():
+            return '<td>step<br><span class="name">sharper than the data resolve: Coulomb</span></td>'
         bound = '<br><span class="name">at a bound</span>' if fit.at_bound.get(n) else ""
         return f"<td>{_fmt(getattr(fit.params, n), fit.stderr.get(n))}{bound}</td>"
 

@@ -32,6 +32,7 @@ OTHERS = ("tau_os", "S", "v_s", "a")
 """The offset (every model) and the Stribeck terms (the models that have them), in a second table."""
 CAPTION = ("value ± standard error; Cramér-Rao: the standard deviation no unbiased estimator from these data "
            "goes below; n.i.: not identifiable; (b): at a bound of the fit, the bound's value, not the data's; "
+           "a step: a tanh slope beyond what the data resolve (Coulomb friction, sgn); "
            "dim: not to be used (status); *: refitted with its terms beyond velocity (the terms' table)")
 NAMES_SHOWN = 6
 """Joints named in a note before "and N more"."""
@@ -40,6 +41,8 @@ NAMES_SHOWN = 6
 def _cell(r: FitResult, name: str) -> str:
     if r.params is None or name not in r.params.names:
         return ""
+    if name in r.steps():
+        return "step"
     return with_error(getattr(r.params, name), r.stderr.get(name)) + (" (b)" if r.at_bound.get(name) else "")
 
 
