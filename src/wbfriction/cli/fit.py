@@ -103,7 +103,9 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
            include: str = typer.Option("", "--include",
                                        help="Fit statuses exported besides ok, comma-separated: weak (large "
                                             "standard errors), at-bound (a parameter at a bound of the fit), "
-                                            "routes-disagree (the two routes' fits differ: one is biased). "
+                                            "routes-disagree (the two routes' fits differ: one is biased), "
+                                            "does-not-predict (fitted on the first 70 % of its samples it "
+                                            "mispredicts the rest). "
                                             "Fits not excited or failed are never exported."),
            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
            mjcf: Optional[Path] = MjcfOpt) -> None:
@@ -151,20 +153,33 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
         pred = predict_file(friction, params)
     table = Table(title=f"Torque prediction on {friction.name}: RMS of measured - predicted [N·m]", box=None)
     with_terms = any(pred.terms)
-    columns = ("joint", "samples", "rigid body only", "with friction", "fit", *(("terms",) if with_terms else ()))
+    columns = ("joint", "samples", "rigid body only", "with friction", "moving", "allowed", "fit",
+               *(("terms",) if with_terms else ()))
     for col in columns:
-        table.add_column(col, justify="right" if col in ("samples", "rigid body only", "with friction") else "left")
+        table.add_column(col, justify="right" if col in ("samples", "rigid body only", "with friction", "moving",
+                                                         "allowed") else "left")
     statuses = pred.status or ("",) * len(pred.joints)
     terms = pred.terms or ((),) * len(pred.joints)
-    for j, n, rigid, full, status, kept in zip(pred.joints, pred.samples, pred.rms_rigid_body, pred.rms, statuses,
-                                               terms):
-        table.add_row(j, str(n), f"{rigid:.4g}", "—" if not np.isfinite(full) else f"{full:.4g}", status,
+    checks = pred.checks or (None,) * len(pred.joints)
+    for j, n, rigid, full, status, kept, check in zip(pred.joints, pred.samples, pred.rms_rigid_body, pred.rms,
+                                                      statuses, terms, checks):
+        moving = "still" if check is None else f"{check.rms:.4g}"
+        allowed = "" if check is None else f"{check.allowed:.4g}" + ("" if check.predicts else " (!)")
+        table.add_row(j, str(n), f"{rigid:.4g}", "—" if not np.isfinite(full) else f"{full:.4g}", moving, allowed,
+                      status,
                       *((", ".join(kept),) if with_terms else ()), style=None if status in ("ok", "") else "dim")
     rigid, full = pred.overall(pred.rms_rigid_body), pred.overall(pred.rms)
     table.add_row("all joints", str(int(pred.samples.sum())), f"{rigid:.4g}",
-                  "—" if not np.isfinite(full) else f"{full:.4g}", "", *(("",) if with_terms else ()), style="bold",
-                  end_section=True)
+                  "—" if not np.isfinite(full) else f"{full:.4g}", "", "", "", *(("",) if with_terms else ()),
+                  style="bold", end_section=True)
+    table.caption = ("moving: with friction, on the samples where the joint moves (not where it may stick: static "
+                     "friction); allowed: there, what the log's noise and the fit's standard errors allow (its model "
+                     "refitted on this log); still: the joint did not move in this log; (!): does not predict it")
+    table.caption_justify = "left"
     out.print(table)
+    for j, check in zip(pred.joints, checks):
+        if check is not None and not check.predicts:
+            console.print(f"{escape(j)}: does not predict this log: {escape(check.describe())}", highlight=False)
     if any(status not in ("ok", "") for status in statuses):
         console.print("a prediction by a fit that is not ok is no better than that fit: see 'fit' for the reason")
 

@@ -85,11 +85,12 @@ class FrictionModelParams(Protocol):
     def F_c(self) -> float: ...
 
 
-Include = Literal["weak", "at-bound", "routes-disagree"]
+Include = Literal["weak", "at-bound", "routes-disagree", "does-not-predict"]
 """The statuses besides ``ok`` whose fits are exported on request (``export --include``; module docstring)."""
 INCLUDE_CHOICES: tuple[Include, ...] = get_args(Include)
 INCLUDED_STATUS: dict[Include, FitStatus] = {"weak": "weak", "at-bound": "at bound",
-                                             "routes-disagree": "routes disagree"}
+                                             "routes-disagree": "routes disagree",
+                                             "does-not-predict": "does not predict"}
 """The fit status each choice of :data:`Include` names."""
 NEVER_EXPORTED: tuple[FitStatus, ...] = ("not excited", "failed")
 """Statuses whose numbers are not the data's: never exported, whatever is included."""

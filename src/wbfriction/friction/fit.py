@@ -48,7 +48,6 @@ Stribeck) is not mistaken for a different model. The start is searched on that s
 from __future__ import annotations
 
 import functools
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Generic, cast
@@ -60,6 +59,14 @@ from wbfriction.exceptions import InputError
 from wbfriction.friction.bound import BATCH, JointNoise, cramer_rao, torque_noise
 from wbfriction.friction.eiv import expected_jacobian, expected_values
 from wbfriction.friction.estimated import FrictionEstimate
+from wbfriction.friction.holdout import (
+    LATER,
+    MIN_HELD_OUT,
+    PredictionCheck,
+    prediction_check,
+    prediction_variance,
+    split_later,
+)
 from wbfriction.friction.models import (
     MODEL_NAMES,
     MODEL_PARAMS,
@@ -77,8 +84,8 @@ from wbfriction.friction.projection import BASINS, Projection, projected_start
 from wbfriction.friction.regression import (
     correlation_lag,
     covariance_errors,
+    held_out_gain,
     held_out_split,
-    lagged_products,
     parameter_covariance,
 )
 from wbfriction.friction.screen import gross_outliers
@@ -290,6 +297,8 @@ class FitResult(Generic[ParamsT]):
         terms: the terms beyond velocity kept with this model (:mod:`~wbfriction.friction.terms`; its
             :attr:`~wbfriction.friction.terms.TermFit.params` are this model's linear coefficients refitted with
             them), or None: none tried.
+        later: how the same model fitted on the earliest samples predicts the last ones
+            (:mod:`~wbfriction.friction.holdout`, :func:`later_stretch`), or None: not checked.
     """
 
     joint: str
@@ -316,6 +325,7 @@ class FitResult(Generic[ParamsT]):
     stick_speed: float = 0.0
     n_stuck: int = 0
     terms: TermFit | None = None
+    later: PredictionCheck | None = None
 
     def __post_init__(self) -> None:
         if self.params is not None:
@@ -457,20 +467,6 @@ def held_out_rms(params: ModelParamsBase, qd: np.ndarray, tau_f: np.ndarray, row
 GAIN_Z = 2.0
 """A model with a parameter at a bound must lower the held-out mean square by more than this many standard errors
 of the lowering to be chosen over a simpler model whose parameters are all interior (:func:`choose_model`)."""
-
-
-def held_out_gain(simpler: np.ndarray, other: np.ndarray, rows: np.ndarray) -> tuple[float, float]:
-    """How much ``other``'s held-out residuals (n,) lower the mean square of ``simpler``'s (n,), on the samples
-    ``rows`` (n,) of the series, and the standard error of that lowering: the mean of ``d = simpler^2 - other^2``
-    and its Newey-West standard error (the residuals are correlated over a filter's window) [N²·m²]."""
-    d = np.asarray(simpler, dtype=float) ** 2 - np.asarray(other, dtype=float) ** 2
-    n = d.size
-    if n < 2:
-        return float("nan"), float("inf")
-    centred = (d - d.mean())[:, None]
-    lag = correlation_lag(centred[:, 0], rows)
-    long_run = float(centred[:, 0] @ centred[:, 0] + 2.0 * lagged_products(centred, rows, lag)[0, 0])
-    return float(d.mean()), math.sqrt(max(long_run, 0.0)) / n
 
 
 def choose_model(scores: tuple[HeldOutScore, ...], tolerance: float = SELECTION_TOLERANCE) -> tuple[ModelName, str]:
@@ -857,20 +853,64 @@ def _fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray,
     return res
 
 
-def _fit_column(args: tuple) -> FitResult:
+def later_stretch(fit: FitResult, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray,
+                  kwargs: Mapping[str, Any]) -> PredictionCheck | None:
+    """How ``fit`` (of :func:`fit_friction` on ``qd``, ``tau_f``, ``valid`` with ``kwargs``) predicts its later
+    stretch (:mod:`~wbfriction.friction.holdout`): its model fitted on the samples before the last
+    :data:`~wbfriction.friction.holdout.LATER` of those it used, with the same options, and scored on them; None for
+    a fit without parameters, a joint that hardly moved, too few samples on either side or an early fit that failed.
+    """
+    if fit.params is None or fit.speed is None or fit.speed < MIN_SPEED or not fit.success:
+        return None
+    smoother, sigma = kwargs.get("smoother"), float(kwargs.get("velocity_noise", 0.0))
+    use = fitted_rows(qd, tau_f, valid, smoother, float(kwargs.get("stick", 0.0)),
+                      int(kwargs.get("stick_margin", 0)))[0]
+    before, later = split_later(use, LATER)
+    if int((use & before).sum()) < MIN_HELD_OUT or int(later.sum()) < MIN_HELD_OUT:
+        return None
+    early = fit_friction(qd, tau_f, mask=valid & before, **{**kwargs, "model": fit.model, "noise": None,
+                                                             "fixed": model_fixed(fit.model, kwargs.get("fixed"))})
+    if early.params is None or not early.success or early.covariance is None:
+        return None
+    share = round(float(later.sum()) / float(use.sum()), 3)
+    return prediction_check(f"the last {100 * share:.0f} % of its samples",
+                            held_out_residuals(early.params, qd, tau_f, later, smoother, sigma),
+                            held_out_residuals(fit.params, qd, tau_f, later, smoother, sigma),
+                            prediction_variance(model_gradient(early, qd, later, smoother, sigma), early.covariance),
+                            np.flatnonzero(later), share)
+
+
+def model_gradient(fit: FitResult, qd: np.ndarray, rows: np.ndarray, smoother=None,
+                   velocity_noise: float = 0.0) -> np.ndarray:
+    """The gradient (n, p) of ``fit``'s model (its expectation under ``velocity_noise`` [rad/s], through
+    ``smoother`` along the series ``qd`` (N,) as in the fit) with respect to its parameters, on the samples ``rows``
+    ((N,) bool, n of them)."""
+    assert fit.params is not None
+    x, delta_s = fit.params.as_vector(), getattr(fit.params, "delta_s", 2.0)
+    if smoother is None:
+        return expected_jacobian(x, qd[rows], velocity_noise, delta_s, fit.model)
+    return filtered_problem(qd, np.zeros_like(qd), rows, smoother, delta_s, fit.model, velocity_noise)[1](x)
+
+
+def _fit_column(args: tuple, later: bool = True) -> FitResult:
+    """One joint's :func:`fit_friction` (a :func:`_column_tasks` task) and, with ``later``, its
+    :func:`later_stretch`."""
     qd, tau_f, valid, kwargs = args
-    return fit_friction(qd, tau_f, mask=valid, **kwargs)
+    fit = fit_friction(qd, tau_f, mask=valid, **kwargs)
+    if later:
+        fit.later = later_stretch(fit, qd, tau_f, valid, kwargs)
+    return fit
 
 
 def _fit_routes(args: tuple) -> tuple[FitResult, FitResult | None]:
-    """One joint's fit (a :func:`_column_tasks` task), and its model's fit on the other route's estimate (a task
-    of that route, or None)."""
+    """One joint's fit (a :func:`_column_tasks` task) with its later stretch checked, and its model's fit on the
+    other route's estimate (a task of that route, or None)."""
     task, other = args
     fit = _fit_column(task)
     if other is None:
         return fit, None
     qd, tau_f, valid, kwargs = other
-    return fit, _fit_column((qd, tau_f, valid, {**kwargs, "model": fit.model}))
+    return fit, _fit_column((qd, tau_f, valid, {**kwargs, "model": fit.model}), later=False)
 
 
 def _column_tasks(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, models: Sequence[ModelChoice], *,
@@ -920,7 +960,7 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
                fixed: dict[str, float] | None = None, workers: int = 1,
                model: ModelChoice | Sequence[ModelName] = "thesis",
                selection_tolerance: float = SELECTION_TOLERANCE, noise: Mapping[str, JointNoise] | None = None,
-               stick_margin: int | None = None) -> list[FitResult]:
+               stick_margin: int | None = None, later: bool = True) -> list[FitResult]:
     """Fit every joint of a friction estimate on its valid samples.
 
     Args:
@@ -940,6 +980,7 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
             carries its Cramér-Rao bound; a joint without: neither.
         stick_margin: with it, samples within that many rows of a speed a joint may stick at
             (:func:`stick_speed`) are left out (:func:`stuck_rows`); None: none.
+        later: each fit checked on its later stretch (:func:`later_stretch`).
 
     Raises:
         InputError: what :func:`fit_friction` raises.
@@ -948,7 +989,8 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
     tasks = _column_tasks(joints, qd, tau_f, valid, cast(Sequence[ModelChoice], models), delta_s=delta_s,
                           min_samples=min_samples, smoother=smoother, fixed=fixed,
                           selection_tolerance=selection_tolerance, noise=noise, stick_margin=stick_margin)
-    return _with_truth(joints, _run(_fit_column, tasks, workers), qd, tau_f, valid, tau_f_true, targets)
+    fit = functools.partial(_fit_column, later=later)
+    return _with_truth(joints, _run(fit, tasks, workers), qd, tau_f, valid, tau_f_true, targets)
 
 
 def stick_margin(est: FrictionEstimate) -> int:

@@ -31,6 +31,7 @@ from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import FitResult, HeldOutScore, ModelSelection, RouteCheck
+from wbfriction.friction.holdout import PredictionCheck
 from wbfriction.friction.models import check_model, params_from_dict, target_from_dict
 from wbfriction.friction.options import ROUTES
 from wbfriction.friction.terms import TermFit
@@ -312,6 +313,8 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
         d["route_check"] = {"route": rc.route, "params": rc.params,
                             "stderr": {k: clean(v) for k, v in rc.stderr.items()}, "disagree": list(rc.disagree)}
     d["velocity_noise"], d["stick_speed"], d["n_stuck"] = fit.velocity_noise, fit.stick_speed, fit.n_stuck
+    if fit.later is not None:
+        d["later_stretch"] = fit.later.to_dict()
     verdict = fit.verdict()
     d["status"], d["status_reason"] = verdict.status, verdict.reason
     if fit.selection is not None:
@@ -369,6 +372,8 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
         res.velocity_noise = float(d.get("velocity_noise", 0.0))
         res.stick_speed = float(d.get("stick_speed", 0.0))
         res.n_stuck = int(d.get("n_stuck", 0))
+        if d.get("later_stretch") is not None:
+            res.later = PredictionCheck.from_dict(d["later_stretch"])
         if d.get("terms") is not None:
             res.terms = TermFit.from_dict(d["terms"])
         if d.get("target") is not None:

@@ -23,6 +23,17 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wbfriction.friction.estimate import FrictionEstimate
+from wbfriction.friction.fit import (
+    FitResult,
+    fit_joints,
+    fitted_rows,
+    held_out_residuals,
+    model_gradient,
+    stick_margin,
+)
+from wbfriction.friction.holdout import MIN_HELD_OUT, PredictionCheck, prediction_check, prediction_variance
+from wbfriction.friction.noise import joint_noises
+from wbfriction.friction.status import MIN_SPEED, joint_speed
 from wbfriction.friction.terms import TermFit, term_signals
 
 
@@ -46,6 +57,8 @@ class TorquePrediction:
         status: per joint, the status of the fit whose model predicts (:mod:`~wbfriction.friction.status`; "" when
             not known): a prediction by a fit that is not ``ok`` is no better than that fit.
         terms: per joint, the terms beyond velocity its model predicted with (:mod:`~wbfriction.friction.terms`).
+        checks: per joint, whether the fit predicts this log as well as its noise and its standard errors allow
+            (:func:`other_log_checks`), or None (not checked: no fit, the joint still in this log).
     """
 
     joints: tuple[str, ...]
@@ -55,6 +68,7 @@ class TorquePrediction:
     rms_torque: np.ndarray
     status: tuple[str, ...] = ()
     terms: tuple[tuple[str, ...], ...] = ()
+    checks: tuple[PredictionCheck | None, ...] = ()
 
     def overall(self, rms: np.ndarray) -> float:
         """The RMS over every joint's valid samples of one of the per-joint RMS arrays (``rms`` or
@@ -113,3 +127,48 @@ def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve 
             scale[i] = _rms(tau[:, i], valid)
     terms = tuple(m.kept if isinstance(m := friction.get(j), TermFit) else () for j in est.joints)
     return TorquePrediction(tuple(est.joints), samples, rms, rigid, scale, terms=terms)
+
+
+def other_log_checks(est: FrictionEstimate, fits: Mapping[str, FitResult], name: str = "this log",
+                     workers: int = 1) -> tuple[PredictionCheck | None, ...]:
+    """Per joint of ``est`` (a log the fits were not fitted on, estimated with their inertias), whether its fit
+    predicts it as well as the noise and its standard errors allow (:mod:`~wbfriction.friction.holdout`): the fit's
+    model (with its terms where it kept some) against the same model fitted on ``est`` itself, on the samples that
+    fit uses (the joint moving; where it may stick, static friction, no function of the velocity, left out), both
+    as its expectation under this log's velocity noise and through its smoother. None for a joint without a fitted
+    model, or still in this log (below :data:`~wbfriction.friction.status.MIN_SPEED`).
+
+    Args:
+        est: the held-out log's friction estimate.
+        fits: the fits, by joint (``wbfriction fit`` of other logs).
+        name: the log, as the reasons name it.
+        workers: processes refitting the joints side by side.
+    """
+    joints = [j for j in est.joints if j in fits and fits[j].params is not None]
+    idx = [est.joints.index(j) for j in joints]
+    noise = joint_noises(est.metadata.get("noise"), est.estimation_route)
+    refits = fit_joints(joints, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], smoother=est.smoother,
+                        model=[fits[j].model for j in joints], noise=noise, stick_margin=stick_margin(est),
+                        workers=workers, later=False)
+    out: dict[str, PredictionCheck | None] = {}
+    for j, i, refit in zip(joints, idx, refits):
+        fit, qd, tau_f = fits[j], est.qd[:, i], est.tau_f[:, i]
+        sigma = noise[j].velocity if j in noise else 0.0
+        use = fitted_rows(qd, tau_f, est.valid[:, i], est.smoother, refit.stick_speed, stick_margin(est))[0]
+        if refit.params is None or joint_speed(qd[use]) < MIN_SPEED or use.sum() < MIN_HELD_OUT:
+            out[j] = None
+            continue
+        terms = fit.kept_terms
+        if terms is not None:  # the model it predicts with, through the smoother as its velocity part
+            model = terms.torque(qd, term_signals(est, i))
+            if est.smoother is not None:
+                model = est.smoother(model[:, None])[:, 0]
+            e_model = (tau_f - model)[use]
+        else:
+            assert fit.params is not None
+            e_model = held_out_residuals(fit.params, qd, tau_f, use, est.smoother, sigma)
+        e_best = held_out_residuals(refit.params, qd, tau_f, use, est.smoother, sigma)
+        variance = (0.0 if fit.covariance is None else
+                    prediction_variance(model_gradient(fit, qd, use, est.smoother, sigma), fit.covariance))
+        out[j] = prediction_check(name, e_model, e_best, variance, np.flatnonzero(use))
+    return tuple(out.get(j) for j in est.joints)

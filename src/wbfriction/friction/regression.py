@@ -13,6 +13,8 @@ A parameter with a component in the numerical null space of ``J`` is not identif
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 HELD_OUT_BLOCKS = 10
@@ -129,3 +131,17 @@ def held_out_split(use: np.ndarray, n_blocks: int = HELD_OUT_BLOCKS,
     held_out[rows[out]] = True
     train[rows[~out]] = True
     return train, held_out
+
+
+def held_out_gain(simpler: np.ndarray, other: np.ndarray, rows: np.ndarray) -> tuple[float, float]:
+    """How much ``other``'s held-out residuals (n,) lower the mean square of ``simpler``'s (n,), on the samples
+    ``rows`` (n,) of the series, and the standard error of that lowering: the mean of ``d = simpler^2 - other^2``
+    and its Newey-West standard error (the residuals are correlated over a filter's window) [N²·m²]."""
+    d = np.asarray(simpler, dtype=float) ** 2 - np.asarray(other, dtype=float) ** 2
+    n = d.size
+    if n < 2:
+        return float("nan"), float("inf")
+    centred = (d - d.mean())[:, None]
+    lag = correlation_lag(centred[:, 0], rows)
+    long_run = float(centred[:, 0] @ centred[:, 0] + 2.0 * lagged_products(centred, rows, lag)[0, 0])
+    return float(d.mean()), math.sqrt(max(long_run, 0.0)) / n

@@ -15,6 +15,11 @@ status, the first that applies:
   route's for the momentum route, and the other way round) differs on F_c or F_v by more than
   :data:`ROUTE_Z` combined standard errors and :data:`ROUTE_REL`
   of the value: one of them is biased, and the standard errors cannot say which; both values are given;
+* ``does not predict`` (issue 52): the same model fitted on the earliest samples predicts the last
+  :data:`~wbfriction.friction.holdout.LATER` of them worse than the noise and its standard errors allow, beyond
+  :data:`~wbfriction.friction.holdout.HOLDOUT_Z` standard errors and by more than
+  :data:`~wbfriction.friction.holdout.HOLDOUT_EXCESS` (:mod:`~wbfriction.friction.holdout`): the friction changed
+  over the log, or a model error the standard errors do not see (the errors and held-out RMS given);
 * ``weak``: a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error, or a Cramér-Rao bound
   (:mod:`~wbfriction.friction.bound`: what the data allow any unbiased estimator), above :data:`WEAK` of its
   (non-zero) value, or is not identifiable (infinite standard error); a magnitude at zero whose standard error
@@ -43,7 +48,7 @@ import numpy as np
 
 from wbfriction.friction.solver import explain_solver
 
-FitStatus = Literal["ok", "weak", "routes disagree", "at bound", "not excited", "failed"]
+FitStatus = Literal["ok", "weak", "does not predict", "routes disagree", "at bound", "not excited", "failed"]
 """A fit's verdict (module docstring)."""
 FIT_STATUSES: tuple[FitStatus, ...] = get_args(FitStatus)
 MIN_SPEED = 0.02
@@ -94,6 +99,7 @@ class Fit(Protocol):
     crb: dict[str, float]
     route_check: Any
     rms_residual: float
+    later: Any
 
     def bounded(self) -> tuple[str, ...]: ...
 
@@ -140,6 +146,8 @@ def fit_verdict(fit: Fit) -> FitVerdict:
     check = fit.route_check
     if check is not None and check.disagree:
         return FitVerdict("routes disagree", check.describe(fit))
+    if fit.later is not None and not fit.later.predicts:
+        return FitVerdict("does not predict", fit.later.describe())
     weak = _weak(fit, values)
     if weak:
         return FitVerdict("weak", "large standard errors: " + ", ".join(weak))
@@ -169,6 +177,8 @@ def _with_terms(fit: Fit, terms: Any) -> FitVerdict:
     disagree += [f"{t}: {v.reason}" for t, v in others.items() if v.status == "routes disagree"]
     if disagree:
         return FitVerdict("routes disagree", "; ".join(disagree))
+    if fit.later is not None and not fit.later.predicts:  # the velocity model's: the terms' own later check decides
+        return FitVerdict("does not predict", fit.later.describe())
     # over part of a turn a ripple's harmonics have a mean the offset trades with: their sum is determined (the
     # energy check removes both), the offset alone is not, and it is no friction a user reads
     judged = [n for n in values if n in terms.stderr and not (n == "tau_os" and "ripple" in terms.kept)]

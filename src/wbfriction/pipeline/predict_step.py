@@ -7,10 +7,10 @@ import dataclasses
 from pathlib import Path
 
 from wbfriction.friction.io import check_params_source, read_friction_file, read_params
-from wbfriction.friction.predict import TorquePrediction, predict_torques
+from wbfriction.friction.predict import TorquePrediction, other_log_checks, predict_torques
 
 
-def predict_file(friction: str | Path, params: str | Path) -> TorquePrediction:
+def predict_file(friction: str | Path, params: str | Path, workers: int = 1) -> TorquePrediction:
     """Torque prediction errors (:func:`~wbfriction.friction.predict.predict_torques`) of the friction
     model ``params`` on the friction table ``friction``.
 
@@ -23,6 +23,10 @@ def predict_file(friction: str | Path, params: str | Path) -> TorquePrediction:
     Raises:
         InputError: what reading either file raises; parameters for another robot or none of
             the table's joints (:func:`~wbfriction.friction.io.check_params_source`).
+
+    Each joint's prediction is checked against what its noise and its fit's standard errors allow on this log
+    (:func:`~wbfriction.friction.predict.other_log_checks`, refitting its model on ``friction`` on ``workers``
+    processes): :attr:`~wbfriction.friction.predict.TorquePrediction.checks`.
     """
     fits = read_params(params)
     est = read_friction_file(friction)
@@ -31,4 +35,5 @@ def predict_file(friction: str | Path, params: str | Path) -> TorquePrediction:
               if f.params is not None}
     pred = predict_torques(est, models, source=str(friction))
     status = tuple(fits[j].verdict().status if j in fits else "" for j in pred.joints)
-    return dataclasses.replace(pred, status=status)
+    checks = other_log_checks(est, fits, Path(friction).name, workers)
+    return dataclasses.replace(pred, status=status, checks=checks)
