@@ -4,6 +4,7 @@ exact data: every joint in every phase with the wrenches, every joint in single 
 from __future__ import annotations
 
 import dataclasses
+from types import SimpleNamespace
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -12,6 +13,7 @@ from tests.helpers import run_cli
 
 from wbfriction.exceptions import ColumnError
 from wbfriction.friction.estimate import estimate_log
+from wbfriction.friction.measured import impacts
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import write_log
@@ -83,6 +85,43 @@ def test_central_differences_with_the_wrenches_beat_the_rigid_route(talos):
         return float(np.sqrt(np.mean((est.tau_f - est.tau_f_true)[:, legs][valid] ** 2)))
     assert wrench.valid[:, legs].mean() > 0.95 > 0.3 > rigid.valid[:, legs].mean()
     assert rms(wrench) < 0.5 * rms(rigid) < 1e-3
+
+
+def _kinematics(talos, normal: np.ndarray, contact: np.ndarray) -> SimpleNamespace:
+    """What :func:`impacts` reads of measured kinematics: 1 kHz rows, the flags, wrenches whose soles' normal
+    forces are ``normal`` (N, 2) [N]."""
+    model, wrench = talos.model, np.zeros((len(normal), len(talos.ft_sensors), 6))
+    for s, sensor in enumerate(talos.ft_sensors):
+        contact_frame = model.frames[model.getFrameId(sensor.contact)].placement
+        axis = (contact_frame.rotation.T @ sensor.placement.rotation)[2]  # the sole's normal in sensor axes
+        wrench[:, s, :3] = normal[:, [talos.contact_frames.index(sensor.contact)]] * axis
+    return SimpleNamespace(time=np.arange(len(normal)) * 1e-3, contact=contact, wrench=wrench)
+
+
+def test_an_impact_starts_at_the_first_touch_and_a_flag_drop_is_none(talos):
+    """A sole touching 100 ms before its flag rises: its impact from two rows before the touch to 20 ms after
+    it (at least to the flag's rise). A standing sole whose flag drops for one row (a lift-off's force
+    chattering about the threshold) rises again without a touch-down: no impact, not the stance before it."""
+    n = 1000
+    normal, contact = np.full((n, 2), 400.0), np.ones((n, 2), dtype=bool)
+    normal[300:500, 1], contact[300:600, 1] = -4.0, False  # right foot: in the air, then a light touch
+    normal[500:600, 1] = 20.0
+    contact[800, 0] = False  # left foot: its flag drops for one row, the sole loaded
+    out = impacts(talos, _kinematics(talos, normal, contact))
+    assert np.array_equal(np.flatnonzero(out), np.arange(498, 601))
+
+
+def test_rows_the_wrench_route_leaves_out_are_not_the_rigid_routes(talos, ft_walk):
+    """Central differences leave a touch-down's stencil and impact out of the wrench route; those rows are
+    then not valid at all, not estimated by the rigid-contact route, which knows nothing of a sole touching
+    the ground before its flag rises. A flag dropping for one row mid-stance (the sole still loaded) costs
+    the rows whose stencil spans it, not the stance before it."""
+    contact = ft_walk.contact.copy()
+    k = int(np.flatnonzero(contact[:, 0] & ~contact[:, 1])[300])  # the left foot standing, the right swinging
+    contact[k, 0] = False
+    est = estimate_log(talos, dataclasses.replace(ft_walk, contact=contact), EstimateOptions(diff="central"))
+    assert np.all(est.route[est.valid.any(axis=1)] == "wrench")
+    assert est.valid[k - 200:k - 1].all() and not est.valid[k - 1:k + 2].any()
 
 
 def test_the_wrenches_make_every_sample_usable(talos, ft_walk):

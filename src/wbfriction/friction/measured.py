@@ -79,17 +79,29 @@ def impacts(robot: Robot, kin: MeasuredKinematics, skip: float = IMPACT_SKIP) ->
     """(N,) the rows of each touch-down's impact: from two rows before the sole's first touch (module
     docstring of :data:`IMPACT_SKIP`) to ``skip`` seconds after it, and at least to its flag's rise; all False
     without wrenches. Anchored on the flags' rises, so that a swinging sole plate's own inertia (a 0.4 kg
-    plate at 25 m/s^2 reads 10 N) is never taken for a touch."""
+    plate at 25 m/s^2 reads 10 N) is never taken for a touch.
+
+    The first touch is looked for only while the flag was off: a flag that dropped for a few rows while its
+    sole still carried more than 1 % of the weight (a lift-off's normal force chattering about the flag's
+    threshold) rises again without a touch-down, and is no impact. Walking back past the drop took the whole
+    stance before it for one (MuJoCo's combined walk: 2.2 s of the left foot's stance, the right leg's two
+    swings in it)."""
     out = np.zeros(len(kin.time), dtype=bool)
     if kin.wrench is None or not sensed_contacts(robot):
         return out
     low = 0.1 * default_thresholds(robot)[0]  # 1 % of the weight
     normal = normal_forces(robot, kin.wrench)
     for c in range(kin.contact.shape[1]):
-        for k in np.flatnonzero(kin.contact[1:, c] & ~kin.contact[:-1, c]) + 1:
+        on = kin.contact[:, c]
+        falls = np.flatnonzero(on[:-1] & ~on[1:]) + 1
+        for k in np.flatnonzero(on[1:] & ~on[:-1]) + 1:
+            before = falls[falls < k]
+            off = int(before[-1]) if before.size else 0  # the first row of the flag's drop
             first = k
-            while first > 0 and normal[first - 1, c] > low:
+            while first > off and normal[first - 1, c] > low:
                 first -= 1
+            if before.size and first == off:  # the sole never left the ground: no touch-down
+                continue
             stop = max(k + 1, np.searchsorted(kin.time, kin.time[first] + skip, side="right"))
             out[max(first - 2, 0):stop] = True
     return out
