@@ -247,3 +247,24 @@ def test_the_new_fields_read_back_from_the_json():
     for name in ("crb", "route", "route_check", "torque_noise", "velocity_noise", "stick_speed", "n_stuck"):
         assert getattr(back, name) == getattr(fit, name), name
     assert back.verdict() == fit.verdict()
+
+
+def test_the_thresholds_decide_each_rule():
+    """Issue 52: the statuses' thresholds are values (:class:`StatusThresholds`) a study can vary; each rule follows
+    its own: a standard error of 30 % is ``weak`` at 0.25 and not at 0.5; routes 5 % apart by 4.5 standard errors
+    disagree at 2 % and not at 6 %; a later stretch 8 % off by 5 standard errors does not predict at 5 % and does
+    at 10 %."""
+    from wbfriction.friction.fit import RouteCheck
+    from wbfriction.friction.holdout import PredictionCheck
+    from wbfriction.friction.status import DEFAULT_THRESHOLDS, StatusThresholds
+
+    fit = _fit(se={"F_v": 0.06, "F_c": 0.01, "tau_os": 0.01})  # F_v = 0.2 ± 0.06: 30 %
+    assert fit_verdict(fit).ok and fit_verdict(fit, StatusThresholds(weak=0.25)).status == "weak"
+    routes = dataclasses.replace(_fit(), route_check=RouteCheck("momentum", {"F_c": 1.05, "F_v": 0.2},
+                                                                {"F_c": 0.005, "F_v": 0.01}))
+    assert fit_verdict(routes).status == "routes disagree" and "F_c 1 ±0.01 (acceleration)" in fit_verdict(routes).reason
+    assert fit_verdict(routes, StatusThresholds(route_rel=0.06)).ok
+    later = dataclasses.replace(_fit(), later=PredictionCheck("the last 30 % of its samples", 300, 0.108, 0.1, 5.0, 0.3))
+    assert fit_verdict(later).status == "does not predict"
+    assert fit_verdict(later, StatusThresholds(holdout_excess=0.1)).ok
+    assert fit_verdict(later, DEFAULT_THRESHOLDS) == later.verdict()

@@ -225,14 +225,16 @@ class RouteCheck:
     stderr: dict[str, float]
     disagree: tuple[str, ...] = ()
 
-    def describe(self, fit: FitResult) -> str:
-        """One phrase: each disagreeing parameter with both routes' values and standard errors."""
+    def describe(self, fit: FitResult, names: Sequence[str] | None = None) -> str:
+        """One phrase: each disagreeing parameter (``names``, default :attr:`disagree`) with both routes' values and
+        standard errors."""
         if fit.params is None or self.params is None:
             return ""
         mine = fit.params.to_dict()
         theirs = self.params
         return "; ".join(f"{n} {mine[n]:.3g} ±{fit.stderr.get(n, np.inf):.2g} ({fit.route}) against "
-                         f"{theirs[n]:.3g} ±{self.stderr.get(n, np.inf):.2g} ({self.route})" for n in self.disagree)
+                         f"{theirs[n]:.3g} ±{self.stderr.get(n, np.inf):.2g} ({self.route})"
+                         for n in (self.disagree if names is None else names))
 
 
 def compare_routes(fit: FitResult, other: FitResult) -> RouteCheck:

@@ -69,7 +69,11 @@ class PredictionCheck:
     @property
     def predicts(self) -> bool:
         """Whether the fit predicts the held-out samples (module docstring)."""
-        return not (self.z > HOLDOUT_Z and self.ratio > 1.0 + HOLDOUT_EXCESS)
+        return self.predicts_at(HOLDOUT_Z, HOLDOUT_EXCESS)
+
+    def predicts_at(self, z: float, excess: float) -> bool:
+        """Whether it predicts with the thresholds ``z`` (:data:`HOLDOUT_Z`) and ``excess`` (:data:`HOLDOUT_EXCESS`)."""
+        return not (self.z > z and self.ratio > 1.0 + excess)
 
     def describe(self) -> str:
         """What it predicted and how, one phrase (the reason of a fit that does not predict)."""

@@ -46,6 +46,7 @@ from typing import Any, Literal, Protocol, cast, get_args
 
 import numpy as np
 
+from wbfriction.friction.holdout import HOLDOUT_EXCESS, HOLDOUT_Z
 from wbfriction.friction.solver import explain_solver
 
 FitStatus = Literal["ok", "weak", "does not predict", "routes disagree", "at bound", "not excited", "failed"]
@@ -69,10 +70,10 @@ ROUTE_REL = 0.02
 routes' own quadratures differ by less)."""
 
 
-def routes_disagree(a: float, se_a: float, b: float, se_b: float) -> bool:
-    """Whether two routes' values of one parameter disagree: they differ by more than :data:`ROUTE_Z` combined
-    standard errors and by more than :data:`ROUTE_REL` of the larger."""
-    return abs(a - b) > ROUTE_Z * math.hypot(se_a, se_b) and abs(a - b) > ROUTE_REL * max(abs(a), abs(b))
+def routes_disagree(a: float, se_a: float, b: float, se_b: float, z: float = ROUTE_Z, rel: float = ROUTE_REL) -> bool:
+    """Whether two routes' values of one parameter disagree: they differ by more than ``z`` (:data:`ROUTE_Z`)
+    combined standard errors and by more than ``rel`` (:data:`ROUTE_REL`) of the larger."""
+    return abs(a - b) > z * math.hypot(se_a, se_b) and abs(a - b) > rel * max(abs(a), abs(b))
 
 
 WEAK = 0.5
@@ -86,6 +87,28 @@ ZERO = 1e-6
 READ_SPEED = 1.0
 """The speed [rad/s] a viscous coefficient at zero is judged at, or the joint's own if it moved faster: a user
 reads F_v = 0 as no viscous friction at any speed, not only at the few the log saw."""
+
+
+@dataclass(frozen=True)
+class StatusThresholds:
+    """The thresholds the statuses are decided by (module docstring), the defaults chosen across the real datasets
+    and the simulators (README, *Defaults chosen across the data*; ``benchmarks/study_defaults.py``).
+
+    Attributes:
+        weak: a standard error or Cramér-Rao bound above this share of its value makes a fit ``weak``.
+        route_z, route_rel: the routes disagree beyond this many combined standard errors and this share.
+        holdout_z, holdout_excess: a fit does not predict its later stretch beyond this many standard errors and
+            this share of what the noise and its standard errors allow (:mod:`~wbfriction.friction.holdout`).
+    """
+
+    weak: float = WEAK
+    route_z: float = ROUTE_Z
+    route_rel: float = ROUTE_REL
+    holdout_z: float = HOLDOUT_Z
+    holdout_excess: float = HOLDOUT_EXCESS
+
+
+DEFAULT_THRESHOLDS = StatusThresholds()
 
 
 class Fit(Protocol):
@@ -127,8 +150,8 @@ def solver_phrase(message: str) -> str:
     return "the solver " + explain_solver(message).meaning
 
 
-def fit_verdict(fit: Fit) -> FitVerdict:
-    """The status of ``fit`` and its reason (module docstring)."""
+def fit_verdict(fit: Fit, thresholds: StatusThresholds = DEFAULT_THRESHOLDS) -> FitVerdict:
+    """The status of ``fit`` and its reason (module docstring), decided by ``thresholds``."""
     if fit.params is None:
         return FitVerdict("not excited", fit.message or "not fitted")
     if fit.speed is not None and fit.speed < MIN_SPEED:
@@ -138,17 +161,18 @@ def fit_verdict(fit: Fit) -> FitVerdict:
         return FitVerdict("failed", solver_phrase(fit.message))
     terms = getattr(fit, "kept_terms", None)
     if terms is not None:
-        return _with_terms(fit, terms)
+        return _with_terms(fit, terms, thresholds)
     values = fit.params.to_dict()
     bounded = [n for n in fit.bounded() if not (n in ZERO_FLOOR and abs(values[n]) < ZERO) and n not in fit.steps()]
     if bounded:
         return FitVerdict("at bound", "at a bound of the fit: " + ", ".join(bounded))
     check = fit.route_check
-    if check is not None and check.disagree:
-        return FitVerdict("routes disagree", check.describe(fit))
-    if fit.later is not None and not fit.later.predicts:
+    disagree = _disagreeing(fit, values, thresholds)
+    if check is not None and disagree:
+        return FitVerdict("routes disagree", check.describe(fit, disagree))
+    if fit.later is not None and not fit.later.predicts_at(thresholds.holdout_z, thresholds.holdout_excess):
         return FitVerdict("does not predict", fit.later.describe())
-    weak = _weak(fit, values)
+    weak = _weak(fit, values, thresholds.weak)
     if weak:
         return FitVerdict("weak", "large standard errors: " + ", ".join(weak))
     return FitVerdict("ok")
@@ -159,7 +183,17 @@ HELD = ("a", "v_s")
 at a bound there is at it in the refit."""
 
 
-def _with_terms(fit: Fit, terms: Any) -> FitVerdict:
+def _disagreeing(fit: Fit, values: dict[str, float], thresholds: StatusThresholds) -> tuple[str, ...]:
+    """The parameters on which ``fit``'s routes disagree (:func:`routes_disagree` at ``thresholds``)."""
+    check = fit.route_check
+    if check is None or check.params is None:
+        return ()
+    return tuple(n for n in READ if n in values and n in check.params and routes_disagree(
+        values[n], fit.stderr.get(n, np.inf), check.params[n], check.stderr.get(n, np.inf), thresholds.route_z,
+        thresholds.route_rel))
+
+
+def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THRESHOLDS) -> FitVerdict:
     """The verdict of a fit that kept terms beyond velocity (:class:`~wbfriction.friction.terms.TermFit`): of the
     model it predicts and exports with, the velocity coefficients refitted with the terms (their standard errors,
     the other route's refit of them) and each term's own (:meth:`~wbfriction.friction.terms.TermFit.verdicts`)."""
@@ -173,26 +207,27 @@ def _with_terms(fit: Fit, terms: Any) -> FitVerdict:
         f"{n} {values[n]:.3g} ±{terms.stderr.get(n, np.inf):.2g} against {check.coefficients[n]:.3g} "
         f"±{check.stderr.get(n, np.inf):.2g} ({check.route})" for n in READ
         if n in check.coefficients and routes_disagree(values[n], terms.stderr.get(n, np.inf), check.coefficients[n],
-                                                       check.stderr.get(n, np.inf))]
+                                                       check.stderr.get(n, np.inf), thresholds.route_z,
+                                                       thresholds.route_rel)]
     disagree += [f"{t}: {v.reason}" for t, v in others.items() if v.status == "routes disagree"]
     if disagree:
         return FitVerdict("routes disagree", "; ".join(disagree))
-    if fit.later is not None and not fit.later.predicts:  # the velocity model's: the terms' own later check decides
+    if fit.later is not None and not fit.later.predicts_at(thresholds.holdout_z, thresholds.holdout_excess):
         return FitVerdict("does not predict", fit.later.describe())
     # over part of a turn a ripple's harmonics have a mean the offset trades with: their sum is determined (the
     # energy check removes both), the offset alone is not, and it is no friction a user reads
     judged = [n for n in values if n in terms.stderr and not (n == "tau_os" and "ripple" in terms.kept)]
     view = SimpleNamespace(params=terms.params, stderr={n: terms.stderr[n] for n in judged}, crb={}, speed=fit.speed,
                            rms_residual=fit.rms_residual)
-    weak = _weak(cast(Fit, view), values) + [f"{t} {v.reason.removeprefix('large standard errors: ')}"
+    weak = _weak(cast(Fit, view), values, thresholds.weak) + [f"{t} {v.reason.removeprefix('large standard errors: ')}"
                                              for t, v in others.items()]
     if weak:
         return FitVerdict("weak", "large standard errors: " + ", ".join(weak))
     return FitVerdict("ok")
 
 
-def _weak(fit: Fit, values: dict[str, float]) -> list[str]:
-    """What makes ``fit`` weak (module docstring), one phrase each."""
+def _weak(fit: Fit, values: dict[str, float], limit: float = WEAK) -> list[str]:
+    """What makes ``fit`` weak (module docstring) at ``limit`` (:data:`WEAK`), one phrase each."""
     speed = fit.speed or 0.0
     odd = 0.5 * float(fit.params.f(speed) - fit.params.f(-speed))  # the friction the joint shows at its speed
     scale = max(abs(odd), fit.rms_residual if np.isfinite(fit.rms_residual) else 0.0)
@@ -204,17 +239,17 @@ def _weak(fit: Fit, values: dict[str, float]) -> list[str]:
             if not np.isfinite(spread):
                 out.append(f"{name} not identifiable{at_best}")
                 break
-            if value >= ZERO and spread > WEAK * value:
+            if value >= ZERO and spread > limit * value:
                 out.append(f"{name} ±{100 * spread / value:.0f} %{at_best}")
                 break
             # a magnitude at zero: against the friction it would make at the speed a user reads it at
             share = spread * (max(speed, READ_SPEED) if name == "F_v" else 1.0)
-            if value < ZERO and share > WEAK * scale:
+            if value < ZERO and share > limit * scale:
                 out.append(f"{name} 0 ±{spread:.2g}{at_best} ({share:.2g} N·m against {scale:.2g} N·m of friction)")
                 break
     se_os, f_c = fit.stderr.get("tau_os", 0.0), abs(values.get("F_c", 0.0))
     if not np.isfinite(se_os):
         out.append("tau_os not identifiable")
-    elif f_c >= ZERO and se_os > WEAK * f_c:
+    elif f_c >= ZERO and se_os > limit * f_c:
         out.append(f"tau_os ±{se_os:.2g} N·m against F_c {f_c:.2g}")
     return out
