@@ -31,7 +31,7 @@ from wbfriction.friction.options import (
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
 from wbfriction.model.robots import BUILTIN_ROBOTS
-from wbfriction.signals.options import FilterOptions
+from wbfriction.signals.options import NOISE_TARGET, FilterOptions
 from wbfriction.sim.options import IdealOptions, MujocoOptions
 from wbfriction.version import __version__
 from wbfriction.walking.options import GaitOptions
@@ -69,6 +69,9 @@ RouteOpt = typer.Option("auto", "--route", help="How the friction is reached: mo
                                                 "differentiated once, generalized momentum), acceleration (twice, "
                                                 "the thesis's) or auto (chosen from the positions' noise, printed); "
                                                 "the other route is estimated too, as a check.")
+NoiseTargetOpt = typer.Option(NOISE_TARGET, "--noise-target",
+                              help="diff and route auto: the most RMS noise of the positions a scheme may leave in "
+                                   "the acceleration [rad/s^2].")
 VelocityWindowOpt = typer.Option(None, "--velocity-window", help="momentum: the velocity's Savitzky-Golay window "
                                                                  "(odd, at least 7) [samples]; default: chosen from "
                                                                  "the noise.")

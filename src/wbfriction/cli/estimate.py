@@ -39,6 +39,7 @@ from wbfriction.cli.common import (
     MaxGapOpt,
     MjcfOpt,
     MomentumWindowOpt,
+    NoiseTargetOpt,
     RobotOpt,
     RouteOpt,
     TimeBaseOpt,
@@ -175,7 +176,7 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                                                              "columns where logged: every joint's friction in "
                                                              "every phase."),
              route: RouteOption = RouteOpt, velocity_window: Optional[int] = VelocityWindowOpt,
-             momentum_window: Optional[int] = MomentumWindowOpt) -> None:
+             momentum_window: Optional[int] = MomentumWindowOpt, noise_target: float = NoiseTargetOpt) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
     from wbfriction.pipeline.estimate_step import RobotSpec
 
@@ -185,7 +186,7 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                            lift_off_skip=lift_off, touch_down_skip=touch_down, ds_weight=ds_weight,
                            ds_regularization=ds_regularization, condition_number=cond, method=method,
                            velocity=velocity, base_motion=base_motion,
-                           wrenches=wrenches, route=route,
+                           wrenches=wrenches, route=route, noise_target=noise_target,
                            momentum=MomentumOptions(velocity_window, momentum_window),
                            filtering=FilterOptions(window=window, poly_order=poly_order,
                                                    weights=weights,

@@ -30,6 +30,7 @@ from wbfriction.cli.common import (
     FitWorkersOpt,
     LogArg,
     MjcfOpt,
+    NoiseTargetOpt,
     RobotOpt,
     RouteOpt,
     TimeUnitOpt,
@@ -73,6 +74,10 @@ def identify(log: Path = LogArg,
              link_margin: float = typer.Option(INERTIAL.link_margin, help="Share of each given body's "
                                                     "pseudo-inertia an identified body keeps (mass and second "
                                                     "moments), in [0, 1); 0: any physical body."),
+             prior_tolerance: float = typer.Option(INERTIAL.prior_tolerance,
+                                                   help="With the prior's weight chosen by validation: the strongest "
+                                                        "weight within this share of the best score."),
+             noise_target: float = NoiseTargetOpt,
              tanh_slope: float = typer.Option(INERTIAL.tanh_slope, min=1e-12,
                                               help="a of the Coulomb term tanh(a qd) [s/rad]."),
              diff: DiffOption = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
@@ -104,10 +109,9 @@ def identify(log: Path = LogArg,
     r = robot_of(robot, urdf, config, mjcf)
     r.require_urdf("identify (it writes the corrected URDF)")
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior,
-                           armature=armature, link_margin=link_margin)
+                           armature=armature, link_margin=link_margin, prior_tolerance=prior_tolerance)
     with console.status("") as status:
-        estimate_options = EstimateOptions(diff=diff, mask=mask,
-                                           route=route)
+        estimate_options = EstimateOptions(diff=diff, mask=mask, route=route, noise_target=noise_target)
         done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
                              options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers,
                              time_unit=time_unit)

@@ -289,7 +289,7 @@ def resolve_differentiation(options: EstimateOptions, source: Log | np.ndarray |
     if source is None:
         return replace(options, diff="central"), None
     try:
-        choice = choose_differentiation(source, dt)
+        choice = choose_differentiation(source, dt, target=options.noise_target)
     except InputError as exc:  # too short a log to measure its noise: say so, differentiate it plainly
         choice = DiffChoice.fallback(f"central differences: {exc}")
     return replace(options, diff=choice.scheme, filtering=choice.filtering), choice

@@ -14,6 +14,7 @@ from wbfriction.signals.options import (
     ALIGNMENT_OPTIONS,
     DIFF_OPTIONS,
     MASKS,
+    NOISE_TARGET,
     VELOCITIES,
     AlignmentOption,
     DiffOption,
@@ -106,6 +107,9 @@ class EstimateOptions:
         momentum: the momentum route's windows (:class:`MomentumOptions`).
         check_route: also estimate the other route, whose fit the status compares
             (:attr:`~wbfriction.friction.estimate.FrictionEstimate.route_check`).
+        noise_target: the most RMS noise of the positions ``diff="auto"`` and ``route="auto"`` leave in the
+            acceleration [rad/s^2] (> 0; :func:`~wbfriction.signals.choice.choose_differentiation`,
+            :func:`~wbfriction.friction.route.choose_route`).
 
     Raises:
         OptionError: a value that is not one of its choices or out of its range, named by its command-line
@@ -131,6 +135,7 @@ class EstimateOptions:
     route: RouteOption = "auto"
     momentum: MomentumOptions = MomentumOptions()
     check_route: bool = True
+    noise_target: float = NOISE_TARGET
 
     def __post_init__(self) -> None:
         check_choice("diff", self.diff, DIFF_OPTIONS)
@@ -142,6 +147,7 @@ class EstimateOptions:
         check_choice("route", self.route, ROUTE_OPTIONS)
         check_range("lift_off_skip", self.lift_off_skip, low=0.0)
         check_range("touch_down_skip", self.touch_down_skip, low=0.0)
+        check_range("noise_target", self.noise_target, low=0.0, strict=True)
         for name in ("ds_weight", "ds_regularization"):
             value = getattr(self, name)
             for v in value if isinstance(value, tuple) else (value,):

@@ -1,8 +1,8 @@
 """Which route, and how much smoothing: chosen from the log's position noise, once per log (issue 38).
 
-Both routes leave at most :data:`~wbfriction.signals.choice.NOISE_TARGET` of the position noise in the
-friction (per unit inertia, in rad/s^2). The acceleration route (thesis ch. 5) does it by a Savitzky-Golay
-window ``L_a`` on the positions, whose velocity is also the friction model's argument; the momentum route
+Both routes leave at most ``options.noise_target`` (:data:`~wbfriction.signals.options.NOISE_TARGET`) of the
+position noise in the friction (per unit inertia, in rad/s^2). The acceleration route (thesis ch. 5) does it by a
+Savitzky-Golay window ``L_a`` on the positions, whose velocity is also the friction model's argument; the momentum route
 (:mod:`~wbfriction.friction.momentum`) by a window on the momenta, its velocity filtered only to
 :data:`~wbfriction.signals.choice.VELOCITY_NOISE_TARGET` by a window ``L_v``
 (:func:`~wbfriction.signals.choice.choose_momentum_smoothing`). The route is the acceleration route where
@@ -29,7 +29,6 @@ from wbfriction.friction.options import EstimateOptions, MomentumOptions, Route
 from wbfriction.logs.clock import longest_segment
 from wbfriction.logs.log import Log
 from wbfriction.signals.choice import (
-    NOISE_TARGET,
     DiffChoice,
     MomentumSmoothing,
     acceleration_content,
@@ -100,13 +99,14 @@ def choose_route(options: EstimateOptions, sigma: float, dt: float, n_samples: i
     given = options.momentum
     if math.isfinite(sigma):
         smoothing = choose_momentum_smoothing(sigma, dt, n_samples, velocity_window=given.velocity_window,
-                                              window=given.window)
+                                              window=given.window, target=options.noise_target)
     else:  # not measured: the least smoothing, or what was given
         smoothing = MomentumSmoothing(given.velocity_window or 7, given.window or 3, math.nan, math.nan, False)
     central = sigma * central_noise_gain(dt)
     longest = max(7, (n_samples // 4) * 2 - 1)
-    accel_window = (savgol_choice(sigma, dt, 4, "uniform", NOISE_TARGET, longest)[0].window
-                    if math.isfinite(sigma) and central > NOISE_TARGET else 1)
+    target = options.noise_target
+    accel_window = (savgol_choice(sigma, dt, 4, "uniform", target, longest)[0].window
+                    if math.isfinite(sigma) and central > target else 1)
     momentum = (f"momentum: velocity savgol L={smoothing.velocity_window} k=4 ({smoothing.velocity_noise:.2g} rad/s "
                 f"of noise), window of {smoothing.window} samples ({smoothing.noise_left:.2g} rad/s^2 left)")
     route: Route
@@ -117,10 +117,10 @@ def choose_route(options: EstimateOptions, sigma: float, dt: float, n_samples: i
         route, why = "acceleration", "acceleration: the simulator's true derivatives (diff 'true')"
     elif not math.isfinite(sigma):
         route, why = "acceleration", "acceleration: the log is too short to measure its noise"
-    elif central <= NOISE_TARGET:
+    elif central <= target:
         route = "acceleration"
         why = (f"acceleration: central second differences leave {central:.2g} rad/s^2 of noise (target "
-               f"{NOISE_TARGET:g}): every sample its own estimate, no window")
+               f"{target:g}): every sample its own estimate, no window")
     elif accel_window <= WINDOW_RATIO * smoothing.velocity_window:
         route = "acceleration"
         why = (f"acceleration: a savgol window of {accel_window} samples meets the noise target, no more than "

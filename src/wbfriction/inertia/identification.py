@@ -73,7 +73,7 @@ that neighbouring, correlated samples do not score their own fit), then refitted
 The compressed systems give every score without another pass over the log, and one decomposition of the
 training system's gives every weight's fit (:class:`~wbfriction.inertia.consistency.RegularisedProblem`). The
 weights are tried from strong to weak, and the search stops at the first weight that scores worse than the
-best; the weight chosen is the strongest whose score is within :data:`PRIOR_TOLERANCE` (2 %) of the best. A
+best; the weight chosen is the strongest whose score is within ``options.prior_tolerance`` (2 %) of the best. A
 weaker prior is a model further from the given one, and has to earn it, as a richer friction model does under
 ``--model auto``: on the KUKA LWR4+ logs the scores of the weights 10 and 1 differ by less than that, and the
 weaker prior predicted the held-out run 3 worse on three joints (the README's KUKA commands; derivations 15).
@@ -496,7 +496,7 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
             scores[weight] = validating.rms(trial.x)
             if scores[weight] > min(scores.values()):
                 break  # past the best weight: weaker priors only fit the noise more closely
-        prior = max(w for w, score in scores.items() if score <= (1 + PRIOR_TOLERANCE) * min(scores.values()))
+        prior = max(w for w, score in scores.items() if score <= (1 + options.prior_tolerance) * min(scores.values()))
     variance = residual_variance(total, base)
     fit = RegularisedProblem(R, z, prior_of, lower).fit(prior * variance, options.link_margin)
     bodies = tuple(robot.model.names[1:])

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal, get_args
 
-from wbfriction.choices import check_choice, flag
+from wbfriction.choices import check_choice, check_range, flag
 from wbfriction.exceptions import InputError, OptionError
 
 ArmatureMode = Literal["known", "identify", "none"]
@@ -83,6 +83,8 @@ class InertialOptions:
             ``../shared/real-data`` five of seven bodies collapsed so (principal moments -97 to -100 %), and
             those bodies predicted another run's torques worse than links kept at a quarter (the held-out run's
             friction fit: 0.344 -> 0.32 N·m mean RMS; 0.1 to 0.3 give the same within 0.002).
+        prior_tolerance: with the prior's weight chosen by validation, the strongest weight whose validation score
+            is within this share of the best is taken (>= 0).
     """
 
     tanh_slope: float = 40.0
@@ -98,10 +100,12 @@ class InertialOptions:
     min_mass: float = 1e-3
     block: int = 200
     link_margin: float = 0.25
+    prior_tolerance: float = 0.02
 
     def __post_init__(self) -> None:
         check_choice("armature", self.armature, ARMATURE_MODES)
         if not 0.0 <= self.link_margin < 1.0:
             raise OptionError(flag("link_margin"), self.link_margin, "at least 0 and below 1")
+        check_range("prior_tolerance", self.prior_tolerance, low=0.0)
         if self.prior is not None and not self.prior > 0:
             raise InputError(f"the prior's weight must be > 0, got {self.prior}")

@@ -67,7 +67,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.logs.clock import longest_segment
 from wbfriction.logs.log import Log
 from wbfriction.signals.filters import ZeroPhaseLowpass, savgol_kernels
-from wbfriction.signals.options import FilterOptions, SavgolWeights
+from wbfriction.signals.options import NOISE_TARGET, FilterOptions, SavgolWeights
 from wbfriction.signals.spectrum import amplitude_spectrum, longest_run, periodic_hann, suggest_cutoff
 
 ChosenScheme = Literal["central", "savgol", "butterworth"]
@@ -90,9 +90,6 @@ FRAME = 128
 walk's impacts, a few samples each, spoil few of them (at 1 kHz, two frames of the 12 of a 0.8 s step), long
 enough that a motion's content leaks into the upper half of the band by about 1e-5 of its amplitude (sines of
 1-20 Hz at 1 kHz: 1e-11 rad of position noise where there is none)."""
-NOISE_TARGET = 0.03
-"""Most RMS noise a scheme may leave in the acceleration [rad/s^2] (module docstring: measured;
-through a joint inertia of 1 kg·m^2 it is 0.03 N·m, below the studies' torque-sensor noise of 0.05 N·m)."""
 
 
 # ------------------------------------------------------------------ the positions' spectrum

@@ -10,6 +10,11 @@ from typing import Literal, get_args
 from wbfriction.choices import check_choice, check_range, flag
 from wbfriction.exceptions import OptionError
 
+NOISE_TARGET = 0.03
+"""Most RMS noise a scheme may leave in the acceleration [rad/s^2] (:mod:`wbfriction.signals.choice`: measured;
+through a joint inertia of 1 kg·m^2 it is 0.03 N·m, below the studies' torque-sensor noise of 0.05 N·m); the
+default of ``EstimateOptions.noise_target``."""
+
 Scheme = Literal["central", "backward", "savgol", "butterworth"]
 """A differentiation scheme: plain differences, then the filtering ones (:mod:`~wbfriction.signals.kinematics`)."""
 SCHEMES: tuple[Scheme, ...] = get_args(Scheme)
