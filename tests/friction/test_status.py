@@ -262,9 +262,11 @@ def test_the_thresholds_decide_each_rule():
     assert fit_verdict(fit).ok and fit_verdict(fit, StatusThresholds(weak=0.25)).status == "weak"
     routes = dataclasses.replace(_fit(), route_check=RouteCheck("momentum", {"F_c": 1.05, "F_v": 0.2},
                                                                 {"F_c": 0.005, "F_v": 0.01}))
-    assert fit_verdict(routes).status == "routes disagree" and "F_c 1 ±0.01 (acceleration)" in fit_verdict(routes).reason
+    verdict = fit_verdict(routes)
+    assert verdict.status == "routes disagree" and "F_c 1 ±0.01 (acceleration)" in verdict.reason
     assert fit_verdict(routes, StatusThresholds(route_rel=0.06)).ok
-    later = dataclasses.replace(_fit(), later=PredictionCheck("the last 30 % of its samples", 300, 0.108, 0.1, 5.0, 0.3))
+    check = PredictionCheck("the last 30 % of its samples", 300, 0.108, 0.1, 5.0, 0.3)
+    later = dataclasses.replace(_fit(), later=check)
     assert fit_verdict(later).status == "does not predict"
     assert fit_verdict(later, StatusThresholds(holdout_excess=0.1)).ok
     assert fit_verdict(later, DEFAULT_THRESHOLDS) == later.verdict()
