@@ -1,0 +1,452 @@
+"""Defaults chosen across the data: every real dataset and the simulators together, one dataset left out (issue 52).
+
+A default picked by looking at data must be picked across all of it. Each default under study is a :class:`Knob`
+(an option of a stage: the identification's link margin and prior tolerance, the estimate's noise target, the fit's
+selection tolerance and terms, the statuses' thresholds) with a few candidate values around today's. Each
+:class:`Case` runs the route a user is given for it (:mod:`~wbfriction.studies.real_data`) with one knob set to
+one value and every other at its default, and scores it:
+
+* ``kuka-lwr4`` (real): the mean over joints of run 3's torque RMS over the peer's (FloBaRoID's method), the route
+  identifying on runs 1 and 2; a fit is *good* where it predicts run 3 as its noise and standard errors allow
+  (:func:`~wbfriction.friction.predict.other_log_checks`);
+* ``ur10e``, ``panda`` (real): the mean of the odd part's relative RMS error against the published curve; a fit
+  is *good* within the issue's targets, 5 % and 15 %;
+* ``panda-sim`` (the arm simulator: motor currents, armature, 1e-4 rad of position noise, 0.05 N·m of torque
+  noise), identified from a model with principal moments x1.1 and masses x1.05 and no armature; ``talos-ideal``
+  (the ideal simulator's combined walk, exact model, no noise); ``talos-mujoco`` (MuJoCo's combined walk with the
+  studies' sensor noise, the ankle wrenches and the IMU): the mean relative error of F_c and F_v against the
+  injected friction; a fit is *good* with F_c within 5 % and F_v within 10 %.
+
+A knob's candidates are compared per case by the loss over the default's (:func:`choose`): the value whose mean
+ratio over the cases is lowest is chosen, and for each case the value chosen **without** it is scored on it (leave
+one dataset out): a default that only one dataset asks for shows there. The statuses' thresholds are scored by
+how well ``ok`` predicts *good*: the share of fits called ``ok`` that are not good (counted twice: a plausible
+wrong number is worse than a missing one) and of good fits not called ``ok``.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from wbfriction.datasets import reference, write_dataset
+from wbfriction.datasets.reference import HeldOutRms
+from wbfriction.friction.estimate import FrictionEstimate, estimate_log
+from wbfriction.friction.fit import FitResult, fit_estimate
+from wbfriction.friction.models import ModelParams
+from wbfriction.friction.options import EstimateOptions, FitOptions, TermOptions
+from wbfriction.friction.predict import other_log_checks, predict_torques
+from wbfriction.friction.status import DEFAULT_THRESHOLDS, StatusThresholds, fit_verdict
+from wbfriction.inertia.closed_loop import identify
+from wbfriction.inertia.options import ArmatureMode, InertialOptions
+from wbfriction.logs.log import Log
+from wbfriction.logs.source import read_log
+from wbfriction.model.loading import load_robot
+from wbfriction.model.robot import Robot
+from wbfriction.studies.real_data import curve_scores
+
+Stage = Literal["identify", "estimate", "fit", "status"]
+"""Where a knob acts: what must run again for a new value."""
+
+
+@dataclass(frozen=True)
+class Setting:
+    """The options of every stage of a route (the case sets the armature)."""
+
+    inertial: InertialOptions = InertialOptions()
+    estimate: EstimateOptions = EstimateOptions()
+    fit: FitOptions = FitOptions()
+    thresholds: StatusThresholds = DEFAULT_THRESHOLDS
+
+
+@dataclass(frozen=True)
+class Knob:
+    """A default under study: its name, the stage it acts in, the candidates (today's included) and how a value is
+    set into a :class:`Setting`."""
+
+    name: str
+    stage: Stage
+    values: tuple[Any, ...]
+    default: Any
+    set: Callable[[Setting, Any], Setting] = field(repr=False, compare=False)
+
+
+def _inertial(name: str) -> Callable[[Setting, Any], Setting]:
+    return lambda s, v: replace(s, inertial=replace(s.inertial, **{name: v}))
+
+
+def _thresholds(name: str) -> Callable[[Setting, Any], Setting]:
+    return lambda s, v: replace(s, thresholds=replace(s.thresholds, **{name: v}))
+
+
+KNOBS: tuple[Knob, ...] = (
+    Knob("link_margin", "identify", (0.0, 0.1, 0.25, 0.5), 0.25, _inertial("link_margin")),
+    Knob("prior_tolerance", "identify", (0.0, 0.02, 0.05, 0.1), 0.02, _inertial("prior_tolerance")),
+    Knob("noise_target", "estimate", (0.01, 0.03, 0.1), 0.03,
+         lambda s, v: replace(s, estimate=replace(s.estimate, noise_target=v))),
+    Knob("selection_tolerance", "fit", (0.0, 0.02, 0.05, 0.1), 0.02,
+         lambda s, v: replace(s, fit=replace(s.fit, selection_tolerance=v))),
+    Knob("terms", "fit", ("none", "all"), "none",
+         lambda s, v: replace(s, fit=replace(s.fit, terms=TermOptions() if v == "all" else TermOptions(terms=())))),
+    Knob("weak", "status", (0.25, 0.5, 1.0), 0.5, _thresholds("weak")),
+    Knob("holdout_excess", "status", (0.02, 0.05, 0.1, 0.2), 0.05, _thresholds("holdout_excess")),
+    Knob("route_rel", "status", (0.02, 0.05, 0.1), 0.02, _thresholds("route_rel")),
+)
+"""The defaults under study (module docstring)."""
+
+
+@dataclass(frozen=True)
+class Judged:
+    """One fit of a case: its status (at the setting's thresholds) and whether it is good (module docstring)."""
+
+    joint: str
+    status: str
+    good: bool
+    error: float
+
+
+@dataclass(frozen=True)
+class CaseScore:
+    """A case's loss (lower is better; module docstring) and each fit judged."""
+
+    loss: float
+    judged: tuple[Judged, ...]
+
+    def misjudged(self) -> float:
+        """The statuses' loss: (2 x ok but not good + good but not ok) / fits."""
+        n = len(self.judged)
+        false_ok = sum(1 for j in self.judged if j.status == "ok" and not j.good)
+        false_not = sum(1 for j in self.judged if j.status != "ok" and j.good)
+        return (2 * false_ok + false_not) / n if n else math.nan
+
+
+@dataclass
+class Fitted:
+    """What a route left for scoring: the estimate fitted, its fits, the robot model, and the held-out estimate."""
+
+    estimate: FrictionEstimate
+    fits: list[FitResult]
+    robot: Robot
+    held_out: FrictionEstimate | None = None
+
+
+class Case(ABC):
+    """A dataset the defaults are chosen on (module docstring); stages cached by the options they depend on."""
+
+    name: str
+    kind: Literal["real", "sim"]
+    identifies: bool = False
+    armature: ArmatureMode = "none"
+
+    def __init__(self, folder: Path):
+        self.folder = folder / self.name
+        self._models: dict[Any, Robot] = {}
+        self._fitted: dict[Any, Fitted] = {}
+
+    @abstractmethod
+    def prepare(self) -> None:
+        """Write or simulate the case's logs (once)."""
+
+    @abstractmethod
+    def given(self) -> Robot:
+        """The model a user starts from."""
+
+    @abstractmethod
+    def logs(self) -> tuple[Log, Log | None]:
+        """The log the route fits on, and the held-out log (None: none)."""
+
+    def model(self, setting: Setting) -> Robot:
+        """The model the route estimates with: identified from the fitted log where the route identifies."""
+        if not self.identifies:
+            return self.given()
+        key = (setting.inertial, setting.estimate)
+        if key not in self._models:
+            inertial = replace(setting.inertial, armature=self.armature)
+            loop = identify(self.given(), self.logs()[0], setting.estimate, inertial, workers=2)
+            self._models[key] = loop.final.identification.robot
+        return self._models[key]
+
+    def fitted(self, setting: Setting) -> Fitted:
+        key = (setting.inertial if self.identifies else None, setting.estimate, setting.fit)
+        if key not in self._fitted:
+            robot = self.model(setting)
+            train, held = self.logs()
+            est = estimate_log(robot, train, setting.estimate)
+            fits = fit_estimate(est, setting.fit, workers=2, targets=self.targets())
+            held_est = None if held is None else estimate_log(robot, held, setting.estimate)
+            self._fitted[key] = Fitted(est, fits, robot, held_est)
+        return self._fitted[key]
+
+    def targets(self) -> Mapping[str, ModelParams] | None:
+        """The injected friction (simulators), None for real data."""
+        return None
+
+    @abstractmethod
+    def score(self, fitted: Fitted, thresholds: StatusThresholds) -> CaseScore:
+        """The case's loss and its fits judged."""
+
+
+def _status(fit: FitResult, thresholds: StatusThresholds) -> str:
+    return fit_verdict(fit, thresholds).status
+
+
+class RealCase(Case):
+    """A real dataset (:mod:`wbfriction.datasets`) through its route."""
+
+    kind = "real"
+    identifies = True
+    _given: Robot
+    _logs: tuple[Log, Log | None]
+
+    def prepare(self) -> None:
+        self.written = write_dataset(self.name, self.folder)
+        self._given = load_robot(config=self.written.config)
+        held = self.written.logs.get("held_out")
+        self._logs = (read_log(self.written.logs["train"], self._given),
+                      None if held is None else read_log(held, self._given))
+
+    def given(self) -> Robot:
+        return self._given
+
+    def logs(self) -> tuple[Log, Log | None]:
+        return self._logs
+
+
+class KukaCase(RealCase):
+    """FloBaRoID's KUKA LWR4+: run 3's torques against the peer's method."""
+
+    name = "kuka-lwr4"
+    armature = "none"
+
+    def score(self, fitted: Fitted, thresholds: StatusThresholds) -> CaseScore:
+        assert fitted.held_out is not None
+        ref = reference(self.name)
+        fits = {f.joint: f for f in fitted.fits}
+        models = {j: f.kept_terms or f.params for j, f in fits.items() if f.params is not None}
+        rms = predict_torques(fitted.held_out, models).rms
+        checks = other_log_checks(fitted.held_out, fits, "run 3", workers=2)
+        assert isinstance(ref, HeldOutRms)
+        peer = np.array([ref.held_out(j) for j in fitted.held_out.joints])
+        judged = tuple(Judged(j, _status(fits[j], thresholds), c is not None and c.predicts, float(r / p))
+                       for j, r, p, c in zip(fitted.held_out.joints, rms, peer, checks))
+        return CaseScore(float(np.mean(rms / peer)), judged)
+
+
+class CurveCase(RealCase):
+    """A real dataset with a published curve: the odd part's error against it."""
+
+    target: float
+
+    def score(self, fitted: Fitted, thresholds: StatusThresholds) -> CaseScore:
+        ref = reference(self.name)
+        est = fitted.estimate
+        judged = []
+        for k, fit in enumerate(fitted.fits):
+            error, _ = curve_scores(fit, est.qd[est.valid[:, k], k], ref, fit.joint)
+            judged.append(Judged(fit.joint, _status(fit, thresholds), bool(error <= self.target), error))
+        return CaseScore(float(np.nanmean([j.error for j in judged])), tuple(judged))
+
+
+class Ur10eCase(CurveCase):
+    name = "ur10e"
+    armature = "identify"
+    target = 0.05
+
+
+class PandaCase(CurveCase):
+    name = "panda"
+    armature = "none"
+    target = 0.15
+
+
+class SimCase(Case):
+    """A simulated log with known friction: the relative errors of F_c and F_v."""
+
+    kind = "sim"
+    _robot: Robot
+    _log: Log
+    _truth: dict[str, ModelParams]
+
+    def targets(self) -> Mapping[str, ModelParams] | None:
+        return self._truth
+
+    def score(self, fitted: Fitted, thresholds: StatusThresholds) -> CaseScore:
+        judged, errors = [], []
+        for fit in fitted.fits:
+            if fit.joint not in self._truth or fit.params is None or (fit.speed or 0.0) < 0.02:
+                continue
+            err = fit.reported().error_percent()  # with terms kept: the velocity model refitted with them
+            if err is None:
+                continue
+            e_c, e_v = err.get("F_c", math.nan) / 100, err.get("F_v", math.nan) / 100
+            errors.append(0.5 * (e_c + e_v))
+            judged.append(Judged(fit.joint, _status(fit, thresholds), bool(e_c <= 0.05 and e_v <= 0.10),
+                                 max(e_c, e_v)))
+        return CaseScore(float(np.nanmean(errors)), tuple(judged))
+
+    def given(self) -> Robot:
+        return self._robot
+
+    def logs(self) -> tuple[Log, Log | None]:
+        return self._log, None
+
+
+class PandaSimCase(SimCase):
+    """The arm simulator's Panda (motor currents, armature, sensor noise) through a wrong model, identified."""
+
+    name = "panda-sim"
+    identifies = True
+    armature = "identify"
+
+    def prepare(self) -> None:
+        from wbfriction.inertia.sensitivity import scaled_robot
+        from wbfriction.studies.noise import family_friction, simulate_family
+
+        robot = load_robot("panda")
+        self._truth = family_friction(robot, "thesis")
+        self._log = simulate_family(robot, "thesis", 1e-4, 0, duration=20.0, steps=0, cache={})
+        wrong = scaled_robot(scaled_robot(robot, 1.1, "rotational"), 1.05, "mass")
+        wrong.model.armature = np.zeros(wrong.model.nv)
+        self._robot = wrong
+
+
+class TalosIdealCase(SimCase):
+    """The ideal simulator's combined walk (3 steps of each gait), Table 6.1 friction, the exact model."""
+
+    name = "talos-ideal"
+
+    def prepare(self) -> None:
+        from wbfriction.friction.targets import friction_by_group
+        from wbfriction.sim import simulate_ideal
+        from wbfriction.studies.common import SIMULATOR
+        from wbfriction.walking import walking_reference
+        from wbfriction.walking.options import GaitOptions
+
+        self._robot = load_robot("talos")
+        self._truth = dict(friction_by_group(self._robot.groups))
+        reference_walk = walking_reference(self._robot, GaitOptions(gait="combined", steps=3))
+        self._log = simulate_ideal(self._robot, reference_walk, self._truth, SIMULATOR).log
+
+
+class TalosMujocoCase(SimCase):
+    """MuJoCo's combined walk (3 steps of each gait) with the studies' sensor noise, the exact model."""
+
+    name = "talos-mujoco"
+
+    def prepare(self) -> None:
+        from wbfriction.studies.noise import family_friction, simulate_family
+
+        self._robot = load_robot("talos")
+        self._truth = family_friction(self._robot, "thesis")
+        self._log = simulate_family(self._robot, "thesis", 1e-4, 0, duration=0.0, steps=3, cache={})
+
+
+CASES: tuple[type[Case], ...] = (KukaCase, Ur10eCase, PandaCase, PandaSimCase, TalosIdealCase, TalosMujocoCase)
+"""Every case, real first."""
+
+
+@dataclass(frozen=True)
+class KnobChoice:
+    """A knob's candidates scored on every case, the value chosen and each case left out (module docstring).
+
+    Attributes:
+        knob: the knob.
+        losses: value -> case -> loss (lower is better; the statuses': :meth:`CaseScore.misjudged`).
+        scores: value -> its mean over the cases (of the loss over the default's, or of the statuses' loss).
+        chosen: the value of the lowest score (the default where it ties).
+        left_out: case -> (the value chosen without it, its loss on it over the default's, or the statuses' loss).
+    """
+
+    knob: Knob
+    losses: dict[Any, dict[str, float]]
+    scores: dict[Any, float]
+    chosen: Any
+    left_out: dict[str, tuple[Any, float]]
+
+
+def choose(knob: Knob, losses: dict[Any, dict[str, float]]) -> KnobChoice:
+    """The choice of module docstring from ``losses`` (value -> case -> loss): numeric knobs by the mean ratio to the
+    default's loss, the statuses' by the mean of their loss; cases where the knob changes nothing count all the
+    same (a ratio of 1)."""
+    cases = list(next(iter(losses.values())))
+    default = losses[knob.default]
+
+    def relative(value: Any, case: str) -> float:
+        x = losses[value][case]
+        if knob.stage == "status":
+            return x
+        return x / default[case] if default[case] > 0 else (1.0 if x == 0 else math.inf)
+
+    def best(among: Sequence[str]) -> Any:
+        means = {v: float(np.mean([relative(v, c) for c in among])) for v in knob.values}
+        low = min(means.values())
+        return knob.default if means[knob.default] <= low + 1e-12 else min(means, key=lambda v: means[v])
+
+    scores = {v: float(np.mean([relative(v, c) for c in cases])) for v in knob.values}
+    left = {}
+    for case in cases:
+        value = best([c for c in cases if c != case])
+        left[case] = (value, relative(value, case))
+    return KnobChoice(knob, losses, scores, best(cases), left)
+
+
+def run_study(folder: Path, knobs: Sequence[Knob] = KNOBS, cases: Sequence[type[Case]] = CASES,
+              say: Callable[[str], None] = lambda s: None) -> list[KnobChoice]:
+    """Every knob of ``knobs`` over every case (module docstring), one knob at a time, the others at their
+    defaults."""
+    folder.mkdir(parents=True, exist_ok=True)
+    built = []
+    for cls in cases:
+        case = cls(folder)
+        say(f"preparing {case.name}")
+        case.prepare()
+        built.append(case)
+    out = []
+    for knob in knobs:
+        losses: dict[Any, dict[str, float]] = {}
+        for value in knob.values:
+            setting = knob.set(Setting(), value)
+            losses[value] = {}
+            for case in built:
+                say(f"{knob.name} = {value}: {case.name}")
+                score = case.score(case.fitted(setting), setting.thresholds)
+                losses[value][case.name] = score.misjudged() if knob.stage == "status" else score.loss
+        out.append(choose(knob, losses))
+    return out
+
+
+def markdown(choices: Sequence[KnobChoice]) -> str:
+    """One table per knob: the loss of each value on each case (relative to the default's, or the statuses' loss),
+    the mean, the value chosen, and for each case the value chosen without it and how it does there."""
+    lines: list[str] = []
+    for choice in choices:
+        knob = choice.knob
+        cases = list(next(iter(choice.losses.values())))
+        unit = "statuses' loss" if knob.stage == "status" else "loss / default's"
+        lines += [f"**{knob.name}** (default {knob.default}; {unit}; chosen: {choice.chosen})", "",
+                  "| value | " + " | ".join(cases) + " | mean |", "|---" * (len(cases) + 2) + "|"]
+        for v in knob.values:
+            row = [choice.losses[v][c] if knob.stage == "status" else
+                   choice.losses[v][c] / choice.losses[knob.default][c] for c in cases]
+            lines.append(f"| {v} | " + " | ".join(f"{x:.3f}" for x in row) + f" | {choice.scores[v]:.3f} |")
+        lines.append("| left out: chosen without it | " + " | ".join(
+            f"{choice.left_out[c][0]} ({choice.left_out[c][1]:.3f})" for c in cases) + " | |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def as_json(choices: Sequence[KnobChoice]) -> list[dict[str, Any]]:
+    """The study's numbers, for a file."""
+    return [{"knob": c.knob.name, "stage": c.knob.stage, "default": c.knob.default, "chosen": c.chosen,
+             "losses": {str(v): d for v, d in c.losses.items()}, "scores": {str(v): s for v, s in c.scores.items()},
+             "left_out": {k: [str(v), r] for k, (v, r) in c.left_out.items()}} for c in choices]
+
+
+__all__ = ["CASES", "KNOBS", "Case", "CaseScore", "Judged", "Knob", "KnobChoice", "Setting", "as_json", "choose",
+           "markdown", "run_study"]
