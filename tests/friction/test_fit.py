@@ -564,6 +564,27 @@ def test_sticking_samples_are_left_out_and_the_sliding_ones_give_the_truth():
     assert abs(kept.params.F_v / 0.2 - 1.0) > 0.05
 
 
+def test_a_reversal_that_passes_through_zero_is_not_sticking():
+    """Issue 52: a joint that reverses through zero without stopping (a 100 Hz log of a sweep, a rate of 0.02 rad/s
+    per row at the reversals) holds no static friction: its slow samples and their neighbours stay in the fit (a
+    UR10e's log lost a fifth of its samples so, its F_c 5-20 % off), and a smoothed fit recovers the friction; the
+    stretches where the same joint stops for a while (below the sticking speed for 40 rows) are left out with their
+    margin."""
+    from wbfriction.friction.fit import stuck_rows
+
+    t = np.arange(6000) * 0.01
+    qd = 0.6 * np.sin(2 * np.pi * 0.5 * t + 0.3)  # through zero at 1.9 rad/s^2: 0.019 rad/s a row
+    assert not stuck_rows(qd, STICK_FLOOR, 16).any()
+    stopped = qd.copy()
+    stopped[1000:1040] = 1e-3 * np.sin(np.arange(40))  # stuck, chattering
+    rows = stuck_rows(stopped, STICK_FLOOR, 16)
+    assert rows[1000:1040].all() and rows[1000 - 16] and not rows[1000 - 17 - 5] and rows.sum() <= 40 + 2 * 16 + 4
+    tau_f = -(0.3 * qd + 1.0 * np.sign(qd))
+    fit = fit_friction(qd, tau_f, model="coulomb-viscous", stick=STICK_FLOOR, stick_margin=16)
+    assert fit.n_stuck == 0
+    assert fit.params.F_c == pytest.approx(1.0, rel=1e-6) and fit.params.F_v == pytest.approx(0.3, rel=1e-6)
+
+
 def test_a_joint_that_hardly_moved_keeps_its_slow_samples():
     """Below the excitation speed there is no velocity model to fit: no sample is left out as sticking (its
     offset comes from all of them), and its speed counts them."""
