@@ -79,7 +79,7 @@ from wbfriction.friction.models import (
     target_from_dict,
 )
 from wbfriction.friction.noise import joint_noises
-from wbfriction.friction.options import MODEL_CHOICES, SELECTION_TOLERANCE, FitOptions, ModelChoice
+from wbfriction.friction.options import MODEL_CHOICES, PASS_ROWS, SELECTION_TOLERANCE, FitOptions, ModelChoice
 from wbfriction.friction.projection import BASINS, Projection, projected_start
 from wbfriction.friction.regression import (
     correlation_lag,
@@ -295,6 +295,7 @@ class FitResult(Generic[ParamsT]):
         velocity_noise: the velocity noise the model's expectation took [rad/s]
             (:mod:`~wbfriction.friction.eiv`; 0: the model itself).
         stick_speed: samples whose window holds a speed below this [rad/s] were left out (:func:`stuck_rows`).
+        pass_rows: but for reversals crossing that band within so many rows (:func:`stuck_rows`).
         n_stuck: valid samples so left out.
         terms: the terms beyond velocity kept with this model (:mod:`~wbfriction.friction.terms`; its
             :attr:`~wbfriction.friction.terms.TermFit.params` are this model's linear coefficients refitted with
@@ -326,6 +327,7 @@ class FitResult(Generic[ParamsT]):
     velocity_noise: float = 0.0
     stick_speed: float = 0.0
     n_stuck: int = 0
+    pass_rows: float = PASS_ROWS
     terms: TermFit | None = None
     later: PredictionCheck | None = None
 
@@ -557,7 +559,7 @@ EDGE_ROWS = 3
 """Rows either side of a slow stretch over which the velocity's rate of change is measured (:func:`stuck_rows`)."""
 
 
-def stuck_rows(qd: np.ndarray, speed: float, margin: int) -> np.ndarray:
+def stuck_rows(qd: np.ndarray, speed: float, margin: int, pass_rows: float = PASS_ROWS) -> np.ndarray:
     """(N,) the samples within ``margin`` rows of a stretch where the joint may have stuck: its speed ``|qd|`` below
     ``speed`` [rad/s] longer than a pass through zero takes. A joint at rest has static friction, any value up to
     its static level, which no model of the velocity predicts, and a filter spreads it over its window (``margin``:
@@ -582,7 +584,8 @@ def stuck_rows(qd: np.ndarray, speed: float, margin: int) -> np.ndarray:
         before, after = v[max(a - 1 - EDGE_ROWS, 0):a], v[b:b + EDGE_ROWS + 1]
         rates = [abs(x[-1] - x[0]) / (x.size - 1) for x in (before, after) if x.size > 1 and np.all(np.isfinite(x))]
         rate = max(rates, default=0.0)  # per row, entering or leaving the band
-        if rate > 0 and b - a <= 1.0 + 2.0 * (2.0 * speed / rate):
+        crossing = 2.0 * speed / rate if rate > 0 else np.inf  # rows a pass through the band takes
+        if crossing <= pass_rows and b - a <= 1.0 + 2.0 * crossing:
             stuck[a:b] = False  # a pass through zero
     if margin <= 0 or not stuck.any():
         return stuck
@@ -590,7 +593,8 @@ def stuck_rows(qd: np.ndarray, speed: float, margin: int) -> np.ndarray:
 
 
 def fitted_rows(qd: np.ndarray, tau_f: np.ndarray, mask: np.ndarray | None = None, smoother=None,
-                stick: float = 0.0, margin: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+                stick: float = 0.0, margin: int = 0, pass_rows: float = PASS_ROWS
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """The samples a fit uses (:func:`fit_friction`'s arguments), and why the others are not.
 
     Returns:
@@ -612,7 +616,7 @@ def fitted_rows(qd: np.ndarray, tau_f: np.ndarray, mask: np.ndarray | None = Non
     # (status ``not excited``), and every sample gives its offset (the energy check's, eq. 7.9)
     speed = joint_speed(qd[use])
     sticks = stick > 0 and speed >= MIN_SPEED
-    stuck = stuck_rows(qd, stick, margin) & use if sticks else np.zeros_like(use)
+    stuck = stuck_rows(qd, stick, margin, pass_rows) & use if sticks else np.zeros_like(use)
     return use & ~stuck, screened, stuck, speed
 
 
@@ -648,7 +652,8 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
                  x0: np.ndarray | None = None, min_samples: int = 20, mask: np.ndarray | None = None,
                  smoother=None, fixed: dict[str, float] | None = None, model: ModelChoice = "thesis",
                  selection_tolerance: float = SELECTION_TOLERANCE, velocity_noise: float = 0.0,
-                 stick: float = 0.0, stick_margin: int = 0, noise: JointNoise | None = None,
+                 stick: float = 0.0, stick_margin: int = 0, pass_rows: float = PASS_ROWS,
+                 noise: JointNoise | None = None,
                  still: ModelName | None = None) -> FitResult:
     """Fit a friction model to friction estimates of one joint (eq. 6.4).
 
@@ -679,7 +684,8 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
             within which the simpler model is chosen.
         velocity_noise: the standard deviation of the noise in ``qd`` [rad/s]: the model compared is its expectation
             under that noise (errors in variables, :mod:`~wbfriction.friction.eiv`); 0: the model itself.
-        stick, stick_margin: samples within ``stick_margin`` rows of a speed below ``stick`` [rad/s] are left out
+        stick, stick_margin, pass_rows: samples within ``stick_margin`` rows of a speed below ``stick`` [rad/s] are
+            left out, but for reversals crossing that band within ``pass_rows`` rows
             (:func:`stuck_rows`) and counted (:attr:`FitResult.n_stuck`); 0: none. Not for a joint that hardly
             moved (:data:`~wbfriction.friction.status.MIN_SPEED`: ``not excited``), whose every sample gives its
             offset.
@@ -700,7 +706,7 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         raise InputError(f"model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
     qd = np.asarray(qd, dtype=float)
     y = -np.asarray(tau_f, dtype=float)
-    use, screened, stuck, speed = fitted_rows(qd, tau_f, mask, smoother, stick, stick_margin)
+    use, screened, stuck, speed = fitted_rows(qd, tau_f, mask, smoother, stick, stick_margin, pass_rows)
     # One BLAS thread: the solver's many small (N x p) factorizations run several times
     # slower on OpenBLAS's threads than on one (30 TALOS joints of a 10-step walk: 78 s
     # against 14 s on 2 cores); fit joints side by side instead (fit_estimate's workers).
@@ -721,6 +727,7 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
     res.n_screened = int(screened.sum())
     res.speed = speed
     res.velocity_noise, res.stick_speed, res.n_stuck = float(velocity_noise), float(stick), int(stuck.sum())
+    res.pass_rows = float(pass_rows)
     return res
 
 
@@ -890,8 +897,8 @@ def later_stretch(fit: FitResult, qd: np.ndarray, tau_f: np.ndarray, valid: np.n
     if fit.params is None or fit.speed is None or fit.speed < MIN_SPEED or not fit.success:
         return None
     smoother, sigma = kwargs.get("smoother"), float(kwargs.get("velocity_noise", 0.0))
-    use = fitted_rows(qd, tau_f, valid, smoother, float(kwargs.get("stick", 0.0)),
-                      int(kwargs.get("stick_margin", 0)))[0]
+    use = fitted_rows(qd, tau_f, valid, smoother, fit.stick_speed, int(kwargs.get("stick_margin", 0)),
+                      fit.pass_rows)[0]
     before, later = split_later(use, LATER)
     if int((use & before).sum()) < MIN_HELD_OUT or int(later.sum()) < MIN_HELD_OUT:
         return None
@@ -943,14 +950,16 @@ def _fit_routes(args: tuple) -> tuple[FitResult, FitResult | None]:
 def _column_tasks(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, models: Sequence[ModelChoice], *,
                   delta_s: float, min_samples: int, smoother, fixed: dict[str, float] | None,
                   selection_tolerance: float, noise: Mapping[str, JointNoise] | None,
-                  stick_margin: int | None, still: ModelName | None = None) -> list[tuple]:
+                  stick_margin: int | None, still: ModelName | None = None,
+                  pass_rows: float = PASS_ROWS) -> list[tuple]:
     """One :func:`_fit_column` task per joint (:func:`fit_joints`'s arguments)."""
     noise = noise or {}
     tasks = []
     for i, joint in enumerate(joints):
         jn = noise.get(joint)
         sigma = 0.0 if jn is None else jn.velocity
-        stick = {} if stick_margin is None else {"stick": stick_speed(sigma), "stick_margin": stick_margin}
+        stick = {} if stick_margin is None else {"stick": stick_speed(sigma), "stick_margin": stick_margin,
+                                                 "pass_rows": pass_rows}
         tasks.append((qd[:, i], tau_f[:, i], valid[:, i],
                       dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, fixed=fixed,
                            model=models[i], selection_tolerance=selection_tolerance, velocity_noise=sigma, noise=jn,
@@ -987,7 +996,8 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
                fixed: dict[str, float] | None = None, workers: int = 1,
                model: ModelChoice | Sequence[ModelName] = "thesis",
                selection_tolerance: float = SELECTION_TOLERANCE, noise: Mapping[str, JointNoise] | None = None,
-               stick_margin: int | None = None, later: bool = True) -> list[FitResult]:
+               stick_margin: int | None = None, later: bool = True,
+               pass_rows: float = PASS_ROWS) -> list[FitResult]:
     """Fit every joint of a friction estimate on its valid samples.
 
     Args:
@@ -1008,6 +1018,7 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
         stick_margin: with it, samples within that many rows of a speed a joint may stick at
             (:func:`stick_speed`) are left out (:func:`stuck_rows`); None: none.
         later: each fit checked on its later stretch (:func:`later_stretch`).
+        pass_rows: reversals crossing the sticking band within so many rows are not left out (:func:`stuck_rows`).
 
     Raises:
         InputError: what :func:`fit_friction` raises.
@@ -1015,7 +1026,8 @@ def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
     models = [model] * len(joints) if isinstance(model, str) else list(model)
     tasks = _column_tasks(joints, qd, tau_f, valid, cast(Sequence[ModelChoice], models), delta_s=delta_s,
                           min_samples=min_samples, smoother=smoother, fixed=fixed,
-                          selection_tolerance=selection_tolerance, noise=noise, stick_margin=stick_margin)
+                          selection_tolerance=selection_tolerance, noise=noise, stick_margin=stick_margin,
+                          pass_rows=pass_rows)
     fit = functools.partial(_fit_column, later=later)
     return _with_truth(joints, _run(fit, tasks, workers), qd, tau_f, valid, tau_f_true, targets)
 
@@ -1068,7 +1080,8 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
     record = est.metadata.get("noise")
     truth = None if est.tau_f_true is None else est.tau_f_true[:, idx]
     common: dict[str, Any] = dict(delta_s=options.delta_s, min_samples=options.min_samples, fixed=fixed,
-                                  selection_tolerance=options.selection_tolerance, still=still)
+                                  selection_tolerance=options.selection_tolerance, still=still,
+                                  pass_rows=options.pass_rows)
     tasks = _column_tasks(names, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], [options.model] * len(idx),
                           smoother=est.smoother, noise=joint_noises(record, est.estimation_route),
                           stick_margin=stick_margin(est), **common)
@@ -1103,12 +1116,12 @@ def _joint_terms(est: FrictionEstimate, i: int, fit: FitResult, other: FitResult
         return None
     signals = term_signals(est, i)
     use = fitted_rows(est.qd[:, i], est.tau_f[:, i], est.valid[:, i], est.smoother, fit.stick_speed,
-                      stick_margin(est))[0]
+                      stick_margin(est), fit.pass_rows)[0]
     terms = fit_terms(fit.params, est.qd[:, i], est.tau_f[:, i], use, signals, options.terms, est.smoother)
     check = est.route_check
     if check is not None and other is not None and other.params is not None and terms.kept:
         rows = fitted_rows(check.qd[:, i], check.tau_f[:, i], check.valid[:, i], check.smoother, other.stick_speed,
-                           stick_margin(check))[0]
+                           stick_margin(check), other.pass_rows)[0]
         terms = replace(terms, check=refit_terms(terms, other.params, check.qd[:, i], check.tau_f[:, i], rows, signals,
                                                  check.estimation_route, check.smoother))
     return terms

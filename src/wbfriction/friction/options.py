@@ -171,6 +171,14 @@ models give well under 1 % (the remainder: velocity sign errors of the different
 around reversals, measured on the ideal simulator's combined walk)."""
 
 
+PASS_ROWS = 2.0
+"""A reversal is a pass through zero only where the log resolves it as a jump: the band of speeds a joint may stick
+at crossed within this many rows at the velocity's rate there (:func:`~wbfriction.friction.fit.stuck_rows`). A
+slower reversal may hold a stop, and where the velocity's noise is more than its measured value (a controller's
+vibration on MuJoCo: ten times), its slow samples bias the fit (a walking humanoid's hip yaw, F_v 3 -> 13 % off with
+them). Chosen across the real datasets and the simulators (README, *Defaults chosen across the data*)."""
+
+
 SELECTION_TOLERANCE = 0.02
 """Relative excess of held-out RMS over the best model's within which a simpler model is chosen
 (:func:`~wbfriction.friction.fit.choose_model`)."""
@@ -245,6 +253,9 @@ class FitOptions:
         delta_s: the Stribeck exponent of (3.5) (dimensionless, > 0; the thesis's 2).
         terms: the terms beyond velocity tried per joint (:mod:`~wbfriction.friction.terms`; by default none: the
             velocity model alone).
+        pass_rows: a reversal crossing the band of speeds a joint may stick at within this many samples is a pass
+            through zero, kept in the fit; a slower one may hold a stop, left out with its filter's margin (>= 0; 0:
+            every slow stretch; :func:`~wbfriction.friction.fit.stuck_rows`).
 
     Raises:
         OptionError: a value not one of its choices or out of its range, named by its command-line option.
@@ -255,9 +266,11 @@ class FitOptions:
     min_samples: int = 20
     delta_s: float = 2.0
     terms: TermOptions = TermOptions(terms=())
+    pass_rows: float = PASS_ROWS
 
     def __post_init__(self) -> None:
         check_choice("model", self.model, MODEL_CHOICES)
+        check_range("pass_rows", self.pass_rows, low=0.0)
         check_range("selection_tolerance", self.selection_tolerance, low=0.0)
         check_range("min_samples", self.min_samples, low=1)
         check_range("delta_s", self.delta_s, low=0.0, strict=True)

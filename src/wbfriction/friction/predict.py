@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike
 
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.fit import (
+    PASS_ROWS,
     FitResult,
     fit_joints,
     fitted_rows,
@@ -149,12 +150,14 @@ def other_log_checks(est: FrictionEstimate, fits: Mapping[str, FitResult], name:
     noise = joint_noises(est.metadata.get("noise"), est.estimation_route)
     refits = fit_joints(joints, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], smoother=est.smoother,
                         model=[fits[j].model for j in joints], noise=noise, stick_margin=stick_margin(est),
-                        workers=workers, later=False)
+                        workers=workers, later=False,
+                        pass_rows=max((fits[j].pass_rows for j in joints), default=PASS_ROWS))
     out: dict[str, PredictionCheck | None] = {}
     for j, i, refit in zip(joints, idx, refits):
         fit, qd, tau_f = fits[j], est.qd[:, i], est.tau_f[:, i]
         sigma = noise[j].velocity if j in noise else 0.0
-        use = fitted_rows(qd, tau_f, est.valid[:, i], est.smoother, refit.stick_speed, stick_margin(est))[0]
+        use = fitted_rows(qd, tau_f, est.valid[:, i], est.smoother, refit.stick_speed, stick_margin(est),
+                          fit.pass_rows)[0]
         if refit.params is None or joint_speed(qd[use]) < MIN_SPEED or use.sum() < MIN_HELD_OUT:
             out[j] = None
             continue

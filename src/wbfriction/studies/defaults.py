@@ -92,6 +92,8 @@ KNOBS: tuple[Knob, ...] = (
          lambda s, v: replace(s, estimate=replace(s.estimate, noise_target=v))),
     Knob("selection_tolerance", "fit", (0.0, 0.02, 0.05, 0.1), 0.02,
          lambda s, v: replace(s, fit=replace(s.fit, selection_tolerance=v))),
+    Knob("pass_rows", "fit", (0.0, 2.0, 5.0, math.inf), 2.0,
+         lambda s, v: replace(s, fit=replace(s.fit, pass_rows=v))),
     Knob("terms", "fit", ("none", "all"), "none",
          lambda s, v: replace(s, fit=replace(s.fit, terms=TermOptions() if v == "all" else TermOptions(terms=())))),
     Knob("weak", "status", (0.25, 0.5, 1.0), 0.5, _thresholds("weak")),
