@@ -386,6 +386,8 @@ def choose(knob: Knob, losses: dict[Any, dict[str, float]]) -> KnobChoice:
         return x / default[case] if default[case] > 0 else (1.0 if x == 0 else math.inf)
 
     def best(among: Sequence[str]) -> Any:
+        if not among:  # nothing to choose on: today's
+            return knob.default
         means = {v: float(np.mean([relative(v, c) for c in among])) for v in knob.values}
         low = min(means.values())
         return knob.default if means[knob.default] <= low + 1e-12 else min(means, key=lambda v: means[v])
