@@ -82,12 +82,16 @@ def fit(friction: Path = FrictionArg,
         terms: str = TermsOpt, max_harmonic: int = MaxHarmonicOpt,
         reference_temperature: Optional[float] = ReferenceTemperatureOpt,
         temperature_law: TemperatureLaw = TemperatureLawOpt,
+        pass_rows: float = typer.Option(FIT.pass_rows, min=0.0,
+                                        help="A reversal crossing the speeds a joint may stick at within this many "
+                                             "samples passes through zero and stays in the fit; a slower one may "
+                                             "hold a stop and is left out with the filter's reach (0: every one)."),
         wide: bool = WideOpt, verbose: bool = VerboseOpt) -> None:
     """Identify a friction model of every joint, with standard errors and the parameters left
     at a bound; warn about joints whose friction generates power (eq. 7.9)."""
     check_paths({"FRICTION": friction}, {"-o": output})
     _run_fit(friction, output, FitOptions(model=model, selection_tolerance=selection_tolerance,
-                                          min_samples=min_samples,
+                                          min_samples=min_samples, pass_rows=pass_rows,
                                           terms=term_options(terms, max_harmonic, reference_temperature,
                                                              temperature_law)),
              energy_threshold, energy_tolerance, workers, wide, verbose)
