@@ -902,7 +902,9 @@ def later_stretch(fit: FitResult, qd: np.ndarray, tau_f: np.ndarray, valid: np.n
     before, later = split_later(use, LATER)
     if int((use & before).sum()) < MIN_HELD_OUT or int(later.sum()) < MIN_HELD_OUT:
         return None
+    # from the whole fit's optimum: the early samples' is near it (the grid search would find the same basin)
     early = fit_friction(qd, tau_f, mask=valid & before, **{**kwargs, "model": fit.model, "noise": None,
+                                                             "x0": fit.params.as_vector(),
                                                              "fixed": model_fixed(fit.model, kwargs.get("fixed"))})
     if early.params is None or not early.success or early.covariance is None:
         return None

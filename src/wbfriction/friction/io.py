@@ -313,7 +313,7 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
         d["route_check"] = {"route": rc.route, "params": rc.params,
                             "stderr": {k: clean(v) for k, v in rc.stderr.items()}, "disagree": list(rc.disagree)}
     d["velocity_noise"], d["stick_speed"], d["n_stuck"] = fit.velocity_noise, fit.stick_speed, fit.n_stuck
-    d["pass_rows"] = fit.pass_rows
+    d["pass_rows"] = clean(fit.pass_rows)  # null: every reversal that changes sign passes
     if fit.later is not None:
         d["later_stretch"] = fit.later.to_dict()
     verdict = fit.verdict()
@@ -373,7 +373,8 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
         res.velocity_noise = float(d.get("velocity_noise", 0.0))
         res.stick_speed = float(d.get("stick_speed", 0.0))
         res.n_stuck = int(d.get("n_stuck", 0))
-        res.pass_rows = float(d.get("pass_rows", res.pass_rows))
+        if "pass_rows" in d:
+            res.pass_rows = _number(d["pass_rows"])
         if d.get("later_stretch") is not None:
             res.later = PredictionCheck.from_dict(d["later_stretch"])
         if d.get("terms") is not None:
