@@ -52,6 +52,7 @@ class PredictionCheck:
             [N·m].
         z: the excess of the held-out mean square in its standard errors.
         share: for the later stretch, the share of the fit's samples held out; None for another log.
+        note: what else explains a miss, a phrase (the held-out log faster than the fit's samples), or "".
     """
 
     held_out: str
@@ -60,6 +61,7 @@ class PredictionCheck:
     allowed: float
     z: float
     share: float | None = None
+    note: str = ""
 
     @property
     def ratio(self) -> float:
@@ -85,17 +87,19 @@ class PredictionCheck:
             head = f"it predicts {self.held_out} to {self.rms:.3g} N·m"
             cause = "the friction or the motion's model error differs there"
         return (f"{head} where the noise and its standard errors allow {self.allowed:.3g} ({self.z:.1f} standard "
-                f"errors): {cause}")
+                f"errors): {cause}" + (f"; {self.note}" if self.note else ""))
 
     def to_dict(self) -> dict[str, Any]:
         return {"held_out": self.held_out, "share": self.share, "samples": self.samples, "rms": self.rms,
-                "allowed": self.allowed, "z": self.z if math.isfinite(self.z) else None, "predicts": self.predicts}
+                "allowed": self.allowed, "z": self.z if math.isfinite(self.z) else None, "predicts": self.predicts,
+                "note": self.note}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> PredictionCheck:
         z = d.get("z")
         return cls(str(d["held_out"]), int(d["samples"]), float(d["rms"]), float(d["allowed"]),
-                   math.inf if z is None else float(z), None if d.get("share") is None else float(d["share"]))
+                   math.inf if z is None else float(z), None if d.get("share") is None else float(d["share"]),
+                   str(d.get("note", "")))
 
 
 def split_later(use: np.ndarray, share: float = LATER) -> tuple[np.ndarray, np.ndarray]:
@@ -117,7 +121,7 @@ def prediction_variance(g: np.ndarray, covariance: np.ndarray) -> float:
 
 
 def prediction_check(held_out: str, e_model: np.ndarray, e_best: np.ndarray, variance: float, rows: np.ndarray,
-                     share: float | None = None) -> PredictionCheck:
+                     share: float | None = None, note: str = "") -> PredictionCheck:
     """The check of the module docstring from the residuals (n,) of the predicting fit and of the best one on the
     held-out ``rows`` (n,) of the series, and the prediction variance [N²·m²] (:func:`prediction_variance`)."""
     finite = np.isfinite(e_model) & np.isfinite(e_best)
@@ -126,4 +130,4 @@ def prediction_check(held_out: str, e_model: np.ndarray, e_best: np.ndarray, var
     rms = float(np.sqrt(np.mean(e_model**2)))
     allowed = float(np.sqrt(np.mean(e_best**2) + variance))
     z = (gain - variance) / se if se > 0 else (math.inf if gain > variance else 0.0)
-    return PredictionCheck(held_out, int(finite.sum()), rms, allowed, float(z), share)
+    return PredictionCheck(held_out, int(finite.sum()), rms, allowed, float(z), share, note)

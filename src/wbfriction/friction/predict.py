@@ -130,6 +130,10 @@ def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve 
     return TorquePrediction(tuple(est.joints), samples, rms, rigid, scale, terms=terms)
 
 
+FASTER = 1.25
+"""A held-out log whose 95th percentile of speed is beyond this many times the fit's is said to be faster."""
+
+
 def other_log_checks(est: FrictionEstimate, fits: Mapping[str, FitResult], name: str = "this log",
                      workers: int = 1) -> tuple[PredictionCheck | None, ...]:
     """Per joint of ``est`` (a log the fits were not fitted on, estimated with their inertias), whether its fit
@@ -173,5 +177,8 @@ def other_log_checks(est: FrictionEstimate, fits: Mapping[str, FitResult], name:
         e_best = held_out_residuals(refit.params, qd, tau_f, use, est.smoother, sigma)
         variance = (0.0 if fit.covariance is None else
                     prediction_variance(model_gradient(fit, qd, use, est.smoother, sigma), fit.covariance))
-        out[j] = prediction_check(name, e_model, e_best, variance, np.flatnonzero(use))
+        speed = joint_speed(qd[use])
+        note = (f"it moves up to {speed:.2g} rad/s there (95 %), its fit's samples up to {fit.speed:.2g}: beyond the "
+                "speeds it was fitted on" if fit.speed is not None and speed > FASTER * fit.speed else "")
+        out[j] = prediction_check(name, e_model, e_best, variance, np.flatnonzero(use), note=note)
     return tuple(out.get(j) for j in est.joints)
