@@ -235,6 +235,7 @@ class TermFit:
     check: TermCheck | None = None
     at_bound: tuple[str, ...] = ()
     covariance: np.ndarray | None = field(default=None, repr=False, compare=False)
+    later: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     @property
     def temperature_rate(self) -> float:
@@ -260,8 +261,12 @@ class TermFit:
                    for n, (v, se) in mine.items() if check is not None and n in theirs
                    and routes_disagree(v, se, *theirs[n])]
             weak = [f"{n} {v:.3g} ±{se:.2g}" for n, (v, se) in mine.items() if not se <= WEAK * abs(v)]
+            d, allowed = self.later.get(term, (0.0, math.inf))
             out[term] = (FitVerdict("routes disagree", "; ".join(off)) if off
                          else FitVerdict("weak", "large standard errors: " + ", ".join(weak)) if weak
+                         else FitVerdict("weak", f"fitted on the earlier samples its torque departs on the later ones "
+                                                 f"by {d:.2g} N·m from theirs, its standard errors allow {allowed:.2g}")
+                         if not d <= allowed
                          else FitVerdict("ok"))
         return out
 
@@ -283,6 +288,7 @@ class TermFit:
                 "q_range": None if self.q_range is None else list(self.q_range), "reasons": dict(self.reasons),
                 "held_out_rms": [clean(x) for x in self.held_out_rms],
                 "check": None if self.check is None else self.check.to_dict(), "at_bound": list(self.at_bound),
+                "later": {t: [clean(d), clean(a)] for t, (d, a) in self.later.items()},
                 "status": {t: v.status for t, v in verdicts.items()},
                 "status_reason": {t: v.reason for t, v in verdicts.items() if v.reason}}
 
@@ -308,7 +314,9 @@ class TermFit:
                        {str(k): str(v) for k, v in (d.get("reasons") or {}).items()},
                        tuple(_number(x) for x in d.get("held_out_rms", (None, None))),  # type: ignore[arg-type]
                        None if check is None else TermCheck.from_dict(check),
-                       tuple(str(n) for n in d.get("at_bound", ())))
+                       tuple(str(n) for n in d.get("at_bound", ())),
+                       later={str(t): (_number(v[0]), math.inf if v[1] is None else float(v[1]))
+                              for t, v in (d.get("later") or {}).items()})
         except KeyError as exc:
             raise InputError(f"terms: missing key {exc}") from None
         except (TypeError, ValueError, AttributeError, IndexError) as exc:
