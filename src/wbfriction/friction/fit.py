@@ -716,7 +716,7 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
                 raise InputError("x0 needs a named model, not 'auto'")
             res = _fit_auto(qd, y, use, delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother,
                             fixed=fixed, tolerance=selection_tolerance, sigma=velocity_noise, noise=noise,
-                            speed=speed)
+                            speed=speed, stuck=stuck)
         else:
             if still is not None and speed < MIN_SPEED:  # held names checked against the model named all the same
                 check_fixed(check_model(model), fixed)
@@ -765,7 +765,8 @@ def blas_controller():
 
 def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float, joint: str, min_samples: int,
               smoother, fixed: dict[str, float] | None, tolerance: float, sigma: float = 0.0,
-              noise: JointNoise | None = None, speed: float = np.inf) -> FitResult:
+              noise: JointNoise | None = None, speed: float = np.inf,
+              stuck: np.ndarray | None = None) -> FitResult:
     """``fit_friction(model="auto")`` on the usable samples ``use`` (module docstring); a joint whose ``speed``
     [rad/s] (:func:`fitted_rows`) is below :data:`~wbfriction.friction.status.MIN_SPEED` gets the simplest model."""
     fixed = dict(fixed or {})
@@ -775,6 +776,10 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     held = {m: model_fixed(m, fixed) for m in MODEL_NAMES}
     kwargs = dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, sigma=sigma)
     train, held_out = held_out_split(use)
+    scored = held_out
+    if stuck is not None and stuck.any():  # the slow samples of the held-out blocks are scored too (issue 52)
+        _, scored = held_out_split(use | stuck)
+        scored &= np.isfinite(qd) & np.isfinite(y)
     n_train, n_held_out = int(train.sum()), int(held_out.sum())
     simplest = MODEL_NAMES[0]
     why = None
@@ -788,12 +793,12 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
         res.selection = ModelSelection(simplest, f"{simplest}: {why}", (), tolerance, n_train, n_held_out)
         return res
     trained = {m: _fit_model(m, qd, y, train, fixed=held[m], **kwargs) for m in MODEL_NAMES}
-    residuals = {m: held_out_residuals(r.params, qd, -y, held_out, smoother, sigma) for m, r in trained.items()
+    residuals = {m: held_out_residuals(r.params, qd, -y, scored, smoother, sigma) for m, r in trained.items()
                  if r.params is not None}
     scores = tuple(HeldOutScore(m, float(np.sqrt(np.mean(residuals[m] ** 2))) if m in residuals else float("nan"),
                                 r.bounded()) for m, r in trained.items())
     chosen, reason = choose_model(scores, tolerance)
-    chosen, reason = prefer_interior(chosen, reason, scores, residuals, np.flatnonzero(held_out))
+    chosen, reason = prefer_interior(chosen, reason, scores, residuals, np.flatnonzero(scored))
     res = _fit_model(chosen, qd, y, use, fixed=held[chosen], noise=noise, **kwargs)  # as if the model had been named
     if res.bounded():
         reason += f"; at a bound: {', '.join(res.bounded())}"
