@@ -315,24 +315,31 @@ def later_check(X: np.ndarray, y: np.ndarray, names: tuple[str, ...], k: int, ke
                 rate_column: Callable[[np.ndarray], np.ndarray] | None = None) -> dict[str, tuple[float, float]]:
     """Per kept term, how far its torque fitted on the samples ``head`` departs on the later ones ``tail`` from its
     torque fitted on ``tail`` itself, and how far their standard errors allow (issue 52): ``(d, allowed)`` [N·m],
-    ``d`` the RMS over ``tail`` of ``X_term (c_head - c_tail)``, ``allowed`` :data:`ROUTE_Z` times the RMS of its
-    standard deviation through both fits' covariances (Newey-West), and at least :attr:`TermOptions.min_torque`. A
-    law of the load, the angle or the temperature is the same law later; a term that stood in for something else is
-    not. Empty when either stretch is too short to fit the model."""
+    ``d`` the RMS over ``tail`` of ``X_term⊥ (c_head - c_tail)``, ``X_term⊥`` the term's regressors on ``tail`` less
+    their projection on the other coefficients' (what no other coefficient can take: a ripple's mean that the offset
+    trades with is not the ripple's departure), ``allowed`` :data:`ROUTE_Z` times the RMS of its standard deviation
+    through both fits' covariances (Newey-West), and at least :data:`~wbfriction.friction.status.WEAK` of the tail's
+    own residual RMS (the noise: a departure below it changes a prediction by a few percent; the Newey-West errors miss
+    an estimate's errors that repeat with the motion) and :attr:`TermOptions.min_torque`. A law of the load, the
+    angle or the temperature is the same law later; a term that stood in for something else is not. Empty when
+    either stretch is too short to fit the model."""
     if min(head.sum(), tail.sum()) <= 2 * X.shape[1]:
         return {}
     X = np.nan_to_num(X)
     fits = [_final(X, y, rows, names, rate_column)[:2] for rows in (head, tail)]
     (c_h, C_h), (c_t, C_t) = fits
+    noise = WEAK * float(np.sqrt(np.mean((y[tail] - X[tail] @ c_t) ** 2)))
     out: dict[str, tuple[float, float]] = {}
     for term in kept:
         cols = [i for i, n in enumerate(names) if i >= k and _term_of(n) == term]
-        Xt = X[tail][:, cols]
+        rest = [i for i in range(X.shape[1]) if i not in cols]
+        Xt, Xo = X[tail][:, cols], X[tail][:, rest]
+        Xt = Xt - Xo @ _solve(Xo, Xt)
         d = Xt @ (c_h[cols] - c_t[cols])
         C = (C_h + C_t)[np.ix_(cols, cols)]
         var = np.einsum("ij,jk,ik->i", Xt, C, Xt) if np.all(np.isfinite(C)) else np.full(len(Xt), np.inf)
         out[term] = (float(np.sqrt(np.mean(d**2))),
-                     max(ROUTE_Z * float(np.sqrt(np.mean(var))), options.min_torque))
+                     max(ROUTE_Z * float(np.sqrt(np.mean(var))), noise, options.min_torque))
     return out
 
 
