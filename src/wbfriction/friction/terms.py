@@ -216,6 +216,9 @@ class TermFit:
         reasons: per term tried, why it was kept or not (one sentence).
         held_out_rms: the held-out RMS [N·m] of the velocity model alone and with the terms kept.
         check: the kept terms refitted on the other route's estimate (``term_selection.refit_terms``), or None.
+        later: per kept term, how far its torque fitted on the earlier samples departs on the later ones from theirs
+            and how far the noise and its standard errors allow [N·m] (``term_selection.later_check``); empty: not
+            checked.
         at_bound: the velocity model's magnitudes held at zero in the refit (``term_selection.NONNEGATIVE``): with
             the terms, the data would put them below it (standard error 0: held, not fitted).
         covariance: the coefficients' covariance, the velocity model's (:func:`velocity_basis` order) then the
@@ -243,13 +246,17 @@ class TermFit:
         return self.coefficients.get("rate_T", 0.0)
 
     def verdicts(self) -> dict[Term, FitVerdict]:
-        """Per kept term, whether its numbers can be used (``ok``, ``weak``, ``routes disagree``) and why.
+        """Per kept term, whether its numbers can be used (``ok``, ``weak``, ``routes disagree``, ``does not predict``)
+        and why.
 
         * ``routes disagree``: the other route's estimate gives one of its coefficients (the ripple: its size,
           ``term_selection.ripple_size``) more than :data:`~wbfriction.friction.status.ROUTE_Z` combined standard
           errors and :data:`~wbfriction.friction.status.ROUTE_REL` away (:attr:`check`);
         * ``weak``: a coefficient's (the ripple's size's) standard error above
           :data:`~wbfriction.friction.status.WEAK` of its value;
+        * ``does not predict`` (issue 52): fitted on the earlier samples, its torque departs on the later ones from
+          theirs beyond what the noise and its standard errors allow (:attr:`later`,
+          ``term_selection.later_check``);
         * ``ok``: neither.
         """
         out: dict[Term, FitVerdict] = {}
@@ -264,8 +271,9 @@ class TermFit:
             d, allowed = self.later.get(term, (0.0, math.inf))
             out[term] = (FitVerdict("routes disagree", "; ".join(off)) if off
                          else FitVerdict("weak", "large standard errors: " + ", ".join(weak)) if weak
-                         else FitVerdict("weak", f"fitted on the earlier samples its torque departs on the later ones "
-                                                 f"by {d:.2g} N·m from theirs, its standard errors allow {allowed:.2g}")
+                         else FitVerdict("does not predict", f"fitted on the earlier samples its torque departs on "
+                                                             f"the later ones by {d:.2g} N·m from theirs, the noise "
+                                                             f"and its standard errors allow {allowed:.2g}")
                          if not d <= allowed
                          else FitVerdict("ok"))
         return out
