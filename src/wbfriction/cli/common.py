@@ -188,8 +188,8 @@ TemperatureLawOpt = typer.Option(FIT.terms.temperature_law, "--temperature-law",
 
 def term_options(terms: str, max_harmonic: int, reference_temperature: float | None,
                  temperature_law: TemperatureLaw = "auto") -> TermOptions:
-    """The terms' options of ``--terms`` (comma-separated, ``auto`` or ``all``: every term, ``none``), ``--max-harmonic``,
-    ``--reference-temperature`` and ``--temperature-law``.
+    """The terms' options of ``--terms`` (comma-separated, ``auto`` or ``all``: every term, ``none``),
+    ``--max-harmonic``, ``--reference-temperature`` and ``--temperature-law``.
 
     Raises:
         OptionError: an unknown term (:class:`~wbfriction.friction.options.TermOptions`).

@@ -34,8 +34,7 @@ from wbfriction.friction.regression import (
     covariance_errors,
     parameter_covariance,
 )
-from wbfriction.friction.status import ROUTE_Z
-from wbfriction.friction.status import MIN_SPEED, WEAK
+from wbfriction.friction.status import MIN_SPEED, ROUTE_Z, WEAK
 from wbfriction.friction.terms import (
     TERM_COEFFICIENTS,
     TermCheck,
