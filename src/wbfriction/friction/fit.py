@@ -1118,9 +1118,11 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
                 refit.route, refit.route_check = f.route, f.route_check
                 if refit.params is None:
                     break
-                same = refit.model == f.model
-                refit.terms = _joint_terms(est, i, refit, maybe if maybe is None or same else _fit_column(
-                    (others[k][0], others[k][1], others[k][2], {**others[k][3], "model": refit.model})), options)
+                other_task = others[k]
+                if other_task is not None and refit.model != f.model:  # the other route's refit of this model
+                    qd_o, tau_o, valid_o, kwargs_o = other_task
+                    maybe = _fit_column((qd_o, tau_o, valid_o, {**kwargs_o, "model": refit.model}), later=False)
+                refit.terms = _joint_terms(est, i, refit, maybe, options)
                 fits[k] = f = refit
     return fits
 
