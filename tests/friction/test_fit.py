@@ -38,7 +38,7 @@ from wbfriction.friction.models import (
     model_jacobian,
     model_values,
 )
-from wbfriction.friction.options import FitOptions
+from wbfriction.friction.options import FitOptions, TermOptions
 from wbfriction.friction.regression import held_out_split, parameter_covariance, standard_errors
 from wbfriction.friction.status import fit_verdict
 from wbfriction.signals.filters import SavgolSmoother
@@ -450,11 +450,14 @@ def test_fit_estimate_fits_every_joint_with_its_targets_and_options():
     # no smoother: a sticking sample reaches one row either side (the central difference's stencil); no noise record
     expected = fit_joints(("a", "b"), qd, tau_f, valid, tau_f_true=truth, **options,
                           targets={"a": FrictionParams(F_v=0.3, F_c=0.5)}, stick_margin=1)
-    assert fit_estimate(est, FitOptions(**options)) == expected
+    assert fit_estimate(est, FitOptions(**options, terms=TermOptions(terms=()))) == expected  # fit_joints: no terms
     assert [f.params is None for f in fit_estimate(est, FitOptions(min_samples=3800))] == [False, True]
-    # the default is 'wbfriction fit's: the model chosen per joint on held-out data
-    assert fit_estimate(est) == fit_joints(("a", "b"), qd, tau_f, valid, tau_f_true=truth, model="auto",
-                                           targets={"a": FrictionParams(F_v=0.3, F_c=0.5)}, stick_margin=1)
+    # the default is 'wbfriction fit's: the model chosen per joint on held-out data, the terms the log allows tried
+    # (this one has no angle, load or temperature: the direction alone)
+    plain = fit_estimate(est, FitOptions(terms=TermOptions(terms=())))
+    assert plain == fit_joints(("a", "b"), qd, tau_f, valid, tau_f_true=truth, model="auto",
+                               targets={"a": FrictionParams(F_v=0.3, F_c=0.5)}, stick_margin=1)
+    assert [f.terms is not None and set(f.terms.reasons) == {"direction"} for f in fit_estimate(est)] == [True, True]
 
 
 def test_auto_passes_every_option_to_its_candidates():

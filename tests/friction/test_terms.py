@@ -366,3 +366,22 @@ def test_a_fit_with_the_exponential_law_reads_back_and_the_linear_law_can_be_for
     assert linear.temperature_rate == 0.0 and "rate_T" not in linear.coefficients
     with pytest.raises(OptionError, match="--temperature-law"):
         TermOptions(temperature_law="arrhenius")  # type: ignore[arg-type]
+
+
+def test_a_load_law_that_changes_later_in_the_log_does_not_predict():
+    """Issue 52: a load term is kept where it predicts the log's later stretch; one whose law changes there (the
+    last 30 % with twice the load coefficient, a stand-in for a term that does not carry over) is not ``ok``: fitted
+    on the earlier samples its torque departs on the later ones beyond the noise and its standard errors."""
+    t, qd, s = trajectory(3, 30.0)
+    rng = np.random.default_rng(3)
+    steady = physical_f(TRUTH, qd, s, ("load",), k_L=PHYSICAL["k_L"]) + rng.normal(0.0, 0.02, qd.size)
+    use = np.abs(qd) > 0.05
+    params = fit_friction(qd, -steady, model="coulomb-viscous", mask=use).params
+    fit = fit_terms(params, qd, -steady, use, s, TermOptions(terms=("load",)))
+    assert fit.kept == ("load",) and fit.verdicts()["load"].status == "ok", (fit.reasons, fit.later)
+    late = t >= 0.7 * t[-1]
+    changed = steady + np.where(late, TRUE["F_L"] * np.abs(s.tau_load) * np.sign(qd), 0.0)
+    fit = fit_terms(params, qd, -changed, use, s, TermOptions(terms=("load",)))
+    verdict = fit.verdicts()["load"]
+    assert verdict.status == "does not predict", (fit.reasons, fit.later)
+    assert TermFit.from_dict(fit.to_dict()).verdicts()["load"].status == "does not predict"

@@ -170,11 +170,12 @@ ModelOpt = typer.Option(FIT.model, "--model", help="Friction model per joint: au
                                                     "is within --selection-tolerance of the best), coulomb-viscous "
                                                     "(3.1 + 3.2), stribeck (3.3 + 3.2) or thesis (3.5); each with "
                                                     "an offset tau_os.")
-TermsOpt = typer.Option("", "--terms", help="Terms beyond velocity tried per joint, comma-separated, or all: load "
-                                            "(Coulomb friction growing with the joint's rigid-body torque), "
-                                            "direction (F_v by direction of motion), ripple (a torque periodic in "
-                                            "the angle, not friction), temperature (needs temperature.<joint> in "
-                                            "the log); each kept where held-out samples improve.")
+TermsOpt = typer.Option("auto", "--terms", help="Terms beyond velocity tried per joint, comma-separated, auto (every "
+                                                "one the log's signals allow; all: the same) or none: load "
+                                                "(Coulomb friction growing with the joint's rigid-body torque), "
+                                                "direction (F_v by direction of motion), ripple (a torque periodic in "
+                                                "the angle, not friction), temperature (needs temperature.<joint> in "
+                                                "the log); each kept where it predicts the log's later samples.")
 MaxHarmonicOpt = typer.Option(FIT.terms.max_harmonic, "--max-harmonic", help="The ripple's highest harmonic tried.")
 ReferenceTemperatureOpt = typer.Option(None, "--reference-temperature",
                                        help="T_ref [°C] the temperature term's levels are stated at [default: each "
@@ -187,13 +188,14 @@ TemperatureLawOpt = typer.Option(FIT.terms.temperature_law, "--temperature-law",
 
 def term_options(terms: str, max_harmonic: int, reference_temperature: float | None,
                  temperature_law: TemperatureLaw = "auto") -> TermOptions:
-    """The terms' options of ``--terms`` (comma-separated, or ``all``), ``--max-harmonic``,
-    ``--reference-temperature`` and ``--temperature-law``.
+    """The terms' options of ``--terms`` (comma-separated, ``auto`` or ``all``: every term, ``none``),
+    ``--max-harmonic``, ``--reference-temperature`` and ``--temperature-law``.
 
     Raises:
         OptionError: an unknown term (:class:`~wbfriction.friction.options.TermOptions`).
     """
-    names = TERMS if terms.strip() == "all" else tuple(t.strip() for t in terms.split(",") if t.strip())
+    names = (TERMS if terms.strip() in ("all", "auto") else () if terms.strip() == "none"
+             else tuple(t.strip() for t in terms.split(",") if t.strip()))
     return TermOptions(terms=cast(tuple[Term, ...], names), max_harmonic=max_harmonic,
                        reference_temperature=reference_temperature, temperature_law=temperature_law)
 

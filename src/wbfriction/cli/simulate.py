@@ -131,10 +131,13 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                                                                                "force-torque sensors' constant "
                                                                                "offsets: force (N), torque (N·m)."),
              duration: float = typer.Option(10.0, help="Fixed-base robot (an arm): seconds of excitation "
-                                                       "trajectory.")) -> None:
+                                                       "trajectory."),
+             excitation_seed: int = typer.Option(0, help="Fixed-base robot (an arm): seed of the excitation "
+                                                         "trajectory's Fourier coefficients (another seed, another "
+                                                         "motion).")) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents."""
-    from wbfriction.sim.arm import ArmOptions
+    from wbfriction.sim.arm import ArmOptions, ExcitationOptions
     from wbfriction.sim.sensors import load_sensors_toml
 
     check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors},
@@ -142,7 +145,8 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
     r = robot_of(robot, urdf, config, mjcf)
     if not r.floating_base:
         arm = ArmOptions(duration=duration, encoder_bits=19 if encoder_bits is None else encoder_bits,
-                         position_std=position_noise or 0.0, torque_std=torque_noise or 0.0, seed=noise_seed or 0)
+                         position_std=position_noise or 0.0, torque_std=torque_noise or 0.0, seed=noise_seed or 0,
+                         excitation=ExcitationOptions(seed=excitation_seed))
         _run_simulate_arm(r, output, arm, friction)
         return
     gait_opts = GaitOptions(gait=gait, steps=steps, step_length=step_length, step_width=step_width,

@@ -251,7 +251,8 @@ class FitOptions:
             (dimensionless, >= 0).
         min_samples: joints with fewer valid samples get no parameters (>= 1).
         delta_s: the Stribeck exponent of (3.5) (dimensionless, > 0; the thesis's 2).
-        terms: the terms beyond velocity tried per joint (:mod:`~wbfriction.friction.terms`; by default none: the
+        terms: the terms beyond velocity tried per joint (:mod:`~wbfriction.friction.terms`; by default every one
+            the log's signals allow, each kept where it predicts the later samples; ``TermOptions(terms=())``: the
             velocity model alone).
         pass_rows: a reversal crossing the band of speeds a joint may stick at within this many samples is a pass
             through zero, kept in the fit; a slower one may hold a stop, left out with its filter's margin (>= 0; 0:
@@ -265,7 +266,7 @@ class FitOptions:
     selection_tolerance: float = SELECTION_TOLERANCE
     min_samples: int = 20
     delta_s: float = 2.0
-    terms: TermOptions = TermOptions(terms=())
+    terms: TermOptions = TermOptions()
     pass_rows: float = PASS_ROWS
 
     def __post_init__(self) -> None:

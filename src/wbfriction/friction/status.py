@@ -214,13 +214,16 @@ def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THR
         return FitVerdict("routes disagree", "; ".join(disagree))
     if fit.later is not None and not fit.later.predicts_at(thresholds.holdout_z, thresholds.holdout_excess):
         return FitVerdict("does not predict", fit.later.describe())
+    later = [f"{t}: {v.reason}" for t, v in others.items() if v.status == "does not predict"]
+    if later:
+        return FitVerdict("does not predict", "; ".join(later))
     # over part of a turn a ripple's harmonics have a mean the offset trades with: their sum is determined (the
     # energy check removes both), the offset alone is not, and it is no friction a user reads
     judged = [n for n in values if n in terms.stderr and not (n == "tau_os" and "ripple" in terms.kept)]
     view = SimpleNamespace(params=terms.params, stderr={n: terms.stderr[n] for n in judged}, crb={}, speed=fit.speed,
                            rms_residual=fit.rms_residual)
     weak = _weak(cast(Fit, view), values, thresholds.weak) + [f"{t} {v.reason.removeprefix('large standard errors: ')}"
-                                             for t, v in others.items()]
+                                             for t, v in others.items() if v.status == "weak"]
     if weak:
         return FitVerdict("weak", "large standard errors: " + ", ".join(weak))
     return FitVerdict("ok")

@@ -216,6 +216,9 @@ class TermFit:
         reasons: per term tried, why it was kept or not (one sentence).
         held_out_rms: the held-out RMS [N·m] of the velocity model alone and with the terms kept.
         check: the kept terms refitted on the other route's estimate (``term_selection.refit_terms``), or None.
+        later: per kept term, how far its torque fitted on the earlier samples departs on the later ones from theirs
+            and how far the noise and its standard errors allow [N·m] (``term_selection.later_check``); empty: not
+            checked.
         at_bound: the velocity model's magnitudes held at zero in the refit (``term_selection.NONNEGATIVE``): with
             the terms, the data would put them below it (standard error 0: held, not fitted).
         covariance: the coefficients' covariance, the velocity model's (:func:`velocity_basis` order) then the
@@ -235,6 +238,7 @@ class TermFit:
     check: TermCheck | None = None
     at_bound: tuple[str, ...] = ()
     covariance: np.ndarray | None = field(default=None, repr=False, compare=False)
+    later: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     @property
     def temperature_rate(self) -> float:
@@ -242,13 +246,17 @@ class TermFit:
         return self.coefficients.get("rate_T", 0.0)
 
     def verdicts(self) -> dict[Term, FitVerdict]:
-        """Per kept term, whether its numbers can be used (``ok``, ``weak``, ``routes disagree``) and why.
+        """Per kept term, whether its numbers can be used (``ok``, ``weak``, ``routes disagree``, ``does not predict``)
+        and why.
 
         * ``routes disagree``: the other route's estimate gives one of its coefficients (the ripple: its size,
           ``term_selection.ripple_size``) more than :data:`~wbfriction.friction.status.ROUTE_Z` combined standard
           errors and :data:`~wbfriction.friction.status.ROUTE_REL` away (:attr:`check`);
         * ``weak``: a coefficient's (the ripple's size's) standard error above
           :data:`~wbfriction.friction.status.WEAK` of its value;
+        * ``does not predict`` (issue 52): fitted on the earlier samples, its torque departs on the later ones from
+          theirs beyond what the noise and its standard errors allow (:attr:`later`,
+          ``term_selection.later_check``);
         * ``ok``: neither.
         """
         out: dict[Term, FitVerdict] = {}
@@ -260,8 +268,13 @@ class TermFit:
                    for n, (v, se) in mine.items() if check is not None and n in theirs
                    and routes_disagree(v, se, *theirs[n])]
             weak = [f"{n} {v:.3g} ±{se:.2g}" for n, (v, se) in mine.items() if not se <= WEAK * abs(v)]
+            d, allowed = self.later.get(term, (0.0, math.inf))
             out[term] = (FitVerdict("routes disagree", "; ".join(off)) if off
                          else FitVerdict("weak", "large standard errors: " + ", ".join(weak)) if weak
+                         else FitVerdict("does not predict", f"fitted on the earlier samples its torque departs on "
+                                                             f"the later ones by {d:.2g} N·m from theirs, the noise "
+                                                             f"and its standard errors allow {allowed:.2g}")
+                         if not d <= allowed
                          else FitVerdict("ok"))
         return out
 
@@ -283,6 +296,7 @@ class TermFit:
                 "q_range": None if self.q_range is None else list(self.q_range), "reasons": dict(self.reasons),
                 "held_out_rms": [clean(x) for x in self.held_out_rms],
                 "check": None if self.check is None else self.check.to_dict(), "at_bound": list(self.at_bound),
+                "later": {t: [clean(d), clean(a)] for t, (d, a) in self.later.items()},
                 "status": {t: v.status for t, v in verdicts.items()},
                 "status_reason": {t: v.reason for t, v in verdicts.items() if v.reason}}
 
@@ -308,7 +322,9 @@ class TermFit:
                        {str(k): str(v) for k, v in (d.get("reasons") or {}).items()},
                        tuple(_number(x) for x in d.get("held_out_rms", (None, None))),  # type: ignore[arg-type]
                        None if check is None else TermCheck.from_dict(check),
-                       tuple(str(n) for n in d.get("at_bound", ())))
+                       tuple(str(n) for n in d.get("at_bound", ())),
+                       later={str(t): (_number(v[0]), math.inf if v[1] is None else float(v[1]))
+                              for t, v in (d.get("later") or {}).items()})
         except KeyError as exc:
             raise InputError(f"terms: missing key {exc}") from None
         except (TypeError, ValueError, AttributeError, IndexError) as exc:
