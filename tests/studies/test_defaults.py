@@ -19,9 +19,20 @@ def test_the_value_best_over_every_dataset_is_chosen_and_each_left_out_scored():
     losses = {0.0: {"a": 2.0, "b": 2.0, "c": 2.0}, 1.0: {"a": 1.0, "b": 1.0, "c": 1.0},
               2.0: {"a": 0.5, "b": 0.5, "c": 1.5}}
     choice = choose(knob(), losses)
-    assert choice.chosen == 2.0 and choice.scores[2.0] == pytest.approx((0.5 + 0.5 + 1.5) / 3)
+    assert choice.best == 2.0 and choice.scores[2.0] == pytest.approx((0.5 + 0.5 + 1.5) / 3)
     assert choice.left_out["c"] == (2.0, 1.5)  # chosen on a and b, 50 % worse on c
     assert choice.left_out["a"] == (1.0, 1.0)  # b and c: 2.0's mean (0.5 + 1.5) / 2 ties the default's: the default
+    # without a, the default: 2.0 rests on a (with b), not on every dataset: today's default stays
+    assert choice.chosen == 1.0
+
+
+def test_a_value_every_fold_agrees_on_replaces_the_default_if_it_matters():
+    agreed = {0.0: {"a": 2.0, "b": 2.0, "c": 2.0}, 1.0: {"a": 1.0, "b": 1.0, "c": 1.0},
+              2.0: {"a": 0.5, "b": 0.6, "c": 0.9}}
+    assert choose(knob(), agreed).chosen == 2.0
+    slight = {0.0: {"a": 2.0, "b": 2.0}, 1.0: {"a": 1.0, "b": 1.0}, 2.0: {"a": 0.995, "b": 0.996}}
+    choice = choose(knob(), slight)
+    assert choice.best == 2.0 and choice.chosen == 1.0  # 0.5 %: within the noise of a few percent
 
 
 def test_a_tie_keeps_the_default():
@@ -33,7 +44,7 @@ def test_statuses_are_scored_by_their_loss_not_a_ratio():
     """A status threshold's loss can be zero: its values are compared as they are."""
     losses = {0.0: {"a": 0.0, "b": 0.4}, 1.0: {"a": 0.2, "b": 0.2}, 2.0: {"a": 0.5, "b": 0.0}}
     choice = choose(knob("status"), losses)
-    assert choice.scores == {0.0: 0.2, 1.0: 0.2, 2.0: 0.25} and choice.chosen == 1.0  # tie: the default
+    assert choice.scores == {0.0: 0.2, 1.0: 0.2, 2.0: 0.25} and choice.best == 1.0  # tie: the default
     assert choice.left_out["a"] == (2.0, 0.5) and choice.left_out["b"] == (0.0, 0.4)
 
 
@@ -47,7 +58,7 @@ def test_every_knob_sets_its_option_and_lists_todays_default():
     current = {"link_margin": InertialOptions().link_margin, "prior_tolerance": InertialOptions().prior_tolerance,
                "noise_target": EstimateOptions().noise_target,
                "selection_tolerance": FitOptions().selection_tolerance, "pass_rows": FitOptions().pass_rows,
-               "terms": "all" if FitOptions().terms == TermOptions() else "none",
+               "terms": "auto" if FitOptions().terms == TermOptions() else "none",
                "weak": DEFAULT_THRESHOLDS.weak, "holdout_excess": DEFAULT_THRESHOLDS.holdout_excess,
                "route_rel": DEFAULT_THRESHOLDS.route_rel}
     assert {k.name for k in KNOBS} == set(current)

@@ -18,8 +18,10 @@ one value and every other at its default, and scores it:
   injected friction; a fit is *good* with F_c within 5 % and F_v within 10 %.
 
 A knob's candidates are compared per case by the loss over the default's (:func:`choose`): the value whose mean
-ratio over the cases is lowest is chosen, and for each case the value chosen **without** it is scored on it (leave
-one dataset out): a default that only one dataset asks for shows there. The statuses' thresholds are scored by
+ratio over the cases is lowest is the best, and for each case the value best **without** it is scored on it (leave
+one dataset out): a default that only one dataset asks for shows there. A value replaces today's default only where
+it is the best over every case *and* without any one of them, and lowers the mean by more than :data:`MARGIN`:
+otherwise one dataset, or the noise of a few percent, would have chosen it. The statuses' thresholds are scored by
 how well ``ok`` predicts *good*: the share of fits called ``ok`` that are not good (counted twice: a plausible
 wrong number is worse than a missing one) and of good fits not called ``ok``.
 """
@@ -94,8 +96,8 @@ KNOBS: tuple[Knob, ...] = (
          lambda s, v: replace(s, fit=replace(s.fit, selection_tolerance=v))),
     Knob("pass_rows", "fit", (0.0, 2.0, 5.0, math.inf), 2.0,
          lambda s, v: replace(s, fit=replace(s.fit, pass_rows=v))),
-    Knob("terms", "fit", ("none", "all"), "none",
-         lambda s, v: replace(s, fit=replace(s.fit, terms=TermOptions() if v == "all" else TermOptions(terms=())))),
+    Knob("terms", "fit", ("none", "auto"), "auto",
+         lambda s, v: replace(s, fit=replace(s.fit, terms=TermOptions() if v == "auto" else TermOptions(terms=())))),
     Knob("weak", "status", (0.25, 0.5, 1.0), 0.5, _thresholds("weak")),
     Knob("holdout_excess", "status", (0.02, 0.05, 0.1, 0.2), 0.05, _thresholds("holdout_excess")),
     Knob("route_rel", "status", (0.02, 0.05, 0.1), 0.02, _thresholds("route_rel")),
@@ -353,6 +355,10 @@ CASES: tuple[type[Case], ...] = (KukaCase, Ur10eCase, PandaCase, PandaSimCase, T
 """Every case, real first."""
 
 
+MARGIN = 0.01
+"""A new default must lower the mean loss ratio by more than this (module docstring)."""
+
+
 @dataclass(frozen=True)
 class KnobChoice:
     """A knob's candidates scored on every case, the value chosen and each case left out (module docstring).
@@ -361,15 +367,18 @@ class KnobChoice:
         knob: the knob.
         losses: value -> case -> loss (lower is better; the statuses': :meth:`CaseScore.misjudged`).
         scores: value -> its mean over the cases (of the loss over the default's, or of the statuses' loss).
-        chosen: the value of the lowest score (the default where it ties).
-        left_out: case -> (the value chosen without it, its loss on it over the default's, or the statuses' loss).
+        best: the value of the lowest score (the default where it ties).
+        left_out: case -> (the value best without it, its loss on it over the default's, or the statuses' loss).
+        chosen: ``best`` where it is also the best without any one case and beats the default's score by more than
+            :data:`MARGIN`, else the default (module docstring).
     """
 
     knob: Knob
     losses: dict[Any, dict[str, float]]
     scores: dict[Any, float]
-    chosen: Any
+    best: Any
     left_out: dict[str, tuple[Any, float]]
+    chosen: Any
 
 
 def choose(knob: Knob, losses: dict[Any, dict[str, float]]) -> KnobChoice:
@@ -397,7 +406,10 @@ def choose(knob: Knob, losses: dict[Any, dict[str, float]]) -> KnobChoice:
     for case in cases:
         value = best([c for c in cases if c != case])
         left[case] = (value, relative(value, case))
-    return KnobChoice(knob, losses, scores, best(cases), left)
+    overall = best(cases)
+    margin = MARGIN if knob.stage != "status" else MARGIN * max(abs(scores[knob.default]), 1e-12)
+    robust = all(v == overall for v, _ in left.values()) and scores[overall] < scores[knob.default] - margin
+    return KnobChoice(knob, losses, scores, overall, left, overall if robust else knob.default)
 
 
 def run_study(folder: Path, knobs: Sequence[Knob] = KNOBS, cases: Sequence[type[Case]] = CASES,
@@ -433,7 +445,8 @@ def markdown(choices: Sequence[KnobChoice]) -> str:
         knob = choice.knob
         cases = list(next(iter(choice.losses.values())))
         unit = "statuses' loss" if knob.stage == "status" else "loss / default's"
-        lines += [f"**{knob.name}** (default {knob.default}; {unit}; chosen: {choice.chosen})", "",
+        lines += [f"**{knob.name}** (default {knob.default}; {unit}; best over all: {choice.best}; chosen: "
+                  f"{choice.chosen})", "",
                   "| value | " + " | ".join(cases) + " | mean |", "|---" * (len(cases) + 2) + "|"]
         for v in knob.values:
             row = [choice.losses[v][c] if knob.stage == "status" else
@@ -447,7 +460,7 @@ def markdown(choices: Sequence[KnobChoice]) -> str:
 
 def as_json(choices: Sequence[KnobChoice]) -> list[dict[str, Any]]:
     """The study's numbers, for a file."""
-    return [{"knob": c.knob.name, "stage": c.knob.stage, "default": c.knob.default, "chosen": c.chosen,
+    return [{"knob": c.knob.name, "stage": c.knob.stage, "default": c.knob.default, "best": c.best, "chosen": c.chosen,
              "losses": {str(v): d for v, d in c.losses.items()}, "scores": {str(v): s for v, s in c.scores.items()},
              "left_out": {k: [str(v), r] for k, (v, r) in c.left_out.items()}} for c in choices]
 
