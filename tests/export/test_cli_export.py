@@ -62,8 +62,8 @@ def test_panda_mjcf_export(panda_params, tmp_path, capsys):
 def test_refused_in_one_line_nothing_written(panda_params, tmp_path, capsys, case):
     """An --include that is not a choice, a file whose fits all fall short, one without joints: one line,
     exit 2, the previous output left byte for byte."""
-    args, needle = ["--include", "weak,failed"], ("--include: 'failed' is not one of weak, at-bound, routes-disagree: "
-                                                  "a fit that is "
+    args, needle = ["--include", "weak,failed"], ("--include: 'failed' is not one of weak, at-bound, routes-disagree, "
+                                                  "does-not-predict: a fit that is "
                                                   "not excited, failed or not fitted has no numbers the data carry, "
                                                   "never exported")
     if case == "nothing":
