@@ -81,7 +81,8 @@ def test_selection_partitions_the_joints_and_never_exports_what_the_data_do_not_
 def test_include_is_checked_where_it_is_defined():
     assert check_include(["at-bound", "weak", "weak"]) == ("at-bound", "weak")
     assert check_include([]) == ()
-    with pytest.raises(InputError, match="^--include: 'strong' is not one of weak, at-bound, routes-disagree$"):
+    with pytest.raises(InputError,
+                       match="^--include: 'strong' is not one of weak, at-bound, routes-disagree, does-not-predict$"):
         check_include(["weak", "strong"])
     for never in ("not-excited", "failed", "not-fitted", "not excited"):
         with pytest.raises(InputError, match=f"^--include: '{never}' .*has no numbers the data carry"):

@@ -64,7 +64,7 @@ def test_fit_keeps_the_simulated_terms_and_predict_uses_them(logs, capsys):
                                        "--reference-temperature", T_REF)
     words = " ".join(printed.split())  # the table wraps its values to the terminal
     assert code == 0 and "Terms beyond velocity" in words and "at zero load, 40 °C" in words
-    assert run_cli(capsys, "fit", tables[0], "-o", plain)[0] == 0
+    assert run_cli(capsys, "fit", tables[0], "-o", plain, "--terms", "none")[0] == 0
     fits = read_params(params)
     for joint, fit in fits.items():
         truth = TRUTH.get(joint)
@@ -79,13 +79,13 @@ def test_fit_keeps_the_simulated_terms_and_predict_uses_them(logs, capsys):
     assert doc["panda_joint4"]["terms"]["reference_temperature"] == T_REF
     assert doc["panda_joint4"]["terms"]["status"] == {"load": "ok", "temperature": "ok"}
     code, printed, _ = run_cli_printed(capsys, "predict", tables[1], "--params", params)
-    assert code == 0 and "load, temperature" in printed
+    assert code == 0 and "with its terms beyond velocity, panda_joint4: load, temperature" in printed
     from wbfriction.pipeline.predict_step import predict_file
 
     with_terms, without = predict_file(tables[1], params), predict_file(tables[1], plain)
     for i, joint in enumerate(with_terms.joints):  # every valid sample, those at rest (static friction) too
         if joint in TRUTH:
-            assert with_terms.rms[i] < (0.5 if joint == "panda_joint4" else 0.97) * without.rms[i], joint
+            assert with_terms.rms[i] < (0.5 if joint == "panda_joint4" else 0.99) * without.rms[i], joint
         else:
             assert with_terms.rms[i] == without.rms[i]
 

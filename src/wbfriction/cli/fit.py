@@ -155,32 +155,30 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
     check_paths({"FRICTION": friction, "--params": params}, {})
     with console.status(f"predicting the torques of {friction.name}"):
         pred = predict_file(friction, params)
-    table = Table(title=f"Torque prediction on {friction.name}: RMS of measured - predicted [N·m]", box=None)
-    with_terms = any(pred.terms)
-    columns = ("joint", "samples", "rigid body only", "with friction", "moving", "allowed", "fit",
-               *(("terms",) if with_terms else ()))
-    for col in columns:
-        table.add_column(col, justify="right" if col in ("samples", "rigid body only", "with friction", "moving",
-                                                         "allowed") else "left")
+    table = Table(title=f"Torque prediction on {friction.name}: RMS of measured - predicted [N·m]", box=None,
+                  collapse_padding=True, caption_justify="left",
+                  caption="rigid body: the inertia model alone; friction: with the friction model; moving: with it, "
+                          "where the joint moves (not where it may stick: static friction); allowed: there, what the "
+                          "log's noise and the fit's standard errors allow (its model refitted on this log); still: "
+                          "the joint did not move in this log; (!): it does not predict it")
+    numbers = ("samples", "rigid body", "friction", "moving", "allowed")
+    for col in ("joint", *numbers, "fit"):  # the joint and the numbers never cut: the status wraps
+        table.add_column(col, justify="right" if col in numbers else "left", no_wrap=col != "fit")
     statuses = pred.status or ("",) * len(pred.joints)
-    terms = pred.terms or ((),) * len(pred.joints)
     checks = pred.checks or (None,) * len(pred.joints)
-    for j, n, rigid, full, status, kept, check in zip(pred.joints, pred.samples, pred.rms_rigid_body, pred.rms,
-                                                      statuses, terms, checks):
-        moving = "still" if check is None else f"{check.rms:.4g}"
-        allowed = "" if check is None else f"{check.allowed:.4g}" + ("" if check.predicts else " (!)")
-        table.add_row(j, str(n), f"{rigid:.4g}", "—" if not np.isfinite(full) else f"{full:.4g}", moving, allowed,
-                      status,
-                      *((", ".join(kept),) if with_terms else ()), style=None if status in ("ok", "") else "dim")
+    for j, n, rigid, full, status, check in zip(pred.joints, pred.samples, pred.rms_rigid_body, pred.rms, statuses,
+                                                checks):
+        moving = "still" if check is None else f"{check.rms:.3g}"
+        allowed = "" if check is None else f"{check.allowed:.3g}" + ("" if check.predicts else " (!)")
+        table.add_row(j, str(n), f"{rigid:.3g}", "—" if not np.isfinite(full) else f"{full:.3g}", moving, allowed,
+                      status, style=None if status in ("ok", "") else "dim")
     rigid, full = pred.overall(pred.rms_rigid_body), pred.overall(pred.rms)
-    table.add_row("all joints", str(int(pred.samples.sum())), f"{rigid:.4g}",
-                  "—" if not np.isfinite(full) else f"{full:.4g}", "", "", "", *(("",) if with_terms else ()),
-                  style="bold", end_section=True)
-    table.caption = ("moving: with friction, on the samples where the joint moves (not where it may stick: static "
-                     "friction); allowed: there, what the log's noise and the fit's standard errors allow (its model "
-                     "refitted on this log); still: the joint did not move in this log; (!): does not predict it")
-    table.caption_justify = "left"
+    table.add_row("all joints", str(int(pred.samples.sum())), f"{rigid:.3g}",
+                  "—" if not np.isfinite(full) else f"{full:.3g}", "", "", "", style="bold", end_section=True)
     out.print(table)
+    for j, kept in zip(pred.joints, pred.terms or ()):
+        if kept:
+            out.print(f"with its terms beyond velocity, {j}: {', '.join(kept)}", highlight=False)
     for j, check in zip(pred.joints, checks):
         if check is not None and not check.predicts:
             console.print(f"{escape(j)}: does not predict this log: {escape(check.describe())}", highlight=False)

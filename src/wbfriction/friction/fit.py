@@ -918,7 +918,14 @@ def later_stretch(fit: FitResult, qd: np.ndarray, tau_f: np.ndarray, valid: np.n
                             held_out_residuals(early.params, qd, tau_f, later, smoother, sigma),
                             held_out_residuals(fit.params, qd, tau_f, later, smoother, sigma),
                             prediction_variance(model_gradient(early, qd, later, smoother, sigma), early.covariance),
-                            np.flatnonzero(later), share)
+                            np.flatnonzero(later), share, friction=shown_friction(fit, qd[later]))
+
+
+def shown_friction(fit: FitResult, qd: np.ndarray) -> float:
+    """The friction ``fit``'s model shows at the speeds ``qd`` [rad/s]: its odd part at their 95th percentile of
+    ``|qd|`` [N·m] (what a prediction's excess is judged against: :mod:`~wbfriction.friction.holdout`)."""
+    value = fit.dissipative(np.array([joint_speed(qd)]))[0]
+    return float(abs(value[0])) if np.isfinite(value[0]) else 0.0
 
 
 def model_gradient(fit: FitResult, qd: np.ndarray, rows: np.ndarray, smoother=None,
@@ -1118,15 +1125,32 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
                 refit = _with_truth([names[k]], [_fit_column(task)], est.qd[:, [i]], est.tau_f[:, [i]],
                                     est.valid[:, [i]], None if truth is None else truth[:, [k]], targets)[0]
                 refit.route, refit.route_check = f.route, f.route_check
-                if refit.params is None:
+                if refit.params is None or not refit.success:  # a refit that did not converge: the fit before it
                     break
                 other_task = others[k]
                 if other_task is not None and refit.model != f.model:  # the other route's refit of this model
                     qd_o, tau_o, valid_o, kwargs_o = other_task
                     maybe = _fit_column((qd_o, tau_o, valid_o, {**kwargs_o, "model": refit.model}), later=False)
                 refit.terms = _joint_terms(est, i, refit, maybe, options)
+                if not _better_refit(refit, f):
+                    break
                 fits[k] = f = refit
     return fits
+
+
+UNUSABLE: tuple[str, ...] = ("failed", "at bound", "not excited")
+
+
+def _better_refit(refit: FitResult, fit: FitResult) -> bool:
+    """Whether a joint's refit with its terms' torque taken out (:data:`TERM_REFITS`) replaces ``fit``: its model with
+    its terms predicts the later stretch no worse (:attr:`~wbfriction.friction.terms.TermFit.held_out_rms`), and its
+    status is usable where ``fit``'s was (issue 52: on a UR10e's shoulder, its gravity load of 100 N·m, a refit ended
+    at a bound 36 % off the published curve, the next one stopped at its evaluation limit)."""
+    if refit.terms is None or fit.terms is None:
+        return False
+    if refit.verdict().status in UNUSABLE and fit.verdict().status not in UNUSABLE:
+        return False
+    return bool(refit.terms.held_out_rms[1] <= fit.terms.held_out_rms[1])
 
 
 TERM_REFITS = 2

@@ -30,6 +30,7 @@ from wbfriction.friction.fit import (
     fitted_rows,
     held_out_residuals,
     model_gradient,
+    shown_friction,
     stick_margin,
 )
 from wbfriction.friction.holdout import MIN_HELD_OUT, PredictionCheck, prediction_check, prediction_variance
@@ -180,5 +181,6 @@ def other_log_checks(est: FrictionEstimate, fits: Mapping[str, FitResult], name:
         speed = joint_speed(qd[use])
         note = (f"it moves up to {speed:.2g} rad/s there (95 %), its fit's samples up to {fit.speed:.2g}: beyond the "
                 "speeds it was fitted on" if fit.speed is not None and speed > FASTER * fit.speed else "")
-        out[j] = prediction_check(name, e_model, e_best, variance, np.flatnonzero(use), note=note)
+        out[j] = prediction_check(name, e_model, e_best, variance, np.flatnonzero(use), note=note,
+                                  friction=shown_friction(fit.reported(), qd[use]))
     return tuple(out.get(j) for j in est.joints)

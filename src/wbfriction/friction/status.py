@@ -46,7 +46,7 @@ from typing import Any, Literal, Protocol, cast, get_args
 
 import numpy as np
 
-from wbfriction.friction.holdout import HOLDOUT_EXCESS, HOLDOUT_Z
+from wbfriction.friction.holdout import HOLDOUT_EXCESS, HOLDOUT_FRICTION, HOLDOUT_Z
 from wbfriction.friction.solver import explain_solver
 
 FitStatus = Literal["ok", "weak", "does not predict", "routes disagree", "at bound", "not excited", "failed"]
@@ -97,8 +97,9 @@ class StatusThresholds:
     Attributes:
         weak: a standard error or Cramér-Rao bound above this share of its value makes a fit ``weak``.
         route_z, route_rel: the routes disagree beyond this many combined standard errors and this share.
-        holdout_z, holdout_excess: a fit does not predict its later stretch beyond this many standard errors and
-            this share of what the noise and its standard errors allow (:mod:`~wbfriction.friction.holdout`).
+        holdout_z, holdout_excess, holdout_friction: a fit does not predict its later stretch beyond this many
+            standard errors, this share of what the noise and its standard errors allow, and an excess of this share
+            of its friction (:mod:`~wbfriction.friction.holdout`).
     """
 
     weak: float = WEAK
@@ -106,6 +107,7 @@ class StatusThresholds:
     route_rel: float = ROUTE_REL
     holdout_z: float = HOLDOUT_Z
     holdout_excess: float = HOLDOUT_EXCESS
+    holdout_friction: float = HOLDOUT_FRICTION
 
 
 DEFAULT_THRESHOLDS = StatusThresholds()
@@ -170,7 +172,8 @@ def fit_verdict(fit: Fit, thresholds: StatusThresholds = DEFAULT_THRESHOLDS) -> 
     disagree = _disagreeing(fit, values, thresholds)
     if check is not None and disagree:
         return FitVerdict("routes disagree", check.describe(fit, disagree))
-    if fit.later is not None and not fit.later.predicts_at(thresholds.holdout_z, thresholds.holdout_excess):
+    if fit.later is not None and not fit.later.predicts_at(thresholds.holdout_z, thresholds.holdout_excess,
+                                                                thresholds.holdout_friction):
         return FitVerdict("does not predict", fit.later.describe())
     weak = _weak(fit, values, thresholds.weak)
     if weak:
@@ -212,7 +215,8 @@ def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THR
     disagree += [f"{t}: {v.reason}" for t, v in others.items() if v.status == "routes disagree"]
     if disagree:
         return FitVerdict("routes disagree", "; ".join(disagree))
-    if fit.later is not None and not fit.later.predicts_at(thresholds.holdout_z, thresholds.holdout_excess):
+    if fit.later is not None and not fit.later.predicts_at(thresholds.holdout_z, thresholds.holdout_excess,
+                                                                thresholds.holdout_friction):
         return FitVerdict("does not predict", fit.later.describe())
     later = [f"{t}: {v.reason}" for t, v in others.items() if v.status == "does not predict"]
     if later:

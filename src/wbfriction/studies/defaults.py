@@ -252,7 +252,7 @@ class CurveCase(RealCase):
         est = fitted.estimate
         judged = []
         for k, fit in enumerate(fitted.fits):
-            error, _ = curve_scores(fit, est.qd[est.valid[:, k], k], ref, fit.joint)
+            error, _ = curve_scores(fit, est, k, ref)
             judged.append(Judged(fit.joint, _status(fit, thresholds), bool(error <= self.target), error))
         return CaseScore(float(np.nanmean([j.error for j in judged])), tuple(judged))
 

@@ -13,7 +13,8 @@ friction table of ``predict``) and scores every joint (:class:`JointScore`):
   error ``|odd_fit - odd_ref| / |odd_ref|`` over the fitted log's valid samples with ``|qd| >= min_speed`` (0.1
   rad/s), and that deviation in the fit's own standard errors (the RMS over the same samples of the deviation over
   the curve's standard error, :meth:`~wbfriction.friction.fit.FitResult.dissipative`): a fit whose standard errors
-  are honest about what the data determine lies within 3;
+  are honest about what the data determine lies within 3 (:func:`curve_scores`: a fit with terms beyond velocity at
+  each sample's load and temperature);
 * on the held-out log, the torque RMS of the model fitted (:func:`~wbfriction.pipeline.predict_step.predict_file`)
   against the peer's where it is known (KUKA: FloBaRoID's method).
 """
@@ -34,9 +35,11 @@ import numpy as np
 from wbfriction.datasets import reference, write_dataset
 from wbfriction.datasets.reference import HeldOutRms, Reference
 from wbfriction.exceptions import WbfrictionError
+from wbfriction.friction.estimated import FrictionEstimate
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.io import read_friction_file, read_params
 from wbfriction.friction.status import MIN_SPEED, joint_speed
+from wbfriction.friction.terms import term_signals
 from wbfriction.pipeline.predict_step import predict_file
 
 
@@ -119,14 +122,32 @@ def outputs(commands: Sequence[str], folder: Path) -> Outputs:
                    None if predict is None else folder / predict[2])
 
 
-def curve_scores(fit: FitResult, qd: np.ndarray, ref: Reference, joint: str) -> tuple[float, float]:
-    """The fit's odd part against the published one's over the speeds ``qd`` [rad/s] (the fitted samples) with
-    ``|qd| >= ref.min_speed``: (relative RMS error, RMS deviation in the fit's standard errors)."""
-    v = qd[np.abs(qd) >= ref.min_speed]
+SPEED_BIN = 0.05
+"""Width of the speed bins [rad/s] a fit with terms is averaged over (:func:`curve_scores`)."""
+
+
+def curve_scores(fit: FitResult, est: FrictionEstimate, k: int, ref: Reference) -> tuple[float, float]:
+    """The fit's friction against the published curve's odd part over the samples of joint column ``k`` of ``est``
+    it was fitted on, with ``|qd| >= ref.min_speed``: (relative RMS error, RMS deviation in the fit's standard
+    errors). The fit's friction is its model's odd part ``(f(qd) - f(-qd)) / 2``, or, where it kept terms beyond
+    velocity, what its model gives at each sample less its offset (the load, direction and temperature of that
+    sample; the ripple, no friction, left out) averaged over the samples of each speed (bins of :data:`SPEED_BIN`,
+    each way): a published model of the velocity alone is such an average over its log's loads; no standard error
+    then (NaN)."""
+    use = est.valid[:, k] & (np.abs(est.qd[:, k]) >= ref.min_speed)
+    v = est.qd[use, k]
     if fit.params is None or v.size == 0:
         return float("nan"), float("nan")
-    mine, se = fit.reported().dissipative(v)  # with terms kept: the refit's curve, no covariance (NaN)
-    published = ref.odd(joint, v)
+    terms = fit.kept_terms
+    if terms is None:
+        mine, se = fit.dissipative(v)
+    else:
+        at_samples = (terms.friction(est.qd[:, k], term_signals(est, k)) - terms.params.tau_os)[use]
+        bins = np.floor(v / SPEED_BIN).astype(int)
+        _, index = np.unique(bins, return_inverse=True)
+        mine = (np.bincount(index, at_samples) / np.bincount(index))[index]  # each speed's mean over its loads
+        se = np.full(v.shape, np.nan)
+    published = ref.odd(fit.joint, v)
     error = float(np.sqrt(np.mean((mine - published) ** 2) / np.mean(published**2)))
     sigmas = float(np.sqrt(np.mean(((mine - published) / se) ** 2))) if np.all(se > 0) else float("nan")
     return error, sigmas
@@ -147,7 +168,7 @@ def score(name: str, outs: Outputs) -> tuple[JointScore, ...]:
         verdict = fit.verdict()
         error = sigmas = float("nan")
         if ref.has_curve:
-            error, sigmas = curve_scores(fit, est.qd[est.valid[:, k], k], ref, joint)
+            error, sigmas = curve_scores(fit, est, k, ref)
         held_out = peer = float("nan")
         moved = False
         if prediction is not None and held is not None:
