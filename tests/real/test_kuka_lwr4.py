@@ -23,7 +23,7 @@ from wbfriction.export.mjcf import write_mjcf
 from wbfriction.export.urdf import write_friction_urdf
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log
 from wbfriction.friction.fit import FitResult, fit_estimate
-from wbfriction.friction.options import EstimateOptions
+from wbfriction.friction.options import EstimateOptions, FitOptions, TermOptions
 from wbfriction.friction.predict import predict_torques
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.clock import read_clock
@@ -36,6 +36,8 @@ from wbfriction.signals.kinematics import measure
 
 pytestmark = needs_kuka
 OPTIONS = EstimateOptions(diff="auto")
+VELOCITY_ONLY = FitOptions(terms=TermOptions(terms=()))
+"""The fit of the velocity model alone (the default tries the terms beyond velocity too)."""
 
 
 @pytest.fixture(scope="module")
@@ -83,7 +85,7 @@ def trained(urdf: Path, logs: dict[str, Path]) -> Trained:
     r = robot(urdf)
     train = estimate_log(r, log_from_table(pq.read_table(logs["runs12"]), r, "runs12"), OPTIONS)
     test = estimate_log(r, log_from_table(pq.read_table(logs["run3"]), r, "run3"), OPTIONS)
-    return Trained(r, train, {f.joint: f for f in fit_estimate(train)}, test)
+    return Trained(r, train, {f.joint: f for f in fit_estimate(train, VELOCITY_ONLY)}, test)
 
 
 @pytest.fixture(scope="module")
@@ -208,16 +210,16 @@ for issue 40."""
 
 
 def test_terms_beyond_velocity_predict_the_held_out_run(logs, identified, tmp_path):
-    """Issue 40, as a user runs it: runs 1-2 and run 3 estimated with the identified inertias into friction tables,
-    ``fit --terms all`` on runs 1-2, ``predict`` on run 3. Run 3's torques are predicted better than with the velocity
-    model alone: the mean per-joint RMS below 0.35 N·m and better than the peer's on six joints (not lwr_1, where the
-    fit's viscous level is at its bound). A position ripple is kept on the wrist joints (lwr_5, lwr_6), refused on the
-    upper arm (lwr_1-lwr_3) because fitted on one direction of motion it does not predict the other; with its ripple
+    """Issues 40 and 52, as a user runs it: runs 1-2 and run 3 estimated with the identified inertias into friction
+    tables, ``fit`` on runs 1-2 (its default tries the terms beyond velocity, each kept where it predicts the last 30 %
+    of the samples; ``--terms none`` the velocity model alone), ``predict`` on run 3. Run 3's torques are predicted
+    better than with the velocity model alone: the mean per-joint RMS below 0.35 N·m, better than the peer's on five
+    joints (not lwr_0, which run 3 drives to twice the speeds of runs 1-2, nor lwr_1, whose velocity model is at a
+    bound). A position ripple is kept on the wrist joints (lwr_5, lwr_6), refused on lwr_1 and lwr_3; with its ripple
     taken out, lwr_6's friction stops generating power on half its samples (the energy check of the parameters JSON:
     under the issue's 10 %)."""
     import json
 
-    from wbfriction.friction.options import FitOptions, TermOptions
     from wbfriction.pipeline.predict_step import predict_file
 
     spec = RobotSpec(None, str(identified), str(KUKA_CONFIG))
@@ -225,19 +227,19 @@ def test_terms_beyond_velocity_predict_the_held_out_run(logs, identified, tmp_pa
     for name, table in tables.items():
         estimate_file(spec, logs[name], table, OPTIONS)
     velocity, terms = tmp_path / "velocity.json", tmp_path / "terms.json"
-    fit_file(tables["runs12"], velocity)
-    fitted = fit_file(tables["runs12"], terms, FitOptions(terms=TermOptions()))
+    fit_file(tables["runs12"], velocity, VELOCITY_ONLY)
+    fitted = fit_file(tables["runs12"], terms)
     before, after = predict_file(tables["run3"], velocity), predict_file(tables["run3"], terms)
     kept = {f.joint: f.terms for f in fitted.fits}
     print("\nrun 3 RMS [N·m], velocity model", np.round(before.rms, 3), "with terms", np.round(after.rms, 3), "peer",
           PEER_RUN3_RMS, {j: t.kept for j, t in kept.items() if t is not None})
     assert np.mean(after.rms) < 0.35 and np.mean(after.rms) < np.mean(before.rms)
     better = [j for j, a, p in zip(after.joints, after.rms, PEER_RUN3_RMS) if a < p]
-    assert len(better) >= 6, better
+    assert len(better) >= 5, better
     assert after.terms[5] == ("ripple",) and after.terms[6] == ("ripple",)
-    for joint in ("lwr_1_joint", "lwr_2_joint", "lwr_3_joint"):
+    for joint in ("lwr_1_joint", "lwr_3_joint"):
         t = kept[joint]
-        assert t is not None and "ripple" not in t.kept and "does not predict the other" in t.reasons["ripple"]
+        assert t is not None and "ripple" not in t.kept and t.reasons["ripple"].startswith("not kept")
     for joint in ("lwr_5_joint", "lwr_6_joint"):  # its size determined, and the other route finds the same
         t = kept[joint]
         assert t is not None and t.verdicts()["ripple"].ok and t.check is not None
@@ -287,7 +289,7 @@ def test_repeated_runs_agree_as_far_as_their_torques_do(logs, identified):
     function of velocity on these logs.)"""
     r = robot(identified)
     ests = [estimate_log(r, log_from_table(pq.read_table(logs[n]), r, n), OPTIONS) for n in ("run1", "run2")]
-    fits = [{f.joint: f.params for f in fit_estimate(e)} for e in ests]
+    fits = [{f.joint: f.params for f in fit_estimate(e, VELOCITY_ONLY)} for e in ests]  # the velocity curves
     common = np.array([np.max([np.nanquantile(e.qd, 0.01, axis=0) for e in ests], axis=0),
                        np.min([np.nanquantile(e.qd, 0.99, axis=0) for e in ests], axis=0)])
     floor = measured_disagreement(common)
@@ -337,7 +339,7 @@ def test_the_exported_urdf_reloads_as_the_identified_model(identified, identifie
     ref = pin.buildModelFromUrdf(str(identified))
     for j in range(1, ref.njoints):
         assert np.allclose(back.inertias[j].toDynamicParameters(), ref.inertias[j].toDynamicParameters(), atol=1e-9)
-    for j, f in fits.items():
+    for j, f in fits.items():  # with terms kept, the levels refitted with them (at zero load): what exports write
         v = back.idx_vs[back.getJointId(j)]
-        assert back.damping[v] == pytest.approx(f.params.F_v, rel=1e-9, abs=1e-12)
-        assert back.friction[v] == pytest.approx(f.params.F_c, rel=1e-9, abs=1e-12)
+        assert back.damping[v] == pytest.approx(f.reported().params.F_v, rel=1e-9, abs=1e-12)
+        assert back.friction[v] == pytest.approx(f.reported().params.F_c, rel=1e-9, abs=1e-12)
