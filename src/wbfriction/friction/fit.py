@@ -653,7 +653,7 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
                  smoother=None, fixed: dict[str, float] | None = None, model: ModelChoice = "thesis",
                  selection_tolerance: float = SELECTION_TOLERANCE, velocity_noise: float = 0.0,
                  stick: float = 0.0, stick_margin: int = 0, pass_rows: float = PASS_ROWS,
-                 noise: JointNoise | None = None,
+                 score_slow: bool = True, noise: JointNoise | None = None,
                  still: ModelName | None = None) -> FitResult:
     """Fit a friction model to friction estimates of one joint (eq. 6.4).
 
@@ -686,6 +686,8 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
             under that noise (errors in variables, :mod:`~wbfriction.friction.eiv`); 0: the model itself.
         stick, stick_margin, pass_rows: samples within ``stick_margin`` rows of a speed below ``stick`` [rad/s] are
             left out, but for reversals crossing that band within ``pass_rows`` rows
+        score_slow: with ``auto``, the held-out blocks' samples left out that way are scored too (what ``predict``
+            scores: a model with no Coulomb step there misses them)
             (:func:`stuck_rows`) and counted (:attr:`FitResult.n_stuck`); 0: none. Not for a joint that hardly
             moved (:data:`~wbfriction.friction.status.MIN_SPEED`: ``not excited``), whose every sample gives its
             offset.
@@ -716,7 +718,7 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
                 raise InputError("x0 needs a named model, not 'auto'")
             res = _fit_auto(qd, y, use, delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother,
                             fixed=fixed, tolerance=selection_tolerance, sigma=velocity_noise, noise=noise,
-                            speed=speed, stuck=stuck)
+                            speed=speed, stuck=stuck if score_slow else None)
         else:
             if still is not None and speed < MIN_SPEED:  # held names checked against the model named all the same
                 check_fixed(check_model(model), fixed)
@@ -965,7 +967,7 @@ def _column_tasks(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, 
                   delta_s: float, min_samples: int, smoother, fixed: dict[str, float] | None,
                   selection_tolerance: float, noise: Mapping[str, JointNoise] | None,
                   stick_margin: int | None, still: ModelName | None = None,
-                  pass_rows: float = PASS_ROWS) -> list[tuple]:
+                  pass_rows: float = PASS_ROWS, score_slow: bool = True) -> list[tuple]:
     """One :func:`_fit_column` task per joint (:func:`fit_joints`'s arguments)."""
     noise = noise or {}
     tasks = []
@@ -973,7 +975,7 @@ def _column_tasks(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, 
         jn = noise.get(joint)
         sigma = 0.0 if jn is None else jn.velocity
         stick = {} if stick_margin is None else {"stick": stick_speed(sigma), "stick_margin": stick_margin,
-                                                 "pass_rows": pass_rows}
+                                                 "pass_rows": pass_rows, "score_slow": score_slow}
         tasks.append((qd[:, i], tau_f[:, i], valid[:, i],
                       dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, fixed=fixed,
                            model=models[i], selection_tolerance=selection_tolerance, velocity_noise=sigma, noise=jn,
@@ -1095,7 +1097,7 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
     truth = None if est.tau_f_true is None else est.tau_f_true[:, idx]
     common: dict[str, Any] = dict(delta_s=options.delta_s, min_samples=options.min_samples, fixed=fixed,
                                   selection_tolerance=options.selection_tolerance, still=still,
-                                  pass_rows=options.pass_rows)
+                                  pass_rows=options.pass_rows, score_slow=options.score_slow)
     tasks = _column_tasks(names, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], [options.model] * len(idx),
                           smoother=est.smoother, noise=joint_noises(record, est.estimation_route),
                           stick_margin=stick_margin(est), **common)

@@ -257,6 +257,8 @@ class FitOptions:
         pass_rows: a reversal crossing the band of speeds a joint may stick at within this many samples is a pass
             through zero, kept in the fit; a slower one may hold a stop, left out with its filter's margin (>= 0; 0:
             every slow stretch; :func:`~wbfriction.friction.fit.stuck_rows`).
+        score_slow: with ``model="auto"``, the held-out blocks' samples left out as sticking are scored too (what a
+            prediction scores).
 
     Raises:
         OptionError: a value not one of its choices or out of its range, named by its command-line option.
@@ -268,6 +270,7 @@ class FitOptions:
     delta_s: float = 2.0
     terms: TermOptions = TermOptions()
     pass_rows: float = PASS_ROWS
+    score_slow: bool = True
 
     def __post_init__(self) -> None:
         check_choice("model", self.model, MODEL_CHOICES)

@@ -100,6 +100,7 @@ KNOBS: tuple[Knob, ...] = (
          lambda s, v: replace(s, fit=replace(s.fit, selection_tolerance=v))),
     Knob("pass_rows", "fit", (0.0, 2.0, 5.0, math.inf), 2.0,
          lambda s, v: replace(s, fit=replace(s.fit, pass_rows=v))),
+    Knob("score_slow", "fit", (False, True), True, lambda s, v: replace(s, fit=replace(s.fit, score_slow=v))),
     Knob("terms", "fit", ("none", "auto"), "auto",
          lambda s, v: replace(s, fit=replace(s.fit, terms=TermOptions() if v == "auto" else TermOptions(terms=())))),
     Knob("term_min_torque", "fit", (0.005, 0.01, 0.02), 0.01,
