@@ -17,9 +17,12 @@ status, the first that applies:
   of the value: one of them is biased, and the standard errors cannot say which; both values are given;
 * ``does not predict`` (issue 52): the same model fitted on the earliest samples predicts the last
   :data:`~wbfriction.friction.holdout.LATER` of them worse than the noise and its standard errors allow, beyond
-  :data:`~wbfriction.friction.holdout.HOLDOUT_Z` standard errors and by more than
-  :data:`~wbfriction.friction.holdout.HOLDOUT_EXCESS` (:mod:`~wbfriction.friction.holdout`): the friction changed
-  over the log, or a model error the standard errors do not see (the errors and held-out RMS given);
+  :data:`~wbfriction.friction.holdout.HOLDOUT_Z` standard errors, by more than
+  :data:`~wbfriction.friction.holdout.HOLDOUT_EXCESS` of what is allowed and by more than
+  :data:`~wbfriction.friction.holdout.HOLDOUT_FRICTION` of the joint's friction
+  (:mod:`~wbfriction.friction.holdout`): the friction changed over the log, or a model error the standard errors
+  do not see (the errors and held-out RMS given); a term beyond velocity that departs on the later stretch makes
+  its joint so too (:mod:`~wbfriction.friction.term_selection`);
 * ``weak``: a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error, or a Cramér-Rao bound
   (:mod:`~wbfriction.friction.bound`: what the data allow any unbiased estimator), above :data:`WEAK` of its
   (non-zero) value, or is not identifiable (infinite standard error); a magnitude at zero whose standard error
