@@ -385,3 +385,42 @@ def test_a_load_law_that_changes_later_in_the_log_does_not_predict():
     verdict = fit.verdicts()["load"]
     assert verdict.status == "does not predict", (fit.reasons, fit.later)
     assert TermFit.from_dict(fit.to_dict()).verdicts()["load"].status == "does not predict"
+
+
+def test_a_term_that_takes_the_friction_s_place_is_named():
+    """A regressor that holds 1.2 times the Coulomb column and a torque of its own (a ripple that, over the angles a
+    joint swept one way and the other, follows the direction of motion): fitted with it, F_c would go below zero and
+    is held there; F_c carries the friction without it, so the term takes the friction's place (``displaced_part``
+    names the Coulomb part). A regressor independent of the friction's takes nothing (None); nor does a held
+    magnitude too small to matter."""
+    from wbfriction.friction.term_selection import displaced_part, nonnegative_solve
+
+    rng = np.random.default_rng(0)
+    qd = 1.5 * np.sin(np.linspace(0.0, 40.0, 4000))
+    names, B, _ = velocity_basis(TRUTH, qd)
+    angle = np.cos(np.linspace(0.0, 7.0, qd.size))  # what the term holds of its own
+    y = B @ np.array([TRUTH.F_v, TRUTH.F_c, TRUTH.tau_os]) + 0.1 * angle + 0.01 * rng.standard_normal(qd.size)
+    X = np.column_stack([B, 1.2 * np.sign(qd) + 0.1 * angle])  # and 1.2 x the Coulomb level with it
+    all_names = (*names, "ripple_sin1")
+    coef, held = nonnegative_solve(X, y, all_names)
+    assert held == ("F_c",) and coef[1] == 0.0
+    assert displaced_part(all_names, X, y, 3, held, TermOptions()) == "Coulomb"
+    independent = np.column_stack([B, angle])
+    coef, held = nonnegative_solve(independent, y, all_names)
+    assert held == () and displaced_part(all_names, independent, y, 3, held, TermOptions()) is None
+    small = y - TRUTH.F_c * np.sign(qd) + 0.004 * np.sign(qd)  # a Coulomb level of 4 mN·m: below what matters
+    assert displaced_part(all_names, X, small, 3, ("F_c",), TermOptions()) is None
+
+
+def test_a_coulomb_level_held_at_zero_holds_its_stribeck_part():
+    """(3.5) with F_c held at zero by the terms holds F_cS = F_c S with it: a Stribeck rise with no Coulomb level is
+    no (3.5) (S infinite), which ``with_coefficients`` would turn into S = 0, dropping the rise silently."""
+    from wbfriction.friction.term_selection import nonnegative_solve
+
+    params = FrictionParams(F_v=0.2, F_c=0.3, S=1.0, v_s=0.3, tau_os=0.0, a=50.0)
+    qd = 1.5 * np.sin(np.linspace(0.0, 40.0, 4000))
+    names, B, c = velocity_basis(params, qd)
+    angle = np.cos(np.linspace(0.0, 7.0, qd.size))
+    X = np.column_stack([B, 1.5 * B[:, 1] + angle])  # a term that holds 1.5 x the tanh column
+    coef, held = nonnegative_solve(X, B @ c + angle, (*names, "extra"))
+    assert {"F_c", "F_cS"} <= set(held) and coef[1] == coef[2] == 0.0

@@ -199,7 +199,9 @@ def _same_identification(new, old) -> None:
     assert len(new.unexcited) == len(old.unexcited)  # which ones among near ties: rounding's, as above
     assert new.samples == old.samples
     for name, value in _figures(new).items():
-        _close(value, _figures(old)[name])
+        # a friction level at zero is a flat direction: rounding moves it by a few 1e-7 of the largest (the Panda's
+        # forearm F_c, 2e-6 or 5e-6 N·m beside 23 N·m, by the machine's BLAS)
+        _close(value, _figures(old)[name], 10 * TOLERANCE if name.startswith("friction") else TOLERANCE)
 
 
 def test_the_walk_identification_is_the_previous_routes(walk_case, monkeypatch):

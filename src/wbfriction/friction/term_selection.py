@@ -213,36 +213,55 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     def holds(term: Term, others: tuple[Term, ...]) -> bool:
         return term not in ("load", "temperature") or carry_over(term, others) > tol
 
-    kept: list[Term] = []
-    current, harmonics = base_rms, 0
-    remaining = list(candidates)
-    while remaining:  # forward: the term that lowers the held-out RMS most, while it lowers it by more than tol
-        trials = {term: best_harmonics((*kept, term)) for term in remaining if holds(term, tuple(kept))}
-        if not trials:
+    def select(tried: tuple[Term, ...]) -> tuple[list[Term], float, int]:
+        """Forward, then backward selection among ``tried``: the terms kept, their held-out RMS, the harmonics."""
+        kept: list[Term] = []
+        current, harmonics = base_rms, 0
+        remaining = list(tried)
+        while remaining:  # forward: the term that lowers the held-out RMS most, while it lowers it by more than tol
+            trials = {term: best_harmonics((*kept, term)) for term in remaining if holds(term, tuple(kept))}
+            if not trials:
+                break
+            best = min(trials, key=lambda t: trials[t][0])
+            if not trials[best][0] < (1.0 - tol) * current:
+                break
+            kept.append(best)
+            current, harmonics = trials[best]
+            remaining.remove(best)
+        while len(kept) > 1:  # backward: a term another has made redundant leaves (a load that stood for a ripple)
+            without = {term: best_harmonics(tuple(t for t in kept if t != term)) for term in kept}
+            weakest = min(without, key=lambda t: without[t][0])
+            if not without[weakest][0] < (1.0 + tol) * current:
+                break
+            kept.remove(weakest)
+            current, harmonics = without[weakest]
+        return kept, current, harmonics
+
+    def displaced(terms: tuple[Term, ...], h: int) -> str | None:
+        names, X, k = design(terms, h)
+        return displaced_part(names, X[use], y_[use], k, nonnegative_solve(X[use], y_[use], names)[1], options)
+
+    refused: list[Term] = []
+    while True:  # a term that is no friction, or takes the friction's place, or is too small, is refused; again
+        kept, current, harmonics = select(tuple(t for t in candidates if t not in refused))
+        if not kept:
             break
-        best = min(trials, key=lambda t: trials[t][0])
-        if not trials[best][0] < (1.0 - tol) * current:
-            break
-        kept.append(best)
-        current, harmonics = trials[best]
-        remaining.remove(best)
-    while len(kept) > 1:  # backward: a term another has made redundant leaves (a load that stood for a ripple)
-        without = {term: best_harmonics(tuple(t for t in kept if t != term)) for term in kept}
-        weakest = min(without, key=lambda t: without[t][0])
-        if not without[weakest][0] < (1.0 + tol) * current:
-            break
-        kept.remove(weakest)
-        current, harmonics = without[weakest]
-    while True:  # a friction term that makes the friction generate power (eq. 7.9) on the samples is not friction
         names, X, k = design(tuple(kept), harmonics)
-        coef, _ = _nonnegative_solve(X[use], y_[use], names)
+        coef, _ = nonnegative_solve(X[use], y_[use], names)
         bad = _unphysical(with_coefficients(params, coef[:k]), dict(zip(names[k:], map(float, coef[k:]))), signals,
-                          use, t_ref or 0.0) or _negligible(names, X[use], coef, k, options)
+                          use, t_ref or 0.0)  # a friction term that makes the friction generate power (eq. 7.9)
+        lost = None if bad else displaced(tuple(kept), harmonics)
+        if lost is not None:  # the term whose leaving gives the magnitude back (the best held-out RMS of those)
+            rest = {t: best_harmonics(tuple(x for x in kept if x != t)) for t in kept}
+            freeing = [t for t in kept if displaced(tuple(x for x in kept if x != t), rest[t][1]) is None]
+            bad = min(freeing or kept, key=lambda t: rest[t][0]), (
+                f"with it the velocity model's {lost} friction is held at zero where, fitted without it, it matters: "
+                "it takes the friction's place, which the data cannot tell apart")
+        bad = bad or _negligible(names, X[use], coef, k, options)
         if bad is None:
             break
-        kept.remove(bad[0])
+        refused.append(bad[0])
         reasons[bad[0]] = f"not kept: {bad[1]}"
-        current, harmonics = best_harmonics(tuple(kept))
     if "ripple" in candidates and "ripple" not in kept:
         ripples = direction_gains(tuple(kept))
         if not any(g > tol for g in ripples.values()):
@@ -347,9 +366,11 @@ NONNEGATIVE = ("F_v", "F_c", "F_cS")
 that would go below zero is held at zero (:attr:`TermFit.at_bound`)."""
 
 
-def _nonnegative_solve(X: np.ndarray, y: np.ndarray, names: tuple[str, ...]) -> tuple[np.ndarray, tuple[str, ...]]:
+def nonnegative_solve(X: np.ndarray, y: np.ndarray, names: tuple[str, ...]) -> tuple[np.ndarray, tuple[str, ...]]:
     """Least squares with the :data:`NONNEGATIVE` coefficients at zero where they would go below: the most negative
-    held at zero and the rest refitted, until none is; and the names held."""
+    held at zero and the rest refitted, until none is; and the names held. ``F_c`` of (3.5) held at zero holds its
+    Stribeck part ``F_cS = F_c S`` with it: a Stribeck rise without a Coulomb level is no (3.5) (its ``S`` would be
+    infinite; :func:`~wbfriction.friction.terms.with_coefficients` would drop it)."""
     free = np.ones(len(names), dtype=bool)
     while True:
         coef = np.zeros(len(names))
@@ -357,7 +378,10 @@ def _nonnegative_solve(X: np.ndarray, y: np.ndarray, names: tuple[str, ...]) -> 
         negative = [i for i, n in enumerate(names) if n in NONNEGATIVE and free[i] and coef[i] < 0]
         if not negative:
             return coef, tuple(n for n, f in zip(names, free) if not f)
-        free[min(negative, key=lambda i: coef[i])] = False
+        worst = min(negative, key=lambda i: coef[i])
+        free[worst] = False
+        if names[worst] == "F_c" and "F_cS" in names:
+            free[names.index("F_cS")] = False
 
 
 def _moving(use: np.ndarray, qd: np.ndarray, y: np.ndarray, signals: TermSignals) -> np.ndarray:
@@ -375,11 +399,11 @@ def _moving(use: np.ndarray, qd: np.ndarray, y: np.ndarray, signals: TermSignals
 def _final(X: np.ndarray, y: np.ndarray, use: np.ndarray, names: tuple[str, ...],
            rate_column: Callable[[np.ndarray], np.ndarray] | None = None,
            ) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
-    """The coefficients on every sample ``use`` (:func:`_nonnegative_solve`), their covariance (residuals correlated
+    """The coefficients on every sample ``use`` (:func:`nonnegative_solve`), their covariance (residuals correlated
     over a filter's window: Newey-West, as the fit's; zero for one held at zero) and the names held. With
     ``rate_column`` (the model's derivative (N,) in the temperature law's rate, given the coefficients), the
     covariance is that of the coefficients and the rate (last): the full Jacobian's, the rate fitted too."""
-    coef, held = _nonnegative_solve(X[use], y[use], names)
+    coef, held = nonnegative_solve(X[use], y[use], names)
     free = np.array([n not in held for n in names])
     residual = y[use] - X[use] @ coef
     rows = np.flatnonzero(use)
@@ -446,7 +470,7 @@ class _TemperatureLaw:
         rate = float(minimize_scalar(lambda r: float(np.sum(self.residual(r, self.use, self.use) ** 2)),
                                      bounds=(-bound, bound), method="bounded", options={"xatol": 1e-6 * bound}).x)
         names, X, k = self.design(rate)
-        coef, _ = _nonnegative_solve(X[self.use], self.y[self.use], names)
+        coef, _ = nonnegative_solve(X[self.use], self.y[self.use], names)
         unphysical = _unphysical(with_coefficients(self.params, coef[:k]), dict(zip(names[k:], map(float, coef[k:]))),
                                  self.signals, self.use, self.t_ref, rate)
         versus = (f"held-out RMS {rms['exponential']:.4g} N·m exponential (rate {rate:.3g} /°C), {rms['linear']:.4g} "
@@ -532,6 +556,33 @@ def _unphysical(params: ModelParams, c: dict[str, float], signals: TermSignals, 
         levels = (F_c + c["F_cT"] * phi, F_v + c["F_vT"] * phi)
         if min(float(np.min(x)) for x in levels) < 0:
             return "temperature", "a Coulomb or viscous level below zero at a temperature met: not friction"
+    return None
+
+
+FRICTION_PARTS = {"Coulomb": ("F_c", "F_cS", "F_s"), "viscous": ("F_v",)}
+"""The velocity model's coefficients by the part of the friction they make (:func:`displaced_part`)."""
+
+
+def displaced_part(names: tuple[str, ...], X: np.ndarray, y: np.ndarray, k: int, held: tuple[str, ...],
+                options: TermOptions) -> str | None:
+    """The part of the velocity model's friction (:data:`FRICTION_PARTS`) that the terms take the place of, or None:
+    with them every coefficient of that part is held at zero (``held``, :func:`nonnegative_solve`) where, fitted
+    without them, the part carries a torque that matters (above :attr:`TermOptions.min_effect` of the friction and
+    :attr:`TermOptions.min_torque`, as :func:`_negligible`). The data then cannot tell the terms from the friction: a
+    3-harmonic ripple on the Panda's flange, over the 2.7 rad its excitation swept, took the whole Coulomb level
+    (0.28 N·m at every speed in its estimate, as published) and left a viscous line 50 % off the published curve
+    (issue 52). One coefficient of a part held (F_cS of (3.5), its Coulomb level F_c still there) takes nothing.
+    ``X`` (n, p), ``y`` (n,): the design and the friction on the samples fitted; ``k``: the velocity model's
+    columns."""
+    alone, _ = nonnegative_solve(X[:, :k], y, names[:k])
+    friction = float(np.sqrt(np.mean((X[:, :k] @ alone) ** 2)))
+    for part, members in FRICTION_PARTS.items():
+        cols = [i for i, n in enumerate(names[:k]) if n in members]
+        if not cols or not all(names[i] in held for i in cols):
+            continue
+        if float(np.sqrt(np.mean((X[:, cols] @ alone[cols]) ** 2))) >= max(options.min_effect * friction,
+                                                                            options.min_torque):
+            return part
     return None
 
 
