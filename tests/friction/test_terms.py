@@ -181,6 +181,23 @@ def test_one_sample_in_floats_is_the_model(qd, q, tau_load, temperature):
                                                                          rel=1e-12, abs=1e-12)
 
 
+@given(st.floats(0.01, 3), st.floats(-50, 50))
+@settings(max_examples=100, deadline=None)
+def test_the_friction_at_a_speed_under_a_load_is_the_models_odd_part(v, tau_load):
+    """What a fleet's row reports (:meth:`TermFit.speed_friction` at the log's load) is ``(f(+v) - f(-v)) / 2`` of the
+    dissipative friction under that load at the reference temperature, every kept term applied; its standard error
+    the delta method's through the covariance (F_L's variance alone: ``|g| |load|`` times its standard error)."""
+    fit = TermFit(FrictionParams(F_v=0.2, F_c=1.0, S=0.3, v_s=0.1, tau_os=0.05, a=30.0), TERMS, 1,
+                  {"F_L": 0.02, "dF_v": 0.03, "ripple_sin1": 0.1, "ripple_cos1": -0.05, "F_cT": -0.008, "F_vT": -0.002},
+                  reference_temperature=40.0, covariance=np.diag([0.0, 0.0, 0.0, 0.0, 1e-6, 0.0, 0.0, 0.0, 0.0, 0.0]))
+    s = TermSignals(q=np.zeros(2), tau_load=np.full(2, tau_load), temperature=np.full(2, 40.0))
+    f = fit.friction(np.array([v, -v]), s)
+    value, se = fit.speed_friction(v, tau_load)
+    assert value == pytest.approx(0.5 * (f[0] - f[1]), rel=1e-12, abs=1e-12)
+    assert se == pytest.approx(np.tanh(30.0 * v) * abs(tau_load) * 1e-3, rel=1e-9, abs=1e-15)
+    assert fit.speed_friction(v)[0] == pytest.approx(value - 0.02 * abs(tau_load) * np.tanh(30.0 * v), abs=1e-12)
+
+
 def test_options_are_checked_where_they_are_defined():
     with pytest.raises(OptionError, match="--terms"):
         TermOptions(terms=("wear",))  # type: ignore[arg-type]

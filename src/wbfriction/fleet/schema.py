@@ -23,6 +23,8 @@ offset ``tau_os`` and robust where the model's parameters trade off against each
 did not reach ``v`` in the log (an extrapolation is no measurement). Where the fit kept terms beyond velocity
 (:mod:`wbfriction.friction.terms`), the values are its velocity model's refitted with them: at zero load, at the
 reference temperature, without the position ripple; ``temperature`` says at which temperature the values are.
+``f_at_<v>`` is then at the log's mean load (``|tau + tau_f|``): the level a velocity model alone fits on the log,
+comparable between logs that keep different terms.
 """
 
 from __future__ import annotations

@@ -130,7 +130,9 @@ def process_log(entry: LogEntry, key: ResultKey, options: BatchOptions, scratch:
                 executor=executor)
             fitted = fit_table(friction, options.fit, threshold=options.energy_threshold,
                                tolerance=options.energy_tolerance)
-        rows = result_rows(key, fitted.fits, fitted.energy, fitted.est.qd, fitted.est.valid, fitted.est.temperature)
+        est = fitted.est
+        rows = result_rows(key, fitted.fits, fitted.energy, est.qd, est.valid, est.temperature,
+                           None if est.tau is None else est.tau + est.tau_f)
         return LogOutcome(entry, key, rows, table=table)
     except OutputError as exc:  # the results cannot be written: no other log's either, the batch stops
         where = table if table is not None else f"{scratch} (the friction table of {entry.log.name})"
@@ -155,11 +157,16 @@ def reference_friction(fit: FitResult, v: float) -> tuple[float, float]:
 
 
 def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy], qd: np.ndarray,
-                valid: np.ndarray, temperature: np.ndarray | None = None) -> pa.Table:
+                valid: np.ndarray, temperature: np.ndarray | None = None, load: np.ndarray | None = None
+                ) -> pa.Table:
     """The rows of the log of ``key`` (:data:`~wbfriction.fleet.schema.RESULT_SCHEMA`), one per joint of ``fits``;
     ``qd`` (N, n_tc) [rad/s] and ``valid`` (N, n_tc) of the estimate give each joint's velocity range,
-    ``temperature`` (N, n_tc) [°C] (or None) its temperature. A fit with terms beyond velocity gives its velocity
-    model refitted with them (at zero load and its reference temperature, without the ripple)."""
+    ``temperature`` (N, n_tc) [°C] (or None) its temperature, ``load`` (N, n_tc) [N·m] (or None) the rigid-body
+    torque ``tau + tau_f`` the load term reads. A fit with terms beyond velocity gives its velocity model refitted
+    with them (``F_c``, ``F_v``: at zero load and its reference temperature, without the ripple); its ``f_at_<v>``
+    is the friction under the log's mean ``|load|`` (zero without ``load``): the level a velocity model alone
+    fits, whichever terms a log keeps (issue 52: the KUKA's repeated wrist run kept a load term in one log and not
+    the other, and at zero load its friction at 0.3 rad/s read 0.18 N·m against the other log's 0.30)."""
     shares = {e.joint: e.generating_share for e in energy}
     columns: dict[str, list] = {name: [] for name in RESULT_SCHEMA.names}
     for i, fit in enumerate(fits):
@@ -191,9 +198,13 @@ def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy]
         for p in TREND_PARAMS[:2]:
             row[f"{p}_check"] = float(check.get(p, float("nan"))) if check else float("nan")
         reach = float(np.max(np.abs(v))) if v.size else 0.0
+        loads = np.abs(load[rows, i]) if load is not None else np.zeros(0)
+        loads = loads[np.isfinite(loads)]
+        mean_load = float(np.mean(loads)) if loads.size else 0.0
         for s in REFERENCE_SPEEDS:
             nan = (float("nan"), float("nan"))
-            f, se = nan if s > reach else terms.speed_friction(s) if terms is not None else reference_friction(fit, s)
+            f, se = (nan if s > reach else terms.speed_friction(s, mean_load) if terms is not None
+                     else reference_friction(fit, s))
             row[speed_column(s)], row[speed_column(s) + "_se"] = f, se
         for name in RESULT_SCHEMA.names:
             columns[name].append(row[name])

@@ -344,11 +344,17 @@ class TermFit:
                 raise InputError(f"{source}: no column '{column}': the fit's {term} term needs it (estimate the "
                                  "log again with this version; a temperature term needs the log's temperature)")
 
-    def speed_friction(self, v: float) -> tuple[float, float]:
-        """The dissipative friction at speed ``v`` [rad/s] at the reference conditions (zero load, ``T_ref``, no
-        ripple): ``(f(+v) - f(-v)) / 2`` [N·m], and its standard error from :attr:`covariance` (NaN without)."""
-        _, B, c = velocity_basis(self.params, np.array([v, -v]))
+    def speed_friction(self, v: float, load: float = 0.0) -> tuple[float, float]:
+        """The dissipative friction at speed ``v`` [rad/s] at the reference temperature ``T_ref``, without the
+        ripple, under the load ``|load|`` [N·m] where a load term is kept (0: the reference conditions):
+        ``(f(+v) - f(-v)) / 2`` [N·m], and its standard error from :attr:`covariance` (NaN without)."""
+        speeds = np.array([v, -v])
+        _, B, c = velocity_basis(self.params, speeds)
         g = 0.5 * (B[0] - B[1])
+        if "load" in self.kept:  # F_L |tau_load| g(qd): the first term's column (TERMS order)
+            shape = coulomb_shape(self.params, speeds)
+            g = np.append(g, 0.5 * (shape[0] - shape[1]) * abs(load))
+            c = np.append(c, self.coefficients["F_L"])
         value = float(g @ c)
         if self.covariance is None:
             return value, float("nan")

@@ -144,7 +144,8 @@ def temperature_fleet(plan: TemperatureFleet = TemperatureFleet()) -> pa.Table:
                                    temperature=np.column_stack(temperature))
             fits = fit_estimate(est, FitOptions(model="coulomb-viscous"))
             key = ResultKey(robot_id, start + timedelta(days=i), f"{robot_id}/{i:03d}.parquet", "", "", "")
-            parts.append(result_rows(key, fits, [], est.qd, est.valid, est.temperature))
+            parts.append(result_rows(key, fits, [], est.qd, est.valid, est.temperature,
+                                     None if est.tau is None else est.tau + est.tau_f))
     return pa.concat_tables(parts)
 
 
