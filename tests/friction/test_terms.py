@@ -429,6 +429,57 @@ def test_a_term_that_takes_the_friction_s_place_is_named():
     assert displaced_part(all_names, X, small, 3, ("F_c",), TermOptions()) is None
 
 
+def test_a_coulomb_level_that_is_all_load_keeps_its_load_term():
+    """A Coulomb level proportional to the load (F_c = 0, F_L = 0.04: 0-1.4 N·m) is friction: the load term takes all
+    of the Coulomb level the velocity model alone fits, F_c held at zero, and is kept (F_L within 2 %), not refused
+    as a term in the friction's place."""
+    t, qd, s = trajectory(4)
+    truth = CoulombViscousParams(F_v=0.2, F_c=0.0, tau_os=0.1)
+    rng = np.random.default_rng(4)
+    y = truth.F_v * qd + truth.tau_os + 0.04 * np.abs(s.tau_load) * np.sign(qd) + 0.01 * rng.standard_normal(qd.size)
+    start = CoulombViscousParams(F_v=0.2, F_c=0.5, tau_os=0.1)
+    fit = fit_terms(start, qd, -y, np.ones(qd.size, dtype=bool), s, TermOptions(terms=("load",)))
+    assert fit.kept == ("load",) and fit.params.F_c == 0.0 and "F_c" in fit.at_bound, fit.reasons
+    assert fit.coefficients["F_L"] == pytest.approx(0.04, rel=0.02)
+
+
+def test_a_ripple_in_the_friction_s_place_is_refused_and_a_load_law_is_not():
+    """``_ripple_in_place``: with the ripple a part of the friction is held at zero and without it not: the ripple
+    is refused, naming the part; where the other terms hold it at zero without the ripple (a Coulomb level all
+    load), or nothing is held, the ripple is not the cause: None."""
+    from wbfriction.friction.term_selection import _ripple_in_place
+
+    def best(terms):
+        return 0.1, 3 if "ripple" in terms else 0
+
+    def held_with_ripple(terms, h):
+        return "Coulomb" if "ripple" in terms else None
+
+    bad = _ripple_in_place(["load", "ripple"], 3, held_with_ripple, best)
+    assert bad is not None and bad[0] == "ripple" and "Coulomb" in bad[1]
+    assert _ripple_in_place(["load", "ripple"], 3, lambda terms, h: "Coulomb", best) is None
+    assert _ripple_in_place(["ripple"], 3, lambda terms, h: None, best) is None
+
+
+def test_a_term_no_value_of_which_is_determined_is_refused():
+    """``_undetermined``: a term whose coefficient's standard error is above half its value (a regressor of noise,
+    whose coefficient is noise) is named with its value and error; a term the data determine is not."""
+    from wbfriction.friction.term_selection import _undetermined
+
+    rng = np.random.default_rng(1)
+    qd = 1.5 * np.sin(np.linspace(0.0, 40.0, 2000))
+    names, B, c = velocity_basis(TRUTH, qd)
+    noise = rng.standard_normal(qd.size)
+    y = B @ c + 0.05 * rng.standard_normal(qd.size)
+    use = np.ones(qd.size, dtype=bool)
+    X = np.column_stack([B, np.abs(qd) * noise])
+    bad = _undetermined((*names, "dF_v"), X, y, use, 3, ["direction"], 0, TermSignals())
+    assert bad is not None and bad[0] == "direction" and "not determined" in bad[1]
+    real = y + 0.3 * np.abs(qd)
+    assert _undetermined((*names, "dF_v"), np.column_stack([B, np.abs(qd)]), real, use, 3, ["direction"], 0,
+                         TermSignals()) is None
+
+
 def test_a_coulomb_level_held_at_zero_holds_its_stribeck_part():
     """(3.5) with F_c held at zero by the terms holds F_cS = F_c S with it: a Stribeck rise with no Coulomb level is
     no (3.5) (S infinite), which ``with_coefficients`` would turn into S = 0, dropping the rise silently."""

@@ -6,8 +6,8 @@ so the folder needs no manifest. A copy of run 1 under another robot and a folde
 are the faults a real fleet folder has; there is no ground-truth friction, so what must hold is what the data
 can check: the copy's numbers are run 1's, the start times are the recordings' own, a second batch computes
 nothing, and runs 1 and 2 (one trajectory run twice, 29 min apart) agree where their torques do: the wrist
-(joints 4-6, friction at 0.3 rad/s within 2-7 %, a fit that kept a load term read at the log's mean load; joints 0-3, whose torques differ by 0.2 N·m RMS between the
-runs, 9-44 %: the friction changed, README's KUKA section).
+(joints 4-6, friction at 0.3 rad/s within 2-7 %, a fit that kept a load term read at the log's mean load; joints
+0-3, whose torques differ by 0.2 N·m RMS between the runs, 9-44 %: the friction changed, README's KUKA section).
 """
 
 from __future__ import annotations

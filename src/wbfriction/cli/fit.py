@@ -85,7 +85,8 @@ def fit(friction: Path = FrictionArg,
         pass_rows: float = typer.Option(FIT.pass_rows, min=0.0,
                                         help="A reversal crossing the speeds a joint may stick at within this many "
                                              "samples passes through zero and stays in the fit; a slower one may "
-                                             "hold a stop and is left out with the filter's reach (0: every one)."),
+                                             "hold a stop and is left out with the filter's reach (inf: every "
+                                             "reversal; 0: none)."),
         wide: bool = WideOpt, verbose: bool = VerboseOpt) -> None:
     """Identify a friction model of every joint, with standard errors and the parameters left
     at a bound; warn about joints whose friction generates power (eq. 7.9)."""

@@ -34,7 +34,7 @@ from wbfriction.friction.regression import (
     covariance_errors,
     parameter_covariance,
 )
-from wbfriction.friction.status import MIN_SPEED, ROUTE_Z, WEAK
+from wbfriction.friction.status import MIN_SPEED, ROUTE_Z, TERM_WEAK
 from wbfriction.friction.terms import (
     TERM_COEFFICIENTS,
     TermCheck,
@@ -242,7 +242,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         return displaced_part(names, X[use], y_[use], k, nonnegative_solve(X[use], y_[use], names)[1], options)
 
     refused: list[Term] = []
-    while True:  # a term that is no friction, or takes the friction's place, or is too small, is refused; again
+    while True:  # a term that is no friction, takes the friction's place, is too small or not determined: refused
         kept, current, harmonics = select(tuple(t for t in candidates if t not in refused))
         if not kept:
             break
@@ -250,14 +250,10 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         coef, _ = nonnegative_solve(X[use], y_[use], names)
         bad = _unphysical(with_coefficients(params, coef[:k]), dict(zip(names[k:], map(float, coef[k:]))), signals,
                           use, t_ref or 0.0)  # a friction term that makes the friction generate power (eq. 7.9)
-        lost = None if bad else displaced(tuple(kept), harmonics)
-        if lost is not None:  # the term whose leaving gives the magnitude back (the best held-out RMS of those)
-            rest = {t: best_harmonics(tuple(x for x in kept if x != t)) for t in kept}
-            freeing = [t for t in kept if displaced(tuple(x for x in kept if x != t), rest[t][1]) is None]
-            bad = min(freeing or kept, key=lambda t: rest[t][0]), (
-                f"with it the velocity model's {lost} friction is held at zero where, fitted without it, it matters: "
-                "it takes the friction's place, which the data cannot tell apart")
-        bad = bad or _negligible(names, X[use], coef, k, options)
+        if bad is None and "ripple" in kept:
+            bad = _ripple_in_place(kept, harmonics, displaced, best_harmonics)
+        bad = bad or _negligible(names, X[use], coef, k, options) or _undetermined(
+            names, X, y_, use, k, kept, harmonics, signals)
         if bad is None:
             break
         refused.append(bad[0])
@@ -336,17 +332,17 @@ def later_check(X: np.ndarray, y: np.ndarray, names: tuple[str, ...], k: int, ke
     ``d`` the RMS over ``tail`` of ``X_term⊥ (c_head - c_tail)``, ``X_term⊥`` the term's regressors on ``tail`` less
     their projection on the other coefficients' (what no other coefficient can take: a ripple's mean that the offset
     trades with is not the ripple's departure), ``allowed`` :data:`ROUTE_Z` times the RMS of its standard deviation
-    through both fits' covariances (Newey-West), and at least :data:`~wbfriction.friction.status.WEAK` of the tail's
-    own residual RMS (the noise: a departure below it changes a prediction by a few percent; the Newey-West errors miss
-    an estimate's errors that repeat with the motion) and :attr:`TermOptions.min_torque`. A law of the load, the
-    angle or the temperature is the same law later; a term that stood in for something else is not. Empty when
+    through both fits' covariances (Newey-West), and at least :data:`~wbfriction.friction.status.TERM_WEAK` of the
+    tail's own residual RMS (the noise: a departure below it changes a prediction by a few percent; the Newey-West
+    errors miss an estimate's errors that repeat with the motion) and :attr:`TermOptions.min_torque`. A law of the
+    load, the angle or the temperature is the same law later; a term that stood in for something else is not. Empty when
     either stretch is too short to fit the model."""
     if min(head.sum(), tail.sum()) <= 2 * X.shape[1]:
         return {}
     X = np.nan_to_num(X)
     fits = [_final(X, y, rows, names, rate_column)[:2] for rows in (head, tail)]
     (c_h, C_h), (c_t, C_t) = fits
-    noise = WEAK * float(np.sqrt(np.mean((y[tail] - X[tail] @ c_t) ** 2)))
+    noise = TERM_WEAK * float(np.sqrt(np.mean((y[tail] - X[tail] @ c_t) ** 2)))
     out: dict[str, tuple[float, float]] = {}
     for term in kept:
         cols = [i for i, n in enumerate(names) if i >= k and _term_of(n) == term]
@@ -453,7 +449,7 @@ class _TemperatureLaw:
         RMS [N·m] (NaN when no rate was searched): the exponential when
         ``options.temperature_law`` asks for it, or (``auto``) when fitted on ``train`` it lowers the held-out RMS
         on ``test`` by more than the tolerance, keeps every level physical, and its rate fitted on every sample is
-        determined (its standard error at most :data:`~wbfriction.friction.status.WEAK` of it: on the ideal
+        determined (its standard error at most :data:`~wbfriction.friction.status.TERM_WEAK` of it: on the ideal
         simulator's noise-free walk, a linear law's knee "improved" by 2 % with a rate of 0.0009 ± 0.0005 /°C)."""
         from scipy.optimize import minimize_scalar
         dT = np.asarray(self.signals.temperature, dtype=float)[self.use] - self.t_ref
@@ -483,7 +479,7 @@ class _TemperatureLaw:
             return 0.0, f"; law linear: {versus}", rms["exponential"]
         _, cov, _ = _final(X, self.y, self.use, names, partial(self.rate_column, rate, names))
         se = float(np.sqrt(max(cov[-1, -1], 0.0)))
-        if not se <= WEAK * abs(rate):
+        if not se <= TERM_WEAK * abs(rate):
             return 0.0, (f"; law linear: the exponential's rate is not determined ({rate:.3g} ±{se:.2g} /°C; "
                          f"{versus})"), rms["exponential"]
         return rate, f"; law exponential: {versus}", rms["exponential"]
@@ -583,6 +579,46 @@ def displaced_part(names: tuple[str, ...], X: np.ndarray, y: np.ndarray, k: int,
         if float(np.sqrt(np.mean((X[:, cols] @ alone[cols]) ** 2))) >= max(options.min_effect * friction,
                                                                             options.min_torque):
             return part
+    return None
+
+
+def _ripple_in_place(kept: list[Term], harmonics: int, displaced: Callable[[tuple[Term, ...], int], str | None],
+                     best_harmonics: Callable[[tuple[Term, ...]], tuple[float, int]]) -> tuple[Term, str] | None:
+    """The ripple and why, when with it a whole part of the velocity model's friction is held at zero where alone
+    it matters (:func:`displaced_part`) and without it not: an angle's torque over part of a turn that follows the
+    direction of motion takes the friction's place, which the data cannot tell apart (the Panda's flange). A law of
+    the load or the temperature that takes all of the Coulomb level is friction still (a Coulomb level
+    proportional to the load), and stays. ``displaced(terms, H)`` and ``best_harmonics(terms)``:
+    :func:`fit_terms`'s."""
+    lost = displaced(tuple(kept), harmonics)
+    others = tuple(t for t in kept if t != "ripple")
+    if lost is None or displaced(others, best_harmonics(others)[1]) is not None:
+        return None
+    return "ripple", (f"with it the velocity model's {lost} friction is held at zero where, fitted without it, it "
+                      "matters: an angle's torque that follows the direction of motion takes the friction's place, "
+                      "which the data cannot tell apart")
+
+
+def _undetermined(names: tuple[str, ...], X: np.ndarray, y: np.ndarray, use: np.ndarray, k: int, kept: list[Term],
+                  harmonics: int, signals: TermSignals) -> tuple[Term, str] | None:
+    """The first kept term no value of which the data determine: each coefficient (the ripple: its size,
+    :func:`ripple_size`) with a standard error (fitted on every sample ``use``, :func:`_final`) above
+    :data:`~wbfriction.friction.status.TERM_WEAK` of its value; None when each is. It lowered the held-out RMS
+    by chance, and would be printed ``weak`` (issue 52: a UR10e shoulder's direction term, dF_v -1.03 ±0.76
+    N·m·s/rad, took the viscous level's place and moved its curve 6 % from the published one)."""
+    coef, cov, _ = _final(X, y, use, names)
+    se = covariance_errors(cov)
+    for term in TERMS:
+        if term not in kept:
+            continue
+        if term == "ripple" and signals.q is not None:
+            values = [ripple_size(np.asarray(signals.q, dtype=float)[use], harmonics, names, coef, cov)]
+        else:
+            values = [(float(coef[i]), float(se[i])) for i, n in enumerate(names) if i >= k and _term_of(n) == term]
+        if values and not any(e <= TERM_WEAK * abs(v) for v, e in values):
+            shown = ", ".join(f"{v:.3g} ±{e:.2g}" for v, e in values)
+            return term, (f"its coefficients are not determined ({shown}: standard errors above "
+                          f"{100 * TERM_WEAK:g} % of the values): it predicts the held-out samples better by chance")
     return None
 
 

@@ -63,7 +63,7 @@ from wbfriction.friction.models import (
     params_from_dict,
 )
 from wbfriction.friction.options import TERMS, Term
-from wbfriction.friction.status import WEAK, FitVerdict, routes_disagree
+from wbfriction.friction.status import TERM_WEAK, FitVerdict, routes_disagree
 
 NOT_DISSIPATIVE: tuple[Term, ...] = ("ripple",)
 """Terms that are not friction: left out of the energy check and of the exports."""
@@ -253,7 +253,7 @@ class TermFit:
           ``term_selection.ripple_size``) more than :data:`~wbfriction.friction.status.ROUTE_Z` combined standard
           errors and :data:`~wbfriction.friction.status.ROUTE_REL` away (:attr:`check`);
         * ``weak``: a coefficient's (the ripple's size's) standard error above
-          :data:`~wbfriction.friction.status.WEAK` of its value;
+          :data:`~wbfriction.friction.status.TERM_WEAK` of its value;
         * ``does not predict`` (issue 52): fitted on the earlier samples, its torque departs on the later ones from
           theirs beyond what the noise and its standard errors allow (:attr:`later`,
           ``term_selection.later_check``);
@@ -267,7 +267,7 @@ class TermFit:
             off = [f"{n} {v:.3g} ±{se:.2g} against {theirs[n][0]:.3g} ±{theirs[n][1]:.2g} ({check.route})"
                    for n, (v, se) in mine.items() if check is not None and n in theirs
                    and routes_disagree(v, se, *theirs[n])]
-            weak = [f"{n} {v:.3g} ±{se:.2g}" for n, (v, se) in mine.items() if not se <= WEAK * abs(v)]
+            weak = [f"{n} {v:.3g} ±{se:.2g}" for n, (v, se) in mine.items() if not se <= TERM_WEAK * abs(v)]
             d, allowed = self.later.get(term, (0.0, math.inf))
             out[term] = (FitVerdict("routes disagree", "; ".join(off)) if off
                          else FitVerdict("weak", "large standard errors: " + ", ".join(weak)) if weak
