@@ -191,7 +191,8 @@ def wiring(monkeypatch, tmp_path):
         calls["fit"] = dict(friction=Path(friction), options=options,
                             threads={i["num_threads"] for i in threadpool_info()}, **kwargs)
         fits, energy, qd, valid, _ = fits_and_samples()
-        return SimpleNamespace(fits=fits, energy=energy, est=SimpleNamespace(qd=qd, valid=valid, temperature=None))
+        return SimpleNamespace(fits=fits, energy=energy, est=SimpleNamespace(qd=qd, valid=valid, temperature=None,
+                                                                          tau=None, tau_f=None))
 
     monkeypatch.setattr("wbfriction.fleet.task.worker_robot", lambda spec: robot)
     monkeypatch.setattr("wbfriction.fleet.task.estimate_file", estimate_file)

@@ -444,10 +444,10 @@ def test_a_coulomb_level_that_is_all_load_keeps_its_load_term():
 
 
 def test_a_ripple_in_the_friction_s_place_is_refused_and_a_load_law_is_not():
-    """``_ripple_in_place``: with the ripple a part of the friction is held at zero and without it not: the ripple
+    """``ripple_in_place``: with the ripple a part of the friction is held at zero and without it not: the ripple
     is refused, naming the part; where the other terms hold it at zero without the ripple (a Coulomb level all
     load), or nothing is held, the ripple is not the cause: None."""
-    from wbfriction.friction.term_selection import _ripple_in_place
+    from wbfriction.friction.term_selection import ripple_in_place
 
     def best(terms):
         return 0.1, 3 if "ripple" in terms else 0
@@ -455,16 +455,16 @@ def test_a_ripple_in_the_friction_s_place_is_refused_and_a_load_law_is_not():
     def held_with_ripple(terms, h):
         return "Coulomb" if "ripple" in terms else None
 
-    bad = _ripple_in_place(["load", "ripple"], 3, held_with_ripple, best)
+    bad = ripple_in_place(["load", "ripple"], 3, held_with_ripple, best)
     assert bad is not None and bad[0] == "ripple" and "Coulomb" in bad[1]
-    assert _ripple_in_place(["load", "ripple"], 3, lambda terms, h: "Coulomb", best) is None
-    assert _ripple_in_place(["ripple"], 3, lambda terms, h: None, best) is None
+    assert ripple_in_place(["load", "ripple"], 3, lambda terms, h: "Coulomb", best) is None
+    assert ripple_in_place(["ripple"], 3, lambda terms, h: None, best) is None
 
 
 def test_a_term_no_value_of_which_is_determined_is_refused():
-    """``_undetermined``: a term whose coefficient's standard error is above half its value (a regressor of noise,
+    """``undetermined_term``: a term whose coefficient's standard error is above half its value (a regressor of noise,
     whose coefficient is noise) is named with its value and error; a term the data determine is not."""
-    from wbfriction.friction.term_selection import _undetermined
+    from wbfriction.friction.term_selection import undetermined_term
 
     rng = np.random.default_rng(1)
     qd = 1.5 * np.sin(np.linspace(0.0, 40.0, 2000))
@@ -473,10 +473,10 @@ def test_a_term_no_value_of_which_is_determined_is_refused():
     y = B @ c + 0.05 * rng.standard_normal(qd.size)
     use = np.ones(qd.size, dtype=bool)
     X = np.column_stack([B, np.abs(qd) * noise])
-    bad = _undetermined((*names, "dF_v"), X, y, use, 3, ["direction"], 0, TermSignals())
+    bad = undetermined_term((*names, "dF_v"), X, y, use, 3, ["direction"], 0, TermSignals())
     assert bad is not None and bad[0] == "direction" and "not determined" in bad[1]
     real = y + 0.3 * np.abs(qd)
-    assert _undetermined((*names, "dF_v"), np.column_stack([B, np.abs(qd)]), real, use, 3, ["direction"], 0,
+    assert undetermined_term((*names, "dF_v"), np.column_stack([B, np.abs(qd)]), real, use, 3, ["direction"], 0,
                          TermSignals()) is None
 
 

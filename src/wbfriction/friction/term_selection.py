@@ -251,8 +251,8 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         bad = _unphysical(with_coefficients(params, coef[:k]), dict(zip(names[k:], map(float, coef[k:]))), signals,
                           use, t_ref or 0.0)  # a friction term that makes the friction generate power (eq. 7.9)
         if bad is None and "ripple" in kept:
-            bad = _ripple_in_place(kept, harmonics, displaced, best_harmonics)
-        bad = bad or _negligible(names, X[use], coef, k, options) or _undetermined(
+            bad = ripple_in_place(kept, harmonics, displaced, best_harmonics)
+        bad = bad or _negligible(names, X[use], coef, k, options) or undetermined_term(
             names, X, y_, use, k, kept, harmonics, signals)
         if bad is None:
             break
@@ -582,7 +582,7 @@ def displaced_part(names: tuple[str, ...], X: np.ndarray, y: np.ndarray, k: int,
     return None
 
 
-def _ripple_in_place(kept: list[Term], harmonics: int, displaced: Callable[[tuple[Term, ...], int], str | None],
+def ripple_in_place(kept: list[Term], harmonics: int, displaced: Callable[[tuple[Term, ...], int], str | None],
                      best_harmonics: Callable[[tuple[Term, ...]], tuple[float, int]]) -> tuple[Term, str] | None:
     """The ripple and why, when with it a whole part of the velocity model's friction is held at zero where alone
     it matters (:func:`displaced_part`) and without it not: an angle's torque over part of a turn that follows the
@@ -599,7 +599,7 @@ def _ripple_in_place(kept: list[Term], harmonics: int, displaced: Callable[[tupl
                       "which the data cannot tell apart")
 
 
-def _undetermined(names: tuple[str, ...], X: np.ndarray, y: np.ndarray, use: np.ndarray, k: int, kept: list[Term],
+def undetermined_term(names: tuple[str, ...], X: np.ndarray, y: np.ndarray, use: np.ndarray, k: int, kept: list[Term],
                   harmonics: int, signals: TermSignals) -> tuple[Term, str] | None:
     """The first kept term no value of which the data determine: each coefficient (the ripple: its size,
     :func:`ripple_size`) with a standard error (fitted on every sample ``use``, :func:`_final`) above

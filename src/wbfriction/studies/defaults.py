@@ -9,6 +9,9 @@ one value and every other at its default, and scores it:
 * ``kuka-lwr4`` (real): the mean over joints of run 3's torque RMS over the peer's (FloBaRoID's method), the route
   identifying on runs 1 and 2; a fit is *good* where it predicts run 3 as its noise and standard errors allow
   (:func:`~wbfriction.friction.predict.other_log_checks`);
+* ``kuka-repeat`` (real): runs 1 and 2 of the same robot (one trajectory run twice) fitted apart, the model
+  identified on both: the mean relative RMS difference of their friction curves (:class:`KukaRepeatCase`); it
+  judges no status;
 * ``ur10e``, ``panda`` (real): the mean of the odd part's relative RMS error against the published curve; a fit
   is *good* within the issue's targets, 5 % and 15 %;
 * ``panda-terms`` (the arm simulator's Panda with a load term and a position ripple on every joint, the studies'
@@ -55,7 +58,7 @@ from wbfriction.logs.log import Log
 from wbfriction.logs.source import read_log
 from wbfriction.model.loading import load_robot
 from wbfriction.model.robot import Robot
-from wbfriction.studies.real_data import curve_scores
+from wbfriction.studies.real_data import curve_scores, odd_friction
 
 Stage = Literal["identify", "estimate", "fit", "status"]
 """Where a knob acts: what must run again for a new value."""
@@ -98,14 +101,16 @@ KNOBS: tuple[Knob, ...] = (
          lambda s, v: replace(s, estimate=replace(s.estimate, noise_target=v))),
     Knob("selection_tolerance", "fit", (0.0, 0.02, 0.05, 0.1), 0.02,
          lambda s, v: replace(s, fit=replace(s.fit, selection_tolerance=v))),
-    Knob("pass_rows", "fit", (0.0, 2.0, 5.0, math.inf), 2.0,
+    Knob("pass_rows", "fit", (0.0, 2.0, 5.0, math.inf), math.inf,
          lambda s, v: replace(s, fit=replace(s.fit, pass_rows=v))),
     Knob("score_slow", "fit", (False, True), True, lambda s, v: replace(s, fit=replace(s.fit, score_slow=v))),
     Knob("terms", "fit", ("none", "auto"), "auto",
          lambda s, v: replace(s, fit=replace(s.fit, terms=TermOptions() if v == "auto" else TermOptions(terms=())))),
     Knob("term_min_torque", "fit", (0.005, 0.01, 0.02), 0.01,
          lambda s, v: replace(s, fit=replace(s.fit, terms=replace(s.fit.terms, min_torque=v)))),
-    Knob("weak", "status", (0.25, 0.5, 1.0), 0.5, _thresholds("weak")),
+    Knob("term_tolerance", "fit", (0.01, 0.02, 0.05), 0.02,
+         lambda s, v: replace(s, fit=replace(s.fit, terms=replace(s.fit.terms, tolerance=v)))),
+    Knob("weak", "status", (0.125, 0.25, 0.5), 0.25, _thresholds("weak")),
     Knob("holdout_excess", "status", (0.02, 0.05, 0.1, 0.2), 0.05, _thresholds("holdout_excess")),
     Knob("holdout_friction", "status", (0.02, 0.05, 0.1), 0.05, _thresholds("holdout_friction")),
     Knob("route_rel", "status", (0.02, 0.05, 0.1), 0.02, _thresholds("route_rel")),
@@ -146,6 +151,8 @@ class Fitted:
     fits: list[FitResult]
     robot: Robot
     held_out: FrictionEstimate | None = None
+    held_out_fits: list[FitResult] | None = None
+    """The held-out estimate fitted alone (the cases that compare two fits), else None."""
 
 
 class Case(ABC):
@@ -155,6 +162,9 @@ class Case(ABC):
     kind: Literal["real", "sim"]
     identifies: bool = False
     armature: ArmatureMode = "none"
+    judges_statuses: bool = True
+    """Whether its fits, judged good or not, score the statuses' thresholds (a case that compares two fits has no
+    truth to judge one by)."""
 
     def __init__(self, folder: Path):
         self.folder = folder / self.name
@@ -216,8 +226,13 @@ class RealCase(Case):
     _given: Robot
     _logs: tuple[Log, Log | None]
 
+    @property
+    def dataset(self) -> str:
+        """The dataset's name (:func:`~wbfriction.datasets.write_dataset`)."""
+        return self.name
+
     def prepare(self) -> None:
-        self.written = write_dataset(self.name, self.folder)
+        self.written = write_dataset(self.dataset, self.folder)
         self._given = load_robot(config=self.written.config)
         held = self.written.logs.get("held_out")
         self._logs = (read_log(self.written.logs["train"], self._given),
@@ -248,6 +263,54 @@ class KukaCase(RealCase):
         judged = tuple(Judged(j, _status(fits[j], thresholds), c is not None and c.predicts, float(r / p))
                        for j, r, p, c in zip(fitted.held_out.joints, rms, peer, checks))
         return CaseScore(float(np.mean(rms / peer)), judged)
+
+
+class KukaRepeatCase(KukaCase):
+    """FloBaRoID's KUKA LWR4+ runs 1 and 2 (one trajectory run twice, half an hour apart), each fitted alone with
+    the model identified on both: the loss is the mean over joints of the two fits' friction curves' relative RMS
+    difference over run 2's samples moving faster than :data:`REPEAT_SPEED` (:func:`~wbfriction.studies.real_data.
+    odd_friction`): a default that makes a fit follow one log's accidents shows as two runs that disagree. No
+    truth judges one fit: the statuses' thresholds are not scored on it."""
+
+    name = "kuka-repeat"
+    judges_statuses = False
+
+    @property
+    def dataset(self) -> str:
+        return KukaCase.name
+
+    def prepare(self) -> None:
+        super().prepare()
+        runs = self._logs[0]  # runs 1 and 2, the half hour between them its longest step
+        cut = int(np.argmax(np.diff(runs.time))) + 1
+        self._runs = (runs.rows(0, cut), runs.rows(cut, len(runs)))
+
+    def fitted(self, setting: Setting) -> Fitted:
+        key = (setting.inertial, setting.estimate, setting.fit)
+        if key not in self._fitted:
+            robot = self.model(setting)
+            est = [estimate_log(robot, run, setting.estimate) for run in self._runs]
+            fits = [fit_estimate(e, setting.fit, workers=2) for e in est]
+            self._fitted[key] = Fitted(est[0], fits[0], robot, est[1], fits[1])
+        return self._fitted[key]
+
+    def score(self, fitted: Fitted, thresholds: StatusThresholds) -> CaseScore:
+        assert fitted.held_out is not None and fitted.held_out_fits is not None
+        est = fitted.held_out
+        judged = []
+        for k, (one, two) in enumerate(zip(fitted.fits, fitted.held_out_fits)):
+            use = est.valid[:, k] & (np.abs(est.qd[:, k]) >= REPEAT_SPEED)
+            if one.params is None or two.params is None or not use.any():
+                continue
+            a, b = odd_friction(one, est, k, use)[0], odd_friction(two, est, k, use)[0]
+            error = float(np.sqrt(np.mean((a - b) ** 2) / np.mean((0.5 * (a + b)) ** 2)))
+            judged.append(Judged(two.joint, _status(two, thresholds), bool(error <= 0.15), error))
+        return CaseScore(float(np.mean([j.error for j in judged])), tuple(judged))
+
+
+REPEAT_SPEED = 0.05
+"""The speed [rad/s] above which two runs' friction curves are compared (:class:`KukaRepeatCase`): below it a
+joint may stick."""
 
 
 class CurveCase(RealCase):
@@ -398,8 +461,8 @@ class PandaTermsCase(SimCase):
         return CaseScore(float(np.mean(ratio)), judged)
 
 
-CASES: tuple[type[Case], ...] = (KukaCase, Ur10eCase, PandaCase, PandaSimCase, PandaTermsCase, TalosIdealCase,
-                                 TalosMujocoCase)
+CASES: tuple[type[Case], ...] = (KukaCase, KukaRepeatCase, Ur10eCase, PandaCase, PandaSimCase, PandaTermsCase,
+                                 TalosIdealCase, TalosMujocoCase)
 """Every case, real first."""
 
 
@@ -478,6 +541,8 @@ def run_study(folder: Path, knobs: Sequence[Knob] = KNOBS, cases: Sequence[type[
             setting = knob.set(Setting(), value)
             losses[value] = {}
             for case in built:
+                if knob.stage == "status" and not case.judges_statuses:
+                    continue
                 say(f"{knob.name} = {value}: {case.name}")
                 score = case.score(case.fitted(setting), setting.thresholds)
                 losses[value][case.name] = score.misjudged() if knob.stage == "status" else score.loss
@@ -513,5 +578,5 @@ def as_json(choices: Sequence[KnobChoice]) -> list[dict[str, Any]]:
              "left_out": {k: [str(v), r] for k, (v, r) in c.left_out.items()}} for c in choices]
 
 
-__all__ = ["CASES", "KNOBS", "Case", "CaseScore", "Judged", "Knob", "KnobChoice", "Setting", "as_json", "choose",
-           "markdown", "run_study"]
+__all__ = ["CASES", "KNOBS", "Case", "CaseScore", "Judged", "Knob", "KnobChoice", "KukaRepeatCase", "Setting",
+           "as_json", "choose", "markdown", "run_study"]

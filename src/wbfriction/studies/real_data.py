@@ -126,27 +126,32 @@ SPEED_BIN = 0.05
 """Width of the speed bins [rad/s] a fit with terms is averaged over (:func:`curve_scores`)."""
 
 
+def odd_friction(fit: FitResult, est: FrictionEstimate, k: int, use: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The friction of ``fit`` (with parameters) at the samples ``use`` of joint column ``k`` of ``est`` [N·m], and
+    its standard errors: its model's odd part ``(f(qd) - f(-qd)) / 2``, or, where it kept terms beyond velocity,
+    what its model gives at each sample less its offset (the load, direction and temperature of that sample; the
+    ripple, no friction, left out) averaged over the samples of each speed (bins of :data:`SPEED_BIN`, each way): a
+    published model of the velocity alone is such an average over its log's loads; no standard error then (NaN)."""
+    v = est.qd[use, k]
+    terms = fit.kept_terms
+    if terms is None:
+        return fit.dissipative(v)
+    at_samples = (terms.friction(est.qd[:, k], term_signals(est, k)) - terms.params.tau_os)[use]
+    bins = np.floor(v / SPEED_BIN).astype(int)
+    _, index = np.unique(bins, return_inverse=True)
+    mine = (np.bincount(index, at_samples) / np.bincount(index))[index]  # each speed's mean over its loads
+    return mine, np.full(v.shape, np.nan)
+
+
 def curve_scores(fit: FitResult, est: FrictionEstimate, k: int, ref: Reference) -> tuple[float, float]:
     """The fit's friction against the published curve's odd part over the samples of joint column ``k`` of ``est``
     it was fitted on, with ``|qd| >= ref.min_speed``: (relative RMS error, RMS deviation in the fit's standard
-    errors). The fit's friction is its model's odd part ``(f(qd) - f(-qd)) / 2``, or, where it kept terms beyond
-    velocity, what its model gives at each sample less its offset (the load, direction and temperature of that
-    sample; the ripple, no friction, left out) averaged over the samples of each speed (bins of :data:`SPEED_BIN`,
-    each way): a published model of the velocity alone is such an average over its log's loads; no standard error
-    then (NaN)."""
+    errors). The fit's friction is :func:`odd_friction`'s; no standard error where it kept terms (NaN)."""
     use = est.valid[:, k] & (np.abs(est.qd[:, k]) >= ref.min_speed)
     v = est.qd[use, k]
     if fit.params is None or v.size == 0:
         return float("nan"), float("nan")
-    terms = fit.kept_terms
-    if terms is None:
-        mine, se = fit.dissipative(v)
-    else:
-        at_samples = (terms.friction(est.qd[:, k], term_signals(est, k)) - terms.params.tau_os)[use]
-        bins = np.floor(v / SPEED_BIN).astype(int)
-        _, index = np.unique(bins, return_inverse=True)
-        mine = (np.bincount(index, at_samples) / np.bincount(index))[index]  # each speed's mean over its loads
-        se = np.full(v.shape, np.nan)
+    mine, se = odd_friction(fit, est, k, use)
     published = ref.odd(fit.joint, v)
     error = float(np.sqrt(np.mean((mine - published) ** 2) / np.mean(published**2)))
     sigmas = float(np.sqrt(np.mean(((mine - published) / se) ** 2))) if np.all(se > 0) else float("nan")
@@ -252,5 +257,5 @@ def summarise(run: DatasetRun, max_error: float) -> Summary:
                    sum(1 for j in peers if j.held_out < j.peer), len(peers), run.seconds)
 
 
-__all__ = ["DatasetRun", "JointScore", "Outputs", "Summary", "Timed", "curve_scores", "outputs", "run_dataset",
-           "run_route", "score", "summarise"]
+__all__ = ["DatasetRun", "JointScore", "Outputs", "Summary", "Timed", "curve_scores", "odd_friction", "outputs",
+           "run_dataset", "run_route", "score", "summarise"]
