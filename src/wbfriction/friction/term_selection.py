@@ -600,7 +600,7 @@ def ripple_in_place(kept: list[Term], harmonics: int, displaced: Callable[[tuple
 
 
 def undetermined_term(names: tuple[str, ...], X: np.ndarray, y: np.ndarray, use: np.ndarray, k: int, kept: list[Term],
-                  harmonics: int, signals: TermSignals) -> tuple[Term, str] | None:
+                      harmonics: int, signals: TermSignals) -> tuple[Term, str] | None:
     """The first kept term no value of which the data determine: each coefficient (the ripple: its size,
     :func:`ripple_size`) with a standard error (fitted on every sample ``use``, :func:`_final`) above
     :data:`~wbfriction.friction.status.TERM_WEAK` of its value; None when each is. It lowered the held-out RMS

@@ -268,9 +268,9 @@ class KukaCase(RealCase):
 class KukaRepeatCase(KukaCase):
     """FloBaRoID's KUKA LWR4+ runs 1 and 2 (one trajectory run twice, half an hour apart), each fitted alone with
     the model identified on both: the loss is the mean over joints of the two fits' friction curves' relative RMS
-    difference over run 2's samples moving faster than :data:`REPEAT_SPEED` (:func:`~wbfriction.studies.real_data.
-    odd_friction`): a default that makes a fit follow one log's accidents shows as two runs that disagree. No
-    truth judges one fit: the statuses' thresholds are not scored on it."""
+    difference over run 2's samples moving faster than :data:`REPEAT_SPEED`
+    (:func:`~wbfriction.studies.real_data.odd_friction`): a default that makes a fit follow one log's accidents
+    shows as two runs that disagree. No truth judges one fit: the statuses' thresholds are not scored on it."""
 
     name = "kuka-repeat"
     judges_statuses = False
