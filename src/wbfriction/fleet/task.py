@@ -29,7 +29,7 @@ from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.fit import FitResult
-from wbfriction.friction.terms import TermFit
+from wbfriction.friction.terms import TermFit, load_torque
 from wbfriction.logs.tables import file_sha256, scratch_folder
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import Chunking
@@ -131,8 +131,7 @@ def process_log(entry: LogEntry, key: ResultKey, options: BatchOptions, scratch:
             fitted = fit_table(friction, options.fit, threshold=options.energy_threshold,
                                tolerance=options.energy_tolerance)
         est = fitted.est
-        rows = result_rows(key, fitted.fits, fitted.energy, est.qd, est.valid, est.temperature,
-                           None if est.tau is None else est.tau + est.tau_f)
+        rows = result_rows(key, fitted.fits, fitted.energy, est.qd, est.valid, est.temperature, load_torque(est))
         return LogOutcome(entry, key, rows, table=table)
     except OutputError as exc:  # the results cannot be written: no other log's either, the batch stops
         where = table if table is not None else f"{scratch} (the friction table of {entry.log.name})"
@@ -162,11 +161,12 @@ def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy]
     """The rows of the log of ``key`` (:data:`~wbfriction.fleet.schema.RESULT_SCHEMA`), one per joint of ``fits``;
     ``qd`` (N, n_tc) [rad/s] and ``valid`` (N, n_tc) of the estimate give each joint's velocity range,
     ``temperature`` (N, n_tc) [°C] (or None) its temperature, ``load`` (N, n_tc) [N·m] (or None) the rigid-body
-    torque ``tau + tau_f`` the load term reads. A fit with terms beyond velocity gives its velocity model refitted
-    with them (``F_c``, ``F_v``: at zero load and its reference temperature, without the ripple); its ``f_at_<v>``
-    is the friction under the log's mean ``|load|`` (zero without ``load``): the level a velocity model alone
-    fits, whichever terms a log keeps (issue 52: the KUKA's repeated wrist run kept a load term in one log and not
-    the other, and at zero load its friction at 0.3 rad/s read 0.18 N·m against the other log's 0.30)."""
+    torque the load term reads (:func:`~wbfriction.friction.terms.load_torque`). A fit with terms beyond velocity
+    gives its velocity model refitted with them (``F_c``, ``F_v``: at zero load and its reference temperature,
+    without the ripple); its ``f_at_<v>`` is the friction under the log's mean ``|load|`` (zero without ``load``):
+    the level a velocity model alone fits, whichever terms a log keeps (issue 52: the KUKA's repeated wrist run kept
+    a load term in one log and not the other, and at zero load its friction at 0.3 rad/s read 0.18 N·m against the
+    other log's 0.30)."""
     shares = {e.joint: e.generating_share for e in energy}
     columns: dict[str, list] = {name: [] for name in RESULT_SCHEMA.names}
     for i, fit in enumerate(fits):

@@ -90,16 +90,22 @@ class TermSignals:
         return tuple(t for t in TERMS if have[t])
 
 
+def load_torque(est: FrictionEstimate) -> np.ndarray | None:
+    """The load term's signal of every column (N, n_tc) [N·m]: the rigid-body torque ``M qdd + h = tau + tau_f``
+    (the sign convention's, :mod:`~wbfriction.friction.estimate`; NaN where the friction is not estimated), not the
+    measured torque, which holds the friction itself (a drive's current does); None without measured torques."""
+    return None if est.tau is None else est.tau + est.tau_f
+
+
 def term_signals(est: FrictionEstimate, joint: int) -> TermSignals:
-    """The terms' signals of column ``joint`` of an estimate: its ``q``; the rigid-body torque
-    ``M qdd + h = tau + tau_f`` (the sign convention's, :mod:`~wbfriction.friction.estimate`) as the load (NaN where
-    the friction is not estimated; not the measured torque, which holds the friction itself: a drive's current does);
-    its ``temperature`` (a column all NaN: not logged)."""
+    """The terms' signals of column ``joint`` of an estimate: its ``q``; its load (:func:`load_torque`); its
+    ``temperature`` (a column all NaN: not logged)."""
     temperature = None if est.temperature is None else est.temperature[:, joint]
     if temperature is not None and np.all(np.isnan(temperature)):
         temperature = None
-    return TermSignals(None if est.q is None else est.q[:, joint],
-                       None if est.tau is None else est.tau[:, joint] + est.tau_f[:, joint], temperature)
+    load = load_torque(est)
+    return TermSignals(None if est.q is None else est.q[:, joint], None if load is None else load[:, joint],
+                       temperature)
 
 
 SIGNAL_COLUMNS: dict[Term, str] = {"load": "tau", "ripple": "q", "temperature": "temperature"}

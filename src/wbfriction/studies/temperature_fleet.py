@@ -115,6 +115,7 @@ def temperature_fleet(plan: TemperatureFleet = TemperatureFleet()) -> pa.Table:
     from wbfriction.friction.estimated import FrictionEstimate
     from wbfriction.friction.fit import fit_estimate
     from wbfriction.friction.options import FitOptions
+    from wbfriction.friction.terms import load_torque
 
     rng = np.random.default_rng([plan.seed, 2])
     wear = plan.wear()
@@ -144,8 +145,7 @@ def temperature_fleet(plan: TemperatureFleet = TemperatureFleet()) -> pa.Table:
                                    temperature=np.column_stack(temperature))
             fits = fit_estimate(est, FitOptions(model="coulomb-viscous"))
             key = ResultKey(robot_id, start + timedelta(days=i), f"{robot_id}/{i:03d}.parquet", "", "", "")
-            parts.append(result_rows(key, fits, [], est.qd, est.valid, est.temperature,
-                                     None if est.tau is None else est.tau + est.tau_f))
+            parts.append(result_rows(key, fits, [], est.qd, est.valid, est.temperature, load_torque(est)))
     return pa.concat_tables(parts)
 
 
