@@ -36,6 +36,8 @@ from wbfriction.friction.regression import (
 )
 from wbfriction.friction.status import MIN_SPEED, ROUTE_Z, TERM_WEAK
 from wbfriction.friction.terms import (
+    NOT_TRIED,
+    SIGNAL_COLUMNS,
     TERM_COEFFICIENTS,
     TermCheck,
     TermFit,
@@ -193,7 +195,8 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
 
     base_rms = score((), 0)
     tol = options.tolerance
-    reasons: dict[str, str] = {}
+    reasons: dict[str, str] = {term: f"{NOT_TRIED}: no {SIGNAL_COLUMNS[term]}.<joint> column for this joint"
+                               for term in options.terms if term not in candidates}
     gains: dict[tuple[Term, tuple[Term, ...]], float] = {}
 
     def carry_over(term: Term, others: tuple[Term, ...]) -> float:

@@ -110,6 +110,8 @@ def term_signals(est: FrictionEstimate, joint: int) -> TermSignals:
 
 SIGNAL_COLUMNS: dict[Term, str] = {"load": "tau", "ripple": "q", "temperature": "temperature"}
 """The friction table's column (``<name>.<joint>``) each term's signal is read from."""
+NOT_TRIED = "not tried"
+"""How a term's reason starts where the table lacks its signal (:data:`SIGNAL_COLUMNS`)."""
 
 
 def coulomb_shape(params: ModelParams, qd: np.ndarray) -> np.ndarray:
