@@ -48,10 +48,10 @@ def synthetic_results():
 
 
 def write_synthetic_results(results: Path, logs: int, robot_id: str = "r1", joints: tuple[str, ...] = ("j0", "j1"),
-                            F_c=lambda i: 1.0) -> list[Path]:
+                            F_c=lambda i: 1.0, temperature=lambda i: float("nan")) -> list[Path]:
     """A results folder of ``logs`` logs of one robot, one a day, written as a batch writes them
     (:func:`~wbfriction.fleet.results.write_part`), each joint's F_c (and friction at 0.3 rad/s) ``F_c(i)`` with a
-    2 % standard error; the files, in log order."""
+    2 % standard error, its temperature ``temperature(i)`` [°C]; the files, in log order."""
     from datetime import UTC, datetime, timedelta
 
     import pyarrow as pa
@@ -69,7 +69,7 @@ def write_synthetic_results(results: Path, logs: int, robot_id: str = "r1", join
                        log_sha256=f"{robot_id}{i}", robot_sha256="", options_sha256="", joint=joint, model="thesis",
                        route="acceleration",
                        status="ok", n_samples=1000, version="test", F_c=F_c(i), F_c_se=0.02 * F_c(i),
-                       **{"f_at_0.3": F_c(i), "f_at_0.3_se": 0.02 * F_c(i)})
+                       temperature=temperature(i), **{"f_at_0.3": F_c(i), "f_at_0.3_se": 0.02 * F_c(i)})
             for name in RESULT_SCHEMA.names:
                 rows[name].append(row[name])
         paths.append(write_part(results, pa.Table.from_pydict(rows, schema=RESULT_SCHEMA)))

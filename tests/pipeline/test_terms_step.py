@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
@@ -101,3 +102,71 @@ def test_bad_terms_and_missing_signals_are_refused_in_one_line(logs, capsys, tmp
     pq.write_table(table.drop_columns([c for c in table.column_names if c.startswith("q.")]), old)
     code, err = run_cli(capsys, "predict", old, "--params", params)
     assert code == 2 and "q.panda_joint6" in err and "ripple" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_glitched_temperature_is_named_and_the_term_still_kept(logs, capsys, tmp_path):
+    """Issue 53: one sample of 6553.5 °C threw the true temperature term out with a false reason ("held-out samples
+    do not improve") and was never named. Read, it is left out and named (file, column, row, value); the term is kept
+    with the truth's coefficients."""
+    folder, _ = logs
+    table = pq.read_table(folder / "log0.parquet")
+    T = table.column("temperature.panda_joint4").to_numpy().copy()
+    T[4321] = 6553.5
+    glitched = tmp_path / "glitched.parquet"
+    pq.write_table(table.set_column(table.column_names.index("temperature.panda_joint4"),
+                                    "temperature.panda_joint4", pa.array(T)), glitched)
+    friction = tmp_path / "friction.parquet"
+    res = run("estimate", glitched, "--robot", "panda", "--diff", "central", "--route", "acceleration", "-o", friction)
+    assert res.returncode == 0, res.stderr
+    assert "temperature.panda_joint4" in res.stderr and "row 4321" in res.stderr and "6553.5 °C" in res.stderr
+    params = tmp_path / "p.json"
+    assert run_cli(capsys, "fit", friction, "-o", params, "--terms", "load,temperature",
+                   "--reference-temperature", T_REF)[0] == 0
+    fit = read_params(params)["panda_joint4"].terms
+    assert fit is not None and set(fit.kept) == {"load", "temperature"}, fit.reasons
+    assert fit.coefficients["F_cT"] == pytest.approx(-0.008, rel=0.1)
+
+
+def test_a_log_in_kelvin_is_refused_before_the_work(logs, tmp_path):
+    folder, _ = logs
+    table = pq.read_table(folder / "log0.parquet")
+    i = table.column_names.index("temperature.panda_joint4")
+    kelvin = tmp_path / "kelvin.parquet"
+    pq.write_table(table.set_column(i, "temperature.panda_joint4",
+                                    pa.array(table.column(i).to_numpy() + 273.15)), kelvin)
+    res = run("estimate", kelvin, "--robot", "panda", "-o", tmp_path / "f.parquet")
+    assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1, res.stderr
+    assert "temperature.panda_joint4" in res.stderr and "kelvin" in res.stderr
+    assert not (tmp_path / "f.parquet").exists()
+
+
+def test_a_term_whose_signal_the_table_lacks_is_said_not_tried(logs, capsys, tmp_path):
+    """Issue 53: ``--terms temperature`` on a table without temperatures exited 0 with "held-out samples do not
+    improve" and empty reasons."""
+    _, tables = logs
+    table = pq.read_table(tables[0])
+    bare = tmp_path / "bare.parquet"
+    pq.write_table(table.drop_columns([c for c in table.column_names if c.startswith("temperature.")]), bare)
+    code, printed, err = run_cli_printed(capsys, "fit", bare, "-o", tmp_path / "p.json", "--terms", "temperature")
+    words = " ".join((printed + err).split())
+    assert code == 0 and "temperature not tried on 7 joints" in words and "no temperature.<joint> column" in words
+    assert "do not improve" not in words
+    reasons = read_params(tmp_path / "p.json")["panda_joint4"].terms.reasons
+    assert reasons == {"temperature": "not tried: no temperature.<joint> column for this joint"}
+
+
+@pytest.mark.parametrize("args, option", [
+    (["--reference-temperature", "nan"], "--reference-temperature"),
+    (["--reference-temperature", "-300"], "--reference-temperature"),
+    (["--reference-temperature", "1e6"], "--reference-temperature"),
+    (["--terms", "load", "--reference-temperature", "40"], "--reference-temperature"),
+    (["--terms", "none", "--temperature-law", "linear"], "--temperature-law"),
+    (["--terms", "load,temperature", "--max-harmonic", "6"], "--max-harmonic"),
+])
+def test_term_options_that_would_be_dropped_or_no_joint_has_are_refused(logs, capsys, tmp_path, args, option):
+    """Issue 53: ``--reference-temperature nan`` wrote NaN into the JSON; an option of a term not tried was
+    dropped without a word."""
+    _, tables = logs
+    code, err = run_cli(capsys, "fit", tables[0], "-o", tmp_path / "p.json", *args)
+    assert code == 2 and option in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "p.json").exists()

@@ -17,7 +17,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
-from wbfriction.exceptions import InputError, WbfrictionError
+from wbfriction.exceptions import InputError, OptionError, WbfrictionError
 from wbfriction.friction.options import (
     DEFAULT_THRESHOLD,
     DEFAULT_TOLERANCE,
@@ -192,10 +192,19 @@ def term_options(terms: str, max_harmonic: int, reference_temperature: float | N
     ``--max-harmonic``, ``--reference-temperature`` and ``--temperature-law``.
 
     Raises:
-        OptionError: an unknown term (:class:`~wbfriction.friction.options.TermOptions`).
+        OptionError: an unknown term (:class:`~wbfriction.friction.options.TermOptions`), a reference temperature
+            no joint has, or an option of a term not tried (``--max-harmonic`` without the ripple,
+            ``--reference-temperature`` or ``--temperature-law`` without the temperature term).
     """
     names = (TERMS if terms.strip() in ("all", "auto") else () if terms.strip() == "none"
              else tuple(t.strip() for t in terms.split(",") if t.strip()))
+    # an option of a term not tried would be dropped without a word
+    if max_harmonic != FIT.terms.max_harmonic and "ripple" not in names:
+        raise OptionError("--max-harmonic", max_harmonic, f"left out without the ripple term (--terms {terms})")
+    for option, value, default in (("--reference-temperature", reference_temperature, None),
+                                   ("--temperature-law", temperature_law, FIT.terms.temperature_law)):
+        if value != default and "temperature" not in names:
+            raise OptionError(option, value, f"left out without the temperature term (--terms {terms})")
     return TermOptions(terms=cast(tuple[Term, ...], names), max_harmonic=max_harmonic,
                        reference_temperature=reference_temperature, temperature_law=temperature_law)
 

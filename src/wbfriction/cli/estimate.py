@@ -12,6 +12,7 @@ from rich.table import Table
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.exceptions import OptionError
 from wbfriction.friction.options import (
     BaseMotion,
     EstimateOptions,
@@ -191,6 +192,9 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                            filtering=FilterOptions(window=window, poly_order=poly_order,
                                                    weights=weights,
                                                    cutoff=cutoff, butter_order=butter_order))
+    if companion and opts.route == "momentum":
+        raise OptionError("--companion", True, "left out with --route momentum (the companion is the acceleration "
+                          "route's other differentiation)")
     spec = RobotSpec.given(robot, urdf, config, mjcf)
     _run_estimate(spec.load(), spec, log, output, opts, bag_map, max_gap, limit_margin, workers,
                   chunk_rows, time_base, time_unit, companion)

@@ -162,6 +162,14 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
         write_trends_html(found, output, title)
         if table is not None:
             write_table(found.to_table(), table)
+    notes = found.temperature_notes()
+    if notes:
+        robot_id, joint, quantity, note = notes[0]
+        joints = len({(r, j) for r, j, _, _ in notes})
+        console.print(f"[yellow]note:[/] temperature left out of {len(notes)} series on {joints} joint"
+                      f"{'s' if joints > 1 else ''} (first {escape(robot_id)} {escape(joint)} {quantity}: "
+                      f"{note.removeprefix('temperature left out: ')}); --table writes each series' temperature_note",
+                      highlight=False, soft_wrap=True)
     for j in found.flagged:
         cp = j.drifts[0]
         size = (f"{100 * cp.relative:+.1f} %" if not math.isnan(cp.relative)

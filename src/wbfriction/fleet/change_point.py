@@ -94,6 +94,8 @@ class ChangePoint:
             temperatures entered the test (:func:`detect_change`); None: they did not.
         temperature_slope, temperature_slope_se: the value's change per °C found with the change, and its standard
             error (NaN without temperatures).
+        temperature_note: why the series' temperatures did not enter its test although it has some (some logs
+            without one; temperatures that cannot be told from a change, :func:`confounded_onset`), or "".
     """
 
     quantity: str
@@ -109,6 +111,7 @@ class ChangePoint:
     reference_temperature: float | None = None
     temperature_slope: float = float("nan")
     temperature_slope_se: float = float("nan")
+    temperature_note: str = ""
 
 
 def _regressor(shape: Shape, t: np.ndarray, k: int) -> np.ndarray:
@@ -125,6 +128,15 @@ def _change_columns(shape: Shape, t: np.ndarray, k: int, w: np.ndarray, covariat
     x = _regressor(shape, t, k)
     columns = [x * w] + ([] if covariates is None else [x * c * w for c in np.atleast_2d(covariates.T)])
     return np.column_stack(columns)
+
+
+def candidate_onsets(t: np.ndarray, min_before: int, min_after: int, shape: Shape) -> np.ndarray:
+    """The candidate onsets (c,) of one shape on times ``t`` (n,): ``min_before`` logs before, ``min_after`` from
+    it on; not a hinge from the last log's time (zero at every log), nor a step between two logs at one time."""
+    onsets = np.arange(min_before, t.size - min_after + 1)
+    if shape == "hinge":
+        return onsets[t[-1] > t[onsets - 1]]
+    return onsets[t[onsets] > t[onsets - 1]]
 
 
 def change_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, min_after: int,
@@ -156,11 +168,7 @@ def change_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, m
     rss0 = np.einsum("ij,ij->j", r0, r0)
     dof = n - 2 * Z.shape[1]
     yy = np.einsum("ij,ij->j", Y, Y)
-    onsets = np.arange(min_before, n - min_after + 1)
-    if shape == "hinge":
-        onsets = onsets[t[-1] > t[onsets - 1]]  # a hinge from the last log's time is no regressor (logs at one time)
-    else:
-        onsets = onsets[t[onsets] > t[onsets - 1]]  # a step between logs at one time is no change in time
+    onsets = candidate_onsets(t, min_before, min_after, shape)
     F = np.empty((onsets.size, Y.shape[1]))
     coef = np.empty((onsets.size, 2 * Z.shape[1], Y.shape[1]))  # [1, covariates] and the change's as many
     for c, k in enumerate(onsets):
@@ -210,6 +218,30 @@ def null_p_value(t: np.ndarray, se: np.ndarray, statistic: float, options: Chang
     return (1 + hits) / (1 + draws)
 
 
+COLLINEAR = 1e-8
+"""A design whose smallest singular value, its columns scaled to unit length, is below this share of its largest has
+columns that one another make: its coefficients are not determined (:func:`confounded_onset`)."""
+
+
+def confounded_onset(t: np.ndarray, se: np.ndarray, covariates: np.ndarray, options: ChangeSettings) -> int | None:
+    """The first candidate onset (over :attr:`ChangeSettings.shapes`) at which the covariates cannot be told from the
+    change: the test's design ``[1, covariates, x_k, x_k covariates]`` is singular (:data:`COLLINEAR`). Temperatures
+    that take one value before the onset and another after it (two seasons, a lab moved) are a step; temperatures
+    that follow the time are a hinge. None: every onset's design is regular."""
+    w = 1.0 / se
+    Z = np.column_stack([w] + [c * w for c in np.atleast_2d(covariates.T)])
+    for shape in options.shapes:
+        for k in candidate_onsets(t, options.min_before, options.min_after, shape):
+            X = np.column_stack([Z, _change_columns(shape, t, int(k), w, covariates)])
+            norms = np.linalg.norm(X, axis=0)
+            if np.any(norms == 0.0):
+                return int(k)
+            sv = np.linalg.svd(X / norms, compute_uv=False)
+            if sv[-1] < COLLINEAR * sv[0]:
+                return int(k)
+    return None
+
+
 BLOCK = 50_000
 """Noise series drawn at a time after the first pass."""
 
@@ -234,7 +266,9 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
             one and they spread by :data:`TEMPERATURE_SPREAD` or more, the value's linear dependence on it enters
             both models (Bittencourt & Axelsson 2014: temperature changes friction more than wear does): the
             baseline and the change are then those at ``reference_temperature`` (default: the points' median),
-            stated in :attr:`ChangePoint.reference_temperature` with the slope found.
+            stated in :attr:`ChangePoint.reference_temperature` with the slope found. Where some points have none,
+            or the temperatures cannot be told from a change (:func:`confounded_onset`), they are left out and
+            :attr:`ChangePoint.temperature_note` says why.
     """
     ok = np.isfinite(y) & np.isfinite(se) & (se > 0)
     idx = np.flatnonzero(ok)
@@ -243,11 +277,19 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
     t0 = time[idx[0]]
     t = np.array([(time[i] - t0).total_seconds() / DAY for i in idx])
     yy, ss = y[idx], se[idx]
-    covariates, t_ref = None, None
-    if temperature is not None and np.all(np.isfinite(temperature[idx])) \
-            and float(np.std(temperature[idx])) >= TEMPERATURE_SPREAD:
+    covariates, t_ref, note = None, None, ""
+    logged = None if temperature is None else np.isfinite(temperature[idx])
+    if logged is not None and logged.any() and not logged.all():
+        note = (f"temperature left out: {int((~logged).sum())} of its {idx.size} logs have none (each value is "
+                "compared at no one temperature)")
+    elif logged is not None and logged.all() and float(np.std(temperature[idx])) >= TEMPERATURE_SPREAD:
         t_ref = float(np.median(temperature[idx])) if reference_temperature is None else reference_temperature
         covariates = (temperature[idx] - t_ref)[:, None]
+        k = confounded_onset(t, ss, covariates, options)
+        if k is not None:
+            note = (f"temperature left out: it cannot be told from a change at {time[idx[k]]:%Y-%m-%d} (the logs' "
+                    "temperatures step or drift with the time there)")
+            covariates, t_ref = None, None
     best: tuple[float, Shape, int, np.ndarray] | None = None
     for shape in options.shapes:
         onsets, F, coef = change_scan(t, yy, ss, options.min_before, options.min_after, shape, covariates)
@@ -277,4 +319,4 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
     slope = (float(b[1]), float(np.sqrt(cov[1, 1]))) if covariates is not None else (float("nan"), float("nan"))
     return ChangePoint(quantity, int(idx[k]), time[idx[k]], base, change,
                        float(np.sqrt(cov[at, at]) * at_last), statistic, float(p),
-                       change / ref if ref > 0 else float("nan"), shape, t_ref, *slope)
+                       change / ref if ref > 0 else float("nan"), shape, t_ref, *slope, note)

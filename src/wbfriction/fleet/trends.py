@@ -40,6 +40,7 @@ from wbfriction.exceptions import InputError, OptionError
 from wbfriction.fleet.change_point import FIRST_PASS, ChangePoint, detect_change
 from wbfriction.fleet.options import SHAPES, Shape
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
+from wbfriction.logs.temperature import check_reference_temperature
 
 QUANTITIES: tuple[str, ...] = (*TREND_PARAMS, *[speed_column(v) for v in REFERENCE_SPEEDS])
 """The quantities followed over time: the model's parameters and the friction at the reference speeds."""
@@ -97,6 +98,10 @@ class TrendOptions:
         unknown = set(self.quantities) - set(QUANTITIES)
         if unknown:
             raise InputError(f"unknown quantities {sorted(unknown)}: choose from {', '.join(QUANTITIES)}")
+        check_reference_temperature(self.reference_temperature)
+        if not self.temperature and self.reference_temperature is not None:
+            raise OptionError("--reference-temperature", self.reference_temperature,
+                              "left out with --no-temperature (no value is compared at a temperature then)")
         need = self.least_replicates()
         if self.replicates is not None and self.replicates < need:
             raise InputError(f"--replicates {self.replicates} cannot resolve --alpha {self.alpha:g} over "
@@ -194,14 +199,22 @@ class FleetTrends:
         untested = f" ({n - tested} not tested: fewer than {self.options.min_points} usable logs)" if n > tested else ""
         return f"{len(self.flagged)} of {tested} tested robot joints drifted{untested}"
 
+    def temperature_notes(self) -> list[tuple[str, str, str, str]]:
+        """``(robot_id, joint, quantity, note)`` of every series whose temperatures were left out of its test
+        although it has some (:attr:`~wbfriction.fleet.change_point.ChangePoint.temperature_note`)."""
+        return [(j.robot_id, j.joint, q, cp.temperature_note) for j in self.joints for q, cp in j.tests.items()
+                if cp.temperature_note]
+
     def to_table(self) -> pa.Table:
         """One row per robot, joint and tested quantity: the best change (its shape, onset, size, statistic,
         p-value), whether it is a flagged drift, and the temperature its baseline and size are at with the slope
-        per °C found (null and NaN where the logs' temperatures did not enter the test)."""
+        per °C found (null and NaN where the logs' temperatures did not enter the test), and why they did not where
+        the series has some (:attr:`~wbfriction.fleet.change_point.ChangePoint.temperature_note`)."""
         rows: dict[str, list] = {k: [] for k in ("robot_id", "joint", "quantity", "points", "flagged", "shape",
                                                  "onset_time", "baseline", "change", "change_se", "relative_change",
                                                  "statistic", "p_value", "last_value", "reference_temperature",
-                                                 "temperature_slope", "temperature_slope_se")}
+                                                 "temperature_slope", "temperature_slope_se",
+                                                 "temperature_note")}
         for j in self.joints:
             for q, cp in j.tests.items():
                 s = j.series[q]
@@ -222,13 +235,15 @@ class FleetTrends:
                 rows["reference_temperature"].append(cp.reference_temperature)
                 rows["temperature_slope"].append(cp.temperature_slope)
                 rows["temperature_slope_se"].append(cp.temperature_slope_se)
+                rows["temperature_note"].append(cp.temperature_note)
         schema = pa.schema([("robot_id", pa.string()), ("joint", pa.string()), ("quantity", pa.string()),
                             ("points", pa.int64()), ("flagged", pa.bool_()), ("shape", pa.string()),
                             ("onset_time", pa.timestamp("us", tz="UTC")),
                             *[(n, pa.float64()) for n in ("baseline", "change", "change_se", "relative_change",
                                                          "statistic", "p_value", "last_value",
                                                          "reference_temperature", "temperature_slope",
-                                                         "temperature_slope_se")]])
+                                                         "temperature_slope_se")],
+                            ("temperature_note", pa.string())])
         return pa.Table.from_pydict(rows, schema=schema)
 
 

@@ -37,6 +37,7 @@ from wbfriction.friction.options import ROUTES
 from wbfriction.friction.terms import TermFit
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.tables import file_sha256, numeric_column, read_metadata, read_table, with_metadata, write_json
+from wbfriction.logs.temperature import screen_temperature
 from wbfriction.signals.kinematics import Smoother, make_smoother
 from wbfriction.signals.options import SCHEMES, FilterOptions
 from wbfriction.signals.window import MomentumWindow
@@ -231,7 +232,15 @@ def read_friction_table(table: pa.Table, source: str = "<table>") -> FrictionEst
         companion_diff=companion_diff, route=route,
         disagreement=_optional_columns(table, "disagreement", joints, source),
         q=_optional_columns(table, "q", joints, source), tau=_optional_columns(table, "tau", joints, source),
-        temperature=_optional_columns(table, "temperature", joints, source))
+        temperature=_temperature(table, joints, source))
+
+
+def _temperature(table: pa.Table, joints, source: str) -> np.ndarray | None:
+    """The ``temperature.<joint>`` columns (N, n) [°C], screened as a log's are
+    (:func:`~wbfriction.logs.temperature.screen_temperature`: ``estimate`` named the glitches it left out, a table
+    written otherwise has them left out here too), or None."""
+    T = _optional_columns(table, "temperature", joints, source)
+    return None if T is None else screen_temperature(T, joints, source)[0]
 
 
 def read_friction_file(path: str | Path) -> FrictionEstimate:

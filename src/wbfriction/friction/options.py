@@ -11,6 +11,7 @@ from typing import Literal, get_args
 
 from wbfriction.choices import check_choice, check_range, flag
 from wbfriction.exceptions import OptionError
+from wbfriction.logs.temperature import check_reference_temperature
 from wbfriction.signals.options import (
     ALIGNMENT_OPTIONS,
     DIFF_OPTIONS,
@@ -153,6 +154,9 @@ class EstimateOptions:
             value = getattr(self, name)
             for v in value if isinstance(value, tuple) else (value,):
                 check_range(name, v, low=0.0, strict=name == "ds_weight")
+        if self.route == "momentum" and self.condition_number:
+            raise OptionError("--cond", True, "left out with --route momentum (cond(M_mod^-1) is the acceleration "
+                              "route's: the momentum route inverts no M_mod)")
         given = [f.name for f in fields(FilterOptions) if getattr(self.filtering, f.name) != f.default]
         if self.diff == "auto" and given:
             raise OptionError(flag(given[0]), getattr(self.filtering, given[0]), "given with --diff savgol or "
@@ -241,6 +245,7 @@ class TermOptions:
         check_range("min_effect", self.min_effect, low=0.0, high=1.0)
         check_range("min_torque", self.min_torque, low=0.0)
         check_range("tolerance", self.tolerance, low=0.0, high=1.0, strict=True)
+        check_reference_temperature(self.reference_temperature)
 
 
 @dataclass(frozen=True)

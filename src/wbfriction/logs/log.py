@@ -48,6 +48,7 @@ from wbfriction.logs.clock import JITTER, Clock, TimeBase, TimeUnit, read_clock,
 from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, sensed_contacts
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
 from wbfriction.logs.tables import numeric_column, numeric_columns, read_metadata, with_metadata, write_table
+from wbfriction.logs.temperature import screen_temperature
 from wbfriction.model.robot import Robot
 
 TorqueSource = Literal["sensor", "current"]
@@ -294,6 +295,9 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
     base = _read_base(table, source, first_row)
     tau_f_true = _read_per_joint(table, "tau_f_true", robot, len(time), source, first_row)
     temperature = _read_per_joint(table, "temperature", robot, len(time), source, first_row)
+    if temperature is not None:  # units, plausibility, glitches (wbfriction.logs.temperature)
+        temperature, glitched = screen_temperature(temperature, robot.torque_controlled, source, first_row)
+        warnings = warnings + glitched
     qd_true = _read_true_rates(table, "qd_true", robot, source, first_row)
     qdd_true = _read_true_rates(table, "qdd_true", robot, source, first_row)
     qd_logged = _read_true_rates(table, "qd", robot, source, first_row)

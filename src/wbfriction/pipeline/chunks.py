@@ -34,7 +34,8 @@ from wbfriction.exceptions import InputError
 from wbfriction.logs.clock import ROUGHNESS_ROWS, Clock, TimeBase, TimeUnit, read_clock, table_stamps
 from wbfriction.logs.log import check_schema, contact_flags_from_forces
 from wbfriction.logs.options import MAX_GAP
-from wbfriction.logs.tables import RowReader, TableFile, numeric_columns
+from wbfriction.logs.tables import RowReader, TableFile, numeric_column, numeric_columns
+from wbfriction.logs.temperature import screen_temperature
 from wbfriction.model.robot import Robot
 
 CONTEXT = 3
@@ -177,10 +178,23 @@ def plan_columns(file: TableFile, robot: Robot, source: str, max_gap: float = MA
     else:
         flags = (numeric_columns(table, columns[1:], source)
                  if robot.floating_base else np.ones((table.num_rows, 1)))  # a fixed base: always welded
+    warnings = warnings + _temperature_warnings(file, robot, source)
     first = first_positions(file, robot)
     clock = read_clock(table_stamps(table, source, unit=time_unit), source, max_gap=max_gap, q=first,
                        time_base=time_base)
     return ColumnPlan(flags != 0, clock, first, warnings, from_forces)
+
+
+def _temperature_warnings(file: TableFile, robot: Robot, source: str) -> tuple[str, ...]:
+    """The whole log's temperature columns screened (:func:`~wbfriction.logs.temperature.screen_temperature`), before
+    any row is estimated: a column in kelvin or not a temperature refused, a glitch named once (each chunk leaves it
+    out again as it reads its rows)."""
+    names = [f"temperature.{n}" for n in robot.torque_controlled if f"temperature.{n}" in file.schema().names]
+    if not names:
+        return ()
+    table = file.read(names)
+    T = np.column_stack([numeric_column(table, c, source, finite=False) for c in names])
+    return screen_temperature(T, [c.partition(".")[2] for c in names], source)[1]
 
 
 def release_freed_memory() -> None:
