@@ -66,3 +66,49 @@ def test_a_segment_that_cannot_be_estimated_is_left_blank(talos, combined_walk):
                           talos, "gapped")
     with pytest.raises(InputError, match="gapped: no single-support sample"):
         estimate_log(talos, only, EstimateOptions())
+
+
+@pytest.fixture(scope="module")
+def panda_sim():
+    """3 s of the built-in Panda (the arm simulator: 1 kHz, 19-bit encoders, no torque noise)."""
+    from wbfriction.model.loading import load_robot
+    from wbfriction.sim.arm import ArmOptions, ExcitationOptions, default_arm_friction, simulate_arm
+    robot = load_robot("panda")
+    options = ArmOptions(duration=3.0, excitation=ExcitationOptions(period=3.0))
+    return robot, simulate_arm(robot, default_arm_friction(robot), options=options).table
+
+
+def _rms(x):
+    return float(np.sqrt(np.mean(np.square(x))))
+
+
+def test_an_arm_logged_by_a_clock_that_skips_one_sample_in_seven(panda_sim):
+    """Issue 53: a Panda log with one sample in seven dropped (exact 1 ms stamps) at the default max_gap is
+    one segment, differentiated on its stamps: the injected friction comes back at its samples, as from the
+    whole log."""
+    robot, table = panda_sim
+    keep = np.flatnonzero(np.arange(table.num_rows) % 7 != 3)
+    log = log_from_table(table.take(pa.array(keep)), robot, "skip7")
+    assert log.segments == [(0, keep.size)] and log.clock.kind == "skipping"
+    for route in ("acceleration", "momentum"):
+        est = estimate_log(robot, log, EstimateOptions(route=route))
+        assert est.valid.mean() > 0.8, route
+        truth = est.tau_f_true
+        for j in range(len(est.joints)):
+            v = est.valid[:, j]
+            assert _rms(est.tau_f[v, j] - truth[v, j]) < 0.1 * _rms(truth[v, j]), (route, est.joints[j])
+
+
+def test_a_gap_costs_an_arm_no_contact_margins(panda_sim):
+    """A fixed-base arm has no contacts to lift off or touch down: a 40 ms dropout costs only the rows the
+    differentiation cannot reach, as if each segment were a log of its own."""
+    robot, table = panda_sim
+    n, a, b = 2500, 1200, 1240
+    keep = np.r_[np.arange(a), np.arange(b, n)]
+    log = log_from_table(table.take(pa.array(keep)), robot, "gapped")
+    assert log.segments == [(0, a), (a, n - (b - a))]
+    opts = EstimateOptions(diff="central", route="acceleration")
+    whole = estimate_log(robot, log, opts)
+    apart = np.concatenate([estimate_log(robot, part, opts).valid for part in log.parts()])
+    np.testing.assert_array_equal(whole.valid, apart)
+    assert whole.valid[a + 1:a + 100].all() and whole.valid[a - 100:a - 1].all()

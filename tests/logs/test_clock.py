@@ -487,3 +487,30 @@ def test_a_forced_regular_clock_keeps_the_lattice_found():
     t = np.concatenate([[0.0], np.cumsum(rng.choice([10, 12], 999))]) * 1e-3
     clock = read_clock(t, "a", time_base="regularised")
     assert clock.kind == "jittered" and clock.lattice == pytest.approx(2e-3, rel=1e-6)
+
+
+@pytest.mark.parametrize("with_positions", [True, False])
+def test_a_clock_that_skips_single_samples_has_no_gap_at_its_skips(with_positions):
+    """Issue 53: a 1 kHz clock that drops one sample in seven (steps of 1 and 2 ms, exact ticks) at the
+    default max_gap: its skips are what the clock does, not gaps (one segment, stamps taken as recorded);
+    a 10 ms dropout and a pause are still gaps."""
+    k = np.arange(7000)
+    t = (k[k % 7 != 3] * 1e-3)
+    t = np.r_[t[:2000], t[2000:4000] + 10e-3, t[4000:] + 0.5 + 10e-3]
+    clock = read_clock(t, "s", q=_motion(t) if with_positions else None)
+    assert clock.kind == "skipping" and clock.lattice == pytest.approx(1e-3)
+    assert clock.segments == [(0, 2000), (2000, 4000), (4000, t.size)]
+    assert "exact stamps of a 1 ms clock skipping samples (steps 1-2 ms = 1-2 ticks)" in clock.reason
+
+
+def test_receive_time_stamps_with_a_missed_sample_keep_their_gap():
+    """Receive-time stamps of a 5 ms clock, written in whole milliseconds (a 1 ms lattice), that miss one
+    sample: regularised, so the miss stays a gap (the regularised clock would count one sample too few
+    across it)."""
+    rng = np.random.default_rng(3)
+    k = np.r_[np.arange(1000), np.arange(1001, 2000)]
+    late = rng.integers(0, 2, k.size) * 1e-3
+    late[999:1001] = 0.0
+    t = k * 5e-3 + late
+    clock = read_clock(t, "j", q=_motion(k * 5e-3))
+    assert clock.kind == "jittered" and clock.segments == [(0, 1000), (1000, 1999)]

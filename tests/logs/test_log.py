@@ -71,22 +71,27 @@ def test_bad_input_names_the_fault(talos, good, edit, message):
         log_from_table(_bad(talos, good, edit), talos, source="x.parquet")
 
 
-@pytest.mark.parametrize("step", [2, 3, 500])
+@pytest.mark.parametrize("step", [2, 3, 6, 500])
 def test_time_gaps_split_the_log_into_segments(talos, good, step):
-    """A step of two periods or more (a dropped sample, a pause) ends a segment."""
+    """A step of two periods or more (dropped samples, a pause) ends a segment, unless it is a few ticks
+    (up to 4 periods) of exact stamps taken as recorded: a clock that skipped samples (issue 53)."""
     table = _bad(talos, good, lambda c: c["time"].__setitem__(slice(20, None), c["time"][20:] + (step - 1) * 1e-3))
-    log = log_from_table(table, talos, source="x.parquet")
-    assert log.segments == [(0, 20), (20, 50)]
-    a, b = log.parts()
-    np.testing.assert_array_equal(b.q, good.q[20:])
-    assert len(a.time) == 20 and b.time[0] == pytest.approx(0.019 + step * 1e-3)
-    # with a larger max_gap, the same step is a clock that skipped samples: one segment,
-    # differentiated on the stamps as recorded
-    if step < 5:
+    skipped = step <= 4
+    for time_base in ("auto", "regularised"):
+        log = log_from_table(table, talos, source="x.parquet", time_base=time_base)
+        if skipped and time_base == "auto":  # one segment, differentiated on the stamps as recorded
+            assert log.segments == [(0, 50)] and log.clock.kind == "skipping"
+            assert log.clock.lattice == pytest.approx(1e-3)
+            np.testing.assert_array_equal(log.clock.t, log.time - log.time[0])
+            continue
+        assert log.segments == [(0, 20), (20, 50)]  # a regularised clock counts samples: a skip is a gap
+        a, b = log.parts()
+        np.testing.assert_array_equal(b.q, good.q[20:])
+        assert len(a.time) == 20 and b.time[0] == pytest.approx(0.019 + step * 1e-3)
+    # with a larger max_gap, the same step is a clock that skipped samples: one segment
+    if skipped:
         log = log_from_table(table, talos, source="x.parquet", max_gap=5)
         assert log.segments == [(0, 50)] and log.clock.kind == "skipping"
-        assert log.clock.lattice == pytest.approx(1e-3)
-        np.testing.assert_array_equal(log.clock.t, log.time - log.time[0])
 
 
 def test_irregular_steps_are_read_with_the_clock_that_explains_them(talos, good):

@@ -91,3 +91,14 @@ def test_a_window_that_cannot_be_is_refused():
     with pytest.raises(InputError, match="clock of 5 samples for 6 rows"):
         MomentumWindow(2, 1e-3, np.arange(5) * 1e-3)(np.ones(6))
     assert np.isnan(MomentumWindow(5, 1e-3)(np.ones(8))).all()  # shorter than the window
+
+
+def test_the_cutoff_of_a_long_window_takes_little_memory_and_time():
+    """Issue 53: the -3 dB frequency of a 100 001-sample window (its gain once took a 64m x 2m grid: 2.3 TiB)
+    is found in a moment, where theory puts it (about 0.72 / (2 m dt) for the Hann window over 2m steps)."""
+    import time
+    window = MomentumWindow(50_000, 1e-3)
+    start = time.perf_counter()
+    assert window.cutoff == pytest.approx(0.72 / (2 * 50_000 * 1e-3), rel=0.05)
+    assert float(window.gain(window.cutoff)) == pytest.approx(1 / math.sqrt(2), abs=1e-9)
+    assert time.perf_counter() - start < 5.0

@@ -328,7 +328,12 @@ def estimate_resolved(robot: Robot, log: Log, options: EstimateOptions, progress
 
 def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress, companion: bool,
                       require_single_support: bool, gaps: tuple[bool, bool] = (False, False)) -> FrictionEstimate:
-    """One segment by ``options.route``, and by the other route as its check (``options.check_route``)."""
+    """One segment by ``options.route``, and by the other route as its check (``options.check_route``).
+
+    The contact margins at a gap (``gaps``) apply only where there are contacts: a fixed base is always
+    welded, nothing lifts off or touches down in a gap."""
+    if not robot.floating_base:
+        gaps = (False, False)
     if options.route == "auto":
         raise InputError("route 'auto' is resolved once per log (resolve_route), not per segment")
     if options.route == "momentum":

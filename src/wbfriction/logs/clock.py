@@ -13,6 +13,11 @@ Loggers write two kinds of irregular stamps, and they call for opposite treatmen
   fit of time against sample index (:func:`regularise`: one period for the log, one offset
   per segment, the gaps excepted).
 
+**Gaps** are decided by what the clock does: a step of at least ``max_gap`` local median steps splits
+the log into segments, never differentiated across, unless it is a few ticks (up to :data:`MAX_SKIP`
+median steps) of a clock whose stamps are whole ticks and taken as recorded: that clock skips samples,
+and its skips are differentiated across on the stamps.
+
 A log whose steps (gaps aside) all lie within :data:`JITTER` of their median is ``uniform`` and is
 differentiated with that median step, as it always was. Otherwise :func:`read_clock` decides by
 measuring: on which time base the positions' second differences are smoother
@@ -56,6 +61,10 @@ ROUGHNESS_ROWS = 20_000
 """Rows (from the first) on which the roughness is measured."""
 LOCAL_STEPS = 101
 """Steps over which the local median step (the gaps' yardstick) is taken."""
+MAX_SKIP = 4.0
+"""A step of up to this many local median steps (up to three samples missed in a row), on a clock whose
+stamps are whole ticks of one period and are taken as recorded, is samples the clock skipped, not a gap
+(:func:`read_clock`)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,11 +205,15 @@ def _checked(stamps: np.ndarray, source: str, first_row: int) -> tuple[np.ndarra
     return t, t0, step
 
 
+def _local_median(step: np.ndarray) -> np.ndarray:
+    """The median of the :data:`LOCAL_STEPS` steps around each step (N - 1,)."""
+    from scipy.ndimage import median_filter
+    return median_filter(step, size=min(LOCAL_STEPS, step.size), mode="reflect")
+
+
 def _gaps(step: np.ndarray, max_gap: float, rel_tol: float) -> np.ndarray:
     """Steps (N - 1,) at least ``max_gap`` (less ``rel_tol``) times the median of the steps around them."""
-    from scipy.ndimage import median_filter
-    local = median_filter(step, size=min(LOCAL_STEPS, step.size), mode="reflect")
-    return step >= (max_gap - rel_tol) * local
+    return step >= (max_gap - rel_tol) * _local_median(step)
 
 
 def _segments(gap: np.ndarray, n: int) -> list[tuple[int, int]]:
@@ -415,7 +428,10 @@ def read_clock(stamps: np.ndarray, source: str, *, max_gap: float = MAX_GAP, fir
             (:func:`table_stamps`).
         source: file name for the messages.
         max_gap: steps of at least this many local median steps split the log
-            (:func:`split_at_gaps`).
+            (:func:`split_at_gaps`), except the steps of up to :data:`MAX_SKIP` local median steps
+            of a clock whose stamps are whole ticks taken as recorded: those are samples the clock
+            skipped, differentiated across on the stamps (with a regularised clock, a skipped
+            sample is a gap: the clock counts samples).
         first_row: row number of ``stamps[0]`` in its file, for the messages.
         q: positions (M, n) of the first M <= N rows [rad], to measure on which time base they
             are smoother (:func:`roughness`, on the first :data:`ROUGHNESS_ROWS`); None: decide
@@ -433,7 +449,21 @@ def read_clock(stamps: np.ndarray, source: str, *, max_gap: float = MAX_GAP, fir
     if time_base not in TIME_BASES:
         raise InputError(f"unknown time base '{time_base}': choose one of {', '.join(TIME_BASES)}")
     t, t0, step = _checked(stamps, source, first_row)
-    gap = _gaps(step, max_gap, JITTER)
+    local = _local_median(step)
+    gap = step >= (max_gap - JITTER) * local
+    skip = gap & (step <= (MAX_SKIP + JITTER) * local)
+    if skip.any() and time_base != "regularised":
+        # what the clock does decides: skipped ticks of a clock whose stamps are taken as recorded are
+        # differentiated across (non-uniform formulas), never cut out of the log
+        clock = _decide(t, t0, step, gap & ~skip, q, time_base)
+        if clock.kind == "skipping" and clock.lattice is not None:
+            return clock
+    return _decide(t, t0, step, gap, q, time_base)
+
+
+def _decide(t: np.ndarray, t0: float, step: np.ndarray, gap: np.ndarray, q: np.ndarray | None,
+            time_base: TimeBase) -> Clock:
+    """:func:`read_clock`'s decision, its gaps (N - 1,) given."""
     segments = _segments(gap, len(t))
     dt = float(np.median(step))
     inner = step[~gap]

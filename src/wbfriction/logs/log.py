@@ -400,13 +400,15 @@ def _read_motion(table: pa.Table, robot: Robot, source: str, max_gap: float, lim
     q [rad] (checked against the limits; continuous joints unwrapped, :func:`unwrap_positions`)."""
     stamps = table_stamps(table, source, first_row, time_unit)
     segments = check_time(stamps, source, max_gap, first_row=first_row)
-    q = _stack(table, [f"q.{n}" for n in robot.actuated], source, first_row)
-    check_limits(q, robot, source, limit_margin, first_row)  # before the jumps: degrees say so first
-    q = unwrap_positions(q, robot, source, segments, first_row)
+    raw = _stack(table, [f"q.{n}" for n in robot.actuated], source, first_row)
+    check_limits(raw, robot, source, limit_margin, first_row)  # before the jumps: degrees say so first
+    q = unwrap_positions(raw, robot, source, segments, first_row)
     if clock is None:
         clock = read_clock(stamps, source, max_gap=max_gap, first_row=first_row, q=q, time_base=time_base)
     elif len(clock) != len(stamps):
         raise InputError(f"{source}: a clock of {len(clock)} rows for a table of {len(stamps)} rows")
+    if clock.segments != segments:  # samples the clock skipped are not gaps: unwrapped across them too
+        q = unwrap_positions(raw, robot, source, clock.segments, first_row)
     time = stamps * 1e-9 if np.issubdtype(stamps.dtype, np.integer) else stamps
     return time, clock, q
 

@@ -144,8 +144,14 @@ class MomentumWindow:
         half_power = 1.0 / math.sqrt(2.0)
         nyquist = 0.5 / self.dt
         grid = np.linspace(0.0, nyquist, 64 * self.half_width + 1)
-        below = np.flatnonzero(self.gain(grid) < half_power)
-        if below.size == 0:
-            return nyquist
-        i = int(below[0])
-        return float(brentq(lambda f: float(self.gain(f)) - half_power, grid[i - 1], grid[i], xtol=1e-9 * nyquist))
+        # the gain on the grid a block at a time (a block x window matrix: a few MB however long the window), up to
+        # the first point below half power (near the grid's start: about 0.72 / (2 m dt) of the Nyquist frequency's
+        # 0.5 / dt)
+        block = max(16, 2**19 // self.length)
+        for start in range(0, grid.size, block):
+            below = np.flatnonzero(self.gain(grid[start:start + block]) < half_power)
+            if below.size:
+                i = start + int(below[0])
+                return float(brentq(lambda f: float(self.gain(f)) - half_power, grid[i - 1], grid[i],
+                                    xtol=1e-9 * grid[i]))
+        return nyquist
