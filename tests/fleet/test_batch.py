@@ -239,3 +239,28 @@ def test_other_options_replace_the_earlier_rows(serial, arm_fleet, tmp_path):
     assert table.num_rows == 21 and len(set(table.column("key").to_pylist())) == 3
     a1 = table.filter(pc.equal(table.column("log"), str(folder / "a1.parquet")))
     assert set(a1.column("model").to_pylist()) == {"coulomb-viscous"}
+
+
+def test_logs_saved_again_elsewhere_replace_their_earlier_results(serial, arm_fleet, tmp_path):
+    """Issue 53, class 8: the logs saved again with a temperature column (other bytes, another folder) and batched
+    into the same results gave each log two results, and trends two points per start time. A log is its robot and
+    start time: the new run's result replaces the earlier one, and the folder holds one file per log."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    folder, _ = arm_fleet
+    results = tmp_path / "results"
+    shutil.copytree(serial, results)
+    again = tmp_path / "again"
+    again.mkdir()
+    for name in ("a1.parquet", "a2.parquet", "b1.parquet"):
+        table = pq.read_table(folder / name)
+        for column in [c for c in table.column_names if c.startswith("tau.")]:
+            table = table.append_column("temperature." + column[4:], pa.array(np.full(table.num_rows, 35.0)))
+        pq.write_table(table, again / name)
+    (again / "manifest.csv").write_text((folder / "manifest.csv").read_text())  # the same rows, the new files
+    summary = run_batch(read_manifest(again / "manifest.csv"), results, engine="serial")
+    assert summary.processed == 3 and set(summary.reasons) == {"an earlier result of its robot and start time"}
+    table = read_results(results).table
+    assert table.num_rows == 21 and {Path(p).parent for p in table.column("log").to_pylist()} == {again}
+    assert len(_files(results)) == 3

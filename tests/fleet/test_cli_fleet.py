@@ -141,3 +141,24 @@ def test_a_scheduler_that_goes_away_is_one_line(arm_fleet, tmp_path):
     from wbfriction.fleet.results import read_parts
 
     assert [p.problem for p in read_parts(tmp_path / "results")] == [""] * len(read_parts(tmp_path / "results"))
+
+
+def test_trends_of_logs_at_one_start_time_say_so(tmp_path, synthetic_results):
+    """Issue 53, classes 8 and 12: ten logs listed at one start time gave 'fewer than 8 usable logs' and no word of
+    the shared time. One note says the start time holds several logs, and the summary says what is short."""
+    import pyarrow.parquet as pq
+
+    from wbfriction.fleet.results import write_part
+
+    parts = synthetic_results(tmp_path / "results", 10)
+    first = pq.read_table(parts[0]).column("start_time")
+    for part in parts:
+        table = pq.read_table(part).replace_schema_metadata(None)
+        table = table.set_column(table.schema.get_field_index("start_time"), "start_time", first)
+        part.unlink()
+        write_part(tmp_path / "results", table)
+    res = wbfriction("trends", "results", "-o", "t.html", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    notes = [line for line in res.stderr.splitlines() if line.startswith("note:")]
+    assert len(notes) == 1 and notes[0].startswith("note: robot r1: 1 start time holds the results of several logs")
+    assert "none of the 2 robot joints could be tested (each has its 10 usable logs at 1 start time" in res.stderr

@@ -4,7 +4,7 @@ checked when read back (a damaged one found, named, recomputed), each robot's lo
 from __future__ import annotations
 
 import shutil
-from datetime import timedelta
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 import pyarrow as pa
@@ -139,3 +139,48 @@ def test_a_robots_log_saved_twice_counts_once(tmp_path, synthetic_results):
     (left,) = dataset.left_out
     assert left.path.name == "r1-again.parquet"
     assert left.reason == "the log /logs/r1/again.parquet has the same bytes as /logs/r1/1.parquet: counted once"
+
+
+def _saved_again(part: Path, log: str, start_time=None) -> Path:
+    """The rows of ``part`` as the result of another log (its path ``log``, other bytes), at ``start_time``."""
+    from wbfriction.fleet.results import write_part
+
+    table = pq.read_table(part).replace_schema_metadata(None)
+    changes = {"log": log, "key": log.strip("/").replace("/", "-").removesuffix(".parquet"),
+               "log_sha256": "other bytes of " + log}
+    if start_time is not None:
+        changes["start_time"] = start_time
+    for column, value in changes.items():
+        field = table.schema.field(column)
+        table = table.set_column(table.schema.get_field_index(column), field, pa.array([value] * table.num_rows,
+                                                                                       field.type))
+    return write_part(part.parents[1], table)
+
+
+def test_start_times_holding_several_logs_are_said_in_one_line(tmp_path, synthetic_results):
+    """Issue 53, class 8: ten logs saved again (with a temperature column) elsewhere and batched into the same results
+    by an earlier version gave trends 20 points at 10 start times of one robot, without a word. The reader says it,
+    one line per robot (a batch run on the logs to keep replaces the others: tests/fleet/test_batch.py)."""
+    results = tmp_path / "results"
+    parts = synthetic_results(results, 10)
+    for i, part in enumerate(parts):
+        _saved_again(part, f"/again/r1/{i}.parquet")
+    dataset = read_results(results)
+    assert dataset.table.num_rows == 2 * 10 * 2 and dataset.left_out == ()
+    (note,) = dataset.notes()
+    assert note.startswith("note: robot r1: 10 start times each hold the results of several logs (e.g. "
+                           "/again/r1/0.parquet, /logs/r1/0.parquet)")
+
+
+def test_logs_listed_at_one_start_time_are_each_counted_and_said(tmp_path, synthetic_results):
+    """Ten logs listed with one start time are ten points (trends says they are at one time), and said."""
+    results = tmp_path / "results"
+    parts = synthetic_results(results, 10)
+    for i, part in enumerate(parts):
+        _saved_again(part, f"/logs/r1/one-{i}.parquet", start_time=datetime(2026, 1, 1, tzinfo=UTC))
+        part.unlink()
+    dataset = read_results(results)
+    assert dataset.table.num_rows == 10 * 2 and dataset.left_out == ()
+    (note,) = dataset.notes()
+    assert note.startswith("note: robot r1: 1 start time holds the results of several logs (e.g. "
+                           "/logs/r1/one-0.parquet, /logs/r1/one-1.parquet, ...)")

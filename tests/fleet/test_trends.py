@@ -213,3 +213,26 @@ def test_a_small_alpha_draws_enough_noise_series():
 def test_the_summary_counts_tested_joints():
     trends = fleet_trends(synthetic_results(0.3), FAST)
     assert trends.summary() == "1 of 4 tested robot joints drifted"
+
+
+def test_the_summary_says_what_an_untested_joint_lacks():
+    """Issue 53, class 12: ten logs at one start time were said to be 'fewer than 8 usable logs'. What is short is
+    start times: the summary says how many usable logs and at how many start times; a joint with too few logs is
+    said to have too few."""
+    rng = np.random.default_rng(3)
+    one = [DAYS[0]] * 10
+    trends = fleet_trends(_series_table({"F_c": 1.0 + 0.01 * rng.standard_normal(10)}, times=one), FAST)
+    assert trends.summary() == ("none of the 1 robot joints could be tested (each has its 10 usable logs at 1 start "
+                                "time: a change over time needs logs at several): no drift can be told")
+    few = _series_table({"F_c": 1.0 + 0.01 * rng.standard_normal(5)})
+    assert fleet_trends(few, FAST).summary() == ("none of the 1 robot joints could be tested (each has fewer than 8 "
+                                                 "usable logs): no drift can be told")
+    tested = _series_table({"F_c": 1.0 + 0.01 * rng.standard_normal(10)})
+    mixed = pa.concat_tables([tested, _renamed(few, "k"), _renamed(_series_table(
+        {"F_c": 1.0 + 0.01 * rng.standard_normal(10)}, times=one), "l")])
+    assert fleet_trends(mixed, FAST).summary() == ("0 of 1 tested robot joints drifted (2 not tested: 1 with fewer "
+                                                   "than 8 usable logs, 1 with its 10 usable logs at 1 start time)")
+
+
+def _renamed(table: pa.Table, joint: str) -> pa.Table:
+    return table.set_column(table.schema.get_field_index("joint"), "joint", pa.array([joint] * table.num_rows))

@@ -154,8 +154,9 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
                            temperature=temperature, reference_temperature=reference_temperature)
     with console.status(f"reading {results}") as status:
         dataset = read_results(results)
-        for left in dataset.left_out:
-            console.print(f"[yellow]left out:[/] {escape(str(left))}", highlight=False, soft_wrap=True)
+        for note in dataset.notes():  # files left out, start times holding several logs
+            label, _, text = note.partition(": ")
+            console.print(f"[yellow]{label}:[/] {escape(text)}", highlight=False, soft_wrap=True)
         status.update(f"testing {dataset.table.num_rows} rows for drifts ({options.draws()} noise series per test)")
         found = fleet_trends(dataset.table, options)
         status.update(f"writing {output}")

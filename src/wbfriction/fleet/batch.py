@@ -15,9 +15,11 @@ one result at most:
 
 * a whole result under its key: the log is done, skipped;
 * a result of the same log under another key (a row corrected, other options, the log changed), or of a log
-  no longer listed whose bytes a listed log has (the same data moved or saved again), or a damaged file: the
-  log is computed again, and the earlier files are removed when its outcome is written (the reason is said);
-* results of logs not listed, and not theirs by bytes: kept as they are (counted);
+  no longer listed whose bytes a listed log has (the same data moved or saved again), or of a log no longer
+  listed with a listed log's robot id and start time (the log saved again with other bytes, e.g. a temperature
+  column added: a robot's log is its start time), or a damaged file: the log is computed again, and the earlier
+  files are removed when its outcome is written (the reason is said);
+* results of logs not listed, and not theirs by bytes or start time: kept as they are (counted);
 * files that are not results (no result metadata): left as they are (named).
 
 So the folder after any sequence of runs holds what one run of the last manifest into an empty folder writes,
@@ -47,7 +49,7 @@ from wbfriction.exceptions import ClusterError, InputError, OutputError
 from wbfriction.fleet.manifest import LogEntry, Skipped
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.results import Part, failure_files, failures_folder, read_parts, table_path, write_outcome
-from wbfriction.fleet.task import LogOutcome, ResultKey, one_line, process_log, result_key, robot_sha256
+from wbfriction.fleet.task import LogOutcome, ResultKey, one_line, process_log, result_key, robot_sha256, utc_ns
 from wbfriction.logs.tables import TableFile, file_sha256, make_folder, remove_file, remove_stale_temporaries
 from wbfriction.pipeline.chunks import CHUNKS_PER_WORKER
 from wbfriction.pipeline.estimate_step import worker_robot
@@ -154,9 +156,12 @@ def plan_batch(entries: list[LogEntry], results: str | Path, options: BatchOptio
     for i, p in enumerate(keyed):
         by_bytes[p.key.log_sha256].append(i)
     by_key = {p.key.key: i for i, p in enumerate(keyed)}
+    by_start: dict[tuple[str, int], int] = {}
+    for i, p in enumerate(keyed):
+        by_start.setdefault((p.key.robot_id, utc_ns(p.key.start_time)), i)
 
     def owner(log: str, log_sha256: str | None) -> int | None:
-        """The listed log whose earlier result a file is: the same path, else the same bytes."""
+        """The listed log whose earlier result or failure a file is: the same path, else the same bytes."""
         if log in by_path:
             return by_path[log]
         same = by_bytes.get(log_sha256 or "")
@@ -179,7 +184,10 @@ def plan_batch(entries: list[LogEntry], results: str | Path, options: BatchOptio
                 why[named] = f"its result was {part.problem}"
             continue
         of = owner(part.first("log"), part.first("log_sha256"))
-        if of is None:
+        if of is None and part.log_id in by_start:  # the log saved again with other bytes (issue 53)
+            files[by_start[part.log_id]].append(part.path)
+            why.setdefault(by_start[part.log_id], "an earlier result of its robot and start time")
+        elif of is None:
             kept += 1
         elif part.key == keyed[of].key.key:
             done.add(of)

@@ -7,12 +7,18 @@ the SHA-256 of its rows (:func:`rows_sha256`) in its ``wbfriction`` metadata; :f
 columns, and that the file's name and folder are its rows' key and robot id, so that a truncated, altered or
 stray file is found and named (:class:`Part`), never read as a result. Failures live beside the dataset
 (:func:`failures_folder`), never inside it: the folder stays a dataset any Parquet reader opens.
+
+A robot's log is its start time (issue 53): a batch replaces the result of a log it no longer lists by that of
+the listed log with its robot id and start time (:mod:`wbfriction.fleet.batch`), and :func:`read_results` says
+where one start time still holds several logs' results (:meth:`ResultsDataset.notes`: written by an earlier
+version, or several logs listed with one start time): each is counted, and said.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+from collections import Counter, defaultdict
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -95,6 +101,12 @@ class Part:
         assert self.rows is not None
         return self.rows.column(column)[0].as_py()
 
+    @property
+    def log_id(self) -> tuple[str, int]:
+        """What tells a log from another: its robot id and start time (nanoseconds since 1970)."""
+        assert self.rows is not None
+        return self.first("robot_id"), self.rows.column("start_time").cast(pa.int64())[0].as_py()
+
 
 def write_part(results: Path, rows: pa.Table) -> Path:
     """Write one log's rows (one key, one robot) with the digest of its rows; the file's path."""
@@ -160,15 +172,37 @@ class ResultsDataset:
             per log: of a robot's logs with the same bytes (a copy) only the first (by start time, then path);
             sorted by robot, start time, log and joint.
         left_out: the files whose rows are not in ``table``, with why (damaged, not a result, a copy).
+        shared_starts: per robot whose start times hold the results of several logs (other bytes, other paths),
+            how many such start times and the first one's logs (each log's rows are in ``table``).
     """
 
     table: pa.Table
     left_out: tuple[Skipped, ...] = ()
+    shared_starts: tuple[tuple[str, int, tuple[str, ...]], ...] = ()
+
+    def notes(self) -> list[str]:
+        """What the reader passed over or found doubtful, one line each: ``left out:`` a file with why (files left
+        out for one reason as one line: their count and the first), ``note:`` per robot the start times that hold
+        several logs (:attr:`shared_starts`)."""
+        counts = Counter(s.reason for s in self.left_out)
+        out, said = [], set()
+        for s in self.left_out:
+            if counts[s.reason] == 1:
+                out.append(f"left out: {s}")
+            elif s.reason not in said:
+                said.add(s.reason)
+                out.append(f"left out: {counts[s.reason]} files ({s.path}, ...): {s.reason}")
+        for robot_id, starts, logs in self.shared_starts:
+            hold = f"{starts} start times each hold" if starts > 1 else "1 start time holds"
+            out.append(f"note: robot {robot_id}: {hold} the results of several logs (e.g. {', '.join(logs)}), each "
+                       "counted as a point: for logs saved again elsewhere, 'wbfriction batch' on the manifest of "
+                       "those to keep replaces the others' results")
+        return out
 
 
 def read_results(results: str | Path) -> ResultsDataset:
     """Every whole result of a results folder (:class:`ResultsDataset`): each file checked (:func:`read_part`),
-    each robot's log counted once.
+    each robot's log counted once (of its copies, one), and the start times holding several logs found.
 
     Raises:
         InputError: a folder without any result (naming what it holds instead), or of the earlier layout.
@@ -192,7 +226,22 @@ def read_results(results: str | Path) -> ResultsDataset:
         assert part.rows is not None
         tables.append(part.rows)
     table = pa.concat_tables(tables)
-    return ResultsDataset(table.take(pc.sort_indices(table, sort_keys=SORT)), tuple(left_out))
+    return ResultsDataset(table.take(pc.sort_indices(table, sort_keys=SORT)), tuple(left_out),
+                          _shared_starts(list(counted.values())))
+
+
+def _shared_starts(parts: list[Part]) -> tuple[tuple[str, int, tuple[str, ...]], ...]:
+    """Per robot (in order), the start times at which its counted results are of several logs: how many, and the
+    first one's logs."""
+    logs: dict[tuple[str, int], list[str]] = defaultdict(list)
+    for part in parts:
+        logs[part.log_id].append(part.first("log"))
+    shared: dict[str, list[tuple[int, list[str]]]] = defaultdict(list)
+    for (robot_id, start), names in sorted(logs.items()):
+        if len(names) > 1:
+            shared[robot_id].append((start, sorted(names)))
+    return tuple((robot_id, len(starts), tuple(starts[0][1][:2]) + (("...",) if len(starts[0][1]) > 2 else ()))
+                 for robot_id, starts in shared.items())
 
 
 def failure_record(outcome: LogOutcome) -> dict[str, Any]:

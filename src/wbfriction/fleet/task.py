@@ -177,7 +177,7 @@ def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy]
         values = params.to_dict() if params is not None else {}
         stderr = terms.stderr if terms is not None else fit.stderr
         crb = {} if terms is not None else fit.crb  # the bound is the velocity model's
-        row = {"robot_id": key.robot_id, "log": key.log, "start_time": _utc(key.start_time),
+        row = {"robot_id": key.robot_id, "log": key.log, "start_time": utc_ns(key.start_time),
                "key": key.key, "log_sha256": key.log_sha256, "robot_sha256": key.robot_sha256,
                "options_sha256": key.options_sha256, "joint": fit.joint, "model": fit.model, "route": fit.route,
                "status": fit.verdict().status, "n_samples": fit.n_samples,
@@ -223,7 +223,7 @@ def _temperature(terms: TermFit | None, temperature: np.ndarray | None, i: int, 
     return float(np.mean(t)) if t.size else float("nan")
 
 
-def _utc(t: datetime) -> int:
+def utc_ns(t: datetime) -> int:
     """Nanoseconds since the epoch of an aware time (exact: a datetime has microseconds)."""
     return (t - EPOCH) // timedelta(microseconds=1) * 1000
 

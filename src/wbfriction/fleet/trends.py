@@ -191,13 +191,27 @@ class FleetTrends:
         return [j for j in self.joints if j.tests]
 
     def summary(self) -> str:
-        """One sentence: how many of the tested joints drifted, and how many could not be tested."""
+        """One sentence: how many of the tested joints drifted, and how many could not be tested and what they
+        lack (usable logs, or start times: logs at one time tell no change over time)."""
         n, tested = len(self.joints), len(self.tested)
+        untested = [j for j in self.joints if not j.tests]
+        need = max(self.options.min_points, self.options.min_before + self.options.min_after)
+        most = [max(((int(s.used.sum()), len({t for t, u in zip(s.time, s.used) if u})) for s in j.series.values()),
+                    default=(0, 0)) for j in untested]  # the usable logs and their start times, at best
+        few = sum(points < need for points, _ in most)
+        clustered = sorted({m for m in most if m[0] >= need})
+        if clustered:  # enough logs, at too few start times
+            points, times = clustered[0] if len(clustered) == 1 else (0, 0)
+            at = (f"its {points} usable logs at {times} start time{'s' if times > 1 else ''}" if points
+                  else "its usable logs at too few start times")
         if tested == 0:
-            return (f"none of the {n} robot joints could be tested (each has fewer than {self.options.min_points} "
-                    "usable logs): no drift can be told")
-        untested = f" ({n - tested} not tested: fewer than {self.options.min_points} usable logs)" if n > tested else ""
-        return f"{len(self.flagged)} of {tested} tested robot joints drifted{untested}"
+            lack = ([f"fewer than {self.options.min_points} usable logs"] if few else []) + ([at] if clustered else [])
+            each = "each has " + " or ".join(lack) + (": a change over time needs logs at several" if not few else "")
+            return f"none of the {n} robot joints could be tested ({each}): no drift can be told"
+        parts = ([f"{few} with fewer than {self.options.min_points} usable logs"] if few else []) + \
+            ([f"{len(untested) - few} with {at}"] if clustered else [])
+        told = f" ({n - tested} not tested: {', '.join(parts)})" if untested else ""
+        return f"{len(self.flagged)} of {tested} tested robot joints drifted{told}"
 
     def temperature_notes(self) -> list[tuple[str, str, str, str]]:
         """``(robot_id, joint, quantity, note)`` of every series whose temperatures were left out of its test
