@@ -148,9 +148,12 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
             params: Path = typer.Option(..., "--params", help="Parameters fitted on other logs estimated with "
                                                               "the same URDF ('wbfriction fit').")) -> None:
     """How well a model predicts torques it was not fitted on: per joint, the RMS of measured minus
-    predicted torque, tau - (M qdd + h + f(qd)), with the friction model and without it."""
+    predicted torque, tau - (M qdd + h + f(qd)), with the friction model and without it; where the log leaves
+    the angles, loads or temperatures the fit's terms were fitted on, it says so (well outside: status
+    'outside fitted ranges')."""
     import numpy as np
 
+    from wbfriction.friction.ranges import OUTSIDE
     from wbfriction.pipeline.predict_step import predict_file
 
     check_paths({"FRICTION": friction, "--params": params}, {})
@@ -180,10 +183,18 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
     for j, kept in zip(pred.joints, pred.terms or ()):
         if kept:
             out.print(f"with its terms beyond velocity, {j}: {', '.join(kept)}", highlight=False)
+    for j, use in zip(pred.joints, pred.ranges or ()):  # a term used beyond what it was fitted on, said
+        for sentence in [] if use is None else use.sentences():
+            console.print(f"{escape(j)}: {escape(sentence)}", highlight=False, soft_wrap=True)
     for j, check in zip(pred.joints, checks):
         if check is not None and not check.predicts:
             console.print(f"{escape(j)}: does not predict this log: {escape(check.describe())}", highlight=False)
-    if any(status not in ("ok", "") for status in statuses):
+    if OUTSIDE in statuses:
+        console.print(f"{OUTSIDE}: this log's signals are beyond the ranges the fit's terms were fitted on by more "
+                      "than those ranges' widths: their laws are extrapolated there, which the fit's status does not "
+                      "cover",
+                      highlight=False, soft_wrap=True)
+    if any(status not in ("ok", "", OUTSIDE) for status in statuses):
         console.print("a prediction by a fit that is not ok is no better than that fit: see 'fit' for the reason")
 
 

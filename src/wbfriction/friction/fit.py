@@ -81,6 +81,7 @@ from wbfriction.friction.models import (
 from wbfriction.friction.noise import joint_noises
 from wbfriction.friction.options import MODEL_CHOICES, PASS_ROWS, SELECTION_TOLERANCE, FitOptions, ModelChoice
 from wbfriction.friction.projection import BASINS, Projection, projected_start
+from wbfriction.friction.ranges import FittedRanges
 from wbfriction.friction.regression import (
     correlation_lag,
     covariance_errors,
@@ -1195,13 +1196,15 @@ def _joint_terms(est: FrictionEstimate, i: int, fit: FitResult, other: FitResult
                  options: FitOptions) -> TermFit | None:
     """The terms beyond velocity of joint column ``i`` of ``est``
     (:func:`~wbfriction.friction.term_selection.fit_terms`) on the samples its fit used, and refitted on the other
-    route's estimate with that route's model (``other``); None for a joint not fitted or not excited."""
+    route's estimate with that route's model (``other``), with the ranges of its signals on those samples
+    (:class:`~wbfriction.friction.ranges.FittedRanges`); None for a joint not fitted or not excited."""
     if fit.params is None or fit.verdict().status in ("not excited", "failed"):
         return None
     signals = term_signals(est, i)
     use = fitted_rows(est.qd[:, i], est.tau_f[:, i], est.valid[:, i], est.smoother, fit.stick_speed,
                       stick_margin(est), fit.pass_rows)[0]
     terms = fit_terms(fit.params, est.qd[:, i], est.tau_f[:, i], use, signals, options.terms, est.smoother)
+    terms = replace(terms, ranges=FittedRanges.of(use, signals.q, signals.tau_load, signals.temperature))
     check = est.route_check
     if check is not None and other is not None and other.params is not None and terms.kept:
         rows = fitted_rows(check.qd[:, i], check.tau_f[:, i], check.valid[:, i], check.smoother, other.stick_speed,

@@ -35,6 +35,7 @@ from wbfriction.friction.fit import (
 )
 from wbfriction.friction.holdout import MIN_HELD_OUT, PredictionCheck, prediction_check, prediction_variance
 from wbfriction.friction.noise import joint_noises
+from wbfriction.friction.ranges import OUTSIDE, RangeUse
 from wbfriction.friction.status import MIN_SPEED, joint_speed
 from wbfriction.friction.terms import TermFit, term_signals
 
@@ -61,6 +62,10 @@ class TorquePrediction:
         terms: per joint, the terms beyond velocity its model predicted with (:mod:`~wbfriction.friction.terms`).
         checks: per joint, whether the fit predicts this log as well as its noise and its standard errors allow
             (:func:`other_log_checks`), or None (not checked: no fit, the joint still in this log).
+        ranges: per joint, where this log's signals leave the ranges its terms were fitted on
+            (:meth:`~wbfriction.friction.terms.TermFit.range_use`), or None (no term kept). A joint ``ok`` by its fit
+            but used well outside them (beyond a range by more than its width) has the status
+            :data:`~wbfriction.friction.ranges.OUTSIDE` instead, whoever sets :attr:`status`.
     """
 
     joints: tuple[str, ...]
@@ -71,6 +76,13 @@ class TorquePrediction:
     status: tuple[str, ...] = ()
     terms: tuple[tuple[str, ...], ...] = ()
     checks: tuple[PredictionCheck | None, ...] = ()
+    ranges: tuple[RangeUse | None, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.status and self.ranges:  # a fit's ok does not cover a log beyond what it was fitted on
+            object.__setattr__(self, "status", tuple(
+                OUTSIDE if status == "ok" and use is not None and use.far else status
+                for status, use in zip(self.status, self.ranges, strict=True)))
 
     def overall(self, rms: np.ndarray) -> float:
         """The RMS over every joint's valid samples of one of the per-joint RMS arrays (``rms`` or
@@ -96,7 +108,8 @@ def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve 
         friction: joint -> friction model (its ``f(qd)``), e.g. the fitted parameters of
             :func:`~wbfriction.friction.io.read_params`, or a model with terms beyond velocity
             (:class:`~wbfriction.friction.terms.TermFit`: its torque on ``est``'s angles, torques and temperatures,
-            the ripple included); joints without one get NaN.
+            the ripple included; where they leave the ranges it was fitted on, :attr:`TorquePrediction.ranges`
+            says so); joints without one get NaN.
         source: where ``est`` was read from, for the messages.
 
     Raises:
@@ -110,6 +123,7 @@ def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve 
     n = len(est.joints)
     rms, rigid, scale = np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan)
     samples = est.valid.sum(axis=0)
+    ranges: list[RangeUse | None] = [None] * n
     for i, joint in enumerate(est.joints):
         valid = est.valid[:, i] & np.isfinite(est.tau_f[:, i])
         rigid[i] = _rms(est.tau_f[:, i], valid)
@@ -118,6 +132,7 @@ def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve 
             if isinstance(curve, TermFit):  # with its terms beyond velocity, on this log's signals
                 signals = term_signals(est, i)
                 curve.check_signals(signals, joint, source)
+                ranges[i] = curve.range_use(signals, valid, joint)
                 model = curve.torque(est.qd[:, i], signals)
             else:
                 model = -curve.f(est.qd[:, i])
@@ -128,7 +143,7 @@ def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve 
         if tau is not None:
             scale[i] = _rms(tau[:, i], valid)
     terms = tuple(m.kept if isinstance(m := friction.get(j), TermFit) else () for j in est.joints)
-    return TorquePrediction(tuple(est.joints), samples, rms, rigid, scale, terms=terms)
+    return TorquePrediction(tuple(est.joints), samples, rms, rigid, scale, terms=terms, ranges=tuple(ranges))
 
 
 FASTER = 1.25

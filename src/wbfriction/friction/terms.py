@@ -23,9 +23,10 @@ weighted least-squares solve fits them together (``term_selection.fit_terms``). 
   way the joint moves, a model error that follows the trajectory does (on the KUKA LWR4+, the wrist's ripple carries
   over by 44-50 %, the upper arm's "ripple" makes the other direction worse by 10-35 %); and with no more harmonics than
   its angles tell apart (``term_selection.MAX_CONDITION``). It is not dissipative: it is reported apart, left out of the
-  energy check (eq. 7.9) and of the exports; predictions include it, within the angles it was fitted on (outside,
-  it is held at its value at the nearest fitted angle: a Fourier series fitted on less than a turn is not known
-  beyond its data, and would run away there).
+  energy check (eq. 7.9) and of the exports; predictions include it, at the angle reduced modulo 2π into the turn
+  around the angles it was fitted on (a continuous joint logged on another branch is at the same angle,
+  :func:`ripple_angle`), within those angles (outside, it is held at its value at the nearest fitted angle: a
+  Fourier series fitted on less than a turn is not known beyond its data, and would run away there).
 * ``temperature``: the Coulomb and viscous levels ``F_c + F_cT phi(T - T_ref)`` and ``F_v + F_vT phi(T - T_ref)``,
   ``T`` the logged joint temperature [°C], ``T_ref`` the reference temperature every output states: coefficients
   ``F_cT`` on ``phi g`` and ``F_vT`` on ``phi qd``, the levels' slopes at ``T_ref`` [N·m/°C, N·m·s/(rad·°C)]
@@ -63,6 +64,7 @@ from wbfriction.friction.models import (
     params_from_dict,
 )
 from wbfriction.friction.options import TERMS, Term
+from wbfriction.friction.ranges import TERM_SIGNAL, FittedRanges, RangeUse, SignalUse, ripple_angle, same_turn
 from wbfriction.friction.status import TERM_WEAK, FitVerdict, routes_disagree
 
 NOT_DISSIPATIVE: tuple[Term, ...] = ("ripple",)
@@ -220,7 +222,8 @@ class TermFit:
             ``F_c+ = F_c + tau_os``, ``F_c- = F_c - tau_os``, ``k_Tc``, ``k_Tv`` [1/°C], ``ripple_rms``: the ripple's
             standard deviation over the samples fitted [N·m]).
         reference_temperature: ``T_ref`` [°C] (None: no temperature term tried).
-        q_range: the angles the ripple was fitted on, ``(q_min, q_max)`` [rad] (None: no ripple).
+        q_range: the angles the ripple was fitted on, ``(q_min, q_max)`` [rad] (None: no ripple); it predicts at
+            angles reduced modulo 2π and held within them (:func:`ripple_angle`).
         reasons: per term tried, why it was kept or not (one sentence).
         held_out_rms: the held-out RMS [N·m] of the velocity model alone and with the terms kept.
         check: the kept terms refitted on the other route's estimate (``term_selection.refit_terms``), or None.
@@ -231,6 +234,9 @@ class TermFit:
             the terms, the data would put them below it (standard error 0: held, not fitted).
         covariance: the coefficients' covariance, the velocity model's (:func:`velocity_basis` order) then the
             terms', or None (read from a parameters file, which keeps the standard errors only).
+        ranges: the angles, loads and temperatures of the samples fitted
+            (:class:`~wbfriction.friction.ranges.FittedRanges`), or None (not recorded: a parameters file of an
+            earlier version); a prediction says where a table leaves them (:meth:`range_use`).
     """
 
     params: ModelParams
@@ -247,6 +253,7 @@ class TermFit:
     at_bound: tuple[str, ...] = ()
     covariance: np.ndarray | None = field(default=None, repr=False, compare=False)
     later: dict[str, tuple[float, float]] = field(default_factory=dict)
+    ranges: FittedRanges | None = None
 
     @property
     def temperature_rate(self) -> float:
@@ -305,13 +312,15 @@ class TermFit:
                 "held_out_rms": [clean(x) for x in self.held_out_rms],
                 "check": None if self.check is None else self.check.to_dict(), "at_bound": list(self.at_bound),
                 "later": {t: [clean(d), clean(a)] for t, (d, a) in self.later.items()},
+                "ranges": None if self.ranges is None else self.ranges.to_dict(),
                 "status": {t: v.status for t, v in verdicts.items()},
                 "status_reason": {t: v.reason for t, v in verdicts.items() if v.reason}}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> TermFit:
         """Inverse of :meth:`to_dict` (``null`` reads back as ``inf`` for a standard error, NaN otherwise; the
-        statuses follow from the rest).
+        statuses follow from the rest; without ``ranges``, a file of an earlier version, the ranges are not known).
+        What the values may be is checked by the parameters file's reader (:mod:`~wbfriction.friction.params_check`).
 
         Raises:
             InputError: a missing key, an unknown term or model, a value of the wrong kind (named).
@@ -321,6 +330,7 @@ class TermFit:
             rng = d.get("q_range")
             check = d.get("check")
             t_ref = d.get("reference_temperature")
+            ranges = d.get("ranges")
             return cls(params_from_dict(str(d["model"]), d["params"]), kept, int(d.get("harmonics", 0)),
                        {str(k): float(v) for k, v in d["coefficients"].items()},
                        {str(k): math.inf if v is None else float(v) for k, v in (d.get("stderr") or {}).items()},
@@ -332,7 +342,8 @@ class TermFit:
                        None if check is None else TermCheck.from_dict(check),
                        tuple(str(n) for n in d.get("at_bound", ())),
                        later={str(t): (_number(v[0]), math.inf if v[1] is None else float(v[1]))
-                              for t, v in (d.get("later") or {}).items()})
+                              for t, v in (d.get("later") or {}).items()},
+                       ranges=None if ranges is None else FittedRanges.from_dict(ranges))
         except KeyError as exc:
             raise InputError(f"terms: missing key {exc}") from None
         except (TypeError, ValueError, AttributeError, IndexError) as exc:
@@ -351,6 +362,33 @@ class TermFit:
                 column = f"{SIGNAL_COLUMNS[term]}.{joint}"
                 raise InputError(f"{source}: no column '{column}': the fit's {term} term needs it (estimate the "
                                  "log again with this version; a temperature term needs the log's temperature)")
+
+    def range_use(self, signals: TermSignals, rows: np.ndarray, joint: str = "") -> RangeUse:
+        """Where the samples ``rows`` (N,) bool of ``signals`` leave the ranges these terms were fitted on
+        (:mod:`~wbfriction.friction.ranges`), for each kept term that reads a signal: the ripple's angle, reduced
+        modulo 2π as it predicts with it (:func:`~wbfriction.friction.ranges.ripple_angle`), against
+        :attr:`q_range`; the load's magnitude and the temperature against :attr:`ranges` (not recorded: said so)."""
+        outside: list[SignalUse] = []
+        unknown: list[str] = []
+        for term in self.kept:
+            signal = TERM_SIGNAL.get(term)
+            if signal is None:
+                continue
+            fitted = self.q_range if signal == "angle" else None if self.ranges is None else self.ranges.get(signal)
+            if fitted is None:
+                unknown.append(term)
+                continue
+            x = {"angle": signals.q, "load": signals.tau_load, "temperature": signals.temperature}[signal]
+            if x is None:
+                continue
+            x = np.asarray(x, dtype=float)[rows]
+            x = np.abs(x) if signal == "load" else same_turn(x, fitted) if signal == "angle" else x
+            x = x[np.isfinite(x)]
+            excess = np.maximum(fitted[0] - x, x - fitted[1])
+            if x.size and excess.max() > 0:
+                outside.append(SignalUse(signal, fitted, (float(x.min()), float(x.max())),
+                                         float(np.mean(excess > 0)), float(excess.max())))
+        return RangeUse(joint, tuple(outside), tuple(unknown))
 
     def speed_friction(self, v: float, load: float = 0.0) -> tuple[float, float]:
         """The dissipative friction at speed ``v`` [rad/s] at the reference temperature ``T_ref``, without the
@@ -397,7 +435,11 @@ class TermFit:
                 rate = self.temperature_rate
                 f += (c["F_cT"] * g + c["F_vT"] * qd) * (dT if rate == 0.0 else math.expm1(rate * dT) / rate)
             else:
-                angle = q if self.q_range is None else min(max(q, self.q_range[0]), self.q_range[1])
+                angle = q
+                if self.q_range is not None:  # ripple_angle of one float
+                    lo, hi = self.q_range
+                    angle = q - 2.0 * math.pi * round((q - 0.5 * (lo + hi)) / (2.0 * math.pi))
+                    angle = min(max(angle, lo), hi)
                 f += sum(c[f"ripple_sin{h}"] * math.sin(h * angle) + c[f"ripple_cos{h}"] * math.cos(h * angle)
                          for h in range(1, self.harmonics + 1))
         return -f
@@ -405,7 +447,7 @@ class TermFit:
     def _value(self, qd: np.ndarray, signals: TermSignals, dissipative: bool) -> np.ndarray:
         f = self.params.f(qd)
         if self.q_range is not None and signals.q is not None:  # the ripple is known on its fitted angles only
-            signals = replace(signals, q=np.clip(signals.q, *self.q_range))
+            signals = replace(signals, q=ripple_angle(signals.q, self.q_range))
         for term in self.kept:
             if dissipative and term in NOT_DISSIPATIVE:
                 continue
