@@ -34,6 +34,7 @@ from wbfriction.friction.fit import FitResult, HeldOutScore, ModelSelection, Rou
 from wbfriction.friction.holdout import PredictionCheck
 from wbfriction.friction.models import check_model, params_from_dict, target_from_dict
 from wbfriction.friction.options import ROUTES
+from wbfriction.friction.params_check import check_model_params, check_terms
 from wbfriction.friction.terms import TermFit
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.tables import file_sha256, numeric_column, read_metadata, read_table, with_metadata, write_json
@@ -345,11 +346,13 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
     identifiable). Without ``model`` (files of earlier versions) the parameters are those of (3.5);
     without ``at_bound``, no parameter is known to be at a bound (an empty table); without ``speed``, how much
     the joint moved is not known. ``status`` is not read: it follows from the rest
-    (:meth:`~wbfriction.friction.fit.FitResult.verdict`).
+    (:meth:`~wbfriction.friction.fit.FitResult.verdict`). The values are held to what ``fit`` writes
+    (:mod:`~wbfriction.friction.params_check`: dissipative parameters, terms whole and consistent with the model).
 
     Raises:
         InputError: an unknown model, unknown parameter names (or ``at_bound`` names that are not
-            the model's), a value that is not a number.
+            the model's), a value that is not a number, a value :mod:`~wbfriction.friction.params_check` refuses
+            (naming its key).
     """
     try:
         model = check_model(str(d.get("model", "thesis")))
@@ -393,6 +396,10 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
         if "rms_error_vs_true" in d:
             res.rms_error_vs_true = _number(d["rms_error_vs_true"])
             res.rms_model_vs_true = _number(d.get("rms_model_vs_true"))
+        if res.params is not None:  # what 'fit' writes, and nothing else (issue 53)
+            check_model_params(res.params, "params")
+        if res.terms is not None:
+            check_terms(res.terms, model)
     except KeyError as exc:
         raise InputError(f"missing key {exc}") from None
     except (TypeError, ValueError, AttributeError) as exc:
