@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pyarrow as pa
 import pytest
 
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import InputError, OptionError
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.options import EstimateOptions
+from wbfriction.friction.options import EstimateOptions, MomentumOptions
 from wbfriction.logs.log import log_from_table
+from wbfriction.signals.options import FilterOptions
 
 
 def _drop(talos, log, start: int, stop: int, n: int):
@@ -112,3 +115,66 @@ def test_a_gap_costs_an_arm_no_contact_margins(panda_sim):
     apart = np.concatenate([estimate_log(robot, part, opts).valid for part in log.parts()])
     np.testing.assert_array_equal(whole.valid, apart)
     assert whole.valid[a + 1:a + 100].all() and whole.valid[a - 100:a - 1].all()
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    (dict(route="momentum", momentum=MomentumOptions(None, 99_999)),
+     "--momentum-window must be at most the 1000 samples of the log's longest stretch without a time gap, "
+     "got 99999"),
+    (dict(route="momentum", momentum=MomentumOptions(5_001, None)), "--velocity-window must be at most the 1000"),
+    (dict(route="momentum", momentum=MomentumOptions(501, 601)),
+     "--momentum-window must be at most the 1000 samples of the log's longest stretch without a time gap, less "
+     "--velocity-window 501 - 1, got 601"),
+    (dict(route="acceleration", diff="savgol", filtering=FilterOptions(window=2_001)),
+     "--window must be at most the 1000 samples"),
+    (dict(route="acceleration", diff="butterworth", filtering=FilterOptions(cutoff=0.05)),
+     "--cutoff must be high enough for the filter's response"),
+    (dict(route="acceleration", diff="butterworth", filtering=FilterOptions(cutoff=1e-6)),
+     "--cutoff must be high enough for the filter's response"),
+])
+def test_a_window_no_stretch_of_the_log_holds_is_refused_naming_the_option(panda_sim, options, message):
+    """Issue 53: a window longer than the log (a 2.3 TiB allocation for --momentum-window 99999, or 'no
+    single-support sample' on an arm) is refused in one line naming the option, before the work."""
+    import time
+    robot, table = panda_sim
+    log = log_from_table(table.slice(0, 1000), robot, "short")
+    start = time.perf_counter()
+    with pytest.raises(OptionError, match=re.escape(message)):
+        estimate_log(robot, log, EstimateOptions(**options))
+    assert time.perf_counter() - start < 8.0  # the noise measured, nothing estimated
+
+
+def test_stretches_too_short_for_any_window_are_refused_in_one_line(panda_sim):
+    """Five-sample stretches between 10 ms dropouts: the momentum route's least windows (7 and 3 samples) do
+    not fit; the one line says how long the stretches are, not 'no single-support sample'."""
+    robot, table = panda_sim
+    k = np.arange(table.num_rows)
+    log = log_from_table(table.take(pa.array(np.flatnonzero(k % 15 < 5))), robot, "seg5")
+    with pytest.raises(InputError, match=re.escape("seg5: the longest stretch without a time gap has 5 samples, "
+                                                   "fewer than the momentum route's windows")):
+        estimate_log(robot, log, EstimateOptions(route="momentum"))
+
+
+def test_a_fit_on_stretches_too_short_to_measure_the_noise_is_never_ok(panda_sim):
+    """Issue 53: 10 ms dropouts every 60 ms leave 50-sample stretches, too short to measure the positions' noise
+    (no Cramér-Rao bound, central differences): no fit is called ok, each says why."""
+    from wbfriction.friction.fit import fit_estimate
+    robot, table = panda_sim
+    k = np.arange(table.num_rows)
+    log = log_from_table(table.take(pa.array(np.flatnonzero(k % 60 < 50))), robot, "drop10")
+    assert len(log.segments) > 40 and max(b - a for a, b in log.segments) == 50
+    est = estimate_log(robot, log)
+    verdicts = [f.verdict() for f in fit_estimate(est)]
+    assert all(v.status not in ("ok",) for v in verdicts), verdicts
+    weak = [v for v in verdicts if v.status == "weak"]
+    assert weak and all("the positions' noise could not be measured: the longest stretch without a time gap has 50 "
+                        "samples" in v.reason for v in weak), verdicts
+
+
+def test_an_arm_is_told_why_nothing_was_estimated_without_contacts_or_masks(panda_sim):
+    """Issue 53: on a fixed base (always welded) the error names the windows, not contact columns or --mask."""
+    from wbfriction.friction.estimated import no_single_support
+    robot, _ = panda_sim
+    message = str(no_single_support(robot, "arm.parquet"))
+    assert message.startswith("arm.parquet: no sample with defined derivatives: every stretch between time gaps")
+    assert "contact." not in message and "--mask" not in message

@@ -25,7 +25,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import InputError, OptionError
 from wbfriction.friction.estimated import FrictionEstimate, no_single_support
 from wbfriction.friction.measured import (
     base_route,
@@ -255,14 +255,19 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
             raise (no segment can be estimated; with ``require_single_support``, no
             single-support sample in the whole log).
     """
+    given = options
     options, choice = resolve_differentiation(options, log)
     options, decision = resolve_route(options, log, choice=choice)
+    check_windows(given, options, log.segments, len(log.time), log.dt, log.source)
     est = estimate_resolved(robot, log, options, progress, companion, require_single_support)
     a, b = longest_segment(log.segments, len(log.time))
     record = noise_record(robot, log.q[a:b], log.dt, options)
+    unmeasured = unmeasured_noise(record, b - a, options)
     for e in (est, est.route_check):
         if e is None:
             continue
+        if unmeasured:
+            e.metadata["noise_unmeasured"] = unmeasured
         if choice is not None:
             e.metadata["differentiation"] = choice.to_dict()
         if decision is not None:
@@ -293,6 +298,75 @@ def resolve_differentiation(options: EstimateOptions, source: Log | np.ndarray |
     except InputError as exc:  # too short a log to measure its noise: say so, differentiate it plainly
         choice = DiffChoice.fallback(f"central differences: {exc}")
     return replace(options, diff=choice.scheme, filtering=choice.filtering), choice
+
+
+def unmeasured_noise(record: dict | None, longest: int, options: EstimateOptions) -> str:
+    """Why a fit of this estimate cannot be called ``ok`` (the metadata's ``noise_unmeasured``,
+    :attr:`~wbfriction.friction.fit.FitResult.unmeasured`): the positions' noise not measured (``record`` None) on
+    the ``longest`` samples between time gaps, so no Cramér-Rao bound says what the data allow; "" when measured,
+    or for the simulators' true derivatives (no noise)."""
+    if record is not None or options.diff == "true":
+        return ""
+    return (f"the positions' noise could not be measured: the longest stretch without a time gap has {longest} "
+            "samples (no Cramér-Rao bound)")
+
+
+FILTER_SPAN = 5_000_000
+"""Rows beyond which a Butterworth filter's response is not computed (its cutoff refused): 40 MB per array."""
+
+
+def check_windows(given: EstimateOptions, options: EstimateOptions, segments: list[tuple[int, int]] | None,
+                  rows: int, dt: float, source: str) -> None:
+    """Refuse, before any work, windows no stretch of the log between two time gaps can hold: nothing would be
+    estimated (or a filter's response too long to compute). The option is named when it was given (``given``, the
+    options before :func:`resolve_differentiation` and :func:`~wbfriction.friction.route.resolve_route`); a window
+    the data chose is refused with the stretches' length.
+
+    Args:
+        given: the options as asked; options: resolved.
+        segments: the log's row ranges between time gaps (None: one); rows: its length; dt: its step [s].
+
+    Raises:
+        OptionError: a given window (``--window``, ``--cutoff``, ``--momentum-window``, ``--velocity-window``) longer
+            than the longest stretch; InputError: a chosen one, or stretches too short for any scheme.
+    """
+    a, b = longest_segment(segments, rows)
+    longest = b - a
+    where = f"at most the {longest} samples of the log's longest stretch without a time gap"
+    asked = given.diff != "auto"
+    if options.route == "momentum":
+        vw, w = options.momentum.velocity_window, options.momentum.window
+        if vw is None or w is None:
+            return
+        for flag, value, was in (("--momentum-window", w, given.momentum.window),
+                                 ("--velocity-window", vw, given.momentum.velocity_window)):
+            if value > longest and was is not None:
+                raise OptionError(flag, value, where)
+        need, what = w + vw - 1, f"the momentum route's windows (--velocity-window {vw}, --momentum-window {w})"
+        if need > longest and given.momentum.window is not None and given.momentum.velocity_window is not None:
+            raise OptionError("--momentum-window", w, f"{where}, less --velocity-window {vw} - 1")
+    elif options.diff == "savgol":
+        need, what = options.filtering.window, f"a Savitzky-Golay window of {options.filtering.window} (--window)"
+        if need > longest and asked:
+            raise OptionError("--window", need, where)
+    elif options.diff == "butterworth":
+        from wbfriction.signals.filters import ZeroPhaseLowpass
+        f = options.filtering
+        span = int(20 * f.butter_order / (f.cutoff * dt)) + 1 if f.cutoff > 0 else FILTER_SPAN + 1
+        # the response's half width is at least a hundredth of ``span`` (FILTER_SPAN: not computed beyond it)
+        if span > FILTER_SPAN or span // 100 > longest:
+            need = 2 * (span // 100) + 1
+        else:
+            need = 2 * ZeroPhaseLowpass(f.cutoff, f.butter_order, dt).half_width + 1
+        what = f"a Butterworth filter of {f.cutoff:g} Hz, order {f.butter_order} ({need} samples or more; --cutoff)"
+        if need > longest and asked:
+            raise OptionError("--cutoff", f.cutoff, f"high enough for the filter's response ({need} samples or "
+                              f"more) to fit in {where.removeprefix('at most ')}")
+    else:
+        need, what = 3, f"{options.diff} differences"
+    if need > longest:
+        raise InputError(f"{source}: the longest stretch without a time gap has {longest} samples, fewer than "
+                         f"{what} needs ({need}): nothing could be estimated")
 
 
 def estimate_resolved(robot: Robot, log: Log, options: EstimateOptions, progress: Progress | None = None,

@@ -98,7 +98,12 @@ class FrictionEstimate:
 
 
 def no_single_support(robot: Robot, source: str) -> InputError:
-    """The error of a log without a single-support sample, naming it and its contact columns."""
+    """The error of a log without a single-support sample, naming it and its contact columns; on a fixed base
+    (always welded: every sample is one), a log without a sample whose derivatives are defined."""
+    if not robot.floating_base:
+        return InputError(f"{source}: no sample with defined derivatives: every stretch between time gaps is "
+                          "shorter than the differentiation's window (--window, --cutoff, --velocity-window, "
+                          "--momentum-window)")
     return InputError(f"{source}: no single-support sample (exactly one of the columns "
                       f"{', '.join('contact.' + f for f in robot.contact_frames)} set) with defined derivatives "
                       "outside the lift-off and touch-down margins (--lift-off, --touch-down) and the "

@@ -303,6 +303,8 @@ class FitResult(Generic[ParamsT]):
             them), or None: none tried.
         later: how the same model fitted on the earliest samples predicts the last ones
             (:mod:`~wbfriction.friction.holdout`, :func:`later_stretch`), or None: not checked.
+        unmeasured: why the estimate's noise is not known (its positions' noise not measured: no Cramér-Rao bound),
+            or "": the fit is then never ``ok`` (:func:`~wbfriction.friction.status.fit_verdict`).
     """
 
     joint: str
@@ -331,6 +333,7 @@ class FitResult(Generic[ParamsT]):
     pass_rows: float = PASS_ROWS
     terms: TermFit | None = None
     later: PredictionCheck | None = None
+    unmeasured: str = ""
 
     def __post_init__(self) -> None:
         if self.params is not None:
@@ -1131,6 +1134,7 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
     checked = [other for _, other in pairs]
     for f, other in zip(fits, checked):
         f.route = est.estimation_route
+        f.unmeasured = str(est.metadata.get("noise_unmeasured", ""))  # never ok then (issue 53)
         if check is not None and other is not None:
             other.route = check.estimation_route
             f.route_check = compare_routes(f, other)
@@ -1143,7 +1147,7 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
                 task = _without_terms(tasks[k], f.kept_terms, est, i)
                 refit = _with_truth([names[k]], [_fit_column(task)], est.qd[:, [i]], est.tau_f[:, [i]],
                                     est.valid[:, [i]], None if truth is None else truth[:, [k]], targets)[0]
-                refit.route, refit.route_check = f.route, f.route_check
+                refit.route, refit.route_check, refit.unmeasured = f.route, f.route_check, f.unmeasured
                 if refit.params is None or not refit.success:  # a refit that did not converge: the fit before it
                     break
                 other_task = others[k]

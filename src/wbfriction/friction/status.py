@@ -29,6 +29,8 @@ status, the first that applies:
   or bound stands for more than :data:`WEAK` of the friction the joint shows (``F_c``'s in N·m, ``F_v``'s times
   the joint's speed or :data:`READ_SPEED`, against the friction's odd part at the joint's speed and the residual's
   RMS: ``F_c = 0 ± 1.1`` beside a friction of 1 N·m is no finding);
+  a fit on an estimate whose positions' noise could not be measured (a log, or its stretches between time gaps,
+  too short: no Cramér-Rao bound to hold its standard errors to) is ``weak`` too, and says so (issue 53);
 * ``ok``: none of these.
 
 A fit that kept terms beyond velocity (:mod:`~wbfriction.friction.terms`) is judged on the model it predicts and
@@ -185,9 +187,15 @@ def fit_verdict(fit: Fit, thresholds: StatusThresholds = DEFAULT_THRESHOLDS) -> 
                                                                 thresholds.holdout_friction):
         return FitVerdict("does not predict", fit.later.describe())
     weak = _weak(fit, values, thresholds.weak)
-    if weak:
-        return FitVerdict("weak", "large standard errors: " + ", ".join(weak))
-    return FitVerdict("ok")
+    return _weak_verdict(fit, weak)
+
+
+def _weak_verdict(fit: Fit, weak: list[str]) -> FitVerdict:
+    """``weak`` for the large standard errors ``weak`` or a noise not measured (``fit.unmeasured``), else ``ok``."""
+    unmeasured = str(getattr(fit, "unmeasured", "") or "")
+    reasons = ([unmeasured] if unmeasured else []) + (
+        ["large standard errors: " + ", ".join(weak)] if weak else [])
+    return FitVerdict("weak", "; ".join(reasons)) if reasons else FitVerdict("ok")
 
 
 HELD = ("a", "v_s")
@@ -237,9 +245,7 @@ def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THR
                            rms_residual=fit.rms_residual)
     weak = _weak(cast(Fit, view), values, thresholds.weak) + [f"{t} {v.reason.removeprefix('large standard errors: ')}"
                                              for t, v in others.items() if v.status == "weak"]
-    if weak:
-        return FitVerdict("weak", "large standard errors: " + ", ".join(weak))
-    return FitVerdict("ok")
+    return _weak_verdict(fit, weak)
 
 
 def _weak(fit: Fit, values: dict[str, float], limit: float = WEAK) -> list[str]:

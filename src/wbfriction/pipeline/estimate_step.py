@@ -25,7 +25,13 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from wbfriction.exceptions import InputError, OutputError
-from wbfriction.friction.estimate import estimate_resolved, no_single_support, resolve_differentiation
+from wbfriction.friction.estimate import (
+    check_windows,
+    estimate_resolved,
+    no_single_support,
+    resolve_differentiation,
+    unmeasured_noise,
+)
 from wbfriction.friction.io import friction_table
 from wbfriction.friction.noise import noise_record
 from wbfriction.friction.options import EstimateOptions
@@ -175,7 +181,10 @@ def _with_provenance(tables: Iterator[pa.Table], chunks: list[Chunk], robot: Rob
     if not single:
         raise no_single_support(robot, source)
     if not any(valid.values()):
-        raise InputError(f"{source}: no valid sample for any joint (the --mask leaves none)")
+        why = ("the --mask, --lift-off and --touch-down leave none" if robot.floating_base else
+               "derivatives defined nowhere: the stretches between time gaps are shorter than the differentiation's "
+               "window")
+        raise InputError(f"{source}: no valid sample for any joint ({why})")
 
 
 def no_valid_warnings(source: str, valid: dict[str, int]) -> tuple[str, ...]:
@@ -249,15 +258,19 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     if first is not None:  # the noise is measured on one segment: a gap between two recordings is no noise
         a, b = longest_segment(clock.segments, len(first))
         first = first[a:b]
+    given = options
     options, choice = resolve_differentiation(options, first, clock.step)
     if choice is not None:
         extra_metadata = {**(extra_metadata or {}), "differentiation": choice.to_dict()}
     options, decision = resolve_route(options, first, clock.step, choice)
+    check_windows(given, options, clock.segments, len(clock), clock.step, source)
     if decision is not None:
         extra_metadata = {**(extra_metadata or {}), "route": decision.to_dict()}
     record = None if first is None else noise_record(robot, first, clock.step, options)
     if record is not None:
         extra_metadata = {**(extra_metadata or {}), "noise": record}
+    elif first is not None and unmeasured_noise(record, len(first), options):
+        extra_metadata = {**(extra_metadata or {}), "noise_unmeasured": unmeasured_noise(record, len(first), options)}
     n = len(contact)
     chunks = plan_chunks(contact, chunking)
     del contact
