@@ -104,3 +104,28 @@ def test_panda_from_a_simulated_log_to_mujoco(tmp_path):
         dof = mj.joint(j).dofadr[0]
         want = (ok[j]["F_v"], ok[j]["F_c"]) if j in ok else (0.0, 0.0)
         assert (mj.dof_damping[dof], mj.dof_frictionloss[dof]) == want, j
+
+
+@pytest.mark.parametrize("suffix", [".urdf", ".xml", ".yaml"])
+def test_an_export_on_a_full_disk_is_one_line_and_keeps_the_previous_file(panda_params, tmp_path, suffix):
+    """Issue 53: on a full disk (here ``ulimit -f``, 1 kB) ``export -o x.urdf`` ended in lxml's SerialisationError
+    traceback while .xml and .yaml gave the one line of every writer: now all three do, status 1, the previous file
+    byte for byte and no temporary file left."""
+    import os
+    import resource
+    import subprocess
+    import sys
+
+    out = tmp_path / f"robot{suffix}"
+    out.write_bytes(PREVIOUS)
+    before = sorted(p.name for p in tmp_path.iterdir())
+
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (1024, 1024))
+
+    res = subprocess.run([sys.executable, "-m", "wbfriction", "export", str(panda_params), "--robot", "panda", "-o",
+                          str(out)], capture_output=True, text=True, preexec_fn=limit,
+                         env=dict(os.environ, COLUMNS="200", PYTHONDONTWRITEBYTECODE="1"))
+    assert res.returncode == 1 and lines(res.stderr) == [
+        f"error: {out}: cannot be written: [Errno 27] File too large (the previous file is kept)"], res.stderr
+    assert out.read_bytes() == PREVIOUS and sorted(p.name for p in tmp_path.iterdir()) == before

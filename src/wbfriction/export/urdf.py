@@ -21,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 from lxml import etree as ET
 
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import InputError, OutputError
 from wbfriction.export.mapping import NOTE_PREFIX, FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.inertia.regressor import body_parameters
 from wbfriction.inertia.urdf import write_urdf
@@ -95,6 +95,8 @@ def write_friction_urdf(robot: Robot, friction: Mapping[str, FrictionLike], path
         InputError: friction that is not dissipative, a joint the robot does not actuate, an
             inertia model of another robot, an unreadable URDF (or a robot loaded from an MJCF), an output
             folder that does not exist.
+        OutputError: the system refused the write (a full disk, ``ulimit -f``:
+            :func:`~wbfriction.logs.tables.write_atomic`), nothing written.
     """
     robot.require_urdf("a .urdf export (the robot's URDF with <dynamics>)")
     joints = joint_exports(friction, armature, robot)
@@ -104,10 +106,15 @@ def write_friction_urdf(robot: Robot, friction: Mapping[str, FrictionLike], path
     def write(tmp: Path) -> None:
         nonlocal moved
         if pi is not None:
-            moved = write_urdf(robot, pi, tmp)
+            try:
+                moved = write_urdf(robot, pi, tmp)
+            except OutputError as exc:  # refused beside ours: the same refusal, reported for the output named
+                raise (OSError(exc.errno, exc.reason) if exc.errno is not None else OSError(exc.reason)) from exc
         tree = read_urdf(tmp if pi is not None else robot.urdf)
         set_dynamics(tree.getroot(), joints)
-        tree.write(str(tmp), xml_declaration=True, encoding="utf-8")
+        # serialised in memory, then written by Python: a refused write is the OSError write_atomic reports in one
+        # line (lxml's own file writing raised its SerialisationError on a full disk, a traceback)
+        tmp.write_bytes(ET.tostring(tree, xml_declaration=True, encoding="utf-8"))
 
     write_atomic(path, write)
     return moved
