@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -97,3 +98,19 @@ def test_floating_base_must_be_a_boolean(tmp_path):
 def test_floating_robots_are_unchanged(talos):
     assert talos.floating_base and talos.contact_frames == ("left_sole_link", "right_sole_link")
     assert talos.locked_joints == {} and talos.torque_constants == {}
+
+
+@pytest.mark.parametrize("value", ["-0.5", "nan"])
+def test_a_link_of_negative_or_no_number_mass_is_refused_naming_it(tmp_path, value):
+    """Issue 53: a URDF whose link has a negative mass (a sign typo) estimated as if it were physics; refused at
+    load, in one line naming the file and the link."""
+    text = (example_robot_data_dir() / PANDA).read_text()
+    start = text.index('<link name="panda_link3">')
+    at = text.index('<mass value="', start) + len('<mass value="')
+    end = text.index('"', at)
+    urdf = tmp_path / "panda.urdf"
+    urdf.write_text(text[:at] + value + text[end:])
+    cfg = tmp_path / "panda.toml"
+    cfg.write_text('name = "panda"\nfloating_base = false\n')
+    with pytest.raises(InputError, match=re.escape(f"{urdf}: link 'panda_link3' has a mass of {value} kg")):
+        load_robot(urdf=urdf, config=cfg)

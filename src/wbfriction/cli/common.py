@@ -233,6 +233,8 @@ def main() -> None:
     :attr:`~wbfriction.exceptions.WbfrictionError.exit_status`). Interruptions (Ctrl-C, SIGTERM)
     are :mod:`wbfriction.entry`'s, which calls this."""
     try:
+        from wbfriction.pipeline.paths import refuse_empty_outputs
+        refuse_empty_outputs(sys.argv[1:])  # -o "": Path("") is the working folder
         status = app(standalone_mode=False)
     except WbfrictionError as exc:
         console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)

@@ -231,6 +231,29 @@ def _lock_joints(model: pin.Model, config: dict, q_ref: np.ndarray | None,
     return reduced, q_red, values
 
 
+def _check_masses(path: Path) -> None:
+    """Refuse a URDF link whose ``<mass value>`` is negative or not a number (a sign typo estimates as physics:
+    Pinocchio takes it), naming the link; a file that does not parse is left to Pinocchio's message."""
+    import math
+    import xml.etree.ElementTree as ET
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError):
+        return
+    for link in root.iter("link"):
+        mass = link.find("inertial/mass")
+        if mass is None:
+            continue
+        text = mass.get("value", "")
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not value >= 0.0:
+            raise InputError(f"{path}: link '{link.get('name')}' has a mass of {text} kg: a link's mass is a "
+                             "number >= 0")
+
+
 def build_model(path: Path, model_format: ModelFormat = "urdf", free_flyer: bool = True) -> pin.Model:
     """The Pinocchio model of a URDF or MJCF file: the one place where the two formats differ.
 
@@ -248,12 +271,15 @@ def build_model(path: Path, model_format: ModelFormat = "urdf", free_flyer: bool
             False: the file's root welded to the world (a fixed-base model as the file has it).
 
     Raises:
-        InputError: a missing file, one that does not load, or (``free_flyer``) an MJCF whose root
+        InputError: a missing file, one that does not load, a URDF link of negative mass (named), or
+            (``free_flyer``) an MJCF whose root
             joint is not free (a hinge at its top body).
     """
     kind = model_format.upper()
     if not path.is_file():
         raise InputError(f"{path}: {kind} file not found")
+    if model_format == "urdf":
+        _check_masses(path)
     try:
         with _quiet_stderr():
             if model_format == "urdf":

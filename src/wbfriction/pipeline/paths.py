@@ -13,7 +13,7 @@ import os
 from collections.abc import Mapping
 from pathlib import Path
 
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import InputError, OptionError
 
 
 def _same(a: Path, b: Path) -> bool:
@@ -62,3 +62,21 @@ def check_paths(inputs: Mapping[str, Path | None], outputs: Mapping[str, Path | 
             if _same(path, other):
                 raise InputError(f"{label} {path}: is also the output {other_label}")
         seen[label] = path
+
+
+OUTPUT_OPTIONS = ("-o", "--output", "--output-dir", "--json", "--table", "--tables", "--config-output")
+"""The options that name what a command writes."""
+
+
+def refuse_empty_outputs(argv: list[str]) -> None:
+    """Refuse an output option given an empty path (``-o ""``: it would write into the working folder, as
+    ``Path("")`` is ``.``), before the command line is parsed.
+
+    Raises:
+        OptionError: naming the option.
+    """
+    for k, arg in enumerate(argv):
+        name, eq, value = arg.partition("=")
+        if name in OUTPUT_OPTIONS and ((eq and not value.strip()) or (not eq and k + 1 < len(argv)
+                                                                      and not argv[k + 1].strip())):
+            raise OptionError(name, "", "a file or folder to write, not an empty path")
