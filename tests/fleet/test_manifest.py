@@ -171,3 +171,12 @@ def test_a_start_time_is_a_datetime_to_the_microsecond_below(tmp_path):
         "ns", tz="UTC")), "robot": ["talos"]}), tmp_path / "m.parquet")
     (entry,) = read_manifest(tmp_path / "m.parquet")
     assert type(entry.start_time) is datetime and entry.start_time == t
+
+
+def test_a_robot_id_too_long_for_a_folder_name_is_refused_before_any_log_runs(folder):
+    """Issue 53: a 300-character robot id names a results folder no file system holds (``File name too long``,
+    once the log had run): refused as the manifest is read, naming the row and column; 128 characters pass."""
+    ok = "r" * 128
+    assert read_manifest(_manifest(folder, f"a.parquet,{ok},2026-03-01T08:00:00Z,talos"))[0].robot_id == ok
+    with pytest.raises(InputError, match=r"row 0, column 'robot_id': 'rrr.*' is not a robot id \(at most 128 "):
+        read_manifest(_manifest(folder, f"a.parquet,{'r' * 300},2026-03-01T08:00:00Z,talos"))

@@ -55,8 +55,9 @@ OPTIONAL = ("robot", "urdf", "config", "diff", "route", "model")
 """The columns a manifest may have (others are refused: a misspelt option would be silently ignored)."""
 LOG_SUFFIXES = (".parquet", ".pq", ".csv", ".h5", ".hdf5")
 """The files a scanned folder's logs are."""
-ROBOT_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
-"""What a robot id may be: it names a folder of the results."""
+ROBOT_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$")
+"""What a robot id may be: it names a folder of the results (at most 128 characters: a file system's names end at
+255 bytes)."""
 EARLIEST = datetime(1970, 1, 1, tzinfo=UTC)
 LATEST = datetime(2262, 1, 1, tzinfo=UTC)
 """The start times a log may have: the results store them as nanoseconds since 1970 in 64 bits (up to April
@@ -165,8 +166,8 @@ def scan_folder(folder: str | Path, robot: RobotSpec, exclude: Sequence[str | Pa
             if sub.suffix.lower() in LOG_SUFFIXES:
                 skipped.append(Skipped(sub, f"not in a robot's folder ({folder}/<robot_id>/<log>)"))
         elif not ROBOT_ID.match(sub.name):
-            skipped.append(Skipped(sub, "not a robot id (letters, digits, '.', '_', '-'; it names a results "
-                                        "folder): rename the folder or list its logs in a manifest"))
+            skipped.append(Skipped(sub, "not a robot id (at most 128 letters, digits, '.', '_', '-'; it names a "
+                                        "results folder): rename the folder or list its logs in a manifest"))
         else:
             _scan_robot(sub, robot, excluded, entries, skipped)
     if not entries:
@@ -291,8 +292,8 @@ def _entry(path: Path, row: int, cell: dict[str, str], start: datetime) -> LogEn
     except InputError as exc:
         raise InputError(f"{where}, column 'log': {exc}") from None
     if not ROBOT_ID.match(cell["robot_id"]):
-        raise InputError(f"{where}, column 'robot_id': {cell['robot_id']!r} is not a robot id (letters, digits, "
-                         "'.', '_', '-'; it names a folder)")
+        raise InputError(f"{where}, column 'robot_id': {cell['robot_id']!r} is not a robot id (at most 128 letters, "
+                         "digits, '.', '_', '-'; it names a folder)")
     name, urdf, config = cell.get("robot", ""), cell.get("urdf", ""), cell.get("config", "")
     if not (name or urdf or config):
         raise InputError(f"{where}: no robot (give column 'robot', a built-in name, or 'urdf' and 'config')")
