@@ -35,8 +35,13 @@ def term_fit(kept: tuple[str, ...] = ("load", "ripple", "temperature"), ranges: 
          if ("load" in kept and n == "F_L") or ("temperature" in kept and n in ("F_cT", "F_vT"))
          or ("ripple" in kept and n.startswith("ripple"))}
     c.update(coefficients)
-    stderr = {n: 0.01 * abs(v) + 1e-6 for n, v in {**c, **VELOCITY.to_dict()}.items()}
-    return TermFit(VELOCITY, kept, 2 if "ripple" in kept else 0, c, stderr,
+    derived = {name: value for name, value in (
+        ("k_L", c.get("F_L", np.nan) / VELOCITY.F_c), ("k_Tc", c.get("F_cT", np.nan) / VELOCITY.F_c),
+        ("k_Tv", c.get("F_vT", np.nan) / VELOCITY.F_v),
+        ("ripple_rms", np.sqrt(sum(v**2 for n, v in c.items() if n.startswith("ripple")) / 2))) if np.isfinite(value)
+        and (name != "ripple_rms" or "ripple" in kept)}  # the ripple's size: its RMS over a whole turn
+    stderr = {n: 0.01 * abs(v) + 1e-6 for n, v in {**c, **derived, **VELOCITY.to_dict()}.items()}
+    return TermFit(VELOCITY, kept, 2 if "ripple" in kept else 0, c, stderr, derived,
                    reference_temperature=T_REF if "temperature" in kept else None,
                    q_range=Q_RANGE if "ripple" in kept else None, held_out_rms=(0.05, 0.04), ranges=ranges)
 

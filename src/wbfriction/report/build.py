@@ -10,6 +10,8 @@ The report shows, for a person to judge a friction table at a glance:
   fitted model (3.5) and the target where known;
 * the identified parameters with their standard errors (6.2.2), and the errors against the
   targets of a simulated log;
+* where fits kept terms beyond velocity, those terms, the conditions their F_c, F_v hold at and the ranges they were
+  fitted on (:mod:`wbfriction.report.terms`);
 * the energy-consistency table (share of power-generating samples, zero crossings of
   ``Delta qdd`` against those of the velocity, Fig. 7.4);
 * per joint: the cloud, ``tau_f`` over time by support phase, Fig. 7.4 with and without

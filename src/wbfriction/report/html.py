@@ -25,6 +25,7 @@ from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
 from wbfriction.report.figures import friction_overview_figure, joint_figure, png_bytes
 from wbfriction.report.numbers import bound_text, duration_text, with_error
+from wbfriction.report.terms import reference_conditions, terms_section
 from wbfriction.workers import process_pool
 
 PAGE_CSS = """
@@ -279,7 +280,8 @@ def _pm(fit: FitResult, name: str, digits: int = 3) -> str:
 
 def _summary_table(r: Report) -> str:
     """One row per joint that moved: label, status, F_c, F_v, tau_os (± standard error), the power-generating
-    share, valid samples and the verdict (:func:`joint_verdict`); the joints that did not move in one line."""
+    share, valid samples and the verdict (:func:`joint_verdict`; with terms beyond velocity, the conditions its F_c,
+    F_v hold at, :func:`~wbfriction.report.terms.reference_conditions`); the joints that did not move in one line."""
     rows = []
     for j in r.moved:
         fit, e = r.fits.get(j), r.energy.get(j)
@@ -292,6 +294,10 @@ def _summary_table(r: Report) -> str:
             verdict = fit.verdict()
             status, ok = verdict.status, verdict.ok
             text, good = joint_verdict(verdict, e)
+            terms = fit.kept_terms
+            if terms is not None:  # its F_c, F_v are levels at the terms' reference conditions (issue 53)
+                text += (f"; F_c, F_v at {reference_conditions(terms)} (terms beyond velocity: "
+                         f"{', '.join(terms.kept)})")
             values = "".join(f"<td>{_pm(fit, n)}</td>" for n in ("F_c", "F_v", "tau_os"))
         rows.append(f'<tr{"" if ok else " class=notok"}>{_joint_cell(r, j)}'
                     f'<td class="status">{html.escape(status)}</td>{values}<td{cls}>{share}</td>'
@@ -354,6 +360,12 @@ def _joint_section(r: Report, joint: str, image: str) -> str:
             f'<p class="sub">{html.escape(note)}</p>{image}</section>')
 
 
+def _terms_section(r: Report) -> str:
+    """The terms beyond velocity of the joints that moved (:func:`~wbfriction.report.terms.terms_section`), "" when
+    no fit kept one."""
+    return terms_section(r.moved, r.fits, lambda joint: _joint_cell(r, joint))
+
+
 def _provenance(r: Report) -> str:
     """Inputs, robot and options, then every dependency's version and the date, as a table."""
     rows = [*r.provenance, ("versions", ", ".join(f"{n} {v}" for n, v in r.versions)), ("date", r.date)]
@@ -365,6 +377,8 @@ def _contents(r: Report) -> str:
     """The table of contents: the page's sections, in order."""
     items = [("summary", "Summary"), ("overview-section", "Friction over velocity"),
              ("parameters-section", "Identified parameters"), ("energy-section", "Energy consistency")]
+    if _terms_section(r):
+        items.append(("terms-section", "Terms beyond velocity"))
     if _routes_section(r):
         items.append(("routes", "Routes cross-checked"))
     if r.identification is not None:
@@ -406,6 +420,7 @@ share of the valid samples where the friction estimate generates power (eq. 7.9)
 <h2 id="parameters-section">Identified parameters (3.5), value ± standard error</h2>
 <p class="sub">Units: F_v N·m·s/rad, F_c and τ_os N·m, v_s rad/s, a s/rad. n.i.: not identifiable from these data.</p>
 {_params_table(r, moved, r.fits)}
+{_terms_section(r)}
 <h2 id="energy-section">Energy consistency (eq. 7.9, Fig. 7.4)</h2>
 <p class="sub">{_ENERGY_NOTE}</p>
 {_energy_table(r, moved)}
