@@ -115,3 +115,19 @@ def test_a_file_without_ranges_says_they_are_not_known(files, capsys):
     assert row.rstrip().endswith(" ok"), row
     assert (f"{JOINT}: the fitted ranges of its load, temperature terms are not recorded (a parameters file of an "
             "earlier version): whether this table is within them is not known") in err, err
+
+
+def test_fit_stores_the_ranges_of_the_samples_it_fitted(tmp_path, capsys):
+    """``fit --terms all`` on a joint swinging over 0.6-2.4 rad under 0-25 N·m while warming from 25 to 55 °C (the
+    three terms in its friction): the three ranges stored are those, to the samples left out at the reversals."""
+    table = table_file(tmp_path / "friction.parquet", np.linspace(25.0, 55.0, 2000))
+    params = tmp_path / "fitted.json"
+    code, _, err = run_cli_printed(capsys, "fit", table, "-o", params, "--terms", "all", "--model", "coulomb-viscous",
+                                   "--reference-temperature", "40", "--workers", "1")
+    assert code == 0, err
+    terms = json.loads(params.read_text())["joints"][JOINT]["terms"]
+    assert terms["kept"] == ["load", "ripple", "temperature"]
+    for key, (lo, hi), slack in (("angle", (0.6, 2.4), 0.01), ("load", (0.0, 25.0), 0.1),
+                                 ("temperature", (25.0, 55.0), 0.1)):
+        got = terms["ranges"][key]
+        assert lo <= got[0] <= lo + slack and hi - slack <= got[1] <= hi, (key, got)
