@@ -217,9 +217,11 @@ def arm_manifest(tmp_path_factory) -> Path:
 def test_a_signal_while_a_batch_runs_on_dask_ends_it_with_one_line(arm_manifest, tmp_path, signum, group):
     """``batch`` interrupted while its local Dask cluster's two worker processes start or estimate: 128 + n,
     the one line (issue 37: each Dask worker printed a KeyboardInterrupt traceback of its own), no process of
-    its group left; a result written is whole (the next run goes on from it)."""
+    its group left; a result written is whole (the next run goes on from it). Issue 53, class 17: nothing else is
+    left in the results and tables folders (the workers' partial files stayed there until the next run), nor the
+    batch's lock."""
     name = signal.Signals(signum).name
-    proc = _start("batch", arm_manifest, "-o", tmp_path / "results", cwd=tmp_path)
+    proc = _start("batch", arm_manifest, "-o", tmp_path / "results", "--tables", tmp_path / "tables", cwd=tmp_path)
     kids = _pool_busy(proc)
     time.sleep(1.0)
     (os.killpg if group else os.kill)(proc.pid, signum)
@@ -231,6 +233,40 @@ def test_a_signal_while_a_batch_runs_on_dask_ends_it_with_one_line(arm_manifest,
     from wbfriction.fleet.results import read_parts
 
     assert all(part.rows is not None for part in read_parts(tmp_path / "results"))
+    assert _leftovers(tmp_path / "results", tmp_path / "tables") == []
+
+
+def _leftovers(*folders: Path) -> list[Path]:
+    """What is in ``folders`` besides whole results and tables: hidden files or folders, other files."""
+    return [p for folder in folders for p in folder.rglob("*")
+            if p.name.startswith(".") or p.is_file() and p.suffix != ".parquet"]
+
+
+@pytest.mark.parametrize(("signum", "group"), [(signal.SIGINT, True), (signal.SIGTERM, False)],
+                         ids=["ctrl-c to the job", "sigterm to the command"])
+def test_a_signal_while_a_dask_batchs_tasks_run_leaves_no_partial_file(arm_manifest, tmp_path, signum, group):
+    """Issue 53, class 17: a batch interrupted while its Dask workers' tasks estimate left their scratch folders
+    (``.wbfriction-<host>-<pid>-<token>``) in the results folder until the next run. They are removed when the batch
+    ends on the signal, with the batch's lock; the results written are whole."""
+    name = signal.Signals(signum).name
+    results, tables = tmp_path / "results", tmp_path / "tables"
+    proc = _start("batch", arm_manifest, "-o", results, "--tables", tables, cwd=tmp_path)
+    deadline = time.monotonic() + 120
+    while proc.poll() is None and time.monotonic() < deadline and len(_leftovers(results)) < 2:
+        time.sleep(0.05)  # both workers' tasks under way: their scratch folders (and the lock) are there
+    assert proc.poll() is None, "the batch ended before it could be interrupted"
+    time.sleep(0.5)
+    kids = _children(proc.pid)
+    (os.killpg if group else os.kill)(proc.pid, signum)
+    _, err = ended_within(proc, 60, name)
+    assert proc.returncode == 128 + signum, err
+    assert _stderr_lines(err) == [f"interrupted ({name})"], err
+    assert _wait_gone(kids, 10.0) < 10.0, f"left alive: {_alive(kids)}"
+    assert _group(proc.pid) == []
+    assert _leftovers(results, tables) == []
+    from wbfriction.fleet.results import read_parts
+
+    assert all(part.rows is not None for part in read_parts(results))
 
 
 def test_ctrl_c_while_the_libraries_load_exits_130_without_a_traceback(tmp_path):

@@ -46,11 +46,19 @@ from typing import Any, Literal
 from threadpoolctl import threadpool_limits
 
 from wbfriction.exceptions import ClusterError, InputError, OutputError
+from wbfriction.fleet.lock import results_lock
 from wbfriction.fleet.manifest import LogEntry, Skipped
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.results import Part, failure_files, failures_folder, read_parts, table_path, write_outcome
 from wbfriction.fleet.task import LogOutcome, ResultKey, one_line, process_log, result_key, robot_sha256, utc_ns
-from wbfriction.logs.tables import TableFile, file_sha256, make_folder, remove_file, remove_stale_temporaries
+from wbfriction.logs.tables import (
+    TableFile,
+    file_sha256,
+    make_folder,
+    remove_file,
+    remove_stale_temporaries,
+    scratch_folder,
+)
 from wbfriction.pipeline.chunks import CHUNKS_PER_WORKER
 from wbfriction.pipeline.estimate_step import worker_robot
 from wbfriction.workers import DASK_PRELOAD, started_held
@@ -305,9 +313,8 @@ def run_batch(entries: list[LogEntry], results: str | Path, options: BatchOption
     results = Path(results).absolute()  # a worker elsewhere (a scheduler's) has another working folder
     tables = Path(tables).absolute() if tables is not None else None
     check_outputs(results, tables)
-    with _cluster_client(engine, scheduler, client) as connected:
+    with results_lock(results), _cluster_client(engine, scheduler, client) as connected:
         plan = plan_batch(entries, results, options)
-        make_folder(results)
         for folder in [results, *(p for p in results.iterdir() if p.is_dir()), failures_folder(results)]:
             remove_stale_temporaries(folder)  # those a killed batch left (a failure record half written too)
         for s in plan.stale:
@@ -324,18 +331,34 @@ def run_batch(entries: list[LogEntry], results: str | Path, options: BatchOption
             if progress is not None:
                 progress(outcome)
 
-        args = [(p.entry, p.key, p.options, results,
-                 table_path(tables, p.entry.robot_id, p.key.key) if tables is not None else None) for p in plan.todo]
-        for a in args:
-            if a[4] is not None:
-                make_folder(a[4].parent)
-        if engine == "serial":
+        # the tasks' scratch folders go in this run's, removed with it however the run ends (a signal kills the
+        # workers, whose own folders would stay): where no result is looked for (a hidden folder)
+        with scratch_folder(results) as scratch, _tables_cleaned(tables):
+            args = [(p.entry, p.key, p.options, scratch,
+                     table_path(tables, p.entry.robot_id, p.key.key) if tables is not None else None)
+                    for p in plan.todo]
             for a in args:
-                record(process_log(*a))
-        elif args:
-            _run_on_dask(args, record, workers or LOCAL_WORKERS, connected)
+                if a[4] is not None:
+                    make_folder(a[4].parent)
+            if engine == "serial":
+                for a in args:
+                    record(process_log(*a))
+            elif args:
+                _run_on_dask(args, record, workers or LOCAL_WORKERS, connected)
     return BatchSummary(len(plan.todo), len(plan.skipped), failed, results, dict(Counter(p.reason for p in plan.todo)),
                         plan.stale, plan.kept, plan.foreign, plan.copies)
+
+
+@contextmanager
+def _tables_cleaned(tables: Path | None) -> Iterator[None]:
+    """On leaving, the partial friction tables of the workers that ended with the run (killed on a signal) removed
+    from each robot's folder of ``tables`` (those of processes of this machine that no longer exist)."""
+    try:
+        yield
+    finally:
+        if tables is not None and tables.is_dir():
+            for folder in [tables, *(p for p in tables.iterdir() if p.is_dir())]:
+                remove_stale_temporaries(folder)
 
 
 @contextmanager
