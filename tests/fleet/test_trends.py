@@ -236,3 +236,15 @@ def test_the_summary_says_what_an_untested_joint_lacks():
 
 def _renamed(table: pa.Table, joint: str) -> pa.Table:
     return table.set_column(table.schema.get_field_index("joint"), "joint", pa.array([joint] * table.num_rows))
+
+
+def test_a_trends_page_of_joints_no_font_draws_warns_nothing(tmp_path):
+    """Issue 53, class 15: a CJK joint name put matplotlib's missing-glyph warnings on standard error."""
+    import warnings
+
+    rng = np.random.default_rng(6)
+    table = _renamed(_series_table({"F_c": 1.0 + 0.01 * rng.standard_normal(10)}), "左膝关节")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        write_trends_html(fleet_trends(table, FAST), tmp_path / "t.html")
+    assert "左膝关节" in (tmp_path / "t.html").read_text()  # the page's text names it

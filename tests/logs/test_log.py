@@ -154,3 +154,22 @@ def test_outputs_are_written_whole_or_not_at_all(tmp_path, monkeypatch):
     assert [p.name for p in tmp_path.iterdir()] == ["out.parquet"]
     write_table(table, target)
     assert pq.read_table(target).num_rows == 2
+
+
+def test_the_float32_warning_gives_each_columns_unit():
+    """Issue 53, class 15: a float32 temperature column was said to hold '2.4e-7 rad at 2 rad'. Each kind of column
+    is given its own unit and size, and the differentiated ones what their rounding costs."""
+    from wbfriction.logs.log import check_schema
+    from wbfriction.model.loading import load_robot
+
+    panda = load_robot("panda")
+    joint = panda.torque_controlled[0]
+    fields = [("time", pa.float64())] + [(f"q.{j}", pa.float64()) for j in panda.actuated] + \
+        [(f"tau.{j}", pa.float64()) for j in panda.actuated]
+    warm = pa.schema(fields + [(f"temperature.{joint}", pa.float32())])
+    (line,) = check_schema(warm, panda, "log.parquet")
+    assert "rad" not in line and "°C" in line and f"temperature.{joint}" in line and "accelerations" not in line
+    both = pa.schema([(n, pa.float32() if n == f"q.{joint}" else t) for n, t in fields]
+                     + [(f"temperature.{joint}", pa.float32())])
+    (line,) = check_schema(both, panda, "log.parquet")
+    assert "2.4e-07 rad at 2 rad" in line and "°C" in line and "accelerations" in line

@@ -109,3 +109,41 @@ def test_the_spectrum_panel_reaches_a_cutoff_beyond_50_hz(estimate):
     panel = next(ax for ax in fig.axes if ax.get_title().startswith("(d)"))
     assert panel.get_xlim()[1] >= 262.0
     assert "amplitude [rad/s²]" == panel.get_ylabel()
+
+
+def _installed_font_draws(text: str) -> bool:
+    """Whether some font matplotlib knows has a glyph for every character of ``text`` (read from the fonts)."""
+    from matplotlib import font_manager
+    from matplotlib.ft2font import FT2Font
+
+    for entry in font_manager.fontManager.ttflist:
+        try:
+            charmap = FT2Font(entry.fname).get_charmap()
+        except (OSError, RuntimeError):
+            continue
+        if all(ord(c) in charmap for c in text):
+            return True
+    return False
+
+
+def test_a_joint_name_no_font_draws_is_drawn_readable_without_a_warning(estimate):
+    """Issue 53, class 15: CJK joint names drew as boxes, with matplotlib's 'Glyph ... missing from font(s)' on
+    standard error for each. With a font that has the glyphs the name is drawn in it; without, the joint is drawn
+    as 'joint #<index>' and the figure says so once; no warning either way."""
+    import dataclasses
+    import warnings
+
+    knee = "右膝关节"
+    est = dataclasses.replace(estimate, joints=("still", knee))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a warning fails the test
+        fig = friction_overview_figure(est, [knee, "still"], {}, {}, labels={knee: knee, "still": "still"})
+        png_bytes(fig)
+    visible = [ax for ax in fig.axes if ax.get_visible()]
+    titles = [ax.get_title() for ax in visible]
+    if _installed_font_draws(knee):
+        assert titles == [knee, "still"]
+    else:
+        assert titles == ["joint #1", "still"]  # its index among the estimate's joints
+        said = [t.get_text() for t in fig.findobj(lambda a: hasattr(a, "get_text")) if "joint #i" in t.get_text()]
+        assert len(said) == 1 and "no installed font" in said[0]

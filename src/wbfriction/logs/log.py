@@ -382,9 +382,26 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
     if not single:
         return ()
     shown = ", ".join(single[:3]) + (f" and {len(single) - 3} more" if len(single) > 3 else "")
+    prefixes = list(dict.fromkeys(n.partition(".")[0] for n in single))
+    sizes = []  # each kind of column in its own unit: the rounding at a typical value (issue 53)
+    for prefix in prefixes:
+        typical, unit = SINGLE_PRECISION_SCALE.get(prefix, (1.0, ""))
+        step = float(np.spacing(np.float32(typical)))
+        sizes.append(f"{prefix}: {step:.2g} {unit} at {typical:g} {unit}" if unit
+                     else f"{prefix}: {step:.2g} at {typical:g}")
+    differentiated = [p for p in prefixes if p in ("time", "q", "qd", "qd_true")]
+    cost = f", whose rounding the accelerations differentiated from {', '.join(differentiated)} amplify" \
+        if differentiated else ""
     return (f"{source}: {shown} are float{schema.field(single[0]).type.bit_width}: "
-            "about 7 significant digits (2.4e-7 rad at 2 rad), whose rounding the differentiated "
-            "accelerations amplify; log float64",)
+            f"about 7 significant digits ({'; '.join(sizes)}){cost}; log float64",)
+
+
+SINGLE_PRECISION_SCALE: dict[str, tuple[float, str]] = {
+    "time": (1000.0, "s"), "q": (2.0, "rad"), "qd": (2.0, "rad/s"), "qd_true": (2.0, "rad/s"),
+    "qdd_true": (20.0, "rad/s²"), "tau": (100.0, "N·m"), "tau_f_true": (10.0, "N·m"), "current": (10.0, "A"),
+    "temperature": (50.0, "°C"), "wrench": (500.0, "N or N·m"), "contact": (1.0, ""), "base": (1.0, "m or rad"),
+    "imu": (10.0, "m/s² or rad/s")}
+"""A typical value and the unit of each kind of column: what the float32 warning says its rounding is at."""
 
 
 def _stack(table: pa.Table, columns: list[str], source: str, first_row: int) -> np.ndarray:

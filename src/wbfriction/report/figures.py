@@ -8,13 +8,16 @@ torque friction exerts on the joint [N·m] (negative of the model f of eq. 3.5).
 from __future__ import annotations
 
 import io
-from collections.abc import Mapping
+import re
+import warnings
+from collections.abc import Mapping, Sequence
 from collections.abc import Set as AbstractSet
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib import rc_context
+from matplotlib import rc_context, rcParams
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
@@ -35,14 +38,90 @@ READABLE: dict[Any, Any] = {"font.size": 10.0, "axes.titlesize": 10.5, "axes.lab
 """Font sizes [pt] of the report's figures: the smallest, 8.5 pt, is 11.8 px at :data:`REPORT_DPI`."""
 
 
+# ----------------------------------------------------------------- names no font draws (issue 53)
+BY_INDEX = "joint #{}"
+"""How a joint whose name no installed font draws is drawn: by its index in the figure's estimate (from 0)."""
+BY_INDEX_NOTE = ("joint #i: joint i (from 0; on a trends page, by name) of the log, whose name no installed font draws "
+                 "(e.g. Noto Sans CJK would)")
+"""What a figure that draws a joint by its index says, once."""
+_GLYPH_WARNING = r"Glyph \d+ .*missing from font"
+"""Matplotlib's warning for a character its font has no glyph for (its figure shows a box)."""
+
+
+@lru_cache(maxsize=1)
+def _default_charmap() -> frozenset[int]:
+    """The characters the default font (matplotlib's ``sans-serif``) draws."""
+    from matplotlib import font_manager
+    from matplotlib.ft2font import FT2Font
+
+    return frozenset(FT2Font(font_manager.findfont(font_manager.FontProperties())).get_charmap())
+
+
+@lru_cache(maxsize=1)
+def _installed_charmaps() -> tuple[tuple[str, frozenset[int]], ...]:
+    """(family, characters) of every other font matplotlib finds installed, in its list's order."""
+    from matplotlib import font_manager
+    from matplotlib.ft2font import FT2Font
+
+    out = []
+    for entry in font_manager.fontManager.ttflist:
+        try:
+            out.append((entry.name, frozenset(FT2Font(entry.fname).get_charmap())))
+        except (OSError, RuntimeError, ValueError):
+            continue
+    return tuple(out)
+
+
+@lru_cache(maxsize=256)
+def font_for(text: str) -> str | None:
+    """``""`` when the default font draws every character of ``text``; else the family of an installed font that
+    draws those it does not (drawn in it, the default font first); None: no installed font does."""
+    missing = {ord(c) for c in text if not c.isspace()} - _default_charmap()
+    if not missing:
+        return ""
+    return next((name for name, charmap in _installed_charmaps() if missing <= charmap), None)
+
+
+def joint_label(label: str, joints: Sequence[str], joint: str) -> str:
+    """``label`` (a joint's name as a figure shows it) where a font draws it, else :data:`BY_INDEX` with the
+    joint's index in ``joints`` (the figure says what it is, :func:`_drawable`)."""
+    return label if font_for(label) is not None else BY_INDEX.format(list(joints).index(joint))
+
+
+def _drawable(fig: Figure) -> None:
+    """Every text of ``fig`` in a font that draws it (an installed font beside the default where the default has
+    no glyph for a character); one line added to the title where a joint is drawn by its index."""
+    from matplotlib.text import Text
+
+    by_index = False
+    for text in fig.findobj(Text):
+        content = text.get_text()
+        font = font_for(content) if content else ""
+        if font:
+            text.set_fontfamily([*rcParams["font.family"], font])
+        by_index = by_index or re.search(r"\bjoint #\d+\b", content) is not None
+    title = fig.get_suptitle()
+    if by_index and BY_INDEX_NOTE not in title:  # once, however often the figure is saved
+        fig.suptitle(f"{title}\n{BY_INDEX_NOTE}" if title else BY_INDEX_NOTE)
+
+
+def _savefig(fig: Figure, target: Any, **kwargs: Any) -> None:
+    """``fig.savefig`` with every text drawable (:func:`_drawable`); a character no installed font has (a title
+    given) is drawn as a box, without matplotlib's warning on standard error."""
+    _drawable(fig)
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", _GLYPH_WARNING, UserWarning)
+        fig.savefig(target, **kwargs)
+
+
 def _save(fig: Figure, path: str | Path) -> None:
-    write_atomic(path, lambda tmp: fig.savefig(tmp, format="png", dpi=110))
+    write_atomic(path, lambda tmp: _savefig(fig, tmp, format="png", dpi=110))
 
 
 def png_bytes(fig: Figure, dpi: int = REPORT_DPI) -> bytes:
     """The figure as PNG bytes (no timestamp in the file: the same figure gives the same bytes)."""
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi, metadata={"Software": None})
+    _savefig(fig, buf, format="png", dpi=dpi, metadata={"Software": None})
     return buf.getvalue()
 
 
@@ -65,7 +144,7 @@ def support_phases_figure(est: FrictionEstimate, joints: list[str], path: str | 
         if est.tau_f_true is not None:
             ax.plot(est.time, est.tau_f_true[:, i], color="k", lw=2.5, alpha=0.35, label="target")
         ax.plot(est.time, est.tau_f[:, i], color="C0", lw=0.8, label="estimate")
-        ax.set_ylabel(joint.replace("_joint", ""), fontsize=8)
+        ax.set_ylabel(joint_label(_short(joint), est.joints, joint), fontsize=8)
     axes[0].legend(loc="upper right", fontsize=8)
     axes[-1].set_xlabel("time [s] (grey: double support)")
     fig.suptitle(title)
@@ -173,7 +252,7 @@ def spectrum_figure(spec, path: str | Path, max_freq: float | None = None, colum
         ax.axvline(spec.cutoff[i], color="C1", ls="--", lw=1)
         if spec.cutoff_found:
             ax.axvline(spec.suggestion, color="C3", lw=1)
-        ax.set_title(f"{joint.replace('_joint', '')}: {spec.cutoff[i]:.1f} Hz", fontsize=8)
+        ax.set_title(f"{joint_label(_short(joint), spec.joints, joint)}: {spec.cutoff[i]:.1f} Hz", fontsize=8)
         ax.tick_params(labelsize=7)
     for ax in axes[n:]:
         ax.set_visible(False)
@@ -199,7 +278,7 @@ def velocity_panels_figure(panels: list[tuple[str, FrictionEstimate, np.ndarray]
             v = np.linspace(np.nanmin(est.qd[mask, i]), np.nanmax(est.qd[mask, i]), 400)
             ax.plot(v, target.torque(v), color="k", lw=2, alpha=0.6, label="target")
         ax.set_title(f"{label} ({int(mask.sum())} samples)", fontsize=9)
-        ax.set_xlabel(f"{joint.replace('_joint', '')} velocity [rad/s]")
+        ax.set_xlabel(f"{joint_label(_short(joint), est.joints, joint)} velocity [rad/s]")
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("tau_f [N·m]")
     axes[0].legend(loc="upper right", fontsize=8, markerscale=6)
@@ -244,7 +323,8 @@ def friction_overview_figure(est: FrictionEstimate, joints: list[str], fits: dic
         axes = fig.subplots(rows, columns, squeeze=False).ravel()
         for ax, joint in zip(axes, joints):
             _cloud(ax, est, est.joints.index(joint), fits.get(joint), targets.get(joint))
-            ax.set_title((labels or {}).get(joint) or _short(joint), color="C3" if joint in flagged else "k")
+            label = joint_label((labels or {}).get(joint) or _short(joint), est.joints, joint)
+            ax.set_title(label, color="C3" if joint in flagged else "k")
         for ax in axes[len(joints):]:
             ax.set_visible(False)
         handles, names = axes[0].get_legend_handles_labels()
@@ -391,7 +471,7 @@ def sensitivity_figure(sens, joints: list[str], columns: int = 4) -> Figure:
             color = "k" if f == 1.0 else cmap(0.5 + 0.5 * (f - 1.0) / span)
             ax.plot(np.where(m, est.qd[:, i], np.nan), np.where(m, est.tau_f[:, i], np.nan), lw=0.6,
                     color=color, alpha=0.9 if f == 1.0 else 0.7, label=f"x {f:g}")
-        ax.set_title(_short(joint), fontsize=8)
+        ax.set_title(joint_label(_short(joint), joints, joint), fontsize=8)
         ax.tick_params(labelsize=7)
         ax.axhline(0, color="k", lw=0.3)
     for ax in axes[len(joints):]:

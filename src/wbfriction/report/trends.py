@@ -21,7 +21,7 @@ from matplotlib.figure import Figure
 from wbfriction.fleet.change_point import ChangePoint
 from wbfriction.fleet.trends import FleetTrends, JointTrend
 from wbfriction.logs.tables import write_atomic
-from wbfriction.report.figures import READABLE, REPORT_WIDTH, png_bytes
+from wbfriction.report.figures import READABLE, REPORT_WIDTH, joint_label, png_bytes
 from wbfriction.report.html import PAGE_CSS
 
 SHOWN = ("F_c", "F_v", "f_at_0.3")
@@ -53,6 +53,7 @@ def joints_figure(joints: list[JointTrend], title: str, columns: int = 4) -> Fig
     with rc_context(READABLE):
         fig = Figure(figsize=(REPORT_WIDTH * columns / 4, 2.4 * rows + 1.0), layout="constrained")
         axes = fig.subplots(rows, columns, squeeze=False, sharex=True).ravel()
+        names = sorted({j.joint for j in joints})  # a joint no font draws is drawn by its index among them
         for ax, j in zip(axes, joints):
             for q in SHOWN:
                 if q in j.series and j.series[q].used.any():
@@ -67,7 +68,8 @@ def joints_figure(joints: list[JointTrend], title: str, columns: int = 4) -> Fig
             for cp in j.drifts[:1]:
                 ax.axvline(cp.onset_time, color="C3", ls="--", lw=1.0)
             ax.axhline(1.0, color="#888888", lw=0.6)
-            ax.set_title(j.joint.removesuffix("_joint") + (f"  drift: {j.drifts[0].quantity}" if j.flagged else ""),
+            drift = f"  drift: {j.drifts[0].quantity}" if j.flagged else ""
+            ax.set_title(joint_label(j.joint.removesuffix("_joint"), names, j.joint) + drift,
                          color="C3" if j.flagged else "k")
             ax.tick_params(axis="x", labelrotation=30)
         for ax in axes[len(joints):]:
