@@ -149,10 +149,10 @@ def test_a_term_whose_signal_the_table_lacks_is_said_not_tried(logs, capsys, tmp
     pq.write_table(table.drop_columns([c for c in table.column_names if c.startswith("temperature.")]), bare)
     code, printed, err = run_cli_printed(capsys, "fit", bare, "-o", tmp_path / "p.json", "--terms", "temperature")
     words = " ".join((printed + err).split())
-    assert code == 0 and "temperature not tried on 7 joints" in words and "no temperature.<joint> column" in words
+    assert code == 0 and "temperature not tried on 7 joints" in words and "): no temperature.<joint> column" in words
     assert "do not improve" not in words
     reasons = read_params(tmp_path / "p.json")["panda_joint4"].terms.reasons
-    assert reasons == {"temperature": "not tried: no temperature.<joint> column for this joint"}
+    assert reasons == {"temperature": "not tried: no temperature.<joint> column"}
 
 
 @pytest.mark.parametrize("args, option", [

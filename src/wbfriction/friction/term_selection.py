@@ -95,14 +95,28 @@ def direction_gain(residual: np.ndarray, qd: np.ndarray, use: np.ndarray, F: np.
     gains = []
     moving = use & (np.abs(qd) > MIN_SPEED)  # a sample at rest has no direction
     for train, test in ((moving & (qd > 0), moving & (qd < 0)), (moving & (qd < 0), moving & (qd > 0))):
-        if train.sum() <= F.shape[1] or not test.any():
+        if train.sum() <= F.shape[1] or test.sum() < 2:
             return float("nan")
         c = _solve(F[train], residual[train])
         before = residual[test] - residual[test].mean()
         after = residual[test] - F[test] @ c
         after = after - after.mean()  # each way its own level: a Coulomb level the velocity model took flips sign
-        gains.append(1.0 - float(np.sqrt(np.mean(after**2) / np.mean(before**2))))
+        spread = float(np.mean(before**2))
+        if not spread > 0.0:  # nothing left to predict that way
+            return float("nan")
+        gains.append(1.0 - float(np.sqrt(np.mean(after**2) / spread)))
     return min(gains)
+
+
+def _carries(gain: float) -> str:
+    """How far a term carried over between the directions of motion (:func:`direction_gain`), as its reason says."""
+    return ("too few samples moving each way to tell" if not np.isfinite(gain)
+            else f"{100 * gain:+.2g} %")
+
+
+MIN_TERM_SAMPLES = 20
+"""Fewer moving samples than this (the fit's own least, :attr:`~wbfriction.friction.options.FitOptions.min_samples`)
+and no term is tried: none could be fitted on some and judged on the later ones."""
 
 
 def _solve(X: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -141,6 +155,10 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
         use &= np.isfinite(X0).all(axis=1)
     y_ = np.where(use, y, 0.0)
     candidates = tuple(t for t in options.terms if t in signals.logged())
+    moving = int(use.sum())
+    if candidates and moving < MIN_TERM_SAMPLES:  # nothing to fit on and hold out
+        return TermFit(params, reasons={t: f"{NOT_TRIED}: {moving} moving samples, fewer than {MIN_TERM_SAMPLES}"
+                                        for t in options.terms})
     t_ref = None
     if "temperature" in candidates and signals.temperature is not None:
         t_ref = (float(np.median(signals.temperature[use])) if options.reference_temperature is None
@@ -195,7 +213,7 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
 
     base_rms = score((), 0)
     tol = options.tolerance
-    reasons: dict[str, str] = {term: f"{NOT_TRIED}: no {SIGNAL_COLUMNS[term]}.<joint> column for this joint"
+    reasons: dict[str, str] = {term: f"{NOT_TRIED}: no {SIGNAL_COLUMNS[term]}.<joint> column"
                                for term in options.terms if term not in candidates}
     gains: dict[tuple[Term, tuple[Term, ...]], float] = {}
 
@@ -264,13 +282,13 @@ def fit_terms(params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.nd
     if "ripple" in candidates and "ripple" not in kept:
         ripples = direction_gains(tuple(kept))
         if not any(g > tol for g in ripples.values()):
+            best = max((g for g in ripples.values() if np.isfinite(g)), default=float("nan"))
             reasons["ripple"] = ("not kept: fitted on one direction of motion it does not predict the other by more "
-                                 f"than {100 * tol:g} % (best {100 * max(ripples.values(), default=float('nan')):+.2g} "
-                                 "%): not a torque of the angle")
+                                 f"than {100 * tol:g} % (best {_carries(best)}): not a torque of the angle")
     for term in candidates:
         if term not in kept and term not in reasons and not holds(term, tuple(kept)):
             reasons[term] = ("not kept: fitted on one direction of motion it does not predict the other by more "
-                             f"than {100 * tol:g} % ({100 * carry_over(term, tuple(kept)):+.2g} %): not a law of the "
+                             f"than {100 * tol:g} % ({_carries(carry_over(term, tuple(kept)))}): not a law of the "
                              f"{term}")
         if term in reasons:
             continue

@@ -22,7 +22,7 @@ from rich.table import Table
 from wbfriction.friction.energy import JointEnergy
 from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import ALL_PARAM_NAMES
-from wbfriction.friction.terms import NOT_TRIED, SIGNAL_COLUMNS, TERM_COEFFICIENTS, TermFit
+from wbfriction.friction.terms import NOT_TRIED, TERM_COEFFICIENTS, TermFit
 from wbfriction.inertia.document import Identification
 from wbfriction.report.numbers import bound_text, with_error
 
@@ -144,15 +144,14 @@ def terms_notes(results: Sequence[FitResult], verbose: bool = False,
             lines += [f"{label(r.joint)}: {term} {why}" for term, why in r.terms.reasons.items()]
     if verbose:
         return lines
-    untried: dict[str, list[str]] = {}  # a term per joint whose table lacks its signal
+    untried: dict[tuple[str, str], list[str]] = {}  # the joints per term and why it was not tried
     for r in results:
         for term, why in ({} if r.terms is None else r.terms.reasons).items():
             if why.startswith(NOT_TRIED):
-                untried.setdefault(term, []).append(label(r.joint))
-    for term, joints in untried.items():
-        them = "them" if len(joints) > 1 else "it"
+                untried.setdefault((term, why.removeprefix(f"{NOT_TRIED}: ")), []).append(label(r.joint))
+    for (term, why), joints in untried.items():
         lines.append(f"{term} not tried on {len(joints)} joint{'s' if len(joints) > 1 else ''} ({_joints(joints)}): "
-                     f"the table has no {SIGNAL_COLUMNS[term]}.<joint> column for {them}")
+                     f"{why}")
     none = [label(r.joint) for r in results if r.terms is not None and not r.terms.kept
             and any(not why.startswith(NOT_TRIED) for why in r.terms.reasons.values())]
     if none:
