@@ -131,3 +131,12 @@ def test_trends_refuse_a_reference_temperature_no_joint_has(tmp_path, synthetic_
     res = _trends("results", "-o", "t.html", f"--reference-temperature={value}", cwd=tmp_path)
     assert res.returncode == 2 and "--reference-temperature" in res.stderr, res.stderr
     assert len(res.stderr.strip().splitlines()) == 1 and not (tmp_path / "t.html").exists()
+
+
+def test_a_fleet_that_turned_to_kelvin_is_said():
+    """Reproduced: °C for 10 logs, then K: "reference 176.075 °C". Results written before the logs were screened
+    still hold such values: the temperature is left out and the first implausible log named."""
+    T = np.where(np.arange(N) < 10, 25.0, 298.15)
+    cp = detect_change(DAYS, _series(), SE, "F_c", OPTIONS, temperature=T)
+    assert cp is not None and cp.reference_temperature is None
+    assert "298.15 °C of the log at 2026-01-11" in cp.temperature_note and "kelvin" in cp.temperature_note

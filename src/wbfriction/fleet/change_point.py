@@ -36,6 +36,7 @@ from typing import Protocol
 import numpy as np
 
 from wbfriction.fleet.options import Shape
+from wbfriction.logs.temperature import PLAUSIBLE
 
 DAY = 86_400.0
 """Seconds per day: the series' time unit."""
@@ -267,8 +268,8 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
             both models (Bittencourt & Axelsson 2014: temperature changes friction more than wear does): the
             baseline and the change are then those at ``reference_temperature`` (default: the points' median),
             stated in :attr:`ChangePoint.reference_temperature` with the slope found. Where some points have none,
-            or the temperatures cannot be told from a change (:func:`confounded_onset`), they are left out and
-            :attr:`ChangePoint.temperature_note` says why.
+            one is no joint's (kelvin), or the temperatures cannot be told from a change (:func:`confounded_onset`),
+            they are left out and :attr:`ChangePoint.temperature_note` says why.
     """
     ok = np.isfinite(y) & np.isfinite(se) & (se > 0)
     idx = np.flatnonzero(ok)
@@ -279,7 +280,13 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
     yy, ss = y[idx], se[idx]
     covariates, t_ref, note = None, None, ""
     logged = None if temperature is None else np.isfinite(temperature[idx])
-    if logged is not None and logged.any() and not logged.all():
+    implausible = None if temperature is None else logged & ((temperature[idx] < PLAUSIBLE[0])
+                                                             | (temperature[idx] > PLAUSIBLE[1]))
+    if implausible is not None and implausible.any():  # results written before logs were screened (kelvin)
+        i = int(np.flatnonzero(implausible)[0])
+        note = (f"temperature left out: {temperature[idx[i]]:.6g} °C of the log at {time[idx[i]]:%Y-%m-%d %H:%M} is "
+                f"no joint's temperature ({PLAUSIBLE[0]:g} to {PLAUSIBLE[1]:g} °C; kelvin?)")
+    elif logged is not None and logged.any() and not logged.all():
         note = (f"temperature left out: {int((~logged).sum())} of its {idx.size} logs have none (each value is "
                 "compared at no one temperature)")
     elif logged is not None and logged.all() and float(np.std(temperature[idx])) >= TEMPERATURE_SPREAD:
