@@ -80,6 +80,9 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
     from wbfriction.pipeline.estimate_step import RobotSpec
 
     check_paths({"MANIFEST": source}, {})
+    options = BatchOptions(estimate=EstimateOptions(diff=diff), fit=FitOptions(  # refused before any log is read
+        model=model, min_samples=min_samples,
+        terms=term_options(terms, max_harmonic, reference_temperature, temperature_law)))
     check_outputs(output, tables)
     quiet_dask_logs()  # its faults are said here, one line each
     start = time.perf_counter()
@@ -91,9 +94,6 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
         entries = scan.entries
     else:
         entries = read_manifest(source)
-    options = BatchOptions(estimate=EstimateOptions(diff=diff), fit=FitOptions(
-        model=model, min_samples=min_samples,
-        terms=term_options(terms, max_harmonic, reference_temperature, temperature_law)))
     with Progress(TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console,
                   transient=True, disable=not console.is_terminal) as bar:
         task = bar.add_task("batch", total=len(entries))

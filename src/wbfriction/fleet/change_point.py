@@ -252,6 +252,33 @@ TEMPERATURE_SPREAD = 1.0
 recorded at one temperature say nothing of its effect (and make the covariate the constant's twin)."""
 
 
+def _temperature_covariate(t: np.ndarray, se: np.ndarray, time: list[datetime], T: np.ndarray,
+                           options: ChangeSettings, reference_temperature: float | None
+                           ) -> tuple[np.ndarray | None, float | None, str]:
+    """The temperature covariate of a series' points (:func:`detect_change`): ``(covariates (n, 1), T_ref, "")``
+    where it enters the test, else ``(None, None, note)`` with why not ("" where the temperatures do not spread)."""
+    logged = np.isfinite(T)
+    implausible = logged & ((T < PLAUSIBLE[0]) | (T > PLAUSIBLE[1]))
+    if implausible.any():  # results written before logs were screened (kelvin)
+        i = int(np.flatnonzero(implausible)[0])
+        return None, None, (f"temperature left out: {T[i]:.6g} °C of the log at {time[i]:%Y-%m-%d %H:%M} is no "
+                            f"joint's temperature ({PLAUSIBLE[0]:g} to {PLAUSIBLE[1]:g} °C; kelvin?)")
+    if not logged.any():
+        return None, None, ""
+    if not logged.all():
+        return None, None, (f"temperature left out: {int((~logged).sum())} of its {T.size} logs have none (each "
+                            "value is compared at no one temperature)")
+    if float(np.std(T)) < TEMPERATURE_SPREAD:
+        return None, None, ""
+    t_ref = float(np.median(T)) if reference_temperature is None else reference_temperature
+    covariates = (T - t_ref)[:, None]
+    k = confounded_onset(t, se, covariates, options)
+    if k is not None:
+        return None, None, (f"temperature left out: it cannot be told from a change at {time[k]:%Y-%m-%d} (the "
+                            "logs' temperatures step or drift with the time there)")
+    return covariates, t_ref, ""
+
+
 def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity: str,
                   options: ChangeSettings, scale: float | None = None, temperature: np.ndarray | None = None,
                   reference_temperature: float | None = None) -> ChangePoint | None:
@@ -279,24 +306,9 @@ def detect_change(time: list[datetime], y: np.ndarray, se: np.ndarray, quantity:
     t = np.array([(time[i] - t0).total_seconds() / DAY for i in idx])
     yy, ss = y[idx], se[idx]
     covariates, t_ref, note = None, None, ""
-    logged = None if temperature is None else np.isfinite(temperature[idx])
-    implausible = None if temperature is None else logged & ((temperature[idx] < PLAUSIBLE[0])
-                                                             | (temperature[idx] > PLAUSIBLE[1]))
-    if implausible is not None and implausible.any():  # results written before logs were screened (kelvin)
-        i = int(np.flatnonzero(implausible)[0])
-        note = (f"temperature left out: {temperature[idx[i]]:.6g} °C of the log at {time[idx[i]]:%Y-%m-%d %H:%M} is "
-                f"no joint's temperature ({PLAUSIBLE[0]:g} to {PLAUSIBLE[1]:g} °C; kelvin?)")
-    elif logged is not None and logged.any() and not logged.all():
-        note = (f"temperature left out: {int((~logged).sum())} of its {idx.size} logs have none (each value is "
-                "compared at no one temperature)")
-    elif logged is not None and logged.all() and float(np.std(temperature[idx])) >= TEMPERATURE_SPREAD:
-        t_ref = float(np.median(temperature[idx])) if reference_temperature is None else reference_temperature
-        covariates = (temperature[idx] - t_ref)[:, None]
-        k = confounded_onset(t, ss, covariates, options)
-        if k is not None:
-            note = (f"temperature left out: it cannot be told from a change at {time[idx[k]]:%Y-%m-%d} (the logs' "
-                    "temperatures step or drift with the time there)")
-            covariates, t_ref = None, None
+    if temperature is not None:
+        covariates, t_ref, note = _temperature_covariate(t, ss, [time[i] for i in idx], temperature[idx], options,
+                                                         reference_temperature)
     best: tuple[float, Shape, int, np.ndarray] | None = None
     for shape in options.shapes:
         onsets, F, coef = change_scan(t, yy, ss, options.min_before, options.min_after, shape, covariates)

@@ -146,11 +146,11 @@ def terms_notes(results: Sequence[FitResult], verbose: bool = False,
         return lines
     untried: dict[tuple[str, str], list[str]] = {}  # the joints per term and why it was not tried
     for r in results:
-        for term, why in ({} if r.terms is None else r.terms.reasons).items():
+        for name, why in ({} if r.terms is None else r.terms.reasons).items():
             if why.startswith(NOT_TRIED):
-                untried.setdefault((term, why.removeprefix(f"{NOT_TRIED}: ")), []).append(label(r.joint))
-    for (term, why), joints in untried.items():
-        lines.append(f"{term} not tried on {len(joints)} joint{'s' if len(joints) > 1 else ''} ({_joints(joints)}): "
+                untried.setdefault((name, why.removeprefix(f"{NOT_TRIED}: ")), []).append(label(r.joint))
+    for (name, why), joints in untried.items():
+        lines.append(f"{name} not tried on {len(joints)} joint{'s' if len(joints) > 1 else ''} ({_joints(joints)}): "
                      f"{why}")
     none = [label(r.joint) for r in results if r.terms is not None and not r.terms.kept
             and any(not why.startswith(NOT_TRIED) for why in r.terms.reasons.values())]
