@@ -47,6 +47,8 @@ def test_trends_need_results_and_an_html_page(tmp_path):
     (["--scheduler", "tcp://127.0.0.1:9"], "--scheduler tcp://127.0.0.1:9: no Dask scheduler answered within 10 s"),
     (["-o", "file.txt/results"], "-o file.txt/results: under file.txt, which is a file, not a folder"),
     (["-o", "file.txt"], "-o file.txt: not a folder"),
+    (["--reference-temperature", "nan"], "--reference-temperature must be a joint's temperature in °C"),
+    (["--terms", "load", "--max-harmonic", "6"], "--max-harmonic must be left out without the ripple term"),
 ])
 def test_batch_faults_are_one_line_within_seconds(arm_fleet, tmp_path, args, message):
     """Issue 37: --scheduler was ignored with --serial; a wrong scheduler address raised OSError after 30 s or
