@@ -377,3 +377,27 @@ def test_the_ur10e_reference_is_the_authors_file():
     published = ur10e.read_parameters(REAL_DATA / "ur10e" / "UR10E_parameters.txt")["pi_frcn"].reshape(6, 3)
     ref = datasets.reference("ur10e")
     np.testing.assert_array_equal(np.column_stack([ref.F_v, ref.F_c, ref.offset]), published)
+
+
+def test_offline_the_error_is_the_only_line(tmp_path, monkeypatch, capfd):
+    """Issue 53: with nothing answering, pooch's 'Failed to download ... Will retry' lines came before the one
+    line that says what to do; only that line is printed now."""
+    import logging
+    import socket
+
+    from wbfriction.datasets.store import RemoteFile, fetch_files
+    with socket.socket() as s:  # a port nothing listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    monkeypatch.delenv(datasets.DATA_ENV, raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    for proxy in ("no_proxy", "NO_PROXY"):
+        monkeypatch.setenv(proxy, "127.0.0.1")
+    monkeypatch.setattr(time, "sleep", lambda seconds: None)
+    f = RemoteFile("x.npz", "o/r", "0" * 40, "x.npz", "0" * 64)
+    with pytest.raises(InputError, match="x.npz: cannot be downloaded from"):
+        fetch_files("offline", [f], base=f"http://127.0.0.1:{port}")
+    out, err = capfd.readouterr()
+    assert "retry" not in (out + err).lower() and "Failed to download" not in out + err
+    import pooch
+    assert pooch.get_logger().level == logging.NOTSET or pooch.get_logger().level < logging.WARNING  # restored

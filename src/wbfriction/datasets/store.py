@@ -101,19 +101,25 @@ def downloaded(folder: str, files: Sequence[RemoteFile], base: str | None = None
     offline = (f"set {DATA_ENV} to a folder holding {folder}/{{name}} (a copy of the repository's files) to work "
                "offline")
     paths = {}
-    for f in files:
-        try:
-            paths[f.name] = Path(store.fetch(f.name))
-        except requests.RequestException as exc:
-            reason = " ".join(str(exc).split()) or type(exc).__name__
-            raise InputError(f"{f.name}: cannot be downloaded from {urls[f.name]} ({reason}); "
-                             + offline.format(name=f.name)) from exc
-        except ValueError as exc:  # pooch: the download's hash is not the registry's
-            reason = " ".join(str(exc).split())
-            raise InputError(f"{f.name}: the file downloaded from {urls[f.name]} is refused ({reason}); "
-                             + offline.format(name=f.name)) from exc
-        except OSError as exc:
-            raise output_error(cache / f.name, exc) from exc
+    logger = pooch.get_logger()  # its retries' lines ("Failed to download ... Will retry") would come first
+    level = logger.level
+    logger.setLevel("WARNING")
+    try:
+        for f in files:
+            try:
+                paths[f.name] = Path(store.fetch(f.name))
+            except requests.RequestException as exc:
+                reason = " ".join(str(exc).split()) or type(exc).__name__
+                raise InputError(f"{f.name}: cannot be downloaded from {urls[f.name]} ({reason}); "
+                                 + offline.format(name=f.name)) from exc
+            except ValueError as exc:  # pooch: the download's hash is not the registry's
+                reason = " ".join(str(exc).split())
+                raise InputError(f"{f.name}: the file downloaded from {urls[f.name]} is refused ({reason}); "
+                                 + offline.format(name=f.name)) from exc
+            except OSError as exc:
+                raise output_error(cache / f.name, exc) from exc
+    finally:
+        logger.setLevel(level)
     return paths
 
 
