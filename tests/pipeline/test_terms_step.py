@@ -64,7 +64,7 @@ def test_fit_keeps_the_simulated_terms_and_predict_uses_them(logs, capsys):
     code, printed, _ = run_cli_printed(capsys, "fit", tables[0], "-o", params, "--terms", "all",
                                        "--reference-temperature", T_REF)
     words = " ".join(printed.split())  # the table wraps its values to the terminal
-    assert code == 0 and "Terms beyond velocity" in words and "at zero load, 40 °C" in words
+    assert code == 0 and "Terms beyond velocity" in words and "at zero load, T_ref 40 °C" in words
     assert run_cli(capsys, "fit", tables[0], "-o", plain, "--terms", "none")[0] == 0
     fits = read_params(params)
     for joint, fit in fits.items():

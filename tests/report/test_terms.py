@@ -11,7 +11,7 @@ import numpy as np
 
 from helpers import run_cli
 from term_params import JOINT, edited, ok_fit, params_file, table_file, term_fit
-from wbfriction.report.terms import reference_conditions, terms_section
+from wbfriction.report.terms import terms_section
 
 
 def _text(page: str) -> str:
@@ -21,9 +21,9 @@ def _text(page: str) -> str:
 
 
 def test_the_conditions_follow_the_terms_kept():
-    assert reference_conditions(term_fit(("load", "temperature"))) == "zero load, T_ref 40 °C"
-    assert reference_conditions(term_fit(("ripple",))) == "no ripple"
-    assert reference_conditions(term_fit(("load", "ripple", "temperature"))) == "zero load, T_ref 40 °C, no ripple"
+    assert term_fit(("load", "temperature")).reference_conditions() == "zero load, T_ref 40 °C"
+    assert term_fit(("ripple",)).reference_conditions() == "no ripple"
+    assert term_fit(("load", "ripple", "temperature")).reference_conditions() == "zero load, T_ref 40 °C, no ripple"
 
 
 def test_the_section_names_each_term_its_status_and_its_fitted_range():

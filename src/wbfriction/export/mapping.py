@@ -272,8 +272,7 @@ def joint_export(joint: str, friction: FrictionLike | None = None, armature: flo
     if terms is not None:  # its velocity model refitted with them: the levels at the reference conditions
         params = terms.params
         dropped = terms.kept
-        conditions = "zero load" + ("" if terms.reference_temperature is None
-                                    else f", T_ref {terms.reference_temperature:.3g} °C")
+        conditions = terms.reference_conditions()
     return JointExport(joint, viscous=float(params.F_v), coulomb=float(params.F_c),
                        static=static_level(params),
                        armature=None if armature is None else float(armature), params=params, verdict=verdict,

@@ -299,6 +299,20 @@ class TermFit:
         names = TERM_COEFFICIENTS[term] + (("rate_T",) if term == "temperature" else ())
         return {n: (c[n], se.get(n, math.inf)) for n in names if n in c}
 
+    def reference_conditions(self) -> str:
+        """The conditions the refitted F_c and F_v (:attr:`params`) hold at, by the terms kept: ``zero load``,
+        ``T_ref 40 °C``, ``the mean of both directions``, ``no ripple`` (comma-separated; "" with none kept)."""
+        parts = []
+        if "load" in self.kept:
+            parts.append("zero load")
+        if "temperature" in self.kept and self.reference_temperature is not None:
+            parts.append(f"T_ref {self.reference_temperature:.3g} °C")
+        if "direction" in self.kept:
+            parts.append("the mean of both directions")
+        if "ripple" in self.kept:
+            parts.append("no ripple")
+        return ", ".join(parts)
+
     def to_dict(self) -> dict[str, Any]:
         """As the parameters JSON holds it (a value that is not finite: ``null``), with each term's status."""
         clean = _finite_or_none

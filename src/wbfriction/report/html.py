@@ -25,7 +25,7 @@ from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
 from wbfriction.report.figures import friction_overview_figure, joint_figure, png_bytes
 from wbfriction.report.numbers import bound_text, duration_text, with_error
-from wbfriction.report.terms import reference_conditions, terms_section
+from wbfriction.report.terms import terms_section
 from wbfriction.workers import process_pool
 
 PAGE_CSS = """
@@ -281,7 +281,8 @@ def _pm(fit: FitResult, name: str, digits: int = 3) -> str:
 def _summary_table(r: Report) -> str:
     """One row per joint that moved: label, status, F_c, F_v, tau_os (± standard error), the power-generating
     share, valid samples and the verdict (:func:`joint_verdict`; with terms beyond velocity, the conditions its F_c,
-    F_v hold at, :func:`~wbfriction.report.terms.reference_conditions`); the joints that did not move in one line."""
+    F_v hold at, :meth:`~wbfriction.friction.terms.TermFit.reference_conditions`); the joints that did not move in
+    one line."""
     rows = []
     for j in r.moved:
         fit, e = r.fits.get(j), r.energy.get(j)
@@ -296,7 +297,7 @@ def _summary_table(r: Report) -> str:
             text, good = joint_verdict(verdict, e)
             terms = fit.kept_terms
             if terms is not None:  # its F_c, F_v are levels at the terms' reference conditions (issue 53)
-                text += (f"; F_c, F_v at {reference_conditions(terms)} (terms beyond velocity: "
+                text += (f"; F_c, F_v at {terms.reference_conditions()} (terms beyond velocity: "
                          f"{', '.join(terms.kept)})")
             values = "".join(f"<td>{_pm(fit, n)}</td>" for n in ("F_c", "F_v", "tau_os"))
         rows.append(f'<tr{"" if ok else " class=notok"}>{_joint_cell(r, j)}'

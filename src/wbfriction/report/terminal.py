@@ -108,9 +108,8 @@ def terms_table(results: Sequence[FitResult], label: Callable[[str], str] = str)
         terms = r.kept_terms
         assert terms is not None
         shown = partial(_term_value, terms)
-        at = "zero load" + ("" if terms.reference_temperature is None or "temperature" not in terms.kept
-                            else f", {terms.reference_temperature:.3g} °C")
-        table.add_row(label(r.joint), "velocity", "", f"{shown('F_c')}, {shown('F_v')} at {at}")
+        table.add_row(label(r.joint), "velocity", "",
+                      f"{shown('F_c')}, {shown('F_v')} at {terms.reference_conditions()}")
         for term, verdict in terms.verdicts().items():
             if term == "ripple":
                 text = (f"size {with_error(terms.derived['ripple_rms'], terms.stderr.get('ripple_rms'))} N·m, "

@@ -4,9 +4,10 @@ means for the numbers the report shows.
 A fit that kept terms reports its velocity model refitted with them
 (:meth:`~wbfriction.friction.fit.FitResult.reported`): its F_c and F_v are the levels at the reference conditions
 (zero load, the reference temperature ``T_ref``, no ripple, the mean of both directions), not the joint's friction
-under its own load or warmth. The report says so beside them (:func:`reference_conditions`) and gives each joint's
-terms in a table (:func:`terms_section`): each term's status, its coefficients ± standard errors and the physical
-parameters they give, and the ranges of angle, load and temperature it was fitted on
+under its own load or warmth. The report says so beside them
+(:meth:`~wbfriction.friction.terms.TermFit.reference_conditions`) and gives each joint's terms in a table
+(:func:`terms_section`): each term's status, its coefficients ± standard errors and the physical parameters they
+give, and the ranges of angle, load and temperature it was fitted on
 (:class:`~wbfriction.friction.ranges.FittedRanges`: beyond them its law is extrapolated).
 """
 
@@ -25,21 +26,6 @@ DERIVED: dict[str, tuple[str, ...]] = {"load": ("k_L",), "direction": ("F_v+", "
 UNITS: dict[str, str] = {"F_L": "", "k_L": "/(N·m)", "dF_v": "N·m·s/rad", "F_v+": "N·m·s/rad", "F_v-": "N·m·s/rad",
                          "F_cT": "N·m/°C", "F_vT": "N·m·s/(rad·°C)", "k_Tc": "/°C", "k_Tv": "/°C", "rate_T": "/°C",
                          "ripple_rms": "N·m"}
-
-
-def reference_conditions(terms: TermFit) -> str:
-    """The conditions the refitted F_c and F_v hold at, by the terms kept: ``zero load``, ``T_ref 40 °C``, ``no
-    ripple``, ``the mean of both directions`` (comma-separated)."""
-    parts = []
-    if "load" in terms.kept:
-        parts.append("zero load")
-    if "temperature" in terms.kept and terms.reference_temperature is not None:
-        parts.append(f"T_ref {terms.reference_temperature:.3g} °C")
-    if "direction" in terms.kept:
-        parts.append("the mean of both directions")
-    if "ripple" in terms.kept:
-        parts.append("no ripple")
-    return ", ".join(parts)
 
 
 def _value(terms: TermFit, name: str) -> str:
@@ -74,7 +60,7 @@ def terms_section(joints: Sequence[str], fits: Mapping[str, FitResult], cell: Ca
             continue
         levels = ", ".join(f"{n} {with_error(getattr(terms.params, n), terms.stderr.get(n))}" for n in ("F_c", "F_v"))
         rows.append(f"<tr>{cell(joint)}<td class=\"text\">velocity</td><td></td>"
-                    f"<td class=\"text\">{html.escape(levels)} at {html.escape(reference_conditions(terms))}</td>"
+                    f"<td class=\"text\">{html.escape(levels)} at {html.escape(terms.reference_conditions())}</td>"
                     "<td></td></tr>")
         for term, verdict in terms.verdicts().items():
             names = list(dict.fromkeys((*TERM_COEFFICIENTS[term], *DERIVED[term])))  # the ripple: its size
