@@ -104,3 +104,18 @@ def test_unreadable_urdf_is_an_input_error(talos, tmp_path):
     with pytest.raises(InputError, match="bad.urdf"):
         write_urdf(robot, body_parameters(talos.model), tmp_path / "out.urdf")
     assert not (tmp_path / "out.urdf").exists()
+
+
+def test_a_massless_body_gives_its_changes_not_a_linalg_error():
+    """Issue 53: ``identify`` with a URDF link of zero mass and inertia ended, after its work, in ``LinAlgError:
+    Eigenvalues did not converge`` (its centre of mass ``h / m`` NaN). A massless body's centre of mass is its frame's
+    origin: the identified body's shift is its own centre of mass, its moments those about it."""
+
+    from wbfriction.inertia.urdf import inertia_changes
+
+    identified = pin.Inertia(2.0, np.array([0.0, 0.3, 0.4]), np.diag([0.1, 0.2, 0.3]))
+    massless = np.zeros(10)
+    (change,) = inertia_changes(["link"], massless[None], identified.toDynamicParameters()[None])
+    assert change.mass_given == 0.0 and change.mass == pytest.approx(2.0)
+    assert change.com_shift == pytest.approx(0.5) and np.isnan(change.mass_change)
+    assert np.allclose(change.moments, [0.1, 0.2, 0.3]) and np.allclose(change.moments_given, 0.0)

@@ -183,12 +183,24 @@ class BodyChange:
             return self.moments / self.moments_given - 1.0
 
 
+def _com_and_moments(p: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """A body's mass [kg], centre of mass [m] and principal moments about it [kg·m^2] (ascending) from its dynamic
+    parameters ``p`` (10,) (Pinocchio's order: ``m, m c, I`` about the body frame's origin). A massless body (a URDF
+    may give one) has its centre of mass at the origin and its moments about it (issue 53: ``LinAlgError`` after
+    the identification's work)."""
+    if p[0] > 0:
+        inertia = pin.Inertia.FromDynamicParameters(p)
+        return float(inertia.mass), np.asarray(inertia.lever), np.linalg.eigvalsh(inertia.inertia)
+    I = np.array([[p[4], p[5], p[7]], [p[5], p[6], p[8]], [p[7], p[8], p[9]]])
+    return float(p[0]), np.zeros(3), np.linalg.eigvalsh(I)
+
+
 def inertia_changes(bodies: tuple[str, ...] | list[str], pi_given: np.ndarray, pi: np.ndarray) -> list[BodyChange]:
     """Per body, the given and identified mass, centre-of-mass shift and principal moments
-    (``pi_given``, ``pi``: (n_bodies, 10) as in :func:`write_urdf`)."""
+    (``pi_given``, ``pi``: (n_bodies, 10) as in :func:`write_urdf`; a massless body's centre of mass at its frame's
+    origin)."""
     out = []
     for name, p0, p1 in zip(bodies, pi_given, pi):
-        a, b = pin.Inertia.FromDynamicParameters(p0), pin.Inertia.FromDynamicParameters(p1)
-        out.append(BodyChange(name, a.mass, b.mass, float(np.linalg.norm(b.lever - a.lever)),
-                              np.linalg.eigvalsh(a.inertia), np.linalg.eigvalsh(b.inertia)))
+        (m0, c0, I0), (m1, c1, I1) = _com_and_moments(np.asarray(p0)), _com_and_moments(np.asarray(p1))
+        out.append(BodyChange(name, m0, m1, float(np.linalg.norm(c1 - c0)), I0, I1))
     return out
