@@ -24,6 +24,7 @@ from wbfriction.logs.tables import read_table
 from wbfriction.model.loading import load_robot
 from wbfriction.pipeline.chunks import Chunking
 from wbfriction.pipeline.estimate_step import RobotSpec, estimate_file
+from wbfriction.signals.options import FilterOptions
 from wbfriction.signals.window import MomentumWindow
 from wbfriction.sim.arm import ExcitationOptions, arm_model, excitation_trajectory
 from wbfriction.sim.ideal import simulate_ideal
@@ -139,6 +140,10 @@ def test_the_route_and_its_windows_are_chosen_from_the_noise_and_said(panda):
     asked, decision = resolve_route(EstimateOptions(route="acceleration"), noisy)
     assert asked.route == "acceleration" and decision.reason.startswith("acceleration, as asked")
     assert resolve_route(EstimateOptions(route="momentum", momentum=MomentumOptions(7, 9)), noisy)[1] is None
+    # issue 53: a filter given for the acceleration route, dropped without a word when auto took the momentum route
+    filtered, decision = resolve_route(EstimateOptions(diff="savgol", filtering=FilterOptions(window=201)), noisy)
+    assert filtered.route == "momentum" and decision.reason.endswith(
+        "; --window 201 not used (the acceleration route's filter; --route acceleration keeps it)")
     with pytest.raises(InputError, match="--momentum-window must be odd"):
         MomentumOptions(window=10)
     with pytest.raises(InputError, match="--route must be one of auto, acceleration, momentum, got 'fast'"):

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from wbfriction.choices import flag
 from wbfriction.exceptions import InputError
 from wbfriction.friction.options import EstimateOptions, MomentumOptions, Route
 from wbfriction.logs.clock import longest_segment
@@ -36,6 +37,7 @@ from wbfriction.signals.choice import (
     choose_momentum_smoothing,
     savgol_choice,
 )
+from wbfriction.signals.options import FilterOptions
 
 WINDOW_RATIO = 2.0
 """The momentum route is chosen where the acceleration route's window exceeds its velocity window this many times
@@ -159,5 +161,10 @@ def resolve_route(options: EstimateOptions, source: Log | np.ndarray | None, dt:
     else:
         n = 0
     decision = choose_route(options, _position_noise(source, dt or 1.0, choice), dt or 1.0, max(n, 1))
+    unused = [f"{flag(f.name)} {getattr(options.filtering, f.name)}" for f in fields(FilterOptions)
+              if getattr(options.filtering, f.name) != f.default]
+    if decision.route == "momentum" and unused:  # the filter given is the acceleration route's: said, not dropped
+        decision = replace(decision, reason=f"{decision.reason}; {', '.join(unused)} not used (the acceleration "
+                           "route's filter; --route acceleration keeps it)")
     momentum = MomentumOptions(decision.velocity_window, decision.window)
     return replace(options, route=decision.route, momentum=momentum), decision
