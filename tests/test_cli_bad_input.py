@@ -197,3 +197,16 @@ def test_bad_bags_write_nothing(talos, combined_walk, tmp_path, capsys, command)
         assert f"{tmp_path / 'bag'}: " in lines[0] and needle in lines[0], lines[0]
         assert output.read_bytes() == PREVIOUS
         assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+@pytest.mark.parametrize("option", ["--cond", "--companion"])
+def test_an_acceleration_route_output_asked_of_the_momentum_route_is_refused(good, talos, tmp_path, capsys, option):
+    """Issue 53: ``estimate --route momentum --cond`` (or ``--companion``) ran and left the column out without a
+    word."""
+    log = tmp_path / "log.parquet"
+    write_log(good, talos, log)
+    code, err = run_cli(capsys, "estimate", log, "--robot", "talos", "--route", "momentum", option,
+                        "-o", tmp_path / "f.parquet")
+    assert code == 2 and len(err.strip().splitlines()) == 1 and f"{option} must be left out with --route momentum" \
+        in err, err
+    assert not (tmp_path / "f.parquet").exists()

@@ -457,7 +457,10 @@ def test_fit_estimate_fits_every_joint_with_its_targets_and_options():
     plain = fit_estimate(est, FitOptions(terms=TermOptions(terms=())))
     assert plain == fit_joints(("a", "b"), qd, tau_f, valid, tau_f_true=truth, model="auto",
                                targets={"a": FrictionParams(F_v=0.3, F_c=0.5)}, stick_margin=1)
-    assert [f.terms is not None and set(f.terms.reasons) == {"direction"} for f in fit_estimate(est)] == [True, True]
+    for f in fit_estimate(est):  # the others said not tried, each for want of its signal (issue 53)
+        assert f.terms is not None and {t for t, why in f.terms.reasons.items() if not why.startswith("not tried")} \
+            == {"direction"}
+        assert f.terms.reasons["temperature"] == "not tried: no temperature.<joint> column"
 
 
 def test_auto_passes_every_option_to_its_candidates():

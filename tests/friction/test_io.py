@@ -112,8 +112,12 @@ def test_parameter_files_of_the_previous_version_read_as_model_3_5(tmp_path):
 def test_malformed_model_entries_name_the_file_and_the_joint(tmp_path):
     for entry, needle in (({"model": "lugre", "params": {"F_c": 1.0}}, "model must be one of"),
                           ({"model": "coulomb-viscous", "params": {"F_c": 1.0, "S": 0.2}}, "unknown friction param"),
-                          ({"model": "coulomb-viscous", "params": {"F_c": 1.0}, "at_bound": {"S": True}}, "at_bound"),
-                          ({"params": {"F_c": 1.0}, "selection": {"chosen": "thesis"}}, "selection: missing key"),
+                          ({"model": "coulomb-viscous", "params": {"F_c": 1.0, "F_v": 0.1, "tau_os": 0.0},
+                            "at_bound": {"S": True}}, "at_bound"),
+                          ({"model": "coulomb-viscous", "params": {"F_c": 1.0, "tau_os": 0.0}},
+                           "params.F_v is missing: 'fit' writes every parameter of the coulomb-viscous model"),
+                          ({"params": {"F_c": 1.0, "F_v": 0.1, "S": 0.0, "v_s": 0.1, "tau_os": 0.0, "a": 40.0,
+                                       "delta_s": 2.0}, "selection": {"chosen": "thesis"}}, "selection: missing key"),
                           ({"selection": {"chosen": "x", "tolerance": 0.1}}, "selection.chosen")):
         (tmp_path / "p.json").write_text(json.dumps({"joints": {"knee": entry}}))
         with pytest.raises(InputError, match=rf"p.json: joint 'knee': .*{needle}"):

@@ -192,6 +192,11 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                            filtering=FilterOptions(window=window, poly_order=poly_order,
                                                    weights=weights,
                                                    cutoff=cutoff, butter_order=butter_order))
+    # the acceleration route's outputs, not the momentum route's: asked for with it, refused (with --route auto, the
+    # route's line says which was taken)
+    if cond and opts.route == "momentum":
+        raise OptionError("--cond", True, "left out with --route momentum (cond(M_mod^-1) is the acceleration "
+                          "route's: the momentum route inverts no M_mod)")
     if companion and opts.route == "momentum":
         raise OptionError("--companion", True, "left out with --route momentum (the companion is the acceleration "
                           "route's other differentiation)")

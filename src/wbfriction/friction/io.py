@@ -363,6 +363,9 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
                                    speed=None if d.get("speed") is None else _number(d["speed"]))
         if d.get("params") is not None:
             res.params = params_from_dict(model, d["params"])
+            missing = [n for n in res.params.names if n not in d["params"]]
+            if missing:  # its default would be read: a removed F_c a frictionless joint
+                raise InputError(f"params.{missing[0]} is missing: 'fit' writes every parameter of the {model} model")
             res.stderr = {k: _number(v) for k, v in (d.get("stderr") or {}).items()}
             if d.get("covariance") is not None:
                 res.covariance = _covariance(d["covariance"], len(res.params.names))

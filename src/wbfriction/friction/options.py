@@ -154,9 +154,6 @@ class EstimateOptions:
             value = getattr(self, name)
             for v in value if isinstance(value, tuple) else (value,):
                 check_range(name, v, low=0.0, strict=name == "ds_weight")
-        if self.route == "momentum" and self.condition_number:
-            raise OptionError("--cond", True, "left out with --route momentum (cond(M_mod^-1) is the acceleration "
-                              "route's: the momentum route inverts no M_mod)")
         given = [f.name for f in fields(FilterOptions) if getattr(self.filtering, f.name) != f.default]
         if self.diff == "auto" and given:
             raise OptionError(flag(given[0]), getattr(self.filtering, given[0]), "given with --diff savgol or "
