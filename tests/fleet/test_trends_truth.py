@@ -490,7 +490,7 @@ def test_untested_joints_are_counted_apart():
     options = TrendOptions(alpha=0.01, quantities=("F_c",), replicates=2000)
     trends = fleet_trends(results_table(rows), options)
     assert [(j.robot_id, j.joint) for j in trends.tested] == [("b", "j"), ("a", "j1"), ("a", "j2")]
-    assert trends.summary() == "2 of 3 tested robot joints drifted (1 not tested: fewer than 8 usable logs)"
+    assert trends.summary() == "2 of 3 tested robot joints drifted (1 not tested: 1 with fewer than 8 usable logs)"
     assert trends.to_table().num_rows == 3
 
 

@@ -9,7 +9,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from wbfriction.exceptions import ColumnError, OptionError
-from wbfriction.logs.temperature import GLITCH_STEP, PLAUSIBLE, check_reference_temperature, screen_temperature
+from wbfriction.logs.options import PLAUSIBLE, check_reference_temperature
+from wbfriction.logs.temperature import GLITCH_STEP, screen_temperature
 
 
 def warming(n: int = 2000, start: float = 25.0, end: float = 55.0, step: float = 0.1) -> np.ndarray:

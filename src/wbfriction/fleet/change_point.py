@@ -36,7 +36,7 @@ from typing import Protocol
 import numpy as np
 
 from wbfriction.fleet.options import Shape
-from wbfriction.logs.temperature import PLAUSIBLE
+from wbfriction.logs.options import PLAUSIBLE
 
 DAY = 86_400.0
 """Seconds per day: the series' time unit."""

@@ -40,7 +40,7 @@ from wbfriction.exceptions import InputError, OptionError
 from wbfriction.fleet.change_point import FIRST_PASS, ChangePoint, detect_change
 from wbfriction.fleet.options import SHAPES, Shape
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
-from wbfriction.logs.temperature import check_reference_temperature
+from wbfriction.logs.options import check_reference_temperature
 
 QUANTITIES: tuple[str, ...] = (*TREND_PARAMS, *[speed_column(v) for v in REFERENCE_SPEEDS])
 """The quantities followed over time: the model's parameters and the friction at the reference speeds."""

@@ -11,7 +11,7 @@ from typing import Literal, get_args
 
 from wbfriction.choices import check_choice, check_range, flag
 from wbfriction.exceptions import OptionError
-from wbfriction.logs.temperature import check_reference_temperature
+from wbfriction.logs.options import check_reference_temperature
 from wbfriction.signals.options import (
     ALIGNMENT_OPTIONS,
     DIFF_OPTIONS,

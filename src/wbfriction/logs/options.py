@@ -3,7 +3,10 @@ shows their defaults in its help without loading NumPy or pyarrow."""
 
 from __future__ import annotations
 
+import math
 from typing import Literal, get_args
+
+from wbfriction.exceptions import OptionError
 
 MAX_GAP = 2.0
 """Default gap [sampling periods]: a time step at least this long (against the median of the
@@ -18,3 +21,19 @@ TIME_BASES: tuple[TimeBase, ...] = get_args(TimeBase)
 TimeUnit = Literal["s", "ms", "us", "ns"]
 """The unit of a numeric ``time`` column (``--time-unit``)."""
 TIME_UNITS: tuple[TimeUnit, ...] = get_args(TimeUnit)
+
+PLAUSIBLE = (-60.0, 200.0)
+"""The temperatures [°C] a robot joint's motor or gearbox is met at: from a cold store to class H insulation's
+180 °C. A column centred outside is refused, a sample outside is a glitch."""
+
+
+def check_reference_temperature(value: float | None, option: str = "--reference-temperature") -> None:
+    """Refuse a reference temperature [°C] that no joint has: not finite, or outside :data:`PLAUSIBLE` (None: the
+    data's median, accepted).
+
+    Raises:
+        OptionError: naming ``option``.
+    """
+    low, high = PLAUSIBLE
+    if value is not None and not (math.isfinite(value) and low <= value <= high):
+        raise OptionError(option, value, f"a joint's temperature in °C, {low:g} to {high:g}")

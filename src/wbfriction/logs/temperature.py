@@ -5,10 +5,10 @@ Friction's temperature term (:mod:`~wbfriction.friction.terms`) and the fleet's 
 unit, or one glitched sample, would move a fitted slope or a drift without a word. So each column is screened where
 it is read, as the torques are:
 
-* **Units and plausibility**: a column whose median lies outside :data:`PLAUSIBLE` (-60 to 200 °C: a joint's
-  motor or gearbox in use, class H insulation's 180 °C included) is refused, naming the column; one in kelvin (a
-  median within :data:`KELVIN`) is told so.
-* **Glitches**: a sample outside :data:`PLAUSIBLE`, or departing by more than :data:`GLITCH_STEP` (5 °C) from the
+* **Units and plausibility**: a column whose median lies outside :data:`~wbfriction.logs.options.PLAUSIBLE` (-60
+  to 200 °C: a joint's motor or gearbox in use, class H insulation's 180 °C included) is refused, naming the
+  column; one in kelvin (a median within :data:`KELVIN`) is told so.
+* **Glitches**: a sample outside that range, or departing by more than :data:`GLITCH_STEP` (5 °C) from the
   running median of the :data:`GLITCH_ROWS` samples either side, is no temperature a joint had (a joint's thermal
   time constant is seconds to minutes; a sensor's quantisation is 1 °C or finer): it becomes NaN, not used by any
   fit, and a warning names the column, the rows and the first value. A column where more than
@@ -23,11 +23,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from wbfriction.exceptions import ColumnError, OptionError
+from wbfriction.exceptions import ColumnError
+from wbfriction.logs.options import PLAUSIBLE
 
-PLAUSIBLE = (-60.0, 200.0)
-"""The temperatures [°C] a robot joint's motor or gearbox is met at: from a cold store to class H insulation's
-180 °C. A column centred outside is refused, a sample outside is a glitch."""
 KELVIN = (200.0, 500.0)
 """A column whose median lies here, above :data:`PLAUSIBLE`, is in kelvin (-73 to 227 °C)."""
 GLITCH_ROWS = 4
@@ -113,14 +111,3 @@ def screen_temperature(T: np.ndarray, joints: Sequence[str], source: str, first_
         T[rows, i] = np.nan
     return T, tuple(warnings)
 
-
-def check_reference_temperature(value: float | None, option: str = "--reference-temperature") -> None:
-    """Refuse a reference temperature [°C] that no joint has: not finite, or outside :data:`PLAUSIBLE` (None: the
-    data's median, accepted).
-
-    Raises:
-        OptionError: naming ``option``.
-    """
-    low, high = PLAUSIBLE
-    if value is not None and not (np.isfinite(value) and low <= value <= high):
-        raise OptionError(option, value, f"a joint's temperature in °C, {low:g} to {high:g}")

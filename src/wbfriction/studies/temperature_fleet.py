@@ -180,7 +180,8 @@ def score_temperature_fleet(plan: TemperatureFleet, results: pa.Table, temperatu
     worn joint, its onset and its size at the reference temperature."""
     from wbfriction.fleet.trends import TrendOptions, fleet_trends
 
-    options = TrendOptions(temperature=temperature, reference_temperature=T_REF, replicates=replicates)
+    options = TrendOptions(temperature=temperature, reference_temperature=T_REF if temperature else None,
+                           replicates=replicates)
     found = fleet_trends(results, options)
     wear = {(w.robot_id, w.joint): w for w in plan.wear()}
     flagged = tuple((j.robot_id, j.joint) for j in found.flagged)
