@@ -267,10 +267,11 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     if decision is not None:
         extra_metadata = {**(extra_metadata or {}), "route": decision.to_dict()}
     record = None if first is None else noise_record(robot, first, clock.step, options)
+    unmeasured = "" if first is None else unmeasured_noise(record, len(first), options)
     if record is not None:
         extra_metadata = {**(extra_metadata or {}), "noise": record}
-    elif first is not None and unmeasured_noise(record, len(first), options):
-        extra_metadata = {**(extra_metadata or {}), "noise_unmeasured": unmeasured_noise(record, len(first), options)}
+    elif unmeasured:
+        extra_metadata = {**(extra_metadata or {}), "noise_unmeasured": unmeasured}
     n = len(contact)
     chunks = plan_chunks(contact, chunking)
     del contact
