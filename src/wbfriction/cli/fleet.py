@@ -170,7 +170,7 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
         console.print(f"[yellow]note:[/] temperature left out of {len(notes)} series on {joints} joint"
                       f"{'s' if joints > 1 else ''} (first {escape(robot_id)} {escape(joint)} {quantity}: "
                       f"{note.removeprefix('temperature left out: ')}); --table writes each series' temperature_note",
-                      highlight=False, soft_wrap=True)
+                      highlight=False, soft_wrap=False)  # a note, not an error line: wrapped to the terminal
     for j in found.flagged:
         cp = j.drifts[0]
         size = (f"{100 * cp.relative:+.1f} %" if not math.isnan(cp.relative)
