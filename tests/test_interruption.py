@@ -220,20 +220,26 @@ def test_a_signal_while_a_batch_runs_on_dask_ends_it_with_one_line(arm_manifest,
     its group left; a result written is whole (the next run goes on from it). Issue 53, class 17: nothing else is
     left in the results and tables folders (the workers' partial files stayed there until the next run), nor the
     batch's lock."""
-    name = signal.Signals(signum).name
     proc = _start("batch", arm_manifest, "-o", tmp_path / "results", "--tables", tmp_path / "tables", cwd=tmp_path)
     kids = _pool_busy(proc)
     time.sleep(1.0)
+    _interrupt(proc, kids, signum, group)
+    from wbfriction.fleet.results import read_parts
+
+    assert all(part.rows is not None for part in read_parts(tmp_path / "results"))
+    assert _leftovers(tmp_path / "results", tmp_path / "tables") == []
+
+
+def _interrupt(proc, kids: list, signum: int, group: bool) -> None:
+    """Send ``signum`` to the batch (its process group with ``group``) and check it ended as a signal ends a command:
+    its exit status, one line, its worker processes gone."""
+    name = signal.Signals(signum).name
     (os.killpg if group else os.kill)(proc.pid, signum)
     _, err = ended_within(proc, 60, name)
     assert proc.returncode == 128 + signum, err
     assert _stderr_lines(err) == [f"interrupted ({name})"], err
     assert _wait_gone(kids, 10.0) < 10.0, f"left alive: {_alive(kids)}"
     assert _group(proc.pid) == []
-    from wbfriction.fleet.results import read_parts
-
-    assert all(part.rows is not None for part in read_parts(tmp_path / "results"))
-    assert _leftovers(tmp_path / "results", tmp_path / "tables") == []
 
 
 def _leftovers(*folders: Path) -> list[Path]:
@@ -248,7 +254,6 @@ def test_a_signal_while_a_dask_batchs_tasks_run_leaves_no_partial_file(arm_manif
     """Issue 53, class 17: a batch interrupted while its Dask workers' tasks estimate left their scratch folders
     (``.wbfriction-<host>-<pid>-<token>``) in the results folder until the next run. They are removed when the batch
     ends on the signal, with the batch's lock; the results written are whole."""
-    name = signal.Signals(signum).name
     results, tables = tmp_path / "results", tmp_path / "tables"
     proc = _start("batch", arm_manifest, "-o", results, "--tables", tables, cwd=tmp_path)
     deadline = time.monotonic() + 120
@@ -257,12 +262,7 @@ def test_a_signal_while_a_dask_batchs_tasks_run_leaves_no_partial_file(arm_manif
     assert proc.poll() is None, "the batch ended before it could be interrupted"
     time.sleep(0.5)
     kids = _children(proc.pid)
-    (os.killpg if group else os.kill)(proc.pid, signum)
-    _, err = ended_within(proc, 60, name)
-    assert proc.returncode == 128 + signum, err
-    assert _stderr_lines(err) == [f"interrupted ({name})"], err
-    assert _wait_gone(kids, 10.0) < 10.0, f"left alive: {_alive(kids)}"
-    assert _group(proc.pid) == []
+    _interrupt(proc, kids, signum, group)
     assert _leftovers(results, tables) == []
     from wbfriction.fleet.results import read_parts
 
