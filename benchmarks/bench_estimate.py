@@ -41,7 +41,7 @@ import pyarrow.parquet as pq  # noqa: E402
 sys.path.insert(0, str(Path(__file__).parent))
 from bench_long_log import work_folder  # noqa: E402
 
-from wbfriction.friction.targets import THESIS_TARGETS  # noqa: E402
+from wbfriction.fit.targets import THESIS_TARGETS  # noqa: E402
 from wbfriction.model.loading import load_robot  # noqa: E402
 from wbfriction.sim import simulate_ideal  # noqa: E402
 from wbfriction.studies.common import leg_joints  # noqa: E402

@@ -7,7 +7,7 @@ the run of least CPU of ``--repeat``), next to the ``estimate`` command that wro
 run (the ratio: how much of a log's processing the fit takes; issue 41 measured about 4 on a fleet task). Then, in
 this process, where the fit's time goes: the solver runs (``scipy.optimize.least_squares``), their evaluations of
 the model and its Jacobian, and the share of the model's expectation under the velocity noise
-(:mod:`wbfriction.friction.eiv`). Target of issue 41: under 3 s wall on 2 cores.
+(:mod:`wbfriction.fit.eiv`). Target of issue 41: under 3 s wall on 2 cores.
 
     python benchmarks/bench_fit.py [--repeat 3] [--workers 2] [--keep DIR]
 """
@@ -26,7 +26,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from bench_estimate import combined_walk, run  # noqa: E402
 from bench_long_log import work_folder  # noqa: E402
 
-from wbfriction.friction.fit import fit_estimate  # noqa: E402
+from wbfriction.fit.joints import fit_estimate  # noqa: E402
 from wbfriction.friction.io import read_friction_file  # noqa: E402
 from wbfriction.model.loading import load_robot  # noqa: E402
 

@@ -31,7 +31,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from bench_estimate import run  # noqa: E402
 from bench_long_log import work_folder  # noqa: E402
 
-from wbfriction.friction.targets import THESIS_TARGETS  # noqa: E402
+from wbfriction.fit.targets import THESIS_TARGETS  # noqa: E402
 from wbfriction.inertia.closed_loop import identify  # noqa: E402
 from wbfriction.inertia.identification import identify_inertia, log_samples  # noqa: E402
 from wbfriction.inertia.regressor import body_parameters  # noqa: E402

@@ -26,7 +26,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from wbfriction.friction.targets import THESIS_TARGETS
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.model.loading import load_robot
 from wbfriction.pipeline.chunks import Chunking
 from wbfriction.sim import simulate_ideal

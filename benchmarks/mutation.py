@@ -55,8 +55,10 @@ TESTS: dict[str, tuple[str, ...]] = {
                               "tests/signals/test_filters.py"),
     "signals/filters.py": ("tests/signals/test_filters.py", "tests/signals/test_weighted_savgol.py",
                            "tests/signals/test_filter_wiring.py", "tests/signals/test_nonuniform.py"),
-    "friction/fit.py": ("tests/friction/test_fit.py", "tests/friction/test_fit_hac.py"),
-    "friction/status.py": ("tests/friction/test_status.py",),
+    "fit/solve.py": ("tests/fit/test_fit.py",),
+    "fit/selection.py": ("tests/fit/test_fit.py",),
+    "fit/joints.py": ("tests/fit/test_fit.py",),
+    "fit/status.py": ("tests/fit/test_status.py",),
     "logs/clock.py": ("tests/logs/test_clock.py", "tests/logs/test_log.py"),
     "signals/choice.py": ("tests/signals/test_choice.py",),
     "fleet/trends.py": ("tests/fleet/test_trends.py", "tests/fleet/test_trends_truth.py"),
@@ -74,7 +76,7 @@ DESELECT: dict[str, tuple[str, ...]] = {
 reaches it); the module's own truth tests reach the same functions in seconds."""
 
 TEXT_FUNCTIONS: dict[str, tuple[str, ...]] = {
-    "friction/status.py": ("FitVerdict.__str__", "solver_phrase"),
+    "fit/status.py": ("FitVerdict.__str__", "solver_phrase"),
     "signals/choice.py": ("DiffChoice.__str__",),
 }
 """Functions whose result is only text, no number formatted (a reason's joints): every mutant of theirs

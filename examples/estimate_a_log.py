@@ -14,7 +14,7 @@ import tempfile
 from pathlib import Path
 
 import wbfriction
-from wbfriction.friction.targets import THESIS_TARGETS, friction_by_group
+from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.logs import write_table
 from wbfriction.sim import IdealOptions, simulate_ideal
 from wbfriction.walking import GaitOptions, walking_reference

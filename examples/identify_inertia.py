@@ -16,7 +16,7 @@ import tempfile
 from pathlib import Path
 
 import wbfriction
-from wbfriction.friction.targets import THESIS_TARGETS, friction_by_group
+from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.inertia import identification_of, identify, scaled_robot, write_urdf
 from wbfriction.sim import IdealOptions, simulate_ideal
 from wbfriction.walking import GaitOptions, walking_reference

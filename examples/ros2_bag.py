@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 import wbfriction
-from wbfriction.friction.targets import THESIS_TARGETS, friction_by_group
+from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.pipeline import convert_log
 from wbfriction.sim import IdealOptions, simulate_ideal
 from wbfriction.walking import GaitOptions, walking_reference

@@ -125,7 +125,7 @@ def truth_samples(robot: Robot, n: int, support: str, seed: int, friction_joints
 def combined_walk(talos):
     """The demo's combined walk (forward, sideways, turning), 3 steps per direction, Table 6.1
     friction on every leg joint, the demo's simulator (physics at 10 kHz)."""
-    from wbfriction.friction.targets import THESIS_TARGETS
+    from wbfriction.fit.targets import THESIS_TARGETS
     from wbfriction.sim import simulate_ideal
     from wbfriction.studies.common import SIMULATOR, leg_joints
     from wbfriction.walking import GaitOptions, walking_reference

@@ -1,6 +1,6 @@
 """Small synthetic parameters files and friction tables of one joint with terms beyond velocity (issue 53's tests):
 a fit whose status is ``ok``, written as ``wbfriction fit`` writes it, and tables whose friction is written from the
-physical law itself, not through :mod:`wbfriction.friction.terms`."""
+physical law itself, not through :mod:`wbfriction.fit.terms`."""
 
 from __future__ import annotations
 
@@ -10,12 +10,13 @@ from typing import Any
 
 import numpy as np
 
+from wbfriction.fit.params_file import write_params
+from wbfriction.fit.ranges import FittedRanges
+from wbfriction.fit.result import FitResult
+from wbfriction.fit.terms import TermFit
 from wbfriction.friction.estimated import FrictionEstimate
-from wbfriction.friction.fit import FitResult
-from wbfriction.friction.io import friction_table, write_params
+from wbfriction.friction.io import friction_table
 from wbfriction.friction.models import CoulombViscousParams
-from wbfriction.friction.ranges import FittedRanges
-from wbfriction.friction.terms import TermFit
 from wbfriction.logs.tables import write_table
 
 JOINT = "panda_joint1"

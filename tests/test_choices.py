@@ -14,8 +14,9 @@ from hypothesis import strategies as st
 
 from wbfriction.choices import check_range, flag
 from wbfriction.exceptions import InputError, OptionError
+from wbfriction.fit.options import FitOptions
 from wbfriction.fleet.options import BatchOptions
-from wbfriction.friction.options import EstimateOptions, FitOptions, MomentumOptions
+from wbfriction.friction.options import EstimateOptions, MomentumOptions
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.signals.options import FilterOptions
 from wbfriction.sim.options import IdealOptions, MujocoOptions

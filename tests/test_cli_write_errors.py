@@ -44,7 +44,7 @@ def _refused_write(res: subprocess.CompletedProcess, folder: Path, out: Path) ->
 @pytest.fixture(scope="module")
 def arm(tmp_path_factory) -> Path:
     """A folder with a 3 s Panda log, its friction table and its parameters, as the commands write them."""
-    from wbfriction.friction.options import FitOptions
+    from wbfriction.fit.options import FitOptions
     from wbfriction.logs.tables import write_table
     from wbfriction.model.loading import load_robot
     from wbfriction.pipeline.chunks import Chunking

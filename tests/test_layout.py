@@ -1,6 +1,6 @@
 """The package's layout, read from the source (no code run): subpackages along the data flow, each importing
-only those before it, no circle between modules, no private name used outside its module, and the README's
-file map naming what is there."""
+only those before it, no circle between modules, no private name used outside its module, and the manual's
+file map (``docs/explanation/layout.md``) naming what is there."""
 
 from __future__ import annotations
 
@@ -18,6 +18,7 @@ LAYERS = [
     {"datasets"},
     {"signals"},
     {"friction"},
+    {"fit"},
     {"inertia"},
     {"export"},
     {"pipeline"},
@@ -138,13 +139,18 @@ def test_no_private_name_crosses_a_module():
     assert not bad, "\n".join(bad)
 
 
-def test_readme_file_map_matches_the_code():
-    """The README's file map lists every subpackage and top-level module of the package, and nothing else."""
-    text = (ROOT / "README.md").read_text()
+FILE_MAP = ROOT / "docs" / "explanation" / "layout.md"
+"""The manual's page holding the package's file map (moved there from the README, issue 54)."""
+
+
+def test_file_map_matches_the_code():
+    """The manual's file map (``docs/explanation/layout.md``) lists every subpackage and top-level module of the
+    package, and nothing else."""
+    text = FILE_MAP.read_text()
     block = re.search(r"<!-- file map -->\n```text\n(.*?)```", text, re.S)
-    assert block, "README: no file map block"
+    assert block, f"{FILE_MAP.relative_to(ROOT)}: no file map block"
     named = set(re.findall(r"^[│├└─ ]*([a-z_]+(?:/|\.py))\s", block.group(1), re.M))
     present = {p.name + "/" for p in PACKAGE.iterdir() if (p / "__init__.py").exists()}
     present |= {p.name for p in PACKAGE.glob("*.py") if p.name not in ("__init__.py", "__main__.py")}
-    assert named == present, (f"README lists {sorted(named - present)} that the code has not; "
-                              f"misses {sorted(present - named)}")
+    assert named == present, (f"{FILE_MAP.relative_to(ROOT)} lists {sorted(named - present)} that the code has "
+                              f"not; misses {sorted(present - named)}")

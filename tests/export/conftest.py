@@ -9,7 +9,7 @@ import pinocchio as pin
 import pytest
 
 from helpers import KUKA_CONFIG, KUKA_URDF
-from wbfriction.friction.fit import FitResult
+from wbfriction.fit.result import FitResult
 from wbfriction.friction.models import FrictionParams
 from wbfriction.model import load_robot
 from wbfriction.model.robot import Robot
@@ -78,7 +78,7 @@ def identified():
 
 
 def _fit_of(joint: str, status: str, F_v: float = 0.2, F_c: float = 1.0) -> FitResult:
-    """A fit whose verdict is ``status`` by the rules of :mod:`wbfriction.friction.status`: a joint that moved
+    """A fit whose verdict is ``status`` by the rules of :mod:`wbfriction.fit.status`: a joint that moved
     (95th percentile of |qd| 1 rad/s), a converged solver and standard errors of 5 % (ok); F_v's standard
     error 3 times its value (weak); v_s left on a bound (at bound); |qd| at most 0.0025 rad/s (not excited);
     a solver that did not converge (failed)."""

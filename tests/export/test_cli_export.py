@@ -10,7 +10,7 @@ import mujoco
 import pytest
 
 from helpers import run, run_cli
-from wbfriction.friction.io import write_params
+from wbfriction.fit.params_file import write_params
 
 PREVIOUS = b"the previous output"
 

@@ -13,7 +13,7 @@ from ruamel.yaml import YAML
 
 from wbfriction.exceptions import InputError
 from wbfriction.export.isaac import ISAAC_FIELDS, isaac_actuator_dict, write_isaac_yaml, yaml_float
-from wbfriction.friction.fit import FitResult
+from wbfriction.fit.result import FitResult
 from wbfriction.friction.models import FrictionParams
 
 YAML_1_1_FLOAT = re.compile(r"^[-+]?([0-9][0-9_]*)?\.[0-9.]*([eE][-+][0-9]+)?$")

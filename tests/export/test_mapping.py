@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
 from wbfriction.export.mapping import JointExport, joint_export, joint_exports
-from wbfriction.friction.fit import FitResult
+from wbfriction.fit.result import FitResult
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams, StribeckParams
 
 positive = st.floats(0.01, 50.0)
@@ -94,7 +94,7 @@ def test_a_fit_with_terms_exports_its_reference_levels_and_says_what_is_dropped(
     them (the levels at zero load and T_ref, not the fit's own levels averaged over the log's conditions), and its
     note names the terms dropped and those conditions."""
     from wbfriction.export.mapping import status_note
-    from wbfriction.friction.terms import TermFit
+    from wbfriction.fit.terms import TermFit
 
     refitted = CoulombViscousParams(F_v=0.25, F_c=0.8, tau_os=0.1)
     terms = TermFit(refitted, ("load", "temperature"), 0, {"F_L": 0.02, "F_cT": -0.008, "F_vT": -0.004},

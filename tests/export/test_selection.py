@@ -24,10 +24,10 @@ from wbfriction.export.mapping import (
     status_note,
 )
 from wbfriction.export.mjcf import write_mjcf
-from wbfriction.friction.fit import FitResult
-from wbfriction.friction.io import write_params
+from wbfriction.fit.params_file import write_params
+from wbfriction.fit.result import FitResult
+from wbfriction.fit.status import FitVerdict
 from wbfriction.friction.models import FrictionParams
-from wbfriction.friction.status import FitVerdict
 from wbfriction.model import load_robot
 from wbfriction.pipeline.export_step import export_files
 

@@ -16,12 +16,12 @@ import numpy as np
 import pyarrow.compute as pc
 import pytest
 
+from wbfriction.fit.options import FitOptions
 from wbfriction.fleet.batch import plan_batch, run_batch
 from wbfriction.fleet.manifest import read_manifest
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.results import read_failures, read_results
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, speed_column
-from wbfriction.friction.options import FitOptions
 
 
 def _files(results: Path) -> dict[str, bytes]:

@@ -15,13 +15,13 @@ import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
+from wbfriction.fit.options import FitOptions
 from wbfriction.fleet.batch import run_batch
 from wbfriction.fleet.manifest import read_manifest
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.results import read_results, rows_sha256
 from wbfriction.fleet.schema import RESULT_SCHEMA
 from wbfriction.fleet.task import LogOutcome
-from wbfriction.friction.options import FitOptions
 
 LOGS = ("a", "b", "c")
 """The logs; each has a copy of its bytes, ``<name>-copy.parquet``."""

@@ -21,13 +21,13 @@ import pytest
 from threadpoolctl import threadpool_info
 
 from wbfriction.exceptions import InputError
+from wbfriction.fit.options import FitOptions
 from wbfriction.fleet.batch import DaskChunks, check_outputs, chunk_on_one_thread, connect, plan_batch, run_batch
 from wbfriction.fleet.manifest import LogEntry
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.results import failures_folder, read_failures, read_results, result_path
 from wbfriction.fleet.schema import RESULT_SCHEMA
 from wbfriction.fleet.task import LogOutcome
-from wbfriction.friction.options import FitOptions
 from wbfriction.pipeline.estimate_step import RobotSpec
 
 DAY = datetime(2026, 3, 1, 8, tzinfo=UTC)

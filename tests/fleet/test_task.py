@@ -6,8 +6,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from wbfriction.fit.result import FitResult
 from wbfriction.fleet.task import reference_friction
-from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams
 
 

@@ -17,6 +17,9 @@ import pytest
 from threadpoolctl import threadpool_info
 
 from wbfriction.exceptions import InputError
+from wbfriction.fit.energy import JointEnergy
+from wbfriction.fit.options import FitOptions
+from wbfriction.fit.result import FitResult
 from wbfriction.fleet.manifest import LogEntry
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, speed_column
@@ -29,10 +32,8 @@ from wbfriction.fleet.task import (
     result_rows,
     robot_sha256,
 )
-from wbfriction.friction.energy import JointEnergy
-from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import CoulombViscousParams, StribeckParams
-from wbfriction.friction.options import EstimateOptions, FitOptions
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.pipeline.estimate_step import RobotSpec
 from wbfriction.version import __version__
 

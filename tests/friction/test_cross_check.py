@@ -43,7 +43,7 @@ def test_exact_routes_agree_and_no_cause_is_given(talos):
 def test_mujoco_imperfections_are_named(talos, options, cause, at_least):
     """A compliant sole makes the rigid route's stance foot move; a force-torque offset shifts the sensors'
     route by a constant (measured: 10 and 8 of the 12 leg joints)."""
-    from wbfriction.friction.targets import THESIS_TARGETS
+    from wbfriction.fit.targets import THESIS_TARGETS
     from wbfriction.studies.common import leg_joints
     friction = {j: THESIS_TARGETS[g] for j, _, g in leg_joints(talos)}
     ref = walking_reference(talos, GaitOptions(gait="forward", steps=2))

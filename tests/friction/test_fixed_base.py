@@ -163,7 +163,7 @@ class _Truth:
 def test_the_true_model_predicts_the_torques(tmp_path, panda_log):
     """Torque prediction (friction.predict): the injected friction predicts the torques exactly,
     the rigid-body model alone misses them by the friction's RMS."""
-    from wbfriction.friction.predict import predict_torques
+    from wbfriction.fit.predict import predict_torques
 
     t, q, qd, qdd, tau_f, tau = panda_log
     robot = load_robot(urdf=example_robot_data_dir() / PANDA, config=config(tmp_path))

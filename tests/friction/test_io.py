@@ -8,16 +8,10 @@ import numpy as np
 import pytest
 
 from wbfriction.exceptions import InputError
+from wbfriction.fit.params_file import fit_from_dict, fit_to_dict, read_params, write_params
+from wbfriction.fit.result import FitResult, HeldOutScore, ModelSelection
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.fit import FitResult, HeldOutScore, ModelSelection
-from wbfriction.friction.io import (
-    fit_from_dict,
-    fit_to_dict,
-    friction_table,
-    read_friction_file,
-    read_params,
-    write_params,
-)
+from wbfriction.friction.io import friction_table, read_friction_file
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams, StribeckParams
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.tables import write_table

@@ -12,10 +12,10 @@ import pytest
 from tests.helpers import run_cli
 
 from wbfriction.exceptions import ColumnError
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.measured import impacts
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import write_log
 from wbfriction.logs.source import read_log
 from wbfriction.sim import IdealOptions, simulate_ideal

@@ -8,7 +8,9 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.fit import fit_friction, fit_joints
+from wbfriction.fit.joints import fit_joints
+from wbfriction.fit.regression import standard_errors
+from wbfriction.fit.selection import fit_friction
 from wbfriction.friction.models import (
     MODEL_NAMES,
     MODEL_PARAMS,
@@ -26,7 +28,6 @@ from wbfriction.friction.models import (
     stribeck_viscous,
     viscous,
 )
-from wbfriction.friction.regression import standard_errors
 
 pos = st.floats(0.01, 10.0)
 vel = st.floats(-20.0, 20.0).filter(lambda x: abs(x) > 1e-2)

@@ -11,13 +11,13 @@ import pyarrow as pa
 import pytest
 
 from wbfriction.exceptions import InputError
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.io import friction_table, read_friction_table
 from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.momentum import step_impulses
 from wbfriction.friction.options import EstimateOptions, MomentumOptions
 from wbfriction.friction.route import resolve_route
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import Log, log_from_table, write_log
 from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import read_table

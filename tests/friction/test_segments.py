@@ -158,7 +158,7 @@ def test_stretches_too_short_for_any_window_are_refused_in_one_line(panda_sim):
 def test_a_fit_on_stretches_too_short_to_measure_the_noise_is_never_ok(panda_sim):
     """Issue 53: 10 ms dropouts every 60 ms leave 50-sample stretches, too short to measure the positions' noise
     (no Cramér-Rao bound, central differences): no fit is called ok, each says why."""
-    from wbfriction.friction.fit import fit_estimate
+    from wbfriction.fit.joints import fit_estimate
     robot, table = panda_sim
     k = np.arange(table.num_rows)
     log = log_from_table(table.take(pa.array(np.flatnonzero(k % 60 < 50))), robot, "drop10")

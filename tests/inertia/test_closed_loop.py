@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from helpers import run_cli, run_cli_printed, widest_line
-from wbfriction.friction.fit import FitResult
+from wbfriction.fit.result import FitResult
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.closed_loop import stribeck_velocity

@@ -14,8 +14,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.inertia.consistency import (
     PHYSICAL,
     RegularisedProblem,

@@ -1,6 +1,6 @@
 """The identification's gate (:mod:`wbfriction.inertia.validation`) on synthetic held-out data whose answer
 is known, the limbs it decides on, and the translation of SciPy's stopping messages
-(:mod:`wbfriction.friction.solver`)."""
+(:mod:`wbfriction.fit.solver`)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from scipy.optimize._lsq.least_squares import TERMINATION_MESSAGES as LEAST_SQUA
 from scipy.optimize._lsq.lsq_linear import TERMINATION_MESSAGES as LSQ_LINEAR
 from scipy.optimize._optimize import _status_message as MINIMIZE
 
-from wbfriction.friction.solver import explain_solver
+from wbfriction.fit.solver import explain_solver
 from wbfriction.inertia.validation import BodyGroup, limbs, validate_groups
 
 JOINTS = ("j0", "j1", "j2", "j3", "j4")

@@ -17,11 +17,13 @@ from hypothesis import strategies as st
 
 from helpers import bag_map, write_bag
 from wbfriction.exceptions import InputError
-from wbfriction.friction.energy import energy_consistency
+from wbfriction.fit.energy import energy_consistency
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.options import FitOptions
+from wbfriction.fit.result import fitted_offsets
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.fit import fit_estimate, fitted_offsets
 from wbfriction.friction.io import friction_table, read_friction_table
-from wbfriction.friction.options import EstimateOptions, FitOptions
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import Log, write_log
 from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import read_table, with_metadata, write_table

@@ -10,10 +10,11 @@ import pyarrow as pa
 import pytest
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.fit import STICK_FLOOR, fit_friction
-from wbfriction.friction.io import read_params
+from wbfriction.fit.options import FitOptions
+from wbfriction.fit.params_file import read_params
+from wbfriction.fit.selection import fit_friction
+from wbfriction.fit.solve import STICK_FLOOR
 from wbfriction.friction.models import CoulombViscousParams, StribeckParams
-from wbfriction.friction.options import FitOptions
 from wbfriction.logs.tables import write_table
 from wbfriction.pipeline.fit_step import fit_file
 

@@ -13,9 +13,10 @@ import pyarrow.parquet as pq
 import pytest
 
 from helpers import run, run_cli, run_cli_printed
-from wbfriction.friction.io import read_friction_file, read_params
+from wbfriction.fit.params_file import read_params
+from wbfriction.fit.terms import TermFit
+from wbfriction.friction.io import read_friction_file
 from wbfriction.friction.models import CoulombViscousParams
-from wbfriction.friction.terms import TermFit
 from wbfriction.logs.tables import write_table
 from wbfriction.sim.arm import ArmOptions, simulate_arm
 

@@ -21,10 +21,12 @@ import pytest
 from helpers import KUKA, KUKA_CONFIG, KUKA_URDF, kuka_table, needs_kuka
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.export.urdf import write_friction_urdf
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.options import FitOptions, TermOptions
+from wbfriction.fit.predict import predict_torques
+from wbfriction.fit.result import FitResult
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log
-from wbfriction.friction.fit import FitResult, fit_estimate
-from wbfriction.friction.options import EstimateOptions, FitOptions, TermOptions
-from wbfriction.friction.predict import predict_torques
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.clock import read_clock
 from wbfriction.logs.log import log_from_table
@@ -175,7 +177,7 @@ def test_identified_friction_dissipates(identified_model, logs):
     friction (about 0.04 N·m) is a fifth of a torque periodic in its own angle (harmonics 1 and 2,
     about 0.2 N·m: torque sensing or transmission ripple, neither friction nor inertia), which,
     learned on runs 1-2, predicts run 3's residual: the 52 % is that torque, not friction."""
-    from wbfriction.friction.energy import generating_share
+    from wbfriction.fit.energy import generating_share
 
     est, fits = identified_model.train, identified_model.fits
     share = {j: generating_share(est.qd[est.valid[:, i], i], est.tau_f[est.valid[:, i], i], fits[j].params.tau_os)

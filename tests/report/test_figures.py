@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from helpers import drawn_texts, text_overlaps
+from wbfriction.fit.joints import fit_estimate
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import fit_estimate
 from wbfriction.friction.models import FrictionParams
 from wbfriction.report.figures import (
     REPORT_DPI,

@@ -8,9 +8,9 @@ from html.parser import HTMLParser
 import numpy as np
 import pytest
 
-from wbfriction.friction.energy import energy_consistency
+from wbfriction.fit.energy import energy_consistency
+from wbfriction.fit.result import FitResult, fitted_offsets
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import FitResult, fitted_offsets
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams
 from wbfriction.report.build import Report
 from wbfriction.report.html import render_html

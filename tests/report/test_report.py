@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 from wbfriction.exceptions import InputError
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.params_file import fit_to_dict, read_params
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.fit import fit_estimate
-from wbfriction.friction.io import fit_to_dict, friction_table, read_params
+from wbfriction.friction.io import friction_table
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.sensitivity import inertia_sensitivity
 from wbfriction.logs.tables import write_table

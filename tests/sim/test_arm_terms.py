@@ -1,6 +1,6 @@
 """The arm simulator with friction beyond velocity (issue 40): a load-dependent Coulomb level, a viscous level by
 direction, a position ripple and temperature-dependent levels applied at every physics step, and what
-:func:`~wbfriction.friction.term_selection.fit_terms` recovers from the log: each injected coefficient within 5 %, no
+:func:`~wbfriction.fit.term_selection.fit_terms` recovers from the log: each injected coefficient within 5 %, no
 term on the joints that have none, over 10 seeds."""
 
 from __future__ import annotations
@@ -9,12 +9,13 @@ import numpy as np
 import pytest
 
 from wbfriction.exceptions import InputError
+from wbfriction.fit.options import TermOptions
+from wbfriction.fit.selection import fit_friction
+from wbfriction.fit.term_selection import fit_terms
+from wbfriction.fit.terms import TermFit, term_signals
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.fit import fit_friction
 from wbfriction.friction.models import CoulombViscousParams
-from wbfriction.friction.options import EstimateOptions, TermOptions
-from wbfriction.friction.term_selection import fit_terms
-from wbfriction.friction.terms import TermFit, term_signals
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import log_from_table
 from wbfriction.sim.arm import ArmOptions, simulate_arm
 

@@ -13,11 +13,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.options import FitOptions, TermOptions
+from wbfriction.fit.targets import load_friction_spec
+from wbfriction.fit.terms import fourier
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.fit import fit_estimate
-from wbfriction.friction.options import EstimateOptions, FitOptions, TermOptions
-from wbfriction.friction.targets import load_friction_spec
-from wbfriction.friction.terms import fourier
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.studies.common import leg_joints
 
 FRICTION_TOML = """

@@ -116,7 +116,7 @@ def test_mujoco_friction_torque_is_the_force_mujoco_applied(talos, mj_talos):
     and it dissipates."""
     import copy
 
-    from wbfriction.friction.targets import friction_by_group
+    from wbfriction.fit.targets import friction_by_group
     from wbfriction.sim.common import injected_friction
     from wbfriction.sim.mujoco_sim import mujoco_friction_torque, set_mujoco_friction
 
@@ -149,9 +149,9 @@ def test_swing_estimate_is_reliable_and_stance_is_not_on_mujoco(talos, mj_talos)
     """Thesis 6.2 (Fig. 6.4): on real (soft) contacts the right knee's friction, estimated
     with central differences, is close to the truth while its leg swings, and far off while
     it stands; contact flags come from measured forces."""
+    from wbfriction.fit.targets import THESIS_TARGETS
     from wbfriction.friction.estimate import estimate_log
     from wbfriction.friction.options import EstimateOptions
-    from wbfriction.friction.targets import THESIS_TARGETS
     from wbfriction.sim.mujoco_sim import simulate_mujoco
     from wbfriction.walking import GaitOptions, walking_reference
 

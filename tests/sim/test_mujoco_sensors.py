@@ -12,9 +12,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.sim import MujocoOptions, simulate_mujoco
 from wbfriction.sim.mujoco_model import build_mujoco_robot
 from wbfriction.sim.mujoco_sim import MatchedMeans, matched_weights

@@ -6,11 +6,11 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from wbfriction.fit.joints import fit_joints
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.fit import fit_joints
 from wbfriction.friction.models import target_from_dict
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.signals.options import FilterOptions
 from wbfriction.sim import IdealOptions, SensorNoise, apply_sensor_noise, simulate_ideal
 from wbfriction.studies.common import SIMULATOR

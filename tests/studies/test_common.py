@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from wbfriction.fit.result import FitResult
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import FrictionParams
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.studies.common import SIMULATOR, fit_legs, leg_joints, leg_params_extra, leg_rows, worst_errors
 from wbfriction.studies.filters import FilterStudyResult, FilterStudyRow
 from wbfriction.studies.thesis import TABLE_6_1, TABLE_6_2, thesis_number

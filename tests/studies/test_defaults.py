@@ -51,8 +51,9 @@ def test_statuses_are_scored_by_their_loss_not_a_ratio():
 def test_every_knob_sets_its_option_and_lists_todays_default():
     """Each knob's default is today's value of the option it sets (a study of another value than the one the code
     uses would choose nothing)."""
-    from wbfriction.friction.options import EstimateOptions, FitOptions, TermOptions
-    from wbfriction.friction.status import DEFAULT_THRESHOLDS
+    from wbfriction.fit.options import FitOptions, TermOptions
+    from wbfriction.fit.status import DEFAULT_THRESHOLDS
+    from wbfriction.friction.options import EstimateOptions
     from wbfriction.inertia.options import InertialOptions
 
     current = {"link_margin": InertialOptions().link_margin, "prior_tolerance": InertialOptions().prior_tolerance,

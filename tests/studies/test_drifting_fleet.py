@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from wbfriction.friction.targets import THESIS_TARGETS
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.studies.drifting_fleet import Drift, FleetPlan, friction_of, score_flags
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from wbfriction.friction.io import read_params
+from wbfriction.fit.params_file import read_params
 from wbfriction.studies.realistic import run_realistic_study, worst_scored
 
 pytestmark = pytest.mark.slow  # module fixtures of 30-55 s (the quick subset: -m "not slow")

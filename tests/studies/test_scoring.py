@@ -16,9 +16,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.models import FrictionParams
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.studies import filters, realistic, simulation
 from wbfriction.studies.common import leg_joints
 from wbfriction.studies.thesis import TABLE_6_1, TABLE_6_2

@@ -18,16 +18,8 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError, OptionError, WbfrictionError
-from wbfriction.friction.options import (
-    DEFAULT_THRESHOLD,
-    DEFAULT_TOLERANCE,
-    TERMS,
-    EstimateOptions,
-    FitOptions,
-    TemperatureLaw,
-    Term,
-    TermOptions,
-)
+from wbfriction.fit.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions, TermOptions
+from wbfriction.friction.options import TERMS, EstimateOptions, TemperatureLaw, Term
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
 from wbfriction.model.robots import BUILTIN_ROBOTS
@@ -192,7 +184,7 @@ def term_options(terms: str, max_harmonic: int, reference_temperature: float | N
     ``--max-harmonic``, ``--reference-temperature`` and ``--temperature-law``.
 
     Raises:
-        OptionError: an unknown term (:class:`~wbfriction.friction.options.TermOptions`), a reference temperature
+        OptionError: an unknown term (:class:`~wbfriction.fit.options.TermOptions`), a reference temperature
             no joint has, or an option of a term not tried (``--max-harmonic`` without the ripple,
             ``--reference-temperature`` or ``--temperature-law`` without the temperature term).
     """

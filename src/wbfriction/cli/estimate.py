@@ -13,13 +13,7 @@ from rich.table import Table
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import OptionError
-from wbfriction.friction.options import (
-    BaseMotion,
-    EstimateOptions,
-    Method,
-    MomentumOptions,
-    RouteOption,
-)
+from wbfriction.friction.options import BaseMotion, EstimateOptions, Method, MomentumOptions, RouteOption
 from wbfriction.inertia.options import InertiaPart
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP, TimeBase, TimeUnit
 from wbfriction.pipeline.paths import check_paths

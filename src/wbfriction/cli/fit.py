@@ -12,11 +12,12 @@ from rich.table import Table
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
-from wbfriction.friction.options import FitOptions, ModelChoice, TemperatureLaw
+from wbfriction.fit.options import FitOptions, ModelChoice
+from wbfriction.friction.options import TemperatureLaw
 from wbfriction.pipeline.paths import check_paths
 
 if TYPE_CHECKING:
-    from wbfriction.friction.fit import FitResult
+    from wbfriction.fit.result import FitResult
 
 from wbfriction.cli.common import (
     FIT,
@@ -153,7 +154,7 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
     'outside fitted ranges')."""
     import numpy as np
 
-    from wbfriction.friction.ranges import OUTSIDE
+    from wbfriction.fit.ranges import OUTSIDE
     from wbfriction.pipeline.predict_step import predict_file
 
     check_paths({"FRICTION": friction, "--params": params}, {})

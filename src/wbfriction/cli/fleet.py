@@ -13,13 +13,9 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError
+from wbfriction.fit.options import FitOptions, ModelChoice
 from wbfriction.fleet.options import SHAPES, Shape
-from wbfriction.friction.options import (
-    EstimateOptions,
-    FitOptions,
-    ModelChoice,
-    TemperatureLaw,
-)
+from wbfriction.friction.options import EstimateOptions, TemperatureLaw
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.signals.options import DiffOption
 

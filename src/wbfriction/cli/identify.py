@@ -11,10 +11,7 @@ from rich.markup import escape
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError
-from wbfriction.friction.options import (
-    EstimateOptions,
-    RouteOption,
-)
+from wbfriction.friction.options import EstimateOptions, RouteOption
 from wbfriction.inertia.options import ArmatureMode, InertialOptions
 from wbfriction.logs.options import TimeUnit
 from wbfriction.pipeline.paths import check_paths

@@ -35,7 +35,7 @@ from wbfriction.cli.common import (
 
 def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptions | MujocoOptions,
                   friction: Optional[Path]) -> None:
-    from wbfriction.friction.targets import load_friction_spec
+    from wbfriction.fit.targets import load_friction_spec
     from wbfriction.logs.log import write_log
     from wbfriction.sim.ideal import simulate_ideal
     from wbfriction.sim.mujoco_sim import simulate_mujoco
@@ -60,7 +60,7 @@ def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptio
 
 
 def _run_simulate_arm(r: Robot, output: Path, options: ArmOptions, friction: Optional[Path]) -> None:
-    from wbfriction.friction.targets import load_friction_spec
+    from wbfriction.fit.targets import load_friction_spec
     from wbfriction.logs.tables import write_table
     from wbfriction.sim.arm import default_arm_friction, simulate_arm
 

@@ -13,9 +13,7 @@ from rich.table import Table
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError
-from wbfriction.friction.options import (
-    RouteOption,
-)
+from wbfriction.friction.options import RouteOption
 from wbfriction.signals.options import Diff, FilterOptions
 from wbfriction.sim.options import SensorNoise, Simulator
 

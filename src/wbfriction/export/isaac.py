@@ -54,7 +54,7 @@ def isaac_actuator_dict(friction: Mapping[str, FrictionLike], armature: Mapping[
     :data:`ISAAC_FIELDS` that has values, ``{re.escape(joint): value}``.
 
     Args:
-        friction: joint -> fitted friction of model (3.5) (:func:`wbfriction.friction.io.read_params`).
+        friction: joint -> fitted friction of model (3.5) (:func:`wbfriction.fit.params_file.read_params`).
         armature: joint -> reflected rotor inertia [kg·m^2], or None.
         robot: if given, the joints must be its actuated joints (and are written in its order).
 

@@ -40,7 +40,7 @@ temperature (k_T)    dropped                 dropped                dropped
   friction falls from F_s to F_c (v_s, the Stribeck velocity) has no field anywhere.
 * ``tau_os`` is not friction (a torque sensor's offset, removed before the energy check, thesis
   7.9): it is not exported. Nor is ``a``, a smoothing of the model's sign function.
-* The terms beyond velocity (:mod:`wbfriction.friction.terms`) have no field in any of the three: friction that
+* The terms beyond velocity (:mod:`wbfriction.fit.terms`) have no field in any of the three: friction that
   grows with the load or falls with the temperature, a viscous level per direction, a position ripple (which is
   not friction). A fit that kept some exports its velocity model refitted with them, at the reference conditions
   (zero load, the reference temperature ``T_ref``, no ripple), and its note says which terms were dropped and at
@@ -49,7 +49,7 @@ temperature (k_T)    dropped                 dropped                dropped
 Friction that is not dissipative (F_c < 0, F_v < 0, or a static level F_s < 0, i.e. S < -1) and
 a negative armature are refused (:class:`~wbfriction.exceptions.InputError`), never exported.
 
-Which fits are exported (:func:`select_fits`) follows their status (:mod:`wbfriction.friction.status`):
+Which fits are exported (:func:`select_fits`) follows their status (:mod:`wbfriction.fit.status`):
 ``ok`` always; ``weak`` (large standard errors) and ``at bound`` (a parameter is the bound's value) only
 on request (:data:`Include`, ``export --include weak,at-bound``): numbers of the data, less certain. A fit
 that is ``not excited`` (the joint hardly moved: its friction is not in the data, and the fit's numbers
@@ -69,8 +69,8 @@ from typing import Literal, Protocol, cast, get_args
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.fit import FitResult
-from wbfriction.friction.status import FitStatus, FitVerdict
+from wbfriction.fit.result import FitResult
+from wbfriction.fit.status import FitStatus, FitVerdict
 from wbfriction.model.robot import Robot
 
 
@@ -124,7 +124,7 @@ class FitSelection:
 
     Attributes:
         exported: joint -> fit to export (status ``ok`` or an included one), in the robot's joint order.
-        left_out: status (a :data:`~wbfriction.friction.status.FitStatus`, or :data:`NOT_FITTED` for a
+        left_out: status (a :data:`~wbfriction.fit.status.FitStatus`, or :data:`NOT_FITTED` for a
             joint the file has no fit of) -> the joints left out with it, in the robot's joint order.
         include: the statuses exported besides ``ok``.
     """
@@ -144,7 +144,7 @@ def select_fits(fits: Mapping[str, FitResult], robot: Robot, include: Iterable[s
     """The fits of ``fits`` that are exported (module docstring): status ``ok``, or one ``include`` names.
 
     Args:
-        fits: joint -> fit (:func:`wbfriction.friction.io.read_params`); each a joint ``robot`` actuates.
+        fits: joint -> fit (:func:`wbfriction.fit.params_file.read_params`); each a joint ``robot`` actuates.
         robot: the robot exported; its actuated joints without a fit in ``fits`` are :data:`NOT_FITTED`.
         include: choices of :data:`Include` (:func:`check_include`).
         source: what names ``fits`` in errors (the parameters file).
@@ -180,7 +180,7 @@ def select_fits(fits: Mapping[str, FitResult], robot: Robot, include: Iterable[s
 
 FrictionLike = FitResult | FrictionModelParams
 """Fitted friction of one joint as the project stores it: a :class:`FitResult` (what
-:func:`wbfriction.friction.io.read_params` returns; one without parameters exports no friction)
+:func:`wbfriction.fit.params_file.read_params` returns; one without parameters exports no friction)
 or bare parameters of a model (e.g. :class:`FrictionParams`)."""
 
 

@@ -171,7 +171,7 @@ def mujoco_spec(robot: Robot, friction: Mapping[str, FrictionLike], armature: Ma
     Args:
         robot: the robot; its URDF (or MJCF) is read (:func:`robot_spec`), :attr:`Robot.floating_base` decides
             the free joint.
-        friction: joint -> fitted friction of model (3.5) (:func:`wbfriction.friction.io.read_params`).
+        friction: joint -> fitted friction of model (3.5) (:func:`wbfriction.fit.params_file.read_params`).
         armature: joint -> reflected rotor inertia [kg·m^2]; a joint not in it keeps the robot
             model's ``armature``.
         inertias: a model of ``robot`` with identified inertias, or None (the URDF's).

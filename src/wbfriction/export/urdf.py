@@ -82,7 +82,7 @@ def write_friction_urdf(robot: Robot, friction: Mapping[str, FrictionLike], path
 
     Args:
         robot: the robot (its :attr:`Robot.urdf` is the file rewritten).
-        friction: joint -> fitted friction of model (3.5) (:func:`wbfriction.friction.io.read_params`).
+        friction: joint -> fitted friction of model (3.5) (:func:`wbfriction.fit.params_file.read_params`).
         path: the URDF to write.
         armature: joint -> [kg·m^2]: only checked (URDF has no field for it).
         inertias: a model of ``robot`` with identified inertias, or None (the URDF's kept).

@@ -42,8 +42,8 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from wbfriction.exceptions import InputError
+from wbfriction.fit.options import MODEL_CHOICES
 from wbfriction.fleet.schema import RESULT_DOCUMENT
-from wbfriction.friction.fit import MODEL_CHOICES
 from wbfriction.friction.options import ROUTE_OPTIONS
 from wbfriction.logs.tables import TableFile, read_metadata, table_format
 from wbfriction.pipeline.estimate_step import RobotSpec

@@ -7,7 +7,8 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any, Literal
 
-from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, EstimateOptions, FitOptions
+from wbfriction.fit.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions
+from wbfriction.friction.options import EstimateOptions
 
 Shape = Literal["hinge", "step"]
 SHAPES: tuple[Shape, ...] = ("hinge", "step")

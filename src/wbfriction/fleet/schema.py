@@ -21,7 +21,7 @@ model ``f(qd)`` is fitted to ``-tau_f`` (positive ``F_c``, ``F_v``: friction opp
 ``f_at_<v>`` is the model's dissipative friction at speed ``v``: ``(f(+v) - f(-v)) / 2`` [N·m], free of the
 offset ``tau_os`` and robust where the model's parameters trade off against each other; NaN where the joint
 did not reach ``v`` in the log (an extrapolation is no measurement). Where the fit kept terms beyond velocity
-(:mod:`wbfriction.friction.terms`), the values are its velocity model's refitted with them: at zero load, at the
+(:mod:`wbfriction.fit.terms`), the values are its velocity model's refitted with them: at zero load, at the
 reference temperature, without the position ripple; ``temperature`` says at which temperature the values are.
 ``f_at_<v>`` is then at the log's mean load (``|tau + tau_f|``): the level a velocity model alone fits on the log,
 comparable between logs that keep different terms.
@@ -38,7 +38,7 @@ REFERENCE_SPEEDS: tuple[float, ...] = (0.1, 0.3, 1.0)
 """The speeds [rad/s] at which each fit's friction ``f_at_<v>`` is reported."""
 TREND_PARAMS: tuple[str, ...] = ("F_c", "F_v", "tau_os")
 """The model parameters followed over time, each with its standard error ``<name>_se`` and its Cramér-Rao bound's
-standard deviation ``<name>_crb`` (:mod:`wbfriction.friction.bound`)."""
+standard deviation ``<name>_crb`` (:mod:`wbfriction.fit.bound`)."""
 
 
 def speed_column(v: float) -> str:

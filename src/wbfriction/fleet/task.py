@@ -24,12 +24,12 @@ import pyarrow as pa
 from threadpoolctl import threadpool_limits
 
 from wbfriction.exceptions import OutputError, WbfrictionError
+from wbfriction.fit.energy import JointEnergy
+from wbfriction.fit.result import FitResult
+from wbfriction.fit.terms import TermFit, load_torque
 from wbfriction.fleet.manifest import LogEntry
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
-from wbfriction.friction.energy import JointEnergy
-from wbfriction.friction.fit import FitResult
-from wbfriction.friction.terms import TermFit, load_torque
 from wbfriction.logs.tables import file_sha256, scratch_folder
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import Chunking
@@ -161,7 +161,7 @@ def result_rows(key: ResultKey, fits: list[FitResult], energy: list[JointEnergy]
     """The rows of the log of ``key`` (:data:`~wbfriction.fleet.schema.RESULT_SCHEMA`), one per joint of ``fits``;
     ``qd`` (N, n_tc) [rad/s] and ``valid`` (N, n_tc) of the estimate give each joint's velocity range,
     ``temperature`` (N, n_tc) [°C] (or None) its temperature, ``load`` (N, n_tc) [N·m] (or None) the rigid-body
-    torque the load term reads (:func:`~wbfriction.friction.terms.load_torque`). A fit with terms beyond velocity
+    torque the load term reads (:func:`~wbfriction.fit.terms.load_torque`). A fit with terms beyond velocity
     gives its velocity model refitted with them (``F_c``, ``F_v``: at zero load and its reference temperature,
     without the ripple); its ``f_at_<v>`` is the friction under the log's mean ``|load|`` (zero without ``load``):
     the level a velocity model alone fits, whichever terms a log keeps (issue 52: the KUKA's repeated wrist run kept

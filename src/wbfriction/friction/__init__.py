@@ -1,7 +1,7 @@
-"""Friction: the models (:mod:`.models`, thesis 3.1-3.5) and their parameters per joint
-(:mod:`.targets`), the estimate from measured kinematics (:mod:`.estimate`, 5.10-5.13, 6.1),
-the fit of model (3.5) with standard errors (:mod:`.fit`, 6.4), the energy check
-(:mod:`.energy`, 7.9), and the friction table and parameters JSON (:mod:`.io`)."""
+"""Friction estimated from a log (log -> ``tau_f``): the models (:mod:`.models`, thesis 3.1-3.5), the estimate
+from measured kinematics (:mod:`.estimate`, 5.10-5.13, 6.1), the momentum route (:mod:`.momentum`), the sensors'
+routes (:mod:`.measured`), the choice of route (:mod:`.route`) and the friction table (:mod:`.io`). Fitting
+models to the estimate is the next stage, :mod:`wbfriction.fit`."""
 
 import lazy_loader
 

@@ -1,19 +1,11 @@
 """Names of :mod:`wbfriction.friction`, imported on first use (:func:`lazy_loader.attach_stub`)."""
 
-from .energy import JointEnergy as JointEnergy
-from .energy import energy_consistency as energy_consistency
 from .estimate import estimate_friction as estimate_friction
 from .estimate import estimate_log as estimate_log
 from .estimated import FrictionEstimate as FrictionEstimate
-from .fit import FitResult as FitResult
-from .fit import fit_estimate as fit_estimate
-from .fit import fit_friction as fit_friction
-from .fit import fit_joints as fit_joints
 from .io import friction_table as friction_table
 from .io import read_friction_file as read_friction_file
 from .io import read_friction_table as read_friction_table
-from .io import read_params as read_params
-from .io import write_params as write_params
 from .models import PARAM_NAMES as PARAM_NAMES
 from .models import FrictionParams as FrictionParams
 from .models import coulomb_viscous_stribeck as coulomb_viscous_stribeck

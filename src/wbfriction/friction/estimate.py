@@ -302,7 +302,7 @@ def resolve_differentiation(options: EstimateOptions, source: Log | np.ndarray |
 
 def unmeasured_noise(record: dict | None, longest: int, options: EstimateOptions) -> str:
     """Why a fit of this estimate cannot be called ``ok`` (the metadata's ``noise_unmeasured``,
-    :attr:`~wbfriction.friction.fit.FitResult.unmeasured`): the positions' noise not measured (``record`` None) on
+    :attr:`~wbfriction.fit.result.FitResult.unmeasured`): the positions' noise not measured (``record`` None) on
     the ``longest`` samples between time gaps, so no Cramér-Rao bound says what the data allow; "" when measured,
     or for the simulators' true derivatives (no noise)."""
     if record is not None or options.diff == "true":

@@ -40,7 +40,7 @@ class FrictionEstimate:
             ``companion_diff`` names its scheme.
         smoother: the zero-phase smoother the estimate went through (filtering schemes),
             or None; the fit passes the model through it too
-            (:func:`~wbfriction.friction.fit.fit_friction`). A table records it as the
+            (:func:`~wbfriction.fit.selection.fit_friction`). A table records it as the
             ``estimate_options`` of its metadata.
         disagreement: (N, n_tc) ``tau_f`` of the measured route less the rigid-contact route's where both
             estimated the sample (single support) [N·m], NaN elsewhere; None without a measured route
@@ -49,13 +49,13 @@ class FrictionEstimate:
             ``contact`` (rigid contacts), ``base`` (measured base motion), ``wrench`` (measured
             wrenches), ``none``; or None (a table that does not say: rigid contacts).
         q: the joints' positions as logged (N, n_tc) [rad], or None (a table of an earlier version): what the
-            position ripple is a function of (:mod:`~wbfriction.friction.terms`).
+            position ripple is a function of (:mod:`~wbfriction.fit.terms`).
         tau: the joints' measured torques (N, n_tc) [N·m], or None: the load their transmissions carry (the
             friction beyond the sensor is not in it), what load-dependent friction is a function of.
         temperature: the joints' logged temperatures (N, n_tc) [°C], NaN for a joint without, or None: none logged.
         route_check: the same samples estimated by the other route (issue 38: the momentum route's for the
             acceleration route's, and the other way round; its ``tau_f``, ``qd``, ``valid`` and ``smoother``),
-            whose fit :func:`~wbfriction.friction.fit.fit_estimate` compares with this one's; or None.
+            whose fit :func:`~wbfriction.fit.joints.fit_estimate` compares with this one's; or None.
     """
 
     joints: tuple[str, ...]

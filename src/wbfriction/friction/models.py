@@ -123,7 +123,7 @@ def model_values(x: np.ndarray, qd: np.ndarray, delta_s: ParamLike, model: Model
 def model_columns(qd: np.ndarray, delta_s: float, model: ModelName = "thesis", v_s: float = 1.0,
                   a: float = 1.0, jump: np.ndarray | None = None) -> np.ndarray:
     """The columns (N, K) of ``model``'s terms at velocities ``qd`` (N,) [rad/s]: the model is their sum, each
-    times a product of its linear parameters (:data:`~wbfriction.friction.projection.TERMS`), once the Stribeck
+    times a product of its linear parameters (:data:`~wbfriction.fit.projection.TERMS`), once the Stribeck
     velocity ``v_s`` [rad/s] and the tanh slope ``a`` [s/rad] are set (ignored where the model has none):
 
     * ``coulomb-viscous``: ``qd``, ``sgn(qd)``, 1 (times F_v, F_c, tau_os);

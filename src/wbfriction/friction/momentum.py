@@ -26,7 +26,7 @@ acceleration anywhere: the Coulomb step is smoothed only as much as the velocity
 estimate is the impulses' weighted mean over a zero-phase Hann window of ``2m`` steps
 (:class:`~wbfriction.signals.window.MomentumWindow`: bandwidth its -3 dB frequency, lag zero): the momentum
 observer's residual (De Luca and Mattone, ICRA 2003), taken forwards and backwards as an offline log allows.
-The fit compares the model through the same window (parallel filtering, :mod:`wbfriction.friction.fit`), at
+The fit compares the model through the same window (parallel filtering, :mod:`wbfriction.fit`), at
 the same once-differentiated velocities.
 
 **Which tree** (the closures of issue 23, each where its equations hold):

@@ -21,13 +21,13 @@ and per route (each with its own filter):
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.bound import JointNoise
 from wbfriction.friction.options import ROUTES, EstimateOptions, Route
 from wbfriction.model.robot import Robot
 from wbfriction.signals.choice import (
@@ -39,6 +39,52 @@ from wbfriction.signals.choice import (
     savgol_noise_gain,
     velocity_noise_gain,
 )
+
+
+@dataclass(frozen=True)
+class NoiseModel:
+    """The per-sample noise of one joint's friction estimate (module docstring).
+
+    Attributes:
+        torque: ``sigma_tau``, the torque's white noise [N·m].
+        position: ``sigma_q``, the positions' white noise [rad].
+        inertia: ``M``, the joint's effective inertia [kg·m²].
+        dt: the sampling period [s].
+    """
+
+    torque: float
+    position: float
+    inertia: float
+    dt: float
+
+    def psd(self, freq: np.ndarray) -> np.ndarray:
+        """``P(f)`` [N²·m²] at ``freq`` [Hz] (module docstring)."""
+        gain = 4.0 * np.sin(np.pi * np.asarray(freq, dtype=float) * self.dt) ** 2 / self.dt**2
+        return self.torque**2 + (self.inertia * self.position * gain) ** 2
+
+
+@dataclass(frozen=True)
+class JointNoise:
+    """What an estimate knows of one joint's noise, before a fit (:func:`~wbfriction.friction.noise.joint_noise`).
+
+    Attributes:
+        position: ``sigma_q``, the positions' white noise [rad], measured from their spectrum.
+        velocity: the white noise's share in the velocity the model takes as its argument [rad/s].
+        acceleration: the route's acceleration noise per unit inertia [rad/s²] (what its filter leaves).
+        inertia: ``M``, the joint's effective inertia [kg·m²].
+        dt: the sampling period [s].
+    """
+
+    position: float
+    velocity: float
+    acceleration: float
+    inertia: float
+    dt: float
+
+    def with_torque(self, torque: float) -> NoiseModel:
+        """The whole :class:`NoiseModel`, with the torque's noise [N·m]."""
+        return NoiseModel(torque, self.position, self.inertia, self.dt)
+
 
 INERTIA_SAMPLES = 32
 """Configurations of the log the effective inertia is the median over."""
@@ -98,7 +144,7 @@ def noise_record(robot: Robot, q: np.ndarray, dt: float, options: EstimateOption
 
 
 def joint_noises(record: Any, route: str) -> dict[str, JointNoise]:
-    """The :class:`~wbfriction.friction.bound.JointNoise` of every joint of a :func:`noise_record` for ``route``;
+    """The :class:`~wbfriction.friction.noise.JointNoise` of every joint of a :func:`noise_record` for ``route``;
     empty without a record (an older table) or the route's entry.
 
     Raises:

@@ -23,11 +23,13 @@ from typing import Literal
 
 import numpy as np
 
-from wbfriction.friction.energy import JointEnergy, energy_consistency
+from wbfriction.fit.energy import JointEnergy, energy_consistency
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.options import FitOptions
+from wbfriction.fit.result import FitResult, fitted_offsets
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log, resolve_differentiation
-from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets
 from wbfriction.friction.models import FrictionParams
-from wbfriction.friction.options import EstimateOptions, FitOptions
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.identification import InertialIdentification, identify_inertia, log_samples
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.log import Log

@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.fit import FitResult
-from wbfriction.friction.io import finite_or_none, fit_from_dict, fit_to_dict
+from wbfriction.fit.params_file import finite_or_none, fit_from_dict, fit_to_dict
+from wbfriction.fit.result import FitResult
 from wbfriction.inertia.excitation import Unexcited
 
 SIGN_CONVENTION = ("tau_f = -f(qd); f = F_v qd + F_c tanh(a qd) (+ (F_s - F_c) tanh(a qd) exp(-(qd/v_s)^2))"
@@ -77,7 +77,7 @@ class PassSummary:
         not_excited: the parameters the data did not determine
             (:func:`~wbfriction.inertia.excitation.unexcited_parameters`).
         message: the solve in words; ``solver``: its outcome
-            (:meth:`~wbfriction.friction.solver.SolverOutcome.to_dict`).
+            (:meth:`~wbfriction.fit.solver.SolverOutcome.to_dict`).
         verdict: the held-out gate's one line; ``validation``: its decisions per limb
             (:mod:`~wbfriction.inertia.validation`). None: no gate ran.
     """

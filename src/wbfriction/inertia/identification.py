@@ -84,7 +84,7 @@ identified inertias are therefore kept per limb (an unbranched chain of bodies) 
 the held-out samples better than the given model with its best friction (by 1 % over all joints, no
 joint more than 5 % worse: :mod:`~wbfriction.inertia.validation`); the other limbs stay as given, and the
 friction (and armature) is the one that best explains the training data with the inertias kept. A conic
-solve that stops short of its minimum says so in the message (:class:`~wbfriction.friction.solver.SolverOutcome`),
+solve that stops short of its minimum says so in the message (:class:`~wbfriction.fit.solver.SolverOutcome`),
 and the gate is what keeps its result honest.
 
 **Same bytes whatever the BLAS thread count** (issue 37). OpenBLAS's threads split the blocked QR
@@ -111,9 +111,9 @@ import pinocchio as pin
 from threadpoolctl import threadpool_limits
 
 from wbfriction.exceptions import InputError
+from wbfriction.fit.solver import SolverOutcome
 from wbfriction.friction.estimate import resolve_differentiation
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.friction.solver import SolverOutcome
 from wbfriction.inertia.consistency import (
     FRICTION,
     STRIBECK,
@@ -141,7 +141,7 @@ is None."""
 PRIOR_TOLERANCE = 0.02
 """The prior chosen by validation is the strongest whose score is within this relative margin of the best: a
 weaker prior, a model further from the given one, has to predict the validation samples better by more
-(the parsimony of ``--model auto``, :data:`~wbfriction.friction.options.SELECTION_TOLERANCE`)."""
+(the parsimony of ``--model auto``, :data:`~wbfriction.fit.options.SELECTION_TOLERANCE`)."""
 NOISY_ACCELERATION = 0.1
 """Share of a joint's acceleration power in the upper half of the band (above a quarter of the sampling
 rate, where a robot's motion has next to none) from which the accelerations count as noisy
@@ -184,7 +184,7 @@ class InertialIdentification:
         holdout: torque predictions on the held-out samples.
         samples: single-support samples in the regression.
         message: how the fit went, in words (the non-linear solver's stopping message translated,
-            :func:`~wbfriction.friction.solver.explain_solver`, and the accelerations' noise).
+            :func:`~wbfriction.fit.solver.explain_solver`, and the accelerations' noise).
         prior: the prior's weight used (in units of the residual variance).
         prior_scores: with the prior chosen by validation, the RMS torque residual on the
             validation samples for each weight tried [N·m].
@@ -202,7 +202,7 @@ class InertialIdentification:
             ``diff = "auto"`` or ``"butterworth"``).
         pi_fit, friction_fit: the fit's inertial parameters (nb, 10) and friction (n_tc, k) before the gate.
         validation: the gate's decision per limb (:func:`~wbfriction.inertia.validation.validate_groups`).
-        solver: why the non-linear solver stopped (:class:`~wbfriction.friction.solver.SolverOutcome`;
+        solver: why the non-linear solver stopped (:class:`~wbfriction.fit.solver.SolverOutcome`;
             ``raw`` empty when the linear solution was physical and no solver ran).
     """
 

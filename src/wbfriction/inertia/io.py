@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.io import finite_or_none
+from wbfriction.fit.params_file import finite_or_none
 from wbfriction.inertia.closed_loop import ClosedLoop
 from wbfriction.inertia.document import (
     BodyProposal,
@@ -32,7 +32,7 @@ def identification_of(loop: ClosedLoop, moved: tuple[str, ...] = (),
     Identification`): per pass the identification's size and condition, its prior's weight and the residual
     it is measured in, the parameters the data did not determine
     (:func:`~wbfriction.inertia.excitation.unexcited_parameters`) and the held-out gate's verdict and solver
-    outcome (:mod:`~wbfriction.inertia.validation`, :func:`~wbfriction.friction.solver.explain_solver`);
+    outcome (:mod:`~wbfriction.inertia.validation`, :func:`~wbfriction.fit.solver.explain_solver`);
     per body the change written (:func:`wbfriction.inertia.urdf.inertia_changes`), the gate's decision and
     what the fit proposed; per torque-controlled joint the friction of both routes, the armature, the share
     of its acceleration's power that is noise, the power-generating shares before and after and the

@@ -21,7 +21,7 @@ Thesis findings, reproduced on simulated logs (tests): a mass error shifts the f
 curve (up or down with the sign of the gravity torque the model gets wrong); a
 rotational-inertia error leaves the curve in place but splits it into branches for rising
 and falling velocity (its error is proportional to the acceleration); both produce friction
-that generates power (:mod:`wbfriction.friction.energy`).
+that generates power (:mod:`wbfriction.fit.energy`).
 """
 
 from __future__ import annotations
@@ -96,7 +96,7 @@ class JointSensitivity:
         split: mean of that change over samples of rising velocity minus its mean over
             samples of falling velocity [N·m]: how far the branches separate (Fig. 7.6).
         generating_share: share of valid samples whose friction generates power
-            (:func:`wbfriction.friction.energy.generating_share`, the given offset removed).
+            (:func:`wbfriction.fit.energy.generating_share`, the given offset removed).
     """
 
     joint: str
@@ -128,7 +128,8 @@ class Sensitivity:
         """The torque offset ``tau_os`` of model (3.5) fitted to the reference estimate of each
         joint [N·m] (0 where too few samples): the offset to remove before the power check
         of every factor (:meth:`joint`)."""
-        from wbfriction.friction.fit import fit_joints, fitted_offsets
+        from wbfriction.fit.joints import fit_joints
+        from wbfriction.fit.result import fitted_offsets
 
         ref = self.reference
         idx = [ref.joints.index(j) for j in joints]
@@ -137,7 +138,7 @@ class Sensitivity:
 
     def reference_share(self, joint: str, tau_os: float = 0.0) -> float:
         """Share of the reference estimate's valid samples of ``joint`` that generate power."""
-        from wbfriction.friction.energy import generating_share
+        from wbfriction.fit.energy import generating_share
 
         ref = self.reference
         i = ref.joints.index(joint)
@@ -147,7 +148,7 @@ class Sensitivity:
         """:class:`JointSensitivity` of ``joint`` for every factor but the reference; ``tau_os``:
         the torque offset [N·m] removed before the power check (e.g. the one identified on the
         reference: an offset refitted per factor would absorb the mass error's shift)."""
-        from wbfriction.friction.energy import generating_share
+        from wbfriction.fit.energy import generating_share
 
         ref = self.reference
         i = ref.joints.index(joint)

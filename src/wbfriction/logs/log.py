@@ -21,7 +21,7 @@ column                 unit        content
                                    x, y, z, w)
 ``temperature.<joint>`` °C         optional motor or gear temperature of a
                                    torque-controlled joint (friction's temperature
-                                   term, :mod:`wbfriction.friction.terms`)
+                                   term, :mod:`wbfriction.fit.terms`)
 ``tau_f_true.<joint>`` N·m         optional true friction (simulations only; never
                                    used by the estimator)
 ``qd_true.<joint>``    rad/s       optional true velocity of every actuated joint

@@ -1,7 +1,7 @@
 """A log's joint temperatures, screened as they are read (issue 53): units, plausibility and glitches.
 
 A ``temperature.<joint>`` column holds the joint's motor or gear temperature in °C (:mod:`wbfriction.logs.log`).
-Friction's temperature term (:mod:`~wbfriction.friction.terms`) and the fleet's trends read it; a value in another
+Friction's temperature term (:mod:`~wbfriction.fit.terms`) and the fleet's trends read it; a value in another
 unit, or one glitched sample, would move a fitted slope or a drift without a word. So each column is screened where
 it is read, as the torques are:
 

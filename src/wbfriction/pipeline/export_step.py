@@ -13,7 +13,7 @@ from wbfriction.export.isaac import write_isaac_yaml
 from wbfriction.export.mapping import FitSelection, select_fits
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.export.urdf import write_friction_urdf
-from wbfriction.friction.io import read_params
+from wbfriction.fit.params_file import read_params
 from wbfriction.model.robot import Robot
 
 ExportFormat = Literal["urdf", "mjcf", "isaac"]

@@ -6,11 +6,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.energy import JointEnergy, energy_consistency
+from wbfriction.fit.energy import JointEnergy, energy_consistency
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions
+from wbfriction.fit.params_file import energy_to_dict, write_params
+from wbfriction.fit.result import FitResult, fitted_offsets, fitted_ripples
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets, fitted_ripples
-from wbfriction.friction.io import SIGN_CONVENTION, energy_to_dict, read_friction_file, write_params
-from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions
+from wbfriction.friction.io import SIGN_CONVENTION, read_friction_file
 from wbfriction.pipeline.provenance import file_provenance
 
 
@@ -42,17 +44,17 @@ def fit_table(friction: str | Path, options: FitOptions = FitOptions(), *, thres
 def fit_file(friction: str | Path, output: str | Path, options: FitOptions = FitOptions(), *,
              threshold: float = DEFAULT_THRESHOLD, tolerance: float = DEFAULT_TOLERANCE,
              workers: int = 1) -> FittedFile:
-    """Fit a friction model to every joint of a friction table (:func:`~wbfriction.friction.fit.fit_joints`,
+    """Fit a friction model to every joint of a friction table (:func:`~wbfriction.fit.joints.fit_joints`,
     on ``workers`` processes), check energy (eq. 7.9), and write the parameters JSON with its
     provenance and the model asked for, whole or not at all.
 
     Args:
         friction: the friction table (``wbfriction estimate``).
         output: the parameters JSON to write.
-        options: the model, its choice and thresholds (:class:`~wbfriction.friction.options.FitOptions`; by
+        options: the model, its choice and thresholds (:class:`~wbfriction.fit.options.FitOptions`; by
             default ``auto``: per joint the simplest model whose held-out RMS is within its
-            ``selection_tolerance`` of the best, the reason recorded; see :mod:`wbfriction.friction.fit`).
-        threshold, tolerance: of the energy check (:func:`~wbfriction.friction.energy.energy_consistency`).
+            ``selection_tolerance`` of the best, the reason recorded; see :mod:`wbfriction.fit`).
+        threshold, tolerance: of the energy check (:func:`~wbfriction.fit.energy.energy_consistency`).
         workers: processes fitting joints side by side.
 
     Raises:

@@ -6,12 +6,13 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
-from wbfriction.friction.io import check_params_source, read_friction_file, read_params
-from wbfriction.friction.predict import TorquePrediction, other_log_checks, predict_torques
+from wbfriction.fit.params_file import check_params_source, read_params
+from wbfriction.fit.predict import TorquePrediction, other_log_checks, predict_torques
+from wbfriction.friction.io import read_friction_file
 
 
 def predict_file(friction: str | Path, params: str | Path, workers: int = 1) -> TorquePrediction:
-    """Torque prediction errors (:func:`~wbfriction.friction.predict.predict_torques`) of the friction
+    """Torque prediction errors (:func:`~wbfriction.fit.predict.predict_torques`) of the friction
     model ``params`` on the friction table ``friction``.
 
     Args:
@@ -22,11 +23,11 @@ def predict_file(friction: str | Path, params: str | Path, workers: int = 1) -> 
 
     Raises:
         InputError: what reading either file raises; parameters for another robot or none of
-            the table's joints (:func:`~wbfriction.friction.io.check_params_source`).
+            the table's joints (:func:`~wbfriction.fit.params_file.check_params_source`).
 
     Each joint's prediction is checked against what its noise and its fit's standard errors allow on this log
-    (:func:`~wbfriction.friction.predict.other_log_checks`, refitting its model on ``friction`` on ``workers``
-    processes): :attr:`~wbfriction.friction.predict.TorquePrediction.checks`.
+    (:func:`~wbfriction.fit.predict.other_log_checks`, refitting its model on ``friction`` on ``workers``
+    processes): :attr:`~wbfriction.fit.predict.TorquePrediction.checks`.
     """
     fits = read_params(params)
     est = read_friction_file(friction)

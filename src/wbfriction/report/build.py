@@ -5,7 +5,7 @@ The report shows, for a person to judge a friction table at a glance:
 
 * a summary: one row per joint that moved (its label, fit status, F_c, F_v, tau_os with standard errors,
   energy share, valid samples, verdict), the joints that did not move in one line, and the
-  energy-consistency warnings (:mod:`wbfriction.friction.energy`, eq. 7.9);
+  energy-consistency warnings (:mod:`wbfriction.fit.energy`, eq. 7.9);
 * the friction clouds of the joints that moved as small multiples, each on its own axes, with the
   fitted model (3.5) and the target where known;
 * the identified parameters with their standard errors (6.2.2), and the errors against the
@@ -31,12 +31,14 @@ from pathlib import Path
 
 import numpy as np
 
-from wbfriction.friction.energy import JointEnergy, energy_consistency
+from wbfriction.fit.energy import JointEnergy, energy_consistency
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
+from wbfriction.fit.params_file import check_params_source, read_params
+from wbfriction.fit.result import FitResult, fitted_offsets, fitted_ripples
+from wbfriction.fit.status import MIN_SPEED, joint_speed
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import FitResult, fit_estimate, fitted_offsets, fitted_ripples
-from wbfriction.friction.io import check_params_source, read_friction_file, read_params
-from wbfriction.friction.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE
-from wbfriction.friction.status import MIN_SPEED, joint_speed
+from wbfriction.friction.io import read_friction_file
 from wbfriction.inertia.document import Identification
 from wbfriction.inertia.io import read_identification
 from wbfriction.logs.tables import file_sha256
@@ -63,7 +65,7 @@ def acceleration_spectra(est: FrictionEstimate, tail: float = 0.01) -> dict[str,
 
 def joint_moved(est: FrictionEstimate, joint: str) -> bool:
     """Whether ``joint`` moved in its valid samples: the 95th percentile of ``|qd|`` there at least
-    :data:`~wbfriction.friction.status.MIN_SPEED` (the fit's "not excited" criterion)."""
+    :data:`~wbfriction.fit.status.MIN_SPEED` (the fit's "not excited" criterion)."""
     i = est.joints.index(joint)
     return joint_speed(est.qd[est.valid[:, i], i]) >= MIN_SPEED
 
@@ -125,12 +127,12 @@ def make_report(friction: str | Path, params: str | Path | None = None,
                 threshold: float = DEFAULT_THRESHOLD, tolerance: float = DEFAULT_TOLERANCE,
                 identification: str | Path | None = None, workers: int = 1) -> Report:
     """Read a friction table (and parameters, else fit them on ``workers`` processes,
-    :func:`~wbfriction.friction.fit.fit_estimate`; and an identification of the inertia model,
+    :func:`~wbfriction.fit.joints.fit_estimate`; and an identification of the inertia model,
     :func:`~wbfriction.inertia.io.read_identification`) and compute the report.
 
     Raises:
         InputError: unreadable inputs; parameters fitted on another table or for another robot
-            (:func:`~wbfriction.friction.io.check_params_source`).
+            (:func:`~wbfriction.fit.params_file.check_params_source`).
     """
     friction = Path(friction)
     ident = None if identification is None else read_identification(identification)

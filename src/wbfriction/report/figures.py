@@ -21,8 +21,8 @@ from matplotlib import rc_context, rcParams
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from wbfriction.fit.result import FitResult
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import FrictionParams, ModelParams
 from wbfriction.logs.tables import write_atomic
 

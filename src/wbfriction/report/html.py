@@ -15,11 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
+from wbfriction.fit.energy import JointEnergy
+from wbfriction.fit.result import FitResult
+from wbfriction.fit.status import MIN_SPEED, FitVerdict
 from wbfriction.friction.cross_check import LARGE, MIN_SAMPLES, cross_check
-from wbfriction.friction.energy import JointEnergy
-from wbfriction.friction.fit import FitResult
 from wbfriction.friction.models import ALL_PARAM_NAMES, ModelParams
-from wbfriction.friction.status import MIN_SPEED, FitVerdict
 from wbfriction.inertia.document import Identification
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
@@ -93,7 +93,7 @@ def _fmt(value: float | None, se: float | None = None, digits: int = 4) -> str:
 def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> str:
     """Each joint's model, its fit's status and parameters (value ±standard error; "at a bound": at a bound of
     the fit), under them their Cramér-Rao bounds and the same model on the other route; blank where a parameter is
-    not one of the joint's model. A fit that is not ``ok`` (:mod:`~wbfriction.friction.status`) is greyed, its
+    not one of the joint's model. A fit that is not ``ok`` (:mod:`~wbfriction.fit.status`) is greyed, its
     status cell giving the reason."""
     names = [n for n in ALL_PARAM_NAMES if any(f.params is not None and n in f.params.names for f in fits.values())]
     head = "".join(f"<th>{n}</th>" for n in names)
@@ -258,7 +258,7 @@ def _summary_box(r: Report) -> str:
 
 def joint_verdict(verdict: FitVerdict, energy: JointEnergy | None) -> tuple[str, bool]:
     """What a reader does with a joint's numbers, in one phrase, and whether they can be used: the fit's
-    status (:mod:`~wbfriction.friction.status`) and the energy check (eq. 7.9) together."""
+    status (:mod:`~wbfriction.fit.status`) and the energy check (eq. 7.9) together."""
     if verdict.status in ("ok", "weak") and energy is not None and energy.flagged:
         return (f"check the inertia model: friction generates power in {100 * energy.generating_share:.1f} % "
                 "of the samples", False)
@@ -281,7 +281,7 @@ def _pm(fit: FitResult, name: str, digits: int = 3) -> str:
 def _summary_table(r: Report) -> str:
     """One row per joint that moved: label, status, F_c, F_v, tau_os (± standard error), the power-generating
     share, valid samples and the verdict (:func:`joint_verdict`; with terms beyond velocity, the conditions its F_c,
-    F_v hold at, :meth:`~wbfriction.friction.terms.TermFit.reference_conditions`); the joints that did not move in
+    F_v hold at, :meth:`~wbfriction.fit.terms.TermFit.reference_conditions`); the joints that did not move in
     one line."""
     rows = []
     for j in r.moved:

@@ -19,10 +19,10 @@ from functools import partial
 
 from rich.table import Table
 
-from wbfriction.friction.energy import JointEnergy
-from wbfriction.friction.fit import FitResult
+from wbfriction.fit.energy import JointEnergy
+from wbfriction.fit.result import FitResult
+from wbfriction.fit.terms import NOT_TRIED, TERM_COEFFICIENTS, TermFit
 from wbfriction.friction.models import ALL_PARAM_NAMES
-from wbfriction.friction.terms import NOT_TRIED, TERM_COEFFICIENTS, TermFit
 from wbfriction.inertia.document import Identification
 from wbfriction.report.numbers import bound_text, with_error
 
@@ -92,8 +92,8 @@ def fit_tables(results: Sequence[FitResult], wide: bool = False,
 
 
 def terms_table(results: Sequence[FitResult], label: Callable[[str], str] = str) -> Table | None:
-    """The terms beyond velocity (:mod:`~wbfriction.friction.terms`) of the joints whose fit kept some, one row per
-    term (a narrow table whatever the terms): its status (:meth:`~wbfriction.friction.terms.TermFit.verdicts`) and
+    """The terms beyond velocity (:mod:`~wbfriction.fit.terms`) of the joints whose fit kept some, one row per
+    term (a narrow table whatever the terms): its status (:meth:`~wbfriction.fit.terms.TermFit.verdicts`) and
     its coefficients ± standard errors, after a row of F_c and F_v refitted with the terms (at zero load and the
     reference temperature, the ones exports write); None when no fit kept one."""
     kept = [r for r in results if r.kept_terms is not None]
@@ -218,7 +218,7 @@ def energy_notes(energy: Iterable[JointEnergy], verbose: bool = False,
                  labels: Mapping[str, str] | None = None) -> list[str]:
     """The energy check's warnings (eq. 7.9): the joints whose friction generates power on more than the
     threshold's share of their valid samples, on one line with each one's share, and what is likely off
-    (thesis 7.2); ``verbose``: one line per joint (:meth:`~wbfriction.friction.energy.JointEnergy.warning`).
+    (thesis 7.2); ``verbose``: one line per joint (:meth:`~wbfriction.fit.energy.JointEnergy.warning`).
     Empty when no joint is flagged."""
     label = _labeller(labels)
     flagged = sorted((e for e in energy if e.flagged), key=lambda e: -e.generating_share)

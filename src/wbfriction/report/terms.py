@@ -1,14 +1,14 @@
-"""The report's terms beyond velocity (issue 53, class 11): what a fit with terms (:mod:`wbfriction.friction.terms`)
+"""The report's terms beyond velocity (issue 53, class 11): what a fit with terms (:mod:`wbfriction.fit.terms`)
 means for the numbers the report shows.
 
 A fit that kept terms reports its velocity model refitted with them
-(:meth:`~wbfriction.friction.fit.FitResult.reported`): its F_c and F_v are the levels at the reference conditions
+(:meth:`~wbfriction.fit.result.FitResult.reported`): its F_c and F_v are the levels at the reference conditions
 (zero load, the reference temperature ``T_ref``, no ripple, the mean of both directions), not the joint's friction
 under its own load or warmth. The report says so beside them
-(:meth:`~wbfriction.friction.terms.TermFit.reference_conditions`) and gives each joint's terms in a table
+(:meth:`~wbfriction.fit.terms.TermFit.reference_conditions`) and gives each joint's terms in a table
 (:func:`terms_section`): each term's status, its coefficients ± standard errors and the physical parameters they
 give, and the ranges of angle, load and temperature it was fitted on
-(:class:`~wbfriction.friction.ranges.FittedRanges`: beyond them its law is extrapolated).
+(:class:`~wbfriction.fit.ranges.FittedRanges`: beyond them its law is extrapolated).
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ from __future__ import annotations
 import html
 from collections.abc import Callable, Mapping, Sequence
 
-from wbfriction.friction.fit import FitResult
-from wbfriction.friction.terms import TERM_COEFFICIENTS, TermFit
+from wbfriction.fit.result import FitResult
+from wbfriction.fit.terms import TERM_COEFFICIENTS, TermFit
 from wbfriction.report.numbers import with_error
 
 DERIVED: dict[str, tuple[str, ...]] = {"load": ("k_L",), "direction": ("F_v+", "F_v-"),

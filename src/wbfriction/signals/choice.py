@@ -491,7 +491,7 @@ def choose_differentiation(source: Log | np.ndarray, dt: float | None = None, *,
 VELOCITY_NOISE_TARGET = 0.002
 """Most RMS noise the momentum route's velocity filter may leave [rad/s] (issue 38): the velocity is the
 friction model's argument, and a noisy argument inside ``sgn``/``tanh`` biases the fit (errors in variables,
-corrected in :mod:`wbfriction.friction.fit` but only to first order); with 1e-4 rad of position noise at
+corrected in :mod:`wbfriction.fit` but only to first order); with 1e-4 rad of position noise at
 1 kHz it picks a 57-sample window (61 measured best in issue 38's study, 0.0018 rad/s)."""
 MOMENTUM_ORDER = 4
 """Polynomial order of the momentum route's Savitzky-Golay velocity."""

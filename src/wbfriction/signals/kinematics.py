@@ -19,7 +19,7 @@ positions and the central-difference velocity and acceleration (6.2) go through 
 forward-backward low-pass, and the torques too. The estimate (5.13) is then the friction
 seen through the filter (up to the filter's commutation with the slowly varying inertia and
 gravity terms), and the identification passes its model through the same smoother
-(:mod:`wbfriction.friction.fit`). No filter window spans a contact change: the rows whose
+(:mod:`wbfriction.fit`). No filter window spans a contact change: the rows whose
 central stencil does (:func:`straddling`: an impact, a touch-down) are left out of every
 filter, so that the rows within a window of them are NaN; there the velocity, the argument of
 the friction model, falls back to the raw central (or three-point) difference, so that the fit,

@@ -19,7 +19,7 @@ taken at its two ends, as a boxcar's ``Delta p`` would.
 
 The same operator applied to a signal sampled at the samples (:meth:`MomentumWindow.__call__`: each step's
 mean by the trapezoid rule, then the window) is what the fit compares the model with (the parallel filtering
-of :mod:`wbfriction.friction.fit`): a linear, time-invariant smoother of ``2m + 1`` samples on a uniform clock,
+of :mod:`wbfriction.fit`): a linear, time-invariant smoother of ``2m + 1`` samples on a uniform clock,
 its weights scaled by each step's duration on a non-uniform one.
 """
 

@@ -52,8 +52,8 @@ import pinocchio as pin
 import pyarrow as pa
 
 from wbfriction.exceptions import InputError
+from wbfriction.fit.terms import TermFit
 from wbfriction.friction.models import FrictionParams, ModelParams
-from wbfriction.friction.terms import TermFit
 from wbfriction.logs.tables import read_metadata, with_metadata
 from wbfriction.model.loading import build_model
 from wbfriction.model.robot import Robot
@@ -269,7 +269,7 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
             robot's own (its ``[armature]``).
         options: :class:`ArmOptions`.
         progress: optional callable receiving numbers of samples done.
-        terms: friction beyond velocity per joint (:class:`~wbfriction.friction.terms.TermFit`: its velocity model
+        terms: friction beyond velocity per joint (:class:`~wbfriction.fit.terms.TermFit`: its velocity model
             and its terms, the load being the joint's rigid-body torque ``M qdd + h = tau_motor + tau_f`` (of the
             previous physics step), the angle its true one, the temperature
             :attr:`ArmOptions.temperature`'s); it replaces ``friction`` for the joints it names. Recorded in the

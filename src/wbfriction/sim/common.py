@@ -9,9 +9,9 @@ from typing import cast
 import numpy as np
 
 from wbfriction.exceptions import InputError
+from wbfriction.fit.targets import friction_by_group
+from wbfriction.fit.terms import TermFit
 from wbfriction.friction.models import MODEL_NAMES, FrictionParams, ModelParams, model_values, stack_params
-from wbfriction.friction.targets import friction_by_group
-from wbfriction.friction.terms import TermFit
 from wbfriction.logs.log import Log
 from wbfriction.model.force_torque import sensor_readings
 from wbfriction.model.imu import imu_readings
@@ -29,7 +29,7 @@ class InjectedFriction:
     Attributes:
         params: parameters per joint name.
         joints: their indices among the torque-controlled joints.
-        terms: per joint with friction beyond velocity (:class:`~wbfriction.friction.terms.TermFit`), its model
+        terms: per joint with friction beyond velocity (:class:`~wbfriction.fit.terms.TermFit`), its model
             and terms (:meth:`with_terms`); its ``params`` are the joint's in :attr:`params`.
     """
 
@@ -89,7 +89,7 @@ class InjectedFriction:
     def with_terms(self, tau_f: np.ndarray, qd: np.ndarray, q: np.ndarray, load: np.ndarray,
                    temperature: float) -> np.ndarray:
         """``tau_f`` (n_f,) of :meth:`torque` with the joints of :attr:`terms` given their whole friction
-        (:meth:`~wbfriction.friction.terms.TermFit.torque_at`), from their velocities, angles [rad], loads (the
+        (:meth:`~wbfriction.fit.terms.TermFit.torque_at`), from their velocities, angles [rad], loads (the
         rigid-body torque ``M qdd + h = tau_motor + tau_f``, the last step's) [N·m] (n_f,) and the temperature
         [°C]."""
         for col, fit in self.beyond:

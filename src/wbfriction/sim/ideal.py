@@ -37,8 +37,8 @@ from collections.abc import Mapping
 import numpy as np
 import pinocchio as pin
 
+from wbfriction.fit.terms import TermFit
 from wbfriction.friction.models import ModelParams
-from wbfriction.friction.terms import TermFit
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.sim.common import InjectedFriction, Recording, SimulationResult, injected_friction
@@ -280,7 +280,7 @@ def simulate_ideal(robot: Robot, reference: WalkingReference,
             targets (Table 6.1) on the leg joint groups, none elsewhere.
         options: :class:`IdealOptions`.
         progress: optional callable receiving numbers of samples done.
-        terms: friction beyond velocity per torque-controlled joint (:class:`~wbfriction.friction.terms.TermFit`:
+        terms: friction beyond velocity per torque-controlled joint (:class:`~wbfriction.fit.terms.TermFit`:
             its model replaces the joint's ``friction``; the load is the joint's rigid-body torque
             ``tau_motor + tau_f`` of the previous physics step, the angle its true one, the temperature the
             options' warm-up), logged as the metadata's ``terms_true``.

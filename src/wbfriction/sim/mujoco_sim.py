@@ -65,9 +65,9 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import InputError, SimulationError
+from wbfriction.fit.targets import friction_by_group
+from wbfriction.fit.terms import TermFit
 from wbfriction.friction.models import ModelParams
-from wbfriction.friction.targets import friction_by_group
-from wbfriction.friction.terms import TermFit
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.sim.common import InjectedFriction, Recording, SimulationResult, injected_friction

@@ -12,11 +12,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.options import FitOptions
+from wbfriction.fit.result import FitResult
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import FrictionEstimate
-from wbfriction.friction.fit import FitResult, fit_estimate
 from wbfriction.friction.models import PARAM_NAMES, ModelParams
-from wbfriction.friction.options import FitOptions
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.model.robot import Robot
 from wbfriction.sim.options import IdealOptions
 from wbfriction.studies.thesis import TABLE_6_1, TABLE_6_2, thesis_number
@@ -75,7 +76,7 @@ def right_knee(legs: list[LegJoint]) -> str:
 def fit_legs(est: FrictionEstimate, legs: list[LegJoint], targets: Mapping[str, ModelParams] | None = None,
              fixed: dict[str, float] | None = None) -> list[FitResult]:
     """Fit model (3.5) to every leg joint of an estimate on its valid samples, as
-    :func:`~wbfriction.friction.fit.fit_estimate` fits every joint (its noise record, the other route), with the
+    :func:`~wbfriction.fit.joints.fit_estimate` fits every joint (its noise record, the other route), with the
     estimate's true friction and ``targets`` for the errors; ``fixed``: parameters held."""
     return fit_estimate(est, FitOptions(model="thesis"), joints=[j for j, _, _ in legs], targets=targets or {},
                         fixed=fixed)
@@ -108,7 +109,7 @@ def worst_errors(rows: list[LegRow], params: tuple[str, ...] = PARAM_NAMES) -> d
 
 
 def not_ok(rows: list[LegRow]) -> list[LegRow]:
-    """The rows whose fit's status is not ``ok`` (:mod:`wbfriction.friction.status`): a short walk that did not
+    """The rows whose fit's status is not ``ok`` (:mod:`wbfriction.fit.status`): a short walk that did not
     excite a joint (the hip yaws of a 2-step combined walk hardly turn) makes its error a statement about the
     walk, not about the estimate."""
     return [r for r in rows if not r.fit.verdict().ok]

@@ -8,7 +8,7 @@ one value and every other at its default, and scores it:
 
 * ``kuka-lwr4`` (real): the mean over joints of run 3's torque RMS over the peer's (FloBaRoID's method), the route
   identifying on runs 1 and 2; a fit is *good* where it predicts run 3 as its noise and standard errors allow
-  (:func:`~wbfriction.friction.predict.other_log_checks`);
+  (:func:`~wbfriction.fit.predict.other_log_checks`);
 * ``kuka-repeat`` (real): runs 1 and 2 of the same robot (one trajectory run twice) fitted apart, the model
   identified on both: the mean relative RMS difference of their friction curves (:class:`KukaRepeatCase`); it
   judges no status;
@@ -46,12 +46,14 @@ import numpy as np
 
 from wbfriction.datasets import reference, write_dataset
 from wbfriction.datasets.reference import HeldOutRms
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.options import FitOptions, TermOptions
+from wbfriction.fit.predict import other_log_checks, predict_torques
+from wbfriction.fit.result import FitResult
+from wbfriction.fit.status import DEFAULT_THRESHOLDS, StatusThresholds, fit_verdict
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log
-from wbfriction.friction.fit import FitResult, fit_estimate
 from wbfriction.friction.models import ModelParams
-from wbfriction.friction.options import EstimateOptions, FitOptions, TermOptions
-from wbfriction.friction.predict import other_log_checks, predict_torques
-from wbfriction.friction.status import DEFAULT_THRESHOLDS, StatusThresholds, fit_verdict
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.closed_loop import identify
 from wbfriction.inertia.options import ArmatureMode, InertialOptions
 from wbfriction.logs.log import Log
@@ -397,7 +399,7 @@ class TalosIdealCase(SimCase):
     name = "talos-ideal"
 
     def prepare(self) -> None:
-        from wbfriction.friction.targets import friction_by_group
+        from wbfriction.fit.targets import friction_by_group
         from wbfriction.sim import simulate_ideal
         from wbfriction.studies.common import SIMULATOR
         from wbfriction.walking import walking_reference
@@ -430,7 +432,7 @@ class PandaTermsCase(SimCase):
     name = "panda-terms"
 
     def prepare(self) -> None:
-        from wbfriction.friction.targets import load_friction_spec
+        from wbfriction.fit.targets import load_friction_spec
         from wbfriction.logs.log import log_from_table
         from wbfriction.sim.arm import ArmOptions, ExcitationOptions, simulate_arm
 

@@ -15,8 +15,8 @@ from datetime import UTC, datetime, timedelta
 from pathlib import Path
 from typing import Literal
 
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.models import FrictionParams
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import write_log
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress

@@ -19,11 +19,11 @@ from pathlib import Path
 import numpy as np
 import pyarrow as pa
 
+from wbfriction.fit.joints import fit_joints
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.fit import fit_joints
 from wbfriction.friction.models import PARAM_NAMES, FrictionParams
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import Log
 from wbfriction.logs.tables import make_folder, write_json, write_table
 from wbfriction.model.robot import Robot

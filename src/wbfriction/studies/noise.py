@@ -11,7 +11,7 @@ as a user would, with the default options (the route chosen from the noise, ``--
   ``frictionloss`` family is MuJoCo's own dry friction, a constraint (a joint sticks), with its damping.
 
 Per joint: the fitted model, its status, the error of F_c and F_v against the injected values, and their
-Cramér-Rao bounds (:mod:`~wbfriction.friction.bound`). Each log is fitted twice: ``--model auto``, as a user runs
+Cramér-Rao bounds (:mod:`~wbfriction.fit.bound`). Each log is fitted twice: ``--model auto``, as a user runs
 it (the accuracy tables), and the true family named, whose RMS error over the seeds is compared with its bound
 (:func:`bound_table`): an efficient estimator is at the bound, a biased one above it.
 
@@ -32,10 +32,12 @@ from typing import Literal, cast, get_args
 
 import numpy as np
 
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.options import FitOptions, ModelChoice
+from wbfriction.fit.result import FitResult
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.fit import FitResult, fit_estimate
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams, ModelName, ModelParams, StribeckParams
-from wbfriction.friction.options import EstimateOptions, FitOptions, ModelChoice
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import Log, log_from_table
 from wbfriction.logs.tables import make_folder, write_atomic
 from wbfriction.model.robot import Robot
@@ -64,7 +66,7 @@ def family_friction(robot: Robot, family: Family) -> dict[str, ModelParams]:
     (:func:`~wbfriction.sim.arm.default_arm_friction`), on a humanoid the thesis's Table 6.1 on the legs and
     :data:`HUMANOID_GROUPS`; a Stribeck effect of half the Coulomb level decaying at 0.05 rad/s, an offset of
     0.1 N·m, none with MuJoCo's ``frictionloss``."""
-    from wbfriction.friction.targets import friction_by_group
+    from wbfriction.fit.targets import friction_by_group
     if robot.floating_base:
         base = friction_by_group(robot.groups) | {j: FrictionParams(F_v=v, F_c=c, S=0.2, v_s=0.05, tau_os=0.1)
                                                   for g, (v, c) in HUMANOID_GROUPS.items()

@@ -12,7 +12,7 @@ friction table of ``predict``) and scores every joint (:class:`JointScore`):
 * against a published curve (UR10e, Panda: :mod:`wbfriction.datasets.reference`), the odd part's relative RMS
   error ``|odd_fit - odd_ref| / |odd_ref|`` over the fitted log's valid samples with ``|qd| >= min_speed`` (0.1
   rad/s), and that deviation in the fit's own standard errors (the RMS over the same samples of the deviation over
-  the curve's standard error, :meth:`~wbfriction.friction.fit.FitResult.dissipative`): a fit whose standard errors
+  the curve's standard error, :meth:`~wbfriction.fit.result.FitResult.dissipative`): a fit whose standard errors
   are honest about what the data determine lies within 3 (:func:`curve_scores`: a fit with terms beyond velocity at
   each sample's load and temperature);
 * on the held-out log, the torque RMS of the model fitted (:func:`~wbfriction.pipeline.predict_step.predict_file`)
@@ -35,11 +35,12 @@ import numpy as np
 from wbfriction.datasets import reference, write_dataset
 from wbfriction.datasets.reference import HeldOutRms, Reference
 from wbfriction.exceptions import WbfrictionError
+from wbfriction.fit.params_file import read_params
+from wbfriction.fit.result import FitResult
+from wbfriction.fit.status import MIN_SPEED, joint_speed
+from wbfriction.fit.terms import term_signals
 from wbfriction.friction.estimated import FrictionEstimate
-from wbfriction.friction.fit import FitResult
-from wbfriction.friction.io import read_friction_file, read_params
-from wbfriction.friction.status import MIN_SPEED, joint_speed
-from wbfriction.friction.terms import term_signals
+from wbfriction.friction.io import read_friction_file
 from wbfriction.pipeline.predict_step import predict_file
 
 
@@ -57,7 +58,7 @@ class JointScore:
 
     Attributes:
         joint: its name.
-        status: the fit's status (:mod:`~wbfriction.friction.status`) and ``reason`` why, when not ``ok``.
+        status: the fit's status (:mod:`~wbfriction.fit.status`) and ``reason`` why, when not ``ok``.
         model: the model family chosen.
         curve_error: the odd part's relative RMS error against the published curve (a share, 0.05 = 5 %).
         curve_sigmas: that deviation in the fit's standard errors (RMS over the samples of deviation / error).

@@ -30,11 +30,12 @@ from pathlib import Path
 
 import numpy as np
 
+from wbfriction.fit.params_file import write_params
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log
-from wbfriction.friction.io import friction_table, write_params
+from wbfriction.friction.io import friction_table
 from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.contacts import normal_forces, sensed_contacts
 from wbfriction.logs.log import Log, write_log
 from wbfriction.logs.tables import make_folder, write_table

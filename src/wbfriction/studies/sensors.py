@@ -25,9 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log
 from wbfriction.friction.options import EstimateOptions, RouteOption
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import Log, write_log
 from wbfriction.logs.tables import make_folder, write_atomic
 from wbfriction.model.robot import Robot

@@ -18,13 +18,14 @@ from pathlib import Path
 
 import numpy as np
 
-from wbfriction.friction.energy import energy_consistency
+from wbfriction.fit.energy import energy_consistency
+from wbfriction.fit.params_file import write_params
+from wbfriction.fit.result import fitted_offsets
+from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.fit import fitted_offsets
-from wbfriction.friction.io import friction_table, write_params
+from wbfriction.friction.io import friction_table
 from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.friction.targets import THESIS_TARGETS
 from wbfriction.logs.log import write_log
 from wbfriction.logs.tables import make_folder, write_table
 from wbfriction.model.robot import Robot

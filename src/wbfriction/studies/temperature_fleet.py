@@ -11,7 +11,7 @@ the warmest log), the log's temperatures logged. The logs' temperatures follow a
 the fleet's days) and each log's duty (a random offset), and warm a little within each log. Some joints wear:
 their Coulomb level grows by 15-30 % (a step or a ramp) from a random onset on.
 
-Each log is fitted (:func:`~wbfriction.friction.fit.fit_estimate`) into the results' rows
+Each log is fitted (:func:`~wbfriction.fit.joints.fit_estimate`) into the results' rows
 (:func:`~wbfriction.fleet.task.result_rows`: each joint's values and the temperature they were measured at), and
 the trends (:func:`~wbfriction.fleet.trends.fleet_trends`) run with the temperatures and without them
 (:func:`score_temperature_fleet`).
@@ -111,11 +111,11 @@ def temperature_fleet(plan: TemperatureFleet = TemperatureFleet()) -> pa.Table:
     Returns:
         The rows, each joint's ``temperature`` the mean over its log's samples.
     """
+    from wbfriction.fit.joints import fit_estimate
+    from wbfriction.fit.options import FitOptions
+    from wbfriction.fit.terms import load_torque
     from wbfriction.fleet.task import ResultKey, result_rows
     from wbfriction.friction.estimated import FrictionEstimate
-    from wbfriction.friction.fit import fit_estimate
-    from wbfriction.friction.options import FitOptions
-    from wbfriction.friction.terms import load_torque
 
     rng = np.random.default_rng([plan.seed, 2])
     wear = plan.wear()

@@ -1,0 +1,286 @@
+"""Every joint of a friction estimate fitted (:func:`fit_estimate`, :func:`fit_joints`): the joints' fits run in
+parallel, each checked on the other route, on its later stretch and with its terms beyond velocity."""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+from typing import Any, cast
+
+import numpy as np
+
+from wbfriction.exceptions import InputError
+from wbfriction.fit.options import PASS_ROWS, SELECTION_TOLERANCE, FitOptions, ModelChoice
+from wbfriction.fit.ranges import FittedRanges
+from wbfriction.fit.result import FitResult, compare_routes
+from wbfriction.fit.screen import gross_outliers
+from wbfriction.fit.selection import fit_friction, later_stretch
+from wbfriction.fit.smoothing import smoother_half_width
+from wbfriction.fit.solve import fitted_rows, stick_speed
+from wbfriction.fit.term_selection import fit_terms, refit_terms
+from wbfriction.fit.terms import TermFit, term_signals
+from wbfriction.friction.estimated import FrictionEstimate
+from wbfriction.friction.models import (
+    ModelName,
+    ModelParams,
+    target_from_dict,
+)
+from wbfriction.friction.noise import JointNoise, joint_noises
+from wbfriction.workers import process_pool
+
+
+def _fit_column(args: tuple, later: bool = True) -> FitResult:
+    """One joint's :func:`fit_friction` (a :func:`_column_tasks` task) and, with ``later``, its
+    :func:`later_stretch`."""
+    qd, tau_f, valid, kwargs = args
+    fit = fit_friction(qd, tau_f, mask=valid, **kwargs)
+    if later:
+        fit.later = later_stretch(fit, qd, tau_f, valid, kwargs)
+    return fit
+
+
+def _fit_routes(args: tuple) -> tuple[FitResult, FitResult | None]:
+    """One joint's fit (a :func:`_column_tasks` task) with its later stretch checked, and its model's fit on the
+    other route's estimate (a task of that route, or None)."""
+    task, other = args
+    fit = _fit_column(task)
+    if other is None:
+        return fit, None
+    qd, tau_f, valid, kwargs = other
+    return fit, _fit_column((qd, tau_f, valid, {**kwargs, "model": fit.model}), later=False)
+
+
+def _column_tasks(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, models: Sequence[ModelChoice], *,
+                  delta_s: float, min_samples: int, smoother, fixed: dict[str, float] | None,
+                  selection_tolerance: float, noise: Mapping[str, JointNoise] | None,
+                  stick_margin: int | None, still: ModelName | None = None,
+                  pass_rows: float = PASS_ROWS, score_slow: bool = True) -> list[tuple]:
+    """One :func:`_fit_column` task per joint (:func:`fit_joints`'s arguments)."""
+    noise = noise or {}
+    tasks = []
+    for i, joint in enumerate(joints):
+        jn = noise.get(joint)
+        sigma = 0.0 if jn is None else jn.velocity
+        stick = {} if stick_margin is None else {"stick": stick_speed(sigma), "stick_margin": stick_margin,
+                                                 "pass_rows": pass_rows, "score_slow": score_slow}
+        tasks.append((qd[:, i], tau_f[:, i], valid[:, i],
+                      dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, fixed=fixed,
+                           model=models[i], selection_tolerance=selection_tolerance, velocity_noise=sigma, noise=jn,
+                           still=still, **stick)))
+    return tasks
+
+
+def _run(fn, tasks: list, workers: int) -> list:
+    """``fn`` over ``tasks``, on ``workers`` processes side by side (one task at a time to each), in order."""
+    if workers > 1 and len(tasks) > 1:
+        with process_pool(min(workers, len(tasks)), "fork") as pool:
+            return list(pool.map(fn, tasks))
+    return [fn(task) for task in tasks]
+
+
+def _with_truth(joints, fitted: list[FitResult], qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray,
+                tau_f_true: np.ndarray | None, targets: Mapping[str, ModelParams] | None) -> list[FitResult]:
+    """``fitted`` with their errors against the true friction and parameters, where known (:func:`fit_joints`)."""
+    for i, (joint, res) in enumerate(zip(joints, fitted)):
+        m = valid[:, i] & np.isfinite(tau_f[:, i]) & np.isfinite(qd[:, i])
+        m &= ~gross_outliers(-tau_f[:, i], m)  # the samples the fit used
+        if tau_f_true is not None and np.isfinite(tau_f_true[m, i]).all() and m.any():
+            res.rms_error_vs_true = float(np.sqrt(np.mean((tau_f[m, i] - tau_f_true[m, i]) ** 2)))
+            if res.params is not None:
+                res.rms_model_vs_true = float(np.sqrt(np.mean((res.params.torque(qd[m, i]) - tau_f_true[m, i]) ** 2)))
+        if targets and joint in targets:
+            res.target = targets[joint]
+    return fitted
+
+
+def fit_joints(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, *,
+               tau_f_true: np.ndarray | None = None, targets: Mapping[str, ModelParams] | None = None,
+               delta_s: float = 2.0, min_samples: int = 20, smoother=None,
+               fixed: dict[str, float] | None = None, workers: int = 1,
+               model: ModelChoice | Sequence[ModelName] = "thesis",
+               selection_tolerance: float = SELECTION_TOLERANCE, noise: Mapping[str, JointNoise] | None = None,
+               stick_margin: int | None = None, later: bool = True,
+               pass_rows: float = PASS_ROWS) -> list[FitResult]:
+    """Fit every joint of a friction estimate on its valid samples.
+
+    Args:
+        joints: names (n,).
+        qd, tau_f, valid: (N, n) arrays of a :class:`~wbfriction.friction.estimate.FrictionEstimate`
+            (the whole time series: with ``smoother`` the model is filtered along it).
+        tau_f_true: (N, n) true friction (NaN columns for unknown) or None.
+        targets: true parameters (any model's) per joint name, when known.
+        smoother: the estimate's smoother (``FrictionEstimate.smoother``) or None.
+        fixed: parameters held instead of fitted (:func:`fit_friction`).
+        workers: processes fitting joints side by side (each fit is independent of the
+            others: the results do not depend on it).
+        model, selection_tolerance: the model, or ``auto`` and its tolerance (:func:`fit_friction`); or one model
+            per joint.
+        noise: what is known of each joint's noise (:func:`~wbfriction.friction.noise.joint_noises`): its velocity
+            noise corrects the model (errors in variables) and sets the speed a joint may stick below, and the fit
+            carries its Cramér-Rao bound; a joint without: neither.
+        stick_margin: with it, samples within that many rows of a speed a joint may stick at
+            (:func:`stick_speed`) are left out (:func:`stuck_rows`); None: none.
+        later: each fit checked on its later stretch (:func:`later_stretch`).
+        pass_rows: reversals crossing the sticking band within so many rows are not left out (:func:`stuck_rows`).
+
+    Raises:
+        InputError: what :func:`fit_friction` raises.
+    """
+    models = [model] * len(joints) if isinstance(model, str) else list(model)
+    tasks = _column_tasks(joints, qd, tau_f, valid, cast(Sequence[ModelChoice], models), delta_s=delta_s,
+                          min_samples=min_samples, smoother=smoother, fixed=fixed,
+                          selection_tolerance=selection_tolerance, noise=noise, stick_margin=stick_margin,
+                          pass_rows=pass_rows)
+    fit = functools.partial(_fit_column, later=later)
+    return _with_truth(joints, _run(fit, tasks, workers), qd, tau_f, valid, tau_f_true, targets)
+
+
+def stick_margin(est: FrictionEstimate) -> int:
+    """Rows a sticking sample reaches in ``est``'s fit (:func:`stuck_rows`): its smoother's half width, and the
+    velocity filter's where the velocity went through another one (the momentum route), or the central difference's
+    stencil without a smoother."""
+    margin = smoother_half_width(est.smoother)
+    if est.estimation_route == "momentum":  # the metadata the table was read with (its smoother checked them)
+        margin += int(est.metadata["estimate_options"]["momentum"]["velocity_window"]) // 2
+    elif est.smoother is None:
+        margin += 1
+    return margin
+
+
+def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, workers: int = 1,
+                 joints: Sequence[str] | None = None, fixed: dict[str, float] | None = None,
+                 targets: Mapping[str, ModelParams] | None = None,
+                 still: ModelName | None = None) -> list[FitResult]:
+    """Fit every joint of an estimate (:func:`fit_joints` on its valid samples, on ``workers``
+    processes); its ``tau_f_true`` and ``friction_true`` metadata, when present (simulated
+    logs), give the errors against truth.
+
+    With the estimate's noise record (:func:`~wbfriction.friction.noise.noise_record`), each fit corrects the model
+    for its velocity's noise, leaves out the samples where its joint may stick, and carries its Cramér-Rao bound.
+    With the other route's estimate (:attr:`~wbfriction.friction.estimate.FrictionEstimate.route_check`), each
+    joint's model is fitted there too and the two compared (:attr:`FitResult.route_check`, :func:`compare_routes`).
+
+    Args:
+        options: the model, its choice and the fit's thresholds (:class:`~wbfriction.fit.options.FitOptions`;
+            its defaults are ``wbfriction fit``'s).
+        workers: processes fitting joints side by side.
+        joints: the joints to fit (default: every one of the estimate), in this order.
+        fixed: parameters held instead of fitted (:func:`fit_friction`).
+        targets: the true parameters per joint, instead of the metadata's ``friction_true``.
+        still: the model of a joint that hardly moved, instead of ``options``' named model (:func:`fit_friction`).
+
+    Raises:
+        InputError: ``friction_true`` metadata that are not a model's parameters; an unknown model or joint; a
+            damaged noise record.
+    """
+    if targets is None:
+        targets = {j: target_from_dict(p) for j, p in est.metadata.get("friction_true", {}).items()}
+    names = list(est.joints if joints is None else joints)
+    unknown = [j for j in names if j not in est.joints]
+    if unknown:
+        raise InputError(f"no joint '{unknown[0]}' in the friction estimate")
+    idx = [est.joints.index(j) for j in names]
+    record = est.metadata.get("noise")
+    truth = None if est.tau_f_true is None else est.tau_f_true[:, idx]
+    common: dict[str, Any] = dict(delta_s=options.delta_s, min_samples=options.min_samples, fixed=fixed,
+                                  selection_tolerance=options.selection_tolerance, still=still,
+                                  pass_rows=options.pass_rows, score_slow=options.score_slow)
+    tasks = _column_tasks(names, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], [options.model] * len(idx),
+                          smoother=est.smoother, noise=joint_noises(record, est.estimation_route),
+                          stick_margin=stick_margin(est), **common)
+    check = est.route_check
+    others: Sequence[tuple | None] = [None] * len(idx)
+    if check is not None:  # each joint's model fitted on the other route too, in the same task
+        others = _column_tasks(names, check.qd[:, idx], check.tau_f[:, idx], check.valid[:, idx],
+                               [options.model] * len(idx), smoother=check.smoother,
+                               noise=joint_noises(record, check.estimation_route), stick_margin=stick_margin(check),
+                               **common)
+    pairs = _run(_fit_routes, list(zip(tasks, others)), workers)
+    fits = _with_truth(names, [fit for fit, _ in pairs], est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], truth,
+                       targets)
+    checked = [other for _, other in pairs]
+    for f, other in zip(fits, checked):
+        f.route = est.estimation_route
+        f.unmeasured = str(est.metadata.get("noise_unmeasured", ""))  # never ok then (issue 53)
+        if check is not None and other is not None:
+            other.route = check.estimation_route
+            f.route_check = compare_routes(f, other)
+    if options.terms.terms:
+        for k, (f, i, maybe) in enumerate(zip(fits, idx, checked)):
+            f.terms = _joint_terms(est, i, f, maybe, options)
+            for _ in range(TERM_REFITS):  # the velocity model chosen and fitted again with the terms' torque taken out
+                if f.kept_terms is None:
+                    break
+                task = _without_terms(tasks[k], f.kept_terms, est, i)
+                refit = _with_truth([names[k]], [_fit_column(task)], est.qd[:, [i]], est.tau_f[:, [i]],
+                                    est.valid[:, [i]], None if truth is None else truth[:, [k]], targets)[0]
+                refit.route, refit.route_check, refit.unmeasured = f.route, f.route_check, f.unmeasured
+                if refit.params is None or not refit.success:  # a refit that did not converge: the fit before it
+                    break
+                other_task = others[k]
+                if other_task is not None and refit.model != f.model:  # the other route's refit of this model
+                    qd_o, tau_o, valid_o, kwargs_o = other_task
+                    maybe = _fit_column((qd_o, tau_o, valid_o, {**kwargs_o, "model": refit.model}), later=False)
+                refit.terms = _joint_terms(est, i, refit, maybe, options)
+                if not _better_refit(refit, f):
+                    break
+                fits[k] = f = refit
+    return fits
+
+
+UNUSABLE: tuple[str, ...] = ("failed", "at bound", "not excited")
+
+
+def _better_refit(refit: FitResult, fit: FitResult) -> bool:
+    """Whether a joint's refit with its terms' torque taken out (:data:`TERM_REFITS`) replaces ``fit``: its model with
+    its terms predicts the later stretch no worse (:attr:`~wbfriction.fit.terms.TermFit.held_out_rms`), and its
+    status is usable where ``fit``'s was (issue 52: on a UR10e's shoulder, its gravity load of 100 N·m, a refit ended
+    at a bound 36 % off the published curve, the next one stopped at its evaluation limit)."""
+    if refit.terms is None or fit.terms is None:
+        return False
+    if refit.verdict().status in UNUSABLE and fit.verdict().status not in UNUSABLE:
+        return False
+    return bool(refit.terms.held_out_rms[1] <= fit.terms.held_out_rms[1])
+
+
+TERM_REFITS = 2
+"""How many times a joint that kept terms has its velocity model chosen and fitted again on the estimate less the
+terms' torque, and its terms fitted again with it (issue 52: chosen without the terms, the velocity model takes what
+the load leaves: on the Panda with a load term on every joint, ``auto`` took a Coulomb-viscous model for a Stribeck
+one, whose missing Stribeck drop then predicted another log 3 to 8 times worse than the noise)."""
+
+
+def _without_terms(task: tuple, terms: TermFit, est: FrictionEstimate, i: int) -> tuple:
+    """``task`` (a :func:`_column_tasks` task of joint column ``i`` of ``est``) with the estimate less the torque of
+    ``terms``' kept terms (their part beyond the velocity model, the ripple included; through the estimate's smoother
+    as the fit's model goes)."""
+    qd, tau_f, valid, kwargs = task
+    signals = term_signals(est, i)
+    part = terms.torque(est.qd[:, i], signals) + terms.params.f(est.qd[:, i])  # tau_f = -f: the terms' share
+    if est.smoother is not None:
+        part = np.asarray(est.smoother(np.where(valid & np.isfinite(part), part, np.nan)[:, None]))[:, 0]
+    ok = np.isfinite(part)
+    return qd, np.where(ok, tau_f - np.where(ok, part, 0.0), np.nan), valid & ok, kwargs
+
+
+def _joint_terms(est: FrictionEstimate, i: int, fit: FitResult, other: FitResult | None,
+                 options: FitOptions) -> TermFit | None:
+    """The terms beyond velocity of joint column ``i`` of ``est``
+    (:func:`~wbfriction.fit.term_selection.fit_terms`) on the samples its fit used, and refitted on the other
+    route's estimate with that route's model (``other``), with the ranges of its signals on those samples
+    (:class:`~wbfriction.fit.ranges.FittedRanges`); None for a joint not fitted or not excited."""
+    if fit.params is None or fit.verdict().status in ("not excited", "failed"):
+        return None
+    signals = term_signals(est, i)
+    use = fitted_rows(est.qd[:, i], est.tau_f[:, i], est.valid[:, i], est.smoother, fit.stick_speed,
+                      stick_margin(est), fit.pass_rows)[0]
+    terms = fit_terms(fit.params, est.qd[:, i], est.tau_f[:, i], use, signals, options.terms, est.smoother)
+    terms = replace(terms, ranges=FittedRanges.of(use, signals.q, signals.tau_load, signals.temperature))
+    check = est.route_check
+    if check is not None and other is not None and other.params is not None and terms.kept:
+        rows = fitted_rows(check.qd[:, i], check.tau_f[:, i], check.valid[:, i], check.smoother, other.stick_speed,
+                           stick_margin(check), other.pass_rows)[0]
+        terms = replace(terms, check=refit_terms(terms, other.params, check.qd[:, i], check.tau_f[:, i], rows, signals,
+                                                 check.estimation_route, check.smoother))
+    return terms

@@ -1,0 +1,293 @@
+"""The choice among the models by held-out error (``model="auto"``), and a joint's fit whatever its model.
+
+The valid samples are cut into contiguous blocks in time; every third is held out
+(:func:`~wbfriction.fit.regression.held_out_split`, deterministic), every model is fitted on the others, and its
+RMS error on the held-out blocks compared (:func:`held_out_rms`). The simplest model whose held-out RMS is within
+``selection_tolerance`` (relative, default :data:`~wbfriction.fit.options.SELECTION_TOLERANCE`) of the best is
+chosen (:func:`choose_model`, the reason recorded in :class:`~wbfriction.fit.result.ModelSelection`) and fitted
+again on every valid sample, as if it had been named. Whole blocks, not scattered samples, are held out: residuals
+correlated in time (filtered estimates) would otherwise let the held-out error see the fit's noise. With too few
+samples to hold a block out, or for a joint that hardly moved (below :data:`~wbfriction.fit.status.MIN_SPEED`:
+``not excited``, no velocity model in its data), the simplest model is fitted. A model with a parameter at a bound
+gives way to the best simpler one whose parameters are interior (:func:`prefer_interior`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from wbfriction.exceptions import InputError
+from wbfriction.fit.eiv import expected_values
+from wbfriction.fit.holdout import (
+    LATER,
+    MIN_HELD_OUT,
+    PredictionCheck,
+    prediction_check,
+    prediction_variance,
+    split_later,
+)
+from wbfriction.fit.options import MODEL_CHOICES, PASS_ROWS, SELECTION_TOLERANCE, ModelChoice
+from wbfriction.fit.regression import (
+    held_out_gain,
+    held_out_split,
+)
+from wbfriction.fit.result import FitResult, HeldOutScore, ModelSelection
+from wbfriction.fit.solve import (
+    blas_controller,
+    check_fixed,
+    fit_model,
+    fitted_rows,
+    model_fixed,
+    model_gradient,
+    shown_friction,
+)
+from wbfriction.fit.status import MIN_SPEED
+from wbfriction.friction.models import (
+    MODEL_NAMES,
+    MODEL_PARAMS,
+    ModelName,
+    ModelParamsBase,
+    check_model,
+)
+from wbfriction.friction.noise import JointNoise
+
+
+def held_out_residuals(params: ModelParamsBase, qd: np.ndarray, tau_f: np.ndarray, rows: np.ndarray, smoother=None,
+                       velocity_noise: float = 0.0) -> np.ndarray:
+    """(model friction torque - ``tau_f``) [N·m] on the samples ``rows`` ((N,) bool), in time order (the model's
+    torque is ``-f``: the residual is ``f + tau_f``).
+
+    Args:
+        params: a model's parameters (:data:`~wbfriction.friction.models.ModelParams`).
+        qd, tau_f: the whole time series (N,) [rad/s], [N·m].
+        rows: the samples scored.
+        smoother: the estimate's smoother or None; the model goes through it along the whole
+            series before it is scored, as in the fit.
+        velocity_noise: the velocity's noise [rad/s]: the model's expectation under it, as in the fit
+            (:mod:`~wbfriction.fit.eiv`).
+    """
+    f = expected_values(params.as_vector(), np.asarray(qd, dtype=float), velocity_noise,
+                        getattr(params, "delta_s", 2.0), params.model)
+    if smoother is not None:
+        f = smoother(f)
+    return (f + np.asarray(tau_f, dtype=float))[np.asarray(rows, dtype=bool)]
+
+
+def held_out_rms(params: ModelParamsBase, qd: np.ndarray, tau_f: np.ndarray, rows: np.ndarray, smoother=None,
+                 velocity_noise: float = 0.0) -> float:
+    """RMS [N·m] of :func:`held_out_residuals` (NaN for no sample)."""
+    r = held_out_residuals(params, qd, tau_f, rows, smoother, velocity_noise)
+    return float(np.sqrt(np.mean(r**2))) if r.size else float("nan")
+
+
+GAIN_Z = 2.0
+"""A model with a parameter at a bound must lower the held-out mean square by more than this many standard errors
+of the lowering to be chosen over a simpler model whose parameters are all interior (:func:`choose_model`)."""
+
+
+def choose_model(scores: tuple[HeldOutScore, ...], tolerance: float = SELECTION_TOLERANCE) -> tuple[ModelName, str]:
+    """The simplest model (first in ``scores``) whose held-out RMS is within ``tolerance``
+    (relative) of the smallest, and the reason, one sentence.
+
+    Raises:
+        InputError: no score is finite.
+    """
+    finite = [s for s in scores if np.isfinite(s.held_out_rms)]
+    if not finite:
+        raise InputError("no model could be scored on held-out samples")
+    best = min(finite, key=lambda s: s.held_out_rms)
+    chosen = next(s for s in finite if s.held_out_rms <= (1.0 + tolerance) * best.held_out_rms)
+    rms = "held-out RMS [N·m]: " + ", ".join(f"{s.model} {s.held_out_rms:.4g}" for s in scores)
+    if chosen is best:
+        reason = f"{chosen.model}: the smallest held-out RMS"
+        if scores.index(chosen) > 0:
+            reason += f"; simpler models exceed it by more than {100 * tolerance:g} %"
+    else:
+        excess = 100.0 * (chosen.held_out_rms / best.held_out_rms - 1.0)
+        reason = (f"{chosen.model}: the simplest model within {100 * tolerance:g} % of the smallest held-out RMS "
+                  f"({best.model}'s; +{excess:.2g} %)")
+    reason += f"; {rms}"
+    return chosen.model, reason
+
+
+def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joint: str = "",
+                 x0: np.ndarray | None = None, min_samples: int = 20, mask: np.ndarray | None = None,
+                 smoother=None, fixed: dict[str, float] | None = None, model: ModelChoice = "thesis",
+                 selection_tolerance: float = SELECTION_TOLERANCE, velocity_noise: float = 0.0,
+                 stick: float = 0.0, stick_margin: int = 0, pass_rows: float = PASS_ROWS,
+                 score_slow: bool = True, noise: JointNoise | None = None,
+                 still: ModelName | None = None) -> FitResult:
+    """Fit a friction model to friction estimates of one joint (eq. 6.4).
+
+    Args:
+        qd: joint velocities (N,) [rad/s].
+        tau_f: friction torques on the joint (N,) [N·m] (``tau_f = -f(qd)``).
+        delta_s: Stribeck exponent, fixed (thesis: 2).
+        joint: name, for the result.
+        x0: a starting point in the order of the model's names
+            (:data:`~wbfriction.friction.models.PARAM_NAMES` for (3.5)); by default several
+            (:func:`initial_guesses`), the best fit is kept. Not with ``model="auto"``.
+        min_samples: fewer samples give a result without parameters.
+        mask: (N,) samples to fit (default: every finite one); gross outliers among them are
+            left out and counted (:func:`~wbfriction.fit.screen.gross_outliers`,
+            :attr:`FitResult.n_screened`).
+        smoother: the zero-phase smoother ``tau_f`` went through
+            (:attr:`~wbfriction.friction.estimate.FrictionEstimate.smoother`), or None; ``qd`` and
+            ``tau_f`` are then whole time series, ``qd`` NaN where the estimate was left out
+            of the smoothing, and the model goes through the same smoother before it is
+            compared (module docstring). Samples where the smoothed model is undefined are
+            not used.
+        fixed: parameters held at a value instead of fitted (standard error 0), e.g.
+            ``{"S": 0, "v_s": 0.1, "tau_os": 0}`` for a Coulomb-viscous model (3.5). With
+            ``model="auto"`` each candidate holds those it has.
+        model: the model (:data:`ModelChoice`): ``thesis`` (3.5), ``stribeck``,
+            ``coulomb-viscous``, or ``auto`` (chosen by held-out error, module docstring).
+        selection_tolerance: with ``auto``, the relative excess of held-out RMS over the best
+            within which the simpler model is chosen.
+        velocity_noise: the standard deviation of the noise in ``qd`` [rad/s]: the model compared is its expectation
+            under that noise (errors in variables, :mod:`~wbfriction.fit.eiv`); 0: the model itself.
+        stick, stick_margin, pass_rows: samples within ``stick_margin`` rows of a speed below ``stick`` [rad/s] are
+            left out, but for reversals crossing that band within ``pass_rows`` rows
+        score_slow: with ``auto``, the held-out blocks' samples left out that way are scored too (what ``predict``
+            scores: a model with no Coulomb step there misses them)
+            (:func:`stuck_rows`) and counted (:attr:`FitResult.n_stuck`); 0: none. Not for a joint that hardly
+            moved (:data:`~wbfriction.fit.status.MIN_SPEED`: ``not excited``), whose every sample gives its
+            offset.
+        noise: what is known of the estimate's noise (:class:`~wbfriction.friction.noise.JointNoise`): the fit then
+            carries its Cramér-Rao bound (:attr:`FitResult.crb`); None: no bound.
+        still: the model fitted instead of the one named (from its own start, not ``x0``) when the joint hardly
+            moved (status ``not excited``: its data hold no velocity model, only an offset; ``auto`` then takes the
+            simplest model anyway); None: the model named.
+
+    Returns:
+        :class:`FitResult`.
+
+    Raises:
+        InputError: an unknown model, a name in ``fixed`` that is not the model's (for
+            ``auto``: no model's), ``x0`` with ``auto``, a ``stribeck`` F_s held without F_c.
+    """
+    if model not in MODEL_CHOICES:
+        raise InputError(f"model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
+    qd = np.asarray(qd, dtype=float)
+    y = -np.asarray(tau_f, dtype=float)
+    use, screened, stuck, speed = fitted_rows(qd, tau_f, mask, smoother, stick, stick_margin, pass_rows)
+    # One BLAS thread: the solver's many small (N x p) factorizations run several times
+    # slower on OpenBLAS's threads than on one (30 TALOS joints of a 10-step walk: 78 s
+    # against 14 s on 2 cores); fit joints side by side instead (fit_estimate's workers).
+    with blas_controller().limit(limits=1, user_api="blas"):
+        if model == "auto":
+            if x0 is not None:
+                raise InputError("x0 needs a named model, not 'auto'")
+            res = _fit_auto(qd, y, use, delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother,
+                            fixed=fixed, tolerance=selection_tolerance, sigma=velocity_noise, noise=noise,
+                            speed=speed, stuck=stuck if score_slow else None)
+        else:
+            if still is not None and speed < MIN_SPEED:  # held names checked against the model named all the same
+                check_fixed(check_model(model), fixed)
+                model, x0, fixed = still, None, model_fixed(still, fixed)
+            res = fit_model(check_model(model), qd, y, use, delta_s=delta_s, joint=joint, x0=x0,
+                             min_samples=min_samples, smoother=smoother, fixed=fixed, sigma=velocity_noise,
+                             noise=noise)
+    res.n_screened = int(screened.sum())
+    res.speed = speed
+    res.velocity_noise, res.stick_speed, res.n_stuck = float(velocity_noise), float(stick), int(stuck.sum())
+    res.pass_rows = float(pass_rows)
+    return res
+
+
+def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float, joint: str, min_samples: int,
+              smoother, fixed: dict[str, float] | None, tolerance: float, sigma: float = 0.0,
+              noise: JointNoise | None = None, speed: float = np.inf,
+              stuck: np.ndarray | None = None) -> FitResult:
+    """``fit_friction(model="auto")`` on the usable samples ``use`` (module docstring); a joint whose ``speed``
+    [rad/s] (:func:`fitted_rows`) is below :data:`~wbfriction.fit.status.MIN_SPEED` gets the simplest model."""
+    fixed = dict(fixed or {})
+    known = {n for m in MODEL_NAMES for n in MODEL_PARAMS[m].names}
+    if set(fixed) - known:
+        raise InputError(f"unknown parameter(s) to fix: {', '.join(sorted(set(fixed) - known))}")
+    held = {m: model_fixed(m, fixed) for m in MODEL_NAMES}
+    kwargs = dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, sigma=sigma)
+    train, held_out = held_out_split(use)
+    scored = held_out
+    if stuck is not None and stuck.any():  # the slow samples of the held-out blocks are scored too (issue 52)
+        _, scored = held_out_split(use | stuck)
+        scored &= np.isfinite(qd) & np.isfinite(y)
+    n_train, n_held_out = int(train.sum()), int(held_out.sum())
+    simplest = MODEL_NAMES[0]
+    why = None
+    if min(n_train, n_held_out) < max(min_samples, 7):
+        why = f"too few samples ({int(use.sum())}) to hold any out"
+    elif speed < MIN_SPEED:
+        why = (f"the joint hardly moved (|qd| at most {speed:.2g} rad/s on 95 % of its samples): no model can be "
+               "chosen, its offset is what the data give")
+    if why is not None:
+        res = fit_model(simplest, qd, y, use, fixed=held[simplest], noise=noise, **kwargs)
+        res.selection = ModelSelection(simplest, f"{simplest}: {why}", (), tolerance, n_train, n_held_out)
+        return res
+    trained = {m: fit_model(m, qd, y, train, fixed=held[m], **kwargs) for m in MODEL_NAMES}
+    residuals = {m: held_out_residuals(r.params, qd, -y, scored, smoother, sigma) for m, r in trained.items()
+                 if r.params is not None}
+    scores = tuple(HeldOutScore(m, float(np.sqrt(np.mean(residuals[m] ** 2))) if m in residuals else float("nan"),
+                                r.bounded()) for m, r in trained.items())
+    chosen, reason = choose_model(scores, tolerance)
+    chosen, reason = prefer_interior(chosen, reason, scores, residuals, np.flatnonzero(scored))
+    res = fit_model(chosen, qd, y, use, fixed=held[chosen], noise=noise, **kwargs)  # as if the model had been named
+    if res.bounded():
+        reason += f"; at a bound: {', '.join(res.bounded())}"
+    res.selection = ModelSelection(chosen, reason, scores, tolerance, n_train, n_held_out)
+    return res
+
+
+def prefer_interior(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ...],
+                         residuals: dict[ModelName, np.ndarray], rows: np.ndarray) -> tuple[ModelName, str]:
+    """The rule of issue 38: a model chosen with a parameter at a bound gives way to the best-scoring simpler model
+    whose parameters are all interior, unless it lowers the held-out mean square by more than :data:`GAIN_Z`
+    standard errors of that lowering (:func:`held_out_gain`)."""
+    by_model = {s.model: s for s in scores}
+    if not by_model[chosen].at_bound:
+        return chosen, reason
+    simpler = [s for s in scores[:[s.model for s in scores].index(chosen)]
+               if not s.at_bound and s.model in residuals and np.isfinite(s.held_out_rms)]
+    if not simpler:
+        return chosen, reason
+    alternative = min(simpler, key=lambda s: s.held_out_rms)
+    gain, se = held_out_gain(residuals[alternative.model], residuals[chosen], rows)
+    if gain > GAIN_Z * se:
+        return chosen, reason + (f"; its held-out gain over {alternative.model} ({gain:.3g} N²·m², {gain / se:.1f} "
+                                 f"standard errors) outweighs its bound ({', '.join(by_model[chosen].at_bound)})")
+    scores_text = reason[reason.find("held-out RMS [N·m]:"):] if "held-out RMS [N·m]:" in reason else ""
+    return alternative.model, (f"{alternative.model}: {chosen} leaves {', '.join(by_model[chosen].at_bound)} at a "
+                               f"bound and lowers the held-out mean square by {gain:.3g} ± {se:.2g} N²·m², within "
+                               f"{GAIN_Z:g} standard errors" + (f"; {scores_text}" if scores_text else ""))
+
+
+def later_stretch(fit: FitResult, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray,
+                  kwargs: Mapping[str, Any]) -> PredictionCheck | None:
+    """How ``fit`` (of :func:`fit_friction` on ``qd``, ``tau_f``, ``valid`` with ``kwargs``) predicts its later
+    stretch (:mod:`~wbfriction.fit.holdout`): its model fitted on the samples before the last
+    :data:`~wbfriction.fit.holdout.LATER` of those it used, with the same options, and scored on them; None for
+    a fit without parameters, a joint that hardly moved, too few samples on either side or an early fit that failed.
+    """
+    if fit.params is None or fit.speed is None or fit.speed < MIN_SPEED or not fit.success:
+        return None
+    smoother, sigma = kwargs.get("smoother"), float(kwargs.get("velocity_noise", 0.0))
+    use = fitted_rows(qd, tau_f, valid, smoother, fit.stick_speed, int(kwargs.get("stick_margin", 0)),
+                      fit.pass_rows)[0]
+    before, later = split_later(use, LATER)
+    if int((use & before).sum()) < MIN_HELD_OUT or int(later.sum()) < MIN_HELD_OUT:
+        return None
+    # from the whole fit's optimum: the early samples' is near it (the grid search would find the same basin)
+    early = fit_friction(qd, tau_f, mask=valid & before, **{**kwargs, "model": fit.model, "noise": None,
+                                                             "x0": fit.params.as_vector(),
+                                                             "fixed": model_fixed(fit.model, kwargs.get("fixed"))})
+    if early.params is None or not early.success or early.covariance is None:
+        return None
+    share = round(float(later.sum()) / float(use.sum()), 3)
+    return prediction_check(f"the last {100 * share:.0f} % of its samples",
+                            held_out_residuals(early.params, qd, tau_f, later, smoother, sigma),
+                            held_out_residuals(fit.params, qd, tau_f, later, smoother, sigma),
+                            prediction_variance(model_gradient(early, qd, later, smoother, sigma), early.covariance),
+                            np.flatnonzero(later), share, friction=shown_friction(fit, qd[later]))
