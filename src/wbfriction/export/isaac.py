@@ -41,6 +41,7 @@ from typing import Any
 
 from wbfriction.exceptions import InputError
 from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
+from wbfriction.export.target import ExportReport, ExportTarget
 from wbfriction.logs.tables import write_atomic
 from wbfriction.model.robot import Robot
 
@@ -117,7 +118,25 @@ def write_isaac_yaml(path: str | Path, friction: Mapping[str, FrictionLike],
     Raises:
         what :func:`isaac_actuator_dict` raises; InputError: an output folder that does not exist.
     """
-    joints = joint_exports(friction, armature, robot)
+    write_actuators(path, joint_exports(friction, armature, robot))
+
+
+def write_actuators(path: str | Path, joints: Mapping[str, JointExport]) -> None:
+    """:func:`write_isaac_yaml` of the joints' simulator parameters (joint -> :class:`JointExport`,
+    :func:`~wbfriction.export.mapping.joint_exports`, in the order written): same errors."""
     notes = {re.escape(name): note for name, exp in joints.items() if (note := status_note(exp)) is not None}
     text = isaac_yaml(_actuator_dict(joints), HEADER, notes)
     write_atomic(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+class IsaacTarget(ExportTarget):
+    """``.yaml``, ``.yml``: an Isaac Lab actuator dictionary (module docstring)."""
+
+    name = "isaac"
+    suffixes = (".yaml", ".yml")
+    description = "Isaac Lab actuators"
+
+    def write(self, path: Path, robot: Robot, joints: Mapping[str, JointExport]) -> ExportReport:
+        """:func:`write_actuators` (``robot`` unused: ``joints`` are already its actuated joints)."""
+        write_actuators(path, joints)
+        return self.report(path, joints)

@@ -70,6 +70,7 @@ from lxml import etree as ET
 
 from wbfriction.exceptions import ModelError
 from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
+from wbfriction.export.target import ExportReport, ExportTarget
 from wbfriction.export.urdf import identified_parameters
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.tables import write_atomic
@@ -346,8 +347,14 @@ def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | P
     Raises:
         what :func:`mujoco_spec` raises; InputError: an output folder that does not exist.
     """
+    return write_model(path, robot, joint_exports(friction, armature, robot), inertias)
+
+
+def write_model(path: str | Path, robot: Robot, joints: Mapping[str, JointExport],
+                inertias: pin.Model | None = None) -> mujoco.MjModel:
+    """:func:`write_mjcf` of the joints' simulator parameters (joint -> :class:`JointExport`,
+    :func:`~wbfriction.export.mapping.joint_exports`): same returns and errors."""
     import mujoco
-    joints = joint_exports(friction, armature, robot)
     spec = _spec(robot, joints, inertias)
     model = compile_spec(spec, robot.urdf)
     notes = {name: note for name, exp in joints.items() if (note := status_note(exp)) is not None}
@@ -357,3 +364,16 @@ def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | P
             != list(robot.actuated):  # bodies reordered in the file: its model, in its order
         model = compile_spec(mujoco.MjSpec.from_file(str(path)), path)
     return model
+
+
+class MjcfTarget(ExportTarget):
+    """``.xml``, ``.mjcf``: a MuJoCo model of the robot with the friction and armature (module docstring)."""
+
+    name = "mjcf"
+    suffixes = (".xml", ".mjcf")
+    description = "MuJoCo MJCF"
+
+    def write(self, path: Path, robot: Robot, joints: Mapping[str, JointExport]) -> ExportReport:
+        """:func:`write_model` (the URDF's inertias)."""
+        write_model(path, robot, joints)
+        return self.report(path, joints)

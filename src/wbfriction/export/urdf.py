@@ -23,11 +23,15 @@ from lxml import etree as ET
 
 from wbfriction.exceptions import InputError, OutputError
 from wbfriction.export.mapping import NOTE_PREFIX, FrictionLike, JointExport, joint_exports, status_note
+from wbfriction.export.target import ExportReport, ExportTarget
 from wbfriction.inertia.regressor import body_parameters
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.tables import write_atomic
 from wbfriction.model.mjspec import read_urdf
 from wbfriction.model.robot import Robot
+
+REQUIREMENT = "a .urdf export (the robot's URDF with <dynamics>)"
+"""What a robot loaded from an MJCF is refused for (:meth:`Robot.require_urdf`)."""
 
 
 def identified_parameters(robot: Robot, inertias: pin.Model) -> np.ndarray:
@@ -98,8 +102,15 @@ def write_friction_urdf(robot: Robot, friction: Mapping[str, FrictionLike], path
         OutputError: the system refused the write (a full disk, ``ulimit -f``:
             :func:`~wbfriction.logs.tables.write_atomic`), nothing written.
     """
-    robot.require_urdf("a .urdf export (the robot's URDF with <dynamics>)")
-    joints = joint_exports(friction, armature, robot)
+    robot.require_urdf(REQUIREMENT)
+    return write_dynamics(path, robot, joint_exports(friction, armature, robot), inertias)
+
+
+def write_dynamics(path: str | Path, robot: Robot, joints: Mapping[str, JointExport],
+                   inertias: pin.Model | None = None) -> tuple[str, ...]:
+    """:func:`write_friction_urdf` of the joints' simulator parameters (joint -> :class:`JointExport`,
+    :func:`~wbfriction.export.mapping.joint_exports`): same returns and errors."""
+    robot.require_urdf(REQUIREMENT)
     pi = None if inertias is None else identified_parameters(robot, inertias)
     moved: tuple[str, ...] = ()
 
@@ -118,3 +129,25 @@ def write_friction_urdf(robot: Robot, friction: Mapping[str, FrictionLike], path
 
     write_atomic(path, write)
     return moved
+
+
+class UrdfTarget(ExportTarget):
+    """``.urdf``: the robot's URDF with ``<dynamics damping friction>`` (module docstring); a robot loaded from an
+    MJCF is refused (:meth:`check`)."""
+
+    name = "urdf"
+    suffixes = (".urdf",)
+    description = "URDF <dynamics>"
+
+    def check(self, robot: Robot) -> None:
+        """Refuse a robot loaded from an MJCF (it has no URDF to rewrite).
+
+        Raises:
+            InputError: a robot loaded from an MJCF.
+        """
+        robot.require_urdf(REQUIREMENT)
+
+    def write(self, path: Path, robot: Robot, joints: Mapping[str, JointExport]) -> ExportReport:
+        """:func:`write_dynamics` (the URDF's inertias kept)."""
+        write_dynamics(path, robot, joints)
+        return self.report(path, joints)

@@ -1,0 +1,110 @@
+"""The export targets by file-name suffix: which :class:`~wbfriction.export.target.ExportTarget` writes an output.
+
+The built-in targets are registered here, in the order errors name them: ``.urdf`` (the URDF's ``<dynamics>``,
+:class:`~wbfriction.export.urdf.UrdfTarget`), ``.xml``/``.mjcf`` (a MuJoCo MJCF,
+:class:`~wbfriction.export.mjcf.MjcfTarget`), ``.yaml``/``.yml`` (Isaac Lab actuators,
+:class:`~wbfriction.export.isaac.IsaacTarget`). Another format plugs in with :func:`register_target`
+(:mod:`wbfriction.export.target`'s docstring has an example); :func:`target_for` then picks it for its suffixes,
+in ``wbfriction.pipeline.export_step.export_files`` as for the built-in ones.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from wbfriction.exceptions import InputError
+from wbfriction.export.isaac import IsaacTarget
+from wbfriction.export.mjcf import MjcfTarget
+from wbfriction.export.target import ExportTarget
+from wbfriction.export.urdf import UrdfTarget
+
+TARGETS: dict[str, ExportTarget] = {}
+"""Suffix (lower case, with its dot) -> the target that writes it, in the order registered."""
+
+
+class SuffixTaken(ValueError):
+    """A target registered for a suffix another target writes.
+
+    Attributes:
+        suffix: the suffix, e.g. ``.xml``.
+        target: the name of the target registered.
+        holder: the name of the target that writes it.
+    """
+
+    def __init__(self, suffix: str, target: str, holder: str):
+        self.suffix, self.target, self.holder = suffix, target, holder
+        super().__init__(f"export target '{target}': {suffix} is written by the '{holder}' target")
+
+
+class UnknownExportFormat(InputError):
+    """An output whose suffix no target writes.
+
+    Attributes:
+        path: the output as given.
+        suffix: its suffix, lower case (empty for a name without one).
+        known: the formats known, each as its first suffix and description (``.urdf (URDF <dynamics>)``).
+    """
+
+    def __init__(self, path: str | Path, suffix: str, known: tuple[str, ...]):
+        self.path, self.suffix, self.known = path, suffix, known
+        super().__init__(f"{path}: unknown export format: name it {spoken(known)}")
+
+    def __reduce__(self):  # picklable across worker processes, with its data
+        return (type(self), (self.path, self.suffix, self.known))
+
+
+def spoken(items: tuple[str, ...]) -> str:
+    """``a, b or c``."""
+    return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} or {items[-1]}"
+
+
+def register_target(target: ExportTarget) -> ExportTarget:
+    """Make ``target`` write every output named with one of its :attr:`~ExportTarget.suffixes`; returns it.
+
+    Registering a target of the same name again replaces it (a module reloaded): its suffixes are the new one's.
+
+    Raises:
+        SuffixTaken: a suffix another target (by name) writes; nothing registered.
+        ValueError: a target without suffixes, or a suffix that is not lower case with its dot (``.csv``).
+    """
+    if not target.suffixes:
+        raise ValueError(f"export target '{target.name}': no suffix")
+    for suffix in target.suffixes:
+        if not suffix.startswith(".") or suffix != suffix.lower():
+            raise ValueError(f"export target '{target.name}': suffix {suffix!r} is not lower case with its dot")
+        holder = TARGETS.get(suffix)
+        if holder is not None and holder.name != target.name:
+            raise SuffixTaken(suffix, target.name, holder.name)
+    for suffix in [s for s, held in TARGETS.items() if held.name == target.name]:
+        del TARGETS[suffix]
+    for suffix in target.suffixes:
+        TARGETS[suffix] = target
+    return target
+
+
+def targets() -> tuple[ExportTarget, ...]:
+    """The targets registered, each once, in the order registered."""
+    return tuple({id(t): t for t in TARGETS.values()}.values())
+
+
+def known_formats() -> tuple[str, ...]:
+    """Each target's first suffix and description, in the order registered: ``(".urdf (URDF <dynamics>)", ...)``."""
+    return tuple(f"{t.suffixes[0]} ({t.description})" for t in targets())
+
+
+def target_for(path: str | Path) -> ExportTarget:
+    """The target that writes ``path``, by its suffix (any case).
+
+    Raises:
+        UnknownExportFormat: a suffix no target writes, naming the file and the formats known.
+    """
+    suffix = Path(path).suffix.lower()
+    target = TARGETS.get(suffix)
+    if target is None:
+        raise UnknownExportFormat(path, suffix, known_formats())
+    return target
+
+
+register_target(UrdfTarget())
+register_target(MjcfTarget())
+register_target(IsaacTarget())
