@@ -249,7 +249,7 @@ def test_the_ripples_size_has_the_spread_of_its_repeats():
     """The ripple's size and its standard error (:func:`ripple_size`, the delta method through the coefficients'
     covariance): over 40 noise draws of one joint whose angles span less than a turn, the sizes' spread is within
     35 % of the standard error each draw states (white torque noise, so the Newey-West sum adds little)."""
-    from wbfriction.fit.term_selection import ripple_size
+    from wbfriction.fit.term_design import ripple_size
 
     _, qd, s = trajectory(3, 20.0)
     assert s.q is not None
@@ -411,7 +411,8 @@ def test_a_term_that_takes_the_friction_s_place_is_named():
     is held there; F_c carries the friction without it, so the term takes the friction's place (``displaced_part``
     names the Coulomb part). A regressor independent of the friction's takes nothing (None); nor does a held
     magnitude too small to matter."""
-    from wbfriction.fit.term_selection import displaced_part, nonnegative_solve
+    from wbfriction.fit.term_checks import displaced_part
+    from wbfriction.fit.term_design import nonnegative_solve
 
     rng = np.random.default_rng(0)
     qd = 1.5 * np.sin(np.linspace(0.0, 40.0, 4000))
@@ -448,7 +449,7 @@ def test_a_ripple_in_the_friction_s_place_is_refused_and_a_load_law_is_not():
     """``ripple_in_place``: with the ripple a part of the friction is held at zero and without it not: the ripple
     is refused, naming the part; where the other terms hold it at zero without the ripple (a Coulomb level all
     load), or nothing is held, the ripple is not the cause: None."""
-    from wbfriction.fit.term_selection import ripple_in_place
+    from wbfriction.fit.term_checks import ripple_in_place
 
     def best(terms):
         return 0.1, 3 if "ripple" in terms else 0
@@ -465,7 +466,7 @@ def test_a_ripple_in_the_friction_s_place_is_refused_and_a_load_law_is_not():
 def test_a_term_no_value_of_which_is_determined_is_refused():
     """``undetermined_term``: a term whose coefficient's standard error is above half its value (a regressor of noise,
     whose coefficient is noise) is named with its value and error; a term the data determine is not."""
-    from wbfriction.fit.term_selection import undetermined_term
+    from wbfriction.fit.term_checks import undetermined_term
 
     rng = np.random.default_rng(1)
     qd = 1.5 * np.sin(np.linspace(0.0, 40.0, 2000))
@@ -484,7 +485,7 @@ def test_a_term_no_value_of_which_is_determined_is_refused():
 def test_a_coulomb_level_held_at_zero_holds_its_stribeck_part():
     """(3.5) with F_c held at zero by the terms holds F_cS = F_c S with it: a Stribeck rise with no Coulomb level is
     no (3.5) (S infinite), which ``with_coefficients`` would turn into S = 0, dropping the rise silently."""
-    from wbfriction.fit.term_selection import nonnegative_solve
+    from wbfriction.fit.term_design import nonnegative_solve
 
     params = FrictionParams(F_v=0.2, F_c=0.3, S=1.0, v_s=0.3, tau_os=0.0, a=50.0)
     qd = 1.5 * np.sin(np.linspace(0.0, 40.0, 4000))

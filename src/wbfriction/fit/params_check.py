@@ -32,7 +32,7 @@ import math
 from dataclasses import fields
 
 from wbfriction.fit.ranges import check_span
-from wbfriction.fit.term_selection import RATE_SPAN
+from wbfriction.fit.temperature_law import RATE_SPAN
 from wbfriction.fit.terms import TERM_COEFFICIENTS, TermFit
 from wbfriction.friction.models import ModelParams
 

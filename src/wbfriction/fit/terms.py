@@ -19,10 +19,10 @@ weighted least-squares solve fits them together (``term_selection.fit_terms``). 
 * ``ripple``: a torque periodic in the joint's angle ``q`` [rad], ``sum_h s_h sin(h q) + c_h cos(h q)`` for
   ``h = 1..H`` (``H`` chosen on held-out samples, at most :attr:`TermOptions.max_harmonic`): torque sensing or
   transmission ripple, neither friction nor inertia. It is tried only where, fitted on the samples moving one way,
-  it predicts those moving the other (``term_selection.direction_gain``): a torque of the angle does not care which
+  it predicts those moving the other (``term_checks.direction_gain``): a torque of the angle does not care which
   way the joint moves, a model error that follows the trajectory does (on the KUKA LWR4+, the wrist's ripple carries
   over by 44-50 %, the upper arm's "ripple" makes the other direction worse by 10-35 %); and with no more harmonics than
-  its angles tell apart (``term_selection.MAX_CONDITION``). It is not dissipative: it is reported apart, left out of the
+  its angles tell apart (``term_checks.MAX_CONDITION``). It is not dissipative: it is reported apart, left out of the
   energy check (eq. 7.9) and of the exports; predictions include it, at the angle reduced modulo 2π into the turn
   around the angles it was fitted on (a continuous joint logged on another branch is at the same angle,
   :func:`ripple_angle`), within those angles (outside, it is held at its value at the nearest fitted angle: a
@@ -228,9 +228,9 @@ class TermFit:
         held_out_rms: the held-out RMS [N·m] of the velocity model alone and with the terms kept.
         check: the kept terms refitted on the other route's estimate (``term_selection.refit_terms``), or None.
         later: per kept term, how far its torque fitted on the earlier samples departs on the later ones from theirs
-            and how far the noise and its standard errors allow [N·m] (``term_selection.later_check``); empty: not
+            and how far the noise and its standard errors allow [N·m] (``term_checks.later_check``); empty: not
             checked.
-        at_bound: the velocity model's magnitudes held at zero in the refit (``term_selection.NONNEGATIVE``): with
+        at_bound: the velocity model's magnitudes held at zero in the refit (``term_design.NONNEGATIVE``): with
             the terms, the data would put them below it (standard error 0: held, not fitted).
         covariance: the coefficients' covariance, the velocity model's (:func:`velocity_basis` order) then the
             terms', or None (read from a parameters file, which keeps the standard errors only).
@@ -265,13 +265,13 @@ class TermFit:
         and why.
 
         * ``routes disagree``: the other route's estimate gives one of its coefficients (the ripple: its size,
-          ``term_selection.ripple_size``) more than :data:`~wbfriction.fit.status.ROUTE_Z` combined standard
+          ``term_design.ripple_size``) more than :data:`~wbfriction.fit.status.ROUTE_Z` combined standard
           errors and :data:`~wbfriction.fit.status.ROUTE_REL` away (:attr:`check`);
         * ``weak``: a coefficient's (the ripple's size's) standard error above
           :data:`~wbfriction.fit.status.TERM_WEAK` of its value;
         * ``does not predict`` (issue 52): fitted on the earlier samples, its torque departs on the later ones from
           theirs beyond what the noise and its standard errors allow (:attr:`later`,
-          ``term_selection.later_check``);
+          ``term_checks.later_check``);
         * ``ok``: neither.
         """
         out: dict[Term, FitVerdict] = {}
@@ -295,7 +295,7 @@ class TermFit:
 
     def _read(self, term: Term, c: Mapping[str, float], se: Mapping[str, float]) -> dict[str, tuple[float, float]]:
         """The values a status judges of ``term`` (name -> value, standard error): its coefficients, the ripple's
-        size (``term_selection.ripple_size``)."""
+        size (``term_design.ripple_size``)."""
         names = TERM_COEFFICIENTS[term] + (("rate_T",) if term == "temperature" else ())
         return {n: (c[n], se.get(n, math.inf)) for n in names if n in c}
 
@@ -474,7 +474,7 @@ class TermFit:
 
 TERM_COEFFICIENTS: dict[Term, tuple[str, ...]] = {"load": ("F_L",), "direction": ("dF_v",),
                                                    "temperature": ("F_cT", "F_vT"), "ripple": ("ripple_rms",)}
-"""Each term's values a status judges: its coefficients; for the ripple, its size (``term_selection.ripple_size``; its
+"""Each term's values a status judges: its coefficients; for the ripple, its size (``term_design.ripple_size``; its
 coefficients are ``ripple_sin<h>``, ``ripple_cos<h>`` for ``h = 1..H``)."""
 
 
