@@ -24,10 +24,12 @@ from wbfriction.inertia.consistency import (
     nearest_consistent,
     prior_model,
 )
-from wbfriction.inertia.identification import identify_inertia, log_samples, residual_variance
+from wbfriction.inertia.identification import identify_inertia
 from wbfriction.inertia.least_squares import CompressedLeastSquares, base_parameters
 from wbfriction.inertia.options import InertialOptions
+from wbfriction.inertia.prior import residual_variance
 from wbfriction.inertia.regressor import act_matrix, body_parameters, stance_regressor
+from wbfriction.inertia.samples import log_samples
 from wbfriction.inertia.sensitivity import scaled_robot
 from wbfriction.model.stance import stance_model
 from wbfriction.signals.options import FilterOptions

@@ -28,13 +28,16 @@ from scipy.optimize import lsq_linear
 
 from wbfriction.friction.estimate import resolve_differentiation
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.inertia import consistency, identification, least_squares
+from wbfriction.inertia import best_friction, consistency, identification, least_squares
 from wbfriction.inertia.consistency import RegularisedProblem, prior_model
-from wbfriction.inertia.identification import identify_inertia, log_samples
+from wbfriction.inertia.identification import identify_inertia
 from wbfriction.inertia.least_squares import CompressedLeastSquares
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import stance_regressor
+from wbfriction.inertia.rows import rest_names, sample_rows
+from wbfriction.inertia.samples import log_samples
 from wbfriction.inertia.sensitivity import scaled_robot
+from wbfriction.inertia.system import compressed_system
 
 TOLERANCE = 1e-7
 
@@ -42,14 +45,14 @@ TOLERANCE = 1e-7
 def previous_system(robot, samples, which, options, progress=None) -> CompressedLeastSquares:
     """The previous compression: every row over every column, per stance, block by block."""
     nb = robot.model.njoints - 1
-    n_rest = len(identification._rest_names(robot, options))
+    n_rest = len(rest_names(robot, options))
     p = 10 * nb + n_rest
     systems = {c: CompressedLeastSquares(p) for c in range(len(robot.contact_frames))}
     for part in samples.parts:
         for c, system in systems.items():
             r = np.flatnonzero(getattr(part, which) & (part.stance == c))
             for start in range(0, r.size, options.block):
-                Y, C, b = identification._rows(robot, part.kin, r[start:start + options.block], c, options)
+                Y, C, b = sample_rows(robot, part.kin, r[start:start + options.block], c, options)
                 system.add(np.concatenate([Y, C], axis=2).reshape(-1, p), b.ravel())
     total = CompressedLeastSquares(p)
     for c, system in systems.items():
@@ -102,11 +105,11 @@ def previous_best_rest(self, pi: np.ndarray) -> np.ndarray:
 
 
 def _previous_routes(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(identification, "_system", previous_system)
+    monkeypatch.setattr(identification, "compressed_system", previous_system)
     monkeypatch.setattr(least_squares.CompressedLeastSquares, "residual", previous_residual)
     monkeypatch.setattr(consistency.RegularisedProblem, "linear", previous_linear)
     monkeypatch.setattr(consistency.RegularisedProblem, "compressed", previous_compressed)
-    monkeypatch.setattr(identification._BestRest, "__call__", previous_best_rest)
+    monkeypatch.setattr(best_friction.BestRest, "__call__", previous_best_rest)
 
 
 @pytest.fixture(scope="module")
@@ -131,7 +134,7 @@ def test_joint_compression_has_the_whole_rows_normal_equations(walk_case):
     zero."""
     robot, log, estimate, options = walk_case
     samples = log_samples(robot, log, estimate, options)
-    new = identification._system(robot, samples, "train", options)
+    new = compressed_system(robot, samples, "train", options)
     old = previous_system(robot, samples, "train", options)
     assert new.rows == old.rows > 0
     _close(new.R.T @ new.R, old.R.T @ old.R, 1e-11)
@@ -142,7 +145,7 @@ def test_joint_compression_has_the_whole_rows_normal_equations(walk_case):
     part = samples.parts[0]
     for c in range(len(robot.contact_frames)):
         rows = np.flatnonzero(part.train & (part.stance == c))[:50]
-        Y = identification._rows(robot, part.kin, rows, c, options)[0]
+        Y = sample_rows(robot, part.kin, rows, c, options)[0]
         pattern = stance_regressor(robot, c).pattern[robot.tc_index]
         assert not np.any(Y[:, ~pattern])
 

@@ -12,7 +12,7 @@
 Each pass is kept, so that a user sees both routes' friction side by side and how the
 identification moved between passes. What does not depend on the model or on ``v_s`` is done once:
 the choice of differentiation (``diff = "auto"``) and the log's kinematics and split of its samples
-(:func:`~wbfriction.inertia.identification.log_samples`). An armature identified in step 2 is the
+(:func:`~wbfriction.inertia.samples.log_samples`). An armature identified in step 2 is the
 identified model's (``model.armature``): step 3's acceleration route uses it.
 """
 
@@ -30,8 +30,9 @@ from wbfriction.fit.result import FitResult, fitted_offsets
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log, resolve_differentiation
 from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.inertia.identification import InertialIdentification, identify_inertia, log_samples
+from wbfriction.inertia.identification import InertialIdentification, identify_inertia
 from wbfriction.inertia.options import InertialOptions
+from wbfriction.inertia.samples import log_samples
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
@@ -109,7 +110,7 @@ def identify(robot: Robot, log: Log, estimate_options: EstimateOptions = Estimat
         robot: the given model (its URDF's inertias).
         log: a walking log with single-support stretches.
         estimate_options: the acceleration route's options; the identification differentiates alike.
-        options: the identification's (:class:`~wbfriction.inertia.identification.InertialOptions`; its
+        options: the identification's (:class:`~wbfriction.inertia.options.InertialOptions`; its
             ``stribeck_velocity`` is set here).
         stribeck: ``"auto"``: ``v_s`` from the acceleration route, ``passes`` times; a number
             [rad/s]: that ``v_s``, one pass; None: no Stribeck term, one pass.

@@ -28,7 +28,7 @@ class PriorUncertainty:
             relative to its largest principal moment (at least that of a 1 cm sphere of its mass).
         armature: of each joint's armature, relative to the larger of its given armature and the
             largest diagonal entry of the given model's joint-space inertia at the reference
-            configuration (:func:`wbfriction.inertia.identification.armature_scale`).
+            configuration (:func:`wbfriction.inertia.prior.armature_scale`).
         friction: of each joint's Coulomb, Stribeck and offset friction, relative to the RMS of its
             torque in the log [N·m]; of its viscous friction, that over its velocity limit [rad/s].
     """
@@ -62,7 +62,7 @@ class InertialOptions:
             regression to compare the models' torque predictions.
         prior: weight of the prior toward the given model, in units of the data's residual
             variance (:mod:`wbfriction.inertia.identification`); None: chosen from
-            :data:`~wbfriction.inertia.identification.PRIOR_GRID` by validation.
+            :data:`~wbfriction.inertia.prior.PRIOR_GRID` by validation.
         uncertainty: the prior's standard deviations
             (:class:`PriorUncertainty`).
         armature: ``"known"`` (the model's, the robot's ``[armature]``), ``"identify"`` (one
