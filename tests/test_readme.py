@@ -1,6 +1,20 @@
-"""The README's commands run as written (issue 24, item 5): every line of its "Commands" block, in order, from a
-copy of the checkout's layout (``examples/`` beside the outputs), each exiting 0 and writing what its ``-o``
-names, no two lines writing the same file; then its Python API block."""
+"""The README's and the manual's commands run as written (issue 24, item 5; issue 54, items 4 and 5).
+
+Every ``bash`` and ``python`` block of the README, of the manual's Getting started, tutorials and how-to guides
+(:data:`PAGES`) runs as written, in the order of its page, from a fresh folder per page that holds ``examples/``
+beside the outputs (a copy of the checkout's layout): each command line exits 0 and writes what its ``-o`` names,
+no two lines of a page write the same file, and a command waits only for the earlier ones whose outputs it reads
+(two run at a time: the machine's two cores). A ``python`` block runs once everything before it has, and whatever
+follows waits for it. Marks, an HTML comment on the line before a fenced block:
+
+* ``<!-- not run: REASON -->``: the block is not run (an install, ``mkdocs serve``);
+* ``<!-- write: FILE -->``: the block's text is written to ``FILE`` in the page's folder first (a TOML a command
+  reads), so that what the page shows is what runs.
+
+The manual's other pages (reference, explanation, measurements: the full-size commands that measured its numbers,
+minutes to hours each) are not run here. A page whose commands fetch a real dataset (``wbfriction dataset``) reads
+it from ``WBFRICTION_DATA`` (else ``../shared/real-data``) and is skipped without it.
+"""
 
 from __future__ import annotations
 
@@ -10,6 +24,7 @@ import shlex
 import subprocess
 import sys
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -17,60 +32,83 @@ import pytest
 from helpers import REAL_DATA
 
 REPO = Path(__file__).resolve().parents[1]
+DOCS = REPO / "docs"
+
+PAGES = ["README.md", "docs/index.md", "docs/getting-started.md",
+         *sorted(str(p.relative_to(REPO)) for p in (DOCS / "tutorials").glob("*.md")),
+         *sorted(str(p.relative_to(REPO)) for p in (DOCS / "how-to").glob("*.md"))]
+"""The pages whose blocks run, relative to the checkout."""
+
+QUICK: set[str] = set()
+"""Pages that run in about 20 s or less, not marked ``slow``: none (the README's tour alone simulates, estimates, fits
+and reports a walk: about a minute)."""
+
+FENCE = re.compile(r"(?:^<!-- (not run|write): *(.*?) -->\n)?^```(\w*)[^\n]*\n(.*?)^```", re.S | re.M)
+"""A fenced block and the mark on the line before it, if any."""
 
 
-def readme_commands() -> list[str]:
-    """The lines of the README's "Commands" bash block, comments dropped."""
-    text = (REPO / "README.md").read_text()
-    block = re.search(r"## Commands\n.*?```bash\n(.*?)```", text, re.S)
-    assert block, "no bash block under '## Commands'"
-    lines = [line.split("  #")[0].strip() for line in block.group(1).splitlines()]
+@dataclass(frozen=True)
+class Step:
+    """One thing a page runs: a ``command`` line, a ``python`` block, or a ``file`` it writes first."""
+
+    kind: str
+    text: str
+    name: str = ""
+
+
+def command_lines(block: str) -> list[str]:
+    """The lines of a bash block, comments dropped (``  #`` starts a line's comment)."""
+    lines = [line.split("  #")[0].strip() for line in block.splitlines()]
     return [line for line in lines if line and not line.startswith("#")]
 
 
-def readme_python() -> str:
-    """The README's Python block under "## The library"."""
-    text = (REPO / "README.md").read_text()
-    block = re.search(r"## The library\n.*?```python\n(.*?)```", text, re.S)
-    assert block, "no python block under '## The library'"
-    return block.group(1)
+def page_steps(page: str) -> list[Step]:
+    """What a page runs, in its order."""
+    steps: list[Step] = []
+    for mark, arg, lang, body in FENCE.findall((REPO / page).read_text()):
+        if mark == "not run":
+            assert arg.strip(), f"{page}: a '<!-- not run: -->' mark gives its reason"
+        elif mark == "write":
+            steps.append(Step("file", body, arg.strip()))
+        elif lang == "bash":
+            steps += [Step("command", line) for line in command_lines(body)]
+        elif lang == "python":
+            steps.append(Step("python", body))
+    return steps
+
+
+def page_commands(page: str) -> list[str]:
+    return [s.text for s in page_steps(page) if s.kind == "command"]
 
 
 def outputs(command: str) -> list[str]:
-    """What a command line says it writes: the values of its ``-o`` options and of ``--json``/``--write``."""
+    """What a command line says it writes: the values of its ``-o`` options and of ``--json``/``--write``/
+    ``--config-output``/``--table``."""
     words = shlex.split(command)
     return [words[i + 1] for i, w in enumerate(words[:-1]) if w in ("-o", "--output", "--output-dir", "--json",
-                                                                     "--write")]
+                                                                     "--write", "--config-output", "--table")]
 
 
-def test_every_output_is_its_own():
-    written = [o for c in readme_commands() for o in outputs(c)]
-    assert written and len(written) == len(set(written)), sorted(w for w in written if written.count(w) > 1)
+def step_outputs(step: Step) -> list[str]:
+    return [step.name] if step.kind == "file" else outputs(step.text) if step.kind == "command" else []
 
 
-def needs(commands: list[str]) -> list[set[int]]:
-    """For each command, the earlier ones it reads the outputs of: an argument that is an earlier command's
-    output, or a path inside one (``fleet/manifest.csv`` inside ``fleet``). The README's order is kept
-    between a command and what it reads; the others may run side by side."""
-    made = [outputs(c) for c in commands]
-    deps = []
-    for i, command in enumerate(commands):
-        words = shlex.split(command)
+def needs(steps: list[Step]) -> list[set[int]]:
+    """For each step, the earlier ones it waits for: a command whose argument is an earlier step's output, or a
+    path inside one (``fleet/manifest.csv`` inside ``fleet``); every earlier step for a ``python`` block, and a
+    ``python`` block for every later step. The page's order is kept between a step and what it reads; the others
+    may run side by side."""
+    made = [step_outputs(s) for s in steps]
+    deps: list[set[int]] = []
+    for i, step in enumerate(steps):
+        if step.kind == "python":
+            deps.append(set(range(i)))
+            continue
+        words = shlex.split(step.text) if step.kind == "command" else []
         deps.append({j for j in range(i) for out in made[j]
-                     if any(w == out or w.startswith(out.rstrip("/") + "/") for w in words)})
+                     if any(w == out or w.startswith(out.rstrip("/") + "/") for w in words)}
+                    | {j for j in range(i) if steps[j].kind == "python"})
     return deps
-
-
-def test_a_command_waits_for_what_it_reads():
-    commands = readme_commands()
-    deps = needs(commands)
-    index = {c.split(" -o ")[0]: i for i, c in enumerate(commands)}
-    fit = index["wbfriction fit walk_friction.parquet"]
-    assert deps[fit] == {index["wbfriction estimate walk.parquet --robot talos"]}
-    predict = next(i for i, c in enumerate(commands) if c.startswith("wbfriction predict"))
-    assert {commands[j].split()[-1] for j in deps[predict]} == {"noisy_friction.parquet", "walk_params.json"}
-    batch = next(i for i, c in enumerate(commands) if c.startswith("wbfriction batch"))
-    assert [commands[j] for j in deps[batch]] == ["python examples/fleet_trends.py --output fleet"]
 
 
 EXPECTED = {
@@ -81,46 +119,130 @@ EXPECTED = {
     ],
 }
 """What a command must print (regular expressions, each found in its output, multi-line): the examples the
-README runs are checked here, once (``tests/test_examples.py`` runs the others)."""
+pages run are checked here, once (``tests/test_examples.py`` runs the others)."""
+
+PRINTS = {
+    "docs/how-to/library.md": [r"leg_right_4_joint: F_c"],  # the API block's fits of the walk
+}
+"""What a page's ``python`` blocks must print, together (regular expressions)."""
+
+WRITES = {
+    "docs/how-to/library.md": ["api_params.json"],
+}
+"""Files a page's ``python`` blocks must write."""
 
 
-def _run(command: str, cwd: Path, env: dict[str, str]) -> subprocess.CompletedProcess:
-    bin_dir = str(Path(sys.executable).parent)
-    argv = shlex.split(command)
-    argv[0] = os.path.join(bin_dir, "wbfriction") if argv[0] == "wbfriction" else sys.executable
+def test_the_pages_are_found():
+    assert {"docs/tutorials/simulated-walk.md", "docs/tutorials/real-arm.md", "docs/tutorials/fleet.md",
+            "docs/how-to/library.md"} <= set(PAGES)
+    for page in PAGES:
+        assert (REPO / page).is_file(), page
+
+
+@pytest.mark.parametrize("page", PAGES)
+def test_every_output_is_its_own(page):
+    written = [o for s in page_steps(page) for o in step_outputs(s)]
+    assert len(written) == len(set(written)), sorted(w for w in written if written.count(w) > 1)
+
+
+@pytest.mark.parametrize("page", PAGES)
+def test_a_page_runs_only_what_it_can(page):
+    """Its command lines are ``wbfriction`` or ``python`` (run without a shell: no variables, no pipes)."""
+    for command in page_commands(page):
+        assert command.split()[0] in ("wbfriction", "python"), f"{page}: {command}"
+        assert not set("$|;&<>`") & set(command.replace("->", "")), f"{page}: a shell's syntax in {command}"
+
+
+def test_a_command_waits_for_what_it_reads():
+    steps = page_steps("docs/tutorials/simulated-walk.md")
+    deps = needs(steps)
+    index = {s.text.split(" -o ")[0]: i for i, s in enumerate(steps)}
+    fit = index["wbfriction fit walk_friction.parquet"]
+    assert deps[fit] == {index["wbfriction estimate walk.parquet --robot talos"]}
+    predict = next(i for i, s in enumerate(steps) if s.text.startswith("wbfriction predict"))
+    assert {steps[j].text.split()[-1] for j in deps[predict]} == {"turn_friction.parquet", "walk_params.json"}
+    steps = page_steps("docs/tutorials/fleet.md")
+    batch = next(i for i, s in enumerate(steps) if s.text.startswith("wbfriction batch"))
+    assert [steps[j].text for j in needs(steps)[batch]] == ["python examples/fleet_trends.py --output fleet"]
+    steps = page_steps("docs/how-to/terms.md")  # a TOML the page writes, then the command that reads it
+    simulate = next(i for i, s in enumerate(steps) if s.text.startswith("wbfriction simulate"))
+    assert [steps[j].name for j in needs(steps)[simulate]] == ["knee_terms.toml"]
+    steps = page_steps("docs/how-to/library.md")  # the API block after the walk it reads
+    assert [s.kind for s in steps] == ["command", "python"] and needs(steps)[1] == {0}
+
+
+def test_the_marks_are_read():
+    text = ("```bash\nwbfriction a -o x  # note\n```\n<!-- not run: an install -->\n```bash\npip install .\n```\n"
+            "<!-- write: f.toml -->\n```toml\nk = 1\n```\n```text\nnot run\n```\n```python\nprint(1)\n```\n")
+    found = FENCE.findall(text)
+    assert [(m, a, lang) for m, a, lang, _ in found] == [("", "", "bash"), ("not run", "an install", "bash"),
+                                                         ("write", "f.toml", "toml"), ("", "", "text"),
+                                                         ("", "", "python")]
+
+
+def _run(step: Step, cwd: Path, env: dict[str, str]) -> subprocess.CompletedProcess:
+    if step.kind == "file":
+        (cwd / step.name).write_text(step.text)
+        return subprocess.CompletedProcess([], 0, "", "")
+    if step.kind == "python":
+        argv = [sys.executable, "-c", step.text]
+    else:
+        argv = shlex.split(step.text)
+        argv[0] = os.path.join(str(Path(sys.executable).parent), "wbfriction") if argv[0] == "wbfriction" \
+            else sys.executable
     return subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True, timeout=900)
 
 
-@pytest.mark.slow
-def test_the_readme_commands_run_as_written(tmp_path):
-    """Each command once what it reads is written, two at a time (the machine's two cores)."""
-    (tmp_path / "examples").symlink_to(REPO / "examples")
+def run_page(page: str, folder: Path) -> None:
+    """Every step of ``page`` in ``folder``, each once what it reads is written, two at a time."""
+    (folder / "examples").symlink_to(REPO / "examples")
     bin_dir = str(Path(sys.executable).parent)
     env = dict(os.environ, PATH=bin_dir + os.pathsep + os.environ.get("PATH", ""), MPLBACKEND="Agg")
     if REAL_DATA.is_dir():  # 'wbfriction dataset' offline: the local copy, checked against the same SHA-256
         env.setdefault("WBFRICTION_DATA", str(REAL_DATA))
-    commands = readme_commands()
-    assert all(c.split()[0] in ("wbfriction", "python") for c in commands)
-    deps = needs(commands)
+    steps = page_steps(page)
+    deps = needs(steps)
     done: set[int] = set()
+    printed = ""
     with ThreadPoolExecutor(2) as pool:
         running: dict[Future, int] = {}
-        while len(done) < len(commands):
-            for i in range(len(commands)):
+        while len(done) < len(steps):
+            for i in range(len(steps)):
                 if i not in done and i not in running.values() and deps[i] <= done and len(running) < 2:
-                    running[pool.submit(_run, commands[i], tmp_path, env)] = i
+                    running[pool.submit(_run, steps[i], folder, env)] = i
             finished, _ = wait(running, return_when=FIRST_COMPLETED)
             for future in finished:
                 i = running.pop(future)
-                command, res = commands[i], future.result()
-                assert res.returncode == 0, f"{command}\n{res.stderr[-2000:]}"
-                for out in outputs(command):
-                    assert (tmp_path / out).exists(), f"{command}: wrote no {out}"
-                for pattern in EXPECTED.get(command, []):
-                    assert re.search(pattern, res.stdout, re.M), f"{command}: {pattern!r} not in\n{res.stdout}"
+                step, res = steps[i], future.result()
+                what = step.text if step.kind == "command" else f"{step.kind} block {i}"
+                assert res.returncode == 0, f"{page}: {what}\n{res.stderr[-2000:]}"
+                for out in step_outputs(step):
+                    assert (folder / out).exists(), f"{page}: {what}: wrote no {out}"
+                for pattern in EXPECTED.get(step.text, []):
+                    assert re.search(pattern, res.stdout, re.M), f"{what}: {pattern!r} not in\n{res.stdout}"
+                if step.kind == "python":
+                    printed += res.stdout
                 done.add(i)
-    # then the Python API block, in the same folder (it reads walk.parquet)
-    res = subprocess.run([sys.executable, "-c", readme_python()], cwd=tmp_path, env=env, capture_output=True,
-                         text=True, timeout=900)
-    assert res.returncode == 0, res.stderr[-2000:]
-    assert "leg_right_4_joint: F_c" in res.stdout and (tmp_path / "api_params.json").exists()
+    for pattern in PRINTS.get(page, []):
+        assert re.search(pattern, printed, re.M), f"{page}: {pattern!r} not in\n{printed}"
+    for name in WRITES.get(page, []):
+        assert (folder / name).exists(), f"{page}: its python blocks wrote no {name}"
+
+
+def _params() -> list:
+    out = []
+    for page in PAGES:
+        commands = page_commands(page)
+        marks = [] if page in QUICK else [pytest.mark.slow]
+        if any(c.startswith("wbfriction dataset") for c in commands):
+            marks.append(pytest.mark.skipif(not REAL_DATA.is_dir(), reason=f"{page} reads the real datasets: "
+                                            f"not at {REAL_DATA} (set WBFRICTION_DATA)"))
+        out.append(pytest.param(page, marks=marks, id=page))
+    return out
+
+
+@pytest.mark.parametrize("page", _params())
+def test_the_page_runs_as_written(page, tmp_path):
+    if not page_steps(page):
+        pytest.skip(f"{page} runs nothing")
+    run_page(page, tmp_path)
