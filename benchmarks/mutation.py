@@ -105,7 +105,7 @@ def prepare(copy: Path, modules: list[str]) -> None:
         "only_mutate": [f"src/wbfriction/{m}" for m in modules],
         "pytest_add_cli_args_test_selection": tests,
         "pytest_add_cli_args": ["-p", "no:cacheprovider", "-m", "not slow", *deselect],
-        "also_copy": ["examples", "README.md"],
+        "also_copy": ["examples", "README.md", "docs"],  # the manual: the file map (test_layout), its pages
     }
     lines = ["", "[tool.mutmut]"] + [f"{k} = {json.dumps(v)}" for k, v in section.items()]
     with (copy / "pyproject.toml").open("a", encoding="utf-8") as f:
