@@ -1,6 +1,7 @@
 """Griffe extensions for the API reference: the package read as it is written, src/ not edited for the manual.
 
-:class:`LazyStubExports`: a package whose names are loaded on first use exports what its stub re-exports.
+:class:`LazyStubExports`: a package whose names are loaded on first use exports what its stub re-exports (or, for a
+package with a module ``__getattr__``, what it imports for type checkers).
 ``wbfriction`` and its subpackages bind ``__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__,
 __file__)``: the names a user imports are those of the ``__init__.pyi`` stub beside (``from .x import Y as Y``), which
 griffe merges into the package but cannot read ``__all__`` from (a call's result). Without ``__all__`` those
@@ -30,11 +31,13 @@ ITEM = re.compile(r"^[\w.*\[\], |]+(\s*\([^)]*\))?:(\s|$)")
 
 
 def _lazy(module: griffe.Module) -> bool:
-    """Whether the package's ``__init__.py`` loads its names from its stub."""
+    """Whether the package's ``__init__.py`` loads its names on first use: from its stub (``lazy_loader``), or
+    through a module ``__getattr__`` over names imported for type checkers."""
     init = module.filepath
     if not isinstance(init, Path) or init.suffix != ".py":
         return False
-    return "lazy_loader.attach_stub" in init.read_text(encoding="utf-8")
+    text = init.read_text(encoding="utf-8")
+    return "lazy_loader.attach_stub" in text or "\ndef __getattr__(" in text
 
 
 class LazyStubExports(griffe.Extension):
