@@ -4,7 +4,7 @@ An identification fits the training samples; on a log the given model already ex
 is noise, and it may predict new data worse than the given model (on a walk simulated with the exact
 model, 9 of 12 leg joints were predicted worse on held-out data, and principal moments moved by -100 %
 and +164 %). So the identified parameters are kept only where they predict the held-out samples (the
-end of the log, never used to identify: :attr:`~wbfriction.inertia.identification.InertialOptions.holdout`)
+end of the log, never used to identify: :attr:`~wbfriction.inertia.options.InertialOptions.holdout`)
 better than the given model with its best friction; the rest stays as given.
 
 **Per limb, not per body.** The unit of the decision is a *limb*: a maximal unbranched chain of bodies
@@ -236,86 +236,159 @@ def validate_groups(groups: Sequence[BodyGroup], body_names: Sequence[str], join
     """
     measured = np.asarray(measured, dtype=float)
     G, N = len(groups), measured.shape[0]
-    cache: dict[tuple[bool, ...], np.ndarray] = {}
-    preds: dict[tuple[bool, ...], np.ndarray] = {}
-
-    def ss(mask: np.ndarray) -> np.ndarray:
-        key = tuple(bool(x) for x in mask)
-        if key not in cache:
-            preds[key] = np.asarray(predict(np.array(key, dtype=bool)), dtype=float)
-            cache[key] = np.sum((preds[key] - measured) ** 2, axis=0)
-        return cache[key]
-
-    def with_(mask: np.ndarray, g: int | np.integer, on: bool) -> np.ndarray:
-        out = mask.copy()
-        out[g] = on
-        return out
-
-    none = np.zeros(G, dtype=bool)
-    ref = ss(none)
-    floor_nm = floor * float(np.sqrt(ref.sum() / max(N * ref.size, 1)))
-    limit = (np.sqrt(ref / max(N, 1)) * (1.0 + tolerance) + floor_nm) ** 2 * max(N, 1) + 1e-30
-    scale = float(ref.sum()) * _ROUNDING
-    better = (1.0 - gain) ** 2 * float(ref.sum())
-
-    def admissible(mask: np.ndarray) -> bool:
-        s = ss(mask)
-        return bool(np.all(s <= limit)) and (not mask.any() or float(s.sum()) <= better)
-
-    def total(mask: np.ndarray) -> float:
-        return float(ss(mask).sum())
-
-    def descend(start: np.ndarray, adding: bool) -> None:
-        """Greedy toggles that lower the total, constraint-free: the path visits the sets worth scoring."""
-        S = start.copy()
-        while True:
-            moves = [with_(S, g, adding) for g in np.flatnonzero(~S if adding else S)]
-            if not moves:
-                return
-            best = min(moves, key=total)
-            if total(best) >= total(S) - scale:
-                return
-            S = best
-
-    everything = np.ones(G, dtype=bool)
-    descend(none, True)  # limbs that help on their own
-    descend(everything, False)  # limbs that help only together (an identification compensates across limbs)
-    admissible_sets = [m for m in (np.array(key, dtype=bool) for key in list(cache)) if admissible(m)]
-    S = min(admissible_sets, key=total)  # the empty set is always there
-    while True:  # single toggles that keep every joint no worse and lower the total (a removal: or keep it)
-        moves = [with_(S, g, not S[g]) for g in range(G)]
-        moves = [m for m, g in zip(moves, range(G)) if admissible(m)
-                 and total(m) < total(S) + (scale if S[g] else -scale)]
-        if not moves:
-            break
-        S = min(moves, key=lambda m: (total(m), int(m.sum())))
+    scores = HeldOutScores(measured, predict)
+    ref = scores(np.zeros(G, dtype=bool))
+    bar = Admission.of(ref, N, tolerance, floor, gain)
+    kept = choose_groups(G, scores, bar)
+    size = np.sqrt(np.mean(measured ** 2, axis=0)) + 1e-12  # each joint's torque: what "moves no torque" is below
+    decisions = tuple(group_decision(g, group, kept, scores, bar, body_names, joints, size)
+                      for g, group in enumerate(groups))
     rms = lambda s: np.sqrt(s / max(N, 1))  # noqa: E731
-    final = ss(S)
-    decisions = []
-    size = np.sqrt(np.mean(measured ** 2, axis=0)) + 1e-12
-    for g, group in enumerate(groups):
-        off, on = with_(S, g, False), with_(S, g, True)
-        s_off, s_on = ss(off), ss(on)
-        p_off, p_on = preds[tuple(off)], preds[tuple(on)]
-        moved = np.max(np.abs(p_on - p_off), axis=0, initial=0.0) > 1e-9 * size
-        names = tuple(j for j, m in zip(joints, moved) if m)
-        before = float(np.sqrt(s_off[moved].sum() / max(N * moved.sum(), 1))) if moved.any() else float("nan")
-        after = float(np.sqrt(s_on[moved].sum() / max(N * moved.sum(), 1))) if moved.any() else float("nan")
-        if S[g] and s_on[moved].sum() < s_off[moved].sum():
-            reason = "predicts the held-out torques of its joints better"
-        elif S[g]:
-            worse = [j for j, bad in zip(joints, s_off > limit) if bad]
-            reason = (f"kept with the others: without it {', '.join(worse[:3])}{' …' if len(worse) > 3 else ''} "
-                      "would be predicted worse than by the given model" if worse else
-                      "kept with the others: without it they do not predict the held-out torques better")
-        elif not moved.any():
-            reason = "moves no held-out torque"
-        elif not np.all(s_on <= limit):
-            worse = [j for j, bad in zip(joints, s_on > limit) if bad]
-            reason = f"would make {', '.join(worse[:3])}{' …' if len(worse) > 3 else ''} worse on held-out data"
-        else:
-            reason = f"does not lower the held-out torques' RMS by {100 * gain:g} %"
-        decisions.append(GroupDecision(group.name, tuple(body_names[b] for b in group.bodies), bool(S[g]), reason,
-                                       names, before, after))
-    return Validation(tuple(decisions), tuple(joints), N, rms(ref), rms(ss(np.ones(G, dtype=bool))), rms(final),
-                      tolerance, floor_nm, gain)
+    return Validation(decisions, tuple(joints), N, rms(ref), rms(scores(np.ones(G, dtype=bool))), rms(scores(kept)),
+                      tolerance, bar.floor, gain)
+
+
+def mask_key(mask: np.ndarray) -> tuple[bool, ...]:
+    """A set of groups (n_groups,) bool as a dictionary key."""
+    return tuple(bool(x) for x in mask)
+
+
+def toggled(mask: np.ndarray, g: int | np.integer, on: bool) -> np.ndarray:
+    """``mask`` with group ``g`` identified (``on``) or given, a copy."""
+    out = mask.copy()
+    out[g] = on
+    return out
+
+
+class HeldOutScores:
+    """Each set of groups' held-out prediction and per-joint sum of squared errors [N^2·m^2], computed once.
+
+    Args:
+        measured: the held-out torques (N, n_tc) [N·m].
+        predict: ``predict(mask)`` -> (N, n_tc) [N·m] (:func:`validate_groups`).
+    """
+
+    def __init__(self, measured: np.ndarray, predict: Callable[[np.ndarray], np.ndarray]):
+        self.measured, self.predict = measured, predict
+        self.squares: dict[tuple[bool, ...], np.ndarray] = {}
+        self.predictions: dict[tuple[bool, ...], np.ndarray] = {}
+
+    def __call__(self, mask: np.ndarray) -> np.ndarray:
+        """Per joint, the sum over the held-out samples of the squared error of the set ``mask`` (n_tc,)."""
+        key = mask_key(mask)
+        if key not in self.squares:
+            self.predictions[key] = np.asarray(self.predict(np.array(key, dtype=bool)), dtype=float)
+            self.squares[key] = np.sum((self.predictions[key] - self.measured) ** 2, axis=0)
+        return self.squares[key]
+
+    def total(self, mask: np.ndarray) -> float:
+        """The sum of squared errors of the set ``mask`` over every joint."""
+        return float(self(mask).sum())
+
+    def scored(self) -> list[np.ndarray]:
+        """The sets scored so far, in the order scored."""
+        return [np.array(key, dtype=bool) for key in list(self.squares)]
+
+
+@dataclass(frozen=True)
+class Admission:
+    """What a set of groups must reach to be kept (module docstring), from the reference's sums of squares.
+
+    Attributes:
+        limit: per joint, the largest sum of squared errors still no worse than the reference's (n_tc,)
+            [N^2·m^2] (:data:`TOLERANCE` of its RMS, plus the floor).
+        better: the largest sum over all joints of a set that predicts better (:data:`GAIN` below the
+            reference's) [N^2·m^2].
+        rounding: a change of a sum over all joints counted as none [N^2·m^2] (:data:`_ROUNDING` of the
+            reference's).
+        floor: the increase of a joint's held-out RMS counted as no change [N·m].
+        gain: the relative decrease of the held-out RMS over all joints ``better`` asks (:data:`GAIN`).
+    """
+
+    limit: np.ndarray
+    better: float
+    rounding: float
+    floor: float
+    gain: float
+
+    @classmethod
+    def of(cls, ref: np.ndarray, samples: int, tolerance: float = TOLERANCE, floor: float = FLOOR,
+           gain: float = GAIN) -> Admission:
+        """The thresholds of the reference's per-joint sums of squares ``ref`` (n_tc,) over ``samples``
+        held-out samples (:func:`validate_groups`' ``tolerance``, ``floor`` and ``gain``)."""
+        floor_nm = floor * float(np.sqrt(ref.sum() / max(samples * ref.size, 1)))
+        limit = (np.sqrt(ref / max(samples, 1)) * (1.0 + tolerance) + floor_nm) ** 2 * max(samples, 1) + 1e-30
+        return cls(limit, (1.0 - gain) ** 2 * float(ref.sum()), float(ref.sum()) * _ROUNDING, floor_nm, gain)
+
+    def admits(self, mask: np.ndarray, squares: np.ndarray) -> bool:
+        """Whether the set ``mask`` with per-joint sums of squares ``squares`` (n_tc,) makes no joint worse and,
+        unless it is the empty set, predicts better over all joints."""
+        return bool(np.all(squares <= self.limit)) and (not mask.any() or float(squares.sum()) <= self.better)
+
+
+def descend(start: np.ndarray, adding: bool, scores: HeldOutScores, rounding: float) -> None:
+    """Greedy toggles from ``start`` (adding groups, or removing them) that lower the total, constraint-free,
+    while one does: the path visits (scores) the sets worth scoring."""
+    S = start.copy()
+    while True:
+        moves = [toggled(S, g, adding) for g in np.flatnonzero(~S if adding else S)]
+        if not moves:
+            return
+        best = min(moves, key=scores.total)
+        if scores.total(best) >= scores.total(S) - rounding:
+            return
+        S = best
+
+
+def choose_groups(G: int, scores: HeldOutScores, bar: Admission) -> np.ndarray:
+    """The groups kept (G,) bool (module docstring): the admissible set of lowest total among those the two
+    greedy paths scored (the empty set always is), then single toggles that keep it admissible and lower the
+    total (a removal: or keep it unchanged)."""
+    descend(np.zeros(G, dtype=bool), True, scores, bar.rounding)  # limbs that help on their own
+    # limbs that help only together (an identification compensates across limbs)
+    descend(np.ones(G, dtype=bool), False, scores, bar.rounding)
+    S = min([m for m in scores.scored() if bar.admits(m, scores(m))], key=scores.total)  # the empty set is there
+    while True:  # single toggles that keep every joint no worse and lower the total (a removal: or keep it)
+        moves = [toggled(S, g, not S[g]) for g in range(G)]
+        moves = [m for m, g in zip(moves, range(G)) if bar.admits(m, scores(m))
+                 and scores.total(m) < scores.total(S) + (bar.rounding if S[g] else -bar.rounding)]
+        if not moves:
+            return S
+        S = min(moves, key=lambda m: (scores.total(m), int(m.sum())))
+
+
+def group_decision(g: int, group: BodyGroup, kept: np.ndarray, scores: HeldOutScores, bar: Admission,
+                   body_names: Sequence[str], joints: Sequence[str], size: np.ndarray) -> GroupDecision:
+    """The decision on group ``g`` of the kept set ``kept``: the joints it moves (a change of their prediction
+    above 1e-9 of their RMS torque ``size`` (n_tc,)), their held-out RMS with it given and identified, and
+    why (:func:`decision_reason`)."""
+    N = scores.measured.shape[0]
+    off, on = toggled(kept, g, False), toggled(kept, g, True)
+    s_off, s_on = scores(off), scores(on)
+    p_off, p_on = scores.predictions[mask_key(off)], scores.predictions[mask_key(on)]
+    moved = np.max(np.abs(p_on - p_off), axis=0, initial=0.0) > 1e-9 * size
+    names = tuple(j for j, m in zip(joints, moved) if m)
+    before = float(np.sqrt(s_off[moved].sum() / max(N * moved.sum(), 1))) if moved.any() else float("nan")
+    after = float(np.sqrt(s_on[moved].sum() / max(N * moved.sum(), 1))) if moved.any() else float("nan")
+    reason = decision_reason(bool(kept[g]), moved, s_off, s_on, bar, joints)
+    return GroupDecision(group.name, tuple(body_names[b] for b in group.bodies), bool(kept[g]), reason, names,
+                         before, after)
+
+
+def decision_reason(kept: bool, moved: np.ndarray, s_off: np.ndarray, s_on: np.ndarray, bar: Admission,
+                    joints: Sequence[str]) -> str:
+    """Why a group is kept or stays as given, one phrase, from the per-joint sums of squares of the kept set
+    with the group given (``s_off``) and identified (``s_on``) (n_tc,), and the joints it ``moved`` (n_tc,) bool."""
+    if kept and s_on[moved].sum() < s_off[moved].sum():
+        return "predicts the held-out torques of its joints better"
+    if kept:
+        worse = [j for j, bad in zip(joints, s_off > bar.limit) if bad]
+        return (f"kept with the others: without it {', '.join(worse[:3])}{' …' if len(worse) > 3 else ''} "
+                "would be predicted worse than by the given model" if worse else
+                "kept with the others: without it they do not predict the held-out torques better")
+    if not moved.any():
+        return "moves no held-out torque"
+    if not np.all(s_on <= bar.limit):
+        worse = [j for j, bad in zip(joints, s_on > bar.limit) if bad]
+        return f"would make {', '.join(worse[:3])}{' …' if len(worse) > 3 else ''} worse on held-out data"
+    return f"does not lower the held-out torques' RMS by {100 * bar.gain:g} %"
