@@ -18,7 +18,8 @@ from wbfriction.pipeline.paths import check_paths
 from wbfriction.signals.options import DiffOption, Mask
 
 if TYPE_CHECKING:
-    pass
+    from wbfriction.inertia.document import Identification
+    from wbfriction.pipeline.identify_step import IdentifiedFile
 
 from wbfriction.cli.common import (
     ESTIMATE,
@@ -92,16 +93,10 @@ def identify(log: Path = LogArg,
     with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
     check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output, "--json": json_output,
                                                                                 "--config-output": config_output})
-    vs_text = stribeck_velocity.strip().lower()
-    try:
-        stribeck: float | Literal["auto"] | None = (None if vs_text == "none" else "auto" if vs_text == "auto"
-                                                    else float(vs_text))
-    except ValueError:
-        raise InputError(f"--stribeck-velocity must be auto, none or a number, got '{stribeck_velocity}'") from None
+    stribeck = stribeck_option(stribeck_velocity)
     if not 0.0 < holdout < 1.0:
         raise InputError(f"--holdout must be between 0 and 1, got {holdout}")
-    from wbfriction.pipeline.identify_step import identify_file, write_identified_config
-    from wbfriction.report.terminal import identification_tables
+    from wbfriction.pipeline.identify_step import identify_file
 
     r = robot_of(robot, urdf, config, mjcf)
     r.require_urdf("identify (it writes the corrected URDF)")
@@ -112,7 +107,35 @@ def identify(log: Path = LogArg,
         done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
                              options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers,
                              time_unit=time_unit)
-    result, moved = done.identification, done.moved
+    print_identification(done, wide)
+    if json_output is not None:
+        console.print(f"wrote {json_output}")
+    warn_energy(done.loop.final.route.energy)
+    console.print(f"wrote {output}")
+    if config_output is not None:
+        from wbfriction.pipeline.identify_step import write_identified_config
+
+        text, folder = config_text(robot, config)
+        write_identified_config(text, folder, output, config_output, done.armature)
+        console.print(f"wrote {config_output}")
+
+
+def stribeck_option(text: str) -> float | Literal["auto"] | None:
+    """``--stribeck-velocity``: ``auto``, ``none`` (any case, spaces around) or a number [rad/s].
+
+    Raises:
+        InputError: anything else, naming the option.
+    """
+    vs_text = text.strip().lower()
+    try:
+        return None if vs_text == "none" else "auto" if vs_text == "auto" else float(vs_text)
+    except ValueError:
+        raise InputError(f"--stribeck-velocity must be auto, none or a number, got '{text}'") from None
+
+
+def print_passes(result: Identification) -> None:
+    """One line per pass of the identification (its v_s, samples, base parameters, condition, prior and how it
+    went), its gate's verdict and the parameters its log did not excite."""
     for p in result.passes:
         vs = "none" if p.stribeck_velocity is None else f"{p.stribeck_velocity:.4g} rad/s"
         condition = "not finite" if p.condition is None else f"{p.condition:.3g}"
@@ -124,7 +147,16 @@ def identify(log: Path = LogArg,
             names = [u.parameter for u in p.not_excited]
             out.print(escape(f"not excited by this log, kept at the given model: {len(names)} parameters ("
                              + ", ".join(names[:4]) + (", ..." if len(names) > 4 else "") + ")"), highlight=False)
-    tables, notes = identification_tables(result, wide)
+
+
+def print_identification(done: IdentifiedFile, wide: bool) -> None:
+    """What ``identify`` found: its passes (:func:`print_passes`), the tables of the bodies and joints and their
+    notes (``wide``: whole, not fitted to the terminal), the identified armature as TOML, and the joints whose
+    body went whole to the child link."""
+    from wbfriction.report.terminal import identification_tables
+
+    print_passes(done.identification)
+    tables, notes = identification_tables(done.identification, wide)
     for table in tables:
         print_whole(table) if wide else out.print(table)
     for note in notes:
@@ -132,16 +164,6 @@ def identify(log: Path = LogArg,
     toml = done.armature_toml()
     if toml is not None:
         out.print(escape("identified armature [kg·m^2], for the robot's TOML:\n" + toml), highlight=False)
-    if moved:
-        console.print(f"[yellow]note:[/] the whole identified body went to the child link of {', '.join(moved)} "
+    if done.moved:
+        console.print(f"[yellow]note:[/] the whole identified body went to the child link of {', '.join(done.moved)} "
                       "(lighter than the links merged with it)")
-    if json_output is not None:
-        console.print(f"wrote {json_output}")
-    warn_energy(done.loop.final.route.energy)
-    console.print(f"wrote {output}")
-    if config_output is not None:
-        text, folder = config_text(robot, config)
-        write_identified_config(text, folder, output, config_output, done.armature)
-        console.print(f"wrote {config_output}")
-
-

@@ -137,34 +137,48 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
                                                          "motion).")) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents."""
-    from wbfriction.sim.arm import ArmOptions, ExcitationOptions
-    from wbfriction.sim.sensors import load_sensors_toml
-
     check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors},
                 {"-o": output})
     r = robot_of(robot, urdf, config, mjcf)
     if not r.floating_base:
-        arm = ArmOptions(duration=duration, encoder_bits=19 if encoder_bits is None else encoder_bits,
-                         position_std=position_noise or 0.0, torque_std=torque_noise or 0.0, seed=noise_seed or 0,
-                         excitation=ExcitationOptions(seed=excitation_seed))
-        _run_simulate_arm(r, output, arm, friction)
-        return
+        return _run_simulate_arm(r, output, arm_options(duration, excitation_seed, position_noise, encoder_bits,
+                                                        torque_noise, noise_seed), friction)
     gait_opts = GaitOptions(gait=gait, steps=steps, step_length=step_length, step_width=step_width,
                             turn_angle=turn_angle, lift_height=lift_height)
-    options: IdealOptions | MujocoOptions
     if simulator == "ideal":
-        options = IdealOptions(substeps=substeps or IDEAL.substeps, integrator=integrator,
-                               log_base=log_base, force_torque=force_torque, imu=force_torque)
+        options: IdealOptions | MujocoOptions = IdealOptions(substeps=substeps or IDEAL.substeps, integrator=integrator,
+                                                             log_base=log_base, force_torque=force_torque,
+                                                             imu=force_torque)
     else:
-        table = load_sensors_toml(sensors) if sensors is not None else {}
-        given = {"position_std": position_noise, "encoder_bits": encoder_bits, "torque_std": torque_noise,
-                 "seed": noise_seed, "delay": None if delay is None else delay * 1e-3}
-        table.update({k: v for k, v in given.items() if v is not None})
-        lag = float(table.pop("delay", 0.0))
-        options = MujocoOptions(substeps=substeps or MUJOCO.substeps, friction=mujoco_friction,
-                                sensors=SensorNoise(**table), delay=lag, log_base=log_base,
-                                sole_timeconst=sole_timeconst, friction_timeconst=friction_timeconst,
-                                torque_drift=torque_drift, ft_offset=ft_offset)
+        noise, lag = sensor_noise(sensors, position_noise, encoder_bits, torque_noise, noise_seed, delay)
+        options = MujocoOptions(substeps=substeps or MUJOCO.substeps, friction=mujoco_friction, sensors=noise,
+                                delay=lag, log_base=log_base, sole_timeconst=sole_timeconst,
+                                friction_timeconst=friction_timeconst, torque_drift=torque_drift, ft_offset=ft_offset)
     _run_simulate(r, output, gait_opts, options, friction)
 
 
+def arm_options(duration: float, excitation_seed: int, position_noise: Optional[float], encoder_bits: Optional[int],
+                torque_noise: Optional[float], noise_seed: Optional[int]) -> ArmOptions:
+    """The options of a fixed-base robot's simulation from the command line's: ``duration`` [s] of the
+    excitation trajectory of seed ``excitation_seed``; sensor noise: joint-position std [rad], encoder bits (19
+    if not given), torque-sensor std [N·m] (none if not given) and their seed (0 if not given)."""
+    from wbfriction.sim.arm import ArmOptions, ExcitationOptions
+
+    return ArmOptions(duration=duration, encoder_bits=19 if encoder_bits is None else encoder_bits,
+                      position_std=position_noise or 0.0, torque_std=torque_noise or 0.0, seed=noise_seed or 0,
+                      excitation=ExcitationOptions(seed=excitation_seed))
+
+
+def sensor_noise(sensors: Optional[Path], position_noise: Optional[float], encoder_bits: Optional[int],
+                 torque_noise: Optional[float], noise_seed: Optional[int],
+                 delay: Optional[float]) -> tuple[SensorNoise, float]:
+    """MuJoCo's sensor noise and measurement-to-command delay [s]: the ``sensors`` TOML's ``[sensors]`` table
+    (none: the defaults), each option given overriding it (``delay`` in ms)."""
+    from wbfriction.sim.sensors import load_sensors_toml
+
+    table = load_sensors_toml(sensors) if sensors is not None else {}
+    given = {"position_std": position_noise, "encoder_bits": encoder_bits, "torque_std": torque_noise,
+             "seed": noise_seed, "delay": None if delay is None else delay * 1e-3}
+    table.update({k: v for k, v in given.items() if v is not None})
+    lag = float(table.pop("delay", 0.0))
+    return SensorNoise(**table), lag
