@@ -14,8 +14,9 @@ import pyarrow.parquet as pq
 import pytest
 
 from helpers import run_cli, write_bag
-from wbfriction.logs.hdf5 import write_hdf5
+from wbfriction.logs.formats.hdf5 import write_hdf5
 from wbfriction.logs.log import Log, log_from_table, write_log
+from wbfriction.logs.options import ReadOptions
 from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import write_table
 
@@ -180,7 +181,7 @@ def test_bad_bags_write_nothing(talos, combined_walk, tmp_path, capsys, command)
     walk = combined_walk.log.to_table(talos).slice(0, 1500)
     degrees = walk.set_column(walk.column_names.index("q.leg_left_4_joint"), "q.leg_left_4_joint",
                               pa.array(np.degrees(walk.column("q.leg_left_4_joint").to_numpy())))
-    write_bag(tmp_path / "bag", log_from_table(degrees, talos, "walk", limit_margin=np.inf), talos)
+    write_bag(tmp_path / "bag", log_from_table(degrees, talos, "walk", ReadOptions(limit_margin=np.inf)), talos)
     left, right = talos.contact_frames
     topics = (f'[joint_states]\ntopic = "/joint_states"\n[[contacts]]\nframe = "{left}"\ntopic = "/left_ft"\n'
               f'threshold = 50\n')

@@ -28,6 +28,7 @@ from helpers import mapped_copy, run_cli, run_cli_printed
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import log_from_table
+from wbfriction.logs.options import ReadOptions
 from wbfriction.logs.tables import write_table
 from wbfriction.model import load_robot
 
@@ -141,7 +142,7 @@ def test_a_continuous_joint_is_unwrapped(tmp_path):
     np.testing.assert_allclose(b.tau_f, a.tau_f, rtol=0, atol=1e-8)
     with pytest.raises(ColumnError, match="q.panda_joint7' jumps by"):
         log_from_table(table.set_column(col, "q.panda_joint7", pa.array(wrapped - np.pi / 2)), panda,
-                       limit_margin=10.0)
+                       read=ReadOptions(limit_margin=10.0))
 
 
 @pytest.mark.parametrize("value", [1e6, 1e300])

@@ -29,6 +29,7 @@ from wbfriction.logs.clock import (
     table_stamps,
 )
 from wbfriction.logs.log import log_from_table
+from wbfriction.logs.options import ReadOptions
 
 
 def _motion(t):
@@ -255,7 +256,7 @@ def test_friction_of_a_walk_logged_with_receive_time_stamps(talos, walk_table, d
     both = b.valid & u.valid
     assert both.sum() > 20_000
     assert _rms(b.tau_f[both] - u.tau_f[both]) < 1e-2 * _rms(u.tau_f[both])
-    recorded = estimate_log(talos, log_from_table(stamped, talos, "b", time_base="recorded"), opts)
+    recorded = estimate_log(talos, log_from_table(stamped, talos, "b", ReadOptions(time_base="recorded")), opts)
     both &= recorded.valid
     assert _rms(recorded.tau_f[both] - u.tau_f[both]) > 2e-2 * _rms(u.tau_f[both])
 

@@ -9,8 +9,9 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from wbfriction.exceptions import InputError, OutputError
+from wbfriction.exceptions import InputError, OptionError, OutputError
 from wbfriction.logs.log import Log, log_from_table, write_log
+from wbfriction.logs.options import ReadOptions
 from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import write_table
 
@@ -78,7 +79,7 @@ def test_time_gaps_split_the_log_into_segments(talos, good, step):
     table = _bad(talos, good, lambda c: c["time"].__setitem__(slice(20, None), c["time"][20:] + (step - 1) * 1e-3))
     skipped = step <= 4
     for time_base in ("auto", "regularised"):
-        log = log_from_table(table, talos, source="x.parquet", time_base=time_base)
+        log = log_from_table(table, talos, source="x.parquet", read=ReadOptions(time_base=time_base))
         if skipped and time_base == "auto":  # one segment, differentiated on the stamps as recorded
             assert log.segments == [(0, 50)] and log.clock.kind == "skipping"
             assert log.clock.lattice == pytest.approx(1e-3)
@@ -90,7 +91,7 @@ def test_time_gaps_split_the_log_into_segments(talos, good, step):
         assert len(a.time) == 20 and b.time[0] == pytest.approx(0.019 + step * 1e-3)
     # with a larger max_gap, the same step is a clock that skipped samples: one segment
     if skipped:
-        log = log_from_table(table, talos, source="x.parquet", max_gap=5)
+        log = log_from_table(table, talos, source="x.parquet", read=ReadOptions(max_gap=5))
         assert log.segments == [(0, 50)] and log.clock.kind == "skipping"
 
 
@@ -102,7 +103,7 @@ def test_irregular_steps_are_read_with_the_clock_that_explains_them(talos, good)
     assert log.segments == [(0, 50)] and log.clock.kind == "skipping"
     assert "exact stamps of a 0.5 ms clock skipping samples (steps 1-1.5 ms = 2-3 ticks)" in log.clock.reason
     assert log.dt == pytest.approx(1e-3)
-    forced = log_from_table(table, talos, source="x.parquet", time_base="regularised")
+    forced = log_from_table(table, talos, source="x.parquet", read=ReadOptions(time_base="regularised"))
     assert forced.clock.kind == "jittered" and "as asked" in forced.clock.reason
 
 
@@ -113,7 +114,7 @@ def test_integer_nanosecond_stamps(talos, good):
     table = _bad(talos, good, lambda c: c.__setitem__("time", ns))
     with pytest.raises(InputError, match="holds integers .* --time-unit"):
         log_from_table(table, talos, source="x.parquet")
-    log = log_from_table(table, talos, source="x.parquet", time_unit="ns")
+    log = log_from_table(table, talos, source="x.parquet", read=ReadOptions(time_unit="ns"))
     assert log.clock.kind == "uniform" and log.dt == 1e-3 and log.clock.t0 == pytest.approx(1.7e9)
     np.testing.assert_allclose(log.clock.t, good.time, rtol=0, atol=1e-15)
     np.testing.assert_allclose(log.time, ns * 1e-9, rtol=1e-15)
@@ -121,7 +122,7 @@ def test_integer_nanosecond_stamps(talos, good):
     dup[10] = dup[9]
     with pytest.raises(InputError, match="duplicated stamp at row 10"):
         log_from_table(_bad(talos, good, lambda c: c.__setitem__("time", dup)), talos, source="x.parquet",
-                       time_unit="ns")
+                       read=ReadOptions(time_unit="ns"))
 
 
 def test_unreadable_and_missing_files(talos, tmp_path):
@@ -173,3 +174,16 @@ def test_the_float32_warning_gives_each_columns_unit():
                      + [(f"temperature.{joint}", pa.float32())])
     (line,) = check_schema(both, panda, "log.parquet")
     assert "2.4e-07 rad at 2 rad" in line and "°C" in line and "accelerations" in line
+
+
+def test_read_options_are_checked_where_made():
+    """The read settings are one value (issue 54), refused when made, naming the option as the command line does."""
+    assert ReadOptions() == ReadOptions(max_gap=2.0, limit_margin=0.2, time_base="auto", time_unit=None)
+    assert ReadOptions(max_gap=np.float64(5), limit_margin=np.inf).limit_margin == np.inf
+    for kw, option in (({"max_gap": 1.0}, "--max-gap"), ({"max_gap": float("nan")}, "--max-gap"),
+                       ({"limit_margin": -0.1}, "--limit-margin"), ({"limit_margin": "0.2"}, "--limit-margin"),
+                       ({"time_base": "exact"}, "--time-base"), ({"time_unit": "h"}, "--time-unit")):
+        with pytest.raises(OptionError) as err:
+            ReadOptions(**kw)
+        assert err.value.option == option and err.value.value == next(iter(kw.values()))
+        assert str(err.value).startswith(f"{option} must be ")

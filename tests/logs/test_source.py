@@ -7,9 +7,9 @@ import pytest
 
 from helpers import bag_map, write_bag
 from wbfriction.exceptions import InputError
-from wbfriction.logs.hdf5 import write_hdf5
+from wbfriction.logs.formats.hdf5 import write_hdf5
 from wbfriction.logs.source import open_log, read_log
-from wbfriction.logs.tables import write_table
+from wbfriction.logs.tables import TableFile, write_table
 
 
 @pytest.fixture(scope="module")
@@ -26,7 +26,7 @@ def test_every_table_format_reads_back_as_the_same_log(talos, short_log, tmp_pat
     else:
         write_table(table, path)
     source = open_log(path)
-    assert source.format == fmt and not source.is_bag
+    assert source.format.name == fmt and not source.is_mapped
     blocks = list(source.blocks(block_rows=250))
     assert [b.num_rows for b in blocks] == [250, 250, 100]
     log = read_log(path, talos)
@@ -39,9 +39,9 @@ def test_a_bag_needs_its_map_and_is_read_through_it(talos, short_log, tmp_path):
     with pytest.raises(InputError, match="a ROS 2 bag needs a topic map"):
         open_log(tmp_path / "bag")
     source = open_log(tmp_path / "bag", bag_map(talos))
-    assert source.format == "bag" and source.is_bag
+    assert source.format.name == "bag" and source.is_mapped
     with pytest.raises(InputError, match="is not a table file"):
-        source.table_file()
+        TableFile(tmp_path / "bag")
     log = read_log(tmp_path / "bag", talos, bag_map(talos))
     # the samples where every topic has data (the odometry every 5th sample bounds both ends)
     first = int(np.flatnonzero((short_log.q == log.q[0]).all(axis=1))[0])

@@ -10,7 +10,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from wbfriction.exceptions import ColumnError, InputError
-from wbfriction.logs.hdf5 import write_hdf5
+from wbfriction.logs.formats.hdf5 import write_hdf5
 from wbfriction.logs.tables import (
     TableFile,
     numeric_column,
@@ -45,7 +45,7 @@ def test_row_ranges_are_slices_of_the_whole(table_file):
         assert part.num_rows == min(stop, 1000) - start
         np.testing.assert_array_equal(part.column("a").to_numpy(), whole.column("a").to_numpy()[start:stop])
     assert sum(b.num_rows for b in file.blocks(300)) == 1000
-    if file.format != "csv":  # CSV keeps no metadata
+    if file.format.name != "csv":  # CSV keeps no metadata
         assert read_metadata(whole) == {"robot": "x"}
         assert read_metadata(file.row_reader(10).rows(0, 5)) == {"robot": "x"}
 
@@ -53,7 +53,7 @@ def test_row_ranges_are_slices_of_the_whole(table_file):
 def test_columns_read_alone(table_file):
     file, _ = table_file
     assert sorted(file.read(["b", "time", "missing"]).column_names) == ["b", "time"]
-    assert file.row_count() == (1000 if file.format == "parquet" else 0)
+    assert file.row_count() == (1000 if file.format.name == "parquet" else 0)
 
 
 def test_a_bad_column_names_its_file_column_and_row():

@@ -63,3 +63,20 @@ def test_a_robot_toml_that_names_its_urdf(talos, tmp_path):
         robot = load_robot(config=tmp_path / name)
         assert robot.actuated == talos.actuated and robot.torque_controlled == talos.torque_controlled
         assert robot.contact_frames == talos.contact_frames and robot.groups == talos.groups
+
+
+def test_a_robot_is_named_one_way(tmp_path):
+    """``--robot``, ``--urdf``, ``--config`` and ``--mjcf`` become a robot through one function (issue 54):
+    :meth:`RobotSpec.given`, whose ``load`` the command line's ``robot_of`` and the worker processes both call."""
+    from wbfriction.cli.common import robot_of
+    from wbfriction.model.loading import RobotSpec
+
+    assert RobotSpec.given("panda") == RobotSpec("panda")
+    config = tmp_path / "arm.toml"
+    spec = RobotSpec.given("talos", "arm.urdf", config)
+    assert spec == RobotSpec(None, "arm.urdf", str(config)) and hash(spec) == hash(RobotSpec(None, "arm.urdf",
+                                                                                            str(config)))
+    panda = robot_of("panda", None, None)
+    assert panda.name == RobotSpec.given("panda").load().name == "panda"
+    with pytest.raises(InputError, match="unknown robot 'nobody'"):
+        robot_of("nobody", None, None)

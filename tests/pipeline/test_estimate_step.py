@@ -3,6 +3,8 @@ outputs whole or not at all, and the same bytes on a re-run."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -114,7 +116,7 @@ def test_every_log_format_is_chunked_to_the_same_table(talos, combined_walk, wal
     """CSV and both HDF5 layouts, read chunk by chunk, give the Parquet log's friction table."""
     import h5py
 
-    from wbfriction.logs.hdf5 import read_hdf5
+    from wbfriction.logs.formats.hdf5 import read_hdf5
 
     table = pq.read_table(walk_file)
     write_table(table, tmp_path / "walk.csv")
@@ -156,3 +158,32 @@ def test_workers_start_only_when_each_gets_enough_chunks(walk_file, tmp_path, mo
     for name in ("tau_f", "delta_qdd", "qd"):
         np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=0, atol=1e-9, err_msg=name)
     np.testing.assert_array_equal(a.valid, b.valid)
+
+
+def test_the_file_and_the_log_decide_through_one_function(talos, walk_file, tmp_path, monkeypatch):
+    """``estimate_file`` and ``estimate_log`` decide the differentiation, the route and the noise once per log
+    through :func:`~wbfriction.friction.decision.decide_log` (issue 54): on a log of one stretch no longer than
+    the rows a file's plan reads, the same positions, the same decision, the same metadata; only what the two
+    hand it differs (the noise's rows, the rows bounding the route's windows), said by the call."""
+    import wbfriction.friction.decision as decision
+    import wbfriction.friction.estimate as in_memory
+    import wbfriction.pipeline.estimate_step as from_file
+    from wbfriction.logs.clock import ROUGHNESS_ROWS
+
+    calls: list[dict] = []
+
+    def spy(robot, options, positions, dt, **kw):
+        calls.append({"rows": None if positions is None else len(positions), **kw})
+        return decision.decide_log(robot, options, positions, dt, **kw)
+
+    for module in (in_memory, from_file):
+        monkeypatch.setattr(module, "decide_log", spy)
+    log = read_log(walk_file, talos)
+    assert len(log) <= ROUGHNESS_ROWS and log.segments in (None, [(0, len(log))])
+    whole = estimate_log(talos, log)
+    estimate_file(RobotSpec("talos"), walk_file, tmp_path / "f.parquet", chunking=Chunking(rows=4000, workers=1))
+    chunked = read_friction_table(read_table(tmp_path / "f.parquet"))
+    assert [c.get("route_rows") for c in calls] == [len(log), None]  # the whole log's rows; the file's: its first ones
+    assert calls[0]["rows"] == calls[1]["rows"] == len(log)
+    for key in ("differentiation", "route", "noise"):  # as JSON: the table's metadata is
+        assert chunked.metadata[key] == json.loads(json.dumps(whole.metadata[key])), key

@@ -21,7 +21,7 @@ from wbfriction.exceptions import InputError, OptionError, WbfrictionError
 from wbfriction.fit.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions, TermOptions
 from wbfriction.friction.options import TERMS, EstimateOptions, TemperatureLaw, Term
 from wbfriction.inertia.options import InertialOptions
-from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
+from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP, MAX_GAP_LEAST
 from wbfriction.model.robots import BUILTIN_ROBOTS
 from wbfriction.signals.options import NOISE_TARGET, FilterOptions
 from wbfriction.sim.options import IdealOptions, MujocoOptions
@@ -41,8 +41,9 @@ WideOpt = typer.Option(False, "--wide", help="Every column in one table, as wide
                                             "fit the terminal).")
 VerboseOpt = typer.Option(False, "--verbose", help="Each joint's own line for the notes shared by several.")
 RobotOpt = typer.Option("talos", "--robot", help=f"Built-in robot: {', '.join(BUILTIN_ROBOTS)}.")
-LOG_FORMATS = "Parquet (.parquet), CSV (.csv) or HDF5 (.h5, .hdf5)"
-"""The log file formats every command reads (a ROS 2 bag too, where a command takes --map)."""
+LOG_FORMATS = "Parquet (.parquet), CSV (.csv), HDF5 (.h5, .hdf5) or NumPy (.npz)"
+"""The log file formats every command reads (a ROS 2 bag too, where a command takes --map): the built-in table
+formats of :mod:`wbfriction.logs.formats`, written out here because the help is shown without loading them."""
 LogArg = typer.Argument(..., metavar="LOG", help=f"Log in the wbfriction format: {LOG_FORMATS}.")
 FrictionArg = typer.Argument(..., metavar="FRICTION", help="Friction table written by 'wbfriction estimate'.")
 EnergyThresholdOpt = typer.Option(DEFAULT_THRESHOLD, min=0.0, max=1.0,
@@ -76,8 +77,8 @@ MapOpt = typer.Option(None, "--map", help="Topic map TOML of a ROS 2 bag log (se
                                            "table log: its [joint_states] rename and [[contacts]] column, threshold.")
 
 
-MaxGapOpt = typer.Option(MAX_GAP, min=1.5, help="Time steps of at least this many local median steps split the log "
-                                        "into segments, estimated apart.")
+MaxGapOpt = typer.Option(MAX_GAP, min=MAX_GAP_LEAST, help="Time steps of at least this many local median steps "
+                                                            "split the log into segments, estimated apart.")
 TimeBaseOpt = typer.Option("auto", help="Time base the positions are differentiated on: auto (decided from the "
                                          "data and printed), recorded (the stamps as they are: a clock that "
                                          "skips samples) or regularised (a uniform clock fitted to "
@@ -96,9 +97,15 @@ def progress_bar(total: int, label: str):
 
 
 def robot_of(robot: str, urdf: Optional[Path], config: Optional[Path], mjcf: Optional[Path] = None) -> Robot:
-    from wbfriction.model.loading import load_robot
+    """The robot ``--robot``, ``--urdf``, ``--config`` and ``--mjcf`` name, loaded
+    (:meth:`RobotSpec.given <wbfriction.model.loading.RobotSpec.given>`, the one way they name a robot).
 
-    return load_robot(robot, urdf=urdf, config=config, mjcf=mjcf)
+    Raises:
+        InputError: what :func:`~wbfriction.model.loading.load_robot` raises.
+    """
+    from wbfriction.model.loading import RobotSpec
+
+    return RobotSpec.given(robot, urdf, config, mjcf).load()
 
 
 def config_text(robot: str, config: Optional[Path]) -> tuple[str, Path]:

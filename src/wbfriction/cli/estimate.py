@@ -15,13 +15,13 @@ from rich.table import Table
 from wbfriction.exceptions import OptionError
 from wbfriction.friction.options import BaseMotion, EstimateOptions, Method, MomentumOptions, RouteOption
 from wbfriction.inertia.options import InertiaPart
-from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP, TimeBase, TimeUnit
+from wbfriction.logs.options import ReadOptions, TimeBase, TimeUnit
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.signals.options import AlignmentOption, DiffOption, FilterOptions, Mask, SavgolWeights, Velocity
 
 if TYPE_CHECKING:
+    from wbfriction.model.loading import RobotSpec
     from wbfriction.model.robot import Robot
-    from wbfriction.pipeline.estimate_step import RobotSpec
 
 from wbfriction.cli.common import (
     ESTIMATE,
@@ -52,11 +52,11 @@ from wbfriction.cli.common import (
 
 
 def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: EstimateOptions,
-                  bag_map: Optional[Path] = None, max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN,
-                  workers: int = 2, chunk_rows: int = 10_000, time_base: TimeBase = "auto",
-                  time_unit: TimeUnit | None = None, companion: bool = False) -> None:
+                  bag_map: Optional[Path] = None, read: ReadOptions = ReadOptions(), workers: int = 2,
+                  chunk_rows: int = 10_000, companion: bool = False) -> None:
     """Estimate a log file in chunks on ``workers`` processes (which load the robot from
-    ``spec``); a ROS 2 bag is first streamed into a temporary Parquet log beside the output."""
+    ``spec``), read as ``read`` says; a ROS 2 bag is first streamed into a temporary Parquet log beside the
+    output."""
     from wbfriction.pipeline.chunks import Chunking
     from wbfriction.pipeline.estimate_step import estimate_source
 
@@ -74,8 +74,7 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
         try:
             result = estimate_source(spec, log, output, opts, bag_map=bag_map, robot=r, stage=reading, progress=bar,
                                      chunking=Chunking(rows=chunk_rows, workers=workers), companion=companion,
-                                     max_gap=max_gap, limit_margin=limit_margin, time_base=time_base,
-                                     time_unit=time_unit)
+                                     read=read)
         finally:
             status.stop()
     console.print(escape(result.clock), highlight=False, soft_wrap=True)
@@ -173,7 +172,7 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
              route: RouteOption = RouteOpt, velocity_window: Optional[int] = VelocityWindowOpt,
              momentum_window: Optional[int] = MomentumWindowOpt, noise_target: float = NoiseTargetOpt) -> None:
     """Estimate the friction torque of every torque-controlled joint at every sample."""
-    from wbfriction.pipeline.estimate_step import RobotSpec
+    from wbfriction.model.loading import RobotSpec
 
     check_paths({"LOG": log, "--map": bag_map, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
     opts = EstimateOptions(diff=diff, compensate_delay=delay_compensation,
@@ -186,17 +185,25 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                            filtering=FilterOptions(window=window, poly_order=poly_order,
                                                    weights=weights,
                                                    cutoff=cutoff, butter_order=butter_order))
-    # the acceleration route's outputs, not the momentum route's: asked for with it, refused (with --route auto, the
-    # route's line says which was taken)
-    if cond and opts.route == "momentum":
+    _refuse_acceleration_outputs(opts, companion)
+    spec = RobotSpec.given(robot, urdf, config, mjcf)
+    read = ReadOptions(max_gap=max_gap, limit_margin=limit_margin, time_base=time_base, time_unit=time_unit)
+    _run_estimate(spec.load(), spec, log, output, opts, bag_map, read, workers, chunk_rows, companion)
+
+
+def _refuse_acceleration_outputs(opts: EstimateOptions, companion: bool) -> None:
+    """The acceleration route's outputs, not the momentum route's: asked for with it, refused (with --route auto, the
+    route's line says which was taken).
+
+    Raises:
+        OptionError: ``--cond`` or ``--companion`` with ``--route momentum``.
+    """
+    if opts.condition_number and opts.route == "momentum":
         raise OptionError("--cond", True, "left out with --route momentum (cond(M_mod^-1) is the acceleration "
                           "route's: the momentum route inverts no M_mod)")
     if companion and opts.route == "momentum":
         raise OptionError("--companion", True, "left out with --route momentum (the companion is the acceleration "
                           "route's other differentiation)")
-    spec = RobotSpec.given(robot, urdf, config, mjcf)
-    _run_estimate(spec.load(), spec, log, output, opts, bag_map, max_gap, limit_margin, workers,
-                  chunk_rows, time_base, time_unit, companion)
 
 
 @app.command()
@@ -218,7 +225,7 @@ def convert(bag: Path = typer.Argument(..., metavar="BAG", help="ROS 2 bag (fold
     check_paths({"BAG": bag, "--map": bag_map, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
     r = robot_of(robot, urdf, config, mjcf)
     with console.status(f"reading {bag}"):
-        rows = convert_log(r, bag, output, bag_map, max_gap=max_gap, limit_margin=limit_margin)
+        rows = convert_log(r, bag, output, bag_map, read=ReadOptions(max_gap=max_gap, limit_margin=limit_margin))
     console.print(f"wrote {output} ({rows} samples)")
 
 
@@ -245,7 +252,7 @@ def sensitivity(log: Path = LogArg,
     check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
     values = parse_factors(factors)
     r = robot_of(robot, urdf, config, mjcf)
-    data = read_log(log, r, time_unit=time_unit)
+    data = read_log(log, r, read=ReadOptions(time_unit=time_unit))
     warn(data.warnings)
     opts = EstimateOptions(diff=diff, mask=mask,
                            route=route)
@@ -291,7 +298,7 @@ def spectrum(log: Path = LogArg,
 
     check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
     r = robot_of(robot, urdf, config, mjcf)
-    data = read_log(log, r, time_unit=time_unit)
+    data = read_log(log, r, read=ReadOptions(time_unit=time_unit))
     warn(data.warnings)
     names = joint_list(r, joints)
     with progress_bar(len(data), "dynamics") as advance:

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from wbfriction.datasets.dataset import Dataset, WrittenDataset, register
 from wbfriction.datasets.store import RemoteFile
-from wbfriction.logs.npz import read_npz_recordings
+from wbfriction.logs.formats.npz import read_npz_recordings
 from wbfriction.logs.tables import make_folder, write_atomic, write_table
 
 FLOBAROID = "kjyv/FloBaRoID"

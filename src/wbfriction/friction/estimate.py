@@ -25,7 +25,9 @@ from typing import Any, cast
 
 import numpy as np
 
-from wbfriction.exceptions import InputError, OptionError
+from wbfriction.exceptions import InputError
+from wbfriction.friction.decision import decide_log, longest_stretch
+from wbfriction.friction.decision import resolve_differentiation as resolve_differentiation  # importable from here
 from wbfriction.friction.estimated import FrictionEstimate, no_single_support
 from wbfriction.friction.measured import (
     base_route,
@@ -35,16 +37,12 @@ from wbfriction.friction.measured import (
     wrench_route,
 )
 from wbfriction.friction.momentum import momentum_estimate
-from wbfriction.friction.noise import noise_record
 from wbfriction.friction.options import METHODS, EstimateOptions, Route
-from wbfriction.friction.route import resolve_route
-from wbfriction.logs.clock import longest_segment
 from wbfriction.logs.log import Log
 from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
 from wbfriction.model.stance import stance_frame_pose, stance_model
 from wbfriction.progress import Progress
-from wbfriction.signals.choice import DiffChoice, choose_differentiation
 from wbfriction.signals.kinematics import MeasuredKinematics, joined_smoother, measure, straddling
 from wbfriction.signals.options import FILTERING_SCHEMES, Diff, Scheme
 from wbfriction.signals.phases import Phases, joint_mask, segment
@@ -150,15 +148,42 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     """
     if options.method not in METHODS:
         raise InputError(f"unknown method '{options.method}': choose one of {', '.join(METHODS)}")
-    n, n_tc = len(kin.time), len(robot.torque_controlled)
     phases: Phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip, gaps)
     assert kin.valid is not None  # set by MeasuredKinematics.__post_init__
     usable = kin.valid & (phases.n_contacts > 0)
     with_wrenches = options.wrenches and kin.wrench is not None
     if require_single_support and not with_wrenches and not np.any(usable & phases.single):
         raise no_single_support(robot, kin.metadata.get('source', 'the log'))
-    cond = np.full(n, np.nan) if options.condition_number else None
+    tau_f, delta, cond = contact_route(robot, kin, phases, usable, options, progress)
+    valid = joint_mask(phases, robot.limb_mask, options.mask) & usable[:, None] & np.isfinite(tau_f)
+    unique = usable & phases.single
+    route = np.where(np.any(np.isfinite(tau_f), axis=1), "contact", "none").astype("<U7")
+    disagreement = measured_routes(robot, kin, phases, usable, options, tau_f, delta, valid, unique, route)
+    metadata = dict(kin.metadata)
+    metadata["estimate_options"] = asdict(options)
+    metadata["joint_labels"] = {j: robot.label(j) for j in robot.torque_controlled}
     tc = robot.tc_index
+    return FrictionEstimate(
+        joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
+        phase=phases.labels(), unique=unique, contact=kin.contact, contact_frames=robot.contact_frames,
+        qdd=kin.qdd[:, tc], delta_qdd=delta, cond=cond, tau_f_true=kin.tau_f_true, metadata=metadata,
+        smoother=kin.smoother, route=route, disagreement=disagreement)
+
+
+def contact_route(robot: Robot, kin: MeasuredKinematics, phases: Phases, usable: np.ndarray,
+                  options: EstimateOptions, progress: Progress | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """The rigid-contact route (thesis ch. 5) on the ``usable`` rows (N,) of ``kin``: single support by
+    ``options.method`` (one RNEA pass on the stance-rooted tree, :func:`single_support`, or the KKT system), double
+    support by the regularised least squares (6.1) (:func:`kkt_rows`).
+
+    Returns:
+        ``(tau_f, delta_qdd, cond)``: the friction (N, n_tc) [N·m] and the acceleration difference (5.12)
+        (N, n_tc) [rad/s^2], NaN where not estimated; ``cond(M_mod^-1)`` (N,) where the KKT system was formed
+        (``options.condition_number``), else None.
+    """
+    n, n_tc = len(kin.time), len(robot.torque_controlled)
+    cond = np.full(n, np.nan) if options.condition_number else None
     ss = usable & phases.single
     # the KKT route (one Pinocchio call per sample) serves double support, and single
     # support when asked for it or for the condition number
@@ -169,7 +194,16 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
         tau_f, delta = single_support(robot, kin, ss, phases.stance, rnea_progress, options.acceleration_difference)
     else:
         tau_f, delta = np.full((n, n_tc), np.nan), np.full((n, n_tc), np.nan)
-    rows = np.flatnonzero(need_kkt)
+    kkt_rows(robot, kin, phases, np.flatnonzero(need_kkt), options, tau_f, delta, cond, progress)
+    return tau_f, delta, cond
+
+
+def kkt_rows(robot: Robot, kin: MeasuredKinematics, phases: Phases, rows: np.ndarray, options: EstimateOptions,
+             tau_f: np.ndarray, delta: np.ndarray, cond: np.ndarray | None, progress: Progress | None = None) -> None:
+    """The KKT system (5.10)-(5.13) on the rows ``rows`` of ``kin``, :data:`CHUNK` at a time, written into
+    ``tau_f`` and ``delta`` (N, n_tc) and, if given, ``cond`` (N,): single support solved exactly (``method="kkt"``),
+    double support by the regularised least squares (6.1)."""
+    tc = robot.tc_index
     for start in range(0, rows.size, CHUNK):
         r = rows[start:start + CHUNK]
         dyn = constrained_dynamics(robot, kin.q[r], kin.qd[r], kin.qdd[r], kin.tau[r], kin.contact[r],
@@ -186,11 +220,21 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
             delta[r[~is_ss]] = d[~is_ss]
         if cond is not None:
             cond[r] = np.linalg.cond(dyn.Mmod_inv)
-    valid = joint_mask(phases, robot.limb_mask, options.mask) & usable[:, None] & np.isfinite(tau_f)
-    unique = ss.copy()
-    route = np.where(np.any(np.isfinite(tau_f), axis=1), "contact", "none").astype("<U7")
-    disagreement = None
-    if with_wrenches:  # every joint, every phase
+
+
+def measured_routes(robot: Robot, kin: MeasuredKinematics, phases: Phases, usable: np.ndarray,
+                    options: EstimateOptions, tau_f: np.ndarray, delta: np.ndarray, valid: np.ndarray,
+                    unique: np.ndarray, route: np.ndarray) -> np.ndarray | None:
+    """The measured routes in place of the rigid-contact route's estimate, where they apply (arrays updated in
+    place): the force-torque sensors' wrenches (``options.wrenches``: every joint in every phase, but across a
+    touch-down), else a measured base motion (every joint in single support; the mask stays).
+
+    Returns:
+        The disagreement of the measured route with the rigid-contact route (N, n_tc) [N·m]
+        (:attr:`FrictionEstimate.disagreement`), or None without a measured route.
+    """
+    if options.wrenches and kin.wrench is not None:  # every joint, every phase
+        assert kin.valid is not None  # set by MeasuredKinematics.__post_init__
         rows = kin.valid
         if options.diff != "true":  # not across a touch-down: its impact is smeared by the differentiation
             left_out = straddling(kin.contact) | impacts(robot, kin)
@@ -201,19 +245,12 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
             valid[left_out] = False
         tau_m, done = wrench_route(robot, kin, rows)
         valid[done] = np.isfinite(tau_m[done])
-        disagreement = _measured(tau_f, delta, unique, route, tau_m, done, "wrench")
-    elif measured_base(kin) != "contact":  # every joint in single support; the mask stays
+        return _measured(tau_f, delta, unique, route, tau_m, done, "wrench")
+    if measured_base(kin) != "contact":  # every joint in single support; the mask stays
         tau_m, done = base_route(robot, kin, usable & phases.single)
         valid[done] = (joint_mask(phases, robot.limb_mask, options.mask) & np.isfinite(tau_m))[done]
-        disagreement = _measured(tau_f, delta, unique, route, tau_m, done, "base")
-    metadata = dict(kin.metadata)
-    metadata["estimate_options"] = asdict(options)
-    metadata["joint_labels"] = {j: robot.label(j) for j in robot.torque_controlled}
-    return FrictionEstimate(
-        joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
-        phase=phases.labels(), unique=unique, contact=kin.contact, contact_frames=robot.contact_frames,
-        qdd=kin.qdd[:, tc], delta_qdd=delta, cond=cond, tau_f_true=kin.tau_f_true, metadata=metadata,
-        smoother=kin.smoother, route=route, disagreement=disagreement)
+        return _measured(tau_f, delta, unique, route, tau_m, done, "base")
+    return None
 
 
 def _measured(tau_f: np.ndarray, delta: np.ndarray, unique: np.ndarray, route: np.ndarray, tau_m: np.ndarray,
@@ -246,134 +283,30 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
     :func:`companion_scheme` (:attr:`FrictionEstimate.companion_delta_qdd`; one more
     inverse-dynamics pass over the single-support samples).
 
-    The route (``options.route``, :func:`~wbfriction.friction.route.resolve_route`) and the differentiation
-    (:func:`resolve_differentiation`) are chosen once for the log, and recorded in the metadata (``route``,
-    ``differentiation``) with the noise the fit reads (``noise``, :func:`~wbfriction.friction.noise.noise_record`).
+    The route (``options.route``) and the differentiation are chosen once for the log
+    (:func:`~wbfriction.friction.decision.decide_log`, its noise measured on its longest stretch between time gaps,
+    the route's windows bounded by its rows), and recorded in the metadata (``route``, ``differentiation``) with
+    the noise the fit reads (``noise``, :func:`~wbfriction.friction.noise.noise_record`).
 
     Raises:
         InputError: what :func:`~wbfriction.signals.kinematics.measure` and :func:`estimate_friction`
             raise (no segment can be estimated; with ``require_single_support``, no
             single-support sample in the whole log).
     """
-    given = options
-    options, choice = resolve_differentiation(options, log)
-    options, decision = resolve_route(options, log, choice=choice)
-    check_windows(given, options, log.segments, len(log.time), log.dt, log.source)
-    est = estimate_resolved(robot, log, options, progress, companion, require_single_support)
-    a, b = longest_segment(log.segments, len(log.time))
-    record = noise_record(robot, log.q[a:b], log.dt, options)
-    unmeasured = unmeasured_noise(record, b - a, options)
+    decision = decide_log(robot, options, longest_stretch(log), log.dt, segments=log.segments, rows=len(log.time),
+                          source=log.source, route_rows=len(log.time))  # the whole log's rows: module docstring
+    est = estimate_resolved(robot, log, decision.options, progress, companion, require_single_support)
     for e in (est, est.route_check):
-        if e is None:
-            continue
-        if unmeasured:
-            e.metadata["noise_unmeasured"] = unmeasured
-        if choice is not None:
-            e.metadata["differentiation"] = choice.to_dict()
-        if decision is not None:
-            e.metadata["route"] = decision.to_dict()
-        if record is not None:
-            e.metadata["noise"] = record
+        if e is not None:
+            e.metadata.update(decision.metadata())
     return est
-
-
-def resolve_differentiation(options: EstimateOptions, source: Log | np.ndarray | None,
-                            dt: float | None = None) -> tuple[EstimateOptions, DiffChoice | None]:
-    """``options`` with ``diff="auto"`` replaced by the scheme and filter chosen from the positions
-    (:func:`~wbfriction.signals.choice.choose_differentiation`), and that choice; other options as
-    they are, and None.
-
-    Args:
-        source: the log, or positions (N, n_act) [rad] sampled every ``dt`` [s] (the first rows
-            of a long log); None: nothing to choose from (central differences, no choice).
-
-    A log too short to measure its noise gets central differences, and a choice that says why.
-    """
-    if options.diff != "auto":
-        return options, None
-    if source is None:
-        return replace(options, diff="central"), None
-    try:
-        choice = choose_differentiation(source, dt, target=options.noise_target)
-    except InputError as exc:  # too short a log to measure its noise: say so, differentiate it plainly
-        choice = DiffChoice.fallback(f"central differences: {exc}")
-    return replace(options, diff=choice.scheme, filtering=choice.filtering), choice
-
-
-def unmeasured_noise(record: dict | None, longest: int, options: EstimateOptions) -> str:
-    """Why a fit of this estimate cannot be called ``ok`` (the metadata's ``noise_unmeasured``,
-    :attr:`~wbfriction.fit.result.FitResult.unmeasured`): the positions' noise not measured (``record`` None) on
-    the ``longest`` samples between time gaps, so no Cramér-Rao bound says what the data allow; "" when measured,
-    or for the simulators' true derivatives (no noise)."""
-    if record is not None or options.diff == "true":
-        return ""
-    return (f"the positions' noise could not be measured: the longest stretch without a time gap has {longest} "
-            "samples (no Cramér-Rao bound)")
-
-
-FILTER_SPAN = 5_000_000
-"""Rows beyond which a Butterworth filter's response is not computed (its cutoff refused): 40 MB per array."""
-
-
-def check_windows(given: EstimateOptions, options: EstimateOptions, segments: list[tuple[int, int]] | None,
-                  rows: int, dt: float, source: str) -> None:
-    """Refuse, before any work, windows no stretch of the log between two time gaps can hold: nothing would be
-    estimated (or a filter's response too long to compute). The option is named when it was given (``given``, the
-    options before :func:`resolve_differentiation` and :func:`~wbfriction.friction.route.resolve_route`); a window
-    the data chose is refused with the stretches' length.
-
-    Args:
-        given: the options as asked; options: resolved.
-        segments: the log's row ranges between time gaps (None: one); rows: its length; dt: its step [s].
-
-    Raises:
-        OptionError: a given window (``--window``, ``--cutoff``, ``--momentum-window``, ``--velocity-window``) longer
-            than the longest stretch; InputError: a chosen one, or stretches too short for any scheme.
-    """
-    a, b = longest_segment(segments, rows)
-    longest = b - a
-    where = f"at most the {longest} samples of the log's longest stretch without a time gap"
-    asked = given.diff != "auto"
-    if options.route == "momentum":
-        vw, w = options.momentum.velocity_window, options.momentum.window
-        if vw is None or w is None:
-            return
-        for flag, value, was in (("--momentum-window", w, given.momentum.window),
-                                 ("--velocity-window", vw, given.momentum.velocity_window)):
-            if value > longest and was is not None:
-                raise OptionError(flag, value, where)
-        need, what = w + vw - 1, f"the momentum route's windows (--velocity-window {vw}, --momentum-window {w})"
-        if need > longest and given.momentum.window is not None and given.momentum.velocity_window is not None:
-            raise OptionError("--momentum-window", w, f"{where}, less --velocity-window {vw} - 1")
-    elif options.diff == "savgol":
-        need, what = options.filtering.window, f"a Savitzky-Golay window of {options.filtering.window} (--window)"
-        if need > longest and asked:
-            raise OptionError("--window", need, where)
-    elif options.diff == "butterworth":
-        from wbfriction.signals.filters import ZeroPhaseLowpass
-        f = options.filtering
-        span = int(20 * f.butter_order / (f.cutoff * dt)) + 1 if f.cutoff > 0 else FILTER_SPAN + 1
-        # the response's half width is at least a hundredth of ``span`` (FILTER_SPAN: not computed beyond it)
-        if span > FILTER_SPAN or span // 100 > longest:
-            need = 2 * (span // 100) + 1
-        else:
-            need = 2 * ZeroPhaseLowpass(f.cutoff, f.butter_order, dt).half_width + 1
-        what = f"a Butterworth filter of {f.cutoff:g} Hz, order {f.butter_order} ({need} samples or more; --cutoff)"
-        if need > longest and asked:
-            raise OptionError("--cutoff", f.cutoff, f"high enough for the filter's response ({need} samples or "
-                              f"more) to fit in {where.removeprefix('at most ')}")
-    else:
-        need, what = 3, f"{options.diff} differences"
-    if need > longest:
-        raise InputError(f"{source}: the longest stretch without a time gap has {longest} samples, fewer than "
-                         f"{what} needs ({need}): nothing could be estimated")
 
 
 def estimate_resolved(robot: Robot, log: Log, options: EstimateOptions, progress: Progress | None = None,
                       companion: bool = False, require_single_support: bool = True) -> FrictionEstimate:
-    """:func:`estimate_log` with ``options`` already resolved (:func:`resolve_differentiation`,
-    :func:`~wbfriction.friction.route.resolve_route`): each of the log's segments by its route and the other, nothing
-    chosen or measured (a chunk of a long log, whose choices are the whole log's).
+    """:func:`estimate_log` with ``options`` already resolved (:func:`~wbfriction.friction.decision.decide_log`):
+    each of the log's segments by its route and the other, nothing chosen or measured (a chunk of a long log, whose
+    choices are the whole log's).
 
     Raises:
         InputError: options not resolved; what the routes raise.

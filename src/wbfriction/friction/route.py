@@ -136,7 +136,8 @@ def choose_route(options: EstimateOptions, sigma: float, dt: float, n_samples: i
 
 
 def resolve_route(options: EstimateOptions, source: Log | np.ndarray | None, dt: float | None = None,
-                  choice: DiffChoice | None = None) -> tuple[EstimateOptions, RouteDecision | None]:
+                  choice: DiffChoice | None = None, *, rows: int | None = None
+                  ) -> tuple[EstimateOptions, RouteDecision | None]:
     """``options`` with ``route = "auto"`` and the momentum windows left to the data replaced (module docstring),
     and the decision; options whose route and windows are all given come back as they are, with None.
 
@@ -144,6 +145,8 @@ def resolve_route(options: EstimateOptions, source: Log | np.ndarray | None, dt:
         source: the log, or positions (N, n_act) [rad] sampled every ``dt`` [s] (the first rows of a long log);
             None: nothing to measure (the acceleration route, the shortest windows).
         choice: the differentiation choice made for the same log, whose noise measurement is reused.
+        rows: the samples the windows are bounded by (:func:`choose_route`'s ``n_samples``); default a log's rows,
+            an array's length (0 for None).
 
     Raises:
         InputError: positions given as an array without ``dt``.
@@ -160,6 +163,7 @@ def resolve_route(options: EstimateOptions, source: Log | np.ndarray | None, dt:
         n = len(source)
     else:
         n = 0
+    n = n if rows is None else rows
     decision = choose_route(options, _position_noise(source, dt or 1.0, choice), dt or 1.0, max(n, 1))
     unused = [f"{flag(f.name)} {getattr(options.filtering, f.name)}" for f in fields(FilterOptions)
               if getattr(options.filtering, f.name) != f.default]

@@ -1,6 +1,7 @@
-"""Logs as files: the log format and its validation (:mod:`.log`), table files and atomic writes
-(:mod:`.tables`), HDF5 (:mod:`.hdf5`), ROS 2 bags (:mod:`.bags`), NumPy recordings (:mod:`.npz`), and
-:func:`open_log`, which decides once what a path is (:mod:`.source`)."""
+"""Logs as files: the log format and its validation (:mod:`.log`), the file formats a log comes in, one module
+each, in a registry new ones join with one call (:mod:`.formats`: Parquet, CSV, HDF5, NumPy, ROS 2 bags;
+:func:`register_format`), table files and atomic writes (:mod:`.tables`), and :func:`open_log`, which decides
+once what a path is (:mod:`.source`)."""
 
 import lazy_loader
 

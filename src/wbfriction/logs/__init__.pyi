@@ -1,12 +1,15 @@
-"""Names of :mod:`wbfriction.logs`, imported on first use (:func:`lazy_loader.attach_stub`)."""
-
 from .bags import BagMap as BagMap
 from .bags import load_bag_map as load_bag_map
+from .formats.base import LogFormat as LogFormat
+from .formats.npz import read_npz_recordings as read_npz_recordings
+from .formats.registry import UnknownFormatError as UnknownFormatError
+from .formats.registry import format_of as format_of
+from .formats.registry import log_formats as log_formats
+from .formats.registry import register_format as register_format
+from .formats.registry import unregister_format as unregister_format
 from .log import Log as Log
 from .log import log_from_table as log_from_table
 from .log import write_log as write_log
-from .npz import read_npz_recordings as read_npz_recordings
-from .source import LogFormat as LogFormat
 from .source import LogSource as LogSource
 from .source import open_log as open_log
 from .source import read_log as read_log

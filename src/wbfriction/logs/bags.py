@@ -48,8 +48,8 @@ import pyarrow as pa
 
 from wbfriction.config import read_toml
 from wbfriction.exceptions import InputError
-from wbfriction.logs.log import BASE_COLUMNS
-from wbfriction.logs.tables import with_metadata
+from wbfriction.logs.columns import BASE_COLUMNS
+from wbfriction.logs.metadata import with_metadata
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
 WRENCH = "geometry_msgs/msg/WrenchStamped"
@@ -123,14 +123,6 @@ def load_bag_map(path: str | Path) -> BagMap:
     if base is not None and (not isinstance(base, dict) or not isinstance(base.get("topic"), str)):
         raise InputError(f"{path}: [base] needs topic = \"/...\"")
     return BagMap(js["topic"], tuple(contacts), dict(rename), None if base is None else base["topic"])
-
-
-def is_bag(path: str | Path) -> bool:
-    """A ROS 2 bag: a folder with ``metadata.yaml``, or a ``.mcap`` / ``.db3`` file in one."""
-    path = Path(path)
-    if path.is_dir():
-        return (path / "metadata.yaml").is_file()
-    return path.suffix.lower() in (".mcap", ".db3")
 
 
 def _stamp(msg) -> int:

@@ -44,23 +44,16 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError, InputError
-from wbfriction.logs.clock import JITTER, Clock, TimeBase, TimeUnit, read_clock, split_at_gaps, table_stamps
+from wbfriction.logs.clock import JITTER, Clock, read_clock, split_at_gaps, table_stamps
+from wbfriction.logs.columns import BASE_COLUMNS, BASE_QD_TRUE_COLUMNS, BASE_QDD_TRUE_COLUMNS, IMU_COLUMNS
 from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, sensed_contacts
-from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
+from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP, ReadOptions
 from wbfriction.logs.tables import numeric_column, numeric_columns, read_metadata, with_metadata, write_table
 from wbfriction.logs.temperature import screen_temperature
 from wbfriction.model.robot import Robot
 
 TorqueSource = Literal["sensor", "current"]
 """Where a log's torques were measured (:attr:`Log.torque_source`)."""
-
-BASE_COLUMNS = ("base.x", "base.y", "base.z", "base.qx", "base.qy", "base.qz", "base.qw")
-BASE_TWIST_AXES = ("vx", "vy", "vz", "wx", "wy", "wz")
-"""Components of a base twist (Pinocchio's free-flyer ``v[:6]``): linear [m/s], then angular [rad/s], base frame."""
-IMU_COLUMNS = tuple(f"imu.{a}" for a in ("gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z"))
-"""An IMU's columns (:mod:`wbfriction.model.imu`): angular velocity [rad/s], specific force [m/s^2], IMU frame."""
-BASE_QD_TRUE_COLUMNS = tuple(f"base_qd_true.{a}" for a in BASE_TWIST_AXES)
-BASE_QDD_TRUE_COLUMNS = tuple(f"base_qdd_true.{a}" for a in BASE_TWIST_AXES)
 
 
 @dataclass
@@ -260,15 +253,16 @@ def unwrap_positions(q: np.ndarray, robot: Robot, source: str, segments: list[tu
     return out
 
 
-def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_gap: float = MAX_GAP,
-                   limit_margin: float = LIMIT_MARGIN, first_row: int = 0, period: float | None = None,
-                   *, clock: Clock | None = None, time_base: TimeBase = "auto", time_unit: TimeUnit | None = None
-                   ) -> Log:
+def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read: ReadOptions = ReadOptions(),
+                   first_row: int = 0, period: float | None = None, *, clock: Clock | None = None) -> Log:
     """Validate an Arrow table against ``robot`` and map its columns by joint name.
 
     Args:
-        max_gap: time steps of at least this many periods split the log (:func:`check_time`).
-        limit_margin: tolerance on the URDF joint limits (:func:`check_limits`).
+        read: how the log is read (:class:`~wbfriction.logs.options.ReadOptions`): the gaps that split it
+            (``max_gap``, :func:`check_time`), the tolerance on the URDF joint limits (``limit_margin``,
+            :func:`check_limits`), the time base (``time_base``, :data:`~wbfriction.logs.clock.TimeBase`; not used
+            with ``clock``) and the unit of a numeric ``time`` column (``time_unit``,
+            :func:`~wbfriction.logs.clock.table_stamps`: needed for integers; floats are seconds by default).
         first_row: row number of the table's first row in its file (a chunk of a long log),
             for the messages.
         period: the sampling period of the whole log, for a chunk of it (:attr:`Log.period`).
@@ -276,9 +270,6 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
             (:meth:`Clock.rows <wbfriction.logs.clock.Clock.rows>`), so that a log estimated in
             chunks is the whole log's; None: read from this table's stamps and positions
             (:func:`~wbfriction.logs.clock.read_clock`).
-        time_base: ``auto``, ``recorded`` or ``regularised`` (:data:`~wbfriction.logs.clock.TimeBase`).
-        time_unit: the unit of a numeric ``time`` column (:func:`~wbfriction.logs.clock.table_stamps`:
-            needed for integers; floats are seconds by default).
 
     Raises:
         InputError: what :func:`check_schema` refuses, NaN, a duplicated or decreasing time
@@ -287,8 +278,7 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", max_g
             0/1, a partial base pose, or a non-unit quaternion.
     """
     warnings = check_schema(table.schema, robot, source)
-    time, clock, q = _read_motion(table, robot, source, max_gap, limit_margin, first_row, clock, time_base,
-                                  time_unit)
+    time, clock, q = _read_motion(table, robot, source, read, first_row, clock)
     tau, torque_source = _read_torque(table, robot, source, first_row)
     wrench = _read_wrench(table, robot, source, first_row)
     contact = _read_contact(table, robot, source, first_row, wrench)
@@ -409,19 +399,18 @@ def _stack(table: pa.Table, columns: list[str], source: str, first_row: int) -> 
     return numeric_columns(table, columns, source, first_row)
 
 
-def _read_motion(table: pa.Table, robot: Robot, source: str, max_gap: float, limit_margin: float,
-                 first_row: int, clock: Clock | None = None, time_base: TimeBase = "auto",
-                 time_unit: TimeUnit | None = None) -> tuple[np.ndarray, Clock, np.ndarray]:
+def _read_motion(table: pa.Table, robot: Robot, source: str, read: ReadOptions, first_row: int,
+                 clock: Clock | None = None) -> tuple[np.ndarray, Clock, np.ndarray]:
     """Time [s] (checked, its unit too: :func:`~wbfriction.logs.clock.table_stamps`), its clock
     (``clock``, the whole log's cut to these rows, else read from the stamps and positions) and
     q [rad] (checked against the limits; continuous joints unwrapped, :func:`unwrap_positions`)."""
-    stamps = table_stamps(table, source, first_row, time_unit)
-    segments = check_time(stamps, source, max_gap, first_row=first_row)
+    stamps = table_stamps(table, source, first_row, read.time_unit)
+    segments = check_time(stamps, source, read.max_gap, first_row=first_row)
     raw = _stack(table, [f"q.{n}" for n in robot.actuated], source, first_row)
-    check_limits(raw, robot, source, limit_margin, first_row)  # before the jumps: degrees say so first
+    check_limits(raw, robot, source, read.limit_margin, first_row)  # before the jumps: degrees say so first
     q = unwrap_positions(raw, robot, source, segments, first_row)
     if clock is None:
-        clock = read_clock(stamps, source, max_gap=max_gap, first_row=first_row, q=q, time_base=time_base)
+        clock = read_clock(stamps, source, max_gap=read.max_gap, first_row=first_row, q=q, time_base=read.time_base)
     elif len(clock) != len(stamps):
         raise InputError(f"{source}: a clock of {len(clock)} rows for a table of {len(stamps)} rows")
     if clock.segments != segments:  # samples the clock skipped are not gaps: unwrapped across them too

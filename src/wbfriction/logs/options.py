@@ -4,6 +4,8 @@ shows their defaults in its help without loading NumPy or pyarrow."""
 from __future__ import annotations
 
 import math
+import numbers
+from dataclasses import dataclass
 from typing import Literal, get_args
 
 from wbfriction.exceptions import OptionError
@@ -11,6 +13,8 @@ from wbfriction.exceptions import OptionError
 MAX_GAP = 2.0
 """Default gap [sampling periods]: a time step at least this long (against the median of the
 steps around it) splits a log into segments."""
+MAX_GAP_LEAST = 1.5
+"""The shortest gap taken [sampling periods]: a shorter one would split a log at its clock's own jitter."""
 LIMIT_MARGIN = 0.2
 """How far a position may pass its URDF limits before the log is refused [rad or m]."""
 
@@ -21,6 +25,44 @@ TIME_BASES: tuple[TimeBase, ...] = get_args(TimeBase)
 TimeUnit = Literal["s", "ms", "us", "ns"]
 """The unit of a numeric ``time`` column (``--time-unit``)."""
 TIME_UNITS: tuple[TimeUnit, ...] = get_args(TimeUnit)
+
+
+
+@dataclass(frozen=True)
+class ReadOptions:
+    """How a log is read, one value passed whole wherever a log is read (the command line's ``--max-gap``,
+    ``--limit-margin``, ``--time-base`` and ``--time-unit``). Checked where made.
+
+    Attributes:
+        max_gap: a time step of at least this many local median steps splits the log into segments, estimated
+            apart (:func:`~wbfriction.logs.clock.split_at_gaps`) [sampling periods]; at least :data:`MAX_GAP_LEAST`.
+        limit_margin: how far a position may pass its URDF limits before the log is refused
+            (:func:`~wbfriction.logs.log.check_limits`) [rad or m]; at least 0 (inf: not checked).
+        time_base: the time base the positions are differentiated on (:data:`TimeBase`: decided from the data, the
+            stamps as recorded, or a regularised clock; :func:`~wbfriction.logs.clock.read_clock`).
+        time_unit: the unit of a numeric ``time`` column (:data:`TimeUnit`; None: seconds for floats, needed for
+            integers; :func:`~wbfriction.logs.clock.table_stamps`).
+
+    Raises:
+        OptionError: a value out of its range or not one of its choices, naming the option as the command line
+            spells it.
+    """
+
+    max_gap: float = MAX_GAP
+    limit_margin: float = LIMIT_MARGIN
+    time_base: TimeBase = "auto"
+    time_unit: TimeUnit | None = None
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.max_gap, numbers.Real) and self.max_gap >= MAX_GAP_LEAST):
+            raise OptionError("--max-gap", self.max_gap, f"a number of sampling periods, at least {MAX_GAP_LEAST:g}")
+        if not (isinstance(self.limit_margin, numbers.Real) and self.limit_margin >= 0):
+            raise OptionError("--limit-margin", self.limit_margin, "a margin of at least 0 rad (or m; inf: none)")
+        if self.time_base not in TIME_BASES:
+            raise OptionError("--time-base", self.time_base, f"one of {', '.join(TIME_BASES)}")
+        if self.time_unit is not None and self.time_unit not in TIME_UNITS:
+            raise OptionError("--time-unit", self.time_unit, f"one of {', '.join(TIME_UNITS)}")
+
 
 PLAUSIBLE = (-60.0, 200.0)
 """The temperatures [°C] a robot joint's motor or gearbox is met at: from a cold store to class H insulation's

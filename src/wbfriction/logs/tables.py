@@ -1,11 +1,11 @@
-"""Table files: Parquet, CSV and HDF5 read and written whole or in row ranges, their metadata, atomic writes.
+"""Table files: read whole or in row ranges through their format, their numeric columns, atomic writes.
 
-A table file's format is decided once, from its suffix (:class:`TableFile`): ``.parquet``/``.pq``
-(Apache Parquet), ``.csv``, ``.h5``/``.hdf5``/``.he5`` (:mod:`wbfriction.logs.hdf5`). Every table
-carries its JSON metadata under the schema key ``wbfriction`` (:func:`with_metadata`,
-:func:`read_metadata`). Every output is written whole or not at all (:func:`write_atomic`), and an
-output the system refuses to write (a full disk, ``ulimit -f``, a read-only folder, a path under a
-file) is one :class:`~wbfriction.exceptions.OutputError` naming it (:func:`output_error`).
+A table file's format is decided once, by the registry of log formats (:func:`~wbfriction.logs.formats.format_of`:
+Parquet, CSV, HDF5, NumPy and any format registered there): :class:`TableFile` reads it, :func:`write_table` and
+:func:`write_tables` write one. Every table carries its JSON metadata under the schema key ``wbfriction``
+(:mod:`wbfriction.logs.metadata`). Every output is written whole or not at all (:func:`write_atomic`), and an
+output the system refuses to write (a full disk, ``ulimit -f``, a read-only folder, a path under a file) is one
+:class:`~wbfriction.exceptions.OutputError` naming it (:func:`output_error`).
 """
 
 from __future__ import annotations
@@ -22,105 +22,37 @@ import tempfile
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.csv as pacsv
-import pyarrow.parquet as pq
 
 from wbfriction.exceptions import ColumnError, InputError, OutputError
-from wbfriction.logs.hdf5 import SUFFIXES as HDF5_SUFFIXES
-from wbfriction.logs.hdf5 import read_hdf5, write_hdf5
-
-META_KEY = b"wbfriction"
-TableFormat = Literal["parquet", "csv", "hdf5"]
-"""The formats of a table file."""
-
-
-# ------------------------------------------------------------------ metadata
-CSV_METADATA = b"#wbfriction "
-"""A CSV file's first line when it carries the ``wbfriction`` metadata (a CSV has no other place for
-it: without it, a log's torque alignment, a table's smoother and provenance would be lost)."""
-
-
-def _csv_metadata(path: Path) -> tuple[int, dict[bytes, bytes] | None]:
-    """Rows to skip at the top of a CSV file and the metadata its first line carries (0, None: none)."""
-    try:
-        with open(path, "rb") as handle:
-            first = handle.readline()
-    except OSError as exc:
-        raise _unreadable(path, exc) from exc
-    if first.startswith(CSV_METADATA):
-        return 1, {META_KEY: first[len(CSV_METADATA):].strip()}
-    return 0, None
-
-
-def _csv_options(path: Path, **kwargs) -> tuple[pacsv.ReadOptions, dict[bytes, bytes] | None]:
-    skip, meta = _csv_metadata(path)
-    return pacsv.ReadOptions(skip_rows=skip, **kwargs), meta
-
-
-def _write_csv_header(handle, schema: pa.Schema) -> None:
-    """The metadata line of a CSV file (:data:`CSV_METADATA`), if the table has metadata."""
-    meta = (schema.metadata or {}).get(META_KEY)
-    if meta is not None:
-        handle.write(CSV_METADATA + meta.replace(b"\n", b" ") + b"\n")
-
-
-def with_metadata(table: pa.Table, metadata: dict) -> pa.Table:
-    """Attach ``metadata`` (JSON-serialisable) to ``table`` under the ``wbfriction`` key."""
-    return table.replace_schema_metadata({META_KEY: json.dumps(metadata, sort_keys=True).encode()})
-
-
-def read_metadata(table: pa.Table, source: str = "<table>") -> dict:
-    """The ``wbfriction`` metadata of a table ({} if none)."""
-    meta = table.schema.metadata or {}
-    if META_KEY not in meta:
-        return {}
-    try:
-        doc = json.loads(meta[META_KEY])
-    except ValueError:
-        raise InputError(f"{source}: the 'wbfriction' metadata is not JSON") from None
-    if not isinstance(doc, dict):
-        raise InputError(f"{source}: the 'wbfriction' metadata is not a JSON object")
-    return doc
+from wbfriction.logs.formats.base import LogFormat, RowReader, TableWriter
+from wbfriction.logs.formats.registry import format_of, format_to_stream, format_to_write
+from wbfriction.logs.metadata import META_KEY as META_KEY  # the metadata's names, importable from here as before
+from wbfriction.logs.metadata import read_metadata as read_metadata
+from wbfriction.logs.metadata import with_metadata as with_metadata
 
 
 # ------------------------------------------------------------------- reading
-TABLE_SUFFIXES = (".parquet", ".pq", ".csv", *HDF5_SUFFIXES)
-_FORMATS: dict[str, TableFormat] = {".parquet": "parquet", ".pq": "parquet", ".csv": "csv",
-                                     **{s: "hdf5" for s in HDF5_SUFFIXES}}
-
-
-def table_format(path: str | Path) -> TableFormat:
-    """The format of an existing table file, from its suffix.
+def table_format(path: str | Path) -> LogFormat:
+    """The format of an existing table file (:func:`~wbfriction.logs.formats.format_of`).
 
     Raises:
-        InputError: a missing file, or a type that is not Parquet, CSV or HDF5.
+        InputError: a missing file, a type no registered format reads, or a file that is no table (a ROS 2 bag).
     """
-    path = Path(path)
-    if path.is_dir():
-        raise InputError(f"{path}: is a folder, not a table file (a ROS 2 bag folder needs --map)")
-    if not path.is_file():
-        raise InputError(f"{path}: file not found")
-    suffix = path.suffix.lower()
-    if suffix not in _FORMATS:
-        raise InputError(f"{path}: unknown file type '{suffix}' (expected .parquet, .csv or .h5)")
-    return _FORMATS[suffix]
-
-
-def _unreadable(path: Path, exc: BaseException, row: int | None = None) -> InputError:
-    at = "" if row is None else f" at row {row}"
-    return InputError(f"{path}: cannot be read{at}: {(str(exc).splitlines() or [repr(exc)])[0]}")
+    fmt = format_of(path)
+    if fmt.needs_map:
+        raise InputError(f"{path}: a {fmt.label} is not a table file: convert it first ('wbfriction convert')")
+    return fmt
 
 
 class TableFile:
-    """A Parquet, CSV or HDF5 table file (format decided once, :func:`table_format`).
+    """A table file and its format (decided once, :func:`table_format`).
 
     Attributes:
         path: the file.
-        format: ``parquet``, ``csv`` or ``hdf5``.
+        format: its :class:`~wbfriction.logs.formats.LogFormat` (``format.name``: ``parquet``, ``csv``, ...).
 
     Raises:
         InputError: a missing file or an unknown type (at construction).
@@ -128,7 +60,7 @@ class TableFile:
 
     def __init__(self, path: str | Path):
         self.path = Path(path)
-        self.format: TableFormat = table_format(self.path)
+        self.format: LogFormat = table_format(self.path)
 
     def read(self, columns: list[str] | None = None, text_columns: Sequence[str] = ()) -> pa.Table:
         """The whole table, or only those of ``columns`` that it has (others are skipped).
@@ -136,145 +68,52 @@ class TableFile:
         Args:
             columns: the columns to read (None: all).
             text_columns: columns a CSV file's cells are read from as text, as written (no type inference:
-                an id ``007`` stays ``"007"``, not ``7``); ignored for Parquet and HDF5, whose columns carry
-                their types.
+                an id ``007`` stays ``"007"``, not ``7``); ignored by formats whose columns carry their types.
 
         Raises:
             InputError: unreadable content, naming the file.
         """
-        path = self.path
-        if self.format == "hdf5":
-            return read_hdf5(path, columns=columns)
-        try:
-            if self.format == "parquet":
-                if columns is None:
-                    table = pq.read_table(path)
-                else:
-                    names = pq.ParquetFile(path).schema_arrow.names
-                    table = pq.read_table(path, columns=[c for c in columns if c in names])
-            else:
-                options, meta = _csv_options(path)
-                types = {c: pa.string() for c in text_columns}
-                if columns is None:
-                    table = pacsv.read_csv(path, read_options=options,
-                                           convert_options=pacsv.ConvertOptions(column_types=types))
-                else:
-                    names = pacsv.open_csv(path, read_options=options).schema.names
-                    table = pacsv.read_csv(path, read_options=options, convert_options=pacsv.ConvertOptions(
-                        include_columns=[c for c in columns if c in names], column_types=types))
-                if meta is not None:
-                    table = table.replace_schema_metadata(meta)
-            _ = table.column_names  # decoded lazily: a damaged header fails here
-            return table
-        except (pa.ArrowException, OSError, ValueError) as exc:  # ValueError: e.g. damaged UTF-8 in the footer
-            raise _unreadable(path, exc) from exc
+        return self.format.read(self.path, columns, text_columns)
 
     def schema(self) -> pa.Schema:
-        """The table's columns and their types, and its metadata, without reading its rows (a CSV's
-        types as inferred from its first block).
+        """The table's columns and their types, and its metadata (without reading its rows where the format can:
+        a CSV's types as inferred from its first block).
 
         Raises:
             InputError: unreadable content, naming the file.
         """
-        if self.format == "hdf5":
-            return read_hdf5(self.path, stop=0).schema
-        try:
-            if self.format == "parquet":
-                return pq.ParquetFile(self.path).schema_arrow
-            options, meta = _csv_options(self.path)
-            schema = pacsv.open_csv(self.path, read_options=options).schema
-            return schema.with_metadata(meta) if meta is not None else schema
-        except (pa.ArrowException, OSError, ValueError) as exc:
-            raise _unreadable(self.path, exc) from exc
+        return self.format.schema(self.path)
+
+    def metadata(self) -> dict:
+        """The table's ``wbfriction`` metadata ({} if none).
+
+        Raises:
+            InputError: unreadable content or metadata, naming the file.
+        """
+        return self.format.metadata(self.path)
 
     def row_count(self) -> int:
-        """Rows of a Parquet file, from its footer; 0 when not known without reading the file."""
-        if self.format != "parquet":
-            return 0
-        try:
-            return pq.ParquetFile(self.path).metadata.num_rows
-        except (pa.ArrowException, OSError, ValueError):  # an unreadable file is reported when it is read
-            return 0
+        """Rows of the table when known without reading it (a Parquet file's footer), else 0."""
+        return self.format.row_count(self.path)
 
     def row_reader(self, batch_rows: int) -> RowReader:
-        """A reader of row ranges, forwards, in bounded memory (:class:`RowReader`)."""
-        return RowReader(self, batch_rows)
+        """A reader of row ranges, forwards (in bounded memory where the format reads ranges alone)."""
+        return self.format.row_reader(self.path, batch_rows)
 
     def blocks(self, block_rows: int = 10_000) -> Iterator[pa.Table]:
-        """The table as consecutive tables of ``block_rows`` rows (with the file's metadata),
-        never read whole.
+        """The table as consecutive tables of ``block_rows`` rows (with the file's metadata).
 
         Raises:
             InputError: an unreadable file, naming it and the row.
         """
-        reader = self.row_reader(block_rows)
-        start = 0
-        while True:
-            table = reader.rows(start, start + block_rows)
-            if table.num_rows == 0:
-                return
-            yield table
-            start += table.num_rows
-
-
-class RowReader:
-    """Row ranges of a Parquet or CSV file, read forwards with a rolling buffer (the memory it
-    holds is one range and what was read ahead of it); of an HDF5 file, read by slicing its
-    datasets.
-
-    Raises:
-        InputError: an unreadable file (at construction or at the row where it fails).
-    """
-
-    def __init__(self, file: TableFile, batch_rows: int):
-        self.path = file.path
-        self._hdf5 = file.format == "hdf5"
-        self.metadata: dict[bytes, bytes] | None
-        if self._hdf5:
-            self.metadata = read_hdf5(self.path, columns=[], stop=0).schema.metadata
-            return
-        try:
-            if file.format == "parquet":
-                # without pre-buffering: pyarrow would otherwise keep whole column chunks read ahead
-                parquet = pq.ParquetFile(self.path, pre_buffer=False)
-                self.metadata = parquet.schema_arrow.metadata
-                self._batches: Iterator[pa.RecordBatch] = parquet.iter_batches(batch_size=batch_rows,
-                                                                               use_threads=False)
-            else:
-                options, self.metadata = _csv_options(self.path, block_size=1 << 24)
-                self._batches = iter(pacsv.open_csv(self.path, read_options=options))
-        except (pa.ArrowException, OSError, ValueError) as exc:
-            raise _unreadable(self.path, exc) from exc
-        self._buffer: list[pa.RecordBatch] = []
-        self._start = 0  # file row of the buffer's first row
-        self._stop = 0
-
-    def rows(self, start: int, stop: int) -> pa.Table:
-        """Rows ``[start, stop)`` (``start`` never below an earlier call's), with the file's metadata."""
-        if self._hdf5:
-            return read_hdf5(self.path, start=start, stop=stop)
-        while self._stop < stop:
-            try:
-                batch = next(self._batches)
-            except StopIteration:
-                break
-            except (pa.ArrowException, OSError, ValueError) as exc:
-                raise _unreadable(self.path, exc, self._stop) from exc
-            self._buffer.append(batch)
-            self._stop += batch.num_rows
-        while self._buffer and self._start + self._buffer[0].num_rows <= start:  # drop what is behind
-            self._start += self._buffer.pop(0).num_rows
-        if not self._buffer:  # past the end (a table without columns would slice to any length)
-            return pa.table({})
-        table = pa.Table.from_batches(self._buffer).slice(start - self._start, stop - start)
-        return table.replace_schema_metadata(self.metadata) if self.metadata else table
+        return self.format.blocks(self.path, block_rows)
 
 
 def read_table(path: str | Path) -> pa.Table:
-    """Read a Parquet, CSV or HDF5 file into an Arrow table (:meth:`TableFile.read`).
+    """Read a table file into an Arrow table (:meth:`TableFile.read`).
 
     Raises:
-        InputError: missing file, unknown extension, or unreadable content.
+        InputError: missing file, unknown type, or unreadable content.
     """
     return TableFile(path).read()
 
@@ -548,71 +387,48 @@ def write_json(path: str | Path, doc: object) -> None:
 
 
 def write_table(table: pa.Table, path: str | Path) -> None:
-    """Write an Arrow table as Parquet (CSV if ``path`` ends in .csv, its metadata in a first line
-    :data:`CSV_METADATA`; HDF5 in .h5 or .hdf5), atomically.
+    """Write an Arrow table, atomically, in the format that claims ``path``'s name
+    (:func:`~wbfriction.logs.formats.format_to_write`: ``.csv`` CSV, its metadata on its first line; ``.h5``
+    HDF5; ``.npz`` NumPy; Parquet for any other).
 
     Raises:
-        InputError: an output folder that does not exist.
+        InputError: an output folder that does not exist; a name whose format writes no file.
         OutputError: the system refused the write (:func:`write_atomic`).
     """
-    path = Path(path)
-    if path.suffix.lower() == ".csv":
-        def write_csv(tmp: Path) -> None:
-            with open(tmp, "wb") as handle:
-                _write_csv_header(handle, table.schema)
-                pacsv.write_csv(table, handle)
-
-        write_atomic(path, write_csv)
-    elif path.suffix.lower() in HDF5_SUFFIXES:
-        write_atomic(path, lambda tmp: write_hdf5(table, tmp))
-    else:
-        write_atomic(path, lambda tmp: pq.write_table(table, tmp, use_dictionary=dictionary_columns(table.schema)))
-
-
-def dictionary_columns(schema: pa.Schema) -> list[str]:
-    """The columns worth Parquet's dictionary encoding: all but the floating-point ones (measured
-    signals rarely repeat a value; encoding them costs 2.8x the write time for a 17 % larger file)."""
-    return [f.name for f in schema if not pa.types.is_floating(f.type)]
+    fmt = format_to_write(path)
+    write_atomic(path, lambda tmp: fmt.write(table, tmp))
 
 
 def write_tables(path: str | Path, tables: Iterable[pa.Table], check=None) -> int:
-    """Stream tables with the same columns into one Parquet or CSV file, whole or not at
+    """Stream tables with the same columns into one file (a format that streams:
+    :func:`~wbfriction.logs.formats.format_to_stream`, Parquet or CSV), whole or not at
     all: the first table gives the schema and its metadata (later ones are cast to it);
     ``check(tmp_path)``, if given, runs on the complete temporary file before the rename and
     may raise to keep the previous output. Returns the rows written.
 
     Raises:
-        InputError: an output that is neither .parquet nor .csv, or no table at all; what
+        InputError: an output in no format that streams, or no table at all; what
             the tables' source or ``check`` raises.
         OutputError: the system refused the write (:func:`write_atomic`); the tables' source is
             not read further.
     """
     path = Path(path)
-    if path.suffix.lower() not in (".parquet", ".pq", ".csv"):
-        raise InputError(f"{path}: tables are streamed as .parquet or .csv")
+    fmt = format_to_stream(path)
     rows = 0
 
     def write(tmp: Path) -> None:
         nonlocal rows
-        writer = None
-        handle = None
+        writer: TableWriter | None = None
         try:
             for table in tables:
                 if writer is None:
                     schema = table.schema
-                    if path.suffix.lower() == ".csv":
-                        handle = open(tmp, "wb")  # noqa: SIM115 - closed below, after the writer
-                        _write_csv_header(handle, schema)
-                        writer = pacsv.CSVWriter(handle, schema)
-                    else:
-                        writer = pq.ParquetWriter(tmp, schema, use_dictionary=dictionary_columns(schema))
+                    writer = fmt.open_writer(tmp, schema)
                 writer.write_table(table.cast(schema) if table.schema != schema else table)
                 rows += table.num_rows
         finally:
             if writer is not None:
                 writer.close()
-            if handle is not None:
-                handle.close()
         if writer is None:
             raise InputError(f"{path}: nothing to write")
         if check is not None:

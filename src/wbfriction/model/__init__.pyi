@@ -3,6 +3,7 @@
 from .dynamics import ConstrainedDynamics as ConstrainedDynamics
 from .dynamics import constrained_dynamics as constrained_dynamics
 from .layout import JointLayout as JointLayout
+from .loading import RobotSpec as RobotSpec
 from .loading import build_robot as build_robot
 from .loading import load_robot as load_robot
 from .robot import Robot as Robot

@@ -13,6 +13,7 @@ import sys
 import tomllib
 from collections.abc import Collection, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
@@ -430,3 +431,36 @@ def load_robot(name: str | None = "talos", *, urdf: str | Path | None = None,
     if given is not None:  # the built-in robot's configuration on another model of it (identified inertias)
         return build_robot(Path(given), cfg, source=f"built-in robot '{name}' on {given}", model_format=model_format)
     return build_robot(_resolve(cfg["urdf"], Path(".")), cfg, source=f"built-in robot '{name}'")
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """How a robot is named, and loaded (:func:`load_robot`): the one way a command's ``--robot``, ``--urdf``,
+    ``--config`` and ``--mjcf`` become a robot (:meth:`given`, then :meth:`load`), and what a worker process is
+    sent to load it again (its paths as text: picklable, hashable).
+
+    Attributes:
+        name: the built-in robot (None: the one ``config`` describes).
+        urdf, config, mjcf: the files given, as text, or None.
+    """
+
+    name: str | None = "talos"
+    urdf: str | None = None
+    config: str | None = None
+    mjcf: str | None = None
+
+    @classmethod
+    def given(cls, name: str, urdf: str | Path | None = None, config: str | Path | None = None,
+              mjcf: str | Path | None = None) -> RobotSpec:
+        """The robot a command's ``--robot``, ``--urdf``, ``--config`` and ``--mjcf`` name (a ``--config`` stands
+        for the whole robot: the built-in name is then not used)."""
+        text = lambda p: None if p is None else str(p)  # noqa: E731
+        return cls(None if config else name, text(urdf), text(config), text(mjcf))
+
+    def load(self) -> Robot:
+        """The robot (:func:`load_robot`).
+
+        Raises:
+            InputError: what :func:`load_robot` raises.
+        """
+        return load_robot(self.name, urdf=self.urdf, config=self.config, mjcf=self.mjcf)

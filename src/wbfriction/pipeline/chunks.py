@@ -31,9 +31,9 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import InputError
-from wbfriction.logs.clock import ROUGHNESS_ROWS, Clock, TimeBase, TimeUnit, read_clock, table_stamps
+from wbfriction.logs.clock import ROUGHNESS_ROWS, Clock, read_clock, table_stamps
 from wbfriction.logs.log import check_schema, contact_flags_from_forces
-from wbfriction.logs.options import MAX_GAP
+from wbfriction.logs.options import ReadOptions
 from wbfriction.logs.tables import RowReader, TableFile, numeric_column, numeric_columns
 from wbfriction.logs.temperature import screen_temperature
 from wbfriction.model.robot import Robot
@@ -150,13 +150,13 @@ def chunk_rows(reader: RowReader, robot: Robot, plan: ColumnPlan, chunk: Chunk) 
     return table
 
 
-def plan_columns(file: TableFile, robot: Robot, source: str, max_gap: float = MAX_GAP,
-                 time_base: TimeBase = "auto", time_unit: TimeUnit | None = None) -> ColumnPlan:
+def plan_columns(file: TableFile, robot: Robot, source: str, read: ReadOptions = ReadOptions()) -> ColumnPlan:
     """Check a log file's schema against ``robot`` (:func:`~wbfriction.logs.log.check_schema`:
     names and types, before any row is estimated), then read its contact columns alone to plan
     its chunks, the whole log's clock (:func:`~wbfriction.logs.clock.read_clock`: its stamps, in
-    ``time_unit``, and the positions of its first :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS`
-    rows when they are finite), and those positions (:func:`first_positions`, None when not finite).
+    ``read.time_unit``, its gaps of ``read.max_gap``, its ``read.time_base``, and the positions of its first
+    :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS` rows when they are finite), and those positions
+    (:func:`first_positions`, None when not finite).
 
     Raises:
         InputError: an unreadable file, what :func:`~wbfriction.logs.log.check_schema` refuses,
@@ -180,8 +180,8 @@ def plan_columns(file: TableFile, robot: Robot, source: str, max_gap: float = MA
                  if robot.floating_base else np.ones((table.num_rows, 1)))  # a fixed base: always welded
     warnings = warnings + _temperature_warnings(file, robot, source)
     first = first_positions(file, robot)
-    clock = read_clock(table_stamps(table, source, unit=time_unit), source, max_gap=max_gap, q=first,
-                       time_base=time_base)
+    clock = read_clock(table_stamps(table, source, unit=read.time_unit), source, max_gap=read.max_gap, q=first,
+                       time_base=read.time_base)
     return ColumnPlan(flags != 0, clock, first, warnings, from_forces)
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from wbfriction.logs.bags import BagMap
-from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
+from wbfriction.logs.options import ReadOptions
 from wbfriction.logs.source import open_log
 from wbfriction.logs.tables import write_tables
 from wbfriction.model.robot import Robot
@@ -13,12 +13,12 @@ from wbfriction.pipeline.estimate_step import check_file
 
 
 def convert_log(robot: Robot, log: str | Path, output: str | Path, bag_map: BagMap | str | Path | None = None, *,
-                max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN) -> int:
+                read: ReadOptions = ReadOptions()) -> int:
     """Stream a log (a ROS 2 bag through its topic map, or a table file,
     through the same map TOML if given: joint renaming, contact flags) into ``output`` (Parquet
     or CSV) in the log format, check it against ``robot`` chunk by chunk
-    (:func:`~wbfriction.pipeline.estimate_step.check_file`) and only then rename it into place.
-    Returns the rows written.
+    (:func:`~wbfriction.pipeline.estimate_step.check_file`, as ``read`` says it is read) and only then rename it
+    into place. Returns the rows written.
 
     Raises:
         InputError: an unreadable log or map, an output that is neither .parquet nor .csv, or
@@ -26,4 +26,4 @@ def convert_log(robot: Robot, log: str | Path, output: str | Path, bag_map: BagM
     """
     source = open_log(log, bag_map, robot)
     return write_tables(output, source.blocks(),
-                        check=lambda tmp: check_file(robot, tmp, str(log), max_gap=max_gap, limit_margin=limit_margin))
+                        check=lambda tmp: check_file(robot, tmp, str(log), read=read))

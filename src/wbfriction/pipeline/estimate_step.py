@@ -25,23 +25,17 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from wbfriction.exceptions import InputError, OutputError
-from wbfriction.friction.estimate import (
-    check_windows,
-    estimate_resolved,
-    no_single_support,
-    resolve_differentiation,
-    unmeasured_noise,
-)
+from wbfriction.friction.decision import decide_log
+from wbfriction.friction.estimate import estimate_resolved, no_single_support
 from wbfriction.friction.io import friction_table
-from wbfriction.friction.noise import noise_record
 from wbfriction.friction.options import EstimateOptions
-from wbfriction.friction.route import resolve_route
-from wbfriction.logs.clock import Clock, TimeBase, TimeUnit, longest_segment
+from wbfriction.logs.clock import Clock, longest_segment
+from wbfriction.logs.formats.registry import format_to_stream
 from wbfriction.logs.log import log_from_table
-from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP
+from wbfriction.logs.options import ReadOptions
 from wbfriction.logs.source import LogSource, open_log
 from wbfriction.logs.tables import TableFile, read_metadata, scratch_folder, with_metadata, write_tables
-from wbfriction.model.loading import load_robot
+from wbfriction.model.loading import RobotSpec
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import (
     CONTEXT,
@@ -57,46 +51,23 @@ from wbfriction.progress import Progress, StageProgress
 from wbfriction.workers import process_pool
 
 
-@dataclass(frozen=True)
-class RobotSpec:
-    """How a worker process loads the robot (:func:`~wbfriction.model.loading.load_robot`)."""
-
-    name: str | None = "talos"
-    urdf: str | None = None
-    config: str | None = None
-    mjcf: str | None = None
-
-    @classmethod
-    def given(cls, name: str, urdf: str | Path | None = None, config: str | Path | None = None,
-              mjcf: str | Path | None = None) -> RobotSpec:
-        """The robot a command's ``--robot``, ``--urdf``, ``--config`` and ``--mjcf`` name (a ``--config`` stands
-        for the whole robot: the built-in name is then not used)."""
-        text = lambda p: None if p is None else str(p)  # noqa: E731
-        return cls(None if config else name, text(urdf), text(config), text(mjcf))
-
-    def load(self) -> Robot:
-        return load_robot(self.name, urdf=self.urdf, config=self.config, mjcf=self.mjcf)
-
-
 def check_file(robot: Robot, path: str | Path, source: str | None = None, chunking: Chunking = Chunking(),
-               max_gap: float = MAX_GAP, limit_margin: float = LIMIT_MARGIN, time_base: TimeBase = "auto",
-               time_unit: TimeUnit | None = None) -> int:
+               read: ReadOptions = ReadOptions()) -> int:
     """Validate a log file against ``robot`` chunk by chunk, as :func:`estimate_file` does
-    before estimating (:func:`~wbfriction.logs.log.log_from_table`), in bounded memory. Returns
-    its rows.
+    before estimating (:func:`~wbfriction.logs.log.log_from_table`, as ``read`` says the log is read), in bounded
+    memory. Returns its rows.
 
     Raises:
         InputError: the first fault, naming ``source`` (default ``path``), column and row.
     """
     file = TableFile(path)
     source = source or str(file.path)
-    plan = plan_columns(file, robot, source, max_gap, time_base, time_unit)
+    plan = plan_columns(file, robot, source, read)
     clock = plan.clock
     reader = file.row_reader(max(1024, min(chunking.rows, 65_536)))
     for c in plan_chunks(plan.contact, chunking):
-        log_from_table(chunk_rows(reader, robot, plan, c), robot, source, max_gap, limit_margin,
-                       first_row=c.read_start, period=clock.step, clock=clock.rows(c.read_start, c.read_stop),
-                       time_unit=time_unit)
+        log_from_table(chunk_rows(reader, robot, plan, c), robot, source, read, first_row=c.read_start,
+                       period=clock.step, clock=clock.rows(c.read_start, c.read_stop))
     return len(plan.contact)
 
 
@@ -113,10 +84,9 @@ def worker_robot(spec: RobotSpec) -> Robot:
 
 
 def _estimate_chunk(robot: Robot, table: pa.Table, chunk: Chunk, clock: Clock, source: str, options: EstimateOptions,
-                    companion: bool, max_gap: float, limit_margin: float, time_unit: TimeUnit | None) -> pa.Table:
+                    companion: bool, read: ReadOptions) -> pa.Table:
     """The friction table of a chunk's own rows; ``clock``: the whole log's, cut to the rows read."""
-    log = log_from_table(table, robot, source, max_gap, limit_margin, first_row=chunk.read_start, period=clock.step,
-                         clock=clock, time_unit=time_unit)
+    log = log_from_table(table, robot, source, read, first_row=chunk.read_start, period=clock.step, clock=clock)
     est = estimate_resolved(robot, log, options, companion=companion, require_single_support=False)
     return friction_table(est).slice(chunk.start - chunk.read_start, chunk.stop - chunk.start)
 
@@ -215,63 +185,52 @@ class ChunkedResult:
 
 
 def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options: EstimateOptions = EstimateOptions(),
-                  *, chunking: Chunking = Chunking(), companion: bool = False, max_gap: float = MAX_GAP,
-                  limit_margin: float = LIMIT_MARGIN, extra_metadata: dict | None = None,
+                  *, chunking: Chunking = Chunking(), companion: bool = False, read: ReadOptions = ReadOptions(),
+                  extra_metadata: dict | None = None,
                   progress: Progress | None = None, robot: Robot | None = None,
-                  source: str | None = None, time_base: TimeBase = "auto",
-                  time_unit: TimeUnit | None = None, executor: ChunkExecutor | None = None) -> ChunkedResult:
-    """Estimate a log file chunk by chunk into ``output`` (Parquet or CSV), whole or not at all.
+                  source: str | None = None, executor: ChunkExecutor | None = None) -> ChunkedResult:
+    """Estimate a log file chunk by chunk into ``output`` (Parquet or CSV: a format that streams), whole or not at
+    all.
 
     Args:
         spec: the robot, as worker processes load it.
-        path: the log (Parquet, CSV or HDF5, read chunk by chunk).
+        path: the log, a table file in any registered format (:mod:`wbfriction.logs.formats`), read chunk by chunk.
         output: the friction table to write (:func:`~wbfriction.friction.io.friction_table`).
         options, companion: as :func:`~wbfriction.friction.estimate.estimate_log` (the companion
             scheme, one more differentiation and inverse-dynamics pass, only on request).
         chunking: chunk length, overlap at forced cuts, processes.
-        max_gap, limit_margin: as :func:`~wbfriction.logs.log.log_from_table`.
+        read: how the log is read (:class:`~wbfriction.logs.options.ReadOptions`: its gaps, the margin on the
+            joint limits, the time base, decided once for the whole log, :func:`~wbfriction.logs.clock.read_clock`,
+            and the unit of its stamps).
         extra_metadata: merged into the table's metadata (provenance).
         progress: optional callable receiving numbers of rows done.
         robot: ``spec`` already loaded in this process, if the caller has it.
         source: the name messages give the log (default ``path``; a bag converted to a
             temporary file is named as the bag).
-        time_base: ``auto``, ``recorded`` or ``regularised``
-            (:func:`~wbfriction.logs.clock.read_clock`, decided once for the whole log).
-        time_unit: the unit of a numeric ``time`` column (:func:`~wbfriction.logs.clock.table_stamps`).
         executor: where the chunks go instead of a pool of ``chunking.workers`` processes (e.g. a Dask cluster,
             :mod:`wbfriction.fleet.batch`), ``chunking.workers`` at a time, when the log has enough chunks
             (:meth:`~wbfriction.pipeline.chunks.Chunking.processes`). The table is the same.
 
     Raises:
         InputError: what reading, validating and estimating raise, naming the file and row;
-            an output that is neither .parquet nor .csv; a log that leaves no valid sample
-            (:func:`no_valid_sample`). Nothing is written then.
+            an output in no format that streams (:func:`~wbfriction.logs.formats.format_to_stream`); a log that
+            leaves no valid sample (:func:`no_valid_sample`). Nothing is written then.
     """
     path, output = Path(path), Path(output)
-    if output.suffix.lower() not in (".parquet", ".pq", ".csv"):
-        raise InputError(f"{output}: friction tables are written as .parquet or .csv")
+    format_to_stream(output, "friction tables are written")
     source = source or str(path)
     robot = robot if robot is not None else spec.load()
     file = TableFile(path)
-    plan = plan_columns(file, robot, source, max_gap, time_base, time_unit)
+    plan = plan_columns(file, robot, source, read)
     contact, clock, first = plan.contact, plan.clock, plan.first_positions
     if first is not None:  # the noise is measured on one segment: a gap between two recordings is no noise
         a, b = longest_segment(clock.segments, len(first))
         first = first[a:b]
-    given = options
-    options, choice = resolve_differentiation(options, first, clock.step)
-    if choice is not None:
-        extra_metadata = {**(extra_metadata or {}), "differentiation": choice.to_dict()}
-    options, decision = resolve_route(options, first, clock.step, choice)
-    check_windows(given, options, clock.segments, len(clock), clock.step, source)
-    if decision is not None:
-        extra_metadata = {**(extra_metadata or {}), "route": decision.to_dict()}
-    record = None if first is None else noise_record(robot, first, clock.step, options)
-    unmeasured = "" if first is None else unmeasured_noise(record, len(first), options)
-    if record is not None:
-        extra_metadata = {**(extra_metadata or {}), "noise": record}
-    elif unmeasured:
-        extra_metadata = {**(extra_metadata or {}), "noise_unmeasured": unmeasured}
+    # the noise measured on the first rows, the route's windows bounded by them: all a file's plan reads (the whole
+    # log's rows in memory, estimate_log: wbfriction.friction.decision)
+    decision = decide_log(robot, options, first, clock.step, segments=clock.segments, rows=len(clock), source=source)
+    options = decision.options
+    extra_metadata = {**(extra_metadata or {}), **decision.metadata()}
     n = len(contact)
     chunks = plan_chunks(contact, chunking)
     del contact
@@ -279,15 +238,16 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     reader = file.row_reader(max(1024, min(chunking.rows, 65_536)))
     first_meta: dict = {}
     valid: dict[str, int] = {}
-    settings = (source, options, companion, max_gap, limit_margin, time_unit)
+    settings = (source, options, companion, read)
     rows = partial(chunk_rows, reader, robot, plan)
     write_tables(output, _with_provenance(_chunk_tables(spec, robot, rows, chunks, clock,
                                                         chunking.processes(len(chunks)),
                                                         settings, executor),
                                           chunks, robot, source, extra_metadata, progress, first_meta, valid))
     return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta,
-                         clock.reason, "" if choice is None else choice.reason,
-                         plan.warnings + no_valid_warnings(source, valid), "" if decision is None else decision.reason)
+                         clock.reason, "" if decision.differentiation is None else decision.differentiation.reason,
+                         plan.warnings + no_valid_warnings(source, valid),
+                         "" if decision.route is None else decision.route.reason)
 
 
 def estimate_source(spec: RobotSpec, log: str | Path, output: str | Path,
@@ -303,9 +263,9 @@ def estimate_source(spec: RobotSpec, log: str | Path, output: str | Path,
         spec, output, options: as :func:`estimate_file`; ``robot``: ``spec`` loaded in this process, if the
             caller has it.
         log: the log file or bag folder; ``bag_map``: its topic or column map (TOML).
-        stage: told ``reading <log>`` while a bag is converted.
+        stage: told ``reading <log>`` while a bag (or a table read through a map) is converted.
         progress: called once with the log's row count, returns the per-row progress of :func:`estimate_file`.
-        file_options: the rest of :func:`estimate_file`'s keywords (chunking, companion, max_gap, ...).
+        file_options: the rest of :func:`estimate_file`'s keywords (chunking, companion, read, ...).
 
     Raises:
         InputError, OutputError: what opening the log, converting it and :func:`estimate_file` raise.
@@ -314,7 +274,7 @@ def estimate_source(spec: RobotSpec, log: str | Path, output: str | Path,
     source = open_log(log, bag_map, robot)
     output = Path(output)
     with ExitStack() as stack:
-        if source.is_bag and stage is not None:
+        if source.is_mapped and stage is not None:
             stage(f"reading {log}")
         table = stack.enter_context(table_log(source, output))
         advance = None if progress is None else progress(TableFile(table).row_count())

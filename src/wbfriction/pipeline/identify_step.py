@@ -23,6 +23,7 @@ from wbfriction.inertia.io import identification_of, write_identification
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.clock import TimeUnit
+from wbfriction.logs.options import ReadOptions
 from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import write_atomic
 from wbfriction.model.robot import Robot
@@ -73,7 +74,7 @@ def identify_file(robot: Robot, log: str | Path, urdf_output: str | Path, json_o
     """
     check_paths({"log": Path(log)}, {"urdf_output": Path(urdf_output),
                                      "json_output": None if json_output is None else Path(json_output)})
-    data = read_log(log, robot, time_unit=time_unit)
+    data = read_log(log, robot, read=ReadOptions(time_unit=time_unit))
     loop = identify(robot, data, estimate_options, options, stribeck, passes, progress=progress, workers=workers)
     moved = write_urdf(robot, loop.final.identification.pi, urdf_output)
     result = identification_of(loop, moved, log_provenance(log, robot))

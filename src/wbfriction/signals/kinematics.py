@@ -320,30 +320,9 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
             ``base_motion`` on a log without a base pose (with ``"true"``: without its true rates);
             ``imu`` on a log without ``imu.*`` columns.
     """
-    if velocity not in VELOCITIES:
-        raise InputError(f"unknown velocity source '{velocity}': choose one of {', '.join(VELOCITIES)}")
-    if velocity == "logged" and log.qd_logged is None:
-        raise InputError(f"{log.source}: --velocity logged needs the columns qd.<joint> of every actuated joint")
-    if base_motion and log.base is None:
-        raise InputError(f"{log.source}: a measured base motion needs the base pose columns base.x ... base.qw")
-    if imu and log.imu is None:
-        raise InputError(f"{log.source}: --base-motion imu needs the columns imu.gyro_x ... imu.acc_z")
+    _check_inputs(log, velocity, base_motion, imu)
     if diff == "true":
-        if log.qd_true is None or log.qdd_true is None:
-            raise InputError(f"{log.source}: diff 'true' needs the columns qd_true.* and qdd_true.* "
-                             "(written by the simulators)")
-        if base_motion and (log.base_qd_true is None or log.base_qdd_true is None):
-            raise InputError(f"{log.source}: diff 'true' with a measured base motion needs the columns "
-                             "base_qd_true.* and base_qdd_true.* (written by the simulators)")
-        imu_rates = None
-        if imu:
-            assert log.imu is not None  # checked above
-            imu_rates = np.hstack([log.imu[:, :3], np.gradient(log.imu[:, :3], log.time, axis=0), log.imu[:, 3:]])
-        return MeasuredKinematics(
-            time=log.time, q=log.q, qd=log.qd_true, qdd=log.qdd_true, tau=log.tau, contact=log.contact,
-            base=log.base, tau_f_true=log.tau_f_true, metadata=dict(log.metadata), wrench=log.wrench,
-            base_qd=log.base_qd_true if base_motion else None, base_qdd=log.base_qdd_true if base_motion else None,
-            imu=imu_rates)
+        return true_kinematics(log, base_motion, imu)
     if diff not in SCHEMES:
         raise InputError(f"unknown differentiation scheme '{diff}': choose one of {', '.join(SCHEMES)}, true")
     n, n_act, n_tc = len(log.time), log.q.shape[1], log.tau.shape[1]
@@ -366,15 +345,59 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
         imu_rates = np.hstack([qd[:, g], qdd[:, g], tau[:, n_tc + n_w:n_tc + n_w + 3]])
     q, qd, qdd, tau = q[:, :n_act], qd[:, :n_act], qdd[:, :n_act], tau[:, :n_tc]
     if velocity == "logged":
-        assert log.qd_logged is not None  # checked above
-        lag = velocity_lag(log.qd_logged, qd, log.dt)
-        metadata["velocity"] = {"source": "logged", "lag_s": lag.seconds, "correlation": lag.correlation,
-                                "reason": lag.describe()}
-        qd = np.where(np.isfinite(qd), log.qd_logged, np.nan)
+        qd = logged_velocity(log, qd, metadata)
     return MeasuredKinematics(
         time=log.time, q=q, qd=qd, qdd=qdd, tau=tau, contact=log.contact, base=log.base,
         tau_f_true=log.tau_f_true, metadata=metadata, smoother=smoother, base_qd=base_qd, base_qdd=base_qdd,
         wrench=wrench, imu=imu_rates)
+
+
+def _check_inputs(log: Log, velocity: Velocity, base_motion: bool, imu: bool) -> None:
+    """Refuse a velocity source that is none, or signals :func:`measure` is asked for that the log does not have."""
+    if velocity not in VELOCITIES:
+        raise InputError(f"unknown velocity source '{velocity}': choose one of {', '.join(VELOCITIES)}")
+    if velocity == "logged" and log.qd_logged is None:
+        raise InputError(f"{log.source}: --velocity logged needs the columns qd.<joint> of every actuated joint")
+    if base_motion and log.base is None:
+        raise InputError(f"{log.source}: a measured base motion needs the base pose columns base.x ... base.qw")
+    if imu and log.imu is None:
+        raise InputError(f"{log.source}: --base-motion imu needs the columns imu.gyro_x ... imu.acc_z")
+
+
+def true_kinematics(log: Log, base_motion: bool = False, imu: bool = False) -> MeasuredKinematics:
+    """The simulators' true velocities and accelerations (``diff="true"``), the torques as logged; with
+    ``base_motion``, the base's true twist and acceleration; with ``imu``, the gyro as logged, its derivative by
+    central differences (:func:`numpy.gradient`) and the specific force.
+
+    Raises:
+        InputError: a log without ``qd_true``/``qdd_true`` columns (with ``base_motion``: without its true rates).
+    """
+    if log.qd_true is None or log.qdd_true is None:
+        raise InputError(f"{log.source}: diff 'true' needs the columns qd_true.* and qdd_true.* "
+                         "(written by the simulators)")
+    if base_motion and (log.base_qd_true is None or log.base_qdd_true is None):
+        raise InputError(f"{log.source}: diff 'true' with a measured base motion needs the columns "
+                         "base_qd_true.* and base_qdd_true.* (written by the simulators)")
+    imu_rates = None
+    if imu:
+        assert log.imu is not None  # checked by measure
+        imu_rates = np.hstack([log.imu[:, :3], np.gradient(log.imu[:, :3], log.time, axis=0), log.imu[:, 3:]])
+    return MeasuredKinematics(
+        time=log.time, q=log.q, qd=log.qd_true, qdd=log.qdd_true, tau=log.tau, contact=log.contact,
+        base=log.base, tau_f_true=log.tau_f_true, metadata=dict(log.metadata), wrench=log.wrench,
+        base_qd=log.base_qd_true if base_motion else None, base_qdd=log.base_qdd_true if base_motion else None,
+        imu=imu_rates)
+
+
+def logged_velocity(log: Log, qd: np.ndarray, metadata: dict) -> np.ndarray:
+    """The log's own velocities (``qd.<joint>``) where the scheme's ``qd`` (N, n_act) [rad/s] is defined (NaN
+    elsewhere); how late they are against it (:func:`~wbfriction.signals.velocity.velocity_lag`) is stated in
+    ``metadata["velocity"]``, not compensated."""
+    assert log.qd_logged is not None  # checked by measure
+    lag = velocity_lag(log.qd_logged, qd, log.dt)
+    metadata["velocity"] = {"source": "logged", "lag_s": lag.seconds, "correlation": lag.correlation,
+                            "reason": lag.describe()}
+    return np.where(np.isfinite(qd), log.qd_logged, np.nan)
 
 
 def _times(log: Log) -> np.ndarray:

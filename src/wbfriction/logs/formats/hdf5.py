@@ -1,4 +1,5 @@
-"""HDF5 logs (``h5py``): the log format's columns in an HDF5 file.
+"""HDF5 (``.h5``, ``.hdf5``, ``.he5``; ``h5py``): the log format's columns in an HDF5 file, read by row ranges
+(its datasets sliced), written whole.
 
 Two layouts are read (the first that applies):
 
@@ -24,6 +25,7 @@ from __future__ import annotations
 import json
 import os
 import re
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +33,8 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import InputError
+from wbfriction.logs.formats.base import LogFormat, RowReader
+from wbfriction.logs.metadata import META_KEY
 
 SUFFIXES = (".h5", ".hdf5", ".he5")
 NAMES_ATTRS = ("names", "columns")
@@ -120,13 +124,14 @@ def read_hdf5(path: str | Path, columns: list[str] | None = None, start: int = 0
             json.loads(metadata)
         except (json.JSONDecodeError, TypeError):
             raise InputError(f"{path}: the 'wbfriction' attribute is not JSON") from None
-        table = table.replace_schema_metadata({b"wbfriction": metadata.encode()})
+        table = table.replace_schema_metadata({META_KEY: metadata.encode()})
     return table
 
 
 def write_hdf5(table: pa.Table, path: str | Path) -> None:
     """Write a table as HDF5, one dataset per column (layout 2), metadata as the file
-    attribute ``wbfriction``. Not atomic by itself: use :func:`~wbfriction.logs.tables.write_table`.
+    attribute ``wbfriction``. Not atomic by itself: use
+    :func:`~wbfriction.logs.tables.write_table`.
 
     Raises:
         OSError: the system refused the write, with the OS's error number (HDF5 raises a RuntimeError
@@ -141,7 +146,7 @@ def write_hdf5(table: pa.Table, path: str | Path) -> None:
                 if data.dtype == object:  # strings (a friction table's phase): fixed-length bytes
                     data = data.astype(str).astype("S")
                 f.create_dataset(name, data=data, track_times=False)  # no timestamps: same input, same bytes
-            meta = (table.schema.metadata or {}).get(b"wbfriction")
+            meta = (table.schema.metadata or {}).get(META_KEY)
             if meta is not None:
                 f.create_dataset(META, data=np.bytes_(meta), track_times=False)
     except (OSError, RuntimeError) as exc:  # HDF5 words the OS's error in its message: "errno = 28"
@@ -151,3 +156,35 @@ def write_hdf5(table: pa.Table, path: str | Path) -> None:
             number = int(found[1])
             raise OSError(number, os.strerror(number)) from exc
         raise
+
+
+class Hdf5Rows:
+    """Row ranges of an HDF5 file, each read by slicing its datasets (:func:`read_hdf5`)."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.metadata: dict[bytes, bytes] | None = read_hdf5(path, columns=[], stop=0).schema.metadata
+
+    def rows(self, start: int, stop: int) -> pa.Table:
+        return read_hdf5(self.path, start=start, stop=stop)
+
+
+class Hdf5Format(LogFormat):
+    """HDF5 files (module docstring)."""
+
+    name = "hdf5"
+    label = "HDF5"
+    suffixes = SUFFIXES
+    writable = True
+
+    def read(self, path: Path, columns: list[str] | None = None, text_columns: Sequence[str] = ()) -> pa.Table:
+        return read_hdf5(path, columns=columns)
+
+    def schema(self, path: Path) -> pa.Schema:
+        return read_hdf5(path, stop=0).schema
+
+    def row_reader(self, path: Path, batch_rows: int) -> RowReader:
+        return Hdf5Rows(path)
+
+    def write(self, table: pa.Table, path: Path) -> None:
+        write_hdf5(table, path)

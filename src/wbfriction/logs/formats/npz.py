@@ -1,7 +1,11 @@
-"""Recordings saved with NumPy (``.npz``), FloBaRoID's layout, read as one log table.
+"""NumPy archives (``.npz``): a log as one named array per column, or FloBaRoID's recordings.
 
-FloBaRoID (https://github.com/kjyv/FloBaRoID) saves a robot's recording as one ``.npz`` archive of
-arrays, N samples by the J joints in a fixed order:
+**A log** (:class:`NpzFormat`) is an archive of 1-D arrays of one length N, each named as its column (``time``,
+``q.<joint>``, ...: ``numpy.savez(path, **columns)``), read whole and written whole; its metadata is the JSON
+object in the 0-d byte-string array ``wbfriction``.
+
+**FloBaRoID** (https://github.com/kjyv/FloBaRoID) saves a robot's recording as one ``.npz`` archive of arrays, N
+samples by the J joints in a fixed order:
 
 * ``times`` (N,): the stamps [s] as the recorder wrote them (Unix epoch seconds for the KUKA LWR4+);
 * ``positions`` (N, J) [rad], ``velocities`` (N, J) [rad/s] (filtered by the controller), ``torques``
@@ -17,6 +21,7 @@ are estimated apart.
 
 from __future__ import annotations
 
+import json
 import zipfile
 from collections.abc import Sequence
 from pathlib import Path
@@ -25,6 +30,8 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import InputError
+from wbfriction.logs.formats.base import LogFormat
+from wbfriction.logs.metadata import META_KEY
 
 TIME_KEY = "times"
 """The array of stamps [s], shape (N,)."""
@@ -112,3 +119,61 @@ def read_npz_recordings(paths: Sequence[str | Path], joints: Sequence[str]) -> p
         tables.append(table)
         previous = path
     return pa.concat_tables(tables)
+
+
+class NpzFormat(LogFormat):
+    """NumPy archives holding a log, one named array per column (module docstring)."""
+
+    name = "npz"
+    label = "NumPy"
+    suffixes = (".npz",)
+    writable = True
+
+    def read(self, path: Path, columns: list[str] | None = None, text_columns: Sequence[str] = ()) -> pa.Table:
+        """The log in ``path`` (or those of ``columns`` it has), its metadata in its schema.
+
+        Raises:
+            InputError: not an ``.npz`` archive of named arrays, a FloBaRoID recording (read by
+                :func:`read_npz_recordings`, given its joints' names), an array that is not 1-D or of another length
+                than the first, metadata that is not JSON.
+        """
+        key = META_KEY.decode()
+        try:
+            archive = np.load(path, allow_pickle=False)
+            if not isinstance(archive, np.lib.npyio.NpzFile):
+                raise InputError(f"{path}: a single array, not an .npz archive of named arrays")
+            with archive:
+                names = [n for n in archive.files if n != key]
+                if TIME_KEY in names and "time" not in names:
+                    raise InputError(f"{path}: a FloBaRoID recording (arrays {', '.join(names)}), not a log: read it "
+                                     "with wbfriction.logs.read_npz_recordings, given its joints' names")
+                arrays = {n: archive[n] for n in names if columns is None or n in columns}
+                meta = archive[key] if key in archive.files else None
+        except InputError:
+            raise
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+            reason = " ".join(str(exc).split()) or type(exc).__name__
+            raise InputError(f"{path}: not a readable .npz archive ({reason})") from exc
+        shapes = {name: values.shape for name, values in arrays.items()}
+        first = next(iter(shapes.values()), (0,))
+        odd = next((name for name, shape in shapes.items() if len(shape) != 1 or shape != first), None)
+        if odd is not None:
+            raise InputError(f"{path}: array '{odd}' has shape {shapes[odd]}, the first {first}: a log holds one "
+                             "1-D array of one length per column")
+        table = pa.table(arrays)
+        if meta is None:
+            return table
+        text = meta.item() if meta.ndim == 0 and meta.dtype.kind == "S" else b""
+        try:
+            json.loads(text)
+        except ValueError:
+            raise InputError(f"{path}: the '{key}' array is not JSON") from None
+        return table.replace_schema_metadata({META_KEY: text})
+
+    def write(self, table: pa.Table, path: Path) -> None:
+        arrays = {n: table.column(n).to_numpy(zero_copy_only=False) for n in table.column_names}
+        meta = (table.schema.metadata or {}).get(META_KEY)
+        if meta is not None:
+            arrays[META_KEY.decode()] = np.bytes_(meta)
+        with open(path, "wb") as handle:
+            np.savez(handle, **arrays)

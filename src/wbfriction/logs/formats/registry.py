@@ -1,0 +1,151 @@
+"""The log formats the package knows, and the one a path is in: every file is read and written through it.
+
+Five are built in, in this order: Parquet, CSV, HDF5, NumPy ``.npz`` and ROS 2 bags (:mod:`.parquet`, :mod:`.csv`,
+:mod:`.hdf5`, :mod:`.npz`, :mod:`.bag`). Another is one call away::
+
+    from wbfriction.logs import LogFormat, register_format
+
+    class Tsv(LogFormat):
+        name, label, suffixes, writable = "tsv", "TSV", (".tsv",), True
+        def read(self, path, columns=None, text_columns=()): ...
+        def write(self, table, path): ...
+
+    register_format(Tsv())
+
+after which every command and function that takes a log reads (and, if the format writes, writes) ``.tsv`` files.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from wbfriction.exceptions import InputError
+from wbfriction.logs.formats.bag import BagFormat
+from wbfriction.logs.formats.base import LogFormat
+from wbfriction.logs.formats.csv import CsvFormat
+from wbfriction.logs.formats.hdf5 import Hdf5Format
+from wbfriction.logs.formats.npz import NpzFormat
+from wbfriction.logs.formats.parquet import ParquetFormat
+
+
+class UnknownFormatError(InputError):
+    """A path that no registered format reads (or, to write it, claims).
+
+    Attributes:
+        path: the file.
+        suffix: its suffix, as given ('' without one).
+        known: the registered formats, as :meth:`LogFormat.describe <wbfriction.logs.formats.base.LogFormat.describe>`
+            words them.
+    """
+
+    def __init__(self, path: str, suffix: str, known: tuple[str, ...]):
+        self.path = path
+        self.suffix = suffix
+        self.known = known
+        super().__init__(f"{path}: unknown file type '{suffix}' (known formats: {'; '.join(known)})")
+
+    def __reduce__(self):  # picklable across worker processes, with its data
+        return (type(self), (self.path, self.suffix, self.known))
+
+
+_FORMATS: dict[str, LogFormat] = {}
+"""The registered formats by name, in the order they are tried."""
+
+DEFAULT_FORMAT = "parquet"
+"""The format a table is written in when no registered format claims its file's name."""
+
+
+def register_format(fmt: LogFormat) -> LogFormat:
+    """Add ``fmt`` to the formats every path is looked up in, after those registered before it (the first whose
+    :meth:`~wbfriction.logs.formats.base.LogFormat.detect` accepts a path reads it). Returns ``fmt``.
+
+    Raises:
+        ValueError: a format of that name registered already, or a suffix another format claims (naming both).
+    """
+    if fmt.name in _FORMATS:
+        raise ValueError(f"a log format named '{fmt.name}' is registered already ({_FORMATS[fmt.name]!r})")
+    for other in _FORMATS.values():
+        shared = sorted(set(fmt.suffixes) & set(other.suffixes))
+        if shared:
+            raise ValueError(f"log format '{fmt.name}' claims {', '.join(shared)}, which format '{other.name}' "
+                             "reads already")
+    _FORMATS[fmt.name] = fmt
+    return fmt
+
+
+def unregister_format(name: str) -> LogFormat:
+    """Remove the format named ``name`` from the registry; returns it.
+
+    Raises:
+        ValueError: no format of that name.
+    """
+    if name not in _FORMATS:
+        raise ValueError(f"no log format named '{name}' (registered: {', '.join(_FORMATS)})")
+    return _FORMATS.pop(name)
+
+
+def log_formats() -> tuple[LogFormat, ...]:
+    """The registered formats, in the order they are tried."""
+    return tuple(_FORMATS.values())
+
+
+def _unknown(path: Path) -> UnknownFormatError:
+    return UnknownFormatError(str(path), path.suffix.lower(), tuple(f.describe() for f in _FORMATS.values()))
+
+
+def format_of(path: str | Path) -> LogFormat:
+    """The format of the existing file (or folder) ``path``: the first registered one that detects it.
+
+    Raises:
+        InputError: a missing file; a folder no format reads (not a bag); :class:`UnknownFormatError`: a file no
+            format reads, naming the file and every known format.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"{path}: file not found")
+    found = next((f for f in _FORMATS.values() if f.detect(path)), None)
+    if found is not None:
+        return found
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder, not a table file (a ROS 2 bag folder needs --map)")
+    raise _unknown(path)
+
+
+def format_to_write(path: str | Path) -> LogFormat:
+    """The format a table is written in at ``path``: the registered one that claims its name (its suffix), else
+    :data:`DEFAULT_FORMAT`.
+
+    Raises:
+        InputError: a format that claims the name but writes no file (a ROS 2 bag).
+    """
+    path = Path(path)
+    fmt = next((f for f in _FORMATS.values() if f.claims(path)), _FORMATS[DEFAULT_FORMAT])
+    if not fmt.writable:
+        raise InputError(f"{path}: {fmt.label} files are read, not written")
+    return fmt
+
+
+def stream_suffixes() -> tuple[str, ...]:
+    """The suffixes of the formats tables are streamed into (table after table: a friction table, a converted bag)."""
+    return tuple(s for f in _FORMATS.values() if f.streamable for s in f.suffixes)
+
+
+def format_to_stream(path: str | Path, what: str = "tables are streamed") -> LogFormat:
+    """The format tables are written in, one after the other, at ``path``: the registered one that claims its name
+    and can (:attr:`~wbfriction.logs.formats.base.LogFormat.streamable`).
+
+    Args:
+        what: what the message says is written so (``friction tables are written``).
+
+    Raises:
+        InputError: a name no such format claims, naming the file and the suffixes there are.
+    """
+    path = Path(path)
+    fmt = next((f for f in _FORMATS.values() if f.claims(path)), None)
+    if fmt is None or not fmt.streamable:
+        raise InputError(f"{path}: {what} as {', '.join(stream_suffixes())}")
+    return fmt
+
+
+for _builtin in (ParquetFormat(), CsvFormat(), Hdf5Format(), NpzFormat(), BagFormat()):
+    register_format(_builtin)
