@@ -10,7 +10,6 @@ from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError
 from wbfriction.fit.coordinates import (
-    UPPER,
     fit_coordinates_jacobian,
     from_fit_coordinates,
     model_bounds,
@@ -24,6 +23,7 @@ from wbfriction.fit.selection import choose_model, fit_friction, held_out_rms, p
 from wbfriction.fit.solve import STICK_FLOOR, filtered_problem, stick_speed
 from wbfriction.fit.status import fit_verdict
 from wbfriction.friction.estimate import FrictionEstimate
+from wbfriction.friction.families.thesis import THESIS
 from wbfriction.friction.models import (
     CoulombViscousParams,
     FrictionParams,
@@ -77,7 +77,7 @@ def test_coulomb_viscous_truth_runs_the_thesis_fit_into_bounds_and_auto_takes_co
     ends at the bound, and says so; ``auto`` fits the model that made the data, off its bounds."""
     truth = CoulombViscousParams(F_v=0.3, F_c=0.8, tau_os=0.2)
     thesis = fit_friction(QD, truth.torque(QD), model="thesis")
-    assert thesis.at_bound["a"] and thesis.params.a > 0.999 * UPPER[5]
+    assert thesis.at_bound["a"] and thesis.params.a > 0.999 * THESIS.upper[THESIS.index("a")]
     for seed in range(3):
         rng = np.random.default_rng(seed)
         tau_f = truth.torque(QD) + rng.normal(0.0, 0.05, QD.size)

@@ -14,15 +14,16 @@ from wbfriction.fit.coordinates import model_bounds, to_fit_coordinates
 from wbfriction.fit.eiv import expected_columns, expected_values
 from wbfriction.fit.joints import stick_margin
 from wbfriction.fit.projection import (
-    TERMS,
     Projection,
     bounded_linear_solve,
+    factor_positions,
     grid_minima,
     linear_part,
     projected_start,
 )
 from wbfriction.fit.selection import fit_friction
 from wbfriction.fit.solve import stick_speed
+from wbfriction.friction.families.registry import family
 from wbfriction.friction.models import ModelName
 
 QD = np.concatenate([np.linspace(-1.5, 1.5, 1201), 0.4 * np.sin(np.linspace(0.0, 30.0, 1500))])
@@ -35,9 +36,9 @@ TRUTH: dict[ModelName, np.ndarray] = {  # the model's parameters, in the order o
 
 
 def linear_coefficients(model: ModelName, x: np.ndarray) -> np.ndarray:
-    """The products of :data:`TERMS` at the model's parameters ``x``."""
+    """The products of the family's column factors (:func:`factor_positions`) at the model's parameters ``x``."""
     z = to_fit_coordinates(model, x)
-    return np.array([np.prod(z[list(m)]) for m in TERMS[model]])
+    return np.array([np.prod(z[list(m)]) for m in factor_positions(family(model))])
 
 
 @pytest.mark.parametrize("model", ["coulomb-viscous", "stribeck", "thesis"])
@@ -46,8 +47,7 @@ def test_the_columns_times_their_products_are_the_model(model, sigma, delta_s):
     """Each model's columns (its expectation under the velocity noise, or itself) times the products of its linear
     parameters are :func:`expected_values`, an independent implementation, for the thesis's exponent and another."""
     x = TRUTH[model]
-    v_s, a = (x[3], x[5]) if model == "thesis" else (x[3] if model == "stribeck" else 1.0, 1.0)
-    columns = expected_columns(QD, sigma, delta_s, model, v_s, a)
+    columns = expected_columns(QD, sigma, delta_s, model, to_fit_coordinates(model, x))
     np.testing.assert_allclose(columns @ linear_coefficients(model, x), expected_values(x, QD, sigma, delta_s, model),
                                rtol=1e-9, atol=1e-9)
 

@@ -11,9 +11,9 @@ from wbfriction.exceptions import InputError
 from wbfriction.fit.joints import fit_joints
 from wbfriction.fit.regression import standard_errors
 from wbfriction.fit.selection import fit_friction
+from wbfriction.friction.families.registry import family
 from wbfriction.friction.models import (
     MODEL_NAMES,
-    MODEL_PARAMS,
     CoulombViscousParams,
     FrictionParams,
     StribeckParams,
@@ -88,7 +88,7 @@ def test_new_models_are_dissipative_without_offset(qd, F_v, F_c, drop, v_s):
 
 @pytest.mark.parametrize("model", MODEL_NAMES)
 def test_parameters_convert_to_vectors_and_dicts_and_back(model):
-    cls = MODEL_PARAMS[model]
+    cls = family(model).params_class
     x = np.arange(1.0, len(cls.names) + 1)
     p = cls.from_vector(x, delta_s=1.5)
     assert p.model == model and np.array_equal(p.as_vector(), x)
@@ -116,7 +116,7 @@ def test_analytic_jacobian_matches_finite_differences(model, x):
     rng = np.random.default_rng(1)
     qd = rng.uniform(-2, 2, 200)
     x = np.array(x)
-    f = lambda x: MODEL_PARAMS[model].from_vector(x, delta_s=2.0).f(qd)  # noqa: E731
+    f = lambda x: family(model).params(x, delta_s=2.0).f(qd)  # noqa: E731
     J = model_jacobian(x, qd, 2.0, model)
     assert J.shape == (qd.size, x.size)
     np.testing.assert_array_equal(model_values(x, qd, 2.0, model), f(x))

@@ -4,7 +4,7 @@ it goes."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING, Optional, cast
 
 import typer
 from rich.markup import escape
@@ -12,7 +12,7 @@ from rich.table import Table
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
-from wbfriction.fit.options import FitOptions, ModelChoice
+from wbfriction.fit.options import FitOptions, ModelChoice, model_choices
 from wbfriction.friction.options import TemperatureLaw
 from wbfriction.pipeline.paths import check_paths
 
@@ -71,12 +71,19 @@ def _run_fit(friction: Path, output: Path, options: FitOptions, threshold: float
     console.print(f"wrote {output}")
 
 
+FitModelOpt = typer.Option(FIT.model, "--model", metavar=f"[{'|'.join(model_choices())}]",
+                           help=f"{ModelOpt.help} Or a family a program registered, or an installed package "
+                                "advertises (entry points 'wbfriction.families').")
+"""``--model``: any family's name, checked once, by :class:`~wbfriction.fit.options.FitOptions` (its error names the
+families known)."""
+
+
 @app.command()
 def fit(friction: Path = FrictionArg,
         output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
         min_samples: int = MinSamplesOpt,
         energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt,
-        workers: int = FitWorkersOpt, model: ModelChoice = ModelOpt,
+        workers: int = FitWorkersOpt, model: str = FitModelOpt,
         selection_tolerance: float = typer.Option(FIT.selection_tolerance, min=0.0,
                                                   help="With --model auto: relative excess of held-out RMS within "
                                                        "which the simpler model is chosen."),
@@ -92,7 +99,7 @@ def fit(friction: Path = FrictionArg,
     """Identify a friction model of every joint, with standard errors and the parameters left
     at a bound; warn about joints whose friction generates power (eq. 7.9)."""
     check_paths({"FRICTION": friction}, {"-o": output})
-    _run_fit(friction, output, FitOptions(model=model, selection_tolerance=selection_tolerance,
+    _run_fit(friction, output, FitOptions(model=cast(ModelChoice, model), selection_tolerance=selection_tolerance,
                                           min_samples=min_samples, pass_rows=pass_rows,
                                           terms=term_options(terms, max_harmonic, reference_temperature,
                                                              temperature_law)),

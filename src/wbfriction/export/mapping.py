@@ -71,6 +71,8 @@ import numpy as np
 from wbfriction.exceptions import InputError
 from wbfriction.fit.result import FitResult
 from wbfriction.fit.status import FitStatus, FitVerdict
+from wbfriction.friction.families.params import ModelParamsBase
+from wbfriction.friction.families.registry import family
 from wbfriction.model.robot import Robot
 
 
@@ -185,12 +187,11 @@ or bare parameters of a model (e.g. :class:`FrictionParams`)."""
 
 
 def static_level(params: FrictionModelParams) -> float:
-    """The static friction F_s [N·m], the level at rest: ``(1 + S) F_c`` of model (3.5), the
+    """The static friction F_s [N·m], the level at rest, as the parameters' family defines it
+    (:meth:`~wbfriction.friction.families.base.FrictionFamily.static_level`): ``(1 + S) F_c`` of model (3.5), the
     ``stribeck`` model's ``F_s``, ``F_c`` of the ``coulomb-viscous`` model."""
-    F_s, S = getattr(params, "F_s", None), getattr(params, "S", None)
-    if F_s is not None:
-        return float(F_s)
-    return float((1.0 + S) * params.F_c) if S is not None else float(params.F_c)
+    model_params = cast(ModelParamsBase, params)
+    return family(model_params.model).static_level(model_params)
 
 
 @dataclass(frozen=True)

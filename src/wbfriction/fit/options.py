@@ -9,16 +9,30 @@ import math
 from dataclasses import dataclass
 from typing import Literal, get_args
 
-from wbfriction.choices import check_choice, check_range
+from wbfriction.choices import check_choice, check_range, flag
+from wbfriction.friction.families.names import REGISTERED, BuiltinName, check_family
 from wbfriction.friction.options import TEMPERATURE_LAWS, TERMS, TemperatureLaw, Term
 from wbfriction.logs.options import check_reference_temperature
 
-ModelChoice = Literal["auto", "coulomb-viscous", "stribeck", "thesis"]
-"""The model to fit: one of :data:`~wbfriction.friction.models.ModelName`, or ``auto``: the
-simplest whose held-out error is within a tolerance of the best (:mod:`~wbfriction.fit`)."""
+AUTO = "auto"
+"""The model choice that is no family: per joint, the simplest family whose held-out error is within a tolerance of
+the best (:mod:`~wbfriction.fit.selection`)."""
+
+ModelChoice = Literal["auto", BuiltinName]
+"""The model to fit: a built-in friction family (:data:`~wbfriction.friction.families.names.BuiltinName`), or
+``auto``: the simplest whose held-out error is within a tolerance of the best (:mod:`~wbfriction.fit`). A family
+registered (:func:`~wbfriction.friction.families.registry.register_family`) is a choice too (:func:`model_choices`)."""
 
 
 MODEL_CHOICES: tuple[ModelChoice, ...] = get_args(ModelChoice)
+"""``auto`` and the built-in families, simplest first."""
+
+
+def model_choices() -> tuple[str, ...]:
+    """``auto``, the built-in families (simplest first) and those registered in this process, none loaded (the
+    command line's help lists them): a family an installed package advertises is a choice too, found when named
+    (:func:`~wbfriction.friction.families.registry.check_family`)."""
+    return tuple(dict.fromkeys((*MODEL_CHOICES, *REGISTERED)))
 
 
 DEFAULT_THRESHOLD = 0.05
@@ -97,8 +111,9 @@ class FitOptions:
     ``wbfriction fit``.
 
     Attributes:
-        model: the model per joint (:data:`ModelChoice`); ``auto``: the simplest whose held-out RMS is within
-            ``selection_tolerance`` of the best.
+        model: the model per joint: a friction family's name (:data:`ModelChoice`, or one registered:
+            :func:`model_choices`); ``auto``: the simplest whose held-out RMS is within ``selection_tolerance`` of the
+            best. Checked here, once: the fit takes it as it is.
         selection_tolerance: relative excess of held-out RMS within which ``auto`` takes the simpler model
             (dimensionless, >= 0).
         min_samples: joints with fewer valid samples get no parameters (>= 1).
@@ -113,6 +128,8 @@ class FitOptions:
             prediction scores).
 
     Raises:
+        UnknownFamilyError: a model that is no family's nor ``auto`` (an :class:`OptionError` naming ``--model`` and
+            the choices).
         OptionError: a value not one of its choices or out of its range, named by its command-line option.
     """
 
@@ -125,7 +142,7 @@ class FitOptions:
     score_slow: bool = True
 
     def __post_init__(self) -> None:
-        check_choice("model", self.model, MODEL_CHOICES)
+        check_family(self.model, flag("model"), also=(AUTO,))
         check_range("pass_rows", self.pass_rows, low=0.0)
         check_range("selection_tolerance", self.selection_tolerance, low=0.0)
         check_range("min_samples", self.min_samples, low=1)

@@ -1,9 +1,11 @@
 """Variable projection: the friction fit's start from its non-linear parameters alone (issue 41).
 
-Every model of :mod:`wbfriction.friction.models` is a sum of terms: a column that depends at most on the Stribeck
-velocity ``v_s`` and the tanh slope ``a`` (:func:`~wbfriction.friction.models.model_columns`, its expectation under
-the velocity noise :func:`~wbfriction.fit.eiv.expected_columns`), times a product of the linear parameters
-(:data:`TERMS`). Model (3.5), for instance, is
+Every friction family (:mod:`wbfriction.friction.families`) is a sum of terms: a design column that depends at most on
+the family's non-linear parameters (:attr:`~wbfriction.friction.families.base.FrictionFamily.nonlinear`: the Stribeck
+velocity ``v_s`` and the tanh slope ``a`` of the built-in ones; :meth:`~wbfriction.friction.families.base.
+FrictionFamily.columns`, its expectation under the velocity noise :meth:`~wbfriction.friction.families.base.
+FrictionFamily.expected_columns`), times a product of the linear parameters
+(:attr:`~wbfriction.friction.families.base.FrictionFamily.column_factors`). Model (3.5), for instance, is
 ``F_v qd + F_c tanh(a qd) + (F_c S) tanh(a qd) exp(-|qd / v_s|^delta_s) + tau_os``: linear in
 ``(F_v, F_c, F_c S, tau_os)`` once ``(v_s, a)`` is set. The least-squares fit over every parameter is then one over
 ``(v_s, a)`` alone of the residual the linear solve leaves (Golub and Pereyra, "The differentiation of pseudo-inverses
@@ -11,11 +13,12 @@ and nonlinear least squares problems whose variables separate", SIAM J. Numer. A
 parameters (one for the Stribeck model, none for the Coulomb-viscous one), each of its evaluations an exact bounded
 linear solve (F_v, F_c, F_s - F_c, F_c S >= 0).
 
-:func:`projected_start` searches it: a coarse grid over ``log (v_s, a)`` (:data:`GRID` points a parameter) marks the
-basins (the grid's local minima), a bounded least-squares search refines the best :data:`BASINS` of them, and the
-best is returned, in the fit's coordinates, as the start of the fit over every parameter
-(:func:`wbfriction.fit.selection.fit_friction`), which then converges in a few iterations and gives the Jacobian of
-the standard errors. The grid replaces random multi-starts: it is the same for every joint of a given speed.
+:func:`projected_start` searches it: a coarse grid over the logarithms of the non-linear parameters (:data:`GRID`
+points a parameter) marks the basins (the grid's local minima), a bounded least-squares search refines the best
+:data:`BASINS` of them, and the best is returned, in the fit's coordinates, as the start of the fit over every
+parameter (:func:`wbfriction.fit.selection.fit_friction`), which then converges in a few iterations and gives the
+Jacobian of the standard errors. The grid replaces random multi-starts: it is the same for every joint of a given
+speed.
 
 Parameters held at a value (``fit_friction``'s ``fixed``) leave the product of the others in each term: a term whose
 parameters are all held is subtracted from the data, terms left with the same free parameters share an unknown
@@ -29,25 +32,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wbfriction.fit.eiv import expected_columns, expected_jump
 from wbfriction.fit.smoothing import row_smoothing
+from wbfriction.friction.families.base import FrictionFamily
+from wbfriction.friction.families.registry import family
 from wbfriction.friction.models import ModelName
 
-TERMS: dict[ModelName, tuple[tuple[int, ...], ...]] = {
-    "coulomb-viscous": ((0,), (1,), (2,)),
-    "stribeck": ((0,), (1,), (2,), (4,)),
-    "thesis": ((0,), (1,), (1, 2), (4,)),
-}
-"""The parameters (positions in the fit's coordinates, :func:`~wbfriction.fit.coordinates.to_fit_coordinates`) whose
-product multiplies each column of :func:`~wbfriction.friction.models.model_columns`: (3.5)'s Stribeck term is
-``F_c S`` times its column, the Stribeck model's ``F_s - F_c``."""
-
-NONLINEAR: dict[ModelName, tuple[int, ...]] = {"coulomb-viscous": (), "stribeck": (3,), "thesis": (3, 5)}
-"""Positions of ``v_s`` and ``a`` (the parameters the columns depend on) in the fit's coordinates."""
-
 GRID = 7
-"""Grid points per non-linear parameter: ``v_s`` from 0.02 to 1 times the joint's speed (the 90th percentile of
-``|qd|``), ``a`` from 1 to 300 over it, evenly in logarithm (and ``a``'s upper bound). Six missed the global
+"""Grid points per non-linear parameter: a velocity (``v_s``) from 0.02 to 1 times the joint's speed (the 90th
+percentile of ``|qd|``), a slope (``a``, one of the family's
+:attr:`~wbfriction.friction.families.base.FrictionFamily.step_slopes`) from 1 to 300 over it, evenly in logarithm
+(and the slope's upper bound). Six missed the global
 minimum of noise-free (3.5) with a soft jump (``a = 10``) and a Stribeck velocity as narrow as it (0.05 rad/s):
 the grid's only two basins both led elsewhere (``tests/friction/test_models.py``)."""
 
@@ -88,12 +82,19 @@ class LinearPart:
         return z
 
 
+def factor_positions(fam: FrictionFamily) -> tuple[tuple[int, ...], ...]:
+    """Per design column of ``fam``, the positions (fit coordinates) of the parameters whose product multiplies it
+    (:attr:`~wbfriction.friction.families.base.FrictionFamily.column_factors`): (3.5)'s Stribeck term is ``F_c S``
+    times its column, the Stribeck model's ``F_s - F_c``."""
+    return tuple(fam.positions(f) for f in fam.column_factors)
+
+
 def linear_part(model: ModelName, held: np.ndarray, free: np.ndarray, lower: np.ndarray,
                 upper: np.ndarray) -> LinearPart:
     """:class:`LinearPart` of ``model`` with the parameters not ``free`` (P,) held at ``held`` (P,) (fit
     coordinates; ``lower``, ``upper`` (P,) their bounds). A product of two free parameters is one unknown (a term
-    can have at most two, :data:`TERMS`)."""
-    terms = TERMS[model]
+    can have at most two, :func:`factor_positions`)."""
+    terms = factor_positions(family(model))
     unknowns: list[tuple[int, ...]] = []
     factors: list[tuple[int, int, float]] = []
     offset = np.zeros(len(terms))
@@ -131,12 +132,12 @@ def bounded_linear_solve(A: np.ndarray, b: np.ndarray, lower: np.ndarray, upper:
 
 class Projection:
     """The variable-projection functional of one joint's fit: the residual (n,) the bounded linear solve leaves at
-    each ``log (v_s, a)`` (the free ones among them), on the rows fitted, with the model's expectation under the
-    velocity noise and, with a smoother, passed through it along the whole series (as
+    each logarithm of the non-linear parameters (the free ones among them), on the rows fitted, with the model's
+    expectation under the velocity noise and, with a smoother, passed through it along the whole series (as
     :func:`~wbfriction.fit.solve.filtered_problem`).
 
     Args:
-        model: the model.
+        model: the model (a family's name).
         qd: velocities (N,) [rad/s] (the whole series with a smoother, NaN where left out of it; else the rows used).
         y: ``-tau_f`` (N,) [N·m], as ``qd``.
         rows: the rows fitted (n,) (indices into ``qd``).
@@ -148,41 +149,55 @@ class Projection:
 
     With a smoother, the columns are computed on the samples the smoother's output on the rows fitted depends on alone
     (:func:`~wbfriction.fit.smoothing.row_smoothing`).
+
+    Raises:
+        UnknownFamilyError: no family named ``model``.
     """
 
     def __init__(self, model: ModelName, qd: np.ndarray, y: np.ndarray, rows: np.ndarray, smoother, sigma: float,
                  delta_s: float, held: np.ndarray, free: np.ndarray, lower: np.ndarray, upper: np.ndarray):
+        self.family = fam = family(model)
         self.model, self.rows = model, rows
         self.sigma, self.delta_s, self.held = sigma, delta_s, held
         self.y = y[rows]
         self.smoothing = None if smoother is None else row_smoothing(smoother, qd.size, rows)
         self.qd = qd[rows] if self.smoothing is None else qd[self.smoothing.support]
         self.part = linear_part(model, held, free, lower, upper)
-        self.theta = tuple(i for i in NONLINEAR[model] if free[i])
+        self.theta = tuple(i for i in fam.positions(fam.nonlinear) if free[i])
+        self.slopes = tuple(fam.names[i] in fam.step_slopes for i in self.theta)  # else a velocity
         self.theta_bounds = (np.log(np.maximum(lower[list(self.theta)], 1e-300)), np.log(upper[list(self.theta)]))
-        self._ends: np.ndarray | None = None  # the columns qd and 1, on the rows (smoothed)
-        self._jump: tuple[float, np.ndarray, np.ndarray] | None = None  # a, its column, on the rows (smoothed)
+        self.jump_at = fam.positions(fam.jump_params)
+        k = len(fam.column_factors)
+        self.fixed = [c for c in range(k) if c != fam.jump_column and c not in fam.varying_columns]
+        self._ends: np.ndarray | None = None  # the columns that depend on no parameter (qd, 1), on the rows (smoothed)
+        # the jump's parameters (a), its column, on the rows (smoothed)
+        self._jump: tuple[tuple[float, ...], np.ndarray, np.ndarray] | None = None
 
     def _columns(self, log_theta: np.ndarray) -> np.ndarray:
         """The model's columns (n, K) on the rows fitted at ``log_theta``, smoothed if the fit is; the jump column,
-        which depends on ``a`` alone, is kept for the next call (a grid's row, a step in ``v_s``)."""
+        which depends on the jump's parameters alone (``a``), is kept for the next call (a grid's row, a step in
+        ``v_s``)."""
+        fam = self.family
         z = self.held.copy()
         z[list(self.theta)] = np.exp(log_theta)
-        v_s, a = (z[3], z[5]) if self.model == "thesis" else (z[3] if self.model == "stribeck" else 1.0, 1.0)
-        if self._jump is None or self._jump[0] != a:
-            jump = expected_jump(self.qd, self.sigma, self.model, a)
-            self._jump = (a, jump, jump if self.smoothing is None else self.smoothing(jump))
-        columns = expected_columns(self.qd, self.sigma, self.delta_s, self.model, v_s, a, jump=self._jump[1])
+        if fam.jump_column is not None:
+            key = tuple(z[i] for i in self.jump_at)
+            if self._jump is None or self._jump[0] != key:
+                jump = fam.expected_jump(self.qd, self.sigma, z)
+                self._jump = (key, jump, jump if self.smoothing is None else self.smoothing(jump))
+        columns = fam.expected_columns(self.qd, self.sigma, self.delta_s, z,
+                                       jump=None if self._jump is None else self._jump[1])
         if self.smoothing is None:
             return columns
-        # qd and 1 (the first and last columns) smoothed once, the jump once for each a
-        ends = [0, columns.shape[1] - 1]
+        # the columns of no parameter (qd and 1) smoothed once, the jump once for each value of its parameters
         if self._ends is None:
-            self._ends = self.smoothing(columns[:, ends])
+            self._ends = self.smoothing(columns[:, self.fixed])
         out = np.empty((self.rows.size, columns.shape[1]))
-        out[:, ends], out[:, 1] = self._ends, self._jump[2]
-        if columns.shape[1] == 4:  # the Stribeck column
-            out[:, 2] = self.smoothing(columns[:, 2])
+        out[:, self.fixed] = self._ends
+        if self._jump is not None and fam.jump_column is not None:
+            out[:, fam.jump_column] = self._jump[2]
+        for c in fam.varying_columns:  # the Stribeck column
+            out[:, c] = self.smoothing(columns[:, c])
         return out
 
     def solve(self, log_theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -205,12 +220,12 @@ class Projection:
 
 
 def theta_axes(projection: Projection, speed: float) -> list[np.ndarray]:
-    """The grid's axes: ``log v_s`` and ``log a`` (the free ones) for a joint of ``speed`` [rad/s] (:data:`GRID`
-    points each, and ``a``'s upper bound), inside the bounds."""
+    """The grid's axes: the logarithms of the free non-linear parameters (``log v_s``, ``log a``) for a joint of
+    ``speed`` [rad/s] (:data:`GRID` points each, and a slope's upper bound), inside the bounds."""
     axes = []
     lo, hi = projection.theta_bounds
-    for j, i in enumerate(projection.theta):
-        if i == 3:
+    for j, slope in enumerate(projection.slopes):
+        if not slope:  # a velocity
             values = np.log(np.geomspace(0.02, 1.0, GRID) * speed)
         else:  # and the bound: a jump sharper than the data's sampling (a sign function) runs a there
             values = np.append(np.log(np.geomspace(1.0, 300.0, GRID) / speed), hi[j])

@@ -12,7 +12,6 @@ from typing import Generic, cast
 import numpy as np
 from numpy.typing import ArrayLike
 
-from wbfriction.fit.coordinates import BOUNDS, STEP_SLOPES
 from wbfriction.fit.holdout import (
     PredictionCheck,
 )
@@ -20,12 +19,11 @@ from wbfriction.fit.options import PASS_ROWS, SELECTION_TOLERANCE
 from wbfriction.fit.status import HELD, FitVerdict, fit_verdict, routes_disagree
 from wbfriction.fit.terms import TermFit, term_signals
 from wbfriction.friction.estimated import FrictionEstimate
+from wbfriction.friction.families.registry import family
 from wbfriction.friction.models import (
-    MODEL_PARAMS,
     ModelName,
     ModelParams,
     ParamsT,
-    model_jacobian,
 )
 
 
@@ -229,13 +227,13 @@ class FitResult(Generic[ParamsT]):
         v = np.asarray(v, dtype=float)
         if self.params is None:
             return np.full(v.shape, np.nan), np.full(v.shape, np.nan)
-        x, model = self.params.as_vector(), self.params.model
+        x, fam = self.params.as_vector(), family(self.params.model)
         value = 0.5 * (self.params.f(v) - self.params.f(-v))
         if self.covariance is None:
             return value, np.full(v.shape, np.nan)
         flat = v.ravel()
         delta_s = getattr(self.params, "delta_s", 2.0)
-        g = 0.5 * (model_jacobian(x, flat, delta_s, model) - model_jacobian(x, -flat, delta_s, model))
+        g = 0.5 * (fam.jacobian(x, flat, delta_s) - fam.jacobian(x, -flat, delta_s))
         # a parameter that is not identifiable (infinite variance) counts where the curve depends on it at these
         # speeds, and makes its error infinite there; elsewhere (a step's slope beyond its first samples) not
         known = np.isfinite(np.diag(self.covariance))
@@ -249,13 +247,15 @@ class FitResult(Generic[ParamsT]):
         return tuple(n for n, at in self.at_bound.items() if at)
 
     def steps(self) -> tuple[str, ...]:
-        """The slopes at their upper bound (:data:`STEP_SLOPES`: (3.5)'s tanh slope ``a``): a step sharper than the
-        data resolve, which is Coulomb friction (``sgn``), not a failure of the fit; its status does not count it
-        as a bound (:func:`~wbfriction.fit.status.fit_verdict`) and the tables show it as a step."""
+        """The slopes at their upper bound (the family's
+        :attr:`~wbfriction.friction.families.base.FrictionFamily.step_slopes`: (3.5)'s tanh slope ``a``): a step
+        sharper than the data resolve, which is Coulomb friction (``sgn``), not a failure of the fit; its status does
+        not count it as a bound (:func:`~wbfriction.fit.status.fit_verdict`) and the tables show it as a step."""
         if self.params is None:
             return ()
-        upper = dict(zip(MODEL_PARAMS[self.model].names, BOUNDS[self.model][1]))
-        return tuple(n for n in STEP_SLOPES if self.at_bound.get(n) and n in upper
+        fam = family(self.model)
+        upper = dict(zip(fam.names, fam.upper))
+        return tuple(n for n in fam.step_slopes if self.at_bound.get(n) and n in upper
                      and getattr(self.params, n) >= 0.5 * upper[n])
 
     def verdict(self) -> FitVerdict:
@@ -265,8 +265,8 @@ class FitResult(Generic[ParamsT]):
 
     def error_percent(self) -> dict[str, float] | None:
         """Relative error of each parameter against :attr:`target` [%] (Tables 6.1, 6.2); for a
-        model other than (3.5), against the target's values under its names
-        (:meth:`~wbfriction.friction.models.FrictionParams.values_in`)."""
+        model other than the target's, against the target's values under its names
+        (:meth:`~wbfriction.friction.families.params.ModelParamsBase.values_in`)."""
         if self.params is None or self.target is None:
             return None
         target = self.target.values_in(self.model)

@@ -20,7 +20,6 @@ from typing import Any
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.fit.eiv import expected_values
 from wbfriction.fit.holdout import (
     LATER,
     MIN_HELD_OUT,
@@ -29,7 +28,7 @@ from wbfriction.fit.holdout import (
     prediction_variance,
     split_later,
 )
-from wbfriction.fit.options import MODEL_CHOICES, PASS_ROWS, SELECTION_TOLERANCE, ModelChoice
+from wbfriction.fit.options import AUTO, PASS_ROWS, SELECTION_TOLERANCE
 from wbfriction.fit.regression import (
     held_out_gain,
     held_out_split,
@@ -37,7 +36,6 @@ from wbfriction.fit.regression import (
 from wbfriction.fit.result import FitResult, HeldOutScore, ModelSelection
 from wbfriction.fit.solve import (
     blas_controller,
-    check_fixed,
     fit_model,
     fitted_rows,
     model_fixed,
@@ -45,13 +43,9 @@ from wbfriction.fit.solve import (
     shown_friction,
 )
 from wbfriction.fit.status import MIN_SPEED
-from wbfriction.friction.models import (
-    MODEL_NAMES,
-    MODEL_PARAMS,
-    ModelName,
-    ModelParamsBase,
-    check_model,
-)
+from wbfriction.friction.families.base import FrictionFamily
+from wbfriction.friction.families.registry import families, family
+from wbfriction.friction.models import ModelName, ModelParamsBase
 from wbfriction.friction.noise import JointNoise
 
 
@@ -69,8 +63,8 @@ def held_out_residuals(params: ModelParamsBase, qd: np.ndarray, tau_f: np.ndarra
         velocity_noise: the velocity's noise [rad/s]: the model's expectation under it, as in the fit
             (:mod:`~wbfriction.fit.eiv`).
     """
-    f = expected_values(params.as_vector(), np.asarray(qd, dtype=float), velocity_noise,
-                        getattr(params, "delta_s", 2.0), params.model)
+    f = family(params.model).expected_values(params.as_vector(), np.asarray(qd, dtype=float), velocity_noise,
+                                             getattr(params, "delta_s", 2.0))
     if smoother is not None:
         f = smoother(f)
     return (f + np.asarray(tau_f, dtype=float))[np.asarray(rows, dtype=bool)]
@@ -115,7 +109,7 @@ def choose_model(scores: tuple[HeldOutScore, ...], tolerance: float = SELECTION_
 
 def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joint: str = "",
                  x0: np.ndarray | None = None, min_samples: int = 20, mask: np.ndarray | None = None,
-                 smoother=None, fixed: dict[str, float] | None = None, model: ModelChoice = "thesis",
+                 smoother=None, fixed: dict[str, float] | None = None, model: str = "thesis",
                  selection_tolerance: float = SELECTION_TOLERANCE, velocity_noise: float = 0.0,
                  stick: float = 0.0, stick_margin: int = 0, pass_rows: float = PASS_ROWS,
                  score_slow: bool = True, noise: JointNoise | None = None,
@@ -127,9 +121,9 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         tau_f: friction torques on the joint (N,) [N·m] (``tau_f = -f(qd)``).
         delta_s: Stribeck exponent, fixed (thesis: 2).
         joint: name, for the result.
-        x0: a starting point in the order of the model's names
-            (:data:`~wbfriction.friction.models.PARAM_NAMES` for (3.5)); by default several
-            (:func:`initial_guesses`), the best fit is kept. Not with ``model="auto"``.
+        x0: a starting point in the order of the model's names (:data:`~wbfriction.friction.models.PARAM_NAMES`
+            for (3.5)); by default the variable projection's (:func:`~wbfriction.fit.projection.projected_start`).
+            Not with ``model="auto"``.
         min_samples: fewer samples give a result without parameters.
         mask: (N,) samples to fit (default: every finite one); gross outliers among them are
             left out and counted (:func:`~wbfriction.fit.screen.gross_outliers`,
@@ -143,19 +137,19 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         fixed: parameters held at a value instead of fitted (standard error 0), e.g.
             ``{"S": 0, "v_s": 0.1, "tau_os": 0}`` for a Coulomb-viscous model (3.5). With
             ``model="auto"`` each candidate holds those it has.
-        model: the model (:data:`ModelChoice`): ``thesis`` (3.5), ``stribeck``,
-            ``coulomb-viscous``, or ``auto`` (chosen by held-out error, module docstring).
+        model: a friction family's name (:func:`~wbfriction.friction.families.registry.family`): ``thesis`` (3.5),
+            ``stribeck``, ``coulomb-viscous`` or one registered; or ``auto`` (chosen by held-out error among every
+            family, module docstring).
         selection_tolerance: with ``auto``, the relative excess of held-out RMS over the best
             within which the simpler model is chosen.
         velocity_noise: the standard deviation of the noise in ``qd`` [rad/s]: the model compared is its expectation
             under that noise (errors in variables, :mod:`~wbfriction.fit.eiv`); 0: the model itself.
         stick, stick_margin, pass_rows: samples within ``stick_margin`` rows of a speed below ``stick`` [rad/s] are
-            left out, but for reversals crossing that band within ``pass_rows`` rows
+            left out, but for reversals crossing that band within ``pass_rows`` rows (:func:`stuck_rows`), and
+            counted (:attr:`FitResult.n_stuck`); 0: none. Not for a joint that hardly moved
+            (:data:`~wbfriction.fit.status.MIN_SPEED`: ``not excited``), whose every sample gives its offset.
         score_slow: with ``auto``, the held-out blocks' samples left out that way are scored too (what ``predict``
-            scores: a model with no Coulomb step there misses them)
-            (:func:`stuck_rows`) and counted (:attr:`FitResult.n_stuck`); 0: none. Not for a joint that hardly
-            moved (:data:`~wbfriction.fit.status.MIN_SPEED`: ``not excited``), whose every sample gives its
-            offset.
+            scores: a model with no Coulomb step there misses them).
         noise: what is known of the estimate's noise (:class:`~wbfriction.friction.noise.JointNoise`): the fit then
             carries its Cramér-Rao bound (:attr:`FitResult.crb`); None: no bound.
         still: the model fitted instead of the one named (from its own start, not ``x0``) when the joint hardly
@@ -166,36 +160,43 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         :class:`FitResult`.
 
     Raises:
-        InputError: an unknown model, a name in ``fixed`` that is not the model's (for
-            ``auto``: no model's), ``x0`` with ``auto``, a ``stribeck`` F_s held without F_c.
+        UnknownFamilyError: a model that is no family's (nor ``auto``).
+        InputError: a name in ``fixed`` that is not the model's (for ``auto``: no model's), ``x0`` with ``auto``,
+            a ``stribeck`` F_s held without F_c.
     """
-    if model not in MODEL_CHOICES:
-        raise InputError(f"model must be one of {', '.join(MODEL_CHOICES)}, got '{model}'")
+    named = None if model == AUTO else family(model)
     qd = np.asarray(qd, dtype=float)
     y = -np.asarray(tau_f, dtype=float)
     use, screened, stuck, speed = fitted_rows(qd, tau_f, mask, smoother, stick, stick_margin, pass_rows)
+    kwargs: dict[str, Any] = dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother,
+                                  fixed=fixed, sigma=velocity_noise, noise=noise)
     # One BLAS thread: the solver's many small (N x p) factorizations run several times
     # slower on OpenBLAS's threads than on one (30 TALOS joints of a 10-step walk: 78 s
     # against 14 s on 2 cores); fit joints side by side instead (fit_estimate's workers).
     with blas_controller().limit(limits=1, user_api="blas"):
-        if model == "auto":
+        if named is None:
             if x0 is not None:
                 raise InputError("x0 needs a named model, not 'auto'")
-            res = _fit_auto(qd, y, use, delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother,
-                            fixed=fixed, tolerance=selection_tolerance, sigma=velocity_noise, noise=noise,
-                            speed=speed, stuck=stuck if score_slow else None)
+            res = _fit_auto(qd, y, use, tolerance=selection_tolerance, speed=speed,
+                            stuck=stuck if score_slow else None, **kwargs)
         else:
-            if still is not None and speed < MIN_SPEED:  # held names checked against the model named all the same
-                check_fixed(check_model(model), fixed)
-                model, x0, fixed = still, None, model_fixed(still, fixed)
-            res = fit_model(check_model(model), qd, y, use, delta_s=delta_s, joint=joint, x0=x0,
-                             min_samples=min_samples, smoother=smoother, fixed=fixed, sigma=velocity_noise,
-                             noise=noise)
-    res.n_screened = int(screened.sum())
-    res.speed = speed
-    res.velocity_noise, res.stick_speed, res.n_stuck = float(velocity_noise), float(stick), int(stuck.sum())
-    res.pass_rows = float(pass_rows)
+            res = fit_named(named, qd, y, use, x0=x0, still=still if speed < MIN_SPEED else None, **kwargs)
+    res.n_screened, res.n_stuck = int(screened.sum()), int(stuck.sum())
+    res.speed, res.velocity_noise = speed, float(velocity_noise)
+    res.stick_speed, res.pass_rows = float(stick), float(pass_rows)
     return res
+
+
+def fit_named(fam: FrictionFamily, qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, x0: np.ndarray | None,
+              still: ModelName | None, fixed: dict[str, float] | None, **kwargs: Any) -> FitResult:
+    """``fit_friction`` of the family ``fam`` named on the usable samples ``use`` of ``y = -tau_f``; with ``still``
+    (a joint that hardly moved), that family instead, from its own start, holding those of ``fixed`` it has (the
+    names held are checked against ``fam`` all the same). ``kwargs``: :func:`~wbfriction.fit.solve.fit_model`'s."""
+    model = fam.name
+    if still is not None:
+        fam.check_fixed(fixed)
+        model, x0, fixed = still, None, model_fixed(still, fixed)
+    return fit_model(model, qd, y, use, x0=x0, fixed=fixed, **kwargs)
 
 
 def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float, joint: str, min_samples: int,
@@ -203,12 +204,14 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
               noise: JointNoise | None = None, speed: float = np.inf,
               stuck: np.ndarray | None = None) -> FitResult:
     """``fit_friction(model="auto")`` on the usable samples ``use`` (module docstring); a joint whose ``speed``
-    [rad/s] (:func:`fitted_rows`) is below :data:`~wbfriction.fit.status.MIN_SPEED` gets the simplest model."""
+    [rad/s] (:func:`fitted_rows`) is below :data:`~wbfriction.fit.status.MIN_SPEED` gets the simplest model. The
+    candidates: every family (:func:`~wbfriction.friction.families.registry.families`), simplest first."""
     fixed = dict(fixed or {})
-    known = {n for m in MODEL_NAMES for n in MODEL_PARAMS[m].names}
+    candidates = [f.name for f in families()]
+    known = {n for f in families() for n in f.names}
     if set(fixed) - known:
         raise InputError(f"unknown parameter(s) to fix: {', '.join(sorted(set(fixed) - known))}")
-    held = {m: model_fixed(m, fixed) for m in MODEL_NAMES}
+    held = {m: model_fixed(m, fixed) for m in candidates}
     kwargs = dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, sigma=sigma)
     train, held_out = held_out_split(use)
     scored = held_out
@@ -216,7 +219,7 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
         _, scored = held_out_split(use | stuck)
         scored &= np.isfinite(qd) & np.isfinite(y)
     n_train, n_held_out = int(train.sum()), int(held_out.sum())
-    simplest = MODEL_NAMES[0]
+    simplest = candidates[0]
     why = None
     if min(n_train, n_held_out) < max(min_samples, 7):
         why = f"too few samples ({int(use.sum())}) to hold any out"
@@ -227,7 +230,7 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
         res = fit_model(simplest, qd, y, use, fixed=held[simplest], noise=noise, **kwargs)
         res.selection = ModelSelection(simplest, f"{simplest}: {why}", (), tolerance, n_train, n_held_out)
         return res
-    trained = {m: fit_model(m, qd, y, train, fixed=held[m], **kwargs) for m in MODEL_NAMES}
+    trained = {m: fit_model(m, qd, y, train, fixed=held[m], **kwargs) for m in candidates}
     residuals = {m: held_out_residuals(r.params, qd, -y, scored, smoother, sigma) for m, r in trained.items()
                  if r.params is not None}
     scores = tuple(HeldOutScore(m, float(np.sqrt(np.mean(residuals[m] ** 2))) if m in residuals else float("nan"),

@@ -1,11 +1,13 @@
 """One model fitted to one joint's friction (thesis 6.2.2, eq. 6.4).
 
 Per joint, ``scipy.optimize.least_squares(method="trf")`` fits the characteristic ``f(qd; p)``
-of one of the models of :mod:`wbfriction.friction.models` (``coulomb-viscous``, ``stribeck``
-or the thesis's (3.5)) to ``-tau_f`` over the valid samples (sign convention of that module),
-with bounds (:mod:`~wbfriction.fit.coordinates`), from one start: the minimum over the non-linear parameters
-``(v_s, a)`` with the linear ones solved exactly (variable projection, :mod:`wbfriction.fit.projection`: a coarse
-grid, then a local search). Each parameter gets a standard error from the Jacobian at the solution,
+of one of the friction families of :mod:`wbfriction.friction.families` (``coulomb-viscous``, ``stribeck``,
+the thesis's (3.5), or one registered) to ``-tau_f`` over the valid samples (sign convention of
+:mod:`wbfriction.friction.models`), with the family's bounds in its fit's coordinates
+(:mod:`~wbfriction.fit.coordinates`), from one start: the minimum over the non-linear parameters
+(the built-in families' ``(v_s, a)``) with the linear ones solved exactly (variable projection,
+:mod:`wbfriction.fit.projection`: a coarse grid, then a local search). Each parameter gets a standard error from
+the Jacobian at the solution,
 
 .. math:: \\operatorname{cov}(\\hat p) = s^2 (J^T J)^{-1}, \\qquad s^2 = \\frac{\\|r\\|^2}{N - p},
 
@@ -30,20 +32,12 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from wbfriction.exceptions import InputError
 from wbfriction.fit.bound import BATCH, cramer_rao, torque_noise
 from wbfriction.fit.coordinates import (
     AT_BOUND_NEAR,
     AT_BOUND_RTOL,
     AT_BOUND_SSR,
-    FIXED_COLUMNS,
-    STEP_SLOPES,
-    fit_coordinates_jacobian,
-    from_fit_coordinates,
-    model_bounds,
-    to_fit_coordinates,
 )
-from wbfriction.fit.eiv import expected_jacobian, expected_values
 from wbfriction.fit.options import PASS_ROWS
 from wbfriction.fit.projection import BASINS, Projection, projected_start
 from wbfriction.fit.regression import (
@@ -55,11 +49,8 @@ from wbfriction.fit.result import FitResult
 from wbfriction.fit.screen import gross_outliers
 from wbfriction.fit.smoothing import row_smoothing, smoother_half_width
 from wbfriction.fit.status import MIN_SPEED, joint_speed
-from wbfriction.friction.models import (
-    MODEL_PARAMS,
-    ModelName,
-    model_jacobian,
-)
+from wbfriction.friction.families.registry import family
+from wbfriction.friction.models import ModelName
 from wbfriction.friction.noise import JointNoise
 
 
@@ -92,20 +83,22 @@ def filtered_problem(qd: np.ndarray, y: np.ndarray, use: np.ndarray, smoother, d
     [rad/s] the model's expectation under it (:mod:`~wbfriction.fit.eiv`).
 
     The smoother is linear and filters each column alone, so the columns of the Jacobian that do
-    not depend on the parameters (:data:`FIXED_COLUMNS`: the regressors ``qd``, ``sgn(qd)``, 1) are
-    filtered once, the others at every call; the residual filters the model's values alone. The model is evaluated
-    on the samples the rows depend on alone (:func:`~wbfriction.fit.smoothing.row_smoothing`)."""
+    not depend on the parameters (the family's
+    :attr:`~wbfriction.friction.families.base.FrictionFamily.constant_columns`: the regressors ``qd``, ``sgn(qd)``,
+    1) are filtered once, the others at every call; the residual filters the model's values alone. The model is
+    evaluated on the samples the rows depend on alone (:func:`~wbfriction.fit.smoothing.row_smoothing`)."""
+    fam = family(model)
     rows = np.flatnonzero(use)
     smoothing = row_smoothing(smoother, qd.size, rows)
     v, y_rows = qd[smoothing.support], y[rows]
-    fixed_columns = list(FIXED_COLUMNS[model])
+    fixed_columns = list(fam.positions(fam.constant_columns))
     filtered_fixed: list[np.ndarray] = []  # the smoothed fixed columns, on the rows used
 
     def residual(x: np.ndarray) -> np.ndarray:
-        return smoothing(expected_values(x, v, velocity_noise, delta_s, model)) - y_rows
+        return smoothing(fam.expected_values(x, v, velocity_noise, delta_s)) - y_rows
 
     def jacobian(x: np.ndarray) -> np.ndarray:
-        jac = expected_jacobian(x, v, velocity_noise, delta_s, model)
+        jac = fam.expected_jacobian(x, v, velocity_noise, delta_s)
         varying = np.ones(jac.shape[1], dtype=bool)
         varying[fixed_columns] = False
         if not filtered_fixed:
@@ -231,24 +224,20 @@ def _at_bound(z: np.ndarray, bounds: tuple[np.ndarray, np.ndarray], residual, id
 
 
 def check_fixed(model: ModelName, fixed: Mapping[str, float] | None) -> dict[str, float]:
-    """``fixed`` (parameter name: value held) as a dict, checked against ``model``'s names.
+    """``fixed`` (parameter name: value held) as a dict, checked against ``model``'s names
+    (:meth:`~wbfriction.friction.families.base.FrictionFamily.check_fixed`).
 
     Raises:
-        InputError: a name that is not ``model``'s; a ``stribeck`` F_s held without F_c.
+        InputError: a name that is not ``model``'s; a parameter held without the one it goes with (a ``stribeck`` F_s
+            held without F_c).
     """
-    fixed = dict(fixed or {})
-    names = MODEL_PARAMS[model].names
-    if set(fixed) - set(names):
-        raise InputError(f"unknown parameter(s) of the {model} model to fix: "
-                         f"{', '.join(sorted(set(fixed) - set(names)))}")
-    if model == "stribeck" and "F_s" in fixed and "F_c" not in fixed:
-        raise InputError("the stribeck model's F_s can be held only with F_c held too")
-    return fixed
+    return family(model).check_fixed(fixed)
 
 
 def model_fixed(model: ModelName, fixed: Mapping[str, float] | None) -> dict[str, float]:
     """The entries of ``fixed`` that are ``model``'s parameters (``auto``'s candidates, ``still``'s model)."""
-    return {k: v for k, v in (fixed or {}).items() if k in MODEL_PARAMS[model].names}
+    names = family(model).names
+    return {k: v for k, v in (fixed or {}).items() if k in names}
 
 
 @functools.cache
@@ -266,42 +255,48 @@ def fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, 
                joint: str = "", x0: np.ndarray | None = None, min_samples: int = 20, smoother=None,
                fixed: dict[str, float] | None = None, sigma: float = 0.0,
                noise: JointNoise | None = None) -> FitResult:
-    """:func:`fit_friction` of one model to ``y = -tau_f`` on the usable samples ``use``, on the threads it is given."""
-    names = MODEL_PARAMS[model].names
-    fixed = check_fixed(model, fixed)
+    """:func:`fit_friction` of one model to ``y = -tau_f`` on the usable samples ``use``, on the threads it is given.
+
+    Raises:
+        UnknownFamilyError: no family named ``model``.
+        InputError: a name in ``fixed`` that is not the model's (:func:`check_fixed`).
+    """
+    fam = family(model)
+    names = fam.names
+    fixed = fam.check_fixed(fixed)
     free = np.array([name not in fixed for name in names])
-    held = to_fit_coordinates(model, np.array([float(fixed.get(name, 0.0)) for name in names]))
+    held = fam.to_fit(np.array([float(fixed.get(name, 0.0)) for name in names]))
 
     def full(z: np.ndarray) -> np.ndarray:
         """The model's parameters from the free ones in the fit's coordinates."""
         x = held.copy()
         x[free] = z
-        return from_fit_coordinates(model, x)
+        return fam.from_fit(x)
 
     n = int(use.sum())
     v, yu = qd[use], y[use]
     speed = joint_speed(v)
     if n < max(min_samples, len(names) + 1):
         return FitResult(joint, n, message=f"only {n} valid samples", model=model, speed=speed)
-    lower, upper = model_bounds(v, model)
+    lower, upper = fam.bounds(v)
     bounds = (lower[free], upper[free])
     rows = np.flatnonzero(use)
     if smoother is None:
-        residual = lambda z: expected_values(full(z), v, sigma, delta_s, model) - yu  # noqa: E731
-        model_jac = lambda z: expected_jacobian(full(z), v, sigma, delta_s, model)  # noqa: E731
+        residual = lambda z: fam.expected_values(full(z), v, sigma, delta_s) - yu  # noqa: E731
+        model_jac = lambda z: fam.expected_jacobian(full(z), v, sigma, delta_s)  # noqa: E731
         projection = Projection(model, v, yu, np.arange(n), None, sigma, delta_s, held, free, lower, upper)
     else:
         f_residual, f_jacobian = filtered_problem(qd, y, use, smoother, delta_s, model, sigma)
         residual = lambda z: f_residual(full(z))  # noqa: E731
         model_jac = lambda z: f_jacobian(full(z))  # noqa: E731
         projection = Projection(model, qd, y, rows, smoother, sigma, delta_s, held, free, lower, upper)
-    jacobian = lambda z: fit_coordinates_jacobian(model, model_jac(z))[:, free]  # noqa: E731
+    jacobian = lambda z: fam.fit_jacobian(model_jac(z))[:, free]  # noqa: E731
     # one start: the given one, or the minimum over the non-linear parameters with the linear ones solved
     # (variable projection, :mod:`~wbfriction.fit.projection`), then the fit over every free parameter
-    start = to_fit_coordinates(model, np.asarray(x0, dtype=float)) if x0 is not None else projected_start(
+    start = fam.to_fit(np.asarray(x0, dtype=float)) if x0 is not None else projected_start(
         projection, float(np.percentile(np.abs(v), 90)), BASINS if speed >= MIN_SPEED else 1)
     best = _step_polish(_solve(residual, jacobian, start[free], bounds, 300), residual, jacobian, bounds,
-                        [i for i, n in enumerate(np.array(names)[free]) if n in STEP_SLOPES])
+                        [i for i, n in enumerate(np.array(names)[free]) if n in fam.step_slopes])
     # residuals correlated over the filter's window, or over the span of a model error;
     # standard errors of the model's own parameters (F_s, not F_s - F_c)
     cov = np.zeros((len(names), len(names)))
@@ -311,7 +306,7 @@ def fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, 
     at_bound = np.zeros(len(names), dtype=bool)
     at_bound[free] = _at_bound(best.x, bounds, residual, np.isfinite(se[free]))
     res = FitResult(
-        joint=joint, n_samples=n, params=MODEL_PARAMS[model].from_vector(full(best.x), delta_s),
+        joint=joint, n_samples=n, params=fam.params(full(best.x), delta_s),
         stderr=dict(zip(names, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
         success=bool(best.success), message=str(best.message), model=model,
         at_bound=dict(zip(names, map(bool, at_bound))), speed=speed, covariance=cov)
@@ -320,7 +315,7 @@ def fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, 
         res.torque_noise = sigma_tau
         if np.isfinite(sigma_tau):
             bound = np.zeros(len(names))
-            exact = model_jacobian(full(best.x), v, delta_s, model)[:, free]  # the bound: velocities known
+            exact = fam.jacobian(full(best.x), v, delta_s)[:, free]  # the bound: velocities known
             bound[free] = covariance_errors(cramer_rao(exact, rows, noise.with_torque(sigma_tau)))
             res.crb = dict(zip(names, map(float, bound)))
     return res
@@ -341,5 +336,5 @@ def model_gradient(fit: FitResult, qd: np.ndarray, rows: np.ndarray, smoother=No
     assert fit.params is not None
     x, delta_s = fit.params.as_vector(), getattr(fit.params, "delta_s", 2.0)
     if smoother is None:
-        return expected_jacobian(x, qd[rows], velocity_noise, delta_s, fit.model)
+        return family(fit.model).expected_jacobian(x, qd[rows], velocity_noise, delta_s)
     return filtered_problem(qd, np.zeros_like(qd), rows, smoother, delta_s, fit.model, velocity_noise)[1](x)

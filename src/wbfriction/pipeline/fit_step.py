@@ -8,7 +8,7 @@ from pathlib import Path
 from wbfriction.exceptions import InputError
 from wbfriction.fit.energy import JointEnergy, energy_consistency
 from wbfriction.fit.joints import fit_estimate
-from wbfriction.fit.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions
+from wbfriction.fit.options import AUTO, DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions
 from wbfriction.fit.params_file import energy_to_dict, write_params
 from wbfriction.fit.result import FitResult, fitted_offsets, fitted_ripples
 from wbfriction.friction.estimate import FrictionEstimate
@@ -66,7 +66,7 @@ def fit_file(friction: str | Path, output: str | Path, options: FitOptions = Fit
     header: dict[str, object] = {"provenance": {**file_provenance("friction", friction),
                                                 **{k: log[k] for k in ("robot", "urdf") if k in log}},
                                  "sign_convention": SIGN_CONVENTION, "model": options.model}
-    if options.model == "auto":
+    if options.model == AUTO:
         header["selection_tolerance"] = options.selection_tolerance
     write_params(output, fitted.fits, header, {e.joint: {"energy": energy_to_dict(e)} for e in fitted.energy})
     return fitted

@@ -36,7 +36,9 @@ from wbfriction.fit.joints import fit_estimate
 from wbfriction.fit.options import FitOptions, ModelChoice
 from wbfriction.fit.result import FitResult
 from wbfriction.friction.estimate import estimate_log
-from wbfriction.friction.models import CoulombViscousParams, FrictionParams, ModelName, ModelParams, StribeckParams
+from wbfriction.friction.families.names import BuiltinName
+from wbfriction.friction.families.registry import family as model_family
+from wbfriction.friction.models import FrictionParams, ModelName, ModelParams
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import Log, log_from_table
 from wbfriction.logs.tables import make_folder, write_atomic
@@ -49,12 +51,17 @@ from wbfriction.studies.common import ENCODER_BITS, TORQUE_STD
 from wbfriction.walking import walking_reference
 from wbfriction.walking.options import GaitOptions
 
-Family = Literal["coulomb-viscous", "stribeck", "thesis", "frictionloss"]
-"""The friction injected: a model of :mod:`~wbfriction.friction.models`, or MuJoCo's ``frictionloss`` (humanoid)."""
+Family = Literal[BuiltinName, "frictionloss"]
+"""The friction injected: a built-in family of :mod:`~wbfriction.friction.families`, or MuJoCo's ``frictionloss``
+(humanoid)."""
 FAMILIES: tuple[Family, ...] = get_args(Family)
-TRUE_MODEL: dict[Family, ModelName] = {"coulomb-viscous": "coulomb-viscous", "stribeck": "stribeck",
-                                       "thesis": "thesis", "frictionloss": "coulomb-viscous"}
+FRICTIONLOSS_MODEL: ModelName = "coulomb-viscous"
+"""The model family MuJoCo's ``frictionloss`` (a dry friction, with its damping) belongs to."""
+TRUE_MODEL: dict[Family, ModelName] = {f: FRICTIONLOSS_MODEL if f == "frictionloss" else f for f in FAMILIES}
 """The model family each friction belongs to."""
+SHAPE = {"F_s": 1.5, "S": 0.3, "v_s": 0.05, "a": 40.0}
+"""The injected friction's shape beyond its levels: a static level ``F_s`` 1.5 times the Coulomb level (Stribeck
+model), ``S`` 0.3 ((3.5)), decaying at ``v_s`` [rad/s], a tanh slope ``a`` [s/rad]; each family takes its own."""
 TOLERANCES = {1e-4: (2.0, 5.0), 3e-4: (5.0, 10.0)}
 """Issue 38's targets [%] of F_c and F_v per position noise [rad]."""
 HUMANOID_GROUPS = {"waist": (0.3, 0.5), "arm_right": (0.1, 0.3), "arm_left": (0.1, 0.3)}
@@ -64,8 +71,8 @@ HUMANOID_GROUPS = {"waist": (0.3, 0.5), "arm_right": (0.1, 0.3), "arm_left": (0.
 def family_friction(robot: Robot, family: Family) -> dict[str, ModelParams]:
     """The friction of ``family`` per torque-controlled joint: on an arm, the arm simulator's default values
     (:func:`~wbfriction.sim.arm.default_arm_friction`), on a humanoid the thesis's Table 6.1 on the legs and
-    :data:`HUMANOID_GROUPS`; a Stribeck effect of half the Coulomb level decaying at 0.05 rad/s, an offset of
-    0.1 N·m, none with MuJoCo's ``frictionloss``."""
+    :data:`HUMANOID_GROUPS`; the Stribeck effect of :data:`SHAPE`, an offset of 0.1 N·m, none with MuJoCo's
+    ``frictionloss``."""
     from wbfriction.fit.targets import friction_by_group
     if robot.floating_base:
         base = friction_by_group(robot.groups) | {j: FrictionParams(F_v=v, F_c=c, S=0.2, v_s=0.05, tau_os=0.1)
@@ -73,16 +80,12 @@ def family_friction(robot: Robot, family: Family) -> dict[str, ModelParams]:
                                                   for j in robot.groups.get(g, ()) if j in robot.torque_controlled}
     else:
         base = default_arm_friction(robot)
-    out: dict[str, ModelParams] = {}
-    for joint, p in base.items():
-        tau_os = 0.0 if family == "frictionloss" else 0.1
-        if family in ("coulomb-viscous", "frictionloss"):
-            out[joint] = CoulombViscousParams(F_v=p.F_v, F_c=p.F_c, tau_os=tau_os)
-        elif family == "stribeck":
-            out[joint] = StribeckParams(F_v=p.F_v, F_c=p.F_c, F_s=1.5 * p.F_c, v_s=0.05, tau_os=tau_os)
-        else:
-            out[joint] = FrictionParams(F_v=p.F_v, F_c=p.F_c, S=0.3, v_s=0.05, tau_os=tau_os, a=40.0)
-    return out
+    model = model_family(TRUE_MODEL[family])
+    tau_os = 0.0 if family == "frictionloss" else 0.1
+    return {joint: cast(ModelParams, model.from_quantities({"F_v": p.F_v, "F_c": p.F_c, "F_s": SHAPE["F_s"] * p.F_c,
+                                                            "S": SHAPE["S"], "v_s": SHAPE["v_s"], "tau_os": tau_os,
+                                                            "a": SHAPE["a"]}))
+            for joint, p in base.items()}
 
 
 @dataclass(frozen=True)
