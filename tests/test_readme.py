@@ -1,11 +1,11 @@
 """The README's and the manual's commands run as written (issue 24, item 5; issue 54, items 4 and 5).
 
-Every ``bash`` and ``python`` block of the README, of the manual's Getting started, tutorials and how-to guides
-(:data:`PAGES`) runs as written, in the order of its page, from a fresh folder per page that holds ``examples/``
-beside the outputs (a copy of the checkout's layout): each command line exits 0 and writes what its ``-o`` names,
-no two lines of a page write the same file, and a command waits only for the earlier ones whose outputs it reads
-(two run at a time: the machine's two cores). A ``python`` block runs once everything before it has, and whatever
-follows waits for it. Marks, an HTML comment on the line before a fenced block:
+Every ``bash`` and ``python`` block of the README, of the manual's Getting started, tutorials, how-to guides and
+guide to extending (:data:`PAGES`) runs as written, in the order of its page, from a fresh folder per page that
+holds ``examples/`` beside the outputs (a copy of the checkout's layout): each command line exits 0 and writes what
+its ``-o`` names, no two lines of a page write the same file, and a command waits only for the earlier ones whose
+outputs it reads (two run at a time: the machine's two cores). A ``python`` block runs once everything before it
+has, and whatever follows waits for it. Marks, an HTML comment on the line before a fenced block:
 
 * ``<!-- not run: REASON -->``: the block is not run (an install, ``mkdocs serve``);
 * ``<!-- write: FILE -->``: the block's text is written to ``FILE`` in the page's folder first (a TOML a command
@@ -36,7 +36,7 @@ DOCS = REPO / "docs"
 
 PAGES = ["README.md", "docs/index.md", "docs/getting-started.md",
          *sorted(str(p.relative_to(REPO)) for p in (DOCS / "tutorials").glob("*.md")),
-         *sorted(str(p.relative_to(REPO)) for p in (DOCS / "how-to").glob("*.md"))]
+         *sorted(str(p.relative_to(REPO)) for p in (DOCS / "how-to").glob("*.md")), "docs/extending.md"]
 """The pages whose blocks run, relative to the checkout."""
 
 QUICK: set[str] = set()
@@ -123,11 +123,17 @@ pages run are checked here, once (``tests/test_examples.py`` runs the others).""
 
 PRINTS = {
     "docs/how-to/library.md": [r"leg_right_4_joint: F_c"],  # the API block's fits of the walk
+    "docs/extending.md": [r"^arm\.tsv: 10000 samples, tau_f of 7 joints$",  # a log format registered, read
+                          r"^wrote panda_friction\.csv \(csv\)$",  # an export target, beside a built-in one
+                          r"^wrote panda_extended\.xml \(mjcf\)$",
+                          r"^panda_joint1: viscous: F_v ",  # a family fitted alone, then scored by --model auto
+                          r"^panda_joint1: thesis: .*held-out RMS.*viscous"],
 }
 """What a page's ``python`` blocks must print, together (regular expressions)."""
 
 WRITES = {
     "docs/how-to/library.md": ["api_params.json"],
+    "docs/extending.md": ["arm.tsv", "panda_friction.csv", "panda_extended.xml"],
 }
 """Files a page's ``python`` blocks must write."""
 
