@@ -46,7 +46,7 @@ class LazyStubExports(griffe.Extension):
         while todo:
             module = todo.pop()
             todo.extend(m for m in module.modules.values() if not m.is_alias)
-            if module.exports is None and module.is_init_module and _lazy(module):
+            if not module.exports and module.is_init_module and _lazy(module):  # None, or [] (unevaluated)
                 module.exports = [name for name, member in module.members.items()
                                   if member.is_alias and member.target_path.startswith(pkg.name + ".")]
 
