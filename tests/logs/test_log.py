@@ -185,5 +185,5 @@ def test_read_options_are_checked_where_made():
                        ({"time_base": "exact"}, "--time-base"), ({"time_unit": "h"}, "--time-unit")):
         with pytest.raises(OptionError) as err:
             ReadOptions(**kw)
-        assert err.value.option == option and err.value.value == next(iter(kw.values()))
+        assert err.value.option == option and err.value.value is next(iter(kw.values()))
         assert str(err.value).startswith(f"{option} must be ")
