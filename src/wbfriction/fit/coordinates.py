@@ -1,7 +1,9 @@
 """The fit's bounds and coordinates: where each model's parameters may go, and the coordinates the solver moves
 them in (thesis 6.2.2), as each family defines them (:class:`~wbfriction.friction.families.base.FrictionFamily`:
-:attr:`~wbfriction.friction.families.base.FrictionFamily.lower`, :meth:`~wbfriction.friction.families.base.
-FrictionFamily.bounds`, :meth:`~wbfriction.friction.families.base.FrictionFamily.to_fit`).
+its :attr:`~wbfriction.friction.families.base.FrictionFamily.lower` and
+:attr:`~wbfriction.friction.families.base.FrictionFamily.upper` bounds,
+:meth:`~wbfriction.friction.families.base.FrictionFamily.bounds`,
+:meth:`~wbfriction.friction.families.base.FrictionFamily.to_fit`).
 
 The built-in families' bounds keep friction dissipative (F_v, F_c >= 0) and the Stribeck effect a drop from
 static to Coulomb friction: (3.5)'s ``S >= 0``, and the Stribeck model's ``F_s >= F_c``, fitted as
@@ -35,7 +37,7 @@ AT_BOUND_NEAR = 1e-3
 
 def model_bounds(qd: np.ndarray, model: ModelName = "thesis") -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper bounds of ``model``'s parameters, in the fit's coordinates, for velocities
-    ``qd`` (N,) [rad/s] (:meth:`FrictionFamily.bounds <wbfriction.friction.families.base.FrictionFamily.bounds>`):
+    ``qd`` (N,) [rad/s] (:meth:`~wbfriction.friction.families.base.FrictionFamily.bounds`):
     for (3.5) those of :data:`~wbfriction.friction.families.thesis.UPPER`; for ``coulomb-viscous`` F_v, F_c >= 0;
     for ``stribeck`` F_v, F_c >= 0, ``F_s >= F_c`` (its coordinate is F_s - F_c >= 0) and v_s in [1e-4, 100];
     ``v_s`` at most the largest speed in ``qd``."""

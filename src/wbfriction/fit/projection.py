@@ -2,9 +2,9 @@
 
 Every friction family (:mod:`wbfriction.friction.families`) is a sum of terms: a design column that depends at most on
 the family's non-linear parameters (:attr:`~wbfriction.friction.families.base.FrictionFamily.nonlinear`: the Stribeck
-velocity ``v_s`` and the tanh slope ``a`` of the built-in ones; :meth:`~wbfriction.friction.families.base.
-FrictionFamily.columns`, its expectation under the velocity noise :meth:`~wbfriction.friction.families.base.
-FrictionFamily.expected_columns`), times a product of the linear parameters
+velocity ``v_s`` and the tanh slope ``a`` of the built-in ones;
+:meth:`~wbfriction.friction.families.base.FrictionFamily.columns`, its expectation under the velocity noise
+:meth:`~wbfriction.friction.families.base.FrictionFamily.expected_columns`), times a product of the linear parameters
 (:attr:`~wbfriction.friction.families.base.FrictionFamily.column_factors`). Model (3.5), for instance, is
 ``F_v qd + F_c tanh(a qd) + (F_c S) tanh(a qd) exp(-|qd / v_s|^delta_s) + tau_os``: linear in
 ``(F_v, F_c, F_c S, tau_os)`` once ``(v_s, a)`` is set. The least-squares fit over every parameter is then one over

@@ -1,15 +1,17 @@
 """The choice among the models by held-out error (``model="auto"``), and a joint's fit whatever its model.
 
 The valid samples are cut into contiguous blocks in time; every third is held out
-(:func:`~wbfriction.fit.regression.held_out_split`, deterministic), every model is fitted on the others, and its
-RMS error on the held-out blocks compared (:func:`held_out_rms`). The simplest model whose held-out RMS is within
-``selection_tolerance`` (relative, default :data:`~wbfriction.fit.options.SELECTION_TOLERANCE`) of the best is
-chosen (:func:`choose_model`, the reason recorded in :class:`~wbfriction.fit.result.ModelSelection`) and fitted
-again on every valid sample, as if it had been named. Whole blocks, not scattered samples, are held out: residuals
-correlated in time (filtered estimates) would otherwise let the held-out error see the fit's noise. With too few
-samples to hold a block out, or for a joint that hardly moved (below :data:`~wbfriction.fit.status.MIN_SPEED`:
-``not excited``, no velocity model in its data), the simplest model is fitted. A model with a parameter at a bound
-gives way to the best simpler one whose parameters are interior (:func:`prefer_interior`).
+(:func:`~wbfriction.fit.regression.held_out_split`, deterministic), every friction family
+(:func:`~wbfriction.friction.families.registry.families`: the built-in ones and those registered, simplest first) is
+fitted on the others, and its RMS error on the held-out blocks compared (:func:`held_out_rms`). The simplest model
+whose held-out RMS is within ``selection_tolerance`` (relative, default
+:data:`~wbfriction.fit.options.SELECTION_TOLERANCE`) of the best is chosen (:func:`choose_model`, the reason recorded
+in :class:`~wbfriction.fit.result.ModelSelection`) and fitted again on every valid sample, as if it had been named.
+Whole blocks, not scattered samples, are held out: residuals correlated in time (filtered estimates) would otherwise
+let the held-out error see the fit's noise. With too few samples to hold a block out, or for a joint that hardly
+moved (below :data:`~wbfriction.fit.status.MIN_SPEED`: ``not excited``, no velocity model in its data), the simplest
+model is fitted. A model with a parameter at a bound gives way to the best simpler one whose parameters are interior
+(:func:`prefer_interior`).
 """
 
 from __future__ import annotations

@@ -74,8 +74,8 @@ ModelParams = CoulombViscousParams | StribeckParams | FrictionParams
 
 def model_values(x: np.ndarray, qd: np.ndarray, delta_s: ParamLike, model: ModelName = "thesis") -> np.ndarray:
     """``model``'s ``f(qd)`` [N·m] for the parameter vector ``x`` in the order of its names
-    (:data:`PARAM_NAMES` for (3.5)), ``qd`` (N,) [rad/s] (:meth:`FrictionFamily.values
-    <wbfriction.friction.families.base.FrictionFamily.values>`).
+    (:data:`PARAM_NAMES` for (3.5)), ``qd`` (N,) [rad/s]
+    (:meth:`~wbfriction.friction.families.base.FrictionFamily.values`).
 
     Raises:
         UnknownFamilyError: no family of that name.

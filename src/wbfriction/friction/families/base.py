@@ -4,9 +4,9 @@ subclass and one call (:func:`~wbfriction.friction.families.registry.register_fa
 
 A family declares (class attributes) its parameters (their dataclass, a :class:`~.params.ModelParamsBase`, whose
 :attr:`~.params.ModelParamsBase.names` are the fit's order; their units), its bounds in the fit's coordinates, and how
-its characteristic is linear in some parameters (the variable projection's design: :attr:`~FrictionFamily.
-column_factors`); it computes (methods) the characteristic and its Jacobian, its design columns, and their
-expectations under a Gaussian velocity noise (errors in variables, :mod:`wbfriction.fit.eiv`).
+its characteristic is linear in some parameters (the variable projection's design:
+:attr:`~FrictionFamily.column_factors`); it computes (methods) the characteristic and its Jacobian, its design
+columns, and their expectations under a Gaussian velocity noise (errors in variables, :mod:`wbfriction.fit.eiv`).
 
 A family that has no closed form for the expectations inherits a 40-point Gauss-Hermite rule over its own
 characteristic (:func:`~.gaussian.hermite_mean`): right for a continuous ``f``, not across a jump (``sgn``), where

@@ -129,18 +129,21 @@ class Stribeck(FrictionFamily):
         return np.sign(qd)
 
     def to_fit(self, x: np.ndarray) -> np.ndarray:
+        s, c = self.index("F_s"), self.index("F_c")
         z = np.array(x, dtype=float)
-        z[2] = x[2] - x[1]  # F_s - F_c
+        z[s] = x[s] - x[c]  # F_s - F_c
         return z
 
     def from_fit(self, z: np.ndarray) -> np.ndarray:
+        s, c = self.index("F_s"), self.index("F_c")
         x = np.array(z, dtype=float)
-        x[2] = z[1] + z[2]
+        x[s] = z[c] + z[s]
         return x
 
     def fit_jacobian(self, jac: np.ndarray) -> np.ndarray:
+        s, c = self.index("F_s"), self.index("F_c")
         jac = jac.copy()
-        jac[:, 1] += jac[:, 2]
+        jac[:, c] += jac[:, s]  # F_c moves F_s too
         return jac
 
     def other_exponent(self, x: np.ndarray, qd: np.ndarray, sigma: float, delta_s: float) -> np.ndarray:
