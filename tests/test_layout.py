@@ -154,3 +154,53 @@ def test_file_map_matches_the_code():
     present |= {p.name for p in PACKAGE.glob("*.py") if p.name not in ("__init__.py", "__main__.py")}
     assert named == present, (f"{FILE_MAP.relative_to(ROOT)} lists {sorted(named - present)} that the code has "
                               f"not; misses {sorted(present - named)}")
+
+
+MAX_MODULE_LINES = 600
+MAX_FUNCTION_LINES = 80
+"""Issue 54's limits: a module over 600 lines holds several concepts, a function over 80 several jobs."""
+
+LONG_FUNCTIONS: dict[str, str] = {}
+"""Functions allowed over :data:`MAX_FUNCTION_LINES`, each with why (``module:function``)."""
+
+
+def sizes(package: Path) -> tuple[dict[str, int], dict[str, int]]:
+    """Lines per module, and per function or method (``module:qualified name``; nested functions count in their
+    parent's lines, as they are part of its job)."""
+    modules: dict[str, int] = {}
+    functions: dict[str, int] = {}
+
+    def visit(node: ast.AST, prefix: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.ClassDef):
+                visit(child, f"{prefix}{child.name}.")
+            elif isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                functions[f"{prefix}{child.name}"] = child.end_lineno - child.lineno + 1
+
+    for path in sorted(package.rglob("*.py")):
+        text = path.read_text()
+        modules[name := module_name(package, path)] = len(text.splitlines())
+        visit(ast.parse(text), f"{name}:")
+    return modules, functions
+
+
+def test_no_module_over_600_lines():
+    modules, _ = sizes(PACKAGE)
+    assert not (long := {m: n for m, n in modules.items() if n > MAX_MODULE_LINES}), long
+
+
+def test_no_function_over_80_lines():
+    _, functions = sizes(PACKAGE)
+    long = {f: n for f, n in functions.items() if n > MAX_FUNCTION_LINES and f not in LONG_FUNCTIONS}
+    assert not long, long
+    assert not (stale := [f for f in LONG_FUNCTIONS if functions.get(f, 0) <= MAX_FUNCTION_LINES]), (
+        f"exceptions no longer needed: {stale}")
+
+
+def test_the_size_checks_see_a_long_function(tmp_path):
+    pkg = tmp_path / "wbfriction"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "big.py").write_text("class A:\n    def f(self):\n" + "        x = 1\n" * 90)
+    modules, functions = sizes(pkg)
+    assert functions["wbfriction.big:A.f"] == 91 and modules["wbfriction.big"] == 92
