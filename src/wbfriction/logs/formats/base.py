@@ -142,6 +142,10 @@ class LogFormat(ABC):
     def __repr__(self) -> str:
         return f"<log format {self.name}>"
 
+    def __str__(self) -> str:
+        """The format's name (``parquet``), as messages and records print it."""
+        return self.name
+
     # ------------------------------------------------------------ recognising
     def claims(self, path: Path) -> bool:
         """Whether ``path``'s name is one of this format's (its suffix, any case): a file to read or to write."""
