@@ -274,8 +274,10 @@ def joint_export(joint: str, friction: FrictionLike | None = None, armature: flo
         params = terms.params
         dropped = terms.kept
         conditions = terms.reference_conditions()
-    return JointExport(joint, viscous=float(params.F_v), coulomb=float(params.F_c),
-                       static=static_level(params),
+    model_params = cast(ModelParamsBase, params)
+    levels = family(model_params.model)
+    return JointExport(joint, viscous=levels.viscous_level(model_params), coulomb=levels.coulomb_level(model_params),
+                       static=levels.static_level(model_params),
                        armature=None if armature is None else float(armature), params=params, verdict=verdict,
                        dropped=dropped, conditions=conditions)
 

@@ -54,7 +54,7 @@ def check_model_params(params: ModelParams, key: str) -> None:
         if not math.isfinite(value):
             raise ValueError(f"{key}.{name} is {value}: not a finite number")
     for name, unit in (("F_v", "N·m·s/rad"), ("F_c", "N·m")):
-        if values[name] < 0:
+        if name in values and values[name] < 0:
             raise ValueError(f"{key}.{name} = {values[name]:g} {unit} < 0: friction that is not dissipative")
     static = params.quantities()["F_s"]
     if static < 0:

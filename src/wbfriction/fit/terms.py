@@ -58,11 +58,9 @@ from wbfriction.exceptions import InputError
 from wbfriction.fit.ranges import TERM_SIGNAL, FittedRanges, RangeUse, SignalUse, ripple_angle, same_turn
 from wbfriction.fit.status import TERM_WEAK, FitVerdict, routes_disagree
 from wbfriction.friction.estimated import FrictionEstimate
+from wbfriction.friction.families.registry import family
 from wbfriction.friction.models import (
-    CoulombViscousParams,
-    FrictionParams,
     ModelParams,
-    StribeckParams,
     params_from_dict,
 )
 from wbfriction.friction.options import TERMS, Term
@@ -117,44 +115,27 @@ NOT_TRIED = "not tried"
 
 
 def coulomb_shape(params: ModelParams, qd: np.ndarray) -> np.ndarray:
-    """``g(qd)``: the model's Coulomb shape, ``tanh(a qd)`` for (3.5), ``sgn(qd)`` for the others (N,)."""
-    if isinstance(params, FrictionParams):
-        return np.tanh(params.a * qd)
-    return np.sign(qd)
+    """``g(qd)``: the model's Coulomb shape (N,), ``tanh(a qd)`` for (3.5), ``sgn(qd)`` for the others (its family's
+    :meth:`~wbfriction.friction.families.base.FrictionFamily.coulomb_shape`)."""
+    return family(params.model).coulomb_shape(params, qd)
 
 
 def velocity_basis(params: ModelParams, qd: np.ndarray) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
     """The velocity model as linear in its coefficients, its non-linear parameters held (``a``, ``v_s``,
-    ``delta_s``): ``f(qd) = B c`` exactly.
+    ``delta_s``): ``f(qd) = B c`` exactly (its family's
+    :meth:`~wbfriction.friction.families.base.FrictionFamily.velocity_basis`).
 
     Returns:
         ``(names, B, c)``: the coefficients' names, the regressors (N, k) and the coefficients (k,) of ``params``:
         ``F_v, F_c, tau_os`` (Coulomb-viscous), ``F_v, F_c, F_s, tau_os`` (Stribeck), ``F_v, F_c, F_cS, tau_os``
         with ``F_cS = F_c S`` (3.5).
     """
-    qd = np.asarray(qd, dtype=float)
-    one = np.ones_like(qd)
-    if isinstance(params, CoulombViscousParams):
-        return ("F_v", "F_c", "tau_os"), np.column_stack([qd, np.sign(qd), one]), \
-            np.array([params.F_v, params.F_c, params.tau_os])
-    e = np.exp(-np.abs(qd / params.v_s) ** params.delta_s)
-    if isinstance(params, StribeckParams):
-        s = np.sign(qd)
-        return ("F_v", "F_c", "F_s", "tau_os"), np.column_stack([qd, s * (1 - e), s * e, one]), \
-            np.array([params.F_v, params.F_c, params.F_s, params.tau_os])
-    th = np.tanh(params.a * qd)
-    return ("F_v", "F_c", "F_cS", "tau_os"), np.column_stack([qd, th, th * e, one]), \
-        np.array([params.F_v, params.F_c, params.F_c * params.S, params.tau_os])
+    return family(params.model).velocity_basis(params, qd)
 
 
 def with_coefficients(params: ModelParams, c: np.ndarray) -> ModelParams:
     """``params`` with the linear coefficients ``c`` of :func:`velocity_basis` (the non-linear ones kept)."""
-    if isinstance(params, CoulombViscousParams):
-        return replace(params, F_v=float(c[0]), F_c=float(c[1]), tau_os=float(c[2]))
-    if isinstance(params, StribeckParams):
-        return replace(params, F_v=float(c[0]), F_c=float(c[1]), F_s=float(c[2]), tau_os=float(c[3]))
-    S = float(c[2] / c[1]) if c[1] != 0 else 0.0
-    return replace(params, F_v=float(c[0]), F_c=float(c[1]), S=S, tau_os=float(c[3]))
+    return cast(ModelParams, family(params.model).with_coefficients(params, c))
 
 
 def fourier(q: np.ndarray, harmonics: int, constant: bool = False) -> np.ndarray:
@@ -438,7 +419,7 @@ class TermFit:
         [rad], load [N·m], temperature [°C]."""
         p, c = self.params, self.coefficients
         f = float(p.f(qd))
-        g = math.tanh(p.a * qd) if isinstance(p, FrictionParams) else math.copysign(1.0, qd) if qd else 0.0
+        g = family(p.model).coulomb_sign(p, qd)
         for term in self.kept:
             if term == "load":
                 f += c["F_L"] * abs(tau_load) * g

@@ -52,8 +52,10 @@ exponent (dimensionless; ignored by a family without one). Sign convention and u
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Mapping
+from dataclasses import replace
 from typing import ClassVar
 
 import numpy as np
@@ -170,6 +172,10 @@ class FrictionFamily(ABC):
         ``quantities()["F_s"]`` (:meth:`~.params.ModelParamsBase.quantities`)."""
         return float(params.quantities()["F_s"])
 
+    def viscous_level(self, params: ModelParamsBase) -> float:
+        """The viscous friction F_v [N·m·s/rad] (URDF and MuJoCo ``damping``, Isaac Lab ``viscous_friction``)."""
+        return float(params.quantities()["F_v"])
+
     def coulomb_level(self, params: ModelParamsBase) -> float:
         """The Coulomb friction F_c [N·m], the level in motion (URDF ``friction``, MuJoCo ``frictionloss``)."""
         return float(params.quantities()["F_c"])
@@ -211,6 +217,43 @@ class FrictionFamily(ABC):
         if self.jump_column is None:
             raise InvalidFamily(self.name, "no jump column")
         return self.columns(qd, 2.0, z)[:, self.jump_column]
+
+    # the family as linear in its magnitudes, its non-linear parameters held (the terms beyond velocity)
+
+    def coulomb_shape(self, params: ModelParamsBase, qd: np.ndarray) -> np.ndarray:
+        """``g(qd)`` (N,): the shape of the Coulomb level, which a load or temperature term scales
+        (:mod:`wbfriction.fit.terms`); ``sgn(qd)`` unless the family smooths it."""
+        return np.sign(qd)
+
+    def coulomb_sign(self, params: ModelParamsBase, qd: float) -> float:
+        """:meth:`coulomb_shape` of one velocity [rad/s], in plain floats (a simulator's physics step)."""
+        return math.copysign(1.0, qd) if qd else 0.0
+
+    def velocity_basis(self, params: ModelParamsBase,
+                       qd: np.ndarray) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
+        """The characteristic as linear in its coefficients, the non-linear parameters held: ``f(qd) = B c``.
+
+        The default holds for a family linear in every parameter, one per design column (:attr:`column_factors`):
+        the coefficients are the parameters themselves.
+
+        Returns:
+            ``(names, B, c)``: the coefficients' names, the regressors (N, k) at ``qd`` (N,), the coefficients (k,).
+
+        Raises:
+            InvalidFamily: a family with non-linear parameters that does not say how it is linear.
+        """
+        if self.nonlinear or any(len(f) != 1 for f in self.column_factors):
+            raise InvalidFamily(self.name, "its parameters are not one per design column: it must define "
+                                "velocity_basis and with_coefficients for the terms beyond velocity")
+        names = tuple(f[0] for f in self.column_factors)
+        x = params.as_vector()
+        return names, self.columns(np.asarray(qd, dtype=float), 2.0, self.to_fit(x)), x[list(self.positions(names))]
+
+    def with_coefficients(self, params: ModelParamsBase, c: np.ndarray) -> ModelParamsBase:
+        """``params`` with the linear coefficients ``c`` (k,) of :meth:`velocity_basis` (the non-linear ones
+        kept)."""
+        names = tuple(f[0] for f in self.column_factors)
+        return replace(params, **{n: float(v) for n, v in zip(names, c)})
 
     # its expectation under a Gaussian velocity noise (module docstring; the model itself for sigma < SMALL)
 

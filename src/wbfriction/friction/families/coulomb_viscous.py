@@ -9,7 +9,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -75,6 +75,15 @@ class CoulombViscous(FrictionFamily):
     constant_columns = ("F_v", "F_c", "tau_os")
     column_factors = (("F_v",), ("F_c",), ("tau_os",))
     jump_column = 1
+
+
+    def velocity_basis(self, params: ModelParamsBase,
+                       qd: np.ndarray) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
+        """``F_v, F_c, tau_os`` on ``[qd, sgn(qd), 1]`` (:meth:`FrictionFamily.velocity_basis`)."""
+        p = cast(CoulombViscousParams, params)
+        qd = np.asarray(qd, dtype=float)
+        return ("F_v", "F_c", "tau_os"), np.column_stack([qd, np.sign(qd), np.ones_like(qd)]), \
+            np.array([p.F_v, p.F_c, p.tau_os])
 
     def values(self, x: np.ndarray, qd: np.ndarray, delta_s: ParamLike) -> np.ndarray:
         return coulomb_viscous(qd, x[0], x[1], x[2])

@@ -13,7 +13,7 @@ Coulomb friction) in place of F_s. Units: F_v [N·m·s/rad]; F_c, F_s, tau_os [N
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -99,6 +99,18 @@ class Stribeck(FrictionFamily):
     jump_column = 1
     varying_columns = (2,)
     held_with = (("F_s", "F_c"),)
+
+
+    def velocity_basis(self, params: ModelParamsBase,
+                       qd: np.ndarray) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
+        """``F_v, F_c, F_s, tau_os`` on ``[qd, sgn(qd) (1 - e), sgn(qd) e, 1]``, ``e = exp(-|qd / v_s|^delta_s)``
+        (:meth:`FrictionFamily.velocity_basis`)."""
+        p = cast(StribeckParams, params)
+        qd = np.asarray(qd, dtype=float)
+        e = np.exp(-np.abs(qd / p.v_s) ** p.delta_s)
+        s = np.sign(qd)
+        return ("F_v", "F_c", "F_s", "tau_os"), np.column_stack([qd, s * (1 - e), s * e, np.ones_like(qd)]), \
+            np.array([p.F_v, p.F_c, p.F_s, p.tau_os])
 
     def values(self, x: np.ndarray, qd: np.ndarray, delta_s: ParamLike) -> np.ndarray:
         return stribeck_viscous(qd, x[0], x[1], x[2], x[3], x[4], delta_s)

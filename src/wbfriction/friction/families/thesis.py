@@ -10,8 +10,9 @@ a [s/rad]; S and delta_s dimensionless. Sign convention: :mod:`wbfriction.fricti
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import ClassVar
+import math
+from dataclasses import dataclass, replace
+from typing import ClassVar, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -103,6 +104,31 @@ class Thesis(FrictionFamily):
     jump_column = 1
     jump_params = ("a",)
     varying_columns = (2,)
+
+
+    def coulomb_shape(self, params: ModelParamsBase, qd: np.ndarray) -> np.ndarray:
+        """``tanh(a qd)`` (:meth:`FrictionFamily.coulomb_shape`)."""
+        return np.tanh(cast(FrictionParams, params).a * qd)
+
+    def coulomb_sign(self, params: ModelParamsBase, qd: float) -> float:
+        """``tanh(a qd)`` of one velocity (:meth:`FrictionFamily.coulomb_sign`)."""
+        return math.tanh(cast(FrictionParams, params).a * qd)
+
+    def velocity_basis(self, params: ModelParamsBase,
+                       qd: np.ndarray) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
+        """``F_v, F_c, F_cS, tau_os`` on ``[qd, tanh(a qd), tanh(a qd) e, 1]`` with ``F_cS = F_c S`` and
+        ``e = exp(-|qd / v_s|^delta_s)`` (:meth:`FrictionFamily.velocity_basis`)."""
+        p = cast(FrictionParams, params)
+        qd = np.asarray(qd, dtype=float)
+        e = np.exp(-np.abs(qd / p.v_s) ** p.delta_s)
+        th = np.tanh(p.a * qd)
+        return ("F_v", "F_c", "F_cS", "tau_os"), np.column_stack([qd, th, th * e, np.ones_like(qd)]), \
+            np.array([p.F_v, p.F_c, p.F_c * p.S, p.tau_os])
+
+    def with_coefficients(self, params: ModelParamsBase, c: np.ndarray) -> ModelParamsBase:
+        """``F_v, F_c, tau_os`` and ``S = F_cS / F_c`` (0 where F_c is) (:meth:`FrictionFamily.with_coefficients`)."""
+        S = float(c[2] / c[1]) if c[1] != 0 else 0.0
+        return replace(cast(FrictionParams, params), F_v=float(c[0]), F_c=float(c[1]), S=S, tau_os=float(c[3]))
 
     def values(self, x: np.ndarray, qd: np.ndarray, delta_s: ParamLike) -> np.ndarray:
         return coulomb_viscous_stribeck(qd, x[0], x[1], x[2], x[3], x[4], x[5], delta_s)
