@@ -13,7 +13,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError
-from wbfriction.fit.options import FitOptions, ModelChoice
+from wbfriction.fit.options import FitOptions, ModelChoice, model_choices
 from wbfriction.fleet.options import SHAPES, Shape
 from wbfriction.friction.options import EstimateOptions, TemperatureLaw
 from wbfriction.pipeline.paths import check_paths
@@ -62,8 +62,9 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
                                                      "(TABLES/<robot_id>/<key>.parquet)."),
           diff: DiffOption = typer.Option(ESTIMATE.diff, help="Differentiation, as 'wbfriction estimate --diff' (a "
                                                         "manifest's diff column overrides it per log)."),
-          model: ModelChoice = typer.Option(FIT.model, help="Friction model, as 'wbfriction fit --model' (a "
-                                                             "manifest's model column overrides it per log)."),
+          model: str = typer.Option(FIT.model, metavar=f"[{'|'.join(model_choices())}]",
+                                    help="Friction model, as 'wbfriction fit --model' (a manifest's model column "
+                                         "overrides it per log)."),
           min_samples: int = MinSamplesOpt, terms: str = TermsOpt, max_harmonic: int = MaxHarmonicOpt,
           reference_temperature: Optional[float] = ReferenceTemperatureOpt,
         temperature_law: TemperatureLaw = TemperatureLawOpt) -> None:
@@ -77,7 +78,7 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
 
     check_paths({"MANIFEST": source}, {})
     options = BatchOptions(estimate=EstimateOptions(diff=diff), fit=FitOptions(  # refused before any log is read
-        model=model, min_samples=min_samples,
+        model=cast(ModelChoice, model), min_samples=min_samples,
         terms=term_options(terms, max_harmonic, reference_temperature, temperature_law)))
     check_outputs(output, tables)
     quiet_dask_logs()  # its faults are said here, one line each

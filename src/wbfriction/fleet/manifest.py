@@ -16,7 +16,8 @@ column         meaning
                ``robot`` and ``config`` (the configuration defines the robot)
 ``diff``       optional: the differentiation of this log (``auto``, ``central``, ``savgol``, ...)
 ``route``      optional: the route of this log (``auto``, ``acceleration``, ``momentum``)
-``model``      optional: the friction model fitted (``auto``, ``thesis``, ``stribeck``, ``coulomb-viscous``)
+``model``      optional: the friction model fitted (``auto``, ``thesis``, ``stribeck``, ``coulomb-viscous``,
+               or a registered family)
 =============  ========================================================================================
 
 A folder is scanned as ``FOLDER/<robot_id>/**/<log>`` (``.parquet``, ``.csv``, ``.h5``), every log with the
@@ -42,7 +43,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from wbfriction.exceptions import InputError
-from wbfriction.fit.options import MODEL_CHOICES
+from wbfriction.fit.options import model_choices
 from wbfriction.fleet.schema import RESULT_DOCUMENT
 from wbfriction.friction.options import ROUTE_OPTIONS
 from wbfriction.logs.tables import TableFile, read_metadata, table_format
@@ -306,7 +307,7 @@ def _entry(path: Path, row: int, cell: dict[str, str], start: datetime) -> LogEn
     robot = RobotSpec(name or None, str((path.parent / urdf).resolve()) if urdf else None,
                       str((path.parent / config).resolve()) if config else None)
     options = {c: cell[c] for c in ("diff", "route", "model") if cell.get(c)}
-    for column, choices in (("diff", DIFF_OPTIONS), ("route", ROUTE_OPTIONS), ("model", MODEL_CHOICES)):
+    for column, choices in (("diff", DIFF_OPTIONS), ("route", ROUTE_OPTIONS), ("model", model_choices())):
         if column in options and options[column] not in choices:
             raise InputError(f"{where}, column '{column}': {options[column]!r} is not one of {', '.join(choices)}")
     return LogEntry(log, cell["robot_id"], start, robot, options, row)

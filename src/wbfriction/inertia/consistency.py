@@ -45,7 +45,7 @@ STRIBECK = "F_s-F_c"
 too (``F_s`` the static friction of 3.4, ``S`` that of :func:`wbfriction.friction.models.coulomb_viscous_stribeck`)."""
 FRICTION_LOWER = {"F_v": 0.0, "F_c": 0.0, "tau_os": -np.inf, STRIBECK: 0.0}
 """Physical friction: dissipative viscous and Coulomb parts, static friction at least the
-Coulomb level (the bounds of :data:`wbfriction.fit.coordinates.LOWER`); the offset is free."""
+Coulomb level (the bounds of :data:`wbfriction.friction.families.thesis.LOWER`); the offset is free."""
 PHYSICAL = ("m", "c_x", "c_y", "c_z", "I_xx", "I_xy", "I_yy", "I_xz", "I_yz", "I_zz")
 """A body's physical parameters: mass [kg], centre of mass in the joint frame [m], rotational
 inertia about the centre of mass in the joint frame's axes [kg·m^2] (the prior's coordinates)."""
