@@ -126,8 +126,8 @@ PRINTS = {
     "docs/extending.md": [r"^arm\.tsv: 10000 samples, tau_f of 7 joints$",  # a log format registered, read
                           r"^wrote panda_friction\.csv \(csv\)$",  # an export target, beside a built-in one
                           r"^wrote panda_extended\.xml \(mjcf\)$",
-                          r"^panda_joint1: viscous: F_v ",  # a family fitted alone, then scored by --model auto
-                          r"^panda_joint1: thesis: .*held-out RMS.*viscous"],
+                          r"^panda_joint1: quadratic: F_v ",  # a family fitted alone, then scored by --model auto
+                          r"^panda_joint1: thesis: .*held-out RMS.*quadratic"],
 }
 """What a page's ``python`` blocks must print, together (regular expressions)."""
 
