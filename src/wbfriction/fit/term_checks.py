@@ -122,7 +122,8 @@ def unphysical_term(params: ModelParams, c: dict[str, float], signals: TermSigna
                 t_ref: float, rate: float = 0.0) -> tuple[Term, str] | None:
     """The first friction term whose levels go below zero on the samples (a viscous level in a direction, a Coulomb
     level under a load met, a level at a temperature met) and what goes below; None when all stay physical."""
-    F_c, F_v = params.F_c, params.F_v
+    quantities = params.quantities()  # any family's (a family without a Coulomb level: 0)
+    F_c, F_v = quantities["F_c"], quantities["F_v"]
     if "dF_v" in c and min(F_v + c["dF_v"], F_v - c["dF_v"]) < 0:
         return "direction", (f"a viscous level below zero in one direction (F_v {F_v:.3g}, dF_v {c['dF_v']:.3g}): "
                              "not friction")

@@ -133,12 +133,13 @@ def term_of(name: str) -> Term:
 def derived_parameters(params: ModelParams, c: dict[str, float]) -> dict[str, float]:
     """The physical parameters of the coefficients (:attr:`TermFit.derived`)."""
     out: dict[str, float] = {}
-    F_c, F_v = params.F_c, params.F_v
+    levels = params.quantities()  # any family's (a family without a Coulomb level: 0)
+    F_c, F_v, tau_os = levels["F_c"], levels["F_v"], levels["tau_os"]
     if "F_L" in c:
         out["k_L"] = c["F_L"] / F_c if F_c else float("nan")
     if "dF_v" in c:
-        out.update({"F_v+": F_v + c["dF_v"], "F_v-": F_v - c["dF_v"], "F_c+": F_c + params.tau_os,
-                    "F_c-": F_c - params.tau_os})
+        out.update({"F_v+": F_v + c["dF_v"], "F_v-": F_v - c["dF_v"], "F_c+": F_c + tau_os,
+                    "F_c-": F_c - tau_os})
     if "F_cT" in c:
         out["k_Tc"] = c["F_cT"] / F_c if F_c else float("nan")
         out["k_Tv"] = c["F_vT"] / F_v if F_v else float("nan")
