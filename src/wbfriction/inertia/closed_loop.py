@@ -28,7 +28,6 @@ from wbfriction.fit.joints import fit_estimate
 from wbfriction.fit.options import FitOptions
 from wbfriction.fit.result import FitResult, fitted_offsets
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log, resolve_differentiation
-from wbfriction.friction.models import FrictionParams
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.identification import InertialIdentification, identify_inertia
 from wbfriction.inertia.options import InertialOptions
@@ -94,9 +93,11 @@ def stribeck_velocity(fits: list[FitResult], max_relative_error: float = 0.5) ->
     """The joints whose fit determines a Stribeck effect (``v_s``, ``F_c`` and the height ``S``
     with standard errors below ``max_relative_error`` of their values; a fit of a model without them, none), and
     their median Stribeck velocity [rad/s] (None if there are none)."""
-    good = {f.joint: f.params.v_s for f in fits if isinstance(f.params, FrictionParams)
+    stribeck = ("v_s", "F_c", "S")
+    good = {f.joint: f.params.v_s for f in fits if f.params is not None
+            and set(stribeck) <= set(f.params.names)
             and all(getattr(f.params, n) > 0 and f.stderr.get(n, np.inf) < max_relative_error * getattr(f.params, n)
-                    for n in ("v_s", "F_c", "S"))}
+                    for n in stribeck)}
     return (float(np.median(list(good.values()))) if good else None, tuple(good))
 
 
