@@ -5,37 +5,20 @@ from __future__ import annotations
 
 import csv
 import re
-from collections.abc import Mapping
 from pathlib import Path
 
 import pytest
 
+from toys.toy_target import FrictionCsv
 from wbfriction.exceptions import InputError
 from wbfriction.export import registry
 from wbfriction.export.isaac import IsaacTarget
-from wbfriction.export.mapping import JointExport
 from wbfriction.export.mjcf import MjcfTarget
 from wbfriction.export.registry import SuffixTaken, UnknownExportFormat, register_target, target_for
-from wbfriction.export.target import ExportReport, ExportTarget
 from wbfriction.export.urdf import UrdfTarget
 from wbfriction.fit.params_file import write_params
-from wbfriction.logs.tables import write_atomic
 from wbfriction.model import load_robot
-from wbfriction.model.robot import Robot
 from wbfriction.pipeline.export_step import export_files
-
-
-class CsvTarget(ExportTarget):
-    """A toy format: ``joint,F_c,F_v``, one row per joint with friction."""
-
-    name = "csv"
-    suffixes = (".csv",)
-    description = "joint, F_c, F_v"
-
-    def write(self, path: Path, robot: Robot, joints: Mapping[str, JointExport]) -> ExportReport:
-        rows = [f"{n},{e.coulomb!r},{e.viscous!r}\n" for n, e in joints.items() if e.has_friction]
-        write_atomic(path, lambda tmp: tmp.write_text("joint,F_c,F_v\n" + "".join(rows)))
-        return self.report(path, joints)
 
 
 @pytest.fixture()
@@ -62,11 +45,11 @@ def params(tmp_path, fit_of):
 def test_a_registered_target_writes_the_fitted_values(targets, panda, params, tmp_path):
     """One call registers the toy target; `export_files` picks it by suffix (any case), beside a built-in one, and
     its file holds the fitted F_c and F_v of the fits that qualify, in the robot's order, exactly."""
-    register_target(CsvTarget())
+    register_target(FrictionCsv())
     path, fits = params
     outs = [tmp_path / "friction.CSV", tmp_path / "panda.yaml"]
     done = export_files(panda, path, outs)
-    assert done.outputs == ((outs[0], "csv"), (outs[1], "isaac"))
+    assert done.outputs == ((outs[0], FrictionCsv.name), (outs[1], "isaac"))
     ok = [f"panda_joint{i}" for i in (1, 2, 4, 5, 6)]
     assert [r.joints for r in done.reports] == [tuple(ok)] * 2
     with outs[0].open(newline="") as f:
@@ -92,7 +75,7 @@ def test_an_unknown_suffix_is_refused_naming_the_file(targets, panda, params, tm
                                "or .yaml (Isaac Lab actuators)")
     assert isinstance(info.value, InputError) and (info.value.path, info.value.suffix) == (out, ".csv")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["p.json"]
-    register_target(CsvTarget())
+    register_target(FrictionCsv())
     with pytest.raises(InputError, match=re.escape("or .csv (joint, F_c, F_v)")):
         target_for(tmp_path / "friction.txt")
     with pytest.raises(InputError, match=r"^export: give at least one output \(-o FILE.urdf, .xml, .yaml or .csv\)$"):
@@ -105,7 +88,7 @@ def test_the_built_in_targets_by_suffix(targets):
     assert by_suffix == {".urdf": UrdfTarget, ".xml": MjcfTarget, ".mjcf": MjcfTarget, ".yaml": IsaacTarget,
                          ".yml": IsaacTarget, ".URDF": UrdfTarget}
 
-    class Other(CsvTarget):
+    class Other(FrictionCsv):
         name = "other"
         suffixes = (".csv", ".xml")
 
