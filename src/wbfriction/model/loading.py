@@ -25,6 +25,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.model.force_torque import parse_sensors
 from wbfriction.model.imu import add_imu_frame
 from wbfriction.model.labels import parse_labels
+from wbfriction.model.pd import parse_pd
 from wbfriction.model.robot import ModelFormat, Robot
 from wbfriction.model.robots import BUILTIN_ROBOTS
 
@@ -104,7 +105,9 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
             fingers, joints a log does not have), ``torque_constants`` (joint name -> N·m/A at
             the joint, gear ratio included: ``current.<joint>`` columns give ``tau``),
             ``armature`` (joint name -> reflected rotor inertia [kg·m^2], in the dynamics
-            through ``model.armature``), ``force_torque`` (six-axis sensors above the contacts:
+            through ``model.armature``), ``pd`` (the PD-driven joints' drivers: gains, delay, torque
+            limits, :func:`~wbfriction.model.pd.parse_pd`), ``encoder_offset`` (joint name -> the logged
+            angle minus the model's [rad]), ``force_torque`` (six-axis sensors above the contacts:
             :func:`~wbfriction.model.force_torque.parse_sensors`), ``contact_force`` ([on, off] [N]:
             contact flags from those sensors, :mod:`wbfriction.logs.contacts`), ``imu`` (link, xyz, rpy:
             :mod:`wbfriction.model.imu`), ``labels`` (joint name -> what a person reads,
@@ -130,6 +133,7 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
         raise InputError(f"{source}: 'contact_frames' has no meaning with floating_base = false "
                          "(the root link is welded to the world)")
     _set_armature(model, config, actuated, source)
+    groups = _groups(config, actuated, source)
     return Robot(
         name=str(config.get("name", urdf.stem)),
         model=model,
@@ -139,7 +143,7 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
         torque_controlled=_in_model_order(actuated, tc_cfg),
         position_controlled=_in_model_order(actuated, pc),
         contact_frames=tuple(frames),
-        groups=_groups(config, actuated, source),
+        groups=groups,
         q_reference=q_ref,
         balance_gains=_balance_gains(config.get("balance_gains", (0.0, 0.0)), source),
         floating_base=floating,
@@ -149,7 +153,14 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
         contact_force=_contact_force(config.get("contact_force"), source),
         imu=add_imu_frame(model, config.get("imu"), source),
         labels=parse_labels(config.get("labels"), actuated, source),
+        pd=parse_pd(config.get("pd"), actuated, groups, _effort_limits(model, actuated), source),
+        encoder_offset=_joint_values(config, "encoder_offset", actuated, source, signed=True),
     )
+
+
+def _effort_limits(model: pin.Model, actuated: list[str]) -> np.ndarray:
+    """The URDF's effort limit of each actuated joint [N·m] (0 where it gives none)."""
+    return np.array([float(model.effortLimit[model.idx_vs[model.getJointId(n)]]) for n in actuated])
 
 
 def _contact_force(value, source: str) -> tuple[float, float] | None:
@@ -177,8 +188,10 @@ def _root_frame(model: pin.Model) -> str:
     return next(f.name for f in model.frames if f.parentJoint == 1 and f.type == pin.FrameType.BODY)
 
 
-def _joint_values(config: dict, key: str, actuated: list[str], source: str, positive: bool = False) -> dict[str, float]:
-    """A ``[key]`` table of joint name -> number, checked against the model's joints."""
+def _joint_values(config: dict, key: str, actuated: list[str], source: str, positive: bool = False,
+                  signed: bool = False) -> dict[str, float]:
+    """A ``[key]`` table of joint name -> number (> 0 with ``positive``, any sign with ``signed``, else >= 0),
+    checked against the model's joints."""
     table = config.get(key, {})
     if not isinstance(table, dict):
         raise InputError(f"{source}: '[{key}]' must be a table of joint = number")
@@ -187,7 +200,7 @@ def _joint_values(config: dict, key: str, actuated: list[str], source: str, posi
     for name, value in table.items():
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
             raise InputError(f"{source}: [{key}] {name} must be a number, got {value!r}")
-        if (value <= 0) if positive else (value < 0):
+        if not signed and ((value <= 0) if positive else (value < 0)):
             raise InputError(f"{source}: [{key}] {name} must be {'> 0' if positive else '>= 0'}, got {value!r}")
         out[name] = float(value)
     return out

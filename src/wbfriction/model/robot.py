@@ -35,6 +35,7 @@ from wbfriction.model.force_torque import ForceTorqueSensor
 from wbfriction.model.imu import Imu
 from wbfriction.model.labels import default_label
 from wbfriction.model.layout import JointLayout, joint_layout
+from wbfriction.model.pd import PdDriver
 
 ModelFormat = Literal["urdf", "mjcf"]
 """The robot description formats a model is built from (:func:`wbfriction.model.loading.build_model`)."""
@@ -77,6 +78,10 @@ class Robot:
         contact_force: ``(on, off)`` [N]: the normal forces above which a sensed sole comes into
             contact and below which it leaves it, for logs without ``contact.*`` columns
             (:mod:`wbfriction.logs.contacts`); None: shares of the robot's weight.
+        pd: the motor drivers of the PD-driven joints (``[pd]`` in the TOML, :mod:`wbfriction.model.pd`): logs
+            with ``q_des.<joint>`` columns take their torque from the PD law; None: no PD-driven joint.
+        encoder_offset: joint -> the logged angle minus the model's angle [rad] (``[encoder_offset]`` in the
+            TOML): the dynamics are evaluated at the logged angle minus it.
     """
 
     name: str
@@ -97,6 +102,8 @@ class Robot:
     contact_force: tuple[float, float] | None = None
     imu: Imu | None = None
     labels: dict[str, str] = field(default_factory=dict)
+    pd: PdDriver | None = None
+    encoder_offset: dict[str, float] = field(default_factory=dict)
     cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
     """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.stance`)."""
 
