@@ -8,13 +8,24 @@ The published friction each is compared with ships as data (:mod:`~wbfriction.da
 
 * ``kuka-lwr4`` (:mod:`~wbfriction.datasets.kuka`): FloBaRoID's KUKA LWR4+, link-side torque sensors;
 * ``ur10e`` (:mod:`~wbfriction.datasets.ur10e`): Mamedov et al.'s UR10e, motor currents and drive gains;
-* ``panda`` (:mod:`~wbfriction.datasets.panda`): Gaz et al.'s Franka Panda, link-side torque sensors.
+* ``panda`` (:mod:`~wbfriction.datasets.panda`): Gaz et al.'s Franka Panda, link-side torque sensors;
+* ``aliengo`` (:mod:`~wbfriction.datasets.aliengo`): the iit-DLSLab's Unitree Aliengo, hung, PD-driven joints (no
+  torque sensor: the set-points and the drivers' gains), and the same lab's identification as the peer
+  (:func:`~wbfriction.datasets.aliengo.aliengo_peer`).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from wbfriction.datasets.aliengo import (
+    ALIENGO_FILES,
+    ALIENGO_JOINTS,
+    AliengoDataset,
+    PeerActuator,
+    aliengo_peer,
+    read_pt,
+)
 from wbfriction.datasets.dataset import DATASETS, Dataset, WrittenDataset, dataset, register
 from wbfriction.datasets.kuka import (
     KUKA_LWR4_FILES,
@@ -45,7 +56,8 @@ def write_dataset(name: str, directory: str | Path) -> WrittenDataset:
     return dataset(name).write(directory)
 
 
-__all__ = ["DATASETS", "DATA_ENV", "Dataset", "GITHUB_RAW", "KUKA_LWR4_FILES", "KUKA_LWR4_JOINTS", "KUKA_LWR4_LOGS",
-           "KUKA_LWR4_ROBOT", "KukaLwr4", "KukaLwr4Dataset", "KukaLwr4Logs", "PandaDataset", "Reference",
-           "RemoteFile", "Ur10eDataset", "WrittenDataset", "dataset", "fetch_files", "kuka_lwr4", "kuka_lwr4_config",
-           "reference", "register", "write_dataset", "write_kuka_lwr4_logs"]
+__all__ = ["ALIENGO_FILES", "ALIENGO_JOINTS", "AliengoDataset", "DATASETS", "DATA_ENV", "Dataset", "GITHUB_RAW",
+           "KUKA_LWR4_FILES", "KUKA_LWR4_JOINTS", "KUKA_LWR4_LOGS", "KUKA_LWR4_ROBOT", "KukaLwr4", "KukaLwr4Dataset",
+           "KukaLwr4Logs", "PandaDataset", "PeerActuator", "Reference", "RemoteFile", "Ur10eDataset", "WrittenDataset",
+           "aliengo_peer", "dataset", "fetch_files", "kuka_lwr4", "kuka_lwr4_config", "read_pt", "reference",
+           "register", "write_dataset", "write_kuka_lwr4_logs"]
