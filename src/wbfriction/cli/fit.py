@@ -3,6 +3,7 @@ it goes."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional, cast
 
@@ -12,6 +13,7 @@ from rich.table import Table
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.exceptions import OptionError
 from wbfriction.fit.options import FitOptions, ModelChoice, model_choices
 from wbfriction.friction.options import TemperatureLaw
 from wbfriction.pipeline.paths import check_paths
@@ -43,6 +45,7 @@ from wbfriction.cli.common import (
     print_whole,
     robot_of,
     term_options,
+    warn,
     warn_energy,
 )
 
@@ -120,20 +123,28 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
                                             "does-not-predict (fitted on the first 70 % of its samples it "
                                             "mispredicts the rest). "
                                             "Fits not excited or failed are never exported."),
+           physics_dt: float = typer.Option(0.005, "--physics-dt",
+                                            help="Physics step \\[s] of the Isaac Lab simulation a PD-driven robot's "
+                                                 "delay is counted in (.yaml: min_delay = max_delay = delay / "
+                                                 "physics-dt, rounded to whole steps, with a warning): 0.005, Isaac "
+                                                 "Lab's locomotion tasks (sim.dt 1/200, decimation 4)."),
            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
            mjcf: Optional[Path] = MjcfOpt) -> None:
     """Write the fitted friction where simulators read it: the fits whose status is ok (and --include),
     each with its status in a comment; the other joints keep what the model file has. F_v -> damping,
     F_c -> Coulomb friction (MuJoCo frictionloss); the Stribeck bump, the tanh and tau_os have no
     simulator field and are dropped. Inertias are the URDF's: give --urdf IDENTIFIED.urdf to export
-    identified ones."""
+    identified ones. A robot with PD-driven joints ([pd] in its TOML) gets its drivers: gains, torque limits, delay
+    and encoder offsets (MuJoCo position actuators; an Isaac Lab DelayedPDActuatorCfg)."""
     from wbfriction.pipeline.export_step import export_files
 
     check_paths({"PARAMS": params, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
                 {f"-o {o}": o for o in outputs})
+    if not (math.isfinite(physics_dt) and physics_dt > 0):
+        raise OptionError("--physics-dt", physics_dt, "a physics step > 0 [s]")
     with console.status(f"exporting {params.name} to {len(outputs)} file{'s' if len(outputs) > 1 else ''}"):
         result = export_files(robot_of(robot, urdf, config, mjcf), params, outputs,
-                              include=[c.strip() for c in include.split(",") if c.strip()])
+                              include=[c.strip() for c in include.split(",") if c.strip()], physics_dt=physics_dt)
     counts = result.selection.exported_statuses
     console.print(f"exported the friction of {sum(counts.values())} joints ("
                   + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")", highlight=False)
@@ -145,6 +156,7 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
                       + ", ".join(f"{j} ({', '.join(kept)})" for j, kept in with_terms.items())
                       + "; their F_c, F_v are at the reference conditions (zero load, T_ref), as each joint's note "
                         "says", highlight=False, soft_wrap=True)
+    warn(dict.fromkeys(w for report in result.reports for w in report.warnings))
     for path, fmt in result.outputs:
         console.print(f"wrote {path} ({fmt})")
 

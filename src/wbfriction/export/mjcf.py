@@ -49,6 +49,27 @@ Compared with the torque of model (3.5), ``tau = rnea + F_v qd + F_c tanh(a qd)(
 the MuJoCo model keeps ``F_v qd`` exactly and ``F_c`` away from reversals, and drops the
 Stribeck bump, the tanh and ``tau_os`` (:mod:`wbfriction.export.mapping`).
 
+**PD-driven joints** (a robot with :attr:`Robot.pd`, :mod:`wbfriction.export.drive`): each gets MuJoCo's position
+actuator, named as its joint (the model file's own actuators of those joints are replaced): ``gainprm[0] = kp``,
+``biasprm = [-kp * offset, -kp, -kd]``, so that
+
+.. math::
+
+    \\texttt{actuator\\_force} = k_p\\,(\\texttt{ctrl} - \\text{offset} - \\texttt{qpos}) - k_d\\,\\texttt{qvel},
+
+clipped at ``forcerange = [-tau_max, tau_max]`` (none where the driver has no limit): ``ctrl`` is the set-point
+``q_des`` as the robot commands it (the encoder's frame), ``qpos`` the model's angle, which the encoder reads as
+``qpos + offset``. The encoder offset goes in the actuator's bias, where the driver meets it, rather than in the
+joint's ``ref`` (which would move ``qpos``'s zero for everything that reads it: ranges, keyframes, Pinocchio's
+reading of the file). With the ``biasprm[0]`` term MuJoCo's writer spells the actuator ``<general ...
+biastype="affine">``, what ``<position kp kv>`` compiles to. The set-points' delay is MuJoCo 4's actuator
+``delay`` [s] with ``interp`` zero-order hold (the driver holds each set-point) and a history of ``nsample =
+ceil(delay / timestep) + 1`` samples at the model's ``timestep`` (:func:`~wbfriction.export.drive.history_samples`;
+a smaller timestep needs more: MuJoCo reads a too-short buffer's oldest sample, silently). The history starts at
+zero (``mj_resetData``): fill it with the first set-point (``mujoco.mj_initCtrlHistory``) before stepping. The
+driver's ``qd_des`` and ``tau_ff`` have no input in a position actuator (a ``<motor>`` beside it can carry
+``kd qd_des + tau_ff``). A comment at the top of ``<actuator>`` says all this and lists the encoder offsets.
+
 The written MJCF (:func:`write_mjcf`) is MuJoCo's own ``MjSpec.to_xml``, whose numbers have 6
 significant digits, with every number of the bodies, inertials, joints and sites rewritten from the
 compiled model at full precision (and the frames MuJoCo writes for fused links folded into the
@@ -69,6 +90,7 @@ import pinocchio as pin
 from lxml import etree as ET
 
 from wbfriction.exceptions import ModelError
+from wbfriction.export.drive import DriveExport, drive_export, history_samples, offset_lines
 from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.export.target import ExportReport, ExportTarget
 from wbfriction.export.urdf import identified_parameters
@@ -213,7 +235,54 @@ def _spec(robot: Robot, joints: Mapping[str, JointExport], inertias: pin.Model |
             joint.damping = damping
             joint.frictionloss = exp.coulomb
         joint.armature = _armature(robot, name, exp)
+    drive = drive_export(robot, joints)
+    if drive is not None:
+        _add_drives(spec, drive)
     return spec
+
+
+def _add_drives(spec: mujoco.MjSpec, drive: DriveExport) -> None:
+    """A position actuator per PD-driven joint, named as the joint (module docstring), replacing the model file's
+    actuators of those joints."""
+    import mujoco
+    for act in list(spec.actuators):
+        if act.trntype == mujoco.mjtTrn.mjTRN_JOINT and act.target in drive.joints:
+            spec.delete(act)
+    timestep = float(spec.option.timestep)
+    for name in drive.joints:
+        kp, kd, limit = drive.kp[name], drive.kd[name], drive.torque_limit[name]
+        act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        act.set_to_position(kp=kp, kv=kd)
+        bias = np.array(act.biasprm, dtype=float)
+        bias[0] = 0.0 - kp * drive.offset(name)  # 0.0, not -0.0, without an offset
+        act.biasprm = bias
+        if np.isfinite(limit):
+            act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+            act.forcerange = [-limit, limit]
+        if drive.delay > 0:
+            act.delay = drive.delay
+            act.nsample = history_samples(drive.delay, timestep)
+            act.interp = 0  # zero-order hold
+
+
+def drive_note(drive: DriveExport, model: mujoco.MjModel) -> str:
+    """The comment at the top of ``<actuator>`` of a PD-driven robot (module docstring), no ``--`` in it."""
+    lines = ["PD drivers (wbfriction): each <general> is MuJoCo's <position> with its set-point offset:",
+             "force = gainprm[0] ctrl + biasprm[0] + biasprm[1] qpos + biasprm[2] qvel",
+             "      = kp (ctrl - offset - qpos) - kd qvel (gainprm kp, biasprm -kp offset, -kp, -kd),",
+             "clipped at forcerange (the driver's torque limit): ctrl is the set-point q_des as the robot commands",
+             "it (encoder frame), qpos the model's angle (the encoder reads qpos + offset). qd_des and tau_ff have",
+             "no input here (a <motor> beside it can carry kd qd_des + tau_ff)."]
+    if drive.delay > 0:
+        samples = min((int(model.actuator_history[i, 0]) for i in range(model.nu)
+                       if model.actuator(i).name in drive.joints), default=0)
+        lines += [f"delay {drive.delay!r} s, zero-order hold: nsample {samples} holds it at timesteps >= "
+                  f"{drive.delay / samples:.6g} s (this model's: {model.opt.timestep!r} s).",
+                  "The history starts at zero: fill it with the first set-point (mujoco.mj_initCtrlHistory)."]
+    if drive.encoder_offset:
+        lines += ["encoder offsets [rad] (the logged angle minus the model's):",
+                  *(f"  {line}" for line in offset_lines(drive))]
+    return "\n".join(f" {line}" for line in lines) + "\n"
 
 
 def compile_spec(spec: mujoco.MjSpec, source: str | Path = "MJCF") -> mujoco.MjModel:
@@ -276,12 +345,15 @@ def _order_bodies(root: ET._Element, joints: Sequence[str]) -> bool:
 
 
 def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] = (),
-             notes: Mapping[str, str] | None = None) -> str:
+             notes: Mapping[str, str] | None = None, actuators: Sequence[str] = (),
+             actuator_note: str | None = None) -> str:
     """The MJCF text of ``spec`` (compiled as ``model``) at full precision (module docstring): the
     bodies' ``pos``, ``quat`` and ``<inertial>``, the joints' ``pos``, ``axis``, ``range``,
     ``actuatorfrcrange``, ``damping``, ``frictionloss`` and ``armature``, the sites' ``pos`` and ``quat``
     from ``model``; sibling bodies in the order of the joint names ``joints`` (:func:`_order_bodies`);
-    ``notes`` (joint -> one line) as a comment before each joint named.
+    ``notes`` (joint -> one line) as a comment before each joint named; the ``gainprm``, ``biasprm``,
+    ``forcerange`` and ``delay`` of the actuators named in ``actuators`` from ``model``, ``actuator_note`` as a
+    comment at the top of ``<actuator>``.
 
     Raises:
         ModelError: a body or joint of the text that ``model`` does not have by name.
@@ -332,8 +404,37 @@ def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] =
                 site.set("pos", _num(model.site_pos[s]))
                 site.set("quat", _num(model.site_quat[s]))
     _order_bodies(root, joints)
+    _actuators_in_full(root, model, actuators, actuator_note)
     ET.indent(root, "  ")
     return ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _trimmed(values: np.ndarray) -> np.ndarray:
+    """``values`` without their trailing zeros (at least one kept), as MuJoCo's writer spells a parameter array."""
+    nonzero = np.flatnonzero(values)
+    return values[: max(1, nonzero[-1] + 1 if nonzero.size else 1)]
+
+
+def _actuators_in_full(root: ET._Element, model: mujoco.MjModel, names: Sequence[str], note: str | None) -> None:
+    """Rewrite the numbers of the actuators ``names`` from ``model`` at full precision, and put ``note`` at the top
+    of ``<actuator>`` (:func:`mjcf_xml`)."""
+    import mujoco
+    section = root.find("actuator")
+    if section is None or not names:
+        return
+    for element in section:
+        name = element.get("name")
+        if element.tag is ET.Comment or name not in names:
+            continue
+        a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+        element.set("gainprm", _num(_trimmed(model.actuator_gainprm[a])))
+        element.set("biasprm", _num(_trimmed(model.actuator_biasprm[a])))
+        if "forcerange" in element.attrib:
+            element.set("forcerange", _num(model.actuator_forcerange[a]))
+        if "delay" in element.attrib:
+            element.set("delay", _num(model.actuator_delay[a]))
+    if note is not None:
+        section.insert(0, ET.Comment(note))
 
 
 def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | Path,
@@ -358,7 +459,11 @@ def write_model(path: str | Path, robot: Robot, joints: Mapping[str, JointExport
     spec = _spec(robot, joints, inertias)
     model = compile_spec(spec, robot.urdf)
     notes = {name: note for name, exp in joints.items() if (note := status_note(exp)) is not None}
-    text = mjcf_xml(spec, model, robot.actuated, notes)
+    drive = drive_export(robot, joints)
+    if drive is None:
+        text = mjcf_xml(spec, model, robot.actuated, notes)
+    else:
+        text = mjcf_xml(spec, model, robot.actuated, notes, drive.joints, drive_note(drive, model))
     write_atomic(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     if [model.joint(j).name for j in range(model.njnt) if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE] \
             != list(robot.actuated):  # bodies reordered in the file: its model, in its order
@@ -367,7 +472,8 @@ def write_model(path: str | Path, robot: Robot, joints: Mapping[str, JointExport
 
 
 class MjcfTarget(ExportTarget):
-    """``.xml``, ``.mjcf``: a MuJoCo model of the robot with the friction and armature (module docstring)."""
+    """``.xml``, ``.mjcf``: a MuJoCo model of the robot with the friction and armature, and position actuators for
+    PD-driven joints (module docstring)."""
 
     name = "mjcf"
     suffixes = (".xml", ".mjcf")

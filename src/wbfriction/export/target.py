@@ -20,6 +20,9 @@ A new format plugs in with a subclass and one call::
             return self.report(path, joints)
 
     register_target(CsvTarget())  # wbfriction.export.registry
+
+A target that takes options (Isaac Lab's physics step, :class:`ExportOptions`) returns a copy of itself set with
+them from :meth:`ExportTarget.configure`; the others are used as registered.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
 
+from wbfriction.export.drive import DEFAULT_PHYSICS_DT, delay_steps
 from wbfriction.export.mapping import JointExport
 from wbfriction.model.robot import Robot
 
@@ -44,11 +48,33 @@ class ExportReport:
             prints after the file (``wrote talos.xml (mjcf)``).
         joints: the joints whose friction the file holds, in the order of the ``joints`` written (the robot's
             actuated order for an export of :func:`~wbfriction.export.mapping.joint_exports` with a robot).
+        warnings: what the file holds less exactly than the robot's values, one line each (a PD driver's delay
+            rounded to whole physics steps); ``wbfriction export`` prints them.
     """
 
     path: Path
     target: str
     joints: tuple[str, ...]
+    warnings: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class ExportOptions:
+    """What an export is told besides the robot and its joints (``wbfriction export`` options).
+
+    Attributes:
+        physics_dt: the physics step [s] of the simulator that counts a PD driver's delay in steps (Isaac Lab:
+            ``min_delay``/``max_delay``; ``--physics-dt``), default
+            :data:`~wbfriction.export.drive.DEFAULT_PHYSICS_DT`.
+
+    Raises:
+        InputError: a physics step that is not a finite number > 0 (naming ``--physics-dt``).
+    """
+
+    physics_dt: float = DEFAULT_PHYSICS_DT
+
+    def __post_init__(self) -> None:
+        delay_steps(0.0, self.physics_dt)  # raises on a step that is not > 0
 
 
 class ExportTarget(ABC):
@@ -64,6 +90,14 @@ class ExportTarget(ABC):
     name: ClassVar[str]
     suffixes: ClassVar[tuple[str, ...]]
     description: ClassVar[str]
+
+    def configure(self, options: ExportOptions) -> ExportTarget:
+        """This target set with ``options`` (a copy when it takes any); the default: itself, unchanged.
+
+        Raises:
+            InputError: an option value the target cannot use (naming the option).
+        """
+        return self
 
     def check(self, robot: Robot) -> None:
         """Refuse a robot the format cannot be written for, before any parameters are read or file written
@@ -87,6 +121,9 @@ class ExportTarget(ABC):
             OutputError: the system refused the write, nothing written.
         """
 
-    def report(self, path: str | Path, joints: Mapping[str, JointExport]) -> ExportReport:
-        """The :class:`ExportReport` of ``joints`` written to ``path`` by this target: the joints with friction."""
-        return ExportReport(Path(path), self.name, tuple(name for name, exp in joints.items() if exp.has_friction))
+    def report(self, path: str | Path, joints: Mapping[str, JointExport],
+               warnings: tuple[str, ...] = ()) -> ExportReport:
+        """The :class:`ExportReport` of ``joints`` written to ``path`` by this target: the joints with friction, and
+        ``warnings``."""
+        return ExportReport(Path(path), self.name, tuple(name for name, exp in joints.items() if exp.has_friction),
+                            tuple(warnings))

@@ -9,9 +9,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from wbfriction.exceptions import InputError
+from wbfriction.export.drive import DEFAULT_PHYSICS_DT
 from wbfriction.export.mapping import FitSelection, joint_exports, select_fits
 from wbfriction.export.registry import spoken, target_for, targets
-from wbfriction.export.target import ExportReport
+from wbfriction.export.target import ExportOptions, ExportReport
 from wbfriction.fit.params_file import read_params
 from wbfriction.model.robot import Robot
 
@@ -32,11 +33,14 @@ class Exported:
 
 
 def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path],
-                 armature: Mapping[str, float] | None = None, include: Iterable[str] = ()) -> Exported:
+                 armature: Mapping[str, float] | None = None, include: Iterable[str] = (),
+                 physics_dt: float = DEFAULT_PHYSICS_DT) -> Exported:
     """Write the fitted friction of ``params`` (``wbfriction fit``) for ``robot`` into each output,
     in the format its suffix names (:func:`~wbfriction.export.registry.target_for`); the robot's inertias are
     its URDF's (give an identified URDF to export identified inertias) and its armature the robot model's unless
-    ``armature`` is given.
+    ``armature`` is given. A robot with PD-driven joints (:attr:`Robot.pd`) gets its drivers too (gains, torque
+    limits, delay, encoder offsets: :mod:`wbfriction.export.drive`), the delay counted in physics steps of
+    ``physics_dt`` [s] where a format counts it so (Isaac Lab); each report's warnings say what was rounded.
 
     Only fits whose status is ``ok`` are exported, and those ``include`` names (``weak``, ``at-bound``;
     :func:`~wbfriction.export.mapping.select_fits`); the other joints keep what the robot's model file has.
@@ -44,15 +48,18 @@ def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path]
     or not at all.
 
     Raises:
-        InputError: an unknown suffix (:class:`~wbfriction.export.registry.UnknownExportFormat`), a .urdf output
+        InputError: a ``physics_dt`` that is not > 0, an unknown suffix
+            (:class:`~wbfriction.export.registry.UnknownExportFormat`), a .urdf output
             for a robot loaded from an MJCF, unreadable parameters, parameters without joints or without a fit
             that qualifies, an unknown ``include`` choice, friction that is not dissipative
-            (:mod:`wbfriction.export.mapping`), a joint the robot does not actuate.
+            (:mod:`wbfriction.export.mapping`), a joint the robot does not actuate; for a .yaml output of a robot
+            with PD-driven joints, exported friction of a joint that is not PD-driven.
     """
     if not outputs:
         names = spoken(tuple(target.suffixes[0] for target in targets()))
         raise InputError(f"export: give at least one output (-o FILE{names})")
-    chosen = [target_for(path) for path in outputs]
+    options = ExportOptions(physics_dt)
+    chosen = [target_for(path).configure(options) for path in outputs]
     for target in {id(t): t for t in chosen}.values():
         target.check(robot)
     selection = select_fits(read_params(params), robot, include, str(params))
