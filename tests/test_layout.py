@@ -19,6 +19,7 @@ LAYERS = [
     {"signals"},
     {"friction"},
     {"fit"},
+    {"actuator"},
     {"inertia"},
     {"export"},
     {"pipeline"},

@@ -10,6 +10,7 @@ from rich.markup import escape
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.actuator.options import ActuatorOptions
 from wbfriction.exceptions import InputError
 from wbfriction.friction.options import EstimateOptions, RouteOption
 from wbfriction.inertia.options import ArmatureMode, InertialOptions
@@ -43,11 +44,24 @@ from wbfriction.cli.common import (
     warn_energy,
 )
 
+Actuator = Literal["none", "pd"]
+ACTUATOR = ActuatorOptions()
+ActuatorOpt = typer.Option("none", help="pd: a hung PD-driven robot's actuators instead (armature, friction, encoder "
+                                        "offsets, the drivers' delay), from its set-points q_des.<joint>; the URDF "
+                                        "is kept.")
+MaxDelayOpt = typer.Option(ACTUATOR.max_delay, help="--actuator pd: longest delay searched [s].")
+DelayOpt = typer.Option(None, help="--actuator pd: a known delay [s] instead.")
+WindowOpt = typer.Option(ACTUATOR.window, help="--actuator pd: window of the momentum balance [s].")
+OffsetBoundOpt = typer.Option(ACTUATOR.offset_bound, help="--actuator pd: largest encoder offset [rad]; 0: the "
+                                                          "TOML's kept.")
+VelocityOpt = typer.Option(ACTUATOR.velocity, help="--actuator pd: the dynamics' velocity: auto, positions "
+                                                   "(differentiated once) or logged (the drivers' qd).")
+
 
 @app.command()
 def identify(log: Path = LogArg,
-             output: Path = typer.Option(..., "-o", "--output", help="Corrected URDF to write (the given one's "
-                                                                    "structure, identified inertias)."),
+             output: Optional[Path] = typer.Option(None, "-o", "--output", help="Corrected URDF to write (the given "
+                                                   "one's structure, identified inertias); not with --actuator pd."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              mjcf: Optional[Path] = MjcfOpt,
              json_output: Optional[Path] = typer.Option(None, "--json", help="Also write every figure as "
@@ -87,10 +101,21 @@ def identify(log: Path = LogArg,
                                               "model: its urdf the corrected URDF, its [armature] the identified "
                                               "one (--armature identify), the rest as given; then 'wbfriction "
                                               "estimate LOG --config THIS'."),
-             wide: bool = WideOpt) -> None:
-    """Identify the inertia model and the friction together from the joint torques of single
-    support (thesis 2.4, ch. 8), write the corrected URDF, and estimate the friction again
-    with it: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'."""
+             wide: bool = WideOpt,
+             actuator: Actuator = ActuatorOpt, max_delay: float = MaxDelayOpt, delay: Optional[float] = DelayOpt,
+             window: float = WindowOpt, offset_bound: float = OffsetBoundOpt, velocity: str = VelocityOpt,
+             ) -> None:
+    """Identify the inertia model and the friction together from the joint torques of single support (thesis
+    2.4, ch. 8), write the corrected URDF: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'. With --actuator
+    pd: a hung PD-driven robot's actuators (armature, friction, encoder offsets, delay) instead."""
+    if actuator == "pd":
+        from wbfriction.cli.actuator import identify_pd
+
+        identify_pd(log, robot, urdf, config, mjcf, json_output, config_output, time_unit, wide, ActuatorOptions(
+            window, max_delay, delay, offset_bound, velocity=velocity, holdout=min(holdout, ACTUATOR.holdout)))
+        return
+    if output is None:
+        raise InputError("identify: -o/--output (the corrected URDF) is required")
     check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output, "--json": json_output,
                                                                                 "--config-output": config_output})
     stribeck = stribeck_option(stribeck_velocity)
@@ -113,11 +138,16 @@ def identify(log: Path = LogArg,
     warn_energy(done.loop.final.route.energy)
     console.print(f"wrote {output}")
     if config_output is not None:
-        from wbfriction.pipeline.identify_step import write_identified_config
+        write_config(robot, config, output, config_output, done)
 
-        text, folder = config_text(robot, config)
-        write_identified_config(text, folder, output, config_output, done.armature)
-        console.print(f"wrote {config_output}")
+
+def write_config(robot: str, config: Optional[Path], urdf: Path, config_output: Path, done: IdentifiedFile) -> None:
+    """``--config-output``: the robot's TOML for the identified model."""
+    from wbfriction.pipeline.identify_step import write_identified_config
+
+    text, folder = config_text(robot, config)
+    write_identified_config(text, folder, urdf, config_output, done.armature)
+    console.print(f"wrote {config_output}")
 
 
 def stribeck_option(text: str) -> float | Literal["auto"] | None:

@@ -48,12 +48,21 @@ from wbfriction.logs.clock import JITTER, Clock, read_clock, split_at_gaps, tabl
 from wbfriction.logs.columns import BASE_COLUMNS, BASE_QD_TRUE_COLUMNS, BASE_QDD_TRUE_COLUMNS, IMU_COLUMNS
 from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, sensed_contacts
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP, ReadOptions
+from wbfriction.logs.pd import (
+    PD_PREFIXES,
+    PdSetpoints,
+    driver_estimate,
+    pd_columns_named,
+    pd_law_torque,
+    read_setpoints,
+    setpoint_columns,
+)
 from wbfriction.logs.tables import numeric_column, numeric_columns, read_metadata, with_metadata, write_table
 from wbfriction.logs.temperature import screen_temperature
 from wbfriction.model.robot import Robot
 
-TorqueSource = Literal["sensor", "current"]
-"""Where a log's torques were measured (:attr:`Log.torque_source`)."""
+TorqueSource = Literal["sensor", "driver", "current", "pd"]
+"""Where a log's torques come from (:attr:`Log.torque_source`; :mod:`wbfriction.logs.pd`)."""
 
 
 @dataclass
@@ -79,10 +88,14 @@ class Log:
             None: the clock's nominal step, else the median step of ``time``.
         qd_logged: joint velocities as the robot logged them (``qd.<joint>`` columns)
             (N, n_act) [rad/s], or None; used with ``--velocity logged`` only.
-        torque_source: where ``tau`` was measured: ``"sensor"`` (link-side joint torque
-            sensors: only the friction after the sensor is in it) or ``"current"`` (motor
-            current x torque constant: the whole drive's friction and the rotor inertia are
-            in it).
+        torque_source: where ``tau`` comes from: ``"sensor"`` (link-side joint torque
+            sensors: only the friction after the sensor is in it), ``"driver"`` (the motor
+            drivers' own estimates, ``tau_est.<joint>``), ``"current"`` (motor current x torque
+            constant) or ``"pd"`` (the drivers' PD law on the logged set-points,
+            :mod:`wbfriction.logs.pd`); the last three are the motor's torque: the whole drive's
+            friction and the rotor inertia are in it.
+        setpoints: a PD-driven robot's set-points and driver velocities
+            (:class:`~wbfriction.logs.pd.PdSetpoints`), or None.
         wrench: measured wrenches of the robot's force-torque sensors (N, n_sensors, 6) in
             :attr:`Robot.ft_sensors <wbfriction.model.robot.Robot.ft_sensors>` order, each in its
             sensor frame [N, N·m] (columns ``wrench.<sensor>.fx`` ... ``.tz``,
@@ -121,6 +134,7 @@ class Log:
     base_qdd_true: np.ndarray | None = None
     imu: np.ndarray | None = None
     temperature: np.ndarray | None = None
+    setpoints: PdSetpoints | None = None
 
     def __post_init__(self) -> None:
         if self.segments is None and self.clock is not None and len(self.clock.segments) > 1:
@@ -150,7 +164,8 @@ class Log:
                    clock=None if self.clock is None else self.clock.rows(start, stop), warnings=self.warnings,
                    wrench=cut(self.wrench), base_qd_true=cut(self.base_qd_true),
                    base_qdd_true=cut(self.base_qdd_true), imu=cut(self.imu),
-                   temperature=cut(self.temperature))
+                   temperature=cut(self.temperature),
+                   setpoints=None if self.setpoints is None else self.setpoints.rows(start, stop))
 
     def __len__(self) -> int:
         return len(self.time)
@@ -158,10 +173,14 @@ class Log:
     def to_table(self, robot: Robot) -> pa.Table:
         """The log as an Arrow table in the log format."""
         cols: dict[str, np.ndarray] = {"time": self.time}
-        cols.update({f"q.{n}": self.q[:, i] for i, n in enumerate(robot.actuated)})
+        cols.update({f"q.{n}": self.q[:, i] + robot.encoder_offset.get(n, 0.0) for i, n in enumerate(robot.actuated)})
         if self.torque_source == "current":
             cols.update({f"current.{n}": self.tau[:, i] / robot.torque_constants[n]
                          for i, n in enumerate(robot.torque_controlled)})
+        elif self.torque_source == "driver":
+            cols.update({f"tau_est.{n}": self.tau[:, i] for i, n in enumerate(robot.torque_controlled)})
+        elif self.setpoints is not None and robot.pd is not None:
+            cols.update(setpoint_columns(self.setpoints, robot.pd.joints))
         else:
             cols.update({f"tau.{n}": self.tau[:, i] for i, n in enumerate(robot.torque_controlled)})
         if robot.floating_base:
@@ -279,7 +298,10 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
     """
     warnings = check_schema(table.schema, robot, source)
     time, clock, q = _read_motion(table, robot, source, read, first_row, clock)
-    tau, torque_source = _read_torque(table, robot, source, first_row)
+    qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
+    setpoints = read_setpoints(table, robot, time, q, qd_logged, source, first_row)
+    tau, torque_source = _read_torque(table, robot, source, first_row, time, q, setpoints)
+    q = q - robot.offset_vector if robot.encoder_offset else q  # the model's angles (wbfriction.model.pd)
     wrench = _read_wrench(table, robot, source, first_row)
     contact = _read_contact(table, robot, source, first_row, wrench)
     base = _read_base(table, source, first_row)
@@ -290,18 +312,21 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
         warnings = warnings + glitched
     qd_true = _read_true_rates(table, "qd_true", robot, source, first_row)
     qdd_true = _read_true_rates(table, "qdd_true", robot, source, first_row)
-    qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
     base_qd_true = _read_group(table, BASE_QD_TRUE_COLUMNS, source, first_row, "true base twist")
     base_qdd_true = _read_group(table, BASE_QDD_TRUE_COLUMNS, source, first_row, "true base acceleration")
     imu = _read_group(table, IMU_COLUMNS, source, first_row, "the IMU's reading")
-    return Log(time, q, tau, contact, base, tau_f_true, read_metadata(table, source), source,
+    metadata = read_metadata(table, source)
+    if torque_source == "pd":  # each sample's torque stands for its period's mean (wbfriction.model.pd)
+        metadata = {"torque_alignment": "sample", **metadata}
+    return Log(time, q, tau, contact, base, tau_f_true, metadata, source,
                qd_true=qd_true, qdd_true=qdd_true, segments=clock.segments, period=period, qd_logged=qd_logged,
                torque_source=torque_source, clock=clock, warnings=warnings, wrench=wrench,
-               base_qd_true=base_qd_true, base_qdd_true=base_qdd_true, imu=imu, temperature=temperature)
+               base_qd_true=base_qd_true, base_qdd_true=base_qdd_true, imu=imu, temperature=temperature,
+               setpoints=setpoints)
 
 
 NUMERIC_PREFIXES = ("q", "tau", "current", "qd", "qd_true", "qdd_true", "tau_f_true", "base", "wrench",
-                    "base_qd_true", "base_qdd_true", "imu", "temperature")
+                    "base_qd_true", "base_qdd_true", "imu", "temperature") + PD_PREFIXES
 """Column prefixes whose values must be numbers."""
 
 
@@ -333,7 +358,7 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
         prefix, _, item = col.partition(".")
         known = {"q": act, "tau": act, "tau_f_true": tc, "temperature": tc, "contact": frames, "qd_true": act,
                  "qdd_true": act, "qd": act, "current": act, "wrench": wrenches,
-                 "imu": {c.partition(".")[2] for c in IMU_COLUMNS}}.get(prefix)
+                 "imu": {c.partition(".")[2] for c in IMU_COLUMNS}, **pd_columns_named(robot)}.get(prefix)
         if known is not None and item not in known:
             what = {"contact": "contact frame", "wrench": "force-torque sensor (or axis)",
                     "imu": "IMU axis"}.get(prefix, "joint")
@@ -345,13 +370,7 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
     for col in [f"q.{n}" for n in robot.actuated] + contact:
         if col not in seen:
             raise ColumnError(source, col, None, f"missing column '{col}'")
-    for n in robot.torque_controlled:
-        if f"tau.{n}" not in seen and f"current.{n}" not in seen:
-            raise ColumnError(source, f"tau.{n}", None, f"missing column 'tau.{n}' (or 'current.{n}' with a "
-                              f"torque constant for '{n}' in the robot's [torque_constants])")
-        if f"tau.{n}" not in seen and n not in robot.torque_constants:
-            raise ColumnError(source, f"current.{n}", None, f"column 'current.{n}' needs a torque constant: add "
-                              f"'{n}' [N·m/A] to the robot's [torque_constants]")
+    _check_torque_columns(robot, seen, source)
     single = []
     for f in schema:
         prefix = f.name.partition(".")[0]
@@ -384,6 +403,22 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
         if differentiated else ""
     return (f"{source}: {shown} are float{schema.field(single[0]).type.bit_width}: "
             f"about 7 significant digits ({'; '.join(sizes)}){cost}; log float64",)
+
+
+def _check_torque_columns(robot: Robot, seen: set[str], source: str) -> None:
+    """Every torque-controlled joint has a torque: ``tau``, ``tau_est``, ``current`` with a torque constant, or
+    ``q_des`` of a PD-driven joint (:mod:`wbfriction.logs.pd`)."""
+    pd_joints = set(robot.pd.joints) if robot.pd is not None else set()
+    for n in robot.torque_controlled:
+        if f"tau_est.{n}" in seen or (n in pd_joints and f"q_des.{n}" in seen):
+            continue
+        if f"tau.{n}" not in seen and f"current.{n}" not in seen:
+            raise ColumnError(source, f"tau.{n}", None, f"missing column 'tau.{n}' (or 'current.{n}' with a "
+                              f"torque constant for '{n}' in the robot's [torque_constants], or 'q_des.{n}' "
+                              "with [pd] gains)")
+        if f"tau.{n}" not in seen and n not in robot.torque_constants:
+            raise ColumnError(source, f"current.{n}", None, f"column 'current.{n}' needs a torque constant: add "
+                              f"'{n}' [N·m/A] to the robot's [torque_constants]")
 
 
 SINGLE_PRECISION_SCALE: dict[str, tuple[float, str]] = {
@@ -419,14 +454,22 @@ def _read_motion(table: pa.Table, robot: Robot, source: str, read: ReadOptions, 
     return time, clock, q
 
 
-def _read_torque(table: pa.Table, robot: Robot, source: str, first_row: int) -> tuple[np.ndarray, TorqueSource]:
-    """The torques of the torque-controlled joints (N, n_tc) [N·m] and where they were measured:
-    ``tau.<joint>`` columns (joint torque sensors), or else ``current.<joint>`` [A] times the joint's
-    torque constant [N·m/A] (:attr:`Robot.torque_constants`). One source for every joint."""
+def _read_torque(table: pa.Table, robot: Robot, source: str, first_row: int, time: np.ndarray, q_logged: np.ndarray,
+                 setpoints: PdSetpoints | None) -> tuple[np.ndarray, TorqueSource]:
+    """The torques of the torque-controlled joints (N, n_tc) [N·m] and where they come from, one source for
+    every joint, the first the log has: ``tau.<joint>`` columns (joint torque sensors), the drivers'
+    ``tau_est.<joint>``, ``current.<joint>`` [A] times the joint's torque constant [N·m/A]
+    (:attr:`Robot.torque_constants`), the PD law on the set-points (:mod:`wbfriction.logs.pd`)."""
     names = set(table.column_names)
     from_sensor = [f"tau.{n}" in names for n in robot.torque_controlled]
     if all(from_sensor):
         return _stack(table, [f"tau.{n}" for n in robot.torque_controlled], source, first_row), "sensor"
+    estimated = driver_estimate(table, robot, source, first_row)
+    if estimated is not None:
+        return estimated, "driver"
+    if setpoints is not None and not any(from_sensor) and not any(f"current.{n}" in names
+                                                                     for n in robot.torque_controlled):
+        return pd_law_torque(robot, setpoints, time, q_logged, source), "pd"
     if any(from_sensor):
         n = robot.torque_controlled[from_sensor.index(False)]
         raise ColumnError(source, f"tau.{n}", None, f"missing column 'tau.{n}': torques come from tau.* columns "

@@ -1,0 +1,164 @@
+"""A PD-driven robot's log: the set-points its drivers were sent, and the torque their PD law applied.
+
+Columns (every PD-driven joint of :attr:`Robot.pd <wbfriction.model.robot.Robot.pd>`; :mod:`wbfriction.model.pd`):
+
+=====================  ==========  ==================================================
+``q_des.<joint>``      rad         the position set-point commanded at the sample
+``qd_des.<joint>``     rad/s       optional velocity set-point (default 0)
+``tau_ff.<joint>``     N·m         optional feed-forward torque (default 0)
+``kp.<joint>``         N·m/rad     optional gain, where it changes (default the TOML's ``[pd]``)
+``kd.<joint>``         N·m·s/rad   optional gain, where it changes (default the TOML's ``[pd]``)
+``tau_est.<joint>``    N·m         optional: the driver's own torque estimate (from its current)
+=====================  ==========  ==================================================
+
+Where the torque comes from, one source for every joint, the first that the log has (:data:`TORQUE_SOURCES`):
+``tau.<joint>`` (a joint torque sensor), ``tau_est.<joint>`` (the driver's estimate: measured beats modelled),
+``current.<joint>`` (times the torque constants), and the PD law on the set-points (``q_des.<joint>``, the drivers'
+delay and limits from the TOML). The law runs on the logged angle (the encoder's) and the driver's velocity
+(``qd.<joint>``; without it, the positions' central difference); the dynamics then take the model's angle, the
+logged one less the TOML's ``[encoder_offset]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pyarrow as pa
+
+from wbfriction.exceptions import ColumnError
+from wbfriction.logs.tables import numeric_columns
+from wbfriction.model.pd import PdDriver, pd_torque
+from wbfriction.model.robot import Robot
+
+PD_PREFIXES = ("q_des", "qd_des", "tau_ff", "kp", "kd", "tau_est")
+"""The column prefixes of a PD-driven robot's log (module docstring)."""
+
+
+@dataclass(frozen=True, eq=False)
+class PdSetpoints:
+    """What a log says its PD drivers were sent, each (N, n_pd) in :attr:`PdDriver.joints
+    <wbfriction.model.pd.PdDriver.joints>` order: ``q_des`` [rad], ``qd_des`` [rad/s], ``tau_ff`` [N·m] (None: not
+    logged, zero), ``kp`` [N·m/rad] and ``kd`` [N·m·s/rad] (None: the TOML's), and the driver's velocity ``qd``
+    [rad/s] the law runs on (logged, or the positions' central difference)."""
+
+    q_des: np.ndarray
+    qd: np.ndarray
+    qd_des: np.ndarray | None = None
+    tau_ff: np.ndarray | None = None
+    kp: np.ndarray | None = None
+    kd: np.ndarray | None = None
+
+    def rows(self, start: int, stop: int) -> PdSetpoints:
+        """The rows ``[start, stop)``."""
+        cut = lambda x: None if x is None else x[start:stop]  # noqa: E731
+        return PdSetpoints(self.q_des[start:stop], self.qd[start:stop], cut(self.qd_des), cut(self.tau_ff),
+                           cut(self.kp), cut(self.kd))
+
+    def torque(self, driver: PdDriver, time: np.ndarray, q_logged: np.ndarray, delay: float | None = None
+               ) -> np.ndarray:
+        """The drivers' torque (N, n_pd) [N·m] (:func:`~wbfriction.model.pd.pd_torque`) on the logged angles
+        ``q_logged`` (N, n_pd) [rad], with the drivers' delay or ``delay`` [s]."""
+        return pd_torque(driver, time, q_logged, self.qd, self.q_des, self.qd_des, self.tau_ff, kp=self.kp,
+                         kd=self.kd, delay=delay)
+
+
+def pd_columns_named(robot: Robot) -> dict[str, set[str]]:
+    """The joints each PD column prefix may name: the PD-driven joints (none without ``[pd]``)."""
+    joints = set(robot.pd.joints) if robot.pd is not None else set()
+    return dict.fromkeys(PD_PREFIXES, joints)
+
+
+def read_setpoints(table: pa.Table, robot: Robot, time: np.ndarray, q_logged: np.ndarray, qd_logged: np.ndarray | None,
+                   source: str, first_row: int) -> PdSetpoints | None:
+    """The set-points of a log with ``q_des.<joint>`` columns (None without any).
+
+    Args:
+        table: the log's table.
+        robot: the robot (its :attr:`~wbfriction.model.robot.Robot.pd`).
+        time: the sample times (N,) [s].
+        q_logged: the logged angles of every actuated joint (N, n_act) [rad] (the encoder's, offset included).
+        qd_logged: the logged velocities (N, n_act) [rad/s], or None.
+        source: the file, for errors.
+        first_row: the table's first row in its file.
+
+    Raises:
+        ColumnError: ``q_des`` columns without a ``[pd]`` in the robot's TOML, or for some PD-driven joints only;
+            an optional column logged for some joints only.
+    """
+    names = set(table.column_names)
+    if not any(c.startswith("q_des.") for c in names):
+        return None
+    if robot.pd is None:
+        col = next(c for c in table.column_names if c.startswith("q_des."))
+        raise ColumnError(source, col, None, f"column '{col}' is a PD set-point, but robot '{robot.name}' has no "
+                          "[pd] gains in its TOML (kp, kd: wbfriction.model.pd)")
+    joints = robot.pd.joints
+
+    def group(prefix: str, required: bool) -> np.ndarray | None:
+        cols = [f"{prefix}.{j}" for j in joints]
+        there = [c in names for c in cols]
+        if not any(there) and not required:
+            return None
+        if not all(there):
+            missing = cols[there.index(False)]
+            raise ColumnError(source, missing, None, f"missing column '{missing}': {prefix}.* is logged for some "
+                              "PD-driven joints only; log it for every one, or for none")
+        return numeric_columns(table, cols, source, first_row)
+
+    index = [robot.actuated.index(j) for j in joints]
+    if qd_logged is not None:
+        qd = qd_logged[:, index]
+    else:
+        qd = np.gradient(q_logged[:, index], time, axis=0)
+    q_des = group("q_des", True)
+    assert q_des is not None
+    return PdSetpoints(q_des, qd, group("qd_des", False), group("tau_ff", False),
+                       group("kp", False), group("kd", False))
+
+
+def driver_estimate(table: pa.Table, robot: Robot, source: str, first_row: int) -> np.ndarray | None:
+    """The drivers' own torque estimates ``tau_est.<joint>`` of the torque-controlled joints (N, n_tc) [N·m], or
+    None if the log has none.
+
+    Raises:
+        ColumnError: ``tau_est`` logged for some torque-controlled joints only.
+    """
+    cols = [f"tau_est.{n}" for n in robot.torque_controlled]
+    there = [c in table.column_names for c in cols]
+    if not any(there):
+        return None
+    if not all(there):
+        missing = cols[there.index(False)]
+        raise ColumnError(source, missing, None, f"missing column '{missing}': the drivers' torque estimates are "
+                          "logged for some joints only; log them for every joint, or for none")
+    return numeric_columns(table, cols, source, first_row)
+
+
+def pd_law_torque(robot: Robot, setpoints: PdSetpoints, time: np.ndarray, q_logged: np.ndarray, source: str
+                  ) -> np.ndarray:
+    """The torque-controlled joints' torques (N, n_tc) [N·m] from the PD law (module docstring).
+
+    Raises:
+        ColumnError: a torque-controlled joint that is not PD-driven (it has no torque column either).
+    """
+    assert robot.pd is not None
+    missing = [n for n in robot.torque_controlled if n not in robot.pd.joints]
+    if missing:
+        raise ColumnError(source, f"tau.{missing[0]}", None, f"missing column 'tau.{missing[0]}': '{missing[0]}' "
+                          "is torque-controlled but not PD-driven (not in [pd] joints) and has no torque column")
+    index = [robot.actuated.index(j) for j in robot.pd.joints]
+    tau = setpoints.torque(robot.pd, time, q_logged[:, index])
+    pos = {j: i for i, j in enumerate(robot.pd.joints)}
+    return tau[:, [pos[n] for n in robot.torque_controlled]]
+
+
+def setpoint_columns(setpoints: PdSetpoints, joints: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """The log columns of ``setpoints`` (the inverse of :func:`read_setpoints`; the driver's velocity is the log's
+    ``qd.<joint>``, written with the other rates)."""
+    cols: dict[str, np.ndarray] = {}
+    for prefix in ("q_des", "qd_des", "tau_ff", "kp", "kd"):
+        x = getattr(setpoints, prefix)
+        if x is not None:
+            cols.update({f"{prefix}.{j}": x[:, i] for i, j in enumerate(joints)})
+    return cols

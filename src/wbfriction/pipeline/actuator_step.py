@@ -1,0 +1,104 @@
+"""``wbfriction identify --actuator pd``: a hung PD-driven robot's actuators from a log file, written as JSON and as
+the robot's TOML for the model identified (:mod:`wbfriction.actuator`)."""
+
+from __future__ import annotations
+
+import json
+import re
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from wbfriction.actuator import ActuatorIdentification, ActuatorOptions, identify_actuators
+from wbfriction.exceptions import InputError
+from wbfriction.logs.options import ReadOptions, TimeUnit
+from wbfriction.logs.source import read_log
+from wbfriction.logs.tables import write_atomic
+from wbfriction.model.robot import Robot
+from wbfriction.pipeline.identify_step import identified_config
+from wbfriction.pipeline.paths import check_paths
+
+WRITTEN = ("ok", "weak")
+"""The statuses whose values go into the robot's TOML: determined by the data (``weak``: with a large error, said in
+a comment). A value at a bound or not excited is left as the TOML had it (a comment says why)."""
+
+
+def identify_actuator_file(robot: Robot, log: str | Path, json_output: str | Path | None = None,
+                           options: ActuatorOptions = ActuatorOptions(), time_unit: TimeUnit | None = None
+                           ) -> ActuatorIdentification:
+    """Identify the actuators of ``robot`` from the log file ``log`` and write the JSON (``to_dict``) to
+    ``json_output`` whole or not at all; paths checked before the work.
+
+    Raises:
+        InputError: an unreadable or invalid log, an output that cannot be written or is the log, what
+            :func:`~wbfriction.actuator.identification.identify_actuators` raises.
+    """
+    check_paths({"log": Path(log)}, {"json_output": None if json_output is None else Path(json_output)})
+    data = read_log(log, robot, read=ReadOptions(time_unit=time_unit))
+    result = identify_actuators(robot, data, options)
+    if json_output is not None:
+        text = json.dumps(result.to_dict(), indent=1, sort_keys=True) + "\n"
+        write_atomic(Path(json_output), lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return result
+
+
+def written_values(result: ActuatorIdentification) -> tuple[dict[str, float], dict[str, float], float | None]:
+    """The armature [kg·m²] and encoder offsets [rad] by joint, and the delay [s], whose status is one of
+    :data:`WRITTEN` (None: the delay is not)."""
+    armature = {j.joint: j.armature.value for j in result.joints if j.armature.status in WRITTEN}
+    offsets = {j.joint: j.offset.value for j in result.joints if j.offset is not None and j.offset.status in WRITTEN}
+    delay = result.delay.value if result.delay.status in WRITTEN else None
+    return armature, offsets, delay
+
+
+def actuator_config(text: str, source_dir: Path, urdf: Path, output: Path, result: ActuatorIdentification) -> str:
+    """The robot's configuration (TOML ``text`` read from ``source_dir``) with the identified actuators
+    (:func:`written_values`): its ``[armature]`` and ``[encoder_offset]`` tables merged with them, its ``[pd]``
+    ``delay`` set; every other line as it was, paths made relative to ``output``.
+
+    Raises:
+        InputError: a configuration that does not read back as the one intended (tables as inline tables or
+            dotted keys), naming ``output``.
+    """
+    armature, offsets, delay = written_values(result)
+    given = tomllib.loads(text)
+    merged_armature = {**given.get("armature", {}), **armature}
+    merged = identified_config(text, source_dir, urdf, output, merged_armature or None)
+    lines, skipping, in_pd = [], False, False
+    for line in merged.splitlines():
+        header = re.match(r"\s*\[([^\]]+)\]", line)
+        if header:
+            skipping = header.group(1).strip() == "encoder_offset"
+            in_pd = header.group(1).strip() == "pd"
+        if skipping or (in_pd and delay is not None and re.match(r"\s*delay\s*=", line)):
+            continue
+        lines.append(line)
+        if header and in_pd and delay is not None:
+            lines.append(f"delay = {delay!r}   # identified by wbfriction identify --actuator pd [s]")
+    offsets = {**given.get("encoder_offset", {}), **offsets}
+    if offsets:
+        lines += ["", "[encoder_offset]   # identified by wbfriction identify --actuator pd [rad]"]
+        lines += [f"{joint} = {value!r}" for joint, value in offsets.items()]
+    written = "\n".join(lines) + "\n"
+    expected: dict[str, Any] = tomllib.loads(merged)
+    if offsets:
+        expected["encoder_offset"] = offsets
+    if delay is not None:
+        expected.setdefault("pd", {})["delay"] = delay
+    if tomllib.loads(written) != expected:
+        raise InputError(f"{output}: the robot's configuration could not be rewritten line by line (its [pd] or "
+                         "[encoder_offset] is not a plain table): copy the values printed into it instead")
+    return written
+
+
+def write_actuator_config(text: str, source_dir: Path, urdf: Path, output: str | Path,
+                          result: ActuatorIdentification) -> None:
+    """Write :func:`actuator_config` to ``output``, whole or not at all.
+
+    Raises:
+        InputError: what :func:`actuator_config` raises.
+        OutputError: the system refused the write.
+    """
+    output = Path(output)
+    written = actuator_config(text, source_dir, urdf, output, result)
+    write_atomic(output, lambda tmp: tmp.write_text(written, encoding="utf-8"))
