@@ -173,7 +173,9 @@ class Log:
     def to_table(self, robot: Robot) -> pa.Table:
         """The log as an Arrow table in the log format."""
         cols: dict[str, np.ndarray] = {"time": self.time}
-        cols.update({f"q.{n}": self.q[:, i] + robot.encoder_offset.get(n, 0.0) for i, n in enumerate(robot.actuated)})
+        offset = robot.encoder_offset  # the logged angle is the model's plus the encoder's offset
+        cols.update({f"q.{n}": self.q[:, i] + offset[n] if n in offset else self.q[:, i]
+                     for i, n in enumerate(robot.actuated)})
         if self.torque_source == "current":
             cols.update({f"current.{n}": self.tau[:, i] / robot.torque_constants[n]
                          for i, n in enumerate(robot.torque_controlled)})
