@@ -57,7 +57,9 @@ actuator, named as its joint (the model file's own actuators of those joints are
 
     \\texttt{actuator\\_force} = k_p\\,(\\texttt{ctrl} - \\text{offset} - \\texttt{qpos}) - k_d\\,\\texttt{qvel},
 
-clipped at ``forcerange = [-tau_max, tau_max]`` (none where the driver has no limit): ``ctrl`` is the set-point
+clipped at ``forcerange = [-tau_max, tau_max]`` (none where the driver has no limit; the joint's
+``actuatorfrcrange``, MuJoCo's import of the URDF's effort limit, is lifted: the driver's limit is the one, and
+it defaults to the URDF's): ``ctrl`` is the set-point
 ``q_des`` as the robot commands it (the encoder's frame), ``qpos`` the model's angle, which the encoder reads as
 ``qpos + offset``. The encoder offset goes in the actuator's bias, where the driver meets it, rather than in the
 joint's ``ref`` (which would move ``qpos``'s zero for everything that reads it: ranges, keyframes, Pinocchio's
@@ -259,6 +261,9 @@ def _add_drives(spec: mujoco.MjSpec, drive: DriveExport) -> None:
         if np.isfinite(limit):
             act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
             act.forcerange = [-limit, limit]
+        joint = spec.joint(name)  # the URDF's effort limit, as MuJoCo's import sets it: the driver's limit instead
+        joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        joint.actfrcrange = [0.0, 0.0]
         if drive.delay > 0:
             act.delay = drive.delay
             act.nsample = history_samples(drive.delay, timestep)
