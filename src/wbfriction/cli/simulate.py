@@ -4,14 +4,16 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING, Literal, Optional
 
 import typer
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.exceptions import InputError
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.sim.options import FrictionMode, IdealOptions, Integrator, MujocoOptions, SensorNoise, Simulator
+from wbfriction.sim.pd_options import DriverNoise, HungOptions, SetpointKind, SetpointOptions
 from wbfriction.walking.options import Gait, GaitOptions
 
 if TYPE_CHECKING:
@@ -31,6 +33,14 @@ from wbfriction.cli.common import (
     progress_bar,
     robot_of,
 )
+
+HUNG = HungOptions()
+SETPOINTS = SetpointOptions()
+Actuator = Literal["torque", "pd"]
+"""How a robot's joints are driven (``--actuator``): motors whose torque is logged, or PD motor drivers."""
+DriverNoiseChoice = Literal["real", "none"]
+"""The PD drivers' sensor noise (``--driver-noise``): a real driver's (:data:`~wbfriction.sim.pd_options.REAL_DRIVER`)
+or none."""
 
 
 def _run_simulate(r: Robot, output: Path, gait: GaitOptions, options: IdealOptions | MujocoOptions,
@@ -75,6 +85,65 @@ def _run_simulate_arm(r: Robot, output: Path, options: ArmOptions, friction: Opt
     console.print(f"wrote {output} ({result.table.num_rows} samples, {options.duration:g} s, motor currents)")
 
 
+def _run_simulate_hung(r: Robot, output: Path, options: HungOptions, friction: Optional[Path]) -> None:
+    from wbfriction.fit.targets import load_friction_spec
+    from wbfriction.logs.tables import write_table
+    from wbfriction.sim.hung import simulate_hung
+
+    spec = None if friction is None else load_friction_spec(friction, r.groups, r.actuated)
+    if spec is not None and (spec.terms or spec.temperature is not None):
+        raise InputError(f"{friction}: a PD-driven robot's simulation takes friction models per joint, without terms "
+                         "beyond velocity or a temperature")
+    with progress_bar(int(round(options.duration * options.rate)), "simulate") as advance:
+        result = simulate_hung(r, options, None if spec is None else spec.params, progress=advance)
+    write_table(result.table, output)
+    console.print(f"wrote {output} ({result.table.num_rows} samples, {options.duration:g} s, PD set-points; "
+                  f"delay {result.driver.delay * 1e3:g} ms, physics step {result.physics_step * 1e3:g} ms)")
+
+
+FrictionOpt = typer.Option(None, help="TOML with [friction.<group or joint>] tables (a model key: coulomb-viscous, "
+                                      "stribeck or (3.5)), each with an optional terms table (F_L, dF_v, ripple, "
+                                      "F_cT, F_vT, reference_temperature), and a [temperature] warm-up (start, end "
+                                      "[°C]) logged as temperature.<joint>; default: thesis Table 6.1 on the legs, "
+                                      "Coulomb-viscous on every joint of a PD-driven robot.")
+SimulatorOpt = typer.Option("ideal", help="ideal (rigid contacts, thesis 6.1) or mujoco (soft contacts, measured "
+                                          "contact flags, sensors, thesis 6.2).")
+SubstepsOpt = typer.Option(None, help=f"Physics steps per control period (default: {IDEAL.substeps} ideal, "
+                                      f"{MUJOCO.substeps} mujoco (1 ms periods), {HUNG.substeps} PD-driven (at "
+                                      f"{HUNG.rate:g} Hz: 1 ms steps)).")
+MujocoFrictionOpt = typer.Option(MUJOCO.friction, help="mujoco and PD-driven: model (any friction model as a joint "
+                                                       "torque) or mujoco (MuJoCo's frictionloss = F_c, damping = "
+                                                       "F_v).")
+SensorsOpt = typer.Option(None, help="mujoco: TOML with a [sensors] table (position_std, encoder_bits, torque_std, "
+                                     "seed, delay); the options below override it.")
+DelayOpt = typer.Option(None, help="mujoco: measurement-to-command delay [ms], whole control periods; PD-driven: "
+                                   "the drivers' set-point delay [ms], any (default the robot's [pd] delay).")
+ForceTorqueOpt = typer.Option(IDEAL.force_torque, help="ideal: write what the robot's force-torque sensors and IMU "
+                                                       "measure (wrench.<sensor>.*, imu.* columns; mujoco always "
+                                                       "does).")
+SoleOpt = typer.Option(None, help="mujoco: the soles' contact time constant (s; default MuJoCo's 0.02, larger is "
+                                  "softer: a compliant sole).")
+FrictionTimeOpt = typer.Option(None, help="mujoco: the friction-loss constraint's time constant (s; default two "
+                                          "physics steps: a joint that sticks; MuJoCo's 0.02 leads the velocity by "
+                                          "10 ms).")
+DurationOpt = typer.Option(None, help="Fixed-base robot: seconds of excitation trajectory (an arm, default 10) or of "
+                                      f"set-points (PD-driven, default {HUNG.duration:g}).")
+SeedOpt = typer.Option(0, help="Fixed-base robot: seed of the excitation trajectory's Fourier coefficients or of the "
+                               "set-points (another seed, another motion).")
+ActuatorOpt = typer.Option(None, help="torque (motors whose torque is logged) or pd (motor drivers closing a PD loop: "
+                                      "a fixed-base robot hung, its drivers tracking ramps and chirps, "
+                                      "wbfriction.sim.hung); default pd for a robot with a [pd] table.")
+SetpointsOpt = typer.Option(SETPOINTS.kind, help="PD-driven: ramps (triangle ramps reversing every "
+                                                 f"{SETPOINTS.reversal[0]:g}-{SETPOINTS.reversal[1]:g} s), chirps "
+                                                 f"({SETPOINTS.chirp[0]:g}-{SETPOINTS.chirp[1]:g} Hz) or both "
+                                                 "(ramps, then chirps).")
+DriverNoiseOpt = typer.Option("real", help="PD-driven: real (a real driver's noise, measured on a Unitree Aliengo: "
+                                           "encoder steps 1.2e-5 rad hip and thigh, 3.8e-5 calf; white noise of "
+                                           "0.08 rad/s on the driver's velocity) or none (exact readings); "
+                                           "--encoder-bits, --position-noise and --velocity-noise override it.")
+VelocityNoiseOpt = typer.Option(None, help="PD-driven: white noise std of the driver's velocity [rad/s].")
+
+
 @app.command()
 def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write: .parquet, .csv or .h5."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
@@ -86,63 +155,44 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              step_width: float = typer.Option(GAIT.step_width, help="Sideways step [m]."),
              turn_angle: float = typer.Option(GAIT.turn_angle, help="Heading change per turning step [rad]."),
              lift_height: float = typer.Option(GAIT.lift_height, help="Swing-foot apex [m]."),
-             friction: Optional[Path] = typer.Option(None, help="TOML with [friction.<group or joint>] tables (a "
-                                                               "model key: coulomb-viscous, stribeck or (3.5)), "
-                                                               "each with an optional terms table (F_L, dF_v, "
-                                                               "ripple, F_cT, F_vT, reference_temperature), and "
-                                                               "a [temperature] warm-up (start, end [°C]) logged "
-                                                               "as temperature.<joint>; default: thesis Table "
-                                                               "6.1 on the legs."),
-             simulator: Simulator = typer.Option("ideal", help="ideal (rigid contacts, thesis 6.1) or mujoco (soft "
-                                                         "contacts, measured contact flags, sensors, thesis 6.2)."),
-             substeps: Optional[int] = typer.Option(None, help=f"Physics steps per 1 ms control period (default: "
-                                                              f"{IDEAL.substeps} ideal, {MUJOCO.substeps} mujoco)."),
+             friction: Optional[Path] = FrictionOpt, simulator: Simulator = SimulatorOpt,
+             substeps: Optional[int] = SubstepsOpt,
              integrator: Integrator = typer.Option(IDEAL.integrator, help="ideal: semi-implicit or explicit Euler."),
-             mujoco_friction: FrictionMode = typer.Option(MUJOCO.friction,
-                                                          help="mujoco: model (eq. 3.5 as a joint torque) "
-                                                               "or mujoco (MuJoCo's frictionloss = F_c, damping "
-                                                               "= F_v)."),
-             sensors: Optional[Path] = typer.Option(None, help="mujoco: TOML with a [sensors] table (position_std, "
-                                                               "encoder_bits, torque_std, seed, delay); the options "
-                                                               "below override it."),
-             position_noise: Optional[float] = typer.Option(None, help="mujoco and arms: joint-position noise std "
-                                                                       "[rad]."),
-             encoder_bits: Optional[int] = typer.Option(None, help="mujoco and arms: encoder resolution [bits per "
-                                                                   "turn]."),
+             mujoco_friction: FrictionMode = MujocoFrictionOpt, sensors: Optional[Path] = SensorsOpt,
+             position_noise: Optional[float] = typer.Option(None, help="mujoco, arms and PD-driven: joint-position "
+                                                                       "noise std [rad]."),
+             encoder_bits: Optional[int] = typer.Option(None, help="mujoco, arms and PD-driven: encoder resolution "
+                                                                   "[bits per turn]."),
              torque_noise: Optional[float] = typer.Option(None, help="mujoco and arms: torque-sensor noise std "
                                                                      "[N·m]."),
-             noise_seed: Optional[int] = typer.Option(None, help="mujoco and arms: seed of the sensor noise."),
-             delay: Optional[float] = typer.Option(None, help="mujoco: measurement-to-command delay [ms], whole "
-                                                              "control periods."),
+             noise_seed: Optional[int] = typer.Option(None, help="mujoco, arms and PD-driven: seed of the sensor "
+                                                                 "noise."),
+             delay: Optional[float] = DelayOpt,
              log_base: bool = typer.Option(IDEAL.log_base, help="Write the base pose to the log."),
-             force_torque: bool = typer.Option(IDEAL.force_torque, help="ideal: write what the robot's force-torque "
-                                                                     "sensors and IMU measure (wrench.<sensor>.*, "
-                                                                     "imu.* columns; mujoco always does)."),
-             sole_timeconst: Optional[float] = typer.Option(None, help="mujoco: the soles' contact time constant "
-                                                                       "(s; default MuJoCo's 0.02, larger is "
-                                                                       "softer: a compliant sole)."),
-             friction_timeconst: Optional[float] = typer.Option(None, help="mujoco: the friction-loss constraint's "
-                                                                           "time constant (s; default two physics "
-                                                                           "steps: a joint that sticks; MuJoCo's "
-                                                                           "0.02 leads the velocity by 10 ms)."),
+             force_torque: bool = ForceTorqueOpt, sole_timeconst: Optional[float] = SoleOpt,
+             friction_timeconst: Optional[float] = FrictionTimeOpt,
              torque_drift: float = typer.Option(MUJOCO.torque_drift, min=0.0, help="mujoco: drift rate of each torque "
                                                                                "sensor's offset (N·m/s)."),
              ft_offset: tuple[float, float] = typer.Option(MUJOCO.ft_offset, help="mujoco: standard deviations of the "
                                                                                "force-torque sensors' constant "
                                                                                "offsets: force (N), torque (N·m)."),
-             duration: float = typer.Option(10.0, help="Fixed-base robot (an arm): seconds of excitation "
-                                                       "trajectory."),
-             excitation_seed: int = typer.Option(0, help="Fixed-base robot (an arm): seed of the excitation "
-                                                         "trajectory's Fourier coefficients (another seed, another "
-                                                         "motion).")) -> None:
+             duration: Optional[float] = DurationOpt, excitation_seed: int = SeedOpt,
+             actuator: Optional[Actuator] = ActuatorOpt, setpoints: SetpointKind = SetpointsOpt,
+             driver_noise: DriverNoiseChoice = DriverNoiseOpt,
+             velocity_noise: Optional[float] = VelocityNoiseOpt) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
-    fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents."""
+    fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents; a PD-driven one
+    (--robot go2) hangs with its base fixed, its drivers tracking ramps and chirps."""
     check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors},
                 {"-o": output})
     r = robot_of(robot, urdf, config, mjcf)
+    if (actuator or ("pd" if r.pd is not None else "torque")) == "pd":
+        drivers = driver_noise_of(driver_noise, encoder_bits, position_noise, velocity_noise, noise_seed)
+        return _run_simulate_hung(r, output, hung_options(duration, substeps, setpoints, excitation_seed, drivers,
+                                                          delay, mujoco_friction, friction_timeconst), friction)
     if not r.floating_base:
-        return _run_simulate_arm(r, output, arm_options(duration, excitation_seed, position_noise, encoder_bits,
-                                                        torque_noise, noise_seed), friction)
+        return _run_simulate_arm(r, output, arm_options(duration or 10.0, excitation_seed, position_noise,
+                                                        encoder_bits, torque_noise, noise_seed), friction)
     gait_opts = GaitOptions(gait=gait, steps=steps, step_length=step_length, step_width=step_width,
                             turn_angle=turn_angle, lift_height=lift_height)
     if simulator == "ideal":
@@ -182,3 +232,29 @@ def sensor_noise(sensors: Optional[Path], position_noise: Optional[float], encod
     table.update({k: v for k, v in given.items() if v is not None})
     lag = float(table.pop("delay", 0.0))
     return SensorNoise(**table), lag
+
+
+def driver_noise_of(choice: str, encoder_bits: Optional[int], position_noise: Optional[float],
+                    velocity_noise: Optional[float], noise_seed: Optional[int]) -> DriverNoise:
+    """The PD drivers' noise: ``choice``'s levels (``real``: :data:`~wbfriction.sim.pd_options.REAL_DRIVER`;
+    ``none``: exact), each option given overriding its level (``encoder_bits`` per turn on every joint)."""
+    import math
+
+    from wbfriction.sim.pd_options import REAL_DRIVER
+
+    noise = REAL_DRIVER if choice == "real" else DriverNoise()
+    resolution = None if encoder_bits is None else 2.0 * math.pi / 2.0**encoder_bits
+    given: dict[str, object] = {"encoder_resolution": resolution, "position_std": position_noise,
+                                "velocity_std": velocity_noise, "seed": noise_seed}
+    return dataclasses.replace(noise, **{k: v for k, v in given.items() if v is not None})  # type: ignore[arg-type]
+
+
+def hung_options(duration: Optional[float], substeps: Optional[int], kind: SetpointKind, seed: int,
+                 noise: DriverNoise, delay: Optional[float], friction: FrictionMode,
+                 friction_timeconst: Optional[float]) -> HungOptions:
+    """The options of a PD-driven robot's simulation from the command line's (``delay`` in ms)."""
+    return HungOptions(duration=HUNG.duration if duration is None else duration,
+                       substeps=HUNG.substeps if substeps is None else substeps,
+                       setpoints=SetpointOptions(kind=kind, seed=seed), noise=noise,
+                       delay=None if delay is None else delay * 1e-3, friction=friction,
+                       friction_timeconst=friction_timeconst)
