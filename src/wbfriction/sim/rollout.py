@@ -1,0 +1,252 @@
+"""The rollout check of a PD-driven robot's identified model (issue 55, item 6): the model replayed on MuJoCo under
+a log's set-points, its joints' angles against the log's.
+
+A parameter set (:class:`ActuatorParams`: friction per joint, and the armature, encoder offsets and drivers' delay,
+each the robot TOML's unless given) runs on the robot's MuJoCo model (:mod:`wbfriction.sim.pd_robot`, the hung
+simulator's: one way to build and run a PD-driven robot) from the log's state at the start of a stretch (the model's
+angle: the logged one less the encoder offset; the logged velocity), its drivers sent the log's set-points
+(``q_des``, ``qd_des``, ``tau_ff``, and ``kp``/``kd`` where logged; the ones commanded before the stretch feed the
+delay), noise-free. The tracking error of each joint is the RMS over the stretch of the simulated logged angle
+(``q + offset``) less the log's ``q`` [rad] (:class:`RolloutResult`); two parameter sets replayed on one stretch
+(ours, a peer's) compare side by side (:func:`rollout_table`).
+
+**Shooting.** By default one shot over the whole stretch (``horizon = None``): a PD-driven joint tracks its
+set-point, so a model's error does not grow without bound; it stays at what the model gets wrong (the friction's
+lag at every reversal, the armature's and the delay's phase), which is what the check measures. With a
+``horizon`` of K seconds the replay restarts from the log's state every K seconds (multiple shooting): for long logs
+where a model's slow drift (a joint that sticks in the model and not on the robot) would otherwise dominate. Each
+restart takes the log's velocity, the driver's noisy one (0.08 rad/s on a real driver), so short horizons add a
+transient of that noise to every shot.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+
+from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.friction.models import MODEL_NAMES, ModelParams, ModelParamsBase
+from wbfriction.logs.tables import numeric_columns, read_table
+from wbfriction.model.robot import Robot
+from wbfriction.sim.options import FrictionMode
+from wbfriction.sim.pd_robot import Commands, PdMujocoRobot, PdRun, build_pd_robot
+
+
+@dataclass(frozen=True)
+class ActuatorParams:
+    """One parameter set of a PD-driven robot's drives, as the rollout replays it.
+
+    Attributes:
+        friction: per joint, parameters of a built-in family (:class:`~wbfriction.friction.models.ModelParams`) or a
+            fit holding them (``.params``: :class:`~wbfriction.fit.result.FitResult`, what
+            :func:`~wbfriction.fit.params_file.read_params` reads; a fit without parameters: no friction), or the
+            path of a parameters JSON; joints not named: none.
+        armature: per joint [kg·m^2] (joints not named: 0); None: the robot's ``[armature]``.
+        encoder_offset: per joint [rad] (joints not named: 0); None: the robot's ``[encoder_offset]``.
+        delay: the drivers' delay [s]; None: the robot's ``[pd]`` delay.
+        label: what the tables call the set (``"ours"``, ``"peer"``).
+    """
+
+    friction: Mapping[str, Any] | str | Path
+    armature: Mapping[str, float] | None = None
+    encoder_offset: Mapping[str, float] | None = None
+    delay: float | None = None
+    label: str = "model"
+
+
+@dataclass(frozen=True, eq=False)
+class RolloutResult:
+    """A parameter set replayed over a stretch of a log (module docstring).
+
+    Attributes:
+        label: the parameter set's (:attr:`ActuatorParams.label`).
+        joints: the joints, in the robot's order.
+        rows: the stretch, rows ``[start, stop)`` of the log.
+        time: the stretch's sample times (M,) [s].
+        q_sim: the simulated logged angles (M, n) [rad] (the model's angle plus the encoder offset).
+        q_log: the log's angles (M, n) [rad].
+        horizon: the shots' length [s] (None: one shot).
+        no_friction: joints replayed without friction (a fit without parameters, or none given).
+    """
+
+    label: str
+    joints: tuple[str, ...]
+    rows: tuple[int, int]
+    time: np.ndarray
+    q_sim: np.ndarray
+    q_log: np.ndarray
+    horizon: float | None
+    no_friction: tuple[str, ...] = ()
+
+    @property
+    def error(self) -> np.ndarray:
+        """The simulated less the logged angles (M, n) [rad]."""
+        return self.q_sim - self.q_log
+
+    @property
+    def rms(self) -> np.ndarray:
+        """Each joint's RMS tracking error over the stretch (n,) [rad]."""
+        return np.sqrt(np.mean(self.error**2, axis=0))
+
+    def by_joint(self) -> dict[str, float]:
+        """:attr:`rms` by joint name [rad]."""
+        return {j: float(e) for j, e in zip(self.joints, self.rms)}
+
+
+def rollout_table(results: Sequence[RolloutResult]) -> pa.Table:
+    """Parameter sets replayed on one stretch, side by side: a row per joint, ``joint`` and ``rms.<label>`` [rad] per
+    set (the labels distinct).
+
+    Raises:
+        InputError: no result, results of other joints or stretches, a label twice.
+    """
+    if not results:
+        raise InputError("rollout_table: no rollout to tabulate")
+    labels = [r.label for r in results]
+    if len(set(labels)) != len(labels):
+        raise InputError(f"rollout_table: the labels must differ, got {labels}")
+    first = results[0]
+    if any(r.joints != first.joints or r.rows != first.rows for r in results):
+        raise InputError("rollout_table: the rollouts must be of the same joints over the same stretch")
+    return pa.table({"joint": list(first.joints), **{f"rms.{r.label}": r.rms for r in results}})
+
+
+def _friction(robot: Robot, given: Mapping[str, Any] | str | Path) -> tuple[dict[str, ModelParams], tuple[str, ...]]:
+    """The friction parameters per joint of :attr:`ActuatorParams.friction`, and the joints without any."""
+    if isinstance(given, (str, Path)):
+        from wbfriction.fit.params_file import read_params
+        given = read_params(given)
+    out: dict[str, ModelParams] = {}
+    for joint, value in given.items():
+        if joint not in robot.actuated:
+            raise InputError(f"friction given for '{joint}', which is not a joint of {robot.name}")
+        params = value if isinstance(value, ModelParamsBase) else getattr(value, "params", value)
+        if params is None:
+            continue
+        if not isinstance(params, ModelParamsBase) or params.model not in MODEL_NAMES:
+            raise InputError(f"friction of '{joint}': parameters of a built-in family ({', '.join(MODEL_NAMES)}) "
+                             f"are replayed, got {type(params).__name__}")
+        out[joint] = params  # type: ignore[assignment]  # a built-in family's (checked above)
+    return out, tuple(j for j in robot.actuated if j not in out)
+
+
+def _per_joint(robot: Robot, given: Mapping[str, float] | None, own: Mapping[str, float], what: str) -> np.ndarray:
+    values = own if given is None else given
+    unknown = sorted(set(values) - set(robot.actuated))
+    if unknown:
+        raise InputError(f"{what} given for '{unknown[0]}', which is not a joint of {robot.name}")
+    return np.array([float(values.get(j, 0.0)) for j in robot.actuated])
+
+
+@dataclass(frozen=True, eq=False)
+class LogSetpoints:
+    """What the rollout reads of a PD-driven robot's log (every joint, in the robot's order): ``time`` (N,) [s], the
+    logged angles ``q`` and velocities ``qd`` (N, n), and the :class:`~wbfriction.sim.pd_robot.Commands`."""
+
+    time: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    commands: Commands
+
+
+def read_log_setpoints(robot: Robot, log: pa.Table | str | Path) -> LogSetpoints:
+    """The columns a rollout needs of a log (a table, or a file in any log format): ``time``, ``q.<joint>``,
+    ``qd.<joint>`` (the driver's velocity; without it the angles' central difference), ``q_des.<joint>``, and where
+    logged ``qd_des``, ``tau_ff`` (default 0), ``kp``, ``kd`` (default the robot's ``[pd]``).
+
+    Raises:
+        ColumnError: a required column missing, an optional one logged for some joints only.
+        InputError: a file that cannot be read.
+    """
+    source = str(log) if isinstance(log, (str, Path)) else "<table>"
+    table = read_table(log) if isinstance(log, (str, Path)) else log
+    names = set(table.column_names)
+
+    def group(prefix: str, required: bool) -> np.ndarray | None:
+        cols = [f"{prefix}.{j}" for j in robot.actuated]
+        there = [c in names for c in cols]
+        if not any(there) and not required:
+            return None
+        if not all(there):
+            missing = cols[there.index(False)]
+            raise ColumnError(source, missing, None, f"missing column '{missing}' (the rollout replays every joint)")
+        return numeric_columns(table, cols, source)
+
+    if "time" not in names:
+        raise ColumnError(source, "time", None, "missing column 'time'")
+    time = numeric_columns(table, ["time"], source)[:, 0]
+    q = group("q", True)
+    q_des = group("q_des", True)
+    assert q is not None and q_des is not None
+    qd = group("qd", False)
+    qd = np.gradient(q, time, axis=0) if qd is None else qd
+    zeros = np.zeros_like(q)
+    qd_des, tau_ff = group("qd_des", False), group("tau_ff", False)
+    commands = Commands(q_des, zeros if qd_des is None else qd_des, zeros if tau_ff is None else tau_ff,
+                        group("kp", False), group("kd", False))
+    return LogSetpoints(time, q, qd, commands)
+
+
+def _stretch(time: np.ndarray, rows: tuple[int, int] | None, times: tuple[float, float] | None) -> tuple[int, int]:
+    """Rows ``[start, stop)`` of a stretch given by rows or by times [s] (``[t0, t1)``), at least two samples."""
+    if rows is not None and times is not None:
+        raise InputError("a rollout's stretch is given by rows or by times, not both")
+    n = len(time)
+    start, stop = (0, n) if rows is None else rows
+    if times is not None:
+        start, stop = (int(np.searchsorted(time, t, side="left")) for t in times)
+    if not 0 <= start < stop <= n or stop - start < 2:
+        raise InputError(f"the rollout's stretch (rows {start} to {stop}) must hold at least two of the log's {n} rows")
+    return start, stop
+
+
+def rollout(robot: Robot, log: pa.Table | str | Path | LogSetpoints, params: ActuatorParams, *,
+            rows: tuple[int, int] | None = None, times: tuple[float, float] | None = None,
+            horizon: float | None = None, substeps: int = 5, friction_mode: FrictionMode = "model",
+            mjr: PdMujocoRobot | None = None) -> RolloutResult:
+    """Replay a parameter set under a log's set-points (module docstring).
+
+    Args:
+        robot: the robot (URDF, ``[pd]`` gains, limits; the armature, encoder offsets and delay where ``params``
+            gives none): a fixed base, every joint PD-driven.
+        log: the log (a table, a file, or :func:`read_log_setpoints`'s reading of it).
+        params: :class:`ActuatorParams`.
+        rows: the stretch as rows ``[start, stop)``; times: as times ``[t0, t1)`` [s]; neither: the whole log.
+        horizon: restart from the log's state every so many seconds (multiple shooting); None: one shot.
+        substeps: physics steps per log period (5: 1 ms at 200 Hz).
+        friction_mode: ``"model"`` or ``"mujoco"`` (:mod:`wbfriction.sim.pd_robot`).
+        mjr: the robot's MuJoCo model, if already built.
+
+    Returns:
+        :class:`RolloutResult`.
+
+    Raises:
+        InputError: a stretch out of the log, a horizon <= 0, values for unknown joints, parameters of no built-in
+            family, a robot that is not a fixed-base PD-driven one.
+        ColumnError: a column the replay needs is missing.
+    """
+    mjr = mjr or build_pd_robot(robot)
+    data = log if isinstance(log, LogSetpoints) else read_log_setpoints(robot, log)
+    start, stop = _stretch(data.time, rows, times)
+    if horizon is not None and not horizon > 0:
+        raise InputError(f"the rollout's horizon must be > 0 s, got {horizon}")
+    friction, bare = _friction(robot, params.friction)
+    armature = _per_joint(robot, params.armature, dict(zip(robot.actuated, robot.model.armature[robot.act_v_index])),
+                          "armature")
+    offset = _per_joint(robot, params.encoder_offset, robot.encoder_offset, "encoder offset")
+    driver = mjr.driver if params.delay is None else mjr.driver.with_delay(params.delay)
+    period = float(np.median(np.diff(data.time)))
+    run = PdRun(mjr, period, substeps, driver, armature, offset, friction, friction_mode)
+    shot = stop - start if horizon is None else max(1, int(round(horizon / period)))
+    q_sim = np.empty((stop - start, robot.n_act))
+    for first in range(start, stop, shot):
+        last = min(first + shot, stop)
+        trajectory = run.run(data.commands, first, last, data.q[first] - offset, data.qd[first])
+        q_sim[first - start:last - start] = trajectory.q + offset
+    return RolloutResult(params.label, robot.actuated, (start, stop), data.time[start:stop], q_sim,
+                         data.q[start:stop].copy(), horizon, bare)
