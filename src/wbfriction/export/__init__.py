@@ -2,7 +2,8 @@
 (3.5) to simulator fields (:mod:`.mapping`), one export target per file format (:mod:`.target`: one writer
 signature), chosen by the output's suffix (:mod:`.registry`, where new formats plug in): the URDF's
 ``<dynamics>`` (:mod:`.urdf`), a MuJoCo model (:mod:`.mjcf`) and an Isaac Lab actuator dictionary as YAML
-(:mod:`.isaac`)."""
+(:mod:`.isaac`); a PD-driven robot's motor drivers (gains, torque limits, delay, encoder offsets) where each holds
+them (:mod:`.drive`)."""
 
 import lazy_loader
 

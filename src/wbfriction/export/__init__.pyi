@@ -1,5 +1,10 @@
 """Names of :mod:`wbfriction.export`, imported on first use (:func:`lazy_loader.attach_stub`)."""
 
+from .drive import DEFAULT_PHYSICS_DT as DEFAULT_PHYSICS_DT
+from .drive import DelaySteps as DelaySteps
+from .drive import DriveExport as DriveExport
+from .drive import delay_steps as delay_steps
+from .drive import drive_export as drive_export
 from .isaac import IsaacTarget as IsaacTarget
 from .isaac import isaac_actuator_dict as isaac_actuator_dict
 from .isaac import write_isaac_yaml as write_isaac_yaml
@@ -18,6 +23,7 @@ from .mjcf import write_mjcf as write_mjcf
 from .registry import UnknownExportFormat as UnknownExportFormat
 from .registry import register_target as register_target
 from .registry import target_for as target_for
+from .target import ExportOptions as ExportOptions
 from .target import ExportReport as ExportReport
 from .target import ExportTarget as ExportTarget
 from .urdf import UrdfTarget as UrdfTarget
