@@ -7,7 +7,9 @@ that reads it (:data:`KINDS`):
 * ``coulomb-viscous`` (:class:`CoulombViscous`, the UR10e): ``f(qd) = F_v qd + F_c sgn(qd) + offset``;
 * ``sigmoid`` (:class:`Sigmoid`, the Panda): ``f(qd) = A / (1 + exp(-alpha (qd + s))) - A / (1 + exp(-alpha s))``;
 * ``held-out-rms`` (:class:`HeldOutRms`, the KUKA LWR4+): no published friction; the peer's method's torque RMS
-  on the held-out log, per joint [N·m].
+  on the held-out log, per joint [N·m];
+* ``peer-parameters`` (:class:`PeerParameters`, the Unitree Aliengo): the peer's identified parameters, in the
+  dataset's own files; their held-out torque RMS computed at run time.
 
 Sign convention: wbfriction's (README): ``f`` is the friction torque's opposite, ``f(qd) > 0`` for ``qd > 0`` when
 friction dissipates; both papers add their ``f`` to the rigid-body torque in the measured torque, as
@@ -144,7 +146,28 @@ class HeldOutRms(Reference):
         return cls(**head, joints=tuple(joints), rms=_per_joint(joints, "rms"))
 
 
-KINDS: dict[str, type[Reference]] = {cls.kind: cls for cls in (CoulombViscous, Sigmoid, HeldOutRms)}
+@dataclass(frozen=True)
+class PeerParameters(Reference):
+    """No curve and no number shipped: the peer published its parameters (a PD-driven robot's armature, friction,
+    encoder offsets and delay), read from the dataset's files at run time; its held-out torque RMS is computed
+    through the same estimate and prediction as wbfriction's (:mod:`wbfriction.studies.pd_peer`)."""
+
+    kind = "peer-parameters"
+
+    @property
+    def has_curve(self) -> bool:
+        return False
+
+    def f(self, joint: str, qd: np.ndarray) -> np.ndarray:
+        raise InputError(f"the {self.dataset} reference holds no friction curve, only the peer's parameters")
+
+    @classmethod
+    def from_joints(cls, head: dict[str, Any], joints: dict[str, dict[str, float]]) -> PeerParameters:
+        return cls(**head, joints=tuple(joints))
+
+
+KINDS: dict[str, type[Reference]] = {cls.kind: cls for cls in (CoulombViscous, Sigmoid, HeldOutRms,
+                                                                 PeerParameters)}
 """A reference file's ``kind`` -> the class that reads it."""
 
 

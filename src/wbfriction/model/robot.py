@@ -222,6 +222,12 @@ class Robot:
         return np.zeros(self.n_act) if self.q_reference is None else self.angles(self.q_reference)
 
     @cached_property
+    def offset_vector(self) -> np.ndarray:
+        """The encoders' offsets (n_act,) in :attr:`actuated` order [rad]: the logged angle minus the model's
+        (:attr:`encoder_offset`, 0 where not given)."""
+        return np.array([self.encoder_offset.get(n, 0.0) for n in self.actuated])
+
+    @cached_property
     def angle_limits(self) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper joint position limits (n_act,) [rad]; +-inf for continuous joints."""
         lo, hi = np.full(self.n_act, -np.inf), np.full(self.n_act, np.inf)

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from wbfriction.datasets import reference, write_dataset
-from wbfriction.datasets.reference import HeldOutRms, Reference
+from wbfriction.datasets.reference import HeldOutRms, PeerParameters, Reference
 from wbfriction.exceptions import WbfrictionError
 from wbfriction.fit.params_file import read_params
 from wbfriction.fit.result import FitResult
@@ -159,9 +159,12 @@ def curve_scores(fit: FitResult, est: FrictionEstimate, k: int, ref: Reference) 
     return error, sigmas
 
 
-def score(name: str, outs: Outputs) -> tuple[JointScore, ...]:
-    """Every joint of the dataset ``name`` from the outputs of its route (module docstring)."""
+def score(name: str, outs: Outputs, config: Path | None = None) -> tuple[JointScore, ...]:
+    """Every joint of the dataset ``name`` from the outputs of its route (module docstring); ``config``: the
+    robot's TOML ``wbfriction dataset`` wrote (a peer whose parameters lie beside it is scored on its held-out
+    log)."""
     ref = reference(name)
+    peers = peer_scores(config) if isinstance(ref, PeerParameters) and config is not None else {}
     fits = read_params(outs.params)
     est = read_friction_file(outs.friction)
     prediction = held = None
@@ -183,6 +186,7 @@ def score(name: str, outs: Outputs) -> tuple[JointScore, ...]:
             moved = joint_speed(held.qd[held.valid[:, i], i]) >= MIN_SPEED
         if isinstance(ref, HeldOutRms):
             peer = ref.held_out(joint)
+        peer = peers.get(joint, peer)
         out.append(JointScore(joint, verdict.status, verdict.reason, fit.model, error, sigmas, held_out, peer, moved))
     return tuple(out)
 
@@ -225,7 +229,18 @@ def run_dataset(name: str, folder: str | Path, python: str = sys.executable,
         timed = run_route(commands, folder, python, echo=echo)
     except WbfrictionError as exc:
         return DatasetRun(name, (convert,), failed=str(exc))
-    return DatasetRun(name, (convert, *timed), score(name, outputs(commands, folder)))
+    return DatasetRun(name, (convert, *timed), score(name, outputs(commands, folder), written.config))
+
+
+def peer_scores(config: Path) -> dict[str, float]:
+    """The held-out torque RMS per joint [N·m] of the peer whose parameters lie beside the robot's TOML ``config``
+    (``peer.toml``, the held-out log ``held_out.parquet``; the one such dataset, the Aliengo's, reads its peer's
+    friction from its fetched file: :mod:`wbfriction.studies.pd_peer`)."""
+    from wbfriction.datasets.aliengo import aliengo_peer
+    from wbfriction.studies.pd_peer import peer_held_out
+
+    folder = config.parent
+    return peer_held_out(config, folder / "peer.toml", aliengo_peer(), folder / "held_out.parquet")
 
 
 @dataclass(frozen=True)

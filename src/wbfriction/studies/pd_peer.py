@@ -1,0 +1,51 @@
+"""A PD-driven robot's peer identification scored as wbfriction's is (issue 55): the held-out torque its parameters
+predict, through the same estimate and the same prediction.
+
+The real Aliengo's peer (iit-DLSLab, PACE-style: :class:`~wbfriction.datasets.aliengo.PeerActuator`) gives an
+armature, an encoder offset, a viscous and a static friction per joint and one delay. Its robot is the dataset's
+``aliengo.toml`` with the peer's tables (``peer.toml``, written by ``wbfriction dataset aliengo``); its friction
+``f(qd) = F_v qd + F_s sgn(qd)`` (Isaac Lab's joint friction: a static level, equal to the dynamic one in their
+assets, and a viscous coefficient; a simulator's Coulomb friction is a step). The held-out log is estimated with
+that robot as the route estimates it with the one identified (:func:`~wbfriction.friction.estimate.estimate_log`,
+default options), and the peer's friction predicts its torque (:func:`~wbfriction.fit.predict.predict_torques`):
+the RMS of measured less predicted, per joint, beside wbfriction's.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from wbfriction.datasets.aliengo import PeerActuator
+from wbfriction.fit.predict import predict_torques
+from wbfriction.friction.estimate import estimate_log
+from wbfriction.friction.families.coulomb_viscous import CoulombViscousParams
+from wbfriction.logs.source import read_log
+from wbfriction.model.loading import build_robot
+
+
+def peer_robot_config(robot_toml: Path, peer_toml: Path) -> dict:
+    """The robot's configuration with the peer's tables (``[armature]``, ``[encoder_offset]``, ``[pd]``) over it."""
+    config = tomllib.loads(robot_toml.read_text(encoding="utf-8"))
+    peer = tomllib.loads(peer_toml.read_text(encoding="utf-8"))
+    for table in ("armature", "encoder_offset"):
+        if table in peer:
+            config[table] = peer[table]
+    config["pd"] = {**config.get("pd", {}), **peer.get("pd", {})}
+    return config
+
+
+def peer_held_out(robot_toml: Path, peer_toml: Path, peer: PeerActuator, held_out: Path) -> dict[str, float]:
+    """Per joint, the RMS [N·m] of the held-out log's torque less what the peer's parameters predict (module
+    docstring).
+
+    Raises:
+        InputError: what reading the robot or the log raises.
+    """
+    config = peer_robot_config(robot_toml, peer_toml) | {"_dir": str(robot_toml.parent)}
+    robot = build_robot(robot_toml.parent / config["urdf"], config, str(peer_toml))
+    est = estimate_log(robot, read_log(held_out, robot))
+    friction = {j: CoulombViscousParams(F_v=peer.viscous_friction[j], F_c=peer.static_friction[j])
+                for j in est.joints}
+    prediction = predict_torques(est, friction)
+    return {j: float(prediction.rms[i]) for i, j in enumerate(prediction.joints)}
