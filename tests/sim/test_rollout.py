@@ -16,7 +16,7 @@ from wbfriction.fit.result import FitResult
 from wbfriction.model.loading import load_robot
 from wbfriction.sim.hung import simulate_hung
 from wbfriction.sim.pd_options import REAL_DRIVER, HungOptions
-from wbfriction.sim.pd_robot import build_pd_robot
+from wbfriction.sim.pd_robot import Commands, PdRun, build_pd_robot
 from wbfriction.sim.rollout import ActuatorParams, read_log_setpoints, rollout, rollout_table
 
 EXACT = 1e-10
@@ -128,3 +128,18 @@ def test_what_a_rollout_refuses(go2, mjr, logs):
         rollout(go2, sim.table, truth(sim), rows=(0, 10), horizon=0.0, mjr=mjr)
     with pytest.raises(InputError, match="knee"):
         rollout(go2, sim.table, truth(sim, friction={"knee": sim.friction["FL_hip_joint"]}), rows=(0, 10), mjr=mjr)
+
+
+def test_a_peers_torque_delay_holds_back_the_whole_law(go2, mjr):
+    """PACE's delay (a peer's model, ``torque_delay``): the torque applied at each physics step is the PD law of the
+    readings and set-points of 12 steps before (feedback delayed too), bit for bit; before that, the first step's."""
+    n, lag = 300, 12
+    q_des = np.tile(go2.reference_angles, (n, 1))
+    q_des[100:] += 0.1
+    run = PdRun(mjr, 1e-3, 1, go2.pd.with_delay(0.012), np.full(12, 0.015), np.zeros(12), {}, torque_delay=True)
+    tr = run.run(Commands(q_des, np.zeros_like(q_des), np.zeros_like(q_des)), 0, n, go2.reference_angles,
+                 np.zeros(12))
+    law = np.clip(go2.pd.kp * (q_des - tr.q_encoder) - go2.pd.kd * tr.qd_driver, -go2.pd.torque_limit,
+                  go2.pd.torque_limit)
+    assert np.array_equal(tr.tau[lag:], law[:-lag])
+    assert np.array_equal(tr.tau[:lag], np.repeat(law[:1], lag, axis=0))

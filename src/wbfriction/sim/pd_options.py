@@ -11,7 +11,7 @@ in its help without loading NumPy or MuJoCo).
   (``position_std = 0``).
 * the driver's velocity: its difference from the angles' central difference (two periods, 10 ms), away from the
   reversals (no sign change within 100 ms, ``|v| > 0.2`` rad/s), is white (lag-one autocorrelation -0.15 on the
-  hips) and grows with the speed alike on every joint: RMS 0.08 rad/s at 0.2-0.6 rad/s, 0.11-0.15 at 0.6-1,
+  hips) and grows with the speed alike on every joint: RMS 0.08 rad/s at 0.2-0.6 rad/s, 0.11-0.16 at 0.6-1,
   0.16-0.22 at 1-2, 0.27-0.46 above (every joint within 0.01 of the others in the slow band). The growth is the
   motion within the central difference's 10 ms (the real set-points are staircases whose steps kick the joints),
   not the driver's: its velocity's white noise is the slow band's, 0.08 rad/s on every joint.
@@ -47,8 +47,8 @@ class SetpointOptions:
             band; ``"chirps"``: a sine of each joint's band whose frequency sweeps linearly over :attr:`chirp`
             (each joint's sweep scaled by a random factor in [0.8, 1.2], so the joints move apart); ``"both"``:
             ramps over the first half, back at the posture at its end, then chirps.
-        amplitude: half the band each joint moves in, as a share of its range (of half its range on either side of
-            the posture), the band kept 5 % of the range off the limits.
+        amplitude: how far each joint moves either side of its posture, as a share of half its range (0.25: a
+            quarter of half the range each way), the band kept 5 % of the range off the limits.
         reversal: shortest and longest time between two reversals of a ramp [s].
         chirp: the chirps' first and last frequencies [Hz].
         velocity: command ``qd_des`` = the set-point's slope; False: zeros (as the real log and most users do).
@@ -68,11 +68,16 @@ class SetpointOptions:
     def __post_init__(self) -> None:
         check_choice("kind", self.kind, SETPOINT_KINDS)
         check_range("hold", self.hold, low=1)
-        check_range("amplitude", self.amplitude, low=0.0, high=0.5, strict=False)
+        check_range("amplitude", self.amplitude, low=0.0, high=1.0)
         if not 0 < self.reversal[0] <= self.reversal[1]:
             raise OptionError("--reversal", self.reversal, "two times 0 < shortest <= longest [s]")
         if not 0 < self.chirp[0] <= self.chirp[1]:
             raise OptionError("--chirp", self.chirp, "two frequencies 0 < first <= last [Hz]")
+
+
+NOISE_FLAGS = {"encoder_resolution": "--encoder-bits", "position_std": "--position-noise",
+               "velocity_std": "--velocity-noise"}
+"""The command line's option of each noise level (:class:`DriverNoise`)."""
 
 
 @dataclass(frozen=True)
@@ -97,18 +102,13 @@ class DriverNoise:
     def __post_init__(self) -> None:
         for name in ("encoder_resolution", "position_std", "velocity_std"):
             value = getattr(self, name)
+            if isinstance(value, Mapping):
+                object.__setattr__(self, name, value := dict(value))  # the metadata is JSON
             values = [] if value is None else list(value.values()) if isinstance(value, Mapping) else [value]
             for v in values:
                 if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0 \
                         or (name == "encoder_resolution" and v == 0):
-                    raise OptionError(f"--{name.replace('_', '-')}", value, "levels >= 0 (a resolution > 0)")
-
-    @property
-    def active(self) -> bool:
-        """Whether the noise changes anything."""
-        def some(x: PerJoint | None) -> bool:
-            return x is not None and (any(v > 0 for v in x.values()) if isinstance(x, Mapping) else x > 0)
-        return some(self.encoder_resolution) or some(self.position_std) or some(self.velocity_std)
+                    raise OptionError(NOISE_FLAGS[name], value, "levels >= 0 (a resolution > 0)")
 
 
 HIP_THIGH_RESOLUTION = 2.0 * math.pi / 2**19
@@ -166,6 +166,8 @@ class HungOptions:
             raise OptionError("--friction-timeconst", self.friction_timeconst, "a time constant > 0 [s]")
         for name in ("armature", "encoder_offset"):
             value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, value := dict(value))  # the metadata is JSON
             if value is not None and not all(isinstance(v, (int, float)) and math.isfinite(v)
                                              and (v >= 0 or name == "encoder_offset") for v in value.values()):
                 raise InputError(f"{name}: every value must be a finite number{' >= 0' * (name == 'armature')}, "

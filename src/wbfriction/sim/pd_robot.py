@@ -208,6 +208,9 @@ class PdRun:
         armature: per joint (n,) [kg·m^2]; offset: the encoders' offsets (n,) [rad].
         friction: the parameters per joint (joints not named: none).
         friction_mode: :data:`~wbfriction.sim.options.FRICTION_MODES`; friction_timeconst: for ``"mujoco"`` [s].
+        torque_delay: delay the PD's torque instead of the set-points (PACE's actuator, a peer's model: the law runs
+            on the set-points as commanded and its torque, feedback and set-point alike, is applied the driver's
+            delay later, rounded to whole physics steps; before the first, the first torque).
 
     Raises:
         InputError: friction for an unknown joint; Stribeck or offset parameters with MuJoCo's friction.
@@ -215,9 +218,10 @@ class PdRun:
 
     def __init__(self, mjr: PdMujocoRobot, period: float, substeps: int, driver: PdDriver, armature: np.ndarray,
                  offset: np.ndarray, friction: Mapping[str, ModelParams], friction_mode: FrictionMode = "model",
-                 friction_timeconst: float | None = None) -> None:
+                 friction_timeconst: float | None = None, torque_delay: bool = False) -> None:
         import mujoco
         self.mjr, self.driver, self.substeps = mjr, driver, substeps
+        self.torque_delay = int(round(driver.delay * substeps / period)) if torque_delay else None
         self.period, self.h = period, period / substeps
         self.offset = np.asarray(offset, dtype=float)
         self.model = copy.copy(mjr.model)
@@ -247,7 +251,7 @@ class PdRun:
         """
         import mujoco
         first, last = start * self.substeps, stop * self.substeps
-        delay_steps = self.driver.delay / self.h
+        delay_steps = self.driver.delay / self.h if self.torque_delay is None else 0.0
         setpoint = [step_setpoints(x, self.substeps, delay_steps, first, last)
                     for x in (commands.q_des, commands.qd_des, commands.tau_ff)]
         data = mujoco.MjData(self.model)
@@ -272,6 +276,8 @@ class _Loop:
         self.gains = (d.kp, d.kd)
         self.limit = d.torque_limit
         self.offset = run.offset
+        lag = run.torque_delay
+        self.delayed = None if lag is None else np.empty((lag + 1, len(self.limit)))  # the torques computed, a ring
 
     def period(self, k: int, out: PdTrajectory) -> None:
         """The ``substeps`` physics steps of sample ``k`` (the run's ``k``-th); the first one recorded in ``out``."""
@@ -291,6 +297,10 @@ class _Loop:
             v_drv = v if noise.velocity is None else v + noise.velocity[s]
             tau = np.clip(kp * (self.q_des[s] - q_enc) + kd * (self.qd_des[s] - v_drv) + self.tau_ff[s],
                           -self.limit, self.limit)
+            if self.delayed is not None:
+                ring = len(self.delayed)
+                self.delayed[s % ring] = tau
+                tau = self.delayed[(s - ring + 1) % ring if s >= ring - 1 else 0].copy()
             data.ctrl[:] = tau
             tau_f = np.zeros_like(v)
             if run.injected.joints and not run.native:
