@@ -21,7 +21,7 @@ from ruamel.yaml import YAML
 
 from helpers import run_cli
 from wbfriction.exceptions import InputError
-from wbfriction.export.drive import DEFAULT_PHYSICS_DT, delay_steps, history_samples
+from wbfriction.export.drive import DEFAULT_PHYSICS_DT, HOLD_EDGE, SMALLEST_TIMESTEP, delay_steps, history_samples
 from wbfriction.export.isaac import NO_FRICTION
 from wbfriction.fit.params_file import write_params
 from wbfriction.model import load_robot
@@ -181,9 +181,9 @@ def mjcf(robot, params, tmp_path):
 
 def test_mjcf_fields_are_the_robots_and_the_fits(robot, mjcf):
     """Read back from the file and from MuJoCo's compiled model: one position actuator per PD-driven joint, named
-    as it: gain kp, bias [-kp offset, -kp, -kd], force range the torque limit (none without), the delay exactly,
-    zero-order hold, a history long enough at the model's timestep; joints' armature, damping = F_v, frictionloss =
-    F_c of the ok fits only."""
+    as it: gain kp, bias [-kp offset, -kp, -kd], force range the torque limit (none without), the delay (less 1 ns,
+    the hold's edge), zero-order hold, a history long enough down to 0.5 ms; joints' armature, damping = F_v,
+    frictionloss = F_c of the ok fits only."""
     text, m, fits = mjcf
     pd = robot.pd
     root = ET.fromstring(text.encode())
@@ -206,8 +206,9 @@ def test_mjcf_fields_are_the_robots_and_the_fits(robot, mjcf):
             assert m.actuator_forcelimited[a] == 1
         else:
             assert m.actuator_forcelimited[a] == 0 and "forcerange" not in xml.attrib
-        assert m.actuator_delay[a] == float(xml.get("delay")) == DELAY
-        assert m.actuator_history[a, 0] == history_samples(DELAY, m.opt.timestep) >= math.ceil(DELAY / m.opt.timestep)
+        assert m.actuator_delay[a] == float(xml.get("delay")) == DELAY - HOLD_EDGE  # the hold's edge: 1 ns
+        samples = m.actuator_history[a, 0]
+        assert samples == history_samples(DELAY, m.opt.timestep) >= math.ceil(DELAY / SMALLEST_TIMESTEP)
         assert xml.get("interp", "zoh") == "zoh"
         armature = robot.model.armature[robot.model.idx_vs[robot.model.getJointId(j)]]
         assert m.dof_armature[dof] == armature
@@ -294,20 +295,23 @@ def test_mjcf_applies_the_drivers_law(robot, mjcf):
     assert clipped > 0
 
 
-def test_mjcf_delays_the_setpoints_as_the_driver(robot, mjcf):
-    """Stepped at its own timestep with set-points that change every step: the force at each step is the driver's
-    law with the set-point commanded DELAY before, held (zero-order): ceil(DELAY / timestep) steps back."""
+@pytest.mark.parametrize("timestep, lag", [(None, 7), (0.001, 13), (0.0005, 26), (0.0007, 19)])
+def test_mjcf_delays_the_setpoints_as_the_driver(robot, mjcf, timestep, lag):
+    """Stepped at its own timestep (0.002 s: 6.5 steps) or a smaller one, whole (13, 26 steps) or not, with
+    set-points that change every step: the force at each step is the driver's law with the set-point commanded
+    DELAY before, held (zero-order): ceil(DELAY / timestep) steps back, every step."""
     _, m, _ = mjcf
+    if timestep is not None:
+        m.opt.timestep = timestep
     acts = [m.actuator(j).id for j in robot.actuated]
     dofs = [m.joint(j).dofadr[0] for j in robot.actuated]
     qadr = [m.joint(j).qposadr[0] for j in robot.actuated]
-    lag = math.ceil(DELAY / m.opt.timestep)
-    assert lag == 7  # 6.5 steps of 0.002 s
+    assert lag == math.ceil(DELAY / m.opt.timestep - 1e-6)
     d = mujoco.MjData(m)
     rng = np.random.default_rng(7)
-    commanded = rng.uniform(-0.05, 0.05, (40, 7))
+    commanded = rng.uniform(-0.05, 0.05, (120, 7))
     init_history(m, d, np.zeros(m.nu))
-    for k in range(40):
+    for k in range(120):
         ctrl = np.zeros(m.nu)
         ctrl[acts] = commanded[k]
         d.ctrl[:] = ctrl
@@ -319,27 +323,43 @@ def test_mjcf_delays_the_setpoints_as_the_driver(robot, mjcf):
         np.testing.assert_allclose(d.actuator_force[acts], want, rtol=1e-12, atol=1e-9, err_msg=f"step {k}")
 
 
+def held_lags(delay: float, timestep: float, nsample: int, steps: int = 12) -> set[int]:
+    """How many steps back a one-joint MuJoCo position actuator with ``delay``, ``nsample`` and zero-order hold
+    reads its control, over ``steps`` steps once its history is full (each step's control its index)."""
+    spec = mujoco.MjSpec()
+    spec.option.timestep, spec.option.gravity = timestep, [0, 0, 0]
+    body = spec.worldbody.add_body()
+    body.add_joint(name="j")
+    body.add_geom(size=[0.1, 0, 0], mass=1e12, contype=0, conaffinity=0)
+    act = spec.add_actuator(target="j", trntype=mujoco.mjtTrn.mjTRN_JOINT)
+    act.set_to_position(kp=1.0, kv=0.0)
+    act.delay, act.nsample, act.interp = delay, nsample, 0
+    m = spec.compile()
+    d = mujoco.MjData(m)
+    lags = set()
+    for k in range(steps):
+        d.ctrl[0] = float(k)
+        mujoco.mj_step(m, d)
+        if k >= nsample + 1:
+            lags.add(round(k - d.actuator_force[0] - d.qpos[0]))
+    return lags
+
+
 def test_mujoco_reads_a_short_history_as_a_shorter_delay():
     """Why nsample covers the delay (history_samples): MuJoCo 4 reads a buffer shorter than the delay at its oldest
     sample, silently. One joint, 0.013 s at 0.005 s: 3 steps with 3 samples or more, 2 with 2."""
-    def lag(nsample: int) -> int:
-        spec = mujoco.MjSpec()
-        spec.option.timestep, spec.option.gravity = 0.005, [0, 0, 0]
-        body = spec.worldbody.add_body()
-        body.add_joint(name="j")
-        body.add_geom(size=[0.1, 0, 0], mass=1e9, contype=0, conaffinity=0)
-        act = spec.add_actuator(target="j", trntype=mujoco.mjtTrn.mjTRN_JOINT)
-        act.set_to_position(kp=1.0, kv=0.0)
-        act.delay, act.nsample, act.interp = 0.013, nsample, 0
-        m = spec.compile()
-        d = mujoco.MjData(m)
-        for k in range(12):
-            d.ctrl[0] = float(k)
-            mujoco.mj_step(m, d)
-        return round(11 - d.actuator_force[0])
+    assert history_samples(0.013, 0.005) == 27  # enough down to 0.5 ms
+    assert [held_lags(0.013, 0.005, n, 14) for n in (2, 3, 4, 8)] == [{2}, {3}, {3}, {3}]
 
-    assert history_samples(0.013, 0.005) == 4
-    assert [lag(n) for n in (2, 3, 4, 8)] == [2, 3, 3, 3]
+
+def test_mujoco_hold_edge():
+    """Why the delay is written 1 ns less (HOLD_EDGE): a delay of whole timesteps sits on the sample times, and
+    MuJoCo's zero-order hold reads one step early or late as the floating-point time rounds; 1 ns less reads the
+    driver's sample every step."""
+    assert held_lags(0.013, 0.001, 20, 3000) == {13, 14}
+    assert held_lags(0.013 - HOLD_EDGE, 0.001, 20, 3000) == {13}
+    assert held_lags(0.012 - HOLD_EDGE, 0.002, 20, 3000) == {6}
+    assert held_lags(0.013 - HOLD_EDGE, 0.002, 20, 3000) == {7}  # not whole: the hold as it was
 
 
 def test_robot_without_drivers_has_no_actuators(panda, params, tmp_path):

@@ -17,15 +17,16 @@ driver                  Isaac Lab ``DelayedPDActuatorCfg`` (3.0)    MuJoCo 4 act
 k_p [N·m/rad]           ``stiffness``                               ``gainprm[0] = kp``, ``biasprm[1] = -kp``
 k_d [N·m·s/rad]         ``damping``                                 ``biasprm[2] = -kd`` (``kv``)
 tau_max [N·m]           ``actuator_effort_limit``                   ``forcerange = [-tau_max, tau_max]``
-d [s]                   ``min_delay = max_delay`` [physics steps]   ``delay`` [s], ``interp`` zero-order hold
+d [s]                   ``min_delay = max_delay`` [physics steps]   ``delay = d - 1 ns``, ``interp`` zero-order hold
 offset [rad]            no field (a comment: how to apply it)       ``biasprm[0] = -kp * offset``
 qd_des, tau_ff          the action's velocity and effort targets    no input (a ``<motor>`` beside it)
 ======================  ==========================================  ==============================================
 
 Isaac Lab counts the delay in physics steps (``DelayBuffer``, pushed once per physics step, ``sim.dt``; the policy's
 decimation does not enter): :func:`delay_steps` rounds ``d / physics_dt`` to the nearest whole step (halves up) and
-says so when ``d`` is not a whole number of steps. MuJoCo 4 delays an actuator's control by ``delay`` seconds,
-exactly, from a history buffer of ``nsample`` samples (:func:`history_samples`).
+says so when ``d`` is not a whole number of steps. MuJoCo 4 delays an actuator's control by ``delay`` seconds
+(written :data:`HOLD_EDGE`, 1 ns, less: the hold's edge), from a history buffer of ``nsample`` samples
+(:func:`history_samples`: enough at the model's timestep and any down to :data:`SMALLEST_TIMESTEP`).
 
 Sources: Isaac Lab 3.0.0 ``isaaclab/actuators/actuator_base_cfg.py`` and ``actuator_pd_cfg.py`` (fields, units),
 ``actuator_pd.py`` (``DelayedPDActuator``: the position, velocity and effort targets delayed, the PD law on the
@@ -103,11 +104,24 @@ def delay_steps(delay: float, physics_dt: float = DEFAULT_PHYSICS_DT) -> DelaySt
     return DelaySteps(float(delay), float(physics_dt), exact, int(math.floor(exact + 0.5 + WHOLE_STEP)))
 
 
+HOLD_EDGE = 1e-9
+"""What a MuJoCo actuator's ``delay`` is written less than the drivers' [s]. MuJoCo 4's zero-order hold reads the
+sample at or before ``time - delay``; a delay that is a whole number of timesteps falls on the sample times, where
+the simulation's floating-point time makes it read one sample early or late from step to step (0.013 s at 1 ms:
+13 or 14 steps; checked in ``tests/export/test_pd_exports.py``). One nanosecond less reads the sample the driver
+applies, every step, for hours of simulated time (the time's rounding stays below 1e-11 s over a delay)."""
+
+SMALLEST_TIMESTEP = 0.0005
+"""The smallest MuJoCo timestep [s] an exported actuator's history holds its delay at (2 kHz; the project's hung
+simulator steps at 1 ms, MuJoCo's default is 2 ms): a user may lower the file's timestep down to it."""
+
+
 def history_samples(delay: float, timestep: float) -> int:
-    """The ``nsample`` of a MuJoCo actuator whose control is delayed by ``delay`` [s] at ``timestep`` [s]: the
-    samples the history buffer must hold, ``ceil(delay / timestep) + 1`` (one to spare). A shorter buffer makes
-    MuJoCo 4 read its oldest sample, silently: a shorter delay (checked in ``tests/export/test_pd_exports.py``)."""
-    return int(math.ceil(delay / timestep - WHOLE_STEP)) + 1
+    """The ``nsample`` of a MuJoCo actuator whose control is delayed by ``delay`` [s]: the samples its history
+    buffer must hold at the model's ``timestep`` [s] or any down to :data:`SMALLEST_TIMESTEP`,
+    ``ceil(delay / min(timestep, SMALLEST_TIMESTEP)) + 1`` (one to spare). A shorter buffer makes MuJoCo 4 read its
+    oldest sample, silently: a shorter delay (checked in ``tests/export/test_pd_exports.py``)."""
+    return int(math.ceil(delay / min(timestep, SMALLEST_TIMESTEP) - WHOLE_STEP)) + 1
 
 
 @dataclass(frozen=True)

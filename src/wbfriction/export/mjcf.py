@@ -65,8 +65,9 @@ it defaults to the URDF's): ``ctrl`` is the set-point
 joint's ``ref`` (which would move ``qpos``'s zero for everything that reads it: ranges, keyframes, Pinocchio's
 reading of the file). With the ``biasprm[0]`` term MuJoCo's writer spells the actuator ``<general ...
 biastype="affine">``, what ``<position kp kv>`` compiles to. The set-points' delay is MuJoCo 4's actuator
-``delay`` [s] with ``interp`` zero-order hold (the driver holds each set-point) and a history of ``nsample =
-ceil(delay / timestep) + 1`` samples at the model's ``timestep`` (:func:`~wbfriction.export.drive.history_samples`;
+``delay`` [s] (less 1 ns, :data:`~wbfriction.export.drive.HOLD_EDGE`: a delay of whole timesteps would sit on
+the hold's edge) with ``interp`` zero-order hold (the driver holds each set-point) and a history of ``nsample``
+samples, enough at the model's ``timestep`` and any down to 0.5 ms (:func:`~wbfriction.export.drive.history_samples`;
 a smaller timestep needs more: MuJoCo reads a too-short buffer's oldest sample, silently). The history starts at
 zero (``mj_resetData``): fill it with the first set-point (``mujoco.mj_initCtrlHistory``) before stepping. The
 driver's ``qd_des`` and ``tau_ff`` have no input in a position actuator (a ``<motor>`` beside it can carry
@@ -92,7 +93,7 @@ import pinocchio as pin
 from lxml import etree as ET
 
 from wbfriction.exceptions import ModelError
-from wbfriction.export.drive import DriveExport, drive_export, history_samples, offset_lines
+from wbfriction.export.drive import HOLD_EDGE, DriveExport, drive_export, history_samples, offset_lines
 from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.export.target import ExportReport, ExportTarget
 from wbfriction.export.urdf import identified_parameters
@@ -264,8 +265,8 @@ def _add_drives(spec: mujoco.MjSpec, drive: DriveExport) -> None:
         joint = spec.joint(name)  # the URDF's effort limit, as MuJoCo's import sets it: the driver's limit instead
         joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE
         joint.actfrcrange = [0.0, 0.0]
-        if drive.delay > 0:
-            act.delay = drive.delay
+        if drive.delay > HOLD_EDGE:
+            act.delay = drive.delay - HOLD_EDGE
             act.nsample = history_samples(drive.delay, timestep)
             act.interp = 0  # zero-order hold
 
@@ -278,11 +279,13 @@ def drive_note(drive: DriveExport, model: mujoco.MjModel) -> str:
              "clipped at forcerange (the driver's torque limit): ctrl is the set-point q_des as the robot commands",
              "it (encoder frame), qpos the model's angle (the encoder reads qpos + offset). qd_des and tau_ff have",
              "no input here (a <motor> beside it can carry kd qd_des + tau_ff)."]
-    if drive.delay > 0:
+    if drive.delay > HOLD_EDGE:
         samples = min((int(model.actuator_history[i, 0]) for i in range(model.nu)
                        if model.actuator(i).name in drive.joints), default=0)
-        lines += [f"delay {drive.delay!r} s, zero-order hold: nsample {samples} holds it at timesteps >= "
-                  f"{drive.delay / samples:.6g} s (this model's: {model.opt.timestep!r} s).",
+        step, least = model.opt.timestep, drive.delay / samples
+        lines += [f"delay {drive.delay!r} s, zero-order hold, written 1 ns less (a delay of whole timesteps would",
+                  "sit on the hold's edge, read one step early or late as the floating-point time rounds);",
+                  f"nsample {samples} holds it at timesteps >= {least:.6g} s (this model's: {step!r} s).",
                   "The history starts at zero: fill it with the first set-point (mujoco.mj_initCtrlHistory)."]
     if drive.encoder_offset:
         lines += ["encoder offsets [rad] (the logged angle minus the model's):",
