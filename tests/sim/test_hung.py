@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from tests.helpers import run_cli
+from tests.toys.toy_family import FixedSlopeParams
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.models import CoulombViscousParams, StribeckParams, target_from_dict
@@ -260,13 +261,16 @@ def test_the_metadata_names_the_truth(go2, mjr):
 
 
 def test_robots_it_does_not_simulate(go2):
-    """A floating base, a robot without [pd], a noise level naming no joint or group: one clear error each."""
+    """A floating base, a robot without [pd], a noise level naming no joint or group, friction of a family the
+    simulator does not apply: one clear error each."""
     with pytest.raises(InputError, match="floating base"):
         build_pd_robot(load_robot("talos"))
     with pytest.raises(InputError, match="not PD-driven"):
         build_pd_robot(load_robot("panda"))
     with pytest.raises(InputError, match="'knee' is neither"):
         simulate_hung(go2, HungOptions(duration=0.1, noise=DriverNoise(velocity_std={"knee": 0.1})))
+    with pytest.raises(InputError, match="built-in families"):  # not dropped in silence
+        simulate_hung(go2, HungOptions(duration=0.1), {"FL_hip_joint": FixedSlopeParams(F_c=0.3)})
 
 
 def test_the_command_line_simulates_a_hung_go2(capsys, tmp_path):

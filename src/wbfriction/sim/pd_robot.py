@@ -43,7 +43,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from wbfriction.exceptions import InputError, ModelError, SimulationError
-from wbfriction.friction.models import ModelParams
+from wbfriction.friction.models import MODEL_NAMES, ModelParams
 from wbfriction.model.mjspec import urdf_spec
 from wbfriction.model.pd import PdDriver
 from wbfriction.model.robot import Robot
@@ -213,7 +213,8 @@ class PdRun:
             delay later, rounded to whole physics steps; before the first, the first torque).
 
     Raises:
-        InputError: friction for an unknown joint; Stribeck or offset parameters with MuJoCo's friction.
+        InputError: friction for an unknown joint or of a family that is not built in; Stribeck or offset parameters
+            with MuJoCo's friction.
     """
 
     def __init__(self, mjr: PdMujocoRobot, period: float, substeps: int, driver: PdDriver, armature: np.ndarray,
@@ -227,6 +228,10 @@ class PdRun:
         self.model = copy.copy(mjr.model)
         self.model.opt.timestep = self.h
         self.model.dof_armature[mjr.dof_index] = armature
+        other = next((j for j, p in friction.items() if p.model not in MODEL_NAMES), None)
+        if other is not None:  # InjectedFriction applies the built-in families only
+            raise InputError(f"friction of '{other}': the simulator applies the built-in families "
+                             f"({', '.join(MODEL_NAMES)}), not '{friction[other].model}'")
         self.injected: InjectedFriction = injected_friction(mjr.robot, friction, joints=mjr.robot.actuated)
         self.native = friction_mode == "mujoco"
         dof_f = mjr.dof_index[self.injected.joints]
