@@ -83,6 +83,10 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
         console.print(f"differentiation: {escape(result.differentiation)}", highlight=False, soft_wrap=True)
     if result.route:
         console.print(f"route: {escape(result.route)}", highlight=False, soft_wrap=True)
+    torque = result.metadata.get("torque_source", {})
+    if torque.get("source") not in (None, "sensor"):
+        delay = f", the set-points {1e3 * torque['delay']:.3g} ms late ({torque['gains']})" if "delay" in torque else ""
+        console.print(escape(f"torque: {torque['what']}{delay}"), highlight=False, soft_wrap=True)
     if opts.velocity == "logged":
         velocity = result.metadata.get("velocity", {})  # measured on the first chunk
         console.print(f"velocity: {escape(velocity.get('reason', 'logged'))} (not compensated)", highlight=False)

@@ -39,6 +39,7 @@ from wbfriction.friction.measured import (
 from wbfriction.friction.momentum import momentum_estimate
 from wbfriction.friction.options import METHODS, EstimateOptions, Route
 from wbfriction.logs.log import Log
+from wbfriction.logs.torque import torque_record
 from wbfriction.model.dynamics import constrained_dynamics
 from wbfriction.model.robot import Robot
 from wbfriction.model.stance import stance_frame_pose, stance_model
@@ -348,6 +349,7 @@ def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress
     else:
         est = _acceleration_segment(robot, log, options, progress, companion, require_single_support, gaps)
     est.q, est.tau, est.temperature = log.q[:, robot.tc_index], log.tau, log.temperature  # the terms' signals
+    est.metadata["torque_source"] = torque_record(robot, log.torque_source, log.setpoints)  # every output says it
     if options.check_route:
         other: Route = "acceleration" if options.route == "momentum" else "momentum"
         est.route_check = _estimate_segment(robot, log, replace(options, route=other, check_route=False), None,

@@ -38,7 +38,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 import pyarrow as pa
@@ -59,10 +58,8 @@ from wbfriction.logs.pd import (
 )
 from wbfriction.logs.tables import numeric_column, numeric_columns, read_metadata, with_metadata, write_table
 from wbfriction.logs.temperature import screen_temperature
+from wbfriction.logs.torque import TorqueSource
 from wbfriction.model.robot import Robot
-
-TorqueSource = Literal["sensor", "driver", "current", "pd"]
-"""Where a log's torques come from (:attr:`Log.torque_source`; :mod:`wbfriction.logs.pd`)."""
 
 
 @dataclass

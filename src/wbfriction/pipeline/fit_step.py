@@ -64,7 +64,9 @@ def fit_file(friction: str | Path, output: str | Path, options: FitOptions = Fit
     fitted = fit_table(friction, options, threshold=threshold, tolerance=tolerance, workers=workers)
     log = fitted.est.metadata.get("provenance", {})
     header: dict[str, object] = {"provenance": {**file_provenance("friction", friction),
-                                                **{k: log[k] for k in ("robot", "urdf") if k in log}},
+                                                **{k: log[k] for k in ("robot", "urdf") if k in log},
+                                                **{k: fitted.est.metadata[k] for k in ("torque_source",)
+                                                   if k in fitted.est.metadata}},
                                  "sign_convention": SIGN_CONVENTION, "model": options.model}
     if options.model == AUTO:
         header["selection_tolerance"] = options.selection_tolerance
