@@ -102,7 +102,7 @@ class ActuatorIdentification:
         source: the log.
         options: the options used (``velocity`` the one kept).
         sigma: each joint's balance noise per window the sensors predict [N·m·s].
-        velocity_reason: which velocity the dynamics took, and why.
+        velocity_reason: which velocity the dynamics took and what the delay holds back, and why.
     """
 
     joints: tuple[JointActuator, ...]
@@ -124,6 +124,7 @@ class ActuatorIdentification:
         """The JSON document (``identify --actuator pd --json``)."""
         return {"kind": "pd actuators", "source": self.source, "period": self.period, "window": self.window,
                 "velocity": {"used": self.options.velocity, "why": self.velocity_reason},
+                "delayed": self.options.delayed,
                 "delay": self.delay.to_dict() | {"steps": self.delay.value / self.period},
                 "units": UNITS,
                 "joints": {j.joint: {k: v.to_dict() for k, v in j.parameters().items()}
@@ -156,19 +157,25 @@ def identify_actuators(robot: Robot, log: Log, options: ActuatorOptions = Actuat
             a log too short.
     """
     pd_joints(robot, log)
-    if options.velocity != "auto":
-        return _identify(robot, log, options, f"{options.velocity} (--velocity)")
-    if log.qd_logged is None:
-        return _identify(robot, log, replace(options, velocity="positions"), "positions: no qd.<joint> column")
-    both = [_identify(robot, log, replace(options, velocity=v), "") for v in ("positions", "logged")]
-    closes = [float(np.sum([(j.rms / max(s, 1e-300)) ** 2 for j, s in zip(r.joints, r.sigma)])) for r in both]
-    best, other = (0, 1) if closes[0] <= closes[1] else (1, 0)
-    why = (f"{both[best].options.velocity}: the balance closes better with it (weighted residual "
-           f"{closes[best] / closes[other]:.2f} of the {both[other].options.velocity} one's)")
-    return replace(both[best], velocity_reason=why)
+    assert robot.pd is not None
+    velocities = [options.velocity] if options.velocity != "auto" else (
+        ["positions", "logged"] if log.qd_logged is not None else ["positions"])
+    held = [options.delayed] if options.delayed != "auto" else ["setpoints", "torque"]
+    runs = [_identify(robot, log, replace(options, velocity=v, delayed=h)) for v in velocities for h in held]
+    closes = [float(np.sum([(j.rms / max(s, 1e-300)) ** 2 for j, s in zip(r.joints, r.sigma)])) for r in runs]
+    order = np.argsort(closes, kind="stable")
+    best = runs[int(order[0])]
+    why = f"{best.options.velocity} velocity, {best.options.delayed} delayed"
+    if len(runs) > 1:
+        second = runs[int(order[1])]
+        why += (f": the balance closes best so (weighted residual {closes[order[0]] / closes[order[1]]:.2f} of the "
+                f"next, {second.options.velocity} velocity, {second.options.delayed} delayed)")
+    elif log.qd_logged is None and options.velocity == "auto":
+        why += ": no qd.<joint> column"
+    return replace(best, velocity_reason=why)
 
 
-def _identify(robot: Robot, log: Log, options: ActuatorOptions, why: str) -> ActuatorIdentification:
+def _identify(robot: Robot, log: Log, options: ActuatorOptions) -> ActuatorIdentification:
     index = pd_joints(robot, log)
     offsets = options.offset_bound > 0
     offset = robot.offset_vector[index].copy()
@@ -185,7 +192,7 @@ def _identify(robot: Robot, log: Log, options: ActuatorOptions, why: str) -> Act
             offset = sol.x[3 * len(index):]
     assert weight is not None
     held = held_out_rms(rows, offsets, weight, options)
-    return replace(_result(rows, d, sol, search, held, log.source, options), velocity_reason=why)
+    return _result(rows, d, sol, search, held, log.source, options)
 
 
 def _delay(rows: BalanceRows, d: Design, weight: np.ndarray, options: ActuatorOptions) -> DelaySearch:

@@ -45,6 +45,9 @@ class ActuatorOptions:
         velocity: the velocity of the dynamics: ``positions`` (the encoders' positions' central difference),
             ``logged`` (the drivers' ``qd.<joint>``), or ``auto``: both identified, the one whose balance closes
             better kept (a driver's velocity may be filtered and lag; positions differentiated once are noisier).
+        delayed: what the drivers' delay holds back: ``setpoints`` (Isaac Lab's ``DelayedPDActuator``), ``torque``
+            (the whole law, PACE's actuator), or ``auto``: both identified, the one whose balance closes better
+            kept (:mod:`wbfriction.model.pd`).
 
     Raises:
         OptionError: a value out of its range, naming the option as the command line spells it.
@@ -58,6 +61,7 @@ class ActuatorOptions:
     passes: int = PASSES
     holdout: float = 0.2
     velocity: str = "auto"
+    delayed: str = "auto"
 
     def __post_init__(self) -> None:
         checks = (("--window", self.window, self.window > 0, "a window > 0 [s]"),
@@ -71,6 +75,8 @@ class ActuatorOptions:
         if self.delay is not None and not (isinstance(self.delay, numbers.Real) and math.isfinite(self.delay)
                                            and self.delay >= 0):
             raise OptionError("--delay", self.delay, "a delay >= 0 [s]")
+        if self.delayed not in ("auto", "setpoints", "torque"):
+            raise OptionError("--delayed", self.delayed, "one of auto, setpoints, torque")
         if self.velocity not in VELOCITIES:
             raise OptionError("--velocity", self.velocity, f"one of {', '.join(VELOCITIES)}")
         if not (isinstance(self.passes, int) and self.passes >= 1):

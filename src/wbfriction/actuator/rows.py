@@ -26,7 +26,8 @@ No acceleration anywhere: the velocity of the dynamics is the positions' central
 "positions"``: the encoder's readings, not filtered) or the driver's own (``"logged"``, ``qd.<joint>``, which a
 driver may filter: the real Aliengo's lags, :class:`~wbfriction.actuator.options.ActuatorOptions`); the PD law's
 damping term always takes the driver's. The
-set-points are held by the driver (zero-order hold) and applied ``d`` late, so a step's set-point impulse is the
+set-points are held by the driver (zero-order hold) and applied ``d`` late (or its whole law's torque, ``delayed =
+"torque"``: then the law's impulse takes the set-points' place and no feedback is left), so a step's impulse is the
 commanded value at ``t_i - d`` linearly interpolated, times the step (:func:`~wbfriction.model.pd.delayed`): between
 two whole periods ``kT <= d <= (k+1)T`` the impulse is linear in ``d``, and the whole problem is a linear least
 squares whose right-hand side moves along a segment: the delay's search is exact, interval by interval
@@ -199,15 +200,20 @@ def _segment_rows(robot: Robot, log: Log, index: np.ndarray, offset: np.ndarray,
         command = command + kd * sp.qd_des
     if sp.tau_ff is not None:
         command = command + sp.tau_ff
+    feedback = kp * q_enc + kd * sp.qd  # the driver's law runs on its own velocity
+    if options.delayed == "torque":  # the whole law held back: its clipped torque is what the delay shifts
+        command = np.clip(command - feedback, -driver.torque_limit, driver.torque_limit)
+        feedback = np.zeros_like(feedback)
     dt = np.diff(log.time)[:, None]
     trap = lambda x: 0.5 * (x[:-1] + x[1:]) * (dt if x.ndim == 2 else dt[:, :, None])  # noqa: E731
     steps = np.arange(n_steps)
     setpoint = np.stack([_window_sum(command[np.maximum(steps - k, 0)] * dt, m, windows) for k in range(K + 2)])
-    feedback = kp * q_enc + kd * sp.qd  # the driver's law runs on its own velocity
     p, b, dg, m_jj = _dynamics(robot, q_enc - offset, v, index)
     ends = np.arange(windows + 1) * m
     rest = -_window_sum(trap(feedback), m, windows) - (p[ends[1:]] - p[ends[:-1]]) + _window_sum(trap(b), m, windows)
     torque = np.stack([command[np.maximum(np.arange(len(log)) - k, 0)] - feedback for k in range(K + 2)])
+    # a law held back whole was clipped before its delay: the limit is reached, not passed
+
     clipped = np.any(np.abs(torque) >= driver.torque_limit, axis=0)  # (N, n)
     usable = ~_window_sum(np.maximum(clipped[:-1], clipped[1:]).astype(int), m, windows).astype(bool)
     sigma_q = _white_noise(q_enc, T)

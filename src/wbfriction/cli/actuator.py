@@ -49,7 +49,7 @@ def print_actuators(result: ActuatorIdentification, wide: bool = False) -> None:
     status = "" if d.status == "ok" else f" ({d.status}: {d.reason})"
     out.print(escape(f"delay {d.value * 1e3:.2f} ms ±{d.se * 1e3:.2f} (bound {d.crb * 1e3:.2f}), "
                      f"{d.value / result.period:.2f} periods of {result.period * 1e3:.3g} ms{status}"), highlight=False)
-    out.print(escape(f"velocity of the dynamics: {result.velocity_reason}"), highlight=False)
+    out.print(escape(f"model: {result.velocity_reason}"), highlight=False)
     table = Table("joint", "armature [g·m²]", "F_c [N·m]", "F_v [N·m·s/rad]", "offset [mrad]", "held-out / fitted")
     for j in result.joints:
         ratio = "–" if not j.held_out_rms == j.held_out_rms else f"{j.held_out_rms / j.rms:.2f}"

@@ -54,6 +54,8 @@ DelayOpt = typer.Option(None, help="--actuator pd: a known delay [s] instead.")
 WindowOpt = typer.Option(ACTUATOR.window, help="--actuator pd: window of the momentum balance [s].")
 OffsetBoundOpt = typer.Option(ACTUATOR.offset_bound, help="--actuator pd: largest encoder offset [rad]; 0: the "
                                                           "TOML's kept.")
+DelayedOpt = typer.Option(ACTUATOR.delayed, help="--actuator pd: what the drivers' delay holds back: auto, setpoints "
+                                                 "(Isaac Lab's DelayedPDActuator) or torque (PACE's actuator).")
 VelocityOpt = typer.Option(ACTUATOR.velocity, help="--actuator pd: the dynamics' velocity: auto, positions "
                                                    "(differentiated once) or logged (the drivers' qd).")
 
@@ -104,7 +106,7 @@ def identify(log: Path = LogArg,
              wide: bool = WideOpt,
              actuator: Actuator = ActuatorOpt, max_delay: float = MaxDelayOpt, delay: Optional[float] = DelayOpt,
              window: float = WindowOpt, offset_bound: float = OffsetBoundOpt, velocity: str = VelocityOpt,
-             ) -> None:
+             delayed: str = DelayedOpt) -> None:
     """Identify the inertia model and the friction together from the joint torques of single support (thesis
     2.4, ch. 8), write the corrected URDF: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'. With --actuator
     pd: a hung PD-driven robot's actuators (armature, friction, encoder offsets, delay) instead."""
@@ -112,7 +114,7 @@ def identify(log: Path = LogArg,
         from wbfriction.cli.actuator import identify_pd
 
         identify_pd(log, robot, urdf, config, mjcf, json_output, config_output, time_unit, wide, ActuatorOptions(
-            window, max_delay, delay, offset_bound, velocity=velocity, holdout=min(holdout, ACTUATOR.holdout)))
+            window, max_delay, delay, offset_bound, velocity=velocity, delayed=delayed, holdout=holdout))
         return
     if output is None:
         raise InputError("identify: -o/--output (the corrected URDF) is required")

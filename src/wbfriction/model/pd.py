@@ -12,7 +12,10 @@ Bjelonic et al. 2025):
                + \\tau_{ff}(t - d),\\; -\\tau_{max},\\; \\tau_{max}\\big)
 
 with ``q`` the encoder's reading (the logged angle), ``qd`` the driver's own velocity, and each set-point held
-from the instant it is commanded (zero-order hold) and applied ``d`` later (the bus and the driver's delay).
+from the instant it is commanded (zero-order hold) and applied ``d`` later (the bus and the driver's delay). A
+driver may instead hold back its whole torque, the feedback with the set-points (``delayed = "torque"``: PACE's
+actuator, ``tau(t) = clip(PD(t - d))``, the law on the state of ``t - d``); which one a robot's drivers do, the
+actuator identification decides from the data (:mod:`wbfriction.actuator`).
 
 **Per sample.** A log samples the torque at ``t_i``; the set-point the driver applied changes within a sample's
 period whenever ``d`` is not a whole number of periods. The value a sample stands for is the mean of the applied
@@ -28,8 +31,14 @@ model's angle ``q_logged - offset`` (``[encoder_offset]`` in the robot TOML).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal, get_args
 
 import numpy as np
+
+Delayed = Literal["setpoints", "torque"]
+"""What a driver's delay holds back: its set-points (Isaac Lab's ``DelayedPDActuator``) or its whole torque
+(PACE's actuator)."""
+DELAYED: tuple[Delayed, ...] = get_args(Delayed)
 
 
 @dataclass(frozen=True, eq=False)
@@ -43,6 +52,7 @@ class PdDriver:
         delay: the set-points' delay [s]: at ``t`` the driver applies the set-point commanded at ``t - delay``
             (zero-order hold); at least 0.
         torque_limit: the torque the driver clips at (n,) [N·m] (inf: none); default the URDF's effort limits.
+        delayed: what the delay holds back (:data:`Delayed`).
 
     Raises:
         ValueError: arrays of another length than :attr:`joints`, a negative or non-finite gain, a negative
@@ -54,6 +64,7 @@ class PdDriver:
     kd: np.ndarray
     delay: float = 0.0
     torque_limit: np.ndarray = field(default_factory=lambda: np.empty(0))
+    delayed: Delayed = "setpoints"
 
     def __post_init__(self) -> None:
         n = len(self.joints)
@@ -69,10 +80,13 @@ class PdDriver:
         object.__setattr__(self, "torque_limit", limit)
         if not (np.isfinite(self.delay) and self.delay >= 0):
             raise ValueError(f"PdDriver.delay must be a finite delay >= 0 [s], got {self.delay!r}")
+        if self.delayed not in DELAYED:
+            raise ValueError(f"PdDriver.delayed must be one of {', '.join(DELAYED)}, got {self.delayed!r}")
 
-    def with_delay(self, delay: float) -> PdDriver:
-        """The same drivers with the set-points' delay ``delay`` [s]."""
-        return PdDriver(self.joints, self.kp, self.kd, float(delay), self.torque_limit)
+    def with_delay(self, delay: float, delayed: Delayed | None = None) -> PdDriver:
+        """The same drivers with the delay ``delay`` [s] (holding back ``delayed``, default as now)."""
+        return PdDriver(self.joints, self.kp, self.kd, float(delay), self.torque_limit,
+                        self.delayed if delayed is None else delayed)
 
 
 def delayed(values: np.ndarray, time: np.ndarray, delay: float) -> np.ndarray:
@@ -121,6 +135,10 @@ def pd_torque(driver: PdDriver, time: np.ndarray, q: np.ndarray, qd: np.ndarray,
     d = driver.delay if delay is None else float(delay)
     kp_ = driver.kp if kp is None else kp
     kd_ = driver.kd if kd is None else kd
+    if driver.delayed == "torque":  # the law on the samples, clipped, then held back whole
+        law = kp_ * (q_des - q) - kd_ * qd
+        law = law + (0.0 if qd_des is None else kd_ * qd_des) + (0.0 if tau_ff is None else tau_ff)
+        return delayed(np.clip(law, -driver.torque_limit, driver.torque_limit), time, d)
     tau = kp_ * (delayed(q_des, time, d) - q) - kd_ * qd
     if qd_des is not None:
         tau = tau + kd_ * delayed(qd_des, time, d)
@@ -134,7 +152,8 @@ def parse_pd(table: object, actuated: list[str], groups: dict[str, tuple[str, ..
     """The robot TOML's ``[pd]`` table as drivers, or None without one.
 
     Keys: ``kp`` [N·m/rad] and ``kd`` [N·m·s/rad], each a number for every PD-driven joint or a table of joint or
-    group -> number (every PD-driven joint covered); ``delay`` [s] (default 0); ``joints`` (the PD-driven joints,
+    group -> number (every PD-driven joint covered); ``delay`` [s] (default 0); ``delayed`` (what the delay holds
+    back, :data:`Delayed`: ``setpoints`` by default, or ``torque``); ``joints`` (the PD-driven joints,
     default every actuated joint); ``torque_limit`` [N·m] (a number or a table as the gains; default the URDF's
     effort limits, none where the URDF gives 0).
 
@@ -155,9 +174,13 @@ def parse_pd(table: object, actuated: list[str], groups: dict[str, tuple[str, ..
         return None
     if not isinstance(table, dict):
         raise InputError(f"{source}: '[pd]' must be a table (kp, kd, delay, joints, torque_limit)")
-    unknown = set(table) - {"kp", "kd", "delay", "joints", "torque_limit"}
+    unknown = set(table) - {"kp", "kd", "delay", "joints", "torque_limit", "delayed"}
     if unknown:
-        raise InputError(f"{source}: [pd] has no key '{sorted(unknown)[0]}' (kp, kd, delay, joints, torque_limit)")
+        raise InputError(f"{source}: [pd] has no key '{sorted(unknown)[0]}' (kp, kd, delay, delayed, joints, "
+                         "torque_limit)")
+    held_back = table.get("delayed", "setpoints")
+    if held_back not in DELAYED:
+        raise InputError(f"{source}: [pd] delayed must be one of {', '.join(DELAYED)}, got {held_back!r}")
     joints = table.get("joints", actuated)
     if not isinstance(joints, list) or any(j not in actuated for j in joints) or not joints:
         bad = next((j for j in joints if j not in actuated), joints) if isinstance(joints, list) else joints
@@ -197,4 +220,4 @@ def parse_pd(table: object, actuated: list[str], groups: dict[str, tuple[str, ..
     if isinstance(delay, bool) or not isinstance(delay, (int, float)) or not (np.isfinite(delay) and delay >= 0):
         raise InputError(f"{source}: [pd] delay must be a number of seconds >= 0, got {delay!r}")
     return PdDriver(tuple(joints), per_joint("kp", None, False), per_joint("kd", None, False), float(delay),
-                    per_joint("torque_limit", limits, True))
+                    per_joint("torque_limit", limits, True), held_back)

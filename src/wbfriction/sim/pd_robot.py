@@ -210,7 +210,8 @@ class PdRun:
         friction_mode: :data:`~wbfriction.sim.options.FRICTION_MODES`; friction_timeconst: for ``"mujoco"`` [s].
         torque_delay: delay the PD's torque instead of the set-points (PACE's actuator, a peer's model: the law runs
             on the set-points as commanded and its torque, feedback and set-point alike, is applied the driver's
-            delay later, rounded to whole physics steps; before the first, the first torque).
+            delay later, rounded to whole physics steps; before the first, the first torque); None: as the drivers'
+            ``delayed`` says (:mod:`wbfriction.model.pd`).
 
     Raises:
         InputError: friction for an unknown joint or of a family that is not built in; Stribeck or offset parameters
@@ -219,9 +220,10 @@ class PdRun:
 
     def __init__(self, mjr: PdMujocoRobot, period: float, substeps: int, driver: PdDriver, armature: np.ndarray,
                  offset: np.ndarray, friction: Mapping[str, ModelParams], friction_mode: FrictionMode = "model",
-                 friction_timeconst: float | None = None, torque_delay: bool = False) -> None:
+                 friction_timeconst: float | None = None, torque_delay: bool | None = None) -> None:
         import mujoco
         self.mjr, self.driver, self.substeps = mjr, driver, substeps
+        torque_delay = driver.delayed == "torque" if torque_delay is None else torque_delay
         self.torque_delay = int(round(driver.delay * substeps / period)) if torque_delay else None
         self.period, self.h = period, period / substeps
         self.offset = np.asarray(offset, dtype=float)

@@ -59,7 +59,7 @@ class ActuatorParams:
         delay: the drivers' delay [s]; None: the robot's ``[pd]`` delay.
         torque_delay: the delay holds back the PD's torque (its feedback and set-point alike, in whole physics
             steps), as PACE's actuator does (a peer's model), instead of the set-points (wbfriction's driver,
-            :mod:`wbfriction.model.pd`).
+            :mod:`wbfriction.model.pd`); None: as the robot's ``[pd] delayed`` says.
         label: what the tables call the set (``"ours"``, ``"peer"``).
     """
 
@@ -67,7 +67,7 @@ class ActuatorParams:
     armature: Mapping[str, float] | None = None
     encoder_offset: Mapping[str, float] | None = None
     delay: float | None = None
-    torque_delay: bool = False
+    torque_delay: bool | None = None
     label: str = "model"
 
 
