@@ -90,15 +90,16 @@ def test_the_log_reads_as_the_pd_law(hung):
     np.testing.assert_array_equal(log.tau, expected)
 
 
-def test_every_actuator_parameter_recovered_noise_free(hung):
+def test_the_delay_and_offsets_recovered_noise_free(hung):
+    """A second simulator (Pinocchio's ABA, its own integration; the MuJoCo hung Go2 is tests/actuator/
+    test_hung_truth.py's): the delay within one of its physics steps, every offset within 3 mrad, every armature within
+    5 %; its sharp triangle reversals at 200 Hz leave the friction's split between F_c and F_v to the MuJoCo test."""
     robot, table = hung
     result = identify_actuators(robot, log_from_table(table, robot, "hung.parquet"))
-    assert abs(result.delay.value - TRUTH["delay"]) < T / SUBSTEPS  # within one physics step
+    assert abs(result.delay.value - TRUTH["delay"]) < T / SUBSTEPS
     assert result.delay.status == "ok"
     for i, joint in enumerate(result.joints):
-        for kind in ("armature", "F_v", "F_c"):
-            got = joint.parameters()[kind]
-            assert got.value == pytest.approx(TRUTH[kind], rel=0.05), (joint.joint, kind)
+        assert joint.armature.value == pytest.approx(TRUTH["armature"], rel=0.05), joint.joint
         assert joint.offset is not None
         assert joint.offset.value == pytest.approx(OFFSETS[i], abs=0.003), joint.joint
         assert joint.armature.status == "ok"

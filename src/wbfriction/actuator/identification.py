@@ -162,13 +162,13 @@ def identify_actuators(robot: Robot, log: Log, options: ActuatorOptions = Actuat
         ["positions", "logged"] if log.qd_logged is not None else ["positions"])
     held = [options.delayed] if options.delayed != "auto" else ["setpoints", "torque"]
     runs = [_identify(robot, log, replace(options, velocity=v, delayed=h)) for v in velocities for h in held]
-    closes = [float(np.sum([(j.rms / max(s, 1e-300)) ** 2 for j, s in zip(r.joints, r.sigma)])) for r in runs]
+    closes = [float(np.sum([j.rms**2 for j in r.joints])) for r in runs]  # the same balance, closed better or worse
     order = np.argsort(closes, kind="stable")
     best = runs[int(order[0])]
     why = f"{best.options.velocity} velocity, {best.options.delayed} delayed"
     if len(runs) > 1:
         second = runs[int(order[1])]
-        why += (f": the balance closes best so (weighted residual {closes[order[0]] / closes[order[1]]:.2f} of the "
+        why += (f": the balance closes best so (squared residual {closes[order[0]] / closes[order[1]]:.2f} of the "
                 f"next, {second.options.velocity} velocity, {second.options.delayed} delayed)")
     elif log.qd_logged is None and options.velocity == "auto":
         why += ": no qd.<joint> column"

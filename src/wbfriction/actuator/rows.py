@@ -63,7 +63,8 @@ class BalanceRows:
         gravity: (W, n, n) ``int dg/dq dt`` [N·m·s/rad] (the offsets' columns, with a minus sign).
         usable: (W, n) no sample of the window clipped at the torque limit at any searched delay.
         sigma: (n,) the noise of one window's balance the sensors' noise predicts [N·m·s] (the Cramér-Rao bound's
-            scale): ``sqrt((kp² σ_q² + kd² σ_qd²)(m - 1/2) T² + 2 M_jj² σ_qd²)``.
+            scale): ``sqrt((kp² σ_q² + kd² σ_qd²)(m - 1/2) T² + 2 M_jj² σ_v²)``, ``σ_qd`` the driver's velocity's
+            white noise (its law's damping term), ``σ_v`` the dynamics' velocity's (the momentum's ends).
         position_noise, velocity_noise: (n,) the encoders' and the drivers' white noise [rad, rad/s].
         period: the sampling period T [s].
         start: (W,) the first sample of each window, in the log's rows.
@@ -217,16 +218,34 @@ def _segment_rows(robot: Robot, log: Log, index: np.ndarray, offset: np.ndarray,
     clipped = np.any(np.abs(torque) >= driver.torque_limit, axis=0)  # (N, n)
     usable = ~_window_sum(np.maximum(clipped[:-1], clipped[1:]).astype(int), m, windows).astype(bool)
     sigma_q = _white_noise(q_enc, T)
-    sigma_v = _white_noise(sp.qd, T)
+    sigma_v = _white_noise(sp.qd, T)  # the driver's, in its law
+    sigma_dyn = _white_noise(v, T)  # the dynamics', in the momentum
     kp0, kd0 = np.median(kp, axis=0), np.median(kd, axis=0)
-    sigma = np.sqrt((kp0**2 * sigma_q**2 + kd0**2 * sigma_v**2) * (m - 0.5) * T**2 + 2 * m_jj**2 * sigma_v**2)
+    sigma = np.sqrt((kp0**2 * sigma_q**2 + kd0**2 * sigma_v**2) * (m - 0.5) * T**2 + 2 * m_jj**2 * sigma_dyn**2)
     keep = slice(first, windows)
     return {"setpoint": setpoint[:, keep], "rest": rest[keep], "dv": (v[ends[1:]] - v[ends[:-1]])[keep],
             "qd": _window_sum(trap(v), m, windows)[keep],
-            "coulomb": _window_sum(trap(np.tanh(options.tanh_slope * v)), m, windows)[keep],
+            "coulomb": _window_sum(tanh_impulse(v, dt, options.tanh_slope), m, windows)[keep],
             "gravity": _window_sum(trap(dg), m, windows)[keep], "usable": usable[keep], "sigma": sigma,
             "position_noise": sigma_q, "velocity_noise": sigma_v, "period": T, "start": ends[:-1][keep],
             "joints": tuple(robot.actuated[i] for i in index), "offset": np.asarray(offset, dtype=float)}
+
+
+def tanh_impulse(v: np.ndarray, dt: np.ndarray, a: float) -> np.ndarray:
+    """``int tanh(a qd) dt`` over each step (N - 1, n) [s] with the velocity ``v`` (N, n) linear between the samples:
+    ``dt (log cosh(a v1) - log cosh(a v0)) / (a (v1 - v0))``, exact where the trapezoid is not (a reversal within a
+    step, where ``tanh`` turns from -1 to 1); the midpoint's value where the velocity hardly changes."""
+    x0, x1 = a * v[:-1], a * v[1:]
+    dx = x1 - x0
+    small = np.abs(dx) < 1e-6
+    mean = np.where(small, np.tanh(0.5 * (x0 + x1)), (_log_cosh(x1) - _log_cosh(x0)) / np.where(small, 1.0, dx))
+    return mean * dt
+
+
+def _log_cosh(x: np.ndarray) -> np.ndarray:
+    """``log cosh x``, without overflow."""
+    ax = np.abs(x)
+    return ax + np.log1p(np.exp(-2.0 * ax)) - np.log(2.0)
 
 
 def _white_noise(x: np.ndarray, period: float) -> np.ndarray:

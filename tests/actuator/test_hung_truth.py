@@ -1,0 +1,60 @@
+"""Issue 55's ground truth: the hung, PD-driven Go2 in MuJoCo (:mod:`wbfriction.sim.hung`: ramps and chirps, 200 Hz,
+1 ms physics steps, Coulomb-viscous friction, armature, encoder offsets, a 12 ms delay) identified by
+``identify_actuators``, noise-free and with a real driver's noise (:data:`~wbfriction.sim.pd_options.REAL_DRIVER`).
+
+Measured at issue 55's close (25 s, seed 0; the note has the tables): noise-free, armature, F_v and F_c within 5.5 %
+(median 0.5 %; the one beyond 5 %: the rear right calf's F_v, whose F_c is 3.8 % low: the split of a large Coulomb
+friction that sticks at reversals, which the identification's ``tanh`` does not), the delay 0.44 ms short (a
+physics step is 1 ms), every hip and thigh offset within 6 mrad, the calves' (whose gravity torque hardly changes
+with their angle) within 21 mrad, beyond their standard errors of 2-4 mrad: an error of the model the statistics do
+not see. With a real driver's noise the same within 5 % (seeds 0 and 1): the error is the simulator's
+discretisation and the friction's step, not the noise, so it lies beyond two Cramér-Rao bounds, which the note says.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import wbfriction
+from wbfriction.actuator import identify_actuators
+from wbfriction.logs.log import log_from_table
+from wbfriction.sim.hung import simulate_hung
+from wbfriction.sim.pd_options import REAL_DRIVER, DriverNoise, HungOptions
+
+HIPS_AND_THIGHS = ("hip", "thigh")
+
+
+@pytest.fixture(scope="module")
+def go2():
+    return wbfriction.load_robot("go2")
+
+
+def identified(robot, noise: DriverNoise):
+    sim = simulate_hung(robot, HungOptions(duration=25.0, noise=noise))
+    return sim, identify_actuators(robot, log_from_table(sim.table, robot, "hung.parquet"))
+
+
+def errors(sim, result) -> dict[str, np.ndarray]:
+    """Relative errors of armature, F_v, F_c and the offsets' absolute ones [rad], per joint."""
+    out: dict[str, list[float]] = {"armature": [], "F_v": [], "F_c": [], "offset": []}
+    for i, joint in enumerate(result.joints):
+        friction = sim.friction[joint.joint]
+        for kind, truth in (("armature", sim.armature[i]), ("F_v", friction.F_v), ("F_c", friction.F_c)):
+            out[kind].append(joint.parameters()[kind].value / truth - 1.0)
+        out["offset"].append(joint.offset.value - sim.encoder_offset[i])
+    return {k: np.abs(v) for k, v in out.items()}
+
+
+@pytest.mark.parametrize("noise", [DriverNoise(), REAL_DRIVER], ids=["noise-free", "real driver"])
+def test_the_hung_go2s_actuators_recovered(go2, noise):
+    sim, result = identified(go2, noise)
+    err = errors(sim, result)
+    assert abs(result.delay.value - sim.driver.delay) < sim.physics_step  # within one physics step
+    for kind in ("armature", "F_v", "F_c"):
+        assert np.median(err[kind]) < 0.015, kind
+        assert np.max(err[kind]) < 0.056, (kind, result.joints[int(np.argmax(err[kind]))].joint)
+    upper = np.array([j.joint.split("_")[1] in HIPS_AND_THIGHS for j in result.joints])
+    assert np.max(err["offset"][upper]) < 0.006
+    assert np.max(err["offset"]) < 0.025  # the calves': known short of the truth (module docstring)
+    assert all(j.armature.status == "ok" for j in result.joints)
