@@ -9,10 +9,12 @@ checkout), the commands the dataset prints run as a user runs them (each its own
   Mamedov et al.'s Coulomb-viscous; Panda: Gaz et al.'s sigmoid), and ``sigmas``: that deviation in the fit's own
   standard errors (honest errors put it within 3);
 * ``held-out``: the torque RMS on the held-out log (KUKA: run 3; UR10e: the shoulder pan's sweep, the other joints
-  at rest there, marked ``still``), and ``peer``: FloBaRoID's method on run 3 (KUKA).
+  at rest there, marked ``still``; Aliengo: the last 40 %), and ``peer``: FloBaRoID's method on run 3 (KUKA), the
+  iit-DLSLab's PACE-style parameters through the same estimate (Aliengo); for a PD-driven robot, the held-out
+  set-points replayed in MuJoCo, the joints' tracking error with ours and with the peer's parameters.
 
 Then one line per dataset with the issue's targets: UR10e every joint within 5 %; Panda every ``ok`` joint within
-15 % and 3 standard errors; KUKA every joint better than the peer.
+15 % and 3 standard errors; KUKA and Aliengo every joint better than the peer.
 
     python benchmarks/bench_real.py [--datasets kuka-lwr4,ur10e,panda] [--keep DIR]
 """
@@ -52,6 +54,15 @@ def table(runs: list[DatasetRun]) -> str:
     return "\n".join(lines)
 
 
+def rollouts(runs: list[DatasetRun]) -> str:
+    """The PD-driven robots' held-out rollouts: each joint's tracking error, ours and the peer's [mrad]."""
+    lines = ["| dataset | joint | rollout, ours [mrad] | rollout, peer [mrad] |", "|---|---|---|---|"]
+    rows = [(run.name, j) for run in runs for j in run.joints if math.isfinite(j.rollout)]
+    lines += [f"| {name} | {j.joint} | {1e3 * j.rollout:.1f} | {cell(1e3 * j.peer_rollout, '.1f')} |"
+              for name, j in rows]
+    return "\n".join(lines) if rows else ""
+
+
 def summary(runs: list[DatasetRun]) -> str:
     lines = ["| dataset | ok | ok within target | ok within 3 SE | worst curve | better than peer | time [s] |",
              "|---|---|---|---|---|---|---|"]
@@ -85,6 +96,9 @@ def main() -> None:
     print(table(runs))
     print()
     print(summary(runs))
+    if rollouts(runs):
+        print()
+        print(rollouts(runs))
 
 
 if __name__ == "__main__":

@@ -8,13 +8,16 @@ armature, an encoder offset, a viscous and a static friction per joint and one d
 assets, and a viscous coefficient; a simulator's Coulomb friction is a step). The held-out log is estimated with
 that robot as the route estimates it with the one identified (:func:`~wbfriction.friction.estimate.estimate_log`,
 default options), and the peer's friction predicts its torque (:func:`~wbfriction.fit.predict.predict_torques`):
-the RMS of measured less predicted, per joint, beside wbfriction's.
+the RMS of measured less predicted, per joint, beside wbfriction's (:func:`peer_held_out`); and the same log's
+set-points replayed in MuJoCo with either's parameters, the joints' tracking error (:func:`peer_rollouts`).
 """
 
 from __future__ import annotations
 
 import tomllib
 from pathlib import Path
+
+import pyarrow as pa
 
 from wbfriction.datasets.aliengo import PeerActuator
 from wbfriction.fit.predict import predict_torques
@@ -49,3 +52,26 @@ def peer_held_out(robot_toml: Path, peer_toml: Path, peer: PeerActuator, held_ou
                 for j in est.joints}
     prediction = predict_torques(est, friction)
     return {j: float(prediction.rms[i]) for i, j in enumerate(prediction.joints)}
+
+
+def peer_rollouts(robot_toml: Path, peer_toml: Path, peer: PeerActuator, identified_toml: Path, params: Path,
+                  held_out: Path) -> pa.Table:
+    """The held-out log's set-points replayed in MuJoCo (:func:`~wbfriction.sim.rollout.rollout`) with wbfriction's
+    identification (the robot ``identified_toml``, the friction of ``params``) and with the peer's, as the peer's
+    simulator applies it (its delay truncated to whole 5 ms steps and applied to the whole torque, PACE's actuator):
+    a row per joint, ``rms.ours`` and ``rms.peer`` [rad], the tracking error of the logged angles.
+
+    Raises:
+        InputError: what reading the robots, the parameters or the log raises.
+    """
+    from wbfriction.model.loading import load_robot
+    from wbfriction.sim.rollout import ActuatorParams, rollout, rollout_table
+
+    ours = rollout(load_robot(None, config=identified_toml), held_out, ActuatorParams(friction=params, label="ours"))
+    config = peer_robot_config(robot_toml, peer_toml) | {"_dir": str(robot_toml.parent)}
+    robot = build_robot(robot_toml.parent / config["urdf"], config, str(peer_toml))
+    friction = {j: CoulombViscousParams(F_v=peer.viscous_friction[j], F_c=peer.static_friction[j])
+                for j in robot.actuated}
+    theirs = rollout(robot, held_out, ActuatorParams(friction=friction, delay=peer.applied_delay, torque_delay=True,
+                                                     label="peer"))
+    return rollout_table([ours, theirs])

@@ -66,6 +66,8 @@ class JointScore:
         peer: the peer's held-out torque RMS [N·m].
         held_out_moved: whether the joint moved in the held-out log (a joint at rest there predicts static
             friction, which no velocity model holds).
+        rollout, peer_rollout: a PD-driven robot's held-out set-points replayed in MuJoCo with the route's
+            identification and with the peer's: the tracking error's RMS [rad] (:mod:`wbfriction.studies.pd_peer`).
     """
 
     joint: str
@@ -77,6 +79,8 @@ class JointScore:
     held_out: float = float("nan")
     peer: float = float("nan")
     held_out_moved: bool = False
+    rollout: float = float("nan")
+    peer_rollout: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -105,22 +109,25 @@ class Outputs:
     params: Path
     friction: Path
     held_out: Path | None = None
+    identified: Path | None = None
 
 
 def outputs(commands: Sequence[str], folder: Path) -> Outputs:
     """The parameters JSON and friction table of the last ``fit`` of ``commands``, and the friction table of the
     last ``predict`` (None without one), as paths in ``folder`` (the commands' working folder)."""
-    fit = predict = None
+    fit = predict = identified = None
     for line in commands:
         words = shlex.split(line)
         if words[1:2] == ["fit"]:
             fit = words
         elif words[1:2] == ["predict"]:
             predict = words
+        elif words[1:2] == ["identify"] and "--config-output" in words:
+            identified = folder / words[words.index("--config-output") + 1]
     if fit is None:
         raise ValueError("the route has no fit")
     return Outputs(folder / fit[fit.index("-o") + 1], folder / fit[2],
-                   None if predict is None else folder / predict[2])
+                   None if predict is None else folder / predict[2], identified)
 
 
 SPEED_BIN = 0.05
@@ -164,7 +171,10 @@ def score(name: str, outs: Outputs, config: Path | None = None) -> tuple[JointSc
     robot's TOML ``wbfriction dataset`` wrote (a peer whose parameters lie beside it is scored on its held-out
     log)."""
     ref = reference(name)
-    peers = peer_scores(config) if isinstance(ref, PeerParameters) and config is not None else {}
+    peers: dict[str, float] = {}
+    rollouts: dict[str, tuple[float, float]] = {}
+    if isinstance(ref, PeerParameters) and config is not None:
+        peers, rollouts = peer_scores(config, outs)
     fits = read_params(outs.params)
     est = read_friction_file(outs.friction)
     prediction = held = None
@@ -187,7 +197,9 @@ def score(name: str, outs: Outputs, config: Path | None = None) -> tuple[JointSc
         if isinstance(ref, HeldOutRms):
             peer = ref.held_out(joint)
         peer = peers.get(joint, peer)
-        out.append(JointScore(joint, verdict.status, verdict.reason, fit.model, error, sigmas, held_out, peer, moved))
+        ours, theirs = rollouts.get(joint, (float("nan"), float("nan")))
+        out.append(JointScore(joint, verdict.status, verdict.reason, fit.model, error, sigmas, held_out, peer, moved,
+                              ours, theirs))
     return tuple(out)
 
 
@@ -232,15 +244,21 @@ def run_dataset(name: str, folder: str | Path, python: str = sys.executable,
     return DatasetRun(name, (convert, *timed), score(name, outputs(commands, folder), written.config))
 
 
-def peer_scores(config: Path) -> dict[str, float]:
+def peer_scores(config: Path, outs: Outputs) -> tuple[dict[str, float], dict[str, tuple[float, float]]]:
     """The held-out torque RMS per joint [N·m] of the peer whose parameters lie beside the robot's TOML ``config``
     (``peer.toml``, the held-out log ``held_out.parquet``; the one such dataset, the Aliengo's, reads its peer's
-    friction from its fetched file: :mod:`wbfriction.studies.pd_peer`)."""
+    friction from its fetched file), and per joint the held-out rollouts' tracking error [rad], the route's
+    identification's and the peer's (:mod:`wbfriction.studies.pd_peer`; none without the route's identified TOML)."""
     from wbfriction.datasets.aliengo import aliengo_peer
-    from wbfriction.studies.pd_peer import peer_held_out
+    from wbfriction.studies.pd_peer import peer_held_out, peer_rollouts
 
-    folder = config.parent
-    return peer_held_out(config, folder / "peer.toml", aliengo_peer(), folder / "held_out.parquet")
+    folder, peer = config.parent, aliengo_peer()
+    held = peer_held_out(config, folder / "peer.toml", peer, folder / "held_out.parquet")
+    if outs.identified is None:
+        return held, {}
+    table = peer_rollouts(config, folder / "peer.toml", peer, outs.identified, outs.params,
+                          folder / "held_out.parquet").to_pydict()
+    return held, {j: (o, p) for j, o, p in zip(table["joint"], table["rms.ours"], table["rms.peer"])}
 
 
 @dataclass(frozen=True)
