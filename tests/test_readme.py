@@ -117,6 +117,11 @@ EXPECTED = {
         r"^drift: arm-1 panda_joint4 \S+ \+\d+ % from 2026-01-1[0-4]$",  # worn from the 8th log, Jan 12
         r"1 of 14 tested robot joints drifted.*; wrote fleet/trends\.html$",  # that joint alone
     ],
+    # the real Aliengo's drivers: a delay near the peer's 2.64 steps of 5 ms (13.2 ms), whole steps apart from it
+    "wbfriction identify aliengo/train.parquet --config aliengo/aliengo.toml --actuator pd --config-output "
+    "aliengo_identified.toml --json aliengo_actuator.json": [r"^delay 1[0-3]\.\d\d ms ±0\.\d\d"],
+    # the hung Go2's 12 ms recovered within one 1 ms physics step
+    "wbfriction identify hung.parquet --robot go2 --actuator pd --json hung_actuator.json": [r"^delay 1[12]\.\d\d ms"],
 }
 """What a command must print (regular expressions, each found in its output, multi-line): the examples the
 pages run are checked here, once (``tests/test_examples.py`` runs the others)."""
@@ -128,6 +133,12 @@ PRINTS = {
                           r"^wrote panda_extended\.xml \(mjcf\)$",
                           r"^panda_joint1: quadratic: F_v ",  # a family fitted alone, then scored by --model auto
                           r"^panda_joint1: thesis: .*held-out RMS.*quadratic"],
+    "docs/how-to/pd-robots.md": [r"^FL_hip_joint: tracking error \d+\.\d mrad, the peer's",  # the rollout check
+                                 r"^ours tracks better on (1[0-2]) of 12 joints$",  # the peer's: worse on most
+                                 r"^delay 1[12]\.\d\d ms, truth 12 ms$",  # the hung Go2: within a physics step
+                                 # its armature and friction within 5 % with a real driver's noise
+                                 r"^armature within [0-4]\.\d %, F_v within [0-4]\.\d %, F_c within [0-4]\.\d % of "
+                                 r"the truth$"],
 }
 """What a page's ``python`` blocks must print, together (regular expressions)."""
 
