@@ -411,6 +411,9 @@ def _check_torque_columns(robot: Robot, seen: set[str], source: str) -> None:
     for n in robot.torque_controlled:
         if f"tau_est.{n}" in seen or (n in pd_joints and f"q_des.{n}" in seen):
             continue
+        if f"tau.{n}" not in seen and f"current.{n}" not in seen and f"q_des.{n}" in seen:
+            raise ColumnError(source, f"q_des.{n}", None, f"column 'q_des.{n}' is a PD set-point, but robot "
+                              f"'{robot.name}' has no [pd] gains for '{n}' in its TOML (kp, kd: wbfriction.model.pd)")
         if f"tau.{n}" not in seen and f"current.{n}" not in seen:
             raise ColumnError(source, f"tau.{n}", None, f"missing column 'tau.{n}' (or 'current.{n}' with a "
                               f"torque constant for '{n}' in the robot's [torque_constants], or 'q_des.{n}' "

@@ -63,10 +63,12 @@ class PdSetpoints:
                          kd=self.kd, delay=delay)
 
 
-def pd_columns_named(robot: Robot) -> dict[str, set[str]]:
-    """The joints each PD column prefix may name: the PD-driven joints (none without ``[pd]``)."""
-    joints = set(robot.pd.joints) if robot.pd is not None else set()
-    return dict.fromkeys(PD_PREFIXES, joints)
+def pd_columns_named(robot: Robot) -> dict[str, set[str] | None]:
+    """The joints each PD column prefix may name: the PD-driven joints for the set-points and gains (None without
+    ``[pd]``: :func:`read_setpoints` then refuses them with the reason), the torque-controlled joints for the
+    drivers' estimates."""
+    joints = set(robot.pd.joints) if robot.pd is not None else None
+    return dict.fromkeys(PD_PREFIXES, joints) | {"tau_est": set(robot.torque_controlled)}
 
 
 def read_setpoints(table: pa.Table, robot: Robot, time: np.ndarray, q_logged: np.ndarray, qd_logged: np.ndarray | None,

@@ -77,7 +77,8 @@ def actuator_config(text: str, source_dir: Path, urdf: Path, output: Path, resul
             lines.pop()
         if header and in_pd and delay is not None:
             lines.append(f"delay = {delay!r}   # identified by wbfriction identify --actuator pd [s]")
-            lines.append(f'delayed = "{result.options.delayed}"   # what the delay holds back (identified)')
+            if result.options.delayed != "auto":
+                lines.append(f'delayed = "{result.options.delayed}"   # what the delay holds back (identified)')
     offsets = {**given.get("encoder_offset", {}), **offsets}
     if offsets:
         lines += ["", "[encoder_offset]   # identified by wbfriction identify --actuator pd [rad]"]
@@ -87,7 +88,9 @@ def actuator_config(text: str, source_dir: Path, urdf: Path, output: Path, resul
     if offsets:
         expected["encoder_offset"] = offsets
     if delay is not None:
-        expected.setdefault("pd", {}).update(delay=delay, delayed=result.options.delayed)
+        expected.setdefault("pd", {})["delay"] = delay
+        if result.options.delayed != "auto":
+            expected["pd"]["delayed"] = result.options.delayed
     if tomllib.loads(written) != expected:
         raise InputError(f"{output}: the robot's configuration could not be rewritten line by line (its [pd] or "
                          "[encoder_offset] is not a plain table): copy the values printed into it instead")

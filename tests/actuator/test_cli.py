@@ -1,0 +1,39 @@
+"""``wbfriction identify --actuator pd`` as a user runs it: a hung Go2 simulated (the built-in ``go2``), its actuators
+identified, the TOML written, the friction estimated with it; bad input refused in one line before any work."""
+
+from __future__ import annotations
+
+import json
+import tomllib
+
+from helpers import assert_one_line_error, run
+
+
+def test_simulate_identify_estimate(tmp_path):
+    assert run("simulate", "--robot", "go2", "-o", "hung.parquet", "--duration", "6", cwd=tmp_path).returncode == 0
+    done = run("identify", "hung.parquet", "--robot", "go2", "--actuator", "pd", "--json", "actuator.json",
+               "--config-output", "identified.toml", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "delay" in done.stdout and "armature" in done.stdout
+    doc = json.loads((tmp_path / "actuator.json").read_text())
+    truth = 0.012  # the built-in go2's [pd] delay, which the simulator injects
+    assert abs(doc["delay"]["value"] - truth) < 0.001 and doc["delay"]["status"] == "ok"
+    written = tomllib.loads((tmp_path / "identified.toml").read_text())
+    assert abs(written["pd"]["delay"] - doc["delay"]["value"]) < 1e-12
+    determined = {j for j, v in doc["joints"].items() if v["armature"]["status"] in ("ok", "weak")}
+    assert set(written["armature"]) == determined
+    estimated = run("estimate", "hung.parquet", "--config", "identified.toml", "-o", "friction.parquet", cwd=tmp_path)
+    assert estimated.returncode == 0, estimated.stderr
+    assert "torque: the drivers' PD law" in estimated.stderr
+
+
+def test_a_robot_without_pd_gains_is_refused_in_one_line(tmp_path):
+    assert run("simulate", "--robot", "panda", "-o", "arm.parquet", "--duration", "1", cwd=tmp_path).returncode == 0
+    res = run("identify", "arm.parquet", "--robot", "panda", "--actuator", "pd", cwd=tmp_path)
+    assert_one_line_error(res, "no [pd] gains")
+
+
+def test_a_bad_option_is_refused_before_any_work(tmp_path):
+    (tmp_path / "log.parquet").write_bytes(b"")
+    res = run("identify", "log.parquet", "--robot", "go2", "--actuator", "pd", "--velocity", "fast", cwd=tmp_path)
+    assert_one_line_error(res, "--velocity")

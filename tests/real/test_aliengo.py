@@ -1,0 +1,77 @@
+"""A real PD-driven robot (issue 55): the iit-DLSLab's Unitree Aliengo, hung, every joint tracking ramps under its
+drivers' PD law at 200 Hz, no torque sensor (../shared/real-data/unitree_aliengo).
+
+No ground truth: what must hold is what a model of a real robot must do, predict data it was not fitted on. The
+route a user takes (``wbfriction dataset aliengo``; ``identify --actuator pd`` on the first 60 %, its TOML; the
+friction estimated and fitted on the same 60 %) predicts the last 40 %'s torque better than the same lab's
+identification (PACE-style, CMA-ES over Isaac Lab rollouts) on every joint, both through the same estimate and
+prediction (:mod:`wbfriction.studies.pd_peer`), and finds the drivers' delay near theirs.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from helpers import REAL_DATA, needs_data
+from wbfriction import datasets
+from wbfriction.actuator import ActuatorOptions
+from wbfriction.datasets.aliengo import aliengo_peer
+from wbfriction.model import load_robot
+from wbfriction.model.loading import RobotSpec
+from wbfriction.pipeline.actuator_step import identify_actuator_file, write_actuator_config
+from wbfriction.pipeline.estimate_step import estimate_file
+from wbfriction.pipeline.fit_step import fit_file
+from wbfriction.pipeline.predict_step import predict_file
+from wbfriction.studies.pd_peer import peer_held_out
+
+pytestmark = [needs_data("unitree_aliengo"), pytest.mark.slow]
+
+
+@pytest.fixture(scope="module")
+def route(tmp_path_factory):
+    """The dataset written, its actuators identified on the first 60 %, the friction fitted there."""
+    folder = tmp_path_factory.mktemp("aliengo")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv(datasets.DATA_ENV, str(REAL_DATA))
+        written = datasets.write_dataset("aliengo", folder / "data")
+        peer = aliengo_peer()
+    config = written.config
+    robot = load_robot(None, config=config)
+    identified = identify_actuator_file(robot, written.logs["train"], folder / "actuator.json", ActuatorOptions())
+    toml = folder / "identified.toml"
+    write_actuator_config(config.read_text(), config.parent, robot.urdf, toml, identified)
+    ours = load_robot(None, config=toml)
+    spec = RobotSpec.given("", config=toml)
+    for role in ("train", "held_out"):
+        estimate_file(spec, written.logs[role], folder / f"{role}_friction.parquet", robot=ours)
+    fit_file(folder / "train_friction.parquet", folder / "params.json")
+    return written, peer, identified, ours, folder
+
+
+def test_the_held_out_torque_predicted_better_than_the_peers_on_every_joint(route):
+    written, peer, _, _, folder = route
+    mine = predict_file(folder / "held_out_friction.parquet", folder / "params.json")
+    theirs = peer_held_out(written.config, written.config.parent / "peer.toml", peer, Path(written.logs["held_out"]))
+    for i, joint in enumerate(mine.joints):
+        assert mine.rms[i] < theirs[joint], joint
+    # measured at issue 55's close: ours 0.08-0.18 N·m, the peer's 0.36-0.64
+    assert max(mine.rms) < 0.25
+
+
+def test_the_delay_near_the_peers(route):
+    _, peer, identified, _, _ = route
+    assert identified.delay.status == "ok"
+    # the peer: 2.64 steps of 5 ms (13.2 ms; its simulator truncates it to 10 ms); ours 11.3 ms ± 0.2
+    assert peer.applied_delay - 0.001 <= identified.delay.value <= peer.delay + 0.001
+
+
+def test_the_identified_toml_holds_only_what_the_data_determine(route):
+    _, _, identified, ours, _ = route
+    for joint in identified.joints:
+        written = ours.model.armature[ours.act_v_index[ours.actuated.index(joint.joint)]]
+        if joint.armature.status in ("ok", "weak"):
+            assert written == pytest.approx(joint.armature.value)
+        else:
+            assert written == 0.0  # aliengo.toml has none: a value at a bound is not written
