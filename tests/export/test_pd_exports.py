@@ -409,3 +409,19 @@ def test_cli_physics_dt(params, tmp_path, capsys):
     other = tmp_path / "b.yaml"
     code, err = run_cli(capsys, "export", params[0], "--config", config, "-o", other, "--physics-dt", "0")
     assert code == 2 and "--physics-dt must be a physics step > 0" in err and not other.exists()
+
+
+def test_a_torque_held_back_whole_is_said_by_both_targets(tmp_path):
+    """``[pd] delayed = "torque"`` (PACE's actuator): neither Isaac Lab's DelayedPDActuator nor MuJoCo's actuator
+    delay holds it; the export says so in one line and writes the delay as a set-point delay."""
+    import wbfriction
+    from wbfriction.export.registry import target_for
+    from wbfriction.model.loading import example_robot_data_dir
+
+    config = tmp_path / "hung.toml"
+    config.write_text(f'name = "hung"\nurdf = "{example_robot_data_dir() / "go2_description/urdf/go2.urdf"}"\n'
+                      'floating_base = false\n[pd]\nkp = 25.0\nkd = 0.5\ndelay = 0.01\ndelayed = "torque"\n')
+    robot = wbfriction.load_robot(None, config=config)
+    for name in ("robot.yaml", "robot.xml"):
+        report = target_for(tmp_path / name).write(tmp_path / name, robot, {})
+        assert any("hold back their whole torque" in w for w in report.warnings), name

@@ -58,6 +58,17 @@ WHOLE_STEP = 1e-6
 ``0.015 / 0.005 = 2.9999999999999996``)."""
 
 
+def held_back_warning(robot: Robot) -> str | None:
+    """One line when the robot's drivers hold back their whole torque (``[pd] delayed = "torque"``,
+    :mod:`wbfriction.model.pd`), which neither target holds: Isaac Lab's ``DelayedPDActuator`` and MuJoCo's actuator
+    delay hold back the set-points (PACE's ``PaceDCMotorCfg`` holds the torque); else None."""
+    if robot.pd is None or robot.pd.delayed != "torque":
+        return None
+    return (f"{robot.name}: its drivers hold back their whole torque ([pd] delayed = \"torque\"); this target "
+            "delays the set-points only: the delay is written as a set-point delay (PACE's PaceDCMotorCfg "
+            "delays the torque)")
+
+
 @dataclass(frozen=True)
 class DelaySteps:
     """A delay counted in physics steps, as Isaac Lab's ``min_delay``/``max_delay`` hold it.

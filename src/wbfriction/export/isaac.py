@@ -56,7 +56,15 @@ from typing import Any
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.export.drive import DEFAULT_PHYSICS_DT, DelaySteps, DriveExport, delay_steps, drive_export, offset_lines
+from wbfriction.export.drive import (
+    DEFAULT_PHYSICS_DT,
+    DelaySteps,
+    DriveExport,
+    delay_steps,
+    drive_export,
+    held_back_warning,
+    offset_lines,
+)
 from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.export.target import ExportOptions, ExportReport, ExportTarget
 from wbfriction.logs.tables import write_atomic
@@ -233,7 +241,7 @@ def write_actuators(path: str | Path, joints: Mapping[str, JointExport], robot: 
         notes |= {re.escape(n): NO_FRICTION for n in drive.joints
                   if not (n in joints and joints[n].has_friction)}
         text = isaac_yaml(pd_actuator_dict(joints, drive, delay), pd_header(drive, delay), notes)
-        warnings = () if delay.warning is None else (delay.warning,)
+        warnings = tuple(w for w in (delay.warning, held_back_warning(robot)) if w is not None)
     write_atomic(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     return warnings
 

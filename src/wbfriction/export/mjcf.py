@@ -93,7 +93,14 @@ import pinocchio as pin
 from lxml import etree as ET
 
 from wbfriction.exceptions import ModelError
-from wbfriction.export.drive import HOLD_EDGE, DriveExport, drive_export, history_samples, offset_lines
+from wbfriction.export.drive import (
+    HOLD_EDGE,
+    DriveExport,
+    drive_export,
+    held_back_warning,
+    history_samples,
+    offset_lines,
+)
 from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.export.target import ExportReport, ExportTarget
 from wbfriction.export.urdf import identified_parameters
@@ -490,4 +497,5 @@ class MjcfTarget(ExportTarget):
     def write(self, path: Path, robot: Robot, joints: Mapping[str, JointExport]) -> ExportReport:
         """:func:`write_model` (the URDF's inertias)."""
         write_model(path, robot, joints)
-        return self.report(path, joints)
+        held_back = held_back_warning(robot)
+        return self.report(path, joints, () if held_back is None else (held_back,))
