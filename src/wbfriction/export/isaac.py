@@ -234,7 +234,7 @@ def write_actuators(path: str | Path, joints: Mapping[str, JointExport], robot: 
     notes = {re.escape(name): note for name, exp in joints.items() if (note := status_note(exp)) is not None}
     drive = None if robot is None else drive_export(robot, joints)
     warnings: tuple[str, ...] = ()
-    if drive is None:
+    if drive is None or robot is None:
         text = isaac_yaml(_actuator_dict(joints), HEADER, notes)
     else:
         delay = delay_steps(drive.delay, physics_dt)

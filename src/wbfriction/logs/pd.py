@@ -68,7 +68,9 @@ def pd_columns_named(robot: Robot) -> dict[str, set[str] | None]:
     ``[pd]``: :func:`read_setpoints` then refuses them with the reason), the torque-controlled joints for the
     drivers' estimates."""
     joints = set(robot.pd.joints) if robot.pd is not None else None
-    return dict.fromkeys(PD_PREFIXES, joints) | {"tau_est": set(robot.torque_controlled)}
+    named: dict[str, set[str] | None] = dict.fromkeys(PD_PREFIXES, joints)
+    named["tau_est"] = set(robot.torque_controlled)
+    return named
 
 
 def read_setpoints(table: pa.Table, robot: Robot, time: np.ndarray, q_logged: np.ndarray, qd_logged: np.ndarray | None,
