@@ -161,7 +161,10 @@ def identify_actuators(robot: Robot, log: Log, options: ActuatorOptions = Actuat
     velocities = [options.velocity] if options.velocity != "auto" else (
         ["positions", "logged"] if log.qd_logged is not None else ["positions"])
     held = [options.delayed] if options.delayed != "auto" else ["setpoints", "torque"]
-    runs = [_identify(robot, log, replace(options, velocity=v, delayed=h)) for v in velocities for h in held]
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(1, user_api="blas"):  # small dense problems: threads cost more than they give
+        runs = [_identify(robot, log, replace(options, velocity=v, delayed=h)) for v in velocities for h in held]
     closes = [float(np.sum([j.rms**2 for j in r.joints])) for r in runs]  # the same balance, closed better or worse
     order = np.argsort(closes, kind="stable")
     best = runs[int(order[0])]

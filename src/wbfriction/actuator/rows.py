@@ -31,7 +31,7 @@ set-points are held by the driver (zero-order hold) and applied ``d`` late (or i
 commanded value at ``t_i - d`` linearly interpolated, times the step (:func:`~wbfriction.model.pd.delayed`): between
 two whole periods ``kT <= d <= (k+1)T`` the impulse is linear in ``d``, and the whole problem is a linear least
 squares whose right-hand side moves along a segment: the delay's search is exact, interval by interval
-(:mod:`wbfriction.actuator.delay`).
+(:mod:`wbfriction.actuator.solve`).
 """
 
 from __future__ import annotations

@@ -50,7 +50,8 @@ def print_actuators(result: ActuatorIdentification, wide: bool = False) -> None:
     out.print(escape(f"delay {d.value * 1e3:.2f} ms ±{d.se * 1e3:.2f} (bound {d.crb * 1e3:.2f}), "
                      f"{d.value / result.period:.2f} periods of {result.period * 1e3:.3g} ms{status}"), highlight=False)
     out.print(escape(f"model: {result.velocity_reason}"), highlight=False)
-    table = Table("joint", "armature [g·m²]", "F_c [N·m]", "F_v [N·m·s/rad]", "offset [mrad]", "held-out / fitted")
+    table = Table(*map(escape, ("joint", "armature [g·m²]", "F_c [N·m]", "F_v [N·m·s/rad]", "offset [mrad]",
+                                "held-out / fitted")))
     for j in result.joints:
         ratio = "–" if not j.held_out_rms == j.held_out_rms else f"{j.held_out_rms / j.rms:.2f}"
         table.add_row(j.joint, _cell(j.armature, 1e3, 2), _cell(j.F_c), _cell(j.F_v), _cell(j.offset, 1e3, 1), ratio)
@@ -58,3 +59,8 @@ def print_actuators(result: ActuatorIdentification, wide: bool = False) -> None:
     reasons = [f"{j.joint}: {p.reason}" for j in result.joints for p in j.parameters().values() if p.reason]
     for line in reasons:
         out.print(escape(line), highlight=False)
+    from wbfriction.pipeline.actuator_step import WRITTEN
+    kept = [f"{j.joint} {kind}" for j in result.joints for kind, p in j.parameters().items()
+            if kind in ("armature", "offset") and p.status not in WRITTEN]
+    if kept:
+        out.print(escape(f"not written to --config-output (the TOML's own kept): {', '.join(kept)}"), highlight=False)

@@ -85,7 +85,8 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
         console.print(f"route: {escape(result.route)}", highlight=False, soft_wrap=True)
     torque = result.metadata.get("torque_source", {})
     if torque.get("source") not in (None, "sensor"):
-        delay = f", the set-points {1e3 * torque['delay']:.3g} ms late ({torque['gains']})" if "delay" in torque else ""
+        held = "the whole torque" if torque.get("delayed") == "torque" else "the set-points"
+        delay = f", {held} {1e3 * torque['delay']:.3g} ms late ({torque['gains']})" if "delay" in torque else ""
         console.print(escape(f"torque: {torque['what']}{delay}"), highlight=False, soft_wrap=True)
     if opts.velocity == "logged":
         velocity = result.metadata.get("velocity", {})  # measured on the first chunk

@@ -46,6 +46,8 @@ from wbfriction.cli.common import (
 
 Actuator = Literal["none", "pd"]
 ACTUATOR = ActuatorOptions()
+HoldoutOpt = typer.Option(INERTIAL.holdout, help="Share of the log, at its end, kept out to compare torque predictions "
+                                                 "(between 0 and 1; below 0.5 with --actuator pd).")
 ActuatorOpt = typer.Option("none", help="pd: a hung PD-driven robot's actuators instead (armature, friction, encoder "
                                         "offsets, the drivers' delay), from its set-points q_des.<joint>; the URDF "
                                         "is kept.")
@@ -73,8 +75,7 @@ def identify(log: Path = LogArg,
                                                                 "acceleration route, refined each pass), a number, "
                                                                 "or none."),
              passes: int = typer.Option(2, min=1, help="Identifications with --stribeck-velocity auto."),
-             holdout: float = typer.Option(INERTIAL.holdout, help="Share of the log, at its end, kept out to compare "
-                                                            "torque predictions (between 0 and 1)."),
+             holdout: float = HoldoutOpt,
              stride: int = typer.Option(INERTIAL.stride, min=1, help="Every stride-th single-support sample is used."),
              prior: Optional[float] = typer.Option(INERTIAL.prior, min=0.0, help="Weight of the prior toward the given "
                                                                           "model, in units of the residual variance; "

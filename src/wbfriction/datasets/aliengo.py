@@ -459,7 +459,8 @@ def aliengo_peer(files: dict[str, Path] | None = None) -> PeerActuator:
 
 def peer_config(peer: PeerActuator) -> str:
     """The peer's identification as a robot-TOML fragment: ``[armature]``, ``[encoder_offset]`` (``-bias``) and a
-    ``[pd]`` with its gains and the delay its simulation applied (:attr:`PeerActuator.applied_delay`)."""
+    ``[pd]`` with its gains and the delay its simulation applied (:attr:`PeerActuator.applied_delay`), to the whole
+    torque (``delayed = "torque"``, as PACE's actuator holds it)."""
     lines = ["# The iit-DLSLab identification of this Aliengo (PACE: CMA-ES over Isaac Lab rollouts), as a robot-TOML",
              f"# fragment: its tables replace aliengo.toml's. From {REPOSITORY} at {COMMIT[:7]},",
              "# robot_model/aliengo/isaaclab_identified_parameters.py. A peer's result, not ground truth.",
@@ -470,8 +471,9 @@ def peer_config(peer: PeerActuator) -> str:
     lines += ["[encoder_offset]"] + [f"{j} = {v!r}" for j, v in peer.encoder_offset.items()]
     lines += ["", f"# Their delay: {peer.delay_steps!r} steps of {PEER_STEP} s ({peer.delay:.5f} s), which PACE",
               f"# truncates to {peer.applied_delay_steps} steps and applies to the PD's torque (set-point and feedback "
-              "alike);", "# written here as the set-points' delay (wbfriction's driver delays the set-points only).",
-              "[pd]", f"kp = {peer.kp!r}", f"kd = {peer.kd!r}", f"delay = {peer.applied_delay!r}   # [s]", "",
+              "alike): [pd] delayed = \"torque\" (wbfriction.model.pd).",
+              "[pd]", f"kp = {peer.kp!r}", f"kd = {peer.kd!r}", f"delay = {peer.applied_delay!r}   # [s]",
+              'delayed = "torque"', "",
               "# Their friction (not a robot-TOML table; PeerActuator holds it), per joint: viscous [N·m·s/rad],",
               "# static (Coulomb) [N·m]:"]
     lines += [f"#   {j}: {peer.viscous_friction[j]!r}, {peer.static_friction[j]!r}" for j in peer.armature]
@@ -511,9 +513,10 @@ class AliengoDataset(Dataset):
         q = {role: shlex.quote(str(p)) for role, p in logs.items()}
         commands = (f"wbfriction identify {q['train']} --config {shlex.quote(str(config))} --actuator pd "
                     "--config-output aliengo_identified.toml --json aliengo_actuator.json",
-                    f"wbfriction estimate {q['train']} --config aliengo_identified.toml -o train_friction.parquet",
+                    f"wbfriction estimate {q['train']} --config aliengo_identified.toml --route momentum "
+                    "-o train_friction.parquet",
                     "wbfriction fit train_friction.parquet -o aliengo_params.json",
-                    f"wbfriction estimate {q['held_out']} --config aliengo_identified.toml "
+                    f"wbfriction estimate {q['held_out']} --config aliengo_identified.toml --route momentum "
                     "-o held_out_friction.parquet",
                     "wbfriction predict held_out_friction.parquet --params aliengo_params.json",
                     "wbfriction export aliengo_params.json --config aliengo_identified.toml -o aliengo_isaac.yaml "

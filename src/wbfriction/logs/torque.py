@@ -20,9 +20,11 @@ TORQUE_SOURCES: dict[str, str] = {
 
 def torque_record(robot: Robot, source: TorqueSource, setpoints: PdSetpoints | None) -> dict[str, object]:
     """Where a log's torques come from, for every output's metadata: ``source`` (:data:`TorqueSource`), ``what``
-    (:data:`TORQUE_SOURCES`), and for the PD law its delay [s] and where its gains come from."""
+    (:data:`TORQUE_SOURCES`), and for the PD law its delay [s], what the delay holds back (``delayed``:
+    :mod:`wbfriction.model.pd`) and where its gains come from."""
     record: dict[str, object] = {"source": source, "what": TORQUE_SOURCES[source]}
     if source == "pd" and robot.pd is not None and setpoints is not None:
         logged = setpoints.kp is not None or setpoints.kd is not None
-        record |= {"delay": robot.pd.delay, "gains": "kp/kd columns" if logged else "the robot's [pd]"}
+        record |= {"delay": robot.pd.delay, "delayed": robot.pd.delayed,
+                   "gains": "kp/kd columns" if logged else "the robot's [pd]"}
     return record

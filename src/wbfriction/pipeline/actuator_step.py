@@ -19,8 +19,8 @@ from wbfriction.pipeline.identify_step import identified_config
 from wbfriction.pipeline.paths import check_paths
 
 WRITTEN = ("ok", "weak")
-"""The statuses whose values go into the robot's TOML: determined by the data (``weak``: with a large error, said in
-a comment). A value at a bound or not excited is left as the TOML had it (a comment says why)."""
+"""The statuses whose values go into the robot's TOML: determined by the data (``weak``: with a large error). A
+value at a bound or not excited is left as the TOML had it; ``identify`` prints which, and the JSON has every status."""
 
 
 def identify_actuator_file(robot: Robot, log: str | Path, json_output: str | Path | None = None,
@@ -63,7 +63,8 @@ def actuator_config(text: str, source_dir: Path, urdf: Path, output: Path, resul
     armature, offsets, delay = written_values(result)
     given = tomllib.loads(text)
     merged_armature = {**given.get("armature", {}), **armature}
-    merged = identified_config(text, source_dir, urdf, output, merged_armature or None)
+    merged = identified_config(text, source_dir, urdf, output, merged_armature or None).replace(
+        "identified by wbfriction identify --armature identify", "identified by wbfriction identify --actuator pd")
     lines, skipping, in_pd = [], False, False
     for line in merged.splitlines():
         header = re.match(r"\s*\[([^\]]+)\]", line)
