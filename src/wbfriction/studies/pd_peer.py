@@ -3,13 +3,14 @@ predict, through the same estimate and the same prediction.
 
 The real Aliengo's peer (iit-DLSLab, PACE-style: :class:`~wbfriction.datasets.aliengo.PeerActuator`) gives an
 armature, an encoder offset, a viscous and a static friction per joint and one delay. Its robot is the dataset's
-``aliengo.toml`` with the peer's tables (``peer.toml``, written by ``wbfriction dataset aliengo``); its friction
-``f(qd) = F_v qd + F_s sgn(qd)`` (Isaac Lab's joint friction: a static level, equal to the dynamic one in their
-assets, and a viscous coefficient; a simulator's Coulomb friction is a step). The held-out log is estimated with
-that robot as the route estimates it with the one identified (:func:`~wbfriction.friction.estimate.estimate_log`,
-default options), and the peer's friction predicts its torque (:func:`~wbfriction.fit.predict.predict_torques`):
-the RMS of measured less predicted, per joint, beside wbfriction's (:func:`peer_held_out`); and the same log's
-set-points replayed in MuJoCo with either's parameters, the joints' tracking error (:func:`peer_rollouts`).
+``aliengo.toml`` with the peer's tables (``peer.toml``, written by ``wbfriction dataset aliengo``: its delay holding
+back the whole torque, as PACE's actuator does); its friction ``f(qd) = F_v qd + F_s sgn(qd)`` (Isaac Lab's joint
+friction: a static level, equal to the dynamic one in their assets, and a viscous coefficient; a simulator's Coulomb
+friction is a step). The held-out log is estimated with that robot as the route estimates it with the one
+identified (:func:`~wbfriction.friction.estimate.estimate_log`, the momentum route, as the dataset's commands take),
+and the peer's friction predicts its torque (:func:`~wbfriction.fit.predict.predict_torques`): the RMS of measured
+less predicted, per joint, beside wbfriction's (:func:`peer_held_out`); and the same log's set-points replayed in
+MuJoCo with either's parameters, the joints' tracking error (:func:`peer_rollouts`).
 """
 
 from __future__ import annotations
@@ -23,8 +24,10 @@ from wbfriction.datasets.aliengo import PeerActuator
 from wbfriction.fit.predict import predict_torques
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.families.coulomb_viscous import CoulombViscousParams
+from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.source import read_log
 from wbfriction.model.loading import build_robot
+from wbfriction.model.robot import Robot
 
 
 def peer_robot_config(robot_toml: Path, peer_toml: Path) -> dict:
@@ -38,6 +41,17 @@ def peer_robot_config(robot_toml: Path, peer_toml: Path) -> dict:
     return config
 
 
+def peer_robot(robot_toml: Path, peer_toml: Path) -> Robot:
+    """The robot with the peer's tables (:func:`peer_robot_config`)."""
+    config = peer_robot_config(robot_toml, peer_toml) | {"_dir": str(robot_toml.parent)}
+    return build_robot(robot_toml.parent / config["urdf"], config, str(peer_toml))
+
+
+def peer_friction(peer: PeerActuator, joints: tuple[str, ...]) -> dict[str, CoulombViscousParams]:
+    """The peer's friction per joint (module docstring)."""
+    return {j: CoulombViscousParams(F_v=peer.viscous_friction[j], F_c=peer.static_friction[j]) for j in joints}
+
+
 def peer_held_out(robot_toml: Path, peer_toml: Path, peer: PeerActuator, held_out: Path) -> dict[str, float]:
     """Per joint, the RMS [N·m] of the held-out log's torque less what the peer's parameters predict (module
     docstring).
@@ -45,12 +59,9 @@ def peer_held_out(robot_toml: Path, peer_toml: Path, peer: PeerActuator, held_ou
     Raises:
         InputError: what reading the robot or the log raises.
     """
-    config = peer_robot_config(robot_toml, peer_toml) | {"_dir": str(robot_toml.parent)}
-    robot = build_robot(robot_toml.parent / config["urdf"], config, str(peer_toml))
-    est = estimate_log(robot, read_log(held_out, robot))
-    friction = {j: CoulombViscousParams(F_v=peer.viscous_friction[j], F_c=peer.static_friction[j])
-                for j in est.joints}
-    prediction = predict_torques(est, friction)
+    robot = peer_robot(robot_toml, peer_toml)
+    est = estimate_log(robot, read_log(held_out, robot), EstimateOptions(route="momentum"))
+    prediction = predict_torques(est, peer_friction(peer, tuple(est.joints)))
     return {j: float(prediction.rms[i]) for i, j in enumerate(prediction.joints)}
 
 
@@ -68,10 +79,7 @@ def peer_rollouts(robot_toml: Path, peer_toml: Path, peer: PeerActuator, identif
     from wbfriction.sim.rollout import ActuatorParams, rollout, rollout_table
 
     ours = rollout(load_robot(None, config=identified_toml), held_out, ActuatorParams(friction=params, label="ours"))
-    config = peer_robot_config(robot_toml, peer_toml) | {"_dir": str(robot_toml.parent)}
-    robot = build_robot(robot_toml.parent / config["urdf"], config, str(peer_toml))
-    friction = {j: CoulombViscousParams(F_v=peer.viscous_friction[j], F_c=peer.static_friction[j])
-                for j in robot.actuated}
-    theirs = rollout(robot, held_out, ActuatorParams(friction=friction, delay=peer.applied_delay, torque_delay=True,
-                                                     label="peer"))
+    robot = peer_robot(robot_toml, peer_toml)
+    theirs = rollout(robot, held_out, ActuatorParams(friction=peer_friction(peer, robot.actuated),
+                                                     delay=peer.applied_delay, torque_delay=True, label="peer"))
     return rollout_table([ours, theirs])
