@@ -249,3 +249,18 @@ def chain_urdf(rng: np.random.Generator) -> str:
     joints.append(f'<joint name="sole_joint" type="fixed"><parent link="{parent}"/><child link="sole"/>'
                   '<origin xyz="0.05 0 -0.1" rpy="0.2 0 0"/></joint>')
     return '<robot name="chain">' + "".join(links + joints) + "</robot>"
+
+
+def load_yaml(text: str, version: tuple[int, int] | None = None):
+    """Safe-load YAML (ruamel, pure); ``version`` (1, 1): as a YAML 1.1 reader, where a float without a dot in its
+    mantissa (PyYAML would read a string) is an error (its warning raised)."""
+    import warnings
+
+    from ruamel.yaml import YAML
+
+    yaml = YAML(typ="safe", pure=True)
+    if version is not None:
+        yaml.version = version
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        return yaml.load(text)

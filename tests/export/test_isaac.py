@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import re
-import warnings
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from ruamel.yaml import YAML
 
+from helpers import load_yaml as load
 from wbfriction.exceptions import InputError
 from wbfriction.export.isaac import ISAAC_FIELDS, isaac_actuator_dict, write_isaac_yaml, yaml_float
 from wbfriction.fit.result import FitResult
@@ -20,14 +19,6 @@ YAML_1_1_FLOAT = re.compile(r"^[-+]?([0-9][0-9_]*)?\.[0-9.]*([eE][-+][0-9]+)?$")
 """The float of the YAML 1.1 type repository (yaml.org/type/float.html), what PyYAML resolves as a float."""
 
 
-def load(text: str, version: tuple[int, int] | None = None):
-    """Safe-load YAML; under 1.1 a float without a dot in its mantissa (PyYAML would read a string) is an error."""
-    yaml = YAML(typ="safe", pure=True)
-    if version is not None:
-        yaml.version = version
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        return yaml.load(text)
 
 
 def test_round_trip_and_mapping(tmp_path, random_friction):

@@ -11,15 +11,13 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
-import warnings
 
 import mujoco
 import numpy as np
 import pytest
 from lxml import etree as ET
-from ruamel.yaml import YAML
 
-from helpers import run_cli
+from helpers import load_yaml, run_cli
 from wbfriction.exceptions import InputError
 from wbfriction.export.drive import DEFAULT_PHYSICS_DT, HOLD_EDGE, SMALLEST_TIMESTEP, delay_steps, history_samples
 from wbfriction.export.isaac import NO_FRICTION
@@ -60,13 +58,6 @@ def params(tmp_path, fit_of):
     return path, {f.joint: f for f in fits}
 
 
-def load_yaml(text: str, version: tuple[int, int] | None = None):
-    yaml = YAML(typ="safe", pure=True)
-    if version is not None:
-        yaml.version = version
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        return yaml.load(text)
 
 
 def by_joint(mapping: dict, joints) -> dict[str, float]:

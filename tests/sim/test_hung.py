@@ -27,16 +27,6 @@ from wbfriction.sim.pd_robot import Commands, PdRun, build_pd_robot, step_setpoi
 T = 0.005  # the log's period at 200 Hz
 
 
-@pytest.fixture(scope="module")
-def go2():
-    return load_robot("go2")
-
-
-@pytest.fixture(scope="module")
-def mjr(go2):
-    return build_pd_robot(go2)
-
-
 def columns(table, prefix, robot):
     return np.column_stack([table[f"{prefix}.{j}"].to_numpy() for j in robot.actuated])
 

@@ -13,10 +13,9 @@ import pytest
 from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.fit.params_file import write_params
 from wbfriction.fit.result import FitResult
-from wbfriction.model.loading import load_robot
 from wbfriction.sim.hung import simulate_hung
 from wbfriction.sim.pd_options import REAL_DRIVER, HungOptions
-from wbfriction.sim.pd_robot import Commands, PdRun, build_pd_robot
+from wbfriction.sim.pd_robot import Commands, PdRun
 from wbfriction.sim.rollout import ActuatorParams, read_log_setpoints, rollout, rollout_table
 
 EXACT = 1e-10
@@ -27,16 +26,6 @@ NOISY = 1e-3
 """Replaying a log with a real driver's noise (encoder steps, 0.08 rad/s on the driver's velocity) noise-free:
 measured 2.3e-4 rad RMS at worst over 25 s (the noise's torque, kd x 0.08 rad/s, moves the robot; the replay's
 does not), 2.0e-4 to 4.0e-4 over this file's 7 s (three noise seeds)."""
-
-
-@pytest.fixture(scope="module")
-def go2():
-    return load_robot("go2")
-
-
-@pytest.fixture(scope="module")
-def mjr(go2):
-    return build_pd_robot(go2)
 
 
 @pytest.fixture(scope="module")

@@ -100,15 +100,7 @@ def read_setpoints(table: pa.Table, robot: Robot, time: np.ndarray, q_logged: np
     joints = robot.pd.joints
 
     def group(prefix: str, required: bool) -> np.ndarray | None:
-        cols = [f"{prefix}.{j}" for j in joints]
-        there = [c in names for c in cols]
-        if not any(there) and not required:
-            return None
-        if not all(there):
-            missing = cols[there.index(False)]
-            raise ColumnError(source, missing, None, f"missing column '{missing}': {prefix}.* is logged for some "
-                              "PD-driven joints only; log it for every one, or for none")
-        return numeric_columns(table, cols, source, first_row)
+        return _every_or_none(table, prefix, joints, source, first_row, required)
 
     index = [robot.actuated.index(j) for j in joints]
     if qd_logged is not None:
@@ -128,14 +120,25 @@ def driver_estimate(table: pa.Table, robot: Robot, source: str, first_row: int) 
     Raises:
         ColumnError: ``tau_est`` logged for some torque-controlled joints only.
     """
-    cols = [f"tau_est.{n}" for n in robot.torque_controlled]
+    return _every_or_none(table, "tau_est", robot.torque_controlled, source, first_row)
+
+
+def _every_or_none(table: pa.Table, prefix: str, joints: tuple[str, ...], source: str, first_row: int,
+                   required: bool = False) -> np.ndarray | None:
+    """The columns ``<prefix>.<joint>`` of every joint (N, n), or None if the log has none and they are not
+    ``required``.
+
+    Raises:
+        ColumnError: the columns of some joints only, naming the first one missing.
+    """
+    cols = [f"{prefix}.{j}" for j in joints]
     there = [c in table.column_names for c in cols]
-    if not any(there):
+    if not any(there) and not required:
         return None
     if not all(there):
         missing = cols[there.index(False)]
-        raise ColumnError(source, missing, None, f"missing column '{missing}': the drivers' torque estimates are "
-                          "logged for some joints only; log them for every joint, or for none")
+        raise ColumnError(source, missing, None, f"missing column '{missing}': {prefix}.* is logged for some joints "
+                          "only; log it for every one, or for none")
     return numeric_columns(table, cols, source, first_row)
 
 

@@ -43,7 +43,15 @@ from wbfriction.model.pd import PdDriver
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
 from wbfriction.sim.pd_options import DriverNoise, HungOptions, PerJoint, SetpointOptions
-from wbfriction.sim.pd_robot import Commands, PdMujocoRobot, PdRun, PdTrajectory, StepNoise, build_pd_robot
+from wbfriction.sim.pd_robot import (
+    Commands,
+    PdMujocoRobot,
+    PdRun,
+    PdTrajectory,
+    StepNoise,
+    build_pd_robot,
+    joint_values,
+)
 
 GENERATOR = "wbfriction.sim.hung.simulate_hung"
 BAND_MARGIN = 0.05
@@ -170,15 +178,6 @@ class HungSimulation:
     physics_step: float
 
 
-def _values(robot: Robot, given: Mapping[str, float] | None, own: Mapping[str, float], what: str) -> np.ndarray:
-    """Per joint (n_act,): the given values (joints not named: 0), else the robot's own ``own``."""
-    values = own if given is None else given
-    unknown = sorted(set(values) - set(robot.actuated))
-    if unknown:
-        raise InputError(f"{what} given for '{unknown[0]}', which is not a joint of {robot.name}")
-    return np.array([float(values.get(j, 0.0)) for j in robot.actuated])
-
-
 def step_noise(robot: Robot, noise: DriverNoise, n_steps: int) -> StepNoise:
     """The drivers' errors at ``n_steps`` physics steps (drawn from ``noise.seed``: position, then velocity; None
     where off)."""
@@ -221,9 +220,9 @@ def simulate_hung(robot: Robot, options: HungOptions = HungOptions(),
     period = 1.0 / options.rate
     time = np.arange(n) * period
     driver = mjr.driver if options.delay is None else mjr.driver.with_delay(options.delay)
-    armature = _values(robot, options.armature, dict(zip(robot.actuated, robot.model.armature[robot.act_v_index])),
+    armature = joint_values(robot, options.armature, dict(zip(robot.actuated, robot.model.armature[robot.act_v_index])),
                        "armature")
-    offset = _values(robot, options.encoder_offset, robot.encoder_offset, "encoder offset")
+    offset = joint_values(robot, options.encoder_offset, robot.encoder_offset, "encoder offset")
     q_model, slope = setpoints(robot, time, options.setpoints)
     commands = Commands(q_model + offset, slope if options.setpoints.velocity else np.zeros_like(slope),
                         np.zeros_like(slope))

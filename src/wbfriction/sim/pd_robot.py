@@ -198,6 +198,20 @@ class Commands:
     kd: np.ndarray | None = None
 
 
+def joint_values(robot: Robot, given: Mapping[str, float] | None, own: Mapping[str, float], what: str) -> np.ndarray:
+    """Per joint (n_act,) in :attr:`Robot.actuated` order: the values ``given`` (joints not named: 0), else the
+    robot's own ``own`` (armature, encoder offsets).
+
+    Raises:
+        InputError: a value for a joint the robot does not have, naming it and ``what``.
+    """
+    values = own if given is None else given
+    unknown = sorted(set(values) - set(robot.actuated))
+    if unknown:
+        raise InputError(f"{what} given for '{unknown[0]}', which is not a joint of {robot.name}")
+    return np.array([float(values.get(j, 0.0)) for j in robot.actuated])
+
+
 class PdRun:
     """Runs of a PD-driven robot (module docstring) with given drives: armature, encoder offsets, drivers, friction.
 

@@ -42,7 +42,7 @@ from wbfriction.friction.models import MODEL_NAMES, ModelParams, ModelParamsBase
 from wbfriction.logs.tables import numeric_columns, read_table
 from wbfriction.model.robot import Robot
 from wbfriction.sim.options import FrictionMode
-from wbfriction.sim.pd_robot import Commands, PdMujocoRobot, PdRun, build_pd_robot
+from wbfriction.sim.pd_robot import Commands, PdMujocoRobot, PdRun, build_pd_robot, joint_values
 
 
 @dataclass(frozen=True)
@@ -147,14 +147,6 @@ def _friction(robot: Robot, given: Mapping[str, Any] | str | Path) -> tuple[dict
     return out, tuple(j for j in robot.actuated if j not in out)
 
 
-def _per_joint(robot: Robot, given: Mapping[str, float] | None, own: Mapping[str, float], what: str) -> np.ndarray:
-    values = own if given is None else given
-    unknown = sorted(set(values) - set(robot.actuated))
-    if unknown:
-        raise InputError(f"{what} given for '{unknown[0]}', which is not a joint of {robot.name}")
-    return np.array([float(values.get(j, 0.0)) for j in robot.actuated])
-
-
 @dataclass(frozen=True, eq=False)
 class LogSetpoints:
     """What the rollout reads of a PD-driven robot's log (every joint, in the robot's order): ``time`` (N,) [s], the
@@ -248,9 +240,9 @@ def rollout(robot: Robot, log: pa.Table | str | Path | LogSetpoints, params: Act
     if horizon is not None and not horizon > 0:
         raise InputError(f"the rollout's horizon must be > 0 s, got {horizon}")
     friction, bare = _friction(robot, params.friction)
-    armature = _per_joint(robot, params.armature, dict(zip(robot.actuated, robot.model.armature[robot.act_v_index])),
+    armature = joint_values(robot, params.armature, dict(zip(robot.actuated, robot.model.armature[robot.act_v_index])),
                           "armature")
-    offset = _per_joint(robot, params.encoder_offset, robot.encoder_offset, "encoder offset")
+    offset = joint_values(robot, params.encoder_offset, robot.encoder_offset, "encoder offset")
     driver = mjr.driver if params.delay is None else mjr.driver.with_delay(params.delay)
     period = float(np.median(np.diff(data.time)))
     run = PdRun(mjr, period, substeps, driver, armature, offset, friction, friction_mode,
