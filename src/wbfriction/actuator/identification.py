@@ -31,6 +31,10 @@ ActuatorStatus = Literal["ok", "weak", "does not predict", "at bound", "not exci
 OFFSET_WEAK = 0.01
 """An encoder offset whose standard error or bound exceeds this [rad] (0.57°) is ``weak``: an a priori resolution
 (a gravity torque's change over it is below the friction of the joints this is for), not fitted on data."""
+OFFSET_PLAUSIBLE = 0.1
+"""An encoder offset beyond this [rad] (5.7°, PACE's search bound on the Aliengo) is ``weak``: more than a joint's
+encoder is mis-set by; a gravity model that is off (masses, centres of mass) fits so too. An a priori limit, not
+fitted on data."""
 HOLDOUT_RATIO = 2.0
 """A joint whose balance on held-out windows has more than this times the RMS of the windows fitted does not
 predict (an a priori factor: with the same noise the ratio is about 1)."""
@@ -225,7 +229,8 @@ def parameter_status(kind: str, value: float, se: float, crb: float, at_bound: b
     """A parameter's status, the first that applies: ``not excited`` (its bound is infinite: the data do not
     determine it), ``at bound`` (left on a bound of the search: an offset at ``--offset-bound``, or an armature at
     zero, which a rotor never has), ``weak`` (a standard error or bound above :data:`~wbfriction.fit.status.WEAK`
-    of its value; for an offset, above :data:`OFFSET_WEAK`), ``ok``."""
+    of its value; for an offset, above :data:`OFFSET_WEAK`, or the offset itself beyond :data:`OFFSET_PLAUSIBLE`),
+    ``ok``."""
     unit = UNITS[kind]
     if not np.isfinite(crb):
         return "not excited", f"{kind}: the log does not determine it"
@@ -233,6 +238,9 @@ def parameter_status(kind: str, value: float, se: float, crb: float, at_bound: b
         return "at bound", f"{kind} at the search's bound ({value:.4g} {unit})"
     worst = max(se, crb)
     if kind == "offset":
+        if abs(value) > OFFSET_PLAUSIBLE:
+            return "weak", (f"offset {value:+.3g} rad: more than an encoder is mis-set by ({OFFSET_PLAUSIBLE:g}); "
+                            "the gravity model (masses, centres of mass) may be off instead")
         if worst > OFFSET_WEAK:
             return "weak", f"offset ±{worst:.2g} rad (more than {OFFSET_WEAK:g})"
         return "ok", ""

@@ -96,8 +96,7 @@ class DelaySteps:
         if self.whole:
             return None
         return (f"the drivers' delay {self.delay:g} s is {self.exact:.3f} physics steps of {self.physics_dt:g} s: "
-                f"Isaac Lab counts whole steps, written as {self.steps} ({self.steps * self.physics_dt:g} s); "
-                f"a --physics-dt that divides {self.delay:g} s keeps it exact")
+                f"written as {self.steps} ({self.steps * self.physics_dt:g} s)")
 
 
 def delay_steps(delay: float, physics_dt: float = DEFAULT_PHYSICS_DT) -> DelaySteps:

@@ -14,7 +14,7 @@ TORQUE_SOURCES: dict[str, str] = {
     "sensor": "joint torque sensors (tau.<joint>)",
     "driver": "the motor drivers' own estimates (tau_est.<joint>)",
     "current": "motor currents times the torque constants (current.<joint>)",
-    "pd": "the drivers' PD law on the logged set-points (q_des.<joint>)"}
+    "pd": "the drivers' PD law on q_des.<joint>"}
 """What each torque source is, as the outputs say it (:data:`TorqueSource`)."""
 
 
