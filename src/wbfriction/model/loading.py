@@ -14,6 +14,7 @@ import tomllib
 from collections.abc import Collection, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
+from typing import cast
 from importlib import resources
 from pathlib import Path
 
@@ -26,7 +27,7 @@ from wbfriction.model.force_torque import parse_sensors
 from wbfriction.model.imu import add_imu_frame
 from wbfriction.model.labels import parse_labels
 from wbfriction.model.pd import parse_pd
-from wbfriction.model.robot import ModelFormat, Robot
+from wbfriction.model.robot import CONTACT_DIMS, ContactKind, ModelFormat, Robot
 from wbfriction.model.robots import BUILTIN_ROBOTS
 
 _ERD_PREFIX = "example-robot-data:"
@@ -111,7 +112,8 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
             :func:`~wbfriction.model.force_torque.parse_sensors`), ``contact_force`` ([on, off] [N]:
             contact flags from those sensors, :mod:`wbfriction.logs.contacts`), ``imu`` (link, xyz, rpy:
             :mod:`wbfriction.model.imu`), ``labels`` (joint name -> what a person reads,
-            :mod:`wbfriction.model.labels`), ``balance_gains``
+            :mod:`wbfriction.model.labels`), ``contact_model`` (``"sole"`` or ``"point"``, or a table contact
+            frame -> kind: :attr:`Robot.contact_kinds`), ``balance_gains``
             (:attr:`Robot.balance_gains`).
         source: file name used in error messages.
         model_format: ``"urdf"`` or ``"mjcf"``: how ``urdf`` is read.
@@ -155,6 +157,7 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
         labels=parse_labels(config.get("labels"), actuated, source),
         pd=parse_pd(config.get("pd"), actuated, groups, _effort_limits(model, actuated), source),
         encoder_offset=_joint_values(config, "encoder_offset", actuated, source, signed=True),
+        contact_kinds=_contact_kinds(config.get("contact_model"), frames, floating, source),
     )
 
 
@@ -353,6 +356,23 @@ def _contact_frames(config: dict, model: pin.Model, urdf: Path, source: str) -> 
         if not model.existFrame(f):
             raise InputError(f"{source}: unknown contact frame '{f}' (not a frame of {urdf.name})")
     return frames
+
+
+def _contact_kinds(value, frames: list[str], floating: bool, source: str) -> tuple[ContactKind, ...]:
+    """``contact_model``: ``"sole"`` or ``"point"`` for every contact frame, or a table frame -> kind (the others
+    soles); () when not given (every frame a sole)."""
+    if value is None:
+        return ()
+    if not floating:
+        raise InputError(f"{source}: 'contact_model' has no meaning with floating_base = false")
+    table = value if isinstance(value, dict) else dict.fromkeys(frames, value)
+    for frame, kind in table.items():
+        if frame not in frames:
+            raise InputError(f"{source}: contact_model names '{frame}', which is not one of contact_frames")
+        if kind not in CONTACT_DIMS:
+            raise InputError(f"{source}: contact_model of '{frame}' is {kind!r}: choose one of "
+                             f"{', '.join(CONTACT_DIMS)}")
+    return tuple(cast(ContactKind, table.get(f, "sole")) for f in frames)
 
 
 def _groups(config: dict, actuated: list[str], source: str) -> dict[str, tuple[str, ...]]:

@@ -37,6 +37,11 @@ from wbfriction.model.labels import default_label
 from wbfriction.model.layout import JointLayout, joint_layout
 from wbfriction.model.pd import PdDriver
 
+ContactKind = Literal["sole", "point"]
+"""How a contact frame touches the ground (:attr:`Robot.contact_kinds`): a sole (6 constraints) or a point (3)."""
+CONTACT_DIMS: dict[str, int] = {"sole": 6, "point": 3}
+"""The constraints (and contact force components) of each :data:`ContactKind`."""
+
 ModelFormat = Literal["urdf", "mjcf"]
 """The robot description formats a model is built from (:func:`wbfriction.model.loading.build_model`)."""
 
@@ -53,7 +58,10 @@ class Robot:
         actuated: names of all actuated (single-DoF) joints, in model order.
         torque_controlled: names of the torque-controlled joints, in model order.
         position_controlled: names of the position-controlled joints, in model order.
-        contact_frames: names of the 6D contact frames (feet soles), as configured.
+        contact_frames: names of the contact frames (feet soles, point feet), as configured.
+        contact_kinds: ``"sole"`` (six constraints: the frame does not move, a contact wrench) or ``"point"``
+            (three: the frame's origin does not move, a contact force; a quadruped's foot) per contact frame
+            (``contact_model`` in the TOML); empty: every frame a sole.
         groups: named joint groups (e.g. ``knee``), used to set friction per group.
         q_reference: a standing configuration (nq,), e.g. TALOS's ``half_sitting``.
         balance_gains: (K [N·m/rad], D [N·m·s/rad]) of the MuJoCo walking controller's
@@ -104,6 +112,7 @@ class Robot:
     labels: dict[str, str] = field(default_factory=dict)
     pd: PdDriver | None = None
     encoder_offset: dict[str, float] = field(default_factory=dict)
+    contact_kinds: tuple[ContactKind, ...] = ()
     cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
     """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.stance`)."""
 
@@ -152,6 +161,18 @@ class Robot:
         if len(self.layout.q2_joint):
             raise ModelError(f"robot '{self.name}': continuous joints are not supported here")
         return np.array([self.model.idx_qs[self.model.getJointId(n)] for n in self.actuated], dtype=int)
+
+    @cached_property
+    def contact_dims(self) -> tuple[int, ...]:
+        """The constraints of each contact frame (n_contacts,): 6 for a sole, 3 for a point (:data:`CONTACT_DIMS`)."""
+        kinds = self.contact_kinds or ("sole",) * len(self.contact_frames)
+        return tuple(CONTACT_DIMS[k] for k in kinds)
+
+    @cached_property
+    def point_contacts(self) -> bool:
+        """Some contact frame is a point (a quadruped's feet): friction is estimated where the contacts leave it
+        determined, sample by sample (:mod:`wbfriction.model.determination`)."""
+        return "point" in self.contact_kinds
 
     @cached_property
     def contact_frame_ids(self) -> tuple[int, ...]:
