@@ -20,7 +20,9 @@ own; each swing's height and sideways bump are drawn from ``seed`` (0.6-1.4 time
 0.03 m outwards) so that no two steps move the joints alike. The base sways in every gait (height, roll, pitch;
 sums of sines of their own frequencies, phases from ``seed``).
 
-A foot's planned position is its contact frame's origin (the Go2's foot sphere's centre), at :data:`FOOT_RADIUS`
+The feet start at their places in the robot's reference configuration, moved together along the base so that
+their centre (the diagonals' crossing) lies under the centre of mass. A foot's planned position is its contact
+frame's origin (the Go2's foot sphere's centre), at :data:`FOOT_RADIUS`
 above the ground while it stands. A stance foot does not move, and the base pose is planned; the leg joints
 follow by inverse kinematics (Newton iterations per sample, from the previous sample's angles), their velocities
 from ``J v = pd`` and accelerations from ``J a = pdd - Jd v`` (Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians of the
@@ -200,7 +202,9 @@ class _Swing:
 
 
 def _legs(robot: Robot) -> tuple[np.ndarray, list[tuple[str, str]]]:
-    """Each foot's position in the base frame at the reference configuration (4, 3) and its (front|rear, left|right).
+    """Each foot's home in the base frame (4, 3): its position at the reference configuration, all four moved
+    forwards or backwards together so that their centre lies under the centre of mass; and its (front|rear,
+    left|right).
 
     Raises:
         ModelError: a robot without four contact frames, one on each corner.
@@ -212,6 +216,8 @@ def _legs(robot: Robot) -> tuple[np.ndarray, list[tuple[str, str]]]:
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, q)
     base = np.array([data.oMf[f].translation for f in robot.contact_frame_ids]) - q[:3]
+    # the footprints centred under the centre of mass: the diagonals cross beneath it (a trot's balance)
+    base[:, 0] += pin.centerOfMass(robot.model, data, q)[0] - q[0] - base[:, 0].mean()
     corners = [("front" if x > 0 else "rear", "left" if y > 0 else "right") for x, y, _ in base]
     if len(set(corners)) != 4:
         raise ModelError(f"robot '{robot.name}': its four feet are not one on each corner of the base: {corners}")
