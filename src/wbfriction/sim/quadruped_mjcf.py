@@ -1,0 +1,130 @@
+"""A walking quadruped's MuJoCo model, built at run time from the URDF of its Pinocchio model (issue 56).
+
+The robot's URDF as MuJoCo reads it (:func:`wbfriction.model.mjspec.urdf_spec`: kinematic tree and inertias; visual
+and collision geometry and the URDF's ``<dynamics>`` dropped), with
+
+* a free joint at the root (a floating base) and a ground plane (``z = 0``, flat and horizontal);
+* one sphere per contact frame (:attr:`Robot.contact_frames <wbfriction.model.robot.Robot.contact_frames>`, the
+  robot's point feet), of radius :data:`FOOT_RADIUS`, **centred on the contact frame's origin** (Unitree's feet are
+  rubber balls about 2 cm in radius round the ``<leg>_foot`` frame), the only geometry that collides: soft point
+  contacts with MuJoCo's default ``solref``/``solimp``, ``condim`` 3 (normal and sliding friction, no torsional or
+  rolling friction: the ground's action on a foot is one force at the contact point), sliding friction
+  :data:`FOOT_FRICTION`;
+* an IMU site at the robot's IMU frame (``[imu]``) with MuJoCo's ``gyro`` and ``accelerometer`` on it (angular
+  velocity and specific force in the IMU frame: :mod:`wbfriction.model.imu`'s convention);
+* one motor per joint (``ctrl`` = the joint torque [N·m], not clipped: the controller or the drivers clip), no joint
+  limit (the reference stays inside the ranges).
+
+The ground's force acts at the contact point MuJoCo finds (half-way into the penetration, about ``r`` below the
+foot frame's origin), not at the origin: a point-foot model taking the origin as fixed sees the moment ``r x f``
+and the sphere's rolling (the origin moves ``r dtheta`` as the foot turns on the ground) as model error
+(:mod:`wbfriction.sim.quadruped_mujoco` measures both).
+
+Conventions that differ between MuJoCo and Pinocchio (joints by name, quaternion order, the free joint's linear
+velocity in world axes) are :class:`~wbfriction.sim.mujoco_model.MujocoRobot`'s maps: the model returned is one.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pinocchio as pin
+
+from wbfriction.exceptions import InputError, ModelError
+from wbfriction.model.mjspec import mujoco_message, urdf_spec
+from wbfriction.model.robot import Robot
+from wbfriction.sim.mujoco_model import MujocoRobot, route_mujoco_warnings
+
+if TYPE_CHECKING:
+    import mujoco
+
+FOOT_RADIUS = 0.022
+"""The feet's radius [m] (the Go2's foot collision mesh spans 0.020-0.026 m round the foot frame's origin)."""
+FOOT_FRICTION = 0.9
+"""The feet's sliding friction coefficient on the ground (rubber on a floor: 0.8-1.0)."""
+
+
+def build_quadruped_model(robot: Robot, timestep: float = 1e-3, foot_radius: float = FOOT_RADIUS,
+                          foot_friction: float = FOOT_FRICTION) -> MujocoRobot:
+    """The MuJoCo model of a walking robot on point feet (module docstring).
+
+    Args:
+        robot: a floating-base robot whose contact frames are points (``contact_model = "point"``), from a URDF.
+        timestep: the physics step [s].
+        foot_radius: the feet's sphere radius [m], > 0.
+        foot_friction: their sliding friction coefficient, > 0.
+
+    Returns:
+        A :class:`~wbfriction.sim.mujoco_model.MujocoRobot`: its ``sole_geoms`` are the feet's spheres, in
+        :attr:`Robot.contact_frames` order; ``imu_index`` the gyro's and accelerometer's ``sensordata`` addresses
+        (empty without an IMU); no touch or force-torque sensor.
+
+    Raises:
+        InputError: a fixed base, contact frames that are not points, a radius or friction <= 0, an MJCF robot.
+        ModelError: a URDF MuJoCo cannot compile, a joint or body it does not have.
+    """
+    import mujoco
+    if not robot.floating_base or not robot.contact_frames:
+        raise InputError(f"robot '{robot.name}': a walking quadruped needs a floating base and contact frames")
+    if any(kind != "point" for kind in robot.contact_kinds) or len(robot.contact_kinds) != len(robot.contact_frames):
+        raise InputError(f"robot '{robot.name}': the quadruped's MuJoCo model has point feet only "
+                         "(contact_model = \"point\")")
+    if not (foot_radius > 0 and foot_friction > 0):
+        raise InputError(f"foot radius ({foot_radius}) and friction ({foot_friction}) must be > 0")
+    route_mujoco_warnings()
+    spec = urdf_spec(robot.require_urdf("the quadruped's MuJoCo model"), free_joint=True)
+    spec.option.timestep = timestep
+    spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1], condim=3,
+                            friction=[foot_friction, 0.0, 0.0])
+    for joint in spec.joints:
+        joint.limited = mujoco.mjtLimited.mjLIMITED_FALSE
+    model = robot.model
+    for frame in robot.contact_frames:
+        fr = model.frames[model.getFrameId(frame)]
+        _joint_body(spec, model, fr.parentJoint).add_geom(
+            name=f"foot_{frame}", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[foot_radius, 0, 0],
+            pos=fr.placement.translation, condim=3, friction=[foot_friction, 0.0, 0.0])
+    if robot.imu is not None:
+        fr = model.frames[robot.imu.frame]
+        _joint_body(spec, model, fr.parentJoint).add_site(
+            name="imu", pos=fr.placement.translation, quat=pin.Quaternion(fr.placement.rotation).coeffs()[[3, 0, 1, 2]])
+        for name, kind in (("imu_gyro", mujoco.mjtSensor.mjSENS_GYRO),
+                           ("imu_acc", mujoco.mjtSensor.mjSENS_ACCELEROMETER)):
+            spec.add_sensor(name=name, type=kind, objtype=mujoco.mjtObj.mjOBJ_SITE, objname="imu")
+    for name in robot.actuated:
+        spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT).set_to_motor()
+    try:
+        mj = spec.compile()
+    except Exception as exc:
+        raise ModelError(f"{robot.urdf}: MuJoCo cannot compile the model: {mujoco_message(exc)}") from None
+    return _addresses(robot, mj)
+
+
+def _joint_body(spec: mujoco.MjSpec, model: pin.Model, joint: int) -> mujoco.MjsBody:
+    """The MuJoCo spec body a Pinocchio joint moves (its child link: the frame the joint's placements are in)."""
+    for f in model.frames:
+        if f.type == pin.FrameType.BODY and f.parentJoint == joint and f.placement.isIdentity():
+            body = spec.body(f.name)
+            if body is not None:
+                return body
+    raise ModelError(f"MuJoCo has no body for joint '{model.names[joint]}'")
+
+
+def _addresses(robot: Robot, mj: mujoco.MjModel) -> MujocoRobot:
+    """The :class:`MujocoRobot` of the compiled model: the joints', feet's and IMU's addresses."""
+    import mujoco
+
+    def named(kind: mujoco.mjtObj, name: str) -> int:
+        i = mujoco.mj_name2id(mj, kind, name)
+        if i < 0:
+            raise ModelError(f"{robot.urdf}: MuJoCo's model has no '{name}'")
+        return int(i)
+
+    joints = np.array([named(mujoco.mjtObj.mjOBJ_JOINT, j) for j in robot.actuated])
+    feet = tuple(named(mujoco.mjtObj.mjOBJ_GEOM, f"foot_{f}") for f in robot.contact_frames)
+    imu = (np.r_[[mj.sensor_adr[named(mujoco.mjtObj.mjOBJ_SENSOR, s)] + i for s in ("imu_gyro", "imu_acc")
+                  for i in range(3)]].astype(int) if robot.imu is not None else np.zeros(0, dtype=int))
+    base = int(mj.jnt_bodyid[np.flatnonzero(mj.jnt_type == mujoco.mjtJoint.mjJNT_FREE)[0]])
+    return MujocoRobot(robot, mj, np.array(mj.jnt_qposadr[joints]), np.array(mj.jnt_dofadr[joints]), feet,
+                       np.zeros(0, dtype=int), joints, base, np.zeros((0, 6), dtype=int), imu)
