@@ -93,6 +93,8 @@ def decide_log(robot: Robot, options: EstimateOptions, positions: np.ndarray | N
             stretches too short for any scheme (:func:`check_windows`).
     """
     given = options
+    if robot.point_contacts and options.route == "auto":  # the momentum route has no point feet (yet)
+        options = replace(options, route="acceleration")
     options, choice = resolve_differentiation(options, positions, dt)
     options, route = resolve_route(options, positions, dt, choice, rows=route_rows)
     check_windows(given, options, segments, rows, dt, source)

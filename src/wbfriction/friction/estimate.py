@@ -38,6 +38,7 @@ from wbfriction.friction.measured import (
 )
 from wbfriction.friction.momentum import momentum_estimate
 from wbfriction.friction.options import METHODS, EstimateOptions, Route
+from wbfriction.friction.point_contacts import point_contact_estimate
 from wbfriction.logs.log import Log
 from wbfriction.logs.torque import torque_record
 from wbfriction.model.dynamics import constrained_dynamics
@@ -149,6 +150,8 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     """
     if options.method not in METHODS:
         raise InputError(f"unknown method '{options.method}': choose one of {', '.join(METHODS)}")
+    if robot.point_contacts:  # where the contacts leave the friction determined, sample by sample
+        return point_contact_estimate(robot, kin, options, progress, require_single_support)
     phases: Phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip, gaps)
     assert kin.valid is not None  # set by MeasuredKinematics.__post_init__
     usable = kin.valid & (phases.n_contacts > 0)
@@ -350,7 +353,7 @@ def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress
         est = _acceleration_segment(robot, log, options, progress, companion, require_single_support, gaps)
     est.q, est.tau, est.temperature = log.q[:, robot.tc_index], log.tau, log.temperature  # the terms' signals
     est.metadata["torque_source"] = torque_record(robot, log.torque_source, log.setpoints)  # every output says it
-    if options.check_route:
+    if options.check_route and not robot.point_contacts:  # point feet: one route (wbfriction.friction.point_contacts)
         other: Route = "acceleration" if options.route == "momentum" else "momentum"
         est.route_check = _estimate_segment(robot, log, replace(options, route=other, check_route=False), None,
                                             False, False, gaps)

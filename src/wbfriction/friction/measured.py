@@ -61,7 +61,8 @@ def log_base_motion(robot: Robot, log: Log, choice: BaseMotion, wrenches: bool
     """
     has_wrench = wrenches and log.wrench is not None
     has_imu = log.imu is not None and robot.imu is not None
-    base_motion = resolve_base_motion(choice, log.base is not None, has_wrench, has_imu)
+    # point feet need the base measured (wbfriction.friction.point_contacts): a logged pose is taken without wrenches
+    base_motion = resolve_base_motion(choice, log.base is not None, has_wrench or robot.point_contacts, has_imu)
     if base_motion == "imu" and (robot.imu is None or log.base is None):
         raise InputError(f"{log.source}: --base-motion imu needs the robot's [imu] (its TOML) and the base "
                          "orientation columns base.qx ... base.qw")
@@ -123,9 +124,9 @@ def wrench_route(robot: Robot, kin: MeasuredKinematics, rows: np.ndarray) -> tup
     """
     assert kin.wrench is not None
     n = len(kin.time)
-    ok = rows & np.all(np.isfinite(kin.wrench.reshape(n, -1)), axis=1) & _finite_base(kin)
+    ok = rows & np.all(np.isfinite(kin.wrench.reshape(n, -1)), axis=1) & finite_base(kin)
     r = np.flatnonzero(ok)
-    q, v, _ = _base_state(robot, kin, r)
+    q, v, _ = base_state(robot, kin, r)
     dyn = measured_inverse_dynamics(robot, q, v, kin.qdd[r], wrench=kin.wrench[r])
     tau_f = np.full((n, robot.tc_index.size), np.nan)
     tau_f[r] = dyn.tau[:, robot.tc_index] - kin.tau[r]
@@ -136,9 +137,9 @@ def base_route(robot: Robot, kin: MeasuredKinematics, rows: np.ndarray) -> tuple
     """Friction from the measured base acceleration, no wrench (module docstring), on the rows ``rows``
     (N,) of ``kin`` that have at most one contact; returns ``(tau_f, done)`` as :func:`wrench_route`."""
     n = len(kin.time)
-    ok = rows & (kin.contact.sum(axis=1) <= 1) & _finite_base(kin)
+    ok = rows & (kin.contact.sum(axis=1) <= 1) & finite_base(kin)
     r = np.flatnonzero(ok)
-    q, v, a_b = _base_state(robot, kin, r)
+    q, v, a_b = base_state(robot, kin, r)
     assert a_b is not None  # a measured base
     dyn = measured_inverse_dynamics(robot, q, v, kin.qdd[r], base_acceleration=a_b, contact=kin.contact[r])
     tau_f = np.full((n, robot.tc_index.size), np.nan)
@@ -146,7 +147,7 @@ def base_route(robot: Robot, kin: MeasuredKinematics, rows: np.ndarray) -> tuple
     return tau_f, ok
 
 
-def _finite_base(kin: MeasuredKinematics) -> np.ndarray:
+def finite_base(kin: MeasuredKinematics) -> np.ndarray:
     """(N,) the rows whose base motion is known: measured rates finite, or a foot on the ground."""
     source = measured_base(kin)
     if source == "imu":
@@ -158,7 +159,7 @@ def _finite_base(kin: MeasuredKinematics) -> np.ndarray:
     return np.asarray(kin.contact.any(axis=1))
 
 
-def _base_state(robot: Robot, kin: MeasuredKinematics, r: np.ndarray
+def base_state(robot: Robot, kin: MeasuredKinematics, r: np.ndarray
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """Full ``q`` (len(r), nq), ``v`` (len(r), nv) and the base's measured acceleration (len(r), 6) of the rows
     ``r``, from :func:`measured_base`: the logged base pose and its differentiated twist, the IMU's rates

@@ -160,8 +160,12 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
 
     Raises:
         InputError: what :func:`~wbfriction.signals.kinematics.measure` raises, windows not resolved, no sample
-            the route can estimate (with ``require_single_support``).
+            the route can estimate (with ``require_single_support``), a robot on point feet (not yet on this route:
+            :mod:`wbfriction.friction.point_contacts` is on the acceleration route).
     """
+    if robot.point_contacts:
+        raise InputError(f"{log.source}: the momentum route does not take point feet yet: --route acceleration "
+                         f"(robot '{robot.name}')")
     window = momentum_window(options, log)
     has_wrench, base_motion = log_base_motion(robot, log, options.base_motion, options.wrenches)
     kin = measure(log, "savgol", compensate_delay=options.compensate_delay, torque_alignment=options.torque_alignment,

@@ -46,6 +46,8 @@ from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.logs.clock import JITTER, Clock, read_clock, split_at_gaps, table_stamps
 from wbfriction.logs.columns import BASE_COLUMNS, BASE_QD_TRUE_COLUMNS, BASE_QDD_TRUE_COLUMNS, IMU_COLUMNS
 from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, sensed_contacts
+from wbfriction.logs.foot_forces import column_names as foot_force_names
+from wbfriction.logs.foot_forces import foot_force_columns, foot_force_table, read_foot_forces
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP, ReadOptions
 from wbfriction.logs.pd import (
     PD_PREFIXES,
@@ -97,6 +99,9 @@ class Log:
             :attr:`Robot.ft_sensors <wbfriction.model.robot.Robot.ft_sensors>` order, each in its
             sensor frame [N, N·m] (columns ``wrench.<sensor>.fx`` ... ``.tz``,
             :mod:`wbfriction.model.force_torque`), or None if not logged.
+        foot_force: the feet's measured forces (N, n_contacts, 3), world axes [N], NaN where not measured (columns
+            ``force.<frame>.x`` ... ``.z``, or the normal ``force.<frame>``: :mod:`wbfriction.logs.foot_forces`),
+            or None.
         imu: the IMU's readings (N, 6): angular velocity [rad/s] and specific force [m/s^2] in its frame
             (columns ``imu.gyro_x`` ... ``imu.acc_z``, :mod:`wbfriction.model.imu`), or None.
         temperature: the torque-controlled joints' temperatures (N, n_tc) [°C] (``temperature.<joint>`` columns),
@@ -132,6 +137,7 @@ class Log:
     imu: np.ndarray | None = None
     temperature: np.ndarray | None = None
     setpoints: PdSetpoints | None = None
+    foot_force: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.segments is None and self.clock is not None and len(self.clock.segments) > 1:
@@ -162,7 +168,8 @@ class Log:
                    wrench=cut(self.wrench), base_qd_true=cut(self.base_qd_true),
                    base_qdd_true=cut(self.base_qdd_true), imu=cut(self.imu),
                    temperature=cut(self.temperature),
-                   setpoints=None if self.setpoints is None else self.setpoints.rows(start, stop))
+                   setpoints=None if self.setpoints is None else self.setpoints.rows(start, stop),
+                   foot_force=cut(self.foot_force))
 
     def __len__(self) -> int:
         return len(self.time)
@@ -189,6 +196,8 @@ class Log:
                          (BASE_QDD_TRUE_COLUMNS, self.base_qdd_true), (IMU_COLUMNS, self.imu)):
             if x is not None:
                 cols.update({c: x[:, i] for i, c in enumerate(names)})
+        if self.foot_force is not None:
+            cols.update(foot_force_table(robot, self.foot_force))
         if self.wrench is not None:
             cols.update({c: self.wrench[:, s, i] for s, sensor in enumerate(robot.ft_sensors)
                          for i, c in enumerate(sensor.columns())})
@@ -302,7 +311,8 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
     tau, torque_source = _read_torque(table, robot, source, first_row, time, q, setpoints)
     q = q - robot.offset_vector if robot.encoder_offset else q  # the model's angles (wbfriction.model.pd)
     wrench = _read_wrench(table, robot, source, first_row)
-    contact = _read_contact(table, robot, source, first_row, wrench)
+    foot_force = read_foot_forces(table, robot, source, first_row)
+    contact = _read_contact(table, robot, source, first_row, wrench, foot_force)
     base = _read_base(table, source, first_row)
     tau_f_true = _read_per_joint(table, "tau_f_true", robot, len(time), source, first_row)
     temperature = _read_per_joint(table, "temperature", robot, len(time), source, first_row)
@@ -321,10 +331,10 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
                qd_true=qd_true, qdd_true=qdd_true, segments=clock.segments, period=period, qd_logged=qd_logged,
                torque_source=torque_source, clock=clock, warnings=warnings, wrench=wrench,
                base_qd_true=base_qd_true, base_qdd_true=base_qdd_true, imu=imu, temperature=temperature,
-               setpoints=setpoints)
+               setpoints=setpoints, foot_force=foot_force)
 
 
-NUMERIC_PREFIXES = ("q", "tau", "current", "qd", "qd_true", "qdd_true", "tau_f_true", "base", "wrench",
+NUMERIC_PREFIXES = ("q", "tau", "current", "qd", "qd_true", "qdd_true", "tau_f_true", "base", "wrench", "force",
                     "base_qd_true", "base_qdd_true", "imu", "temperature") + PD_PREFIXES
 """Column prefixes whose values must be numbers."""
 
@@ -357,9 +367,10 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
         prefix, _, item = col.partition(".")
         known = {"q": act, "tau": act, "tau_f_true": tc, "temperature": tc, "contact": frames, "qd_true": act,
                  "qdd_true": act, "qd": act, "current": act, "wrench": wrenches,
-                 "imu": {c.partition(".")[2] for c in IMU_COLUMNS}, **pd_columns_named(robot)}.get(prefix)
+                 "imu": {c.partition(".")[2] for c in IMU_COLUMNS}, "force": foot_force_names(robot),
+                 **pd_columns_named(robot)}.get(prefix)
         if known is not None and item not in known:
-            what = {"contact": "contact frame", "wrench": "force-torque sensor (or axis)",
+            what = {"contact": "contact frame", "wrench": "force-torque sensor (or axis)", "force": "foot (or axis)",
                     "imu": "IMU axis"}.get(prefix, "joint")
             raise ColumnError(source, col, None,
                               f"column '{col}' names an unknown {what} '{item}' of robot '{robot.name}'")
@@ -483,25 +494,30 @@ def _read_torque(table: pa.Table, robot: Robot, source: str, first_row: int, tim
 
 def forces_give_contacts(robot: Robot, columns: set[str] | list[str]) -> bool:
     """Whether a log with these columns and no ``contact.*`` column has its contact flags from the
-    measured forces: every contact frame is sensed and every sensor's columns are there."""
-    return sensed_contacts(robot) and all(c in columns for s in robot.ft_sensors for c in s.columns())
+    measured forces: every contact frame is sensed and every sensor's columns are there, or every foot's normal
+    force is logged (:mod:`wbfriction.logs.foot_forces`)."""
+    feet = all(any(c in columns for c in foot_force_columns(f)) for f in robot.contact_frames)
+    return feet or sensed_contacts(robot) and all(c in columns for s in robot.ft_sensors for c in s.columns())
 
 
-def contact_flags_from_forces(robot: Robot, wrench: np.ndarray) -> np.ndarray:
-    """Contact flags (N, n_contacts) from the sensors' wrenches (N, n_sensors, 6): the soles' normal
-    forces through the robot's thresholds with hysteresis (:mod:`wbfriction.logs.contacts`)."""
+def contact_flags_from_forces(robot: Robot, wrench: np.ndarray | None, foot_force: np.ndarray | None = None
+                              ) -> np.ndarray:
+    """Contact flags (N, n_contacts) from the feet's normal forces, the sensors' wrenches' (N, n_sensors, 6) or
+    the foot forces' (N, n_contacts, 3), through the robot's thresholds with hysteresis (:mod:`.contacts`)."""
     on, off = default_thresholds(robot)
-    return hysteresis(normal_forces(robot, wrench), on, off)
+    normal = normal_forces(robot, wrench) if wrench is not None else foot_force[..., 2]  # type: ignore[index]
+    return hysteresis(normal, on, off)
 
 
 def _read_contact(table: pa.Table, robot: Robot, source: str, first_row: int,
-                  wrench: np.ndarray | None = None) -> np.ndarray:
+                  wrench: np.ndarray | None = None, foot_force: np.ndarray | None = None) -> np.ndarray:
     """The contact flags (N, n_contacts) as booleans, refusing values other than 0 and 1; on a fixed
     base, the weld: always in contact; without ``contact.*`` columns, from the measured forces."""
     if not robot.floating_base:
         return np.ones((table.num_rows, 1), dtype=bool)
-    if wrench is not None and not any(f"contact.{f}" in table.column_names for f in robot.contact_frames):
-        return contact_flags_from_forces(robot, wrench)
+    if not any(f"contact.{f}" in table.column_names for f in robot.contact_frames) and \
+            forces_give_contacts(robot, table.column_names):
+        return contact_flags_from_forces(robot, wrench, foot_force)
     contact_cols = []
     for f in robot.contact_frames:
         c = numeric_column(table, f"contact.{f}", source, first_row)

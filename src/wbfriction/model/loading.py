@@ -14,9 +14,9 @@ import tomllib
 from collections.abc import Collection, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import cast
 from importlib import resources
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import pinocchio as pin

@@ -32,6 +32,7 @@ import pyarrow as pa
 
 from wbfriction.exceptions import InputError
 from wbfriction.logs.clock import ROUGHNESS_ROWS, Clock, read_clock, table_stamps
+from wbfriction.logs.foot_forces import read_foot_forces
 from wbfriction.logs.log import check_schema, contact_flags_from_forces
 from wbfriction.logs.options import ReadOptions
 from wbfriction.logs.tables import RowReader, TableFile, numeric_column, numeric_columns
@@ -167,12 +168,17 @@ def plan_columns(file: TableFile, robot: Robot, source: str, read: ReadOptions =
     schema = file.schema()
     warnings = check_schema(schema, robot, source)
     from_forces = robot.floating_base and not any(f"contact.{f}" in schema.names for f in robot.contact_frames)
-    if from_forces:  # no contact column: the flags from the measured forces (check_schema made sure)
+    feet = from_forces and not robot.ft_sensors  # the feet's forces (wbfriction.logs.foot_forces)
+    if feet:
+        columns = ["time"] + [c for c in schema.names if c.startswith("force.")]
+    elif from_forces:  # no contact column: the flags from the measured forces (check_schema made sure)
         columns = ["time"] + [c for s in robot.ft_sensors for c in s.columns()]
     else:
         columns = ["time"] + ([f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else [])
     table = file.read(columns)
-    if from_forces:
+    if feet:
+        flags = contact_flags_from_forces(robot, None, read_foot_forces(table, robot, source))
+    elif from_forces:
         wrench = numeric_columns(table, columns[1:], source)
         flags = contact_flags_from_forces(robot, wrench.reshape(len(wrench), -1, 6))
     else:

@@ -230,6 +230,8 @@ class MeasuredKinematics:
             the torques, or None.
         imu: with ``measure(..., imu=True)``, the IMU's angular velocity, its time derivative and its
             specific force (N, 9) [rad/s, rad/s^2, m/s^2] in its frame, through the joints' scheme; or None.
+        foot_force: the feet's measured forces (N, n_contacts, 3) [N], world axes, NaN where not measured
+            (:mod:`wbfriction.logs.foot_forces`), aligned and filtered as the torques, or None.
     """
 
     time: np.ndarray
@@ -247,6 +249,7 @@ class MeasuredKinematics:
     base_qdd: np.ndarray | None = None
     wrench: np.ndarray | None = None
     imu: np.ndarray | None = None
+    foot_force: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.valid is None:
@@ -330,8 +333,10 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
     # as more columns: positions [joints, base pose, gyro integral], torques [joints, wrenches, acc]
     extra_q = ([continuous_quaternions(log.base)] if base_motion and log.base is not None else []) + \
         ([_running_integral(log.imu[:, :3], _times(log))] if imu and log.imu is not None else [])
+    feet = None if log.foot_force is None else np.isfinite(log.foot_force[:1]).reshape(-1)  # measured components
     extra_tau = ([log.wrench.reshape(n, -1)] if log.wrench is not None else []) + \
-        ([log.imu[:, 3:]] if imu and log.imu is not None else [])
+        ([log.imu[:, 3:]] if imu and log.imu is not None else []) + \
+        ([log.foot_force.reshape(n, -1)[:, feet]] if log.foot_force is not None and feet is not None else [])
     extended = replace(log, q=np.hstack([log.q, *extra_q]), tau=np.hstack([log.tau, *extra_tau]))
     q, qd, qdd, tau, smoother, metadata = _derivatives(extended, diff, compensate_delay, torque_alignment, filtering)
     base_qd = base_qdd = imu_rates = None
@@ -343,13 +348,18 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
     if imu:
         g = slice(q.shape[1] - 3, q.shape[1])
         imu_rates = np.hstack([qd[:, g], qdd[:, g], tau[:, n_tc + n_w:n_tc + n_w + 3]])
+    foot_force = None
+    if feet is not None:
+        foot_force = np.full((n, feet.size), np.nan)
+        foot_force[:, feet] = tau[:, tau.shape[1] - int(feet.sum()):]
+        foot_force = foot_force.reshape(n, -1, 3)
     q, qd, qdd, tau = q[:, :n_act], qd[:, :n_act], qdd[:, :n_act], tau[:, :n_tc]
     if velocity == "logged":
         qd = logged_velocity(log, qd, metadata)
     return MeasuredKinematics(
         time=log.time, q=q, qd=qd, qdd=qdd, tau=tau, contact=log.contact, base=log.base,
         tau_f_true=log.tau_f_true, metadata=metadata, smoother=smoother, base_qd=base_qd, base_qdd=base_qdd,
-        wrench=wrench, imu=imu_rates)
+        wrench=wrench, imu=imu_rates, foot_force=foot_force)
 
 
 def _check_inputs(log: Log, velocity: Velocity, base_motion: bool, imu: bool) -> None:
@@ -386,7 +396,7 @@ def true_kinematics(log: Log, base_motion: bool = False, imu: bool = False) -> M
         time=log.time, q=log.q, qd=log.qd_true, qdd=log.qdd_true, tau=log.tau, contact=log.contact,
         base=log.base, tau_f_true=log.tau_f_true, metadata=dict(log.metadata), wrench=log.wrench,
         base_qd=log.base_qd_true if base_motion else None, base_qdd=log.base_qdd_true if base_motion else None,
-        imu=imu_rates)
+        imu=imu_rates, foot_force=log.foot_force)
 
 
 def logged_velocity(log: Log, qd: np.ndarray, metadata: dict) -> np.ndarray:

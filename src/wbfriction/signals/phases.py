@@ -131,3 +131,25 @@ def joint_mask(phases: Phases, limb_mask: np.ndarray, mask: Mask = "swing") -> n
         on_stance_limb[single] = limb_mask[phases.stance[single]]
         valid &= ~on_stance_limb
     return valid
+
+
+def settled(time: np.ndarray, contact: np.ndarray, lift_off_skip: float = 0.10, touch_down_skip: float = 0.05
+            ) -> np.ndarray:
+    """(N,) the samples away from every contact change, for robots whose friction is determined in any phase (point
+    feet, :mod:`wbfriction.model.determination`): the thesis's margins (6.2.1) around each foot's switches, the
+    ``lift_off_skip`` seconds after a flag falls and the ``touch_down_skip`` seconds before and after one rises
+    (the landing's impact, which differentiation smears on both sides).
+
+    Args:
+        time: (N,) [s]; contact: (N, n_contacts) flags.
+    """
+    keep = np.ones(len(time), dtype=bool)
+    for c in range(contact.shape[1]):
+        on = contact[:, c].astype(bool)
+        for k in np.flatnonzero(on[1:] != on[:-1]) + 1:
+            t = time[k]
+            if on[k]:  # touch-down at row k
+                keep &= ~((time >= t - touch_down_skip - 1e-9) & (time < t + touch_down_skip - 1e-9))
+            else:  # lift-off at row k
+                keep &= ~((time >= t - 1e-9) & (time < t + lift_off_skip - 1e-9))
+    return keep
