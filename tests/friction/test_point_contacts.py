@@ -10,9 +10,12 @@ import pytest
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import estimate_log
+from wbfriction.friction.io import friction_table, read_friction_file
 from wbfriction.friction.options import EstimateOptions
+from wbfriction.friction.point_contacts import determined_shares
 from wbfriction.logs.log import Log, write_log
 from wbfriction.logs.source import read_log
+from wbfriction.logs.tables import write_table
 from wbfriction.model.determination import contact_jacobian
 from wbfriction.model.loading import load_robot
 
@@ -89,11 +92,12 @@ def test_exact_where_determined(go2):
         down = {f for f, on in zip(frames, est.contact[k]) if on}
         assert len(down) == 2
         assert (est.valid[k] == ~np.isin(legs, list(down))).all()
-    shares = est.metadata["determination"]
+    shares = determined_shares(est).to_dict()
     by_pattern = {p["pattern"]: p for p in shares["patterns"]}
     assert by_pattern["FL_foot+RR_foot"]["share"]["FR_hip_joint"] == 1.0
     assert by_pattern["FL_foot+RR_foot"]["share"]["FL_hip_joint"] == 0.0
-    assert by_pattern["FL_foot+FR_foot+RL_foot+RR_foot"]["share"]["FL_hip_joint"] == 0.0
+    assert set(by_pattern["FL_foot+FR_foot+RL_foot+RR_foot"]["share"].values()) == {0.0}  # standing: none
+    assert sum(p["samples"] for p in shares["patterns"]) == np.isfinite(est.cond).sum()
 
 
 def test_foot_forces_determine_every_joint(go2, tmp_path):
@@ -106,6 +110,10 @@ def test_foot_forces_determine_every_joint(go2, tmp_path):
     write_log(log, go2, path)
     again = estimate_log(go2, read_log(path, go2), TRUE)
     assert np.array_equal(again.valid, est.valid)
+    table = tmp_path / "friction.parquet"
+    write_table(friction_table(est), table)
+    back = read_friction_file(table)
+    assert np.array_equal(back.determined, est.determined) and np.array_equal(back.cond, est.cond, equal_nan=True)
     assert np.allclose(again.tau_f[est.valid], est.tau_f[est.valid], rtol=0, atol=1e-12)
 
 

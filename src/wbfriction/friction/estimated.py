@@ -53,6 +53,9 @@ class FrictionEstimate:
         tau: the joints' measured torques (N, n_tc) [N·m], or None: the load their transmissions carry (the
             friction beyond the sensor is not in it), what load-dependent friction is a function of.
         temperature: the joints' logged temperatures (N, n_tc) [°C], NaN for a joint without, or None: none logged.
+        determined: (N, n_tc) the joint's friction is determined by the sample's equations (point feet: the rank
+            decision of :mod:`wbfriction.model.determination`; False where the dynamics were not evaluated, those rows
+            with ``cond`` NaN), or None (the thesis's phases decide).
         route_check: the same samples estimated by the other route (issue 38: the momentum route's for the
             acceleration route's, and the other way round; its ``tau_f``, ``qd``, ``valid`` and ``smoother``),
             whose fit :func:`~wbfriction.fit.joints.fit_estimate` compares with this one's; or None.
@@ -80,6 +83,7 @@ class FrictionEstimate:
     q: np.ndarray | None = None
     tau: np.ndarray | None = None
     temperature: np.ndarray | None = None
+    determined: np.ndarray | None = None
     route_check: FrictionEstimate | None = field(default=None, repr=False)
 
     def keeping(self, rows: np.ndarray) -> FrictionEstimate:

@@ -41,6 +41,7 @@ def friction_table(est: FrictionEstimate) -> pa.Table:
     """The estimate as an Arrow table: ``time``, ``phase``, ``unique``, [``route``], [``cond``],
     ``contact.<frame>``, and per joint ``qd.<j>``, ``tau_f.<j>``, ``valid.<j>``,
     ``qdd.<j>``, ``delta_qdd.<j>``, [``delta_qdd_companion.<j>``], [``disagreement.<j>``], [``tau_f_true.<j>``],
+    [``determined.<j>``] (point feet),
     the terms' signals [``q.<j>``, ``tau.<j>``, ``temperature.<j>``] (:mod:`~wbfriction.fit.terms`),
     [the other route's ``check.qd.<j>``, ``check.tau_f.<j>``, ``check.valid.<j>`` (:data:`CHECK`)];
     the companion's scheme is the metadata key ``companion_diff``, the other route's metadata ``route_check``."""
@@ -58,7 +59,7 @@ def friction_table(est: FrictionEstimate) -> pa.Table:
         cols[f"valid.{j}"] = est.valid[:, i]
         for name, arr in (("qdd", est.qdd), ("delta_qdd", est.delta_qdd),
                           ("delta_qdd_companion", est.companion_delta_qdd), ("disagreement", est.disagreement),
-                          ("q", est.q), ("tau", est.tau)):
+                          ("q", est.q), ("tau", est.tau), ("determined", est.determined)):
             if arr is not None:
                 cols[f"{name}.{j}"] = arr[:, i]
         if est.temperature is not None and not np.all(np.isnan(est.temperature[:, i])):
@@ -217,7 +218,13 @@ def read_friction_table(table: pa.Table, source: str = "<table>") -> FrictionEst
         companion_diff=companion_diff, route=route,
         disagreement=_optional_columns(table, "disagreement", joints, source),
         q=_optional_columns(table, "q", joints, source), tau=_optional_columns(table, "tau", joints, source),
-        temperature=_temperature(table, joints, source))
+        temperature=_temperature(table, joints, source), determined=_determined(table, joints, source))
+
+
+def _determined(table: pa.Table, joints, source: str) -> np.ndarray | None:
+    """The ``determined.<joint>`` columns (N, n) (point feet, :mod:`wbfriction.friction.point_contacts`), or None."""
+    flags = _optional_columns(table, "determined", joints, source)
+    return None if flags is None else flags == 1
 
 
 def _temperature(table: pa.Table, joints, source: str) -> np.ndarray | None:

@@ -16,7 +16,7 @@ Sign convention: ``tau_f = tau_joint - tau``, the torque friction exerts on the 
 
 from __future__ import annotations
 
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -73,8 +73,8 @@ def point_contact_estimate(robot: Robot, kin: MeasuredKinematics, options: Estim
     The estimate's ``valid`` is (N, n_tc): determined, the derivatives defined, outside the switches' margins;
     ``unique`` (N,) a sample that determines some joint; ``cond`` the conditioning of the contact forces
     (:class:`~wbfriction.model.determination.Determination`); ``route`` ``"base"``.
-    The determination of every sample is kept in the metadata's ``determination``: the share of samples that
-    determine each joint, by contact pattern (:func:`determined_shares`).
+    ``determined`` is the rank decision of every evaluated sample (:func:`determined_shares` counts it by contact
+    pattern).
 
     Raises:
         InputError: what :func:`contacts_route` raises; with ``require_determined``, no sample determining a joint.
@@ -91,40 +91,58 @@ def point_contact_estimate(robot: Robot, kin: MeasuredKinematics, options: Estim
     metadata = dict(kin.metadata)
     metadata["estimate_options"] = asdict(options)
     metadata["joint_labels"] = {j: robot.label(j) for j in robot.torque_controlled}
-    metadata["determination"] = determined_shares(robot, kin.contact, det.determined[:, tc] & usable[:, None],
-                                                  usable)
     return FrictionEstimate(
         joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
         phase=segment(kin.time, kin.contact).labels(), unique=valid.any(axis=1), contact=kin.contact,
         contact_frames=robot.contact_frames, qdd=kin.qdd[:, tc], delta_qdd=np.full_like(tau_f, np.nan),
         cond=det.cond, tau_f_true=kin.tau_f_true, metadata=metadata, smoother=kin.smoother,
-        route=np.where(valid.any(axis=1), "base", "none").astype("<U7"))
+        route=np.where(valid.any(axis=1), "base", "none").astype("<U7"), determined=det.determined[:, tc])
 
 
-def contact_pattern(robot: Robot, flags: np.ndarray) -> str:
+def contact_pattern(frames: tuple[str, ...], flags: np.ndarray) -> str:
     """A contact pattern's name: the frames on the ground joined by ``+`` (``"FL_foot+RR_foot"``), ``"flight"``."""
-    down = [f for f, on in zip(robot.contact_frames, flags) if on]
+    down = [f for f, on in zip(frames, flags) if on]
     return "+".join(down) if down else "flight"
 
 
-def determined_shares(robot: Robot, contact: np.ndarray, determined: np.ndarray, usable: np.ndarray) -> dict:
-    """The share of samples that determine each torque-controlled joint, by contact pattern (issue 56's table).
+@dataclass(frozen=True)
+class DeterminedShares:
+    """The share of samples that determine each joint's friction, by contact pattern (issue 56's table).
 
-    Args:
-        contact: (N, n_contacts) flags; determined: (N, n_tc); usable: (N,) the samples counted (derivatives
-            defined, outside the margins).
-
-    Returns:
-        ``{"patterns": [{"pattern": name, "samples": int, "share": {joint: fraction}}, ...], "all": {joint:
-        fraction}}``: each pattern's samples among the usable ones, most frequent first; ``all`` over every usable
-        sample.
+    Attributes:
+        joints: the torque-controlled joints (n_tc,).
+        patterns: the contact patterns (:func:`contact_pattern`), most frequent first (n_p,).
+        samples: (n_p,) the samples of each pattern whose dynamics were evaluated (derivatives defined, outside the
+            switches' margins).
+        share: (n_p, n_tc) the fraction of them that determine the joint.
+        overall: (n_tc,) the fraction over every evaluated sample.
     """
-    patterns, of = np.unique(contact[usable].astype(bool), axis=0, return_inverse=True)
-    det = determined[usable]
-    joints = robot.torque_controlled
-    counted = [(int((of.ravel() == p).sum()), contact_pattern(robot, flags), of.ravel() == p)
-               for p, flags in enumerate(patterns)]
-    rows = [{"pattern": name, "samples": count, "share": {j: float(det[mine, i].mean()) for i, j in enumerate(joints)}}
-            for count, name, mine in sorted(counted, key=lambda c: (-c[0], c[1]))]
-    total = max(int(usable.sum()), 1)
-    return {"patterns": rows, "all": {j: float(det[:, i].sum() / total) for i, j in enumerate(joints)}}
+
+    joints: tuple[str, ...]
+    patterns: tuple[str, ...]
+    samples: np.ndarray
+    share: np.ndarray
+    overall: np.ndarray
+
+    def to_dict(self) -> dict:
+        """As JSON: ``{"patterns": [{"pattern", "samples", "share": {joint: fraction}}], "all": {joint: fraction}}``."""
+        return {"patterns": [{"pattern": p, "samples": int(n), "share": dict(zip(self.joints, map(float, row)))}
+                             for p, n, row in zip(self.patterns, self.samples, self.share)],
+                "all": dict(zip(self.joints, map(float, self.overall)))}
+
+
+def determined_shares(est: FrictionEstimate) -> DeterminedShares | None:
+    """:class:`DeterminedShares` of an estimate of a robot on point feet (its ``determined`` flags, the samples
+    counted those with a finite ``cond``); None for an estimate without them (the thesis's phases decided)."""
+    if est.determined is None or est.cond is None:
+        return None
+    counted = np.isfinite(est.cond)
+    patterns, of = np.unique(est.contact[counted].astype(bool), axis=0, return_inverse=True)
+    of = of.ravel()
+    det = est.determined[counted]
+    samples = np.bincount(of, minlength=len(patterns))
+    order = sorted(range(len(patterns)), key=lambda p: (-samples[p], contact_pattern(est.contact_frames, patterns[p])))
+    share = np.array([det[of == p].mean(axis=0) for p in order]).reshape(len(order), len(est.joints))
+    overall = det.mean(axis=0) if len(det) else np.zeros(len(est.joints))
+    return DeterminedShares(est.joints, tuple(contact_pattern(est.contact_frames, patterns[p]) for p in order),
+                            samples[order], share, overall)
