@@ -95,8 +95,22 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     if routes and r.floating_base:  # decided on the first chunk; a fixed base has none
         console.print(f"base motion: {routes['base']}" + ("; wrenches: every joint in every phase"
                                                           if routes["wrenches"] else ""), highlight=False)
-        _print_cross_check(output)
+        if r.point_contacts:
+            _print_determination(output, r)
+        else:
+            _print_cross_check(output)
     console.print(f"wrote {output}: {result.rows} samples")
+
+
+def _print_determination(friction: Path, robot: Robot) -> None:
+    """The share of samples that determine each joint's friction, by contact pattern (a robot on point feet)."""
+    from wbfriction.friction.io import read_friction_file
+    from wbfriction.friction.point_contacts import determined_shares
+    from wbfriction.report.terminal import determination_table
+
+    shares = determined_shares(read_friction_file(friction))
+    if shares is not None:
+        console.print(determination_table(shares, robot.labels))
 
 
 def _print_cross_check(friction: Path) -> None:

@@ -93,10 +93,14 @@ def decide_log(robot: Robot, options: EstimateOptions, positions: np.ndarray | N
             stretches too short for any scheme (:func:`check_windows`).
     """
     given = options
-    if robot.point_contacts and options.route == "auto":  # the momentum route has no point feet (yet)
+    point_feet = robot.point_contacts and options.route == "auto"  # the momentum route has no point feet (yet)
+    if point_feet:
         options = replace(options, route="acceleration")
     options, choice = resolve_differentiation(options, positions, dt)
     options, route = resolve_route(options, positions, dt, choice, rows=route_rows)
+    if point_feet and route is not None:
+        route = replace(route, reason="acceleration: the robot's point feet (the momentum route does not take them "
+                                      "yet)")
     check_windows(given, options, segments, rows, dt, source)
     if positions is None:
         return LogDecision(options, choice, route, None)

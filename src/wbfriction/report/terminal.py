@@ -23,6 +23,7 @@ from wbfriction.fit.energy import JointEnergy
 from wbfriction.fit.result import FitResult
 from wbfriction.fit.terms import NOT_TRIED, TERM_COEFFICIENTS, TermFit
 from wbfriction.friction.models import ALL_PARAM_NAMES
+from wbfriction.friction.point_contacts import DeterminedShares
 from wbfriction.inertia.document import Identification
 from wbfriction.report.numbers import bound_text, with_error
 
@@ -312,3 +313,31 @@ def identification_tables(result: Identification, wide: bool = False) -> tuple[l
         rms.add_row(joint, f"{h.given:.4f}", f"{h.given_with_friction:.4f}", f"{h.identified:.4f}",
                     "—" if h.validated is None else f"{h.validated:.4f}")
     return [t for t in (bodies, friction, rms) if t.row_count], notes
+
+
+def determination_table(shares: DeterminedShares, labels: Mapping[str, str] | None = None) -> Table:
+    """The share of samples that determine each joint's friction, by contact pattern (issue 56): one row per joint,
+    one column per pattern (its feet, the contact frames' common suffix left out, and its samples), the most frequent
+    first, then every sample's; a pattern's share is of its samples whose dynamics were evaluated
+    (:func:`~wbfriction.friction.point_contacts.determined_shares`)."""
+    label = _labeller(labels)
+    suffix = _common_suffix([f for p in shares.patterns if p != "flight" for f in p.split("+")])
+    table = _table("determined: share of samples, by feet on the ground", ["joint"], [], caption=(
+        "a joint is determined where the equations of motion leave its friction unique (the rank of [S^T J^T], "
+        "foot forces counted where logged); samples within the switches' margins are not counted"))
+    for pattern, n in zip(shares.patterns, shares.samples):
+        name = "+".join(f.removesuffix(suffix) for f in pattern.split("+")) if pattern != "flight" else pattern
+        table.add_column(f"{name}\n({n})", justify="right", no_wrap=True)
+    table.add_column(f"all\n({int(shares.samples.sum())})", justify="right", no_wrap=True)
+    for i, joint in enumerate(shares.joints):
+        table.add_row(label(joint), *(f"{100 * s:.0f} %" for s in shares.share[:, i]),
+                      f"{100 * shares.overall[i]:.0f} %")
+    return table
+
+
+def _common_suffix(names: Sequence[str]) -> str:
+    """The longest suffix every name has, from its last ``_`` (``"_foot"``), or ""."""
+    if not names:
+        return ""
+    tail = names[0][names[0].rfind("_"):] if "_" in names[0] else ""
+    return tail if tail and all(n.endswith(tail) and n != tail for n in names) else ""
