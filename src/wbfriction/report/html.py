@@ -20,6 +20,7 @@ from wbfriction.fit.result import FitResult
 from wbfriction.fit.status import MIN_SPEED, FitVerdict
 from wbfriction.friction.cross_check import LARGE, MIN_SAMPLES, cross_check
 from wbfriction.friction.models import ALL_PARAM_NAMES, ModelParams
+from wbfriction.friction.point_contacts import determined_shares
 from wbfriction.inertia.document import Identification
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
@@ -235,6 +236,23 @@ def _routes_section(r: Report) -> str:
             f'<th>mean [N·m]</th><th>share of τ_f [%]</th><th class="text">likely cause</th></tr>{rows}</table></div>')
 
 
+def _determination_section(r: Report) -> str:
+    """A robot on point feet: the share of samples that determine each joint's friction, by feet on the ground
+    (:func:`~wbfriction.friction.point_contacts.determined_shares`); "" otherwise."""
+    shares = determined_shares(r.est)
+    if shares is None:
+        return ""
+    head = "".join(f"<th>{html.escape(p)} ({n})</th>" for p, n in zip(shares.patterns, shares.samples))
+    rows = "".join(f"<tr>{_joint_cell(r, j)}" + "".join(f"<td>{100 * s:.0f}</td>" for s in shares.share[:, i])
+                   + f"<td>{100 * shares.overall[i]:.0f}</td></tr>" for i, j in enumerate(shares.joints))
+    return ('<h2 id="determined">Where each joint\'s friction is determined</h2>'
+            '<p class="sub">Share of samples [%], by the feet on the ground: a joint is determined where the '
+            "equations of motion leave its friction unique (the rank of [Sᵀ Jᵀ], the logged foot forces counted), "
+            "never guessed elsewhere. Samples within the switches' margins are not counted.</p>"
+            f'<div class="scroll"><table id="determined"><tr><th>joint</th>{head}<th>all ({int(shares.samples.sum())})'
+            f"</th></tr>{rows}</table></div>")
+
+
 def _summary_box(r: Report) -> str:
     """The box atop the report: the joints whose friction generates power, or the worst one's share."""
     flagged = r.flagged
@@ -382,6 +400,8 @@ def _contents(r: Report) -> str:
         items.append(("terms-section", "Terms beyond velocity"))
     if _routes_section(r):
         items.append(("routes", "Routes cross-checked"))
+    if _determination_section(r):
+        items.append(("determined", "Where each joint's friction is determined"))
     if r.identification is not None:
         items.append(("identification", "Inertia model identified"))
     items += [("joints", f"Joints that moved ({len(r.moved)})"), ("provenance-section", "Provenance")]
@@ -397,6 +417,8 @@ def _page(r: Report, overview: str, sections: list[str]) -> str:
     nav = "".join(f'<a href="#{_anchor(j)}">{html.escape(r.label(j))}</a>' for j in moved)
     n_valid = int(est.valid.any(axis=1).sum())
     support = f"{int(est.unique.sum())} in single support, " if est.contact_frames else "fixed base, "
+    if est.determined is not None:
+        support = f"{int(est.determined.any(axis=1).sum())} determining some joint, "
     still = ""
     if r.still:
         still = (f'<details class="still"><summary>{len(r.still)} joints did not move: no figure</summary>'
@@ -426,6 +448,7 @@ share of the valid samples where the friction estimate generates power (eq. 7.9)
 <p class="sub">{_ENERGY_NOTE}</p>
 {_energy_table(r, moved)}
 {_routes_section(r)}
+{_determination_section(r)}
 {"" if r.identification is None else _identification_section(r, r.identification)}
 <h2 id="joints">Joints that moved</h2>
 <nav class="joints">{nav}</nav>
