@@ -9,8 +9,8 @@ configuration:
 * ``step``: a trot in place, diagonal pairs alternating (front left with rear right);
 * ``trot``: the same, moving forward at ``speed``;
 * ``walk``: a crawl, one leg swinging at a time (rear left, front left, rear right, front right), three feet down
-  (four between swings), the base shifted sideways away from the swinging side so that its centre stays over the
-  triangle of the stance feet.
+  (four between swings), the base swaying sideways away from the swinging side so that the zero-moment point stays
+  inside the triangle of the stance feet (crossing the middle while four feet are down).
 
 The gaits start with every foot down for half a period, the forward speed ramping up (minimum jerk) over the first
 period of swings. A swing runs from the foot's last footprint to the next (under its hip at the middle of the
@@ -116,6 +116,7 @@ class QuadrupedReference:
         base_v: the base's twist (N, 6), Pinocchio's free-flyer velocity ``v[:6]`` (linear, angular; base frame)
             [m/s, rad/s].
         base_a: its derivative (N, 6), the free-flyer's ``a[:6]`` [m/s^2, rad/s^2].
+        feet_v, feet_a: the feet's planned velocities [m/s] and accelerations [m/s^2] (N, 4, 3), world.
     """
 
     options: GaitOptions
@@ -128,6 +129,8 @@ class QuadrupedReference:
     qdd: np.ndarray
     base_v: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
     base_a: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+    feet_v: np.ndarray = field(default_factory=lambda: np.zeros((0, 4, 3)))
+    feet_a: np.ndarray = field(default_factory=lambda: np.zeros((0, 4, 3)))
 
     def __len__(self) -> int:
         return len(self.time)
@@ -231,8 +234,10 @@ def _swings(options: GaitOptions, corners: list[tuple[str, str]], rng: np.random
     T, start = options.period, 0.5 * options.period
     if options.gait == "walk":
         groups = [[corners.index(c)] for c in _CRAWL]
-        length = 0.7 * T / 4  # a moment on four feet between swings
-        offsets = [(i + 0.15) * T / 4 for i in range(4)]
+        # four feet down for T/12 where the base crosses from one side to the other, T/60 between the two swings
+        # of a side
+        length, gap, cross = 0.2 * T, T / 60, T / 12
+        offsets = [0.5 * cross, 0.5 * cross + length + gap, 0.5 * (T + cross), 0.5 * (T + cross) + length + gap]
     else:  # diagonal pairs: front left with rear right, then front right with rear left
         groups = [[corners.index(("front", "left")), corners.index(("rear", "right"))],
                   [corners.index(("front", "right")), corners.index(("rear", "left"))]]
@@ -250,8 +255,6 @@ def _swings(options: GaitOptions, corners: list[tuple[str, str]], rng: np.random
                 out.append(_Swing(leg, t0, t0 + length, options.step_height * rng.uniform(0.6, 1.4),
                                   rng.uniform(-0.02, 0.03)))
         cycle += 1
-
-
 
 
 def _base_motion(t: np.ndarray, options: GaitOptions, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -275,15 +278,12 @@ def _base_motion(t: np.ndarray, options: GaitOptions, rng: np.random.Generator) 
     return pos, rp
 
 
-def _crawl_shift(t: np.ndarray, T: float, amplitude: float = 0.05) -> np.ndarray:
-    """The crawl's sideways shift of the base (3, N) [m] (value, rate, its rate): right while the left legs swing
-    (the first half of each cycle), left while the right ones do, a rounded square wave
-    ``-A (sin th + sin 3 th / 4)`` a little behind the swings (the front leg's swing ends on the narrower side of
-    the stance triangle), faded in over the first half period."""
-    start = 0.5 * T + 0.03 * T
-    out = np.zeros((3, len(t)))
-    for a, k in ((amplitude, 1), (0.25 * amplitude, 3)):
-        out += np.array(_wave(t, -a, k / T, k / T, -2 * np.pi * k * start / T, 1.0))
+def _crawl_shift(t: np.ndarray, T: float, amplitude: float = 0.06) -> np.ndarray:
+    """The crawl's sideways shift of the base (3, N) [m] (value, rate, its rate): ``-A sin(2 pi (t - T/2) / T)``,
+    right while the left legs swing (the first half of each cycle), left while the right ones do, crossing the middle
+    while four feet are down; faded in over the first half period. A sine: its zero-moment point moves with it,
+    ``1 + (2 pi / T)^2 z / g`` times as far (a higher harmonic's would move against it)."""
+    out = np.array(_wave(t, -amplitude, 1 / T, 1 / T, -np.pi, 1.0))
     fade = np.array(_min_jerk((t - 0.1 * T) / (0.4 * T)))
     fade[1:] /= np.array([[0.4 * T], [(0.4 * T) ** 2]])
     return np.array([out[0] * fade[0], out[1] * fade[0] + out[0] * fade[1],
@@ -364,7 +364,8 @@ def quadruped_reference(robot: Robot, options: GaitOptions = GaitOptions()) -> Q
     base_a[:, :3] = np.einsum("nji,nj->ni", R, pos[2]) - np.cross(base_v[:, 3:], base_v[:, :3])
     base_a[:, 3:] = np.einsum("nji,nj->ni", R, domega)
     q, qd, qdd = _leg_ik(robot, base, base_v, base_a, feet)
-    return QuadrupedReference(options, t, contact, base, feet[0].copy(), q, qd, qdd, base_v, base_a)
+    return QuadrupedReference(options, t, contact, base, feet[0].copy(), q, qd, qdd, base_v, base_a, feet[1].copy(),
+                              feet[2].copy())
 
 
 def _leg_ik(robot: Robot, base: np.ndarray, base_v: np.ndarray, base_a: np.ndarray, feet: np.ndarray,

@@ -1,0 +1,119 @@
+"""The walking quadruped's balance controller: whole-body inverse dynamics with point feet, at the log rate.
+
+Two point feet exert no moment about the line between them: in a trot's stance the robot's rotation about that
+diagonal is not actuated (its angular momentum about the line changes by gravity alone), and a feed-forward of the
+reference's inverse dynamics plus joint PD lets it tip, more at each step. The controller instead chooses, at each
+sample, the accelerations ``a`` (nv) and the stance feet's forces ``lambda`` (3 per foot, world axes) that the
+dynamics allow and that come closest to its tasks, then the torques that produce them:
+
+.. math::
+
+    \\min_{a, \\lambda} \\; \\|a_{base} - a_{base}^*\\|^2 + \\sum_{swing} \\|J_c a + \\dot J_c v - \\ddot p_c^*\\|^2
+    + w_q \\|a_{joints} - \\ddot q^*\\|^2 + w_\\lambda \\|\\lambda\\|^2
+    \\quad \\text{s.t.} \\quad M_{base} a + h_{base} = J_{s,base}^T \\lambda, \\quad J_s a + \\dot J_s v = 0
+
+with ``tau = M_joints a + h_joints - J_{s,joints}^T lambda``. The tasks are PD laws on the reference
+(:class:`~wbfriction.walking.quadruped.QuadrupedReference`): the base's pose (world position and orientation,
+Pinocchio's free-flyer acceleration in the base frame), the swing feet's world positions (a swing foot lands on its
+footprint wherever the base is), the joint angles (a light posture task). The first constraint is the whole body's
+Newton-Euler equation (the base's six rows of the equation of motion), the second keeps the stance feet still.
+Solved as one equality-constrained least-squares problem (its KKT system, about 50 unknowns).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from wbfriction.model.robot import Robot
+from wbfriction.walking.quadruped import QuadrupedReference
+
+LWA = pin.LOCAL_WORLD_ALIGNED
+
+
+@dataclass(frozen=True)
+class BalanceGains:
+    """The controller's PD gains ``(Kp [1/s^2], Kd [1/s])`` per task and its weights (module docstring).
+
+    Attributes:
+        base: the base's position and orientation.
+        feet: the swing feet's positions.
+        joints: the joint angles (the posture task).
+        joint_weight: ``w_q``, the posture task's weight against the base's and the feet's (1).
+        force_weight: ``w_lambda`` [1/N^2 in the tasks' units]: the least forces among those that do the same.
+    """
+
+    base: tuple[float, float] = (100.0, 20.0)
+    feet: tuple[float, float] = (400.0, 40.0)
+    joints: tuple[float, float] = (100.0, 20.0)
+    joint_weight: float = 1e-2
+    force_weight: float = 1e-6
+
+
+class BalanceController:
+    """The controller of one run (module docstring) on ``model`` (the robot's, or a copy with another armature)."""
+
+    def __init__(self, robot: Robot, model: pin.Model, reference: QuadrupedReference,
+                 gains: BalanceGains = BalanceGains()) -> None:
+        self.robot, self.model, self.ref, self.gains = robot, model, reference, gains
+        self.data = model.createData()
+        self.iv, self.iq = robot.act_v_index, robot.act_q_index
+        # the reference base's world velocity and acceleration (linear, angular)
+        R = np.array([pin.Quaternion(np.asarray(b[3:])).toRotationMatrix() for b in reference.base])
+        v, a = reference.base_v, reference.base_a
+        self.R_ref = R
+        self.pd_ref = np.einsum("nij,nj->ni", R, v[:, :3])
+        self.pdd_ref = np.einsum("nij,nj->ni", R, a[:, :3] + np.cross(v[:, 3:], v[:, :3]))
+        self.w_ref = np.einsum("nij,nj->ni", R, v[:, 3:])
+        self.wd_ref = np.einsum("nij,nj->ni", R, a[:, 3:])
+
+    def base_task(self, k: int, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The base's desired free-flyer acceleration (6,) (base frame, Pinocchio's ``a[:6]``)."""
+        kp, kd = self.gains.base
+        R = pin.Quaternion(q[3:7]).toRotationMatrix()
+        vl, wl = v[:3], v[3:6]
+        lin = self.pdd_ref[k] + kp * (self.ref.base[k, :3] - q[:3]) + kd * (self.pd_ref[k] - R @ vl)
+        ang = self.wd_ref[k] + kp * pin.log3(self.R_ref[k] @ R.T) + kd * (self.w_ref[k] - R @ wl)
+        return np.concatenate([R.T @ lin - np.cross(wl, vl), R.T @ ang])
+
+    def torque(self, k: int, q: np.ndarray, v: np.ndarray, active: np.ndarray) -> np.ndarray:
+        """The joint torques (n_act,) [N·m] at sample ``k`` from the state ``q``, ``v``, the feet ``active`` (indices
+        into the contact frames) standing (module docstring)."""
+        model, data, g, ref = self.model, self.data, self.gains, self.ref
+        nv, n_lam = model.nv, 3 * len(active)
+        M = pin.crba(model, data, q)
+        M = np.triu(M) + np.triu(M, 1).T
+        h = pin.nle(model, data, q, v)
+        pin.computeJointJacobians(model, data, q)
+        pin.forwardKinematics(model, data, q, v, np.zeros(nv))
+        pin.updateFramePlacements(model, data)
+        J, drift, p = [], [], []
+        for f in self.robot.contact_frame_ids:
+            J.append(pin.getFrameJacobian(model, data, f, LWA)[:3])
+            drift.append(pin.getFrameClassicalAcceleration(model, data, f, LWA).linear)
+            p.append(data.oMf[f].translation.copy())
+        rows: list[tuple[np.ndarray, np.ndarray, float]] = []  # (A over x = [a, lambda], b, weight)
+        pad = lambda A: np.hstack([A, np.zeros((A.shape[0], n_lam))])  # noqa: E731
+        rows.append((pad(np.eye(6, nv)), self.base_task(k, q, v), 1.0))
+        kp, kd = g.feet
+        for c in range(len(J)):
+            if c not in active:
+                want = ref.feet_a[k, c] + kp * (ref.feet[k, c] - p[c]) + kd * (ref.feet_v[k, c] - J[c] @ v)
+                rows.append((pad(J[c]), want - drift[c], 1.0))
+        kp, kd = g.joints
+        want = ref.qdd[k] + kp * (ref.q[k] - q[self.iq]) + kd * (ref.qd[k] - v[self.iv])
+        rows.append((pad(np.eye(nv)[self.iv]), want, g.joint_weight))
+        if n_lam:
+            rows.append((np.hstack([np.zeros((n_lam, nv)), np.eye(n_lam)]), np.zeros(n_lam), g.force_weight))
+        Js = np.vstack([J[c] for c in active]) if n_lam else np.zeros((0, nv))
+        C = np.vstack([np.hstack([M[:6], -Js[:, :6].T]), np.hstack([Js, np.zeros((n_lam, n_lam))])])
+        d = np.concatenate([-h[:6]] + [-drift[c] for c in active])
+        H = sum(w * A.T @ A for A, _, w in rows)
+        r = sum(w * A.T @ b for A, b, w in rows)
+        m = len(d)
+        K = np.block([[H, C.T], [C, np.zeros((m, m))]])
+        x = np.linalg.solve(K, np.concatenate([r, d]))
+        a, lam = x[:nv], x[nv:nv + n_lam]
+        return (M[self.iv] @ a + h[self.iv] - Js[:, self.iv].T @ lam)
