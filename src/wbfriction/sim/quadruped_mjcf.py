@@ -5,8 +5,9 @@ and collision geometry and the URDF's ``<dynamics>`` dropped), with
 
 * a free joint at the root (a floating base) and a ground plane (``z = 0``, flat and horizontal);
 * one sphere per contact frame (:attr:`Robot.contact_frames <wbfriction.model.robot.Robot.contact_frames>`, the
-  robot's point feet), of radius :data:`FOOT_RADIUS`, **centred on the contact frame's origin** (Unitree's feet are
-  rubber balls about 2 cm in radius round the ``<leg>_foot`` frame), the only geometry that collides: soft point
+  robot's point feet), of the gait's radius (:data:`wbfriction.walking.quadruped.FOOT_RADIUS`, 2.3 cm: where the
+  gait plans a standing foot's frame), **centred on the contact frame's origin** (Unitree's feet are rubber balls
+  about 2 cm in radius round the ``<leg>_foot`` frame), the only geometry that collides: soft point
   contacts with MuJoCo's default ``solref``/``solimp``, ``condim`` 3 (normal and sliding friction, no torsional or
   rolling friction: the ground's action on a foot is one force at the contact point), sliding friction
   :data:`FOOT_FRICTION`;
@@ -36,12 +37,11 @@ from wbfriction.exceptions import InputError, ModelError
 from wbfriction.model.mjspec import mujoco_message, urdf_spec
 from wbfriction.model.robot import Robot
 from wbfriction.sim.mujoco_model import MujocoRobot, route_mujoco_warnings
+from wbfriction.walking.quadruped import FOOT_RADIUS
 
 if TYPE_CHECKING:
     import mujoco
 
-FOOT_RADIUS = 0.022
-"""The feet's radius [m] (the Go2's foot collision mesh spans 0.020-0.026 m round the foot frame's origin)."""
 FOOT_FRICTION = 0.9
 """The feet's sliding friction coefficient on the ground (rubber on a floor: 0.8-1.0)."""
 SOLVER_TOLERANCE = 1e-10
@@ -56,7 +56,8 @@ def build_quadruped_model(robot: Robot, timestep: float = 1e-3, foot_radius: flo
     Args:
         robot: a floating-base robot whose contact frames are points (``contact_model = "point"``), from a URDF.
         timestep: the physics step [s].
-        foot_radius: the feet's sphere radius [m], > 0.
+        foot_radius: the feet's sphere radius [m], > 0 (default the gait's
+            :data:`~wbfriction.walking.quadruped.FOOT_RADIUS`).
         foot_friction: their sliding friction coefficient, > 0.
 
     Returns:
