@@ -18,21 +18,24 @@ the velocity is projected onto the contacts (``pin.impulseDynamics``: the plasti
 integration's drift otherwise), so that the logged state satisfies ``J_c v = 0`` exactly. Semi-implicit Euler:
 ``v+ = v + h a``, ``q+ = q (+) h v+``.
 
-**The controller** runs at the log rate. Its feed-forward is the inverse dynamics of the reference
-(:func:`feedforward`): ``b = M a_ref + h`` (``pin.rnea``), the stance feet's forces the least-norm ones that meet
-the base's six rows (least squares where they cannot all be met: two point feet exert no moment about the line
-between them), the joint torques the rest, plus the friction of the reference's velocities (the controller knows
-its robot's friction model). Two drives:
+**The controller** runs at the log rate, on the true state: the balance controller of
+:mod:`wbfriction.sim.quadruped_control` (whole-body inverse dynamics: the base's pose, the swing feet, the posture;
+two point feet exert no moment about the line between them, so that a feed-forward of the reference's inverse
+dynamics plus joint PD lets a trot tip over), plus the friction of the reference's velocities (the controller
+knows its robot's friction model; ``compensate``). Two drives:
 
-* ``torque``: the motors apply ``tau = tau_ff + kp (q_ref - q) + kd (qd_ref - qd)`` held over the period (the log's
-  ``tau``: the joint torque sensors sit before the friction: the command);
+* ``torque``: the motors apply ``tau = tau_c + kp (q_ref - q) + kd (qd_ref - qd)`` held over the period (``tau_c``
+  the controller's; the log's ``tau``: the joint torque sensors sit before the friction: the command);
 * ``pd``: the robot's motor drivers (``[pd]``, :mod:`wbfriction.model.pd`) are sent ``q_des`` (the reference, in the
-  encoder's coordinates), ``qd_des`` and ``tau_ff`` at the samples; at every physics step they apply the PD law on
-  the encoder's angle and the velocity, clipped at their limits, with each set-point as
-  :func:`~wbfriction.model.pd.pd_torque` models it (``setpoints = "model"``: the box average over one period of the
-  held set-points, delayed: the linear interpolation of the commands at ``t - T/2 - delay``), so that the law on the
-  logged set-points gives the torque applied at the samples exactly; or held from their sample and delayed
-  (``setpoints = "held"``, the hung robot's drivers, :func:`~wbfriction.sim.pd_robot.step_setpoints`). The log then
+  encoder's coordinates), ``qd_des`` (the reference's) and ``tau_ff`` (the controller's torque less the drivers'
+  PD at the sample) at the samples; at every physics step they apply the PD law on the encoder's angle and the
+  velocity, clipped at their limits, with each set-point as :func:`~wbfriction.model.pd.pd_torque` takes it
+  (``setpoints = "model"``: the linear interpolation of the commands at ``t - T/2 - delay``, the box average over
+  one period of the held commands, held at the last command arrived where it would need a later one: a driver
+  cannot know the next command), so that the law on the logged set-points gives the torque applied at the samples
+  exactly (where the delay leaves every command it needs arrived: ``delay mod T <= T/2``, e.g. none); or held from
+  their sample and delayed (``setpoints = "held"``, the hung robot's drivers,
+  :func:`~wbfriction.sim.pd_robot.step_setpoints`). The log then
   has no ``tau.*`` but ``q_des.*``, ``qd_des.*``, ``tau_ff.*`` and the drivers' velocity ``qd.*``.
 
 **The log** (the project's format, one row per sample, the physics step starting at it): ``q.*``, the torques (per

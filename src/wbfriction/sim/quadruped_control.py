@@ -9,15 +9,16 @@ dynamics allow and that come closest to its tasks, then the torques that produce
 .. math::
 
     \\min_{a, \\lambda} \\; \\|a_{base} - a_{base}^*\\|^2 + \\sum_{swing} \\|J_c a + \\dot J_c v - \\ddot p_c^*\\|^2
-    + w_q \\|a_{joints} - \\ddot q^*\\|^2 + w_\\lambda \\|\\lambda\\|^2
+    + w_q \\|a_{joints} - \\ddot q^*\\|^2 + w_\\lambda \\|D (\\lambda - \\lambda_0)\\|^2
     \\quad \\text{s.t.} \\quad M_{base} a + h_{base} = J_{s,base}^T \\lambda, \\quad J_s a + \\dot J_s v = 0
 
-with ``tau = M_joints a + h_joints - J_{s,joints}^T lambda``. The tasks are PD laws on the reference
-(:class:`~wbfriction.walking.quadruped.QuadrupedReference`): the base's pose (world position and orientation,
-Pinocchio's free-flyer acceleration in the base frame), the swing feet's world positions (a swing foot lands on its
-footprint wherever the base is), the joint angles (a light posture task). The first constraint is the whole body's
-Newton-Euler equation (the base's six rows of the equation of motion), the second keeps the stance feet still.
-Solved as one equality-constrained least-squares problem (its KKT system, about 50 unknowns).
+with ``tau = M_joints a + h_joints - J_{s,joints}^T lambda``, ``lambda_0`` an even share of the robot's weight on the
+stance feet (vertical), ``D`` weighing the tangential components more (:class:`BalanceGains`). The tasks are PD
+laws on the reference (:class:`~wbfriction.walking.quadruped.QuadrupedReference`): the base's pose (world position
+and orientation, Pinocchio's free-flyer acceleration in the base frame), the swing feet's world positions (a swing
+foot lands on its footprint wherever the base is), the joint angles (a light posture task). The first constraint is
+the whole body's Newton-Euler equation (the base's six rows of the equation of motion), the second keeps the stance
+feet still. Solved as one equality-constrained least-squares problem (its KKT system, about 50 unknowns).
 """
 
 from __future__ import annotations
@@ -42,14 +43,17 @@ class BalanceGains:
         feet: the swing feet's positions.
         joints: the joint angles (the posture task).
         joint_weight: ``w_q``, the posture task's weight against the base's and the feet's (1).
-        force_weight: ``w_lambda`` [1/N^2 in the tasks' units]: the least forces among those that do the same.
+        force_weight: ``w_lambda`` [1/N^2 in the tasks' units]: among forces that do the same, those nearest an
+            even share of the robot's weight on the stance feet, pushing down.
+        tangential: the tangential components' scale in that distance (their weight the square).
     """
 
-    base: tuple[float, float] = (100.0, 20.0)
+    base: tuple[float, float] = (50.0, 10.0)
     feet: tuple[float, float] = (400.0, 40.0)
     joints: tuple[float, float] = (100.0, 20.0)
     joint_weight: float = 1e-2
-    force_weight: float = 1e-6
+    force_weight: float = 1e-4
+    tangential: float = 3.0
 
 
 class BalanceController:
@@ -59,6 +63,7 @@ class BalanceController:
                  gains: BalanceGains = BalanceGains()) -> None:
         self.robot, self.model, self.ref, self.gains = robot, model, reference, gains
         self.data = model.createData()
+        self.weight = float(pin.computeTotalMass(model)) * float(np.linalg.norm(model.gravity.linear))
         self.iv, self.iq = robot.act_v_index, robot.act_q_index
         # the reference base's world velocity and acceleration (linear, angular)
         R = np.array([pin.Quaternion(np.asarray(b[3:])).toRotationMatrix() for b in reference.base])
@@ -105,8 +110,10 @@ class BalanceController:
         kp, kd = g.joints
         want = ref.qdd[k] + kp * (ref.q[k] - q[self.iq]) + kd * (ref.qd[k] - v[self.iv])
         rows.append((pad(np.eye(nv)[self.iv]), want, g.joint_weight))
-        if n_lam:
-            rows.append((np.hstack([np.zeros((n_lam, nv)), np.eye(n_lam)]), np.zeros(n_lam), g.force_weight))
+        if n_lam:  # near an even share of the weight, pushing down (tangential components weigh more)
+            scale = np.tile([g.tangential, g.tangential, 1.0], len(active))
+            nominal = np.tile([0.0, 0.0, self.weight / len(active)], len(active))
+            rows.append((np.hstack([np.zeros((n_lam, nv)), np.diag(scale)]), scale * nominal, g.force_weight))
         Js = np.vstack([J[c] for c in active]) if n_lam else np.zeros((0, nv))
         C = np.vstack([np.hstack([M[:6], -Js[:, :6].T]), np.hstack([Js, np.zeros((n_lam, n_lam))])])
         d = np.concatenate([-h[:6]] + [-drift[c] for c in active])

@@ -265,8 +265,8 @@ def _base_motion(t: np.ndarray, options: GaitOptions, rng: np.random.Generator) 
     pos[:, :, 0] = np.array(_ramp_path(t, options.speed, 0.5 * T, T))
     pos[0, :, 2] = options.base_height
     if options.gait == "stand":  # chirps, each axis its own frequencies [m or rad, Hz, Hz]
-        waves = [(pos, 2, 0.035, 0.15, 1.3), (pos, 1, 0.03, 0.1, 0.9), (pos, 0, 0.03, 0.12, 1.1),
-                 (rp, 0, 0.15, 0.13, 1.2), (rp, 1, 0.12, 0.11, 1.0)]
+        waves = [(pos, 2, 0.035, 0.15, 1.3), (pos, 1, 0.03, 0.1, 1.3), (pos, 0, 0.03, 0.12, 1.1),
+                 (rp, 0, 0.15, 0.13, 1.6), (rp, 1, 0.12, 0.11, 1.0)]
     else:
         waves = [(pos, 2, 0.012, 0.71, 0.71), (rp, 0, 0.05, 0.43, 0.43), (rp, 1, 0.04, 0.57, 0.57)]
         if options.gait != "walk":
