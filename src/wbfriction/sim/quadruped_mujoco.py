@@ -199,6 +199,9 @@ class _Sim:
         if options.drive == "pd" and (robot.pd is None or robot.pd.joints != robot.actuated):
             raise InputError(f"robot '{robot.name}': --drive pd needs a [pd] table driving every joint "
                              "(wbfriction.model.pd)")
+        if self.driver is not None and self.driver.delayed == "torque" and self.driver.delay > 0:
+            raise InputError(f"robot '{robot.name}': a driver delaying its whole torque ([pd] delayed = torque) is "
+                             "not simulated here yet")
         self.data = mujoco.MjData(self.model)
         self.data.qpos[:] = self.mjr.qpos(q_ref[0])
         self.data.qvel[:] = self.mjr.velocity_map(q_ref[0]) @ v_ref[0]
@@ -400,7 +403,8 @@ def simulate_quadruped_mujoco(robot: Robot, reference: QuadrupedReference,
         :class:`MujocoQuadrupedRun`, one log row per reference sample.
 
     Raises:
-        InputError: a robot that is not such a quadruped, friction or armature for a joint it does not have.
+        InputError: a robot that is not such a quadruped, friction or armature for a joint it does not have, PD
+            drivers that delay their whole torque.
         OptionError: a physics step that does not divide the reference's period.
         SimulationError: the robot fell or the simulation diverged (the message gives the time).
     """
