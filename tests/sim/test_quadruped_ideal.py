@@ -215,3 +215,25 @@ def test_bad_options_say_so(robot, references):
         simulate_quadruped(robot, references["stand"], QuadrupedOptions(physics_dt=0.0003))
     with pytest.raises(InputError, match="point feet"):
         simulate_quadruped(load_robot("talos"), references["stand"])
+
+
+def test_the_command_line_walks_a_quadruped(robot, tmp_path, capsys):
+    """``simulate --robot go2_walking --gait walk --drive pd --foot-forces 3d`` writes a PD-driven crawl's log
+    (set-points, no torque columns, the feet's 3-D forces, the planned contacts, three feet down or four); a
+    humanoid's gait on point feet, and a quadruped's on a humanoid, are one-line errors naming --gait."""
+    from helpers import run_cli
+    from wbfriction.logs.source import read_log
+
+    path = tmp_path / "crawl.parquet"
+    code, err = run_cli(capsys, "simulate", "--robot", "go2_walking", "--gait", "walk", "--drive", "pd",
+                        "--duration", "1.5", "--foot-forces", "3d", "-o", path)
+    assert code == 0, err
+    log = read_log(path, robot)
+    assert log.torque_source == "pd" and len(log) == 750
+    assert np.isfinite(log.foot_force).all()
+    assert set(log.contact.sum(axis=1).tolist()) == {3, 4}
+    assert log.metadata["gait"]["gait"] == "walk" and log.metadata["drive"] == "pd"
+    code, err = run_cli(capsys, "simulate", "--robot", "go2_walking", "--gait", "forward", "-o", path)
+    assert code == 2 and "--gait forward" in err and len(err.strip().splitlines()) == 1
+    code, err = run_cli(capsys, "simulate", "--gait", "trot", "-o", path)
+    assert code == 2 and "--gait trot" in err and len(err.strip().splitlines()) == 1

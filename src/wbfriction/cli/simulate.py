@@ -14,7 +14,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.sim.options import FrictionMode, IdealOptions, Integrator, MujocoOptions, SensorNoise, Simulator
 from wbfriction.sim.pd_options import DriverNoise, HungOptions, SetpointKind, SetpointOptions
-from wbfriction.walking.options import Gait, GaitOptions
+from wbfriction.walking.options import GaitOptions
 
 if TYPE_CHECKING:
     from wbfriction.model.robot import Robot
@@ -36,6 +36,12 @@ from wbfriction.cli.common import (
 
 HUNG = HungOptions()
 SETPOINTS = SetpointOptions()
+GaitChoice = Literal["forward", "sideways", "turning", "both", "combined", "stand", "step", "trot", "walk"]
+"""``--gait``: a walk's (:data:`~wbfriction.walking.options.Gait`) or, for a robot on point feet, a quadruped's
+(:data:`~wbfriction.walking.quadruped.Gait`)."""
+QUADRUPED_GAITS = ("stand", "step", "trot", "walk")
+FootForces = Literal["none", "normal", "3d"]
+"""``--foot-forces``: the feet's force columns a walking quadruped's log carries."""
 Actuator = Literal["torque", "pd"]
 """How a robot's joints are driven (``--actuator``): motors whose torque is logged, or PD motor drivers."""
 DriverNoiseChoice = Literal["real", "none"]
@@ -101,6 +107,46 @@ def _run_simulate_hung(r: Robot, output: Path, options: HungOptions, friction: O
                   f"delay {result.driver.delay * 1e3:g} ms, physics step {result.physics_step * 1e3:g} ms)")
 
 
+def _run_simulate_quadruped(r: Robot, output: Path, gait: str, duration: Optional[float], speed: Optional[float],
+                            seed: int, simulator: Simulator, options: dict, friction: Optional[Path]) -> None:
+    """A walking quadruped (a robot on point feet, issue 56): its gait planned
+    (:func:`~wbfriction.walking.quadruped.quadruped_reference`), simulated in the ideal simulator
+    (:func:`~wbfriction.sim.quadruped.simulate_quadruped`) or on MuJoCo
+    (:func:`~wbfriction.sim.quadruped_mujoco.simulate_quadruped_mujoco`), the log written; ``options``: the
+    :class:`~wbfriction.sim.quadruped.QuadrupedOptions` fields the command line gave."""
+    from wbfriction.fit.targets import load_friction_spec
+    from wbfriction.logs.log import write_log
+    from wbfriction.sim.quadruped import QuadrupedOptions, QuadrupedRun, simulate_quadruped
+    from wbfriction.walking.quadruped import GaitOptions as QuadrupedGait
+    from wbfriction.walking.quadruped import quadruped_reference
+
+    if gait not in QUADRUPED_GAITS:
+        raise InputError(f"--gait {gait}: robot '{r.name}' stands on point feet: its gaits are "
+                         f"{', '.join(QUADRUPED_GAITS)}")
+    spec = None if friction is None else load_friction_spec(friction, r.groups, r.actuated)
+    if spec is not None and (spec.terms or spec.temperature is not None):
+        raise InputError(f"{friction}: a walking quadruped's simulation takes friction models per joint, without "
+                         "terms beyond velocity or a temperature")
+    gait_options = QuadrupedGait(gait=gait, duration=8.0 if duration is None else duration, speed=speed,  # type: ignore[arg-type]
+                                 seed=seed)
+    opts = QuadrupedOptions(friction=None if spec is None else spec.params, **options)
+    with console.status(f"planning {gait_options.duration:g} s ({gait})"):
+        ref = quadruped_reference(r, gait_options)
+    with progress_bar(len(ref), "simulate") as advance:
+        if simulator == "mujoco":
+            from wbfriction.sim.quadruped_mujoco import simulate_quadruped_mujoco
+            run: QuadrupedRun = simulate_quadruped_mujoco(r, ref, opts, progress=advance)
+        else:
+            run = simulate_quadruped(r, ref, opts, progress=advance)
+    write_log(run.log, r, output)
+    drive = "PD set-points" if opts.drive == "pd" else "joint torques"
+    console.print(f"wrote {output} ({len(run.log)} samples, {gait_options.duration:g} s, {gait}, {drive})")
+    normal = run.force[..., 2][run.log.contact]
+    if normal.size and normal.min() < 0:
+        console.print(f"[yellow]warning:[/] a foot pulled on the ground at {int((normal < 0).sum())} samples (down to "
+                      f"{normal.min():.1f} N)", highlight=False)
+
+
 FrictionOpt = typer.Option(None, help="TOML with [friction.<group or joint>] tables (a model key: coulomb-viscous, "
                                       "stribeck or (3.5)), each with an optional terms table (F_L, dF_v, ripple, "
                                       "F_cT, F_vT, reference_temperature), and a [temperature] warm-up (start, end "
@@ -110,7 +156,8 @@ SimulatorOpt = typer.Option("ideal", help="ideal (rigid contacts, thesis 6.1) or
                                           "contact flags, sensors, thesis 6.2).")
 SubstepsOpt = typer.Option(None, help=f"Physics steps per control period (default: {IDEAL.substeps} ideal, "
                                       f"{MUJOCO.substeps} mujoco (1 ms periods), {HUNG.substeps} PD-driven (at "
-                                      f"{HUNG.rate:g} Hz: 1 ms steps)).")
+                                      f"{HUNG.rate:g} Hz: 1 ms steps), 4 for a robot on point feet (2 ms periods: "
+                                      "0.5 ms steps)).")
 MujocoFrictionOpt = typer.Option(MUJOCO.friction, help="mujoco and PD-driven: model (any friction model as a joint "
                                                        "torque) or mujoco (MuJoCo's frictionloss = F_c, damping = "
                                                        "F_v).")
@@ -127,12 +174,19 @@ FrictionTimeOpt = typer.Option(None, help="mujoco: the friction-loss constraint'
                                           "physics steps: a joint that sticks; MuJoCo's 0.02 leads the velocity by "
                                           "10 ms).")
 DurationOpt = typer.Option(None, help="Fixed-base robot: seconds of excitation trajectory (an arm, default 10) or of "
-                                      f"set-points (PD-driven, default {HUNG.duration:g}).")
+                                      f"set-points (PD-driven, default {HUNG.duration:g}); a robot on point feet: "
+                                      "seconds of gait (default 8).")
 SeedOpt = typer.Option(0, help="Fixed-base robot: seed of the excitation trajectory's Fourier coefficients or of the "
-                               "set-points (another seed, another motion).")
-ActuatorOpt = typer.Option(None, help="torque (motors whose torque is logged) or pd (motor drivers closing a PD loop: "
-                                      "a fixed-base robot hung, its drivers tracking ramps and chirps, "
-                                      "wbfriction.sim.hung); default pd for a robot with a [pd] table.")
+                               "set-points (another seed, another motion); a robot on point feet: of the gait's swings "
+                               "and sway.")
+ActuatorOpt = typer.Option(None, "--actuator", "--drive",
+                           help="torque (motors whose torque is logged) or pd (motor drivers closing a PD loop: "
+                                "a fixed-base robot hung, its drivers tracking ramps and chirps, "
+                                "wbfriction.sim.hung; a walking quadruped's drivers sent its set-points); default pd "
+                                "for a fixed-base robot with a [pd] table, torque otherwise.")
+SpeedOpt = typer.Option(None, help="A robot on point feet: forward speed [m/s] (default 0.2 trot, 0.1 walk).")
+FootForcesOpt = typer.Option("none", help="A robot on point feet: the feet's force columns logged: none, normal "
+                                          "(force.<foot>, as Unitree's foot sensors) or 3d (force.<foot>.x|y|z).")
 SetpointsOpt = typer.Option(SETPOINTS.kind, help="PD-driven: ramps (triangle ramps reversing every "
                                                  f"{SETPOINTS.reversal[0]:g}-{SETPOINTS.reversal[1]:g} s), chirps "
                                                  f"({SETPOINTS.chirp[0]:g}-{SETPOINTS.chirp[1]:g} Hz) or both "
@@ -148,8 +202,10 @@ VelocityNoiseOpt = typer.Option(None, help="PD-driven: white noise std of the dr
 def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write: .parquet, .csv or .h5."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              mjcf: Optional[Path] = MjcfOpt,
-             gait: Gait = typer.Option(GAIT.gait, help="forward, sideways, turning, both (forward + sideways) or "
-                                                    "combined (all three)."),
+             gait: Optional[GaitChoice] = typer.Option(None, help="A walk: forward (default), sideways, turning, "
+                                                                 "both (forward + sideways) or combined (all three); "
+                                                                 "a robot on point feet: stand, step (a trot in "
+                                                                 "place), trot (default) or walk (a crawl)."),
              steps: int = typer.Option(GAIT.steps, help="Number of steps (per direction for both/combined)."),
              step_length: float = typer.Option(GAIT.step_length, help="Forward distance between footprints [m]."),
              step_width: float = typer.Option(GAIT.step_width, help="Sideways step [m]."),
@@ -179,13 +235,23 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              duration: Optional[float] = DurationOpt, excitation_seed: int = SeedOpt,
              actuator: Optional[Actuator] = ActuatorOpt, setpoints: SetpointKind = SetpointsOpt,
              driver_noise: DriverNoiseChoice = DriverNoiseOpt,
-             velocity_noise: Optional[float] = VelocityNoiseOpt) -> None:
+             velocity_noise: Optional[float] = VelocityNoiseOpt, speed: Optional[float] = SpeedOpt,
+             foot_forces: FootForces = FootForcesOpt) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents; a PD-driven one
     (--robot go2) hangs with its base fixed, its drivers tracking ramps and chirps."""
     check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors},
                 {"-o": output})
     r = robot_of(robot, urdf, config, mjcf)
+    if r.point_contacts:
+        noise, lag = sensor_noise(sensors, position_noise, encoder_bits, torque_noise, noise_seed, delay)
+        if lag:
+            raise InputError("--delay: a walking quadruped's simulation has no measurement delay (its drivers' is the "
+                             "robot's [pd] delay)")
+        physics = {} if substeps is None else {"physics_dt": 0.002 / substeps}
+        return _run_simulate_quadruped(r, output, gait or "trot", duration, speed, excitation_seed, simulator,
+                                       {"drive": actuator or "torque", "noise": noise, "foot_forces": foot_forces,
+                                        **physics}, friction)
     if (actuator or ("pd" if r.pd is not None else "torque")) == "pd":
         drivers = driver_noise_of(driver_noise, encoder_bits, position_noise, velocity_noise, noise_seed)
         return _run_simulate_hung(r, output, hung_options(duration, substeps, setpoints, excitation_seed, drivers,
@@ -193,8 +259,12 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
     if not r.floating_base:
         return _run_simulate_arm(r, output, arm_options(duration or 10.0, excitation_seed, position_noise,
                                                         encoder_bits, torque_noise, noise_seed), friction)
-    gait_opts = GaitOptions(gait=gait, steps=steps, step_length=step_length, step_width=step_width,
-                            turn_angle=turn_angle, lift_height=lift_height)
+    if gait in QUADRUPED_GAITS:
+        raise InputError(f"--gait {gait}: a quadruped's gait; robot '{r.name}' walks forward, sideways, turning, "
+                         "both or combined")
+    gait_opts = GaitOptions(gait=gait or GAIT.gait,  # type: ignore[arg-type]  # a walk's: checked above
+                            steps=steps, step_length=step_length, step_width=step_width, turn_angle=turn_angle,
+                            lift_height=lift_height)
     if simulator == "ideal":
         options: IdealOptions | MujocoOptions = IdealOptions(substeps=substeps or IDEAL.substeps, integrator=integrator,
                                                              log_base=log_base, force_torque=force_torque,
