@@ -32,7 +32,7 @@ from wbfriction.friction.route import RouteDecision, resolve_route
 from wbfriction.logs.clock import longest_segment
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
-from wbfriction.signals.choice import DiffChoice, choose_differentiation
+from wbfriction.signals.choice import DiffChoice, choose_differentiation, contact_changes
 
 
 @dataclass(frozen=True)
@@ -72,7 +72,7 @@ class LogDecision:
 
 def decide_log(robot: Robot, options: EstimateOptions, positions: np.ndarray | None, dt: float, *,
                segments: list[tuple[int, int]] | None, rows: int, source: str,
-               route_rows: int | None = None) -> LogDecision:
+               route_rows: int | None = None, changes: np.ndarray | None = None) -> LogDecision:
     """Decide once for a log what ``options`` leave to the data, and measure its noise (module docstring).
 
     Args:
@@ -87,35 +87,33 @@ def decide_log(robot: Robot, options: EstimateOptions, positions: np.ndarray | N
         source: the log's name, for the messages.
         route_rows: the samples the route's windows are bounded by
             (:func:`~wbfriction.friction.route.choose_route`); default the rows of ``positions``.
+        changes: the rows of ``positions`` where a contact flag changes
+            (:func:`~wbfriction.signals.choice.contact_changes`): their impacts are not counted as noise.
 
     Raises:
         OptionError: a window given longer than the log's longest stretch; InputError: one the data chose, or
             stretches too short for any scheme (:func:`check_windows`).
     """
     given = options
-    point_feet = robot.point_contacts and options.route == "auto"  # the momentum route has no point feet (yet)
-    if point_feet:
-        options = replace(options, route="acceleration")
-    options, choice = resolve_differentiation(options, positions, dt)
+    options, choice = resolve_differentiation(options, positions, dt, changes)
     options, route = resolve_route(options, positions, dt, choice, rows=route_rows)
-    if point_feet and route is not None:
-        route = replace(route, reason="acceleration: the robot's point feet (the momentum route does not take them "
-                                      "yet)")
     check_windows(given, options, segments, rows, dt, source)
     if positions is None:
         return LogDecision(options, choice, route, None)
-    record = noise_record(robot, positions, dt, options)
+    record = noise_record(robot, positions, dt, options, changes)
     return LogDecision(options, choice, route, record, unmeasured_noise(record, len(positions), options))
 
 
-def longest_stretch(log: Log) -> np.ndarray:
-    """The positions (M, n_act) [rad] of the log's longest stretch between time gaps."""
+def longest_stretch(log: Log) -> tuple[np.ndarray, np.ndarray | None]:
+    """The positions (M, n_act) [rad] of the log's longest stretch between time gaps, and the rows (M,) where a
+    contact flag changes there (:func:`~wbfriction.signals.choice.contact_changes`, None: none)."""
     a, b = longest_segment(log.segments, len(log.time))
-    return log.q[a:b]
+    return log.q[a:b], contact_changes(log.contact[a:b])
 
 
 def resolve_differentiation(options: EstimateOptions, source: Log | np.ndarray | None,
-                            dt: float | None = None) -> tuple[EstimateOptions, DiffChoice | None]:
+                            dt: float | None = None, changes: np.ndarray | None = None
+                            ) -> tuple[EstimateOptions, DiffChoice | None]:
     """``options`` with ``diff="auto"`` replaced by the scheme and filter chosen from the positions
     (:func:`~wbfriction.signals.choice.choose_differentiation`), and that choice; other options as
     they are, and None.
@@ -123,6 +121,7 @@ def resolve_differentiation(options: EstimateOptions, source: Log | np.ndarray |
     Args:
         source: the log, or positions (N, n_act) [rad] sampled every ``dt`` [s] (the first rows
             of a long log); None: nothing to choose from (central differences, no choice).
+        changes: the rows of positions where a contact flag changes, not counted as noise (a log: its own).
 
     A log too short to measure its noise gets central differences, and a choice that says why.
     """
@@ -131,7 +130,7 @@ def resolve_differentiation(options: EstimateOptions, source: Log | np.ndarray |
     if source is None:
         return replace(options, diff="central"), None
     try:
-        choice = choose_differentiation(source, dt, target=options.noise_target)
+        choice = choose_differentiation(source, dt, target=options.noise_target, changes=changes)
     except InputError as exc:  # too short a log to measure its noise: say so, differentiate it plainly
         choice = DiffChoice.fallback(f"central differences: {exc}")
     return replace(options, diff=choice.scheme, filtering=choice.filtering), choice

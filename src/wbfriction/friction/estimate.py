@@ -297,8 +297,10 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
             raise (no segment can be estimated; with ``require_single_support``, no
             single-support sample in the whole log).
     """
-    decision = decide_log(robot, options, longest_stretch(log), log.dt, segments=log.segments, rows=len(log.time),
-                          source=log.source, route_rows=len(log.time))  # the whole log's rows: module docstring
+    positions, changes = longest_stretch(log)
+    decision = decide_log(robot, options, positions, log.dt, segments=log.segments, rows=len(log.time),
+                          source=log.source, route_rows=len(log.time),  # the whole log's rows: module docstring
+                          changes=changes)
     est = estimate_resolved(robot, log, decision.options, progress, companion, require_single_support)
     for e in (est, est.route_check):
         if e is not None:
@@ -353,7 +355,7 @@ def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress
         est = _acceleration_segment(robot, log, options, progress, companion, require_single_support, gaps)
     est.q, est.tau, est.temperature = log.q[:, robot.tc_index], log.tau, log.temperature  # the terms' signals
     est.metadata["torque_source"] = torque_record(robot, log.torque_source, log.setpoints)  # every output says it
-    if options.check_route and not robot.point_contacts:  # point feet: one route (wbfriction.friction.point_contacts)
+    if options.check_route:
         other: Route = "acceleration" if options.route == "momentum" else "momentum"
         est.route_check = _estimate_segment(robot, log, replace(options, route=other, check_route=False), None,
                                             False, False, gaps)

@@ -40,6 +40,11 @@ the same once-differentiated velocities.
   logged base pose differentiated once, its angular part from the IMU's gyro where the base motion is
   ``imu``; without a logged pose, from the stance feet (not sliding, not turning). Windows leave out each
   touch-down's impact and every contact change, as the acceleration route does.
+* ``base`` (point feet, :attr:`~wbfriction.model.robot.Robot.contact_kinds`): the free-floating robot, its base
+  twist measured as for ``wrench``; a joint's row holds no unknown force while no foot is down on its limb (a swinging
+  leg, :func:`~wbfriction.model.determination.free_rows`) or while its feet's three force components are measured
+  (their ``J^T f`` is ``e``). The stance legs that only the base's rows determine (one foot down) are left to the
+  acceleration route (:mod:`wbfriction.friction.point_contacts`). Windows never span a contact change.
 * **Where the equations do not allow it.** In double support without wrenches the second foot's wrench is
   unknown and enters the joint rows: projecting it out (``P J^T = 0``) leaves combinations of the joints'
   frictions, not each joint's, as (6.1) does for the accelerations; that phase is left out. A measured base
@@ -60,9 +65,11 @@ from wbfriction.friction.estimated import FrictionEstimate, no_single_support
 from wbfriction.friction.measured import impacts, log_base_motion
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import Log
+from wbfriction.model.determination import foot_force_torques, free_rows
 from wbfriction.model.dynamics import floating_base_state
 from wbfriction.model.imu import base_motion_from_imu
 from wbfriction.model.measured_dynamics import measured_momentum
+from wbfriction.model.momentum import momentum_and_drift
 from wbfriction.model.robot import Robot
 from wbfriction.model.stance import stance_frame_pose, stance_model
 from wbfriction.progress import Progress
@@ -160,17 +167,14 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
 
     Raises:
         InputError: what :func:`~wbfriction.signals.kinematics.measure` raises, windows not resolved, no sample
-            the route can estimate (with ``require_single_support``), a robot on point feet (not yet on this route:
-            :mod:`wbfriction.friction.point_contacts` is on the acceleration route).
+            the route can estimate (with ``require_single_support``), a robot on point feet without its base pose.
     """
-    if robot.point_contacts:
-        raise InputError(f"{log.source}: the momentum route does not take point feet yet: --route acceleration "
-                         f"(robot '{robot.name}')")
     window = momentum_window(options, log)
     has_wrench, base_motion = log_base_motion(robot, log, options.base_motion, options.wrenches)
+    floating = has_wrench or robot.point_contacts  # the free-floating tree, its base twist measured
     kin = measure(log, "savgol", compensate_delay=options.compensate_delay, torque_alignment=options.torque_alignment,
                   filtering=velocity_filter(options), velocity=options.velocity,
-                  base_motion=has_wrench and log.base is not None, imu=has_wrench and base_motion == "imu")
+                  base_motion=floating and log.base is not None, imu=floating and base_motion == "imu")
     n, tc = len(log.time), robot.tc_index
     phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip, gaps)
     rows_ok = _filter_rows(kin, log.contact) & np.all(np.isfinite(kin.q), axis=1) & np.all(np.isfinite(kin.qd), axis=1)
@@ -180,7 +184,19 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
     p, b = np.full((n, robot.n_act), np.nan), np.full((n, robot.n_act), np.nan)
     e = np.zeros((n, robot.n_act))  # the sensors' wrenches' joint torques, read as the torques are
     mask = np.zeros((n, len(tc)), dtype=bool)
-    if has_wrench:
+    if robot.point_contacts:
+        if log.base is None:
+            raise InputError(f"{log.source}: a robot on point feet needs the base's measured motion: the base pose "
+                             "columns base.x ... base.qw (and the IMU's imu.* with --base-motion imu)")
+        r = np.flatnonzero(rows_ok & ~straddling(log.contact))
+        q, v, known = _base_twist(robot, kin, log, base_motion, r)
+        r, q, v = r[known], q[known], v[known]
+        feet = None if log.foot_force is None else log.foot_force[r]
+        p[r], b[r] = (x[:, robot.act_v_index] for x in momentum_and_drift(robot.model, q, v, progress=progress)[:2])
+        e[r] = foot_force_torques(robot, q, log.contact[r], feet)[:, robot.act_v_index]
+        closure[r] = n_c + 1
+        mask[r] = free_rows(robot, log.contact[r], feet)
+    elif has_wrench:
         assert log.wrench is not None
         rows = rows_ok & np.all(np.isfinite(log.wrench.reshape(n, -1)), axis=1) & ~straddling(log.contact)
         rows &= ~impacts(robot, kin)
@@ -208,7 +224,8 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
                              _alignment(options, log), closure)
     tau_f = window.over_steps(impulses)
     valid = _whole_windows(mask, window.half_width) & np.isfinite(tau_f)
-    route = np.where(closure == n_c, "wrench", np.where(closure >= 0, "contact", "none")).astype("<U7")
+    route = np.where(closure == n_c, "wrench", np.where(closure == n_c + 1, "base",
+                                                        np.where(closure >= 0, "contact", "none"))).astype("<U7")
     metadata = dict(kin.metadata)
     metadata.update(robot=robot.name, source=log.source)
     metadata["base_motion"] = {"base": base_motion, "wrenches": has_wrench}

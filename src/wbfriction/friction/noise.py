@@ -126,12 +126,14 @@ def effective_inertia(robot: Robot, q: np.ndarray) -> np.ndarray:
     return np.median(norms, axis=0) if norms else np.full(len(tc), np.nan)
 
 
-def noise_record(robot: Robot, q: np.ndarray, dt: float, options: EstimateOptions) -> dict[str, Any] | None:
+def noise_record(robot: Robot, q: np.ndarray, dt: float, options: EstimateOptions,
+                 changes: np.ndarray | None = None) -> dict[str, Any] | None:
     """The JSON-ready record of an estimate's noise (module docstring) from joint positions ``q`` (N, n_act) [rad]
     sampled every ``dt`` [s] (a stretch without gaps) and resolved ``options``; None for positions too few to
-    measure their noise."""
+    measure their noise. ``changes`` (N,): the rows where a contact flag changes, whose impacts are not noise
+    (:func:`~wbfriction.signals.choice.white_position_noise`)."""
     try:
-        content = acceleration_content(q, dt)
+        content = acceleration_content(q, dt, changes=changes)
     except InputError:
         return None
     sigma = dict(zip(robot.actuated, map(float, content.position_noise)))

@@ -180,12 +180,10 @@ def joint_torques(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, con
         pin.updateFramePlacements(model, data)
         row = 0
         for c in active:
-            J = contact_jacobian(robot, data, int(c))
             free = ~measured[c] if dims[c] == 3 else np.ones(6, dtype=bool)
-            if dims[c] == 3 and measured[c].any():
-                r[k] -= J[measured[c]].T @ foot_force[k, c, measured[c]]  # type: ignore[index]
-            J_u[k, row:row + int(free.sum())] = J[free]
+            J_u[k, row:row + int(free.sum())] = contact_jacobian(robot, data, int(c))[free]
             row += int(free.sum())
+    r -= foot_force_torques(robot, q, contact, foot_force)
     tau = np.full((n, robot.n_act), np.nan)
     force = np.full((n, m_max), np.nan)
     det = Determination(np.zeros((n, robot.n_act), dtype=bool), np.zeros(n, dtype=int), np.full(n, np.nan),
@@ -201,3 +199,34 @@ def joint_torques(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, con
         if progress is not None:
             progress(len(rows))
     return ContactSolution(tau, force, det)
+
+
+def free_rows(robot: Robot, contact: np.ndarray, foot_force: np.ndarray | None = None) -> np.ndarray:
+    """(N, n_tc) the torque-controlled joints whose own row of the equations of motion holds no unknown contact
+    force: no foot on the ground on their limb (:attr:`~wbfriction.model.robot.Robot.limb_mask`), or only feet whose
+    three force components are measured. Such a row needs neither the base's rows nor the rank decision: the
+    momentum route takes it as it is (:mod:`wbfriction.friction.momentum`)."""
+    measured = np.zeros((len(robot.contact_frames), 3), dtype=bool)
+    if foot_force is not None and len(foot_force):
+        measured = np.isfinite(foot_force).all(axis=0)
+    unknown = contact.astype(bool) & ~measured.all(axis=1)  # (N, n_contacts): on the ground, force not all measured
+    return ~((unknown.astype(float) @ robot.limb_mask.astype(float)) > 0)
+
+
+def foot_force_torques(robot: Robot, q: np.ndarray, contact: np.ndarray, foot_force: np.ndarray | None
+                       ) -> np.ndarray:
+    """``sum_c J_c^T f_c`` (N, nv) [N·m] over the feet on the ground and their measured force components (world axes,
+    :func:`contact_jacobian`), zero without foot forces: the measured forces' generalized torque."""
+    out = np.zeros((len(q), robot.model.nv))
+    if foot_force is None:
+        return out
+    measured = np.isfinite(foot_force).all(axis=0) if len(foot_force) else np.zeros((len(contact[0]), 3), bool)
+    data = robot.model.createData()
+    for k in np.flatnonzero(np.any(contact.astype(bool) & measured.any(axis=1), axis=1)):
+        pin.computeJointJacobians(robot.model, data, q[k])
+        pin.updateFramePlacements(robot.model, data)
+        for c in np.flatnonzero(contact[k]):
+            if robot.contact_dims[c] == 3 and measured[c].any():
+                J = contact_jacobian(robot, data, int(c))
+                out[k] += J[measured[c]].T @ foot_force[k, c, measured[c]]
+    return out

@@ -48,6 +48,7 @@ from wbfriction.pipeline.chunks import (
 )
 from wbfriction.pipeline.provenance import log_provenance
 from wbfriction.progress import Progress, StageProgress
+from wbfriction.signals.choice import contact_changes
 from wbfriction.workers import process_pool
 
 
@@ -223,12 +224,14 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     file = TableFile(path)
     plan = plan_columns(file, robot, source, read)
     contact, clock, first = plan.contact, plan.clock, plan.first_positions
+    changes = None
     if first is not None:  # the noise is measured on one segment: a gap between two recordings is no noise
         a, b = longest_segment(clock.segments, len(first))
-        first = first[a:b]
+        first, changes = first[a:b], contact_changes(contact[a:b])
     # the noise measured on the first rows, the route's windows bounded by them: all a file's plan reads (the whole
     # log's rows in memory, estimate_log: wbfriction.friction.decision)
-    decision = decide_log(robot, options, first, clock.step, segments=clock.segments, rows=len(clock), source=source)
+    decision = decide_log(robot, options, first, clock.step, segments=clock.segments, rows=len(clock), source=source,
+                          changes=changes)
     options = decision.options
     extra_metadata = {**(extra_metadata or {}), **decision.metadata()}
     n = len(contact)

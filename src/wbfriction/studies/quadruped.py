@@ -1,0 +1,123 @@
+"""What each gait gives a walking quadruped (issue 56): ``wbfriction study-quadruped``.
+
+A quadruped on point feet (the built-in ``go2_walking``) walks with known friction on every joint, in the ideal
+simulator (:mod:`wbfriction.sim.quadruped`: point feet welded while down) or on MuJoCo
+(:mod:`wbfriction.sim.quadruped_mujoco`: soft contacts, its sensors), torque- or PD-driven. Its log is estimated
+(:mod:`wbfriction.friction.point_contacts`: each joint where the contacts leave its friction determined) and every
+joint's friction fitted (the injected family, (3.5) without Stribeck effect: F_c and F_v free, ``S = 0``). The study
+reports, per joint, the share of samples that determine it by contact pattern, its fit's status and the fitted F_c
+and F_v against the truth, with their Cramér-Rao bounds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.options import FitOptions
+from wbfriction.fit.result import FitResult
+from wbfriction.friction.estimate import estimate_log
+from wbfriction.friction.estimated import FrictionEstimate
+from wbfriction.friction.options import EstimateOptions
+from wbfriction.friction.point_contacts import DeterminedShares, determined_shares
+from wbfriction.model.robot import Robot
+from wbfriction.progress import StageProgress
+from wbfriction.sim.options import SensorNoise
+from wbfriction.sim.quadruped import Drive, FootForces, QuadrupedOptions, QuadrupedRun, simulate_quadruped
+from wbfriction.walking.quadruped import Gait, GaitOptions, quadruped_reference
+
+Simulator = Literal["ideal", "mujoco"]
+REAL_NOISE = SensorNoise(encoder_bits=19, torque_std=0.05)
+"""A real robot's sensors: the encoder lattice measured on the real Aliengo (2 pi / 2^19 rad at the joint, issue
+55) and a joint torque sensor's 0.05 N·m of white noise."""
+FIXED = {"S": 0.0, "v_s": 0.1}
+"""The injected family's parameters held in the fit: no Stribeck effect (``v_s`` then has no effect)."""
+
+
+@dataclass(frozen=True)
+class QuadrupedCase:
+    """One simulated walk of :func:`run_quadruped`.
+
+    Attributes:
+        simulator: ``ideal`` or ``mujoco``; gait: :data:`~wbfriction.walking.quadruped.Gait`; drive: ``torque`` or
+        ``pd``; foot_forces: the feet's forces logged (``none``, ``normal``, ``3d``); noise: a real robot's sensor
+        noise (the simulator's), then differentiated (``diff="auto"``), else the true derivatives (``diff="true"``);
+        duration [s]; seed.
+    """
+
+    simulator: Simulator = "ideal"
+    gait: Gait = "trot"
+    drive: Drive = "torque"
+    foot_forces: FootForces = "none"
+    noise: bool = False
+    duration: float = 8.0
+    seed: int = 0
+
+
+@dataclass
+class QuadrupedStudy:
+    """What :func:`run_quadruped` measured.
+
+    Attributes:
+        case: the walk; run: the simulation; est: its estimate; fits: every joint's fit (against its truth);
+        shares: the share of samples that determine each joint by contact pattern.
+    """
+
+    case: QuadrupedCase
+    run: QuadrupedRun
+    est: FrictionEstimate
+    fits: list[FitResult]
+    shares: DeterminedShares
+    notes: list[str] = field(default_factory=list)
+
+    def worst_error(self) -> dict[str, float]:
+        """The largest error of F_c and F_v over the fitted joints [%] (NaN: none fitted)."""
+        errors = [f.error_percent() or {} for f in self.fits if f.params is not None]
+        return {p: max((e.get(p, np.nan) for e in errors), default=np.nan) for p in ("F_c", "F_v")}
+
+
+def simulate_case(robot: Robot, case: QuadrupedCase) -> QuadrupedRun:
+    """The walk of ``case`` on ``robot``, the simulator's default friction on every joint."""
+    reference = quadruped_reference(robot, GaitOptions(gait=case.gait, duration=case.duration, seed=case.seed))
+    noise = REAL_NOISE if case.noise else None
+    options = QuadrupedOptions(drive=case.drive, foot_forces=case.foot_forces, noise=noise, seed=case.seed)
+    if case.simulator == "mujoco":
+        from wbfriction.sim.quadruped_mujoco import simulate_quadruped_mujoco
+
+        return simulate_quadruped_mujoco(robot, reference, options)
+    return simulate_quadruped(robot, reference, options)
+
+
+def run_quadruped(robot: Robot, case: QuadrupedCase = QuadrupedCase(),
+                  progress: StageProgress | None = None) -> QuadrupedStudy:
+    """Simulate ``case``, estimate its friction where determined, fit every joint (module docstring)."""
+    say = progress or (lambda _label: None)
+    say(f"simulating a {case.gait} ({case.simulator}, {case.drive}-driven, {case.duration:g} s)")
+    run = simulate_case(robot, case)
+    say("estimating each joint's friction where the contacts determine it")
+    # noise-free: the true derivatives, the base's own (the IMU's gyro would be differentiated); else as a user's log
+    options = (EstimateOptions(diff="auto", route="acceleration") if case.noise else
+               EstimateOptions(diff="true", route="acceleration", base_motion="logged"))
+    est = estimate_log(robot, run.log, options)
+    say("fitting every joint")
+    fits = fit_estimate(est, FitOptions(model="thesis"), fixed=FIXED)
+    shares = determined_shares(est)
+    assert shares is not None  # a robot on point feet
+    return QuadrupedStudy(case, run, est, fits, shares)
+
+
+def study_record(study: QuadrupedStudy) -> dict:
+    """The study as JSON: the case, the shares, each joint's status, fitted F_c, F_v, their errors and bounds."""
+    joints = {}
+    for f in study.fits:
+        errors = f.error_percent() or {}
+        joints[f.joint] = {
+            "status": f.verdict().status, "samples": int(f.n_samples),
+            **{p: None if f.params is None else float(getattr(f.params, p)) for p in ("F_c", "F_v")},
+            **{f"{p}_error_percent": errors.get(p) for p in ("F_c", "F_v")},
+            **{f"{p}_bound": f.crb.get(p) if f.crb else None for p in ("F_c", "F_v")}}
+    return {"case": asdict(study.case), "shares": study.shares.to_dict(), "joints": joints,
+            "worst_error_percent": study.worst_error()}
