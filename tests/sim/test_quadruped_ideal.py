@@ -163,17 +163,19 @@ def test_each_gait_has_its_contact_pattern(robot, references):
 
 @pytest.mark.parametrize("gait", GAITS)
 def test_the_robot_stays_up_and_the_feet_push(robot, runs, references, gait):
-    """The base stays within 3 cm of its planned height and 2.5 cm of its planned place; a foot in contact pushes
-    on the ground (its normal force >= 0) except on the switch samples of a trot (within a few newtons there)."""
+    """The base stays within 2.5 cm of its planned position; a foot in contact pushes on the ground (its normal
+    force > 0) but at a switch's sample, where a landing foot may pull a little (the impact, the joints' PD on four
+    feet: under 15 N, a fifth of a stance foot's load), a foot in the air feels none; a landing foot is within 3 mm
+    of its footprint (the configuration's projection at touch-down moves it no more)."""
     run, ref = runs[gait], references[gait]
-    assert np.abs(run.log.base[:, 2] - ref.base[:, 2]).max() < 0.03
-    assert np.abs(run.log.base[:, :2] - ref.base[:, :2]).max() < 0.025
-    normal = run.force[..., 2]
+    assert np.abs(run.log.base[:, :3] - ref.base[:, :3]).max() < 0.025
     stance = run.log.contact
-    switch = stance.all(axis=1) & np.r_[False, np.any(np.diff(stance, axis=0), axis=1)]
-    assert normal[stance & ~switch[:, None]].min() > -1.0
-    assert normal[stance].min() > -10.0
+    switch = np.r_[False, np.any(np.diff(stance, axis=0), axis=1)]
+    normal = run.force[..., 2]
+    assert normal[stance & ~switch[:, None]].min() > 0
+    assert normal[stance].min() > -15.0
     assert np.all(run.force[~stance] == 0)
+    assert gait == "stand" or 0 < run.snap.max() < 0.003
 
 
 @pytest.mark.parametrize("gait", GAITS)

@@ -24,12 +24,15 @@ two point feet exert no moment about the line between them, so that a feed-forwa
 dynamics plus joint PD lets a trot tip over), plus the friction of the reference's velocities (the controller
 knows its robot's friction model; ``compensate``). Two drives:
 
-* ``torque``: the motors apply ``tau = tau_c + kp (q_ref - q) + kd (qd_ref - qd)`` held over the period (``tau_c``
-  the controller's; the log's ``tau``: the joint torque sensors sit before the friction: the command);
-* ``pd``: the robot's motor drivers (``[pd]``, :mod:`wbfriction.model.pd`) are sent ``q_des`` (the reference, in the
-  encoder's coordinates), ``qd_des`` (the reference's) and ``tau_ff`` (the controller's torque less the drivers'
-  PD at the sample) at the samples; at every physics step they apply the PD law on the encoder's angle and the
-  velocity, clipped at their limits, with each set-point as :func:`~wbfriction.model.pd.pd_torque` takes it
+* ``torque``: the motors apply ``tau = tau_c + kp (q_des - q) + kd (qd_des - qd)`` held over the period (``tau_c``
+  the controller's torque, ``q_des``, ``qd_des`` its joint set-points: the reference's on a stance leg, on a swing
+  leg those that put the foot on its reference from where the base is,
+  :meth:`~wbfriction.sim.quadruped_control.BalanceController.leg_setpoints`; the log's ``tau``: the joint torque
+  sensors sit before the friction: the command);
+* ``pd``: the robot's motor drivers (``[pd]``, :mod:`wbfriction.model.pd`) are sent the controller's ``q_des`` (in
+  the encoder's coordinates), ``qd_des`` and ``tau_ff`` (its torque, their PD on top) at the samples; at every
+  physics step they apply the PD law on the encoder's angle and the velocity, clipped at their limits, with each
+  set-point as :func:`~wbfriction.model.pd.pd_torque` takes it
   (``setpoints = "model"``: the linear interpolation of the commands at ``t - T/2 - delay``, the box average over
   one period of the held commands, held at the last command arrived where it would need a later one: a driver
   cannot know the next command), so that the law on the logged set-points gives the torque applied at the samples
@@ -313,12 +316,12 @@ class _Run:
         """The torque the motors apply at physics step ``s`` of sample ``k`` (module docstring: the drive)."""
         if s == 0:  # the controller, at the log rate
             tau = self.controller.torque(k, q, v, self.active) + self.compensation[k]
+            q_des, qd_des = self.controller.setpoints
             if self.driver is None:
-                o, ref = self.options, self.ref
-                self.held = tau + o.kp * (ref.q[k] - q[self.iq]) + o.kd * (ref.qd[k] - v[self.iv])
-            else:  # the feed-forward that makes the drivers' law give it at the command
-                d, (q_des, qd_des, tau_ff) = self.driver, self.commands
-                tau_ff[k] = tau - d.kp * (q_des[k] - (q[self.iq] + self.offset)) - d.kd * (qd_des[k] - v[self.iv])
+                o = self.options
+                self.held = tau + o.kp * (q_des - q[self.iq]) + o.kd * (qd_des - v[self.iv])
+            else:  # the drivers' set-points and feed-forward, their PD on top (as the torque drive's)
+                self.commands[0][k], self.commands[1][k], self.commands[2][k] = q_des + self.offset, qd_des, tau
                 self.step_commands = self.applied_setpoints(k)
         if self.driver is None:
             return self.held

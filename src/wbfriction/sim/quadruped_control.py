@@ -19,6 +19,12 @@ and orientation, Pinocchio's free-flyer acceleration in the base frame), the swi
 foot lands on its footprint wherever the base is), the joint angles (a light posture task). The first constraint is
 the whole body's Newton-Euler equation (the base's six rows of the equation of motion), the second keeps the stance
 feet still. Solved as one equality-constrained least-squares problem (its KKT system, about 50 unknowns).
+
+With the torque it gives joint set-points for a PD on top (the drivers' or the torque drive's,
+:meth:`BalanceController.leg_setpoints`): a stance leg's the reference's (the PD holds the base's posture over the
+feet), a swing leg's those that put its foot on its reference from where the base is (the PD moves the foot to
+its footprint, not with the base: it lands within about a millimetre of it), a landed leg's faded from the one to
+the other over ``landing`` seconds.
 """
 
 from __future__ import annotations
@@ -46,14 +52,18 @@ class BalanceGains:
         force_weight: ``w_lambda`` [1/N^2 in the tasks' units]: among forces that do the same, those nearest an
             even share of the robot's weight on the stance feet, pushing down.
         tangential: the tangential components' scale in that distance (their weight the square).
+        landing: the time a landed leg's joint set-points take to go from where its swing left them to the
+            reference's [s] (:meth:`BalanceController.leg_setpoints`).
     """
 
     base: tuple[float, float] = (50.0, 10.0)
     feet: tuple[float, float] = (400.0, 40.0)
     joints: tuple[float, float] = (100.0, 20.0)
+    feet_weight: float = 1.0
     joint_weight: float = 1e-2
     force_weight: float = 1e-4
     tangential: float = 3.0
+    landing: float = 0.1
 
 
 class BalanceController:
@@ -65,6 +75,11 @@ class BalanceController:
         self.data = model.createData()
         self.weight = float(pin.computeTotalMass(model)) * float(np.linalg.norm(model.gravity.linear))
         self.iv, self.iq = robot.act_v_index, robot.act_q_index
+        self.swing_offset = np.zeros((len(robot.contact_frames), 3))
+        self.stance_samples = np.zeros(len(robot.contact_frames), dtype=int)
+        # each leg's velocity columns and its joints' places in the actuated order
+        self.legs = [(self.iv[rows], rows) for rows in
+                     (np.array([robot.actuated.index(j) for j in robot.limb(f)]) for f in robot.contact_frames)]
         # the reference base's world velocity and acceleration (linear, angular)
         R = np.array([pin.Quaternion(np.asarray(b[3:])).toRotationMatrix() for b in reference.base])
         v, a = reference.base_v, reference.base_a
@@ -87,6 +102,7 @@ class BalanceController:
         """The joint torques (n_act,) [N·m] at sample ``k`` from the state ``q``, ``v``, the feet ``active`` (indices
         into the contact frames) standing (module docstring)."""
         model, data, g, ref = self.model, self.data, self.gains, self.ref
+        self.q_now = q
         nv, n_lam = model.nv, 3 * len(active)
         M = pin.crba(model, data, q)
         M = np.triu(M) + np.triu(M, 1).T
@@ -106,7 +122,7 @@ class BalanceController:
         for c in range(len(J)):
             if c not in active:
                 want = ref.feet_a[k, c] + kp * (ref.feet[k, c] - p[c]) + kd * (ref.feet_v[k, c] - J[c] @ v)
-                rows.append((pad(J[c]), want - drift[c], 1.0))
+                rows.append((pad(J[c]), want - drift[c], g.feet_weight))
         kp, kd = g.joints
         want = ref.qdd[k] + kp * (ref.q[k] - q[self.iq]) + kd * (ref.qd[k] - v[self.iv])
         rows.append((pad(np.eye(nv)[self.iv]), want, g.joint_weight))
@@ -123,4 +139,26 @@ class BalanceController:
         K = np.block([[H, C.T], [C, np.zeros((m, m))]])
         x = np.linalg.solve(K, np.concatenate([r, d]))
         a, lam = x[:nv], x[nv:nv + n_lam]
+        self.setpoints = self.leg_setpoints(k, v, J, p, active)
         return (M[self.iv] @ a + h[self.iv] - Js[:, self.iv].T @ lam)
+
+    def leg_setpoints(self, k: int, v: np.ndarray, J: list[np.ndarray], p: list[np.ndarray], active: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """Joint angle and velocity set-points (n_act,) each: a stance leg's, the reference's (a joint PD toward
+        them holds the base's posture over the feet); a swing leg's, those that put its foot on its reference from
+        the base where it is (one Newton step of the leg's IK from the present angles; the velocity that gives the
+        foot its reference velocity): a joint PD toward them moves the swing foot where it should land, not with
+        the base."""
+        ref = self.ref
+        fade = self.gains.landing / ref.dt
+        q_des, qd_des = ref.q[k].copy(), ref.qd[k].copy()
+        for c, (cols, rows) in enumerate(self.legs):
+            if c in active:  # the last swing's offset from the reference, faded out over the landing time
+                self.stance_samples[c] += 1
+                q_des[rows] += self.swing_offset[c] * max(0.0, 1.0 - self.stance_samples[c] / fade)
+                continue
+            J_leg = J[c][:, cols]
+            q_des[rows] = self.q_now[self.iq[rows]] + np.linalg.solve(J_leg, ref.feet[k, c] - p[c])
+            qd_des[rows] = np.linalg.solve(J_leg, ref.feet_v[k, c] - J[c][:, :6] @ v[:6])
+            self.swing_offset[c], self.stance_samples[c] = q_des[rows] - ref.q[k, rows], 0
+        return q_des, qd_des
