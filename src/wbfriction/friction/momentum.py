@@ -65,7 +65,7 @@ from wbfriction.friction.estimated import FrictionEstimate, no_single_support
 from wbfriction.friction.measured import impacts, log_base_motion
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import Log
-from wbfriction.model.determination import foot_force_torques, free_rows
+from wbfriction.model.determination import determination, foot_force_torques, free_rows
 from wbfriction.model.dynamics import floating_base_state
 from wbfriction.model.imu import base_motion_from_imu
 from wbfriction.model.measured_dynamics import measured_momentum
@@ -75,7 +75,7 @@ from wbfriction.model.stance import stance_frame_pose, stance_model
 from wbfriction.progress import Progress
 from wbfriction.signals.kinematics import MeasuredKinematics, measure, straddling, time_base
 from wbfriction.signals.options import FilterOptions
-from wbfriction.signals.phases import joint_mask, segment
+from wbfriction.signals.phases import joint_mask, segment, settled
 from wbfriction.signals.window import MomentumWindow
 
 VELOCITY_ORDER = 4
@@ -188,7 +188,8 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
         if log.base is None:
             raise InputError(f"{log.source}: a robot on point feet needs the base's measured motion: the base pose "
                              "columns base.x ... base.qw (and the IMU's imu.* with --base-motion imu)")
-        r = np.flatnonzero(rows_ok & ~straddling(log.contact))
+        # the switches' margins, as the acceleration route's (a foot touching before its flag rises pushes unseen)
+        r = np.flatnonzero(rows_ok & settled(kin.time, log.contact, options.lift_off_skip, options.touch_down_skip))
         q, v, known = _base_twist(robot, kin, log, base_motion, r)
         r, q, v = r[known], q[known], v[known]
         feet = None if log.foot_force is None else log.foot_force[r]
@@ -196,6 +197,9 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
         e[r] = foot_force_torques(robot, q, log.contact[r], feet)[:, robot.act_v_index]
         closure[r] = n_c + 1
         mask[r] = free_rows(robot, log.contact[r], feet)
+        det = determination(robot, q, log.contact[r], feet)  # what the equations determine, for the shares
+        determined, cond = np.zeros((n, len(tc)), dtype=bool), np.full(n, np.nan)
+        determined[r], cond[r] = det.determined[:, tc], det.cond
     elif has_wrench:
         assert log.wrench is not None
         rows = rows_ok & np.all(np.isfinite(log.wrench.reshape(n, -1)), axis=1) & ~straddling(log.contact)
@@ -218,6 +222,8 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
             p[r], b[r] = stance.momentum(kin.q[r], kin.qd[r], pose, progress)
             closure[r] = c
             mask[r] = per_joint[r]
+    if not robot.point_contacts:
+        determined, cond = None, None  # type: ignore[assignment]
     if require_single_support and not np.any(closure >= 0):
         raise no_single_support(robot, log.source)
     impulses = step_impulses(p[:, tc], b[:, tc], log.tau + e[:, tc], window.step_durations(n),
@@ -236,7 +242,7 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
     return FrictionEstimate(
         joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
         phase=phases.labels(), unique=closure >= 0, contact=kin.contact, contact_frames=robot.contact_frames,
-        tau_f_true=kin.tau_f_true, metadata=metadata, smoother=window, route=route)
+        tau_f_true=kin.tau_f_true, metadata=metadata, smoother=window, route=route, determined=determined, cond=cond)
 
 
 def _alignment(options: EstimateOptions, log: Log) -> str:

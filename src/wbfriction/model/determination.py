@@ -99,12 +99,17 @@ class ContactSolution:
 
 def contact_jacobian(robot: Robot, data: pin.Data, c: int) -> np.ndarray:
     """The constraint Jacobian of contact ``c`` after ``pin.computeJointJacobians`` and ``pin.updateFramePlacements``
-    on ``data``: a sole's six LOCAL rows, or a point's three linear LOCAL_WORLD_ALIGNED rows (the velocity of the
-    frame's origin in world axes), (6 or 3, nv)."""
+    on ``data``: a sole's six LOCAL rows, or a point's three rows in world axes, the velocity of its contact point:
+    the frame's origin, or with :attr:`~wbfriction.model.robot.Robot.foot_radius` ``r`` the sphere's lowest point
+    ``d = -r e_z`` from it, ``J_lin - [d]x J_ang`` (LOCAL_WORLD_ALIGNED), (6 or 3, nv)."""
     fid = robot.contact_frame_ids[c]
     if robot.contact_dims[c] == 6:
         return pin.getFrameJacobian(robot.model, data, fid, pin.LOCAL)
-    return pin.getFrameJacobian(robot.model, data, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
+    J = pin.getFrameJacobian(robot.model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+    if not robot.foot_radius:
+        return J[:3]
+    r = robot.foot_radius  # v_p = v_o + w x d, d = (0, 0, -r): w x d = (-r w_y, r w_x, 0)
+    return J[:3] + np.array([[0.0, -r, 0.0], [r, 0.0, 0.0], [0.0, 0.0, 0.0]]) @ J[3:]
 
 
 def determine(base_map: np.ndarray, joint_map: np.ndarray, r_base: np.ndarray, r_joint: np.ndarray
@@ -230,3 +235,12 @@ def foot_force_torques(robot: Robot, q: np.ndarray, contact: np.ndarray, foot_fo
                 J = contact_jacobian(robot, data, int(c))
                 out[k] += J[measured[c]].T @ foot_force[k, c, measured[c]]
     return out
+
+
+def determination(robot: Robot, q: np.ndarray, contact: np.ndarray, foot_force: np.ndarray | None = None
+                  ) -> Determination:
+    """The rank decision alone (module docstring) at configurations ``q`` (N, nq) with the feet ``contact``
+    (N, n_contacts) down and the ``foot_force`` components measured: it depends on the contact Jacobians only
+    (:func:`joint_torques` at rest; its residual is then meaningless)."""
+    zeros = np.zeros((len(q), robot.model.nv))
+    return joint_torques(robot, q, zeros, zeros, contact, foot_force).determination

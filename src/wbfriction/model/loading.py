@@ -113,7 +113,8 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
             contact flags from those sensors, :mod:`wbfriction.logs.contacts`), ``imu`` (link, xyz, rpy:
             :mod:`wbfriction.model.imu`), ``labels`` (joint name -> what a person reads,
             :mod:`wbfriction.model.labels`), ``contact_model`` (``"sole"`` or ``"point"``, or a table contact
-            frame -> kind: :attr:`Robot.contact_kinds`), ``balance_gains``
+            frame -> kind: :attr:`Robot.contact_kinds`), ``foot_radius`` (a point foot's sphere [m]:
+            :attr:`Robot.foot_radius`), ``balance_gains``
             (:attr:`Robot.balance_gains`).
         source: file name used in error messages.
         model_format: ``"urdf"`` or ``"mjcf"``: how ``urdf`` is read.
@@ -158,6 +159,7 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
         pd=parse_pd(config.get("pd"), actuated, groups, _effort_limits(model, actuated), source),
         encoder_offset=_joint_values(config, "encoder_offset", actuated, source, signed=True),
         contact_kinds=_contact_kinds(config.get("contact_model"), frames, floating, source),
+        foot_radius=_foot_radius(config.get("foot_radius", 0.0), source),
     )
 
 
@@ -373,6 +375,13 @@ def _contact_kinds(value, frames: list[str], floating: bool, source: str) -> tup
             raise InputError(f"{source}: contact_model of '{frame}' is {kind!r}: choose one of "
                              f"{', '.join(CONTACT_DIMS)}")
     return tuple(cast(ContactKind, table.get(f, "sole")) for f in frames)
+
+
+def _foot_radius(value, source: str) -> float:
+    """``foot_radius`` [m]: a number >= 0."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not value >= 0:
+        raise InputError(f"{source}: 'foot_radius' must be a number of metres >= 0, got {value!r}")
+    return float(value)
 
 
 def _groups(config: dict, actuated: list[str], source: str) -> dict[str, tuple[str, ...]]:

@@ -62,6 +62,9 @@ class Robot:
         contact_kinds: ``"sole"`` (six constraints: the frame does not move, a contact wrench) or ``"point"``
             (three: the frame's origin does not move, a contact force; a quadruped's foot) per contact frame
             (``contact_model`` in the TOML); empty: every frame a sole.
+        foot_radius: the radius of a point foot's sphere [m] (``foot_radius`` in the TOML): its contact point, where
+            the ground's force acts, is that far below the contact frame's origin (the sphere's centre), along the
+            world's vertical (flat ground); 0: at the origin.
         groups: named joint groups (e.g. ``knee``), used to set friction per group.
         q_reference: a standing configuration (nq,), e.g. TALOS's ``half_sitting``.
         balance_gains: (K [N·m/rad], D [N·m·s/rad]) of the MuJoCo walking controller's
@@ -113,6 +116,7 @@ class Robot:
     pd: PdDriver | None = None
     encoder_offset: dict[str, float] = field(default_factory=dict)
     contact_kinds: tuple[ContactKind, ...] = ()
+    foot_radius: float = 0.0
     cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
     """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.stance`)."""
 

@@ -11,7 +11,7 @@ and F_v against the truth, with their Cramér-Rao bounds.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -27,12 +27,13 @@ from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
 from wbfriction.sim.options import SensorNoise
 from wbfriction.sim.quadruped import Drive, FootForces, QuadrupedOptions, QuadrupedRun, simulate_quadruped
-from wbfriction.walking.quadruped import Gait, GaitOptions, quadruped_reference
+from wbfriction.walking.quadruped import FOOT_RADIUS, Gait, GaitOptions, quadruped_reference
 
 Simulator = Literal["ideal", "mujoco"]
 REAL_NOISE = SensorNoise(encoder_bits=19, torque_std=0.05)
 """A real robot's sensors: the encoder lattice measured on the real Aliengo (2 pi / 2^19 rad at the joint, issue
-55) and a joint torque sensor's 0.05 N·m of white noise."""
+55) and a joint torque sensor's 0.05 N·m of white noise; on MuJoCo also the drivers' velocity (0.02 rad/s), the IMU
+(0.005 rad/s, 0.05 m/s^2) and the foot forces (2 N), :data:`~wbfriction.sim.quadruped_mujoco.UNITREE_NOISE`'s."""
 FIXED = {"S": 0.0, "v_s": 0.1}
 """The injected family's parameters held in the fit: no Stribeck effect (``v_s`` then has no effect)."""
 
@@ -79,15 +80,27 @@ class QuadrupedStudy:
         return {p: max((e.get(p, np.nan) for e in errors), default=np.nan) for p in ("F_c", "F_v")}
 
 
+def case_robot(robot: Robot, case: QuadrupedCase) -> Robot:
+    """The robot as ``case``'s simulator builds it: on MuJoCo, its feet are spheres of
+    :data:`~wbfriction.walking.quadruped.FOOT_RADIUS` round the contact frames (the ground's force acts at their
+    lowest point: :attr:`~wbfriction.model.robot.Robot.foot_radius`); the ideal simulator's are points."""
+    if case.simulator != "mujoco" or robot.foot_radius:
+        return robot
+    return replace(robot, foot_radius=FOOT_RADIUS, cache={})
+
+
 def simulate_case(robot: Robot, case: QuadrupedCase) -> QuadrupedRun:
     """The walk of ``case`` on ``robot``, the simulator's default friction on every joint."""
     reference = quadruped_reference(robot, GaitOptions(gait=case.gait, duration=case.duration, seed=case.seed))
     noise = REAL_NOISE if case.noise else None
     options = QuadrupedOptions(drive=case.drive, foot_forces=case.foot_forces, noise=noise, seed=case.seed)
     if case.simulator == "mujoco":
-        from wbfriction.sim.quadruped_mujoco import simulate_quadruped_mujoco
+        from wbfriction.sim.quadruped_mujoco import QuadrupedNoise, simulate_quadruped_mujoco
 
-        return simulate_quadruped_mujoco(robot, reference, options)
+        sensors = None if not case.noise else QuadrupedNoise(
+            encoder_resolution=REAL_NOISE.resolution, torque_std=REAL_NOISE.torque_std, velocity_std=0.02,
+            gyro_std=0.005, acc_std=0.05, force_std=2.0, seed=case.seed)
+        return simulate_quadruped_mujoco(robot, reference, options, sensors)
     return simulate_quadruped(robot, reference, options)
 
 
@@ -96,11 +109,12 @@ def run_quadruped(robot: Robot, case: QuadrupedCase = QuadrupedCase(),
     """Simulate ``case``, estimate its friction where determined, fit every joint (module docstring)."""
     say = progress or (lambda _label: None)
     say(f"simulating a {case.gait} ({case.simulator}, {case.drive}-driven, {case.duration:g} s)")
+    robot = case_robot(robot, case)
     run = simulate_case(robot, case)
     say("estimating each joint's friction where the contacts determine it")
     # noise-free: the true derivatives, the base's own (the IMU's gyro would be differentiated); else as a user's log
-    options = (EstimateOptions(diff="auto", route="acceleration") if case.noise else
-               EstimateOptions(diff="true", route="acceleration", base_motion="logged"))
+    options = (EstimateOptions() if case.noise else
+               EstimateOptions(diff="true", route="acceleration", base_motion="logged", check_route=False))
     est = estimate_log(robot, run.log, options)
     say("fitting every joint")
     fits = fit_estimate(est, FitOptions(model="thesis"), fixed=FIXED)
