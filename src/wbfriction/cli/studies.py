@@ -300,3 +300,38 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
     console.print(f"study finished in {time.perf_counter() - start:.1f} s")
 
 
+
+
+@app.command("study-quadruped")
+def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped"), "-o", "--output-dir",
+                                                    help="Where to write."),
+                    robot: str = typer.Option("go2_walking", help="A built-in quadruped on point feet."),
+                    simulator: str = typer.Option("ideal", help="ideal (point feet welded while down) or mujoco "
+                                                                "(soft contacts, sphere feet)."),
+                    gait: str = typer.Option("trot", help="trot, walk (three feet down), step (a trot in place) "
+                                                          "or stand."),
+                    drive: str = typer.Option("torque", help="torque (joint torque sensors) or pd (the drivers' "
+                                                             "PD law on the logged set-points)."),
+                    foot_forces: str = typer.Option("none", help="The feet's forces logged: none, normal or 3d."),
+                    noise: bool = typer.Option(False, "--noise", help="A real robot's sensors (19-bit encoders, "
+                                                                      "0.05 N·m torques; on MuJoCo the IMU and "
+                                                                      "foot forces too): estimated as a user's log "
+                                                                      "(route and differentiation chosen)."),
+                    duration: float = typer.Option(8.0, min=1.0, help="Simulated time [s]."),
+                    seed: int = typer.Option(0, help="The gait's and the noise's seed.")) -> None:
+    """What each gait gives a walking quadruped (issue 56): per joint, the share of samples where its friction is
+    determined, by feet on the ground, and its fit against the injected friction."""
+    from wbfriction.report.terminal import determination_table
+    from wbfriction.studies.quadruped import QuadrupedCase, case_robot, fits_markdown, run_quadruped, write_study
+
+    case = QuadrupedCase(simulator=simulator, gait=gait, drive=drive, foot_forces=foot_forces,  # type: ignore[arg-type]
+                         noise=noise, duration=duration, seed=seed)
+    r = case_robot(robot_of(robot, None, None), case)
+    if not r.point_contacts:
+        raise InputError(f"--robot {robot}: not a robot on point feet (contact_model = \"point\" in its TOML)")
+    with console.status("") as status:
+        study = run_quadruped(r, case, progress=lambda label: status.update(label))
+    console.print(determination_table(study.shares, r.labels))
+    out.print(escape(fits_markdown(study)), highlight=False, soft_wrap=True)
+    for f in write_study(r, study, output_dir):
+        console.print(f"wrote {f}")

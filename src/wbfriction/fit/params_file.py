@@ -90,7 +90,7 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
                          "rms_residual": clean(fit.rms_residual), "model": fit.model,
                          "params": None if fit.params is None else fit.params.to_dict(),
                          "stderr": {k: clean(v) for k, v in fit.stderr.items()},
-                         "at_bound": dict(fit.at_bound), "speed": fit.speed}
+                         "at_bound": dict(fit.at_bound), "speed": fit.speed, "reverse": fit.reverse}
     if fit.params is not None and fit.covariance is not None:  # the curve's standard error at any speed
         d["covariance"] = [[clean(float(x)) for x in row] for row in fit.covariance]
     d["crb"] = {k: clean(v) for k, v in fit.crb.items()}
@@ -138,7 +138,8 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
                                    n_screened=int(d.get("n_screened", 0)),
                                    success=bool(d.get("success", False)), message=str(d.get("message", "")),
                                    rms_residual=_number(d.get("rms_residual")), model=model,
-                                   speed=None if d.get("speed") is None else _number(d["speed"]))
+                                   speed=None if d.get("speed") is None else _number(d["speed"]),
+                                   reverse=None if d.get("reverse") is None else _number(d["reverse"]))
         if d.get("params") is not None:
             res.params = params_from_dict(model, d["params"])
             missing = [n for n in res.params.names if n not in d["params"]]

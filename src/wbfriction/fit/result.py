@@ -138,6 +138,9 @@ class FitResult(Generic[ParamsT]):
         speed: the 95th percentile of ``|qd|`` over the samples fitted and those left out as sticking [rad/s]
             (how much the joint moved), or
             None (not known: a parameters file of an earlier version).
+        reverse: the share of the fitted samples moving the less frequent way
+            (:func:`~wbfriction.fit.status.reverse_share`), or None (not known: a parameters file of an earlier
+            version).
         covariance: the parameters' covariance (p, p) in :attr:`params`' order (held ones: 0; ``inf`` rows
             for one that is not identifiable; :func:`parameter_covariance`), or None (not fitted, or read
             from a parameters file, which keeps only the standard errors).
@@ -178,6 +181,7 @@ class FitResult(Generic[ParamsT]):
     selection: ModelSelection | None = None
     n_screened: int = 0
     speed: float | None = None
+    reverse: float | None = None
     covariance: np.ndarray | None = field(default=None, repr=False, compare=False)
     crb: dict[str, float] = field(default_factory=dict)
     torque_noise: float | None = None

@@ -44,7 +44,7 @@ from wbfriction.fit.solve import (
     model_gradient,
     shown_friction,
 )
-from wbfriction.fit.status import MIN_SPEED
+from wbfriction.fit.status import MIN_SPEED, reverse_share
 from wbfriction.friction.families.base import FrictionFamily
 from wbfriction.friction.families.registry import families, family
 from wbfriction.friction.models import ModelName, ModelParamsBase
@@ -184,7 +184,7 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         else:
             res = fit_named(named, qd, y, use, x0=x0, still=still if speed < MIN_SPEED else None, **kwargs)
     res.n_screened, res.n_stuck = int(screened.sum()), int(stuck.sum())
-    res.speed, res.velocity_noise = speed, float(velocity_noise)
+    res.speed, res.velocity_noise, res.reverse = speed, float(velocity_noise), reverse_share(qd[use])
     res.stick_speed, res.pass_rows = float(stick), float(pass_rows)
     return res
 

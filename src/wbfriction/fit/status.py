@@ -23,7 +23,9 @@ status, the first that applies:
   (:mod:`~wbfriction.fit.holdout`): the friction changed over the log, or a model error the standard errors
   do not see (the errors and held-out RMS given); a term beyond velocity that departs on the later stretch makes
   its joint so too (:mod:`~wbfriction.fit.term_selection`);
-* ``weak``: a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error, or a Cramér-Rao bound
+* ``weak``: the joint moved one way (the other on fewer than :data:`MIN_REVERSE` of its samples: its Coulomb
+  friction and offset are not separable, whatever their standard errors say), or
+  a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error, or a Cramér-Rao bound
   (:mod:`~wbfriction.fit.bound`: what the data allow any unbiased estimator), above :data:`WEAK` of its
   (non-zero) value, or is not identifiable (infinite standard error); a magnitude at zero whose standard error
   or bound stands for more than :data:`WEAK` of the friction the joint shows (``F_c``'s in N·m, ``F_v``'s times
@@ -59,6 +61,22 @@ FitStatus = Literal["ok", "weak", "does not predict", "routes disagree", "at bou
 FIT_STATUSES: tuple[FitStatus, ...] = get_args(FitStatus)
 MIN_SPEED = 0.02
 """A joint whose 95th percentile of ``|qd|`` over the fitted samples is below this [rad/s] is not excited."""
+
+
+MIN_REVERSE = 0.05
+"""A joint whose fitted samples move the other way on fewer than this share of them (:func:`reverse_share`) cannot
+separate its Coulomb friction from its offset: ``F_c sgn(qd)`` and ``tau_os`` are then one column but for those few
+samples, and the two numbers rest on them (on 5 % the pair's information is a fifth of an even log's). A walking
+quadruped's thigh seen only while its leg swings (issue 56) moves one way; no real arm's log comes near
+(measured in the issue's note)."""
+
+
+def reverse_share(qd: np.ndarray) -> float:
+    """The share of samples ``qd`` (n,) [rad/s] moving the less frequent way (``qd`` of the sign fewer of them have;
+    zero counts as neither); 0.5 for none."""
+    qd = np.asarray(qd, dtype=float)
+    up, down = int(np.sum(qd > 0)), int(np.sum(qd < 0))
+    return min(up, down) / (up + down) if up + down else 0.5
 
 
 def joint_speed(qd: np.ndarray) -> float:
@@ -191,9 +209,13 @@ def fit_verdict(fit: Fit, thresholds: StatusThresholds = DEFAULT_THRESHOLDS) -> 
 
 
 def _weak_verdict(fit: Fit, weak: list[str]) -> FitVerdict:
-    """``weak`` for the large standard errors ``weak`` or a noise not measured (``fit.unmeasured``), else ``ok``."""
+    """``weak`` for a joint that moved one way (:data:`MIN_REVERSE`), the large standard errors ``weak`` or a noise
+    not measured (``fit.unmeasured``), else ``ok``."""
     unmeasured = str(getattr(fit, "unmeasured", "") or "")
-    reasons = ([unmeasured] if unmeasured else []) + (
+    reverse, names = getattr(fit, "reverse", None), fit.params.names
+    one_way = [f"it moved one way (the other on {100 * reverse:.1f} % of its samples): F_c and tau_os are not "
+               "separable"] if reverse is not None and reverse < MIN_REVERSE and {"F_c", "tau_os"} <= set(names) else []
+    reasons = ([unmeasured] if unmeasured else []) + one_way + (
         ["large standard errors: " + ", ".join(weak)] if weak else [])
     return FitVerdict("weak", "; ".join(reasons)) if reasons else FitVerdict("ok")
 

@@ -12,10 +12,12 @@ and F_v against the truth, with their Cramér-Rao bounds.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, replace
-from typing import Literal
+from pathlib import Path
+from typing import Literal, get_args
 
 import numpy as np
 
+from wbfriction.exceptions import OptionError
 from wbfriction.fit.joints import fit_estimate
 from wbfriction.fit.options import FitOptions
 from wbfriction.fit.result import FitResult
@@ -30,6 +32,7 @@ from wbfriction.sim.quadruped import Drive, FootForces, QuadrupedOptions, Quadru
 from wbfriction.walking.quadruped import FOOT_RADIUS, Gait, GaitOptions, quadruped_reference
 
 Simulator = Literal["ideal", "mujoco"]
+SIMULATORS: tuple[Simulator, ...] = get_args(Simulator)
 REAL_NOISE = SensorNoise(encoder_bits=19, torque_std=0.05)
 """A real robot's sensors: the encoder lattice measured on the real Aliengo (2 pi / 2^19 rad at the joint, issue
 55) and a joint torque sensor's 0.05 N·m of white noise; on MuJoCo also the drivers' velocity (0.02 rad/s), the IMU
@@ -56,6 +59,12 @@ class QuadrupedCase:
     noise: bool = False
     duration: float = 8.0
     seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.simulator not in SIMULATORS:
+            raise OptionError("--simulator", self.simulator, f"one of {', '.join(SIMULATORS)}")
+        GaitOptions(gait=self.gait, duration=self.duration)  # what they refuse, before any simulation
+        QuadrupedOptions(drive=self.drive, foot_forces=self.foot_forces)
 
 
 @dataclass
@@ -135,3 +144,56 @@ def study_record(study: QuadrupedStudy) -> dict:
             **{f"{p}_bound": f.crb.get(p) if f.crb else None for p in ("F_c", "F_v")}}
     return {"case": asdict(study.case), "shares": study.shares.to_dict(), "joints": joints,
             "worst_error_percent": study.worst_error()}
+
+
+def write_study(robot: Robot, study: QuadrupedStudy, output_dir: Path) -> list[Path]:
+    """The study's log, friction table, parameters JSON, record (``quadruped.json``) and Markdown (``quadruped.md``)
+    into ``output_dir``; ``robot`` the one the log was simulated and estimated with (:func:`case_robot`)."""
+    from wbfriction.fit.params_file import write_params
+    from wbfriction.friction.io import friction_table
+    from wbfriction.logs.log import write_log
+    from wbfriction.logs.tables import make_folder, write_atomic, write_json, write_table
+
+    make_folder(output_dir)
+    files = [output_dir / n for n in ("quadruped_log.parquet", "quadruped_friction.parquet", "quadruped_params.json",
+                                      "quadruped.json", "quadruped.md")]
+    write_log(study.run.log, robot, files[0])
+    write_table(friction_table(study.est), files[1])
+    write_params(files[2], study.fits, {"robot": robot.name, "case": asdict(study.case)})
+    write_json(files[3], study_record(study))
+    write_atomic(files[4], lambda tmp: tmp.write_text(quadruped_markdown(study)))
+    return files
+
+
+def quadruped_markdown(study: QuadrupedStudy) -> str:
+    """The study as Markdown: the share of samples that determine each joint by feet on the ground, then each
+    joint's fit (status, F_c and F_v against the truth, their bounds)."""
+    shares, case = study.shares, study.case
+    feet = [p.replace("_foot", "") for p in shares.patterns]
+    lines = [f"# A {case.gait} ({case.simulator}, {case.drive}-driven, foot forces: {case.foot_forces}, "
+             f"{'a real robot' + chr(39) + 's noise' if case.noise else 'noise-free'}, {case.duration:g} s)", "",
+             "Share of samples [%] that determine each joint's friction, by feet on the ground (samples):", "",
+             "| joint | " + " | ".join(f"{p} ({n})" for p, n in zip(feet, shares.samples)) + f" | all "
+             f"({int(shares.samples.sum())}) |", "|---" * (len(feet) + 2) + "|"]
+    for i, j in enumerate(shares.joints):
+        lines.append(f"| {j} | " + " | ".join(f"{100 * s:.0f}" for s in shares.share[:, i])
+                     + f" | {100 * shares.overall[i]:.0f} |")
+    return "\n".join(lines) + "\n\n" + fits_markdown(study)
+
+
+def fits_markdown(study: QuadrupedStudy) -> str:
+    """Each joint's fit as Markdown: status, samples, F_c and F_v against the injected friction, the worst."""
+    route = study.est.metadata.get("route", {}).get("route", "acceleration")
+    lines = [f"Fits ({route} route), errors against the injected friction:", "",
+             "| joint | status | samples | F_c error [%] | F_v error [%] |", "|---|---|---|---|---|"]
+    for f in study.fits:
+        e = f.error_percent() or {}
+        lines.append(f"| {f.joint} | {f.verdict().status} | {f.n_samples} | {_pct(e.get('F_c'))} | "
+                     f"{_pct(e.get('F_v'))} |")
+    worst = study.worst_error()
+    lines += ["", f"Worst: F_c {_pct(worst['F_c'])} %, F_v {_pct(worst['F_v'])} %."]
+    return "\n".join(lines) + "\n"
+
+
+def _pct(x: float | None) -> str:
+    return "–" if x is None or not np.isfinite(x) else f"{x:.1f}"
