@@ -4,10 +4,13 @@ forces; the contact pattern's shares; what is refused."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pinocchio as pin
 import pytest
 
+from helpers import run_cli, widest_line
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.io import friction_table, read_friction_file
@@ -134,3 +137,40 @@ def test_refusals(go2):
     for options in (TRUE, EstimateOptions(diff="central", route="momentum", check_route=False)):
         with pytest.raises(InputError, match="nobase.parquet: a robot on point feet needs the base's measured motion"):
             estimate_log(go2, no_base, options)
+
+
+def test_estimate_prints_the_shares_by_feet_down(go2, tmp_path, capsys):
+    """``wbfriction estimate`` on a robot on point feet prints, per joint, the share of samples that determine it by
+    the feet on the ground, within 100 columns."""
+    log = tmp_path / "trot.parquet"
+    write_log(exact_log(go2), go2, log)
+    code, text = run_cli(capsys, "estimate", str(log), "--robot", "go2_walking", "--diff", "true", "-o",
+                         str(tmp_path / "f.parquet"))
+    assert code == 0
+    lines = text.splitlines()
+    head = next(i for i, line in enumerate(lines) if line.startswith("determined: share of samples"))
+    columns = lines[head + 1].split()
+    assert sorted(columns) == ["FL+FR+RL+RR", "FL+RR", "FR+RL", "all"]
+    rows = {line[:18].strip(): dict(zip(columns, line[18:].split()[::2])) for line in lines[head + 3:head + 15]}
+    assert len(rows) == 12
+    assert rows["front left hip"] == {**rows["front left hip"], "FR+RL": "100", "FL+RR": "0", "FL+FR+RL+RR": "0"}
+    assert rows["front right hip"] == {**rows["front right hip"], "FR+RL": "0", "FL+RR": "100", "FL+FR+RL+RR": "0"}
+    assert widest_line(text) <= 100
+
+
+def test_contact_point_below_a_spherical_foot(go2):
+    """With ``foot_radius`` r, a point foot's Jacobian gives the velocity of the sphere's lowest point, ``v_o + w x
+    (0, 0, -r)`` (the frame's velocity in world axes, Pinocchio's own)."""
+    robot = replace(go2, foot_radius=0.023, cache={})
+    model, data = robot.model, robot.model.createData()
+    rng = np.random.default_rng(3)
+    q = robot.configuration(robot.reference_angles + rng.normal(0, 0.2, robot.n_act), np.r_[0, 0, 0.3, 0, 0, 0, 1])
+    v = rng.normal(0, 1, model.nv)
+    pin.forwardKinematics(model, data, q, v)
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    for c, fid in enumerate(robot.contact_frame_ids):
+        twist = pin.getFrameVelocity(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+        expected = twist.linear + np.cross(twist.angular, [0.0, 0.0, -0.023])
+        assert np.allclose(contact_jacobian(robot, data, c) @ v, expected, atol=1e-12)
+        assert np.allclose(contact_jacobian(go2, data, c) @ v, twist.linear, atol=1e-12)

@@ -323,8 +323,8 @@ def determination_table(shares: DeterminedShares, labels: Mapping[str, str] | No
     label = _labeller(labels)
     suffix = _common_suffix([f for p in shares.patterns if p != "flight" for f in p.split("+")])
     table = _table("determined: share of samples, by feet on the ground", ["joint"], [], caption=(
-        "a joint is determined where the equations of motion leave its friction unique (the rank of [S^T J^T], "
-        "foot forces counted where logged); samples within the switches' margins are not counted"))
+        "where the equations of motion leave a joint's friction unique\n(the rank of [S^T J^T], the logged foot "
+        "forces counted;\nsamples within the switches' margins not counted)"))
     for pattern, n in zip(shares.patterns, shares.samples):
         name = "+".join(f.removesuffix(suffix) for f in pattern.split("+")) if pattern != "flight" else pattern
         table.add_column(f"{name}\n({n})", justify="right", no_wrap=True)

@@ -140,8 +140,9 @@ def white_position_noise(acc: np.ndarray, dt: float, frame: int = FRAME, changes
     gain = tapered_gain(second_difference_gain(freq, dt))
     upper = freq >= freq[-1] / 2
     per_frame = np.median((amp[upper] / gain[upper, None, None]) ** 2, axis=0) / math.log(2.0)  # (M, n)
-    counted = share > 0.5 if np.any(share > 0.5) else share > 0  # a frame mostly left out measures little
-    per_frame = per_frame[counted] / share[counted, None]
+    if changes is not None:  # a frame mostly left out measures little
+        counted = share > 0.5 if np.any(share > 0.5) else share > 0
+        per_frame = per_frame[counted] / share[counted, None]
     # E amp^2 of white noise through a Hann taper: 4 sigma^2 |G|^2 sum(w^2) / L^2, sum(w^2) = 3 L / 8
     return np.sqrt(np.median(per_frame, axis=0) * length / 1.5)
 
