@@ -241,9 +241,14 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
         ``pi_fit``/``friction_fit`` the fit's, ``validation`` the decision per limb.
 
     Raises:
-        InputError: no single-support sample to learn from, or none held out.
+        InputError: no single-support sample to learn from, or none held out; a robot on point feet (its equations
+            hold the joints' torques where the feet leave them determined, :mod:`wbfriction.model.determination`,
+            not on a tree rooted at a sole: not taken yet).
 
     """
+    if robot.point_contacts:
+        raise InputError(f"{log.source}: the inertia identification roots the robot at a sole in single support "
+                         f"(thesis ch. 8); robot '{robot.name}' stands on point feet, which it does not take yet")
     if blas_threads is not None:
         with threadpool_limits(blas_threads, user_api="blas"):
             return identify_inertia(robot, log, estimate_options, options, progress, shared, None)
