@@ -264,3 +264,30 @@ def load_yaml(text: str, version: tuple[int, int] | None = None):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         return yaml.load(text)
+
+
+def consistent_motion(robot, q: np.ndarray, v: np.ndarray, a_joint: np.ndarray, contact: np.ndarray,
+                      force: np.ndarray, tau_f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Exact data for a robot on point feet: the base's acceleration that the contact forces ``force`` (N, n_c, 3)
+    (world axes, at the feet ``contact`` (N, n_c) down) make with the joints' accelerations ``a_joint`` (N, n_act),
+    its six rows solved, and the joint torques ``tau`` (N, n_act) the motion then needs less the friction ``tau_f``
+    (the equation of motion ``M a + h = S^T (tau + tau_f) + sum J^T f`` holds to round-off); returns ``(a, tau)``."""
+    import pinocchio as pin
+
+    from wbfriction.model.determination import contact_jacobian
+
+    model, data = robot.model, robot.model.createData()
+    a = np.zeros((len(q), model.nv))
+    tau = np.empty((len(q), robot.n_act))
+    for k in range(len(q)):
+        a[k, robot.act_v_index] = a_joint[k]
+        pin.computeJointJacobians(model, data, q[k])
+        pin.updateFramePlacements(model, data)
+        ext = sum((contact_jacobian(robot, data, c).T @ force[k, c] for c in np.flatnonzero(contact[k])),
+                  np.zeros(model.nv))
+        M = pin.crba(model, data, q[k])
+        a[k, :6] = -np.linalg.solve(M[:6, :6], (pin.rnea(model, data, q[k], v[k], a[k]) - ext)[:6])
+        r = pin.rnea(model, data, q[k], v[k], a[k]) - ext
+        assert np.abs(r[:6]).max() < 1e-9
+        tau[k] = r[robot.act_v_index] - tau_f[k]
+    return a, tau

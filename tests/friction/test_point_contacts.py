@@ -10,7 +10,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from helpers import run_cli, widest_line
+from helpers import consistent_motion, run_cli, widest_line
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.io import friction_table, read_friction_file
@@ -38,7 +38,6 @@ def exact_log(robot, n: int = 600, forces: str = "none", seed: int = 0) -> Log:
     are not one trajectory (the base's pose does not integrate its acceleration): with the true derivatives
     (diff "true") the estimator reads each one alone."""
     rng = np.random.default_rng(seed)
-    model, data = robot.model, robot.model.createData()
     t = np.arange(n) * DT
     phase = 2 * np.pi * t / 0.5
     amp, off = rng.uniform(0.1, 0.3, robot.n_act), rng.uniform(0, 2 * np.pi, robot.n_act)
@@ -51,24 +50,12 @@ def exact_log(robot, n: int = 600, forces: str = "none", seed: int = 0) -> Log:
     base = np.tile([0.0, 0.0, 0.3, 0.0, 0.0, 0.0, 1.0], (n, 1))
     base[:, 3] = 0.05 * np.sin(phase)  # a roll
     base[:, 3:] /= np.linalg.norm(base[:, 3:], axis=1, keepdims=True)
-    v = np.zeros((n, model.nv))
+    v = np.zeros((n, robot.model.nv))
     v[:, :6] = rng.normal(0, 0.2, (n, 6))
     v[:, robot.act_v_index] = qd
     force = rng.normal(0, 15, (n, 4, 3)) + [0, 0, 50]
     tau_f = -(0.3 * np.tanh(50 * qd) + 0.1 * qd)
-    a = np.zeros((n, model.nv))
-    tau = np.empty((n, robot.n_act))
-    q = robot.configuration(angles, base)
-    for k in range(n):
-        a[k, robot.act_v_index] = qdd_j[k]
-        pin.computeJointJacobians(model, data, q[k])
-        pin.updateFramePlacements(model, data)
-        ext = sum((contact_jacobian(robot, data, c).T @ force[k, c] for c in np.flatnonzero(contact[k])),
-                  np.zeros(model.nv))
-        M = pin.crba(model, data, q[k])
-        r0 = pin.rnea(model, data, q[k], v[k], a[k]) - ext
-        a[k, :6] = -np.linalg.solve(M[:6, :6], r0[:6])
-        tau[k] = (pin.rnea(model, data, q[k], v[k], a[k]) - ext)[robot.act_v_index] - tau_f[k]
+    a, tau = consistent_motion(robot, robot.configuration(angles, base), v, qdd_j, contact, force, tau_f)
     foot_force = None
     if forces != "none":
         foot_force = np.where(contact[..., None], force, 0.0)

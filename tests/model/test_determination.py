@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from helpers import consistent_motion
 from wbfriction.model.determination import COND_MAX, contact_jacobian, determine, joint_torques
 from wbfriction.model.loading import load_robot
 
@@ -76,28 +77,6 @@ def test_point_feet_decision(go2, feet, determined_legs, nullity):
         assert (det.cond < 30).all()  # a regular stance is well conditioned
 
 
-def _consistent(robot, q, v, a_joint, flags, force, tau_f):
-    """Exact data: the base's acceleration that the contact forces ``force`` (per foot, world axes) make (its six
-    rows solved), and the joint torques tau the motion then needs, less ``tau_f``."""
-    model, data = robot.model, robot.model.createData()
-    n = len(q)
-    a = np.zeros((n, model.nv))
-    tau = np.empty((n, robot.n_act))
-    for k in range(n):
-        a[k, robot.act_v_index] = a_joint[k]
-        pin.computeJointJacobians(model, data, q[k])
-        pin.updateFramePlacements(model, data)
-        ext = sum((contact_jacobian(robot, data, c).T @ force[k, c] for c in np.flatnonzero(flags[k])),
-                  np.zeros(model.nv))
-        M = pin.crba(model, data, q[k])
-        r0 = pin.rnea(model, data, q[k], v[k], a[k]) - ext  # base acceleration zero
-        a[k, :6] = -np.linalg.solve(M[:6, :6], r0[:6])
-        r = pin.rnea(model, data, q[k], v[k], a[k]) - ext
-        assert np.abs(r[:6]).max() < 1e-9
-        tau[k] = r[robot.act_v_index] - tau_f[k]
-    return a, tau
-
-
 @settings(max_examples=15, deadline=None)
 @given(seed=st.integers(0, 10_000), feet=st.sampled_from([(1, 0, 0, 1), (0, 1, 1, 0), (1, 1, 1, 0), (0, 1, 1, 1),
                                                             (1, 1, 1, 1), (0, 0, 1, 0), (0, 0, 0, 0)]),
@@ -110,7 +89,7 @@ def test_determined_torques_are_exact(go2, seed, feet, forces):
     flags = np.tile(np.array(feet, dtype=bool), (2, 1))
     force = rng.normal(0, 40, (2, 4, 3)) + [0, 0, 60]
     tau_f = rng.normal(0, 1, (2, go2.n_act))
-    a, tau = _consistent(go2, q, v, rng.normal(0, 2, (2, go2.n_act)), flags, force, tau_f)
+    a, tau = consistent_motion(go2, q, v, rng.normal(0, 2, (2, go2.n_act)), flags, force, tau_f)
     measured = {"none": None, "3d": force,
                 "normal": np.where(np.arange(3) == 2, force, np.nan)}[forces]
     sol = joint_torques(go2, q, v, a, flags, measured)
