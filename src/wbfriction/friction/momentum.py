@@ -65,7 +65,7 @@ from wbfriction.friction.estimated import FrictionEstimate, no_single_support
 from wbfriction.friction.measured import impacts, log_base_motion
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import Log
-from wbfriction.model.determination import determination, foot_force_torques, free_rows
+from wbfriction.model.determination import Determination, determination, foot_force_torques, free_rows
 from wbfriction.model.dynamics import floating_base_state
 from wbfriction.model.imu import base_motion_from_imu
 from wbfriction.model.measured_dynamics import measured_momentum
@@ -175,30 +175,18 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
     kin = measure(log, "savgol", compensate_delay=options.compensate_delay, torque_alignment=options.torque_alignment,
                   filtering=velocity_filter(options), velocity=options.velocity,
                   base_motion=floating and log.base is not None, imu=floating and base_motion == "imu")
-    n, tc = len(log.time), robot.tc_index
+    n, tc, n_c = len(log.time), robot.tc_index, len(robot.contact_frames)
     phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip, gaps)
     rows_ok = _filter_rows(kin, log.contact) & np.all(np.isfinite(kin.q), axis=1) & np.all(np.isfinite(kin.qd), axis=1)
-    # the closure of each row: -1 none, c in [0, n_contacts) the rigid stance on contact c, n_contacts the wrenches
-    n_c = len(robot.contact_frames)
+    # each row's closure: -1 none, c < n_c the rigid stance on contact c, n_c the wrenches, n_c + 1 the point feet
     closure = np.full(n, -1)
     p, b = np.full((n, robot.n_act), np.nan), np.full((n, robot.n_act), np.nan)
     e = np.zeros((n, robot.n_act))  # the sensors' wrenches' joint torques, read as the torques are
     mask = np.zeros((n, len(tc)), dtype=bool)
+    determined, cond = None, None  # point feet: the rank decision on the rows taken, for the shares
     if robot.point_contacts:
-        if log.base is None:
-            raise InputError(f"{log.source}: a robot on point feet needs the base's measured motion: the base pose "
-                             "columns base.x ... base.qw (and the IMU's imu.* with --base-motion imu)")
-        # the switches' margins, as the acceleration route's (a foot touching before its flag rises pushes unseen)
-        r = np.flatnonzero(rows_ok & settled(kin.time, log.contact, options.lift_off_skip, options.touch_down_skip))
-        q, v, known = _base_twist(robot, kin, log, base_motion, r)
-        r, q, v = r[known], q[known], v[known]
-        feet = None if log.foot_force is None else log.foot_force[r]
-        p[r], b[r] = (x[:, robot.act_v_index] for x in momentum_and_drift(robot.model, q, v, progress=progress)[:2])
-        e[r] = foot_force_torques(robot, q, log.contact[r], feet)[:, robot.act_v_index]
-        closure[r] = n_c + 1
-        mask[r] = free_rows(robot, log.contact[r], feet)
-        det = determination(robot, q, log.contact[r], feet)  # what the equations determine, for the shares
-        determined, cond = np.zeros((n, len(tc)), dtype=bool), np.full(n, np.nan)
+        r, mask_r, det = _point_feet(robot, kin, log, options, base_motion, rows_ok, (p, b, e), progress)
+        closure[r], mask[r], determined, cond = n_c + 1, mask_r, np.zeros((n, len(tc)), dtype=bool), np.full(n, np.nan)
         determined[r], cond[r] = det.determined[:, tc], det.cond
     elif has_wrench:
         assert log.wrench is not None
@@ -222,27 +210,47 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
             p[r], b[r] = stance.momentum(kin.q[r], kin.qd[r], pose, progress)
             closure[r] = c
             mask[r] = per_joint[r]
-    if not robot.point_contacts:
-        determined, cond = None, None  # type: ignore[assignment]
     if require_single_support and not np.any(closure >= 0):
         raise no_single_support(robot, log.source)
     impulses = step_impulses(p[:, tc], b[:, tc], log.tau + e[:, tc], window.step_durations(n),
                              _alignment(options, log), closure)
     tau_f = window.over_steps(impulses)
     valid = _whole_windows(mask, window.half_width) & np.isfinite(tau_f)
-    route = np.where(closure == n_c, "wrench", np.where(closure == n_c + 1, "base",
-                                                        np.where(closure >= 0, "contact", "none"))).astype("<U7")
-    metadata = dict(kin.metadata)
-    metadata.update(robot=robot.name, source=log.source)
-    metadata["base_motion"] = {"base": base_motion, "wrenches": has_wrench}
-    metadata["estimate_options"] = asdict(options)
-    metadata["joint_labels"] = {j: robot.label(j) for j in robot.torque_controlled}
-    metadata["momentum"] = {"velocity_window": velocity_filter(options).window, "window": window.length,
-                            "window_s": window.length * log.dt, "cutoff_hz": window.cutoff, "lag_s": 0.0}
+    route = np.select([closure == n_c, closure == n_c + 1, closure >= 0], ["wrench", "base", "contact"],
+                      "none").astype("<U7")
+    metadata = {**kin.metadata, "robot": robot.name, "source": log.source,
+                "base_motion": {"base": base_motion, "wrenches": has_wrench}, "estimate_options": asdict(options),
+                "joint_labels": {j: robot.label(j) for j in robot.torque_controlled},
+                "momentum": {"velocity_window": velocity_filter(options).window, "window": window.length,
+                             "window_s": window.length * log.dt, "cutoff_hz": window.cutoff, "lag_s": 0.0}}
     return FrictionEstimate(
         joints=robot.torque_controlled, time=kin.time, qd=kin.qd[:, tc], tau_f=tau_f, valid=valid,
         phase=phases.labels(), unique=closure >= 0, contact=kin.contact, contact_frames=robot.contact_frames,
         tau_f_true=kin.tau_f_true, metadata=metadata, smoother=window, route=route, determined=determined, cond=cond)
+
+
+def _point_feet(robot: Robot, kin: MeasuredKinematics, log: Log, options: EstimateOptions, base_motion: str,
+                rows_ok: np.ndarray, out: tuple[np.ndarray, np.ndarray, np.ndarray], progress: Progress | None
+                ) -> tuple[np.ndarray, np.ndarray, Determination]:
+    """The ``base`` closure of a robot on point feet (module docstring): its momenta, rates and measured foot forces'
+    torques written into ``out = (p, b, e)`` (N, n_act) at the rows it takes (outside the switches' margins, as the
+    acceleration route's: a foot touching before its flag rises pushes unseen, its base twist known); returns those
+    rows (M,), the joint rows they hold with no unknown force (M, n_tc) and what the equations determine there.
+
+    Raises:
+        InputError: a log without the base pose.
+    """
+    if log.base is None:
+        raise InputError(f"{log.source}: a robot on point feet needs the base's measured motion: the base pose "
+                         "columns base.x ... base.qw (and the IMU's imu.* with --base-motion imu)")
+    r = np.flatnonzero(rows_ok & settled(kin.time, log.contact, options.lift_off_skip, options.touch_down_skip))
+    q, v, known = _base_twist(robot, kin, log, base_motion, r)
+    r, q, v = r[known], q[known], v[known]
+    feet = None if log.foot_force is None else log.foot_force[r]
+    p, b, e = out
+    p[r], b[r] = (x[:, robot.act_v_index] for x in momentum_and_drift(robot.model, q, v, progress=progress)[:2])
+    e[r] = foot_force_torques(robot, q, log.contact[r], feet)[:, robot.act_v_index]
+    return r, free_rows(robot, log.contact[r], feet), determination(robot, q, log.contact[r], feet)
 
 
 def _alignment(options: EstimateOptions, log: Log) -> str:

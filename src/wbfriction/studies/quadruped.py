@@ -11,9 +11,9 @@ and F_v against the truth, with their Cramér-Rao bounds.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import Literal, get_args
+from typing import get_args
 
 import numpy as np
 
@@ -27,11 +27,10 @@ from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.point_contacts import DeterminedShares, determined_shares
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
-from wbfriction.sim.options import SensorNoise
+from wbfriction.sim.options import SensorNoise, Simulator
 from wbfriction.sim.quadruped import Drive, FootForces, QuadrupedOptions, QuadrupedRun, simulate_quadruped
 from wbfriction.walking.quadruped import FOOT_RADIUS, Gait, GaitOptions, quadruped_reference
 
-Simulator = Literal["ideal", "mujoco"]
 SIMULATORS: tuple[Simulator, ...] = get_args(Simulator)
 REAL_NOISE = SensorNoise(encoder_bits=19, torque_std=0.05)
 """A real robot's sensors: the encoder lattice measured on the real Aliengo (2 pi / 2^19 rad at the joint, issue
@@ -81,7 +80,6 @@ class QuadrupedStudy:
     est: FrictionEstimate
     fits: list[FitResult]
     shares: DeterminedShares
-    notes: list[str] = field(default_factory=list)
 
     def worst_error(self) -> dict[str, float]:
         """The largest error of F_c and F_v over the fitted joints [%] (NaN: none fitted)."""
