@@ -17,6 +17,7 @@ at hand (after checking on the recorded stack that nothing moved).
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import json
 import os
@@ -118,14 +119,17 @@ def run_scenario(name: str, folder: Path) -> dict[str, str]:
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(SCENARIOS))
 def test_outputs_are_the_bytes_recorded(name, tmp_path):
-    golden = json.loads(GOLDEN.read_text()) if GOLDEN.is_file() else {"stack": stack(), "scenarios": {}}
     if RECORD:
         hashes = run_scenario(name, tmp_path)
-        golden["stack"] = stack()
-        golden["scenarios"][name] = hashes
         GOLDEN.parent.mkdir(exist_ok=True)
-        GOLDEN.write_text(json.dumps(golden, indent=1, sort_keys=True) + "\n")
+        with open(GOLDEN.with_suffix(".lock"), "w") as lock:  # the scenarios record side by side (-n 2): one
+            fcntl.flock(lock, fcntl.LOCK_EX)                  # read-modify-write at a time, none lost
+            golden = json.loads(GOLDEN.read_text()) if GOLDEN.is_file() else {"stack": stack(), "scenarios": {}}
+            golden["stack"] = stack()
+            golden["scenarios"][name] = hashes
+            GOLDEN.write_text(json.dumps(golden, indent=1, sort_keys=True) + "\n")
         return
+    golden = json.loads(GOLDEN.read_text()) if GOLDEN.is_file() else {"stack": stack(), "scenarios": {}}
     differs = {k: (v, golden["stack"].get(k)) for k, v in stack().items() if golden["stack"].get(k) != v}
     hashes = run_scenario(name, _folder(tmp_path, "first"))
     if differs:
