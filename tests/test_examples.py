@@ -85,3 +85,17 @@ def test_kuka_lwr4_convert(tmp_path):
     log = read_log(out, robot)
     assert log.segments == [(0, 5027), (5027, 10054)]  # the half hour between the runs is a gap
     assert log.clock is not None and log.clock.kind == "jittered"
+
+
+def test_quadruped_walk():
+    """Three feet down: the swinging leg alone determined, every leg with the feet's forces, and then exact."""
+    plain = run_example("quadruped_walk.py")
+    three = re.findall(r"^(\w+_foot\+\w+_foot\+\w+_foot) \(\d+ samples\): determined (.*)$", plain, re.M)
+    assert len(three) == 4
+    for pattern, legs in three:
+        swinging = {"FL", "FR", "RL", "RR"} - {f[:2] for f in pattern.split("+")}
+        assert set(legs.split(", ")) == swinging
+    forces = run_example("quadruped_walk.py", "--foot-forces", "3d")
+    assert all(legs == "FL, FR, RL, RR" for legs in re.findall(r"\): determined (.*)$", forces, re.M))
+    errors = [float(x) for x in re.findall(r"\(([\d.]+) % off\)", forces)]
+    assert len(errors) == 24 and max(errors) < 1.0
