@@ -158,6 +158,11 @@ def joint_list(r: Robot, joints: Optional[str]) -> list[str]:
 
 
 ESTIMATE = EstimateOptions()  # one source of defaults: the library's
+BaseMotionOpt = typer.Option(ESTIMATE.base_motion, "--base-motion",
+                             help="Base motion: contact (rigid stance foot, thesis 5.4), logged (the base.* pose "
+                                  "differentiated like the joints), imu (the imu.* gyro and accelerometer, the base.q* "
+                                  "orientation) or auto (imu, else logged with wrenches or point feet, else contact; "
+                                  "printed).")
 FILTER = FilterOptions()
 GAIT = GaitOptions()
 IDEAL = IdealOptions()

@@ -27,6 +27,7 @@ from wbfriction.cli.common import (
     ESTIMATE,
     FILTER,
     LOG_FORMATS,
+    BaseMotionOpt,
     ConfigOpt,
     LimitMarginOpt,
     LogArg,
@@ -178,13 +179,7 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                                             help="Also write delta_qdd_companion.<joint>: the acceleration "
                                                  "difference through the other kind of scheme, for the report's "
                                                  "Fig. 7.4 (one more pass)."),
-             base_motion: BaseMotion = typer.Option(ESTIMATE.base_motion,
-                                                    help="Base motion: contact (rigid stance foot, "
-                                                         "thesis 5.4), logged (the base.* pose "
-                                                         "differentiated like the joints), imu (the "
-                                                         "imu.* gyro and accelerometer, the base.q* "
-                                                         "orientation) or auto (imu, else logged with "
-                                                         "wrenches, else contact; printed)."),
+             base_motion: BaseMotion = BaseMotionOpt,
              wrenches: bool = typer.Option(ESTIMATE.wrenches, help="Use the force-torque sensors' wrench.<sensor>.* "
                                                              "columns where logged: every joint's friction in "
                                                              "every phase."),

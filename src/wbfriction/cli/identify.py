@@ -12,7 +12,7 @@ from rich.markup import escape
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.actuator.options import ActuatorOptions
 from wbfriction.exceptions import InputError
-from wbfriction.friction.options import EstimateOptions, RouteOption
+from wbfriction.friction.options import BaseMotion, EstimateOptions, RouteOption
 from wbfriction.inertia.options import ArmatureMode, InertialOptions
 from wbfriction.logs.options import TimeUnit
 from wbfriction.pipeline.paths import check_paths
@@ -25,6 +25,7 @@ if TYPE_CHECKING:
 from wbfriction.cli.common import (
     ESTIMATE,
     INERTIAL,
+    BaseMotionOpt,
     ConfigOpt,
     FitWorkersOpt,
     LogArg,
@@ -97,7 +98,7 @@ def identify(log: Path = LogArg,
                                               help="a of the Coulomb term tanh(a qd) [s/rad]."),
              diff: DiffOption = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
              mask: Mask = typer.Option(ESTIMATE.mask, help="swing or single (see 'estimate')."),
-             route: RouteOption = RouteOpt,
+             route: RouteOption = RouteOpt, base_motion: BaseMotion = BaseMotionOpt,
              workers: int = FitWorkersOpt, time_unit: Optional[TimeUnit] = TimeUnitOpt,
              config_output: Optional[Path] = typer.Option(
                  None, "--config-output", help="Also write the robot's configuration (TOML) for the identified "
@@ -131,7 +132,8 @@ def identify(log: Path = LogArg,
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior,
                            armature=armature, link_margin=link_margin, prior_tolerance=prior_tolerance)
     with console.status("") as status:
-        estimate_options = EstimateOptions(diff=diff, mask=mask, route=route, noise_target=noise_target)
+        estimate_options = EstimateOptions(diff=diff, mask=mask, route=route, noise_target=noise_target,
+                                           base_motion=base_motion)
         done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
                              options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers,
                              time_unit=time_unit)

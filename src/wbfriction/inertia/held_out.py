@@ -19,7 +19,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.inertia.best_friction import BestRest
 from wbfriction.inertia.consistency import ConsistentFit
 from wbfriction.inertia.options import InertialOptions
-from wbfriction.inertia.regressor import stance_regressor
+from wbfriction.inertia.regressor import regressor_of, row_groups
 from wbfriction.inertia.rows import given_armature, own_columns, sample_rows
 from wbfriction.inertia.samples import LogSamples
 from wbfriction.inertia.validation import BodyGroup, Validation, limbs, validate_groups
@@ -45,7 +45,8 @@ class TorqueFit:
 @dataclass
 class HeldOut:
     """The held-out samples, stacked, in the form every candidate model's prediction needs [N·m]: the
-    measured torques (less a known armature's share) ``measured`` (N, n_tc); the given inertias'
+    measured torques (less a known armature's share) ``measured`` (N, n_tc), NaN where a joint's row does not hold
+    (point feet: :attr:`~wbfriction.inertia.samples.Part.rows`); the given inertias'
     prediction ``given`` (N, n_tc) and the given armature's share ``given_armature`` (N, n_tc, zeros
     unless identified); each limb's identified change of the prediction ``effects`` (n_groups, N, n_tc)
     (the torques are linear in the inertias); each joint's own friction (and armature) columns
@@ -83,7 +84,7 @@ class HeldOut:
         """Per joint RMS of the given model, it with ``rest_best``, the identified one (every limb, the fit's
         ``rest_fit``) and the validated one (the limbs ``kept``, ``rest_valid``)."""
         G = self.effects.shape[0]
-        rms = lambda pred: np.sqrt(np.mean((pred - self.measured) ** 2, axis=0))  # noqa: E731
+        rms = lambda pred: np.sqrt(np.nanmean((pred - self.measured) ** 2, axis=0))  # noqa: E731
         return TorqueFit(rms(self.given + self.given_armature), rms(self.predict(np.zeros(G, bool), rest_best)),
                          rms(self.predict(np.ones(G, bool), rest_fit)), self.samples,
                          rms(self.predict(kept, rest_valid)))
@@ -106,13 +107,14 @@ def held_out(robot: Robot, samples: LogSamples, pi0: np.ndarray, pi_fit: np.ndar
     out: dict[str, list[np.ndarray]] = {"measured": [], "given": [], "effects": [], "features": [], "arm": []}
     for part in samples.parts:
         kin, stance, rows = part.kin, part.stance, part.held
-        for c in range(len(robot.contact_frames)):
+        for c in row_groups(robot):
             r = np.flatnonzero(rows & (stance == c))
             for start in range(0, r.size, 1000):
                 rr = r[start:start + 1000]
                 Y, C, b = sample_rows(robot, kin, rr, c, options)
-                T = stance_regressor(robot, c).to_rooted
-                out["measured"].append(b)
+                T = regressor_of(robot, c).to_rooted
+                holds = part.holds(rr)
+                out["measured"].append(b if holds is None else np.where(holds, b, np.nan))
                 out["given"].append(Y @ (T @ pi0.ravel()))
                 out["effects"].append(np.moveaxis(Y @ (T @ D), 2, 0))
                 out["features"].append(C[:, idx, cols])

@@ -14,7 +14,11 @@ foot is welded to the ground and the robot is a fixed-base tree rooted at it
 the contact wrench (which acts at the root). That is the floating-base dynamics
 projected into the null space of the stance foot's Jacobian, in the coordinates of the
 joint velocities. (A fixed-base robot, an arm, is one permanent single support welded at its
-root link.) For torque-controlled joint ``i``:
+root link.) A robot on point feet (a quadruped, issue 56) gives no tree rooted at a foot; with its base's motion
+measured (its logged pose, or the IMU), the floating model's joint rows hold every acceleration, and joint
+``i``'s row is free of the contact forces wherever no foot whose force is unknown is down on its limb (a leg in the
+air; a stance leg whose foot logs its 3-D force, moved to the right-hand side as ``J^T f``:
+:func:`~wbfriction.inertia.rows.floating_rows`). For torque-controlled joint ``i``:
 
 .. math::
 
@@ -129,7 +133,7 @@ from wbfriction.inertia.rows import (
     own_columns,
     rest_names,
 )
-from wbfriction.inertia.samples import LogSamples, log_samples, torque_rms
+from wbfriction.inertia.samples import LogSamples, log_samples, one_way_joints, torque_rms
 from wbfriction.inertia.system import compressed_system
 from wbfriction.inertia.validation import Validation
 from wbfriction.logs.log import Log
@@ -241,14 +245,10 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
         ``pi_fit``/``friction_fit`` the fit's, ``validation`` the decision per limb.
 
     Raises:
-        InputError: no single-support sample to learn from, or none held out; a robot on point feet (its equations
-            hold the joints' torques where the feet leave them determined, :mod:`wbfriction.model.determination`,
-            not on a tree rooted at a sole: not taken yet).
+        InputError: no single-support sample to learn from (on point feet: no joint's row free of unknown contact
+            forces), or none held out; a robot on point feet without the base's measured motion.
 
     """
-    if robot.point_contacts:
-        raise InputError(f"{log.source}: the inertia identification roots the robot at a sole in single support "
-                         f"(thesis ch. 8); robot '{robot.name}' stands on point feet, which it does not take yet")
     if blas_threads is not None:
         with threadpool_limits(blas_threads, user_api="blas"):
             return identify_inertia(robot, log, estimate_options, options, progress, shared, None)
@@ -256,6 +256,7 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
         shared = log_samples(robot, log, estimate_options, options)
     elif not shared.matches(robot, log, estimate_options, options):
         raise ValueError("samples split from another robot, log or options")
+    options = dataclasses.replace(options, one_way_joints=one_way_joints(robot, shared.parts))
     n_tc, k = len(robot.torque_controlled), len(friction_names(options))
     fitting, validating, total, samples = training_systems(robot, shared, options, progress, log.source)
     pi0 = body_parameters(robot.model)
@@ -280,8 +281,9 @@ def identify_inertia(robot: Robot, log: Log, estimate_options: EstimateOptions =
     return InertialIdentification(
         validated_robot(robot, gated.pi, armature, options), bodies, pi0, gated.pi, friction_names(options),
         joint_friction(gated.rest, robot, options), gated.rest_given[:k * n_tc].reshape(n_tc, k), base,
-        gated.holdout, samples, fit_message(fit, solver, noise, robot, log.dt), prior, scores, options.armature,
-        given_armature(robot), np.array(armature, dtype=float), unexcited, float(np.sqrt(variance)), noise,
+        gated.holdout, samples, fit_message(fit, solver, noise, robot, log.dt, options), prior, scores,
+        options.armature, given_armature(robot), np.array(armature, dtype=float), unexcited,
+        float(np.sqrt(variance)), noise,
         pi_fit=fit.pi, friction_fit=joint_friction(fit.rest, robot, options), validation=gated.validation,
         solver=solver)
 
@@ -297,9 +299,11 @@ def training_systems(robot: Robot, samples: LogSamples, options: InertialOptions
     """
     fitting = compressed_system(robot, samples, "train", options, progress)
     validating = compressed_system(robot, samples, "validation", options, progress)
-    count = (fitting.rows + validating.rows) // len(robot.torque_controlled)
+    count = sum(int(np.sum((part.train | part.validation) & (part.stance >= 0))) for part in samples.parts)
     if count == 0:
-        raise InputError(f"{source}: no single-support sample to identify the inertia model from")
+        what = ("sample with a joint free of unknown contact forces (a leg in the air, or feet with 3-D force "
+                "columns)" if robot.point_contacts else "single-support sample")
+        raise InputError(f"{source}: no {what} to identify the inertia model from")
     total = CompressedLeastSquares(fitting.n)
     for system in (fitting, validating):
         total.absorb(system)
@@ -324,11 +328,16 @@ def validated_robot(robot: Robot, pi: np.ndarray, armature: np.ndarray, options:
     return dataclasses.replace(robot, model=model, cache={})
 
 
-def fit_message(fit: ConsistentFit, solver: SolverOutcome, noise: np.ndarray, robot: Robot, dt: float) -> str:
-    """How the fit went, in words: the fit's message, that the gate keeps its result honest when the solver
-    stopped short, and the worst joint's noisy accelerations (:data:`NOISY_ACCELERATION` of ``noise`` (n_tc,),
-    the log sampled every ``dt`` [s])."""
+def fit_message(fit: ConsistentFit, solver: SolverOutcome, noise: np.ndarray, robot: Robot, dt: float,
+                options: InertialOptions) -> str:
+    """How the fit went, in words: the fit's message, the joints that moved one way
+    (:attr:`~wbfriction.inertia.options.InertialOptions.one_way_joints`), that the gate keeps its result honest when
+    the solver stopped short, and the worst joint's noisy accelerations (:data:`NOISY_ACCELERATION` of ``noise``
+    (n_tc,), the log sampled every ``dt`` [s])."""
     message = fit.message
+    if options.one_way_joints:
+        message += (f"; {', '.join(options.one_way_joints)} moved one way: their offset held at 0, F_c their "
+                    "friction's level")
     if not solver.converged:
         message += "; kept only where held-out data improve"
     if np.any(noise > NOISY_ACCELERATION):

@@ -56,6 +56,11 @@ class InertialOptions:
         stribeck_joints: the joints given the Stribeck term (None: every torque-controlled
             one). A joint that never moves faster than ``v_s`` cannot tell it from Coulomb
             friction: their columns would cancel with huge opposite values.
+        one_way_joints: the joints whose regression rows moved one way (the other on fewer than
+            :data:`~wbfriction.fit.status.MIN_REVERSE` of them): their Coulomb and offset columns are then one, and
+            would cancel as well; their offset is held at zero (no column) and ``F_c`` carries their friction's level
+            (a walking quadruped's thighs, seen while their legs swing forwards). Set by
+            :func:`~wbfriction.inertia.identification.identify_inertia` from the samples.
         stride: every ``stride``-th single-support sample enters the regression (1 kHz
             logs are far denser than the dynamics need).
         holdout: share of the log's recorded time (gaps left out), at its end, kept out of the
@@ -90,6 +95,7 @@ class InertialOptions:
     tanh_slope: float = 40.0
     stribeck_velocity: float | None = None
     stribeck_joints: tuple[str, ...] | None = None
+    one_way_joints: tuple[str, ...] = ()
     stride: int = 5
     holdout: float = 0.2
     prior: float | None = None

@@ -1,4 +1,5 @@
-"""The joint-torque regressor of the robot standing on one sole, in the original bodies' inertial parameters.
+"""The joint-torque regressor of the robot standing on one sole, or on point feet with its base's motion measured, in
+the original bodies' inertial parameters.
 
 The inverse dynamics are linear in each body's ten inertial parameters
 ``pi_b = (m, m c_x, m c_y, m c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz)`` (about the body's joint
@@ -6,6 +7,11 @@ frame; ``pin.Inertia.toDynamicParameters`` order). In single support the stance 
 to the ground and the robot is a fixed-base tree rooted at it (:mod:`wbfriction.model.stance`);
 the joint rows of that tree's regressor (``pin.computeJointTorqueRegressor``) are free of the
 contact wrench. :class:`StanceRegressor` maps its columns back to the original bodies.
+
+A robot on point feet gives no such tree (a point foot turns about its contact). With the base's motion measured,
+the floating model's own regressor holds every acceleration (:class:`FloatingRegressor`): a joint's row is free of
+the contact forces where no foot with an unknown force is down on its limb
+(:func:`~wbfriction.model.determination.free_rows`; issue 56).
 """
 
 from __future__ import annotations
@@ -73,7 +79,7 @@ class StanceRegressor:
 
     def __post_init__(self) -> None:
         self.data = self.stance.model.createData()
-        self.pattern = structural_pattern(self.stance, self.data)
+        self.pattern = structural_pattern(self.stance.model, self.data, self.stance.v_index)
 
     def joint_rows(self, frame_pose: np.ndarray, angles: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """``Y`` with ``Y @ to_rooted @ pi.ravel() = S (M qdd + h - J^T lambda)`` (without the
@@ -100,21 +106,60 @@ class StanceRegressor:
         return Y
 
 
-def structural_pattern(stance: StanceModel, data: pin.Data, states: int = 3) -> np.ndarray:
-    """Where the actuated joints' rows of the stance tree's regressor can be non-zero (n_act, 10 n_bodies):
-    the entries non-zero at any of ``states`` random configurations, velocities and accelerations (the
-    root's included, so that no gravity direction or motion is special). An entry zero at a generic state is
-    zero by the tree's structure (the bodies not beyond the joint, the parameters a joint's axis does not
-    see), at every state: a regression may leave such columns out of a joint's rows."""
-    model = stance.model
+def structural_pattern(model: pin.Model, data: pin.Data, v_index: np.ndarray, states: int = 3) -> np.ndarray:
+    """Where the rows ``v_index`` (the actuated joints') of ``model``'s regressor can be non-zero
+    (len(v_index), 10 n_bodies): the entries non-zero at any of ``states`` random configurations, velocities and
+    accelerations (the root's included, so that no gravity direction or motion is special). An entry zero at a
+    generic state is zero by the tree's structure (the bodies not beyond the joint, the parameters a joint's axis
+    does not see), at every state: a regression may leave such columns out of a joint's rows."""
     rng = np.random.default_rng(0)
-    out = np.zeros((len(stance.v_index), 10 * (model.njoints - 1)), dtype=bool)
+    out = np.zeros((len(v_index), 10 * (model.njoints - 1)), dtype=bool)
     for _ in range(states):
         q = pin.integrate(model, pin.neutral(model), rng.standard_normal(model.nv))
         Y = pin.computeJointTorqueRegressor(model, data, q, rng.standard_normal(model.nv),
                                             rng.standard_normal(model.nv))
-        out |= Y[stance.v_index] != 0.0
+        out |= Y[v_index] != 0.0
     return out
+
+
+@dataclass
+class FloatingRegressor:
+    """Joint-torque regressor of a robot on point feet whose base's motion is measured (module docstring): the
+    floating model's, its actuated joints' rows, in the original bodies' parameters.
+
+    Attributes:
+        model: the robot's floating model.
+        v_index: the actuated joints' velocity indices (n_act,).
+        to_rooted: the identity (10 n_bodies, 10 n_bodies): :class:`StanceRegressor`'s map, here none.
+        pattern: (n_act, 10 n_bodies), as :attr:`StanceRegressor.pattern`.
+    """
+
+    model: pin.Model
+    v_index: np.ndarray
+    data: pin.Data = field(init=False, repr=False)
+    to_rooted: np.ndarray = field(init=False, repr=False)
+    pattern: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.data = self.model.createData()
+        self.to_rooted = np.eye(10 * (self.model.njoints - 1))
+        self.pattern = structural_pattern(self.model, self.data, self.v_index)
+
+    def joint_rows(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """``Y`` with ``Y @ pi.ravel() = S (M a + h)`` (without the armature), for each sample.
+
+        Args:
+            q, v, a: the floating model's configurations (N, nq), velocities and accelerations (N, nv), the base's
+                in Pinocchio's convention (its twist in its own frame).
+
+        Returns:
+            (N, n_act, 10 n_bodies) [N·m per parameter unit].
+        """
+        Y = np.empty((len(q), len(self.v_index), 10 * (self.model.njoints - 1)))
+        for k in range(len(q)):
+            np.take(pin.computeJointTorqueRegressor(self.model, self.data, q[k], v[k], a[k]), self.v_index, axis=0,
+                    out=Y[k])
+        return Y
 
 
 def stance_regressor(robot: Robot, contact_index: int) -> StanceRegressor:
@@ -130,3 +175,21 @@ def stance_regressor(robot: Robot, contact_index: int) -> StanceRegressor:
             T[10 * c:10 * c + 10, 10 * (j - 1):10 * j] = act_matrix(f.placement)
         robot.cache[key] = StanceRegressor(stance, T)
     return robot.cache[key]
+
+
+def floating_regressor(robot: Robot) -> FloatingRegressor:
+    """The floating regressor of ``robot`` on point feet (built once)."""
+    if "floating regressor" not in robot.cache:
+        robot.cache["floating regressor"] = FloatingRegressor(robot.model, np.asarray(robot.act_v_index))
+    return robot.cache["floating regressor"]
+
+
+def row_groups(robot: Robot) -> range:
+    """The groups of rows a regression builds with one regressor each (:func:`regressor_of`): one per contact frame
+    on soles (the stance it is rooted at), one on point feet (the floating model)."""
+    return range(1) if robot.point_contacts else range(len(robot.contact_frames))
+
+
+def regressor_of(robot: Robot, group: int) -> StanceRegressor | FloatingRegressor:
+    """The regressor of a group of :func:`row_groups`: the floating one on point feet, else the stance's."""
+    return floating_regressor(robot) if robot.point_contacts else stance_regressor(robot, group)

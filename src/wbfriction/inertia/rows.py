@@ -13,9 +13,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from wbfriction.friction.measured import base_state
 from wbfriction.inertia.consistency import FRICTION, STRIBECK, friction_lower_bounds
 from wbfriction.inertia.options import InertialOptions
-from wbfriction.inertia.regressor import stance_regressor
+from wbfriction.inertia.regressor import floating_regressor, stance_regressor
+from wbfriction.model.determination import foot_force_torques
 from wbfriction.model.robot import Robot
 from wbfriction.model.stance import stance_frame_pose
 from wbfriction.signals.kinematics import MeasuredKinematics
@@ -49,8 +51,10 @@ def given_armature(robot: Robot) -> np.ndarray:
     return np.array(robot.model.armature[robot.act_v_index][robot.tc_index], dtype=float)
 
 
-def friction_columns(qd_tc: np.ndarray, options: InertialOptions, stribeck: np.ndarray | None = None) -> np.ndarray:
-    """(N, n_tc, k n_tc): joint ``i``'s row holds ``qd_i, tanh(a qd_i), 1`` (and the Stribeck
+def friction_columns(qd_tc: np.ndarray, options: InertialOptions, stribeck: np.ndarray | None = None,
+                     one_way: np.ndarray | None = None) -> np.ndarray:
+    """(N, n_tc, k n_tc): joint ``i``'s row holds ``qd_i, tanh(a qd_i), 1`` (the offset's zero where ``one_way[i]``:
+    :attr:`~wbfriction.inertia.options.InertialOptions.one_way_joints`; and the Stribeck
     column ``tanh(a qd_i) exp(-(qd_i / v_s)^2)`` where ``stribeck[i]``, else zero) in its ``k``
     columns, ``f(qd) = columns @ params``; ``qd_tc`` (N, n_tc) [rad/s]."""
     n, m = qd_tc.shape
@@ -60,7 +64,7 @@ def friction_columns(qd_tc: np.ndarray, options: InertialOptions, stribeck: np.n
     coulomb = np.tanh(options.tanh_slope * qd_tc)
     out[:, idx, k * idx] = qd_tc
     out[:, idx, k * idx + 1] = coulomb
-    out[:, idx, k * idx + 2] = 1.0
+    out[:, idx, k * idx + 2] = 1.0 if one_way is None else np.where(one_way, 0.0, 1.0)
     if k == 4:
         on = np.ones(m, dtype=bool) if stribeck is None else stribeck
         out[:, idx, k * idx + 3] = coulomb * np.exp(-(qd_tc / options.stribeck_velocity) ** 2) * on
@@ -77,28 +81,48 @@ def armature_columns(qdd_tc: np.ndarray) -> np.ndarray:
 
 def sample_rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int,
                 options: InertialOptions) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The rows of samples ``r`` standing on contact frame ``c``, per torque-controlled joint.
+    """The rows of samples ``r`` of row group ``c`` (:func:`~wbfriction.inertia.regressor.row_groups`: standing on
+    contact frame ``c``, or on point feet), per torque-controlled joint.
 
     Returns:
-        ``Y`` (N, n_tc, p_rooted): the regressor over the stance-rooted tree's parameters
-        (:func:`~wbfriction.inertia.regressor.stance_regressor`: its ``to_rooted`` maps the bodies' to them);
+        ``Y`` (N, n_tc, p_rooted): the regressor over the group's parameters
+        (:func:`~wbfriction.inertia.regressor.regressor_of`: its ``to_rooted`` maps the bodies' to them);
         ``C`` (N, n_tc, k n_tc [+ n_tc]): the columns of the other parameters (:func:`friction_columns`,
         :func:`armature_columns` when identified); ``b`` (N, n_tc) [N·m]: the measured torques, less a known
-        armature's share.
+        armature's share, plus on point feet the measured foot forces' ``J^T f``
+        (:func:`~wbfriction.model.determination.foot_force_torques`). On point feet a joint's row holds only where
+        no foot with an unknown force is down on its limb (:attr:`~wbfriction.inertia.samples.Part.rows`).
     """
-    reg = stance_regressor(robot, c)
     tc = robot.tc_index
-    pose = stance_frame_pose(robot, reg.stance, kin.q[r], None if kin.base is None else kin.base[r])
-    Y = reg.joint_rows(pose, kin.q[r], kin.qd[r], kin.qdd[r])[:, tc]
+    if robot.point_contacts:
+        Y, b = floating_rows(robot, kin, r)
+    else:
+        reg = stance_regressor(robot, c)
+        pose = stance_frame_pose(robot, reg.stance, kin.q[r], None if kin.base is None else kin.base[r])
+        Y, b = reg.joint_rows(pose, kin.q[r], kin.qd[r], kin.qdd[r])[:, tc], kin.tau[r]
     stribeck = None if options.stribeck_joints is None else np.isin(robot.torque_controlled, options.stribeck_joints)
-    C = friction_columns(kin.qd[r][:, tc], options, stribeck)
+    one_way = np.isin(robot.torque_controlled, options.one_way_joints) if options.one_way_joints else None
+    C = friction_columns(kin.qd[r][:, tc], options, stribeck, one_way)
     qdd_tc = kin.qdd[r][:, tc]
-    b = kin.tau[r]
     if options.armature == "identify":
         C = np.concatenate([C, armature_columns(qdd_tc)], axis=2)
     elif options.armature == "known":
         b = b - given_armature(robot) * qdd_tc
     return Y, C, b
+
+
+def floating_rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A robot on point feet, its base's motion measured (:func:`~wbfriction.friction.measured.base_state`): the
+    torque-controlled joints' rows of the floating regressor (N, n_tc, 10 n_bodies) and their measured torques plus
+    the measured foot forces' ``J^T f`` (N, n_tc) [N·m] (``S (M a + h) = tau + tau_f + S J^T f``)."""
+    q, v, a_b = base_state(robot, kin, r)
+    assert a_b is not None  # point feet: the base measured (split_log)
+    a = np.zeros_like(v)
+    a[:, :6], a[:, robot.act_v_index] = a_b, kin.qdd[r]
+    rows = robot.act_v_index[robot.tc_index]
+    feet = None if kin.foot_force is None else kin.foot_force[r]
+    forces = foot_force_torques(robot, q, kin.contact[r], feet)[:, rows]
+    return floating_regressor(robot).joint_rows(q, v, a)[:, robot.tc_index], kin.tau[r] + forces
 
 
 def lower_bounds(robot: Robot, options: InertialOptions) -> np.ndarray:
@@ -112,10 +136,11 @@ def lower_bounds(robot: Robot, options: InertialOptions) -> np.ndarray:
 
 def joint_friction(rest: np.ndarray, robot: Robot, options: InertialOptions) -> np.ndarray:
     """The friction per torque-controlled joint (n_tc, k) of the parameters after the bodies' ``rest``
-    (k n_tc [+ n_tc],), a copy; the Stribeck parameter zero on the joints without the term (no column: its
-    value is no fit's, nor a bound's)."""
+    (k n_tc [+ n_tc],), a copy; the Stribeck parameter zero on the joints without the term, the offset on the joints
+    that moved one way (no column: its value is no fit's, nor a bound's)."""
     n_tc, k = len(robot.torque_controlled), len(friction_names(options))
     friction = rest[:k * n_tc].reshape(n_tc, k).copy()
     if k == len(FRICTION) + 1 and options.stribeck_joints is not None:
         friction[~np.isin(robot.torque_controlled, options.stribeck_joints), -1] = 0.0
+    friction[np.isin(robot.torque_controlled, options.one_way_joints), FRICTION.index("tau_os")] = 0.0
     return friction

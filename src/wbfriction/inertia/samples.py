@@ -16,13 +16,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from wbfriction.exceptions import InputError
+from wbfriction.fit.status import MIN_REVERSE, reverse_share
 from wbfriction.friction.estimate import resolve_differentiation
+from wbfriction.friction.measured import finite_base, log_base_motion
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.log import Log
+from wbfriction.model.determination import free_rows
 from wbfriction.model.robot import Robot
 from wbfriction.signals.kinematics import MeasuredKinematics, measure
-from wbfriction.signals.phases import segment
+from wbfriction.signals.phases import segment, settled
 
 
 @dataclass
@@ -32,10 +35,15 @@ class Part:
 
     Attributes:
         kin: the part's kinematics (:func:`~wbfriction.signals.kinematics.measure`).
-        stance: per sample, the index of the stance contact frame (:attr:`Robot.contact_frames`) in single
-            support, -1 otherwise (N,) (:func:`~wbfriction.signals.phases.segment`).
-        use: single-support samples with valid kinematics, impacts left out (N,) bool.
+        stance: per sample, its row group (:func:`~wbfriction.inertia.regressor.row_groups`), -1 if none: the index
+            of the stance contact frame (:attr:`Robot.contact_frames`) in single support
+            (:func:`~wbfriction.signals.phases.segment`); on point feet 0 wherever some joint's row holds.
+        use: the samples with valid kinematics, impacts left out, in single support or, on point feet, outside the
+            switches' margins with the base's motion measured and some joint's row free of unknown contact forces
+            (N,) bool.
         train, validation, held: the training, validation and held-out rows among ``use`` (N,) bool.
+        rows: on point feet, where each torque-controlled joint's row holds (N, n_tc) bool
+            (:func:`~wbfriction.model.determination.free_rows`); None: every joint's, wherever ``use``.
     """
 
     kin: MeasuredKinematics
@@ -44,6 +52,11 @@ class Part:
     train: np.ndarray
     validation: np.ndarray
     held: np.ndarray
+    rows: np.ndarray | None = None
+
+    def holds(self, r: np.ndarray) -> np.ndarray | None:
+        """Where each joint's row holds on the samples ``r`` (len(r), n_tc) bool; None: everywhere."""
+        return None if self.rows is None else self.rows[r]
 
 
 def split_log(robot: Robot, log: Log, est: EstimateOptions, opts: InertialOptions) -> list[Part]:
@@ -55,23 +68,35 @@ def split_log(robot: Robot, log: Log, est: EstimateOptions, opts: InertialOption
     active = active_time(log)
     cut = (1.0 - opts.holdout) * active[-1]
     cut_validation = (1.0 - opts.holdout) * (1.0 - opts.validation) * active[-1]
+    base_motion = log_base_motion(robot, log, est.base_motion, False)[1] if robot.point_contacts else "contact"
+    if base_motion == "contact" and robot.point_contacts:
+        raise InputError(f"{log.source}: robot '{robot.name}' stands on point feet: its identification needs the "
+                         "base's measured motion, the base pose columns base.x ... base.qw (and the IMU's imu.*)")
     out = []
     for (a, b), part in zip(log.segments or [(0, len(log))], log.parts()):
         t_active = active[a:b]
         try:
             kin = measure(part, est.diff, compensate_delay=est.compensate_delay,
-                          torque_alignment=est.torque_alignment, filtering=est.filtering, velocity=est.velocity)
+                          torque_alignment=est.torque_alignment, filtering=est.filtering, velocity=est.velocity,
+                          base_motion=base_motion == "logged", imu=base_motion == "imu")
         except InputError:
             continue  # too short for the scheme: nothing to learn from it
-        phases = segment(kin.time, kin.contact, est.lift_off_skip, est.touch_down_skip)
         assert kin.valid is not None  # set by MeasuredKinematics.__post_init__
-        use = kin.valid & phases.keep
+        rows = None
+        if robot.point_contacts:
+            rows = free_rows(robot, kin.contact, kin.foot_force)
+            use = (kin.valid & settled(kin.time, kin.contact, est.lift_off_skip, est.touch_down_skip)
+                   & finite_base(kin) & rows.any(axis=1))
+            stance = np.where(use, 0, -1)
+        else:
+            phases = segment(kin.time, kin.contact, est.lift_off_skip, est.touch_down_skip)
+            use, stance = kin.valid & phases.keep, phases.stance
         train = np.zeros_like(use)
         idx = np.flatnonzero(use & (t_active < cut))
         train[idx[:: opts.stride]] = True
         held = use & (t_active >= cut)
         validation = train & (t_active >= cut_validation)
-        out.append(Part(kin, phases.stance, use, train & ~validation, validation, held))
+        out.append(Part(kin, stance, use, train & ~validation, validation, held, rows))
     return out
 
 
@@ -123,12 +148,28 @@ def log_samples(robot: Robot, log: Log, estimate_options: EstimateOptions = Esti
                       split_log(robot, log, estimate_options, options))
 
 
+def one_way_joints(robot: Robot, parts: list[Part]) -> tuple[str, ...]:
+    """The torque-controlled joints whose regression rows (training and validation, where each joint's row holds)
+    move the other way on fewer than :data:`~wbfriction.fit.status.MIN_REVERSE` of them
+    (:attr:`~wbfriction.inertia.options.InertialOptions.one_way_joints`)."""
+    qd: list[list[np.ndarray]] = [[] for _ in robot.torque_controlled]
+    for part in parts:
+        rows = np.flatnonzero((part.train | part.validation) & (part.stance >= 0))
+        held = part.holds(rows)
+        for i, column in enumerate(part.kin.qd[rows][:, robot.tc_index].T):
+            qd[i].append(column if held is None else column[held[:, i]])
+    return tuple(j for j, v in zip(robot.torque_controlled, qd)
+                 if v and np.concatenate(v).size and reverse_share(np.concatenate(v)) < MIN_REVERSE)
+
+
 def torque_rms(robot: Robot, parts: list[Part]) -> np.ndarray:
     """RMS measured torque of each torque-controlled joint over the regression's samples (the training and
     validation rows of ``parts``) (n_tc,) [N·m]."""
-    sq, count = np.zeros(len(robot.torque_controlled)), 0
+    sq, count = np.zeros(len(robot.torque_controlled)), np.zeros(len(robot.torque_controlled))
     for part in parts:
         rows = part.train | part.validation
-        sq += np.sum(part.kin.tau[rows] ** 2, axis=0)
-        count += int(rows.sum())
-    return np.sqrt(sq / max(count, 1))
+        held = part.holds(rows)
+        tau = part.kin.tau[rows] if held is None else np.where(held, part.kin.tau[rows], 0.0)
+        sq += np.sum(tau ** 2, axis=0)
+        count += rows.sum() if held is None else held.sum(axis=0)
+    return np.sqrt(sq / np.maximum(count, 1))

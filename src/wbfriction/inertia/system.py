@@ -2,12 +2,13 @@
 so that a long log needs memory of the size of the parameter vector only
 (:class:`~wbfriction.inertia.least_squares.CompressedLeastSquares`; :mod:`wbfriction.inertia.identification`).
 
-Each joint's rows of each stance are compressed on their own, over the columns they can be non-zero in: the
-rooted bodies' parameters beyond the joint (:attr:`~wbfriction.inertia.regressor.StanceRegressor.pattern`) and its
-own friction and armature (:func:`~wbfriction.inertia.rows.own_columns`). A QR costs the square of its columns per
-row, and a joint's row is zero in most of them (on TALOS 8 to 317 of the 330 inertial columns, all but 4 of the
-120 friction ones): about a tenth of the work of compressing the whole rows. The joints' factors are then mapped
-to the original parameters and merged in one QR (the stacked rows' least squares, the same up to rounding).
+Each joint's rows of each stance are compressed on their own, over the columns they can be non-zero in: the rooted
+bodies' parameters beyond the joint (:attr:`~wbfriction.inertia.regressor.StanceRegressor.pattern`; on point feet
+the floating model's, one group, each joint's rows where they hold: :attr:`~wbfriction.inertia.samples.Part.rows`)
+and its own friction and armature (:func:`~wbfriction.inertia.rows.own_columns`). A QR costs the square of its
+columns per row, and a joint's row is zero in most of them (on TALOS 8 to 317 of the 330 inertial columns, all but 4
+of the 120 friction ones): about a tenth of the work of compressing the whole rows. The joints' factors are then
+mapped to the original parameters and merged in one QR (the stacked rows' least squares, the same up to rounding).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 
 from wbfriction.inertia.least_squares import CompressedLeastSquares
 from wbfriction.inertia.options import InertialOptions
-from wbfriction.inertia.regressor import stance_regressor
+from wbfriction.inertia.regressor import regressor_of, row_groups
 from wbfriction.inertia.rows import own_columns, rest_names, sample_rows
 from wbfriction.inertia.samples import LogSamples
 from wbfriction.model.robot import Robot
@@ -34,8 +35,8 @@ def compressed_system(robot: Robot, samples: LogSamples, which: Literal["train",
     p = p_in + len(rest_names(robot, options))
     own = own_columns(robot, options)
     merged = []
-    for c in range(len(robot.contact_frames)):
-        reg = stance_regressor(robot, c)
+    for c in row_groups(robot):
+        reg = regressor_of(robot, c)
         inertial = [np.flatnonzero(reg.pattern[i]) for i in robot.tc_index]
         systems = [CompressedLeastSquares(cols.size + own.shape[1], min_rows=4 * (cols.size + own.shape[1]))
                    for cols in inertial]
@@ -44,8 +45,10 @@ def compressed_system(robot: Robot, samples: LogSamples, which: Literal["train",
             for start in range(0, r.size, options.block):
                 rr = r[start:start + options.block]
                 Y, C, b = sample_rows(robot, part.kin, rr, c, options)
+                holds = part.holds(rr)
                 for i, system in enumerate(systems):
-                    system.add(np.column_stack([Y[:, i, inertial[i]], C[:, i, own[i]]]), b[:, i])
+                    keep = slice(None) if holds is None else holds[:, i]
+                    system.add(np.column_stack([Y[keep, i][:, inertial[i]], C[keep, i][:, own[i]]]), b[keep, i])
                 if progress is not None:
                     progress(rr.size)
         for i, system in enumerate(systems):

@@ -222,7 +222,8 @@ def validate_groups(groups: Sequence[BodyGroup], body_names: Sequence[str], join
         groups: the groups decided on (:func:`limbs`).
         body_names: names of all bodies (indexed by :attr:`BodyGroup.bodies`).
         joints: the torque-controlled joints (n_tc,).
-        measured: the held-out torques the models predict (N, n_tc) [N·m] (less a known armature's share).
+        measured: the held-out torques the models predict (N, n_tc) [N·m] (less a known armature's share), NaN where
+            a joint's row does not hold (a robot on point feet): each joint is scored on its own rows.
         predict: ``predict(mask)`` -> (N, n_tc) [N·m]: the held-out torques predicted by the model with the
             groups ``mask`` (n_groups,) bool identified and the others given, with its best friction; called
             at most a few times per group (results cached).
@@ -238,12 +239,12 @@ def validate_groups(groups: Sequence[BodyGroup], body_names: Sequence[str], join
     G, N = len(groups), measured.shape[0]
     scores = HeldOutScores(measured, predict)
     ref = scores(np.zeros(G, dtype=bool))
-    bar = Admission.of(ref, N, tolerance, floor, gain)
+    bar = Admission.of(ref, scores.counts, tolerance, floor, gain)
     kept = choose_groups(G, scores, bar)
-    size = np.sqrt(np.mean(measured ** 2, axis=0)) + 1e-12  # each joint's torque: what "moves no torque" is below
+    size = np.sqrt(np.nanmean(measured ** 2, axis=0)) + 1e-12  # each joint's torque: what "moves no torque" is below
     decisions = tuple(group_decision(g, group, kept, scores, bar, body_names, joints, size)
                       for g, group in enumerate(groups))
-    rms = lambda s: np.sqrt(s / max(N, 1))  # noqa: E731
+    rms = lambda s: np.sqrt(s / np.maximum(scores.counts, 1))  # noqa: E731
     return Validation(decisions, tuple(joints), N, rms(ref), rms(scores(np.ones(G, dtype=bool))), rms(scores(kept)),
                       tolerance, bar.floor, gain)
 
@@ -264,12 +265,16 @@ class HeldOutScores:
     """Each set of groups' held-out prediction and per-joint sum of squared errors [N^2·m^2], computed once.
 
     Args:
-        measured: the held-out torques (N, n_tc) [N·m].
+        measured: the held-out torques (N, n_tc) [N·m], NaN where a joint's row does not hold.
         predict: ``predict(mask)`` -> (N, n_tc) [N·m] (:func:`validate_groups`).
+
+    Attributes:
+        counts: each joint's held-out rows (n_tc,): its finite ``measured``.
     """
 
     def __init__(self, measured: np.ndarray, predict: Callable[[np.ndarray], np.ndarray]):
         self.measured, self.predict = measured, predict
+        self.counts = np.isfinite(measured).sum(axis=0)
         self.squares: dict[tuple[bool, ...], np.ndarray] = {}
         self.predictions: dict[tuple[bool, ...], np.ndarray] = {}
 
@@ -278,7 +283,7 @@ class HeldOutScores:
         key = mask_key(mask)
         if key not in self.squares:
             self.predictions[key] = np.asarray(self.predict(np.array(key, dtype=bool)), dtype=float)
-            self.squares[key] = np.sum((self.predictions[key] - self.measured) ** 2, axis=0)
+            self.squares[key] = np.nansum((self.predictions[key] - self.measured) ** 2, axis=0)
         return self.squares[key]
 
     def total(self, mask: np.ndarray) -> float:
@@ -312,12 +317,13 @@ class Admission:
     gain: float
 
     @classmethod
-    def of(cls, ref: np.ndarray, samples: int, tolerance: float = TOLERANCE, floor: float = FLOOR,
+    def of(cls, ref: np.ndarray, counts: np.ndarray, tolerance: float = TOLERANCE, floor: float = FLOOR,
            gain: float = GAIN) -> Admission:
-        """The thresholds of the reference's per-joint sums of squares ``ref`` (n_tc,) over ``samples``
-        held-out samples (:func:`validate_groups`' ``tolerance``, ``floor`` and ``gain``)."""
-        floor_nm = floor * float(np.sqrt(ref.sum() / max(samples * ref.size, 1)))
-        limit = (np.sqrt(ref / max(samples, 1)) * (1.0 + tolerance) + floor_nm) ** 2 * max(samples, 1) + 1e-30
+        """The thresholds of the reference's per-joint sums of squares ``ref`` (n_tc,) over each joint's ``counts``
+        (n_tc,) held-out rows (:func:`validate_groups`' ``tolerance``, ``floor`` and ``gain``)."""
+        floor_nm = floor * float(np.sqrt(ref.sum() / max(int(np.sum(counts)), 1)))
+        rows = np.maximum(counts, 1)
+        limit = (np.sqrt(ref / rows) * (1.0 + tolerance) + floor_nm) ** 2 * rows + 1e-30
         return cls(limit, (1.0 - gain) ** 2 * float(ref.sum()), float(ref.sum()) * _ROUNDING, floor_nm, gain)
 
     def admits(self, mask: np.ndarray, squares: np.ndarray) -> bool:
@@ -362,14 +368,14 @@ def group_decision(g: int, group: BodyGroup, kept: np.ndarray, scores: HeldOutSc
     """The decision on group ``g`` of the kept set ``kept``: the joints it moves (a change of their prediction
     above 1e-9 of their RMS torque ``size`` (n_tc,)), their held-out RMS with it given and identified, and
     why (:func:`decision_reason`)."""
-    N = scores.measured.shape[0]
     off, on = toggled(kept, g, False), toggled(kept, g, True)
     s_off, s_on = scores(off), scores(on)
     p_off, p_on = scores.predictions[mask_key(off)], scores.predictions[mask_key(on)]
     moved = np.max(np.abs(p_on - p_off), axis=0, initial=0.0) > 1e-9 * size
     names = tuple(j for j, m in zip(joints, moved) if m)
-    before = float(np.sqrt(s_off[moved].sum() / max(N * moved.sum(), 1))) if moved.any() else float("nan")
-    after = float(np.sqrt(s_on[moved].sum() / max(N * moved.sum(), 1))) if moved.any() else float("nan")
+    rows = max(int(scores.counts[moved].sum()), 1)
+    before = float(np.sqrt(s_off[moved].sum() / rows)) if moved.any() else float("nan")
+    after = float(np.sqrt(s_on[moved].sum() / rows)) if moved.any() else float("nan")
     reason = decision_reason(bool(kept[g]), moved, s_off, s_on, bar, joints)
     return GroupDecision(group.name, tuple(body_names[b] for b in group.bodies), bool(kept[g]), reason, names,
                          before, after)

@@ -186,7 +186,9 @@ def _identification_section(r: Report, ident: Identification) -> str:
         "<th>written (kept where it helps)</th>" if validated else "")
     return f"""<h2 id="identification">Inertia model identified from the torques (thesis 2.4, ch. 8)</h2>
 <ul class="sub">{''.join(passes)}</ul>
-<p class="sub">Held out: the last {ident.holdout_samples} single-support samples of the log, not used to identify.
+<p class="sub">Held out: the last {ident.holdout_samples} samples of the log whose equations are free of the contact
+forces (single support; on point feet, each joint's where no foot with an unknown force is down on its leg), not
+used to identify.
 The identified inertias are written only for the limbs where they predict these samples better than the given
 model with its best friction; the other limbs stay as given.</p>
 <h3>Held-out joint torques: RMS of measured − predicted [N·m]</h3>

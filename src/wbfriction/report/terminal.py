@@ -304,8 +304,8 @@ def identification_tables(result: Identification, wide: bool = False) -> tuple[l
         notes.append(f"not excited by this log, friction and held-out torques left out: {len(still)} joints "
                      f"({', '.join(still[:NAMES_SHOWN])}{' and more' if len(still) > NAMES_SHOWN else ''}); --wide "
                      "lists them")
-    rms = Table(title=f"Held-out torques ({result.holdout_samples} single-support samples at the end of the log): "
-                      "RMS of measured - predicted [N·m]", box=None, title_justify="left")
+    rms = Table(title=f"Held-out torques ({result.holdout_samples} samples at the end of the log, free of the contact "
+                      "forces): RMS of measured - predicted [N·m]", box=None, title_justify="left")
     for col in ("joint", "given model", "given + its friction", "identified", "written"):
         rms.add_column(col, justify="left" if col == "joint" else "right", no_wrap=True)
     for joint in moved:
