@@ -58,7 +58,9 @@ def test_friction_comes_back_through_both_routes(identified, panda, panda_fricti
     F = np.array([[panda_friction[j].F_v, panda_friction[j].F_c] for j in panda.torque_controlled])
     names = list(ident.friction_names)
     torque_route = ident.friction[:, [names.index("F_v"), names.index("F_c")]]
-    assert np.abs(torque_route / F - 1).max() < 0.03, torque_route
+    # measured 3.9 % (joint 2's F_v; the others within 1.5 %) with the friction passed through the differentiation's
+    # filter as the torques are (2.0 % before, its held-out torques up to 3.7 times worse predicted)
+    assert np.abs(torque_route / F - 1).max() < 0.05, torque_route
     fits = {f.joint: f.params for f in done.loop.final.route.fits}
     accel_route = np.array([[fits[j].F_v, fits[j].F_c] for j in panda.torque_controlled])
     assert np.abs(accel_route / F - 1).max() < 0.03, accel_route
@@ -79,8 +81,8 @@ def test_the_urdf_written_is_the_identified_model(identified, panda):
 def test_the_gate_keeps_the_given_model_where_identification_does_not_help(identified, panda):
     """Issue 24: identification must not make held-out prediction worse. Per joint, the model written
     (``validated``) predicts the held-out torques no worse than the exact model with its best friction;
-    the limbs the gate did not keep are written as given (bit for bit, the URDF's own text); the verdict
-    and the solver's outcome are in the JSON."""
+    the limbs the gate kept are written as identified, the others as given (bit for bit, the URDF's own text);
+    the verdict and the solver's outcome are in the JSON."""
     import json
 
     out, done = identified
@@ -88,13 +90,14 @@ def test_the_gate_keeps_the_given_model_where_identification_does_not_help(ident
     h, gate = ident.holdout, ident.validation
     limit = h.given_with_friction * (1 + gate.tolerance) + gate.floor
     assert np.all(h.validated <= limit), (h.validated, h.given_with_friction)
-    rejected = [b for g in gate.groups if not g.kept for b in g.bodies]
-    assert rejected  # measured: the identified arm predicts panda_joint3 and panda_joint7 worse
     reread = body_parameters(load_robot(panda.name, urdf=out / "panda_identified.urdf").model)
-    for b in rejected:
-        k = ident.bodies.index(b)
-        np.testing.assert_array_equal(ident.pi[k], ident.pi_given[k])
-        np.testing.assert_allclose(reread[k], ident.pi_given[k], rtol=1e-12, atol=1e-12)
+    for g in gate.groups:
+        for b in g.bodies:
+            k = ident.bodies.index(b)
+            expected = ident.pi_fit[k] if g.kept else ident.pi_given[k]
+            np.testing.assert_array_equal(ident.pi[k], expected)
+            if not g.kept:
+                np.testing.assert_allclose(reread[k], ident.pi_given[k], rtol=1e-12, atol=1e-12)
     doc = json.loads((out / "identification.json").read_text())
     p = doc["passes"][-1]
     assert p["verdict"] == gate.verdict("pass 1") and p["verdict"].startswith("pass 1: ")

@@ -203,8 +203,10 @@ def _same_identification(new, old) -> None:
     assert new.samples == old.samples
     for name, value in _figures(new).items():
         # a friction level at zero is a flat direction: rounding moves it by a few 1e-7 of the largest (the Panda's
-        # forearm F_c, 2e-6 or 5e-6 N·m beside 23 N·m, by the machine's BLAS)
-        _close(value, _figures(old)[name], 10 * TOLERANCE if name.startswith("friction") else TOLERANCE)
+        # forearm F_c, 2e-6 or 5e-6 N·m beside 23 N·m, by the machine's BLAS), and the validation scores with it
+        # (8e-7 of the largest on the still-wrist Panda)
+        flat = name.startswith("friction") or name == "scores"
+        _close(value, _figures(old)[name], 10 * TOLERANCE if flat else TOLERANCE)
 
 
 def test_the_walk_identification_is_the_previous_routes(walk_case, monkeypatch):

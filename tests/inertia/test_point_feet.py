@@ -92,8 +92,10 @@ def test_a_wrong_leg_is_corrected_and_the_friction_recovered(go2w, trots):
     h, front_left = res.holdout, [i for i, j in enumerate(go2w.torque_controlled) if j.startswith("FL_")]
     assert np.all(h.given_with_friction[front_left] > 0.03), h
     assert np.all(h.validated < 1e-6), h
-    thighs = ", ".join(j for j in go2w.torque_controlled if j.endswith("thigh_joint"))
-    assert f"{thighs} moved one way: their offset held at 0" in res.message
+    assert _one_way(res.message) == [j for j in go2w.torque_controlled if j.endswith("thigh_joint")], res.message
+    for group in res.validation.groups:  # the limbs not kept are written as given, bit for bit
+        bodies = [res.bodies.index(b) for b in group.bodies]
+        np.testing.assert_array_equal(res.pi[bodies], (res.pi_fit if group.kept else res.pi_given)[bodies])
     truth = default_quadruped_friction(go2w)
     names = list(res.friction_names)
     for i, joint in enumerate(go2w.torque_controlled):
@@ -103,7 +105,44 @@ def test_a_wrong_leg_is_corrected_and_the_friction_recovered(go2w, trots):
         assert abs(f["tau_os"]) < 0.01 * truth[joint].F_c, (joint, f)
 
 
+def _one_way(message: str) -> list[str]:
+    """The joints the identification's message says moved one way."""
+    head, sep, _ = message.partition(" moved one way")
+    return head.split("; ")[-1].split(", ") if sep else []
+
+
 def test_point_feet_need_the_base_measured(go2w, trots):
     """Without the base's measured motion the floating rows are not known: one line, before any work."""
     with pytest.raises(InputError, match="point feet: its identification needs the base's measured motion"):
         identify_inertia(go2w, trots["3d"], EstimateOptions(diff="true", base_motion="contact"), InertialOptions())
+
+
+def test_a_wrong_leg_is_corrected_on_a_noisy_soft_contact_trot(go2w):
+    """MuJoCo's trot (soft contacts, sphere feet), the feet's 3-D forces, and a real robot's noise (19-bit encoders,
+    0.05 N·m torques, 2 N forces, the IMU's), differentiated as a user's log would be (``diff auto``: a
+    Savitzky-Golay filter), seen through the wrong front left leg: the gate keeps that leg, its joints' held-out
+    torques are predicted at least twice as well, and the friction of every joint that moves both ways is the
+    injected one within 6 % (F_c) and 10 % (F_v). The friction columns go through the differentiation's filter as
+    the torques do; evaluated at the filtered velocities instead, F_c came out 15-37 % low and F_v up to 115 % high."""
+    from wbfriction.studies.quadruped import QuadrupedCase, case_robot, simulate_case
+
+    case = QuadrupedCase(simulator="mujoco", gait="trot", foot_forces="3d", noise=True, duration=8.0)
+    robot = case_robot(go2w, case)
+    log = simulate_case(robot, case).log
+    model = pin.Model(robot.model)
+    for j in range(1, model.njoints):
+        if model.names[j].startswith("FL_"):
+            model.inertias[j] = scale_inertia(scale_inertia(model.inertias[j], 1.3, "rotational"), 1.1, "mass")
+    res = identify_inertia(dataclasses.replace(robot, model=model, cache={}), log, EstimateOptions(),
+                           InertialOptions(stribeck_velocity=None))
+    assert {g.name: g.kept for g in res.validation.groups}["FL_hip_joint…FL_calf_joint"]
+    h, front_left = res.holdout, [i for i, j in enumerate(robot.torque_controlled) if j.startswith("FL_")]
+    assert np.all(h.validated[front_left] < 0.5 * h.given_with_friction[front_left]), h
+    truth, one_way = default_quadruped_friction(robot), _one_way(res.message)
+    assert one_way == [j for j in robot.torque_controlled if j.endswith("thigh_joint")], res.message
+    for i, joint in enumerate(robot.torque_controlled):
+        if joint in one_way:  # F_c is the friction's level
+            continue
+        f = dict(zip(res.friction_names, res.friction[i]))
+        assert f["F_c"] == pytest.approx(truth[joint].F_c, rel=0.06), (joint, f)
+        assert f["F_v"] == pytest.approx(truth[joint].F_v, rel=0.10), (joint, f)

@@ -20,7 +20,7 @@ from wbfriction.inertia.best_friction import BestRest
 from wbfriction.inertia.consistency import ConsistentFit
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import regressor_of, row_groups
-from wbfriction.inertia.rows import given_armature, own_columns, sample_rows
+from wbfriction.inertia.rows import given_armature, own_columns, row_mask, sample_rows
 from wbfriction.inertia.samples import LogSamples
 from wbfriction.inertia.validation import BodyGroup, Validation, limbs, validate_groups
 from wbfriction.model.robot import Robot
@@ -113,11 +113,11 @@ def held_out(robot: Robot, samples: LogSamples, pi0: np.ndarray, pi_fit: np.ndar
                 rr = r[start:start + 1000]
                 Y, C, b = sample_rows(robot, kin, rr, c, options)
                 T = regressor_of(robot, c).to_rooted
-                holds = part.holds(rr)
-                out["measured"].append(b if holds is None else np.where(holds, b, np.nan))
+                rows = row_mask(part.holds(rr), C, b)
+                out["measured"].append(b if rows is None else np.where(rows, b, np.nan))
                 out["given"].append(Y @ (T @ pi0.ravel()))
                 out["effects"].append(np.moveaxis(Y @ (T @ D), 2, 0))
-                out["features"].append(C[:, idx, cols])
+                out["features"].append(C[:, idx, cols] if rows is None else np.nan_to_num(C[:, idx, cols]))
                 qdd = kin.qdd[rr][:, robot.tc_index]
                 out["arm"].append(given_armature(robot) * qdd if arm else np.zeros_like(qdd))
     kk = cols.shape[1]

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from wbfriction.fit.smoothing import row_smoothing
 from wbfriction.friction.measured import base_state
 from wbfriction.inertia.consistency import FRICTION, STRIBECK, friction_lower_bounds
 from wbfriction.inertia.options import InertialOptions
@@ -51,24 +52,57 @@ def given_armature(robot: Robot) -> np.ndarray:
     return np.array(robot.model.armature[robot.act_v_index][robot.tc_index], dtype=float)
 
 
-def friction_columns(qd_tc: np.ndarray, options: InertialOptions, stribeck: np.ndarray | None = None,
-                     one_way: np.ndarray | None = None) -> np.ndarray:
-    """(N, n_tc, k n_tc): joint ``i``'s row holds ``qd_i, tanh(a qd_i), 1`` (the offset's zero where ``one_way[i]``:
+def friction_features(qd_tc: np.ndarray, options: InertialOptions, stribeck: np.ndarray | None = None,
+                      one_way: np.ndarray | None = None) -> np.ndarray:
+    """(N, n_tc, k): joint ``i``'s ``qd_i, tanh(a qd_i), 1`` (the offset's zero where ``one_way[i]``:
     :attr:`~wbfriction.inertia.options.InertialOptions.one_way_joints`; and the Stribeck
-    column ``tanh(a qd_i) exp(-(qd_i / v_s)^2)`` where ``stribeck[i]``, else zero) in its ``k``
-    columns, ``f(qd) = columns @ params``; ``qd_tc`` (N, n_tc) [rad/s]."""
-    n, m = qd_tc.shape
+    column ``tanh(a qd_i) exp(-(qd_i / v_s)^2)`` where ``stribeck[i]``, else zero), ``f_i(qd) = features_i @ params_i``;
+    ``qd_tc`` (N, n_tc) [rad/s]."""
     k = len(friction_names(options))
+    out = np.empty((*qd_tc.shape, k))
+    coulomb = np.tanh(options.tanh_slope * qd_tc)
+    out[:, :, 0] = qd_tc
+    out[:, :, 1] = coulomb
+    out[:, :, 2] = 1.0 if one_way is None else np.where(one_way, 0.0, 1.0)
+    if k == 4:
+        on = np.ones(qd_tc.shape[1], dtype=bool) if stribeck is None else stribeck
+        out[:, :, 3] = coulomb * np.exp(-(qd_tc / options.stribeck_velocity) ** 2) * on
+    return out
+
+
+def friction_columns(features: np.ndarray) -> np.ndarray:
+    """(N, n_tc, k n_tc): joint ``i``'s row holds its :func:`friction_features` (N, n_tc, k) in its ``k`` columns
+    (``f(qd) = columns @ params``), zero elsewhere."""
+    n, m, k = features.shape
     out = np.zeros((n, m, k * m))
     idx = np.arange(m)
-    coulomb = np.tanh(options.tanh_slope * qd_tc)
-    out[:, idx, k * idx] = qd_tc
-    out[:, idx, k * idx + 1] = coulomb
-    out[:, idx, k * idx + 2] = 1.0 if one_way is None else np.where(one_way, 0.0, 1.0)
-    if k == 4:
-        on = np.ones(m, dtype=bool) if stribeck is None else stribeck
-        out[:, idx, k * idx + 3] = coulomb * np.exp(-(qd_tc / options.stribeck_velocity) ** 2) * on
+    for c in range(k):
+        out[:, idx, k * idx + c] = features[:, :, c]
     return out
+
+
+def friction_rows(kin: MeasuredKinematics, r: np.ndarray, tc: np.ndarray, options: InertialOptions,
+                  stribeck: np.ndarray | None = None, one_way: np.ndarray | None = None) -> np.ndarray:
+    """The :func:`friction_columns` of the rows ``r`` (len(r), n_tc, k n_tc), at the kinematics' velocities; with a
+    smoother (``kin.smoother``: the differentiation's filter, which the torques went through too), passed through it
+    as the fit's model is (parallel filtering, :func:`~wbfriction.fit.solve.filtered_problem`): the friction seen
+    through the filter, not the friction of the filtered velocity. NaN where the smoother's window holds a sample
+    without a velocity (such a row is left out: :func:`row_mask`)."""
+    qd = kin.qd[:, tc]
+    if kin.smoother is None:
+        return friction_columns(friction_features(qd[r], options, stribeck, one_way))
+    smoothing = row_smoothing(kin.smoother, len(qd), r)
+    return friction_columns(smoothing(friction_features(qd[smoothing.support], options, stribeck, one_way)))
+
+
+def row_mask(holds: np.ndarray | None, C: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """Where each joint's row of a block enters the regression (n, n_tc) bool: it holds (``holds``, None: everywhere:
+    :meth:`~wbfriction.inertia.samples.Part.holds`) and its columns ``C`` (n, n_tc, p) and torque ``b`` (n, n_tc)
+    are finite; None: every row."""
+    finite = np.isfinite(C).all(axis=2) & np.isfinite(b)
+    if holds is None:
+        return None if finite.all() else finite
+    return holds & finite
 
 
 def armature_columns(qdd_tc: np.ndarray) -> np.ndarray:
@@ -102,7 +136,7 @@ def sample_rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int,
         Y, b = reg.joint_rows(pose, kin.q[r], kin.qd[r], kin.qdd[r])[:, tc], kin.tau[r]
     stribeck = None if options.stribeck_joints is None else np.isin(robot.torque_controlled, options.stribeck_joints)
     one_way = np.isin(robot.torque_controlled, options.one_way_joints) if options.one_way_joints else None
-    C = friction_columns(kin.qd[r][:, tc], options, stribeck, one_way)
+    C = friction_rows(kin, r, tc, options, stribeck, one_way)
     qdd_tc = kin.qdd[r][:, tc]
     if options.armature == "identify":
         C = np.concatenate([C, armature_columns(qdd_tc)], axis=2)

@@ -20,7 +20,7 @@ import numpy as np
 from wbfriction.inertia.least_squares import CompressedLeastSquares
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import regressor_of, row_groups
-from wbfriction.inertia.rows import own_columns, rest_names, sample_rows
+from wbfriction.inertia.rows import own_columns, rest_names, row_mask, sample_rows
 from wbfriction.inertia.samples import LogSamples
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
@@ -45,9 +45,9 @@ def compressed_system(robot: Robot, samples: LogSamples, which: Literal["train",
             for start in range(0, r.size, options.block):
                 rr = r[start:start + options.block]
                 Y, C, b = sample_rows(robot, part.kin, rr, c, options)
-                holds = part.holds(rr)
+                rows = row_mask(part.holds(rr), C, b)
                 for i, system in enumerate(systems):
-                    keep = slice(None) if holds is None else holds[:, i]
+                    keep = slice(None) if rows is None else rows[:, i]
                     system.add(np.column_stack([Y[keep, i][:, inertial[i]], C[keep, i][:, own[i]]]), b[keep, i])
                 if progress is not None:
                     progress(rr.size)
