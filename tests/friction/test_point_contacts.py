@@ -161,11 +161,3 @@ def test_contact_point_below_a_spherical_foot(go2):
         expected = twist.linear + np.cross(twist.angular, [0.0, 0.0, -0.023])
         assert np.allclose(contact_jacobian(robot, data, c) @ v, expected, atol=1e-12)
         assert np.allclose(contact_jacobian(go2, data, c) @ v, twist.linear, atol=1e-12)
-
-
-def test_inertia_identification_refuses_point_feet(go2):
-    """Not taken yet (the identification roots the robot at a sole): refused in one line, never a wrong model."""
-    from wbfriction.inertia.identification import identify_inertia
-
-    with pytest.raises(InputError, match="exact.parquet: .*stands on point feet"):
-        identify_inertia(go2, exact_log(go2, n=300))

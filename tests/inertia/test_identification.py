@@ -403,3 +403,18 @@ def test_the_gate_keeps_a_corrected_leg(talos, combined_walk):
     assert np.all(h.validated <= h.given_with_friction * (1 + gate.tolerance) + gate.floor)
     legs = [i for i, j in enumerate(talos.torque_controlled) if j.startswith("leg_")]
     assert np.all(h.validated[legs] < 0.1 * h.given_with_friction[legs]), h
+
+
+def test_held_out_rows_of_every_stance_are_predicted(talos, combined_walk):
+    """The held-out samples of both soles' single support are stacked, each with its own stance's regressor: with
+    the given model the stacked rows are its inverse dynamics, whichever foot is down (half the walk held out, so
+    that both stances are in it)."""
+    from wbfriction.inertia.held_out import held_out
+
+    options = InertialOptions(holdout=0.5)
+    samples = log_samples(talos, combined_walk.log, EstimateOptions(), options)
+    held = held_out(talos, samples, body_parameters(talos.model), body_parameters(talos.model), [], options)
+    stances = np.concatenate([part.stance[part.held] for part in samples.parts])
+    assert set(stances) == {0, 1}, set(stances)  # both feet in the held-out rows
+    assert held.samples == stances.size
+    assert np.isfinite(held.measured).all() and np.isfinite(held.given).all()

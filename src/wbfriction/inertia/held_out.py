@@ -113,11 +113,11 @@ def held_out(robot: Robot, samples: LogSamples, pi0: np.ndarray, pi_fit: np.ndar
                 rr = r[start:start + 1000]
                 Y, C, b = sample_rows(robot, kin, rr, c, options)
                 T = regressor_of(robot, c).to_rooted
-                rows = row_mask(part.holds(rr), C, b)
-                out["measured"].append(b if rows is None else np.where(rows, b, np.nan))
+                mask = row_mask(part.holds(rr), C, b)
+                out["measured"].append(b if mask is None else np.where(mask, b, np.nan))
                 out["given"].append(Y @ (T @ pi0.ravel()))
                 out["effects"].append(np.moveaxis(Y @ (T @ D), 2, 0))
-                out["features"].append(C[:, idx, cols] if rows is None else np.nan_to_num(C[:, idx, cols]))
+                out["features"].append(C[:, idx, cols] if mask is None else np.nan_to_num(C[:, idx, cols]))
                 qdd = kin.qdd[rr][:, robot.tc_index]
                 out["arm"].append(given_armature(robot) * qdd if arm else np.zeros_like(qdd))
     kk = cols.shape[1]
