@@ -116,13 +116,15 @@ def _joints(model: pin.Model) -> list[_Joint]:
         ModelError: a joint with more than one velocity, or one whose motion is a screw (helical).
     """
     out = []
+    data = model.createData()
+    # each joint's motion subspace: its own column of its Jacobian in its frame (standard calls that return copies;
+    # the same bytes as a JointData's S on every built-in robot, without a JointData per joint)
+    pin.computeJointJacobians(model, data, pin.neutral(model))
     for j in range(1, model.njoints):
         joint = model.joints[j]
         if joint.nv != 1:
             raise ModelError(f"joint '{model.names[j]}' has {joint.nv} velocities: a tree of 1-DoF joints is needed")
-        data = joint.createData()
-        joint.calc(data, pin.neutral(model)[joint.idx_q:joint.idx_q + joint.nq])
-        S = np.asarray(data.S).reshape(6)
+        S = pin.getJointJacobian(model, data, j, pin.LOCAL)[:, joint.idx_v].copy()
         if np.any(S[:3]) and np.any(S[3:]):
             raise ModelError(f"joint '{model.names[j]}' is helical: not supported")
         M, Y = model.jointPlacements[j], model.inertias[j]
