@@ -20,7 +20,7 @@ from wbfriction.inertia.best_friction import BestRest
 from wbfriction.inertia.consistency import ConsistentFit
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import regressor_of, row_groups
-from wbfriction.inertia.rows import given_armature, own_columns, row_mask, sample_rows
+from wbfriction.inertia.rows import friction_rows, given_armature, own_columns, row_mask, sample_rows
 from wbfriction.inertia.samples import LogSamples
 from wbfriction.inertia.validation import BodyGroup, Validation, limbs, validate_groups
 from wbfriction.model.robot import Robot
@@ -109,9 +109,10 @@ def held_out(robot: Robot, samples: LogSamples, pi0: np.ndarray, pi_fit: np.ndar
         kin, stance, rows = part.kin, part.stance, part.held
         for c in row_groups(robot):
             r = np.flatnonzero(rows & (stance == c))
+            features = friction_rows(robot, kin, r, options)  # once: a global smoother filters the whole part
             for start in range(0, r.size, 1000):
                 rr = r[start:start + 1000]
-                Y, C, b = sample_rows(robot, kin, rr, c, options)
+                Y, C, b = sample_rows(robot, kin, rr, c, options, features[start:start + 1000])
                 T = regressor_of(robot, c).to_rooted
                 mask = row_mask(part.holds(rr), C, b)
                 out["measured"].append(b if mask is None else np.where(mask, b, np.nan))

@@ -81,18 +81,22 @@ def friction_columns(features: np.ndarray) -> np.ndarray:
     return out
 
 
-def friction_rows(kin: MeasuredKinematics, r: np.ndarray, tc: np.ndarray, options: InertialOptions,
-                  stribeck: np.ndarray | None = None, one_way: np.ndarray | None = None) -> np.ndarray:
-    """The :func:`friction_columns` of the rows ``r`` (len(r), n_tc, k n_tc), at the kinematics' velocities; with a
-    smoother (``kin.smoother``: the differentiation's filter, which the torques went through too), passed through it
-    as the fit's model is (parallel filtering, :func:`~wbfriction.fit.solve.filtered_problem`): the friction seen
-    through the filter, not the friction of the filtered velocity. NaN where the smoother's window holds a sample
-    without a velocity (such a row is left out: :func:`row_mask`)."""
-    qd = kin.qd[:, tc]
-    if kin.smoother is None:
-        return friction_columns(friction_features(qd[r], options, stribeck, one_way))
+def friction_rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, options: InertialOptions) -> np.ndarray:
+    """The :func:`friction_features` of the rows ``r`` (len(r), n_tc, k) (the Stribeck term on ``options``'
+    joints, no offset on its joints that moved one way), at the kinematics' velocities; with a smoother
+    (``kin.smoother``: the differentiation's filter, which the torques went through too), passed through it as the
+    fit's model is (parallel filtering, :func:`~wbfriction.fit.solve.filtered_problem`): the friction seen through
+    the filter, not the friction of the filtered velocity. NaN where the smoother's window holds a sample without a
+    velocity (such a row is left out: :func:`row_mask`). A global smoother (Butterworth) filters the whole series:
+    call it once for all the rows of a part, not per block."""
+    joints = robot.torque_controlled
+    stribeck = None if options.stribeck_joints is None else np.isin(joints, options.stribeck_joints)
+    one_way = np.isin(joints, options.one_way_joints) if options.one_way_joints else None
+    qd = kin.qd[:, robot.tc_index]
+    if kin.smoother is None or not len(r):
+        return friction_features(qd[r], options, stribeck, one_way)
     smoothing = row_smoothing(kin.smoother, len(qd), r)
-    return friction_columns(smoothing(friction_features(qd[smoothing.support], options, stribeck, one_way)))
+    return smoothing(friction_features(qd[smoothing.support], options, stribeck, one_way))
 
 
 def row_mask(holds: np.ndarray | None, C: np.ndarray, b: np.ndarray) -> np.ndarray | None:
@@ -113,10 +117,11 @@ def armature_columns(qdd_tc: np.ndarray) -> np.ndarray:
     return out
 
 
-def sample_rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int,
-                options: InertialOptions) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def sample_rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int, options: InertialOptions,
+                features: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The rows of samples ``r`` of row group ``c`` (:func:`~wbfriction.inertia.regressor.row_groups`: standing on
-    contact frame ``c``, or on point feet), per torque-controlled joint.
+    contact frame ``c``, or on point feet), per torque-controlled joint; ``features``: their
+    :func:`friction_rows` (len(r), n_tc, k) if computed already (None: here).
 
     Returns:
         ``Y`` (N, n_tc, p_rooted): the regressor over the group's parameters
@@ -134,9 +139,7 @@ def sample_rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int,
         reg = stance_regressor(robot, c)
         pose = stance_frame_pose(robot, reg.stance, kin.q[r], None if kin.base is None else kin.base[r])
         Y, b = reg.joint_rows(pose, kin.q[r], kin.qd[r], kin.qdd[r])[:, tc], kin.tau[r]
-    stribeck = None if options.stribeck_joints is None else np.isin(robot.torque_controlled, options.stribeck_joints)
-    one_way = np.isin(robot.torque_controlled, options.one_way_joints) if options.one_way_joints else None
-    C = friction_rows(kin, r, tc, options, stribeck, one_way)
+    C = friction_columns(friction_rows(robot, kin, r, options) if features is None else features)
     qdd_tc = kin.qdd[r][:, tc]
     if options.armature == "identify":
         C = np.concatenate([C, armature_columns(qdd_tc)], axis=2)

@@ -158,8 +158,8 @@ def one_way_joints(robot: Robot, parts: list[Part]) -> tuple[str, ...]:
         held = part.holds(rows)
         for i, column in enumerate(part.kin.qd[rows][:, robot.tc_index].T):
             qd[i].append(column if held is None else column[held[:, i]])
-    return tuple(j for j, v in zip(robot.torque_controlled, qd)
-                 if v and np.concatenate(v).size and reverse_share(np.concatenate(v)) < MIN_REVERSE)
+    moved = [np.concatenate(v) if v else np.zeros(0) for v in qd]
+    return tuple(j for j, v in zip(robot.torque_controlled, moved) if v.size and reverse_share(v) < MIN_REVERSE)
 
 
 def torque_rms(robot: Robot, parts: list[Part]) -> np.ndarray:

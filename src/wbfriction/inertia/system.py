@@ -20,7 +20,7 @@ import numpy as np
 from wbfriction.inertia.least_squares import CompressedLeastSquares
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import regressor_of, row_groups
-from wbfriction.inertia.rows import own_columns, rest_names, row_mask, sample_rows
+from wbfriction.inertia.rows import friction_rows, own_columns, rest_names, row_mask, sample_rows
 from wbfriction.inertia.samples import LogSamples
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
@@ -42,9 +42,10 @@ def compressed_system(robot: Robot, samples: LogSamples, which: Literal["train",
                    for cols in inertial]
         for part in samples.parts:
             r = np.flatnonzero(getattr(part, which) & (part.stance == c))
+            features = friction_rows(robot, part.kin, r, options)  # once: a global smoother filters the whole part
             for start in range(0, r.size, options.block):
                 rr = r[start:start + options.block]
-                Y, C, b = sample_rows(robot, part.kin, rr, c, options)
+                Y, C, b = sample_rows(robot, part.kin, rr, c, options, features[start:start + options.block])
                 rows = row_mask(part.holds(rr), C, b)
                 for i, system in enumerate(systems):
                     keep = slice(None) if rows is None else rows[:, i]
