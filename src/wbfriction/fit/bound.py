@@ -103,3 +103,21 @@ def cramer_rao(jac: np.ndarray, rows: np.ndarray, noise: NoiseModel, rtol: float
     cov[bad, :] = np.inf
     cov[:, bad] = np.inf
     return cov
+
+
+def at_least_bound(covariance: np.ndarray, bound: np.ndarray) -> np.ndarray:
+    """``covariance`` (p, p) scaled so that no standard error falls below its Cramér-Rao bound ``bound`` (p,)
+    (standard deviations; 0 or not finite: no bound): ``D C D`` with ``D = diag(max(1, b_i / s_i))``, which keeps the
+    correlations (issue 63). The residuals' sandwich sees the torque's noise and the model's error as the fit's
+    residual shows them; the bound sees the positions' noise through the equations of motion, which the residual of
+    a filtered or momentum estimate shows smoothed away: where the bound is the larger, no unbiased estimator could
+    do better than it, and a standard error below it claims what the data cannot carry (the README's tour: F_v 0.180
+    ± 0.005 against an injected 0.2, a bound of 0.008)."""
+    cov = np.array(covariance, dtype=float)
+    se = np.sqrt(np.abs(np.diag(cov)))
+    b = np.nan_to_num(np.asarray(bound, dtype=float), nan=0.0, posinf=0.0)
+    scale = np.ones_like(se)
+    raise_ = np.isfinite(se) & (se > 0) & (b > se)
+    scale[raise_] = b[raise_] / se[raise_]
+    with np.errstate(invalid="ignore"):
+        return cov * np.outer(scale, scale)

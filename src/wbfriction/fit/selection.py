@@ -17,6 +17,7 @@ model is fitted. A model with a parameter at a bound gives way to the best simpl
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -45,6 +46,7 @@ from wbfriction.fit.solve import (
     shown_friction,
 )
 from wbfriction.fit.status import MIN_SPEED, reverse_share
+from wbfriction.fit.transition import unresolved
 from wbfriction.friction.families.base import FrictionFamily
 from wbfriction.friction.families.registry import families, family
 from wbfriction.friction.models import ModelName, ModelParamsBase
@@ -236,14 +238,61 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     residuals = {m: held_out_residuals(r.params, qd, -y, scored, smoother, sigma) for m, r in trained.items()
                  if r.params is not None}
     scores = tuple(HeldOutScore(m, float(np.sqrt(np.mean(residuals[m] ** 2))) if m in residuals else float("nan"),
-                                r.bounded()) for m, r in trained.items())
-    chosen, reason = choose_model(scores, tolerance)
-    chosen, reason = prefer_interior(chosen, reason, scores, residuals, np.flatnonzero(scored))
+                                r.bounded(), () if r.params is None else unresolved(r.params, qd[train], sigma))
+                   for m, r in trained.items())
+    eligible = tuple(s for s in scores if not s.unresolved) or scores
+    chosen, reason = choose_model(eligible, tolerance)
+    chosen, reason = prefer_interior(chosen, reason, eligible, residuals, np.flatnonzero(scored))
+    slow = use | stuck if stuck is not None else use
+    chosen, reason, scores = confirm_later(chosen, reason, scores, eligible, qd, y, slow, use,
+                                           held=held, tolerance=tolerance, **kwargs)
+    left = [f"{s.model} ({'; '.join(s.unresolved)})" for s in scores if s.unresolved]
+    if left:
+        reason += "; not candidates, transitions the data do not resolve: " + ", ".join(left)
     res = fit_model(chosen, qd, y, use, fixed=held[chosen], noise=noise, **kwargs)  # as if the model had been named
     if res.bounded():
         reason += f"; at a bound: {', '.join(res.bounded())}"
     res.selection = ModelSelection(chosen, reason, scores, tolerance, n_train, n_held_out)
     return res
+
+
+def confirm_later(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ...],
+                  eligible: tuple[HeldOutScore, ...], qd: np.ndarray, y: np.ndarray, scored: np.ndarray,
+                  use: np.ndarray, *, held: Mapping[ModelName, dict[str, float]], tolerance: float,
+                  **kwargs: Any) -> tuple[ModelName, str, tuple[HeldOutScore, ...]]:
+    """A model chosen over the simplest candidate on the interleaved held-out blocks confirmed on data that differ
+    (issue 63): every candidate up to it, fitted on the samples ``use`` before the log's later stretch
+    (:func:`~wbfriction.fit.holdout.split_later`, the last :data:`~wbfriction.fit.holdout.LATER`), is scored on
+    that stretch (``scored``: the samples scored, the slow ones too), and the simplest within ``tolerance`` of the
+    best there is chosen if it is simpler: a richer model must predict both the interleaved blocks and the later
+    stretch better than the simpler ones. Returns the model, its reason and the scores with their ``later_rms``.
+    Too few samples on either side (:data:`~wbfriction.fit.holdout.MIN_HELD_OUT`): the choice as it is."""
+    names = [s.model for s in eligible]
+    if chosen == names[0]:
+        return chosen, reason, scores
+    before, later = split_later(use, LATER)
+    later_scored = scored & ~before & np.isfinite(qd) & np.isfinite(y)
+    if int((use & before).sum()) < MIN_HELD_OUT or int(later_scored.sum()) < MIN_HELD_OUT:
+        return chosen, reason, scores
+    rms: dict[ModelName, float] = {}
+    for m in names[:names.index(chosen) + 1]:
+        early = fit_model(m, qd, y, use & before, fixed=held[m], **kwargs)
+        if early.params is not None:
+            r = held_out_residuals(early.params, qd, -y, later_scored, kwargs.get("smoother"), kwargs.get("sigma", 0.0))
+            rms[m] = float(np.sqrt(np.mean(r**2)))
+    scores = tuple(replace(s, later_rms=rms.get(s.model, float("nan"))) for s in scores)
+    finite = [s for s in scores if s.model in rms and np.isfinite(s.later_rms)]
+    if not finite:
+        return chosen, reason, scores
+    best = min(s.later_rms for s in finite)
+    confirmed = next(s for s in finite if s.later_rms <= (1.0 + tolerance) * best)
+    if confirmed.model == chosen:
+        return chosen, reason + "; confirmed on the log's later stretch", scores
+    text = ", ".join(f"{s.model} {s.later_rms:.4g}" for s in finite)
+    return confirmed.model, (f"{confirmed.model}: {chosen} was best on the interleaved held-out blocks but not "
+                             f"confirmed on the log's later stretch, where {confirmed.model} is within "
+                             f"{100 * tolerance:g} % of the best (later-stretch RMS [N·m]: {text}); first choice: "
+                             f"{reason}"), scores
 
 
 def prefer_interior(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ...],

@@ -14,7 +14,9 @@ the Jacobian at the solution,
 computed through the SVD of J, with a Newey-West correction for residuals correlated in
 time (filtered estimates above all; :mod:`~wbfriction.fit.regression`); a parameter with a component
 in the numerical null space of J (e.g. ``v_s`` when ``S = 0``, or the Stribeck parameters when the data never
-leave the Stribeck region) gets an infinite standard error: the data cannot identify it.
+leave the Stribeck region) gets an infinite standard error: the data cannot identify it. Where the fit carries its
+Cramér-Rao bound (:mod:`~wbfriction.fit.bound`), no standard error is below it: the covariance is scaled up to it
+(:func:`~wbfriction.fit.bound.at_least_bound`, issue 63).
 
 Filtered estimates (thesis 7.1) are compared with the model filtered the same way: when
 the friction went through a zero-phase smoother ``H``, the fit minimises
@@ -32,7 +34,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from wbfriction.fit.bound import BATCH, cramer_rao, torque_noise
+from wbfriction.fit.bound import BATCH, at_least_bound, cramer_rao, torque_noise
 from wbfriction.fit.coordinates import (
     AT_BOUND_NEAR,
     AT_BOUND_RTOL,
@@ -117,11 +119,14 @@ STICK_SIGMAS = 3.0
 measured speed is below this many standard deviations of the velocity's noise (:func:`stuck_rows`)."""
 
 
-STICK_FLOOR = 3e-3
-"""... and never below this speed [rad/s]: what a sticking joint creeps or chatters at in a simulator (MuJoCo's
-soft friction-loss constraint creeps; a sign function applied at every physics step makes a stuck joint chatter,
-up to 2e-3 rad/s on TALOS's hip roll at 4 kHz, and at 1e-3 rad/s its noise-free F_v came out 15 % off, at 2e-3
-and 3e-3 0.0 %)."""
+STICK_FLOOR = MIN_SPEED
+"""... and never below this speed [rad/s], what the statuses call not moving: what a sticking joint creeps or
+chatters at. MuJoCo's soft friction-loss constraint creeps; a sign function applied at every physics step makes a
+stuck joint chatter, up to 2e-3 rad/s on TALOS's hip roll at 4 kHz (at a floor of 1e-3 rad/s its noise-free F_v
+came out 15 % off); a walking quadruped's loaded stance leg creeps at 0.003-0.02 rad/s, its friction there set by
+the contact, not the velocity (issue 63: a crawl made elsewhere, whose creep at a floor of 3e-3 rad/s drove a
+Stribeck fit to F_c = 0 and F_v 287 % off; ``tests/fit/test_transition.py`` builds such a leg). A reversal that
+passes through the band is kept whatever its width (:func:`stuck_rows`)."""
 
 
 def stick_speed(velocity_noise: float) -> float:
@@ -318,6 +323,9 @@ def fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, 
             exact = fam.jacobian(full(best.x), v, delta_s)[:, free]  # the bound: velocities known
             bound[free] = covariance_errors(cramer_rao(exact, rows, noise.with_torque(sigma_tau)))
             res.crb = dict(zip(names, map(float, bound)))
+            # no standard error below what any unbiased estimator reaches (issue 63)
+            res.covariance = at_least_bound(cov, bound)
+            res.stderr = dict(zip(names, map(float, covariance_errors(res.covariance))))
     return res
 
 

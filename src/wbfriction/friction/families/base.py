@@ -180,6 +180,13 @@ class FrictionFamily(ABC):
         """The Coulomb friction F_c [N·m], the level in motion (URDF ``friction``, MuJoCo ``frictionloss``)."""
         return float(params.quantities()["F_c"])
 
+    def transitions(self, params: ModelParamsBase) -> dict[str, float]:
+        """The speeds [rad/s] at which the shape parameters of ``params`` act, by name (e.g. ``{"v_s": 0.05}``):
+        each is a transition of the characteristic that the data must resolve, with samples inside and beyond it,
+        for the family to be chosen (:mod:`wbfriction.fit.transition`). The default: none (a family whose shape is
+        fixed by its magnitudes, as Coulomb-viscous)."""
+        return {}
+
     # the fit's coordinates
 
     def to_fit(self, x: np.ndarray) -> np.ndarray:

@@ -101,6 +101,12 @@ class Stribeck(FrictionFamily):
     held_with = (("F_s", "F_c"),)
 
 
+    def transitions(self, params: ModelParamsBase) -> dict[str, float]:
+        """``{"v_s": v_s}`` where the Stribeck effect is there (``F_s > F_c``), else none
+        (:meth:`FrictionFamily.transitions`)."""
+        p = cast(StribeckParams, params)
+        return {"v_s": float(p.v_s)} if p.F_s - p.F_c > 1e-6 * max(abs(p.F_c), 1.0) else {}
+
     def velocity_basis(self, params: ModelParamsBase,
                        qd: np.ndarray) -> tuple[tuple[str, ...], np.ndarray, np.ndarray]:
         """``F_v, F_c, F_s, tau_os`` on ``[qd, sgn(qd) (1 - e), sgn(qd) e, 1]``, ``e = exp(-|qd / v_s|^delta_s)``

@@ -106,6 +106,16 @@ class Thesis(FrictionFamily):
     varying_columns = (2,)
 
 
+    def transitions(self, params: ModelParamsBase) -> dict[str, float]:
+        """``v_s`` where the Stribeck effect is there (``S > 0``) and ``1 / a``, the speed at which ``tanh(a qd)``
+        reaches 0.76, unless ``a`` is at its upper bound (a step: Coulomb friction, no transition to resolve)
+        (:meth:`FrictionFamily.transitions`)."""
+        p = cast(FrictionParams, params)
+        out = {"v_s": float(p.v_s)} if p.S > 1e-6 and p.F_c > 0 else {}
+        if p.a < (1.0 - 1e-3) * UPPER[5]:
+            out["a"] = 1.0 / float(p.a)
+        return out
+
     def coulomb_shape(self, params: ModelParamsBase, qd: np.ndarray) -> np.ndarray:
         """``tanh(a qd)`` (:meth:`FrictionFamily.coulomb_shape`)."""
         return np.tanh(cast(FrictionParams, params).a * qd)
