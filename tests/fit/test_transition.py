@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from wbfriction.fit.bound import at_least_bound
 from wbfriction.fit.selection import fit_friction
 from wbfriction.fit.solve import stick_speed
-from wbfriction.fit.transition import TRANSITION_SAMPLES, creep_floor, transition_counts, unresolved
+from wbfriction.fit.transition import creep_floor, transition_counts, unresolved
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams, StribeckParams
 
 
@@ -66,13 +66,19 @@ def test_a_resolved_stribeck_curve_is_still_chosen():
 
 def test_transition_counts_and_floor():
     qd = np.concatenate([np.full(30, 0.006), np.full(25, 0.03), np.full(40, -0.05), np.full(7, 0.2)])
-    assert transition_counts(0.04, qd, 0.02) == (25, 40)  # inside [0.02, 0.04), beyond [0.04, 0.12)
-    assert transition_counts(0.01, qd, 0.02) == (0, 0)  # in the creep: nothing counts
-    assert creep_floor(0.0) == 0.02 and creep_floor(0.01) == 0.03
+    assert transition_counts(0.04, qd, 0.02) == (25, 40)  # below: [0.02, 0.04), beyond [0.04, 0.12)
+    assert transition_counts(0.04, qd, 0.0) == (55, 40)
+    assert transition_counts(0.01, qd, 0.02) == (0, 0)  # in the noise: nothing counts
+    assert creep_floor(0.0) == 0.0 and creep_floor(0.01) == 0.03
     creeping = StribeckParams(F_v=0.3, F_c=0.6, F_s=1.0, v_s=0.01, tau_os=0.0)
-    assert unresolved(creeping, qd) and unresolved(creeping, qd)[0].startswith("v_s 0.01 rad/s (0 samples inside")
+    assert unresolved(creeping, qd, 0.007)[0].startswith("v_s 0.01 rad/s (0 samples below")
+    assert unresolved(creeping, qd[30:])[0].startswith("v_s 0.01 rad/s (0 samples below")
     resolved = StribeckParams(F_v=0.3, F_c=0.6, F_s=1.0, v_s=0.04, tau_os=0.0)
-    assert unresolved(resolved, np.repeat(qd, (TRANSITION_SAMPLES + 24) // 25)) == ()
+    assert unresolved(resolved, qd) == ()
+    # below and beyond it samples enough, but not determined by the fit: its standard error decides
+    assert unresolved(resolved, qd, stderr={"v_s": 0.016}) == ()
+    assert unresolved(resolved, qd, stderr={"v_s": 0.024}) == ("v_s 0.04 rad/s (±60 %)",)
+    assert unresolved(resolved, qd, stderr={}) == ("v_s 0.04 rad/s (not identifiable)",)
     # no Stribeck effect (F_s = F_c) or a tanh at its step: no transition to resolve
     assert unresolved(StribeckParams(F_v=0.3, F_c=0.6, F_s=0.6, v_s=0.01, tau_os=0.0), qd) == ()
     assert unresolved(FrictionParams(F_v=0.3, F_c=0.6, S=0.0, v_s=0.1, tau_os=0.0, a=1e4), qd) == ()

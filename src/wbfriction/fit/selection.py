@@ -238,7 +238,7 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     residuals = {m: held_out_residuals(r.params, qd, -y, scored, smoother, sigma) for m, r in trained.items()
                  if r.params is not None}
     scores = tuple(HeldOutScore(m, float(np.sqrt(np.mean(residuals[m] ** 2))) if m in residuals else float("nan"),
-                                r.bounded(), () if r.params is None else unresolved(r.params, qd[train], sigma))
+                                r.bounded(), () if r.params is None else unresolved(r.params, qd[train], sigma, r.stderr))
                    for m, r in trained.items())
     eligible = tuple(s for s in scores if not s.unresolved) or scores
     chosen, reason = choose_model(eligible, tolerance)

@@ -5,58 +5,76 @@ the Stribeck velocity ``v_s`` (3.3), ``1 / a`` of the thesis's ``tanh(a qd)`` (3
 lower its residual, and where few samples lie around them they fit the noise, or a joint's creep: a walking robot's
 stance leg creeps at 0.003-0.02 rad/s, its friction there a function of the load and the contact, not of the
 velocity, and a Stribeck curve whose ``v_s`` sits among those samples predicts nothing the next step does (issue 63:
-such fits `ok` and 100 % off on a crawl made elsewhere). A transition is *resolved* when at least
-:data:`TRANSITION_SAMPLES` samples (and :data:`TRANSITION_SHARE` of those fitted) lie inside it, between half its
-speed and its speed, and as many beyond it, between its speed and three times it; speeds below the creep floor
-(:func:`creep_floor`: :data:`~wbfriction.fit.status.MIN_SPEED`, or three standard deviations of the velocity's
-noise) count as neither. A family with a transition its data do not resolve is not a candidate of the automatic
-choice (:mod:`~wbfriction.fit.selection`): creep below a transition is not evidence for it.
+such fits `ok` and 100 % off on a crawl made elsewhere). A transition is *resolved* when the data determine it,
+its parameter's standard error at most :data:`TRANSITION_REL` of its value, and when at least
+:data:`TRANSITION_SAMPLES` of the samples fitted (and :data:`TRANSITION_SHARE` of them) lie below its speed and as
+many between its speed and three times it (a parameter's standard error assumes the model: a curve placed where no
+sample is may look determined by its smooth shape alone); speeds below three standard deviations of the velocity's
+noise (:func:`creep_floor`) count as neither. The samples fitted hold no creep: a joint slower than
+:data:`~wbfriction.fit.solve.STICK_FLOOR` for longer than a pass through zero takes is left out as one that may stick
+(:func:`~wbfriction.fit.solve.stuck_rows`), so what lies below a transition are passes through it. A family with a
+transition its data do not resolve is not a candidate of the automatic choice (:mod:`~wbfriction.fit.selection`):
+creep below a transition is not evidence for it.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
-from wbfriction.fit.status import MIN_SPEED
 from wbfriction.friction.families.registry import family
 from wbfriction.friction.models import ModelParamsBase
 
-TRANSITION_SAMPLES = 20
-"""The fewest samples inside a transition, and beyond it, that resolve it."""
-TRANSITION_SHARE = 0.005
+TRANSITION_SAMPLES = 5
+"""The fewest samples below a transition's speed, and beyond it, that resolve it: a guard against a curve placed
+where no sample is, the standard error deciding otherwise (:data:`TRANSITION_REL`). A walking humanoid's joint at
+1 kHz passes through a tanh transition at 0.025 rad/s with 6-16 samples below it in its training blocks (the
+README's tour), and (3.5) predicts its held-out blocks 10-20 times better than a step there."""
+TRANSITION_SHARE = 0.001
 """... and the smallest share of the samples fitted, in each."""
+TRANSITION_REL = 0.5
+"""A transition whose parameter's standard error is above this share of its value is not determined (the
+threshold of a term beyond velocity, :data:`~wbfriction.fit.status.TERM_WEAK`)."""
 NOISE_SIGMAS = 3.0
 """Speeds below this many standard deviations of the velocity's noise are noise, not a transition's evidence."""
 
 
 def creep_floor(velocity_noise: float = 0.0) -> float:
-    """The speed [rad/s] below which samples are no evidence of a transition: :data:`MIN_SPEED` (what the statuses
-    call not moving), or :data:`NOISE_SIGMAS` standard deviations of the velocity's noise ``velocity_noise``
-    [rad/s] where that is more."""
-    return max(MIN_SPEED, NOISE_SIGMAS * float(velocity_noise))
+    """The speed [rad/s] below which samples are no evidence of a transition: :data:`NOISE_SIGMAS` standard
+    deviations of the velocity's noise ``velocity_noise`` [rad/s] (0 for a noise-free velocity)."""
+    return NOISE_SIGMAS * float(velocity_noise)
 
 
 def transition_counts(speed: float, qd: np.ndarray, floor: float) -> tuple[int, int]:
-    """How many of the velocities ``qd`` (n,) [rad/s] lie inside a transition at ``speed`` [rad/s] (``|qd|`` in
-    ``[max(speed / 2, floor), speed)``) and beyond it (in ``[max(speed, floor), 3 speed)``)."""
+    """How many of the velocities ``qd`` (n,) [rad/s] lie below a transition at ``speed`` [rad/s] (``|qd|`` in
+    ``[floor, speed)``) and beyond it (in ``[max(speed, floor), 3 speed)``)."""
     v = np.abs(np.asarray(qd, dtype=float))
     v = v[np.isfinite(v)]
-    inside = (v >= max(0.5 * speed, floor)) & (v < speed)
+    inside = (v >= floor) & (v < speed)
     beyond = (v >= max(speed, floor)) & (v < 3.0 * speed)
     return int(inside.sum()), int(beyond.sum())
 
 
-def unresolved(params: ModelParamsBase, qd: np.ndarray, velocity_noise: float = 0.0) -> tuple[str, ...]:
+def unresolved(params: ModelParamsBase, qd: np.ndarray, velocity_noise: float = 0.0,
+               stderr: Mapping[str, float] | None = None) -> tuple[str, ...]:
     """The transitions of ``params`` (:meth:`~wbfriction.friction.families.base.FrictionFamily.transitions`) the
-    velocities ``qd`` (n,) [rad/s] of the samples fitted do not resolve (module docstring), one phrase each, e.g.
-    ``"v_s 0.008 rad/s (0 samples inside, 3 beyond, above 0.02 rad/s)"``; empty when every one is resolved."""
+    velocities ``qd`` (n,) [rad/s] of the samples fitted, and the fit's standard errors ``stderr`` (by name; None:
+    not judged), do not resolve (module docstring), one phrase each, e.g.
+    ``"v_s 0.008 rad/s (0 samples below, 3 beyond)"``; empty when every one is resolved."""
     qd = np.asarray(qd, dtype=float)
     need = max(TRANSITION_SAMPLES, int(np.ceil(TRANSITION_SHARE * np.isfinite(qd).sum())))
     floor = creep_floor(velocity_noise)
+    values = params.to_dict()
     out = []
     for name, speed in family(params.model).transitions(params).items():
+        label = f"{'1/a' if name == 'a' else name} {speed:.2g} rad/s"
         inside, beyond = transition_counts(speed, qd, floor)
+        se = np.inf if stderr is None else float(stderr.get(name, np.inf))
+        rel = se / abs(values[name]) if values[name] else np.inf
         if min(inside, beyond) < need:
-            out.append(f"{'1/a' if name == 'a' else name} {speed:.2g} rad/s ({inside} samples inside, {beyond} beyond, above {floor:.2g} "
-                       "rad/s)")
+            out.append(f"{label} ({inside} samples below, {beyond} beyond" +
+                       (f", above {floor:.2g} rad/s)" if floor > 0 else ")"))
+        elif stderr is not None and not rel <= TRANSITION_REL:
+            out.append(f"{label} (±{100 * rel:.0f} %)" if np.isfinite(rel) else f"{label} (not identifiable)")
     return tuple(out)
