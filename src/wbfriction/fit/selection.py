@@ -238,7 +238,8 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     residuals = {m: held_out_residuals(r.params, qd, -y, scored, smoother, sigma) for m, r in trained.items()
                  if r.params is not None}
     scores = tuple(HeldOutScore(m, float(np.sqrt(np.mean(residuals[m] ** 2))) if m in residuals else float("nan"),
-                                r.bounded(), () if r.params is None else unresolved(r.params, qd[train], sigma, r.stderr))
+                                r.bounded(),
+                                () if r.params is None else unresolved(r.params, qd[train], sigma, r.stderr))
                    for m, r in trained.items())
     eligible = tuple(s for s in scores if not s.unresolved) or scores
     chosen, reason = choose_model(eligible, tolerance)
@@ -278,7 +279,8 @@ def confirm_later(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ..
     for m in names[:names.index(chosen) + 1]:
         early = fit_model(m, qd, y, use & before, fixed=held[m], **kwargs)
         if early.params is not None:
-            r = held_out_residuals(early.params, qd, -y, later_scored, kwargs.get("smoother"), kwargs.get("sigma", 0.0))
+            r = held_out_residuals(early.params, qd, -y, later_scored, kwargs.get("smoother"),
+                                   kwargs.get("sigma", 0.0))
             rms[m] = float(np.sqrt(np.mean(r**2)))
     scores = tuple(replace(s, later_rms=rms.get(s.model, float("nan"))) for s in scores)
     finite = [s for s in scores if s.model in rms and np.isfinite(s.later_rms)]

@@ -32,8 +32,9 @@ MAIN = ("F_c", "F_v")
 OTHERS = ("tau_os", "S", "v_s", "a")
 """The offset (every model) and the Stribeck terms (the models that have them), in a second table."""
 CAPTION = ("value ± standard error (the residuals' autocorrelation-consistent sandwich, raised to the "
-           "Cramér-Rao bound where that is larger); Cramér-Rao: the standard deviation no unbiased estimator from "
-           "these data goes below; n.i.: not identifiable; (b): at a bound of the fit, the bound's value, not the data's; "
+           "Cramér-Rao bound where that is larger); Cramér-Rao: the standard deviation no unbiased estimator "
+           "from these data goes below; n.i.: not identifiable; (b): at a bound of the fit, the bound's value, "
+           "not the data's; "
            "a step: a tanh slope beyond what the data resolve (Coulomb friction, sgn); "
            "dim: not to be used (status); *: refitted with its terms beyond velocity (the terms' table)")
 NAMES_SHOWN = 6
