@@ -11,7 +11,7 @@ from typing import Any, cast
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.fit.options import PASS_ROWS, SELECTION_TOLERANCE, FitOptions, ModelChoice
+from wbfriction.fit.options import PASS_ROWS, SELECTION_TOLERANCE, STICK_FLOOR, FitOptions, ModelChoice
 from wbfriction.fit.ranges import FittedRanges
 from wbfriction.fit.result import FitResult, compare_routes
 from wbfriction.fit.screen import gross_outliers
@@ -55,14 +55,15 @@ def _column_tasks(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, 
                   delta_s: float, min_samples: int, smoother, fixed: dict[str, float] | None,
                   selection_tolerance: float, noise: Mapping[str, JointNoise] | None,
                   stick_margin: int | None, still: ModelName | None = None,
-                  pass_rows: float = PASS_ROWS, score_slow: bool = True) -> list[tuple]:
+                  pass_rows: float = PASS_ROWS, score_slow: bool = True,
+                  stick_floor: float = STICK_FLOOR) -> list[tuple]:
     """One :func:`_fit_column` task per joint (:func:`fit_joints`'s arguments)."""
     noise = noise or {}
     tasks = []
     for i, joint in enumerate(joints):
         jn = noise.get(joint)
         sigma = 0.0 if jn is None else jn.velocity
-        stick = {} if stick_margin is None else {"stick": stick_speed(sigma), "stick_margin": stick_margin,
+        stick = {} if stick_margin is None else {"stick": stick_speed(sigma, stick_floor), "stick_margin": stick_margin,
                                                  "pass_rows": pass_rows, "score_slow": score_slow}
         tasks.append((qd[:, i], tau_f[:, i], valid[:, i],
                       dict(delta_s=delta_s, joint=joint, min_samples=min_samples, smoother=smoother, fixed=fixed,
@@ -185,7 +186,8 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
     truth = None if est.tau_f_true is None else est.tau_f_true[:, idx]
     common: dict[str, Any] = dict(delta_s=options.delta_s, min_samples=options.min_samples, fixed=fixed,
                                   selection_tolerance=options.selection_tolerance, still=still,
-                                  pass_rows=options.pass_rows, score_slow=options.score_slow)
+                                  pass_rows=options.pass_rows, score_slow=options.score_slow,
+                                  stick_floor=options.stick_floor)
     tasks = _column_tasks(names, est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], [options.model] * len(idx),
                           smoother=est.smoother, noise=joint_noises(record, est.estimation_route),
                           stick_margin=stick_margin(est), **common)

@@ -52,6 +52,18 @@ against 2 rows it predicts the KUKA's repeat run 2.1 times better and brings the
 published ones, at the price of the MuJoCo walk's noisy hip yaw (F_v 8 -> 13 % off)."""
 
 
+STICK_FLOOR = 0.02
+"""The speed [rad/s] a joint may stick below, whatever its velocity's noise
+(:func:`~wbfriction.fit.solve.stick_speed`), what the statuses call not moving
+(:data:`~wbfriction.fit.status.MIN_SPEED`): what a sticking joint creeps or chatters at. MuJoCo's soft friction-loss
+constraint creeps; a sign function applied at every physics step makes a stuck joint chatter, up to 2e-3 rad/s on
+TALOS's hip roll at 4 kHz (at a floor of 1e-3 rad/s its noise-free F_v came out 15 % off); a walking quadruped's
+loaded stance leg creeps at 0.003-0.02 rad/s, its friction there set by the contact, not the velocity (issue 63: a
+crawl made elsewhere, whose creep at a floor of 3e-3 rad/s drove a Stribeck fit to F_c = 0 and F_v 287 % off;
+``tests/fit/test_transition.py`` builds such a leg). A reversal that passes through the band is kept whatever its
+width (:func:`~wbfriction.fit.solve.stuck_rows`). A knob of ``benchmarks/study_defaults.py`` (``stick_floor``)."""
+
+
 SELECTION_TOLERANCE = 0.02
 """Relative excess of held-out RMS over the best model's within which a simpler model is chosen
 (:func:`~wbfriction.fit.selection.choose_model`)."""
@@ -126,6 +138,8 @@ class FitOptions:
             every slow stretch; :func:`~wbfriction.fit.solve.stuck_rows`).
         score_slow: with ``model="auto"``, the held-out blocks' samples left out as sticking are scored too (what a
             prediction scores).
+        stick_floor: the speed [rad/s] a joint may stick or creep below whatever its velocity's noise
+            (:data:`STICK_FLOOR`; >= 0).
 
     Raises:
         UnknownFamilyError: a model that is no family's nor ``auto`` (an :class:`OptionError` naming ``--model`` and
@@ -140,10 +154,12 @@ class FitOptions:
     terms: TermOptions = TermOptions()
     pass_rows: float = PASS_ROWS
     score_slow: bool = True
+    stick_floor: float = STICK_FLOOR
 
     def __post_init__(self) -> None:
         check_family(self.model, flag("model"), also=(AUTO,))
         check_range("pass_rows", self.pass_rows, low=0.0)
+        check_range("stick_floor", self.stick_floor, low=0.0)
         check_range("selection_tolerance", self.selection_tolerance, low=0.0)
         check_range("min_samples", self.min_samples, low=1)
         check_range("delta_s", self.delta_s, low=0.0, strict=True)

@@ -40,7 +40,7 @@ from wbfriction.fit.coordinates import (
     AT_BOUND_RTOL,
     AT_BOUND_SSR,
 )
-from wbfriction.fit.options import PASS_ROWS
+from wbfriction.fit.options import PASS_ROWS, STICK_FLOOR
 from wbfriction.fit.projection import BASINS, Projection, projected_start
 from wbfriction.fit.regression import (
     correlation_lag,
@@ -119,20 +119,13 @@ STICK_SIGMAS = 3.0
 measured speed is below this many standard deviations of the velocity's noise (:func:`stuck_rows`)."""
 
 
-STICK_FLOOR = MIN_SPEED
-"""... and never below this speed [rad/s], what the statuses call not moving: what a sticking joint creeps or
-chatters at. MuJoCo's soft friction-loss constraint creeps; a sign function applied at every physics step makes a
-stuck joint chatter, up to 2e-3 rad/s on TALOS's hip roll at 4 kHz (at a floor of 1e-3 rad/s its noise-free F_v
-came out 15 % off); a walking quadruped's loaded stance leg creeps at 0.003-0.02 rad/s, its friction there set by
-the contact, not the velocity (issue 63: a crawl made elsewhere, whose creep at a floor of 3e-3 rad/s drove a
-Stribeck fit to F_c = 0 and F_v 287 % off; ``tests/fit/test_transition.py`` builds such a leg). A reversal that
-passes through the band is kept whatever its width (:func:`stuck_rows`)."""
 
 
-def stick_speed(velocity_noise: float) -> float:
+
+def stick_speed(velocity_noise: float, floor: float = STICK_FLOOR) -> float:
     """The speed [rad/s] below which a sample may be sticking: :data:`STICK_SIGMAS` standard deviations of the
-    velocity noise [rad/s], at least :data:`STICK_FLOOR`."""
-    return max(STICK_SIGMAS * velocity_noise, STICK_FLOOR)
+    velocity noise [rad/s], at least ``floor`` [rad/s] (:data:`~wbfriction.fit.options.STICK_FLOOR`)."""
+    return max(STICK_SIGMAS * velocity_noise, floor)
 
 
 EDGE_ROWS = 3

@@ -11,7 +11,7 @@ its parameter's standard error at most :data:`TRANSITION_REL` of its value, and 
 many between its speed and three times it (a parameter's standard error assumes the model: a curve placed where no
 sample is may look determined by its smooth shape alone); speeds below three standard deviations of the velocity's
 noise (:func:`creep_floor`) count as neither. The samples fitted hold no creep: a joint slower than
-:data:`~wbfriction.fit.solve.STICK_FLOOR` for longer than a pass through zero takes is left out as one that may stick
+:data:`~wbfriction.fit.options.STICK_FLOOR` for longer than a pass through zero takes is left out as one that may stick
 (:func:`~wbfriction.fit.solve.stuck_rows`), so what lies below a transition are passes through it. A family with a
 transition its data do not resolve is not a candidate of the automatic choice (:mod:`~wbfriction.fit.selection`):
 creep below a transition is not evidence for it.
