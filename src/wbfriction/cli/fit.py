@@ -98,12 +98,16 @@ def fit(friction: Path = FrictionArg,
                                              "samples passes through zero and stays in the fit; a slower one may "
                                              "hold a stop and is left out with the filter's reach (inf: every "
                                              "reversal; 0: none)."),
+        stick_floor: float = typer.Option(FIT.stick_floor, min=0.0,
+                                          help="Speed [rad/s] below which a joint that lingers may stick or creep "
+                                               "(a loaded stance leg), whatever its velocity's noise: those samples "
+                                               "are left out of the fit."),
         wide: bool = WideOpt, verbose: bool = VerboseOpt) -> None:
     """Identify a friction model of every joint, with standard errors and the parameters left
     at a bound; warn about joints whose friction generates power (eq. 7.9)."""
     check_paths({"FRICTION": friction}, {"-o": output})
     _run_fit(friction, output, FitOptions(model=cast(ModelChoice, model), selection_tolerance=selection_tolerance,
-                                          min_samples=min_samples, pass_rows=pass_rows,
+                                          min_samples=min_samples, pass_rows=pass_rows, stick_floor=stick_floor,
                                           terms=term_options(terms, max_harmonic, reference_temperature,
                                                              temperature_law)),
              energy_threshold, energy_tolerance, workers, wide, verbose)
