@@ -69,11 +69,17 @@ class ForceSampling:
         ratio = self.rss[self.used] / max(self.rss[self.best], 1e-300)
         return (f"{source}: the foot forces fit the momentum balance read as {_phrase(self.best)} better than as "
                 f"{_phrase(self.used)} (residual {ratio:.1f} times smaller): check which period the logger's "
-                "force.* rows stand for (docs/reference/log-format.md)")
+                f"force.* rows stand for (docs/reference/log-format.md){REMEDY.get((self.used, self.best), '')}")
 
     def to_dict(self) -> dict:
         """As JSON (the friction table's metadata ``foot_force_sampling``)."""
         return {"used": self.used, "best": self.best, "rss": dict(self.rss), "joints": self.joints}
+
+
+REMEDY = {("held", "held before"): "; if a row late, move the force.* columns one row earlier",
+          ("held", "instants"): "; if sampled at the instants, give each row the mean of it and the next",
+          ("instants", "held"): "; if held like the torques, --torque-alignment zoh"}
+"""What to do with the log, by (used, best) reading."""
 
 
 def _phrase(reading: str) -> str:
