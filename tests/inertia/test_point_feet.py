@@ -117,6 +117,17 @@ def test_point_feet_need_the_base_measured(go2w, trots):
         identify_inertia(go2w, trots["3d"], EstimateOptions(diff="true", base_motion="contact"), InertialOptions())
 
 
+def test_a_held_out_share_that_determines_nothing_says_so_on_point_feet(go2w, trots):
+    """Every foot down over the held-out last 20 % (no leg free of unknown forces there): the one line names what a
+    quadruped's sample needs, not a humanoid's single support (issue 63)."""
+    log = trots["none"]
+    contact = log.contact.copy()
+    contact[int(0.75 * len(contact)):] = True
+    with pytest.raises(InputError, match="no sample with a joint free of unknown contact forces .* in the held-out"):
+        identify_inertia(go2w, dataclasses.replace(log, contact=contact),
+                         EstimateOptions(diff="true", base_motion="logged"), InertialOptions())
+
+
 def test_a_wrong_leg_is_corrected_on_a_noisy_soft_contact_trot(go2w):
     """MuJoCo's trot (soft contacts, sphere feet), the feet's 3-D forces, and a real robot's noise (19-bit encoders,
     0.05 N·m torques, 2 N forces, the IMU's), differentiated as a user's log would be (``diff auto``: a

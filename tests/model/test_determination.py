@@ -117,9 +117,10 @@ def test_normal_forces_leave_flat_stance_legs_undetermined(go2):
     assert (stacked == det.determined[0]).all()
 
 
-def test_ill_conditioned_sample_is_not_determined():
-    """A contact map with a singular value just above round-off (three feet nearly on a line): its conditioning
-    beyond COND_MAX makes no joint determined, though the rank is full."""
+def test_ill_conditioned_direction_leaves_only_the_joints_it_moves_undetermined():
+    """A contact map with a singular value just above round-off (three feet nearly on a line): the internal force
+    along it counts as free, so the joints it moves are not determined and those the contacts do not reach are
+    (issue 63: a badly conditioned stance dropped the swinging legs too); well conditioned, the rank is full."""
     rng = np.random.default_rng(1)
     U, _ = np.linalg.qr(rng.normal(size=(6, 6)))
     V, _ = np.linalg.qr(rng.normal(size=(9, 9)))
@@ -127,12 +128,35 @@ def test_ill_conditioned_sample_is_not_determined():
     base_map = (U[:, :6] * s) @ V[:6]
     joint_map = rng.normal(size=(1, 12, 9))
     joint_map[0, :3] = 0.0  # a joint the contacts do not reach
-    _, _, det = determine(base_map[None], joint_map, rng.normal(size=(1, 6)), rng.normal(size=(1, 12)))
-    assert det.nullity[0] == 3 and det.cond[0] > COND_MAX
-    assert not det.determined.any()
-    well = (U[:, :6] * s[[0, 1, 2, 3, 4, 4]]) @ V[:6]
-    _, _, det = determine(well[None], joint_map, rng.normal(size=(1, 6)), rng.normal(size=(1, 12)))
+    r_base, r_joint = rng.normal(size=(1, 6)), rng.normal(size=(1, 12))
+    tau, _, det = determine(base_map[None], joint_map, r_base, r_joint)
+    assert det.nullity[0] == 4 and det.cond[0] == pytest.approx(1.0 / 0.3)
     assert det.determined[0, :3].all() and not det.determined[0, 3:].any()
+    assert np.array_equal(tau[0, :3], r_joint[0, :3])  # no contact force on their rows
+    well = (U[:, :6] * s[[0, 1, 2, 3, 4, 4]]) @ V[:6]
+    _, _, det = determine(well[None], joint_map, r_base, r_joint)
+    assert det.nullity[0] == 3 and det.cond[0] == pytest.approx(1.0 / 0.3)
+    assert det.determined[0, :3].all() and not det.determined[0, 3:].any()
+
+
+def test_stance_a_few_micrometres_off_flat_keeps_the_swinging_legs(go2):
+    """Normal forces measured on a trot's stance whose feet stand 1e-6 m apart in height (a simulator's drift): the
+    horizontal forces' moments nearly repeat their sum's, a singular value 1e-6 of the largest. The swinging legs
+    stay determined and exact, the stance legs not (before issue 63 the whole sample was dropped)."""
+    rng = np.random.default_rng(3)
+    q = np.tile(go2.q_reference, (2, 1))
+    calf = [i for i, n in enumerate(go2.actuated) if n == "FL_calf_joint"][0]
+    q[1, 7 + calf] += 1e-5  # the FL foot about a micrometre lower
+    v, flags = rng.normal(0, 0.3, (2, go2.model.nv)), np.tile(np.array([1, 0, 0, 1], dtype=bool), (2, 1))
+    force = rng.normal(0, 20, (2, 4, 3)) + [0, 0, 70]
+    tau_f = rng.normal(0, 1, (2, go2.n_act))
+    a, tau = consistent_motion(go2, q, v, rng.normal(0, 2, (2, go2.n_act)), flags, force, tau_f)
+    normal = np.where(np.arange(3) == 2, force, np.nan)
+    sol = joint_torques(go2, q, v, a, flags, normal)
+    swing = _leg(go2, "FR") | _leg(go2, "RL")
+    assert (sol.determination.determined == swing).all()
+    assert np.allclose(sol.tau[:, swing], (tau + tau_f)[:, swing], rtol=1e-8, atol=1e-8)
+    assert (sol.determination.cond <= COND_MAX).all()
 
 
 def test_soles_single_and_double_support():

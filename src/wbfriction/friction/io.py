@@ -73,7 +73,7 @@ def friction_table(est: FrictionEstimate) -> pa.Table:
             cols.update({f"{CHECK}qd.{j}": check.qd[:, i], f"{CHECK}tau_f.{j}": check.tau_f[:, i],
                          f"{CHECK}valid.{j}": check.valid[:, i]})
         metadata["route_check"] = {k: v for k, v in check.metadata.items()
-                                   if k in ("estimate_options", "momentum", "base_motion")}
+                                   if k in ("estimate_options", "momentum", "base_motion", "foot_force_sampling")}
     if est.companion_diff is not None:
         metadata["companion_diff"] = est.companion_diff
     return with_metadata(pa.table(cols), metadata)

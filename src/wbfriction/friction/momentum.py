@@ -18,8 +18,10 @@ impulse is
     F_i = \\int_{t_i}^{t_{i+1}} \\tau_f\\, dt = p_{i+1} - p_i - \\int_{t_i}^{t_{i+1}} (\\tau + e)\\, dt
           - \\frac{b_i + b_{i+1}}{2} \\Delta t_i, \\qquad b = C^T v - g, \\quad e = \\sum_e J_e^T f_e ,
 
-the torque's integral (and the measured wrenches', read as the torques are) exact for a torque held over the
-step (``zoh``: ``tau_i Delta t_i``) and the trapezoid for one sampled at the instants (``sample``); ``b``, a
+the torque's integral (and the measured wrenches' and foot forces', read as the torques are: the log-format
+reference's convention) exact for a torque held over the step (``zoh``: ``tau_i Delta t_i``) and the trapezoid for
+one sampled at the instants (``sample``); a log whose foot forces fit another period better is named
+(:mod:`wbfriction.friction.force_sampling`, the metadata ``foot_force_sampling``); ``b``, a
 smooth function of the state, by the trapezoid (an error ``dt^2 / 12`` times the momentum's third derivative:
 below 1e-8 N·m on a slow arm trajectory sampled at 10 kHz, ``tests/friction/test_momentum.py``). No
 acceleration anywhere: the Coulomb step is smoothed only as much as the velocity needs. The per-sample
@@ -62,6 +64,7 @@ import numpy as np
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.estimated import FrictionEstimate, no_single_support
+from wbfriction.friction.force_sampling import check_force_sampling
 from wbfriction.friction.measured import impacts, log_base_motion
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import Log
@@ -216,11 +219,11 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
                              _alignment(options, log), closure)
     tau_f = window.over_steps(impulses)
     valid = _whole_windows(mask, window.half_width) & np.isfinite(tau_f)
-    route = np.select([closure == n_c, closure == n_c + 1, closure >= 0], ["wrench", "base", "contact"],
-                      "none").astype("<U7")
+    route = np.select([closure == n_c, closure == n_c + 1, closure >= 0], ["wrench", "base", "contact"], "none")  # <U7
     metadata = {**kin.metadata, "robot": robot.name, "source": log.source,
                 "base_motion": {"base": base_motion, "wrenches": has_wrench}, "estimate_options": asdict(options),
                 "joint_labels": {j: robot.label(j) for j in robot.torque_controlled},
+                **_force_sampling(robot, log, options, kin.qd, (p, b, e), valid, window, closure),
                 "momentum": {"velocity_window": velocity_filter(options).window, "window": window.length,
                              "window_s": window.length * log.dt, "cutoff_hz": window.cutoff, "lag_s": 0.0}}
     return FrictionEstimate(
@@ -251,6 +254,22 @@ def _point_feet(robot: Robot, kin: MeasuredKinematics, log: Log, options: Estima
     p[r], b[r] = (x[:, robot.act_v_index] for x in momentum_and_drift(robot.model, q, v, progress=progress)[:2])
     e[r] = foot_force_torques(robot, q, log.contact[r], feet)[:, robot.act_v_index]
     return r, free_rows(robot, log.contact[r], feet), determination(robot, q, log.contact[r], feet)
+
+
+def _force_sampling(robot: Robot, log: Log, options: EstimateOptions, qd: np.ndarray,
+                    pbe: tuple[np.ndarray, np.ndarray, np.ndarray], valid: np.ndarray, window: MomentumWindow,
+                    closure: np.ndarray) -> dict:
+    """``{"foot_force_sampling": ...}``: the readings of the measured foot forces compared on the momentum balance
+    (:mod:`wbfriction.friction.force_sampling`, its warning line or ""), for a robot on point feet whose log has foot
+    forces; else ``{}``. ``qd`` (N, n_act) and ``pbe`` (each (N, n_act)): the route's velocities, momenta, their
+    rates and the measured forces' torques; ``valid`` (N, n_tc)."""
+    if not robot.point_contacts or log.foot_force is None:
+        return {}
+    tc, alignment = robot.tc_index, _alignment(options, log)
+    p, b, e = (x[:, tc] for x in pbe)
+    impulses = step_impulses(p, b, log.tau, window.step_durations(len(qd)), alignment, closure)
+    found = check_force_sampling(impulses, e, qd[:, tc], valid, window, "held" if alignment == "zoh" else "instants")
+    return {"foot_force_sampling": {**found.to_dict(), "warning": found.warning(log.source)}}
 
 
 def _alignment(options: EstimateOptions, log: Log) -> str:

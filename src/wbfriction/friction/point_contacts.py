@@ -21,7 +21,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.estimated import FrictionEstimate
+from wbfriction.friction.estimated import FrictionEstimate, no_single_support
 from wbfriction.friction.measured import base_state, finite_base, measured_base
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.model.determination import Determination, joint_torques
@@ -85,8 +85,7 @@ def point_contact_estimate(robot: Robot, kin: MeasuredKinematics, options: Estim
     tc = robot.tc_index
     valid = det.determined[:, tc] & usable[:, None] & np.isfinite(tau_f)
     if require_determined and not valid.any():
-        raise InputError(f"{kin.metadata.get('source', 'the log')}: no sample determines any joint's friction "
-                         "(outside the switches' margins --lift-off, --touch-down, and the differentiation's window)")
+        raise no_single_support(robot, kin.metadata.get("source", "the log"))
     tau_f = np.where(valid, tau_f, np.nan)
     metadata = dict(kin.metadata)
     metadata["estimate_options"] = asdict(options)

@@ -21,7 +21,7 @@ from wbfriction.inertia.consistency import ConsistentFit
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import regressor_of, row_groups
 from wbfriction.inertia.rows import friction_rows, given_armature, own_columns, row_mask, sample_rows
-from wbfriction.inertia.samples import LogSamples
+from wbfriction.inertia.samples import LogSamples, usable_samples
 from wbfriction.inertia.validation import BodyGroup, Validation, limbs, validate_groups
 from wbfriction.model.robot import Robot
 
@@ -191,13 +191,14 @@ def validate_limbs(robot: Robot, samples: LogSamples, pi0: np.ndarray, fit: Cons
         source: what names the log in errors.
 
     Raises:
-        InputError: no single-support sample in the held-out share of the log.
+        InputError: no usable sample in the held-out share of the log
+            (:func:`~wbfriction.inertia.samples.usable_samples`).
     """
     bodies = tuple(robot.model.names[1:])
     groups = limbs(robot.model)
     held = held_out(robot, samples, pi0, fit.pi, groups, options)
     if held.samples == 0:
-        raise InputError(f"{source}: no single-support sample in the held-out {options.holdout:.0%} of the log")
+        raise InputError(f"{source}: no {usable_samples(robot)} in the held-out {options.holdout:.0%} of the log")
     model_of = LimbModels(pi0, fit.pi, groups, best_rest)
     validation = validate_groups(groups, bodies, robot.torque_controlled, held.measured,
                                  lambda mask: held.predict(mask, model_of(mask)[1]))

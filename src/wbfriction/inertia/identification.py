@@ -133,7 +133,7 @@ from wbfriction.inertia.rows import (
     own_columns,
     rest_names,
 )
-from wbfriction.inertia.samples import LogSamples, log_samples, one_way_joints, torque_rms
+from wbfriction.inertia.samples import LogSamples, log_samples, one_way_joints, torque_rms, usable_samples
 from wbfriction.inertia.system import compressed_system
 from wbfriction.inertia.validation import Validation
 from wbfriction.logs.log import Log
@@ -301,9 +301,7 @@ def training_systems(robot: Robot, samples: LogSamples, options: InertialOptions
     validating = compressed_system(robot, samples, "validation", options, progress)
     count = sum(int(np.sum((part.train | part.validation) & (part.stance >= 0))) for part in samples.parts)
     if count == 0:
-        what = ("sample with a joint free of unknown contact forces (a leg in the air, or feet with 3-D force "
-                "columns)" if robot.point_contacts else "single-support sample")
-        raise InputError(f"{source}: no {what} to identify the inertia model from")
+        raise InputError(f"{source}: no {usable_samples(robot)} to identify the inertia model from")
     total = CompressedLeastSquares(fitting.n)
     for system in (fitting, validating):
         total.absorb(system)

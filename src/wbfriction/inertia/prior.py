@@ -106,8 +106,8 @@ def choose_prior(fitting: CompressedLeastSquares, validating: CompressedLeastSqu
     if options.prior is not None:
         return options.prior, {}
     if fitting.rows == 0 or validating.rows == 0:
-        raise InputError(f"{source}: too few single-support samples to choose the prior by validation "
-                         "(give one)")
+        raise InputError(f"{source}: too few samples to learn from (single support; on point feet, a joint free of "
+                         "unknown contact forces) to choose the prior by validation (give one)")
     variance = residual_variance(fitting, fitting.base_parameters(options.rank_tolerance))
     trials = RegularisedProblem(fitting.R, fitting.z, prior, lower)  # one decomposition for every weight
     scores: dict[float, float] = {}

@@ -59,6 +59,14 @@ class Part:
         return None if self.rows is None else self.rows[r]
 
 
+def usable_samples(robot: Robot) -> str:
+    """What a sample the identification learns from is, in the robot's words: a humanoid's single-support sample, or
+    on point feet one with a joint free of unknown contact forces (messages)."""
+    if robot.point_contacts:
+        return "sample with a joint free of unknown contact forces (a leg in the air, or feet with 3-D force columns)"
+    return "single-support sample"
+
+
 def split_log(robot: Robot, log: Log, est: EstimateOptions, opts: InertialOptions) -> list[Part]:
     """Per log part: its kinematics, stance, and the training, validation and held-out
     single-support rows (module docstring); a part too short for the differentiation is left out."""

@@ -15,7 +15,7 @@ forces that exert no wrench on the base (internal forces, one foot pushing again
 they would need. So
 
 * the rank of ``[S^T  J_u^T]`` is ``n_act + rank(J_{u,b}^T)``, decided on the 6 x m matrix ``J_{u,b}^T`` by its
-  singular values (:data:`RANK_RTOL`);
+  singular values (those below ``sigma_max /`` :data:`COND_MAX` count as zero, Conditioning below);
 * joint ``j`` is determined when ``|J_{u,j}^T N|_j`` (``N`` the orthonormal null basis) is below
   :data:`LEAK_TOL` [m]: the free internal forces exert no torque on it;
 * the determined torques are those of the least-norm solution, ``lambda_u = J_{u,b}^{T+} r_b``,
@@ -37,9 +37,15 @@ What that gives a quadruped on point feet (three unknowns per foot down, :attr:`
 A humanoid's sole (six unknowns, a wrench) fits the same: single support determines every joint (thesis 5.13),
 double support the joints off the legs' closed chain.
 
-Conditioning: ``cond = sigma_max / sigma_r`` of ``J_{u,b}^T`` (its kept singular values; forces in N, moments in
-N·m, so lengths in metres): how much an error in the base rows can grow in the contact forces, and so in the stance
-legs' torques. A sample with ``cond`` above :data:`COND_MAX` (three feet nearly on a line) counts as not determined.
+Conditioning: a singular value of ``J_{u,b}^T`` below ``sigma_max /`` :data:`COND_MAX` counts as zero: the
+internal force along it would need a thousandfold the base rows' error to be told apart, so it is left free like an
+exact null vector, and only the joints it moves lose their determination. Three feet nearly on a line, or feet whose
+normal forces are measured standing at heights a few micrometres apart (flat ground: the horizontal forces' moments
+about the base are then nearly those of their sum), leave the stance legs not determined and every swinging leg
+determined (issue 63: a trot's swinging legs were 0-1 % determined when the whole sample was dropped). ``cond =
+sigma_max / sigma_r`` of the kept singular values (forces in N, moments in N·m, so lengths in metres), at most
+:data:`COND_MAX`: how much an error in the base rows can grow in the contact forces, and so in the stance legs'
+torques.
 
 Sign convention: ``tau_f = tau_joint - tau``, the torque friction exerts on the joint.
 """
@@ -54,14 +60,14 @@ import pinocchio as pin
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
 
-RANK_RTOL = 1e-9
-"""Singular values of ``J_{u,b}^T`` below this share of the largest count as zero (rank deficient): round-off, not
-geometry (a two-feet stance's sixth singular value is 1e-17 of the first on the Go2)."""
 LEAK_TOL = 1e-9
 """[m] A joint is determined when the free internal contact forces move its torque by less than this per newton."""
 COND_MAX = 1e3
-"""Above this conditioning of ``J_{u,b}^T`` a sample counts as not determined: an error of the base rows would grow
-a thousandfold in the contact forces. Regular stances of a quadruped are about 3-10 (the Go2: two to four feet)."""
+"""A singular value of ``J_{u,b}^T`` below ``sigma_max / COND_MAX`` counts as zero (its internal force left free,
+module docstring): an error of the base rows would grow a thousandfold in the contact forces. Regular stances of a
+quadruped are about 3-10 (the Go2: two to four feet, no force measured). Feet on flat ground whose normal forces are
+measured leave a direction that is exactly free on level feet and conditioned by their heights' differences: 1e6-1e9
+on the ideal simulator's trot and walk (micrometres), 2.1e3-1.5e7 on MuJoCo's soft-footed trot (issue 63)."""
 
 
 @dataclass
@@ -69,9 +75,11 @@ class Determination:
     """Which joint torques the contacts leave determined, per sample (module docstring).
 
     Attributes:
-        determined: (N, n_act) joint ``j``'s torque is unique (and the sample's ``cond`` at most :data:`COND_MAX`).
-        nullity: (N,) the dimension of the internal contact forces the equations leave free.
-        cond: (N,) the conditioning of ``J_{u,b}^T`` (1 with no unknown contact force).
+        determined: (N, n_act) joint ``j``'s torque is unique: no free internal force moves it.
+        nullity: (N,) the dimension of the internal contact forces the equations leave free (singular values below
+            ``sigma_max /`` :data:`COND_MAX` counted as zero).
+        cond: (N,) the conditioning of ``J_{u,b}^T`` on its kept singular values, at most :data:`COND_MAX` (1 with
+            no unknown contact force).
         residual: (N, 6) the base rows left unexplained [N, N·m], base frame.
     """
 
@@ -129,7 +137,7 @@ def determine(base_map: np.ndarray, joint_map: np.ndarray, r_base: np.ndarray, r
         return (r_joint.copy(), np.zeros((n, 0)),
                 Determination(np.ones((n, n_act), dtype=bool), np.zeros(n, dtype=int), np.ones(n), r_base.copy()))
     U, s, Vt = np.linalg.svd(base_map, full_matrices=True)  # (N,6,6), (N,k), (N,m,m); k = min(6, m)
-    kept = s > RANK_RTOL * s[:, :1]
+    kept = s > s[:, :1] / COND_MAX  # round-off (a two-feet stance's sixth value: 1e-17 of the first) and worse
     rank = kept.sum(axis=1)
     inv = np.where(kept, 1.0 / np.where(kept, s, 1.0), 0.0)
     k = s.shape[1]
@@ -140,7 +148,7 @@ def determine(base_map: np.ndarray, joint_map: np.ndarray, r_base: np.ndarray, r
     null = np.concatenate([Vt[:, :k] * ~kept[..., None], Vt[:, k:]], axis=1)  # (N, m, m): zero rows are not null
     leak = np.linalg.norm(np.einsum("nai,nri->nar", joint_map, null), axis=2)
     cond = s[:, 0] / np.take_along_axis(s, np.maximum(rank - 1, 0)[:, None], axis=1)[:, 0]
-    determined = (leak <= LEAK_TOL) & (cond <= COND_MAX)[:, None]
+    determined = leak <= LEAK_TOL
     return tau, force, Determination(determined, m - rank, cond, residual)
 
 

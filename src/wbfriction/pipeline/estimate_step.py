@@ -167,6 +167,13 @@ def no_valid_warnings(source: str, valid: dict[str, int]) -> tuple[str, ...]:
     return (f"{source}: no valid sample for {shown} (never in a phase the --mask keeps)",)
 
 
+def force_sampling_warnings(metadata: dict) -> tuple[str, ...]:
+    """The momentum route's line on the foot forces' sampling (:mod:`wbfriction.friction.force_sampling`), from the
+    estimate's metadata or its route check's, if it names another reading."""
+    found = [m.get("foot_force_sampling", {}).get("warning", "") for m in (metadata, metadata.get("route_check", {}))]
+    return tuple(w for w in found if w)
+
+
 @dataclass
 class ChunkedResult:
     """What :func:`estimate_file` did: rows, chunks, and their contact-change cuts; ``clock``: the
@@ -249,7 +256,7 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
                                           chunks, robot, source, extra_metadata, progress, first_meta, valid))
     return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta,
                          clock.reason, "" if decision.differentiation is None else decision.differentiation.reason,
-                         plan.warnings + no_valid_warnings(source, valid),
+                         plan.warnings + no_valid_warnings(source, valid) + force_sampling_warnings(first_meta),
                          "" if decision.route is None else decision.route.reason)
 
 
