@@ -18,9 +18,9 @@ from wbfriction.model.robot import Robot
 from wbfriction.pipeline.identify_step import identified_config
 from wbfriction.pipeline.paths import check_paths
 
-WRITTEN = ("ok", "weak")
-"""The statuses whose values go into the robot's TOML: determined by the data (``weak``: with a large error). A
-value at a bound or not excited is left as the TOML had it; ``identify`` prints which, and the JSON has every status."""
+WRITTEN = ("ok",)
+"""The statuses whose values go into the robot's TOML: only what the log determines (issue 63: a ``weak`` value, one
+at a bound or not excited, is left as the TOML had it); ``identify`` prints which, and the JSON has every status."""
 
 
 def identify_actuator_file(robot: Robot, log: str | Path, json_output: str | Path | None = None,
@@ -44,7 +44,11 @@ def identify_actuator_file(robot: Robot, log: str | Path, json_output: str | Pat
 
 def written_values(result: ActuatorIdentification) -> tuple[dict[str, float], dict[str, float], float | None]:
     """The armature [kg·m²] and encoder offsets [rad] by joint, and the delay [s], whose status is one of
-    :data:`WRITTEN` (None: the delay is not)."""
+    :data:`WRITTEN` (None: the delay is not). Without the delay (not ``ok``, nor given with ``--delay``) nothing is
+    written: the armatures and offsets were fitted under it, and a TOML keeping its old delay beside them would
+    mix two laws."""
+    if result.delay.status not in WRITTEN:
+        return {}, {}, None
     armature = {j.joint: j.armature.value for j in result.joints if j.armature.status in WRITTEN}
     offsets = {j.joint: j.offset.value for j in result.joints if j.offset is not None and j.offset.status in WRITTEN}
     delay = result.delay.value if result.delay.status in WRITTEN else None
