@@ -16,7 +16,7 @@ import wbfriction
 from wbfriction.actuator import identify_actuators
 from wbfriction.actuator.excitation import JointMotion
 from wbfriction.actuator.law_check import GAIN_FACTOR
-from wbfriction.actuator.solve import _inverse, sandwich
+from wbfriction.actuator.solve import sandwich
 from wbfriction.fit.status import MIN_SPEED
 from wbfriction.logs.log import log_from_table
 from wbfriction.pipeline.actuator_step import written_values
@@ -159,7 +159,7 @@ def test_the_sandwich_covers_autocorrelated_residuals():
         r = e - b * x[:, 0]
         s = np.std(r)
         slopes.append(b)
-        plain.append(np.sqrt(_inverse(x / s)[0, 0]))
+        plain.append(np.sqrt(np.linalg.inv((x / s).T @ (x / s))[0, 0]))
         hac.append(np.sqrt(sandwich(x / s, r / s, np.arange(n), 40)[0, 0]))
     spread = np.std(slopes)
     assert np.median(plain) < 0.5 * spread
