@@ -12,7 +12,9 @@ way its F_c and offset ``weak`` (:mod:`wbfriction.actuator.excitation`); a delay
 every value fitted under it ``at bound``; a robot TOML whose PD gains the log contradicts leaves every value fitted
 under them ``weak`` (:mod:`wbfriction.actuator.law_check`, which also names a TOML's delay that is not the one
 found). Standard errors are the autocorrelation-consistent sandwich's (:func:`~wbfriction.actuator.solve.sandwich`)
-and never below the Cramér-Rao bound: :attr:`Identified.se` is ``max(se, crb)``. Stamps with receive-time jitter
+with how far each value moves under a Coulomb term :data:`~wbfriction.actuator.options.STEEPER` times as steep
+(the delay searched again) added in quadrature, a model error the residuals do not show, and never below the
+Cramér-Rao bound: :attr:`Identified.se` is ``max(se, crb)``. Stamps with receive-time jitter
 are taken on the regularised clock the log's reader found (:mod:`wbfriction.logs.clock`), before the delay is
 searched.
 
@@ -59,8 +61,9 @@ class Identified:
     Attributes:
         value: the value, in :data:`UNITS` of its kind.
         se: its standard error: the residuals' autocorrelation-consistent one
-            (:func:`~wbfriction.actuator.solve.sandwich`) or the Cramér-Rao bound, the larger; inf where the data
-            do not determine it.
+            (:func:`~wbfriction.actuator.solve.sandwich`) with the nuisance model's sensitivity
+            (:data:`~wbfriction.actuator.options.STEEPER`) in quadrature, or the Cramér-Rao bound, the larger; inf
+            where the data do not determine it.
         crb: its Cramér-Rao bound (the standard deviation any unbiased estimator has at the sensors' noise).
         status: :data:`ActuatorStatus`.
         reason: why, when not ``ok``.
@@ -223,8 +226,12 @@ def _identify(robot: Robot, log: Log, options: ActuatorOptions) -> ActuatorIdent
         if offsets:
             offset = sol.x[3 * len(index):]
     assert weight is not None
+    steep = design(rows, windows, offsets, steep=True)  # the nuisance model's sensitivity: options.STEEPER
+    steep_delay = _delay(rows, steep, weight, options).delay
+    moved = solve(steep, steep.rhs(rows, rows.balance(steep_delay)), weight, rows.sigma, options.offset_bound)
+    sol = replace(sol, covariance=sol.covariance + np.diag((moved.x - sol.x) ** 2))
     held = held_out_rms(rows, offsets, weight, options)
-    delay = _delay_value(search, rows, sol, options)
+    delay = _delay_value(search, rows, sol, options, abs(steep_delay - search.delay))
     assert robot.pd is not None
     motion = joint_motion(rows)
     law = check_law(rows, d, weight, delay.value, _lags(rows, options), options.delay is None, delay.se,
@@ -312,14 +319,15 @@ def _result(rows: BalanceRows, d: Design, sol: Solution, delay: Identified, prof
                                   tuple(map(float, rows.sigma)))
 
 
-def _delay_value(search: DelaySearch, rows: BalanceRows, sol: Solution, options: ActuatorOptions) -> Identified:
+def _delay_value(search: DelaySearch, rows: BalanceRows, sol: Solution, options: ActuatorOptions,
+                 moved: float = 0.0) -> Identified:
     if options.delay is not None:
         return Identified(options.delay, 0.0, 0.0, "ok", "given (--delay)")
     # weights 1/rms make the residual's variance 1; with 1/sigma the bound's: the curvature is in the first
     scale = np.median(sol.rms / np.maximum(rows.sigma, 1e-300))
     se = float(1.0 / np.sqrt(search.curvature)) if search.curvature > 0 else np.inf
     crb = se / scale if np.isfinite(se) and scale > 0 else np.inf
-    se = max(se, crb) if np.isfinite(crb) else se
+    se = max(float(np.hypot(se, moved)), crb) if np.isfinite(crb) else se  # with the nuisance model's sensitivity
     top = (rows.max_steps + 1) * rows.period
     status: ActuatorStatus
     if not np.isfinite(se):

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from wbfriction.actuator.options import ActuatorOptions
+from wbfriction.actuator.options import STEEPER, ActuatorOptions
 from wbfriction.exceptions import InputError
 from wbfriction.logs.log import Log
 from wbfriction.model.momentum import momentum_and_drift
@@ -73,6 +73,8 @@ class BalanceRows:
         period: the sampling period T [s].
         start: (W,) the first sample of each window, in the log's rows.
         offset: (n,) the offsets ``o_0`` the dynamics were taken about [rad].
+        coulomb_steep: (W, n) the Coulomb column with a slope :data:`~wbfriction.actuator.options.STEEPER` times as
+            steep (the nuisance model's sensitivity, :mod:`wbfriction.actuator.identification`), or None.
     """
 
     joints: tuple[str, ...]
@@ -91,6 +93,7 @@ class BalanceRows:
     period: float
     start: np.ndarray
     offset: np.ndarray
+    coulomb_steep: np.ndarray | None = None
 
     @property
     def max_steps(self) -> int:
@@ -109,7 +112,8 @@ class BalanceRows:
         return BalanceRows(self.joints, self.setpoint[:, windows], self.rest[windows], self.dv[windows],
                            self.qd[windows], self.coulomb[windows], self.gravity[windows], self.usable[windows],
                            self.feedback[windows], self.speed[windows], self.sigma, self.position_noise,
-                           self.velocity_noise, self.period, self.start[windows], self.offset)
+                           self.velocity_noise, self.period, self.start[windows], self.offset,
+                           None if self.coulomb_steep is None else self.coulomb_steep[windows])
 
 
 def pd_joints(robot: Robot, log: Log) -> np.ndarray:
@@ -234,6 +238,7 @@ def _segment_rows(robot: Robot, log: Log, index: np.ndarray, offset: np.ndarray,
     return {"setpoint": setpoint[:, keep], "rest": rest[keep], "dv": (v[ends[1:]] - v[ends[:-1]])[keep],
             "qd": _window_sum(trap(v), m, windows)[keep],
             "coulomb": _window_sum(tanh_impulse(v, dt, options.tanh_slope), m, windows)[keep],
+            "coulomb_steep": _window_sum(tanh_impulse(v, dt, STEEPER * options.tanh_slope), m, windows)[keep],
             "gravity": _window_sum(trap(dg), m, windows)[keep], "usable": usable[keep],
             "feedback": feedback_impulse[keep],
             "speed": ((q_enc[ends[1:]] - q_enc[ends[:-1]]) / (time[ends[1:]] - time[ends[:-1]])[:, None])[keep],
@@ -276,4 +281,5 @@ def _concatenate(parts: list[tuple[int, dict]]) -> BalanceRows:
     return BalanceRows(longest["joints"], np.concatenate([r["setpoint"][:K] for r in rows], axis=1), cat("rest"),
                        cat("dv"), cat("qd"), cat("coulomb"), cat("gravity"), cat("usable"), cat("feedback"),
                        cat("speed"), longest["sigma"], longest["position_noise"], longest["velocity_noise"],
-                       longest["period"], np.concatenate([a + r["start"] for a, r in parts]), longest["offset"])
+                       longest["period"], np.concatenate([a + r["start"] for a, r in parts]), longest["offset"],
+                       cat("coulomb_steep"))

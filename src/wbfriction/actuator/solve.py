@@ -49,8 +49,9 @@ class Design:
         return shifted[self.window, self.joint]
 
 
-def design(rows: BalanceRows, windows: np.ndarray, offsets: bool) -> Design:
-    """The design of the usable rows of ``windows`` (indices into W) (module docstring)."""
+def design(rows: BalanceRows, windows: np.ndarray, offsets: bool, steep: bool = False) -> Design:
+    """The design of the usable rows of ``windows`` (indices into W) (module docstring); ``steep``: the Coulomb
+    column :attr:`~wbfriction.actuator.rows.BalanceRows.coulomb_steep`."""
     n = len(rows.joints)
     usable = rows.usable[windows]
     w_idx, j_idx = np.nonzero(usable)
@@ -59,7 +60,8 @@ def design(rows: BalanceRows, windows: np.ndarray, offsets: bool) -> Design:
     r = np.arange(len(window))
     A[r, j_idx] = rows.dv[window, j_idx]
     A[r, n + j_idx] = rows.qd[window, j_idx]
-    A[r, 2 * n + j_idx] = rows.coulomb[window, j_idx]
+    coulomb = rows.coulomb_steep if steep and rows.coulomb_steep is not None else rows.coulomb
+    A[r, 2 * n + j_idx] = coulomb[window, j_idx]
     if offsets:
         A[:, 3 * n:] = -rows.gravity[window, j_idx, :]
     return Design(A, j_idx, window, offsets)
