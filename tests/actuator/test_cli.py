@@ -4,6 +4,7 @@ identified, the TOML written, the friction estimated with it; bad input refused 
 from __future__ import annotations
 
 import json
+import re
 import tomllib
 
 import pytest
@@ -27,6 +28,13 @@ def test_simulate_identify_estimate(tmp_path):
     estimated = run("estimate", "hung.parquet", "--config", "identified.toml", "-o", "friction.parquet", cwd=tmp_path)
     assert estimated.returncode == 0, estimated.stderr
     assert "torque: the drivers' PD law" in estimated.stderr
+    assert "warning:" not in estimated.stderr  # the law identified is the drivers'
+    text = (tmp_path / "identified.toml").read_text()
+    (tmp_path / "late.toml").write_text(re.sub(r"(?m)^delay = .*$", "delay = 0.0", text))
+    wrong = run("estimate", "hung.parquet", "--config", "late.toml", "-o", "wrong.parquet", cwd=tmp_path)
+    assert wrong.returncode == 0, wrong.stderr
+    lines = [line for line in wrong.stderr.splitlines() if line.startswith("warning:")]
+    assert len(lines) == 1 and "[pd] delay (0 ms) is not the drivers'" in lines[0]  # issue 63
 
 
 def test_drivers_later_than_the_search_write_nothing_and_say_so(tmp_path):

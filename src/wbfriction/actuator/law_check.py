@@ -106,7 +106,8 @@ class LawCheck:
                     f"TOML's PD law on {worst}" if self.gains_differ else
                     f"the robot TOML's PD law gives {g:.2f} times the torque the URDF's dynamics take on {worst}")
             tail = ("fix kp, kd in [pd] (or log kp.<joint>, kd.<joint>): the values fitted under them are not ok"
-                    if self.gains_differ else "its [pd] gains or the URDF's masses are off; the values are kept")
+                    if self.gains_differ else
+                    f"its [pd] gains or the URDF's masses are off (not acted on within a factor {GAIN_FACTOR:g})")
             out.append(f"{head} ({len(self.gains_off)} of {len(self.joints)} joints beyond {GAIN_TOL:.0%}); {tail}")
         if self.delay_differs:
             assert self.delay is not None

@@ -113,3 +113,30 @@ def write_actuator_config(text: str, source_dir: Path, urdf: Path, output: str |
     output = Path(output)
     written = actuator_config(text, source_dir, urdf, output, result)
     write_atomic(output, lambda tmp: tmp.write_text(written, encoding="utf-8"))
+
+
+LAW_CHECK_SECONDS = 20.0
+"""The first seconds of a log on which ``estimate`` checks the robot TOML's PD law (:func:`pd_law_warnings`): a
+hung robot's ramps reverse every 0.2-2 s, so 20 s hold tens of reversals, and the check costs a second or two."""
+
+
+def pd_law_warnings(robot: Robot, log: str | Path, time_unit: TimeUnit | None = None) -> list[str]:
+    """The robot TOML's PD law against the first :data:`LAW_CHECK_SECONDS` of the log file ``log`` of a hung
+    PD-driven robot whose torque is the PD law's (:mod:`wbfriction.actuator.law_check`: its delay and gains against
+    what the log shows; a delay beyond the search), one warning line each; none where the check does not apply (a
+    floating base, no ``[pd]``, a measured torque, a log the identification refuses)."""
+    if robot.pd is None or robot.floating_base:
+        return []
+    data = read_log(log, robot, read=ReadOptions(time_unit=time_unit))
+    if data.torque_source != "pd":
+        return []
+    import numpy as np
+
+    stop = int(np.searchsorted(data.time - data.time[0], LAW_CHECK_SECONDS))
+    # the positions' velocity and the TOML's delayed: one identification, not identify's two to four
+    options = ActuatorOptions(holdout=0.0, velocity="positions", delayed=robot.pd.delayed)
+    try:
+        result = identify_actuators(robot, data.rows(0, stop) if stop < len(data.time) else data, options)
+    except InputError:
+        return []
+    return list(result.warnings)
