@@ -4,7 +4,10 @@ identified, the TOML written, the friction estimated with it; bad input refused 
 from __future__ import annotations
 
 import json
+import re
 import tomllib
+
+import pytest
 
 from helpers import assert_one_line_error, run
 
@@ -20,11 +23,37 @@ def test_simulate_identify_estimate(tmp_path):
     assert abs(doc["delay"]["value"] - truth) < 0.001 and doc["delay"]["status"] == "ok"
     written = tomllib.loads((tmp_path / "identified.toml").read_text())
     assert abs(written["pd"]["delay"] - doc["delay"]["value"]) < 1e-12
-    determined = {j for j, v in doc["joints"].items() if v["armature"]["status"] in ("ok", "weak")}
+    determined = {j for j, v in doc["joints"].items() if v["armature"]["status"] == "ok"}
     assert set(written["armature"]) == determined
     estimated = run("estimate", "hung.parquet", "--config", "identified.toml", "-o", "friction.parquet", cwd=tmp_path)
     assert estimated.returncode == 0, estimated.stderr
     assert "torque: the drivers' PD law" in estimated.stderr
+    assert "warning:" not in estimated.stderr  # the law identified is the drivers'
+    text = (tmp_path / "identified.toml").read_text()
+    (tmp_path / "late.toml").write_text(re.sub(r"(?m)^delay = .*$", "delay = 0.0", text))
+    wrong = run("estimate", "hung.parquet", "--config", "late.toml", "-o", "wrong.parquet", cwd=tmp_path)
+    assert wrong.returncode == 0, wrong.stderr
+    lines = [line for line in wrong.stderr.splitlines() if line.startswith("warning:")]
+    assert len(lines) == 1 and "[pd] delay (0 ms) is not the drivers'" in lines[0]  # issue 63
+
+
+def test_drivers_later_than_the_search_write_nothing_and_say_so(tmp_path):
+    """Issue 63: drivers 80 ms late, the search to 50 ms: a one-line warning naming --max-delay, and the TOML written
+    keeps the robot's own delay, armatures and offsets (none fitted under a delay at its bound)."""
+    import wbfriction
+
+    assert run("simulate", "--robot", "go2", "-o", "late.parquet", "--duration", "4", "--delay", "80",
+               cwd=tmp_path).returncode == 0
+    done = run("identify", "late.parquet", "--robot", "go2", "--actuator", "pd", "--config-output", "late.toml",
+               cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    warnings = [line for line in done.stderr.splitlines() if line.startswith("warning:")]
+    assert len(warnings) == 1 and "--max-delay" in warnings[0]
+    written = tomllib.loads((tmp_path / "late.toml").read_text())
+    go2 = wbfriction.load_robot("go2")
+    assert written["pd"]["delay"] == go2.pd.delay
+    assert written["armature"] == pytest.approx(dict(zip(go2.actuated, go2.model.armature[go2.act_v_index])))
+    assert written["encoder_offset"] == go2.encoder_offset
 
 
 def test_a_robot_without_pd_gains_is_refused_in_one_line(tmp_path):

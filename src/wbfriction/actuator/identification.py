@@ -7,6 +7,17 @@ the first weights each joint's rows by the noise its sensors predict, the next b
 takes the dynamics again about the offsets the previous one found. A check on data the fit did not see: the same
 identification on the log's first windows predicts its last ``holdout`` share (:func:`held_out_rms`).
 
+What the log determines (issue 63): a joint that hardly moved leaves its values ``not excited``, one that moved one
+way its F_c and offset ``weak`` (:mod:`wbfriction.actuator.excitation`); a delay at the search's upper bound leaves
+every value fitted under it ``at bound``; a robot TOML whose PD gains the log contradicts leaves every value fitted
+under them ``weak`` (:mod:`wbfriction.actuator.law_check`, which also names a TOML's delay that is not the one
+found). Standard errors are the autocorrelation-consistent sandwich's (:func:`~wbfriction.actuator.solve.sandwich`)
+with how far each value moves under a Coulomb term :data:`~wbfriction.actuator.options.STEEPER` times as steep
+(the delay searched again) added in quadrature, a model error the residuals do not show, and never below the
+Cramér-Rao bound: :attr:`Identified.se` is ``max(se, crb)``. Stamps with receive-time jitter
+are taken on the regularised clock the log's reader found (:mod:`wbfriction.logs.clock`), before the delay is
+searched.
+
 PACE (Bjelonic et al., "Towards Bridging the Gap: Systematic Sim-to-Real Transfer for Diverse Legged Robots",
 2025) and the iit-DLSLab identification fit the same quantities by CMA-ES over simulated rollouts; here the problem
 is linear but for the delay, solved in seconds on a CPU.
@@ -19,9 +30,11 @@ from typing import Any, Literal
 
 import numpy as np
 
+from wbfriction.actuator.excitation import JointMotion, joint_motion
+from wbfriction.actuator.law_check import LawCheck, check_law
 from wbfriction.actuator.options import ActuatorOptions
 from wbfriction.actuator.rows import BalanceRows, balance_rows, pd_joints
-from wbfriction.actuator.solve import KINDS, DelaySearch, Design, Solution, design, search_delay, solve
+from wbfriction.actuator.solve import KINDS, DelaySearch, Design, Solution, design, hac_lags, search_delay, solve
 from wbfriction.fit.status import WEAK
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
@@ -47,7 +60,10 @@ class Identified:
 
     Attributes:
         value: the value, in :data:`UNITS` of its kind.
-        se: its standard error (from the residuals), inf where the data do not determine it.
+        se: its standard error: the residuals' autocorrelation-consistent one
+            (:func:`~wbfriction.actuator.solve.sandwich`) with the nuisance model's sensitivity
+            (:data:`~wbfriction.actuator.options.STEEPER`) in quadrature, or the Cramér-Rao bound, the larger; inf
+            where the data do not determine it.
         crb: its Cramér-Rao bound (the standard deviation any unbiased estimator has at the sensors' noise).
         status: :data:`ActuatorStatus`.
         reason: why, when not ``ok``.
@@ -107,6 +123,10 @@ class ActuatorIdentification:
         options: the options used (``velocity`` the one kept).
         sigma: each joint's balance noise per window the sensors predict [N·m·s].
         velocity_reason: which velocity the dynamics took and what the delay holds back, and why.
+        clock: what the log's time stamps are and the time base taken (:attr:`Clock.reason
+            <wbfriction.logs.clock.Clock.reason>`; "" for a log built in memory).
+        law: the robot TOML's PD law checked against the log (:class:`~wbfriction.actuator.law_check.LawCheck`).
+        warnings: what the identification found wrong in its input, one line each (the PD law's mismatches).
     """
 
     joints: tuple[JointActuator, ...]
@@ -120,6 +140,9 @@ class ActuatorIdentification:
     options: ActuatorOptions = field(default_factory=ActuatorOptions)
     sigma: tuple[float, ...] = ()
     velocity_reason: str = ""
+    clock: str = ""
+    law: LawCheck | None = None
+    warnings: tuple[str, ...] = ()
 
     def joint(self, name: str) -> JointActuator:
         return next(j for j in self.joints if j.joint == name)
@@ -128,7 +151,11 @@ class ActuatorIdentification:
         """The JSON document (``identify --actuator pd --json``)."""
         return {"kind": "pd actuators", "source": self.source, "period": self.period, "window": self.window,
                 "velocity": {"used": self.options.velocity, "why": self.velocity_reason},
-                "delayed": self.options.delayed,
+                "delayed": self.options.delayed, "clock": self.clock, "warnings": list(self.warnings),
+                "pd_law": None if self.law is None else {
+                    "gain": dict(zip(self.law.joints, map(float, self.law.gain))),
+                    "gain_se": {j: _finite(s) for j, s in zip(self.law.joints, self.law.gain_se)},
+                    "toml_delay": self.law.toml_delay},
                 "delay": self.delay.to_dict() | {"steps": self.delay.value / self.period},
                 "units": UNITS,
                 "joints": {j.joint: {k: v.to_dict() for k, v in j.parameters().items()}
@@ -179,7 +206,7 @@ def identify_actuators(robot: Robot, log: Log, options: ActuatorOptions = Actuat
                 f"next, {second.options.velocity} velocity, {second.options.delayed} delayed)")
     elif log.qd_logged is None and options.velocity == "auto":
         why += ": no qd.<joint> column"
-    return replace(best, velocity_reason=why)
+    return replace(best, velocity_reason=why, clock=log.clock.reason if log.clock is not None else "")
 
 
 def _identify(robot: Robot, log: Log, options: ActuatorOptions) -> ActuatorIdentification:
@@ -193,13 +220,28 @@ def _identify(robot: Robot, log: Log, options: ActuatorOptions) -> ActuatorIdent
         d = design(rows, windows, offsets)
         weight = 1.0 / np.maximum(rows.sigma, 1e-12) if weight is None else weight
         search = _delay(rows, d, weight, options)
-        sol = solve(d, d.rhs(rows, rows.balance(search.delay)), weight, rows.sigma, options.offset_bound)
+        sol = solve(d, d.rhs(rows, rows.balance(search.delay)), weight, rows.sigma, options.offset_bound,
+                    _lags(rows, options))
         weight = 1.0 / np.maximum(sol.rms, 1e-12)
         if offsets:
             offset = sol.x[3 * len(index):]
     assert weight is not None
+    steep = design(rows, windows, offsets, steep=True)  # the nuisance model's sensitivity: options.STEEPER
+    steep_delay = _delay(rows, steep, weight, options).delay
+    moved = solve(steep, steep.rhs(rows, rows.balance(steep_delay)), weight, rows.sigma, options.offset_bound)
+    sol = replace(sol, covariance=sol.covariance + np.diag((moved.x - sol.x) ** 2))
     held = held_out_rms(rows, offsets, weight, options)
-    return _result(rows, d, sol, search, held, log.source, options)
+    delay = _delay_value(search, rows, sol, options, abs(steep_delay - search.delay))
+    assert robot.pd is not None
+    motion = joint_motion(rows)
+    law = check_law(rows, d, weight, delay.value, _lags(rows, options), options.delay is None, delay.se,
+                    robot.pd.delay, np.array([m.excited for m in motion]))
+    result = _result(rows, d, sol, delay, search.profile, held, log.source, options)
+    return _verdicts(replace(result, law=law), motion, rows.max_steps)
+
+
+def _lags(rows: BalanceRows, options: ActuatorOptions) -> int:
+    return hac_lags(len(rows.rest), options.window)
 
 
 def _delay(rows: BalanceRows, d: Design, weight: np.ndarray, options: ActuatorOptions) -> DelaySearch:
@@ -250,11 +292,12 @@ def parameter_status(kind: str, value: float, se: float, crb: float, at_bound: b
     return "ok", ""
 
 
-def _result(rows: BalanceRows, d: Design, sol: Solution, search: DelaySearch, held: np.ndarray, source: str,
-            options: ActuatorOptions) -> ActuatorIdentification:
+def _result(rows: BalanceRows, d: Design, sol: Solution, delay: Identified, profile: np.ndarray, held: np.ndarray,
+            source: str, options: ActuatorOptions) -> ActuatorIdentification:
     n = len(rows.joints)
-    se = np.sqrt(np.abs(np.diag(sol.covariance)))
     crb = np.sqrt(np.abs(np.diag(sol.bound)))
+    se = np.sqrt(np.abs(np.diag(sol.covariance)))
+    se = np.where(np.isfinite(crb), np.maximum(se, crb), se)  # never below the bound (module docstring)
 
     def value(kind: str, j: int) -> Identified:
         k = KINDS.index(kind) * n + j
@@ -270,20 +313,21 @@ def _result(rows: BalanceRows, d: Design, sol: Solution, search: DelaySearch, he
                              f"held-out balance RMS {ho:.3g} against {rms:.3g} fitted")
         joints.append(JointActuator(name, arm, value("F_v", j), value("F_c", j),
                                     value("offset", j) if d.offsets else None, rms, ho, int(sol.rows[j])))
-    delay = _delay_value(search, rows, sol, options)
-    return ActuatorIdentification(tuple(joints), delay, rows.period, options.window, search.profile,
+    return ActuatorIdentification(tuple(joints), delay, rows.period, options.window, profile,
                                   dict(zip(rows.joints, map(float, rows.position_noise))),
                                   dict(zip(rows.joints, map(float, rows.velocity_noise))), source, options,
                                   tuple(map(float, rows.sigma)))
 
 
-def _delay_value(search: DelaySearch, rows: BalanceRows, sol: Solution, options: ActuatorOptions) -> Identified:
+def _delay_value(search: DelaySearch, rows: BalanceRows, sol: Solution, options: ActuatorOptions,
+                 moved: float = 0.0) -> Identified:
     if options.delay is not None:
         return Identified(options.delay, 0.0, 0.0, "ok", "given (--delay)")
     # weights 1/rms make the residual's variance 1; with 1/sigma the bound's: the curvature is in the first
     scale = np.median(sol.rms / np.maximum(rows.sigma, 1e-300))
     se = float(1.0 / np.sqrt(search.curvature)) if search.curvature > 0 else np.inf
     crb = se / scale if np.isfinite(se) and scale > 0 else np.inf
+    se = max(float(np.hypot(se, moved)), crb) if np.isfinite(crb) else se  # with the nuisance model's sensitivity
     top = (rows.max_steps + 1) * rows.period
     status: ActuatorStatus
     if not np.isfinite(se):
@@ -295,3 +339,43 @@ def _delay_value(search: DelaySearch, rows: BalanceRows, sol: Solution, options:
     else:
         status, reason = "ok", ""
     return Identified(search.delay, se, crb, status, reason)
+
+
+def _demoted(p: Identified, status: ActuatorStatus, reason: str) -> Identified:
+    """``p`` with ``status`` and ``reason`` where its own is ``ok`` or ``weak`` (a worse one is kept)."""
+    if p.status not in ("ok", "weak") or (status == "weak" and p.status == "weak"):
+        return p
+    return replace(p, status=status, reason=reason)
+
+
+def _verdicts(result: ActuatorIdentification, motion: tuple[JointMotion, ...], max_steps: int
+              ) -> ActuatorIdentification:
+    """The statuses of what the log does not determine (module docstring): a joint that did not move, a delay at the
+    search's upper bound, a PD law the log contradicts."""
+    d = result.delay
+    top = (max_steps + 1) * result.period
+    under = (f"fitted under a delay at the search's bound ({d.value * 1e3:.3g} ms; --max-delay)"
+             if d.status == "at bound" and d.value >= top - 1e-12 else "")
+    law = None if under else result.law  # a law checked under a wrong delay says nothing of the gains
+    joints = []
+    for j, m in zip(result.joints, motion):
+        gains = law.gain_reason(j.joint) if law is not None else ""
+        values = {}
+        for kind, p in j.parameters().items():
+            by_motion = m.verdict(kind)
+            if by_motion is not None:
+                p = _demoted(p, by_motion[0], by_motion[1])  # type: ignore[arg-type]
+            if under:
+                p = _demoted(p, "at bound", f"{kind}: {under}")
+            if gains:
+                p = _demoted(p, "weak", f"{kind}: {gains}")
+            values[kind] = p
+        joints.append(replace(j, armature=values["armature"], F_v=values["F_v"], F_c=values["F_c"],
+                              offset=values.get("offset")))
+    if law is not None and law.gains_differ:
+        d = _demoted(d, "weak", "found under the TOML's PD gains, which the log contradicts")
+    lines = law.lines() if law is not None else []
+    if under:
+        lines.insert(0, f"the drivers' delay is beyond the search ({d.value * 1e3:.3g} ms, its bound): raise "
+                        "--max-delay; every value fitted under it is at bound and none is written")
+    return replace(result, joints=tuple(joints), delay=d, law=law, warnings=tuple(lines))

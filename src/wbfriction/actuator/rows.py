@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from wbfriction.actuator.options import ActuatorOptions
+from wbfriction.actuator.options import STEEPER, ActuatorOptions
 from wbfriction.exceptions import InputError
 from wbfriction.logs.log import Log
 from wbfriction.model.momentum import momentum_and_drift
@@ -62,6 +62,10 @@ class BalanceRows:
         coulomb: (W, n) ``int tanh(a qd) dt`` [s] (the Coulomb column).
         gravity: (W, n, n) ``int dg/dq dt`` [N·m·s/rad] (the offsets' columns, with a minus sign).
         usable: (W, n) no sample of the window clipped at the torque limit at any searched delay.
+        feedback: (W, n) the PD law's feedback impulse ``int (k_p q_enc + k_d qd)`` [N·m·s] (in :attr:`rest` with a
+            minus sign; zero with ``delayed = "torque"``, whose set-point impulse is the whole law's).
+        speed: (W, n) each window's mean velocity from the encoder's positions, ``Delta q_enc / window`` [rad/s]
+            (what the joint moved, whatever the velocity of the dynamics: :mod:`wbfriction.actuator.excitation`).
         sigma: (n,) the noise of one window's balance the sensors' noise predicts [N·m·s] (the Cramér-Rao bound's
             scale): ``sqrt((kp² σ_q² + kd² σ_qd²)(m - 1/2) T² + 2 M_jj² σ_v²)``, ``σ_qd`` the driver's velocity's
             white noise (its law's damping term), ``σ_v`` the dynamics' velocity's (the momentum's ends).
@@ -69,6 +73,8 @@ class BalanceRows:
         period: the sampling period T [s].
         start: (W,) the first sample of each window, in the log's rows.
         offset: (n,) the offsets ``o_0`` the dynamics were taken about [rad].
+        coulomb_steep: (W, n) the Coulomb column with a slope :data:`~wbfriction.actuator.options.STEEPER` times as
+            steep (the nuisance model's sensitivity, :mod:`wbfriction.actuator.identification`), or None.
     """
 
     joints: tuple[str, ...]
@@ -79,12 +85,15 @@ class BalanceRows:
     coulomb: np.ndarray
     gravity: np.ndarray
     usable: np.ndarray
+    feedback: np.ndarray
+    speed: np.ndarray
     sigma: np.ndarray
     position_noise: np.ndarray
     velocity_noise: np.ndarray
     period: float
     start: np.ndarray
     offset: np.ndarray
+    coulomb_steep: np.ndarray | None = None
 
     @property
     def max_steps(self) -> int:
@@ -102,8 +111,9 @@ class BalanceRows:
         """The windows ``windows`` (an index or mask over W)."""
         return BalanceRows(self.joints, self.setpoint[:, windows], self.rest[windows], self.dv[windows],
                            self.qd[windows], self.coulomb[windows], self.gravity[windows], self.usable[windows],
-                           self.sigma, self.position_noise, self.velocity_noise, self.period, self.start[windows],
-                           self.offset)
+                           self.feedback[windows], self.speed[windows], self.sigma, self.position_noise,
+                           self.velocity_noise, self.period, self.start[windows], self.offset,
+                           None if self.coulomb_steep is None else self.coulomb_steep[windows])
 
 
 def pd_joints(robot: Robot, log: Log) -> np.ndarray:
@@ -193,7 +203,8 @@ def _segment_rows(robot: Robot, log: Log, index: np.ndarray, offset: np.ndarray,
     if windows - first < 2:
         return None
     q_enc = log.q[:, index] + robot.offset_vector[index]
-    v = sp.qd if options.velocity == "logged" else np.gradient(q_enc, log.time, axis=0)
+    time = log.time if log.clock is None else log.clock.t  # receive-time jitter regularised (logs.clock)
+    v = sp.qd if options.velocity == "logged" else np.gradient(q_enc, time, axis=0)
     kp = np.broadcast_to(driver.kp if sp.kp is None else sp.kp, q_enc.shape)
     kd = np.broadcast_to(driver.kd if sp.kd is None else sp.kd, q_enc.shape)
     command = kp * sp.q_des
@@ -205,13 +216,14 @@ def _segment_rows(robot: Robot, log: Log, index: np.ndarray, offset: np.ndarray,
     if options.delayed == "torque":  # the whole law held back: its clipped torque is what the delay shifts
         command = np.clip(command - feedback, -driver.torque_limit, driver.torque_limit)
         feedback = np.zeros_like(feedback)
-    dt = np.diff(log.time)[:, None]
+    dt = np.diff(time)[:, None]
     trap = lambda x: 0.5 * (x[:-1] + x[1:]) * (dt if x.ndim == 2 else dt[:, :, None])  # noqa: E731
     steps = np.arange(n_steps)
     setpoint = np.stack([_window_sum(command[np.maximum(steps - k, 0)] * dt, m, windows) for k in range(K + 2)])
     p, b, dg, m_jj = _dynamics(robot, q_enc - offset, v, index)
     ends = np.arange(windows + 1) * m
-    rest = -_window_sum(trap(feedback), m, windows) - (p[ends[1:]] - p[ends[:-1]]) + _window_sum(trap(b), m, windows)
+    feedback_impulse = _window_sum(trap(feedback), m, windows)
+    rest = -feedback_impulse - (p[ends[1:]] - p[ends[:-1]]) + _window_sum(trap(b), m, windows)
     torque = np.stack([command[np.maximum(np.arange(len(log)) - k, 0)] - feedback for k in range(K + 2)])
     # a law held back whole was clipped before its delay: the limit is reached, not passed
 
@@ -226,7 +238,11 @@ def _segment_rows(robot: Robot, log: Log, index: np.ndarray, offset: np.ndarray,
     return {"setpoint": setpoint[:, keep], "rest": rest[keep], "dv": (v[ends[1:]] - v[ends[:-1]])[keep],
             "qd": _window_sum(trap(v), m, windows)[keep],
             "coulomb": _window_sum(tanh_impulse(v, dt, options.tanh_slope), m, windows)[keep],
-            "gravity": _window_sum(trap(dg), m, windows)[keep], "usable": usable[keep], "sigma": sigma,
+            "coulomb_steep": _window_sum(tanh_impulse(v, dt, STEEPER * options.tanh_slope), m, windows)[keep],
+            "gravity": _window_sum(trap(dg), m, windows)[keep], "usable": usable[keep],
+            "feedback": feedback_impulse[keep],
+            "speed": ((q_enc[ends[1:]] - q_enc[ends[:-1]]) / (time[ends[1:]] - time[ends[:-1]])[:, None])[keep],
+            "sigma": sigma,
             "position_noise": sigma_q, "velocity_noise": sigma_v, "period": T, "start": ends[:-1][keep],
             "joints": tuple(robot.actuated[i] for i in index), "offset": np.asarray(offset, dtype=float)}
 
@@ -263,6 +279,7 @@ def _concatenate(parts: list[tuple[int, dict]]) -> BalanceRows:
     longest = max(rows, key=lambda r: len(r["rest"]))
     cat = lambda key: np.concatenate([r[key] for r in rows])  # noqa: E731
     return BalanceRows(longest["joints"], np.concatenate([r["setpoint"][:K] for r in rows], axis=1), cat("rest"),
-                       cat("dv"), cat("qd"), cat("coulomb"), cat("gravity"), cat("usable"), longest["sigma"],
-                       longest["position_noise"], longest["velocity_noise"], longest["period"],
-                       np.concatenate([a + r["start"] for a, r in parts]), longest["offset"])
+                       cat("dv"), cat("qd"), cat("coulomb"), cat("gravity"), cat("usable"), cat("feedback"),
+                       cat("speed"), longest["sigma"], longest["position_noise"], longest["velocity_noise"],
+                       longest["period"], np.concatenate([a + r["start"] for a, r in parts]), longest["offset"],
+                       cat("coulomb_steep"))

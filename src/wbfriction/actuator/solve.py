@@ -3,8 +3,16 @@ bounded solution and its covariances.
 
 Unknowns, in this order: the armature ``I_a`` of each of the ``n`` joints [kg·m²], ``F_v`` [N·m·s/rad], ``F_c``
 [N·m], then (where fitted) the encoder offsets ``o`` [rad]. Each row is one joint's balance over one window, weighted
-by the inverse of that joint's noise (:class:`Weighted`): the residuals' own RMS for the standard errors, the noise
-the sensors predict for the Cramér-Rao bound (:attr:`BalanceRows.sigma <wbfriction.actuator.rows.BalanceRows.sigma>`).
+by the inverse of that joint's noise: the residuals' own RMS for the standard errors, the noise the sensors predict
+for the Cramér-Rao bound (:attr:`BalanceRows.sigma <wbfriction.actuator.rows.BalanceRows.sigma>`).
+
+**Standard errors under correlated residuals.** A window's residual is mostly model error (the simulator's
+discretisation, a friction that sticks, a driver's filter), correlated over the windows of a ramp: the covariance
+is a heteroscedasticity- and autocorrelation-consistent sandwich (Newey and West, 1987), the scores summed over the
+joints of each window (the joints' residuals of one instant correlate through the offsets' columns) and their
+cross-products kept up to :func:`hac_lags` windows apart with Bartlett weights (:func:`sandwich`). The
+identification reports no standard error below its Cramér-Rao bound (``max(se, crb)``:
+:mod:`wbfriction.actuator.identification`).
 
 **Delay.** Between two whole periods, ``kT <= d <= (k+1)T``, the right-hand side is ``y_k + theta (y_{k+1} - y_k)``
 and the residual of the linear problem's projection is ``r(theta) = r_k + theta Delta r``: the squared residual is a
@@ -41,8 +49,9 @@ class Design:
         return shifted[self.window, self.joint]
 
 
-def design(rows: BalanceRows, windows: np.ndarray, offsets: bool) -> Design:
-    """The design of the usable rows of ``windows`` (indices into W) (module docstring)."""
+def design(rows: BalanceRows, windows: np.ndarray, offsets: bool, steep: bool = False) -> Design:
+    """The design of the usable rows of ``windows`` (indices into W) (module docstring); ``steep``: the Coulomb
+    column :attr:`~wbfriction.actuator.rows.BalanceRows.coulomb_steep`."""
     n = len(rows.joints)
     usable = rows.usable[windows]
     w_idx, j_idx = np.nonzero(usable)
@@ -51,7 +60,8 @@ def design(rows: BalanceRows, windows: np.ndarray, offsets: bool) -> Design:
     r = np.arange(len(window))
     A[r, j_idx] = rows.dv[window, j_idx]
     A[r, n + j_idx] = rows.qd[window, j_idx]
-    A[r, 2 * n + j_idx] = rows.coulomb[window, j_idx]
+    coulomb = rows.coulomb_steep if steep and rows.coulomb_steep is not None else rows.coulomb
+    A[r, 2 * n + j_idx] = coulomb[window, j_idx]
     if offsets:
         A[:, 3 * n:] = -rows.gravity[window, j_idx, :]
     return Design(A, j_idx, window, offsets)
@@ -124,10 +134,11 @@ def bounds(n: int, offsets: bool, offset_bound: float) -> tuple[np.ndarray, np.n
     return lower, upper
 
 
-def solve(d: Design, y: np.ndarray, weight: np.ndarray, predicted: np.ndarray, offset_bound: float) -> Solution:
+def solve(d: Design, y: np.ndarray, weight: np.ndarray, predicted: np.ndarray, offset_bound: float,
+          lags: int = 0) -> Solution:
     """The bounded weighted least squares of the balance (rows weighted by ``weight`` (n,) of their joint), its
-    covariance from each joint's residual RMS and its Cramér-Rao bound from ``predicted`` (n,), the sensors'
-    noise of one window's balance [N·m·s]."""
+    covariance from each joint's residuals (:func:`sandwich` with ``lags`` windows of autocorrelation) and its
+    Cramér-Rao bound from ``predicted`` (n,), the sensors' noise of one window's balance [N·m·s]."""
     n = len(weight)
     w = weight[d.joint]
     lower, upper = bounds(n, d.offsets, offset_bound)
@@ -139,8 +150,47 @@ def solve(d: Design, y: np.ndarray, weight: np.ndarray, predicted: np.ndarray, o
     count = np.bincount(d.joint, minlength=n)
     dof = max(len(y) - d.A.shape[1], 1) / max(len(y), 1)
     rms = np.sqrt(np.bincount(d.joint, weights=e**2, minlength=n) / np.maximum(count * dof, 1))
-    return Solution(x, at_bound, _inverse(d.A / _safe(rms)[d.joint][:, None]),
+    scale = _safe(rms)[d.joint]
+    return Solution(x, at_bound, sandwich(d.A / scale[:, None], e / scale, d.window, lags),
                     _inverse(d.A / _safe(predicted)[d.joint][:, None]), rms, count)
+
+
+HAC_SPAN = 0.5
+"""The longest lag of the sandwich's autocorrelation [s] (:func:`hac_lags`): a ramp's half reversal period on the
+set-points this is for (reversals every 0.2-1.5 s; the real Aliengo's likewise): a model error that follows the
+motion changes sign at the reversals. A physical span, not fitted on data."""
+
+
+def hac_lags(windows: int, window: float) -> int:
+    """The sandwich's longest lag in windows: :data:`HAC_SPAN` over the window ``window`` [s], at most a quarter
+    of the log's ``windows`` (a lag as long as the log estimates nothing)."""
+    return max(0, min(int(round(HAC_SPAN / window)), windows // 4))
+
+
+def sandwich(X: np.ndarray, e: np.ndarray, window: np.ndarray, lags: int) -> np.ndarray:
+    """The autocorrelation-consistent covariance (P, P) of a least squares of the weighted design ``X`` (R, P) with
+    weighted residuals ``e`` (R,), whose rows fall in the windows ``window`` (R,) (module docstring): ``B S B``
+    with ``B = (X^T X)^-1`` (:func:`_inverse`: infinite where the rows determine nothing) and ``S`` the
+    Bartlett-weighted sum of the windows' score products up to ``lags`` apart; returned as ``B`` with each
+    parameter's variance grown to the sandwich's, never shrunk (a correlation estimated to shrink the error is not
+    taken), so the matrix stays a covariance."""
+    bread = _inverse(X)
+    finite = np.isfinite(np.diag(bread))
+    if len(e) == 0 or not finite.any():
+        return bread
+    first = int(window.min())
+    scores = np.zeros((int(window.max()) - first + 1, X.shape[1]))
+    np.add.at(scores, window - first, X * e[:, None])
+    meat = scores.T @ scores
+    for lag in range(1, lags + 1):
+        c = scores[lag:].T @ scores[:-lag]
+        meat += (1.0 - lag / (lags + 1)) * (c + c.T)
+    b = bread[np.ix_(finite, finite)]
+    hac = np.diag(b @ meat[np.ix_(finite, finite)] @ b)
+    grow = np.sqrt(np.maximum(hac, np.diag(b)) / np.maximum(np.diag(b), 1e-300))
+    cov = bread.copy()
+    cov[np.ix_(finite, finite)] = b * np.outer(grow, grow)
+    return cov
 
 
 def _safe(x: np.ndarray) -> np.ndarray:

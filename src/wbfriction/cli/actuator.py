@@ -9,7 +9,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from wbfriction.actuator import ActuatorIdentification, ActuatorOptions, Identified
-from wbfriction.cli.common import config_text, console, out, print_whole, robot_of
+from wbfriction.cli.common import config_text, console, out, print_whole, robot_of, warn
 from wbfriction.logs.options import TimeUnit
 from wbfriction.pipeline.paths import check_paths
 
@@ -27,6 +27,7 @@ def identify_pd(log: Path, robot: str, urdf: Optional[Path], config: Optional[Pa
     with console.status("identifying the actuators"):
         result = identify_actuator_file(r, log, json_output, options, time_unit)
     print_actuators(result, wide)
+    warn(result.warnings)
     if json_output is not None:
         console.print(f"wrote {json_output}")
     if config_output is not None:
@@ -50,6 +51,8 @@ def print_actuators(result: ActuatorIdentification, wide: bool = False) -> None:
     out.print(escape(f"delay {d.value * 1e3:.2f} ms ±{d.se * 1e3:.2f} (bound {d.crb * 1e3:.2f}), "
                      f"{d.value / result.period:.2f} periods of {result.period * 1e3:.3g} ms{status}"), highlight=False)
     out.print(escape(f"model: {result.velocity_reason}"), highlight=False)
+    if result.clock:
+        out.print(escape(f"clock: {result.clock}"), highlight=False)
     table = Table(*map(escape, ("joint", "armature [g·m²]", "F_c [N·m]", "F_v [N·m·s/rad]", "offset [mrad]",
                                 "held-out / fitted")))
     for j in result.joints:

@@ -89,6 +89,10 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
         held = "the whole torque" if torque.get("delayed") == "torque" else "the set-points"
         delay = f", {held} {1e3 * torque['delay']:.3g} ms late ({torque['gains']})" if "delay" in torque else ""
         console.print(escape(f"torque: {torque['what']}{delay}"), highlight=False, soft_wrap=True)
+        if torque.get("source") == "pd" and bag_map is None:
+            from wbfriction.pipeline.actuator_step import pd_law_warnings
+
+            warn(pd_law_warnings(r, log, read.time_unit))
     if opts.velocity == "logged":
         velocity = result.metadata.get("velocity", {})  # measured on the first chunk
         console.print(f"velocity: {escape(velocity.get('reason', 'logged'))} (not compensated)", highlight=False)

@@ -18,9 +18,9 @@ from wbfriction.model.robot import Robot
 from wbfriction.pipeline.identify_step import identified_config
 from wbfriction.pipeline.paths import check_paths
 
-WRITTEN = ("ok", "weak")
-"""The statuses whose values go into the robot's TOML: determined by the data (``weak``: with a large error). A
-value at a bound or not excited is left as the TOML had it; ``identify`` prints which, and the JSON has every status."""
+WRITTEN = ("ok",)
+"""The statuses whose values go into the robot's TOML: only what the log determines (issue 63: a ``weak`` value, one
+at a bound or not excited, is left as the TOML had it); ``identify`` prints which, and the JSON has every status."""
 
 
 def identify_actuator_file(robot: Robot, log: str | Path, json_output: str | Path | None = None,
@@ -44,7 +44,11 @@ def identify_actuator_file(robot: Robot, log: str | Path, json_output: str | Pat
 
 def written_values(result: ActuatorIdentification) -> tuple[dict[str, float], dict[str, float], float | None]:
     """The armature [kg·m²] and encoder offsets [rad] by joint, and the delay [s], whose status is one of
-    :data:`WRITTEN` (None: the delay is not)."""
+    :data:`WRITTEN` (None: the delay is not). Without the delay (not ``ok``, nor given with ``--delay``) nothing is
+    written: the armatures and offsets were fitted under it, and a TOML keeping its old delay beside them would
+    mix two laws."""
+    if result.delay.status not in WRITTEN:
+        return {}, {}, None
     armature = {j.joint: j.armature.value for j in result.joints if j.armature.status in WRITTEN}
     offsets = {j.joint: j.offset.value for j in result.joints if j.offset is not None and j.offset.status in WRITTEN}
     delay = result.delay.value if result.delay.status in WRITTEN else None
@@ -109,3 +113,30 @@ def write_actuator_config(text: str, source_dir: Path, urdf: Path, output: str |
     output = Path(output)
     written = actuator_config(text, source_dir, urdf, output, result)
     write_atomic(output, lambda tmp: tmp.write_text(written, encoding="utf-8"))
+
+
+LAW_CHECK_SECONDS = 20.0
+"""The first seconds of a log on which ``estimate`` checks the robot TOML's PD law (:func:`pd_law_warnings`): a
+hung robot's ramps reverse every 0.2-2 s, so 20 s hold tens of reversals, and the check costs a second or two."""
+
+
+def pd_law_warnings(robot: Robot, log: str | Path, time_unit: TimeUnit | None = None) -> list[str]:
+    """The robot TOML's PD law against the first :data:`LAW_CHECK_SECONDS` of the log file ``log`` of a hung
+    PD-driven robot whose torque is the PD law's (:mod:`wbfriction.actuator.law_check`: its delay and gains against
+    what the log shows; a delay beyond the search), one warning line each; none where the check does not apply (a
+    floating base, no ``[pd]``, a measured torque, a log the identification refuses)."""
+    if robot.pd is None or robot.floating_base:
+        return []
+    data = read_log(log, robot, read=ReadOptions(time_unit=time_unit))
+    if data.torque_source != "pd":
+        return []
+    import numpy as np
+
+    stop = int(np.searchsorted(data.time - data.time[0], LAW_CHECK_SECONDS))
+    # the positions' velocity and the TOML's delayed: one identification, not identify's two to four
+    options = ActuatorOptions(holdout=0.0, velocity="positions", delayed=robot.pd.delayed)
+    try:
+        result = identify_actuators(robot, data.rows(0, stop) if stop < len(data.time) else data, options)
+    except InputError:
+        return []
+    return list(result.warnings)
