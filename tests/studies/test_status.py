@@ -11,6 +11,9 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 
 from wbfriction.studies.status import (
@@ -23,6 +26,7 @@ from wbfriction.studies.status import (
     excited,
     fits_from_actuators,
     fits_from_params,
+    log_speeds,
     results_json,
     score_fits,
 )
@@ -79,7 +83,7 @@ def test_a_joint_that_did_not_move():
     still = JointFit("a", "ok", (ParameterFit("F_c", 0.41, 0.01, 0.005, 0.4, True),
                                  ParameterFit("F_v", 2.0, 0.01, 0.005, 0.2, False)))
     score = score_fits("x", [still], noisy=False)
-    assert (score.ok_good, score.not_excited, score.scored) == (1, 1, 1)
+    assert (score.ok_good, score.not_excited, score.ok_not_excited, score.scored) == (1, 1, 1, 1)
     assert not excited(0.01, "ok") and excited(0.5, "ok") and not excited(0.5, "not excited") and excited(None, "ok")
 
 
@@ -140,13 +144,14 @@ def test_actuator_json_read_as_identify_writes_it(tmp_path):
     excited_names = [p.name for f in still for p in f.parameters if p.excited]
     assert excited_names == ["F_c", "offset", "F_c", "offset"]
     held = score_fits("still", still, noisy=True)  # judged on F_c alone: the knee's F_v 200 % off no longer counts
-    assert (held.ok_good, held.not_ok_good, held.not_excited) == (1, 1, 5)
+    assert (held.ok_good, held.not_ok_good, held.not_excited, held.ok_not_excited) == (1, 1, 5, 3)
 
 
 def test_tables_and_json():
     score = score_fits("crawl", [joint("a", "ok", 0.07)], noisy=False)
     text = cases_markdown([score])
-    assert "| crawl | 5 % | 0 | 1 | 0 | 0 |" in text and "ok within tolerance NO" in text and "(ok and bad: a)" in text
+    assert "| crawl | 5 % | 0 | 1 | 0 | 0 | 50 % (1 of 2) | 0 of 2 | 0 (0) | 7.0 |" in text  # F_c 2.8 SE off
+    assert "ok within tolerance NO" in text and "(ok and bad: a)" in text
     assert "| – |" in text  # the time, not measured
     doc = json.loads(results_json([score], [], {"commit": "x"}))
     assert doc["cases"]["crawl"]["ok_bad"] == 1 and doc["cases"]["crawl"]["seconds"] is None
@@ -157,3 +162,17 @@ def test_cases_are_the_issues():
     assert len(set(names)) == len(names)
     assert {"crawl", "crawl-3d", "crawl-noisy", "arm-noisy", "walk", "pd", "pd-still", "pd-late"} == set(names)
     assert all(c.commands[-1].split()[1] in ("fit", "identify") for c in CASES)
+
+
+def test_a_joint_held_still_under_a_noisy_velocity(tmp_path):
+    """A driver's velocity of white noise (0.08 rad/s, 95th percentile 0.16: above the 0.02 rad/s of a joint that
+    moved) on a joint whose angle holds, encoder steps aside, reads as still; a ramp at 0.5 rad/s as 0.5."""
+    rng = np.random.default_rng(0)
+    t = np.arange(2000) / 200.0
+    still = 0.3 + 1.2e-5 * np.round(rng.normal(0.0, 1.0, t.size))
+    table = pa.table({"time": t, "q.still": still, "qd.still": rng.normal(0.0, 0.08, t.size), "q.ramp": 0.5 * t,
+                      "qd.ramp": np.full(t.size, 0.5)})
+    pq.write_table(table, tmp_path / "log.parquet")
+    speeds = log_speeds(tmp_path / "log.parquet", ["still", "ramp", "absent"])
+    assert set(speeds) == {"still", "ramp"}
+    assert speeds["still"] < 0.002 and speeds["ramp"] == pytest.approx(0.5)
