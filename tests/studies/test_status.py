@@ -27,7 +27,9 @@ from wbfriction.studies.status import (
     fits_from_actuators,
     fits_from_params,
     log_speeds,
+    log_truth,
     results_json,
+    run_case,
     score_fits,
 )
 
@@ -176,3 +178,19 @@ def test_a_joint_held_still_under_a_noisy_velocity(tmp_path):
     speeds = log_speeds(tmp_path / "log.parquet", ["still", "ramp", "absent"])
     assert set(speeds) == {"still", "ramp"}
     assert speeds["still"] < 0.002 and speeds["ramp"] == pytest.approx(0.5)
+
+
+@pytest.mark.slow
+def test_the_hung_go2_through_its_route(tmp_path):
+    """The ``pd`` case as the benchmark runs it (each command its own process): every joint counted once, the delay
+    scored once, each parameter against the log's own truth (the ``identify`` JSON's armature of the front right
+    thigh against the ``armature_true`` the simulator wrote, 0.0135 kg·m², within its 10 %)."""
+    case = next(c for c in CASES if c.name == "pd")
+    score = run_case(case, tmp_path)
+    assert not score.failed, score.failed
+    assert score.ok_good + score.ok_bad + score.not_ok_good + score.not_ok_bad == 12
+    assert score.scored + score.not_excited <= 12 * 4 + 1 and score.with_crb == 12 * 4 + 1
+    fits = fits_from_actuators(tmp_path / case.result, log_truth(tmp_path / case.log),
+                               log_speeds(tmp_path / case.log, ["FR_thigh_joint"]))
+    armature = next(p for f in fits if f.joint == "FR_thigh_joint" for p in f.parameters if p.name == "armature")
+    assert armature.truth == 0.0135 and armature.error < 0.1
