@@ -114,7 +114,6 @@ def test_a_json_written_holds_no_nan_nor_infinity(tmp_path):
     """Issue 63: every number that is not finite, NumPy's and nested ones too, is written ``null``; finite numbers,
     booleans, integers and text as they were (NumPy's as plain numbers)."""
     from helpers import strict_json
-
     from wbfriction.logs.tables import write_json
 
     doc = {"a": float("nan"), "b": [1.5, float("inf"), -np.inf, np.float64("nan")], "c": {"d": np.float32(2.5)},
