@@ -8,9 +8,9 @@ parameters, standard errors, and those that ``disagree``), the velocity noise th
 (``velocity_noise``), the samples left out where the joint may stick (``stick_speed``, ``n_stuck``) and, when
 the model was chosen by held-out error, how (``selection``). :func:`write_params` writes it (``wbfriction
 fit`` and the studies), :func:`read_params` reads it (``wbfriction report --params``). A standard error that
-is not finite (not identifiable) is written as ``null`` and read back as ``inf``; no number that is not finite is written at all
-(``logs.tables.finite_json``: ``null``, its meaning the key's). Files written before the model choice (no ``model``
-key) hold model (3.5) and read back so.
+is not finite (not identifiable) is written as ``null`` and read back as ``inf``; no number that is not finite is
+written at all (``logs.tables.finite_json``: ``null``, its meaning the key's). Files written before the model
+choice (no ``model`` key) hold model (3.5) and read back so.
 
 What ``fit`` writes, its readers take (issue 63): :mod:`~wbfriction.fit.params_check` is what both sides hold to.
 The fit's bounds keep its own parameters within it, and the terms' refit holds every magnitude of the velocity model
