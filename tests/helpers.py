@@ -45,6 +45,19 @@ def kuka_table(*runs: int) -> pa.Table:
     return read_npz_recordings([KUKA / f"measurements_{i}.npz" for i in runs], KUKA_LWR4_JOINTS)
 
 
+def strict_json(path):
+    """The JSON document at ``path``, refused (the test fails) where it holds ``NaN``, ``Infinity`` or
+    ``-Infinity``: no file the package writes may (issue 63; a number that is not finite is ``null``)."""
+    import json
+
+    text = Path(path).read_text(encoding="utf-8")
+
+    def refuse(constant: str):
+        pytest.fail(f"{path}: holds {constant}, which JSON does not have (null expected)")
+
+    return json.loads(text, parse_constant=refuse)
+
+
 def run(*args, cwd=None, columns: int = 200):
     """``python -m wbfriction ARGS`` in a terminal ``columns`` wide."""
     return subprocess.run([sys.executable, "-m", "wbfriction", *map(str, args)], capture_output=True, text=True,

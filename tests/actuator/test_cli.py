@@ -9,7 +9,7 @@ import tomllib
 
 import pytest
 
-from helpers import assert_one_line_error, run
+from helpers import assert_one_line_error, run, strict_json
 
 
 def test_simulate_identify_estimate(tmp_path):
@@ -18,7 +18,7 @@ def test_simulate_identify_estimate(tmp_path):
                "--config-output", "identified.toml", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert "delay" in done.stdout and "armature" in done.stdout
-    doc = json.loads((tmp_path / "actuator.json").read_text())
+    doc = strict_json(tmp_path / "actuator.json")  # no NaN nor Infinity (issue 63)
     truth = 0.012  # the built-in go2's [pd] delay, which the simulator injects
     assert abs(doc["delay"]["value"] - truth) < 0.001 and doc["delay"]["status"] == "ok"
     written = tomllib.loads((tmp_path / "identified.toml").read_text())

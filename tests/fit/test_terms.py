@@ -494,3 +494,26 @@ def test_a_coulomb_level_held_at_zero_holds_its_stribeck_part():
     X = np.column_stack([B, 1.5 * B[:, 1] + angle])  # a term that holds 1.5 x the tanh column
     coef, held = nonnegative_solve(X, B @ c + angle, (*names, "extra"))
     assert {"F_c", "F_cS"} <= set(held) and coef[1] == coef[2] == 0.0
+
+
+def test_a_stribeck_static_level_the_terms_would_drive_below_zero_is_held_at_zero():
+    """Issue 63: a Stribeck joint's terms refit left its static level ``F_s`` free; a term holding the Stribeck column
+    and a torque of its own drove it below zero (a humanoid's torso roll: -0.048 N·m), a file ``predict`` then
+    refused whole. The static level is a magnitude: held at zero, named, and the refitted parameters are what the
+    readers take."""
+    from wbfriction.fit.params_check import check_model_params
+    from wbfriction.fit.term_design import nonnegative_solve
+    from wbfriction.fit.terms import with_coefficients
+    from wbfriction.friction.models import StribeckParams
+
+    params = StribeckParams(F_v=0.2, F_c=0.3, F_s=0.4, v_s=0.3, tau_os=0.0)
+    qd = 1.5 * np.sin(np.linspace(0.0, 40.0, 4000))
+    names, B, c = velocity_basis(params, qd)
+    assert names[2] == "F_s"
+    angle = np.cos(np.linspace(0.0, 7.0, qd.size))
+    X = np.column_stack([B, 1.5 * B[:, 2] + angle])  # a term that holds 1.5 x the Stribeck column
+    free = np.linalg.lstsq(X, B @ c + angle, rcond=None)[0]
+    assert free[2] < 0  # what the refit wrote before
+    coef, held = nonnegative_solve(X, B @ c + angle, (*names, "extra"))
+    assert "F_s" in held and coef[2] == 0.0 and (coef[:2] >= 0).all()
+    check_model_params(with_coefficients(params, coef[:len(names)]), "terms.params")

@@ -68,3 +68,18 @@ def test_not_json_at_all(tmp_path):
     (tmp_path / "i.json").write_bytes(b"\xff\xfe")
     with pytest.raises(InputError, match="not an identification written by 'wbfriction identify --json'"):
         read_identification(tmp_path / "i.json")
+
+
+
+def test_an_identification_with_numbers_not_finite_writes_null(tmp_path):
+    """Issue 63: a value that is not finite (a friction parameter not determined) is written ``null``, not ``NaN``."""
+    import dataclasses
+
+    from helpers import strict_json
+
+    (tmp_path / "i.json").write_text(json.dumps(DOC))
+    result = read_identification(tmp_path / "i.json")
+    knee = result.joints["knee"]
+    joints = {"knee": dataclasses.replace(knee, identified={**knee.identified, "F_c": float("nan")})}
+    write_identification(tmp_path / "n.json", dataclasses.replace(result, joints=joints))
+    assert strict_json(tmp_path / "n.json")["joints"]["knee"]["identified"]["F_c"] is None

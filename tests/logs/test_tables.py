@@ -108,3 +108,19 @@ def test_columns_read_as_one_array_are_the_columns_read_one_by_one():
     with pytest.raises(InputError) as single:
         numeric_column(table, "b", "log", first_row=10)
     assert str(many.value) == str(single.value) and "row 11" in str(many.value)
+
+
+def test_a_json_written_holds_no_nan_nor_infinity(tmp_path):
+    """Issue 63: every number that is not finite, NumPy's and nested ones too, is written ``null``; finite numbers,
+    booleans, integers and text as they were (NumPy's as plain numbers)."""
+    from helpers import strict_json
+    from wbfriction.logs.tables import write_json
+
+    doc = {"a": float("nan"), "b": [1.5, float("inf"), -np.inf, np.float64("nan")], "c": {"d": np.float32(2.5)},
+           "e": (np.int64(3), True, np.bool_(False), "x", None), "f": np.array([0.25, np.nan])}
+    write_json(tmp_path / "d.json", doc)
+    assert strict_json(tmp_path / "d.json") == {"a": None, "b": [1.5, None, None, None], "c": {"d": 2.5},
+                                                 "e": [3, True, False, "x", None], "f": [0.25, None]}
+    with pytest.raises(pytest.fail.Exception, match="NaN"):
+        (tmp_path / "bad.json").write_text(json.dumps({"a": float("nan")}))
+        strict_json(tmp_path / "bad.json")

@@ -147,3 +147,43 @@ def test_a_joint_name_no_font_draws_is_drawn_readable_without_a_warning(estimate
         assert titles == ["joint #1", "still"]  # its index among the estimate's joints
         said = [t.get_text() for t in fig.findobj(lambda a: hasattr(a, "get_text")) if "joint #i" in t.get_text()]
         assert len(said) == 1 and "no installed font" in said[0]
+
+
+def test_the_drawn_fit_passes_through_the_samples_it_predicts_with_its_terms_and_family():
+    """Issue 63: the KUKA's lwr_6 was drawn at +2.3 N·m where its samples sat at 0-0.5 (a velocity curve without
+    the terms its fit kept) and every legend said ``fit (coulomb-viscous)``. Constructed: a joint whose friction is a
+    Stribeck curve with an offset and a position ripple of 0.4 N·m, exactly; another a Coulomb-viscous curve. The
+    drawn data (not the picture) of the first pass through every valid sample to rounding; the second's curve
+    meets its samples; each panel's legend names its own model."""
+    from wbfriction.fit.result import FitResult
+    from wbfriction.fit.terms import TermFit
+    from wbfriction.friction.models import CoulombViscousParams, StribeckParams
+
+    t = np.arange(3000) * 1e-3
+    qd = np.column_stack([np.sin(2 * np.pi * 0.7 * t), 0.8 * np.cos(2 * np.pi * 0.4 * t)])
+    q = np.column_stack([0.5 + 0.3 * np.cos(2 * np.pi * 0.7 * t), np.sin(t)])
+    stribeck = StribeckParams(F_v=0.3, F_c=0.2, F_s=0.35, v_s=0.1, tau_os=0.25)
+    terms = TermFit(stribeck, kept=("ripple",), harmonics=1, coefficients={"ripple_sin1": 0.4, "ripple_cos1": -0.3},
+                    q_range=(0.2, 0.8))
+    plain = CoulombViscousParams(F_v=0.5, F_c=0.3, tau_os=-0.1)
+    tau_f = np.column_stack([-(stribeck.f(qd[:, 0]) + 0.4 * np.sin(q[:, 0]) - 0.3 * np.cos(q[:, 0])),
+                             plain.torque(qd[:, 1])])
+    valid = np.ones_like(qd, dtype=bool)
+    est = FrictionEstimate(joints=("lwr_6", "other"), time=t, qd=qd, tau_f=tau_f, valid=valid,
+                           phase=np.full(t.size, "single"), unique=valid[:, 0], contact=valid,
+                           contact_frames=("left", "right"), qdd=np.zeros_like(qd), delta_qdd=np.zeros_like(qd), q=q)
+    fits = {"lwr_6": FitResult(joint="lwr_6", n_samples=3000, params=stribeck, success=True, terms=terms),
+            "other": FitResult(joint="other", n_samples=3000, params=plain, success=True)}
+    fig = friction_overview_figure(est, ["lwr_6", "other"], fits, {})
+    for ax, i, name in zip(fig.axes, (0, 1), ("fit (stribeck + ripple), at the samples", "fit (coulomb-viscous)")):
+        line = next(ln for ln in ax.get_lines() if ln.get_label().startswith("fit ("))
+        assert line.get_label() == name
+        assert [text.get_text() for text in ax.get_legend().get_texts()] == [name]
+        x, y = np.asarray(line.get_xdata()), np.asarray(line.get_ydata())
+        if i == 0:  # a dot per valid sample, at its own friction
+            assert np.array_equal(x, qd[:, 0]) and np.allclose(y, tau_f[:, 0], atol=1e-12)
+        else:  # the curve, where the samples are (away from the Coulomb jump, between two of its 400 points)
+            away = np.abs(qd[:, 1]) > 0.01
+            assert np.allclose(np.interp(qd[away, 1], x, y), tau_f[away, 1], atol=1e-9)
+    velocity_only = stribeck.torque(qd[:, 0])  # what was drawn before: off the samples by the offset and ripple
+    assert np.max(np.abs(velocity_only - tau_f[:, 0])) > 0.2

@@ -105,16 +105,24 @@ class PredictionCheck:
                 f"errors{share}): {cause}" + (f"; {self.note}" if self.note else ""))
 
     def to_dict(self) -> dict[str, Any]:
-        return {"held_out": self.held_out, "share": self.share, "samples": self.samples, "rms": self.rms,
-                "allowed": self.allowed, "z": self.z if math.isfinite(self.z) else None, "predicts": self.predicts,
-                "note": self.note, "friction": self.friction}
+        """As the parameters JSON's ``later_stretch`` holds it: a number that is not finite ``null`` (``z``: no
+        standard error of the excess, an infinite one; ``rms``, ``allowed``, ``friction``: not known)."""
+        def clean(x: float) -> float | None:
+            return float(x) if math.isfinite(x) else None
+
+        return {"held_out": self.held_out, "share": self.share, "samples": self.samples, "rms": clean(self.rms),
+                "allowed": clean(self.allowed), "z": clean(self.z), "predicts": self.predicts,
+                "note": self.note, "friction": clean(self.friction)}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> PredictionCheck:
-        z = d.get("z")
-        return cls(str(d["held_out"]), int(d["samples"]), float(d["rms"]), float(d["allowed"]),
-                   math.inf if z is None else float(z), None if d.get("share") is None else float(d["share"]),
-                   str(d.get("note", "")), float(d.get("friction", 0.0)))
+        """Inverse of :meth:`to_dict` (``z`` ``null``: infinite; the others ``null``: NaN)."""
+        def number(key: str, missing: float) -> float:
+            return missing if d.get(key) is None else float(d[key])
+
+        return cls(str(d["held_out"]), int(d["samples"]), number("rms", math.nan), number("allowed", math.nan),
+                   number("z", math.inf), None if d.get("share") is None else float(d["share"]),
+                   str(d.get("note", "")), number("friction", 0.0))
 
 
 def split_later(use: np.ndarray, share: float = LATER) -> tuple[np.ndarray, np.ndarray]:
@@ -129,10 +137,18 @@ def split_later(use: np.ndarray, share: float = LATER) -> tuple[np.ndarray, np.n
 def prediction_variance(g: np.ndarray, covariance: np.ndarray) -> float:
     """``mean_t(g_t C g_t^T)`` [N²·m²] of the model's gradients ``g`` (n, p) and the fit's covariance ``C`` (p, p):
     what its parameters' uncertainty adds to its mean square error on those samples; a parameter that is not
-    identifiable (infinite variance) left out."""
+    identifiable (infinite variance) left out.
+
+    A covariance is positive semi-definite, but one of nearly collinear parameters (an offset and a ripple's
+    ``cos q`` on a joint that hardly moves) holds rounding of the size of its largest entries: its quadratic form
+    ``g C g^T`` can come out negative, and ``sqrt(mean(e_best^2) + variance)`` NaN (issue 63). The form is taken on
+    its eigenvalues clipped at zero, ``sum_i max(lambda_i, 0) (g v_i)^2``: never below zero."""
+    if not len(g):
+        return 0.0
     known = np.isfinite(np.diag(covariance))
     cov = np.where(np.outer(known, known), covariance, 0.0)
-    return float(np.mean(np.einsum("ij,jk,ik->i", g, cov, g))) if len(g) else 0.0
+    values, vectors = np.linalg.eigh(0.5 * (cov + cov.T))
+    return float(np.mean((np.asarray(g) @ vectors) ** 2 @ np.clip(values, 0.0, None)))
 
 
 def prediction_check(held_out: str, e_model: np.ndarray, e_best: np.ndarray, variance: float, rows: np.ndarray,
@@ -142,7 +158,12 @@ def prediction_check(held_out: str, e_model: np.ndarray, e_best: np.ndarray, var
     finite = np.isfinite(e_model) & np.isfinite(e_best)
     e_model, e_best, rows = e_model[finite], e_best[finite], rows[finite]
     gain, se = held_out_gain(e_model, e_best, rows)
+    if not finite.any():  # nothing to score: no excess, nothing allowed
+        return PredictionCheck(held_out, 0, 0.0, 0.0, 0.0, share, note, friction)
     rms = float(np.sqrt(np.mean(e_model**2)))
-    allowed = float(np.sqrt(np.mean(e_best**2) + variance))
-    z = (gain - variance) / se if se > 0 else (math.inf if gain > variance else 0.0)
+    allowed = float(np.sqrt(np.mean(e_best**2) + max(variance, 0.0)))
+    if not math.isfinite(gain):  # fewer than two samples: no excess measured
+        z = 0.0
+    else:
+        z = (gain - variance) / se if se > 0 else (math.inf if gain > variance else 0.0)
     return PredictionCheck(held_out, int(finite.sum()), rms, allowed, float(z), share, note, friction)

@@ -8,8 +8,16 @@ parameters, standard errors, and those that ``disagree``), the velocity noise th
 (``velocity_noise``), the samples left out where the joint may stick (``stick_speed``, ``n_stuck``) and, when
 the model was chosen by held-out error, how (``selection``). :func:`write_params` writes it (``wbfriction
 fit`` and the studies), :func:`read_params` reads it (``wbfriction report --params``). A standard error that
-is not finite (not identifiable) is written as ``null`` and read back as ``inf``. Files written before the
-model choice (no ``model`` key) hold model (3.5) and read back so.
+is not finite (not identifiable) is written as ``null`` and read back as ``inf``; no number that is not finite is
+written at all (``logs.tables.finite_json``: ``null``, its meaning the key's). Files written before the model
+choice (no ``model`` key) hold model (3.5) and read back so.
+
+What ``fit`` writes, its readers take (issue 63): :mod:`~wbfriction.fit.params_check` is what both sides hold to.
+The fit's bounds keep its own parameters within it, and the terms' refit holds every magnitude of the velocity model
+(F_v, F_c, F_cS, the Stribeck level F_s) at zero where the data would put it below
+(:data:`~wbfriction.fit.term_design.NONNEGATIVE`, named in ``terms.at_bound``), so a file is refused only where it
+is not ``fit``'s (hand-edited, damaged): at the writer, not by readers that would take a value ``fit`` should not
+have written. ``tests/fit/test_roundtrip.py`` fits many tables and reads every file back.
 """
 
 from __future__ import annotations
@@ -164,11 +172,11 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
         if d.get("route_check") is not None:
             rc = d["route_check"]
             res.route_check = RouteCheck(str(rc["route"]), None if rc.get("params") is None else
-                                         {str(k): float(v) for k, v in rc["params"].items()},
+                                         {str(k): _number(v) for k, v in rc["params"].items()},
                                          {str(k): _number(v) for k, v in (rc.get("stderr") or {}).items()},
                                          tuple(map(str, rc.get("disagree", ()))))
-        res.velocity_noise = float(d.get("velocity_noise", 0.0))
-        res.stick_speed = float(d.get("stick_speed", 0.0))
+        res.velocity_noise = float(d.get("velocity_noise") or 0.0)  # null (not measured): none taken
+        res.stick_speed = float(d.get("stick_speed") or 0.0)
         res.n_stuck = int(d.get("n_stuck", 0))
         if "pass_rows" in d:
             res.pass_rows = _number(d["pass_rows"])

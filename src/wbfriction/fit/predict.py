@@ -93,6 +93,22 @@ def _rms(x: np.ndarray, valid: np.ndarray) -> float:
     return float(np.sqrt(np.mean(x[valid] ** 2))) if valid.any() else float("nan")
 
 
+def predicted_friction(est: FrictionEstimate, joint: int, curve: FrictionCurve | TermFit,
+                       valid: np.ndarray) -> np.ndarray:
+    """What a friction model predicts of the estimate ``est.tau_f[:, joint]`` [N·m] (N,), the sign convention's
+    ``tau_f``: ``-f(qd)`` of a velocity model; a model with terms beyond velocity (:class:`TermFit`) on ``est``'s
+    angles, loads and temperatures, the ripple and the offset included (:meth:`TermFit.torque`); through the
+    estimate's smoother where it has one (the estimate is the friction seen through it), over the samples ``valid``
+    (N,) bool (NaN where the smoother has no value). What :func:`predict_torques` scores and the report draws."""
+    if isinstance(curve, TermFit):
+        model = curve.torque(est.qd[:, joint], term_signals(est, joint))
+    else:
+        model = -curve.f(est.qd[:, joint])
+    if est.smoother is not None:
+        model = est.smoother(np.where(valid, model, np.nan)[:, None])[:, 0]
+    return np.asarray(model, dtype=float)
+
+
 def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve | TermFit],
                     tau: np.ndarray | None = None, source: str = "the friction table") -> TorquePrediction:
     """Torque prediction errors of a model on the valid samples of an estimate made with its inertias.
@@ -128,11 +144,8 @@ def predict_torques(est: FrictionEstimate, friction: Mapping[str, FrictionCurve 
                 signals = term_signals(est, i)
                 curve.check_signals(signals, joint, source)
                 ranges[i] = curve.range_use(signals, valid, joint)
-                model = curve.torque(est.qd[:, i], signals)
-            else:
-                model = -curve.f(est.qd[:, i])
-            if est.smoother is not None:  # the estimate is the friction seen through the filter: so is the model
-                model = est.smoother(np.where(valid, model, np.nan)[:, None])[:, 0]
+            model = predicted_friction(est, i, curve, valid)
+            if est.smoother is not None:  # where the filter has no value
                 valid &= np.isfinite(model)
             rms[i] = _rms(est.tau_f[:, i] - model, valid)
         if tau is not None:

@@ -269,7 +269,11 @@ def projected_start(projection: Projection, speed: float, basins: int = BASINS) 
         r = projection.residual(grid[k])
         costs[k] = float(r @ r)
     costs = costs.reshape([len(x) for x in axes])
-    scale = 1.0 / max(math.sqrt(float(costs.min())), 1e-300)
+    # noise-free data the grid fits exactly (a friction of zero: issue 63) have a best cost of zero: the scale is
+    # held to 1e-12 of the worst grid point's residual (1 where every point is exact), or the search's residuals
+    # overflow to inf and NaN
+    worst = float(np.max(costs, where=np.isfinite(costs), initial=0.0))
+    scale = 1.0 / max(math.sqrt(float(costs.min())), 1e-12 * math.sqrt(worst) if worst > 0 else 1.0)
     best = min((least_squares(lambda t: scale * projection.residual(t), grid[k], bounds=projection.theta_bounds,
                               method="trf", diff_step=1e-7, ftol=1e-12, xtol=1e-10, gtol=1e-14, max_nfev=50)
                 for k in grid_minima(costs)[:basins]), key=lambda r: r.cost)

@@ -39,20 +39,22 @@ def parameter_covariance(jac: np.ndarray, residual: np.ndarray, rtol: float = 1e
         null space of ``J`` (not identifiable) are ``inf``.
     """
     n, p = jac.shape
-    _, sv, Vt = np.linalg.svd(jac, full_matrices=False)
+    U, sv, Vt = np.linalg.svd(jac, full_matrices=False)
     keep = sv > rtol * sv[0] if sv[0] > 0 else np.zeros_like(sv, dtype=bool)
     V = Vt.T
     null = V[:, ~keep]
     unidentifiable = (np.abs(null) > 1e-6).any(axis=1) if null.size else np.zeros(p, dtype=bool)
-    bread = (V[:, keep] / sv[keep] ** 2) @ V[:, keep].T  # (J^T J)^+
+    half = V[:, keep] / sv[keep]  # (J^T J)^+ = half half^T
     if max_lag <= 0:
-        cov = bread * (float(residual @ residual) / max(n - p, 1))
+        cov = half @ half.T * (float(residual @ residual) / max(n - p, 1))
     else:
+        # the sandwich in the SVD's coordinates, J = U S V^T: (J^T J)^+ J^T W J (J^T J)^+ = half (U^T W U) half^T.
+        # Formed as bread @ (J^T W J) @ bread, the meat's rounding times two breads of 1/s_min^2 made a covariance
+        # with negative eigenvalues of 1e9 where the offset and a ripple's cos q were nearly one column (issue 63)
         rows = np.arange(n) if rows is None else np.asarray(rows)
-        g = jac * residual[:, None] * np.sqrt(n / max(n - p, 1))
+        g = U[:, keep] * residual[:, None] * np.sqrt(n / max(n - p, 1))
         lagged = lagged_products(g, rows, max_lag)
-        meat = g.T @ g + lagged + lagged.T
-        cov = bread @ meat @ bread
+        cov = half @ (g.T @ g + lagged + lagged.T) @ half.T
     cov[unidentifiable, :] = np.inf
     cov[:, unidentifiable] = np.inf
     return cov

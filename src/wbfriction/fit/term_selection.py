@@ -286,12 +286,12 @@ class TermSearch:
             if term in kept:
                 rms_without = self.best_harmonics(tuple(t for t in kept if t != term))[0]
                 self.reasons[term] = (f"kept: held-out RMS {current:.4g} N·m with it, {rms_without:.4g} without "
-                                      f"(+{100 * (rms_without / current - 1):.2g} %)"
+                                      f"({_change(rms_without, current)})"
                                       + (f"; {harmonics} harmonics" if term == "ripple" else ""))
             else:
                 rms_with = self.best_harmonics((*kept, term))[0]
                 self.reasons[term] = (f"not kept: held-out RMS {current:.4g} N·m without it, {rms_with:.4g} with "
-                                      f"({100 * (rms_with / current - 1):+.2g} %; kept from -{100 * tol:g} %)")
+                                      f"({_change(rms_with, current)}; kept from -{100 * tol:g} %)")
 
     def final(self, kept: tuple[Term, ...], current: float, harmonics: int) -> TermFit:
         """The :class:`TermFit` of the terms ``kept`` (in :data:`TERMS` order): the temperature law chosen, every
@@ -324,6 +324,14 @@ class TermSearch:
             derived["ripple_rms"], stderr["ripple_rms"] = ripple_size(q_used, harmonics, names, coef, cov)
         return TermFit(refitted, kept, harmonics, coefficients, stderr, derived, t_ref, q_range, self.reasons,
                        (self.base_rms, current), at_bound=held, covariance=cov, later=later)
+
+
+def _change(rms: float, current: float) -> str:
+    """``rms`` against ``current`` [N·m] as a signed percentage; ``exact`` where the current held-out RMS is zero (a
+    noise-free table the velocity model fits exactly: a friction of zero, issue 63)."""
+    if current > 0:
+        return f"{100 * (rms / current - 1):+.2g} %"
+    return "both exact" if rms == 0 else "exact as it is"
 
 
 def refit_terms(fit: TermFit, params: ModelParams, qd: np.ndarray, tau_f: np.ndarray, use: np.ndarray,

@@ -375,14 +375,40 @@ def write_atomic(path: str | Path, write) -> None:
         raise
 
 
+def finite_json(doc: object) -> object:
+    """``doc`` with every number that is not finite (NaN, an infinity, NumPy's too) ``null``: no file the package
+    writes holds ``NaN`` or ``Infinity``, which JSON does not have and strict readers refuse (issue 63). What a
+    ``null`` means is its key's (docs/reference: a standard error that is not identifiable, a held-out RMS not
+    scored...). Mappings, lists and tuples are walked; NumPy scalars and arrays become plain numbers and lists."""
+    if isinstance(doc, dict):
+        return {k: finite_json(v) for k, v in doc.items()}
+    if isinstance(doc, (list, tuple)):
+        return [finite_json(v) for v in doc]
+    if isinstance(doc, np.ndarray):
+        return finite_json(doc.tolist())
+    if isinstance(doc, (bool, np.bool_)):
+        return bool(doc)
+    if isinstance(doc, (float, np.floating)):
+        return float(doc) if np.isfinite(doc) else None
+    if isinstance(doc, np.integer):
+        return int(doc)
+    return doc
+
+
+def json_text(doc: object, indent: int = 2, sort_keys: bool = False) -> str:
+    """The JSON text of ``doc`` as the package writes it (:func:`finite_json`: no ``NaN`` nor ``Infinity``)."""
+    return json.dumps(finite_json(doc), indent=indent, sort_keys=sort_keys, allow_nan=False)
+
+
 def write_json(path: str | Path, doc: object) -> None:
-    """Write a JSON document (indented by 2, keys in their order), whole or not at all.
+    """Write a JSON document (indented by 2, keys in their order), whole or not at all; a number that is not finite
+    is written ``null`` (:func:`finite_json`).
 
     Raises:
         InputError: an output folder that does not exist.
         OutputError: the system refused the write (:func:`write_atomic`).
     """
-    text = json.dumps(doc, indent=2)
+    text = json_text(doc)
     write_atomic(path, lambda tmp: tmp.write_text(text))
 
 

@@ -3,7 +3,6 @@ the robot's TOML for the model identified (:mod:`wbfriction.actuator`)."""
 
 from __future__ import annotations
 
-import json
 import re
 import tomllib
 from pathlib import Path
@@ -13,7 +12,7 @@ from wbfriction.actuator import ActuatorIdentification, ActuatorOptions, identif
 from wbfriction.exceptions import InputError
 from wbfriction.logs.options import ReadOptions, TimeUnit
 from wbfriction.logs.source import read_log
-from wbfriction.logs.tables import write_atomic
+from wbfriction.logs.tables import json_text, write_atomic
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.identify_step import identified_config
 from wbfriction.pipeline.paths import check_paths
@@ -37,7 +36,7 @@ def identify_actuator_file(robot: Robot, log: str | Path, json_output: str | Pat
     data = read_log(log, robot, read=ReadOptions(time_unit=time_unit))
     result = identify_actuators(robot, data, options)
     if json_output is not None:
-        text = json.dumps(result.to_dict(), indent=1, sort_keys=True) + "\n"
+        text = json_text(result.to_dict(), indent=1, sort_keys=True) + "\n"  # a value not finite: null
         write_atomic(Path(json_output), lambda tmp: tmp.write_text(text, encoding="utf-8"))
     return result
 

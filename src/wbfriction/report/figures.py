@@ -21,6 +21,7 @@ from matplotlib import rc_context, rcParams
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from wbfriction.fit.predict import predicted_friction
 from wbfriction.fit.result import FitResult
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.models import FrictionParams, ModelParams
@@ -200,7 +201,8 @@ def friction_curves_figure(est: FrictionEstimate, fits: list[FitResult], path: s
     target (when known), shared axes (:func:`friction_overview_figure`)."""
     fig = friction_overview_figure(est, [f.joint for f in fits], {f.joint: f for f in fits},
                                    {f.joint: f.target for f in fits if f.target is not None}, columns=columns,
-                                   title="Friction over velocity: valid estimates, fitted model (3.5), target")
+                                   title="Friction over velocity: valid estimates, each joint's fit as it "
+                                         "predicts them, target")
     _save(fig, path)
 
 
@@ -292,9 +294,25 @@ def _short(joint: str) -> str:
     return joint.replace("_joint", "")
 
 
+def model_label(fit: FitResult) -> str:
+    """A fit's model as its legend names it: the family, and the terms beyond velocity it kept (``stribeck +
+    ripple``)."""
+    terms = fit.kept_terms
+    return fit.model + ("" if terms is None else " + " + " + ".join(terms.kept))
+
+
+FIT_DRAWN = ("the fit as it predicts the samples: its curve over velocity; where it kept terms beyond velocity or "
+             "the estimate went through a filter, its prediction at each valid sample (dots)")
+"""How :func:`_cloud` draws a fit (the figures' captions say so)."""
+
+
 def _cloud(ax, est: FrictionEstimate, i: int, fit: FitResult | None, target: ModelParams | None) -> None:
-    """The valid estimates of joint ``i`` over its velocity, under the target (wide, grey) and over which the
-    fitted model runs dashed, so that neither hides the cloud."""
+    """The valid estimates of joint ``i`` over its velocity, under the target (wide, grey) and under the fitted
+    model as it predicts those samples (:data:`FIT_DRAWN`, :func:`~wbfriction.fit.predict.predicted_friction`): a
+    model of the velocity alone is a curve over the velocity, dashed, so that it hides no sample; with terms beyond
+    velocity (a ripple, a load, a temperature, which the velocity curve alone leaves out: issue 63) or through the
+    estimate's filter, it is no function of the velocity, and its prediction at each valid sample is drawn, a dot
+    per sample. The legend names its family and terms (:func:`model_label`)."""
     m = est.valid[:, i]
     ax.plot(est.qd[m, i], est.tau_f[m, i], ".", ms=1.5, color="C0", alpha=0.35, zorder=2, rasterized=True)
     if m.any():
@@ -302,15 +320,23 @@ def _cloud(ax, est: FrictionEstimate, i: int, fit: FitResult | None, target: Mod
         if target is not None:
             ax.plot(v, target.torque(v), color="k", lw=3, alpha=0.25, zorder=1, label="target")
         if fit is not None and fit.params is not None:
-            ax.plot(v, fit.params.torque(v), color="C1", lw=1.6, ls="--", zorder=3, label=f"fit ({fit.model})")
+            label, terms = f"fit ({model_label(fit)})", fit.kept_terms
+            if terms is None and est.smoother is None:
+                ax.plot(v, fit.params.torque(v), color="C1", lw=1.6, ls="--", zorder=3, label=label)
+            else:
+                model = predicted_friction(est, i, fit.params if terms is None else terms, m)
+                drawn = m & np.isfinite(model)
+                ax.plot(est.qd[drawn, i], model[drawn], ".", ms=1.0, color="C1", zorder=3, rasterized=True,
+                        label=label + ", at the samples")
     ax.axhline(0, color="k", lw=0.4, zorder=0)
     ax.axvline(0, color="k", lw=0.4, zorder=0)
 
 
 def friction_overview_figure(est: FrictionEstimate, joints: list[str], fits: dict[str, FitResult],
                              targets: Mapping[str, ModelParams], flagged: AbstractSet[str] = frozenset(),
-                             columns: int = 4, title: str = "Friction over velocity, valid samples (each joint on "
-                                                            "its own axes; red: generates power)",
+                             columns: int = 4, title: str = "Friction over velocity, valid samples, and each "
+                                                            "joint's fit as it predicts them (each joint on its own "
+                                                            "axes; red: generates power)",
                              labels: dict[str, str] | None = None) -> Figure:
     """Small multiples, each joint on its own axes (a knee's newton-metres do not squash an ankle's): per
     joint the valid estimates over velocity, the fitted model and the target; titles of joints flagged by
@@ -327,9 +353,14 @@ def friction_overview_figure(est: FrictionEstimate, joints: list[str], fits: dic
             ax.set_title(label, color="C3" if joint in flagged else "k")
         for ax in axes[len(joints):]:
             ax.set_visible(False)
+        for ax in axes[:len(joints)]:  # each joint's own model in its own legend
+            fitted = [(h, n) for h, n in zip(*ax.get_legend_handles_labels()) if n.startswith("fit (")]
+            if fitted:
+                ax.legend(*zip(*fitted), loc="best", frameon=False, markerscale=6)
         handles, names = axes[0].get_legend_handles_labels()
-        if handles:  # under the panels, where it hides no sample
-            fig.legend(handles, names, loc="outside lower right", ncols=len(handles))
+        shared = [(h, n) for h, n in zip(handles, names) if not n.startswith("fit (")]
+        if shared:  # under the panels, where it hides no sample
+            fig.legend(*zip(*shared), loc="outside lower right", ncols=len(shared))
         fig.supxlabel("qd [rad/s]")
         fig.supylabel("tau_f [N·m]")
         fig.suptitle(title)

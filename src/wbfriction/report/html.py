@@ -24,7 +24,7 @@ from wbfriction.friction.point_contacts import determined_shares
 from wbfriction.inertia.document import Identification
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
-from wbfriction.report.figures import friction_overview_figure, joint_figure, png_bytes
+from wbfriction.report.figures import FIT_DRAWN, friction_overview_figure, joint_figure, png_bytes
 from wbfriction.report.numbers import bound_text, duration_text, with_error
 from wbfriction.report.terms import terms_section
 from wbfriction.workers import process_pool
@@ -441,6 +441,7 @@ def _page(r: Report, overview: str, sections: list[str]) -> str:
 share of the valid samples where the friction estimate generates power (eq. 7.9).</p>
 {_summary_table(r)}
 <h2 id="overview-section">Friction over velocity</h2>
+<p class="sub">Each joint's valid samples and {html.escape(FIT_DRAWN)}; its legend names the fit's model.</p>
 {overview}
 <h2 id="parameters-section">Identified parameters (3.5), value ± standard error</h2>
 <p class="sub">Units: F_v N·m·s/rad, F_c and τ_os N·m, v_s rad/s, a s/rad. n.i.: not identifiable from these data.</p>
