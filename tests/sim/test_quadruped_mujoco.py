@@ -183,3 +183,31 @@ def test_the_sensors_noise(robot, pd_trot):
     np.testing.assert_allclose(err.std(axis=0), [noise.gyro_std] * 3 + [noise.acc_std] * 3, rtol=0.1)
     assert np.isnan(log.foot_force[..., :2]).all()
     assert abs((log.foot_force[..., 2] - pd_trot.force[..., 2]).std() / noise.force_std - 1) < 0.1
+
+
+def test_the_held_torque_is_a_real_robots_zero_order_hold(robot, mjr):
+    """Four physics steps per period (the default, 500 Hz): the command ``tau[k]`` acts over ``[t_k, t_k+1)`` as on a
+    real robot (the period's first step takes the trapezoid's half step), and the sample's truth is the command's:
+    the logged torques, friction and 3-D forces balance the logged state and acceleration to 1e-7. Central
+    differences then see the torque as ``zoh`` does: on a 3 s trot without foot forces (each hip seen as its leg
+    swings; with 3-D forces the sphere feet's moment is a model error of its own) every hip's fitted F_v within 5 %
+    of the injected one (2.6 % at worst; MuJoCo's semi-implicit Euler applied the command half a physics step early:
+    1.3-18 % high, issue 63)."""
+    from wbfriction.fit.joints import fit_estimate
+    from wbfriction.fit.options import FitOptions
+    from wbfriction.friction.estimate import estimate_log
+    from wbfriction.friction.options import EstimateOptions
+    from wbfriction.sim.quadruped import default_quadruped_friction
+    from wbfriction.studies.quadruped import QuadrupedCase, case_robot
+
+    reference = quadruped_reference(robot, GaitOptions("trot", duration=3.0))
+    run = simulate_quadruped_mujoco(robot, reference, QuadrupedOptions(foot_forces="3d"), mjr=mjr)
+    run_none = simulate_quadruped_mujoco(robot, reference, QuadrupedOptions(), mjr=mjr)
+    assert run.log.metadata["torque_alignment"] == "zoh" and run.log.metadata["physics_step"] == 0.0005
+    np.testing.assert_allclose(balance(robot, run, at_contact_point=True), 0.0, atol=1e-7)
+    est = estimate_log(case_robot(robot, QuadrupedCase(simulator="mujoco")), run_none.log,
+                       EstimateOptions(diff="central", route="acceleration", base_motion="logged", check_route=False))
+    fits = {f.joint: f for f in fit_estimate(est, FitOptions(model="thesis"), fixed={"S": 0.0, "v_s": 0.1})}
+    truth = default_quadruped_friction(robot)
+    errors = {j: fits[j].params.F_v / truth[j].F_v - 1 for j in robot.actuated if "hip" in j}
+    assert max(abs(e) for e in errors.values()) < 0.05, errors

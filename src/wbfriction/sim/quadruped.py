@@ -28,7 +28,13 @@ knows its robot's friction model; ``compensate``). Two drives:
   the controller's torque, ``q_des``, ``qd_des`` its joint set-points: the reference's on a stance leg, on a swing
   leg those that put the foot on its reference from where the base is,
   :meth:`~wbfriction.sim.quadruped_control.BalanceController.leg_setpoints`; the log's ``tau``: the joint torque
-  sensors sit before the friction: the command);
+  sensors sit before the friction: the command). With more than one physics step per period, the first step of
+  each period (the switch at ``t_k``) takes the mean of the previous and the new command (the trapezoid rule), so
+  that the command acts over ``[t_k, t_k+1)`` as a real robot's zero-order hold (the log's ``torque_alignment =
+  "zoh"``, exact to O(h^2)): semi-implicit Euler kicks the velocity at a step's start, and a command applied from the
+  period's first step to its last acted over ``[t_k - h/2, t_k+1 - h/2)`` as the positions see it, half a physics
+  step early, which put the hips' F_v 3-17 % high on noise-free logs once differentiated (issue 63: an error of
+  about ``M omega^2 h / 2`` in F_v). The sample's truth (acceleration, forces) is that of the command itself;
 * ``pd``: the robot's motor drivers (``[pd]``, :mod:`wbfriction.model.pd`) are sent the controller's ``q_des`` (in
   the encoder's coordinates), ``qd_des`` and ``tau_ff`` (its torque, their PD on top) at the samples; at every
   physics step they apply the PD law on the encoder's angle and the velocity, clipped at their limits, with each
@@ -258,6 +264,7 @@ class _Run:
         q_full, v_full, _ = reference.full(robot)
         self.q, self.v = q_full[0].copy(), v_full[0].copy()
         self.driver: PdDriver | None = None
+        self.held: np.ndarray | None = None  # the torque drive's command of the sample
         if options.drive == "pd":
             self._setup_drivers()
 
@@ -319,7 +326,9 @@ class _Run:
             q_des, qd_des = self.controller.setpoints
             if self.driver is None:
                 o = self.options
-                self.held = tau + o.kp * (q_des - q[self.iq]) + o.kd * (qd_des - v[self.iv])
+                previous, self.held = self.held, tau + o.kp * (q_des - q[self.iq]) + o.kd * (qd_des - v[self.iv])
+                if previous is not None and self.substeps > 1:  # the switch at t_k: the trapezoid's half step
+                    return 0.5 * (previous + self.held)
             else:  # the drivers' set-points and feed-forward, their PD on top (as the torque drive's)
                 self.commands[0][k], self.commands[1][k], self.commands[2][k] = q_des + self.offset, qd_des, tau
                 self.step_commands = self.applied_setpoints(k)
@@ -348,23 +357,26 @@ class _Run:
                 tau[self.iv_f] += tau_f
                 a = pin.constraintDynamics(model, data, q, v, tau, self.cmodels, self.cdatas, settings)
                 if s == 0:
-                    self.record(k, q, v, a, tau_m, tau_f)
+                    self.record(k, q, v, a, self.held if self.driver is None else tau_m, tau_m, tau_f)
                 v = v + h * a
                 q = pin.integrate(model, q, h * v)
             if not np.isfinite(v).all():
                 raise SimulationError(f"the quadruped's simulation diverged at sample {k}")
             self.q, self.v = q, v
 
-    def record(self, k: int, q: np.ndarray, v: np.ndarray, a: np.ndarray, tau_m: np.ndarray,
+    def record(self, k: int, q: np.ndarray, v: np.ndarray, a: np.ndarray, tau_m: np.ndarray, applied: np.ndarray,
                tau_f: np.ndarray) -> None:
-        """Log sample ``k``: the state, the true acceleration and forces (the Baumgarte term taken off both: one
-        more solve with the KKT factorisation of the step), the torques."""
+        """Log sample ``k``: the state, the true acceleration and forces under the motor torque ``tau_m`` of the
+        sample (the Baumgarte term and the switch's half step, ``applied - tau_m``, taken off both: one more solve
+        with the KKT factorisation of the step), the torques."""
         n_lam, data = self.n_lam, self.data
         lam = data.lambda_c.copy()
         a = a.copy()
+        rhs = np.zeros(n_lam + self.model.nv)
         if n_lam:
-            rhs = np.zeros(n_lam + self.model.nv)
             rhs[:n_lam] = -np.concatenate([cd.contact_acceleration_error.linear for cd in self.cdatas])
+        rhs[n_lam + self.iv] = tau_m - applied
+        if rhs.any():
             X = data.constraint_chol.solve(rhs)
             a += X[n_lam:]
             lam -= X[:n_lam]

@@ -11,6 +11,11 @@ stance feet standing, PD tasks on the base, the swing feet and the joints; ``opt
 ``options.compensate``, the friction of the reference's velocities. **Torque-driven**: ``tau = clip(tau_c + kp
 (q_ref - q_enc) + kd (qd_ref - qd_drv))`` (``options.kp``, ``kd``; clipped at the URDF's effort limits), held over
 the period; the log's ``tau`` is that command (the joint torque sensor sits before the friction), plus its noise.
+With more than one physics step per period, the first step (the switch at ``t_k``) takes the mean of the previous
+and the new command, so that the command acts over ``[t_k, t_k+1)`` as a real robot's zero-order hold
+(``torque_alignment = "zoh"``; MuJoCo's semi-implicit Euler otherwise applies it half a physics step early as the
+positions see it: the ideal simulator's module docstring, issue 63), and the sample is recorded (``mj_forward``)
+under the command itself.
 **PD-driven**: the drivers (:mod:`wbfriction.sim.pd_robot`'s law; gains, delay and limits from the robot's
 ``[pd]``) are sent ``q_des = q_ref`` (encoder's coordinates), ``qd_des = qd_ref`` and ``tau_ff`` = the controller's
 torque, their PD on top (as a Unitree low-level command; the ideal simulator's drivers instead get the ``tau_ff``
@@ -275,6 +280,9 @@ class _Sim:
             d = self.driver
             tau_ff[k] = tau
             q_des, qd_des, ff = self.setpoints(k)
+        # torque-driven, physics steps within the period: the switch at t_k takes the trapezoid's half step (module
+        # docstring), the sample is recorded under the command
+        half = 0.5 * (self.tau[k - 1] + tau) if self.driver is None and k and self.substeps > 1 else None
         for j in range(self.substeps):
             if self.driver is not None:
                 if j:
@@ -286,8 +294,12 @@ class _Sim:
             data.qfrc_applied[self.dof_f] = tau_f
             if j == 0:
                 qpos, qvel = data.qpos.copy(), data.qvel.copy()
+                if half is not None:
+                    mujoco.mj_forward(model, data)
+                    self.record(k, qpos, qvel, q_enc, qd_drv, tau, tau_f)
+                    data.ctrl[:] = half
             mujoco.mj_step(model, data)
-            if j == 0:
+            if j == 0 and half is None:
                 self.record(k, qpos, qvel, q_enc, qd_drv, tau, tau_f)
 
     def record(self, k: int, qpos: np.ndarray, qvel: np.ndarray, q_enc: np.ndarray, qd_drv: np.ndarray,
