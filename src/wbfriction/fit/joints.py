@@ -279,6 +279,9 @@ def _joint_terms(est: FrictionEstimate, i: int, fit: FitResult, other: FitResult
                       stick_margin(est), fit.pass_rows)[0]
     terms = fit_terms(fit.params, est.qd[:, i], est.tau_f[:, i], use, signals, options.terms, est.smoother)
     terms = replace(terms, ranges=FittedRanges.of(use, signals.q, signals.tau_load, signals.temperature))
+    if terms.kept and fit.crb:  # adding terms can only raise the velocity coefficients' bound (issue 63)
+        terms = replace(terms, stderr={n: max(se, fit.crb[n]) if np.isfinite(fit.crb.get(n, np.nan)) else se
+                                       for n, se in terms.stderr.items()})
     check = est.route_check
     if check is not None and other is not None and other.params is not None and terms.kept:
         rows = fitted_rows(check.qd[:, i], check.tau_f[:, i], check.valid[:, i], check.smoother, other.stick_speed,
