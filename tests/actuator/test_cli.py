@@ -3,7 +3,6 @@ identified, the TOML written, the friction estimated with it; bad input refused 
 
 from __future__ import annotations
 
-import json
 import re
 import tomllib
 

@@ -61,7 +61,7 @@ def test_every_knob_sets_its_option_and_lists_todays_default():
                "selection_tolerance": FitOptions().selection_tolerance, "pass_rows": FitOptions().pass_rows,
                "terms": "auto" if FitOptions().terms == TermOptions() else "none",
                "term_min_torque": FitOptions().terms.min_torque, "score_slow": FitOptions().score_slow,
-               "term_tolerance": FitOptions().terms.tolerance,
+               "term_tolerance": FitOptions().terms.tolerance, "stick_floor": FitOptions().stick_floor,
                "weak": DEFAULT_THRESHOLDS.weak, "holdout_excess": DEFAULT_THRESHOLDS.holdout_excess,
                "holdout_friction": DEFAULT_THRESHOLDS.holdout_friction,
                "route_rel": DEFAULT_THRESHOLDS.route_rel}

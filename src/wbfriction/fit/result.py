@@ -45,7 +45,7 @@ class HeldOutScore:
     held_out_rms: float
     at_bound: tuple[str, ...] = ()
     unresolved: tuple[str, ...] = ()
-    later_rms: float = float("nan")
+    later_rms: float | None = None
 
 
 @dataclass(frozen=True)

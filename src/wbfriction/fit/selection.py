@@ -279,22 +279,21 @@ def confirm_later(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ..
     for m in names[:names.index(chosen) + 1]:
         early = fit_model(m, qd, y, use & before, fixed=held[m], **kwargs)
         if early.params is not None:
-            r = held_out_residuals(early.params, qd, -y, later_scored, kwargs.get("smoother"),
-                                   kwargs.get("sigma", 0.0))
-            rms[m] = float(np.sqrt(np.mean(r**2)))
-    scores = tuple(replace(s, later_rms=rms.get(s.model, float("nan"))) for s in scores)
-    finite = [s for s in scores if s.model in rms and np.isfinite(s.later_rms)]
+            res = held_out_residuals(early.params, qd, -y, later_scored, kwargs.get("smoother"),
+                                     kwargs.get("sigma", 0.0))
+            rms[m] = float(np.sqrt(np.mean(res**2)))
+    scores = tuple(replace(s, later_rms=rms.get(s.model)) for s in scores)
+    finite = [(m, v) for m, v in rms.items() if np.isfinite(v)]
     if not finite:
         return chosen, reason, scores
-    best = min(s.later_rms for s in finite)
-    confirmed = next(s for s in finite if s.later_rms <= (1.0 + tolerance) * best)
-    if confirmed.model == chosen:
+    best = min(v for _, v in finite)
+    confirmed = next(m for m, v in finite if v <= (1.0 + tolerance) * best)
+    if confirmed == chosen:
         return chosen, reason + "; confirmed on the log's later stretch", scores
-    text = ", ".join(f"{s.model} {s.later_rms:.4g}" for s in finite)
-    return confirmed.model, (f"{confirmed.model}: {chosen} was best on the interleaved held-out blocks but not "
-                             f"confirmed on the log's later stretch, where {confirmed.model} is within "
-                             f"{100 * tolerance:g} % of the best (later-stretch RMS [N·m]: {text}); first choice: "
-                             f"{reason}"), scores
+    text = ", ".join(f"{m} {v:.4g}" for m, v in finite)
+    return confirmed, (f"{confirmed}: {chosen} was best on the interleaved held-out blocks but not confirmed on the "
+                       f"log's later stretch, where {confirmed} is within {100 * tolerance:g} % of the best "
+                       f"(later-stretch RMS [N·m]: {text}); first choice: {reason}"), scores
 
 
 def prefer_interior(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ...],

@@ -333,6 +333,7 @@ class _Run:
                 self.commands[0][k], self.commands[1][k], self.commands[2][k] = q_des + self.offset, qd_des, tau
                 self.step_commands = self.applied_setpoints(k)
         if self.driver is None:
+            assert self.held is not None  # set at every sample's first step
             return self.held
         d = self.driver
         q_des, qd_des, tau_ff = (x[s] for x in self.step_commands)
@@ -357,7 +358,8 @@ class _Run:
                 tau[self.iv_f] += tau_f
                 a = pin.constraintDynamics(model, data, q, v, tau, self.cmodels, self.cdatas, settings)
                 if s == 0:
-                    self.record(k, q, v, a, self.held if self.driver is None else tau_m, tau_m, tau_f)
+                    commanded = self.held if self.driver is None and self.held is not None else tau_m
+                    self.record(k, q, v, a, commanded, tau_m, tau_f)
                 v = v + h * a
                 q = pin.integrate(model, q, h * v)
             if not np.isfinite(v).all():
