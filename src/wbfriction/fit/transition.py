@@ -10,11 +10,11 @@ its parameter's standard error at most :data:`TRANSITION_REL` of its value, and 
 :data:`TRANSITION_SAMPLES` of the samples fitted (and :data:`TRANSITION_SHARE` of them) lie below its speed and as
 many between its speed and three times it (a parameter's standard error assumes the model: a curve placed where no
 sample is may look determined by its smooth shape alone); speeds below three standard deviations of the velocity's
-noise (:func:`creep_floor`) count as neither. The samples fitted hold no creep: a joint slower than
-:data:`~wbfriction.fit.options.STICK_FLOOR` for longer than a pass through zero takes is left out as one that may stick
-(:func:`~wbfriction.fit.solve.stuck_rows`), so what lies below a transition are passes through it. A family with a
-transition its data do not resolve is not a candidate of the automatic choice (:mod:`~wbfriction.fit.selection`):
-creep below a transition is not evidence for it.
+noise (:func:`creep_floor`) count as neither. A joint slower than the stick floor
+(:data:`~wbfriction.fit.options.STICK_FLOOR`, ``fit --stick-floor``) for longer than a pass through zero takes is left
+out as one that may stick (:func:`~wbfriction.fit.solve.stuck_rows`): with the floor above a stance leg's creep, what
+lies below a transition are passes through it. A family with a transition its data do not resolve is not a candidate
+of the automatic choice (:mod:`~wbfriction.fit.selection`).
 """
 
 from __future__ import annotations

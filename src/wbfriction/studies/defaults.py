@@ -105,7 +105,7 @@ KNOBS: tuple[Knob, ...] = (
          lambda s, v: replace(s, fit=replace(s.fit, selection_tolerance=v))),
     Knob("pass_rows", "fit", (0.0, 2.0, 5.0, math.inf), math.inf,
          lambda s, v: replace(s, fit=replace(s.fit, pass_rows=v))),
-    Knob("stick_floor", "fit", (0.003, 0.01, 0.02, 0.05), 0.02,
+    Knob("stick_floor", "fit", (0.003, 0.01, 0.02, 0.05), 0.003,
          lambda s, v: replace(s, fit=replace(s.fit, stick_floor=v))),
     Knob("score_slow", "fit", (False, True), True, lambda s, v: replace(s, fit=replace(s.fit, score_slow=v))),
     Knob("terms", "fit", ("none", "auto"), "auto",
