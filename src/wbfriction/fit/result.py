@@ -37,15 +37,12 @@ class HeldOutScore:
         at_bound: the parameters that fit left at a bound.
         unresolved: the transitions the training samples do not resolve (:func:`~wbfriction.fit.transition.unresolved`):
             a model with one is no candidate.
-        later_rms: RMS [N·m] of the model fitted on the samples before the log's later stretch, over that stretch
-            (the second held-out set the choice is confirmed on; NaN: not needed or not scored).
     """
 
     model: ModelName
     held_out_rms: float
     at_bound: tuple[str, ...] = ()
     unresolved: tuple[str, ...] = ()
-    later_rms: float | None = None
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,6 @@ model is fitted. A model with a parameter at a bound gives way to the best simpl
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -239,14 +238,11 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
                  if r.params is not None}
     scores = tuple(HeldOutScore(m, float(np.sqrt(np.mean(residuals[m] ** 2))) if m in residuals else float("nan"),
                                 r.bounded(),
-                                () if r.params is None else unresolved(r.params, qd[train], sigma, r.stderr))
+                                () if r.params is None else unresolved(r.params, qd[train], sigma))
                    for m, r in trained.items())
     eligible = tuple(s for s in scores if not s.unresolved) or scores
     chosen, reason = choose_model(eligible, tolerance)
     chosen, reason = prefer_interior(chosen, reason, eligible, residuals, np.flatnonzero(scored))
-    slow = use | stuck if stuck is not None else use
-    chosen, reason, scores = confirm_later(chosen, reason, scores, eligible, qd, y, slow, use,
-                                           held=held, tolerance=tolerance, **kwargs)
     left = [f"{s.model} ({'; '.join(s.unresolved)})" for s in scores if s.unresolved]
     if left:
         reason += "; not candidates, transitions the data do not resolve: " + ", ".join(left)
@@ -255,45 +251,6 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
         reason += f"; at a bound: {', '.join(res.bounded())}"
     res.selection = ModelSelection(chosen, reason, scores, tolerance, n_train, n_held_out)
     return res
-
-
-def confirm_later(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ...],
-                  eligible: tuple[HeldOutScore, ...], qd: np.ndarray, y: np.ndarray, scored: np.ndarray,
-                  use: np.ndarray, *, held: Mapping[ModelName, dict[str, float]], tolerance: float,
-                  **kwargs: Any) -> tuple[ModelName, str, tuple[HeldOutScore, ...]]:
-    """A model chosen over the simplest candidate on the interleaved held-out blocks confirmed on data that differ
-    (issue 63): every candidate up to it, fitted on the samples ``use`` before the log's later stretch
-    (:func:`~wbfriction.fit.holdout.split_later`, the last :data:`~wbfriction.fit.holdout.LATER`), is scored on
-    that stretch (``scored``: the samples scored, the slow ones too), and the simplest within ``tolerance`` of the
-    best there is chosen if it is simpler: a richer model must predict both the interleaved blocks and the later
-    stretch better than the simpler ones. Returns the model, its reason and the scores with their ``later_rms``.
-    Too few samples on either side (:data:`~wbfriction.fit.holdout.MIN_HELD_OUT`): the choice as it is."""
-    names = [s.model for s in eligible]
-    if chosen == names[0]:
-        return chosen, reason, scores
-    before, later = split_later(use, LATER)
-    later_scored = scored & ~before & np.isfinite(qd) & np.isfinite(y)
-    if int((use & before).sum()) < MIN_HELD_OUT or int(later_scored.sum()) < MIN_HELD_OUT:
-        return chosen, reason, scores
-    rms: dict[ModelName, float] = {}
-    for m in names[:names.index(chosen) + 1]:
-        early = fit_model(m, qd, y, use & before, fixed=held[m], **kwargs)
-        if early.params is not None:
-            res = held_out_residuals(early.params, qd, -y, later_scored, kwargs.get("smoother"),
-                                     kwargs.get("sigma", 0.0))
-            rms[m] = float(np.sqrt(np.mean(res**2)))
-    scores = tuple(replace(s, later_rms=rms.get(s.model)) for s in scores)
-    finite = [(m, v) for m, v in rms.items() if np.isfinite(v)]
-    if not finite:
-        return chosen, reason, scores
-    best = min(v for _, v in finite)
-    confirmed = next(m for m, v in finite if v <= (1.0 + tolerance) * best)
-    if confirmed == chosen:
-        return chosen, reason + "; confirmed on the log's later stretch", scores
-    text = ", ".join(f"{m} {v:.4g}" for m, v in finite)
-    return confirmed, (f"{confirmed}: {chosen} was best on the interleaved held-out blocks but not confirmed on the "
-                       f"log's later stretch, where {confirmed} is within {100 * tolerance:g} % of the best "
-                       f"(later-stretch RMS [N·m]: {text}); first choice: {reason}"), scores
 
 
 def prefer_interior(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ...],
