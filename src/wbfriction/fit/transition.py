@@ -29,11 +29,10 @@ from wbfriction.friction.models import ModelParamsBase
 
 TRANSITION_SAMPLES = 5
 """The fewest samples below a transition's speed that resolve it: a guard against a curve placed
-where no sample is, the standard error deciding otherwise (:data:`TRANSITION_REL`). A walking humanoid's joint at
-1 kHz passes through a tanh transition at 0.025 rad/s with 6-16 samples below it in its training blocks (the
+where no sample is. A walking humanoid's joint at 1 kHz passes through a tanh transition at 0.025 rad/s with 6-16 samples below it in its training blocks (the
 README's tour), and (3.5) predicts its held-out blocks 10-20 times better than a step there."""
 TRANSITION_SHARE = 0.001
-"""... and the smallest share of the samples fitted, in each."""
+"""... and the smallest share of the samples fitted."""
 NOISE_SIGMAS = 3.0
 """Speeds below this many standard deviations of the velocity's noise are noise, not a transition's evidence."""
 
