@@ -32,31 +32,6 @@ TRANSITION_SAMPLES = 5
 A walking humanoid's joint at 1 kHz passes through a tanh transition at 0.025 rad/s with 6-16 samples below it in
 its training blocks (the README's tour), and (3.5) predicts its held-out blocks 10-20 times better than a step
 there."""
-TRANSITION_SHARE` of them) lie below its speed, above
-three standard deviations of the velocity's noise (:func:`creep_floor`): a curve placed where no sample is, or only
-noise, is no finding. The samples between its speed and three times it are counted and reported, not required: a
-transition at the top of the data's speeds (a Stribeck velocity at its bound, its curve decaying over the whole
-range) is left to the rule on parameters at a bound (:func:`~wbfriction.fit.selection.prefer_interior`), and on the
-real Aliengo's calves such curves predict the held-out torque better than a step. Nor is the parameter's standard
-error required to be small: a shape parameter correlated with the magnitudes (``a`` with F_c) can be poorly
-determined while the curve it draws predicts held-out data better (the Aliengo's calves, the KUKA's repeat runs).
-A joint slower than the stick floor (:data:`~wbfriction.fit.options.STICK_FLOOR`, ``fit --stick-floor``) for longer
-than a pass through zero takes is left out as one that may stick (:func:`~wbfriction.fit.solve.stuck_rows`): with the
-floor above a stance leg's creep, what lies below a transition are passes through it. A family with a transition its
-data do not resolve is not a candidate of the automatic choice (:mod:`~wbfriction.fit.selection`).
-"""
-
-from __future__ import annotations
-
-import numpy as np
-
-from wbfriction.friction.families.registry import family
-from wbfriction.friction.models import ModelParamsBase
-
-TRANSITION_SAMPLES = 5
-"""The fewest samples below a transition's speed that resolve it: a guard against a curve placed
-where no sample is. A walking humanoid's joint at 1 kHz passes through a tanh transition at 0.025 rad/s with 6-16 samples below it in its training blocks (the
-README's tour), and (3.5) predicts its held-out blocks 10-20 times better than a step there."""
 TRANSITION_SHARE = 0.001
 """... and the smallest share of the samples fitted."""
 NOISE_SIGMAS = 3.0
