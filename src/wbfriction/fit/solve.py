@@ -318,7 +318,7 @@ def fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, 
             res.crb = dict(zip(names, map(float, bound)))
             # no standard error below what any unbiased estimator reaches (issue 63)
             res.covariance = at_least_bound(cov, bound)
-            res.stderr = dict(zip(names, map(float, covariance_errors(res.covariance))))
+            res.stderr = dict(zip(names, map(float, np.maximum(covariance_errors(res.covariance), bound))))
     return res
 
 
