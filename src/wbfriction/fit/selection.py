@@ -240,8 +240,12 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
                                 r.bounded(),
                                 () if r.params is None else unresolved(r.params, qd[train], sigma))
                    for m, r in trained.items())
+    # the choice among every candidate, an unresolved one included (how well the data can be fitted); where that
+    # choice's transition is not resolved, the choice among those resolved
     eligible = tuple(s for s in scores if not s.unresolved) or scores
-    chosen, reason = choose_model(eligible, tolerance)
+    chosen, reason = choose_model(scores, tolerance)
+    if chosen not in {s.model for s in eligible}:
+        chosen, reason = choose_model(eligible, tolerance)
     chosen, reason = prefer_interior(chosen, reason, eligible, residuals, np.flatnonzero(scored))
     left = [f"{s.model} ({'; '.join(s.unresolved)})" for s in scores if s.unresolved]
     if left:

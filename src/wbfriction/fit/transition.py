@@ -17,7 +17,10 @@ determined while the curve it draws predicts held-out data better (the Aliengo's
 A joint slower than the stick floor (:data:`~wbfriction.fit.options.STICK_FLOOR`, ``fit --stick-floor``) for longer
 than a pass through zero takes is left out as one that may stick (:func:`~wbfriction.fit.solve.stuck_rows`): with the
 floor above a stance leg's creep, what lies below a transition are passes through it. A family with a transition its
-data do not resolve is not a candidate of the automatic choice (:mod:`~wbfriction.fit.selection`).
+data do not resolve is not chosen by the automatic choice (:mod:`~wbfriction.fit.selection`): the simplest model
+within the tolerance of the best is chosen as before, the best among every candidate; only where that is one whose
+transition is unresolved is the choice made again among the others (excluding it from the reference too moved the
+UR10e's wrist 1 from Coulomb-viscous, 4.8 % off the published curve, to a Stribeck curve 5.8 % off).
 """
 
 from __future__ import annotations
