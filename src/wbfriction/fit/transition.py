@@ -19,8 +19,8 @@ than a pass through zero takes is left out as one that may stick (:func:`~wbfric
 floor above a stance leg's creep, what lies below a transition are passes through it. A family with a transition its
 data do not resolve is not chosen by the automatic choice (:mod:`~wbfriction.fit.selection`): the simplest model
 within the tolerance of the best is chosen as before, the best among every candidate; only where that is one whose
-transition is unresolved is the choice made again among the others (excluding it from the reference too moved the
-UR10e's wrist 1 from Coulomb-viscous, 4.8 % off the published curve, to a Stribeck curve 5.8 % off).
+transition is unresolved is the choice made again among the others (an unresolved model still says how well the
+data can be fitted).
 """
 
 from __future__ import annotations
