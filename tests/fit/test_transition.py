@@ -68,15 +68,19 @@ def test_a_resolved_stribeck_curve_is_still_chosen():
 
 def test_transition_counts_and_floor():
     qd = np.concatenate([np.full(30, 0.006), np.full(25, 0.03), np.full(40, -0.05), np.full(7, 0.2)])
-    assert transition_counts(0.04, qd, 0.02) == (25, 40)  # below: [0.02, 0.04), beyond [0.04, 0.12)
-    assert transition_counts(0.04, qd, 0.0) == (55, 40)
-    assert transition_counts(0.01, qd, 0.02) == (0, 0)  # in the noise: nothing counts
+    assert transition_counts(0.04, qd, 0.02) == (25, 7)  # below: [0.02, 0.04), settled: from 0.08
+    assert transition_counts(0.04, qd, 0.0) == (55, 7)
+    assert transition_counts(0.02, qd, 0.0) == (30, 47)  # settled from 0.04
+    assert transition_counts(0.01, qd, 0.02) == (0, 72)  # in the noise: nothing below counts
     assert creep_floor(0.0) == 0.0 and creep_floor(0.01) == 0.03
     creeping = StribeckParams(F_v=0.3, F_c=0.6, F_s=1.0, v_s=0.01, tau_os=0.0)
     assert unresolved(creeping, qd, 0.007)[0].startswith("v_s 0.01 rad/s (0 samples below")
     assert unresolved(creeping, qd[30:])[0].startswith("v_s 0.01 rad/s (0 samples below")
     resolved = StribeckParams(F_v=0.3, F_c=0.6, F_s=1.0, v_s=0.04, tau_os=0.0)
     assert unresolved(resolved, qd) == ()
+    # a Stribeck curve decaying over the whole range of speeds (up to 0.2 rad/s): nothing where it has settled
+    decaying = StribeckParams(F_v=0.3, F_c=0.0, F_s=1.0, v_s=0.15, tau_os=0.0)
+    assert unresolved(decaying, qd) == ("v_s 0.15 rad/s (95 samples below, 0 beyond 2 times it)",)
     # no Stribeck effect (F_s = F_c) or a tanh at its step: no transition to resolve
     assert unresolved(StribeckParams(F_v=0.3, F_c=0.6, F_s=0.6, v_s=0.01, tau_os=0.0), qd) == ()
     assert unresolved(FrictionParams(F_v=0.3, F_c=0.6, S=0.0, v_s=0.1, tau_os=0.0, a=1e4), qd) == ()

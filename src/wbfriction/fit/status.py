@@ -194,7 +194,7 @@ def fit_verdict(fit: Fit, thresholds: StatusThresholds = DEFAULT_THRESHOLDS) -> 
     if terms is not None:
         return _with_terms(fit, terms, thresholds)
     values = fit.params.to_dict()
-    bounded = [n for n in fit.bounded() if not (n in ZERO_FLOOR and abs(values[n]) < ZERO) and n not in fit.steps()]
+    bounded = search_bounds(fit)
     if bounded:
         return FitVerdict("at bound", "at a bound of the fit: " + ", ".join(bounded))
     check = fit.route_check
@@ -206,6 +206,16 @@ def fit_verdict(fit: Fit, thresholds: StatusThresholds = DEFAULT_THRESHOLDS) -> 
         return FitVerdict("does not predict", fit.later.describe())
     weak = _weak(fit, values, thresholds.weak)
     return _weak_verdict(fit, weak)
+
+
+def search_bounds(fit: Fit) -> list[str]:
+    """The parameters of ``fit`` (with parameters) left on a bound of the fit's search: its
+    :meth:`~wbfriction.fit.result.FitResult.bounded` less a magnitude at its floor of zero (:data:`ZERO_FLOOR`: no
+    such friction found, a result) and a slope at its step bound (:meth:`~wbfriction.fit.result.FitResult.steps`:
+    Coulomb friction). What makes a fit ``at bound``, and what the automatic choice weighs
+    (:func:`~wbfriction.fit.selection.prefer_interior`)."""
+    values = fit.params.to_dict()
+    return [n for n in fit.bounded() if not (n in ZERO_FLOOR and abs(values[n]) < ZERO) and n not in fit.steps()]
 
 
 def _weak_verdict(fit: Fit, weak: list[str]) -> FitVerdict:
@@ -268,6 +278,13 @@ def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THR
     weak = _weak(cast(Fit, view), values, thresholds.weak) + [f"{t} {v.reason.removeprefix('large standard errors: ')}"
                                              for t, v in others.items() if v.status == "weak"]
     return _weak_verdict(fit, weak)
+
+
+def weak_parameters(fit: Fit, limit: float = WEAK) -> list[str]:
+    """What makes the parameters of ``fit`` (with parameters) a user reads weak at ``limit`` (:data:`WEAK`): their
+    standard errors or Cramér-Rao bounds against their values (module docstring), one phrase each; empty when none.
+    """
+    return _weak(fit, fit.params.to_dict(), limit)
 
 
 def _weak(fit: Fit, values: dict[str, float], limit: float = WEAK) -> list[str]:

@@ -7,13 +7,13 @@ stance leg creeps at 0.003-0.02 rad/s, its friction there a function of the load
 velocity, and a Stribeck curve whose ``v_s`` sits among those samples predicts nothing the next step does (issue 63:
 such fits `ok` and 100 % off on a crawl made elsewhere). A transition is *resolved* when at least
 :data:`TRANSITION_SAMPLES` of the samples fitted (and :data:`TRANSITION_SHARE` of them) lie below its speed, above
-three standard deviations of the velocity's noise (:func:`creep_floor`): a curve placed where no sample is, or only
-noise, is no finding. The samples between its speed and three times it are counted and reported, not required: a
-transition at the top of the data's speeds (a Stribeck velocity at its bound, its curve decaying over the whole
-range) is left to the rule on parameters at a bound (:func:`~wbfriction.fit.selection.prefer_interior`), and on the
-real Aliengo's calves such curves predict the held-out torque better than a step. Nor is the parameter's standard
-error required to be small: a shape parameter correlated with the magnitudes (``a`` with F_c) can be poorly
-determined while the curve it draws predicts held-out data better (the Aliengo's calves, the KUKA's repeat runs).
+three standard deviations of the velocity's noise (:func:`creep_floor`), and as many where it has settled (beyond
+:data:`SETTLED` times its speed): a curve placed where no sample is, or only noise, is no finding, and one that decays
+over the whole range of the data's speeds (a Stribeck velocity near the top speed: the crawl's noisy calf, F_c = 0
+and F_v 16 % off, called `ok`) trades its levels for its shape, with nothing to tell F_c and F_v from F_s. The
+parameter's standard error is not required to be small: a shape parameter correlated with the magnitudes (``a`` with
+F_c) can be poorly determined while the curve it draws predicts held-out data better; the magnitudes' own standard
+errors are what the choice weighs (:func:`~wbfriction.fit.selection.prefer_interior`).
 A joint slower than the stick floor (:data:`~wbfriction.fit.options.STICK_FLOOR`, ``fit --stick-floor``) for longer
 than a pass through zero takes is left out as one that may stick (:func:`~wbfriction.fit.solve.stuck_rows`): with the
 floor above a stance leg's creep, what lies below a transition are passes through it. A family with a transition its
@@ -37,6 +37,9 @@ its training blocks (the README's tour), and (3.5) predicts its held-out blocks 
 there."""
 TRANSITION_SHARE = 0.001
 """... and the smallest share of the samples fitted."""
+SETTLED = 2.0
+"""A transition has settled at this multiple of its speed (a Stribeck term, ``exp(-(qd / v_s)^2)``, is 2 % of its
+height there; ``tanh(a qd)`` 96 % of its step): samples there separate the levels it joins (F_c and F_v from F_s)."""
 NOISE_SIGMAS = 3.0
 """Speeds below this many standard deviations of the velocity's noise are noise, not a transition's evidence."""
 
@@ -49,12 +52,12 @@ def creep_floor(velocity_noise: float = 0.0) -> float:
 
 def transition_counts(speed: float, qd: np.ndarray, floor: float) -> tuple[int, int]:
     """How many of the velocities ``qd`` (n,) [rad/s] lie below a transition at ``speed`` [rad/s] (``|qd|`` in
-    ``[floor, speed)``) and beyond it (in ``[max(speed, floor), 3 speed)``)."""
+    ``[floor, speed)``) and where it has settled (``|qd| >= max(SETTLED * speed, floor)``, :data:`SETTLED`)."""
     v = np.abs(np.asarray(qd, dtype=float))
     v = v[np.isfinite(v)]
     inside = (v >= floor) & (v < speed)
-    beyond = (v >= max(speed, floor)) & (v < 3.0 * speed)
-    return int(inside.sum()), int(beyond.sum())
+    settled = v >= max(SETTLED * speed, floor)
+    return int(inside.sum()), int(settled.sum())
 
 
 def unresolved(params: ModelParamsBase, qd: np.ndarray, velocity_noise: float = 0.0) -> tuple[str, ...]:
@@ -66,8 +69,9 @@ def unresolved(params: ModelParamsBase, qd: np.ndarray, velocity_noise: float = 
     floor = creep_floor(velocity_noise)
     out = []
     for name, speed in family(params.model).transitions(params).items():
-        inside, beyond = transition_counts(speed, qd, floor)
-        if inside < need:
-            out.append(f"{'1/a' if name == 'a' else name} {speed:.2g} rad/s ({inside} samples below, {beyond} "
-                       "beyond" + (f", above {floor:.2g} rad/s)" if floor > 0 else ")"))
+        inside, settled = transition_counts(speed, qd, floor)
+        if inside < need or settled < need:
+            out.append(f"{'1/a' if name == 'a' else name} {speed:.2g} rad/s ({inside} samples below"
+                       + (f" and above {floor:.2g} rad/s" if floor > 0 else "")
+                       + f", {settled} beyond {SETTLED:g} times it)")
     return tuple(out)
