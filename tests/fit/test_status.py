@@ -163,10 +163,15 @@ def test_not_excited_means_below_the_minimum_speed():
     assert _fit(speed=np.nextafter(MIN_SPEED, 0.0)).verdict().status == "not excited"
 
 
-def test_a_magnitude_at_its_floor_is_below_zero_not_at_it():
-    """F_v on its lower bound: below ZERO it is "no viscous friction" (ok), at ZERO already a bound's value."""
+def test_a_magnitude_at_its_floor_is_a_finding_unless_the_data_press_it():
+    """F_v on its floor of zero (the solver's 1e-6 or 1e-4 of it alike) is "no viscous friction" (ok), judged as a
+    zero; pressed below it by the data (issue 63: freed of the floor it would be -0.2 ± 0.02), a bound."""
     assert _fit(F_v=np.nextafter(ZERO, 0.0), at_bound=("F_v",)).verdict().status == "ok"
-    assert _fit(F_v=ZERO, at_bound=("F_v",)).verdict() == FitVerdict("at bound", "at a bound of the fit: F_v")
+    assert _fit(F_v=1e-4, at_bound=("F_v",)).verdict().status == "ok"
+    pressed = _fit(F_v=1e-4, at_bound=("F_v",))
+    pressed.pressed = {"F_v": (-0.2, 0.02)}
+    assert pressed.verdict() == FitVerdict("at bound", "at a bound of the fit: F_v at zero, the data ask for -0.2 "
+                                                       "± 0.02")
 
 
 def test_weak_means_a_standard_error_above_a_quarter_of_the_value():

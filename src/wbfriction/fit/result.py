@@ -177,6 +177,9 @@ class FitResult(Generic[ParamsT]):
             (:mod:`~wbfriction.fit.holdout`, :func:`later_stretch`), or None: not checked.
         unmeasured: why the estimate's noise is not known (its positions' noise not measured: no Cramér-Rao bound),
             or "": the fit is then never ``ok`` (:func:`~wbfriction.fit.status.fit_verdict`).
+        pressed: the magnitudes at their floor of zero that the data press below it
+            (:func:`~wbfriction.fit.solve.pressed_floors`): name -> (the value without the floor, its standard
+            error); such a zero is a bound of the model, not a finding, and the fit is ``at bound``.
     """
 
     joint: str
@@ -207,6 +210,7 @@ class FitResult(Generic[ParamsT]):
     terms: TermFit | None = None
     later: PredictionCheck | None = None
     unmeasured: str = ""
+    pressed: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.params is not None:

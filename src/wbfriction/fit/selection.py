@@ -10,8 +10,10 @@ in :class:`~wbfriction.fit.result.ModelSelection`) and fitted again on every val
 Whole blocks, not scattered samples, are held out: residuals correlated in time (filtered estimates) would otherwise
 let the held-out error see the fit's noise. With too few samples to hold a block out, or for a joint that hardly
 moved (below :data:`~wbfriction.fit.status.MIN_SPEED`: ``not excited``, no velocity model in its data), the simplest
-model is fitted. A model with a parameter at a bound gives way to the best simpler one whose parameters are interior
-(:func:`prefer_interior`).
+model is fitted. A model whose fit has a defect, a parameter at a bound of its search or a magnitude a user reads its
+data do not determine, gives way to the best simpler one without one unless it predicts clearly better
+(:func:`prefer_interior`); a model with a transition its data do not resolve is no candidate
+(:mod:`~wbfriction.fit.transition`).
 """
 
 from __future__ import annotations

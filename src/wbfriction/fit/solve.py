@@ -50,7 +50,7 @@ from wbfriction.fit.regression import (
 from wbfriction.fit.result import FitResult
 from wbfriction.fit.screen import gross_outliers
 from wbfriction.fit.smoothing import row_smoothing, smoother_half_width
-from wbfriction.fit.status import MIN_SPEED, joint_speed
+from wbfriction.fit.status import MIN_SPEED, ZERO_FLOOR, joint_speed
 from wbfriction.friction.families.registry import family
 from wbfriction.friction.models import ModelName
 from wbfriction.friction.noise import JointNoise
@@ -193,6 +193,41 @@ def fitted_rows(qd: np.ndarray, tau_f: np.ndarray, mask: np.ndarray | None = Non
     return use & ~stuck, screened, stuck, speed
 
 
+PRESS_Z = 3.0
+"""A magnitude held at its floor of zero whose fit, freed of that floor, would go below zero by more than this many of
+its standard errors is pressed against the floor (:func:`pressed_floors`): a bound of the model, not a finding."""
+
+
+def pressed_floors(z: np.ndarray, r: np.ndarray, jac: np.ndarray, floors: list[int], names: np.ndarray,
+                   rows: np.ndarray) -> dict[str, tuple[float, float]]:
+    """The magnitudes at their floor of zero that the data press against it: for each of ``floors`` (indices into
+    the free parameters ``z`` (p,) in the fit's coordinates, at a lower bound of 0), the value one Gauss-Newton step
+    from the optimum without bounds would give, where it lies below zero by more than :data:`PRESS_Z` standard
+    errors (the Newey-West sandwich at the optimum, as the fit's own), as ``{name: (that value, its standard
+    error)}`` in the fit's coordinates (the model's own for F_v and F_c).
+
+    A Coulomb-viscous fit with F_v = 0 is no finding of "no viscous friction" when the data's friction falls with
+    the speed (a Stribeck curve, or an estimate that is not the window's average of a friction of the velocity):
+    the same fit freed of the floor puts F_v at -0.2 ± 0.02 (the real Aliengo's momentum route, issue 63). Exact for
+    a model linear in those parameters (the Coulomb-viscous one), one step for the others.
+
+    Args:
+        z: (p,) the optimum; r: (n,) its residuals (model - target) on the fitted ``rows`` (n,) of the series;
+        jac: (n, p) their Jacobian in the fit's coordinates; names: (p,) the free parameters' names.
+    """
+    if not floors or r.size <= z.size:
+        return {}
+    step = np.linalg.lstsq(jac, -r, rcond=None)[0]
+    cov = parameter_covariance(jac, r + jac @ step, rows=rows, max_lag=correlation_lag(r + jac @ step, rows))
+    out = {}
+    for i in floors:
+        se = float(np.sqrt(cov[i, i])) if cov[i, i] > 0 else float("inf")
+        free_value = float(z[i] + step[i])
+        if np.isfinite(se) and free_value < -PRESS_Z * se:
+            out[str(names[i])] = (free_value, se)
+    return out
+
+
 def _at_bound(z: np.ndarray, bounds: tuple[np.ndarray, np.ndarray], residual, identifiable: np.ndarray
               ) -> np.ndarray:
     """(p,) bool: which of the fitted ``z`` (the fit's coordinates) are at a bound: within
@@ -303,11 +338,14 @@ def fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, 
     se = covariance_errors(cov)
     at_bound = np.zeros(len(names), dtype=bool)
     at_bound[free] = _at_bound(best.x, bounds, residual, np.isfinite(se[free]))
+    floors = [i for i, name in enumerate(np.array(names)[free]) if name in ZERO_FLOOR and at_bound[free][i]
+              and bounds[0][i] == 0.0]
     res = FitResult(
         joint=joint, n_samples=n, params=fam.params(full(best.x), delta_s),
         stderr=dict(zip(names, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
         success=bool(best.success), message=str(best.message), model=model,
-        at_bound=dict(zip(names, map(bool, at_bound))), speed=speed, covariance=cov)
+        at_bound=dict(zip(names, map(bool, at_bound))), speed=speed, covariance=cov,
+        pressed=pressed_floors(best.x, best.fun, jacobian(best.x), floors, np.array(names)[free], rows))
     if noise is not None:
         sigma_tau = torque_noise(best.fun, rows, max(BATCH, 4 * (2 * smoother_half_width(smoother) + 1)))
         res.torque_noise = sigma_tau

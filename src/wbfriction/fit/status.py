@@ -8,7 +8,9 @@ status, the first that applies:
 * ``failed``: the solver stopped without converging (its message translated, :func:`solver_phrase`);
 * ``at bound``: a parameter was left on a bound of the fit's search (its value is the bound's, not the
   data's), named. A magnitude at its floor of zero (F_c, F_v, S, F_s = 0: no such friction found) is a
-  result, not a bound of the search; so is a slope at its upper bound (the tanh slope ``a`` of (3.5)): a step
+  result, not a bound of the search, unless the data press it below zero (freed of the floor it would lie more than
+  :data:`~wbfriction.fit.solve.PRESS_Z` standard errors below: :func:`~wbfriction.fit.solve.pressed_floors`; the
+  data's friction then falls with the speed, which the model cannot draw); so is a slope at its upper bound (the tanh slope ``a`` of (3.5)): a step
   sharper than the data resolve is Coulomb friction (``sgn``), the step is the finding
   (:meth:`~wbfriction.fit.result.FitResult.steps`);
 * ``routes disagree`` (issue 38): the same model fitted on the other route's estimate (the acceleration
@@ -196,7 +198,7 @@ def fit_verdict(fit: Fit, thresholds: StatusThresholds = DEFAULT_THRESHOLDS) -> 
     values = fit.params.to_dict()
     bounded = search_bounds(fit)
     if bounded:
-        return FitVerdict("at bound", "at a bound of the fit: " + ", ".join(bounded))
+        return FitVerdict("at bound", "at a bound of the fit: " + bound_phrase(fit, bounded))
     check = fit.route_check
     disagree = _disagreeing(fit, values, thresholds)
     if check is not None and disagree:
@@ -211,11 +213,19 @@ def fit_verdict(fit: Fit, thresholds: StatusThresholds = DEFAULT_THRESHOLDS) -> 
 def search_bounds(fit: Fit) -> list[str]:
     """The parameters of ``fit`` (with parameters) left on a bound of the fit's search: its
     :meth:`~wbfriction.fit.result.FitResult.bounded` less a magnitude at its floor of zero (:data:`ZERO_FLOOR`: no
-    such friction found, a result) and a slope at its step bound (:meth:`~wbfriction.fit.result.FitResult.steps`:
+    such friction found, a result) that the data do not press below it (``fit.pressed``) and a slope at its step bound (:meth:`~wbfriction.fit.result.FitResult.steps`:
     Coulomb friction). What makes a fit ``at bound``, and what the automatic choice weighs
     (:func:`~wbfriction.fit.selection.prefer_interior`)."""
-    values = fit.params.to_dict()
-    return [n for n in fit.bounded() if not (n in ZERO_FLOOR and abs(values[n]) < ZERO) and n not in fit.steps()]
+    pressed = getattr(fit, "pressed", {}) or {}
+    return [n for n in fit.bounded() if not (n in ZERO_FLOOR and n not in pressed) and n not in fit.steps()]
+
+
+def bound_phrase(fit: Fit, names: list[str]) -> str:
+    """``names`` (of :func:`search_bounds`) as the status's reason gives them: a magnitude pressed against its floor
+    with the value the data ask for (``F_v at zero, the data ask for -0.2 ± 0.02``)."""
+    pressed = getattr(fit, "pressed", {}) or {}
+    return ", ".join(f"{n} at zero, the data ask for {pressed[n][0]:.2g} ± {pressed[n][1]:.1g}" if n in pressed else n
+                     for n in names)
 
 
 def _weak_verdict(fit: Fit, weak: list[str]) -> FitVerdict:
@@ -250,9 +260,11 @@ def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THR
     model it predicts and exports with, the velocity coefficients refitted with the terms (their standard errors,
     the other route's refit of them) and each term's own (:meth:`~wbfriction.fit.terms.TermFit.verdicts`)."""
     values = terms.params.to_dict()
-    bounded = [n for n in fit.bounded() if n in HELD and n not in fit.steps()]
+    pressed = getattr(fit, "pressed", {}) or {}  # the velocity fit's, where the refit left the magnitude at zero too
+    bounded = [n for n in fit.bounded() if n in HELD and n not in fit.steps()] + [
+        n for n in pressed if n in terms.at_bound]
     if bounded:
-        return FitVerdict("at bound", "at a bound of the fit: " + ", ".join(bounded))
+        return FitVerdict("at bound", "at a bound of the fit: " + bound_phrase(fit, bounded))
     check = terms.check
     others = {t: v for t, v in terms.verdicts().items() if not v.ok}
     disagree = [] if check is None else [
@@ -274,7 +286,7 @@ def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THR
     # energy check removes both), the offset alone is not, and it is no friction a user reads
     judged = [n for n in values if n in terms.stderr and not (n == "tau_os" and "ripple" in terms.kept)]
     view = SimpleNamespace(params=terms.params, stderr={n: terms.stderr[n] for n in judged}, crb={}, speed=fit.speed,
-                           rms_residual=fit.rms_residual)
+                           rms_residual=fit.rms_residual, at_bound={n: True for n in terms.at_bound})
     weak = _weak(cast(Fit, view), values, thresholds.weak) + [f"{t} {v.reason.removeprefix('large standard errors: ')}"
                                              for t, v in others.items() if v.status == "weak"]
     return _weak_verdict(fit, weak)
@@ -293,8 +305,10 @@ def _weak(fit: Fit, values: dict[str, float], limit: float = WEAK) -> list[str]:
     odd = 0.5 * float(fit.params.f(speed) - fit.params.f(-speed))  # the friction the joint shows at its speed
     scale = max(abs(odd), fit.rms_residual if np.isfinite(fit.rms_residual) else 0.0)
     out = []
+    at_bound = getattr(fit, "at_bound", {}) or {}
     for name in (n for n in READ if n in fit.stderr):
-        value = abs(values[name])
+        # a magnitude its fit left at its floor is zero (1e-5 of an F_v is the solver's, not the data's)
+        value = 0.0 if at_bound.get(name) else abs(values[name])
         for bound, spread in ((False, fit.stderr[name]), (True, fit.crb.get(name, 0.0))):
             at_best = " at best (Cramér-Rao)" if bound else ""
             if not np.isfinite(spread):
