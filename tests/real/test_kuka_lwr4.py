@@ -83,11 +83,16 @@ class Trained:
     test: FrictionEstimate
 
 
-def trained(urdf: Path, logs: dict[str, Path]) -> Trained:
+ONE_FAMILY = FitOptions(model="coulomb-viscous", terms=TermOptions(terms=()))
+"""One friction family for every model compared: a comparison of inertia models that the automatic choice of the
+family does not confound (issue 63: the choice differs between two URDFs' estimates on a joint or two)."""
+
+
+def trained(urdf: Path, logs: dict[str, Path], options: FitOptions = VELOCITY_ONLY) -> Trained:
     r = robot(urdf)
     train = estimate_log(r, log_from_table(pq.read_table(logs["runs12"]), r, "runs12"), OPTIONS)
     test = estimate_log(r, log_from_table(pq.read_table(logs["run3"]), r, "run3"), OPTIONS)
-    return Trained(r, train, {f.joint: f for f in fit_estimate(train, VELOCITY_ONLY)}, test)
+    return Trained(r, train, {f.joint: f for f in fit_estimate(train, options)}, test)
 
 
 @pytest.fixture(scope="module")
@@ -131,20 +136,21 @@ def test_logged_velocities_lag_by_what_the_controller_filter_adds(logs):
     assert 1e-3 < lag["lag_s"] < 3e-3 and lag["correlation"] > 0.99  # about 2 ms, stated
 
 
-def test_the_identified_model_predicts_the_held_out_run(logs, identified, identified_model):
-    """Run 3's torques (a trajectory none of the models was fitted on), RMS per joint [N·m]."""
-    def held_out(model: Trained):
+def test_the_identified_model_predicts_the_held_out_run(logs, identified):
+    """Run 3's torques (a trajectory none of the models was fitted on), RMS per joint [N·m], each inertia model with
+    its Coulomb-viscous friction fitted on runs 1 and 2 (:data:`ONE_FAMILY`)."""
+    def held_out(urdf: Path):
+        model = trained(urdf, logs, ONE_FAMILY)
         return predict_torques(model.test, {j: f.params for j, f in model.fits.items()})
 
-    given, flo = held_out(trained(KUKA_URDF, logs)), held_out(trained(flobaroid_urdf(identified.parent), logs))
-    ident = held_out(identified_model)
+    given, flo, ident = held_out(KUKA_URDF), held_out(flobaroid_urdf(identified.parent)), held_out(identified)
     overall = lambda p: float(np.sqrt(np.mean(p.rms**2)))  # noqa: E731
     print("\nheld-out RMS [N·m]  given", np.round(given.rms, 3), "FloBaRoID", np.round(flo.rms, 3),
           "identified", np.round(ident.rms, 3))
     assert np.all(ident.rms < given.rms)  # every joint better than the given URDF with its best friction
     assert overall(ident) < 0.6 * overall(given)
     assert overall(ident) < overall(flo)  # better than the peer's identified URDF, overall
-    assert np.sum(ident.rms < flo.rms) >= 5  # and on 5 of the 7 joints (not lwr_3, lwr_5: see the issue note)
+    assert np.sum(ident.rms < flo.rms) >= 6  # and on 6 of the 7 joints (not lwr_5: measured 0.299 against 0.268)
 
 
 def test_the_identified_bodies_stay_links(identified):

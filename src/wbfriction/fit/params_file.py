@@ -56,7 +56,7 @@ def selection_to_dict(selection: ModelSelection) -> dict[str, Any]:
     return {"chosen": selection.chosen, "reason": selection.reason, "tolerance": selection.tolerance,
             "n_train": selection.n_train, "n_held_out": selection.n_held_out,
             "scores": [{"model": c.model, "held_out_rms": finite_or_none(c.held_out_rms),
-                        "at_bound": list(c.at_bound), "unresolved": list(c.unresolved), "weak": list(c.weak)}
+                        "at_bound": list(c.at_bound), "unresolved": list(c.unresolved)}
                        for c in selection.scores]}
 
 
@@ -69,8 +69,7 @@ def selection_from_dict(d: Mapping[str, Any]) -> ModelSelection:
     try:
         scores = tuple(HeldOutScore(check_model(c["model"], "selection.scores.model"),
                                     float("nan") if c.get("held_out_rms") is None else float(c["held_out_rms"]),
-                                    tuple(map(str, c.get("at_bound", ()))), tuple(map(str, c.get("unresolved", ()))),
-                                    tuple(map(str, c.get("weak", ()))))
+                                    tuple(map(str, c.get("at_bound", ()))), tuple(map(str, c.get("unresolved", ()))))
                        for c in d.get("scores", ()))
         return ModelSelection(check_model(d["chosen"], "selection.chosen"), str(d.get("reason", "")), scores,
                               float(d["tolerance"]), int(d.get("n_train", 0)), int(d.get("n_held_out", 0)))

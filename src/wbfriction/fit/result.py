@@ -38,21 +38,12 @@ class HeldOutScore:
             not a magnitude at zero, nor a step).
         unresolved: the transitions the training samples do not resolve (:func:`~wbfriction.fit.transition.unresolved`):
             a model with one is no candidate.
-        weak: what makes that fit's parameters a user reads weak (:func:`~wbfriction.fit.status.weak_parameters`),
-            one phrase each: it gives way to a simpler model that is not, unless it predicts clearly better
-            (:func:`~wbfriction.fit.selection.prefer_interior`).
     """
 
     model: ModelName
     held_out_rms: float
     at_bound: tuple[str, ...] = ()
     unresolved: tuple[str, ...] = ()
-    weak: tuple[str, ...] = ()
-
-    @property
-    def defects(self) -> tuple[str, ...]:
-        """Why this fit's numbers could not be used as they are: its parameters at a bound, then its weak ones."""
-        return tuple(f"{n} at a bound" for n in self.at_bound) + self.weak
 
 
 @dataclass(frozen=True)

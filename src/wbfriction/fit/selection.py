@@ -10,10 +10,10 @@ in :class:`~wbfriction.fit.result.ModelSelection`) and fitted again on every val
 Whole blocks, not scattered samples, are held out: residuals correlated in time (filtered estimates) would otherwise
 let the held-out error see the fit's noise. With too few samples to hold a block out, or for a joint that hardly
 moved (below :data:`~wbfriction.fit.status.MIN_SPEED`: ``not excited``, no velocity model in its data), the simplest
-model is fitted. A model whose fit has a defect, a parameter at a bound of its search or a magnitude a user reads its
-data do not determine, gives way to the best simpler one without one unless it predicts clearly better
-(:func:`prefer_interior`); a model with a transition its data do not resolve is no candidate
-(:mod:`~wbfriction.fit.transition`).
+model is fitted. A model with a parameter at a bound of its search gives way to the best simpler one whose
+parameters are interior unless it predicts clearly better (:func:`prefer_interior`), and keeps its place if that
+simpler model, fitted on every sample, is at a bound too; a model with a transition its data do not resolve is no
+candidate (:mod:`~wbfriction.fit.transition`).
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ from wbfriction.fit.solve import (
     model_gradient,
     shown_friction,
 )
-from wbfriction.fit.status import MIN_SPEED, reverse_share, search_bounds, weak_parameters
+from wbfriction.fit.status import MIN_SPEED, reverse_share, search_bounds
 from wbfriction.fit.transition import unresolved
 from wbfriction.friction.families.base import FrictionFamily
 from wbfriction.friction.families.registry import families, family
@@ -83,9 +83,8 @@ def held_out_rms(params: ModelParamsBase, qd: np.ndarray, tau_f: np.ndarray, row
 
 
 GAIN_Z = 2.0
-"""A model whose fit has a defect (a parameter at a bound, a parameter a user reads not determined) must lower the
-held-out mean square by more than this many standard errors of the lowering to be chosen over a simpler model without
-one (:func:`prefer_interior`)."""
+"""A model with a parameter at a bound must lower the held-out mean square by more than this many standard errors
+of the lowering to be chosen over a simpler model whose parameters are all interior (:func:`prefer_interior`)."""
 
 
 def choose_model(scores: tuple[HeldOutScore, ...], tolerance: float = SELECTION_TOLERANCE) -> tuple[ModelName, str]:
@@ -241,8 +240,7 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
                  if r.params is not None}
     scores = tuple(HeldOutScore(m, float(np.sqrt(np.mean(residuals[m] ** 2))) if m in residuals else float("nan"),
                                 tuple(search_bounds(r)) if r.params is not None else (),
-                                () if r.params is None else unresolved(r.params, qd[train], sigma),
-                                () if r.params is None else tuple(weak_parameters(r)))
+                                () if r.params is None else unresolved(r.params, qd[train], sigma))
                    for m, r in trained.items())
     # the choice among every candidate, an unresolved one included (how well the data can be fitted); where that
     # choice's transition is not resolved, the choice among those resolved
@@ -250,11 +248,18 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     chosen, reason = choose_model(scores, tolerance)
     if chosen not in {s.model for s in eligible}:
         chosen, reason = choose_model(eligible, tolerance)
+    first, first_reason = chosen, reason
     chosen, reason = prefer_interior(chosen, reason, eligible, residuals, np.flatnonzero(scored))
     left = [f"{s.model} ({'; '.join(s.unresolved)})" for s in scores if s.unresolved]
     if left:
         reason += "; not candidates, transitions the data do not resolve: " + ", ".join(left)
+        first_reason += "; not candidates, transitions the data do not resolve: " + ", ".join(left)
     res = fit_model(chosen, qd, y, use, fixed=held[chosen], noise=noise, **kwargs)  # as if the model had been named
+    if chosen != first and res.params is not None and search_bounds(res):
+        # the simpler model taken for its interior parameters is at a bound on every sample: no reason to prefer it
+        simpler, left_at = chosen, ", ".join(search_bounds(res))
+        res = fit_model(first, qd, y, use, fixed=held[first], noise=noise, **kwargs)
+        chosen, reason = first, first_reason + f"; kept: {simpler}, fitted on every sample, is at a bound too ({left_at})"
     if res.params is not None and search_bounds(res):
         reason += f"; at a bound: {', '.join(search_bounds(res))}"
     res.selection = ModelSelection(chosen, reason, scores, tolerance, n_train, n_held_out)
@@ -263,28 +268,26 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
 
 def prefer_interior(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ...],
                     residuals: dict[ModelName, np.ndarray], rows: np.ndarray) -> tuple[ModelName, str]:
-    """The rule of issues 38 and 63: a model chosen whose fit has a defect (:attr:`HeldOutScore.defects`: a
-    parameter at a bound of its search, or a parameter a user reads that its data do not determine) gives way to
-    the best-scoring simpler model without one, unless it lowers the held-out mean square by more than
-    :data:`GAIN_Z` standard errors of that lowering (:func:`held_out_gain`): a richer curve whose numbers cannot be
-    used must predict clearly better to be kept."""
+    """The rule of issue 38: a model chosen with a parameter at a bound of its search
+    (:func:`~wbfriction.fit.status.search_bounds`: a magnitude at its floor of zero is a finding, unless the data
+    press it below) gives way to the best-scoring simpler model whose parameters are all interior, unless it lowers
+    the held-out mean square by more than :data:`GAIN_Z` standard errors of that lowering (:func:`held_out_gain`)."""
     by_model = {s.model: s for s in scores}
-    defects = by_model[chosen].defects
-    if not defects:
+    if not by_model[chosen].at_bound:
         return chosen, reason
     simpler = [s for s in scores[:[s.model for s in scores].index(chosen)]
-               if not s.defects and s.model in residuals and np.isfinite(s.held_out_rms)]
+               if not s.at_bound and s.model in residuals and np.isfinite(s.held_out_rms)]
     if not simpler:
         return chosen, reason
     alternative = min(simpler, key=lambda s: s.held_out_rms)
     gain, se = held_out_gain(residuals[alternative.model], residuals[chosen], rows)
     if gain > GAIN_Z * se:
         return chosen, reason + (f"; its held-out gain over {alternative.model} ({gain:.3g} N²·m², {gain / se:.1f} "
-                                 f"standard errors) outweighs its defects ({', '.join(defects)})")
+                                 f"standard errors) outweighs its bound ({', '.join(by_model[chosen].at_bound)})")
     scores_text = reason[reason.find("held-out RMS [N·m]:"):] if "held-out RMS [N·m]:" in reason else ""
-    return alternative.model, (f"{alternative.model}: {chosen} has {', '.join(defects)} and lowers the held-out "
-                               f"mean square by {gain:.3g} ± {se:.2g} N²·m², within {GAIN_Z:g} standard errors"
-                               + (f"; {scores_text}" if scores_text else ""))
+    return alternative.model, (f"{alternative.model}: {chosen} leaves {', '.join(by_model[chosen].at_bound)} at a "
+                               f"bound and lowers the held-out mean square by {gain:.3g} ± {se:.2g} N²·m², within "
+                               f"{GAIN_Z:g} standard errors" + (f"; {scores_text}" if scores_text else ""))
 
 
 def later_stretch(fit: FitResult, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray,

@@ -292,13 +292,6 @@ def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THR
     return _weak_verdict(fit, weak)
 
 
-def weak_parameters(fit: Fit, limit: float = WEAK) -> list[str]:
-    """What makes the parameters of ``fit`` (with parameters) a user reads weak at ``limit`` (:data:`WEAK`): their
-    standard errors or Cramér-Rao bounds against their values (module docstring), one phrase each; empty when none.
-    """
-    return _weak(fit, fit.params.to_dict(), limit)
-
-
 def _weak(fit: Fit, values: dict[str, float], limit: float = WEAK) -> list[str]:
     """What makes ``fit`` weak (module docstring) at ``limit`` (:data:`WEAK`), one phrase each."""
     speed = fit.speed or 0.0
