@@ -523,9 +523,9 @@ def test_a_bounded_model_must_beat_a_simpler_interior_one_beyond_the_noise_of_th
     assert prefer_interior("coulomb-viscous", "r", scores, {}, rows) == ("coulomb-viscous", "r")
 
 
-def test_a_magnitude_at_its_floor_of_zero_is_no_bound_for_the_choice():
-    """A Coulomb-viscous fit with F_v = 0 (no viscous friction found: a result, :func:`search_bounds`) is an interior
-    alternative to a Stribeck fit whose v_s is at its search bound."""
+def test_a_magnitude_at_its_floor_of_zero_is_no_bound_for_the_status():
+    """A Coulomb-viscous fit with F_v = 0 (no viscous friction found) is at a bound of its fit (what the automatic
+    choice weighs) but not of its search (:func:`search_bounds`: its status is not ``at bound``)."""
     fit = FitResult(joint="j", n_samples=100, success=True, rms_residual=0.01, model="coulomb-viscous",
                     params=CoulombViscousParams(0.0, 0.5, 0.0),
                     stderr={"F_v": 0.01, "F_c": 0.01, "tau_os": 0.01},

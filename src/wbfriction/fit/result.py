@@ -34,8 +34,8 @@ class HeldOutScore:
     Attributes:
         model: the model.
         held_out_rms: RMS of (model - estimate) over the held-out samples [N·m] (NaN: no fit).
-        at_bound: the parameters that fit left at a bound of its search (:func:`~wbfriction.fit.status.search_bounds`:
-            not a magnitude at zero, nor a step).
+        at_bound: the parameters that fit left at a bound (:meth:`FitResult.bounded`: a magnitude at its floor of zero
+            included).
         unresolved: the transitions the training samples do not resolve (:func:`~wbfriction.fit.transition.unresolved`):
             a model with one is no candidate.
     """

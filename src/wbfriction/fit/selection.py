@@ -10,10 +10,10 @@ in :class:`~wbfriction.fit.result.ModelSelection`) and fitted again on every val
 Whole blocks, not scattered samples, are held out: residuals correlated in time (filtered estimates) would otherwise
 let the held-out error see the fit's noise. With too few samples to hold a block out, or for a joint that hardly
 moved (below :data:`~wbfriction.fit.status.MIN_SPEED`: ``not excited``, no velocity model in its data), the simplest
-model is fitted. A model with a parameter at a bound of its search gives way to the best simpler one whose
-parameters are interior unless it predicts clearly better (:func:`prefer_interior`), and keeps its place if that
-simpler model, fitted on every sample, is at a bound too; a model with a transition its data do not resolve is no
-candidate (:mod:`~wbfriction.fit.transition`).
+model is fitted. A model with a parameter at a bound (a magnitude at zero included: in a richer model it has often
+traded its level for a shape parameter) gives way to the best simpler one whose parameters are all interior unless it
+predicts clearly better (:func:`prefer_interior`); a model with a transition its data do not resolve is no candidate
+(:mod:`~wbfriction.fit.transition`).
 """
 
 from __future__ import annotations
@@ -239,7 +239,7 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     residuals = {m: held_out_residuals(r.params, qd, -y, scored, smoother, sigma) for m, r in trained.items()
                  if r.params is not None}
     scores = tuple(HeldOutScore(m, float(np.sqrt(np.mean(residuals[m] ** 2))) if m in residuals else float("nan"),
-                                tuple(search_bounds(r)) if r.params is not None else (),
+                                r.bounded(),
                                 () if r.params is None else unresolved(r.params, qd[train], sigma))
                    for m, r in trained.items())
     # the choice among every candidate, an unresolved one included (how well the data can be fitted); where that
@@ -248,18 +248,11 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     chosen, reason = choose_model(scores, tolerance)
     if chosen not in {s.model for s in eligible}:
         chosen, reason = choose_model(eligible, tolerance)
-    first, first_reason = chosen, reason
     chosen, reason = prefer_interior(chosen, reason, eligible, residuals, np.flatnonzero(scored))
     left = [f"{s.model} ({'; '.join(s.unresolved)})" for s in scores if s.unresolved]
     if left:
         reason += "; not candidates, transitions the data do not resolve: " + ", ".join(left)
-        first_reason += "; not candidates, transitions the data do not resolve: " + ", ".join(left)
     res = fit_model(chosen, qd, y, use, fixed=held[chosen], noise=noise, **kwargs)  # as if the model had been named
-    if chosen != first and res.params is not None and search_bounds(res):
-        # the simpler model taken for its interior parameters is at a bound on every sample: no reason to prefer it
-        simpler, left_at = chosen, ", ".join(search_bounds(res))
-        res = fit_model(first, qd, y, use, fixed=held[first], noise=noise, **kwargs)
-        chosen, reason = first, first_reason + f"; kept: {simpler}, fitted on every sample, is at a bound too ({left_at})"
     if res.params is not None and search_bounds(res):
         reason += f"; at a bound: {', '.join(search_bounds(res))}"
     res.selection = ModelSelection(chosen, reason, scores, tolerance, n_train, n_held_out)
@@ -268,10 +261,10 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
 
 def prefer_interior(chosen: ModelName, reason: str, scores: tuple[HeldOutScore, ...],
                     residuals: dict[ModelName, np.ndarray], rows: np.ndarray) -> tuple[ModelName, str]:
-    """The rule of issue 38: a model chosen with a parameter at a bound of its search
-    (:func:`~wbfriction.fit.status.search_bounds`: a magnitude at its floor of zero is a finding, unless the data
-    press it below) gives way to the best-scoring simpler model whose parameters are all interior, unless it lowers
-    the held-out mean square by more than :data:`GAIN_Z` standard errors of that lowering (:func:`held_out_gain`)."""
+    """The rule of issue 38: a model chosen with a parameter at a bound (:attr:`HeldOutScore.at_bound`, a magnitude at
+    its floor of zero included) gives way to the best-scoring simpler model whose parameters are all interior, unless
+    it lowers the held-out mean square by more than :data:`GAIN_Z` standard errors of that lowering
+    (:func:`held_out_gain`)."""
     by_model = {s.model: s for s in scores}
     if not by_model[chosen].at_bound:
         return chosen, reason

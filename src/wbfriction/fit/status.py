@@ -214,8 +214,7 @@ def search_bounds(fit: Fit) -> list[str]:
     """The parameters of ``fit`` (with parameters) left on a bound of the fit's search: its
     :meth:`~wbfriction.fit.result.FitResult.bounded` less a magnitude at its floor of zero (:data:`ZERO_FLOOR`: no
     such friction found, a result) that the data do not press below it (``fit.pressed``) and a slope at its step bound (:meth:`~wbfriction.fit.result.FitResult.steps`:
-    Coulomb friction). What makes a fit ``at bound``, and what the automatic choice weighs
-    (:func:`~wbfriction.fit.selection.prefer_interior`)."""
+    Coulomb friction). What makes a fit ``at bound``."""
     pressed = getattr(fit, "pressed", {}) or {}
     return [n for n in fit.bounded() if not (n in ZERO_FLOOR and n not in pressed) and n not in fit.steps()]
 
