@@ -9,7 +9,10 @@ whole torque, as PACE's actuator does), both through the same estimate and predi
 (:mod:`wbfriction.studies.pd_peer`: the momentum route for both), and finds the drivers' delay near theirs. Measured
 at issue 55's close: better on 10 of 12 joints (ours 0.075-0.155 N·m, mean 0.107, the peer's 0.080-0.291, mean 0.185;
 not the front left calf, 0.089 against 0.080, nor the rear right calf, 0.155 against 0.092): the issue's "every
-joint" not reached.
+joint" not reached. Issue 63 (second session) lowered it to 9 of 12: a transition is a candidate only with samples
+where it has settled, and the rear left calf's (3.5) curve, whose Stribeck velocity of 1.3 rad/s lies beyond the
+joint's speeds (nothing above 2.6 rad/s; its F_c ±3993 %), predicted the last 40 % to 0.083 N·m; the Coulomb-viscous
+fit now chosen predicts it to 0.101, the peer 0.097 (the rear right calf gained: 0.155 -> 0.124).
 """
 
 from __future__ import annotations
@@ -61,7 +64,7 @@ def test_the_held_out_torque_predicted_better_than_the_peers_on_every_joint(rout
     mine = predict_file(folder / "held_out_friction.parquet", folder / "params.json")
     theirs = peer_held_out(written.config, written.config.parent / "peer.toml", peer, Path(written.logs["held_out"]))
     better = [j for i, j in enumerate(mine.joints) if mine.rms[i] < theirs[j]]
-    assert len(better) >= 10, sorted(set(mine.joints) - set(better))  # module docstring
+    assert len(better) >= 9, sorted(set(mine.joints) - set(better))  # module docstring
     assert sum(mine.rms) < 0.7 * sum(theirs.values())
     assert max(mine.rms) < 0.2
 
