@@ -3,8 +3,9 @@
 The **parameters JSON** holds the fitted model per joint (:class:`~wbfriction.fit.result.FitResult`): its
 name (``model``: ``coulomb-viscous``, ``stribeck`` or ``thesis`` (3.5)), parameters, standard errors, their
 Cramér-Rao bounds (``crb``) and the torque noise they take (``torque_noise``), which parameters ended at a
-bound (``at_bound``) and which magnitudes the data press against their floor of zero (``pressed``), the estimate's ``route`` and the same model on the other route (``route_check``: its
-parameters, standard errors, and those that ``disagree``), the velocity noise the model's expectation took
+bound (``at_bound``) and which magnitudes the data press against their floor of zero (``pressed``), the
+estimate's ``route`` and the same model on the other route (``route_check``: its parameters, standard errors, and
+those that ``disagree``), the velocity noise the model's expectation took
 (``velocity_noise``), the samples left out where the joint may stick (``stick_speed``, ``n_stuck``) and, when
 the model was chosen by held-out error, how (``selection``). :func:`write_params` writes it (``wbfriction
 fit`` and the studies), :func:`read_params` reads it (``wbfriction report --params``). A standard error that

@@ -10,9 +10,9 @@ status, the first that applies:
   data's), named. A magnitude at its floor of zero (F_c, F_v, S, F_s = 0: no such friction found) is a
   result, not a bound of the search, unless the data press it below zero (freed of the floor it would lie more than
   :data:`~wbfriction.fit.solve.PRESS_Z` standard errors below: :func:`~wbfriction.fit.solve.pressed_floors`; the
-  data's friction then falls with the speed, which the model cannot draw); so is a slope at its upper bound (the tanh slope ``a`` of (3.5)): a step
-  sharper than the data resolve is Coulomb friction (``sgn``), the step is the finding
-  (:meth:`~wbfriction.fit.result.FitResult.steps`);
+  data's friction then falls with the speed, which the model cannot draw); so is a slope at its upper bound (the
+  tanh slope ``a`` of (3.5)): a step sharper than the data resolve is Coulomb friction (``sgn``), the step is the
+  finding (:meth:`~wbfriction.fit.result.FitResult.steps`);
 * ``routes disagree`` (issue 38): the same model fitted on the other route's estimate (the acceleration
   route's for the momentum route, and the other way round) differs on F_c or F_v by more than
   :data:`ROUTE_Z` combined standard errors and :data:`ROUTE_REL`
@@ -213,8 +213,8 @@ def fit_verdict(fit: Fit, thresholds: StatusThresholds = DEFAULT_THRESHOLDS) -> 
 def search_bounds(fit: Fit) -> list[str]:
     """The parameters of ``fit`` (with parameters) left on a bound of the fit's search: its
     :meth:`~wbfriction.fit.result.FitResult.bounded` less a magnitude at its floor of zero (:data:`ZERO_FLOOR`: no
-    such friction found, a result) that the data do not press below it (``fit.pressed``) and a slope at its step bound (:meth:`~wbfriction.fit.result.FitResult.steps`:
-    Coulomb friction). What makes a fit ``at bound``."""
+    such friction found, a result) that the data do not press below it (``fit.pressed``) and a slope at its step
+    bound (:meth:`~wbfriction.fit.result.FitResult.steps`: Coulomb friction). What makes a fit ``at bound``."""
     pressed = getattr(fit, "pressed", {}) or {}
     return [n for n in fit.bounded() if not (n in ZERO_FLOOR and n not in pressed) and n not in fit.steps()]
 
