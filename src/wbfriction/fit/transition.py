@@ -12,8 +12,8 @@ three standard deviations of the velocity's noise (:func:`creep_floor`), and as 
 over the whole range of the data's speeds (a Stribeck velocity near the top speed: the crawl's noisy calf, F_c = 0
 and F_v 16 % off, called `ok`) trades its levels for its shape, with nothing to tell F_c and F_v from F_s. The
 parameter's standard error is not required to be small: a shape parameter correlated with the magnitudes (``a`` with
-F_c) can be poorly determined while the curve it draws predicts held-out data better (the Aliengo's calves, the
-KUKA's repeat runs: a rule that passed over such fits made the two runs' lwr_4 curves differ by 13 %).
+F_c) can be poorly determined while the curve it draws predicts held-out data better (the KUKA's repeat runs: a
+rule that passed over such fits made the two runs' lwr_4 curves differ by 13 %).
 A joint slower than the stick floor (:data:`~wbfriction.fit.options.STICK_FLOOR`, ``fit --stick-floor``) for longer
 than a pass through zero takes is left out as one that may stick (:func:`~wbfriction.fit.solve.stuck_rows`): with the
 floor above a stance leg's creep, what lies below a transition are passes through it. A family with a transition its
