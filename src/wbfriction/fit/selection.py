@@ -253,8 +253,8 @@ def _fit_auto(qd: np.ndarray, y: np.ndarray, use: np.ndarray, *, delta_s: float,
     if left:
         reason += "; not candidates, transitions the data do not resolve: " + ", ".join(left)
     res = fit_model(chosen, qd, y, use, fixed=held[chosen], noise=noise, **kwargs)  # as if the model had been named
-    if res.params is not None and search_bounds(res):
-        reason += f"; at a bound: {', '.join(search_bounds(res))}"
+    if res.params is not None and (bounded := search_bounds(res)):
+        reason += f"; at a bound: {', '.join(bounded)}"
     res.selection = ModelSelection(chosen, reason, scores, tolerance, n_train, n_held_out)
     return res
 

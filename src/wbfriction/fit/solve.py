@@ -198,7 +198,7 @@ PRESS_Z = 3.0
 its standard errors is pressed against the floor (:func:`pressed_floors`): a bound of the model, not a finding."""
 
 
-def pressed_floors(z: np.ndarray, r: np.ndarray, jac: np.ndarray, floors: list[int], names: np.ndarray,
+def pressed_floors(z: np.ndarray, r: np.ndarray, jacobian, floors: list[int], names: np.ndarray,
                    rows: np.ndarray) -> dict[str, tuple[float, float]]:
     """The magnitudes at their floor of zero that the data press against it: for each of ``floors`` (indices into
     the free parameters ``z`` (p,) in the fit's coordinates, at a lower bound of 0), the value one Gauss-Newton step
@@ -213,12 +213,15 @@ def pressed_floors(z: np.ndarray, r: np.ndarray, jac: np.ndarray, floors: list[i
 
     Args:
         z: (p,) the optimum; r: (n,) its residuals (model - target) on the fitted ``rows`` (n,) of the series;
-        jac: (n, p) their Jacobian in the fit's coordinates; names: (p,) the free parameters' names.
+        jacobian: ``z -> (n, p)``, their Jacobian in the fit's coordinates (evaluated only when a magnitude is at its
+            floor); names: (p,) the free parameters' names.
     """
     if not floors or r.size <= z.size:
         return {}
+    jac = jacobian(z)
     step = np.linalg.lstsq(jac, -r, rcond=None)[0]
-    cov = parameter_covariance(jac, r + jac @ step, rows=rows, max_lag=correlation_lag(r + jac @ step, rows))
+    freed = r + jac @ step  # the residuals without the floor
+    cov = parameter_covariance(jac, freed, rows=rows, max_lag=correlation_lag(freed, rows))
     out = {}
     for i in floors:
         se = float(np.sqrt(cov[i, i])) if cov[i, i] > 0 else float("inf")
@@ -338,14 +341,15 @@ def fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, 
     se = covariance_errors(cov)
     at_bound = np.zeros(len(names), dtype=bool)
     at_bound[free] = _at_bound(best.x, bounds, residual, np.isfinite(se[free]))
-    floors = [i for i, name in enumerate(np.array(names)[free]) if name in ZERO_FLOOR and at_bound[free][i]
-              and bounds[0][i] == 0.0]
+    free_names = np.array(names)[free]
+    floors = [i for i, (name, at) in enumerate(zip(free_names, at_bound[free]))
+              if at and name in ZERO_FLOOR and bounds[0][i] == 0.0]
     res = FitResult(
         joint=joint, n_samples=n, params=fam.params(full(best.x), delta_s),
         stderr=dict(zip(names, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
         success=bool(best.success), message=str(best.message), model=model,
         at_bound=dict(zip(names, map(bool, at_bound))), speed=speed, covariance=cov,
-        pressed=pressed_floors(best.x, best.fun, jacobian(best.x), floors, np.array(names)[free], rows))
+        pressed=pressed_floors(best.x, best.fun, jacobian, floors, free_names, rows))
     if noise is not None:
         sigma_tau = torque_noise(best.fun, rows, max(BATCH, 4 * (2 * smoother_half_width(smoother) + 1)))
         res.torque_noise = sigma_tau

@@ -156,6 +156,8 @@ class Fit(Protocol):
     route_check: Any
     rms_residual: float
     later: Any
+    at_bound: dict[str, bool]
+    pressed: dict[str, tuple[float, float]]
 
     def bounded(self) -> tuple[str, ...]: ...
 
@@ -215,14 +217,13 @@ def search_bounds(fit: Fit) -> list[str]:
     :meth:`~wbfriction.fit.result.FitResult.bounded` less a magnitude at its floor of zero (:data:`ZERO_FLOOR`: no
     such friction found, a result) that the data do not press below it (``fit.pressed``) and a slope at its step
     bound (:meth:`~wbfriction.fit.result.FitResult.steps`: Coulomb friction). What makes a fit ``at bound``."""
-    pressed = getattr(fit, "pressed", {}) or {}
-    return [n for n in fit.bounded() if not (n in ZERO_FLOOR and n not in pressed) and n not in fit.steps()]
+    return [n for n in fit.bounded() if not (n in ZERO_FLOOR and n not in fit.pressed) and n not in fit.steps()]
 
 
 def bound_phrase(fit: Fit, names: list[str]) -> str:
     """``names`` (of :func:`search_bounds`) as the status's reason gives them: a magnitude pressed against its floor
     with the value the data ask for (``F_v at zero, the data ask for -0.2 ± 0.02``)."""
-    pressed = getattr(fit, "pressed", {}) or {}
+    pressed = fit.pressed
     return ", ".join(f"{n} at zero, the data ask for {pressed[n][0]:.2g} ± {pressed[n][1]:.1g}" if n in pressed else n
                      for n in names)
 
@@ -259,9 +260,9 @@ def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THR
     model it predicts and exports with, the velocity coefficients refitted with the terms (their standard errors,
     the other route's refit of them) and each term's own (:meth:`~wbfriction.fit.terms.TermFit.verdicts`)."""
     values = terms.params.to_dict()
-    pressed = getattr(fit, "pressed", {}) or {}  # the velocity fit's, where the refit left the magnitude at zero too
+    # and the velocity fit's pressed magnitudes, where the refit left them at zero too
     bounded = [n for n in fit.bounded() if n in HELD and n not in fit.steps()] + [
-        n for n in pressed if n in terms.at_bound]
+        n for n in fit.pressed if n in terms.at_bound]
     if bounded:
         return FitVerdict("at bound", "at a bound of the fit: " + bound_phrase(fit, bounded))
     check = terms.check
@@ -297,10 +298,9 @@ def _weak(fit: Fit, values: dict[str, float], limit: float = WEAK) -> list[str]:
     odd = 0.5 * float(fit.params.f(speed) - fit.params.f(-speed))  # the friction the joint shows at its speed
     scale = max(abs(odd), fit.rms_residual if np.isfinite(fit.rms_residual) else 0.0)
     out = []
-    at_bound = getattr(fit, "at_bound", {}) or {}
     for name in (n for n in READ if n in fit.stderr):
         # a magnitude its fit left at its floor is zero (1e-5 of an F_v is the solver's, not the data's)
-        value = 0.0 if at_bound.get(name) else abs(values[name])
+        value = 0.0 if fit.at_bound.get(name) else abs(values[name])
         for bound, spread in ((False, fit.stderr[name]), (True, fit.crb.get(name, 0.0))):
             at_best = " at best (Cramér-Rao)" if bound else ""
             if not np.isfinite(spread):
