@@ -183,3 +183,16 @@ def test_a_joint_that_moved_one_way_leaves_its_coulomb_friction_and_offset_weak(
     assert one_way.verdict("F_v") is None and one_way.verdict("armature") is None
     still = JointMotion(speed=0.5 * MIN_SPEED, reverse=0.0)
     assert all(still.verdict(k)[0] == "not excited" for k in ("armature", "F_v", "F_c", "offset"))
+
+
+def test_the_simulators_set_point_delay_is_told_from_a_torque_delay(go2):
+    """The hung Go2's drivers hold back their set-points: the balance closes clearly better so than with the whole
+    torque held back, and the identification says the log tells which (:func:`structure_gain`)."""
+    result = identified(go2, simulated(go2).table)
+    assert result.options.delayed == "setpoints" and result.delayed_known
+    assert "does not tell" not in result.velocity_reason
+
+
+def test_still_setpoints_do_not_tell_what_the_delay_holds_back(go2):
+    result = identified(go2, simulated(go2, amplitude=0.0).table)
+    assert not result.delayed_known and "does not tell what the delay holds back" in result.velocity_reason

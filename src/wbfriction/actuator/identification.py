@@ -18,6 +18,17 @@ Cramér-Rao bound: :attr:`Identified.se` is ``max(se, crb)``. Stamps with receiv
 are taken on the regularised clock the log's reader found (:mod:`wbfriction.logs.clock`), before the delay is
 searched.
 
+What the delay holds back (``delayed``: the set-points, or the whole torque) is chosen by the balance: the one that
+closes it best. On steady motion the two differ by a viscous torque ``kp delay qd``
+(:meth:`~wbfriction.model.pd.PdDriver.viscous_equivalent`), which F_v takes up; they differ otherwise only at the
+reversals. Where the best does not close the balance better than the other by more than
+:data:`~wbfriction.fit.selection.GAIN_Z` Newey-West standard errors of the per-window difference
+(:func:`structure_gain`), the log does not tell which: the friction's standard errors then have their distance to
+the other's values added in quadrature (:data:`STRUCTURE_SPREAD`; on the real Aliengo, F_v 0 with the set-points
+delayed and 0.26-0.33 with the torque: ``kp delay`` is 0.28), the identification says so
+(:attr:`ActuatorIdentification.delayed_known`) and ``--config-output`` writes ``delayed_known = false``, from which
+the friction fitted afterwards carries ``kp delay`` in F_v's standard error (:mod:`wbfriction.fit.joints`).
+
 PACE (Bjelonic et al., "Towards Bridging the Gap: Systematic Sim-to-Real Transfer for Diverse Legged Robots",
 2025) and the iit-DLSLab identification fit the same quantities by CMA-ES over simulated rollouts; here the problem
 is linear but for the delay, solved in seconds on a CPU.
@@ -35,6 +46,8 @@ from wbfriction.actuator.law_check import LawCheck, check_law
 from wbfriction.actuator.options import ActuatorOptions
 from wbfriction.actuator.rows import BalanceRows, balance_rows, pd_joints
 from wbfriction.actuator.solve import KINDS, DelaySearch, Design, Solution, design, hac_lags, search_delay, solve
+from wbfriction.fit.regression import held_out_gain
+from wbfriction.fit.selection import GAIN_Z
 from wbfriction.fit.status import WEAK
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
@@ -127,6 +140,10 @@ class ActuatorIdentification:
             <wbfriction.logs.clock.Clock.reason>`; "" for a log built in memory).
         law: the robot TOML's PD law checked against the log (:class:`~wbfriction.actuator.law_check.LawCheck`).
         warnings: what the identification found wrong in its input, one line each (the PD law's mismatches).
+        delayed_known: whether the log tells what the delay holds back (module docstring; True where only one was
+            tried).
+        residuals: (W, n) each window's balance residual over the noise its sensors predict (NaN where not used),
+            for comparing identifications of one log; not written.
     """
 
     joints: tuple[JointActuator, ...]
@@ -143,6 +160,8 @@ class ActuatorIdentification:
     clock: str = ""
     law: LawCheck | None = None
     warnings: tuple[str, ...] = ()
+    delayed_known: bool = True
+    residuals: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def joint(self, name: str) -> JointActuator:
         return next(j for j in self.joints if j.joint == name)
@@ -151,7 +170,8 @@ class ActuatorIdentification:
         """The JSON document (``identify --actuator pd --json``)."""
         return {"kind": "pd actuators", "source": self.source, "period": self.period, "window": self.window,
                 "velocity": {"used": self.options.velocity, "why": self.velocity_reason},
-                "delayed": self.options.delayed, "clock": self.clock, "warnings": list(self.warnings),
+                "delayed": self.options.delayed, "delayed_known": self.delayed_known,
+                "clock": self.clock, "warnings": list(self.warnings),
                 "pd_law": None if self.law is None else {
                     "gain": dict(zip(self.law.joints, map(float, self.law.gain))),
                     "gain_se": {j: _finite(s) for j, s in zip(self.law.joints, self.law.gain_se)},
@@ -206,7 +226,64 @@ def identify_actuators(robot: Robot, log: Log, options: ActuatorOptions = Actuat
                 f"next, {second.options.velocity} velocity, {second.options.delayed} delayed)")
     elif log.qd_logged is None and options.velocity == "auto":
         why += ": no qd.<joint> column"
+    others = [runs[int(k)] for k in order if runs[int(k)].options.delayed != best.options.delayed]
+    if others:
+        gain, se = structure_gain(best, others[0])
+        if not gain > GAIN_Z * se:
+            why += (f"; {others[0].options.delayed} delayed closes it within {GAIN_Z:g} standard errors ("
+                    f"{gain:.3g} ± {se:.2g} per window): the log does not tell what the delay holds back")
+            best = _structure_unknown(best, others[0])
     return replace(best, velocity_reason=why, clock=log.clock.reason if log.clock is not None else "")
+
+
+def structure_gain(best: ActuatorIdentification, other: ActuatorIdentification) -> tuple[float, float]:
+    """How much ``best`` lowers the balance's squared residual per window (over the sensors' noise, summed over the
+    joints both use there) against ``other``, an identification of the same log holding back another part of the
+    law, and the Newey-West standard error of that lowering (:func:`~wbfriction.fit.regression.held_out_gain`);
+    (nan, inf) without residuals to compare."""
+    a, b = best.residuals, other.residuals
+    if a is None or b is None or a.shape != b.shape:
+        return float("nan"), float("inf")
+    both = np.isfinite(a) & np.isfinite(b)
+    windows = np.flatnonzero(both.any(axis=1))
+    mine = np.sqrt(np.sum(np.where(both, a, 0.0) ** 2, axis=1))[windows]
+    theirs = np.sqrt(np.sum(np.where(both, b, 0.0) ** 2, axis=1))[windows]
+    return held_out_gain(theirs, mine, windows)
+
+
+STRUCTURE_SPREAD = ("F_v", "F_c")
+"""The values whose standard error carries what the delay holds back where the log does not tell
+(:func:`_structure_unknown`): the friction, which a user reads as the joint's. The armature, the offsets and the delay
+are written to ``--config-output`` beside the ``delayed`` they were fitted under, a pair that closes the balance as
+the other pair does (the real Aliengo's calves: armature 0.012 with the set-points delayed, 0.016 with the torque;
+neither written would leave 0, worse than both)."""
+
+
+def _structure_unknown(best: ActuatorIdentification, other: ActuatorIdentification) -> ActuatorIdentification:
+    """``best`` with its friction's standard errors (:data:`STRUCTURE_SPREAD`) grown by their distance to ``other``'s
+    (module docstring) and their status again, one demoted naming both values; ``delayed_known`` False."""
+    here, there = best.options.delayed, other.options.delayed
+
+    def widened(kind: str, p: Identified, q: Identified | None) -> Identified:
+        if q is None or not (np.isfinite(p.value) and np.isfinite(q.value)):
+            return p
+        se = float(np.hypot(p.se, p.value - q.value))
+        status, reason = parameter_status(kind, p.value, se, p.crb, p.status == "at bound")
+        grown = replace(p, se=se)
+        if status == "ok" or p.status != "ok":
+            return grown
+        return replace(grown, status=status, reason=(f"{kind} {p.value:.3g} with the {here} delayed, {q.value:.3g} "
+                                                     f"with the {there}: the log does not tell which ({reason})"))
+
+    joints = []
+    for j in best.joints:
+        o = other.joint(j.joint)
+        theirs = o.parameters()
+        values = {k: widened(k, p, theirs.get(k)) if k in STRUCTURE_SPREAD else p for k, p in j.parameters().items()}
+        joints.append(replace(j, armature=values["armature"], F_v=values["F_v"], F_c=values["F_c"],
+                              offset=values.get("offset")))
+    delay = replace(best.delay, se=float(np.hypot(best.delay.se, best.delay.value - other.delay.value)))
+    return replace(best, joints=tuple(joints), delay=delay, delayed_known=False)
 
 
 def _identify(robot: Robot, log: Log, options: ActuatorOptions) -> ActuatorIdentification:
@@ -237,7 +314,10 @@ def _identify(robot: Robot, log: Log, options: ActuatorOptions) -> ActuatorIdent
     law = check_law(rows, d, weight, delay.value, _lags(rows, options), options.delay is None, delay.se,
                     robot.pd.delay, np.array([m.excited for m in motion]))
     result = _result(rows, d, sol, delay, search.profile, held, log.source, options)
-    return _verdicts(replace(result, law=law), motion, rows.max_steps)
+    e = d.rhs(rows, rows.balance(search.delay)) - d.A @ sol.x
+    residuals = np.full(rows.rest.shape, np.nan)
+    residuals[d.window, d.joint] = e / np.maximum(rows.sigma[d.joint], 1e-300)
+    return _verdicts(replace(result, law=law, residuals=residuals), motion, rows.max_steps)
 
 
 def _lags(rows: BalanceRows, options: ActuatorOptions) -> int:

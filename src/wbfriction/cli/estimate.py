@@ -88,6 +88,8 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     if torque.get("source") not in (None, "sensor"):
         held = "the whole torque" if torque.get("delayed") == "torque" else "the set-points"
         delay = f", {held} {1e3 * torque['delay']:.3g} ms late ({torque['gains']})" if "delay" in torque else ""
+        if torque.get("delayed_known") is False:
+            delay += "; the log it was identified on does not tell what the delay holds back: F_v known to kp delay"
         console.print(escape(f"torque: {torque['what']}{delay}"), highlight=False, soft_wrap=True)
         if torque.get("source") == "pd" and bag_map is None:
             from wbfriction.pipeline.actuator_step import pd_law_warnings

@@ -4,6 +4,7 @@ parallel, each checked on the other route, on its later stretch and with its ter
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import Any, cast
@@ -228,7 +229,25 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
                 if not _better_refit(refit, f):
                     break
                 fits[k] = f = refit
+    structure = delay_structure_spread(est.metadata)
+    for f in fits:
+        if f.joint in structure and f.params is not None and "F_v" in f.params.names:
+            f.model_spread = {**f.model_spread, "F_v": math.hypot(f.model_spread.get("F_v", 0.0), structure[f.joint])}
     return fits
+
+
+def delay_structure_spread(metadata: Mapping[str, Any]) -> dict[str, float]:
+    """Per joint, the viscous coefficient [N·m·s/rad] by which an estimate's torque would differ had its PD drivers'
+    delay held back the other part of their law (``kp delay``,
+    :meth:`~wbfriction.model.pd.PdDriver.viscous_equivalent`), where the log the delay was identified on did not
+    tell which (its ``torque_source`` metadata: ``delayed_known`` false); {} otherwise. On steady motion the
+    friction's F_v takes that torque up whole, so it is F_v's model error
+    (:attr:`~wbfriction.fit.result.FitResult.model_spread`; issue 63: on the real Aliengo, F_v 0 with the set-points
+    delayed and 0.2-0.3 with the torque, ``kp delay`` 0.28)."""
+    torque = metadata.get("torque_source") or {}
+    if not isinstance(torque, Mapping) or torque.get("delayed_known") is not False:
+        return {}
+    return {str(j): float(v) for j, v in (torque.get("viscous_equivalent") or {}).items()}
 
 
 UNUSABLE: tuple[str, ...] = ("failed", "at bound", "not excited")

@@ -3,7 +3,9 @@
 The **parameters JSON** holds the fitted model per joint (:class:`~wbfriction.fit.result.FitResult`): its
 name (``model``: ``coulomb-viscous``, ``stribeck`` or ``thesis`` (3.5)), parameters, standard errors, their
 Cramér-Rao bounds (``crb``) and the torque noise they take (``torque_noise``), which parameters ended at a
-bound (``at_bound``) and which magnitudes the data press against their floor of zero (``pressed``), the
+bound (``at_bound``), which magnitudes the data press against their floor of zero (``pressed``), how far F_c and
+F_v move between the candidate families (``model_spread``: with ``model="auto"``; the standard error a user reads
+is ``stderr`` and it in quadrature), the
 estimate's ``route`` and the same model on the other route (``route_check``: its parameters, standard errors, and
 those that ``disagree``), the velocity noise the model's expectation took
 (``velocity_noise``), the samples left out where the joint may stick (``stick_speed``, ``n_stuck``) and, when
@@ -104,6 +106,8 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
                          "at_bound": dict(fit.at_bound), "speed": fit.speed, "reverse": fit.reverse}
     if fit.pressed:
         d["pressed"] = {k: [clean(v), clean(se)] for k, (v, se) in fit.pressed.items()}
+    if fit.model_spread:
+        d["model_spread"] = {k: clean(v) for k, v in fit.model_spread.items()}
     if fit.params is not None and fit.covariance is not None:  # the curve's standard error at any speed
         d["covariance"] = [[clean(float(x)) for x in row] for row in fit.covariance]
     d["crb"] = {k: clean(v) for k, v in fit.crb.items()}
@@ -167,6 +171,7 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
             raise InputError(f"at_bound names {', '.join(sorted(unknown))}: not parameters of the {model} model")
         res.at_bound = {str(k): bool(v) for k, v in at_bound.items()}
         res.pressed = {str(k): (_number(v[0]), _number(v[1])) for k, v in (d.get("pressed") or {}).items()}
+        res.model_spread = {str(k): _number(v) for k, v in (d.get("model_spread") or {}).items()}
         if d.get("selection") is not None:
             res.selection = selection_from_dict(d["selection"])
         res.crb = {str(k): _number(v) for k, v in (d.get("crb") or {}).items()}

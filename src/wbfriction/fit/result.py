@@ -5,6 +5,7 @@ through this type (the report, the exports, the parameters JSON)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Generic, cast
@@ -171,6 +172,12 @@ class FitResult(Generic[ParamsT]):
         pressed: the magnitudes at their floor of zero that the data press below it
             (:func:`~wbfriction.fit.solve.pressed_floors`): name -> (the value without the floor, its standard
             error); such a zero is a bound of the model, not a finding, and the fit is ``at bound``.
+        model_spread: with ``model="auto"``, per magnitude a user reads (F_c, F_v), how far it moves between the
+            model chosen and the other candidate families (:func:`~wbfriction.fit.selection.family_spread`): the
+            model error the data do not resolve; and F_v's, where the PD drivers' delay holds back a part of their law
+            the log did not tell (:func:`~wbfriction.fit.joints.delay_structure_spread`), ``kp delay`` with it in
+            quadrature. The standard error a user reads (:meth:`read_stderr`) adds it in quadrature to
+            :attr:`stderr`; the route check and the predictions use :attr:`stderr` (issue 63).
     """
 
     joint: str
@@ -202,6 +209,7 @@ class FitResult(Generic[ParamsT]):
     later: PredictionCheck | None = None
     unmeasured: str = ""
     pressed: dict[str, tuple[float, float]] = field(default_factory=dict)
+    model_spread: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.params is not None:
@@ -211,6 +219,11 @@ class FitResult(Generic[ParamsT]):
     def kept_terms(self) -> TermFit | None:
         """:attr:`terms` when they kept any (the model predictions and exports use), else None."""
         return self.terms if self.terms is not None and self.terms.kept else None
+
+    def read_stderr(self) -> dict[str, float]:
+        """The standard errors a user reads, per parameter: :attr:`stderr` and :attr:`model_spread` in quadrature
+        (the statistical spread and the model family's; issue 63)."""
+        return {n: math.hypot(se, self.model_spread.get(n, 0.0)) for n, se in self.stderr.items()}
 
     def reported(self) -> FitResult:
         """This fit as its numbers are shown: with terms kept (:attr:`kept_terms`), the model its status judges and

@@ -27,7 +27,8 @@ status, the first that applies:
   its joint so too (:mod:`~wbfriction.fit.term_selection`);
 * ``weak``: the joint moved one way (the other on fewer than :data:`MIN_REVERSE` of its samples: its Coulomb
   friction and offset are not separable, whatever their standard errors say), or
-  a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error, or a Cramér-Rao bound
+  a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error (with ``model="auto"`` the
+  statistical one and the model family's spread in quadrature: ``FitResult.read_stderr``), or a Cramér-Rao bound
   (:mod:`~wbfriction.fit.bound`: what the data allow any unbiased estimator), above :data:`WEAK` of its
   (non-zero) value, or is not identifiable (infinite standard error); a magnitude at zero whose standard error
   or bound stands for more than :data:`WEAK` of the friction the joint shows (``F_c``'s in N·m, ``F_v``'s times
@@ -158,6 +159,7 @@ class Fit(Protocol):
     later: Any
     at_bound: dict[str, bool]
     pressed: dict[str, tuple[float, float]]
+    model_spread: dict[str, float]
 
     def bounded(self) -> tuple[str, ...]: ...
 
@@ -286,7 +288,8 @@ def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THR
     # energy check removes both), the offset alone is not, and it is no friction a user reads
     judged = [n for n in values if n in terms.stderr and not (n == "tau_os" and "ripple" in terms.kept)]
     view = SimpleNamespace(params=terms.params, stderr={n: terms.stderr[n] for n in judged}, crb={}, speed=fit.speed,
-                           rms_residual=fit.rms_residual, at_bound={n: True for n in terms.at_bound})
+                           rms_residual=fit.rms_residual, at_bound={n: True for n in terms.at_bound},
+                           model_spread=fit.model_spread)
     weak = _weak(cast(Fit, view), values, thresholds.weak) + [f"{t} {v.reason.removeprefix('large standard errors: ')}"
                                              for t, v in others.items() if v.status == "weak"]
     return _weak_verdict(fit, weak)
@@ -301,13 +304,15 @@ def _weak(fit: Fit, values: dict[str, float], limit: float = WEAK) -> list[str]:
     for name in (n for n in READ if n in fit.stderr):
         # a magnitude its fit left at its floor is zero (1e-5 of an F_v is the solver's, not the data's)
         value = 0.0 if fit.at_bound.get(name) else abs(values[name])
-        for bound, spread in ((False, fit.stderr[name]), (True, fit.crb.get(name, 0.0))):
+        family = fit.model_spread.get(name, 0.0)  # the model family's spread, in quadrature (issue 63)
+        for bound, spread in ((False, math.hypot(fit.stderr[name], family)), (True, fit.crb.get(name, 0.0))):
             at_best = " at best (Cramér-Rao)" if bound else ""
             if not np.isfinite(spread):
                 out.append(f"{name} not identifiable{at_best}")
                 break
             if value >= ZERO and spread > limit * value:
-                out.append(f"{name} ±{100 * spread / value:.0f} %{at_best}")
+                of_family = f" (its model family ±{100 * family / value:.0f} %)" if not bound and family > ZERO else ""
+                out.append(f"{name} ±{100 * spread / value:.0f} %{at_best}{of_family}")
                 break
             # a magnitude at zero: against the friction it would make at the speed a user reads it at
             share = spread * (max(speed, READ_SPEED) if name == "F_v" else 1.0)

@@ -53,6 +53,11 @@ class PdDriver:
             (zero-order hold); at least 0.
         torque_limit: the torque the driver clips at (n,) [N·m] (inf: none); default the URDF's effort limits.
         delayed: what the delay holds back (:data:`Delayed`).
+        delayed_known: whether the log it was identified on told what the delay holds back (``wbfriction identify
+            --actuator pd``): False where set-points and torque delayed close its balance alike. On steady motion
+            the two differ by a viscous torque ``kp delay qd`` (the set-point's lag ``delay qd`` times kp), which a
+            friction fitted under either takes up: its F_v is then known only to within ``kp delay``
+            (:func:`viscous_equivalent`; issue 63).
 
     Raises:
         ValueError: arrays of another length than :attr:`joints`, a negative or non-finite gain, a negative
@@ -65,6 +70,7 @@ class PdDriver:
     delay: float = 0.0
     torque_limit: np.ndarray = field(default_factory=lambda: np.empty(0))
     delayed: Delayed = "setpoints"
+    delayed_known: bool = True
 
     def __post_init__(self) -> None:
         n = len(self.joints)
@@ -86,7 +92,13 @@ class PdDriver:
     def with_delay(self, delay: float, delayed: Delayed | None = None) -> PdDriver:
         """The same drivers with the delay ``delay`` [s] (holding back ``delayed``, default as now)."""
         return PdDriver(self.joints, self.kp, self.kd, float(delay), self.torque_limit,
-                        self.delayed if delayed is None else delayed)
+                        self.delayed if delayed is None else delayed, self.delayed_known)
+
+    def viscous_equivalent(self) -> dict[str, float]:
+        """Per joint, the viscous coefficient ``kp delay`` [N·m·s/rad] by which the set-points delayed and the torque
+        delayed differ on steady motion (:attr:`delayed_known`): at speed ``qd`` a set-point held back by ``delay`` lags
+        by ``delay qd``, so its law applies ``kp delay qd`` less than the whole law held back does."""
+        return {j: float(k * self.delay) for j, k in zip(self.joints, self.kp)}
 
 
 def delayed(values: np.ndarray, time: np.ndarray, delay: float) -> np.ndarray:
@@ -153,7 +165,9 @@ def parse_pd(table: object, actuated: list[str], groups: dict[str, tuple[str, ..
 
     Keys: ``kp`` [N·m/rad] and ``kd`` [N·m·s/rad], each a number for every PD-driven joint or a table of joint or
     group -> number (every PD-driven joint covered); ``delay`` [s] (default 0); ``delayed`` (what the delay holds
-    back, :data:`Delayed`: ``setpoints`` by default, or ``torque``); ``joints`` (the PD-driven joints,
+    back, :data:`Delayed`: ``setpoints`` by default, or ``torque``); ``delayed_known`` (true by default; false where the
+    log ``identify`` found the delay on did not tell what it holds back: :attr:`PdDriver.delayed_known`); ``joints``
+    (the PD-driven joints,
     default every actuated joint); ``torque_limit`` [N·m] (a number or a table as the gains; default the URDF's
     effort limits, none where the URDF gives 0).
 
@@ -174,13 +188,16 @@ def parse_pd(table: object, actuated: list[str], groups: dict[str, tuple[str, ..
         return None
     if not isinstance(table, dict):
         raise InputError(f"{source}: '[pd]' must be a table (kp, kd, delay, joints, torque_limit)")
-    unknown = set(table) - {"kp", "kd", "delay", "joints", "torque_limit", "delayed"}
+    unknown = set(table) - {"kp", "kd", "delay", "joints", "torque_limit", "delayed", "delayed_known"}
     if unknown:
-        raise InputError(f"{source}: [pd] has no key '{sorted(unknown)[0]}' (kp, kd, delay, delayed, joints, "
-                         "torque_limit)")
+        raise InputError(f"{source}: [pd] has no key '{sorted(unknown)[0]}' (kp, kd, delay, delayed, delayed_known, "
+                         "joints, torque_limit)")
     held_back = table.get("delayed", "setpoints")
     if held_back not in DELAYED:
         raise InputError(f"{source}: [pd] delayed must be one of {', '.join(DELAYED)}, got {held_back!r}")
+    known = table.get("delayed_known", True)
+    if not isinstance(known, bool):
+        raise InputError(f"{source}: [pd] delayed_known must be true or false, got {known!r}")
     joints = table.get("joints", actuated)
     if not isinstance(joints, list) or any(j not in actuated for j in joints) or not joints:
         bad = next((j for j in joints if j not in actuated), joints) if isinstance(joints, list) else joints
@@ -220,4 +237,4 @@ def parse_pd(table: object, actuated: list[str], groups: dict[str, tuple[str, ..
     if isinstance(delay, bool) or not isinstance(delay, (int, float)) or not (np.isfinite(delay) and delay >= 0):
         raise InputError(f"{source}: [pd] delay must be a number of seconds >= 0, got {delay!r}")
     return PdDriver(tuple(joints), per_joint("kp", None, False), per_joint("kd", None, False), float(delay),
-                    per_joint("torque_limit", limits, True), held_back)
+                    per_joint("torque_limit", limits, True), held_back, known)

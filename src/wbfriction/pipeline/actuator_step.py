@@ -77,12 +77,15 @@ def actuator_config(text: str, source_dir: Path, urdf: Path, output: Path, resul
         if skipping or (in_pd and delay is not None and re.match(r"\s*delay\s*=", line)):
             continue
         lines.append(line)
-        if in_pd and delay is not None and re.match(r"\s*delayed\s*=", line):
+        if in_pd and delay is not None and re.match(r"\s*delayed(_known)?\s*=", line):
             lines.pop()
         if header and in_pd and delay is not None:
             lines.append(f"delay = {delay!r}   # identified by wbfriction identify --actuator pd [s]")
             if result.options.delayed != "auto":
                 lines.append(f'delayed = "{result.options.delayed}"   # what the delay holds back (identified)')
+            if not result.delayed_known:
+                lines.append("delayed_known = false   # the log closes the balance as well with the other: the "
+                             "friction's F_v is known only to within kp delay")
     offsets = {**given.get("encoder_offset", {}), **offsets}
     if offsets:
         lines += ["", "[encoder_offset]   # identified by wbfriction identify --actuator pd [rad]"]
@@ -95,6 +98,9 @@ def actuator_config(text: str, source_dir: Path, urdf: Path, output: Path, resul
         expected.setdefault("pd", {})["delay"] = delay
         if result.options.delayed != "auto":
             expected["pd"]["delayed"] = result.options.delayed
+        expected["pd"].pop("delayed_known", None)
+        if not result.delayed_known:
+            expected["pd"]["delayed_known"] = False
     if tomllib.loads(written) != expected:
         raise InputError(f"{output}: the robot's configuration could not be rewritten line by line (its [pd] or "
                          "[encoder_offset] is not a plain table): copy the values printed into it instead")

@@ -106,7 +106,7 @@ def _params_table(r: Report, joints: list[str], fits: dict[str, FitResult]) -> s
         if n in fit.steps():
             return '<td>step<br><span class="name">sharper than the data resolve: Coulomb</span></td>'
         bound = '<br><span class="name">at a bound</span>' if fit.at_bound.get(n) else ""
-        return f"<td>{_fmt(getattr(fit.params, n), fit.stderr.get(n))}{bound}</td>"
+        return f"<td>{_fmt(getattr(fit.params, n), fit.read_stderr().get(n))}{bound}</td>"
 
     for j in joints:
         fit = fits.get(j)
@@ -295,7 +295,7 @@ def _pm(fit: FitResult, name: str, digits: int = 3) -> str:
         return "—"
     value = getattr(fit.params, name)
     value = 0.0 if abs(value) < 1e-9 else value  # a magnitude at its floor of zero, not 2.4e-15
-    return _fmt(value, fit.stderr.get(name), digits)
+    return _fmt(value, fit.read_stderr().get(name), digits)
 
 
 def _summary_table(r: Report) -> str:

@@ -32,9 +32,10 @@ MAIN = ("F_c", "F_v")
 OTHERS = ("tau_os", "S", "v_s", "a")
 """The offset (every model) and the Stribeck terms (the models that have them), in a second table."""
 CAPTION = ("value ± standard error (the residuals' autocorrelation-consistent sandwich, raised to the "
-           "Cramér-Rao bound where that is larger); Cramér-Rao: the standard deviation no unbiased estimator "
-           "from these data goes below; n.i.: not identifiable; (b): at a bound of the fit, the bound's value, "
-           "not the data's; "
+           "Cramér-Rao bound where that is larger; for F_c and F_v of a model chosen automatically, with the "
+           "model error the candidate families show, in quadrature); Cramér-Rao: the standard deviation no "
+           "unbiased estimator from these data goes below; n.i.: not identifiable; (b): at a bound of the fit, "
+           "the bound's value, not the data's; "
            "a step: a tanh slope beyond what the data resolve (Coulomb friction, sgn); "
            "dim: not to be used (status); *: refitted with its terms beyond velocity (the terms' table)")
 NAMES_SHOWN = 6
@@ -46,7 +47,7 @@ def _cell(r: FitResult, name: str) -> str:
         return ""
     if name in r.steps():
         return "step"
-    return with_error(getattr(r.params, name), r.stderr.get(name)) + (" (b)" if r.at_bound.get(name) else "")
+    return with_error(getattr(r.params, name), r.read_stderr().get(name)) + (" (b)" if r.at_bound.get(name) else "")
 
 
 def _table(title: str, first: Sequence[str], names: Sequence[str], caption: str | None = None) -> Table:

@@ -205,7 +205,8 @@ def excited(speed: float | None, status: str) -> bool:
 
 def fits_from_params(path: str | Path, truth: Mapping[str, Mapping[str, float]]) -> list[JointFit]:
     """Every joint of a parameters JSON (``wbfriction fit -o``) that has a truth, as :class:`JointFit`: its
-    ``status``, and F_c and F_v with their ``stderr`` and ``crb`` (a joint without parameters: none; with terms
+    ``status``, and F_c and F_v with their ``stderr`` (and ``model_spread`` in quadrature, as a user reads them)
+    and ``crb`` (a joint without parameters: none; with terms
     kept, the velocity model refitted with them, ``terms.params`` and ``terms.stderr``, as the status judges it and
     :meth:`~wbfriction.fit.result.FitResult.reported` shows it, without a bound); ``truth``:
     per joint the injected parameters (the log's ``friction_true``). F_v is not excited on a joint that did not
@@ -227,9 +228,10 @@ def fits_from_params(path: str | Path, truth: Mapping[str, Mapping[str, float]])
         terms = d.get("terms") or {}
         if terms.get("kept"):  # the model the status judges and predictions use: refitted with its terms, no bound
             params, stderr, crb = terms.get("params") or {}, terms.get("stderr") or {}, {}
+        family = d.get("model_spread") or {}  # the standard error a user reads: the family's spread in quadrature
         out.append(JointFit(joint, status, tuple(
-            ParameterFit(n, float(params[n]), _number(stderr.get(n)), _number(crb.get(n)), float(truth[joint][n]),
-                         moved or n != "F_v")
+            ParameterFit(n, float(params[n]), math.hypot(_number(stderr.get(n)), float(family.get(n) or 0.0)),
+                         _number(crb.get(n)), float(truth[joint][n]), moved or n != "F_v")
             for n in FRICTION if n in params and n in truth[joint])))
     return out
 
