@@ -19,7 +19,7 @@ import pytest
 
 import wbfriction
 from wbfriction.actuator import identify_actuators
-from wbfriction.actuator.identification import _structure_unknown, structure_gain
+from wbfriction.actuator.identification import structure_gain, structure_widened
 from wbfriction.exceptions import InputError
 from wbfriction.fit.joints import delay_structure_spread
 from wbfriction.logs.log import log_from_table
@@ -57,7 +57,7 @@ def test_a_structure_not_told_widens_the_friction_by_its_distance_to_the_others(
                                                  armature=replace(j.armature, value=j.armature.value + 0.01))
                                          for j in result.joints))
     other = replace(other, options=replace(result.options, delayed="torque"))
-    widened = _structure_unknown(result, other)
+    widened = structure_widened(result, other)
     assert not widened.delayed_known
     for before, after in zip(result.joints, widened.joints):
         assert after.F_v.se == pytest.approx(math.hypot(before.F_v.se, 0.3))

@@ -230,9 +230,10 @@ def identify_actuators(robot: Robot, log: Log, options: ActuatorOptions = Actuat
     if others:
         gain, se = structure_gain(best, others[0])
         if not gain > GAIN_Z * se:
-            why += (f"; {others[0].options.delayed} delayed closes it within {GAIN_Z:g} standard errors ("
-                    f"{gain:.3g} ± {se:.2g} per window): the log does not tell what the delay holds back")
-            best = _structure_unknown(best, others[0])
+            why += (f"; {others[0].options.delayed} delayed closes it as well (its squared residual per window over "
+                    f"the sensors' noise higher by {gain:.3g} ± {se:.2g}, within {GAIN_Z:g} standard errors): the log "
+                    "does not tell what the delay holds back")
+            best = structure_widened(best, others[0])
     return replace(best, velocity_reason=why, clock=log.clock.reason if log.clock is not None else "")
 
 
@@ -253,13 +254,13 @@ def structure_gain(best: ActuatorIdentification, other: ActuatorIdentification) 
 
 STRUCTURE_SPREAD = ("F_v", "F_c")
 """The values whose standard error carries what the delay holds back where the log does not tell
-(:func:`_structure_unknown`): the friction, which a user reads as the joint's. The armature, the offsets and the delay
+(:func:`structure_widened`): the friction, which a user reads as the joint's. The armature, the offsets and the delay
 are written to ``--config-output`` beside the ``delayed`` they were fitted under, a pair that closes the balance as
 the other pair does (the real Aliengo's calves: armature 0.012 with the set-points delayed, 0.016 with the torque;
 neither written would leave 0, worse than both)."""
 
 
-def _structure_unknown(best: ActuatorIdentification, other: ActuatorIdentification) -> ActuatorIdentification:
+def structure_widened(best: ActuatorIdentification, other: ActuatorIdentification) -> ActuatorIdentification:
     """``best`` with its friction's standard errors (:data:`STRUCTURE_SPREAD`) grown by their distance to ``other``'s
     (module docstring) and their status again, one demoted naming both values; ``delayed_known`` False."""
     here, there = best.options.delayed, other.options.delayed

@@ -229,7 +229,12 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
                 if not _better_refit(refit, f):
                     break
                 fits[k] = f = refit
-    structure = delay_structure_spread(est.metadata)
+    return _with_delay_structure(fits, est.metadata)
+
+
+def _with_delay_structure(fits: list[FitResult], metadata: Mapping[str, Any]) -> list[FitResult]:
+    """``fits`` with F_v's :func:`delay_structure_spread` in their ``model_spread`` (in quadrature)."""
+    structure = delay_structure_spread(metadata)
     for f in fits:
         if f.joint in structure and f.params is not None and "F_v" in f.params.names:
             f.model_spread = {**f.model_spread, "F_v": math.hypot(f.model_spread.get("F_v", 0.0), structure[f.joint])}
