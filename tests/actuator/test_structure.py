@@ -2,9 +2,10 @@
 
 Set-points held back by ``d`` and the whole law held back differ on steady motion by a viscous torque ``kp d qd``: a
 friction fitted under either takes it up in F_v. On the real Aliengo (``tests/real/test_aliengo.py``) the two close
-the balance alike and F_v is 0 under one, 0.26-0.33 under the other (``kp d`` = 0.28). Where the log does not tell,
-the identified friction carries its distance to the other's, ``--config-output`` says so (``delayed_known = false``)
-and the friction fitted afterwards carries ``kp d`` in F_v's standard error.
+the balance alike and F_v is 0 on ten joints under one, 0.14-0.61 under the other, 0.33 higher where both are
+interior (``kp d`` = 0.28). Where the log does not tell, the identified friction carries its distance to the
+other's, ``--config-output`` says so (``delayed_known = false``) and the friction fitted afterwards carries ``kp d``
+in F_v's standard error.
 """
 
 from __future__ import annotations

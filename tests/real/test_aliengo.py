@@ -16,9 +16,9 @@ fit now chosen predicts it to 0.101, the peer 0.097 (the rear right calf gained:
 
 What the log cannot tell (issue 63, third session): the drivers' delay holding back the set-points or the whole
 torque closes the balance alike (squared residual ratio 1.00), and on the ramps the two differ by a viscous torque
-``kp delay qd`` (0.28 N·m·s/rad), which F_v takes up: F_v 0 with the set-points held back, 0.26-0.33 with the torque
-(the peer's 0.24-0.31). No F_v is then ``ok``, and the friction fitted afterwards carries ``kp delay`` in F_v's
-standard error.
+``kp delay qd`` (0.28 N·m·s/rad), which F_v takes up: F_v 0 on ten joints with the set-points held back, 0.14-0.61
+with the torque (the peer's 0.24-0.31), 0.33 higher on the two hips where both are interior. No F_v is then
+``ok``, and the friction fitted afterwards carries ``kp delay`` in F_v's standard error.
 """
 
 from __future__ import annotations

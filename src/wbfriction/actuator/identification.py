@@ -24,10 +24,11 @@ closes it best. On steady motion the two differ by a viscous torque ``kp delay q
 reversals. Where the best does not close the balance better than the other by more than
 :data:`~wbfriction.fit.selection.GAIN_Z` Newey-West standard errors of the per-window difference
 (:func:`structure_gain`), the log does not tell which: the friction's standard errors then have their distance to
-the other's values added in quadrature (:data:`STRUCTURE_SPREAD`; on the real Aliengo, F_v 0 with the set-points
-delayed and 0.26-0.33 with the torque: ``kp delay`` is 0.28), the identification says so
-(:attr:`ActuatorIdentification.delayed_known`) and ``--config-output`` writes ``delayed_known = false``, from which
-the friction fitted afterwards carries ``kp delay`` in F_v's standard error (:mod:`wbfriction.fit.joints`).
+the other's values added in quadrature (:data:`STRUCTURE_SPREAD`; on the real Aliengo, F_v 0 on ten joints with the
+set-points delayed, 0.14-0.61 with the torque, 0.33 higher where both are interior: ``kp delay`` is 0.28), the
+identification says so (:attr:`ActuatorIdentification.delayed_known`) and ``--config-output`` writes
+``delayed_known = false``, from which the friction fitted afterwards carries ``kp delay`` in F_v's standard error
+(:mod:`wbfriction.fit.joints`).
 
 PACE (Bjelonic et al., "Towards Bridging the Gap: Systematic Sim-to-Real Transfer for Diverse Legged Robots",
 2025) and the iit-DLSLab identification fit the same quantities by CMA-ES over simulated rollouts; here the problem

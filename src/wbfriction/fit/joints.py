@@ -247,8 +247,8 @@ def delay_structure_spread(metadata: Mapping[str, Any]) -> dict[str, float]:
     :meth:`~wbfriction.model.pd.PdDriver.viscous_equivalent`), where the log the delay was identified on did not
     tell which (its ``torque_source`` metadata: ``delayed_known`` false); {} otherwise. On steady motion the
     friction's F_v takes that torque up whole, so it is F_v's model error
-    (:attr:`~wbfriction.fit.result.FitResult.model_spread`; issue 63: on the real Aliengo, F_v 0 with the set-points
-    delayed and 0.2-0.3 with the torque, ``kp delay`` 0.28)."""
+    (:attr:`~wbfriction.fit.result.FitResult.model_spread`; issue 63: on the real Aliengo, F_v 0 on ten joints with
+    the set-points delayed, 0.14-0.61 with the torque, 0.33 higher where both are interior; ``kp delay`` 0.28)."""
     torque = metadata.get("torque_source") or {}
     if not isinstance(torque, Mapping) or torque.get("delayed_known") is not False:
         return {}
