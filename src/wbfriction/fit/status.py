@@ -304,14 +304,14 @@ def _weak(fit: Fit, values: dict[str, float], limit: float = WEAK) -> list[str]:
     for name in (n for n in READ if n in fit.stderr):
         # a magnitude its fit left at its floor is zero (1e-5 of an F_v is the solver's, not the data's)
         value = 0.0 if fit.at_bound.get(name) else abs(values[name])
-        family = fit.model_spread.get(name, 0.0)  # the model family's spread, in quadrature (issue 63)
+        family = fit.model_spread.get(name, 0.0)  # the model error the data do not resolve, in quadrature (issue 63)
         for bound, spread in ((False, math.hypot(fit.stderr[name], family)), (True, fit.crb.get(name, 0.0))):
             at_best = " at best (Cramér-Rao)" if bound else ""
             if not np.isfinite(spread):
                 out.append(f"{name} not identifiable{at_best}")
                 break
             if value >= ZERO and spread > limit * value:
-                of_family = f" (its model family ±{100 * family / value:.0f} %)" if not bound and family > ZERO else ""
+                of_family = f" (model error ±{100 * family / value:.0f} %)" if not bound and family > ZERO else ""
                 out.append(f"{name} ±{100 * spread / value:.0f} %{at_best}{of_family}")
                 break
             # a magnitude at zero: against the friction it would make at the speed a user reads it at
