@@ -121,6 +121,11 @@ class JointActuator:
         out = {"armature": self.armature, "F_v": self.F_v, "F_c": self.F_c}
         return out | ({"offset": self.offset} if self.offset is not None else {})
 
+    def with_values(self, values: dict[str, Identified]) -> JointActuator:
+        """This joint with its :meth:`parameters` replaced by ``values`` (the same kinds)."""
+        return replace(self, armature=values["armature"], F_v=values["F_v"], F_c=values["F_c"],
+                       offset=values.get("offset"))
+
 
 @dataclass(frozen=True)
 class ActuatorIdentification:
@@ -272,18 +277,16 @@ def structure_widened(best: ActuatorIdentification, other: ActuatorIdentificatio
         se = float(np.hypot(p.se, p.value - q.value))
         status, reason = parameter_status(kind, p.value, se, p.crb, p.status == "at bound")
         grown = replace(p, se=se)
-        if status == "ok" or p.status != "ok":
+        if status == "ok":
             return grown
-        return replace(grown, status=status, reason=(f"{kind} {p.value:.3g} with the {here} delayed, {q.value:.3g} "
-                                                     f"with the {there}: the log does not tell which ({reason})"))
+        return _demoted(grown, status, f"{kind} {p.value:.3g} with the {here} delayed, {q.value:.3g} with the "
+                                       f"{there}: the log does not tell which ({reason})")
 
     joints = []
     for j in best.joints:
-        o = other.joint(j.joint)
-        theirs = o.parameters()
-        values = {k: widened(k, p, theirs.get(k)) if k in STRUCTURE_SPREAD else p for k, p in j.parameters().items()}
-        joints.append(replace(j, armature=values["armature"], F_v=values["F_v"], F_c=values["F_c"],
-                              offset=values.get("offset")))
+        theirs = other.joint(j.joint).parameters()
+        joints.append(j.with_values({k: widened(k, p, theirs.get(k)) if k in STRUCTURE_SPREAD else p
+                                     for k, p in j.parameters().items()}))
     delay = replace(best.delay, se=float(np.hypot(best.delay.se, best.delay.value - other.delay.value)))
     return replace(best, joints=tuple(joints), delay=delay, delayed_known=False)
 
@@ -452,8 +455,7 @@ def _verdicts(result: ActuatorIdentification, motion: tuple[JointMotion, ...], m
             if gains:
                 p = _demoted(p, "weak", f"{kind}: {gains}")
             values[kind] = p
-        joints.append(replace(j, armature=values["armature"], F_v=values["F_v"], F_c=values["F_c"],
-                              offset=values.get("offset")))
+        joints.append(j.with_values(values))
     if law is not None and law.gains_differ:
         d = _demoted(d, "weak", "found under the TOML's PD gains, which the log contradicts")
     lines = law.lines() if law is not None else []

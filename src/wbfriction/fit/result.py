@@ -5,7 +5,6 @@ through this type (the report, the exports, the parameters JSON)."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Generic, cast
@@ -17,7 +16,7 @@ from wbfriction.fit.holdout import (
     PredictionCheck,
 )
 from wbfriction.fit.options import PASS_ROWS, SELECTION_TOLERANCE
-from wbfriction.fit.status import HELD, FitVerdict, fit_verdict, routes_disagree
+from wbfriction.fit.status import HELD, FitVerdict, fit_verdict, read_error, routes_disagree
 from wbfriction.fit.terms import TermFit, term_signals
 from wbfriction.friction.estimated import FrictionEstimate
 from wbfriction.friction.families.registry import family
@@ -223,7 +222,7 @@ class FitResult(Generic[ParamsT]):
     def read_stderr(self) -> dict[str, float]:
         """The standard errors a user reads, per parameter: :attr:`stderr` and :attr:`model_spread` in quadrature
         (the statistical spread and the model family's; issue 63)."""
-        return {n: math.hypot(se, self.model_spread.get(n, 0.0)) for n, se in self.stderr.items()}
+        return {n: read_error(se, self.model_spread.get(n, 0.0)) for n, se in self.stderr.items()}
 
     def reported(self) -> FitResult:
         """This fit as its numbers are shown: with terms kept (:attr:`kept_terms`), the model its status judges and

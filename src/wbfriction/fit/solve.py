@@ -30,7 +30,7 @@ filtered objective. Samples where the joint may stick are left out (:func:`stuck
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 
@@ -198,8 +198,8 @@ PRESS_Z = 3.0
 its standard errors is pressed against the floor (:func:`pressed_floors`): a bound of the model, not a finding."""
 
 
-def pressed_floors(z: np.ndarray, r: np.ndarray, jacobian, floors: list[int], names: np.ndarray,
-                   rows: np.ndarray) -> dict[str, tuple[float, float]]:
+def pressed_floors(z: np.ndarray, r: np.ndarray, jacobian: Callable[[np.ndarray], np.ndarray], floors: list[int],
+                   names: np.ndarray, rows: np.ndarray) -> dict[str, tuple[float, float]]:
     """The magnitudes at their floor of zero that the data press against it: for each of ``floors`` (indices into
     the free parameters ``z`` (p,) in the fit's coordinates, at a lower bound of 0), the value one Gauss-Newton step
     from the optimum without bounds would give, where it lies below zero by more than :data:`PRESS_Z` standard

@@ -102,6 +102,12 @@ def routes_disagree(a: float, se_a: float, b: float, se_b: float, z: float = ROU
     return abs(a - b) > z * math.hypot(se_a, se_b) and abs(a - b) > rel * max(abs(a), abs(b))
 
 
+def read_error(stderr: float, model_spread: float = 0.0) -> float:
+    """The standard error a user reads: the statistical ``stderr`` and the model error the data do not resolve
+    (``model_spread``, :attr:`~wbfriction.fit.result.FitResult.model_spread`) in quadrature (issue 63)."""
+    return math.hypot(stderr, model_spread)
+
+
 WEAK = 0.25
 """A user-facing parameter whose standard error (or Cramér-Rao bound) exceeds this share of its value makes a fit
 weak. Chosen across the real datasets and the simulators, one left out (README, *Defaults chosen across the data*):
@@ -305,7 +311,7 @@ def _weak(fit: Fit, values: dict[str, float], limit: float = WEAK) -> list[str]:
         # a magnitude its fit left at its floor is zero (1e-5 of an F_v is the solver's, not the data's)
         value = 0.0 if fit.at_bound.get(name) else abs(values[name])
         family = fit.model_spread.get(name, 0.0)  # the model error the data do not resolve, in quadrature (issue 63)
-        for bound, spread in ((False, math.hypot(fit.stderr[name], family)), (True, fit.crb.get(name, 0.0))):
+        for bound, spread in ((False, read_error(fit.stderr[name], family)), (True, fit.crb.get(name, 0.0))):
             at_best = " at best (Cramér-Rao)" if bound else ""
             if not np.isfinite(spread):
                 out.append(f"{name} not identifiable{at_best}")

@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from wbfriction.fit.status import MIN_SPEED, joint_speed
+from wbfriction.fit.status import MIN_SPEED, joint_speed, read_error
 
 GOOD_NOISE_FREE = 0.05
 """A fit on a noise-free log is good when F_c and F_v lie within this share of the truth (the issue's 5 %)."""
@@ -230,7 +230,7 @@ def fits_from_params(path: str | Path, truth: Mapping[str, Mapping[str, float]])
             params, stderr, crb = terms.get("params") or {}, terms.get("stderr") or {}, {}
         family = d.get("model_spread") or {}  # the standard error a user reads: the family's spread in quadrature
         out.append(JointFit(joint, status, tuple(
-            ParameterFit(n, float(params[n]), math.hypot(_number(stderr.get(n)), float(family.get(n) or 0.0)),
+            ParameterFit(n, float(params[n]), read_error(_number(stderr.get(n)), float(family.get(n) or 0.0)),
                          _number(crb.get(n)), float(truth[joint][n]), moved or n != "F_v")
             for n in FRICTION if n in params and n in truth[joint])))
     return out
