@@ -287,8 +287,7 @@ def structure_widened(best: ActuatorIdentification, other: ActuatorIdentificatio
         theirs = other.joint(j.joint).parameters()
         joints.append(j.with_values({k: widened(k, p, theirs.get(k)) if k in STRUCTURE_SPREAD else p
                                      for k, p in j.parameters().items()}))
-    delay = replace(best.delay, se=float(np.hypot(best.delay.se, best.delay.value - other.delay.value)))
-    return replace(best, joints=tuple(joints), delay=delay, delayed_known=False)
+    return replace(best, joints=tuple(joints), delayed_known=False)
 
 
 def _identify(robot: Robot, log: Log, options: ActuatorOptions) -> ActuatorIdentification:
