@@ -79,10 +79,16 @@ def header_offsets(text: str) -> dict[str, float]:
     return found
 
 
+def setpoint_offsets(text: str) -> dict[str, float]:
+    """The set-point offsets a file's comment lists, ``"<joint>": <rad> (tau_os <N·m> N·m)`` one per line."""
+    return {m[1]: float(m[2]) for m in re.finditer(r'"([^"]+)": (\S+) \(tau_os \S+ N·m\)', text)}
+
+
 def test_isaac_fields_are_the_robots_and_the_fits(robot, params, tmp_path):
     """The YAML (read by YAML 1.2 and 1.1) is a DelayedPDActuatorCfg of every PD-driven joint: stiffness = kp,
     damping = kd, armature the TOML's, the frictions of the ok fits only, the finite torque limits, the delay in
-    whole physics steps; the encoder offsets listed in the header; each joint's status beside its name."""
+    whole physics steps; the encoder offsets listed in the header, and the ok fits' constant tau_os as set-point
+    offsets offset + tau_os / kp; each joint's status beside its name."""
     path, fits = params
     out = tmp_path / "a.yaml"
     done = export_files(robot, path, [out])
@@ -110,6 +116,9 @@ def test_isaac_fields_are_the_robots_and_the_fits(robot, params, tmp_path):
     assert doc["min_delay"] == doc["max_delay"] == steps == 3  # 2.6 steps rounded
     assert header_offsets(text) == robot.encoder_offset
     assert "encoder_bias = -offset" in text
+    kp = dict(zip(joints, pd.kp))  # the ok fits' tau_os as set-point offsets, in the header and in the result
+    assert setpoint_offsets(text) == {j: robot.encoder_offset.get(j, 0.0) + fits[j].params.tau_os / kp[j] for j in ok}
+    assert done.drive is not None and done.drive.torque_offset == {j: fits[j].params.tau_os for j in ok}
     notes = dict(re.findall(r'^  - "([^"]+)"  # (.*)$', text, re.M))
     assert notes["panda_joint1"] == "wbfriction fit of panda_joint1: ok"
     assert notes["panda_joint3"] == notes["panda_joint5"] == notes["panda_joint7"] == NO_FRICTION
@@ -172,9 +181,10 @@ def mjcf(robot, params, tmp_path):
 
 def test_mjcf_fields_are_the_robots_and_the_fits(robot, mjcf):
     """Read back from the file and from MuJoCo's compiled model: one position actuator per PD-driven joint, named
-    as it: gain kp, bias [-kp offset, -kp, -kd], force range the torque limit (none without), the delay (less 1 ns,
-    the hold's edge), zero-order hold, a history long enough down to 0.5 ms; joints' armature, damping = F_v,
-    frictionloss = F_c of the ok fits only."""
+    as it: gain kp, bias [-kp offset - tau_os, -kp, -kd] (tau_os the exported fit's, none without), force range the
+    torque limit (none without), the delay (less 1 ns, the hold's edge), zero-order hold, a history long enough down
+    to 0.5 ms; joints' armature, damping = F_v, frictionloss = F_c of the ok fits only; the comment lists the encoder
+    offsets and the set-point offsets offset + tau_os / kp."""
     text, m, fits = mjcf
     pd = robot.pd
     root = ET.fromstring(text.encode())
@@ -184,14 +194,17 @@ def test_mjcf_fields_are_the_robots_and_the_fits(robot, mjcf):
     for i, j in enumerate(robot.actuated):
         a, dof = m.actuator(j).id, m.joint(j).dofadr[0]
         kp, kd, off = pd.kp[i], pd.kd[i], robot.encoder_offset.get(j, 0.0)
+        exported = j in ("panda_joint1", "panda_joint2", "panda_joint4")
+        tau_os = fits[j].params.tau_os if exported else 0.0
         assert m.actuator_trnid[a, 0] == m.joint(j).id
         assert m.actuator_gainprm[a, 0] == kp and not np.any(m.actuator_gainprm[a, 1:])
-        assert list(m.actuator_biasprm[a, :3]) == [-kp * off, -kp, -kd] and not np.any(m.actuator_biasprm[a, 3:])
+        assert m.actuator_biasprm[a, 0] == pytest.approx(-kp * off - tau_os, rel=1e-15, abs=1e-15)
+        assert list(m.actuator_biasprm[a, 1:3]) == [-kp, -kd] and not np.any(m.actuator_biasprm[a, 3:])
         assert m.actuator_gaintype[a] == mujoco.mjtGain.mjGAIN_FIXED
         assert m.actuator_biastype[a] == mujoco.mjtBias.mjBIAS_AFFINE
         xml = acts[i]
         assert [float(x) for x in xml.get("gainprm").split()] == [kp]
-        assert [float(x) for x in xml.get("biasprm").split()] == [-kp * off + 0.0, -kp, -kd]
+        assert [float(x) for x in xml.get("biasprm").split()] == list(m.actuator_biasprm[a, :3])
         if np.isfinite(pd.torque_limit[i]):
             assert list(m.actuator_forcerange[a]) == [-pd.torque_limit[i], pd.torque_limit[i]]
             assert m.actuator_forcelimited[a] == 1
@@ -203,11 +216,13 @@ def test_mjcf_fields_are_the_robots_and_the_fits(robot, mjcf):
         assert xml.get("interp", "zoh") == "zoh"
         armature = robot.model.armature[robot.model.idx_vs[robot.model.getJointId(j)]]
         assert m.dof_armature[dof] == armature
-        exported = j in ("panda_joint1", "panda_joint2", "panda_joint4")
         want = (fits[j].params.F_v, fits[j].params.F_c) if exported else (0.0, 0.0)
         assert (m.dof_damping[dof], m.dof_frictionloss[dof]) == want, j
     assert "<!-- wbfriction fit of panda_joint1: ok -->" in text
     assert header_offsets(text) == robot.encoder_offset
+    kp = dict(zip(robot.actuated, pd.kp))
+    assert setpoint_offsets(text) == {j: pytest.approx(robot.encoder_offset.get(j, 0.0) + 0.01 / kp[j], rel=1e-15)
+                                      for j in ("panda_joint1", "panda_joint2", "panda_joint4")}
 
 
 ONE_JOINT = """<mujoco model="pendulum">
@@ -229,7 +244,8 @@ ONE_JOINT = """<mujoco model="pendulum">
 
 def test_one_joint_position_actuator(tmp_path, fit_of):
     """A one-joint robot from an MJCF with its own motor on the joint: the export replaces the motor by the
-    driver's actuator, whose torque on hand-set states is kp (q_des - q_enc) - kd qd with q_enc = qpos + offset."""
+    driver's actuator, whose torque on hand-set states is kp (q_des - q_enc) - kd qd - tau_os with q_enc = qpos +
+    offset and tau_os the fit's."""
     (tmp_path / "pendulum.xml").write_text(ONE_JOINT)
     config = tmp_path / "pendulum.toml"
     config.write_text('name = "pendulum"\nmjcf = "pendulum.xml"\nfloating_base = false\n'
@@ -247,7 +263,8 @@ def test_one_joint_position_actuator(tmp_path, fit_of):
         d.qpos[0], d.qvel[0], d.ctrl[0] = q, qd, q_des
         mujoco.mj_initCtrlHistory(m, d, 0, None, np.full((int(m.actuator_history[0, 0]), 1), q_des))
         mujoco.mj_forward(m, d)
-        assert d.qfrc_actuator[0] == pytest.approx(30.0 * (q_des - (q - 0.05)) - 0.8 * qd, abs=1e-12)
+        # the fit's tau_os (0.01 N·m) as a set-point offset: the joint gets -tau_os
+        assert d.qfrc_actuator[0] == pytest.approx(30.0 * (q_des - (q - 0.05)) - 0.8 * qd - 0.01, abs=1e-12)
 
 
 def init_history(m: mujoco.MjModel, d: mujoco.MjData, ctrl: np.ndarray) -> None:
@@ -257,16 +274,26 @@ def init_history(m: mujoco.MjModel, d: mujoco.MjData, ctrl: np.ndarray) -> None:
         mujoco.mj_initCtrlHistory(m, d, a, None, np.full((n, 1), ctrl[a]))
 
 
+def exported_tau_os(robot, fits) -> np.ndarray:
+    """The constant tau_os [N·m] of each joint's exported fit (the ok ones: joints 1, 2, 4), 0 elsewhere."""
+    tau_os = np.array([fits[j].params.tau_os if fits.get(j) is not None and fits[j].verdict().ok else 0.0
+                       for j in robot.actuated])
+    assert np.count_nonzero(tau_os) == 3
+    return tau_os
+
+
 def test_mjcf_applies_the_drivers_law(robot, mjcf):
     """On hand-set states (the set-points held since before the start, so their delay does not show), MuJoCo's
     joint torque from the actuators is the driver's law of wbfriction.model.pd on the encoder's reading qpos +
-    offset: kp (q_des - q_enc) - kd qd, clipped at the limit (some states drive past it)."""
-    _, m, _ = mjcf
+    offset, with the exported fit's constant tau_os as a set-point offset tau_os / kp: kp (q_des - tau_os / kp - q_enc)
+    - kd qd, clipped at the limit (some states drive past it)."""
+    _, m, fits = mjcf
     rng = np.random.default_rng(4)
     order = [m.joint(j).qposadr[0] for j in robot.actuated]
     dofs = [m.joint(j).dofadr[0] for j in robot.actuated]
     acts = [m.actuator(j).id for j in robot.actuated]
     offset = robot.offset_vector
+    tau_os = exported_tau_os(robot, fits)
     clipped = 0
     for _ in range(20):
         d = mujoco.MjData(m)
@@ -278,8 +305,9 @@ def test_mjcf_applies_the_drivers_law(robot, mjcf):
         init_history(m, d, ctrl)
         mujoco.mj_forward(m, d)
         time = np.array([0.0, 1.0])
-        want = pd_torque(robot.pd, time, np.tile(q + offset, (2, 1)), np.tile(qd, (2, 1)), np.tile(q_des, (2, 1)))[0]
-        raw = robot.pd.kp * (q_des - q - offset) - robot.pd.kd * qd
+        q_set = q_des - tau_os / robot.pd.kp
+        want = pd_torque(robot.pd, time, np.tile(q + offset, (2, 1)), np.tile(qd, (2, 1)), np.tile(q_set, (2, 1)))[0]
+        raw = robot.pd.kp * (q_set - q - offset) - robot.pd.kd * qd
         clipped += int(np.sum(np.abs(raw) > robot.pd.torque_limit))
         np.testing.assert_allclose(d.qfrc_actuator[dofs], want, rtol=1e-12, atol=1e-12)
         np.testing.assert_allclose(d.actuator_force[acts], want, rtol=1e-12, atol=1e-12)
@@ -291,7 +319,8 @@ def test_mjcf_delays_the_setpoints_as_the_driver(robot, mjcf, timestep, lag):
     """Stepped at its own timestep (0.002 s: 6.5 steps) or a smaller one, whole (13, 26 steps) or not, with
     set-points that change every step: the force at each step is the driver's law with the set-point commanded
     DELAY before, held (zero-order): ceil(DELAY / timestep) steps back, every step."""
-    _, m, _ = mjcf
+    _, m, fits = mjcf
+    tau_os = exported_tau_os(robot, fits)
     if timestep is not None:
         m.opt.timestep = timestep
     acts = [m.actuator(j).id for j in robot.actuated]
@@ -309,7 +338,7 @@ def test_mjcf_delays_the_setpoints_as_the_driver(robot, mjcf, timestep, lag):
         q, qd = d.qpos[qadr].copy(), d.qvel[dofs].copy()
         mujoco.mj_step(m, d)
         applied = commanded[k - lag] if k >= lag else np.zeros(7)
-        raw = robot.pd.kp * (applied - q - robot.offset_vector) - robot.pd.kd * qd
+        raw = robot.pd.kp * (applied - q - robot.offset_vector) - robot.pd.kd * qd - tau_os
         want = np.clip(raw, -robot.pd.torque_limit, robot.pd.torque_limit)
         np.testing.assert_allclose(d.actuator_force[acts], want, rtol=1e-12, atol=1e-9, err_msg=f"step {k}")
 

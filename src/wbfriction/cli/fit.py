@@ -136,10 +136,11 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
            mjcf: Optional[Path] = MjcfOpt) -> None:
     """Write the fitted friction where simulators read it: the fits whose status is ok (and --include),
     each with its status in a comment; the other joints keep what the model file has. F_v -> damping,
-    F_c -> Coulomb friction (MuJoCo frictionloss); the Stribeck bump, the tanh and tau_os have no
+    F_c -> Coulomb friction (MuJoCo frictionloss); the Stribeck bump and the tanh have no
     simulator field and are dropped. Inertias are the URDF's: give --urdf IDENTIFIED.urdf to export
-    identified ones. A robot with PD-driven joints ([pd] in its TOML) gets its drivers: gains, torque limits, delay
-    and encoder offsets (MuJoCo position actuators; an Isaac Lab DelayedPDActuatorCfg)."""
+    identified ones. A robot with PD-driven joints ([pd] in its TOML) gets its drivers: gains, torque limits, delay,
+    encoder offsets and the fits' constant tau_os as a set-point offset tau_os/kp (MuJoCo position actuators; an
+    Isaac Lab DelayedPDActuatorCfg); elsewhere tau_os, a torque sensor's offset, is dropped."""
     from wbfriction.pipeline.export_step import export_files
 
     check_paths({"PARAMS": params, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
@@ -160,6 +161,12 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
                       + ", ".join(f"{j} ({', '.join(kept)})" for j, kept in with_terms.items())
                       + "; their F_c, F_v are at the reference conditions (zero load, T_ref), as each joint's note "
                         "says", highlight=False, soft_wrap=True)
+    if result.drive is not None and result.drive.torque_offset:
+        drive = result.drive
+        shifts = [1e3 * (drive.setpoint_offset(j) - drive.offset(j)) for j in drive.torque_offset]
+        console.print(f"PD drivers: the fits' constant tau_os written as set-point offsets tau_os/kp on "
+                      f"{len(shifts)} joints ({min(shifts):.3g} to {max(shifts):.3g} mrad), where the drive applies "
+                      "it (the URDF has no drive: there it is dropped)", highlight=False, soft_wrap=True)
     warn(dict.fromkeys(w for report in result.reports for w in report.warnings))
     for path, fmt in result.outputs:
         console.print(f"wrote {path} ({fmt})")

@@ -14,9 +14,10 @@ dynamic <= static). These meanings hold from Isaac Sim 5.0 (Isaac Lab 2.2 on); i
 
 From model (3.5) (:mod:`wbfriction.export.mapping`): ``friction = (1 + S) F_c`` (the static level
 F_s; the ``stribeck`` model's F_s, the ``coulomb-viscous`` model's F_c), ``dynamic_friction = F_c``,
-``viscous_friction = F_v``; the Stribeck velocity v_s, the tanh slope a and the offset tau_os are
-dropped. A joint with F_s < F_c (S < 0: static below Coulomb friction, which PhysX does not allow)
-is refused.
+``viscous_friction = F_v``; the Stribeck velocity v_s and the tanh slope a are dropped, and so is the offset tau_os
+but on a PD-driven joint, where it is the drivers' set-point offset ``tau_os / kp`` (listed in the header,
+:mod:`wbfriction.export.drive`). A joint with F_s < F_c (S < 0: static below Coulomb friction, which PhysX does not
+allow) is refused.
 
 The document: ``joint_names_expr`` (the joints, each with friction from a fit followed by a comment of
 its status, :func:`~wbfriction.export.mapping.status_note`), then one mapping per field, joint -> value,
@@ -64,6 +65,7 @@ from wbfriction.export.drive import (
     drive_export,
     held_back_warning,
     offset_lines,
+    setpoint_offset_lines,
 )
 from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.export.target import ExportOptions, ExportReport, ExportTarget
@@ -193,7 +195,7 @@ def pd_header(drive: DriveExport, delay: DelaySteps) -> str:
         "stiffness = kp [N·m/rad], damping = kd [N·m·s/rad] (the drivers' gains), actuator_effort_limit = the drivers' "
         "torque limit [N·m] (Isaac Lab 2.x: effort_limit);",
         "friction = (1 + S) F_c (static), dynamic_friction = F_c, viscous_friction = F_v [N·m·s/rad] (model (3.5); the "
-        "Stribeck velocity, the tanh slope and the torque offset dropped), armature [kg·m^2].",
+        "Stribeck velocity and the tanh slope dropped), armature [kg·m^2].",
         f"delay: {delay.delay!r} s = {delay.exact:.6g} physics steps of {delay.physics_dt!r} s (sim.dt): "
         f"min_delay = max_delay = {delay.steps}{rounded}.",
     ]
@@ -203,6 +205,11 @@ def pd_header(drive: DriveExport, delay: DelaySteps) -> str:
                   "(e.g. the action term's offset) and observe joint_pos + offset; PACE's PaceDCMotorCfg: "
                   "encoder_bias = -offset.",
                   *(f"  {line}" for line in offset_lines(drive))]
+    if drive.torque_offset:
+        lines += ["the friction fits' constant tau_os [N·m] (the joint gets -tau_os) has no Isaac Lab field: it is the "
+                  "drivers' set-point offset tau_os / kp, so command q_des - offset - tau_os / kp; per joint, "
+                  "offset + tau_os / kp [rad]:",
+                  *(f"  {line}" for line in setpoint_offset_lines(drive))]
     lines.append("Use: DelayedPDActuatorCfg(**yaml.safe_load(open(this_file)))")
     return "\n".join(lines)
 

@@ -18,7 +18,7 @@ F_c [N·m]            ``friction``            ``frictionloss``       ``dynamic_f
 F_s = (1 + S) F_c    --                      --                     ``friction`` (static)
 S, v_s (Stribeck)    dropped                 dropped                shape dropped (only the level F_s)
 a (tanh slope)       dropped                 dropped                dropped
-tau_os (offset)      dropped                 dropped                dropped
+tau_os (offset)      dropped                 PD: actuator bias      PD: set-point offset (header)
 armature [kg·m^2]    -- (no URDF field)      ``armature``           ``armature``
 load (k_L)           dropped                 dropped                dropped
 direction (dF_v)     dropped                 dropped                dropped
@@ -39,7 +39,9 @@ temperature (k_T)    dropped                 dropped                dropped
   motion, F_c (PhysX needs ``dynamic_friction <= friction``, i.e. F_s >= F_c, S >= 0). How fast the
   friction falls from F_s to F_c (v_s, the Stribeck velocity) has no field anywhere.
 * ``tau_os`` is not friction (a torque sensor's offset, removed before the energy check, thesis
-  7.9): it is not exported. Nor is ``a``, a smoothing of the model's sign function.
+  7.9): it is not exported as friction. A PD-driven joint has no torque sensor: there it is a constant torque of
+  the drive, exported with the drivers as the set-point offset ``tau_os / kp`` (:mod:`wbfriction.export.drive`).
+  Nor is ``a`` exported, a smoothing of the model's sign function.
 * The terms beyond velocity (:mod:`wbfriction.fit.terms`) have no field in any of the three: friction that
   grows with the load or falls with the temperature, a viscous level per direction, a position ripple (which is
   not friction). A fit that kept some exports its velocity model refitted with them, at the reference conditions
@@ -207,7 +209,8 @@ class JointExport:
         static: static friction F_s [N·m] (:func:`static_level`; Isaac ``friction``), None without
             identified friction.
         armature: reflected rotor inertia [kg·m^2] (MJCF and Isaac ``armature``), None when not given.
-        params: the model parameters the friction comes from (what is dropped: tau_os, and S, v_s, a of (3.5)).
+        params: the model parameters the friction comes from (what is dropped: S, v_s, a of (3.5), and tau_os but
+            on a PD-driven joint).
         verdict: the status of the fit the friction comes from (:func:`status_note`), None for bare parameters.
         dropped: the terms beyond velocity the fit kept, which no simulator holds (module docstring).
         conditions: where the fit kept terms, the conditions its levels are at (``zero load, T_ref 40 °C``).

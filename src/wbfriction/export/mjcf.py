@@ -47,15 +47,17 @@ diagonal approximation of ``M^-1``, frozen at ``qpos0``). So mj_inverse's dry fr
 
 Compared with the torque of model (3.5), ``tau = rnea + F_v qd + F_c tanh(a qd)(1 + S e^...) + tau_os``,
 the MuJoCo model keeps ``F_v qd`` exactly and ``F_c`` away from reversals, and drops the
-Stribeck bump, the tanh and ``tau_os`` (:mod:`wbfriction.export.mapping`).
+Stribeck bump, the tanh and ``tau_os`` (:mod:`wbfriction.export.mapping`), which a PD-driven joint's actuator holds
+(below).
 
 **PD-driven joints** (a robot with :attr:`Robot.pd`, :mod:`wbfriction.export.drive`): each gets MuJoCo's position
 actuator, named as its joint (the model file's own actuators of those joints are replaced): ``gainprm[0] = kp``,
-``biasprm = [-kp * offset, -kp, -kd]``, so that
+``biasprm = [-kp * offset - tau_os, -kp, -kd]``, so that
 
 .. math::
 
-    \\texttt{actuator\\_force} = k_p\\,(\\texttt{ctrl} - \\text{offset} - \\texttt{qpos}) - k_d\\,\\texttt{qvel},
+    \\texttt{actuator\\_force} = k_p\\,(\\texttt{ctrl} - \\text{offset} - \\texttt{qpos}) - k_d\\,\\texttt{qvel}
+                               - \\tau_{os},
 
 clipped at ``forcerange = [-tau_max, tau_max]`` (none where the driver has no limit; the joint's
 ``actuatorfrcrange``, MuJoCo's import of the URDF's effort limit, is lifted: the driver's limit is the one, and
@@ -71,7 +73,9 @@ samples, enough at the model's ``timestep`` and any down to 0.5 ms (:func:`~wbfr
 a smaller timestep needs more: MuJoCo reads a too-short buffer's oldest sample, silently). The history starts at
 zero (``mj_resetData``): fill it with the first set-point (``mujoco.mj_initCtrlHistory``) before stepping. The
 driver's ``qd_des`` and ``tau_ff`` have no input in a position actuator (a ``<motor>`` beside it can carry
-``kd qd_des + tau_ff``). A comment at the top of ``<actuator>`` says all this and lists the encoder offsets.
+``kd qd_des + tau_ff``). ``tau_os`` is the constant of the joint's exported friction fit
+(:attr:`~wbfriction.export.drive.DriveExport.torque_offset`: a set-point offset ``tau_os / kp``; 0 without one).
+A comment at the top of ``<actuator>`` says all this and lists the encoder offsets and the set-point offsets.
 
 The written MJCF (:func:`write_mjcf`) is MuJoCo's own ``MjSpec.to_xml``, whose numbers have 6
 significant digits, with every number of the bodies, inertials, joints and sites rewritten from the
@@ -100,6 +104,7 @@ from wbfriction.export.drive import (
     held_back_warning,
     history_samples,
     offset_lines,
+    setpoint_offset_lines,
 )
 from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.export.target import ExportReport, ExportTarget
@@ -264,7 +269,7 @@ def _add_drives(spec: mujoco.MjSpec, drive: DriveExport) -> None:
         act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
         act.set_to_position(kp=kp, kv=kd)
         bias = np.array(act.biasprm, dtype=float)
-        bias[0] = 0.0 - kp * drive.offset(name)  # 0.0, not -0.0, without an offset
+        bias[0] = 0.0 - kp * drive.setpoint_offset(name)  # 0.0, not -0.0, without an offset
         act.biasprm = bias
         if np.isfinite(limit):
             act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
@@ -286,6 +291,10 @@ def drive_note(drive: DriveExport, model: mujoco.MjModel) -> str:
              "clipped at forcerange (the driver's torque limit): ctrl is the set-point q_des as the robot commands",
              "it (encoder frame), qpos the model's angle (the encoder reads qpos + offset). qd_des and tau_ff have",
              "no input here (a <motor> beside it can carry kd qd_des + tau_ff)."]
+    if drive.torque_offset:
+        lines += ["The friction fits' constant tau_os (the joint gets -tau_os) is in the bias as a set-point offset",
+                  "tau_os / kp: biasprm[0] = -kp (offset + tau_os / kp) [rad], per joint:",
+                  *(f"  {line}" for line in setpoint_offset_lines(drive))]
     if drive.delay > HOLD_EDGE:
         samples = min((int(model.actuator_history[i, 0]) for i in range(model.nu)
                        if model.actuator(i).name in drive.joints), default=0)

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from wbfriction.exceptions import InputError
-from wbfriction.export.drive import DEFAULT_PHYSICS_DT
+from wbfriction.export.drive import DEFAULT_PHYSICS_DT, DriveExport, drive_export
 from wbfriction.export.mapping import FitSelection, joint_exports, select_fits
 from wbfriction.export.registry import spoken, target_for, targets
 from wbfriction.export.target import ExportOptions, ExportReport
@@ -21,10 +21,12 @@ from wbfriction.model.robot import Robot
 class Exported:
     """What :func:`export_files` wrote: one report per output, in order
     (:class:`~wbfriction.export.target.ExportReport`), and which fits went into them
-    (:class:`~wbfriction.export.mapping.FitSelection`: the joints left out, by status)."""
+    (:class:`~wbfriction.export.mapping.FitSelection`: the joints left out, by status), and the robot's drivers as
+    written (:class:`~wbfriction.export.drive.DriveExport`; None for a robot without PD-driven joints)."""
 
     reports: tuple[ExportReport, ...]
     selection: FitSelection
+    drive: DriveExport | None = None
 
     @property
     def outputs(self) -> tuple[tuple[Path, str], ...]:
@@ -39,8 +41,9 @@ def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path]
     in the format its suffix names (:func:`~wbfriction.export.registry.target_for`); the robot's inertias are
     its URDF's (give an identified URDF to export identified inertias) and its armature the robot model's unless
     ``armature`` is given. A robot with PD-driven joints (:attr:`Robot.pd`) gets its drivers too (gains, torque
-    limits, delay, encoder offsets: :mod:`wbfriction.export.drive`), the delay counted in physics steps of
-    ``physics_dt`` [s] where a format counts it so (Isaac Lab); each report's warnings say what was rounded.
+    limits, delay, encoder offsets, the fits' constant torques as set-point offsets: :mod:`wbfriction.export.drive`),
+    the delay counted in physics steps of ``physics_dt`` [s] where a format counts it so (Isaac Lab); each report's
+    warnings say what was rounded.
 
     Only fits whose status is ``ok`` are exported, and those ``include`` names (``weak``, ``at-bound``;
     :func:`~wbfriction.export.mapping.select_fits`); the other joints keep what the robot's model file has.
@@ -65,4 +68,4 @@ def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path]
     selection = select_fits(read_params(params), robot, include, str(params))
     joints = joint_exports(selection.exported, armature, robot)
     reports = tuple(target.write(Path(path), robot, joints) for path, target in zip(outputs, chosen))
-    return Exported(reports, selection)
+    return Exported(reports, selection, drive_export(robot, joints))
