@@ -518,3 +518,35 @@ def sensitivity_figure(sens, joints: list[str], columns: int = 4) -> Figure:
 def save_png(fig: Figure, path: str | Path) -> None:
     """Write a figure as a PNG file, whole or not at all."""
     _save(fig, path)
+
+
+def rollout_figure(results: Sequence[Any], path: str | Path, columns: int = 3) -> None:
+    """The tracking error of replays of one log (:class:`~wbfriction.sim.rollout.RolloutResult`, the same joints and
+    stretch): per joint, the simulated less the logged angle [mrad] against the log's time from the stretch's start
+    [s], one line per replay, its RMS in the legend; a replay restarted from the log every ``horizon`` seconds starts
+    each window at zero error (dotted lines mark the restarts)."""
+    first = results[0]
+    n = len(first.joints)
+    columns = min(columns, n)
+    rows = int(np.ceil(n / columns))
+    fig = Figure(figsize=(3.4 * columns, 2.0 * rows + 0.9), layout="constrained")
+    axes = fig.subplots(rows, columns, sharex=True, squeeze=False).ravel()
+    t = first.time - first.time[0]
+    for i, (ax, joint) in enumerate(zip(axes, first.joints)):
+        for k, result in enumerate(results):
+            ax.plot(t, 1e3 * result.error[:, i], lw=0.7, color=f"C{k}",
+                    label=f"{result.label} {1e3 * result.rms[i]:.2f}")
+        if first.horizon is not None:
+            for start in np.arange(first.horizon, t[-1], first.horizon):
+                ax.axvline(start, color="0.8", lw=0.5, ls=":")
+        ax.axhline(0.0, color="0.5", lw=0.5)
+        ax.set_title(_short(joint), fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.legend(fontsize=6, loc="upper right", title="RMS [mrad]", title_fontsize=6)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    fig.supxlabel("time from the stretch's start [s]")
+    fig.supylabel("simulated - logged angle [mrad]")
+    window = "one shot" if first.horizon is None else f"restarted from the log every {first.horizon:g} s"
+    fig.suptitle(f"Replay of the log's set-points, {window}")
+    _save(fig, path)

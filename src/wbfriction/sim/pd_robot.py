@@ -244,6 +244,10 @@ class PdRun:
         self.model = copy.copy(mjr.model)
         self.model.opt.timestep = self.h
         self.model.dof_armature[mjr.dof_index] = armature
+        # the constants MuJoCo derives from the mass matrix at qpos0 (dof_invweight0: the friction-loss constraint's
+        # softness, R = (1 - solimp[0]) / solimp[0] * dof_invweight0) with this armature, as a model compiled with
+        # it has them (an exported MJCF): without, MuJoCo's friction would be that of the armature compiled before
+        mujoco.mj_setConst(self.model, mujoco.MjData(self.model))
         other = next((j for j, p in friction.items() if p.model not in MODEL_NAMES), None)
         if other is not None:  # InjectedFriction applies the built-in families only
             raise InputError(f"friction of '{other}': the simulator applies the built-in families "

@@ -196,7 +196,7 @@ def read_log_setpoints(robot: Robot, log: pa.Table | str | Path) -> LogSetpoints
     return LogSetpoints(time, q, qd, commands)
 
 
-def _stretch(time: np.ndarray, rows: tuple[int, int] | None, times: tuple[float, float] | None) -> tuple[int, int]:
+def stretch_rows(time: np.ndarray, rows: tuple[int, int] | None, times: tuple[float, float] | None) -> tuple[int, int]:
     """Rows ``[start, stop)`` of a stretch given by rows or by times [s] (``[t0, t1)``), at least two samples."""
     if rows is not None and times is not None:
         raise InputError("a rollout's stretch is given by rows or by times, not both")
@@ -205,7 +205,10 @@ def _stretch(time: np.ndarray, rows: tuple[int, int] | None, times: tuple[float,
     if times is not None:
         start, stop = (int(np.searchsorted(time, t, side="left")) for t in times)
     if not 0 <= start < stop <= n or stop - start < 2:
-        raise InputError(f"the rollout's stretch (rows {start} to {stop}) must hold at least two of the log's {n} rows")
+        where = "" if times is None else (f" (times {times[0]:g} to {times[1]:g} s; the log's run from {time[0]:g} to "
+                                          f"{time[-1]:g} s)")
+        raise InputError(f"the rollout's stretch (rows {start} to {stop}{where}) must hold at least two of the log's "
+                         f"{n} rows")
     return start, stop
 
 
@@ -236,7 +239,7 @@ def rollout(robot: Robot, log: pa.Table | str | Path | LogSetpoints, params: Act
     """
     mjr = mjr or build_pd_robot(robot)
     data = log if isinstance(log, LogSetpoints) else read_log_setpoints(robot, log)
-    start, stop = _stretch(data.time, rows, times)
+    start, stop = stretch_rows(data.time, rows, times)
     if horizon is not None and not horizon > 0:
         raise InputError(f"the rollout's horizon must be > 0 s, got {horizon}")
     friction, bare = _friction(robot, params.friction)

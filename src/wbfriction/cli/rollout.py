@@ -1,0 +1,72 @@
+"""``wbfriction rollout``: an exported MJCF replayed under a log's set-points, its tracking error per joint."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Optional
+
+import typer
+from rich.table import Table
+
+from wbfriction.cli.common import ConfigOpt, LogArg, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of
+from wbfriction.exceptions import OptionError
+from wbfriction.pipeline.paths import check_paths
+
+
+@app.command()
+def rollout(log: Path = LogArg,
+            model: Path = typer.Argument(..., metavar="MODEL",
+                                         help="MuJoCo MJCF written by 'wbfriction export' for the robot (--config): "
+                                              "its PD-driven joints' actuators, named as the joints, are replayed."),
+            window: float = typer.Option(1.0, "--window",
+                                         help="Restart from the log's state every so many seconds \\[s]; the "
+                                              "whole stretch in one shot is scored too."),
+            start: Optional[float] = typer.Option(None, "--from", help="Replay from this time of the log \\[s] "
+                                                                       "(default: its start)."),
+            stop: Optional[float] = typer.Option(None, "--to", help="Replay up to this time of the log \\[s] "
+                                                                    "(default: its end)."),
+            torque_delay: Optional[int] = typer.Option(None, "--torque-delay", min=0,
+                                                       help="Replay PACE's actuator instead of the file's: the PD "
+                                                            "law computed once a log period and its whole torque "
+                                                            "applied so many periods later (a model identified so)."),
+            timestep: Optional[float] = typer.Option(None, "--timestep",
+                                                     help="Physics step \\[s] (default: the file's)."),
+            label: str = typer.Option("model", "--label", help="What the figure calls the replay."),
+            output: Optional[Path] = typer.Option(None, "-o", "--output",
+                                                  help="Table to write (.parquet, .csv): per joint, the RMS "
+                                                       "tracking error [rad] in windows and in one shot."),
+            figure: Optional[Path] = typer.Option(None, "--figure", help="PNG of each joint's tracking error."),
+            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
+            mjcf: Optional[Path] = MjcfOpt) -> None:
+    """Replay the log's set-points on an exported MuJoCo model, as MuJoCo runs it (the file's timestep, gains,
+    offsets, torque limits and set-point delay), restarted from the log's state every --window seconds and in one
+    shot: how far the simulated encoder angles go from the logged ones, per joint (a hung robot, its base fixed)."""
+    from wbfriction.pipeline.rollout_step import replay_file
+    from wbfriction.sim.replay import Replay
+
+    check_paths({"LOG": log, "MODEL": model, "--config": config, "--urdf": urdf, "--mjcf": mjcf},
+                {"-o": output, "--figure": figure})
+    if not (math.isfinite(window) and window > 0):
+        raise OptionError("--window", window, "a time > 0 [s]")
+    if timestep is not None and not (math.isfinite(timestep) and timestep > 0):
+        raise OptionError("--timestep", timestep, "a physics step > 0 [s]")
+    times = None if start is None and stop is None else (-math.inf if start is None else start,
+                                                          math.inf if stop is None else stop)
+    replay = Replay(label=label, horizon=window, torque_delay=torque_delay, timestep=timestep)
+    with console.status(f"replaying {log.name} on {model.name}"):
+        check = replay_file(robot_of(robot, urdf, config, mjcf), log, model, replay, times=times, output=output,
+                            figure=figure)
+    w = check.windows
+    table = Table(title="RMS of simulated - logged angle [mrad]", box=None, caption_justify="left",
+                  caption=f"{model.name} replayed on rows {w.rows[0]} to {w.rows[1]} of {log.name}; windows: "
+                          f"restarted from the log every {window:g} s; whole: one shot")
+    for col in ("joint", f"windows ({window:g} s)", "whole"):
+        table.add_column(col, justify="left" if col == "joint" else "right")
+    for joint, a, b in zip(w.joints, check.windows.rms, check.whole.rms):
+        table.add_row(joint, f"{1e3 * a:.2f}", f"{1e3 * b:.2f}")
+    table.add_row("mean", f"{1e3 * check.windows.rms.mean():.2f}", f"{1e3 * check.whole.rms.mean():.2f}")
+    out.print(table)
+    for path in (output, figure):
+        if path is not None:
+            console.print(f"wrote {path}")

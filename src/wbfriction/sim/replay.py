@@ -1,0 +1,225 @@
+"""An exported simulator file replayed under a log's set-points, as that simulator runs it (issue 64, item 3): the
+check of what a user of ``wbfriction export`` gets.
+
+:mod:`wbfriction.sim.rollout` replays a parameter set on the project's own simulator (its friction drawn as the fit's
+model, ``tau_os`` included, the PD law every physics step). What a user simulates is the exported file: MuJoCo's
+``frictionloss`` and ``damping`` instead of the model, the drivers as the file's actuators hold them. This module runs
+that file (:func:`replay_mjcf`): the robot's PD-driven joints' actuators, each named as its joint (what ``wbfriction
+export`` writes; :mod:`wbfriction.export.mjcf`), are sent the log's ``q_des``, each sample held until the next (the
+drivers' zero-order hold, :mod:`wbfriction.model.pd`), at the file's own timestep, with the file's gains, offsets,
+torque limits and set-point delay (MuJoCo 4's actuator ``delay``, its history filled with the set-points commanded
+before the stretch).
+
+**A peer's actuator.** PACE (the peer's method) runs Isaac Lab at the log's rate and delays the PD's whole torque,
+feedback and set-point alike, by a whole number of physics steps (:attr:`Replay.torque_delay`): with it, the file's
+actuators' law (its gain and bias, clipped at its force range) is computed once a log period on the simulated state,
+and its torque applied ``torque_delay`` periods later, held through the period (``qfrc_applied``; the actuators
+themselves off). The file's physics step is then the log's period divided into whole steps, the largest at most
+the file's. This is how a torque-delayed model, which no MJCF holds, is scored as it was identified.
+
+**Windows.** As in :mod:`wbfriction.sim.rollout`, every ``horizon`` seconds the replay restarts from the log's
+state (the model's angle: the logged one less the encoder offset; the logged velocity): 1 s by default, the error
+a simulator's user sees over a second of its own motion; ``horizon=None`` replays the stretch in one shot.
+
+Sources: MuJoCo 4.0.0 ``mj_initCtrlHistory`` (the actuator's history), ``actuator_gainprm``/``biasprm`` (the
+affine law ``force = gainprm[0] ctrl + biasprm[0] + biasprm[1] qpos + biasprm[2] qvel``); PACE's actuator
+(leggedrobotics/pace-sim2real, ``pace_actuator.py``: the PD torque pushed through Isaac Lab's ``DelayBuffer``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+
+from wbfriction.exceptions import InputError
+from wbfriction.model.robot import Robot
+from wbfriction.sim.rollout import LogSetpoints, RolloutResult, read_log_setpoints, stretch_rows
+
+
+@dataclass(frozen=True)
+class Replay:
+    """How a file is replayed (module docstring).
+
+    Attributes:
+        label: what the tables call it (``"ours"``, ``"peer"``).
+        horizon: restart from the log's state every so many seconds; None: one shot.
+        torque_delay: PACE's actuator: the PD torque computed once a log period and held back so many periods
+            (whole, >= 0); None: the file's own actuators (its set-point delay).
+        timestep: the physics step [s]; None: the file's (with ``torque_delay``: the log's period in whole steps of
+            at most it).
+    """
+
+    label: str = "model"
+    horizon: float | None = 1.0
+    torque_delay: int | None = None
+    timestep: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.horizon is not None and not (math.isfinite(self.horizon) and self.horizon > 0):
+            raise InputError(f"the replay's horizon must be a time > 0 [s], got {self.horizon!r}")
+        if self.torque_delay is not None and self.torque_delay < 0:
+            raise InputError(f"the replay's torque delay must be a whole number of periods >= 0, got {self.torque_delay}")
+        if self.timestep is not None and not (math.isfinite(self.timestep) and self.timestep > 0):
+            raise InputError(f"the replay's timestep must be > 0 [s], got {self.timestep!r}")
+
+
+@dataclass(frozen=True, eq=False)
+class _Drives:
+    """The file's PD-driven joints: their actuators, qpos and dof addresses, and the law's parameters."""
+
+    acts: np.ndarray
+    qpos: np.ndarray
+    dofs: np.ndarray
+    gain: np.ndarray
+    bias: np.ndarray
+    limit: np.ndarray
+
+
+def _drives(model, robot: Robot, source: str) -> _Drives:
+    """The actuators of the robot's PD-driven joints in ``model``, each named as its joint and driving it."""
+    import mujoco
+
+    if robot.pd is None:
+        raise InputError(f"{robot.name}: no PD-driven joints ([pd] in its TOML): nothing to replay set-points on")
+    acts, qpos, dofs = [], [], []
+    for name in robot.actuated:
+        act, joint = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, name), \
+            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
+        if joint < 0:
+            raise InputError(f"{source}: no joint '{name}' (a joint of {robot.name}): not this robot's model")
+        if act < 0 or model.actuator_trnid[act, 0] != joint:
+            raise InputError(f"{source}: no actuator named '{name}' driving its joint (what 'wbfriction export' "
+                             f"writes for a PD-driven joint)")
+        acts.append(act)
+        qpos.append(model.jnt_qposadr[joint])
+        dofs.append(model.jnt_dofadr[joint])
+    acts_a = np.array(acts)
+    limit = np.where(model.actuator_forcelimited[acts_a] == 1, model.actuator_forcerange[acts_a, 1], np.inf)
+    return _Drives(acts_a, np.array(qpos), np.array(dofs), model.actuator_gainprm[acts_a, 0].copy(),
+                   model.actuator_biasprm[acts_a, :3].copy(), limit)
+
+
+def _check_setpoints(data: LogSetpoints, drives: _Drives, source: str) -> None:
+    """Refuse a log whose commands the file's position actuators cannot take: a velocity set-point or a
+    feed-forward torque (no input there), gains other than the file's."""
+    c = data.commands
+    for what, values in (("qd_des", c.qd_des), ("tau_ff", c.tau_ff)):
+        if np.any(values != 0.0):
+            raise InputError(f"{source}: the log's '{what}' columns are not zero; a position actuator has no input for "
+                             f"them (the replay sends q_des only)")
+    for what, logged, held in (("kp", c.kp, drives.gain), ("kd", c.kd, -drives.bias[:, 2])):
+        if logged is not None and not np.allclose(logged, held, rtol=1e-9, atol=0.0):
+            raise InputError(f"{source}: the log's '{what}' differs from the file's actuators' ({what} = "
+                             f"{', '.join(f'{x:g}' for x in held)}): export with the robot TOML of this log")
+
+
+def replay_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | LogSetpoints, replay: Replay = Replay(),
+                *, rows: tuple[int, int] | None = None, times: tuple[float, float] | None = None) -> RolloutResult:
+    """Replay an MJCF file under a log's set-points (module docstring).
+
+    Args:
+        model: the MJCF file (``wbfriction export -o robot.xml``): its PD-driven joints' actuators named as the joints.
+        robot: the robot it was exported for (its TOML): the PD-driven joints, and the encoder offsets that take the
+            log's angles to the model's; a fixed base (:attr:`Robot.floating_base` false).
+        log: the log (a table, a file, or :func:`~wbfriction.sim.rollout.read_log_setpoints`'s reading of it):
+            ``time``, ``q``, ``qd``, ``q_des`` of every PD-driven joint.
+        replay: :class:`Replay`.
+        rows, times: the stretch, as rows ``[start, stop)`` or times ``[t0, t1)`` [s]; neither: the whole log.
+
+    Returns:
+        :class:`~wbfriction.sim.rollout.RolloutResult`: the simulated logged angles (the model's plus the encoder
+        offset) against the log's [rad].
+
+    Raises:
+        InputError: a file MuJoCo cannot load, a floating-base robot, a joint or actuator the file lacks, a stretch out
+            of the log, a log with velocity set-points, feed-forward torques or gains the file does not hold.
+        ColumnError: a column the replay needs is missing.
+        SimulationError: the state diverged.
+    """
+    import mujoco
+
+    from wbfriction.exceptions import SimulationError
+
+    source = str(model)
+    if robot.floating_base:
+        raise InputError(f"{robot.name}: the replay holds the base fixed, as in a hung robot's log; this robot's base "
+                         "floats (floating_base = true)")
+    try:
+        m = mujoco.MjModel.from_xml_path(source)
+    except (ValueError, OSError) as err:
+        raise InputError(f"{source}: MuJoCo cannot load it: {err}") from None
+    drives = _drives(m, robot, source)
+    data = log if isinstance(log, LogSetpoints) else read_log_setpoints(robot, log)
+    _check_setpoints(data, drives, source)
+    start, stop = stretch_rows(data.time, rows, times)
+    period = float(np.median(np.diff(data.time)))
+    if replay.timestep is not None:
+        m.opt.timestep = replay.timestep
+    if replay.torque_delay is not None:
+        m.opt.timestep = period / math.ceil(period / m.opt.timestep - 1e-9)
+        m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_ACTUATION
+    offset = robot.offset_vector
+    shot = stop - start if replay.horizon is None else max(1, int(round(replay.horizon / period)))
+    q_sim = np.empty((stop - start, robot.n_act))
+    d = mujoco.MjData(m)
+    for first in range(start, stop, shot):
+        last = min(first + shot, stop)
+        mujoco.mj_resetData(m, d)
+        d.qpos[drives.qpos], d.qvel[drives.dofs] = data.q[first] - offset, data.qd[first]
+        run = _held_torque if replay.torque_delay is not None else _actuated
+        q_sim[first - start:last - start] = run(m, d, drives, data, first, last, period, replay.torque_delay or 0)
+        if not np.all(np.isfinite(q_sim[first - start:last - start])):
+            raise SimulationError(f"{source}: the replay diverged between rows {first} and {last}")
+    q_sim += offset
+    return RolloutResult(replay.label, robot.actuated, (start, stop), data.time[start:stop], q_sim,
+                         data.q[start:stop].copy(), replay.horizon)
+
+
+def _actuated(m, d, drives: _Drives, data: LogSetpoints, first: int, last: int, period: float,
+              _: int) -> np.ndarray:
+    """Samples ``[first, last)`` run by the file's actuators: ``q_des`` held a period each, the history holding
+    those commanded before ``first`` (at their times); the model's angles at each sample (last - first, n)."""
+    import mujoco
+
+    q_des, n = data.commands.q_des, len(data.time)
+    h = m.opt.timestep
+    for a, act in enumerate(drives.acts):
+        samples = int(m.actuator_history[act, 0])
+        if samples:
+            times = -h * np.arange(samples - 1, -1, -1, dtype=float)
+            held = np.clip(first + np.floor(times / period + 1e-9).astype(int), 0, n - 1)
+            mujoco.mj_initCtrlHistory(m, d, int(act), times.reshape(-1, 1), np.ascontiguousarray(q_des[held, a:a + 1]))
+    out = np.empty((last - first, len(drives.acts)))
+    out[0] = d.qpos[drives.qpos]
+    for k in range(1, last - first):
+        while d.time < k * period - 1e-9 * period:
+            d.ctrl[drives.acts] = q_des[first + int(math.floor(d.time / period + 1e-9))]
+            mujoco.mj_step(m, d)
+        out[k] = d.qpos[drives.qpos]
+    return out
+
+
+def _held_torque(m, d, drives: _Drives, data: LogSetpoints, first: int, last: int, period: float,
+                 delay: int) -> np.ndarray:
+    """Samples ``[first, last)`` run by PACE's actuator (module docstring): the law on the state at each sample,
+    applied ``delay`` samples later (before then, the first torque); the model's angles at each sample."""
+    import mujoco
+
+    q_des = data.commands.q_des
+    substeps = int(round(period / m.opt.timestep))
+    torques: list[np.ndarray] = []
+    out = np.empty((last - first, len(drives.acts)))
+    out[0] = d.qpos[drives.qpos]
+    for k in range(last - first - 1):
+        law = (drives.gain * q_des[first + k] + drives.bias[:, 0] + drives.bias[:, 1] * d.qpos[drives.qpos]
+               + drives.bias[:, 2] * d.qvel[drives.dofs])
+        torques.append(np.clip(law, -drives.limit, drives.limit))
+        d.qfrc_applied[drives.dofs] = torques[max(0, k - delay)]
+        for _ in range(substeps):
+            mujoco.mj_step(m, d)
+        out[k + 1] = d.qpos[drives.qpos]
+    return out
