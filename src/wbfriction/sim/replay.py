@@ -62,7 +62,8 @@ class Replay:
         if self.horizon is not None and not (math.isfinite(self.horizon) and self.horizon > 0):
             raise InputError(f"the replay's horizon must be a time > 0 [s], got {self.horizon!r}")
         if self.torque_delay is not None and self.torque_delay < 0:
-            raise InputError(f"the replay's torque delay must be a whole number of periods >= 0, got {self.torque_delay}")
+            raise InputError(f"the replay's torque delay must be a whole number of periods >= 0, got "
+                             f"{self.torque_delay}")
         if self.timestep is not None and not (math.isfinite(self.timestep) and self.timestep > 0):
             raise InputError(f"the replay's timestep must be > 0 [s], got {self.timestep!r}")
 
