@@ -134,7 +134,9 @@ PRINTS = {
                           r"^panda_joint1: quadratic: F_v ",  # a family fitted alone, then scored by --model auto
                           r"^panda_joint1: thesis: .*held-out RMS.*quadratic"],
     "docs/how-to/pd-robots.md": [r"^FL_hip_joint: tracking error \d+\.\d mrad, the peer's",  # the rollout check
-                                 r"^ours tracks better on (1[0-2]) of 12 joints$",  # the peer's: worse on most
+                                 # the exported MJCF against the peer as PACE simulates it: a lower mean
+                                 r"^ours tracks better on ([89]|1[0-2]) of 12 joints: mean [3-5]\.\d\d mrad, the "
+                                 r"peer's [6-8]\.\d\d$",
                                  r"^delay 1[12]\.\d\d ms, truth 12 ms$",  # the hung Go2: within a physics step
                                  # its armature and friction within 5 % with a real driver's noise
                                  r"^armature within [0-4]\.\d %, F_v within [0-4]\.\d %, F_c within [0-4]\.\d % of "

@@ -6,7 +6,9 @@ real KUKA LWR4+ through the real-arm tutorial's commands."""
 
 from __future__ import annotations
 
+import json
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -100,11 +102,16 @@ def read_back(table, params, folder, robot) -> None:
     what the readers take, predicted on the table, exported, reported."""
     strict_json(params)
     fits = read_params(params)
+    written = json.loads(Path(params).read_text())["joints"]
     for joint, fit in fits.items():
         if fit.params is not None:
             check_model_params(fit.params, f"{joint}.params")
         if fit.terms is not None:
             check_terms(fit.terms, fit.model, f"{joint}.terms")
+        if fit.fallback is not None:  # beside a chosen fit not ok: the simplest family, no terms, as written
+            assert fit.verdict().status not in ("ok", "not excited")
+            assert fit.fallback.model == "coulomb-viscous" and fit.fallback.kept_terms is None
+            assert fit.fallback.verdict().status == written[joint]["fallback"]["status"]
     prediction = predict_file(table, params)
     assert set(prediction.joints) >= set(fits)
     try:

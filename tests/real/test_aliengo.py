@@ -123,3 +123,38 @@ def test_the_two_structures_f_v_differ_by_kp_delay(route):
     for joint, difference in interior:
         assert difference == pytest.approx(kp_delay, rel=0.25), joint
     assert all(t.F_v.value > j.F_v.value for j, t in zip(identified.joints, torque.joints))
+
+
+def test_the_exported_simulator_tracks_the_held_out_stretch_better_than_the_peers(route, tmp_path):
+    """Issue 64: the MJCF the route exports (the default fits, weak and at-bound included as the dataset's command
+    does; where the model chosen is not ok, its Coulomb-viscous fit), replayed under the last 40 %'s set-points as
+    MuJoCo runs it, tracks the logged angles better on average than the peer's parameters simulated as PACE
+    simulates them (its torque held back 2 periods, the law once a period), and on the hips and thighs; the fits'
+    tau_os exported as set-point offsets is what takes it there: without them the same file is worse than the
+    peer's. Measured: 4.77 mrad mean against the peer's 7.05 (9 of 12 joints; the front left, rear left and rear
+    right calves not: 3.7, 3.3, 5.5 against 3.1, 2.7, 3.6); 9.5 without tau_os."""
+    import mujoco
+    import numpy as np
+
+    from wbfriction.pipeline.export_step import export_files
+    from wbfriction.sim.replay import Replay, replay_mjcf
+    from wbfriction.studies.pd_peer import peer_rollouts
+
+    written, peer, _, ours, folder = route
+    mjcf = tmp_path / "aliengo.xml"
+    export_files(ours, folder / "params.json", [mjcf], include=("weak", "at-bound"))
+    table = peer_rollouts(written.config, written.config.parent / "peer.toml", peer, folder / "identified.toml",
+                          mjcf, written.logs["held_out"]).to_pydict()
+    mine, theirs = np.array(table["rms.ours"]), np.array(table["rms.peer"])
+    assert mine.mean() < 0.8 * theirs.mean(), (mine, theirs)
+    legs = [i for i, j in enumerate(table["joint"]) if "calf" not in j]
+    assert np.all(mine[legs] < theirs[legs]), (mine, theirs)
+    spec = mujoco.MjSpec.from_file(str(mjcf))  # the same file without the fits' constant torques
+    for j in ours.actuated:
+        bias = np.array(spec.actuator(j).biasprm, dtype=float)
+        bias[0] = -25.0 * ours.encoder_offset.get(j, 0.0)
+        spec.actuator(j).biasprm = bias
+    bare = tmp_path / "no_tau_os.xml"
+    bare.write_text(spec.to_xml())
+    without = replay_mjcf(bare, ours, written.logs["held_out"], Replay()).rms
+    assert without.mean() > theirs.mean() > mine.mean()

@@ -155,6 +155,11 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
                   + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")", highlight=False)
     for status, joints in result.selection.left_out.items():
         console.print(f"not exported, {status}: {', '.join(joints)}", highlight=False, soft_wrap=True)
+    instead = result.selection.instead
+    if instead:
+        console.print("the simplest family's fit (coulomb-viscous, no terms) exported in place of the model chosen, "
+                      "not ok: " + ", ".join(f"{j} ({f.model}, {f.verdict().status})" for j, f in instead.items()),
+                      highlight=False, soft_wrap=True)
     with_terms = {j: t.kept for j, f in result.selection.exported.items() if (t := f.kept_terms) is not None}
     if with_terms:
         console.print("no simulator holds the terms beyond velocity: dropped for "

@@ -51,9 +51,12 @@ temperature (k_T)    dropped                 dropped                dropped
 Friction that is not dissipative (F_c < 0, F_v < 0, or a static level F_s < 0, i.e. S < -1) and
 a negative armature are refused (:class:`~wbfriction.exceptions.InputError`), never exported.
 
-Which fits are exported (:func:`select_fits`) follows their status (:mod:`wbfriction.fit.status`):
-``ok`` always; ``weak`` (large standard errors) and ``at bound`` (a parameter is the bound's value) only
-on request (:data:`Include`, ``export --include weak,at-bound``): numbers of the data, less certain. A fit
+Which fits are exported (:func:`select_fits`, :func:`exported_fit`) follows their status
+(:mod:`wbfriction.fit.status`): ``ok`` always; where the model ``--model auto`` chose is not ``ok``, its simplest
+family's fit (:attr:`~wbfriction.fit.result.FitResult.fallback`: Coulomb-viscous, without terms) when that is ``ok``
+or included, its note saying which it replaces; ``weak`` (large standard errors) and ``at bound`` (a parameter is
+the bound's value) only on request (:data:`Include`, ``export --include weak,at-bound``): numbers of the data, less
+certain. A fit
 that is ``not excited`` (the joint hardly moved: its friction is not in the data, and the fit's numbers
 are whatever the solver settled on, e.g. F_v 38 N·m·s/rad for a hip yaw of 0.2) or ``failed`` (the solver
 stopped without converging) never is, and :func:`joint_export` refuses one; a joint without a fit (not
@@ -65,7 +68,8 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from collections.abc import Set as AbstractSet
+from dataclasses import dataclass, field
 from typing import Literal, Protocol, cast, get_args
 
 import numpy as np
@@ -127,15 +131,29 @@ class FitSelection:
     """The fits of a parameters file that are exported, and the robot's joints that are not.
 
     Attributes:
-        exported: joint -> fit to export (status ``ok`` or an included one), in the robot's joint order.
+        exported: joint -> fit to export (status ``ok`` or an included one, :func:`exported_fit`), in the robot's
+            joint order.
         left_out: status (a :data:`~wbfriction.fit.status.FitStatus`, or :data:`NOT_FITTED` for a
             joint the file has no fit of) -> the joints left out with it, in the robot's joint order.
         include: the statuses exported besides ``ok``.
+        instead: joint -> the fit chosen, where its :attr:`~wbfriction.fit.result.FitResult.fallback` (the simplest
+            family's) is exported in its place.
     """
 
     exported: Mapping[str, FitResult]
     left_out: Mapping[str, tuple[str, ...]]
     include: tuple[Include, ...] = ()
+    instead: Mapping[str, FitResult] = field(default_factory=dict)
+
+    def instead_note(self, joint: str) -> str:
+        """Where the simplest family's fit is exported in place of the model chosen (:attr:`instead`), what the
+        chosen one was and why it is not (``in place of the stribeck fit chosen, at bound: ...``); else ""."""
+        chosen = self.instead.get(joint)
+        if chosen is None:
+            return ""
+        verdict = chosen.verdict()
+        return (f"in place of the {chosen.model} fit chosen ({verdict.status}"
+                + (f": {verdict.reason}" if verdict.reason else "") + ")")
 
     @property
     def exported_statuses(self) -> dict[str, int]:
@@ -166,20 +184,39 @@ def select_fits(fits: Mapping[str, FitResult], robot: Robot, include: Iterable[s
     wanted: set[str] = {"ok", *(INCLUDED_STATUS[c] for c in included)}
     exported: dict[str, FitResult] = {}
     left_out: dict[str, list[str]] = {}
+    instead: dict[str, FitResult] = {}
     for joint in robot.actuated:
         fit = fits.get(joint)
-        status = NOT_FITTED if fit is None else fit.verdict().status
-        if fit is not None and status in wanted:
-            exported[joint] = fit
+        chosen = None if fit is None else exported_fit(fit, wanted)
+        if fit is not None and chosen is not None:
+            exported[joint] = chosen
+            if chosen is not fit:
+                instead[joint] = fit
         else:
-            left_out.setdefault(status, []).append(joint)
+            left_out.setdefault(NOT_FITTED if fit is None else fit.verdict().status, []).append(joint)
     if not exported:
         counts = Counter(fit.verdict().status for fit in fits.values())
         hint = [c for c, status in INCLUDED_STATUS.items() if counts[status] and c not in included]
         raise InputError(f"{source}: no fit qualifies for export ("
                          + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")"
                          + (f": --include {','.join(hint)} exports those" if hint else ""))
-    return FitSelection(exported, {status: tuple(joints) for status, joints in left_out.items()}, included)
+    return FitSelection(exported, {status: tuple(joints) for status, joints in left_out.items()}, included, instead)
+
+
+def exported_fit(fit: FitResult, wanted: AbstractSet[str]) -> FitResult | None:
+    """The fit of a joint an export writes (module docstring), of the statuses ``wanted`` (``ok`` and those
+    included): the fit itself where it is ``ok``; else its :attr:`~wbfriction.fit.result.FitResult.fallback` (the
+    simplest family's, fitted without terms) where that is ``ok``, or is wanted (of two fits neither ``ok``, the one
+    with the fewest parameters the data must carry); else the fit where it is wanted; else None (issue 64: on the
+    real Aliengo, a Stribeck fit at its bound with a ripple dropped tracked its held-out stretch at 19.9 mrad in the
+    exported MJCF, its Coulomb-viscous fit at 6.0)."""
+    status = fit.verdict().status
+    if status == "ok":
+        return fit
+    simple = fit.fallback
+    if simple is not None and simple.verdict().status in {"ok", *wanted} - set(NEVER_EXPORTED):
+        return simple
+    return fit if status in wanted else None
 
 
 FrictionLike = FitResult | FrictionModelParams
@@ -214,6 +251,8 @@ class JointExport:
         verdict: the status of the fit the friction comes from (:func:`status_note`), None for bare parameters.
         dropped: the terms beyond velocity the fit kept, which no simulator holds (module docstring).
         conditions: where the fit kept terms, the conditions its levels are at (``zero load, T_ref 40 °C``).
+        instead: where the fit is the simplest family's in place of the one chosen, what that was
+            (:meth:`FitSelection.instead_note`), else "".
 
     Raises:
         InputError: a value that is negative (not dissipative) or not finite, or friction given in part.
@@ -228,6 +267,7 @@ class JointExport:
     verdict: FitVerdict | None = None
     dropped: tuple[str, ...] = ()
     conditions: str = ""
+    instead: str = ""
 
     def __post_init__(self) -> None:
         given = [x is not None for x in (self.viscous, self.coulomb, self.static)]
@@ -302,6 +342,8 @@ def status_note(exp: JointExport) -> str | None:
         return None
     v = exp.verdict
     text = f"{NOTE_PREFIX} {exp.joint}: {v.status}" + (f" ({v.reason})" if v.reason else "")
+    if exp.instead:
+        text += f"; its {getattr(exp.params, 'model', '')} fit {exp.instead}"
     if exp.dropped:
         text += (f"; terms beyond velocity dropped (no field here): {', '.join(exp.dropped)}; levels at "
                  f"{exp.conditions}")

@@ -12,7 +12,7 @@ from typing import Any, cast
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.fit.options import PASS_ROWS, SELECTION_TOLERANCE, STICK_FLOOR, FitOptions, ModelChoice
+from wbfriction.fit.options import AUTO, PASS_ROWS, SELECTION_TOLERANCE, STICK_FLOOR, FitOptions, ModelChoice
 from wbfriction.fit.ranges import FittedRanges
 from wbfriction.fit.result import FitResult, compare_routes
 from wbfriction.fit.screen import gross_outliers
@@ -229,7 +229,37 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
                 if not _better_refit(refit, f):
                     break
                 fits[k] = f = refit
-    return _with_delay_structure(fits, est.metadata)
+    fits = _with_delay_structure(fits, est.metadata)
+    if options.model == AUTO:  # with its status final: the delay structure's spread can make a fit weak
+        for k, (f, i) in enumerate(zip(fits, idx)):
+            f.fallback = _fallback(f, tasks[k], others[k], est, i, None if truth is None else truth[:, [k]], targets)
+    return fits
+
+
+NO_FALLBACK: tuple[str, ...] = ("ok", "not excited")
+"""Statuses of a fit chosen by ``model="auto"`` that get no :attr:`~wbfriction.fit.result.FitResult.fallback`:
+``ok`` (it is what is used) and ``not excited`` (no friction in the data, whatever the family)."""
+
+
+def _fallback(fit: FitResult, task: tuple, other: tuple | None, est: FrictionEstimate, i: int,
+              truth: np.ndarray | None, targets: Mapping[str, ModelParams] | None) -> FitResult | None:
+    """The simplest family's fit of a joint whose chosen fit is not ``ok`` (:attr:`FitResult.fallback`): the task of
+    its column ``i`` (``task``, and ``other`` on the other route) with that family and no terms, checked as the
+    chosen fit is; None where the chosen fit is ``ok`` or not excited, or is that family's without terms."""
+    from wbfriction.friction.families.registry import families
+
+    simplest = families()[0].name
+    if fit.verdict().status in NO_FALLBACK or (fit.model == simplest and fit.kept_terms is None):
+        return None
+    qd, tau_f, valid, kwargs = task
+    simple, checked = _fit_routes(((qd, tau_f, valid, {**kwargs, "model": simplest}), other))
+    simple = _with_truth([fit.joint], [simple], est.qd[:, [i]], est.tau_f[:, [i]], est.valid[:, [i]], truth,
+                         targets)[0]
+    simple.route, simple.unmeasured = fit.route, fit.unmeasured
+    if checked is not None and est.route_check is not None:
+        checked.route = est.route_check.estimation_route
+        simple.route_check = compare_routes(simple, checked)
+    return _with_delay_structure([simple], est.metadata)[0]
 
 
 def _with_delay_structure(fits: list[FitResult], metadata: Mapping[str, Any]) -> list[FitResult]:

@@ -133,6 +133,8 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
     if fit.target is not None:
         d["target"] = fit.target.to_target()
         d["error_percent"] = {k: clean(v) for k, v in (fit.error_percent() or {}).items()}
+    if fit.fallback is not None:
+        d["fallback"] = fit_to_dict(fit.fallback)
     return d
 
 
@@ -201,6 +203,11 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
             check_model_params(res.params, "params")
         if res.terms is not None:
             check_terms(res.terms, model)
+        if d.get("fallback") is not None:
+            try:
+                res.fallback = fit_from_dict(joint, d["fallback"])
+            except InputError as exc:
+                raise InputError(f"fallback: {exc}") from None
     except KeyError as exc:
         raise InputError(f"missing key {exc}") from None
     except (TypeError, ValueError, AttributeError) as exc:

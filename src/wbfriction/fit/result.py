@@ -177,6 +177,11 @@ class FitResult(Generic[ParamsT]):
             the log did not tell (:func:`~wbfriction.fit.joints.delay_structure_spread`), ``kp delay`` with it in
             quadrature. The standard error a user reads (:meth:`read_stderr`) adds it in quadrature to
             :attr:`stderr`; the route check and the predictions use :attr:`stderr` (issue 63).
+        fallback: with ``model="auto"``, where the model chosen is not ``ok``: the simplest family (the first of
+            :func:`~wbfriction.friction.families.registry.families`, Coulomb-viscous) fitted on the same samples
+            without terms, with its own checks (route, later stretch), or None. It is what an export writes for the
+            joint when it is ``ok``, or when neither is and both statuses are included: the model with the fewest
+            parameters the data must carry (:func:`~wbfriction.export.mapping.select_fits`; issue 64).
     """
 
     joint: str
@@ -209,6 +214,7 @@ class FitResult(Generic[ParamsT]):
     unmeasured: str = ""
     pressed: dict[str, tuple[float, float]] = field(default_factory=dict)
     model_spread: dict[str, float] = field(default_factory=dict)
+    fallback: FitResult | None = None
 
     def __post_init__(self) -> None:
         if self.params is not None:

@@ -5,7 +5,7 @@ format each output's name says (:mod:`wbfriction.export`: the target of each suf
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from wbfriction.exceptions import InputError
@@ -66,6 +66,7 @@ def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path]
     for target in {id(t): t for t in chosen}.values():
         target.check(robot)
     selection = select_fits(read_params(params), robot, include, str(params))
-    joints = joint_exports(selection.exported, armature, robot)
+    joints = {name: replace(exp, instead=selection.instead_note(name))
+              for name, exp in joint_exports(selection.exported, armature, robot).items()}
     reports = tuple(target.write(Path(path), robot, joints) for path, target in zip(outputs, chosen))
     return Exported(reports, selection, drive_export(robot, joints))

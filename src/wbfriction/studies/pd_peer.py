@@ -9,8 +9,9 @@ friction: a static level, equal to the dynamic one in their assets, and a viscou
 friction is a step). The held-out log is estimated with that robot as the route estimates it with the one
 identified (:func:`~wbfriction.friction.estimate.estimate_log`, the momentum route, as the dataset's commands take),
 and the peer's friction predicts its torque (:func:`~wbfriction.fit.predict.predict_torques`): the RMS of measured
-less predicted, per joint, beside wbfriction's (:func:`peer_held_out`); and the same log's set-points replayed in
-MuJoCo with either's parameters, the joints' tracking error (:func:`peer_rollouts`).
+less predicted, per joint, beside wbfriction's (:func:`peer_held_out`); and the same log's set-points replayed on
+the MJCF wbfriction exported and on the peer's parameters as PACE simulates them, the joints' tracking error
+(:func:`peer_rollouts`).
 """
 
 from __future__ import annotations
@@ -30,8 +31,9 @@ from wbfriction.model.loading import build_robot
 from wbfriction.model.robot import Robot
 
 
-def peer_robot_config(robot_toml: Path, peer_toml: Path) -> dict:
+def peer_robot_config(robot_toml: str | Path, peer_toml: str | Path) -> dict:
     """The robot's configuration with the peer's tables (``[armature]``, ``[encoder_offset]``, ``[pd]``) over it."""
+    robot_toml, peer_toml = Path(robot_toml), Path(peer_toml)
     config = tomllib.loads(robot_toml.read_text(encoding="utf-8"))
     peer = tomllib.loads(peer_toml.read_text(encoding="utf-8"))
     for table in ("armature", "encoder_offset"):
@@ -41,8 +43,9 @@ def peer_robot_config(robot_toml: Path, peer_toml: Path) -> dict:
     return config
 
 
-def peer_robot(robot_toml: Path, peer_toml: Path) -> Robot:
+def peer_robot(robot_toml: str | Path, peer_toml: str | Path) -> Robot:
     """The robot with the peer's tables (:func:`peer_robot_config`)."""
+    robot_toml = Path(robot_toml)
     config = peer_robot_config(robot_toml, peer_toml) | {"_dir": str(robot_toml.parent)}
     return build_robot(robot_toml.parent / config["urdf"], config, str(peer_toml))
 
@@ -65,21 +68,30 @@ def peer_held_out(robot_toml: Path, peer_toml: Path, peer: PeerActuator, held_ou
     return {j: float(prediction.rms[i]) for i, j in enumerate(prediction.joints)}
 
 
-def peer_rollouts(robot_toml: Path, peer_toml: Path, peer: PeerActuator, identified_toml: Path, params: Path,
-                  held_out: Path) -> pa.Table:
-    """The held-out log's set-points replayed in MuJoCo (:func:`~wbfriction.sim.rollout.rollout`) with wbfriction's
-    identification (the robot ``identified_toml``, the friction of ``params``) and with the peer's, as the peer's
-    simulator applies it (its delay truncated to whole 5 ms steps and applied to the whole torque, PACE's actuator):
-    a row per joint, ``rms.ours`` and ``rms.peer`` [rad], the tracking error of the logged angles.
+def peer_rollouts(robot_toml: str | Path, peer_toml: str | Path, peer: PeerActuator, identified_toml: str | Path,
+                  mjcf: str | Path, held_out: str | Path, horizon: float | None = 1.0) -> pa.Table:
+    """The held-out log's set-points replayed (:func:`~wbfriction.sim.replay.replay_mjcf`, restarted from the log every
+    ``horizon`` seconds) on the MJCF wbfriction exported (``mjcf``, for the robot ``identified_toml``), as MuJoCo
+    runs it, and on the peer's parameters written by the same export and run as PACE simulates them (the PD law once
+    a 5 ms period, its whole torque held back its delay truncated to whole periods): a row per joint, ``rms.ours`` and
+    ``rms.peer`` [rad], the tracking error of the logged angles.
 
     Raises:
-        InputError: what reading the robots, the parameters or the log raises.
+        InputError: what reading the robots, the files or the log raises.
     """
-    from wbfriction.model.loading import load_robot
-    from wbfriction.sim.rollout import ActuatorParams, rollout, rollout_table
+    import tempfile
 
-    ours = rollout(load_robot(None, config=identified_toml), held_out, ActuatorParams(friction=params, label="ours"))
+    from wbfriction.export.mjcf import write_mjcf
+    from wbfriction.model.loading import load_robot
+    from wbfriction.sim.replay import Replay, replay_mjcf
+    from wbfriction.sim.rollout import rollout_table
+
+    ours = replay_mjcf(mjcf, load_robot(None, config=Path(identified_toml)), held_out,
+                       Replay(label="ours", horizon=horizon))
     robot = peer_robot(robot_toml, peer_toml)
-    theirs = rollout(robot, held_out, ActuatorParams(friction=peer_friction(peer, robot.actuated),
-                                                     delay=peer.applied_delay, torque_delay=True, label="peer"))
+    with tempfile.TemporaryDirectory(prefix="wbfriction-peer-") as tmp:
+        path = Path(tmp) / "peer.xml"
+        write_mjcf(robot, peer_friction(peer, robot.actuated), path, armature=peer.armature)
+        theirs = replay_mjcf(path, robot, held_out, Replay(label="peer", horizon=horizon,
+                                                           torque_delay=peer.applied_delay_steps))
     return rollout_table([ours, theirs])

@@ -110,12 +110,14 @@ class Outputs:
     friction: Path
     held_out: Path | None = None
     identified: Path | None = None
+    mjcf: Path | None = None
 
 
 def outputs(commands: Sequence[str], folder: Path) -> Outputs:
-    """The parameters JSON and friction table of the last ``fit`` of ``commands``, and the friction table of the
-    last ``predict`` (None without one), as paths in ``folder`` (the commands' working folder)."""
-    fit = predict = identified = None
+    """The parameters JSON and friction table of the last ``fit`` of ``commands``, the friction table of the
+    last ``predict``, the TOML ``identify --config-output`` wrote and the MJCF the last ``export`` wrote (each None
+    without one), as paths in ``folder`` (the commands' working folder)."""
+    fit = predict = identified = mjcf = None
     for line in commands:
         words = shlex.split(line)
         if words[1:2] == ["fit"]:
@@ -124,10 +126,13 @@ def outputs(commands: Sequence[str], folder: Path) -> Outputs:
             predict = words
         elif words[1:2] == ["identify"] and "--config-output" in words:
             identified = folder / words[words.index("--config-output") + 1]
+        elif words[1:2] == ["export"]:
+            written = [words[i + 1] for i, w in enumerate(words[:-1]) if w in ("-o", "--output")]
+            mjcf = next((folder / w for w in written if w.endswith((".xml", ".mjcf"))), mjcf)
     if fit is None:
         raise ValueError("the route has no fit")
     return Outputs(folder / fit[fit.index("-o") + 1], folder / fit[2],
-                   None if predict is None else folder / predict[2], identified)
+                   None if predict is None else folder / predict[2], identified, mjcf)
 
 
 SPEED_BIN = 0.05
@@ -247,16 +252,16 @@ def run_dataset(name: str, folder: str | Path, python: str = sys.executable,
 def peer_scores(config: Path, outs: Outputs) -> tuple[dict[str, float], dict[str, tuple[float, float]]]:
     """The held-out torque RMS per joint [N·m] of the peer whose parameters lie beside the robot's TOML ``config``
     (``peer.toml``, the held-out log ``held_out.parquet``; the one such dataset, the Aliengo's, reads its peer's
-    friction from its fetched file), and per joint the held-out rollouts' tracking error [rad], the route's
-    identification's and the peer's (:mod:`wbfriction.studies.pd_peer`; none without the route's identified TOML)."""
+    friction from its fetched file), and per joint the held-out rollouts' tracking error [rad], the MJCF the route
+    exported and the peer's (:mod:`wbfriction.studies.pd_peer`; none without the route's identified TOML and MJCF)."""
     from wbfriction.datasets.aliengo import aliengo_peer
     from wbfriction.studies.pd_peer import peer_held_out, peer_rollouts
 
     folder, peer = config.parent, aliengo_peer()
     held = peer_held_out(config, folder / "peer.toml", peer, folder / "held_out.parquet")
-    if outs.identified is None:
+    if outs.identified is None or outs.mjcf is None:
         return held, {}
-    table = peer_rollouts(config, folder / "peer.toml", peer, outs.identified, outs.params,
+    table = peer_rollouts(config, folder / "peer.toml", peer, outs.identified, outs.mjcf,
                           folder / "held_out.parquet").to_pydict()
     return held, {j: (o, p) for j, o, p in zip(table["joint"], table["rms.ours"], table["rms.peer"])}
 
