@@ -21,6 +21,8 @@ from .pd_options import HungOptions as HungOptions
 from .pd_options import SetpointOptions as SetpointOptions
 from .pd_robot import PdMujocoRobot as PdMujocoRobot
 from .pd_robot import build_pd_robot as build_pd_robot
+from .replay import Replay as Replay
+from .replay import replay_mjcf as replay_mjcf
 from .rollout import ActuatorParams as ActuatorParams
 from .rollout import RolloutResult as RolloutResult
 from .rollout import rollout as rollout
