@@ -210,29 +210,40 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
             other.route = check.estimation_route
             f.route_check = compare_routes(f, other)
     if options.terms.terms:
-        for k, (f, i, maybe) in enumerate(zip(fits, idx, checked)):
-            f.terms = _joint_terms(est, i, f, maybe, options)
-            for _ in range(TERM_REFITS):  # the velocity model chosen and fitted again with the terms' torque taken out
-                if f.kept_terms is None:
-                    break
-                task = _without_terms(tasks[k], f.kept_terms, est, i)
-                refit = _with_truth([names[k]], [_fit_column(task)], est.qd[:, [i]], est.tau_f[:, [i]],
-                                    est.valid[:, [i]], None if truth is None else truth[:, [k]], targets)[0]
-                refit.route, refit.route_check, refit.unmeasured = f.route, f.route_check, f.unmeasured
-                if refit.params is None or not refit.success:  # a refit that did not converge: the fit before it
-                    break
-                other_task = others[k]
-                if other_task is not None and refit.model != f.model:  # the other route's refit of this model
-                    qd_o, tau_o, valid_o, kwargs_o = other_task
-                    maybe = _fit_column((qd_o, tau_o, valid_o, {**kwargs_o, "model": refit.model}), later=False)
-                refit.terms = _joint_terms(est, i, refit, maybe, options)
-                if not _better_refit(refit, f):
-                    break
-                fits[k] = f = refit
-    fits = _with_delay_structure(fits, est.metadata)
-    if options.model == AUTO:  # with its status final: the delay structure's spread can make a fit weak
+        fits = _with_terms(fits, checked, tasks, others, est, idx, truth, targets, options)
+    fits = _with_delay_structure(fits, est.metadata)  # before the fallbacks: its spread can make a fit weak
+    if options.model == AUTO:
         for k, (f, i) in enumerate(zip(fits, idx)):
             f.fallback = _fallback(f, tasks[k], others[k], est, i, None if truth is None else truth[:, [k]], targets)
+    return fits
+
+
+def _with_terms(fits: list[FitResult], checked: Sequence[FitResult | None], tasks: list[tuple],
+                others: Sequence[tuple | None], est: FrictionEstimate, idx: list[int], truth: np.ndarray | None,
+                targets: Mapping[str, ModelParams] | None, options: FitOptions) -> list[FitResult]:
+    """``fits`` with their terms beyond velocity (:func:`_joint_terms`), each joint's velocity model chosen and fitted
+    again with the terms' torque taken out while that predicts better (:data:`TERM_REFITS`, :func:`_better_refit`)."""
+    fits = list(fits)
+    names = [f.joint for f in fits]
+    for k, (f, i, maybe) in enumerate(zip(fits, idx, checked)):
+        f.terms = _joint_terms(est, i, f, maybe, options)
+        for _ in range(TERM_REFITS):  # the velocity model chosen and fitted again with the terms' torque taken out
+            if f.kept_terms is None:
+                break
+            task = _without_terms(tasks[k], f.kept_terms, est, i)
+            refit = _with_truth([names[k]], [_fit_column(task)], est.qd[:, [i]], est.tau_f[:, [i]],
+                                est.valid[:, [i]], None if truth is None else truth[:, [k]], targets)[0]
+            refit.route, refit.route_check, refit.unmeasured = f.route, f.route_check, f.unmeasured
+            if refit.params is None or not refit.success:  # a refit that did not converge: the fit before it
+                break
+            other_task = others[k]
+            if other_task is not None and refit.model != f.model:  # the other route's refit of this model
+                qd_o, tau_o, valid_o, kwargs_o = other_task
+                maybe = _fit_column((qd_o, tau_o, valid_o, {**kwargs_o, "model": refit.model}), later=False)
+            refit.terms = _joint_terms(est, i, refit, maybe, options)
+            if not _better_refit(refit, f):
+                break
+            fits[k] = f = refit
     return fits
 
 
