@@ -128,7 +128,7 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
                                             "mispredicts the rest). "
                                             "Fits not excited or failed are never exported."),
            physics_dt: float = typer.Option(0.005, "--physics-dt",
-                                            help="Physics step \\[s] of the Isaac Lab simulation a PD-driven robot's "
+                                            help="Physics step [s] of the Isaac Lab simulation a PD-driven robot's "
                                                  "delay is counted in (.yaml: min_delay = max_delay = delay / "
                                                  "physics-dt, rounded to whole steps, with a warning): 0.005, Isaac "
                                                  "Lab's locomotion tasks (sim.dt 1/200, decimation 4)."),

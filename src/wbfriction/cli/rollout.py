@@ -20,18 +20,18 @@ def rollout(log: Path = LogArg,
                                          help="MuJoCo MJCF written by 'wbfriction export' for the robot (--config): "
                                               "its PD-driven joints' actuators, named as the joints, are replayed."),
             window: float = typer.Option(1.0, "--window",
-                                         help="Restart from the log's state every so many seconds \\[s]; the "
+                                         help="Restart from the log's state every so many seconds [s]; the "
                                               "whole stretch in one shot is scored too."),
-            start: Optional[float] = typer.Option(None, "--from", help="Replay from this time of the log \\[s] "
+            start: Optional[float] = typer.Option(None, "--from", help="Replay from this time of the log [s] "
                                                                        "(default: its start)."),
-            stop: Optional[float] = typer.Option(None, "--to", help="Replay up to this time of the log \\[s] "
+            stop: Optional[float] = typer.Option(None, "--to", help="Replay up to this time of the log [s] "
                                                                     "(default: its end)."),
             torque_delay: Optional[int] = typer.Option(None, "--torque-delay", min=0,
                                                        help="Replay PACE's actuator instead of the file's: the PD "
                                                             "law computed once a log period and its whole torque "
                                                             "applied so many periods later (a model identified so)."),
             timestep: Optional[float] = typer.Option(None, "--timestep",
-                                                     help="Physics step \\[s] (default: the file's)."),
+                                                     help="Physics step [s] (default: the file's)."),
             label: str = typer.Option("model", "--label", help="What the figure calls the replay."),
             output: Optional[Path] = typer.Option(None, "-o", "--output",
                                                   help="Table to write (.parquet, .csv): per joint, the RMS "
