@@ -42,8 +42,8 @@ def rollout(log: Path = LogArg,
     """Replay the log's set-points on an exported MuJoCo model, as MuJoCo runs it (the file's timestep, gains,
     offsets, torque limits and set-point delay), restarted from the log's state every --window seconds and in one
     shot: how far the simulated encoder angles go from the logged ones, per joint (a hung robot, its base fixed)."""
-    from wbfriction.pipeline.rollout_step import replay_file
-    from wbfriction.sim.replay import Replay
+    from wbfriction.report.figures import rollout_figure
+    from wbfriction.sim.replay import Replay, replay_check
 
     check_paths({"LOG": log, "MODEL": model, "--config": config, "--urdf": urdf, "--mjcf": mjcf},
                 {"-o": output, "--figure": figure})
@@ -55,8 +55,9 @@ def rollout(log: Path = LogArg,
                                                           math.inf if stop is None else stop)
     replay = Replay(label=label, horizon=window, torque_delay=torque_delay, timestep=timestep)
     with console.status(f"replaying {log.name} on {model.name}"):
-        check = replay_file(robot_of(robot, urdf, config, mjcf), log, model, replay, times=times, output=output,
-                            figure=figure)
+        check = replay_check(model, robot_of(robot, urdf, config, mjcf), log, replay, times=times, output=output)
+        if figure is not None:
+            rollout_figure([check.windows], figure)
     w = check.windows
     table = Table(title="RMS of simulated - logged angle [mrad]", box=None, caption_justify="left",
                   caption=f"{model.name} replayed on rows {w.rows[0]} to {w.rows[1]} of {log.name}; windows: "

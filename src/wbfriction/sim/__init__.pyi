@@ -22,6 +22,8 @@ from .pd_options import SetpointOptions as SetpointOptions
 from .pd_robot import PdMujocoRobot as PdMujocoRobot
 from .pd_robot import build_pd_robot as build_pd_robot
 from .replay import Replay as Replay
+from .replay import ReplayCheck as ReplayCheck
+from .replay import replay_check as replay_check
 from .replay import replay_mjcf as replay_mjcf
 from .rollout import ActuatorParams as ActuatorParams
 from .rollout import RolloutResult as RolloutResult

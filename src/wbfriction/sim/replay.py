@@ -224,3 +224,40 @@ def _held_torque(m, d, drives: _Drives, data: LogSetpoints, first: int, last: in
             mujoco.mj_step(m, d)
         out[k + 1] = d.qpos[drives.qpos]
     return out
+
+
+@dataclass(frozen=True)
+class ReplayCheck:
+    """A file replayed two ways over one stretch (:func:`replay_check`): restarted from the log every
+    ``horizon`` seconds (``windows``) and in one shot (``whole``), each a
+    :class:`~wbfriction.sim.rollout.RolloutResult`."""
+
+    windows: RolloutResult
+    whole: RolloutResult
+
+    def table(self) -> pa.Table:
+        """A row per joint: ``joint``, ``rms_windows`` and ``rms_whole`` [rad]."""
+        return pa.table({"joint": list(self.windows.joints), "rms_windows": self.windows.rms,
+                         "rms_whole": self.whole.rms})
+
+
+def replay_check(model: str | Path, robot: Robot, log: str | Path, replay: Replay = Replay(), *,
+                 times: tuple[float, float] | None = None, output: str | Path | None = None) -> ReplayCheck:
+    """What ``wbfriction rollout`` runs: ``model`` (an MJCF ``wbfriction export`` wrote for ``robot``) replayed under
+    the set-points of ``log`` over ``times`` ([t0, t1) [s]; None: the whole log) in windows of ``replay.horizon``
+    and in one shot (:func:`replay_mjcf`); the table (:meth:`ReplayCheck.table`) written to ``output`` where given,
+    whole or not at all.
+
+    Raises:
+        what :func:`replay_mjcf` raises; InputError: an output that cannot be written.
+    """
+    from dataclasses import replace
+
+    from wbfriction.logs.tables import write_table
+
+    data = read_log_setpoints(robot, log)
+    check = ReplayCheck(replay_mjcf(model, robot, data, replay, times=times),
+                        replay_mjcf(model, robot, data, replace(replay, horizon=None), times=times))
+    if output is not None:
+        write_table(check.table(), output)
+    return check
