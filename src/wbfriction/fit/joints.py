@@ -16,7 +16,7 @@ from wbfriction.fit.options import AUTO, PASS_ROWS, SELECTION_TOLERANCE, STICK_F
 from wbfriction.fit.ranges import FittedRanges
 from wbfriction.fit.result import FitResult, compare_routes
 from wbfriction.fit.screen import gross_outliers
-from wbfriction.fit.selection import fit_friction, later_stretch
+from wbfriction.fit.selection import SPREAD, fit_friction, later_stretch
 from wbfriction.fit.smoothing import smoother_half_width
 from wbfriction.fit.solve import fitted_rows, stick_speed
 from wbfriction.fit.term_selection import fit_terms, refit_terms
@@ -256,7 +256,14 @@ def _fallback(fit: FitResult, task: tuple, other: tuple | None, est: FrictionEst
               truth: np.ndarray | None, targets: Mapping[str, ModelParams] | None) -> FitResult | None:
     """The simplest family's fit of a joint whose chosen fit is not ``ok`` (:attr:`FitResult.fallback`): the task of
     its column ``i`` (``task``, and ``other`` on the other route) with that family and no terms, checked as the
-    chosen fit is; None where the chosen fit is ``ok`` or not excited, or is that family's without terms."""
+    chosen fit is; None where the chosen fit is ``ok`` or not excited, or is that family's without terms.
+
+    The family chosen predicted the held-out blocks better than this one (or kept terms that did): its F_c and F_v
+    are where a model error this fit does not resolve may put them. Their distance to this fit's is its model
+    spread, whole (:func:`~wbfriction.fit.selection.family_spread` with the roles turned: another family that fits
+    the data better carries its whole distance), so that a fit the data prefer another curve to is not ``ok`` on
+    its tight statistical errors (on the project's crawl with 3-D foot forces, a hip's Coulomb-viscous fit was
+    ``ok`` 15 % and 79 % off F_c and F_v beside a (3.5) fit 15 % and 16 % off, ``weak``)."""
     from wbfriction.friction.families.registry import families
 
     simplest = families()[0].name
@@ -270,6 +277,11 @@ def _fallback(fit: FitResult, task: tuple, other: tuple | None, est: FrictionEst
     if checked is not None and est.route_check is not None:
         checked.route = est.route_check.estimation_route
         simple.route_check = compare_routes(simple, checked)
+    chosen = fit.reported().params
+    if simple.params is not None and chosen is not None:  # the chosen family predicts the held-out blocks better
+        theirs, mine = chosen.to_dict(), simple.params.to_dict()
+        simple.model_spread = {n: math.hypot(simple.model_spread.get(n, 0.0), abs(mine[n] - theirs[n]))
+                               for n in SPREAD if n in mine and n in theirs}
     return _with_delay_structure([simple], est.metadata)[0]
 
 

@@ -179,8 +179,9 @@ class FitResult(Generic[ParamsT]):
             :attr:`stderr`; the route check and the predictions use :attr:`stderr` (issue 63).
         fallback: with ``model="auto"``, where the model chosen is not ``ok``: the simplest family (the first of
             :func:`~wbfriction.friction.families.registry.families`, Coulomb-viscous) fitted on the same samples
-            without terms, with its own checks (route, later stretch), or None. It is what an export writes for the
-            joint when it is ``ok``, or when neither is and both statuses are included: the model with the fewest
+            without terms, with its own checks (route, later stretch) and its distance to the chosen fit's F_c and F_v
+            in its :attr:`model_spread` (the chosen family predicted better), or None. It is what an export writes for
+            the joint when it is ``ok``, or when neither is and both statuses are included: the model with the fewest
             parameters the data must carry (:func:`~wbfriction.export.mapping.select_fits`; issue 64).
     """
 
