@@ -214,7 +214,7 @@ def exported_fit(fit: FitResult, wanted: AbstractSet[str]) -> FitResult | None:
     if status == "ok":
         return fit
     simple = fit.fallback
-    if simple is not None and simple.verdict().status in {"ok", *wanted} - set(NEVER_EXPORTED):
+    if simple is not None and simple.verdict().status in {"ok", *wanted}:
         return simple
     return fit if status in wanted else None
 

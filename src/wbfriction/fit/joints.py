@@ -213,8 +213,7 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
         fits = _with_terms(fits, checked, tasks, others, est, idx, truth, targets, options)
     fits = _with_delay_structure(fits, est.metadata)  # before the fallbacks: its spread can make a fit weak
     if options.model == AUTO:
-        for k, (f, i) in enumerate(zip(fits, idx)):
-            f.fallback = _fallback(f, tasks[k], others[k], est, i, None if truth is None else truth[:, [k]], targets)
+        _with_fallbacks(fits, tasks, others, est, idx, truth, targets, workers)
     return fits
 
 
@@ -252,14 +251,16 @@ NO_FALLBACK: tuple[str, ...] = ("ok", "not excited")
 ``ok`` (it is what is used) and ``not excited`` (no friction in the data, whatever the family)."""
 
 
-def _fallback(fit: FitResult, task: tuple, other: tuple | None, est: FrictionEstimate, i: int,
-              truth: np.ndarray | None, targets: Mapping[str, ModelParams] | None) -> FitResult | None:
-    """The simplest family's fit of a joint whose chosen fit is not ``ok`` (:attr:`FitResult.fallback`): the task of
-    its column ``i`` (``task``, and ``other`` on the other route) with that family and no terms, checked as the
-    chosen fit is; None where the chosen fit is ``ok`` or not excited, or is that family's without terms.
+def _with_fallbacks(fits: list[FitResult], tasks: list[tuple], others: Sequence[tuple | None], est: FrictionEstimate,
+                    idx: list[int], truth: np.ndarray | None, targets: Mapping[str, ModelParams] | None,
+                    workers: int) -> None:
+    """Set :attr:`FitResult.fallback` of each fit chosen by ``model="auto"`` that is not ``ok``: the simplest family's
+    fit of its column (its task of ``tasks``, and of ``others`` on the other route) with no terms, fitted side by side
+    on ``workers`` processes as the chosen fits are, and checked as they are; none where the chosen fit is ``ok`` or
+    not excited, or is that family's without terms.
 
     The family chosen predicted the held-out blocks better than this one (or kept terms that did): its F_c and F_v
-    are where a model error this fit does not resolve may put them. Their distance to this fit's is its model
+    are where a model error the simplest fit does not resolve may put them. Their distance to that fit's is its model
     spread, whole (:func:`~wbfriction.fit.selection.family_spread` with the roles turned: another family that fits
     the data better carries its whole distance), so that a fit the data prefer another curve to is not ``ok`` on
     its tight statistical errors (on the project's crawl with 3-D foot forces, a hip's Coulomb-viscous fit was
@@ -267,22 +268,24 @@ def _fallback(fit: FitResult, task: tuple, other: tuple | None, est: FrictionEst
     from wbfriction.friction.families.registry import families
 
     simplest = families()[0].name
-    if fit.verdict().status in NO_FALLBACK or (fit.model == simplest and fit.kept_terms is None):
-        return None
-    qd, tau_f, valid, kwargs = task
-    simple, checked = _fit_routes(((qd, tau_f, valid, {**kwargs, "model": simplest}), other))
-    simple = _with_truth([fit.joint], [simple], est.qd[:, [i]], est.tau_f[:, [i]], est.valid[:, [i]], truth,
-                         targets)[0]
-    simple.route, simple.unmeasured = fit.route, fit.unmeasured
-    if checked is not None and est.route_check is not None:
-        checked.route = est.route_check.estimation_route
-        simple.route_check = compare_routes(simple, checked)
-    chosen = fit.reported().params
-    if simple.params is not None and chosen is not None:  # the chosen family predicts the held-out blocks better
-        theirs, mine = chosen.to_dict(), simple.params.to_dict()
-        simple.model_spread = {n: math.hypot(simple.model_spread.get(n, 0.0), abs(mine[n] - theirs[n]))
-                               for n in SPREAD if n in mine and n in theirs}
-    return _with_delay_structure([simple], est.metadata)[0]
+    wanted = [k for k, f in enumerate(fits)
+              if f.verdict().status not in NO_FALLBACK and not (f.model == simplest and f.kept_terms is None)]
+    pairs = _run(_fit_routes, [((*tasks[k][:3], {**tasks[k][3], "model": simplest}), others[k]) for k in wanted],
+                 workers)
+    for k, (simple, checked) in zip(wanted, pairs):
+        fit, i = fits[k], idx[k]
+        simple = _with_truth([fit.joint], [simple], est.qd[:, [i]], est.tau_f[:, [i]], est.valid[:, [i]],
+                             None if truth is None else truth[:, [k]], targets)[0]
+        simple.route, simple.unmeasured = fit.route, fit.unmeasured
+        if checked is not None and est.route_check is not None:
+            checked.route = est.route_check.estimation_route
+            simple.route_check = compare_routes(simple, checked)
+        chosen = fit.reported().params
+        if simple.params is not None and chosen is not None:  # the chosen family predicts the held-out blocks better
+            theirs, mine = chosen.to_dict(), simple.params.to_dict()
+            simple.model_spread = {n: math.hypot(simple.model_spread.get(n, 0.0), abs(mine[n] - theirs[n]))
+                                   for n in SPREAD if n in mine and n in theirs}
+        fit.fallback = _with_delay_structure([simple], est.metadata)[0]
 
 
 def _with_delay_structure(fits: list[FitResult], metadata: Mapping[str, Any]) -> list[FitResult]:

@@ -28,6 +28,7 @@ affine law ``force = gainprm[0] ctrl + biasprm[0] + biasprm[1] qpos + biasprm[2]
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -167,12 +168,12 @@ def replay_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | Lo
     shot = stop - start if replay.horizon is None else max(1, int(round(replay.horizon / period)))
     q_sim = np.empty((stop - start, robot.n_act))
     d = mujoco.MjData(m)
+    run = _actuated if replay.torque_delay is None else functools.partial(_held_torque, delay=replay.torque_delay)
     for first in range(start, stop, shot):
         last = min(first + shot, stop)
         mujoco.mj_resetData(m, d)
         d.qpos[drives.qpos], d.qvel[drives.dofs] = data.q[first] - offset, data.qd[first]
-        run = _held_torque if replay.torque_delay is not None else _actuated
-        q_sim[first - start:last - start] = run(m, d, drives, data, first, last, period, replay.torque_delay or 0)
+        q_sim[first - start:last - start] = run(m, d, drives, data, first, last, period)
         if not np.all(np.isfinite(q_sim[first - start:last - start])):
             raise SimulationError(f"{source}: the replay diverged between rows {first} and {last}")
     q_sim += offset
@@ -180,8 +181,7 @@ def replay_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | Lo
                          data.q[start:stop].copy(), replay.horizon)
 
 
-def _actuated(m, d, drives: _Drives, data: LogSetpoints, first: int, last: int, period: float,
-              _: int) -> np.ndarray:
+def _actuated(m, d, drives: _Drives, data: LogSetpoints, first: int, last: int, period: float) -> np.ndarray:
     """Samples ``[first, last)`` run by the file's actuators: ``q_des`` held a period each, the history holding
     those commanded before ``first`` (at their times); the model's angles at each sample (last - first, n)."""
     import mujoco
