@@ -126,6 +126,6 @@ def test_cli(hung, tmp_path, capsys):
     assert table.column("joint").to_pylist() == list(robot.actuated)
     assert max(table.column("rms_whole").to_pylist()) < AGREE
     assert fig.read_bytes()[:4] == b"\x89PNG"
-    assert "mean" in printed and f"wrote {out}" in err
+    assert "mean" in printed and "[mrad]" in printed and f"wrote {out}" in err
     code, _, err = run_cli_printed(capsys, "rollout", log, truth, "--config", config, "--window", "0")
     assert code == 2 and "--window" in err and len(err.strip().splitlines()) == 1

@@ -59,7 +59,7 @@ def rollout(log: Path = LogArg,
         if figure is not None:
             rollout_figure([check.windows], figure)
     w = check.windows
-    table = Table(title="RMS of simulated - logged angle [mrad]", box=None, caption_justify="left",
+    table = Table(title="RMS of simulated - logged angle \\[mrad]", box=None, caption_justify="left",
                   caption=f"{model.name} replayed on rows {w.rows[0]} to {w.rows[1]} of {log.name}; windows: "
                           f"restarted from the log every {window:g} s; whole: one shot")
     for col in ("joint", f"windows ({window:g} s)", "whole"):

@@ -28,15 +28,19 @@ affine law ``force = gainprm[0] ctrl + biasprm[0] + biasprm[1] qpos + biasprm[2]
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import InputError
+from wbfriction.export.drive import HOLD_EDGE
 from wbfriction.model.robot import Robot
 from wbfriction.sim.rollout import LogSetpoints, RolloutResult, read_log_setpoints, stretch_rows
 
@@ -119,6 +123,104 @@ def _check_setpoints(data: LogSetpoints, drives: _Drives, source: str) -> None:
                              f"{', '.join(f'{x:g}' for x in held)}): export with the robot TOML of this log")
 
 
+@dataclass(frozen=True, eq=False)
+class ReplayModel:
+    """An MJCF loaded for replays (:func:`load_replay`): the compiled model (its timestep and flags set as
+    ``replay`` asks) and its PD-driven joints' actuators."""
+
+    model: Any
+    drives: _Drives
+    replay: Replay
+    source: str
+
+    @property
+    def delay(self) -> float:
+        """The set-points' delay of the PD-driven joints' actuators [s] (the file's ``delay`` plus
+        :data:`~wbfriction.export.drive.HOLD_EDGE`; 0 without a history), their first's."""
+        d = float(self.model.actuator_delay[self.drives.acts[0]])
+        return d + HOLD_EDGE if d > 0 else 0.0
+
+    @property
+    def longest_delay(self) -> float:
+        """The longest delay the actuators' history buffers hold at the model's timestep [s] (0 without one)."""
+        samples = int(self.model.actuator_history[self.drives.acts, 0].min())
+        return max(samples - 1, 0) * float(self.model.opt.timestep)
+
+    def with_parameters(self, armature: np.ndarray, frictionloss: np.ndarray, damping: np.ndarray,
+                        bias: np.ndarray, delay: float | None = None) -> ReplayModel:
+        """A copy with these (n,) values for the PD-driven joints, in the robot's order: ``dof_armature``
+        [kg·m^2], ``dof_frictionloss`` [N·m], ``dof_damping`` [N·m·s/rad] and the actuators' ``biasprm[0]``
+        [N·m], and the set-points' ``delay`` [s] (at most :attr:`longest_delay`; None: the file's); the constants
+        that depend on them recomputed (``mj_setConst``)."""
+        import mujoco
+
+        m = copy.copy(self.model)
+        d = self.drives
+        m.dof_armature[d.dofs], m.dof_frictionloss[d.dofs], m.dof_damping[d.dofs] = armature, frictionloss, damping
+        m.actuator_biasprm[d.acts, 0] = bias
+        if delay is not None:
+            m.actuator_delay[d.acts] = max(delay - HOLD_EDGE, 0.0)
+        mujoco.mj_setConst(m, mujoco.MjData(m))
+        drives = dataclasses.replace(d, bias=m.actuator_biasprm[d.acts, :3].copy())
+        return ReplayModel(m, drives, self.replay, self.source)
+
+    def run(self, robot: Robot, data: LogSetpoints, start: int, stop: int, horizon: float | None) -> np.ndarray:
+        """The simulated logged angles (the model's plus the encoder offset) of rows ``[start, stop)`` of ``data``,
+        restarted from the log's state every ``horizon`` seconds (None: one shot) [rad], (stop - start, n).
+
+        Raises:
+            SimulationError: the state diverged.
+        """
+        import mujoco
+
+        from wbfriction.exceptions import SimulationError
+
+        m, drives, replay = self.model, self.drives, self.replay
+        period = float(np.median(np.diff(data.time)))
+        offset = robot.offset_vector
+        shot = stop - start if horizon is None else max(1, int(round(horizon / period)))
+        q_sim = np.empty((stop - start, robot.n_act))
+        d = mujoco.MjData(m)
+        run = _actuated if replay.torque_delay is None else functools.partial(_held_torque, delay=replay.torque_delay)
+        for first in range(start, stop, shot):
+            last = min(first + shot, stop)
+            mujoco.mj_resetData(m, d)
+            d.qpos[drives.qpos], d.qvel[drives.dofs] = data.q[first] - offset, data.qd[first]
+            q_sim[first - start:last - start] = run(m, d, drives, data, first, last, period)
+            if not np.all(np.isfinite(q_sim[first - start:last - start])):
+                raise SimulationError(f"{self.source}: the replay diverged between rows {first} and {last}")
+        return q_sim + offset
+
+
+def load_replay(model: str | Path, robot: Robot, data: LogSetpoints, replay: Replay = Replay()) -> ReplayModel:
+    """``model`` (an MJCF) loaded to replay ``data``, a log of ``robot`` (:func:`replay_mjcf`), its timestep set as
+    ``replay`` asks.
+
+    Raises:
+        InputError: a file MuJoCo cannot load, a floating-base robot, a joint or actuator the file lacks, a log with
+            velocity set-points, feed-forward torques or gains the file does not hold.
+    """
+    import mujoco
+
+    source = str(model)
+    if robot.floating_base:
+        raise InputError(f"{robot.name}: the replay holds the base fixed, as in a hung robot's log; this robot's base "
+                         "floats (floating_base = true)")
+    try:
+        m = mujoco.MjModel.from_xml_path(source)
+    except (ValueError, OSError) as err:
+        raise InputError(f"{source}: MuJoCo cannot load it: {err}") from None
+    drives = _drives(m, robot, source)
+    _check_setpoints(data, drives, source)
+    if replay.timestep is not None:
+        m.opt.timestep = replay.timestep
+    if replay.torque_delay is not None:
+        period = float(np.median(np.diff(data.time)))
+        m.opt.timestep = period / math.ceil(period / m.opt.timestep - 1e-9)
+        m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_ACTUATION
+    return ReplayModel(m, drives, replay, source)
+
+
 def replay_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | LogSetpoints, replay: Replay = Replay(),
                 *, rows: tuple[int, int] | None = None, times: tuple[float, float] | None = None) -> RolloutResult:
     """Replay an MJCF file under a log's set-points (module docstring).
@@ -137,46 +239,14 @@ def replay_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | Lo
         offset) against the log's [rad].
 
     Raises:
-        InputError: a file MuJoCo cannot load, a floating-base robot, a joint or actuator the file lacks, a stretch out
-            of the log, a log with velocity set-points, feed-forward torques or gains the file does not hold.
+        InputError: what :func:`load_replay` refuses, a stretch out of the log.
         ColumnError: a column the replay needs is missing.
         SimulationError: the state diverged.
     """
-    import mujoco
-
-    from wbfriction.exceptions import SimulationError
-
-    source = str(model)
-    if robot.floating_base:
-        raise InputError(f"{robot.name}: the replay holds the base fixed, as in a hung robot's log; this robot's base "
-                         "floats (floating_base = true)")
-    try:
-        m = mujoco.MjModel.from_xml_path(source)
-    except (ValueError, OSError) as err:
-        raise InputError(f"{source}: MuJoCo cannot load it: {err}") from None
-    drives = _drives(m, robot, source)
     data = log if isinstance(log, LogSetpoints) else read_log_setpoints(robot, log)
-    _check_setpoints(data, drives, source)
+    loaded = load_replay(model, robot, data, replay)
     start, stop = stretch_rows(data.time, rows, times)
-    period = float(np.median(np.diff(data.time)))
-    if replay.timestep is not None:
-        m.opt.timestep = replay.timestep
-    if replay.torque_delay is not None:
-        m.opt.timestep = period / math.ceil(period / m.opt.timestep - 1e-9)
-        m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_ACTUATION
-    offset = robot.offset_vector
-    shot = stop - start if replay.horizon is None else max(1, int(round(replay.horizon / period)))
-    q_sim = np.empty((stop - start, robot.n_act))
-    d = mujoco.MjData(m)
-    run = _actuated if replay.torque_delay is None else functools.partial(_held_torque, delay=replay.torque_delay)
-    for first in range(start, stop, shot):
-        last = min(first + shot, stop)
-        mujoco.mj_resetData(m, d)
-        d.qpos[drives.qpos], d.qvel[drives.dofs] = data.q[first] - offset, data.qd[first]
-        q_sim[first - start:last - start] = run(m, d, drives, data, first, last, period)
-        if not np.all(np.isfinite(q_sim[first - start:last - start])):
-            raise SimulationError(f"{source}: the replay diverged between rows {first} and {last}")
-    q_sim += offset
+    q_sim = loaded.run(robot, data, start, stop, replay.horizon)
     return RolloutResult(replay.label, robot.actuated, (start, stop), data.time[start:stop], q_sim,
                          data.q[start:stop].copy(), replay.horizon)
 
