@@ -55,11 +55,20 @@ def table(runs: list[DatasetRun]) -> str:
 
 
 def rollouts(runs: list[DatasetRun]) -> str:
-    """The PD-driven robots' held-out rollouts: each joint's tracking error, ours and the peer's [mrad]."""
-    lines = ["| dataset | joint | rollout, ours [mrad] | rollout, peer [mrad] |", "|---|---|---|---|"]
+    """The PD-driven robots' held-out rollouts: each joint's tracking error, ours (the route's export and its
+    refinement) and the peer's [mrad]."""
+    lines = ["| dataset | joint | rollout, ours [mrad] | refined [mrad] | rollout, peer [mrad] |",
+             "|---|---|---|---|---|"]
     rows = [(run.name, j) for run in runs for j in run.joints if math.isfinite(j.rollout)]
-    lines += [f"| {name} | {j.joint} | {1e3 * j.rollout:.1f} | {cell(1e3 * j.peer_rollout, '.1f')} |"
-              for name, j in rows]
+    lines += [f"| {name} | {j.joint} | {1e3 * j.rollout:.1f} | {cell(1e3 * j.refined_rollout, '.1f')} | "
+              f"{cell(1e3 * j.peer_rollout, '.1f')} |" for name, j in rows]
+    for run in runs:
+        scored = [j for j in run.joints if math.isfinite(j.rollout)]
+        if scored:
+            mean = {k: 1e3 * sum(getattr(j, k) for j in scored) / len(scored)
+                    for k in ("rollout", "refined_rollout", "peer_rollout")}
+            lines.append(f"| {run.name} | mean | {mean['rollout']:.2f} | {cell(mean['refined_rollout'], '.2f')} | "
+                         f"{cell(mean['peer_rollout'], '.2f')} |")
     return "\n".join(lines) if rows else ""
 
 

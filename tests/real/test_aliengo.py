@@ -158,3 +158,30 @@ def test_the_exported_simulator_tracks_the_held_out_stretch_better_than_the_peer
     bare.write_text(spec.to_xml())
     without = replay_mjcf(bare, ours, written.logs["held_out"], Replay()).rms
     assert without.mean() > theirs.mean() > mine.mean()
+
+
+def test_the_refined_simulator_tracks_the_held_out_stretch_better_than_the_export(route, tmp_path):
+    """Issue 64, item 2: the route's MJCF refined on its own replay of the first 60 % (``wbfriction refine``) tracks
+    the last 40 % better on average than the export it started from, and than the peer's (a cross-check on data it
+    was not refined on). Measured (``--model coulomb-viscous --terms none``, the how-to's export): 4.24 mrad mean
+    against 4.77 and the peer's 7.05; better than the export on the thighs and rear hips (6 of 12), worse on the
+    calves and front hips (the front left 7.2 against 4.0); better than the peer's on 8 of 12 (not the calves: 4.1,
+    3.8, 3.9, 5.8 against 3.1, 3.6, 2.7, 3.6); the set-points' delay 6 ms (three 2 ms steps) against the
+    identification's 11.3. The default fits' export (this test's) is the same file (its fits not ok replaced by
+    the Coulomb-viscous ones): the same numbers."""
+    import numpy as np
+
+    from wbfriction.pipeline.export_step import export_files
+    from wbfriction.sim.refine import refine_mjcf, write_refined
+    from wbfriction.studies.pd_peer import peer_rollouts
+
+    written, peer, _, ours, folder = route
+    mjcf, refined = tmp_path / "aliengo.xml", tmp_path / "refined.xml"
+    export_files(ours, folder / "params.json", [mjcf], include=("weak", "at-bound"))
+    result = refine_mjcf(mjcf, ours, written.logs["train"])
+    write_refined(mjcf, result, ours, refined)
+    assert result.rms.mean() < result.rms_start.mean()
+    table = peer_rollouts(written.config, written.config.parent / "peer.toml", peer, folder / "identified.toml",
+                          mjcf, written.logs["held_out"], refined=refined).to_pydict()
+    export, better, theirs = (np.array(table[f"rms.{k}"]) for k in ("ours", "refined", "peer"))
+    assert better.mean() < 0.95 * export.mean() and better.mean() < 0.7 * theirs.mean(), (better, export, theirs)

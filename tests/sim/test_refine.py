@@ -122,7 +122,7 @@ def test_cli(case, tmp_path, capsys):
     assert code == 0, err
     values = read_table(table)
     assert values.column_names == ["joint", "parameter", "unit", "start", "value", "stderr", "status"]
-    assert values.num_rows == 4 * 12
+    assert values.num_rows == 5 * 12 and values.column("parameter").to_pylist()[-1] == "delay"
     assert "[kg·m²]" in printed and "[mrad]" in printed and "delay 15.00 -> 12.00 ms" in printed
     assert f"wrote {out}" in err and out.exists()
     code, _, err = run_cli_printed(capsys, "refine", log, off, "--config", config, "-o", tmp_path / "x.xml",

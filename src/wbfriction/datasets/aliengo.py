@@ -522,6 +522,9 @@ class AliengoDataset(Dataset):
                     # no F_v of this log is ok: what the drivers' delay holds back is not told, and F_v carries
                     # kp delay (issue 63); the simulator takes the pair written, each fit's status in a comment
                     "wbfriction export aliengo_params.json --config aliengo_identified.toml --include weak,at-bound "
-                    "-o aliengo_isaac.yaml -o aliengo.xml")
+                    "-o aliengo_isaac.yaml -o aliengo.xml",
+                    # the exported MJCF refined on its own replay of the training log, checked on the held-out one
+                    f"wbfriction refine {q['train']} aliengo.xml --config aliengo_identified.toml "
+                    f"-o aliengo_refined.xml --held-out {q['held_out']}")
         return WrittenDataset(self.name, logs, {r: t.num_rows for r, t in tables.items()}, config, commands,
                               {role: what for role, (_, what) in LOGS.items()})

@@ -118,14 +118,19 @@ class Refinement:
     delay_status: str
 
     def table(self) -> pa.Table:
-        """A row per joint and parameter: ``joint``, ``parameter``, ``unit``, ``start``, ``value``, ``stderr``,
-        ``status``."""
+        """A row per joint and value: ``joint``, ``parameter`` (:data:`PARAMETERS`, then ``delay``, each joint's
+        actuator's), ``unit``, ``start`` (the file's), ``value``, ``stderr``, ``status``."""
         n = len(self.joints)
-        return pa.table({"joint": [j for _ in PARAMETERS for j in self.joints],
-                         "parameter": [p for p in PARAMETERS for _ in range(n)],
-                         "unit": [UNITS[p] for p in PARAMETERS for _ in range(n)],
-                         "start": self.start.ravel(), "value": self.value.ravel(), "stderr": self.stderr.ravel(),
-                         "status": [s for row in self.status for s in row]})
+        names = (*PARAMETERS, "delay")
+        start = np.vstack([self.start, np.full(n, self.delay_start)])
+        value = np.vstack([self.value, np.full(n, self.delay)])
+        stderr = np.vstack([self.stderr, np.full(n, self.delay_se)])
+        status = (*self.status, (self.delay_status,) * n)
+        return pa.table({"joint": [j for _ in names for j in self.joints],
+                         "parameter": [p for p in names for _ in range(n)],
+                         "unit": [{**UNITS, "delay": "s"}[p] for p in names for _ in range(n)],
+                         "start": start.ravel(), "value": value.ravel(), "stderr": stderr.ravel(),
+                         "status": [s for row in status for s in row]})
 
 
 def branches(loaded: ReplayModel) -> np.ndarray:
@@ -165,15 +170,13 @@ class _Problem:
 
 
 def delay_grid(loaded: ReplayModel) -> np.ndarray:
-    """The delays the refinement may choose [s]: the file's plus or less whole timesteps (a zero-order hold's delay
-    acts in whole timesteps), from zero to what the history holds; empty where the file has no delay to refine (no
-    history, or PACE's torque delay replayed)."""
+    """The delays the refinement may choose [s]: whole timesteps (MuJoCo's history holds one set-point a step, read
+    with a zero-order hold: a delay acts as the whole steps it reaches, ``ceil(delay / h) h``), from zero to what the
+    history holds; empty where the file has no delay to refine (no history, or PACE's torque delay replayed)."""
     step = float(loaded.model.opt.timestep)
     if loaded.longest_delay <= 0 or loaded.replay.torque_delay is not None:
         return np.empty(0)
-    below, above = int(np.floor(loaded.delay / step + 1e-9)), int(np.floor((loaded.longest_delay - loaded.delay)
-                                                                           / step + 1e-9))
-    return loaded.delay + step * np.arange(-below, above + 1)
+    return step * np.arange(int(np.floor(loaded.longest_delay / step + 1e-9)) + 1)
 
 
 def refine_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | LogSetpoints, replay: Replay = Replay(),
@@ -239,7 +242,7 @@ def _profile(problem: _Problem, x0: np.ndarray, grid: np.ndarray, period: float,
             solutions[k] = _least_squares(problem, start, float(grid[k]), weight)
         return solutions[k].cost
 
-    k = int(np.argmin(np.abs(grid - problem.loaded.delay)))
+    k = min(int(np.ceil(problem.loaded.delay / step - 1e-6)), grid.size - 1)  # the file's delay, as it acts
     stride = max(1, int(round(period / step)))
     while stride >= 1:
         moved = True
@@ -288,8 +291,10 @@ def _least_squares(problem: _Problem, x: np.ndarray, delay: float | None, weight
     sol = least_squares(residual, (x / scale).ravel(), jac_sparsity=sparsity, bounds=(lower, np.inf), method="trf",
                         diff_step=1e-3, max_nfev=max(2, MAX_REPLAYS // (1 + columns)))
     jac = sol.jac.toarray() if hasattr(sol.jac, "toarray") else np.asarray(sol.jac)
-    return _Solution(sol.x.reshape(4, n) * scale, weight, sol.fun, jac / scale.ravel()[None, :],
-                     sol.active_mask.reshape(4, n) < 0, int(sol.nfev + sol.njev * columns), sol.status > 0)
+    at_floor = sol.active_mask.reshape(4, n) < 0
+    x = np.where(at_floor, 0.0, sol.x.reshape(4, n) * scale)  # on its floor: zero, not SciPy's 1e-10 inside it
+    return _Solution(x, weight, sol.fun, jac / scale.ravel()[None, :], at_floor, int(sol.nfev + sol.njev * columns),
+                     sol.status > 0)
 
 
 def _refinement(problem: _Problem, x0: np.ndarray, d0: float, sol: _Solution, delay: float | None,

@@ -69,12 +69,14 @@ def peer_held_out(robot_toml: Path, peer_toml: Path, peer: PeerActuator, held_ou
 
 
 def peer_rollouts(robot_toml: str | Path, peer_toml: str | Path, peer: PeerActuator, identified_toml: str | Path,
-                  mjcf: str | Path, held_out: str | Path, horizon: float | None = 1.0) -> pa.Table:
+                  mjcf: str | Path, held_out: str | Path, horizon: float | None = 1.0,
+                  refined: str | Path | None = None) -> pa.Table:
     """The held-out log's set-points replayed (:func:`~wbfriction.sim.replay.replay_mjcf`, restarted from the log every
     ``horizon`` seconds) on the MJCF wbfriction exported (``mjcf``, for the robot ``identified_toml``), as MuJoCo
     runs it, and on the peer's parameters written by the same export and run as PACE simulates them (the PD law once
     a 5 ms period, its whole torque held back its delay truncated to whole periods): a row per joint, ``rms.ours`` and
-    ``rms.peer`` [rad], the tracking error of the logged angles.
+    ``rms.peer`` [rad], the tracking error of the logged angles; with ``refined`` (the MJCF ``wbfriction refine``
+    wrote), ``rms.refined`` too.
 
     Raises:
         InputError: what reading the robots, the files or the log raises.
@@ -86,12 +88,13 @@ def peer_rollouts(robot_toml: str | Path, peer_toml: str | Path, peer: PeerActua
     from wbfriction.sim.replay import Replay, replay_mjcf
     from wbfriction.sim.rollout import rollout_table
 
-    ours = replay_mjcf(mjcf, load_robot(None, config=Path(identified_toml)), held_out,
-                       Replay(label="ours", horizon=horizon))
+    identified = load_robot(None, config=Path(identified_toml))
+    ours = [replay_mjcf(path, identified, held_out, Replay(label=label, horizon=horizon))
+            for label, path in (("ours", mjcf), ("refined", refined)) if path is not None]
     robot = peer_robot(robot_toml, peer_toml)
     with tempfile.TemporaryDirectory(prefix="wbfriction-peer-") as tmp:
         path = Path(tmp) / "peer.xml"
         write_mjcf(robot, peer_friction(peer, robot.actuated), path, armature=peer.armature)
         theirs = replay_mjcf(path, robot, held_out, Replay(label="peer", horizon=horizon,
                                                            torque_delay=peer.applied_delay_steps))
-    return rollout_table([ours, theirs])
+    return rollout_table([*ours, theirs])

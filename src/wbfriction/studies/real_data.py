@@ -68,6 +68,7 @@ class JointScore:
             friction, which no velocity model holds).
         rollout, peer_rollout: a PD-driven robot's held-out set-points replayed in MuJoCo with the route's
             identification and with the peer's: the tracking error's RMS [rad] (:mod:`wbfriction.studies.pd_peer`).
+        refined_rollout: the same with the route's MJCF refined on the training log (``wbfriction refine``) [rad].
     """
 
     joint: str
@@ -81,6 +82,7 @@ class JointScore:
     held_out_moved: bool = False
     rollout: float = float("nan")
     peer_rollout: float = float("nan")
+    refined_rollout: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -111,13 +113,14 @@ class Outputs:
     held_out: Path | None = None
     identified: Path | None = None
     mjcf: Path | None = None
+    refined: Path | None = None
 
 
 def outputs(commands: Sequence[str], folder: Path) -> Outputs:
     """The parameters JSON and friction table of the last ``fit`` of ``commands``, the friction table of the
-    last ``predict``, the TOML ``identify --config-output`` wrote and the MJCF the last ``export`` wrote (each None
-    without one), as paths in ``folder`` (the commands' working folder)."""
-    fit = predict = identified = mjcf = None
+    last ``predict``, the TOML ``identify --config-output`` wrote, the MJCF the last ``export`` wrote and the one the
+    last ``refine`` wrote (each None without one), as paths in ``folder`` (the commands' working folder)."""
+    fit = predict = identified = mjcf = refined = None
     for line in commands:
         words = shlex.split(line)
         if words[1:2] == ["fit"]:
@@ -129,10 +132,12 @@ def outputs(commands: Sequence[str], folder: Path) -> Outputs:
         elif words[1:2] == ["export"]:
             written = [words[i + 1] for i, w in enumerate(words[:-1]) if w in ("-o", "--output")]
             mjcf = next((folder / w for w in written if w.endswith((".xml", ".mjcf"))), mjcf)
+        elif words[1:2] == ["refine"]:
+            refined = folder / words[words.index("-o") + 1]
     if fit is None:
         raise ValueError("the route has no fit")
     return Outputs(folder / fit[fit.index("-o") + 1], folder / fit[2],
-                   None if predict is None else folder / predict[2], identified, mjcf)
+                   None if predict is None else folder / predict[2], identified, mjcf, refined)
 
 
 SPEED_BIN = 0.05
@@ -177,7 +182,7 @@ def score(name: str, outs: Outputs, config: Path | None = None) -> tuple[JointSc
     log)."""
     ref = reference(name)
     peers: dict[str, float] = {}
-    rollouts: dict[str, tuple[float, float]] = {}
+    rollouts: dict[str, tuple[float, ...]] = {}
     if isinstance(ref, PeerParameters) and config is not None:
         peers, rollouts = peer_scores(config, outs)
     fits = read_params(outs.params)
@@ -202,9 +207,9 @@ def score(name: str, outs: Outputs, config: Path | None = None) -> tuple[JointSc
         if isinstance(ref, HeldOutRms):
             peer = ref.held_out(joint)
         peer = peers.get(joint, peer)
-        ours, theirs = rollouts.get(joint, (float("nan"), float("nan")))
+        ours, theirs, refined = rollouts.get(joint, (float("nan"),) * 3)
         out.append(JointScore(joint, verdict.status, verdict.reason, fit.model, error, sigmas, held_out, peer, moved,
-                              ours, theirs))
+                              ours, theirs, refined))
     return tuple(out)
 
 
@@ -249,11 +254,12 @@ def run_dataset(name: str, folder: str | Path, python: str = sys.executable,
     return DatasetRun(name, (convert, *timed), score(name, outputs(commands, folder), written.config))
 
 
-def peer_scores(config: Path, outs: Outputs) -> tuple[dict[str, float], dict[str, tuple[float, float]]]:
+def peer_scores(config: Path, outs: Outputs) -> tuple[dict[str, float], dict[str, tuple[float, ...]]]:
     """The held-out torque RMS per joint [N·m] of the peer whose parameters lie beside the robot's TOML ``config``
     (``peer.toml``, the held-out log ``held_out.parquet``; the one such dataset, the Aliengo's, reads its peer's
-    friction from its fetched file), and per joint the held-out rollouts' tracking error [rad], the MJCF the route
-    exported and the peer's (:mod:`wbfriction.studies.pd_peer`; none without the route's identified TOML and MJCF)."""
+    friction from its fetched file), and per joint the held-out rollouts' tracking error [rad] of the MJCF the route
+    exported, the peer's and the route's refined MJCF (NaN without one) (:mod:`wbfriction.studies.pd_peer`; none
+    without the route's identified TOML and MJCF)."""
     from wbfriction.datasets.aliengo import aliengo_peer
     from wbfriction.studies.pd_peer import peer_held_out, peer_rollouts
 
@@ -262,8 +268,9 @@ def peer_scores(config: Path, outs: Outputs) -> tuple[dict[str, float], dict[str
     if outs.identified is None or outs.mjcf is None:
         return held, {}
     table = peer_rollouts(config, folder / "peer.toml", peer, outs.identified, outs.mjcf,
-                          folder / "held_out.parquet").to_pydict()
-    return held, {j: (o, p) for j, o, p in zip(table["joint"], table["rms.ours"], table["rms.peer"])}
+                          folder / "held_out.parquet", refined=outs.refined).to_pydict()
+    refined = table.get("rms.refined", [float("nan")] * len(table["joint"]))
+    return held, {j: (o, p, r) for j, o, p, r in zip(table["joint"], table["rms.ours"], table["rms.peer"], refined)}
 
 
 @dataclass(frozen=True)
