@@ -363,6 +363,7 @@ def test_the_command_writes_the_logs_and_prints_the_pd_route(tmp_path, capsys, m
                                                "peer.toml"}
     assert (out / "aliengo.urdf").read_bytes() == (FOLDER / aliengo.URDF_FILE).read_bytes()
     lines = [line.strip() for line in printed.splitlines() if line.strip().startswith("wbfriction ")]
-    assert [line.split()[1] for line in lines] == ["identify", "estimate", "fit", "estimate", "predict", "export"]
+    assert [line.split()[1] for line in lines] == ["identify", "estimate", "fit", "estimate", "predict", "export",
+                                                  "refine"]
     assert f"--config {out / 'aliengo.toml'} --actuator pd" in lines[0]
     assert "aliengo" in datasets.DATASETS and datasets.dataset("aliengo").folder == "unitree_aliengo"
