@@ -96,6 +96,17 @@ def run_cli_printed(capsys, *args) -> tuple[int, str, str]:
     return code, captured.out, captured.err
 
 
+def hung_go2_toml(path: Path, robot, delay: float) -> Path:
+    """A robot TOML at ``path`` for the hung Go2 ``robot`` (its URDF, drivers' gains, encoder offsets) with the
+    drivers' ``delay`` [s]: what ``--config`` takes for a simulated log's own truth."""
+    offsets = "\n".join(f"{j} = {v!r}" for j, v in robot.encoder_offset.items())
+    pd = robot.pd
+    path.write_text(f'name = "go2"\nurdf = "{robot.urdf}"\nfloating_base = false\n'
+                    f'[pd]\nkp = {float(pd.kp[0])!r}\nkd = {float(pd.kd[0])!r}\ndelay = {delay!r}\n'
+                    f'[encoder_offset]\n{offsets}\n')
+    return path
+
+
 def ros_time(ts, ns: int):
     return ts.types["builtin_interfaces/msg/Time"](sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
 

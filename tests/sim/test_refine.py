@@ -11,7 +11,7 @@ import numpy as np
 import pyarrow as pa
 import pytest
 
-from helpers import run_cli_printed
+from helpers import hung_go2_toml, run_cli_printed
 from wbfriction.exceptions import InputError
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.logs.tables import read_table
@@ -110,12 +110,7 @@ def test_cli(case, tmp_path, capsys):
     log, held = tmp_path / "train.parquet", tmp_path / "held.parquet"
     pa.parquet.write_table(sim.table.slice(0, 400), log)
     pa.parquet.write_table(sim.table.slice(400, 200), held)
-    config = tmp_path / "go2.toml"
-    offsets = "\n".join(f"{j} = {v!r}" for j, v in robot.encoder_offset.items())
-    pd = robot.pd
-    config.write_text(f'name = "go2"\nurdf = "{robot.urdf}"\nfloating_base = false\n'
-                      f'[pd]\nkp = {float(pd.kp[0])!r}\nkd = {float(pd.kd[0])!r}\ndelay = {sim.driver.delay!r}\n'
-                      f'[encoder_offset]\n{offsets}\n')
+    config = hung_go2_toml(tmp_path / "go2.toml", robot, sim.driver.delay)
     out, table = tmp_path / "refined.xml", tmp_path / "values.csv"
     code, printed, err = run_cli_printed(capsys, "refine", log, off, "--config", config, "-o", out,
                                          "--held-out", held, "--table", table, "--timestep", str(STEP))

@@ -12,7 +12,7 @@ import numpy as np
 import pyarrow as pa
 import pytest
 
-from helpers import run_cli_printed
+from helpers import hung_go2_toml, run_cli_printed
 from wbfriction.exceptions import InputError
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.logs.tables import read_table
@@ -111,12 +111,7 @@ def test_what_a_replay_refuses(hung, go2, tmp_path):
 def test_cli(hung, tmp_path, capsys):
     """``wbfriction rollout``: the table per joint, the file and the figure; a bad option in one line."""
     sim, robot, truth, log = hung
-    config = tmp_path / "go2.toml"
-    offsets = "\n".join(f"{j} = {v!r}" for j, v in robot.encoder_offset.items())
-    pd = robot.pd
-    config.write_text(f'name = "go2"\nurdf = "{robot.urdf}"\nfloating_base = false\n'
-                      f'[pd]\nkp = {float(pd.kp[0])!r}\nkd = {float(pd.kd[0])!r}\ndelay = {sim.driver.delay!r}\n'
-                      f'[encoder_offset]\n{offsets}\n')
+    config = hung_go2_toml(tmp_path / "go2.toml", robot, sim.driver.delay)
     out, fig = tmp_path / "r.parquet", tmp_path / "r.png"
     code, printed, err = run_cli_printed(capsys, "rollout", log, truth, "--config", config, "--timestep", "0.001",
                                          "-o", out, "--figure", fig)

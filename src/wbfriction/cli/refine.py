@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Optional
 
@@ -11,7 +10,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from wbfriction.cli.common import ConfigOpt, LogArg, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of
-from wbfriction.exceptions import OptionError
+from wbfriction.cli.rollout import replay_options
 from wbfriction.pipeline.paths import check_paths
 
 
@@ -43,18 +42,11 @@ def refine(log: Path = LogArg,
     the replayed angles' error (as 'wbfriction rollout' replays it), each with its standard error and status; the
     refined file written beside the original (a hung robot, its base fixed)."""
     from wbfriction.sim.refine import refine_mjcf, write_refined
-    from wbfriction.sim.replay import Replay
 
     check_paths({"LOG": log, "MODEL": model, "--held-out": held_out, "--config": config, "--urdf": urdf,
                  "--mjcf": mjcf}, {"-o": output, "--table": table})
-    if not (math.isfinite(window) and window > 0):
-        raise OptionError("--window", window, "a time > 0 [s]")
-    if timestep is not None and not (math.isfinite(timestep) and timestep > 0):
-        raise OptionError("--timestep", timestep, "a physics step > 0 [s]")
-    times = None if start is None and stop is None else (-math.inf if start is None else start,
-                                                          math.inf if stop is None else stop)
+    replay, times = replay_options(window, timestep, start, stop)
     the_robot = robot_of(robot, urdf, config, mjcf)
-    replay = Replay(horizon=window, timestep=timestep)
     with console.status(f"refining {model.name} on {log.name} (a minute or so: MuJoCo replays the log some "
                         "hundred times)"):
         result = refine_mjcf(model, the_robot, log, replay, times=times)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Optional
+from typing import TYPE_CHECKING, Optional
 
 import typer
 from rich.table import Table
@@ -12,6 +12,9 @@ from rich.table import Table
 from wbfriction.cli.common import ConfigOpt, LogArg, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of
 from wbfriction.exceptions import OptionError
 from wbfriction.pipeline.paths import check_paths
+
+if TYPE_CHECKING:
+    from wbfriction.sim.replay import Replay
 
 
 @app.command()
@@ -43,17 +46,11 @@ def rollout(log: Path = LogArg,
     offsets, torque limits and set-point delay), restarted from the log's state every --window seconds and in one
     shot: how far the simulated encoder angles go from the logged ones, per joint (a hung robot, its base fixed)."""
     from wbfriction.report.figures import rollout_figure
-    from wbfriction.sim.replay import Replay, replay_check
+    from wbfriction.sim.replay import replay_check
 
     check_paths({"LOG": log, "MODEL": model, "--config": config, "--urdf": urdf, "--mjcf": mjcf},
                 {"-o": output, "--figure": figure})
-    if not (math.isfinite(window) and window > 0):
-        raise OptionError("--window", window, "a time > 0 [s]")
-    if timestep is not None and not (math.isfinite(timestep) and timestep > 0):
-        raise OptionError("--timestep", timestep, "a physics step > 0 [s]")
-    times = None if start is None and stop is None else (-math.inf if start is None else start,
-                                                          math.inf if stop is None else stop)
-    replay = Replay(label=label, horizon=window, torque_delay=torque_delay, timestep=timestep)
+    replay, times = replay_options(window, timestep, start, stop, label=label, torque_delay=torque_delay)
     with console.status(f"replaying {log.name} on {model.name}"):
         check = replay_check(model, robot_of(robot, urdf, config, mjcf), log, replay, times=times, output=output)
         if figure is not None:
@@ -71,3 +68,22 @@ def rollout(log: Path = LogArg,
     for path in (output, figure):
         if path is not None:
             console.print(f"wrote {path}")
+
+
+def replay_options(window: float, timestep: float | None, start: float | None, stop: float | None,
+                   **replay) -> tuple[Replay, tuple[float, float] | None]:
+    """The replay (:class:`~wbfriction.sim.replay.Replay`, its other fields ``replay``) and the stretch ``[--from,
+    --to)`` (None: the whole log) of the options ``--window``, ``--timestep``, ``--from``, ``--to``.
+
+    Raises:
+        OptionError: a window or timestep that is not a time > 0.
+    """
+    from wbfriction.sim.replay import Replay
+
+    if not (math.isfinite(window) and window > 0):
+        raise OptionError("--window", window, "a time > 0 [s]")
+    if timestep is not None and not (math.isfinite(timestep) and timestep > 0):
+        raise OptionError("--timestep", timestep, "a physics step > 0 [s]")
+    times = None if start is None and stop is None else (-math.inf if start is None else start,
+                                                          math.inf if stop is None else stop)
+    return Replay(horizon=window, timestep=timestep, **replay), times
