@@ -40,7 +40,7 @@ def refine(log: Path = LogArg,
     """Refine an exported MuJoCo model on the log it should reproduce: each PD-driven joint's armature,
     frictionloss (F_c), damping (F_v) and constant torque (tau_os), and the set-points' delay, moved to minimise
     the replayed angles' error (as 'wbfriction rollout' replays it), each with its standard error and status; the
-    refined file written beside the original (a hung robot, its base fixed)."""
+    refined file written to -o, MODEL untouched (a hung robot, its base fixed)."""
     from wbfriction.sim.refine import refine_mjcf, write_refined
 
     check_paths({"LOG": log, "MODEL": model, "--held-out": held_out, "--config": config, "--urdf": urdf,
