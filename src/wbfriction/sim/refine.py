@@ -58,6 +58,7 @@ from __future__ import annotations
 import time as clock
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pyarrow as pa
@@ -146,10 +147,16 @@ def branches(loaded: ReplayModel) -> np.ndarray:
     return np.array(top)
 
 
+def actuator_bias(gain: np.ndarray | float, offset: np.ndarray | float, tau_os: np.ndarray | float) -> Any:
+    """The actuator's ``biasprm[0]`` [N·m] of a drive of gain ``gain`` [N·m/rad], encoder offset ``offset`` [rad]
+    and constant torque ``tau_os`` [N·m]: ``-kp offset - tau_os`` (:mod:`wbfriction.export.drive`)."""
+    return -gain * offset - tau_os
+
+
 def file_parameters(loaded: ReplayModel, robot: Robot) -> np.ndarray:
     """The file's :data:`PARAMETERS` of each PD-driven joint (4, n)."""
     m, d = loaded.model, loaded.drives
-    tau_os = -(m.actuator_biasprm[d.acts, 0] + d.gain * robot.offset_vector)
+    tau_os = actuator_bias(d.gain, robot.offset_vector, 0.0) - m.actuator_biasprm[d.acts, 0]  # its inverse
     return np.stack([m.dof_armature[d.dofs], m.dof_frictionloss[d.dofs], m.dof_damping[d.dofs], tau_os])
 
 
@@ -163,9 +170,14 @@ class _Problem:
     rows: tuple[int, int]
     horizon: float | None
 
+    @property
+    def period(self) -> float:
+        """The log's sample period [s]."""
+        return float(np.median(np.diff(self.data.time)))
+
     def error(self, x: np.ndarray, delay: float | None) -> np.ndarray:
         """The simulated less logged angles (N, n) [rad] at the values ``x`` (4, n) and ``delay`` [s]."""
-        bias = -self.loaded.drives.gain * self.robot.offset_vector - x[3]
+        bias = actuator_bias(self.loaded.drives.gain, self.robot.offset_vector, x[3])
         model = self.loaded.with_parameters(x[0], x[1], x[2], bias, delay)
         return model.run(self.robot, self.data, *self.rows, self.horizon) - self.data.q[self.rows[0]:self.rows[1]]
 
@@ -206,13 +218,12 @@ def refine_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | Lo
     loaded = load_replay(model, robot, data, replay)
     rows = stretch_rows(data.time, None, times)
     problem = _Problem(loaded, robot, data, rows, replay.horizon)
-    period = float(np.median(np.diff(data.time)))
     grid = delay_grid(loaded)
     x0, d0 = file_parameters(loaded, robot), loaded.delay
     rms0 = np.sqrt(np.mean(problem.error(x0, None) ** 2, axis=0))
     weight = _weights(rms0)
     if grid.size:
-        solutions = _profile(problem, x0, grid, period, weight)
+        solutions = _profile(problem, x0, grid, weight)
         best = min(solutions, key=lambda k: solutions[k].cost)
         x, delay, replays = solutions[best].x, float(grid[best]), 1 + sum(s.replays for s in solutions.values())
     else:
@@ -230,8 +241,7 @@ def _weights(rms: np.ndarray) -> np.ndarray:
     return 1.0 / np.where(rms > 0, rms, good.min() if good.size else 1.0)
 
 
-def _profile(problem: _Problem, x0: np.ndarray, grid: np.ndarray, period: float,
-             weight: np.ndarray) -> dict[int, _Solution]:
+def _profile(problem: _Problem, x0: np.ndarray, grid: np.ndarray, weight: np.ndarray) -> dict[int, _Solution]:
     """The values refined at the delays of ``grid`` a pattern search visits (module docstring): from the file's
     delay, steps of a log period in whole timesteps, then halved down to one timestep, each refinement started from
     the nearest delay's; the refined solutions by grid index."""
@@ -246,7 +256,7 @@ def _profile(problem: _Problem, x0: np.ndarray, grid: np.ndarray, period: float,
         return solutions[k].cost
 
     k = min(int(np.ceil(problem.loaded.delay / step - 1e-6)), grid.size - 1)  # the file's delay, as it acts
-    stride = max(1, int(round(period / step)))
+    stride = max(1, int(round(problem.period / step)))
     while stride >= 1:
         moved = True
         while moved:
@@ -313,8 +323,7 @@ def _refinement(problem: _Problem, x0: np.ndarray, d0: float, sol: _Solution, de
         column = (problem.error(x, high) - problem.error(x, low)) * sol.weight
         jac = np.hstack([jac, (column.ravel() / (high - low))[:, None]])
         replays += 2
-    period = float(np.median(np.diff(problem.data.time)))
-    shot = stop - start if problem.horizon is None else max(1, int(round(problem.horizon / period)))
+    shot = stop - start if problem.horizon is None else max(1, int(round(problem.horizon / problem.period)))
     cov = sandwich(jac, sol.fun, np.repeat(np.arange(stop - start), n), lags=shot)
     se_all = np.sqrt(np.diag(cov))
     se = se_all[:4 * n].reshape(4, n)
@@ -374,7 +383,6 @@ def write_refined(model: str | Path, refinement: Refinement, robot: Robot, outpu
     except (OSError, etree.XMLSyntaxError) as err:
         raise InputError(f"{model}: cannot read it as XML: {err}") from None
     root = tree.getroot()
-    gain = {}
     for j, joint in enumerate(refinement.joints):
         found = root.findall(f".//joint[@name='{joint}']")
         acts = [a for a in root.find("actuator") if a.get("name") == joint] if root.find("actuator") is not None \
@@ -382,12 +390,11 @@ def write_refined(model: str | Path, refinement: Refinement, robot: Robot, outpu
         if len(found) != 1 or len(acts) != 1:
             raise InputError(f"{model}: no single joint and actuator named '{joint}' to write the refinement into")
         armature, frictionloss, damping, tau_os = refinement.value[:, j]
-        found[0].set("armature", f"{armature:.9g}")
-        found[0].set("frictionloss", f"{frictionloss:.9g}")
-        found[0].set("damping", f"{damping:.9g}")
+        for name, value in (("armature", armature), ("frictionloss", frictionloss), ("damping", damping)):
+            found[0].set(name, repr(float(value)))
         bias = acts[0].get("biasprm", "0 0 0").split()
-        gain[joint] = -float(bias[1]) if len(bias) > 1 else 0.0
-        bias[0] = f"{-gain[joint] * robot.encoder_offset.get(joint, 0.0) - tau_os:.9g}"
+        gain = -float(bias[1]) if len(bias) > 1 else 0.0  # biasprm[1] = -kp
+        bias[0] = repr(float(actuator_bias(gain, robot.encoder_offset.get(joint, 0.0), tau_os)))
         acts[0].set("biasprm", " ".join(bias))
         if refinement.delay_status != "not refined":
             acts[0].set("delay", repr(max(refinement.delay - HOLD_EDGE, 0.0)))
