@@ -84,6 +84,22 @@ def test_the_written_file_is_the_refined_model(case):
     assert held["refined"] < held["truth"] and 50 * held["refined"] < held["off"], held
 
 
+def test_a_value_not_ok_is_named_in_the_file(case, tmp_path):
+    """A refined value that is not ``ok`` is written, and a comment of the file names it with its status."""
+    _, robot, _, off, r, _ = case
+    status = tuple(tuple("at bound" if (k, j) == (2, 1) else "ok" for j in range(12)) for k in range(4))
+    marked = dataclasses.replace(r, status=status, delay_status="weak")
+    written = tmp_path / "marked.xml"
+    write_refined(off, marked, robot, written)
+    text = written.read_text()
+    assert f"FL_thigh_joint F_v {r.value[2, 1]:.4g} ± {r.stderr[2, 1]:.2g} N·m·s/rad: at bound" in text
+    assert "s: weak" in text and text.count(": at bound") == 1
+    plain = tmp_path / "plain.xml"
+    write_refined(off, dataclasses.replace(r, status=tuple(("ok",) * 12 for _ in range(4)), delay_status="ok"),
+                  robot, plain)
+    assert ": at bound" not in plain.read_text() and ": weak" not in plain.read_text()
+
+
 def test_what_a_refinement_refuses(case):
     sim, robot, _, off, _, folder = case
     with pytest.raises(InputError, match="must hold at least two"):

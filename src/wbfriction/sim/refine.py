@@ -368,8 +368,9 @@ def _statuses(x: np.ndarray, se: np.ndarray, at_floor: np.ndarray) -> tuple[tupl
 def write_refined(model: str | Path, refinement: Refinement, robot: Robot, output: str | Path,
                   timestep: float | None = None) -> None:
     """``model`` (the MJCF refined) with the refined values written into its joints and actuators (and the
-    ``timestep`` [s] refined at, where given, into its ``<option>``), and a comment saying so, to ``output`` (whole
-    or not at all); ``model`` itself is not touched.
+    ``timestep`` [s] refined at, where given, into its ``<option>``), and comments saying so and naming every value
+    that is not ``ok`` (:func:`not_ok_lines`: written as refined, not as if the data determined it), to ``output``
+    (whole or not at all); ``model`` itself is not touched.
 
     Raises:
         InputError: a file without the joints or actuators refined, an output that cannot be written.
@@ -404,9 +405,23 @@ def write_refined(model: str | Path, refinement: Refinement, robot: Robot, outpu
             option = etree.Element("option")
             root.insert(0, option)
         option.set("timestep", repr(timestep))
+    for line in reversed(not_ok_lines(refinement)):
+        root.insert(0, etree.Comment(f" {line} "))
     root.insert(0, etree.Comment(
         " refined by wbfriction refine on rows {} to {} of its training log: armature, frictionloss, damping, "
         "biasprm[0] (the drive's constant torque tau_os) and delay of {} joints; the export's notes below give the "
         "values before ".format(*refinement.rows, len(refinement.joints))))
     text = etree.tostring(tree, encoding="unicode")
     write_atomic(output, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+
+
+def not_ok_lines(refinement: Refinement) -> list[str]:
+    """One line per refined value whose status is not ``ok``: ``"<joint> <value> <v> ± <se> <unit>: <status>"``, in
+    the robot's order, then the delay's (``not refined`` is no finding against it, and has none)."""
+    lines = [f"{joint} {name} {refinement.value[k, j]:.4g} ± {refinement.stderr[k, j]:.2g} {UNITS[name]}: "
+             f"{refinement.status[k][j]}"
+             for j, joint in enumerate(refinement.joints) for k, name in enumerate(PARAMETERS)
+             if refinement.status[k][j] != "ok"]
+    if refinement.delay_status not in ("ok", "not refined"):
+        lines.append(f"delay {refinement.delay:.4g} ± {refinement.delay_se:.2g} s: {refinement.delay_status}")
+    return lines
