@@ -405,12 +405,13 @@ def write_refined(model: str | Path, refinement: Refinement, robot: Robot, outpu
             option = etree.Element("option")
             root.insert(0, option)
         option.set("timestep", repr(timestep))
-    for line in reversed(not_ok_lines(refinement)):
-        root.insert(0, etree.Comment(f" {line} "))
-    root.insert(0, etree.Comment(
-        " refined by wbfriction refine on rows {} to {} of its training log: armature, frictionloss, damping, "
-        "biasprm[0] (the drive's constant torque tau_os) and delay of {} joints; the export's notes below give the "
-        "values before ".format(*refinement.rows, len(refinement.joints))))
+    header = ("refined by wbfriction refine on rows {} to {} of its training log: armature, frictionloss, damping, "
+              "biasprm[0] (the drive's constant torque tau_os) and delay of {} joints; the export's notes below give "
+              "the values before".format(*refinement.rows, len(refinement.joints)))
+    for line in reversed([header, *not_ok_lines(refinement)]):
+        comment = etree.Comment(f" {line} ")
+        comment.tail = "\n  "
+        root.insert(0, comment)
     text = etree.tostring(tree, encoding="unicode")
     write_atomic(output, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
