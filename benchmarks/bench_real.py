@@ -54,21 +54,29 @@ def table(runs: list[DatasetRun]) -> str:
     return "\n".join(lines)
 
 
+ROLLOUTS = (("rollout", "rollout, ours"), ("refined_rollout", "refined"), ("peer_rollout", "rollout, peer"),
+            ("whole_rollout", "refined on the whole log (the peer's footing)"))
+
+
 def rollouts(runs: list[DatasetRun]) -> str:
     """The PD-driven robots' held-out rollouts: each joint's tracking error, ours (the route's export and its
-    refinement) and the peer's [mrad]."""
-    lines = ["| dataset | joint | rollout, ours [mrad] | refined [mrad] | rollout, peer [mrad] |",
-             "|---|---|---|---|---|"]
+    refinement), the peer's, and the export refined on the whole log as the peer was fitted [mrad]; the means, and
+    on how many joints each of ours is at most the peer's."""
+    lines = ["| dataset | joint | " + " | ".join(f"{title} [mrad]" for _, title in ROLLOUTS) + " |",
+             "|---|---|" + "---|" * len(ROLLOUTS)]
     rows = [(run.name, j) for run in runs for j in run.joints if math.isfinite(j.rollout)]
-    lines += [f"| {name} | {j.joint} | {1e3 * j.rollout:.1f} | {cell(1e3 * j.refined_rollout, '.1f')} | "
-              f"{cell(1e3 * j.peer_rollout, '.1f')} |" for name, j in rows]
+    lines += [f"| {name} | {j.joint} | " + " | ".join(cell(1e3 * getattr(j, k), ".1f") for k, _ in ROLLOUTS) + " |"
+              for name, j in rows]
     for run in runs:
         scored = [j for j in run.joints if math.isfinite(j.rollout)]
         if scored:
-            mean = {k: 1e3 * sum(getattr(j, k) for j in scored) / len(scored)
-                    for k in ("rollout", "refined_rollout", "peer_rollout")}
-            lines.append(f"| {run.name} | mean | {mean['rollout']:.2f} | {cell(mean['refined_rollout'], '.2f')} | "
-                         f"{cell(mean['peer_rollout'], '.2f')} |")
+            mean = [1e3 * sum(getattr(j, k) for j in scored) / len(scored) for k, _ in ROLLOUTS]
+            lines.append(f"| {run.name} | mean | " + " | ".join(cell(m, ".2f") for m in mean) + " |")
+            better = [sum(getattr(j, k) <= j.peer_rollout for j in scored) if math.isfinite(m) else None
+                      for (k, _), m in zip(ROLLOUTS, mean)]
+            lines.append(f"| {run.name} | at most the peer's | " + " | ".join(
+                "-" if k == "peer_rollout" or b is None else f"{b} of {len(scored)}"
+                for (k, _), b in zip(ROLLOUTS, better)) + " |")
     return "\n".join(lines) if rows else ""
 
 

@@ -12,11 +12,18 @@ and the peer's friction predicts its torque (:func:`~wbfriction.fit.predict.pred
 less predicted, per joint, beside wbfriction's (:func:`peer_held_out`); and the same log's set-points replayed on
 the MJCF wbfriction exported and on the peer's parameters as PACE simulates them, the joints' tracking error
 (:func:`peer_rollouts`).
+
+**The peer's footing.** The peer's parameters were fitted on the whole log: PACE's ``my_fit.py`` in the peer's
+repository replays all of ``traj_0.pt`` at each CMA-ES generation (its ``data_dir``; ``time_steps`` the log's
+length). The last 40 % is held out from wbfriction's route, not from the peer. :func:`refine_on_whole_log` refines
+the route's MJCF on the same whole log, the peer's training data, so that both are scored on data both were fitted
+on.
 """
 
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import pyarrow as pa
@@ -70,13 +77,13 @@ def peer_held_out(robot_toml: Path, peer_toml: Path, peer: PeerActuator, held_ou
 
 def peer_rollouts(robot_toml: str | Path, peer_toml: str | Path, peer: PeerActuator, identified_toml: str | Path,
                   mjcf: str | Path, held_out: str | Path, horizon: float | None = 1.0,
-                  refined: str | Path | None = None) -> pa.Table:
+                  others: Mapping[str, str | Path] | None = None) -> pa.Table:
     """The held-out log's set-points replayed (:func:`~wbfriction.sim.replay.replay_mjcf`, restarted from the log every
     ``horizon`` seconds) on the MJCF wbfriction exported (``mjcf``, for the robot ``identified_toml``), as MuJoCo
     runs it, and on the peer's parameters written by the same export and run as PACE simulates them (the PD law once
     a 5 ms period, its whole torque held back its delay truncated to whole periods): a row per joint, ``rms.ours`` and
-    ``rms.peer`` [rad], the tracking error of the logged angles; with ``refined`` (the MJCF ``wbfriction refine``
-    wrote), ``rms.refined`` too.
+    ``rms.peer`` [rad], the tracking error of the logged angles; ``others``: more MJCF files for the same robot (the
+    ones ``wbfriction refine`` wrote) by label, each replayed as ``mjcf`` is, ``rms.<label>`` too.
 
     Raises:
         InputError: what reading the robots, the files or the log raises.
@@ -89,8 +96,9 @@ def peer_rollouts(robot_toml: str | Path, peer_toml: str | Path, peer: PeerActua
     from wbfriction.sim.rollout import rollout_table
 
     identified = load_robot(None, config=Path(identified_toml))
+    files = {"ours": mjcf, **(others or {})}
     ours = [replay_mjcf(path, identified, held_out, Replay(label=label, horizon=horizon))
-            for label, path in (("ours", mjcf), ("refined", refined)) if path is not None]
+            for label, path in files.items()]
     robot = peer_robot(robot_toml, peer_toml)
     with tempfile.TemporaryDirectory(prefix="wbfriction-peer-") as tmp:
         path = Path(tmp) / "peer.xml"
@@ -98,3 +106,28 @@ def peer_rollouts(robot_toml: str | Path, peer_toml: str | Path, peer: PeerActua
         theirs = replay_mjcf(path, robot, held_out, Replay(label="peer", horizon=horizon,
                                                            torque_delay=peer.applied_delay_steps))
     return rollout_table([*ours, theirs])
+
+
+def refine_on_whole_log(identified_toml: str | Path, mjcf: str | Path, logs: Sequence[str | Path],
+                        output: str | Path) -> Path:
+    """``mjcf`` (exported for the robot ``identified_toml``) refined (:func:`~wbfriction.sim.refine.refine_mjcf`) on
+    ``logs`` read one after the other as one log (a dataset's ``train.parquet`` then ``held_out.parquet``: the whole
+    log the peer was fitted on, module docstring), written to ``output``.
+
+    Raises:
+        InputError: what reading the robot, the file or the logs raises; stretches whose times do not follow on.
+    """
+    import pyarrow.parquet as pq
+
+    from wbfriction.exceptions import InputError
+    from wbfriction.model.loading import load_robot
+    from wbfriction.sim.refine import refine_mjcf, write_refined
+
+    tables = [pq.read_table(path) for path in logs]
+    for before, after, path in zip(tables, tables[1:], logs[1:]):
+        if after.num_rows and before.num_rows and after["time"][0].as_py() <= before["time"][-1].as_py():
+            raise InputError(f"{path}: its times do not follow those of the log before it")
+    robot = load_robot(None, config=Path(identified_toml))
+    refinement = refine_mjcf(mjcf, robot, pa.concat_tables(tables))
+    write_refined(mjcf, refinement, robot, output)
+    return Path(output)

@@ -69,6 +69,8 @@ class JointScore:
         rollout, peer_rollout: a PD-driven robot's held-out set-points replayed in MuJoCo with the route's
             identification and with the peer's: the tracking error's RMS [rad] (:mod:`wbfriction.studies.pd_peer`).
         refined_rollout: the same with the route's MJCF refined on the training log (``wbfriction refine``) [rad].
+        whole_rollout: the same with the route's MJCF refined on the whole log, the peer's training data (the peer's
+            footing: :func:`~wbfriction.studies.pd_peer.refine_on_whole_log`) [rad].
     """
 
     joint: str
@@ -83,6 +85,7 @@ class JointScore:
     rollout: float = float("nan")
     peer_rollout: float = float("nan")
     refined_rollout: float = float("nan")
+    whole_rollout: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -207,9 +210,9 @@ def score(name: str, outs: Outputs, config: Path | None = None) -> tuple[JointSc
         if isinstance(ref, HeldOutRms):
             peer = ref.held_out(joint)
         peer = peers.get(joint, peer)
-        ours, theirs, refined = rollouts.get(joint, (float("nan"),) * 3)
+        ours, theirs, refined, whole = rollouts.get(joint, (float("nan"),) * 4)
         out.append(JointScore(joint, verdict.status, verdict.reason, fit.model, error, sigmas, held_out, peer, moved,
-                              ours, theirs, refined))
+                              ours, theirs, refined, whole))
     return tuple(out)
 
 
@@ -258,19 +261,30 @@ def peer_scores(config: Path, outs: Outputs) -> tuple[dict[str, float], dict[str
     """The held-out torque RMS per joint [N·m] of the peer whose parameters lie beside the robot's TOML ``config``
     (``peer.toml``, the held-out log ``held_out.parquet``; the one such dataset, the Aliengo's, reads its peer's
     friction from its fetched file), and per joint the held-out rollouts' tracking error [rad] of the MJCF the route
-    exported, the peer's and the route's refined MJCF (NaN without one) (:mod:`wbfriction.studies.pd_peer`; none
-    without the route's identified TOML and MJCF)."""
+    exported, the peer's, the route's refined MJCF and the export refined on the whole log as the peer was fitted
+    (the last two NaN without a route that refines) (:mod:`wbfriction.studies.pd_peer`; none without the route's
+    identified TOML and MJCF)."""
+    import tempfile
+
     from wbfriction.datasets.aliengo import aliengo_peer
-    from wbfriction.studies.pd_peer import peer_held_out, peer_rollouts
+    from wbfriction.studies.pd_peer import peer_held_out, peer_rollouts, refine_on_whole_log
 
     folder, peer = config.parent, aliengo_peer()
     held = peer_held_out(config, folder / "peer.toml", peer, folder / "held_out.parquet")
     if outs.identified is None or outs.mjcf is None:
         return held, {}
-    table = peer_rollouts(config, folder / "peer.toml", peer, outs.identified, outs.mjcf,
-                          folder / "held_out.parquet", refined=outs.refined).to_pydict()
-    refined = table.get("rms.refined", [float("nan")] * len(table["joint"]))
-    return held, {j: (o, p, r) for j, o, p, r in zip(table["joint"], table["rms.ours"], table["rms.peer"], refined)}
+    with tempfile.TemporaryDirectory(prefix="wbfriction-whole-") as tmp:
+        others = {}
+        if outs.refined is not None:
+            whole = refine_on_whole_log(outs.identified, outs.mjcf, [folder / "train.parquet",
+                                                                     folder / "held_out.parquet"],
+                                        Path(tmp) / "refined_whole.xml")
+            others = {"refined": outs.refined, "whole": whole}
+        table = peer_rollouts(config, folder / "peer.toml", peer, outs.identified, outs.mjcf,
+                              folder / "held_out.parquet", others=others).to_pydict()
+    nan = [float("nan")] * len(table["joint"])
+    columns = [table[k] for k in ("rms.ours", "rms.peer")] + [table.get(f"rms.{k}", nan) for k in ("refined", "whole")]
+    return held, {j: tuple(values) for j, *values in zip(table["joint"], *columns)}
 
 
 @dataclass(frozen=True)
