@@ -119,6 +119,17 @@ def test_what_a_rollout_refuses(go2, mjr, logs):
         rollout(go2, sim.table, truth(sim, friction={"knee": sim.friction["FL_hip_joint"]}), rows=(0, 10), mjr=mjr)
 
 
+def test_a_parameters_file_of_another_robot_is_refused(go2, mjr, logs, tmp_path):
+    """Issue 65, class 1: a Go2 and an Aliengo share their joints' names, so a parameters file fitted for the other
+    robot would replay silently: the file's recorded robot must be the one replayed, named in one line."""
+    sim = logs["exact"]
+    path = tmp_path / "params.json"
+    write_params(path, [FitResult(j, 100, p, model=p.model, success=True) for j, p in sim.friction.items()],
+                 {"provenance": {"robot": "aliengo"}})
+    with pytest.raises(InputError, match=r"params.json: parameters of robot 'aliengo', not of 'go2'"):
+        rollout(go2, sim.table, truth(sim, friction=str(path)), rows=(0, 10), mjr=mjr)
+
+
 def test_a_peers_torque_delay_holds_back_the_whole_law(go2, mjr):
     """PACE's delay (a peer's model, ``torque_delay``): the torque applied at each physics step is the PD law of the
     readings and set-points of 12 steps before (feedback delayed too), bit for bit; before that, the first step's."""

@@ -261,6 +261,36 @@ def read_params(path: str | Path) -> dict[str, FitResult]:
     return out
 
 
+def params_robot(params: str | Path) -> str | None:
+    """The robot a parameters file (one :func:`read_params` has read) was fitted for: its provenance's ``robot``
+    (:func:`~wbfriction.pipeline.provenance.log_provenance`); None where it records none."""
+    doc = json.loads(Path(params).read_text())
+    prov = doc.get("provenance", {}) if isinstance(doc, dict) else {}
+    robot = prov.get("robot") if isinstance(prov, dict) else None
+    return robot if isinstance(robot, str) else None
+
+
+def read_robot_params(params: str | Path, robot: str, joints: Iterable[str]) -> dict[str, FitResult]:
+    """:func:`read_params` for the robot named ``robot`` whose joints are ``joints``: the one check wherever a
+    parameters file meets a robot model (export, rollout). Two robots of one class share their joints' names (a Go2
+    and an Aliengo), so the joints alone do not tell them apart: the file's recorded robot must be this one.
+
+    Raises:
+        InputError: what :func:`read_params` raises; a file fitted for another robot; a joint ``robot`` lacks (each
+            naming the file).
+    """
+    fits = read_params(params)
+    fitted_for = params_robot(params)
+    if fitted_for is not None and fitted_for != robot:
+        raise InputError(f"{params}: parameters of robot '{fitted_for}', not of '{robot}': give the robot model "
+                         "they were fitted with")
+    known = set(joints)
+    unknown = [j for j in fits if j not in known]
+    if unknown:
+        raise InputError(f"{params}: joint '{unknown[0]}' is not an actuated joint of robot '{robot}'")
+    return fits
+
+
 def check_params_source(params: str | Path, est: FrictionEstimate, table: str | Path | None = None) -> None:
     """Refuse a parameters file (one :func:`read_params` has read) that does not belong with a
     friction table: fitted for another robot (the robots both record,
@@ -275,7 +305,7 @@ def check_params_source(params: str | Path, est: FrictionEstimate, table: str | 
     doc = json.loads(path.read_text())  # read by read_params first: a parameters file
     prov = doc.get("provenance", {}) if isinstance(doc, dict) else {}
     prov = prov if isinstance(prov, dict) else {}
-    robot, table_robot = prov.get("robot"), est.metadata.get("provenance", {}).get("robot")
+    robot, table_robot = params_robot(path), est.metadata.get("provenance", {}).get("robot")
     if robot is not None and table_robot is not None and robot != table_robot:
         raise InputError(f"{path}: parameters of robot '{robot}', not of the table's robot '{table_robot}'")
     joints = doc.get("joints", {}) if isinstance(doc, dict) else {}

@@ -13,7 +13,7 @@ from wbfriction.export.drive import DEFAULT_PHYSICS_DT, DriveExport, drive_expor
 from wbfriction.export.mapping import FitSelection, joint_exports, select_fits
 from wbfriction.export.registry import spoken, target_for, targets
 from wbfriction.export.target import ExportOptions, ExportReport
-from wbfriction.fit.params_file import read_params
+from wbfriction.fit.params_file import read_robot_params
 from wbfriction.model.robot import Robot
 
 
@@ -53,7 +53,8 @@ def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path]
     Raises:
         InputError: a ``physics_dt`` that is not > 0, an unknown suffix
             (:class:`~wbfriction.export.registry.UnknownExportFormat`), a .urdf output
-            for a robot loaded from an MJCF, unreadable parameters, parameters without joints or without a fit
+            for a robot loaded from an MJCF, unreadable parameters, parameters fitted for another robot
+            (:func:`~wbfriction.fit.params_file.read_robot_params`), parameters without joints or without a fit
             that qualifies, an unknown ``include`` choice, friction that is not dissipative
             (:mod:`wbfriction.export.mapping`), a joint the robot does not actuate; for a .yaml output of a robot
             with PD-driven joints, exported friction of a joint that is not PD-driven.
@@ -65,7 +66,7 @@ def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path]
     chosen = [target_for(path).configure(options) for path in outputs]
     for target in {id(t): t for t in chosen}.values():
         target.check(robot)
-    selection = select_fits(read_params(params), robot, include, str(params))
+    selection = select_fits(read_robot_params(params, robot.name, robot.actuated), robot, include, str(params))
     joints = {name: replace(exp, instead=selection.instead_note(name))
               for name, exp in joint_exports(selection.exported, armature, robot).items()}
     reports = tuple(target.write(Path(path), robot, joints) for path, target in zip(outputs, chosen))

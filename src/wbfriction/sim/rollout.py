@@ -131,8 +131,8 @@ def rollout_table(results: Sequence[RolloutResult]) -> pa.Table:
 def _friction(robot: Robot, given: Mapping[str, Any] | str | Path) -> tuple[dict[str, ModelParams], tuple[str, ...]]:
     """The friction parameters per joint of :attr:`ActuatorParams.friction`, and the joints without any."""
     if isinstance(given, (str, Path)):
-        from wbfriction.fit.params_file import read_params
-        given = read_params(given)
+        from wbfriction.fit.params_file import read_robot_params
+        given = read_robot_params(given, robot.name, robot.actuated)
     out: dict[str, ModelParams] = {}
     for joint, value in given.items():
         if joint not in robot.actuated:

@@ -1,0 +1,39 @@
+"""Issue 65, class 1: parameters meet a robot through one check (:func:`~wbfriction.fit.params_file.read_robot_params`).
+A Go2's fit exported with another robot of the same joints' names was written as that robot's friction ("exported the
+friction of 12 joints (12 ok)"); it is now refused in one line naming the file and both robots, nothing written."""
+
+from __future__ import annotations
+
+import pytest
+
+from helpers import run_cli
+from wbfriction.exceptions import InputError
+from wbfriction.fit.params_file import read_robot_params, write_params
+from wbfriction.model import load_robot
+
+
+@pytest.fixture()
+def go2_params(tmp_path, fit_of):
+    """Ok fits of every Go2 joint, recorded as fitted for the built-in go2."""
+    path = tmp_path / "go2.json"
+    write_params(path, [fit_of(j, "ok") for j in load_robot("go2").actuated], {"provenance": {"robot": "go2"}})
+    return path
+
+
+def test_another_robots_parameters_are_refused_before_anything_is_written(go2_params, tmp_path, capsys):
+    out = tmp_path / "walking.xml"
+    code, err = run_cli(capsys, "export", go2_params, "--robot", "go2_walking", "-o", out)
+    assert code == 2 and not out.exists()
+    assert err.strip() == (f"error: {go2_params}: parameters of robot 'go2', not of 'go2_walking': give the robot "
+                           "model they were fitted with")
+    code, err = run_cli(capsys, "export", go2_params, "--robot", "go2", "-o", out)
+    assert code == 0 and out.exists(), err
+
+
+def test_a_file_without_a_recorded_robot_is_checked_by_its_joints(tmp_path, fit_of):
+    """A hand-written file records no robot: its joints must be the robot's."""
+    path = tmp_path / "hand.json"
+    write_params(path, [fit_of("FL_hip_joint", "ok")])
+    assert set(read_robot_params(path, "go2", load_robot("go2").actuated)) == {"FL_hip_joint"}
+    with pytest.raises(InputError, match="hand.json: joint 'FL_hip_joint' is not an actuated joint of robot 'panda'"):
+        read_robot_params(path, "panda", load_robot("panda").actuated)
