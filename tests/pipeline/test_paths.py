@@ -18,3 +18,34 @@ def test_an_empty_output_path_is_refused_naming_the_option(capsys, tmp_path, mon
     assert code == 2
     assert err.strip() == f"error: {option} must be a file or folder to write, not an empty path, got ''"
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("command", ["study-quadruped", "study-filters", "demo"])
+def test_an_output_folder_that_cannot_be_made_is_refused_before_the_work(tmp_path, capsys, command):
+    """Issue 65, class 3: ``study-quadruped -o <a file>/study`` simulated, estimated and fitted, printed 34 lines,
+    then failed. Every command that writes into a folder checks it first: under a file, a file itself, or in a
+    read-only folder, one line and nothing else printed."""
+    import os
+    import time
+
+    from helpers import run_cli
+
+    a_file = tmp_path / "a_file"
+    a_file.write_text("not a folder")
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o555)
+    try:
+        cases = [(a_file / "study", "a_file' is a file: no folder can be made under it"),
+                 (a_file, "a_file: is a file, not a folder")]
+        if os.geteuid() != 0:  # root writes anywhere
+            cases += [(locked / "study", f"cannot be made: '{locked}' cannot be written"),
+                      (locked, f"{locked}: cannot be written")]
+        for folder, needle in cases:
+            began = time.perf_counter()
+            code, err = run_cli(capsys, command, "-o", folder)
+            assert code == 2 and needle in err and len(err.strip().splitlines()) == 1, err
+            assert time.perf_counter() - began < 2.0
+    finally:
+        locked.chmod(0o755)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file", "locked"] and not any(locked.iterdir())

@@ -8,6 +8,7 @@ from typing import Literal
 import typer
 
 from wbfriction.cli.common import app, console, out
+from wbfriction.pipeline.paths import check_paths
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only typer:
 # the datasets' registry (wbfriction.datasets.DATASETS, which these names equal: tested) is imported when it runs.
@@ -36,6 +37,7 @@ def dataset(name: DatasetName = typer.Argument(..., metavar="NAME",
     local copy, for offline machines, checked the same way). Prints the commands to run next."""
     from wbfriction.datasets import write_dataset
 
+    check_paths({}, {}, {"-o": output_dir})
     with console.status(f"fetching the {name} dataset"):
         written = write_dataset(name, output_dir)
     logs = ", ".join(f"{path} ({written.rows[role]} samples: {written.described.get(role, role)})"

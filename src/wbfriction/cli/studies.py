@@ -10,10 +10,12 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-# Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
-# options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError
 from wbfriction.friction.options import RouteOption
+
+# Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
+# options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.pipeline.paths import check_paths
 from wbfriction.signals.options import Diff, FilterOptions
 from wbfriction.sim.options import SensorNoise, Simulator
 
@@ -135,6 +137,7 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
     from wbfriction.studies.common import worst_errors
     from wbfriction.studies.simulation import run_study
 
+    check_paths({}, {}, {"-o": output_dir})
     start = time.perf_counter()
     r = robot_of(robot, None, None)
     if simulator == "mujoco":
@@ -183,6 +186,7 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
     from wbfriction.studies.realistic import NOISE
     from wbfriction.studies.sensors import SUBSTEPS, run_sensors_study, sensors_markdown
 
+    check_paths({}, {}, {"-o": output_dir})
     r = robot_of(robot, None, None)
     if not r.ft_sensors:
         raise InputError(f"--robot {robot}: the robot has no force-torque sensors ([force_torque.<name>] in its TOML)")
@@ -214,6 +218,7 @@ def study_noise(output_dir: Path = typer.Option(Path("wbfriction-noise"), "-o", 
     Cramér-Rao bound."""
     from wbfriction.studies.noise import FAMILIES, Family, noise_markdown, run_noise_study
 
+    check_paths({}, {}, {"-o": output_dir})
     chosen = [f.strip() for f in families.split(",") if f.strip()]
     unknown = [f for f in chosen if f not in FAMILIES]
     if unknown:
@@ -244,6 +249,7 @@ def study_fleet(output_dir: Path = typer.Option(Path("wbfriction-fleet"), "-o", 
 
     from wbfriction.studies.drifting_fleet import FleetPlan, run_fleet_study
 
+    check_paths({}, {}, {"-o": output_dir})
     plan = dataclasses.replace(FleetPlan(), robots=robots, logs=logs)
     if robots < 3:
         plan = dataclasses.replace(plan, drifts=tuple(d for d in plan.drifts if d.robot_id in plan.robot_ids))
@@ -273,6 +279,7 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
     from wbfriction.friction.models import PARAM_NAMES
     from wbfriction.studies.filters import LEVELS, run_filter_study
 
+    check_paths({}, {}, {"-o": output_dir})
     start = time.perf_counter()
     r = robot_of(robot, None, None)
     with console.status("") as status:
@@ -324,6 +331,7 @@ def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped")
     from wbfriction.report.terminal import determination_table
     from wbfriction.studies.quadruped import QuadrupedCase, case_robot, fits_markdown, run_quadruped, write_study
 
+    check_paths({}, {}, {"-o": output_dir})
     case = QuadrupedCase(simulator=simulator, gait=gait, drive=drive, foot_forces=foot_forces,  # type: ignore[arg-type]
                          noise=noise, duration=duration, seed=seed)
     r = case_robot(robot_of(robot, None, None), case)

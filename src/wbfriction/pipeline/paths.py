@@ -26,7 +26,8 @@ def _same(a: Path, b: Path) -> bool:
         return False
 
 
-def check_paths(inputs: Mapping[str, Path | None], outputs: Mapping[str, Path | None]) -> None:
+def check_paths(inputs: Mapping[str, Path | None], outputs: Mapping[str, Path | None],
+                folders: Mapping[str, Path | None] | None = None) -> None:
     """Refuse, before any work, a missing input, an output that cannot be written whole, and an
     output that is an input or another output.
 
@@ -34,12 +35,17 @@ def check_paths(inputs: Mapping[str, Path | None], outputs: Mapping[str, Path | 
         inputs: the files read, by the argument or option that names them (e.g.
             ``{"LOG": log, "--params": params}``; None: not given).
         outputs: the files written, likewise (e.g. ``{"-o": output, "--json": json}``).
+        folders: the folders written into, made with their parents where missing (``{"-o": output_dir}``).
 
     Raises:
         InputError: naming the option and the path: an input that does not exist; an output
             that is a folder, in a folder that does not exist or cannot be written, equal to an
-            input (inputs are never overwritten) or to another output.
+            input (inputs are never overwritten) or to another output; a folder that is a file, under
+            a file, or that cannot be made or written.
     """
+    for label, folder in (folders or {}).items():
+        if folder is not None:
+            _check_folder(label, Path(folder))
     given_in = {k: Path(v) for k, v in inputs.items() if v is not None}
     given_out = {k: Path(v) for k, v in outputs.items() if v is not None}
     for label, path in given_in.items():
@@ -62,6 +68,21 @@ def check_paths(inputs: Mapping[str, Path | None], outputs: Mapping[str, Path | 
             if _same(path, other):
                 raise InputError(f"{label} {path}: is also the output {other_label}")
         seen[label] = path
+
+
+def _check_folder(label: str, folder: Path) -> None:
+    """Refuse an output folder that is a file, lies under one, or cannot be made or written (the nearest folder
+    that exists is the one written into)."""
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{label} {folder}: is a file, not a folder")
+    existing = folder
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise InputError(f"{label} {folder}: '{existing}' is a file: no folder can be made under it")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        what = "cannot be written" if existing == folder else f"cannot be made: '{existing}' cannot be written"
+        raise InputError(f"{label} {folder}: {what}")
 
 
 OUTPUT_OPTIONS = ("-o", "--output", "--output-dir", "--json", "--table", "--tables", "--config-output")
