@@ -75,9 +75,14 @@ def test_fixed_base_refuses_contact_frames(tmp_path, extra, message):
 
 @pytest.mark.parametrize("table, message", [
     ("[locked_joints]\nno_such_joint = 0.0\n", "unknown joint in \\[locked_joints\\] 'no_such_joint'"),
-    ("[torque_constants]\npanda_joint1 = 0.0\n", "panda_joint1 must be > 0"),
-    ("[armature]\npanda_joint1 = -0.1\n", "panda_joint1 must be >= 0"),
-    ("[armature]\npanda_joint1 = \"big\"\n", "panda_joint1 must be a number"),
+    ("[torque_constants]\npanda_joint1 = 0.0\n",
+     re.escape("[torque_constants] panda_joint1: 0 N·m/A is outside (0, 1000]")),
+    ("[armature]\npanda_joint1 = -0.1\n", re.escape("[armature] panda_joint1: -0.1 kg·m² is outside [0, 100] kg·m²")),
+    ("[armature]\npanda_joint1 = 1e6\n", re.escape("[armature] panda_joint1: 1e+06 kg·m² is outside [0, 100] kg·m²")),
+    ("[armature]\npanda_joint1 = \"big\"\n",
+     re.escape("[armature] panda_joint1: must be a number in [0, 100] kg·m², got 'big'")),
+    ("[encoder_offset]\npanda_joint1 = 100.0\n", re.escape("[encoder_offset] panda_joint1: 100 rad is outside "
+                                                           "[-3.14159, 3.14159] rad")),
     ("[locked_joints]\npanda_finger_joint1 = 0.0\n[torque_constants]\npanda_finger_joint1 = 1.0\n",
      "unknown joint in \\[torque_constants\\] 'panda_finger_joint1'"),  # a locked joint is no longer in the model
 ])

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -71,11 +73,13 @@ def test_parse_pd_per_joint_group_and_default_limits():
 @pytest.mark.parametrize(("table", "message"), [
     ({"kd": 0.5}, "needs 'kp'"),
     ({"kp": {"a": 1.0}, "kd": 0.5}, "no value for 'b'"),
-    ({"kp": -1.0, "kd": 0.5}, "kp of 'a' must be a number >= 0"),
-    ({"kp": 1.0, "kd": 0.5, "delay": -0.1}, "delay must be"),
+    ({"kp": -1.0, "kd": 0.5}, re.escape("[pd] kp of 'a': -1 N·m/rad is outside [0, 100000] N·m/rad")),
+    ({"kp": 1.0, "kd": 0.5, "delay": -0.1}, re.escape("[pd] delay: -0.1 s is outside [0, 0.5] s")),
+    ({"kp": 1.0, "kd": 0.5, "delay": 20.0}, re.escape("[pd] delay: 20 s is outside [0, 0.5] s")),
     ({"kp": 1.0, "kd": 0.5, "gain": 2}, "no key 'gain'"),
     ({"kp": {"leg": 1.0, "x": 2.0}, "kd": 0.5}, "'x' is neither"),
-    ({"kp": 1.0, "kd": 0.5, "torque_limit": 0.0}, "torque_limit of 'a' must be a number > 0"),
+    ({"kp": 1.0, "kd": 0.5, "torque_limit": 0.0},
+     re.escape("[pd] torque_limit of 'a': 0 N·m is outside (0, 100000] N·m")),
 ])
 def test_parse_pd_refuses_naming_the_file_and_key(table, message):
     with pytest.raises(InputError, match=message) as err:

@@ -29,6 +29,7 @@ from wbfriction.model.labels import parse_labels
 from wbfriction.model.pd import parse_pd
 from wbfriction.model.robot import CONTACT_DIMS, ContactKind, ModelFormat, Robot
 from wbfriction.model.robots import BUILTIN_ROBOTS
+from wbfriction.ranges import in_range
 
 _ERD_PREFIX = "example-robot-data:"
 _GENERATED = "wbfriction:"  # a URDF this package generates: "wbfriction:<name>" (robots/<name>.py)
@@ -151,13 +152,13 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
         balance_gains=_balance_gains(config.get("balance_gains", (0.0, 0.0)), source),
         floating_base=floating,
         locked_joints=locked,
-        torque_constants=_joint_values(config, "torque_constants", actuated, source, positive=True),
+        torque_constants=_joint_values(config, "torque_constants", actuated, source, "torque_constant"),
         ft_sensors=parse_sensors(model, config.get("force_torque"), frames, source),
         contact_force=_contact_force(config.get("contact_force"), source),
         imu=add_imu_frame(model, config.get("imu"), source),
         labels=parse_labels(config.get("labels"), actuated, source),
         pd=parse_pd(config.get("pd"), actuated, groups, _effort_limits(model, actuated), source),
-        encoder_offset=_joint_values(config, "encoder_offset", actuated, source, signed=True),
+        encoder_offset=_joint_values(config, "encoder_offset", actuated, source, "encoder_offset"),
         contact_kinds=_contact_kinds(config.get("contact_model"), frames, floating, source),
         foot_radius=_foot_radius(config.get("foot_radius", 0.0), source),
     )
@@ -193,28 +194,20 @@ def _root_frame(model: pin.Model) -> str:
     return next(f.name for f in model.frames if f.parentJoint == 1 and f.type == pin.FrameType.BODY)
 
 
-def _joint_values(config: dict, key: str, actuated: list[str], source: str, positive: bool = False,
-                  signed: bool = False) -> dict[str, float]:
-    """A ``[key]`` table of joint name -> number (> 0 with ``positive``, any sign with ``signed``, else >= 0),
-    checked against the model's joints."""
+def _joint_values(config: dict, key: str, actuated: list[str], source: str, quantity: str) -> dict[str, float]:
+    """A ``[key]`` table of joint name -> number, each in the physical range of ``quantity``
+    (:data:`~wbfriction.ranges.RANGES`), checked against the model's joints."""
     table = config.get(key, {})
     if not isinstance(table, dict):
         raise InputError(f"{source}: '[{key}]' must be a table of joint = number")
     _check_names(list(table), set(actuated), f"joint in [{key}]", source)
-    out = {}
-    for name, value in table.items():
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
-            raise InputError(f"{source}: [{key}] {name} must be a number, got {value!r}")
-        if not signed and ((value <= 0) if positive else (value < 0)):
-            raise InputError(f"{source}: [{key}] {name} must be {'> 0' if positive else '>= 0'}, got {value!r}")
-        out[name] = float(value)
-    return out
+    return {name: in_range(quantity, value, f"{source}: [{key}] {name}") for name, value in table.items()}
 
 
 def _set_armature(model: pin.Model, config: dict, actuated: list[str], source: str) -> None:
     """Set ``model.armature`` of the joints in ``[armature]`` [kg·m^2] (rnea and crba include it)."""
     armature = model.armature.copy()
-    for name, value in _joint_values(config, "armature", actuated, source).items():
+    for name, value in _joint_values(config, "armature", actuated, source, "armature").items():
         armature[model.idx_vs[model.getJointId(name)]] = value
     model.armature = armature
 
@@ -378,10 +371,8 @@ def _contact_kinds(value, frames: list[str], floating: bool, source: str) -> tup
 
 
 def _foot_radius(value, source: str) -> float:
-    """``foot_radius`` [m]: a number >= 0."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not value >= 0:
-        raise InputError(f"{source}: 'foot_radius' must be a number of metres >= 0, got {value!r}")
-    return float(value)
+    """``foot_radius`` [m], in its physical range (:data:`~wbfriction.ranges.RANGES`)."""
+    return in_range("foot_radius", value, f"{source}: foot_radius")
 
 
 def _groups(config: dict, actuated: list[str], source: str) -> dict[str, tuple[str, ...]]:

@@ -180,9 +180,10 @@ def parse_pd(table: object, actuated: list[str], groups: dict[str, tuple[str, ..
 
     Raises:
         InputError: a ``[pd]`` that is not a table, an unknown key, joint or group, a gain missing for a joint, a
-            value that is not a number >= 0 (a limit > 0), naming the file and the key.
+            value outside its physical range (:data:`~wbfriction.ranges.RANGES`), naming the file and the key.
     """
     from wbfriction.exceptions import InputError
+    from wbfriction.ranges import in_range
 
     if table is None:
         return None
@@ -205,7 +206,7 @@ def parse_pd(table: object, actuated: list[str], groups: dict[str, tuple[str, ..
     joints = [j for j in actuated if j in set(joints)]
     limits = dict(zip(actuated, np.where(effort_limit > 0, effort_limit, np.inf)))
 
-    def per_joint(key: str, default: dict[str, float] | None, positive: bool) -> np.ndarray:
+    def per_joint(key: str, default: dict[str, float] | None) -> np.ndarray:
         value = table.get(key)
         if value is None:
             if default is None:
@@ -223,18 +224,8 @@ def parse_pd(table: object, actuated: list[str], groups: dict[str, tuple[str, ..
         missing = [j for j in joints if j not in spread]
         if missing:
             raise InputError(f"{source}: [pd] {key} gives no value for '{missing[0]}'")
-        out = np.empty(len(joints))
-        for i, j in enumerate(joints):
-            v = spread[j]
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or v < 0 \
-                    or (positive and v == 0):
-                raise InputError(f"{source}: [pd] {key} of '{j}' must be a number {'> 0' if positive else '>= 0'}, "
-                                 f"got {v!r}")
-            out[i] = float(v)
-        return out
+        return np.array([in_range(key, spread[j], f"{source}: [pd] {key} of '{j}'") for j in joints])
 
-    delay = table.get("delay", 0.0)
-    if isinstance(delay, bool) or not isinstance(delay, (int, float)) or not (np.isfinite(delay) and delay >= 0):
-        raise InputError(f"{source}: [pd] delay must be a number of seconds >= 0, got {delay!r}")
-    return PdDriver(tuple(joints), per_joint("kp", None, False), per_joint("kd", None, False), float(delay),
-                    per_joint("torque_limit", limits, True), held_back, known)
+    delay = in_range("pd_delay", table.get("delay", 0.0), f"{source}: [pd] delay")
+    return PdDriver(tuple(joints), per_joint("kp", None), per_joint("kd", None), delay,
+                    per_joint("torque_limit", limits), held_back, known)
