@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Optional
 
@@ -56,7 +57,7 @@ def print_actuators(result: ActuatorIdentification, wide: bool = False) -> None:
     table = Table(*map(escape, ("joint", "armature [g·m²]", "F_c [N·m]", "F_v [N·m·s/rad]", "offset [mrad]",
                                 "held-out / fitted")))
     for j in result.joints:
-        ratio = "–" if not j.held_out_rms == j.held_out_rms else f"{j.held_out_rms / j.rms:.2f}"
+        ratio = f"{j.held_out_rms / j.rms:.2f}" if math.isfinite(j.held_out_rms) and j.rms > 0 else "–"
         table.add_row(j.joint, _cell(j.armature, 1e3, 2), _cell(j.F_c), _cell(j.F_v), _cell(j.offset, 1e3, 1), ratio)
     print_whole(table) if wide else out.print(table)
     reasons = [f"{j.joint}: {p.reason}" for j in result.joints for p in j.parameters().values() if p.reason]

@@ -3,7 +3,6 @@ it goes."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional, cast
 
@@ -13,10 +12,10 @@ from rich.table import Table
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
-from wbfriction.exceptions import OptionError
 from wbfriction.fit.options import FitOptions, ModelChoice, model_choices
 from wbfriction.friction.options import TemperatureLaw
 from wbfriction.pipeline.paths import check_paths
+from wbfriction.quantities import check_options
 
 if TYPE_CHECKING:
     from wbfriction.fit.result import FitResult
@@ -145,8 +144,7 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
 
     check_paths({"PARAMS": params, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
                 {f"-o {o}": o for o in outputs})
-    if not (math.isfinite(physics_dt) and physics_dt > 0):
-        raise OptionError("--physics-dt", physics_dt, "a physics step > 0 [s]")
+    check_options({"--physics-dt": ("physics_dt", physics_dt)})
     with console.status(f"exporting {params.name} to {len(outputs)} file{'s' if len(outputs) > 1 else ''}"):
         result = export_files(robot_of(robot, urdf, config, mjcf), params, outputs,
                               include=[c.strip() for c in include.split(",") if c.strip()], physics_dt=physics_dt)

@@ -12,6 +12,7 @@ import typer
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError
 from wbfriction.pipeline.paths import check_paths
+from wbfriction.quantities import check_options
 from wbfriction.sim.options import FrictionMode, IdealOptions, Integrator, MujocoOptions, SensorNoise, Simulator
 from wbfriction.sim.pd_options import DriverNoise, HungOptions, SetpointKind, SetpointOptions
 from wbfriction.walking.options import GaitOptions
@@ -242,6 +243,11 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
     (--robot go2) hangs with its base fixed, its drivers tracking ramps and chirps."""
     check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors},
                 {"-o": output})
+    check_options({"--duration": ("duration", duration), "--excitation-seed": ("seed", excitation_seed),
+                   "--noise-seed": ("seed", noise_seed), "--encoder-bits": ("encoder_bits", encoder_bits),
+                   "--delay": ("delay_ms", delay), "--substeps": ("substeps", substeps),
+                   "--position-noise": ("position_std", position_noise), "--torque-noise": ("torque_std", torque_noise),
+                   "--velocity-noise": ("velocity_std", velocity_noise)})
     r = robot_of(robot, urdf, config, mjcf)
     if r.point_contacts:
         noise, lag = sensor_noise(sensors, position_noise, encoder_bits, torque_noise, noise_seed, delay)

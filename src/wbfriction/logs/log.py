@@ -233,24 +233,34 @@ def check_time(time: np.ndarray, source: str, max_gap: float = MAX_GAP,
     return split_at_gaps(time, source, max_gap, rel_tol, first_row)
 
 
-def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT_MARGIN, first_row: int = 0) -> None:
-    """Refuse positions beyond the URDF limits by more than ``margin`` (degrees logged as
+def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT_MARGIN, first_row: int = 0,
+                 prefix: str = "q", joints: tuple[str, ...] | None = None) -> None:
+    """Refuse angles beyond the URDF limits by more than ``margin`` [rad] (degrees logged as
     radians, millimetres as metres); joints without finite limits are not checked.
+
+    Args:
+        q: the logged angles (N, len(joints)) [rad], the encoders' offsets included (taken off here).
+        robot: the robot: its limits and encoder offsets.
+        prefix: the columns' prefix (``q``, ``q_des``).
+        joints: the columns' joints, in order (default :attr:`Robot.actuated`).
 
     Raises:
         InputError: naming the column, the row and the limits.
     """
     lower, upper = robot.angle_limits
-    for i, name in enumerate(robot.actuated):
-        lo, hi = lower[i], upper[i]
+    for i, name in enumerate(joints or robot.actuated):
+        k_act = robot.actuated.index(name)
+        offset = robot.encoder_offset.get(name, 0.0)
+        lo, hi = lower[k_act] + offset, upper[k_act] + offset
         if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
             continue
         out = np.flatnonzero((q[:, i] < lo - margin) | (q[:, i] > hi + margin))
         if out.size:
             k = out[0]
-            raise ColumnError(source, f"q.{name}", int(first_row + k),
-                              f"column 'q.{name}' is {q[k, i]:.6g} at row {first_row + k}, beyond its URDF limits "
-                              f"[{lo:.4g}, {hi:.4g}] by more than {margin:g}: wrong units (degrees for radians)?")
+            raise ColumnError(source, f"{prefix}.{name}", int(first_row + k),
+                              f"column '{prefix}.{name}' is {q[k, i]:.6g} at row {first_row + k}, beyond its URDF "
+                              f"limits [{lo:.4g}, {hi:.4g}] by more than {margin:g}: wrong units (degrees for "
+                              "radians)?")
 
 
 def unwrap_positions(q: np.ndarray, robot: Robot, source: str, segments: list[tuple[int, int]],
@@ -308,6 +318,8 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
     time, clock, q = _read_motion(table, robot, source, read, first_row, clock)
     qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
     setpoints = read_setpoints(table, robot, time, q, qd_logged, source, first_row)
+    if setpoints is not None and robot.pd is not None:  # a set-point in degrees drives the joint to its limits
+        check_limits(setpoints.q_des, robot, source, read.limit_margin, first_row, "q_des", robot.pd.joints)
     tau, torque_source = _read_torque(table, robot, source, first_row, time, q, setpoints)
     q = q - robot.offset_vector if robot.encoder_offset else q  # the model's angles (wbfriction.model.pd)
     wrench = _read_wrench(table, robot, source, first_row)

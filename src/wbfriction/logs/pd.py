@@ -30,6 +30,7 @@ from wbfriction.exceptions import ColumnError
 from wbfriction.logs.tables import numeric_columns
 from wbfriction.model.pd import PdDriver, pd_torque
 from wbfriction.model.robot import Robot
+from wbfriction.quantities import RANGES, first_outside
 
 PD_PREFIXES = ("q_des", "qd_des", "tau_ff", "kp", "kd", "tau_est")
 """The column prefixes of a PD-driven robot's log (module docstring)."""
@@ -109,8 +110,22 @@ def read_setpoints(table: pa.Table, robot: Robot, time: np.ndarray, q_logged: np
         qd = np.gradient(q_logged[:, index], time, axis=0)
     q_des = group("q_des", True)
     assert q_des is not None
-    return PdSetpoints(q_des, qd, group("qd_des", False), group("tau_ff", False),
-                       group("kp", False), group("kd", False))
+    gains = {prefix: group(prefix, False) for prefix in ("kp", "kd")}
+    for prefix, values in gains.items():
+        if values is not None:
+            _check_gains(prefix, values, joints, source, first_row)
+    return PdSetpoints(q_des, qd, group("qd_des", False), group("tau_ff", False), gains["kp"], gains["kd"])
+
+
+def _check_gains(prefix: str, values: np.ndarray, joints: tuple[str, ...], source: str, first_row: int) -> None:
+    """Refuse a logged gain outside its physical range (:data:`~wbfriction.quantities.RANGES`: a negative gain
+    pushes the joint away from its set-point), naming the column and row."""
+    bad = first_outside(prefix, values)
+    if bad is not None:
+        row, k = divmod(bad, len(joints))
+        rng, col = RANGES[prefix], f"{prefix}.{joints[k]}"
+        raise ColumnError(source, col, first_row + row, f"column '{col}' at row {first_row + row}: "
+                          f"{values[row, k]:g} {rng.unit} is outside {rng.span()}: {rng.why}")
 
 
 def driver_estimate(table: pa.Table, robot: Robot, source: str, first_row: int) -> np.ndarray | None:

@@ -29,7 +29,7 @@ from wbfriction.model.labels import parse_labels
 from wbfriction.model.pd import parse_pd
 from wbfriction.model.robot import CONTACT_DIMS, ContactKind, ModelFormat, Robot
 from wbfriction.model.robots import BUILTIN_ROBOTS
-from wbfriction.ranges import in_range
+from wbfriction.quantities import in_range
 
 _ERD_PREFIX = "example-robot-data:"
 _GENERATED = "wbfriction:"  # a URDF this package generates: "wbfriction:<name>" (robots/<name>.py)
@@ -196,7 +196,7 @@ def _root_frame(model: pin.Model) -> str:
 
 def _joint_values(config: dict, key: str, actuated: list[str], source: str, quantity: str) -> dict[str, float]:
     """A ``[key]`` table of joint name -> number, each in the physical range of ``quantity``
-    (:data:`~wbfriction.ranges.RANGES`), checked against the model's joints."""
+    (:data:`~wbfriction.quantities.RANGES`), checked against the model's joints."""
     table = config.get(key, {})
     if not isinstance(table, dict):
         raise InputError(f"{source}: '[{key}]' must be a table of joint = number")
@@ -371,7 +371,7 @@ def _contact_kinds(value, frames: list[str], floating: bool, source: str) -> tup
 
 
 def _foot_radius(value, source: str) -> float:
-    """``foot_radius`` [m], in its physical range (:data:`~wbfriction.ranges.RANGES`)."""
+    """``foot_radius`` [m], in its physical range (:data:`~wbfriction.quantities.RANGES`)."""
     return in_range("foot_radius", value, f"{source}: foot_radius")
 
 
@@ -379,7 +379,13 @@ def _groups(config: dict, actuated: list[str], source: str) -> dict[str, tuple[s
     """The configured joint groups: group name -> joints."""
     known = set(actuated)
     groups = {}
-    for gname, joints in dict(config.get("groups", {})).items():
+    table = config.get("groups", {})
+    if not isinstance(table, dict):
+        raise InputError(f"{source}: '[groups]' must be a table of group = [joint names]")
+    for gname, joints in table.items():
+        if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
+            raise InputError(f"{source}: [groups] {gname} must be a list of joint names (e.g. {gname} = "
+                             f"[\"{actuated[0]}\"]), got {joints!r}")
         _check_names(joints, known, f"joint in group '{gname}'", source)
         groups[gname] = tuple(joints)
     return groups

@@ -180,10 +180,10 @@ def parse_pd(table: object, actuated: list[str], groups: dict[str, tuple[str, ..
 
     Raises:
         InputError: a ``[pd]`` that is not a table, an unknown key, joint or group, a gain missing for a joint, a
-            value outside its physical range (:data:`~wbfriction.ranges.RANGES`), naming the file and the key.
+            value outside its physical range (:data:`~wbfriction.quantities.RANGES`), naming the file and the key.
     """
     from wbfriction.exceptions import InputError
-    from wbfriction.ranges import in_range
+    from wbfriction.quantities import in_range
 
     if table is None:
         return None

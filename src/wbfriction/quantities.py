@@ -20,7 +20,7 @@ import numpy as np
 
 from wbfriction.exceptions import InputError
 
-__all__ = ["Range", "RANGES", "in_range", "first_outside"]
+__all__ = ["Range", "RANGES", "in_range", "check_options", "first_outside"]
 
 
 @dataclass(frozen=True)
@@ -51,7 +51,8 @@ class Range:
     def span(self) -> str:
         """The range as read: ``[0, 100] kg·m²``, ``(0, 3600] s``."""
         unit = f" {self.unit}" if self.unit else ""
-        return f"{'(' if self.low_open else '['}{self.low:g}, {self.high:g}]{unit}"
+        low, high = (f"{int(x)}" if self.integer else f"{x:g}" for x in (self.low, self.high))
+        return f"{'(' if self.low_open else '['}{low}, {high}]{unit}"
 
 
 RANGES: Mapping[str, Range] = MappingProxyType({
@@ -74,6 +75,10 @@ RANGES: Mapping[str, Range] = MappingProxyType({
     "duration": Range(0.0, 3600.0, "s", "a simulated log of at most an hour (simulate longer logs in pieces)",
                       low_open=True),
     "seed": Range(0, 2**32 - 1, "", "a random generator's seed: a whole number >= 0", integer=True),
+    "position_std": Range(0.0, 0.1, "rad", "an encoder's noise: far below a tenth of a radian"),
+    "torque_std": Range(0.0, 100.0, "N·m", "a torque sensor's noise"),
+    "velocity_std": Range(0.0, 10.0, "rad/s", "a driver's velocity noise"),
+    "substeps": Range(1, 1000, "", "physics steps per control period", integer=True),
 })
 """Each quantity's :class:`Range`, by the name :func:`in_range` takes."""
 
@@ -96,6 +101,18 @@ def in_range(quantity: str, value: object, where: str) -> float:
     if not rng.holds(float(value)):
         raise InputError(f"{where}: {value:g}{' ' + rng.unit if rng.unit else ''} is outside {rng.span()}: {rng.why}")
     return float(value)
+
+
+def check_options(options: Mapping[str, tuple[str, object]]) -> None:
+    """Refuse, before any work, an option outside its range (:func:`in_range`): ``options`` maps each option's
+    name (``"--duration"``) to its quantity and the value given (None: not given, not checked).
+
+    Raises:
+        InputError: naming the first option at fault.
+    """
+    for option, (quantity, value) in options.items():
+        if value is not None:
+            in_range(quantity, value, option)
 
 
 def first_outside(quantity: str, values: np.ndarray) -> int | None:
