@@ -18,9 +18,9 @@ from types import MappingProxyType
 
 import numpy as np
 
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import InputError, OptionError
 
-__all__ = ["Range", "RANGES", "in_range", "check_options", "first_outside"]
+__all__ = ["Range", "RANGES", "in_range", "check_option", "check_options", "first_outside"]
 
 
 @dataclass(frozen=True)
@@ -103,16 +103,31 @@ def in_range(quantity: str, value: object, where: str) -> float:
     return float(value)
 
 
+def check_option(option: str, quantity: str, value: object) -> None:
+    """Refuse an option's value outside :data:`RANGES` ``[quantity]`` (``option`` as the command line spells it,
+    ``--duration``; None: not given, not checked).
+
+    Raises:
+        OptionError: naming the option, the range and why.
+    """
+    if value is None:
+        return
+    rng = RANGES[quantity]
+    number = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    if not (number and rng.holds(float(value))):  # type: ignore[arg-type]  # a finite number: checked
+        raise OptionError(option, value, f"{'a whole number' if rng.integer else 'a number'} in {rng.span()} "
+                          f"({rng.why})")
+
+
 def check_options(options: Mapping[str, tuple[str, object]]) -> None:
-    """Refuse, before any work, an option outside its range (:func:`in_range`): ``options`` maps each option's
+    """Refuse, before any work, an option outside its range (:func:`check_option`): ``options`` maps each option's
     name (``"--duration"``) to its quantity and the value given (None: not given, not checked).
 
     Raises:
-        InputError: naming the first option at fault.
+        OptionError: naming the first option at fault.
     """
     for option, (quantity, value) in options.items():
-        if value is not None:
-            in_range(quantity, value, option)
+        check_option(option, quantity, value)
 
 
 def first_outside(quantity: str, values: np.ndarray) -> int | None:

@@ -45,7 +45,7 @@ def test_an_output_folder_that_cannot_be_made_is_refused_before_the_work(tmp_pat
             began = time.perf_counter()
             code, err = run_cli(capsys, command, "-o", folder)
             assert code == 2 and needle in err and len(err.strip().splitlines()) == 1, err
-            assert time.perf_counter() - began < 2.0
+            assert time.perf_counter() - began < 10.0  # the study takes minutes
     finally:
         locked.chmod(0o755)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file", "locked"] and not any(locked.iterdir())

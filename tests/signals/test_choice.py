@@ -144,6 +144,22 @@ def test_impacts_are_not_position_noise():
     assert acceleration_content(q, DT).position_noise == pytest.approx(np.full(3, 1e-7), rel=0.1)
 
 
+def test_contact_flags_that_flicker_measure_no_noise_and_say_nothing():
+    """Issue 65, class 5: flags that change every few samples leave no frame to measure the noise in; the median of
+    no frame printed numpy's 'Mean of empty slice' on the terminal. It is NaN, said by the caller, and silent."""
+    import warnings
+
+    from wbfriction.signals.choice import white_position_noise
+
+    q = sines(8.0, 1e-5)
+    acc = np.diff(q, 2, axis=0) / DT**2
+    changes = np.zeros(len(q) + 2, dtype=bool)
+    changes[::3] = True
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert np.all(np.isnan(white_position_noise(acc, DT, changes=changes)))
+
+
 def test_noise_free_fast_log_keeps_central_differences():
     choice = choose_differentiation(sines(20.0, sigma=0.0), DT)
     assert choice.scheme == "central"

@@ -8,6 +8,7 @@ import numbers
 from dataclasses import dataclass
 
 from wbfriction.exceptions import OptionError
+from wbfriction.quantities import check_option
 
 WINDOW = 0.04
 """Default window [s] the momentum balance is summed over (module :mod:`wbfriction.actuator.rows`): long enough
@@ -75,16 +76,14 @@ class ActuatorOptions:
 
     def __post_init__(self) -> None:
         checks = (("--window", self.window, self.window > 0, "a window > 0 [s]"),
-                  ("--max-delay", self.max_delay, self.max_delay >= 0, "a delay >= 0 [s]"),
                   ("--offset-bound", self.offset_bound, self.offset_bound >= 0, "a bound >= 0 [rad] (0: none fitted)"),
                   ("--tanh-slope", self.tanh_slope, self.tanh_slope > 0, "a slope > 0 [s/rad]"),
                   ("--holdout", self.holdout, 0 <= self.holdout < 0.5, "a share in [0, 0.5)"))
         for option, value, ok, expected in checks:
             if not (isinstance(value, numbers.Real) and math.isfinite(value) and ok):
                 raise OptionError(option, value, expected)
-        if self.delay is not None and not (isinstance(self.delay, numbers.Real) and math.isfinite(self.delay)
-                                           and self.delay >= 0):
-            raise OptionError("--delay", self.delay, "a delay >= 0 [s]")
+        check_option("--delay", "pd_delay", self.delay)
+        check_option("--max-delay", "pd_delay", self.max_delay)
         if self.delayed not in ("auto", "setpoints", "torque"):
             raise OptionError("--delayed", self.delayed, "one of auto, setpoints, torque")
         if self.velocity not in VELOCITIES:

@@ -85,12 +85,13 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     if result.route:
         console.print(f"route: {escape(result.route)}", highlight=False, soft_wrap=True)
     torque = result.metadata.get("torque_source", {})
-    if torque.get("source") not in (None, "sensor"):
+    if torque.get("source") not in (None, "sensor") or "setpoints" in torque:
         held = "the whole torque" if torque.get("delayed") == "torque" else "the set-points"
         delay = f", {held} {1e3 * torque['delay']:.3g} ms late ({torque['gains']})" if "delay" in torque else ""
         if torque.get("delayed_known") is False:
             delay += "; the log it was identified on does not tell what the delay holds back: F_v known to kp delay"
-        console.print(escape(f"torque: {torque['what']}{delay}"), highlight=False, soft_wrap=True)
+        unused = "; the set-points q_des.<joint> not used (the measured torque is)" if "setpoints" in torque else ""
+        console.print(escape(f"torque: {torque['what']}{delay}{unused}"), highlight=False, soft_wrap=True)
         if torque.get("source") == "pd" and bag_map is None:
             from wbfriction.pipeline.actuator_step import pd_law_warnings
 

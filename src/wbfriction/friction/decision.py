@@ -96,7 +96,7 @@ def decide_log(robot: Robot, options: EstimateOptions, positions: np.ndarray | N
     """
     given = options
     options, choice = resolve_differentiation(options, positions, dt, changes)
-    options, route = resolve_route(options, positions, dt, choice, rows=route_rows)
+    options, route = resolve_route(options, positions, dt, choice, rows=route_rows, asked=given.filtering)
     check_windows(given, options, segments, rows, dt, source)
     if positions is None:
         return LogDecision(options, choice, route, None)

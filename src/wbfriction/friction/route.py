@@ -136,7 +136,7 @@ def choose_route(options: EstimateOptions, sigma: float, dt: float, n_samples: i
 
 
 def resolve_route(options: EstimateOptions, source: Log | np.ndarray | None, dt: float | None = None,
-                  choice: DiffChoice | None = None, *, rows: int | None = None
+                  choice: DiffChoice | None = None, *, rows: int | None = None, asked: FilterOptions | None = None
                   ) -> tuple[EstimateOptions, RouteDecision | None]:
     """``options`` with ``route = "auto"`` and the momentum windows left to the data replaced (module docstring),
     and the decision; options whose route and windows are all given come back as they are, with None.
@@ -147,6 +147,8 @@ def resolve_route(options: EstimateOptions, source: Log | np.ndarray | None, dt:
         choice: the differentiation choice made for the same log, whose noise measurement is reused.
         rows: the samples the windows are bounded by (:func:`choose_route`'s ``n_samples``); default a log's rows,
             an array's length (0 for None).
+        asked: the acceleration route's filter as the user gave it, before a differentiation choice filled it in
+            (default ``options.filtering``): what the momentum route says it does not use.
 
     Raises:
         InputError: positions given as an array without ``dt``.
@@ -165,8 +167,9 @@ def resolve_route(options: EstimateOptions, source: Log | np.ndarray | None, dt:
         n = 0
     n = n if rows is None else rows
     decision = choose_route(options, _position_noise(source, dt or 1.0, choice), dt or 1.0, max(n, 1))
-    unused = [f"{flag(f.name)} {getattr(options.filtering, f.name)}" for f in fields(FilterOptions)
-              if getattr(options.filtering, f.name) != f.default]
+    asked = options.filtering if asked is None else asked
+    unused = [f"{flag(f.name)} {getattr(asked, f.name)}" for f in fields(FilterOptions)
+              if getattr(asked, f.name) != f.default]
     if decision.route == "momentum" and unused:  # the filter given is the acceleration route's: said, not dropped
         decision = replace(decision, reason=f"{decision.reason}; {', '.join(unused)} not used (the acceleration "
                            "route's filter; --route acceleration keeps it)")

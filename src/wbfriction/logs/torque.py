@@ -24,8 +24,11 @@ def torque_record(robot: Robot, source: TorqueSource, setpoints: PdSetpoints | N
     :mod:`wbfriction.model.pd`) and where its gains come from; where the log ``identify`` found the delay on did not
     tell what it holds back (:attr:`~wbfriction.model.pd.PdDriver.delayed_known` false), ``delayed_known`` false
     and per joint the viscous coefficient the two differ by (``viscous_equivalent`` [N·m·s/rad], ``kp delay``),
-    which the friction's F_v carries (:func:`~wbfriction.fit.joints.fit_estimate`)."""
+    which the friction's F_v carries (:func:`~wbfriction.fit.joints.fit_estimate`); a log of measured torques that
+    also holds set-points, ``setpoints`` "not used" (the measured torque is taken, the PD law is not)."""
     record: dict[str, object] = {"source": source, "what": TORQUE_SOURCES[source]}
+    if source != "pd" and setpoints is not None:
+        record |= {"setpoints": "not used"}
     if source == "pd" and robot.pd is not None and setpoints is not None:
         logged = setpoints.kp is not None or setpoints.kd is not None
         record |= {"delay": robot.pd.delay, "delayed": robot.pd.delayed,

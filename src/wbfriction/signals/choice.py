@@ -124,7 +124,8 @@ def white_position_noise(acc: np.ndarray, dt: float, frame: int = FRAME, changes
     differences that straddle one (a touch-down's velocity step) are left out of their frames (zeroed, each frame's
     power scaled back by its taper's share kept). A trot's feet switch every 0.25 s, so that every frame of a
     500 Hz log held an impact and the median over frames measured the impacts (8e-5 rad on the ideal trot, against
-    the 3.5e-6 rad of its 19-bit encoders; 3.8e-6 with them left out)."""
+    the 3.5e-6 rad of its 19-bit encoders; 3.8e-6 with them left out). Where every frame straddles changes (flags
+    that flicker), nothing is measured: NaN."""
     acc = np.asarray(acc, dtype=float)
     length = min(frame, len(acc) - len(acc) % 2)
     taper = periodic_hann(length)
@@ -142,6 +143,8 @@ def white_position_noise(acc: np.ndarray, dt: float, frame: int = FRAME, changes
     per_frame = np.median((amp[upper] / gain[upper, None, None]) ** 2, axis=0) / math.log(2.0)  # (M, n)
     if changes is not None:  # a frame mostly left out measures little
         counted = share > 0.5 if np.any(share > 0.5) else share > 0
+        if not np.any(counted):  # every frame straddles contact changes (flags that flicker): nothing measured
+            return np.full(acc.shape[1], np.nan)
         per_frame = per_frame[counted] / share[counted, None]
     # E amp^2 of white noise through a Hann taper: 4 sigma^2 |G|^2 sum(w^2) / L^2, sum(w^2) = 3 L / 8
     return np.sqrt(np.median(per_frame, axis=0) * length / 1.5)
