@@ -258,6 +258,10 @@ def test_a_joint_not_fitted_says_so(walk_friction, tmp_path, capsys):
     assert code == 0
     entry = json.loads((tmp_path / "p.json").read_text())["joints"][joint]
     assert entry["fitted"] is False and entry["params"] is None and not entry["success"]
+    # issue 65, class 5: a leg joint without a valid sample on a humanoid is its stance leg's under --mask swing,
+    # however far it moved: said so, not "only 0 valid samples"
+    assert entry["message"].startswith("no valid sample: the estimate's --mask swing counts a joint only while its "
+                                       "leg swings"), entry["message"]
 
 
 # ----------------------------------------------------------------- 7. wrong pairing

@@ -150,6 +150,17 @@ def stick_margin(est: FrictionEstimate) -> int:
     return margin
 
 
+def no_sample_reason(est: FrictionEstimate) -> str:
+    """Why a joint of ``est`` has no valid sample, in the estimate's terms: a humanoid's ``--mask swing`` counts a
+    joint only while its leg swings (a leg that stood throughout has none, however far it moved)."""
+    options = est.metadata.get("estimate_options", {})
+    legs = est.contact is not None and est.contact.shape[1] == 2 and bool(np.any(est.phase == "single"))
+    if legs and isinstance(options, dict) and options.get("mask") == "swing":
+        return ("no valid sample: the estimate's --mask swing counts a joint only while its leg swings (estimate with "
+                "--mask single to count its stance too)")
+    return "no valid sample in the friction table"
+
+
 def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, workers: int = 1,
                  joints: Sequence[str] | None = None, fixed: dict[str, float] | None = None,
                  targets: Mapping[str, ModelParams] | None = None,
@@ -203,7 +214,9 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
     fits = _with_truth(names, [fit for fit, _ in pairs], est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], truth,
                        targets)
     checked = [other for _, other in pairs]
-    for f, other in zip(fits, checked):
+    for f, other, k in zip(fits, checked, idx):
+        if f.params is None and not est.valid[:, k].any():
+            f.message = no_sample_reason(est)
         f.route = est.estimation_route
         f.unmeasured = str(est.metadata.get("noise_unmeasured", ""))  # never ok then (issue 53)
         if check is not None and other is not None:
