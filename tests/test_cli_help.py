@@ -55,3 +55,17 @@ def test_wbfriction_alone_prints_its_overview_and_succeeds():
 def test_version():
     result = typer.testing.CliRunner().invoke(app, ["--version"])
     assert result.exit_code == 0 and result.output.strip() == f"wbfriction {version('wbfriction')}"
+
+
+ISSUE = re.compile(r"\bissues?\s*#?\s*\d+|#\d+", re.IGNORECASE)
+
+
+@pytest.mark.parametrize("name", [None, *COMMANDS])
+def test_no_help_names_an_issue_number(name):
+    """No help names one of the project's issues ("(issue 23)"): a person reading it has no tracker to look them up
+    in. Checked on the help as shown (the overview's one-line summaries too) and on the texts it is made of, so that
+    neither a line's wrap nor markup hides one."""
+    command = GROUP if name is None else GROUP.commands[name]  # type: ignore[attr-defined]
+    texts = [command.help or "", command.short_help or ""] + [getattr(p, "help", None) or "" for p in command.params]
+    shown = _help(*([] if name is None else [name]))
+    assert [m.group(0) for text in (*texts, shown) for m in ISSUE.finditer(" ".join(text.split()))] == []

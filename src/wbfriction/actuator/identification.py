@@ -47,6 +47,7 @@ from wbfriction.actuator.law_check import LawCheck, check_law
 from wbfriction.actuator.options import ActuatorOptions
 from wbfriction.actuator.rows import BalanceRows, balance_rows, pd_joints
 from wbfriction.actuator.solve import KINDS, DelaySearch, Design, Solution, design, hac_lags, search_delay, solve
+from wbfriction.exceptions import InputError
 from wbfriction.fit.regression import held_out_gain
 from wbfriction.fit.selection import GAIN_Z
 from wbfriction.fit.status import WEAK
@@ -211,9 +212,12 @@ def identify_actuators(robot: Robot, log: Log, options: ActuatorOptions = Actuat
 
     Raises:
         InputError: a robot or log the identification cannot take (:func:`~wbfriction.actuator.rows.pd_joints`),
-            a log too short.
+            a log too short, ``velocity="logged"`` on a log without the drivers' velocities.
     """
     pd_joints(robot, log)
+    if options.velocity == "logged" and log.qd_logged is None:  # else the positions' would be taken in its name
+        raise InputError(f"{log.source}: --velocity logged needs the drivers' velocities, the columns qd.<joint> "
+                         "(none in this log): give --velocity positions or auto")
     assert robot.pd is not None
     velocities = [options.velocity] if options.velocity != "auto" else (
         ["positions", "logged"] if log.qd_logged is not None else ["positions"])

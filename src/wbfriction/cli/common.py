@@ -1,11 +1,12 @@
 """The command line's shared parts: the app, its two consoles (messages on standard error, one line each;
 results on standard output, as wide as the terminal), the options several commands take with the library's
-defaults, the robot from --robot/--urdf/--config/--mjcf, the progress bar and the entry point :func:`main`."""
+defaults, the robot from --robot/--urdf/--config/--mjcf, the refusal of the options a command's mode does not read
+(:func:`refuse_options`), the progress bar and the entry point :func:`main`."""
 
 from __future__ import annotations
 
 import sys
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional, cast
@@ -155,6 +156,47 @@ def joint_list(r: Robot, joints: Optional[str]) -> list[str]:
         bad = unknown[0] if unknown else joints
         raise InputError(f"--joints: '{bad}' is not a torque-controlled joint of {r.name}")
     return names
+
+
+GIVEN = ("COMMANDLINE", "ENVIRONMENT")
+"""Where an option's value comes from when the user gave it (click's ``ParameterSource``, named so that typer's own
+copy of click answers the same): not its default, whatever the default is."""
+
+
+def given_options(ctx: typer.Context) -> list[str]:
+    """The names of the parameters the command line (or the environment) gave the command, in its order."""
+    return [p.name for p in ctx.command.params
+            if p.name is not None and getattr(ctx.get_parameter_source(p.name), "name", None) in GIVEN]
+
+
+def option_flag(param) -> str:
+    """An option as the command line spells it, every spelling: ``--gait``, ``-o/--output``,
+    ``--log-base/--no-log-base``."""
+    return "/".join([*param.opts, *getattr(param, "secondary_opts", ())])
+
+
+def refuse_options(ctx: typer.Context, mode: str, takes: Collection[str], shared: Collection[str] = ()) -> None:
+    """Refuse, before any work, the first option the user gave (:func:`given_options`) that the way the command
+    runs does not read: an option of another mode, which would be dropped without a word.
+
+    Args:
+        ctx: the command's context.
+        mode: the way it runs, as the message says it, e.g. ``robot 'go2' is a hung PD-driven robot (fixed base,
+            [pd])``.
+        takes: the names of the parameters that mode reads (the command's, e.g. ``excitation_seed``), listed in the
+            message in the command's order.
+        shared: those every mode of the command reads that name what runs (the robot, the log, the mode): not
+            listed.
+
+    Raises:
+        InputError: ``--gait: robot 'go2' is ...: it takes --duration, ...; not --gait``.
+    """
+    params = {p.name: p for p in ctx.command.params}
+    for name in given_options(ctx):
+        if name not in takes and name not in shared:
+            flag = option_flag(params[name])
+            listed = ", ".join(option_flag(p) for n, p in params.items() if n in takes)
+            raise InputError(f"{flag}: {mode}: it takes {listed}; not {flag}")
 
 
 ESTIMATE = EstimateOptions()  # one source of defaults: the library's

@@ -41,12 +41,38 @@ from wbfriction.cli.common import (
     console,
     out,
     print_whole,
+    refuse_options,
     robot_of,
     warn_energy,
 )
 
 Actuator = Literal["none", "pd"]
 ACTUATOR = ActuatorOptions()
+OutputOpt = typer.Option(None, "-o", "--output", help="Corrected URDF to write (the given one's structure, identified "
+                                                      "inertias); not with --actuator pd.")
+JsonOpt = typer.Option(None, "--json", help="Also write every figure as JSON (for 'wbfriction report "
+                                            "--identification').")
+StribeckOpt = typer.Option("auto", help="v_s of the Stribeck term [rad/s]: auto (from the acceleration route, refined "
+                                        "each pass), a number, or none.")
+StrideOpt = typer.Option(INERTIAL.stride, min=1, help="Every stride-th single-support sample is used.")
+PriorOpt = typer.Option(INERTIAL.prior, min=0.0, help="Weight of the prior toward the given model, in units of the "
+                                                      "residual variance; default: chosen by validation from 1e4 down "
+                                                      "to 1.")
+ArmatureOpt = typer.Option(INERTIAL.armature, help="Rotor inertia: known (the TOML's [armature]), identify (one per "
+                                                   "joint, with the friction; for motor-current torques) or none "
+                                                   "(link-side torque sensors).")
+LinkMarginOpt = typer.Option(INERTIAL.link_margin, help="Share of each given body's pseudo-inertia an identified body "
+                                                        "keeps (mass and second moments), in [0, 1); 0: any physical "
+                                                        "body.")
+PriorToleranceOpt = typer.Option(INERTIAL.prior_tolerance, help="With the prior's weight chosen by validation: the "
+                                                                "strongest weight within this share of the best "
+                                                                "score.")
+TanhSlopeOpt = typer.Option(INERTIAL.tanh_slope, min=1e-12, help="a of the Coulomb term tanh(a qd) [s/rad].")
+ConfigOutputOpt = typer.Option(None, "--config-output", help="Also write the robot's configuration (TOML) for the "
+                                                             "identified model: its urdf the corrected URDF, its "
+                                                             "[armature] the identified one (--armature identify), "
+                                                             "the rest as given; then 'wbfriction estimate LOG "
+                                                             "--config THIS'.")
 HoldoutOpt = typer.Option(INERTIAL.holdout, help="Share of the log, at its end, kept out to compare torque predictions "
                                                  "(between 0 and 1; below 0.5 with --actuator pd).")
 ActuatorOpt = typer.Option("none", help="pd: a hung PD-driven robot's actuators instead (armature, friction, encoder "
@@ -62,56 +88,45 @@ DelayedOpt = typer.Option(ACTUATOR.delayed, help="--actuator pd: what the driver
 VelocityOpt = typer.Option(ACTUATOR.velocity, help="--actuator pd: the dynamics' velocity: auto, positions "
                                                    "(differentiated once) or logged (the drivers' qd).")
 
+SHARED = ("log", "robot", "urdf", "config", "mjcf", "actuator")
+"""The options both modes of ``identify`` read that name what is identified: the log, the robot, the mode."""
+BOTH = ("json_output", "config_output", "time_unit", "wide", "holdout")
+MODES: dict[Actuator, tuple[str, tuple[str, ...]]] = {
+    "none": ("identify without --actuator pd identifies the inertia model and the friction (the URDF written)",
+             ("output", "stribeck_velocity", "passes", "stride", "prior", "armature", "link_margin",
+              "prior_tolerance", "noise_target", "tanh_slope", "diff", "mask", "route", "base_motion", "workers",
+              *BOTH)),
+    "pd": ("--actuator pd identifies a hung PD-driven robot's actuators (the URDF kept)",
+           ("max_delay", "delay", "window", "offset_bound", "velocity", "delayed", *BOTH)),
+}
+"""Each ``--actuator``: what it does, as a refusal says it, and the options (:func:`identify`'s parameters) it reads
+beyond :data:`SHARED`: the inertia model's identification's (:func:`~wbfriction.pipeline.identify_step.identify_file`)
+or the PD-driven actuators' (:func:`~wbfriction.cli.actuator.identify_pd`); any other given on the command line is
+refused before the work (:func:`~wbfriction.cli.common.refuse_options`)."""
+
 
 @app.command()
-def identify(log: Path = LogArg,
-             output: Optional[Path] = typer.Option(None, "-o", "--output", help="Corrected URDF to write (the given "
-                                                   "one's structure, identified inertias); not with --actuator pd."),
-             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
-             mjcf: Optional[Path] = MjcfOpt,
-             json_output: Optional[Path] = typer.Option(None, "--json", help="Also write every figure as "
-                                                                             "JSON (for 'wbfriction report "
-                                                                             "--identification')."),
-             stribeck_velocity: str = typer.Option("auto", help="v_s of the Stribeck term [rad/s]: auto (from the "
-                                                                "acceleration route, refined each pass), a number, "
-                                                                "or none."),
+def identify(ctx: typer.Context, log: Path = LogArg, output: Optional[Path] = OutputOpt, robot: str = RobotOpt,
+             urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt, mjcf: Optional[Path] = MjcfOpt,
+             json_output: Optional[Path] = JsonOpt, stribeck_velocity: str = StribeckOpt,
              passes: int = typer.Option(2, min=1, help="Identifications with --stribeck-velocity auto."),
-             holdout: float = HoldoutOpt,
-             stride: int = typer.Option(INERTIAL.stride, min=1, help="Every stride-th single-support sample is used."),
-             prior: Optional[float] = typer.Option(INERTIAL.prior, min=0.0, help="Weight of the prior toward the given "
-                                                                          "model, in units of the residual variance; "
-                                                                          "default: chosen by validation from 1e4 "
-                                                                          "down to 1."),
-             armature: ArmatureMode = typer.Option(INERTIAL.armature,
-                                                   help="Rotor inertia: known (the TOML's [armature]), "
-                                                        "identify (one per joint, with the friction; for "
-                                                        "motor-current torques) or none (link-side "
-                                                        "torque sensors)."),
-             link_margin: float = typer.Option(INERTIAL.link_margin, help="Share of each given body's "
-                                                    "pseudo-inertia an identified body keeps (mass and second "
-                                                    "moments), in [0, 1); 0: any physical body."),
-             prior_tolerance: float = typer.Option(INERTIAL.prior_tolerance,
-                                                   help="With the prior's weight chosen by validation: the strongest "
-                                                        "weight within this share of the best score."),
-             noise_target: float = NoiseTargetOpt,
-             tanh_slope: float = typer.Option(INERTIAL.tanh_slope, min=1e-12,
-                                              help="a of the Coulomb term tanh(a qd) [s/rad]."),
+             holdout: float = HoldoutOpt, stride: int = StrideOpt, prior: Optional[float] = PriorOpt,
+             armature: ArmatureMode = ArmatureOpt, link_margin: float = LinkMarginOpt,
+             prior_tolerance: float = PriorToleranceOpt, noise_target: float = NoiseTargetOpt,
+             tanh_slope: float = TanhSlopeOpt,
              diff: DiffOption = typer.Option("auto", help="Differentiation scheme (see 'estimate')."),
              mask: Mask = typer.Option(ESTIMATE.mask, help="swing or single (see 'estimate')."),
              route: RouteOption = RouteOpt, base_motion: BaseMotion = BaseMotionOpt,
              workers: int = FitWorkersOpt, time_unit: Optional[TimeUnit] = TimeUnitOpt,
-             config_output: Optional[Path] = typer.Option(
-                 None, "--config-output", help="Also write the robot's configuration (TOML) for the identified "
-                                              "model: its urdf the corrected URDF, its [armature] the identified "
-                                              "one (--armature identify), the rest as given; then 'wbfriction "
-                                              "estimate LOG --config THIS'."),
-             wide: bool = WideOpt,
+             config_output: Optional[Path] = ConfigOutputOpt, wide: bool = WideOpt,
              actuator: Actuator = ActuatorOpt, max_delay: float = MaxDelayOpt, delay: Optional[float] = DelayOpt,
              window: float = WindowOpt, offset_bound: float = OffsetBoundOpt, velocity: str = VelocityOpt,
              delayed: str = DelayedOpt) -> None:
     """Identify the inertia model and the friction together from the joint torques of single support (thesis
     2.4, ch. 8), write the corrected URDF: then 'wbfriction estimate LOG --urdf IDENTIFIED.urdf'. With --actuator
-    pd: a hung PD-driven robot's actuators (armature, friction, encoder offsets, delay) instead."""
+    pd: a hung PD-driven robot's actuators (armature, friction, encoder offsets, delay) instead; the options of the
+    other kind are refused."""
+    refuse_options(ctx, *MODES[actuator], SHARED)
     if actuator == "pd":
         from wbfriction.cli.actuator import identify_pd
 

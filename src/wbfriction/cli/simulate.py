@@ -32,6 +32,7 @@ from wbfriction.cli.common import (
     app,
     console,
     progress_bar,
+    refuse_options,
     robot_of,
 )
 
@@ -110,7 +111,7 @@ def _run_simulate_hung(r: Robot, output: Path, options: HungOptions, friction: O
 
 def _run_simulate_quadruped(r: Robot, output: Path, gait: str, duration: Optional[float], speed: Optional[float],
                             seed: int, simulator: Simulator, options: dict, friction: Optional[Path]) -> None:
-    """A walking quadruped (a robot on point feet, issue 56): its gait planned
+    """A walking quadruped (a robot on point feet): its gait planned
     (:func:`~wbfriction.walking.quadruped.quadruped_reference`), simulated in the ideal simulator
     (:func:`~wbfriction.sim.quadruped.simulate_quadruped`) or on MuJoCo
     (:func:`~wbfriction.sim.quadruped_mujoco.simulate_quadruped_mujoco`), the log written; ``options``: the
@@ -148,32 +149,53 @@ def _run_simulate_quadruped(r: Robot, output: Path, gait: str, duration: Optiona
                       f"{normal.min():.1f} N)", highlight=False)
 
 
+OutputOpt = typer.Option(..., "-o", "--output", help="Log to write: .parquet, .csv or .h5.")
 FrictionOpt = typer.Option(None, help="TOML with [friction.<group or joint>] tables (a model key: coulomb-viscous, "
                                       "stribeck or (3.5)), each with an optional terms table (F_L, dF_v, ripple, "
                                       "F_cT, F_vT, reference_temperature), and a [temperature] warm-up (start, end "
                                       "[°C]) logged as temperature.<joint>; default: thesis Table 6.1 on the legs, "
                                       "Coulomb-viscous on every joint of a PD-driven robot.")
-SimulatorOpt = typer.Option("ideal", help="ideal (rigid contacts, thesis 6.1) or mujoco (soft contacts, measured "
-                                          "contact flags, sensors, thesis 6.2).")
+GaitOpt = typer.Option(None, help="A walk: forward (default), sideways, turning, both (forward + sideways) or "
+                                  "combined (all three); a robot on point feet: stand, step (a trot in place), trot "
+                                  "(default) or walk (a crawl).")
+StepsOpt = typer.Option(GAIT.steps, help="A walk: number of steps (per direction for both/combined).")
+StepLengthOpt = typer.Option(GAIT.step_length, help="A walk: forward distance between footprints [m].")
+StepWidthOpt = typer.Option(GAIT.step_width, help="A walk: sideways step [m].")
+TurnAngleOpt = typer.Option(GAIT.turn_angle, help="A walk: heading change per turning step [rad].")
+LiftHeightOpt = typer.Option(GAIT.lift_height, help="A walk: swing-foot apex [m].")
+SimulatorOpt = typer.Option("ideal", help="A walk or a robot on point feet: ideal (rigid contacts, thesis 6.1) or "
+                                          "mujoco (soft contacts, measured contact flags, sensors, thesis 6.2).")
 SubstepsOpt = typer.Option(None, help=f"Physics steps per control period (default: {IDEAL.substeps} ideal, "
                                       f"{MUJOCO.substeps} mujoco (1 ms periods), {HUNG.substeps} PD-driven (at "
                                       f"{HUNG.rate:g} Hz: 1 ms steps), 4 for a robot on point feet (2 ms periods: "
                                       "0.5 ms steps)).")
+IntegratorOpt = typer.Option(IDEAL.integrator, help="A walk, ideal: semi-implicit or explicit Euler.")
 MujocoFrictionOpt = typer.Option(MUJOCO.friction, help="mujoco and PD-driven: model (any friction model as a joint "
                                                        "torque) or mujoco (MuJoCo's frictionloss = F_c, damping = "
                                                        "F_v).")
-SensorsOpt = typer.Option(None, help="mujoco: TOML with a [sensors] table (position_std, encoder_bits, torque_std, "
-                                     "seed, delay); the options below override it.")
+SensorsOpt = typer.Option(None, help="mujoco and a robot on point feet: TOML with a [sensors] table (position_std, "
+                                     "encoder_bits, torque_std, seed; mujoco: delay); the options below override it.")
+PositionNoiseOpt = typer.Option(None, help="mujoco, a robot on point feet, arms and PD-driven: joint-position noise "
+                                           "std [rad].")
+EncoderBitsOpt = typer.Option(None, help="mujoco, a robot on point feet, arms and PD-driven: encoder resolution [bits "
+                                         "per turn].")
+TorqueNoiseOpt = typer.Option(None, help="mujoco, a robot on point feet and arms: torque-sensor noise std [N·m].")
+NoiseSeedOpt = typer.Option(None, help="mujoco, a robot on point feet, arms and PD-driven: seed of the sensor noise.")
 DelayOpt = typer.Option(None, help="mujoco: measurement-to-command delay [ms], whole control periods; PD-driven: "
                                    "the drivers' set-point delay [ms], any (default the robot's [pd] delay).")
-ForceTorqueOpt = typer.Option(IDEAL.force_torque, help="ideal: write what the robot's force-torque sensors and IMU "
-                                                       "measure (wrench.<sensor>.*, imu.* columns; mujoco always "
-                                                       "does).")
+LogBaseOpt = typer.Option(IDEAL.log_base, help="A walk: write the base pose to the log.")
+ForceTorqueOpt = typer.Option(IDEAL.force_torque, help="A walk, ideal: write what the robot's force-torque sensors "
+                                                       "and IMU measure (wrench.<sensor>.*, imu.* columns; mujoco "
+                                                       "always does).")
 SoleOpt = typer.Option(None, help="mujoco: the soles' contact time constant (s; default MuJoCo's 0.02, larger is "
                                   "softer: a compliant sole).")
-FrictionTimeOpt = typer.Option(None, help="mujoco: the friction-loss constraint's time constant (s; default two "
-                                          "physics steps: a joint that sticks; MuJoCo's 0.02 leads the velocity by "
-                                          "10 ms).")
+FrictionTimeOpt = typer.Option(None, help="mujoco and PD-driven: the friction-loss constraint's time constant (s; "
+                                          "default two physics steps: a joint that sticks; MuJoCo's 0.02 leads the "
+                                          "velocity by 10 ms).")
+TorqueDriftOpt = typer.Option(MUJOCO.torque_drift, min=0.0, help="mujoco: drift rate of each torque sensor's offset "
+                                                                 "(N·m/s).")
+FtOffsetOpt = typer.Option(MUJOCO.ft_offset, help="mujoco: standard deviations of the force-torque sensors' constant "
+                                                  "offsets: force (N), torque (N·m).")
 DurationOpt = typer.Option(None, help="Fixed-base robot: seconds of excitation trajectory (an arm, default 10) or of "
                                       f"set-points (PD-driven, default {HUNG.duration:g}); a robot on point feet: "
                                       "seconds of gait (default 8).")
@@ -198,41 +220,56 @@ DriverNoiseOpt = typer.Option("real", help="PD-driven: real (a real driver's noi
                                            "--encoder-bits, --position-noise and --velocity-noise override it.")
 VelocityNoiseOpt = typer.Option(None, help="PD-driven: white noise std of the driver's velocity [rad/s].")
 
+SimulateMode = Literal["quadruped", "hung", "arm", "ideal walk", "mujoco walk"]
+"""The ways ``simulate`` runs, chosen by the robot (:func:`simulate_mode`)."""
+SHARED = ("output", "robot", "urdf", "config", "mjcf", "actuator")
+"""The options every mode of ``simulate`` reads that name what is simulated: the log, the robot, how it is driven."""
+SENSOR_NOISE = ("position_noise", "encoder_bits", "torque_noise", "noise_seed")
+WALK = ("gait", "steps", "step_length", "step_width", "turn_angle", "lift_height", "friction", "simulator", "substeps",
+        "log_base")
+MODES: dict[SimulateMode, tuple[str, ...]] = {
+    "quadruped": ("gait", "friction", "simulator", "substeps", "sensors", *SENSOR_NOISE, "duration", "excitation_seed",
+                  "speed", "foot_forces"),
+    "hung": ("friction", "substeps", "mujoco_friction", "position_noise", "encoder_bits", "noise_seed", "delay",
+             "friction_timeconst", "duration", "excitation_seed", "setpoints", "driver_noise", "velocity_noise"),
+    "arm": ("friction", *SENSOR_NOISE, "duration", "excitation_seed"),
+    "ideal walk": (*WALK, "integrator", "force_torque"),
+    "mujoco walk": (*WALK, "mujoco_friction", "sensors", *SENSOR_NOISE, "delay", "sole_timeconst",
+                    "friction_timeconst", "torque_drift", "ft_offset"),
+}
+"""The options (:func:`simulate`'s parameters) each mode reads beyond :data:`SHARED`, what its branch passes on:
+any other given on the command line is refused before the work (:func:`~wbfriction.cli.common.refuse_options`)."""
+
+
+def simulate_mode(r: Robot, actuator: Optional[Actuator], simulator: Simulator) -> tuple[SimulateMode, str]:
+    """How ``simulate`` runs robot ``r``, and what that is as a refusal says it: a robot on point feet walks as a
+    quadruped; one driven by PD drivers (``--actuator pd``; by default one with a ``[pd]`` table) hangs, its base
+    fixed; a fixed base otherwise is an arm tracking an excitation; the rest walks in the ``simulator``."""
+    who = f"robot '{r.name}'"
+    if r.point_contacts:
+        return "quadruped", f"{who} stands on point feet (a walking quadruped)"
+    if actuator == "pd" or (actuator is None and r.pd is not None):
+        return "hung", f"{who} is a hung PD-driven robot (fixed base, {'--actuator pd' if actuator else '[pd]'})"
+    if not r.floating_base:
+        return "arm", f"{who} is a fixed-base arm (torque-driven, an excitation trajectory)"
+    if simulator == "ideal":
+        return "ideal walk", f"{who} walks in the ideal simulator"
+    return "mujoco walk", f"{who} walks on MuJoCo (--simulator mujoco)"
+
 
 @app.command()
-def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write: .parquet, .csv or .h5."),
-             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
-             mjcf: Optional[Path] = MjcfOpt,
-             gait: Optional[GaitChoice] = typer.Option(None, help="A walk: forward (default), sideways, turning, "
-                                                                 "both (forward + sideways) or combined (all three); "
-                                                                 "a robot on point feet: stand, step (a trot in "
-                                                                 "place), trot (default) or walk (a crawl)."),
-             steps: int = typer.Option(GAIT.steps, help="Number of steps (per direction for both/combined)."),
-             step_length: float = typer.Option(GAIT.step_length, help="Forward distance between footprints [m]."),
-             step_width: float = typer.Option(GAIT.step_width, help="Sideways step [m]."),
-             turn_angle: float = typer.Option(GAIT.turn_angle, help="Heading change per turning step [rad]."),
-             lift_height: float = typer.Option(GAIT.lift_height, help="Swing-foot apex [m]."),
+def simulate(ctx: typer.Context, output: Path = OutputOpt, robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt,
+             config: Optional[Path] = ConfigOpt, mjcf: Optional[Path] = MjcfOpt,
+             gait: Optional[GaitChoice] = GaitOpt, steps: int = StepsOpt, step_length: float = StepLengthOpt,
+             step_width: float = StepWidthOpt, turn_angle: float = TurnAngleOpt, lift_height: float = LiftHeightOpt,
              friction: Optional[Path] = FrictionOpt, simulator: Simulator = SimulatorOpt,
-             substeps: Optional[int] = SubstepsOpt,
-             integrator: Integrator = typer.Option(IDEAL.integrator, help="ideal: semi-implicit or explicit Euler."),
+             substeps: Optional[int] = SubstepsOpt, integrator: Integrator = IntegratorOpt,
              mujoco_friction: FrictionMode = MujocoFrictionOpt, sensors: Optional[Path] = SensorsOpt,
-             position_noise: Optional[float] = typer.Option(None, help="mujoco, arms and PD-driven: joint-position "
-                                                                       "noise std [rad]."),
-             encoder_bits: Optional[int] = typer.Option(None, help="mujoco, arms and PD-driven: encoder resolution "
-                                                                   "[bits per turn]."),
-             torque_noise: Optional[float] = typer.Option(None, help="mujoco and arms: torque-sensor noise std "
-                                                                     "[N·m]."),
-             noise_seed: Optional[int] = typer.Option(None, help="mujoco, arms and PD-driven: seed of the sensor "
-                                                                 "noise."),
-             delay: Optional[float] = DelayOpt,
-             log_base: bool = typer.Option(IDEAL.log_base, help="Write the base pose to the log."),
-             force_torque: bool = ForceTorqueOpt, sole_timeconst: Optional[float] = SoleOpt,
-             friction_timeconst: Optional[float] = FrictionTimeOpt,
-             torque_drift: float = typer.Option(MUJOCO.torque_drift, min=0.0, help="mujoco: drift rate of each torque "
-                                                                               "sensor's offset (N·m/s)."),
-             ft_offset: tuple[float, float] = typer.Option(MUJOCO.ft_offset, help="mujoco: standard deviations of the "
-                                                                               "force-torque sensors' constant "
-                                                                               "offsets: force (N), torque (N·m)."),
+             position_noise: Optional[float] = PositionNoiseOpt, encoder_bits: Optional[int] = EncoderBitsOpt,
+             torque_noise: Optional[float] = TorqueNoiseOpt, noise_seed: Optional[int] = NoiseSeedOpt,
+             delay: Optional[float] = DelayOpt, log_base: bool = LogBaseOpt, force_torque: bool = ForceTorqueOpt,
+             sole_timeconst: Optional[float] = SoleOpt, friction_timeconst: Optional[float] = FrictionTimeOpt,
+             torque_drift: float = TorqueDriftOpt, ft_offset: tuple[float, float] = FtOffsetOpt,
              duration: Optional[float] = DurationOpt, excitation_seed: int = SeedOpt,
              actuator: Optional[Actuator] = ActuatorOpt, setpoints: SetpointKind = SetpointsOpt,
              driver_noise: DriverNoiseChoice = DriverNoiseOpt,
@@ -240,29 +277,32 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
              foot_forces: FootForces = FootForcesOpt) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents; a PD-driven one
-    (--robot go2) hangs with its base fixed, its drivers tracking ramps and chirps."""
+    (--robot go2) hangs with its base fixed, its drivers tracking ramps and chirps. Options of another kind of robot
+    are refused."""
     check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors},
                 {"-o": output})
+    r = robot_of(robot, urdf, config, mjcf)
+    mode, what = simulate_mode(r, actuator, simulator)
+    refuse_options(ctx, what, MODES[mode], SHARED)
     check_options({"--duration": ("duration", duration), "--excitation-seed": ("seed", excitation_seed),
                    "--noise-seed": ("seed", noise_seed), "--encoder-bits": ("encoder_bits", encoder_bits),
                    "--delay": ("delay_ms", delay), "--substeps": ("substeps", substeps),
                    "--position-noise": ("position_std", position_noise), "--torque-noise": ("torque_std", torque_noise),
                    "--velocity-noise": ("velocity_std", velocity_noise)})
-    r = robot_of(robot, urdf, config, mjcf)
-    if r.point_contacts:
-        noise, lag = sensor_noise(sensors, position_noise, encoder_bits, torque_noise, noise_seed, delay)
+    if mode == "quadruped":
+        noise, lag = sensor_noise(sensors, position_noise, encoder_bits, torque_noise, noise_seed, None)
         if lag:
-            raise InputError("--delay: a walking quadruped's simulation has no measurement delay (its drivers' is the "
-                             "robot's [pd] delay)")
+            raise InputError(f"{sensors}: delay: a walking quadruped's simulation has no measurement delay (its "
+                             "drivers' is the robot's [pd] delay)")
         physics = {} if substeps is None else {"physics_dt": 0.002 / substeps}
         return _run_simulate_quadruped(r, output, gait or "trot", duration, speed, excitation_seed, simulator,
                                        {"drive": actuator or "torque", "noise": noise, "foot_forces": foot_forces,
                                         **physics}, friction)
-    if (actuator or ("pd" if r.pd is not None else "torque")) == "pd":
+    if mode == "hung":
         drivers = driver_noise_of(driver_noise, encoder_bits, position_noise, velocity_noise, noise_seed)
         return _run_simulate_hung(r, output, hung_options(duration, substeps, setpoints, excitation_seed, drivers,
                                                           delay, mujoco_friction, friction_timeconst), friction)
-    if not r.floating_base:
+    if mode == "arm":
         return _run_simulate_arm(r, output, arm_options(duration or 10.0, excitation_seed, position_noise,
                                                         encoder_bits, torque_noise, noise_seed), friction)
     if gait in QUADRUPED_GAITS:
@@ -271,7 +311,7 @@ def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to wri
     gait_opts = GaitOptions(gait=gait or GAIT.gait,  # type: ignore[arg-type]  # a walk's: checked above
                             steps=steps, step_length=step_length, step_width=step_width, turn_angle=turn_angle,
                             lift_height=lift_height)
-    if simulator == "ideal":
+    if mode == "ideal walk":
         options: IdealOptions | MujocoOptions = IdealOptions(substeps=substeps or IDEAL.substeps, integrator=integrator,
                                                              log_base=log_base, force_torque=force_torque,
                                                              imu=force_torque)

@@ -182,7 +182,7 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
                                                          help="MuJoCo physics steps per 1 ms control period "
                                                               "(default 16: friction lags half a step)."),
                   route: RouteOption = RouteOpt) -> None:
-    """What the ankle force-torque sensors and the base pose change, on MuJoCo's soft contacts (issue 23)."""
+    """What the ankle force-torque sensors and the base pose change, on MuJoCo's soft contacts."""
     from wbfriction.studies.realistic import NOISE
     from wbfriction.studies.sensors import SUBSTEPS, run_sensors_study, sensors_markdown
 
@@ -213,7 +213,7 @@ def study_noise(output_dir: Path = typer.Option(Path("wbfriction-noise"), "-o", 
                 duration: float = typer.Option(20.0, min=1.0, help="The arm's excitation [s]."),
                 steps: int = typer.Option(10, min=1, help="The humanoid's combined walk: steps per direction."),
                 workers: int = FitWorkersOpt) -> None:
-    """Every model family on noisy logs, estimated and fitted with the default options (issue 38): errors
+    """Every model family on noisy logs, estimated and fitted with the default options: errors
     against the injected friction, the model chosen, and each parameter's RMS error over the seeds against its
     Cramér-Rao bound."""
     from wbfriction.studies.noise import FAMILIES, Family, noise_markdown, run_noise_study
@@ -243,7 +243,7 @@ def study_fleet(output_dir: Path = typer.Option(Path("wbfriction-fleet"), "-o", 
                 robots: int = typer.Option(4, min=1, help="Robots of the fleet."),
                 logs: int = typer.Option(25, min=12, help="Logs per robot (one a day)."),
                 workers: int = typer.Option(2, min=1, help="Worker processes of the local Dask cluster.")) -> None:
-    """A simulated TALOS fleet whose friction drifts on two joints (issue 25): batch, trends, and the joints
+    """A simulated TALOS fleet whose friction drifts on two joints: batch, trends, and the joints
     flagged against the truth."""
     import dataclasses
 
@@ -326,7 +326,7 @@ def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped")
                                                                       "(route and differentiation chosen)."),
                     duration: float = typer.Option(8.0, min=1.0, help="Simulated time [s]."),
                     seed: int = typer.Option(0, help="The gait's and the noise's seed.")) -> None:
-    """What each gait gives a walking quadruped (issue 56): per joint, the share of samples where its friction is
+    """What each gait gives a walking quadruped: per joint, the share of samples where its friction is
     determined, by feet on the ground, and its fit against the injected friction."""
     from wbfriction.report.terminal import determination_table
     from wbfriction.studies.quadruped import QuadrupedCase, case_robot, fits_markdown, run_quadruped, write_study

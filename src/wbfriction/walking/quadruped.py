@@ -363,15 +363,26 @@ def quadruped_reference(robot: Robot, options: GaitOptions = GaitOptions()) -> Q
     base_v[:, 3:] = np.einsum("nji,nj->ni", R, omega)
     base_a[:, :3] = np.einsum("nji,nj->ni", R, pos[2]) - np.cross(base_v[:, 3:], base_v[:, :3])
     base_a[:, 3:] = np.einsum("nji,nj->ni", R, domega)
-    q, qd, qdd = _leg_ik(robot, base, base_v, base_a, feet)
+    q, qd, qdd = _leg_ik(robot, base, base_v, base_a, feet, _reach_remedy(options))
     return QuadrupedReference(options, t, contact, base, feet[0].copy(), q, qd, qdd, base_v, base_a, feet[1].copy(),
                               feet[2].copy())
 
 
-def _leg_ik(robot: Robot, base: np.ndarray, base_v: np.ndarray, base_a: np.ndarray, feet: np.ndarray,
+def _reach_remedy(options: GaitOptions) -> str:
+    """What to change when the gait puts a foot out of its leg's reach, as the error says it: the speed (the command
+    line's --speed), the heights where not the defaults (fields of :class:`GaitOptions` alone), else the robot."""
+    remedies = [f"lower --speed ({options.speed:g} m/s)"] if options.speed > 0 else []
+    if (options.base_height, options.step_height) != (GaitOptions.base_height, GaitOptions.step_height):
+        remedies.append(f"lower base_height ({options.base_height:g} m) or step_height ({options.step_height:g} m)")
+    return " or ".join(remedies) or (f"its legs do not reach the ground {options.base_height:g} m below its base with "
+                                     f"swings {options.step_height:g} m high")
+
+
+def _leg_ik(robot: Robot, base: np.ndarray, base_v: np.ndarray, base_a: np.ndarray, feet: np.ndarray, remedy: str,
             iterations: int = 20, tol: float = 1e-12) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The leg joints' angles, velocities and accelerations (N, n_act) putting the feet at ``feet`` (3, N, 4, 3)
-    with the base at ``base`` (N, 7), moving by ``base_v``, ``base_a`` (N, 6) (module docstring)."""
+    with the base at ``base`` (N, 7), moving by ``base_v``, ``base_a`` (N, 6) (module docstring); ``remedy``: what
+    the error says to change where a foot is out of reach."""
     model, data = robot.model, robot.model.createData()
     n = len(base)
     legs = [np.array([robot.model.idx_vs[robot.model.getJointId(j)] for j in robot.limb(f)])
@@ -397,7 +408,7 @@ def _leg_ik(robot: Robot, base: np.ndarray, base_v: np.ndarray, base_a: np.ndarr
             q = pin.integrate(model, q, dq)
         else:
             raise InputError(f"the gait puts a foot of robot '{robot.name}' out of its leg's reach at "
-                             f"sample {k}: lower base_height or step_height")
+                             f"sample {k}: {remedy}")
         v, a = zero.copy(), zero.copy()
         v[:6], a[:6] = base_v[k], base_a[k]
         pin.forwardKinematics(model, data, q, v, a)  # the base's motion alone: the legs' share below
