@@ -4,7 +4,7 @@ output left. The silent-wrong classes assert the right answer.
 
 Mechanisms: the time column's unit is read from its type or stated (:func:`~wbfriction.logs.clock.table_stamps`);
 a log's schema is checked before any row is (:func:`~wbfriction.logs.log.check_schema`); continuous
-joints are unwrapped where positions are read (:func:`~wbfriction.logs.log.unwrap_positions`);
+joints are unwrapped where positions are read (:func:`~wbfriction.logs.angles.unwrap_positions`);
 gross outliers are screened where a fit starts (:mod:`wbfriction.fit.screen`); every command
 checks its paths before work (:func:`~wbfriction.pipeline.paths.check_paths`); option ranges are
 the parser's, its errors one line; a parameters file is checked against the table it is used with

@@ -43,12 +43,13 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.logs.angles import check_limits, unwrap_positions
 from wbfriction.logs.clock import JITTER, Clock, read_clock, split_at_gaps, table_stamps
 from wbfriction.logs.columns import BASE_COLUMNS, BASE_QD_TRUE_COLUMNS, BASE_QDD_TRUE_COLUMNS, IMU_COLUMNS
 from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, sensed_contacts
 from wbfriction.logs.foot_forces import column_names as foot_force_names
 from wbfriction.logs.foot_forces import foot_force_columns, foot_force_table, read_foot_forces
-from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP, ReadOptions
+from wbfriction.logs.options import MAX_GAP, ReadOptions
 from wbfriction.logs.pd import (
     PD_PREFIXES,
     PdSetpoints,
@@ -231,63 +232,6 @@ def check_time(time: np.ndarray, source: str, max_gap: float = MAX_GAP,
             stamp, naming column ``time`` and the first row at fault (counted from ``first_row``).
     """
     return split_at_gaps(time, source, max_gap, rel_tol, first_row)
-
-
-def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT_MARGIN, first_row: int = 0,
-                 prefix: str = "q", joints: tuple[str, ...] | None = None) -> None:
-    """Refuse angles beyond the URDF limits by more than ``margin`` [rad] (degrees logged as
-    radians, millimetres as metres); joints without finite limits are not checked.
-
-    Args:
-        q: the logged angles (N, len(joints)) [rad], the encoders' offsets included (taken off here).
-        robot: the robot: its limits and encoder offsets.
-        prefix: the columns' prefix (``q``, ``q_des``).
-        joints: the columns' joints, in order (default :attr:`Robot.actuated`).
-
-    Raises:
-        InputError: naming the column, the row and the limits.
-    """
-    lower, upper = robot.angle_limits
-    for i, name in enumerate(joints or robot.actuated):
-        k_act = robot.actuated.index(name)
-        offset = robot.encoder_offset.get(name, 0.0)
-        lo, hi = lower[k_act] + offset, upper[k_act] + offset
-        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
-            continue
-        out = np.flatnonzero((q[:, i] < lo - margin) | (q[:, i] > hi + margin))
-        if out.size:
-            k = out[0]
-            raise ColumnError(source, f"{prefix}.{name}", int(first_row + k),
-                              f"column '{prefix}.{name}' is {q[k, i]:.6g} at row {first_row + k}, beyond its URDF "
-                              f"limits [{lo:.4g}, {hi:.4g}] by more than {margin:g}: wrong units (degrees for "
-                              "radians)?")
-
-
-def unwrap_positions(q: np.ndarray, robot: Robot, source: str, segments: list[tuple[int, int]],
-                     first_row: int = 0) -> np.ndarray:
-    """Positions (N, n_act) [rad] with every continuous joint (unbounded revolute) unwrapped
-    within each segment (a logger writes its angle in (-pi, pi]: a jump of 2 pi between two
-    samples is a wrap, not motion; differentiated across it, it is a 1e5 N·m friction).
-
-    Raises:
-        ColumnError: another joint whose position jumps by more than pi between two samples of
-            a segment (a wrapped angle, or a glitch), naming the column and the row.
-    """
-    continuous = np.zeros(q.shape[1], dtype=bool)
-    continuous[robot.layout.q2_joint] = True
-    out = q.copy() if continuous.any() else q
-    for a, b in segments:
-        if continuous.any():
-            out[a:b, continuous] = np.unwrap(q[a:b, continuous], axis=0)
-        jump = np.abs(np.diff(out[a:b], axis=0)) > np.pi
-        if jump.any():
-            k, i = np.argwhere(jump)[0]
-            name = robot.actuated[i]
-            raise ColumnError(source, f"q.{name}", int(first_row + a + k + 1),
-                              f"column 'q.{name}' jumps by {out[a + k + 1, i] - out[a + k, i]:.4g} rad at row "
-                              f"{first_row + a + k + 1}: a wrapped angle of a joint the URDF does not make "
-                              "continuous, or a glitch")
-    return out
 
 
 def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read: ReadOptions = ReadOptions(),

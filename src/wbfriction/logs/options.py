@@ -37,7 +37,7 @@ class ReadOptions:
         max_gap: a time step of at least this many local median steps splits the log into segments, estimated
             apart (:func:`~wbfriction.logs.clock.split_at_gaps`) [sampling periods]; at least :data:`MAX_GAP_LEAST`.
         limit_margin: how far a position may pass its URDF limits before the log is refused
-            (:func:`~wbfriction.logs.log.check_limits`) [rad or m]; at least 0 (inf: not checked).
+            (:func:`~wbfriction.logs.angles.check_limits`) [rad or m]; at least 0 (inf: not checked).
         time_base: the time base the positions are differentiated on (:data:`TimeBase`: decided from the data, the
             stamps as recorded, or a regularised clock; :func:`~wbfriction.logs.clock.read_clock`).
         time_unit: the unit of a numeric ``time`` column (:data:`TimeUnit`; None: seconds for floats, needed for
