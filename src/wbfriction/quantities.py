@@ -15,10 +15,12 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from wbfriction.exceptions import InputError, OptionError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = ["Range", "RANGES", "in_range", "check_option", "check_options", "first_outside"]
 
@@ -133,6 +135,8 @@ def check_options(options: Mapping[str, tuple[str, object]]) -> None:
 def first_outside(quantity: str, values: np.ndarray) -> int | None:
     """The flat index of the first of ``values`` outside :data:`RANGES` ``[quantity]`` (a NaN is missing data, not
     outside), or None."""
+    import numpy as np  # the command line loads this module to check its options: numpy only when arrays come
+
     rng = RANGES[quantity]
     flat = np.asarray(values, dtype=float).ravel()
     low = flat <= rng.low if rng.low_open else flat < rng.low
