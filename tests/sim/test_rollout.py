@@ -126,7 +126,8 @@ def test_a_parameters_file_of_another_robot_is_refused(go2, mjr, logs, tmp_path)
     path = tmp_path / "params.json"
     write_params(path, [FitResult(j, 100, p, model=p.model, success=True) for j, p in sim.friction.items()],
                  {"provenance": {"robot": "aliengo"}})
-    with pytest.raises(InputError, match=r"params.json: parameters of robot 'aliengo', not of 'go2'"):
+    refusal = r"params.json: parameters of robot 'aliengo' \(its model file not recorded\), not of 'go2' "
+    with pytest.raises(InputError, match=refusal):
         rollout(go2, sim.table, truth(sim, friction=str(path)), rows=(0, 10), mjr=mjr)
 
 

@@ -261,29 +261,43 @@ def read_params(path: str | Path) -> dict[str, FitResult]:
     return out
 
 
-def params_robot(params: str | Path) -> str | None:
+def params_robot(params: str | Path) -> tuple[str | None, str | None]:
     """The robot a parameters file (one :func:`read_params` has read) was fitted for: its provenance's ``robot``
-    (:func:`~wbfriction.pipeline.provenance.log_provenance`); None where it records none."""
+    and ``urdf`` (:func:`~wbfriction.pipeline.provenance.log_provenance`), each None where it records none."""
     doc = json.loads(Path(params).read_text())
     prov = doc.get("provenance", {}) if isinstance(doc, dict) else {}
-    robot = prov.get("robot") if isinstance(prov, dict) else None
-    return robot if isinstance(robot, str) else None
+    prov = prov if isinstance(prov, dict) else {}
+    name, urdf = prov.get("robot"), prov.get("urdf")
+    return (name if isinstance(name, str) else None), (urdf if isinstance(urdf, str) else None)
 
 
-def read_robot_params(params: str | Path, robot: str, joints: Iterable[str]) -> dict[str, FitResult]:
-    """:func:`read_params` for the robot named ``robot`` whose joints are ``joints``: the one check wherever a
-    parameters file meets a robot model (export, rollout). Two robots of one class share their joints' names (a Go2
-    and an Aliengo), so the joints alone do not tell them apart: the file's recorded robot must be this one.
+def same_model_file(recorded: str | None, urdf: str | Path) -> bool:
+    """Whether the model file a provenance recorded is ``urdf``: the same path, or the same bytes."""
+    if recorded is None:
+        return False
+    a, b = Path(recorded), Path(urdf)
+    try:
+        return a.resolve() == b.resolve() or (a.is_file() and b.is_file() and a.read_bytes() == b.read_bytes())
+    except OSError:
+        return False
+
+
+def read_robot_params(params: str | Path, robot: str, joints: Iterable[str],
+                      urdf: str | Path | None = None) -> dict[str, FitResult]:
+    """:func:`read_params` for the robot named ``robot`` (model file ``urdf``) whose joints are ``joints``: the one
+    check wherever a parameters file meets a robot model (export, rollout). Two robots of one class share their
+    joints' names (a Go2 and an Aliengo), so the joints alone do not tell them apart: the file's recorded robot must
+    be this one, by its name or its model file (the same URDF under another TOML's name is the same robot).
 
     Raises:
         InputError: what :func:`read_params` raises; a file fitted for another robot; a joint ``robot`` lacks (each
             naming the file).
     """
     fits = read_params(params)
-    fitted_for = params_robot(params)
-    if fitted_for is not None and fitted_for != robot:
-        raise InputError(f"{params}: parameters of robot '{fitted_for}', not of '{robot}': give the robot model "
-                         "they were fitted with")
+    name, fitted_urdf = params_robot(params)
+    if name is not None and name != robot and not (urdf is not None and same_model_file(fitted_urdf, urdf)):
+        raise InputError(f"{params}: parameters of robot '{name}' ({fitted_urdf or 'its model file not recorded'}), "
+                         f"not of '{robot}' ({urdf}): give the robot model they were fitted with")
     known = set(joints)
     unknown = [j for j in fits if j not in known]
     if unknown:
@@ -305,7 +319,7 @@ def check_params_source(params: str | Path, est: FrictionEstimate, table: str | 
     doc = json.loads(path.read_text())  # read by read_params first: a parameters file
     prov = doc.get("provenance", {}) if isinstance(doc, dict) else {}
     prov = prov if isinstance(prov, dict) else {}
-    robot, table_robot = params_robot(path), est.metadata.get("provenance", {}).get("robot")
+    robot, table_robot = params_robot(path)[0], est.metadata.get("provenance", {}).get("robot")
     if robot is not None and table_robot is not None and robot != table_robot:
         raise InputError(f"{path}: parameters of robot '{robot}', not of the table's robot '{table_robot}'")
     joints = doc.get("joints", {}) if isinstance(doc, dict) else {}

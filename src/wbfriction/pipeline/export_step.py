@@ -66,7 +66,8 @@ def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path]
     chosen = [target_for(path).configure(options) for path in outputs]
     for target in {id(t): t for t in chosen}.values():
         target.check(robot)
-    selection = select_fits(read_robot_params(params, robot.name, robot.actuated), robot, include, str(params))
+    fits = read_robot_params(params, robot.name, robot.actuated, robot.urdf)
+    selection = select_fits(fits, robot, include, str(params))
     joints = {name: replace(exp, instead=selection.instead_note(name))
               for name, exp in joint_exports(selection.exported, armature, robot).items()}
     reports = tuple(target.write(Path(path), robot, joints) for path, target in zip(outputs, chosen))

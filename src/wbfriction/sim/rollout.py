@@ -132,7 +132,7 @@ def _friction(robot: Robot, given: Mapping[str, Any] | str | Path) -> tuple[dict
     """The friction parameters per joint of :attr:`ActuatorParams.friction`, and the joints without any."""
     if isinstance(given, (str, Path)):
         from wbfriction.fit.params_file import read_robot_params
-        given = read_robot_params(given, robot.name, robot.actuated)
+        given = read_robot_params(given, robot.name, robot.actuated, robot.urdf)
     out: dict[str, ModelParams] = {}
     for joint, value in given.items():
         if joint not in robot.actuated:
