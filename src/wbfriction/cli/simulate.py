@@ -11,6 +11,7 @@ import typer
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError
+from wbfriction.logs.formats.catalog import written_suffixes
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.sim.options import FrictionMode, IdealOptions, Integrator, MujocoOptions, SensorNoise, Simulator
 from wbfriction.sim.pd_options import DriverNoise, HungOptions, SetpointKind, SetpointOptions
@@ -199,7 +200,7 @@ VelocityNoiseOpt = typer.Option(None, help="PD-driven: white noise std of the dr
 
 
 @app.command()
-def simulate(output: Path = typer.Option(..., "-o", "--output", help="Log to write: .parquet, .csv or .h5."),
+def simulate(output: Path = typer.Option(..., "-o", "--output", help=f"Log to write: {written_suffixes()}."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              mjcf: Optional[Path] = MjcfOpt,
              gait: Optional[GaitChoice] = typer.Option(None, help="A walk: forward (default), sideways, turning, "
