@@ -69,3 +69,39 @@ def test_no_help_names_an_issue_number(name):
     texts = [command.help or "", command.short_help or ""] + [getattr(p, "help", None) or "" for p in command.params]
     shown = _help(*([] if name is None else [name]))
     assert [m.group(0) for text in (*texts, shown) for m in ISSUE.finditer(" ".join(text.split()))] == []
+
+
+def test_every_help_that_lists_the_formats_lists_the_registrys():
+    """Issue 65: the help listed the formats by hand (the friction table's ``-o`` offered ``.h5``, which is not
+    streamed; ``convert``'s log left out ``.npz``; ``simulate -o`` ``.npz``, ``.pq``): every list is the registry's
+    now. A format registered before the command line is loaded (the toy Feather, in a process of its own: the help
+    is made as the command line loads, and reads the formats' catalogue, not their modules) is in every help that
+    lists the logs read, and in ``simulate -o`` (it writes whole tables), not in the streamed outputs' (it does not
+    stream); ``.npz`` wherever a log is read."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = ("import json\nimport typer.testing\nfrom toys.toy_format import Feather\n"
+            "from wbfriction.logs import register_format\nregister_format(Feather())\n"
+            "from wbfriction.cli import app\nout = {}\n"
+            "for c in ('estimate', 'convert', 'simulate', 'batch', 'sensitivity', 'spectrum', 'identify', 'refine', "
+            "'rollout'):\n"
+            "    r = typer.testing.CliRunner().invoke(app, [c, '--help'], terminal_width=10000)\n"
+            "    assert r.exit_code == 0, r.output\n    out[c] = ' '.join(r.output.split())\n"
+            "print(json.dumps(out))")
+    tests = Path(__file__).resolve().parent
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tests), os.environ.get("PYTHONPATH", "")]))
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+    assert run.returncode == 0, run.stderr
+    shown = json.loads(run.stdout.splitlines()[-1])
+    table_formats = ("Parquet (.parquet, .pq)", "CSV (.csv)", "HDF5 (.h5, .hdf5, .he5)", "NumPy (.npz)",
+                     "Feather (.feather)")
+    for command, text in shown.items():  # every command that reads a log names every table format
+        assert command == "simulate" or all(f in text for f in table_formats), command
+    assert "ROS 2 bag (.mcap, .db3" in shown["estimate"] and "ROS 2 bag (.mcap, .db3" in shown["convert"]
+    assert "Friction table to write: .parquet, .pq or .csv." in shown["estimate"]
+    assert "Log to write: .parquet, .pq or .csv." in shown["convert"]
+    assert "Log to write: .parquet, .pq, .csv, .h5, .hdf5, .he5, .npz or .feather." in shown["simulate"]

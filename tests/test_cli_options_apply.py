@@ -121,7 +121,7 @@ VALUES = {
     "substeps": ["--substeps", "2"], "integrator": ["--integrator", "explicit"],
     "mujoco_friction": ["--mujoco-friction", "mujoco"], "sensors": ["--sensors", "FILE"],
     "position_noise": ["--position-noise", "1e-4"], "encoder_bits": ["--encoder-bits", "16"],
-    "torque_noise": ["--torque-noise", "0.01"], "noise_seed": ["--noise-seed", "1"], "delay": ["--delay", "1"],
+    "torque_noise": ["--torque-noise", "0.01"], "noise_seed": ["--noise-seed", "1"], "delay": ["--delay", "0.01"],
     "log_base": ["--no-log-base"], "force_torque": ["--force-torque"], "sole_timeconst": ["--sole-timeconst", "0.03"],
     "friction_timeconst": ["--friction-timeconst", "0.01"], "torque_drift": ["--torque-drift", "0.1"],
     "ft_offset": ["--ft-offset", "1", "0.1"], "duration": ["--duration", "1"],

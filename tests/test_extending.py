@@ -1,28 +1,39 @@
-"""A new kind of thing is one file and one registry entry (issue 54): a toy friction family
+"""A new kind of thing is one file and one registry entry (issues 54, 65): a toy friction family
 (``toys/toy_family.py``), a toy export target (``toys/toy_target.py``) and a toy log format (``toys/toy_format.py``),
-each registered with one call, carry a simulated arm's log from its file through ``estimate``, ``fit`` and
-``export`` on the command line, and the friction injected comes out of the other end."""
+each registered with one call, reach every command (run in this process, as ``docs/extending.md`` says registration
+reaches) and public function that takes their kind.
+
+* The family: ``simulate --friction`` (its ``model`` key) injects it and logs its own characteristic; ``fit --model``
+  recovers it; ``predict`` and ``report`` read its fits; ``export`` writes them (a built-in MJCF and the toy target);
+  ``batch --model`` fits it; the rollout (:func:`~wbfriction.sim.rollout.rollout`) replays it as the (3.5) it equals.
+  Every simulator's injection: ``tests/sim/test_injected_families.py``.
+* The target: ``export -o FILE.csv`` (:func:`~wbfriction.pipeline.export_step.export_files`).
+* The format: ``simulate -o`` writes it; ``estimate``, ``convert``, ``spectrum``, ``sensitivity``, ``identify``,
+  ``rollout``, ``refine`` and ``batch`` (a folder's scan) read it.
+"""
 
 from __future__ import annotations
 
 import csv
-import dataclasses
 import json
+from datetime import UTC, datetime
 
 import numpy as np
+import pyarrow as pa
 import pytest
 
 from helpers import run_cli_printed
-from toys.toy_family import NAME, A, FixedSlope
+from toys.toy_family import NAME, A, FixedSlope, FixedSlopeParams
 from toys.toy_format import Feather
 from toys.toy_target import FrictionCsv
 from wbfriction.export import registry
 from wbfriction.export.registry import register_target
 from wbfriction.friction.families.registry import register_family, unregister_family
+from wbfriction.friction.models import FrictionParams
 from wbfriction.logs import register_format, unregister_format
-from wbfriction.logs.tables import write_table
+from wbfriction.logs.tables import read_metadata, read_table, write_table
 from wbfriction.model.loading import load_robot
-from wbfriction.sim.arm import ArmOptions, default_arm_friction, simulate_arm
+from wbfriction.sim.arm import default_arm_friction
 
 
 @pytest.fixture
@@ -35,21 +46,42 @@ def toys(monkeypatch):
     unregister_format(fmt.name)
 
 
-def test_a_toy_family_target_and_format_run_from_a_log_to_an_export(toys, tmp_path, capsys):
-    robot = load_robot("panda")
-    truth = {j: dataclasses.replace(p, S=0.0, a=A) for j, p in default_arm_friction(robot).items()}  # the toy's
-    sim = simulate_arm(robot, truth, options=ArmOptions(duration=6.0, seed=3, torque_std=0.01))
-    log = tmp_path / "arm.feather"
-    write_table(sim.table, log)  # through the toy format: it claims the name
-    assert log.read_bytes()[:6] == b"ARROW1"
-
-    def cli(*args):
+@pytest.fixture
+def cli(capsys):
+    """``wbfriction ARGS`` in this process, which must succeed; its standard output."""
+    def run(*args) -> str:
         code, out, err = run_cli_printed(capsys, *args)
-        assert code == 0, err
+        assert code == 0, (args[0], err)
         return out
+    return run
+
+
+def friction_toml(path, params: dict[str, FixedSlopeParams]):
+    """``simulate --friction``'s TOML: the toy family (its ``model`` key) on each joint of ``params``."""
+    path.write_text("".join(f'[friction.{j}]\nmodel = "{NAME}"\nF_v = {p.F_v!r}\nF_c = {p.F_c!r}\n'
+                            f"tau_os = {p.tau_os!r}\n" for j, p in params.items()))
+    return path
+
+
+def test_a_toy_family_target_and_format_run_from_a_simulation_to_an_export(toys, tmp_path, cli):
+    """The Panda simulated with the toy family (the thesis's defaults with S = 0, the toy's slope) into the toy
+    format; its log estimated, fitted with the toy family, predicted and exported by the toy target: the friction
+    injected comes out of the other end."""
+    robot = load_robot("panda")
+    truth = {j: FixedSlopeParams(F_v=p.F_v, F_c=p.F_c, tau_os=p.tau_os) for j, p in default_arm_friction(robot).items()}
+    log = tmp_path / "arm.feather"
+    cli("simulate", "--robot", "panda", "--friction", friction_toml(tmp_path / "toy.toml", truth), "--duration", "6",
+        "--torque-noise", "0.01", "--noise-seed", "3", "-o", log)
+    assert log.read_bytes()[:6] == b"ARROW1"  # written through the toy format: it claims the name
+    table = read_table(log)
+    for joint, p in truth.items():  # the toy's own characteristic injected and logged
+        assert read_metadata(table)["friction_true"][joint]["model"] == NAME
+        np.testing.assert_allclose(table[f"tau_f_true.{joint}"].to_numpy(),
+                                   p.torque(table[f"qd_true.{joint}"].to_numpy()), rtol=1e-12, atol=1e-12)
 
     cli("estimate", log, "--robot", "panda", "-o", tmp_path / "friction.parquet")
     cli("fit", tmp_path / "friction.parquet", "--model", NAME, "--terms", "none", "-o", tmp_path / "params.json")
+    predicted = cli("predict", tmp_path / "friction.parquet", "--params", tmp_path / "params.json")
     cli("export", tmp_path / "params.json", "--robot", "panda", "--include", "weak", "-o", tmp_path / "friction.csv")
 
     fits = json.loads((tmp_path / "params.json").read_text())["joints"]
@@ -62,3 +94,66 @@ def test_a_toy_family_target_and_format_run_from_a_log_to_an_export(toys, tmp_pa
             assert fit["params"][name] == pytest.approx(getattr(p, name), rel=0.05), (joint, name)
             assert float(rows[joint][name]) == fit["params"][name]  # exported as fitted, to the bit
     assert np.isfinite([f["stderr"]["F_c"] for f in fits.values()]).all()
+    everyone = next(line.split() for line in predicted.splitlines() if line.strip().startswith("all joints"))
+    rigid, with_friction = float(everyone[3]), float(everyone[4])  # the RMS without and with the toy's fits
+    assert with_friction < 0.1 * rigid  # what is left is the 0.01 N·m torque noise, not the friction of ~1 N·m
+
+
+@pytest.mark.slow
+def test_the_toys_reach_every_other_command_that_takes_their_kind(toys, tmp_path, cli):
+    """The toy format read by every other command that reads a log, on a Panda log (``convert``, ``spectrum``,
+    ``sensitivity``, ``batch``'s folder scan) and a hung Go2's (``identify --actuator pd``, ``rollout``,
+    ``refine``); the toy family fitted by ``batch --model``, read by ``report``, exported as a built-in MJCF that
+    ``rollout`` replays, and replayed by the rollout function as the (3.5) it equals (about 30 s)."""
+    panda = load_robot("panda")
+    truth = {j: FixedSlopeParams(F_v=p.F_v, F_c=p.F_c, tau_os=p.tau_os) for j, p in default_arm_friction(panda).items()}
+    arm = tmp_path / "arm.feather"
+    cli("simulate", "--robot", "panda", "--friction", friction_toml(tmp_path / "toy.toml", truth), "--duration", "3",
+        "-o", arm)
+    cli("convert", arm, "--robot", "panda", "-o", tmp_path / "arm.parquet")
+    assert read_table(tmp_path / "arm.parquet").select(read_table(arm).column_names).equals(read_table(arm))
+    cli("spectrum", arm, "--robot", "panda", "--joints", "panda_joint1", "-o", tmp_path / "spectrum.png")
+    cli("sensitivity", arm, "--robot", "panda", "--factors", "1.1", "--joints", "panda_joint1",
+        "-o", tmp_path / "sensitivity.png")
+    for path in (tmp_path / "spectrum.png", tmp_path / "sensitivity.png"):
+        assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+    # batch: a folder of one robot, its log in the toy format (its time as dates), the toy family fitted
+    dated = read_table(arm)
+    start = datetime(2026, 3, 1, 8, tzinfo=UTC).timestamp()
+    dated = dated.set_column(0, "time", pa.array(((start + dated["time"].to_numpy()) * 1e9).astype("int64"),
+                                                 pa.timestamp("ns", tz="UTC")))
+    (tmp_path / "fleet" / "arm-1").mkdir(parents=True)
+    write_table(dated, tmp_path / "fleet" / "arm-1" / "run.feather")
+    cli("batch", tmp_path / "fleet", "--robot", "panda", "--model", NAME, "--terms", "none", "--serial",
+        "-o", tmp_path / "results")
+    from wbfriction.fleet.results import read_results
+    results = read_results(tmp_path / "results").table
+    assert set(results["model"].to_pylist()) == {NAME} and results.num_rows == len(truth)
+    cli("estimate", arm, "--robot", "panda", "-o", tmp_path / "friction.parquet")
+    cli("fit", tmp_path / "friction.parquet", "--model", NAME, "--terms", "none", "-o", tmp_path / "params.json")
+    cli("report", tmp_path / "friction.parquet", "--params", tmp_path / "params.json", "-o", tmp_path / "report.html")
+    assert NAME in (tmp_path / "report.html").read_text()
+
+    # the hung Go2, its log in the toy format: the actuators identified, the toy family's fit exported and replayed
+    hung = tmp_path / "hung.feather"
+    cli("simulate", "--robot", "go2", "--actuator", "pd", "--duration", "4", "-o", hung)
+    cli("identify", hung, "--robot", "go2", "--actuator", "pd", "--json", tmp_path / "actuator.json")
+    cli("estimate", hung, "--robot", "go2", "-o", tmp_path / "hung_friction.parquet")
+    cli("fit", tmp_path / "hung_friction.parquet", "--model", NAME, "--terms", "none",
+        "-o", tmp_path / "hung_params.json")
+    cli("export", tmp_path / "hung_params.json", "--robot", "go2", "--include", "weak,at-bound",
+        "-o", tmp_path / "go2.xml")
+    cli("rollout", hung, tmp_path / "go2.xml", "--robot", "go2", "-o", tmp_path / "rollout.parquet")
+    tracking = read_table(tmp_path / "rollout.parquet")["rms_windows"].to_numpy()
+    assert (tracking < 0.01).all(), tracking  # the exported fit tracks the log (measured: 1-4 mrad)
+    cli("refine", hung, tmp_path / "go2.xml", "--robot", "go2", "--to", "1.5", "-o", tmp_path / "refined.xml")
+    assert (tmp_path / "refined.xml").read_text().lstrip().startswith(("<", "<!--"))
+
+    from wbfriction.sim.rollout import ActuatorParams, rollout
+    go2 = load_robot("go2")
+    toy = {j: FixedSlopeParams(F_v=0.2, F_c=0.4, tau_os=0.05) for j in go2.actuated}
+    thesis = {j: FrictionParams(F_v=0.2, F_c=0.4, S=0.0, v_s=0.05, tau_os=0.05, a=A) for j in go2.actuated}
+    ours, same = (rollout(go2, hung, ActuatorParams(friction=f), times=(0.0, 2.0)) for f in (toy, thesis))
+    assert ours.no_friction == () and ours.joints == same.joints
+    np.testing.assert_allclose(ours.q_sim, same.q_sim, rtol=0, atol=1e-12)  # the toy is (3.5) with S = 0, a = A

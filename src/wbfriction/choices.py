@@ -8,6 +8,11 @@ from collections.abc import Iterable
 from wbfriction.exceptions import OptionError
 
 
+def spoken(items: tuple[str, ...]) -> str:
+    """``a, b or c`` (a message's or a help's list of choices)."""
+    return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} or {items[-1]}"
+
+
 def flag(field: str) -> str:
     """The command-line spelling of an options field: ``poly_order`` -> ``--poly-order``."""
     return "--" + field.replace("_", "-")

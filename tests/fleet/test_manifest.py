@@ -180,3 +180,37 @@ def test_a_robot_id_too_long_for_a_folder_name_is_refused_before_any_log_runs(fo
     assert read_manifest(_manifest(folder, f"a.parquet,{ok},2026-03-01T08:00:00Z,talos"))[0].robot_id == ok
     with pytest.raises(InputError, match=r"row 0, column 'robot_id': 'rrr.*' is not a robot id \(at most 128 "):
         read_manifest(_manifest(folder, f"a.parquet,{'r' * 300},2026-03-01T08:00:00Z,talos"))
+
+
+def _dated_table() -> pa.Table:
+    return pa.table({"time": pa.array([datetime(2026, 3, 1, 8, tzinfo=UTC)] * 2, pa.timestamp("ns", tz="UTC"))})
+
+
+def test_a_scan_finds_every_registered_formats_logs(tmp_path):
+    """Issue 65: the scan kept its own list of suffixes and passed over the built-in ``.npz`` logs as "not a log"; a
+    log of any format the registry holds (every built-in table format, a toy registered in the test) is found, a
+    ROS 2 bag (a file, or a folder: said once) is said as one (it needs a map a batch does not take), a file no
+    format reads is said."""
+    from toys.toy_format import Feather
+    from wbfriction.logs import register_format, unregister_format
+    from wbfriction.logs.tables import write_table
+
+    logs = ["a.parquet", "b.pq", "c.csv", "d.npz", "e.feather"]  # HDF5 holds no dates: its logs need a manifest
+    (tmp_path / "r1").mkdir()
+    register_format(Feather())
+    try:
+        for name in logs:
+            write_table(_dated_table(), tmp_path / "r1" / name)
+        (tmp_path / "r1" / "run.mcap").write_bytes(b"")
+        (tmp_path / "r1" / "bag").mkdir()
+        (tmp_path / "r1" / "bag" / "metadata.yaml").write_text("")
+        (tmp_path / "r1" / "bag" / "bag_0.db3").write_bytes(b"")
+        (tmp_path / "r1" / "notes.txt").write_text("")
+        scan = scan_folder(tmp_path, RobotSpec("talos"))
+    finally:
+        unregister_format("feather")
+    assert [e.log.name for e in scan.entries] == logs
+    said = {p.path.name: p.reason for p in scan.skipped}
+    assert set(said) == {"run.mcap", "bag", "notes.txt"}
+    assert all("ROS 2 bag" in said[n] and "map" in said[n] for n in ("run.mcap", "bag"))
+    assert "NumPy (.npz)" in said["notes.txt"]  # the formats there are, from the registry

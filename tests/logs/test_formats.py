@@ -147,3 +147,27 @@ def test_a_bag_is_no_table_file_and_is_never_written(tmp_path):
     (tmp_path / "folder").mkdir()
     with pytest.raises(InputError, match="is a folder, not a table file"):
         format_of(tmp_path / "folder")
+
+
+def test_the_catalogue_the_help_reads_is_the_registrys(jsonl):
+    """The command line's help names the formats from their catalogue (:mod:`wbfriction.logs.formats.catalog`),
+    which loads no format and no pyarrow: what it holds before the registry is imported is what the registry's
+    formats are after (a fresh process), so a built-in format cannot be missing from the help; a format registered
+    or unregistered joins or leaves it (here)."""
+    import subprocess
+    import sys
+
+    from wbfriction.logs.formats.catalog import FormatKind, format_kinds
+
+    code = ("import sys\nfrom wbfriction.logs.formats.catalog import FormatKind, format_kinds\n"
+            "before = format_kinds()\nassert 'pyarrow' not in sys.modules\n"
+            "from wbfriction.logs.formats.registry import log_formats\n"
+            "assert before == format_kinds() == tuple(FormatKind.of(f) for f in log_formats()), before\n"
+            "print(' '.join(k.name for k in before))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split() == ["parquet", "csv", "hdf5", "npz", "bag"]
+    assert format_kinds()[-1] == FormatKind.of(jsonl) and FormatKind.of(jsonl).words() == "JSON lines (.jsonl)"
+    unregister_format(jsonl.name)
+    assert jsonl.name not in [k.name for k in format_kinds()]
+    register_format(jsonl)  # as the fixture left it

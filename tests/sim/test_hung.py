@@ -15,6 +15,7 @@ from tests.helpers import run_cli
 from tests.toys.toy_family import FixedSlopeParams
 
 from wbfriction.exceptions import InputError
+from wbfriction.friction.families.names import UnknownFamilyError
 from wbfriction.friction.models import CoulombViscousParams, StribeckParams, target_from_dict
 from wbfriction.logs.tables import read_metadata, read_table, write_table
 from wbfriction.model.loading import load_robot
@@ -252,14 +253,14 @@ def test_the_metadata_names_the_truth(go2, mjr):
 
 def test_robots_it_does_not_simulate(go2):
     """A floating base, a robot without [pd], a noise level naming no joint or group, friction of a family the
-    simulator does not apply: one clear error each."""
+    registry does not know (any it knows is simulated: ``test_injected_families.py``): one clear error each."""
     with pytest.raises(InputError, match="floating base"):
         build_pd_robot(load_robot("talos"))
     with pytest.raises(InputError, match="not PD-driven"):
         build_pd_robot(load_robot("panda"))
     with pytest.raises(InputError, match="'knee' is neither"):
         simulate_hung(go2, HungOptions(duration=0.1, noise=DriverNoise(velocity_std={"knee": 0.1})))
-    with pytest.raises(InputError, match="built-in families"):  # not dropped in silence
+    with pytest.raises(UnknownFamilyError, match="fixed-slope"):  # the toy, not registered: not dropped in silence
         simulate_hung(go2, HungOptions(duration=0.1), {"FL_hip_joint": FixedSlopeParams(F_c=0.3)})
 
 

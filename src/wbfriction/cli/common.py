@@ -22,6 +22,7 @@ from wbfriction.exceptions import InputError, OptionError, WbfrictionError
 from wbfriction.fit.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions, TermOptions
 from wbfriction.friction.options import TERMS, EstimateOptions, TemperatureLaw, Term
 from wbfriction.inertia.options import InertialOptions
+from wbfriction.logs.formats.catalog import table_formats
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP, MAX_GAP_LEAST
 from wbfriction.model.robots import BUILTIN_ROBOTS
 from wbfriction.signals.options import NOISE_TARGET, FilterOptions
@@ -42,10 +43,8 @@ WideOpt = typer.Option(False, "--wide", help="Every column in one table, as wide
                                             "fit the terminal).")
 VerboseOpt = typer.Option(False, "--verbose", help="Each joint's own line for the notes shared by several.")
 RobotOpt = typer.Option("talos", "--robot", help=f"Built-in robot: {', '.join(BUILTIN_ROBOTS)}.")
-LOG_FORMATS = "Parquet (.parquet), CSV (.csv), HDF5 (.h5, .hdf5) or NumPy (.npz)"
-"""The log file formats every command reads (a ROS 2 bag too, where a command takes --map): the built-in table
-formats of :mod:`wbfriction.logs.formats`, written out here because the help is shown without loading them."""
-LogArg = typer.Argument(..., metavar="LOG", help=f"Log in the wbfriction format: {LOG_FORMATS}.")
+# the help names the log formats registered as it is loaded (their catalogue: no pyarrow imported)
+LogArg = typer.Argument(..., metavar="LOG", help=f"Log in the wbfriction format: {table_formats()}.")
 FrictionArg = typer.Argument(..., metavar="FRICTION", help="Friction table written by 'wbfriction estimate'.")
 EnergyThresholdOpt = typer.Option(DEFAULT_THRESHOLD, min=0.0, max=1.0,
                                   help="Share of power-generating samples (eq. 7.9) above which a joint is flagged.")

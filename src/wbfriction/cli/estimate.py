@@ -15,6 +15,7 @@ from rich.table import Table
 from wbfriction.exceptions import OptionError
 from wbfriction.friction.options import BaseMotion, EstimateOptions, Method, MomentumOptions, RouteOption
 from wbfriction.inertia.options import InertiaPart
+from wbfriction.logs.formats.catalog import mapped_formats, table_formats, written_suffixes
 from wbfriction.logs.options import ReadOptions, TimeBase, TimeUnit
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.signals.options import AlignmentOption, DiffOption, FilterOptions, Mask, SavgolWeights, Velocity
@@ -26,7 +27,6 @@ if TYPE_CHECKING:
 from wbfriction.cli.common import (
     ESTIMATE,
     FILTER,
-    LOG_FORMATS,
     BaseMotionOpt,
     ConfigOpt,
     LimitMarginOpt,
@@ -142,9 +142,10 @@ def _print_cross_check(friction: Path) -> None:
 
 @app.command()
 def estimate(log: Path = typer.Argument(..., metavar="LOG",
-                                        help=f"Log in the wbfriction format: {LOG_FORMATS}; or a ROS 2 bag (--map)."),
-             output: Path = typer.Option(..., "-o", "--output", help="Friction table to write: .parquet, .csv or "
-                                                                     ".h5."),
+                                        help=f"Log in the wbfriction format: {table_formats()}; through --map: "
+                                             f"{mapped_formats()}."),
+             output: Path = typer.Option(..., "-o", "--output",
+                                         help=f"Friction table to write: {written_suffixes(streamed=True)}."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              mjcf: Optional[Path] = MjcfOpt,
              bag_map: Optional[Path] = MapOpt, max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt,
@@ -228,13 +229,14 @@ def _refuse_acceleration_outputs(opts: EstimateOptions, companion: bool) -> None
 
 
 @app.command()
-def convert(bag: Path = typer.Argument(..., metavar="BAG", help="ROS 2 bag (folder with metadata.yaml; MCAP or "
-                                                                "sqlite3), or a Parquet, CSV or HDF5 log."),
+def convert(bag: Path = typer.Argument(..., metavar="BAG", help=f"Log to convert, through --map: {mapped_formats()}; "
+                                                                f"or a table log: {table_formats()}."),
             bag_map: Optional[Path] = typer.Option(None, "--map", help="Topic map TOML of a bag: [joint_states], "
                                                                         "[[contacts]], [base]; of a table log: "
                                                                         "[joint_states] rename, [[contacts]] "
                                                                         "column, threshold."),
-            output: Path = typer.Option(..., "-o", "--output", help="Log to write: .parquet or .csv."),
+            output: Path = typer.Option(..., "-o", "--output",
+                                        help=f"Log to write: {written_suffixes(streamed=True)}."),
             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
             mjcf: Optional[Path] = MjcfOpt,
             max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt) -> None:

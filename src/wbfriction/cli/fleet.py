@@ -16,6 +16,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.fit.options import FitOptions, ModelChoice, model_choices
 from wbfriction.fleet.options import SHAPES, Shape
 from wbfriction.friction.options import EstimateOptions, TemperatureLaw
+from wbfriction.logs.formats.catalog import table_formats
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.signals.options import DiffOption
 
@@ -41,9 +42,10 @@ from wbfriction.cli.common import (
 
 @app.command()
 def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
-                                        help="Manifest (CSV or Parquet; columns log, robot_id, start_time [ISO 8601 "
-                                             "with zone], robot or urdf/config, optional diff and model), or a "
-                                             "folder of <robot_id>/<log> files (with --robot or --urdf/--config)."),
+                                        help="Manifest (a CSV or Parquet table: its columns hold text; columns "
+                                             "log, robot_id, start_time [ISO 8601 with zone], robot or urdf/config, "
+                                             "optional diff and model), or a folder of <robot_id>/<log> files (with "
+                                             f"--robot or --urdf/--config), each log a {table_formats()} file."),
           output: Path = typer.Option(..., "-o", "--output", help="Results folder: a Parquet dataset, a folder per "
                                                                   "robot; logs whose results are there are "
                                                                   "skipped, results of a log listed with anything "

@@ -11,6 +11,7 @@ import typer
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import InputError
+from wbfriction.logs.formats.catalog import written_suffixes
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.quantities import check_options
 from wbfriction.sim.options import FrictionMode, IdealOptions, Integrator, MujocoOptions, SensorNoise, Simulator
@@ -149,7 +150,7 @@ def _run_simulate_quadruped(r: Robot, output: Path, gait: str, duration: Optiona
                       f"{normal.min():.1f} N)", highlight=False)
 
 
-OutputOpt = typer.Option(..., "-o", "--output", help="Log to write: .parquet, .csv or .h5.")
+OutputOpt = typer.Option(..., "-o", "--output", help=f"Log to write: {written_suffixes()}.")
 FrictionOpt = typer.Option(None, help="TOML with [friction.<group or joint>] tables (a model key: coulomb-viscous, "
                                       "stribeck or (3.5)), each with an optional terms table (F_L, dF_v, ripple, "
                                       "F_cT, F_vT, reference_temperature), and a [temperature] warm-up (start, end "

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from wbfriction.choices import spoken
 from wbfriction.exceptions import InputError
 from wbfriction.export.isaac import IsaacTarget
 from wbfriction.export.mjcf import MjcfTarget
@@ -51,11 +52,6 @@ class UnknownExportFormat(InputError):
 
     def __reduce__(self):  # picklable across worker processes, with its data
         return (type(self), (self.path, self.suffix, self.known))
-
-
-def spoken(items: tuple[str, ...]) -> str:
-    """``a, b or c``."""
-    return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} or {items[-1]}"
 
 
 def register_target(target: ExportTarget) -> ExportTarget:

@@ -1,11 +1,11 @@
 """The logs a batch processes (issue 25): a manifest table, or a folder scanned.
 
-A manifest is a CSV or Parquet table, one row per log:
+A manifest is a table of text columns, in a format that holds them (CSV, Parquet), one row per log:
 
 =============  ========================================================================================
 column         meaning
 =============  ========================================================================================
-``log``        the log's path (Parquet, CSV or HDF5), relative to the manifest's folder or absolute
+``log``        the log's path (a file of any log format), relative to the manifest's folder or absolute
 ``robot_id``   the robot that wrote it, as text (letters, digits, ``.``, ``_``, ``-``): ``007`` and ``7``
                are two robots, whatever a CSV reader would infer; it names the robot's results folder
 ``start_time`` when the log started: ISO 8601 with a time zone (``2026-03-01T08:00:00+00:00``), or a
@@ -20,12 +20,14 @@ column         meaning
                or a registered family)
 =============  ========================================================================================
 
-A folder is scanned as ``FOLDER/<robot_id>/**/<log>`` (``.parquet``, ``.csv``, ``.h5``), every log with the
-robot given on the command line, its start time from its ``time`` column when that holds dates (a Parquet
-timestamp); a log whose time stamps are relative needs a manifest row. Every file or folder the scan passes
-over is said (:attr:`FolderScan.skipped`), but hidden ones (a name starting with ``.``): a folder whose name is
-not a robot id, a file outside any robot's folder or of another type, a table that wbfriction wrote (a
-friction table, a batch's result) and the batch's own output folders.
+A folder is scanned as ``FOLDER/<robot_id>/**/<log>``, a log being any file (or folder) a registered log format
+detects (:func:`~wbfriction.logs.formats.registry.find_format`: Parquet, CSV, HDF5, ``.npz`` built in, and any
+format registered), every log with the robot given on the command line, its start time from its ``time`` column
+when that holds dates (a timestamp column); a log whose time stamps are relative needs a manifest row. Every file
+or folder the scan passes over is said (:attr:`FolderScan.skipped`), but hidden ones (a name starting with ``.``):
+a folder whose name is not a robot id, a file outside any robot's folder or that no format reads, a log read only
+through a map (a ROS 2 bag: a batch takes none), a table that wbfriction wrote (a friction table, a batch's
+result) and the batch's own output folders.
 
 Everything is checked here, before any log is processed: a fault is one :class:`~wbfriction.exceptions.InputError`
 naming the manifest, its row and column.
@@ -46,6 +48,8 @@ from wbfriction.exceptions import InputError
 from wbfriction.fit.options import model_choices
 from wbfriction.fleet.schema import RESULT_DOCUMENT
 from wbfriction.friction.options import ROUTE_OPTIONS
+from wbfriction.logs.formats.catalog import table_formats
+from wbfriction.logs.formats.registry import find_format
 from wbfriction.logs.tables import TableFile, read_metadata, table_format
 from wbfriction.pipeline.estimate_step import RobotSpec
 from wbfriction.signals.options import DIFF_OPTIONS
@@ -54,8 +58,6 @@ REQUIRED = ("log", "robot_id", "start_time")
 """The columns every manifest has."""
 OPTIONAL = ("robot", "urdf", "config", "diff", "route", "model")
 """The columns a manifest may have (others are refused: a misspelt option would be silently ignored)."""
-LOG_SUFFIXES = (".parquet", ".pq", ".csv", ".h5", ".hdf5")
-"""The files a scanned folder's logs are."""
 ROBOT_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$")
 """What a robot id may be: it names a folder of the results (at most 128 characters: a file system's names end at
 255 bytes)."""
@@ -164,7 +166,7 @@ def scan_folder(folder: str | Path, robot: RobotSpec, exclude: Sequence[str | Pa
         if sub.resolve() in excluded:
             skipped.append(Skipped(sub, "this batch's output, not logs"))
         elif not sub.is_dir():
-            if sub.suffix.lower() in LOG_SUFFIXES:
+            if find_format(sub) is not None:
                 skipped.append(Skipped(sub, f"not in a robot's folder ({folder}/<robot_id>/<log>)"))
         elif not ROBOT_ID.match(sub.name):
             skipped.append(Skipped(sub, "not a robot id (at most 128 letters, digits, '.', '_', '-'; it names a "
@@ -172,7 +174,7 @@ def scan_folder(folder: str | Path, robot: RobotSpec, exclude: Sequence[str | Pa
         else:
             _scan_robot(sub, robot, excluded, entries, skipped)
     if not entries:
-        raise InputError(f"{folder}: no log found as {folder}/<robot_id>/<log>.parquet|.csv|.h5"
+        raise InputError(f"{folder}: no log found as {folder}/<robot_id>/<log> ({table_formats()})"
                          + (f" ({len(skipped)} passed over, e.g. {skipped[0]})" if skipped else ""))
     return FolderScan(entries, skipped)
 
@@ -180,7 +182,8 @@ def scan_folder(folder: str | Path, robot: RobotSpec, exclude: Sequence[str | Pa
 def _scan_robot(sub: Path, robot: RobotSpec, excluded: set[Path], entries: list[LogEntry],
                 skipped: list[Skipped]) -> None:
     """The logs of one robot's folder (recursively, hidden names left out) into ``entries``; what is not a log
-    into ``skipped``."""
+    into ``skipped``. A folder a format detects (a ROS 2 bag's) is one file: said once, its files not scanned."""
+    passed: set[Path] = set()  # the folders a format detects: their files are the format's, not scanned
     for path in sorted(sub.rglob("*")):
         if any(p.startswith(".") for p in path.relative_to(sub).parts):
             continue  # hidden
@@ -188,16 +191,21 @@ def _scan_robot(sub: Path, robot: RobotSpec, excluded: set[Path], entries: list[
         if resolved in excluded:
             skipped.append(Skipped(path, "this batch's output, not logs"))
             continue
-        if not path.is_file() or any(resolved.is_relative_to(e) for e in excluded):
-            continue  # a folder (its files are scanned); or inside an output (said once, for the output)
-        if path.suffix.lower() not in LOG_SUFFIXES:
-            skipped.append(Skipped(path, f"not a log ({', '.join(LOG_SUFFIXES)})"))
-            continue
-        written = _written_by_wbfriction(path)
-        if written:
-            skipped.append(Skipped(path, written))
-            continue
-        entries.append(LogEntry(path.resolve(), sub.name, log_start_time(path), robot))
+        if any(resolved.is_relative_to(p) for p in excluded | passed):
+            continue  # inside an output or a format's folder (said once, for it)
+        fmt = find_format(path)
+        if fmt is None:
+            if path.is_file():
+                skipped.append(Skipped(path, f"not a log: no log format reads it ({table_formats()})"))
+            continue  # a folder: its files are scanned
+        if path.is_dir():
+            passed.add(resolved)
+        why = (f"a {fmt.label}, read only through a map (--map), which a batch does not take: convert it first "
+               "('wbfriction convert')") if fmt.needs_map else _written_by_wbfriction(path)
+        if why:
+            skipped.append(Skipped(path, why))
+        else:
+            entries.append(LogEntry(path.resolve(), sub.name, log_start_time(path), robot))
 
 
 def _written_by_wbfriction(path: Path) -> str:

@@ -8,10 +8,11 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from wbfriction.choices import spoken
 from wbfriction.exceptions import InputError
 from wbfriction.export.drive import DEFAULT_PHYSICS_DT, DriveExport, drive_export
 from wbfriction.export.mapping import FitSelection, joint_exports, select_fits
-from wbfriction.export.registry import spoken, target_for, targets
+from wbfriction.export.registry import target_for, targets
 from wbfriction.export.target import ExportOptions, ExportReport
 from wbfriction.fit.params_file import read_robot_params
 from wbfriction.model.robot import Robot

@@ -3,8 +3,8 @@ motor-current log (the ground truth of an arm's identification).
 
 The arm is the robot's URDF on a fixed base (``pin.buildModelFromUrdf`` without a free flyer), its
 ``[locked_joints]`` removed (``pin.buildReducedModel``: the Panda's fingers). Its dynamics, with the
-reflected rotor inertia ``armature`` [kg·m^2] of each drive on its joint's axis and friction (3.5) in
-every joint:
+reflected rotor inertia ``armature`` [kg·m^2] of each drive on its joint's axis and friction (of any family: (3.5)
+by default) in every joint:
 
 .. math::
 
@@ -264,7 +264,7 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
 
     Args:
         robot: a fixed-base robot (``floating_base = false``) with a torque constant per joint.
-        friction: parameters (3.5) per joint (joints not named have none).
+        friction: parameters per joint, of any friction family the registry knows (joints not named have none).
         armature: true reflected rotor inertia per joint [kg·m^2] (joints not named: 0); None: the
             robot's own (its ``[armature]``).
         options: :class:`ArmOptions`.

@@ -11,7 +11,10 @@ import numpy as np
 from wbfriction.exceptions import InputError
 from wbfriction.fit.targets import friction_by_group
 from wbfriction.fit.terms import TermFit
-from wbfriction.friction.models import MODEL_NAMES, FrictionParams, ModelParams, model_values, stack_params
+from wbfriction.friction.families.base import FrictionFamily
+from wbfriction.friction.families.params import ModelParamsBase
+from wbfriction.friction.families.registry import family
+from wbfriction.friction.models import FrictionParams, ModelParams, stack_params
 from wbfriction.logs.log import Log
 from wbfriction.model.force_torque import sensor_readings
 from wbfriction.model.imu import imu_readings
@@ -20,10 +23,49 @@ from wbfriction.walking import WalkingReference
 from wbfriction.walking.indexing import as_slice
 
 
+@dataclass(frozen=True)
+class FamilyColumns:
+    """The joints of one friction family among an :class:`InjectedFriction`'s, its parameters stacked.
+
+    Attributes:
+        columns: the joints' positions (n_cols,) among the injected ones.
+        family: their family, from the registry (:func:`~wbfriction.friction.families.registry.family`).
+        x: their parameters (P, n_cols) in the order of the family's names (each row broadcasts over the joints).
+        delta_s: their Stribeck exponents (n_cols,) (2 for a family without one, which ignores it).
+    """
+
+    columns: np.ndarray
+    family: FrictionFamily
+    x: np.ndarray
+    delta_s: np.ndarray
+
+    def torque(self, qd: np.ndarray) -> np.ndarray:
+        """``tau_f = -f(qd)`` [N·m] of these joints from their velocities (..., n_cols) [rad/s]: the family's own
+        characteristic (:meth:`~wbfriction.friction.families.base.FrictionFamily.values`)."""
+        return -self.family.values(self.x, qd, self.delta_s)
+
+
+def family_columns(params: Sequence[ModelParamsBase]) -> list[FamilyColumns]:
+    """The joints of ``params`` (one per joint) grouped by family, in the order each family first appears: every
+    joint in exactly one group, whatever family it is (any the registry knows).
+
+    Raises:
+        UnknownFamilyError: parameters of a family the registry does not know.
+    """
+    out = []
+    for model in dict.fromkeys(p.model for p in params):
+        columns = np.array([i for i, p in enumerate(params) if p.model == model])
+        of_model = [params[i] for i in columns]
+        out.append(FamilyColumns(columns, family(model), np.array([p.as_vector() for p in of_model]).T,
+                                 np.array([float(getattr(p, "delta_s", 2.0)) for p in of_model])))
+    return out
+
+
 @dataclass
 class InjectedFriction:
-    """Friction a simulator applies to some torque-controlled joints: (3.5), or any model of
-    :mod:`~wbfriction.friction.models` (a sign function applied as it is: where the joint would stop, the
+    """Friction a simulator applies to some torque-controlled joints: any friction family's the registry knows
+    (:mod:`~wbfriction.friction.families`: the built-in ones, (3.5) among them, and those registered), its
+    characteristic as the family computes it (a sign function applied as it is: where the joint would stop, the
     simulator's steps make it chatter about zero velocity, a joint that sticks).
 
     Attributes:
@@ -39,7 +81,7 @@ class InjectedFriction:
 
     def __post_init__(self) -> None:
         self.beyond = [(col, self.terms[joint]) for col, joint in enumerate(self.params) if joint in self.terms]
-        self._gaussian = bool(self.params) and all(isinstance(p, FrictionParams) and p.delta_s == 2.0
+        self._gaussian = bool(self.params) and all(type(p) is FrictionParams and p.delta_s == 2.0
                                                    for p in self.params.values())
         if self._gaussian:
             self._stacked = stack_params(cast(list[FrictionParams], list(self.params.values())))
@@ -47,10 +89,8 @@ class InjectedFriction:
             p = {k: np.broadcast_to(np.asarray(v, dtype=float), (n,)).copy() for k, v in self._stacked.items()}
             # (3.5)'s constants, the additive ones negated (tau_f = -f: see torque)
             self._c = (1.0 / p["v_s"], -(p["F_c"] * p["S"]), -p["F_c"], p["a"], -p["tau_os"], -p["F_v"])
-        # the others: each joint's model, joints of one model at once
-        self._groups = [(np.array([i for i, q in enumerate(self.params.values()) if q.model == m]),
-                         [q for q in self.params.values() if q.model == m]) for m in MODEL_NAMES]
-        self._groups = [(cols, ps) for cols, ps in self._groups if len(cols)]
+        # the others: each joint's family, the joints of one family at once
+        self._groups = family_columns(list(self.params.values()))
 
     def torque(self, qd: np.ndarray) -> np.ndarray:
         """``tau_f = -f(qd)`` of the joints, from their velocities (n_f,) [rad/s] (a new array).
@@ -78,12 +118,12 @@ class InjectedFriction:
         return add(out, multiply(qd, m_Fv, out=e), out=out)
 
     def _torque_by_model(self, qd: np.ndarray) -> np.ndarray:
-        """:meth:`torque` of any models and shapes (..., n_f): each model's joints at once."""
-        out = np.empty_like(qd, dtype=float)
-        for cols, params in self._groups:
-            values = np.array([p.as_vector() for p in params]).T  # (n_params, n_cols): each row broadcasts
-            delta_s = np.array([getattr(p, "delta_s", 2.0) for p in params])
-            out[..., cols] = -model_values(values, qd[..., cols], delta_s, params[0].model)
+        """:meth:`torque` of any families and shapes (..., n_f): each family's joints at once."""
+        if len(self._groups) == 1:  # one family on every joint: its columns are 0, 1, ..., n_f - 1
+            return self._groups[0].torque(qd)
+        out = np.zeros(np.shape(qd))
+        for group in self._groups:  # every joint is one group's
+            out[..., group.columns] = group.torque(qd[..., group.columns])
         return out
 
     def with_terms(self, tau_f: np.ndarray, qd: np.ndarray, q: np.ndarray, load: np.ndarray,

@@ -43,7 +43,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from wbfriction.exceptions import InputError, ModelError, SimulationError
-from wbfriction.friction.models import MODEL_NAMES, ModelParams
+from wbfriction.friction.models import ModelParams
 from wbfriction.model.mjspec import urdf_spec
 from wbfriction.model.pd import PdDriver
 from wbfriction.model.robot import Robot
@@ -220,7 +220,7 @@ class PdRun:
         period: the samples' period [s]; substeps: physics steps per period.
         driver: the drivers (gains, delay, limits) of every joint.
         armature: per joint (n,) [kg·m^2]; offset: the encoders' offsets (n,) [rad].
-        friction: the parameters per joint (joints not named: none).
+        friction: the parameters per joint, of any friction family the registry knows (joints not named: none).
         friction_mode: :data:`~wbfriction.sim.options.FRICTION_MODES`; friction_timeconst: for ``"mujoco"`` [s].
         torque_delay: delay the PD's torque instead of the set-points (PACE's actuator, a peer's model: the law runs
             on the set-points as commanded and its torque, feedback and set-point alike, is applied the driver's
@@ -228,8 +228,8 @@ class PdRun:
             ``delayed`` says (:mod:`wbfriction.model.pd`).
 
     Raises:
-        InputError: friction for an unknown joint or of a family that is not built in; Stribeck or offset parameters
-            with MuJoCo's friction.
+        InputError: friction for an unknown joint; Stribeck or offset parameters with MuJoCo's friction.
+        UnknownFamilyError: parameters of a family the registry does not know.
     """
 
     def __init__(self, mjr: PdMujocoRobot, period: float, substeps: int, driver: PdDriver, armature: np.ndarray,
@@ -248,10 +248,6 @@ class PdRun:
         # softness, R = (1 - solimp[0]) / solimp[0] * dof_invweight0) with this armature, as a model compiled with
         # it has them (an exported MJCF): without, MuJoCo's friction would be that of the armature compiled before
         mujoco.mj_setConst(self.model, mujoco.MjData(self.model))
-        other = next((j for j, p in friction.items() if p.model not in MODEL_NAMES), None)
-        if other is not None:  # InjectedFriction applies the built-in families only
-            raise InputError(f"friction of '{other}': the simulator applies the built-in families "
-                             f"({', '.join(MODEL_NAMES)}), not '{friction[other].model}'")
         self.injected: InjectedFriction = injected_friction(mjr.robot, friction, joints=mjr.robot.actuated)
         self.native = friction_mode == "mujoco"
         dof_f = mjr.dof_index[self.injected.joints]

@@ -26,11 +26,11 @@ error, and a trot with the base gains (50, 10) fell at 6.7 s); at every physics 
 columns gives the torque applied at the samples exactly; ``"held"``: :func:`~wbfriction.sim.pd_robot.step_setpoints`).
 The log then has ``q_des``/``qd_des``/``tau_ff`` and no torque.
 
-**Friction** per joint (any built-in family, :class:`~wbfriction.sim.common.InjectedFriction`), ``tau_f = -f(qd)``
-of each physics step's velocity applied as a generalised force (``qfrc_applied``), logged (``tau_f_true``) at
-the samples. Not MuJoCo's ``frictionloss`` and ``damping``: the friction-loss constraint's force is not a function
-of the velocity (it sticks, and leads the velocity by its time constant), so the truth would not be the model
-fitted; an applied torque is exactly ``-f(qd)`` in the step's equations.
+**Friction** per joint (any family the registry knows, :class:`~wbfriction.sim.common.InjectedFriction`),
+``tau_f = -f(qd)`` of each physics step's velocity applied as a generalised force (``qfrc_applied``), logged
+(``tau_f_true``) at the samples. Not MuJoCo's ``frictionloss`` and ``damping``: the friction-loss constraint's force
+is not a function of the velocity (it sticks, and leads the velocity by its time constant), so the truth would not
+be the model fitted; an applied torque is exactly ``-f(qd)`` in the step's equations.
 
 **The log**, at each sample the physics step that starts at it (the truth then balances exactly at the samples:
 ``M(q) qdd + h(q, qd) = S^T (tau + tau_f) + sum_c J_c^T f_c`` with ``J_c`` at the contact points):

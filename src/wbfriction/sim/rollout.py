@@ -38,7 +38,7 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError, InputError
-from wbfriction.friction.models import MODEL_NAMES, ModelParams, ModelParamsBase
+from wbfriction.friction.models import ModelParams, ModelParamsBase
 from wbfriction.logs.tables import numeric_columns, read_table
 from wbfriction.model.robot import Robot
 from wbfriction.sim.options import FrictionMode
@@ -50,10 +50,10 @@ class ActuatorParams:
     """One parameter set of a PD-driven robot's drives, as the rollout replays it.
 
     Attributes:
-        friction: per joint, parameters of a built-in family (:class:`~wbfriction.friction.models.ModelParams`) or a
-            fit holding them (``.params``: :class:`~wbfriction.fit.result.FitResult`, what
-            :func:`~wbfriction.fit.params_file.read_params` reads; a fit without parameters: no friction), or the
-            path of a parameters JSON; joints not named: none.
+        friction: per joint, parameters of any friction family the registry knows
+            (:class:`~wbfriction.friction.families.params.ModelParamsBase`) or a fit holding them (``.params``:
+            :class:`~wbfriction.fit.result.FitResult`, what :func:`~wbfriction.fit.params_file.read_params` reads; a
+            fit without parameters: no friction), or the path of a parameters JSON; joints not named: none.
         armature: per joint [kg·m^2] (joints not named: 0); None: the robot's ``[armature]``.
         encoder_offset: per joint [rad] (joints not named: 0); None: the robot's ``[encoder_offset]``.
         delay: the drivers' delay [s]; None: the robot's ``[pd]`` delay.
@@ -140,10 +140,10 @@ def _friction(robot: Robot, given: Mapping[str, Any] | str | Path) -> tuple[dict
         params = value if isinstance(value, ModelParamsBase) else getattr(value, "params", value)
         if params is None:
             continue
-        if not isinstance(params, ModelParamsBase) or params.model not in MODEL_NAMES:
-            raise InputError(f"friction of '{joint}': parameters of a built-in family ({', '.join(MODEL_NAMES)}) "
-                             f"are replayed, got {type(params).__name__}")
-        out[joint] = params  # type: ignore[assignment]  # a built-in family's (checked above)
+        if not isinstance(params, ModelParamsBase):
+            raise InputError(f"friction of '{joint}': a friction family's parameters are replayed, got "
+                             f"{type(params).__name__}")
+        out[joint] = params  # type: ignore[assignment]  # any family's (the simulator asks the registry)
     return out, tuple(j for j in robot.actuated if j not in out)
 
 
@@ -233,8 +233,9 @@ def rollout(robot: Robot, log: pa.Table | str | Path | LogSetpoints, params: Act
         :class:`RolloutResult`.
 
     Raises:
-        InputError: a stretch out of the log, a horizon <= 0, values for unknown joints, parameters of no built-in
-            family, a robot that is not a fixed-base PD-driven one.
+        InputError: a stretch out of the log, a horizon <= 0, values for unknown joints, friction that is no family's
+            parameters, a robot that is not a fixed-base PD-driven one.
+        UnknownFamilyError: parameters of a family the registry does not know.
         ColumnError: a column the replay needs is missing.
     """
     mjr = mjr or build_pd_robot(robot)

@@ -117,13 +117,12 @@ def refine_on_whole_log(identified_toml: str | Path, mjcf: str | Path, logs: Seq
     Raises:
         InputError: what reading the robot, the file or the logs raises; stretches whose times do not follow on.
     """
-    import pyarrow.parquet as pq
-
     from wbfriction.exceptions import InputError
+    from wbfriction.logs.tables import read_table
     from wbfriction.model.loading import load_robot
     from wbfriction.sim.refine import refine_mjcf, write_refined
 
-    tables = [pq.read_table(path) for path in logs]
+    tables = [read_table(path) for path in logs]  # any log format (the registry's)
     for before, after, path in zip(tables, tables[1:], logs[1:]):
         if after.num_rows and before.num_rows and after["time"][0].as_py() <= before["time"][-1].as_py():
             raise InputError(f"{path}: its times do not follow those of the log before it")

@@ -299,11 +299,12 @@ def log_speeds(path: str | Path, joints: Sequence[str]) -> dict[str, float]:
     """Each joint's 95th percentile of ``|qd|`` in the log [rad/s] (:func:`~wbfriction.fit.status.joint_speed`), its
     ``q.<joint>`` differentiated over :data:`SPEED_WINDOW` against the log's ``time``; joints without such a column
     left out."""
-    import pyarrow.parquet as pq
+    from wbfriction.logs.tables import TableFile
 
-    names = set(pq.read_schema(path).names)
+    log = TableFile(path)  # any log format (the registry's)
+    names = set(log.schema().names)
     columns = [f"q.{j}" for j in joints if f"q.{j}" in names]
-    table = pq.read_table(path, columns=["time", *columns])
+    table = log.read(["time", *columns])
     t = table.column("time").to_numpy()
     w = max(1, int(round(0.5 * SPEED_WINDOW / float(np.median(np.diff(t)))))) if t.size > 1 else 1
     if t.size <= 2 * w:

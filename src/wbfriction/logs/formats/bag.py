@@ -12,6 +12,7 @@ import pyarrow as pa
 from wbfriction.exceptions import InputError
 from wbfriction.logs.bags import BagMap, iter_bag, load_bag_map, read_bag
 from wbfriction.logs.formats.base import LogFormat
+from wbfriction.logs.formats.catalog import BAG
 from wbfriction.model.robot import Robot
 
 
@@ -21,13 +22,8 @@ def _bag_map(path: Path, mapping: object) -> BagMap:
     return mapping
 
 
-class BagFormat(LogFormat):
-    """ROS 2 bags, MCAP or sqlite3 (module docstring)."""
-
-    name = "bag"
-    label = "ROS 2 bag"
-    suffixes = (".mcap", ".db3")
-    needs_map = True
+class BagFormat(LogFormat, kind=BAG):
+    """ROS 2 bags, MCAP or sqlite3 (module docstring), read through a map, never written."""
 
     def detect(self, path: Path) -> bool:
         """A folder with ``metadata.yaml``, or a ``.mcap`` / ``.db3`` file."""

@@ -22,11 +22,12 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import ClassVar, Protocol
+from typing import Any, ClassVar, Protocol
 
 import pyarrow as pa
 
 from wbfriction.exceptions import InputError
+from wbfriction.logs.formats.catalog import FormatKind
 from wbfriction.logs.metadata import read_metadata
 from wbfriction.logs.table_map import TableMap, load_table_map
 from wbfriction.model.robot import Robot
@@ -130,6 +131,11 @@ class LogFormat(ABC):
         streamable: :meth:`open_writer` writes tables one after the other (a friction table, a converted bag).
         needs_map: its files are read only through a map (a ROS 2 bag's topics): :meth:`read_log` and
             :meth:`log_blocks` are its own, and it is not a table file (:meth:`read` refuses).
+        detail: what else the command line's help says of its files (a ROS 2 bag: ``or a folder with
+            metadata.yaml``), or "".
+
+    A built-in format's class takes these from its kind in :mod:`~wbfriction.logs.formats.catalog` (which the help
+    reads without importing the format): ``class ParquetFormat(LogFormat, kind=PARQUET)``.
     """
 
     name: ClassVar[str]
@@ -138,6 +144,14 @@ class LogFormat(ABC):
     writable: ClassVar[bool] = False
     streamable: ClassVar[bool] = False
     needs_map: ClassVar[bool] = False
+    detail: ClassVar[str] = ""
+
+    def __init_subclass__(cls, kind: FormatKind | None = None, **kwargs: Any) -> None:
+        """A subclass; with ``kind``, its name, label, suffixes and abilities are the kind's."""
+        super().__init_subclass__(**kwargs)
+        if kind is not None:
+            cls.name, cls.label, cls.suffixes, cls.detail = kind.name, kind.label, kind.suffixes, kind.detail
+            cls.writable, cls.streamable, cls.needs_map = kind.writable, kind.streamable, kind.needs_map
 
     def __repr__(self) -> str:
         return f"<log format {self.name}>"

@@ -13,6 +13,7 @@ import pyarrow as pa
 import pyarrow.csv as pacsv
 
 from wbfriction.logs.formats.base import BatchRows, LogFormat, RowReader, TableWriter, unreadable
+from wbfriction.logs.formats.catalog import CSV
 from wbfriction.logs.metadata import META_KEY
 
 CSV_METADATA = b"#wbfriction "
@@ -65,14 +66,8 @@ class CsvWriter:
             self._handle.close()
 
 
-class CsvFormat(LogFormat):
-    """CSV files (module docstring)."""
-
-    name = "csv"
-    label = "CSV"
-    suffixes = (".csv",)
-    writable = True
-    streamable = True
+class CsvFormat(LogFormat, kind=CSV):
+    """CSV files (module docstring): ``.csv``, written whole or streamed."""
 
     def read(self, path: Path, columns: list[str] | None = None, text_columns: Sequence[str] = ()) -> pa.Table:
         try:

@@ -34,9 +34,9 @@ import pyarrow as pa
 
 from wbfriction.exceptions import InputError
 from wbfriction.logs.formats.base import LogFormat, RowReader
+from wbfriction.logs.formats.catalog import HDF5
 from wbfriction.logs.metadata import META_KEY
 
-SUFFIXES = (".h5", ".hdf5", ".he5")
 NAMES_ATTRS = ("names", "columns")
 META = "wbfriction"
 """Name of the metadata's scalar dataset (and of the attribute older files carry)."""
@@ -169,13 +169,8 @@ class Hdf5Rows:
         return read_hdf5(self.path, start=start, stop=stop)
 
 
-class Hdf5Format(LogFormat):
-    """HDF5 files (module docstring)."""
-
-    name = "hdf5"
-    label = "HDF5"
-    suffixes = SUFFIXES
-    writable = True
+class Hdf5Format(LogFormat, kind=HDF5):
+    """HDF5 files (module docstring): ``.h5``, ``.hdf5``, ``.he5``, written whole."""
 
     def read(self, path: Path, columns: list[str] | None = None, text_columns: Sequence[str] = ()) -> pa.Table:
         return read_hdf5(path, columns=columns)

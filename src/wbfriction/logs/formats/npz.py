@@ -31,6 +31,7 @@ import pyarrow as pa
 
 from wbfriction.exceptions import InputError
 from wbfriction.logs.formats.base import LogFormat
+from wbfriction.logs.formats.catalog import NPZ
 from wbfriction.logs.metadata import META_KEY
 
 TIME_KEY = "times"
@@ -121,13 +122,8 @@ def read_npz_recordings(paths: Sequence[str | Path], joints: Sequence[str]) -> p
     return pa.concat_tables(tables)
 
 
-class NpzFormat(LogFormat):
-    """NumPy archives holding a log, one named array per column (module docstring)."""
-
-    name = "npz"
-    label = "NumPy"
-    suffixes = (".npz",)
-    writable = True
+class NpzFormat(LogFormat, kind=NPZ):
+    """NumPy archives holding a log, one named array per column (module docstring): ``.npz``, written whole."""
 
     def read(self, path: Path, columns: list[str] | None = None, text_columns: Sequence[str] = ()) -> pa.Table:
         """The log in ``path`` (or those of ``columns`` it has), its metadata in its schema.

@@ -10,6 +10,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from wbfriction.logs.formats.base import BatchRows, LogFormat, RowReader, TableWriter, unreadable
+from wbfriction.logs.formats.catalog import PARQUET
 
 
 def dictionary_columns(schema: pa.Schema) -> list[str]:
@@ -18,14 +19,8 @@ def dictionary_columns(schema: pa.Schema) -> list[str]:
     return [f.name for f in schema if not pa.types.is_floating(f.type)]
 
 
-class ParquetFormat(LogFormat):
-    """Apache Parquet files (module docstring)."""
-
-    name = "parquet"
-    label = "Parquet"
-    suffixes = (".parquet", ".pq")
-    writable = True
-    streamable = True
+class ParquetFormat(LogFormat, kind=PARQUET):
+    """Apache Parquet files (module docstring): ``.parquet``, ``.pq``, written whole or streamed."""
 
     def read(self, path: Path, columns: list[str] | None = None, text_columns: Sequence[str] = ()) -> pa.Table:
         try:

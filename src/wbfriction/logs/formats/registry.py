@@ -12,7 +12,9 @@ Five are built in, in this order: Parquet, CSV, HDF5, NumPy ``.npz`` and ROS 2 b
 
     register_format(Tsv())
 
-after which every command and function that takes a log reads (and, if the format writes, writes) ``.tsv`` files.
+after which every function that takes a log reads (and, if the format writes, writes) ``.tsv`` files: a folder's
+scan for logs (:func:`find_format`), and the command line's help, which lists the formats registered
+(:mod:`.catalog`) as the command line is loaded.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from pathlib import Path
 from wbfriction.exceptions import InputError
 from wbfriction.logs.formats.bag import BagFormat
 from wbfriction.logs.formats.base import LogFormat
+from wbfriction.logs.formats.catalog import KINDS, FormatKind
 from wbfriction.logs.formats.csv import CsvFormat
 from wbfriction.logs.formats.hdf5 import Hdf5Format
 from wbfriction.logs.formats.npz import NpzFormat
@@ -59,6 +62,8 @@ def register_format(fmt: LogFormat) -> LogFormat:
     """Add ``fmt`` to the formats every path is looked up in, after those registered before it (the first whose
     :meth:`~wbfriction.logs.formats.base.LogFormat.detect` accepts a path reads it). Returns ``fmt``.
 
+    Its kind joins the catalogue the command line's help reads (:mod:`~wbfriction.logs.formats.catalog`).
+
     Raises:
         ValueError: a format of that name registered already, or a suffix another format claims (naming both).
     """
@@ -70,6 +75,7 @@ def register_format(fmt: LogFormat) -> LogFormat:
             raise ValueError(f"log format '{fmt.name}' claims {', '.join(shared)}, which format '{other.name}' "
                              "reads already")
     _FORMATS[fmt.name] = fmt
+    KINDS[fmt.name] = FormatKind.of(fmt)
     return fmt
 
 
@@ -81,6 +87,7 @@ def unregister_format(name: str) -> LogFormat:
     """
     if name not in _FORMATS:
         raise ValueError(f"no log format named '{name}' (registered: {', '.join(_FORMATS)})")
+    KINDS.pop(name, None)
     return _FORMATS.pop(name)
 
 
@@ -93,8 +100,16 @@ def _unknown(path: Path) -> UnknownFormatError:
     return UnknownFormatError(str(path), path.suffix.lower(), tuple(f.describe() for f in _FORMATS.values()))
 
 
+def find_format(path: str | Path) -> LogFormat | None:
+    """The first registered format that detects the existing file (or folder) ``path``
+    (:meth:`~wbfriction.logs.formats.base.LogFormat.detect`), or None: what a folder's scan for logs asks of each of
+    its files."""
+    return next((f for f in _FORMATS.values() if f.detect(Path(path))), None)
+
+
 def format_of(path: str | Path) -> LogFormat:
-    """The format of the existing file (or folder) ``path``: the first registered one that detects it.
+    """The format of the existing file (or folder) ``path``: the first registered one that detects it
+    (:func:`find_format`).
 
     Raises:
         InputError: a missing file; a folder no format reads (not a bag); :class:`UnknownFormatError`: a file no
@@ -103,7 +118,7 @@ def format_of(path: str | Path) -> LogFormat:
     path = Path(path)
     if not path.exists():
         raise InputError(f"{path}: file not found")
-    found = next((f for f in _FORMATS.values() if f.detect(path)), None)
+    found = find_format(path)
     if found is not None:
         return found
     if path.is_dir():
