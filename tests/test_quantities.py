@@ -198,3 +198,14 @@ def test_set_points_in_degrees_are_refused_before_the_work(go2, hung_log, tmp_pa
         code, err = run_cli(capsys, *command)
         assert code == 2 and "column 'q_des." in err and "wrong units (degrees for radians)?" in err, err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["degrees.parquet"]
+
+
+def test_the_robots_reference_gives_every_range():
+    """The manual's table (docs/reference/robots.md, "Physical ranges") holds each quantity's range and reason as
+    the code checks them."""
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "reference" / "robots.md").read_text()
+    rows = [ln for ln in page.splitlines() if ln.startswith("| `")]
+    for quantity, rng in RANGES.items():
+        assert any(f"| {rng.span()} | {rng.why} |" in row for row in rows), quantity
