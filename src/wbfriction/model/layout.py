@@ -1,4 +1,5 @@
-"""How joint angles map to a Pinocchio configuration vector (revolute, prismatic and continuous joints)."""
+"""How joint angles map to a Pinocchio configuration vector (revolute, prismatic and continuous joints), and the one
+number a continuous joint's angle is written as (:func:`principal_angle`)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,14 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+
+
+def principal_angle(q: np.ndarray | float) -> np.ndarray:
+    """Angles ``q`` [rad] (any shape) reduced modulo 2π into (−π, π]: the one number of a continuous joint's physical
+    angle (its configuration is (cos q, sin q)), whatever branch a log held it on; an angle already in (−π, π] is
+    returned exactly."""
+    q = np.asarray(q, dtype=float)
+    return q - 2.0 * np.pi * np.ceil((q - np.pi) / (2.0 * np.pi))
 
 
 @dataclass(frozen=True)
