@@ -50,6 +50,27 @@ class JointLayout:
         q[:, self.q2_index + 1] = np.sin(a[:, self.q2_joint])
         return q[0] if single else q
 
+    def principal(self, angles: np.ndarray) -> np.ndarray:
+        """Joint angles (n,) or (N, n) [rad] with every continuous joint's reduced into (−π, π]
+        (:func:`principal_angle`; the others as given): one number per configuration."""
+        a = np.array(angles, dtype=float)
+        if len(self.q2_joint):
+            a[..., self.q2_joint] = principal_angle(a[..., self.q2_joint])
+        return a
+
+    def unwrap(self, angles: np.ndarray) -> np.ndarray:
+        """Joint angles (N, n) [rad] of consecutive samples with every continuous joint's column unwrapped: a step of
+        more than π between two rows is a wrap, and the angle continues by whole turns from the first row's; the
+        others as given (``angles`` itself without a continuous joint). The first row's branch is the log's (its
+        convention, (−π, π] or [0, 2π), and where its window starts): what is a function of the angle reduces it
+        (:meth:`principal`); the differences, from which the clock, the noise and the derivatives are decided, are
+        the motion's."""
+        if not len(self.q2_joint):
+            return angles
+        out = np.array(angles, dtype=float)
+        out[:, self.q2_joint] = np.unwrap(out[:, self.q2_joint], axis=0)
+        return out
+
     def angles(self, q: np.ndarray) -> np.ndarray:
         """Inverse of :meth:`configuration` (without sign): joint positions from configurations."""
         q = np.asarray(q, dtype=float)
