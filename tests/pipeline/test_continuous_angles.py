@@ -2,12 +2,12 @@
 (−π, π] and to [0, 2π) gives the same friction table, the same fit and the same held-out prediction, up to rounding.
 
 The Panda with its last joint made ``continuous``, its encoder's zero put so that the joint's logged angle runs from
-2.6 to 4.3 rad on the fitted log (2.0 to 4.8 on the held-out one): across π, where a logger in (−π, π] wraps it and one
-in [0, 2π) does not; a two-harmonic position ripple in its friction. Both logs are estimated in chunks (each chunk
+2.76 to 3.44 rad on the fitted log (2.26 to 3.94 on the held-out one): across π, where a logger in (−π, π] wraps it and
+one in [0, 2π) does not; a two-harmonic position ripple in its friction. Both logs are estimated in chunks (each chunk
 unwrapped from its own first row) with the automatic differentiation and route, fitted with the ripple, and the
-held-out one predicted. Before issue 65, class 8: the (−π, π] table held the fitted angles on two branches (−7.14 to
-0.85 rad), the ripple's range came out wider than a turn, and the same held-out rows predicted 0.1425 N·m against
-0.1412 from the [0, 2π) log's fit.
+held-out one predicted. Before issue 65, class 8: the (−π, π] table held the fitted angles on two branches (−6.62 to
+0.34 rad), the ripple's range came out wider than a turn, and the same held-out rows predicted 0.2172 N·m against
+0.2185 from the [0, 2π) log's fit; the noise and differentiation were decided on first rows holding the wrap.
 """
 
 from __future__ import annotations

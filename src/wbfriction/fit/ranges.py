@@ -14,10 +14,12 @@ load term is a function of its magnitude), the temperature ``T`` [°C].
 **Angles are points of a circle** (issue 65, class 8). A continuous joint's angle is known modulo 2π only: a log
 holds it in (−π, π] or in [0, 2π), unwrapped from wherever its window (a segment, a chunk of a long log) starts, so
 the same physical motion reaches a friction table on other branches, and one table may hold it on several (a motion
-across π estimated in chunks: −7.14 to 0.85 rad where the joint turned over 1.7 rad). A range of angles is therefore
-the shortest arc of the circle holding them (:func:`angle_arc`), a function of the angles modulo 2π alone, and a
-ripple is evaluated at the angle reduced into that arc's turn (:func:`ripple_angle`): fit and prediction see the
-physical angle only, whatever its branch (the same held-out rows logged both ways predicted 0.1425 and 0.1412 N·m).
+across π estimated in chunks: −6.62 to 0.34 rad where the joint turned over 0.67 rad; ``estimate`` now writes a
+continuous joint's angle in (−π, π], but a table need not come from it). A range of angles is therefore the shortest
+arc of the circle holding them (:func:`angle_arc`), a function of the angles modulo 2π alone, and a ripple is
+evaluated at the angle reduced into that arc's turn (:func:`ripple_angle`): fit and prediction see the physical angle
+only, whatever its branch (the same held-out rows, fitted on the log written both ways, predicted 0.2172 and 0.2185
+N·m).
 """
 
 from __future__ import annotations
