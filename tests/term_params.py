@@ -82,28 +82,36 @@ def physical_friction(qd: np.ndarray, q: np.ndarray, load: np.ndarray, temperatu
             + sum(c[f"ripple_sin{h}"] * np.sin(h * q) + c[f"ripple_cos{h}"] * np.cos(h * q) for h in (1, 2)))
 
 
-def motion(n: int = 2000, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``(time, qd, q, load)``: a joint swinging over the angles 0.6-2.4 rad (inside :data:`Q_RANGE`) at up to
-    about 1.6 rad/s, under a load of 0-25 N·m, sampled at 100 Hz."""
+def motion(n: int = 2000, seed: int = 0, swing: float = 0.9) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(time, qd, q, load)``: a joint swinging over the angles 0.6-2.4 rad (inside :data:`Q_RANGE`; ``1.5 ± swing``
+    [rad]) at up to about 1.6 rad/s, under a load of 0-25 N·m, sampled at 100 Hz."""
     t = np.arange(n) * 0.01
-    q = 1.5 + 0.9 * np.sin(1.7 * t)
-    qd = 0.9 * 1.7 * np.cos(1.7 * t)
+    q = 1.5 + swing * np.sin(1.7 * t)
+    qd = swing * 1.7 * np.cos(1.7 * t)
     load = 12.5 + 12.5 * np.sin(0.6 * t + 0.3)
     return t, qd, q, load
+
+
+def motion_estimate(temperature: np.ndarray, q_logged: np.ndarray | None = None, noise: float = 0.01, seed: int = 0,
+                    c: dict[str, float] = COEFFICIENTS, swing: float = 0.9) -> FrictionEstimate:
+    """The friction estimate of :data:`JOINT` (as ``estimate`` makes it) of :func:`motion` (``swing``) at
+    ``temperature`` (N,) [°C], its friction :func:`physical_friction` of the true angle plus ``noise`` [N·m] of white
+    noise, its angle logged as ``q_logged`` (N,) [rad] (default the true one: another branch is the logger's)."""
+    t, qd, q, load = motion(len(temperature), seed, swing)
+    tau_f = -physical_friction(qd, q, load, temperature, c) + np.random.default_rng(seed).normal(0, noise, len(t))
+    col = lambda x: np.asarray(x, dtype=float)[:, None]  # noqa: E731
+    return FrictionEstimate(joints=(JOINT,), time=t, qd=col(qd), tau_f=col(tau_f), valid=np.ones((len(t), 1), bool),
+                            phase=np.full(len(t), "single"), unique=np.ones(len(t), bool),
+                            contact=np.zeros((len(t), 0), bool), contact_frames=(),
+                            q=col(q if q_logged is None else q_logged), tau=col(load - tau_f),
+                            temperature=col(temperature), metadata={"provenance": {"robot": "panda"}})
 
 
 def table_file(path: Path, temperature: np.ndarray, q_shift: float = 0.0, noise: float = 0.01, seed: int = 0,
                c: dict[str, float] = COEFFICIENTS) -> Path:
     """A friction table of :data:`JOINT` (as ``estimate`` writes it) of :func:`motion` at ``temperature`` (N,) [°C],
     its angle logged ``q_shift`` [rad] away (another branch: 2π k), its friction :func:`physical_friction` of the
-    true angle plus ``noise`` [N·m] of white noise."""
-    t, qd, q, load = motion(len(temperature), seed)
-    tau_f = -physical_friction(qd, q, load, temperature, c) + np.random.default_rng(seed).normal(0, noise, len(t))
-    col = lambda x: np.asarray(x, dtype=float)[:, None]  # noqa: E731
-    est = FrictionEstimate(joints=(JOINT,), time=t, qd=col(qd), tau_f=col(tau_f), valid=np.ones((len(t), 1), bool),
-                           phase=np.full(len(t), "single"), unique=np.ones(len(t), bool),
-                           contact=np.zeros((len(t), 0), bool), contact_frames=(), q=col(q + q_shift),
-                           tau=col(load - tau_f), temperature=col(temperature),
-                           metadata={"provenance": {"robot": "panda"}})
-    write_table(friction_table(est), path)
+    true angle plus ``noise`` [N·m] of white noise (:func:`motion_estimate`)."""
+    q = motion(len(temperature), seed)[2]
+    write_table(friction_table(motion_estimate(temperature, q + q_shift, noise, seed, c)), path)
     return path

@@ -1,7 +1,8 @@
 """The ranges a fit's terms were fitted on, and a prediction outside them (issue 53, classes 4 and 7): a ripple is a
 function of the angle modulo 2π, so a continuous joint logged on another branch predicts the same; ``predict`` says in
 a plain sentence where a table leaves the fitted temperatures, loads and angles, and well outside them (beyond a range
-by more than its width) the prediction is not ``ok``."""
+by more than its width) the prediction is not ``ok``. The angles' range is an arc of the circle (issue 65, class 8):
+a table holding them on several branches at once fits and predicts as one holding them on one."""
 
 from __future__ import annotations
 
@@ -11,8 +12,22 @@ import numpy as np
 import pytest
 
 from helpers import run_cli_printed
-from term_params import COEFFICIENTS, JOINT, Q_RANGE, edited, params_file, table_file, term_fit
-from wbfriction.fit.ranges import OUTSIDE, FittedRanges, ripple_angle
+from term_params import (
+    COEFFICIENTS,
+    JOINT,
+    Q_RANGE,
+    T_REF,
+    edited,
+    motion,
+    motion_estimate,
+    params_file,
+    table_file,
+    term_fit,
+)
+from wbfriction.fit.joints import fit_estimate
+from wbfriction.fit.options import FitOptions, TermOptions
+from wbfriction.fit.predict import predict_torques
+from wbfriction.fit.ranges import OUTSIDE, FittedRanges, angle_arc, ripple_angle
 from wbfriction.fit.terms import TermSignals
 
 N = 400
@@ -54,6 +69,51 @@ def test_the_fitted_ranges_are_those_of_the_rows_fitted():
     assert ranges == FittedRanges(angle=(-0.3, 0.2), load=(1.0, 20.0), temperature=(29.5, 31.0))
     assert FittedRanges.from_dict(json.loads(json.dumps(ranges.to_dict()))) == ranges
     assert FittedRanges.of(use) == FittedRanges()  # nothing logged: no range
+
+
+TWO_PI = 2 * np.pi
+WRAPS = {"pi": lambda x: x - TWO_PI * np.ceil((x - np.pi) / TWO_PI), "2pi": lambda x: np.mod(x, TWO_PI)}
+"""A logger's angle in (−π, π] and in [0, 2π), each from its definition."""
+RIPPLE_ONLY = {**COEFFICIENTS, "F_L": 0.0}
+"""The joint's friction without its load term (its temperature held at ``T_REF``): the velocity law and the ripple."""
+
+
+def test_the_arc_of_angles_is_that_of_the_physical_angles():
+    """A joint swept over 2.8-3.5 rad, across π: its arc is (2.8, 3.5) however the angles are written, in (−π, π], in
+    [0, 2π), a turn away, or half on one branch and half on another (a log unwrapped in chunks: its min and max were
+    −3.48 and 3.5, a range wider than the motion by 2π - 0.7). Angles that never wrap give their min and max."""
+    q = np.linspace(2.8, 3.5, 71)
+    for written in (q, WRAPS["pi"](q), WRAPS["2pi"](q), q + 3 * TWO_PI, np.where(np.arange(71) < 30, q, q - TWO_PI)):
+        np.testing.assert_allclose(angle_arc(written), (2.8, 3.5), rtol=0, atol=1e-12)
+    assert angle_arc(np.array([0.1, -0.3, np.nan, 0.2])) == (-0.3, 0.2)  # exactly
+    assert angle_arc(np.array([-2.48, -1.41, -2.0])) == (-2.48, -1.41)
+    np.testing.assert_allclose(angle_arc(np.linspace(3.2, 3.4, 5)), (3.2 - TWO_PI, 3.4 - TWO_PI), rtol=0, atol=1e-12)
+    low, high = angle_arc(np.linspace(-10.0, 10.0, 2001))  # more than a turn: every angle but less than a step
+    assert -np.pi < low <= np.pi and TWO_PI - 0.011 < high - low < TWO_PI
+    assert angle_arc(np.array([np.nan])) is None and angle_arc(np.array([1.0])) == (1.0, 1.0)
+
+
+def test_a_fit_on_angles_held_on_two_branches_is_the_fit_on_one():
+    """A joint swept over 2.5-4.3 rad (its angle logged 1.9 rad from the one its ripple is written in), its table's
+    angles half on one branch and half a turn lower (the (−π, π] log estimated in two chunks): the same arc,
+    coefficients and prediction of a wider swing (2.2-4.6 rad, logged in (−π, π]; beyond the fitted angles the ripple
+    is held at their edge) as the table on one branch. Before issue 65, class 8, the range was −3.78 to 4.3 rad, wider
+    than a turn, so nothing was held: the same rows predicted to 0.0101 N·m RMS, against 0.0218 by the fit of the
+    table on one branch."""
+    temperature = np.full(2000, T_REF)
+    q = motion(2000)[2] + 1.9
+    options = FitOptions(model="coulomb-viscous", terms=TermOptions(terms=("ripple",)))
+    one, two = (fit_estimate(motion_estimate(temperature, x, c=RIPPLE_ONLY), options)[0].terms
+                for x in (q, np.where(np.arange(2000) < 1000, q, q - TWO_PI)))
+    assert one is not None and two is not None and one.kept == two.kept == ("ripple",)
+    np.testing.assert_allclose(two.q_range, one.q_range, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(one.q_range, (2.5, 4.3), atol=1e-3)
+    for name, value in one.coefficients.items():
+        assert two.coefficients[name] == pytest.approx(value, rel=1e-9, abs=1e-12), name
+    wider = WRAPS["pi"](motion(2000, swing=1.2)[2] + 1.9)
+    held = motion_estimate(temperature, wider, seed=1, c=RIPPLE_ONLY, swing=1.2)
+    a, b = (predict_torques(held, {JOINT: fit}) for fit in (one, two))
+    assert b.rms[0] == pytest.approx(a.rms[0], rel=1e-12)
 
 
 @pytest.fixture(scope="module")

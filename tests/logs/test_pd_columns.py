@@ -121,3 +121,37 @@ def test_the_identification_refuses_a_log_whose_torque_is_not_the_pd_laws(robot)
     talos = wbfriction.load_robot("talos")
     with pytest.raises(InputError, match="no \\[pd\\] gains"):
         identify_actuators(talos, log_from_table(table(robot), robot, "x"))
+
+
+@pytest.mark.parametrize("wrap", ["(-pi, pi]", "[0, 2pi)"])
+def test_a_continuous_joints_setpoint_is_read_on_its_angles_branch(tmp_path, wrap):
+    """Issue 65, class 8: the Go2's front left thigh made continuous, swinging across where the logger wraps its angle
+    (π in (−π, π], 0 in [0, 2π)), its angle and set-point wrapped alike, each on its own side of the wrap at times:
+    the drivers' torque is the PD law on the unwrapped angle and set-point (written from their definitions). The
+    set-point read as logged was a turn from the angle there: ``kp 2π`` = 126 N·m, clipped at the drive's limit."""
+    urdf = tmp_path / "go2_continuous.urdf"
+    text = (example_robot_data_dir() / "go2_description/urdf/go2.urdf").read_text()
+    at = text.index('name="FL_thigh_joint"')
+    urdf.write_text(text[:at] + text[at:].replace('type="revolute"', 'type="continuous"', 1))
+    config = tmp_path / "continuous.toml"
+    config.write_text(f'name = "hung"\nurdf = "{urdf}"\nfloating_base = false\n[pd]\nkp = 20.0\nkd = 0.4\n'
+                      "delay = 0.0075\n")
+    robot = wbfriction.load_robot(None, config=config)
+    i = robot.actuated.index("FL_thigh_joint")
+    assert list(robot.layout.q2_joint) == [i]
+    t = table(wbfriction.load_robot(None, config=robot_toml(tmp_path)))  # the same joints, revolute
+    time = t["time"].to_numpy()
+    wraps_at = np.pi if wrap == "(-pi, pi]" else 0.0
+    q, q_des = wraps_at + 0.3 * np.sin(4 * time), wraps_at + 0.3 * np.sin(4 * time + 0.1)  # the angles as they are
+    reduce = ((lambda x: x - 2 * np.pi * np.ceil((x - np.pi) / (2 * np.pi))) if wrap == "(-pi, pi]"
+              else (lambda x: np.mod(x, 2 * np.pi)))
+    assert np.any(np.abs(reduce(q_des) - reduce(q)) > np.pi)  # a turn apart as logged
+    for prefix, x in (("q", q), ("q_des", q_des)):
+        t = t.set_column(t.column_names.index(f"{prefix}.FL_thigh_joint"), f"{prefix}.FL_thigh_joint",
+                         pa.array(reduce(x)))
+    log = log_from_table(t, robot, "hung.parquet")
+    angles, setpoints = column(t, "q", robot), column(t, "q_des", robot)
+    angles[:, i], setpoints[:, i] = q, q_des
+    expected = pd_torque(robot.pd, log.time, angles, column(t, "qd", robot), setpoints)
+    np.testing.assert_allclose(log.tau, expected, rtol=0, atol=1e-12)
+    assert np.abs(log.tau[:, i]).max() < 3.0

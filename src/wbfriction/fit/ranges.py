@@ -10,6 +10,16 @@ outside (beyond a range by more than the range's width) the prediction is not ``
 The signals and their units: the joint angle ``q`` [rad] (the ripple; compared after reduction modulo 2π into the
 turn around its fitted angles, :func:`ripple_angle`), the load ``|tau_load|`` [N·m] (the
 load term is a function of its magnitude), the temperature ``T`` [°C].
+
+**Angles are points of a circle** (issue 65, class 8). A continuous joint's angle is known modulo 2π only: a log
+holds it in (−π, π] or in [0, 2π), unwrapped from wherever its window (a segment, a chunk of a long log) starts, so
+the same physical motion reaches a friction table on other branches, and one table may hold it on several (a motion
+across π estimated in chunks: −6.62 to 0.34 rad where the joint turned over 0.67 rad; ``estimate`` now writes a
+continuous joint's angle in (−π, π], but a table need not come from it). A range of angles is therefore the shortest
+arc of the circle holding them (:func:`angle_arc`), a function of the angles modulo 2π alone, and a ripple is
+evaluated at the angle reduced into that arc's turn (:func:`ripple_angle`): fit and prediction see the physical angle
+only, whatever its branch (the same held-out rows, fitted on the log written both ways, predicted 0.2172 and 0.2185
+N·m).
 """
 
 from __future__ import annotations
@@ -20,6 +30,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from wbfriction.model.layout import principal_angle
 
 Span = tuple[float, float]
 """A closed range ``(low, high)``, ``low <= high``, in its signal's unit."""
@@ -47,7 +59,8 @@ class FittedRanges:
     """The signals' ranges over the samples a joint's terms were fitted on; None: not logged.
 
     Attributes:
-        angle: the joint angle's ``(q_min, q_max)`` [rad].
+        angle: the arc of the joint's angles ``(q_low, q_high)`` [rad] (:func:`angle_arc`: ``(q_min, q_max)`` of a
+            joint that stays within an arc, whatever branch the table holds its angles on).
         load: the load magnitude's ``(min |tau_load|, max |tau_load|)`` [N·m].
         temperature: ``(T_min, T_max)`` [°C].
     """
@@ -59,13 +72,14 @@ class FittedRanges:
     @classmethod
     def of(cls, use: np.ndarray, angle: np.ndarray | None = None, load: np.ndarray | None = None,
            temperature: np.ndarray | None = None) -> FittedRanges:
-        """The ranges over the rows ``use`` (N,) bool of the joint angle [rad], its load torque ``tau_load`` [N·m]
-        (its magnitude's range) and its temperature [°C], each (N,) or None (not logged)."""
+        """The ranges over the rows ``use`` (N,) bool of the joint angle [rad] (its arc, :func:`angle_arc`), its load
+        torque ``tau_load`` [N·m] (its magnitude's range) and its temperature [°C], each (N,) or None (not logged)."""
         def pick(x: np.ndarray | None) -> np.ndarray | None:
             return None if x is None else np.asarray(x, dtype=float)[use]
 
         magnitude = None if load is None else np.abs(np.asarray(load, dtype=float))
-        return cls(_span(pick(angle)), _span(pick(magnitude)), _span(pick(temperature)))
+        angles = pick(angle)
+        return cls(None if angles is None else angle_arc(angles), _span(pick(magnitude)), _span(pick(temperature)))
 
     def get(self, signal: str) -> Span | None:
         """The range of ``signal`` (a key of :data:`SIGNALS`)."""
@@ -91,6 +105,28 @@ class FittedRanges:
         return cls(**{k: check_span(d.get(k), f"ranges.{k}", nonnegative=k == "load") for k in SIGNALS})
 
 
+def angle_arc(q: np.ndarray) -> Span | None:
+    """The shortest arc of the circle holding every finite angle of ``q`` (N,) [rad], as ``(low, high)``: it starts
+    past the widest gap between the angles taken modulo 2π and runs round to the gap's other side; ``low`` in
+    (−π, π], ``low <= high < low + 2π``. A function of the angles modulo 2π only: angles on other branches, or on
+    several at once (a continuous joint, module docstring), give the same arc, up to rounding. Angles that never wrap,
+    with no gap between them wider than the one their span leaves (a limited joint's), give ``(min, max)`` itself,
+    moved by whole turns into ``low`` in (−π, π] (:func:`~wbfriction.model.layout.principal_angle`). None without any
+    finite angle."""
+    q = np.asarray(q, dtype=float)
+    q = q[np.isfinite(q)]
+    if not q.size:
+        return None
+    turn = np.mod(q, 2.0 * np.pi)
+    order = np.argsort(turn, kind="stable")
+    ordered = turn[order]
+    gaps = np.diff(ordered, append=ordered[0] + 2.0 * np.pi)  # after each angle, the last one's round to the first
+    widest = int(np.argmax(gaps))
+    low = float(principal_angle(q[order[(widest + 1) % q.size]]))
+    end = q[order[widest]]
+    return low, float(end - 2.0 * np.pi * np.floor((end - low) / (2.0 * np.pi)))
+
+
 def same_turn(q: np.ndarray, span: Span) -> np.ndarray:
     """The angles ``q`` (N,) [rad] reduced modulo 2π into the turn centred on ``span``: the same angles of a joint
     (of a periodic function of them), on the branch nearest the range."""
@@ -99,10 +135,11 @@ def same_turn(q: np.ndarray, span: Span) -> np.ndarray:
 
 
 def ripple_angle(q: np.ndarray, q_range: Span | None) -> np.ndarray:
-    """The angle ``q`` (N,) [rad] a ripple fitted on the angles ``q_range`` is evaluated at: reduced modulo 2π into
-    the turn centred on ``q_range`` (:func:`same_turn`: a ripple, a series in ``sin(h q)``, ``cos(h q)``, is periodic
-    in 2π, and a continuous joint logged on another branch is at the same angle), then held within ``q_range`` (beyond
-    it the series is not known, its value at the nearest fitted angle is kept); ``q`` as given without ``q_range``."""
+    """The angle ``q`` (N,) [rad] a ripple fitted on the angles of the arc ``q_range`` (:func:`angle_arc`) is evaluated
+    at: reduced modulo 2π into the turn centred on ``q_range`` (:func:`same_turn`: a ripple, a series in ``sin(h q)``,
+    ``cos(h q)``, is periodic in 2π, and a continuous joint logged on another branch is at the same angle), then held
+    within ``q_range`` (beyond it the series is not known, its value at the nearest fitted angle going round the circle
+    is kept); ``q`` as given without ``q_range``. With the arc, a function of ``q`` modulo 2π (up to rounding)."""
     q = np.asarray(q, dtype=float)
     return q if q_range is None else np.clip(same_turn(q, q_range), *q_range)
 

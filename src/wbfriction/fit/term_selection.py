@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from wbfriction.fit.options import TermOptions
+from wbfriction.fit.ranges import angle_arc
 from wbfriction.fit.regression import covariance_errors
 from wbfriction.fit.temperature_law import ExponentialLaw
 from wbfriction.fit.term_checks import (
@@ -320,7 +321,7 @@ class TermSearch:
         derived = derived_parameters(refitted, coefficients)
         if "ripple" in kept and self.signals.q is not None:
             q_used = np.asarray(self.signals.q, dtype=float)[use]
-            q_range = (float(q_used.min()), float(q_used.max()))
+            q_range = angle_arc(q_used)  # the physical angles' arc, whatever branches the table holds them on
             derived["ripple_rms"], stderr["ripple_rms"] = ripple_size(q_used, harmonics, names, coef, cov)
         return TermFit(refitted, kept, harmonics, coefficients, stderr, derived, t_ref, q_range, self.reasons,
                        (self.base_rms, current), at_bound=held, covariance=cov, later=later)

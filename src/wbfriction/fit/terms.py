@@ -24,9 +24,10 @@ weighted least-squares solve fits them together (``term_selection.fit_terms``). 
   over by 44-50 %, the upper arm's "ripple" makes the other direction worse by 10-35 %); and with no more harmonics than
   its angles tell apart (``term_checks.MAX_CONDITION``). It is not dissipative: it is reported apart, left out of the
   energy check (eq. 7.9) and of the exports; predictions include it, at the angle reduced modulo 2π into the turn
-  around the angles it was fitted on (a continuous joint logged on another branch is at the same angle,
-  :func:`ripple_angle`), within those angles (outside, it is held at its value at the nearest fitted angle: a
-  Fourier series fitted on less than a turn is not known beyond its data, and would run away there).
+  around the arc of the angles it was fitted on (a continuous joint logged on another branch is at the same angle,
+  :func:`ripple_angle`; the arc is that of the physical angles, :func:`~wbfriction.fit.ranges.angle_arc`), within
+  those angles (outside, it is held at its value at the nearest fitted angle: a Fourier series fitted on less than a
+  turn is not known beyond its data, and would run away there).
 * ``temperature``: the Coulomb and viscous levels ``F_c + F_cT phi(T - T_ref)`` and ``F_v + F_vT phi(T - T_ref)``,
   ``T`` the logged joint temperature [°C], ``T_ref`` the reference temperature every output states: coefficients
   ``F_cT`` on ``phi g`` and ``F_vT`` on ``phi qd``, the levels' slopes at ``T_ref`` [N·m/°C, N·m·s/(rad·°C)]
@@ -203,8 +204,9 @@ class TermFit:
             ``F_c+ = F_c + tau_os``, ``F_c- = F_c - tau_os``, ``k_Tc``, ``k_Tv`` [1/°C], ``ripple_rms``: the ripple's
             standard deviation over the samples fitted [N·m]).
         reference_temperature: ``T_ref`` [°C] (None: no temperature term tried).
-        q_range: the angles the ripple was fitted on, ``(q_min, q_max)`` [rad] (None: no ripple); it predicts at
-            angles reduced modulo 2π and held within them (:func:`ripple_angle`).
+        q_range: the arc of the angles the ripple was fitted on, ``(q_low, q_high)`` [rad] (None: no ripple;
+            :func:`~wbfriction.fit.ranges.angle_arc`, whatever branches the table held them on); it predicts at angles
+            reduced modulo 2π and held within it (:func:`ripple_angle`).
         reasons: per term tried, why it was kept or not (one sentence).
         held_out_rms: the held-out RMS [N·m] of the velocity model alone and with the terms kept.
         check: the kept terms refitted on the other route's estimate (``term_selection.refit_terms``), or None.

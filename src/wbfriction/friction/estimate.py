@@ -353,7 +353,8 @@ def _estimate_segment(robot: Robot, log: Log, options: EstimateOptions, progress
         est = momentum_estimate(robot, log, options, progress, require_single_support, gaps)
     else:
         est = _acceleration_segment(robot, log, options, progress, companion, require_single_support, gaps)
-    est.q, est.tau, est.temperature = log.q[:, robot.tc_index], log.tau, log.temperature  # the terms' signals
+    # the terms' signals; a continuous joint's angle unwrapped from its window's first row, written in (-pi, pi]
+    est.q, est.tau, est.temperature = robot.layout.principal(log.q)[:, robot.tc_index], log.tau, log.temperature
     est.metadata["torque_source"] = torque_record(robot, log.torque_source, log.setpoints)  # every output says it
     if options.check_route:
         other: Route = "acceleration" if options.route == "momentum" else "momentum"

@@ -48,8 +48,10 @@ class FrictionEstimate:
         route: (N,) how each sample was estimated (:data:`~wbfriction.friction.measured.Closure`):
             ``contact`` (rigid contacts), ``base`` (measured base motion), ``wrench`` (measured
             wrenches), ``none``; or None (a table that does not say: rigid contacts).
-        q: the joints' positions as logged (N, n_tc) [rad], or None (a table of an earlier version): what the
-            position ripple is a function of (:mod:`~wbfriction.fit.terms`).
+        q: the joints' positions (N, n_tc) [rad], the model's (the logged ones less the encoder offsets), a
+            continuous joint's in (−π, π] (:func:`~wbfriction.model.layout.principal_angle`: the same number on every
+            row, whatever the log's convention or the window it was unwrapped in), or None (a table of an earlier
+            version): what the position ripple is a function of (:mod:`~wbfriction.fit.terms`).
         tau: the joints' measured torques (N, n_tc) [N·m], or None: the load their transmissions carry (the
             friction beyond the sensor is not in it), what load-dependent friction is a function of.
         temperature: the joints' logged temperatures (N, n_tc) [°C], NaN for a joint without, or None: none logged.

@@ -43,19 +43,19 @@ def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT
 def unwrap_positions(q: np.ndarray, robot: Robot, source: str, segments: list[tuple[int, int]],
                      first_row: int = 0) -> np.ndarray:
     """Positions (N, n_act) [rad] with every continuous joint (unbounded revolute) unwrapped
-    within each segment (a logger writes its angle in (-pi, pi]: a jump of 2 pi between two
-    samples is a wrap, not motion; differentiated across it, it is a 1e5 N·m friction).
+    within each segment (:meth:`~wbfriction.model.layout.JointLayout.unwrap`; a logger writes its angle in (-pi, pi]
+    or [0, 2pi): a jump of 2 pi between two samples is a wrap, not motion; differentiated across it, it is a 1e5 N·m
+    friction).
 
     Raises:
         ColumnError: another joint whose position jumps by more than pi between two samples of
             a segment (a wrapped angle, or a glitch), naming the column and the row.
     """
-    continuous = np.zeros(q.shape[1], dtype=bool)
-    continuous[robot.layout.q2_joint] = True
-    out = q.copy() if continuous.any() else q
+    continuous = len(robot.layout.q2_joint) > 0
+    out = q.copy() if continuous else q
     for a, b in segments:
-        if continuous.any():
-            out[a:b, continuous] = np.unwrap(q[a:b, continuous], axis=0)
+        if continuous:
+            out[a:b] = robot.layout.unwrap(q[a:b])
         jump = np.abs(np.diff(out[a:b], axis=0)) > np.pi
         if jump.any():
             k, i = np.argwhere(jump)[0]

@@ -17,6 +17,12 @@ Where the torque comes from, one source for every joint, the first that the log 
 delay and limits from the TOML). The law runs on the logged angle (the encoder's) and the driver's velocity
 (``qd.<joint>``; without it, the positions' central difference); the dynamics then take the model's angle, the
 logged one less the TOML's ``[encoder_offset]``.
+
+A continuous joint's set-point is logged as its angle is, wrapped (in (−π, π] or [0, 2π)), while its angle is read
+unwrapped (:func:`~wbfriction.logs.log.unwrap_positions`): the set-point is moved by whole turns onto the angle's
+branch (:func:`setpoints_on_branch`), so that the law's error ``q_des - q`` is the physical one, within half a turn,
+and the set-point runs on continuously where its delay interpolates it (a 2π error was a torque of ``kp 2π``,
+157 N·m on the Aliengo's thighs, clipped at the drives' limits: 25 N·m RMS where the log said 0.6).
 """
 
 from __future__ import annotations
@@ -28,6 +34,7 @@ import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError
 from wbfriction.logs.tables import numeric_columns
+from wbfriction.model.layout import principal_angle
 from wbfriction.model.pd import PdDriver, pd_torque
 from wbfriction.model.robot import Robot
 from wbfriction.quantities import RANGES, first_outside
@@ -39,7 +46,8 @@ PD_PREFIXES = ("q_des", "qd_des", "tau_ff", "kp", "kd", "tau_est")
 @dataclass(frozen=True, eq=False)
 class PdSetpoints:
     """What a log says its PD drivers were sent, each (N, n_pd) in :attr:`PdDriver.joints
-    <wbfriction.model.pd.PdDriver.joints>` order: ``q_des`` [rad], ``qd_des`` [rad/s], ``tau_ff`` [N·m] (None: not
+    <wbfriction.model.pd.PdDriver.joints>` order: ``q_des`` [rad] (a continuous joint's on the branch of its
+    unwrapped angle, :func:`setpoints_on_branch`), ``qd_des`` [rad/s], ``tau_ff`` [N·m] (None: not
     logged, zero), ``kp`` [N·m/rad] and ``kd`` [N·m·s/rad] (None: the TOML's), and the driver's velocity ``qd``
     [rad/s] the law runs on (logged, or the positions' central difference)."""
 
@@ -82,7 +90,8 @@ def read_setpoints(table: pa.Table, robot: Robot, time: np.ndarray, q_logged: np
         table: the log's table.
         robot: the robot (its :attr:`~wbfriction.model.robot.Robot.pd`).
         time: the sample times (N,) [s].
-        q_logged: the logged angles of every actuated joint (N, n_act) [rad] (the encoder's, offset included).
+        q_logged: the logged angles of every actuated joint (N, n_act) [rad] (the encoder's, offset included;
+            continuous joints unwrapped: their set-points are put on its branch, :func:`setpoints_on_branch`).
         qd_logged: the logged velocities (N, n_act) [rad/s], or None.
         source: the file, for errors.
         first_row: the table's first row in its file.
@@ -110,6 +119,7 @@ def read_setpoints(table: pa.Table, robot: Robot, time: np.ndarray, q_logged: np
         qd = np.gradient(q_logged[:, index], time, axis=0)
     q_des = group("q_des", True)
     assert q_des is not None
+    q_des = setpoints_on_branch(q_des, q_logged[:, index], np.isin(index, robot.layout.q2_joint))
     gains = {prefix: group(prefix, False) for prefix in ("kp", "kd")}
     for prefix, values in gains.items():
         if values is not None:
@@ -126,6 +136,19 @@ def _check_gains(prefix: str, values: np.ndarray, joints: tuple[str, ...], sourc
         rng, col = RANGES[prefix], f"{prefix}.{joints[k]}"
         raise ColumnError(source, col, first_row + row, f"column '{col}' at row {first_row + row}: "
                           f"{values[row, k]:g} {rng.unit} is outside {rng.span()}: {rng.why}")
+
+
+def setpoints_on_branch(q_des: np.ndarray, q: np.ndarray, continuous: np.ndarray) -> np.ndarray:
+    """Position set-points ``q_des`` (N, n) [rad] with those of the continuous joints (``continuous`` (n,) bool)
+    moved by whole turns onto the branch of the joints' unwrapped angles ``q`` (N, n) [rad]:
+    ``q + principal_angle(q_des - q)`` (:func:`~wbfriction.model.layout.principal_angle`; module docstring); the
+    others as given (``q_des`` itself without a continuous joint)."""
+    continuous = np.asarray(continuous, dtype=bool)
+    if not continuous.any():
+        return q_des
+    out = np.array(q_des, dtype=float)
+    out[:, continuous] = q[:, continuous] + principal_angle(q_des[:, continuous] - q[:, continuous])
+    return out
 
 
 def driver_estimate(table: pa.Table, robot: Robot, source: str, first_row: int) -> np.ndarray | None:

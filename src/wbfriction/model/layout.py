@@ -1,4 +1,5 @@
-"""How joint angles map to a Pinocchio configuration vector (revolute, prismatic and continuous joints)."""
+"""How joint angles map to a Pinocchio configuration vector (revolute, prismatic and continuous joints), and the one
+number a continuous joint's angle is written as (:func:`principal_angle`)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,14 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+
+
+def principal_angle(q: np.ndarray | float) -> np.ndarray:
+    """Angles ``q`` [rad] (any shape) reduced modulo 2π into (−π, π]: the one number of a continuous joint's physical
+    angle (its configuration is (cos q, sin q)), whatever branch a log held it on; an angle already in (−π, π] is
+    returned exactly."""
+    q = np.asarray(q, dtype=float)
+    return q - 2.0 * np.pi * np.ceil((q - np.pi) / (2.0 * np.pi))
 
 
 @dataclass(frozen=True)
@@ -40,6 +49,27 @@ class JointLayout:
         q[:, self.q2_index] = np.cos(a[:, self.q2_joint])
         q[:, self.q2_index + 1] = np.sin(a[:, self.q2_joint])
         return q[0] if single else q
+
+    def principal(self, angles: np.ndarray) -> np.ndarray:
+        """Joint angles (n,) or (N, n) [rad] with every continuous joint's reduced into (−π, π]
+        (:func:`principal_angle`; the others as given): one number per configuration."""
+        a = np.array(angles, dtype=float)
+        if len(self.q2_joint):
+            a[..., self.q2_joint] = principal_angle(a[..., self.q2_joint])
+        return a
+
+    def unwrap(self, angles: np.ndarray) -> np.ndarray:
+        """Joint angles (N, n) [rad] of consecutive samples with every continuous joint's column unwrapped: a step of
+        more than π between two rows is a wrap, and the angle continues by whole turns from the first row's; the
+        others as given (``angles`` itself without a continuous joint). The first row's branch is the log's (its
+        convention, (−π, π] or [0, 2π), and where its window starts): what is a function of the angle reduces it
+        (:meth:`principal`); the differences, from which the clock, the noise and the derivatives are decided, are
+        the motion's."""
+        if not len(self.q2_joint):
+            return angles
+        out = np.array(angles, dtype=float)
+        out[:, self.q2_joint] = np.unwrap(out[:, self.q2_joint], axis=0)
+        return out
 
     def angles(self, q: np.ndarray) -> np.ndarray:
         """Inverse of :meth:`configuration` (without sign): joint positions from configurations."""

@@ -219,8 +219,9 @@ def release_freed_memory() -> None:
 
 def first_positions(file: TableFile, robot: Robot) -> np.ndarray | None:
     """The positions of the first :data:`~wbfriction.logs.clock.ROUGHNESS_ROWS` rows (M, n_act), from
-    which the clock and the differentiation are decided, or None when a column is missing or not
-    finite (the chunk that holds it says so)."""
+    which the clock and the differentiation are decided, continuous joints unwrapped
+    (:meth:`~wbfriction.model.layout.JointLayout.unwrap`: a wrap is no motion, and no noise), or None when a column is
+    missing or not finite (the chunk that holds it says so)."""
     table = file.row_reader(ROUGHNESS_ROWS).rows(0, ROUGHNESS_ROWS)
     names = [f"q.{n}" for n in robot.actuated]
     if any(n not in table.column_names for n in names):
@@ -229,4 +230,4 @@ def first_positions(file: TableFile, robot: Robot) -> np.ndarray | None:
         q = np.column_stack([table.column(n).to_numpy(zero_copy_only=False).astype(float) for n in names])
     except (ValueError, TypeError):
         return None
-    return q if np.all(np.isfinite(q)) else None
+    return robot.layout.unwrap(q) if np.all(np.isfinite(q)) else None
