@@ -7,8 +7,9 @@ command line's help lists the names); the names below are imported on first use.
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+import lazy_loader
 
 if TYPE_CHECKING:
     from .base import FrictionFamily as FrictionFamily
@@ -43,15 +44,5 @@ MODULES = {
 }
 """Each public name and the module (of this package) that defines it."""
 
-__all__ = sorted(MODULES)
-
-
-def __getattr__(name: str):
-    """A public name, its module imported on first use (:data:`MODULES`)."""
-    if name not in MODULES:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f"{__name__}.{MODULES[name]}"), name)
-
-
-def __dir__() -> list[str]:
-    return __all__
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__, submod_attrs={module: [n for n, m in MODULES.items() if m == module] for module in set(MODULES.values())})
