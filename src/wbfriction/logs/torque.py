@@ -10,7 +10,7 @@ constants (``current.<joint>``, the robot TOML's ``[torque_constants]``), the dr
     from wbfriction.logs import TorqueKind, register_torque_source
 
     class Effort(TorqueKind):
-        name, what, prefix, precedence = "effort", "the drives' effort in mN·m (effort.<joint>)", "effort", 5
+        name, what, prefix, precedence = "effort", "the drives' effort in mN·m (effort.<joint>)", "effort", 25
         def torque(self, given):
             return 1e-3 * given.columns("effort")
 
