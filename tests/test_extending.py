@@ -1,7 +1,7 @@
 """A new kind of thing is one file and one registry entry (issues 54, 65): a toy friction family
-(``toys/toy_family.py``), a toy export target (``toys/toy_target.py``) and a toy log format (``toys/toy_format.py``),
-each registered with one call, reach every command (run in this process, as ``docs/extending.md`` says registration
-reaches) and public function that takes their kind.
+(``toys/toy_family.py``), a toy export target (``toys/toy_target.py``), a toy log format (``toys/toy_format.py``) and
+a toy torque source (``toys/toy_torque.py``), each registered with one call, reach every command (run in this
+process, as ``docs/extending.md`` says registration reaches) and public function that takes their kind.
 
 * The family: ``simulate --friction`` (its ``model`` key) injects it and logs its own characteristic; ``fit --model``
   recovers it; ``predict`` and ``report`` read its fits; ``export`` writes them (a built-in MJCF and the toy target);
@@ -10,6 +10,8 @@ reaches) and public function that takes their kind.
 * The target: ``export -o FILE.csv`` (:func:`~wbfriction.pipeline.export_step.export_files`).
 * The format: ``simulate -o`` writes it; ``estimate``, ``convert``, ``spectrum``, ``sensitivity``, ``identify``,
   ``rollout``, ``refine`` and ``batch`` (a folder's scan) read it.
+* The torque source: a log written through it (:func:`~wbfriction.logs.log.write_log`: its own columns), then
+  ``convert``, ``spectrum``, ``estimate`` (which says it) and ``fit`` read it.
 """
 
 from __future__ import annotations
@@ -26,11 +28,19 @@ from helpers import run_cli_printed
 from toys.toy_family import NAME, A, FixedSlope, FixedSlopeParams
 from toys.toy_format import Feather
 from toys.toy_target import FrictionCsv
+from toys.toy_torque import SCALE, Effort
 from wbfriction.export import registry
 from wbfriction.export.registry import register_target
 from wbfriction.friction.families.registry import register_family, unregister_family
 from wbfriction.friction.models import FrictionParams
-from wbfriction.logs import register_format, unregister_format
+from wbfriction.logs import (
+    read_log,
+    register_format,
+    register_torque_source,
+    unregister_format,
+    unregister_torque_source,
+)
+from wbfriction.logs.log import write_log
 from wbfriction.logs.tables import read_metadata, read_table, write_table
 from wbfriction.model.loading import load_robot
 from wbfriction.sim.arm import default_arm_friction
@@ -44,6 +54,14 @@ def toys(monkeypatch):
     yield family, fmt, target
     unregister_family(family.name)
     unregister_format(fmt.name)
+
+
+@pytest.fixture
+def effort():
+    """The toy torque source registered (one call), and forgotten after the test."""
+    kind = register_torque_source(Effort())
+    yield kind
+    unregister_torque_source(kind.name)
 
 
 @pytest.fixture
@@ -97,6 +115,56 @@ def test_a_toy_family_target_and_format_run_from_a_simulation_to_an_export(toys,
     everyone = next(line.split() for line in predicted.splitlines() if line.strip().startswith("all joints"))
     rigid, with_friction = float(everyone[3]), float(everyone[4])  # the RMS without and with the toy's fits
     assert with_friction < 0.1 * rigid  # what is left is the 0.01 N·m torque noise, not the friction of ~1 N·m
+
+
+def test_a_toy_torque_source_runs_from_a_log_to_the_fitted_friction(toys, effort, tmp_path, cli, capsys):
+    """The Panda simulated with the toy family (its currents logged), its log written through the toy torque source
+    (``effort.<joint>`` in mN·m, no current), then converted, read, estimated and fitted: the friction injected comes
+    out of the other end, and the outputs say where the torque came from."""
+    robot = load_robot("panda")
+    truth = {j: FixedSlopeParams(F_v=p.F_v, F_c=p.F_c, tau_os=p.tau_os) for j, p in default_arm_friction(robot).items()}
+    cli("simulate", "--robot", "panda", "--friction", friction_toml(tmp_path / "toy.toml", truth), "--duration", "6",
+        "--torque-noise", "0.01", "--noise-seed", "3", "-o", tmp_path / "arm.parquet")
+    simulated = read_log(tmp_path / "arm.parquet", robot)
+    assert simulated.torque_source == "current"
+    simulated.torque_source = effort.name
+    write_log(simulated, robot, tmp_path / "effort.parquet")
+    table = read_table(tmp_path / "effort.parquet")
+    assert not [c for c in table.column_names if c.partition(".")[0] in ("tau", "tau_est", "current", "q_des")]
+    for i, joint in enumerate(robot.torque_controlled):  # its own columns, in its own unit
+        np.testing.assert_allclose(table[f"effort.{joint}"].to_numpy(), simulated.tau[:, i] / SCALE, rtol=1e-15)
+
+    log = tmp_path / "converted.parquet"
+    cli("convert", tmp_path / "effort.parquet", "--robot", "panda", "-o", log)
+    back = read_log(log, robot)
+    assert back.torque_source == effort.name
+    np.testing.assert_allclose(back.tau, simulated.tau, rtol=1e-15, atol=0)
+    cli("spectrum", log, "--robot", "panda", "--joints", "panda_joint1", "-o", tmp_path / "spectrum.png")
+    assert (tmp_path / "spectrum.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    code, _, said = run_cli_printed(capsys, "estimate", log, "--robot", "panda", "-o", tmp_path / "friction.parquet")
+    assert code == 0, said
+    assert f"torque: {Effort.what}\n" in said  # the text output says it, as it says a built-in's
+    assert read_metadata(read_table(tmp_path / "friction.parquet"))["torque_source"] == {
+        "source": effort.name, "what": Effort.what}
+    cli("fit", tmp_path / "friction.parquet", "--model", NAME, "--terms", "none", "-o", tmp_path / "params.json")
+    fits = json.loads((tmp_path / "params.json").read_text())["joints"]
+    assert set(fits) == set(truth)
+    for joint, p in truth.items():
+        for name in ("F_c", "F_v"):
+            assert fits[joint]["params"][name] == pytest.approx(getattr(p, name), rel=0.05), (joint, name)
+
+
+def test_a_torque_source_is_refused_a_name_or_precedence_taken(effort):
+    """One source per name and per place in the order: the toy registered twice, or at the currents' precedence, is
+    refused, naming what holds it; the order is the precedence's, whatever the order of registration."""
+    from wbfriction.logs import torque_sources
+
+    with pytest.raises(ValueError, match="'effort' is registered already"):
+        register_torque_source(Effort())
+    tied = type("Tied", (Effort,), {"name": "tied", "precedence": 30})
+    with pytest.raises(ValueError, match="precedence 30 of 'current'"):
+        register_torque_source(tied())
+    assert [k.name for k in torque_sources()] == ["sensor", "driver", "effort", "current", "pd"]
 
 
 @pytest.mark.slow

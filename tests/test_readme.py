@@ -129,6 +129,8 @@ pages run are checked here, once (``tests/test_examples.py`` runs the others).""
 PRINTS = {
     "docs/how-to/library.md": [r"leg_right_4_joint: F_c"],  # the API block's fits of the walk
     "docs/extending.md": [r"^arm\.tsv: 10000 samples, tau_f of 7 joints$",  # a log format registered, read
+                          # a torque source registered: a log written through it, read back as its own
+                          r"^arm_effort\.parquet: effort: the drives' effort in mN·m \(effort\.<joint>\)$",
                           r"^wrote panda_friction\.csv \(csv\)$",  # an export target, beside a built-in one
                           r"^wrote panda_extended\.xml \(mjcf\)$",
                           r"^panda_joint1: quadratic: F_v ",  # a family fitted alone, then scored by --model auto
@@ -149,7 +151,7 @@ PRINTS = {
 
 WRITES = {
     "docs/how-to/library.md": ["api_params.json"],
-    "docs/extending.md": ["arm.tsv", "panda_friction.csv", "panda_extended.xml"],
+    "docs/extending.md": ["arm.tsv", "arm_effort.parquet", "panda_friction.csv", "panda_extended.xml"],
 }
 """Files a page's ``python`` blocks must write."""
 

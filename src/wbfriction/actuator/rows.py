@@ -44,6 +44,7 @@ import pinocchio as pin
 from wbfriction.actuator.options import STEEPER, ActuatorOptions
 from wbfriction.exceptions import InputError
 from wbfriction.logs.log import Log
+from wbfriction.logs.torque import torque_kind
 from wbfriction.model.momentum import momentum_and_drift
 from wbfriction.model.robot import Robot
 from wbfriction.signals.choice import acceleration_content
@@ -130,7 +131,7 @@ def pd_joints(robot: Robot, log: Log) -> np.ndarray:
     if robot.floating_base:
         raise InputError(f"robot '{robot.name}': the actuator identification needs a fixed base (the robot hung, "
                          "floating_base = false in its TOML)")
-    if log.torque_source != "pd" or log.setpoints is None:
+    if not torque_kind(log.torque_source).pd_law or log.setpoints is None:
         raise InputError(f"{log.source}: the torque comes from {log.torque_source} columns, not the PD law: the "
                          "actuator identification needs the set-points q_des.<joint> and no tau, tau_est or "
                          "current column")

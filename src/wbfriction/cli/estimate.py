@@ -58,6 +58,7 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     """Estimate a log file in chunks on ``workers`` processes (which load the robot from
     ``spec``), read as ``read`` says; a ROS 2 bag is first streamed into a temporary Parquet log beside the
     output."""
+    from wbfriction.logs.torque import torque_kind
     from wbfriction.pipeline.chunks import Chunking
     from wbfriction.pipeline.estimate_step import estimate_source
 
@@ -85,14 +86,15 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     if result.route:
         console.print(f"route: {escape(result.route)}", highlight=False, soft_wrap=True)
     torque = result.metadata.get("torque_source", {})
-    if torque.get("source") not in (None, "sensor") or "setpoints" in torque:
+    kind = torque_kind(torque["source"]) if "source" in torque else None  # what the source is, asked of it
+    if (kind is not None and kind.printed) or "setpoints" in torque:
         held = "the whole torque" if torque.get("delayed") == "torque" else "the set-points"
         delay = f", {held} {1e3 * torque['delay']:.3g} ms late ({torque['gains']})" if "delay" in torque else ""
         if torque.get("delayed_known") is False:
             delay += "; the log it was identified on does not tell what the delay holds back: F_v known to kp delay"
         unused = "; the set-points q_des.<joint> not used (the measured torque is)" if "setpoints" in torque else ""
         console.print(escape(f"torque: {torque['what']}{delay}{unused}"), highlight=False, soft_wrap=True)
-        if torque.get("source") == "pd" and bag_map is None:
+        if kind is not None and kind.pd_law and bag_map is None:
             from wbfriction.pipeline.actuator_step import pd_law_warnings
 
             warn(pd_law_warnings(r, log, read.time_unit))

@@ -16,3 +16,8 @@ from .source import read_log as read_log
 from .tables import TableFile as TableFile
 from .tables import read_table as read_table
 from .tables import write_table as write_table
+from .torque import TorqueColumns as TorqueColumns
+from .torque import TorqueKind as TorqueKind
+from .torque import register_torque_source as register_torque_source
+from .torque import torque_sources as torque_sources
+from .torque import unregister_torque_source as unregister_torque_source

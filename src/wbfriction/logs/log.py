@@ -50,18 +50,10 @@ from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forc
 from wbfriction.logs.foot_forces import column_names as foot_force_names
 from wbfriction.logs.foot_forces import foot_force_columns, foot_force_table, read_foot_forces
 from wbfriction.logs.options import MAX_GAP, ReadOptions
-from wbfriction.logs.pd import (
-    PD_PREFIXES,
-    PdSetpoints,
-    driver_estimate,
-    pd_columns_named,
-    pd_law_torque,
-    read_setpoints,
-    setpoint_columns,
-)
+from wbfriction.logs.pd import PD_PREFIXES, PdSetpoints, pd_columns_named, read_setpoints
 from wbfriction.logs.tables import numeric_column, numeric_columns, read_metadata, with_metadata, write_table
 from wbfriction.logs.temperature import screen_temperature
-from wbfriction.logs.torque import TorqueSource
+from wbfriction.logs.torque import TorqueColumns, TorqueSource, check_torque_columns, torque_kind, torque_source_of
 from wbfriction.model.robot import Robot
 
 
@@ -88,11 +80,11 @@ class Log:
             None: the clock's nominal step, else the median step of ``time``.
         qd_logged: joint velocities as the robot logged them (``qd.<joint>`` columns)
             (N, n_act) [rad/s], or None; used with ``--velocity logged`` only.
-        torque_source: where ``tau`` comes from: ``"sensor"`` (link-side joint torque
-            sensors: only the friction after the sensor is in it), ``"driver"`` (the motor
-            drivers' own estimates, ``tau_est.<joint>``), ``"current"`` (motor current x torque
-            constant) or ``"pd"`` (the drivers' PD law on the logged set-points,
-            :mod:`wbfriction.logs.pd`); the last three are the motor's torque: the whole drive's
+        torque_source: where ``tau`` comes from, the name of a registered torque source
+            (:mod:`wbfriction.logs.torque`): ``"sensor"`` (link-side joint torque sensors: only the friction after
+            the sensor is in it), ``"driver"`` (the motor drivers' own estimates, ``tau_est.<joint>``),
+            ``"current"`` (motor current x torque constant) or ``"pd"`` (the drivers' PD law on the logged
+            set-points, :mod:`wbfriction.logs.pd`); the last three are the motor's torque: the whole drive's
             friction and the rotor inertia are in it.
         setpoints: a PD-driven robot's set-points and driver velocities
             (:class:`~wbfriction.logs.pd.PdSetpoints`), or None.
@@ -181,15 +173,7 @@ class Log:
         offset = robot.encoder_offset  # the logged angle is the model's plus the encoder's offset
         cols.update({f"q.{n}": self.q[:, i] + offset[n] if n in offset else self.q[:, i]
                      for i, n in enumerate(robot.actuated)})
-        if self.torque_source == "current":
-            cols.update({f"current.{n}": self.tau[:, i] / robot.torque_constants[n]
-                         for i, n in enumerate(robot.torque_controlled)})
-        elif self.torque_source == "driver":
-            cols.update({f"tau_est.{n}": self.tau[:, i] for i, n in enumerate(robot.torque_controlled)})
-        elif self.setpoints is not None and robot.pd is not None:
-            cols.update(setpoint_columns(self.setpoints, robot.pd.joints))
-        else:
-            cols.update({f"tau.{n}": self.tau[:, i] for i, n in enumerate(robot.torque_controlled)})
+        cols.update(torque_kind(self.torque_source).columns(self.tau, robot, self.setpoints))
         if robot.floating_base:
             cols.update({f"contact.{n}": self.contact[:, i].astype(np.int8)
                          for i, n in enumerate(robot.contact_frames)})
@@ -264,7 +248,8 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
     setpoints = read_setpoints(table, robot, time, q, qd_logged, source, first_row)
     if setpoints is not None and robot.pd is not None:  # a set-point in degrees drives the joint to its limits
         check_limits(setpoints.q_des, robot, source, read.limit_margin, first_row, "q_des", robot.pd.joints)
-    tau, torque_source = _read_torque(table, robot, source, first_row, time, q, setpoints)
+    kind = torque_source_of(given := TorqueColumns(table, robot, source, first_row, time, q, setpoints))
+    tau = kind.torque(given)  # one source for every joint (wbfriction.logs.torque)
     q = q - robot.offset_vector if robot.encoder_offset else q  # the model's angles (wbfriction.model.pd)
     wrench = _read_wrench(table, robot, source, first_row)
     foot_force = read_foot_forces(table, robot, source, first_row)
@@ -281,11 +266,11 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
     base_qdd_true = _read_group(table, BASE_QDD_TRUE_COLUMNS, source, first_row, "true base acceleration")
     imu = _read_group(table, IMU_COLUMNS, source, first_row, "the IMU's reading")
     metadata = read_metadata(table, source)
-    if torque_source == "pd":  # each sample's torque stands for its period's mean (wbfriction.model.pd)
-        metadata = {"torque_alignment": "sample", **metadata}
+    if kind.alignment is not None:  # e.g. the PD law's: each sample's torque its period's mean (wbfriction.model.pd)
+        metadata = {"torque_alignment": kind.alignment, **metadata}
     return Log(time, q, tau, contact, base, tau_f_true, metadata, source,
                qd_true=qd_true, qdd_true=qdd_true, segments=clock.segments, period=period, qd_logged=qd_logged,
-               torque_source=torque_source, clock=clock, warnings=warnings, wrench=wrench,
+               torque_source=kind.name, clock=clock, warnings=warnings, wrench=wrench,
                base_qd_true=base_qd_true, base_qdd_true=base_qdd_true, imu=imu, temperature=temperature,
                setpoints=setpoints, foot_force=foot_force)
 
@@ -336,7 +321,7 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
     for col in [f"q.{n}" for n in robot.actuated] + contact:
         if col not in seen:
             raise ColumnError(source, col, None, f"missing column '{col}'")
-    _check_torque_columns(robot, seen, source)
+    check_torque_columns(robot, seen, source)  # every joint's torque from a registered source
     single = []
     for f in schema:
         prefix = f.name.partition(".")[0]
@@ -371,25 +356,6 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
             f"about 7 significant digits ({'; '.join(sizes)}){cost}; log float64",)
 
 
-def _check_torque_columns(robot: Robot, seen: set[str], source: str) -> None:
-    """Every torque-controlled joint has a torque: ``tau``, ``tau_est``, ``current`` with a torque constant, or
-    ``q_des`` of a PD-driven joint (:mod:`wbfriction.logs.pd`)."""
-    pd_joints = set(robot.pd.joints) if robot.pd is not None else set()
-    for n in robot.torque_controlled:
-        if f"tau_est.{n}" in seen or (n in pd_joints and f"q_des.{n}" in seen):
-            continue
-        if f"tau.{n}" not in seen and f"current.{n}" not in seen and f"q_des.{n}" in seen:
-            raise ColumnError(source, f"q_des.{n}", None, f"column 'q_des.{n}' is a PD set-point, but robot "
-                              f"'{robot.name}' has no [pd] gains for '{n}' in its TOML (kp, kd: wbfriction.model.pd)")
-        if f"tau.{n}" not in seen and f"current.{n}" not in seen:
-            raise ColumnError(source, f"tau.{n}", None, f"missing column 'tau.{n}' (or 'current.{n}' with a "
-                              f"torque constant for '{n}' in the robot's [torque_constants], or 'q_des.{n}' "
-                              "with [pd] gains)")
-        if f"tau.{n}" not in seen and n not in robot.torque_constants:
-            raise ColumnError(source, f"current.{n}", None, f"column 'current.{n}' needs a torque constant: add "
-                              f"'{n}' [N·m/A] to the robot's [torque_constants]")
-
-
 SINGLE_PRECISION_SCALE: dict[str, tuple[float, str]] = {
     "time": (1000.0, "s"), "q": (2.0, "rad"), "qd": (2.0, "rad/s"), "qd_true": (2.0, "rad/s"),
     "qdd_true": (20.0, "rad/s²"), "tau": (100.0, "N·m"), "tau_f_true": (10.0, "N·m"), "current": (10.0, "A"),
@@ -421,31 +387,6 @@ def _read_motion(table: pa.Table, robot: Robot, source: str, read: ReadOptions, 
         q = unwrap_positions(raw, robot, source, clock.segments, first_row)
     time = stamps * 1e-9 if np.issubdtype(stamps.dtype, np.integer) else stamps
     return time, clock, q
-
-
-def _read_torque(table: pa.Table, robot: Robot, source: str, first_row: int, time: np.ndarray, q_logged: np.ndarray,
-                 setpoints: PdSetpoints | None) -> tuple[np.ndarray, TorqueSource]:
-    """The torques of the torque-controlled joints (N, n_tc) [N·m] and where they come from, one source for
-    every joint, the first the log has: ``tau.<joint>`` columns (joint torque sensors), the drivers'
-    ``tau_est.<joint>``, ``current.<joint>`` [A] times the joint's torque constant [N·m/A]
-    (:attr:`Robot.torque_constants`), the PD law on the set-points (:mod:`wbfriction.logs.pd`)."""
-    names = set(table.column_names)
-    from_sensor = [f"tau.{n}" in names for n in robot.torque_controlled]
-    if all(from_sensor):
-        return _stack(table, [f"tau.{n}" for n in robot.torque_controlled], source, first_row), "sensor"
-    estimated = driver_estimate(table, robot, source, first_row)
-    if estimated is not None:
-        return estimated, "driver"
-    if setpoints is not None and not any(from_sensor) and not any(f"current.{n}" in names
-                                                                     for n in robot.torque_controlled):
-        return pd_law_torque(robot, setpoints, time, q_logged, source), "pd"
-    if any(from_sensor):
-        n = robot.torque_controlled[from_sensor.index(False)]
-        raise ColumnError(source, f"tau.{n}", None, f"missing column 'tau.{n}': torques come from tau.* columns "
-                          "for some joints and current.* for others; log one kind for every joint")
-    current = _stack(table, [f"current.{n}" for n in robot.torque_controlled], source, first_row)
-    k = np.array([robot.torque_constants[n] for n in robot.torque_controlled])
-    return current * k, "current"
 
 
 def forces_give_contacts(robot: Robot, columns: set[str] | list[str]) -> bool:

@@ -11,7 +11,7 @@ Columns (every PD-driven joint of :attr:`Robot.pd <wbfriction.model.robot.Robot.
 ``tau_est.<joint>``    N·m         optional: the driver's own torque estimate (from its current)
 =====================  ==========  ==================================================
 
-Where the torque comes from, one source for every joint, the first that the log has (:data:`TORQUE_SOURCES`):
+Where the torque comes from, one source for every joint, the first that the log has (:mod:`wbfriction.logs.torque`):
 ``tau.<joint>`` (a joint torque sensor), ``tau_est.<joint>`` (the driver's estimate: measured beats modelled),
 ``current.<joint>`` (times the torque constants), and the PD law on the set-points (``q_des.<joint>``, the drivers'
 delay and limits from the TOML). The law runs on the logged angle (the encoder's) and the driver's velocity

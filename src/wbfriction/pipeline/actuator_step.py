@@ -13,6 +13,7 @@ from wbfriction.exceptions import InputError
 from wbfriction.logs.options import ReadOptions, TimeUnit
 from wbfriction.logs.source import read_log
 from wbfriction.logs.tables import json_text, write_atomic
+from wbfriction.logs.torque import torque_kind
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.identify_step import identified_config
 from wbfriction.pipeline.paths import check_paths
@@ -133,7 +134,7 @@ def pd_law_warnings(robot: Robot, log: str | Path, time_unit: TimeUnit | None = 
     if robot.pd is None or robot.floating_base:
         return []
     data = read_log(log, robot, read=ReadOptions(time_unit=time_unit))
-    if data.torque_source != "pd":
+    if not torque_kind(data.torque_source).pd_law:
         return []
     import numpy as np
 
