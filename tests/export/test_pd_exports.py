@@ -50,11 +50,12 @@ def robot(panda):
 
 @pytest.fixture()
 def params(tmp_path, fit_of):
-    """Fits as `fit` writes them: joints 1, 2, 4 ok (each its own numbers), 3 weak, 5 failed, 6 and 7 not fitted."""
+    """Fits as `fit` writes them: joints 1, 2, 4 ok (each its own numbers), 3 weak, 5 failed, 6 and 7 not fitted;
+    fitted for the built-in panda (its URDF: the PD TOMLs below use it too)."""
     status = {1: "ok", 2: "ok", 3: "weak", 4: "ok", 5: "failed"}
     fits = [fit_of(f"panda_joint{i}", s, F_v=0.07 * i, F_c=0.21 * i) for i, s in status.items()]
     path = tmp_path / "p.json"
-    write_params(path, fits, {"provenance": {"robot": "panda"}})
+    write_params(path, fits, {"provenance": {"robot": "panda", "urdf": str(load_robot("panda").urdf)}})
     return path, {f.joint: f for f in fits}
 
 

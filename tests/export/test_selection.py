@@ -143,7 +143,7 @@ def test_the_status_note_is_one_line_that_xml_and_yaml_read_as_a_comment(status,
 
 
 def write_fits(path, fits: dict[str, FitResult]) -> None:
-    write_params(path, fits.values(), {"provenance": {"robot": "test"}})
+    write_params(path, fits.values(), {"provenance": {"robot": "talos"}})
 
 
 def talos_fits(talos, fit_of) -> dict[str, FitResult]:
