@@ -9,6 +9,7 @@ be written) wastes the user's time, and one whose output is its own input destro
 
 from __future__ import annotations
 
+import errno
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -40,12 +41,12 @@ def check_paths(inputs: Mapping[str, Path | None], outputs: Mapping[str, Path | 
     Raises:
         InputError: naming the option and the path: an input that does not exist; an output
             that is a folder, in a folder that does not exist or cannot be written, equal to an
-            input (inputs are never overwritten) or to another output; a folder that is a file, under
-            a file, or that cannot be made or written.
+            input (inputs are never overwritten) or to another output.
+        OutputError: a folder that is a file, under a file, or that cannot be made or written.
     """
-    for label, folder in (folders or {}).items():
+    for folder in (folders or {}).values():
         if folder is not None:
-            _check_folder(label, Path(folder))
+            _check_folder(Path(folder))
     given_in = {k: Path(v) for k, v in inputs.items() if v is not None}
     given_out = {k: Path(v) for k, v in outputs.items() if v is not None}
     for label, path in given_in.items():
@@ -70,19 +71,22 @@ def check_paths(inputs: Mapping[str, Path | None], outputs: Mapping[str, Path | 
         seen[label] = path
 
 
-def _check_folder(label: str, folder: Path) -> None:
+def _check_folder(folder: Path) -> None:
     """Refuse an output folder that is a file, lies under one, or cannot be made or written (the nearest folder
-    that exists is the one written into)."""
-    if folder.exists() and not folder.is_dir():
-        raise InputError(f"{label} {folder}: is a file, not a folder")
+    that exists is the one written into), as making it would (:func:`~wbfriction.logs.tables.make_folder`: the
+    same :class:`~wbfriction.exceptions.OutputError`), before the work."""
     existing = folder
     while not existing.exists() and existing != existing.parent:
         existing = existing.parent
-    if not existing.is_dir():
-        raise InputError(f"{label} {folder}: '{existing}' is a file: no folder can be made under it")
-    if not os.access(existing, os.W_OK | os.X_OK):
-        what = "cannot be written" if existing == folder else f"cannot be made: '{existing}' cannot be written"
-        raise InputError(f"{label} {folder}: {what}")
+    if existing.exists() and not existing.is_dir():
+        number = errno.EEXIST if existing == folder else errno.ENOTDIR
+    elif not os.access(existing, os.W_OK | os.X_OK):
+        number = errno.EACCES
+    else:
+        return
+    from wbfriction.logs.tables import output_error  # the command line loads this module: pyarrow only on a refusal
+
+    raise output_error(folder, OSError(number, os.strerror(number)))
 
 
 OUTPUT_OPTIONS = ("-o", "--output", "--output-dir", "--json", "--table", "--tables", "--config-output")
