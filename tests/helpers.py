@@ -315,3 +315,15 @@ def consistent_motion(robot, q: np.ndarray, v: np.ndarray, a_joint: np.ndarray, 
         assert np.abs(r[:6]).max() < 1e-9
         tau[k] = r[robot.act_v_index] - tau_f[k]
     return a, tau
+
+
+def assert_same_tables(a: pa.Table, b: pa.Table, what: str, atol: float = 1e-9) -> None:
+    """Two tables with the same columns, their floats equal to ``rtol=1e-9`` and ``atol``, the rest exactly (``what``
+    names them in a failure)."""
+    assert a.column_names == b.column_names, what
+    for name in a.column_names:
+        x, y = a[name].to_numpy(zero_copy_only=False), b[name].to_numpy(zero_copy_only=False)
+        if x.dtype.kind == "f":
+            np.testing.assert_allclose(x, y, rtol=1e-9, atol=atol, err_msg=f"{what}: {name}")
+        else:
+            assert np.array_equal(x, y), (what, name)

@@ -21,6 +21,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import wbfriction
+from helpers import assert_same_tables
 from wbfriction.fit.options import FitOptions, TermOptions
 from wbfriction.fit.terms import TermFit
 from wbfriction.friction.models import CoulombViscousParams
@@ -125,15 +126,9 @@ def test_the_same_friction_table_either_way(runs):
     the joint's content ending at 147 Hz instead of 26)."""
     for role in ("train", "held_out"):
         a, b = (pq.read_table(runs[wrap][role]) for wrap in WRAPS)
-        assert a.column_names == b.column_names
         decided = [{k: v for k, v in read_metadata(t, "").items() if k not in ("source", "provenance")} for t in (a, b)]
         _assert_same(*decided, role)
-        for name in a.column_names:
-            x, y = a[name].to_numpy(zero_copy_only=False), b[name].to_numpy(zero_copy_only=False)
-            if x.dtype.kind == "f":
-                np.testing.assert_allclose(x, y, rtol=1e-9, atol=1e-7, err_msg=f"{role}: {name}")
-            else:
-                assert np.array_equal(x, y), (role, name)
+        assert_same_tables(a, b, role, atol=1e-7)
         q = a[f"q.{JOINT}"].to_numpy()
         assert -np.pi < q.min() and q.max() <= np.pi
 

@@ -19,7 +19,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from helpers import REAL_DATA, needs_data
+from helpers import REAL_DATA, assert_same_tables, needs_data
 from wbfriction import datasets
 from wbfriction.fit.options import FitOptions, TermOptions
 from wbfriction.friction.options import EstimateOptions
@@ -76,14 +76,7 @@ def test_the_thighs_cross_the_wrap_one_way_only(runs):
 
 def test_the_same_table_fit_and_held_out_prediction_either_way(runs):
     for role in ("train", "held_out"):
-        a, b = (pq.read_table(runs[w][role]) for w in WRAPS)
-        assert a.column_names == b.column_names
-        for name in a.column_names:
-            x, y = a[name].to_numpy(zero_copy_only=False), b[name].to_numpy(zero_copy_only=False)
-            if x.dtype.kind == "f":
-                np.testing.assert_allclose(x, y, rtol=1e-9, atol=1e-9, err_msg=f"{role}: {name}")
-            else:
-                assert np.array_equal(x, y), (role, name)
+        assert_same_tables(*(pq.read_table(runs[w][role]) for w in WRAPS), role)
     predictions = {(fit, held): predict_file(runs[held]["held_out"], runs[fit]["params"])
                    for fit in WRAPS for held in WRAPS}
     reference = predictions["2pi", "2pi"]

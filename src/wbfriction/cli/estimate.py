@@ -92,7 +92,7 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
         delay = f", {held} {1e3 * torque['delay']:.3g} ms late ({torque['gains']})" if "delay" in torque else ""
         if torque.get("delayed_known") is False:
             delay += "; the log it was identified on does not tell what the delay holds back: F_v known to kp delay"
-        unused = "; the set-points q_des.<joint> not used (the measured torque is)" if "setpoints" in torque else ""
+        unused = "; the set-points q_des.<joint> not used" if "setpoints" in torque else ""
         console.print(escape(f"torque: {torque['what']}{delay}{unused}"), highlight=False, soft_wrap=True)
         if kind is not None and kind.pd_law and bag_map is None:
             from wbfriction.pipeline.actuator_step import pd_law_warnings
