@@ -274,9 +274,12 @@ def test_parameters_of_another_table_are_refused(walk_friction, tmp_path, capsys
                                          tmp_path / "r.html"), "not on")
     doc = json.loads((tmp_path / "p.json").read_text())
     doc["provenance"]["robot"] = "another_robot"
+    (tmp_path / "q.json").write_text(json.dumps(doc))  # the same model file under another name: the same robot
+    assert run_cli(capsys, "predict", walk_friction, "--params", tmp_path / "q.json")[0] == 0
+    doc["provenance"]["urdf"] = str(tmp_path / "another_robot.urdf")  # another robot: name and model file
     (tmp_path / "q.json").write_text(json.dumps(doc))
     _refused(capsys, tmp_path, [walk_friction], ("predict", walk_friction, "--params", tmp_path / "q.json"),
-             "not of the table's robot")
+             "not of the table's robot 'talos'")
 
 
 # ----------------------------------------------------------------- 9. outputs honour the umask

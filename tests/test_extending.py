@@ -29,8 +29,7 @@ from toys.toy_family import NAME, A, FixedSlope, FixedSlopeParams
 from toys.toy_format import Feather
 from toys.toy_target import FrictionCsv
 from toys.toy_torque import SCALE, Effort
-from wbfriction.export import registry
-from wbfriction.export.registry import register_target
+from wbfriction.export.registry import register_target, unregister_target
 from wbfriction.friction.families.registry import register_family, unregister_family
 from wbfriction.friction.models import FrictionParams
 from wbfriction.logs import (
@@ -49,11 +48,11 @@ from wbfriction.sim.arm import default_arm_friction
 @pytest.fixture
 def toys(monkeypatch):
     """The three toys registered (one call each), and forgotten after the test."""
-    monkeypatch.setattr(registry, "TARGETS", dict(registry.TARGETS))  # the export targets as they were, after
     family, fmt, target = register_family(FixedSlope()), register_format(Feather()), register_target(FrictionCsv())
     yield family, fmt, target
     unregister_family(family.name)
     unregister_format(fmt.name)
+    unregister_target(target.name)
 
 
 @pytest.fixture
@@ -225,3 +224,26 @@ def test_the_toys_reach_every_other_command_that_takes_their_kind(toys, tmp_path
     ours, same = (rollout(go2, hung, ActuatorParams(friction=f), times=(0.0, 2.0)) for f in (toy, thesis))
     assert ours.no_friction == () and ours.joints == same.joints
     np.testing.assert_allclose(ours.q_sim, same.q_sim, rtol=0, atol=1e-12)  # the toy is (3.5) with S = 0, a = A
+
+
+def test_the_help_lists_the_registered_targets_and_formats(tmp_path):
+    """Registered before the command line is loaded (as an installed package's entry point or the package itself
+    registers them), the toy target and format are in the help that lists the targets and formats: the help reads the
+    catalogs the registries keep, no list of its own (issue 65, class 7)."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = (f"import sys; sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
+              "from toys.toy_format import Feather\nfrom toys.toy_target import FrictionCsv\n"
+              "from wbfriction.export.registry import register_target\nfrom wbfriction.logs import register_format\n"
+              "register_target(FrictionCsv()); register_format(Feather())\n"
+              "from wbfriction.entry import main\nmain()\n")
+    env = {**os.environ, "COLUMNS": "200"}
+    export = subprocess.run([sys.executable, "-c", script, "export", "--help"], capture_output=True, text=True, env=env)
+    simulate = subprocess.run([sys.executable, "-c", script, "simulate", "--help"], capture_output=True, text=True,
+                              env=env)
+    assert export.returncode == 0 and simulate.returncode == 0, (export.stderr, simulate.stderr)
+    assert f"{FrictionCsv.suffixes[0]} ({FrictionCsv.description})" in " ".join(export.stdout.split())
+    assert Feather.suffixes[0] in simulate.stdout

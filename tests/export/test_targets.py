@@ -11,7 +11,7 @@ import pytest
 
 from toys.toy_target import FrictionCsv
 from wbfriction.exceptions import InputError
-from wbfriction.export import registry
+from wbfriction.export import catalog, registry
 from wbfriction.export.isaac import IsaacTarget
 from wbfriction.export.mjcf import MjcfTarget
 from wbfriction.export.registry import SuffixTaken, UnknownExportFormat, register_target, target_for
@@ -25,6 +25,7 @@ from wbfriction.pipeline.export_step import export_files
 def targets(monkeypatch):
     """The registry as it is, restored after the test."""
     monkeypatch.setattr(registry, "TARGETS", dict(registry.TARGETS))
+    monkeypatch.setattr(catalog, "KINDS", dict(catalog.KINDS))  # what the help and errors name
     return registry.TARGETS
 
 
@@ -71,8 +72,9 @@ def test_an_unknown_suffix_is_refused_naming_the_file(targets, panda, params, tm
     out = tmp_path / "friction.csv"
     with pytest.raises(UnknownExportFormat) as info:
         export_files(panda, path, [tmp_path / "panda.xml", out])
-    assert str(info.value) == (f"{out}: unknown export format: name it .urdf (URDF <dynamics>), .xml (MuJoCo MJCF) "
-                               "or .yaml (Isaac Lab actuators)")
+    assert str(info.value) == (f"{out}: unknown export format: name it .urdf (URDF <dynamics damping "
+                               "friction>), .xml (MuJoCo MJCF: damping, frictionloss, armature) or .yaml (Isaac Lab "
+                               "actuators)")
     assert isinstance(info.value, InputError) and (info.value.path, info.value.suffix) == (out, ".csv")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["p.json"]
     register_target(FrictionCsv())

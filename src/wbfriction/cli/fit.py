@@ -12,6 +12,7 @@ from rich.table import Table
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.export.catalog import targets_words
 from wbfriction.fit.options import FitOptions, ModelChoice, model_choices
 from wbfriction.friction.options import TemperatureLaw
 from wbfriction.pipeline.paths import check_paths
@@ -115,10 +116,8 @@ def fit(friction: Path = FrictionArg,
 @app.command()
 def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters written by 'wbfriction fit'."),
            outputs: list[Path] = typer.Option(..., "-o", "--output",
-                                              help="File to write, format by name: .urdf (<dynamics damping "
-                                                   "friction>), .xml (MuJoCo MJCF: damping, frictionloss, "
-                                                   "armature) or .yaml (Isaac Lab actuators); repeat -o for "
-                                                   "several."),
+                                              help=f"File to write, format by name: {targets_words()}; repeat -o "
+                                                   "for several."),
            include: str = typer.Option("", "--include",
                                        help="Fit statuses exported besides ok, comma-separated: weak (large "
                                             "standard errors), at-bound (a parameter at a bound of the fit), "

@@ -57,6 +57,7 @@ from typing import Any
 import numpy as np
 
 from wbfriction.exceptions import InputError
+from wbfriction.export.catalog import ISAAC
 from wbfriction.export.drive import (
     DEFAULT_PHYSICS_DT,
     DelaySteps,
@@ -253,16 +254,13 @@ def write_actuators(path: str | Path, joints: Mapping[str, JointExport], robot: 
     return warnings
 
 
-class IsaacTarget(ExportTarget):
+class IsaacTarget(ExportTarget, kind=ISAAC):
     """``.yaml``, ``.yml``: an Isaac Lab actuator dictionary (module docstring).
 
     Attributes:
         physics_dt: Isaac Lab's physics step [s] a PD-driven robot's delay is counted in (``--physics-dt``).
     """
 
-    name = "isaac"
-    suffixes = (".yaml", ".yml")
-    description = "Isaac Lab actuators"
 
     def __init__(self, physics_dt: float = DEFAULT_PHYSICS_DT):
         delay_steps(0.0, physics_dt)  # checked

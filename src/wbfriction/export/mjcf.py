@@ -97,6 +97,7 @@ import pinocchio as pin
 from lxml import etree as ET
 
 from wbfriction.exceptions import ModelError
+from wbfriction.export.catalog import MJCF
 from wbfriction.export.drive import (
     HOLD_EDGE,
     DriveExport,
@@ -495,13 +496,10 @@ def write_model(path: str | Path, robot: Robot, joints: Mapping[str, JointExport
     return model
 
 
-class MjcfTarget(ExportTarget):
+class MjcfTarget(ExportTarget, kind=MJCF):
     """``.xml``, ``.mjcf``: a MuJoCo model of the robot with the friction and armature, and position actuators for
     PD-driven joints (module docstring)."""
 
-    name = "mjcf"
-    suffixes = (".xml", ".mjcf")
-    description = "MuJoCo MJCF"
 
     def write(self, path: Path, robot: Robot, joints: Mapping[str, JointExport]) -> ExportReport:
         """:func:`write_model` (the URDF's inertias)."""

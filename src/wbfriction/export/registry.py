@@ -14,6 +14,7 @@ from pathlib import Path
 
 from wbfriction.choices import spoken
 from wbfriction.exceptions import InputError
+from wbfriction.export import catalog
 from wbfriction.export.isaac import IsaacTarget
 from wbfriction.export.mjcf import MjcfTarget
 from wbfriction.export.target import ExportTarget
@@ -43,7 +44,8 @@ class UnknownExportFormat(InputError):
     Attributes:
         path: the output as given.
         suffix: its suffix, lower case (empty for a name without one).
-        known: the formats known, each as its first suffix and description (``.urdf (URDF <dynamics>)``).
+        known: the formats known, each as its first suffix and description
+            (``.urdf (URDF <dynamics damping friction>)``).
     """
 
     def __init__(self, path: str | Path, suffix: str, known: tuple[str, ...]):
@@ -75,7 +77,15 @@ def register_target(target: ExportTarget) -> ExportTarget:
         del TARGETS[suffix]
     for suffix in target.suffixes:
         TARGETS[suffix] = target
+    catalog.KINDS[target.name] = catalog.TargetKind.of(target)
     return target
+
+
+def unregister_target(name: str) -> None:
+    """Forget the target named ``name`` (a no-op if none is): its suffixes are written by no target."""
+    for suffix in [s for s, held in TARGETS.items() if held.name == name]:
+        del TARGETS[suffix]
+    catalog.KINDS.pop(name, None)
 
 
 def targets() -> tuple[ExportTarget, ...]:
@@ -84,8 +94,9 @@ def targets() -> tuple[ExportTarget, ...]:
 
 
 def known_formats() -> tuple[str, ...]:
-    """Each target's first suffix and description, in the order registered: ``(".urdf (URDF <dynamics>)", ...)``."""
-    return tuple(f"{t.suffixes[0]} ({t.description})" for t in targets())
+    """Each target's first suffix and description, in the order registered
+    (:func:`~wbfriction.export.catalog.known_targets`)."""
+    return catalog.known_targets()
 
 
 def target_for(path: str | Path) -> ExportTarget:

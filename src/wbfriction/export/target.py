@@ -31,8 +31,9 @@ from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar
+from typing import Any, ClassVar
 
+from wbfriction.export.catalog import TargetKind
 from wbfriction.export.drive import DEFAULT_PHYSICS_DT, delay_steps
 from wbfriction.export.mapping import JointExport
 from wbfriction.model.robot import Robot
@@ -84,12 +85,21 @@ class ExportTarget(ABC):
         name: the format's short name, printed after each file written (``mjcf``).
         suffixes: the file-name suffixes it writes, lower case with their dot, the one to name first
             (errors list it) first (``(".xml", ".mjcf")``).
-        description: what the file is, a few words for errors (``MuJoCo MJCF``).
+        description: what the file is, a few words for the help and errors (``MuJoCo MJCF: damping, ...``).
+
+    A built-in target takes them from its kind in :mod:`wbfriction.export.catalog` (``class MjcfTarget(ExportTarget,
+    kind=MJCF)``), which the help reads without importing the target's module.
     """
 
     name: ClassVar[str]
     suffixes: ClassVar[tuple[str, ...]]
     description: ClassVar[str]
+
+    def __init_subclass__(cls, kind: TargetKind | None = None, **kwargs: Any) -> None:
+        """A subclass; with ``kind``, its name, suffixes and description are the kind's."""
+        super().__init_subclass__(**kwargs)
+        if kind is not None:
+            cls.name, cls.suffixes, cls.description = kind.name, kind.suffixes, kind.description
 
     def configure(self, options: ExportOptions) -> ExportTarget:
         """This target set with ``options`` (a copy when it takes any); the default: itself, unchanged.

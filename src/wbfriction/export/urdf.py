@@ -22,6 +22,7 @@ import pinocchio as pin
 from lxml import etree as ET
 
 from wbfriction.exceptions import InputError, OutputError
+from wbfriction.export.catalog import URDF
 from wbfriction.export.mapping import NOTE_PREFIX, FrictionLike, JointExport, joint_exports, status_note
 from wbfriction.export.target import ExportReport, ExportTarget
 from wbfriction.inertia.regressor import body_parameters
@@ -131,13 +132,10 @@ def write_dynamics(path: str | Path, robot: Robot, joints: Mapping[str, JointExp
     return moved
 
 
-class UrdfTarget(ExportTarget):
+class UrdfTarget(ExportTarget, kind=URDF):
     """``.urdf``: the robot's URDF with ``<dynamics damping friction>`` (module docstring); a robot loaded from an
     MJCF is refused (:meth:`check`)."""
 
-    name = "urdf"
-    suffixes = (".urdf",)
-    description = "URDF <dynamics>"
 
     def check(self, robot: Robot) -> None:
         """Refuse a robot loaded from an MJCF (it has no URDF to rewrite).

@@ -282,6 +282,24 @@ def same_model_file(recorded: str | None, urdf: str | Path) -> bool:
         return False
 
 
+def check_params_robot(params: str | Path, robot: str | None, urdf: str | Path | None = None,
+                       whose: str = "") -> None:
+    """Refuse a parameters file (one :func:`read_params` has read) fitted for another robot than ``robot`` (model
+    file ``urdf``): the file's recorded robot differs from it both by name and by model file (two TOMLs of one URDF,
+    ``panda`` and ``panda_pd``, are one robot). Nothing is refused where either side records no robot. ``whose``:
+    the words before the robot's name in the message (e.g. "the table's ").
+
+    Raises:
+        InputError: naming the file, both robots and their model files.
+    """
+    name, fitted_urdf = params_robot(params)
+    if name is None or robot is None or name == robot or (urdf is not None and same_model_file(fitted_urdf, urdf)):
+        return
+    raise InputError(f"{params}: parameters of robot '{name}' ({fitted_urdf or 'its model file not recorded'}), "
+                     f"not of {whose}'{robot}' ({urdf or 'its model file not recorded'}): give the robot model they "
+                     "were fitted with")
+
+
 def read_robot_params(params: str | Path, robot: str, joints: Iterable[str],
                       urdf: str | Path | None = None) -> dict[str, FitResult]:
     """:func:`read_params` for the robot named ``robot`` (model file ``urdf``) whose joints are ``joints``: the one
@@ -294,10 +312,7 @@ def read_robot_params(params: str | Path, robot: str, joints: Iterable[str],
             naming the file).
     """
     fits = read_params(params)
-    name, fitted_urdf = params_robot(params)
-    if name is not None and name != robot and not (urdf is not None and same_model_file(fitted_urdf, urdf)):
-        raise InputError(f"{params}: parameters of robot '{name}' ({fitted_urdf or 'its model file not recorded'}), "
-                         f"not of '{robot}' ({urdf}): give the robot model they were fitted with")
+    check_params_robot(params, robot, urdf)
     known = set(joints)
     unknown = [j for j in fits if j not in known]
     if unknown:
@@ -319,9 +334,9 @@ def check_params_source(params: str | Path, est: FrictionEstimate, table: str | 
     doc = json.loads(path.read_text())  # read by read_params first: a parameters file
     prov = doc.get("provenance", {}) if isinstance(doc, dict) else {}
     prov = prov if isinstance(prov, dict) else {}
-    robot, table_robot = params_robot(path)[0], est.metadata.get("provenance", {}).get("robot")
-    if robot is not None and table_robot is not None and robot != table_robot:
-        raise InputError(f"{path}: parameters of robot '{robot}', not of the table's robot '{table_robot}'")
+    made = est.metadata.get("provenance", {})
+    made = made if isinstance(made, dict) else {}
+    check_params_robot(path, made.get("robot"), made.get("urdf"), whose="the table's robot ")
     joints = doc.get("joints", {}) if isinstance(doc, dict) else {}
     if not set(joints) & set(est.joints):
         raise InputError(f"{path}: none of its joints is a joint of the friction table")
