@@ -97,3 +97,12 @@ def test_the_built_in_targets_by_suffix(targets):
     with pytest.raises(SuffixTaken, match="'other': .xml is written by the 'mjcf' target"):
         register_target(Other())
     assert ".csv" not in targets
+
+
+def test_the_catalogue_the_help_reads_is_the_registrys():
+    """``export --help`` and the unknown-suffix error name the targets from their catalogue
+    (:mod:`wbfriction.export.catalog`, which imports nothing heavy): it is the registry's, target by target, in order,
+    and a built-in target's name, suffixes and description are its kind's (issue 65, class 7)."""
+    assert catalog.known_targets() == tuple(f"{t.suffixes[0]} ({t.description})" for t in registry.targets())
+    assert tuple(catalog.KINDS) == tuple(t.name for t in registry.targets())
+    assert catalog.BUILTIN == tuple(catalog.TargetKind.of(t) for t in registry.targets()[:len(catalog.BUILTIN)])
