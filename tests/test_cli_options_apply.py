@@ -225,3 +225,26 @@ def test_the_tables_name_the_commands_options(command, shared, tables):
     assert named <= options, named - options
     assert options <= named, options - named
     assert set(_options(command, shared)) <= set(VALUES)
+
+
+ESTIMATE_CONTACT_VALUES = {"mask": "single", "lift_off": "0.1", "touch_down": "0.1", "ds_weight": "2",
+                           "ds_regularization": "0.1", "base_motion": "logged", "wrenches": None}
+
+
+@pytest.mark.parametrize("name", list(ESTIMATE_CONTACT_VALUES))
+def test_estimate_on_a_fixed_base_refuses_the_contacts_options(capsys, tmp_path, name):
+    """A fixed-base robot's estimate reads no contact switch, double support or base motion: each of those options,
+    given, is one line naming it and what the robot is, exit 2, before the log is read, nothing written."""
+    from wbfriction.cli.estimate import CONTACT_OPTIONS
+
+    assert set(ESTIMATE_CONTACT_VALUES) == set(CONTACT_OPTIONS)
+    param = next(p for p in COMMANDS["estimate"].params if p.name == name)
+    value = ESTIMATE_CONTACT_VALUES[name]
+    given = [param.opts[0]] if value is None else [param.opts[0], value]
+    log = tmp_path / "log.parquet"
+    log.write_bytes(b"not read")
+    code, err = run_cli(capsys, "estimate", log, "--robot", "panda", *given, "-o", tmp_path / "f.parquet")
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert err.startswith(f"error: {option_flag(param)}: robot 'panda' has a fixed base (no contact switch, no "
+                          "double support, no base to measure): it reads none of --mask, --lift-off, "), err
+    assert not (tmp_path / "f.parquet").exists()

@@ -198,6 +198,21 @@ def refuse_options(ctx: typer.Context, mode: str, takes: Collection[str], shared
             raise InputError(f"{flag}: {mode}: it takes {listed}; not {flag}")
 
 
+def refuse_unread(ctx: typer.Context, mode: str, unread: Collection[str]) -> None:
+    """Refuse, before any work, the first option the user gave (:func:`given_options`) of those ``unread`` that the
+    way the command runs does not read (where they are fewer than those it reads: :func:`refuse_options` lists
+    those).
+
+    Raises:
+        InputError: ``--mask: robot 'panda' has a fixed base ...: it reads none of --mask, --lift-off, ...``.
+    """
+    params = {p.name: p for p in ctx.command.params}
+    for name in given_options(ctx):
+        if name in unread:
+            listed = ", ".join(option_flag(p) for n, p in params.items() if n in unread)
+            raise InputError(f"{option_flag(params[name])}: {mode}: it reads none of {listed}")
+
+
 ESTIMATE = EstimateOptions()  # one source of defaults: the library's
 BaseMotionOpt = typer.Option(ESTIMATE.base_motion, "--base-motion",
                              help="Base motion: contact (rigid stance foot, thesis 5.4), logged (the base.* pose "

@@ -47,6 +47,7 @@ from wbfriction.cli.common import (
     joint_list,
     out,
     progress_bar,
+    refuse_unread,
     robot_of,
     warn,
 )
@@ -143,7 +144,7 @@ def _print_cross_check(friction: Path) -> None:
 
 
 @app.command()
-def estimate(log: Path = typer.Argument(..., metavar="LOG",
+def estimate(ctx: typer.Context, log: Path = typer.Argument(..., metavar="LOG",
                                         help=f"Log in the wbfriction format: {table_formats()}; through --map: "
                                              f"{mapped_formats()}."),
              output: Path = typer.Option(..., "-o", "--output",
@@ -211,8 +212,17 @@ def estimate(log: Path = typer.Argument(..., metavar="LOG",
                                                    cutoff=cutoff, butter_order=butter_order))
     _refuse_acceleration_outputs(opts, companion)
     spec = RobotSpec.given(robot, urdf, config, mjcf)
+    r = spec.load()
+    if not r.floating_base:
+        refuse_unread(ctx, f"robot '{r.name}' has a fixed base (no contact switch, no double support, no base to "
+                           "measure)", CONTACT_OPTIONS)
     read = ReadOptions(max_gap=max_gap, limit_margin=limit_margin, time_base=time_base, time_unit=time_unit)
-    _run_estimate(spec.load(), spec, log, output, opts, bag_map, read, workers, chunk_rows, companion)
+    _run_estimate(r, spec, log, output, opts, bag_map, read, workers, chunk_rows, companion)
+
+
+CONTACT_OPTIONS = ("mask", "lift_off", "touch_down", "ds_weight", "ds_regularization", "base_motion", "wrenches")
+"""The options of ``estimate`` (its parameters) that read the contacts or the floating base: a fixed-base robot's
+estimate reads none of them, and refuses them given (:func:`~wbfriction.cli.common.refuse_unread`)."""
 
 
 def _refuse_acceleration_outputs(opts: EstimateOptions, companion: bool) -> None:
