@@ -432,6 +432,27 @@ def test_cli_physics_dt(params, tmp_path, capsys):
     assert code == 2 and "--physics-dt must be a number in [1e-05, 0.1] s" in err and not other.exists()
 
 
+def test_a_physics_step_nothing_reads_is_refused(params, tmp_path, capsys):
+    """``--physics-dt`` counts a PD driver's delay in an Isaac Lab file's physics steps: given with outputs none of
+    which counts it (an MJCF, a URDF), or for a robot without PD drivers, it is refused in one line before anything is
+    written, not ignored (issue 65, class 6)."""
+    config = tmp_path / "panda_pd.toml"
+    config.write_text(PD_TOML)
+    outs = [tmp_path / "a.xml", tmp_path / "a.urdf"]
+    code, err = run_cli(capsys, "export", params[0], "--config", config, *sum((["-o", o] for o in outs), []),
+                        "--physics-dt", "0.002")
+    assert code == 2 and err.strip() == ("error: --physics-dt: no output counts a driver's delay in physics steps "
+                                         "(only .yaml does): not --physics-dt"), err
+    code, err = run_cli(capsys, "export", params[0], "--robot", "panda", "-o", tmp_path / "a.yaml",
+                        "--physics-dt", "0.002")
+    assert code == 2 and err.strip() == ("error: --physics-dt: robot 'panda' has no PD-driven joints ([pd] in its "
+                                         "TOML): no driver's delay to count in physics steps; not --physics-dt"), err
+    assert not [p for p in tmp_path.iterdir() if p.suffix in (".xml", ".urdf", ".yaml")]
+    code, err = run_cli(capsys, "export", params[0], "--config", config, "-o", outs[0], "-o", tmp_path / "a.yaml",
+                        "--physics-dt", "0.002")
+    assert code == 0, err  # one output counts it
+
+
 def test_a_torque_held_back_whole_is_said_by_both_targets(tmp_path):
     """``[pd] delayed = "torque"`` (PACE's actuator): neither Isaac Lab's DelayedPDActuator nor MuJoCo's actuator
     delay holds it; the export says so in one line and writes the delay as a set-point delay."""

@@ -12,6 +12,7 @@ from rich.table import Table
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.exceptions import InputError
 from wbfriction.export.catalog import targets_words
 from wbfriction.fit.options import FitOptions, ModelChoice, model_choices
 from wbfriction.friction.options import TemperatureLaw
@@ -20,6 +21,7 @@ from wbfriction.quantities import check_options
 
 if TYPE_CHECKING:
     from wbfriction.fit.result import FitResult
+    from wbfriction.model.robot import Robot
 
 from wbfriction.cli.common import (
     FIT,
@@ -41,6 +43,7 @@ from wbfriction.cli.common import (
     WideOpt,
     app,
     console,
+    given_options,
     out,
     print_whole,
     robot_of,
@@ -114,7 +117,8 @@ def fit(friction: Path = FrictionArg,
 
 
 @app.command()
-def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters written by 'wbfriction fit'."),
+def export(ctx: typer.Context,
+           params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters written by 'wbfriction fit'."),
            outputs: list[Path] = typer.Option(..., "-o", "--output",
                                               help=f"File to write, format by name: {targets_words()}; repeat -o "
                                                    "for several."),
@@ -144,9 +148,12 @@ def export(params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters
     check_paths({"PARAMS": params, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
                 {f"-o {o}": o for o in outputs})
     check_options({"--physics-dt": ("physics_dt", physics_dt)})
+    r = robot_of(robot, urdf, config, mjcf)
+    if "physics_dt" in given_options(ctx):
+        refuse_physics_dt(r, outputs)
     with console.status(f"exporting {params.name} to {len(outputs)} file{'s' if len(outputs) > 1 else ''}"):
-        result = export_files(robot_of(robot, urdf, config, mjcf), params, outputs,
-                              include=[c.strip() for c in include.split(",") if c.strip()], physics_dt=physics_dt)
+        result = export_files(r, params, outputs, include=[c.strip() for c in include.split(",") if c.strip()],
+                              physics_dt=physics_dt)
     counts = result.selection.exported_statuses
     console.print(f"exported the friction of {sum(counts.values())} joints ("
                   + ", ".join(f"{n} {status}" for status, n in counts.items()) + ")", highlight=False)
@@ -257,3 +264,19 @@ def report(friction: Path = FrictionArg,
     console.print(f"wrote {output} ({len(rep.est.joints)} joints, {len(rep.flagged)} flagged)")
 
 
+def refuse_physics_dt(r: Robot, outputs: list[Path]) -> None:
+    """``--physics-dt`` given where nothing reads it: no output's target counts a delay in physics steps
+    (:attr:`~wbfriction.export.target.ExportTarget.reads`), or the robot has no PD drivers whose delay it counts.
+
+    Raises:
+        InputError: naming the option and why.
+    """
+    from wbfriction.export.registry import target_for, targets
+
+    if not any("physics_dt" in target_for(o).reads for o in outputs):
+        readers = ", ".join(t.suffixes[0] for t in targets() if "physics_dt" in t.reads)
+        raise InputError(f"--physics-dt: no output counts a driver's delay in physics steps (only {readers} "
+                         "does): not --physics-dt")
+    if r.pd is None:
+        raise InputError(f"--physics-dt: robot '{r.name}' has no PD-driven joints ([pd] in its TOML): no driver's "
+                         "delay to count in physics steps; not --physics-dt")

@@ -266,6 +266,8 @@ class IsaacTarget(ExportTarget, kind=ISAAC):
         delay_steps(0.0, physics_dt)  # checked
         self.physics_dt = float(physics_dt)
 
+    reads = ("physics_dt",)
+
     def configure(self, options: ExportOptions) -> IsaacTarget:
         """A target counting the delay in steps of ``options.physics_dt``.
 

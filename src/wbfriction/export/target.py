@@ -94,6 +94,8 @@ class ExportTarget(ABC):
     name: ClassVar[str]
     suffixes: ClassVar[tuple[str, ...]]
     description: ClassVar[str]
+    reads: ClassVar[tuple[str, ...]] = ()
+    """The :class:`ExportOptions` fields :meth:`configure` reads (``export`` refuses an option no output reads)."""
 
     def __init_subclass__(cls, kind: TargetKind | None = None, **kwargs: Any) -> None:
         """A subclass; with ``kind``, its name, suffixes and description are the kind's."""
