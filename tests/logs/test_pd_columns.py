@@ -76,6 +76,19 @@ def test_the_drivers_estimate_comes_first_and_is_said(robot):
     np.testing.assert_array_equal(log.tau, 1.5)
 
 
+@pytest.mark.parametrize(("prefix", "source"), [("tau", "sensor"), ("tau_est", "driver")])
+def test_a_measured_torque_and_its_setpoints_are_written_back_both(robot, prefix, source):
+    """A log of measured torques that also holds set-points is written back with both (it was written as its
+    set-points alone, a PD law's log: its measured torque dropped, or with the drivers' estimates, its set-points):
+    read again, the same source, torque and set-points."""
+    log = log_from_table(table(robot, **{prefix: 1.5}), robot, "hung.parquet")
+    assert log.torque_source == source
+    back = log_from_table(log.to_table(robot), robot, "back.parquet")
+    assert back.torque_source == source
+    np.testing.assert_array_equal(back.tau, log.tau)
+    np.testing.assert_array_equal(back.setpoints.q_des, log.setpoints.q_des)
+
+
 @pytest.mark.parametrize(("change", "message"), [
     (lambda t: t.drop(["q_des.FL_hip_joint"]), r"or 'q_des.FL_hip_joint' with \[pd\] gains"),
     (lambda t: t.append_column("tau_est.FL_hip_joint", t["q.FL_hip_joint"]), "missing column 'tau_est.FL_thigh_joint'"),

@@ -50,7 +50,7 @@ from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forc
 from wbfriction.logs.foot_forces import column_names as foot_force_names
 from wbfriction.logs.foot_forces import foot_force_columns, foot_force_table, read_foot_forces
 from wbfriction.logs.options import MAX_GAP, ReadOptions
-from wbfriction.logs.pd import PD_PREFIXES, PdSetpoints, pd_columns_named, read_setpoints
+from wbfriction.logs.pd import PD_PREFIXES, PdSetpoints, pd_columns_named, read_setpoints, setpoint_columns
 from wbfriction.logs.tables import numeric_column, numeric_columns, read_metadata, with_metadata, write_table
 from wbfriction.logs.temperature import screen_temperature
 from wbfriction.logs.torque import TorqueColumns, TorqueSource, check_torque_columns, torque_kind, torque_source_of
@@ -174,6 +174,8 @@ class Log:
         cols.update({f"q.{n}": self.q[:, i] + offset[n] if n in offset else self.q[:, i]
                      for i, n in enumerate(robot.actuated)})
         cols.update(torque_kind(self.torque_source).columns(self.tau, robot, self.setpoints))
+        if self.setpoints is not None and robot.pd is not None:  # kept whatever the torque's source
+            cols.update(setpoint_columns(self.setpoints, robot.pd.joints))
         if robot.floating_base:
             cols.update({f"contact.{n}": self.contact[:, i].astype(np.int8)
                          for i, n in enumerate(robot.contact_frames)})

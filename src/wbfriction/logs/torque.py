@@ -248,12 +248,6 @@ class SensorTorque(TorqueKind):
 
     name, what, prefix, precedence, printed = "sensor", "joint torque sensors (tau.<joint>)", "tau", 10, False
 
-    def columns(self, tau: np.ndarray, robot: Robot, setpoints: PdSetpoints | None) -> dict[str, np.ndarray]:
-        """``tau.<joint>``; a log that also holds set-points, as its set-points (as the PD law's is written)."""
-        if setpoints is not None and robot.pd is not None:
-            return setpoint_columns(setpoints, robot.pd.joints)
-        return super().columns(tau, robot, setpoints)
-
     def hint(self, joint: str) -> str | None:
         """None: the message names ``tau.<joint>`` itself."""
         return None
