@@ -309,4 +309,4 @@ def require_point_feet(robot: Robot, simulator: str) -> None:
     if other is not None:
         frame, kind = other
         raise InputError(f"robot '{robot.name}': {simulator} simulates point feet only (contact_model = \"point\"), "
-                         f"not contact model '{kind.name}' of '{frame}' ({kind.what})")
+                         f"not contact model '{kind.name}' of '{frame}': {kind.what}")
