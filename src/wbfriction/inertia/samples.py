@@ -61,9 +61,12 @@ class Part:
 
 def usable_samples(robot: Robot) -> str:
     """What a sample the identification learns from is, in the robot's words: a humanoid's single-support sample, or
-    on point feet one with a joint free of unknown contact forces (messages)."""
+    on point feet (contacts that leave the base undetermined alone) one with a joint free of unknown contact forces
+    (messages)."""
     if robot.partial_contacts:
-        return "sample with a joint free of unknown contact forces (a leg in the air, or feet with 3-D force columns)"
+        sensed = any(m.world_force for m in robot.contact_models)
+        return "sample with a joint free of unknown contact forces (a leg in the air" + \
+            (", or feet with 3-D force columns)" if sensed else ")")
     return "single-support sample"
 
 
