@@ -134,7 +134,10 @@ PRINTS = {
                           r"^wrote panda_friction\.csv \(csv\)$",  # an export target, beside a built-in one
                           r"^wrote panda_extended\.xml \(mjcf\)$",
                           r"^panda_joint1: quadratic: F_v ",  # a family fitted alone, then scored by --model auto
-                          r"^panda_joint1: thesis: .*held-out RMS.*quadratic"],
+                          r"^panda_joint1: thesis: .*held-out RMS.*quadratic",
+                          # a contact model registered: a Go2's trot read with it, the point feet's friction
+                          r"^trot\.parquet on local points: [1-9]\d?% of the samples' friction determined, "
+                          r"(0e\+00|\de-1[2-9]) N·m from the point feet's$"],
     "docs/how-to/pd-robots.md": [r"^FL_hip_joint: tracking error \d+\.\d mrad, the peer's",  # the rollout check
                                  # the exported MJCF against the peer as PACE simulates it: a lower mean
                                  r"^ours tracks better on ([89]|1[0-2]) of 12 joints: mean [3-5]\.\d\d mrad, the "

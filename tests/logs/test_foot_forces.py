@@ -69,7 +69,7 @@ def test_contact_model_in_the_toml():
     urdf = example_robot_data_dir() / "go2_description" / "urdf" / "go2.urdf"
     base = {"name": "q", "contact_frames": list(FEET)}
     robot = build_robot(urdf, {**base, "contact_model": {"FL_foot": "point"}})
-    assert robot.contact_dims == (3, 6, 6, 6) and robot.point_contacts
+    assert robot.contact_dims == (3, 6, 6, 6) and robot.partial_contacts
     assert build_robot(urdf, base).contact_dims == (6, 6, 6, 6)
     with pytest.raises(InputError, match="contact_model of 'FL_foot' is 'ball'"):
         build_robot(urdf, {**base, "contact_model": {"FL_foot": "ball"}})

@@ -106,7 +106,7 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     if routes and r.floating_base:  # decided on the first chunk; a fixed base has none
         console.print(f"base motion: {routes['base']}" + ("; wrenches: every joint in every phase"
                                                           if routes["wrenches"] else ""), highlight=False)
-        if r.point_contacts:
+        if r.partial_contacts:
             _print_determination(output, r)
         else:
             _print_cross_check(output)

@@ -124,7 +124,7 @@ def _run_simulate_quadruped(r: Robot, output: Path, gait: str, duration: Optiona
     from wbfriction.walking.quadruped import quadruped_reference
 
     if gait not in QUADRUPED_GAITS:
-        raise InputError(f"--gait {gait}: robot '{r.name}' stands on point feet: its gaits are "
+        raise InputError(f"--gait {gait}: robot '{r.name}' stands on {r.stands_on}: its gaits are "
                          f"{', '.join(QUADRUPED_GAITS)}")
     spec = None if friction is None else load_friction_spec(friction, r.groups, r.actuated)
     if spec is not None and (spec.terms or spec.temperature is not None):
@@ -247,8 +247,8 @@ def simulate_mode(r: Robot, actuator: Optional[Actuator], simulator: Simulator) 
     quadruped; one driven by PD drivers (``--actuator pd``; by default one with a ``[pd]`` table) hangs, its base
     fixed; a fixed base otherwise is an arm tracking an excitation; the rest walks in the ``simulator``."""
     who = f"robot '{r.name}'"
-    if r.point_contacts:
-        return "quadruped", f"{who} stands on point feet (a walking quadruped)"
+    if r.partial_contacts:
+        return "quadruped", f"{who} stands on {r.stands_on} (a walking quadruped)"
     if actuator == "pd" or (actuator is None and r.pd is not None):
         return "hung", f"{who} is a hung PD-driven robot (fixed base, {'--actuator pd' if actuator else '[pd]'})"
     if not r.floating_base:

@@ -335,7 +335,7 @@ def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped")
     case = QuadrupedCase(simulator=simulator, gait=gait, drive=drive, foot_forces=foot_forces,  # type: ignore[arg-type]
                          noise=noise, duration=duration, seed=seed)
     r = case_robot(robot_of(robot, None, None), case)
-    if not r.point_contacts:
+    if not r.partial_contacts:
         raise InputError(f"--robot {robot}: not a robot on point feet (contact_model = \"point\" in its TOML)")
     with console.status("") as status:
         study = run_quadruped(r, case, progress=lambda label: status.update(label))

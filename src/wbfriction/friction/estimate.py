@@ -150,7 +150,7 @@ def estimate_friction(robot: Robot, kin: MeasuredKinematics, options: EstimateOp
     """
     if options.method not in METHODS:
         raise InputError(f"unknown method '{options.method}': choose one of {', '.join(METHODS)}")
-    if robot.point_contacts:  # where the contacts leave the friction determined, sample by sample
+    if robot.partial_contacts:  # where the contacts leave the friction determined, sample by sample
         return point_contact_estimate(robot, kin, options, progress, require_single_support)
     phases: Phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip, gaps)
     assert kin.valid is not None  # set by MeasuredKinematics.__post_init__

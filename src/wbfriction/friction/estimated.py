@@ -108,12 +108,14 @@ def no_single_support(robot: Robot, source: str) -> InputError:
     (always welded: every sample is one), a log without a sample whose derivatives are defined; on point feet
     (no single support: the rank decides, :mod:`wbfriction.model.determination`), a log without a sample that
     determines a joint's friction."""
-    if robot.point_contacts:
-        forces = ", ".join(f"force.{f}.x|y|z" for f in robot.contact_frames[:2])
-        return InputError(f"{source}: no sample determines any joint's friction: every leg has a foot down whose "
-                          f"force is not logged in 3-D ({forces}, ...) at every sample with defined derivatives "
-                          "outside the switches' margins (--lift-off, --touch-down) and the differentiation's "
-                          "window (--window, --cutoff)")
+    if robot.partial_contacts:
+        sensed = [f for f, m in zip(robot.contact_frames, robot.contact_models) if m.world_force]
+        forces = ", ".join(f"force.{f}.x|y|z" for f in sensed[:2])
+        unknown = f"whose force is not logged in 3-D ({forces}, ...)" if sensed else \
+            f"({robot.stands_on}: no force column is read)"
+        return InputError(f"{source}: no sample determines any joint's friction: every leg has a foot down {unknown} "
+                          "at every sample with defined derivatives outside the switches' margins (--lift-off, "
+                          "--touch-down) and the differentiation's window (--window, --cutoff)")
     if not robot.floating_base:
         return InputError(f"{source}: no sample with defined derivatives: every stretch between time gaps is "
                           "shorter than the differentiation's window (--window, --cutoff, --velocity-window, "

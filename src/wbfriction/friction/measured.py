@@ -62,7 +62,7 @@ def log_base_motion(robot: Robot, log: Log, choice: BaseMotion, wrenches: bool
     has_wrench = wrenches and log.wrench is not None
     has_imu = log.imu is not None and robot.imu is not None
     # point feet need the base measured (wbfriction.friction.point_contacts): a logged pose is taken without wrenches
-    base_motion = resolve_base_motion(choice, log.base is not None, has_wrench or robot.point_contacts, has_imu)
+    base_motion = resolve_base_motion(choice, log.base is not None, has_wrench or robot.partial_contacts, has_imu)
     if base_motion == "imu" and (robot.imu is None or log.base is None):
         raise InputError(f"{log.source}: --base-motion imu needs the robot's [imu] (its TOML) and the base "
                          "orientation columns base.qx ... base.qw")

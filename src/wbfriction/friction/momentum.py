@@ -174,7 +174,7 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
     """
     window = momentum_window(options, log)
     has_wrench, base_motion = log_base_motion(robot, log, options.base_motion, options.wrenches)
-    floating = has_wrench or robot.point_contacts  # the free-floating tree, its base twist measured
+    floating = has_wrench or robot.partial_contacts  # the free-floating tree, its base twist measured
     kin = measure(log, "savgol", compensate_delay=options.compensate_delay, torque_alignment=options.torque_alignment,
                   filtering=velocity_filter(options), velocity=options.velocity,
                   base_motion=floating and log.base is not None, imu=floating and base_motion == "imu")
@@ -187,7 +187,7 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
     e = np.zeros((n, robot.n_act))  # the sensors' wrenches' joint torques, read as the torques are
     mask = np.zeros((n, len(tc)), dtype=bool)
     determined, cond = None, None  # point feet: the rank decision on the rows taken, for the shares
-    if robot.point_contacts:
+    if robot.partial_contacts:
         r, mask_r, det = _point_feet(robot, kin, log, options, base_motion, rows_ok, (p, b, e), progress)
         closure[r], mask[r], determined, cond = n_c + 1, mask_r, np.zeros((n, len(tc)), dtype=bool), np.full(n, np.nan)
         determined[r], cond[r] = det.determined[:, tc], det.cond
@@ -244,7 +244,7 @@ def _point_feet(robot: Robot, kin: MeasuredKinematics, log: Log, options: Estima
         InputError: a log without the base pose.
     """
     if log.base is None:
-        raise InputError(f"{log.source}: a robot on point feet needs the base's measured motion: the base pose "
+        raise InputError(f"{log.source}: a robot on {robot.stands_on} needs the base's measured motion: the base pose "
                          "columns base.x ... base.qw (and the IMU's imu.* with --base-motion imu)")
     r = np.flatnonzero(rows_ok & settled(kin.time, log.contact, options.lift_off_skip, options.touch_down_skip))
     q, v, known = _base_twist(robot, kin, log, base_motion, r)
@@ -263,7 +263,7 @@ def _force_sampling(robot: Robot, log: Log, options: EstimateOptions, qd: np.nda
     (:mod:`wbfriction.friction.force_sampling`, its warning line or ""), for a robot on point feet whose log has foot
     forces; else ``{}``. ``qd`` (N, n_act) and ``pbe`` (each (N, n_act)): the route's velocities, momenta, their
     rates and the measured forces' torques; ``valid`` (N, n_tc)."""
-    if not robot.point_contacts or log.foot_force is None:
+    if not robot.partial_contacts or log.foot_force is None:
         return {}
     tc, alignment = robot.tc_index, _alignment(options, log)
     p, b, e = (x[:, tc] for x in pbe)

@@ -45,8 +45,8 @@ def contacts_route(robot: Robot, kin: MeasuredKinematics, rows: np.ndarray, prog
     """
     if measured_base(kin) == "contact":
         source = kin.metadata.get("source", "the log")
-        raise InputError(f"{source}: a robot on point feet needs the base's measured motion: the base pose columns "
-                         "base.x ... base.qw (with --base-motion logged or auto), or them and the IMU's imu.* "
+        raise InputError(f"{source}: a robot on {robot.stands_on} needs the base's measured motion: the base pose "
+                         "columns base.x ... base.qw (with --base-motion logged or auto), or them and the IMU's imu.* "
                          "(--base-motion imu)")
     n, tc = len(kin.time), robot.tc_index
     ok = rows & finite_base(kin)

@@ -187,9 +187,9 @@ def floating_regressor(robot: Robot) -> FloatingRegressor:
 def row_groups(robot: Robot) -> range:
     """The groups of rows a regression builds with one regressor each (:func:`regressor_of`): one per contact frame
     on soles (the stance it is rooted at), one on point feet (the floating model)."""
-    return range(1) if robot.point_contacts else range(len(robot.contact_frames))
+    return range(1) if robot.partial_contacts else range(len(robot.contact_frames))
 
 
 def regressor_of(robot: Robot, group: int) -> StanceRegressor | FloatingRegressor:
     """The regressor of a group of :func:`row_groups`: the floating one on point feet, else the stance's."""
-    return floating_regressor(robot) if robot.point_contacts else stance_regressor(robot, group)
+    return floating_regressor(robot) if robot.partial_contacts else stance_regressor(robot, group)

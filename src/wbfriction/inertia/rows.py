@@ -133,7 +133,7 @@ def sample_rows(robot: Robot, kin: MeasuredKinematics, r: np.ndarray, c: int, op
         no foot with an unknown force is down on its limb (:attr:`~wbfriction.inertia.samples.Part.rows`).
     """
     tc = robot.tc_index
-    if robot.point_contacts:
+    if robot.partial_contacts:
         Y, b = floating_rows(robot, kin, r)
     else:
         reg = stance_regressor(robot, c)

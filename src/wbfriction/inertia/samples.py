@@ -61,9 +61,12 @@ class Part:
 
 def usable_samples(robot: Robot) -> str:
     """What a sample the identification learns from is, in the robot's words: a humanoid's single-support sample, or
-    on point feet one with a joint free of unknown contact forces (messages)."""
-    if robot.point_contacts:
-        return "sample with a joint free of unknown contact forces (a leg in the air, or feet with 3-D force columns)"
+    on point feet (contacts that leave the base undetermined alone) one with a joint free of unknown contact forces
+    (messages)."""
+    if robot.partial_contacts:
+        sensed = any(m.world_force for m in robot.contact_models)
+        return "sample with a joint free of unknown contact forces (a leg in the air" + \
+            (", or feet with 3-D force columns)" if sensed else ")")
     return "single-support sample"
 
 
@@ -76,10 +79,11 @@ def split_log(robot: Robot, log: Log, est: EstimateOptions, opts: InertialOption
     active = active_time(log)
     cut = (1.0 - opts.holdout) * active[-1]
     cut_validation = (1.0 - opts.holdout) * (1.0 - opts.validation) * active[-1]
-    base_motion = log_base_motion(robot, log, est.base_motion, False)[1] if robot.point_contacts else "contact"
-    if base_motion == "contact" and robot.point_contacts:
-        raise InputError(f"{log.source}: robot '{robot.name}' stands on point feet: its identification needs the "
-                         "base's measured motion, the base pose columns base.x ... base.qw (and the IMU's imu.*)")
+    base_motion = log_base_motion(robot, log, est.base_motion, False)[1] if robot.partial_contacts else "contact"
+    if base_motion == "contact" and robot.partial_contacts:
+        raise InputError(f"{log.source}: robot '{robot.name}' stands on {robot.stands_on}: its identification "
+                         "needs the base's measured motion, the base pose columns base.x ... base.qw (and the IMU's "
+                         "imu.*)")
     out = []
     for (a, b), part in zip(log.segments or [(0, len(log))], log.parts()):
         t_active = active[a:b]
@@ -91,7 +95,7 @@ def split_log(robot: Robot, log: Log, est: EstimateOptions, opts: InertialOption
             continue  # too short for the scheme: nothing to learn from it
         assert kin.valid is not None  # set by MeasuredKinematics.__post_init__
         rows = None
-        if robot.point_contacts:
+        if robot.partial_contacts:
             rows = free_rows(robot, kin.contact, kin.foot_force)
             use = (kin.valid & settled(kin.time, kin.contact, est.lift_off_skip, est.touch_down_skip)
                    & finite_base(kin) & rows.any(axis=1))

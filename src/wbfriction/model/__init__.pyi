@@ -1,5 +1,10 @@
 """Names of :mod:`wbfriction.model`, imported on first use (:func:`lazy_loader.attach_stub`)."""
 
+from .contacts import ContactModel as ContactModel
+from .contacts import contact_model_of as contact_model_of
+from .contacts import contact_models as contact_models
+from .contacts import register_contact_model as register_contact_model
+from .contacts import unregister_contact_model as unregister_contact_model
 from .dynamics import ConstrainedDynamics as ConstrainedDynamics
 from .dynamics import constrained_dynamics as constrained_dynamics
 from .layout import JointLayout as JointLayout

@@ -106,18 +106,23 @@ class ContactSolution:
 
 
 def contact_jacobian(robot: Robot, data: pin.Data, c: int) -> np.ndarray:
-    """The constraint Jacobian of contact ``c`` after ``pin.computeJointJacobians`` and ``pin.updateFramePlacements``
-    on ``data``: a sole's six LOCAL rows, or a point's three rows in world axes, the velocity of its contact point:
-    the frame's origin, or with :attr:`~wbfriction.model.robot.Robot.foot_radius` ``r`` the sphere's lowest point
-    ``d = -r e_z`` from it, ``J_lin - [d]x J_ang`` (LOCAL_WORLD_ALIGNED), (6 or 3, nv)."""
-    fid = robot.contact_frame_ids[c]
-    if robot.contact_dims[c] == 6:
-        return pin.getFrameJacobian(robot.model, data, fid, pin.LOCAL)
-    J = pin.getFrameJacobian(robot.model, data, fid, pin.LOCAL_WORLD_ALIGNED)
-    if not robot.foot_radius:
-        return J[:3]
-    r = robot.foot_radius  # v_p = v_o + w x d, d = (0, 0, -r): w x d = (-r w_y, r w_x, 0)
-    return J[:3] + np.array([[0.0, -r, 0.0], [r, 0.0, 0.0], [0.0, 0.0, 0.0]]) @ J[3:]
+    """The constraint Jacobian of contact ``c`` (dims, nv) after ``pin.computeJointJacobians`` and
+    ``pin.updateFramePlacements`` on ``data``: its contact model's
+    (:meth:`ContactModel.jacobian <wbfriction.model.contacts.ContactModel.jacobian>`): a sole's six LOCAL rows, a
+    point's three rows in world axes, the velocity of its contact point (the sphere's lowest point with
+    :attr:`~wbfriction.model.robot.Robot.foot_radius`)."""
+    return robot.contact_models[c].jacobian(robot, data, robot.contact_frame_ids[c])
+
+
+def measured_components(robot: Robot, foot_force: np.ndarray | None) -> np.ndarray:
+    """(n_contacts, 3) which components of each contact's force the foot sensors measure: a foot's finite columns
+    (every row or none, :mod:`wbfriction.logs.foot_forces`) of a contact whose model takes world-axes forces
+    (:attr:`ContactModel.world_force <wbfriction.model.contacts.ContactModel.world_force>`: a point foot); none of
+    another's (a sole's wrench, a contact in its own axes)."""
+    measured = np.zeros((len(robot.contact_frames), 3), dtype=bool)
+    if foot_force is not None and len(foot_force):
+        measured = np.isfinite(foot_force).all(axis=0)
+    return measured & np.array([m.world_force for m in robot.contact_models], dtype=bool)[:, None]
 
 
 def determine(base_map: np.ndarray, joint_map: np.ndarray, r_base: np.ndarray, r_joint: np.ndarray
@@ -173,15 +178,12 @@ def joint_torques(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, con
     model = robot.model
     data = model.createData()
     n, iv = len(q), robot.act_v_index
-    measured = np.zeros((len(robot.contact_frames), 3), dtype=bool)
-    if foot_force is not None and n:
-        measured = np.isfinite(foot_force).all(axis=0)  # a foot's components: all rows or none
+    measured = measured_components(robot, foot_force)  # a foot's components: all rows or none
     dims = robot.contact_dims
     r = np.empty((n, model.nv))
     patterns, pattern_of = np.unique(contact.astype(bool), axis=0, return_inverse=True)
     pattern_of = pattern_of.ravel()
-    sizes = [sum(dims[c] - (int(measured[c].sum()) if dims[c] == 3 else 0) for c in np.flatnonzero(p))
-             for p in patterns]
+    sizes = [sum(dims[c] - int(measured[c].sum()) for c in np.flatnonzero(p)) for p in patterns]
     m_max = max(sizes, default=0)
     J_u = np.zeros((n, m_max, model.nv))
     for k in range(n):
@@ -193,7 +195,7 @@ def joint_torques(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, con
         pin.updateFramePlacements(model, data)
         row = 0
         for c in active:
-            free = ~measured[c] if dims[c] == 3 else np.ones(6, dtype=bool)
+            free = ~measured[c] if robot.contact_models[c].world_force else np.ones(dims[c], dtype=bool)
             J_u[k, row:row + int(free.sum())] = contact_jacobian(robot, data, int(c))[free]
             row += int(free.sum())
     r -= foot_force_torques(robot, q, contact, foot_force)
@@ -219,9 +221,7 @@ def free_rows(robot: Robot, contact: np.ndarray, foot_force: np.ndarray | None =
     force: no foot on the ground on their limb (:attr:`~wbfriction.model.robot.Robot.limb_mask`), or only feet whose
     three force components are measured. Such a row needs neither the base's rows nor the rank decision: the
     momentum route takes it as it is (:mod:`wbfriction.friction.momentum`)."""
-    measured = np.zeros((len(robot.contact_frames), 3), dtype=bool)
-    if foot_force is not None and len(foot_force):
-        measured = np.isfinite(foot_force).all(axis=0)
+    measured = measured_components(robot, foot_force)
     unknown = contact.astype(bool) & ~measured.all(axis=1)  # (N, n_contacts): on the ground, force not all measured
     return ~((unknown.astype(float) @ robot.limb_mask.astype(float)) > 0)
 
@@ -233,13 +233,13 @@ def foot_force_torques(robot: Robot, q: np.ndarray, contact: np.ndarray, foot_fo
     out = np.zeros((len(q), robot.model.nv))
     if foot_force is None:
         return out
-    measured = np.isfinite(foot_force).all(axis=0) if len(foot_force) else np.zeros((len(contact[0]), 3), bool)
+    measured = measured_components(robot, foot_force)
     data = robot.model.createData()
     for k in np.flatnonzero(np.any(contact.astype(bool) & measured.any(axis=1), axis=1)):
         pin.computeJointJacobians(robot.model, data, q[k])
         pin.updateFramePlacements(robot.model, data)
         for c in np.flatnonzero(contact[k]):
-            if robot.contact_dims[c] == 3 and measured[c].any():
+            if measured[c].any():
                 J = contact_jacobian(robot, data, int(c))
                 out[k] += J[measured[c]].T @ foot_force[k, c, measured[c]]
     return out

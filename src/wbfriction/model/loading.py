@@ -16,18 +16,18 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import cast
 
 import numpy as np
 import pinocchio as pin
 
 from wbfriction.config import read_toml
 from wbfriction.exceptions import InputError
+from wbfriction.model.contacts import ContactKind, contact_models
 from wbfriction.model.force_torque import parse_sensors
 from wbfriction.model.imu import add_imu_frame
 from wbfriction.model.labels import parse_labels
 from wbfriction.model.pd import parse_pd
-from wbfriction.model.robot import CONTACT_DIMS, ContactKind, ModelFormat, Robot
+from wbfriction.model.robot import ModelFormat, Robot
 from wbfriction.model.robots import BUILTIN_ROBOTS
 from wbfriction.quantities import in_range
 
@@ -113,8 +113,9 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
             :func:`~wbfriction.model.force_torque.parse_sensors`), ``contact_force`` ([on, off] [N]:
             contact flags from those sensors, :mod:`wbfriction.logs.contacts`), ``imu`` (link, xyz, rpy:
             :mod:`wbfriction.model.imu`), ``labels`` (joint name -> what a person reads,
-            :mod:`wbfriction.model.labels`), ``contact_model`` (``"sole"`` or ``"point"``, or a table contact
-            frame -> kind: :attr:`Robot.contact_kinds`), ``foot_radius`` (a point foot's sphere [m]:
+            :mod:`wbfriction.model.labels`), ``contact_model`` (a registered contact model's name,
+            ``"sole"`` or ``"point"`` built in, or a table contact frame -> name: :attr:`Robot.contact_kinds`,
+            :mod:`wbfriction.model.contacts`), ``foot_radius`` (a point foot's sphere [m]:
             :attr:`Robot.foot_radius`), ``balance_gains``
             (:attr:`Robot.balance_gains`).
         source: file name used in error messages.
@@ -354,8 +355,8 @@ def _contact_frames(config: dict, model: pin.Model, urdf: Path, source: str) -> 
 
 
 def _contact_kinds(value, frames: list[str], floating: bool, source: str) -> tuple[ContactKind, ...]:
-    """``contact_model``: ``"sole"`` or ``"point"`` for every contact frame, or a table frame -> kind (the others
-    soles); () when not given (every frame a sole)."""
+    """``contact_model``: a registered contact model's name (:mod:`wbfriction.model.contacts`) for every contact frame,
+    or a table frame -> name (the others soles); () when not given (every frame a sole)."""
     if value is None:
         return ()
     if not floating:
@@ -364,10 +365,11 @@ def _contact_kinds(value, frames: list[str], floating: bool, source: str) -> tup
     for frame, kind in table.items():
         if frame not in frames:
             raise InputError(f"{source}: contact_model names '{frame}', which is not one of contact_frames")
-        if kind not in CONTACT_DIMS:
-            raise InputError(f"{source}: contact_model of '{frame}' is {kind!r}: choose one of "
-                             f"{', '.join(CONTACT_DIMS)}")
-    return tuple(cast(ContactKind, table.get(f, "sole")) for f in frames)
+        known = [m.name for m in contact_models()]
+        if kind not in known:
+            raise InputError(f"{source}: contact_model of '{frame}' is {kind!r}: choose one of the registered "
+                             f"contact models, {', '.join(known)}")
+    return tuple(str(table.get(f, "sole")) for f in frames)
 
 
 def _foot_radius(value, source: str) -> float:

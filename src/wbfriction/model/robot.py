@@ -31,16 +31,12 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import InputError, ModelError
+from wbfriction.model.contacts import ContactKind, ContactModel, contact_model_of
 from wbfriction.model.force_torque import ForceTorqueSensor
 from wbfriction.model.imu import Imu
 from wbfriction.model.labels import default_label
 from wbfriction.model.layout import JointLayout, joint_layout
 from wbfriction.model.pd import PdDriver
-
-ContactKind = Literal["sole", "point"]
-"""How a contact frame touches the ground (:attr:`Robot.contact_kinds`): a sole (6 constraints) or a point (3)."""
-CONTACT_DIMS: dict[str, int] = {"sole": 6, "point": 3}
-"""The constraints (and contact force components) of each :data:`ContactKind`."""
 
 ModelFormat = Literal["urdf", "mjcf"]
 """The robot description formats a model is built from (:func:`wbfriction.model.loading.build_model`)."""
@@ -59,9 +55,10 @@ class Robot:
         torque_controlled: names of the torque-controlled joints, in model order.
         position_controlled: names of the position-controlled joints, in model order.
         contact_frames: names of the contact frames (feet soles, point feet), as configured.
-        contact_kinds: ``"sole"`` (six constraints: the frame does not move, a contact wrench) or ``"point"``
-            (three: the frame's origin does not move, a contact force; a quadruped's foot) per contact frame
-            (``contact_model`` in the TOML); empty: every frame a sole.
+        contact_kinds: the name of each contact frame's registered contact model (``contact_model`` in the TOML,
+            :mod:`wbfriction.model.contacts`): ``"sole"`` (six constraints: the frame does not move, a contact
+            wrench), ``"point"`` (three: the frame's origin does not move, a contact force; a quadruped's foot) built
+            in; empty: every frame a sole.
         foot_radius: the radius of a point foot's sphere [m] (``foot_radius`` in the TOML): its contact point, where
             the ground's force acts, is that far below the contact frame's origin (the sphere's centre), along the
             world's vertical (flat ground); 0: at the origin.
@@ -167,16 +164,36 @@ class Robot:
         return np.array([self.model.idx_qs[self.model.getJointId(n)] for n in self.actuated], dtype=int)
 
     @cached_property
-    def contact_dims(self) -> tuple[int, ...]:
-        """The constraints of each contact frame (n_contacts,): 6 for a sole, 3 for a point (:data:`CONTACT_DIMS`)."""
+    def contact_models(self) -> tuple[ContactModel, ...]:
+        """The registered contact model of each contact frame (n_contacts,) (:mod:`wbfriction.model.contacts`; every
+        frame a sole where :attr:`contact_kinds` is empty).
+
+        Raises:
+            InputError: a kind no model is registered under (unregistered since the robot was loaded).
+        """
         kinds = self.contact_kinds or ("sole",) * len(self.contact_frames)
-        return tuple(CONTACT_DIMS[k] for k in kinds)
+        return tuple(contact_model_of(k) for k in kinds)
 
     @cached_property
-    def point_contacts(self) -> bool:
-        """Some contact frame is a point (a quadruped's feet): friction is estimated where the contacts leave it
-        determined, sample by sample (:mod:`wbfriction.model.determination`)."""
-        return "point" in self.contact_kinds
+    def contact_dims(self) -> tuple[int, ...]:
+        """The constraints (contact force components) of each contact frame (n_contacts,): 6 for a sole, 3 for a
+        point (:attr:`ContactModel.dims <wbfriction.model.contacts.ContactModel.dims>`)."""
+        return tuple(m.dims for m in self.contact_models)
+
+    @cached_property
+    def partial_contacts(self) -> bool:
+        """Some contact frame's model does not fix the floating base alone (a quadruped's point feet,
+        :attr:`ContactModel.fixes_base <wbfriction.model.contacts.ContactModel.fixes_base>`): there is no single
+        support, friction is estimated where the contacts leave it determined, sample by sample
+        (:mod:`wbfriction.model.determination`), from the base's measured motion."""
+        return any(not m.fixes_base for m in self.contact_models)
+
+    @cached_property
+    def stands_on(self) -> str:
+        """What the robot stands on, for messages: the :attr:`~wbfriction.model.contacts.ContactModel.plural` of its
+        contact models that do not fix the base (``"point feet"``), else of its contacts (``"soles"``)."""
+        models = [m for m in self.contact_models if not m.fixes_base] or list(self.contact_models)
+        return " and ".join(dict.fromkeys(m.plural for m in models))
 
     @cached_property
     def contact_frame_ids(self) -> tuple[int, ...]:

@@ -295,3 +295,18 @@ class Recording:
             log.temperature = np.repeat(self.temperature[:, None], self.tau.shape[1], axis=1)
         return SimulationResult(log, self.wrench, Q, V, self.reference, tuple(self.robot.contact_frames),
                                 self.tau.copy())
+
+
+def require_point_feet(robot: Robot, simulator: str) -> None:
+    """Refuse a robot whose contact frames are not all point feet (``contact_model = "point"``): the quadruped
+    simulators model a foot as a sphere touching the ground at a point, and cannot simulate another contact model
+    (a sole, or one registered in a program: :mod:`wbfriction.model.contacts`), whatever its estimation.
+
+    Raises:
+        InputError: the first other contact model, naming it and its frame.
+    """
+    other = next(((f, m) for f, m in zip(robot.contact_frames, robot.contact_models) if m.name != "point"), None)
+    if other is not None:
+        frame, kind = other
+        raise InputError(f"robot '{robot.name}': {simulator} simulates point feet only (contact_model = \"point\"), "
+                         f"not contact model '{kind.name}' of '{frame}': {kind.what}")

@@ -73,7 +73,7 @@ from wbfriction.model.imu import imu_readings
 from wbfriction.model.pd import PdDriver, pd_torque
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
-from wbfriction.sim.common import InjectedFriction, injected_friction
+from wbfriction.sim.common import InjectedFriction, injected_friction, require_point_feet
 from wbfriction.sim.options import SensorNoise
 from wbfriction.sim.pd_robot import joint_values, step_setpoints
 from wbfriction.sim.quadruped_control import BalanceController, BalanceGains
@@ -447,9 +447,10 @@ def simulate_quadruped(robot: Robot, reference: QuadrupedReference,
         OptionError: a physics step that does not divide the reference's period.
         SimulationError: the state diverged.
     """
-    if not robot.floating_base or any(k != "point" for k in robot.contact_kinds) or len(robot.contact_frames) != 4:
+    if not robot.floating_base or len(robot.contact_frames) != 4:
         raise InputError(f"robot '{robot.name}': the quadruped simulator needs a floating base and four point feet "
                          "(contact_model = \"point\")")
+    require_point_feet(robot, "the quadruped simulator")
     if robot.torque_controlled != robot.actuated:
         raise InputError(f"robot '{robot.name}': the quadruped simulator drives every joint: none may be "
                          "position-controlled")

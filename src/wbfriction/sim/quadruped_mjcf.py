@@ -36,6 +36,7 @@ import pinocchio as pin
 from wbfriction.exceptions import InputError, ModelError
 from wbfriction.model.mjspec import mujoco_message, urdf_spec
 from wbfriction.model.robot import Robot
+from wbfriction.sim.common import require_point_feet
 from wbfriction.sim.mujoco_model import MujocoRobot, route_mujoco_warnings
 from wbfriction.walking.quadruped import FOOT_RADIUS
 
@@ -72,9 +73,7 @@ def build_quadruped_model(robot: Robot, timestep: float = 1e-3, foot_radius: flo
     import mujoco
     if not robot.floating_base or not robot.contact_frames:
         raise InputError(f"robot '{robot.name}': a walking quadruped needs a floating base and contact frames")
-    if any(kind != "point" for kind in robot.contact_kinds) or len(robot.contact_kinds) != len(robot.contact_frames):
-        raise InputError(f"robot '{robot.name}': the quadruped's MuJoCo model has point feet only "
-                         "(contact_model = \"point\")")
+    require_point_feet(robot, "the quadruped's MuJoCo model")
     if not (foot_radius > 0 and foot_friction > 0):
         raise InputError(f"foot radius ({foot_radius}) and friction ({foot_friction}) must be > 0")
     route_mujoco_warnings()

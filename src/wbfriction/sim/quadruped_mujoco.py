@@ -65,7 +65,7 @@ from wbfriction.logs.log import Log
 from wbfriction.logs.pd import PdSetpoints
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
-from wbfriction.sim.common import InjectedFriction, injected_friction
+from wbfriction.sim.common import InjectedFriction, injected_friction, require_point_feet
 from wbfriction.sim.mujoco_model import MujocoRobot
 from wbfriction.sim.options import SensorNoise
 from wbfriction.sim.pd_robot import joint_values, step_setpoints
@@ -420,9 +420,10 @@ def simulate_quadruped_mujoco(robot: Robot, reference: QuadrupedReference,
         OptionError: a physics step that does not divide the reference's period.
         SimulationError: the robot fell or the simulation diverged (the message gives the time).
     """
-    if not robot.floating_base or any(k != "point" for k in robot.contact_kinds) or not robot.contact_frames:
+    if not robot.floating_base or not robot.contact_frames:
         raise InputError(f"robot '{robot.name}': the quadruped simulator needs a floating base and point feet "
                          "(contact_model = \"point\")")
+    require_point_feet(robot, "the quadruped simulator on MuJoCo")
     if robot.torque_controlled != robot.actuated:
         raise InputError(f"robot '{robot.name}': the quadruped simulator drives every joint: none may be "
                          "position-controlled")
