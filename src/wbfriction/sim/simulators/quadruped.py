@@ -82,7 +82,7 @@ class QuadrupedKind(SimulatorKind):
                 run = simulate_quadruped(robot, ref, opts, progress=advance)
         drive = "PD set-points" if opts.drive == "pd" else "joint torques"
         normal = run.force[..., 2][run.log.contact]
-        pulled = (f"a foot pulled on the ground at {int((normal < 0).sum())} samples (down to {normal.min():.1f} N)",)
+        pulled = () if not normal.size or normal.min() >= 0 else \
+            (f"a foot pulled on the ground at {int((normal < 0).sum())} samples (down to {normal.min():.1f} N)",)
         return SimulationOutput(log=run.log, summary=f"{len(run.log)} samples, {gait_options.duration:g} s, {gait}, "
-                                                     f"{drive}", warnings=pulled if normal.size and normal.min() < 0
-                                else ())
+                                                     f"{drive}", warnings=pulled)
