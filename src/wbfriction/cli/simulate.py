@@ -1,4 +1,6 @@
-"""``wbfriction simulate``: a walk (ideal or MuJoCo) or an arm's excitation with known friction, as a log."""
+"""``wbfriction simulate``: a walk (ideal or MuJoCo) or an arm's excitation with known friction, as a log. The
+simulator that runs a robot is a registered kind (:mod:`wbfriction.sim.simulators`): this module parses, asks the
+registry, refuses the options the kind does not read, shows the progress, writes and prints."""
 
 from __future__ import annotations
 
