@@ -137,7 +137,9 @@ PRINTS = {
                           r"^panda_joint1: thesis: .*held-out RMS.*quadratic",
                           # a contact model registered: a Go2's trot read with it, the point feet's friction
                           r"^trot\.parquet on local points: [1-9]\d?% of the samples' friction determined, "
-                          r"(0e\+00|\de-1[2-9]) N·m from the point feet's$"],
+                          r"(0e\+00|\de-1[2-9]) N·m from the point feet's$",
+                          # a simulator registered, run by simulate, its injected friction fitted back
+                          r"^sine_arm\.parquet: panda_joint1: F_c 0\.(59|60|61) N·m, F_v 0\.(29|30|31) N·m·s/rad$"],
     "docs/how-to/pd-robots.md": [r"^FL_hip_joint: tracking error \d+\.\d mrad, the peer's",  # the rollout check
                                  # the exported MJCF against the peer as PACE simulates it: a lower mean
                                  r"^ours tracks better on ([89]|1[0-2]) of 12 joints: mean [3-5]\.\d\d mrad, the "
@@ -154,7 +156,8 @@ PRINTS = {
 
 WRITES = {
     "docs/how-to/library.md": ["api_params.json"],
-    "docs/extending.md": ["arm.tsv", "arm_effort.parquet", "panda_friction.csv", "panda_extended.xml"],
+    "docs/extending.md": ["arm.tsv", "arm_effort.parquet", "panda_friction.csv", "panda_extended.xml",
+                          "sine_arm.parquet"],
 }
 """Files a page's ``python`` blocks must write."""
 

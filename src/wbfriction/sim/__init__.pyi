@@ -30,3 +30,10 @@ from .rollout import RolloutResult as RolloutResult
 from .rollout import rollout as rollout
 from .rollout import rollout_table as rollout_table
 from .sensors import apply_sensor_noise as apply_sensor_noise
+from .simulators import SimulationOutput as SimulationOutput
+from .simulators import SimulationProgress as SimulationProgress
+from .simulators import SimulatorKind as SimulatorKind
+from .simulators import register_simulator as register_simulator
+from .simulators import simulator_for as simulator_for
+from .simulators import simulator_names as simulator_names
+from .simulators import unregister_simulator as unregister_simulator

@@ -1,0 +1,141 @@
+"""A walk with known friction (thesis 6.1, 6.2): the reference walk planned (:mod:`wbfriction.walking.reference`),
+simulated ideal (:func:`~wbfriction.sim.ideal.simulate_ideal`) or on MuJoCo
+(:func:`~wbfriction.sim.mujoco_sim.simulate_mujoco`), as ``simulate --simulator ideal|mujoco`` runs it."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Optional
+
+from wbfriction.exceptions import InputError
+from wbfriction.sim.options import IdealOptions, MujocoOptions, SensorNoise
+from wbfriction.sim.simulators.base import SimulationOutput, SimulationProgress, SimulatorKind
+from wbfriction.walking.options import GaitOptions
+
+if TYPE_CHECKING:
+    from wbfriction.model.robot import Robot
+
+IDEAL = IdealOptions()
+MUJOCO = MujocoOptions()
+GAIT = GaitOptions()
+QUADRUPED_GAITS = ("stand", "step", "trot", "walk")
+"""The gaits of a robot on point feet (:data:`wbfriction.walking.quadruped.Gait`), refused for a walk."""
+SENSOR_NOISE = ("position_noise", "encoder_bits", "torque_noise", "noise_seed")
+"""The ``simulate`` options of the sensor noise."""
+WALK = ("gait", "steps", "step_length", "step_width", "turn_angle", "lift_height", "friction", "simulator", "substeps",
+        "log_base")
+"""The ``simulate`` options both walks read."""
+
+
+def sensor_noise(sensors: Optional[Path], position_noise: Optional[float], encoder_bits: Optional[int],
+                 torque_noise: Optional[float], noise_seed: Optional[int],
+                 delay: Optional[float]) -> tuple[SensorNoise, float]:
+    """MuJoCo's sensor noise and measurement-to-command delay [s]: the ``sensors`` TOML's ``[sensors]`` table
+    (none: the defaults), each option given overriding it (``delay`` in ms).
+
+    Raises:
+        InputError: a sensors TOML that cannot be read, or with unknown keys.
+    """
+    from wbfriction.sim.sensors import load_sensors_toml
+
+    table = load_sensors_toml(sensors) if sensors is not None else {}
+    given = {"position_std": position_noise, "encoder_bits": encoder_bits, "torque_std": torque_noise,
+             "seed": noise_seed, "delay": None if delay is None else delay * 1e-3}
+    table.update({k: v for k, v in given.items() if v is not None})
+    lag = float(table.pop("delay", 0.0))
+    return SensorNoise(**table), lag
+
+
+def walk_gait(robot: Robot, values: Mapping[str, Any]) -> GaitOptions:
+    """The walk the ``simulate`` options give (``gait``, ``steps``, ``step_length`` [m], ``step_width`` [m],
+    ``turn_angle`` [rad], ``lift_height`` [m]).
+
+    Raises:
+        InputError: a quadruped's gait (``trot``).
+    """
+    gait = values.get("gait")
+    if gait in QUADRUPED_GAITS:
+        raise InputError(f"--gait {gait}: a quadruped's gait; robot '{robot.name}' walks forward, sideways, turning, "
+                         "both or combined")
+    return GaitOptions(gait=gait or GAIT.gait, steps=values.get("steps", GAIT.steps),
+                       step_length=values.get("step_length", GAIT.step_length),
+                       step_width=values.get("step_width", GAIT.step_width),
+                       turn_angle=values.get("turn_angle", GAIT.turn_angle),
+                       lift_height=values.get("lift_height", GAIT.lift_height))
+
+
+def run_walk(robot: Robot, gait: GaitOptions, options: IdealOptions | MujocoOptions, friction: Path | None,
+             progress: SimulationProgress) -> SimulationOutput:
+    """The walk ``gait`` planned and simulated with ``options`` (MuJoCo's or the ideal simulator's), the friction
+    of the ``friction`` TOML (None: thesis Table 6.1 on the legs); a foot that pulled on the ground is a warning.
+
+    Raises:
+        InputError: a friction file that cannot be read, a walk the robot cannot make.
+    """
+    from wbfriction.fit.targets import load_friction_spec
+    from wbfriction.sim.ideal import simulate_ideal
+    from wbfriction.walking.reference import walking_reference
+
+    spec = None if friction is None else load_friction_spec(friction, robot.groups, robot.torque_controlled)
+    params, terms = (None, None) if spec is None else (spec.params, spec.terms)
+    if spec is not None and spec.temperature is not None:
+        options = dataclasses.replace(options, temperature=spec.temperature)
+    with progress.stage(f"planning {gait.steps} steps ({gait.gait})"):
+        ref = walking_reference(robot, gait)
+    with progress.steps(len(ref)) as advance:
+        if isinstance(options, MujocoOptions):
+            from wbfriction.sim.mujoco_sim import simulate_mujoco
+            result = simulate_mujoco(robot, ref, params, options, progress=advance, terms=terms)
+        else:
+            result = simulate_ideal(robot, ref, params, options, progress=advance, terms=terms)
+    pulls = tuple(f"{p.frame} pulled on the ground from {p.start:.3f} s to {p.end:.3f} s ({p.samples} samples, down "
+                  f"to {p.min_force:.1f} N)" for p in result.pulls())
+    return SimulationOutput(log=result.log, summary=f"{len(result.log)} samples, {result.log.time[-1]:.1f} s",
+                            warnings=pulls)
+
+
+class IdealWalk(SimulatorKind):
+    """A walk in the ideal simulator (rigid contacts, thesis 6.1): ``--simulator ideal``, the default."""
+
+    name, precedence = "ideal", 40
+    options = (*WALK, "integrator", "force_torque")
+
+    def what(self, robot: Robot, actuator: str | None = None) -> str:
+        return f"robot '{robot.name}' walks in the ideal simulator"
+
+    def run(self, robot: Robot, values: Mapping[str, Any], friction: Path | None,
+            progress: SimulationProgress) -> SimulationOutput:
+        gait = walk_gait(robot, values)
+        substeps, force_torque = values.get("substeps"), values.get("force_torque", IDEAL.force_torque)
+        options = IdealOptions(substeps=substeps or IDEAL.substeps,
+                               integrator=values.get("integrator", IDEAL.integrator),
+                               log_base=values.get("log_base", IDEAL.log_base), force_torque=force_torque,
+                               imu=force_torque)
+        return run_walk(robot, gait, options, friction, progress)
+
+
+class MujocoWalk(SimulatorKind):
+    """A walk on MuJoCo (soft contacts, measured contact flags, sensors, thesis 6.2): ``--simulator mujoco``."""
+
+    name, precedence = "mujoco", 50
+    options = (*WALK, "mujoco_friction", "sensors", *SENSOR_NOISE, "delay", "sole_timeconst", "friction_timeconst",
+               "torque_drift", "ft_offset")
+
+    def what(self, robot: Robot, actuator: str | None = None) -> str:
+        return f"robot '{robot.name}' walks on MuJoCo (--simulator mujoco)"
+
+    def run(self, robot: Robot, values: Mapping[str, Any], friction: Path | None,
+            progress: SimulationProgress) -> SimulationOutput:
+        gait = walk_gait(robot, values)
+        noise, lag = sensor_noise(values.get("sensors"), values.get("position_noise"), values.get("encoder_bits"),
+                                  values.get("torque_noise"), values.get("noise_seed"), values.get("delay"))
+        options = MujocoOptions(substeps=values.get("substeps") or MUJOCO.substeps,
+                                friction=values.get("mujoco_friction", MUJOCO.friction), sensors=noise, delay=lag,
+                                log_base=values.get("log_base", MUJOCO.log_base),
+                                sole_timeconst=values.get("sole_timeconst"),
+                                friction_timeconst=values.get("friction_timeconst"),
+                                torque_drift=values.get("torque_drift", MUJOCO.torque_drift),
+                                ft_offset=values.get("ft_offset", MUJOCO.ft_offset))
+        return run_walk(robot, gait, options, friction, progress)
