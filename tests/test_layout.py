@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "src" / "wbfriction"
 
 LAYERS = [
-    {"version", "exceptions", "choices", "progress", "config", "workers", "quantities"},
+    {"version", "exceptions", "choices", "progress", "config", "workers", "quantities", "registry"},
     {"model"},
     {"logs"},
     {"datasets"},

@@ -32,6 +32,7 @@ from wbfriction.exceptions import ColumnError
 from wbfriction.logs.pd import PdSetpoints, driver_estimate, pd_law_torque, setpoint_columns
 from wbfriction.logs.tables import numeric_columns
 from wbfriction.model.robot import Robot
+from wbfriction.registry import Registry
 
 TorqueSource = str
 """Where a log's torques come from: the name of a registered :class:`TorqueKind` (``"sensor"``, ``"driver"``,
@@ -145,8 +146,8 @@ class TorqueKind:
         return f"{type(self).__name__}({self.name!r})"
 
 
-_SOURCES: dict[str, TorqueKind] = {}
-"""The registered torque sources by name, in precedence order."""
+SOURCES: Registry[TorqueKind] = Registry("torque source", precedence=lambda k: k.precedence)
+"""The registered torque sources, in precedence order."""
 
 
 def register_torque_source(kind: TorqueKind) -> TorqueKind:
@@ -155,15 +156,7 @@ def register_torque_source(kind: TorqueKind) -> TorqueKind:
     Raises:
         ValueError: a source of that name, or of that precedence, registered already (naming it).
     """
-    if kind.name in _SOURCES:
-        raise ValueError(f"a torque source named '{kind.name}' is registered already ({_SOURCES[kind.name]!r})")
-    tied = next((k for k in _SOURCES.values() if k.precedence == kind.precedence), None)
-    if tied is not None:
-        raise ValueError(f"torque source '{kind.name}' has the precedence {kind.precedence:g} of '{tied.name}'")
-    _SOURCES[kind.name] = kind
-    for k in sorted(_SOURCES.values(), key=lambda k: k.precedence):
-        _SOURCES[k.name] = _SOURCES.pop(k.name)
-    return kind
+    return SOURCES.add(kind)
 
 
 def unregister_torque_source(name: str) -> TorqueKind:
@@ -172,14 +165,12 @@ def unregister_torque_source(name: str) -> TorqueKind:
     Raises:
         ValueError: no source of that name.
     """
-    if name not in _SOURCES:
-        raise ValueError(f"no torque source named '{name}' (registered: {', '.join(_SOURCES)})")
-    return _SOURCES.pop(name)
+    return SOURCES.remove(name)
 
 
 def torque_sources() -> tuple[TorqueKind, ...]:
     """The registered torque sources, in precedence order."""
-    return tuple(_SOURCES.values())
+    return SOURCES.kinds()
 
 
 def torque_kind(name: TorqueSource) -> TorqueKind:
@@ -188,9 +179,7 @@ def torque_kind(name: TorqueSource) -> TorqueKind:
     Raises:
         ValueError: no source of that name.
     """
-    if name not in _SOURCES:
-        raise ValueError(f"no torque source named '{name}' (registered: {', '.join(_SOURCES)})")
-    return _SOURCES[name]
+    return SOURCES.get(name)
 
 
 def torque_source_of(given: TorqueColumns) -> TorqueKind:
@@ -199,11 +188,11 @@ def torque_source_of(given: TorqueColumns) -> TorqueKind:
     Raises:
         ColumnError: none claims it, naming the first torque-controlled joint's ``tau`` column.
     """
-    found = next((k for k in _SOURCES.values() if k.claims(given)), None)
+    found = next((k for k in SOURCES if k.claims(given)), None)
     if found is None:
         n = given.robot.torque_controlled[0]
         raise ColumnError(given.source, f"tau.{n}", None, f"missing column 'tau.{n}': no torque source "
-                          f"({', '.join(_SOURCES)}) has the torque of every torque-controlled joint")
+                          f"({SOURCES.listed()}) has the torque of every torque-controlled joint")
     return found
 
 
@@ -216,7 +205,7 @@ def check_torque_columns(robot: Robot, seen: set[str], source: str) -> None:
         ColumnError: a joint without, naming what its columns lack (:meth:`TorqueKind.refuse`), else its ``tau``
             column and the alternatives (:meth:`TorqueKind.hint`).
     """
-    kinds = tuple(_SOURCES.values())
+    kinds = SOURCES.kinds()
     for n in robot.torque_controlled:
         if any(k.gives(robot, n, seen) for k in kinds):
             continue

@@ -38,6 +38,7 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import InputError
+from wbfriction.registry import Registry
 
 ContactKind = str
 """How a contact frame touches the ground: the name of a registered :class:`ContactModel` (``"sole"``, ``"point"``
@@ -126,8 +127,8 @@ class Point(ContactModel):
         return J[:3] + np.array([[0.0, -r, 0.0], [r, 0.0, 0.0], [0.0, 0.0, 0.0]]) @ J[3:]
 
 
-_MODELS: dict[str, ContactModel] = {}
-"""The registered contact models by name."""
+MODELS: Registry[ContactModel] = Registry("contact model", unknown=InputError)
+"""The registered contact models, in the order they were registered."""
 
 
 def register_contact_model(kind: ContactModel) -> ContactModel:
@@ -137,15 +138,12 @@ def register_contact_model(kind: ContactModel) -> ContactModel:
         ValueError: a model of that name registered already (naming it), one whose :attr:`~ContactModel.dims` is
             not 1-6, or one of :attr:`~ContactModel.world_force` whose force is not three components.
     """
-    if kind.name in _MODELS:
-        raise ValueError(f"a contact model named '{kind.name}' is registered already ({_MODELS[kind.name]!r})")
     if not 1 <= kind.dims <= 6:
         raise ValueError(f"contact model '{kind.name}' has {kind.dims} constraints: a contact has 1 to 6")
     if kind.world_force and kind.dims != 3:
         raise ValueError(f"contact model '{kind.name}' takes foot sensors' world-axes forces (world_force) but has "
                          f"{kind.dims} constraints, not their 3 components")
-    _MODELS[kind.name] = kind
-    return kind
+    return MODELS.add(kind)
 
 
 def unregister_contact_model(name: str) -> ContactModel:
@@ -154,14 +152,12 @@ def unregister_contact_model(name: str) -> ContactModel:
     Raises:
         ValueError: no model of that name.
     """
-    if name not in _MODELS:
-        raise ValueError(f"no contact model named '{name}' (registered: {', '.join(_MODELS)})")
-    return _MODELS.pop(name)
+    return MODELS.remove(name)
 
 
 def contact_models() -> tuple[ContactModel, ...]:
     """The registered contact models, in the order they were registered."""
-    return tuple(_MODELS.values())
+    return MODELS.kinds()
 
 
 def contact_model_of(name: ContactKind) -> ContactModel:
@@ -170,9 +166,7 @@ def contact_model_of(name: ContactKind) -> ContactModel:
     Raises:
         InputError: no model of that name (listing the registered ones).
     """
-    if name not in _MODELS:
-        raise InputError(f"unknown contact model {name!r}: choose one of {', '.join(_MODELS)}")
-    return _MODELS[name]
+    return MODELS.get(name)
 
 
 for _builtin in (Sole(), Point()):

@@ -29,6 +29,7 @@ from wbfriction.logs.formats.csv import CsvFormat
 from wbfriction.logs.formats.hdf5 import Hdf5Format
 from wbfriction.logs.formats.npz import NpzFormat
 from wbfriction.logs.formats.parquet import ParquetFormat
+from wbfriction.registry import Registry
 
 
 class UnknownFormatError(InputError):
@@ -51,7 +52,7 @@ class UnknownFormatError(InputError):
         return (type(self), (self.path, self.suffix, self.known))
 
 
-_FORMATS: dict[str, LogFormat] = {}
+FORMATS: Registry[LogFormat] = Registry("log format")
 """The registered formats by name, in the order they are tried."""
 
 DEFAULT_FORMAT = "parquet"
@@ -67,14 +68,13 @@ def register_format(fmt: LogFormat) -> LogFormat:
     Raises:
         ValueError: a format of that name registered already, or a suffix another format claims (naming both).
     """
-    if fmt.name in _FORMATS:
-        raise ValueError(f"a log format named '{fmt.name}' is registered already ({_FORMATS[fmt.name]!r})")
-    for other in _FORMATS.values():
+    others = () if fmt.name in FORMATS else FORMATS.kinds()  # a name taken: FORMATS.add refuses it, naming it
+    for other in others:
         shared = sorted(set(fmt.suffixes) & set(other.suffixes))
         if shared:
             raise ValueError(f"log format '{fmt.name}' claims {', '.join(shared)}, which format '{other.name}' "
                              "reads already")
-    _FORMATS[fmt.name] = fmt
+    FORMATS.add(fmt)
     KINDS[fmt.name] = FormatKind.of(fmt)
     return fmt
 
@@ -85,26 +85,25 @@ def unregister_format(name: str) -> LogFormat:
     Raises:
         ValueError: no format of that name.
     """
-    if name not in _FORMATS:
-        raise ValueError(f"no log format named '{name}' (registered: {', '.join(_FORMATS)})")
+    fmt = FORMATS.remove(name)
     KINDS.pop(name, None)
-    return _FORMATS.pop(name)
+    return fmt
 
 
 def log_formats() -> tuple[LogFormat, ...]:
     """The registered formats, in the order they are tried."""
-    return tuple(_FORMATS.values())
+    return FORMATS.kinds()
 
 
 def _unknown(path: Path) -> UnknownFormatError:
-    return UnknownFormatError(str(path), path.suffix.lower(), tuple(f.describe() for f in _FORMATS.values()))
+    return UnknownFormatError(str(path), path.suffix.lower(), tuple(f.describe() for f in FORMATS))
 
 
 def find_format(path: str | Path) -> LogFormat | None:
     """The first registered format that detects the existing file (or folder) ``path``
     (:meth:`~wbfriction.logs.formats.base.LogFormat.detect`), or None: what a folder's scan for logs asks of each of
     its files."""
-    return next((f for f in _FORMATS.values() if f.detect(Path(path))), None)
+    return next((f for f in FORMATS if f.detect(Path(path))), None)
 
 
 def format_of(path: str | Path) -> LogFormat:
@@ -134,7 +133,7 @@ def format_to_write(path: str | Path) -> LogFormat:
         InputError: a format that claims the name but writes no file (a ROS 2 bag).
     """
     path = Path(path)
-    fmt = next((f for f in _FORMATS.values() if f.claims(path)), _FORMATS[DEFAULT_FORMAT])
+    fmt = next((f for f in FORMATS if f.claims(path)), FORMATS.get(DEFAULT_FORMAT))
     if not fmt.writable:
         raise InputError(f"{path}: {fmt.label} files are read, not written")
     return fmt
@@ -142,7 +141,7 @@ def format_to_write(path: str | Path) -> LogFormat:
 
 def stream_suffixes() -> tuple[str, ...]:
     """The suffixes of the formats tables are streamed into (table after table: a friction table, a converted bag)."""
-    return tuple(s for f in _FORMATS.values() if f.streamable for s in f.suffixes)
+    return tuple(s for f in FORMATS if f.streamable for s in f.suffixes)
 
 
 def format_to_stream(path: str | Path, what: str = "tables are streamed") -> LogFormat:
@@ -156,7 +155,7 @@ def format_to_stream(path: str | Path, what: str = "tables are streamed") -> Log
         InputError: a name no such format claims, naming the file and the suffixes there are.
     """
     path = Path(path)
-    fmt = next((f for f in _FORMATS.values() if f.claims(path)), None)
+    fmt = next((f for f in FORMATS if f.claims(path)), None)
     if fmt is None or not fmt.streamable:
         raise InputError(f"{path}: {what} as {', '.join(stream_suffixes())}")
     return fmt

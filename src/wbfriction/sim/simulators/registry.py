@@ -26,6 +26,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from wbfriction.exceptions import InputError
+from wbfriction.registry import Registry
 from wbfriction.sim.simulators.base import SimulatorKind
 from wbfriction.sim.simulators.fixed_base import ArmKind, HungKind
 from wbfriction.sim.simulators.quadruped import QuadrupedKind
@@ -34,8 +35,8 @@ from wbfriction.sim.simulators.walks import IdealWalk, MujocoWalk
 if TYPE_CHECKING:
     from wbfriction.model.robot import Robot
 
-_KINDS: dict[str, SimulatorKind] = {}
-"""The registered simulators by name, in precedence order."""
+SIMULATORS: Registry[SimulatorKind] = Registry("simulator", precedence=lambda k: k.precedence)
+"""The registered simulators, in precedence order."""
 
 
 def register_simulator(kind: SimulatorKind) -> SimulatorKind:
@@ -45,15 +46,7 @@ def register_simulator(kind: SimulatorKind) -> SimulatorKind:
     Raises:
         ValueError: a simulator of that name, or of that precedence, registered already (naming it).
     """
-    if kind.name in _KINDS:
-        raise ValueError(f"a simulator named '{kind.name}' is registered already ({_KINDS[kind.name]!r})")
-    tied = next((k for k in _KINDS.values() if k.precedence == kind.precedence), None)
-    if tied is not None:
-        raise ValueError(f"simulator '{kind.name}' has the precedence {kind.precedence:g} of '{tied.name}'")
-    _KINDS[kind.name] = kind
-    for k in sorted(_KINDS.values(), key=lambda k: k.precedence):
-        _KINDS[k.name] = _KINDS.pop(k.name)
-    return kind
+    return SIMULATORS.add(kind)
 
 
 def unregister_simulator(name: str) -> SimulatorKind:
@@ -62,21 +55,19 @@ def unregister_simulator(name: str) -> SimulatorKind:
     Raises:
         ValueError: no simulator of that name.
     """
-    if name not in _KINDS:
-        raise ValueError(f"no simulator named '{name}' (registered: {', '.join(_KINDS)})")
-    return _KINDS.pop(name)
+    return SIMULATORS.remove(name)
 
 
 def simulators() -> tuple[SimulatorKind, ...]:
     """The registered simulators, in precedence order."""
-    return tuple(_KINDS.values())
+    return SIMULATORS.kinds()
 
 
 def simulator_names() -> tuple[str, ...]:
     """The names ``--simulator`` takes: the registered simulators it chooses
     (:attr:`~wbfriction.sim.simulators.base.SimulatorKind.chosen`), in precedence order (``ideal``, ``mujoco``
     built in)."""
-    return tuple(k.name for k in _KINDS.values() if k.chosen)
+    return tuple(k.name for k in SIMULATORS if k.chosen)
 
 
 def simulator_for(robot: Robot, actuator: str | None, simulator: str) -> SimulatorKind:
@@ -87,7 +78,7 @@ def simulator_for(robot: Robot, actuator: str | None, simulator: str) -> Simulat
     Raises:
         InputError: none claims it, naming the robot and the simulators ``--simulator`` takes.
     """
-    found = next((k for k in _KINDS.values() if k.claims(robot, actuator, simulator)), None)
+    found = next((k for k in SIMULATORS if k.claims(robot, actuator, simulator)), None)
     if found is None:
         raise InputError(f"--simulator {simulator}: no simulator runs robot '{robot.name}' so (--simulator takes "
                          f"{', '.join(simulator_names())})")
