@@ -8,6 +8,7 @@ import pinocchio as pin
 import pytest
 from hypothesis import settings
 
+from helpers import run_cli_printed
 from wbfriction.model.loading import load_robot
 from wbfriction.model.robot import Robot
 from wbfriction.signals.kinematics import MeasuredKinematics
@@ -133,3 +134,13 @@ def combined_walk(talos):
     friction = {j: THESIS_TARGETS[g] for j, _, g in leg_joints(talos)}
     ref = walking_reference(talos, GaitOptions(gait="combined", steps=3))
     return simulate_ideal(talos, ref, friction, SIMULATOR)
+
+
+@pytest.fixture
+def cli(capsys):
+    """``wbfriction ARGS`` in this process, which must succeed; its standard output."""
+    def run(*args) -> str:
+        code, out, err = run_cli_printed(capsys, *args)
+        assert code == 0, (args[0], err)
+        return out
+    return run

@@ -63,16 +63,6 @@ def effort():
     unregister_torque_source(kind.name)
 
 
-@pytest.fixture
-def cli(capsys):
-    """``wbfriction ARGS`` in this process, which must succeed; its standard output."""
-    def run(*args) -> str:
-        code, out, err = run_cli_printed(capsys, *args)
-        assert code == 0, (args[0], err)
-        return out
-    return run
-
-
 def friction_toml(path, params: dict[str, FixedSlopeParams]):
     """``simulate --friction``'s TOML: the toy family (its ``model`` key) on each joint of ``params``."""
     path.write_text("".join(f'[friction.{j}]\nmodel = "{NAME}"\nF_v = {p.F_v!r}\nF_c = {p.F_c!r}\n'

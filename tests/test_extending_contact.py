@@ -42,16 +42,6 @@ def local_point():
     unregister_contact_model(kind.name)
 
 
-@pytest.fixture
-def cli(capsys):
-    """``wbfriction ARGS`` in this process, which must succeed; its standard output."""
-    def run(*args) -> str:
-        code, out, err = run_cli_printed(capsys, *args)
-        assert code == 0, (args[0], err)
-        return out
-    return run
-
-
 def toy_toml(path, kind: str = NAME):
     """The built-in ``go2_walking``'s TOML (no foot radius) with ``contact_model = kind``, named ``go2_toy``."""
     text, _ = config_text("go2_walking", None)
