@@ -1,6 +1,7 @@
-"""``wbfriction simulate``: a walk (ideal or MuJoCo) or an arm's excitation with known friction, as a log. The
-simulator that runs a robot is a registered kind (:mod:`wbfriction.sim.simulators`): this module parses, asks the
-registry, refuses the options the kind does not read, shows the progress, writes and prints."""
+"""``wbfriction simulate``: a robot with known friction, as a log (a walk, ideal or on MuJoCo; a quadruped's gait; an
+arm's excitation; a hung PD-driven robot's set-points). The simulator that runs a robot is a registered kind
+(:mod:`wbfriction.sim.simulators`): this module parses, asks the registry, refuses the options the kind does not
+read, shows the progress, writes and prints."""
 
 from __future__ import annotations
 
