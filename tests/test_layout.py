@@ -25,6 +25,7 @@ LAYERS = [
     {"pipeline"},
     {"walking"},
     {"sim"},
+    {"excite"},
     {"fleet"},
     {"report"},
     {"studies"},

@@ -18,10 +18,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from wbfriction.exceptions import InputError
 from wbfriction.excite.information import FRICTION_READ, limit_shares, torque_bound
 from wbfriction.excite.limits import JointLimits, Margins, inverse_dynamics, margins
 from wbfriction.excite.trajectory import FourierSpace, joint_series
-from wbfriction.exceptions import InputError
 from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.friction.noise import NoiseModel
 from wbfriction.model.robot import Robot

@@ -23,8 +23,8 @@ import numpy as np
 
 from wbfriction.fit.bound import cramer_rao
 from wbfriction.fit.status import WEAK
-from wbfriction.friction.families.registry import family
 from wbfriction.friction.families.params import ModelParamsBase
+from wbfriction.friction.families.registry import family
 from wbfriction.friction.noise import NoiseModel
 
 FRICTION_READ = ("F_c", "F_v")

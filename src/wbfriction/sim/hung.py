@@ -193,7 +193,8 @@ def step_noise(robot: Robot, noise: DriverNoise, n_steps: int) -> StepNoise:
 
 def simulate_hung(robot: Robot, options: HungOptions = HungOptions(),
                   friction: Mapping[str, ModelParams] | None = None, progress: Progress | None = None,
-                  mjr: PdMujocoRobot | None = None) -> HungSimulation:
+                  mjr: PdMujocoRobot | None = None,
+                  reference: tuple[np.ndarray, np.ndarray] | None = None) -> HungSimulation:
     """Simulate ``robot`` hung with its base fixed, its PD drivers tracking ramps and chirps (module docstring).
 
     Args:
@@ -203,6 +204,9 @@ def simulate_hung(robot: Robot, options: HungOptions = HungOptions(),
         friction: parameters of any family per joint (joints not named: none); None: :func:`default_hung_friction`.
         progress: optional callable receiving numbers of samples done.
         mjr: the robot's MuJoCo model, if already built (:func:`~wbfriction.sim.pd_robot.build_pd_robot`).
+        reference: the set-points to send instead of :attr:`HungOptions.setpoints`' ramps and chirps: the model's
+            angles (N, n_act) [rad] at the samples and their slope (N, n_act) [rad/s] (a designed excitation,
+            :mod:`wbfriction.excite`), ``N = round(duration x rate)``.
 
     Returns:
         :class:`HungSimulation` with ``round(duration * rate)`` samples.
@@ -223,7 +227,13 @@ def simulate_hung(robot: Robot, options: HungOptions = HungOptions(),
     armature = joint_values(robot, options.armature, dict(zip(robot.actuated, robot.model.armature[robot.act_v_index])),
                        "armature")
     offset = joint_values(robot, options.encoder_offset, robot.encoder_offset, "encoder offset")
-    q_model, slope = setpoints(robot, time, options.setpoints)
+    if reference is None:
+        q_model, slope = setpoints(robot, time, options.setpoints)
+    else:
+        q_model, slope = (np.asarray(x, dtype=float) for x in reference)
+        if q_model.shape != (n, robot.n_act) or slope.shape != q_model.shape:
+            raise InputError(f"a hung simulation's reference must be ({n}, {robot.n_act}) set-points and slopes "
+                             f"(duration x rate, the robot's joints), got {q_model.shape} and {slope.shape}")
     commands = Commands(q_model + offset, slope if options.setpoints.velocity else np.zeros_like(slope),
                         np.zeros_like(slope))
     run = PdRun(mjr, period, options.substeps, driver, armature, offset, friction, options.friction,
