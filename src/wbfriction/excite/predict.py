@@ -7,7 +7,9 @@ sandwich on the balance's residual, the Coulomb nuisance's slope, the delay's fo
 apart, each by the identification's own code:
 
 * the **model error**: the identification of the motion simulated without sensor noise (the robot's drivers, its
-  delay and friction as the prior has them): what it reports there is the model error alone;
+  delay and friction as the prior has them), under the delay's form the noisy run finds (on data without noise the
+  form's test has no noise to weigh the two forms' difference against): what it reports there is the model error
+  alone;
 * the **noise**: the Cramér-Rao bound of the same identification on the motion simulated with the drivers' noise
   (:class:`~wbfriction.sim.pd_options.DriverNoise`);
 
@@ -20,16 +22,17 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from wbfriction.actuator.identification import ActuatorIdentification, identify_actuators
+from wbfriction.actuator.identification import (STRUCTURE_SPREAD, ActuatorIdentification, Identified,
+                                                identify_actuators, parameter_status)
 from wbfriction.actuator.options import ActuatorOptions
 from wbfriction.friction.models import ModelParams
 from wbfriction.logs.log import log_from_table
 from wbfriction.model.robot import Robot
-from wbfriction.sim.hung import simulate_hung
+from wbfriction.sim.hung import HungSimulation, simulate_hung
 from wbfriction.sim.pd_options import DriverNoise, HungOptions
 
 
@@ -42,8 +45,7 @@ class Predicted:
         model_error: the standard error the noise-free identification reports [the parameter's unit].
         bound: its Cramér-Rao bound with the drivers' noise.
         se: ``hypot(model_error, bound)``: what the identification is predicted to report.
-        status, reason: the noise-free identification's verdict (a delay's form it cannot tell, a joint it does
-            not excite: the motion's, whatever the noise).
+        status, reason: the predicted verdict (:func:`_predicted`).
     """
 
     value: float
@@ -61,10 +63,16 @@ class ActuatorPrediction:
     Attributes:
         joints: per joint, each parameter's :class:`Predicted` (``armature``, ``F_v``, ``F_c``, ``offset``).
         delay: the drivers' delay's.
+        delayed_known: whether the identification is predicted to tell what the delay holds back (the set-points
+            or the whole torque; :attr:`~wbfriction.actuator.identification.ActuatorIdentification.delayed_known`).
+        motion: the motion simulated without noise (its set-points, angles and the drivers' torque: what the
+            motion asks of the robot).
     """
 
     joints: dict[str, dict[str, Predicted]]
     delay: Predicted
+    delayed_known: bool = True
+    motion: HungSimulation | None = field(default=None, repr=False, compare=False)
 
     def worst(self, limits: Mapping[str, float], weak: float) -> tuple[str, str, float]:
         """The parameter whose predicted standard error comes to the largest share of its status's limit:
@@ -85,19 +93,34 @@ def predict_pd(robot: Robot, options: HungOptions, friction: Mapping[str, ModelP
     Raises:
         InputError: what :func:`~wbfriction.sim.hung.simulate_hung` and the identification raise.
     """
-    def identified(noise: DriverNoise) -> ActuatorIdentification:
+    def identified(noise: DriverNoise, held: ActuatorOptions) -> tuple[HungSimulation, ActuatorIdentification]:
         sim = simulate_hung(robot, dataclasses.replace(options, noise=noise), friction, reference=reference)
-        return identify_actuators(robot, log_from_table(sim.table, robot, "excite"), identification)
+        return sim, identify_actuators(robot, log_from_table(sim.table, robot, "excite"), held)
 
-    clean, noisy = identified(DriverNoise()), identified(options.noise)
+    _, noisy = identified(options.noise, identification)
+    motion, clean = identified(DriverNoise(), dataclasses.replace(identification, delayed=noisy.options.delayed))
     joints = {}
     for jc, jn in zip(clean.joints, noisy.joints):
-        noisy_params = jn.parameters()
-        joints[jc.joint] = {name: _predicted(c, noisy_params[name].crb) for name, c in jc.parameters().items()}
-    return ActuatorPrediction(joints, _predicted(clean.delay, noisy.delay.crb))
+        theirs = jn.parameters()
+        joints[jc.joint] = {name: _predicted(name, c, theirs[name], spread=not noisy.delayed_known
+                                             and name in STRUCTURE_SPREAD) for name, c in jc.parameters().items()}
+    return ActuatorPrediction(joints, _predicted("delay", clean.delay, noisy.delay, spread=False),
+                              noisy.delayed_known, motion)
 
 
-def _predicted(clean, bound: float) -> Predicted:
+def _predicted(kind: str, clean: Identified, noisy: Identified, spread: bool) -> Predicted:
+    """What the identification is predicted to report of one parameter: the model error (``clean``'s standard error)
+    and the noise's bound (``noisy``'s) in quadrature; where the log does not tell the delay's form (``spread``), no
+    less than the noisy run's, which carries the distance between the two forms' values (:func:`~wbfriction.actuator.
+    identification.structure_widened`). Its status: the noisy run's where the motion leaves it undetermined or at a
+    bound, else the rule's (:func:`~wbfriction.actuator.identification.parameter_status`) on the prediction."""
     model_error = float(clean.se) if np.isfinite(clean.se) else np.inf
-    return Predicted(float(clean.value), model_error, float(bound), float(np.hypot(model_error, bound)),
-                     str(clean.status), str(clean.reason))
+    bound = float(noisy.crb)
+    se = float(np.hypot(model_error, bound))
+    if spread:
+        se = max(se, float(noisy.se))
+    if noisy.status in ("not excited", "at bound"):
+        status, reason = noisy.status, noisy.reason
+    else:
+        status, reason = parameter_status(kind, float(clean.value), se, bound, False)
+    return Predicted(float(clean.value), model_error, bound, se, status, reason)

@@ -1,0 +1,196 @@
+"""The design of a hung PD-driven robot's excitation: the set-points whose identification
+(:func:`~wbfriction.actuator.identify_actuators`) is predicted to report every parameter furthest inside its status's
+limit.
+
+**The criterion** is the worst share of its ``ok`` limit that a parameter's *predicted reported* standard error comes to
+(:meth:`~.predict.ActuatorPrediction.worst`: an offset's limit is
+:data:`~wbfriction.actuator.identification.OFFSET_WEAK`, the others' :data:`~wbfriction.fit.status.WEAK` times their
+value): E-optimality's worst parameter, on the scale the status reads, so that below 1 every parameter is predicted
+``ok``. Not the Cramér-Rao bound alone, nor D-optimality: on a hung Go2 (30 s, a real driver's noise) the bound's
+worst share hardly moves between motions (0.25-0.34), while what the identification reports moves 25-fold (0.27 on
+wide ramps, 6.9 on wide chirps, whose delay's form the balance cannot tell; ``excite_design`` notes). The standard
+error reported is mostly model error (the sandwich on the balance's residual, the Coulomb nuisance's slope, the
+delay's form), which the prediction (:func:`~.predict.predict_pd`) takes from the identification itself on the motion
+simulated without noise, with the identification's own Fisher information for the noise.
+
+**The family** is triangle ramps (:func:`~wbfriction.sim.hung.setpoints`, ``kind="ramps"``): each joint between
+random levels in the far half of its band about the robot's posture, reversing after a random time in ``reversal``.
+A triangle wave is the Fourier series of odd harmonics falling as ``1/k^2``, the field's parameterisation (Swevers et
+al. 1997) pushed to short reversals at constant speed: smooth series of five harmonics dwell near zero speed, where
+the Coulomb nuisance's slope is model error, and reverse slowly (worst share 2.8-4.4 on the hung Go2, the calves'
+offsets ``weak``), and the random levels give each joint a spread of speeds, so that F_v and F_c are not collinear as
+they are on ramps at one speed. The ramps span the band (``amplitude``, a share of half the range) for the offsets,
+whose information is the gravity torque's slope across it.
+
+**The search** (:func:`design_pd`): the amplitudes of :attr:`PdExciteOptions.amplitudes` at the first reversal
+range, then the reversal ranges at the best amplitude, each candidate scored by the prediction (two simulations and
+two identifications, 5-10 s for 30 s of a quadruped); a candidate whose motion leaves a position or velocity limit or
+asks more than :attr:`PdExciteOptions.torque_share` of a driver's torque limit is refused; the lowest worst share
+kept. Derivative-free on a grid: the score of random levels is not smooth in these variables.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from wbfriction.actuator.identification import OFFSET_WEAK
+from wbfriction.actuator.options import ActuatorOptions
+from wbfriction.exceptions import InputError
+from wbfriction.excite.limits import JointLimits, Margins, margins
+from wbfriction.excite.predict import ActuatorPrediction, predict_pd
+from wbfriction.fit.status import WEAK
+from wbfriction.friction.models import ModelParams
+from wbfriction.model.robot import Robot
+from wbfriction.progress import Progress
+from wbfriction.sim.pd_options import REAL_DRIVER, DriverNoise, HungOptions, SetpointOptions
+
+SHARE_LIMITS = {"offset": OFFSET_WEAK}
+"""The status's absolute limits (the others: :data:`~wbfriction.fit.status.WEAK` times the value)."""
+
+
+@dataclass(frozen=True)
+class PdExciteOptions:
+    """What :func:`design_pd` designs (module docstring).
+
+    Attributes:
+        duration: the recording [s]; rate: the drivers' rate [Hz] (the set-points' samples).
+        amplitudes: the shares of each joint's half range searched.
+        reversals: the ranges of times between two reversals searched [s] (shortest, longest).
+        torque_share: share of each driver's torque limit the motion may ask.
+        velocity: command ``qd_des`` = the set-points' slope (False: zeros, as the real Aliengo's log).
+        noise: the drivers' noise the prediction takes (:data:`~wbfriction.sim.pd_options.REAL_DRIVER`: a real
+            driver's).
+        seed: the ramps' levels and times.
+    """
+
+    duration: float = 30.0
+    rate: float = 200.0
+    amplitudes: tuple[float, ...] = (0.5, 0.65, 0.8, 0.95)
+    reversals: tuple[tuple[float, float], ...] = ((0.2, 1.5), (0.1, 0.8), (0.5, 3.0))
+    torque_share: float = 0.8
+    velocity: bool = False
+    noise: DriverNoise = REAL_DRIVER
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.duration) and self.duration * self.rate >= 2 * 200):
+            raise InputError(f"--duration {self.duration:g}: the design needs at least 200 samples x 2 "
+                             f"({400 / self.rate:g} s at {self.rate:g} Hz)")
+        if not self.amplitudes or not all(0 < a <= 1 for a in self.amplitudes):
+            raise InputError(f"--amplitude {self.amplitudes}: shares of each joint's half range, in (0, 1]")
+        if not 0 < self.torque_share <= 1:
+            raise InputError(f"--torque-share {self.torque_share!r} is not a share in (0, 1]")
+
+    def hung(self, amplitude: float, reversal: tuple[float, float]) -> HungOptions:
+        """The simulation of the candidate ``amplitude``, ``reversal`` with the drivers' noise."""
+        return HungOptions(duration=self.duration, rate=self.rate, noise=self.noise,
+                           setpoints=SetpointOptions(kind="ramps", amplitude=amplitude, reversal=reversal,
+                                                     velocity=self.velocity, seed=self.seed))
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One candidate of the search: its ``amplitude``, ``reversal`` [s], the parameter predicted worst ``worst``
+    (joint, name, share of its limit), its motion's :class:`~.limits.Margins` ``margins`` and whether it was within
+    the limits (``within``)."""
+
+    amplitude: float
+    reversal: tuple[float, float]
+    worst: tuple[str, str, float]
+    margins: Margins
+    within: bool
+
+
+@dataclass(frozen=True)
+class PdDesign:
+    """A hung PD-driven robot's designed excitation.
+
+    Attributes:
+        robot: the robot's name; joints: its PD-driven joints (its actuated order).
+        time: the set-points' times (N,) [s] from the start, at the drivers' rate.
+        q_des: the set-points (N, n) [rad], in the encoders' coordinates (the model's angle plus the robot's
+            ``[encoder_offset]``), as the drivers take them.
+        qd_des: the velocity set-points (N, n) [rad/s] (zeros unless :attr:`PdExciteOptions.velocity`).
+        chosen: the candidate kept; candidates: every one scored, in the search's order.
+        prediction: what the identification is predicted to report on it (:class:`~.predict.ActuatorPrediction`).
+        margins: how far inside its limits its motion stays (noise-free, the prior's friction).
+        options: what was designed.
+    """
+
+    robot: str
+    joints: tuple[str, ...]
+    time: np.ndarray
+    q_des: np.ndarray
+    qd_des: np.ndarray
+    chosen: Candidate
+    candidates: tuple[Candidate, ...]
+    prediction: ActuatorPrediction
+    margins: Margins
+    options: PdExciteOptions
+
+    def worst(self) -> tuple[str, str, float]:
+        """The parameter predicted worst: (joint, name, share of its status's limit)."""
+        return self.chosen.worst
+
+
+def design_pd(robot: Robot, options: PdExciteOptions = PdExciteOptions(),
+              prior: Mapping[str, ModelParams] | None = None,
+              identification: ActuatorOptions = ActuatorOptions(), progress: Progress | None = None) -> PdDesign:
+    """The excitation of a hung PD-driven robot (module docstring).
+
+    Args:
+        robot: a fixed-base robot whose joints are all PD-driven (``[pd]``), with finite position, velocity and
+            torque limits; its ``[pd]`` delay, ``[armature]`` and ``[encoder_offset]`` are the prior's.
+        options: :class:`PdExciteOptions`.
+        prior: the friction expected per joint (a fit; None: the simulator's default,
+            :func:`~wbfriction.sim.hung.default_hung_friction`).
+        identification: how the recording will be identified.
+        progress: told of each candidate scored.
+
+    Raises:
+        InputError: a robot the hung simulator does not take, a joint without limits
+            (:meth:`~.limits.JointLimits.of`); no candidate within the limits.
+    """
+    limits = JointLimits.of(robot)
+    scored: dict[tuple[float, tuple[float, float]], tuple[Candidate, ActuatorPrediction]] = {}
+
+    def score(amplitude: float, reversal: tuple[float, float]) -> Candidate:
+        key = (amplitude, reversal)
+        if key not in scored:
+            prediction = predict_pd(robot, options.hung(amplitude, reversal), prior, identification=identification)
+            assert prediction.motion is not None
+            run = prediction.motion.trajectory
+            m = margins(limits, run.q, run.qd, run.tau)
+            within = bool(min(m.position.min(), m.velocity.min()) > 0
+                          and m.torque.min() >= 1.0 - options.torque_share)
+            scored[key] = (Candidate(amplitude, reversal, prediction.worst(SHARE_LIMITS, WEAK), m, within),
+                           prediction)
+            if progress is not None:
+                progress(1)
+        return scored[key][0]
+
+    def best(cands: list[Candidate]) -> Candidate | None:
+        ok = [c for c in cands if c.within]
+        return min(ok, key=lambda c: c.worst[2]) if ok else None
+
+    first = best([score(a, options.reversals[0]) for a in options.amplitudes])
+    amplitude = first.amplitude if first is not None else min(options.amplitudes)
+    chosen = best([score(amplitude, r) for r in options.reversals])
+    if chosen is None:
+        least = min(scored.values(), key=lambda x: -x[0].margins.least())[0]
+        raise InputError(f"robot '{robot.name}': no candidate stays within its limits (the best leaves "
+                         f"{least.margins.least():.0%} of one): lower --amplitude or raise --torque-share")
+    prediction = scored[(chosen.amplitude, chosen.reversal)][1]
+    assert prediction.motion is not None
+    commands = prediction.motion.commands
+    return PdDesign(robot.name, robot.actuated, prediction.motion.time, commands.q_des, commands.qd_des, chosen,
+                    tuple(c for c, _ in scored.values()), prediction, chosen.margins, options)
+
+
+def play_options(design: PdDesign, noise: DriverNoise) -> HungOptions:
+    """The hung simulation that plays ``design`` with the drivers' noise ``noise``."""
+    return dataclasses.replace(design.options.hung(design.chosen.amplitude, design.chosen.reversal), noise=noise)
