@@ -251,6 +251,6 @@ def test_estimate_on_a_fixed_base_refuses_the_contacts_options(capsys, tmp_path,
     log.write_bytes(b"not read")
     code, err = run_cli(capsys, "estimate", log, "--robot", "panda", *given, "-o", tmp_path / "f.parquet")
     assert code == 2 and len(err.strip().splitlines()) == 1, err
-    assert err.startswith(f"error: {option_flag(param)}: robot 'panda' has a fixed base (no contact switch, no "
-                          "double support, no base to measure): it reads none of --mask, --lift-off, "), err
+    said = f"error: {option_flag(param)}: robot 'panda' has a fixed base: it takes no contact or base option"
+    assert err.strip() == said and len(said) <= 100, err
     assert not (tmp_path / "f.parquet").exists()
