@@ -441,12 +441,11 @@ def test_a_physics_step_nothing_reads_is_refused(params, tmp_path, capsys):
     outs = [tmp_path / "a.xml", tmp_path / "a.urdf"]
     code, err = run_cli(capsys, "export", params[0], "--config", config, *sum((["-o", o] for o in outs), []),
                         "--physics-dt", "0.002")
-    assert code == 2 and err.strip() == ("error: --physics-dt: no output counts a driver's delay in physics steps "
-                                         "(only .yaml does): not --physics-dt"), err
+    assert code == 2 and err.strip() == "error: --physics-dt: only a .yaml output counts a delay in physics steps", err
     code, err = run_cli(capsys, "export", params[0], "--robot", "panda", "-o", tmp_path / "a.yaml",
                         "--physics-dt", "0.002")
-    assert code == 2 and err.strip() == ("error: --physics-dt: robot 'panda' has no PD-driven joints ([pd] in its "
-                                         "TOML): no driver's delay to count in physics steps; not --physics-dt"), err
+    assert code == 2 and err.strip() == ("error: --physics-dt: robot 'panda' has no PD drivers ([pd]) whose delay it "
+                                         "counts"), err
     assert not [p for p in tmp_path.iterdir() if p.suffix in (".xml", ".urdf", ".yaml")]
     code, err = run_cli(capsys, "export", params[0], "--config", config, "-o", outs[0], "-o", tmp_path / "a.yaml",
                         "--physics-dt", "0.002")

@@ -198,19 +198,18 @@ def refuse_options(ctx: typer.Context, mode: str, takes: Collection[str], shared
             raise InputError(f"{flag}: {mode}: it takes {listed}; not {flag}")
 
 
-def refuse_unread(ctx: typer.Context, mode: str, unread: Collection[str]) -> None:
+def refuse_unread(ctx: typer.Context, mode: str, unread: Collection[str], what: str) -> None:
     """Refuse, before any work, the first option the user gave (:func:`given_options`) of those ``unread`` that the
     way the command runs does not read (where they are fewer than those it reads: :func:`refuse_options` lists
-    those).
+    those); ``what`` names them as a kind (``contact or base``), so the line stays short.
 
     Raises:
-        InputError: ``--mask: robot 'panda' has a fixed base ...: it reads none of --mask, --lift-off, ...``.
+        InputError: ``--mask: robot 'panda' has a fixed base: it takes no contact or base option``.
     """
     params = {p.name: p for p in ctx.command.params}
     for name in given_options(ctx):
         if name in unread:
-            listed = ", ".join(option_flag(p) for n, p in params.items() if n in unread)
-            raise InputError(f"{option_flag(params[name])}: {mode}: it reads none of {listed}")
+            raise InputError(f"{option_flag(params[name])}: {mode}: it takes no {what} option")
 
 
 ESTIMATE = EstimateOptions()  # one source of defaults: the library's

@@ -214,8 +214,7 @@ def estimate(ctx: typer.Context, log: Path = typer.Argument(..., metavar="LOG",
     spec = RobotSpec.given(robot, urdf, config, mjcf)
     r = spec.load()
     if not r.floating_base:
-        refuse_unread(ctx, f"robot '{r.name}' has a fixed base (no contact switch, no double support, no base to "
-                           "measure)", CONTACT_OPTIONS)
+        refuse_unread(ctx, f"robot '{r.name}' has a fixed base", CONTACT_OPTIONS, "contact or base")
     read = ReadOptions(max_gap=max_gap, limit_margin=limit_margin, time_base=time_base, time_unit=time_unit)
     _run_estimate(r, spec, log, output, opts, bag_map, read, workers, chunk_rows, companion)
 

@@ -274,9 +274,7 @@ def refuse_physics_dt(r: Robot, outputs: list[Path]) -> None:
     from wbfriction.export.registry import target_for, targets
 
     if not any("physics_dt" in target_for(o).reads for o in outputs):
-        readers = ", ".join(t.suffixes[0] for t in targets() if "physics_dt" in t.reads)
-        raise InputError(f"--physics-dt: no output counts a driver's delay in physics steps (only {readers} "
-                         "does): not --physics-dt")
+        readers = " or ".join(t.suffixes[0] for t in targets() if "physics_dt" in t.reads)
+        raise InputError(f"--physics-dt: only a {readers} output counts a delay in physics steps")
     if r.pd is None:
-        raise InputError(f"--physics-dt: robot '{r.name}' has no PD-driven joints ([pd] in its TOML): no driver's "
-                         "delay to count in physics steps; not --physics-dt")
+        raise InputError(f"--physics-dt: robot '{r.name}' has no PD drivers ([pd]) whose delay it counts")

@@ -36,7 +36,7 @@ from wbfriction.progress import Progress
 from wbfriction.quantities import check_options
 from wbfriction.sim.options import FrictionMode, Integrator
 from wbfriction.sim.pd_options import HungOptions, SetpointKind, SetpointOptions
-from wbfriction.sim.simulators import SimulationProgress, simulator_for, simulator_names, simulators
+from wbfriction.sim.simulators import SimulationProgress, simulator_for, simulator_names
 
 HUNG = HungOptions()
 SETPOINTS = SetpointOptions()
@@ -143,12 +143,6 @@ VelocityNoiseOpt = typer.Option(None, help="PD-driven: white noise std of the dr
 SHARED = ("output", "robot", "urdf", "config", "mjcf", "actuator")
 """The options every simulator of ``simulate`` reads that name what is simulated: the log, the robot, how it is
 driven."""
-MODES: dict[str, tuple[str, ...]] = {{"ideal": "ideal walk", "mujoco": "mujoco walk"}.get(k.name, k.name): k.options
-                                     for k in simulators()}
-"""The options (:func:`simulate`'s parameters) each built-in simulator reads beyond :data:`SHARED` (its
-:attr:`~wbfriction.sim.simulators.base.SimulatorKind.options`), by the way it runs (``quadruped``, ``hung``, ``arm``,
-``ideal walk``, ``mujoco walk``): any other given on the command line is refused before the work
-(:func:`~wbfriction.cli.common.refuse_options`)."""
 
 
 @app.command()
