@@ -11,7 +11,7 @@ status 2.
 
 # the commands, registered in the order a user meets them (``wbfriction --help`` lists them so)
 # isort: off
-from wbfriction.cli import simulate, estimate, fit, rollout, refine, identify, studies, fleet, data  # noqa: F401
+from wbfriction.cli import simulate, estimate, fit, rollout, refine, identify, excite, studies, fleet, data  # noqa: F401
 # isort: on
 from wbfriction.cli.common import app, main
 

@@ -24,6 +24,7 @@ from wbfriction.cli.common import (
     console,
     progress_bar,
     refuse_options,
+    refuse_unread,
     robot_of,
 )
 
@@ -139,6 +140,11 @@ DriverNoiseOpt = typer.Option("real", help="PD-driven: real (a real driver's noi
                                            "0.08 rad/s on the driver's velocity) or none (exact readings); "
                                            "--encoder-bits, --position-noise and --velocity-noise override it.")
 VelocityNoiseOpt = typer.Option(None, help="PD-driven: white noise std of the driver's velocity [rad/s].")
+PlayOpt = typer.Option(None, "--play", help="PD-driven: set-points to play (a table 'wbfriction excite' writes: "
+                                            "time, q_des.<joint>, qd_des.<joint>) instead of ramps and chirps; "
+                                            "its duration and rate are the table's.")
+PLAYED = ("duration", "setpoints", "excitation_seed")
+"""What a played table fixes: refused beside ``--play``."""
 
 SHARED = ("output", "robot", "urdf", "config", "mjcf", "actuator")
 """The options every simulator of ``simulate`` reads that name what is simulated: the log, the robot, how it is
@@ -162,7 +168,7 @@ def simulate(ctx: typer.Context, output: Path = OutputOpt, robot: str = RobotOpt
              actuator: Optional[Actuator] = ActuatorOpt, setpoints: SetpointKind = SetpointsOpt,
              driver_noise: DriverNoiseChoice = DriverNoiseOpt,
              velocity_noise: Optional[float] = VelocityNoiseOpt, speed: Optional[float] = SpeedOpt,
-             foot_forces: FootForces = FootForcesOpt) -> None:
+             foot_forces: FootForces = FootForcesOpt, play: Optional[Path] = PlayOpt) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents; a PD-driven one
     (--robot go2) hangs with its base fixed, its drivers tracking ramps and chirps; --simulator also takes a
@@ -170,11 +176,13 @@ def simulate(ctx: typer.Context, output: Path = OutputOpt, robot: str = RobotOpt
     values = {name: value for name, value in locals().items() if name != "ctx"}
     if simulator not in simulator_names():
         raise OptionError("--simulator", simulator, f"one of {', '.join(simulator_names())}")
-    check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors},
-                {"-o": output})
+    check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors,
+                 "--play": play}, {"-o": output})
     r = robot_of(robot, urdf, config, mjcf)
     kind = simulator_for(r, actuator, simulator)
     refuse_options(ctx, kind.what(r, actuator), kind.options, SHARED)
+    if play is not None:
+        refuse_unread(ctx, f"the set-points played ({play.name}) fix the motion", PLAYED, "motion")
     check_options({"--duration": ("duration", duration), "--excitation-seed": ("seed", excitation_seed),
                    "--noise-seed": ("seed", noise_seed), "--encoder-bits": ("encoder_bits", encoder_bits),
                    "--delay": ("delay_ms", delay), "--substeps": ("substeps", substeps),

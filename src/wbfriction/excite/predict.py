@@ -26,8 +26,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from wbfriction.actuator.identification import (STRUCTURE_SPREAD, ActuatorIdentification, Identified,
-                                                identify_actuators, parameter_status)
+from wbfriction.actuator.identification import (
+    STRUCTURE_SPREAD,
+    ActuatorIdentification,
+    Identified,
+    identify_actuators,
+    parameter_status,
+)
 from wbfriction.actuator.options import ActuatorOptions
 from wbfriction.friction.models import ModelParams
 from wbfriction.logs.log import log_from_table

@@ -62,6 +62,25 @@ def hung_options(duration: Optional[float], substeps: Optional[int], kind: Setpo
                        friction_timeconst=friction_timeconst)
 
 
+def played(robot: Robot, path: Path, options: HungOptions) -> tuple[HungOptions, tuple[Any, Any]]:
+    """``options`` and the reference (:func:`~wbfriction.sim.hung.simulate_hung`) that play the set-points table
+    at ``path`` (:mod:`wbfriction.logs.setpoint_table`, what ``excite`` writes): its duration and rate, the velocity
+    set-points sent where it holds any.
+
+    Raises:
+        InputError: what :func:`~wbfriction.logs.setpoint_table.read_setpoint_table` raises.
+    """
+    import numpy as np
+
+    from wbfriction.logs.setpoint_table import read_setpoint_table
+
+    table = read_setpoint_table(path, robot)
+    velocity = bool(np.any(table.qd_des != 0.0))
+    options = dataclasses.replace(options, duration=table.duration, rate=table.rate,
+                                  setpoints=dataclasses.replace(options.setpoints, velocity=velocity))
+    return options, (table.q_des - robot.offset_vector, table.qd_des)
+
+
 class ArmKind(SimulatorKind):
     """A fixed-base arm (torque-driven) tracking an excitation trajectory, its motor currents logged; default
     friction :func:`~wbfriction.sim.arm.default_arm_friction`."""
@@ -100,7 +119,8 @@ class HungKind(SimulatorKind):
 
     name, precedence, chosen = "hung", 20, False
     options = ("friction", "substeps", "mujoco_friction", "position_noise", "encoder_bits", "noise_seed", "delay",
-               "friction_timeconst", "duration", "excitation_seed", "setpoints", "driver_noise", "velocity_noise")
+               "friction_timeconst", "duration", "excitation_seed", "setpoints", "driver_noise", "velocity_noise",
+               "play")
 
     def what(self, robot: Robot, actuator: str | None = None) -> str:
         return f"robot '{robot.name}' is a hung PD-driven robot (fixed base, {'--actuator pd' if actuator else '[pd]'})"
@@ -124,8 +144,12 @@ class HungKind(SimulatorKind):
         if spec is not None and (spec.terms or spec.temperature is not None):
             raise InputError(f"{friction}: a PD-driven robot's simulation takes friction models per joint, without "
                              "terms beyond velocity or a temperature")
+        reference = None
+        if values.get("play") is not None:
+            options, reference = played(robot, values["play"], options)
         with progress.steps(int(round(options.duration * options.rate))) as advance:
-            result = simulate_hung(robot, options, None if spec is None else spec.params, progress=advance)
+            result = simulate_hung(robot, options, None if spec is None else spec.params, progress=advance,
+                                   reference=reference)
         return SimulationOutput(table=result.table, summary=f"{result.table.num_rows} samples, {options.duration:g} s, "
                                                             f"PD set-points; delay {result.driver.delay * 1e3:g} ms, "
                                                             f"physics step {result.physics_step * 1e3:g} ms")

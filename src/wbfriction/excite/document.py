@@ -1,0 +1,63 @@
+"""What ``wbfriction excite`` writes of a design: the set-points table a robot plays
+(:mod:`wbfriction.logs.setpoint_table`) and the JSON document of the prediction, the margins and the search (one
+writer each; the reader of the table is ``simulate --play``'s, the document is for the user and the benchmark).
+
+The document::
+
+    {"robot": ..., "kind": "hung PD-driven", "criterion": ..., "worst": {"joint", "parameter", "share"},
+     "chosen": {"amplitude", "reversal"}, "candidates": [{"amplitude", "reversal", "worst", "within"}, ...],
+     "predicted": {"<joint>": {"<parameter>": {"value", "se", "model_error", "bound", "limit", "share", "status",
+                                               "reason"}}},
+     "delay": {...}, "delayed_known": bool,
+     "margins": {"<joint>": {"position", "velocity", "torque"}}}
+
+Units: each parameter's own (:data:`~wbfriction.actuator.identification.UNITS`); ``share`` is ``se / limit``, below
+1 where the parameter is predicted ``ok``; margins are shares of each limit left unused (0: at it).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pyarrow as pa
+
+from wbfriction.excite.pd_design import SHARE_LIMITS, PdDesign
+from wbfriction.excite.predict import Predicted
+from wbfriction.fit.status import WEAK
+from wbfriction.logs.setpoint_table import setpoint_table
+
+CRITERION = ("the worst share of its status's limit (offsets 0.01 rad, others 0.25 x value) that a parameter's "
+             "predicted reported standard error comes to")
+
+
+def pd_setpoints(design: PdDesign) -> pa.Table:
+    """The set-points table of a hung PD-driven robot's design."""
+    return setpoint_table(design.robot, design.joints, design.time, design.q_des, design.qd_des,
+                          kind="hung PD-driven", amplitude=design.chosen.amplitude,
+                          reversal=list(design.chosen.reversal), seed=design.options.seed)
+
+
+def _parameter(name: str, p: Predicted) -> dict[str, Any]:
+    limit = SHARE_LIMITS.get(name, WEAK * abs(p.value))
+    return {"value": p.value, "se": p.se, "model_error": p.model_error, "bound": p.bound, "limit": limit,
+            "share": p.se / limit if limit > 0 else None, "status": p.status, "reason": p.reason}
+
+
+def pd_document(design: PdDesign) -> dict[str, Any]:
+    """The JSON document (module docstring) of a hung PD-driven robot's design."""
+    joint, name, share = design.worst()
+    m = design.margins
+    return {
+        "robot": design.robot, "kind": "hung PD-driven", "criterion": CRITERION,
+        "duration": design.options.duration, "rate": design.options.rate,
+        "worst": {"joint": joint, "parameter": name, "share": share},
+        "chosen": {"amplitude": design.chosen.amplitude, "reversal": list(design.chosen.reversal)},
+        "candidates": [{"amplitude": c.amplitude, "reversal": list(c.reversal), "worst": c.worst[2],
+                        "within": c.within} for c in design.candidates],
+        "predicted": {j: {n: _parameter(n, p) for n, p in params.items()}
+                      for j, params in design.prediction.joints.items()},
+        "delay": _parameter("delay", design.prediction.delay),
+        "delayed_known": design.prediction.delayed_known,
+        "margins": {j: {"position": float(m.position[i]), "velocity": float(m.velocity[i]),
+                        "torque": float(m.torque[i])} for i, j in enumerate(design.joints)},
+    }

@@ -1,0 +1,114 @@
+"""A table of set-points for a robot to play: what ``wbfriction excite`` writes and ``wbfriction simulate --play``
+reads (one writer, one reader).
+
+=====================  ==========  ==========================================================================
+column                 unit        meaning
+=====================  ==========  ==========================================================================
+``time``               s           from the motion's start, at the drivers' (or controller's) rate
+``q_des.<joint>``      rad         the joint's position set-point, in its encoder's coordinates (the model's
+                                   angle plus the robot's ``[encoder_offset]``)
+``qd_des.<joint>``     rad/s       the velocity set-point (zeros: the drivers are sent none)
+=====================  ==========  ==========================================================================
+
+The metadata (:mod:`wbfriction.logs.metadata`) says ``generator`` (``wbfriction.excite``), the ``robot``, and for a
+motion that is a finite Fourier series (an arm's), its coefficients (``fourier``: ``center`` (n,) [rad], ``a``,
+``b`` (n, L) [rad/s], ``omega`` [rad/s]; :class:`~wbfriction.sim.arm.FourierTrajectory`), from which the motion's
+accelerations are exact.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+
+from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.logs.metadata import read_metadata, with_metadata
+from wbfriction.logs.tables import numeric_column, numeric_columns, read_table
+from wbfriction.model.robot import Robot
+
+GENERATOR = "wbfriction.excite"
+
+
+@dataclass(frozen=True)
+class SetpointTable:
+    """Set-points read from a table (module docstring).
+
+    Attributes:
+        source: the file.
+        time: (N,) [s], from 0, evenly spaced; rate: its samples per second [Hz].
+        joints: the joints (the robot's actuated order).
+        q_des, qd_des: (N, n) [rad, rad/s], encoder coordinates.
+        fourier: the motion's Fourier coefficients where the table holds them (module docstring), else None.
+    """
+
+    source: str
+    time: np.ndarray
+    rate: float
+    joints: tuple[str, ...]
+    q_des: np.ndarray
+    qd_des: np.ndarray
+    fourier: dict | None = None
+
+    @property
+    def duration(self) -> float:
+        """The motion's length [s]: its samples over its rate."""
+        return len(self.time) / self.rate
+
+
+def setpoint_table(robot: str, joints: tuple[str, ...], time: np.ndarray, q_des: np.ndarray, qd_des: np.ndarray,
+                   fourier: dict | None = None, **meta) -> pa.Table:
+    """The table (module docstring) of the set-points ``q_des``, ``qd_des`` (N, n) [rad, rad/s] of ``joints`` at
+    ``time`` (N,) [s]; ``meta``: more metadata (JSON-able)."""
+    columns = {"time": pa.array(np.asarray(time, dtype=float))}
+    for i, j in enumerate(joints):
+        columns[f"q_des.{j}"] = pa.array(np.asarray(q_des[:, i], dtype=float))
+    for i, j in enumerate(joints):
+        columns[f"qd_des.{j}"] = pa.array(np.asarray(qd_des[:, i], dtype=float))
+    doc = {"generator": GENERATOR, "robot": robot, **meta}
+    if fourier is not None:
+        doc["fourier"] = {k: np.asarray(v).tolist() if not np.isscalar(v) else float(v) for k, v in fourier.items()}
+    return with_metadata(pa.table(columns), doc)
+
+
+def read_setpoint_table(path: str | Path, robot: Robot) -> SetpointTable:
+    """The set-points of ``robot``'s actuated joints in the table at ``path`` (any format
+    :func:`~wbfriction.logs.tables.read_table` reads).
+
+    Raises:
+        ColumnError: no ``time`` column, a joint's ``q_des`` column missing or not finite, a ``qd_des`` column
+            for some joints only, times not evenly spaced from 0.
+        InputError: fewer than two rows; Fourier coefficients of another number of joints.
+    """
+    source = str(path)
+    table = read_table(path)
+    for col in ("time", *(f"q_des.{j}" for j in robot.actuated)):
+        if col not in table.column_names:
+            raise ColumnError(source, col, None, f"missing column '{col}': set-points for robot '{robot.name}' "
+                              f"need time and q_des.<joint> for each of its {robot.n_act} joints")
+    if table.num_rows < 2:
+        raise InputError(f"{source}: {table.num_rows} row(s): set-points need at least two")
+    time = numeric_column(table, "time", source)
+    step = np.diff(time)
+    rate = 1.0 / float(np.median(step))
+    bad = np.flatnonzero(np.abs(step * rate - 1.0) > 1e-6)
+    if abs(time[0]) > 1e-9 or bad.size:
+        row = 0 if abs(time[0]) > 1e-9 else int(bad[0]) + 1
+        raise ColumnError(source, "time", row, f"row {row} of column 'time': set-points start at 0 and are evenly "
+                          f"spaced (a rate of {rate:g} Hz)")
+    q_des = numeric_columns(table, [f"q_des.{j}" for j in robot.actuated], source)
+    velocity = [f"qd_des.{j}" for j in robot.actuated]
+    there = [c in table.column_names for c in velocity]
+    if any(there) and not all(there):
+        missing = velocity[there.index(False)]
+        raise ColumnError(source, missing, None, f"missing column '{missing}': qd_des.* is given for some joints "
+                          "only; give it for every one, or for none")
+    qd_des = numeric_columns(table, velocity, source) if all(there) else np.zeros_like(q_des)
+    meta = read_metadata(table, source)
+    fourier = meta.get("fourier")
+    if fourier is not None and np.shape(fourier.get("center")) != (robot.n_act,):
+        raise InputError(f"{source}: its Fourier coefficients are of {np.size(fourier.get('center'))} joints, robot "
+                         f"'{robot.name}' has {robot.n_act}")
+    return SetpointTable(source, time, rate, robot.actuated, q_des, qd_des, fourier)
