@@ -1,0 +1,54 @@
+"""The set-points table ``excite`` writes and ``simulate --play`` reads (:mod:`wbfriction.logs.setpoint_table`):
+what is written is read back, in every format, and a table that cannot be played is refused in one line naming the
+file and the column."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import wbfriction
+from wbfriction.exceptions import ColumnError
+from wbfriction.logs.setpoint_table import read_setpoint_table, setpoint_table
+from wbfriction.logs.tables import write_table
+
+
+@pytest.fixture(scope="module")
+def go2():
+    return wbfriction.load_robot("go2")
+
+
+@settings(max_examples=15, deadline=None)
+@given(n=st.integers(2, 50), rate=st.sampled_from([100.0, 200.0, 500.0, 1000.0]), seed=st.integers(0, 2**16),
+       suffix=st.sampled_from([".parquet", ".csv"]), velocity=st.booleans())
+def test_what_is_written_is_read_back(go2, tmp_path_factory, n, rate, seed, suffix, velocity):
+    rng = np.random.default_rng(seed)
+    time = np.arange(n) / rate
+    q_des, qd_des = rng.normal(size=(n, go2.n_act)), rng.normal(size=(n, go2.n_act)) * velocity
+    path = tmp_path_factory.mktemp("sp") / f"design{suffix}"
+    write_table(setpoint_table(go2.name, go2.actuated, time, q_des, qd_des), path)
+    read = read_setpoint_table(path, go2)
+    assert read.joints == go2.actuated and read.rate == pytest.approx(rate)
+    assert read.duration == pytest.approx(n / rate)
+    np.testing.assert_array_equal(read.q_des, q_des)
+    np.testing.assert_array_equal(read.qd_des, qd_des)
+
+
+def test_a_table_that_cannot_be_played_is_refused_naming_its_column(go2, tmp_path):
+    time = np.arange(10) / 200.0
+    q = np.zeros((10, go2.n_act))
+    table = setpoint_table(go2.name, go2.actuated, time, q, q)
+    path = tmp_path / "d.parquet"
+    write_table(table.drop_columns([f"q_des.{go2.actuated[3]}"]), path)
+    with pytest.raises(ColumnError, match=f"missing column 'q_des.{go2.actuated[3]}'"):
+        read_setpoint_table(path, go2)
+    write_table(table.drop_columns([f"qd_des.{go2.actuated[0]}"]), path)
+    with pytest.raises(ColumnError, match="qd_des.\\* is given for some joints only"):
+        read_setpoint_table(path, go2)
+    uneven = setpoint_table(go2.name, go2.actuated, np.r_[time[:5], time[5:] + 0.001], q, q)
+    write_table(uneven, path)
+    with pytest.raises(ColumnError, match="row 5 of column 'time'") as err:
+        read_setpoint_table(path, go2)
+    assert err.value.row == 5 and str(path) in str(err.value)
