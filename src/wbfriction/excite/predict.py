@@ -23,6 +23,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -80,12 +81,18 @@ class ActuatorPrediction:
     motion: HungSimulation | None = field(default=None, repr=False, compare=False)
 
     def worst(self, limits: Mapping[str, float], weak: float) -> tuple[str, str, float]:
-        """The parameter whose predicted standard error comes to the largest share of its status's limit:
-        ``limits[name]`` [its unit] where given (an offset's), else ``weak`` times its value; (joint, name,
-        share)."""
-        shares = [(j, n, p.se / (limits[n] if n in limits else weak * abs(p.value)))
-                  for j, params in self.joints.items() for n, p in params.items()]
-        return max(shares, key=lambda x: x[2])
+        """The parameter predicted worst (:func:`worst_share`)."""
+        return worst_share(self.joints, limits, weak)
+
+
+def worst_share(joints: Mapping[str, Mapping[str, Any]], limits: Mapping[str, float], weak: float
+                ) -> tuple[str, str, float]:
+    """The parameter whose standard error (``.se``, of a :class:`Predicted` or of what the identification reports)
+    comes to the largest share of its status's limit: ``limits[name]`` [its unit] where given (an offset's), else
+    ``weak`` times its value; (joint, name, share)."""
+    shares = [(j, n, p.se / (limits[n] if n in limits else weak * abs(p.value)))
+              for j, params in joints.items() for n, p in params.items()]
+    return max(shares, key=lambda x: x[2])
 
 
 def predict_pd(robot: Robot, options: HungOptions, friction: Mapping[str, ModelParams] | None = None,
