@@ -61,7 +61,7 @@ def _bad(talos, good, edit):
     (lambda c: c["time"].__setitem__(10, c["time"][9]), "duplicated stamp at row 10"),
     (lambda c: c["time"].__setitem__(10, c["time"][9] - 1e-4), "decreasing stamp at row 10"),
     (lambda c: c["q.leg_left_4_joint"].__setitem__(12, 57.3), "column 'q.leg_left_4_joint' is 57.3 at row 12, "
-                                                              "beyond its URDF limits [0, 2.618]"),
+                                                              "beyond its limits [0, 2.618]"),
     (lambda c: c["q.leg_left_4_joint"].__setitem__(7, np.nan),
      "'q.leg_left_4_joint' has a non-finite value (NaN or inf) at row 7"),
     (lambda c: c["contact.left_sole_link"].__setitem__(3, 2), "must hold 0 or 1, found 2 at row 3"),

@@ -12,7 +12,8 @@ from wbfriction.model.robot import Robot
 
 def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT_MARGIN, first_row: int = 0,
                  prefix: str = "q", joints: tuple[str, ...] | None = None) -> None:
-    """Refuse angles beyond the URDF limits by more than ``margin`` [rad] (degrees logged as
+    """Refuse angles beyond the joints' limits (:attr:`~wbfriction.model.robot.Robot.angle_limits`: the URDF's or the
+    TOML's ``[angle_limits]``) by more than ``margin`` [rad] (degrees logged as
     radians, millimetres as metres); joints without finite limits are not checked.
 
     Args:
@@ -35,7 +36,7 @@ def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT
         if out.size:
             k = out[0]
             raise ColumnError(source, f"{prefix}.{name}", int(first_row + k),
-                              f"column '{prefix}.{name}' is {q[k, i]:.6g} at row {first_row + k}, beyond its URDF "
+                              f"column '{prefix}.{name}' is {q[k, i]:.6g} at row {first_row + k}, beyond its "
                               f"limits [{lo:.4g}, {hi:.4g}] by more than {margin:g}: wrong units (degrees for "
                               "radians)?")
 

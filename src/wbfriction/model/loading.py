@@ -117,7 +117,8 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
             ``"sole"`` or ``"point"`` built in, or a table contact frame -> name: :attr:`Robot.contact_kinds`,
             :mod:`wbfriction.model.contacts`), ``foot_radius`` (a point foot's sphere [m]:
             :attr:`Robot.foot_radius`), ``balance_gains``
-            (:attr:`Robot.balance_gains`).
+            (:attr:`Robot.balance_gains`), ``angle_limits`` (joint name -> [lower, upper] [rad]:
+            :attr:`Robot.angle_bounds`).
         source: file name used in error messages.
         model_format: ``"urdf"`` or ``"mjcf"``: how ``urdf`` is read.
 
@@ -162,7 +163,22 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
         encoder_offset=_joint_values(config, "encoder_offset", actuated, source, "encoder_offset"),
         contact_kinds=_contact_kinds(config.get("contact_model"), frames, floating, source),
         foot_radius=_foot_radius(config.get("foot_radius", 0.0), source),
+        angle_bounds=_angle_bounds(config.get("angle_limits", {}), actuated, source),
     )
+
+
+def _angle_bounds(table: object, actuated: list[str], source: str) -> dict[str, tuple[float, float]]:
+    """The ``[angle_limits]`` table: joint name -> [lower, upper] [rad], finite, lower < upper."""
+    if not isinstance(table, dict):
+        raise InputError(f"{source}: '[angle_limits]' must be a table of joint = [lower, upper] (rad)")
+    _check_names(list(table), set(actuated), "joint in [angle_limits]", source)
+    bounds = {}
+    for name, value in table.items():
+        ok = isinstance(value, list) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value)
+        if not ok or not (np.isfinite(value[0]) and np.isfinite(value[1]) and value[0] < value[1]):
+            raise InputError(f"{source}: [angle_limits] {name} = {value!r}: give [lower, upper] in rad, lower < upper")
+        bounds[name] = (float(value[0]), float(value[1]))
+    return bounds
 
 
 def _effort_limits(model: pin.Model, actuated: list[str]) -> np.ndarray:

@@ -90,6 +90,9 @@ class Robot:
             with ``q_des.<joint>`` columns take their torque from the PD law; None: no PD-driven joint.
         encoder_offset: joint -> the logged angle minus the model's angle [rad] (``[encoder_offset]`` in the
             TOML): the dynamics are evaluated at the logged angle minus it.
+        angle_bounds: joint -> (lower, upper) position limits [rad], the model's angle (``[angle_limits]`` in the
+            TOML): where the URDF gives none (a continuous joint that has stops) or other ones; they replace the
+            URDF's in :attr:`angle_limits`.
     """
 
     name: str
@@ -114,6 +117,7 @@ class Robot:
     encoder_offset: dict[str, float] = field(default_factory=dict)
     contact_kinds: tuple[ContactKind, ...] = ()
     foot_radius: float = 0.0
+    angle_bounds: dict[str, tuple[float, float]] = field(default_factory=dict)
     cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
     """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.stance`)."""
 
@@ -271,9 +275,13 @@ class Robot:
 
     @cached_property
     def angle_limits(self) -> tuple[np.ndarray, np.ndarray]:
-        """Lower and upper joint position limits (n_act,) [rad]; +-inf for continuous joints."""
+        """Lower and upper joint position limits (n_act,) [rad]: the URDF's, those of :attr:`angle_bounds` in their
+        place; +-inf for a continuous joint without bounds."""
         lo, hi = np.full(self.n_act, -np.inf), np.full(self.n_act, np.inf)
         lay = self.layout
         lo[lay.q1_joint] = self.model.lowerPositionLimit[lay.q1_index]
         hi[lay.q1_joint] = self.model.upperPositionLimit[lay.q1_index]
+        for joint, (lower, upper) in self.angle_bounds.items():
+            k = self.actuated.index(joint)
+            lo[k], hi[k] = lower, upper
         return lo, hi
