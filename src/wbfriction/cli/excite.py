@@ -41,6 +41,11 @@ def excite(output: list[Path] = typer.Option(..., "-o", "--output",
            velocity: bool = typer.Option(PD_EXCITE.velocity, help="Send qd_des = the set-points' slope (default: "
                                                                   "zeros, as most drivers are sent)."),
            seed: int = typer.Option(PD_EXCITE.seed, help="Seed of the ramps' levels and times."),
+           after: Optional[Path] = typer.Option(None, "--after",
+                                                help="What to record next: the parameters JSON 'fit' wrote from a log "
+                                                     "of this robot. Only the joints whose fit is not ok move (the "
+                                                     "others are held), with their fitted friction as the prior; "
+                                                     "the log's errors are printed beside the predicted ones."),
            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
            mjcf: Optional[Path] = MjcfOpt) -> None:
     """Design the motion to record on a hung PD-driven robot (its base fixed): set-points whose identification
@@ -51,7 +56,7 @@ def excite(output: list[Path] = typer.Option(..., "-o", "--output",
     from wbfriction.excite.pd_design import design_pd
     from wbfriction.logs.tables import write_json, write_table
 
-    check_paths({"--urdf": urdf, "--config": config, "--mjcf": mjcf},
+    check_paths({"--urdf": urdf, "--config": config, "--mjcf": mjcf, "--after": after},
                 {**{f"-o #{k + 1}": p for k, p in enumerate(output)}, "--json": prediction, "--figure": figure})
     options = PdExciteOptions(duration=duration, rate=rate, amplitudes=tuple(amplitude), torque_share=torque_share,
                               velocity=velocity, seed=seed)
@@ -59,13 +64,24 @@ def excite(output: list[Path] = typer.Option(..., "-o", "--output",
     if r.floating_base or r.pd is None:
         raise InputError(f"robot '{r.name}': excite designs a hung PD-driven robot's motion (a fixed base and a "
                          "[pd] table)")
+    fits = None
+    if after is not None:
+        from wbfriction.fit.params_file import read_robot_params
+
+        fits = read_robot_params(after, r.name, r.actuated, r.urdf)
     total = len(options.amplitudes) + len(options.reversals) - 1
     done = [0]
     with console.status(f"designing: candidate 1 of {total}") as status:
         def advance(n: int) -> None:
             done[0] += n
             status.update(f"designing: candidate {min(done[0] + 1, total)} of {total}")
-        design = design_pd(r, options, progress=advance)
+        if fits is None:
+            design = design_pd(r, options, progress=advance)
+        else:
+            from wbfriction.excite.next import record_next
+
+            following = record_next(r, fits, str(after), options, progress=advance)
+            design = following.design
     table = pd_setpoints(design)
     for path in output:
         write_table(table, path)
@@ -74,6 +90,8 @@ def excite(output: list[Path] = typer.Option(..., "-o", "--output",
     if figure is not None:
         _figure(design, r, figure)
     _print(design)
+    if fits is not None:
+        _print_next(following, after)
     for path in (*output, prediction, figure):
         if path is not None:
             console.print(f"wrote {path}")
@@ -115,3 +133,30 @@ def _print(design: PdDesign) -> None:
                  f"{doc['delay']['share']:.2f} of its limit",
                  f"worst: {joint} {name}, {share:.2f} of its limit (below 1: predicted ok)"):
         out.print(line, highlight=False)
+
+
+def _print_next(following, after: Path) -> None:
+    from wbfriction.excite.next import COMPARED
+
+    design = following.design
+    table = Table(title=f"The joints {after.name} left undetermined: the log's fit against the design's prediction",
+                  box=None)
+    table.add_column("joint")
+    table.add_column("log's status")
+    for name in COMPARED:
+        unit = "N·m·s/rad" if name == "F_v" else "N·m"
+        table.add_column(f"{name} log [{unit}]", justify="right")
+        table.add_column(f"{name} next [{unit}]", justify="right")
+    for joint, logged in following.logged.items():
+        predicted = design.prediction.joints[joint]
+        cells = []
+        for name in COMPARED:
+            value, se = logged.values.get(name, (float("nan"), float("nan")))
+            p = predicted[name]
+            cells += [f"{value:.3f} ± {se:.2g}", f"{p.value:.3f} ± {p.se:.2g}"]
+        table.add_row(joint, logged.status, *cells)
+    out.print(table)
+    held = [j for j in design.joints if j not in design.moving]
+    out.print(f"held at their posture (their fits ok): {', '.join(held) if held else 'none'}; prior friction from "
+              f"the fit on {len(following.prior_from_fit)} joints, the simulator's default on the others",
+              highlight=False)

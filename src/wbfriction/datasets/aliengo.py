@@ -317,7 +317,9 @@ def _gains_toml(key: str, values: np.ndarray, unit: str) -> list[str]:
 
 def robot_config(kp: np.ndarray, kd: np.ndarray, urdf: str) -> str:
     """The Aliengo's configuration (TOML): ``urdf``, a fixed base, the drivers' gains ``kp`` [N·m/rad] and ``kd``
-    [N·m·s/rad] (one number when every joint has the same, else a table), no delay, the joints' labels."""
+    [N·m·s/rad] (one number when every joint has the same, else a table), no delay, the joints' groups (``hip``,
+    ``thigh``, ``calf``: a real driver's noise, :data:`~wbfriction.sim.pd_options.REAL_DRIVER`, is given per group)
+    and labels."""
     lines = ["# A Unitree Aliengo hung with its base fixed and level, its joints PD-driven, for the iit-DLSLab log",
              "# (wbfriction dataset aliengo).",
              'name = "aliengo"', f'urdf = "{urdf}"   # beside this file (Unitree\'s unitree_ros)',
@@ -326,7 +328,11 @@ def robot_config(kp: np.ndarray, kd: np.ndarray, urdf: str) -> str:
              "# URDF's effort limits, on its encoder's angle q and its own velocity qd (the log's columns).",
              "[pd]"]
     lines += _gains_toml("kp", kp, "N·m/rad") + _gains_toml("kd", kd, "N·m·s/rad")
-    lines += ["delay = 0.0   # [s]: 'wbfriction identify --actuator pd' finds it", "", "[labels]"]
+    lines += ["delay = 0.0   # [s]: 'wbfriction identify --actuator pd' finds it", "", "[groups]"]
+    for part in PARTS:
+        members = ", ".join(f'"{j}"' for j in ALIENGO_JOINTS if f"_{part}_" in j)
+        lines.append(f"{part} = [{members}]")
+    lines += ["", "[labels]"]
     lines += [f'{j} = "{LABELS[j]}"' for j in ALIENGO_JOINTS]
     return "\n".join(lines) + "\n"
 

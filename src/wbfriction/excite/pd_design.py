@@ -32,7 +32,7 @@ kept. Derivative-free on a grid: the score of random levels is not smooth in the
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,11 +42,12 @@ from wbfriction.actuator.options import ActuatorOptions
 from wbfriction.exceptions import InputError
 from wbfriction.excite.limits import JointLimits, Margins, margins
 from wbfriction.excite.options import PdExciteOptions
-from wbfriction.excite.predict import ActuatorPrediction, predict_pd
+from wbfriction.excite.predict import ActuatorPrediction, predict_pd, worst_share
 from wbfriction.fit.status import WEAK
 from wbfriction.friction.models import ModelParams
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
+from wbfriction.sim.hung import setpoint_band, setpoints
 from wbfriction.sim.pd_options import DriverNoise, HungOptions
 
 SHARE_LIMITS = {"offset": OFFSET_WEAK}
@@ -78,8 +79,10 @@ class PdDesign:
         qd_des: the velocity set-points (N, n) [rad/s] (zeros unless :attr:`PdExciteOptions.velocity`).
         chosen: the candidate kept; candidates: every one scored, in the search's order.
         prediction: what the identification is predicted to report on it (:class:`~.predict.ActuatorPrediction`).
-        margins: how far inside its limits its motion stays (noise-free, the prior's friction).
+        margins: how far inside its limits its motion stays (noise-free, the prior's friction; a joint held still:
+            1).
         options: what was designed.
+        moving: the joints it excites (the others held at their posture).
     """
 
     robot: str
@@ -92,6 +95,7 @@ class PdDesign:
     prediction: ActuatorPrediction
     margins: Margins
     options: PdExciteOptions
+    moving: tuple[str, ...]
 
     def worst(self) -> tuple[str, str, float]:
         """The parameter predicted worst: (joint, name, share of its status's limit)."""
@@ -100,7 +104,8 @@ class PdDesign:
 
 def design_pd(robot: Robot, options: PdExciteOptions = PdExciteOptions(),
               prior: Mapping[str, ModelParams] | None = None,
-              identification: ActuatorOptions = ActuatorOptions(), progress: Progress | None = None) -> PdDesign:
+              identification: ActuatorOptions = ActuatorOptions(), progress: Progress | None = None,
+              moving: Collection[str] | None = None) -> PdDesign:
     """The excitation of a hung PD-driven robot (module docstring).
 
     Args:
@@ -111,24 +116,32 @@ def design_pd(robot: Robot, options: PdExciteOptions = PdExciteOptions(),
             :func:`~wbfriction.sim.hung.default_hung_friction`).
         identification: how the recording will be identified.
         progress: told of each candidate scored.
+        moving: the joints to excite (None: every one); the others are held at their posture, and the criterion
+            reads the moving joints' parameters only (what a log already determines is not recorded again,
+            :mod:`wbfriction.excite.next`).
 
     Raises:
         InputError: a robot the hung simulator does not take, a joint without limits
             (:meth:`~.limits.JointLimits.of`); no candidate within the limits.
     """
     limits = JointLimits.of(robot)
+    still = np.zeros(robot.n_act, dtype=bool) if moving is None else ~np.isin(robot.actuated, tuple(moving))
     scored: dict[tuple[float, tuple[float, float]], tuple[Candidate, ActuatorPrediction]] = {}
 
     def score(amplitude: float, reversal: tuple[float, float]) -> Candidate:
         key = (amplitude, reversal)
         if key not in scored:
-            prediction = predict_pd(robot, options.hung(amplitude, reversal), prior, identification=identification)
+            hung = options.hung(amplitude, reversal)
+            prediction = predict_pd(robot, hung, prior, reference=held(robot, hung, still),
+                                    identification=identification)
             assert prediction.motion is not None
             run = prediction.motion.trajectory
             m = margins(limits, run.q, run.qd, run.tau)
+            m = Margins(np.where(still, 1.0, m.position), np.where(still, 1.0, m.velocity), m.torque)
             within = bool(min(m.position.min(), m.velocity.min()) > 0
                           and m.torque.min() >= 1.0 - options.torque_share)
-            scored[key] = (Candidate(amplitude, reversal, prediction.worst(SHARE_LIMITS, WEAK), m, within),
+            asked = {j: p for j, p in prediction.joints.items() if not still[robot.actuated.index(j)]}
+            scored[key] = (Candidate(amplitude, reversal, worst_share(asked, SHARE_LIMITS, WEAK), m, within),
                            prediction)
             if progress is not None:
                 progress(1)
@@ -149,7 +162,20 @@ def design_pd(robot: Robot, options: PdExciteOptions = PdExciteOptions(),
     assert prediction.motion is not None
     commands = prediction.motion.commands
     return PdDesign(robot.name, robot.actuated, prediction.motion.time, commands.q_des, commands.qd_des, chosen,
-                    tuple(c for c, _ in scored.values()), prediction, chosen.margins, options)
+                    tuple(c for c, _ in scored.values()), prediction, chosen.margins, options,
+                    tuple(j for j, s in zip(robot.actuated, still) if not s))
+
+
+def held(robot: Robot, options: HungOptions, still: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The set-points of ``options`` (model angles and slopes (N, n_act)) with the joints ``still`` (n_act,) held at
+    their posture; None where none is (the simulator's own)."""
+    if not still.any():
+        return None
+    time = np.arange(int(round(options.duration * options.rate))) / options.rate
+    q, slope = setpoints(robot, time, options.setpoints)
+    posture = setpoint_band(robot, options.setpoints.amplitude)[0]
+    q[:, still], slope[:, still] = posture[still], 0.0
+    return q, slope
 
 
 def play_options(design: PdDesign, noise: DriverNoise) -> HungOptions:

@@ -89,9 +89,12 @@ def worst_share(joints: Mapping[str, Mapping[str, Any]], limits: Mapping[str, fl
                 ) -> tuple[str, str, float]:
     """The parameter whose standard error (``.se``, of a :class:`Predicted` or of what the identification reports)
     comes to the largest share of its status's limit: ``limits[name]`` [its unit] where given (an offset's), else
-    ``weak`` times its value; (joint, name, share)."""
-    shares = [(j, n, p.se / (limits[n] if n in limits else weak * abs(p.value)))
-              for j, params in joints.items() for n, p in params.items()]
+    ``weak`` times its value (inf where that is 0); (joint, name, share)."""
+    def share(name: str, p: Any) -> float:
+        limit = limits[name] if name in limits else weak * abs(p.value)
+        return float(p.se / limit) if limit > 0 else np.inf
+
+    shares = [(j, n, share(n, p)) for j, params in joints.items() for n, p in params.items()]
     return max(shares, key=lambda x: x[2])
 
 
