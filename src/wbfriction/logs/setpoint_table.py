@@ -92,8 +92,9 @@ def read_setpoint_table(path: str | Path, robot: Robot) -> SetpointTable:
         raise InputError(f"{source}: {table.num_rows} row(s): set-points need at least two")
     time = numeric_column(table, "time", source)
     step = np.diff(time)
-    rate = 1.0 / float(np.median(step))
-    bad = np.flatnonzero(np.abs(step * rate - 1.0) > 1e-6)
+    median = float(np.median(step))
+    bad = np.flatnonzero(~(np.abs(step / median - 1.0) <= 1e-6)) if median > 0 else np.arange(len(step))
+    rate = (len(time) - 1) / float(time[-1] - time[0]) if not bad.size else 1.0 / median
     if abs(time[0]) > 1e-9 or bad.size:
         row = 0 if abs(time[0]) > 1e-9 else int(bad[0]) + 1
         raise ColumnError(source, "time", row, f"row {row} of column 'time': set-points start at 0 and are evenly "

@@ -1,0 +1,47 @@
+"""``wbfriction excite`` as a user runs it (:mod:`wbfriction.cli.excite`): the set-points it writes are what
+``simulate --play`` plays, in both formats, the JSON holds every joint's prediction, and what it cannot design is one
+line before any work."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+import wbfriction
+from helpers import run_cli_printed
+from wbfriction.logs.setpoint_table import read_setpoint_table
+
+
+def test_a_design_written_then_played(cli, tmp_path):
+    out = cli("excite", "--robot", "go2", "--duration", "4", "--amplitude", "0.8", "-o", tmp_path / "d.parquet",
+              "-o", tmp_path / "d.csv", "--json", tmp_path / "d.json", "--figure", tmp_path / "d.png")
+    assert "worst: " in out and "of its limit" in out
+    go2 = wbfriction.load_robot("go2")
+    parquet, csv = (read_setpoint_table(tmp_path / f"d.{s}", go2) for s in ("parquet", "csv"))
+    np.testing.assert_array_equal(parquet.q_des, csv.q_des)
+    assert parquet.rate == pytest.approx(200.0, rel=1e-12) and parquet.duration == pytest.approx(4.0, rel=1e-12)
+    lower, upper = go2.angle_limits
+    model = parquet.q_des - go2.offset_vector
+    assert np.all((model >= lower) & (model <= upper))
+    doc = json.loads((tmp_path / "d.json").read_text())
+    assert set(doc["predicted"]) == set(go2.actuated) and doc["worst"]["share"] > 0
+    assert set(doc["margins"]["FL_calf_joint"]) == {"position", "velocity", "torque"}
+    assert (tmp_path / "d.png").stat().st_size > 10_000
+    cli("simulate", "--robot", "go2", "--play", tmp_path / "d.csv", "-o", tmp_path / "played.parquet")
+    played = pq.read_table(tmp_path / "played.parquet")
+    assert played.num_rows == 800
+    np.testing.assert_allclose(played.column("q_des.FL_calf_joint").to_numpy(), parquet.q_des[:, 2])
+
+
+def test_what_cannot_be_designed_is_one_line_before_the_work(capsys, tmp_path):
+    code, _, err = run_cli_printed(capsys, "excite", "--robot", "talos", "-o", tmp_path / "d.parquet")
+    assert code == 2 and "robot 'talos': excite designs a hung PD-driven robot's motion" in err
+    code, _, err = run_cli_printed(capsys, "excite", "--robot", "go2", "--duration", "1", "-o", tmp_path / "d.parquet")
+    assert code == 2 and "--duration 1: the design needs at least" in err
+    code, _, err = run_cli_printed(capsys, "simulate", "--robot", "go2", "--play", tmp_path / "missing.parquet",
+                                   "-o", tmp_path / "x.parquet")
+    assert code == 2 and "missing.parquet" in err
+    assert not (tmp_path / "d.parquet").exists() and not (tmp_path / "x.parquet").exists()
