@@ -60,11 +60,11 @@ class NextRecording:
 
 
 def physical(fit: FitResult) -> bool:
-    """Whether a fit's friction can be a design's prior: every value finite, each magnitude a user reads (F_c, F_v)
-    off its bound and larger than its standard error (a value the data do not tell from zero is what is in
-    question, not a prior)."""
+    """Whether a fit's friction can be a design's prior: ``ok`` or ``weak`` (not a fit at a bound, of a joint the
+    log did not excite, or failed), every value finite, each magnitude a user reads (F_c, F_v) larger than its
+    standard error (a value the data do not tell from zero is what is in question, not a prior)."""
     params = fit.params
-    if params is None or not np.all(np.isfinite(params.as_vector())):
+    if fit.verdict().status not in ("ok", "weak") or params is None or not np.all(np.isfinite(params.as_vector())):
         return False
     read = fit.read_stderr()
     return all(getattr(params, n) > read.get(n, np.inf) and not fit.at_bound.get(n, False)
