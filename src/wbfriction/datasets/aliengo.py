@@ -315,11 +315,23 @@ def _gains_toml(key: str, values: np.ndarray, unit: str) -> list[str]:
     return [f"{key} = {{ {table} }}   # [{unit}] (the log's '{key}')"]
 
 
-def robot_config(kp: np.ndarray, kd: np.ndarray, urdf: str) -> str:
+CONTINUOUS = tuple(j for j in ALIENGO_JOINTS if "_thigh_" in j)
+"""The joints the URDF leaves ``continuous`` (no position limits)."""
+
+
+def log_range(trajectory: dict[str, np.ndarray], joints: tuple[str, ...]) -> dict[str, tuple[float, float]]:
+    """The range [rad] the log's angles and set-points cover, per joint of ``joints``, rounded outward to 0.01 rad."""
+    both = np.vstack([trajectory["dof_pos"], trajectory["des_dof_pos"]])
+    return {j: (float(np.floor(both[:, k].min() * 100) / 100), float(np.ceil(both[:, k].max() * 100) / 100))
+            for j in joints for k in [ALIENGO_JOINTS.index(j)]}
+
+
+def robot_config(kp: np.ndarray, kd: np.ndarray, urdf: str,
+                 angle_limits: dict[str, tuple[float, float]] | None = None) -> str:
     """The Aliengo's configuration (TOML): ``urdf``, a fixed base, the drivers' gains ``kp`` [N·m/rad] and ``kd``
     [N·m·s/rad] (one number when every joint has the same, else a table), no delay, the joints' groups (``hip``,
-    ``thigh``, ``calf``: a real driver's noise, :data:`~wbfriction.sim.pd_options.REAL_DRIVER`, is given per group)
-    and labels."""
+    ``thigh``, ``calf``: a real driver's noise, :data:`~wbfriction.sim.pd_options.REAL_DRIVER`, is given per group),
+    labels, and ``angle_limits`` (joint -> [lower, upper] [rad]) for the joints the URDF leaves continuous."""
     lines = ["# A Unitree Aliengo hung with its base fixed and level, its joints PD-driven, for the iit-DLSLab log",
              "# (wbfriction dataset aliengo).",
              'name = "aliengo"', f'urdf = "{urdf}"   # beside this file (Unitree\'s unitree_ros)',
@@ -334,6 +346,10 @@ def robot_config(kp: np.ndarray, kd: np.ndarray, urdf: str) -> str:
         lines.append(f"{part} = [{members}]")
     lines += ["", "[labels]"]
     lines += [f'{j} = "{LABELS[j]}"' for j in ALIENGO_JOINTS]
+    if angle_limits:
+        lines += ["", "# The URDF leaves these joints continuous: their limits are the range the log moved them",
+                  "# through (a design, 'wbfriction excite', stays within it)", "[angle_limits]"]
+        lines += [f"{j} = [{lo:g}, {hi:g}]" for j, (lo, hi) in angle_limits.items()]
     return "\n".join(lines) + "\n"
 
 
@@ -513,8 +529,8 @@ class AliengoDataset(Dataset):
             write_table(table, logs[role])
         urdf, config = folder / URDF_FILE, folder / "aliengo.toml"
         write_atomic(urdf, lambda tmp: tmp.write_bytes(files[URDF_FILE].read_bytes()))
-        write_atomic(config, lambda tmp: tmp.write_text(robot_config(trajectory["kp"], trajectory["kd"],
-                                                                     urdf.name)))
+        text = robot_config(trajectory["kp"], trajectory["kd"], urdf.name, log_range(trajectory, CONTINUOUS))
+        write_atomic(config, lambda tmp: tmp.write_text(text))
         write_atomic(folder / "peer.toml", lambda tmp: tmp.write_text(peer_config(peer)))
         q = {role: shlex.quote(str(p)) for role, p in logs.items()}
         commands = (f"wbfriction identify {q['train']} --config {shlex.quote(str(config))} --actuator pd "
