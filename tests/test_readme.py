@@ -112,6 +112,13 @@ def needs(steps: list[Step]) -> list[set[int]]:
 
 
 EXPECTED = {
+    # issue 66: the Go2's design predicts every parameter ok, the worst a calf's offset at its noise's floor
+    "wbfriction excite --robot go2 -o go2_excite.parquet -o go2_excite.csv --json go2_excite.json --figure "
+    "go2_excite.png": [r"^worst: \w+_calf_joint offset, 0\.2\d of its limit \(below 1: predicted ok\)$"],
+    # what to record next after the real Aliengo's log: every parameter predicted ok under its model
+    "wbfriction excite --config aliengo_identified.toml --after aliengo_params.json -o aliengo_next.parquet --json "
+    "aliengo_next.json --figure aliengo_next.png": [r"^worst: \w+ \w+, 0\.[0-5]\d of its limit",
+                                                   r"^held at their posture \(their fits ok\): none"],
     "python examples/fleet_trends.py --output fleet": [  # arm 1's joint 4 alone, from the day its wear began
         r"^24 logs processed on Dask, 0 already done$",
         r"^drift: arm-1 panda_joint4 \S+ \+\d+ % from 2026-01-1[0-4]$",  # worn from the 8th log, Jan 12
@@ -127,6 +134,9 @@ EXPECTED = {
 pages run are checked here, once (``tests/test_examples.py`` runs the others)."""
 
 PRINTS = {
+    # the Go2's design played with another noise: every parameter ok, its standard errors as predicted
+    "docs/how-to/excitation.md": [r"^48 of 48 parameters ok; 4[3-8] of 48 standard errors within 1\.5x of the "
+                                  r"prediction$"],
     "docs/how-to/library.md": [r"leg_right_4_joint: F_c"],  # the API block's fits of the walk
     "docs/extending.md": [r"^arm\.tsv: 10000 samples, tau_f of 7 joints$",  # a log format registered, read
                           # a torque source registered: a log written through it, read back as its own
