@@ -23,8 +23,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from wbfriction.excite.stance import StanceOptions, stance_reference, support_margin, swing_band
 from wbfriction.exceptions import InputError
+from wbfriction.excite.stance import StanceOptions, stance_reference, support_margin, swing_band
 from wbfriction.fit.joints import fit_joints
 from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import estimate_log
