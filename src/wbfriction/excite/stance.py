@@ -52,7 +52,7 @@ LWA = pin.LOCAL_WORLD_ALIGNED
 
 SWING_BAND: dict[str, tuple[float, float]] = {
     "hip_yaw": (-0.15, 0.05),
-    "hip_roll": (-0.35, -0.15),
+    "hip_roll": (-0.4, -0.2),
     "hip_pitch": (-0.9, -0.5),
     "knee": (1.3, 1.8),
     "ankle_pitch": (-0.9, -0.4),
