@@ -193,7 +193,15 @@ class StanceIK:
 
     Args:
         robot: a biped (two soles, six joints per leg); stance: the stance sole's index.
-        sole: the stance sole's placement (flat on the ground); com: the centre-of-mass target (3,) [m].
+        sole: the stance sole's placement (flat on the ground, world frame); com: the centre-of-mass target (3,)
+            [m], world frame.
+
+    Attributes:
+        cols: the velocity indices solved (12,): the base's six, then the stance leg's joints.
+        rest: every other velocity index (nv - 12,), in increasing order: the joints prescribed.
+
+    Raises:
+        ModelError: a stance leg of other than six joints.
     """
 
     def __init__(self, robot: Robot, stance: int, sole: pin.SE3, com: np.ndarray) -> None:
