@@ -18,7 +18,9 @@ the last, so that every sample is one the estimator maps exactly to the swing le
   constant), so the reference keeps the stance sole still at the acceleration level. *Quasi-static*: the centre of
   mass, not the zero-moment point, is held over the sole; the ZMP of the reference's own dynamics
   (:func:`zero_moment_point`) is computed and must stay inside the sole's footprint (:func:`support_margin`,
-  ModelError otherwise): the swing leg's velocity cap is what keeps it there.
+  ModelError otherwise): the swing leg's velocity cap is what keeps it there. (TALOS, the default options: the ZMP
+  within 14 mm of the sole's centre, 53 mm inside its edges; the swing sole 58 mm above the ground at its lowest
+  corner, 22-32 mm beside the stance sole; measured on both feet.)
 
 The motion starts at rest in single support (the series is at rest at ``t = 0``) with the swing foot already in the
 air: both simulators accept that (the ideal one welds the stance sole at its first sample; MuJoCo starts from the
