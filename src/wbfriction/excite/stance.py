@@ -1,0 +1,413 @@
+"""A humanoid standing on one foot while its other leg is excited (issue 66): a reference the project's walking
+simulators play (:class:`~wbfriction.walking.reference.WalkingReference`), single support from the first sample to
+the last, so that every sample is one the estimator maps exactly to the swing leg's friction torque.
+
+* **The swing leg**: each joint a finite Fourier series at rest at both ends (:mod:`.trajectory`), designed alone by
+  :func:`~.design.design_joint` on the Cramér-Rao bound of its friction (:attr:`StanceOptions.asked`) within a
+  conservative *posture band* (:data:`SWING_BAND`, given for a right swing leg, mirrored for a left one: hip and
+  ankle roll and hip yaw change sign) intersected with its URDF range less :attr:`StanceOptions.margin`, and below
+  :attr:`StanceOptions.velocity`. The band keeps the leg flexed (hip pitch forward, knee bent, the foot lifted) and
+  its hip rolled outward, away from the stance leg; :func:`stance_reference` checks on the solved motion that the
+  swing sole's lowest corner stays :attr:`StanceOptions.clearance` above the ground and its corners beside the
+  stance sole's footprint (ModelError otherwise).
+* **Every other joint but the stance leg's** is held at the robot's reference posture (arms, torso, head).
+* **The floating base and the stance leg** (``6 + 6`` unknowns) come from a square inverse kinematics per sample
+  (Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), twelve tasks: the stance sole's placement
+  (flat at its standing footprint, 6), the centre of mass over the sole's centre at the standing posture's height
+  (3), the base upright (3). Velocities from ``J v = 0``, accelerations from ``J a = -Jd v`` (the targets are
+  constant), so the reference keeps the stance sole still at the acceleration level. *Quasi-static*: the centre of
+  mass, not the zero-moment point, is held over the sole; the ZMP of the reference's own dynamics
+  (:func:`zero_moment_point`) is computed and must stay inside the sole's footprint (:func:`support_margin`,
+  ModelError otherwise): the swing leg's velocity cap is what keeps it there. (TALOS, the default options: the ZMP
+  within 14 mm of the sole's centre, 53 mm inside its edges; the swing sole 58 mm above the ground at its lowest
+  corner, 22-32 mm beside the stance sole; measured on both feet.)
+
+The motion starts at rest in single support (the series is at rest at ``t = 0``) with the swing foot already in the
+air: both simulators accept that (the ideal one welds the stance sole at its first sample; MuJoCo starts from the
+reference's first state), so no transition from double support is planned.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from wbfriction.exceptions import InputError, ModelError
+from wbfriction.excite.design import ExciteOptions, design_joint
+from wbfriction.excite.information import FRICTION_READ
+from wbfriction.excite.trajectory import FourierSpace
+from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
+from wbfriction.friction.families.params import ModelParamsBase
+from wbfriction.friction.noise import NoiseModel
+from wbfriction.model.robot import Robot
+from wbfriction.sim.arm import FourierTrajectory
+from wbfriction.sim.mujoco_model import sole_footprint
+from wbfriction.walking.footsteps import FootstepPlan
+from wbfriction.walking.options import GaitOptions
+from wbfriction.walking.reference import WalkingReference, standing_configuration
+from wbfriction.walking.swing import foot_placement
+
+LWA = pin.LOCAL_WORLD_ALIGNED
+
+SWING_BAND: dict[str, tuple[float, float]] = {
+    "hip_yaw": (-0.15, 0.05),
+    "hip_roll": (-0.4, -0.2),
+    "hip_pitch": (-0.9, -0.5),
+    "knee": (1.3, 1.8),
+    "ankle_pitch": (-0.9, -0.4),
+    "ankle_roll": (-0.15, 0.15),
+}
+"""The swing leg's posture band [rad] per joint group, for a *right* swing leg (TALOS's conventions: a negative hip
+roll moves the right foot outward; a left swing leg's hip yaw, hip roll and ankle roll bands are negated): the
+foot lifted and rolled away from the stance leg."""
+MIRRORED = ("hip_yaw", "hip_roll", "ankle_roll")
+"""The groups whose band changes sign from one leg to the other."""
+SLACK = (1e-3, 0.99)
+"""What each joint's design is given: its band less 1 mrad at each end, 99 % of its velocity cap: the design holds
+its limits on a grid (:data:`~.design.GRID` points per period) and overshoots them between the points by up to about
+0.2 mrad (measured), which this keeps within the band and the cap at every sample."""
+
+
+@dataclass(frozen=True)
+class StanceOptions:
+    """What :func:`stance_reference` builds.
+
+    Attributes:
+        stance: ``"left"`` or ``"right"``: the foot stood on (the other leg swings).
+        duration: the recording [s]; rate: its samples per second [Hz]; period: the series' period [s] (a whole
+            number of periods per recording).
+        harmonics: ``L`` per swing joint.
+        velocity: the cap on each swing joint's speed [rad/s] (also at most ``velocity_share`` of its URDF limit).
+        velocity_share: share of each URDF velocity limit.
+        margin: how far inside its URDF range each swing joint stays [rad].
+        clearance: the least height of the swing sole's lowest corner above the ground [m].
+        zmp_margin: the least distance of the reference's ZMP to the stance sole's edges [m].
+        asked: the friction parameters each swing joint's design determines.
+        torque_noise: the design's torque noise [N·m]; position_noise: its position noise [rad].
+        starts: seeded starts of each joint's design; seed: their seed.
+    """
+
+    stance: str = "left"
+    duration: float = 8.0
+    rate: float = 1000.0
+    period: float = 4.0
+    harmonics: int = 5
+    velocity: float = 1.5
+    velocity_share: float = 0.8
+    margin: float = 0.05
+    clearance: float = 0.02
+    zmp_margin: float = 0.01
+    asked: tuple[str, ...] = FRICTION_READ
+    torque_noise: float = 0.05
+    position_noise: float = 1e-4
+    starts: int = 2
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.stance not in ("left", "right"):
+            raise InputError(f"--stance {self.stance!r}: 'left' or 'right'")
+        if not (np.isfinite(self.velocity) and self.velocity > 0):
+            raise InputError(f"--velocity {self.velocity!r}: a swing joint's speed cap must be > 0 rad/s")
+
+    def excite(self) -> ExciteOptions:
+        """The :class:`~.design.ExciteOptions` of each swing joint's design (InputError: a period that does not
+        divide the duration)."""
+        return ExciteOptions(duration=self.duration, rate=self.rate, period=self.period, harmonics=self.harmonics,
+                             range_share=1.0, velocity_share=self.velocity_share, asked=self.asked,
+                             starts=self.starts, seed=self.seed)
+
+
+@dataclass(frozen=True)
+class StanceExcitation:
+    """A one-foot stance with the swing leg excited.
+
+    Attributes:
+        reference: the whole-body reference (N samples at ``rate``): ``contact`` has the stance foot only,
+            ``feet`` the stance sole's footprint and the swing sole's pose (x, y, z [m], yaw [rad], world),
+            ``com`` the centre of mass [m], ``zmp`` the ZMP of the reference's own dynamics [m].
+        stance: the stance foot's index in :attr:`Robot.contact_frames`.
+        joints: the swing leg's joints (the robot's actuated order); trajectory: their series.
+        lower, upper: each swing joint's band [rad] (the posture band within its URDF range less the margin).
+        zmp_margin: the least distance of the ZMP to the stance sole's edges [m] (negative: outside).
+        clearance: the least height of the swing sole's corners above the ground [m].
+    """
+
+    reference: WalkingReference
+    stance: int
+    joints: tuple[str, ...]
+    trajectory: FourierTrajectory
+    lower: np.ndarray
+    upper: np.ndarray
+    zmp_margin: float
+    clearance: float
+
+
+def swing_band(robot: Robot, joints: tuple[str, ...], side: str, margin: float) -> tuple[np.ndarray, np.ndarray]:
+    """Each swing joint's band (n,), (n,) [rad]: :data:`SWING_BAND` of its group (mirrored for a left leg) within its
+    URDF range less ``margin``.
+
+    Raises:
+        InputError: a joint whose group has no band, or whose band leaves no room within its range.
+    """
+    lo_urdf, hi_urdf = robot.angle_limits
+    lower, upper = np.empty(len(joints)), np.empty(len(joints))
+    for i, joint in enumerate(joints):
+        group = robot.group_of(joint)
+        if group not in SWING_BAND:
+            raise InputError(f"swing joint '{joint}' (group {group!r}) has no posture band: one of "
+                             f"{sorted(SWING_BAND)}")
+        lo, hi = SWING_BAND[group]
+        if side == "left" and group in MIRRORED:
+            lo, hi = -hi, -lo
+        a = robot.actuated.index(joint)
+        lower[i], upper[i] = max(lo, lo_urdf[a] + margin), min(hi, hi_urdf[a] - margin)
+        if not upper[i] > lower[i]:
+            raise InputError(f"swing joint '{joint}': its band [{lo:g}, {hi:g}] rad leaves no room within its "
+                             f"range [{lo_urdf[a]:g}, {hi_urdf[a]:g}] less {margin:g} rad")
+    return lower, upper
+
+
+def design_swing(robot: Robot, joints: tuple[str, ...], lower: np.ndarray, upper: np.ndarray,
+                 prior: Mapping[str, ModelParamsBase], options: StanceOptions) -> FourierTrajectory:
+    """The swing joints' series (n joints): each designed alone by :func:`~.design.design_joint` within its band
+    ``[lower, upper]`` (n,) [rad] and below the velocity cap, for its ``prior`` friction and the options' noise (the
+    joint's inertia: the mass matrix's diagonal at the standing posture), less :data:`SLACK`."""
+    excite = options.excite()
+    space = FourierSpace(1, excite.harmonics, excite.omega)
+    inertia = np.diag(pin.crba(robot.model, robot.model.createData(), standing_configuration(robot)))
+    rng = np.random.default_rng(options.seed)
+    z = []
+    for i, joint in enumerate(joints):
+        a = robot.actuated.index(joint)
+        iv = robot.act_v_index[a]
+        velocity = min(options.velocity, options.velocity_share * float(robot.model.velocityLimit[iv]))
+        noise = NoiseModel(options.torque_noise, options.position_noise, float(inertia[iv]), 1.0 / options.rate)
+        z.append(design_joint(space, excite, float(lower[i]) + SLACK[0], float(upper[i]) - SLACK[0],
+                              SLACK[1] * velocity, prior[joint], noise, rng))
+    return FourierSpace(len(joints), excite.harmonics, excite.omega).trajectory(np.concatenate(z))
+
+
+class StanceIK:
+    """The square single-support inverse kinematics of the module docstring, for one robot and stance foot.
+
+    Args:
+        robot: a biped (two soles, six joints per leg); stance: the stance sole's index.
+        sole: the stance sole's placement (flat on the ground, world frame); com: the centre-of-mass target (3,)
+            [m], world frame.
+
+    Attributes:
+        cols: the velocity indices solved (12,): the base's six, then the stance leg's joints.
+        rest: every other velocity index (nv - 12,), in increasing order: the joints prescribed.
+
+    Raises:
+        ModelError: a stance leg of other than six joints.
+    """
+
+    def __init__(self, robot: Robot, stance: int, sole: pin.SE3, com: np.ndarray) -> None:
+        self.robot, self.model, self.data = robot, robot.model, robot.model.createData()
+        leg = [robot.actuated.index(j) for j in robot.limb(robot.contact_frames[stance])]
+        if len(leg) != 6:
+            raise ModelError(f"robot '{robot.name}': a stance leg of {len(leg)} joints, the IK needs 6")
+        self.cols = np.concatenate([np.arange(6), robot.act_v_index[leg]])
+        self.rest = np.setdiff1d(np.arange(self.model.nv), self.cols)
+        self.frame = robot.contact_frame_ids[stance]
+        self.sole, self.com = sole, np.asarray(com, dtype=float)
+        self.base_R = pin.rpy.rpyToMatrix(0.0, 0.0, pin.rpy.matrixToRpy(sole.rotation)[2])
+
+    def _system(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The task Jacobian (12, nv) and error (12,) at ``q``: sole (position [m], rotation [rad]), centre of
+        mass [m], base rotation [rad]."""
+        model, data = self.model, self.data
+        pin.computeJointJacobians(model, data, q)
+        J = np.zeros((12, model.nv))
+        J[0:6] = pin.getFrameJacobian(model, data, self.frame, LWA)
+        J[6:9] = pin.jacobianCenterOfMass(model, data, True)
+        R = data.oMi[1].rotation
+        J[9:12, 3:6] = R
+        oMf = data.oMf[self.frame]
+        e = np.concatenate([self.sole.translation - oMf.translation, pin.log3(self.sole.rotation @ oMf.rotation.T),
+                            self.com - data.com[0], pin.log3(self.base_R @ R.T)])
+        return J, e
+
+    def solve(self, q: np.ndarray, v_rest: np.ndarray, a_rest: np.ndarray, tol: float = 1e-11,
+              max_iter: int = 50) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The configuration (nq,), velocity and acceleration (nv,) whose joints outside the base and the stance
+        leg are those of ``q`` (a guess of the rest), ``v_rest`` and ``a_rest`` (on :attr:`rest`).
+
+        Raises:
+            ModelError: the Newton iterations do not converge (the target out of reach).
+        """
+        model, data, cols = self.model, self.data, self.cols
+        for _ in range(max_iter):
+            J, e = self._system(q)
+            if np.max(np.abs(e)) < tol:
+                break
+            dv = np.zeros(model.nv)
+            dv[cols] = np.linalg.solve(J[:, cols], e)
+            q = pin.integrate(model, q, dv)
+        else:
+            raise ModelError(f"one-foot stance IK did not converge (residual {np.max(np.abs(e)):.2e})")
+        Jc_inv, Jr = np.linalg.inv(J[:, cols]), J[:, self.rest]
+        v, a = np.zeros(model.nv), np.zeros(model.nv)
+        v[self.rest], a[self.rest] = v_rest, a_rest
+        v[cols] = -Jc_inv @ (Jr @ v_rest)
+        pin.centerOfMass(model, data, q, v, np.zeros(model.nv))  # drift: zero acceleration
+        drift = np.concatenate([pin.getFrameClassicalAcceleration(model, data, self.frame, LWA).vector,
+                                data.acom[0], np.zeros(3)])
+        a[cols] = -Jc_inv @ (drift + Jr @ a_rest)
+        return q, v, a
+
+
+def zero_moment_point(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """The zero-moment point (N, 2) [m] on the ground (z = 0, world frame) of a motion ``q`` (N, nq), ``v``, ``a``
+    (N, nv): where the contact wrench that the rate of the centroidal momentum asks
+    (``pin.computeCentroidalMomentumTimeVariation``) has no horizontal moment."""
+    model, data = robot.model, robot.model.createData()
+    mass, g = pin.computeTotalMass(model), model.gravity.linear
+    out = np.empty((len(q), 2))
+    for k in range(len(q)):
+        pin.computeCentroidalMomentumTimeVariation(model, data, q[k], v[k], a[k])
+        force = data.dhg.linear - mass * g
+        moment = data.dhg.angular + np.cross(data.com[0], force)  # about the world origin
+        out[k] = -moment[1] / force[2], moment[0] / force[2]
+    return out
+
+
+def support_margin(robot: Robot, stance: int, zmp: np.ndarray) -> float:
+    """The least distance [m] of the points ``zmp`` (N, 2) (world) to the edges of the stance sole's footprint
+    (:func:`~wbfriction.sim.mujoco_model.sole_footprint`), the sole flat at its standing placement; negative: a
+    point outside."""
+    model, data = robot.model, robot.model.createData()
+    pin.framesForwardKinematics(model, data, standing_configuration(robot))
+    sole = data.oMf[robot.contact_frame_ids[stance]]
+    centre, half = sole_footprint(robot, robot.contact_frames[stance])
+    local = (zmp - sole.translation[:2]) @ sole.rotation[:2, :2]
+    return float(np.min(half - np.abs(local - centre)))
+
+
+def _swing_corners(robot: Robot, stance: int, q: np.ndarray, every: int = 10) -> tuple[float, float]:
+    """The swing sole's lowest corner height [m] over the motion ``q`` (N, nq) (every ``every`` samples), and its
+    corners' least lateral distance beyond the stance sole's inner edge [m] (negative: beside it no longer)."""
+    model, data = robot.model, robot.model.createData()
+    swing = 1 - stance
+    centre, half = sole_footprint(robot, robot.contact_frames[swing])
+    corners = np.array([[centre[0] + sx * half[0], centre[1] + sy * half[1], 0.0]
+                        for sx in (-1, 1) for sy in (-1, 1)])
+    s_centre, s_half = sole_footprint(robot, robot.contact_frames[stance])
+    pin.framesForwardKinematics(model, data, q[0])
+    stance_sole = data.oMf[robot.contact_frame_ids[stance]].copy()
+    inward = 1.0 if stance == 0 else -1.0  # the swing foot lies to the stance sole's -y (left stance) or +y
+    edge = s_centre[1] - inward * s_half[1]
+    low, beside = np.inf, np.inf
+    for k in range(0, len(q), every):
+        pin.framesForwardKinematics(model, data, q[k])
+        world = corners @ data.oMf[robot.contact_frame_ids[swing]].rotation.T + data.oMf[
+            robot.contact_frame_ids[swing]].translation
+        in_stance = (world - stance_sole.translation) @ stance_sole.rotation
+        low = min(low, float(world[:, 2].min()))
+        beside = min(beside, float(np.min(inward * (edge - in_stance[:, 1]))))
+    return low, beside
+
+
+def stance_reference(robot: Robot, options: StanceOptions = StanceOptions(),
+                     prior: Mapping[str, ModelParamsBase] | None = None) -> StanceExcitation:
+    """Stand on one foot for :attr:`StanceOptions.duration` while the other leg follows its designed series
+    (module docstring).
+
+    Args:
+        robot: a biped: two soles (left, right, in that order), six joints per leg, its leg joints in groups of
+            :data:`SWING_BAND`.
+        options: :class:`StanceOptions`.
+        prior: per swing joint, the friction its design's bound is taken at; default: the thesis's targets by
+            group (:data:`~wbfriction.fit.targets.THESIS_TARGETS`).
+
+    Returns:
+        A :class:`StanceExcitation` of ``duration x rate`` samples.
+
+    Raises:
+        InputError: a robot without two soles, a swing joint without band or prior, a period that does not divide
+            the duration; ModelError: the IK out of reach, the ZMP leaving the sole, the swing sole too low or
+            under the stance sole, a stance joint outside its URDF range.
+    """
+    stance = 0 if options.stance == "left" else 1
+    q0 = standing_configuration(robot)
+    joints = robot.limb(robot.contact_frames[1 - stance])
+    prior = friction_by_group(robot.groups, THESIS_TARGETS) if prior is None else prior
+    if missing := [j for j in joints if j not in prior]:
+        raise InputError(f"no prior friction for swing joint '{missing[0]}'")
+    lower, upper = swing_band(robot, joints, "right" if stance == 0 else "left", options.margin)
+    trajectory = design_swing(robot, joints, lower, upper, prior, options)
+    time = options.excite().times()
+    qs, qds, qdds = trajectory(time)
+    model, data = robot.model, robot.model.createData()
+    pin.framesForwardKinematics(model, data, q0)
+    feet0 = np.array([[*data.oMf[f].translation[:2], 0.0, pin.rpy.matrixToRpy(data.oMf[f].rotation)[2]]
+                      for f in robot.contact_frame_ids])
+    sole = foot_placement(feet0[stance])
+    centre, _ = sole_footprint(robot, robot.contact_frames[stance])
+    act = np.array([robot.actuated.index(j) for j in joints])
+    q = q0.copy()
+    q[robot.act_q_index[act]] = qs[0]
+    com = np.array([*sole.act(np.array([*centre, 0.0]))[:2], pin.centerOfMass(model, data, q0)[2]])
+    ik = StanceIK(robot, stance, sole, com)
+    Q, V, A = _solved(robot, ik, q, act, (qs, qds, qdds))
+    return _checked(robot, options, stance, joints, trajectory, (lower, upper), feet0, time, (Q, V, A))
+
+
+def _solved(robot: Robot, ik: StanceIK, q: np.ndarray, act: np.ndarray,
+            swing: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The IK at every sample of the swing joints' motion (N, n) each (``act``: their actuated indices), from ``q``
+    (the first guess)."""
+    qs, qds, qdds = swing
+    model = robot.model
+    n = len(qs)
+    Q, V, A = np.empty((n, model.nq)), np.empty((n, model.nv)), np.empty((n, model.nv))
+    iq = robot.act_q_index[act]
+    on_rest = np.searchsorted(ik.rest, robot.act_v_index[act])
+    v_rest, a_rest = np.zeros(len(ik.rest)), np.zeros(len(ik.rest))
+    for k in range(n):
+        q = q.copy()
+        q[iq] = qs[k]
+        v_rest[on_rest], a_rest[on_rest] = qds[k], qdds[k]
+        q, V[k], A[k] = ik.solve(q, v_rest, a_rest)
+        Q[k] = q
+    return Q, V, A
+
+
+def _checked(robot: Robot, options: StanceOptions, stance: int, joints: tuple[str, ...],
+             trajectory: FourierTrajectory, band: tuple[np.ndarray, np.ndarray], feet0: np.ndarray,
+             time: np.ndarray, motion: tuple[np.ndarray, np.ndarray, np.ndarray]) -> StanceExcitation:
+    """The :class:`StanceExcitation` of a solved motion, its ZMP, clearance and stance leg's range checked."""
+    Q, V, A = motion
+    zmp = zero_moment_point(robot, Q, V, A)
+    margin = support_margin(robot, stance, zmp)
+    if margin < options.zmp_margin:
+        raise ModelError(f"the ZMP comes within {margin * 1e3:.1f} mm of the stance sole's edge (at least "
+                         f"{options.zmp_margin * 1e3:.1f} mm asked): lower --velocity")
+    low, beside = _swing_corners(robot, stance, Q)
+    if low < options.clearance or beside < 0.0:
+        raise ModelError(f"the swing sole comes {low * 1e3:.1f} mm above the ground and {beside * 1e3:.1f} mm beside "
+                         f"the stance sole (at least {options.clearance * 1e3:.1f} and 0 mm): a narrower band")
+    lo, hi = robot.angle_limits
+    angles = robot.angles(Q)
+    if np.any(angles < lo) or np.any(angles > hi):
+        worst = int(np.argmax(np.maximum(lo - angles, angles - hi).max(axis=0)))
+        raise ModelError(f"joint '{robot.actuated[worst]}' leaves its URDF range on one foot")
+    model, data = robot.model, robot.model.createData()
+    feet = np.empty((len(Q), 2, 4))
+    feet[:, stance] = feet0[stance]
+    swing = robot.contact_frame_ids[1 - stance]
+    com = np.empty((len(Q), 3))
+    for k in range(len(Q)):
+        com[k] = pin.centerOfMass(model, data, Q[k])
+        pin.updateFramePlacement(model, data, swing)
+        M = data.oMf[swing]
+        feet[k, 1 - stance] = [*M.translation, np.arctan2(M.rotation[1, 0], M.rotation[0, 0])]
+    contact = np.zeros((len(Q), 2), dtype=bool)
+    contact[:, stance] = True
+    plan = FootstepPlan(feet0[:, [0, 1, 3]], (), float(options.duration), GaitOptions())
+    reference = WalkingReference(time, Q, V, A, contact, feet, com, zmp, plan)
+    return StanceExcitation(reference, stance, joints, trajectory, band[0], band[1], margin, low)
