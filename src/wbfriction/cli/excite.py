@@ -90,11 +90,11 @@ def excite(output: list[Path] = typer.Option(..., "-o", "--output",
     if figure is not None:
         _figure(design, r, figure)
     _print(design)
-    if fits is not None:
+    if fits is not None and after is not None:
         _print_next(following, after)
-    for path in (*output, prediction, figure):
-        if path is not None:
-            console.print(f"wrote {path}")
+    for written in (*output, prediction, figure):
+        if written is not None:
+            console.print(f"wrote {written}")
 
 
 def _figure(design: PdDesign, robot, path: Path) -> None:

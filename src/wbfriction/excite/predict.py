@@ -134,8 +134,8 @@ def _predicted(kind: str, clean: Identified, noisy: Identified, spread: bool) ->
     se = float(np.hypot(model_error, bound))
     if spread:
         se = max(se, float(noisy.se))
-    if noisy.status in ("not excited", "at bound"):
-        status, reason = noisy.status, noisy.reason
-    else:
+    status: str = noisy.status
+    reason = noisy.reason
+    if status not in ("not excited", "at bound"):
         status, reason = parameter_status(kind, float(clean.value), se, bound, False)
     return Predicted(float(clean.value), model_error, bound, se, status, reason)

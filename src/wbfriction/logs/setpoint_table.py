@@ -69,7 +69,7 @@ def setpoint_table(robot: str, joints: tuple[str, ...], time: np.ndarray, q_des:
         columns[f"qd_des.{j}"] = pa.array(np.asarray(qd_des[:, i], dtype=float))
     doc = {"generator": GENERATOR, "robot": robot, **meta}
     if fourier is not None:
-        doc["fourier"] = {k: np.asarray(v).tolist() if not np.isscalar(v) else float(v) for k, v in fourier.items()}
+        doc["fourier"] = {k: np.asarray(v, dtype=float).tolist() for k, v in fourier.items()}
     return with_metadata(pa.table(columns), doc)
 
 

@@ -29,7 +29,7 @@ def excite_figure(path: str | Path, joints: tuple[str, ...], time: np.ndarray, q
     columns = min(columns, n)
     rows = int(np.ceil(n / columns))
     fig = Figure(figsize=(3.0 * columns, 1.7 * rows + 3.4), layout="constrained")
-    top, bottom = fig.subfigures(2, 1, height_ratios=[1.7 * rows, 3.0])
+    top, bottom = np.asarray(fig.subfigures(2, 1, height_ratios=[1.7 * rows, 3.0])).ravel()
     axes = top.subplots(rows, columns, sharex=True, squeeze=False).ravel()
     for i, (ax, joint) in enumerate(zip(axes, joints)):
         ax.plot(time, q_des[:, i], lw=0.7, color="C0")
