@@ -37,7 +37,6 @@ import pinocchio as pin
 
 from wbfriction.exceptions import InputError, ModelError
 from wbfriction.excite.design import ExciteOptions, design_joint
-from wbfriction.excite.information import FRICTION_READ
 from wbfriction.excite.trajectory import FourierSpace
 from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.friction.families.params import ModelParamsBase
@@ -77,47 +76,32 @@ class StanceOptions:
 
     Attributes:
         stance: ``"left"`` or ``"right"``: the foot stood on (the other leg swings).
-        duration: the recording [s]; rate: its samples per second [Hz]; period: the series' period [s] (a whole
-            number of periods per recording).
-        harmonics: ``L`` per swing joint.
-        velocity: the cap on each swing joint's speed [rad/s] (also at most ``velocity_share`` of its URDF limit).
-        velocity_share: share of each URDF velocity limit.
+        design: each swing joint's design (:class:`~.design.ExciteOptions`: the recording's duration and rate, the
+            series' period (a whole number per recording) and harmonics, the share of each URDF velocity limit, the
+            friction parameters asked, the starts and seed; its range share is not read: the band is
+            :data:`SWING_BAND`'s).
+        velocity: the cap on each swing joint's speed [rad/s] (also at most the design's velocity share of its URDF
+            limit).
         margin: how far inside its URDF range each swing joint stays [rad].
         clearance: the least height of the swing sole's lowest corner above the ground [m].
         zmp_margin: the least distance of the reference's ZMP to the stance sole's edges [m].
-        asked: the friction parameters each swing joint's design determines.
         torque_noise: the design's torque noise [N·m]; position_noise: its position noise [rad].
-        starts: seeded starts of each joint's design; seed: their seed.
     """
 
     stance: str = "left"
-    duration: float = 8.0
-    rate: float = 1000.0
-    period: float = 4.0
-    harmonics: int = 5
+    design: ExciteOptions = ExciteOptions(duration=8.0, period=4.0, harmonics=5, range_share=1.0)
     velocity: float = 1.5
-    velocity_share: float = 0.8
     margin: float = 0.05
     clearance: float = 0.02
     zmp_margin: float = 0.01
-    asked: tuple[str, ...] = FRICTION_READ
     torque_noise: float = 0.05
     position_noise: float = 1e-4
-    starts: int = 2
-    seed: int = 0
 
     def __post_init__(self) -> None:
         if self.stance not in ("left", "right"):
             raise InputError(f"--stance {self.stance!r}: 'left' or 'right'")
         if not (np.isfinite(self.velocity) and self.velocity > 0):
             raise InputError(f"--velocity {self.velocity!r}: a swing joint's speed cap must be > 0 rad/s")
-
-    def excite(self) -> ExciteOptions:
-        """The :class:`~.design.ExciteOptions` of each swing joint's design (InputError: a period that does not
-        divide the duration)."""
-        return ExciteOptions(duration=self.duration, rate=self.rate, period=self.period, harmonics=self.harmonics,
-                             range_share=1.0, velocity_share=self.velocity_share, asked=self.asked,
-                             starts=self.starts, seed=self.seed)
 
 
 @dataclass(frozen=True)
@@ -175,16 +159,16 @@ def design_swing(robot: Robot, joints: tuple[str, ...], lower: np.ndarray, upper
     """The swing joints' series (n joints): each designed alone by :func:`~.design.design_joint` within its band
     ``[lower, upper]`` (n,) [rad] and below the velocity cap, for its ``prior`` friction and the options' noise (the
     joint's inertia: the mass matrix's diagonal at the standing posture), less :data:`SLACK`."""
-    excite = options.excite()
+    excite = options.design
     space = FourierSpace(1, excite.harmonics, excite.omega)
     inertia = np.diag(pin.crba(robot.model, robot.model.createData(), standing_configuration(robot)))
-    rng = np.random.default_rng(options.seed)
+    rng = np.random.default_rng(excite.seed)
     z = []
     for i, joint in enumerate(joints):
         a = robot.actuated.index(joint)
         iv = robot.act_v_index[a]
-        velocity = min(options.velocity, options.velocity_share * float(robot.model.velocityLimit[iv]))
-        noise = NoiseModel(options.torque_noise, options.position_noise, float(inertia[iv]), 1.0 / options.rate)
+        velocity = min(options.velocity, excite.velocity_share * float(robot.model.velocityLimit[iv]))
+        noise = NoiseModel(options.torque_noise, options.position_noise, float(inertia[iv]), 1.0 / excite.rate)
         z.append(design_joint(space, excite, float(lower[i]) + SLACK[0], float(upper[i]) - SLACK[0],
                               SLACK[1] * velocity, prior[joint], noise, rng))
     return FourierSpace(len(joints), excite.harmonics, excite.omega).trajectory(np.concatenate(z))
@@ -340,7 +324,7 @@ def stance_reference(robot: Robot, options: StanceOptions = StanceOptions(),
         raise InputError(f"no prior friction for swing joint '{missing[0]}'")
     lower, upper = swing_band(robot, joints, "right" if stance == 0 else "left", options.margin)
     trajectory = design_swing(robot, joints, lower, upper, prior, options)
-    time = options.excite().times()
+    time = options.design.times()
     qs, qds, qdds = trajectory(time)
     model, data = robot.model, robot.model.createData()
     pin.framesForwardKinematics(model, data, q0)
@@ -408,6 +392,6 @@ def _checked(robot: Robot, options: StanceOptions, stance: int, joints: tuple[st
         feet[k, 1 - stance] = [*M.translation, np.arctan2(M.rotation[1, 0], M.rotation[0, 0])]
     contact = np.zeros((len(Q), 2), dtype=bool)
     contact[:, stance] = True
-    plan = FootstepPlan(feet0[:, [0, 1, 3]], (), float(options.duration), GaitOptions())
+    plan = FootstepPlan(feet0[:, [0, 1, 3]], (), float(options.design.duration), GaitOptions())
     reference = WalkingReference(time, Q, V, A, contact, feet, com, zmp, plan)
     return StanceExcitation(reference, stance, joints, trajectory, band[0], band[1], margin, low)
