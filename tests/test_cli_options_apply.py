@@ -30,7 +30,7 @@ def simulator_options() -> dict[str, tuple[str, ...]]:
 
 HUNG = ("robot 'go2' is a hung PD-driven robot (fixed base, [pd]): it takes --friction, --substeps, "
         "--mujoco-friction, --position-noise, --encoder-bits, --noise-seed, --delay, --friction-timeconst, "
-        "--duration, --excitation-seed, --setpoints, --driver-noise, --velocity-noise")
+        "--duration, --excitation-seed, --setpoints, --driver-noise, --velocity-noise, --play")
 QUADRUPED = ("robot 'go2_walking' stands on point feet (a walking quadruped): it takes --gait, --friction, "
              "--simulator, --substeps, --sensors, --position-noise, --encoder-bits, --torque-noise, --noise-seed, "
              "--duration, --excitation-seed, --speed, --foot-forces")
@@ -133,7 +133,7 @@ VALUES = {
     "ft_offset": ["--ft-offset", "1", "0.1"], "duration": ["--duration", "1"],
     "excitation_seed": ["--excitation-seed", "2"], "setpoints": ["--setpoints", "chirps"],
     "driver_noise": ["--driver-noise", "none"], "velocity_noise": ["--velocity-noise", "0.01"],
-    "speed": ["--speed", "0.1"], "foot_forces": ["--foot-forces", "3d"],
+    "speed": ["--speed", "0.1"], "foot_forces": ["--foot-forces", "3d"], "play": ["--play", "FILE"],
     # identify's
     "output": ["-o", "OUT"], "json_output": ["--json", "OUT"], "stribeck_velocity": ["--stribeck-velocity", "0.1"],
     "passes": ["--passes", "1"], "holdout": ["--holdout", "0.3"], "stride": ["--stride", "2"],

@@ -15,7 +15,7 @@ from helpers import run_cli_printed
 from wbfriction.logs.setpoint_table import read_setpoint_table
 
 
-def test_a_design_written_then_played(cli, tmp_path):
+def test_a_design_written_then_played(cli, capsys, tmp_path):
     out = cli("excite", "--robot", "go2", "--duration", "4", "--amplitude", "0.8", "-o", tmp_path / "d.parquet",
               "-o", tmp_path / "d.csv", "--json", tmp_path / "d.json", "--figure", tmp_path / "d.png")
     assert "worst: " in out and "of its limit" in out
@@ -31,6 +31,9 @@ def test_a_design_written_then_played(cli, tmp_path):
     assert set(doc["margins"]["FL_calf_joint"]) == {"position", "velocity", "torque"}
     assert (tmp_path / "d.png").stat().st_size > 10_000
     cli("simulate", "--robot", "go2", "--play", tmp_path / "d.csv", "-o", tmp_path / "played.parquet")
+    code, _, err = run_cli_printed(capsys, "simulate", "--robot", "go2", "--play", tmp_path / "d.csv", "--duration",
+                                   "5", "-o", tmp_path / "other.parquet")
+    assert code == 2 and "--duration: the set-points played (d.csv) fix the motion: it takes no motion option" in err
     played = pq.read_table(tmp_path / "played.parquet")
     assert played.num_rows == 800
     np.testing.assert_allclose(played.column("q_des.FL_calf_joint").to_numpy(), parquet.q_des[:, 2])
