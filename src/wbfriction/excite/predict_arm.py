@@ -15,9 +15,11 @@ encoders, torque noise 0.05 N·m: median 2.3 on a designed motion, 3.1 on a rand
   (:attr:`~wbfriction.fit.result.FitResult.model_spread`), which the noise sets (the Stribeck and transition
   parameters it leaves loose), not the model: 3 to 30 times the bound.
 
-So the prediction is the identification's report on the motion simulated with the sensors' noise
-(:attr:`ArmPrediction.joints`, ``se``), never below the floor above; its statistical part (without the family
-spread, :attr:`ArmPrediction.statistical`) likewise. What the noise makes of a standard error differs from one
+So the prediction is the identification's own report on the motion simulated with the sensors' noise
+(:attr:`ArmPrediction.joints`, ``se``; its statistical part without the family spread,
+:attr:`ArmPrediction.statistical`), the model error and the bound kept beside it. (Not floored at their sum: where
+the noise leads ``auto`` to a simpler family than the noise-free motion does, that family's misfit of the
+noise-free motion is no error the noisy fit reports.) What the noise makes of a standard error differs from one
 recording to another: on another noise's recording the statistical standard errors of F_c, F_v and ``tau_os`` came
 within 1.25 times those predicted (42 of 42 over the two motions), the Stribeck and transition parameters' (S, v_s, a)
 within 0.2 to 3.7 times, and the family spread within 0.5 to 3.1 times (a single draw of the families' disagreement).
@@ -55,12 +57,12 @@ class ArmPrediction:
 
     Attributes:
         joints: per joint, each parameter of the model the fit chose on the noisy motion, a :class:`Predicted`:
-            ``value`` the noise-free fit's, ``model_error`` the standard error the noise-free fit reports (read:
-            with its family spread), ``bound`` the noisy fit's Cramér-Rao bound, ``se`` the standard error a user
-            will read (:meth:`~wbfriction.fit.result.FitResult.read_stderr`) [the parameter's unit], ``status`` and
-            ``reason`` the noisy fit's verdict.
-        statistical: per joint and parameter, the predicted standard error without the family spread
-            (:attr:`~wbfriction.fit.result.FitResult.stderr`) [the parameter's unit].
+            ``value`` the noise-free fit's, ``model_error`` the standard error the noise-free fit (of the same
+            family) reports, ``bound`` the noisy fit's Cramér-Rao bound, ``se`` the standard error the noisy fit
+            reports, the one a user will read (:meth:`~wbfriction.fit.result.FitResult.read_stderr`: with the family
+            spread) [the parameter's unit], ``status`` and ``reason`` the noisy fit's verdict.
+        statistical: per joint and parameter, the predicted standard error without the family spread (the noisy
+            fit's :attr:`~wbfriction.fit.result.FitResult.stderr`) [the parameter's unit].
         models: per joint, the family the fit chose on the noisy motion.
     """
 
@@ -139,22 +141,17 @@ def predict_arm(robot: Robot, friction: Mapping[str, ModelParams], trajectory: R
 
 def predicted_joint(clean: FitResult, noisy: FitResult) -> tuple[dict[str, Predicted], dict[str, float]]:
     """One joint's :class:`Predicted` per parameter of ``noisy``'s model, and its statistical standard errors
-    (:class:`ArmPrediction`), from the fits of the same motion without (``clean``) and with the sensors' noise.
-    A parameter the noise-free fit has no finite standard error for (or no parameters) has an infinite model error."""
+    (:class:`ArmPrediction`), from the fits of the same motion without (``clean``, of the same family) and with the
+    sensors' noise (``noisy``). A parameter the noise-free fit has no finite standard error for (or no parameters)
+    has an infinite model error."""
     verdict = noisy.verdict()
     clean_read = clean.read_stderr() if clean.params is not None else {}
-    noisy_read = noisy.read_stderr()
-    out, statistical = {}, {}
-    for name in noisy_read:
-        bound = float(noisy.crb.get(name, 0.0))
-        model_error = _finite_or_inf(clean_read.get(name, np.inf))
-        floor = float(np.hypot(model_error, bound))
+    out = {}
+    for name, se in noisy.read_stderr().items():
         value = getattr(clean.params, name) if clean.params is not None else getattr(noisy.params, name)
-        out[name] = Predicted(float(value), model_error, bound, max(floor, float(noisy_read[name])),
-                              str(verdict.status), str(verdict.reason))
-        statistical[name] = max(float(np.hypot(_finite_or_inf(clean.stderr.get(name, np.inf)), bound)),
-                                float(noisy.stderr[name]))
-    return out, statistical
+        out[name] = Predicted(float(value), _finite_or_inf(clean_read.get(name, np.inf)),
+                              float(noisy.crb.get(name, 0.0)), float(se), str(verdict.status), str(verdict.reason))
+    return out, {name: float(se) for name, se in noisy.stderr.items()}
 
 
 def _finite_or_inf(x: float) -> float:
