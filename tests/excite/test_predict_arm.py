@@ -2,7 +2,9 @@
 what ``estimate`` and ``fit`` report on the motion recorded with another noise: a Panda, 30 s, a real arm's sensors,
 on the motion ``excite`` designs and on a random Fourier excitation within the same limits.
 
-Cost (2 cores): the design about 11 s (one start per joint), each identification of 30 s 20-40 s; six of them."""
+Cost: the design about 11 s (one start per joint), each identification of 30 s 20 to 60 s (simulation 3 s, estimate
+1 s, fit the rest), six of them: the fixture about 5 min on a busy 2-core machine (3 min of CPU), computed once per
+worker."""
 
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ import numpy as np
 import pytest
 
 from wbfriction.excite.design import ExciteOptions, design_excitation
+from wbfriction.excite.predict import Predicted
 from wbfriction.excite.predict_arm import REAL_ARM, ArmPrediction, identify_arm, predict_arm
 from wbfriction.fit.result import FitResult
 from wbfriction.friction.noise import NoiseModel, effective_inertia
@@ -75,7 +78,8 @@ def test_the_statistical_standard_errors_are_those_predicted_within_a_factor_1_5
 
 @pytest.mark.xfail(strict=True, reason="the standard error a user reads holds the family spread and the Stribeck and "
                    "transition parameters' (S, v_s, a), which the noise sets anew in each recording: measured 72 % "
-                   "(designed) and 56 % (random) of the parameters within 1.5x, medians 1.07 and 0.98")
+                   "(designed) and 56 % (random) of the parameters within 1.5x, medians 1.07 and 0.98, ratios "
+                   "0.2-3.7")
 @pytest.mark.slow
 def test_every_read_standard_error_is_that_predicted_within_a_factor_1_5(runs):
     for motion, (prediction, fits) in runs.items():
@@ -98,3 +102,18 @@ def test_the_designed_motion_determines_every_parameter_asked(runs):
         for name in ("F_c", "F_v"):
             error = abs(getattr(fit.params, name) - getattr(truth[fit.joint], name))
             assert error < 2 * read[name], (fit.joint, name, error, read[name])
+
+
+def test_the_worst_share_is_the_largest_of_the_magnitudes_read():
+    """``worst``: the largest predicted standard error over ``weak`` times its value among F_c and F_v (an offset,
+    however loose, is not one of them unless asked for); a magnitude at zero is infinitely weak."""
+    def p(value: float, se: float) -> Predicted:
+        return Predicted(value, 0.0, 0.0, se, "ok", "")
+
+    prediction = ArmPrediction({"a": {"F_c": p(1.0, 0.05), "F_v": p(0.5, 0.05), "tau_os": p(0.1, 1.0)},
+                                "b": {"F_c": p(2.0, 0.2), "F_v": p(0.2, 0.01)}}, {}, {})
+    joint, name, share = prediction.worst(0.25)
+    assert (joint, name) == ("a", "F_v") and share == pytest.approx(0.05 / (0.25 * 0.5))
+    assert prediction.worst(0.25, ("tau_os",))[2] == pytest.approx(1.0 / (0.25 * 0.1))
+    prediction.joints["b"]["F_v"] = p(0.0, 0.01)
+    assert prediction.worst(0.25) == ("b", "F_v", np.inf)

@@ -4,16 +4,16 @@ itself on the motion simulated under the prior (:func:`~wbfriction.sim.arm.simul
 
 The route of a PD-driven robot (:mod:`.predict`) predicts a standard error as two parts in quadrature: the model
 error (what the identification reports on the motion simulated without sensor noise) and the noise's Cramér-Rao
-bound (on the motion simulated with it). On an arm that sum is a floor, not a prediction: the standard error the fit
-reports there is mostly the noise's, and 2 to 16 times the bound (Panda, 30 s, positions' noise 1e-4 rad, 19-bit
-encoders, torque noise 0.05 N·m: median 2.3 on a designed motion, 3.1 on a random one), for two reasons:
+bound (on the motion simulated with it). On an arm that sum is no prediction: the standard error the fit reports is
+a median 2.0 times it, from 0.2 to 16 times, within 1.5 times for a third of the parameters (Panda, 30 s, positions'
+noise 1e-4 rad, 19-bit encoders, torque noise 0.05 N·m; a designed and a random motion), for two reasons:
 
 * the estimate is not efficient where the joint's inertia is large: the positions' noise reaches the friction
   through the inertia and a second derivative, and what the route's filter leaves of it makes the sandwich standard
-  error of the shoulder and elbow (Panda A1-A4) 2 to 5 times their bound;
+  error of F_c and F_v on the shoulder and elbow (Panda A1-A4) 3 to 5 times their bound (the wrist's: the bound);
 * with ``model="auto"`` the standard error a user reads of F_c and F_v holds how far the other families put them
   (:attr:`~wbfriction.fit.result.FitResult.model_spread`), which the noise sets (the Stribeck and transition
-  parameters it leaves loose), not the model: 3 to 30 times the bound.
+  parameters it leaves loose), not the model: 2.4 to 22 times the bound.
 
 So the prediction is the identification's own report on the motion simulated with the sensors' noise
 (:attr:`ArmPrediction.joints`, ``se``; its statistical part without the family spread,
@@ -21,8 +21,9 @@ So the prediction is the identification's own report on the motion simulated wit
 the noise leads ``auto`` to a simpler family than the noise-free motion does, that family's misfit of the
 noise-free motion is no error the noisy fit reports.) What the noise makes of a standard error differs from one
 recording to another: on another noise's recording the statistical standard errors of F_c, F_v and ``tau_os`` came
-within 1.25 times those predicted (42 of 42 over the two motions), the Stribeck and transition parameters' (S, v_s, a)
-within 0.2 to 3.7 times, and the family spread within 0.5 to 3.1 times (a single draw of the families' disagreement).
+within 0.84 to 1.25 times those predicted (42 of 42 over the two motions, medians 1.07 and 1.03), but the standard
+errors read, every parameter's, within 1.5 times for 72 % and 56 % of them only (0.2 to 3.7 times: the Stribeck and
+transition parameters S, v_s and a, and the family spread, a single draw of the families' disagreement).
 """
 
 from __future__ import annotations
