@@ -121,3 +121,25 @@ def test_what_the_simulator_refuses(panda, talos):
         ArmOptions(duration=0.0)
     with pytest.raises(InputError, match="harmonics >= 2"):
         ExcitationOptions(harmonics=1)
+
+
+def test_a_trajectory_given_is_the_one_tracked(panda):
+    """A trajectory given replaces the random excitation: the arm tracks it (its true positions within 0.01 rad of
+    it, the same dynamics as with its own: the random series given back gives the same samples), it is recorded in
+    the metadata, and one of the wrong shape is refused."""
+    opts = ArmOptions(duration=1.0, excitation=ExcitationOptions(period=2.0, seed=4))
+    model = panda.model
+    lower, upper = panda.angle_limits
+    velocity = model.velocityLimit[panda.act_v_index]
+    own = excitation_trajectory(lower, upper, velocity, ExcitationOptions(period=2.0, seed=9))
+    given = simulate_arm(panda, friction_of(panda), options=opts, trajectory=own)
+    t = given.table["time"].to_numpy()
+    assert np.abs(given.q - own(t)[0]).max() < 0.01
+    assert read_metadata(given.table)["trajectory"]["a"] == own.a.tolist()
+    random = simulate_arm(panda, friction_of(panda), options=opts)
+    assert np.abs(random.q - own(t)[0]).max() > 0.05  # not the one given: another seed
+    mirrored = excitation_trajectory(lower, upper, velocity, ExcitationOptions(period=2.0, seed=4))
+    again = simulate_arm(panda, friction_of(panda), options=opts, trajectory=mirrored)
+    np.testing.assert_array_equal(again.q, random.q)
+    with pytest.raises(InputError, match="trajectory given"):
+        simulate_arm(panda, {}, options=opts, trajectory=lambda t: (np.zeros((len(t), 3)),) * 3)

@@ -22,7 +22,7 @@ Van Brussel, *Optimal robot excitation and identification*, IEEE T-RA 13(5), 199
 
 periodic in ``2 pi / omega_f``, with random coefficients (seeded) constrained to start at rest
 (``sum_l a_il = 0``, ``sum_l l b_il = 0``) and scaled into a share of each joint's position range and
-velocity limit (:func:`excitation_trajectory`).
+velocity limit (:func:`excitation_trajectory`), or any trajectory given (``excite``'s design: :func:`simulate_arm`).
 
 **Control.** At the log rate, computed torque from the reference (the arm's own model, armature
 included, no friction compensation) plus a joint PD of a given bandwidth; the torque is held over the
@@ -43,7 +43,7 @@ constants injected.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -62,6 +62,10 @@ from wbfriction.sim.common import injected_friction, terms_truth, warm_up
 from wbfriction.sim.options import SensorNoise
 
 GENERATOR = "wbfriction.sim.arm.simulate_arm"
+
+Reference = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
+"""A reference motion: times ``t`` (N,) [s] to positions [rad], velocities [rad/s] and accelerations [rad/s^2],
+each (N, n) in the robot's actuated order (a :class:`FourierTrajectory` is one)."""
 
 
 @dataclass(frozen=True)
@@ -194,14 +198,14 @@ class ArmSimulation:
 
     Attributes:
         table: the log (module docstring), metadata included.
-        trajectory: the reference.
+        trajectory: the reference tracked (:func:`excitation_trajectory`'s, or the one given).
         q, qd, qdd: true positions [rad], velocities [rad/s], accelerations [rad/s^2] at the samples (N, n).
         tau_motor: motor torque held from each sample [N·m] (N, n), without noise.
         tau_f: friction at each sample [N·m] (N, n).
     """
 
     table: pa.Table
-    trajectory: FourierTrajectory
+    trajectory: Reference
     q: np.ndarray
     qd: np.ndarray
     qdd: np.ndarray
@@ -259,7 +263,7 @@ def default_arm_friction(robot: Robot) -> dict[str, FrictionParams]:
 
 def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: dict[str, float] | None = None,
                  options: ArmOptions = ArmOptions(), progress: Progress | None = None,
-                 terms: Mapping[str, TermFit] | None = None) -> ArmSimulation:
+                 terms: Mapping[str, TermFit] | None = None, trajectory: Reference | None = None) -> ArmSimulation:
     """Simulate ``robot`` as a fixed-base arm tracking an excitation trajectory (module docstring).
 
     Args:
@@ -274,13 +278,18 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
             previous physics step), the angle its true one, the temperature
             :attr:`ArmOptions.temperature`'s); it replaces ``friction`` for the joints it names. Recorded in the
             metadata's ``terms_true``.
+        trajectory: the reference to track instead of :func:`excitation_trajectory`'s random one (then
+            :attr:`ArmOptions.excitation` is unused): a :class:`FourierTrajectory` (``excite``'s design) or any
+            :data:`Reference`; the arm starts in its state at ``t = 0``. The sensors' noise stays
+            :class:`ArmOptions`' (``position_std = torque_std = 0``, ``encoder_bits = None``: exact).
 
     Returns:
         :class:`ArmSimulation` with ``round(duration * rate)`` samples.
 
     Raises:
         InputError: a floating-base robot, a joint without torque constant, friction, terms or armature for
-            an unknown joint, a negative armature, a temperature term without :attr:`ArmOptions.temperature`.
+            an unknown joint, a negative armature, a temperature term without :attr:`ArmOptions.temperature`, a
+            ``trajectory`` whose arrays are not (N, n_act) and finite.
     """
     if robot.floating_base:
         raise InputError(f"robot '{robot.name}' has a floating base: simulate_arm needs floating_base = false")
@@ -294,12 +303,12 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
     model.armature = _armature(robot, armature)
     k_t = _torque_constants(robot)
     injected = injected_friction(robot, friction, terms, robot.actuated)
-    excited = None if options.excitation.excited is None else np.isin(robot.actuated, options.excitation.excited)
-    traj = excitation_trajectory(model.lowerPositionLimit, model.upperPositionLimit, model.velocityLimit,
-                                 options.excitation, excited)
-    n, dt = int(round(options.duration * options.rate)), 1.0 / options.rate
-    time = np.arange(n) * dt
-    q_ref, qd_ref, qdd_ref = traj(time)
+    traj = trajectory if trajectory is not None else excitation_trajectory(
+        model.lowerPositionLimit, model.upperPositionLimit, model.velocityLimit, options.excitation,
+        None if options.excitation.excited is None else np.isin(robot.actuated, options.excitation.excited))
+    time, dt = _times(options)
+    n = len(time)
+    q_ref, qd_ref, qdd_ref = _sampled(traj, time, model.nv)
     data = model.createData()
     ff = np.array([pin.rnea(model, data, q_ref[k], qd_ref[k], qdd_ref[k]) for k in range(n)])
     inertia = np.diag(pin.crba(model, data, q_ref[0]))  # armature included
@@ -327,14 +336,44 @@ def simulate_arm(robot: Robot, friction: Mapping[str, ModelParams], armature: di
             v = v + h * a
             q = q + h * v
     table = _table(robot, time, Q, V, A, T, F, k_t, model.armature, injected.params, options)
+    return ArmSimulation(_completed(table, robot, warm, terms, trajectory), traj, Q, V, A, T, F)
+
+
+def _times(options: ArmOptions) -> tuple[np.ndarray, float]:
+    """The log's sample times (N,) [s] and period [s]."""
+    dt = 1.0 / options.rate
+    return np.arange(int(round(options.duration * options.rate))) * dt, dt
+
+
+def _completed(table: pa.Table, robot: Robot, warm: np.ndarray | None, terms: Mapping[str, TermFit],
+               trajectory: Reference | None) -> pa.Table:
+    """The log with its temperature columns, and the terms and trajectory injected in its metadata."""
     meta = read_metadata(table)
     if warm is not None:
         for j in robot.actuated:
             table = table.append_column(f"temperature.{j}", pa.array(warm))
     if terms:
         meta["terms_true"] = terms_truth(terms)
-    table = with_metadata(table, meta)
-    return ArmSimulation(table, traj, Q, V, A, T, F)
+    if trajectory is not None:  # options.excitation did not make it
+        meta["trajectory"] = _described(trajectory)
+    return with_metadata(table, meta)
+
+
+def _sampled(trajectory: Reference, time: np.ndarray, nv: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A reference's positions, velocities and accelerations at ``time`` (N,), each checked (N, nv) and finite."""
+    q, qd, qdd = (np.asarray(x, dtype=float) for x in trajectory(time))
+    if any(x.shape != (len(time), nv) or not np.all(np.isfinite(x)) for x in (q, qd, qdd)):
+        raise InputError(f"the trajectory given must give finite ({len(time)}, {nv}) positions, velocities and "
+                         f"accelerations, got shapes {q.shape}, {qd.shape}, {qdd.shape}")
+    return q, qd, qdd
+
+
+def _described(trajectory: Reference) -> dict:
+    """The metadata's record of a trajectory given: a Fourier series' coefficients, else its type's name."""
+    if isinstance(trajectory, FourierTrajectory):
+        return {"kind": "fourier", "center": trajectory.center.tolist(), "a": trajectory.a.tolist(),
+                "b": trajectory.b.tolist(), "omega": float(trajectory.omega)}
+    return {"kind": type(trajectory).__name__}
 
 
 def _table(robot: Robot, time: np.ndarray, Q: np.ndarray, V: np.ndarray, A: np.ndarray, T: np.ndarray,
