@@ -24,7 +24,7 @@ from wbfriction.pipeline.fit_step import fit_file
 from wbfriction.sim.hung import simulate_hung
 from wbfriction.sim.pd_options import REAL_DRIVER, HungOptions, SetpointOptions
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_next")]  # one module fixture, one worker
 
 
 @pytest.fixture(scope="module")

@@ -26,7 +26,7 @@ from wbfriction.logs.log import log_from_table
 from wbfriction.sim.hung import simulate_hung
 from wbfriction.sim.pd_options import REAL_DRIVER
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_pd_design")]  # one module fixture, one worker
 DISCRETISATION = {"armature": 0.02, "F_v": 0.015, "F_c": 0.015}
 """The relative error the simulator's 1 ms physics steps leave (module docstring; measured up to 0.9 %)."""
 OFFSET_ERROR = {"hip": 0.006, "thigh": 0.006, "calf": 0.025}

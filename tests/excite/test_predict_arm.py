@@ -21,6 +21,8 @@ from wbfriction.friction.noise import NoiseModel, effective_inertia
 from wbfriction.model.loading import load_robot
 from wbfriction.sim.arm import ExcitationOptions, default_arm_friction, excitation_trajectory
 
+pytestmark = pytest.mark.xdist_group("excite_arm")  # one module fixture, one worker
+
 STATISTICAL = ("F_c", "F_v", "tau_os")
 """The parameters whose statistical standard error one noisy simulation predicts (module docstring of
 :mod:`~wbfriction.excite.predict_arm`)."""

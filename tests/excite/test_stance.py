@@ -35,7 +35,8 @@ from wbfriction.sim.mujoco_sim import simulate_mujoco
 from wbfriction.sim.options import MujocoOptions
 from wbfriction.studies.common import SIMULATOR
 
-pytestmark = pytest.mark.slow  # the design and the IK: about 15 s; the ideal simulator 10-15 s, MuJoCo 1-2 s
+# the design and the IK: about 15 s; the ideal simulator 10-15 s, MuJoCo 1-2 s; one module fixture, one worker
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_stance")]
 
 TOLERANCE = 2.0
 """The issue's: each swing joint's F_c and F_v within 2 % [%]."""
