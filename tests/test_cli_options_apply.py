@@ -35,7 +35,7 @@ QUADRUPED = ("robot 'go2_walking' stands on point feet (a walking quadruped): it
              "--simulator, --substeps, --sensors, --position-noise, --encoder-bits, --torque-noise, --noise-seed, "
              "--duration, --excitation-seed, --speed, --foot-forces")
 ARM = ("robot 'panda' is a fixed-base arm (torque-driven, an excitation trajectory): it takes --friction, "
-       "--position-noise, --encoder-bits, --torque-noise, --noise-seed, --duration, --excitation-seed")
+       "--position-noise, --encoder-bits, --torque-noise, --noise-seed, --duration, --excitation-seed, --play")
 PD = ("--actuator pd identifies a hung PD-driven robot's actuators (the URDF kept): it takes --json, --holdout, "
       "--time-unit, --config-output, --wide, --max-delay, --delay, --window, --offset-bound, --velocity, --delayed")
 

@@ -41,10 +41,32 @@ def test_a_design_written_then_played(cli, capsys, tmp_path):
 
 def test_what_cannot_be_designed_is_one_line_before_the_work(capsys, tmp_path):
     code, _, err = run_cli_printed(capsys, "excite", "--robot", "talos", "-o", tmp_path / "d.parquet")
-    assert code == 2 and "robot 'talos': excite designs a hung PD-driven robot's motion" in err
+    assert code == 2 and "robot 'talos' has a floating base: excite designs a hung PD-driven robot's or an arm's" in err
     code, _, err = run_cli_printed(capsys, "excite", "--robot", "go2", "--duration", "1", "-o", tmp_path / "d.parquet")
     assert code == 2 and "--duration 1: the design needs at least" in err
+    code, _, err = run_cli_printed(capsys, "excite", "--robot", "go2", "--period", "5", "-o", tmp_path / "d.parquet")
+    assert code == 2 and "--period: robot 'go2' is a hung PD-driven robot: it takes no arm's option" in err
     code, _, err = run_cli_printed(capsys, "simulate", "--robot", "go2", "--play", tmp_path / "missing.parquet",
                                    "-o", tmp_path / "x.parquet")
     assert code == 2 and "missing.parquet" in err
     assert not (tmp_path / "d.parquet").exists() and not (tmp_path / "x.parquet").exists()
+
+
+def test_an_arms_design_written_then_played(cli, capsys, tmp_path):
+    """A Panda: a Fourier design, its series in the table, played by the arm simulator along it."""
+    out = cli("excite", "--robot", "panda", "--duration", "4", "--period", "4", "-o", tmp_path / "arm.csv", "--json",
+              tmp_path / "arm.json")
+    assert "worst: panda_joint" in out
+    panda = wbfriction.load_robot("panda")
+    table = read_setpoint_table(tmp_path / "arm.csv", panda)
+    assert table.rate == pytest.approx(1000.0, rel=1e-12) and table.fourier is not None
+    doc = json.loads((tmp_path / "arm.json").read_text())
+    assert set(doc["predicted"]) == set(panda.actuated) and doc["kind"] == "fixed-base arm"
+    cli("simulate", "--robot", "panda", "--play", tmp_path / "arm.csv", "-o", tmp_path / "played.parquet")
+    played = pq.read_table(tmp_path / "played.parquet")
+    assert played.num_rows == 4000
+    q = played.column("q.panda_joint4").to_numpy()
+    assert np.max(np.abs(q - table.q_des[:, 3])) < 0.01  # the arm tracks the design (its PD at 10 Hz bandwidth)
+    code, _, err = run_cli_printed(capsys, "excite", "--robot", "panda", "--after", tmp_path / "arm.json", "-o",
+                                   tmp_path / "x.csv")
+    assert code == 2 and "--after: robot 'panda' is a fixed-base arm: it takes no hung PD-driven robot's option" in err

@@ -15,9 +15,8 @@ import pytest
 
 from wbfriction.excite.design import ExciteOptions, design_excitation
 from wbfriction.excite.predict import Predicted
-from wbfriction.excite.predict_arm import REAL_ARM, ArmPrediction, identify_arm, predict_arm
+from wbfriction.excite.predict_arm import REAL_ARM, ArmPrediction, identify_arm, predict_arm, sensor_noise
 from wbfriction.fit.result import FitResult
-from wbfriction.friction.noise import NoiseModel, effective_inertia
 from wbfriction.model.loading import load_robot
 from wbfriction.sim.arm import ExcitationOptions, default_arm_friction, excitation_trajectory
 
@@ -26,17 +25,6 @@ pytestmark = pytest.mark.xdist_group("excite_arm")  # one module fixture, one wo
 STATISTICAL = ("F_c", "F_v", "tau_os")
 """The parameters whose statistical standard error one noisy simulation predicts (module docstring of
 :mod:`~wbfriction.excite.predict_arm`)."""
-
-
-def sensor_noise(robot) -> dict[str, NoiseModel]:
-    """Each joint's friction noise as :data:`REAL_ARM`'s sensors make it (white position noise and the encoder's
-    rounding, the torque's noise), its inertia at the middle of the ranges."""
-    lower, upper = robot.angle_limits
-    inertia = effective_inertia(robot, (0.5 * (lower + upper))[None, :])
-    step = 2 * np.pi / 2 ** REAL_ARM.encoder_bits
-    position = float(np.hypot(REAL_ARM.position_std, step / np.sqrt(12)))
-    return {j: NoiseModel(REAL_ARM.torque_std, position, float(inertia[i]), 1.0 / REAL_ARM.rate)
-            for i, j in enumerate(robot.actuated)}
 
 
 @pytest.fixture(scope="module")

@@ -8,20 +8,26 @@ from typing import TYPE_CHECKING, Optional
 import typer
 from rich.table import Table
 
-from wbfriction.cli.common import ConfigOpt, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of
+from wbfriction.cli.common import ConfigOpt, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, refuse_unread, robot_of
 from wbfriction.exceptions import InputError
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: the design is imported when the command runs.
-from wbfriction.excite.options import PD_EXCITE, PdExciteOptions
+from wbfriction.excite.options import ARM_PERIOD, ARM_RATE, PD_EXCITE, PdExciteOptions
 from wbfriction.pipeline.paths import check_paths
+
+HUNG_ONLY = ("amplitude", "velocity", "after")
+"""The options only a hung PD-driven robot's design reads: refused for an arm."""
+ARM_ONLY = ("period",)
+"""The options only an arm's design reads: refused for a hung PD-driven robot."""
 
 if TYPE_CHECKING:
     from wbfriction.excite.pd_design import PdDesign
 
 
 @app.command()
-def excite(output: list[Path] = typer.Option(..., "-o", "--output",
+def excite(ctx: typer.Context,
+           output: list[Path] = typer.Option(..., "-o", "--output",
                                              help="Set-points to write, as many as given (.parquet, .csv): time "
                                                   "[s], q_des.<joint> [rad] in the encoders' coordinates, "
                                                   "qd_des.<joint> [rad/s], at the drivers' rate; then 'wbfriction "
@@ -32,49 +38,72 @@ def excite(output: list[Path] = typer.Option(..., "-o", "--output",
            figure: Optional[Path] = typer.Option(None, "--figure", help="Also write a PNG of the set-points within "
                                                                         "the limits and of the predicted errors."),
            duration: float = typer.Option(PD_EXCITE.duration, help="The recording [s]."),
-           rate: float = typer.Option(PD_EXCITE.rate, help="The drivers' rate [Hz]: the set-points' samples."),
+           rate: Optional[float] = typer.Option(None, help=f"The drivers' rate [Hz]: the set-points' samples "
+                                                           f"(default {PD_EXCITE.rate:g} hung, {ARM_RATE:g} an "
+                                                           "arm)."),
            amplitude: list[float] = typer.Option(list(PD_EXCITE.amplitudes),
-                                                 help="Shares of each joint's half range the search tries (repeat "
-                                                      "the option for each)."),
+                                                 help="Hung: shares of each joint's half range the search tries "
+                                                      "(repeat the option for each)."),
            torque_share: float = typer.Option(PD_EXCITE.torque_share,
-                                              help="Share of each driver's torque limit the motion may ask."),
-           velocity: bool = typer.Option(PD_EXCITE.velocity, help="Send qd_des = the set-points' slope (default: "
-                                                                  "zeros, as most drivers are sent)."),
-           seed: int = typer.Option(PD_EXCITE.seed, help="Seed of the ramps' levels and times."),
+                                              help="Share of each joint's torque limit the motion may ask."),
+           velocity: bool = typer.Option(PD_EXCITE.velocity, help="Hung: send qd_des = the set-points' slope "
+                                                                  "(default: zeros, as most drivers are sent)."),
+           seed: int = typer.Option(PD_EXCITE.seed, help="Seed of the ramps' levels and times (hung), of the "
+                                                         "design's starts (an arm)."),
+           period: float = typer.Option(ARM_PERIOD, help="An arm: the Fourier series' period [s]; the recording holds "
+                                                         "a whole number of them."),
            after: Optional[Path] = typer.Option(None, "--after",
-                                                help="What to record next: the parameters JSON 'fit' wrote from a log "
-                                                     "of this robot. Only the joints whose fit is not ok move (the "
+                                                help="Hung: what to record next, after a log whose parameters JSON "
+                                                     "'fit' wrote: only the joints whose fit is not ok move (the "
                                                      "others are held), with their fitted friction as the prior; "
                                                      "the log's errors are printed beside the predicted ones."),
            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
            mjcf: Optional[Path] = MjcfOpt) -> None:
-    """Design the motion to record on a hung PD-driven robot (its base fixed): set-points whose identification
-    ('identify --actuator pd') is predicted to report every joint's armature, F_v, F_c and encoder offset, and the
-    drivers' delay, furthest inside their 'ok' limits, within the URDF's position and velocity limits and the
-    drivers' torque. Predicted by simulating the motion under the robot's own model and identifying it."""
+    """Design the motion to record so that its identification determines every parameter: on a hung PD-driven
+    robot (its base fixed), set-points whose 'identify --actuator pd' is predicted to report every joint's armature,
+    F_v, F_c and encoder offset and the drivers' delay furthest inside their 'ok' limits; on a fixed-base arm, a
+    Fourier excitation whose 'estimate' and 'fit' determine each joint's friction. Within the URDF's position,
+    velocity and torque limits; predicted by simulating the motion under the robot's model and identifying it."""
+    check_paths({"--urdf": urdf, "--config": config, "--mjcf": mjcf, "--after": after},
+                {**{f"-o #{k + 1}": p for k, p in enumerate(output)}, "--json": prediction, "--figure": figure})
+    r = robot_of(robot, urdf, config, mjcf)
+    if r.floating_base:
+        raise InputError(f"robot '{r.name}' has a floating base: excite designs a hung PD-driven robot's or an arm's "
+                         "motion (a humanoid on one foot: wbfriction.excite.stance)")
+    if r.pd is None:
+        refuse_unread(ctx, f"robot '{r.name}' is a fixed-base arm", HUNG_ONLY, "hung PD-driven robot's")
+        _excite_arm(r, output, prediction, figure, duration, rate or ARM_RATE, period, torque_share, seed)
+        return
+    refuse_unread(ctx, f"robot '{r.name}' is a hung PD-driven robot", ARM_ONLY, "arm's")
+    options = PdExciteOptions(duration=duration, rate=rate or PD_EXCITE.rate, amplitudes=tuple(amplitude),
+                              torque_share=torque_share, velocity=velocity, seed=seed)
+    _excite_pd(r, output, prediction, figure, options, after)
+
+
+def _candidates(total: int, what: str):
+    """A status line counting the design's steps, and the callable that advances it."""
+    done = [0]
+    status = console.status(f"designing: {what} 1 of {total}")
+
+    def advance(n: int) -> None:
+        done[0] += n
+        status.update(f"designing: {what} {min(done[0] + 1, total)} of {total}")
+    return status, advance
+
+
+def _excite_pd(r, output: list[Path], prediction: Path | None, figure: Path | None, options: PdExciteOptions,
+               after: Path | None) -> None:
     from wbfriction.excite.document import pd_document, pd_setpoints
     from wbfriction.excite.pd_design import design_pd
     from wbfriction.logs.tables import write_json, write_table
 
-    check_paths({"--urdf": urdf, "--config": config, "--mjcf": mjcf, "--after": after},
-                {**{f"-o #{k + 1}": p for k, p in enumerate(output)}, "--json": prediction, "--figure": figure})
-    options = PdExciteOptions(duration=duration, rate=rate, amplitudes=tuple(amplitude), torque_share=torque_share,
-                              velocity=velocity, seed=seed)
-    r = robot_of(robot, urdf, config, mjcf)
-    if r.floating_base or r.pd is None:
-        raise InputError(f"robot '{r.name}': excite designs a hung PD-driven robot's motion (a fixed base and a "
-                         "[pd] table)")
     fits = None
     if after is not None:
         from wbfriction.fit.params_file import read_robot_params
 
         fits = read_robot_params(after, r.name, r.actuated, r.urdf)
-    total = len(options.amplitudes) + len(options.reversals) - 1
-    done = [0]
-    with console.status(f"designing: candidate 1 of {total}") as status:
-        def advance(n: int) -> None:
-            done[0] += n
-            status.update(f"designing: candidate {min(done[0] + 1, total)} of {total}")
+    status, advance = _candidates(len(options.amplitudes) + len(options.reversals) - 1, "candidate")
+    with status:
         if fits is None:
             design = design_pd(r, options, progress=advance)
         else:
@@ -92,9 +121,55 @@ def excite(output: list[Path] = typer.Option(..., "-o", "--output",
     _print(design)
     if fits is not None and after is not None:
         _print_next(following, after)
-    for written in (*output, prediction, figure):
-        if written is not None:
-            console.print(f"wrote {written}")
+    _wrote(output, prediction, figure)
+
+
+def _excite_arm(r, output: list[Path], prediction: Path | None, figure: Path | None, duration: float, rate: float,
+                period: float, torque_share: float, seed: int) -> None:
+    from wbfriction.excite.arm_design import design_arm
+    from wbfriction.excite.design import ExciteOptions
+    from wbfriction.excite.document import arm_document, arm_setpoints
+    from wbfriction.fit.status import WEAK
+    from wbfriction.logs.tables import write_json, write_table
+    from wbfriction.report.excite import excite_figure
+
+    options = ExciteOptions(duration=duration, rate=rate, period=period, torque_share=torque_share, seed=seed)
+    status, advance = _candidates(r.n_act, "joint")
+    with status:
+        design = design_arm(r, options, progress=advance)
+        status.update("predicting what estimate and fit will report (two simulated recordings)")
+    table = arm_setpoints(design, r.offset_vector)
+    for path in output:
+        write_table(table, path)
+    doc = arm_document(design)
+    if prediction is not None:
+        write_json(prediction, doc)
+    shares = {j: {n: p["share"] for n, p in params.items() if "share" in p} for j, params in doc["predicted"].items()}
+    if figure is not None:
+        lower, upper = r.angle_limits
+        excite_figure(figure, design.design.joints, design.time, design.q_des + r.offset_vector,
+                      lower + r.offset_vector, upper + r.offset_vector, shares,
+                      f"{r.name}: Fourier excitation; predicted worst {doc['worst']['share']:.2f} of the weak limit")
+    table_out = Table(title=f"Predicted standard error / {WEAK:g} x value (family the fit is predicted to choose)",
+                      box=None)
+    for col in ("joint", "family", "F_c", "F_v", "status"):
+        table_out.add_column(col, justify="left" if col in ("joint", "family", "status") else "right")
+    for joint, params in doc["predicted"].items():
+        cells = [f"{shares[joint][n]:.3f}" if n in shares[joint] else "-" for n in ("F_c", "F_v")]
+        worst = next((p["status"] for p in params.values() if p["status"] != "ok"), "ok")
+        table_out.add_row(joint, doc["models"].get(joint, "-"), *cells, worst)
+    out.print(table_out)
+    w = doc["worst"]
+    out.print(f"least margin to a limit {design.design.margins.least():.0%}; worst: {w['joint']} {w['parameter']}, "
+              f"{w['share']:.3f} of its limit (below 1: predicted ok)", highlight=False)
+    _wrote(output, prediction, figure)
+
+
+def _wrote(*paths) -> None:
+    for path in paths:
+        for written in (path if isinstance(path, list) else [path]):
+            if written is not None:
+                console.print(f"wrote {written}")
 
 
 def _figure(design: PdDesign, robot, path: Path) -> None:

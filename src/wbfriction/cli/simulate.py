@@ -140,9 +140,10 @@ DriverNoiseOpt = typer.Option("real", help="PD-driven: real (a real driver's noi
                                            "0.08 rad/s on the driver's velocity) or none (exact readings); "
                                            "--encoder-bits, --position-noise and --velocity-noise override it.")
 VelocityNoiseOpt = typer.Option(None, help="PD-driven: white noise std of the driver's velocity [rad/s].")
-PlayOpt = typer.Option(None, "--play", help="PD-driven: set-points to play (a table 'wbfriction excite' writes: "
-                                            "time, q_des.<joint>, qd_des.<joint>) instead of ramps and chirps; "
-                                            "its duration and rate are the table's.")
+PlayOpt = typer.Option(None, "--play", help="PD-driven and arms: the set-points to play (a table 'wbfriction excite' "
+                                            "writes: time, q_des.<joint>, qd_des.<joint>; an arm's also its Fourier "
+                                            "series) instead of ramps and chirps or a random excitation; its "
+                                            "duration and rate are the table's.")
 PLAYED = ("duration", "setpoints", "excitation_seed")
 """What a played table fixes: refused beside ``--play``."""
 

@@ -21,6 +21,7 @@ import numpy as np
 from wbfriction.exceptions import InputError
 from wbfriction.excite.information import FRICTION_READ, limit_shares, torque_bound
 from wbfriction.excite.limits import JointLimits, Margins, inverse_dynamics, margins
+from wbfriction.excite.options import ARM_PERIOD, ARM_RATE
 from wbfriction.excite.trajectory import FourierSpace, joint_series
 from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.friction.noise import NoiseModel
@@ -52,8 +53,8 @@ class ExciteOptions:
     """
 
     duration: float = 30.0
-    rate: float = 1000.0
-    period: float = 10.0
+    rate: float = ARM_RATE
+    period: float = ARM_PERIOD
     harmonics: int = 6
     range_share: float = 0.9
     velocity_share: float = 0.8

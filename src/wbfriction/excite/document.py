@@ -1,6 +1,7 @@
-"""What ``wbfriction excite`` writes of a design: the set-points table a robot plays
-(:mod:`wbfriction.logs.setpoint_table`) and the JSON document of the prediction, the margins and the search (one
-writer each; the reader of the table is ``simulate --play``'s, the document is for the user and the benchmark).
+"""What ``wbfriction excite`` writes of a design (a hung PD-driven robot's, a fixed-base arm's): the set-points table
+a robot plays (:mod:`wbfriction.logs.setpoint_table`) and the JSON document of the prediction, the margins and the
+search (one writer each; the reader of the table is ``simulate --play``'s, the document is for the user and the
+benchmark).
 
 The document::
 
@@ -21,6 +22,7 @@ from typing import Any
 
 import pyarrow as pa
 
+from wbfriction.excite.arm_design import ArmDesign
 from wbfriction.excite.pd_design import SHARE_LIMITS, PdDesign
 from wbfriction.excite.predict import Predicted
 from wbfriction.fit.status import WEAK
@@ -60,4 +62,36 @@ def pd_document(design: PdDesign) -> dict[str, Any]:
         "delayed_known": design.prediction.delayed_known,
         "margins": {j: {"position": float(m.position[i]), "velocity": float(m.velocity[i]),
                         "torque": float(m.torque[i])} for i, j in enumerate(design.joints)},
+    }
+
+
+def arm_setpoints(design: ArmDesign, offset) -> pa.Table:
+    """The set-points table of a fixed-base arm's design, its angles in the encoders' coordinates (plus ``offset``
+    (n,) [rad], the robot's ``[encoder_offset]``), its Fourier coefficients the model's."""
+    d = design.design
+    return setpoint_table(d.robot, d.joints, design.time, design.q_des + offset, design.qd_des, design.fourier(),
+                          kind="fixed-base arm", seed=d.options.seed)
+
+
+def arm_document(design: ArmDesign) -> dict[str, Any]:
+    """The JSON document of a fixed-base arm's design: as :func:`pd_document`'s, its ``predicted`` the parameters of
+    the family each joint's fit is predicted to choose (``models``), F_c's and F_v's with their share of the ``weak``
+    limit, and ``statistical``: the standard errors without the families' spread; the design's own Cramér-Rao
+    shares (``design_shares``)."""
+    joint, name, share = design.prediction.worst(WEAK)
+    m = design.design.margins
+    return {
+        "robot": design.design.robot, "kind": "fixed-base arm",
+        "criterion": "the worst share of 0.25 x its value that F_c's or F_v's Cramér-Rao bound comes to (the design); "
+                     "the prediction: the identification's report on the motion simulated with the sensors' noise",
+        "duration": design.design.options.duration, "rate": design.design.options.rate,
+        "worst": {"joint": joint, "parameter": name, "share": share},
+        "models": design.prediction.models,
+        "predicted": {j: {n: _parameter(n, p) if n in ("F_c", "F_v") else
+                          {"value": p.value, "se": p.se, "status": p.status} for n, p in params.items()}
+                      for j, params in design.prediction.joints.items()},
+        "statistical": design.prediction.statistical,
+        "design_shares": design.design.shares,
+        "margins": {j: {"position": float(m.position[i]), "velocity": float(m.velocity[i]),
+                        "torque": float(m.torque[i])} for i, j in enumerate(design.design.joints)},
     }

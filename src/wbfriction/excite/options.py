@@ -53,3 +53,8 @@ class PdExciteOptions:
 
 PD_EXCITE = PdExciteOptions()
 """The defaults."""
+
+ARM_RATE = 1000.0
+"""A fixed-base arm's default rate [Hz] (:class:`~wbfriction.excite.design.ExciteOptions`' own)."""
+ARM_PERIOD = 10.0
+"""A fixed-base arm's default Fourier period [s] (:class:`~wbfriction.excite.design.ExciteOptions`' own)."""

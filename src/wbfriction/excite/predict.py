@@ -95,6 +95,8 @@ def worst_share(joints: Mapping[str, Mapping[str, Any]], limits: Mapping[str, fl
         return float(p.se / limit) if limit > 0 else np.inf
 
     shares = [(j, n, share(n, p)) for j, params in joints.items() for n, p in params.items()]
+    if not shares:
+        raise ValueError("no parameter to share out")
     return max(shares, key=lambda x: x[2])
 
 

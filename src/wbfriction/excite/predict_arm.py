@@ -35,13 +35,14 @@ from typing import cast
 
 import numpy as np
 
-from wbfriction.excite.predict import Predicted
+from wbfriction.excite.predict import Predicted, worst_share
 from wbfriction.fit.joints import fit_estimate
 from wbfriction.fit.options import FitOptions, ModelChoice
 from wbfriction.fit.result import FitResult
 from wbfriction.fit.status import READ
 from wbfriction.friction.estimate import FrictionEstimate, estimate_log
 from wbfriction.friction.models import ModelParams
+from wbfriction.friction.noise import NoiseModel, effective_inertia
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import log_from_table
 from wbfriction.model.robot import Robot
@@ -79,9 +80,20 @@ class ArmPrediction:
         Raises:
             ValueError: no joint has a parameter of ``names``.
         """
-        shares = [(j, n, p.se / (weak * abs(p.value)) if p.value != 0 else np.inf)
-                  for j, params in self.joints.items() for n, p in params.items() if n in names]
-        return max(shares, key=lambda x: x[2])
+        return worst_share({j: {n: p for n, p in params.items() if n in names} for j, params in self.joints.items()},
+                           {}, weak)
+
+
+def sensor_noise(robot: Robot, options: ArmOptions = REAL_ARM) -> dict[str, NoiseModel]:
+    """Each joint's friction noise as ``options``' sensors make it (white position noise and the encoder's rounding,
+    the torque's noise), its inertia at the middle of the ranges: what :func:`~.design.design_excitation` designs
+    against."""
+    lower, upper = robot.angle_limits
+    inertia = effective_inertia(robot, (0.5 * (lower + upper))[None, :])
+    step = 2 * np.pi / 2 ** options.encoder_bits if options.encoder_bits else 0.0
+    position = float(np.hypot(options.position_std, step / np.sqrt(12)))
+    return {j: NoiseModel(options.torque_std, position, float(inertia[i]), 1.0 / options.rate)
+            for i, j in enumerate(robot.actuated)}
 
 
 def noise_free(options: ArmOptions) -> ArmOptions:

@@ -81,12 +81,36 @@ def played(robot: Robot, path: Path, options: HungOptions) -> tuple[HungOptions,
     return options, (table.q_des - robot.offset_vector, table.qd_des)
 
 
+def played_arm(robot: Robot, path: Path, options: ArmOptions) -> tuple[ArmOptions, Any]:
+    """``options`` and the trajectory (:class:`~wbfriction.sim.arm.FourierTrajectory`) that play the set-points
+    table at ``path`` on a fixed-base arm: its duration and rate, the Fourier series its metadata holds (what
+    ``excite`` writes for an arm: the accelerations the arm's feed-forward takes are exact).
+
+    Raises:
+        InputError: what :func:`~wbfriction.logs.setpoint_table.read_setpoint_table` raises; a table without the
+            series.
+    """
+    import numpy as np
+
+    from wbfriction.logs.setpoint_table import read_setpoint_table
+    from wbfriction.sim.arm import FourierTrajectory
+
+    table = read_setpoint_table(path, robot)
+    if table.fourier is None:
+        raise InputError(f"{path}: an arm plays a Fourier design (the 'fourier' series 'wbfriction excite' writes "
+                         "in an arm's table): this table has none")
+    f = table.fourier
+    trajectory = FourierTrajectory(np.asarray(f["center"], dtype=float), np.asarray(f["a"], dtype=float),
+                                   np.asarray(f["b"], dtype=float), float(f["omega"]))
+    return dataclasses.replace(options, duration=table.duration, rate=table.rate), trajectory
+
+
 class ArmKind(SimulatorKind):
     """A fixed-base arm (torque-driven) tracking an excitation trajectory, its motor currents logged; default
     friction :func:`~wbfriction.sim.arm.default_arm_friction`."""
 
     name, precedence, chosen = "arm", 30, False
-    options = ("friction", *SENSOR_NOISE, "duration", "excitation_seed")
+    options = ("friction", *SENSOR_NOISE, "duration", "excitation_seed", "play")
 
     def what(self, robot: Robot, actuator: str | None = None) -> str:
         return f"robot '{robot.name}' is a fixed-base arm (torque-driven, an excitation trajectory)"
@@ -106,9 +130,12 @@ class ArmKind(SimulatorKind):
         params = default_arm_friction(robot) if spec is None else spec.params
         if spec is not None and spec.temperature is not None:
             options = dataclasses.replace(options, temperature=spec.temperature)
+        trajectory = None
+        if values.get("play") is not None:
+            options, trajectory = played_arm(robot, values["play"], options)
         with progress.steps(int(options.duration * options.rate)) as advance:
             result = simulate_arm(robot, params, options=options, progress=advance,
-                                  terms=None if spec is None else spec.terms)
+                                  terms=None if spec is None else spec.terms, trajectory=trajectory)
         return SimulationOutput(table=result.table, summary=f"{result.table.num_rows} samples, "
                                                             f"{options.duration:g} s, motor currents")
 
