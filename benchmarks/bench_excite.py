@@ -15,9 +15,18 @@ pd`` does. The table gives per motion the worst share (standard error over its l
 0.25 x value; below 1: ``ok``), the parameters not ``ok`` and the delay's status; the designed one's predicted worst
 beside it, and the ratio of each motion's worst to the designed one's (the issue's target: at least 3).
 
-    python benchmarks/bench_excite.py [--duration 30] [--seeds 7,8]
+On a Panda (torque sensors, a real arm's sensors: :data:`~wbfriction.excite.predict_arm.REAL_ARM`), for 30 s each,
+within 90 % of each joint's range and 80 % of its velocity limit: ``excite``'s Fourier design
+(:func:`~wbfriction.excite.arm_design.design_arm`), a chirp of constant amplitude sweeping 0.05-1 Hz (its amplitude
+what the velocity limit allows at 1 Hz), and triangle ramps at the velocity limit's 80 % with rounded reversals (5 %
+of the range). Each is simulated with two noise seeds, estimated and fitted as ``estimate`` and ``fit`` do, the worst
+share of F_c's and F_v's standard error read over 0.25 x value reported (below 1: not ``weak``); the torque margin
+beside it (the simulator does not clip: a motion over its torque limit is not one a robot can play).
 
-Needs ``$WBFRICTION_DATA`` (or the dataset's download) for the Aliengo row; about 3 minutes on two cores.
+    python benchmarks/bench_excite.py [--duration 30] [--seeds 7,8] [--no-arm]
+
+Needs ``$WBFRICTION_DATA`` (or the dataset's download) for the Aliengo row; about 3 minutes on two cores, and 6 more
+for the Panda's (``--no-arm`` skips them).
 """
 
 from __future__ import annotations
@@ -32,11 +41,16 @@ import pinocchio as pin
 import wbfriction
 from wbfriction.actuator import identify_actuators
 from wbfriction.datasets.aliengo import ALIENGO_JOINTS, LOG_FILE, URDF_FILE, AliengoDataset, read_trajectory
+from wbfriction.excite.arm_design import design_arm
+from wbfriction.excite.design import ExciteOptions
+from wbfriction.excite.limits import JointLimits, inverse_dynamics, margins
 from wbfriction.excite.options import PdExciteOptions
 from wbfriction.excite.pd_design import SHARE_LIMITS, design_pd
-from wbfriction.excite.predict import worst_share
+from wbfriction.excite.predict import Predicted, worst_share
+from wbfriction.excite.predict_arm import REAL_ARM, identify_arm
 from wbfriction.fit.status import WEAK
 from wbfriction.logs.log import log_from_table
+from wbfriction.sim.arm import default_arm_friction
 from wbfriction.sim.hung import setpoint_band, simulate_hung
 from wbfriction.sim.pd_options import REAL_DRIVER, HungOptions, SetpointOptions
 
@@ -72,10 +86,60 @@ def score(robot, options: HungOptions, reference=None) -> tuple[tuple[str, str, 
     return worst_share(joints, SHARE_LIMITS, WEAK), not_ok, result.delay.status
 
 
+ARM_RANGE, ARM_VELOCITY = 0.9, 0.8
+
+
+def arm_motions(robot, duration: float):
+    """The Panda's chirp and ramps (module docstring): each a callable of the times (N,) giving q, qd, qdd (N, n)."""
+    lim = JointLimits.of(robot)
+    middle, half = 0.5 * (lim.lower + lim.upper), 0.5 * (lim.upper - lim.lower) * ARM_RANGE
+    v = ARM_VELOCITY * lim.velocity
+
+    def chirp(t, f0=0.05, f1=1.0):
+        a = np.minimum(half, v / (2 * np.pi * f1))
+        phase = 2 * np.pi * (f0 * t + 0.5 * (f1 - f0) * t**2 / duration)
+        w, dw = 2 * np.pi * (f0 + (f1 - f0) * t / duration), 2 * np.pi * (f1 - f0) / duration
+        sin, cos = np.sin(phase)[:, None], np.cos(phase)[:, None]
+        return middle + a * sin, a * cos * w[:, None], a * (-sin * w[:, None] ** 2 + cos * dw)
+
+    def ramps(t, rounding=0.05):
+        k = 1 - rounding
+        ak = np.arcsin(k)
+        om = v * ak / (k * half)  # the peak speed v
+        x = np.outer(t, om)
+        sin, cos = np.sin(x), np.cos(x)
+        r = 1 - k**2 * sin**2
+        return (middle + half * np.arcsin(k * sin) / ak, half * k * om * cos / np.sqrt(r) / ak,
+                half * k * om**2 / ak * sin * (k**2 - 1) / r**1.5)
+    return {"chirp": chirp, "ramps": ramps}
+
+
+def arm_rows(duration: float, seeds: list[int]) -> list[tuple[str, float, str, float]]:
+    """Per Panda motion: its worst reported share (of F_c and F_v, over the seeds), where, its torque margin."""
+    robot = wbfriction.load_robot("panda")
+    prior = default_arm_friction(robot)
+    options = ExciteOptions(duration=duration, range_share=ARM_RANGE, velocity_share=ARM_VELOCITY)
+    motions = {"designed": design_arm(robot, options, prior).design.trajectory, **arm_motions(robot, duration)}
+    lim, t = JointLimits.of(robot), options.times()
+    rows = []
+    for name, motion in motions.items():
+        q, qd, qdd = motion(t)
+        torque = margins(lim, q, qd, inverse_dynamics(robot, q, qd, qdd, prior)).torque.min()
+        worst = ("", "", 0.0)
+        for seed in seeds:
+            fits = identify_arm(robot, prior, motion, replace(REAL_ARM, duration=duration, seed=seed))[1]
+            shares = {f.joint: {n: Predicted(getattr(f.params, n), 0.0, 0.0, f.read_stderr()[n], "", "")
+                                for n in ("F_c", "F_v")} for f in fits if f.params is not None}
+            worst = max(worst, worst_share(shares, {}, WEAK), key=lambda w: w[2])
+        rows.append((name, worst[2], f"{worst[0]} {worst[1]}", torque))
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--duration", type=float, default=30.0)
     parser.add_argument("--seeds", default="7,8")
+    parser.add_argument("--no-arm", dest="arm", action="store_false", help="skip the Panda's rows")
     args = parser.parse_args()
     seeds = [int(s) for s in args.seeds.split(",")]
     robot = wbfriction.load_robot("go2")
@@ -100,6 +164,13 @@ def main() -> None:
     print("|---|---|---|---|---|---|")
     for name, (joint, param, share), not_ok, delay in rows:
         print(f"| {name} | {share:.2f} | {joint} {param} | {not_ok} | {delay} | {share / mine:.1f} |")
+    if args.arm:
+        arm = arm_rows(args.duration, seeds)
+        print(f"\nPanda, {args.duration:g} s, a real arm's sensors, seeds {args.seeds}\n")
+        print("| motion | worst reported share (F_c, F_v) | at | least torque margin | worst / designed's |")
+        print("|---|---|---|---|---|")
+        for name, share, at, torque in arm:
+            print(f"| {name} | {share:.3f} | {at} | {torque:.0%} | {share / arm[0][1]:.1f} |")
 
 
 if __name__ == "__main__":
