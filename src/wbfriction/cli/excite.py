@@ -114,11 +114,12 @@ def _excite_pd(r, output: list[Path], prediction: Path | None, figure: Path | No
     table = pd_setpoints(design)
     for path in output:
         write_table(table, path)
+    doc = pd_document(design)
     if prediction is not None:
-        write_json(prediction, pd_document(design))
+        write_json(prediction, doc)
     if figure is not None:
-        _figure(design, r, figure)
-    _print(design)
+        _figure(design, doc, r, figure)
+    _print(design, doc)
     if fits is not None and after is not None:
         _print_next(following, after)
     _wrote(output, prediction, figure)
@@ -144,7 +145,7 @@ def _excite_arm(r, output: list[Path], prediction: Path | None, figure: Path | N
     doc = arm_document(design)
     if prediction is not None:
         write_json(prediction, doc)
-    shares = {j: {n: p["share"] for n, p in params.items() if "share" in p} for j, params in doc["predicted"].items()}
+    shares = _shares(doc)
     if figure is not None:
         lower, upper = r.angle_limits
         excite_figure(figure, design.design.joints, design.time, design.q_des + r.offset_vector,
@@ -172,14 +173,17 @@ def _wrote(*paths) -> None:
                 console.print(f"wrote {written}")
 
 
-def _figure(design: PdDesign, robot, path: Path) -> None:
-    from wbfriction.excite.pd_design import SHARE_LIMITS
-    from wbfriction.fit.status import WEAK
+def _shares(doc: dict) -> dict[str, dict[str, float]]:
+    """Each joint's parameters' predicted shares of their limits, from a design's document."""
+    return {j: {n: p["share"] for n, p in params.items() if p.get("share") is not None}
+            for j, params in doc["predicted"].items()}
+
+
+def _figure(design: PdDesign, doc: dict, robot, path: Path) -> None:
     from wbfriction.report.excite import excite_figure
 
     lower, upper = robot.angle_limits
-    shares = {j: {n: p.se / SHARE_LIMITS.get(n, WEAK * abs(p.value)) for n, p in params.items()}
-              for j, params in design.prediction.joints.items()}
+    shares = _shares(doc)
     excite_figure(path, design.joints, design.time, design.q_des, lower + robot.offset_vector,
                   upper + robot.offset_vector, shares,
                   f"{design.robot}: ramps over {design.chosen.amplitude:g} of each half range, reversing every "
@@ -187,18 +191,18 @@ def _figure(design: PdDesign, robot, path: Path) -> None:
                   f"{design.worst()[2]:.2f} of its limit")
 
 
-def _print(design: PdDesign) -> None:
-    from wbfriction.excite.document import pd_document
-
-    doc = pd_document(design)
+def _print(design: PdDesign, doc: dict) -> None:
     names = list(next(iter(doc["predicted"].values())))
     table = Table(title="Predicted standard error / limit of ok (status)", box=None)
     table.add_column("joint")
     for name in names:
         table.add_column(name, justify="right")
+    def cell(p: dict) -> str:
+        share = "inf" if p["share"] is None else f"{p['share']:.2f}"  # a value of 0: no relative limit
+        return share + ("" if p["status"] == "ok" else f" ({p['status']})")
+
     for joint, params in doc["predicted"].items():
-        table.add_row(joint, *(f"{params[n]['share']:.2f}" + ("" if params[n]["status"] == "ok"
-                                                               else f" ({params[n]['status']})") for n in names))
+        table.add_row(joint, *(cell(params[n]) for n in names))
     out.print(table)
     joint, name, share = design.worst()
     chosen = design.chosen
@@ -211,6 +215,7 @@ def _print(design: PdDesign) -> None:
 
 
 def _print_next(following, after: Path) -> None:
+    from wbfriction.actuator.identification import UNITS
     from wbfriction.excite.next import COMPARED
 
     design = following.design
@@ -219,9 +224,8 @@ def _print_next(following, after: Path) -> None:
     table.add_column("joint")
     table.add_column("log's status")
     for name in COMPARED:
-        unit = "N·m·s/rad" if name == "F_v" else "N·m"
-        table.add_column(f"{name} log [{unit}]", justify="right")
-        table.add_column(f"{name} next [{unit}]", justify="right")
+        table.add_column(f"{name} log [{UNITS[name]}]", justify="right")
+        table.add_column(f"{name} next [{UNITS[name]}]", justify="right")
     for joint, logged in following.logged.items():
         predicted = design.prediction.joints[joint]
         cells = []
