@@ -3,9 +3,8 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-
-import numpy as np
 
 from wbfriction.exceptions import InputError
 from wbfriction.sim.pd_options import REAL_DRIVER, DriverNoise, HungOptions, SetpointOptions
@@ -36,7 +35,7 @@ class PdExciteOptions:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.duration) and self.duration * self.rate >= 2 * 200):
+        if not (math.isfinite(self.duration) and self.duration * self.rate >= 2 * 200):
             raise InputError(f"--duration {self.duration:g}: the design needs at least 200 samples x 2 "
                              f"({400 / self.rate:g} s at {self.rate:g} Hz)")
         if not self.amplitudes or not all(0 < a <= 1 for a in self.amplitudes):
