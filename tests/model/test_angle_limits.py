@@ -11,7 +11,8 @@ import pytest
 
 import wbfriction
 from helpers import REAL_DATA, needs_data
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.logs.angles import check_limits
 from wbfriction.model.loading import build_robot
 
 
@@ -41,6 +42,14 @@ def test_a_continuous_joint_gets_limits():
     assert np.isinf(free.angle_limits[0][k])
     bounded = build_robot(urdf, {**cfg, "angle_limits": {"FL_thigh_joint": [0.4, 1.3]}})
     assert bounded.angle_limits[0][k] == 0.4 and bounded.angle_limits[1][k] == 1.3
+    # a continuous joint's angle is checked on whatever turn it is logged: a turn away is the same angle
+    lower, upper = bounded.angle_limits
+    q = np.tile(np.where(np.isfinite(lower), 0.5 * (lower + upper), 0.0), (3, 1))
+    q[:, k] = [0.5, 1.2 - 2 * np.pi, 0.9 + 4 * np.pi]
+    check_limits(q, bounded, "log.parquet")
+    q[1, k] = 2.0 - 2 * np.pi  # 0.7 rad beyond the upper limit, a turn away
+    with pytest.raises(ColumnError, match="column 'q.FL_thigh_joint' is .* at row 1, beyond its limits"):
+        check_limits(q, bounded, "log.parquet")
 
 
 @pytest.mark.parametrize("limits, message", [

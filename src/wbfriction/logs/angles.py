@@ -17,7 +17,9 @@ def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT
     radians, millimetres as metres); joints without finite limits are not checked.
 
     Args:
-        q: the logged angles (N, len(joints)) [rad], the encoders' offsets included (taken off here).
+        q: the logged angles (N, len(joints)) [rad], the encoders' offsets included (taken off here); a continuous
+            joint's on any turn (checked on the turn nearest its limits' middle: a joint the TOML's
+            ``[angle_limits]`` gives limits the URDF does not).
         robot: the robot: its limits and encoder offsets.
         prefix: the columns' prefix (``q``, ``q_des``).
         joints: the columns' joints, in order (default :attr:`Robot.actuated`).
@@ -26,13 +28,18 @@ def check_limits(q: np.ndarray, robot: Robot, source: str, margin: float = LIMIT
         InputError: naming the column, the row and the limits.
     """
     lower, upper = robot.angle_limits
+    continuous = {robot.actuated[k] for k in robot.layout.q2_joint}
     for i, name in enumerate(joints or robot.actuated):
         k_act = robot.actuated.index(name)
         offset = robot.encoder_offset.get(name, 0.0)
         lo, hi = lower[k_act] + offset, upper[k_act] + offset
         if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
             continue
-        out = np.flatnonzero((q[:, i] < lo - margin) | (q[:, i] > hi + margin))
+        x = q[:, i]
+        if name in continuous:  # on the turn nearest the limits' middle
+            middle = 0.5 * (lo + hi)
+            x = middle + (x - middle + np.pi) % (2 * np.pi) - np.pi
+        out = np.flatnonzero((x < lo - margin) | (x > hi + margin))
         if out.size:
             k = out[0]
             raise ColumnError(source, f"{prefix}.{name}", int(first_row + k),
