@@ -68,8 +68,7 @@ def excite(ctx: typer.Context,
                 {**{f"-o #{k + 1}": p for k, p in enumerate(output)}, "--json": prediction, "--figure": figure})
     r = robot_of(robot, urdf, config, mjcf)
     if r.floating_base:
-        raise InputError(f"robot '{r.name}' has a floating base: excite designs a hung PD-driven robot's or an arm's "
-                         "motion (a humanoid on one foot: wbfriction.excite.stance)")
+        raise InputError(f"robot '{r.name}' has a floating base: excite designs a fixed base's motion (hung, an arm)")
     if r.pd is None:
         refuse_unread(ctx, f"robot '{r.name}' is a fixed-base arm", HUNG_ONLY, "hung PD-driven robot's")
         _excite_arm(r, output, prediction, figure, duration, rate or ARM_RATE, period, torque_share, seed)

@@ -155,9 +155,8 @@ def design_pd(robot: Robot, options: PdExciteOptions = PdExciteOptions(),
     amplitude = first.amplitude if first is not None else min(options.amplitudes)
     chosen = best([score(amplitude, r) for r in options.reversals])
     if chosen is None:
-        closest = max(c.margins.least() for c, _ in scored.values())
-        raise InputError(f"robot '{robot.name}': no candidate stays within its limits and {options.torque_share:.0%} "
-                         f"of its torque limits (the closest's least margin {closest:.0%}): lower --amplitude")
+        raise InputError(f"robot '{robot.name}': every candidate passes a limit or {options.torque_share:.0%} of a "
+                         "torque limit: lower --amplitude")
     prediction = scored[(chosen.amplitude, chosen.reversal)][1]
     assert prediction.motion is not None
     commands = prediction.motion.commands

@@ -86,8 +86,8 @@ def read_setpoint_table(path: str | Path, robot: Robot) -> SetpointTable:
     table = read_table(path)
     for col in ("time", *(f"q_des.{j}" for j in robot.actuated)):
         if col not in table.column_names:
-            raise ColumnError(source, col, None, f"missing column '{col}': set-points for robot '{robot.name}' "
-                              f"need time and q_des.<joint> for each of its {robot.n_act} joints")
+            raise ColumnError(source, col, None, f"missing column '{col}': robot '{robot.name}' plays time and "
+                              "q_des.<joint>")
     if table.num_rows < 2:
         raise InputError(f"{source}: {table.num_rows} row(s): set-points need at least two")
     time = numeric_column(table, "time", source)

@@ -97,8 +97,7 @@ def played_arm(robot: Robot, path: Path, options: ArmOptions) -> tuple[ArmOption
 
     table = read_setpoint_table(path, robot)
     if table.fourier is None:
-        raise InputError(f"{path}: an arm plays a Fourier design (the 'fourier' series 'wbfriction excite' writes "
-                         "in an arm's table): this table has none")
+        raise InputError(f"{path}: no Fourier series: an arm plays what 'wbfriction excite' writes for an arm")
     f = table.fourier
     trajectory = FourierTrajectory(np.asarray(f["center"], dtype=float), np.asarray(f["a"], dtype=float),
                                    np.asarray(f["b"], dtype=float), float(f["omega"]))
