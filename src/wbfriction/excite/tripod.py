@@ -21,8 +21,9 @@ leg's friction torque (its joints' rows of the equation of motion hold no contac
   is held inside the triangle (:attr:`TripodOptions.com_margin` from its edges); the ZMP of the reference's own
   dynamics (:func:`~.stance.zero_moment_point`, on the ground) is computed and must stay
   :attr:`TripodOptions.zmp_margin` inside the triangle (ModelError otherwise): the swing leg's velocity cap is
-  what keeps it there. (The Go2 ``go2_walking``, the default options, each leg swung: the centre of mass 86-92 mm
-  inside the triangle's edges, the ZMP at least 70 mm; the swing foot's sphere at least 49 mm above the ground.)
+  what keeps it there. (The Go2 ``go2_walking``, the default options, each leg swung in turn: the centre of mass
+  held 104 mm inside the triangle's edges (its inradius), the ZMP at least 100 mm; the swing foot's sphere 59-94 mm
+  above the ground at its lowest, the swing leg 97-210 mm from the others.)
 
 The feet stand where the robot's reference posture puts them (moved together along the base so that their centre
 lies under the centre of mass, as :func:`~wbfriction.walking.quadruped.quadruped_reference` does), the base
@@ -350,14 +351,13 @@ def tripod_reference(robot: Robot, options: TripodOptions = TripodOptions(),
     if missing := [j for j in joints if j not in prior]:
         raise InputError(f"no prior friction for swing joint '{missing[0]}'")
     feet = standing_feet(robot)
-    band = swing_band(robot, joints, bool(feet[swing, 1] > 0), options.margin)
-    trajectory = design_swing(robot, joints, band, prior, options)
-    qs, qds, qdds = trajectory(options.design.times())
-    triangle = feet[list(stance), :2]
-    centre, inradius = incentre(triangle)
+    centre, inradius = incentre(feet[list(stance), :2])
     if inradius < options.com_margin:
         raise ModelError(f"the stance triangle's incentre is {inradius * 1e3:.1f} mm from its edges (at least "
                          f"{options.com_margin * 1e3:.1f} mm asked): lower --com-margin")
+    band = swing_band(robot, joints, bool(feet[swing, 1] > 0), options.margin)
+    trajectory = design_swing(robot, joints, band, prior, options)
+    qs, qds, qdds = trajectory(options.design.times())
     model, data = robot.model, robot.model.createData()
     q = robot.configuration(robot.reference_angles)
     com_z = pin.centerOfMass(model, data, q)[2] - q[2] + options.height
