@@ -178,7 +178,8 @@ def test_each_swing_joint_friction_recovered_within_two_percent(go2, excitations
     assert moved < 5e-3  # it stood: no slip, no tipping
     assert run.force[1:, list(excitation.stance), 2].min() > 0  # every stance foot pushes (MuJoCo: from its second)
     est = estimate_log(robot, log, EstimateOptions())
-    fits = {f.joint: f for f in fit_estimate(est, FitOptions(model="thesis"), fixed={"S": 0.0, "v_s": 0.1})}
+    fits = {f.joint: f for f in fit_estimate(est, FitOptions(model="thesis"), joints=excitation.joints,
+                                             fixed={"S": 0.0, "v_s": 0.1})}
     print(f"\n{leg} swung, {simulator}: simulated {len(log)} samples in {simulated:.1f} s, estimated and fitted in "
           f"{time.perf_counter() - start - simulated:.1f} s, the stance feet moved {moved * 1e3:.2f} mm")
     errors = {}
