@@ -6,13 +6,14 @@ within 2 %.
 
 The friction injected is not the design's prior (the quadruped simulators' default): F_c 1.25 times and F_v 0.75
 times it, on every joint. Both simulators run their physics at 4 kHz (:data:`PHYSICS`), not their default 2 kHz: at
-2 kHz their explicit integration of the Coulomb term ``-F_c tanh(40 qd)`` is unstable near zero velocity on the
-light calf (``F_c a h / I`` about 3 > 2 for the front right calf, F_c 0.75 N·m, I about 0.005 kg·m^2): its velocity
-chatters through zero (21 sign changes against the reference's 15, measured), which put the front right calf's
-F_v 4.5 % low (4.2 % on MuJoCo; the hip's 1.6 %), the simulator's integration, not the excitation or the estimator.
-At 4 kHz (measured, the default estimate): worst F_c 0.13 % and F_v 0.62 % over the four legs, on either simulator
-(the front right calf's F_v 0.54 % ideal, 0.59 % MuJoCo; the rear left's joints within 0.10 %). MuJoCo's stance
-feet move by their soft contacts' give (2.5-2.6 mm). The test prints the table of its run.
+2 kHz their explicit integration of the Coulomb term ``-F_c tanh(40 qd)`` is near its stability bound on the light
+calf (``F_c a h / I`` about 3 for the front right calf, the largest F_c injected, 0.75 N·m, I about
+0.005 kg·m^2; an explicit step is stable below 2): its velocity chatters through zero (21 sign changes against the
+reference's 15, measured; 15 at 4 kHz), which put the front right calf's F_v 4.5 % low (4.2 % on MuJoCo; its hip's
+1.6 %), the simulator's integration, not the excitation or the estimator (the other three legs: within 0.6 % at
+2 kHz too, ideal). At 4 kHz (measured, the default estimate): worst F_c 0.13 % and F_v 0.62 % over the four legs,
+on either simulator (the front right calf's F_v 0.54 % ideal, 0.59 % MuJoCo; the rear left's joints within
+0.10 %). MuJoCo's stance feet move by their soft contacts' give (2.5-2.6 mm). The test prints the table of its run.
 """
 
 from __future__ import annotations
