@@ -141,7 +141,9 @@ PRINTS = {
                                   r"^7 of 7 joints ok; F_c and F_v: 1[0-4] of 14 standard errors within 1\.5x of "
                                   r"the prediction$",
                                   # TALOS on one foot, its swing leg's friction recovered (issue 66: within 2 %)
-                                  r"^swing leg: 6 joints, F_c and F_v within [01]\.\d\d % of the truth$"],
+                                  r"^swing leg: 6 joints, F_c and F_v within [01]\.\d\d % of the truth$",
+                                  # the Go2 on three feet, its front right leg's friction recovered (within 2 %)
+                                  r"^swing leg FR: 3 joints, F_c and F_v within [01]\.\d\d % of the truth$"],
     "docs/how-to/library.md": [r"leg_right_4_joint: F_c"],  # the API block's fits of the walk
     "docs/extending.md": [r"^arm\.tsv: 10000 samples, tau_f of 7 joints$",  # a log format registered, read
                           # a torque source registered: a log written through it, read back as its own
