@@ -246,8 +246,7 @@ def stance_reference(robot: Robot, options: StanceOptions = StanceOptions(),
         raise InputError(f"no prior friction for swing joint '{missing[0]}'")
     lower, upper = swing_band(robot, joints, SIDES[1 - stance], options.margin)
     trajectory = design_swing(robot, joints, lower, upper, prior, options)
-    reference = single_support_reference(robot, stance, joints, trajectory, len(options.design.times()),
-                                         options.design.rate)
+    reference = single_support_reference(robot, stance, joints, trajectory, options.design.times())
     margin, low = _checked(robot, options, stance, reference)
     return StanceExcitation(reference, stance, joints, trajectory, lower, upper, margin, low)
 

@@ -148,10 +148,9 @@ def solve_stance(robot: Robot, ik: StanceIK, q: np.ndarray, act: np.ndarray,
 
 
 def single_support_reference(robot: Robot, stance: int, joints: tuple[str, ...], trajectory: FourierTrajectory,
-                             samples: int, rate: float) -> WalkingReference:
-    """Stand on sole ``stance`` (its index in :attr:`Robot.contact_frames`) for ``samples`` samples at ``rate``
-    [Hz] (``time = k / rate``) while ``joints`` (the swing leg's, n) follow ``trajectory`` (n joints) (module
-    docstring).
+                             time: np.ndarray) -> WalkingReference:
+    """Stand on sole ``stance`` (its index in :attr:`Robot.contact_frames`) at the evenly spaced ``time`` (N,) [s]
+    while ``joints`` (the swing leg's, n) follow ``trajectory`` (n joints) (module docstring).
 
     Returns:
         The reference: ``contact`` the stance foot only, ``feet`` the stance sole's standing footprint and the
@@ -160,7 +159,7 @@ def single_support_reference(robot: Robot, stance: int, joints: tuple[str, ...],
     Raises:
         ModelError: a stance leg of other than six joints, the IK out of reach.
     """
-    time = np.arange(samples) / rate
+    time = np.asarray(time, dtype=float)
     qs, qds, qdds = trajectory(time)
     q0 = standing_configuration(robot)
     feet0 = standing_feet(robot)
@@ -183,5 +182,5 @@ def single_support_reference(robot: Robot, stance: int, joints: tuple[str, ...],
         feet[k, 1 - stance] = [*M.translation, np.arctan2(M.rotation[1, 0], M.rotation[0, 0])]
     contact = np.zeros((len(Q), 2), dtype=bool)
     contact[:, stance] = True
-    plan = FootstepPlan(feet0[:, [0, 1, 3]], (), samples / rate, GaitOptions())
+    plan = FootstepPlan(feet0[:, [0, 1, 3]], (), float(len(time) * (time[1] - time[0])), GaitOptions())
     return WalkingReference(time, Q, V, A, contact, feet, coms, zero_moment_point(robot, Q, V, A), plan)
