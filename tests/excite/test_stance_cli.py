@@ -117,7 +117,7 @@ def test_what_a_stance_does_not_take_is_one_line(capsys, talos, tmp_path):
     write_table(with_metadata(pa.table(columns), {"generator": "wbfriction.excite", "robot": "talos"}), path)
     assert read_metadata(pq.read_table(path)).get("stance") is None
     for args, line in [
-        ((), "plain.parquet: no stance foot and swing series: a walk plays what 'wbfriction excite' writes for a biped"),
+        ((), "plain.parquet: no stance foot or swing series: a biped plays what 'excite --stance' writes"),
         (("--gait", "sideways"), "--gait: the set-points played (plain.parquet) fix the motion: it takes no motion"),
         (("--steps", "3"), "--steps: the set-points played (plain.parquet) fix the motion: it takes no motion"),
         (("--simulator", "mujoco", "--duration", "3"), "--duration: robot 'talos' walks on MuJoCo"),

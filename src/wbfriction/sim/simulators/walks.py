@@ -86,8 +86,7 @@ def played_stance(robot: Robot, path: Path) -> WalkingReference:
 
     table = read_setpoint_table(path, robot)
     if table.stance is None or table.fourier is None:
-        raise InputError(f"{path}: no stance foot and swing series: a walk plays what 'wbfriction excite' writes "
-                         "for a biped")
+        raise InputError(f"{path}: no stance foot or swing series: a biped plays what 'excite --stance' writes")
     f = table.fourier
     trajectory = FourierTrajectory(np.asarray(f["center"], dtype=float), np.asarray(f["a"], dtype=float),
                                    np.asarray(f["b"], dtype=float), float(f["omega"]))
