@@ -55,7 +55,8 @@ def excite(ctx: typer.Context,
                                                  help="Hung: shares of each joint's half range the search tries "
                                                       "(repeat the option for each)."),
            torque_share: float = typer.Option(PD_EXCITE.torque_share,
-                                              help="Share of each joint's torque limit the motion may ask."),
+                                              help="A fixed base: share of each joint's torque limit the motion "
+                                                   "may ask."),
            velocity: bool = typer.Option(PD_EXCITE.velocity, help="Hung: send qd_des = the set-points' slope "
                                                                   "(default: zeros, as most drivers are sent)."),
            seed: int = typer.Option(PD_EXCITE.seed, help="Seed of the ramps' levels and times (hung), of the "
