@@ -36,7 +36,8 @@ OFFSET_ERROR = {"hip": 0.006, "thigh": 0.006, "calf": 0.025}
 @pytest.fixture(scope="module")
 def played():
     robot = wbfriction.load_robot("go2")
-    design = design_pd(robot, PdExciteOptions(duration=30.0))
+    # the search's choice (the how-to's run searches the whole default grid: tests/test_readme.py), predicted once
+    design = design_pd(robot, PdExciteOptions(duration=30.0, amplitudes=(0.95,), reversals=((0.2, 1.5),)))
     sim = simulate_hung(robot, play_options(design, replace(REAL_DRIVER, seed=7)),
                         reference=(design.q_des - robot.offset_vector, design.qd_des))
     blind = replace(robot, encoder_offset={})  # the TOML's offsets are the truth, not the identification's guess

@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import wbfriction
-from wbfriction.exceptions import ColumnError
+from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.logs.setpoint_table import read_setpoint_table, setpoint_table
 from wbfriction.logs.tables import write_table
 
@@ -52,3 +52,28 @@ def test_a_table_that_cannot_be_played_is_refused_naming_its_column(go2, tmp_pat
     with pytest.raises(ColumnError, match="row 5 of column 'time'") as err:
         read_setpoint_table(path, go2)
     assert err.value.row == 5 and str(path) in str(err.value)
+
+
+@pytest.mark.parametrize("suffix", [".parquet", ".csv"])
+def test_a_stances_series_and_foot_are_read_back(go2, tmp_path, suffix):
+    """A one-foot stance's table (``excite --stance``): the series of some joints only, named, and the foot."""
+    time = np.arange(10) / 1000.0
+    q = np.zeros((10, go2.n_act))
+    series = {"center": [0.1, -0.2], "a": [[0.3, 0.4], [0.5, 0.6]], "b": [[0.0, 0.1], [0.2, 0.3]], "omega": 1.5}
+    joints = (go2.actuated[2], go2.actuated[5])
+    path = tmp_path / f"stance{suffix}"
+    write_table(setpoint_table(go2.name, go2.actuated, time, q, q, series, fourier_joints=joints, stance="right"),
+                path)
+    read = read_setpoint_table(path, go2)
+    assert read.stance == "right" and read.fourier_joints == joints and read.fourier is not None
+    for key, value in series.items():
+        np.testing.assert_array_equal(read.fourier[key], value)
+    write_table(setpoint_table(go2.name, go2.actuated, time, q, q, series, fourier_joints=("knee", joints[1])), path)
+    with pytest.raises(InputError, match="its Fourier series names joint 'knee'"):
+        read_setpoint_table(path, go2)
+    write_table(setpoint_table(go2.name, go2.actuated, time, q, q, series, fourier_joints=joints[:1]), path)
+    with pytest.raises(InputError, match="its Fourier coefficients are of 2 joints, it names 1"):
+        read_setpoint_table(path, go2)
+    write_table(setpoint_table(go2.name, go2.actuated, time, q, q, stance="both"), path)
+    with pytest.raises(InputError, match="its stance 'both' is not 'left' or 'right'"):
+        read_setpoint_table(path, go2)

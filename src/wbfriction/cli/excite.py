@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING, Literal, Optional
 
 import typer
 from rich.table import Table
@@ -20,6 +20,14 @@ HUNG_ONLY = ("amplitude", "velocity", "after")
 """The options only a hung PD-driven robot's design reads: refused for an arm."""
 ARM_ONLY = ("period",)
 """The options only an arm's design reads: refused for a hung PD-driven robot."""
+FIXED_ONLY = (*HUNG_ONLY, "torque_share")
+"""The options only a fixed base's designs read: refused for a floating base."""
+FLOATING_ONLY = ("stance",)
+"""The options only a floating base's designs read: refused for a fixed base."""
+BIPED_DURATION, BIPED_PERIOD = 8.0, 4.0
+"""A biped's default time on one foot and its swing joints' Fourier period [s]
+(:class:`~wbfriction.excite.stance.StanceOptions`' own)."""
+Stance = Literal["left", "right"]
 
 if TYPE_CHECKING:
     from wbfriction.excite.pd_design import PdDesign
@@ -37,21 +45,29 @@ def excite(ctx: typer.Context,
                                                           "parameter, the limits' margins and the search (JSON)."),
            figure: Optional[Path] = typer.Option(None, "--figure", help="Also write a PNG of the set-points within "
                                                                         "the limits and of the predicted errors."),
-           duration: float = typer.Option(PD_EXCITE.duration, help="The recording [s]."),
+           duration: Optional[float] = typer.Option(None, help=f"The recording [s] (default {PD_EXCITE.duration:g} "
+                                                               f"hung or an arm; a biped: the time on one foot, "
+                                                               f"default {BIPED_DURATION:g})."),
            rate: Optional[float] = typer.Option(None, help=f"The drivers' rate [Hz]: the set-points' samples "
                                                            f"(default {PD_EXCITE.rate:g} hung, {ARM_RATE:g} an "
-                                                           "arm)."),
+                                                           "arm or a biped)."),
            amplitude: list[float] = typer.Option(list(PD_EXCITE.amplitudes),
                                                  help="Hung: shares of each joint's half range the search tries "
                                                       "(repeat the option for each)."),
            torque_share: float = typer.Option(PD_EXCITE.torque_share,
-                                              help="Share of each joint's torque limit the motion may ask."),
+                                              help="A fixed base: share of each joint's torque limit the motion "
+                                                   "may ask."),
            velocity: bool = typer.Option(PD_EXCITE.velocity, help="Hung: send qd_des = the set-points' slope "
                                                                   "(default: zeros, as most drivers are sent)."),
            seed: int = typer.Option(PD_EXCITE.seed, help="Seed of the ramps' levels and times (hung), of the "
-                                                         "design's starts (an arm)."),
-           period: float = typer.Option(ARM_PERIOD, help="An arm: the Fourier series' period [s]; the recording holds "
-                                                         "a whole number of them."),
+                                                         "design's starts (an arm, a biped's swing joints)."),
+           period: Optional[float] = typer.Option(None, help=f"An arm or a biped's swing leg: the Fourier series' "
+                                                             f"period [s] (default {ARM_PERIOD:g} an arm, "
+                                                             f"{BIPED_PERIOD:g} a biped); the recording holds a "
+                                                             "whole number of them."),
+           stance: Optional[Stance] = typer.Option(None, help="A biped (a floating base on two soles): the foot it "
+                                                              "stands on, left (default) or right, while the other "
+                                                              "leg's joints follow their designed series."),
            after: Optional[Path] = typer.Option(None, "--after",
                                                 help="Hung: what to record next, after a log whose parameters JSON "
                                                      "'fit' wrote: only the joints whose fit is not ok move (the "
@@ -62,21 +78,48 @@ def excite(ctx: typer.Context,
     """Design the motion to record so that its identification determines every parameter: on a hung PD-driven
     robot (its base fixed), set-points whose 'identify --actuator pd' is predicted to report every joint's armature,
     F_v, F_c and encoder offset and the drivers' delay furthest inside their 'ok' limits; on a fixed-base arm, a
-    Fourier excitation whose 'estimate' and 'fit' determine each joint's friction. Within the URDF's position,
-    velocity and torque limits; predicted by simulating the motion under the robot's model and identifying it."""
+    Fourier excitation whose 'estimate' and 'fit' determine each joint's friction; on a biped (--robot talos), one
+    leg's Fourier excitation while it stands on the other foot (--stance), every sample in single support. Within
+    the URDF's position, velocity and torque limits; predicted by simulating the motion under the robot's model and
+    identifying it (a biped: each swing joint's Cramér-Rao bound)."""
     check_paths({"--urdf": urdf, "--config": config, "--mjcf": mjcf, "--after": after},
                 {**{f"-o #{k + 1}": p for k, p in enumerate(output)}, "--json": prediction, "--figure": figure})
     r = robot_of(robot, urdf, config, mjcf)
     if r.floating_base:
-        raise InputError(f"robot '{r.name}' has a floating base: excite designs a fixed base's motion (hung, an arm)")
+        refuse_unread(ctx, f"robot '{r.name}' has a floating base", FIXED_ONLY, "fixed base's")
+        _excite_floating(r, output, prediction, figure, stance or "left", duration, rate, period, seed)
+        return
+    refuse_unread(ctx, f"robot '{r.name}' has a fixed base", FLOATING_ONLY, "floating base's")
+    duration = PD_EXCITE.duration if duration is None else duration
     if r.pd is None:
         refuse_unread(ctx, f"robot '{r.name}' is a fixed-base arm", HUNG_ONLY, "hung PD-driven robot's")
-        _excite_arm(r, output, prediction, figure, duration, rate or ARM_RATE, period, torque_share, seed)
+        _excite_arm(r, output, prediction, figure, duration, rate or ARM_RATE, period or ARM_PERIOD, torque_share,
+                    seed)
         return
     refuse_unread(ctx, f"robot '{r.name}' is a hung PD-driven robot", ARM_ONLY, "arm's")
     options = PdExciteOptions(duration=duration, rate=rate or PD_EXCITE.rate, amplitudes=tuple(amplitude),
                               torque_share=torque_share, velocity=velocity, seed=seed)
     _excite_pd(r, output, prediction, figure, options, after)
+
+
+def _excite_floating(r, output: list[Path], prediction: Path | None, figure: Path | None, stance: str,
+                     duration: float | None, rate: float | None, period: float | None, seed: int) -> None:
+    """A floating base's design, by the kind of robot: a biped (two soles) stands on one foot. Another kind (a
+    quadruped on three feet) is one more branch here.
+
+    Raises:
+        InputError: a floating base of another kind.
+    """
+    if r.partial_contacts or len(r.contact_frames) != 2:
+        raise InputError(f"robot '{r.name}' has a floating base on {len(r.contact_frames)} feet: excite designs a "
+                         "biped's one-foot stance")
+    from wbfriction.excite.design import ExciteOptions
+    from wbfriction.excite.stance import StanceOptions
+
+    design = ExciteOptions(duration=BIPED_DURATION if duration is None else duration, rate=rate or ARM_RATE,
+                           period=period or BIPED_PERIOD, harmonics=StanceOptions().design.harmonics,
+                           range_share=1.0, seed=seed)
+    _excite_biped(r, output, prediction, figure, StanceOptions(stance=stance, design=design))
 
 
 def _candidates(total: int, what: str):
@@ -163,6 +206,49 @@ def _excite_arm(r, output: list[Path], prediction: Path | None, figure: Path | N
     out.print(f"least margin to a limit {design.design.margins.least():.0%}; worst: {w['joint']} {w['parameter']}, "
               f"{w['share']:.3f} of its limit (below 1: predicted ok)", highlight=False)
     _wrote(output, prediction, figure)
+
+
+def _excite_biped(r, output: list[Path], prediction: Path | None, figure: Path | None, options) -> None:
+    from wbfriction.excite.document import stance_document, stance_setpoints
+    from wbfriction.excite.stance import stance_reference, swing_bounds
+    from wbfriction.logs.tables import write_json, write_table
+    from wbfriction.report.excite import excite_figure
+
+    with console.status(f"designing the swing leg's series, then the stance on the {options.stance} foot (its IK "
+                        "at every sample)"):
+        excitation = stance_reference(r, options)
+    table = stance_setpoints(r, excitation, options)
+    for path in output:
+        write_table(table, path)
+    doc = stance_document(r, excitation, options, swing_bounds(r, excitation, options))
+    if prediction is not None:
+        write_json(prediction, doc)
+    shares = {j: s["share"] for j, s in doc["swing"].items()}
+    if figure is not None:
+        act = [r.actuated.index(j) for j in excitation.joints]
+        offset = r.offset_vector[act]
+        ref = excitation.reference
+        excite_figure(figure, excitation.joints, ref.time, r.angles(ref.q)[:, act] + offset,
+                      excitation.lower + offset, excitation.upper + offset, shares,
+                      f"{r.name} on its {options.stance} foot: the swing leg within its posture band; Cramér-Rao "
+                      "bound / weak limit")
+    _print_biped(doc)
+    _wrote(output, prediction, figure)
+
+
+def _print_biped(doc: dict) -> None:
+    table = Table(title=f"The swing leg on the {doc['stance']} foot: band and Cramér-Rao bound / weak limit",
+                  box=None)
+    for col in ("joint", "band [rad]", "reached [rad]", "peak [rad/s]", "F_c", "F_v"):
+        table.add_column(col, justify="left" if col == "joint" else "right")
+    for joint, s in doc["swing"].items():
+        table.add_row(joint, f"{s['band'][0]:.2f} to {s['band'][1]:.2f}",
+                      f"{s['reached'][0]:.2f} to {s['reached'][1]:.2f}", f"{s['peak_velocity']:.2f}",
+                      *(f"{s['share'][n]:.3f}" if n in s["share"] else "-" for n in ("F_c", "F_v")))
+    out.print(table)
+    out.print(f"ZMP {doc['zmp_margin'] * 1e3:.1f} mm inside the {doc['stance']} sole's edges (at least "
+              f"{doc['limits']['zmp_margin'] * 1e3:.0f}); the swing sole {doc['clearance'] * 1e3:.1f} mm above the "
+              f"ground (at least {doc['limits']['clearance'] * 1e3:.0f})", highlight=False)
 
 
 def _wrote(*paths) -> None:

@@ -140,11 +140,14 @@ DriverNoiseOpt = typer.Option("real", help="PD-driven: real (a real driver's noi
                                            "0.08 rad/s on the driver's velocity) or none (exact readings); "
                                            "--encoder-bits, --position-noise and --velocity-noise override it.")
 VelocityNoiseOpt = typer.Option(None, help="PD-driven: white noise std of the driver's velocity [rad/s].")
-PlayOpt = typer.Option(None, "--play", help="PD-driven and arms: the set-points to play (a table 'wbfriction excite' "
-                                            "writes: time, q_des.<joint>, qd_des.<joint>; an arm's also its Fourier "
-                                            "series) instead of ramps and chirps or a random excitation; its "
-                                            "duration and rate are the table's.")
-PLAYED = ("duration", "setpoints", "excitation_seed")
+PlayOpt = typer.Option(None, "--play", help="PD-driven, arms and a biped (ideal, mujoco): the set-points to play (a "
+                                            "table 'wbfriction excite' writes: time, q_des.<joint>, qd_des.<joint>; "
+                                            "an arm's also its Fourier series, a biped's its stance foot and swing "
+                                            "leg's series, from which its stance is rebuilt) instead of ramps and "
+                                            "chirps, a random excitation or a walk; its duration and rate are the "
+                                            "table's.")
+PLAYED = ("duration", "setpoints", "excitation_seed", "gait", "steps", "step_length", "step_width", "turn_angle",
+          "lift_height")
 """What a played table fixes: refused beside ``--play``."""
 
 SHARED = ("output", "robot", "urdf", "config", "mjcf", "actuator")

@@ -1,4 +1,5 @@
-"""What ``wbfriction excite`` writes of a design (a hung PD-driven robot's, a fixed-base arm's): the set-points table
+"""What ``wbfriction excite`` writes of a design (a hung PD-driven robot's, a fixed-base arm's, a biped's on one
+foot): the set-points table
 a robot plays (:mod:`wbfriction.logs.setpoint_table`) and the JSON document of the prediction, the margins and the
 search (one writer each; the reader of the table is ``simulate --play``'s, the document is for the user and the
 benchmark).
@@ -18,15 +19,22 @@ Units: each parameter's own (:data:`~wbfriction.actuator.identification.UNITS`);
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
 import pyarrow as pa
 
 from wbfriction.excite.arm_design import ArmDesign
+from wbfriction.excite.information import limit_shares
 from wbfriction.excite.pd_design import SHARE_LIMITS, PdDesign
 from wbfriction.excite.predict import Predicted
+from wbfriction.excite.stance import StanceExcitation, StanceOptions
 from wbfriction.fit.status import WEAK
+from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.logs.setpoint_table import setpoint_table
+from wbfriction.model.robot import Robot
+from wbfriction.sim.single_support import SIDES
 
 CRITERION = ("the worst share of its status's limit (offsets 0.01 rad, others 0.25 x value) that a parameter's "
              "predicted reported standard error comes to")
@@ -95,3 +103,49 @@ def arm_document(design: ArmDesign) -> dict[str, Any]:
         "margins": {j: {"position": float(m.position[i]), "velocity": float(m.velocity[i]),
                         "torque": float(m.torque[i])} for i, j in enumerate(design.design.joints)},
     }
+
+
+def stance_setpoints(robot: Robot, excitation: StanceExcitation, options: StanceOptions) -> pa.Table:
+    """The set-points table of a biped's one-foot stance: every actuated joint's angle [rad] in the encoders'
+    coordinates (the model's plus the robot's ``[encoder_offset]``) and velocity [rad/s] along the reference; its
+    metadata the stance foot and the swing leg's series (the model's angles), from which ``simulate --play``
+    rebuilds the reference (:func:`~wbfriction.sim.single_support.single_support_reference`)."""
+    ref, t = excitation.reference, excitation.trajectory
+    qd = ref.v[:, robot.act_v_index]
+    fourier = {"center": t.center, "a": t.a, "b": t.b, "omega": t.omega}
+    return setpoint_table(robot.name, robot.actuated, ref.time, robot.angles(ref.q) + robot.offset_vector, qd,
+                          fourier, fourier_joints=excitation.joints, stance=SIDES[excitation.stance],
+                          kind="biped on one foot", seed=options.design.seed)
+
+
+def stance_document(robot: Robot, excitation: StanceExcitation, options: StanceOptions,
+                    bounds: Mapping[str, Mapping[str, float]]) -> dict[str, Any]:
+    """The JSON document of a biped's one-foot stance::
+
+        {"robot", "kind": "biped on one foot", "stance": "left"|"right", "duration" [s], "rate" [Hz], "period" [s],
+         "harmonics", "velocity_cap" [rad/s], "zmp_margin" [m], "clearance" [m], "limits": {"zmp_margin",
+         "clearance"} [m],
+         "swing": {"<joint>": {"band": [lower, upper] [rad], "reached": [min, max] [rad], "peak_velocity" [rad/s],
+                               "bound": {"<parameter>": its Cramér-Rao bound}, "share": {"F_c", "F_v"}}}}
+
+    ``bounds``: each swing joint's Cramér-Rao bounds (:func:`~wbfriction.excite.stance.swing_bounds`); ``share``
+    is the bound over :data:`~wbfriction.fit.status.WEAK` of the prior's value (below 1: ``ok`` at best)."""
+    prior = friction_by_group(robot.groups, THESIS_TARGETS)
+    ref, asked = excitation.reference, options.design.asked
+    act = [robot.actuated.index(j) for j in excitation.joints]
+    angles, speed = robot.angles(ref.q)[:, act], np.abs(ref.v[:, robot.act_v_index[act]])
+    swing = {}
+    for i, j in enumerate(excitation.joints):
+        shares = limit_shares(bounds[j], prior[j], asked)
+        swing[j] = {"band": [float(excitation.lower[i]), float(excitation.upper[i])],
+                    "reached": [float(angles[:, i].min()), float(angles[:, i].max())],
+                    "peak_velocity": float(speed[:, i].max()), "bound": dict(bounds[j]),
+                    "share": {n: float(x) for n, x in zip(asked, shares)}}
+    d = options.design
+    return {"robot": robot.name, "kind": "biped on one foot", "stance": SIDES[excitation.stance],
+            "criterion": f"each swing joint's worst share of {WEAK:g} x its prior's value that F_c's or F_v's "
+                         "Cramér-Rao bound comes to, within its posture band and below the velocity cap",
+            "duration": d.duration, "rate": d.rate, "period": d.period, "harmonics": d.harmonics,
+            "velocity_cap": options.velocity, "zmp_margin": excitation.zmp_margin,
+            "clearance": excitation.clearance,
+            "limits": {"zmp_margin": options.zmp_margin, "clearance": options.clearance}, "swing": swing}

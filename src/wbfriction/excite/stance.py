@@ -12,7 +12,8 @@ the last, so that every sample is one the estimator maps exactly to the swing le
   stance sole's footprint (ModelError otherwise).
 * **Every other joint but the stance leg's** is held at the robot's reference posture (arms, torso, head).
 * **The floating base and the stance leg** (``6 + 6`` unknowns) come from a square inverse kinematics per sample
-  (Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), twelve tasks: the stance sole's placement
+  (:mod:`wbfriction.sim.single_support`, which ``simulate --play`` reruns on the set-points table's series:
+  Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), twelve tasks: the stance sole's placement
   (flat at its standing footprint, 6), the centre of mass over the sole's centre at the standing posture's height
   (3), the base upright (3). Velocities from ``J v = 0``, accelerations from ``J a = -Jd v`` (the targets are
   constant), so the reference keeps the stance sole still at the acceleration level. *Quasi-static*: the centre of
@@ -37,6 +38,7 @@ import pinocchio as pin
 
 from wbfriction.exceptions import InputError, ModelError
 from wbfriction.excite.design import ExciteOptions, design_joint
+from wbfriction.excite.information import torque_bound
 from wbfriction.excite.trajectory import FourierSpace
 from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.friction.families.params import ModelParamsBase
@@ -44,12 +46,13 @@ from wbfriction.friction.noise import NoiseModel
 from wbfriction.model.robot import Robot
 from wbfriction.sim.arm import FourierTrajectory
 from wbfriction.sim.mujoco_model import sole_footprint
-from wbfriction.walking.footsteps import FootstepPlan
-from wbfriction.walking.options import GaitOptions
+from wbfriction.sim.single_support import (  # noqa: F401 (StanceIK, zero_moment_point: this module's names too)
+    SIDES,
+    StanceIK,
+    single_support_reference,
+    zero_moment_point,
+)
 from wbfriction.walking.reference import WalkingReference, standing_configuration
-from wbfriction.walking.swing import foot_placement
-
-LWA = pin.LOCAL_WORLD_ALIGNED
 
 SWING_BAND: dict[str, tuple[float, float]] = {
     "hip_yaw": (-0.15, 0.05),
@@ -161,103 +164,23 @@ def design_swing(robot: Robot, joints: tuple[str, ...], lower: np.ndarray, upper
     joint's inertia: the mass matrix's diagonal at the standing posture), less :data:`SLACK`."""
     excite = options.design
     space = FourierSpace(1, excite.harmonics, excite.omega)
-    inertia = np.diag(pin.crba(robot.model, robot.model.createData(), standing_configuration(robot)))
     rng = np.random.default_rng(excite.seed)
     z = []
-    for i, joint in enumerate(joints):
-        a = robot.actuated.index(joint)
-        iv = robot.act_v_index[a]
+    for i, (joint, noise) in enumerate(zip(joints, swing_noise(robot, joints, options))):
+        iv = robot.act_v_index[robot.actuated.index(joint)]
         velocity = min(options.velocity, excite.velocity_share * float(robot.model.velocityLimit[iv]))
-        noise = NoiseModel(options.torque_noise, options.position_noise, float(inertia[iv]), 1.0 / excite.rate)
         z.append(design_joint(space, excite, float(lower[i]) + SLACK[0], float(upper[i]) - SLACK[0],
                               SLACK[1] * velocity, prior[joint], noise, rng))
     return FourierSpace(len(joints), excite.harmonics, excite.omega).trajectory(np.concatenate(z))
 
 
-class StanceIK:
-    """The square single-support inverse kinematics of the module docstring, for one robot and stance foot.
-
-    Args:
-        robot: a biped (two soles, six joints per leg); stance: the stance sole's index.
-        sole: the stance sole's placement (flat on the ground, world frame); com: the centre-of-mass target (3,)
-            [m], world frame.
-
-    Attributes:
-        cols: the velocity indices solved (12,): the base's six, then the stance leg's joints.
-        rest: every other velocity index (nv - 12,), in increasing order: the joints prescribed.
-
-    Raises:
-        ModelError: a stance leg of other than six joints.
-    """
-
-    def __init__(self, robot: Robot, stance: int, sole: pin.SE3, com: np.ndarray) -> None:
-        self.robot, self.model, self.data = robot, robot.model, robot.model.createData()
-        leg = [robot.actuated.index(j) for j in robot.limb(robot.contact_frames[stance])]
-        if len(leg) != 6:
-            raise ModelError(f"robot '{robot.name}': a stance leg of {len(leg)} joints, the IK needs 6")
-        self.cols = np.concatenate([np.arange(6), robot.act_v_index[leg]])
-        self.rest = np.setdiff1d(np.arange(self.model.nv), self.cols)
-        self.frame = robot.contact_frame_ids[stance]
-        self.sole, self.com = sole, np.asarray(com, dtype=float)
-        self.base_R = pin.rpy.rpyToMatrix(0.0, 0.0, pin.rpy.matrixToRpy(sole.rotation)[2])
-
-    def _system(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The task Jacobian (12, nv) and error (12,) at ``q``: sole (position [m], rotation [rad]), centre of
-        mass [m], base rotation [rad]."""
-        model, data = self.model, self.data
-        pin.computeJointJacobians(model, data, q)
-        J = np.zeros((12, model.nv))
-        J[0:6] = pin.getFrameJacobian(model, data, self.frame, LWA)
-        J[6:9] = pin.jacobianCenterOfMass(model, data, True)
-        R = data.oMi[1].rotation
-        J[9:12, 3:6] = R
-        oMf = data.oMf[self.frame]
-        e = np.concatenate([self.sole.translation - oMf.translation, pin.log3(self.sole.rotation @ oMf.rotation.T),
-                            self.com - data.com[0], pin.log3(self.base_R @ R.T)])
-        return J, e
-
-    def solve(self, q: np.ndarray, v_rest: np.ndarray, a_rest: np.ndarray, tol: float = 1e-11,
-              max_iter: int = 50) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The configuration (nq,), velocity and acceleration (nv,) whose joints outside the base and the stance
-        leg are those of ``q`` (a guess of the rest), ``v_rest`` and ``a_rest`` (on :attr:`rest`).
-
-        Raises:
-            ModelError: the Newton iterations do not converge (the target out of reach).
-        """
-        model, data, cols = self.model, self.data, self.cols
-        for _ in range(max_iter):
-            J, e = self._system(q)
-            if np.max(np.abs(e)) < tol:
-                break
-            dv = np.zeros(model.nv)
-            dv[cols] = np.linalg.solve(J[:, cols], e)
-            q = pin.integrate(model, q, dv)
-        else:
-            raise ModelError(f"one-foot stance IK did not converge (residual {np.max(np.abs(e)):.2e})")
-        Jc_inv, Jr = np.linalg.inv(J[:, cols]), J[:, self.rest]
-        v, a = np.zeros(model.nv), np.zeros(model.nv)
-        v[self.rest], a[self.rest] = v_rest, a_rest
-        v[cols] = -Jc_inv @ (Jr @ v_rest)
-        pin.centerOfMass(model, data, q, v, np.zeros(model.nv))  # drift: zero acceleration
-        drift = np.concatenate([pin.getFrameClassicalAcceleration(model, data, self.frame, LWA).vector,
-                                data.acom[0], np.zeros(3)])
-        a[cols] = -Jc_inv @ (drift + Jr @ a_rest)
-        return q, v, a
-
-
-def zero_moment_point(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-    """The zero-moment point (N, 2) [m] on the ground (z = 0, world frame) of a motion ``q`` (N, nq), ``v``, ``a``
-    (N, nv): where the contact wrench that the rate of the centroidal momentum asks
-    (``pin.computeCentroidalMomentumTimeVariation``) has no horizontal moment."""
-    model, data = robot.model, robot.model.createData()
-    mass, g = pin.computeTotalMass(model), model.gravity.linear
-    out = np.empty((len(q), 2))
-    for k in range(len(q)):
-        pin.computeCentroidalMomentumTimeVariation(model, data, q[k], v[k], a[k])
-        force = data.dhg.linear - mass * g
-        moment = data.dhg.angular + np.cross(data.com[0], force)  # about the world origin
-        out[k] = -moment[1] / force[2], moment[0] / force[2]
-    return out
+def swing_noise(robot: Robot, joints: tuple[str, ...], options: StanceOptions) -> list[NoiseModel]:
+    """Each swing joint's noise as its design takes it: the options' torque and position noise, the joint's inertia
+    (the mass matrix's diagonal at the standing posture), the design's sample period."""
+    inertia = np.diag(pin.crba(robot.model, robot.model.createData(), standing_configuration(robot)))
+    return [NoiseModel(options.torque_noise, options.position_noise,
+                       float(inertia[robot.act_v_index[robot.actuated.index(j)]]), 1.0 / options.design.rate)
+            for j in joints]
 
 
 def support_margin(robot: Robot, stance: int, zmp: np.ndarray) -> float:
@@ -316,82 +239,43 @@ def stance_reference(robot: Robot, options: StanceOptions = StanceOptions(),
             the duration; ModelError: the IK out of reach, the ZMP leaving the sole, the swing sole too low or
             under the stance sole, a stance joint outside its URDF range.
     """
-    stance = 0 if options.stance == "left" else 1
-    q0 = standing_configuration(robot)
+    stance = SIDES.index(options.stance)
     joints = robot.limb(robot.contact_frames[1 - stance])
     prior = friction_by_group(robot.groups, THESIS_TARGETS) if prior is None else prior
     if missing := [j for j in joints if j not in prior]:
         raise InputError(f"no prior friction for swing joint '{missing[0]}'")
-    lower, upper = swing_band(robot, joints, "right" if stance == 0 else "left", options.margin)
+    lower, upper = swing_band(robot, joints, SIDES[1 - stance], options.margin)
     trajectory = design_swing(robot, joints, lower, upper, prior, options)
-    time = options.design.times()
-    qs, qds, qdds = trajectory(time)
-    model, data = robot.model, robot.model.createData()
-    pin.framesForwardKinematics(model, data, q0)
-    feet0 = np.array([[*data.oMf[f].translation[:2], 0.0, pin.rpy.matrixToRpy(data.oMf[f].rotation)[2]]
-                      for f in robot.contact_frame_ids])
-    sole = foot_placement(feet0[stance])
-    centre, _ = sole_footprint(robot, robot.contact_frames[stance])
-    act = np.array([robot.actuated.index(j) for j in joints])
-    q = q0.copy()
-    q[robot.act_q_index[act]] = qs[0]
-    com = np.array([*sole.act(np.array([*centre, 0.0]))[:2], pin.centerOfMass(model, data, q0)[2]])
-    ik = StanceIK(robot, stance, sole, com)
-    Q, V, A = _solved(robot, ik, q, act, (qs, qds, qdds))
-    return _checked(robot, options, stance, joints, trajectory, (lower, upper), feet0, time, (Q, V, A))
+    reference = single_support_reference(robot, stance, joints, trajectory, options.design.times())
+    margin, low = _checked(robot, options, stance, reference)
+    return StanceExcitation(reference, stance, joints, trajectory, lower, upper, margin, low)
 
 
-def _solved(robot: Robot, ik: StanceIK, q: np.ndarray, act: np.ndarray,
-            swing: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The IK at every sample of the swing joints' motion (N, n) each (``act``: their actuated indices), from ``q``
-    (the first guess)."""
-    qs, qds, qdds = swing
-    model = robot.model
-    n = len(qs)
-    Q, V, A = np.empty((n, model.nq)), np.empty((n, model.nv)), np.empty((n, model.nv))
-    iq = robot.act_q_index[act]
-    on_rest = np.searchsorted(ik.rest, robot.act_v_index[act])
-    v_rest, a_rest = np.zeros(len(ik.rest)), np.zeros(len(ik.rest))
-    for k in range(n):
-        q = q.copy()
-        q[iq] = qs[k]
-        v_rest[on_rest], a_rest[on_rest] = qds[k], qdds[k]
-        q, V[k], A[k] = ik.solve(q, v_rest, a_rest)
-        Q[k] = q
-    return Q, V, A
-
-
-def _checked(robot: Robot, options: StanceOptions, stance: int, joints: tuple[str, ...],
-             trajectory: FourierTrajectory, band: tuple[np.ndarray, np.ndarray], feet0: np.ndarray,
-             time: np.ndarray, motion: tuple[np.ndarray, np.ndarray, np.ndarray]) -> StanceExcitation:
-    """The :class:`StanceExcitation` of a solved motion, its ZMP, clearance and stance leg's range checked."""
-    Q, V, A = motion
-    zmp = zero_moment_point(robot, Q, V, A)
-    margin = support_margin(robot, stance, zmp)
+def _checked(robot: Robot, options: StanceOptions, stance: int, reference: WalkingReference) -> tuple[float, float]:
+    """The ZMP's least distance to the stance sole's edges [m] and the swing sole's least height [m] of a solved
+    motion, its ZMP, clearance and stance leg's range checked (ModelError)."""
+    margin = support_margin(robot, stance, reference.zmp)
     if margin < options.zmp_margin:
         raise ModelError(f"the ZMP comes within {margin * 1e3:.1f} mm of the stance sole's edge (at least "
                          f"{options.zmp_margin * 1e3:.1f} mm asked): lower --velocity")
-    low, beside = _swing_corners(robot, stance, Q)
+    low, beside = _swing_corners(robot, stance, reference.q)
     if low < options.clearance or beside < 0.0:
         raise ModelError(f"the swing sole comes {low * 1e3:.1f} mm above the ground and {beside * 1e3:.1f} mm beside "
                          f"the stance sole (at least {options.clearance * 1e3:.1f} and 0 mm): a narrower band")
     lo, hi = robot.angle_limits
-    angles = robot.angles(Q)
+    angles = robot.angles(reference.q)
     if np.any(angles < lo) or np.any(angles > hi):
         worst = int(np.argmax(np.maximum(lo - angles, angles - hi).max(axis=0)))
         raise ModelError(f"joint '{robot.actuated[worst]}' leaves its URDF range on one foot")
-    model, data = robot.model, robot.model.createData()
-    feet = np.empty((len(Q), 2, 4))
-    feet[:, stance] = feet0[stance]
-    swing = robot.contact_frame_ids[1 - stance]
-    com = np.empty((len(Q), 3))
-    for k in range(len(Q)):
-        com[k] = pin.centerOfMass(model, data, Q[k])
-        pin.updateFramePlacement(model, data, swing)
-        M = data.oMf[swing]
-        feet[k, 1 - stance] = [*M.translation, np.arctan2(M.rotation[1, 0], M.rotation[0, 0])]
-    contact = np.zeros((len(Q), 2), dtype=bool)
-    contact[:, stance] = True
-    plan = FootstepPlan(feet0[:, [0, 1, 3]], (), float(options.design.duration), GaitOptions())
-    reference = WalkingReference(time, Q, V, A, contact, feet, com, zmp, plan)
-    return StanceExcitation(reference, stance, joints, trajectory, band[0], band[1], margin, low)
+    return margin, low
+
+
+def swing_bounds(robot: Robot, excitation: StanceExcitation, options: StanceOptions,
+                 prior: Mapping[str, ModelParamsBase] | None = None) -> dict[str, dict[str, float]]:
+    """Each swing joint's Cramér-Rao bound of its friction's parameters on the designed motion [their units]
+    (:func:`~.information.torque_bound`: its prior friction, as :func:`design_swing` takes it, the options'
+    noise), per joint and parameter name (``F_c`` [N·m], ``F_v`` [N·m·s/rad], ...)."""
+    prior = friction_by_group(robot.groups, THESIS_TARGETS) if prior is None else prior
+    noise = swing_noise(robot, excitation.joints, options)
+    _, qd, _ = excitation.trajectory(excitation.reference.time)
+    return {j: torque_bound(prior[j], qd[:, i], noise[i]) for i, j in enumerate(excitation.joints)}

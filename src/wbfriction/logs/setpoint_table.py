@@ -13,7 +13,10 @@ column                 unit        meaning
 The metadata (:mod:`wbfriction.logs.metadata`) says ``generator`` (``wbfriction.excite``), the ``robot``, and for a
 motion that is a finite Fourier series (an arm's), its coefficients (``fourier``: ``center`` (n,) [rad], ``a``,
 ``b`` (n, L) [rad/s], ``omega`` [rad/s]; :class:`~wbfriction.sim.arm.FourierTrajectory`), from which the motion's
-accelerations are exact.
+accelerations are exact. A humanoid standing on one foot (``excite --stance``) also says the foot stood on
+(``stance``: ``left`` or ``right``), and its series are the swing leg's only (``fourier.joints``: their names, n):
+the rest of the body follows from them (:mod:`wbfriction.sim.single_support`); without ``joints`` the series are
+of every actuated joint.
 """
 
 from __future__ import annotations
@@ -42,6 +45,9 @@ class SetpointTable:
         joints: the joints (the robot's actuated order).
         q_des, qd_des: (N, n) [rad, rad/s], encoder coordinates.
         fourier: the motion's Fourier coefficients where the table holds them (module docstring), else None.
+        fourier_joints: the joints the series are of (the robot's actuated order): all where the metadata names
+            none, none without series.
+        stance: the foot stood on (``left``, ``right``): a humanoid's one-foot stance; else None.
     """
 
     source: str
@@ -51,6 +57,8 @@ class SetpointTable:
     q_des: np.ndarray
     qd_des: np.ndarray
     fourier: dict | None = None
+    fourier_joints: tuple[str, ...] = ()
+    stance: str | None = None
 
     @property
     def duration(self) -> float:
@@ -59,9 +67,11 @@ class SetpointTable:
 
 
 def setpoint_table(robot: str, joints: tuple[str, ...], time: np.ndarray, q_des: np.ndarray, qd_des: np.ndarray,
-                   fourier: dict | None = None, **meta) -> pa.Table:
+                   fourier: dict | None = None, fourier_joints: tuple[str, ...] | None = None,
+                   stance: str | None = None, **meta) -> pa.Table:
     """The table (module docstring) of the set-points ``q_des``, ``qd_des`` (N, n) [rad, rad/s] of ``joints`` at
-    ``time`` (N,) [s]; ``meta``: more metadata (JSON-able)."""
+    ``time`` (N,) [s]; ``fourier``: the series' coefficients, of ``fourier_joints`` (None: of ``joints``);
+    ``stance``: the foot a humanoid stands on; ``meta``: more metadata (JSON-able)."""
     columns = {"time": pa.array(np.asarray(time, dtype=float))}
     for i, j in enumerate(joints):
         columns[f"q_des.{j}"] = pa.array(np.asarray(q_des[:, i], dtype=float))
@@ -70,6 +80,10 @@ def setpoint_table(robot: str, joints: tuple[str, ...], time: np.ndarray, q_des:
     doc = {"generator": GENERATOR, "robot": robot, **meta}
     if fourier is not None:
         doc["fourier"] = {k: np.asarray(v, dtype=float).tolist() for k, v in fourier.items()}
+        if fourier_joints is not None:
+            doc["fourier"]["joints"] = list(fourier_joints)
+    if stance is not None:
+        doc["stance"] = stance
     return with_metadata(pa.table(columns), doc)
 
 
@@ -80,7 +94,9 @@ def read_setpoint_table(path: str | Path, robot: Robot) -> SetpointTable:
     Raises:
         ColumnError: no ``time`` column, a joint's ``q_des`` column missing or not finite, a ``qd_des`` column
             for some joints only, times not evenly spaced from 0.
-        InputError: fewer than two rows; Fourier coefficients of another number of joints.
+        InputError: fewer than two rows; Fourier coefficients of another number of joints than they name (all
+            the robot's where they name none), or of a joint the robot has not; a stance not ``left`` or
+            ``right``.
     """
     source = str(path)
     table = read_table(path)
@@ -108,8 +124,16 @@ def read_setpoint_table(path: str | Path, robot: Robot) -> SetpointTable:
                           "only; give it for every one, or for none")
     qd_des = numeric_columns(table, velocity, source) if all(there) else np.zeros_like(q_des)
     meta = read_metadata(table, source)
-    fourier = meta.get("fourier")
-    if fourier is not None and np.shape(fourier.get("center")) != (robot.n_act,):
-        raise InputError(f"{source}: its Fourier coefficients are of {np.size(fourier.get('center'))} joints, robot "
-                         f"'{robot.name}' has {robot.n_act}")
-    return SetpointTable(source, time, rate, robot.actuated, q_des, qd_des, fourier)
+    fourier, stance = meta.get("fourier"), meta.get("stance")
+    series: tuple[str, ...] = ()
+    if fourier is not None:
+        named = "joints" in fourier
+        series = tuple(fourier.pop("joints", robot.actuated))
+        if unknown := [j for j in series if j not in robot.actuated]:
+            raise InputError(f"{source}: its Fourier series names joint '{unknown[0]}', not robot '{robot.name}''s")
+        if np.shape(fourier.get("center")) != (len(series),):
+            of = f"it names {len(series)}" if named else f"robot '{robot.name}' has {len(series)}"
+            raise InputError(f"{source}: its Fourier coefficients are of {np.size(fourier.get('center'))} joints, {of}")
+    if stance not in (None, "left", "right"):
+        raise InputError(f"{source}: its stance {stance!r} is not 'left' or 'right'")
+    return SetpointTable(source, time, rate, robot.actuated, q_des, qd_des, fourier, series, stance)

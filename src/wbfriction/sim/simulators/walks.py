@@ -1,5 +1,6 @@
 """A walk with known friction (thesis 6.1, 6.2): the reference walk planned (:mod:`wbfriction.walking.reference`),
-simulated ideal (:func:`~wbfriction.sim.ideal.simulate_ideal`) or on MuJoCo
+or a biped's one-foot stance played (``--play``, what ``excite --stance`` writes:
+:mod:`wbfriction.sim.single_support`), simulated ideal (:func:`~wbfriction.sim.ideal.simulate_ideal`) or on MuJoCo
 (:func:`~wbfriction.sim.mujoco_sim.simulate_mujoco`), as ``simulate --simulator ideal|mujoco`` runs it."""
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from wbfriction.walking.options import GaitOptions
 
 if TYPE_CHECKING:
     from wbfriction.model.robot import Robot
+    from wbfriction.walking.reference import WalkingReference
 
 IDEAL = IdealOptions()
 MUJOCO = MujocoOptions()
@@ -25,7 +27,7 @@ QUADRUPED_GAITS = ("stand", "step", "trot", "walk")
 SENSOR_NOISE = ("position_noise", "encoder_bits", "torque_noise", "noise_seed")
 """The ``simulate`` options of the sensor noise."""
 WALK = ("gait", "steps", "step_length", "step_width", "turn_angle", "lift_height", "friction", "simulator", "substeps",
-        "log_base")
+        "log_base", "play")
 """The ``simulate`` options both walks read."""
 
 
@@ -66,24 +68,69 @@ def walk_gait(robot: Robot, values: Mapping[str, Any]) -> GaitOptions:
                        lift_height=values.get("lift_height", GAIT.lift_height))
 
 
-def run_walk(robot: Robot, gait: GaitOptions, options: IdealOptions | MujocoOptions, friction: Path | None,
-             progress: SimulationProgress) -> SimulationOutput:
-    """The walk ``gait`` planned and simulated with ``options`` (MuJoCo's or the ideal simulator's), the friction
-    of the ``friction`` TOML (None: thesis Table 6.1 on the legs); a foot that pulled on the ground is a warning.
+def played_stance(robot: Robot, path: Path) -> WalkingReference:
+    """The reference of a biped's one-foot stance that the set-points table at ``path`` holds (what ``excite
+    --stance`` writes): rebuilt from its stance foot, its swing leg's series and its times
+    (:func:`~wbfriction.sim.single_support.single_support_reference`), checked against its ``q_des``.
 
     Raises:
-        InputError: a friction file that cannot be read, a walk the robot cannot make.
+        InputError: what :func:`~wbfriction.logs.setpoint_table.read_setpoint_table` raises; a table without a
+            stance or series; its ``q_des`` more than 1e-6 rad from the rebuilt reference (edited, or another
+            robot's model).
+    """
+    import numpy as np
+
+    from wbfriction.logs.setpoint_table import read_setpoint_table
+    from wbfriction.sim.arm import FourierTrajectory
+    from wbfriction.sim.single_support import SIDES, single_support_reference
+
+    table = read_setpoint_table(path, robot)
+    if table.stance is None or table.fourier is None:
+        raise InputError(f"{path}: no stance foot or swing series: a biped plays what 'excite --stance' writes")
+    f = table.fourier
+    trajectory = FourierTrajectory(np.asarray(f["center"], dtype=float), np.asarray(f["a"], dtype=float),
+                                   np.asarray(f["b"], dtype=float), float(f["omega"]))
+    ref = single_support_reference(robot, SIDES.index(table.stance), table.fourier_joints, trajectory, table.time)
+    off = np.abs(robot.angles(ref.q) + robot.offset_vector - table.q_des).max(axis=0)
+    if off.max() > 1e-6:
+        raise InputError(f"{path}: q_des.{robot.actuated[int(off.argmax())]} is {off.max():.2g} rad from the stance "
+                         "its series make: not as 'wbfriction excite' wrote it")
+    return ref
+
+
+def walk_reference(robot: Robot, values: Mapping[str, Any], progress: SimulationProgress) -> WalkingReference:
+    """The reference to simulate: the ``--play`` table's one-foot stance (:func:`played_stance`), else the walk the
+    options give (:func:`walk_gait`) planned.
+
+    Raises:
+        InputError: what those raise; a walk the robot cannot make.
+    """
+    from wbfriction.walking.reference import walking_reference
+
+    if values.get("play") is not None:
+        with progress.stage(f"rebuilding the stance of {Path(values['play']).name} (its IK at every sample)"):
+            return played_stance(robot, values["play"])
+    gait = walk_gait(robot, values)
+    with progress.stage(f"planning {gait.steps} steps ({gait.gait})"):
+        return walking_reference(robot, gait)
+
+
+def run_walk(robot: Robot, ref: WalkingReference, options: IdealOptions | MujocoOptions, friction: Path | None,
+             progress: SimulationProgress) -> SimulationOutput:
+    """The reference ``ref`` (:func:`walk_reference`) simulated with ``options`` (MuJoCo's or the ideal
+    simulator's), the friction of the ``friction`` TOML (None: thesis Table 6.1 on the legs); a foot that pulled on
+    the ground is a warning.
+
+    Raises:
+        InputError: a friction file that cannot be read.
     """
     from wbfriction.fit.targets import load_friction_spec
     from wbfriction.sim.ideal import simulate_ideal
-    from wbfriction.walking.reference import walking_reference
 
     spec = None if friction is None else load_friction_spec(friction, robot.groups, robot.torque_controlled)
     params, terms = (None, None) if spec is None else (spec.params, spec.terms)
     if spec is not None and spec.temperature is not None:
         options = dataclasses.replace(options, temperature=spec.temperature)
-    with progress.stage(f"planning {gait.steps} steps ({gait.gait})"):
-        ref = walking_reference(robot, gait)
     with progress.steps(len(ref)) as advance:
         if isinstance(options, MujocoOptions):
             from wbfriction.sim.mujoco_sim import simulate_mujoco
@@ -107,13 +154,13 @@ class IdealWalk(SimulatorKind):
 
     def run(self, robot: Robot, values: Mapping[str, Any], friction: Path | None,
             progress: SimulationProgress) -> SimulationOutput:
-        gait = walk_gait(robot, values)
+        ref = walk_reference(robot, values, progress)
         substeps, force_torque = values.get("substeps"), values.get("force_torque", IDEAL.force_torque)
         options = IdealOptions(substeps=substeps or IDEAL.substeps,
                                integrator=values.get("integrator", IDEAL.integrator),
                                log_base=values.get("log_base", IDEAL.log_base), force_torque=force_torque,
                                imu=force_torque)
-        return run_walk(robot, gait, options, friction, progress)
+        return run_walk(robot, ref, options, friction, progress)
 
 
 class MujocoWalk(SimulatorKind):
@@ -128,7 +175,6 @@ class MujocoWalk(SimulatorKind):
 
     def run(self, robot: Robot, values: Mapping[str, Any], friction: Path | None,
             progress: SimulationProgress) -> SimulationOutput:
-        gait = walk_gait(robot, values)
         noise, lag = sensor_noise(values.get("sensors"), values.get("position_noise"), values.get("encoder_bits"),
                                   values.get("torque_noise"), values.get("noise_seed"), values.get("delay"))
         options = MujocoOptions(substeps=values.get("substeps") or MUJOCO.substeps,
@@ -138,4 +184,4 @@ class MujocoWalk(SimulatorKind):
                                 friction_timeconst=values.get("friction_timeconst"),
                                 torque_drift=values.get("torque_drift", MUJOCO.torque_drift),
                                 ft_offset=values.get("ft_offset", MUJOCO.ft_offset))
-        return run_walk(robot, gait, options, friction, progress)
+        return run_walk(robot, walk_reference(robot, values, progress), options, friction, progress)
