@@ -13,7 +13,8 @@ leg's friction torque (its joints' rows of the equation of motion hold no contac
   the swing leg's foot and knee :attr:`TripodOptions.spacing` away from the other legs' feet and knees
   (ModelError otherwise).
 * **The floating base and the three stance legs** (``6 + 9`` unknowns) come from a square inverse kinematics per
-  sample (Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), fifteen tasks: the three stance feet's
+  sample (:mod:`wbfriction.sim.tripod_support`, which ``simulate --play`` reruns on the set-points table's series:
+  Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), fifteen tasks: the three stance feet's
   contact frame origins at their footprints (9), the centre of mass over the *incentre* of the stance triangle (the
   point farthest from its edges) at the standing height (3), the base upright and facing forward (3). Velocities
   from ``J v = 0``, accelerations from ``J a = -Jd v`` (the targets are constant), so that the reference keeps
@@ -44,6 +45,7 @@ import pinocchio as pin
 
 from wbfriction.exceptions import InputError, ModelError
 from wbfriction.excite.design import ExciteOptions, design_joint
+from wbfriction.excite.information import torque_bound
 from wbfriction.excite.stance import SLACK, zero_moment_point
 from wbfriction.excite.trajectory import FourierSpace
 from wbfriction.friction.families.params import ModelParamsBase
@@ -51,9 +53,17 @@ from wbfriction.friction.noise import NoiseModel
 from wbfriction.model.robot import Robot
 from wbfriction.sim.arm import FourierTrajectory
 from wbfriction.sim.quadruped import default_quadruped_friction
-from wbfriction.walking.quadruped import FOOT_RADIUS, GaitOptions, QuadrupedReference
-
-LWA = pin.LOCAL_WORLD_ALIGNED
+from wbfriction.sim.tripod_support import (  # noqa: F401 (TripodIK, leg_points, LWA: this module's names too)
+    LWA,
+    TripodIK,
+    TripodMotion,
+    incentre,
+    leg_points,
+    standing_feet,
+    triangle_margin,
+    tripod_support_reference,
+)
+from wbfriction.walking.quadruped import FOOT_RADIUS, QuadrupedReference
 
 SWING_BAND: dict[str, tuple[float, float]] = {
     "hip": (-0.5, -0.05),
@@ -193,135 +203,31 @@ def swing_band(robot: Robot, joints: tuple[str, ...], left: bool, margin: float)
     return lower, upper
 
 
+def swing_noise(robot: Robot, joints: tuple[str, ...], options: TripodOptions) -> list[NoiseModel]:
+    """Each swing joint's noise as its design takes it: the options' torque and position noise, the joint's inertia
+    (the mass matrix's diagonal at the reference posture), the design's sample period."""
+    q0 = robot.configuration(robot.reference_angles)
+    inertia = np.diag(pin.crba(robot.model, robot.model.createData(), q0))
+    return [NoiseModel(options.torque_noise, options.position_noise,
+                       float(inertia[robot.act_v_index[robot.actuated.index(j)]]), 1.0 / options.design.rate)
+            for j in joints]
+
+
 def design_swing(robot: Robot, joints: tuple[str, ...], band: tuple[np.ndarray, np.ndarray],
                  prior: Mapping[str, ModelParamsBase], options: TripodOptions) -> FourierTrajectory:
     """The swing joints' series (n joints): each designed alone by :func:`~.design.design_joint` within its band
     ``(lower, upper)`` (n,) each [rad] and below the velocity cap, for its ``prior`` friction and the options'
-    noise (the joint's inertia: the mass matrix's diagonal at the reference posture), less
-    :data:`~.stance.SLACK`."""
+    noise (:func:`swing_noise`), less :data:`~.stance.SLACK`."""
     excite = options.design
     space = FourierSpace(1, excite.harmonics, excite.omega)
-    q0 = robot.configuration(robot.reference_angles)
-    inertia = np.diag(pin.crba(robot.model, robot.model.createData(), q0))
     rng = np.random.default_rng(excite.seed)
     z = []
-    for i, joint in enumerate(joints):
-        a = robot.actuated.index(joint)
-        iv = robot.act_v_index[a]
+    for i, (joint, noise) in enumerate(zip(joints, swing_noise(robot, joints, options))):
+        iv = robot.act_v_index[robot.actuated.index(joint)]
         velocity = min(options.velocity, excite.velocity_share * float(robot.model.velocityLimit[iv]))
-        noise = NoiseModel(options.torque_noise, options.position_noise, float(inertia[iv]), 1.0 / excite.rate)
         z.append(design_joint(space, excite, float(band[0][i]) + SLACK[0], float(band[1][i]) - SLACK[0],
                               SLACK[1] * velocity, prior[joint], noise, rng))
     return FourierSpace(len(joints), excite.harmonics, excite.omega).trajectory(np.concatenate(z))
-
-
-class TripodIK:
-    """The square three-feet inverse kinematics of the module docstring, for one robot and swing foot.
-
-    Args:
-        robot: a quadruped (four point feet, three joints per leg); swing: the swing foot's index.
-        feet: the stance feet's footprints (3, 3) [m], world, in increasing foot order; com: the centre of mass's
-            target (3,) [m], world.
-
-    Attributes:
-        cols: the velocity indices solved (15,): the base's six, then the stance legs' joints.
-        rest: every other velocity index (nv - 15,), in increasing order: the joints prescribed.
-
-    Raises:
-        ModelError: a stance leg of other than three joints.
-    """
-
-    def __init__(self, robot: Robot, swing: int, feet: np.ndarray, com: np.ndarray) -> None:
-        self.robot, self.model, self.data = robot, robot.model, robot.model.createData()
-        stance = [c for c in range(len(robot.contact_frames)) if c != swing]
-        legs = [[robot.actuated.index(j) for j in robot.limb(robot.contact_frames[c])] for c in stance]
-        if any(len(leg) != 3 for leg in legs):
-            raise ModelError(f"robot '{robot.name}': a stance leg of other than 3 joints (the IK needs 3 per leg)")
-        self.cols = np.concatenate([np.arange(6), robot.act_v_index[np.concatenate(legs)]])
-        self.rest = np.setdiff1d(np.arange(self.model.nv), self.cols)
-        self.frames = [robot.contact_frame_ids[c] for c in stance]
-        self.feet, self.com = np.asarray(feet, dtype=float), np.asarray(com, dtype=float)
-
-    def _system(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The task Jacobian (15, nv) and error (15,) at ``q``: the stance feet [m], the centre of mass [m], the
-        base's rotation [rad]."""
-        model, data = self.model, self.data
-        pin.computeJointJacobians(model, data, q)
-        pin.updateFramePlacements(model, data)
-        J = np.zeros((15, model.nv))
-        for i, f in enumerate(self.frames):
-            J[3 * i:3 * i + 3] = pin.getFrameJacobian(model, data, f, LWA)[:3]
-        J[9:12] = pin.jacobianCenterOfMass(model, data, True)
-        R = data.oMi[1].rotation
-        J[12:15, 3:6] = R
-        e = np.concatenate([*(p - data.oMf[f].translation for p, f in zip(self.feet, self.frames)),
-                            self.com - data.com[0], pin.log3(R.T)])
-        return J, e
-
-    def solve(self, q: np.ndarray, v_rest: np.ndarray, a_rest: np.ndarray, tol: float = 1e-11,
-              max_iter: int = 50) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The configuration (nq,), velocity and acceleration (nv,) whose joints outside the base and the stance
-        legs are those of ``q`` (a guess of the rest), ``v_rest`` and ``a_rest`` (on :attr:`rest`).
-
-        Raises:
-            ModelError: the Newton iterations do not converge (the target out of reach).
-        """
-        model, data, cols = self.model, self.data, self.cols
-        for _ in range(max_iter):
-            J, e = self._system(q)
-            if np.max(np.abs(e)) < tol:
-                break
-            dv = np.zeros(model.nv)
-            dv[cols] = np.linalg.solve(J[:, cols], e)
-            q = pin.integrate(model, q, dv)
-        else:
-            raise ModelError(f"three-feet stance IK did not converge (residual {np.max(np.abs(e)):.2e}): "
-                             "lower --height")
-        Jc_inv, Jr = np.linalg.inv(J[:, cols]), J[:, self.rest]
-        v, a = np.zeros(model.nv), np.zeros(model.nv)
-        v[self.rest], a[self.rest] = v_rest, a_rest
-        v[cols] = -Jc_inv @ (Jr @ v_rest)
-        pin.centerOfMass(model, data, q, v, np.zeros(model.nv))  # drift: zero acceleration
-        pin.updateFramePlacements(model, data)
-        drift = np.concatenate([*(pin.getFrameClassicalAcceleration(model, data, f, LWA).linear
-                                  for f in self.frames), data.acom[0], np.zeros(3)])
-        a[cols] = -Jc_inv @ (drift + Jr @ a_rest)
-        return q, v, a
-
-
-def triangle_margin(points: np.ndarray, triangle: np.ndarray) -> float:
-    """The least signed distance [m] of the points ``points`` (N, 2) to the edges of the triangle ``triangle``
-    (3, 2) (world, on the ground): positive inside, negative for a point outside."""
-    points, triangle = np.atleast_2d(points), np.asarray(triangle, dtype=float)
-    centre = triangle.mean(axis=0)
-    worst = np.inf
-    for i in range(3):
-        a, b = triangle[i], triangle[(i + 1) % 3]
-        normal = np.array([b[1] - a[1], a[0] - b[0]]) / np.linalg.norm(b - a)
-        if normal @ (centre - a) < 0:
-            normal = -normal  # inward
-        worst = min(worst, float(np.min((points - a) @ normal)))
-    return worst
-
-
-def incentre(triangle: np.ndarray) -> tuple[np.ndarray, float]:
-    """The triangle's (3, 2) incentre (2,) [m] (the point farthest from its edges) and its inradius [m]."""
-    side = np.array([np.linalg.norm(triangle[(i + 1) % 3] - triangle[(i + 2) % 3]) for i in range(3)])
-    centre = side @ triangle / side.sum()
-    return centre, triangle_margin(centre[None], triangle)
-
-
-def standing_feet(robot: Robot) -> np.ndarray:
-    """The four feet's footprints (4, 3) [m], world: where the reference posture puts the contact frames about the
-    base (its origin at x = y = 0), moved together along it so that their centre lies under the centre of mass, at
-    :data:`~wbfriction.walking.quadruped.FOOT_RADIUS` above the ground."""
-    model, data = robot.model, robot.model.createData()
-    q = robot.configuration(robot.reference_angles)
-    pin.framesForwardKinematics(model, data, q)
-    feet = np.array([data.oMf[f].translation for f in robot.contact_frame_ids]) - q[:3]
-    feet[:, 0] += pin.centerOfMass(model, data, q)[0] - q[0] - feet[:, 0].mean()
-    feet[:, 2] = FOOT_RADIUS
-    return feet
 
 
 def tripod_reference(robot: Robot, options: TripodOptions = TripodOptions(),
@@ -345,67 +251,20 @@ def tripod_reference(robot: Robot, options: TripodOptions = TripodOptions(),
             the triangle's edges, the swing foot too low or too near another leg, a joint outside its URDF range.
     """
     swing = swing_foot(robot, options.swing)
-    stance = tuple(c for c in range(4) if c != swing)
+    stance = [c for c in range(4) if c != swing]
     joints = robot.limb(robot.contact_frames[swing])
     prior = default_quadruped_friction(robot) if prior is None else prior
     if missing := [j for j in joints if j not in prior]:
         raise InputError(f"no prior friction for swing joint '{missing[0]}'")
     feet = standing_feet(robot)
-    centre, inradius = incentre(feet[list(stance), :2])
+    _, inradius = incentre(feet[stance, :2])
     if inradius < options.com_margin:
         raise ModelError(f"the stance triangle's incentre is {inradius * 1e3:.1f} mm from its edges (at least "
                          f"{options.com_margin * 1e3:.1f} mm asked): lower --com-margin")
     band = swing_band(robot, joints, bool(feet[swing, 1] > 0), options.margin)
     trajectory = design_swing(robot, joints, band, prior, options)
-    qs, qds, qdds = trajectory(options.design.times())
-    model, data = robot.model, robot.model.createData()
-    q = robot.configuration(robot.reference_angles)
-    com_z = pin.centerOfMass(model, data, q)[2] - q[2] + options.height
-    q[:3] = [centre[0], centre[1], options.height]
-    act = np.array([robot.actuated.index(j) for j in joints])
-    q[robot.act_q_index[act]] = qs[0]
-    ik = TripodIK(robot, swing, feet[list(stance)], np.array([*centre, com_z]))
-    motion = _solved(robot, ik, q, act, (qs, qds, qdds))
-    return _checked(robot, options, swing, (joints, trajectory, band), feet, motion)
-
-
-def _solved(robot: Robot, ik: TripodIK, q: np.ndarray, act: np.ndarray,
-            swing: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The IK at every sample of the swing joints' motion (N, n) each (``act``: their actuated indices), from ``q``
-    (the first guess)."""
-    qs, qds, qdds = swing
-    model = robot.model
-    n = len(qs)
-    Q, V, A = np.empty((n, model.nq)), np.empty((n, model.nv)), np.empty((n, model.nv))
-    iq = robot.act_q_index[act]
-    on_rest = np.searchsorted(ik.rest, robot.act_v_index[act])
-    v_rest, a_rest = np.zeros(len(ik.rest)), np.zeros(len(ik.rest))
-    for k in range(n):
-        q = q.copy()
-        q[iq] = qs[k]
-        v_rest[on_rest], a_rest[on_rest] = qds[k], qdds[k]
-        q, V[k], A[k] = ik.solve(q, v_rest, a_rest)
-        Q[k] = q
-    return Q, V, A
-
-
-def leg_points(robot: Robot, motion: tuple[np.ndarray, np.ndarray, np.ndarray]
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Along a motion ``(q, v, a)`` (N, nq), (N, nv), (N, nv): the feet's positions, velocities and accelerations
-    (N, 4, 3) each (contact frame origins [m, m/s, m/s^2], world) and the knees' positions (N, 4, 3) [m] (each
-    leg's last joint's origin)."""
-    model, data = robot.model, robot.model.createData()
-    knees = [model.getJointId(robot.limb(f)[-1]) for f in robot.contact_frames]
-    out = np.empty((4, len(motion[0]), 4, 3))
-    for k, (q, v, a) in enumerate(zip(*motion)):
-        pin.forwardKinematics(model, data, q, v, a)
-        pin.updateFramePlacements(model, data)
-        for c, f in enumerate(robot.contact_frame_ids):
-            out[0, k, c] = data.oMf[f].translation
-            out[1, k, c] = pin.getFrameVelocity(model, data, f, LWA).linear
-            out[2, k, c] = pin.getFrameClassicalAcceleration(model, data, f, LWA).linear
-            out[3, k, c] = data.oMi[knees[c]].translation
-    return out[0], out[1], out[2], out[3]
+    motion = tripod_support_reference(robot, swing, joints, trajectory, options.design.times(), options.height)
+    return _checked(robot, options, swing, (joints, trajectory, band), motion)
 
 
 def swing_spacing(swing: int, feet: np.ndarray, knees: np.ndarray) -> float:
@@ -418,14 +277,14 @@ def swing_spacing(swing: int, feet: np.ndarray, knees: np.ndarray) -> float:
 
 
 def _checked(robot: Robot, options: TripodOptions, swing: int,
-             design: tuple[tuple[str, ...], FourierTrajectory, tuple[np.ndarray, np.ndarray]], feet0: np.ndarray,
-             motion: tuple[np.ndarray, np.ndarray, np.ndarray]) -> TripodExcitation:
+             design: tuple[tuple[str, ...], FourierTrajectory, tuple[np.ndarray, np.ndarray]],
+             motion: TripodMotion) -> TripodExcitation:
     """The :class:`TripodExcitation` of a solved motion, its centre of mass, ZMP, clearance, spacing and joints'
     ranges checked."""
-    Q, V, A = motion
+    Q, V, A = motion.q, motion.v, motion.a
     joints, trajectory, band = design
     stance = tuple(c for c in range(4) if c != swing)
-    triangle = feet0[list(stance), :2]
+    triangle = motion.triangle
     model, data = robot.model, robot.model.createData()
     com = np.array([pin.centerOfMass(model, data, q) for q in Q])
     com_margin = triangle_margin(com[:, :2], triangle)
@@ -433,12 +292,11 @@ def _checked(robot: Robot, options: TripodOptions, swing: int,
     if zmp_margin < options.zmp_margin:
         raise ModelError(f"the ZMP comes within {zmp_margin * 1e3:.1f} mm of the stance triangle's edge (at least "
                          f"{options.zmp_margin * 1e3:.1f} mm asked): lower --velocity")
-    feet, feet_v, feet_a, knees = leg_points(robot, motion)
-    clearance = float(feet[:, swing, 2].min()) - FOOT_RADIUS
+    clearance = float(motion.feet[:, swing, 2].min()) - FOOT_RADIUS
     if clearance < options.clearance:
         raise ModelError(f"the swing foot comes {clearance * 1e3:.1f} mm above the ground (at least "
                          f"{options.clearance * 1e3:.1f} mm asked): raise --height or lower --clearance")
-    spacing = swing_spacing(swing, feet, knees)
+    spacing = swing_spacing(swing, motion.feet, motion.knees)
     if spacing < options.spacing:
         raise ModelError(f"the swing leg comes {spacing * 1e3:.1f} mm from another leg (at least "
                          f"{options.spacing * 1e3:.1f} mm asked): lower --spacing")
@@ -447,15 +305,17 @@ def _checked(robot: Robot, options: TripodOptions, swing: int,
     if np.any(angles < lo) or np.any(angles > hi):
         worst = int(np.argmax(np.maximum(lo - angles, angles - hi).max(axis=0)))
         raise ModelError(f"joint '{robot.actuated[worst]}' leaves its URDF range on three feet: lower --height")
-    feet[:, list(stance)] = feet0[list(stance)]  # their footprints (the IK's residual below 1e-11 m)
-    feet_v[:, list(stance)], feet_a[:, list(stance)] = 0.0, 0.0
-    contact = np.ones((len(Q), 4), dtype=bool)
-    contact[:, swing] = False
-    excite = options.design
-    gait = GaitOptions(gait="stand", duration=excite.duration, dt=1.0 / excite.rate, step_height=0.0, speed=0.0,
-                       base_height=options.height)
-    iq, iv = robot.act_q_index, robot.act_v_index
-    reference = QuadrupedReference(gait, excite.times(), contact, Q[:, :7].copy(), feet, Q[:, iq], V[:, iv],
-                                   A[:, iv], V[:, :6].copy(), A[:, :6].copy(), feet_v, feet_a)
-    return TripodExcitation(reference, swing, stance, joints, trajectory, band[0], band[1], triangle, com_margin,
-                            zmp_margin, clearance, spacing)
+    return TripodExcitation(motion.reference, swing, stance, joints, trajectory, band[0], band[1], triangle,
+                            com_margin, zmp_margin, clearance, spacing)
+
+
+def swing_bounds(robot: Robot, excitation: TripodExcitation, options: TripodOptions,
+                 prior: Mapping[str, ModelParamsBase] | None = None) -> dict[str, dict[str, float]]:
+    """Each swing joint's Cramér-Rao bound of its friction's parameters on the designed motion [their units]
+    (:func:`~.information.torque_bound`: its prior friction, as :func:`design_swing` takes it (default the
+    quadruped simulators' default), the options' noise), per joint and parameter name (``F_c`` [N·m], ``F_v``
+    [N·m·s/rad], ...)."""
+    prior = default_quadruped_friction(robot) if prior is None else prior
+    noise = swing_noise(robot, excitation.joints, options)
+    _, qd, _ = excitation.trajectory(excitation.reference.time)
+    return {j: torque_bound(prior[j], qd[:, i], noise[i]) for i, j in enumerate(excitation.joints)}
