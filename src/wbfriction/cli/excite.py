@@ -22,11 +22,19 @@ ARM_ONLY = ("period",)
 """The options only an arm's design reads: refused for a hung PD-driven robot."""
 FIXED_ONLY = (*HUNG_ONLY, "torque_share")
 """The options only a fixed base's designs read: refused for a floating base."""
-FLOATING_ONLY = ("stance",)
+BIPED_ONLY = ("stance",)
+"""The options only a biped's design reads: refused for a quadruped."""
+QUADRUPED_ONLY = ("swing",)
+"""The options only a quadruped's design reads: refused for a biped."""
+FLOATING_ONLY = (*BIPED_ONLY, *QUADRUPED_ONLY)
 """The options only a floating base's designs read: refused for a fixed base."""
 BIPED_DURATION, BIPED_PERIOD = 8.0, 4.0
 """A biped's default time on one foot and its swing joints' Fourier period [s]
-(:class:`~wbfriction.excite.stance.StanceOptions`' own)."""
+(:class:`~wbfriction.excite.stance.StanceOptions`' own); a quadruped's on three feet are the same
+(:class:`~wbfriction.excite.tripod.TripodOptions`' own)."""
+QUADRUPED_RATE = 500.0
+"""A quadruped's default set-points rate [Hz]: its simulators' control rate (:class:`~wbfriction.excite.tripod.
+TripodOptions`' own)."""
 Stance = Literal["left", "right"]
 
 if TYPE_CHECKING:
@@ -46,11 +54,12 @@ def excite(ctx: typer.Context,
            figure: Optional[Path] = typer.Option(None, "--figure", help="Also write a PNG of the set-points within "
                                                                         "the limits and of the predicted errors."),
            duration: Optional[float] = typer.Option(None, help=f"The recording [s] (default {PD_EXCITE.duration:g} "
-                                                               f"hung or an arm; a biped: the time on one foot, "
-                                                               f"default {BIPED_DURATION:g})."),
+                                                               f"hung or an arm; a biped or a quadruped: the time "
+                                                               f"on one or three feet, default "
+                                                               f"{BIPED_DURATION:g})."),
            rate: Optional[float] = typer.Option(None, help=f"The drivers' rate [Hz]: the set-points' samples "
                                                            f"(default {PD_EXCITE.rate:g} hung, {ARM_RATE:g} an "
-                                                           "arm or a biped)."),
+                                                           f"arm or a biped, {QUADRUPED_RATE:g} a quadruped)."),
            amplitude: list[float] = typer.Option(list(PD_EXCITE.amplitudes),
                                                  help="Hung: shares of each joint's half range the search tries "
                                                       "(repeat the option for each)."),
@@ -61,13 +70,17 @@ def excite(ctx: typer.Context,
                                                                   "(default: zeros, as most drivers are sent)."),
            seed: int = typer.Option(PD_EXCITE.seed, help="Seed of the ramps' levels and times (hung), of the "
                                                          "design's starts (an arm, a biped's swing joints)."),
-           period: Optional[float] = typer.Option(None, help=f"An arm or a biped's swing leg: the Fourier series' "
-                                                             f"period [s] (default {ARM_PERIOD:g} an arm, "
-                                                             f"{BIPED_PERIOD:g} a biped); the recording holds a "
-                                                             "whole number of them."),
+           period: Optional[float] = typer.Option(None, help=f"An arm or a swing leg: the Fourier series' period [s] "
+                                                             f"(default {ARM_PERIOD:g} an arm, {BIPED_PERIOD:g} a "
+                                                             "biped or a quadruped); the recording holds a whole "
+                                                             "number of them."),
            stance: Optional[Stance] = typer.Option(None, help="A biped (a floating base on two soles): the foot it "
                                                               "stands on, left (default) or right, while the other "
                                                               "leg's joints follow their designed series."),
+           swing: Optional[str] = typer.Option(None, help="A quadruped (a floating base on four point feet, --robot "
+                                                          "go2_walking): the leg lifted, by its name (FL, FR, RL, RR; "
+                                                          "default FR) or its foot frame's, while it stands on the "
+                                                          "other three."),
            after: Optional[Path] = typer.Option(None, "--after",
                                                 help="Hung: what to record next, after a log whose parameters JSON "
                                                      "'fit' wrote: only the joints whose fit is not ok move (the "
@@ -79,15 +92,16 @@ def excite(ctx: typer.Context,
     robot (its base fixed), set-points whose 'identify --actuator pd' is predicted to report every joint's armature,
     F_v, F_c and encoder offset and the drivers' delay furthest inside their 'ok' limits; on a fixed-base arm, a
     Fourier excitation whose 'estimate' and 'fit' determine each joint's friction; on a biped (--robot talos), one
-    leg's Fourier excitation while it stands on the other foot (--stance), every sample in single support. Within
+    leg's Fourier excitation while it stands on the other foot (--stance), every sample in single support; on a
+    quadruped (--robot go2_walking), one leg's while it stands on the other three point feet (--swing). Within
     the URDF's position, velocity and torque limits; predicted by simulating the motion under the robot's model and
-    identifying it (a biped: each swing joint's Cramér-Rao bound)."""
+    identifying it (a biped or a quadruped: each swing joint's Cramér-Rao bound)."""
     check_paths({"--urdf": urdf, "--config": config, "--mjcf": mjcf, "--after": after},
                 {**{f"-o #{k + 1}": p for k, p in enumerate(output)}, "--json": prediction, "--figure": figure})
     r = robot_of(robot, urdf, config, mjcf)
     if r.floating_base:
         refuse_unread(ctx, f"robot '{r.name}' has a floating base", FIXED_ONLY, "fixed base's")
-        _excite_floating(r, output, prediction, figure, stance or "left", duration, rate, period, seed)
+        _excite_floating(ctx, r, (output, prediction, figure), stance, swing, (duration, rate, period, seed))
         return
     refuse_unread(ctx, f"robot '{r.name}' has a fixed base", FLOATING_ONLY, "floating base's")
     duration = PD_EXCITE.duration if duration is None else duration
@@ -102,24 +116,40 @@ def excite(ctx: typer.Context,
     _excite_pd(r, output, prediction, figure, options, after)
 
 
-def _excite_floating(r, output: list[Path], prediction: Path | None, figure: Path | None, stance: str,
-                     duration: float | None, rate: float | None, period: float | None, seed: int) -> None:
-    """A floating base's design, by the kind of robot: a biped (two soles) stands on one foot. Another kind (a
-    quadruped on three feet) is one more branch here.
+def _excite_floating(ctx: typer.Context, r, paths: tuple[list[Path], Path | None, Path | None],
+                     stance: str | None, swing: str | None,
+                     design: tuple[float | None, float | None, float | None, int]) -> None:
+    """A floating base's design, by the kind of robot: a biped (two soles) stands on one foot, a quadruped (four
+    point feet) on three; ``paths``: the tables, the JSON and the figure to write; ``design``: the duration, rate,
+    period given (None: the kind's default) and the seed.
 
     Raises:
-        InputError: a floating base of another kind.
+        InputError: a floating base of another kind; an option of the other kind.
     """
-    if r.partial_contacts or len(r.contact_frames) != 2:
-        raise InputError(f"robot '{r.name}' has a floating base on {len(r.contact_frames)} feet: excite designs a "
-                         "biped's one-foot stance")
     from wbfriction.excite.design import ExciteOptions
+
+    duration, rate, period, seed = design
+    feet = len(r.contact_frames)
+    if r.partial_contacts and feet == 4:
+        refuse_unread(ctx, f"robot '{r.name}' is a quadruped on {r.stands_on}", BIPED_ONLY, "biped's")
+        from wbfriction.excite.tripod import TripodOptions
+
+        harmonics, rate = TripodOptions().design.harmonics, rate or QUADRUPED_RATE
+        options = TripodOptions(swing=swing or "FR", design=ExciteOptions(
+            duration=BIPED_DURATION if duration is None else duration, rate=rate, period=period or BIPED_PERIOD,
+            harmonics=harmonics, range_share=1.0, seed=seed))
+        _excite_quadruped(r, *paths, options)
+        return
+    if r.partial_contacts or feet != 2:
+        raise InputError(f"robot '{r.name}' has a floating base on {feet} {r.stands_on}: excite designs a biped's "
+                         "one-foot stance or a quadruped's on three point feet")
+    refuse_unread(ctx, f"robot '{r.name}' is a biped", QUADRUPED_ONLY, "quadruped's")
     from wbfriction.excite.stance import StanceOptions
 
-    design = ExciteOptions(duration=BIPED_DURATION if duration is None else duration, rate=rate or ARM_RATE,
-                           period=period or BIPED_PERIOD, harmonics=StanceOptions().design.harmonics,
-                           range_share=1.0, seed=seed)
-    _excite_biped(r, output, prediction, figure, StanceOptions(stance=stance, design=design))
+    options = ExciteOptions(duration=BIPED_DURATION if duration is None else duration, rate=rate or ARM_RATE,
+                            period=period or BIPED_PERIOD, harmonics=StanceOptions().design.harmonics,
+                            range_share=1.0, seed=seed)
+    _excite_biped(r, *paths, StanceOptions(stance=stance or "left", design=options))
 
 
 def _candidates(total: int, what: str):
@@ -211,34 +241,66 @@ def _excite_arm(r, output: list[Path], prediction: Path | None, figure: Path | N
 def _excite_biped(r, output: list[Path], prediction: Path | None, figure: Path | None, options) -> None:
     from wbfriction.excite.document import stance_document, stance_setpoints
     from wbfriction.excite.stance import stance_reference, swing_bounds
-    from wbfriction.logs.tables import write_json, write_table
-    from wbfriction.report.excite import excite_figure
 
     with console.status(f"designing the swing leg's series, then the stance on the {options.stance} foot (its IK "
                         "at every sample)"):
         excitation = stance_reference(r, options)
-    table = stance_setpoints(r, excitation, options)
-    for path in output:
-        write_table(table, path)
     doc = stance_document(r, excitation, options, swing_bounds(r, excitation, options))
-    if prediction is not None:
-        write_json(prediction, doc)
-    shares = {j: s["share"] for j, s in doc["swing"].items()}
-    if figure is not None:
-        act = [r.actuated.index(j) for j in excitation.joints]
-        offset = r.offset_vector[act]
-        ref = excitation.reference
-        excite_figure(figure, excitation.joints, ref.time, r.angles(ref.q)[:, act] + offset,
-                      excitation.lower + offset, excitation.upper + offset, shares,
-                      f"{r.name} on its {options.stance} foot: the swing leg within its posture band; Cramér-Rao "
-                      "bound / weak limit")
-    _print_biped(doc)
+    _write_standing(r, (output, prediction, figure), excitation, stance_setpoints(r, excitation, options), doc,
+                    f"{r.name} on its {options.stance} foot: the swing leg within its posture band; Cramér-Rao "
+                    "bound / weak limit")
+    _print_swing(doc, f"The swing leg on the {doc['stance']} foot")
+    out.print(f"ZMP {doc['zmp_margin'] * 1e3:.1f} mm inside the {doc['stance']} sole's edges (at least "
+              f"{doc['limits']['zmp_margin'] * 1e3:.0f}); the swing sole {doc['clearance'] * 1e3:.1f} mm above the "
+              f"ground (at least {doc['limits']['clearance'] * 1e3:.0f})", highlight=False)
     _wrote(output, prediction, figure)
 
 
-def _print_biped(doc: dict) -> None:
-    table = Table(title=f"The swing leg on the {doc['stance']} foot: band and Cramér-Rao bound / weak limit",
-                  box=None)
+def _excite_quadruped(r, output: list[Path], prediction: Path | None, figure: Path | None, options) -> None:
+    from wbfriction.excite.document import tripod_document, tripod_setpoints
+    from wbfriction.excite.tripod import swing_bounds, tripod_reference
+
+    with console.status("designing the swing leg's series, then the stance on the three other feet (its IK at "
+                        "every sample)"):
+        excitation = tripod_reference(r, options)
+    doc = tripod_document(r, excitation, options, swing_bounds(r, excitation, options))
+    leg = doc["swing_foot"].split("_")[0]
+    _write_standing(r, (output, prediction, figure), excitation, tripod_setpoints(r, excitation, options), doc,
+                    f"{r.name} on three feet, its {leg} leg swung within its posture band; Cramér-Rao bound / weak "
+                    "limit")
+    _print_swing(doc, f"The {leg} leg swung, on {', '.join(f.split('_')[0] for f in doc['stance_feet'])}")
+    mm = {n: f"{doc[n] * 1e3:.1f} mm (at least {doc['limits'][n] * 1e3:.0f})"
+          for n in ("com_margin", "zmp_margin", "clearance", "spacing")}
+    out.print(f"centre of mass {mm['com_margin']} and ZMP {mm['zmp_margin']} inside the stance triangle's edges; the "
+              f"swing foot {mm['clearance']} above the ground, {mm['spacing']} from the other legs", highlight=False)
+    _wrote(output, prediction, figure)
+
+
+def _write_standing(r, paths: tuple[list[Path], Path | None, Path | None], excitation, table, doc: dict,
+                    title: str) -> None:
+    """Write a standing design's set-points ``table`` to every path, its ``doc`` as JSON, and its figure (the swing
+    joints' set-points within their bands, the shares of their bounds, ``title``), where asked."""
+    import numpy as np
+
+    from wbfriction.logs.tables import write_json, write_table
+    from wbfriction.report.excite import excite_figure
+
+    output, prediction, figure = paths
+    for path in output:
+        write_table(table, path)
+    if prediction is not None:
+        write_json(prediction, doc)
+    if figure is not None:
+        joints = excitation.joints
+        offset = r.offset_vector[[r.actuated.index(j) for j in joints]]
+        q_des = np.column_stack([table.column(f"q_des.{j}").to_numpy() for j in joints])
+        excite_figure(figure, joints, table.column("time").to_numpy(), q_des, excitation.lower + offset,
+                      excitation.upper + offset, {j: s["share"] for j, s in doc["swing"].items()}, title)
+
+
+def _print_swing(doc: dict, where: str) -> None:
+    """The swing joints' table of a standing design's document: band, reach, peak speed, bounds' shares."""
+    table = Table(title=f"{where}: band and Cramér-Rao bound / weak limit", box=None)
     for col in ("joint", "band [rad]", "reached [rad]", "peak [rad/s]", "F_c", "F_v"):
         table.add_column(col, justify="left" if col == "joint" else "right")
     for joint, s in doc["swing"].items():
@@ -246,9 +308,6 @@ def _print_biped(doc: dict) -> None:
                       f"{s['reached'][0]:.2f} to {s['reached'][1]:.2f}", f"{s['peak_velocity']:.2f}",
                       *(f"{s['share'][n]:.3f}" if n in s["share"] else "-" for n in ("F_c", "F_v")))
     out.print(table)
-    out.print(f"ZMP {doc['zmp_margin'] * 1e3:.1f} mm inside the {doc['stance']} sole's edges (at least "
-              f"{doc['limits']['zmp_margin'] * 1e3:.0f}); the swing sole {doc['clearance'] * 1e3:.1f} mm above the "
-              f"ground (at least {doc['limits']['clearance'] * 1e3:.0f})", highlight=False)
 
 
 def _wrote(*paths) -> None:

@@ -1,5 +1,5 @@
 """What ``wbfriction excite`` writes of a design (a hung PD-driven robot's, a fixed-base arm's, a biped's on one
-foot): the set-points table
+foot, a quadruped's on three): the set-points table
 a robot plays (:mod:`wbfriction.logs.setpoint_table`) and the JSON document of the prediction, the margins and the
 search (one writer each; the reader of the table is ``simulate --play``'s, the document is for the user and the
 benchmark).
@@ -26,14 +26,19 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.excite.arm_design import ArmDesign
+from wbfriction.excite.design import ExciteOptions
 from wbfriction.excite.information import limit_shares
 from wbfriction.excite.pd_design import SHARE_LIMITS, PdDesign
 from wbfriction.excite.predict import Predicted
 from wbfriction.excite.stance import StanceExcitation, StanceOptions
+from wbfriction.excite.tripod import TripodExcitation, TripodOptions
 from wbfriction.fit.status import WEAK
 from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
+from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.logs.setpoint_table import setpoint_table
 from wbfriction.model.robot import Robot
+from wbfriction.sim.arm import FourierTrajectory
+from wbfriction.sim.quadruped import default_quadruped_friction
 from wbfriction.sim.single_support import SIDES
 
 CRITERION = ("the worst share of its status's limit (offsets 0.01 rad, others 0.25 x value) that a parameter's "
@@ -105,17 +110,64 @@ def arm_document(design: ArmDesign) -> dict[str, Any]:
     }
 
 
-def stance_setpoints(robot: Robot, excitation: StanceExcitation, options: StanceOptions) -> pa.Table:
-    """The set-points table of a biped's one-foot stance: every actuated joint's angle [rad] in the encoders'
-    coordinates (the model's plus the robot's ``[encoder_offset]``) and velocity [rad/s] along the reference; its
-    metadata the stance foot and the swing leg's series (the model's angles), from which ``simulate --play``
-    rebuilds the reference (:func:`~wbfriction.sim.single_support.single_support_reference`)."""
-    ref, t = excitation.reference, excitation.trajectory
-    qd = ref.v[:, robot.act_v_index]
+def swing_setpoints(robot: Robot, time: np.ndarray, angles: np.ndarray, velocities: np.ndarray,
+                    joints: tuple[str, ...], trajectory: FourierTrajectory, kind: str, seed: int,
+                    **where: Any) -> pa.Table:
+    """The set-points table of a floating base standing while one leg swings: every actuated joint's ``angles``
+    (N, n_act) [rad] (the model's) in the encoders' coordinates (plus the robot's ``[encoder_offset]``) and
+    ``velocities`` (N, n_act) [rad/s] at ``time`` (N,) [s]; its metadata the swing ``joints``' series (the model's
+    angles), the ``kind``, the design's ``seed`` and ``where`` it stands (``stance`` a biped's foot; ``swing``,
+    ``base_height`` a quadruped's), from which ``simulate --play`` rebuilds the reference."""
+    t = trajectory
     fourier = {"center": t.center, "a": t.a, "b": t.b, "omega": t.omega}
-    return setpoint_table(robot.name, robot.actuated, ref.time, robot.angles(ref.q) + robot.offset_vector, qd,
-                          fourier, fourier_joints=excitation.joints, stance=SIDES[excitation.stance],
-                          kind="biped on one foot", seed=options.design.seed)
+    return setpoint_table(robot.name, robot.actuated, time, angles + robot.offset_vector, velocities, fourier,
+                          fourier_joints=joints, kind=kind, seed=seed, **where)
+
+
+def stance_setpoints(robot: Robot, excitation: StanceExcitation, options: StanceOptions) -> pa.Table:
+    """The set-points table of a biped's one-foot stance (:func:`swing_setpoints`: its metadata the stance foot and
+    the swing leg's series), from which ``simulate --play`` rebuilds the reference
+    (:func:`~wbfriction.sim.single_support.single_support_reference`)."""
+    ref = excitation.reference
+    return swing_setpoints(robot, ref.time, robot.angles(ref.q), ref.v[:, robot.act_v_index], excitation.joints,
+                           excitation.trajectory, "biped on one foot", options.design.seed,
+                           stance=SIDES[excitation.stance])
+
+
+def tripod_setpoints(robot: Robot, excitation: TripodExcitation, options: TripodOptions) -> pa.Table:
+    """The set-points table of a quadruped on three feet (:func:`swing_setpoints`: its metadata the swing foot, the
+    base's height and the swing leg's series), from which ``simulate --play`` rebuilds the reference
+    (:func:`~wbfriction.sim.tripod_support.tripod_support_reference`)."""
+    ref = excitation.reference
+    return swing_setpoints(robot, ref.time, ref.q, ref.qd, excitation.joints, excitation.trajectory,
+                           "quadruped on three feet", options.design.seed,
+                           swing=robot.contact_frames[excitation.swing], base_height=options.height)
+
+
+def swing_rows(robot: Robot, joints: tuple[str, ...], band: tuple[np.ndarray, np.ndarray], angles: np.ndarray,
+               speed: np.ndarray, bounds: Mapping[str, Mapping[str, float]],
+               prior: Mapping[str, ModelParamsBase], asked: tuple[str, ...]) -> dict[str, dict[str, Any]]:
+    """Each swing joint's row of a standing design's document: its band ``(lower, upper)`` (n,) each [rad], the
+    range its ``angles`` (N, n) [rad] reach, the peak of its ``speed`` (N, n) [rad/s], its Cramér-Rao ``bounds``
+    and their shares of :data:`~wbfriction.fit.status.WEAK` times its ``prior``'s values (the ``asked``
+    parameters)."""
+    rows = {}
+    for i, j in enumerate(joints):
+        shares = limit_shares(bounds[j], prior[j], asked)
+        rows[j] = {"band": [float(band[0][i]), float(band[1][i])],
+                   "reached": [float(angles[:, i].min()), float(angles[:, i].max())],
+                   "peak_velocity": float(speed[:, i].max()), "bound": dict(bounds[j]),
+                   "share": {n: float(x) for n, x in zip(asked, shares)}}
+    return rows
+
+
+def _standing(robot: Robot, kind: str, design: ExciteOptions, velocity: float) -> dict[str, Any]:
+    """The fields a standing design's document opens with."""
+    return {"robot": robot.name, "kind": kind,
+            "criterion": f"each swing joint's worst share of {WEAK:g} x its prior's value that F_c's or F_v's "
+                         "Cramér-Rao bound comes to, within its posture band and below the velocity cap",
+            "duration": design.duration, "rate": design.rate, "period": design.period,
+            "harmonics": design.harmonics, "velocity_cap": velocity}
 
 
 def stance_document(robot: Robot, excitation: StanceExcitation, options: StanceOptions,
@@ -130,22 +182,31 @@ def stance_document(robot: Robot, excitation: StanceExcitation, options: StanceO
 
     ``bounds``: each swing joint's Cramér-Rao bounds (:func:`~wbfriction.excite.stance.swing_bounds`); ``share``
     is the bound over :data:`~wbfriction.fit.status.WEAK` of the prior's value (below 1: ``ok`` at best)."""
-    prior = friction_by_group(robot.groups, THESIS_TARGETS)
-    ref, asked = excitation.reference, options.design.asked
+    ref = excitation.reference
     act = [robot.actuated.index(j) for j in excitation.joints]
     angles, speed = robot.angles(ref.q)[:, act], np.abs(ref.v[:, robot.act_v_index[act]])
-    swing = {}
-    for i, j in enumerate(excitation.joints):
-        shares = limit_shares(bounds[j], prior[j], asked)
-        swing[j] = {"band": [float(excitation.lower[i]), float(excitation.upper[i])],
-                    "reached": [float(angles[:, i].min()), float(angles[:, i].max())],
-                    "peak_velocity": float(speed[:, i].max()), "bound": dict(bounds[j]),
-                    "share": {n: float(x) for n, x in zip(asked, shares)}}
-    d = options.design
-    return {"robot": robot.name, "kind": "biped on one foot", "stance": SIDES[excitation.stance],
-            "criterion": f"each swing joint's worst share of {WEAK:g} x its prior's value that F_c's or F_v's "
-                         "Cramér-Rao bound comes to, within its posture band and below the velocity cap",
-            "duration": d.duration, "rate": d.rate, "period": d.period, "harmonics": d.harmonics,
-            "velocity_cap": options.velocity, "zmp_margin": excitation.zmp_margin,
+    swing = swing_rows(robot, excitation.joints, (excitation.lower, excitation.upper), angles, speed, bounds,
+                       friction_by_group(robot.groups, THESIS_TARGETS), options.design.asked)
+    return {**_standing(robot, "biped on one foot", options.design, options.velocity),
+            "stance": SIDES[excitation.stance], "zmp_margin": excitation.zmp_margin,
             "clearance": excitation.clearance,
             "limits": {"zmp_margin": options.zmp_margin, "clearance": options.clearance}, "swing": swing}
+
+
+def tripod_document(robot: Robot, excitation: TripodExcitation, options: TripodOptions,
+                    bounds: Mapping[str, Mapping[str, float]]) -> dict[str, Any]:
+    """The JSON document of a quadruped on three feet: as :func:`stance_document`'s, with ``"kind": "quadruped on
+    three feet"``, ``"swing_foot"`` (the lifted foot's contact frame), ``"stance_feet"`` (the three others),
+    ``"base_height"`` [m], the margins ``"com_margin"``, ``"zmp_margin"`` (to the stance triangle's edges),
+    ``"clearance"`` (the swing foot's sphere above the ground), ``"spacing"`` (the swing leg to the others) [m] and
+    their ``"limits"``; ``bounds``: :func:`~wbfriction.excite.tripod.swing_bounds`' (the prior: the quadruped
+    simulators' default friction)."""
+    ref = excitation.reference
+    act = [robot.actuated.index(j) for j in excitation.joints]
+    swing = swing_rows(robot, excitation.joints, (excitation.lower, excitation.upper), ref.q[:, act],
+                       np.abs(ref.qd[:, act]), bounds, default_quadruped_friction(robot), options.design.asked)
+    limits = {n: getattr(options, n) for n in ("com_margin", "zmp_margin", "clearance", "spacing")}
+    return {**_standing(robot, "quadruped on three feet", options.design, options.velocity),
+            "swing_foot": robot.contact_frames[excitation.swing],
+            "stance_feet": [robot.contact_frames[c] for c in excitation.stance], "base_height": options.height,
+            **{n: float(getattr(excitation, n)) for n in limits}, "limits": limits, "swing": swing}

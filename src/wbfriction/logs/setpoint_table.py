@@ -16,7 +16,9 @@ motion that is a finite Fourier series (an arm's), its coefficients (``fourier``
 accelerations are exact. A humanoid standing on one foot (``excite --stance``) also says the foot stood on
 (``stance``: ``left`` or ``right``), and its series are the swing leg's only (``fourier.joints``: their names, n):
 the rest of the body follows from them (:mod:`wbfriction.sim.single_support`); without ``joints`` the series are
-of every actuated joint.
+of every actuated joint. A quadruped standing on three point feet (``excite --swing``) says the foot lifted
+(``swing``: its contact frame's name; the three others stand) and the base's height above the ground
+(``base_height`` [m]), its series the swing leg's (:mod:`wbfriction.sim.tripod_support`).
 """
 
 from __future__ import annotations
@@ -48,6 +50,8 @@ class SetpointTable:
         fourier_joints: the joints the series are of (the robot's actuated order): all where the metadata names
             none, none without series.
         stance: the foot stood on (``left``, ``right``): a humanoid's one-foot stance; else None.
+        swing: the foot lifted (its contact frame's name): a quadruped on three feet; else None.
+        base_height: a quadruped on three feet: its base's height above the ground [m]; else None.
     """
 
     source: str
@@ -59,6 +63,8 @@ class SetpointTable:
     fourier: dict | None = None
     fourier_joints: tuple[str, ...] = ()
     stance: str | None = None
+    swing: str | None = None
+    base_height: float | None = None
 
     @property
     def duration(self) -> float:
@@ -68,10 +74,12 @@ class SetpointTable:
 
 def setpoint_table(robot: str, joints: tuple[str, ...], time: np.ndarray, q_des: np.ndarray, qd_des: np.ndarray,
                    fourier: dict | None = None, fourier_joints: tuple[str, ...] | None = None,
-                   stance: str | None = None, **meta) -> pa.Table:
+                   stance: str | None = None, swing: str | None = None, base_height: float | None = None,
+                   **meta) -> pa.Table:
     """The table (module docstring) of the set-points ``q_des``, ``qd_des`` (N, n) [rad, rad/s] of ``joints`` at
     ``time`` (N,) [s]; ``fourier``: the series' coefficients, of ``fourier_joints`` (None: of ``joints``);
-    ``stance``: the foot a humanoid stands on; ``meta``: more metadata (JSON-able)."""
+    ``stance``: the foot a humanoid stands on; ``swing``, ``base_height``: the foot a quadruped lifts and its base's
+    height [m]; ``meta``: more metadata (JSON-able)."""
     columns = {"time": pa.array(np.asarray(time, dtype=float))}
     for i, j in enumerate(joints):
         columns[f"q_des.{j}"] = pa.array(np.asarray(q_des[:, i], dtype=float))
@@ -84,6 +92,8 @@ def setpoint_table(robot: str, joints: tuple[str, ...], time: np.ndarray, q_des:
             doc["fourier"]["joints"] = list(fourier_joints)
     if stance is not None:
         doc["stance"] = stance
+    if swing is not None:
+        doc["swing"], doc["base_height"] = swing, None if base_height is None else float(base_height)
     return with_metadata(pa.table(columns), doc)
 
 
@@ -96,7 +106,7 @@ def read_setpoint_table(path: str | Path, robot: Robot) -> SetpointTable:
             for some joints only, times not evenly spaced from 0.
         InputError: fewer than two rows; Fourier coefficients of another number of joints than they name (all
             the robot's where they name none), or of a joint the robot has not; a stance not ``left`` or
-            ``right``.
+            ``right``; a swing foot not one of the robot's contact frames, or without a base height > 0.
     """
     source = str(path)
     table = read_table(path)
@@ -136,4 +146,11 @@ def read_setpoint_table(path: str | Path, robot: Robot) -> SetpointTable:
             raise InputError(f"{source}: its Fourier coefficients are of {np.size(fourier.get('center'))} joints, {of}")
     if stance not in (None, "left", "right"):
         raise InputError(f"{source}: its stance {stance!r} is not 'left' or 'right'")
-    return SetpointTable(source, time, rate, robot.actuated, q_des, qd_des, fourier, series, stance)
+    swing, height = meta.get("swing"), meta.get("base_height")
+    if swing is not None and swing not in robot.contact_frames:
+        raise InputError(f"{source}: its swing foot {swing!r} is not one of robot '{robot.name}''s feet "
+                         f"({', '.join(robot.contact_frames)})")
+    if swing is not None and not (isinstance(height, (int, float)) and height > 0):
+        raise InputError(f"{source}: its swing foot {swing} without a base height > 0 (base_height: {height!r})")
+    return SetpointTable(source, time, rate, robot.actuated, q_des, qd_des, fourier, series, stance, swing,
+                         None if swing is None else float(height))

@@ -16,7 +16,11 @@ from wbfriction.sim.simulators.base import SimulationOutput, SimulationProgress,
 from wbfriction.walking.options import GaitOptions
 
 if TYPE_CHECKING:
+    import numpy as np
+
+    from wbfriction.logs.setpoint_table import SetpointTable
     from wbfriction.model.robot import Robot
+    from wbfriction.sim.arm import FourierTrajectory
     from wbfriction.walking.reference import WalkingReference
 
 IDEAL = IdealOptions()
@@ -68,33 +72,52 @@ def walk_gait(robot: Robot, values: Mapping[str, Any]) -> GaitOptions:
                        lift_height=values.get("lift_height", GAIT.lift_height))
 
 
+def played_series(table: SetpointTable) -> FourierTrajectory:
+    """The swing leg's series a set-points table holds (its ``fourier`` metadata; the caller checked it has one)."""
+    import numpy as np
+
+    from wbfriction.sim.arm import FourierTrajectory
+
+    f = table.fourier or {}
+    return FourierTrajectory(np.asarray(f["center"], dtype=float), np.asarray(f["a"], dtype=float),
+                             np.asarray(f["b"], dtype=float), float(f["omega"]))
+
+
+def check_played(robot: Robot, table: SetpointTable, angles: np.ndarray, what: str) -> None:
+    """Refuse a table whose ``q_des`` are more than 1e-6 rad from the rebuilt reference's ``angles`` (N, n_act)
+    [rad] (the model's; ``what`` names the reference: ``stance``).
+
+    Raises:
+        InputError: one joint's ``q_des`` that far (the table edited, or another robot's model).
+    """
+    import numpy as np
+
+    off = np.abs(angles + robot.offset_vector - table.q_des).max(axis=0)
+    if off.max() > 1e-6:
+        raise InputError(f"{table.source}: q_des.{robot.actuated[int(off.argmax())]} is {off.max():.2g} "
+                         f"rad from the {what} its series make: not as 'wbfriction excite' wrote it")
+
+
 def played_stance(robot: Robot, path: Path) -> WalkingReference:
     """The reference of a biped's one-foot stance that the set-points table at ``path`` holds (what ``excite
     --stance`` writes): rebuilt from its stance foot, its swing leg's series and its times
-    (:func:`~wbfriction.sim.single_support.single_support_reference`), checked against its ``q_des``.
+    (:func:`~wbfriction.sim.single_support.single_support_reference`), checked against its ``q_des``
+    (:func:`check_played`).
 
     Raises:
         InputError: what :func:`~wbfriction.logs.setpoint_table.read_setpoint_table` raises; a table without a
             stance or series; its ``q_des`` more than 1e-6 rad from the rebuilt reference (edited, or another
             robot's model).
     """
-    import numpy as np
-
     from wbfriction.logs.setpoint_table import read_setpoint_table
-    from wbfriction.sim.arm import FourierTrajectory
     from wbfriction.sim.single_support import SIDES, single_support_reference
 
     table = read_setpoint_table(path, robot)
     if table.stance is None or table.fourier is None:
         raise InputError(f"{path}: no stance foot or swing series: a biped plays what 'excite --stance' writes")
-    f = table.fourier
-    trajectory = FourierTrajectory(np.asarray(f["center"], dtype=float), np.asarray(f["a"], dtype=float),
-                                   np.asarray(f["b"], dtype=float), float(f["omega"]))
-    ref = single_support_reference(robot, SIDES.index(table.stance), table.fourier_joints, trajectory, table.time)
-    off = np.abs(robot.angles(ref.q) + robot.offset_vector - table.q_des).max(axis=0)
-    if off.max() > 1e-6:
-        raise InputError(f"{path}: q_des.{robot.actuated[int(off.argmax())]} is {off.max():.2g} rad from the stance "
-                         "its series make: not as 'wbfriction excite' wrote it")
+    ref = single_support_reference(robot, SIDES.index(table.stance), table.fourier_joints, played_series(table),
+                                   table.time)
+    check_played(robot, table, robot.angles(ref.q), "stance")
     return ref
 
 
