@@ -40,8 +40,8 @@ def test_a_design_written_then_played(cli, capsys, tmp_path):
 
 
 def test_what_cannot_be_designed_is_one_line_before_the_work(capsys, tmp_path):
-    code, _, err = run_cli_printed(capsys, "excite", "--robot", "go2_walking", "-o", tmp_path / "d.parquet")
-    assert code == 2 and "robot 'go2_walking' has a floating base on 4 feet: excite designs a biped's one-foot" in err
+    code, _, err = run_cli_printed(capsys, "excite", "--robot", "go2", "--swing", "FR", "-o", tmp_path / "d.parquet")
+    assert code == 2 and "--swing: robot 'go2' has a fixed base: it takes no floating base's option" in err
     code, _, err = run_cli_printed(capsys, "excite", "--robot", "go2", "--duration", "1", "-o", tmp_path / "d.parquet")
     assert code == 2 and "--duration 1: the design needs at least" in err
     code, _, err = run_cli_printed(capsys, "excite", "--robot", "go2", "--duration", "2", "--amplitude", "0.95",

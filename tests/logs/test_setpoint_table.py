@@ -77,3 +77,24 @@ def test_a_stances_series_and_foot_are_read_back(go2, tmp_path, suffix):
     write_table(setpoint_table(go2.name, go2.actuated, time, q, q, stance="both"), path)
     with pytest.raises(InputError, match="its stance 'both' is not 'left' or 'right'"):
         read_setpoint_table(path, go2)
+
+
+@pytest.mark.parametrize("suffix", [".parquet", ".csv"])
+def test_a_three_feet_stances_swing_foot_and_height_are_read_back(tmp_path, suffix):
+    """A quadruped's three-feet stance (``excite --swing``): the foot lifted, one of the robot's, and the base's
+    height, which the stance needs to be rebuilt."""
+    go2 = wbfriction.load_robot("go2_walking")
+    time = np.arange(10) / 500.0
+    q = np.zeros((10, go2.n_act))
+    series = {"center": [0.1], "a": [[0.3]], "b": [[0.2]], "omega": 1.5}
+    path = tmp_path / f"tripod{suffix}"
+    write_table(setpoint_table(go2.name, go2.actuated, time, q, q, series, fourier_joints=go2.actuated[3:4],
+                               swing="FR_foot", base_height=0.3), path)
+    read = read_setpoint_table(path, go2)
+    assert (read.swing, read.base_height, read.stance, read.fourier_joints) == ("FR_foot", 0.3, None, ("FR_hip_joint",))
+    for swing, height, line in [("FR", 0.3, "its swing foot 'FR' is not one of robot 'go2_walking''s feet (FL_foot, "),
+                                ("RL_foot", None, "its swing foot RL_foot without a base height > 0"),
+                                ("RL_foot", -0.1, "its swing foot RL_foot without a base height > 0")]:
+        write_table(setpoint_table(go2.name, go2.actuated, time, q, q, swing=swing, base_height=height), path)
+        with pytest.raises(InputError, match=line.replace("(", r"\(")):
+            read_setpoint_table(path, go2)
