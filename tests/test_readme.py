@@ -118,6 +118,9 @@ EXPECTED = {
     # TALOS on one foot: the ZMP of the designed stance well inside the stance sole (its edges 10 mm at the least)
     "wbfriction excite --robot talos --stance left -o talos_stance.parquet --json talos_stance.json --figure "
     "talos_stance.png": [r"^ZMP [2-9]\d\.\d mm inside the left sole's edges \(at least 10\)"],
+    # the Go2 on three feet: its centre of mass and ZMP near the stance triangle's inradius (104 mm) from its edges
+    "wbfriction excite --robot go2_walking --swing FR -o go2_tripod.parquet --json go2_tripod.json --figure "
+    "go2_tripod.png": [r"^centre of mass 10\d\.\d mm \(at least 50\) and ZMP \d{2,3}\.\d mm \(at least 30\)"],
     # what to record next after the real Aliengo's log: every parameter predicted ok under its model
     "wbfriction excite --config aliengo_identified.toml --after aliengo_params.json -o aliengo_next.parquet --json "
     "aliengo_next.json --figure aliengo_next.png": [r"^worst: \w+ \w+, 0\.[0-5]\d of its limit",
@@ -145,7 +148,8 @@ PRINTS = {
                                   r"the prediction$",
                                   # TALOS on one foot, its swing leg's friction recovered (issue 66: within 2 %)
                                   r"^swing leg: 6 joints, F_c and F_v within [01]\.\d\d % of the truth$",
-                                  # the Go2 on three feet, its front right leg's friction recovered (within 2 %)
+                                  # the Go2 on three feet, played from the table excite wrote, its front right leg's
+                                  # friction recovered (within 2 %)
                                   r"^swing leg FR: 3 joints, F_c and F_v within [01]\.\d\d % of the truth$"],
     "docs/how-to/library.md": [r"leg_right_4_joint: F_c"],  # the API block's fits of the walk
     "docs/extending.md": [r"^arm\.tsv: 10000 samples, tau_f of 7 joints$",  # a log format registered, read

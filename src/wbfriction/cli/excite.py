@@ -146,10 +146,10 @@ def _excite_floating(ctx: typer.Context, r, paths: tuple[list[Path], Path | None
     refuse_unread(ctx, f"robot '{r.name}' is a biped", QUADRUPED_ONLY, "quadruped's")
     from wbfriction.excite.stance import StanceOptions
 
-    options = ExciteOptions(duration=BIPED_DURATION if duration is None else duration, rate=rate or ARM_RATE,
-                            period=period or BIPED_PERIOD, harmonics=StanceOptions().design.harmonics,
-                            range_share=1.0, seed=seed)
-    _excite_biped(r, *paths, StanceOptions(stance=stance or "left", design=options))
+    excite = ExciteOptions(duration=BIPED_DURATION if duration is None else duration, rate=rate or ARM_RATE,
+                           period=period or BIPED_PERIOD, harmonics=StanceOptions().design.harmonics,
+                           range_share=1.0, seed=seed)
+    _excite_biped(r, *paths, StanceOptions(stance=stance or "left", design=excite))
 
 
 def _candidates(total: int, what: str):

@@ -153,4 +153,4 @@ def read_setpoint_table(path: str | Path, robot: Robot) -> SetpointTable:
     if swing is not None and not (isinstance(height, (int, float)) and height > 0):
         raise InputError(f"{source}: its swing foot {swing} without a base height > 0 (base_height: {height!r})")
     return SetpointTable(source, time, rate, robot.actuated, q_des, qd_des, fourier, series, stance, swing,
-                         None if swing is None else float(height))
+                         float(height) if swing is not None and height is not None else None)
