@@ -69,7 +69,7 @@ def excite(ctx: typer.Context,
            velocity: bool = typer.Option(PD_EXCITE.velocity, help="Hung: send qd_des = the set-points' slope "
                                                                   "(default: zeros, as most drivers are sent)."),
            seed: int = typer.Option(PD_EXCITE.seed, help="Seed of the ramps' levels and times (hung), of the "
-                                                         "design's starts (an arm, a biped's swing joints)."),
+                                                         "design's starts (an arm, a swing leg's joints)."),
            period: Optional[float] = typer.Option(None, help=f"An arm or a swing leg: the Fourier series' period [s] "
                                                              f"(default {ARM_PERIOD:g} an arm, {BIPED_PERIOD:g} a "
                                                              "biped or a quadruped); the recording holds a whole "
@@ -127,29 +127,27 @@ def _excite_floating(ctx: typer.Context, r, paths: tuple[list[Path], Path | None
         InputError: a floating base of another kind; an option of the other kind.
     """
     from wbfriction.excite.design import ExciteOptions
+    from wbfriction.excite.stance import StanceOptions
+    from wbfriction.excite.tripod import TripodOptions
 
-    duration, rate, period, seed = design
     feet = len(r.contact_frames)
-    if r.partial_contacts and feet == 4:
+    quadruped = bool(r.partial_contacts) and feet == 4
+    if quadruped:
         refuse_unread(ctx, f"robot '{r.name}' is a quadruped on {r.stands_on}", BIPED_ONLY, "biped's")
-        from wbfriction.excite.tripod import TripodOptions
-
-        harmonics, rate = TripodOptions().design.harmonics, rate or QUADRUPED_RATE
-        options = TripodOptions(swing=swing or "FR", design=ExciteOptions(
-            duration=BIPED_DURATION if duration is None else duration, rate=rate, period=period or BIPED_PERIOD,
-            harmonics=harmonics, range_share=1.0, seed=seed))
-        _excite_quadruped(r, *paths, options)
-        return
-    if r.partial_contacts or feet != 2:
+    elif r.partial_contacts or feet != 2:
         raise InputError(f"robot '{r.name}' has a floating base on {feet} {r.stands_on}: excite designs a biped's "
                          "one-foot stance or a quadruped's on three point feet")
-    refuse_unread(ctx, f"robot '{r.name}' is a biped", QUADRUPED_ONLY, "quadruped's")
-    from wbfriction.excite.stance import StanceOptions
-
-    excite = ExciteOptions(duration=BIPED_DURATION if duration is None else duration, rate=rate or ARM_RATE,
-                           period=period or BIPED_PERIOD, harmonics=StanceOptions().design.harmonics,
-                           range_share=1.0, seed=seed)
-    _excite_biped(r, *paths, StanceOptions(stance=stance or "left", design=excite))
+    else:
+        refuse_unread(ctx, f"robot '{r.name}' is a biped", QUADRUPED_ONLY, "quadruped's")
+    duration, rate, period, seed = design
+    kind = TripodOptions() if quadruped else StanceOptions()
+    excite = ExciteOptions(duration=BIPED_DURATION if duration is None else duration,
+                           rate=rate or (QUADRUPED_RATE if quadruped else ARM_RATE), period=period or BIPED_PERIOD,
+                           harmonics=kind.design.harmonics, range_share=1.0, seed=seed)
+    if quadruped:
+        _excite_quadruped(r, *paths, TripodOptions(swing=swing or "FR", design=excite))
+    else:
+        _excite_biped(r, *paths, StanceOptions(stance=stance or "left", design=excite))
 
 
 def _candidates(total: int, what: str):
