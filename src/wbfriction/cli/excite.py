@@ -8,7 +8,18 @@ from typing import TYPE_CHECKING, Optional
 import typer
 from rich.table import Table
 
-from wbfriction.cli.common import ConfigOpt, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, refuse_unread, robot_of
+from wbfriction.cli.common import (
+    ConfigOpt,
+    MjcfOpt,
+    RobotOpt,
+    UrdfOpt,
+    app,
+    console,
+    out,
+    print_whole,
+    refuse_unread,
+    robot_of,
+)
 from wbfriction.exceptions import InputError
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
@@ -253,7 +264,7 @@ def _print_next(following, after: Path) -> None:
             p = predicted.get(name)  # an arm's fit predicted to fail has none
             cells += [f"{value:.3f} ± {se:.2g}", "-" if p is None else f"{p.value:.3f} ± {p.se:.2g}"]
         table.add_row(joint, logged.status, *cells)
-    out.print(table)
+    print_whole(table)  # a few rows, none of their numbers cut
     held = [j for j in design.joints if j not in design.moving]
     out.print(f"held at their posture (their fits ok): {', '.join(held) if held else 'none'}; prior friction from "
               f"the fit on {len(following.prior_from_fit)} joints, the simulator's default on the others",

@@ -101,7 +101,7 @@ def arm_document(design: ArmDesign) -> dict[str, Any]:
     }
 
 
-def next_document(following: NextRecording, params: str) -> dict[str, Any]:
+def next_document(following: NextRecording[PdDesign] | NextRecording[ArmDesign], params: str) -> dict[str, Any]:
     """The ``after`` entry of a design's document (module docstring) made after the log whose parameters file is
     ``params`` (:mod:`~wbfriction.excite.next`): the joints moved and held, those whose prior is their fit, and per
     moving joint what the log's fit gave (its status and reason, each compared parameter's value and the standard

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from typing import Generic, TypeVar
 
 import numpy as np
 
@@ -44,6 +45,7 @@ ARMATURE_PRIOR = 0.01
 """The armature prior [kg·m^2] of a robot whose TOML gives none (a quadruped's knee drive's order of size)."""
 COMPARED = ("F_v", "F_c")
 """The parameters a log's fit and the design's identification both give, compared."""
+Design = TypeVar("Design", PdDesign, ArmDesign)
 
 
 @dataclass(frozen=True)
@@ -57,7 +59,7 @@ class Logged:
 
 
 @dataclass(frozen=True)
-class NextRecording:
+class NextRecording(Generic[Design]):
     """The motion to record next (module docstring).
 
     Attributes:
@@ -66,7 +68,7 @@ class NextRecording:
         prior_from_fit: the joints whose prior is their fitted friction (the others: the simulator's default).
     """
 
-    design: PdDesign | ArmDesign
+    design: Design
     logged: dict[str, Logged]
     prior_from_fit: tuple[str, ...]
 
@@ -138,7 +140,7 @@ def logged_all(fits: Mapping[str, FitResult], moving: tuple[str, ...]) -> dict[s
 def record_next(robot: Robot, fits: Mapping[str, FitResult], source: str,
                 options: PdExciteOptions = PdExciteOptions(),
                 identification: ActuatorOptions = ActuatorOptions(),
-                progress: Progress | None = None) -> NextRecording:
+                progress: Progress | None = None) -> NextRecording[PdDesign]:
     """The motion to record next on a hung PD-driven ``robot`` after a log whose fits are ``fits`` (module
     docstring); ``source``: the parameters file, for errors.
 
@@ -150,12 +152,12 @@ def record_next(robot: Robot, fits: Mapping[str, FitResult], source: str,
     prior, from_fit = prior_of(robot, fits, default_hung_friction(robot))
     design = design_pd(with_armature(robot), options, prior, identification, progress,  # type: ignore[arg-type]
                        moving=moving)
-    return NextRecording(design, logged_all(fits, moving), from_fit)
+    return NextRecording[PdDesign](design, logged_all(fits, moving), from_fit)
 
 
 def record_next_arm(robot: Robot, fits: Mapping[str, FitResult], source: str,
                     options: ExciteOptions = ExciteOptions(), recording: ArmOptions = REAL_ARM,
-                    progress: Progress | None = None) -> NextRecording:
+                    progress: Progress | None = None) -> NextRecording[ArmDesign]:
     """The motion to record next on a fixed-base arm ``robot`` (torque-measured joints) after a log whose fits are
     ``fits`` (module docstring); ``source``: the parameters file, for errors. ``options`` and ``recording``: as
     :func:`~wbfriction.excite.arm_design.design_arm` takes them.
@@ -168,4 +170,4 @@ def record_next_arm(robot: Robot, fits: Mapping[str, FitResult], source: str,
     moving = undetermined(robot, fits, source)
     prior, from_fit = prior_of(robot, fits, default_arm_friction(robot))
     design = design_arm(robot, options, prior, recording, progress, moving=moving)
-    return NextRecording(design, logged_all(fits, moving), from_fit)
+    return NextRecording[ArmDesign](design, logged_all(fits, moving), from_fit)
