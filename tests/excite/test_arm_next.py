@@ -14,7 +14,9 @@ import numpy as np
 import pytest
 
 import wbfriction
-from wbfriction.excite.predict_arm import REAL_ARM, identify_arm
+from wbfriction.exceptions import InputError
+from wbfriction.excite.design import ExciteOptions, design_excitation
+from wbfriction.excite.predict_arm import REAL_ARM, identify_arm, sensor_noise
 from wbfriction.fit.params_file import read_params
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.setpoint_table import read_setpoint_table
@@ -29,8 +31,6 @@ from wbfriction.sim.arm import (
     excitation_trajectory,
     simulate_arm,
 )
-
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite")]
 
 WRIST = ("panda_joint5", "panda_joint6", "panda_joint7")
 DURATION = 10.0
@@ -58,6 +58,8 @@ def first(tmp_path_factory):
     return panda, truth, folder
 
 
+@pytest.mark.slow
+@pytest.mark.xdist_group("excite")
 def test_the_wrist_held_still_is_recorded_next_and_determined(first, cli, tmp_path):
     panda, truth, folder = first
     fits = read_params(folder / "params.json")
@@ -66,7 +68,8 @@ def test_the_wrist_held_still_is_recorded_next_and_determined(first, cli, tmp_pa
     assert {fits[j].verdict().status for j in WRIST} == {"not excited"}
 
     out = " ".join(cli("excite", "--robot", "panda", "--after", folder / "params.json", "--duration", DURATION,
-                       "--period", DURATION, "-o", tmp_path / "next.csv", "--json", tmp_path / "next.json").split())
+                       "--period", DURATION, "-o", tmp_path / "next.csv", "--json", tmp_path / "next.json",
+                       "--figure", tmp_path / "next.png").split())
     assert "held at their posture (their fits ok): panda_joint1, panda_joint2, panda_joint3, panda_joint4" in out
     assert "prior friction from the fit on 4 joints" in out  # the shoulder's and elbow's fits: ok, their priors
     doc = json.loads((tmp_path / "next.json").read_text())
@@ -75,6 +78,7 @@ def test_the_wrist_held_still_is_recorded_next_and_determined(first, cli, tmp_pa
     assert {after["logged"][j]["status"] for j in WRIST} == {"not excited"}
     assert set(doc["predicted"]) == set(WRIST) and min(doc["margins"][j]["torque"] for j in panda.actuated) >= 0.2
 
+    assert (tmp_path / "next.png").stat().st_size > 10_000
     table = read_setpoint_table(tmp_path / "next.csv", panda)
     still = [panda.actuated.index(j) for j in panda.actuated if j not in WRIST]
     assert np.ptp(table.q_des[:, still], axis=0).max() == 0.0
@@ -90,3 +94,23 @@ def test_the_wrist_held_still_is_recorded_next_and_determined(first, cli, tmp_pa
         for name in ("F_c", "F_v"):
             error = abs(getattr(fit.params, name) - getattr(truth[fit.joint], name))
             assert error < 2 * read[name], (fit.joint, name, error, read[name])
+
+
+def test_a_design_holds_the_joints_it_does_not_move():
+    """The held joints' series are constants at the middle of their range, their velocity margin whole; the bounds
+    and shares are the moving joint's alone; a joint the robot does not have, or none, is refused."""
+    panda = wbfriction.load_robot("panda")
+    prior, noise = default_arm_friction(panda), sensor_noise(panda)
+    options = ExciteOptions(duration=2.0, period=2.0, starts=1)
+    design = design_excitation(panda, prior, noise, options, moving=["panda_joint7"])
+    lower, upper = panda.angle_limits
+    t = design.trajectory
+    np.testing.assert_array_equal(t.center[:6], 0.5 * (lower + upper)[:6])
+    assert not np.any(t.a[:6]) and not np.any(t.b[:6]) and np.any(t.a[6])
+    assert design.moving == ("panda_joint7",) and set(design.shares) == set(design.bound) == {"panda_joint7"}
+    np.testing.assert_array_equal(design.margins.velocity[:6], 1.0)
+    assert design.margins.torque.min() >= 1.0 - options.torque_share  # the held joints' gravity within the limit
+    with pytest.raises(InputError, match="robot 'panda': no actuated joint 'elbow' to move"):
+        design_excitation(panda, prior, noise, options, moving=["elbow"])
+    with pytest.raises(InputError, match="robot 'panda': no joint to move"):
+        design_excitation(panda, prior, noise, options, moving=[])
