@@ -71,9 +71,9 @@ def test_the_statistical_standard_errors_are_those_predicted_within_a_factor_1_5
 
 
 @pytest.mark.xfail(strict=True, reason="the standard error a user reads holds the family spread and the Stribeck and "
-                   "transition parameters' (S, v_s, a), which the noise sets anew in each recording: measured on 30 s: 72 % "
-                   "(designed) and 56 % (random) of the parameters within 1.5x, medians 1.07 and 0.98, ratios "
-                   "0.2-3.7")
+                   "transition parameters' (S, v_s, a), which the noise sets anew in each recording: measured on "
+                   "30 s: 72 % (designed) and 56 % (random) of the parameters within 1.5x, medians 1.07 and 0.98, "
+                   "ratios 0.2-3.7")
 @pytest.mark.slow
 def test_every_read_standard_error_is_that_predicted_within_a_factor_1_5(runs):
     for motion, (prediction, fits) in runs.items():
