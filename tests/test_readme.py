@@ -125,6 +125,12 @@ EXPECTED = {
     "wbfriction excite --config aliengo_identified.toml --after aliengo_params.json -o aliengo_next.parquet --json "
     "aliengo_next.json --figure aliengo_next.png": [r"^worst: \w+ \w+, 0\.[0-5]\d of its limit",
                                                    r"^held at their posture \(their fits ok\): none"],
+    # what to record next after a Panda's log whose wrist held still: the wrist alone moves, predicted ok
+    "wbfriction excite --robot panda --after panda_wrist_still_params.json --duration 10 --period 10 -o "
+    "panda_next.parquet --json panda_next.json": [r"worst: panda_joint[567] F_[cv], 0\.0\d\d of its limit",
+                                                r"^ panda_joint[567]\s+not excited\s", r"^held at their posture "
+                                                r"\(their fits ok\): panda_joint1, panda_joint2, panda_joint3,"
+                                                r"\s+panda_joint4;"],
     "python examples/fleet_trends.py --output fleet": [  # arm 1's joint 4 alone, from the day its wear began
         r"^24 logs processed on Dask, 0 already done$",
         r"^drift: arm-1 panda_joint4 \S+ \+\d+ % from 2026-01-1[0-4]$",  # worn from the 8th log, Jan 12

@@ -70,6 +70,6 @@ def test_an_arms_design_written_then_played(cli, capsys, tmp_path):
     assert played.num_rows == 4000
     q = played.column("q.panda_joint4").to_numpy()
     assert np.max(np.abs(q - table.q_des[:, 3])) < 0.01  # the arm tracks the design (its PD at 10 Hz bandwidth)
-    code, _, err = run_cli_printed(capsys, "excite", "--robot", "panda", "--after", tmp_path / "arm.json", "-o",
+    code, _, err = run_cli_printed(capsys, "excite", "--robot", "panda", "--amplitude", "0.5", "-o",
                                    tmp_path / "x.csv")
-    assert code == 2 and "--after: robot 'panda' is a fixed-base arm: it takes no hung PD-driven robot's option" in err
+    assert code == 2 and "--amplitude: robot 'panda' is a fixed-base arm: it takes no hung PD-driven robot's" in err

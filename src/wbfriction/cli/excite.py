@@ -8,7 +8,18 @@ from typing import TYPE_CHECKING, Literal, Optional
 import typer
 from rich.table import Table
 
-from wbfriction.cli.common import ConfigOpt, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, refuse_unread, robot_of
+from wbfriction.cli.common import (
+    ConfigOpt,
+    MjcfOpt,
+    RobotOpt,
+    UrdfOpt,
+    app,
+    console,
+    out,
+    print_whole,
+    refuse_unread,
+    robot_of,
+)
 from wbfriction.exceptions import InputError
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
@@ -16,11 +27,11 @@ from wbfriction.exceptions import InputError
 from wbfriction.excite.options import ARM_PERIOD, ARM_RATE, PD_EXCITE, PdExciteOptions
 from wbfriction.pipeline.paths import check_paths
 
-HUNG_ONLY = ("amplitude", "velocity", "after")
+HUNG_ONLY = ("amplitude", "velocity")
 """The options only a hung PD-driven robot's design reads: refused for an arm."""
 ARM_ONLY = ("period",)
 """The options only an arm's design reads: refused for a hung PD-driven robot."""
-FIXED_ONLY = (*HUNG_ONLY, "torque_share")
+FIXED_ONLY = (*HUNG_ONLY, "torque_share", "after")
 """The options only a fixed base's designs read: refused for a floating base."""
 BIPED_ONLY = ("stance",)
 """The options only a biped's design reads: refused for a quadruped."""
@@ -82,10 +93,12 @@ def excite(ctx: typer.Context,
                                                           "default FR) or its foot frame's, while it stands on the "
                                                           "other three."),
            after: Optional[Path] = typer.Option(None, "--after",
-                                                help="Hung: what to record next, after a log whose parameters JSON "
+                                                help="What to record next, after a log whose parameters JSON "
                                                      "'fit' wrote: only the joints whose fit is not ok move (the "
-                                                     "others are held), with their fitted friction as the prior; "
-                                                     "the log's errors are printed beside the predicted ones."),
+                                                     "others are held: hung, at their posture; an arm, at the "
+                                                     "middle of their range), with their fitted friction as the "
+                                                     "prior where it can be one; the log's values and errors are "
+                                                     "printed beside the predicted ones (and in --json)."),
            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
            mjcf: Optional[Path] = MjcfOpt) -> None:
     """Design the motion to record so that its identification determines every parameter: on a hung PD-driven
@@ -107,8 +120,8 @@ def excite(ctx: typer.Context,
     duration = PD_EXCITE.duration if duration is None else duration
     if r.pd is None:
         refuse_unread(ctx, f"robot '{r.name}' is a fixed-base arm", HUNG_ONLY, "hung PD-driven robot's")
-        _excite_arm(r, output, prediction, figure, duration, rate or ARM_RATE, period or ARM_PERIOD, torque_share,
-                    seed)
+        _excite_arm(r, output, prediction, figure, duration, rate or ARM_RATE, period or ARM_PERIOD,
+                    torque_share, seed, after)
         return
     refuse_unread(ctx, f"robot '{r.name}' is a hung PD-driven robot", ARM_ONLY, "arm's")
     options = PdExciteOptions(duration=duration, rate=rate or PD_EXCITE.rate, amplitudes=tuple(amplitude),
@@ -163,15 +176,11 @@ def _candidates(total: int, what: str):
 
 def _excite_pd(r, output: list[Path], prediction: Path | None, figure: Path | None, options: PdExciteOptions,
                after: Path | None) -> None:
-    from wbfriction.excite.document import pd_document, pd_setpoints
+    from wbfriction.excite.document import next_document, pd_document, pd_setpoints
     from wbfriction.excite.pd_design import design_pd
     from wbfriction.logs.tables import write_json, write_table
 
-    fits = None
-    if after is not None:
-        from wbfriction.fit.params_file import read_robot_params
-
-        fits = read_robot_params(after, r.name, r.actuated, r.urdf)
+    fits = _read_after(r, after)
     status, advance = _candidates(len(options.amplitudes) + len(options.reversals) - 1, "candidate")
     with status:
         if fits is None:
@@ -185,6 +194,8 @@ def _excite_pd(r, output: list[Path], prediction: Path | None, figure: Path | No
     for path in output:
         write_table(table, path)
     doc = pd_document(design)
+    if fits is not None and after is not None:
+        doc["after"] = next_document(following, str(after))
     if prediction is not None:
         write_json(prediction, doc)
     if figure is not None:
@@ -195,24 +206,42 @@ def _excite_pd(r, output: list[Path], prediction: Path | None, figure: Path | No
     _wrote(output, prediction, figure)
 
 
+def _read_after(r, after: Path | None):
+    """The fits of the parameters file ``--after`` names, for robot ``r`` (None without it)."""
+    if after is None:
+        return None
+    from wbfriction.fit.params_file import read_robot_params
+
+    return read_robot_params(after, r.name, r.actuated, r.urdf)
+
+
 def _excite_arm(r, output: list[Path], prediction: Path | None, figure: Path | None, duration: float, rate: float,
-                period: float, torque_share: float, seed: int) -> None:
+                period: float, torque_share: float, seed: int, after: Path | None) -> None:
     from wbfriction.excite.arm_design import design_arm
     from wbfriction.excite.design import ExciteOptions
-    from wbfriction.excite.document import arm_document, arm_setpoints
+    from wbfriction.excite.document import arm_document, arm_setpoints, next_document
+    from wbfriction.excite.next import record_next_arm, undetermined
     from wbfriction.fit.status import WEAK
     from wbfriction.logs.tables import write_json, write_table
     from wbfriction.report.excite import excite_figure
 
     options = ExciteOptions(duration=duration, rate=rate, period=period, torque_share=torque_share, seed=seed)
-    status, advance = _candidates(r.n_act, "joint")
+    fits = _read_after(r, after)
+    following = None
+    status, advance = _candidates(r.n_act if fits is None else len(undetermined(r, fits, str(after))), "joint")
     with status:
-        design = design_arm(r, options, progress=advance)
+        if fits is None:
+            design = design_arm(r, options, progress=advance)
+        else:
+            following = record_next_arm(r, fits, str(after), options, progress=advance)
+            design = following.design
         status.update("predicting what estimate and fit will report (two simulated recordings)")
     table = arm_setpoints(design, r.offset_vector)
     for path in output:
         write_table(table, path)
     doc = arm_document(design)
+    if following is not None:
+        doc["after"] = next_document(following, str(after))
     if prediction is not None:
         write_json(prediction, doc)
     shares = _shares(doc)
@@ -233,6 +262,8 @@ def _excite_arm(r, output: list[Path], prediction: Path | None, figure: Path | N
     w = doc["worst"]
     out.print(f"least margin to a limit {design.design.margins.least():.0%}; worst: {w['joint']} {w['parameter']}, "
               f"{w['share']:.3f} of its limit (below 1: predicted ok)", highlight=False)
+    if following is not None and after is not None:
+        _print_next(following, after)
     _wrote(output, prediction, figure)
 
 
@@ -369,14 +400,14 @@ def _print_next(following, after: Path) -> None:
         table.add_column(f"{name} log [{UNITS[name]}]", justify="right")
         table.add_column(f"{name} next [{UNITS[name]}]", justify="right")
     for joint, logged in following.logged.items():
-        predicted = design.prediction.joints[joint]
+        predicted = design.prediction.joints.get(joint, {})
         cells = []
         for name in COMPARED:
             value, se = logged.values.get(name, (float("nan"), float("nan")))
-            p = predicted[name]
-            cells += [f"{value:.3f} ± {se:.2g}", f"{p.value:.3f} ± {p.se:.2g}"]
+            p = predicted.get(name)  # an arm's fit predicted to fail has none
+            cells += [f"{value:.3f} ± {se:.2g}", "-" if p is None else f"{p.value:.3f} ± {p.se:.2g}"]
         table.add_row(joint, logged.status, *cells)
-    out.print(table)
+    print_whole(table)  # a few rows, none of their numbers cut
     held = [j for j in design.joints if j not in design.moving]
     out.print(f"held at their posture (their fits ok): {', '.join(held) if held else 'none'}; prior friction from "
               f"the fit on {len(following.prior_from_fit)} joints, the simulator's default on the others",

@@ -11,7 +11,7 @@ errors are 2-16 times it (:mod:`.predict_arm`), so the prediction printed and wr
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -34,6 +34,8 @@ class ArmDesign:
         time: the samples' times (N,) [s]; q_des, qd_des: the trajectory's angles and velocities there (N, n)
             [rad, rad/s], the model's (an arm's encoders read them less its ``[encoder_offset]``, 0 unless given).
         recording: the sensors the prediction took.
+
+    A design that holds joints (:attr:`moving`) predicts the moving joints' identification only.
     """
 
     design: ExcitationDesign
@@ -49,10 +51,20 @@ class ArmDesign:
         t = self.design.trajectory
         return {"center": t.center, "a": t.a, "b": t.b, "omega": t.omega}
 
+    @property
+    def joints(self) -> tuple[str, ...]:
+        """The joints of the design (the robot's actuated order)."""
+        return self.design.joints
+
+    @property
+    def moving(self) -> tuple[str, ...]:
+        """The joints it moves (the others held at the middle of their range)."""
+        return self.design.moving
+
 
 def design_arm(robot: Robot, options: ExciteOptions = ExciteOptions(),
                prior: Mapping[str, ModelParamsBase] | None = None, recording: ArmOptions = REAL_ARM,
-               progress: Progress | None = None) -> ArmDesign:
+               progress: Progress | None = None, moving: Collection[str] | None = None) -> ArmDesign:
     """Design a fixed-base arm's excitation and predict its identification (module docstring).
 
     Args:
@@ -62,14 +74,17 @@ def design_arm(robot: Robot, options: ExciteOptions = ExciteOptions(),
         recording: the sensors the prediction simulates (:data:`~.predict_arm.REAL_ARM`), at the design's duration
             and rate.
         progress: told of each joint designed.
+        moving: the joints to move (None: every one); the others are held at the middle of their range
+            (:func:`~.design.design_excitation`), and only the moving joints' identification is predicted.
 
     Raises:
         InputError: what :func:`~.design.design_excitation` and :func:`~.predict_arm.predict_arm` raise.
     """
     prior = dict(default_arm_friction(robot) if prior is None else prior)
     recording = replace(recording, duration=options.duration, rate=options.rate)
-    design = design_excitation(robot, prior, sensor_noise(robot, recording), options, progress)
-    prediction = predict_arm(robot, prior, design.trajectory, recording)  # type: ignore[arg-type]
+    design = design_excitation(robot, prior, sensor_noise(robot, recording), options, progress, moving)
+    prediction = predict_arm(robot, prior, design.trajectory, recording,  # type: ignore[arg-type]
+                             joints=None if moving is None else design.moving)
     time = options.times()
     q, qd, _ = design.trajectory(time)
     return ArmDesign(design, prediction, time, q, qd, recording)

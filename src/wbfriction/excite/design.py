@@ -9,11 +9,16 @@ and velocity limits (:mod:`.limits`), then checked against its torque limit.
 (SciPy's SLSQP; the epigraph makes the largest ``rho`` smooth), from :attr:`ExciteOptions.starts` seeded starts, the
 best kept. The torque the whole motion asks (:func:`~.limits.inverse_dynamics`) is checked afterwards: where it
 passes :attr:`ExciteOptions.torque_share` of a limit, every joint's velocity share is lowered and the design redone.
+
+**Held joints.** A design may move some joints only (``moving``: what a log left undetermined,
+:mod:`wbfriction.excite.next`): the others are held at the middle of their range (their series a constant), the
+torque check reads every joint (a held joint's gravity and the moving ones' reaction included), and the bounds and
+shares are the moving joints' alone.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -93,8 +98,10 @@ class ExcitationDesign:
         bound: per joint, each parameter's Cramér-Rao bound [its unit] on the designed motion.
         shares: per joint, each asked parameter's ``rho`` (:func:`~.information.limit_shares`): below 1, ``ok``
             at best.
-        margins: how far inside its limits the motion stays.
+        margins: how far inside its limits the motion stays (a held joint's: 1 for its velocity, its posture's
+            distance to its limits for its position).
         prior: per joint, the friction the bounds are taken at.
+        moving: the joints the design moves (``bound`` and ``shares`` are theirs); the others are held.
     """
 
     robot: str
@@ -105,6 +112,7 @@ class ExcitationDesign:
     shares: dict[str, dict[str, float]]
     margins: Margins
     prior: dict[str, ModelParamsBase] = field(repr=False)
+    moving: tuple[str, ...] = ()
 
     def worst(self) -> float:
         """The largest ``rho`` of any joint and parameter asked."""
@@ -171,7 +179,8 @@ def _inside(space: FourierSpace, z: np.ndarray, middle: float, half: float, velo
 
 
 def design_excitation(robot: Robot, prior: Mapping[str, ModelParamsBase], noise: Mapping[str, NoiseModel],
-                      options: ExciteOptions = ExciteOptions(), progress: Progress | None = None) -> ExcitationDesign:
+                      options: ExciteOptions = ExciteOptions(), progress: Progress | None = None,
+                      moving: Collection[str] | None = None) -> ExcitationDesign:
     """The excitation of every actuated joint of a fixed-base robot whose torque is measured (module docstring).
 
     Args:
@@ -180,10 +189,13 @@ def design_excitation(robot: Robot, prior: Mapping[str, ModelParamsBase], noise:
         noise: per joint, its friction estimate's noise (the torque's and the positions', its inertia, the period).
         options: :class:`ExciteOptions`.
         progress: told of each joint designed.
+        moving: the joints to move (None: every one); the others are held at the middle of their range (module
+            docstring).
 
     Raises:
         InputError: a floating-base robot, a joint without prior or noise, or without limits
-            (:meth:`~.limits.JointLimits.of`); a parameter asked for that its prior's family has not.
+            (:meth:`~.limits.JointLimits.of`); a parameter asked for that its prior's family has not; ``moving``
+            empty or naming a joint the robot does not actuate.
     """
     if robot.floating_base:
         raise InputError(f"robot '{robot.name}' has a floating base: excite designs a fixed-base robot's motion here")
@@ -194,11 +206,16 @@ def design_excitation(robot: Robot, prior: Mapping[str, ModelParamsBase], noise:
         unknown = [p for p in options.asked if p != "tau_os" and p not in type(prior[j]).names]
         if unknown:
             raise InputError(f"--asked {unknown[0]}: not a parameter of joint '{j}''s {prior[j].model} prior")
+    moved = robot.actuated if moving is None else tuple(j for j in robot.actuated if j in set(moving))
+    unknown = sorted(set(moving or ()) - set(robot.actuated))
+    if unknown or not moved:
+        raise InputError(f"robot '{robot.name}': " + (f"no actuated joint '{unknown[0]}' to move" if unknown
+                                                       else "no joint to move"))
     limits = JointLimits.of(robot)
     space = FourierSpace(1, options.harmonics, options.omega)
     share = options.velocity_share
     for _ in range(4):
-        design = _design(robot, prior, noise, options, limits, space, share, progress)
+        design = _design(robot, prior, noise, options, limits, space, share, progress, moved)
         if design.margins.torque.min() >= 1.0 - options.torque_share:
             return design
         share *= SHRINK
@@ -208,11 +225,14 @@ def design_excitation(robot: Robot, prior: Mapping[str, ModelParamsBase], noise:
 
 def _design(robot: Robot, prior: Mapping[str, ModelParamsBase], noise: Mapping[str, NoiseModel],
             options: ExciteOptions, limits: JointLimits, space: FourierSpace, share: float,
-            progress: Progress | None) -> ExcitationDesign:
+            progress: Progress | None, moving: tuple[str, ...]) -> ExcitationDesign:
     rng = np.random.default_rng(options.seed)
     middle, half = 0.5 * (limits.lower + limits.upper), 0.5 * (limits.upper - limits.lower) * options.range_share
     z = []
     for i, joint in enumerate(robot.actuated):
+        if joint not in moving:  # held at the middle of its range: a constant series
+            z.append(np.concatenate([[middle[i]], np.zeros(space.per_joint - 1)]))
+            continue
         z.append(design_joint(space, options, middle[i] - half[i], middle[i] + half[i], share * limits.velocity[i],
                               prior[joint], noise[joint], rng))
         if progress is not None:
@@ -221,8 +241,8 @@ def _design(robot: Robot, prior: Mapping[str, ModelParamsBase], noise: Mapping[s
     trajectory = full.trajectory(np.concatenate(z))
     q, qd, qdd = trajectory(options.times())
     tau = inverse_dynamics(robot, q, qd, qdd, prior)
-    bound = {j: torque_bound(prior[j], qd[:, i], noise[j]) for i, j in enumerate(robot.actuated)}
+    bound = {j: torque_bound(prior[j], qd[:, i], noise[j]) for i, j in enumerate(robot.actuated) if j in moving}
     shares = {j: dict(zip(options.asked, map(float, limit_shares(bound[j], prior[j], options.asked))))
-              for j in robot.actuated}
+              for j in moving}
     return ExcitationDesign(robot.name, robot.actuated, trajectory, options, bound, shares,
-                            margins(limits, q, qd, tau), dict(prior))
+                            margins(limits, q, qd, tau), dict(prior), moving)

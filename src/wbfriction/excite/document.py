@@ -11,7 +11,9 @@ The document::
      "predicted": {"<joint>": {"<parameter>": {"value", "se", "model_error", "bound", "limit", "share", "status",
                                                "reason"}}},
      "delay": {...}, "delayed_known": bool,
-     "margins": {"<joint>": {"position", "velocity", "torque"}}}
+     "margins": {"<joint>": {"position", "velocity", "torque"}},
+     "after": {"params", "moving", "held", "prior_from_fit",                       (--after only)
+               "logged": {"<joint>": {"status", "reason", "F_v": {"value", "se"}, "F_c": {...}}}}}
 
 Units: each parameter's own (:data:`~wbfriction.actuator.identification.UNITS`); ``share`` is ``se / limit``, below
 1 where the parameter is predicted ``ok``; margins are shares of each limit left unused (0: at it).
@@ -28,10 +30,12 @@ import pyarrow as pa
 from wbfriction.excite.arm_design import ArmDesign
 from wbfriction.excite.design import ExciteOptions
 from wbfriction.excite.information import limit_shares
+from wbfriction.excite.next import NextRecording
 from wbfriction.excite.pd_design import SHARE_LIMITS, PdDesign
 from wbfriction.excite.predict import Predicted
 from wbfriction.excite.stance import StanceExcitation, StanceOptions
 from wbfriction.excite.tripod import TripodExcitation, TripodOptions
+from wbfriction.fit.params_file import finite_or_none
 from wbfriction.fit.status import WEAK
 from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.friction.families.params import ModelParamsBase
@@ -210,3 +214,17 @@ def tripod_document(robot: Robot, excitation: TripodExcitation, options: TripodO
             "swing_foot": robot.contact_frames[excitation.swing],
             "stance_feet": [robot.contact_frames[c] for c in excitation.stance], "base_height": options.height,
             **{n: float(getattr(excitation, n)) for n in limits}, "limits": limits, "swing": swing}
+
+
+def next_document(following: NextRecording[PdDesign] | NextRecording[ArmDesign], params: str) -> dict[str, Any]:
+    """The ``after`` entry of a design's document (module docstring) made after the log whose parameters file is
+    ``params`` (:mod:`~wbfriction.excite.next`): the joints moved and held, those whose prior is their fit, and per
+    moving joint what the log's fit gave (its status and reason, each compared parameter's value and the standard
+    error a user reads; null where the file has none)."""
+    design = following.design
+    logged = {j: {"status": lg.status, "reason": lg.reason,
+                  **{n: {"value": finite_or_none(v), "se": finite_or_none(se)} for n, (v, se) in lg.values.items()}}
+              for j, lg in following.logged.items()}
+    return {"params": params, "moving": list(design.moving),
+            "held": [j for j in design.joints if j not in design.moving],
+            "prior_from_fit": list(following.prior_from_fit), "logged": logged}

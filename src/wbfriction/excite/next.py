@@ -10,28 +10,42 @@ simulator's default (:func:`~wbfriction.sim.hung.default_hung_friction`). A join
 at zero, so ``--config-output`` wrote none: a rotor always has some) takes the median of those the TOML gives, else
 :data:`ARMATURE_PRIOR`. Beside each moving joint's predicted standard errors it keeps what the log gave (the fit's
 value and the standard error a user reads, its status), so that the two can be read side by side.
+
+A fixed-base arm's (:func:`record_next_arm`) is the same choice of joints, prior and log's values on the arm's
+design (:func:`~wbfriction.excite.arm_design.design_arm` with ``moving``): the held joints at the middle of their
+range (the parameters file records no posture), the torque limits checked with their gravity, each moving joint's
+prior its fitted friction where :func:`physical`, else the arm simulator's default
+(:func:`~wbfriction.sim.arm.default_arm_friction`), and the prediction (what ``estimate`` and ``fit`` will report)
+the moving joints'.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from typing import Generic, TypeVar
 
 import numpy as np
 
 from wbfriction.actuator.options import ActuatorOptions
 from wbfriction.exceptions import InputError
+from wbfriction.excite.arm_design import ArmDesign, design_arm
+from wbfriction.excite.design import ExciteOptions
 from wbfriction.excite.options import PdExciteOptions
 from wbfriction.excite.pd_design import PdDesign, design_pd
+from wbfriction.excite.predict_arm import REAL_ARM
 from wbfriction.fit.result import FitResult
+from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
+from wbfriction.sim.arm import ArmOptions, default_arm_friction
 from wbfriction.sim.hung import default_hung_friction
 
 ARMATURE_PRIOR = 0.01
 """The armature prior [kg·m^2] of a robot whose TOML gives none (a quadruped's knee drive's order of size)."""
 COMPARED = ("F_v", "F_c")
 """The parameters a log's fit and the design's identification both give, compared."""
+Design = TypeVar("Design", PdDesign, ArmDesign)
 
 
 @dataclass(frozen=True)
@@ -45,16 +59,16 @@ class Logged:
 
 
 @dataclass(frozen=True)
-class NextRecording:
+class NextRecording(Generic[Design]):
     """The motion to record next (module docstring).
 
     Attributes:
-        design: the design, moving :attr:`~wbfriction.excite.pd_design.PdDesign.moving`.
+        design: the design (a hung PD-driven robot's or an arm's), moving its ``moving`` joints.
         logged: per moving joint, what the log gave.
         prior_from_fit: the joints whose prior is their fitted friction (the others: the simulator's default).
     """
 
-    design: PdDesign
+    design: Design
     logged: dict[str, Logged]
     prior_from_fit: tuple[str, ...]
 
@@ -95,10 +109,38 @@ def logged_of(fit: FitResult) -> Logged:
     return Logged(verdict.status, verdict.reason, values)
 
 
+def undetermined(robot: Robot, fits: Mapping[str, FitResult], source: str) -> tuple[str, ...]:
+    """The joints of ``robot`` whose fit in ``fits`` is not ``ok`` or missing (module docstring), in its actuated
+    order; ``source``: the parameters file, for errors.
+
+    Raises:
+        InputError: every joint's fit ``ok`` (nothing left to determine).
+    """
+    moving = tuple(j for j in robot.actuated if j not in fits or not fits[j].verdict().ok)
+    if not moving:
+        raise InputError(f"{source}: every joint's fit is ok: the log determined them all, nothing to record next")
+    return moving
+
+
+def prior_of(robot: Robot, fits: Mapping[str, FitResult], default: Mapping[str, ModelParamsBase]
+             ) -> tuple[dict[str, ModelParamsBase], tuple[str, ...]]:
+    """Each actuated joint's prior: its fitted friction where :func:`physical`, else ``default``'s (none where
+    neither has one: the design refuses it); and the joints whose prior is their fit."""
+    from_fit = tuple(j for j in robot.actuated if j in fits and physical(fits[j]))
+    prior = {j: fits[j].params if j in from_fit else default[j] for j in robot.actuated
+             if j in from_fit or j in default}
+    return prior, from_fit  # type: ignore[return-value]
+
+
+def logged_all(fits: Mapping[str, FitResult], moving: tuple[str, ...]) -> dict[str, Logged]:
+    """:class:`Logged` of each moving joint (``not fitted`` where the file has no fit of it)."""
+    return {j: logged_of(fits[j]) if j in fits else Logged("not fitted", "", {}) for j in moving}
+
+
 def record_next(robot: Robot, fits: Mapping[str, FitResult], source: str,
                 options: PdExciteOptions = PdExciteOptions(),
                 identification: ActuatorOptions = ActuatorOptions(),
-                progress: Progress | None = None) -> NextRecording:
+                progress: Progress | None = None) -> NextRecording[PdDesign]:
     """The motion to record next on a hung PD-driven ``robot`` after a log whose fits are ``fits`` (module
     docstring); ``source``: the parameters file, for errors.
 
@@ -106,13 +148,26 @@ def record_next(robot: Robot, fits: Mapping[str, FitResult], source: str,
         InputError: every joint's fit ``ok`` (nothing left to determine); what
             :func:`~wbfriction.excite.pd_design.design_pd` raises.
     """
-    moving = tuple(j for j in robot.actuated if j not in fits or not fits[j].verdict().ok)
-    if not moving:
-        raise InputError(f"{source}: every joint's fit is ok: the log determined them all, nothing to record next")
-    default = default_hung_friction(robot)
-    from_fit = tuple(j for j in robot.actuated if j in fits and physical(fits[j]))
-    prior = {j: fits[j].params if j in from_fit else default[j] for j in robot.actuated}
+    moving = undetermined(robot, fits, source)
+    prior, from_fit = prior_of(robot, fits, default_hung_friction(robot))
     design = design_pd(with_armature(robot), options, prior, identification, progress,  # type: ignore[arg-type]
                        moving=moving)
-    logged = {j: logged_of(fits[j]) if j in fits else Logged("not fitted", "", {}) for j in moving}
-    return NextRecording(design, logged, from_fit)
+    return NextRecording[PdDesign](design, logged_all(fits, moving), from_fit)
+
+
+def record_next_arm(robot: Robot, fits: Mapping[str, FitResult], source: str,
+                    options: ExciteOptions = ExciteOptions(), recording: ArmOptions = REAL_ARM,
+                    progress: Progress | None = None) -> NextRecording[ArmDesign]:
+    """The motion to record next on a fixed-base arm ``robot`` (torque-measured joints) after a log whose fits are
+    ``fits`` (module docstring); ``source``: the parameters file, for errors. ``options`` and ``recording``: as
+    :func:`~wbfriction.excite.arm_design.design_arm` takes them.
+
+    Raises:
+        InputError: every joint's fit ``ok`` (nothing left to determine); what
+            :func:`~wbfriction.excite.arm_design.design_arm` raises (a torque limit passed, the held joints'
+            gravity included).
+    """
+    moving = undetermined(robot, fits, source)
+    prior, from_fit = prior_of(robot, fits, default_arm_friction(robot))
+    design = design_arm(robot, options, prior, recording, progress, moving=moving)
+    return NextRecording[ArmDesign](design, logged_all(fits, moving), from_fit)

@@ -103,29 +103,32 @@ def noise_free(options: ArmOptions) -> ArmOptions:
 
 def identify_arm(robot: Robot, friction: Mapping[str, ModelParams], trajectory: Reference,
                  options: ArmOptions = REAL_ARM, armature: dict[str, float] | None = None,
-                 estimate: EstimateOptions = EstimateOptions(),
-                 fit: FitOptions = FitOptions()) -> tuple[FrictionEstimate, list[FitResult]]:
+                 estimate: EstimateOptions = EstimateOptions(), fit: FitOptions = FitOptions(),
+                 joints: Sequence[str] | None = None) -> tuple[FrictionEstimate, list[FitResult]]:
     """The arm's motion along ``trajectory`` simulated (:func:`~wbfriction.sim.arm.simulate_arm`: ``friction`` and
     ``armature`` injected, ``options``' sensors) and identified as ``wbfriction estimate`` and ``wbfriction fit``
     do (:func:`~wbfriction.friction.estimate.estimate_log`, :func:`~wbfriction.fit.joints.fit_estimate`): the
-    friction estimate and each torque-controlled joint's fit.
+    friction estimate and the fit of each torque-controlled joint (of ``joints`` only where given: the joints a
+    design moves).
 
     Raises:
         InputError: what the simulator, the estimate and the fit raise.
     """
     sim = simulate_arm(robot, friction, armature, options, trajectory=trajectory)
     est = estimate_log(robot, log_from_table(sim.table, robot, "excite"), estimate)
-    return est, fit_estimate(est, fit)
+    return est, fit_estimate(est, fit, joints=joints)
 
 
 def predict_arm(robot: Robot, friction: Mapping[str, ModelParams], trajectory: Reference,
                 options: ArmOptions = REAL_ARM, armature: dict[str, float] | None = None,
-                estimate: EstimateOptions = EstimateOptions(), fit: FitOptions = FitOptions()) -> ArmPrediction:
+                estimate: EstimateOptions = EstimateOptions(), fit: FitOptions = FitOptions(),
+                joints: Sequence[str] | None = None) -> ArmPrediction:
     """:class:`ArmPrediction` (module docstring) of the fixed-base ``robot`` following ``trajectory`` (an
     ``excite`` design's :class:`~wbfriction.sim.arm.FourierTrajectory`, or any reference) for
     :attr:`ArmOptions.duration`, its ``friction`` and ``armature`` (None: the robot's) as the prior has them, read by
     ``options``' sensors (their noise's seed :attr:`ArmOptions.seed`), identified with ``estimate`` and ``fit``
-    (their defaults: the commands').
+    (their defaults: the commands'); of ``joints`` only where given (a design's moving joints: a joint held still
+    is not predicted).
 
     Where the noise-free fit chose another family than the noisy one, its joint is fitted again with the noisy
     one's, so that each parameter has its model error. A joint the noisy fit could not fit has no parameters.
@@ -133,23 +136,24 @@ def predict_arm(robot: Robot, friction: Mapping[str, ModelParams], trajectory: R
     Raises:
         InputError: what :func:`~wbfriction.sim.arm.simulate_arm`, the estimate and the fit raise.
     """
-    clean_est, clean_fits = identify_arm(robot, friction, trajectory, noise_free(options), armature, estimate, fit)
-    _, noisy_fits = identify_arm(robot, friction, trajectory, options, armature, estimate, fit)
+    clean_est, clean_fits = identify_arm(robot, friction, trajectory, noise_free(options), armature, estimate, fit,
+                                         joints)
+    _, noisy_fits = identify_arm(robot, friction, trajectory, options, armature, estimate, fit, joints)
     clean = {f.joint: f for f in clean_fits}
-    joints: dict[str, dict[str, Predicted]] = {}
+    predicted: dict[str, dict[str, Predicted]] = {}
     statistical: dict[str, dict[str, float]] = {}
     models: dict[str, str] = {}
     for noisy in noisy_fits:
         if noisy.params is None:
-            joints[noisy.joint], statistical[noisy.joint] = {}, {}
+            predicted[noisy.joint], statistical[noisy.joint] = {}, {}
             continue
         c = clean[noisy.joint]
         if c.model != noisy.model:
             again = dataclasses.replace(fit, model=cast(ModelChoice, noisy.model))
             c = fit_estimate(clean_est, again, joints=[noisy.joint])[0]
-        joints[noisy.joint], statistical[noisy.joint] = predicted_joint(c, noisy)
+        predicted[noisy.joint], statistical[noisy.joint] = predicted_joint(c, noisy)
         models[noisy.joint] = noisy.model
-    return ArmPrediction(joints, statistical, models)
+    return ArmPrediction(predicted, statistical, models)
 
 
 def predicted_joint(clean: FitResult, noisy: FitResult) -> tuple[dict[str, Predicted], dict[str, float]]:
