@@ -37,12 +37,10 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import InputError, ModelError
-from wbfriction.excite.design import ExciteOptions, design_joint
-from wbfriction.excite.information import torque_bound
-from wbfriction.excite.trajectory import FourierSpace
+from wbfriction.excite.design import ExciteOptions
+from wbfriction.excite.swing import design_swing, posture_band, series_bounds, swing_noise
 from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.friction.families.params import ModelParamsBase
-from wbfriction.friction.noise import NoiseModel
 from wbfriction.model.robot import Robot
 from wbfriction.sim.arm import FourierTrajectory
 from wbfriction.sim.mujoco_model import sole_footprint
@@ -67,12 +65,6 @@ roll moves the right foot outward; a left swing leg's hip yaw, hip roll and ankl
 foot lifted and rolled away from the stance leg."""
 MIRRORED = ("hip_yaw", "hip_roll", "ankle_roll")
 """The groups whose band changes sign from one leg to the other."""
-SLACK = (1e-3, 0.99)
-"""What each joint's design is given: its band less 1 mrad at each end, 99 % of its velocity cap: the design holds
-its limits on a grid (:data:`~.design.GRID` points per period) and overshoots them between the points by up to about
-0.2 mrad (measured), which this keeps within the band and the cap at every sample."""
-
-
 @dataclass(frozen=True)
 class StanceOptions:
     """What :func:`stance_reference` builds.
@@ -133,54 +125,13 @@ class StanceExcitation:
 
 
 def swing_band(robot: Robot, joints: tuple[str, ...], side: str, margin: float) -> tuple[np.ndarray, np.ndarray]:
-    """Each swing joint's band (n,), (n,) [rad]: :data:`SWING_BAND` of its group (mirrored for a left leg) within its
-    URDF range less ``margin``.
+    """Each swing joint's band (n,), (n,) [rad]: :data:`SWING_BAND` of its group (mirrored for a ``"left"`` leg,
+    :data:`MIRRORED`) within its URDF range less ``margin`` (:func:`~.swing.posture_band`).
 
     Raises:
         InputError: a joint whose group has no band, or whose band leaves no room within its range.
     """
-    lo_urdf, hi_urdf = robot.angle_limits
-    lower, upper = np.empty(len(joints)), np.empty(len(joints))
-    for i, joint in enumerate(joints):
-        group = robot.group_of(joint)
-        if group not in SWING_BAND:
-            raise InputError(f"swing joint '{joint}' (group {group!r}) has no posture band: one of "
-                             f"{sorted(SWING_BAND)}")
-        lo, hi = SWING_BAND[group]
-        if side == "left" and group in MIRRORED:
-            lo, hi = -hi, -lo
-        a = robot.actuated.index(joint)
-        lower[i], upper[i] = max(lo, lo_urdf[a] + margin), min(hi, hi_urdf[a] - margin)
-        if not upper[i] > lower[i]:
-            raise InputError(f"swing joint '{joint}': its band [{lo:g}, {hi:g}] rad leaves no room within its "
-                             f"range [{lo_urdf[a]:g}, {hi_urdf[a]:g}] less {margin:g} rad")
-    return lower, upper
-
-
-def design_swing(robot: Robot, joints: tuple[str, ...], lower: np.ndarray, upper: np.ndarray,
-                 prior: Mapping[str, ModelParamsBase], options: StanceOptions) -> FourierTrajectory:
-    """The swing joints' series (n joints): each designed alone by :func:`~.design.design_joint` within its band
-    ``[lower, upper]`` (n,) [rad] and below the velocity cap, for its ``prior`` friction and the options' noise (the
-    joint's inertia: the mass matrix's diagonal at the standing posture), less :data:`SLACK`."""
-    excite = options.design
-    space = FourierSpace(1, excite.harmonics, excite.omega)
-    rng = np.random.default_rng(excite.seed)
-    z = []
-    for i, (joint, noise) in enumerate(zip(joints, swing_noise(robot, joints, options))):
-        iv = robot.act_v_index[robot.actuated.index(joint)]
-        velocity = min(options.velocity, excite.velocity_share * float(robot.model.velocityLimit[iv]))
-        z.append(design_joint(space, excite, float(lower[i]) + SLACK[0], float(upper[i]) - SLACK[0],
-                              SLACK[1] * velocity, prior[joint], noise, rng))
-    return FourierSpace(len(joints), excite.harmonics, excite.omega).trajectory(np.concatenate(z))
-
-
-def swing_noise(robot: Robot, joints: tuple[str, ...], options: StanceOptions) -> list[NoiseModel]:
-    """Each swing joint's noise as its design takes it: the options' torque and position noise, the joint's inertia
-    (the mass matrix's diagonal at the standing posture), the design's sample period."""
-    inertia = np.diag(pin.crba(robot.model, robot.model.createData(), standing_configuration(robot)))
-    return [NoiseModel(options.torque_noise, options.position_noise,
-                       float(inertia[robot.act_v_index[robot.actuated.index(j)]]), 1.0 / options.design.rate)
-            for j in joints]
+    return posture_band(robot, joints, SWING_BAND, MIRRORED if side == "left" else (), margin)
 
 
 def support_margin(robot: Robot, stance: int, zmp: np.ndarray) -> float:
@@ -245,7 +196,8 @@ def stance_reference(robot: Robot, options: StanceOptions = StanceOptions(),
     if missing := [j for j in joints if j not in prior]:
         raise InputError(f"no prior friction for swing joint '{missing[0]}'")
     lower, upper = swing_band(robot, joints, SIDES[1 - stance], options.margin)
-    trajectory = design_swing(robot, joints, lower, upper, prior, options)
+    noise = swing_noise(robot, joints, options, standing_configuration(robot))
+    trajectory = design_swing(robot, joints, (lower, upper), prior, options, noise)
     reference = single_support_reference(robot, stance, joints, trajectory, options.design.times())
     margin, low = _checked(robot, options, stance, reference)
     return StanceExcitation(reference, stance, joints, trajectory, lower, upper, margin, low)
@@ -273,9 +225,8 @@ def _checked(robot: Robot, options: StanceOptions, stance: int, reference: Walki
 def swing_bounds(robot: Robot, excitation: StanceExcitation, options: StanceOptions,
                  prior: Mapping[str, ModelParamsBase] | None = None) -> dict[str, dict[str, float]]:
     """Each swing joint's Cramér-Rao bound of its friction's parameters on the designed motion [their units]
-    (:func:`~.information.torque_bound`: its prior friction, as :func:`design_swing` takes it, the options'
-    noise), per joint and parameter name (``F_c`` [N·m], ``F_v`` [N·m·s/rad], ...)."""
+    (:func:`~.swing.series_bounds`: its prior friction, as its design takes it, the options' noise at the
+    standing posture), per joint and parameter name (``F_c`` [N·m], ``F_v`` [N·m·s/rad], ...)."""
     prior = friction_by_group(robot.groups, THESIS_TARGETS) if prior is None else prior
-    noise = swing_noise(robot, excitation.joints, options)
-    _, qd, _ = excitation.trajectory(excitation.reference.time)
-    return {j: torque_bound(prior[j], qd[:, i], noise[i]) for i, j in enumerate(excitation.joints)}
+    noise = swing_noise(robot, excitation.joints, options, standing_configuration(robot))
+    return series_bounds(excitation.joints, excitation.trajectory, excitation.reference.time, prior, noise)

@@ -44,12 +44,10 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import InputError, ModelError
-from wbfriction.excite.design import ExciteOptions, design_joint
-from wbfriction.excite.information import torque_bound
-from wbfriction.excite.stance import SLACK, zero_moment_point
-from wbfriction.excite.trajectory import FourierSpace
+from wbfriction.excite.design import ExciteOptions
+from wbfriction.excite.stance import zero_moment_point
+from wbfriction.excite.swing import design_swing, posture_band, series_bounds, swing_noise
 from wbfriction.friction.families.params import ModelParamsBase
-from wbfriction.friction.noise import NoiseModel
 from wbfriction.model.robot import Robot
 from wbfriction.sim.arm import FourierTrajectory
 from wbfriction.sim.quadruped import default_quadruped_friction
@@ -179,55 +177,13 @@ def swing_foot(robot: Robot, swing: int | str) -> int:
 
 
 def swing_band(robot: Robot, joints: tuple[str, ...], left: bool, margin: float) -> tuple[np.ndarray, np.ndarray]:
-    """Each swing joint's band (n,), (n,) [rad]: :data:`SWING_BAND` of its group (mirrored for a ``left`` leg)
-    within its URDF range less ``margin``.
+    """Each swing joint's band (n,), (n,) [rad]: :data:`SWING_BAND` of its group (mirrored for a ``left`` leg,
+    :data:`MIRRORED`) within its URDF range less ``margin`` (:func:`~.swing.posture_band`).
 
     Raises:
         InputError: a joint whose group has no band, or whose band leaves no room within its range.
     """
-    lo_urdf, hi_urdf = robot.angle_limits
-    lower, upper = np.empty(len(joints)), np.empty(len(joints))
-    for i, joint in enumerate(joints):
-        group = robot.group_of(joint)
-        if group not in SWING_BAND:
-            raise InputError(f"swing joint '{joint}' (group {group!r}) has no posture band: one of "
-                             f"{sorted(SWING_BAND)}")
-        lo, hi = SWING_BAND[group]
-        if left and group in MIRRORED:
-            lo, hi = -hi, -lo
-        a = robot.actuated.index(joint)
-        lower[i], upper[i] = max(lo, lo_urdf[a] + margin), min(hi, hi_urdf[a] - margin)
-        if not upper[i] > lower[i]:
-            raise InputError(f"swing joint '{joint}': its band [{lo:g}, {hi:g}] rad leaves no room within its "
-                             f"range [{lo_urdf[a]:g}, {hi_urdf[a]:g}] less {margin:g} rad")
-    return lower, upper
-
-
-def swing_noise(robot: Robot, joints: tuple[str, ...], options: TripodOptions) -> list[NoiseModel]:
-    """Each swing joint's noise as its design takes it: the options' torque and position noise, the joint's inertia
-    (the mass matrix's diagonal at the reference posture), the design's sample period."""
-    q0 = robot.configuration(robot.reference_angles)
-    inertia = np.diag(pin.crba(robot.model, robot.model.createData(), q0))
-    return [NoiseModel(options.torque_noise, options.position_noise,
-                       float(inertia[robot.act_v_index[robot.actuated.index(j)]]), 1.0 / options.design.rate)
-            for j in joints]
-
-
-def design_swing(robot: Robot, joints: tuple[str, ...], band: tuple[np.ndarray, np.ndarray],
-                 prior: Mapping[str, ModelParamsBase], options: TripodOptions) -> FourierTrajectory:
-    """The swing joints' series (n joints): each designed alone by :func:`~.design.design_joint` within its band
-    ``(lower, upper)`` (n,) each [rad] and below the velocity cap, for its ``prior`` friction and the options'
-    noise (:func:`swing_noise`), less :data:`~.stance.SLACK`."""
-    excite = options.design
-    space = FourierSpace(1, excite.harmonics, excite.omega)
-    rng = np.random.default_rng(excite.seed)
-    z = []
-    for i, (joint, noise) in enumerate(zip(joints, swing_noise(robot, joints, options))):
-        iv = robot.act_v_index[robot.actuated.index(joint)]
-        velocity = min(options.velocity, excite.velocity_share * float(robot.model.velocityLimit[iv]))
-        z.append(design_joint(space, excite, float(band[0][i]) + SLACK[0], float(band[1][i]) - SLACK[0],
-                              SLACK[1] * velocity, prior[joint], noise, rng))
-    return FourierSpace(len(joints), excite.harmonics, excite.omega).trajectory(np.concatenate(z))
+    return posture_band(robot, joints, SWING_BAND, MIRRORED if left else (), margin)
 
 
 def tripod_reference(robot: Robot, options: TripodOptions = TripodOptions(),
@@ -262,7 +218,8 @@ def tripod_reference(robot: Robot, options: TripodOptions = TripodOptions(),
         raise ModelError(f"the stance triangle's incentre is {inradius * 1e3:.1f} mm from its edges (at least "
                          f"{options.com_margin * 1e3:.1f} mm asked): lower --com-margin")
     band = swing_band(robot, joints, bool(feet[swing, 1] > 0), options.margin)
-    trajectory = design_swing(robot, joints, band, prior, options)
+    noise = swing_noise(robot, joints, options, robot.configuration(robot.reference_angles))
+    trajectory = design_swing(robot, joints, band, prior, options, noise)
     motion = tripod_support_reference(robot, swing, joints, trajectory, options.design.times(), options.height)
     return _checked(robot, options, swing, (joints, trajectory, band), motion)
 
@@ -312,10 +269,9 @@ def _checked(robot: Robot, options: TripodOptions, swing: int,
 def swing_bounds(robot: Robot, excitation: TripodExcitation, options: TripodOptions,
                  prior: Mapping[str, ModelParamsBase] | None = None) -> dict[str, dict[str, float]]:
     """Each swing joint's Cramér-Rao bound of its friction's parameters on the designed motion [their units]
-    (:func:`~.information.torque_bound`: its prior friction, as :func:`design_swing` takes it (default the
-    quadruped simulators' default), the options' noise), per joint and parameter name (``F_c`` [N·m], ``F_v``
+    (:func:`~.swing.series_bounds`: its prior friction, as its design takes it (default the quadruped simulators'
+    default), the options' noise at the reference posture), per joint and parameter name (``F_c`` [N·m], ``F_v``
     [N·m·s/rad], ...)."""
     prior = default_quadruped_friction(robot) if prior is None else prior
-    noise = swing_noise(robot, excitation.joints, options)
-    _, qd, _ = excitation.trajectory(excitation.reference.time)
-    return {j: torque_bound(prior[j], qd[:, i], noise[i]) for i, j in enumerate(excitation.joints)}
+    noise = swing_noise(robot, excitation.joints, options, robot.configuration(robot.reference_angles))
+    return series_bounds(excitation.joints, excitation.trajectory, excitation.reference.time, prior, noise)

@@ -23,17 +23,17 @@ from wbfriction.exceptions import ModelError
 from wbfriction.model.robot import Robot
 from wbfriction.sim.arm import FourierTrajectory
 from wbfriction.sim.mujoco_model import sole_footprint
+from wbfriction.sim.support_ik import LWA, SupportIK
 from wbfriction.walking.footsteps import FootstepPlan
 from wbfriction.walking.options import GaitOptions
 from wbfriction.walking.reference import WalkingReference, standing_configuration
 from wbfriction.walking.swing import foot_placement
 
-LWA = pin.LOCAL_WORLD_ALIGNED
 SIDES = ("left", "right")
 """The stance foot's names, in :attr:`Robot.contact_frames` order (a biped's left sole first)."""
 
 
-class StanceIK:
+class StanceIK(SupportIK):
     """The square single-support inverse kinematics of the module docstring, for one robot and stance foot.
 
     Args:
@@ -48,6 +48,8 @@ class StanceIK:
     Raises:
         ModelError: a stance leg of other than six joints.
     """
+
+    stance_name = "one-foot"
 
     def __init__(self, robot: Robot, stance: int, sole: pin.SE3, com: np.ndarray) -> None:
         self.robot, self.model, self.data = robot, robot.model, robot.model.createData()
@@ -75,33 +77,9 @@ class StanceIK:
                             self.com - data.com[0], pin.log3(self.base_R @ R.T)])
         return J, e
 
-    def solve(self, q: np.ndarray, v_rest: np.ndarray, a_rest: np.ndarray, tol: float = 1e-11,
-              max_iter: int = 50) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The configuration (nq,), velocity and acceleration (nv,) whose joints outside the base and the stance
-        leg are those of ``q`` (a guess of the rest), ``v_rest`` and ``a_rest`` (on :attr:`rest`).
-
-        Raises:
-            ModelError: the Newton iterations do not converge (the target out of reach).
-        """
-        model, data, cols = self.model, self.data, self.cols
-        for _ in range(max_iter):
-            J, e = self._system(q)
-            if np.max(np.abs(e)) < tol:
-                break
-            dv = np.zeros(model.nv)
-            dv[cols] = np.linalg.solve(J[:, cols], e)
-            q = pin.integrate(model, q, dv)
-        else:
-            raise ModelError(f"one-foot stance IK did not converge (residual {np.max(np.abs(e)):.2e})")
-        Jc_inv, Jr = np.linalg.inv(J[:, cols]), J[:, self.rest]
-        v, a = np.zeros(model.nv), np.zeros(model.nv)
-        v[self.rest], a[self.rest] = v_rest, a_rest
-        v[cols] = -Jc_inv @ (Jr @ v_rest)
-        pin.centerOfMass(model, data, q, v, np.zeros(model.nv))  # drift: zero acceleration
-        drift = np.concatenate([pin.getFrameClassicalAcceleration(model, data, self.frame, LWA).vector,
-                                data.acom[0], np.zeros(3)])
-        a[cols] = -Jc_inv @ (drift + Jr @ a_rest)
-        return q, v, a
+    def _feet_drift(self) -> np.ndarray:
+        """The stance sole's classical acceleration (6,) at a zero acceleration: its tasks' ``Jd v``."""
+        return pin.getFrameClassicalAcceleration(self.model, self.data, self.frame, LWA).vector
 
 
 def zero_moment_point(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
@@ -127,26 +105,6 @@ def standing_feet(robot: Robot) -> np.ndarray:
                      for f in robot.contact_frame_ids])
 
 
-def solve_stance(robot: Robot, ik: StanceIK, q: np.ndarray, act: np.ndarray,
-                 swing: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The IK at every sample of the swing joints' motion (N, n) each (``act``: their actuated indices), from ``q``
-    (the first guess): the configurations (N, nq), velocities and accelerations (N, nv)."""
-    qs, qds, qdds = swing
-    model = robot.model
-    n = len(qs)
-    Q, V, A = np.empty((n, model.nq)), np.empty((n, model.nv)), np.empty((n, model.nv))
-    iq = robot.act_q_index[act]
-    on_rest = np.searchsorted(ik.rest, robot.act_v_index[act])
-    v_rest, a_rest = np.zeros(len(ik.rest)), np.zeros(len(ik.rest))
-    for k in range(n):
-        q = q.copy()
-        q[iq] = qs[k]
-        v_rest[on_rest], a_rest[on_rest] = qds[k], qdds[k]
-        q, V[k], A[k] = ik.solve(q, v_rest, a_rest)
-        Q[k] = q
-    return Q, V, A
-
-
 def single_support_reference(robot: Robot, stance: int, joints: tuple[str, ...], trajectory: FourierTrajectory,
                              time: np.ndarray) -> WalkingReference:
     """Stand on sole ``stance`` (its index in :attr:`Robot.contact_frames`) at the evenly spaced ``time`` (N,) [s]
@@ -170,7 +128,7 @@ def single_support_reference(robot: Robot, stance: int, joints: tuple[str, ...],
     q = q0.copy()
     q[robot.act_q_index[act]] = qs[0]
     com = np.array([*sole.act(np.array([*centre, 0.0]))[:2], pin.centerOfMass(model, data, q0)[2]])
-    Q, V, A = solve_stance(robot, StanceIK(robot, stance, sole, com), q, act, (qs, qds, qdds))
+    Q, V, A = StanceIK(robot, stance, sole, com).solve_motion(q, act, (qs, qds, qdds))
     feet = np.empty((len(Q), 2, 4))
     feet[:, stance] = feet0[stance]
     swing = robot.contact_frame_ids[1 - stance]

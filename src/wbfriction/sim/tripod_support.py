@@ -28,12 +28,11 @@ import pinocchio as pin
 from wbfriction.exceptions import ModelError
 from wbfriction.model.robot import Robot
 from wbfriction.sim.arm import FourierTrajectory
+from wbfriction.sim.support_ik import LWA, SupportIK
 from wbfriction.walking.quadruped import FOOT_RADIUS, GaitOptions, QuadrupedReference
 
-LWA = pin.LOCAL_WORLD_ALIGNED
 
-
-class TripodIK:
+class TripodIK(SupportIK):
     """The square three-feet inverse kinematics of the module docstring, for one robot and swing foot.
 
     Args:
@@ -48,6 +47,8 @@ class TripodIK:
     Raises:
         ModelError: a stance leg of other than three joints.
     """
+
+    stance_name, hint = "three-feet", ": lower --height"
 
     def __init__(self, robot: Robot, swing: int, feet: np.ndarray, com: np.ndarray) -> None:
         self.robot, self.model, self.data = robot, robot.model, robot.model.createData()
@@ -76,35 +77,11 @@ class TripodIK:
                             self.com - data.com[0], pin.log3(R.T)])
         return J, e
 
-    def solve(self, q: np.ndarray, v_rest: np.ndarray, a_rest: np.ndarray, tol: float = 1e-11,
-              max_iter: int = 50) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The configuration (nq,), velocity and acceleration (nv,) whose joints outside the base and the stance
-        legs are those of ``q`` (a guess of the rest), ``v_rest`` and ``a_rest`` (on :attr:`rest`).
-
-        Raises:
-            ModelError: the Newton iterations do not converge (the target out of reach).
-        """
-        model, data, cols = self.model, self.data, self.cols
-        for _ in range(max_iter):
-            J, e = self._system(q)
-            if np.max(np.abs(e)) < tol:
-                break
-            dv = np.zeros(model.nv)
-            dv[cols] = np.linalg.solve(J[:, cols], e)
-            q = pin.integrate(model, q, dv)
-        else:
-            raise ModelError(f"three-feet stance IK did not converge (residual {np.max(np.abs(e)):.2e}): "
-                             "lower --height")
-        Jc_inv, Jr = np.linalg.inv(J[:, cols]), J[:, self.rest]
-        v, a = np.zeros(model.nv), np.zeros(model.nv)
-        v[self.rest], a[self.rest] = v_rest, a_rest
-        v[cols] = -Jc_inv @ (Jr @ v_rest)
-        pin.centerOfMass(model, data, q, v, np.zeros(model.nv))  # drift: zero acceleration
+    def _feet_drift(self) -> np.ndarray:
+        """The stance feet's classical linear accelerations (9,) at a zero acceleration: their tasks' ``Jd v``."""
+        model, data = self.model, self.data
         pin.updateFramePlacements(model, data)
-        drift = np.concatenate([*(pin.getFrameClassicalAcceleration(model, data, f, LWA).linear
-                                  for f in self.frames), data.acom[0], np.zeros(3)])
-        a[cols] = -Jc_inv @ (drift + Jr @ a_rest)
-        return q, v, a
+        return np.concatenate([pin.getFrameClassicalAcceleration(model, data, f, LWA).linear for f in self.frames])
 
 
 @dataclass(frozen=True)
@@ -164,26 +141,6 @@ def standing_feet(robot: Robot) -> np.ndarray:
     return feet
 
 
-def solve_tripod(robot: Robot, ik: TripodIK, q: np.ndarray, act: np.ndarray,
-                 swing: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The IK at every sample of the swing joints' motion (N, n) each (``act``: their actuated indices), from ``q``
-    (the first guess): the configurations (N, nq), velocities and accelerations (N, nv)."""
-    qs, qds, qdds = swing
-    model = robot.model
-    n = len(qs)
-    Q, V, A = np.empty((n, model.nq)), np.empty((n, model.nv)), np.empty((n, model.nv))
-    iq = robot.act_q_index[act]
-    on_rest = np.searchsorted(ik.rest, robot.act_v_index[act])
-    v_rest, a_rest = np.zeros(len(ik.rest)), np.zeros(len(ik.rest))
-    for k in range(n):
-        q = q.copy()
-        q[iq] = qs[k]
-        v_rest[on_rest], a_rest[on_rest] = qds[k], qdds[k]
-        q, V[k], A[k] = ik.solve(q, v_rest, a_rest)
-        Q[k] = q
-    return Q, V, A
-
-
 def leg_points(robot: Robot, motion: tuple[np.ndarray, np.ndarray, np.ndarray]
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Along a motion ``(q, v, a)`` (N, nq), (N, nv), (N, nv): the feet's positions, velocities and accelerations
@@ -231,7 +188,7 @@ def tripod_support_reference(robot: Robot, swing: int, joints: tuple[str, ...], 
     act = np.array([robot.actuated.index(j) for j in joints])
     q[robot.act_q_index[act]] = qs[0]
     ik = TripodIK(robot, swing, feet0[stance], np.array([*centre, com_z]))
-    Q, V, A = solve_tripod(robot, ik, q, act, (qs, qds, qdds))
+    Q, V, A = ik.solve_motion(q, act, (qs, qds, qdds))
     solved, feet_v, feet_a, knees = leg_points(robot, (Q, V, A))
     feet = solved.copy()
     feet[:, stance] = feet0[stance]  # their footprints (the IK's residual below 1e-11 m)
