@@ -59,7 +59,7 @@ def first(tmp_path_factory):
 
 
 @pytest.mark.slow
-@pytest.mark.xdist_group("excite")
+@pytest.mark.xdist_group("excite_arm_next")
 def test_the_wrist_held_still_is_recorded_next_and_determined(first, cli, tmp_path):
     panda, truth, folder = first
     fits = read_params(folder / "params.json")

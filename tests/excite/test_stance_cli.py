@@ -31,7 +31,7 @@ from wbfriction.logs.setpoint_table import read_setpoint_table
 from wbfriction.logs.tables import write_table
 
 # excite (the design and the IK) 10-20 s, the reference again 10 s, simulate at 40 kHz 15 s, estimate and fit 13 s
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite")]
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_stance_cli")]
 
 TOLERANCE = 1.0
 """Each swing joint's F_c and F_v within 1 % [%] (module docstring)."""

@@ -34,7 +34,7 @@ from wbfriction.sim.quadruped import default_quadruped_friction
 from wbfriction.sim.simulators.quadruped import played_tripod
 
 # excite (the design and the IK) 6 s, the reference again 5 s, simulate 3 s, estimate and fit 5 s
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite")]
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_tripod_cli")]
 
 TOLERANCE = 1.0
 """Each swing joint's F_c and F_v within 1 % [%] (module docstring)."""

@@ -18,6 +18,8 @@ from wbfriction.model.loading import load_robot
 from wbfriction.pipeline.identify_step import identify_file
 from wbfriction.signals.options import FilterOptions
 
+pytestmark = pytest.mark.xdist_group("inertia_identify_exact")  # its module fixture computed once
+
 ESTIMATE = EstimateOptions(diff="butterworth", filtering=FilterOptions(cutoff=20.0))
 
 

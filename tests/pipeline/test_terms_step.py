@@ -20,6 +20,8 @@ from wbfriction.friction.models import CoulombViscousParams
 from wbfriction.logs.tables import write_table
 from wbfriction.sim.arm import ArmOptions, simulate_arm
 
+pytestmark = pytest.mark.xdist_group("pipeline_terms_step")  # its module fixture computed once
+
 T_REF = 40.0
 VELOCITY = CoulombViscousParams(F_v=0.2, F_c=1.0, tau_os=0.1)
 TRUTH = {

@@ -42,7 +42,7 @@ from wbfriction.pipeline.fit_step import fit_file
 from wbfriction.pipeline.predict_step import predict_file
 from wbfriction.studies.pd_peer import peer_held_out
 
-pytestmark = [needs_data("unitree_aliengo"), pytest.mark.slow]
+pytestmark = [needs_data("unitree_aliengo"), pytest.mark.slow, pytest.mark.xdist_group("real_aliengo")]
 
 
 @pytest.fixture(scope="module")

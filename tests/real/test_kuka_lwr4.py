@@ -36,7 +36,7 @@ from wbfriction.pipeline.fit_step import fit_file
 from wbfriction.pipeline.identify_step import identify_file
 from wbfriction.signals.kinematics import measure
 
-pytestmark = needs_kuka
+pytestmark = [needs_kuka, pytest.mark.xdist_group("real_kuka_lwr4")]
 OPTIONS = EstimateOptions(diff="auto")
 VELOCITY_ONLY = FitOptions(terms=TermOptions(terms=()))
 """The fit of the velocity model alone (the default tries the terms beyond velocity too)."""

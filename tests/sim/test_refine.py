@@ -20,6 +20,8 @@ from wbfriction.sim.pd_options import HungOptions
 from wbfriction.sim.refine import PARAMETERS, refine_mjcf, write_refined
 from wbfriction.sim.replay import Replay, replay_mjcf
 
+pytestmark = pytest.mark.xdist_group("sim_refine")  # its module fixture computed once
+
 STEP = 0.001
 """The simulator's physics step, the replays'."""
 TRAIN = (0.0, 4.0)

@@ -16,7 +16,8 @@ from wbfriction.sim import IdealOptions, SensorNoise, apply_sensor_noise, simula
 from wbfriction.studies.common import SIMULATOR
 from wbfriction.walking import GaitOptions, walking_reference
 
-pytestmark = pytest.mark.slow  # module fixtures of 30-55 s (the quick subset: -m "not slow")
+# module fixtures of 30-55 s (the quick subset: -m "not slow")
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("sim_simulated")]
 
 RIGHT_LEG = [f"leg_right_{i}_joint" for i in range(1, 7)]
 

@@ -17,7 +17,8 @@ from wbfriction.studies.noise import (
     run_noise_study,
 )
 
-pytestmark = pytest.mark.slow  # two 10 s arm runs estimated and fitted twice each: about a minute
+# two 10 s arm runs estimated and fitted twice each: about a minute
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("studies_noise")]
 
 
 @pytest.fixture(scope="module")

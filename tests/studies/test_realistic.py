@@ -8,7 +8,8 @@ import pytest
 from wbfriction.fit.params_file import read_params
 from wbfriction.studies.realistic import run_realistic_study, worst_scored
 
-pytestmark = pytest.mark.slow  # module fixtures of 30-55 s (the quick subset: -m "not slow")
+# module fixtures of 30-55 s (the quick subset: -m "not slow")
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("studies_realistic")]
 
 
 @pytest.fixture(scope="module")

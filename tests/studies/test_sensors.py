@@ -9,7 +9,8 @@ import pytest
 
 from wbfriction.studies.sensors import PARTS, run_sensors_study
 
-pytestmark = pytest.mark.slow  # module fixtures of 30-55 s (the quick subset: -m "not slow")
+# module fixtures of 30-55 s (the quick subset: -m "not slow")
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("studies_sensors")]
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,8 @@ import pytest
 from wbfriction.fit.params_file import read_params
 from wbfriction.studies.simulation import run_study
 
-pytestmark = pytest.mark.slow  # module fixtures of 30-55 s (the quick subset: -m "not slow")
+# module fixtures of 30-55 s (the quick subset: -m "not slow")
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("studies_simulation")]
 
 
 @pytest.fixture(scope="module")
