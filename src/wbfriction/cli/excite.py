@@ -392,13 +392,14 @@ def _print_next(following, after: Path) -> None:
     from wbfriction.excite.next import COMPARED
 
     design = following.design
-    table = Table(title=f"The joints {after.name} left undetermined: the log's fit against the design's prediction",
-                  box=None)
+    units = ", ".join(f"{name} [{UNITS[name]}]" for name in COMPARED)
+    table = Table(title=f"The joints {after.name} left undetermined: the log's fit against the design's prediction "
+                        f"({units})", box=None)
     table.add_column("joint")
     table.add_column("log's status")
-    for name in COMPARED:
-        table.add_column(f"{name} log [{UNITS[name]}]", justify="right")
-        table.add_column(f"{name} next [{UNITS[name]}]", justify="right")
+    for name in COMPARED:  # the units in the title: the table fits 100 columns
+        table.add_column(f"{name} log", justify="right")
+        table.add_column(f"{name} next", justify="right")
     for joint, logged in following.logged.items():
         predicted = design.prediction.joints.get(joint, {})
         cells = []
