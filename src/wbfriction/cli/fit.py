@@ -186,19 +186,28 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
                                             help="Friction table of a held-out log ('wbfriction estimate' with the URDF"
                                                  " under test)."),
             params: Path = typer.Option(..., "--params", help="Parameters fitted on other logs estimated with "
-                                                              "the same URDF ('wbfriction fit').")) -> None:
+                                                              "the same URDF ('wbfriction fit')."),
+            table_file: Optional[Path] = typer.Option(None, "--table",
+                                                 help="Also write the prediction table (.parquet; .csv, .h5 by "
+                                                      "name): per sample and joint, time from the log's start "
+                                                      "[s], qd, measured and predicted torque and friction, "
+                                                      "residual [N·m]; each joint's RMS in its metadata."),
+            figure: Optional[Path] = typer.Option(None, "--figure",
+                                                  help="Also write a PNG: per joint, measured and predicted torque "
+                                                       "over time (a panel per run) and friction against "
+                                                       "velocity.")) -> None:
     """How well a model predicts torques it was not fitted on: per joint, the RMS of measured minus
     predicted torque, tau - (M qdd + h + f(qd)), with the friction model and without it; where the log leaves
     the angles, loads or temperatures the fit's terms were fitted on, it says so (well outside: status
-    'outside fitted ranges')."""
+    'outside fitted ranges'). --table and --figure write it sample by sample."""
     import numpy as np
 
     from wbfriction.fit.ranges import OUTSIDE
-    from wbfriction.pipeline.predict_step import predict_file
+    from wbfriction.report.prediction import write_prediction
 
-    check_paths({"FRICTION": friction, "--params": params}, {})
+    check_paths({"FRICTION": friction, "--params": params}, {"--table": table_file, "--figure": figure})
     with console.status(f"predicting the torques of {friction.name}"):
-        pred = predict_file(friction, params)
+        pred = write_prediction(friction, params, table_file, figure)
     table = Table(title=f"Torque prediction on {friction.name}: RMS of measured - predicted [N·m]", box=None,
                   collapse_padding=True, caption_justify="left",
                   caption="rigid body: the inertia model alone; friction: with the friction model; moving: with it, "
@@ -236,6 +245,9 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
                       highlight=False, soft_wrap=True)
     if any(status not in ("ok", "", OUTSIDE) for status in statuses):
         console.print("a prediction by a fit that is not ok is no better than that fit: see 'fit' for the reason")
+    for path in (table_file, figure):
+        if path is not None:
+            console.print(f"wrote {path}")
 
 
 @app.command()

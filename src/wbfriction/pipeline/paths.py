@@ -89,7 +89,7 @@ def _check_folder(folder: Path) -> None:
     raise output_error(folder, OSError(number, os.strerror(number)))
 
 
-OUTPUT_OPTIONS = ("-o", "--output", "--output-dir", "--json", "--table", "--tables", "--config-output")
+OUTPUT_OPTIONS = ("-o", "--output", "--output-dir", "--json", "--table", "--tables", "--config-output", "--figure")
 """The options that name what a command writes."""
 
 
