@@ -8,6 +8,7 @@ against the given URDF and against the peer's (FloBaRoID's) identified URDF.
 
 from __future__ import annotations
 
+import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -217,6 +218,28 @@ squares on runs 1-2's torque residual, with the recorder's velocities and accele
 for issue 40."""
 
 
+def _check_prediction_table(table, written, pred, friction) -> None:
+    """``predict --table`` on a real log (issue 67): the file is the table returned; its time from run 3's first
+    stamp (a Unix time) in one run; its measured torque and friction the friction table's; per joint the RMS of its
+    residual over its valid samples is the RMS ``predict`` prints, and its predicted torque the measured one less
+    that residual."""
+    assert table.schema.equals(written.schema, check_metadata=True)
+    for name in table.column_names:  # NaN where not estimated: equal as arrays, not as Arrow's equals
+        np.testing.assert_array_equal(table.column(name).to_numpy(), written.column(name).to_numpy())
+    meta = json.loads(table.schema.metadata[b"wbfriction"])
+    stamps = friction.column("time").to_numpy()
+    np.testing.assert_allclose(table.column("time").to_numpy(), stamps - stamps[0], rtol=0, atol=1e-6)
+    assert meta["time_origin"] == stamps[0] > 1e9 and meta["runs"] == [[0, table.num_rows]]
+    for i, joint in enumerate(pred.joints):
+        col = lambda name: table.column(f"{name}.{joint}").to_numpy()  # noqa: E731
+        for name in ("tau", "tau_f", "qd"):
+            np.testing.assert_array_equal(col(name), friction.column(f"{name}.{joint}").to_numpy())
+        valid = col("valid")
+        assert valid.sum() == pred.samples[i]
+        assert np.sqrt(np.mean(col("residual")[valid] ** 2)) == pytest.approx(pred.rms[i], rel=1e-9)
+        np.testing.assert_allclose(col("tau_pred")[valid], (col("tau") - col("residual"))[valid], atol=1e-9)
+
+
 def test_terms_beyond_velocity_predict_the_held_out_run(logs, identified, tmp_path):
     """Issues 40 and 52, as a user runs it: runs 1-2 and run 3 estimated with the identified inertias into friction
     tables, ``fit`` on runs 1-2 (its default tries the terms beyond velocity, each kept where it predicts the last 30 %
@@ -229,7 +252,7 @@ def test_terms_beyond_velocity_predict_the_held_out_run(logs, identified, tmp_pa
     generating power on half its samples (the energy check of the parameters JSON: under the issue's 10 %)."""
     import json
 
-    from wbfriction.pipeline.predict_step import predict_file
+    from wbfriction.pipeline.predict_step import predict_file, predict_table
 
     spec = RobotSpec(None, str(identified), str(KUKA_CONFIG))
     tables = {name: tmp_path / f"{name}_friction.parquet" for name in ("runs12", "run3")}
@@ -238,7 +261,10 @@ def test_terms_beyond_velocity_predict_the_held_out_run(logs, identified, tmp_pa
     velocity, terms = tmp_path / "velocity.json", tmp_path / "terms.json"
     fit_file(tables["runs12"], velocity, VELOCITY_ONLY)
     fitted = fit_file(tables["runs12"], terms)
-    before, after = predict_file(tables["run3"], velocity), predict_file(tables["run3"], terms)
+    before = predict_file(tables["run3"], velocity)
+    after, written = predict_table(tables["run3"], terms, table=tmp_path / "run3_prediction.parquet")
+    _check_prediction_table(pq.read_table(tmp_path / "run3_prediction.parquet"), written, after,
+                            pq.read_table(tables["run3"]))
     kept = {f.joint: f.terms for f in fitted.fits}
     print("\nrun 3 RMS [N·m], velocity model", np.round(before.rms, 3), "with terms", np.round(after.rms, 3), "peer",
           PEER_RUN3_RMS, {j: t.kept for j, t in kept.items() if t is not None})
