@@ -83,10 +83,11 @@ def page_commands(page: str) -> list[str]:
 
 def outputs(command: str) -> list[str]:
     """What a command line says it writes: the values of its ``-o`` options and of ``--json``/``--write``/
-    ``--config-output``/``--table``."""
+    ``--config-output``/``--table``/``--figure``."""
     words = shlex.split(command)
     return [words[i + 1] for i, w in enumerate(words[:-1]) if w in ("-o", "--output", "--output-dir", "--json",
-                                                                     "--write", "--config-output", "--table")]
+                                                                     "--write", "--config-output", "--table",
+                                                                     "--figure")]
 
 
 def step_outputs(step: Step) -> list[str]:

@@ -231,7 +231,7 @@ def _check_prediction_table(table, written, pred, friction) -> None:
     np.testing.assert_allclose(table.column("time").to_numpy(), stamps - stamps[0], rtol=0, atol=1e-6)
     assert meta["time_origin"] == stamps[0] > 1e9 and meta["runs"] == [[0, table.num_rows]]
     for i, joint in enumerate(pred.joints):
-        col = lambda name: table.column(f"{name}.{joint}").to_numpy()  # noqa: E731
+        col = lambda name, joint=joint: table.column(f"{name}.{joint}").to_numpy()  # noqa: E731
         for name in ("tau", "tau_f", "qd"):
             np.testing.assert_array_equal(col(name), friction.column(f"{name}.{joint}").to_numpy())
         valid = col("valid")
