@@ -30,6 +30,7 @@ error, which makes the bound larger, never smaller.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -68,8 +69,9 @@ def fisher_information(jac: np.ndarray, rows: np.ndarray, noise: NoiseModel) -> 
     """The Fisher information (p, p) of the model's Jacobian ``jac`` (n, p) at the samples ``rows`` (n,) (their
     indices in the log, increasing: each run of consecutive rows one stationary stretch), the noise's covariance
     within a run ``sigma_tau^2 I + (M sigma_q / dt^2)^2 T``, ``T`` the second difference's (bands 6, -4, 1): exactly
-    ``J^T Sigma^-1 J``, by a banded Cholesky solve per run (``scipy.linalg.solveh_banded``)."""
-    from scipy.linalg import solveh_banded
+    ``J^T Sigma^-1 J``, by a banded Cholesky solve per run (LAPACK's ``pbtrf`` then ``pbtrs``: what
+    ``scipy.linalg.solveh_banded`` does, the factor kept for the next run of that length and noise)."""
+    from scipy.linalg import cho_solve_banded
     rows = np.asarray(rows)
     n, p = jac.shape
     info = np.zeros((p, p))
@@ -80,10 +82,21 @@ def fisher_information(jac: np.ndarray, rows: np.ndarray, noise: NoiseModel) -> 
         if c == 0.0:
             info += J.T @ J / noise.torque**2
             continue
-        bands = np.empty((3, b - a))
-        bands[0], bands[1], bands[2] = c, -4.0 * c, 6.0 * c + noise.torque**2
-        info += J.T @ solveh_banded(bands, J)
+        info += J.T @ cho_solve_banded((_noise_factor(c, noise.torque**2, b - a), False), J)
     return info
+
+
+@lru_cache(maxsize=32)
+def _noise_factor(c: float, white: float, n: int) -> np.ndarray:
+    """The upper banded Cholesky factor (3, n) of ``white I + c T`` over ``n`` consecutive samples
+    (:func:`fisher_information`); read-only, shared by the calls with the same noise and length (a design's
+    optimiser asks for the same one thousands of times)."""
+    from scipy.linalg import cholesky_banded
+    bands = np.empty((3, n))
+    bands[0], bands[1], bands[2] = c, -4.0 * c, 6.0 * c + white
+    factor = cholesky_banded(bands, lower=False)
+    factor.flags.writeable = False
+    return factor
 
 
 def cramer_rao(jac: np.ndarray, rows: np.ndarray, noise: NoiseModel, rtol: float = 1e-9) -> np.ndarray:

@@ -45,6 +45,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -116,11 +117,26 @@ class FourierTrajectory:
     def __call__(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Positions [rad], velocities [rad/s] and accelerations [rad/s^2] at times ``t`` (N,): each (N, n)."""
         w = self.omega * np.arange(1, self.a.shape[1] + 1)  # (L,)
-        s, c = np.sin(np.outer(t, w)), np.cos(np.outer(t, w))  # (N, L)
+        s, c = _harmonics(np.asarray(t, dtype=float), w)  # (N, L)
         q = self.center + s @ (self.a / w).T - c @ (self.b / w).T
         qd = c @ self.a.T + s @ self.b.T
         qdd = -s @ (self.a * w).T + c @ (self.b * w).T
         return q, qd, qdd
+
+
+def _harmonics(t: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``sin(t w^T)`` and ``cos(t w^T)`` (N, L), read-only (:func:`_harmonics_of`)."""
+    return _harmonics_of(t.tobytes(), w.tobytes())
+
+
+@lru_cache(maxsize=8)
+def _harmonics_of(t: bytes, w: bytes) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_harmonics` of the times and frequencies given as bytes, kept for the next call with the same (a
+    design's optimiser evaluates one time grid thousands of times)."""
+    arg = np.outer(np.frombuffer(t), np.frombuffer(w))
+    s, c = np.sin(arg), np.cos(arg)
+    s.flags.writeable = c.flags.writeable = False
+    return s, c
 
 
 def excitation_trajectory(lower: np.ndarray, upper: np.ndarray, velocity_limit: np.ndarray,
