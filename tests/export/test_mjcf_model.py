@@ -186,3 +186,16 @@ def test_joints_not_exported_hold_no_friction_in_both_files(tmp_path, name):
         assert (mj.dof_damping[dof], mj.dof_frictionloss[dof]) == want, joint
         assert (written.damping[v_out], written.friction[v_out]) == want, joint
     assert np.any(source.damping[[source.idx_vs[source.getJointId(j)] for j in robot.actuated[1:]]])
+
+
+def test_a_mesh_not_found_is_left_out_with_a_warning(kuka, tmp_path):
+    """The real KUKA LWR4+'s URDF names a wrist mesh its folder does not hold: the file is written without it, the
+    other geometry kept, and the warning names the link in one line within 100 columns."""
+    from wbfriction.export.mjcf import MjcfTarget
+
+    path = tmp_path / "kuka_friction.xml"
+    report = MjcfTarget().write(path, kuka, {})
+    model = mujoco.MjModel.from_xml_path(str(path))
+    assert model.ngeom > 10 and model.nu == 7
+    assert report.warnings == ("kuka_friction.xml: left out 1 collision mesh(es) MuJoCo cannot load: lwr_6_link",)
+    assert len("warning: " + report.warnings[0]) <= 100

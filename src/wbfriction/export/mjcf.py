@@ -585,8 +585,8 @@ class MjcfTarget(ExportTarget, kind=MJCF):
         _, skipped = write_model(path, robot, joints)
         held_back = held_back_warning(robot)
         warnings: tuple[str, ...] = () if held_back is None else (held_back,)
-        if skipped:
-            links = ", ".join(line.split(":", 1)[0] for line in skipped)
-            warnings += (f"{path.name}: {len(skipped)} collision element(s) left out (a mesh MuJoCo cannot read, "
-                         f"or not found): {links}",)
+        if skipped:  # one line within 100 columns with "warning: " before it (a long file name aside)
+            links = sorted({line.split(":", 1)[0] for line in skipped})
+            named = links[0] + (f" and {len(links) - 1} more" if len(links) > 1 else "")
+            warnings += (f"{path.name}: left out {len(skipped)} collision mesh(es) MuJoCo cannot load: {named}",)
         return self.report(path, joints, warnings)
