@@ -17,8 +17,9 @@ as in the Pinocchio model; the equality constraints, actuators and sensors on a 
 Panda's fingers: the URDF's ``<mimic>`` of ``panda_finger_joint2`` is such a constraint). Every actuated joint has
 an actuator named as it: a ``<motor>`` (``ctrl`` = the torque [N·m], ``ctrlrange`` the URDF's effort limit) where
 the joint is torque-controlled, a position actuator with the drivers' gains where it is PD-driven (below), the
-model file's own where it has one. The keyframe :data:`~wbfriction.export.mjcf_scene.STANCE` holds the reference configuration standing on the
-floor (:func:`~wbfriction.export.mjcf_scene.add_stance`); a model file's keyframes are dropped.
+model file's own where it has one. The keyframe :data:`~wbfriction.export.mjcf_scene.STANCE` holds the reference
+configuration standing on the floor (:func:`~wbfriction.export.mjcf_scene.add_stance`); a model file's keyframes
+are dropped.
 
 Per actuated joint (:mod:`wbfriction.export.mapping`): ``damping = F_v`` [N·m·s/rad],
 ``frictionloss = F_c`` [N·m], ``armature`` [kg·m^2] (the given one, else the robot model's
