@@ -138,6 +138,7 @@ def test_floating_base(talos, random_friction):
     q_act, qd, qdd = random_state(talos, rng)
     q = talos.configuration(q_act)
     q[:3] = rng.normal(size=3)
+    q[2] = 3.0 + abs(q[2])  # high above the floor: no contact
     v, a = rng.normal(size=model.nv), rng.normal(size=model.nv)
     v[:3] = 0.0
     v[talos.act_v_index], a[talos.act_v_index] = qd, qdd
@@ -217,8 +218,10 @@ def test_what_refers_to_a_locked_joint_goes_with_it(tmp_path):
                       "[locked_joints]\ngripper_left_joint = 0.0\n")
     robot = load_robot(mjcf=path, config=config)
     mj = mujoco_model(robot, {})
-    assert (mj.neq, mj.nu, mj.nsensor) == (0, 1, 1)
-    assert mj.joint(mj.actuator_trnid[0, 0]).name == mj.joint(mj.sensor_objid[0]).name == "gripper_right_joint"
+    assert (mj.neq, mj.nu, mj.nsensor) == (0, 31 + 1, 1)  # the export's motors on the 31 joints left, the extra one
+    driven = [mj.joint(mj.actuator_trnid[a, 0]).name for a in range(mj.nu)]
+    assert driven.count("gripper_right_joint") == 2 and "gripper_left_joint" not in driven
+    assert mj.joint(mj.sensor_objid[0]).name == "gripper_right_joint"
     assert mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_JOINT, "gripper_left_joint") == -1
 
 

@@ -384,10 +384,12 @@ def test_mujoco_hold_edge():
 
 
 def test_robot_without_drivers_has_no_actuators(panda, params, tmp_path):
-    """No [pd]: no actuator, no gain, no delay (the export of before; tests/test_same_bytes.py hashes it)."""
+    """No [pd]: a motor per joint (ctrl = the torque; issue 67), no gain, no delay."""
     outs = [tmp_path / "a.xml", tmp_path / "a.yaml"]
     done = export_files(panda, params[0], outs)
-    assert mujoco.MjModel.from_xml_path(str(outs[0])).nu == 0
+    mj = mujoco.MjModel.from_xml_path(str(outs[0]))
+    assert mj.nu == 7 and np.all(mj.actuator_biastype == mujoco.mjtBias.mjBIAS_NONE)
+    assert np.all(mj.actuator_gainprm[:, 0] == 1.0) and not np.any(mj.actuator_delay)
     assert list(load_yaml(outs[1].read_text())) == ["joint_names_expr", "friction", "dynamic_friction",
                                                     "viscous_friction"]
     assert all(r.warnings == () for r in done.reports)

@@ -175,8 +175,8 @@ def comments_before(root: ET._Element, tag: str) -> dict[str, str]:
 
 def test_talos_not_excited_hip_yaw_is_not_exported(talos, fit_of, tmp_path):
     """Issue 37's repro: a hip yaw `fit` called not excited (F_v 38.8) and the 20 torso and arm joints that
-    never moved are not exported by default; the joints not exported keep the model file's friction (MuJoCo:
-    none, the URDF's <dynamics> are dropped; URDF: its own <dynamics>; Isaac Lab: no entry); the exported
+    never moved are not exported by default; the joints not exported hold no friction in the MJCF and the URDF
+    alike (issue 67: the URDF's <dynamics> set to 0; Isaac Lab: no entry); the exported
     ones carry the JSON's numbers and a comment with their status. With --include weak the weak knee is
     exported, with its reason; the same input gives the same bytes."""
     fits = talos_fits(talos, fit_of)
@@ -202,6 +202,8 @@ def test_talos_not_excited_hip_yaw_is_not_exported(talos, fit_of, tmp_path):
                                                                               fits[name].params.F_c)
         elif original[name] is None:
             assert dyn is None, name
+        elif name in talos.actuated:
+            assert (float(dyn.get("damping")), float(dyn.get("friction"))) == (0.0, 0.0), name
         else:
             assert dyn.attrib == original[name].attrib, name
     assert comments_before(urdf, "dynamics") == mjcf_notes

@@ -83,9 +83,9 @@ def test_pace_actuator_holds_the_torque_back_whole_periods(hung):
 
 def test_what_a_replay_refuses(hung, go2, tmp_path):
     sim, robot, truth, _ = hung
-    bare = tmp_path / "bare.xml"  # the robot's model without its drivers' actuators
+    bare = tmp_path / "bare.xml"  # the robot's model without its drivers' actuators: motors (issue 67)
     write_mjcf(dataclasses.replace(go2, pd=None, cache={}), {}, bare)
-    with pytest.raises(InputError, match="no actuator named 'FL_hip_joint'"):
+    with pytest.raises(InputError, match="no position actuator named 'FL_hip_joint'"):
         replay_mjcf(bare, robot, sim.table)
     with pytest.raises(InputError, match="MuJoCo cannot load it"):
         (tmp_path / "broken.xml").write_text("<mujoco><worldbody><body></mujoco>")

@@ -137,12 +137,15 @@ def export(ctx: typer.Context,
            robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
            mjcf: Optional[Path] = MjcfOpt) -> None:
     """Write the fitted friction where simulators read it: the fits whose status is ok (and --include),
-    each with its status in a comment; the other joints keep what the model file has. F_v -> damping,
+    each with its status in a comment; the other actuated joints hold no friction (.urdf: their <dynamics> set
+    to 0; .xml: 0; from an MJCF model file: its own values). F_v -> damping,
     F_c -> Coulomb friction (MuJoCo frictionloss); the Stribeck bump and the tanh have no
     simulator field and are dropped. Inertias are the URDF's: give --urdf IDENTIFIED.urdf to export
     identified ones. A robot with PD-driven joints ([pd] in its TOML) gets its drivers: gains, torque limits, delay,
     encoder offsets and the fits' constant tau_os as a set-point offset tau_os/kp (MuJoCo position actuators; an
-    Isaac Lab DelayedPDActuatorCfg); elsewhere tau_os, a torque sensor's offset, is dropped."""
+    Isaac Lab DelayedPDActuatorCfg); elsewhere tau_os, a torque sensor's offset, is dropped. The .xml is the whole
+    MuJoCo model: the URDF's collision geometry (meshes by absolute path), a floor and free joint under a floating
+    base, a motor per torque-controlled joint, the keyframe 'stance'."""
     from wbfriction.pipeline.export_step import export_files
 
     check_paths({"PARAMS": params, "--urdf": urdf, "--mjcf": mjcf, "--config": config},

@@ -1,28 +1,38 @@
-"""A MuJoCo model (MJCF) of the robot with the identified friction, armature and inertias.
+"""A MuJoCo model (MJCF) of the robot with the identified friction, armature and inertias: the robot's whole
+model, loadable and steppable in MuJoCo as it is (issue 67).
 
-Built from the robot's URDF by MuJoCo's own URDF import (:func:`urdf_spec`): visual and
-collision geometry dropped (no ``package://`` path to resolve, no contact), the URDF's
-``<dynamics>`` dropped (the friction is the exported one only), static links fused into their
-bodies as Pinocchio merges them, each such link kept as a ``<site>`` of its name at its frame (a
-sole, an IMU: the frames a robot TOML names; Pinocchio's MJCF parser reads sites as frames). A
-robot loaded from an MJCF (:attr:`Robot.model_format`) starts from that file as it is. A
-floating-base robot gets a free joint at its root link; a
-fixed-base one (:attr:`Robot.floating_base` false, e.g. the KUKA LWR4+) has its root link welded
-to the world where the URDF puts it. The robot's locked joints (:attr:`Robot.locked_joints`) are
-welded at their positions, so that the joints are :attr:`Robot.actuated`, as in the Pinocchio model; the
-equality constraints, actuators and sensors on a locked joint go with it (the Panda's fingers: the URDF's
-``<mimic>`` of ``panda_finger_joint2`` is such a constraint).
+Built from the robot's URDF by MuJoCo's own URDF import (:func:`~wbfriction.model.mjspec.urdf_model_spec`): the
+URDF's collision geometry (meshes at their absolute path in the installed package, nothing copied; ``<visual>``
+dropped: Collada ``.dae``, which MuJoCo does not read, or finer copies of the collision meshes; a collision mesh
+MuJoCo cannot read, or not found, left out and named in a warning), the robot's geoms colliding with the floor and
+what a user adds but not with each other (``contype 1``, ``conaffinity 0``), no mass from the geometry
+(``inertiafromgeom`` off), the URDF's ``<dynamics>`` dropped (the friction is the exported one only), static links
+fused into their bodies as Pinocchio merges them, each such link kept as a ``<site>`` of its name at its frame (a
+sole, an IMU: the frames a robot TOML names; Pinocchio's MJCF parser reads sites as frames). A robot loaded from an
+MJCF (:attr:`Robot.model_format`) starts from that file as it is. A floating-base robot gets a free joint at its
+root link and a ``floor`` plane at ``z = 0``; a fixed-base one (:attr:`Robot.floating_base` false, e.g. the KUKA
+LWR4+, a hung Go2) has its root link welded to the world where the URDF puts it, and no floor. The robot's locked
+joints (:attr:`Robot.locked_joints`) are welded at their positions, so that the joints are :attr:`Robot.actuated`,
+as in the Pinocchio model; the equality constraints, actuators and sensors on a locked joint go with it (the
+Panda's fingers: the URDF's ``<mimic>`` of ``panda_finger_joint2`` is such a constraint). Every actuated joint has
+an actuator named as it: a ``<motor>`` (``ctrl`` = the torque [N·m], ``ctrlrange`` the URDF's effort limit) where
+the joint is torque-controlled, a position actuator with the drivers' gains where it is PD-driven (below), the
+model file's own where it has one. The keyframe :data:`~wbfriction.export.mjcf_scene.STANCE` holds the reference
+configuration standing on the floor (:func:`~wbfriction.export.mjcf_scene.add_stance`); a model file's keyframes
+are dropped.
 
 Per actuated joint (:mod:`wbfriction.export.mapping`): ``damping = F_v`` [N·m·s/rad],
 ``frictionloss = F_c`` [N·m], ``armature`` [kg·m^2] (the given one, else the robot model's
-``armature``, zero unless its configuration sets one); a joint without identified friction keeps the
-model file's ``damping`` and ``frictionloss`` (none from a URDF, whose ``<dynamics>`` are dropped; a
-robot's MJCF's own). The written file has a comment before each joint with friction from a fit, its
-status (:func:`~wbfriction.export.mapping.status_note`). Identified inertias (a ``pin.Model`` of the robot) go through
-:func:`wbfriction.inertia.urdf.write_urdf` into the URDF the model is built from.
+``armature``, zero unless its configuration sets one); a joint without identified friction holds none
+(``damping`` and ``frictionloss`` 0: the URDF's ``<dynamics>`` are dropped, and the ``.urdf`` export sets them to 0
+alike, :mod:`wbfriction.export.urdf`) but from a robot's MJCF, whose own values it keeps. The written file has a
+comment before each joint with friction from a fit, its status (:func:`~wbfriction.export.mapping.status_note`).
+Identified inertias (a ``pin.Model`` of the robot) go through :func:`wbfriction.inertia.urdf.write_urdf` into the
+URDF the model is built from.
 
 What ``mujoco.mj_inverse`` returns with these fields (MuJoCo 4 defaults: continuous-time inverse,
-``invdiscrete`` off; no contact since there is no geometry; joint limits inactive inside them):
+``invdiscrete`` off; no contact: a base off the floor, the robot's geoms not colliding with each other; joint
+limits inactive inside them):
 
 .. math::
 
@@ -89,6 +99,7 @@ from __future__ import annotations
 
 import tempfile
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -108,26 +119,34 @@ from wbfriction.export.drive import (
     setpoint_offset_lines,
 )
 from wbfriction.export.mapping import FrictionLike, JointExport, joint_exports, status_note
+from wbfriction.export.mjcf_scene import add_floor, add_motors, add_stance
 from wbfriction.export.target import ExportReport, ExportTarget
 from wbfriction.export.urdf import identified_parameters
 from wbfriction.inertia.urdf import write_urdf
 from wbfriction.logs.tables import write_atomic
-from wbfriction.model.mjspec import mujoco_message, urdf_spec
+from wbfriction.model.mjspec import mujoco_message, urdf_model_spec
+from wbfriction.model.mjspec import urdf_spec as urdf_spec  # re-exported: wbfriction.export.urdf_spec
 from wbfriction.model.robot import Robot
 
 if TYPE_CHECKING:
     import mujoco
 
-def robot_spec(robot: Robot) -> mujoco.MjSpec:
-    """The MuJoCo spec of ``robot``'s own description: :func:`urdf_spec` of its URDF, or its MJCF as it
-    is (with a free joint added at its top body if it is a floating base that has none).
+def robot_spec(robot: Robot, inertias_urdf: str | Path | None = None) -> tuple[mujoco.MjSpec, tuple[str, ...]]:
+    """The MuJoCo spec of ``robot``'s own description, and the collision elements it skipped: its URDF with its
+    collision geometry, without its joints' ``<dynamics>`` (:func:`~wbfriction.model.mjspec.urdf_model_spec`; read from
+    ``inertias_urdf``, a copy with identified inertias, when given, the meshes found from the robot's URDF), or its
+    MJCF as it is (with a free joint added at its top body if it is a floating base that has none).
 
     Raises:
         ModelError: a file MuJoCo cannot read.
     """
     import mujoco
     if robot.model_format == "urdf":
-        return urdf_spec(robot.urdf, robot.floating_base)
+        spec, skipped = urdf_model_spec(robot.urdf if inertias_urdf is None else inertias_urdf, robot.floating_base,
+                                        robot.urdf)
+        for geom in spec.geoms:  # the robot's own: no self-collision (its meshes overlap at the joints)
+            geom.conaffinity = 0
+        return spec, skipped
     try:
         spec = mujoco.MjSpec.from_file(str(robot.urdf))
     except Exception as exc:  # mujoco raises ValueError with its parser's message
@@ -136,7 +155,7 @@ def robot_spec(robot: Robot) -> mujoco.MjSpec:
     if robot.floating_base and base is not None and not any(j.type == mujoco.mjtJoint.mjJNT_FREE
                                                             for j in base.joints):
         base.add_freejoint()
-    return spec
+    return spec, ()
 
 
 def _add_link_sites(spec: mujoco.MjSpec) -> None:
@@ -220,21 +239,32 @@ def mujoco_spec(robot: Robot, friction: Mapping[str, FrictionLike], armature: Ma
             inertia model of another robot, inertias of a robot loaded from an MJCF.
         ModelError: a URDF MuJoCo cannot read, or whose joints are not the robot's.
     """
-    return _spec(robot, joint_exports(friction, armature, robot), inertias)
+    return _spec(robot, joint_exports(friction, armature, robot), inertias).spec
 
 
-def _spec(robot: Robot, joints: Mapping[str, JointExport], inertias: pin.Model | None) -> mujoco.MjSpec:
-    """:func:`mujoco_spec` of the joints' simulator parameters (:func:`joint_exports`)."""
+@dataclass
+class _Built:
+    """What :func:`_spec` built: the spec, the collision elements skipped, notes beside joints."""
+
+    spec: mujoco.MjSpec
+    skipped: tuple[str, ...]
+    notes: dict[str, str]
+
+
+def _spec(robot: Robot, joints: Mapping[str, JointExport], inertias: pin.Model | None) -> _Built:
+    """:func:`mujoco_spec` of the joints' simulator parameters (:func:`joint_exports`), with what was skipped."""
     import mujoco
     if inertias is None:
-        spec = robot_spec(robot)
+        spec, skipped = robot_spec(robot)
     else:
         robot.require_urdf("exporting identified inertias")
         pi = identified_parameters(robot, inertias)
         with tempfile.TemporaryDirectory(prefix="wbfriction-mjcf-") as tmp:
             path = Path(tmp) / Path(robot.urdf).name
             write_urdf(robot, pi, path)
-            spec = urdf_spec(path, robot.floating_base)
+            spec, skipped = robot_spec(robot, path)
+    for key in list(spec.keys):  # a model file's keyframes: their sizes are that file's
+        spec.delete(key)
     for name, value in robot.locked_joints.items():
         _lock_joint(spec, name, value)
     names = {j.name for j in spec.joints if j.type != mujoco.mjtJoint.mjJNT_FREE}
@@ -243,6 +273,7 @@ def _spec(robot: Robot, joints: Mapping[str, JointExport], inertias: pin.Model |
         raise ModelError(f"{robot.urdf}: the MuJoCo model's joints are not robot '{robot.name}''s "
                          f"(e.g. '{odd[0]}')")
     _add_link_sites(spec)
+    notes: dict[str, str] = {}
     for name in robot.actuated:
         joint, exp = spec.joint(name), joints.get(name)
         if exp is not None and exp.viscous is not None and exp.coulomb is not None:
@@ -254,7 +285,11 @@ def _spec(robot: Robot, joints: Mapping[str, JointExport], inertias: pin.Model |
     drive = drive_export(robot, joints)
     if drive is not None:
         _add_drives(spec, drive)
-    return spec
+    add_motors(spec, robot, () if drive is None else drive.joints)
+    if robot.floating_base:
+        add_floor(spec)
+    add_stance(spec, robot, drive, compile_spec(spec.copy(), robot.urdf))
+    return _Built(spec, skipped, notes)
 
 
 def _add_drives(spec: mujoco.MjSpec, drive: DriveExport) -> None:
@@ -337,13 +372,28 @@ def _num(values) -> str:
     return " ".join(repr(float(x)) for x in np.atleast_1d(values))
 
 
+def _vector(element: ET._Element, key: str, default: Sequence[float]) -> np.ndarray:
+    text = element.get(key)
+    return np.array(default if text is None else [float(x) for x in text.split()], dtype=float)
+
+
 def _unwrap_frames(root: ET._Element) -> None:
-    """Replace every ``<frame>`` by its children (deepest first): the bodies' placements are then
-    set from the compiled model, relative to their parent body."""
+    """Replace every ``<frame>`` by its children (deepest first), the frame's placement composed into each child
+    ``<geom>``'s and ``<site>``'s: the bodies' placements (and sites') are then set from the compiled model,
+    relative to their parent body."""
+    import mujoco
     for frame in reversed(list(root.iter("frame"))):
         parent = frame.getparent()
         index = parent.index(frame)
+        pos, quat = _vector(frame, "pos", (0, 0, 0)), _vector(frame, "quat", (1, 0, 0, 0))
+        turn = np.zeros(9)
+        mujoco.mju_quat2Mat(turn, quat / np.linalg.norm(quat))
         for child in reversed(list(frame)):
+            if child.tag in ("geom", "site"):
+                q = np.zeros(4)
+                mujoco.mju_mulQuat(q, quat / np.linalg.norm(quat), _vector(child, "quat", (1, 0, 0, 0)))
+                child.set("pos", _num(pos + turn.reshape(3, 3) @ _vector(child, "pos", (0, 0, 0))))
+                child.set("quat", _num(q))
             parent.insert(index, child)
         parent.remove(frame)
 
@@ -430,6 +480,7 @@ def mjcf_xml(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: Sequence[str] =
                 site.set("quat", _num(model.site_quat[s]))
     _order_bodies(root, joints)
     _actuators_in_full(root, model, actuators, actuator_note)
+    _keys_in_full(root, model)
     ET.indent(root, "  ")
     return ET.tostring(root, encoding="unicode") + "\n"
 
@@ -441,25 +492,49 @@ def _trimmed(values: np.ndarray) -> np.ndarray:
 
 
 def _actuators_in_full(root: ET._Element, model: mujoco.MjModel, names: Sequence[str], note: str | None) -> None:
-    """Rewrite the numbers of the actuators ``names`` from ``model`` at full precision, and put ``note`` at the top
-    of ``<actuator>`` (:func:`mjcf_xml`)."""
+    """Rewrite the numbers of the actuators ``names`` (``gainprm``, ``biasprm``, ``delay``) and every actuator's
+    ``ctrlrange`` and ``forcerange`` from ``model`` at full precision, and put ``note`` at the top of ``<actuator>``
+    (:func:`mjcf_xml`)."""
     import mujoco
     section = root.find("actuator")
-    if section is None or not names:
+    if section is None:
         return
     for element in section:
         name = element.get("name")
-        if element.tag is ET.Comment or name not in names:
+        if element.tag is ET.Comment or not name:
             continue
         a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+        for key, values in (("ctrlrange", model.actuator_ctrlrange), ("forcerange", model.actuator_forcerange)):
+            if key in element.attrib:
+                element.set(key, _num(values[a]))
+        if name not in names:
+            continue
         element.set("gainprm", _num(_trimmed(model.actuator_gainprm[a])))
         element.set("biasprm", _num(_trimmed(model.actuator_biasprm[a])))
-        if "forcerange" in element.attrib:
-            element.set("forcerange", _num(model.actuator_forcerange[a]))
         if "delay" in element.attrib:
             element.set("delay", _num(model.actuator_delay[a]))
-    if note is not None:
+    if note is not None and names:
         section.insert(0, ET.Comment(note))
+
+
+def _keys_in_full(root: ET._Element, model: mujoco.MjModel) -> None:
+    """Rewrite each keyframe's ``qpos`` and ``ctrl`` from ``model`` at full precision, ``qpos`` in the order of the
+    text's joints (its bodies may be reordered: :func:`_order_bodies`) (:func:`mjcf_xml`)."""
+    import mujoco
+    sizes = {int(mujoco.mjtJoint.mjJNT_FREE): 7, int(mujoco.mjtJoint.mjJNT_BALL): 4}
+    free = [j for j in range(model.njnt) if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE]
+    order = []
+    for element in root.find("worldbody").iter("joint", "freejoint"):
+        name = element.get("name")
+        order.append(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) if name else free.pop(0))
+    for key in root.iter("key"):
+        k = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, key.get("name") or "")
+        if k >= 0:
+            qpos = [model.key_qpos[k, model.jnt_qposadr[j]:model.jnt_qposadr[j] + sizes.get(int(model.jnt_type[j]), 1)]
+                    for j in order]
+            key.set("qpos", _num(np.concatenate(qpos) if qpos else model.key_qpos[k]))
+            if model.nu:
+                key.set("ctrl", _num(model.key_ctrl[k]))
 
 
 def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | Path,
@@ -473,27 +548,32 @@ def write_mjcf(robot: Robot, friction: Mapping[str, FrictionLike], path: str | P
     Raises:
         what :func:`mujoco_spec` raises; InputError: an output folder that does not exist.
     """
-    return write_model(path, robot, joint_exports(friction, armature, robot), inertias)
+    return write_model(path, robot, joint_exports(friction, armature, robot), inertias)[0]
 
 
 def write_model(path: str | Path, robot: Robot, joints: Mapping[str, JointExport],
-                inertias: pin.Model | None = None) -> mujoco.MjModel:
+                inertias: pin.Model | None = None) -> tuple[mujoco.MjModel, tuple[str, ...]]:
     """:func:`write_mjcf` of the joints' simulator parameters (joint -> :class:`JointExport`,
-    :func:`~wbfriction.export.mapping.joint_exports`): same returns and errors."""
+    :func:`~wbfriction.export.mapping.joint_exports`): same errors.
+
+    Returns:
+        the compiled model the file holds, and the URDF's collision elements left out (one
+        ``"<link>: <file> (<why>)"`` each: :func:`~wbfriction.model.mjspec.keep_collision_geometry`).
+    """
     import mujoco
-    spec = _spec(robot, joints, inertias)
+    built = _spec(robot, joints, inertias)
+    spec = built.spec
     model = compile_spec(spec, robot.urdf)
     notes = {name: note for name, exp in joints.items() if (note := status_note(exp)) is not None}
+    notes.update(built.notes)
     drive = drive_export(robot, joints)
-    if drive is None:
-        text = mjcf_xml(spec, model, robot.actuated, notes)
-    else:
-        text = mjcf_xml(spec, model, robot.actuated, notes, drive.joints, drive_note(drive, model))
+    note = None if drive is None else drive_note(drive, model)
+    text = mjcf_xml(spec, model, robot.actuated, notes, () if drive is None else drive.joints, note)
     write_atomic(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     if [model.joint(j).name for j in range(model.njnt) if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE] \
             != list(robot.actuated):  # bodies reordered in the file: its model, in its order
         model = compile_spec(mujoco.MjSpec.from_file(str(path)), path)
-    return model
+    return model, built.skipped
 
 
 class MjcfTarget(ExportTarget, kind=MJCF):
@@ -502,7 +582,12 @@ class MjcfTarget(ExportTarget, kind=MJCF):
 
 
     def write(self, path: Path, robot: Robot, joints: Mapping[str, JointExport]) -> ExportReport:
-        """:func:`write_model` (the URDF's inertias)."""
-        write_model(path, robot, joints)
+        """:func:`write_model` (the URDF's inertias); a warning names the collision meshes left out."""
+        _, skipped = write_model(path, robot, joints)
         held_back = held_back_warning(robot)
-        return self.report(path, joints, () if held_back is None else (held_back,))
+        warnings: tuple[str, ...] = () if held_back is None else (held_back,)
+        if skipped:  # one line within 100 columns with "warning: " before it (a long file name aside)
+            links = sorted({line.split(":", 1)[0] for line in skipped})
+            named = links[0] + (f" and {len(links) - 1} more" if len(links) > 1 else "")
+            warnings += (f"{path.name}: left out {len(skipped)} collision mesh(es) MuJoCo cannot load: {named}",)
+        return self.report(path, joints, warnings)

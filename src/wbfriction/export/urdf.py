@@ -4,8 +4,12 @@ Each exported joint gets ``<dynamics damping="F_v" friction="F_c"/>`` (:mod:`wbf
 viscous [N·m·s/rad] and Coulomb [N·m] friction of model (3.5); the Stribeck bump, its tanh slope
 and the offset tau_os have no URDF field), after a comment with its fit's status when it comes from a fit
 (:func:`~wbfriction.export.mapping.status_note`; one written by an earlier export is replaced). URDF has no
-armature field either: the armature is not written (MJCF and Isaac Lab hold it). Everything else is the
-given URDF's: other joints keep their ``<dynamics>``, comments and meshes stay. Identified inertias go in through
+armature field either: the armature is not written (MJCF and Isaac Lab hold it). The robot's other actuated joints
+hold no friction, as in the MJCF: their ``<dynamics>``, where they have one, get ``damping="0.0" friction="0.0"``
+(its other attributes kept; the URDF's values are its author's simulator settings, not measurements: TALOS's
+1.0 N·m on 18 joints whatever the joint, the real KUKA LWR4+'s file negative frictions). Everything else is the
+given URDF's: joints the robot does not actuate (fixed, locked) keep their ``<dynamics>``, comments and meshes
+stay. Identified inertias go in through
 :func:`wbfriction.inertia.urdf.write_urdf` (bodies merged by Pinocchio split back over their links).
 
 Pinocchio reads the written file's ``<dynamics>`` into ``model.damping`` and ``model.friction``
@@ -14,7 +18,7 @@ Pinocchio reads the written file's ``<dynamics>`` into ``model.damping`` and ``m
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -47,15 +51,24 @@ def identified_parameters(robot: Robot, inertias: pin.Model) -> np.ndarray:
     return body_parameters(inertias)
 
 
-def set_dynamics(root: ET._Element, joints: Mapping[str, JointExport]) -> None:
+def set_dynamics(root: ET._Element, joints: Mapping[str, JointExport], others: Sequence[str] = ()) -> None:
     """Set ``<dynamics damping friction>`` of every joint of ``joints`` with friction (in place),
     after its other children for a joint that had none, with its :func:`status_note` as a comment
-    before it (replacing one an earlier export wrote in that joint).
+    before it (replacing one an earlier export wrote in that joint); ``others``, joints without exported friction
+    (the robot's other actuated joints), get ``damping="0.0" friction="0.0"`` where they have ``<dynamics>`` (as the
+    MJCF: no friction but the fitted one; their other attributes kept).
 
     Raises:
         InputError: a joint the URDF does not have.
     """
     elements = {j.get("name"): j for j in root.findall("joint")}
+    for name in others:
+        dyn = None if name in joints and joints[name].has_friction else elements.get(name)
+        dyn = None if dyn is None else dyn.find("dynamics")
+        if dyn is not None:
+            for key in ("damping", "friction"):
+                if key in dyn.attrib:
+                    dyn.set(key, "0.0")
     for name, exp in joints.items():
         if not exp.has_friction:
             continue
@@ -123,7 +136,7 @@ def write_dynamics(path: str | Path, robot: Robot, joints: Mapping[str, JointExp
             except OutputError as exc:  # refused beside ours: the same refusal, reported for the output named
                 raise (OSError(exc.errno, exc.reason) if exc.errno is not None else OSError(exc.reason)) from exc
         tree = read_urdf(tmp if pi is not None else robot.urdf)
-        set_dynamics(tree.getroot(), joints)
+        set_dynamics(tree.getroot(), joints, robot.actuated)
         # serialised in memory, then written by Python: a refused write is the OSError write_atomic reports in one
         # line (lxml's own file writing raised its SerialisationError on a full disk, a traceback)
         tmp.write_bytes(ET.tostring(tree, xml_declaration=True, encoding="utf-8"))

@@ -47,7 +47,8 @@ def export_files(robot: Robot, params: str | Path, outputs: Sequence[str | Path]
     warnings say what was rounded.
 
     Only fits whose status is ``ok`` are exported, and those ``include`` names (``weak``, ``at-bound``;
-    :func:`~wbfriction.export.mapping.select_fits`); the other joints keep what the robot's model file has.
+    :func:`~wbfriction.export.mapping.select_fits`); the other actuated joints hold no friction (a URDF's
+    ``<dynamics>`` set to 0 in the ``.urdf``, none in the ``.xml``; an MJCF model file's own values kept).
     Every output name and the parameters are checked before anything is written; each file is written whole
     or not at all.
 

@@ -86,7 +86,8 @@ class _Drives:
 
 
 def _drives(model, robot: Robot, source: str) -> _Drives:
-    """The actuators of the robot's PD-driven joints in ``model``, each named as its joint and driving it."""
+    """The actuators of the robot's PD-driven joints in ``model``, each named as its joint and driving it, a position
+    actuator (affine bias; not the ``<motor>`` an export writes on a torque-controlled joint)."""
     import mujoco
 
     if robot.pd is None:
@@ -97,9 +98,10 @@ def _drives(model, robot: Robot, source: str) -> _Drives:
             mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
         if joint < 0:
             raise InputError(f"{source}: no joint '{name}' (a joint of {robot.name}): not this robot's model")
-        if act < 0 or model.actuator_trnid[act, 0] != joint:
-            raise InputError(f"{source}: no actuator named '{name}' driving its joint (what 'wbfriction export' "
-                             f"writes for a PD-driven joint)")
+        if act < 0 or model.actuator_trnid[act, 0] != joint \
+                or model.actuator_biastype[act] != mujoco.mjtBias.mjBIAS_AFFINE:  # a motor: a torque-driven export
+            raise InputError(f"{source}: no position actuator named '{name}' driving its joint (what 'wbfriction "
+                             f"export' writes for a PD-driven joint)")
         acts.append(act)
         qpos.append(model.jnt_qposadr[joint])
         dofs.append(model.jnt_dofadr[joint])
