@@ -151,7 +151,7 @@ def test_a_joint_name_no_font_draws_is_drawn_readable_without_a_warning(estimate
 
 def test_the_drawn_fit_passes_through_the_samples_it_predicts_with_its_terms_and_family():
     """Issue 63: the KUKA's lwr_6 was drawn at +2.3 N·m where its samples sat at 0-0.5 (a velocity curve without
-    the terms its fit kept) and every legend said ``fit (coulomb-viscous)`` (issue 67). Constructed: a joint whose friction is a
+    the terms its fit kept) and every legend said ``fit (coulomb-viscous)``. Constructed: a joint whose friction is a
     Stribeck curve with an offset and a position ripple of 0.4 N·m, exactly; another a Coulomb-viscous curve. The
     drawn data (not the picture) of the first pass through every valid sample to rounding; the second's curve
     meets its samples; each panel's legend names its own model."""

@@ -493,7 +493,7 @@ def _spectrum_panel(ax: Axes, spectrum: tuple[np.ndarray, np.ndarray, float] | N
         ax.set_visible(False)
 
 
-def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, target: FrictionParams | None,
+def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, target: ModelParams | None,
                  spectrum: tuple[np.ndarray, np.ndarray, float] | None = None, max_freq: float = 50.0) -> Figure:
     """One joint at a glance, four panels in two rows, :data:`REPORT_WIDTH` inches wide with fonts of
     :data:`READABLE` size:

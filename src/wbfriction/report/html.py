@@ -364,9 +364,9 @@ def report_figure(r: Report, joint: str | None, spectra: Mapping[str, tuple[np.n
                   | None = None) -> Figure:
     """A figure of the report as the page shows it: the overview (``joint`` None:
     :func:`~wbfriction.report.figures.friction_overview_figure` of the joints that moved) or one joint's
-    (:func:`~wbfriction.report.figures.joint_figure`); ``spectra`` as :func:`~wbfriction.report.build.acceleration_spectra`
-    gives them (computed when None)."""
-    targets = {j: f.target for j, f in r.fits.items() if f.target is not None}
+    (:func:`~wbfriction.report.figures.joint_figure`); ``spectra`` as
+    :func:`~wbfriction.report.build.acceleration_spectra` gives them (computed when None)."""
+    targets: dict[str, ModelParams] = {j: f.target for j, f in r.fits.items() if f.target is not None}
     if joint is None:
         joints = list(r.moved)
         return friction_overview_figure(r.est, joints, r.fits, targets, {e.joint for e in r.flagged},
