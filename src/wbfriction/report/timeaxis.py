@@ -87,7 +87,8 @@ def time_panels(fig: Figure | SubFigure, spec: Any, time: np.ndarray, plot: Plot
     (:func:`log_runs`), each from its run's start (a shared y axis; the panels' widths in proportion to the runs'
     durations, none under a sixth of the widest), and ``plot`` called on each. One run: one axes, time from the
     log's start. More than :data:`MAX_PANELS` runs: one axes of recorded time, each run after the one before
-    (dotted lines at the gaps cut out). ``xlabel`` goes under the panels. Returns the axes, the first run's first,
+    (dotted lines at the gaps cut out). ``xlabel`` goes under each panel (``time from its start [s]`` where there
+is room). Returns the axes, the first run's first,
 each labelled ``time...`` (:meth:`~matplotlib.artist.Artist.get_label`: a test finds the axes over time)."""
     t = np.asarray(time, dtype=float)
     runs = log_runs(t)
@@ -115,8 +116,9 @@ each labelled ``time...`` (:meth:`~matplotlib.artist.Artist.get_label`: a test f
         ax.set_title(run_title(k, run), fontsize="small", loc="left")
         if k:
             ax.tick_params(labelleft=False)
+        wide = ratios[k] >= 0.3 * ratios.sum()  # room for the longer label
+        ax.set_xlabel(xlabel.replace("time", "time from its start") if wide else xlabel)
         axes.append(ax)
-    axes[len(axes) // 2].set_xlabel(f"{xlabel} from each run's start")
     return axes
 
 
