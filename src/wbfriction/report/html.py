@@ -471,6 +471,9 @@ share of the valid samples where the friction estimate generates power (eq. 7.9)
 {_determination_section(r)}
 {"" if r.identification is None else _identification_section(r, r.identification)}
 <h2 id="joints">Joints that moved</h2>
+<p class="sub">Each joint's figure: (a) its friction over velocity and its fit; (b) τ_f over time in seconds from the
+log's start, a panel per run where gaps split it (each from its own start), by support phase (single dark blue,
+double green, flight red; valid samples orange); (c) Fig. 7.4 over its widest valid stretch; (d) Fig. 7.1.</p>
 <nav class="joints">{nav}</nav>
 {''.join(sections)}
 {still}
