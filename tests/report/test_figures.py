@@ -175,8 +175,8 @@ def test_the_drawn_fit_passes_through_the_samples_it_predicts_with_its_terms_and
     fits = {"lwr_6": FitResult(joint="lwr_6", n_samples=3000, params=stribeck, success=True, terms=terms),
             "other": FitResult(joint="other", n_samples=3000, params=plain, success=True)}
     fig = friction_overview_figure(est, ["lwr_6", "other"], fits, {})
-    for ax, i, name in zip(fig.axes, (0, 1), ("fit (stribeck + ripple), at the samples", "fit (coulomb-viscous)")):
-        line = next(ln for ln in ax.get_lines() if ln.get_label().startswith("fit ("))
+    for ax, i, name in zip(fig.axes, (0, 1), ("fit: stribeck + ripple", "fit: coulomb-viscous")):
+        line = next(ln for ln in ax.get_lines() if ln.get_label().startswith("fit: "))
         assert line.get_label() == name
         assert [text.get_text() for text in ax.get_legend().get_texts()] == [name]
         x, y = np.asarray(line.get_xdata()), np.asarray(line.get_ydata())
@@ -187,3 +187,38 @@ def test_the_drawn_fit_passes_through_the_samples_it_predicts_with_its_terms_and
             assert np.allclose(np.interp(qd[away, 1], x, y), tau_f[away, 1], atol=1e-9)
     velocity_only = stribeck.torque(qd[:, 0])  # what was drawn before: off the samples by the offset and ripple
     assert np.max(np.abs(velocity_only - tau_f[:, 0])) > 0.2
+
+
+def test_runs_of_a_log_stamped_in_epoch_seconds():
+    """Issue 67: two runs of 25 s at 200 Hz, 29 min apart, stamped in Unix epoch seconds (the KUKA's): two runs,
+    the second from 29 min 25 s; each sample's time from its run's start; a 0.1 s dropout in a run is no new run."""
+    from wbfriction.report.timeaxis import log_runs, run_title, time_from_start
+
+    run = np.arange(5000) * 0.005
+    t = 1.46e9 + np.r_[run, run + 25.0 + 29 * 60]
+    runs = log_runs(t)
+    assert [(r.rows.start, r.rows.stop) for r in runs] == [(0, 5000), (5000, 10000)]
+    assert runs[1].start == pytest.approx(25.0 + 29 * 60, abs=1e-6)
+    assert run_title(1, runs[1]) == "run 2, from 29.4 min"
+    assert np.allclose(time_from_start(t), np.r_[run, run], atol=1e-5)
+    dropout = np.r_[run[:2000], run[2020:]]  # 20 samples lost: a step of 0.105 s, 0.4 % of the run
+    assert len(log_runs(dropout)) == 1
+
+
+def test_time_panels_one_per_run():
+    """Two runs: two axes side by side, each from 0 to its duration, a shared torque axis; five runs (more than
+    MAX_PANELS): one axes of recorded time, the runs one after the other."""
+    from matplotlib.figure import Figure
+
+    from wbfriction.report.timeaxis import MAX_PANELS, time_panels
+
+    run = np.arange(2000) * 0.01
+    for n in (1, 2, MAX_PANELS + 1):
+        t = 1.46e9 + np.concatenate([run + k * 3600.0 for k in range(n)])
+        fig = Figure()
+        axes = time_panels(fig, fig.add_gridspec(1, 1)[0, 0], t, lambda ax, rows, x: ax.plot(x, np.sin(x)))
+        assert len(axes) == (n if n <= MAX_PANELS else 1)
+        for ax in axes:
+            x = np.concatenate([line.get_xdata() for line in ax.get_lines()])
+            assert x.min() == 0 and x.max() == pytest.approx(19.99 if len(axes) > 1 else 19.99 * n + 0.01 * (n - 1))
+        png_bytes(fig)

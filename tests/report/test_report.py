@@ -1,16 +1,22 @@
-"""The HTML report: its content from a simulated walk, and how it renders in a real browser
-(headless Chromium, Debian's ``chromium`` and ``chromium-driver``, which ``.ci/run`` installs)."""
+"""The HTML report: its content from a simulated walk, its figures as drawn, and how it renders in a real browser
+(headless Chromium, Debian's ``chromium`` and ``chromium-driver``, which ``.ci/run`` installs; :mod:`report_checks`).
+The real arm's report: ``test_report_kuka.py``."""
 
 from __future__ import annotations
 
 import base64
 import re
-import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from report_checks import (
+    CHROMIUM_MISSING,
+    check_figures,
+    check_fits_drawn_in_their_samples,
+    check_page,
+    render_in_chromium,
+)
 from wbfriction.exceptions import InputError
 from wbfriction.fit.joints import fit_estimate
 from wbfriction.fit.params_file import fit_to_dict, read_params
@@ -22,10 +28,8 @@ from wbfriction.logs.tables import write_table
 from wbfriction.report.build import acceleration_spectra, make_report
 from wbfriction.report.html import render_html, write_report
 
-pytestmark = pytest.mark.slow  # module fixtures of 30-55 s (the quick subset: -m "not slow")
-
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-CHROMEDRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
+pytestmark = [pytest.mark.slow,  # module fixtures of 30-55 s (the quick subset: -m "not slow")
+              pytest.mark.xdist_group("report_walk")]  # computed once
 
 
 @pytest.fixture(scope="module")
@@ -156,84 +160,19 @@ def test_spectrum_is_that_of_the_estimated_acceleration(talos, combined_walk, ta
     np.testing.assert_allclose(ours[1], dyn_spec.amplitude[:, 0], rtol=1e-6, atol=1e-9)
 
 
-_PAGE_TEXT = """
-const rects = [], small = [];
-const walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
-let node, k = 0;
-while ((node = walker.nextNode())) {
-  const text = node.textContent.trim();
-  const el = node.parentElement;
-  if (!text || !el.checkVisibility()) continue;
-  const size = parseFloat(getComputedStyle(el).fontSize);
-  if (size < 11) small.push([text.slice(0, 40), size]);
-  const range = document.createRange();
-  range.selectNodeContents(node);
-  for (const r of range.getClientRects())
-    if (r.width > 0 && r.height > 0)
-      rects.push([k, r.left, r.top + scrollY, r.right, r.bottom + scrollY, text.slice(0, 40)]);
-  k++;
-}
-rects.sort((a, b) => a[2] - b[2]);
-const overlaps = [];
-for (let i = 0; i < rects.length; i++)
-  for (let j = i + 1; j < rects.length && rects[j][2] < rects[i][4] - 1; j++) {
-    const a = rects[i], b = rects[j];
-    if (a[0] === b[0]) continue;
-    const w = Math.min(a[3], b[3]) - Math.max(a[1], b[1]), h = Math.min(a[4], b[4]) - Math.max(a[2], b[2]);
-    if (w > 1 && h > 1) overlaps.push([a[5], b[5]]);
-  }
-const images = [...document.images].map(im => [im.id, im.complete, im.naturalWidth, im.getBoundingClientRect().width]);
-const cut = [...document.querySelectorAll("table")].filter(t => t.getBoundingClientRect().width > 0)
-  .map(t => [t.id || t.className || t.rows[0].textContent.slice(0, 40), t.scrollWidth,
-             (t.closest(".scroll") || document.body).clientWidth])
-  .filter(([, table, room]) => table > room);
-return {small, overlaps, texts: rects.length, images, width: document.documentElement.scrollWidth, cut};
-"""
-"""What the page shows at 1400 px, measured in the browser: texts under 11 px, pairs of texts whose boxes overlap,
-the images (id, loaded, natural width, width shown), the page's width and the tables wider than the room they
-have (their columns cut, to be scrolled to)."""
+def test_walk_report_figures_read_right(talos, true_report):
+    """Issue 67, the simulated walk: every ``ok`` fit drawn inside its samples, no overlapping text in any figure
+    (matplotlib's own text boxes), time in seconds from the walk's start."""
+    assert len(check_fits_drawn_in_their_samples(true_report)) >= 8
+    check_figures(true_report)
 
 
-@pytest.mark.skipif(not (Path(CHROMIUM).exists() and Path(CHROMEDRIVER).exists()),
-                    reason="Debian's chromium and chromium-driver are not both installed (.ci/run installs them)")
+@CHROMIUM_MISSING
 def test_report_renders_in_headless_chromium(talos, report_file, tmp_path):
-    """At 1400 px in headless Chromium: every figure loads and is shown at its own size (its fonts, at least
-    11 px, stay so), no text of the page is under 11 px, no two texts overlap, nothing is wider than the
-    window, no table wider than its room; a joint that moved has its figure, one that did not has none.
-    Screenshots go to ``tmp_path``."""
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-
-    options = webdriver.ChromeOptions()
-    options.binary_location = CHROMIUM
-    for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                 "--disable-dev-shm-usage", f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1400,1000",
-                 "--hide-scrollbars"):
-        options.add_argument(flag)
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    driver = webdriver.Chrome(service=Service(executable_path=CHROMEDRIVER), options=options)
-    try:
-        driver.get(report_file.as_uri())
-        assert driver.execute_script("return document.readyState") == "complete"
-        assert "wbfriction report" in driver.title
-        severe = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
-        assert not severe, severe
-        page = driver.execute_script(_PAGE_TEXT)
-        assert page["texts"] > 500
-        assert not page["small"], page["small"][:10]
-        assert not page["overlaps"], page["overlaps"][:10]
-        assert page["width"] <= 1400
-        assert not page["cut"], page["cut"]  # every table whole at 1400 px (issue 39)
-        images = {i: (loaded, natural, shown) for i, loaded, natural, shown in page["images"]}
-        for i, (loaded, natural, shown) in images.items():
-            assert loaded and natural >= 1000 and shown == natural, (i, natural, shown)
-        walking, held = _walking_and_still(talos)
-        assert all(f"fig-joint-{j.replace('_', '-')}" in images for j in walking)
-        assert not any(f"fig-joint-{j.replace('_', '-')}" in images for j in held)
-        assert "overview" in images
-        for k, y in enumerate(range(0, driver.execute_script("return document.body.scrollHeight"), 900)):
-            driver.execute_script(f"window.scrollTo(0, {y})")
-            driver.save_screenshot(str(tmp_path / f"report_{k:02d}.png"))
-    finally:
-        driver.quit()
+    """At 1400 px in headless Chromium (:func:`check_page`): the simulated walk's page; a joint that moved has its
+    figure, one that did not has none."""
+    images = check_page(render_in_chromium(report_file, tmp_path), 500)
+    walking, held = _walking_and_still(talos)
+    assert all(f"fig-joint-{j.replace('_', '-')}" in images for j in walking)
+    assert not any(f"fig-joint-{j.replace('_', '-')}" in images for j in held)
+    assert "overview" in images

@@ -26,6 +26,7 @@ from wbfriction.fit.result import FitResult
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.models import FrictionParams, ModelParams
 from wbfriction.logs.tables import write_atomic
+from wbfriction.report.timeaxis import log_runs, time_from_start, time_panels, widest_run
 
 _DOUBLE_SUPPORT_COLOR = "#dddddd"
 REPORT_DPI = 100
@@ -288,7 +289,6 @@ def velocity_panels_figure(panels: list[tuple[str, FrictionEstimate, np.ndarray]
     _save(fig, path)
 
 
-PHASE_COLORS = {"single": "C0", "double": "#9a9a9a", "flight": "C3"}
 
 def _short(joint: str) -> str:
     return joint.replace("_joint", "")
@@ -306,28 +306,57 @@ FIT_DRAWN = ("the fit as it predicts the samples: its curve over velocity; where
 """How :func:`_cloud` draws a fit (the figures' captions say so)."""
 
 
+def drawn_fit(est: FrictionEstimate, i: int, fit: FitResult | None) -> tuple[str, np.ndarray, np.ndarray] | None:
+    """The fit of joint ``i`` as :func:`_cloud` draws it: ``(kind, qd, tau_f)``, ``kind`` ``"curve"`` (a velocity
+    model with no filter: its curve over the valid samples' velocities, 400 points, ``qd`` [rad/s] increasing) or
+    ``"samples"`` (its prediction at each valid sample where it has one,
+    :func:`~wbfriction.fit.predict.predicted_friction`: the terms beyond velocity at the angles, loads and
+    temperatures the log met them, the offset included); ``tau_f`` [N·m] in the sign convention. None: no fit, no
+    parameters or no valid sample."""
+    m = est.valid[:, i]
+    if fit is None or fit.params is None or not m.any():
+        return None
+    terms = fit.kept_terms
+    if terms is None and est.smoother is None:
+        v = np.linspace(est.qd[m, i].min(), est.qd[m, i].max(), 400)
+        return "curve", v, np.asarray(fit.params.torque(v), dtype=float)
+    model = predicted_friction(est, i, fit.params if terms is None else terms, m)
+    drawn = m & np.isfinite(model)
+    return "samples", est.qd[drawn, i], model[drawn]
+
+
+def fit_legend(fit: FitResult, width: int = 30) -> str:
+    """A fit's legend entry, its model (:func:`model_label`), broken before a ``+`` past ``width`` characters so that
+    it fits a small panel: ``fit: coulomb-viscous\n+ load + ripple``."""
+    lines = [f"fit: {fit.model}"]
+    for term in (fit.kept_terms.kept if fit.kept_terms is not None else ()):
+        if len(lines[-1]) + len(term) + 3 > width:
+            lines.append(f"+ {term}")
+        else:
+            lines[-1] += f" + {term}"
+    return "\n".join(lines)
+
+
 def _cloud(ax, est: FrictionEstimate, i: int, fit: FitResult | None, target: ModelParams | None) -> None:
     """The valid estimates of joint ``i`` over its velocity, under the target (wide, grey) and under the fitted
-    model as it predicts those samples (:data:`FIT_DRAWN`, :func:`~wbfriction.fit.predict.predicted_friction`): a
-    model of the velocity alone is a curve over the velocity, dashed, so that it hides no sample; with terms beyond
-    velocity (a ripple, a load, a temperature, which the velocity curve alone leaves out: issue 63) or through the
-    estimate's filter, it is no function of the velocity, and its prediction at each valid sample is drawn, a dot
-    per sample. The legend names its family and terms (:func:`model_label`)."""
+    model as it predicts those samples (:data:`FIT_DRAWN`, :func:`drawn_fit`): a model of the velocity alone is a
+    curve over the velocity, dashed, so that it hides no sample; with terms beyond velocity (a ripple, a load, a
+    temperature, which the velocity curve alone leaves out: issue 63) or through the estimate's filter, it is no
+    function of the velocity, and its prediction at each valid sample is drawn, a dot per sample (an average over
+    velocity would draw a hysteresis loop's two branches as one line between them, where no sample is). The legend
+    names its family and terms (:func:`fit_legend`)."""
     m = est.valid[:, i]
     ax.plot(est.qd[m, i], est.tau_f[m, i], ".", ms=1.5, color="C0", alpha=0.35, zorder=2, rasterized=True)
-    if m.any():
+    if m.any() and target is not None:
         v = np.linspace(est.qd[m, i].min(), est.qd[m, i].max(), 400)
-        if target is not None:
-            ax.plot(v, target.torque(v), color="k", lw=3, alpha=0.25, zorder=1, label="target")
-        if fit is not None and fit.params is not None:
-            label, terms = f"fit ({model_label(fit)})", fit.kept_terms
-            if terms is None and est.smoother is None:
-                ax.plot(v, fit.params.torque(v), color="C1", lw=1.6, ls="--", zorder=3, label=label)
-            else:
-                model = predicted_friction(est, i, fit.params if terms is None else terms, m)
-                drawn = m & np.isfinite(model)
-                ax.plot(est.qd[drawn, i], model[drawn], ".", ms=1.0, color="C1", zorder=3, rasterized=True,
-                        label=label + ", at the samples")
+        ax.plot(v, target.torque(v), color="k", lw=3, alpha=0.25, zorder=1, label="target")
+    drawn = drawn_fit(est, i, fit)
+    if drawn is not None and fit is not None:
+        kind, qd, tau = drawn
+        if kind == "curve":
+            ax.plot(qd, tau, color="C1", lw=1.6, ls="--", zorder=3, label=fit_legend(fit))
+        else:
+            ax.plot(qd, tau, ".", ms=1.0, color="C1", zorder=3, rasterized=True, label=fit_legend(fit))
     ax.axhline(0, color="k", lw=0.4, zorder=0)
     ax.axvline(0, color="k", lw=0.4, zorder=0)
 
@@ -354,27 +383,17 @@ def friction_overview_figure(est: FrictionEstimate, joints: list[str], fits: dic
         for ax in axes[len(joints):]:
             ax.set_visible(False)
         for ax in axes[:len(joints)]:  # each joint's own model in its own legend
-            fitted = [(h, n) for h, n in zip(*ax.get_legend_handles_labels()) if n.startswith("fit (")]
+            fitted = [(h, n) for h, n in zip(*ax.get_legend_handles_labels()) if n.startswith("fit: ")]
             if fitted:
                 ax.legend(*zip(*fitted), loc="best", frameon=False, markerscale=6)
         handles, names = axes[0].get_legend_handles_labels()
-        shared = [(h, n) for h, n in zip(handles, names) if not n.startswith("fit (")]
+        shared = [(h, n) for h, n in zip(handles, names) if not n.startswith("fit: ")]
         if shared:  # under the panels, where it hides no sample
             fig.legend(*zip(*shared), loc="outside lower right", ncols=len(shared))
         fig.supxlabel("qd [rad/s]")
         fig.supylabel("tau_f [N·m]")
         fig.suptitle(title)
     return fig
-
-
-def widest_run(mask: np.ndarray, x: np.ndarray) -> slice:
-    """The stretch of consecutive True values of ``mask`` over which ``x`` spans the widest
-    range (empty slice if none): for Fig. 7.4, the swing phase where the joint moves most."""
-    edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(np.int8), 0]))
-    if edges.size == 0:
-        return slice(0, 0)
-    runs = [slice(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2])]
-    return max(runs, key=lambda r: float(np.nanmax(x[r]) - np.nanmin(x[r])) if np.isfinite(x[r]).any() else -1.0)
 
 
 def _cloud_panel(ax: Axes, est: FrictionEstimate, i: int, fit: FitResult | None,
@@ -388,33 +407,52 @@ def _cloud_panel(ax: Axes, est: FrictionEstimate, i: int, fit: FitResult | None,
         ax.legend(loc="upper right")
 
 
-def _phase_panel(ax: Axes, est: FrictionEstimate, i: int) -> None:
-    """Panel (b) of :func:`joint_figure`: ``tau_f`` over time coloured by support phase, valid samples dark;
-    the axis spans the valid samples (a double-support estimate, never valid, may leave it: said in the title)."""
-    clipped = False
+PHASE_COLORS = {"single": "#1f5fa8", "double": "#2ca02c", "flight": "#d62728"}
+"""Each support phase's colour in panel (b) of :func:`joint_figure`, drawn opaque: dark blue, green, red (the
+valid samples over them in orange)."""
+
+
+def _phase_panel(fig: Figure, spec: Any, est: FrictionEstimate, i: int) -> list[Axes]:
+    """Panel (b) of :func:`joint_figure` in the place ``spec``: ``tau_f`` over time coloured by support phase
+    (:data:`PHASE_COLORS`; one colour, "samples", for a log of one phase, a fixed-base arm's), the valid samples in
+    orange over them; time from the log's start, a panel per run (:func:`~wbfriction.report.timeaxis.time_panels`).
+    The y axis spans the valid samples (a double-support estimate, never valid, may leave it: said in the title)."""
     valid_tau = est.tau_f[est.valid[:, i], i]
     lim = 1.5 * float(np.max(np.abs(valid_tau))) + 1e-6 if valid_tau.size else None
-    for phase, color in PHASE_COLORS.items():
-        sel = est.phase == phase
-        if sel.any():
-            y = np.where(sel, est.tau_f[:, i], np.nan)
-            ax.plot(est.time, y, lw=0.5, color=color, alpha=0.45, label=phase)
-            clipped |= lim is not None and bool(np.nanmax(np.abs(y), initial=0.0) > lim)
-    ax.plot(est.time, np.where(est.valid[:, i], est.tau_f[:, i], np.nan), lw=0.9, color="C1", label="valid")
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("tau_f [N·m]")
-    ax.set_title("(b) tau_f over time by support phase" + (" (axis: valid samples; others clipped)"
-                                                           if clipped else ""))
+    phases = [p for p in PHASE_COLORS if (est.phase == p).any()]
+    clipped = [False]
+
+    def plot(ax: Axes, rows: slice, t: np.ndarray) -> None:
+        tau, phase, valid = est.tau_f[rows, i], est.phase[rows], est.valid[rows, i]
+        for name in phases:
+            y = np.where(phase == name, tau, np.nan)
+            ax.plot(t, y, lw=0.7, color=PHASE_COLORS[name], label=name if len(phases) > 1 else "samples")
+            clipped[0] |= lim is not None and bool(np.nanmax(np.abs(y), initial=0.0) > lim)
+        ax.plot(t, np.where(valid, tau, np.nan), lw=0.9, color="C1", label="valid")
+
+    axes = time_panels(fig, spec, est.time, plot)
+    axes[0].set_ylabel("tau_f [N·m]")
+    title = "(b) tau_f over time by support phase" + (" (axis: valid samples; others clipped)" if clipped[0] else "")
+    if len(axes) > 1:
+        box = axes[0].get_position(), axes[-1].get_position()  # above the runs' titles
+        fig.text(0.5 * (box[0].x0 + box[1].x1), box[0].y1 + 0.035, title, ha="center", va="bottom",
+                 fontsize=READABLE["axes.titlesize"])
+    else:
+        axes[0].set_title(title)
     if lim is not None:
-        ax.set_ylim(-lim, lim)
-    ax.legend(ncol=4, loc="upper right")
+        axes[0].set_ylim(-lim, lim)
+    axes[-1].legend(ncol=2, loc="upper right")
+    return axes
 
 
 def _delta_panel(ax: Axes, est: FrictionEstimate, i: int) -> None:
-    """Panel (c) of :func:`joint_figure` (Fig. 7.4): both schemes' ``Delta qdd`` and ``qd`` over one valid stretch."""
+    """Panel (c) of :func:`joint_figure` (Fig. 7.4): both schemes' ``Delta qdd`` and ``qd`` over one valid stretch,
+    time from its run's start (:func:`~wbfriction.report.timeaxis.time_from_start`)."""
     run = widest_run(est.valid[:, i], est.qd[:, i])
     if est.delta_qdd is not None and run.stop > run.start:
-        t = est.time[run]
+        runs = log_runs(est.time)
+        t = time_from_start(est.time, runs)[run]
+        ax.set_label("time")
         diff = est.metadata.get("estimate_options", {}).get("diff", "estimate")
         ax.plot(t, est.delta_qdd[run, i], color="C0", lw=1, label=f"Δqdd ({diff})")
         if est.companion_delta_qdd is not None:
@@ -429,7 +467,8 @@ def _delta_panel(ax: Axes, est: FrictionEstimate, i: int) -> None:
             top = float(np.nanmax(np.abs(a.get_ylim())))
             a.set_ylim(-top, top)
         ax.legend(loc="upper left")
-        ax.set_xlabel("time [s]")
+        which = next((k for k, r in enumerate(runs) if r.rows.start <= run.start < r.rows.stop), 0)
+        ax.set_xlabel("time [s]" if len(runs) == 1 else f"time from run {which + 1}'s start [s]")
     else:
         ax.text(0.5, 0.5, "no acceleration difference in the table", ha="center", va="center",
                 transform=ax.transAxes)
@@ -454,7 +493,7 @@ def _spectrum_panel(ax: Axes, spectrum: tuple[np.ndarray, np.ndarray, float] | N
         ax.set_visible(False)
 
 
-def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, target: FrictionParams | None,
+def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, target: ModelParams | None,
                  spectrum: tuple[np.ndarray, np.ndarray, float] | None = None, max_freq: float = 50.0) -> Figure:
     """One joint at a glance, four panels in two rows, :data:`REPORT_WIDTH` inches wide with fonts of
     :data:`READABLE` size:
@@ -471,13 +510,12 @@ def joint_figure(est: FrictionEstimate, joint: str, fit: FitResult | None, targe
     with rc_context(READABLE):
         # a fixed layout: constrained layout would cost most of the time of a report's many figures
         fig = Figure(figsize=(REPORT_WIDTH, 6.4))
-        (ax_c, ax_t), (ax_e, ax_s) = fig.subplots(2, 2, gridspec_kw={
-            "width_ratios": [1, 1.3], "wspace": 0.3, "hspace": 0.5, "left": 0.075, "right": 0.985,
-            "bottom": 0.09, "top": 0.95})
-        _cloud_panel(ax_c, est, i, fit, target)
-        _phase_panel(ax_t, est, i)
-        _delta_panel(ax_e, est, i)
-        _spectrum_panel(ax_s, spectrum, max_freq)
+        grid = fig.add_gridspec(2, 2, width_ratios=[1, 1.3], wspace=0.3, hspace=0.5, left=0.075, right=0.985,
+                                bottom=0.09, top=0.93)
+        _cloud_panel(fig.add_subplot(grid[0, 0]), est, i, fit, target)
+        _phase_panel(fig, grid[0, 1], est, i)
+        _delta_panel(fig.add_subplot(grid[1, 0]), est, i)
+        _spectrum_panel(fig.add_subplot(grid[1, 1]), spectrum, max_freq)
     return fig
 
 

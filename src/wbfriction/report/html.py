@@ -12,6 +12,7 @@ import base64
 import html
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -28,6 +29,9 @@ from wbfriction.report.figures import FIT_DRAWN, friction_overview_figure, joint
 from wbfriction.report.numbers import bound_text, duration_text, with_error
 from wbfriction.report.terms import terms_section
 from wbfriction.workers import process_pool
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 PAGE_CSS = """
 body { font-family: system-ui, -apple-system, "Segoe UI", sans-serif; margin: 0 auto; max-width: 1480px;
@@ -356,16 +360,29 @@ _FIGURE_INPUTS: dict = {}
 """What :func:`_figure_image` draws from: set by :func:`_figures` before its workers fork."""
 
 
+def report_figure(r: Report, joint: str | None, spectra: Mapping[str, tuple[np.ndarray, np.ndarray, float]]
+                  | None = None) -> Figure:
+    """A figure of the report as the page shows it: the overview (``joint`` None:
+    :func:`~wbfriction.report.figures.friction_overview_figure` of the joints that moved) or one joint's
+    (:func:`~wbfriction.report.figures.joint_figure`); ``spectra`` as
+    :func:`~wbfriction.report.build.acceleration_spectra` gives them (computed when None)."""
+    targets: dict[str, ModelParams] = {j: f.target for j, f in r.fits.items() if f.target is not None}
+    if joint is None:
+        joints = list(r.moved)
+        return friction_overview_figure(r.est, joints, r.fits, targets, {e.joint for e in r.flagged},
+                                        labels={j: r.label(j) for j in joints})
+    spectra = acceleration_spectra(r.est) if spectra is None else spectra
+    return joint_figure(r.est, joint, r.fits.get(joint), targets.get(joint), spectra.get(joint))
+
+
 def _figure_image(joint: str | None) -> str:
     """The ``<img>`` of the overview figure (``joint`` None) or of one joint's figure."""
-    r, targets, spectra, joints = (_FIGURE_INPUTS[k] for k in ("r", "targets", "spectra", "joints"))
+    r, spectra = _FIGURE_INPUTS["r"], _FIGURE_INPUTS["spectra"]
     if joint is None:
-        flagged = {e.joint for e in r.flagged}
-        labels = {j: r.label(j) for j in joints}
-        return _img(friction_overview_figure(r.est, joints, r.fits, targets, flagged, labels=labels),
-                    "friction of every joint that moved, over velocity", "overview", "overview-figure")
-    fig = joint_figure(r.est, joint, r.fits.get(joint), targets.get(joint), spectra.get(joint))
-    return _img(fig, f"friction of {r.label(joint)}", "fig-" + _anchor(joint), "joint-figure")
+        return _img(report_figure(r, None), "friction of every joint that moved, over velocity", "overview",
+                    "overview-figure")
+    return _img(report_figure(r, joint, spectra), f"friction of {r.label(joint)}", "fig-" + _anchor(joint),
+                "joint-figure")
 
 
 def _joint_section(r: Report, joint: str, image: str) -> str:
@@ -454,6 +471,9 @@ share of the valid samples where the friction estimate generates power (eq. 7.9)
 {_determination_section(r)}
 {"" if r.identification is None else _identification_section(r, r.identification)}
 <h2 id="joints">Joints that moved</h2>
+<p class="sub">Each joint's figure: (a) its friction over velocity and its fit; (b) τ_f over time in seconds from the
+log's start, a panel per run where gaps split it (each from its own start), by support phase (single dark blue,
+double green, flight red; valid samples orange); (c) Fig. 7.4 over its widest valid stretch; (d) Fig. 7.1.</p>
 <nav class="joints">{nav}</nav>
 {''.join(sections)}
 {still}
