@@ -25,6 +25,7 @@ from wbfriction.fit.predict import FrictionCurve, TorquePrediction, predicted_fr
 from wbfriction.fit.terms import TermFit
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.logs.metadata import read_metadata, with_metadata
+from wbfriction.logs.runs import log_runs
 from wbfriction.logs.tables import file_sha256, finite_json
 
 KIND = "wbfriction prediction table"
@@ -48,23 +49,6 @@ COLUMNS = {
 """What each column holds, as the metadata's ``columns`` holds it."""
 
 SIGN_CONVENTION = "tau_f = -f(qd): the torque friction exerts on the joint; residual = measured - predicted"
-
-RUN_GAP = 100.0
-"""A step between two samples of at least this many median steps starts a new run (a log joining recordings made
-apart: the KUKA's runs 1-2, 29 minutes apart): the figure draws each run in its own panel."""
-
-
-def log_runs(time: np.ndarray, gap: float = RUN_GAP) -> list[tuple[int, int]]:
-    """The runs of a log's stamps ``time`` (N,) [s]: half-open row ranges split where a step is at least ``gap``
-    times the median step (every row in one run; one run for fewer than 3 samples)."""
-    n = len(time)
-    if n < 3:
-        return [(0, n)]
-    step = np.diff(time)
-    median = float(np.median(step))
-    edges = [0, *(np.flatnonzero(step >= gap * median) + 1).tolist(), n] if median > 0 else [0, n]
-    return list(zip(edges[:-1], edges[1:]))
-
 
 def _joint_summary(pred: TorquePrediction, i: int, model: str) -> dict[str, Any]:
     check = pred.checks[i] if pred.checks else None
@@ -92,7 +76,7 @@ def prediction_table(est: FrictionEstimate, models: Mapping[str, FrictionCurve |
 
     Returns:
         The Arrow table, N rows; the metadata also holds ``time_origin`` (the log's first stamp [s]), ``runs``
-        (:func:`log_runs`, row ranges) and ``order`` (the joints, in the log's order).
+        (:func:`~wbfriction.logs.runs.log_runs`, row ranges) and ``order`` (the joints, in the log's order).
     """
     cols: dict[str, Any] = {"time": est.time - est.time[0] if len(est.time) else est.time}
     joints = [j for j in est.joints if j in models]
@@ -112,7 +96,7 @@ def prediction_table(est: FrictionEstimate, models: Mapping[str, FrictionCurve |
     index = {j: k for k, j in enumerate(pred.joints)}
     metadata = {"kind": KIND, "units": UNITS, "columns": COLUMNS, "sign_convention": SIGN_CONVENTION,
                 "time_origin": float(est.time[0]) if len(est.time) else 0.0,
-                "runs": [list(r) for r in log_runs(est.time)], "order": joints,
+                "runs": [[r.rows.start, r.rows.stop] for r in log_runs(est.time)], "order": joints,
                 "robot": est.metadata.get("provenance", {}).get("robot"),
                 "sources": {role: {"file": Path(path).name, "sha256": file_sha256(path)}
                             for role, path in (sources or {}).items()},

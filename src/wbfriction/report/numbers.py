@@ -61,25 +61,23 @@ def bound_text(bound: float | None) -> str:
     return f"± {round(bound, -place):.{max(-place, 0)}f}" if -4 <= place <= 4 else f"± {bound:.{digits}e}"
 
 
-GAP_STEPS = 10.0
-"""A time step longer than this many median steps is a gap between recordings, not recorded time."""
-
-
 def duration_text(time: Sequence[float] | np.ndarray) -> str:
     """How long a log lasts: the time recorded (the sum of its steps, gaps left out) and, when gaps split it, the
     span from its first sample to its last and the number of recordings, e.g. ``50.3 s recorded in 2 runs over
     29.3 min``; time [s], increasing."""
     import numpy as np
 
+    from wbfriction.logs.runs import GAP_STEPS, log_runs
+
     t = np.asarray(time, dtype=float)
     if len(t) < 2:
         return "0 s recorded"
     steps = np.diff(t)
-    gap = steps > GAP_STEPS * np.median(steps)
-    recorded = float(steps[~gap].sum())
-    if not gap.any():
+    recorded = float(steps[steps <= GAP_STEPS * np.median(steps)].sum())
+    runs = len(log_runs(t))
+    if runs == 1:
         return f"{_seconds(recorded)} recorded"
-    return f"{_seconds(recorded)} recorded in {int(gap.sum()) + 1} runs over {_seconds(float(t[-1] - t[0]))}"
+    return f"{_seconds(recorded)} recorded in {runs} runs over {_seconds(float(t[-1] - t[0]))}"
 
 
 def _seconds(s: float) -> str:

@@ -3,10 +3,10 @@ figure, per joint the measured and the predicted torque over time and the fricti
 the velocity, in the report's style (:data:`~wbfriction.report.figures.READABLE` fonts,
 :data:`~wbfriction.report.figures.REPORT_WIDTH` inches wide).
 
-The figure is drawn from the table alone, so it shows what the file holds. Time runs from the log's first sample
-[s]; a log joining runs recorded apart (steps of at least :data:`~wbfriction.pipeline.prediction_table.RUN_GAP`
-median steps) is drawn one panel per run, up to :data:`MAX_RUN_PANELS` runs (beyond, one panel whose lines break at
-the gaps): the runs are not squeezed into slivers of one axis.
+The figure is drawn from the table alone, so it shows what the file holds. Its time axes are the report's
+(:func:`~wbfriction.report.timeaxis.time_panels`): seconds from the log's start, a log joining runs recorded apart
+(:func:`~wbfriction.logs.runs.log_runs`) drawn one panel per run, each from its own start: the runs are not
+squeezed into slivers of one axis.
 """
 
 from __future__ import annotations
@@ -26,9 +26,8 @@ from wbfriction.logs.tables import write_atomic
 from wbfriction.pipeline.predict_step import predict_table
 from wbfriction.pipeline.prediction_table import read_prediction_summary
 from wbfriction.report.figures import READABLE, REPORT_WIDTH, joint_label, png_bytes
+from wbfriction.report.timeaxis import time_panels
 
-MAX_RUN_PANELS = 4
-"""Runs drawn each in its own time panel; a log with more is drawn on one axis, its lines broken at the gaps."""
 MAX_POINTS = 20000
 """Samples drawn per joint against the velocity at most (every k-th valid sample beyond): the same cloud, a figure
 drawn in seconds."""
@@ -51,19 +50,19 @@ def _row_title(joint: str, entry: dict) -> str:
             + (f"; RMS of measured - predicted {rms:.3g} N·m" if rms is not None else ""))
 
 
-def _time_panels(axes: list[Axes], table: pa.Table, joint: str, runs: tuple[tuple[int, int], ...]) -> None:
-    """Measured torque (all samples) and predicted (the valid ones) over time, one panel per run (or one panel)."""
-    t = _column(table, "time")
+def _time_plot(table: pa.Table, joint: str):
+    """Draws measured torque (all samples) and predicted (the valid ones) of a run over its time
+    (:data:`~wbfriction.report.timeaxis.PlotRun`)."""
     torque = f"tau.{joint}" in table.column_names
     measured = _column(table, f"tau.{joint}" if torque else f"tau_f.{joint}")
     predicted = _column(table, f"tau_pred.{joint}" if torque else f"tau_f_pred.{joint}")
     valid = table.column(f"valid.{joint}").to_numpy(zero_copy_only=False).astype(bool)
     predicted = np.where(valid, predicted, np.nan)
-    for k, (a, b) in enumerate(runs):  # on one axis, each run its own line: broken at the gaps
-        ax = axes[k] if len(axes) > 1 else axes[0]
-        ax.plot(t[a:b], measured[a:b], color=MEASURED, lw=0.8)
-        ax.plot(t[a:b], predicted[a:b], color=PREDICTED, lw=0.8)
-    axes[0].set_ylabel("tau [N·m]" if torque else "tau_f [N·m]")
+
+    def plot(ax: Axes, rows: slice, t: np.ndarray) -> None:
+        ax.plot(t, measured[rows], color=MEASURED, lw=0.8)
+        ax.plot(t, predicted[rows], color=PREDICTED, lw=0.8)
+    return plot
 
 
 def _velocity_panel(ax: Axes, table: pa.Table, joint: str) -> None:
@@ -91,25 +90,21 @@ def prediction_figure(table: pa.Table, title: str = "") -> Figure:
     """
     info = read_prediction_summary(table)
     joints = list(info.joints)
-    runs = info.runs if len(info.runs) <= MAX_RUN_PANELS else ((0, table.num_rows),)
     t = _column(table, "time")
-    spans = [max(float(t[b - 1] - t[a]), 1e-9) if b > a else 1e-9 for a, b in runs]
-    total = sum(spans)
-    widths = [max(s / total, 0.12) * 2.6 for s in spans] + [1.0]
     with rc_context(READABLE):
         fig = Figure(figsize=(REPORT_WIDTH, ROW_HEIGHT * max(len(joints), 1) + 0.9), layout="constrained")
-        grid = fig.subplots(max(len(joints), 1), len(runs) + 1, squeeze=False, gridspec_kw={"width_ratios": widths})
-        for row, joint in zip(grid, joints):
-            time_axes = list(row[:-1])
-            for ax in time_axes[1:]:
-                ax.sharey(time_axes[0])
-            _time_panels(time_axes, table, joint, info.runs)
-            _velocity_panel(row[-1], table, joint)
-            name = joint_label(joint, joints, joint)
-            time_axes[0].set_title(_row_title(name, info.summary.get(joint, {})), loc="left")
-        for k, ax in enumerate(grid[-1][:-1]):
-            ax.set_xlabel("time from the log's start [s]" + (f" (run {k + 1})" if len(runs) > 1 else ""))
-        grid[-1][-1].set_xlabel("qd [rad/s]")
+        grid = fig.add_gridspec(max(len(joints), 1), 2, width_ratios=[2.6, 1.0])
+        velocity_axes = []
+        for k, joint in enumerate(joints):
+            time_axes = time_panels(fig, grid[k, 0], t, _time_plot(table, joint))
+            velocity_axes.append(fig.add_subplot(grid[k, 1]))
+            _velocity_panel(velocity_axes[-1], table, joint)
+            time_axes[0].set_ylabel("tau [N·m]" if f"tau.{joint}" in table.column_names else "tau_f [N·m]")
+            run = time_axes[0].get_title(loc="left")  # a log of several runs: the first's title
+            title = _row_title(joint_label(joint, joints, joint), info.summary.get(joint, {}))
+            time_axes[0].set_title(title + (f"\n{run}" if run else ""), loc="left")
+        for ax in velocity_axes:
+            ax.set_xlabel("qd [rad/s]")
         fig.suptitle(title or "Measured and predicted torque")
         fig.legend(handles=[Line2D([], [], color=MEASURED, lw=1.5, label="measured torque; estimated friction"),
                             Line2D([], [], color=PREDICTED, lw=1.5, label="predicted by the model")],

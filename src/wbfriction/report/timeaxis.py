@@ -3,55 +3,25 @@ its own panel.
 
 A log's stamps are often those of a clock that started long before (Unix epoch seconds, 1.46e9 s): drawn as they
 are, the axis reads ``1.4600350e9`` with its tick labels on top of each other, and two runs 29 minutes apart are two
-slivers of one axis. :func:`log_runs` finds the runs, :func:`time_panels` gives each run its own axes (widths in
-proportion to its duration, shared torque axis), time from the run's start; the first starts at the log's start, and
-each later one says in its title when it starts.
+slivers of one axis. :func:`~wbfriction.logs.runs.log_runs` finds the runs, :func:`time_panels` gives each run its
+own axes (widths in proportion to its duration, shared torque axis), time from the run's start; the first starts at
+the log's start, and each later one says in its title when it starts.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure, SubFigure
 
-from wbfriction.report.numbers import GAP_STEPS
+from wbfriction.logs.runs import Run, log_runs
 
 MAX_PANELS = 4
 """Most runs drawn as panels of their own; a log with more is drawn on one axis of recorded time, the gaps cut
 out (:func:`time_panels`)."""
-GAP_SHARE = 0.05
-"""A step is a gap between runs when it is longer than :data:`~wbfriction.report.numbers.GAP_STEPS` median steps
-and than this share of the log's recorded time (a dropped packet in a walk is no new run)."""
-
-
-@dataclass(frozen=True)
-class Run:
-    """One run of a log: its rows ``rows`` (a slice of the log's samples) and when it starts, ``start`` [s] from the
-    log's first sample."""
-
-    rows: slice
-    start: float
-
-
-def log_runs(time: np.ndarray) -> list[Run]:
-    """The runs of a log whose stamps are ``time`` (N,) [s], increasing: split where a step is longer than
-    :data:`~wbfriction.report.numbers.GAP_STEPS` median steps and than :data:`GAP_SHARE` of the recorded time (the
-    steps that are not gaps); one run without such a gap, none for an empty log."""
-    t = np.asarray(time, dtype=float)
-    if t.size == 0:
-        return []
-    steps = np.diff(t)
-    if steps.size == 0:
-        return [Run(slice(0, t.size), 0.0)]
-    long = steps > GAP_STEPS * float(np.median(steps))
-    recorded = float(steps[~long].sum())
-    gap = long & (steps > GAP_SHARE * recorded)
-    edges = [0, *(np.flatnonzero(gap) + 1).tolist(), t.size]
-    return [Run(slice(a, b), float(t[a] - t[0])) for a, b in zip(edges[:-1], edges[1:])]
 
 
 def time_from_start(time: np.ndarray, runs: list[Run] | None = None) -> np.ndarray:
