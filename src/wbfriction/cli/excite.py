@@ -20,6 +20,7 @@ from wbfriction.cli.common import (
     refuse_unread,
     robot_of,
 )
+from wbfriction.cli.helpformat import ROBOT
 from wbfriction.exceptions import InputError
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
@@ -52,7 +53,8 @@ if TYPE_CHECKING:
     from wbfriction.excite.pd_design import PdDesign
 
 
-@app.command()
+@app.command(rich_help_panel=ROBOT,
+             short_help="Design a motion to record whose identification determines every parameter")
 def excite(ctx: typer.Context,
            output: list[Path] = typer.Option(..., "-o", "--output",
                                              help="Set-points to write, as many as given (.parquet, .csv): time "

@@ -38,9 +38,10 @@ from wbfriction.cli.common import (
     console,
     term_options,
 )
+from wbfriction.cli.helpformat import FLEETS
 
 
-@app.command()
+@app.command(rich_help_panel=FLEETS)
 def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
                                         help="Manifest (a CSV or Parquet table: its columns hold text; columns "
                                              "log, robot_id, start_time [ISO 8601 with zone], robot or urdf/config, "
@@ -115,7 +116,7 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
         raise typer.Exit(1)
 
 
-@app.command()
+@app.command(rich_help_panel=FLEETS)
 def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results folder written by 'wbfriction "
                                                                        "batch'."),
            output: Path = typer.Option(..., "-o", "--output", help="HTML page to write (.html)."),

@@ -32,6 +32,7 @@ from wbfriction.cli.common import (
     out,
     robot_of,
 )
+from wbfriction.cli.helpformat import STUDIES
 
 
 def _study_table(rows, title: str, params: tuple[str, ...] | None = None) -> Table:
@@ -126,13 +127,14 @@ def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
     return result.files
 
 
-@app.command()
+@app.command(rich_help_panel=STUDIES)
 def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--output-dir", help="Where to write."),
          robot: str = RobotOpt,
          steps: int = typer.Option(GAIT.steps, help="Steps per direction of the combined walk."),
          simulator: Simulator = typer.Option("ideal", help="ideal: Tables 6.1/6.2, Fig. 6.1-6.3; mujoco: the realistic "
                                                      "simulator's study, Fig. 6.4-6.5.")) -> None:
-    """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.5."""
+    """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.3 (--simulator mujoco:
+    the realistic simulator's tables and Fig. 6.4-6.5)."""
     from wbfriction.friction.models import PARAM_NAMES
     from wbfriction.studies.common import worst_errors
     from wbfriction.studies.simulation import run_study
@@ -169,7 +171,7 @@ def _percent(x: float) -> str:
     return f"{x:.1f}" if x < 1e4 else ("inf" if not np.isfinite(x) else ">1e4")
 
 
-@app.command("study-sensors")
+@app.command("study-sensors", rich_help_panel=STUDIES)
 def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-o", "--output-dir",
                                                   help="Where to write."),
                   robot: str = RobotOpt,
@@ -200,7 +202,7 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
         console.print(f"wrote {f}")
 
 
-@app.command("study-noise")
+@app.command("study-noise", rich_help_panel=STUDIES)
 def study_noise(output_dir: Path = typer.Option(Path("wbfriction-noise"), "-o", "--output-dir", help="Where to write."),
                 robots: str = typer.Option("panda,talos", help="Comma-separated built-in robots: an arm (panda) "
                                                                "and a humanoid (talos, on MuJoCo)."),
@@ -238,7 +240,7 @@ def study_noise(output_dir: Path = typer.Option(Path("wbfriction-noise"), "-o", 
     console.print(f"wrote {output_dir / 'noise.md'}, {output_dir / 'noise.json'}")
 
 
-@app.command("study-fleet")
+@app.command("study-fleet", rich_help_panel=STUDIES)
 def study_fleet(output_dir: Path = typer.Option(Path("wbfriction-fleet"), "-o", "--output-dir", help="Where to write."),
                 robots: int = typer.Option(4, min=1, help="Robots of the fleet."),
                 logs: int = typer.Option(25, min=12, help="Logs per robot (one a day)."),
@@ -268,7 +270,7 @@ def study_fleet(output_dir: Path = typer.Option(Path("wbfriction-fleet"), "-o", 
         console.print(f"wrote {f}")
 
 
-@app.command("study-filters")
+@app.command("study-filters", rich_help_panel=STUDIES)
 def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-o", "--output-dir",
                                                   help="Where to write."),
                   robot: str = RobotOpt,
@@ -309,7 +311,7 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
 
 
 
-@app.command("study-quadruped")
+@app.command("study-quadruped", rich_help_panel=STUDIES)
 def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped"), "-o", "--output-dir",
                                                     help="Where to write."),
                     robot: str = typer.Option("go2_walking", help="A built-in quadruped on point feet."),
@@ -339,7 +341,7 @@ def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped")
         raise InputError(f"--robot {robot}: not a robot on point feet (contact_model = \"point\" in its TOML)")
     with console.status("") as status:
         study = run_quadruped(r, case, progress=lambda label: status.update(label))
-    console.print(determination_table(study.shares, r.labels))
+    console.print(determination_table(study.shares))
     out.print(escape(fits_markdown(study)), highlight=False, soft_wrap=True)
     for f in write_study(r, study, output_dir):
         console.print(f"wrote {f}")
