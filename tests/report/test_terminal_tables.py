@@ -1,0 +1,95 @@
+"""The terminal's tables (issue 67): within a 100-column terminal and using it, a unit in every parameter column's
+header, the joints by their names, and the joints that carry no information (not excited) folded into one line
+that names every one of them, their rows back with ``--wide``."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+from rich.console import Console
+
+from wbfriction.fit.selection import fit_friction
+from wbfriction.friction.models import CoulombViscousParams, FrictionParams
+from wbfriction.report.terminal import compact_names, fit_notes, fit_tables
+
+TRUE = CoulombViscousParams(F_v=0.2, F_c=1.0, tau_os=0.3)
+MOVED = ("leg_left_2_joint", "leg_left_3_joint", "leg_right_4_joint")
+STILL = ("torso_1_joint", "torso_2_joint", "arm_left_1_joint", "arm_left_2_joint", "arm_left_3_joint",
+         "arm_left_5_joint", "gripper_left_joint")
+UNITS = {"F_c": "[N·m]", "F_v": "[N·m·s/rad]", "tau_os": "[N·m]", "S": "[-]", "v_s": "[rad/s]", "a": "[s/rad]"}
+
+
+def _fit(joint: str, amplitude: float, seed: int):
+    rng = np.random.default_rng(seed)
+    qd = amplitude * np.sin(np.linspace(0, 12 * np.pi, 1500))
+    return fit_friction(qd, TRUE.torque(qd) + 0.005 * rng.normal(size=qd.size), joint=joint,
+                        model="coulomb-viscous")
+
+
+@pytest.fixture(scope="module")
+def fits():
+    """Three joints swept at 1 rad/s (ok) and seven at 1 mrad/s (not excited: below 0.02 rad/s)."""
+    out = [_fit(j, 1.0, k) for k, j in enumerate(MOVED)] + [_fit(j, 1e-3, 10 + k) for k, j in enumerate(STILL)]
+    assert [f.verdict().status for f in out] == ["ok"] * len(MOVED) + ["not excited"] * len(STILL)
+    return out
+
+
+def _printed(renderables, width: int = 100) -> list[str]:
+    console = Console(width=width, record=True, file=open("/dev/null", "w"), color_system=None)
+    for r in renderables:
+        console.print(r, highlight=False)
+    return console.export_text().splitlines()
+
+
+def _expand(name: str) -> list[str]:
+    """Bash's brace expansion of one name (``a_{1..3,5}_b``), written apart from the code under test."""
+    m = re.fullmatch(r"(.*)\{(.*)\}(.*)", name)
+    if m is None:
+        return [name]
+    numbers = []
+    for part in m.group(2).split(","):
+        low, _, high = part.partition("..")
+        numbers += list(range(int(low), int(high or low) + 1))
+    return [f"{m.group(1)}{n}{m.group(3)}" for n in numbers]
+
+
+def test_compact_names_expand_back_to_the_names():
+    names = ["leg_left_1_joint", "torso_1_joint", "torso_2_joint", *[f"arm_left_{k}_joint" for k in (1, 2, 3, 5)],
+             "panda_joint7", "lwr_6", "FR_calf_joint"]
+    shown = compact_names(names)
+    assert shown == ["leg_left_1_joint", "torso_{1,2}_joint", "arm_left_{1..3,5}_joint", "panda_joint7", "lwr_6",
+                     "FR_calf_joint"]
+    assert sorted(n for s in shown for n in _expand(s)) == sorted(names)
+
+
+def test_the_joints_not_excited_are_one_line_that_names_them_all(fits):
+    lines = _printed([*fit_tables(fits), *fit_notes(fits)])
+    assert all(len(line) <= 100 for line in lines), [line for line in lines if len(line) > 100]
+    rows = [line.split()[0] for line in lines if line.split() and line.split()[0] in (*MOVED, *STILL)]
+    assert sorted(set(rows)) == sorted(MOVED)  # a row per joint that moved, none of the others
+    text = " ".join(lines)
+    folded = re.search(r"(\d+) joints not excited \([^)]*\): (.*?)(?: model chosen|$)", " ".join(text.split()))
+    assert folded is not None, text
+    named = [n for s in folded.group(2).split(", ") for n in _expand(s.strip())]
+    assert int(folded.group(1)) == len(STILL) and sorted(named) == sorted(STILL)
+    wide = _printed(fit_tables(fits, wide=True), width=300)
+    assert {line.split()[0] for line in wide if line.split()} >= {*MOVED, *STILL}  # --wide: every joint's row
+
+
+def test_every_parameter_column_has_its_unit(fits):
+    thesis = fit_friction(*_sweep(), model="thesis", joint="knee")
+    for table in fit_tables([*fits, thesis]):
+        if "error [%]" in str(table.title) or table.title == "Terms beyond velocity":
+            continue  # percentages, said in the title; the terms' values carry their units in the cell
+        for column in table.columns:
+            name = str(column.header).split(" [")[0]
+            if name in UNITS:
+                assert str(column.header) == f"{name} {UNITS[name]}", column.header
+
+
+def _sweep():
+    qd = np.sin(np.linspace(0, 12 * np.pi, 3000))
+    truth = FrictionParams(F_v=0.2, F_c=1.0, S=0.2, v_s=0.2, tau_os=0.3, a=40.0)
+    return qd, truth.torque(qd) + 0.005 * np.random.default_rng(1).normal(size=qd.size)
