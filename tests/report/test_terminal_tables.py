@@ -93,3 +93,34 @@ def _sweep():
     qd = np.sin(np.linspace(0, 12 * np.pi, 3000))
     truth = FrictionParams(F_v=0.2, F_c=1.0, S=0.2, v_s=0.2, tau_os=0.3, a=40.0)
     return qd, truth.torque(qd) + 0.005 * np.random.default_rng(1).normal(size=qd.size)
+
+
+def test_the_demos_table_fits_and_says_what_the_thesis_errors_over_100_percent_are():
+    """The demo's table beside the thesis's Tables 6.1/6.2: within 100 columns, a unit under every parameter, the
+    thesis's errors to the digits that mean something (its hip rolls' F_v 971.75 % and 1125.90 % as 972 and 1126),
+    and the caption naming each one over 100 %: nothing left to a lone footnote."""
+    import dataclasses
+
+    from wbfriction.cli.studies import study_table
+    from wbfriction.studies.common import LegRow
+    from wbfriction.studies.thesis import TABLE_6_1, TABLE_6_2
+
+    qd, tau_f = _sweep()
+    truth = FrictionParams(F_v=0.2, F_c=1.0, S=0.2, v_s=0.2, tau_os=0.3, a=40.0)
+    fit = dataclasses.replace(fit_friction(qd, tau_f, model="thesis"), target=truth)
+    rows = [LegRow(joint, side, group, number, dataclasses.replace(fit, joint=joint), TABLE_6_1[(side, group)],
+                   TABLE_6_2[(side, group)])
+            for joint, side, group, number in (("leg_right_2_joint", "right", "hip_roll", 1),
+                                               ("leg_right_4_joint", "right", "knee", 4),
+                                               ("leg_left_2_joint", "left", "hip_roll", 7))]
+    lines = _printed([study_table(rows, "Identified friction (3.5)")])
+    assert all(len(line) <= 100 for line in lines), [line for line in lines if len(line) > 100]
+    header = " ".join(lines[1:3])
+    assert all(unit in header for unit in UNITS.values())
+    thesis = [line.split() for line in lines if line.strip().startswith("T6.1 [%]")]
+    assert [r[2] for r in thesis] == ["972", "0.50", "1126"]  # F_v of Table 6.1, hip rolls and the right knee
+    caption = " ".join(" ".join(lines).split())
+    over = re.search(r"T6\.1 over 100 % \(([^)]*)\)", caption)
+    assert over is not None, caption
+    assert over.group(1) == "#1 F_v 972, #1 S 680, #7 F_v 1126, #7 S 392"  # every value of Table 6.1 above 100
+    assert "at most 18 %" in caption  # the same entries of Table 6.2: 17.25, 5.85, 17.70, 11.95

@@ -23,6 +23,7 @@ from rich.text import Text
 
 from wbfriction.fit.energy import JointEnergy
 from wbfriction.fit.result import FitResult
+from wbfriction.fit.status import ZERO
 from wbfriction.fit.terms import NOT_TRIED, TERM_COEFFICIENTS, TermFit
 from wbfriction.friction.models import ALL_PARAM_NAMES
 from wbfriction.friction.point_contacts import DeterminedShares
@@ -306,13 +307,20 @@ for the centre of mass) is as given: left out of the bodies' table."""
 
 
 def _g(x: float | None) -> str:
-    """A number without a standard error, in three significant digits ("—": none)."""
-    return "—" if x is None else f"{x:.3g}"
+    """A friction parameter without a standard error, in three significant digits ("—": none; "0": a magnitude
+    below :data:`~wbfriction.fit.status.ZERO`, at its floor of zero, not ``2.18e-67``: the solver's rounding)."""
+    return "—" if x is None else "0" if abs(x) < ZERO else f"{x:.3g}"
 
 
 def _change(x: float | None, digits: int) -> str:
     """A relative change as a signed percentage; ``new`` for a body the given model had none of."""
     return "new" if x is None else f"{100 * x:+.{digits}f}"
+
+
+def _stacked(name: str) -> Text:
+    """A column's header with the unit of its parameter (``accel. F_v``: F_v's) below its name."""
+    unit = UNITS.get(name.removeprefix("accel. "))
+    return Text(name if unit is None else f"{name}\n[{unit}]")
 
 
 def identification_tables(result: Identification, wide: bool = False) -> tuple[list[Table], list[str]]:
@@ -321,11 +329,13 @@ def identification_tables(result: Identification, wide: bool = False) -> tuple[l
     the friction of the joints whose acceleration-route fit moved (both routes, the status of the
     acceleration route's fit, the power-generating share), and their held-out torques."""
     notes: list[str] = []
+    # Text, not markup, wherever a unit is in brackets: Rich would take "[kg]" or "[mm]" for a tag and drop it
     bodies = Table(title="Inertia model: given -> written", box=None, title_justify="left", caption_justify="left",
-                   caption="COM: shift [mm]; I1-I3: principal moments about the centre of mass, ascending, change "
-                           "[%]; kept: the identified body predicted held-out torques better (else as given)")
+                   caption=Text("COM: shift [mm]; I1-I3: principal moments about the centre of mass, ascending, "
+                                "change [%]; kept: the identified body predicted held-out torques better (else as "
+                                "given)"))
     for col in ("body", "mass [kg]", "mass [%]", "COM [mm]", "I1 [%]", "I2 [%]", "I3 [%]", "kept"):
-        bodies.add_column(col, justify="left" if col == "body" else "right", no_wrap=True)
+        bodies.add_column(Text(col), justify="left" if col == "body" else "right", no_wrap=True)
     massive = [b for b in result.bodies if b.has_mass]
     changed = [b for b in massive if wide or b.kept or b.mass_change is None
                or abs(b.mass_change) >= CHANGED or b.com_shift >= CHANGED
@@ -347,12 +357,13 @@ def identification_tables(result: Identification, wide: bool = False) -> tuple[l
     names = result.friction_names
     friction = Table(title="Friction: this route (torques, the inertias written) and the acceleration route (5.10)",
                      box=None, title_justify="left", caption_justify="left",
-                     caption="status: of the acceleration route's fit; gen: share of valid samples whose friction "
-                             "generates power (eq. 7.9) [%], given model -> identified; target: the simulator's")
+                     caption=Text("status: of the acceleration route's fit; accel.: its parameters; gen: share of "
+                                  "valid samples whose friction generates power (eq. 7.9) [%], given model -> "
+                                  "identified; target: the simulator's; 0: at its floor of zero"))
     friction.add_column("joint", no_wrap=True)
-    friction.add_column("status")
-    for n in (*names, "accel. F_v", "accel. F_c", "gen [%]"):
-        friction.add_column(n, justify="right", no_wrap=True)
+    friction.add_column("status")  # wraps, where the terminal is narrow: the numbers never do
+    for n in (*names, "accel. F_v", "accel. F_c", "gen [%]"):  # each unit below its name: narrow columns
+        friction.add_column(_stacked(n), justify="right", no_wrap=True)
     pct = lambda x: "—" if x is None else f"{100 * x:.1f}"  # noqa: E731
     for joint in moved:
         j = joints[joint]
