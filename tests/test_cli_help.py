@@ -33,6 +33,7 @@ def test_every_bracketed_unit_of_a_command_is_printed(name):
     expected = {b for text in texts for b in BRACKETS.findall(" ".join(text.split()))}
     shown = _help(name)
     assert [b for b in sorted(expected) if b not in shown] == []
+    assert "\\[" not in shown  # no markup escape shown ("Physics step \\[s]")
 
 
 def test_units_that_markup_used_to_delete_are_there():
