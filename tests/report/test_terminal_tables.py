@@ -124,3 +124,33 @@ def test_the_demos_table_fits_and_says_what_the_thesis_errors_over_100_percent_a
     assert over is not None, caption
     assert over.group(1) == "#1 F_v 972, #1 S 680, #7 F_v 1126, #7 S 392"  # every value of Table 6.1 above 100
     assert "at most 18 %" in caption  # the same entries of Table 6.2: 17.25, 5.85, 17.70, 11.95
+
+
+def test_identifys_tables_show_their_units_and_a_magnitude_at_zero_as_zero(fits):
+    """``identify``'s tables: the units of the bodies' table that Rich took for tags ([kg], [mm]) shown, a unit
+    under each friction parameter, and an acceleration-route F_v the solver left at 2.18e-67 N·m·s/rad (its floor
+    of zero: below :data:`~wbfriction.fit.status.ZERO`) printed 0; within 100 columns."""
+    import dataclasses
+
+    from wbfriction.inertia.document import BodyWritten, HeldOutRms, Identification, JointIdentified
+    from wbfriction.report.terminal import identification_tables
+
+    moved = fits[0]
+    at_zero = dataclasses.replace(moved, params=dataclasses.replace(moved.params, F_v=2.18e-67))
+    joints = {joint: JointIdentified(identified={"F_v": value, "F_c": 0.409, "tau_os": 0.824, "F_s-F_c": 0.0},
+                                     acceleration_route=route, acceleration_route_given_model=route,
+                                     holdout_rms=HeldOutRms(1.41, 0.342, 0.266, 0.265), generating_share=0.5,
+                                     generating_share_given_model=0.5)
+              for joint, value, route in (("lwr_0_joint", 1.49, moved), ("lwr_6_joint", 5.52e-30, at_zero))}
+    bodies = (BodyWritten("lwr_1_link", 2.7, 2.967, 0.0989, 0.0515, (0.01, 0.02, 0.02), (0.006, 0.01, 0.011),
+                          (-0.361, -0.501, -0.452), kept=True),)
+    result = Identification(passes=(), bodies=bodies, joints=joints, holdout_samples=2010)
+    tables, _ = identification_tables(result)
+    lines = _printed(tables)
+    assert all(len(line) <= 100 for line in lines), [line for line in lines if len(line) > 100]
+    text = "\n".join(lines)
+    assert "mass [kg]" in text and "COM [mm]" in text and "COM: shift [mm]" in " ".join(text.split())
+    assert "[N·m·s/rad]" in text and "[N·m]" in text
+    assert "e-30" not in text and "e-67" not in text
+    row = next(line.split() for line in lines if line.startswith(" lwr_6_joint") or line.startswith("lwr_6_joint"))
+    assert row[2] == "0" and row[6] == "0", row  # F_v of this route and of the acceleration route
