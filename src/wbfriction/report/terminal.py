@@ -1,14 +1,16 @@
 """The fit as the terminal shows it (issue 39): tables that fit the terminal's width and notes one line per
-family.
+family; joints named by their names, as the log, the URDF and every command name them.
 
 :func:`fit_tables` gives the friction table of ``wbfriction fit`` (and of ``identify``'s friction): by default
-one row per joint with its model, its status, F_c and F_v (value ± standard error,
+one row per joint that moved with its model, its status, F_c and F_v (value ± standard error,
 :func:`~wbfriction.report.numbers.with_error`) and their Cramér-Rao bounds below; the offset tau_os and the
 Stribeck terms (S, v_s, a, for the models that have them) of the fitted joints in a second table; and on
-simulated logs the errors against the truth in a third, the joints that were not excited left out (their
-errors measure nothing): three tables that fit 100 columns. ``wide=True`` gives every parameter in one
-table, as wide as it takes. :func:`fit_notes` says what the statuses and the model choice mean: one line
-per family of joints that share a status or a chosen model, each joint's own reason with ``verbose``.
+simulated logs the errors against the truth in a third: three tables that fit 100 columns, every parameter's
+column headed by its unit (:func:`header`). The joints that were not excited carry no information: no row, one
+line of :func:`fit_notes` names them all (:func:`compact_names`: ``arm_left_{1..7}_joint``). ``wide=True`` gives
+every joint and every parameter in one table, as wide as it takes. :func:`fit_notes` says what the statuses and
+the model choice mean: one line per family of joints that share a status or a chosen model, each joint's own
+reason with ``verbose``.
 """
 
 from __future__ import annotations
