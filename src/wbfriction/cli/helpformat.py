@@ -32,17 +32,19 @@ _PHRASE_ENDS = ("; ", ": ", " (", ", ")
 def summary(text: str, limit: int) -> str:
     """A command's one-line summary of its help ``text``: the first sentence, whole when it fits ``limit``
     characters, else cut at the last end of a phrase that fits, the strongest first (``;``, ``:``, an opening
-    bracket, ``,``); a sentence with none is given whole (the help wraps it)."""
+    bracket, ``,``); where none fits, its first phrase, wrapped; a sentence with none is given whole (wrapped)."""
     words = " ".join(text.split("\n\n")[0].split())
     ends = [m.end() - 1 for m in _SENTENCE_END.finditer(words) if m.group(1) not in _ABBREVIATIONS]
     first = words[:ends[0]] if ends else words
     if len(first) <= limit:
         return first
+    cuts = {end: [m.start() for m in re.finditer(re.escape(end), first)] for end in _PHRASE_ENDS}
     for end in _PHRASE_ENDS:
-        cuts = [m.start() for m in re.finditer(re.escape(end), first) if m.start() <= limit]
-        if cuts:
-            return first[:cuts[-1]]
-    return first
+        fit = [c for c in cuts[end] if c <= limit]
+        if fit:
+            return first[:fit[-1]]
+    every = [c for found in cuts.values() for c in found]
+    return first[:min(every)] if every else first  # none fits: the shortest phrase, wrapped
 
 
 class SectionedGroup(TyperGroup):
