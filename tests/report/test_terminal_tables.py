@@ -154,3 +154,9 @@ def test_identifys_tables_show_their_units_and_a_magnitude_at_zero_as_zero(fits)
     assert "e-30" not in text and "e-67" not in text
     row = next(line.split() for line in lines if line.startswith(" lwr_6_joint") or line.startswith("lwr_6_joint"))
     assert row[2] == "0" and row[6] == "0", row  # F_v of this route and of the acceleration route
+
+
+def test_a_p_value_below_the_floating_points_digits_is_said_so():
+    from wbfriction.report.numbers import p_value_text
+
+    assert [p_value_text(p) for p in (1.37e-67, 0.0, 1e-12, 0.0123)] == ["< 1e-12", "< 1e-12", "1e-12", "0.012"]

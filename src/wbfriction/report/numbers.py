@@ -61,6 +61,15 @@ def bound_text(bound: float | None) -> str:
     return f"± {round(bound, -place):.{max(-place, 0)}f}" if -4 <= place <= 4 else f"± {bound:.{digits}e}"
 
 
+P_FLOOR = 1e-12
+"""A p-value below this is printed ``< 1e-12``: its digits are the floating point's, not the data's."""
+
+
+def p_value_text(p: float) -> str:
+    """A p-value in two significant digits, or ``< 1e-12`` below :data:`P_FLOOR` (not ``1.37e-67``)."""
+    return f"< {P_FLOOR:g}" if p < P_FLOOR else f"{p:.2g}"
+
+
 GAP_STEPS = 10.0
 """A time step longer than this many median steps is a gap between recordings, not recorded time."""
 
