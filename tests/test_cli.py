@@ -41,7 +41,9 @@ def test_main_job_steps_write_log_friction_and_params(demo_dir):
     # the joint's own TOML table overrides its group's
     assert params["joints"]["leg_left_4_joint"]["target"]["F_c"] == 0.5
     assert params["joints"]["leg_left_4_joint"]["target"]["F_v"] == 0.0
-    assert "right knee" in res.stdout and "Against the simulator's friction: error [%]" in res.stdout  # by its label
+    # by its name, as the log and the URDF name it (the report, not the terminal, names it by its label)
+    assert "leg_right_4_joint " in res.stdout and "right knee" not in res.stdout
+    assert "Against the simulator's friction: error [%]" in res.stdout
     table = pq.read_table(out / "friction.parquet")
     for col in ("time", "phase", "unique", "qd.leg_right_4_joint", "tau_f.leg_right_4_joint",
                 "valid.leg_right_4_joint", "tau_f_true.leg_right_4_joint"):
@@ -52,7 +54,7 @@ def test_main_job_steps_write_log_friction_and_params(demo_dir):
 def test_demo_prints_the_thesis_table_and_writes_figures(tmp_path):
     res = run("demo", "-o", tmp_path, "--steps", "2", columns=100)
     assert res.returncode == 0, res.stderr
-    assert "T6.2 [%]" in res.stdout and "leg_right_4_joint (knee)" in res.stdout
+    assert "T6.2 [%]" in res.stdout and "leg_right_4_joint " in res.stdout and "knee target" in res.stdout
     assert widest_line(res.stdout) <= 100, res.stdout
     # the 2-step walk hardly turns the hip yaws: said before the table, left out of the worst errors
     table = res.stdout.index("T6.2 [%]")
@@ -191,7 +193,7 @@ def test_fit_warns_about_friction_that_generates_power(demo_dir, tmp_path):
     res = run("fit", tmp_path / "f.parquet", "-o", tmp_path / "p.json")
     assert res.returncode == 0, res.stderr
     warnings = [line for line in res.stderr.splitlines() if line.startswith("warning: friction generates power")]
-    assert len(warnings) == 1 and "right knee" in warnings[0], res.stderr  # one line, the joint by its label
+    assert len(warnings) == 1 and "leg_right_4_joint" in warnings[0], res.stderr  # one line, the joint by its name
     energy = json.loads((tmp_path / "p.json").read_text())["joints"]["leg_right_4_joint"]["energy"]
     assert energy["flagged"] and energy["generating_share"] > 0.5
     ok = json.loads((out / "params.json").read_text())["joints"]["leg_right_4_joint"]["energy"]
@@ -273,30 +275,58 @@ def test_api_and_cli_give_the_same_friction_table_and_fits_with_their_defaults(t
 
 
 def test_fit_prints_tables_that_fit_a_100_column_terminal(demo_dir, tmp_path):
-    """``COLUMNS=100 wbfriction fit``: no line over 100 columns, every joint named whole, each status shown, the
-    joints that did not move in one line; ``--wide`` every parameter in one table, as wide as it takes; ``--verbose``
-    each joint's reason (issue 39)."""
+    """``COLUMNS=100 wbfriction fit``: no line over 100 columns, every joint that moved named whole by its name (as
+    the log, the URDF, ``predict`` and ``export`` name it), each status shown, the joints that did not move (status
+    ``not excited`` in the parameters written) folded into one line that names every one of them (issue 67);
+    ``--wide`` every parameter in one table, every joint's row, as wide as it takes; ``--verbose`` each joint's
+    reason (issue 39)."""
+    import re
+
     out, _ = demo_dir
     res = run("fit", out / "friction.parquet", "-o", tmp_path / "p.json", columns=100)
     assert res.returncode == 0, res.stderr
     assert widest_line(res.stdout) <= 100, res.stdout
     params = json.loads((tmp_path / "p.json").read_text())["joints"]
-    labels = json.loads(pq.read_schema(out / "friction.parquet").metadata[b"wbfriction"])["joint_labels"]
-    assert labels["leg_right_4_joint"] == "right knee"  # the robot TOML's [labels], recorded by estimate
     rows: dict[str, list[str]] = {}
-    for joint in params:  # each joint's first row, the main table's: by its label, whole, never cut
-        line = next(line for line in res.stdout.splitlines() if line.startswith(labels[joint] + " "))
-        rows[joint] = line[len(labels[joint]):].split()
-    moved = [j for j in params if rows[j][1:3] != ["not", "excited"]]
-    assert moved and all(rows[j][1] in ("ok", "weak", "at", "failed", "routes", "does") for j in moved)
-    still = len(params) - len(moved)
-    assert sum("hardly moved" in line for line in res.stdout.splitlines()) == (1 if still else 0)
+    for joint in params:  # each joint's first row, the main table's: by its name, whole, never cut
+        line = next((line for line in res.stdout.splitlines() if line.startswith(joint + " ")), None)
+        if line is not None:
+            rows[joint] = line[len(joint):].split()
+    still = [j for j in params if params[j]["status"] == "not excited"]
+    assert sorted(rows) == sorted(j for j in params if j not in still)  # a row for each joint that moved alone
+    assert rows and all(rows[j][1] in ("ok", "weak", "at", "failed", "routes", "does") for j in rows)
+    text = " ".join(res.stdout.split())  # the lines the terminal's width wrapped, whole again
+    folded = re.search(r"(\d+) joints? not excited \([^)]*\): ", text)
+    if still:  # one line, bash's braces (arm_left_{1..7}_joint) expanded here
+        assert folded is not None and int(folded.group(1)) == len(still), res.stdout
+        named: list[str] = []
+        for item in text[folded.end():].split(", "):  # up to the next line's first word
+            named += _braces(item.split(" ")[0])
+            if " " in item:
+                break
+        assert sorted(named) == sorted(still), named
+    else:
+        assert folded is None
     assert "Against the simulator's friction" in res.stdout  # the walk's log carries the truth
+    assert "F_c [N·m]" in res.stdout and "F_v [N·m·s/rad]" in res.stdout  # units in the headers
     wide = run("fit", out / "friction.parquet", "-o", tmp_path / "w.json", "--wide", columns=100)
     assert wide.returncode == 0 and widest_line(wide.stdout) > 100 and " N " in wide.stdout.splitlines()[1]
+    assert all(any(line.startswith(j + " ") for line in wide.stdout.splitlines()) for j in params)
     verbose = run("fit", out / "friction.parquet", "-o", tmp_path / "v.json", "--verbose", columns=100)
     words = "".join(verbose.stdout.split())  # each reason once, however the terminal's width wrapped it
     scored = [j for j in params if (params[j].get("selection") or {}).get("scores")]  # not those that hardly moved
     assert words.count("held-outRMS[N·m]:") == len(scored) > 0
     assert words.count("nomodelcanbechosen") == len([j for j in params if params[j].get("selection")]) - len(scored)
     assert widest_line(verbose.stdout) <= 100
+
+
+def _braces(word: str) -> list[str]:
+    """Bash's brace expansion of one word (``arm_left_{1..3,5}_joint``), written apart from the code that folds."""
+    m = re.fullmatch(r"(.*)\{(.*)\}(.*)", word)
+    if m is None:
+        return [word]
+    numbers: list[int] = []
+    for part in m.group(2).split(","):
+        low, _, high = part.partition("..")
+        numbers += list(range(int(low), int(high or low) + 1))
+    return [f"{m.group(1)}{n}{m.group(3)}" for n in numbers]

@@ -33,6 +33,7 @@ def test_every_bracketed_unit_of_a_command_is_printed(name):
     expected = {b for text in texts for b in BRACKETS.findall(" ".join(text.split()))}
     shown = _help(name)
     assert [b for b in sorted(expected) if b not in shown] == []
+    assert "\\[" not in shown  # no markup escape shown ("Physics step \\[s]")
 
 
 def test_units_that_markup_used_to_delete_are_there():
@@ -105,3 +106,93 @@ def test_every_help_that_lists_the_formats_lists_the_registrys():
     assert "Friction table to write: .parquet, .pq or .csv." in shown["estimate"]
     assert "Log to write: .parquet, .pq or .csv." in shown["convert"]
     assert "Log to write: .parquet, .pq, .csv, .h5, .hdf5, .he5, .npz or .feather." in shown["simulate"]
+
+
+def _shown(*args: str, columns: int = 100) -> str:
+    """``wbfriction ARGS --help`` in a terminal ``columns`` wide (the runner's width: it does not read $COLUMNS,
+    :func:`test_the_help_reads_the_terminals_width_up_to_120` does)."""
+    result = typer.testing.CliRunner().invoke(app, [*args, "--help"], terminal_width=columns)
+    assert result.exit_code == 0, result.output
+    return result.output
+
+
+@pytest.mark.parametrize("name", [None, *COMMANDS])
+def test_help_fits_a_100_column_terminal_and_uses_it(name):
+    """Issue 67: the help stayed 80 columns wide in a 100-column terminal; it uses the width now (its widest line
+    beyond 80) and stays within it."""
+    lines = _shown(*([] if name is None else [name])).splitlines()
+    widest = max(len(line) for line in lines)
+    assert 80 < widest <= 100, (widest, [line for line in lines if len(line) > 100])
+
+
+@pytest.mark.parametrize(("columns", "least", "most"), [(100, 81, 100), (200, 101, 120)])
+def test_the_help_reads_the_terminals_width_up_to_120(columns, least, most):
+    """As a shell runs it ($COLUMNS, no runner): 100 columns used, and no more than 120 however wide the terminal."""
+    import os
+    import subprocess
+    import sys
+
+    run = subprocess.run([sys.executable, "-m", "wbfriction", "--help"], capture_output=True, text=True,
+                         env=dict(os.environ, COLUMNS=str(columns)))
+    assert run.returncode == 0, run.stderr
+    assert least <= max(len(line) for line in run.stdout.splitlines()) <= most
+
+
+SECTIONS = {  # the sections of 'wbfriction --help' and the commands a user finds under each, in this order
+    "Logs in": ["simulate", "convert", "dataset"],
+    "Friction from a log (the pipeline)": ["estimate", "fit", "export", "predict", "report"],
+    "The whole robot: inertia, actuators, excitation, replay": ["rollout", "refine", "identify", "excite"],
+    "Studies (the thesis's and this project's)": ["sensitivity", "spectrum", "demo", "study-sensors", "study-noise",
+                                                  "study-fleet", "study-filters", "study-quadruped"],
+    "Fleets": ["batch", "trends"],
+}
+
+
+def test_the_overview_groups_the_commands():
+    """The pipeline a user runs apart from the studies and the fleets: each section's heading, then its commands,
+    one line each, every command in one section."""
+    lines = _shown().splitlines()
+    found: dict[str, list[str]] = {}
+    section = None
+    for line in lines:
+        if line.endswith(":") and not line.startswith(" "):
+            section = line[:-1]
+            found[section] = []
+        elif section in SECTIONS and line.startswith("  ") and not line.startswith("   "):
+            found[section].append(line.split()[0])
+    assert {s: c for s, c in found.items() if s in SECTIONS} == SECTIONS
+    assert sorted(c for cs in SECTIONS.values() for c in cs) == COMMANDS
+
+
+@pytest.mark.parametrize("columns", [80, 100])
+def test_each_summary_is_whole_or_ends_a_phrase(columns):
+    """A command's summary in the overview is never cut mid-phrase ("Estimate the friction torque of every..."):
+    it is the command's own short help, or its help's first words up to the end of a sentence or a phrase
+    (``;``, ``:``, ``,``, an opening bracket)."""
+    text = _shown(columns=columns).split("\n", 1)[1]  # after the usage line ("[ARGS]...")
+    assert "..." not in text
+    rows = re.findall(r"^  (\S+) +(.+(?:\n {10,}\S.*)*)", text.split("Commands:")[-1] if "Commands:" in text
+                      else text.split("Options:")[1], re.M)
+    summaries = {name: " ".join(s.split()) for name, s in rows if name in GROUP.commands}  # type: ignore[attr-defined]
+    assert sorted(summaries) == COMMANDS
+    for name, summary in summaries.items():
+        command = GROUP.commands[name]  # type: ignore[attr-defined]
+        if command.short_help:
+            assert summary == " ".join(command.short_help.split()), name
+            continue
+        whole = " ".join((command.help or "").split())
+        assert whole.startswith(summary), name
+        assert whole[len(summary):][:2] in (". ", "; ", ": ", ", ", " (") or whole[len(summary):] in ("", "."), name
+
+
+def test_the_demo_names_the_figures_it_writes():
+    """The ideal study writes Fig. 6.1-6.3 (and the mujoco study 6.4-6.5, not the ideal one): the help says which."""
+    import inspect
+
+    from wbfriction.studies import realistic, simulation
+
+    shown = " ".join(_shown("demo").split())
+    assert "Fig. 6.1-6.3" in shown and "Fig. 6.1-6.5" not in shown
+    assert all(f"fig6_{k}_" in inspect.getsource(simulation) for k in (1, 2, 3))
+    assert all(f"fig6_{k}_" in inspect.getsource(realistic) for k in (4, 5))
+    assert "mujoco" in shown.split("Fig. 6.4-6.5")[0].split("Fig. 6.1-6.3")[-1]

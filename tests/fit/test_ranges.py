@@ -141,7 +141,8 @@ def test_a_table_well_outside_the_fitted_temperatures_is_not_ok_and_says_so(file
     row, err = _predict(capsys, tables["hot"], good)
     assert row.rstrip().endswith(OUTSIDE), row
     assert (f"{JOINT}: temperature 100 to 130 °C in this table, fitted on 25 to 55 °C: 100 % of its samples outside, "
-            "up to 75 °C beyond; the temperature term extrapolated") in err, err
+            "up to 75 °C beyond; the temperature term extrapolated on those samples, farther than the fitted range is "
+            "wide") in err, err
 
 
 def test_a_table_a_little_outside_is_said_and_stays_ok(files, capsys):
@@ -149,8 +150,10 @@ def test_a_table_a_little_outside_is_said_and_stays_ok(files, capsys):
     good, _, tables = files
     row, err = _predict(capsys, tables["warmer"], good)
     assert row.rstrip().endswith(" ok"), row
+    # the words follow the numbers: two thirds of the samples outside, none farther than a third of the width
     assert "temperature 50 to 65 °C in this table, fitted on 25 to 55 °C: 66.5 % of its samples outside, up to 10 °C" \
-           " beyond; the temperature term extrapolated a little" in err, err
+           " beyond; the temperature term extrapolated on those samples, by at most 33 % of the fitted range's " \
+           "width" in err, err
     assert OUTSIDE not in err
 
 

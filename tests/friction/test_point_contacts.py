@@ -138,10 +138,11 @@ def test_estimate_prints_the_shares_by_feet_down(go2, tmp_path, capsys):
     head = next(i for i, line in enumerate(lines) if line.startswith("determined: share of samples"))
     columns = lines[head + 1].split()
     assert sorted(columns) == ["FL+FR+RL+RR", "FL+RR", "FR+RL", "all"]
-    rows = {line[:18].strip(): dict(zip(columns, line[18:].split()[::2])) for line in lines[head + 3:head + 15]}
-    assert len(rows) == 12
-    assert rows["front left hip"] == {**rows["front left hip"], "FR+RL": "100", "FL+RR": "0", "FL+FR+RL+RR": "0"}
-    assert rows["front right hip"] == {**rows["front right hip"], "FR+RL": "0", "FL+RR": "100", "FL+FR+RL+RR": "0"}
+    # each joint by its name, as the log and every other command name it
+    rows = {line.split()[0]: dict(zip(columns, line.split()[1:][::2])) for line in lines[head + 3:head + 15]}
+    assert sorted(rows) == sorted(go2.actuated)
+    assert rows["FL_hip_joint"] == {**rows["FL_hip_joint"], "FR+RL": "100", "FL+RR": "0", "FL+FR+RL+RR": "0"}
+    assert rows["FR_hip_joint"] == {**rows["FR_hip_joint"], "FR+RL": "0", "FL+RR": "100", "FL+FR+RL+RR": "0"}
     assert widest_line("\n".join(lines[head:head + 18])) <= 100
 
 

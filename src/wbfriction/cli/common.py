@@ -18,6 +18,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
+from wbfriction.cli.helpformat import MAX_WIDTH, SectionedGroup
 from wbfriction.exceptions import InputError, OptionError, WbfrictionError
 from wbfriction.fit.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions, TermOptions
 from wbfriction.friction.options import TERMS, EstimateOptions, TemperatureLaw, Term
@@ -34,8 +35,10 @@ if TYPE_CHECKING:
     from wbfriction.model.robot import Robot
 
 # rich_markup_mode=None: click's plain help, so that units in brackets ([m], [rad/s], [friction.<group>]) are
-# printed as written (Rich markup would take them for tags and delete them)
-app = typer.Typer(add_completion=False, rich_markup_mode=None)
+# printed as written (Rich markup would take them for tags and delete them); the commands in sections, the help as
+# wide as the terminal up to MAX_WIDTH (click's default stops at 80)
+app = typer.Typer(add_completion=False, rich_markup_mode=None, cls=SectionedGroup,
+                  context_settings={"max_content_width": MAX_WIDTH})
 console = Console(stderr=True, soft_wrap=True)  # a message is one line, wrapped by the terminal, not cut into lines
 out = Console()  # as wide as the terminal (COLUMNS); tables fit it (--wide: every column)
 

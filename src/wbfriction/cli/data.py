@@ -8,6 +8,7 @@ from typing import Literal
 import typer
 
 from wbfriction.cli.common import app, console, out
+from wbfriction.cli.helpformat import LOGS
 from wbfriction.pipeline.paths import check_paths
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only typer:
@@ -15,7 +16,8 @@ from wbfriction.pipeline.paths import check_paths
 DatasetName = Literal["aliengo", "kuka-lwr4", "panda", "ur10e"]
 
 
-@app.command()
+@app.command(rich_help_panel=LOGS,
+             short_help="Fetch a real robot's logs and write them as wbfriction logs")
 def dataset(name: DatasetName = typer.Argument(..., metavar="NAME",
                                                help="The dataset: kuka-lwr4 (FloBaRoID's KUKA LWR4+: three runs of "
                                                     "25 s, link-side joint torque sensors, about 6 MB), ur10e "

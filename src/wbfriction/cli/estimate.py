@@ -51,6 +51,7 @@ from wbfriction.cli.common import (
     robot_of,
     warn,
 )
+from wbfriction.cli.helpformat import FRICTION, LOGS, STUDIES
 
 
 def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: EstimateOptions,
@@ -121,7 +122,7 @@ def _print_determination(friction: Path, robot: Robot) -> None:
 
     shares = determined_shares(read_friction_file(friction))
     if shares is not None:
-        console.print(determination_table(shares, robot.labels))
+        console.print(determination_table(shares))
 
 
 def _print_cross_check(friction: Path) -> None:
@@ -143,7 +144,7 @@ def _print_cross_check(friction: Path) -> None:
                       highlight=False, soft_wrap=True)
 
 
-@app.command()
+@app.command(rich_help_panel=FRICTION)
 def estimate(ctx: typer.Context, log: Path = typer.Argument(..., metavar="LOG",
                                         help=f"Log in the wbfriction format: {table_formats()}; through --map: "
                                              f"{mapped_formats()}."),
@@ -239,7 +240,7 @@ def _refuse_acceleration_outputs(opts: EstimateOptions, companion: bool) -> None
                           "route's other differentiation)")
 
 
-@app.command()
+@app.command(rich_help_panel=LOGS)
 def convert(bag: Path = typer.Argument(..., metavar="BAG", help=f"Log to convert, through --map: {mapped_formats()}; "
                                                                 f"or a table log: {table_formats()}."),
             bag_map: Optional[Path] = typer.Option(None, "--map", help="Topic map TOML of a bag: [joint_states], "
@@ -263,7 +264,7 @@ def convert(bag: Path = typer.Argument(..., metavar="BAG", help=f"Log to convert
     console.print(f"wrote {output} ({rows} samples)")
 
 
-@app.command()
+@app.command(rich_help_panel=STUDIES)
 def sensitivity(log: Path = LogArg,
                 output: Path = typer.Option(Path("sensitivity.png"), "-o", "--output", help="Figure to write (PNG)."),
                 robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
@@ -315,7 +316,7 @@ def sensitivity(log: Path = LogArg,
     console.print(f"wrote {output}")
 
 
-@app.command()
+@app.command(rich_help_panel=STUDIES)
 def spectrum(log: Path = LogArg,
              output: Path = typer.Option(Path("spectrum.png"), "-o", "--output", help="Figure to write (PNG)."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,

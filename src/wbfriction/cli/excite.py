@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Literal, Optional
 
 import typer
 from rich.table import Table
+from rich.text import Text
 
 from wbfriction.cli.common import (
     ConfigOpt,
@@ -20,6 +21,7 @@ from wbfriction.cli.common import (
     refuse_unread,
     robot_of,
 )
+from wbfriction.cli.helpformat import ROBOT
 from wbfriction.exceptions import InputError
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
@@ -52,7 +54,8 @@ if TYPE_CHECKING:
     from wbfriction.excite.pd_design import PdDesign
 
 
-@app.command()
+@app.command(rich_help_panel=ROBOT,
+             short_help="Design a motion to record whose identification determines every parameter")
 def excite(ctx: typer.Context,
            output: list[Path] = typer.Option(..., "-o", "--output",
                                              help="Set-points to write, as many as given (.parquet, .csv): time "
@@ -330,8 +333,8 @@ def _write_standing(r, paths: tuple[list[Path], Path | None, Path | None], excit
 def _print_swing(doc: dict, where: str) -> None:
     """The swing joints' table of a standing design's document: band, reach, peak speed, bounds' shares."""
     table = Table(title=f"{where}: band and Cramér-Rao bound / weak limit", box=None)
-    for col in ("joint", "band [rad]", "reached [rad]", "peak [rad/s]", "F_c", "F_v"):
-        table.add_column(col, justify="left" if col == "joint" else "right")
+    for col in ("joint", "band [rad]", "reached [rad]", "peak [rad/s]", "F_c", "F_v"):  # Text: "[rad]" is no tag
+        table.add_column(Text(col), justify="left" if col == "joint" else "right")
     for joint, s in doc["swing"].items():
         table.add_row(joint, f"{s['band'][0]:.2f} to {s['band'][1]:.2f}",
                       f"{s['reached'][0]:.2f} to {s['reached'][1]:.2f}", f"{s['peak_velocity']:.2f}",

@@ -51,17 +51,17 @@ from wbfriction.cli.common import (
     warn,
     warn_energy,
 )
+from wbfriction.cli.helpformat import FRICTION
 
 
-def _print_fits(results: list[FitResult], labels: dict[str, str] | None, wide: bool = False,
-                verbose: bool = False) -> None:
+def _print_fits(results: list[FitResult], wide: bool = False, verbose: bool = False) -> None:
     """The fitted friction's tables and notes (:mod:`~wbfriction.report.terminal`), as wide as the terminal,
-    the joints by their ``labels``."""
+    the joints by their names (as the log, the URDF and every other command name them)."""
     from wbfriction.report.terminal import fit_notes, fit_tables, terms_notes
 
-    for table in fit_tables(results, wide, labels):
+    for table in fit_tables(results, wide):
         print_whole(table) if wide else out.print(table)
-    for line in [*fit_notes(results, verbose, labels), *terms_notes(results, verbose, labels)]:
+    for line in [*fit_notes(results, verbose, wide=wide), *terms_notes(results, verbose)]:
         out.print(escape(line), highlight=False)
 
 
@@ -71,9 +71,8 @@ def _run_fit(friction: Path, output: Path, options: FitOptions, threshold: float
 
     with console.status(f"fitting {friction.name} (--model {options.model})"):
         fitted = fit_file(friction, output, options, threshold=threshold, tolerance=tolerance, workers=workers)
-    labels = fitted.est.metadata.get("joint_labels")
-    _print_fits(fitted.fits, labels, wide, verbose)
-    warn_energy(fitted.energy, verbose, labels)
+    _print_fits(fitted.fits, wide, verbose)
+    warn_energy(fitted.energy, verbose)
     console.print(f"wrote {output}")
 
 
@@ -84,7 +83,8 @@ FitModelOpt = typer.Option(FIT.model, "--model", metavar=f"[{'|'.join(model_choi
 families known)."""
 
 
-@app.command()
+@app.command(rich_help_panel=FRICTION,
+             short_help="Fit a friction model per joint, with standard errors and a status per fit")
 def fit(friction: Path = FrictionArg,
         output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
         min_samples: int = MinSamplesOpt,
@@ -116,7 +116,8 @@ def fit(friction: Path = FrictionArg,
              energy_threshold, energy_tolerance, workers, wide, verbose)
 
 
-@app.command()
+@app.command(rich_help_panel=FRICTION,
+             short_help="Write the fitted friction where simulators read it (MJCF, URDF, Isaac Lab)")
 def export(ctx: typer.Context,
            params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters written by 'wbfriction fit'."),
            outputs: list[Path] = typer.Option(..., "-o", "--output",
@@ -184,7 +185,7 @@ def export(ctx: typer.Context,
         console.print(f"wrote {path} ({fmt})")
 
 
-@app.command()
+@app.command(rich_help_panel=FRICTION)
 def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
                                             help="Friction table of a held-out log ('wbfriction estimate' with the URDF"
                                                  " under test)."),
@@ -253,7 +254,8 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
             console.print(f"wrote {path}")
 
 
-@app.command()
+@app.command(rich_help_panel=FRICTION,
+             short_help="One self-contained HTML report of the friction, its fits and their checks")
 def report(friction: Path = FrictionArg,
            output: Path = typer.Option(Path("report.html"), "-o", "--output", help="HTML file to write."),
            params: Optional[Path] = typer.Option(None, help="Parameters written by 'wbfriction fit' (default: "
@@ -275,7 +277,7 @@ def report(friction: Path = FrictionArg,
     with console.status("building the report"):
         rep = make_report(friction, params, energy_threshold, energy_tolerance, identification, workers)
         write_report(rep, output, workers)
-    warn_energy(rep.energy.values(), labels=rep.labels)
+    warn_energy(rep.energy.values())
     console.print(f"wrote {output} ({len(rep.est.joints)} joints, {len(rep.flagged)} flagged)")
 
 

@@ -38,9 +38,10 @@ from wbfriction.cli.common import (
     console,
     term_options,
 )
+from wbfriction.cli.helpformat import FLEETS
 
 
-@app.command()
+@app.command(rich_help_panel=FLEETS)
 def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
                                         help="Manifest (a CSV or Parquet table: its columns hold text; columns "
                                              "log, robot_id, start_time [ISO 8601 with zone], robot or urdf/config, "
@@ -115,7 +116,7 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
         raise typer.Exit(1)
 
 
-@app.command()
+@app.command(rich_help_panel=FLEETS)
 def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results folder written by 'wbfriction "
                                                                        "batch'."),
            output: Path = typer.Option(..., "-o", "--output", help="HTML page to write (.html)."),
@@ -141,6 +142,7 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
     from wbfriction.fleet.results import read_results
     from wbfriction.fleet.trends import UNITS, TrendOptions, fleet_trends
     from wbfriction.logs.tables import write_table
+    from wbfriction.report.numbers import p_value_text
     from wbfriction.report.trends import write_trends_html
 
     if output.suffix.lower() not in (".html", ".htm"):
@@ -175,7 +177,7 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
         size = (f"{100 * cp.relative:+.1f} %" if not math.isnan(cp.relative)
                 else f"{cp.change:+.3g} {UNITS[cp.quantity]} from a baseline not told from zero")
         console.print(f"drift: {j.robot_id} {j.joint}: {cp.quantity} {size} ({cp.shape}) from {cp.onset_time:%Y-%m-%d} "
-                      f"(p {cp.p_value:.2g})", highlight=False)
+                      f"(p {p_value_text(cp.p_value)})", highlight=False)
     console.print(f"{found.summary()}; wrote {output}" + (f" and {table}" if table is not None else ""),
                   highlight=False)
 

@@ -45,6 +45,7 @@ from wbfriction.cli.common import (
     robot_of,
     warn_energy,
 )
+from wbfriction.cli.helpformat import ROBOT
 
 Actuator = Literal["none", "pd"]
 ACTUATOR = ActuatorOptions()
@@ -105,7 +106,8 @@ or the PD-driven actuators' (:func:`~wbfriction.cli.actuator.identify_pd`); any 
 refused before the work (:func:`~wbfriction.cli.common.refuse_options`)."""
 
 
-@app.command()
+@app.command(rich_help_panel=ROBOT,
+             short_help="Identify inertias and friction together (--actuator pd: a PD robot's drives)")
 def identify(ctx: typer.Context, log: Path = LogArg, output: Optional[Path] = OutputOpt, robot: str = RobotOpt,
              urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt, mjcf: Optional[Path] = MjcfOpt,
              json_output: Optional[Path] = JsonOpt, stribeck_velocity: str = StribeckOpt,

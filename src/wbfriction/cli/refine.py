@@ -10,11 +10,12 @@ from rich.markup import escape
 from rich.table import Table
 
 from wbfriction.cli.common import ConfigOpt, LogArg, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of
+from wbfriction.cli.helpformat import ROBOT
 from wbfriction.cli.rollout import replay_options
 from wbfriction.pipeline.paths import check_paths
 
 
-@app.command()
+@app.command(rich_help_panel=ROBOT)
 def refine(log: Path = LogArg,
            model: Path = typer.Argument(..., metavar="MODEL",
                                         help="MuJoCo MJCF written by 'wbfriction export' for the robot (--config), "

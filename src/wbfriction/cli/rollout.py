@@ -10,6 +10,7 @@ import typer
 from rich.table import Table
 
 from wbfriction.cli.common import ConfigOpt, LogArg, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of
+from wbfriction.cli.helpformat import ROBOT
 from wbfriction.exceptions import OptionError
 from wbfriction.pipeline.paths import check_paths
 
@@ -17,7 +18,7 @@ if TYPE_CHECKING:
     from wbfriction.sim.replay import Replay
 
 
-@app.command()
+@app.command(rich_help_panel=ROBOT)
 def rollout(log: Path = LogArg,
             model: Path = typer.Argument(..., metavar="MODEL",
                                          help="MuJoCo MJCF written by 'wbfriction export' for the robot (--config): "

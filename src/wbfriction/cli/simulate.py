@@ -27,6 +27,7 @@ from wbfriction.cli.common import (
     refuse_unread,
     robot_of,
 )
+from wbfriction.cli.helpformat import LOGS
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
@@ -157,7 +158,8 @@ SHARED = ("output", "robot", "urdf", "config", "mjcf", "actuator")
 driven."""
 
 
-@app.command()
+@app.command(rich_help_panel=LOGS,
+             short_help="Simulate a log with known friction: a walk, an arm's motion, a hung PD robot")
 def simulate(ctx: typer.Context, output: Path = OutputOpt, robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt,
              config: Optional[Path] = ConfigOpt, mjcf: Optional[Path] = MjcfOpt,
              gait: Optional[GaitChoice] = GaitOpt, steps: int = StepsOpt, step_length: float = StepLengthOpt,

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Optional, cast
 import typer
 from rich.markup import escape
 from rich.table import Table
+from rich.text import Text
 
 from wbfriction.exceptions import InputError
 from wbfriction.friction.options import RouteOption
@@ -32,38 +33,61 @@ from wbfriction.cli.common import (
     out,
     robot_of,
 )
+from wbfriction.cli.helpformat import STUDIES
 
 
-def _study_table(rows, title: str, params: tuple[str, ...] | None = None) -> Table:
+def _thesis_percent(x: float) -> str:
+    """A thesis error [%] to the digits that mean something: 972, not 971.75."""
+    return f"{x:.0f}" if x >= 100 else f"{x:.2f}"
+
+
+def _thesis_caption(rows, cols: list[int], params: tuple[str, ...]) -> str:
+    """What the table's thesis rows are, and why some of Table 6.1's errors are over 100 % (the straight walk
+    barely moved those joints in swing: its fit traded Coulomb for viscous friction; Table 6.2's walk, sideways
+    too, has them small)."""
+    text = "T6.1 / T6.2: the thesis's errors for the same joint (TORO, straight / straight and sideways) [%]"
+    over = [(row, params[k], c) for row in rows if row.thesis_6_1 is not None
+            for k, c in enumerate(cols) if row.thesis_6_1[c] > 100]
+    if not over:
+        return text
+    named = ", ".join(f"#{row.number} {name} {_thesis_percent(row.thesis_6_1[c])}" for row, name, c in over)
+    after = max((row.thesis_6_2[c] for row, _, c in over if row.thesis_6_2 is not None), default=None)
+    return (f"{text}; T6.1 over 100 % ({named}): the thesis's straight walk barely moved these joints in swing "
+            "and its fit traded Coulomb for viscous friction"
+            + ("" if after is None else f"; with sideways steps (T6.2) the same errors are at most {after:.0f} %"))
+
+
+def study_table(rows, title: str, params: tuple[str, ...] | None = None) -> Table:
     """Tables 6.1/6.2 layout: per leg joint (thesis numbering) the fit's status, target, estimate, error,
     thesis errors (a joint that did not move: no estimate, no error); ``params``: the parameters shown (default:
-    every one of model 3.5)."""
+    every one of model 3.5), their units in the headers."""
     from wbfriction.friction.models import PARAM_NAMES
+    from wbfriction.report.terminal import header
 
     params = PARAM_NAMES if params is None else params
-    table = Table(title=title, box=None,
-                  caption="err: error to the target [%]; T6.1 / T6.2: the thesis's errors for the same joint "
-                          "(TORO, straight / straight and sideways)")
+    cols = [PARAM_NAMES.index(n) for n in params]
+    table = Table(title=title, box=None, pad_edge=False, caption_justify="left",
+                  caption="err: error to the target [%]; " + _thesis_caption(rows, cols, params))
     table.add_column("#", justify="right")
     table.add_column("joint")
     table.add_column("status")
-    for name in params:
-        table.add_column(name, justify="right")
-    cols = [PARAM_NAMES.index(n) for n in params]
+    for name in params:  # the unit below the name: the columns stay as narrow as their numbers
+        table.add_column(Text(header(name).replace(" [", "\n[")), justify="right")
     for row in rows:
         fit = row.fit
         err = fit.error_percent() or {}
         status = fit.verdict().status
         shown = fit.params is not None and status != "not excited"  # a joint that did not move: no value to show
-        table.add_row(str(row.number), f"{row.joint} ({row.group})", status,
+        table.add_row(str(row.number), row.joint, status,
                       *[f"{getattr(fit.params, n):.4f}" if shown else "—" for n in params],
                       style=None if status == "ok" else "dim")
-        table.add_row("", "  target", "", *[f"{getattr(fit.target, n):.4g}" for n in params], style="dim")
+        table.add_row("", f"  {row.group} target", "", *[f"{getattr(fit.target, n):.4g}" for n in params],
+                      style="dim")
         table.add_row("", "  err [%]", "", *[f"{err.get(n, float('nan')):.2f}" if shown else "—" for n in params],
                       style="bold")
         for label, ref in (("  T6.1 [%]", row.thesis_6_1), ("  T6.2 [%]", row.thesis_6_2)):
             if ref is not None:
-                table.add_row("", label, "", *[f"{ref[c]:.2f}" for c in cols], style="dim")
+                table.add_row("", label, "", *[_thesis_percent(ref[c]) for c in cols], style="dim")
     return table
 
 
@@ -114,7 +138,7 @@ def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
         if k:
             out.print()
         _print_not_ok(case.rows)
-        out.print(_study_table(case.rows, f"MuJoCo, combined walk, swing phase: {case.label}", case.scored))
+        out.print(study_table(case.rows, f"MuJoCo, combined walk, swing phase: {case.label}", case.scored))
         ok = [row for row in case.rows if row.fit.verdict().ok]
         _print_worst(case.rows, worst_scored(case, ok), case.scored)
         if case.thesis_rows is not None:  # the thesis's comparison: the same log, rigid contacts, no wrenches
@@ -126,13 +150,14 @@ def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
     return result.files
 
 
-@app.command()
+@app.command(rich_help_panel=STUDIES)
 def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--output-dir", help="Where to write."),
          robot: str = RobotOpt,
          steps: int = typer.Option(GAIT.steps, help="Steps per direction of the combined walk."),
          simulator: Simulator = typer.Option("ideal", help="ideal: Tables 6.1/6.2, Fig. 6.1-6.3; mujoco: the realistic "
                                                      "simulator's study, Fig. 6.4-6.5.")) -> None:
-    """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.5."""
+    """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.3 (--simulator mujoco:
+    the realistic simulator's tables and Fig. 6.4-6.5)."""
     from wbfriction.friction.models import PARAM_NAMES
     from wbfriction.studies.common import worst_errors
     from wbfriction.studies.simulation import run_study
@@ -148,7 +173,7 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
     with console.status("") as status:
         result = run_study(r, output_dir, steps=steps, progress=lambda label: status.update(label))
     _print_not_ok(result.rows)  # before the table: its error figures of those joints measure the walk
-    out.print(_study_table(result.rows, "Identified friction (3.5) of the leg joints, combined walk, "
+    out.print(study_table(result.rows, "Identified friction (3.5) of the leg joints, combined walk, "
                                         "central differences"))
     _print_worst(result.rows, worst_errors([row for row in result.rows if row.fit.verdict().ok]), PARAM_NAMES)
     out.print(f"true accelerations: max |tau_f - tau_f_true| in single support = {result.truth_max_error:.2e} N·m")
@@ -169,7 +194,7 @@ def _percent(x: float) -> str:
     return f"{x:.1f}" if x < 1e4 else ("inf" if not np.isfinite(x) else ">1e4")
 
 
-@app.command("study-sensors")
+@app.command("study-sensors", rich_help_panel=STUDIES)
 def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-o", "--output-dir",
                                                   help="Where to write."),
                   robot: str = RobotOpt,
@@ -200,7 +225,7 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
         console.print(f"wrote {f}")
 
 
-@app.command("study-noise")
+@app.command("study-noise", rich_help_panel=STUDIES)
 def study_noise(output_dir: Path = typer.Option(Path("wbfriction-noise"), "-o", "--output-dir", help="Where to write."),
                 robots: str = typer.Option("panda,talos", help="Comma-separated built-in robots: an arm (panda) "
                                                                "and a humanoid (talos, on MuJoCo)."),
@@ -238,7 +263,7 @@ def study_noise(output_dir: Path = typer.Option(Path("wbfriction-noise"), "-o", 
     console.print(f"wrote {output_dir / 'noise.md'}, {output_dir / 'noise.json'}")
 
 
-@app.command("study-fleet")
+@app.command("study-fleet", rich_help_panel=STUDIES)
 def study_fleet(output_dir: Path = typer.Option(Path("wbfriction-fleet"), "-o", "--output-dir", help="Where to write."),
                 robots: int = typer.Option(4, min=1, help="Robots of the fleet."),
                 logs: int = typer.Option(25, min=12, help="Logs per robot (one a day)."),
@@ -268,7 +293,7 @@ def study_fleet(output_dir: Path = typer.Option(Path("wbfriction-fleet"), "-o", 
         console.print(f"wrote {f}")
 
 
-@app.command("study-filters")
+@app.command("study-filters", rich_help_panel=STUDIES)
 def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-o", "--output-dir",
                                                   help="Where to write."),
                   robot: str = RobotOpt,
@@ -309,7 +334,7 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
 
 
 
-@app.command("study-quadruped")
+@app.command("study-quadruped", rich_help_panel=STUDIES)
 def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped"), "-o", "--output-dir",
                                                     help="Where to write."),
                     robot: str = typer.Option("go2_walking", help="A built-in quadruped on point feet."),
@@ -339,7 +364,7 @@ def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped")
         raise InputError(f"--robot {robot}: not a robot on point feet (contact_model = \"point\" in its TOML)")
     with console.status("") as status:
         study = run_quadruped(r, case, progress=lambda label: status.update(label))
-    console.print(determination_table(study.shares, r.labels))
+    console.print(determination_table(study.shares))
     out.print(escape(fits_markdown(study)), highlight=False, soft_wrap=True)
     for f in write_study(r, study, output_dir):
         console.print(f"wrote {f}")

@@ -193,8 +193,12 @@ class SignalUse:
     def sentence(self, terms: str) -> str:
         """One plain sentence: what this table holds, what was fitted, how far outside and what that does."""
         name, unit = SIGNALS[self.signal]
+        width = self.fitted[1] - self.fitted[0]
+        # how far, in the fitted range's width: however many samples are outside, that is what the words say
         held = ("held at its value at the nearest fitted angle" if self.signal == "angle"
-                else "extrapolated" if self.far else "extrapolated a little")
+                else "extrapolated on those samples, farther than the fitted range is wide" if self.far
+                else "extrapolated on those samples, by at most "
+                     f"{100 * self.beyond / width if width > 0 else 0:.0f} % of the fitted range's width")
         return (f"{name} {self.used[0]:.3g} to {self.used[1]:.3g} {unit} in this table, fitted on "
                 f"{self.fitted[0]:.3g} to {self.fitted[1]:.3g} {unit}: {100 * self.share:.3g} % of its samples "
                 f"outside, up to {self.beyond:.3g} {unit} beyond; the {terms} term {held}")

@@ -61,6 +61,15 @@ def bound_text(bound: float | None) -> str:
     return f"± {round(bound, -place):.{max(-place, 0)}f}" if -4 <= place <= 4 else f"± {bound:.{digits}e}"
 
 
+P_FLOOR = 1e-12
+"""A p-value below this is printed ``< 1e-12``: its digits are the floating point's, not the data's."""
+
+
+def p_value_text(p: float) -> str:
+    """A p-value in two significant digits, or ``< 1e-12`` below :data:`P_FLOOR` (not ``1.37e-67``)."""
+    return f"< {P_FLOOR:g}" if p < P_FLOOR else f"{p:.2g}"
+
+
 def duration_text(time: Sequence[float] | np.ndarray) -> str:
     """How long a log lasts: the time recorded (the sum of its steps, gaps left out) and, when gaps split it, the
     span from its first sample to its last and the number of recordings, e.g. ``50.3 s recorded in 2 runs over

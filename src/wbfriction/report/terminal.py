@@ -1,26 +1,31 @@
 """The fit as the terminal shows it (issue 39): tables that fit the terminal's width and notes one line per
-family.
+family; joints named by their names, as the log, the URDF and every command name them.
 
 :func:`fit_tables` gives the friction table of ``wbfriction fit`` (and of ``identify``'s friction): by default
-one row per joint with its model, its status, F_c and F_v (value ± standard error,
+one row per joint that moved with its model, its status, F_c and F_v (value ± standard error,
 :func:`~wbfriction.report.numbers.with_error`) and their Cramér-Rao bounds below; the offset tau_os and the
 Stribeck terms (S, v_s, a, for the models that have them) of the fitted joints in a second table; and on
-simulated logs the errors against the truth in a third, the joints that were not excited left out (their
-errors measure nothing): three tables that fit 100 columns. ``wide=True`` gives every parameter in one
-table, as wide as it takes. :func:`fit_notes` says what the statuses and the model choice mean: one line
-per family of joints that share a status or a chosen model, each joint's own reason with ``verbose``.
+simulated logs the errors against the truth in a third: three tables that fit 100 columns, every parameter's
+column headed by its unit (:func:`header`). The joints that were not excited carry no information: no row, one
+line of :func:`fit_notes` names them all (:func:`compact_names`: ``arm_left_{1..7}_joint``). ``wide=True`` gives
+every joint and every parameter in one table, as wide as it takes. :func:`fit_notes` says what the statuses and
+the model choice mean: one line per family of joints that share a status or a chosen model, each joint's own
+reason with ``verbose``.
 """
 
 from __future__ import annotations
 
+import re
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from functools import partial
 
 from rich.table import Table
+from rich.text import Text
 
 from wbfriction.fit.energy import JointEnergy
 from wbfriction.fit.result import FitResult
+from wbfriction.fit.status import ZERO
 from wbfriction.fit.terms import NOT_TRIED, TERM_COEFFICIENTS, TermFit
 from wbfriction.friction.models import ALL_PARAM_NAMES
 from wbfriction.friction.point_contacts import DeterminedShares
@@ -34,12 +39,22 @@ OTHERS = ("tau_os", "S", "v_s", "a")
 CAPTION = ("value ± standard error (the residuals' autocorrelation-consistent sandwich, raised to the "
            "Cramér-Rao bound where that is larger; for F_c and F_v of a model chosen automatically, with the "
            "model error the candidate families show, in quadrature); Cramér-Rao: the standard deviation no "
-           "unbiased estimator from these data goes below; n.i.: not identifiable; (b): at a bound of the fit, "
-           "the bound's value, not the data's; "
-           "a step: a tanh slope beyond what the data resolve (Coulomb friction, sgn); "
-           "dim: not to be used (status); *: refitted with its terms beyond velocity (the terms' table)")
+           "unbiased estimator from these data goes below")
+MARKS = {"n.i.": "n.i.: not identifiable", "(b)": "(b): at a bound of the fit, the bound's value, not the data's",
+         "step": "step: a tanh slope beyond what the data resolve (Coulomb friction, sgn)",
+         "dim": "dim: not to be used (status)", "*": "*: refitted with its terms beyond velocity (the terms' table)"}
+"""What each mark of the friction table means: the caption explains those the table shows."""
 NAMES_SHOWN = 6
-"""Joints named in a note before "and N more"."""
+"""Joints (or groups of joints, :func:`compact_names`) named in a note before "and N more"."""
+UNITS = {"F_c": "N·m", "F_s": "N·m", "tau_os": "N·m", "F_s-F_c": "N·m", "F_v": "N·m·s/rad", "v_s": "rad/s",
+         "a": "s/rad", "S": "-", "delta_s": "-"}
+"""The unit of each built-in family's parameter, as a column's header gives it (``-``: a ratio)."""
+
+
+def header(name: str) -> str:
+    """A parameter's column header: its name and unit, ``F_v [N·m·s/rad]`` (a registered family's parameter
+    without a known unit: its name)."""
+    return f"{name} [{UNITS[name]}]" if name in UNITS else name
 
 
 def _cell(r: FitResult, name: str) -> str:
@@ -50,13 +65,15 @@ def _cell(r: FitResult, name: str) -> str:
     return with_error(getattr(r.params, name), r.read_stderr().get(name)) + (" (b)" if r.at_bound.get(name) else "")
 
 
-def _table(title: str, first: Sequence[str], names: Sequence[str], caption: str | None = None) -> Table:
+def _table(title: str, first: Sequence[str], names: Sequence[str], caption: str | None = None,
+           units: bool = True) -> Table:
     table = Table(title=title, caption=caption, box=None, title_justify="left", caption_justify="left",
                   pad_edge=False)
     for col in first:
         table.add_column(col, no_wrap=col != "status", justify="right" if col == "N" else "left")
     for name in names:
-        table.add_column(name, justify="right", no_wrap=True)
+        # a Text, not markup: Rich would take "[rad/s]" for a tag and drop it
+        table.add_column(Text(header(name) if units else name), justify="right", no_wrap=True)
     return table
 
 
@@ -72,17 +89,21 @@ def fit_tables(results: Sequence[FitResult], wide: bool = False,
     title = f"Friction per joint: f(qd) fitted to -tau_f ({routes} route)"
     if wide:
         names = [n for n in ALL_PARAM_NAMES if any(n in r.params.names for r in fitted if r.params is not None)]
-        return [_rows(_table(title, ("joint", "model", "status", "N"), names, CAPTION), results, names, label,
-                      True)]
-    tables = [_rows(_table(title, ("joint", "model", "status"), MAIN, CAPTION), results, MAIN, label, False)]
+        return [_rows(_table(title, ("joint", "model", "status", "N"), names, _caption(results, names)), results,
+                      names, label, True)]
+    # the joints that did not move carry no information: folded into one line (fit_notes), --wide shows them
+    shown = [r for r in results if not _folded(r)]
+    tables = [_rows(_table(title, ("joint", "model", "status"), MAIN, _caption(shown, MAIN)), shown, MAIN, label,
+                    False)]
     others = [n for n in OTHERS if any(n in r.params.names for r in fitted if r.params is not None)]
-    tables.append(_rows(_table("Offset and Stribeck terms", ("joint",), others), fitted, others, label, False,
-                        short=True))
+    tables.append(_rows(_table("Offset and Stribeck terms", ("joint",), others),
+                        [r for r in fitted if not _folded(r)], others, label, False, short=True))
     truth = [r for r in fitted if r.error_percent() is not None]
     still = [r.joint for r in truth if r.verdict().status == "not excited"]
     if truth:
+        # the joints not excited left out: the line of fit_notes names them
         table = _table("Against the simulator's friction: error [%]", ("joint", "model"), [*MAIN, *OTHERS, "RMS"],
-                       caption=f"not excited, left out: {', '.join(label(j) for j in still)}" if still else None)
+                       units=False)
         for r in truth:
             if r.joint in still:
                 continue
@@ -93,6 +114,21 @@ def fit_tables(results: Sequence[FitResult], wide: bool = False,
         tables.append(table)
     terms = terms_table(results, label)
     return [t for t in [*tables, terms] if t is not None and t.row_count]
+
+
+def _caption(results: Sequence[FitResult], names: Sequence[str]) -> str:
+    """The friction table's caption: :data:`CAPTION` and what each mark the table shows means (:data:`MARKS`)."""
+    cells = [_cell(r, n) for r in results for n in names]
+    bounds = [bound_text(r.crb.get(n)) for r in results for n in names if r.params is not None]
+    shown = {"n.i.": any("n.i." in c for c in [*cells, *bounds]), "(b)": any(c.endswith("(b)") for c in cells),
+             "step": "step" in cells, "dim": any(not r.verdict().ok for r in results),
+             "*": any(r.params is not None and r.kept_terms is not None for r in results)}
+    return "; ".join([CAPTION, *(MARKS[m] for m, there in shown.items() if there)])
+
+
+def _folded(r: FitResult) -> bool:
+    """Whether a fit's rows are folded into the line of the joints not excited (:func:`fit_notes`)."""
+    return r.verdict().status == "not excited"
 
 
 def terms_table(results: Sequence[FitResult], label: Callable[[str], str] = str) -> Table | None:
@@ -185,27 +221,60 @@ def _labeller(labels: Mapping[str, str] | None) -> Callable[[str], str]:
     return lambda joint: (labels or {}).get(joint) or joint
 
 
-def _joints(names: Sequence[str]) -> str:
-    shown = ", ".join(names[:NAMES_SHOWN])
-    return shown + (f" and {len(names) - NAMES_SHOWN} more" if len(names) > NAMES_SHOWN else "")
+def compact_names(names: Sequence[str]) -> list[str]:
+    """Joint names that differ by one number written once, bash's way: ``arm_left_{1..7}_joint`` for seven
+    (a run of three or more), ``torso_{1,2}_joint``; the others as they are; in the order of their first name."""
+    groups: dict[str | tuple[str, str], list[str]] = {}  # (prefix, suffix) of a numbered name, else the name
+    for name in names:
+        m = _NUMBERED.match(name)
+        groups.setdefault((m.group(1), m.group(3)) if m else name, []).append(name)
+    shown = []
+    for key, members in groups.items():
+        if isinstance(key, str) or len(set(members)) == 1:
+            shown.append(members[0])
+            continue
+        runs: list[list[int]] = []
+        for n in sorted({int(_NUMBERED.match(m).group(2)) for m in members}):  # type: ignore[union-attr]
+            if runs and n == runs[-1][-1] + 1:
+                runs[-1].append(n)
+            else:
+                runs.append([n])
+        inner = ",".join(f"{r[0]}..{r[-1]}" if len(r) > 2 else ",".join(map(str, r)) for r in runs)
+        shown.append(f"{key[0]}{{{inner}}}{key[1]}")
+    return shown
+
+
+_NUMBERED = re.compile(r"^(.*?)(\d+)(\D*)$")
+
+
+def _joints(names: Sequence[str], everyone: bool = False) -> str:
+    """Joints as a note names them (:func:`compact_names`): the first :data:`NAMES_SHOWN` and "and N more"
+    (``everyone``: all of them)."""
+    groups = compact_names(names)
+    shown = groups if everyone else groups[:NAMES_SHOWN]
+    return ", ".join(shown) + (f" and {len(groups) - len(shown)} more" if len(groups) > len(shown) else "")
 
 
 def fit_notes(results: Sequence[FitResult], verbose: bool = False,
-              labels: Mapping[str, str] | None = None) -> list[str]:
-    """What the table's statuses and models mean, one line each: every fit that is not ``ok`` with its reason,
-    except the joints that did not move, which share one line; the model chosen on held-out data (``--model
+              labels: Mapping[str, str] | None = None, wide: bool = False) -> list[str]:
+    """What the table's statuses and models mean, one line each: the joints not excited, whose rows
+    :func:`fit_tables` folds, on one line that names them all (``wide``: their rows are in the table; the line
+    says so); every other fit that is not ``ok`` with its reason; the model chosen on held-out data (``--model
     auto``), one line per model. ``verbose``: each joint's own line for both. Joints by their ``labels``."""
     label = _labeller(labels)
     lines = []
+    folded = [label(r.reported().joint) for r in results if _folded(r.reported())]
     still = [label(r.joint) for r in results if r.verdict().status == "not excited" and r.params is not None
              and r.speed is not None]
+    if folded:
+        why = "hardly moved" if len(still) == len(folded) else "not determined by this log"
+        lines.append(f"{len(folded)} joint{'s' if len(folded) > 1 else ''} not excited ({why}; "
+                     + ("their rows above" if wide else "no rows: --wide shows them")
+                     + ("" if verbose else ", --verbose why") + f"): {_joints(folded, everyone=True)}")
     for r in results:
         verdict = r.verdict()
         if not verdict.ok and (verbose or label(r.joint) not in still):
             lines.append(f"{label(r.joint)}: {verdict}")
-    if still and not verbose:
-        lines.append(f"not excited: {len(still)} joints hardly moved ({_joints(still)}); --verbose gives each "
-                     "one's speed")
     chosen: dict[str, list[str]] = defaultdict(list)
     for r in results:
         if r.selection is not None:
@@ -240,13 +309,20 @@ for the centre of mass) is as given: left out of the bodies' table."""
 
 
 def _g(x: float | None) -> str:
-    """A number without a standard error, in three significant digits ("—": none)."""
-    return "—" if x is None else f"{x:.3g}"
+    """A friction parameter without a standard error, in three significant digits ("—": none; "0": a magnitude
+    below :data:`~wbfriction.fit.status.ZERO`, at its floor of zero, not ``2.18e-67``: the solver's rounding)."""
+    return "—" if x is None else "0" if abs(x) < ZERO else f"{x:.3g}"
 
 
 def _change(x: float | None, digits: int) -> str:
     """A relative change as a signed percentage; ``new`` for a body the given model had none of."""
     return "new" if x is None else f"{100 * x:+.{digits}f}"
+
+
+def _stacked(name: str) -> Text:
+    """A column's header with the unit of its parameter (``accel. F_v``: F_v's) below its name."""
+    unit = UNITS.get(name.removeprefix("accel. "))
+    return Text(name if unit is None else f"{name}\n[{unit}]")
 
 
 def identification_tables(result: Identification, wide: bool = False) -> tuple[list[Table], list[str]]:
@@ -255,11 +331,13 @@ def identification_tables(result: Identification, wide: bool = False) -> tuple[l
     the friction of the joints whose acceleration-route fit moved (both routes, the status of the
     acceleration route's fit, the power-generating share), and their held-out torques."""
     notes: list[str] = []
+    # Text, not markup, wherever a unit is in brackets: Rich would take "[kg]" or "[mm]" for a tag and drop it
     bodies = Table(title="Inertia model: given -> written", box=None, title_justify="left", caption_justify="left",
-                   caption="COM: shift [mm]; I1-I3: principal moments about the centre of mass, ascending, change "
-                           "[%]; kept: the identified body predicted held-out torques better (else as given)")
+                   caption=Text("COM: shift [mm]; I1-I3: principal moments about the centre of mass, ascending, "
+                                "change [%]; kept: the identified body predicted held-out torques better (else as "
+                                "given)"))
     for col in ("body", "mass [kg]", "mass [%]", "COM [mm]", "I1 [%]", "I2 [%]", "I3 [%]", "kept"):
-        bodies.add_column(col, justify="left" if col == "body" else "right", no_wrap=True)
+        bodies.add_column(Text(col), justify="left" if col == "body" else "right", no_wrap=True)
     massive = [b for b in result.bodies if b.has_mass]
     changed = [b for b in massive if wide or b.kept or b.mass_change is None
                or abs(b.mass_change) >= CHANGED or b.com_shift >= CHANGED
@@ -281,12 +359,13 @@ def identification_tables(result: Identification, wide: bool = False) -> tuple[l
     names = result.friction_names
     friction = Table(title="Friction: this route (torques, the inertias written) and the acceleration route (5.10)",
                      box=None, title_justify="left", caption_justify="left",
-                     caption="status: of the acceleration route's fit; gen: share of valid samples whose friction "
-                             "generates power (eq. 7.9) [%], given model -> identified; target: the simulator's")
+                     caption=Text("status: of the acceleration route's fit; accel.: its parameters; gen: share of "
+                                  "valid samples whose friction generates power (eq. 7.9) [%], given model -> "
+                                  "identified; target: the simulator's; 0: at its floor of zero"))
     friction.add_column("joint", no_wrap=True)
-    friction.add_column("status")
-    for n in (*names, "accel. F_v", "accel. F_c", "gen [%]"):
-        friction.add_column(n, justify="right", no_wrap=True)
+    friction.add_column("status")  # wraps, where the terminal is narrow: the numbers never do
+    for n in (*names, "accel. F_v", "accel. F_c", "gen [%]"):  # each unit below its name: narrow columns
+        friction.add_column(_stacked(n), justify="right", no_wrap=True)
     pct = lambda x: "—" if x is None else f"{100 * x:.1f}"  # noqa: E731
     for joint in moved:
         j = joints[joint]

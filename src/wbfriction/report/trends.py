@@ -23,6 +23,7 @@ from wbfriction.fleet.trends import FleetTrends, JointTrend
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.figures import READABLE, REPORT_WIDTH, joint_label, png_bytes
 from wbfriction.report.html import PAGE_CSS
+from wbfriction.report.numbers import p_value_text
 
 SHOWN = ("F_c", "F_v", "f_at_0.3")
 """The quantities each joint's panel shows (every tested quantity is in the table)."""
@@ -117,7 +118,7 @@ def _drifts_table(joints: list[JointTrend]) -> str:
     rows = "".join(
         f'<tr class="flag"><td>{html.escape(j.joint)}</td><td>{html.escape(cp.quantity)}</td><td>{cp.shape}</td>'
         f"<td>{_date(cp.onset_time)}</td><td>{_num(cp.change)} ± {_num(cp.change_se, 2)}</td>"
-        f"<td>{_relative_change(cp)}</td><td>{cp.p_value:.2g}</td><td>{_at(cp)}</td></tr>"
+        f"<td>{_relative_change(cp)}</td><td>{html.escape(p_value_text(cp.p_value))}</td><td>{_at(cp)}</td></tr>"
         for j in joints for cp in j.drifts)
     return ('<div class="scroll"><table><tr>' + "".join(f"<th>{h}</th>" for h in head) + f"</tr>{rows}</table></div>")
 
@@ -136,7 +137,7 @@ def _tests_table(joints: list[JointTrend]) -> str:
                         f"<td>{_num(float(s.value[s.used][-1]))}</td><td>{_num(cp.baseline)}</td>"
                         f"<td>{cp.shape}</td><td>{_date(cp.onset_time)}</td>"
                         f"<td>{_num(cp.change)} ± {_num(cp.change_se, 2)}</td>"
-                        f"<td>{_relative_change(cp)}</td><td>{cp.p_value:.2g}</td>"
+                        f"<td>{_relative_change(cp)}</td><td>{html.escape(p_value_text(cp.p_value))}</td>"
                         f"<td>{'yes' if flag else ''}</td></tr>")
     return ('<details><summary>Every tested quantity</summary><div class="scroll"><table><tr>'
             + "".join(f"<th>{h}</th>" for h in head) + "</tr>" + "".join(rows) + "</table></div></details>")
