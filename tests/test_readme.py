@@ -9,7 +9,17 @@ has, and whatever follows waits for it. Marks, an HTML comment on the line befor
 
 * ``<!-- not run: REASON -->``: the block is not run (an install, ``mkdocs serve``);
 * ``<!-- write: FILE -->``: the block's text is written to ``FILE`` in the page's folder first (a TOML a command
-  reads), so that what the page shows is what runs.
+  reads), so that what the page shows is what runs;
+* ``<!-- output of: COMMAND -->``: the (``text``) block shows what COMMAND, a command line of the page (a prefix of
+  exactly one), printed: every number in it is one the run printed, within the rounding it is written with.
+
+A paragraph that quotes numbers a command printed is followed by ``<!-- quoted from COMMAND: 0.401 0.602 -->``: each
+number is in the paragraph and in what COMMAND printed, within its rounding (``python``: the page's ``python``
+blocks; another page, ``docs/how-to/x.md``: numbers that page quotes so). A figure a page shows,
+``![...](../figures/<page>/<name>.png)``, is made by its commands: a PNG they write, or ``<report>.<id>.png``, an image
+of an HTML report they write; the run copies it into ``docs/figures/<page>/`` (not committed: the manual's build
+shows it, ``docs/hooks/figures.py``) and fails without it. A command line that writes only what it names
+(:data:`SHARED`) runs once per session on the same inputs, whichever pages show it.
 
 The manual's other pages (reference, explanation, measurements: the full-size commands that measured its numbers,
 minutes to hours each) are not run here. A page whose commands fetch a real dataset (``wbfriction dataset``) reads
@@ -357,12 +367,17 @@ def make_figures(page: str, folder: Path) -> None:
         part.replace(target)
 
 
-@pytest.mark.parametrize("page", PAGES)
+MANUAL = sorted({*PAGES, *(str(p.relative_to(REPO)) for p in DOCS.rglob("*.md"))})
+"""Every page: the measurements' may quote what a page that runs quotes (``<!-- quoted from docs/tutorials/x.md``)."""
+
+
+@pytest.mark.parametrize("page", MANUAL)
 def test_a_quote_names_what_it_quotes(page):
     """A quote's source is one of the page's command lines (a prefix of exactly one), its ``python`` blocks, or
     another page that quotes the same numbers (within the rounding of this one); a paragraph's marked numbers are
-    in the paragraph."""
+    in the paragraph. A page whose commands do not run quotes only other pages."""
     for quote in quotes(page):
+        assert page in PAGES or quote.source.endswith(".md"), f"{page} does not run: it quotes only pages that do"
         assert quote.numbers, f"{page}: a quote of {quote.source!r} with no number"
         assert all(n in numbers(quote.text) for n in quote.numbers), f"{page}: {quote.numbers} not all in\n{quote.text}"
         if quote.source.endswith(".md"):
@@ -388,7 +403,7 @@ def test_quoted_numbers_are_read_within_their_rounding():
     assert match and match[1] == "wbfriction fit a" and match[2].split() == ["38", "0.2"]
 
 
-@pytest.mark.parametrize("page", [str(p.relative_to(REPO)) for p in sorted(DOCS.rglob("*.md"))] + ["README.md"])
+@pytest.mark.parametrize("page", MANUAL)
 def test_a_figure_is_made_by_its_page(page):
     """A page shows only figures its own commands write (a file, or an image of an HTML report), in its own folder
     of ``docs/figures/``; ``test_the_page_runs_as_written`` makes them and fails if one is not."""
