@@ -2,7 +2,8 @@
 
 A page whose commands run in the suite (a tutorial, a how-to) shows a figure as
 ``![what it shows](../figures/<page>/<name>.png)``, ``<page>`` the page's file name without ``.md``. ``<name>.png``
-is a file one of the page's commands writes (``--figure x.png``, ``-o x.png``, or a ``python`` block), or
+is a file one of the page's commands writes (``--figure x.png``, ``-o x.png``, ``demo/fig6_1_support_phases.png`` in
+a folder it writes, or a ``python`` block's), or
 ``<report>.<id>.png``: the image ``id="<id>"`` of the HTML report ``<report>.html`` a command writes (``overview``:
 the friction clouds of every joint; ``fig-joint-<joint>``: a joint's four panels).
 ``tests/test_readme.py`` runs each page's commands and copies its figures into ``docs/figures/<page>/``
@@ -28,7 +29,7 @@ from mkdocs.structure.files import File, Files
 
 log = logging.getLogger("mkdocs.hooks.figures")
 
-FIGURE = re.compile(r"!\[[^\]]*\]\((?:\.\./)*figures/([\w.-]+)/([\w.-]+\.png)\)")
+FIGURE = re.compile(r"!\[[^\]]*\]\((?:\.\./)*figures/([\w.-]+)/([\w.-]+(?:/[\w.-]+)*\.png)\)")
 """A figure a page shows: its page folder and its file name."""
 
 PLACEHOLDER = bytes.fromhex(  # a 1x1 grey PNG
