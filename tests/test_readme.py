@@ -484,6 +484,7 @@ def _run(step: Step, cwd: Path, env: dict[str, str], shared: Path | None = None)
     res = subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True, timeout=900)
     if kept is not None and res.returncode == 0 and all((cwd / o).exists() for o in outputs(step.text)):
         part = kept.with_name(f"{key}.{os.getpid()}.{threading.get_ident()}")
+        part.mkdir()
         for out in outputs(step.text):
             _copy(cwd / out, part / "files" / out)
         (part / "stdout").write_text(res.stdout)
