@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -62,6 +63,36 @@ def run(*args, cwd=None, columns: int = 200):
     """``python -m wbfriction ARGS`` in a terminal ``columns`` wide."""
     return subprocess.run([sys.executable, "-m", "wbfriction", *map(str, args)], capture_output=True, text=True,
                           cwd=cwd, env=dict(os.environ, COLUMNS=str(columns)))
+
+
+STAGE_LINE = re.compile(r"(?P<label>.+): (?:(?P<items>\d+) (?P<unit>\S+) in )?(?P<seconds>\d+\.\d) s")
+"""A stage's line on standard error off a terminal (:mod:`wbfriction.cli.stages`): ``fit: 12 joints in 81.2 s``,
+``reading friction.parquet: 0.4 s``."""
+
+
+def stage_lines(stderr: str) -> dict[str, re.Match]:
+    """The stage lines of a command's standard error (piped, not a terminal), by label; each checked to be one
+    plain line of at most 100 characters (no carriage return, no ANSI escape)."""
+    assert "\r" not in stderr and "\x1b" not in stderr, repr(stderr[:300])
+    found = {}
+    for line in stderr.splitlines():
+        match = STAGE_LINE.fullmatch(line)
+        if match is not None:
+            assert len(line) <= 100, line
+            found[match["label"]] = match
+    return found
+
+
+def assert_stages(stderr: str, *labels: str) -> dict[str, re.Match]:
+    """Assert that a command's standard error holds a stage line starting with each of ``labels`` (in order)."""
+    found = stage_lines(stderr)
+    names = list(found)
+    at = -1
+    for label in labels:
+        hits = [k for k, name in enumerate(names) if name.startswith(label) and k > at]
+        assert hits, f"no stage line '{label}...' after {names[:at + 1]} in:\n{stderr}"
+        at = hits[0]
+    return found
 
 
 def widest_line(text: str) -> int:

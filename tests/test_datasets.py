@@ -21,7 +21,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import wbfriction
-from helpers import KUKA, REAL_DATA, REPO, needs_data, needs_kuka, run_cli_printed
+from helpers import KUKA, REAL_DATA, REPO, assert_stages, needs_data, needs_kuka, run_cli_printed
 from wbfriction import datasets
 from wbfriction.cli.data import DatasetName
 from wbfriction.datasets import panda, ur10e
@@ -233,6 +233,7 @@ def test_the_command_writes_both_kuka_logs(tmp_path, capsys, local_copy):
     out = tmp_path / "new" / "kuka"
     code, printed, err = run_cli_printed(capsys, "dataset", "kuka-lwr4", "-o", out)
     assert code == 0, err
+    assert_stages(err, "fetching the kuka-lwr4 dataset")  # piped: its stage's line (issue 67)
     runs = []
     for i in (1, 2, 3):
         with np.load(KUKA / f"measurements_{i}.npz") as recording:

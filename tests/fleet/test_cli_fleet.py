@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from helpers import assert_stages
+
 
 def wbfriction(*args: str, cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "wbfriction", *args], cwd=cwd, capture_output=True, text=True)
@@ -76,6 +78,7 @@ def test_trends_say_what_they_leave_out(tmp_path, synthetic_results):
     pq.write_table(pa.table({"x": [1]}), tmp_path / "results" / "r1" / "stray.parquet")
     res = wbfriction("trends", "results", "-o", "t.html", cwd=tmp_path)
     assert res.returncode == 0, res.stderr
+    assert_stages(res.stderr, "reading results", "testing", "writing t.html")  # piped: a line per stage (issue 67)
     left = [line for line in res.stderr.splitlines() if line.startswith("left out:")]
     assert len(left) == 2 and "unreadable" in left[0] and "stray.parquet: not a result" in left[1]
     assert "0 of 2 tested robot joints drifted" in res.stderr and (tmp_path / "t.html").exists()
@@ -86,6 +89,7 @@ def test_trends_that_cannot_test_say_so(tmp_path, synthetic_results):
     synthetic_results(tmp_path / "results", 3)
     res = wbfriction("trends", "results", "-o", "t.html", cwd=tmp_path)
     assert res.returncode == 0, res.stderr
+    assert_stages(res.stderr, "reading results", "testing", "writing t.html")  # piped: a line per stage (issue 67)
     assert "none of the 2 robot joints could be tested (each has fewer than 8 usable logs)" in res.stderr
 
 
@@ -161,6 +165,7 @@ def test_trends_of_logs_at_one_start_time_say_so(tmp_path, synthetic_results):
         write_part(tmp_path / "results", table)
     res = wbfriction("trends", "results", "-o", "t.html", cwd=tmp_path)
     assert res.returncode == 0, res.stderr
+    assert_stages(res.stderr, "reading results", "testing", "writing t.html")  # piped: a line per stage (issue 67)
     notes = [line for line in res.stderr.splitlines() if line.startswith("note:")]
     assert len(notes) == 1 and notes[0].startswith("note: robot r1: 1 start time holds the results of several logs")
     assert "none of the 2 robot joints could be tested (each has its 10 usable logs at 1 start time" in res.stderr

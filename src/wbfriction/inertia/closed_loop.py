@@ -131,6 +131,7 @@ def identify(robot: Robot, log: Log, estimate_options: EstimateOptions = Estimat
         passes = 1
     v_s, joints = stribeck_velocity(given.fits) if stribeck == "auto" else (stribeck, None)
     done: list[LoopPass] = []
+    say("the identification's samples (its dynamics at every sample)")
     samples = log_samples(robot, log, estimate_options, options)  # the passes differ in v_s only
     for k in range(max(passes, 1)):
         say(f"identifying the inertia model (pass {k + 1}, v_s = {v_s if v_s is None else round(v_s, 4)})")
