@@ -70,6 +70,13 @@ STAGE_LINE = re.compile(r"(?P<label>.+): (?:(?P<items>\d+) (?P<unit>\S+) in )?(?
 ``reading friction.parquet: 0.4 s``."""
 
 
+def said(stderr: str) -> list[str]:
+    """The non-empty lines of a command's standard error but its stages' (:data:`STAGE_LINE`, printed as each ends
+    when standard error is not a terminal): its messages, e.g. an error's one line."""
+    return [line for line in stderr.strip().splitlines()
+            if line.strip() and (line.startswith(("error:", "warning:")) or not STAGE_LINE.fullmatch(line))]
+
+
 def stage_lines(stderr: str) -> dict[str, re.Match]:
     """The stage lines of a command's standard error (piped, not a terminal), by label; each checked to be one
     plain line of at most 100 characters (no carriage return, no ANSI escape)."""
@@ -102,7 +109,7 @@ def widest_line(text: str) -> int:
 
 def assert_one_line_error(res, needle):
     assert res.returncode == 2
-    lines = [ln for ln in res.stderr.strip().splitlines() if ln.strip()]
+    lines = said(res.stderr)
     assert len(lines) == 1 and needle in lines[0], res.stderr
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers import assert_stages
+from helpers import assert_stages, said
 
 
 def wbfriction(*args: str, cwd: Path) -> subprocess.CompletedProcess:
@@ -30,7 +30,7 @@ def test_a_bad_manifest_is_one_line_and_nothing_is_written(tmp_path, manifest, m
         (tmp_path / "m.csv").write_text(manifest)
     res = wbfriction("batch", "m.csv", "-o", "results", cwd=tmp_path)
     assert res.returncode == 2 and message in res.stderr, res.stderr
-    assert len(res.stderr.strip().splitlines()) == 1 and not (tmp_path / "results").exists()
+    assert len(said(res.stderr)) == 1 and not (tmp_path / "results").exists()
 
 
 def test_trends_need_results_and_an_html_page(tmp_path):
@@ -62,7 +62,7 @@ def test_batch_faults_are_one_line_within_seconds(arm_fleet, tmp_path, args, mes
         argv += ["-o", "results"]
     res = wbfriction(*argv, cwd=tmp_path)
     assert res.returncode == 2 and message in res.stderr, res.stderr
-    assert len(res.stderr.strip().splitlines()) == 1 and "Traceback" not in res.stderr
+    assert len(said(res.stderr)) == 1 and "Traceback" not in res.stderr
     assert not (tmp_path / "results").exists()
     assert (tmp_path / "file.txt").read_text() == "x"
 
@@ -141,7 +141,7 @@ def test_a_scheduler_that_goes_away_is_one_line(arm_fleet, tmp_path):
                 os.killpg(p.pid, signal.SIGKILL)
             except ProcessLookupError:
                 pass
-    lines = [ln for ln in err.splitlines() if ln.strip()]
+    lines = said(err)
     assert batch.returncode == 1 and len(lines) == 1, err
     assert f"error: the Dask scheduler {address} went away: " in lines[0] and "run the batch again" in lines[0]
     from wbfriction.fleet.results import read_parts
