@@ -77,29 +77,26 @@ def said(stderr: str) -> list[str]:
             if line.strip() and (line.startswith(("error:", "warning:")) or not STAGE_LINE.fullmatch(line))]
 
 
-def stage_lines(stderr: str) -> dict[str, re.Match]:
-    """The stage lines of a command's standard error (piped, not a terminal), by label; each checked to be one
-    plain line of at most 100 characters (no carriage return, no ANSI escape)."""
+def stage_lines(stderr: str) -> list[re.Match]:
+    """The stage lines of a command's standard error (piped, not a terminal), in order; each checked to be one plain
+    line of at most 100 characters (no carriage return, no ANSI escape)."""
     assert "\r" not in stderr and "\x1b" not in stderr, repr(stderr[:300])
-    found = {}
-    for line in stderr.splitlines():
-        match = STAGE_LINE.fullmatch(line)
-        if match is not None:
-            assert len(line) <= 100, line
-            found[match["label"]] = match
+    found = [m for m in map(STAGE_LINE.fullmatch, stderr.splitlines()) if m is not None]
+    assert all(len(m[0]) <= 100 for m in found), [m[0] for m in found]
     return found
 
 
 def assert_stages(stderr: str, *labels: str) -> dict[str, re.Match]:
-    """Assert that a command's standard error holds a stage line starting with each of ``labels`` (in order)."""
+    """Assert that a command's standard error holds a stage line starting with each of ``labels``, in this order;
+    the lines by label (the first of each)."""
     found = stage_lines(stderr)
-    names = list(found)
+    names = [m["label"] for m in found]
     at = -1
     for label in labels:
         hits = [k for k, name in enumerate(names) if name.startswith(label) and k > at]
         assert hits, f"no stage line '{label}...' after {names[:at + 1]} in:\n{stderr}"
         at = hits[0]
-    return found
+    return {name: m for name, m in reversed(list(zip(names, found)))}
 
 
 def widest_line(text: str) -> int:

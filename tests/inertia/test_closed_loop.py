@@ -65,8 +65,8 @@ def test_identify_command_closes_the_loop(talos, wrong, combined_walk, tmp_path,
     code, printed, err = run_cli_printed(capsys, "identify", log, "--urdf", given, "-o", tmp_path / "id.urdf",
                                          "--json", tmp_path / "id.json", "--stribeck-velocity", "0.2")
     assert code == 0, err
-    assert_stages(err, "acceleration route with the given model", "the identification's samples",
-                  "identifying the inertia model (pass 1", "acceleration route with the identified model (pass 1)")
+    assert_stages(err, "estimating with the given model", "fit", "the identification's samples",
+                  "identifying the inertia model (pass 1", "estimating with the identified model (pass 1)", "fit")
     assert widest_line(printed) <= 100 and "Held-out torques" in printed, printed
     doc = json.loads((tmp_path / "id.json").read_text())
     legs = [j for j, _, _ in leg_joints(talos)]

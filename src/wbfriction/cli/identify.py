@@ -153,7 +153,8 @@ def identify(ctx: typer.Context, log: Path = LogArg, output: Optional[Path] = Ou
         estimate_options = EstimateOptions(diff=diff, mask=mask, route=route, noise_target=noise_target,
                                            base_motion=base_motion)
         done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
-                             options=opts, stribeck=stribeck, passes=passes, progress=status, workers=workers,
+                             options=opts, stribeck=stribeck, passes=passes, progress=status, steps=status.steps,
+                             workers=workers,
                              time_unit=time_unit)
     print_identification(done, wide)
     if json_output is not None:
