@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -64,6 +65,40 @@ def run(*args, cwd=None, columns: int = 200):
                           cwd=cwd, env=dict(os.environ, COLUMNS=str(columns)))
 
 
+STAGE_LINE = re.compile(r"(?P<label>.+): (?:(?P<items>\d+) (?P<unit>\S+) in )?(?P<seconds>\d+\.\d) s")
+"""A stage's line on standard error off a terminal (:mod:`wbfriction.cli.stages`): ``fit: 12 joints in 81.2 s``,
+``reading friction.parquet: 0.4 s``."""
+
+
+def said(stderr: str) -> list[str]:
+    """The non-empty lines of a command's standard error but its stages' (:data:`STAGE_LINE`, printed as each ends
+    when standard error is not a terminal): its messages, e.g. an error's one line."""
+    return [line for line in stderr.strip().splitlines()
+            if line.strip() and (line.startswith(("error:", "warning:")) or not STAGE_LINE.fullmatch(line))]
+
+
+def stage_lines(stderr: str) -> list[re.Match]:
+    """The stage lines of a command's standard error (piped, not a terminal), in order; each checked to be one plain
+    line of at most 100 characters (no carriage return, no ANSI escape)."""
+    assert "\r" not in stderr and "\x1b" not in stderr, repr(stderr[:300])
+    found = [m for m in map(STAGE_LINE.fullmatch, stderr.splitlines()) if m is not None]
+    assert all(len(m[0]) <= 100 for m in found), [m[0] for m in found]
+    return found
+
+
+def assert_stages(stderr: str, *labels: str) -> dict[str, re.Match]:
+    """Assert that a command's standard error holds a stage line starting with each of ``labels``, in this order;
+    the lines by label (the first of each)."""
+    found = stage_lines(stderr)
+    names = [m["label"] for m in found]
+    at = -1
+    for label in labels:
+        hits = [k for k, name in enumerate(names) if name.startswith(label) and k > at]
+        assert hits, f"no stage line '{label}...' after {names[:at + 1]} in:\n{stderr}"
+        at = hits[0]
+    return {name: m for name, m in reversed(list(zip(names, found)))}
+
+
 def widest_line(text: str) -> int:
     """The longest line of ``text`` in characters, trailing spaces left out (what a terminal shows)."""
     return max((len(line.rstrip()) for line in text.splitlines()), default=0)
@@ -71,7 +106,7 @@ def widest_line(text: str) -> int:
 
 def assert_one_line_error(res, needle):
     assert res.returncode == 2
-    lines = [ln for ln in res.stderr.strip().splitlines() if ln.strip()]
+    lines = said(res.stderr)
     assert len(lines) == 1 and needle in lines[0], res.stderr
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from helpers import assert_one_line_error, run, widest_line
+from helpers import assert_one_line_error, assert_stages, run, widest_line
 from wbfriction.logs.log import write_log
 from wbfriction.logs.source import read_log
 
@@ -23,10 +23,13 @@ def demo_dir(tmp_path_factory):
                   "[friction.leg_left_4_joint]\nF_c = 0.5\n")
     res = run("simulate", "-o", out / "log.parquet", "--gait", "forward", "--steps", "3", "--friction", fr)
     assert res.returncode == 0, res.stderr
+    assert_stages(res.stderr, "planning 3 steps (forward)", "simulate")  # piped: a line per stage (issue 67)
     res = run("estimate", out / "log.parquet", "-o", out / "friction.parquet")
     assert res.returncode == 0, res.stderr
+    assert_stages(res.stderr, "estimate")
     res = run("fit", out / "friction.parquet", "-o", out / "params.json")
     assert res.returncode == 0, res.stderr
+    assert_stages(res.stderr, "reading friction.parquet", "fit", "terms")
     return out, res
 
 
@@ -54,6 +57,9 @@ def test_main_job_steps_write_log_friction_and_params(demo_dir):
 def test_demo_prints_the_thesis_table_and_writes_figures(tmp_path):
     res = run("demo", "-o", tmp_path, "--steps", "2", columns=100)
     assert res.returncode == 0, res.stderr
+    assert_stages(res.stderr, "planning a forward walk", "simulating the forward walk", "estimating with four",
+                  "planning the combined walk", "simulating the combined walk", "estimating (central", "fit",
+                  "writing the report")  # piped: a line per stage as it ends, with its time (issue 67)
     assert "T6.2 [%]" in res.stdout and "leg_right_4_joint " in res.stdout and "knee target" in res.stdout
     assert widest_line(res.stdout) <= 100, res.stdout
     # the 2-step walk hardly turns the hip yaws: said before the table, left out of the worst errors
@@ -165,6 +171,7 @@ def test_report_and_sensitivity_commands(demo_dir, tmp_path):
     out, _ = demo_dir
     res = run("report", out / "friction.parquet", "--params", out / "params.json", "-o", tmp_path / "r.html")
     assert res.returncode == 0, res.stderr
+    assert_stages(res.stderr, "building the report")
     text = (tmp_path / "r.html").read_text()
     assert "leg_right_4_joint" in text and "params.json (sha256" in text
     res = run("sensitivity", out / "log.parquet", "--factors", "0.9,1.1", "--part", "mass", "--joints",

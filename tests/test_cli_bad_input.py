@@ -13,7 +13,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from helpers import run_cli, write_bag
+from helpers import run_cli, said, write_bag
 from wbfriction.logs.formats.hdf5 import write_hdf5
 from wbfriction.logs.log import Log, log_from_table, write_log
 from wbfriction.logs.options import ReadOptions
@@ -85,7 +85,7 @@ def test_estimate_refuses_bad_logs_and_writes_nothing(talos, good, tmp_path, cap
     output.write_bytes(PREVIOUS)
     before = sorted(p.name for p in tmp_path.iterdir())
     code, err = run_cli(capsys, "estimate", log, "-o", output)
-    lines = [ln for ln in err.strip().splitlines() if ln.strip()]
+    lines = said(err)
     assert code == 2 and len(lines) == 1, err
     assert str(log) in lines[0] and needle in lines[0], lines[0]
     assert output.read_bytes() == PREVIOUS
@@ -127,7 +127,7 @@ def test_damaged_and_missing_files_write_nothing(talos, good, tmp_path, capsys, 
                         (tmp_path / "none.parquet", "not found"),
                         (tmp_path / "notes.txt", "unknown file type")):
         code, err = run_cli(capsys, command, bad, "-o", output, *extra)
-        lines = [ln for ln in err.strip().splitlines() if ln.strip()]
+        lines = said(err)
         assert code == 2 and len(lines) == 1 and needle in lines[0] and bad.name in lines[0], (bad, err)
         assert output.read_bytes() == PREVIOUS
         assert sorted(p.name for p in tmp_path.iterdir()) == before
@@ -193,7 +193,7 @@ def test_bad_bags_write_nothing(talos, combined_walk, tmp_path, capsys, command)
     for map_file, needle in (("map.toml", "column 'q.leg_left_4_joint' is "),
                              ("one_foot.toml", f"missing column 'contact.{right}'")):
         code, err = run_cli(capsys, command, tmp_path / "bag", "--map", tmp_path / map_file, "-o", output)
-        lines = [ln for ln in err.strip().splitlines() if ln.strip()]
+        lines = said(err)
         assert code == 2 and len(lines) == 1, err
         assert f"{tmp_path / 'bag'}: " in lines[0] and needle in lines[0], lines[0]
         assert output.read_bytes() == PREVIOUS
@@ -208,6 +208,6 @@ def test_an_acceleration_route_output_asked_of_the_momentum_route_is_refused(goo
     write_log(good, talos, log)
     code, err = run_cli(capsys, "estimate", log, "--robot", "talos", "--route", "momentum", option,
                         "-o", tmp_path / "f.parquet")
-    assert code == 2 and len(err.strip().splitlines()) == 1 and f"{option} must be left out with --route momentum" \
+    assert code == 2 and len(said(err)) == 1 and f"{option} must be left out with --route momentum" \
         in err, err
     assert not (tmp_path / "f.parquet").exists()

@@ -24,7 +24,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from helpers import mapped_copy, run_cli, run_cli_printed
+from helpers import mapped_copy, run_cli, run_cli_printed, said
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import log_from_table
@@ -65,7 +65,7 @@ def _refused(capsys, tmp_path: Path, inputs: list[Path], args, needle: str) -> N
     before = {p: _digest(p) for p in inputs if p.is_file()}
     listing = sorted(p.name for p in tmp_path.iterdir())
     code, err = run_cli(capsys, *args)
-    lines = [ln for ln in err.strip().splitlines() if ln.strip()]
+    lines = said(err)
     assert code == 2 and len(lines) == 1 and needle in lines[0], err
     assert "Traceback" not in err
     assert {p: _digest(p) for p in before} == before

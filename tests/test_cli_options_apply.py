@@ -12,7 +12,7 @@ import json
 import pytest
 import typer.main
 
-from helpers import run_cli
+from helpers import run_cli, said
 from wbfriction.cli import actuator as actuator_cli
 from wbfriction.cli import app
 from wbfriction.cli import identify as identify_cli
@@ -174,7 +174,7 @@ def _sorted(capsys, command: str, argv: list[str], options: list[str], values: d
     found = {}
     for name in options:
         code, err = run_cli(capsys, command, *argv, *_argv(values.get(name, VALUES[name]), tmp_path))
-        lines = err.strip().splitlines()
+        lines = said(err)
         assert code == 2 and len(lines) == 1, (name, err)
         found[name] = "accepted" if lines[0] == "error: accepted" else lines[0]
     return found
@@ -250,7 +250,7 @@ def test_estimate_on_a_fixed_base_refuses_the_contacts_options(capsys, tmp_path,
     log = tmp_path / "log.parquet"
     log.write_bytes(b"not read")
     code, err = run_cli(capsys, "estimate", log, "--robot", "panda", *given, "-o", tmp_path / "f.parquet")
-    assert code == 2 and len(err.strip().splitlines()) == 1, err
-    said = f"error: {option_flag(param)}: robot 'panda' has a fixed base: it takes no contact or base option"
-    assert err.strip() == said and len(said) <= 100, err
+    assert code == 2 and len(said(err)) == 1, err
+    message = f"error: {option_flag(param)}: robot 'panda' has a fixed base: it takes no contact or base option"
+    assert err.strip() == message and len(message) <= 100, err
     assert not (tmp_path / "f.parquet").exists()

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers import run_cli
+from helpers import run_cli, said
 
 LIMIT = 1024
 """Bytes a file of the command may grow to: below every output written here, above nothing it reads."""
@@ -34,7 +34,7 @@ def _limited(*args, cwd: Path) -> subprocess.CompletedProcess:
 def _refused_write(res: subprocess.CompletedProcess, folder: Path, out: Path) -> None:
     """One line on standard error naming ``out`` and the OS's reason, status 1, no traceback, the previous
     output byte for byte, and no file other than those that were there."""
-    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    lines = said(res.stderr)
     assert res.returncode == 1, res.stderr
     assert lines == [f"error: {out.name}: cannot be written: [Errno 27] File too large (the previous file is kept)"], \
         res.stderr
@@ -119,7 +119,7 @@ def test_an_output_folder_under_a_file_is_one_line(tmp_path, capsys):
     before any walk is simulated."""
     (tmp_path / "notes.txt").write_bytes(b"a file")
     code, err = run_cli(capsys, "demo", "--steps", "1", "-o", tmp_path / "notes.txt" / "demo")
-    lines = [ln for ln in err.splitlines() if ln.strip()]
+    lines = said(err)
     assert code == 1 and lines == [f"error: {tmp_path}/notes.txt/demo: cannot be written: [Errno 20] Not a "
                                    "directory (nothing written)"], err
     assert [p.name for p in tmp_path.iterdir()] == ["notes.txt"]
@@ -133,7 +133,7 @@ def test_a_batch_on_a_full_disk_stops_with_one_line(arm, tmp_path, engine):
     (tmp_path / "manifest.csv").write_text("log,robot_id,start_time,robot\n"
                                            "a1.parquet,arm-1,2026-03-01T08:00:00+00:00,panda\n")
     res = _limited("batch", "manifest.csv", "-o", "results", *engine, cwd=tmp_path)
-    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    lines = said(res.stderr)
     assert res.returncode == 1 and len(lines) == 1, res.stderr
     assert lines[0].startswith("error: ") and "cannot be written: [Errno 27] File too large" in lines[0]
     assert not list((tmp_path / "results").rglob("*.parquet")) and not (tmp_path / "results-failed").exists()

@@ -21,7 +21,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import wbfriction
-from helpers import KUKA, REAL_DATA, REPO, needs_data, needs_kuka, run_cli_printed
+from helpers import KUKA, REAL_DATA, REPO, assert_stages, needs_data, needs_kuka, run_cli_printed, said
 from wbfriction import datasets
 from wbfriction.cli.data import DatasetName
 from wbfriction.datasets import panda, ur10e
@@ -233,6 +233,7 @@ def test_the_command_writes_both_kuka_logs(tmp_path, capsys, local_copy):
     out = tmp_path / "new" / "kuka"
     code, printed, err = run_cli_printed(capsys, "dataset", "kuka-lwr4", "-o", out)
     assert code == 0, err
+    assert_stages(err, "fetching the kuka-lwr4 dataset")  # piped: its stage's line (issue 67)
     runs = []
     for i in (1, 2, 3):
         with np.load(KUKA / f"measurements_{i}.npz") as recording:
@@ -341,7 +342,7 @@ def test_a_panda_file_with_a_value_missing_is_refused(tmp_path, local_copy):
 
 def test_the_command_refuses_an_unknown_dataset(tmp_path, capsys):
     code, _, err = run_cli_printed(capsys, "dataset", "kuka", "-o", tmp_path / "out")
-    assert code == 2 and "'kuka'" in err and "kuka-lwr4" in err and len(err.strip().splitlines()) == 1
+    assert code == 2 and "'kuka'" in err and "kuka-lwr4" in err and len(said(err)) == 1
 
 
 @needs_kuka
@@ -350,7 +351,7 @@ def test_the_command_refuses_a_damaged_copy_before_writing(tmp_path, capsys, mon
     flip_a_byte(root / "kuka_lwr4" / "kuka_lwr4.urdf", at=5000)
     monkeypatch.setenv(datasets.DATA_ENV, str(root))
     code, _, err = run_cli_printed(capsys, "dataset", "kuka-lwr4", "-o", tmp_path / "out")
-    lines = err.strip().splitlines()
+    lines = said(err)
     assert code == 2 and len(lines) == 1 and f"{root / 'kuka_lwr4' / 'kuka_lwr4.urdf'}: SHA-256" in lines[0]
     assert not (tmp_path / "out").exists()  # refused before anything is written
 

@@ -18,7 +18,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from helpers import run_cli_printed
+from helpers import run_cli_printed, said
 from toys.toy_contact import NAME, LocalPoint
 from wbfriction.cli.common import config_text
 from wbfriction.exceptions import InputError
@@ -91,7 +91,7 @@ def test_a_toy_contact_model_runs_every_command_that_takes_the_robot(local_point
 
     code, _, err = run_cli_printed(capsys, "simulate", "--config", toml, "--duration", "1",
                                    "-o", tmp_path / "never.parquet")
-    lines = [ln for ln in err.strip().splitlines() if ln.strip()]
+    lines = said(err)
     assert code == 2 and len(lines) == 1, err
     assert f"not contact model '{NAME}' of 'FL_foot': {LocalPoint.what}" in lines[0] and "point feet only" in lines[0]
     assert not (tmp_path / "never.parquet").exists()
@@ -139,5 +139,5 @@ def test_an_unknown_contact_model_in_a_toml_is_one_line_naming_the_file(tmp_path
     assert f"contact_model of 'FL_foot' is '{NAME}': choose one of the registered contact models, sole, point" \
         in str(caught.value)
     code, _, err = run_cli_printed(capsys, "simulate", "--config", toml, "-o", tmp_path / "never.parquet")
-    lines = [ln for ln in err.strip().splitlines() if ln.strip()]
+    lines = said(err)
     assert code == 2 and len(lines) == 1 and str(toml.name) in lines[0], err

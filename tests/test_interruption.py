@@ -24,7 +24,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers import ended_within, run
+from helpers import ended_within, run, said
 from wbfriction.logs.tables import write_json
 
 ESTIMATE = ("estimate", "--workers", "2", "--chunk-rows", "800")
@@ -143,7 +143,8 @@ def _pool_busy(proc: subprocess.Popen, workers: int = 2) -> dict[int, str]:
 
 
 def _stderr_lines(text: str) -> list[str]:
-    return [line for line in text.splitlines() if line.strip()]
+    """The lines a command said on standard error, those of the stages it ended before the signal left out."""
+    return said(text)
 
 
 # ------------------------------------------------------------------ tests

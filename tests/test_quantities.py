@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from helpers import run_cli
+from helpers import run_cli, said
 from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.model import load_robot
 from wbfriction.quantities import RANGES, first_outside, in_range
@@ -138,7 +138,7 @@ def test_an_option_out_of_range_is_refused_before_the_work(tmp_path, capsys, arg
     args = tuple(log if a == "LOG" else a for a in args)
     code, err = run_cli(capsys, *args, *(("-o", out) if args[0] == "simulate" else ("--json", out)))
     assert code == 2 and err.startswith(f"error: {needle}"), err
-    assert len(err.strip().splitlines()) == 1 and not out.exists()
+    assert len(said(err)) == 1 and not out.exists()
 
 
 def test_an_export_physics_step_of_a_picosecond_is_refused(tmp_path, capsys):

@@ -107,7 +107,11 @@ def index_page(group: Any, ctx: Any, commands: list[tuple[str, Any]]) -> str:
         "(`docs/hooks/cli_reference.py`): what it says is what `wbfriction COMMAND --help` prints. "
         "Bad input prints one line naming the file, column, row or option at fault and exits with status 2; "
         "an output that cannot be written exits with status 1; Ctrl-C, SIGTERM and SIGHUP end a command with "
-        "128 + the signal's number (130, 143, 129).",
+        "128 + the signal's number (130, 143, 129). "
+        "Results go to standard output, messages and progress to standard error: on a terminal a bar per long "
+        "stage with its share done, the time it has run and the time left; when standard error is not a terminal "
+        "(a pipe, a file, CI) one plain line per stage as it ends, what it counted and how long it took "
+        "(`fit: N joints in T s`), no animation; a stage that fails prints only the error.",
         "",
         "| command | what it does |",
         "|---|---|",

@@ -11,7 +11,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import wbfriction
-from helpers import run_cli_printed
+from helpers import assert_stages, run_cli_printed
 from wbfriction.logs.setpoint_table import read_setpoint_table
 
 
@@ -57,9 +57,11 @@ def test_what_cannot_be_designed_is_one_line_before_the_work(capsys, tmp_path):
 
 def test_an_arms_design_written_then_played(cli, capsys, tmp_path):
     """A Panda: a Fourier design, its series in the table, played by the arm simulator along it."""
-    out = cli("excite", "--robot", "panda", "--duration", "4", "--period", "4", "-o", tmp_path / "arm.csv", "--json",
-              tmp_path / "arm.json")
+    code, out, err = run_cli_printed(capsys, "excite", "--robot", "panda", "--duration", "4", "--period", "4", "-o",
+                                     tmp_path / "arm.csv", "--json", tmp_path / "arm.json")
+    assert code == 0, err
     assert "worst: panda_joint" in out
+    assert int(assert_stages(err, "design", "predicting what")["design"]["items"]) == 7  # the arm's joints, each told
     panda = wbfriction.load_robot("panda")
     table = read_setpoint_table(tmp_path / "arm.csv", panda)
     assert table.rate == pytest.approx(1000.0, rel=1e-12) and table.fourier is not None

@@ -9,7 +9,7 @@ import json
 import mujoco
 import pytest
 
-from helpers import run, run_cli
+from helpers import run, run_cli, said
 from wbfriction.fit.params_file import write_params
 
 PREVIOUS = b"the previous output"
@@ -28,7 +28,7 @@ def panda_params(tmp_path, fit_of):
 
 
 def lines(err: str) -> list[str]:
-    return [ln for ln in err.strip().splitlines() if ln.strip()]
+    return said(err)
 
 
 def test_panda_mjcf_export(panda_params, tmp_path, capsys):

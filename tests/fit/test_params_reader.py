@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 import pytest
 
-from helpers import run_cli
+from helpers import run_cli, said
 from term_params import JOINT, RANGES, edited, params_file, table_file, term_fit
 from wbfriction.exceptions import InputError
 from wbfriction.fit.params_file import read_params
@@ -96,7 +96,7 @@ def test_every_command_refuses_it_in_one_line_before_any_work(good, tmp_path, ca
     args = {"predict": (table, "--params", bad), "export": (bad, "--robot", "panda", "-o", out),
             "report": (table, "--params", bad, "-o", out, "--workers", "1")}[command]
     code, err = run_cli(capsys, command, *args)
-    lines = [ln for ln in err.splitlines() if ln.strip()]
+    lines = said(err)
     assert code == 2 and len(lines) == 1, err
     assert f"{bad}: joint '{JOINT}': " in lines[0] and needle in lines[0], err
     assert out is None or not out.exists()

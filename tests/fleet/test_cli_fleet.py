@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from helpers import assert_stages, said
+
 
 def wbfriction(*args: str, cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "wbfriction", *args], cwd=cwd, capture_output=True, text=True)
@@ -28,7 +30,7 @@ def test_a_bad_manifest_is_one_line_and_nothing_is_written(tmp_path, manifest, m
         (tmp_path / "m.csv").write_text(manifest)
     res = wbfriction("batch", "m.csv", "-o", "results", cwd=tmp_path)
     assert res.returncode == 2 and message in res.stderr, res.stderr
-    assert len(res.stderr.strip().splitlines()) == 1 and not (tmp_path / "results").exists()
+    assert len(said(res.stderr)) == 1 and not (tmp_path / "results").exists()
 
 
 def test_trends_need_results_and_an_html_page(tmp_path):
@@ -60,7 +62,7 @@ def test_batch_faults_are_one_line_within_seconds(arm_fleet, tmp_path, args, mes
         argv += ["-o", "results"]
     res = wbfriction(*argv, cwd=tmp_path)
     assert res.returncode == 2 and message in res.stderr, res.stderr
-    assert len(res.stderr.strip().splitlines()) == 1 and "Traceback" not in res.stderr
+    assert len(said(res.stderr)) == 1 and "Traceback" not in res.stderr
     assert not (tmp_path / "results").exists()
     assert (tmp_path / "file.txt").read_text() == "x"
 
@@ -76,6 +78,7 @@ def test_trends_say_what_they_leave_out(tmp_path, synthetic_results):
     pq.write_table(pa.table({"x": [1]}), tmp_path / "results" / "r1" / "stray.parquet")
     res = wbfriction("trends", "results", "-o", "t.html", cwd=tmp_path)
     assert res.returncode == 0, res.stderr
+    assert_stages(res.stderr, "reading results", "testing", "writing t.html")  # piped: a line per stage (issue 67)
     left = [line for line in res.stderr.splitlines() if line.startswith("left out:")]
     assert len(left) == 2 and "unreadable" in left[0] and "stray.parquet: not a result" in left[1]
     assert "0 of 2 tested robot joints drifted" in res.stderr and (tmp_path / "t.html").exists()
@@ -86,6 +89,7 @@ def test_trends_that_cannot_test_say_so(tmp_path, synthetic_results):
     synthetic_results(tmp_path / "results", 3)
     res = wbfriction("trends", "results", "-o", "t.html", cwd=tmp_path)
     assert res.returncode == 0, res.stderr
+    assert_stages(res.stderr, "reading results", "testing", "writing t.html")  # piped: a line per stage (issue 67)
     assert "none of the 2 robot joints could be tested (each has fewer than 8 usable logs)" in res.stderr
 
 
@@ -137,7 +141,7 @@ def test_a_scheduler_that_goes_away_is_one_line(arm_fleet, tmp_path):
                 os.killpg(p.pid, signal.SIGKILL)
             except ProcessLookupError:
                 pass
-    lines = [ln for ln in err.splitlines() if ln.strip()]
+    lines = said(err)
     assert batch.returncode == 1 and len(lines) == 1, err
     assert f"error: the Dask scheduler {address} went away: " in lines[0] and "run the batch again" in lines[0]
     from wbfriction.fleet.results import read_parts
@@ -161,6 +165,7 @@ def test_trends_of_logs_at_one_start_time_say_so(tmp_path, synthetic_results):
         write_part(tmp_path / "results", table)
     res = wbfriction("trends", "results", "-o", "t.html", cwd=tmp_path)
     assert res.returncode == 0, res.stderr
+    assert_stages(res.stderr, "reading results", "testing", "writing t.html")  # piped: a line per stage (issue 67)
     notes = [line for line in res.stderr.splitlines() if line.startswith("note:")]
     assert len(notes) == 1 and notes[0].startswith("note: robot r1: 1 start time holds the results of several logs")
     assert "none of the 2 robot joints could be tested (each has its 10 usable logs at 1 start time" in res.stderr

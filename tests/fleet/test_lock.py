@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from helpers import said
 from wbfriction.exceptions import InputError
 from wbfriction.fleet.batch import run_batch
 from wbfriction.fleet.lock import lock_path, results_lock
@@ -36,7 +37,7 @@ def test_a_second_batch_into_running_results_is_refused_with_one_line(arm_fleet,
     second = subprocess.run([sys.executable, "-m", "wbfriction", "batch", manifest, "-o", "results", "--serial",
                              "--model", "coulomb-viscous"], cwd=tmp_path, capture_output=True, text=True)
     assert second.returncode == 2, second.stderr
-    assert len(second.stderr.strip().splitlines()) == 1 and "Traceback" not in second.stderr
+    assert len(said(second.stderr)) == 1 and "Traceback" not in second.stderr
     assert f"results: another batch is writing these results (process {first.pid} on {socket.gethostname()}, " \
            "since " in second.stderr, second.stderr
     _, err = first.communicate(timeout=300)

@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from helpers import said
 from wbfriction.exceptions import OptionError
 from wbfriction.fleet.change_point import confounded_onset, detect_change
 from wbfriction.fleet.trends import TrendOptions
@@ -130,7 +131,7 @@ def test_trends_refuse_a_reference_temperature_no_joint_has(tmp_path, synthetic_
     synthetic_results(tmp_path / "results", 10, temperature=lambda i: 20.0 + 3 * (i % 4))
     res = _trends("results", "-o", "t.html", f"--reference-temperature={value}", cwd=tmp_path)
     assert res.returncode == 2 and "--reference-temperature" in res.stderr, res.stderr
-    assert len(res.stderr.strip().splitlines()) == 1 and not (tmp_path / "t.html").exists()
+    assert len(said(res.stderr)) == 1 and not (tmp_path / "t.html").exists()
 
 
 def test_a_fleet_that_turned_to_kelvin_is_said():

@@ -11,7 +11,7 @@ import tomllib
 import numpy as np
 import pytest
 
-from helpers import run_cli, run_cli_printed, widest_line
+from helpers import assert_stages, run_cli, run_cli_printed, said, widest_line
 from wbfriction.fit.result import FitResult
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams
 from wbfriction.friction.options import EstimateOptions
@@ -65,6 +65,8 @@ def test_identify_command_closes_the_loop(talos, wrong, combined_walk, tmp_path,
     code, printed, err = run_cli_printed(capsys, "identify", log, "--urdf", given, "-o", tmp_path / "id.urdf",
                                          "--json", tmp_path / "id.json", "--stribeck-velocity", "0.2")
     assert code == 0, err
+    assert_stages(err, "estimating with the given model", "fit", "the identification's samples",
+                  "identifying the inertia model (pass 1", "estimating with the identified model (pass 1)", "fit")
     assert widest_line(printed) <= 100 and "Held-out torques" in printed, printed
     doc = json.loads((tmp_path / "id.json").read_text())
     legs = [j for j, _, _ in leg_joints(talos)]
@@ -106,7 +108,7 @@ def test_identify_command_closes_the_loop(talos, wrong, combined_walk, tmp_path,
 def test_identify_bad_options(tmp_path, capsys, args, message):
     (tmp_path / "log.parquet").write_bytes(b"")
     code, err = run_cli(capsys, "identify", tmp_path / "log.parquet", "-o", tmp_path / "id.urdf", *args)
-    assert code == 2 and message in err and len(err.strip().splitlines()) == 1
+    assert code == 2 and message in err and len(said(err)) == 1
     assert not (tmp_path / "id.urdf").exists()
 
 
@@ -115,7 +117,7 @@ def test_report_refuses_a_malformed_identification(tmp_path, capsys):
     bad.write_text(json.dumps({"joints": {"leg_left_1_joint": {"holdout_rms": {"given": 1.0}}}}))
     (tmp_path / "f.parquet").write_bytes(b"")
     code, err = run_cli(capsys, "report", tmp_path / "f.parquet", "--identification", bad, "-o", tmp_path / "r.html")
-    assert code == 2 and len(err.strip().splitlines()) == 1 and not (tmp_path / "r.html").exists()
+    assert code == 2 and len(said(err)) == 1 and not (tmp_path / "r.html").exists()
     assert "id.json" in err and "holdout_rms" in err
 
 

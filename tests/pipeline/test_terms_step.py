@@ -12,7 +12,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from helpers import run, run_cli, run_cli_printed
+from helpers import run, run_cli, run_cli_printed, said
 from wbfriction.fit.params_file import read_params
 from wbfriction.fit.terms import TermFit
 from wbfriction.friction.io import read_friction_file
@@ -97,14 +97,14 @@ def test_fit_keeps_the_simulated_terms_and_predict_uses_them(logs, capsys):
 def test_bad_terms_and_missing_signals_are_refused_in_one_line(logs, capsys, tmp_path):
     folder, tables = logs
     code, err = run_cli(capsys, "fit", tables[0], "-o", tmp_path / "p.json", "--terms", "load,wear")
-    assert code == 2 and "--terms" in err and "wear" in err and len(err.strip().splitlines()) == 1
+    assert code == 2 and "--terms" in err and "wear" in err and len(said(err)) == 1
     params = folder / "terms_for_refusal.json"
     assert run_cli(capsys, "fit", tables[0], "-o", params, "--terms", "ripple")[0] == 0
     table = pq.read_table(tables[1])
     old = tmp_path / "old.parquet"
     pq.write_table(table.drop_columns([c for c in table.column_names if c.startswith("q.")]), old)
     code, err = run_cli(capsys, "predict", old, "--params", params)
-    assert code == 2 and "q.panda_joint6" in err and "ripple" in err and len(err.strip().splitlines()) == 1
+    assert code == 2 and "q.panda_joint6" in err and "ripple" in err and len(said(err)) == 1
 
 
 def test_a_glitched_temperature_is_named_and_the_term_still_kept(logs, capsys, tmp_path):
@@ -138,7 +138,7 @@ def test_a_log_in_kelvin_is_refused_before_the_work(logs, tmp_path):
     pq.write_table(table.set_column(i, "temperature.panda_joint4",
                                     pa.array(table.column(i).to_numpy() + 273.15)), kelvin)
     res = run("estimate", kelvin, "--robot", "panda", "-o", tmp_path / "f.parquet")
-    assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1, res.stderr
+    assert res.returncode == 2 and len(said(res.stderr)) == 1, res.stderr
     assert "temperature.panda_joint4" in res.stderr and "kelvin" in res.stderr
     assert not (tmp_path / "f.parquet").exists()
 
@@ -171,5 +171,5 @@ def test_term_options_that_would_be_dropped_or_no_joint_has_are_refused(logs, ca
     dropped without a word."""
     _, tables = logs
     code, err = run_cli(capsys, "fit", tables[0], "-o", tmp_path / "p.json", *args)
-    assert code == 2 and option in err and len(err.strip().splitlines()) == 1, err
+    assert code == 2 and option in err and len(said(err)) == 1, err
     assert not (tmp_path / "p.json").exists()

@@ -11,7 +11,7 @@ import numpy as np
 import pyarrow as pa
 import pytest
 
-from helpers import hung_go2_toml, run_cli_printed
+from helpers import assert_stages, hung_go2_toml, run_cli_printed, said
 from wbfriction.exceptions import InputError
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.logs.tables import read_table
@@ -133,6 +133,7 @@ def test_cli(case, tmp_path, capsys):
     code, printed, err = run_cli_printed(capsys, "refine", log, off, "--config", config, "-o", out,
                                          "--held-out", held, "--table", table, "--timestep", str(STEP))
     assert code == 0, err
+    assert_stages(err, "refining")  # piped: its stage's line (issue 67)
     values = read_table(table)
     assert values.column_names == ["joint", "parameter", "unit", "start", "value", "stderr", "status"]
     assert values.num_rows == 5 * 12 and values.column("parameter").to_pylist()[-1] == "delay"
@@ -140,5 +141,5 @@ def test_cli(case, tmp_path, capsys):
     assert f"wrote {out}" in err and out.exists()
     code, _, err = run_cli_printed(capsys, "refine", log, off, "--config", config, "-o", tmp_path / "x.xml",
                                    "--window", "0")
-    assert code == 2 and "--window" in err and len(err.strip().splitlines()) == 1
+    assert code == 2 and "--window" in err and len(said(err)) == 1
     assert not (tmp_path / "x.xml").exists()

@@ -12,7 +12,7 @@ import numpy as np
 import pyarrow as pa
 import pytest
 
-from helpers import hung_go2_toml, run_cli_printed
+from helpers import assert_stages, hung_go2_toml, run_cli_printed, said
 from wbfriction.exceptions import InputError
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.logs.tables import read_table
@@ -116,6 +116,7 @@ def test_cli(hung, tmp_path, capsys):
     code, printed, err = run_cli_printed(capsys, "rollout", log, truth, "--config", config, "--timestep", "0.001",
                                          "-o", out, "--figure", fig)
     assert code == 0, err
+    assert_stages(err, "replaying")  # piped: its stage's line (issue 67)
     table = read_table(out)
     assert table.column_names == ["joint", "rms_windows", "rms_whole"]
     assert table.column("joint").to_pylist() == list(robot.actuated)
@@ -123,4 +124,4 @@ def test_cli(hung, tmp_path, capsys):
     assert fig.read_bytes()[:4] == b"\x89PNG"
     assert "mean" in printed and "[mrad]" in printed and f"wrote {out}" in err
     code, _, err = run_cli_printed(capsys, "rollout", log, truth, "--config", config, "--window", "0")
-    assert code == 2 and "--window" in err and len(err.strip().splitlines()) == 1
+    assert code == 2 and "--window" in err and len(said(err)) == 1

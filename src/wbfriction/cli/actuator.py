@@ -10,7 +10,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from wbfriction.actuator import ActuatorIdentification, ActuatorOptions, Identified
-from wbfriction.cli.common import config_text, console, out, print_whole, robot_of, warn
+from wbfriction.cli.common import config_text, console, out, print_whole, robot_of, stages, warn
 from wbfriction.logs.options import TimeUnit
 from wbfriction.pipeline.paths import check_paths
 
@@ -25,7 +25,8 @@ def identify_pd(log: Path, robot: str, urdf: Optional[Path], config: Optional[Pa
     check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
                 {"--json": json_output, "--config-output": config_output})
     r = robot_of(robot, urdf, config, mjcf)
-    with console.status("identifying the actuators"):
+    with stages() as stage:
+        stage("identifying the actuators")
         result = identify_actuator_file(r, log, json_output, options, time_unit)
     print_actuators(result, wide)
     warn(result.warnings)

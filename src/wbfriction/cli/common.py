@@ -1,7 +1,7 @@
 """The command line's shared parts: the app, its two consoles (messages on standard error, one line each;
 results on standard output, as wide as the terminal), the options several commands take with the library's
 defaults, the robot from --robot/--urdf/--config/--mjcf, the refusal of the options a command's mode does not read
-(:func:`refuse_options`), the progress bar and the entry point :func:`main`."""
+(:func:`refuse_options`), the progress of its stages (:func:`stages`) and the entry point :func:`main`."""
 
 from __future__ import annotations
 
@@ -14,11 +14,11 @@ from typing import TYPE_CHECKING, Optional, cast
 import typer
 from rich.console import Console
 from rich.markup import escape
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.cli.helpformat import MAX_WIDTH, SectionedGroup
+from wbfriction.cli.stages import Stages
 from wbfriction.exceptions import InputError, OptionError, WbfrictionError
 from wbfriction.fit.options import DEFAULT_THRESHOLD, DEFAULT_TOLERANCE, FitOptions, TermOptions
 from wbfriction.friction.options import TERMS, EstimateOptions, TemperatureLaw, Term
@@ -91,12 +91,17 @@ LimitMarginOpt = typer.Option(LIMIT_MARGIN, min=0.0,
                                    "units).")
 
 
+def stages() -> Stages:
+    """A command's progress on standard error, stage by stage (:class:`~wbfriction.cli.stages.Stages`: bars on a
+    terminal, one line per stage ended elsewhere); a context manager around the command's work."""
+    return Stages(console)
+
+
 @contextmanager
-def progress_bar(total: int, label: str):
-    with Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-                  console=console, transient=True, disable=total < 2000) as bar:
-        task = bar.add_task(label, total=total)
-        yield lambda n: bar.advance(task, n)
+def progress_bar(total: int, label: str, unit: str = "samples"):
+    """One stage of ``total`` items of ``unit`` (:func:`stages`); yields the callable told of the items done."""
+    with stages() as stage:
+        yield stage.steps(label, total, unit)
 
 
 def robot_of(robot: str, urdf: Optional[Path], config: Optional[Path], mjcf: Optional[Path] = None) -> Robot:

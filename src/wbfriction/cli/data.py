@@ -7,7 +7,7 @@ from typing import Literal
 
 import typer
 
-from wbfriction.cli.common import app, console, out
+from wbfriction.cli.common import app, console, out, stages
 from wbfriction.cli.helpformat import LOGS
 from wbfriction.pipeline.paths import check_paths
 
@@ -40,7 +40,8 @@ def dataset(name: DatasetName = typer.Argument(..., metavar="NAME",
     from wbfriction.datasets import write_dataset
 
     check_paths({}, {}, {"-o": output_dir})
-    with console.status(f"fetching the {name} dataset"):
+    with stages() as stage:
+        stage(f"fetching the {name} dataset")
         written = write_dataset(name, output_dir)
     logs = ", ".join(f"{path} ({written.rows[role]} samples: {written.described.get(role, role)})"
                      for role, path in written.logs.items())

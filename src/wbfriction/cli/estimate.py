@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from contextlib import ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional
 
@@ -49,6 +48,7 @@ from wbfriction.cli.common import (
     progress_bar,
     refuse_unread,
     robot_of,
+    stages,
     warn,
 )
 from wbfriction.cli.helpformat import FRICTION, LOGS, STUDIES
@@ -64,23 +64,10 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
     from wbfriction.pipeline.chunks import Chunking
     from wbfriction.pipeline.estimate_step import estimate_source
 
-    with ExitStack() as stack:
-        status = console.status("")
-
-        def reading(label: str) -> None:
-            status.update(label)
-            status.start()
-
-        def bar(total: int):
-            status.stop()  # one live display at a time
-            return stack.enter_context(progress_bar(total, "estimate"))
-
-        try:
-            result = estimate_source(spec, log, output, opts, bag_map=bag_map, robot=r, stage=reading, progress=bar,
-                                     chunking=Chunking(rows=chunk_rows, workers=workers), companion=companion,
-                                     read=read)
-        finally:
-            status.stop()
+    with stages() as status:
+        result = estimate_source(spec, log, output, opts, bag_map=bag_map, robot=r, stage=status,
+                                 progress=lambda total: status.steps("estimate", total, "samples"),
+                                 chunking=Chunking(rows=chunk_rows, workers=workers), companion=companion, read=read)
     console.print(escape(result.clock), highlight=False, soft_wrap=True)
     warn(result.warnings)
     if result.differentiation:
@@ -259,7 +246,8 @@ def convert(bag: Path = typer.Argument(..., metavar="BAG", help=f"Log to convert
 
     check_paths({"BAG": bag, "--map": bag_map, "--urdf": urdf, "--mjcf": mjcf, "--config": config}, {"-o": output})
     r = robot_of(robot, urdf, config, mjcf)
-    with console.status(f"reading {bag}"):
+    with stages() as stage:
+        stage(f"reading {bag}")
         rows = convert_log(r, bag, output, bag_map, read=ReadOptions(max_gap=max_gap, limit_margin=limit_margin))
     console.print(f"wrote {output} ({rows} samples)")
 
@@ -291,10 +279,11 @@ def sensitivity(log: Path = LogArg,
     warn(data.warnings)
     opts = EstimateOptions(diff=diff, mask=mask,
                            route=route)
-    with console.status("") as status:
-        sens = inertia_sensitivity(r, data, values, part, opts, progress=status.update)
+    with stages() as status:
+        sens = inertia_sensitivity(r, data, values, part, opts, progress=status)
     names = joint_list(r, joints)
-    with console.status("fitting the offsets of the model as given"):
+    with stages() as stage:
+        stage("fitting the offsets of the model as given")
         tau_os = sens.reference_offsets(names)
     table = Table(title=f"Change of the friction estimate with {part} inertia scaled, against the model as given",
                   caption="shift: mean change over the valid samples; split: mean change on rising minus falling "

@@ -20,6 +20,7 @@ from wbfriction.cli.common import (
     print_whole,
     refuse_unread,
     robot_of,
+    stages,
 )
 from wbfriction.cli.helpformat import ROBOT
 from wbfriction.exceptions import InputError
@@ -167,14 +168,10 @@ def _excite_floating(ctx: typer.Context, r, paths: tuple[list[Path], Path | None
 
 
 def _candidates(total: int, what: str):
-    """A status line counting the design's steps, and the callable that advances it."""
-    done = [0]
-    status = console.status(f"designing: {what} 1 of {total}")
-
-    def advance(n: int) -> None:
-        done[0] += n
-        status.update(f"designing: {what} {min(done[0] + 1, total)} of {total}")
-    return status, advance
+    """The design's stages (:func:`~wbfriction.cli.common.stages`), its first counting ``total`` ``what``s, and the
+    callable told of each done."""
+    status = stages()
+    return status, status.steps("design", total, f"{what}s")
 
 
 def _excite_pd(r, output: list[Path], prediction: Path | None, figure: Path | None, options: PdExciteOptions,
@@ -238,7 +235,7 @@ def _excite_arm(r, output: list[Path], prediction: Path | None, figure: Path | N
         else:
             following = record_next_arm(r, fits, str(after), options, progress=advance)
             design = following.design
-        status.update("predicting what estimate and fit will report (two simulated recordings)")
+        status("predicting what estimate and fit will report (two simulated recordings)")
     table = arm_setpoints(design, r.offset_vector)
     for path in output:
         write_table(table, path)
@@ -274,8 +271,9 @@ def _excite_biped(r, output: list[Path], prediction: Path | None, figure: Path |
     from wbfriction.excite.document import stance_document, stance_setpoints
     from wbfriction.excite.stance import stance_reference, swing_bounds
 
-    with console.status(f"designing the swing leg's series, then the stance on the {options.stance} foot (its IK "
-                        "at every sample)"):
+    with stages() as stage:
+        stage(f"designing the swing leg's series, then the stance on the {options.stance} foot (its IK "
+              "at every sample)")
         excitation = stance_reference(r, options)
     doc = stance_document(r, excitation, options, swing_bounds(r, excitation, options))
     _write_standing(r, (output, prediction, figure), excitation, stance_setpoints(r, excitation, options), doc,
@@ -292,8 +290,9 @@ def _excite_quadruped(r, output: list[Path], prediction: Path | None, figure: Pa
     from wbfriction.excite.document import tripod_document, tripod_setpoints
     from wbfriction.excite.tripod import swing_bounds, tripod_reference
 
-    with console.status("designing the swing leg's series, then the stance on the three other feet (its IK at "
-                        "every sample)"):
+    with stages() as stage:
+        stage("designing the swing leg's series, then the stance on the three other feet (its IK at "
+              "every sample)")
         excitation = tripod_reference(r, options)
     doc = tripod_document(r, excitation, options, swing_bounds(r, excitation, options))
     leg = doc["swing_foot"].split("_")[0]

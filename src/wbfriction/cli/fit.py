@@ -47,6 +47,7 @@ from wbfriction.cli.common import (
     out,
     print_whole,
     robot_of,
+    stages,
     term_options,
     warn,
     warn_energy,
@@ -69,8 +70,10 @@ def _run_fit(friction: Path, output: Path, options: FitOptions, threshold: float
              workers: int, wide: bool = False, verbose: bool = False) -> None:
     from wbfriction.pipeline.fit_step import fit_file
 
-    with console.status(f"fitting {friction.name} (--model {options.model})"):
-        fitted = fit_file(friction, output, options, threshold=threshold, tolerance=tolerance, workers=workers)
+    with stages() as stage:
+        stage(f"reading {friction.name}")
+        fitted = fit_file(friction, output, options, threshold=threshold, tolerance=tolerance, workers=workers,
+                          progress=stage.steps)
     _print_fits(fitted.fits, wide, verbose)
     warn_energy(fitted.energy, verbose)
     console.print(f"wrote {output}")
@@ -155,7 +158,8 @@ def export(ctx: typer.Context,
     r = robot_of(robot, urdf, config, mjcf)
     if "physics_dt" in given_options(ctx):
         refuse_physics_dt(r, outputs)
-    with console.status(f"exporting {params.name} to {len(outputs)} file{'s' if len(outputs) > 1 else ''}"):
+    with stages() as stage:
+        stage(f"exporting {params.name} to {len(outputs)} file{'s' if len(outputs) > 1 else ''}")
         result = export_files(r, params, outputs, include=[c.strip() for c in include.split(",") if c.strip()],
                               physics_dt=physics_dt)
     counts = result.selection.exported_statuses
@@ -210,7 +214,8 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
     from wbfriction.report.prediction import write_prediction
 
     check_paths({"FRICTION": friction, "--params": params}, {"--table": table_file, "--figure": figure})
-    with console.status(f"predicting the torques of {friction.name}"):
+    with stages() as stage:
+        stage(f"predicting the torques of {friction.name}")
         pred = write_prediction(friction, params, table_file, figure)
     table = Table(title=f"Torque prediction on {friction.name}: RMS of measured - predicted [N·m]", box=None,
                   collapse_padding=True, caption_justify="left",
@@ -274,7 +279,8 @@ def report(friction: Path = FrictionArg,
 
     check_paths({"FRICTION": friction, "--params": params, "--identification": identification}, {"-o": output})
 
-    with console.status("building the report"):
+    with stages() as stage:
+        stage("building the report")
         rep = make_report(friction, params, energy_threshold, energy_tolerance, identification, workers)
         write_report(rep, output, workers)
     warn_energy(rep.energy.values())

@@ -8,7 +8,6 @@ from typing import TYPE_CHECKING, Optional, cast
 
 import typer
 from rich.markup import escape
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
@@ -36,6 +35,7 @@ from wbfriction.cli.common import (
     UrdfOpt,
     app,
     console,
+    stages,
     term_options,
 )
 from wbfriction.cli.helpformat import FLEETS
@@ -94,11 +94,10 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
         entries = scan.entries
     else:
         entries = read_manifest(source)
-    with Progress(TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console,
-                  transient=True, disable=not console.is_terminal) as bar:
-        task = bar.add_task("batch", total=len(entries))
+    with stages() as status:
+        advance = status.steps("batch", len(entries), "logs")
         summary = run_batch(entries, output, options, engine="serial" if serial else "dask", workers=workers,
-                            scheduler=scheduler, tables=tables, progress=lambda outcome: bar.advance(task, 1))
+                            scheduler=scheduler, tables=tables, progress=lambda outcome: advance(1))
     for a, b in summary.copies:
         console.print(f"[yellow]note:[/] {escape(b.where)} has the same bytes as {escape(a.where)}: two results",
                       highlight=False, soft_wrap=True)
@@ -153,14 +152,15 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
     options = TrendOptions(alpha=alpha, min_change=min_change, replicates=replicates,
                            shapes=tuple(cast("Shape", s.strip()) for s in shapes.split(",") if s.strip()),
                            temperature=temperature, reference_temperature=reference_temperature)
-    with console.status(f"reading {results}") as status:
+    with stages() as status:
+        status(f"reading {results}")
         dataset = read_results(results)
         for note in dataset.notes():  # files left out, start times holding several logs
             label, _, text = note.partition(": ")
             console.print(f"[yellow]{label}:[/] {escape(text)}", highlight=False, soft_wrap=True)
-        status.update(f"testing {dataset.table.num_rows} rows for drifts ({options.draws()} noise series per test)")
+        status(f"testing {dataset.table.num_rows} rows for drifts ({options.draws()} noise series per test)")
         found = fleet_trends(dataset.table, options)
-        status.update(f"writing {output}")
+        status(f"writing {output}")
         write_trends_html(found, output, title)
         if table is not None:
             write_table(found.to_table(), table)

@@ -43,6 +43,7 @@ from wbfriction.cli.common import (
     print_whole,
     refuse_options,
     robot_of,
+    stages,
     warn_energy,
 )
 from wbfriction.cli.helpformat import ROBOT
@@ -148,11 +149,12 @@ def identify(ctx: typer.Context, log: Path = LogArg, output: Optional[Path] = Ou
     r.require_urdf("identify (it writes the corrected URDF)")
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior,
                            armature=armature, link_margin=link_margin, prior_tolerance=prior_tolerance)
-    with console.status("") as status:
+    with stages() as status:
         estimate_options = EstimateOptions(diff=diff, mask=mask, route=route, noise_target=noise_target,
                                            base_motion=base_motion)
         done = identify_file(r, log, output, json_output, estimate_options=estimate_options,
-                             options=opts, stribeck=stribeck, passes=passes, progress=status.update, workers=workers,
+                             options=opts, stribeck=stribeck, passes=passes, progress=status, steps=status.steps,
+                             workers=workers,
                              time_unit=time_unit)
     print_identification(done, wide)
     if json_output is not None:

@@ -9,7 +9,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from wbfriction.cli.common import ConfigOpt, LogArg, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of
+from wbfriction.cli.common import ConfigOpt, LogArg, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of, stages
 from wbfriction.cli.helpformat import ROBOT
 from wbfriction.cli.rollout import replay_options
 from wbfriction.pipeline.paths import check_paths
@@ -48,8 +48,9 @@ def refine(log: Path = LogArg,
                  "--mjcf": mjcf}, {"-o": output, "--table": table})
     replay, times = replay_options(window, timestep, start, stop)
     the_robot = robot_of(robot, urdf, config, mjcf)
-    with console.status(f"refining {model.name} on {log.name} (a minute or so: MuJoCo replays the log some "
-                        "hundred times)"):
+    with stages() as stage:
+        stage(f"refining {model.name} on {log.name} (a minute or so: MuJoCo replays the log some "
+              "hundred times)")
         result = refine_mjcf(model, the_robot, log, replay, times=times)
         write_refined(model, result, the_robot, output, timestep=timestep)
         if table is not None:

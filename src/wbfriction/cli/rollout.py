@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Optional
 import typer
 from rich.table import Table
 
-from wbfriction.cli.common import ConfigOpt, LogArg, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of
+from wbfriction.cli.common import ConfigOpt, LogArg, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of, stages
 from wbfriction.cli.helpformat import ROBOT
 from wbfriction.exceptions import OptionError
 from wbfriction.pipeline.paths import check_paths
@@ -52,7 +52,8 @@ def rollout(log: Path = LogArg,
     check_paths({"LOG": log, "MODEL": model, "--config": config, "--urdf": urdf, "--mjcf": mjcf},
                 {"-o": output, "--figure": figure})
     replay, times = replay_options(window, timestep, start, stop, label=label, torque_delay=torque_delay)
-    with console.status(f"replaying {log.name} on {model.name}"):
+    with stages() as stage:
+        stage(f"replaying {log.name} on {model.name}")
         check = replay_check(model, robot_of(robot, urdf, config, mjcf), log, replay, times=times, output=output)
         if figure is not None:
             rollout_figure([check.windows], figure)

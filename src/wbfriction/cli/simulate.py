@@ -26,6 +26,7 @@ from wbfriction.cli.common import (
     refuse_options,
     refuse_unread,
     robot_of,
+    stages,
 )
 from wbfriction.cli.helpformat import LOGS
 
@@ -59,7 +60,8 @@ class CliProgress(SimulationProgress):
 
     @contextmanager
     def stage(self, text: str) -> Iterator[None]:
-        with console.status(text):
+        with stages() as stage:
+            stage(text)
             yield
 
     @contextmanager

@@ -32,6 +32,7 @@ from wbfriction.cli.common import (
     console,
     out,
     robot_of,
+    stages,
 )
 from wbfriction.cli.helpformat import STUDIES
 
@@ -132,8 +133,8 @@ def _pulls_note(pulls: int, in_double: int) -> str:
 def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
     from wbfriction.studies.realistic import run_realistic_study, worst_scored
 
-    with console.status("") as status:
-        result = run_realistic_study(r, output_dir, steps=steps, progress=lambda label: status.update(label))
+    with stages() as status:
+        result = run_realistic_study(r, output_dir, steps=steps, progress=status)
     for k, case in enumerate(result.cases):
         if k:
             out.print()
@@ -170,8 +171,8 @@ def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--outpu
             console.print(f"wrote {f}")
         console.print(f"demo finished in {time.perf_counter() - start:.1f} s")
         return
-    with console.status("") as status:
-        result = run_study(r, output_dir, steps=steps, progress=lambda label: status.update(label))
+    with stages() as status:
+        result = run_study(r, output_dir, steps=steps, progress=status, steps_done=status.steps)
     _print_not_ok(result.rows)  # before the table: its error figures of those joints measure the walk
     out.print(study_table(result.rows, "Identified friction (3.5) of the leg joints, combined walk, "
                                         "central differences"))
@@ -215,10 +216,10 @@ def study_sensors(output_dir: Path = typer.Option(Path("wbfriction-sensors"), "-
     r = robot_of(robot, None, None)
     if not r.ft_sensors:
         raise InputError(f"--robot {robot}: the robot has no force-torque sensors ([force_torque.<name>] in its TOML)")
-    with console.status("") as status:
+    with stages() as status:
         result = run_sensors_study(r, output_dir, steps=steps, diff=diff,
                                    filtering=FilterOptions(window=window), noise=NOISE if noise else SensorNoise(),
-                                   substeps=substeps or SUBSTEPS, progress=lambda label: status.update(label),
+                                   substeps=substeps or SUBSTEPS, progress=status,
                                    route=route)
     out.print(escape(sensors_markdown(result)), highlight=False, soft_wrap=True)
     for f in result.files:
@@ -255,10 +256,10 @@ def study_noise(output_dir: Path = typer.Option(Path("wbfriction-noise"), "-o", 
     if not levels or any(not x > 0 for x in levels):
         raise InputError(f"--noises must be positive numbers [rad], got '{noises}'")
     loaded = [robot_of(name.strip(), None, None) for name in robots.split(",") if name.strip()]
-    with console.status("") as status:
+    with stages() as status:
         rows = run_noise_study(loaded, output_dir, families=cast("list[Family]", chosen), noises=levels, seeds=seeds,
                                duration=duration, steps=steps, workers=workers,
-                               progress=lambda label: status.update(label))
+                               progress=status)
     out.print(escape(noise_markdown(rows)), highlight=False, soft_wrap=True)
     console.print(f"wrote {output_dir / 'noise.md'}, {output_dir / 'noise.json'}")
 
@@ -278,9 +279,9 @@ def study_fleet(output_dir: Path = typer.Option(Path("wbfriction-fleet"), "-o", 
     plan = dataclasses.replace(FleetPlan(), robots=robots, logs=logs)
     if robots < 3:
         plan = dataclasses.replace(plan, drifts=tuple(d for d in plan.drifts if d.robot_id in plan.robot_ids))
-    with console.status("") as status:
+    with stages() as status:
         study = run_fleet_study(robot_of("talos", None, None), output_dir, plan, workers,
-                                progress=lambda label: status.update(label))
+                                progress=status)
     s = study.score
     for robot_id, joint, quantity, onset in study.flagged:
         console.print(f"flagged: {robot_id} {joint} ({quantity}, onset at log {onset})", highlight=False)
@@ -307,9 +308,9 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
     check_paths({}, {}, {"-o": output_dir})
     start = time.perf_counter()
     r = robot_of(robot, None, None)
-    with console.status("") as status:
+    with stages() as status:
         result = run_filter_study(r, output_dir, steps=steps, seed=seed, workers=workers,
-                                  progress=lambda label: status.update(label))
+                                  progress=status)
     table = Table(title="Friction of the 12 leg joints through each scheme: combined walk, sensor noise",
                   caption="rms: estimate - tau_f_true on the valid samples [N·m]; parameters: worst error over "
                           "the leg joints [%]; se F_v: the largest standard error of F_v the fit reports [% of "
@@ -362,8 +363,8 @@ def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped")
     r = case_robot(robot_of(robot, None, None), case)
     if not r.partial_contacts:
         raise InputError(f"--robot {robot}: not a robot on point feet (contact_model = \"point\" in its TOML)")
-    with console.status("") as status:
-        study = run_quadruped(r, case, progress=lambda label: status.update(label))
+    with stages() as status:
+        study = run_quadruped(r, case, progress=status)
     console.print(determination_table(study.shares))
     out.print(escape(fits_markdown(study)), highlight=False, soft_wrap=True)
     for f in write_study(r, study, output_dir):

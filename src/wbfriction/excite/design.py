@@ -188,7 +188,7 @@ def design_excitation(robot: Robot, prior: Mapping[str, ModelParamsBase], noise:
         prior: per joint, the friction expected (the bounds' point: a fit, or a guess).
         noise: per joint, its friction estimate's noise (the torque's and the positions', its inertia, the period).
         options: :class:`ExciteOptions`.
-        progress: told of each joint designed.
+        progress: told of each joint designed (once: a design shrunk to fit the torque limits is not told again).
         moving: the joints to move (None: every one); the others are held at the middle of their range (module
             docstring).
 
@@ -214,8 +214,9 @@ def design_excitation(robot: Robot, prior: Mapping[str, ModelParamsBase], noise:
     limits = JointLimits.of(robot)
     space = FourierSpace(1, options.harmonics, options.omega)
     share = options.velocity_share
-    for _ in range(4):
-        design = _design(robot, prior, noise, options, limits, space, share, progress, moved)
+    for attempt in range(4):  # a design shrunk to fit the torque limits is designed again, its joints not told again
+        design = _design(robot, prior, noise, options, limits, space, share, progress if attempt == 0 else None,
+                         moved)
         if design.margins.torque.min() >= 1.0 - options.torque_share:
             return design
         share *= SHRINK

@@ -28,6 +28,7 @@ from wbfriction.friction.models import (
     target_from_dict,
 )
 from wbfriction.friction.noise import JointNoise, joint_noises
+from wbfriction.progress import Progress, Steps
 from wbfriction.workers import process_pool
 
 
@@ -73,12 +74,21 @@ def _column_tasks(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, 
     return tasks
 
 
-def _run(fn, tasks: list, workers: int) -> list:
-    """``fn`` over ``tasks``, on ``workers`` processes side by side (one task at a time to each), in order."""
+def _run(fn, tasks: list, workers: int, progress: Progress | None = None) -> list:
+    """``fn`` over ``tasks``, on ``workers`` processes side by side (one task at a time to each), in order;
+    ``progress`` told of each result as it comes (in order)."""
+    tell = progress or (lambda n: None)
+    results = []
     if workers > 1 and len(tasks) > 1:
         with process_pool(min(workers, len(tasks)), "fork") as pool:
-            return list(pool.map(fn, tasks))
-    return [fn(task) for task in tasks]
+            for result in pool.map(fn, tasks):
+                results.append(result)
+                tell(1)
+        return results
+    for task in tasks:
+        results.append(fn(task))
+        tell(1)
+    return results
 
 
 def _with_truth(joints, fitted: list[FitResult], qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray,
@@ -164,7 +174,7 @@ def no_sample_reason(est: FrictionEstimate) -> str:
 def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, workers: int = 1,
                  joints: Sequence[str] | None = None, fixed: dict[str, float] | None = None,
                  targets: Mapping[str, ModelParams] | None = None,
-                 still: ModelName | None = None) -> list[FitResult]:
+                 still: ModelName | None = None, progress: Steps | None = None) -> list[FitResult]:
     """Fit every joint of an estimate (:func:`fit_joints` on its valid samples, on ``workers``
     processes); its ``tau_f_true`` and ``friction_true`` metadata, when present (simulated
     logs), give the errors against truth.
@@ -182,6 +192,8 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
         fixed: parameters held instead of fitted (:func:`fit_friction`).
         targets: the true parameters per joint, instead of the metadata's ``friction_true``.
         still: the model of a joint that hardly moved, instead of ``options``' named model (:func:`fit_friction`).
+        progress: told of its stages, each counted in joints (:data:`~wbfriction.progress.Steps`): ``fit``, then
+            ``terms`` (with ``options.terms``) and ``fallback fits`` (``auto``, where some fit is not ``ok``).
 
     Raises:
         InputError: ``friction_true`` metadata that are not a model's parameters; an unknown model or joint; a
@@ -210,7 +222,8 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
                                [options.model] * len(idx), smoother=check.smoother,
                                noise=joint_noises(record, check.estimation_route), stick_margin=stick_margin(check),
                                **common)
-    pairs = _run(_fit_routes, list(zip(tasks, others)), workers)
+    pairs = _run(_fit_routes, list(zip(tasks, others)), workers, None if progress is None else
+                 progress("fit", len(tasks), "joints"))
     fits = _with_truth(names, [fit for fit, _ in pairs], est.qd[:, idx], est.tau_f[:, idx], est.valid[:, idx], truth,
                        targets)
     checked = [other for _, other in pairs]
@@ -223,18 +236,21 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
             other.route = check.estimation_route
             f.route_check = compare_routes(f, other)
     if options.terms.terms:
-        fits = _with_terms(fits, checked, tasks, others, est, idx, truth, targets, options)
+        fits = _with_terms(fits, checked, tasks, others, est, idx, truth, targets, options,
+                           None if progress is None else progress("terms", len(fits), "joints"))
     fits = _with_delay_structure(fits, est.metadata)  # before the fallbacks: its spread can make a fit weak
     if options.model == AUTO:
-        _with_fallbacks(fits, tasks, others, est, idx, truth, targets, workers)
+        _with_fallbacks(fits, tasks, others, est, idx, truth, targets, workers, progress)
     return fits
 
 
 def _with_terms(fits: list[FitResult], checked: Sequence[FitResult | None], tasks: list[tuple],
                 others: Sequence[tuple | None], est: FrictionEstimate, idx: list[int], truth: np.ndarray | None,
-                targets: Mapping[str, ModelParams] | None, options: FitOptions) -> list[FitResult]:
+                targets: Mapping[str, ModelParams] | None, options: FitOptions,
+                progress: Progress | None = None) -> list[FitResult]:
     """``fits`` with their terms beyond velocity (:func:`_joint_terms`), each joint's velocity model chosen and fitted
-    again with the terms' torque taken out while that predicts better (:data:`TERM_REFITS`, :func:`_better_refit`)."""
+    again with the terms' torque taken out while that predicts better (:data:`TERM_REFITS`, :func:`_better_refit`);
+    ``progress`` told of each joint done."""
     fits = list(fits)
     names = [f.joint for f in fits]
     for k, (f, i, maybe) in enumerate(zip(fits, idx, checked)):
@@ -256,6 +272,8 @@ def _with_terms(fits: list[FitResult], checked: Sequence[FitResult | None], task
             if not _better_refit(refit, f):
                 break
             fits[k] = f = refit
+        if progress is not None:
+            progress(1)
     return fits
 
 
@@ -266,7 +284,7 @@ NO_FALLBACK: tuple[str, ...] = ("ok", "not excited")
 
 def _with_fallbacks(fits: list[FitResult], tasks: list[tuple], others: Sequence[tuple | None], est: FrictionEstimate,
                     idx: list[int], truth: np.ndarray | None, targets: Mapping[str, ModelParams] | None,
-                    workers: int) -> None:
+                    workers: int, progress: Steps | None = None) -> None:
     """Set :attr:`FitResult.fallback` of each fit chosen by ``model="auto"`` that is not ``ok``: the simplest family's
     fit of its column (its task of ``tasks``, and of ``others`` on the other route) with no terms, fitted side by side
     on ``workers`` processes as the chosen fits are, and checked as they are; none where the chosen fit is ``ok`` or
@@ -283,8 +301,9 @@ def _with_fallbacks(fits: list[FitResult], tasks: list[tuple], others: Sequence[
     simplest = families()[0].name
     wanted = [k for k, f in enumerate(fits)
               if f.verdict().status not in NO_FALLBACK and not (f.model == simplest and f.kept_terms is None)]
+    tell = None if progress is None or not wanted else progress("fallback fits", len(wanted), "joints")
     pairs = _run(_fit_routes, [((*tasks[k][:3], {**tasks[k][3], "model": simplest}), others[k]) for k in wanted],
-                 workers)
+                 workers, tell)
     for k, (simple, checked) in zip(wanted, pairs):
         fit, i = fits[k], idx[k]
         simple = _with_truth([fit.joint], [simple], est.qd[:, [i]], est.tau_f[:, [i]], est.valid[:, [i]],

@@ -34,7 +34,7 @@ from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.samples import log_samples
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
-from wbfriction.progress import StageProgress
+from wbfriction.progress import StageProgress, Steps
 from wbfriction.signals.choice import DiffChoice
 
 
@@ -74,18 +74,19 @@ class ClosedLoop:
 
 
 def acceleration_route(robot: Robot, log: Log, options: EstimateOptions, min_samples: int = 20,
-                       workers: int = 1, choice: DiffChoice | None = None) -> Route:
+                       workers: int = 1, choice: DiffChoice | None = None, steps: Steps | None = None) -> Route:
     """Estimate (5.10-5.13) and fit (3.5) every torque-controlled joint (on ``workers``
     processes), and check energy (7.9). A joint that hardly moved (status ``not excited``) is given the
     Coulomb-viscous model instead, as ``wbfriction fit`` gives it: its data hold an offset, no Stribeck term.
     ``choice``: how ``options``' differentiation was chosen
     (:func:`~wbfriction.friction.estimate.resolve_differentiation`, done once for several routes),
-    recorded in the estimate's metadata as :func:`~wbfriction.friction.estimate.estimate_log` does."""
+    recorded in the estimate's metadata as :func:`~wbfriction.friction.estimate.estimate_log` does. ``steps``: told
+    of the fit's stages, counted in joints (:func:`~wbfriction.fit.joints.fit_estimate`)."""
     est = estimate_log(robot, log, options)
     if choice is not None:
         est.metadata["differentiation"] = choice.to_dict()
     fits = fit_estimate(est, FitOptions(model="thesis", min_samples=min_samples), workers=workers,
-                        still="coulomb-viscous")
+                        still="coulomb-viscous", progress=steps)
     return Route(est, fits, energy_consistency(est, fitted_offsets(fits)))
 
 
@@ -104,7 +105,8 @@ def stribeck_velocity(fits: list[FitResult], max_relative_error: float = 0.5) ->
 def identify(robot: Robot, log: Log, estimate_options: EstimateOptions = EstimateOptions(),
                           options: InertialOptions = InertialOptions(),
                           stribeck: float | Literal["auto"] | None = "auto", passes: int = 2,
-                          progress: StageProgress | None = None, workers: int = 1) -> ClosedLoop:
+                          progress: StageProgress | None = None, workers: int = 1,
+                          steps: Steps | None = None) -> ClosedLoop:
     """Run the loop (module docstring).
 
     Args:
@@ -118,6 +120,7 @@ def identify(robot: Robot, log: Log, estimate_options: EstimateOptions = Estimat
         passes: identifications with ``"auto"`` (at least 1).
         progress: called with a label as each stage starts.
         workers: processes fitting the joints of the acceleration route side by side.
+        steps: told of the stages of counted items (each route's fit, its joints; :data:`~wbfriction.progress.Steps`).
 
     Raises:
         InputError: what :func:`~wbfriction.friction.estimate.estimate_log` and
@@ -125,19 +128,20 @@ def identify(robot: Robot, log: Log, estimate_options: EstimateOptions = Estimat
     """
     say = progress or (lambda label: None)
     estimate_options, choice = resolve_differentiation(estimate_options, log)  # once for every route and pass
-    say("acceleration route with the given model")
-    given = acceleration_route(robot, log, estimate_options, workers=workers, choice=choice)
+    say("estimating with the given model (acceleration route)")
+    given = acceleration_route(robot, log, estimate_options, workers=workers, choice=choice, steps=steps)
     if stribeck != "auto":
         passes = 1
     v_s, joints = stribeck_velocity(given.fits) if stribeck == "auto" else (stribeck, None)
     done: list[LoopPass] = []
+    say("the identification's samples (its dynamics at every sample)")
     samples = log_samples(robot, log, estimate_options, options)  # the passes differ in v_s only
     for k in range(max(passes, 1)):
         say(f"identifying the inertia model (pass {k + 1}, v_s = {v_s if v_s is None else round(v_s, 4)})")
         ident = identify_inertia(robot, log, estimate_options,
                                  replace(options, stribeck_velocity=v_s, stribeck_joints=joints), shared=samples)
-        say(f"acceleration route with the identified model (pass {k + 1})")
-        route = acceleration_route(ident.robot, log, estimate_options, workers=workers, choice=choice)
+        say(f"estimating with the identified model (pass {k + 1})")
+        route = acceleration_route(ident.robot, log, estimate_options, workers=workers, choice=choice, steps=steps)
         done.append(LoopPass(v_s, joints, ident, route))
         if stribeck == "auto":
             found = stribeck_velocity(route.fits)

@@ -14,6 +14,7 @@ from wbfriction.fit.result import FitResult, fitted_offsets, fitted_ripples
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.io import SIGN_CONVENTION, read_friction_file
 from wbfriction.pipeline.provenance import file_provenance
+from wbfriction.progress import Steps
 
 
 @dataclass
@@ -26,14 +27,14 @@ class FittedFile:
 
 
 def fit_table(friction: str | Path, options: FitOptions = FitOptions(), *, threshold: float = DEFAULT_THRESHOLD,
-              tolerance: float = DEFAULT_TOLERANCE, workers: int = 1) -> FittedFile:
+              tolerance: float = DEFAULT_TOLERANCE, workers: int = 1, progress: Steps | None = None) -> FittedFile:
     """:func:`fit_file` without writing: the table read, every joint fitted, the energy checked.
 
     Raises:
         InputError: as :func:`fit_file`.
     """
     est = read_friction_file(friction)
-    fits = fit_estimate(est, options, workers=workers)
+    fits = fit_estimate(est, options, workers=workers, progress=progress)
     if not any(f.params is not None for f in fits):
         raise InputError(f"{friction}: no joint could be fitted (each has fewer than --min-samples "
                          f"{options.min_samples} valid samples); nothing written")
@@ -43,7 +44,7 @@ def fit_table(friction: str | Path, options: FitOptions = FitOptions(), *, thres
 
 def fit_file(friction: str | Path, output: str | Path, options: FitOptions = FitOptions(), *,
              threshold: float = DEFAULT_THRESHOLD, tolerance: float = DEFAULT_TOLERANCE,
-             workers: int = 1) -> FittedFile:
+             workers: int = 1, progress: Steps | None = None) -> FittedFile:
     """Fit a friction model to every joint of a friction table (:func:`~wbfriction.fit.joints.fit_joints`,
     on ``workers`` processes), check energy (eq. 7.9), and write the parameters JSON with its
     provenance and the model asked for, whole or not at all.
@@ -56,12 +57,13 @@ def fit_file(friction: str | Path, output: str | Path, options: FitOptions = Fit
             ``selection_tolerance`` of the best, the reason recorded; see :mod:`wbfriction.fit`).
         threshold, tolerance: of the energy check (:func:`~wbfriction.fit.energy.energy_consistency`).
         workers: processes fitting joints side by side.
+        progress: told of the fit's stages, counted in joints (:func:`~wbfriction.fit.joints.fit_estimate`).
 
     Raises:
         InputError: an unreadable or malformed friction table, a table where no joint has
             ``options.min_samples`` valid samples (nothing is written), an output folder that does not exist.
     """
-    fitted = fit_table(friction, options, threshold=threshold, tolerance=tolerance, workers=workers)
+    fitted = fit_table(friction, options, threshold=threshold, tolerance=tolerance, workers=workers, progress=progress)
     log = fitted.est.metadata.get("provenance", {})
     header: dict[str, object] = {"provenance": {**file_provenance("friction", friction),
                                                 **{k: log[k] for k in ("robot", "urdf") if k in log},

@@ -29,7 +29,7 @@ from wbfriction.logs.tables import write_atomic
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.pipeline.provenance import log_provenance
-from wbfriction.progress import StageProgress
+from wbfriction.progress import StageProgress, Steps
 
 
 @dataclass
@@ -61,12 +61,13 @@ def identify_file(robot: Robot, log: str | Path, urdf_output: str | Path, json_o
                   estimate_options: EstimateOptions = EstimateOptions(), options: InertialOptions = InertialOptions(),
                   stribeck: float | Literal["auto"] | None = "auto", passes: int = 2,
                   progress: StageProgress | None = None, workers: int = 1,
-                  time_unit: TimeUnit | None = None) -> IdentifiedFile:
+                  time_unit: TimeUnit | None = None, steps: Steps | None = None) -> IdentifiedFile:
     """Identify the inertia model and the friction of ``robot`` from a log file (the closed loop,
     :func:`~wbfriction.inertia.closed_loop.identify`), write the corrected URDF to ``urdf_output``
     and, if given, the identification JSON to ``json_output``, each whole or not at all; the
     outputs are checked before the work (:func:`~wbfriction.pipeline.paths.check_paths`).
-    ``time_unit``: the unit of a numeric time column (:func:`~wbfriction.logs.source.read_log`).
+    ``time_unit``: the unit of a numeric time column (:func:`~wbfriction.logs.source.read_log`); ``progress`` and
+    ``steps``: told of the loop's stages (:func:`~wbfriction.inertia.closed_loop.identify`).
 
     Raises:
         InputError: an output that cannot be written or is the log, an unreadable or invalid
@@ -75,7 +76,8 @@ def identify_file(robot: Robot, log: str | Path, urdf_output: str | Path, json_o
     check_paths({"log": Path(log)}, {"urdf_output": Path(urdf_output),
                                      "json_output": None if json_output is None else Path(json_output)})
     data = read_log(log, robot, read=ReadOptions(time_unit=time_unit))
-    loop = identify(robot, data, estimate_options, options, stribeck, passes, progress=progress, workers=workers)
+    loop = identify(robot, data, estimate_options, options, stribeck, passes, progress=progress, workers=workers,
+                    steps=steps)
     moved = write_urdf(robot, loop.final.identification.pi, urdf_output)
     result = identification_of(loop, moved, log_provenance(log, robot))
     if json_output is not None:

@@ -19,6 +19,7 @@ from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.models import PARAM_NAMES, ModelParams
 from wbfriction.model.robot import Robot
+from wbfriction.progress import Steps
 from wbfriction.sim.options import IdealOptions
 from wbfriction.studies.thesis import TABLE_6_1, TABLE_6_2, thesis_number
 
@@ -74,12 +75,13 @@ def right_knee(legs: list[LegJoint]) -> str:
 
 
 def fit_legs(est: FrictionEstimate, legs: list[LegJoint], targets: Mapping[str, ModelParams] | None = None,
-             fixed: dict[str, float] | None = None) -> list[FitResult]:
+             fixed: dict[str, float] | None = None, progress: Steps | None = None) -> list[FitResult]:
     """Fit model (3.5) to every leg joint of an estimate on its valid samples, as
     :func:`~wbfriction.fit.joints.fit_estimate` fits every joint (its noise record, the other route), with the
-    estimate's true friction and ``targets`` for the errors; ``fixed``: parameters held."""
+    estimate's true friction and ``targets`` for the errors; ``fixed``: parameters held; ``progress``: told of the
+    joints fitted."""
     return fit_estimate(est, FitOptions(model="thesis"), joints=[j for j, _, _ in legs], targets=targets or {},
-                        fixed=fixed)
+                        fixed=fixed, progress=progress)
 
 
 def leg_rows(legs: list[LegJoint], fits: list[FitResult]) -> list[LegRow]:

@@ -29,7 +29,7 @@ from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.log import write_log
 from wbfriction.logs.tables import make_folder, write_table
 from wbfriction.model.robot import Robot
-from wbfriction.progress import Progress, StageProgress
+from wbfriction.progress import StageProgress, Steps
 from wbfriction.report.build import make_report
 from wbfriction.report.figures import derivative_schemes_figure, friction_curves_figure, support_phases_figure
 from wbfriction.report.html import write_report
@@ -69,17 +69,21 @@ class StudyResult:
     pulls_double_support: int = 0  # of the pulls' samples, those in double support (never valid: not estimated)
 
 
-def _simulate(robot: Robot, gait: GaitOptions, friction: dict[str, FrictionParams],
-              progress: Progress | None = None) -> SimulationResult:
+def _simulate(robot: Robot, gait: GaitOptions, friction: dict[str, FrictionParams], label: str,
+              steps: Steps | None = None) -> SimulationResult:
+    """The walk ``gait`` simulated with ``friction``, its samples counted to ``steps`` as a stage called ``label``."""
     ref = walking_reference(robot, gait)
+    progress = None if steps is None else steps(label, len(ref), "samples")
     return simulate_ideal(robot, ref, friction, SIMULATOR, progress=progress)
 
 
 def _derivative_schemes(robot: Robot, legs: list[LegJoint], knee: str, knee_steps: int, output_dir: Path,
-                        say: StageProgress) -> tuple[float, dict[str, tuple[float, float]], list[Pull], list[Path]]:
+                        say: StageProgress, steps: Steps | None = None
+                        ) -> tuple[float, dict[str, tuple[float, float]], list[Pull], list[Path]]:
     """Sub-study 1 (Fig. 6.1-6.3): the truth's error, the knee's RMS per scheme, the walk's pulls, the files written."""
-    say("simulating a forward walk, friction on the right knee")
-    knee_sim = _simulate(robot, GaitOptions(gait="forward", steps=knee_steps), {knee: THESIS_TARGETS["knee"]})
+    say("planning a forward walk")
+    knee_sim = _simulate(robot, GaitOptions(gait="forward", steps=knee_steps), {knee: THESIS_TARGETS["knee"]},
+                         "simulating the forward walk, friction on the right knee", steps)
     write_log(knee_sim.log, robot, output_dir / "knee_log.parquet")
     say("estimating with four differentiation schemes")
     schemes = {label: estimate_log(robot, knee_sim.log, opts) for label, opts in DERIVATIVE_SCHEMES.items()}
@@ -106,17 +110,20 @@ def _derivative_schemes(robot: Robot, legs: list[LegJoint], knee: str, knee_step
 
 
 def _identification(robot: Robot, legs: list[LegJoint], steps: int, output_dir: Path,
-                    say: StageProgress) -> tuple[list[LegRow], list[Pull], dict[str, float], list[Path]]:
+                    say: StageProgress, counted: Steps | None = None
+                    ) -> tuple[list[LegRow], list[Pull], dict[str, float], list[Path]]:
     """Sub-study 2 (Tables 6.1, 6.2, report): the rows, the walk's pulls, the legs' power shares, the files written."""
-    say(f"simulating the combined walk ({steps} steps forward, sideways, turning)")
+    say(f"planning the combined walk ({steps} steps forward, sideways, turning)")
     friction = {j: THESIS_TARGETS[g] for j, _, g in legs}
-    walk = _simulate(robot, GaitOptions(gait="combined", steps=steps), friction)
+    walk = _simulate(robot, GaitOptions(gait="combined", steps=steps), friction, "simulating the combined walk",
+                     counted)
     write_log(walk.log, robot, output_dir / "walk_log.parquet")
     say("estimating (central differences)")
     est = estimate_log(robot, walk.log, EstimateOptions(diff="central", route="acceleration"), companion=True)
     write_table(friction_table(est), output_dir / "walk_friction.parquet")
-    say("fitting the friction model of every leg joint")
-    fits = fit_legs(est, legs, friction)
+    if counted is None:  # else its stages say themselves, the joints counted
+        say("fitting the friction model of every leg joint")
+    fits = fit_legs(est, legs, friction, progress=counted)
     rows = leg_rows(legs, fits)
     write_params(output_dir / "walk_params.json", fits,
                  {"robot": robot.name, "gait": asdict(GaitOptions(gait="combined", steps=steps))},
@@ -134,7 +141,7 @@ def _identification(robot: Robot, legs: list[LegJoint], steps: int, output_dir: 
 
 
 def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int = 5,
-              progress: StageProgress | None = None) -> StudyResult:
+              progress: StageProgress | None = None, steps_done: Steps | None = None) -> StudyResult:
     """Run the study and write its logs, estimates, parameters and figures to ``output_dir``.
 
     Args:
@@ -142,15 +149,18 @@ def run_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int =
         steps: steps per direction of the combined walk.
         knee_steps: steps of the right-knee walk (Fig. 6.1-6.3).
         progress: called with a label as each stage starts (:data:`~wbfriction.progress.StageProgress`).
+        steps_done: told of the stages of counted items (the walks' samples simulated, the legs' joints fitted;
+            :data:`~wbfriction.progress.Steps`).
     """
     say = progress or (lambda label: None)
     make_folder(output_dir)
     legs = leg_joints(robot)
     knee = right_knee(legs)
     # 1. right knee only: Fig. 6.1-6.3
-    truth_err, knee_rms, knee_pulls, knee_files = _derivative_schemes(robot, legs, knee, knee_steps, output_dir, say)
+    truth_err, knee_rms, knee_pulls, knee_files = _derivative_schemes(robot, legs, knee, knee_steps, output_dir, say,
+                                                                        steps_done)
     # 2. combined walk, Table 6.1 friction on all leg joints: identification
-    rows, walk_pulls, share, walk_files = _identification(robot, legs, steps, output_dir, say)
+    rows, walk_pulls, share, walk_files = _identification(robot, legs, steps, output_dir, say, steps_done)
     pulls = sum(p.samples for p in knee_pulls + walk_pulls)
     in_double = sum(p.double_support for p in knee_pulls + walk_pulls)
     return StudyResult(rows, truth_err, knee_rms, pulls, knee_files + walk_files, share, in_double)
