@@ -87,7 +87,7 @@ def test_realistic_study_scores_each_leg_joint_against_its_own_friction(talos, t
 
 def test_demo_scores_each_leg_joint_against_its_own_friction(talos, tmp_path, monkeypatch):
     """``wbfriction demo``'s identification table (Tables 6.1, 6.2)."""
-    monkeypatch.setattr(simulation, "_simulate", lambda robot, gait, friction, progress=None:
+    monkeypatch.setattr(simulation, "_simulate", lambda robot, gait, friction, label="", steps=None:
                         SimpleNamespace(log=friction, pulls=lambda: []))
     monkeypatch.setattr(simulation, "estimate_log", lambda robot, friction, options, companion=False:
                         exact_estimate(robot, friction))
