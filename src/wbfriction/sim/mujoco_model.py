@@ -27,7 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import ModelError
-from wbfriction.model.mjspec import urdf_spec
+from wbfriction.model.mjspec import resolve_mesh, urdf_spec
 from wbfriction.model.robot import Robot
 
 if TYPE_CHECKING:
@@ -101,17 +101,10 @@ def _collision_vertices(col: ET.Element, urdf: Path) -> np.ndarray | None:
 
 
 def _resolve_mesh(filename: str, urdf: Path) -> Path:
-    """A ``package://`` or relative mesh path, found next to the URDF's package tree."""
-    if filename.startswith("package://"):
-        rel = filename[len("package://"):]
-        for parent in Path(urdf).resolve().parents:
-            for candidate in (parent / rel, parent / rel.split("/", 1)[-1]):
-                if candidate.is_file():
-                    return candidate
+    """A URDF mesh path as a file (:func:`~wbfriction.model.mjspec.resolve_mesh`); ModelError where none is."""
+    path = resolve_mesh(filename, urdf)
+    if path is None:
         raise ModelError(f"mesh '{filename}' not found above {urdf}")
-    path = (Path(urdf).parent / filename).resolve()
-    if not path.is_file():
-        raise ModelError(f"mesh '{filename}' not found")
     return path
 
 
