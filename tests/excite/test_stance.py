@@ -24,8 +24,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from wbfriction.exceptions import InputError
-from wbfriction.excite.stance import StanceOptions, stance_reference, support_margin, swing_band
+from wbfriction.exceptions import InputError, ModelError
+from wbfriction.excite import stance as stance_module
+from wbfriction.excite.stance import StanceOptions, band_clearance, stance_reference, support_margin, swing_band
 from wbfriction.fit.joints import fit_joints
 from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import estimate_log
@@ -122,6 +123,31 @@ def test_the_band_is_mirrored_and_checked(talos):
         swing_band(talos, ("arm_left_1_joint",), "left", 0.05)
     with pytest.raises(InputError, match="stance"):
         StanceOptions(stance="both")
+
+
+@pytest.mark.parametrize("stance", ["left", "right"])
+def test_every_posture_of_the_band_keeps_the_swing_sole_clear(talos, stance):
+    """The band's 64 corners, each with the base and stance leg solved: the swing sole stays above the clearance
+    and beside the stance sole whatever the design's series combine (not only on the design one processor's rounding
+    finds)."""
+    c = ("left", "right").index(stance)
+    joints = talos.limb(talos.contact_frames[1 - c])
+    lower, upper = swing_band(talos, joints, ("left", "right")[1 - c], StanceOptions().margin)
+    low, beside = band_clearance(talos, c, joints, lower, upper)
+    assert low > StanceOptions().clearance and beside > 0.01
+
+
+def test_a_band_that_lets_the_sole_cross_is_refused_before_the_design(talos, monkeypatch):
+    """The earlier band (hip yaw -0.15..0.05, hip roll -0.4..-0.2) lets a corner come 44 mm across the stance sole:
+    refused in one line before the excitation is designed."""
+    monkeypatch.setitem(stance_module.SWING_BAND, "hip_yaw", (-0.15, 0.05))
+    monkeypatch.setitem(stance_module.SWING_BAND, "hip_roll", (-0.4, -0.2))
+
+    def not_reached(*args, **kwargs):
+        raise AssertionError("designed a band that is not admissible")
+    monkeypatch.setattr(stance_module, "design_swing", not_reached)
+    with pytest.raises(ModelError, match="posture band lets the swing sole come .* -4[0-9].[0-9] mm beside"):
+        stance_reference(talos, StanceOptions(stance="right"))
 
 
 @pytest.mark.parametrize("stance, simulator", [("left", "ideal"), ("left", "mujoco"), ("right", "mujoco")])

@@ -20,8 +20,8 @@ the last, so that every sample is one the estimator maps exactly to the swing le
   mass, not the zero-moment point, is held over the sole; the ZMP of the reference's own dynamics
   (:func:`zero_moment_point`) is computed and must stay inside the sole's footprint (:func:`support_margin`,
   ModelError otherwise): the swing leg's velocity cap is what keeps it there. (TALOS, the default options: the ZMP
-  within 14 mm of the sole's centre, 53 mm inside its edges; the swing sole 58 mm above the ground at its lowest
-  corner, 22-32 mm beside the stance sole; measured on both feet.)
+  within 25 mm of the sole's centre along either axis, 55 mm inside its edges; the swing sole 71 mm above the ground
+  at its lowest corner, 87-109 mm beside the stance sole; measured on both feet.)
 
 The motion starts at rest in single support (the series is at rest at ``t = 0``) with the swing foot already in the
 air: both simulators accept that (the ideal one welds the stance sole at its first sample; MuJoCo starts from the
@@ -30,6 +30,7 @@ reference's first state), so no transition from double support is planned.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -48,21 +49,27 @@ from wbfriction.sim.single_support import (  # noqa: F401 (StanceIK, zero_moment
     SIDES,
     StanceIK,
     single_support_reference,
+    stance_ik,
     zero_moment_point,
 )
 from wbfriction.walking.reference import WalkingReference, standing_configuration
 
 SWING_BAND: dict[str, tuple[float, float]] = {
-    "hip_yaw": (-0.15, 0.05),
-    "hip_roll": (-0.4, -0.2),
+    "hip_yaw": (-0.05, 0.15),
+    "hip_roll": (-0.5, -0.3),
     "hip_pitch": (-0.9, -0.5),
     "knee": (1.3, 1.8),
     "ankle_pitch": (-0.9, -0.4),
     "ankle_roll": (-0.15, 0.15),
 }
 """The swing leg's posture band [rad] per joint group, for a *right* swing leg (TALOS's conventions: a negative hip
-roll moves the right foot outward; a left swing leg's hip yaw, hip roll and ankle roll bands are negated): the
-foot lifted and rolled away from the stance leg."""
+roll moves the right foot outward, a positive hip yaw turns its toe inward; a left swing leg's hip yaw, hip roll and
+ankle roll bands are negated): the foot lifted and rolled away from the stance leg. Every posture of the band
+(its 64 corners checked by :func:`band_clearance`, with the floating base and stance leg solved) keeps the swing
+sole clear of the ground and beside the stance sole, whatever combination of the band the designed series reach:
+on TALOS at least 50 mm above the ground and 19.7 mm beside (the earlier band, hip yaw -0.15..0.05 and hip roll
+-0.4..-0.2, let corners come 44 mm across the stance sole, and whether the design's series met them depended on
+the optimiser's rounding)."""
 MIRRORED = ("hip_yaw", "hip_roll", "ankle_roll")
 """The groups whose band changes sign from one leg to the other."""
 @dataclass(frozen=True)
@@ -146,6 +153,22 @@ def support_margin(robot: Robot, stance: int, zmp: np.ndarray) -> float:
     return float(np.min(half - np.abs(local - centre)))
 
 
+def band_clearance(robot: Robot, stance: int, joints: tuple[str, ...], lower: np.ndarray,
+                   upper: np.ndarray) -> tuple[float, float]:
+    """The swing sole's least height [m] and least distance beside the stance sole [m] (as :func:`_swing_corners`)
+    over every corner of the band ``lower``, ``upper`` (n,) [rad] of the swing ``joints`` (2^n postures, the other
+    joints at the reference posture, the floating base and the stance leg from :func:`stance_ik`, at rest)."""
+    ik = stance_ik(robot, stance)
+    iq = robot.act_q_index[[robot.actuated.index(j) for j in joints]]
+    rest = np.zeros(len(ik.rest))
+    postures = []
+    for corner in itertools.product(*zip(lower, upper)):
+        q = standing_configuration(robot)
+        q[iq] = corner
+        postures.append(ik.solve(q, rest, rest)[0])
+    return _swing_corners(robot, stance, np.array(postures), every=1)
+
+
 def _swing_corners(robot: Robot, stance: int, q: np.ndarray, every: int = 10) -> tuple[float, float]:
     """The swing sole's lowest corner height [m] over the motion ``q`` (N, nq) (every ``every`` samples), and its
     corners' least lateral distance beyond the stance sole's inner edge [m] (negative: beside it no longer)."""
@@ -196,6 +219,7 @@ def stance_reference(robot: Robot, options: StanceOptions = StanceOptions(),
     if missing := [j for j in joints if j not in prior]:
         raise InputError(f"no prior friction for swing joint '{missing[0]}'")
     lower, upper = swing_band(robot, joints, SIDES[1 - stance], options.margin)
+    _clear(options, *band_clearance(robot, stance, joints, lower, upper), "the posture band lets the swing sole come")
     noise = swing_noise(robot, joints, options, standing_configuration(robot))
     trajectory = design_swing(robot, joints, (lower, upper), prior, options, noise)
     reference = single_support_reference(robot, stance, joints, trajectory, options.design.times())
@@ -211,15 +235,21 @@ def _checked(robot: Robot, options: StanceOptions, stance: int, reference: Walki
         raise ModelError(f"the ZMP comes within {margin * 1e3:.1f} mm of the stance sole's edge (at least "
                          f"{options.zmp_margin * 1e3:.1f} mm asked): lower --velocity")
     low, beside = _swing_corners(robot, stance, reference.q)
-    if low < options.clearance or beside < 0.0:
-        raise ModelError(f"the swing sole comes {low * 1e3:.1f} mm above the ground and {beside * 1e3:.1f} mm beside "
-                         f"the stance sole (at least {options.clearance * 1e3:.1f} and 0 mm): a narrower band")
+    _clear(options, low, beside, "the swing sole comes")
     lo, hi = robot.angle_limits
     angles = robot.angles(reference.q)
     if np.any(angles < lo) or np.any(angles > hi):
         worst = int(np.argmax(np.maximum(lo - angles, angles - hi).max(axis=0)))
         raise ModelError(f"joint '{robot.actuated[worst]}' leaves its URDF range on one foot")
     return margin, low
+
+
+def _clear(options: StanceOptions, low: float, beside: float, subject: str) -> None:
+    """ModelError unless the swing sole's least height ``low`` [m] reaches the clearance asked and its least
+    distance ``beside`` [m] the stance sole is not negative (``subject`` begins the message)."""
+    if low < options.clearance or beside < 0.0:
+        raise ModelError(f"{subject} {low * 1e3:.1f} mm above the ground and {beside * 1e3:.1f} mm beside the stance "
+                         f"sole (at least {options.clearance * 1e3:.1f} and 0 mm): a narrower band")
 
 
 def swing_bounds(robot: Robot, excitation: StanceExcitation, options: StanceOptions,

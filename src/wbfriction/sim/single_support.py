@@ -105,6 +105,16 @@ def standing_feet(robot: Robot) -> np.ndarray:
                      for f in robot.contact_frame_ids])
 
 
+def stance_ik(robot: Robot, stance: int) -> StanceIK:
+    """The :class:`StanceIK` of sole ``stance`` (its index in :attr:`Robot.contact_frames`): the sole flat at its
+    standing footprint, the centre of mass over the sole's centre at the standing posture's height."""
+    q0 = standing_configuration(robot)
+    sole = foot_placement(standing_feet(robot)[stance])
+    centre, _ = sole_footprint(robot, robot.contact_frames[stance])
+    height = pin.centerOfMass(robot.model, robot.model.createData(), q0)[2]
+    return StanceIK(robot, stance, sole, np.array([*sole.act(np.array([*centre, 0.0]))[:2], height]))
+
+
 def single_support_reference(robot: Robot, stance: int, joints: tuple[str, ...], trajectory: FourierTrajectory,
                              time: np.ndarray) -> WalkingReference:
     """Stand on sole ``stance`` (its index in :attr:`Robot.contact_frames`) at the evenly spaced ``time`` (N,) [s]
@@ -119,16 +129,12 @@ def single_support_reference(robot: Robot, stance: int, joints: tuple[str, ...],
     """
     time = np.asarray(time, dtype=float)
     qs, qds, qdds = trajectory(time)
-    q0 = standing_configuration(robot)
     feet0 = standing_feet(robot)
-    sole = foot_placement(feet0[stance])
-    centre, _ = sole_footprint(robot, robot.contact_frames[stance])
     model, data = robot.model, robot.model.createData()
     act = np.array([robot.actuated.index(j) for j in joints])
-    q = q0.copy()
+    q = standing_configuration(robot)
     q[robot.act_q_index[act]] = qs[0]
-    com = np.array([*sole.act(np.array([*centre, 0.0]))[:2], pin.centerOfMass(model, data, q0)[2]])
-    Q, V, A = StanceIK(robot, stance, sole, com).solve_motion(q, act, (qs, qds, qdds))
+    Q, V, A = stance_ik(robot, stance).solve_motion(q, act, (qs, qds, qdds))
     feet = np.empty((len(Q), 2, 4))
     feet[:, stance] = feet0[stance]
     swing = robot.contact_frame_ids[1 - stance]
