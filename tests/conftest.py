@@ -3,6 +3,13 @@ from __future__ import annotations
 import dataclasses
 import os
 
+# One BLAS/OpenMP thread per test process (set before NumPy loads; the pages' commands inherit it): the suite runs
+# two xdist workers on two cores, and OpenBLAS's spinning threads on the project's small dense problems cost CPU
+# time and give none back (tests/inertia, 120 tests on a loaded 2-core machine: 128 s of user time on two threads
+# per process, 88 s on one). An exported value wins: `OPENBLAS_NUM_THREADS=2 python -m pytest` runs them on two.
+for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_name, "1")
+
 import numpy as np
 import pinocchio as pin
 import pytest
