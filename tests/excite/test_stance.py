@@ -138,10 +138,11 @@ def test_every_posture_of_the_band_keeps_the_swing_sole_clear(talos, stance):
 
 
 def test_a_band_that_lets_the_sole_cross_is_refused_before_the_design(talos, monkeypatch):
-    """The earlier band (hip yaw -0.15..0.05, hip roll -0.4..-0.2) lets a corner come 44 mm across the stance sole:
-    refused in one line before the excitation is designed."""
+    """The earlier band (hip yaw -0.15..0.05, hip roll -0.4..-0.2, ankle roll -0.15..0.15) lets a corner come 44 mm
+    across the stance sole (its corners solved one by one, right stance): refused in one line before the design."""
     monkeypatch.setitem(stance_module.SWING_BAND, "hip_yaw", (-0.15, 0.05))
     monkeypatch.setitem(stance_module.SWING_BAND, "hip_roll", (-0.4, -0.2))
+    monkeypatch.setitem(stance_module.SWING_BAND, "ankle_roll", (-0.15, 0.15))
 
     def not_reached(*args, **kwargs):
         raise AssertionError("designed a band that is not admissible")

@@ -20,8 +20,8 @@ the last, so that every sample is one the estimator maps exactly to the swing le
   mass, not the zero-moment point, is held over the sole; the ZMP of the reference's own dynamics
   (:func:`zero_moment_point`) is computed and must stay inside the sole's footprint (:func:`support_margin`,
   ModelError otherwise): the swing leg's velocity cap is what keeps it there. (TALOS, the default options: the ZMP
-  within 25 mm of the sole's centre along either axis, 55 mm inside its edges; the swing sole 71 mm above the ground
-  at its lowest corner, 87-109 mm beside the stance sole; measured on both feet.)
+  within 27 mm of the sole's centre along either axis, 49 mm inside its edges; the swing sole 69 mm above the ground
+  at its lowest corner, 52-64 mm beside the stance sole; measured on both feet.)
 
 The motion starts at rest in single support (the series is at rest at ``t = 0``) with the swing foot already in the
 air: both simulators accept that (the ideal one welds the stance sole at its first sample; MuJoCo starts from the
@@ -56,20 +56,20 @@ from wbfriction.walking.reference import WalkingReference, standing_configuratio
 
 SWING_BAND: dict[str, tuple[float, float]] = {
     "hip_yaw": (-0.05, 0.15),
-    "hip_roll": (-0.5, -0.3),
+    "hip_roll": (-0.5, -0.25),
     "hip_pitch": (-0.9, -0.5),
     "knee": (1.3, 1.8),
     "ankle_pitch": (-0.9, -0.4),
-    "ankle_roll": (-0.15, 0.15),
+    "ankle_roll": (-0.2, 0.0),
 }
 """The swing leg's posture band [rad] per joint group, for a *right* swing leg (TALOS's conventions: a negative hip
-roll moves the right foot outward, a positive hip yaw turns its toe inward; a left swing leg's hip yaw, hip roll and
+roll moves the right foot outward; a left swing leg's hip yaw, hip roll and
 ankle roll bands are negated): the foot lifted and rolled away from the stance leg. Every posture of the band
 (its 64 corners checked by :func:`band_clearance`, with the floating base and stance leg solved) keeps the swing
 sole clear of the ground and beside the stance sole, whatever combination of the band the designed series reach:
-on TALOS at least 50 mm above the ground and 19.7 mm beside (the earlier band, hip yaw -0.15..0.05 and hip roll
--0.4..-0.2, let corners come 44 mm across the stance sole, and whether the design's series met them depended on
-the optimiser's rounding)."""
+on TALOS at least 43 mm above the ground and 17 mm beside (the earlier band, hip yaw -0.15..0.05, hip roll
+-0.4..-0.2 and ankle roll -0.15..0.15, let corners come 44 mm across the stance sole, and whether the design's series
+met them depended on the optimiser's rounding)."""
 MIRRORED = ("hip_yaw", "hip_roll", "ankle_roll")
 """The groups whose band changes sign from one leg to the other."""
 @dataclass(frozen=True)
