@@ -36,7 +36,7 @@ pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_stance_cli")]
 TOLERANCE = 1.0
 """Each swing joint's F_c and F_v within 1 % [%] (module docstring)."""
 DESIGN = ("--duration", "4", "--period", "4")
-"""A 4 s stance, one period: the shortest whose swing sole stays beside the stance sole (a 2 s period does not)."""
+"""A 4 s stance, one period (half the default recording)."""
 
 
 def friction_toml(path, talos, joints) -> dict:
