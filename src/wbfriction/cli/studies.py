@@ -131,10 +131,10 @@ def _pulls_note(pulls: int, in_double: int) -> str:
 
 
 def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
-    from wbfriction.studies.realistic import run_realistic_study, worst_scored
+    from wbfriction.studies.realistic import KNEE_STEPS, run_realistic_study, worst_scored
 
-    with stages() as status:
-        result = run_realistic_study(r, output_dir, steps=steps, progress=status)
+    with stages() as status:  # a short combined walk, short forward walks too (the full size's are 5 steps)
+        result = run_realistic_study(r, output_dir, steps=steps, knee_steps=min(steps, KNEE_STEPS), progress=status)
     for k, case in enumerate(result.cases):
         if k:
             out.print()
@@ -154,7 +154,8 @@ def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
 @app.command(rich_help_panel=STUDIES)
 def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--output-dir", help="Where to write."),
          robot: str = RobotOpt,
-         steps: int = typer.Option(GAIT.steps, help="Steps per direction of the combined walk."),
+         steps: int = typer.Option(GAIT.steps, help="Steps per direction of the combined walk (--simulator mujoco: "
+                                                    "of the forward walks of Fig. 6.4-6.5 too, at most 5)."),
          simulator: Simulator = typer.Option("ideal", help="ideal: Tables 6.1/6.2, Fig. 6.1-6.3; mujoco: the realistic "
                                                      "simulator's study, Fig. 6.4-6.5.")) -> None:
     """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.3 (--simulator mujoco:
