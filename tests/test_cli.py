@@ -10,6 +10,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from helpers import assert_one_line_error, assert_stages, run, widest_line
+from wbfriction.exceptions import InputError
 from wbfriction.logs.log import write_log
 from wbfriction.logs.source import read_log
 
@@ -117,6 +118,18 @@ def test_bad_inputs_exit_2_with_one_line(talos, demo_dir, tmp_path):
     assert_one_line_error(run("estimate", out / "log.parquet", "--robot", "asimo", "-o", tmp_path / "x.parquet"),
                            "unknown robot 'asimo'")
     assert_one_line_error(run("fit", out / "log.parquet", "-o", tmp_path / "p.json"), "no 'tau_f.<joint>' column")
+
+
+def test_the_filter_study_takes_its_noise_levels_or_says_why_not(tmp_path):
+    from wbfriction.cli.studies import noise_levels
+
+    assert noise_levels("exact, 0,1e-4") == (None, 0.0, 1e-4)  # in the order given, 'exact': no sensor model
+    for bad in ("-1e-4", "1e-4,1e-4", ","):
+        with pytest.raises(InputError, match="--levels must be"):
+            noise_levels(bad)
+    # refused in one line before the walk is simulated
+    assert_one_line_error(run("study-filters", "--levels", "1e-4,loud", "-o", tmp_path / "f"), "--levels must be")
+    assert not (tmp_path / "f").exists()
 
 
 def test_any_robot_from_urdf_and_toml(talos, demo_dir, tmp_path):

@@ -185,7 +185,8 @@ def needs(steps: list[Step]) -> list[set[int]]:
 EXPECTED = {
     # issue 66: the Go2's design predicts every parameter ok, the worst a calf's offset at its noise's floor
     "wbfriction excite --robot go2 -o go2_excite.parquet -o go2_excite.csv --json go2_excite.json --figure "
-    "go2_excite.png": [r"^worst: \w+_calf_joint offset, 0\.2\d of its limit \(below 1: predicted ok\)$"],
+    "go2_excite.png --amplitude 0.95": [
+        r"^worst: \w+_calf_joint offset, 0\.2\d of its limit \(below 1: predicted ok\)$"],
     # TALOS on one foot: the ZMP of the designed stance well inside the stance sole (its edges 10 mm at the least)
     "wbfriction excite --robot talos --stance left -o talos_stance.parquet --json talos_stance.json --figure "
     "talos_stance.png": [r"^ZMP [2-9]\d\.\d mm inside the left sole's edges \(at least 10\)"],
@@ -194,7 +195,7 @@ EXPECTED = {
     "go2_tripod.png": [r"^centre of mass 10\d\.\d mm \(at least 50\) and ZMP \d{2,3}\.\d mm \(at least 30\)"],
     # what to record next after the real Aliengo's log: every parameter predicted ok under its model
     "wbfriction excite --config aliengo_identified.toml --after aliengo_params.json -o aliengo_next.parquet --json "
-    "aliengo_next.json --figure aliengo_next.png": [r"^worst: \w+ \w+, 0\.[0-5]\d of its limit",
+    "aliengo_next.json --figure aliengo_next.png --amplitude 0.95": [r"^worst: \w+ \w+, 0\.[0-5]\d of its limit",
                                                    r"^held at their posture \(their fits ok\): none"],
     # what to record next after a Panda's log whose wrist held still: the wrist alone moves, predicted ok
     "wbfriction excite --robot panda --after panda_wrist_still_params.json --duration 10 --period 10 -o "

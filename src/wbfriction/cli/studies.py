@@ -131,10 +131,10 @@ def _pulls_note(pulls: int, in_double: int) -> str:
 
 
 def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
-    from wbfriction.studies.realistic import run_realistic_study, worst_scored
+    from wbfriction.studies.realistic import KNEE_STEPS, run_realistic_study, worst_scored
 
-    with stages() as status:
-        result = run_realistic_study(r, output_dir, steps=steps, progress=status)
+    with stages() as status:  # a short combined walk, short forward walks too (the full size's are 5 steps)
+        result = run_realistic_study(r, output_dir, steps=steps, knee_steps=min(steps, KNEE_STEPS), progress=status)
     for k, case in enumerate(result.cases):
         if k:
             out.print()
@@ -154,7 +154,8 @@ def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
 @app.command(rich_help_panel=STUDIES)
 def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--output-dir", help="Where to write."),
          robot: str = RobotOpt,
-         steps: int = typer.Option(GAIT.steps, help="Steps per direction of the combined walk."),
+         steps: int = typer.Option(GAIT.steps, help="Steps per direction of the combined walk (--simulator mujoco: "
+                                                    "of the forward walks of Fig. 6.4-6.5 too, at most 5)."),
          simulator: Simulator = typer.Option("ideal", help="ideal: Tables 6.1/6.2, Fig. 6.1-6.3; mujoco: the realistic "
                                                      "simulator's study, Fig. 6.4-6.5.")) -> None:
     """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.3 (--simulator mujoco:
@@ -294,23 +295,40 @@ def study_fleet(output_dir: Path = typer.Option(Path("wbfriction-fleet"), "-o", 
         console.print(f"wrote {f}")
 
 
+def noise_levels(text: str) -> tuple[float | None, ...]:
+    """``study-filters --levels``: comma-separated position noises [rad], ``exact`` for a log without a sensor model
+    (None), in the order given. Raises InputError: not such a list, a negative noise or one given twice."""
+    try:
+        levels = tuple(None if x.strip() == "exact" else float(x) for x in text.split(",") if x.strip())
+    except ValueError:
+        raise InputError(f"--levels must be comma-separated noises [rad] or 'exact', got '{text}'") from None
+    if not levels or any(x is not None and not x >= 0 for x in levels) or len(set(levels)) < len(levels):
+        raise InputError(f"--levels must be distinct noises of at least 0 rad or 'exact', got '{text}'")
+    return levels
+
+
 @app.command("study-filters", rich_help_panel=STUDIES)
 def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-o", "--output-dir",
                                                   help="Where to write."),
                   robot: str = RobotOpt,
                   steps: int = typer.Option(GAIT.steps, help="Steps per direction of the combined walk."),
-                  seed: int = typer.Option(0, help="Noise seed."),
+                  seed: int = typer.Option(0, help="Noise seed (the i-th level takes seed + i)."),
+                  levels: str = typer.Option("exact,0,1e-5,1e-4,1e-3", "--levels",
+                                             help="Comma-separated position noises [rad] (0: the encoder's and the "
+                                                  "torque's noise alone; exact: no sensor model); the figure at "
+                                                  "1e-4, else the last."),
                   workers: Optional[int] = typer.Option(None, help="Processes (default: up to 2).")) -> None:
     """Score the differentiation schemes on noisy logs (thesis 7.2, Fig. 7.2)."""
     from wbfriction.friction.models import PARAM_NAMES
-    from wbfriction.studies.filters import LEVELS, run_filter_study
+    from wbfriction.studies.filters import run_filter_study
 
     check_paths({}, {}, {"-o": output_dir})
+    chosen = noise_levels(levels)
     start = time.perf_counter()
     r = robot_of(robot, None, None)
     with stages() as status:
-        result = run_filter_study(r, output_dir, steps=steps, seed=seed, workers=workers,
-                                  progress=status)
+        result = run_filter_study(r, output_dir, steps=steps, levels=chosen, seed=seed, workers=workers,
+                                  curve_level=1e-4 if 1e-4 in chosen else chosen[-1], progress=status)
     table = Table(title="Friction of the 12 leg joints through each scheme: combined walk, sensor noise",
                   caption="rms: estimate - tau_f_true on the valid samples [N·m]; parameters: worst error over "
                           "the leg joints [%]; se F_v: the largest standard error of F_v the fit reports [% of "
@@ -319,7 +337,7 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
                   box=None)
     for col in ("position noise", "scheme", "N", "rms", *PARAM_NAMES, "se F_v"):
         table.add_column(col, justify="left" if col in ("position noise", "scheme") else "right")
-    for level in LEVELS:
+    for level in chosen:
         best = result.best(level)
         for row in (x for x in result.rows if x.position_std == level):
             noise = "exact log" if level is None else f"{level:g} rad"

@@ -199,7 +199,12 @@ def _identify(robot: Robot, mjr: MujocoRobot, legs: list[LegJoint], spec: _CaseS
     return Case(spec.name, spec.label, rows, spec.scored, thesis_rows), files
 
 
-def run_realistic_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int = 5,
+KNEE_STEPS = 5
+"""Steps of the forward walks of Fig. 6.4 and 6.5 (:func:`run_realistic_study`'s default; ``demo --simulator mujoco
+--steps N`` takes ``min(N, KNEE_STEPS)``)."""
+
+
+def run_realistic_study(robot: Robot, output_dir: Path, steps: int = 10, knee_steps: int = KNEE_STEPS,
                         options: MujocoOptions = MujocoOptions(),
                         progress: StageProgress | None = None) -> RealisticResult:
     """Run the study (module docstring) and write its parameters and figures to ``output_dir``.
