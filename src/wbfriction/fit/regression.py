@@ -120,8 +120,10 @@ def correlation_lag(residual: np.ndarray, rows: np.ndarray, threshold: float = 0
         return rule
     top = min(cap, n - 1)
     candidates: Iterable[int] = range(1, top + 1)
-    if top >= 1 and math.isfinite(var) and np.all(np.diff(rows) > 0):
-        sums, counts = _run_autocorrelation(residual, rows, top)
+    summed = top >= 1 and math.isfinite(var) and np.all(np.diff(rows) > 0)
+    sums_counts = _run_autocorrelation(residual, rows, top) if summed else None
+    if sums_counts is not None:
+        sums, counts = sums_counts
         margin = 1e-9 * n * var  # far above the FFT's rounding (about 1e-15 of the sum of squares)
         candidates = np.flatnonzero((counts < 10) | (sums < threshold * var * counts + margin)) + 1
     for lag in candidates:
@@ -132,19 +134,29 @@ def correlation_lag(residual: np.ndarray, rows: np.ndarray, threshold: float = 0
     return max(rule, 2 * cap)
 
 
-def _run_autocorrelation(residual: np.ndarray, rows: np.ndarray, top: int) -> tuple[np.ndarray, np.ndarray]:
+MAX_DENSE = 1 << 22
+"""Samples at most in :func:`_run_autocorrelation`'s padded series (beyond: the lags summed one by one)."""
+
+
+def _run_autocorrelation(residual: np.ndarray, rows: np.ndarray,
+                         top: int) -> tuple[np.ndarray, np.ndarray] | None:
     """For each lag ``1 .. top``: the sum of ``residual[i + lag] residual[i]`` over the pairs of samples that lag
-    apart with no row missing between them (through the FFT: to rounding) and their number (exact), (top,) each.
+    apart with no row missing between them (through the FFT: to rounding; zero beyond the longest run) and their
+    number (exact), (top,) each; None where the runs padded apart would exceed :data:`MAX_DENSE` samples.
     ``rows`` (n,) strictly increasing."""
     cuts = np.concatenate([[0], np.flatnonzero(np.diff(rows) != 1) + 1, [len(rows)]])
     lengths = np.diff(cuts)
-    # each run shifted by ``top`` zeros per run before it: no pair of two runs lies within ``top`` of each other
-    place = np.arange(len(rows)) + top * np.repeat(np.arange(len(lengths)), lengths)
+    reach = int(min(top, lengths.max() - 1))  # no pair lies further apart than the longest run
+    if len(rows) + reach * (len(lengths) - 1) > MAX_DENSE:
+        return None
+    # each run shifted by ``reach`` zeros per run before it: no pair of two runs lies within ``reach``
+    place = np.arange(len(rows)) + reach * np.repeat(np.arange(len(lengths)), lengths)
     dense = np.zeros(int(place[-1]) + 1)
     dense[place] = residual
-    size = 1 << int(np.ceil(np.log2(dense.size + top)))  # no wrap-around up to the largest lag
+    size = 1 << int(np.ceil(np.log2(dense.size + reach)))  # no wrap-around up to the largest lag
     spectrum = np.fft.rfft(dense, size)
-    sums = np.fft.irfft(spectrum * np.conj(spectrum), size)[1:top + 1]
+    sums = np.zeros(top)
+    sums[:reach] = np.fft.irfft(spectrum * np.conj(spectrum), size)[1:reach + 1]
     lags = np.arange(1, top + 1)
     runs_of = np.bincount(lengths, minlength=top + 2)  # count(lag) = sum over runs longer than lag of (length - lag)
     longer = np.cumsum(runs_of[::-1])[::-1]
