@@ -62,3 +62,17 @@ def test_correlation_lag_by_its_definition():
     for r, rws, threshold, cap in cases:
         assert correlation_lag(r, rws, threshold, cap) == _lag_by_definition(r, rws, threshold, cap)
     assert 90 <= correlation_lag(sine, k) <= 102  # about twice a quarter period
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(1, 400), gap_share=st.floats(0.0, 0.5), kind=st.sampled_from(["white", "walk", "sine", "ties"]),
+       threshold=st.sampled_from([0.05, 0.3, 0.0, 1.0]), cap=st.integers(1, 300), seed=st.integers(0, 2**32 - 1))
+def test_correlation_lag_by_its_definition_with_gaps(n, gap_share, kind, threshold, cap, seed):
+    """The FFT's sums and the exact check of the lags near the threshold give the definition's lag, runs of
+    rows cut by gaps of 1-4 rows included."""
+    rng = np.random.default_rng(seed)
+    rows = np.cumsum(1 + (rng.random(n) < gap_share) * rng.integers(1, 5, n))
+    r = {"white": rng.normal(size=n), "walk": np.cumsum(rng.normal(size=n)),
+         "sine": np.sin(np.arange(n) / rng.uniform(1, 50)) + 0.1 * rng.normal(size=n),
+         "ties": np.round(rng.normal(size=n))}[kind]
+    assert correlation_lag(r, rows, threshold, cap) == _lag_by_definition(r, rows, threshold, cap)

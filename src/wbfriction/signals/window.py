@@ -113,9 +113,18 @@ class MomentumWindow:
         out = np.full((n, *impulses.shape[1:]), np.nan)
         if n - 1 < 2 * m:
             return out
-        total = _window_sums(self.step_durations(n), self.weights)
+        total = self._durations_summed(n)
         out[m:n - m] = _window_sums(impulses, self.weights) / total.reshape((-1,) + (1,) * (impulses.ndim - 1))
         return out
+
+    def _durations_summed(self, n: int) -> np.ndarray:
+        """``sum_j w_j Delta t`` around each sample of ``n`` (:meth:`over_steps`' denominator), computed once per
+        ``n`` (the fits filter many signals through one window)."""
+        cache = self.__dict__.setdefault("_totals", {})
+        if n not in cache:
+            cache[n] = _window_sums(self.step_durations(n), self.weights)
+            cache[n].setflags(write=False)
+        return cache[n]
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         """``x`` (N, ...) sampled at the samples through the window: each step's trapezoid ``(x_i + x_i+1) / 2
