@@ -102,17 +102,59 @@ def lagged_products(g: np.ndarray, rows: np.ndarray, max_lag: int) -> np.ndarray
 def correlation_lag(residual: np.ndarray, rows: np.ndarray, threshold: float = 0.05, cap: int = 2000) -> int:
     """Largest lag worth summing in :func:`standard_errors`: twice the lag at which the
     residuals' autocorrelation (over samples truly that many rows apart) first falls below
-    ``threshold``, and at least Newey and West's rule of thumb ``4 (n / 100)^(2/9)``."""
+    ``threshold``, and at least Newey and West's rule of thumb ``4 (n / 100)^(2/9)``.
+
+    The first :data:`DIRECT_LAGS` lags are summed pair by pair; the longer ones, where slowly varying residuals
+    take the search, through the FFT over each run of consecutive rows (all lags at once,
+    :func:`autocorrelation_sums`). A lag whose FFT sum lies within rounding of the threshold is summed pair by
+    pair again: the lag is the sum over pairs' (tests/fit/test_regression.py)."""
     n = len(residual)
     rule = int(4 * (n / 100.0) ** (2.0 / 9.0))
-    var = float(residual @ residual) / max(n, 1)
+    power = float(residual @ residual)
+    var = power / max(n, 1)
     if var == 0:
         return rule
-    for lag in range(1, min(cap, n - 1) + 1):
+    top = min(cap, n - 1)
+
+    def falls(lag: int) -> bool:
         pair = rows[lag:] - rows[:-lag] == lag
-        if pair.sum() < 10 or float(residual[lag:][pair] @ residual[:-lag][pair]) / pair.sum() < threshold * var:
+        return bool(pair.sum() < 10 or float(residual[lag:][pair] @ residual[:-lag][pair]) / pair.sum()
+                    < threshold * var)
+
+    for lag in range(1, min(top, DIRECT_LAGS) + 1):
+        if falls(lag):
             return max(rule, 2 * lag)
+    if top > DIRECT_LAGS:
+        sums, counts = autocorrelation_sums(residual, rows, top)
+        rounding = 1e-9 * power  # far above the FFT's error on a sum of products (about 1e-15 of the power)
+        for lag in range(DIRECT_LAGS + 1, top + 1):
+            gap = sums[lag] - threshold * var * counts[lag]
+            if counts[lag] < 10 or (gap < 0 if abs(gap) > rounding else falls(lag)):
+                return max(rule, 2 * lag)
     return max(rule, 2 * cap)
+
+
+DIRECT_LAGS = 32
+"""Lags :func:`correlation_lag` sums pair by pair before it turns to the FFT (most residuals decorrelate sooner)."""
+
+
+def autocorrelation_sums(x: np.ndarray, rows: np.ndarray, max_lag: int) -> tuple[np.ndarray, np.ndarray]:
+    """For each lag ``0..max_lag``, the sum of ``x[i] x[j]`` (the FFT's, to rounding) and the number of pairs
+    ``i < j`` of the samples ``x`` (n,) at ``rows`` (n,) (increasing) that lag apart in rows and in order (in one
+    run of consecutive rows): two (max_lag + 1,) arrays, the counts exact."""
+    cuts = np.concatenate([[0], np.flatnonzero(np.diff(rows) != 1) + 1, [len(x)]])
+    sums = np.zeros(max_lag + 1)
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        lags = min(max_lag, b - a - 1)
+        size = 1 << int(np.ceil(np.log2(b - a + lags)))  # no wrap-around up to the largest lag
+        F = np.fft.rfft(x[a:b], size)
+        sums[:lags + 1] += np.fft.irfft(F * np.conj(F), size)[:lags + 1]
+    lengths = np.bincount(np.diff(cuts), minlength=max_lag + 2)
+    longer = np.cumsum(lengths[::-1])[::-1]  # runs longer than each length - 1
+    samples = np.cumsum((lengths * np.arange(lengths.size))[::-1])[::-1]
+    lag = np.arange(max_lag + 1)
+    counts = samples[lag + 1] - lag * longer[lag + 1]  # sum over runs longer than lag of (length - lag)
+    return sums, counts
 
 
 def held_out_split(use: np.ndarray, n_blocks: int = HELD_OUT_BLOCKS,
