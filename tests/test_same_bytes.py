@@ -5,7 +5,8 @@ predict, report, export), an arm (4 s of a simulated Panda: estimate, fit, ident
 simulated Panda logs, one per robot, one drifted, batched on Dask, then their trends: every output kind at the least
 cost; the trends, too few logs to test, say so). Every file they write and every line they print is hashed (SHA-256)
 and compared with ``tests/golden/same_bytes.json``, recorded before issue 54 moved the fitting into its own
-stage (commit ``1390c40``). A refactoring that moves one bit of one output fails here.
+stage (commit ``1390c40``; the arm's and the fleet's re-recorded when they were shortened, after the files of the
+longer ones were checked unmoved). A refactoring that moves one bit of one output fails here.
 
 Bytes depend on the libraries that compute them (a SciPy release may round differently; PyArrow writes its
 version into every Parquet file), so the comparison holds where the stack is the one recorded: Python, NumPy,

@@ -22,7 +22,7 @@ from wbfriction.sim.arm import ExcitationOptions, default_arm_friction, excitati
 
 pytestmark = pytest.mark.xdist_group("excite_arm")  # one module fixture, one worker
 
-DURATION = 20.0
+DURATION = 10.0
 """The recordings' duration [s]: two of the design's periods (the how-to's run holds the issue's 30 s)."""
 STATISTICAL = ("F_c", "F_v", "tau_os")
 """The parameters whose statistical standard error one noisy simulation predicts (module docstring of

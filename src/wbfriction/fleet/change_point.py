@@ -173,7 +173,7 @@ def change_scan(t: np.ndarray, y: np.ndarray, se: np.ndarray, min_before: int, m
     yy = np.einsum("ij,ij->j", Y, Y)
     onsets = candidate_onsets(t, min_before, min_after, shape)
     F = np.empty((onsets.size, Y.shape[1]))
-    coef = np.empty((onsets.size, 2 * Z.shape[1] if fits else 0, Y.shape[1]))  # [1, covariates] and the change's as many
+    coef = np.empty((onsets.size, 2 * Z.shape[1] if fits else 0, Y.shape[1]))  # [1, covariates], the change's as many
     for c, k in enumerate(onsets):
         X = np.column_stack([Z, _change_columns(shape, t, int(k), w, covariates)])
         Q, R = np.linalg.qr(X)
