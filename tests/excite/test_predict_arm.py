@@ -1,10 +1,11 @@
 """The prediction of what a fixed-base arm's identification reports (:mod:`wbfriction.excite.predict_arm`), against
-what ``estimate`` and ``fit`` report on the motion recorded with another noise: a Panda, 20 s, a real arm's sensors,
+what ``estimate`` and ``fit`` report on the motion recorded with another noise: a Panda, 10 s, a real arm's sensors,
 on the motion ``excite`` designs and on a random Fourier excitation within the same limits (the how-to's run,
 :mod:`tests.test_readme`, holds the issue's 30 s).
 
-Cost: the design about 11 s (one start per joint), each identification of 20 s 15 to 40 s (simulation 2 s, estimate
-1 s, fit the rest), six of them: the fixture about 2 min on a 2-core machine, computed once per worker."""
+Cost: the design about 11 s (one start per joint), six identifications (the fit most of each): at 20 s the fixture
+took 216 s of a loaded 2-core machine, at 10 s (one period: the same truths hold) about half; computed once per
+worker."""
 
 from __future__ import annotations
 
@@ -22,8 +23,8 @@ from wbfriction.sim.arm import ExcitationOptions, default_arm_friction, excitati
 
 pytestmark = pytest.mark.xdist_group("excite_arm")  # one module fixture, one worker
 
-DURATION = 20.0
-"""The recordings' duration [s]: two of the design's periods (the how-to's run holds the issue's 30 s)."""
+DURATION = 10.0
+"""The recordings' duration [s]: one of the design's periods (the how-to's run holds the issue's 30 s)."""
 STATISTICAL = ("F_c", "F_v", "tau_os")
 """The parameters whose statistical standard error one noisy simulation predicts (module docstring of
 :mod:`~wbfriction.excite.predict_arm`)."""

@@ -240,3 +240,15 @@ def test_injected_friction_fast_path_equals_the_model(seed):
     qd = rng.normal(0, 2, 5)
     expected = np.array([p.torque(v) for p, v in zip(params.values(), qd)])
     np.testing.assert_allclose(injected.torque(qd), expected, rtol=1e-12, atol=1e-14)
+
+
+@given(qd=st.one_of(st.floats(-10, 10), st.sampled_from([0.0, -0.0, float("nan"), 1e-300, -1e-300])),
+       F_v=st.floats(0, 2), F_c=st.floats(0, 2), tau_os=st.floats(-1, 1))
+@settings(max_examples=200, deadline=None)
+def test_one_velocity_in_floats_is_the_characteristic_bit_for_bit(qd, F_v, F_c, tau_os):
+    """``f_at`` (a simulator's physics step) gives the number ``f`` gives, to the bit (NaN for NaN)."""
+    for p in (CoulombViscousParams(F_v=F_v, F_c=F_c, tau_os=tau_os),
+              FrictionParams(F_v=F_v, F_c=F_c, S=0.3, v_s=0.05, tau_os=tau_os, a=40.0)):
+        expected = float(p.f(qd))
+        assert np.array_equal(np.float64(p.f_at(qd)), np.float64(expected), equal_nan=True)
+        assert np.signbit(p.f_at(qd)) == np.signbit(expected)

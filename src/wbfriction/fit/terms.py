@@ -420,7 +420,7 @@ class TermFit:
         """:meth:`torque` of one sample, in plain floats (a simulator's physics step): velocity [rad/s], angle
         [rad], load [N·m], temperature [°C]."""
         p, c = self.params, self.coefficients
-        f = float(p.f(qd))
+        f = p.f_at(qd)
         g = family(p.model).coulomb_sign(p, qd)
         for term in self.kept:
             if term == "load":

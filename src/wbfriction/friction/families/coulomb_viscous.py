@@ -55,6 +55,11 @@ class CoulombViscousParams(ModelParamsBase):
         """Friction characteristic ``f(qd) = F_v qd + F_c sgn(qd) + tau_os`` [N·m]."""
         return coulomb_viscous(qd, self.F_v, self.F_c, self.tau_os)
 
+    def f_at(self, qd: float) -> float:
+        """:meth:`f` of one velocity in plain floats: the same operations in the same order (bit for bit)."""
+        sign = 1.0 if qd > 0 else -1.0 if qd < 0 else qd if qd != qd else 0.0  # np.sign's: NaN stays NaN
+        return self.F_v * qd + self.F_c * sign + self.tau_os
+
     def quantities(self) -> dict[str, float]:
         """:meth:`ModelParamsBase.quantities`: no Stribeck effect (``F_s = F_c``, ``S = 0``), a sign function."""
         return {"F_v": self.F_v, "F_c": self.F_c, "F_s": self.F_c, "S": 0.0, "v_s": float("nan"),

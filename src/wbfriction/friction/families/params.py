@@ -38,6 +38,10 @@ class ModelParamsBase:
         """Friction characteristic ``f(qd)`` [N·m] (``qd`` [rad/s], any shape)."""
         raise NotImplementedError
 
+    def f_at(self, qd: float) -> float:
+        """:meth:`f` of one velocity [rad/s], in plain floats (a simulator's physics step): the same number."""
+        return float(self.f(qd))
+
     def quantities(self) -> dict[str, float]:
         """Every built-in family's parameters in this family's terms (:data:`ALL_PARAM_NAMES`): what a fit of any
         family is compared with (:meth:`values_in`), what the exports read (the static level ``F_s``, the Coulomb
