@@ -186,7 +186,13 @@ def test_each_swing_joint_friction_recovered_within_two_percent(go2, excitations
     errors = {}
     for joint in excitation.joints:
         fit = fits[joint]
-        assert fit.params is not None and fit.n_samples > 0.98 * len(log), joint  # three feet: every sample
+        assert fit.params is not None, joint
+        # three feet: every sample is estimated, and fitted but where the joint may stick (the fit's rule near zero
+        # speed, :func:`~wbfriction.fit.solve.stuck_rows`: 0.7-2.6 % of the samples, as the design's series dwell
+        # near a reversal; which design the optimiser finds moves with the processor's and BLAS's rounding)
+        valid = int(est.valid[:, est.joints.index(joint)].sum())
+        assert valid > 0.99 * len(log) and fit.n_screened == 0, joint
+        assert fit.n_samples + fit.n_stuck == valid and fit.n_stuck < 0.05 * len(log), (joint, fit.n_stuck)
         for name in ("F_c", "F_v"):
             want, got = getattr(truth[joint], name), getattr(fit.params, name)
             errors[joint, name] = 100 * abs(got / want - 1)
