@@ -15,7 +15,6 @@ import pytest
 import wbfriction
 from wbfriction.actuator import identify_actuators
 from wbfriction.actuator.excitation import JointMotion
-from wbfriction.actuator.law_check import GAIN_FACTOR
 from wbfriction.actuator.solve import sandwich
 from wbfriction.fit.status import MIN_SPEED
 from wbfriction.logs.log import log_from_table
@@ -93,17 +92,20 @@ def test_drivers_later_than_the_search_leave_every_value_at_bound(go2):
     assert len(result.warnings) == 1 and "--max-delay" in result.warnings[0]
 
 
-def test_a_toml_whose_gains_are_twice_the_drivers_is_named(go2):
+def test_a_toml_whose_gains_are_twice_the_drivers_is_named_and_its_error_measured(go2):
     """The TOML's kp 50 against the drivers' 25: the law's scale the log shows is the truth's (25/50, the damping's
-    share aside), every joint beyond the factor, named in one line; no value ``ok`` (the issue: 34 ``ok`` and off)."""
+    share aside), named in one line with the causes the log cannot tell apart (gains, masses); no factor decides
+    anything: how far the values move with the scale freed is in their standard errors, so no value is ``ok`` more
+    than three standard errors off the truth (before: every value demoted at a factor 1.6 chosen between two
+    robots)."""
     sim = simulated(go2)
     result = identified(go2, sim.table, kp=np.full(12, 50.0))
     assert result.law is not None
     assert np.all(np.abs(result.law.gain - 0.5) < 0.1)  # the truth: half the TOML's stiffness
-    assert np.all(result.law.gain < 1.0 / GAIN_FACTOR)
-    assert ok_values(result) == [] and result.delay.status != "ok"
+    assert np.all(result.law.moved[:12] > 0)  # every joint's scale off: its armature's move measured
+    assert off_truth(sim, result) == []
     lines = [w for w in result.warnings if "gains" in w]
-    assert len(lines) == 1 and "not the drivers'" in lines[0] and "\n" not in lines[0]
+    assert len(lines) == 1 and "cannot tell which" in lines[0] and "masses" in lines[0] and "\n" not in lines[0]
 
 
 def test_a_toml_whose_delay_is_not_the_drivers_is_named(go2):

@@ -109,18 +109,30 @@ def test_setpoints_without_gains_are_refused(tmp_path, robot):
         log_from_table(table(robot), other, "hung.parquet")
 
 
-def test_the_identified_toml_keeps_the_rest_and_writes_what_is_determined(tmp_path):
+def test_the_identified_toml_keeps_the_rest_and_writes_what_was_chosen(tmp_path):
     from wbfriction.actuator.identification import ActuatorIdentification, Identified, JointActuator
+    from wbfriction.actuator.written import WrittenChoice, WrittenValue
     from wbfriction.pipeline.actuator_step import actuator_config
 
     path = robot_toml(tmp_path, "[armature]   # given\nFL_hip_joint = 0.001\nFR_hip_joint = 0.002\n")
     ok, bound = Identified(0.011, 1e-4, 1e-4), Identified(0.0, 1e-3, 1e-3, "at bound", "armature at bound")
     joints = (JointActuator("FL_hip_joint", ok, ok, ok, Identified(0.02, 1e-3, 1e-3), 0.0, 0.0, 1),
               JointActuator("FR_hip_joint", bound, ok, ok, Identified(0.3, 1e-3, 1e-3, "at bound"), 0.0, 0.0, 1))
-    result = ActuatorIdentification(joints, Identified(0.012, 1e-4, 1e-4), T, 0.04, np.empty((0, 2)), {}, {}, "x")
+    nan2 = (np.nan, np.nan)
+
+    def chosen(kind: str, joint: str, identified: float, given: float, source: str) -> WrittenValue:
+        return WrittenValue(kind, joint, identified, given, source, nan2, np.nan, np.inf, "")  # type: ignore[arg-type]
+
+    choice = WrittenChoice(chosen("delay", "", 0.012, 0.0, "identified"),
+                           (chosen("armature", "FL_hip_joint", 0.011, 0.001, "identified"),
+                            chosen("offset", "FL_hip_joint", 0.02, 0.0, "identified"),
+                            chosen("armature", "FR_hip_joint", 0.0, 0.002, "given"),
+                            chosen("offset", "FR_hip_joint", 0.3, 0.0, "given")), 10)
+    result = ActuatorIdentification(joints, Identified(0.012, 1e-4, 1e-4), T, 0.04, np.empty((0, 2)), {}, {}, "x",
+                                    written=choice)
     text = open(path).read()
     written = tomllib.loads(actuator_config(text, tmp_path, tmp_path / "go2.urdf", tmp_path / "out.toml", result))
-    assert written["armature"] == {"FL_hip_joint": 0.011, "FR_hip_joint": 0.002}  # the bound's is not written
+    assert written["armature"] == {"FL_hip_joint": 0.011, "FR_hip_joint": 0.002}  # the TOML's kept where chosen
     assert written["encoder_offset"] == {"FL_hip_joint": 0.02}
     assert written["pd"] == {"kp": 20.0, "kd": 0.4, "delay": 0.012}  # what the delay holds back: not decided here
     assert written["name"] == "hung" and written["floating_base"] is False

@@ -9,14 +9,16 @@ identification on the log's first windows predicts its last ``holdout`` share (:
 
 What the log determines (issue 63): a joint that hardly moved leaves its values ``not excited``, one that moved one
 way its F_c and offset ``weak`` (:mod:`wbfriction.actuator.excitation`); a delay at the search's upper bound leaves
-every value fitted under it ``at bound``; a robot TOML whose PD gains the log contradicts leaves every value fitted
-under them ``weak`` (:mod:`wbfriction.actuator.law_check`, which also names a TOML's delay that is not the one
-found). Standard errors are the autocorrelation-consistent sandwich's (:func:`~wbfriction.actuator.solve.sandwich`)
-with how far each value moves under a Coulomb term :data:`~wbfriction.actuator.options.STEEPER` times as steep
-(the delay searched again) added in quadrature, a model error the residuals do not show, and never below the
-Cramér-Rao bound: :attr:`Identified.se` is ``max(se, crb)``. Stamps with receive-time jitter
-are taken on the regularised clock the log's reader found (:mod:`wbfriction.logs.clock`), before the delay is
-searched.
+every value fitted under it ``at bound``. Where the robot TOML's PD law and the URDF's dynamics disagree (a joint's
+scale of the law off 1 beyond three standard errors: :mod:`wbfriction.actuator.law_check`, which names it, and a TOML
+delay that is not the one found), how far that joint's values move with the scale freed is added to their standard
+errors in quadrature. What ``--config-output`` writes is chosen on held-out blocks of the log
+(:mod:`wbfriction.actuator.written`), not by the statuses. Standard errors are the autocorrelation-consistent
+sandwich's (:func:`~wbfriction.actuator.solve.sandwich`) with how far each value moves under a Coulomb term
+:data:`~wbfriction.actuator.options.STEEPER` times as steep (the delay searched again) added in quadrature, a model
+error the residuals do not show, and never below the Cramér-Rao bound: :attr:`Identified.se` is ``max(se, crb)``.
+Stamps with receive-time jitter are taken on the regularised clock the log's reader found
+(:mod:`wbfriction.logs.clock`), before the delay is searched.
 
 What the delay holds back (``delayed``: the set-points, or the whole torque) is chosen by the balance: the one that
 closes it best. On steady motion the two differ by a viscous torque ``kp delay qd``
@@ -41,12 +43,14 @@ from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from wbfriction.actuator.excitation import JointMotion, joint_motion
 from wbfriction.actuator.law_check import LawCheck, check_law
 from wbfriction.actuator.options import ActuatorOptions
 from wbfriction.actuator.rows import BalanceRows, balance_rows, pd_joints
 from wbfriction.actuator.solve import KINDS, DelaySearch, Design, Solution, design, hac_lags, search_delay, solve
+from wbfriction.actuator.written import WrittenChoice, choose_written
 from wbfriction.exceptions import InputError
 from wbfriction.fit.regression import held_out_gain
 from wbfriction.fit.selection import GAIN_Z
@@ -149,8 +153,12 @@ class ActuatorIdentification:
         warnings: what the identification found wrong in its input, one line each (the PD law's mismatches).
         delayed_known: whether the log tells what the delay holds back (module docstring; True where only one was
             tried).
+        written: what ``--config-output`` writes, each value chosen against the robot TOML's on held-out blocks of
+            the log (:mod:`wbfriction.actuator.written`); None for a result built without it.
         residuals: (W, n) each window's balance residual over the noise its sensors predict (NaN where not used),
             for comparing identifications of one log; not written.
+        balance, weight: the balance solved (its last pass) and its joints' weights, for :attr:`written`; not
+            written.
     """
 
     joints: tuple[JointActuator, ...]
@@ -168,7 +176,10 @@ class ActuatorIdentification:
     law: LawCheck | None = None
     warnings: tuple[str, ...] = ()
     delayed_known: bool = True
+    written: WrittenChoice | None = None
     residuals: np.ndarray | None = field(default=None, repr=False, compare=False)
+    balance: BalanceRows | None = field(default=None, repr=False, compare=False)
+    weight: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def joint(self, name: str) -> JointActuator:
         return next(j for j in self.joints if j.joint == name)
@@ -189,7 +200,8 @@ class ActuatorIdentification:
                            | {"rms": j.rms, "held_out_rms": _finite(j.held_out_rms), "rows": j.rows,
                               "position_noise": self.position_noise[j.joint],
                               "velocity_noise": self.velocity_noise[j.joint]} for j in self.joints},
-                "delay_profile": self.profile.tolist()}
+                "delay_profile": self.profile.tolist(),
+                "written": None if self.written is None else self.written.to_dict()}
 
 
 def _finite(x: float) -> float | None:
@@ -222,8 +234,6 @@ def identify_actuators(robot: Robot, log: Log, options: ActuatorOptions = Actuat
     velocities = [options.velocity] if options.velocity != "auto" else (
         ["positions", "logged"] if log.qd_logged is not None else ["positions"])
     held = [options.delayed] if options.delayed != "auto" else ["setpoints", "torque"]
-    from threadpoolctl import threadpool_limits
-
     with threadpool_limits(1, user_api="blas"):  # small dense problems: threads cost more than they give
         runs = [_identify(robot, log, replace(options, velocity=v, delayed=h)) for v in velocities for h in held]
     closes = [float(np.sum([j.rms**2 for j in r.joints])) for r in runs]  # the same balance, closed better or worse
@@ -244,7 +254,33 @@ def identify_actuators(robot: Robot, log: Log, options: ActuatorOptions = Actuat
                     f"the sensors' noise higher by {gain:.3g} ± {se:.2g}, within {GAIN_Z:g} standard errors): the log "
                     "does not tell what the delay holds back")
             best = structure_widened(best, others[0])
-    return replace(best, velocity_reason=why, clock=log.clock.reason if log.clock is not None else "")
+    return replace(best, velocity_reason=why, clock=log.clock.reason if log.clock is not None else "",
+                   written=written_choice(robot, log, best))
+
+
+def written_choice(robot: Robot, log: Log, result: ActuatorIdentification) -> WrittenChoice | None:
+    """What ``--config-output`` writes for ``result`` (:func:`~wbfriction.actuator.written.choose_written`): each
+    value against the robot TOML's on held-out blocks of the log; None without the balance."""
+    rows, weight = result.balance, result.weight
+    if rows is None or weight is None:
+        return None
+    assert robot.pd is not None
+    index = pd_joints(robot, log)
+    n = len(rows.joints)
+    offsets = all(j.offset is not None for j in result.joints)
+    values = [[j.parameters()[kind] for j in result.joints] for kind in (KINDS if offsets else KINDS[:3])]
+    x = np.array([p.value for column in values for p in column])
+    se = np.array([p.se for column in values for p in column])
+    moved = [m.excited for m in joint_motion(rows)]  # an at-bound status may hide a joint that did not move
+    excited = {kind: np.array([moved[k] and kind in j.parameters() and j.parameters()[kind].status != "not excited"
+                               for k, j in enumerate(result.joints)]) for kind in ("armature", "offset")}
+    top = (rows.max_steps + 1) * rows.period
+    beyond = result.delay.status == "at bound" and result.delay.value >= top - 1e-12
+    with threadpool_limits(1, user_api="blas"):
+        return choose_written(rows, weight, result.options, offsets,
+                              robot.model.armature[robot.act_v_index[index]][:n], robot.offset_vector[index],
+                              robot.pd.delay, x, se, result.delay.value, result.delay.se, excited, beyond,
+                              result.delay.status != "not excited")
 
 
 def structure_gain(best: ActuatorIdentification, other: ActuatorIdentification) -> tuple[float, float]:
@@ -320,12 +356,14 @@ def _identify(robot: Robot, log: Log, options: ActuatorOptions) -> ActuatorIdent
     assert robot.pd is not None
     motion = joint_motion(rows)
     law = check_law(rows, d, weight, delay.value, _lags(rows, options), options.delay is None, delay.se,
-                    robot.pd.delay, np.array([m.excited for m in motion]))
+                    robot.pd.delay, np.array([m.excited for m in motion]), sol.x)
+    sol = replace(sol, covariance=sol.covariance + np.diag(law.moved**2))  # the law's disagreement: law_check
     result = _result(rows, d, sol, delay, search.profile, held, log.source, options)
     e = d.rhs(rows, rows.balance(search.delay)) - d.A @ sol.x
     residuals = np.full(rows.rest.shape, np.nan)
     residuals[d.window, d.joint] = e / np.maximum(rows.sigma[d.joint], 1e-300)
-    return _verdicts(replace(result, law=law, residuals=residuals), motion, rows.max_steps)
+    return _verdicts(replace(result, law=law, residuals=residuals, balance=rows, weight=weight), motion,
+                     rows.max_steps)
 
 
 def _lags(rows: BalanceRows, options: ActuatorOptions) -> int:
@@ -439,7 +477,9 @@ def _demoted(p: Identified, status: ActuatorStatus, reason: str) -> Identified:
 def _verdicts(result: ActuatorIdentification, motion: tuple[JointMotion, ...], max_steps: int
               ) -> ActuatorIdentification:
     """The statuses of what the log does not determine (module docstring): a joint that did not move, a delay at the
-    search's upper bound, a PD law the log contradicts."""
+    search's upper bound. The PD law's check names a disagreement (:attr:`ActuatorIdentification.warnings`) and
+    changes no status: it cannot tell the drivers' gains from the URDF's masses (:mod:`wbfriction.actuator.
+    law_check`)."""
     d = result.delay
     top = (max_steps + 1) * result.period
     under = (f"fitted under a delay at the search's bound ({d.value * 1e3:.3g} ms; --max-delay)"
@@ -447,7 +487,6 @@ def _verdicts(result: ActuatorIdentification, motion: tuple[JointMotion, ...], m
     law = None if under else result.law  # a law checked under a wrong delay says nothing of the gains
     joints = []
     for j, m in zip(result.joints, motion):
-        gains = law.gain_reason(j.joint) if law is not None else ""
         values = {}
         for kind, p in j.parameters().items():
             by_motion = m.verdict(kind)
@@ -455,12 +494,8 @@ def _verdicts(result: ActuatorIdentification, motion: tuple[JointMotion, ...], m
                 p = _demoted(p, by_motion[0], by_motion[1])  # type: ignore[arg-type]
             if under:
                 p = _demoted(p, "at bound", f"{kind}: {under}")
-            if gains:
-                p = _demoted(p, "weak", f"{kind}: {gains}")
             values[kind] = p
         joints.append(j.with_values(values))
-    if law is not None and law.gains_differ:
-        d = _demoted(d, "weak", "found under the TOML's PD gains, which the log contradicts")
     lines = law.lines() if law is not None else []
     if under:
         lines.insert(0, f"the drivers' delay is beyond the search ({d.value * 1e3:.3g} ms, its bound): raise "

@@ -64,8 +64,9 @@ def print_actuators(result: ActuatorIdentification, wide: bool = False) -> None:
     reasons = [f"{j.joint}: {p.reason}" for j in result.joints for p in j.parameters().values() if p.reason]
     for line in reasons:
         out.print(escape(line), highlight=False)
-    from wbfriction.pipeline.actuator_step import WRITTEN
-    kept = [f"{j.joint} {kind}" for j in result.joints for kind, p in j.parameters().items()
-            if kind in ("armature", "offset") and p.status not in WRITTEN]
-    if kept:
-        out.print(escape(f"not written to --config-output (the TOML's own kept): {', '.join(kept)}"), highlight=False)
+    if result.written is not None:
+        kept = [f"{v.joint} {v.kind}" if v.joint else v.kind for v in result.written.kept]
+        if kept:
+            out.print(escape("the TOML's own kept by --config-output (it predicts held-out blocks of the log as well "
+                             f"or better, or the log does not determine the value): {', '.join(kept)}"),
+                      highlight=False)

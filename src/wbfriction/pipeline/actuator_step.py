@@ -18,10 +18,6 @@ from wbfriction.model.robot import Robot
 from wbfriction.pipeline.identify_step import identified_config
 from wbfriction.pipeline.paths import check_paths
 
-WRITTEN = ("ok",)
-"""The statuses whose values go into the robot's TOML: only what the log determines (issue 63: a ``weak`` value, one
-at a bound or not excited, is left as the TOML had it); ``identify`` prints which, and the JSON has every status."""
-
 
 def identify_actuator_file(robot: Robot, log: str | Path, json_output: str | Path | None = None,
                            options: ActuatorOptions = ActuatorOptions(), time_unit: TimeUnit | None = None
@@ -43,16 +39,15 @@ def identify_actuator_file(robot: Robot, log: str | Path, json_output: str | Pat
 
 
 def written_values(result: ActuatorIdentification) -> tuple[dict[str, float], dict[str, float], float | None]:
-    """The armature [kg·m²] and encoder offsets [rad] by joint, and the delay [s], whose status is one of
-    :data:`WRITTEN` (None: the delay is not). Without the delay (not ``ok``, nor given with ``--delay``) nothing is
-    written: the armatures and offsets were fitted under it, and a TOML keeping its old delay beside them would
-    mix two laws."""
-    if result.delay.status not in WRITTEN:
+    """The armature [kg·m²] and encoder offsets [rad] by joint, and the delay [s] (None: the TOML's kept), that
+    ``--config-output`` writes from the identification: each chosen against the robot TOML's own on held-out blocks
+    of the log (:attr:`~wbfriction.actuator.identification.ActuatorIdentification.written`,
+    :mod:`wbfriction.actuator.written`); nothing for a result without that choice, or whose delay lies beyond the
+    search."""
+    choice = result.written
+    if choice is None:
         return {}, {}, None
-    armature = {j.joint: j.armature.value for j in result.joints if j.armature.status in WRITTEN}
-    offsets = {j.joint: j.offset.value for j in result.joints if j.offset is not None and j.offset.status in WRITTEN}
-    delay = result.delay.value if result.delay.status in WRITTEN else None
-    return armature, offsets, delay
+    return choice.of("armature"), choice.of("offset"), choice.written_delay
 
 
 def actuator_config(text: str, source_dir: Path, urdf: Path, output: Path, result: ActuatorIdentification) -> str:
@@ -90,7 +85,7 @@ def actuator_config(text: str, source_dir: Path, urdf: Path, output: Path, resul
     offsets = {**given.get("encoder_offset", {}), **offsets}
     if offsets:
         lines += ["", "[encoder_offset]   # identified by wbfriction identify --actuator pd [rad]"]
-        lines += [f"{joint} = {value!r}" for joint, value in offsets.items()]
+        lines += [f"{joint} = {value!r}" + _status_comment(result, joint, "offset") for joint, value in offsets.items()]
     written = "\n".join(lines) + "\n"
     expected: dict[str, Any] = tomllib.loads(merged)
     if offsets:
@@ -106,6 +101,18 @@ def actuator_config(text: str, source_dir: Path, urdf: Path, output: Path, resul
         raise InputError(f"{output}: the robot's configuration could not be rewritten line by line (its [pd] or "
                          "[encoder_offset] is not a plain table): copy the values printed into it instead")
     return written
+
+
+def _status_comment(result: ActuatorIdentification, joint: str, kind: str) -> str:
+    """`` # <status>: <reason>`` of an identified value written that is not ``ok`` ("" otherwise, or where the TOML's
+    own is kept): a value written because it predicts better is not called good."""
+    choice = result.written
+    if choice is None or joint not in choice.of(kind) or joint not in [j.joint for j in result.joints]:
+        return ""
+    p = result.joint(joint).parameters().get(kind)
+    if p is None or p.status == "ok":
+        return ""
+    return f"   # {p.status}: {p.reason}; written as it predicts held-out blocks of the log better than the TOML's"
 
 
 def write_actuator_config(text: str, source_dir: Path, urdf: Path, output: str | Path,
