@@ -33,8 +33,8 @@ def dataset(name: DatasetName = typer.Argument(..., metavar="NAME",
                                                  "runs12.parquet, run3.parquet held out; ur10e: excitation.parquet, "
                                                  "joint1.parquet held out; panda: excitation.parquet; aliengo, "
                                                  "go2: train.parquet, held_out.parquet, and the peer's "
-                                                 "identification peer.toml), the robot's URDF where it is the dataset's and its "
-                                                 "configuration <robot>.toml.")) -> None:
+                                                 "identification peer.toml), the robot's URDF where it is the "
+                                                 "dataset's and its configuration <robot>.toml.")) -> None:
     """Fetch a real robot's logs and write them as wbfriction logs with the robot beside them: downloaded once
     into the user's cache, each file checked against its SHA-256, or taken from $WBFRICTION_DATA/<dataset>/ (a
     local copy, for offline machines, checked the same way). Prints the commands to run next."""

@@ -34,7 +34,7 @@ from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.families.coulomb_viscous import CoulombViscousParams
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.source import read_log
-from wbfriction.model.loading import build_robot
+from wbfriction.model.loading import build_robot, resolve_file
 from wbfriction.model.robot import Robot
 
 
@@ -51,10 +51,11 @@ def peer_robot_config(robot_toml: str | Path, peer_toml: str | Path) -> dict:
 
 
 def peer_robot(robot_toml: str | Path, peer_toml: str | Path) -> Robot:
-    """The robot with the peer's tables (:func:`peer_robot_config`)."""
+    """The robot with the peer's tables (:func:`peer_robot_config`), on the description its TOML names (beside it
+    or an installed one, :func:`~wbfriction.model.loading.resolve_file`)."""
     robot_toml = Path(robot_toml)
     config = peer_robot_config(robot_toml, peer_toml) | {"_dir": str(robot_toml.parent)}
-    return build_robot(robot_toml.parent / config["urdf"], config, str(peer_toml))
+    return build_robot(resolve_file(config["urdf"], robot_toml.parent), config, str(peer_toml))
 
 
 def peer_friction(peer: PeerActuator, joints: tuple[str, ...]) -> dict[str, CoulombViscousParams]:
