@@ -9,14 +9,14 @@ checkout), the commands the dataset prints run as a user runs them (each its own
   Mamedov et al.'s Coulomb-viscous; Panda: Gaz et al.'s sigmoid), and ``sigmas``: that deviation in the fit's own
   standard errors (honest errors put it within 3);
 * ``held-out``: the torque RMS on the held-out log (KUKA: run 3; UR10e: the shoulder pan's sweep, the other joints
-  at rest there, marked ``still``; Aliengo: the last 40 %), and ``peer``: FloBaRoID's method on run 3 (KUKA), the
-  iit-DLSLab's PACE-style parameters through the same estimate (Aliengo); for a PD-driven robot, the held-out
-  set-points replayed in MuJoCo, the joints' tracking error with ours and with the peer's parameters.
+  at rest there, marked ``still``; Aliengo, Go2: the last 40 %), and ``peer``: FloBaRoID's method on run 3 (KUKA),
+  the iit-DLSLab's PACE-style parameters through the same estimate (Aliengo, Go2); for a PD-driven robot, the
+  held-out set-points replayed in MuJoCo, the joints' tracking error with ours and with the peer's parameters.
 
 Then one line per dataset with the issue's targets: UR10e every joint within 5 %; Panda every ``ok`` joint within
-15 % and 3 standard errors; KUKA and Aliengo every joint better than the peer.
+15 % and 3 standard errors; KUKA and Aliengo every joint better than the peer (the Go2 is scored the same way).
 
-    python benchmarks/bench_real.py [--datasets kuka-lwr4,ur10e,panda] [--keep DIR]
+    python benchmarks/bench_real.py [--datasets kuka-lwr4,ur10e,panda,aliengo,go2] [--keep DIR]
 """
 
 from __future__ import annotations

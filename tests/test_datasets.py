@@ -70,7 +70,7 @@ def local_copy(monkeypatch):
 
 
 def test_the_command_names_every_registered_dataset():
-    assert typing.get_args(DatasetName) == tuple(datasets.DATASETS) == ("aliengo", "kuka-lwr4", "panda", "ur10e")
+    assert typing.get_args(DatasetName) == tuple(datasets.DATASETS) == ("aliengo", "go2", "kuka-lwr4", "panda", "ur10e")
     with pytest.raises(InputError, match="unknown dataset 'kuka'.*kuka-lwr4"):
         datasets.dataset("kuka")
 

@@ -60,3 +60,18 @@ def test_the_panda_row_scores_the_odd_part(tmp_path):
     assert len(run.joints) == 7
     for j in run.joints:
         assert math.isfinite(j.curve_error) and j.status and not math.isfinite(j.held_out)
+
+
+@needs_data("unitree_go2")
+def test_the_go2_row_scores_the_peer_as_the_aliengos(tmp_path):
+    """The hung Go2 through the Aliengo's route and scoring: every joint's held-out torque beside the peer's (its
+    PACE parameters through the same estimate), and the held-out rollouts of ours, the peer's, ours refined on the
+    training log and on the whole log (the peer's footing), all finite and in the range of a tracking error [rad]."""
+    run = rows("go2", tmp_path)
+    assert [j.joint for j in run.joints] == [f"{leg}_{part}_joint" for leg in ("FL", "FR", "RL", "RR")
+                                             for part in ("hip", "thigh", "calf")]
+    for j in run.joints:
+        assert math.isfinite(j.held_out) and math.isfinite(j.peer) and j.held_out_moved and j.status
+        for rms in (j.rollout, j.peer_rollout, j.refined_rollout, j.whole_rollout):
+            assert 0.0 < rms < 0.1, (j.joint, rms)
+    assert summarise(run, math.inf).peers == 12

@@ -68,7 +68,14 @@ def _quiet_stderr() -> Iterator[None]:
         os.close(devnull)
 
 
-def _resolve(spec: str, base_dir: Path) -> Path:
+def resolve_file(spec: str, base_dir: Path) -> Path:
+    """The file a robot TOML's ``urdf``, ``mjcf`` or ``srdf`` names: ``example-robot-data:<path>`` in the installed
+    package (:func:`example_robot_data_dir`), ``wbfriction:<name>`` a URDF this package generates
+    (``wbfriction:toro``), else a path (``~`` expanded; relative to ``base_dir``, the TOML's folder).
+
+    Raises:
+        InputError: an unknown generated URDF; example-robot-data not installed.
+    """
     if spec.startswith(_ERD_PREFIX):
         return example_robot_data_dir() / spec[len(_ERD_PREFIX):]
     if spec.startswith(_GENERATED):
@@ -414,7 +421,7 @@ def _reference_configuration(model: pin.Model, config: dict, actuated: list[str]
     q_ref = None
     srdf = config.get("srdf")
     if srdf:
-        srdf_path = _resolve(srdf, Path(config.get("_dir", ".")))
+        srdf_path = resolve_file(srdf, Path(config.get("_dir", ".")))
         pin.loadReferenceConfigurations(model, str(srdf_path), False)
         ref = config.get("reference_configuration")
         if ref is not None and ref in model.referenceConfigurations:
@@ -478,7 +485,7 @@ def load_robot(name: str | None = "talos", *, urdf: str | Path | None = None,
                 raise InputError(f"{cfg_path}: no 'urdf' in the robot TOML: give the robot's --urdf (or its "
                                  "'mjcf' or --mjcf)")
             model_format = "mjcf" if named[0] == "mjcf" else "urdf"
-            given = _resolve(cfg[named[0]], cfg_path.parent)
+            given = resolve_file(cfg[named[0]], cfg_path.parent)
         return build_robot(Path(given), cfg, source=str(cfg_path), model_format=model_format)
     if name not in BUILTIN_ROBOTS:
         raise InputError(f"unknown robot '{name}': built-in robots are {', '.join(BUILTIN_ROBOTS)}; "
@@ -487,7 +494,7 @@ def load_robot(name: str | None = "talos", *, urdf: str | Path | None = None,
     cfg = tomllib.loads(text)  # the package's own file
     if given is not None:  # the built-in robot's configuration on another model of it (identified inertias)
         return build_robot(Path(given), cfg, source=f"built-in robot '{name}' on {given}", model_format=model_format)
-    return build_robot(_resolve(cfg["urdf"], Path(".")), cfg, source=f"built-in robot '{name}'")
+    return build_robot(resolve_file(cfg["urdf"], Path(".")), cfg, source=f"built-in robot '{name}'")
 
 
 @dataclass(frozen=True)

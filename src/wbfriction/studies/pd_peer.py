@@ -1,16 +1,16 @@
 """A PD-driven robot's peer identification scored as wbfriction's is (issue 55): the held-out torque its parameters
 predict, through the same estimate and the same prediction.
 
-The real Aliengo's peer (iit-DLSLab, PACE-style: :class:`~wbfriction.datasets.aliengo.PeerActuator`) gives an
-armature, an encoder offset, a viscous and a static friction per joint and one delay. Its robot is the dataset's
-``aliengo.toml`` with the peer's tables (``peer.toml``, written by ``wbfriction dataset aliengo``: its delay holding
-back the whole torque, as PACE's actuator does); its friction ``f(qd) = F_v qd + F_s sgn(qd)`` (Isaac Lab's joint
-friction: a static level, equal to the dynamic one in their assets, and a viscous coefficient; a simulator's Coulomb
-friction is a step). The held-out log is estimated with that robot as the route estimates it with the one
-identified (:func:`~wbfriction.friction.estimate.estimate_log`, the momentum route, as the dataset's commands take),
-and the peer's friction predicts its torque (:func:`~wbfriction.fit.predict.predict_torques`): the RMS of measured
-less predicted, per joint, beside wbfriction's (:func:`peer_held_out`); and the same log's set-points replayed on
-the MJCF wbfriction exported and on the peer's parameters as PACE simulates them, the joints' tracking error
+The real Aliengo's and Go2's peer (iit-DLSLab, PACE-style: :class:`~wbfriction.datasets.pace_peer.PeerActuator`) gives
+an armature, an encoder offset, a viscous and a Coulomb friction per joint and one delay. Its robot is the dataset's
+``<robot>.toml`` with the peer's tables (``peer.toml``, written by ``wbfriction dataset aliengo`` or ``go2``: its delay
+holding back the whole torque, as PACE's actuator does); its friction ``f(qd) = F_v qd + F_s sgn(qd)`` (Isaac Lab's
+joint friction: a static level, equal to the dynamic one in their assets, and a viscous coefficient; a simulator's
+Coulomb friction is a step). The held-out log is estimated with that robot as the route estimates it with the one
+identified (:func:`~wbfriction.friction.estimate.estimate_log`, the momentum route, as the dataset's commands take), and
+the peer's friction predicts its torque (:func:`~wbfriction.fit.predict.predict_torques`): the RMS of measured less
+predicted, per joint, beside wbfriction's (:func:`peer_held_out`); and the same log's set-points replayed on the MJCF
+wbfriction exported and on the peer's parameters as PACE simulates them, the joints' tracking error
 (:func:`peer_rollouts`).
 
 **The peer's footing.** The peer's parameters were fitted on the whole log: PACE's ``my_fit.py`` in the peer's
@@ -28,13 +28,13 @@ from pathlib import Path
 
 import pyarrow as pa
 
-from wbfriction.datasets.aliengo import PeerActuator
+from wbfriction.datasets.pace_peer import PeerActuator
 from wbfriction.fit.predict import predict_torques
 from wbfriction.friction.estimate import estimate_log
 from wbfriction.friction.families.coulomb_viscous import CoulombViscousParams
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.logs.source import read_log
-from wbfriction.model.loading import build_robot
+from wbfriction.model.loading import build_robot, resolve_file
 from wbfriction.model.robot import Robot
 
 
@@ -51,15 +51,16 @@ def peer_robot_config(robot_toml: str | Path, peer_toml: str | Path) -> dict:
 
 
 def peer_robot(robot_toml: str | Path, peer_toml: str | Path) -> Robot:
-    """The robot with the peer's tables (:func:`peer_robot_config`)."""
+    """The robot with the peer's tables (:func:`peer_robot_config`), on the description its TOML names (beside it
+    or an installed one, :func:`~wbfriction.model.loading.resolve_file`)."""
     robot_toml = Path(robot_toml)
     config = peer_robot_config(robot_toml, peer_toml) | {"_dir": str(robot_toml.parent)}
-    return build_robot(robot_toml.parent / config["urdf"], config, str(peer_toml))
+    return build_robot(resolve_file(config["urdf"], robot_toml.parent), config, str(peer_toml))
 
 
 def peer_friction(peer: PeerActuator, joints: tuple[str, ...]) -> dict[str, CoulombViscousParams]:
     """The peer's friction per joint (module docstring)."""
-    return {j: CoulombViscousParams(F_v=peer.viscous_friction[j], F_c=peer.static_friction[j]) for j in joints}
+    return {j: CoulombViscousParams(F_v=peer.viscous_friction[j], F_c=peer.coulomb_friction[j]) for j in joints}
 
 
 def peer_held_out(robot_toml: Path, peer_toml: Path, peer: PeerActuator, held_out: Path) -> dict[str, float]:

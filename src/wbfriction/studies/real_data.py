@@ -16,7 +16,8 @@ friction table of ``predict``) and scores every joint (:class:`JointScore`):
   are honest about what the data determine lies within 3 (:func:`curve_scores`: a fit with terms beyond velocity at
   each sample's load and temperature);
 * on the held-out log, the torque RMS of the model fitted (:func:`~wbfriction.pipeline.predict_step.predict_file`)
-  against the peer's where it is known (KUKA: FloBaRoID's method).
+  against the peer's where it is known (KUKA: FloBaRoID's method; the hung Aliengo and Go2: the iit-DLSLab's PACE
+  parameters through the same estimate, and MuJoCo rollouts of the held-out set-points, :func:`peer_scores`).
 """
 
 from __future__ import annotations
@@ -187,7 +188,7 @@ def score(name: str, outs: Outputs, config: Path | None = None) -> tuple[JointSc
     peers: dict[str, float] = {}
     rollouts: dict[str, tuple[float, ...]] = {}
     if isinstance(ref, PeerParameters) and config is not None:
-        peers, rollouts = peer_scores(config, outs)
+        peers, rollouts = peer_scores(name, config, outs)
     fits = read_params(outs.params)
     est = read_friction_file(outs.friction)
     prediction = held = None
@@ -257,19 +258,29 @@ def run_dataset(name: str, folder: str | Path, python: str = sys.executable,
     return DatasetRun(name, (convert, *timed), score(name, outputs(commands, folder), written.config))
 
 
-def peer_scores(config: Path, outs: Outputs) -> tuple[dict[str, float], dict[str, tuple[float, ...]]]:
-    """The held-out torque RMS per joint [N·m] of the peer whose parameters lie beside the robot's TOML ``config``
-    (``peer.toml``, the held-out log ``held_out.parquet``; the one such dataset, the Aliengo's, reads its peer's
-    friction from its fetched file), and per joint the held-out rollouts' tracking error [rad] of the MJCF the route
-    exported, the peer's, the route's refined MJCF and the export refined on the whole log as the peer was fitted
-    (the last two NaN without a route that refines) (:mod:`wbfriction.studies.pd_peer`; none without the route's
-    identified TOML and MJCF)."""
+def peer_scores(name: str, config: Path, outs: Outputs) -> tuple[dict[str, float], dict[str, tuple[float, ...]]]:
+    """The held-out torque RMS per joint [N·m] of the peer of the dataset ``name`` (a
+    :class:`~wbfriction.datasets.hung_quadruped.HungQuadrupedDataset`: the Aliengo, the Go2), whose parameters lie
+    beside the robot's TOML ``config`` (``peer.toml``, the held-out log ``held_out.parquet``; its friction read from the
+    dataset's fetched file, :meth:`~wbfriction.datasets.hung_quadruped.HungQuadrupedDataset.peer`), and per joint the
+    held-out rollouts' tracking error [rad] of the MJCF the route exported, the peer's, the route's refined MJCF and the
+    export refined on the whole log as the peer was fitted (the last two NaN without a route that refines)
+    (:mod:`wbfriction.studies.pd_peer`; none without the route's identified TOML and MJCF).
+
+    Raises:
+        InputError: a dataset without such a peer (not a hung quadruped's); what reading the peer raises.
+    """
     import tempfile
 
-    from wbfriction.datasets.aliengo import aliengo_peer
+    from wbfriction.datasets import dataset
+    from wbfriction.datasets.hung_quadruped import HungQuadrupedDataset
+    from wbfriction.exceptions import InputError
     from wbfriction.studies.pd_peer import peer_held_out, peer_rollouts, refine_on_whole_log
 
-    folder, peer = config.parent, aliengo_peer()
+    source = dataset(name)
+    if not isinstance(source, HungQuadrupedDataset):
+        raise InputError(f"dataset '{name}': its reference is a peer's parameters, but it has no peer's file to read")
+    folder, peer = config.parent, source.peer()
     held = peer_held_out(config, folder / "peer.toml", peer, folder / "held_out.parquet")
     if outs.identified is None or outs.mjcf is None:
         return held, {}
