@@ -32,6 +32,8 @@ NUMERICAL = "numerical: a size, batch, grid or pass count of a computation, no v
 FORMAT = "a file format's or an export target's convention"
 PHYSICS = "a mathematical or unit constant"
 EXCLUDED: dict[str, str] = {
+    # actuator
+    "actuator.written.WRITABLE": NAMES + " (the per-joint quantities a robot TOML holds)",
     # fit
     "fit.bound.BATCH": NUMERICAL + " (the torque noise's batch means)",
     "fit.options.MODEL_CHOICES": NAMES + " (the families, simplest first: their parameter count)",
