@@ -11,7 +11,9 @@ checkout), the commands the dataset prints run as a user runs them (each its own
 * ``held-out``: the torque RMS on the held-out log (KUKA: run 3; UR10e: the shoulder pan's sweep, the other joints
   at rest there, marked ``still``; Aliengo, Go2: the last 40 %), and ``peer``: FloBaRoID's method on run 3 (KUKA),
   the iit-DLSLab's PACE-style parameters through the same estimate (Aliengo, Go2); for a PD-driven robot, the
-  held-out set-points replayed in MuJoCo, the joints' tracking error with ours and with the peer's parameters.
+  held-out set-points replayed in MuJoCo, the joints' tracking error with ours and with the peer's parameters; and
+  the held-out torque through the same route with the robot TOML as given (the identified TOML must do at least as
+  well on every joint) and with the route run on the whole log, as the peer was fitted.
 
 Then one line per dataset with the issue's targets: UR10e every joint within 5 %; Panda every ``ok`` joint within
 15 % and 3 standard errors; KUKA and Aliengo every joint better than the peer (the Go2 is scored the same way).
@@ -80,6 +82,33 @@ def rollouts(runs: list[DatasetRun]) -> str:
     return "\n".join(lines) if rows else ""
 
 
+HELD_OUT = (("held_out", "ours"), ("given_held_out", "the given TOML"),
+            ("whole_held_out", "ours, on the whole log (the peer's footing)"), ("peer", "peer"))
+
+
+def pd_held_out(runs: list[DatasetRun]) -> str:
+    """The PD-driven robots' held-out torque RMS [N·m]: the route's (identified TOML), the same route with the TOML as
+    given, the route run on the whole log as the peer was fitted, and the peer's; the means, on how many joints the
+    identified TOML is at most the given one's, and on how many the whole log's is at most the peer's."""
+    rows = [(run.name, j) for run in runs for j in run.joints if math.isfinite(j.given_held_out)]
+    if not rows:
+        return ""
+    lines = ["| dataset | joint | " + " | ".join(f"{title} [N·m]" for _, title in HELD_OUT) + " |",
+             "|---|---|" + "---|" * len(HELD_OUT)]
+    lines += [f"| {name} | {j.joint} | " + " | ".join(cell(getattr(j, k), ".3f") for k, _ in HELD_OUT) + " |"
+              for name, j in rows]
+    for run in runs:
+        scored = [j for j in run.joints if math.isfinite(j.given_held_out)]
+        if scored:
+            mean = [sum(getattr(j, k) for j in scored) / len(scored) for k, _ in HELD_OUT]
+            lines.append(f"| {run.name} | mean | " + " | ".join(cell(m, ".3f") for m in mean) + " |")
+            given = sum(j.held_out <= j.given_held_out for j in scored)
+            peer = sum(j.whole_held_out <= j.peer for j in scored)
+            lines.append(f"| {run.name} | ours at most the given TOML's; whole log at most the peer's | "
+                         f"{given} of {len(scored)} | | {peer} of {len(scored)} | |")
+    return "\n".join(lines)
+
+
 def summary(runs: list[DatasetRun]) -> str:
     lines = ["| dataset | ok | ok within target | ok within 3 SE | worst curve | better than peer | time [s] |",
              "|---|---|---|---|---|---|---|"]
@@ -113,9 +142,10 @@ def main() -> None:
     print(table(runs))
     print()
     print(summary(runs))
-    if rollouts(runs):
-        print()
-        print(rollouts(runs))
+    for extra in (pd_held_out(runs), rollouts(runs)):
+        if extra:
+            print()
+            print(extra)
 
 
 if __name__ == "__main__":

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import pyarrow as pa
 
 from wbfriction.datasets import reference, write_dataset
 from wbfriction.datasets.reference import HeldOutRms, PeerParameters, Reference
@@ -72,6 +73,10 @@ class JointScore:
         refined_rollout: the same with the route's MJCF refined on the training log (``wbfriction refine``) [rad].
         whole_rollout: the same with the route's MJCF refined on the whole log, the peer's training data (the peer's
             footing: :func:`~wbfriction.studies.pd_peer.refine_on_whole_log`) [rad].
+        given_held_out: a PD-driven robot's held-out torque RMS [N·m] through the same route with the robot TOML as
+            the dataset gave it, no identification (what ``identify --config-output`` must beat).
+        whole_held_out: its held-out torque RMS [N·m] with the route run on the whole log (identified and fitted on
+            the training and held-out logs together, as the peer was fitted), the held-out log predicted.
     """
 
     joint: str
@@ -87,6 +92,8 @@ class JointScore:
     peer_rollout: float = float("nan")
     refined_rollout: float = float("nan")
     whole_rollout: float = float("nan")
+    given_held_out: float = float("nan")
+    whole_held_out: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -187,8 +194,10 @@ def score(name: str, outs: Outputs, config: Path | None = None) -> tuple[JointSc
     ref = reference(name)
     peers: dict[str, float] = {}
     rollouts: dict[str, tuple[float, ...]] = {}
+    footings: dict[str, tuple[float, float]] = {}
     if isinstance(ref, PeerParameters) and config is not None:
         peers, rollouts = peer_scores(name, config, outs)
+        footings = pd_footings(config, outs)
     fits = read_params(outs.params)
     est = read_friction_file(outs.friction)
     prediction = held = None
@@ -212,8 +221,9 @@ def score(name: str, outs: Outputs, config: Path | None = None) -> tuple[JointSc
             peer = ref.held_out(joint)
         peer = peers.get(joint, peer)
         ours, theirs, refined, whole = rollouts.get(joint, (float("nan"),) * 4)
+        given, whole_log = footings.get(joint, (float("nan"), float("nan")))
         out.append(JointScore(joint, verdict.status, verdict.reason, fit.model, error, sigmas, held_out, peer, moved,
-                              ours, theirs, refined, whole))
+                              ours, theirs, refined, whole, given, whole_log))
     return tuple(out)
 
 
@@ -296,6 +306,43 @@ def peer_scores(name: str, config: Path, outs: Outputs) -> tuple[dict[str, float
     nan = [float("nan")] * len(table["joint"])
     columns = [table[k] for k in ("rms.ours", "rms.peer")] + [table.get(f"rms.{k}", nan) for k in ("refined", "whole")]
     return held, {j: tuple(values) for j, *values in zip(table["joint"], *columns)}
+
+
+FOOTING_ROUTE = ("wbfriction estimate {train} --config {config} --route momentum -o {tag}_train_friction.parquet",
+                 "wbfriction fit {tag}_train_friction.parquet -o {tag}_params.json",
+                 "wbfriction estimate {held_out} --config {config} --route momentum -o {tag}_held_out_friction.parquet")
+"""The PD datasets' route after ``identify`` (the commands ``wbfriction dataset`` prints), for :func:`pd_footings`."""
+
+
+def pd_footings(config: Path, outs: Outputs) -> dict[str, tuple[float, float]]:
+    """Per joint of a hung PD-driven robot's dataset (its robot TOML ``config``, the logs ``train.parquet`` and
+    ``held_out.parquet`` beside it), the held-out torque RMS [N·m] through the dataset's route (:data:`FOOTING_ROUTE`,
+    each command its own process, in the folder of ``outs``' parameters) two more ways: with ``config`` as given (no
+    identification), and with the identification and the fit made on the whole log (``train`` then ``held_out``, one
+    log: the peer's footing) (:attr:`JointScore.given_held_out`, :attr:`JointScore.whole_held_out`).
+
+    Raises:
+        WbfrictionError: a command that failed.
+    """
+    import pyarrow.parquet as pq
+
+    from wbfriction.logs.tables import write_table
+
+    folder, data = outs.params.parent, config.parent
+    train, held_out = data / "train.parquet", data / "held_out.parquet"
+    whole = folder / "whole_log.parquet"
+    write_table(pa.concat_tables([pq.read_table(train), pq.read_table(held_out)]), whole)
+    identify = (f"wbfriction identify {whole.name} --config {shlex.quote(str(config))} --actuator pd "
+                "--config-output whole_identified.toml")
+    runs = {"given": (str(config), str(train), ()), "whole": ("whole_identified.toml", whole.name, (identify,))}
+    out: dict[str, dict[str, float]] = {}
+    for tag, (toml, fitted, first) in runs.items():
+        lines = [*first, *(c.format(train=shlex.quote(fitted), config=shlex.quote(toml), tag=tag,
+                                     held_out=shlex.quote(str(held_out))) for c in FOOTING_ROUTE)]
+        run_route(lines, folder)
+        prediction = predict_file(folder / f"{tag}_held_out_friction.parquet", folder / f"{tag}_params.json")
+        out[tag] = {j: float(r) for j, r in zip(prediction.joints, prediction.rms)}
+    return {j: (out["given"].get(j, float("nan")), out["whole"].get(j, float("nan"))) for j in out["given"]}
 
 
 @dataclass(frozen=True)
