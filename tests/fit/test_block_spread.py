@@ -65,10 +65,10 @@ def test_the_blocks_are_contiguous_and_nearly_equal():
     assert counts.max() - counts.min() <= 1
 
 
-def test_the_count_keeps_blocks_longer_than_twice_the_correlation():
+def test_the_count_keeps_blocks_longer_than_the_correlation_lag():
     assert block_count(4000, 10, 3) == BLOCKS
-    assert block_count(4000, 300, 3) == 6  # 4000 // 600
-    assert block_count(4000, 500, 3) == 0  # 4 blocks: fewer than MIN_BLOCKS
+    assert block_count(4000, 600, 3) == 6  # 4000 // 600
+    assert block_count(4000, 1000, 3) == 0  # 4 blocks: fewer than MIN_BLOCKS
     assert block_count(30, 1, 6) == 0 and MIN_BLOCKS == 5
     assert np.all(block_spread(J[:100], np.ones(100), np.ones(3, dtype=bool), lag=40) == 0.0)
 

@@ -25,8 +25,9 @@ exact for a model linear in its parameters (Coulomb-viscous), to first order for
 their status says what they are).
 
 The number of blocks: :data:`BLOCKS` (the model choice's cut, :data:`~wbfriction.fit.regression.HELD_OUT_BLOCKS`),
-fewer where a block would be shorter than twice the residuals' correlation lag (the blocks must be nearly
-independent for the formula to hold), none below :data:`MIN_BLOCKS`. With ``K`` blocks the variance estimate has
+fewer where a block would be shorter than the residuals' correlation lag (the Newey-West lag,
+:func:`~wbfriction.fit.regression.correlation_lag`: itself twice the lag where their autocorrelation falls below 5 %;
+the blocks must be nearly independent for the formula to hold), none below :data:`MIN_BLOCKS`. With ``K`` blocks the variance estimate has
 ``K - 1`` degrees of freedom: at ten blocks ±2 such standard errors cover a normal value with probability 0.92
 (Student's t with 9), and the estimate's own relative error is about ``1 / sqrt(2 (K - 1))`` (24 %): it enters the
 read error as the larger of it and the Newey-West one (:func:`statistical_error`), never alone below the latter.
@@ -53,9 +54,10 @@ def block_labels(n: int, n_blocks: int) -> np.ndarray:
 
 
 def block_count(n: int, lag: int, p: int, blocks: int = BLOCKS) -> int:
-    """How many blocks ``n`` samples are cut into: ``blocks``, fewer so that each is at least twice the residuals'
-    correlation ``lag`` [samples] long and holds more than ``p`` samples; 0 below :data:`MIN_BLOCKS`."""
-    longest = max(2 * max(lag, 1), p + 1)
+    """How many blocks ``n`` samples are cut into: ``blocks``, fewer so that each is at least the residuals'
+    correlation ``lag`` [samples] long (:func:`~wbfriction.fit.regression.correlation_lag`: twice the lag where their
+    autocorrelation falls below 5 %) and holds more than ``p`` samples; 0 below :data:`MIN_BLOCKS`."""
+    longest = max(lag, p + 1, 1)
     k = min(blocks, n // longest)
     return k if k >= MIN_BLOCKS else 0
 
