@@ -14,7 +14,8 @@ import numpy as np
 from wbfriction.exceptions import InputError
 from wbfriction.fit.options import AUTO, PASS_ROWS, SELECTION_TOLERANCE, STICK_FLOOR, FitOptions, ModelChoice
 from wbfriction.fit.ranges import FittedRanges
-from wbfriction.fit.result import FitResult, compare_routes
+from wbfriction.fit.result import ROUTE_PARAMS, FitResult, check_routes
+from wbfriction.fit.route_spread import route_spread
 from wbfriction.fit.screen import gross_outliers
 from wbfriction.fit.selection import SPREAD, fit_friction, later_stretch
 from wbfriction.fit.smoothing import smoother_half_width
@@ -182,7 +183,7 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
     With the estimate's noise record (:func:`~wbfriction.friction.noise.noise_record`), each fit corrects the model
     for its velocity's noise, leaves out the samples where its joint may stick, and carries its Cramér-Rao bound.
     With the other route's estimate (:attr:`~wbfriction.friction.estimate.FrictionEstimate.route_check`), each
-    joint's model is fitted there too and the two compared (:attr:`FitResult.route_check`, :func:`compare_routes`).
+    joint's model is fitted there too and the two compared (:attr:`FitResult.route_check`, :func:`~wbfriction.fit.result.check_routes`).
 
     Args:
         options: the model, its choice and the fit's thresholds (:class:`~wbfriction.fit.options.FitOptions`;
@@ -234,7 +235,7 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
         f.unmeasured = str(est.metadata.get("noise_unmeasured", ""))  # never ok then (issue 53)
         if check is not None and other is not None:
             other.route = check.estimation_route
-            f.route_check = compare_routes(f, other)
+            check_routes(f, other)
     if options.terms.terms:
         fits = _with_terms(fits, checked, tasks, others, est, idx, truth, targets, options,
                            None if progress is None else progress("terms", len(fits), "joints"))
@@ -262,6 +263,8 @@ def _with_terms(fits: list[FitResult], checked: Sequence[FitResult | None], task
             refit = _with_truth([names[k]], [_fit_column(task)], est.qd[:, [i]], est.tau_f[:, [i]],
                                 est.valid[:, [i]], None if truth is None else truth[:, [k]], targets)[0]
             refit.route, refit.route_check, refit.unmeasured = f.route, f.route_check, f.unmeasured
+            refit.route_spread = {} if f.route_check is None else route_spread(
+                refit.params.to_dict(), f.route_check.params, ROUTE_PARAMS) if refit.params is not None else {}
             if refit.params is None or not refit.success:  # a refit that did not converge: the fit before it
                 break
             other_task = others[k]
@@ -311,7 +314,7 @@ def _with_fallbacks(fits: list[FitResult], tasks: list[tuple], others: Sequence[
         simple.route, simple.unmeasured = fit.route, fit.unmeasured
         if checked is not None and est.route_check is not None:
             checked.route = est.route_check.estimation_route
-            simple.route_check = compare_routes(simple, checked)
+            check_routes(simple, checked)
         chosen = fit.reported().params
         if simple.params is not None and chosen is not None:  # the chosen family predicts the held-out blocks better
             theirs, mine = chosen.to_dict(), simple.params.to_dict()

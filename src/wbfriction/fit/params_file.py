@@ -4,8 +4,11 @@ The **parameters JSON** holds the fitted model per joint (:class:`~wbfriction.fi
 name (``model``: ``coulomb-viscous``, ``stribeck`` or ``thesis`` (3.5)), parameters, standard errors, their
 Cramér-Rao bounds (``crb``) and the torque noise they take (``torque_noise``), which parameters ended at a
 bound (``at_bound``), which magnitudes the data press against their floor of zero (``pressed``), how far F_c and
-F_v move between the candidate families (``model_spread``: with ``model="auto"``; the standard error a user reads
-is ``stderr`` and it in quadrature), the
+F_v move between the candidate families (``model_spread``: with ``model="auto"``), the delete-one-block jackknife's
+standard errors (``block_spread``, :mod:`~wbfriction.fit.block_spread`) and the share of the two routes' difference
+read as the estimate's bias (``route_spread``, :mod:`~wbfriction.fit.route_spread`) (the standard error a user
+reads: the larger of ``stderr`` and ``block_spread``, ``model_spread`` and ``route_spread`` in quadrature; a file
+without the last two, of an earlier version, reads back without them), the
 estimate's ``route`` and the same model on the other route (``route_check``: its parameters, standard errors, and
 those that ``disagree``), the velocity noise the model's expectation took
 (``velocity_noise``), the samples left out where the joint may stick (``stick_speed``, ``n_stuck``) and, when
@@ -108,6 +111,10 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
         d["pressed"] = {k: [clean(v), clean(se)] for k, (v, se) in fit.pressed.items()}
     if fit.model_spread:
         d["model_spread"] = {k: clean(v) for k, v in fit.model_spread.items()}
+    if fit.block_spread:
+        d["block_spread"] = {k: clean(v) for k, v in fit.block_spread.items()}
+    if fit.route_spread:
+        d["route_spread"] = {k: clean(v) for k, v in fit.route_spread.items()}
     if fit.params is not None and fit.covariance is not None:  # the curve's standard error at any speed
         d["covariance"] = [[clean(float(x)) for x in row] for row in fit.covariance]
     d["crb"] = {k: clean(v) for k, v in fit.crb.items()}
@@ -117,6 +124,8 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
         rc = fit.route_check
         d["route_check"] = {"route": rc.route, "params": rc.params,
                             "stderr": {k: clean(v) for k, v in rc.stderr.items()}, "disagree": list(rc.disagree)}
+        if rc.block_spread:
+            d["route_check"]["block_spread"] = {k: clean(v) for k, v in rc.block_spread.items()}
     d["velocity_noise"], d["stick_speed"], d["n_stuck"] = fit.velocity_noise, fit.stick_speed, fit.n_stuck
     d["pass_rows"] = clean(fit.pass_rows)  # null: every reversal that changes sign passes
     if fit.later is not None:
@@ -174,6 +183,8 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
         res.at_bound = {str(k): bool(v) for k, v in at_bound.items()}
         res.pressed = {str(k): (_number(v[0]), _number(v[1])) for k, v in (d.get("pressed") or {}).items()}
         res.model_spread = {str(k): _number(v) for k, v in (d.get("model_spread") or {}).items()}
+        res.block_spread = {str(k): _number(v) for k, v in (d.get("block_spread") or {}).items()}
+        res.route_spread = {str(k): _number(v) for k, v in (d.get("route_spread") or {}).items()}
         if d.get("selection") is not None:
             res.selection = selection_from_dict(d["selection"])
         res.crb = {str(k): _number(v) for k, v in (d.get("crb") or {}).items()}
@@ -184,7 +195,8 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
             res.route_check = RouteCheck(str(rc["route"]), None if rc.get("params") is None else
                                          {str(k): _number(v) for k, v in rc["params"].items()},
                                          {str(k): _number(v) for k, v in (rc.get("stderr") or {}).items()},
-                                         tuple(map(str, rc.get("disagree", ()))))
+                                         tuple(map(str, rc.get("disagree", ()))),
+                                         {str(k): _number(v) for k, v in (rc.get("block_spread") or {}).items()})
         res.velocity_noise = float(d.get("velocity_noise") or 0.0)  # null (not measured): none taken
         res.stick_speed = float(d.get("stick_speed") or 0.0)
         res.n_stuck = int(d.get("n_stuck", 0))

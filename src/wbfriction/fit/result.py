@@ -15,7 +15,9 @@ from numpy.typing import ArrayLike
 from wbfriction.fit.holdout import (
     PredictionCheck,
 )
+from wbfriction.fit.block_spread import statistical_error
 from wbfriction.fit.options import PASS_ROWS, SELECTION_TOLERANCE
+from wbfriction.fit.route_spread import route_spread
 from wbfriction.fit.status import HELD, FitVerdict, fit_verdict, read_error, routes_disagree
 from wbfriction.fit.terms import TermFit, term_signals
 from wbfriction.friction.estimated import FrictionEstimate
@@ -79,12 +81,15 @@ class RouteCheck:
         params: its parameters, by name (None: not fitted there).
         stderr: their standard errors.
         disagree: the parameters of :data:`ROUTE_PARAMS` on which the routes disagree (:func:`compare_routes`).
+        block_spread: their block-jackknife standard errors (:mod:`~wbfriction.fit.block_spread`; empty: not known,
+            a parameters file of an earlier version).
     """
 
     route: str
     params: dict[str, float] | None
     stderr: dict[str, float]
     disagree: tuple[str, ...] = ()
+    block_spread: dict[str, float] = field(default_factory=dict)
 
     def describe(self, fit: FitResult, names: Sequence[str] | None = None) -> str:
         """One phrase: each disagreeing parameter (``names``, default :attr:`disagree`) with both routes' values and
@@ -100,8 +105,9 @@ class RouteCheck:
 
 def compare_routes(fit: FitResult, other: FitResult) -> RouteCheck:
     """``other`` (the same joint and model on the other route's estimate) as ``fit``'s :class:`RouteCheck`: a
-    parameter of :data:`ROUTE_PARAMS` disagrees where the two values differ by more than :data:`ROUTE_Z` combined
-    standard errors and more than :data:`ROUTE_REL` of the larger."""
+    parameter of :data:`ROUTE_PARAMS` disagrees where the two values differ by more than
+    :data:`~wbfriction.fit.status.ROUTE_Z` combined statistical errors (each route's Newey-West error raised to its
+    block jackknife's) and more than :data:`~wbfriction.fit.status.ROUTE_REL` of the larger."""
     if other.params is None:
         return RouteCheck(other.route, None, {})
     theirs = other.params.to_dict()
@@ -112,9 +118,18 @@ def compare_routes(fit: FitResult, other: FitResult) -> RouteCheck:
             a, b = mine.get(n), theirs.get(n)
             if a is None or b is None:
                 continue
-            if routes_disagree(a, fit.stderr.get(n, np.inf), b, other.stderr.get(n, np.inf)):
+            if routes_disagree(a, statistical_error(fit.stderr.get(n, np.inf), fit.block_spread.get(n, 0.0)), b,
+                               statistical_error(other.stderr.get(n, np.inf), other.block_spread.get(n, 0.0))):
                 disagree.append(n)
-    return RouteCheck(other.route, theirs, dict(other.stderr), tuple(disagree))
+    return RouteCheck(other.route, theirs, dict(other.stderr), tuple(disagree), dict(other.block_spread))
+
+
+def check_routes(fit: FitResult, other: FitResult) -> None:
+    """Set ``fit``'s :attr:`~FitResult.route_check` (:func:`compare_routes` with ``other``, the same joint and model
+    on the other route's estimate) and its :attr:`~FitResult.route_spread` (:mod:`~wbfriction.fit.route_spread`)."""
+    fit.route_check = compare_routes(fit, other)
+    fit.route_spread = {} if fit.params is None else route_spread(fit.params.to_dict(), fit.route_check.params,
+                                                                  ROUTE_PARAMS)
 
 
 @dataclass
@@ -177,6 +192,13 @@ class FitResult(Generic[ParamsT]):
             the log did not tell (:func:`~wbfriction.fit.joints.delay_structure_spread`), ``kp delay`` with it in
             quadrature. The standard error a user reads (:meth:`read_stderr`) adds it in quadrature to
             :attr:`stderr`; the route check and the predictions use :attr:`stderr` (issue 63).
+        block_spread: per interior parameter, the delete-one-block jackknife's standard error over the log's time
+            blocks (:mod:`~wbfriction.fit.block_spread`): what the log shows of an error that changes over it; the
+            read error's statistical part is the larger of it and :attr:`stderr`; empty: not computed (too few
+            samples for its blocks, or a parameters file of an earlier version).
+        route_spread: per magnitude a user reads (F_c, F_v), the share of the two routes' difference
+            (:mod:`~wbfriction.fit.route_spread`, :func:`check_routes`) that the read error carries as the estimate's
+            bias; empty: no other route.
         fallback: with ``model="auto"``, where the model chosen is not ``ok``: the simplest family (the first of
             :func:`~wbfriction.friction.families.registry.families`, Coulomb-viscous) fitted on the same samples
             without terms, with its own checks (route, later stretch) and its distance to the chosen fit's F_c and F_v
@@ -216,6 +238,8 @@ class FitResult(Generic[ParamsT]):
     pressed: dict[str, tuple[float, float]] = field(default_factory=dict)
     model_spread: dict[str, float] = field(default_factory=dict)
     fallback: FitResult | None = None
+    block_spread: dict[str, float] = field(default_factory=dict)
+    route_spread: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.params is not None:
@@ -227,9 +251,11 @@ class FitResult(Generic[ParamsT]):
         return self.terms if self.terms is not None and self.terms.kept else None
 
     def read_stderr(self) -> dict[str, float]:
-        """The standard errors a user reads, per parameter: :attr:`stderr` and :attr:`model_spread` in quadrature
-        (the statistical spread and the model family's; issue 63)."""
-        return {n: read_error(se, self.model_spread.get(n, 0.0)) for n, se in self.stderr.items()}
+        """The standard errors a user reads, per parameter (:func:`~wbfriction.fit.status.read_error`): the larger of
+        :attr:`stderr` and :attr:`block_spread`, :attr:`model_spread` and :attr:`route_spread` in quadrature (the
+        statistical spread, the model family's and the routes'; issue 63)."""
+        return {n: read_error(se, self.model_spread.get(n, 0.0), self.block_spread.get(n, 0.0),
+                              self.route_spread.get(n, 0.0)) for n, se in self.stderr.items()}
 
     def reported(self) -> FitResult:
         """This fit as its numbers are shown: with terms kept (:attr:`kept_terms`), the model its status judges and
@@ -242,13 +268,17 @@ class FitResult(Generic[ParamsT]):
             return self
         names = terms.params.names
         check = terms.check
+        route_check = None if check is None else RouteCheck(
+            check.route, {n: v for n, v in check.coefficients.items() if n in names},
+            {n: v for n, v in check.stderr.items() if n in names},
+            block_spread={n: v for n, v in check.block_spread.items() if n in names})
         return replace(self, params=cast(ParamsT, terms.params),
                        stderr={n: terms.stderr[n] for n in names if n in terms.stderr},
                        at_bound={n: bool(self.at_bound.get(n)) if n in HELD else n in terms.at_bound for n in names},
-                       crb={}, covariance=None,
-                       route_check=None if check is None else RouteCheck(
-                           check.route, {n: v for n, v in check.coefficients.items() if n in names},
-                           {n: v for n, v in check.stderr.items() if n in names}))
+                       crb={}, covariance=None, route_check=route_check,
+                       block_spread={n: v for n, v in terms.block_spread.items() if n in names},
+                       route_spread={} if route_check is None else route_spread(
+                           terms.params.to_dict(), route_check.params, ROUTE_PARAMS))
 
     def dissipative(self, v: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """The model's dissipative friction at the speeds ``v`` [rad/s], ``(f(v) - f(-v)) / 2`` [N·m] (free of the

@@ -16,7 +16,9 @@ time (filtered estimates above all; :mod:`~wbfriction.fit.regression`); a parame
 in the numerical null space of J (e.g. ``v_s`` when ``S = 0``, or the Stribeck parameters when the data never
 leave the Stribeck region) gets an infinite standard error: the data cannot identify it. Where the fit carries its
 Cramér-Rao bound (:mod:`~wbfriction.fit.bound`), no standard error is below it: the covariance is scaled up to it
-(:func:`~wbfriction.fit.bound.at_least_bound`, issue 63).
+(:func:`~wbfriction.fit.bound.at_least_bound`, issue 63). Each interior parameter also gets its block spread, a
+delete-one-block jackknife over the log's time blocks (:mod:`~wbfriction.fit.block_spread`): the standard error a
+user reads is the larger of the two (:meth:`~wbfriction.fit.result.FitResult.read_stderr`).
 
 Filtered estimates (thesis 7.1) are compared with the model filtered the same way: when
 the friction went through a zero-phase smoother ``H``, the fit minimises
@@ -34,6 +36,7 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
+from wbfriction.fit.block_spread import block_spread
 from wbfriction.fit.bound import BATCH, at_least_bound, cramer_rao, torque_noise
 from wbfriction.fit.coordinates import (
     AT_BOUND_NEAR,
@@ -336,11 +339,14 @@ def fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, 
     # residuals correlated over the filter's window, or over the span of a model error;
     # standard errors of the model's own parameters (F_s, not F_s - F_c)
     cov = np.zeros((len(names), len(names)))
-    cov[np.ix_(free, free)] = parameter_covariance(model_jac(best.x)[:, free], best.fun, rows=rows,
-                                                   max_lag=correlation_lag(best.fun, rows))
+    lag, jac_free = correlation_lag(best.fun, rows), model_jac(best.x)[:, free]
+    cov[np.ix_(free, free)] = parameter_covariance(jac_free, best.fun, rows=rows, max_lag=lag)
     se = covariance_errors(cov)
     at_bound = np.zeros(len(names), dtype=bool)
     at_bound[free] = _at_bound(best.x, bounds, residual, np.isfinite(se[free]))
+    # what the log shows of an error that changes over it: the blocks' jackknife, the interior parameters stepped
+    blocks = np.zeros(len(names))
+    blocks[free] = block_spread(jac_free, best.fun, ~at_bound[free] & np.isfinite(se[free]), lag)
     free_names = np.array(names)[free]
     floors = [i for i, (name, at) in enumerate(zip(free_names, at_bound[free]))
               if at and name in ZERO_FLOOR and bounds[0][i] == 0.0]
@@ -349,7 +355,8 @@ def fit_model(model: ModelName, qd: np.ndarray, y: np.ndarray, use: np.ndarray, 
         stderr=dict(zip(names, map(float, se))), rms_residual=float(np.sqrt(np.mean(best.fun**2))),
         success=bool(best.success), message=str(best.message), model=model,
         at_bound=dict(zip(names, map(bool, at_bound))), speed=speed, covariance=cov,
-        pressed=pressed_floors(best.x, best.fun, jacobian, floors, free_names, rows))
+        pressed=pressed_floors(best.x, best.fun, jacobian, floors, free_names, rows),
+        block_spread={n: float(b) for n, b in zip(names, blocks) if b > 0})
     if noise is not None:
         sigma_tau = torque_noise(best.fun, rows, max(BATCH, 4 * (2 * smoother_half_width(smoother) + 1)))
         res.torque_noise = sigma_tau

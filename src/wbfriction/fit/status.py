@@ -15,8 +15,11 @@ status, the first that applies:
   finding (:meth:`~wbfriction.fit.result.FitResult.steps`);
 * ``routes disagree`` (issue 38): the same model fitted on the other route's estimate (the acceleration
   route's for the momentum route, and the other way round) differs on F_c or F_v by more than
-  :data:`ROUTE_Z` combined standard errors and :data:`ROUTE_REL`
-  of the value: one of them is biased, and the standard errors cannot say which; both values are given;
+  :data:`ROUTE_Z` combined statistical errors (each route's Newey-West error raised to its block jackknife's,
+  :mod:`~wbfriction.fit.block_spread`) and :data:`ROUTE_REL`
+  of the value: one of them is biased beyond what either route shows of itself; both values are given. The
+  difference is also in the read error of every fit that has the other route (:mod:`~wbfriction.fit.route_spread`:
+  not in what the check tests, which would make it vacuous);
 * ``does not predict`` (issue 52): the same model fitted on the earliest samples predicts the last
   :data:`~wbfriction.fit.holdout.LATER` of them worse than the noise and its standard errors allow, beyond
   :data:`~wbfriction.fit.holdout.HOLDOUT_Z` standard errors, by more than
@@ -28,7 +31,8 @@ status, the first that applies:
 * ``weak``: the joint moved one way (the other on fewer than :data:`MIN_REVERSE` of its samples: its Coulomb
   friction and offset are not separable, whatever their standard errors say), or
   a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error (with ``model="auto"`` the
-  statistical one and the model family's spread in quadrature: ``FitResult.read_stderr``), or a Cramér-Rao bound
+  statistical one, the larger of the Newey-West and the block jackknife's, the model family's spread and the routes'
+  in quadrature: ``FitResult.read_stderr``), or a Cramér-Rao bound
   (:mod:`~wbfriction.fit.bound`: what the data allow any unbiased estimator), above :data:`WEAK` of its
   (non-zero) value, or is not identifiable (infinite standard error); a magnitude at zero whose standard error
   or bound stands for more than :data:`WEAK` of the friction the joint shows (``F_c``'s in N·m, ``F_v``'s times
@@ -56,7 +60,9 @@ from typing import Any, Literal, Protocol, cast, get_args
 
 import numpy as np
 
+from wbfriction.fit.block_spread import statistical_error
 from wbfriction.fit.holdout import HOLDOUT_EXCESS, HOLDOUT_FRICTION, HOLDOUT_Z
+from wbfriction.fit.route_spread import route_spread
 from wbfriction.fit.solver import explain_solver
 
 FitStatus = Literal["ok", "weak", "does not predict", "routes disagree", "at bound", "not excited", "failed"]
@@ -88,9 +94,10 @@ def joint_speed(qd: np.ndarray) -> float:
     qd = np.asarray(qd, dtype=float)
     return float(np.percentile(np.abs(qd), 95)) if qd.size else 0.0
 ROUTE_Z = 3.0
-"""Two routes disagree on a parameter beyond this many standard errors of their difference (each route's own,
-combined as if independent: the routes share the data's noise, so the difference's is smaller and the rule errs
-towards agreement)."""
+"""Two routes disagree on a parameter beyond this many standard errors of their difference (each route's own
+statistical error, the larger of its Newey-West and block-jackknife ones, combined as if independent: the routes share
+the data's noise, so the difference's is smaller and the rule errs towards agreement). Not the read errors: they
+carry the difference itself (:mod:`~wbfriction.fit.route_spread`)."""
 ROUTE_REL = 0.02
 """... and beyond this share of the parameter's value: a difference below 2 % is no bias worth a status (the
 routes' own quadratures differ by less)."""
@@ -98,14 +105,19 @@ routes' own quadratures differ by less)."""
 
 def routes_disagree(a: float, se_a: float, b: float, se_b: float, z: float = ROUTE_Z, rel: float = ROUTE_REL) -> bool:
     """Whether two routes' values of one parameter disagree: they differ by more than ``z`` (:data:`ROUTE_Z`)
-    combined standard errors and by more than ``rel`` (:data:`ROUTE_REL`) of the larger."""
+    combined standard errors (``se_a``, ``se_b``: each route's statistical error,
+    :func:`~wbfriction.fit.block_spread.statistical_error`) and by more than ``rel`` (:data:`ROUTE_REL`) of the
+    larger."""
     return abs(a - b) > z * math.hypot(se_a, se_b) and abs(a - b) > rel * max(abs(a), abs(b))
 
 
-def read_error(stderr: float, model_spread: float = 0.0) -> float:
-    """The standard error a user reads: the statistical ``stderr`` and the model error the data do not resolve
-    (``model_spread``, :attr:`~wbfriction.fit.result.FitResult.model_spread`) in quadrature (issue 63)."""
-    return math.hypot(stderr, model_spread)
+def read_error(stderr: float, model_spread: float = 0.0, block: float = 0.0, route: float = 0.0) -> float:
+    """The standard error a user reads [the parameter's unit] (issue 63), in quadrature: the statistical one, the
+    larger of the Newey-West ``stderr`` and the block jackknife's ``block``
+    (:func:`~wbfriction.fit.block_spread.statistical_error`); the model error the data do not resolve
+    (``model_spread``, :attr:`~wbfriction.fit.result.FitResult.model_spread`); the routes' difference's share
+    (``route``, :mod:`~wbfriction.fit.route_spread`)."""
+    return math.hypot(statistical_error(stderr, block), model_spread, route)
 
 
 WEAK = 0.25
@@ -166,6 +178,8 @@ class Fit(Protocol):
     at_bound: dict[str, bool]
     pressed: dict[str, tuple[float, float]]
     model_spread: dict[str, float]
+    block_spread: dict[str, float]
+    route_spread: dict[str, float]
 
     def bounded(self) -> tuple[str, ...]: ...
 
@@ -258,8 +272,10 @@ def _disagreeing(fit: Fit, values: dict[str, float], thresholds: StatusThreshold
     check = fit.route_check
     if check is None or check.params is None:
         return ()
+    theirs = getattr(check, "block_spread", {}) or {}
     return tuple(n for n in READ if n in values and n in check.params and routes_disagree(
-        values[n], fit.stderr.get(n, np.inf), check.params[n], check.stderr.get(n, np.inf), thresholds.route_z,
+        values[n], statistical_error(fit.stderr.get(n, np.inf), fit.block_spread.get(n, 0.0)), check.params[n],
+        statistical_error(check.stderr.get(n, np.inf), theirs.get(n, 0.0)), thresholds.route_z,
         thresholds.route_rel))
 
 
@@ -275,11 +291,14 @@ def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THR
         return FitVerdict("at bound", "at a bound of the fit: " + bound_phrase(fit, bounded))
     check = terms.check
     others = {t: v for t, v in terms.verdicts().items() if not v.ok}
+    mine = {n: statistical_error(se, terms.block_spread.get(n, 0.0)) for n, se in terms.stderr.items()}
+    theirs = {} if check is None else {n: statistical_error(se, check.block_spread.get(n, 0.0))
+                                       for n, se in check.stderr.items()}
     disagree = [] if check is None else [
-        f"{n} {values[n]:.3g} ±{terms.stderr.get(n, np.inf):.2g} against {check.coefficients[n]:.3g} "
-        f"±{check.stderr.get(n, np.inf):.2g} ({check.route})" for n in READ
-        if n in check.coefficients and routes_disagree(values[n], terms.stderr.get(n, np.inf), check.coefficients[n],
-                                                       check.stderr.get(n, np.inf), thresholds.route_z,
+        f"{n} {values[n]:.3g} ±{mine.get(n, np.inf):.2g} against {check.coefficients[n]:.3g} "
+        f"±{theirs.get(n, np.inf):.2g} ({check.route})" for n in READ
+        if n in check.coefficients and routes_disagree(values[n], mine.get(n, np.inf), check.coefficients[n],
+                                                       theirs.get(n, np.inf), thresholds.route_z,
                                                        thresholds.route_rel)]
     disagree += [f"{t}: {v.reason}" for t, v in others.items() if v.status == "routes disagree"]
     if disagree:
@@ -295,7 +314,8 @@ def _with_terms(fit: Fit, terms: Any, thresholds: StatusThresholds = DEFAULT_THR
     judged = [n for n in values if n in terms.stderr and not (n == "tau_os" and "ripple" in terms.kept)]
     view = SimpleNamespace(params=terms.params, stderr={n: terms.stderr[n] for n in judged}, crb={}, speed=fit.speed,
                            rms_residual=fit.rms_residual, at_bound={n: True for n in terms.at_bound},
-                           model_spread=fit.model_spread)
+                           model_spread=fit.model_spread, block_spread=terms.block_spread,
+                           route_spread={} if check is None else route_spread(values, check.coefficients, READ))
     weak = _weak(cast(Fit, view), values, thresholds.weak) + [f"{t} {v.reason.removeprefix('large standard errors: ')}"
                                              for t, v in others.items() if v.status == "weak"]
     return _weak_verdict(fit, weak)
@@ -311,7 +331,8 @@ def _weak(fit: Fit, values: dict[str, float], limit: float = WEAK) -> list[str]:
         # a magnitude its fit left at its floor is zero (1e-5 of an F_v is the solver's, not the data's)
         value = 0.0 if fit.at_bound.get(name) else abs(values[name])
         family = fit.model_spread.get(name, 0.0)  # the model error the data do not resolve, in quadrature (issue 63)
-        for bound, spread in ((False, read_error(fit.stderr[name], family)), (True, fit.crb.get(name, 0.0))):
+        read = read_error(fit.stderr[name], family, fit.block_spread.get(name, 0.0), fit.route_spread.get(name, 0.0))
+        for bound, spread in ((False, read), (True, fit.crb.get(name, 0.0))):
             at_best = " at best (Cramér-Rao)" if bound else ""
             if not np.isfinite(spread):
                 out.append(f"{name} not identifiable{at_best}")

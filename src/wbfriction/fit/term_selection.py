@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from wbfriction.fit.block_spread import linear_block_spread
 from wbfriction.fit.options import TermOptions
 from wbfriction.fit.ranges import angle_arc
 from wbfriction.fit.regression import covariance_errors
@@ -311,6 +312,7 @@ class TermSearch:
         if rate != 0.0:
             rate_column = partial(law.rate_column, rate, names)
         coef, cov, held = final_fit(X, y, use, names, rate_column)
+        blocks = linear_block_spread(X, y, use, coef, np.array([n not in held for n in names]))
         refitted = with_coefficients(params, coef[:k])
         coefficients = dict(zip(names[k:], map(float, coef[k:])))
         stderr = dict(zip(names, map(float, covariance_errors(cov))))
@@ -324,7 +326,8 @@ class TermSearch:
             q_range = angle_arc(q_used)  # the physical angles' arc, whatever branches the table holds them on
             derived["ripple_rms"], stderr["ripple_rms"] = ripple_size(q_used, harmonics, names, coef, cov)
         return TermFit(refitted, kept, harmonics, coefficients, stderr, derived, t_ref, q_range, self.reasons,
-                       (self.base_rms, current), at_bound=held, covariance=cov, later=later)
+                       (self.base_rms, current), at_bound=held, covariance=cov, later=later,
+                       block_spread={n: float(b) for n, b in zip(names, blocks) if b > 0})
 
 
 def _change(rms: float, current: float) -> str:
@@ -352,12 +355,13 @@ def refit_terms(fit: TermFit, params: ModelParams, qd: np.ndarray, tau_f: np.nda
     use &= np.isfinite(X).all(axis=1)
     if use.sum() <= X.shape[1]:
         return None
-    coef, cov, _ = final_fit(X, np.where(use, y, 0.0), use, names)
+    coef, cov, held = final_fit(X, np.where(use, y, 0.0), use, names)
+    blocks = linear_block_spread(X, np.where(use, y, 0.0), use, coef, np.array([n not in held for n in names]))
     coefficients = dict(zip(names, map(float, coef)))
     stderr = dict(zip(names, map(float, covariance_errors(cov))))
     if "ripple" in fit.kept and signals.q is not None:
         coefficients["ripple_rms"], stderr["ripple_rms"] = ripple_size(np.asarray(signals.q, dtype=float)[use],
                                                                       fit.harmonics, names, coef, cov)
-    return TermCheck(route, coefficients, stderr)
+    return TermCheck(route, coefficients, stderr, {n: float(b) for n, b in zip(names, blocks) if b > 0})
 
 

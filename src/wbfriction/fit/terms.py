@@ -220,6 +220,9 @@ class TermFit:
         ranges: the angles, loads and temperatures of the samples fitted
             (:class:`~wbfriction.fit.ranges.FittedRanges`), or None (not recorded: a parameters file of an
             earlier version); a prediction says where a table leaves them (:meth:`range_use`).
+        block_spread: the velocity model's linear coefficients' and the terms' block-jackknife standard errors
+            (:func:`~wbfriction.fit.block_spread.linear_block_spread`), by name; empty: not computed (a parameters
+            file of an earlier version). The read error takes the larger of it and :attr:`stderr`.
     """
 
     params: ModelParams
@@ -237,6 +240,7 @@ class TermFit:
     covariance: np.ndarray | None = field(default=None, repr=False, compare=False)
     later: dict[str, tuple[float, float]] = field(default_factory=dict)
     ranges: FittedRanges | None = None
+    block_spread: dict[str, float] = field(default_factory=dict)
 
     @property
     def temperature_rate(self) -> float:
@@ -310,6 +314,7 @@ class TermFit:
                 "check": None if self.check is None else self.check.to_dict(), "at_bound": list(self.at_bound),
                 "later": {t: [clean(d), clean(a)] for t, (d, a) in self.later.items()},
                 "ranges": None if self.ranges is None else self.ranges.to_dict(),
+                **({"block_spread": {k: clean(v) for k, v in self.block_spread.items()}} if self.block_spread else {}),
                 "status": {t: v.status for t, v in verdicts.items()},
                 "status_reason": {t: v.reason for t, v in verdicts.items() if v.reason}}
 
@@ -340,7 +345,8 @@ class TermFit:
                        tuple(str(n) for n in d.get("at_bound", ())),
                        later={str(t): (_number(v[0]), math.inf if v[1] is None else float(v[1]))
                               for t, v in (d.get("later") or {}).items()},
-                       ranges=None if ranges is None else FittedRanges.from_dict(ranges))
+                       ranges=None if ranges is None else FittedRanges.from_dict(ranges),
+                       block_spread={str(k): _number(v) for k, v in (d.get("block_spread") or {}).items()})
         except KeyError as exc:
             raise InputError(f"terms: missing key {exc}") from None
         except (TypeError, ValueError, AttributeError, IndexError) as exc:
@@ -488,17 +494,23 @@ class TermCheck:
         route: that route (``acceleration`` or ``momentum``).
         coefficients, stderr: its coefficients (the velocity model's linear ones, :func:`velocity_basis`, and the
             terms') and their standard errors, by name.
+        block_spread: their block-jackknife standard errors, by name (:attr:`TermFit.block_spread`; empty: not
+            computed).
     """
 
     route: str
     coefficients: dict[str, float]
     stderr: dict[str, float]
+    block_spread: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         return {"route": self.route, "coefficients": dict(self.coefficients),
-                "stderr": {k: _finite_or_none(v) for k, v in self.stderr.items()}}
+                "stderr": {k: _finite_or_none(v) for k, v in self.stderr.items()},
+                **({"block_spread": {k: _finite_or_none(v) for k, v in self.block_spread.items()}}
+                   if self.block_spread else {})}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> TermCheck:
         return cls(str(d["route"]), {str(k): float(v) for k, v in d["coefficients"].items()},
-                   {str(k): math.inf if v is None else float(v) for k, v in (d.get("stderr") or {}).items()})
+                   {str(k): math.inf if v is None else float(v) for k, v in (d.get("stderr") or {}).items()},
+                   {str(k): _number(v) for k, v in (d.get("block_spread") or {}).items()})

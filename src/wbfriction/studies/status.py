@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from wbfriction.fit.route_spread import route_spread as route_spread_of
 from wbfriction.fit.status import MIN_SPEED, joint_speed, read_error
 
 GOOD_NOISE_FREE = 0.05
@@ -205,7 +206,8 @@ def excited(speed: float | None, status: str) -> bool:
 
 def fits_from_params(path: str | Path, truth: Mapping[str, Mapping[str, float]]) -> list[JointFit]:
     """Every joint of a parameters JSON (``wbfriction fit -o``) that has a truth, as :class:`JointFit`: its
-    ``status``, and F_c and F_v with their ``stderr`` (and ``model_spread`` in quadrature, as a user reads them)
+    ``status``, and F_c and F_v with their ``stderr`` (the larger of it and ``block_spread``, with ``model_spread``
+    and ``route_spread`` in quadrature, as a user reads them: :func:`~wbfriction.fit.status.read_error`)
     and ``crb`` (a joint without parameters: none; with terms
     kept, the velocity model refitted with them, ``terms.params`` and ``terms.stderr``, as the status judges it and
     :meth:`~wbfriction.fit.result.FitResult.reported` shows it, without a bound); ``truth``:
@@ -226,11 +228,15 @@ def fits_from_params(path: str | Path, truth: Mapping[str, Mapping[str, float]])
         moved = excited(None if d.get("speed") is None else float(d["speed"]), status)
         stderr, crb = d.get("stderr") or {}, d.get("crb") or {}
         terms = d.get("terms") or {}
+        blocks, routes = d.get("block_spread") or {}, d.get("route_spread") or {}
         if terms.get("kept"):  # the model the status judges and predictions use: refitted with its terms, no bound
             params, stderr, crb = terms.get("params") or {}, terms.get("stderr") or {}, {}
+            blocks, other = terms.get("block_spread") or {}, (terms.get("check") or {}).get("coefficients") or {}
+            routes = {n: route_spread_of(params, other, (n,)).get(n, 0.0) for n in FRICTION}
         family = d.get("model_spread") or {}  # the standard error a user reads: the family's spread in quadrature
         out.append(JointFit(joint, status, tuple(
-            ParameterFit(n, float(params[n]), read_error(_number(stderr.get(n)), float(family.get(n) or 0.0)),
+            ParameterFit(n, float(params[n]), read_error(_number(stderr.get(n)), float(family.get(n) or 0.0),
+                                                         float(blocks.get(n) or 0.0), float(routes.get(n) or 0.0)),
                          _number(crb.get(n)), float(truth[joint][n]), moved or n != "F_v")
             for n in FRICTION if n in params and n in truth[joint])))
     return out
