@@ -6,7 +6,8 @@ MuJoCo as :func:`~wbfriction.model.mjspec.urdf_spec` reads it (the root welded t
 limit), the drawn armature in ``dof_armature``, MuJoCo's semi-implicit Euler at ``rate x substeps``. The arm tracks
 :func:`~wbfriction.sim.arm.excitation_trajectory`'s Fourier series by computed torque (Pinocchio's ``rnea`` on the
 simulated model, armature included, no friction compensation) plus a joint PD of 8 Hz (critically damped, gains
-from each joint's apparent inertia ``1 / (M + diag(armature))^-1_jj`` at the start: stable at 250 Hz), the torque held over each sample; the friction
+from each joint's apparent inertia ``1 / (M + diag(armature))^-1_jj``, its least along the reference: stable at
+200 Hz), the torque held over each sample; the friction
 (:class:`~wbfriction.studies.generalise.laws.LawState`: any law, of the state at each physics step) and the motor
 torque are applied as ``qfrc_applied``. The log (:mod:`wbfriction.sim.arm`'s columns): ``time`` (stamps late by up
 to the clock's jitter), ``q.<joint>`` (the encoder: noise, then rounding), ``current.<joint>`` (the motor torque plus
@@ -125,7 +126,10 @@ def simulate_arm_mujoco(urdf: Path, joints: tuple[str, ...], sc: Scenario, k_tru
     time = np.arange(n) * dt
     q_ref, qd_ref, qdd_ref = traj(time)
     ff = np.array([pin.rnea(model, data, q_ref[k], qd_ref[k], qdd_ref[k]) for k in range(n)])
-    inertia = 1.0 / np.diag(np.linalg.inv(pin.crba(model, data, q_ref[0])))  # each joint's, the others free
+    # each joint's apparent inertia (the others free), its least along the reference: what the gains and the
+    # bristles are kept stable on
+    inertia = np.min([1.0 / np.diag(np.linalg.inv(pin.crba(model, data, q_ref[k])))
+                      for k in range(0, n, max(1, n // 64))], axis=0)
     w = 2.0 * np.pi * BANDWIDTH
     kp, kd = inertia * w**2, 2.0 * w * inertia
 
@@ -184,9 +188,9 @@ def simulate_arm_mujoco(urdf: Path, joints: tuple[str, ...], sc: Scenario, k_tru
 
 
 BRISTLE_STEP = 0.5
-"""The most ``h sqrt(sigma_0 / I)`` a LuGre bristle is simulated at (``I`` the joint's inertia on its axis at the
-start, armature included, ``h`` the physics step): MuJoCo's explicit coupling of the bristle's spring to the joint is
-stable below 2; ``I`` the joint's apparent inertia ``1 / (M^-1)_jj``, the other joints free."""
+"""The most ``h sqrt(sigma_0 / I)`` a LuGre bristle is simulated at (``I`` the joint's apparent inertia ``1 /
+(M^-1)_jj``, the other joints free, its least along the reference, armature included; ``h`` the physics step):
+MuJoCo's explicit coupling of the bristle's spring to the joint is stable below 2."""
 
 
 def stable_laws(laws: tuple[JointLaw, ...], inertia: np.ndarray, h: float) -> tuple[JointLaw, ...]:
