@@ -116,9 +116,14 @@ class LawState:
         self.bristle = c["sigma0"] > 0
         self.z = np.zeros(len(laws))
         self.warm_up, self.duration = warm_up, duration
+        # the parts every joint lacks are skipped (the same numbers: each would add zero or multiply by one)
+        self._asymmetric = bool(np.any(c["F_c"] != c["F_c_neg"]) or np.any(c["F_v"] != c["F_v_neg"]))
+        self._stribeck, self._load = bool(np.any(c["S"] != 0)), bool(np.any(c["k_load"] != 0))
+        self._ripple = bool(np.any(c["ripple"] != 0))
+        self._warm = bool(np.any(c["k_temp"] != 0)) and warm_up[1] != warm_up[0]
 
     def temperature_factor(self, t: float | np.ndarray) -> np.ndarray:
-        """``m_T`` per joint at time ``t`` [s] (module docstring)."""
+        """``m_T`` per joint at time ``t`` [s] (module docstring): (n,), or (N, n) for times (N,)."""
         t0, t1 = self.warm_up
         rise = (t1 - t0) * np.clip(np.asarray(t, dtype=float) / self.duration, 0.0, 1.0)
         return 1.0 + np.multiply.outer(rise, self.c["k_temp"])
@@ -127,21 +132,29 @@ class LawState:
         """The law's ``f`` (n,) [N·m] over the physics step ``[t, t + h)`` from the step's velocities [rad/s],
         angles [rad] and loads [N·m]; advances the bristles by ``h`` [s]."""
         c = self.c
-        positive = qd > 0
-        F_c = np.where(positive, c["F_c"], c["F_c_neg"])
-        F_v = np.where(positive, c["F_v"], c["F_v_neg"])
-        stribeck = 1.0 + c["S"] * np.exp(-np.square(qd / c["v_s"]))
-        coulomb = np.tanh(c["a"] * qd) * F_c * stribeck
+        if self._asymmetric:
+            positive = qd > 0
+            F_c = np.where(positive, c["F_c"], c["F_c_neg"])
+            F_v = np.where(positive, c["F_v"], c["F_v_neg"])
+        else:
+            F_c, F_v = c["F_c"], c["F_v"]
+        if self._stribeck:
+            F_c = F_c * (1.0 + c["S"] * np.exp(-np.square(qd / c["v_s"])))
+        coulomb = np.tanh(c["a"] * qd) * F_c
         if self.bristle.any():
             b = self.bristle
-            g = F_c[b] * stribeck[b]
-            z = self.z[b]
-            coulomb[b] = c["sigma0"][b] * z
-            z_ss = np.sign(qd[b]) * g / c["sigma0"][b]
-            self.z[b] = z_ss + (z - z_ss) * np.exp(-c["sigma0"][b] * np.abs(qd[b]) * h / g)
-        coulomb = coulomb * (1.0 + c["k_load"] * np.abs(load))
-        ripple = c["ripple"] * np.sin(c["ripple_n"] * q + c["ripple_phase"])
-        return self.temperature_factor(t) * (coulomb + F_v * qd) + ripple
+            g, z, sigma0 = F_c[b], self.z[b], c["sigma0"][b]
+            coulomb[b] = sigma0 * z
+            z_ss = np.sign(qd[b]) * g / sigma0
+            self.z[b] = z_ss + (z - z_ss) * np.exp(-sigma0 * np.abs(qd[b]) * h / g)
+        if self._load:
+            coulomb = coulomb * (1.0 + c["k_load"] * np.abs(load))
+        out = coulomb + F_v * qd
+        if self._warm:
+            out = self.temperature_factor(t) * out
+        if self._ripple:
+            out = out + c["ripple"] * np.sin(c["ripple_n"] * q + c["ripple_phase"])
+        return out
 
 
 def truth_from_log(laws: Sequence[JointLaw], qd: np.ndarray, tau_f: np.ndarray,

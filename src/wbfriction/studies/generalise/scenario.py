@@ -144,7 +144,7 @@ def draw(seed: int) -> Scenario:
         duration = float({"good": rng.uniform(12.0, 20.0), "poor": rng.uniform(6.0, 10.0),
                           "still": rng.uniform(8.0, 12.0)}[excitation])
         rate = float(_pick(rng, (200.0, 250.0, 500.0)))
-        substeps = int(2000.0 / rate)
+        substeps = int(round(10000.0 / rate))  # 10 kHz physics: a 2 kHz one chattered at reversals (F_v 2x off)
         sensor = "current" if rng.uniform() < 0.6 else "torque"
         armature = tuple(float(x) for x in (rng.uniform(0.02, 0.4, n) if sensor == "current" else np.zeros(n)))
         if robot == "panda" and sensor == "current":

@@ -24,6 +24,7 @@ one (not closer).
 from __future__ import annotations
 
 import math
+import os
 import time
 import tomllib
 from collections.abc import Callable, Iterable, Sequence
@@ -140,18 +141,30 @@ def score_scenario(sc: Scenario, folder: Path) -> ScenarioScore:
                          score_fits(sc.name, fits, noisy=True), outside, values, written)
 
 
-def run_scenario(seed: int, folder: str | Path, echo: Callable[[str], None] | None = None) -> ScenarioScore:
-    """Draw ``seed``'s scenario, simulate it into ``folder`` (made if missing), run its route and score it; a
-    simulation or a route that fails is a score with its message in the case's ``failed``."""
+def absolute_pythonpath() -> dict[str, str]:
+    """This process's environment with ``PYTHONPATH``'s entries made absolute: the route's commands run in the
+    scenario's folder, where a relative entry (``PYTHONPATH=src``) would name nothing and the commands would run
+    another installed ``wbfriction``."""
+    env = dict(os.environ)
+    if env.get("PYTHONPATH"):
+        env["PYTHONPATH"] = os.pathsep.join(str(Path(p).resolve()) if p else p
+                                            for p in env["PYTHONPATH"].split(os.pathsep))
+    return env
+
+
+def run_scenario(seed: int | Scenario, folder: str | Path, echo: Callable[[str], None] | None = None
+                 ) -> ScenarioScore:
+    """Draw ``seed``'s scenario (or take the one given), simulate it into ``folder`` (made if missing), run its route
+    and score it; a simulation or a route that fails is a score with its message in the case's ``failed``."""
     from wbfriction.exceptions import WbfrictionError
     from wbfriction.studies.real_data import run_route
 
-    sc = draw(seed)
+    sc = seed if isinstance(seed, Scenario) else draw(seed)
     folder = Path(folder)
     start = time.perf_counter()
     try:
         write_scenario(sc, folder)
-        run_route(commands(sc), folder, echo=echo)
+        run_route(commands(sc), folder, env=absolute_pythonpath(), echo=echo)
         score = score_scenario(sc, folder)
     except (WbfrictionError, ValueError, OSError) as exc:
         return ScenarioScore(sc.seed, sc.set, sc.robot_class, sc.robot, sc.law, sc.excitation,

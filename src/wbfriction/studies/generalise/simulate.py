@@ -3,7 +3,9 @@ simulated one's inertial parameters perturbed) and the robot TOML naming it, in 
 
 **Arms** (:func:`simulate_arm_mujoco`): the URDF (a Panda's, its fingers fixed, or a random chain's) loaded in
 MuJoCo as :func:`~wbfriction.model.mjspec.urdf_spec` reads it (the root welded to the world, no contact, no joint
-limit), the drawn armature in ``dof_armature``, MuJoCo's semi-implicit Euler at ``rate x substeps``. The arm tracks
+limit), the drawn armature in ``dof_armature``, MuJoCo's semi-implicit Euler at ``rate x substeps`` (10 kHz, as
+:mod:`wbfriction.sim.arm`: at 2 kHz the explicit friction chattered about its reversals within a sample, and a
+200 Hz log's F_v came out twice the law's on a light joint). The arm tracks
 :func:`~wbfriction.sim.arm.excitation_trajectory`'s Fourier series by computed torque (Pinocchio's ``rnea`` on the
 simulated model, armature included, no friction compensation) plus a joint PD of 8 Hz (critically damped, gains
 from each joint's apparent inertia ``1 / (M + diag(armature))^-1_jj``, its least along the reference: stable at
