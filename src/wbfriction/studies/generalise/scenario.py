@@ -7,8 +7,12 @@ the same :class:`Scenario` (and, simulated, the same log bytes: :mod:`wbfriction
 **Classes** (:data:`CLASSES`): ``arm`` (a fixed-base arm, the built-in Panda or a random serial chain of 3-7
 revolute joints, simulated on MuJoCo tracking a Fourier excitation with computed torque and PD; the tool runs
 ``estimate`` then ``fit``) and ``pd`` (the built-in Go2 hung with its base fixed, its joints PD-driven, the hung
-simulator :mod:`wbfriction.sim.hung`; the tool runs ``identify --actuator pd``). Arms are drawn 60 % of the
-time (a Panda in 30 % of those), the hung Go2 40 %.
+simulator :mod:`wbfriction.sim.hung`; the tool runs ``identify --actuator pd``), ``crawl`` (the built-in
+``go2_walking`` crawling, or standing, on point feet, ``wbfriction simulate --simulator mujoco``; ``estimate`` then
+``fit``) and ``humanoid`` (TALOS walking forward on its soles, the same; friction on its legs). Drawn 50, 35, 10
+and 5 % of the time (:data:`CLASS_WEIGHTS`; a Panda in 30 % of the arms). The walking classes' simulators take
+friction of the velocity alone (Coulomb–viscous, Stribeck, an asymmetric Coulomb level), their torque from a
+sensor, no armature; their ``duration`` is seconds for the crawl and steps for TALOS.
 
 **Split** (:func:`split`): a seed is in ``tuning`` when the first byte of the SHA-256 of ``"wbfriction-generalise:"``
 followed by its decimal digits is even, else in ``test``: about half each, each seed in one set only, whatever the
@@ -25,14 +29,18 @@ import numpy as np
 
 from wbfriction.studies.generalise.laws import LAWS, VELOCITY_LAWS, JointLaw, Law, draw_law
 
-RobotClass = Literal["arm", "pd"]
+RobotClass = Literal["arm", "pd", "crawl", "humanoid"]
 CLASSES: tuple[RobotClass, ...] = get_args(RobotClass)
+CLASS_WEIGHTS = (0.5, 0.35, 0.1, 0.05)
+"""How often each of :data:`CLASSES` is drawn."""
 Excitation = Literal["good", "poor", "still"]
 EXCITATIONS: tuple[Excitation, ...] = get_args(Excitation)
 SetName = Literal["tuning", "test"]
 SETS: tuple[SetName, ...] = get_args(SetName)
 PANDA_JOINTS = 7
 GO2_JOINTS = 12
+WALKERS = {"crawl": "go2_walking", "humanoid": "talos"}
+"""The built-in robot of each walking class."""
 
 
 def split(seed: int) -> SetName:
@@ -120,26 +128,31 @@ def _pick(rng: np.random.Generator, options: tuple, weights: tuple[float, ...] |
 def draw(seed: int) -> Scenario:
     """The scenario of ``seed`` (module docstring; ranges in the code)."""
     rng = np.random.default_rng(seed)
-    robot_class: RobotClass = _pick(rng, CLASSES, (0.6, 0.4))
+    robot_class: RobotClass = _pick(rng, CLASSES, CLASS_WEIGHTS)
     if robot_class == "arm":
         robot = "panda" if rng.uniform() < 0.3 else "chain"
         n = PANDA_JOINTS if robot == "panda" else int(rng.integers(3, 8))
-    else:
+    elif robot_class == "pd":
         robot, n = "go2", GO2_JOINTS
+    else:
+        robot, n = WALKERS[robot_class], GO2_JOINTS  # the Go2's joints, TALOS's legs
     chain_seed = int(rng.integers(2**31))
     perturbation = float(rng.uniform(0.0, 0.2))
     law: Law = _pick(rng, LAWS if robot_class == "arm" else VELOCITY_LAWS)
-    if robot_class == "arm":
+    if robot_class == "humanoid":  # TALOS's legs: larger drives
+        F_c, F_v = rng.uniform(0.5, 3.0, n), rng.uniform(0.1, 1.0, n)
+    elif robot_class == "arm":
         F_c, F_v = rng.uniform(0.3, 2.5, n), rng.uniform(0.1, 1.2, n)
         if robot == "panda":  # the wrist's drives are small
             F_c[4:], F_v[4:] = 0.3 * F_c[4:], 0.3 * F_v[4:]
     else:
         F_c, F_v = rng.uniform(0.2, 0.7, n), rng.uniform(0.1, 0.4, n)
     laws = tuple(draw_law(rng, law, float(c), float(v)) for c, v in zip(F_c, F_v))
-    if robot_class == "pd":  # the hung simulator's friction is (3.5): an asymmetric Coulomb level, one F_v
+    if robot_class != "arm":  # the other simulators' friction is (3.5): an asymmetric Coulomb level, one F_v
         laws = tuple(replace(x, F_v_neg=x.F_v) for x in laws)
     warm_up = (25.0, float(25.0 + rng.uniform(10.0, 30.0))) if law == "temperature" else (25.0, 25.0)
-    excitation: Excitation = _pick(rng, EXCITATIONS, (0.6, 0.25, 0.15))
+    excitation: Excitation = _pick(rng, EXCITATIONS, (0.6, 0.25, 0.15) if robot_class != "humanoid" else
+                                   (0.6, 0.4, 0.0))
     if robot_class == "arm":
         duration = float({"good": rng.uniform(12.0, 20.0), "poor": rng.uniform(6.0, 10.0),
                           "still": rng.uniform(8.0, 12.0)}[excitation])
@@ -156,6 +169,18 @@ def draw(seed: int) -> Scenario:
         torque_delay = float(_pick(rng, (0.0, 0.0, 1.0, 2.0))) / rate
         clock_jitter = float(_pick(rng, (0.0, 0.0, 0.2))) / rate
         velocity_std, offset = 0.0, tuple(0.0 for _ in range(n))
+        delay = given_delay = 0.0
+        delayed, kp, kd, gain_error = "setpoints", 0.0, 0.0, 0.0
+    elif robot_class != "pd":
+        duration = float({"good": rng.uniform(6.0, 8.0), "poor": rng.uniform(3.0, 4.0), "still": 4.0}[excitation])
+        if robot_class == "humanoid":  # steps, not seconds
+            duration = float({"good": 3, "poor": 1}[excitation])
+        rate, substeps, sensor = 1000.0, 1, "torque"
+        armature = tuple(0.0 for _ in range(n))
+        k_t_error, position_std, torque_delay, clock_jitter, velocity_std = 0.0, 0.0, 0.0, 0.0, 0.0
+        encoder_bits = _pick(rng, (None, 19, 16))
+        torque_std = float(_pick(rng, (0.0, 0.05, 0.2)))
+        offset = tuple(0.0 for _ in range(n))
         delay = given_delay = 0.0
         delayed, kp, kd, gain_error = "setpoints", 0.0, 0.0, 0.0
     else:

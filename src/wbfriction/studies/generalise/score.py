@@ -24,7 +24,6 @@ one (not closer).
 from __future__ import annotations
 
 import math
-import os
 import time
 import tomllib
 from collections.abc import Callable, Iterable, Sequence
@@ -33,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from wbfriction.studies.generalise.scenario import CLASSES, Scenario, draw
-from wbfriction.studies.generalise.simulate import GIVEN_TOML, LOG, write_scenario
+from wbfriction.studies.generalise.simulate import GIVEN_TOML, LOG, absolute_pythonpath, write_scenario
 from wbfriction.studies.status import (
     GOOD_NOISY,
     CaseScore,
@@ -139,17 +138,6 @@ def score_scenario(sc: Scenario, folder: Path) -> ScenarioScore:
     outside, values = promise(fits)
     return ScenarioScore(sc.seed, sc.set, sc.robot_class, sc.robot, sc.law, sc.excitation,
                          score_fits(sc.name, fits, noisy=True), outside, values, written)
-
-
-def absolute_pythonpath() -> dict[str, str]:
-    """This process's environment with ``PYTHONPATH``'s entries made absolute: the route's commands run in the
-    scenario's folder, where a relative entry (``PYTHONPATH=src``) would name nothing and the commands would run
-    another installed ``wbfriction``."""
-    env = dict(os.environ)
-    if env.get("PYTHONPATH"):
-        env["PYTHONPATH"] = os.pathsep.join(str(Path(p).resolve()) if p else p
-                                            for p in env["PYTHONPATH"].split(os.pathsep))
-    return env
 
 
 def run_scenario(seed: int | Scenario, folder: str | Path, echo: Callable[[str], None] | None = None

@@ -24,6 +24,12 @@ gains ``gain_error`` off, the given delay, no armature and no encoder offset.
 The metadata (``wbfriction`` key) has, beside the simulator's, ``friction_true`` (the truth:
 :func:`~wbfriction.studies.generalise.laws.truth_from_log`), ``friction_law`` (each joint's law), ``scenario`` (the
 draw) and ``given`` (what the TOML holds: armature, offsets, delay).
+
+**Walking robots** (:func:`_write_walk`): ``wbfriction simulate --simulator mujoco`` run as a user runs it (its own
+process), the built-in ``go2_walking`` crawling (``--gait walk``, or ``stand`` for an almost still log) for the
+drawn seconds or TALOS walking forward the drawn steps, with the drawn friction (a ``--friction`` TOML of (3.5)
+parameters per joint: velocity laws), encoder bits, torque noise and noise seed; the given TOML is the built-in
+one naming the perturbed URDF. The log is the command's with the truth put in its metadata.
 """
 
 from __future__ import annotations
@@ -284,6 +290,75 @@ def _write_pd(sc: Scenario, folder: Path) -> Written:
     return _finish(sc, folder, table, joints, given_values)
 
 
+def absolute_pythonpath() -> dict[str, str]:
+    """This process's environment with ``PYTHONPATH``'s entries made absolute: the commands run in a scenario's
+    folder, where a relative entry (``PYTHONPATH=src``) would name nothing and the commands would run another
+    installed ``wbfriction``."""
+    import os
+
+    env = dict(os.environ)
+    if env.get("PYTHONPATH"):
+        env["PYTHONPATH"] = os.pathsep.join(str(Path(p).resolve()) if p else p
+                                            for p in env["PYTHONPATH"].split(os.pathsep))
+    return env
+
+
+def walking_joints(robot) -> tuple[str, ...]:
+    """The joints a walking scenario injects friction on: a quadruped's every torque-controlled joint, a humanoid's
+    legs (``leg_*``)."""
+    joints = tuple(robot.torque_controlled)
+    legs = tuple(j for j in joints if j.startswith("leg_"))
+    return legs or joints
+
+
+def _walk_command(sc: Scenario) -> str:
+    """The ``wbfriction simulate`` line of a walking scenario (module docstring)."""
+    if sc.robot_class == "crawl":
+        gait = "stand" if sc.excitation == "still" else "walk"
+        what = f"--robot {sc.robot} --gait {gait} --duration {sc.duration:g}"
+    else:
+        what = f"--robot {sc.robot} --gait forward --steps {int(sc.duration)}"
+    noise = (f" --encoder-bits {sc.encoder_bits}" if sc.encoder_bits is not None else "") + (
+        f" --torque-noise {sc.torque_std:g}" if sc.torque_std > 0 else "")
+    return (f"wbfriction simulate {what} --simulator mujoco --friction {WALK_FRICTION}{noise} "
+            f"--noise-seed {sc.noise_seed} -o {WALK_LOG}")
+
+
+WALK_FRICTION, WALK_LOG = "friction.toml", "simulated.parquet"
+
+
+def _write_walk(sc: Scenario, folder: Path) -> Written:
+    """A crawl or a humanoid's walk by ``wbfriction simulate --simulator mujoco`` (its own process: the documented
+    simulator as a user runs it), with the drawn friction, sensors and the given model perturbed."""
+    import re
+
+    import pyarrow.parquet as pq
+
+    from wbfriction.model.loading import load_robot
+    from wbfriction.model.robots import __file__ as robots_init
+    from wbfriction.studies.real_data import run_route
+
+    robot = load_robot(sc.robot)
+    joints = walking_joints(robot)
+    text = Path(robot.urdf).read_text()
+    given, _ = perturbed_urdf(text, sc.perturbation, np.random.default_rng([sc.seed, 1]))
+    (folder / GIVEN_URDF).write_text(given)
+    toml = (Path(robots_init).parent / f"{sc.robot}.toml").read_text()
+    (folder / GIVEN_TOML).write_text(re.sub(r'(?m)^urdf = .*$', f'urdf = "{GIVEN_URDF}"', toml, count=1))
+    tables = {f"friction.{j}": {k: getattr(p, k) for k in ("F_v", "F_c", "S", "v_s", "tau_os", "a")}
+              for j, p in ((j, hung_friction(law)) for j, law in zip(joints, sc.laws))}
+    (folder / WALK_FRICTION).write_text(_toml({}, tables))
+    run_route([_walk_command(sc)], folder, env=absolute_pythonpath())
+    table = pq.read_table(folder / WALK_LOG)
+    (folder / WALK_LOG).unlink()
+    qd = np.column_stack([table.column(f"qd_true.{j}").to_numpy() for j in joints])
+    tau_f = np.column_stack([table.column(f"tau_f_true.{j}").to_numpy() for j in joints])
+    meta = read_metadata(table)
+    truth = truth_from_log(sc.laws, qd, tau_f)
+    meta["friction_true"] = {j: _truth_params(law, t) for j, law, t in zip(joints, sc.laws, truth)}
+    return _finish(sc, folder, with_metadata(table, meta), joints, {})
+
+
 def _finish(sc: Scenario, folder: Path, table: pa.Table, joints: tuple[str, ...], given: dict) -> Written:
     meta = read_metadata(table)
     meta.setdefault("friction_law", {j: law.to_dict() for j, law in zip(joints, sc.laws)})
@@ -302,4 +377,5 @@ def write_scenario(sc: Scenario, folder: str | Path) -> Written:
     """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    return _write_arm(sc, folder) if sc.robot_class == "arm" else _write_pd(sc, folder)
+    write = {"arm": _write_arm, "pd": _write_pd}.get(sc.robot_class, _write_walk)
+    return write(sc, folder)
