@@ -106,9 +106,10 @@ def test_truth_is_the_fit_of_the_injected_friction(tmp_path, law):
 
 
 def test_a_tiny_draw_end_to_end(tmp_path):
-    """A correct tool on logs it can fit: the arm's ``ok`` fits within 10 %, most fits good (the full draw's arms
-    with a Coulomb–viscous law, a good excitation and a torque sensor are 80-90 % good); on the hung Go2,
-    ``--config-output``'s armature and delay closer to the truth than the TOML's (none, and 0)."""
+    """A correct tool on logs it can fit: on a noise-free arm with its exact model, a Coulomb–viscous law and a
+    torque sensor (where a plain least-squares fit of ``estimate``'s table on ``[sgn(qd), qd]`` returns the truth),
+    the ``ok`` fits within 10 % and most fits good; on the hung Go2 with its exact model and gains,
+    ``--config-output``'s delay and most armatures closer to the truth than the TOML's (0 and none)."""
     arm = fast_chain("coulomb-viscous", duration=10.0, perturbation=0.0, sensor="torque",
                      armature=tuple(0.0 for _ in range(fast_chain().n_joints)), encoder_bits=None, position_std=0.0,
                      torque_std=0.0, torque_delay=0.0, clock_jitter=0.0)
