@@ -41,8 +41,9 @@ def fast_chain(law: str = "coulomb-viscous", **changes) -> Scenario:
     return dataclasses.replace(sc, **(fields | changes))
 
 
-def test_same_seed_same_scenario_and_bytes(tmp_path):
-    seed = first_seed(robot="chain", excitation="poor")
+@pytest.mark.parametrize("robot", ["chain", "go2"])
+def test_same_seed_same_scenario_and_bytes(tmp_path, robot):
+    seed = first_seed(robot=robot, excitation="poor")
     assert draw(seed) == draw(seed) and draw(seed) != draw(seed + 1)
     sc = dataclasses.replace(draw(seed), duration=3.0)
     for folder in ("a", "b"):
