@@ -63,7 +63,8 @@ class Scenario:
         warm_up: the joints' temperature at the log's start and end [°C] (not logged).
         excitation: ``good`` (long, fast, many harmonics or ramps and chirps), ``poor`` (short, slow, one speed),
             ``still`` (almost still).
-        duration [s], rate [Hz], substeps: the log and the physics steps per sample.
+        duration [s], rate [Hz], substeps: the log and the physics steps per sample (a walk: its seconds, or
+            TALOS's steps; its rate and physics step are the simulator's own, ``rate`` and ``substeps`` unused).
         armature: the simulated rotor inertia per joint [kg·m²] (the tool's TOML has none).
         sensor: ``current`` (motor current times a torque constant the TOML gives ``k_t_error`` off; the rotor in the
             dynamics), ``torque`` (a joint torque sensor after the rotor: no armature) or ``pd`` (the drivers' law).
