@@ -84,14 +84,30 @@ def test_the_delay_near_the_peers(route):
     assert peer.applied_delay - 0.001 <= identified.delay.value <= peer.delay + 0.001
 
 
-def test_the_identified_toml_holds_only_what_the_data_determine(route):
-    _, _, identified, ours, _ = route
-    for joint in identified.joints:
-        written = ours.model.armature[ours.act_v_index[ours.actuated.index(joint.joint)]]
-        if joint.armature.status == "ok":
-            assert written == pytest.approx(joint.armature.value)
+def test_the_identified_toml_writes_the_held_out_choice_and_predicts_better_than_the_given(route):
+    """What ``--config-output`` wrote is the choice on held-out blocks of the training log
+    (:mod:`wbfriction.actuator.written`), and the TOML so written predicts the held-out 40 %'s torque better than the
+    TOML as the dataset gives it (no armature, no offsets, no delay), joint by joint, through the same route. Measured
+    at issue 79: 0.061-0.131 N·m against 0.182-0.375 (means 0.100, 0.267)."""
+    written, _, identified, ours, folder = route
+    assert identified.written is not None
+    for v in identified.written.values:
+        if v.kind == "armature":
+            assert ours.model.armature[ours.act_v_index[ours.actuated.index(v.joint)]] == pytest.approx(v.written)
         else:
-            assert written == 0.0  # aliengo.toml has none: a value not ok (weak, at a bound) is not written
+            assert ours.encoder_offset.get(v.joint, 0.0) == pytest.approx(v.written)
+    assert identified.written.written_delay == pytest.approx(ours.pd.delay)
+    given = load_robot(None, config=written.config)
+    spec = RobotSpec.given("", config=written.config)
+    for role in ("train", "held_out"):
+        estimate_file(spec, written.logs[role], folder / f"given_{role}.parquet", EstimateOptions(route="momentum"),
+                      robot=given)
+    fit_file(folder / "given_train.parquet", folder / "given_params.json")
+    theirs = predict_file(folder / "given_held_out.parquet", folder / "given_params.json")
+    mine = predict_file(folder / "held_out_friction.parquet", folder / "params.json")
+    assert mine.joints == theirs.joints
+    worse = [j for j, a, b in zip(mine.joints, mine.rms, theirs.rms) if not a <= b]
+    assert worse == []
 
 
 def test_the_log_does_not_tell_what_the_delay_holds_back(route):
