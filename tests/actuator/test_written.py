@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 import wbfriction
 from wbfriction.actuator import identify_actuators
-from wbfriction.actuator.written import _blocks
+from wbfriction.actuator.written import held_out_blocks
 from wbfriction.fit.regression import HELD_OUT_BLOCKS
 from wbfriction.logs.log import log_from_table
 from wbfriction.pipeline.actuator_step import written_values
@@ -54,7 +54,7 @@ def written_against_truth(sim, result) -> tuple[list[str], list[str]]:
 
 @given(st.integers(min_value=2, max_value=400))
 def test_the_blocks_are_contiguous_and_cover_every_window(count):
-    blocks = _blocks(count)
+    blocks = held_out_blocks(count)
     assert 2 <= len(blocks) <= HELD_OUT_BLOCKS
     assert np.array_equal(np.concatenate(blocks), np.arange(count))
     assert all(len(b) >= 1 and np.all(np.diff(b) == 1) for b in blocks)

@@ -140,14 +140,45 @@ class WrittenChoice:
 
 
 @dataclass(frozen=True)
-class _Fold:
-    """One held-out block: the design of the blocks fitted and of the one held out."""
+class _CrossValidation:
+    """The balance's blocked cross-validation (module docstring): per held-out block, the design of the blocks fitted
+    and of the one held out; rows weighted by ``weight`` (n,) of their joint; the unknowns' ``lower`` and ``upper``
+    bounds."""
 
-    train: Design
-    test: Design
+    rows: BalanceRows
+    folds: tuple[tuple[Design, Design], ...]
+    weight: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+
+    @classmethod
+    def of(cls, rows: BalanceRows, weight: np.ndarray, offsets: bool, offset_bound: float) -> _CrossValidation:
+        windows = np.arange(len(rows.rest))
+        folds = tuple((design(rows, np.setdiff1d(windows, b), offsets), design(rows, b, offsets))
+                      for b in held_out_blocks(len(windows)))
+        return cls(rows, folds, weight, *bounds(len(rows.joints), offsets, offset_bound))
+
+    def searched_delays(self, options: ActuatorOptions) -> list[float]:
+        """Each fold's delay searched on its fitted blocks (``options.delay`` where given)."""
+        if options.delay is not None:
+            return [options.delay] * len(self.folds)
+        return [search_delay(self.rows, train, self.weight).delay for train, _ in self.folds]
+
+    def score(self, delays: list[float], fixed: dict[int, float]) -> tuple[np.ndarray, np.ndarray]:
+        """Each held-out window's weighted squared residual (summed over its joints) with each fold at its delay of
+        ``delays`` [s] and the unknowns ``fixed`` (column -> value) held, and the windows."""
+        rows, per_window, windows = self.rows, [], []
+        for (train, test), d in zip(self.folds, delays):
+            x = _solve(train.A, train.rhs(rows, rows.balance(d)), self.weight[train.joint], self.lower, self.upper,
+                       fixed)
+            e = (test.rhs(rows, rows.balance(d)) - test.A @ x) * self.weight[test.joint]
+            used = np.unique(test.window)
+            per_window.append(np.bincount(test.window, weights=e**2, minlength=len(rows.rest))[used])
+            windows.append(used)
+        return np.concatenate(per_window), np.concatenate(windows)
 
 
-def _blocks(count: int) -> list[np.ndarray]:
+def held_out_blocks(count: int) -> list[np.ndarray]:
     """The windows ``0..count-1`` cut into at most :data:`HELD_OUT_BLOCKS` contiguous blocks of two windows or
     more."""
     k = max(2, min(HELD_OUT_BLOCKS, count // 2))
@@ -204,46 +235,19 @@ def choose_written(rows: BalanceRows, weight: np.ndarray, options: ActuatorOptio
         return WrittenChoice(None, tuple(_kept(kind, rows.joints[j], float(identified[KINDS.index(kind) * n + j]),
                                                float(_given(kind, j, given_armature, given_offset)), reason)
                                          for j in range(n) for kind in kinds), 0)
-    lower, upper = bounds(n, offsets, options.offset_bound)
-    blocks = _blocks(len(rows.rest))
-    folds = []
-    for b in blocks:
-        train = np.setdiff1d(np.arange(len(rows.rest)), b)
-        folds.append(_Fold(design(rows, train, offsets), design(rows, b, offsets)))
-
-    def fold_delay(fold: _Fold, searched: bool) -> float:
-        if not searched:
-            return given_delay
-        if options.delay is not None:
-            return options.delay
-        return search_delay(rows, fold.train, weight).delay
-
-    def score(delays: list[float], fixed: dict[int, float]) -> tuple[np.ndarray, np.ndarray]:
-        """Each held-out window's weighted squared residual (summed over its joints), and the windows."""
-        per_window, windows = [], []
-        for fold, d in zip(folds, delays):
-            wt = weight[fold.train.joint]
-            x = _solve(fold.train.A, fold.train.rhs(rows, rows.balance(d)), wt, lower, upper, fixed)
-            e = (fold.test.rhs(rows, rows.balance(d)) - fold.test.A @ x) * weight[fold.test.joint]
-            sums = np.bincount(fold.test.window, weights=e**2, minlength=len(rows.rest))
-            used = np.unique(fold.test.window)
-            per_window.append(sums[used])
-            windows.append(used)
-        return np.concatenate(per_window), np.concatenate(windows)
-
-    searched = [fold_delay(f, True) for f in folds]
-    held = [fold_delay(f, False) for f in folds]
-    free_score, win = score(searched, {})
-    given_score, _ = score(held, {})
+    cv = _CrossValidation.of(rows, weight, offsets, options.offset_bound)
+    searched, held = cv.searched_delays(options), [given_delay] * len(cv.folds)
+    free_score, win = cv.score(searched, {})
+    given_score, _ = cv.score(held, {})
     delay_choice = _compare("delay", "", delay, delay_se, given_delay, free_score, given_score, win)
     if not delay_determined:
         delay_choice = replace(delay_choice, source="given", reason="the log does not determine it")
     delays, base = (searched, free_score) if delay_choice.source == "identified" else (held, given_score)
     if delay_choice.source == "given" and not np.isclose(given_delay, delay):
         # the values written with the TOML's delay are those the whole log gives under it
-        all_rows = design(rows, np.arange(len(rows.rest)), offsets)
-        identified = _solve(all_rows.A, all_rows.rhs(rows, rows.balance(given_delay)), weight[all_rows.joint],
-                            lower, upper, {})
+        whole = design(rows, np.arange(len(rows.rest)), offsets)
+        identified = _solve(whole.A, whole.rhs(rows, rows.balance(given_delay)), weight[whole.joint], cv.lower,
+                            cv.upper, {})
     values = []
     for j in range(n):
         for kind in kinds:
@@ -253,10 +257,10 @@ def choose_written(rows: BalanceRows, weight: np.ndarray, options: ActuatorOptio
                 values.append(_kept(kind, rows.joints[j], float(identified[col]), given,
                                     "the log does not determine it"))
                 continue
-            held_score, _ = score(delays, {col: given})
+            held_score, _ = cv.score(delays, {col: given})
             values.append(_compare(kind, rows.joints[j], float(identified[col]), float(se[col]), given, base,
                                    held_score, win, kind != "armature" or given > 0))
-    return WrittenChoice(delay_choice, tuple(values), len(blocks))
+    return WrittenChoice(delay_choice, tuple(values), len(cv.folds))
 
 
 def _kept(kind: str, joint: str, identified: float, given: float, reason: str) -> WrittenValue:

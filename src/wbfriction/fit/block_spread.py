@@ -27,13 +27,13 @@ their status says what they are).
 The number of blocks: :data:`BLOCKS` (the model choice's cut, :data:`~wbfriction.fit.regression.HELD_OUT_BLOCKS`),
 fewer where a block would be shorter than the residuals' correlation lag (the Newey-West lag,
 :func:`~wbfriction.fit.regression.correlation_lag`: itself twice the lag where their autocorrelation falls below 5 %;
-the blocks must be nearly independent for the formula to hold), none below :data:`MIN_BLOCKS`. With ``K`` blocks the variance estimate has
-``K - 1`` degrees of freedom: the interval it gives is Student's, ``theta ± t_{K-1} v_JK^(1/2)`` (Efron 1982, ch. 3;
-Künsch 1989, sec. 3), whose 95 % quantile ``t_{9}`` is 2.26 at ten blocks, not the normal 1.96, and its own relative
-error about ``1 / sqrt(2 (K - 1))`` (24 %). The spread is therefore given on the normal scale, the jackknife's
-standard error times ``t_{K-1} / z`` (both at 97.5 %, :func:`t_scale`: 1.15 at ten blocks), so that ±2 of it, as a
-user reads any standard error, is the jackknife's 95 % interval; it enters the read error as the larger of it and the
-Newey-West one (:func:`statistical_error`), never alone below the latter.
+the blocks must be nearly independent for the formula to hold), none below :data:`MIN_BLOCKS`. With ``K`` blocks the
+variance estimate has ``K - 1`` degrees of freedom: the interval it gives is Student's, ``theta ± t_{K-1} v_JK^(1/2)``
+(Efron 1982, ch. 3; Künsch 1989, sec. 3), whose 95 % quantile ``t_{9}`` is 2.26 at ten blocks, not the normal 1.96,
+and its own relative error about ``1 / sqrt(2 (K - 1))`` (24 %). The spread is therefore given on the normal scale,
+the jackknife's standard error times ``t_{K-1} / z`` (both at 97.5 %, :func:`t_scale`: 1.15 at ten blocks), so that ±2
+of it, as a user reads any standard error, is the jackknife's 95 % interval; it enters the read error as the larger of
+it and the Newey-West one (:func:`statistical_error`), never alone below the latter.
 """
 
 from __future__ import annotations

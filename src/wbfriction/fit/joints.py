@@ -183,7 +183,8 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
     With the estimate's noise record (:func:`~wbfriction.friction.noise.noise_record`), each fit corrects the model
     for its velocity's noise, leaves out the samples where its joint may stick, and carries its Cramér-Rao bound.
     With the other route's estimate (:attr:`~wbfriction.friction.estimate.FrictionEstimate.route_check`), each
-    joint's model is fitted there too and the two compared (:attr:`FitResult.route_check`, :func:`~wbfriction.fit.result.check_routes`).
+    joint's model is fitted there too and the two compared (:attr:`FitResult.route_check`,
+    :func:`~wbfriction.fit.result.check_routes`).
 
     Args:
         options: the model, its choice and the fit's thresholds (:class:`~wbfriction.fit.options.FitOptions`;

@@ -12,10 +12,10 @@ from typing import Generic, cast
 import numpy as np
 from numpy.typing import ArrayLike
 
+from wbfriction.fit.block_spread import statistical_error
 from wbfriction.fit.holdout import (
     PredictionCheck,
 )
-from wbfriction.fit.block_spread import statistical_error
 from wbfriction.fit.options import PASS_ROWS, SELECTION_TOLERANCE
 from wbfriction.fit.route_spread import route_spread
 from wbfriction.fit.status import HELD, FitVerdict, fit_verdict, read_error, routes_disagree

@@ -126,6 +126,19 @@ def _pick(rng: np.random.Generator, options: tuple, weights: tuple[float, ...] |
     return options[int(rng.choice(len(options), p=None if weights is None else np.asarray(weights)))]
 
 
+def _friction_levels(rng: np.random.Generator, robot_class: RobotClass, robot: str, n: int
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Each joint's Coulomb level F_c [N·m] and viscous coefficient F_v [N·m·s/rad], drawn for the robot's drives."""
+    if robot_class == "humanoid":  # TALOS's legs: larger drives
+        return rng.uniform(0.5, 3.0, n), rng.uniform(0.1, 1.0, n)
+    if robot_class == "arm":
+        F_c, F_v = rng.uniform(0.3, 2.5, n), rng.uniform(0.1, 1.2, n)
+        if robot == "panda":  # the wrist's drives are small
+            F_c[4:], F_v[4:] = 0.3 * F_c[4:], 0.3 * F_v[4:]
+        return F_c, F_v
+    return rng.uniform(0.2, 0.7, n), rng.uniform(0.1, 0.4, n)
+
+
 def draw(seed: int) -> Scenario:
     """The scenario of ``seed`` (module docstring; ranges in the code)."""
     rng = np.random.default_rng(seed)
@@ -140,14 +153,7 @@ def draw(seed: int) -> Scenario:
     chain_seed = int(rng.integers(2**31))
     perturbation = float(rng.uniform(0.0, 0.2))
     law: Law = _pick(rng, LAWS if robot_class == "arm" else VELOCITY_LAWS)
-    if robot_class == "humanoid":  # TALOS's legs: larger drives
-        F_c, F_v = rng.uniform(0.5, 3.0, n), rng.uniform(0.1, 1.0, n)
-    elif robot_class == "arm":
-        F_c, F_v = rng.uniform(0.3, 2.5, n), rng.uniform(0.1, 1.2, n)
-        if robot == "panda":  # the wrist's drives are small
-            F_c[4:], F_v[4:] = 0.3 * F_c[4:], 0.3 * F_v[4:]
-    else:
-        F_c, F_v = rng.uniform(0.2, 0.7, n), rng.uniform(0.1, 0.4, n)
+    F_c, F_v = _friction_levels(rng, robot_class, robot, n)
     laws = tuple(draw_law(rng, law, float(c), float(v)) for c, v in zip(F_c, F_v))
     if robot_class != "arm":  # the other simulators' friction is (3.5): an asymmetric Coulomb level, one F_v
         laws = tuple(replace(x, F_v_neg=x.F_v) for x in laws)

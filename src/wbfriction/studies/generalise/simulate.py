@@ -119,7 +119,6 @@ def simulate_arm_mujoco(urdf: Path, joints: tuple[str, ...], sc: Scenario, k_tru
     from wbfriction.model.mjspec import urdf_spec
     from wbfriction.sim.arm import excitation_trajectory
     from wbfriction.sim.mujoco_model import route_mujoco_warnings
-    from wbfriction.sim.options import SensorNoise
 
     model = pin.buildModelFromUrdf(str(urdf))
     if tuple(model.names[1:]) != joints:
@@ -172,6 +171,19 @@ def simulate_arm_mujoco(urdf: Path, joints: tuple[str, ...], sc: Scenario, k_tru
                 A[k] = md.qacc[dadr]
         if not np.isfinite(md.qvel).all() or md.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
             raise SimulationError(f"the arm's MuJoCo simulation diverged at sample {k}")
+    return _arm_log(sc, joints, time, (Q, V, A, T, F), laws, state, k_true)
+
+
+def _arm_log(sc: Scenario, joints: tuple[str, ...], time: np.ndarray, states: tuple[np.ndarray, ...],
+             laws: tuple[JointLaw, ...], state: LawState, k_true: np.ndarray) -> pa.Table:
+    """The arm's log table with its truth in the metadata, from the simulated samples ``states``: angles, velocities,
+    accelerations, motor torques and friction (N, n) [rad, rad/s, rad/s², N·m, N·m] at the samples ``time`` (N,) [s]:
+    the sensors' noise, rounding, delay and clock jitter applied (module docstring)."""
+    from wbfriction.sim.options import SensorNoise
+
+    Q, V, A, T, F = states
+    n, nv = Q.shape
+    armature = np.array(sc.armature)
     rng = np.random.default_rng(sc.noise_seed)
     noise = SensorNoise(position_std=sc.position_std, encoder_bits=sc.encoder_bits, torque_std=sc.torque_std,
                         seed=sc.noise_seed)
