@@ -60,17 +60,19 @@ def test_the_blocks_are_contiguous_and_cover_every_window(count):
     assert all(len(b) >= 1 and np.all(np.diff(b) == 1) for b in blocks)
 
 
-def test_a_toml_without_offsets_or_delay_gets_the_ones_the_log_shows(go2, sim):
+def test_a_toml_without_delay_gets_the_one_the_log_shows_and_keeps_its_offsets(go2, sim):
     """The TOML's delay 0 and offsets 0 against the drivers' 12 ms and offsets of 10-40 mrad: the delay written is the
-    drivers' (within a physics step), some offsets written, each closer to the truth than 0; the TOML's armature is
-    the truth, and none of it is replaced."""
+    drivers' (within a physics step); the TOML's armature is the truth, and none of it is replaced; the offsets that
+    predict the held-out blocks better are named in the JSON and not written: an offset and the URDF's gravity model
+    close the balance alike (:data:`~wbfriction.actuator.written.CONFOUNDED`)."""
     blind = replace(go2, encoder_offset={}, pd=replace(go2.pd, delay=0.0))
     result = identified(blind, sim.table)
     armature, offsets, delay = written_values(result)
     assert delay is not None and abs(delay - sim.driver.delay) < sim.physics_step
-    assert armature == {}
-    closer, farther = written_against_truth(sim, result)
-    assert farther == [] and len(offsets) >= 3 and len(closer) == len(offsets)
+    assert armature == {} and offsets == {}
+    assert result.written is not None
+    assert sum(v.kind == "offset" and "cannot tell them apart" in v.reason for v in result.written.values) >= 3
+    assert written_against_truth(sim, result)[1] == []
 
 
 def test_a_toml_that_holds_the_truth_is_kept(go2, sim):

@@ -67,6 +67,6 @@ def print_actuators(result: ActuatorIdentification, wide: bool = False) -> None:
     if result.written is not None:
         kept = [f"{v.joint} {v.kind}" if v.joint else v.kind for v in result.written.kept]
         if kept:
-            out.print(escape("the TOML's own kept by --config-output (it predicts held-out blocks of the log as well "
-                             f"or better, or the log does not determine the value): {', '.join(kept)}"),
-                      highlight=False)
+            out.print(escape("the TOML's own kept by --config-output (the identified value does not predict "
+                             "held-out blocks of the log better, or the log does not tell it; the JSON's 'written' "
+                             f"says which): {', '.join(kept)}"), highlight=False)
