@@ -20,7 +20,7 @@ import pytest
 
 from wbfriction.studies.generalise.laws import EXACT_LAWS, LAWS, V_MIN, draw_law
 from wbfriction.studies.generalise.scenario import SETS, Scenario, draw, split
-from wbfriction.studies.generalise.score import run_scenario
+from wbfriction.studies.generalise.score import Written, run_scenario, toml_verdict
 from wbfriction.studies.generalise.simulate import GIVEN_URDF, LOG, TRUE_URDF, write_scenario
 from wbfriction.studies.generalise.urdf import link_masses
 from wbfriction.studies.status import log_truth
@@ -128,4 +128,19 @@ def test_a_tiny_draw_end_to_end(tmp_path):
     assert delay.closer and abs(delay.written - 0.012) < 0.002
     armature = [w for w in score.written if w.name == "armature"]
     assert sum(w.closer for w in armature) >= 0.75 * len(armature)
+    assert toml_verdict(score.written) == "closer"
     assert score.case.coverage >= 0.6
+
+
+def test_toml_verdict_sums_each_quantity_in_its_own_unit():
+    """Closer on one quantity and farther on none: closer; one quantity's summed error larger: farther, however much
+    closer the others (an armature off by more than the given 0 outweighs a delay put right); nothing written:
+    unchanged."""
+    arm = [Written("armature", "a", 0.02, 0.0, 0.018, True), Written("armature", "b", 0.01, 0.0, 0.0, False)]
+    delay = Written("delay", "", 0.012, 0.0, 0.0121, True)
+    assert toml_verdict([*arm, delay]) == "closer"
+    worse = [Written("armature", "a", 0.02, 0.0, 0.05, True), Written("armature", "b", 0.01, 0.0, 0.011, True)]
+    assert toml_verdict([*worse, delay]) == "farther"  # |0.03| + |0.001| > |0.02| + |0.01|
+    kept = [Written("armature", "a", 0.02, 0.0, 0.0, False), Written("delay", "", 0.012, 0.0, 0.0, False)]
+    assert toml_verdict(kept) == "unchanged"
+    assert toml_verdict([]) == ""

@@ -49,7 +49,17 @@ from wbfriction.actuator.excitation import JointMotion, joint_motion
 from wbfriction.actuator.law_check import LawCheck, check_law
 from wbfriction.actuator.options import ActuatorOptions
 from wbfriction.actuator.rows import BalanceRows, balance_rows, pd_joints
-from wbfriction.actuator.solve import KINDS, DelaySearch, Design, Solution, design, hac_lags, search_delay, solve
+from wbfriction.actuator.solve import (
+    KINDS,
+    DelaySearch,
+    Design,
+    Solution,
+    block_grown,
+    design,
+    hac_lags,
+    search_delay,
+    solve,
+)
 from wbfriction.actuator.written import WrittenChoice, choose_written
 from wbfriction.exceptions import InputError
 from wbfriction.fit.regression import held_out_gain
@@ -341,12 +351,14 @@ def _identify(robot: Robot, log: Log, options: ActuatorOptions) -> ActuatorIdent
         d = design(rows, windows, offsets)
         weight = 1.0 / np.maximum(rows.sigma, 1e-12) if weight is None else weight
         search = _delay(rows, d, weight, options)
-        sol = solve(d, d.rhs(rows, rows.balance(search.delay)), weight, rows.sigma, options.offset_bound,
-                    _lags(rows, options))
+        y = d.rhs(rows, rows.balance(search.delay))
+        sol = solve(d, y, weight, rows.sigma, options.offset_bound, _lags(rows, options))
+        solved_with = weight
         weight = 1.0 / np.maximum(sol.rms, 1e-12)
         if offsets:
             offset = sol.x[3 * len(index):]
     assert weight is not None
+    sol = block_grown(sol, d, y, solved_with, _lags(rows, options))  # the block spread: actuator.solve
     steep = design(rows, windows, offsets, steep=True)  # the nuisance model's sensitivity: options.STEEPER
     steep_delay = _delay(rows, steep, weight, options).delay
     moved = solve(steep, steep.rhs(rows, rows.balance(steep_delay)), weight, rows.sigma, options.offset_bound)

@@ -11,8 +11,11 @@ discretisation, a friction that sticks, a driver's filter), correlated over the 
 is a heteroscedasticity- and autocorrelation-consistent sandwich (Newey and West, 1987), the scores summed over the
 joints of each window (the joints' residuals of one instant correlate through the offsets' columns) and their
 cross-products kept up to :func:`hac_lags` windows apart with Bartlett weights (:func:`sandwich`). The
-identification reports no standard error below its Cramér-Rao bound (``max(se, crb)``:
-:mod:`wbfriction.actuator.identification`).
+variance of each value is raised to its delete-one-block jackknife's over contiguous time blocks of the windows
+(:func:`block_grown`, :mod:`wbfriction.fit.block_spread`): a model error that changes slowly over the log (a gravity
+model off while the posture drifts, a friction law the columns do not hold) moves the values by more than its small
+correlation at each lag shows the sandwich. The identification reports no standard error below its Cramér-Rao
+bound (``max(se, crb)``: :mod:`wbfriction.actuator.identification`).
 
 **Delay.** Between two whole periods, ``kT <= d <= (k+1)T``, the right-hand side is ``y_k + theta (y_{k+1} - y_k)``
 and the residual of the linear problem's projection is ``r(theta) = r_k + theta Delta r``: the squared residual is a
@@ -22,12 +25,13 @@ curvature ``|Delta r|² / T²`` the delay's information (profile likelihood: ``v
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import lsq_linear
 
 from wbfriction.actuator.rows import BalanceRows
+from wbfriction.fit.block_spread import block_count, jackknife_shifts, jackknife_spread, t_scale
 
 KINDS = ("armature", "F_v", "F_c", "offset")
 """The unknowns' kinds, in the design's column order (module docstring)."""
@@ -191,6 +195,27 @@ def sandwich(X: np.ndarray, e: np.ndarray, window: np.ndarray, lags: int) -> np.
     cov = bread.copy()
     cov[np.ix_(finite, finite)] = b * np.outer(grow, grow)
     return cov
+
+
+def block_grown(sol: Solution, d: Design, y: np.ndarray, weight: np.ndarray, lags: int) -> Solution:
+    """``sol`` with each value's variance raised to its block jackknife's (module docstring): the windows cut into
+    contiguous time blocks of at least ``lags`` windows (:func:`~wbfriction.fit.block_spread.block_count`), each
+    block's rows (every joint's of its windows) left out in turn from the weighted least squares of ``d`` (R, P),
+    ``y`` (R,) and the joints' ``weight`` (n,), on the normal scale (:func:`~wbfriction.fit.block_spread.t_scale`);
+    values on a bound of the search, at a floor of zero or not determined are not stepped. Never lowers a variance;
+    ``sol`` unchanged with too few windows for the blocks."""
+    active = ~sol.at_bound & (np.abs(sol.x) > 1e-12) & np.isfinite(np.diag(sol.covariance))
+    first, count = int(d.window.min()), int(np.ptp(d.window)) + 1 if len(d.window) else 0
+    k = block_count(count, lags, 0)
+    if k == 0 or not active.any():
+        return sol
+    w = weight[d.joint]
+    labels = (d.window - first) * k // count
+    shifts = jackknife_shifts(d.A * w[:, None], (d.A @ sol.x - y) * w, active, k, labels=labels)
+    spread = t_scale(k) * jackknife_spread(shifts)
+    grow = np.sqrt(np.maximum(spread**2, np.diag(sol.covariance)) / np.maximum(np.diag(sol.covariance), 1e-300))
+    grow = np.where(np.isfinite(grow), grow, 1.0)
+    return replace(sol, covariance=sol.covariance * np.outer(grow, grow))
 
 
 def _safe(x: np.ndarray) -> np.ndarray:

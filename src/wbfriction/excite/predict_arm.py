@@ -74,7 +74,7 @@ class ArmPrediction:
 
     def worst(self, weak: float, names: Sequence[str] = READ) -> tuple[str, str, float]:
         """The parameter of ``names`` (default F_c and F_v) whose predicted standard error is the largest share of
-        ``weak`` times its value (``weak = 0.25``: :data:`~wbfriction.fit.status.WEAK`, the ``weak`` status's
+        ``weak`` times its value (:data:`~wbfriction.fit.status.WEAK`, the ``weak`` status's
         limit; above 1: predicted ``weak``); (joint, name, share), the share infinite for a value at zero.
 
         Raises:

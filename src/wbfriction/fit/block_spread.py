@@ -66,7 +66,7 @@ def block_count(n: int, lag: int, p: int, blocks: int = BLOCKS) -> int:
 
 
 def jackknife_shifts(jac: np.ndarray, residual: np.ndarray, active: np.ndarray, n_blocks: int,
-                     rtol: float = 1e-12) -> np.ndarray:
+                     rtol: float = 1e-12, labels: np.ndarray | None = None) -> np.ndarray:
     """The delete-one-block shifts ``theta_(k) - theta`` (K, p) of a least-squares fit (module docstring).
 
     Args:
@@ -77,6 +77,8 @@ def jackknife_shifts(jac: np.ndarray, residual: np.ndarray, active: np.ndarray, 
         n_blocks: ``K`` contiguous blocks (:func:`block_labels`).
         rtol: eigenvalues of the column-scaled normal matrix below this share of the largest are dropped (its
             numerical null space: 1e-12, a singular value of 1e-6 of the largest).
+        labels: (n,) each row's block in ``0 .. K-1``, for rows not in time order (several series' rows of one
+            instant: :mod:`wbfriction.actuator.solve`); default :func:`block_labels` of the row order.
 
     Returns:
         (K, p) in the parameters' units.
@@ -92,7 +94,7 @@ def jackknife_shifts(jac: np.ndarray, residual: np.ndarray, active: np.ndarray, 
     scale[scale == 0] = 1.0
     Js = J / scale  # unit columns: the parameters' units do not set the conditioning
     full = Js.T @ Js
-    labels = block_labels(n, n_blocks)
+    labels = block_labels(n, n_blocks) if labels is None else np.asarray(labels)
     for k in range(n_blocks):
         rows = labels == k
         Jk, rk = Js[rows], residual[rows]

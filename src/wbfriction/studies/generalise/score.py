@@ -13,12 +13,15 @@ good when F_c and F_v lie within :data:`~wbfriction.studies.status.GOOD_NOISY` (
 not the noise-free 5 %: every scenario's model is off (masses, inertias, the armature unknown, a torque constant),
 most logs carry sensor noise, and most laws' truth is a best approximation, so 5 % would call bad what a user
 would take as right; beyond 10 % a friction compensation is visibly off. Beside them :data:`PROMISE`: the ``ok``
-values (F_c, F_v of ``ok`` fits, excited) outside ±20 % of the truth, a proposed promise of ``ok``.
+values (F_c, F_v of ``ok`` fits, excited) outside the promise of ``ok``, ±20 % of the truth
+(:data:`~wbfriction.fit.status.PROMISE`).
 
 For a PD-driven robot, what ``--config-output`` wrote (its ``[armature]``, ``[encoder_offset]``, ``[pd] delay``)
 against the truth and against what the given TOML held (no armature, no offsets: 0; its delay): per value, whether
 the written one is closer to the truth than the given one (:class:`Written`); a value not written keeps the given
-one (not closer).
+one (not closer). Per scenario (:func:`toml_verdict`), whether the written TOML as a whole is closer: per quantity,
+its absolute errors summed over the joints against the given TOML's (one unit per sum, no scale chosen); ``closer``
+where it is closer on one quantity and farther on none, ``farther`` where it is farther on one, else ``unchanged``.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from wbfriction.fit.status import PROMISE
 from wbfriction.studies.generalise.scenario import CLASSES, Scenario, draw
 from wbfriction.studies.generalise.simulate import GIVEN_TOML, LOG, absolute_pythonpath, write_scenario
 from wbfriction.studies.status import (
@@ -44,8 +48,6 @@ from wbfriction.studies.status import (
     score_fits,
 )
 
-PROMISE = 0.20
-"""An ``ok`` value beyond this share of its truth breaks the proposed promise of ``ok``."""
 PARAMS, ACTUATOR_JSON, IDENTIFIED = "params.json", "actuator.json", "identified.toml"
 WRITTEN_VALUES = ("armature", "offset", "delay")
 
@@ -95,6 +97,20 @@ def written_values(path: Path, truth: dict[str, Any], joints: Sequence[str]) -> 
     wrote = delay is not None and float(delay) != g
     out.append(Written("delay", "", float(truth["delay_true"]), g, float(delay) if wrote else g, wrote))
     return tuple(out)
+
+
+def toml_verdict(written: Sequence[Written]) -> str:
+    """``closer``, ``farther`` or ``unchanged``: the written TOML against the given one (module docstring); ``""``
+    without written values (not a PD-driven robot)."""
+    if not written:
+        return ""
+    verdicts = set()
+    for name in WRITTEN_VALUES:
+        values = [w for w in written if w.name == name]
+        now = sum(abs(w.written - w.truth) for w in values)
+        before = sum(abs(w.given - w.truth) for w in values)
+        verdicts.add("closer" if now < before * (1 - 1e-9) else "farther" if now > before * (1 + 1e-9) else "")
+    return "farther" if "farther" in verdicts else "closer" if "closer" in verdicts else "unchanged"
 
 
 @dataclass(frozen=True)
@@ -177,6 +193,8 @@ class Summary:
     ok_values: int
     written: dict[str, tuple[int, int, int]]
     """per value name: (closer to the truth than the given, written but not closer, not written)"""
+    tomls: tuple[int, int, int]
+    """scenarios whose written TOML is closer, farther, unchanged (:func:`toml_verdict`)"""
     seconds: float
 
     @property
@@ -195,9 +213,11 @@ def summarise(group: str, scores: Sequence[ScenarioScore]) -> Summary:
             closer = sum(w.closer for w in values)
             kept = sum(not w.was_written for w in values)
             written[name] = (closer, len(values) - closer - kept, kept)
+    verdicts = [toml_verdict(s.written) for s in ok]
+    tomls = (verdicts.count("closer"), verdicts.count("farther"), verdicts.count("unchanged"))
     return Summary(group, len(scores), len(scores) - len(ok), total("ok_good"), total("ok_bad"),
                    total("not_ok_good"), total("not_ok_bad"), total("covered"), total("scored"),
-                   sum(s.ok_outside for s in ok), sum(s.ok_values for s in ok), written,
+                   sum(s.ok_outside for s in ok), sum(s.ok_values for s in ok), written, tomls,
                    sum(s.case.seconds for s in scores if math.isfinite(s.case.seconds)))
 
 
@@ -223,12 +243,14 @@ def markdown(rows: Sequence[Summary], title: str) -> str:
                      f"{r.seconds:.0f} |")
     written = [r for r in rows if r.written]
     if written:
-        lines += ["", "`identify --actuator pd --config-output` against the given TOML (written closer to the truth "
-                  "than given / written, not closer / not written):", "",
-                  "| class | " + " | ".join(WRITTEN_VALUES) + " |", "|---" * (1 + len(WRITTEN_VALUES)) + "|"]
+        lines += ["", "`identify --actuator pd --config-output` against the given TOML (per value: written closer to "
+                  "the truth than given / written, not closer / not written; per scenario, the written TOML: closer / "
+                  "farther / unchanged):", "",
+                  "| class | " + " | ".join(WRITTEN_VALUES) + " | scenarios |",
+                  "|---" * (2 + len(WRITTEN_VALUES)) + "|"]
         for r in written:
             cells = [("{} / {} / {}".format(*r.written[n]) if n in r.written else "–") for n in WRITTEN_VALUES]
-            lines.append(f"| {r.group} | " + " | ".join(cells) + " |")
+            lines.append(f"| {r.group} | " + " | ".join(cells) + " | {} / {} / {} |".format(*r.tomls))
     return "\n".join(lines)
 
 
@@ -237,8 +259,9 @@ def breakdown(scores: Sequence[ScenarioScore], key: str) -> str:
     values = sorted({getattr(s, key) for s in scores})
     rows = [summarise(v, [s for s in scores if getattr(s, key) == v]) for v in values]
     lines = [f"| {key} | scenarios (failed) | ok, good | ok, bad | not ok, good | not ok, bad | coverage ±2 SE | "
-             f"ok outside ±{100 * PROMISE:.0f} % |", "|---" * 8 + "|"]
+             f"ok outside ±{100 * PROMISE:.0f} % | written TOML closer / farther / unchanged |", "|---" * 9 + "|"]
     for r in rows:
+        tomls = "{} / {} / {}".format(*r.tomls) if any(r.tomls) else "–"
         lines.append(f"| {r.group} | {r.scenarios} ({r.failed}) | {r.ok_good} | {r.ok_bad} | {r.not_ok_good} | "
-                     f"{r.not_ok_bad} | {_pct(r.covered, r.scored)} | {_pct(r.ok_outside, r.ok_values)} |")
+                     f"{r.not_ok_bad} | {_pct(r.covered, r.scored)} | {_pct(r.ok_outside, r.ok_values)} | {tomls} |")
     return "\n".join(lines)
