@@ -27,8 +27,9 @@ No acceleration anywhere: the velocity of the dynamics is the positions' central
 driver may filter: the real Aliengo's lags, :class:`~wbfriction.actuator.options.ActuatorOptions`); the PD law's
 damping term always takes the driver's. The
 set-points are held by the driver (zero-order hold) and applied ``d`` late (or its whole law's torque, ``delayed =
-"torque"``: then the law's impulse takes the set-points' place and no feedback is left), so a step's impulse is the
-commanded value at ``t_i - d`` linearly interpolated, times the step (:func:`~wbfriction.model.pd.delayed`): between
+"torque"``: then the law's impulse takes the set-points' place and no feedback is left, each step's the law's mean
+over it, the feedback by the trapezoid as without: :func:`_law_mean`), so a step's impulse is the commanded value at
+``t_i - d`` linearly interpolated, times the step (:func:`~wbfriction.model.pd.delayed`): between
 two whole periods ``kT <= d <= (k+1)T`` the impulse is linear in ``d``, and the whole problem is a linear least
 squares whose right-hand side moves along a segment: the delay's search is exact, interval by interval
 (:mod:`wbfriction.actuator.solve`).
@@ -214,13 +215,15 @@ def _segment_rows(robot: Robot, log: Log, index: np.ndarray, offset: np.ndarray,
     if sp.tau_ff is not None:
         command = command + sp.tau_ff
     feedback = kp * q_enc + kd * sp.qd  # the driver's law runs on its own velocity
-    if options.delayed == "torque":  # the whole law held back: its clipped torque is what the delay shifts
-        command = np.clip(command - feedback, -driver.torque_limit, driver.torque_limit)
-        feedback = np.zeros_like(feedback)
     dt = np.diff(time)[:, None]
     trap = lambda x: 0.5 * (x[:-1] + x[1:]) * (dt if x.ndim == 2 else dt[:, :, None])  # noqa: E731
+    held = command[:-1]  # each step's set-points: held from its first sample
+    if options.delayed == "torque":  # the whole law held back: its clipped torque is what the delay shifts
+        held = _law_mean(command, feedback, driver.torque_limit)
+        command = np.clip(command - feedback, -driver.torque_limit, driver.torque_limit)
+        feedback = np.zeros_like(feedback)
     steps = np.arange(n_steps)
-    setpoint = np.stack([_window_sum(command[np.maximum(steps - k, 0)] * dt, m, windows) for k in range(K + 2)])
+    setpoint = np.stack([_window_sum(held[np.maximum(steps - k, 0)] * dt, m, windows) for k in range(K + 2)])
     p, b, dg, m_jj = _dynamics(robot, q_enc - offset, v, index)
     ends = np.arange(windows + 1) * m
     feedback_impulse = _window_sum(trap(feedback), m, windows)
@@ -246,6 +249,20 @@ def _segment_rows(robot: Robot, log: Log, index: np.ndarray, offset: np.ndarray,
             "sigma": sigma,
             "position_noise": sigma_q, "velocity_noise": sigma_v, "period": T, "start": ends[:-1][keep],
             "joints": tuple(robot.actuated[i] for i in index), "offset": np.asarray(offset, dtype=float)}
+
+
+def _law_mean(command: np.ndarray, feedback: np.ndarray, limit: np.ndarray) -> np.ndarray:
+    """The whole law's mean torque over each step (N - 1, n) [N·m] (``delayed = "torque"``): the set-points'
+    ``command`` (N, n) held from the step's first sample, the ``feedback`` (N, n) of the state, which moves within the
+    step, by the trapezoid (as the set-points' delay's ``rest`` takes it), each end clipped at ``limit``.
+
+    Held back by ``d``, the law's impulse over a step is then its impulse over the step ``d`` earlier: at ``d = 0``
+    the balance of the set-points delayed. The feedback taken at the step's first sample instead (held as the
+    set-points are) put it half a period early: ``kp T/2 qd`` more torque in the balance than the driver applied,
+    which F_v took up (+21 % on the simulated Go2, kp 25, 200 Hz), and ``kd T/2 qdd``, which the armature took up.
+    """
+    held = command[:-1]
+    return 0.5 * (np.clip(held - feedback[:-1], -limit, limit) + np.clip(held - feedback[1:], -limit, limit))
 
 
 def tanh_impulse(v: np.ndarray, dt: np.ndarray, a: float) -> np.ndarray:
