@@ -8,15 +8,17 @@ numbers every decision is judged on; ``tuning`` the ones rules may be chosen on;
 :func:`~wbfriction.studies.generalise.scenario.split`) and classes (``--classes``) run, one Dask task each on a
 local cluster of ``--workers`` single-threaded processes (each task simulates its scenario and runs the route's
 commands as processes). Printed, per class and overall: the four counts of fits (good: F_c and F_v within 10 % of
-the truth), the coverage of ±2 standard errors, the ``ok`` values outside ±20 % of the truth; for the hung PD-driven
+the truth), the coverage of ±2 standard errors (of F_c and F_v, the issue's target; and of every value, a PD-driven
+robot's armatures, offsets and delay too), the ``ok`` values outside ±20 % of the truth; for the hung PD-driven
 robots what ``identify --actuator pd --config-output`` wrote against the given TOML; then the counts per law, per
 excitation and per robot. The default (300 seeds, the test set: about 145 scenarios) takes about 30 minutes on two
 cores.
 
     python benchmarks/bench_generalise.py [--seeds 300] [--set test|tuning|all] [--classes arm,pd,crawl,humanoid]
-        [--workers 2] [--first 0] [--keep DIR] [-o DIR]
+        [--workers 2] [--first 0] [--keep DIR [--score-only]] [-o DIR]
 
-``-o DIR`` writes ``generalise.md`` and ``generalise.json`` there; ``--keep DIR`` keeps each scenario's folder.
+``-o DIR`` writes ``generalise.md`` and ``generalise.json`` there; ``--keep DIR`` keeps each scenario's folder;
+``--score-only`` scores the folders a run kept there again (a change of the scoring, not of the tool), in seconds.
 """
 
 from __future__ import annotations
@@ -30,7 +32,14 @@ import time
 from pathlib import Path
 
 from wbfriction.studies.generalise.scenario import CLASSES, SETS, draw, split
-from wbfriction.studies.generalise.score import ScenarioScore, breakdown, markdown, run_scenario, summaries
+from wbfriction.studies.generalise.score import (
+    ScenarioScore,
+    breakdown,
+    markdown,
+    run_scenario,
+    score_scenario,
+    summaries,
+)
 from wbfriction.studies.status import GOOD_NOISY, CaseScore
 
 REPO = Path(__file__).resolve().parents[1]
@@ -52,6 +61,17 @@ def _task(seed: int, base: str) -> ScenarioScore:
         sc = draw(seed)
         return ScenarioScore(seed, sc.set, sc.robot_class, sc.robot, sc.law, sc.excitation,
                              CaseScore(sc.name, GOOD_NOISY, failed=f"{type(exc).__name__}: {exc}"))
+
+
+def rescore(seed: int, folder: Path) -> ScenarioScore:
+    """``seed``'s scenario scored on the files a run kept in ``folder`` (its route not run again); a folder without
+    them: failed, named."""
+    sc = draw(seed)
+    try:
+        return score_scenario(sc, folder)
+    except (ValueError, OSError, KeyError) as exc:
+        return ScenarioScore(seed, sc.set, sc.robot_class, sc.robot, sc.law, sc.excitation,
+                             CaseScore(sc.name, GOOD_NOISY, failed=f"{folder}: {type(exc).__name__}: {exc}"))
 
 
 def run(seeds: list[int], base: Path, workers: int) -> list[ScenarioScore]:
@@ -84,6 +104,8 @@ def main() -> None:
     parser.add_argument("--classes", default=",".join(CLASSES), help="comma-separated, of " + ", ".join(CLASSES))
     parser.add_argument("--workers", type=int, default=2, help="Dask worker processes (default 2)")
     parser.add_argument("--keep", type=Path, help="run in this folder and keep each scenario's files")
+    parser.add_argument("--score-only", action="store_true",
+                        help="score the scenarios' files a run kept in --keep again, without running them")
     parser.add_argument("-o", "--output", type=Path, help="write generalise.md and generalise.json into this folder")
     args = parser.parse_args()
     classes = [c.strip() for c in args.classes.split(",") if c.strip()]
@@ -96,10 +118,15 @@ def main() -> None:
     print(f"{len(seeds)} scenarios: seeds {args.first}-{args.first + args.seeds - 1}, set {args.set}, "
           f"classes {', '.join(classes)}, {args.workers} workers", flush=True)
     start = time.perf_counter()
-    with tempfile.TemporaryDirectory(prefix="bench_generalise-") as scratch:
-        base = args.keep or Path(scratch)
-        base.mkdir(parents=True, exist_ok=True)
-        scores = run(seeds, base, args.workers)
+    if args.score_only:
+        if args.keep is None or not args.keep.is_dir():
+            sys.exit("--score-only: --keep must name the folder a run kept")
+        scores = [rescore(seed, args.keep / str(seed)) for seed in seeds]
+    else:
+        with tempfile.TemporaryDirectory(prefix="bench_generalise-") as scratch:
+            base = args.keep or Path(scratch)
+            base.mkdir(parents=True, exist_ok=True)
+            scores = run(seeds, base, args.workers)
     wall = time.perf_counter() - start
     title = f"set {args.set}: seeds {args.first}-{args.first + args.seeds - 1}, {len(seeds)} scenarios"
     text = "\n\n".join([markdown(summaries(scores), title), breakdown(scores, "law"), breakdown(scores, "excitation"),

@@ -263,6 +263,9 @@ def identify_actuators(robot: Robot, log: Log, options: ActuatorOptions = Actuat
             why += (f"; {others[0].options.delayed} delayed closes it as well (its squared residual per window over "
                     f"the sensors' noise higher by {gain:.3g} ± {se:.2g}, within {GAIN_Z:g} standard errors): the log "
                     "does not tell what the delay holds back")
+            if best.options.delayed != UNDECIDED:
+                best, others[0] = others[0], best
+                why += f"; the {UNDECIDED} delayed taken, what a simulator's actuator delays"
             best = structure_widened(best, others[0])
     return replace(best, velocity_reason=why, clock=log.clock.reason if log.clock is not None else "",
                    written=written_choice(robot, log, best))
@@ -308,6 +311,13 @@ def structure_gain(best: ActuatorIdentification, other: ActuatorIdentification) 
     return held_out_gain(theirs, mine, windows)
 
 
+UNDECIDED = "setpoints"
+"""What the delay holds back where the log does not tell (:func:`structure_gain` within
+:data:`~wbfriction.fit.selection.GAIN_Z` standard errors): the set-points, the structure every simulator
+``export`` writes represents (a MuJoCo or Isaac actuator delays its target, not its feedback), so the armatures and
+the delay written stay the ones a simulator can replay; the friction's standard errors carry the other structure's
+values either way (:func:`structure_widened`). A tie-break between two models the data support alike, not a
+threshold: on the real Aliengo the two close the balance within 2 standard errors of each other."""
 STRUCTURE_SPREAD = ("F_v", "F_c")
 """The values whose standard error carries what the delay holds back where the log does not tell
 (:func:`structure_widened`): the friction, which a user reads as the joint's. The armature, the offsets and the delay

@@ -38,6 +38,7 @@ from wbfriction.fit.status import PROMISE
 from wbfriction.studies.generalise.scenario import CLASSES, Scenario, draw
 from wbfriction.studies.generalise.simulate import GIVEN_TOML, LOG, absolute_pythonpath, write_scenario
 from wbfriction.studies.status import (
+    FRICTION,
     GOOD_NOISY,
     CaseScore,
     JointFit,
@@ -116,7 +117,9 @@ def toml_verdict(written: Sequence[Written]) -> str:
 @dataclass(frozen=True)
 class ScenarioScore:
     """A scenario's score: its draw's key facts, :class:`~wbfriction.studies.status.CaseScore`, the ``ok`` values
-    outside :data:`PROMISE` (of ``ok_values``), and for a PD-driven robot what ``--config-output`` wrote."""
+    outside :data:`PROMISE` (of ``ok_values``), the friction's (F_c, F_v) values within ±2 standard errors of the
+    truth (of ``friction_scored``: the case's coverage counts a PD-driven robot's armatures, offsets and delay too),
+    and for a PD-driven robot what ``--config-output`` wrote."""
 
     seed: int
     set: str
@@ -127,6 +130,8 @@ class ScenarioScore:
     case: CaseScore
     ok_outside: int = 0
     ok_values: int = 0
+    friction_covered: int = 0
+    friction_scored: int = 0
     written: tuple[Written, ...] = field(default_factory=tuple)
 
     def to_dict(self) -> dict[str, Any]:
@@ -152,8 +157,9 @@ def score_scenario(sc: Scenario, folder: Path) -> ScenarioScore:
     else:
         fits = fits_from_params(folder / PARAMS, truth["friction_true"])
     outside, values = promise(fits)
+    friction = [p.covered for f in fits for p in f.parameters if p.name in FRICTION and p.covered is not None]
     return ScenarioScore(sc.seed, sc.set, sc.robot_class, sc.robot, sc.law, sc.excitation,
-                         score_fits(sc.name, fits, noisy=True), outside, values, written)
+                         score_fits(sc.name, fits, noisy=True), outside, values, sum(friction), len(friction), written)
 
 
 def run_scenario(seed: int | Scenario, folder: str | Path, echo: Callable[[str], None] | None = None
@@ -191,6 +197,8 @@ class Summary:
     scored: int
     ok_outside: int
     ok_values: int
+    friction_covered: int
+    friction_scored: int
     written: dict[str, tuple[int, int, int]]
     """per value name: (closer to the truth than the given, written but not closer, not written)"""
     tomls: tuple[int, int, int]
@@ -217,7 +225,8 @@ def summarise(group: str, scores: Sequence[ScenarioScore]) -> Summary:
     tomls = (verdicts.count("closer"), verdicts.count("farther"), verdicts.count("unchanged"))
     return Summary(group, len(scores), len(scores) - len(ok), total("ok_good"), total("ok_bad"),
                    total("not_ok_good"), total("not_ok_bad"), total("covered"), total("scored"),
-                   sum(s.ok_outside for s in ok), sum(s.ok_values for s in ok), written, tomls,
+                   sum(s.ok_outside for s in ok), sum(s.ok_values for s in ok), sum(s.friction_covered for s in ok),
+                   sum(s.friction_scored for s in ok), written, tomls,
                    sum(s.case.seconds for s in scores if math.isfinite(s.case.seconds)))
 
 
@@ -235,12 +244,13 @@ def _pct(a: int, b: int) -> str:
 def markdown(rows: Sequence[Summary], title: str) -> str:
     """The summaries as Markdown: the fits' counts, coverage and promise, then ``--config-output``'s values."""
     lines = [f"### {title}", "",
-             "| class | scenarios (failed) | ok, good | ok, bad | not ok, good | not ok, bad | coverage ±2 SE | "
-             f"ok outside ±{100 * PROMISE:.0f} % | time, summed [s] |", "|---" * 9 + "|"]
+             "| class | scenarios (failed) | ok, good | ok, bad | not ok, good | not ok, bad | coverage ±2 SE, F_c and "
+             f"F_v | coverage ±2 SE, every value | ok outside ±{100 * PROMISE:.0f} % | time, summed [s] |",
+             "|---" * 10 + "|"]
     for r in rows:
         lines.append(f"| {r.group} | {r.scenarios} ({r.failed}) | {r.ok_good} | {r.ok_bad} | {r.not_ok_good} | "
-                     f"{r.not_ok_bad} | {_pct(r.covered, r.scored)} | {_pct(r.ok_outside, r.ok_values)} | "
-                     f"{r.seconds:.0f} |")
+                     f"{r.not_ok_bad} | {_pct(r.friction_covered, r.friction_scored)} | {_pct(r.covered, r.scored)} | "
+                     f"{_pct(r.ok_outside, r.ok_values)} | {r.seconds:.0f} |")
     written = [r for r in rows if r.written]
     if written:
         lines += ["", "`identify --actuator pd --config-output` against the given TOML (per value: written closer to "
@@ -258,10 +268,12 @@ def breakdown(scores: Sequence[ScenarioScore], key: str) -> str:
     """A Markdown table of the fits' counts per value of ``key`` (``law``, ``excitation``, ``robot``)."""
     values = sorted({getattr(s, key) for s in scores})
     rows = [summarise(v, [s for s in scores if getattr(s, key) == v]) for v in values]
-    lines = [f"| {key} | scenarios (failed) | ok, good | ok, bad | not ok, good | not ok, bad | coverage ±2 SE | "
-             f"ok outside ±{100 * PROMISE:.0f} % | written TOML closer / farther / unchanged |", "|---" * 9 + "|"]
+    lines = [f"| {key} | scenarios (failed) | ok, good | ok, bad | not ok, good | not ok, bad | coverage ±2 SE, F_c "
+             f"and F_v | ok outside ±{100 * PROMISE:.0f} % | written TOML closer / farther / unchanged |",
+             "|---" * 9 + "|"]
     for r in rows:
         tomls = "{} / {} / {}".format(*r.tomls) if any(r.tomls) else "–"
         lines.append(f"| {r.group} | {r.scenarios} ({r.failed}) | {r.ok_good} | {r.ok_bad} | {r.not_ok_good} | "
-                     f"{r.not_ok_bad} | {_pct(r.covered, r.scored)} | {_pct(r.ok_outside, r.ok_values)} | {tomls} |")
+                     f"{r.not_ok_bad} | {_pct(r.friction_covered, r.friction_scored)} | "
+                     f"{_pct(r.ok_outside, r.ok_values)} | {tomls} |")
     return "\n".join(lines)
