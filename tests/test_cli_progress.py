@@ -96,7 +96,8 @@ def test_commands_print_a_line_per_stage_when_piped(capsys, tmp_path):
     assert int(assert_stages(err, "reading friction.parquet", "fit")["fit"]["items"]) == 7  # the arm's joints
     assert not stage_lines(out)
     for args, labels in ((("predict", friction, "--params", params), ("predicting",)),
-                         (("export", params, "--robot", "panda", "-o", tmp_path / "panda.xml"), ("exporting",))):
+                         (("export", params, "--robot", "panda", "--include", "weak,does-not-predict", "-o",
+                           tmp_path / "panda.xml"), ("exporting",))):
         code, _, err = run_cli_printed(capsys, *args)
         assert code == 0, err
         assert_stages(err, *labels)

@@ -61,7 +61,9 @@ def test_every_parameter_is_ok_and_its_standard_error_as_predicted(played):
     ratios = np.array([p.se / design.prediction.joints[j.joint][name].se
                        for j in result.joints for name, p in j.parameters().items()])
     assert len(ratios) == 48
-    assert np.mean((ratios > 1 / 1.5) & (ratios < 1.5)) >= 0.9, np.sort(ratios)
+    # both standard errors carry a ten-block jackknife (actuator.solve.block_grown), each estimated to about 24 %
+    # (1 / sqrt(2 x 9)): their ratio to about 35 %, so within a factor 2 nine times in ten
+    assert np.mean((ratios > 1 / 2) & (ratios < 2)) >= 0.9, np.sort(ratios)
     assert 0.8 < np.median(ratios) < 1.25
     assert 1 / 1.5 < result.delay.se / design.prediction.delay.se < 1.5
 

@@ -286,7 +286,7 @@ def test_a_magnitude_the_terms_would_drive_negative_is_held_at_zero():
 
 def test_a_fit_with_terms_reports_the_model_its_status_judges():
     """A velocity fit that is weak alone (F_c 0.04 ± 0.08, lwr_6's on the KUKA) but well determined once its ripple is
-    fitted (0.061 ± 0.008): its status is the refitted model's, and so are the numbers shown beside it
+    fitted (0.061 ± 0.005): its status is the refitted model's, and so are the numbers shown beside it
     (:meth:`~wbfriction.fit.result.FitResult.reported`); no Cramér-Rao bound of the other model is shown with
     them. Without terms kept, the fit reports itself."""
     from wbfriction.fit.result import FitResult
@@ -296,13 +296,13 @@ def test_a_fit_with_terms_reports_the_model_its_status_judges():
                     at_bound={"F_v": True}, speed=1.0, crb={"F_c": 0.03, "F_v": 0.07})
     assert fit.verdict().status == "weak" and fit.reported() is fit
     terms = TermFit(CoulombViscousParams(F_v=0.0, F_c=0.061, tau_os=-0.1), ("ripple",), 1,
-                    {"ripple_sin1": 0.2, "ripple_cos1": 0.1}, {"F_v": 0.0, "F_c": 0.008, "tau_os": 0.6,
+                    {"ripple_sin1": 0.2, "ripple_cos1": 0.1}, {"F_v": 0.0, "F_c": 0.005, "tau_os": 0.6,
                                                                 "ripple_rms": 0.008}, {"ripple_rms": 0.225},
                     at_bound=("F_v",))
     with_terms = replace(fit, terms=terms)
     shown = with_terms.reported()
     assert with_terms.verdict().ok and shown.verdict() == with_terms.verdict()
-    assert shown.params == terms.params and shown.stderr["F_c"] == 0.008 and shown.crb == {}
+    assert shown.params == terms.params and shown.stderr["F_c"] == 0.005 and shown.crb == {}
     assert shown.at_bound == {"F_v": True, "F_c": False, "tau_os": False}
     none_kept = replace(fit, terms=replace(terms, kept=(), harmonics=0))
     assert none_kept.reported() is none_kept and none_kept.verdict().status == "weak"

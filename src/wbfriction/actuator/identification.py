@@ -265,7 +265,10 @@ def identify_actuators(robot: Robot, log: Log, options: ActuatorOptions = Actuat
                     "does not tell what the delay holds back")
             if best.options.delayed != UNDECIDED:
                 best, others[0] = others[0], best
-                why += f"; the {UNDECIDED} delayed taken, what a simulator's actuator delays"
+                why = (f"{best.options.velocity} velocity, {UNDECIDED} delayed, as a simulator's actuator delays: the "
+                       f"log does not tell what the delay holds back ({others[0].options.delayed} delayed closes the "
+                       f"balance as well, its squared residual per window over the sensors' noise lower by "
+                       f"{gain:.3g} ± {se:.2g}, within {GAIN_Z:g} standard errors)")
             best = structure_widened(best, others[0])
     return replace(best, velocity_reason=why, clock=log.clock.reason if log.clock is not None else "",
                    written=written_choice(robot, log, best))

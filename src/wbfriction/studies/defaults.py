@@ -114,7 +114,7 @@ KNOBS: tuple[Knob, ...] = (
          lambda s, v: replace(s, fit=replace(s.fit, terms=replace(s.fit.terms, min_torque=v)))),
     Knob("term_tolerance", "fit", (0.01, 0.02, 0.05), 0.02,
          lambda s, v: replace(s, fit=replace(s.fit, terms=replace(s.fit.terms, tolerance=v)))),
-    Knob("weak", "status", (0.125, 0.25, 0.5), 0.25, _thresholds("weak")),
+    Knob("weak", "status", (0.1, 0.125, 0.25, 0.5), 0.1, _thresholds("weak")),
     Knob("holdout_excess", "status", (0.02, 0.05, 0.1, 0.2), 0.05, _thresholds("holdout_excess")),
     Knob("holdout_friction", "status", (0.02, 0.05, 0.1), 0.05, _thresholds("holdout_friction")),
     Knob("route_rel", "status", (0.02, 0.05, 0.1), 0.02, _thresholds("route_rel")),
