@@ -222,8 +222,8 @@ PRINTS = {
     "docs/how-to/excitation.md": [r"^48 of 48 parameters ok; 4[3-8] of 48 standard errors within 2x of the "
                                   r"prediction$",
                                   # the Panda's design played: every joint ok, its errors near those predicted
-                                  r"^7 of 7 joints ok; F_c and F_v: ([7-9]|1[0-4]) of 14 standard errors within 1\.5x of "
-                                  r"the prediction$",
+                                  r"^7 of 7 joints ok; F_c and F_v: ([7-9]|1[0-4]) of 14 standard errors within "
+                                  r"1\.5x of the prediction$",
                                   # TALOS on one foot, its swing leg's friction recovered (issue 66: within 2 %)
                                   r"^swing leg: 6 joints, F_c and F_v within [01]\.\d\d % of the truth$",
                                   # the Go2 on three feet, played from the table excite wrote, its front right leg's
