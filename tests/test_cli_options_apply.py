@@ -2,7 +2,7 @@
 class 6): one line naming the option, the mode and what it takes, exit 2, before the work, nothing written.
 ``simulate``'s modes (a robot on point feet, a hung PD-driven robot, an arm, a walk ideal or on MuJoCo) and
 ``identify``'s (the inertia model, ``--actuator pd``) each read the options of their table (each simulator kind's
-:attr:`~wbfriction.sim.simulators.base.SimulatorKind.options`, :data:`wbfriction.cli.identify.MODES`); the refusal
+:attr:`~wbfriction.rigs.base.Rig.simulation`'s fields, and the engine's, :data:`wbfriction.cli.identify.MODES`); the refusal
 is :func:`wbfriction.cli.common.refuse_options`. Also the misleading lines of class 5 in these commands."""
 
 from __future__ import annotations
@@ -19,14 +19,28 @@ from wbfriction.cli import identify as identify_cli
 from wbfriction.cli import simulate as simulate_cli
 from wbfriction.cli.common import option_flag
 from wbfriction.exceptions import InputError
-from wbfriction.sim.simulators import simulators
+from wbfriction.cli import rigs as rigs_cli
+from wbfriction.options import option_names
+from wbfriction.rigs.registry import RIGS
+from wbfriction.sim.engines import engine_of
 
 COMMANDS = typer.main.get_command(app).commands  # type: ignore[attr-defined]
 
 
+MODES = {"quadruped": ("quadruped", "ideal"), "hung": ("hung", None), "arm": ("arm", None), "ideal": ("biped", "ideal"),
+         "mujoco": ("biped", "mujoco")}
+"""Each mode of ``simulate``: the rig and the engine it runs in."""
+
+
 def simulator_options() -> dict[str, tuple[str, ...]]:
-    """The options each registered simulator reads beyond ``simulate``'s shared ones, by its name."""
-    return {k.name: k.options for k in simulators()}
+    """The options each mode reads beyond ``simulate``'s shared ones: its rig's and its engine's, ``--simulator``
+    where it runs in one."""
+    found = {}
+    for mode, (rig_name, engine_name) in MODES.items():
+        rig, engine = RIGS.get(rig_name), None if engine_name is None else engine_of(engine_name)
+        found[mode] = (*option_names(rig.simulation), *option_names(rig.engine_options(engine)),
+                       *(("simulator",) if engine is not None else ()))
+    return found
 
 HUNG = ("robot 'go2' is a hung PD-driven robot (fixed base, [pd]): it takes --friction, --substeps, "
         "--mujoco-friction, --position-noise, --encoder-bits, --noise-seed, --delay, --friction-timeconst, "
@@ -190,7 +204,7 @@ def stop_after_the_refusal(monkeypatch):
     robots: dict = {}
     robot_of = simulate_cli.robot_of
     monkeypatch.setattr(simulate_cli, "robot_of", lambda *a: robots.get(a) or robots.setdefault(a, robot_of(*a)))
-    monkeypatch.setattr(simulate_cli, "check_options", accepted)
+    monkeypatch.setattr(rigs_cli, "read_options", accepted)
     monkeypatch.setattr(identify_cli, "check_paths", accepted)
     monkeypatch.setattr(actuator_cli, "check_paths", accepted)
 

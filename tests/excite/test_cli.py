@@ -41,14 +41,14 @@ def test_a_design_written_then_played(cli, capsys, tmp_path):
 
 def test_what_cannot_be_designed_is_one_line_before_the_work(capsys, tmp_path):
     code, _, err = run_cli_printed(capsys, "excite", "--robot", "go2", "--swing", "FR", "-o", tmp_path / "d.parquet")
-    assert code == 2 and "--swing: robot 'go2' has a fixed base: it takes no floating base's option" in err
+    assert code == 2 and "--swing: robot 'go2' is a hung PD-driven robot (fixed base, [pd]): it takes" in err
     code, _, err = run_cli_printed(capsys, "excite", "--robot", "go2", "--duration", "1", "-o", tmp_path / "d.parquet")
     assert code == 2 and "--duration 1: the design needs at least" in err
     code, _, err = run_cli_printed(capsys, "excite", "--robot", "go2", "--duration", "2", "--amplitude", "0.95",
                                    "--torque-share", "0.05", "-o", tmp_path / "d.parquet")
     assert code == 2 and "every candidate passes a limit or 5% of a torque limit" in err
     code, _, err = run_cli_printed(capsys, "excite", "--robot", "go2", "--period", "5", "-o", tmp_path / "d.parquet")
-    assert code == 2 and "--period: robot 'go2' is a hung PD-driven robot: it takes no arm's option" in err
+    assert code == 2 and "--period: robot 'go2' is a hung PD-driven robot (fixed base, [pd]): it takes" in err
     code, _, err = run_cli_printed(capsys, "simulate", "--robot", "go2", "--play", tmp_path / "missing.parquet",
                                    "-o", tmp_path / "x.parquet")
     assert code == 2 and "missing.parquet" in err

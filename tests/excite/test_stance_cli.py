@@ -100,11 +100,11 @@ def test_a_stance_designed_played_estimated_and_fitted(cli, talos, tmp_path):
 def test_what_a_stance_does_not_take_is_one_line(capsys, talos, tmp_path):
     for args, line in [
         (("--robot", "panda", "--stance", "left"),
-         "--stance: robot 'panda' has a fixed base: it takes no floating base's option"),
+         "--stance: robot 'panda' is a fixed-base arm (torque-driven, an excitation trajectory): it takes"),
         (("--robot", "talos", "--amplitude", "0.5"),
-         "--amplitude: robot 'talos' has a floating base: it takes no fixed base's option"),
+         "--amplitude: robot 'talos' is a biped on soles: it takes"),
         (("--robot", "talos", "--torque-share", "0.5"),
-         "--torque-share: robot 'talos' has a floating base: it takes no fixed base's option"),
+         "--torque-share: robot 'talos' is a biped on soles: it takes"),
         (("--robot", "talos", "--stance", "both"), "'both' is not one of"),
         (("--robot", "talos", "--duration", "4", "--period", "3"), "--period 3: the recording of 4 s must hold"),
     ]:
@@ -120,7 +120,7 @@ def test_what_a_stance_does_not_take_is_one_line(capsys, talos, tmp_path):
         ((), "plain.parquet: no stance foot or swing series: a biped plays what 'excite --stance' writes"),
         (("--gait", "sideways"), "--gait: the set-points played (plain.parquet) fix the motion: it takes no motion"),
         (("--steps", "3"), "--steps: the set-points played (plain.parquet) fix the motion: it takes no motion"),
-        (("--simulator", "mujoco", "--duration", "3"), "--duration: robot 'talos' walks on MuJoCo"),
+        (("--simulator", "mujoco", "--duration", "3"), "--duration: robot 'talos' is a biped on soles, simulated in mujoco"),
     ]:
         code, _, err = run_cli_printed(capsys, "simulate", "--robot", "talos", "--play", path, *args, "-o",
                                        tmp_path / "y.parquet")

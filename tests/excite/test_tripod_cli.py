@@ -31,7 +31,7 @@ from wbfriction.logs.setpoint_table import read_setpoint_table
 from wbfriction.logs.tables import write_table
 from wbfriction.model import load_robot
 from wbfriction.sim.quadruped import default_quadruped_friction
-from wbfriction.sim.simulators.quadruped import played_tripod
+from wbfriction.rigs.played import played_tripod
 
 # excite (the design and the IK) 6 s, the reference again 5 s, simulate 3 s, estimate and fit 5 s
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_tripod_cli")]
@@ -126,13 +126,13 @@ def test_a_three_feet_stance_designed_played_estimated_and_fitted(cli, capsys, g
 
 def test_what_a_three_feet_stance_does_not_take_is_one_line(capsys, go2, tmp_path):
     for args, line in [
-        (("--robot", "talos", "--swing", "FR"), "--swing: robot 'talos' is a biped: it takes no quadruped's option"),
+        (("--robot", "talos", "--swing", "FR"), "--swing: robot 'talos' is a biped on soles: it takes"),
         (("--robot", "go2_walking", "--stance", "left"),
-         "--stance: robot 'go2_walking' is a quadruped on point feet: it takes no biped's option"),
+         "--stance: robot 'go2_walking' stands on point feet (a walking quadruped): it takes"),
         (("--robot", "panda", "--swing", "FR"),
-         "--swing: robot 'panda' has a fixed base: it takes no floating base's option"),
+         "--swing: robot 'panda' is a fixed-base arm (torque-driven, an excitation trajectory): it takes"),
         (("--robot", "go2_walking", "--amplitude", "0.5"),
-         "--amplitude: robot 'go2_walking' has a floating base: it takes no fixed base's option"),
+         "--amplitude: robot 'go2_walking' stands on point feet (a walking quadruped): it takes"),
         (("--robot", "go2_walking", "--swing", "XX"), "--swing 'XX': one of FL, FR, RL, RR"),
         (("--robot", "go2_walking", "--duration", "4", "--period", "3"), "--period 3: the recording of 4 s must hold"),
     ]:

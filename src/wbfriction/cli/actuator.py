@@ -11,8 +11,10 @@ from rich.table import Table
 
 from wbfriction.actuator import ActuatorIdentification, ActuatorOptions, Identified
 from wbfriction.cli.common import config_text, console, out, print_whole, robot_of, stages, warn
+from wbfriction.exceptions import InputError
 from wbfriction.logs.options import TimeUnit
 from wbfriction.pipeline.paths import check_paths
+from wbfriction.rigs import rig_for
 
 
 def identify_pd(log: Path, robot: str, urdf: Optional[Path], config: Optional[Path], mjcf: Optional[Path],
@@ -25,6 +27,10 @@ def identify_pd(log: Path, robot: str, urdf: Optional[Path], config: Optional[Pa
     check_paths({"LOG": log, "--urdf": urdf, "--mjcf": mjcf, "--config": config},
                 {"--json": json_output, "--config-output": config_output})
     r = robot_of(robot, urdf, config, mjcf)
+    rig = rig_for(r, "pd")
+    if not rig.identifies_actuators:
+        raise InputError(f"--actuator pd: {rig.what(r, 'pd')}: its identification is the inertia model's and the "
+                         "friction's ('identify' without --actuator pd)")
     with stages() as stage:
         stage("identifying the actuators")
         result = identify_actuator_file(r, log, json_output, options, time_unit)

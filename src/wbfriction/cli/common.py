@@ -318,3 +318,14 @@ def main() -> None:
         raise
     if isinstance(status, int) and status:
         sys.exit(status)
+
+
+def print_items(items) -> None:
+    """Print what an operation returned to print (:class:`~wbfriction.report.printed.Printed` items), in order, on
+    standard output: a line without highlighting, a table fitted to the terminal or, ``whole``, as wide as it
+    takes."""
+    for p in items:
+        if p.whole:
+            print_whole(p.item)
+        else:
+            out.print(p.item, highlight=False, soft_wrap=p.soft_wrap)

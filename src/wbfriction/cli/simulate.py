@@ -1,12 +1,11 @@
 """``wbfriction simulate``: a robot with known friction, as a log (a walk, ideal or on MuJoCo; a quadruped's gait; an
-arm's excitation; a hung PD-driven robot's set-points). The simulator that runs a robot is a registered kind
-(:mod:`wbfriction.sim.simulators`): this module parses, asks the registry, refuses the options the kind does not
-read, shows the progress, writes and prints."""
+arm's excitation; a hung PD-driven robot's set-points). What runs is the robot's rig (:func:`~wbfriction.rigs.
+rig_for`) in the engine ``--simulator`` names where the rig runs in one (:mod:`wbfriction.sim.engines`): this module
+parses, asks the rig, hands it its typed options (refusing those it does not read), shows the progress, writes and
+prints."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Literal, Optional
 
@@ -22,24 +21,21 @@ from wbfriction.cli.common import (
     UrdfOpt,
     app,
     console,
-    progress_bar,
-    refuse_options,
-    refuse_unread,
     robot_of,
     stages,
 )
 from wbfriction.cli.helpformat import LOGS
+from wbfriction.cli.rigs import RigOptionOpt, rig_options
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.exceptions import OptionError
 from wbfriction.logs.formats.catalog import written_suffixes
 from wbfriction.pipeline.paths import check_paths
-from wbfriction.progress import Progress
-from wbfriction.quantities import check_options
+from wbfriction.rigs import RigProgress, rig_for
+from wbfriction.sim.engines import engine_names, engines
 from wbfriction.sim.options import FrictionMode, Integrator
 from wbfriction.sim.pd_options import HungOptions, SetpointKind, SetpointOptions
-from wbfriction.sim.simulators import SimulationProgress, simulator_for, simulator_names
 
 HUNG = HungOptions()
 SETPOINTS = SetpointOptions()
@@ -53,21 +49,6 @@ Actuator = Literal["torque", "pd"]
 DriverNoiseChoice = Literal["real", "none"]
 """The PD drivers' sensor noise (``--driver-noise``): a real driver's (:data:`~wbfriction.sim.pd_options.REAL_DRIVER`)
 or none."""
-
-
-class CliProgress(SimulationProgress):
-    """A simulation's progress on the terminal: a status line around each stage, a bar over the samples."""
-
-    @contextmanager
-    def stage(self, text: str) -> Iterator[None]:
-        with stages() as stage:
-            stage(text)
-            yield
-
-    @contextmanager
-    def steps(self, total: int) -> Iterator[Progress | None]:
-        with progress_bar(total, "simulate") as advance:
-            yield advance
 
 
 OutputOpt = typer.Option(..., "-o", "--output", help=f"Log to write: {written_suffixes()}.")
@@ -84,11 +65,10 @@ StepLengthOpt = typer.Option(GAIT.step_length, help="A walk: forward distance be
 StepWidthOpt = typer.Option(GAIT.step_width, help="A walk: sideways step [m].")
 TurnAngleOpt = typer.Option(GAIT.turn_angle, help="A walk: heading change per turning step [rad].")
 LiftHeightOpt = typer.Option(GAIT.lift_height, help="A walk: swing-foot apex [m].")
-SimulatorOpt = typer.Option("ideal", metavar=f"[{'|'.join(simulator_names())}]",
-                            help="A walk or a robot on point feet: ideal (rigid contacts, thesis 6.1) or mujoco (soft "
-                                 "contacts, measured contact flags, sensors, thesis 6.2); or a simulator a program "
-                                 "registered (wbfriction.sim.simulators.register_simulator), for the robots it "
-                                 f"claims. Registered: {', '.join(simulator_names())}.")
+SimulatorOpt = typer.Option(None, metavar=f"[{'|'.join(engine_names())}]",
+                            help="A walk or a robot on point feet: the engine it runs in, "
+                                 + "; ".join(e.what for e in engines()) + " (default: the first); or one a program "
+                                 "registered (wbfriction.sim.engines.register_engine).")
 SubstepsOpt = typer.Option(None, help=f"Physics steps per control period (default: {IDEAL.substeps} ideal, "
                                       f"{MUJOCO.substeps} mujoco (1 ms periods), {HUNG.substeps} PD-driven (at "
                                       f"{HUNG.rate:g} Hz: 1 ms steps), 4 for a robot on point feet (2 ms periods: "
@@ -151,11 +131,7 @@ PlayOpt = typer.Option(None, "--play", help="PD-driven, arms, a biped and a robo
                                             "foot, base height and swing leg's series, from which its stance is "
                                             "rebuilt) instead of ramps and chirps, a random excitation, a walk or a "
                                             "gait; its duration and rate are the table's.")
-PLAYED = ("duration", "setpoints", "excitation_seed", "gait", "steps", "step_length", "step_width", "turn_angle",
-          "lift_height", "speed")
-"""What a played table fixes: refused beside ``--play``."""
-
-SHARED = ("output", "robot", "urdf", "config", "mjcf", "actuator")
+SHARED = ("output", "robot", "urdf", "config", "mjcf", "actuator", "rig_option")
 """The options every simulator of ``simulate`` reads that name what is simulated: the log, the robot, how it is
 driven."""
 
@@ -166,7 +142,7 @@ def simulate(ctx: typer.Context, output: Path = OutputOpt, robot: str = RobotOpt
              config: Optional[Path] = ConfigOpt, mjcf: Optional[Path] = MjcfOpt,
              gait: Optional[GaitChoice] = GaitOpt, steps: int = StepsOpt, step_length: float = StepLengthOpt,
              step_width: float = StepWidthOpt, turn_angle: float = TurnAngleOpt, lift_height: float = LiftHeightOpt,
-             friction: Optional[Path] = FrictionOpt, simulator: str = SimulatorOpt,
+             friction: Optional[Path] = FrictionOpt, simulator: Optional[str] = SimulatorOpt,
              substeps: Optional[int] = SubstepsOpt, integrator: Integrator = IntegratorOpt,
              mujoco_friction: FrictionMode = MujocoFrictionOpt, sensors: Optional[Path] = SensorsOpt,
              position_noise: Optional[float] = PositionNoiseOpt, encoder_bits: Optional[int] = EncoderBitsOpt,
@@ -178,27 +154,25 @@ def simulate(ctx: typer.Context, output: Path = OutputOpt, robot: str = RobotOpt
              actuator: Optional[Actuator] = ActuatorOpt, setpoints: SetpointKind = SetpointsOpt,
              driver_noise: DriverNoiseChoice = DriverNoiseOpt,
              velocity_noise: Optional[float] = VelocityNoiseOpt, speed: Optional[float] = SpeedOpt,
-             foot_forces: FootForces = FootForcesOpt, play: Optional[Path] = PlayOpt) -> None:
+             foot_forces: FootForces = FootForcesOpt, play: Optional[Path] = PlayOpt,
+             rig_option: list[str] = RigOptionOpt) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents; a PD-driven one
     (--robot go2) hangs with its base fixed, its drivers tracking ramps and chirps; --simulator also takes a
     simulator a program registered. Options of another kind of robot are refused."""
     values = {name: value for name, value in locals().items() if name != "ctx"}
-    if simulator not in simulator_names():
-        raise OptionError("--simulator", simulator, f"one of {', '.join(simulator_names())}")
+    if simulator is not None and simulator not in engine_names():
+        raise OptionError("--simulator", simulator, f"one of {', '.join(engine_names())}")
     check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors,
                  "--play": play}, {"-o": output})
     r = robot_of(robot, urdf, config, mjcf)
-    kind = simulator_for(r, actuator, simulator)
-    refuse_options(ctx, kind.what(r, actuator), kind.options, SHARED)
-    if play is not None:
-        refuse_unread(ctx, f"the set-points played ({play.name}) fix the motion", PLAYED, "motion")
-    check_options({"--duration": ("duration", duration), "--excitation-seed": ("seed", excitation_seed),
-                   "--noise-seed": ("seed", noise_seed), "--encoder-bits": ("encoder_bits", encoder_bits),
-                   "--delay": ("delay_ms", delay), "--substeps": ("substeps", substeps),
-                   "--position-noise": ("position_std", position_noise), "--torque-noise": ("torque_std", torque_noise),
-                   "--velocity-noise": ("velocity_std", velocity_noise)})
-    result = kind.run(r, values, friction, CliProgress())
+    rig = rig_for(r, actuator)
+    engine = rig.engine(r, simulator)
+    mode = rig.what(r, actuator) + ("" if engine is None else f", simulated in {engine.name}")
+    options, own = rig_options(ctx, values, (rig.simulation, rig.engine_options(engine)), mode, SHARED, rig_option,
+                               play, engine=engine is not None)
+    with stages() as status:
+        result = rig.simulate(r, options, engine, own, RigProgress(status, status.steps))
     if result.log is not None:
         from wbfriction.logs.log import write_log
         write_log(result.log, r, output)

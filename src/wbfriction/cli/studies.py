@@ -9,19 +9,19 @@ from typing import TYPE_CHECKING, Optional, cast
 import typer
 from rich.markup import escape
 from rich.table import Table
-from rich.text import Text
 
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import InputError, OptionError
 from wbfriction.friction.options import RouteOption
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.signals.options import Diff, FilterOptions
-from wbfriction.sim.options import SensorNoise, Simulator
+from wbfriction.sim.engines import engine_names
+from wbfriction.sim.options import SensorNoise
 
 if TYPE_CHECKING:
-    from wbfriction.model.robot import Robot
+    pass
 
 from wbfriction.cli.common import (
     GAIT,
@@ -31,161 +31,46 @@ from wbfriction.cli.common import (
     app,
     console,
     out,
+    print_items,
     robot_of,
     stages,
 )
 from wbfriction.cli.helpformat import STUDIES
-
-
-def _thesis_percent(x: float) -> str:
-    """A thesis error [%] to the digits that mean something: 972, not 971.75."""
-    return f"{x:.0f}" if x >= 100 else f"{x:.2f}"
-
-
-def _thesis_caption(rows, cols: list[int], params: tuple[str, ...]) -> str:
-    """What the table's thesis rows are, and why some of Table 6.1's errors are over 100 % (the straight walk
-    barely moved those joints in swing: its fit traded Coulomb for viscous friction; Table 6.2's walk, sideways
-    too, has them small)."""
-    text = "T6.1 / T6.2: the thesis's errors for the same joint (TORO, straight / straight and sideways) [%]"
-    over = [(row, params[k], c) for row in rows if row.thesis_6_1 is not None
-            for k, c in enumerate(cols) if row.thesis_6_1[c] > 100]
-    if not over:
-        return text
-    named = ", ".join(f"#{row.number} {name} {_thesis_percent(row.thesis_6_1[c])}" for row, name, c in over)
-    after = max((row.thesis_6_2[c] for row, _, c in over if row.thesis_6_2 is not None), default=None)
-    return (f"{text}; T6.1 over 100 % ({named}): the thesis's straight walk barely moved these joints in swing "
-            "and its fit traded Coulomb for viscous friction"
-            + ("" if after is None else f"; with sideways steps (T6.2) the same errors are at most {after:.0f} %"))
-
-
-def study_table(rows, title: str, params: tuple[str, ...] | None = None) -> Table:
-    """Tables 6.1/6.2 layout: per leg joint (thesis numbering) the fit's status, target, estimate, error,
-    thesis errors (a joint that did not move: no estimate, no error); ``params``: the parameters shown (default:
-    every one of model 3.5), their units in the headers."""
-    from wbfriction.friction.models import PARAM_NAMES
-    from wbfriction.report.terminal import header
-
-    params = PARAM_NAMES if params is None else params
-    cols = [PARAM_NAMES.index(n) for n in params]
-    table = Table(title=title, box=None, pad_edge=False, caption_justify="left",
-                  caption="err: error to the target [%]; " + _thesis_caption(rows, cols, params))
-    table.add_column("#", justify="right")
-    table.add_column("joint")
-    table.add_column("status")
-    for name in params:  # the unit below the name: the columns stay as narrow as their numbers
-        table.add_column(Text(header(name).replace(" [", "\n[")), justify="right")
-    for row in rows:
-        fit = row.fit
-        err = fit.error_percent() or {}
-        status = fit.verdict().status
-        shown = fit.params is not None and status != "not excited"  # a joint that did not move: no value to show
-        table.add_row(str(row.number), row.joint, status,
-                      *[f"{getattr(fit.params, n):.4f}" if shown else "—" for n in params],
-                      style=None if status == "ok" else "dim")
-        table.add_row("", f"  {row.group} target", "", *[f"{getattr(fit.target, n):.4g}" for n in params],
-                      style="dim")
-        table.add_row("", "  err [%]", "", *[f"{err.get(n, float('nan')):.2f}" if shown else "—" for n in params],
-                      style="bold")
-        for label, ref in (("  T6.1 [%]", row.thesis_6_1), ("  T6.2 [%]", row.thesis_6_2)):
-            if ref is not None:
-                table.add_row("", label, "", *[_thesis_percent(ref[c]) for c in cols], style="dim")
-    return table
-
-
-def _print_not_ok(rows) -> None:
-    """Say which rows of a study table are not ``ok`` fits and why: their errors measure the walk's excitation
-    (or the fit's trouble), not the estimate."""
-    from wbfriction.studies.common import not_ok
-
-    for row in not_ok(rows):
-        verdict = row.fit.verdict()
-        if verdict.status == "at bound":
-            out.print(escape(f"not an ok fit: {row.joint} ({row.group}), {verdict}; a value at a bound is the "
-                             "bound's, not the data's (the others may hold)."), highlight=False)
-            continue
-        why = ("this walk hardly moved it: no estimate below (a short walk hardly turns the hip yaws: try more "
-               "--steps)" if verdict.status == "not excited"
-               else "its errors below measure the walk, not the estimate: its parameters are not determined by "
-                    "these samples")
-        out.print(escape(f"not an ok fit: {row.joint} ({row.group}), {verdict}; {why}."), highlight=False)
-
-
-def _print_worst(rows, worst: dict[str, float], params: tuple[str, ...]) -> None:
-    """The worst error of each parameter over the leg joints whose fit is ``ok`` (the others said above)."""
-    ok = sum(row.fit.verdict().ok for row in rows)
-    if ok:
-        out.print(f"worst error over the {ok} leg joints with an ok fit [%]: "
-                  + ", ".join(f"{n} {worst[n]:.2f}" for n in params))
-
-
-def _pulls_note(pulls: int, in_double: int) -> str:
-    """The demo's count of samples where a welded foot pulled, and what it means."""
-    if not pulls:
-        return "no welded foot pulled on the ground (the walk is one a real sole could make)"
-    return (f"samples where a welded foot pulled on the ground: {pulls}, {in_double} of them in double support. "
-            "The ideal simulator welds a standing sole (a bilateral contact): just after a touch-down the weld "
-            "stops the landing foot and shares the load with the other by pulling, where a real sole would "
-            "bounce or roll. Double-support samples are never valid for the estimate, so its numbers are not "
-            "touched" + ("." if in_double == pulls else "; the others are single-support samples: there the "
-                         "walk asks more of the ground than it can give."))
-
-
-def _demo_mujoco(output_dir: Path, r: Robot, steps: int) -> list[Path]:
-    from wbfriction.studies.realistic import KNEE_STEPS, run_realistic_study, worst_scored
-
-    with stages() as status:  # a short combined walk, short forward walks too (the full size's are 5 steps)
-        result = run_realistic_study(r, output_dir, steps=steps, knee_steps=min(steps, KNEE_STEPS), progress=status)
-    for k, case in enumerate(result.cases):
-        if k:
-            out.print()
-        _print_not_ok(case.rows)
-        out.print(study_table(case.rows, f"MuJoCo, combined walk, swing phase: {case.label}", case.scored))
-        ok = [row for row in case.rows if row.fit.verdict().ok]
-        _print_worst(case.rows, worst_scored(case, ok), case.scored)
-        if case.thesis_rows is not None:  # the thesis's comparison: the same log, rigid contacts, no wrenches
-            thesis = worst_scored(case, [row for row in case.thesis_rows if row.fit.verdict().ok])
-            out.print("  the thesis's route on the same log (rigid stance contact, no wrenches) [%]: "
-                      + ", ".join(f"{n} {thesis[n]:.2f}" for n in case.scored))
-    out.print("right knee alone, RMS error [N·m] (central differences): " + "; ".join(
-        f"{k} {v:.4f}" for k, v in result.knee_rms.items()))
-    return result.files
+from wbfriction.cli.rigs import RigOptionOpt, rig_options
 
 
 @app.command(rich_help_panel=STUDIES)
-def demo(output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--output-dir", help="Where to write."),
+def demo(ctx: typer.Context,
+         output_dir: Path = typer.Option(Path("wbfriction-demo"), "-o", "--output-dir", help="Where to write."),
          robot: str = RobotOpt,
-         steps: int = typer.Option(GAIT.steps, help="Steps per direction of the combined walk (--simulator mujoco: "
-                                                    "of the forward walks of Fig. 6.4-6.5 too, at most 5)."),
-         simulator: Simulator = typer.Option("ideal", help="ideal: Tables 6.1/6.2, Fig. 6.1-6.3; mujoco: the realistic "
-                                                     "simulator's study, Fig. 6.4-6.5.")) -> None:
-    """The thesis's simulation study: walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.3 (--simulator mujoco:
-    the realistic simulator's tables and Fig. 6.4-6.5)."""
-    from wbfriction.friction.models import PARAM_NAMES
-    from wbfriction.studies.common import worst_errors
-    from wbfriction.studies.simulation import run_study
+         steps: int = typer.Option(GAIT.steps, help="A biped: steps per direction of the combined walk (--simulator "
+                                                    "mujoco: of the forward walks of Fig. 6.4-6.5 too, at most 5)."),
+         simulator: Optional[str] = typer.Option(None, metavar=f"[{'|'.join(engine_names())}]",
+                                                 help="The engine: ideal (a biped: Tables 6.1/6.2, Fig. 6.1-6.3) or "
+                                                      "mujoco (the realistic simulator's study, Fig. 6.4-6.5); "
+                                                      "default: the first the rig runs on."),
+         rig_option: list[str] = RigOptionOpt) -> None:
+    """What the robot's rig shows in a few minutes: a biped (talos), the thesis's simulation study (walk, estimate,
+    fit; Tables 6.1/6.2 and Fig. 6.1-6.3; --simulator mujoco: the realistic simulator's tables and Fig. 6.4-6.5); a
+    quadruped on point feet (go2_walking), what its gait gives each joint (--rig-option gait=walk)."""
+    from wbfriction.rigs import RigProgress, rig_for
 
+    values = {name: value for name, value in locals().items() if name != "ctx"}
+    if simulator is not None and simulator not in engine_names():
+        raise OptionError("--simulator", simulator, f"one of {', '.join(engine_names())}")
     check_paths({}, {}, {"-o": output_dir})
     start = time.perf_counter()
     r = robot_of(robot, None, None)
-    if simulator == "mujoco":
-        for f in _demo_mujoco(output_dir, r, steps):
-            console.print(f"wrote {f}")
-        console.print(f"demo finished in {time.perf_counter() - start:.1f} s")
-        return
+    rig = rig_for(r)
+    if rig.demo_options is None:
+        raise InputError(f"{rig.what(r)}: demo shows a biped's walk or a quadruped's gait")
+    engine = rig.engine(r, simulator)
+    (options,) = rig_options(ctx, values, (rig.demo_options,), rig.what(r), ("output_dir", "robot", "rig_option"), rig_option,
+                             engine=engine is not None)
     with stages() as status:
-        result = run_study(r, output_dir, steps=steps, progress=status, steps_done=status.steps)
-    _print_not_ok(result.rows)  # before the table: its error figures of those joints measure the walk
-    out.print(study_table(result.rows, "Identified friction (3.5) of the leg joints, combined walk, "
-                                        "central differences"))
-    _print_worst(result.rows, worst_errors([row for row in result.rows if row.fit.verdict().ok]), PARAM_NAMES)
-    out.print(f"true accelerations: max |tau_f - tau_f_true| in single support = {result.truth_max_error:.2e} N·m")
-    out.print("right knee, RMS error [N·m] with the leg in swing / in stance: " + "; ".join(
-        f"{k} {a:.4f} / {b:.4f}" for k, (a, b) in result.knee_rms.items()))
-    out.print(_pulls_note(result.pulls, result.pulls_double_support))
-    worst_joint = max(result.generating_share, key=lambda j: result.generating_share[j])
-    out.print(f"friction generating power (eq. 7.9), leg joints in swing: at most "
-              f"{100 * result.generating_share[worst_joint]:.2f} % of the samples ({worst_joint})")
-    for f in result.files:
+        shown = rig.demo(r, options, engine, output_dir, RigProgress(status, status.steps))
+    print_items(shown.printed)
+    for f in shown.files:
         console.print(f"wrote {f}")
     console.print(f"demo finished in {time.perf_counter() - start:.1f} s")
 
@@ -357,8 +242,10 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
 def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped"), "-o", "--output-dir",
                                                     help="Where to write."),
                     robot: str = typer.Option("go2_walking", help="A built-in quadruped on point feet."),
-                    simulator: str = typer.Option("ideal", help="ideal (point feet welded while down) or mujoco "
-                                                                "(soft contacts, sphere feet)."),
+                    simulator: Optional[str] = typer.Option(None, metavar=f"[{'|'.join(engine_names())}]",
+                                                            help="The engine: ideal (point feet welded while down) "
+                                                                 "or mujoco (soft contacts, sphere feet); default: "
+                                                                 "the first."),
                     gait: str = typer.Option("trot", help="trot, walk (three feet down), step (a trot in place) "
                                                           "or stand."),
                     drive: str = typer.Option("torque", help="torque (joint torque sensors) or pd (the drivers' "
@@ -373,14 +260,20 @@ def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped")
     """What each gait gives a walking quadruped: per joint, the share of samples where its friction is
     determined, by feet on the ground, and its fit against the injected friction."""
     from wbfriction.report.terminal import determination_table
+    from wbfriction.rigs import rig_for
+    from wbfriction.rigs.quadruped import QuadrupedRig
     from wbfriction.studies.quadruped import QuadrupedCase, case_robot, fits_markdown, run_quadruped, write_study
 
     check_paths({}, {}, {"-o": output_dir})
-    case = QuadrupedCase(simulator=simulator, gait=gait, drive=drive, foot_forces=foot_forces,  # type: ignore[arg-type]
-                         noise=noise, duration=duration, seed=seed)
-    r = case_robot(robot_of(robot, None, None), case)
-    if not r.partial_contacts:
+    given = robot_of(robot, None, None)
+    rig = rig_for(given)
+    if not isinstance(rig, QuadrupedRig):
         raise InputError(f"--robot {robot}: not a robot on point feet (contact_model = \"point\" in its TOML)")
+    engine = rig.engine(given, simulator)
+    assert engine is not None  # a quadruped runs in an engine
+    case = QuadrupedCase(simulator=engine.name, gait=gait, drive=drive, foot_forces=foot_forces,  # type: ignore[arg-type]
+                         noise=noise, duration=duration, seed=seed)
+    r = case_robot(given, case)
     with stages() as status:
         study = run_quadruped(r, case, progress=status)
     console.print(determination_table(study.shares))

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Generic, TypeVar
 
 import numpy as np
@@ -171,3 +172,17 @@ def record_next_arm(robot: Robot, fits: Mapping[str, FitResult], source: str,
     prior, from_fit = prior_of(robot, fits, default_arm_friction(robot))
     design = design_arm(robot, options, prior, recording, progress, moving=moving)
     return NextRecording[ArmDesign](design, logged_all(fits, moving), from_fit)
+
+
+def fits_after(robot: Robot, after: Path | None) -> dict[str, FitResult] | None:
+    """The fits of the parameters file ``after`` (``excite --after``: what ``fit`` wrote of the log recorded) for
+    ``robot``; None without one.
+
+    Raises:
+        InputError: what :func:`~wbfriction.fit.params_file.read_robot_params` raises.
+    """
+    if after is None:
+        return None
+    from wbfriction.fit.params_file import read_robot_params
+
+    return read_robot_params(after, robot.name, robot.actuated, robot.urdf)

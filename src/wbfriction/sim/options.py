@@ -122,10 +122,6 @@ class IdealOptions:
             raise InputError(f"substeps must be at least 1, got {self.substeps}")
 
 
-Simulator = Literal["ideal", "mujoco"]
-"""The humanoid's simulators: ``ideal`` (rigid contacts, thesis 6.1) or ``mujoco`` (soft contacts, sensors, 6.2)."""
-SIMULATORS: tuple[Simulator, ...] = get_args(Simulator)
-
 FrictionMode = Literal["model", "mujoco"]
 """How the MuJoCo simulator applies friction (:mod:`wbfriction.sim.mujoco_sim`)."""
 FRICTION_MODES: tuple[FrictionMode, ...] = get_args(FrictionMode)

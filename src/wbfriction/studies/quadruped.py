@@ -13,7 +13,6 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import get_args
 
 import numpy as np
 
@@ -27,11 +26,11 @@ from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.point_contacts import DeterminedShares, determined_shares
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
-from wbfriction.sim.options import SensorNoise, Simulator
-from wbfriction.sim.quadruped import Drive, FootForces, QuadrupedOptions, QuadrupedRun, simulate_quadruped
+from wbfriction.sim.engines import engine_names, engine_of
+from wbfriction.sim.options import SensorNoise
+from wbfriction.sim.quadruped import Drive, FootForces, QuadrupedOptions, QuadrupedRun
 from wbfriction.walking.quadruped import FOOT_RADIUS, Gait, GaitOptions, quadruped_reference
 
-SIMULATORS: tuple[Simulator, ...] = get_args(Simulator)
 REAL_NOISE = SensorNoise(encoder_bits=19, torque_std=0.05)
 """A real robot's sensors: the encoder lattice measured on the real Aliengo (2 pi / 2^19 rad at the joint, issue
 55) and a joint torque sensor's 0.05 N·m of white noise; on MuJoCo also the drivers' velocity (0.02 rad/s), the IMU
@@ -45,13 +44,13 @@ class QuadrupedCase:
     """One simulated walk of :func:`run_quadruped`.
 
     Attributes:
-        simulator: ``ideal`` or ``mujoco``; gait: :data:`~wbfriction.walking.quadruped.Gait`; drive: ``torque`` or
-        ``pd``; foot_forces: the feet's forces logged (``none``, ``normal``, ``3d``); noise: a real robot's sensor
-        noise (the simulator's), then differentiated (``diff="auto"``), else the true derivatives (``diff="true"``);
-        duration [s]; seed.
+        simulator: the engine's name (:mod:`wbfriction.sim.engines`); gait:
+        :data:`~wbfriction.walking.quadruped.Gait`; drive: ``torque`` or ``pd``; foot_forces: the feet's forces
+        logged (``none``, ``normal``, ``3d``); noise: a real robot's sensor noise (the simulator's), then
+        differentiated (``diff="auto"``), else the true derivatives (``diff="true"``); duration [s]; seed.
     """
 
-    simulator: Simulator = "ideal"
+    simulator: str = engine_names()[0]
     gait: Gait = "trot"
     drive: Drive = "torque"
     foot_forces: FootForces = "none"
@@ -60,8 +59,8 @@ class QuadrupedCase:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        if self.simulator not in SIMULATORS:
-            raise OptionError("--simulator", self.simulator, f"one of {', '.join(SIMULATORS)}")
+        if self.simulator not in engine_names():
+            raise OptionError("--simulator", self.simulator, f"one of {', '.join(engine_names())}")
         GaitOptions(gait=self.gait, duration=self.duration)  # what they refuse, before any simulation
         QuadrupedOptions(drive=self.drive, foot_forces=self.foot_forces)
 
@@ -91,7 +90,7 @@ def case_robot(robot: Robot, case: QuadrupedCase) -> Robot:
     """The robot as ``case``'s simulator builds it: on MuJoCo, its feet are spheres of
     :data:`~wbfriction.walking.quadruped.FOOT_RADIUS` round the contact frames (the ground's force acts at their
     lowest point: :attr:`~wbfriction.model.robot.Robot.foot_radius`); the ideal simulator's are points."""
-    if case.simulator != "mujoco" or robot.foot_radius:
+    if not engine_of(case.simulator).soft_contacts or robot.foot_radius:
         return robot
     return replace(robot, foot_radius=FOOT_RADIUS, cache={})
 
@@ -101,14 +100,14 @@ def simulate_case(robot: Robot, case: QuadrupedCase) -> QuadrupedRun:
     reference = quadruped_reference(robot, GaitOptions(gait=case.gait, duration=case.duration, seed=case.seed))
     noise = REAL_NOISE if case.noise else None
     options = QuadrupedOptions(drive=case.drive, foot_forces=case.foot_forces, noise=noise, seed=case.seed)
-    if case.simulator == "mujoco":
-        from wbfriction.sim.quadruped_mujoco import QuadrupedNoise, simulate_quadruped_mujoco
+    engine = engine_of(case.simulator)
+    sensors = None
+    if case.noise and engine.soft_contacts:  # a soft-contact engine's own sensors: its IMU and foot forces too
+        from wbfriction.sim.quadruped_mujoco import QuadrupedNoise
 
-        sensors = None if not case.noise else QuadrupedNoise(
-            encoder_resolution=REAL_NOISE.resolution, torque_std=REAL_NOISE.torque_std, velocity_std=0.02,
-            gyro_std=0.005, acc_std=0.05, force_std=2.0, seed=case.seed)
-        return simulate_quadruped_mujoco(robot, reference, options, sensors)
-    return simulate_quadruped(robot, reference, options)
+        sensors = QuadrupedNoise(encoder_resolution=REAL_NOISE.resolution, torque_std=REAL_NOISE.torque_std,
+                                 velocity_std=0.02, gyro_std=0.005, acc_std=0.05, force_std=2.0, seed=case.seed)
+    return engine.quadruped(robot, reference, options, sensors=sensors)
 
 
 def run_quadruped(robot: Robot, case: QuadrupedCase = QuadrupedCase(),

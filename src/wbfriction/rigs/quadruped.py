@@ -1,0 +1,203 @@
+"""A quadruped on point feet (a floating base whose contacts do not fix it alone): ``simulate`` walks its gait, or
+plays its three-feet stance (``--play``), in an engine (:mod:`wbfriction.sim.engines`); ``excite`` designs one leg's
+excitation while it stands on the other three (:func:`~wbfriction.excite.tripod.tripod_reference`); ``demo`` shows
+what a gait gives each joint (:func:`~wbfriction.studies.quadruped.run_quadruped`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal, Optional
+
+from wbfriction.exceptions import InputError
+from wbfriction.excite.options import PD_EXCITE
+from wbfriction.options import option
+from wbfriction.report.printed import Printed
+from wbfriction.rigs.base import DemoOutput, DesignOutput, Rig, RigProgress, SimulationOutput
+from wbfriction.rigs.biped import STANDING_DURATION, STANDING_PERIOD
+from wbfriction.sim.noise_options import SensorsFileOptions
+
+if TYPE_CHECKING:
+    from wbfriction.model.robot import Robot
+    from wbfriction.sim.engines import Engine
+    from wbfriction.walking.quadruped import QuadrupedReference
+
+PLAYED_SUBSTEPS = 8
+"""The physics steps per 2 ms period when a three-feet stance is played and ``--substeps`` is not given: 0.25 ms
+(4 kHz). At the gaits' 0.5 ms the explicit integration of the injected Coulomb term chatters about zero velocity on
+the light calf and the front right calf's F_v comes out 4.5 % low; at 0.25 ms every swing joint's F_c and F_v within
+0.6 % (``tests/excite/test_tripod.py``)."""
+STANDING_RATE = 500.0
+"""A quadruped's default set-points rate [Hz]: its simulators' control rate (:class:`~wbfriction.excite.tripod.
+TripodOptions`' own)."""
+
+
+@dataclass(frozen=True)
+class QuadrupedSimulation(SensorsFileOptions):
+    """What ``simulate`` reads of a quadruped, beyond the sensor noise (no delay: its drivers' is the robot's
+    ``[pd]`` delay).
+
+    Attributes:
+        actuator: how its joints are driven: torque (None: the default) or pd (its drivers sent the set-points).
+        friction: TOML of the injected friction per joint; None: the simulator's default.
+        play: a three-feet stance ``excite`` wrote, played instead of a gait.
+        substeps: physics steps per 2 ms period; None: 4 (8 playing a stance, :data:`PLAYED_SUBSTEPS`).
+        foot_forces: the feet's force columns logged: none, normal or 3d.
+        gait: stand, step, trot (None: the default) or walk; duration [s] of gait (None: 8); excitation_seed: the
+            gait's swings and sway; speed: forward speed [m/s] (None: the gait's).
+    """
+
+    actuator: Optional[Literal["torque", "pd"]] = option(None)
+    friction: Optional[Path] = option(None)
+    play: Optional[Path] = option(None)
+    substeps: Optional[int] = option(None, quantity="substeps")
+    foot_forces: Literal["none", "normal", "3d"] = option("none")
+    gait: Optional[str] = option(None, motion=True)
+    duration: Optional[float] = option(None, quantity="duration", motion=True)
+    excitation_seed: int = option(0, quantity="seed", motion=True)
+    speed: Optional[float] = option(None, motion=True)
+
+
+@dataclass(frozen=True)
+class QuadrupedDesignOptions:
+    """What ``excite`` reads of a quadruped: the recording [s] on three feet (``duration``), the set-points' rate
+    [Hz], the swing joints' Fourier period [s], the seed of the design's starts, the leg lifted (``swing``: FL, FR,
+    RL, RR or its foot frame's name)."""
+
+    duration: float = option(STANDING_DURATION, quantity="duration")
+    rate: float = option(STANDING_RATE)
+    period: float = option(STANDING_PERIOD)
+    seed: int = option(PD_EXCITE.seed, quantity="seed")
+    swing: str = option("FR")
+
+
+@dataclass(frozen=True)
+class QuadrupedDemoOptions:
+    """What ``demo`` reads of a quadruped (:class:`~wbfriction.studies.quadruped.QuadrupedCase`): the gait, the
+    drive (torque or pd), the feet's forces logged, a real robot's sensor noise, the simulated time [s] and the
+    seed."""
+
+    gait: Literal["stand", "step", "trot", "walk"] = option("trot")
+    drive: Literal["torque", "pd"] = option("torque")
+    foot_forces: Literal["none", "normal", "3d"] = option("none")
+    noise: bool = option(False)
+    duration: float = option(8.0, quantity="duration")
+    seed: int = option(0, quantity="seed")
+
+
+class QuadrupedRig(Rig):
+    """A floating base on point feet (contacts that do not fix the base alone), walking in an engine."""
+
+    name, precedence, motion = "quadruped", 10, "quadruped"
+    simulation, design_options, demo_options = QuadrupedSimulation, QuadrupedDesignOptions, QuadrupedDemoOptions
+
+    def what(self, robot: Robot, actuator: str | None = None) -> str:
+        return f"robot '{robot.name}' stands on {robot.stands_on} (a walking quadruped)"
+
+    def claims(self, robot: Robot, actuator: str | None) -> bool:
+        return robot.floating_base and robot.partial_contacts
+
+    def simulate(self, robot: Robot, options: Any, engine: Engine | None, engine_options: Any,
+                 progress: RigProgress) -> SimulationOutput:
+        from wbfriction.sim.quadruped import QuadrupedOptions
+
+        assert engine is not None  # a rig with a motion has one (Rig.engine)
+        opts = QuadrupedOptions(**self.run_options(robot, options))
+        ref, motion = self.reference(robot, options, progress)
+        run = engine.quadruped(robot, ref, opts, progress=progress.count("simulate", len(ref), "samples"))
+        drive = "PD set-points" if opts.drive == "pd" else "joint torques"
+        normal = run.force[..., 2][run.log.contact]
+        pulled = () if not normal.size or normal.min() >= 0 else \
+            (f"a foot pulled on the ground at {int((normal < 0).sum())} samples (down to {normal.min():.1f} N)",)
+        return SimulationOutput(log=run.log, summary=f"{len(run.log)} samples, {len(ref) * ref.dt:g} s, {motion}, "
+                                                     f"{drive}", warnings=pulled)
+
+    @staticmethod
+    def run_options(robot: Robot, o: QuadrupedSimulation) -> dict[str, Any]:
+        """The :class:`~wbfriction.sim.quadruped.QuadrupedOptions` fields the options give: ``drive`` (the
+        ``actuator``), the sensor noise, ``foot_forces``, ``physics_dt`` (2 ms periods over ``substeps``) and the
+        friction.
+
+        Raises:
+            InputError: a sensor delay; a friction file with terms beyond velocity or a temperature; a gait of a
+                walk.
+        """
+        from wbfriction.fit.targets import load_friction_spec
+        from wbfriction.walking.quadruped import GAITS
+
+        noise, lag = o.noise()
+        if lag:
+            raise InputError(f"{o.sensors}: delay: a walking quadruped's simulation has no measurement delay (its "
+                             "drivers' is the robot's [pd] delay)")
+        substeps = PLAYED_SUBSTEPS if o.substeps is None and o.play is not None else o.substeps
+        if (o.gait or "trot") not in GAITS:
+            raise InputError(f"--gait {o.gait}: robot '{robot.name}' stands on {robot.stands_on}: its gaits are "
+                             f"{', '.join(GAITS)}")
+        spec = None if o.friction is None else load_friction_spec(o.friction, robot.groups, robot.actuated)
+        if spec is not None and (spec.terms or spec.temperature is not None):
+            raise InputError(f"{o.friction}: a walking quadruped's simulation takes friction models per joint, "
+                             "without terms beyond velocity or a temperature")
+        return {"drive": o.actuator or "torque", "noise": noise, "foot_forces": o.foot_forces,
+                **({} if substeps is None else {"physics_dt": 0.002 / substeps}),
+                "friction": None if spec is None else spec.params}
+
+    @staticmethod
+    def reference(robot: Robot, o: QuadrupedSimulation, progress: RigProgress) -> tuple[QuadrupedReference, str]:
+        """The reference to simulate and its name: the played table's three-feet stance, else the gait planned."""
+        from wbfriction.rigs.played import played_tripod
+        from wbfriction.walking.quadruped import GaitOptions, quadruped_reference
+
+        if o.play is not None:
+            progress.say(f"rebuilding the stance of {o.play.name} (its IK at every sample)")
+            ref = played_tripod(robot, o.play)
+            return ref, f"{robot.contact_frames[int(ref.contact[0].argmin())]} swung on three feet"
+        gait = GaitOptions(gait=o.gait or "trot", duration=8.0 if o.duration is None else o.duration,  # type: ignore[arg-type]
+                           speed=o.speed, seed=o.excitation_seed)  # type: ignore[arg-type]  # None: the gait's speed
+        progress.say(f"planning {gait.duration:g} s ({gait.gait})")
+        return quadruped_reference(robot, gait), gait.gait
+
+    def design(self, robot: Robot, options: Any, progress: RigProgress) -> DesignOutput:
+        from wbfriction.excite.design import ExciteOptions
+        from wbfriction.excite.document import tripod_document, tripod_setpoints
+        from wbfriction.excite.tripod import TripodOptions, swing_bounds, tripod_reference
+        from wbfriction.report.excite_tables import swing_printed
+        from wbfriction.rigs.standing import standing_figure
+
+        o: QuadrupedDesignOptions = options
+        if len(robot.contact_frames) != 4:
+            raise InputError(f"robot '{robot.name}' has a floating base on {len(robot.contact_frames)} "
+                             f"{robot.stands_on}: excite designs a quadruped's stance on three of four point feet")
+        excite = ExciteOptions(duration=o.duration, rate=o.rate, period=o.period,
+                               harmonics=TripodOptions().design.harmonics, range_share=1.0, seed=o.seed)
+        tripod = TripodOptions(swing=o.swing, design=excite)
+        progress.say("designing the swing leg's series, then the stance on the three other feet (its IK at every "
+                     "sample)")
+        excitation = tripod_reference(robot, tripod)
+        doc = tripod_document(robot, excitation, tripod, swing_bounds(robot, excitation, tripod))
+        leg = doc["swing_foot"].split("_")[0]
+        table = tripod_setpoints(robot, excitation, tripod)
+        figure = standing_figure(robot, excitation, table, doc, f"{robot.name} on three feet, its {leg} leg swung "
+                                 "within its posture band; Cramér-Rao bound / weak limit")
+        mm = {n: f"{doc[n] * 1e3:.1f} mm (at least {doc['limits'][n] * 1e3:.0f})"
+              for n in ("com_margin", "zmp_margin", "clearance", "spacing")}
+        return DesignOutput(table, doc, figure, (
+            swing_printed(doc, f"The {leg} leg swung, on {', '.join(f.split('_')[0] for f in doc['stance_feet'])}"),
+            Printed(f"centre of mass {mm['com_margin']} and ZMP {mm['zmp_margin']} inside the stance triangle's "
+                    f"edges; the swing foot {mm['clearance']} above the ground, {mm['spacing']} from the other legs")))
+
+    def demo(self, robot: Robot, options: Any, engine: Engine | None, output_dir: Path,
+             progress: RigProgress) -> DemoOutput:
+        from rich.markup import escape
+
+        from wbfriction.report.terminal import determination_table
+        from wbfriction.studies.quadruped import QuadrupedCase, case_robot, fits_markdown, run_quadruped, write_study
+
+        assert engine is not None
+        o: QuadrupedDemoOptions = options
+        case = QuadrupedCase(simulator=engine.name, gait=o.gait, drive=o.drive, foot_forces=o.foot_forces,
+                             noise=o.noise, duration=o.duration, seed=o.seed)
+        r = case_robot(robot, case)
+        study = run_quadruped(r, case, progress=progress.say)
+        files = write_study(r, study, output_dir)
+        return DemoOutput((Printed(determination_table(study.shares)),
+                           Printed(escape(fits_markdown(study)), soft_wrap=True)), tuple(files))
