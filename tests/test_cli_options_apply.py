@@ -16,10 +16,10 @@ from helpers import run_cli, said
 from wbfriction.cli import actuator as actuator_cli
 from wbfriction.cli import app
 from wbfriction.cli import identify as identify_cli
+from wbfriction.cli import rigs as rigs_cli
 from wbfriction.cli import simulate as simulate_cli
 from wbfriction.cli.common import option_flag
 from wbfriction.exceptions import InputError
-from wbfriction.cli import rigs as rigs_cli
 from wbfriction.options import option_names
 from wbfriction.rigs.registry import RIGS
 from wbfriction.sim.engines import engine_of

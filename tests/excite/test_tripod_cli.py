@@ -30,8 +30,8 @@ from wbfriction.logs.metadata import read_metadata, with_metadata
 from wbfriction.logs.setpoint_table import read_setpoint_table
 from wbfriction.logs.tables import write_table
 from wbfriction.model import load_robot
-from wbfriction.sim.quadruped import default_quadruped_friction
 from wbfriction.rigs.played import played_tripod
+from wbfriction.sim.quadruped import default_quadruped_friction
 
 # excite (the design and the IK) 6 s, the reference again 5 s, simulate 3 s, estimate and fit 5 s
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_tripod_cli")]
