@@ -1,8 +1,8 @@
 """Options that do not apply to the robot or the mode a command runs in are refused, not ignored (issue 65,
 class 6): one line naming the option, the mode and what it takes, exit 2, before the work, nothing written.
 ``simulate``'s modes (a robot on point feet, a hung PD-driven robot, an arm, a walk ideal or on MuJoCo) and
-``identify``'s (the inertia model, ``--actuator pd``) each read the options of their table (each simulator kind's
-:attr:`~wbfriction.rigs.base.Rig.simulation`'s fields, and the engine's, :data:`wbfriction.cli.identify.MODES`); the refusal
+``identify``'s (the inertia model, ``--actuator pd``) each read the options of their table (each rig's
+:attr:`~wbfriction.rigs.base.Rig.simulation` fields and its engine's, :data:`wbfriction.cli.identify.MODES`); the refusal
 is :func:`wbfriction.cli.common.refuse_options`. Also the misleading lines of class 5 in these commands."""
 
 from __future__ import annotations

@@ -67,7 +67,8 @@ def test_the_toys_excite_identify_and_demo_run(toy, tmp_path, capsys):
     assert pq.read_table(tmp_path / "sp.parquet").num_rows == 4000 and "sines of 0.2 of each half range" in out
     code, _, err = run_cli_printed(capsys, "excite", "--robot", "panda", "--duration", "4", "-o",
                                    tmp_path / "x.parquet", "--figure", tmp_path / "x.png")
-    assert (code, err.strip()) == (2, "error: --figure: robot 'panda' is on the toy arm rig: its design draws no figure")
+    assert (code, err.strip()) == (2, "error: --figure: robot 'panda' is on the toy arm rig: its design draws no "
+                                      "figure")
     assert not (tmp_path / "x.parquet").exists()
     code, out, err = run_cli_printed(capsys, "demo", "--robot", "panda", "--rig-option", "duration=4", "-o",
                                      tmp_path / "demo")
@@ -92,7 +93,7 @@ def test_the_other_rigs_refuse_the_toys_option(toy, tmp_path, capsys, command, r
     written."""
     out = ("-o", tmp_path / ("d" if command == "demo" else "x.parquet"))
     code, _, err = run_cli_printed(capsys, command, "--robot", robot, "--rig-option", "sine_share=0.3", *out)
-    assert code == 2 and err.strip().startswith("error: --rig-option sine_share: not an option here (the options: "), err
+    assert code == 2 and err.strip().startswith("error: --rig-option sine_share: not an option here (the options: ")
     assert not out[1].exists()
 
 

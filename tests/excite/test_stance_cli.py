@@ -120,7 +120,8 @@ def test_what_a_stance_does_not_take_is_one_line(capsys, talos, tmp_path):
         ((), "plain.parquet: no stance foot or swing series: a biped plays what 'excite --stance' writes"),
         (("--gait", "sideways"), "--gait: the set-points played (plain.parquet) fix the motion: it takes no motion"),
         (("--steps", "3"), "--steps: the set-points played (plain.parquet) fix the motion: it takes no motion"),
-        (("--simulator", "mujoco", "--duration", "3"), "--duration: robot 'talos' is a biped on soles, simulated in mujoco"),
+        (("--simulator", "mujoco", "--duration", "3"),
+         "--duration: robot 'talos' is a biped on soles, simulated in mujoco"),
     ]:
         code, _, err = run_cli_printed(capsys, "simulate", "--robot", "talos", "--play", path, *args, "-o",
                                        tmp_path / "y.parquet")

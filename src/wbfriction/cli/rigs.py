@@ -21,8 +21,8 @@ def rig_options(ctx: typer.Context, values: Mapping[str, Any], classes: tuple[ty
                 engine: bool = False) -> tuple[Any, ...]:
     """Each of ``classes`` (an operation's options dataclasses; None: none) built from the options the command line
     gave (``values``: the command's parameters by name) and the ``--rig-option`` texts, after refusing any option
-    given that none of them reads (nor ``shared``: ``rig_option`` among them, nor, with an ``engine``, ``--simulator``), and, where a table is
-    ``play``-ed, those that shape the motion.
+    given that none of them reads (nor ``shared``, ``rig_option`` among them, nor, with an ``engine``,
+    ``--simulator``), and, where a table is ``play``-ed, those that shape the motion.
 
     Raises:
         InputError: an option the operation does not read (naming ``mode`` and what it takes); a ``--rig-option``

@@ -65,8 +65,8 @@ def demo(ctx: typer.Context,
     if rig.demo_options is None:
         raise InputError(f"{rig.what(r)}: demo shows a biped's walk or a quadruped's gait")
     engine = rig.engine(r, simulator)
-    (options,) = rig_options(ctx, values, (rig.demo_options,), rig.what(r), ("output_dir", "robot", "rig_option"), rig_option,
-                             engine=engine is not None)
+    (options,) = rig_options(ctx, values, (rig.demo_options,), rig.what(r), ("output_dir", "robot", "rig_option"),
+                             rig_option, engine=engine is not None)
     with stages() as status:
         shown = rig.demo(r, options, engine, output_dir, RigProgress(status, status.steps))
     print_items(shown.printed)
