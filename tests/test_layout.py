@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "src" / "wbfriction"
 
 LAYERS = [
-    {"version", "exceptions", "choices", "progress", "config", "workers", "quantities", "registry"},
+    {"version", "exceptions", "choices", "progress", "config", "workers", "quantities", "registry", "options"},
     {"model"},
     {"logs"},
     {"datasets"},
@@ -29,6 +29,7 @@ LAYERS = [
     {"fleet"},
     {"report"},
     {"studies"},
+    {"rigs"},
     {"cli", "__main__", "__init__", "entry"},
 ]
 """The top-level modules and subpackages in data-flow order: each may import only from its own layer
@@ -206,3 +207,71 @@ def test_the_size_checks_see_a_long_function(tmp_path):
     (pkg / "big.py").write_text("class A:\n    def f(self):\n" + "        x = 1\n" * 90)
     modules, functions = sizes(pkg)
     assert functions["wbfriction.big:A.f"] == 91 and modules["wbfriction.big"] == 92
+
+
+KINDS = {"rig": (PACKAGE / "rigs", ("quadruped", "hung", "arm", "biped")),
+         "engine": (PACKAGE / "sim" / "engines", ("ideal", "mujoco"))}
+"""Each registry whose kinds' names nothing outside its folder may decide by: its folder and its built-in names."""
+CHOOSERS = re.compile(r"(simulator|engine|rig)s?$")
+"""What a variable, attribute or parameter that holds a rig's or an engine's name is called."""
+
+
+def named(node: ast.AST) -> str:
+    """The identifier a node ends in (``case.simulator``: ``simulator``), or ``""``."""
+    return node.id if isinstance(node, ast.Name) else node.attr if isinstance(node, ast.Attribute) else ""
+
+
+def kind_names_decided(package: Path) -> list[str]:
+    """Where a module outside a registry's folder decides by one of its kinds' names: a comparison of a variable
+    named like a choice of them (``simulator == "mujoco"``, ``rig.name in ("arm", ...)``) with the name, a default
+    of such a parameter or field, or a ``Literal`` that lists the engines."""
+    found = []
+    for what, (folder, names) in KINDS.items():
+        for path in sorted(package.rglob("*.py")):
+            if folder in path.parents:
+                continue
+            rel = path.relative_to(package.parent)
+            for node in ast.walk(ast.parse(path.read_text())):
+                consts: list[ast.AST] = []
+                if isinstance(node, ast.Compare):
+                    sides = [node.left, *node.comparators]
+                    if any(CHOOSERS.search(named(s)) or named(s) == "name" for s in sides):
+                        consts = [c for s in sides for c in ast.walk(s) if isinstance(c, ast.Constant)]
+                elif isinstance(node, ast.arguments):
+                    args = [*node.posonlyargs, *node.args][-len(node.defaults):] if node.defaults else []
+                    consts = [c for a, d in zip(args, node.defaults, strict=True) if CHOOSERS.search(a.arg)
+                              for c in ast.walk(d) if isinstance(c, ast.Constant)]
+                    consts += [c for a, d in zip(node.kwonlyargs, node.kw_defaults, strict=True)
+                               if d is not None and CHOOSERS.search(a.arg) for c in ast.walk(d)
+                               if isinstance(c, ast.Constant)]
+                elif isinstance(node, ast.AnnAssign) and node.value is not None and CHOOSERS.search(named(node.target)):
+                    consts = [c for c in ast.walk(node.value) if isinstance(c, ast.Constant)]
+                elif isinstance(node, ast.Subscript) and named(node.value) == "Literal" and what == "engine":
+                    listed = {c.value for c in ast.walk(node.slice) if isinstance(c, ast.Constant)}
+                    consts = [node] if set(names) <= listed else []
+                found += [f"{rel}:{c.lineno}: {what} name" for c in consts
+                          if not isinstance(c, ast.Constant) or c.value in names]
+    return found
+
+
+def test_no_rig_or_engine_name_outside_its_registrys_folder():
+    """Nothing outside ``rigs/`` decides by a rig's name, nor outside ``sim/engines/`` by an engine's: they ask the
+    registry (``rig_for``, ``engine_of``) and the kind's own properties."""
+    assert not (bad := kind_names_decided(PACKAGE)), "\n".join(bad)
+
+
+def test_the_name_check_sees_a_decision_by_name(tmp_path):
+    pkg = tmp_path / "wbfriction"
+    (pkg / "studies").mkdir(parents=True)
+    (pkg / "studies" / "a.py").write_text(
+        'from typing import Literal\nS = Literal["ideal", "mujoco"]\n\n\ndef f(simulator="ideal"):\n'
+        '    return simulator == "mujoco" or rig.name in ("arm", "x")\n')
+    assert kind_names_decided(pkg) == [f"wbfriction/studies/a.py:{n}: {what} name"
+                                       for n, what in ((6, "rig"), (2, "engine"), (5, "engine"), (6, "engine"))]
+
+
+def test_no_options_read_by_name_in_sim():
+    """The simulators take typed options: no ``Mapping[str, Any]`` of options in ``sim/``."""
+    bad = [f"{p.relative_to(ROOT)}" for p in sorted((PACKAGE / "sim").rglob("*.py"))
+           if re.search(r"Mapping\[str, Any\]", p.read_text())]
+    assert not bad, bad
