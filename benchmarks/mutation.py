@@ -61,6 +61,7 @@ TESTS: dict[str, tuple[str, ...]] = {
     "fit/status.py": ("tests/fit/test_status.py",),
     "logs/clock.py": ("tests/logs/test_clock.py", "tests/logs/test_log.py"),
     "signals/choice.py": ("tests/signals/test_choice.py",),
+    "signals/content.py": ("tests/signals/test_choice.py",),
     "fleet/trends.py": ("tests/fleet/test_trends.py", "tests/fleet/test_trends_truth.py"),
     "fleet/change_point.py": ("tests/fleet/test_trends_truth.py", "tests/fleet/test_change_point.py"),
     "fleet/batch.py": ("tests/fleet/test_batch_truth.py", "tests/fleet/test_results.py"),

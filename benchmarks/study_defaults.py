@@ -21,7 +21,8 @@ import time
 from pathlib import Path
 
 from wbfriction.datasets import DATA_ENV
-from wbfriction.studies.defaults import CASES, KNOBS, as_json, markdown, run_study
+from wbfriction.studies.default_cases import CASES
+from wbfriction.studies.defaults import KNOBS, as_json, markdown, run_study
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from wbfriction.report.build import Report, acceleration_spectra
-from wbfriction.report.figures import drawn_fit
+from wbfriction.report.friction_figures import drawn_fit
 from wbfriction.report.html import report_figure
 from wbfriction.report.timeaxis import log_runs
 
@@ -21,11 +21,11 @@ CHROMEDRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
 
 
 def off_samples(est, i: int, drawn: tuple[str, np.ndarray, np.ndarray], bins: int = 12) -> list[str]:
-    """Where a drawn fit (:func:`~wbfriction.report.figures.drawn_fit`) leaves its valid samples: beyond their range
-    of ``tau_f`` (by more than a tenth of it), or, in one of ``bins`` bins of velocity holding 10 samples or more, its
-    median beyond the range of the bin's samples (by a tenth of the whole range); the bin across zero velocity left
-    out (the Coulomb step, where a sign model's jump and a smooth transition part by design). Empty: it lies in its
-    cloud."""
+    """Where a drawn fit (:func:`~wbfriction.report.friction_figures.drawn_fit`) leaves its valid samples: beyond
+    their range of ``tau_f`` (by more than a tenth of it), or, in one of ``bins`` bins of velocity holding 10 samples
+    or more, its median beyond the range of the bin's samples (by a tenth of the whole range); the bin across zero
+    velocity left out (the Coulomb step, where a sign model's jump and a smooth transition part by design). Empty: it
+    lies in its cloud."""
     _, qd, tau = drawn
     m = est.valid[:, i]
     x, y = est.qd[m, i], est.tau_f[m, i]

@@ -162,6 +162,8 @@ def test_file_map_matches_the_code():
 MAX_MODULE_LINES = 600
 MAX_FUNCTION_LINES = 80
 """Issue 54's limits: a module over 600 lines holds several concepts, a function over 80 several jobs."""
+MODULE_MARGIN = 20
+"""Lines a module must stay below :data:`MAX_MODULE_LINES`: at most 580."""
 
 LONG_FUNCTIONS: dict[str, str] = {}
 """Functions allowed over :data:`MAX_FUNCTION_LINES`, each with why (``module:function``)."""
@@ -187,9 +189,13 @@ def sizes(package: Path) -> tuple[dict[str, int], dict[str, int]]:
     return modules, functions
 
 
-def test_no_module_over_600_lines():
+def test_no_module_over_or_near_600_lines():
+    """No module over :data:`MAX_MODULE_LINES`, nor within :data:`MODULE_MARGIN` lines of it: a module near the limit
+    is one edit from over it, and splitting it then, to land that edit, is rushed; split it by concept now."""
     modules, _ = sizes(PACKAGE)
-    assert not (long := {m: n for m, n in modules.items() if n > MAX_MODULE_LINES}), long
+    limit = MAX_MODULE_LINES - MODULE_MARGIN
+    assert not (long := {m: n for m, n in modules.items() if n > limit}), (
+        f"modules over {limit} lines ({MAX_MODULE_LINES} less a margin of {MODULE_MARGIN}): {long}")
 
 
 def test_no_function_over_80_lines():

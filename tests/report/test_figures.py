@@ -10,15 +10,9 @@ from helpers import drawn_texts, text_overlaps
 from wbfriction.fit.joints import fit_estimate
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.models import FrictionParams
-from wbfriction.report.figures import (
-    REPORT_DPI,
-    friction_curves_figure,
-    friction_overview_figure,
-    joint_figure,
-    png_bytes,
-    save_png,
-    widest_run,
-)
+from wbfriction.report.figures import REPORT_DPI, png_bytes, save_png
+from wbfriction.report.friction_figures import friction_curves_figure, friction_overview_figure, joint_figure
+from wbfriction.report.timeaxis import widest_run
 
 TRUE = FrictionParams(F_v=0.2, F_c=1.0, S=0.2, v_s=0.2, tau_os=0.5, a=40.0)
 

@@ -23,7 +23,7 @@ from wbfriction.fit.predict import predicted_friction
 from wbfriction.pipeline.estimate_step import RobotSpec, estimate_file
 from wbfriction.pipeline.fit_step import fit_file
 from wbfriction.report.build import Report, make_report
-from wbfriction.report.figures import drawn_fit
+from wbfriction.report.friction_figures import drawn_fit
 from wbfriction.report.html import report_figure, write_report
 from wbfriction.report.timeaxis import log_runs
 

@@ -17,10 +17,8 @@ from helpers import KUKA
 from wbfriction.exceptions import InputError
 from wbfriction.logs.log import Log
 from wbfriction.signals.choice import (
-    MIN_SEGMENT,
     NOISE_TARGET,
     DiffChoice,
-    acceleration_content,
     butterworth_noise_gain,
     central_noise_gain,
     choose_differentiation,
@@ -28,8 +26,8 @@ from wbfriction.signals.choice import (
     savgol_noise_gain,
     savgol_window,
     schafer_window,
-    second_difference_gain,
 )
+from wbfriction.signals.content import MIN_SEGMENT, acceleration_content, second_difference_gain
 from wbfriction.signals.filters import ZeroPhaseLowpass, savgol_differentiate, savgol_kernels
 from wbfriction.signals.kinematics import central_differences
 from wbfriction.signals.options import FilterOptions
@@ -149,7 +147,7 @@ def test_contact_flags_that_flicker_measure_no_noise_and_say_nothing():
     no frame printed numpy's 'Mean of empty slice' on the terminal. It is NaN, said by the caller, and silent."""
     import warnings
 
-    from wbfriction.signals.choice import white_position_noise
+    from wbfriction.signals.content import white_position_noise
 
     q = sines(8.0, 1e-5)
     acc = np.diff(q, 2, axis=0) / DT**2

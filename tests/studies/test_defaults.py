@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from wbfriction.studies.defaults import KNOBS, Knob, Setting, choose
+from wbfriction.studies.default_cases import Setting
+from wbfriction.studies.defaults import KNOBS, Knob, choose
 
 
 def knob(stage="fit") -> Knob:

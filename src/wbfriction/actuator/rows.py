@@ -48,7 +48,7 @@ from wbfriction.logs.log import Log
 from wbfriction.logs.torque import torque_kind
 from wbfriction.model.momentum import momentum_and_drift
 from wbfriction.model.robot import Robot
-from wbfriction.signals.choice import acceleration_content
+from wbfriction.signals.content import acceleration_content
 
 
 @dataclass(frozen=True)
@@ -283,7 +283,7 @@ def _log_cosh(x: np.ndarray) -> np.ndarray:
 
 
 def _white_noise(x: np.ndarray, period: float) -> np.ndarray:
-    """The white noise (n,) of each column of ``x`` (N, n) (:func:`~wbfriction.signals.choice.acceleration_content`'s
+    """The white noise (n,) of each column of ``x`` (N, n) (:func:`~wbfriction.signals.content.acceleration_content`'s
     floor), zero where the stretch is too short to measure it."""
     try:
         return np.nan_to_num(acceleration_content(x, period).position_noise)

@@ -32,7 +32,8 @@ from wbfriction.friction.route import RouteDecision, resolve_route
 from wbfriction.logs.clock import longest_segment
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
-from wbfriction.signals.choice import DiffChoice, choose_differentiation, contact_changes
+from wbfriction.signals.choice import DiffChoice, choose_differentiation
+from wbfriction.signals.content import contact_changes
 
 
 @dataclass(frozen=True)
@@ -88,7 +89,7 @@ def decide_log(robot: Robot, options: EstimateOptions, positions: np.ndarray | N
         route_rows: the samples the route's windows are bounded by
             (:func:`~wbfriction.friction.route.choose_route`); default the rows of ``positions``.
         changes: the rows of ``positions`` where a contact flag changes
-            (:func:`~wbfriction.signals.choice.contact_changes`): their impacts are not counted as noise.
+            (:func:`~wbfriction.signals.content.contact_changes`): their impacts are not counted as noise.
 
     Raises:
         OptionError: a window given longer than the log's longest stretch; InputError: one the data chose, or
@@ -106,7 +107,7 @@ def decide_log(robot: Robot, options: EstimateOptions, positions: np.ndarray | N
 
 def longest_stretch(log: Log) -> tuple[np.ndarray, np.ndarray | None]:
     """The positions (M, n_act) [rad] of the log's longest stretch between time gaps, and the rows (M,) where a
-    contact flag changes there (:func:`~wbfriction.signals.choice.contact_changes`, None: none)."""
+    contact flag changes there (:func:`~wbfriction.signals.content.contact_changes`, None: none)."""
     a, b = longest_segment(log.segments, len(log.time))
     return log.q[a:b], contact_changes(log.contact[a:b])
 

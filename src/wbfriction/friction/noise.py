@@ -4,7 +4,7 @@ correction and Cramér-Rao bound read.
 Per joint, measured once per log from its positions and model (:func:`noise_record`):
 
 * ``position``: the positions' white noise ``sigma_q`` [rad] (the spectrum of their second difference,
-  :func:`~wbfriction.signals.choice.acceleration_content`; an encoder's quantisation is in it);
+  :func:`~wbfriction.signals.content.acceleration_content`; an encoder's quantisation is in it);
 * ``inertia``: the joint's effective inertia ``M`` [kg·m²]: the median over the log of the norm of its row of the
   joint-space inertia matrix (every joint's position noise reaches its friction through that row). The whole
   robot's matrix, not the stance-rooted tree's: a bound, not a number the estimate uses;
@@ -31,7 +31,6 @@ from wbfriction.exceptions import InputError
 from wbfriction.friction.options import ROUTES, EstimateOptions, Route
 from wbfriction.model.robot import Robot
 from wbfriction.signals.choice import (
-    acceleration_content,
     butterworth_noise_gain,
     butterworth_velocity_gain,
     central_noise_gain,
@@ -39,6 +38,7 @@ from wbfriction.signals.choice import (
     savgol_noise_gain,
     velocity_noise_gain,
 )
+from wbfriction.signals.content import acceleration_content
 
 
 @dataclass(frozen=True)
@@ -131,7 +131,7 @@ def noise_record(robot: Robot, q: np.ndarray, dt: float, options: EstimateOption
     """The JSON-ready record of an estimate's noise (module docstring) from joint positions ``q`` (N, n_act) [rad]
     sampled every ``dt`` [s] (a stretch without gaps) and resolved ``options``; None for positions too few to
     measure their noise. ``changes`` (N,): the rows where a contact flag changes, whose impacts are not noise
-    (:func:`~wbfriction.signals.choice.white_position_noise`)."""
+    (:func:`~wbfriction.signals.content.white_position_noise`)."""
     try:
         content = acceleration_content(q, dt, changes=changes)
     except InputError:

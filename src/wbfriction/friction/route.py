@@ -32,11 +32,11 @@ from wbfriction.logs.log import Log
 from wbfriction.signals.choice import (
     DiffChoice,
     MomentumSmoothing,
-    acceleration_content,
     central_noise_gain,
     choose_momentum_smoothing,
     savgol_choice,
 )
+from wbfriction.signals.content import acceleration_content
 from wbfriction.signals.options import FilterOptions
 
 WINDOW_RATIO = 2.0

@@ -48,7 +48,7 @@ from wbfriction.pipeline.chunks import (
 )
 from wbfriction.pipeline.provenance import log_provenance
 from wbfriction.progress import Progress, StageProgress
-from wbfriction.signals.choice import contact_changes
+from wbfriction.signals.content import contact_changes
 from wbfriction.workers import process_pool
 
 

@@ -25,7 +25,8 @@ from wbfriction.friction.point_contacts import determined_shares
 from wbfriction.inertia.document import Identification
 from wbfriction.logs.tables import write_atomic
 from wbfriction.report.build import Report, acceleration_spectra
-from wbfriction.report.figures import FIT_DRAWN, friction_overview_figure, joint_figure, png_bytes
+from wbfriction.report.figures import png_bytes
+from wbfriction.report.friction_figures import FIT_DRAWN, friction_overview_figure, joint_figure
 from wbfriction.report.numbers import bound_text, duration_text, with_error
 from wbfriction.report.terms import terms_section
 from wbfriction.workers import process_pool
@@ -341,7 +342,7 @@ def _summary_table(r: Report) -> str:
 def _figures(r: Report, joints: list[str], targets: Mapping[str, ModelParams],
              spectra: dict[str, tuple[np.ndarray, np.ndarray, float]], workers: int = 1) -> list[str]:
     """The overview figure's ``<img>`` (none without a joint), then each joint's
-    (:func:`~wbfriction.report.figures.joint_figure`), rendered on ``workers`` processes (forked: they read the
+    (:func:`~wbfriction.report.friction_figures.joint_figure`), rendered on ``workers`` processes (forked: they read the
     report from memory), the overview first."""
     _FIGURE_INPUTS.update(r=r, targets=targets, spectra=spectra, joints=joints)
     keys: list[str | None] = [None, *joints] if joints else []
@@ -363,8 +364,8 @@ _FIGURE_INPUTS: dict = {}
 def report_figure(r: Report, joint: str | None, spectra: Mapping[str, tuple[np.ndarray, np.ndarray, float]]
                   | None = None) -> Figure:
     """A figure of the report as the page shows it: the overview (``joint`` None:
-    :func:`~wbfriction.report.figures.friction_overview_figure` of the joints that moved) or one joint's
-    (:func:`~wbfriction.report.figures.joint_figure`); ``spectra`` as
+    :func:`~wbfriction.report.friction_figures.friction_overview_figure` of the joints that moved) or one joint's
+    (:func:`~wbfriction.report.friction_figures.joint_figure`); ``spectra`` as
     :func:`~wbfriction.report.build.acceleration_spectra` gives them (computed when None)."""
     targets: dict[str, ModelParams] = {j: f.target for j, f in r.fits.items() if f.target is not None}
     if joint is None:

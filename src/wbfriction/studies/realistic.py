@@ -42,7 +42,8 @@ from wbfriction.logs.tables import make_folder, write_table
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress
 from wbfriction.report.build import make_report
-from wbfriction.report.figures import friction_curves_figure, velocity_panels_figure
+from wbfriction.report.figures import velocity_panels_figure
+from wbfriction.report.friction_figures import friction_curves_figure
 from wbfriction.report.html import write_report
 from wbfriction.sim import SimulationResult, simulate_mujoco
 from wbfriction.sim.mujoco_model import MujocoRobot, build_mujoco_robot

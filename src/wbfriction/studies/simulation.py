@@ -31,7 +31,8 @@ from wbfriction.logs.tables import make_folder, write_table
 from wbfriction.model.robot import Robot
 from wbfriction.progress import StageProgress, Steps
 from wbfriction.report.build import make_report
-from wbfriction.report.figures import derivative_schemes_figure, friction_curves_figure, support_phases_figure
+from wbfriction.report.figures import derivative_schemes_figure, support_phases_figure
+from wbfriction.report.friction_figures import friction_curves_figure
 from wbfriction.report.html import write_report
 from wbfriction.sim import Pull, SimulationResult, simulate_ideal
 from wbfriction.studies.common import (
