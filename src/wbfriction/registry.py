@@ -1,15 +1,31 @@
-"""A registry of named kinds of one sort: what every place where a new kind plugs in keeps (the log formats, the torque
-sources, the contact models, the simulators; ``docs/extending.md``).
+"""A registry of named kinds of one sort: what every place where a new kind plugs in keeps (the friction families,
+the export targets, the log formats, the torque sources, the contact models, the simulators; ``docs/extending.md``).
 
-A kind is an object with a ``name``. The registry refuses a name taken (and, kept in precedence order, a precedence
-taken: the kind of lowest precedence that claims a thing takes it), names what it holds in its errors, and gives its
-kinds in the order they are asked in: precedence, or registration.
+A kind is an object with a ``name``. Every registry works alike: :meth:`Registry.register` adds a kind (refusing a
+name taken, or replacing its kind where the registry says so, and, kept in precedence order, a precedence taken: the
+kind of lowest precedence that claims a thing takes it), :meth:`~Registry.unregister` (or :meth:`~Registry.discard`)
+takes one off, :meth:`~Registry.get` finds one by name, :meth:`~Registry.kinds` and :meth:`~Registry.names` list them
+in the order they are asked in (precedence, or registration), and every error names what the registry holds.
+
+What differs from one registry to the next is given when it is made: what its kinds must be (``check``), what
+follows a registration (``on_register``, ``on_unregister``: a catalogue the help reads), and where kinds come from
+besides the calls: built-in kinds whose modules are imported when first named (``builtins``), and kinds installed
+packages advertise under an entry-point group (``entry_points``), read once, the first time the registry is asked,
+and each loaded when first named. An entry point that does not load fails in one line naming it and its distribution
+(:class:`EntryPointError`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from typing import Generic, Protocol, TypeVar
+import copy
+import importlib
+from collections.abc import Callable, Iterator, Mapping
+from typing import TYPE_CHECKING, Any, Generic, Protocol, TypeVar
+
+from wbfriction.exceptions import WbfrictionError
+
+if TYPE_CHECKING:
+    from importlib.metadata import EntryPoint
 
 
 class Named(Protocol):
@@ -23,77 +39,219 @@ class Named(Protocol):
 K = TypeVar("K", bound=Named)
 
 
+class EntryPointError(WbfrictionError):
+    """An entry point an installed package advertises that does not load (its module missing or broken, its object
+    missing, or not callable without arguments): the environment, not the input.
+
+    Attributes:
+        entry_point: the entry point as its package declares it, ``name = module:object``.
+        distribution: the package that advertises it (its name and version), or ``an unknown distribution``.
+        problem: what loading it raised, in one line (``ModuleNotFoundError: No module named 'x'``).
+    """
+
+    exit_status = 1
+
+    def __init__(self, entry_point: str, distribution: str, problem: str):
+        self.entry_point, self.distribution, self.problem = entry_point, distribution, problem
+        super().__init__(f"the entry point '{entry_point}' of {distribution} does not load: {problem}")
+
+    def __reduce__(self):  # picklable across worker processes, with its data
+        return (type(self), (self.entry_point, self.distribution, self.problem))
+
+
+def distribution_of(ep: EntryPoint) -> str:
+    """The package that advertises ``ep``: ``name version``, or ``an unknown distribution``."""
+    dist = getattr(ep, "dist", None)
+    return "an unknown distribution" if dist is None else f"{dist.name} {dist.version}"
+
+
 class Registry(Generic[K]):
     """The registered kinds of one sort, by name, in the order they are asked in.
 
     Args:
         what: what one kind is, for errors (``"torque source"``).
         precedence: each kind's precedence (``lambda k: k.precedence``): kept in that order, two kinds may not
-            share one; None: in the order registered.
+            share one; None: in the order registered (the built-in kinds' names first, the entry points' last).
         unknown: the exception :meth:`get` raises for a name not registered (``ValueError`` by default; the
             user-facing ones: :class:`~wbfriction.exceptions.InputError`), built from the message.
+        replace: a kind registered under a name taken replaces the kind of that name (a module reloaded), rather
+            than being refused.
+        check: what a kind must be, before it is registered: it raises what is wrong (nothing registered).
+        on_register: what follows a kind's registration (a catalogue the help reads, kept in step).
+        on_unregister: what follows a kind's unregistration, given its name.
+        builtins: the built-in kinds' names, each to the module that registers it when imported, the first time it
+            is named: listed before they are loaded, and never unregistered.
+        entry_points: the entry-point group installed packages advertise kinds under (each entry's name the kind's,
+            its object the kind or a class called without arguments); None: none.
+        missing: the exception for a name not registered, from the name and the names that could be given instead
+            (:meth:`get`: every name; :meth:`unregister`: those registered but built in); None: ``unknown``'s
+            (:meth:`get`) or ``ValueError``'s (:meth:`unregister`), built from the message.
+        invalid: the exception for a kind of an entry point that is another name's, from its name and the problem
+            (``ValueError`` by default, ``"<what> '<name>': <problem>"``).
     """
 
     def __init__(self, what: str, precedence: Callable[[K], float] | None = None,
-                 unknown: Callable[[str], Exception] = ValueError) -> None:
-        self.what, self.precedence, self.unknown = what, precedence, unknown
+                 unknown: Callable[[str], Exception] = ValueError, *, replace: bool = False,
+                 check: Callable[[K], None] | None = None, on_register: Callable[[K], None] | None = None,
+                 on_unregister: Callable[[str], None] | None = None, builtins: Mapping[str, str] | None = None,
+                 entry_points: str | None = None,
+                 missing: Callable[[str, tuple[str, ...]], Exception] | None = None,
+                 invalid: Callable[[str, str], Exception] | None = None) -> None:
+        self.what, self.precedence, self.unknown, self.replace = what, precedence, unknown, replace
+        self.check, self.on_register, self.on_unregister = check, on_register, on_unregister
+        self.builtins: dict[str, str] = dict(builtins or {})
+        self.entry_points, self.missing, self.invalid = entry_points, missing, invalid
         self._kinds: dict[str, K] = {}
+        self._advertised: dict[str, EntryPoint] | None = None
 
-    def add(self, kind: K) -> K:
+    def register(self, kind: K) -> K:
         """Register ``kind``; returns it.
 
         Raises:
-            ValueError: a kind of that name, or of that precedence, registered already (naming it).
+            what the registry's ``check`` raises: a kind that is not what the registry holds; nothing registered.
+            ValueError: a kind of that name (unless the registry replaces it), or of that precedence, registered
+                already (naming it).
         """
-        if kind.name in self._kinds:
-            raise ValueError(f"a {self.what} named '{kind.name}' is registered already ({self._kinds[kind.name]!r})")
+        if self.check is not None:
+            self.check(kind)
+        taken = self._kinds.get(kind.name)
+        if taken is not None and not self.replace:
+            raise ValueError(f"a {self.what} named '{kind.name}' is registered already ({taken!r})")
         order = self.precedence
         if order is not None:
-            tied = next((k for k in self._kinds.values() if order(k) == order(kind)), None)
+            tied = next((k for k in self._kinds.values() if k.name != kind.name and order(k) == order(kind)), None)
             if tied is not None:
                 raise ValueError(f"{self.what} '{kind.name}' has the precedence {order(kind):g} of '{tied.name}'")
+        self._kinds.pop(kind.name, None)
         self._kinds[kind.name] = kind
         if order is not None:
-            self._kinds = {k.name: k for k in sorted(self._kinds.values(), key=order)}
+            ordered = sorted(self._kinds.values(), key=order)
+            self._kinds.clear()
+            self._kinds.update((k.name, k) for k in ordered)
+        if self.on_register is not None:
+            self.on_register(kind)
         return kind
 
-    def remove(self, name: str) -> K:
-        """Unregister the kind named ``name``; returns it.
+    def unregister(self, name: str) -> K:
+        """Unregister the kind named ``name``; returns it. A kind of an entry point is loaded again when named.
 
         Raises:
-            ValueError: none of that name (naming those registered).
+            ValueError: a built-in kind; none of that name registered (naming those registered), or the registry's
+                ``missing`` exception.
         """
+        if name in self.builtins:
+            raise ValueError(f"the built-in {self.what} '{name}' cannot be unregistered")
         if name not in self._kinds:
-            raise ValueError(f"no {self.what} named '{name}' (registered: {self.listed()})")
-        return self._kinds.pop(name)
+            registered = tuple(n for n in self._kinds if n not in self.builtins)
+            if self.missing is not None:
+                raise self.missing(name, registered)
+            raise ValueError(f"no {self.what} named '{name}' (registered: {', '.join(registered)})")
+        kind = self._kinds.pop(name)
+        if self.on_unregister is not None:
+            self.on_unregister(name)
+        return kind
+
+    def discard(self, name: str) -> None:
+        """Unregister the kind named ``name`` if one is registered (a no-op if none is)."""
+        if name in self._kinds:
+            self.unregister(name)
 
     def get(self, name: str) -> K:
-        """The kind named ``name``.
+        """The kind named ``name``: a built-in one's module imported, an entry point's loaded, the first time.
 
         Raises:
-            the registry's ``unknown`` exception: none of that name (naming those registered).
+            the registry's ``unknown`` (or ``missing``) exception: none of that name (naming those there are).
+            EntryPointError: the entry point of that name does not load.
+            the registry's ``invalid`` exception: an entry point's kind that is another name's.
         """
-        if name not in self._kinds:
-            raise self.unknown(f"unknown {self.what} {name!r}: choose one of {self.listed()}")
-        return self._kinds[name]
+        kind = self._kinds.get(name)
+        if kind is not None:
+            return kind
+        if name in self.builtins:
+            importlib.import_module(self.builtins[name])
+            return self._kinds[name]
+        ep = self.advertised().get(name)
+        if ep is not None:
+            return self._load(name, ep)
+        if self.missing is not None:
+            raise self.missing(name, self.names())
+        raise self.unknown(f"unknown {self.what} {name!r}: choose one of {self.listed()}")
+
+    def advertised(self) -> dict[str, EntryPoint]:
+        """The kinds installed packages advertise under the registry's entry-point group, by name, not loaded: read
+        once, the first time it is asked."""
+        if self._advertised is None:
+            self._advertised = {}
+            if self.entry_points is not None:
+                from importlib.metadata import entry_points
+
+                self._advertised = {ep.name: ep for ep in entry_points(group=self.entry_points)}
+        return self._advertised
+
+    def _load(self, name: str, ep: EntryPoint) -> K:
+        """The kind of the entry point ``ep``, advertised as ``name``, loaded and registered."""
+        try:
+            loaded: Any = ep.load()
+            kind = loaded() if isinstance(loaded, type) else loaded
+        except Exception as exc:
+            problem = " ".join(f"{type(exc).__name__}: {exc}".split())
+            raise EntryPointError(f"{ep.name} = {ep.value}", distribution_of(ep), problem) from exc
+        if kind.name != name:
+            problem = f"advertised as '{name}' by the entry point {ep.value}"
+            if self.invalid is not None:
+                raise self.invalid(kind.name, problem)
+            raise ValueError(f"{self.what} '{kind.name}': {problem}")
+        return self.register(kind)
+
+    def _lazy(self) -> bool:
+        """Whether kinds may be named before they are loaded (built-in modules, entry points)."""
+        return bool(self.builtins) or self.entry_points is not None
 
     def kinds(self) -> tuple[K, ...]:
-        """The registered kinds, in the order they are asked in."""
+        """The kinds, in the order they are asked in (each loaded)."""
+        if self._lazy():
+            return tuple(self.get(n) for n in self.names())
         return tuple(self._kinds.values())
 
     def names(self) -> tuple[str, ...]:
-        """The registered kinds' names, in order."""
+        """The kinds' names, in order, none loaded (but in precedence order, which loads them): the built-in ones,
+        those registered, those the entry points advertise."""
+        if not self._lazy():
+            return tuple(self._kinds)
+        if self.precedence is not None:
+            for n in (*self.builtins, *self.advertised()):
+                self.get(n)
+            return tuple(self._kinds)
+        return tuple(dict.fromkeys((*self.builtins, *self._kinds, *self.advertised())))
+
+    def loaded(self) -> tuple[str, ...]:
+        """The names of the kinds registered so far (the built-in ones and the entry points' once named), in
+        order."""
         return tuple(self._kinds)
 
     def listed(self) -> str:
         """The names as messages list them: ``a, b, c``."""
-        return ", ".join(self._kinds)
+        return ", ".join(self.names())
+
+    def copy(self) -> Registry[K]:
+        """A registry of the same rules and kinds, changed on its own (what a test registers in and throws away)."""
+        twin = copy.copy(self)
+        twin._kinds = dict(self._kinds)
+        return twin
+
+    add = register
+    """What :meth:`register` was called first."""
+    remove = unregister
+    """What :meth:`unregister` was called first."""
 
     def __contains__(self, name: object) -> bool:
-        return name in self._kinds
+        """Whether a kind is named ``name`` (registered, built in or advertised; none loaded)."""
+        if name in self._kinds or name in self.builtins:
+            return True
+        return self.entry_points is not None and name in self.advertised()
 
     def __iter__(self) -> Iterator[K]:
-        return iter(tuple(self._kinds.values()))
+        return iter(self.kinds())
 
     def __len__(self) -> int:
-        return len(self._kinds)
+        return len(self.names())

@@ -19,9 +19,7 @@ from wbfriction.export.isaac import IsaacTarget
 from wbfriction.export.mjcf import MjcfTarget
 from wbfriction.export.target import ExportTarget
 from wbfriction.export.urdf import UrdfTarget
-
-TARGETS: dict[str, ExportTarget] = {}
-"""Suffix (lower case, with its dot) -> the target that writes it, in the order registered."""
+from wbfriction.registry import Registry
 
 
 class SuffixTaken(ValueError):
@@ -56,6 +54,40 @@ class UnknownExportFormat(InputError):
         return (type(self), (self.path, self.suffix, self.known))
 
 
+def check_suffixes(target: ExportTarget) -> None:
+    """Refuse a target without suffixes, with one that is not lower case with its dot, or with one another target
+    (by name) writes: what :func:`register_target` checks first.
+
+    Raises:
+        SuffixTaken: a suffix another target writes.
+        ValueError: no suffix, or one not lower case with its dot.
+    """
+    if not target.suffixes:
+        raise ValueError(f"export target '{target.name}': no suffix")
+    for suffix in target.suffixes:
+        if not suffix.startswith(".") or suffix != suffix.lower():
+            raise ValueError(f"export target '{target.name}': suffix {suffix!r} is not lower case with its dot")
+        holder = next((t for t in TARGETS if suffix in t.suffixes), None)
+        if holder is not None and holder.name != target.name:
+            raise SuffixTaken(suffix, target.name, holder.name)
+
+
+def catalogue(target: ExportTarget) -> None:
+    """Put ``target``'s kind in the catalogue the command line's help reads (:mod:`~wbfriction.export.catalog`)."""
+    catalog.KINDS[target.name] = catalog.TargetKind.of(target)
+
+
+def uncatalogue(name: str) -> None:
+    """Take the target ``name``'s kind off the catalogue the command line's help reads."""
+    catalog.KINDS.pop(name, None)
+
+
+TARGETS: Registry[ExportTarget] = Registry("export target", replace=True, check=check_suffixes,
+                                           on_register=catalogue, on_unregister=uncatalogue)
+"""The registered targets by name, in the order registered (a target registered again: last); each writes the
+outputs named with one of its suffixes (:func:`target_for`)."""
+
+
 def register_target(target: ExportTarget) -> ExportTarget:
     """Make ``target`` write every output named with one of its :attr:`~ExportTarget.suffixes`; returns it.
 
@@ -65,32 +97,17 @@ def register_target(target: ExportTarget) -> ExportTarget:
         SuffixTaken: a suffix another target (by name) writes; nothing registered.
         ValueError: a target without suffixes, or a suffix that is not lower case with its dot (``.csv``).
     """
-    if not target.suffixes:
-        raise ValueError(f"export target '{target.name}': no suffix")
-    for suffix in target.suffixes:
-        if not suffix.startswith(".") or suffix != suffix.lower():
-            raise ValueError(f"export target '{target.name}': suffix {suffix!r} is not lower case with its dot")
-        holder = TARGETS.get(suffix)
-        if holder is not None and holder.name != target.name:
-            raise SuffixTaken(suffix, target.name, holder.name)
-    for suffix in [s for s, held in TARGETS.items() if held.name == target.name]:
-        del TARGETS[suffix]
-    for suffix in target.suffixes:
-        TARGETS[suffix] = target
-    catalog.KINDS[target.name] = catalog.TargetKind.of(target)
-    return target
+    return TARGETS.register(target)
 
 
 def unregister_target(name: str) -> None:
     """Forget the target named ``name`` (a no-op if none is): its suffixes are written by no target."""
-    for suffix in [s for s, held in TARGETS.items() if held.name == name]:
-        del TARGETS[suffix]
-    catalog.KINDS.pop(name, None)
+    TARGETS.discard(name)
 
 
 def targets() -> tuple[ExportTarget, ...]:
     """The targets registered, each once, in the order registered."""
-    return tuple({id(t): t for t in TARGETS.values()}.values())
+    return TARGETS.kinds()
 
 
 def known_formats() -> tuple[str, ...]:
@@ -106,7 +123,7 @@ def target_for(path: str | Path) -> ExportTarget:
         UnknownExportFormat: a suffix no target writes, naming the file and the formats known.
     """
     suffix = Path(path).suffix.lower()
-    target = TARGETS.get(suffix)
+    target = next((t for t in TARGETS if suffix in t.suffixes), None)
     if target is None:
         raise UnknownExportFormat(path, suffix, known_formats())
     return target

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from typing import Literal, get_args
 
 from wbfriction.choices import check_choice, check_range, flag
-from wbfriction.friction.families.names import REGISTERED, BuiltinName, check_family
+from wbfriction.friction.families.names import FAMILIES, BuiltinName, check_family
 from wbfriction.friction.options import TEMPERATURE_LAWS, TERMS, TemperatureLaw, Term
 from wbfriction.logs.options import check_reference_temperature
 
@@ -32,7 +32,7 @@ def model_choices() -> tuple[str, ...]:
     """``auto``, the built-in families (simplest first) and those registered in this process, none loaded (the
     command line's help lists them): a family an installed package advertises is a choice too, found when named
     (:func:`~wbfriction.friction.families.registry.check_family`)."""
-    return tuple(dict.fromkeys((*MODEL_CHOICES, *REGISTERED)))
+    return tuple(dict.fromkeys((*MODEL_CHOICES, *FAMILIES.loaded())))
 
 
 DEFAULT_THRESHOLD = 0.05

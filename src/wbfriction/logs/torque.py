@@ -156,7 +156,7 @@ def register_torque_source(kind: TorqueKind) -> TorqueKind:
     Raises:
         ValueError: a source of that name, or of that precedence, registered already (naming it).
     """
-    return SOURCES.add(kind)
+    return SOURCES.register(kind)
 
 
 def unregister_torque_source(name: str) -> TorqueKind:
@@ -165,7 +165,7 @@ def unregister_torque_source(name: str) -> TorqueKind:
     Raises:
         ValueError: no source of that name.
     """
-    return SOURCES.remove(name)
+    return SOURCES.unregister(name)
 
 
 def torque_sources() -> tuple[TorqueKind, ...]:

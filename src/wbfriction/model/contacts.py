@@ -127,7 +127,22 @@ class Point(ContactModel):
         return J[:3] + np.array([[0.0, -r, 0.0], [r, 0.0, 0.0], [0.0, 0.0, 0.0]]) @ J[3:]
 
 
-MODELS: Registry[ContactModel] = Registry("contact model", unknown=InputError)
+def check_contact_model(kind: ContactModel) -> None:
+    """Refuse a contact model whose :attr:`~ContactModel.dims` is not 1-6, or one of
+    :attr:`~ContactModel.world_force` whose force is not three components (what :func:`register_contact_model` checks
+    first).
+
+    Raises:
+        ValueError: naming the model and what is wrong.
+    """
+    if not 1 <= kind.dims <= 6:
+        raise ValueError(f"contact model '{kind.name}' has {kind.dims} constraints: a contact has 1 to 6")
+    if kind.world_force and kind.dims != 3:
+        raise ValueError(f"contact model '{kind.name}' takes foot sensors' world-axes forces (world_force) but has "
+                         f"{kind.dims} constraints, not their 3 components")
+
+
+MODELS: Registry[ContactModel] = Registry("contact model", unknown=InputError, check=check_contact_model)
 """The registered contact models, in the order they were registered."""
 
 
@@ -138,12 +153,7 @@ def register_contact_model(kind: ContactModel) -> ContactModel:
         ValueError: a model of that name registered already (naming it), one whose :attr:`~ContactModel.dims` is
             not 1-6, or one of :attr:`~ContactModel.world_force` whose force is not three components.
     """
-    if not 1 <= kind.dims <= 6:
-        raise ValueError(f"contact model '{kind.name}' has {kind.dims} constraints: a contact has 1 to 6")
-    if kind.world_force and kind.dims != 3:
-        raise ValueError(f"contact model '{kind.name}' takes foot sensors' world-axes forces (world_force) but has "
-                         f"{kind.dims} constraints, not their 3 components")
-    return MODELS.add(kind)
+    return MODELS.register(kind)
 
 
 def unregister_contact_model(name: str) -> ContactModel:
@@ -152,7 +162,7 @@ def unregister_contact_model(name: str) -> ContactModel:
     Raises:
         ValueError: no model of that name.
     """
-    return MODELS.remove(name)
+    return MODELS.unregister(name)
 
 
 def contact_models() -> tuple[ContactModel, ...]:

@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wbfriction.exceptions import InputError
-from wbfriction.friction.families.names import load
+from wbfriction.friction.families.names import FAMILIES
 
 ALL_PARAM_NAMES = ("F_v", "F_c", "F_s", "S", "v_s", "tau_os", "a")
 """Every built-in family's parameter names, in one order (e.g. the columns of a table of several families): the keys
@@ -58,7 +58,7 @@ class ModelParamsBase:
             KeyError: a parameter of ``model`` that is not one of :data:`ALL_PARAM_NAMES`.
         """
         q = self.quantities()
-        return {n: q[n] for n in load(model).names}
+        return {n: q[n] for n in FAMILIES.get(model).names}
 
     def to_target(self) -> dict[str, float | str]:
         """These parameters and their family's name, as a simulator's ``friction_true`` metadata holds them

@@ -10,7 +10,8 @@ candidate of ``--model auto``. A family defined in a program takes one call::
 
     register_family(ViscousOnly())  # a FrictionFamily subclass (wbfriction.friction.families.base)
 
-This module imports nothing heavy (the families are kept in :mod:`.names`): checking a name (:func:`check_family`,
+This module imports nothing heavy (the families are kept in :data:`.names.FAMILIES`, a
+:class:`~wbfriction.registry.Registry` as every registered kind): checking a name (:func:`check_family`,
 what :class:`~wbfriction.fit.options.FitOptions` does) loads no family.
 """
 
@@ -18,15 +19,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from wbfriction.friction.families.names import (
-    BUILTIN_NAMES,
-    REGISTERED,
-    UnknownFamilyError,
-    check_family,
-    family_names,
-    keep,
-    load,
-)
+from wbfriction.friction.families.names import FAMILIES, UnknownFamilyError, check_family, family_names
 
 if TYPE_CHECKING:
     from wbfriction.friction.families.base import FrictionFamily
@@ -43,7 +36,7 @@ def register_family(fam: FrictionFamily) -> FrictionFamily:
         InvalidFamily: a definition that does not hold together (:meth:`FrictionFamily.validate`); nothing
             registered.
     """
-    return keep(fam)
+    return FAMILIES.register(fam)
 
 
 def unregister_family(name: str) -> None:
@@ -54,11 +47,7 @@ def unregister_family(name: str) -> None:
         ValueError: a built-in family (:data:`~.names.BUILTIN_NAMES`).
         UnknownFamilyError: a name no family registered has.
     """
-    if name in BUILTIN_NAMES:
-        raise ValueError(f"the built-in friction family '{name}' cannot be unregistered")
-    if name not in REGISTERED:
-        raise UnknownFamilyError(name, tuple(n for n in REGISTERED if n not in BUILTIN_NAMES))
-    del REGISTERED[name]
+    FAMILIES.unregister(name)
 
 
 def family(name: str) -> FrictionFamily:
@@ -67,11 +56,13 @@ def family(name: str) -> FrictionFamily:
     Raises:
         UnknownFamilyError: no family has that name (the message names the families known).
         InvalidFamily: an entry point's family that does not hold together, or is another name's.
+        EntryPointError: an entry point that does not load (:class:`wbfriction.registry.EntryPointError`: one line
+            naming it and its package).
     """
-    return load(name)
+    return FAMILIES.get(name)
 
 
 def families() -> tuple[FrictionFamily, ...]:
     """Every family (each loaded), simplest (fewest parameters) first, in the order of :func:`family_names` among
     those of as many parameters: what ``--model auto`` chooses among."""
-    return tuple(sorted((family(n) for n in family_names()), key=lambda f: len(f.names)))
+    return tuple(sorted(FAMILIES.kinds(), key=lambda f: len(f.names)))

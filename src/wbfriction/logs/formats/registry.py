@@ -52,7 +52,33 @@ class UnknownFormatError(InputError):
         return (type(self), (self.path, self.suffix, self.known))
 
 
-FORMATS: Registry[LogFormat] = Registry("log format")
+def check_suffixes(fmt: LogFormat) -> None:
+    """Refuse a format that claims a suffix another registered format reads (what :func:`register_format` checks
+    first; a name taken is the registry's to refuse).
+
+    Raises:
+        ValueError: naming the suffixes and the format that reads them.
+    """
+    others = () if fmt.name in FORMATS else FORMATS.kinds()  # a name taken: FORMATS.register refuses it, naming it
+    for other in others:
+        shared = sorted(set(fmt.suffixes) & set(other.suffixes))
+        if shared:
+            raise ValueError(f"log format '{fmt.name}' claims {', '.join(shared)}, which format '{other.name}' "
+                             "reads already")
+
+
+def catalogue(fmt: LogFormat) -> None:
+    """Put ``fmt``'s kind in the catalogue the command line's help reads (:mod:`~wbfriction.logs.formats.catalog`)."""
+    KINDS[fmt.name] = FormatKind.of(fmt)
+
+
+def uncatalogue(name: str) -> None:
+    """Take the format ``name``'s kind off the catalogue the command line's help reads."""
+    KINDS.pop(name, None)
+
+
+FORMATS: Registry[LogFormat] = Registry("log format", check=check_suffixes, on_register=catalogue,
+                                        on_unregister=uncatalogue)
 """The registered formats by name, in the order they are tried."""
 
 DEFAULT_FORMAT = "parquet"
@@ -68,15 +94,7 @@ def register_format(fmt: LogFormat) -> LogFormat:
     Raises:
         ValueError: a format of that name registered already, or a suffix another format claims (naming both).
     """
-    others = () if fmt.name in FORMATS else FORMATS.kinds()  # a name taken: FORMATS.add refuses it, naming it
-    for other in others:
-        shared = sorted(set(fmt.suffixes) & set(other.suffixes))
-        if shared:
-            raise ValueError(f"log format '{fmt.name}' claims {', '.join(shared)}, which format '{other.name}' "
-                             "reads already")
-    FORMATS.add(fmt)
-    KINDS[fmt.name] = FormatKind.of(fmt)
-    return fmt
+    return FORMATS.register(fmt)
 
 
 def unregister_format(name: str) -> LogFormat:
@@ -85,9 +103,7 @@ def unregister_format(name: str) -> LogFormat:
     Raises:
         ValueError: no format of that name.
     """
-    fmt = FORMATS.remove(name)
-    KINDS.pop(name, None)
-    return fmt
+    return FORMATS.unregister(name)
 
 
 def log_formats() -> tuple[LogFormat, ...]:
