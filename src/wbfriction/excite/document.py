@@ -41,9 +41,9 @@ from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.logs.setpoint_table import setpoint_table
 from wbfriction.model.robot import Robot
-from wbfriction.sim.arm import FourierTrajectory
 from wbfriction.sim.quadruped import default_quadruped_friction
-from wbfriction.sim.single_support import SIDES
+from wbfriction.walking.fourier import FourierTrajectory
+from wbfriction.walking.single_support import SIDES
 
 CRITERION = ("the worst share of its status's limit (offsets 0.01 rad, others 0.25 x value) that a parameter's "
              "predicted reported standard error comes to")
@@ -131,7 +131,7 @@ def swing_setpoints(robot: Robot, time: np.ndarray, angles: np.ndarray, velociti
 def stance_setpoints(robot: Robot, excitation: StanceExcitation, options: StanceOptions) -> pa.Table:
     """The set-points table of a biped's one-foot stance (:func:`swing_setpoints`: its metadata the stance foot and
     the swing leg's series), from which ``simulate --play`` rebuilds the reference
-    (:func:`~wbfriction.sim.single_support.single_support_reference`)."""
+    (:func:`~wbfriction.walking.single_support.single_support_reference`)."""
     ref = excitation.reference
     return swing_setpoints(robot, ref.time, robot.angles(ref.q), ref.v[:, robot.act_v_index], excitation.joints,
                            excitation.trajectory, "biped on one foot", options.design.seed,
@@ -141,7 +141,7 @@ def stance_setpoints(robot: Robot, excitation: StanceExcitation, options: Stance
 def tripod_setpoints(robot: Robot, excitation: TripodExcitation, options: TripodOptions) -> pa.Table:
     """The set-points table of a quadruped on three feet (:func:`swing_setpoints`: its metadata the swing foot, the
     base's height and the swing leg's series), from which ``simulate --play`` rebuilds the reference
-    (:func:`~wbfriction.sim.tripod_support.tripod_support_reference`)."""
+    (:func:`~wbfriction.walking.tripod_support.tripod_support_reference`)."""
     ref = excitation.reference
     return swing_setpoints(robot, ref.time, ref.q, ref.qd, excitation.joints, excitation.trajectory,
                            "quadruped on three feet", options.design.seed,

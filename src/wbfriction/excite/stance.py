@@ -12,7 +12,7 @@ the last, so that every sample is one the estimator maps exactly to the swing le
   stance sole's footprint (ModelError otherwise).
 * **Every other joint but the stance leg's** is held at the robot's reference posture (arms, torso, head).
 * **The floating base and the stance leg** (``6 + 6`` unknowns) come from a square inverse kinematics per sample
-  (:mod:`wbfriction.sim.single_support`, which ``simulate --play`` reruns on the set-points table's series:
+  (:mod:`wbfriction.walking.single_support`, which ``simulate --play`` reruns on the set-points table's series:
   Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), twelve tasks: the stance sole's placement
   (flat at its standing footprint, 6), the centre of mass over the sole's centre at the standing posture's height
   (3), the base upright (3). Velocities from ``J v = 0``, accelerations from ``J a = -Jd v`` (the targets are
@@ -42,17 +42,17 @@ from wbfriction.excite.design import ExciteOptions
 from wbfriction.excite.swing import design_swing, posture_band, series_bounds, swing_noise
 from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.friction.families.params import ModelParamsBase
+from wbfriction.model.footprint import sole_footprint
 from wbfriction.model.robot import Robot
-from wbfriction.sim.arm import FourierTrajectory
-from wbfriction.sim.mujoco_model import sole_footprint
-from wbfriction.sim.single_support import (  # noqa: F401 (StanceIK, zero_moment_point: this module's names too)
+from wbfriction.walking.fourier import FourierTrajectory
+from wbfriction.walking.reference import WalkingReference, standing_configuration
+from wbfriction.walking.single_support import (  # noqa: F401 (StanceIK, zero_moment_point: this module's names too)
     SIDES,
     StanceIK,
     single_support_reference,
     stance_ik,
     zero_moment_point,
 )
-from wbfriction.walking.reference import WalkingReference, standing_configuration
 
 SWING_BAND: dict[str, tuple[float, float]] = {
     "hip_yaw": (-0.05, 0.15),
@@ -143,7 +143,7 @@ def swing_band(robot: Robot, joints: tuple[str, ...], side: str, margin: float) 
 
 def support_margin(robot: Robot, stance: int, zmp: np.ndarray) -> float:
     """The least distance [m] of the points ``zmp`` (N, 2) (world) to the edges of the stance sole's footprint
-    (:func:`~wbfriction.sim.mujoco_model.sole_footprint`), the sole flat at its standing placement; negative: a
+    (:func:`~wbfriction.model.footprint.sole_footprint`), the sole flat at its standing placement; negative: a
     point outside."""
     model, data = robot.model, robot.model.createData()
     pin.framesForwardKinematics(model, data, standing_configuration(robot))

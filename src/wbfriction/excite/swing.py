@@ -19,7 +19,7 @@ from wbfriction.excite.trajectory import FourierSpace
 from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.friction.noise import NoiseModel
 from wbfriction.model.robot import Robot
-from wbfriction.sim.arm import FourierTrajectory
+from wbfriction.walking.fourier import FourierTrajectory
 
 SLACK = (1e-3, 0.99)
 """What each joint's design is given: its band less 1 mrad at each end, 99 % of its velocity cap: the design holds

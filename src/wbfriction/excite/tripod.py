@@ -13,7 +13,7 @@ leg's friction torque (its joints' rows of the equation of motion hold no contac
   the swing leg's foot and knee :attr:`TripodOptions.spacing` away from the other legs' feet and knees
   (ModelError otherwise).
 * **The floating base and the three stance legs** (``6 + 9`` unknowns) come from a square inverse kinematics per
-  sample (:mod:`wbfriction.sim.tripod_support`, which ``simulate --play`` reruns on the set-points table's series:
+  sample (:mod:`wbfriction.walking.tripod_support`, which ``simulate --play`` reruns on the set-points table's series:
   Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), fifteen tasks: the three stance feet's
   contact frame origins at their footprints (9), the centre of mass over the *incentre* of the stance triangle (the
   point farthest from its edges) at the standing height (3), the base upright and facing forward (3). Velocities
@@ -49,9 +49,10 @@ from wbfriction.excite.stance import zero_moment_point
 from wbfriction.excite.swing import design_swing, posture_band, series_bounds, swing_noise
 from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.model.robot import Robot
-from wbfriction.sim.arm import FourierTrajectory
 from wbfriction.sim.quadruped import default_quadruped_friction
-from wbfriction.sim.tripod_support import (  # noqa: F401 (TripodIK, leg_points, LWA: this module's names too)
+from wbfriction.walking.fourier import FourierTrajectory
+from wbfriction.walking.quadruped import FOOT_RADIUS, QuadrupedReference
+from wbfriction.walking.tripod_support import (  # noqa: F401 (TripodIK, leg_points, LWA: this module's names too)
     LWA,
     TripodIK,
     TripodMotion,
@@ -61,7 +62,6 @@ from wbfriction.sim.tripod_support import (  # noqa: F401 (TripodIK, leg_points,
     triangle_margin,
     tripod_support_reference,
 )
-from wbfriction.walking.quadruped import FOOT_RADIUS, QuadrupedReference
 
 SWING_BAND: dict[str, tuple[float, float]] = {
     "hip": (-0.5, -0.05),

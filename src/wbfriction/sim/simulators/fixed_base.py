@@ -82,7 +82,7 @@ def played(robot: Robot, path: Path, options: HungOptions) -> tuple[HungOptions,
 
 
 def played_arm(robot: Robot, path: Path, options: ArmOptions) -> tuple[ArmOptions, Any]:
-    """``options`` and the trajectory (:class:`~wbfriction.sim.arm.FourierTrajectory`) that play the set-points
+    """``options`` and the trajectory (:class:`~wbfriction.walking.fourier.FourierTrajectory`) that play the set-points
     table at ``path`` on a fixed-base arm: its duration and rate, the Fourier series its metadata holds (what
     ``excite`` writes for an arm: the accelerations the arm's feed-forward takes are exact).
 
@@ -93,7 +93,7 @@ def played_arm(robot: Robot, path: Path, options: ArmOptions) -> tuple[ArmOption
     import numpy as np
 
     from wbfriction.logs.setpoint_table import read_setpoint_table
-    from wbfriction.sim.arm import FourierTrajectory
+    from wbfriction.walking.fourier import FourierTrajectory
 
     table = read_setpoint_table(path, robot)
     if table.fourier is None:

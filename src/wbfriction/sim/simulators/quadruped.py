@@ -1,6 +1,6 @@
 """A walking quadruped (a robot on point feet) with known friction, as ``simulate`` runs it: its gait planned
 (:func:`~wbfriction.walking.quadruped.quadruped_reference`), or its stance on three feet played (``--play``, what
-``excite --swing`` writes: :mod:`wbfriction.sim.tripod_support`), simulated ideal
+``excite --swing`` writes: :mod:`wbfriction.walking.tripod_support`), simulated ideal
 (:func:`~wbfriction.sim.quadruped.simulate_quadruped`) or on MuJoCo
 (:func:`~wbfriction.sim.quadruped_mujoco.simulate_quadruped_mujoco`)."""
 
@@ -61,7 +61,7 @@ def quadruped_options(robot: Robot, values: Mapping[str, Any], friction: Path | 
 def played_tripod(robot: Robot, path: Path) -> QuadrupedReference:
     """The reference of a quadruped's three-feet stance that the set-points table at ``path`` holds (what ``excite
     --swing`` writes): rebuilt from its swing foot, base height, swing leg's series and times
-    (:func:`~wbfriction.sim.tripod_support.tripod_support_reference`), checked against its ``q_des``
+    (:func:`~wbfriction.walking.tripod_support.tripod_support_reference`), checked against its ``q_des``
     (:func:`~.walks.check_played`).
 
     Raises:
@@ -69,7 +69,7 @@ def played_tripod(robot: Robot, path: Path) -> QuadrupedReference:
             swing foot or series; its ``q_des`` more than 1e-6 rad from the rebuilt reference.
     """
     from wbfriction.logs.setpoint_table import read_setpoint_table
-    from wbfriction.sim.tripod_support import tripod_support_reference
+    from wbfriction.walking.tripod_support import tripod_support_reference
 
     table = read_setpoint_table(path, robot)
     if table.swing is None or table.base_height is None or table.fourier is None:

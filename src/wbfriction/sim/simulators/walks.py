@@ -1,6 +1,6 @@
 """A walk with known friction (thesis 6.1, 6.2): the reference walk planned (:mod:`wbfriction.walking.reference`),
 or a biped's one-foot stance played (``--play``, what ``excite --stance`` writes:
-:mod:`wbfriction.sim.single_support`), simulated ideal (:func:`~wbfriction.sim.ideal.simulate_ideal`) or on MuJoCo
+:mod:`wbfriction.walking.single_support`), simulated ideal (:func:`~wbfriction.sim.ideal.simulate_ideal`) or on MuJoCo
 (:func:`~wbfriction.sim.mujoco_sim.simulate_mujoco`), as ``simulate --simulator ideal|mujoco`` runs it."""
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 
     from wbfriction.logs.setpoint_table import SetpointTable
     from wbfriction.model.robot import Robot
-    from wbfriction.sim.arm import FourierTrajectory
+    from wbfriction.walking.fourier import FourierTrajectory
     from wbfriction.walking.reference import WalkingReference
 
 IDEAL = IdealOptions()
@@ -76,7 +76,7 @@ def played_series(table: SetpointTable) -> FourierTrajectory:
     """The swing leg's series a set-points table holds (its ``fourier`` metadata; the caller checked it has one)."""
     import numpy as np
 
-    from wbfriction.sim.arm import FourierTrajectory
+    from wbfriction.walking.fourier import FourierTrajectory
 
     f = table.fourier or {}
     return FourierTrajectory(np.asarray(f["center"], dtype=float), np.asarray(f["a"], dtype=float),
@@ -101,7 +101,7 @@ def check_played(robot: Robot, table: SetpointTable, angles: np.ndarray, what: s
 def played_stance(robot: Robot, path: Path) -> WalkingReference:
     """The reference of a biped's one-foot stance that the set-points table at ``path`` holds (what ``excite
     --stance`` writes): rebuilt from its stance foot, its swing leg's series and its times
-    (:func:`~wbfriction.sim.single_support.single_support_reference`), checked against its ``q_des``
+    (:func:`~wbfriction.walking.single_support.single_support_reference`), checked against its ``q_des``
     (:func:`check_played`).
 
     Raises:
@@ -110,7 +110,7 @@ def played_stance(robot: Robot, path: Path) -> WalkingReference:
             robot's model).
     """
     from wbfriction.logs.setpoint_table import read_setpoint_table
-    from wbfriction.sim.single_support import SIDES, single_support_reference
+    from wbfriction.walking.single_support import SIDES, single_support_reference
 
     table = read_setpoint_table(path, robot)
     if table.stance is None or table.fourier is None:

@@ -3,7 +3,7 @@
 ``wbfriction excite --stance`` designs (:mod:`wbfriction.excite.stance`) and ``wbfriction simulate --play``
 rebuilds from the set-points table's stance foot and series, sample for sample the same.
 
-* **The swing leg** follows its series (:class:`~wbfriction.sim.arm.FourierTrajectory`).
+* **The swing leg** follows its series (:class:`~wbfriction.walking.fourier.FourierTrajectory`).
 * **Every other joint but the stance leg's** is held at the robot's reference posture (arms, torso, head).
 * **The floating base and the stance leg** (``6 + 6`` unknowns) come from a square inverse kinematics per sample
   (:class:`StanceIK`: Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), twelve tasks: the stance
@@ -20,13 +20,13 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import ModelError
+from wbfriction.model.footprint import sole_footprint
 from wbfriction.model.robot import Robot
-from wbfriction.sim.arm import FourierTrajectory
-from wbfriction.sim.mujoco_model import sole_footprint
-from wbfriction.sim.support_ik import LWA, SupportIK
 from wbfriction.walking.footsteps import FootstepPlan
+from wbfriction.walking.fourier import FourierTrajectory
 from wbfriction.walking.options import GaitOptions
 from wbfriction.walking.reference import WalkingReference, standing_configuration
+from wbfriction.walking.support_ik import LWA, SupportIK
 from wbfriction.walking.swing import foot_placement
 
 SIDES = ("left", "right")
