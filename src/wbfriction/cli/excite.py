@@ -44,7 +44,7 @@ FLOATING_ONLY = (*BIPED_ONLY, *QUADRUPED_ONLY)
 """The options only a floating base's designs read: refused for a fixed base."""
 BIPED_DURATION, BIPED_PERIOD = 8.0, 4.0
 """A biped's default time on one foot and its swing joints' Fourier period [s]
-(:class:`~wbfriction.excite.stance.StanceOptions`' own); a quadruped's on three feet are the same
+(:class:`~wbfriction.excite.one_foot.OneFootOptions`' own); a quadruped's on three feet are the same
 (:class:`~wbfriction.excite.tripod.TripodOptions`' own)."""
 QUADRUPED_RATE = 500.0
 """A quadruped's default set-points rate [Hz]: its simulators' control rate (:class:`~wbfriction.excite.tripod.
@@ -144,7 +144,7 @@ def _excite_floating(ctx: typer.Context, r, paths: tuple[list[Path], Path | None
         InputError: a floating base of another kind; an option of the other kind.
     """
     from wbfriction.excite.design import ExciteOptions
-    from wbfriction.excite.stance import StanceOptions
+    from wbfriction.excite.one_foot import OneFootOptions
     from wbfriction.excite.tripod import TripodOptions
 
     feet = len(r.contact_frames)
@@ -157,14 +157,14 @@ def _excite_floating(ctx: typer.Context, r, paths: tuple[list[Path], Path | None
     else:
         refuse_unread(ctx, f"robot '{r.name}' is a biped", QUADRUPED_ONLY, "quadruped's")
     duration, rate, period, seed = design
-    kind = TripodOptions() if quadruped else StanceOptions()
+    kind = TripodOptions() if quadruped else OneFootOptions()
     excite = ExciteOptions(duration=BIPED_DURATION if duration is None else duration,
                            rate=rate or (QUADRUPED_RATE if quadruped else ARM_RATE), period=period or BIPED_PERIOD,
                            harmonics=kind.design.harmonics, range_share=1.0, seed=seed)
     if quadruped:
         _excite_quadruped(r, *paths, TripodOptions(swing=swing or "FR", design=excite))
     else:
-        _excite_biped(r, *paths, StanceOptions(stance=stance or "left", design=excite))
+        _excite_biped(r, *paths, OneFootOptions(stance=stance or "left", design=excite))
 
 
 def _candidates(total: int, what: str):
@@ -268,15 +268,15 @@ def _excite_arm(r, output: list[Path], prediction: Path | None, figure: Path | N
 
 
 def _excite_biped(r, output: list[Path], prediction: Path | None, figure: Path | None, options) -> None:
-    from wbfriction.excite.document import stance_document, stance_setpoints
-    from wbfriction.excite.stance import stance_reference, swing_bounds
+    from wbfriction.excite.document import one_foot_document, one_foot_setpoints
+    from wbfriction.excite.one_foot import one_foot_reference, swing_bounds
 
     with stages() as stage:
         stage(f"designing the swing leg's series, then the stance on the {options.stance} foot (its IK "
               "at every sample)")
-        excitation = stance_reference(r, options)
-    doc = stance_document(r, excitation, options, swing_bounds(r, excitation, options))
-    _write_standing(r, (output, prediction, figure), excitation, stance_setpoints(r, excitation, options), doc,
+        excitation = one_foot_reference(r, options)
+    doc = one_foot_document(r, excitation, options, swing_bounds(r, excitation, options))
+    _write_standing(r, (output, prediction, figure), excitation, one_foot_setpoints(r, excitation, options), doc,
                     f"{r.name} on its {options.stance} foot: the swing leg within its posture band; Cramér-Rao "
                     "bound / weak limit")
     _print_swing(doc, f"The swing leg on the {doc['stance']} foot")

@@ -31,9 +31,9 @@ from wbfriction.excite.arm_design import ArmDesign
 from wbfriction.excite.design import ExciteOptions
 from wbfriction.excite.information import limit_shares
 from wbfriction.excite.next import NextRecording
+from wbfriction.excite.one_foot import OneFootExcitation, OneFootOptions
 from wbfriction.excite.pd_design import SHARE_LIMITS, PdDesign
 from wbfriction.excite.predict import Predicted
-from wbfriction.excite.stance import StanceExcitation, StanceOptions
 from wbfriction.excite.tripod import TripodExcitation, TripodOptions
 from wbfriction.fit.params_file import finite_or_none
 from wbfriction.fit.status import WEAK
@@ -128,7 +128,7 @@ def swing_setpoints(robot: Robot, time: np.ndarray, angles: np.ndarray, velociti
                           fourier_joints=joints, kind=kind, seed=seed, **where)
 
 
-def stance_setpoints(robot: Robot, excitation: StanceExcitation, options: StanceOptions) -> pa.Table:
+def one_foot_setpoints(robot: Robot, excitation: OneFootExcitation, options: OneFootOptions) -> pa.Table:
     """The set-points table of a biped's one-foot stance (:func:`swing_setpoints`: its metadata the stance foot and
     the swing leg's series), from which ``simulate --play`` rebuilds the reference
     (:func:`~wbfriction.walking.single_support.single_support_reference`)."""
@@ -174,7 +174,7 @@ def _standing(robot: Robot, kind: str, design: ExciteOptions, velocity: float) -
             "harmonics": design.harmonics, "velocity_cap": velocity}
 
 
-def stance_document(robot: Robot, excitation: StanceExcitation, options: StanceOptions,
+def one_foot_document(robot: Robot, excitation: OneFootExcitation, options: OneFootOptions,
                     bounds: Mapping[str, Mapping[str, float]]) -> dict[str, Any]:
     """The JSON document of a biped's one-foot stance::
 
@@ -184,7 +184,7 @@ def stance_document(robot: Robot, excitation: StanceExcitation, options: StanceO
          "swing": {"<joint>": {"band": [lower, upper] [rad], "reached": [min, max] [rad], "peak_velocity" [rad/s],
                                "bound": {"<parameter>": its Cramér-Rao bound}, "share": {"F_c", "F_v"}}}}
 
-    ``bounds``: each swing joint's Cramér-Rao bounds (:func:`~wbfriction.excite.stance.swing_bounds`); ``share``
+    ``bounds``: each swing joint's Cramér-Rao bounds (:func:`~wbfriction.excite.one_foot.swing_bounds`); ``share``
     is the bound over :data:`~wbfriction.fit.status.WEAK` of the prior's value (below 1: ``ok`` at best)."""
     ref = excitation.reference
     act = [robot.actuated.index(j) for j in excitation.joints]
@@ -199,7 +199,7 @@ def stance_document(robot: Robot, excitation: StanceExcitation, options: StanceO
 
 def tripod_document(robot: Robot, excitation: TripodExcitation, options: TripodOptions,
                     bounds: Mapping[str, Mapping[str, float]]) -> dict[str, Any]:
-    """The JSON document of a quadruped on three feet: as :func:`stance_document`'s, with ``"kind": "quadruped on
+    """The JSON document of a quadruped on three feet: as :func:`one_foot_document`'s, with ``"kind": "quadruped on
     three feet"``, ``"swing_foot"`` (the lifted foot's contact frame), ``"stance_feet"`` (the three others),
     ``"base_height"`` [m], the margins ``"com_margin"``, ``"zmp_margin"`` (to the stance triangle's edges),
     ``"clearance"`` (the swing foot's sphere above the ground), ``"spacing"`` (the swing leg to the others) [m] and

@@ -20,7 +20,7 @@ leg's friction torque (its joints' rows of the equation of motion hold no contac
   from ``J v = 0``, accelerations from ``J a = -Jd v`` (the targets are constant), so that the reference keeps
   the stance feet still at the acceleration level. *Quasi-static*: the centre of mass, not the zero-moment point,
   is held inside the triangle (:attr:`TripodOptions.com_margin` from its edges); the ZMP of the reference's own
-  dynamics (:func:`~.stance.zero_moment_point`, on the ground) is computed and must stay
+  dynamics (:func:`~wbfriction.walking.single_support.zero_moment_point`, on the ground) is computed and must stay
   :attr:`TripodOptions.zmp_margin` inside the triangle (ModelError otherwise): the swing leg's velocity cap is
   what keeps it there. (The Go2 ``go2_walking``, the default options, each leg swung in turn: the centre of mass
   held 104 mm inside the triangle's edges (its inradius), the ZMP at least 100 mm; the swing foot's sphere 59-94 mm
@@ -45,7 +45,7 @@ import pinocchio as pin
 
 from wbfriction.exceptions import InputError, ModelError
 from wbfriction.excite.design import ExciteOptions
-from wbfriction.excite.stance import zero_moment_point
+from wbfriction.excite.one_foot import zero_moment_point
 from wbfriction.excite.swing import design_swing, posture_band, series_bounds, swing_noise
 from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.model.robot import Robot
