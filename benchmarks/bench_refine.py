@@ -7,7 +7,7 @@ smooth Coulomb-viscous law, or ``mujoco``, MuJoCo's own friction loss and dampin
 wall time is printed against issue 64's 2 minutes and PACE's published 2 h 15 min (CMA-ES over Isaac Lab on an RTX
 3080, ANYmal). Then the export, the refined file and the truth's own file (written from the log's metadata) are
 replayed on the last 40 % at the simulator's 1 ms (``--timestep``), and the refined values are compared with the
-truth (the armature as MuJoCo's Euler step holds it, less ``h F_v``: :mod:`wbfriction.sim.refine`), each error in its
+truth (the armature as MuJoCo's Euler step holds it, less ``h F_v``: :mod:`wbfriction.replay.refine`), each error in its
 standard errors. With ``--true-offsets`` the refinement runs with the truth's encoder offsets (what it does not
 refine) instead of the identified ones.
 
@@ -29,8 +29,8 @@ import pyarrow.parquet as pq
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.friction.models import params_from_dict
 from wbfriction.model.loading import load_robot
-from wbfriction.sim.refine import PARAMETERS
-from wbfriction.sim.replay import Replay, replay_mjcf
+from wbfriction.replay.mjcf import Replay, replay_mjcf
+from wbfriction.replay.refine import PARAMETERS
 from wbfriction.studies.real_data import run_route
 
 PACE_SECONDS = 2 * 3600 + 15 * 60

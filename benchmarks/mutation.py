@@ -50,7 +50,7 @@ TESTS: dict[str, tuple[str, ...]] = {
                              "tests/friction/test_condition_number.py", "tests/friction/test_fixed_base.py"),
     "model/dynamics.py": ("tests/model/test_dynamics.py", "tests/friction/test_double_support.py",
                           "tests/friction/test_condition_number.py"),
-    "model/stance.py": ("tests/model/test_stance.py", "tests/friction/test_estimate.py"),
+    "model/rerooted.py": ("tests/model/test_rerooted.py", "tests/friction/test_estimate.py"),
     "signals/kinematics.py": ("tests/signals/test_kinematics.py", "tests/signals/test_filter_wiring.py",
                               "tests/signals/test_filters.py"),
     "signals/filters.py": ("tests/signals/test_filters.py", "tests/signals/test_weighted_savgol.py",

@@ -5,7 +5,7 @@ process, as ``docs/extending.md`` says registration reaches) and public function
 
 * The family: ``simulate --friction`` (its ``model`` key) injects it and logs its own characteristic; ``fit --model``
   recovers it; ``predict`` and ``report`` read its fits; ``export`` writes them (a built-in MJCF and the toy target);
-  ``batch --model`` fits it; the rollout (:func:`~wbfriction.sim.rollout.rollout`) replays it as the (3.5) it equals.
+  ``batch --model`` fits it; the rollout (:func:`~wbfriction.replay.rollout.rollout`) replays it as the (3.5) it equals.
   Every simulator's injection: ``tests/sim/test_injected_families.py``.
 * The target: ``export -o FILE.csv`` (:func:`~wbfriction.pipeline.export_step.export_files`).
 * The format: ``simulate -o`` writes it; ``estimate``, ``convert``, ``spectrum``, ``sensitivity``, ``identify``,
@@ -207,7 +207,7 @@ def test_the_toys_reach_every_other_command_that_takes_their_kind(toys, tmp_path
     cli("refine", hung, tmp_path / "go2.xml", "--robot", "go2", "--to", "1.5", "-o", tmp_path / "refined.xml")
     assert (tmp_path / "refined.xml").read_text().lstrip().startswith(("<", "<!--"))
 
-    from wbfriction.sim.rollout import ActuatorParams, rollout
+    from wbfriction.replay.rollout import ActuatorParams, rollout
     go2 = load_robot("go2")
     toy = {j: FixedSlopeParams(F_v=0.2, F_c=0.4, tau_os=0.05) for j in go2.actuated}
     thesis = {j: FrictionParams(F_v=0.2, F_c=0.4, S=0.0, v_s=0.05, tau_os=0.05, a=A) for j in go2.actuated}

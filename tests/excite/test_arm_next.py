@@ -24,13 +24,8 @@ from wbfriction.logs.tables import write_table
 from wbfriction.model.loading import RobotSpec
 from wbfriction.pipeline.estimate_step import estimate_file
 from wbfriction.pipeline.fit_step import fit_file
-from wbfriction.sim.arm import (
-    ExcitationOptions,
-    FourierTrajectory,
-    default_arm_friction,
-    excitation_trajectory,
-    simulate_arm,
-)
+from wbfriction.sim.arm import ExcitationOptions, default_arm_friction, excitation_trajectory, simulate_arm
+from wbfriction.walking.fourier import FourierTrajectory
 
 WRIST = ("panda_joint5", "panda_joint6", "panda_joint7")
 DURATION = 10.0

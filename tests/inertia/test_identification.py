@@ -31,7 +31,7 @@ from wbfriction.inertia.prior import residual_variance
 from wbfriction.inertia.regressor import act_matrix, body_parameters, stance_regressor
 from wbfriction.inertia.samples import log_samples
 from wbfriction.inertia.sensitivity import scaled_robot
-from wbfriction.model.stance import stance_model
+from wbfriction.model.rerooted import stance_model
 from wbfriction.signals.options import FilterOptions
 from wbfriction.studies.common import leg_joints
 

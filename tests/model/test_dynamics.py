@@ -9,7 +9,7 @@ import pytest
 
 from conftest import constrained_forward, random_state
 from wbfriction.model.dynamics import constrained_dynamics, floating_base_state
-from wbfriction.model.stance import stance_model
+from wbfriction.model.rerooted import stance_model
 
 
 def _samples(robot, support: str, n: int, seed: int):

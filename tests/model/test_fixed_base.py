@@ -12,7 +12,7 @@ import pytest
 from wbfriction.exceptions import InputError
 from wbfriction.model import load_robot
 from wbfriction.model.loading import example_robot_data_dir
-from wbfriction.model.stance import stance_model
+from wbfriction.model.rerooted import stance_model
 
 PANDA = "panda_description/urdf/panda.urdf"
 FINGERS = ("panda_finger_joint1", "panda_finger_joint2")

@@ -11,7 +11,7 @@ from wbfriction.model import momentum
 from wbfriction.model.force_torque import above_sensors_model
 from wbfriction.model.measured_dynamics import measured_momentum
 from wbfriction.model.momentum import momentum_and_drift, tree_momentum_and_drift
-from wbfriction.model.stance import stance_model
+from wbfriction.model.rerooted import stance_model
 
 
 def _states(model: pin.Model, rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -103,7 +103,7 @@ def test_a_tilted_foot_sees_gravity_tilted(talos):
 
 def _tree_cases(talos) -> list[tuple[str, pin.Model]]:
     """Fixed-base trees: TALOS's stance tree with its root locked (reversed joints, continuous joints none), and a
-    chain of every 1-DoF joint type Pinocchio makes of a URDF (tests/model/test_stance.py)."""
+    chain of every 1-DoF joint type Pinocchio makes of a URDF (tests/model/test_rerooted.py)."""
     stance = stance_model(talos, 1)
     rooted = pin.buildReducedModel(stance.model, [1], pin.neutral(stance.model))
     chain = pin.buildModelFromXML(chain_urdf(np.random.default_rng(7)))

@@ -153,7 +153,7 @@ def test_the_exported_simulator_tracks_the_held_out_stretch_better_than_the_peer
     import numpy as np
 
     from wbfriction.pipeline.export_step import export_files
-    from wbfriction.sim.replay import Replay, replay_mjcf
+    from wbfriction.replay.mjcf import Replay, replay_mjcf
     from wbfriction.studies.pd_peer import peer_rollouts
 
     written, peer, _, ours, folder = route
@@ -188,7 +188,7 @@ def test_the_refined_simulator_tracks_the_held_out_stretch_better_than_the_expor
     import numpy as np
 
     from wbfriction.pipeline.export_step import export_files
-    from wbfriction.sim.refine import refine_mjcf, write_refined
+    from wbfriction.replay.refine import refine_mjcf, write_refined
     from wbfriction.studies.pd_peer import peer_rollouts
 
     written, peer, _, ours, folder = route

@@ -1,4 +1,4 @@
-"""The hung, PD-driven Go2 the simulator's and the rollout's tests share (built once a module)."""
+"""The hung, PD-driven Go2 the hung simulator's tests share (built once a module)."""
 
 from __future__ import annotations
 

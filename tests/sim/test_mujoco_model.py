@@ -9,7 +9,8 @@ import pytest
 
 from wbfriction.friction.models import FrictionParams
 from wbfriction.logs.contacts import normal_forces
-from wbfriction.sim.mujoco_model import SOLE_THICKNESS, build_mujoco_robot, sole_footprint
+from wbfriction.model.footprint import sole_footprint
+from wbfriction.sim.mujoco_model import SOLE_THICKNESS, build_mujoco_robot
 
 
 @pytest.fixture(scope="module")

@@ -42,7 +42,7 @@ def refine(log: Path = LogArg,
     frictionloss (F_c), damping (F_v) and constant torque (tau_os), and the set-points' delay, moved to minimise
     the replayed angles' error (as 'wbfriction rollout' replays it), each with its standard error and status; the
     refined file written to -o, MODEL untouched (a hung robot, its base fixed)."""
-    from wbfriction.sim.refine import refine_mjcf, write_refined
+    from wbfriction.replay.refine import refine_mjcf, write_refined
 
     check_paths({"LOG": log, "MODEL": model, "--held-out": held_out, "--config": config, "--urdf": urdf,
                  "--mjcf": mjcf}, {"-o": output, "--table": table})
@@ -71,7 +71,7 @@ def refine(log: Path = LogArg,
 
 def _values(result) -> Table:
     """Each joint's refined values ± their standard errors, a status beside a value that is not ok."""
-    from wbfriction.sim.refine import PARAMETERS, UNITS
+    from wbfriction.replay.refine import PARAMETERS, UNITS
 
     table = Table(title="refined values ± standard error (--table: the file's beside them)", box=None)
     table.add_column("joint")
@@ -89,8 +89,8 @@ def _values(result) -> Table:
 
 def _held_out(model: Path, refined: Path, robot, held_out: Path, replay) -> Table:
     """The file and the refined file replayed on the held-out log: their RMS per joint [mrad]."""
-    from wbfriction.sim.replay import replay_mjcf
-    from wbfriction.sim.rollout import read_log_setpoints
+    from wbfriction.replay.mjcf import replay_mjcf
+    from wbfriction.replay.rollout import read_log_setpoints
 
     data = read_log_setpoints(robot, held_out)
     before, after = replay_mjcf(model, robot, data, replay), replay_mjcf(refined, robot, data, replay)

@@ -15,7 +15,7 @@ from wbfriction.exceptions import OptionError
 from wbfriction.pipeline.paths import check_paths
 
 if TYPE_CHECKING:
-    from wbfriction.sim.replay import Replay
+    from wbfriction.replay.mjcf import Replay
 
 
 @app.command(rich_help_panel=ROBOT)
@@ -46,8 +46,8 @@ def rollout(log: Path = LogArg,
     """Replay the log's set-points on an exported MuJoCo model, as MuJoCo runs it (the file's timestep, gains,
     offsets, torque limits and set-point delay), restarted from the log's state every --window seconds and in one
     shot: how far the simulated encoder angles go from the logged ones, per joint (a hung robot, its base fixed)."""
+    from wbfriction.replay.mjcf import replay_check
     from wbfriction.report.figures import rollout_figure
-    from wbfriction.sim.replay import replay_check
 
     check_paths({"LOG": log, "MODEL": model, "--config": config, "--urdf": urdf, "--mjcf": mjcf},
                 {"-o": output, "--figure": figure})
@@ -74,13 +74,13 @@ def rollout(log: Path = LogArg,
 
 def replay_options(window: float, timestep: float | None, start: float | None, stop: float | None,
                    **replay) -> tuple[Replay, tuple[float, float] | None]:
-    """The replay (:class:`~wbfriction.sim.replay.Replay`, its other fields ``replay``) and the stretch ``[--from,
+    """The replay (:class:`~wbfriction.replay.mjcf.Replay`, its other fields ``replay``) and the stretch ``[--from,
     --to)`` (None: the whole log) of the options ``--window``, ``--timestep``, ``--from``, ``--to``.
 
     Raises:
         OptionError: a window or timestep that is not a time > 0.
     """
-    from wbfriction.sim.replay import Replay
+    from wbfriction.replay.mjcf import Replay
 
     if not (math.isfinite(window) and window > 0):
         raise OptionError("--window", window, "a time > 0 [s]")

@@ -32,7 +32,7 @@ from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.friction.noise import NoiseModel
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
-from wbfriction.sim.arm import FourierTrajectory
+from wbfriction.walking.fourier import FourierTrajectory
 
 GRID = 400
 """Points per period the limits are held at during the design (checked at every sample afterwards)."""

@@ -31,9 +31,9 @@ from wbfriction.excite.arm_design import ArmDesign
 from wbfriction.excite.design import ExciteOptions
 from wbfriction.excite.information import limit_shares
 from wbfriction.excite.next import NextRecording
+from wbfriction.excite.one_foot import OneFootExcitation, OneFootOptions
 from wbfriction.excite.pd_design import SHARE_LIMITS, PdDesign
 from wbfriction.excite.predict import Predicted
-from wbfriction.excite.stance import StanceExcitation, StanceOptions
 from wbfriction.excite.tripod import TripodExcitation, TripodOptions
 from wbfriction.fit.params_file import finite_or_none
 from wbfriction.fit.status import WEAK
@@ -41,9 +41,9 @@ from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.logs.setpoint_table import setpoint_table
 from wbfriction.model.robot import Robot
-from wbfriction.sim.arm import FourierTrajectory
 from wbfriction.sim.quadruped import default_quadruped_friction
-from wbfriction.sim.single_support import SIDES
+from wbfriction.walking.fourier import FourierTrajectory
+from wbfriction.walking.single_support import SIDES
 
 CRITERION = ("the worst share of its status's limit (offsets 0.01 rad, others 0.25 x value) that a parameter's "
              "predicted reported standard error comes to")
@@ -128,10 +128,10 @@ def swing_setpoints(robot: Robot, time: np.ndarray, angles: np.ndarray, velociti
                           fourier_joints=joints, kind=kind, seed=seed, **where)
 
 
-def stance_setpoints(robot: Robot, excitation: StanceExcitation, options: StanceOptions) -> pa.Table:
+def one_foot_setpoints(robot: Robot, excitation: OneFootExcitation, options: OneFootOptions) -> pa.Table:
     """The set-points table of a biped's one-foot stance (:func:`swing_setpoints`: its metadata the stance foot and
     the swing leg's series), from which ``simulate --play`` rebuilds the reference
-    (:func:`~wbfriction.sim.single_support.single_support_reference`)."""
+    (:func:`~wbfriction.walking.single_support.single_support_reference`)."""
     ref = excitation.reference
     return swing_setpoints(robot, ref.time, robot.angles(ref.q), ref.v[:, robot.act_v_index], excitation.joints,
                            excitation.trajectory, "biped on one foot", options.design.seed,
@@ -141,7 +141,7 @@ def stance_setpoints(robot: Robot, excitation: StanceExcitation, options: Stance
 def tripod_setpoints(robot: Robot, excitation: TripodExcitation, options: TripodOptions) -> pa.Table:
     """The set-points table of a quadruped on three feet (:func:`swing_setpoints`: its metadata the swing foot, the
     base's height and the swing leg's series), from which ``simulate --play`` rebuilds the reference
-    (:func:`~wbfriction.sim.tripod_support.tripod_support_reference`)."""
+    (:func:`~wbfriction.walking.tripod_support.tripod_support_reference`)."""
     ref = excitation.reference
     return swing_setpoints(robot, ref.time, ref.q, ref.qd, excitation.joints, excitation.trajectory,
                            "quadruped on three feet", options.design.seed,
@@ -174,7 +174,7 @@ def _standing(robot: Robot, kind: str, design: ExciteOptions, velocity: float) -
             "harmonics": design.harmonics, "velocity_cap": velocity}
 
 
-def stance_document(robot: Robot, excitation: StanceExcitation, options: StanceOptions,
+def one_foot_document(robot: Robot, excitation: OneFootExcitation, options: OneFootOptions,
                     bounds: Mapping[str, Mapping[str, float]]) -> dict[str, Any]:
     """The JSON document of a biped's one-foot stance::
 
@@ -184,7 +184,7 @@ def stance_document(robot: Robot, excitation: StanceExcitation, options: StanceO
          "swing": {"<joint>": {"band": [lower, upper] [rad], "reached": [min, max] [rad], "peak_velocity" [rad/s],
                                "bound": {"<parameter>": its Cramér-Rao bound}, "share": {"F_c", "F_v"}}}}
 
-    ``bounds``: each swing joint's Cramér-Rao bounds (:func:`~wbfriction.excite.stance.swing_bounds`); ``share``
+    ``bounds``: each swing joint's Cramér-Rao bounds (:func:`~wbfriction.excite.one_foot.swing_bounds`); ``share``
     is the bound over :data:`~wbfriction.fit.status.WEAK` of the prior's value (below 1: ``ok`` at best)."""
     ref = excitation.reference
     act = [robot.actuated.index(j) for j in excitation.joints]
@@ -199,7 +199,7 @@ def stance_document(robot: Robot, excitation: StanceExcitation, options: StanceO
 
 def tripod_document(robot: Robot, excitation: TripodExcitation, options: TripodOptions,
                     bounds: Mapping[str, Mapping[str, float]]) -> dict[str, Any]:
-    """The JSON document of a quadruped on three feet: as :func:`stance_document`'s, with ``"kind": "quadruped on
+    """The JSON document of a quadruped on three feet: as :func:`one_foot_document`'s, with ``"kind": "quadruped on
     three feet"``, ``"swing_foot"`` (the lifted foot's contact frame), ``"stance_feet"`` (the three others),
     ``"base_height"`` [m], the margins ``"com_margin"``, ``"zmp_margin"`` (to the stance triangle's edges),
     ``"clearance"`` (the swing foot's sphere above the ground), ``"spacing"`` (the swing leg to the others) [m] and

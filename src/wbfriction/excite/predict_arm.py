@@ -124,7 +124,7 @@ def predict_arm(robot: Robot, friction: Mapping[str, ModelParams], trajectory: R
                 estimate: EstimateOptions = EstimateOptions(), fit: FitOptions = FitOptions(),
                 joints: Sequence[str] | None = None) -> ArmPrediction:
     """:class:`ArmPrediction` (module docstring) of the fixed-base ``robot`` following ``trajectory`` (an
-    ``excite`` design's :class:`~wbfriction.sim.arm.FourierTrajectory`, or any reference) for
+    ``excite`` design's :class:`~wbfriction.walking.fourier.FourierTrajectory`, or any reference) for
     :attr:`ArmOptions.duration`, its ``friction`` and ``armature`` (None: the robot's) as the prior has them, read by
     ``options``' sensors (their noise's seed :attr:`ArmOptions.seed`), identified with ``estimate`` and ``fit``
     (their defaults: the commands'); of ``joints`` only where given (a design's moving joints: a joint held still

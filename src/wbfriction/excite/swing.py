@@ -1,4 +1,4 @@
-"""The swing leg's design shared by a humanoid's one-foot stance (:mod:`.stance`) and a quadruped's three-feet
+"""The swing leg's design shared by a humanoid's one-foot stance (:mod:`.one_foot`) and a quadruped's three-feet
 stance (:mod:`.tripod`): each swing joint's posture band within its URDF range (:func:`posture_band`), its
 finite Fourier series designed alone on the Cramér-Rao bound of its friction (:func:`design_swing`), the noise that
 design takes (:func:`swing_noise`) and the bounds its series reach (:func:`series_bounds`).
@@ -19,7 +19,7 @@ from wbfriction.excite.trajectory import FourierSpace
 from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.friction.noise import NoiseModel
 from wbfriction.model.robot import Robot
-from wbfriction.sim.arm import FourierTrajectory
+from wbfriction.walking.fourier import FourierTrajectory
 
 SLACK = (1e-3, 0.99)
 """What each joint's design is given: its band less 1 mrad at each end, 99 % of its velocity cap: the design holds
@@ -28,7 +28,7 @@ its limits on a grid (:data:`~.design.GRID` points per period) and overshoots th
 
 
 class SwingOptions(Protocol):
-    """The fields of :class:`~.stance.StanceOptions` and :class:`~.tripod.TripodOptions` the swing's design reads."""
+    """The fields of :class:`~.one_foot.OneFootOptions` and :class:`~.tripod.TripodOptions` the swing's design reads."""
 
     @property
     def design(self) -> ExciteOptions: ...

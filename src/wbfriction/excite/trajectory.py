@@ -13,7 +13,7 @@ periodic in ``2 pi / omega_f`` (a whole number of periods per recording: it ends
 joint's ``a`` and ``b`` in a basis of their null spaces (:class:`FourierSpace`): the design's free variables are
 each joint's centre ``c_i`` and ``2 (L - 1)`` coordinates, unconstrained.
 
-The series is :class:`~wbfriction.sim.arm.FourierTrajectory`, which the arm simulator tracks.
+The series is :class:`~wbfriction.walking.fourier.FourierTrajectory`, which the arm simulator tracks.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wbfriction.exceptions import InputError
-from wbfriction.sim.arm import FourierTrajectory
+from wbfriction.walking.fourier import FourierTrajectory
 
 
 def rest_basis(harmonics: int) -> tuple[np.ndarray, np.ndarray]:

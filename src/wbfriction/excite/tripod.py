@@ -13,14 +13,14 @@ leg's friction torque (its joints' rows of the equation of motion hold no contac
   the swing leg's foot and knee :attr:`TripodOptions.spacing` away from the other legs' feet and knees
   (ModelError otherwise).
 * **The floating base and the three stance legs** (``6 + 9`` unknowns) come from a square inverse kinematics per
-  sample (:mod:`wbfriction.sim.tripod_support`, which ``simulate --play`` reruns on the set-points table's series:
+  sample (:mod:`wbfriction.walking.tripod_support`, which ``simulate --play`` reruns on the set-points table's series:
   Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), fifteen tasks: the three stance feet's
   contact frame origins at their footprints (9), the centre of mass over the *incentre* of the stance triangle (the
   point farthest from its edges) at the standing height (3), the base upright and facing forward (3). Velocities
   from ``J v = 0``, accelerations from ``J a = -Jd v`` (the targets are constant), so that the reference keeps
   the stance feet still at the acceleration level. *Quasi-static*: the centre of mass, not the zero-moment point,
   is held inside the triangle (:attr:`TripodOptions.com_margin` from its edges); the ZMP of the reference's own
-  dynamics (:func:`~.stance.zero_moment_point`, on the ground) is computed and must stay
+  dynamics (:func:`~wbfriction.walking.single_support.zero_moment_point`, on the ground) is computed and must stay
   :attr:`TripodOptions.zmp_margin` inside the triangle (ModelError otherwise): the swing leg's velocity cap is
   what keeps it there. (The Go2 ``go2_walking``, the default options, each leg swung in turn: the centre of mass
   held 104 mm inside the triangle's edges (its inradius), the ZMP at least 100 mm; the swing foot's sphere 59-94 mm
@@ -45,13 +45,14 @@ import pinocchio as pin
 
 from wbfriction.exceptions import InputError, ModelError
 from wbfriction.excite.design import ExciteOptions
-from wbfriction.excite.stance import zero_moment_point
+from wbfriction.excite.one_foot import zero_moment_point
 from wbfriction.excite.swing import design_swing, posture_band, series_bounds, swing_noise
 from wbfriction.friction.families.params import ModelParamsBase
 from wbfriction.model.robot import Robot
-from wbfriction.sim.arm import FourierTrajectory
 from wbfriction.sim.quadruped import default_quadruped_friction
-from wbfriction.sim.tripod_support import (  # noqa: F401 (TripodIK, leg_points, LWA: this module's names too)
+from wbfriction.walking.fourier import FourierTrajectory
+from wbfriction.walking.quadruped import FOOT_RADIUS, QuadrupedReference
+from wbfriction.walking.tripod_support import (  # noqa: F401 (TripodIK, leg_points, LWA: this module's names too)
     LWA,
     TripodIK,
     TripodMotion,
@@ -61,7 +62,6 @@ from wbfriction.sim.tripod_support import (  # noqa: F401 (TripodIK, leg_points,
     triangle_margin,
     tripod_support_reference,
 )
-from wbfriction.walking.quadruped import FOOT_RADIUS, QuadrupedReference
 
 SWING_BAND: dict[str, tuple[float, float]] = {
     "hip": (-0.5, -0.05),

@@ -7,7 +7,7 @@ The acceleration difference of the torque-controlled joints is caused by frictio
 * **Single support** (one contact): ``M_mod^{-1}`` is invertible and
   ``tau_f = M_mod Delta qdd_tc`` (5.13) is exact. The default route computes it with one
   recursive Newton-Euler pass on the robot re-rooted at the stance foot
-  (:mod:`wbfriction.model.stance`), batched in C++ (``pin.rneaInParallel``); ``method="kkt"``
+  (:mod:`wbfriction.model.rerooted`), batched in C++ (``pin.rneaInParallel``); ``method="kkt"``
   forms (5.10)-(5.13) explicitly (:mod:`wbfriction.model.dynamics`). Both agree to 1e-9.
 * **Double support**: ``M_mod^{-1}`` is singular; the regularised weighted least squares
   (6.1) ``min 1/2 |Delta - M_mod^{-1} tau_f|_W^2 + 1/2 tau_f^T Lambda tau_f`` gives
@@ -42,8 +42,8 @@ from wbfriction.friction.point_contacts import point_contact_estimate
 from wbfriction.logs.log import Log
 from wbfriction.logs.torque import torque_record
 from wbfriction.model.dynamics import constrained_dynamics
+from wbfriction.model.rerooted import stance_frame_pose, stance_model
 from wbfriction.model.robot import Robot
-from wbfriction.model.stance import stance_frame_pose, stance_model
 from wbfriction.progress import Progress
 from wbfriction.signals.kinematics import MeasuredKinematics, joined_smoother, measure, straddling
 from wbfriction.signals.options import FILTERING_SCHEMES, Diff, Scheme
@@ -70,7 +70,7 @@ def single_support_friction_rnea(robot: Robot, contact_index: int, angles: np.nd
         :mod:`wbfriction.friction.models`, and the acceleration difference (5.12)
         ``Delta qdd_tc = qdd_msr - qdd_est = M_mod^{-1} tau_f`` (N, n_tc) [rad/s^2],
         with ``M_mod`` the stance-rooted mass matrix of the torque-controlled joints
-        (:meth:`~wbfriction.model.stance.StanceModel.acceleration_difference`).
+        (:meth:`~wbfriction.model.rerooted.StanceModel.acceleration_difference`).
     """
     stance = stance_model(robot, contact_index)
     tau_f = np.empty_like(tau_tc, dtype=float)

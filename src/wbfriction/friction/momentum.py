@@ -34,7 +34,7 @@ the same once-differentiated velocities.
 **Which tree** (the closures of issue 23, each where its equations hold):
 
 * ``contact`` (rigid contacts, the thesis's premise): in single support, the tree rooted at the stance
-  sole, welded flat (:meth:`~wbfriction.model.stance.StanceModel.momentum`); its contact wrench acts on the
+  sole, welded flat (:meth:`~wbfriction.model.rerooted.StanceModel.momentum`); its contact wrench acts on the
   root only, so every joint row holds without it. Windows never span a contact change.
 * ``wrench`` (force-torque sensors): the robot above its sensors, free-floating, every external wrench
   measured (:func:`~wbfriction.model.measured_dynamics.measured_momentum`): every joint, every phase. The
@@ -73,8 +73,8 @@ from wbfriction.model.dynamics import floating_base_state
 from wbfriction.model.imu import base_motion_from_imu
 from wbfriction.model.measured_dynamics import measured_momentum
 from wbfriction.model.momentum import momentum_and_drift
+from wbfriction.model.rerooted import stance_frame_pose, stance_model
 from wbfriction.model.robot import Robot
-from wbfriction.model.stance import stance_frame_pose, stance_model
 from wbfriction.progress import Progress
 from wbfriction.signals.kinematics import MeasuredKinematics, measure, straddling, time_base
 from wbfriction.signals.options import FilterOptions

@@ -10,7 +10,7 @@ without its Stribeck term.
 
 **The equations that hold without the contact forces.** In single support the stance
 foot is welded to the ground and the robot is a fixed-base tree rooted at it
-(:mod:`wbfriction.model.stance`); every joint row of that tree's inverse dynamics is free of
+(:mod:`wbfriction.model.rerooted`); every joint row of that tree's inverse dynamics is free of
 the contact wrench (which acts at the root). That is the floating-base dynamics
 projected into the null space of the stance foot's Jacobian, in the coordinates of the
 joint velocities. (A fixed-base robot, an arm, is one permanent single support welded at its

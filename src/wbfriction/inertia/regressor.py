@@ -4,7 +4,7 @@ the original bodies' inertial parameters.
 The inverse dynamics are linear in each body's ten inertial parameters
 ``pi_b = (m, m c_x, m c_y, m c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz)`` (about the body's joint
 frame; ``pin.Inertia.toDynamicParameters`` order). In single support the stance foot is welded
-to the ground and the robot is a fixed-base tree rooted at it (:mod:`wbfriction.model.stance`);
+to the ground and the robot is a fixed-base tree rooted at it (:mod:`wbfriction.model.rerooted`);
 the joint rows of that tree's regressor (``pin.computeJointTorqueRegressor``) are free of the
 contact wrench. :class:`StanceRegressor` maps its columns back to the original bodies.
 
@@ -21,8 +21,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from wbfriction.model.rerooted import StanceModel, body_frame, stance_model
 from wbfriction.model.robot import Robot
-from wbfriction.model.stance import StanceModel, body_frame, stance_model
 
 PARAMS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
 """The ten inertial parameters of a body, in ``pin.Inertia.toDynamicParameters`` order
@@ -65,7 +65,7 @@ class StanceRegressor:
     system built in rooted parameters is mapped once, not row by row).
 
     Attributes:
-        stance: the stance-rooted model (:mod:`wbfriction.model.stance`).
+        stance: the stance-rooted model (:mod:`wbfriction.model.rerooted`).
         to_rooted: (10 n_bodies, 10 n_bodies): ``pi_rooted = to_rooted @ pi.ravel()``.
         pattern: (n_act, 10 n_bodies), whether an actuated joint's row of :meth:`joint_rows` can be
             non-zero in a rooted parameter (:func:`structural_pattern`): a joint's torque depends only on

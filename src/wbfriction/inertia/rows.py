@@ -19,8 +19,8 @@ from wbfriction.inertia.consistency import FRICTION, STRIBECK, friction_lower_bo
 from wbfriction.inertia.options import InertialOptions
 from wbfriction.inertia.regressor import floating_regressor, stance_regressor
 from wbfriction.model.determination import foot_force_torques
+from wbfriction.model.rerooted import stance_frame_pose
 from wbfriction.model.robot import Robot
-from wbfriction.model.stance import stance_frame_pose
 from wbfriction.signals.kinematics import MeasuredKinematics
 
 

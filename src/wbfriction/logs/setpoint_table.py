@@ -12,13 +12,13 @@ column                 unit        meaning
 
 The metadata (:mod:`wbfriction.logs.metadata`) says ``generator`` (``wbfriction.excite``), the ``robot``, and for a
 motion that is a finite Fourier series (an arm's), its coefficients (``fourier``: ``center`` (n,) [rad], ``a``,
-``b`` (n, L) [rad/s], ``omega`` [rad/s]; :class:`~wbfriction.sim.arm.FourierTrajectory`), from which the motion's
-accelerations are exact. A humanoid standing on one foot (``excite --stance``) also says the foot stood on
+``b`` (n, L) [rad/s], ``omega`` [rad/s]; :class:`~wbfriction.walking.fourier.FourierTrajectory`), from which the
+motion's accelerations are exact. A humanoid standing on one foot (``excite --stance``) also says the foot stood on
 (``stance``: ``left`` or ``right``), and its series are the swing leg's only (``fourier.joints``: their names, n):
-the rest of the body follows from them (:mod:`wbfriction.sim.single_support`); without ``joints`` the series are
+the rest of the body follows from them (:mod:`wbfriction.walking.single_support`); without ``joints`` the series are
 of every actuated joint. A quadruped standing on three point feet (``excite --swing``) says the foot lifted
 (``swing``: its contact frame's name; the three others stand) and the base's height above the ground
-(``base_height`` [m]), its series the swing leg's (:mod:`wbfriction.sim.tripod_support`).
+(``base_height`` [m]), its series the swing leg's (:mod:`wbfriction.walking.tripod_support`).
 """
 
 from __future__ import annotations

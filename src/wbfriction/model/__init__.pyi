@@ -11,8 +11,8 @@ from .layout import JointLayout as JointLayout
 from .loading import RobotSpec as RobotSpec
 from .loading import build_robot as build_robot
 from .loading import load_robot as load_robot
+from .rerooted import StanceModel as StanceModel
+from .rerooted import stance_frame_pose as stance_frame_pose
+from .rerooted import stance_model as stance_model
 from .robot import Robot as Robot
 from .robots import BUILTIN_ROBOTS as BUILTIN_ROBOTS
-from .stance import StanceModel as StanceModel
-from .stance import stance_frame_pose as stance_frame_pose
-from .stance import stance_model as stance_model

@@ -23,7 +23,7 @@ class JointLayout:
 
     Single-coordinate joints (revolute, prismatic) take the angle itself; continuous
     joints (unbounded revolute, nq = 2) take (cos, sin). ``sign`` flips a joint's
-    direction (used for the re-rooted models of :mod:`wbfriction.model.stance`).
+    direction (used for the re-rooted models of :mod:`wbfriction.model.rerooted`).
     """
 
     nq: int

@@ -119,7 +119,7 @@ class Robot:
     foot_radius: float = 0.0
     angle_bounds: dict[str, tuple[float, float]] = field(default_factory=dict)
     cache: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
-    """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.stance`)."""
+    """Derived models built on demand (e.g. the stance models of :mod:`wbfriction.model.rerooted`)."""
 
     def require_urdf(self, purpose: str) -> Path:
         """The robot's URDF, for ``purpose`` (rewriting it, a simulator built from its geometry).

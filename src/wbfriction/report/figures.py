@@ -321,7 +321,7 @@ def save_png(fig: Figure, path: str | Path) -> None:
 
 
 def rollout_figure(results: Sequence[Any], path: str | Path, columns: int = 3) -> None:
-    """The tracking error of replays of one log (:class:`~wbfriction.sim.rollout.RolloutResult`, the same joints and
+    """The tracking error of replays of one log (:class:`~wbfriction.replay.rollout.RolloutResult`, the same joints and
     stretch): per joint, the simulated less the logged angle [mrad] against the log's time from the stretch's start
     [s], one line per replay, its RMS in the legend; a replay restarted from the log every ``horizon`` seconds starts
     each window at zero error (dotted lines mark the restarts)."""

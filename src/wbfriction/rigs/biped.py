@@ -1,6 +1,6 @@
 """A biped on its soles (a floating base whose every contact fixes it, thesis 4.4): ``simulate`` walks it, or plays
 its one-foot stance (``--play``), in an engine (:mod:`wbfriction.sim.engines`); ``excite`` designs one leg's
-excitation while it stands on the other foot (:func:`~wbfriction.excite.stance.stance_reference`); ``demo`` shows
+excitation while it stands on the other foot (:func:`~wbfriction.excite.one_foot.one_foot_reference`); ``demo`` shows
 the thesis's simulation study (Tables 6.1/6.2, Fig. 6.1-6.3; on soft contacts, Fig. 6.4-6.5)."""
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ if TYPE_CHECKING:
 GAIT = GaitOptions()
 STANDING_DURATION, STANDING_PERIOD = 8.0, 4.0
 """A standing design's default time on one foot (or three) and its swing joints' Fourier period [s]
-(:class:`~wbfriction.excite.stance.StanceOptions`' and :class:`~wbfriction.excite.tripod.TripodOptions`' own)."""
+(:class:`~wbfriction.excite.one_foot.OneFootOptions`' and :class:`~wbfriction.excite.tripod.TripodOptions`' own)."""
 
 
 @dataclass(frozen=True)
@@ -143,8 +143,8 @@ class BipedRig(Rig):
 
     def design(self, robot: Robot, options: Any, progress: RigProgress) -> DesignOutput:
         from wbfriction.excite.design import ExciteOptions
-        from wbfriction.excite.document import stance_document, stance_setpoints
-        from wbfriction.excite.stance import StanceOptions, stance_reference, swing_bounds
+        from wbfriction.excite.document import one_foot_document, one_foot_setpoints
+        from wbfriction.excite.one_foot import OneFootOptions, one_foot_reference, swing_bounds
         from wbfriction.report.excite_tables import swing_printed
         from wbfriction.rigs.standing import standing_figure
 
@@ -153,13 +153,13 @@ class BipedRig(Rig):
             raise InputError(f"robot '{robot.name}' has a floating base on {len(robot.contact_frames)} "
                              f"{robot.stands_on}: excite designs a biped's one-foot stance")
         excite = ExciteOptions(duration=o.duration, rate=o.rate, period=o.period,
-                               harmonics=StanceOptions().design.harmonics, range_share=1.0, seed=o.seed)
-        stance = StanceOptions(stance=o.stance, design=excite)
+                               harmonics=OneFootOptions().design.harmonics, range_share=1.0, seed=o.seed)
+        stance = OneFootOptions(stance=o.stance, design=excite)
         progress.say(f"designing the swing leg's series, then the stance on the {stance.stance} foot (its IK at "
                      "every sample)")
-        excitation = stance_reference(robot, stance)
-        doc = stance_document(robot, excitation, stance, swing_bounds(robot, excitation, stance))
-        table = stance_setpoints(robot, excitation, stance)
+        excitation = one_foot_reference(robot, stance)
+        doc = one_foot_document(robot, excitation, stance, swing_bounds(robot, excitation, stance))
+        table = one_foot_setpoints(robot, excitation, stance)
         figure = standing_figure(robot, excitation, table, doc, f"{robot.name} on its {stance.stance} foot: the swing "
                                  "leg within its posture band; Cramér-Rao bound / weak limit")
         line = (f"ZMP {doc['zmp_margin'] * 1e3:.1f} mm inside the {doc['stance']} sole's edges (at least "

@@ -18,9 +18,9 @@ def thesis_demo(robot: Robot, output_dir: Path, steps: int, progress: RigProgres
     """The thesis's study on the ideal simulator: its fits not ``ok`` and why, Table 6.1's layout, the worst
     errors, the true accelerations' error, the knee's RMS errors, the pulls and the power-generating share."""
     from wbfriction.friction.models import PARAM_NAMES
-    from wbfriction.studies.tables import not_ok_printed, pulls_note, study_table, worst_printed
     from wbfriction.studies.common import worst_errors
     from wbfriction.studies.simulation import run_study
+    from wbfriction.studies.tables import not_ok_printed, pulls_note, study_table, worst_printed
 
     result = run_study(robot, output_dir, steps=steps, progress=progress.say, steps_done=progress.count)
     printed = not_ok_printed(result.rows)  # before the table: its error figures of those joints measure the walk
@@ -43,8 +43,8 @@ def realistic_demo(robot: Robot, output_dir: Path, steps: int, progress: RigProg
     """The realistic simulator's study (a short combined walk, short forward walks too: the full size's are 5
     steps): per case its fits not ``ok``, its table, its worst errors and the thesis's route's on the same log; the
     knee's RMS errors."""
-    from wbfriction.studies.tables import not_ok_printed, study_table, worst_printed
     from wbfriction.studies.realistic import KNEE_STEPS, run_realistic_study, worst_scored
+    from wbfriction.studies.tables import not_ok_printed, study_table, worst_printed
 
     result = run_realistic_study(robot, output_dir, steps=steps, knee_steps=min(steps, KNEE_STEPS),
                                  progress=progress.say)

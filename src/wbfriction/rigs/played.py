@@ -13,7 +13,7 @@ if TYPE_CHECKING:
 
     from wbfriction.logs.setpoint_table import SetpointTable
     from wbfriction.model.robot import Robot
-    from wbfriction.sim.arm import FourierTrajectory
+    from wbfriction.walking.fourier import FourierTrajectory
     from wbfriction.walking.quadruped import QuadrupedReference
     from wbfriction.walking.reference import WalkingReference
 
@@ -22,7 +22,7 @@ def played_series(table: SetpointTable) -> FourierTrajectory:
     """The Fourier series a set-points table holds (its ``fourier`` metadata; the caller checked it has one)."""
     import numpy as np
 
-    from wbfriction.sim.arm import FourierTrajectory
+    from wbfriction.walking.fourier import FourierTrajectory
 
     f = table.fourier or {}
     return FourierTrajectory(np.asarray(f["center"], dtype=float), np.asarray(f["a"], dtype=float),
@@ -63,7 +63,7 @@ def played_arm(robot: Robot, path: Path) -> tuple[SetpointTable, FourierTrajecto
 def played_stance(robot: Robot, path: Path) -> WalkingReference:
     """The reference of a biped's one-foot stance that the set-points table at ``path`` holds (what ``excite
     --stance`` writes): rebuilt from its stance foot, its swing leg's series and its times
-    (:func:`~wbfriction.sim.single_support.single_support_reference`), checked against its ``q_des``.
+    (:func:`~wbfriction.walking.single_support.single_support_reference`), checked against its ``q_des``.
 
     Raises:
         InputError: what :func:`~wbfriction.logs.setpoint_table.read_setpoint_table` raises; a table without a
@@ -71,7 +71,7 @@ def played_stance(robot: Robot, path: Path) -> WalkingReference:
             robot's model).
     """
     from wbfriction.logs.setpoint_table import read_setpoint_table
-    from wbfriction.sim.single_support import SIDES, single_support_reference
+    from wbfriction.walking.single_support import SIDES, single_support_reference
 
     table = read_setpoint_table(path, robot)
     if table.stance is None or table.fourier is None:
@@ -85,14 +85,14 @@ def played_stance(robot: Robot, path: Path) -> WalkingReference:
 def played_tripod(robot: Robot, path: Path) -> QuadrupedReference:
     """The reference of a quadruped's three-feet stance that the set-points table at ``path`` holds (what ``excite
     --swing`` writes): rebuilt from its swing foot, base height, swing leg's series and times
-    (:func:`~wbfriction.sim.tripod_support.tripod_support_reference`), checked against its ``q_des``.
+    (:func:`~wbfriction.walking.tripod_support.tripod_support_reference`), checked against its ``q_des``.
 
     Raises:
         InputError: what :func:`~wbfriction.logs.setpoint_table.read_setpoint_table` raises; a table without a
             swing foot or series; its ``q_des`` more than 1e-6 rad from the rebuilt reference.
     """
     from wbfriction.logs.setpoint_table import read_setpoint_table
-    from wbfriction.sim.tripod_support import tripod_support_reference
+    from wbfriction.walking.tripod_support import tripod_support_reference
 
     table = read_setpoint_table(path, robot)
     if table.swing is None or table.base_height is None or table.fourier is None:

@@ -21,14 +21,6 @@ from .pd_options import HungOptions as HungOptions
 from .pd_options import SetpointOptions as SetpointOptions
 from .pd_robot import PdMujocoRobot as PdMujocoRobot
 from .pd_robot import build_pd_robot as build_pd_robot
-from .replay import Replay as Replay
-from .replay import ReplayCheck as ReplayCheck
-from .replay import replay_check as replay_check
-from .replay import replay_mjcf as replay_mjcf
-from .rollout import ActuatorParams as ActuatorParams
-from .rollout import RolloutResult as RolloutResult
-from .rollout import rollout as rollout
-from .rollout import rollout_table as rollout_table
 from .sensors import apply_sensor_noise as apply_sensor_noise
 from .simulators import SimulationOutput as SimulationOutput
 from .simulators import SimulationProgress as SimulationProgress

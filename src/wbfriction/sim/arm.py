@@ -12,8 +12,9 @@ by default) in every joint:
 
 (``tau_m`` the motor torque at the joint, gear included; ``pin.aba`` with ``model.armature`` set).
 
-**Trajectory.** Each joint follows a finite Fourier series (Swevers, Ganseman, Tukel, De Schutter &
-Van Brussel, *Optimal robot excitation and identification*, IEEE T-RA 13(5), 1997):
+**Trajectory.** Each joint follows a finite Fourier series (:class:`~wbfriction.walking.fourier.FourierTrajectory`;
+Swevers, Ganseman, Tukel, De Schutter & Van Brussel, *Optimal robot excitation and identification*, IEEE T-RA 13(5),
+1997):
 
 .. math::
 
@@ -45,7 +46,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -61,6 +61,7 @@ from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress, counted
 from wbfriction.sim.common import injected_friction, terms_truth, warm_up
 from wbfriction.sim.options import SensorNoise
+from wbfriction.walking.fourier import FourierTrajectory
 
 GENERATOR = "wbfriction.sim.arm.simulate_arm"
 
@@ -97,46 +98,6 @@ class ExcitationOptions:
         if not (0 < self.range_share <= 1 and 0 < self.velocity_share <= 1):
             raise InputError(f"excitation: range_share and velocity_share must be in (0, 1], got "
                              f"{self.range_share}, {self.velocity_share}")
-
-
-@dataclass(frozen=True)
-class FourierTrajectory:
-    """Joint positions as finite Fourier series (module docstring).
-
-    Attributes:
-        center: ``q_0`` (n,) [rad].
-        a, b: coefficients (n, L) [rad/s].
-        omega: fundamental angular frequency ``omega_f`` [rad/s].
-    """
-
-    center: np.ndarray
-    a: np.ndarray
-    b: np.ndarray
-    omega: float
-
-    def __call__(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Positions [rad], velocities [rad/s] and accelerations [rad/s^2] at times ``t`` (N,): each (N, n)."""
-        w = self.omega * np.arange(1, self.a.shape[1] + 1)  # (L,)
-        s, c = _harmonics(np.asarray(t, dtype=float), w)  # (N, L)
-        q = self.center + s @ (self.a / w).T - c @ (self.b / w).T
-        qd = c @ self.a.T + s @ self.b.T
-        qdd = -s @ (self.a * w).T + c @ (self.b * w).T
-        return q, qd, qdd
-
-
-def _harmonics(t: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``sin(t w^T)`` and ``cos(t w^T)`` (N, L), read-only (:func:`_harmonics_of`)."""
-    return _harmonics_of(t.tobytes(), w.tobytes())
-
-
-@lru_cache(maxsize=8)
-def _harmonics_of(t: bytes, w: bytes) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_harmonics` of the times and frequencies given as bytes, kept for the next call with the same (a
-    design's optimiser evaluates one time grid thousands of times)."""
-    arg = np.outer(np.frombuffer(t), np.frombuffer(w))
-    s, c = np.sin(arg), np.cos(arg)
-    s.flags.writeable = c.flags.writeable = False
-    return s, c
 
 
 def excitation_trajectory(lower: np.ndarray, upper: np.ndarray, velocity_limit: np.ndarray,

@@ -25,8 +25,8 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import InputError
+from wbfriction.model.rerooted import stance_model
 from wbfriction.model.robot import Robot
-from wbfriction.model.stance import stance_model
 from wbfriction.walking import WalkingReference
 
 
@@ -55,7 +55,7 @@ def feedforward(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray, conta
     """Joint torques and contact wrenches of a reference motion (module docstring).
 
     Single-support samples are computed in one batched RNEA pass on the robot re-rooted at
-    the stance sole (:mod:`wbfriction.model.stance`: the same solution, since the reference keeps
+    the stance sole (:mod:`wbfriction.model.rerooted`: the same solution, since the reference keeps
     the stance sole still), double-support samples one by one with the weighted sharing.
 
     Args:

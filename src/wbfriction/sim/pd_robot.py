@@ -1,6 +1,6 @@
 """A fixed-base robot whose joints are driven by PD motor drivers, on MuJoCo: its model (:func:`build_pd_robot`) and
 its run under commanded set-points (:class:`PdRun`), what the hung robot's simulator (:mod:`wbfriction.sim.hung`)
-and the rollout check (:mod:`wbfriction.sim.rollout`) both use: one way to build and run such a robot.
+and the rollout check (:mod:`wbfriction.replay.rollout`) both use: one way to build and run such a robot.
 
 **Model.** The robot's URDF as MuJoCo reads it (:func:`wbfriction.model.mjspec.urdf_spec`: kinematic tree and
 inertias; visual and collision geometry, the URDF's ``<dynamics>`` dropped) with its root link welded to the world

@@ -79,7 +79,7 @@ def peer_held_out(robot_toml: Path, peer_toml: Path, peer: PeerActuator, held_ou
 def peer_rollouts(robot_toml: str | Path, peer_toml: str | Path, peer: PeerActuator, identified_toml: str | Path,
                   mjcf: str | Path, held_out: str | Path, horizon: float | None = 1.0,
                   others: Mapping[str, str | Path] | None = None) -> pa.Table:
-    """The held-out log's set-points replayed (:func:`~wbfriction.sim.replay.replay_mjcf`, restarted from the log every
+    """The held-out log's set-points replayed (:func:`~wbfriction.replay.mjcf.replay_mjcf`, restarted from the log every
     ``horizon`` seconds) on the MJCF wbfriction exported (``mjcf``, for the robot ``identified_toml``), as MuJoCo
     runs it, and on the peer's parameters written by the same export and run as PACE simulates them (the PD law once
     a 5 ms period, its whole torque held back its delay truncated to whole periods): a row per joint, ``rms.ours`` and
@@ -93,8 +93,8 @@ def peer_rollouts(robot_toml: str | Path, peer_toml: str | Path, peer: PeerActua
 
     from wbfriction.export.mjcf import write_mjcf
     from wbfriction.model.loading import load_robot
-    from wbfriction.sim.replay import Replay, replay_mjcf
-    from wbfriction.sim.rollout import rollout_table
+    from wbfriction.replay.mjcf import Replay, replay_mjcf
+    from wbfriction.replay.rollout import rollout_table
 
     identified = load_robot(None, config=Path(identified_toml))
     files = {"ours": mjcf, **(others or {})}
@@ -111,7 +111,7 @@ def peer_rollouts(robot_toml: str | Path, peer_toml: str | Path, peer: PeerActua
 
 def refine_on_whole_log(identified_toml: str | Path, mjcf: str | Path, logs: Sequence[str | Path],
                         output: str | Path) -> Path:
-    """``mjcf`` (exported for the robot ``identified_toml``) refined (:func:`~wbfriction.sim.refine.refine_mjcf`) on
+    """``mjcf`` (exported for the robot ``identified_toml``) refined (:func:`~wbfriction.replay.refine.refine_mjcf`) on
     ``logs`` read one after the other as one log (a dataset's ``train.parquet`` then ``held_out.parquet``: the whole
     log the peer was fitted on, module docstring), written to ``output``.
 
@@ -121,7 +121,7 @@ def refine_on_whole_log(identified_toml: str | Path, mjcf: str | Path, logs: Seq
     from wbfriction.exceptions import InputError
     from wbfriction.logs.tables import read_table
     from wbfriction.model.loading import load_robot
-    from wbfriction.sim.refine import refine_mjcf, write_refined
+    from wbfriction.replay.refine import refine_mjcf, write_refined
 
     tables = [read_table(path) for path in logs]  # any log format (the registry's)
     for before, after, path in zip(tables, tables[1:], logs[1:]):

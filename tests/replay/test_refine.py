@@ -15,12 +15,12 @@ from helpers import assert_stages, hung_go2_toml, run_cli_printed, said
 from wbfriction.exceptions import InputError
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.logs.tables import read_table
+from wbfriction.replay.mjcf import Replay, replay_mjcf
+from wbfriction.replay.refine import PARAMETERS, refine_mjcf, write_refined
 from wbfriction.sim.hung import simulate_hung
 from wbfriction.sim.pd_options import HungOptions
-from wbfriction.sim.refine import PARAMETERS, refine_mjcf, write_refined
-from wbfriction.sim.replay import Replay, replay_mjcf
 
-pytestmark = pytest.mark.xdist_group("sim_refine")  # its module fixture computed once
+pytestmark = pytest.mark.xdist_group("replay_refine")  # its module fixture computed once
 
 STEP = 0.001
 """The simulator's physics step, the replays'."""

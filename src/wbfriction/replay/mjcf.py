@@ -1,7 +1,7 @@
 """An exported simulator file replayed under a log's set-points, as that simulator runs it (issue 64, item 3): the
 check of what a user of ``wbfriction export`` gets.
 
-:mod:`wbfriction.sim.rollout` replays a parameter set on the project's own simulator (its friction drawn as the fit's
+:mod:`wbfriction.replay.rollout` replays a parameter set on the project's own simulator (its friction drawn as the fit's
 model, ``tau_os`` included, the PD law every physics step). What a user simulates is the exported file: MuJoCo's
 ``frictionloss`` and ``damping`` instead of the model, the drivers as the file's actuators hold them. This module runs
 that file (:func:`replay_mjcf`): the robot's PD-driven joints' actuators, each named as its joint (what ``wbfriction
@@ -17,7 +17,7 @@ and its torque applied ``torque_delay`` periods later, held through the period (
 themselves off). The file's physics step is then the log's period divided into whole steps, the largest at most
 the file's. This is how a torque-delayed model, which no MJCF holds, is scored as it was identified.
 
-**Windows.** As in :mod:`wbfriction.sim.rollout`, every ``horizon`` seconds the replay restarts from the log's
+**Windows.** As in :mod:`wbfriction.replay.rollout`, every ``horizon`` seconds the replay restarts from the log's
 state (the model's angle: the logged one less the encoder offset; the logged velocity): 1 s by default, the error
 a simulator's user sees over a second of its own motion; ``horizon=None`` replays the stretch in one shot.
 
@@ -42,7 +42,7 @@ import pyarrow as pa
 from wbfriction.exceptions import InputError
 from wbfriction.export.drive import HOLD_EDGE
 from wbfriction.model.robot import Robot
-from wbfriction.sim.rollout import LogSetpoints, RolloutResult, read_log_setpoints, stretch_rows
+from wbfriction.replay.rollout import LogSetpoints, RolloutResult, read_log_setpoints, stretch_rows
 
 
 @dataclass(frozen=True)
@@ -231,13 +231,13 @@ def replay_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | Lo
         model: the MJCF file (``wbfriction export -o robot.xml``): its PD-driven joints' actuators named as the joints.
         robot: the robot it was exported for (its TOML): the PD-driven joints, and the encoder offsets that take the
             log's angles to the model's; a fixed base (:attr:`Robot.floating_base` false).
-        log: the log (a table, a file, or :func:`~wbfriction.sim.rollout.read_log_setpoints`'s reading of it):
+        log: the log (a table, a file, or :func:`~wbfriction.replay.rollout.read_log_setpoints`'s reading of it):
             ``time``, ``q``, ``qd``, ``q_des`` of every PD-driven joint.
         replay: :class:`Replay`.
         rows, times: the stretch, as rows ``[start, stop)`` or times ``[t0, t1)`` [s]; neither: the whole log.
 
     Returns:
-        :class:`~wbfriction.sim.rollout.RolloutResult`: the simulated logged angles (the model's plus the encoder
+        :class:`~wbfriction.replay.rollout.RolloutResult`: the simulated logged angles (the model's plus the encoder
         offset) against the log's [rad].
 
     Raises:
@@ -302,7 +302,7 @@ def _held_torque(m, d, drives: _Drives, data: LogSetpoints, first: int, last: in
 class ReplayCheck:
     """A file replayed two ways over one stretch (:func:`replay_check`): restarted from the log every
     ``horizon`` seconds (``windows``) and in one shot (``whole``), each a
-    :class:`~wbfriction.sim.rollout.RolloutResult`."""
+    :class:`~wbfriction.replay.rollout.RolloutResult`."""
 
     windows: RolloutResult
     whole: RolloutResult

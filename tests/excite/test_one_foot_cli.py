@@ -1,11 +1,11 @@
 """TALOS on one foot from the command line (issue 66): ``excite --stance`` writes the set-points of the reference
-:func:`~wbfriction.excite.stance.stance_reference` builds, ``simulate --play`` plays them in the ideal simulator,
+:func:`~wbfriction.excite.one_foot.one_foot_reference` builds, ``simulate --play`` plays them in the ideal simulator,
 and ``estimate`` and ``fit`` run on the log as on a walk's recover each swing joint's injected friction; what does not
 apply is refused in one line naming the option.
 
 The friction injected (a ``--friction`` TOML) is the thesis's Table 6.1 with F_c 1.25 times and F_v 0.75 times it on
 the swing leg, so that the design's prior is not the answer. :data:`TOLERANCE`: 1 %, from what
-``tests/excite/test_stance.py`` measured: with no sensor noise the error is the ideal simulator's integration bias,
+``tests/excite/test_one_foot.py`` measured: with no sensor noise the error is the ideal simulator's integration bias,
 which halves each time its physics rate doubles (worst F_v 2.07 % at 10 kHz, 0.52 % at 40 kHz on an 8 s left
 stance); this test runs 40 kHz (``--substeps 40``) on a 4 s stance (its worst F_v 0.52 %, the swing hip pitch's;
 F_c within 0.05 %), so 1 % is that bias with a margin of about two, and a played reference off by a sample or a
@@ -23,7 +23,7 @@ import pytest
 
 from helpers import run_cli_printed
 from wbfriction.excite.design import ExciteOptions
-from wbfriction.excite.stance import StanceOptions, stance_reference
+from wbfriction.excite.one_foot import OneFootOptions, one_foot_reference
 from wbfriction.fit.params_file import read_params
 from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.logs.metadata import read_metadata, with_metadata
@@ -31,7 +31,7 @@ from wbfriction.logs.setpoint_table import read_setpoint_table
 from wbfriction.logs.tables import write_table
 
 # excite (the design and the IK) 10-20 s, the reference again 10 s, simulate at 40 kHz 15 s, estimate and fit 13 s
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_stance_cli")]
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_one_foot_cli")]
 
 TOLERANCE = 1.0
 """Each swing joint's F_c and F_v within 1 % [%] (module docstring)."""
@@ -65,7 +65,7 @@ def test_a_stance_designed_played_estimated_and_fitted(cli, talos, tmp_path):
     assert (tmp_path / "s.png").stat().st_size > 10_000
 
     # the table holds the reference the library builds, every actuated joint, in the encoders' coordinates
-    excitation = stance_reference(talos, StanceOptions(stance="left", design=ExciteOptions(
+    excitation = one_foot_reference(talos, OneFootOptions(stance="left", design=ExciteOptions(
         duration=4.0, period=4.0, harmonics=5, range_share=1.0)))
     ref = excitation.reference
     parquet, csv = (read_setpoint_table(tmp_path / f"s.{s}", talos) for s in ("parquet", "csv"))

@@ -1,4 +1,4 @@
-"""Stance models: the robot re-rooted at a contact frame, for single-support inverse dynamics.
+"""Re-rooted models: the robot re-rooted at a contact frame (its stance foot), for single-support inverse dynamics.
 
 In single support the stance foot is welded to the ground, so the floating-base robot
 is a fixed-base tree rooted at that foot. With every joint acceleration measured, the
@@ -52,7 +52,7 @@ the joint's motion subspace (angular part for a revolute joint, linear part for 
 LOCKED_ARMATURE = 1e30
 """Armature [kg·m² or kg] that locks a joint in the articulated-body algorithm: its share ``U U^T / D`` of the
 articulated inertia (``D`` = the joint's inertia + armature) is then below the last bit of any body's inertia,
-and its acceleration ``u / D`` zero to machine precision (tests/model/test_stance.py: the crba route to 1e-12)."""
+and its acceleration ``u / D`` zero to machine precision (tests/model/test_rerooted.py: the crba route to 1e-12)."""
 
 
 def _graph_joint(joint: pin.JointModel):

@@ -1,6 +1,6 @@
 """The square inverse kinematics a robot standing still on some of its feet solves per sample (the base of
-:class:`~wbfriction.sim.single_support.StanceIK`, a humanoid on one sole, and
-:class:`~wbfriction.sim.tripod_support.TripodIK`, a quadruped on three point feet): Newton iterations on the
+:class:`~wbfriction.walking.single_support.SingleSupportIK`, a humanoid on one sole, and
+:class:`~wbfriction.walking.tripod_support.TripodIK`, a quadruped on three point feet): Newton iterations on the
 base's and the stance legs' velocity columns (:attr:`SupportIK.cols`) until the tasks' error (the stance feet, the
 centre of mass, the base's rotation) vanishes, then velocities from ``J v = 0`` and accelerations from
 ``J a = -Jd v`` (the targets are constant), the other joints (:attr:`SupportIK.rest`) prescribed. Pinocchio's

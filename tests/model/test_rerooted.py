@@ -14,8 +14,8 @@ from conftest import constrained_forward, random_state
 from helpers import chain_urdf
 from wbfriction.exceptions import ModelError
 from wbfriction.model.dynamics import constrained_dynamics
+from wbfriction.model.rerooted import body_frame, check_kinematics, stance_frame_pose, stance_model
 from wbfriction.model.robot import Robot
-from wbfriction.model.stance import body_frame, check_kinematics, stance_frame_pose, stance_model
 
 
 @pytest.mark.parametrize("contact", [0, 1])

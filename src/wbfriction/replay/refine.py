@@ -12,7 +12,7 @@ for its friction and drive:
   robot TOML's; :mod:`wbfriction.export.drive`),
 
 and the set-points' delay (the actuators' ``delay``, one for all), to minimise the replay's error
-(:mod:`wbfriction.sim.replay`, as the file runs: its timestep, gains and limits) over a training stretch: every
+(:mod:`wbfriction.replay.mjcf`, as the file runs: its timestep, gains and limits) over a training stretch: every
 joint's simulated less logged angle, in windows restarted from the log every ``horizon`` seconds, each joint's error
 divided by its RMS (the joints weigh alike, each weighted error of unit variance).
 
@@ -69,8 +69,8 @@ from wbfriction.exceptions import InputError
 from wbfriction.export.drive import HOLD_EDGE
 from wbfriction.fit.status import WEAK
 from wbfriction.model.robot import Robot
-from wbfriction.sim.replay import Replay, ReplayModel, load_replay
-from wbfriction.sim.rollout import LogSetpoints, read_log_setpoints, stretch_rows
+from wbfriction.replay.mjcf import Replay, ReplayModel, load_replay
+from wbfriction.replay.rollout import LogSetpoints, read_log_setpoints, stretch_rows
 
 PARAMETERS = ("armature", "F_c", "F_v", "tau_os")
 """The refined values of each joint, in the order of :attr:`Refinement.value`'s rows."""
@@ -202,8 +202,8 @@ def refine_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | Lo
     Args:
         model: the MJCF (``wbfriction export``): its PD-driven joints' actuators named as the joints.
         robot: the robot it was exported for (its TOML, a fixed base): the encoder offsets.
-        log: the training log (a table, a file, or its :func:`~wbfriction.sim.rollout.read_log_setpoints`).
-        replay: how the file is replayed (:class:`~wbfriction.sim.replay.Replay`: its windows' ``horizon``, the
+        log: the training log (a table, a file, or its :func:`~wbfriction.replay.rollout.read_log_setpoints`).
+        replay: how the file is replayed (:class:`~wbfriction.replay.mjcf.Replay`: its windows' ``horizon``, the
             timestep, PACE's torque delay); ``horizon=None``: one shot.
         times: the training stretch ``[t0, t1)`` [s]; None: the whole log.
 
@@ -211,7 +211,7 @@ def refine_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | Lo
         :class:`Refinement`; :func:`write_refined` writes it into the file.
 
     Raises:
-        what :func:`~wbfriction.sim.replay.replay_mjcf` raises (a stretch of less than two samples among them).
+        what :func:`~wbfriction.replay.mjcf.replay_mjcf` raises (a stretch of less than two samples among them).
     """
     began = clock.perf_counter()
     data = log if isinstance(log, LogSetpoints) else read_log_setpoints(robot, log)

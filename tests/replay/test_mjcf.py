@@ -16,9 +16,9 @@ from helpers import assert_stages, hung_go2_toml, run_cli_printed, said
 from wbfriction.exceptions import InputError
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.logs.tables import read_table
+from wbfriction.replay.mjcf import Replay, replay_mjcf
 from wbfriction.sim.hung import simulate_hung
 from wbfriction.sim.pd_options import HungOptions
-from wbfriction.sim.replay import Replay, replay_mjcf
 
 AGREE = 1e-3
 """The truth's MJCF against the simulator that wrote the log, noise-free, the file stepped at the simulator's 1 ms:

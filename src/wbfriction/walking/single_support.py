@@ -1,12 +1,12 @@
 """A humanoid standing on one foot while its other leg follows given Fourier series: the whole-body reference
 (:class:`~wbfriction.walking.reference.WalkingReference`, single support from the first sample to the last) that
-``wbfriction excite --stance`` designs (:mod:`wbfriction.excite.stance`) and ``wbfriction simulate --play``
+``wbfriction excite --stance`` designs (:mod:`wbfriction.excite.one_foot`) and ``wbfriction simulate --play``
 rebuilds from the set-points table's stance foot and series, sample for sample the same.
 
-* **The swing leg** follows its series (:class:`~wbfriction.sim.arm.FourierTrajectory`).
+* **The swing leg** follows its series (:class:`~wbfriction.walking.fourier.FourierTrajectory`).
 * **Every other joint but the stance leg's** is held at the robot's reference posture (arms, torso, head).
 * **The floating base and the stance leg** (``6 + 6`` unknowns) come from a square inverse kinematics per sample
-  (:class:`StanceIK`: Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), twelve tasks: the stance
+  (:class:`SingleSupportIK`: Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), twelve tasks: the stance
   sole's placement (flat at its standing footprint, 6), the centre of mass over the sole's centre at the standing
   posture's height (3), the base upright (3). Velocities from ``J v = 0``, accelerations from ``J a = -Jd v`` (the
   targets are constant), so the reference keeps the stance sole still at the acceleration level. *Quasi-static*:
@@ -20,20 +20,20 @@ import numpy as np
 import pinocchio as pin
 
 from wbfriction.exceptions import ModelError
+from wbfriction.model.footprint import sole_footprint
 from wbfriction.model.robot import Robot
-from wbfriction.sim.arm import FourierTrajectory
-from wbfriction.sim.mujoco_model import sole_footprint
-from wbfriction.sim.support_ik import LWA, SupportIK
 from wbfriction.walking.footsteps import FootstepPlan
+from wbfriction.walking.fourier import FourierTrajectory
 from wbfriction.walking.options import GaitOptions
 from wbfriction.walking.reference import WalkingReference, standing_configuration
+from wbfriction.walking.support_ik import LWA, SupportIK
 from wbfriction.walking.swing import foot_placement
 
 SIDES = ("left", "right")
 """The stance foot's names, in :attr:`Robot.contact_frames` order (a biped's left sole first)."""
 
 
-class StanceIK(SupportIK):
+class SingleSupportIK(SupportIK):
     """The square single-support inverse kinematics of the module docstring, for one robot and stance foot.
 
     Args:
@@ -105,14 +105,14 @@ def standing_feet(robot: Robot) -> np.ndarray:
                      for f in robot.contact_frame_ids])
 
 
-def stance_ik(robot: Robot, stance: int) -> StanceIK:
-    """The :class:`StanceIK` of sole ``stance`` (its index in :attr:`Robot.contact_frames`): the sole flat at its
+def single_support_ik(robot: Robot, stance: int) -> SingleSupportIK:
+    """The :class:`SingleSupportIK` of sole ``stance`` (its index in :attr:`Robot.contact_frames`): the sole flat at its
     standing footprint, the centre of mass over the sole's centre at the standing posture's height."""
     q0 = standing_configuration(robot)
     sole = foot_placement(standing_feet(robot)[stance])
     centre, _ = sole_footprint(robot, robot.contact_frames[stance])
     height = pin.centerOfMass(robot.model, robot.model.createData(), q0)[2]
-    return StanceIK(robot, stance, sole, np.array([*sole.act(np.array([*centre, 0.0]))[:2], height]))
+    return SingleSupportIK(robot, stance, sole, np.array([*sole.act(np.array([*centre, 0.0]))[:2], height]))
 
 
 def single_support_reference(robot: Robot, stance: int, joints: tuple[str, ...], trajectory: FourierTrajectory,
@@ -134,7 +134,7 @@ def single_support_reference(robot: Robot, stance: int, joints: tuple[str, ...],
     act = np.array([robot.actuated.index(j) for j in joints])
     q = standing_configuration(robot)
     q[robot.act_q_index[act]] = qs[0]
-    Q, V, A = stance_ik(robot, stance).solve_motion(q, act, (qs, qds, qdds))
+    Q, V, A = single_support_ik(robot, stance).solve_motion(q, act, (qs, qds, qdds))
     feet = np.empty((len(Q), 2, 4))
     feet[:, stance] = feet0[stance]
     swing = robot.contact_frame_ids[1 - stance]

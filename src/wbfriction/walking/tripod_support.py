@@ -3,7 +3,7 @@
 ``wbfriction excite --swing`` designs (:mod:`wbfriction.excite.tripod`) and ``wbfriction simulate --play`` rebuilds
 from the set-points table's swing foot, base height and series, sample for sample the same.
 
-* **The swing leg** follows its series (:class:`~wbfriction.sim.arm.FourierTrajectory`).
+* **The swing leg** follows its series (:class:`~wbfriction.walking.fourier.FourierTrajectory`).
 * **The floating base and the three stance legs** (``6 + 9`` unknowns) come from a square inverse kinematics per
   sample (:class:`TripodIK`: Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), fifteen tasks: the
   three stance feet's contact frame origins at their footprints (9), the centre of mass over the *incentre* of the
@@ -27,9 +27,9 @@ import pinocchio as pin
 
 from wbfriction.exceptions import ModelError
 from wbfriction.model.robot import Robot
-from wbfriction.sim.arm import FourierTrajectory
-from wbfriction.sim.support_ik import LWA, SupportIK
+from wbfriction.walking.fourier import FourierTrajectory
 from wbfriction.walking.quadruped import FOOT_RADIUS, GaitOptions, QuadrupedReference
+from wbfriction.walking.support_ik import LWA, SupportIK
 
 
 class TripodIK(SupportIK):

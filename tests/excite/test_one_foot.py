@@ -1,5 +1,5 @@
 """TALOS standing on one foot while its other leg follows a designed excitation (issue 66,
-:mod:`wbfriction.excite.stance`): the reference keeps the stance sole still and its ZMP inside the sole, and, played
+:mod:`wbfriction.excite.one_foot`): the reference keeps the stance sole still and its ZMP inside the sole, and, played
 in the ideal simulator and in MuJoCo with friction injected on the swing leg, the project's estimate and fit recover
 each swing joint's injected F_c and F_v within 2 %.
 
@@ -26,8 +26,8 @@ import pinocchio as pin
 import pytest
 
 from wbfriction.exceptions import InputError, ModelError
-from wbfriction.excite import stance as stance_module
-from wbfriction.excite.stance import StanceOptions, band_clearance, stance_reference, support_margin, swing_band
+from wbfriction.excite import one_foot as one_foot_module
+from wbfriction.excite.one_foot import OneFootOptions, band_clearance, one_foot_reference, support_margin, swing_band
 from wbfriction.fit.joints import fit_joints
 from wbfriction.fit.targets import THESIS_TARGETS
 from wbfriction.friction.estimate import estimate_log
@@ -38,7 +38,7 @@ from wbfriction.sim.options import MujocoOptions
 from wbfriction.studies.common import SIMULATOR
 
 # the design and the IK: about 15 s; the ideal simulator 10-15 s, MuJoCo 1-2 s; one module fixture, one worker
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_stance")]
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("excite_one_foot")]
 
 TOLERANCE = 2.0
 """The issue's: each swing joint's F_c and F_v within 2 % [%]."""
@@ -53,7 +53,7 @@ def excitations(talos):
 
     def get(stance: str):
         if stance not in cache:
-            cache[stance] = stance_reference(talos, StanceOptions(stance=stance))
+            cache[stance] = one_foot_reference(talos, OneFootOptions(stance=stance))
         return cache[stance]
     return get
 
@@ -109,7 +109,7 @@ def test_the_stance_sole_stays_put_and_the_zmp_inside_it(talos, excitations, sta
     assert np.all(angles >= excitation.lower - 1e-9) and np.all(angles <= excitation.upper + 1e-9)
     assert np.ptp(angles, axis=0).min() > 0.1  # every swing joint moves
     speed = np.abs(ref.v[:, talos.act_v_index[[talos.actuated.index(j) for j in excitation.joints]]])
-    assert speed.max() <= StanceOptions().velocity
+    assert speed.max() <= OneFootOptions().velocity
 
 
 def test_the_band_is_mirrored_and_checked(talos):
@@ -123,7 +123,7 @@ def test_the_band_is_mirrored_and_checked(talos):
     with pytest.raises(InputError, match="band"):
         swing_band(talos, ("arm_left_1_joint",), "left", 0.05)
     with pytest.raises(InputError, match="stance"):
-        StanceOptions(stance="both")
+        OneFootOptions(stance="both")
 
 
 @pytest.mark.parametrize("stance", ["left", "right"])
@@ -133,23 +133,23 @@ def test_every_posture_of_the_band_keeps_the_swing_sole_clear(talos, stance):
     finds)."""
     c = ("left", "right").index(stance)
     joints = talos.limb(talos.contact_frames[1 - c])
-    lower, upper = swing_band(talos, joints, ("left", "right")[1 - c], StanceOptions().margin)
+    lower, upper = swing_band(talos, joints, ("left", "right")[1 - c], OneFootOptions().margin)
     low, beside = band_clearance(talos, c, joints, lower, upper)
-    assert low > StanceOptions().clearance and beside > 0.01
+    assert low > OneFootOptions().clearance and beside > 0.01
 
 
 def test_a_band_that_lets_the_sole_cross_is_refused_before_the_design(talos, monkeypatch):
     """The earlier band (hip yaw -0.15..0.05, hip roll -0.4..-0.2, ankle roll -0.15..0.15) lets a corner come 44 mm
     across the stance sole (its corners solved one by one, right stance): refused in one line before the design."""
-    monkeypatch.setitem(stance_module.SWING_BAND, "hip_yaw", (-0.15, 0.05))
-    monkeypatch.setitem(stance_module.SWING_BAND, "hip_roll", (-0.4, -0.2))
-    monkeypatch.setitem(stance_module.SWING_BAND, "ankle_roll", (-0.15, 0.15))
+    monkeypatch.setitem(one_foot_module.SWING_BAND, "hip_yaw", (-0.15, 0.05))
+    monkeypatch.setitem(one_foot_module.SWING_BAND, "hip_roll", (-0.4, -0.2))
+    monkeypatch.setitem(one_foot_module.SWING_BAND, "ankle_roll", (-0.15, 0.15))
 
     def not_reached(*args, **kwargs):
         raise AssertionError("designed a band that is not admissible")
-    monkeypatch.setattr(stance_module, "design_swing", not_reached)
+    monkeypatch.setattr(one_foot_module, "design_swing", not_reached)
     with pytest.raises(ModelError, match="posture band lets the swing sole come .* -4[0-9].[0-9] mm beside"):
-        stance_reference(talos, StanceOptions(stance="right"))
+        one_foot_reference(talos, OneFootOptions(stance="right"))
 
 
 @pytest.mark.parametrize("stance, simulator", [("left", "ideal"), ("left", "mujoco"), ("right", "mujoco")])

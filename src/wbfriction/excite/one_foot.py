@@ -3,16 +3,16 @@ simulators play (:class:`~wbfriction.walking.reference.WalkingReference`), singl
 the last, so that every sample is one the estimator maps exactly to the swing leg's friction torque.
 
 * **The swing leg**: each joint a finite Fourier series at rest at both ends (:mod:`.trajectory`), designed alone by
-  :func:`~.design.design_joint` on the Cramér-Rao bound of its friction (:attr:`StanceOptions.asked`) within a
+  :func:`~.design.design_joint` on the Cramér-Rao bound of its friction (:attr:`OneFootOptions.asked`) within a
   conservative *posture band* (:data:`SWING_BAND`, given for a right swing leg, mirrored for a left one: hip and
-  ankle roll and hip yaw change sign) intersected with its URDF range less :attr:`StanceOptions.margin`, and below
-  :attr:`StanceOptions.velocity`. The band keeps the leg flexed (hip pitch forward, knee bent, the foot lifted) and
-  its hip rolled outward, away from the stance leg; :func:`stance_reference` checks on the solved motion that the
-  swing sole's lowest corner stays :attr:`StanceOptions.clearance` above the ground and its corners beside the
+  ankle roll and hip yaw change sign) intersected with its URDF range less :attr:`OneFootOptions.margin`, and below
+  :attr:`OneFootOptions.velocity`. The band keeps the leg flexed (hip pitch forward, knee bent, the foot lifted) and
+  its hip rolled outward, away from the stance leg; :func:`one_foot_reference` checks on the solved motion that the
+  swing sole's lowest corner stays :attr:`OneFootOptions.clearance` above the ground and its corners beside the
   stance sole's footprint (ModelError otherwise).
 * **Every other joint but the stance leg's** is held at the robot's reference posture (arms, torso, head).
 * **The floating base and the stance leg** (``6 + 6`` unknowns) come from a square inverse kinematics per sample
-  (:mod:`wbfriction.sim.single_support`, which ``simulate --play`` reruns on the set-points table's series:
+  (:mod:`wbfriction.walking.single_support`, which ``simulate --play`` reruns on the set-points table's series:
   Newton iterations, Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians), twelve tasks: the stance sole's placement
   (flat at its standing footprint, 6), the centre of mass over the sole's centre at the standing posture's height
   (3), the base upright (3). Velocities from ``J v = 0``, accelerations from ``J a = -Jd v`` (the targets are
@@ -42,17 +42,17 @@ from wbfriction.excite.design import ExciteOptions
 from wbfriction.excite.swing import design_swing, posture_band, series_bounds, swing_noise
 from wbfriction.fit.targets import THESIS_TARGETS, friction_by_group
 from wbfriction.friction.families.params import ModelParamsBase
+from wbfriction.model.footprint import sole_footprint
 from wbfriction.model.robot import Robot
-from wbfriction.sim.arm import FourierTrajectory
-from wbfriction.sim.mujoco_model import sole_footprint
-from wbfriction.sim.single_support import (  # noqa: F401 (StanceIK, zero_moment_point: this module's names too)
+from wbfriction.walking.fourier import FourierTrajectory
+from wbfriction.walking.reference import WalkingReference, standing_configuration
+from wbfriction.walking.single_support import (  # noqa: F401 (SingleSupportIK, zero_moment_point: this module's names too)
     SIDES,
-    StanceIK,
+    SingleSupportIK,
+    single_support_ik,
     single_support_reference,
-    stance_ik,
     zero_moment_point,
 )
-from wbfriction.walking.reference import WalkingReference, standing_configuration
 
 SWING_BAND: dict[str, tuple[float, float]] = {
     "hip_yaw": (-0.05, 0.15),
@@ -73,8 +73,8 @@ met them depended on the optimiser's rounding)."""
 MIRRORED = ("hip_yaw", "hip_roll", "ankle_roll")
 """The groups whose band changes sign from one leg to the other."""
 @dataclass(frozen=True)
-class StanceOptions:
-    """What :func:`stance_reference` builds.
+class OneFootOptions:
+    """What :func:`one_foot_reference` builds.
 
     Attributes:
         stance: ``"left"`` or ``"right"``: the foot stood on (the other leg swings).
@@ -107,7 +107,7 @@ class StanceOptions:
 
 
 @dataclass(frozen=True)
-class StanceExcitation:
+class OneFootExcitation:
     """A one-foot stance with the swing leg excited.
 
     Attributes:
@@ -143,7 +143,7 @@ def swing_band(robot: Robot, joints: tuple[str, ...], side: str, margin: float) 
 
 def support_margin(robot: Robot, stance: int, zmp: np.ndarray) -> float:
     """The least distance [m] of the points ``zmp`` (N, 2) (world) to the edges of the stance sole's footprint
-    (:func:`~wbfriction.sim.mujoco_model.sole_footprint`), the sole flat at its standing placement; negative: a
+    (:func:`~wbfriction.model.footprint.sole_footprint`), the sole flat at its standing placement; negative: a
     point outside."""
     model, data = robot.model, robot.model.createData()
     pin.framesForwardKinematics(model, data, standing_configuration(robot))
@@ -157,8 +157,8 @@ def band_clearance(robot: Robot, stance: int, joints: tuple[str, ...], lower: np
                    upper: np.ndarray) -> tuple[float, float]:
     """The swing sole's least height [m] and least distance beside the stance sole [m] (as :func:`_swing_corners`)
     over every corner of the band ``lower``, ``upper`` (n,) [rad] of the swing ``joints`` (2^n postures, the other
-    joints at the reference posture, the floating base and the stance leg from :func:`stance_ik`, at rest)."""
-    ik = stance_ik(robot, stance)
+    joints at the reference posture, the floating base and the stance leg from :func:`single_support_ik`, at rest)."""
+    ik = single_support_ik(robot, stance)
     iq = robot.act_q_index[[robot.actuated.index(j) for j in joints]]
     rest = np.zeros(len(ik.rest))
     postures = []
@@ -193,20 +193,20 @@ def _swing_corners(robot: Robot, stance: int, q: np.ndarray, every: int = 10) ->
     return low, beside
 
 
-def stance_reference(robot: Robot, options: StanceOptions = StanceOptions(),
-                     prior: Mapping[str, ModelParamsBase] | None = None) -> StanceExcitation:
-    """Stand on one foot for :attr:`StanceOptions.duration` while the other leg follows its designed series
+def one_foot_reference(robot: Robot, options: OneFootOptions = OneFootOptions(),
+                     prior: Mapping[str, ModelParamsBase] | None = None) -> OneFootExcitation:
+    """Stand on one foot for :attr:`OneFootOptions.duration` while the other leg follows its designed series
     (module docstring).
 
     Args:
         robot: a biped: two soles (left, right, in that order), six joints per leg, its leg joints in groups of
             :data:`SWING_BAND`.
-        options: :class:`StanceOptions`.
+        options: :class:`OneFootOptions`.
         prior: per swing joint, the friction its design's bound is taken at; default: the thesis's targets by
             group (:data:`~wbfriction.fit.targets.THESIS_TARGETS`).
 
     Returns:
-        A :class:`StanceExcitation` of ``duration x rate`` samples.
+        A :class:`OneFootExcitation` of ``duration x rate`` samples.
 
     Raises:
         InputError: a robot without two soles, a swing joint without band or prior, a period that does not divide
@@ -224,10 +224,10 @@ def stance_reference(robot: Robot, options: StanceOptions = StanceOptions(),
     trajectory = design_swing(robot, joints, (lower, upper), prior, options, noise)
     reference = single_support_reference(robot, stance, joints, trajectory, options.design.times())
     margin, low = _checked(robot, options, stance, reference)
-    return StanceExcitation(reference, stance, joints, trajectory, lower, upper, margin, low)
+    return OneFootExcitation(reference, stance, joints, trajectory, lower, upper, margin, low)
 
 
-def _checked(robot: Robot, options: StanceOptions, stance: int, reference: WalkingReference) -> tuple[float, float]:
+def _checked(robot: Robot, options: OneFootOptions, stance: int, reference: WalkingReference) -> tuple[float, float]:
     """The ZMP's least distance to the stance sole's edges [m] and the swing sole's least height [m] of a solved
     motion, its ZMP, clearance and stance leg's range checked (ModelError)."""
     margin = support_margin(robot, stance, reference.zmp)
@@ -244,7 +244,7 @@ def _checked(robot: Robot, options: StanceOptions, stance: int, reference: Walki
     return margin, low
 
 
-def _clear(options: StanceOptions, low: float, beside: float, subject: str) -> None:
+def _clear(options: OneFootOptions, low: float, beside: float, subject: str) -> None:
     """ModelError unless the swing sole's least height ``low`` [m] reaches the clearance asked and its least
     distance ``beside`` [m] the stance sole is not negative (``subject`` begins the message)."""
     if low < options.clearance or beside < 0.0:
@@ -252,7 +252,7 @@ def _clear(options: StanceOptions, low: float, beside: float, subject: str) -> N
                          f"sole (at least {options.clearance * 1e3:.1f} and 0 mm): a narrower band")
 
 
-def swing_bounds(robot: Robot, excitation: StanceExcitation, options: StanceOptions,
+def swing_bounds(robot: Robot, excitation: OneFootExcitation, options: OneFootOptions,
                  prior: Mapping[str, ModelParamsBase] | None = None) -> dict[str, dict[str, float]]:
     """Each swing joint's Cramér-Rao bound of its friction's parameters on the designed motion [their units]
     (:func:`~.swing.series_bounds`: its prior friction, as its design takes it, the options' noise at the

@@ -13,10 +13,10 @@ import pytest
 from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.fit.params_file import write_params
 from wbfriction.fit.result import FitResult
+from wbfriction.replay.rollout import ActuatorParams, read_log_setpoints, rollout, rollout_table
 from wbfriction.sim.hung import simulate_hung
 from wbfriction.sim.pd_options import REAL_DRIVER, HungOptions
 from wbfriction.sim.pd_robot import Commands, PdRun
-from wbfriction.sim.rollout import ActuatorParams, read_log_setpoints, rollout, rollout_table
 
 EXACT = 1e-10
 """Replaying a noise-free log with its true parameters: measured at most 4e-15 rad RMS (1e-14 at worst) over 25 s of
