@@ -2,8 +2,8 @@
 class 6): one line naming the option, the mode and what it takes, exit 2, before the work, nothing written.
 ``simulate``'s modes (a robot on point feet, a hung PD-driven robot, an arm, a walk ideal or on MuJoCo) and
 ``identify``'s (the inertia model, ``--actuator pd``) each read the options of their table (each rig's
-:attr:`~wbfriction.rigs.base.Rig.simulation` fields and its engine's, :data:`wbfriction.cli.identify.MODES`); the refusal
-is :func:`wbfriction.cli.common.refuse_options`. Also the misleading lines of class 5 in these commands."""
+:attr:`~wbfriction.rigs.base.Rig.simulation` fields and its engine's, :data:`wbfriction.cli.identify.MODES`);
+the refusal is :func:`wbfriction.cli.common.refuse_options`. Also the misleading lines of class 5 in these commands."""
 
 from __future__ import annotations
 
@@ -45,7 +45,7 @@ def simulator_options() -> dict[str, tuple[str, ...]]:
 HUNG = ("robot 'go2' is a hung PD-driven robot (fixed base, [pd]): it takes --friction, --substeps, "
         "--mujoco-friction, --position-noise, --encoder-bits, --noise-seed, --delay, --friction-timeconst, "
         "--duration, --excitation-seed, --setpoints, --driver-noise, --velocity-noise, --play")
-QUADRUPED = ("robot 'go2_walking' stands on point feet (a walking quadruped): it takes --gait, --friction, "
+QUADRUPED = ("robot 'go2_walking' stands on point feet (a walking quadruped), simulated in ideal: it takes --gait, --friction, "
              "--simulator, --substeps, --sensors, --position-noise, --encoder-bits, --torque-noise, --noise-seed, "
              "--duration, --excitation-seed, --speed, --foot-forces, --play")
 ARM = ("robot 'panda' is a fixed-base arm (torque-driven, an excitation trajectory): it takes --friction, "

@@ -27,7 +27,7 @@ class Kind:
 def test_kinds_are_asked_in_precedence_order_whatever_the_order_registered(precedences):
     registry: Registry[Kind] = Registry("kind", precedence=lambda k: k.precedence)
     for p in precedences:
-        registry.add(Kind(f"k{p}", p))
+        registry.register(Kind(f"k{p}", p))
     assert [k.precedence for k in registry] == sorted(precedences)
     assert registry.names() == tuple(f"k{p}" for p in sorted(precedences))
 
@@ -36,24 +36,24 @@ def test_kinds_are_asked_in_precedence_order_whatever_the_order_registered(prece
 def test_without_precedence_kinds_keep_the_order_registered(names):
     registry: Registry[Kind] = Registry("kind")
     for n in names:
-        registry.add(Kind(n))
+        registry.register(Kind(n))
     assert registry.names() == tuple(names) and len(registry) == len(names)
     for n in names[::2]:
-        registry.remove(n)
+        registry.unregister(n)
     assert registry.names() == tuple(names[1::2])
 
 
 def test_a_name_or_precedence_taken_and_an_unknown_name_are_refused_naming_what_is_there():
     registry: Registry[Kind] = Registry("widget", precedence=lambda k: k.precedence, unknown=InputError)
-    registry.add(Kind("a", 1))
+    registry.register(Kind("a", 1))
     with pytest.raises(ValueError, match="a widget named 'a' is registered already"):
-        registry.add(Kind("a", 2))
+        registry.register(Kind("a", 2))
     with pytest.raises(ValueError, match="widget 'b' has the precedence 1 of 'a'"):
-        registry.add(Kind("b", 1))
+        registry.register(Kind("b", 1))
     with pytest.raises(InputError, match="unknown widget 'c': choose one of a"):
         registry.get("c")
     with pytest.raises(ValueError, match=r"no widget named 'c' \(registered: a\)"):
-        registry.remove("c")
+        registry.unregister("c")
     assert registry.get("a") == Kind("a", 1) and "a" in registry and "b" not in registry
 
 
@@ -89,11 +89,11 @@ def test_the_rules_given_when_made_replace_check_and_follow_a_registration():
 
 def test_the_old_names_of_the_calls_still_work_and_a_copy_changes_on_its_own():
     registry: Registry[Kind] = Registry("kind")
-    assert registry.add(Kind("a")) == Kind("a") and list(registry) == [Kind("a")]
+    assert registry.register(Kind("a")) == Kind("a") and list(registry) == [Kind("a")]
     twin = registry.copy()
-    twin.add(Kind("b"))
+    twin.register(Kind("b"))
     assert registry.names() == ("a",) and twin.names() == ("a", "b")
-    assert registry.remove("a") == Kind("a") and "a" not in registry and "a" in twin
+    assert registry.unregister("a") == Kind("a") and "a" not in registry and "a" in twin
 
 
 def test_an_unknown_name_raises_the_registrys_own_error_naming_what_there_is():
@@ -104,7 +104,7 @@ def test_an_unknown_name_raises_the_registrys_own_error_naming_what_there_is():
         return KeyError(name)
 
     registry: Registry[Kind] = Registry("kind", missing=unknown)
-    registry.add(Kind("a"))
+    registry.register(Kind("a"))
     with pytest.raises(KeyError):
         registry.get("z")
     with pytest.raises(KeyError):
@@ -136,7 +136,7 @@ def test_entry_points_are_read_once_and_each_loaded_when_first_named():
     advertised = [entry_point("toy", "toys:Toy", loads=Toy), entry_point("other", "toys:OTHER", loads=Kind("other"))]
     with patch("importlib.metadata.entry_points", return_value=advertised) as read:
         registry: Registry[Kind] = Registry("kind", entry_points="toys")
-        registry.add(Kind("a"))
+        registry.register(Kind("a"))
         assert read.call_count == 0
         assert registry.names() == ("a", "toy", "other") and "toy" in registry and "b" not in registry
         assert registry.loaded() == ("a",)
@@ -178,11 +178,11 @@ def test_built_in_kinds_are_listed_first_loaded_when_named_and_never_unregistere
 
     def import_module(name: str):
         imported.append(name)
-        registry.add(Kind("b"))
+        registry.register(Kind("b"))
         return module
 
     monkeypatch.setattr(importlib, "import_module", import_module)
-    registry.add(Kind("a"))
+    registry.register(Kind("a"))
     assert registry.names() == ("b", "a") and registry.loaded() == ("a",) and "b" in registry
     assert registry.get("b") == Kind("b") and registry.get("b") == Kind("b") and imported == ["toy_builtin_kind"]
     with pytest.raises(ValueError, match="^the built-in kind 'b' cannot be unregistered$"):

@@ -239,11 +239,6 @@ class Registry(Generic[K]):
         twin._kinds = dict(self._kinds)
         return twin
 
-    add = register
-    """What :meth:`register` was called first."""
-    remove = unregister
-    """What :meth:`unregister` was called first."""
-
     def __contains__(self, name: object) -> bool:
         """Whether a kind is named ``name`` (registered, built in or advertised; none loaded)."""
         if name in self._kinds or name in self.builtins:

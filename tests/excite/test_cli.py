@@ -74,4 +74,5 @@ def test_an_arms_design_written_then_played(cli, capsys, tmp_path):
     assert np.max(np.abs(q - table.q_des[:, 3])) < 0.01  # the arm tracks the design (its PD at 10 Hz bandwidth)
     code, _, err = run_cli_printed(capsys, "excite", "--robot", "panda", "--amplitude", "0.5", "-o",
                                    tmp_path / "x.csv")
-    assert code == 2 and "--amplitude: robot 'panda' is a fixed-base arm: it takes no hung PD-driven robot's" in err
+    assert code == 2 and ("--amplitude: robot 'panda' is a fixed-base arm (torque-driven, an excitation trajectory): "
+                          "it takes --duration") in err

@@ -30,7 +30,7 @@ def rig_options(ctx: typer.Context, values: Mapping[str, Any], classes: tuple[ty
         OptionError: a value outside its range.
     """
     takes = {name for cls in classes for name in option_names(cls)}
-    refuse_options(ctx, mode, takes | ({"simulator"} if engine else set()), shared)
+    refuse_options(ctx, mode, (takes - set(shared)) | ({"simulator"} if engine else set()), shared)
     if play is not None:
         refuse_unread(ctx, f"the set-points played ({play.name}) fix the motion",
                       [n for cls in classes for n in motion_names(cls)], "motion")

@@ -45,7 +45,7 @@ def register_rig(rig: Rig) -> Rig:
     Raises:
         ValueError: a rig of that name, or of that precedence, registered already (naming it).
     """
-    return RIGS.add(rig)
+    return RIGS.register(rig)
 
 
 def unregister_rig(name: str) -> Rig:
@@ -54,7 +54,7 @@ def unregister_rig(name: str) -> Rig:
     Raises:
         ValueError: no rig of that name.
     """
-    return RIGS.remove(name)
+    return RIGS.unregister(name)
 
 
 def rigs() -> tuple[Rig, ...]:

@@ -22,10 +22,3 @@ from .pd_options import SetpointOptions as SetpointOptions
 from .pd_robot import PdMujocoRobot as PdMujocoRobot
 from .pd_robot import build_pd_robot as build_pd_robot
 from .sensors import apply_sensor_noise as apply_sensor_noise
-from .simulators import SimulationOutput as SimulationOutput
-from .simulators import SimulationProgress as SimulationProgress
-from .simulators import SimulatorKind as SimulatorKind
-from .simulators import register_simulator as register_simulator
-from .simulators import simulator_for as simulator_for
-from .simulators import simulator_names as simulator_names
-from .simulators import unregister_simulator as unregister_simulator

@@ -19,7 +19,7 @@ def register_engine(engine: Engine) -> Engine:
     Raises:
         ValueError: an engine of that name, or of that precedence, registered already.
     """
-    return ENGINES.add(engine)
+    return ENGINES.register(engine)
 
 
 def unregister_engine(name: str) -> Engine:
@@ -28,7 +28,7 @@ def unregister_engine(name: str) -> Engine:
     Raises:
         ValueError: no engine of that name.
     """
-    return ENGINES.remove(name)
+    return ENGINES.unregister(name)
 
 
 def engines() -> tuple[Engine, ...]:
