@@ -45,8 +45,8 @@ def simulator_options() -> dict[str, tuple[str, ...]]:
 HUNG = ("robot 'go2' is a hung PD-driven robot (fixed base, [pd]): it takes --friction, --substeps, "
         "--mujoco-friction, --position-noise, --encoder-bits, --noise-seed, --delay, --friction-timeconst, "
         "--duration, --excitation-seed, --setpoints, --driver-noise, --velocity-noise, --play")
-QUADRUPED = ("robot 'go2_walking' stands on point feet (a walking quadruped), simulated in ideal: it takes --gait, --friction, "
-             "--simulator, --substeps, --sensors, --position-noise, --encoder-bits, --torque-noise, --noise-seed, "
+QUADRUPED = ("robot 'go2_walking' stands on point feet (a walking quadruped), simulated in ideal: it takes --gait, "
+             "--friction, --simulator, --substeps, --sensors, --position-noise, --encoder-bits, --torque-noise, --noise-seed, "
              "--duration, --excitation-seed, --speed, --foot-forces, --play")
 ARM = ("robot 'panda' is a fixed-base arm (torque-driven, an excitation trajectory): it takes --friction, "
        "--position-noise, --encoder-bits, --torque-noise, --noise-seed, --duration, --excitation-seed, --play")
