@@ -46,8 +46,8 @@ HUNG = ("robot 'go2' is a hung PD-driven robot (fixed base, [pd]): it takes --fr
         "--mujoco-friction, --position-noise, --encoder-bits, --noise-seed, --delay, --friction-timeconst, "
         "--duration, --excitation-seed, --setpoints, --driver-noise, --velocity-noise, --play")
 QUADRUPED = ("robot 'go2_walking' stands on point feet (a walking quadruped), simulated in ideal: it takes --gait, "
-             "--friction, --simulator, --substeps, --sensors, --position-noise, --encoder-bits, --torque-noise, --noise-seed, "
-             "--duration, --excitation-seed, --speed, --foot-forces, --play")
+             "--friction, --simulator, --substeps, --sensors, --position-noise, --encoder-bits, --torque-noise, "
+             "--noise-seed, --duration, --excitation-seed, --speed, --foot-forces, --play")
 ARM = ("robot 'panda' is a fixed-base arm (torque-driven, an excitation trajectory): it takes --friction, "
        "--position-noise, --encoder-bits, --torque-noise, --noise-seed, --duration, --excitation-seed, --play")
 PD = ("--actuator pd identifies a hung PD-driven robot's actuators (the URDF kept): it takes --json, --holdout, "
