@@ -240,8 +240,10 @@ PRINTS = {
                           # a contact model registered: a Go2's trot read with it, the point feet's friction
                           r"^trot\.parquet on local points: [1-9]\d?% of the samples' friction determined, "
                           r"(0e\+00|\de-1[2-9]) N·m from the point feet's$",
-                          # a simulator registered, run by simulate, its injected friction fitted back
-                          r"^sine_arm\.parquet: panda_joint1: F_c 0\.(59|60|61) N·m, F_v 0\.(29|30|31) N·m·s/rad$"],
+                          # a rig registered, run by simulate with its own option, its injected friction fitted back
+                          r"^sine_arm\.parquet: panda_joint1: F_c 0\.(59|60|61) N·m, F_v 0\.(29|30|31) N·m·s/rad$",
+                          # an engine registered, a biped's walk simulated in it
+                          r"^fine_walk\.parquet: \d{4,} samples, \d\.\d s$"],
     # a trot without foot forces: the two swinging legs determined, the stance pair not (the rank of [S^T J^T])
     "docs/how-to/quadrupeds.md": [r"^FL_foot\+RR_foot down: determined on every sample: FR_hip_joint, FR_thigh_joint, "
                                   r"FR_calf_joint, RL_hip_joint, RL_thigh_joint, RL_calf_joint$",
@@ -266,7 +268,7 @@ WRITES = {
     "docs/how-to/quadrupeds.md": ["trot_determined.png"],
     "docs/how-to/library.md": ["api_params.json"],
     "docs/extending.md": ["arm.tsv", "arm_effort.parquet", "panda_friction.csv", "panda_extended.xml",
-                          "sine_arm.parquet"],
+                          "sine_arm.parquet", "fine_walk.parquet"],
 }
 """Files a page's ``python`` blocks must write."""
 
