@@ -34,6 +34,21 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     items.sort(key=lambda item: item.get_closest_marker("slow") is None)
 
 
+@pytest.fixture(scope="module")
+def go2() -> Robot:
+    """The built-in ``go2``: hung, PD-driven (the hung simulator's and the replays' tests; a module of its own may
+    name another robot so)."""
+    return load_robot("go2")
+
+
+@pytest.fixture(scope="module")
+def mjr(go2):
+    """Its MuJoCo model (:func:`~wbfriction.sim.pd_robot.build_pd_robot`), built once a module."""
+    from wbfriction.sim.pd_robot import build_pd_robot
+
+    return build_pd_robot(go2)
+
+
 @pytest.fixture(scope="session")
 def talos() -> Robot:
     return load_robot("talos")

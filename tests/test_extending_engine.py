@@ -19,8 +19,10 @@ from wbfriction.sim.engines import engine_names, register_engine, unregister_eng
 @pytest.fixture
 def toy():
     engine = register_engine(FineIdeal())
-    yield engine
-    unregister_engine(engine.name)
+    try:
+        yield engine
+    finally:
+        unregister_engine(engine.name)
 
 
 def test_the_toy_engine_runs_a_walk_finer_and_the_same(toy, tmp_path, capsys):

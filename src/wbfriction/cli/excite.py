@@ -27,8 +27,8 @@ from wbfriction.exceptions import InputError
 from wbfriction.excite.options import ARM_PERIOD, ARM_RATE, PD_EXCITE
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.rigs import RigProgress, rig_for
-from wbfriction.rigs.biped import STANDING_DURATION, STANDING_PERIOD
 from wbfriction.rigs.quadruped import STANDING_RATE
+from wbfriction.rigs.standing import STANDING_DURATION, STANDING_PERIOD
 
 SHARED = ("output", "prediction", "figure", "robot", "urdf", "config", "mjcf", "rig_option")
 """The options every rig's design reads: what is written, the robot."""

@@ -150,27 +150,14 @@ SOURCES: Registry[TorqueKind] = Registry("torque source", precedence=lambda k: k
 """The registered torque sources, in precedence order."""
 
 
-def register_torque_source(kind: TorqueKind) -> TorqueKind:
-    """Add ``kind`` to the torque sources every log is asked of, at its :attr:`~TorqueKind.precedence`. Returns it.
-
-    Raises:
-        ValueError: a source of that name, or of that precedence, registered already (naming it).
-    """
-    return SOURCES.register(kind)
-
-
-def unregister_torque_source(name: str) -> TorqueKind:
-    """Remove the torque source named ``name``; returns it.
-
-    Raises:
-        ValueError: no source of that name.
-    """
-    return SOURCES.unregister(name)
-
-
-def torque_sources() -> tuple[TorqueKind, ...]:
-    """The registered torque sources, in precedence order."""
-    return SOURCES.kinds()
+register_torque_source = SOURCES.register
+"""Add a torque source (a :class:`TorqueKind`) to those every log is asked of, at its
+:attr:`~TorqueKind.precedence`; returns it (:meth:`Registry.register <wbfriction.registry.Registry.register>`:
+ValueError for a name, or a precedence, registered already, naming it)."""
+unregister_torque_source = SOURCES.unregister
+"""Remove the torque source of a name; returns it (ValueError: none of that name)."""
+torque_sources = SOURCES.kinds
+"""The registered torque sources, in precedence order."""
 
 
 def torque_kind(name: TorqueSource) -> TorqueKind:

@@ -146,37 +146,17 @@ MODELS: Registry[ContactModel] = Registry("contact model", unknown=InputError, c
 """The registered contact models, in the order they were registered."""
 
 
-def register_contact_model(kind: ContactModel) -> ContactModel:
-    """Add ``kind`` to the contact models a robot TOML's ``contact_model`` may name. Returns it.
-
-    Raises:
-        ValueError: a model of that name registered already (naming it), one whose :attr:`~ContactModel.dims` is
-            not 1-6, or one of :attr:`~ContactModel.world_force` whose force is not three components.
-    """
-    return MODELS.register(kind)
-
-
-def unregister_contact_model(name: str) -> ContactModel:
-    """Remove the contact model named ``name``; returns it.
-
-    Raises:
-        ValueError: no model of that name.
-    """
-    return MODELS.unregister(name)
-
-
-def contact_models() -> tuple[ContactModel, ...]:
-    """The registered contact models, in the order they were registered."""
-    return MODELS.kinds()
-
-
-def contact_model_of(name: ContactKind) -> ContactModel:
-    """The registered contact model named ``name``.
-
-    Raises:
-        InputError: no model of that name (listing the registered ones).
-    """
-    return MODELS.get(name)
+register_contact_model = MODELS.register
+"""Add a contact model (a :class:`ContactModel`) to those a robot TOML's ``contact_model`` may name; returns it.
+ValueError: a model of that name registered already (naming it), one whose :attr:`~ContactModel.dims` is not 1-6, or
+one of :attr:`~ContactModel.world_force` whose force is not three components."""
+unregister_contact_model = MODELS.unregister
+"""Remove the contact model of a name; returns it (ValueError: none of that name)."""
+contact_models = MODELS.kinds
+"""The registered contact models, in the order they were registered."""
+contact_model_of = MODELS.get
+"""The registered contact model of a name (:class:`~wbfriction.exceptions.InputError`: none, listing those
+registered)."""
 
 
 for _builtin in (Sole(), Point()):

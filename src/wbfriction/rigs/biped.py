@@ -10,10 +10,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, Optional
 
 from wbfriction.exceptions import InputError
-from wbfriction.excite.options import ARM_RATE, PD_EXCITE
 from wbfriction.options import option
 from wbfriction.report.printed import Printed
 from wbfriction.rigs.base import DemoOutput, DesignOutput, Rig, RigProgress, SimulationOutput
+from wbfriction.rigs.standing import StandingDesignOptions, require_feet, standing_figure
 from wbfriction.sim.engines import WalkSettings
 from wbfriction.walking.options import GaitOptions
 
@@ -23,9 +23,6 @@ if TYPE_CHECKING:
     from wbfriction.walking.reference import WalkingReference
 
 GAIT = GaitOptions()
-STANDING_DURATION, STANDING_PERIOD = 8.0, 4.0
-"""A standing design's default time on one foot (or three) and its swing joints' Fourier period [s]
-(:class:`~wbfriction.excite.one_foot.OneFootOptions`' and :class:`~wbfriction.excite.tripod.TripodOptions`' own)."""
 
 
 @dataclass(frozen=True)
@@ -72,14 +69,9 @@ class BipedSimulation:
 
 
 @dataclass(frozen=True)
-class BipedDesignOptions:
-    """What ``excite`` reads of a biped: the recording [s] on one foot (``duration``), the set-points' rate [Hz],
-    the swing joints' Fourier period [s], the seed of the design's starts, the foot it stands on."""
+class BipedDesignOptions(StandingDesignOptions):
+    """What ``excite`` reads of a biped: a standing design's options, and the foot it stands on (``stance``)."""
 
-    duration: float = option(STANDING_DURATION, quantity="duration")
-    rate: float = option(ARM_RATE)
-    period: float = option(STANDING_PERIOD)
-    seed: int = option(PD_EXCITE.seed, quantity="seed")
     stance: Literal["left", "right"] = option("left")
 
 
@@ -142,19 +134,13 @@ class BipedRig(Rig):
         return walking_reference(robot, gait)
 
     def design(self, robot: Robot, options: Any, progress: RigProgress) -> DesignOutput:
-        from wbfriction.excite.design import ExciteOptions
         from wbfriction.excite.document import one_foot_document, one_foot_setpoints
         from wbfriction.excite.one_foot import OneFootOptions, one_foot_reference, swing_bounds
         from wbfriction.report.excite_tables import swing_printed
-        from wbfriction.rigs.standing import standing_figure
 
         o: BipedDesignOptions = options
-        if len(robot.contact_frames) != 2:
-            raise InputError(f"robot '{robot.name}' has a floating base on {len(robot.contact_frames)} "
-                             f"{robot.stands_on}: excite designs a biped's one-foot stance")
-        excite = ExciteOptions(duration=o.duration, rate=o.rate, period=o.period,
-                               harmonics=OneFootOptions().design.harmonics, range_share=1.0, seed=o.seed)
-        stance = OneFootOptions(stance=o.stance, design=excite)
+        require_feet(robot, 2, "a biped's one-foot stance")
+        stance = OneFootOptions(stance=o.stance, design=o.excite(OneFootOptions().design.harmonics))
         progress.say(f"designing the swing leg's series, then the stance on the {stance.stance} foot (its IK at "
                      "every sample)")
         excitation = one_foot_reference(robot, stance)

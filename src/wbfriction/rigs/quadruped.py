@@ -10,11 +10,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, Optional
 
 from wbfriction.exceptions import InputError
-from wbfriction.excite.options import PD_EXCITE
 from wbfriction.options import option
 from wbfriction.report.printed import Printed
 from wbfriction.rigs.base import DemoOutput, DesignOutput, Rig, RigProgress, SimulationOutput
-from wbfriction.rigs.biped import STANDING_DURATION, STANDING_PERIOD
+from wbfriction.rigs.standing import StandingDesignOptions, require_feet, standing_figure
 from wbfriction.sim.noise_options import SensorsFileOptions
 
 if TYPE_CHECKING:
@@ -59,15 +58,11 @@ class QuadrupedSimulation(SensorsFileOptions):
 
 
 @dataclass(frozen=True)
-class QuadrupedDesignOptions:
-    """What ``excite`` reads of a quadruped: the recording [s] on three feet (``duration``), the set-points' rate
-    [Hz], the swing joints' Fourier period [s], the seed of the design's starts, the leg lifted (``swing``: FL, FR,
-    RL, RR or its foot frame's name)."""
+class QuadrupedDesignOptions(StandingDesignOptions):
+    """What ``excite`` reads of a quadruped: a standing design's options (its rate its simulators' control rate),
+    and the leg lifted (``swing``: FL, FR, RL, RR or its foot frame's name)."""
 
-    duration: float = option(STANDING_DURATION, quantity="duration")
     rate: float = option(STANDING_RATE)
-    period: float = option(STANDING_PERIOD)
-    seed: int = option(PD_EXCITE.seed, quantity="seed")
     swing: str = option("FR")
 
 
@@ -157,19 +152,13 @@ class QuadrupedRig(Rig):
         return quadruped_reference(robot, gait), gait.gait
 
     def design(self, robot: Robot, options: Any, progress: RigProgress) -> DesignOutput:
-        from wbfriction.excite.design import ExciteOptions
         from wbfriction.excite.document import tripod_document, tripod_setpoints
         from wbfriction.excite.tripod import TripodOptions, swing_bounds, tripod_reference
         from wbfriction.report.excite_tables import swing_printed
-        from wbfriction.rigs.standing import standing_figure
 
         o: QuadrupedDesignOptions = options
-        if len(robot.contact_frames) != 4:
-            raise InputError(f"robot '{robot.name}' has a floating base on {len(robot.contact_frames)} "
-                             f"{robot.stands_on}: excite designs a quadruped's stance on three of four point feet")
-        excite = ExciteOptions(duration=o.duration, rate=o.rate, period=o.period,
-                               harmonics=TripodOptions().design.harmonics, range_share=1.0, seed=o.seed)
-        tripod = TripodOptions(swing=o.swing, design=excite)
+        require_feet(robot, 4, "a quadruped's stance on three of four point feet")
+        tripod = TripodOptions(swing=o.swing, design=o.excite(TripodOptions().design.harmonics))
         progress.say("designing the swing leg's series, then the stance on the three other feet (its IK at every "
                      "sample)")
         excitation = tripod_reference(robot, tripod)

@@ -39,27 +39,14 @@ RIGS: Registry[Rig] = Registry("rig", precedence=lambda r: r.precedence)
 """The registered rigs, in precedence order."""
 
 
-def register_rig(rig: Rig) -> Rig:
-    """Add ``rig`` to those every command asks, at its :attr:`~wbfriction.rigs.base.Rig.precedence`. Returns it.
-
-    Raises:
-        ValueError: a rig of that name, or of that precedence, registered already (naming it).
-    """
-    return RIGS.register(rig)
-
-
-def unregister_rig(name: str) -> Rig:
-    """Remove the rig named ``name``; returns it.
-
-    Raises:
-        ValueError: no rig of that name.
-    """
-    return RIGS.unregister(name)
-
-
-def rigs() -> tuple[Rig, ...]:
-    """The registered rigs, in precedence order."""
-    return RIGS.kinds()
+register_rig = RIGS.register
+"""Add a rig (a :class:`~wbfriction.rigs.base.Rig`) to those every command asks, at its
+:attr:`~wbfriction.rigs.base.Rig.precedence`; returns it (ValueError: a rig of that name, or of that precedence,
+registered already, naming it)."""
+unregister_rig = RIGS.unregister
+"""Remove the rig of a name; returns it (ValueError: none of that name)."""
+rigs = RIGS.kinds
+"""The registered rigs, in precedence order."""
 
 
 def rig_for(robot: Robot, actuator: str | None = None) -> Rig:

@@ -1,16 +1,56 @@
-"""The figure of a standing design (a biped on one foot, a quadruped on three): the swing joints' set-points within
-their bands and the shares of their Cramér-Rao bounds."""
+"""What a standing design shares (a biped on one foot, a quadruped on three): its options, the feet it needs, and its
+figure (the swing joints' set-points within their bands and the shares of their Cramér-Rao bounds)."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from wbfriction.exceptions import InputError
+from wbfriction.excite.options import ARM_RATE, PD_EXCITE
+from wbfriction.options import option
 
 if TYPE_CHECKING:
     import pyarrow as pa
 
+    from wbfriction.excite.design import ExciteOptions
     from wbfriction.model.robot import Robot
+
+STANDING_DURATION, STANDING_PERIOD = 8.0, 4.0
+"""A standing design's default time on one foot (or three) and its swing joints' Fourier period [s]
+(:class:`~wbfriction.excite.one_foot.OneFootOptions`' and :class:`~wbfriction.excite.tripod.TripodOptions`' own)."""
+
+
+@dataclass(frozen=True)
+class StandingDesignOptions:
+    """What ``excite`` reads of a robot standing on some feet while one leg swings: the recording [s] on them
+    (``duration``), the set-points' rate [Hz], the swing joints' Fourier period [s], the seed of the design's
+    starts."""
+
+    duration: float = option(STANDING_DURATION, quantity="duration")
+    rate: float = option(ARM_RATE)
+    period: float = option(STANDING_PERIOD)
+    seed: int = option(PD_EXCITE.seed, quantity="seed")
+
+    def excite(self, harmonics: int) -> ExciteOptions:
+        """Each swing joint's design: these, ``harmonics`` per joint, the whole range (its band is the design's)."""
+        from wbfriction.excite.design import ExciteOptions
+
+        return ExciteOptions(duration=self.duration, rate=self.rate, period=self.period, harmonics=harmonics,
+                             range_share=1.0, seed=self.seed)
+
+
+def require_feet(robot: Robot, feet: int, what: str) -> None:
+    """Refuse a robot not on ``feet`` contacts (``what``: the stance the design makes).
+
+    Raises:
+        InputError: naming the robot, its contacts and the stance.
+    """
+    if len(robot.contact_frames) != feet:
+        raise InputError(f"robot '{robot.name}' has a floating base on {len(robot.contact_frames)} "
+                         f"{robot.stands_on}: excite designs {what}")
 
 
 def standing_figure(robot: Robot, excitation: Any, table: pa.Table, doc: dict, title: str) -> Callable[[Path], None]:

@@ -85,30 +85,15 @@ DEFAULT_FORMAT = "parquet"
 """The format a table is written in when no registered format claims its file's name."""
 
 
-def register_format(fmt: LogFormat) -> LogFormat:
-    """Add ``fmt`` to the formats every path is looked up in, after those registered before it (the first whose
-    :meth:`~wbfriction.logs.formats.base.LogFormat.detect` accepts a path reads it). Returns ``fmt``.
-
-    Its kind joins the catalogue the command line's help reads (:mod:`~wbfriction.logs.formats.catalog`).
-
-    Raises:
-        ValueError: a format of that name registered already, or a suffix another format claims (naming both).
-    """
-    return FORMATS.register(fmt)
-
-
-def unregister_format(name: str) -> LogFormat:
-    """Remove the format named ``name`` from the registry; returns it.
-
-    Raises:
-        ValueError: no format of that name.
-    """
-    return FORMATS.unregister(name)
-
-
-def log_formats() -> tuple[LogFormat, ...]:
-    """The registered formats, in the order they are tried."""
-    return FORMATS.kinds()
+register_format = FORMATS.register
+"""Add a format (a :class:`~wbfriction.logs.formats.base.LogFormat`) to those every path is looked up in, after those
+registered before it (the first whose :meth:`~wbfriction.logs.formats.base.LogFormat.detect` accepts a path reads
+it); returns it. Its kind joins the catalogue the command line's help reads (:mod:`~wbfriction.logs.formats.catalog`).
+ValueError: a format of that name registered already, or a suffix another format claims (naming both)."""
+unregister_format = FORMATS.unregister
+"""Remove the format of a name from the registry; returns it (ValueError: none of that name)."""
+log_formats = FORMATS.kinds
+"""The registered formats, in the order they are tried."""
 
 
 def _unknown(path: Path) -> UnknownFormatError:

@@ -13,41 +13,18 @@ ENGINES: Registry[Engine] = Registry("engine", precedence=lambda e: e.precedence
 """The registered engines, in precedence order."""
 
 
-def register_engine(engine: Engine) -> Engine:
-    """Add ``engine`` to those ``--simulator`` takes, at its precedence. Returns it.
-
-    Raises:
-        ValueError: an engine of that name, or of that precedence, registered already.
-    """
-    return ENGINES.register(engine)
-
-
-def unregister_engine(name: str) -> Engine:
-    """Remove the engine named ``name``; returns it.
-
-    Raises:
-        ValueError: no engine of that name.
-    """
-    return ENGINES.unregister(name)
-
-
-def engines() -> tuple[Engine, ...]:
-    """The registered engines, in precedence order."""
-    return ENGINES.kinds()
-
-
-def engine_names() -> tuple[str, ...]:
-    """The names ``--simulator`` takes, in precedence order."""
-    return ENGINES.names()
-
-
-def engine_of(name: str) -> Engine:
-    """The engine ``--simulator`` ``name`` names.
-
-    Raises:
-        InputError: none of that name, listing those registered.
-    """
-    return ENGINES.get(name)
+engine_names = ENGINES.names
+"""The names ``--simulator`` takes, in precedence order."""
+engine_of = ENGINES.get
+"""The engine ``--simulator`` names (:class:`~wbfriction.exceptions.InputError`: none of that name, listing those
+registered)."""
+engines = ENGINES.kinds
+"""The registered engines, in precedence order."""
+register_engine = ENGINES.register
+"""Add an engine (an :class:`~wbfriction.sim.engines.base.Engine`) to those ``--simulator`` takes, at its precedence;
+returns it (ValueError: an engine of that name, or of that precedence, registered already)."""
+unregister_engine = ENGINES.unregister
+"""Remove the engine of a name; returns it (ValueError: none of that name)."""
 
 
 for _builtin in (IdealEngine(), MujocoEngine()):
