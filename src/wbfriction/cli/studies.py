@@ -50,9 +50,11 @@ def demo(ctx: typer.Context,
                                                       "mujoco (the realistic simulator's study, Fig. 6.4-6.5); "
                                                       "default: the first the rig runs on."),
          rig_option: list[str] = RigOptionOpt) -> None:
-    """What the robot's rig shows in a few minutes: a biped (talos), the thesis's simulation study (walk, estimate,
-    fit; Tables 6.1/6.2 and Fig. 6.1-6.3; --simulator mujoco: the realistic simulator's tables and Fig. 6.4-6.5); a
-    quadruped on point feet (go2_walking), what its gait gives each joint (--rig-option gait=walk)."""
+    """What the robot's rig shows in a few minutes, against the truth its simulation injected: a biped (talos,
+    the default), the thesis's simulation study (walk, estimate, fit; Tables 6.1/6.2 and Fig. 6.1-6.3; --simulator
+    mujoco: the realistic simulator's tables and Fig. 6.4-6.5); a quadruped on point feet (go2_walking), what its
+    gait gives each joint (--rig-option gait=walk); an arm (panda), its friction fitted; a hung PD-driven robot
+    (go2), its actuators identified."""
     from wbfriction.rigs import RigProgress, rig_for
 
     values = {name: value for name, value in locals().items() if name != "ctx"}
@@ -63,7 +65,7 @@ def demo(ctx: typer.Context,
     r = robot_of(robot, None, None)
     rig = rig_for(r)
     if rig.demo_options is None:
-        raise InputError(f"{rig.what(r)}: demo shows a biped's walk or a quadruped's gait")
+        raise InputError(f"{rig.what(r)}: demo shows nothing of it")
     engine = rig.engine(r, simulator)
     (options,) = rig_options(ctx, values, (rig.demo_options,), rig.what(r), ("output_dir", "robot", "rig_option"),
                              rig_option, engine=engine is not None)

@@ -5,13 +5,15 @@ determine each joint's friction (:func:`~wbfriction.excite.arm_design.design_arm
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Optional
 
 from wbfriction.excite.options import ARM_PERIOD, ARM_RATE, PD_EXCITE
 from wbfriction.options import option
-from wbfriction.rigs.base import DesignOutput, Rig, RigProgress, SimulationOutput
+from wbfriction.report.printed import Printed
+from wbfriction.rigs.base import DemoOutput, DesignOutput, Rig, RigProgress, SimulationOutput
 from wbfriction.sim.noise_options import SensorNoiseOptions
 
 if TYPE_CHECKING:
@@ -57,12 +59,20 @@ class ArmDesignOptions:
     after: Optional[Path] = option(None)
 
 
+@dataclass(frozen=True)
+class ArmDemoOptions:
+    """What ``demo`` reads of an arm: seconds of excitation trajectory simulated, and its seed."""
+
+    duration: float = option(10.0, quantity="duration")
+    excitation_seed: int = option(0, quantity="seed")
+
+
 class ArmRig(Rig):
     """A fixed-base robot (torque-driven): an arm; its default friction :func:`~wbfriction.sim.arm.
     default_arm_friction`."""
 
     name, precedence = "arm", 30
-    simulation, design_options = ArmSimulation, ArmDesignOptions
+    simulation, design_options, demo_options = ArmSimulation, ArmDesignOptions, ArmDemoOptions
 
     def what(self, robot: Robot, actuator: str | None = None) -> str:
         return f"robot '{robot.name}' is a fixed-base arm (torque-driven, an excitation trajectory)"
@@ -132,3 +142,30 @@ class ArmRig(Rig):
             printed += next_printed(following, o.after)
         return DesignOutput(arm_setpoints(design, robot.offset_vector), doc, figure, tuple(printed))
 
+
+    def demo(self, robot: Robot, options: Any, engine: Engine | None, output_dir: Path,
+             progress: RigProgress) -> DemoOutput:
+        """The arm simulated with its default friction (a random excitation, motor currents logged), estimated and
+        fitted (the model chosen per joint): each joint's F_c and F_v against the friction injected."""
+        from wbfriction.fit.joints import fit_estimate
+        from wbfriction.friction.estimate import estimate_log
+        from wbfriction.logs.source import read_log
+        from wbfriction.logs.tables import write_table
+        from wbfriction.report.truth import not_ok_line, truth_table
+
+        output_dir.mkdir(parents=True, exist_ok=True)
+        log = output_dir / "arm.parquet"
+        run = ArmSimulation(duration=options.duration, excitation_seed=options.excitation_seed)
+        write_table(self.simulate(robot, run, None, None, progress).table, log)
+        progress.say("estimating and fitting (the model chosen per joint)")
+        fits = fit_estimate(estimate_log(robot, read_log(log, robot)))
+        rows = {}
+        for f in fits:
+            if f.params is None or f.target is None:
+                continue
+            truth, se = f.target.values_in(f.model), f.read_stderr()
+            rows[f.joint] = [(getattr(f.params, n), se.get(n, math.inf), truth[n], f.verdict().status)
+                             for n in ("F_c", "F_v")]
+        title = f"{robot.name}, {options.duration:g} s of excitation: fitted friction ± standard error, and the truth"
+        columns = (("F_c", "N·m", 1.0), ("F_v", "N·m·s/rad", 1.0))
+        return DemoOutput((Printed(truth_table(title, columns, rows)), Printed(not_ok_line(columns, rows))), (log,))

@@ -182,7 +182,7 @@ class Rig:
     def demo(self, robot: Robot, options: Any, engine: Engine | None, output_dir: Path,
              progress: RigProgress) -> DemoOutput:
         """Its study in a few minutes: simulate, estimate, fit, against the truth, into ``output_dir``."""
-        raise InputError(f"{self.what(robot)}: demo shows a biped's walk or a quadruped's gait")
+        raise InputError(f"{self.what(robot)}: demo shows nothing of it")
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r})"

@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING, Any, Literal, Optional
 from wbfriction.exceptions import InputError
 from wbfriction.excite.options import PD_EXCITE
 from wbfriction.options import option
-from wbfriction.rigs.base import DesignOutput, Rig, RigProgress, SimulationOutput
+from wbfriction.report.printed import Printed
+from wbfriction.rigs.base import DemoOutput, DesignOutput, Rig, RigProgress, SimulationOutput
 from wbfriction.sim.options import FrictionMode
 from wbfriction.sim.pd_options import DriverNoise, HungOptions, SetpointKind, SetpointOptions
 
@@ -98,12 +99,20 @@ class HungDesignOptions:
     after: Optional[Path] = option(None)
 
 
+@dataclass(frozen=True)
+class HungDemoOptions:
+    """What ``demo`` reads of a hung robot: seconds of set-points simulated (ramps, then chirps) and their seed."""
+
+    duration: float = option(HUNG.duration, quantity="duration")
+    excitation_seed: int = option(0, quantity="seed")
+
+
 class HungRig(Rig):
     """A PD-driven robot hung, its base fixed (``--actuator pd``, by default a robot with a ``[pd]`` table); its
     default friction Coulomb-viscous on every joint."""
 
     name, precedence, identifies_actuators = "hung", 20, True
-    simulation, design_options = HungSimulation, HungDesignOptions
+    simulation, design_options, demo_options = HungSimulation, HungDesignOptions, HungDemoOptions
 
     def what(self, robot: Robot, actuator: str | None = None) -> str:
         return f"robot '{robot.name}' is a hung PD-driven robot (fixed base, {'--actuator pd' if actuator else '[pd]'})"
@@ -175,3 +184,33 @@ class HungRig(Rig):
         if following is not None and o.after is not None:
             printed += next_printed(following, o.after)
         return DesignOutput(pd_setpoints(design), doc, figure, tuple(printed))
+
+    def demo(self, robot: Robot, options: Any, engine: Engine | None, output_dir: Path,
+             progress: RigProgress) -> DemoOutput:
+        """The robot hung and simulated (a real driver's noise, the default friction), its actuators identified
+        (``identify --actuator pd``): each joint's armature, F_c, F_v and encoder offset, and the drivers' delay,
+        against the truth."""
+        from wbfriction.actuator.identification import identify_actuators
+        from wbfriction.logs.metadata import read_metadata
+        from wbfriction.logs.source import read_log
+        from wbfriction.logs.tables import write_table
+        from wbfriction.report.truth import found_text, not_ok_line, truth_table
+
+        output_dir.mkdir(parents=True, exist_ok=True)
+        log = output_dir / "hung.parquet"
+        run = HungSimulation(duration=options.duration, excitation_seed=options.excitation_seed)
+        table = self.simulate(robot, run, None, None, progress).table
+        write_table(table, log)
+        truth = read_metadata(table)
+        progress.say("identifying the actuators")
+        found = identify_actuators(robot, read_log(log, robot))
+        rows = {j.joint: [(x.value, x.se, t, x.status) for x, t in (
+            (j.armature, truth["armature_true"][j.joint]), (j.F_c, truth["friction_true"][j.joint]["F_c"]),
+            (j.F_v, truth["friction_true"][j.joint]["F_v"]), (j.offset, truth["encoder_offset_true"][j.joint]))]
+            for j in found.joints}
+        d = found.delay
+        title = f"{robot.name} hung, {options.duration:g} s: identified ± standard error, and the truth"
+        columns = (("armature", "g·m²", 1e3), ("F_c", "N·m", 1.0), ("F_v", "N·m·s/rad", 1.0), ("offset", "mrad", 1e3))
+        delay = f"delay {found_text(d.value, d.se, 1e3)} ms{'' if d.status == 'ok' else ' (' + d.status + ')'}"
+        return DemoOutput((Printed(truth_table(title, columns, rows)), Printed(not_ok_line(columns, rows)),
+                           Printed(f"{delay}, truth {truth['delay_true'] * 1e3:g} ms")), (log,))
