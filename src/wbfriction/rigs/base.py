@@ -11,7 +11,8 @@ it runs when it runs.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -63,7 +64,7 @@ class DesignOutput:
 
     table: pa.Table
     document: dict
-    figure: Any
+    figure: Callable[[Path], None] | None
     printed: tuple[Printed, ...] = ()
 
 
@@ -72,7 +73,7 @@ class DemoOutput:
     """What a rig's demo gives the command to print: :class:`Printed` items in order and the files it wrote."""
 
     printed: tuple[Printed, ...] = ()
-    files: tuple[Path, ...] = field(default_factory=tuple)
+    files: tuple[Path, ...] = ()
 
 
 def _quiet(label: str) -> None:
