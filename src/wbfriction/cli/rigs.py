@@ -9,7 +9,9 @@ from typing import Any
 import typer
 
 from wbfriction.cli.common import given_options, refuse_options, refuse_unread
+from wbfriction.exceptions import OptionError
 from wbfriction.options import motion_names, option_names, parse_option, read_options
+from wbfriction.sim.engines import engine_names
 
 RigOptionOpt = typer.Option([], "--rig-option", metavar="NAME=VALUE",
                             help="An option of the robot's rig by its name, for one no flag spells (a rig a program "
@@ -38,3 +40,13 @@ def rig_options(ctx: typer.Context, values: Mapping[str, Any], classes: tuple[ty
              for name in given_options(ctx) if name in takes}
     given.update(parse_option(tuple(c for c in classes if c is not None), text) for text in rig_option)
     return tuple(None if cls is None else read_options(cls, given) for cls in classes)
+
+
+def check_engine(simulator: str | None) -> None:
+    """Refuse, before the robot is loaded, a ``--simulator`` that names no registered engine (None: not given).
+
+    Raises:
+        OptionError: listing the engines registered.
+    """
+    if simulator is not None and simulator not in engine_names():
+        raise OptionError("--simulator", simulator, f"one of {', '.join(engine_names())}")

@@ -25,11 +25,10 @@ from wbfriction.cli.common import (
     stages,
 )
 from wbfriction.cli.helpformat import LOGS
-from wbfriction.cli.rigs import RigOptionOpt, rig_options
+from wbfriction.cli.rigs import RigOptionOpt, check_engine, rig_options
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
-from wbfriction.exceptions import OptionError
 from wbfriction.logs.formats.catalog import written_suffixes
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.rigs import RigProgress, rig_for
@@ -158,11 +157,11 @@ def simulate(ctx: typer.Context, output: Path = OutputOpt, robot: str = RobotOpt
              rig_option: list[str] = RigOptionOpt) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents; a PD-driven one
-    (--robot go2) hangs with its base fixed, its drivers tracking ramps and chirps; --simulator also takes a
-    simulator a program registered. Options of another kind of robot are refused."""
+    (--robot go2) hangs with its base fixed, its drivers tracking ramps and chirps; --simulator also takes an engine
+    a program registered, --rig-option any option of the robot's rig by name. Options the rig does not read are
+    refused."""
     values = {name: value for name, value in locals().items() if name != "ctx"}
-    if simulator is not None and simulator not in engine_names():
-        raise OptionError("--simulator", simulator, f"one of {', '.join(engine_names())}")
+    check_engine(simulator)
     check_paths({"--urdf": urdf, "--mjcf": mjcf, "--config": config, "--friction": friction, "--sensors": sensors,
                  "--play": play}, {"-o": output})
     r = robot_of(robot, urdf, config, mjcf)

@@ -10,7 +10,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from wbfriction.exceptions import InputError, OptionError
+from wbfriction.exceptions import InputError
 from wbfriction.friction.options import RouteOption
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
@@ -36,7 +36,7 @@ from wbfriction.cli.common import (
     stages,
 )
 from wbfriction.cli.helpformat import STUDIES
-from wbfriction.cli.rigs import RigOptionOpt, rig_options
+from wbfriction.cli.rigs import RigOptionOpt, check_engine, rig_options
 
 
 @app.command(rich_help_panel=STUDIES)
@@ -58,8 +58,7 @@ def demo(ctx: typer.Context,
     from wbfriction.rigs import RigProgress, rig_for
 
     values = {name: value for name, value in locals().items() if name != "ctx"}
-    if simulator is not None and simulator not in engine_names():
-        raise OptionError("--simulator", simulator, f"one of {', '.join(engine_names())}")
+    check_engine(simulator)
     check_paths({}, {}, {"-o": output_dir})
     start = time.perf_counter()
     r = robot_of(robot, None, None)
