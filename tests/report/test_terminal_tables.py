@@ -101,8 +101,8 @@ def test_the_demos_table_fits_and_says_what_the_thesis_errors_over_100_percent_a
     and the caption naming each one over 100 %: nothing left to a lone footnote."""
     import dataclasses
 
-    from wbfriction.cli.studies import study_table
     from wbfriction.studies.common import LegRow
+    from wbfriction.studies.tables import study_table
     from wbfriction.studies.thesis import TABLE_6_1, TABLE_6_2
 
     qd, tau_f = _sweep()

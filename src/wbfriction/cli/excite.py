@@ -103,7 +103,8 @@ def excite(ctx: typer.Context,
     (options,) = rig_options(ctx, values, (rig.design_options,), rig.what(r), SHARED, rig_option)
     with stages() as status:
         design = rig.design(r, options, RigProgress(status, status.steps))
-    if figure is not None and design.figure is None:
+    draw = design.figure
+    if figure is not None and draw is None:
         raise InputError(f"--figure: {rig.what(r)}: its design draws no figure")
     from wbfriction.logs.tables import write_json, write_table
 
@@ -111,8 +112,8 @@ def excite(ctx: typer.Context,
         write_table(design.table, path)
     if prediction is not None:
         write_json(prediction, design.document)
-    if figure is not None:
-        design.figure(figure)
+    if figure is not None and draw is not None:
+        draw(figure)
     print_items(design.printed)
     for written in (*output, prediction, figure):
         if written is not None:

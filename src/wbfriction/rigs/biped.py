@@ -64,7 +64,7 @@ class BipedSimulation:
                              "turning, both or combined" if self.gait in QUADRUPED_GAITS else
                              f"--gait {self.gait}: robot '{robot.name}' walks forward, sideways, turning, both or "
                              "combined")
-        return GaitOptions(gait=self.gait or GAIT.gait, steps=self.steps, step_length=self.step_length,  # type: ignore[arg-type]
+        return GaitOptions(gait=self.gait or GAIT.gait, steps=self.steps, step_length=self.step_length,
                            step_width=self.step_width, turn_angle=self.turn_angle, lift_height=self.lift_height)
 
 

@@ -6,6 +6,7 @@ identifies its actuators."""
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, Optional
@@ -204,7 +205,8 @@ class HungRig(Rig):
         truth = read_metadata(table)
         progress.say("identifying the actuators")
         found = identify_actuators(robot, read_log(log, robot))
-        rows = {j.joint: [(x.value, x.se, t, x.status) for x, t in (
+        rows = {j.joint: [(math.nan, math.inf, t, "not excited") if x is None else (x.value, x.se, t, x.status)
+                          for x, t in (
             (j.armature, truth["armature_true"][j.joint]), (j.F_c, truth["friction_true"][j.joint]["F_c"]),
             (j.F_v, truth["friction_true"][j.joint]["F_v"]), (j.offset, truth["encoder_offset_true"][j.joint]))]
             for j in found.joints}
