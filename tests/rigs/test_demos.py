@@ -19,7 +19,8 @@ def found_and_true(out: str, names: tuple[str, ...]) -> dict[str, list[tuple[flo
     ``names`` (a status not ``ok`` named in the line after the table: ``not ok: FL_calf_joint offset (weak)``)."""
     rows: dict[str, list[tuple[float, float, float, str]]] = {}
     lines = out.splitlines()
-    statuses = dict(((j, n), s) for j, n, s in re.findall(r"(\w+) (\w+) \((weak|at bound|not excited|failed|does not predict)\)", out))
+    named = re.findall(r"(\w+) (\w+) \((weak|at bound|not excited|failed|does not predict)\)", out)
+    statuses = {(joint, name): status for joint, name, status in named}
     for k, line in enumerate(lines[:-1]):
         truth = lines[k + 1].split()
         found = re.findall(r"(-?[\d.]+) ± (\S+)", line)
