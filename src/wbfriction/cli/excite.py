@@ -26,7 +26,7 @@ from wbfriction.exceptions import InputError
 # options, whose defaults the help shows: the design is imported when the command runs.
 from wbfriction.excite.options import ARM_PERIOD, ARM_RATE, PD_EXCITE
 from wbfriction.pipeline.paths import check_paths
-from wbfriction.rigs import RigProgress, rig_for
+from wbfriction.rigs import DesignOutput, RigProgress, rig_for
 from wbfriction.rigs.quadruped import STANDING_RATE
 from wbfriction.rigs.standing import STANDING_DURATION, STANDING_PERIOD
 
@@ -103,9 +103,20 @@ def excite(ctx: typer.Context,
     (options,) = rig_options(ctx, values, (rig.design_options,), rig.what(r), SHARED, rig_option)
     with stages() as status:
         design = rig.design(r, options, RigProgress(status, status.steps))
+    write_design(design, output, prediction, figure, rig.what(r))
+
+
+def write_design(design: DesignOutput, output: list[Path], prediction: Path | None, figure: Path | None,
+                 what: str) -> None:
+    """Write a rig's design (the set-points to every ``-o``, the prediction to ``--json``, the figure to
+    ``--figure``), print what it prints and name what was written; ``what``: the robot on its rig.
+
+    Raises:
+        InputError: ``--figure`` for a design that draws none (before anything is written).
+    """
     draw = design.figure
     if figure is not None and draw is None:
-        raise InputError(f"--figure: {rig.what(r)}: its design draws no figure")
+        raise InputError(f"--figure: {what}: its design draws no figure")
     from wbfriction.logs.tables import write_json, write_table
 
     for path in output:
