@@ -35,7 +35,7 @@ class BipedSimulation:
         play: a one-foot stance ``excite`` wrote, played instead of a walk.
         substeps: physics steps per control period; None: the engine's default.
         log_base: write the base pose to the log.
-        gait: forward (None: the default), sideways, turning, both or combined; steps: per direction;
+        gait: forward, sideways, turning, both or combined; steps: per direction;
             step_length, step_width [m]; turn_angle [rad] per turning step; lift_height: swing-foot apex [m].
     """
 
@@ -43,7 +43,7 @@ class BipedSimulation:
     play: Optional[Path] = option(None)
     substeps: Optional[int] = option(None, quantity="substeps")
     log_base: bool = option(True)
-    gait: Optional[str] = option(None, motion=True)
+    gait: str = option(GAIT.gait, motion=True)
     steps: int = option(GAIT.steps, motion=True)
     step_length: float = option(GAIT.step_length, motion=True)
     step_width: float = option(GAIT.step_width, motion=True)
@@ -59,12 +59,12 @@ class BipedSimulation:
         from wbfriction.walking.options import GAITS
         from wbfriction.walking.quadruped import GAITS as QUADRUPED_GAITS
 
-        if self.gait is not None and self.gait not in GAITS:
+        if self.gait not in GAITS:
             raise InputError(f"--gait {self.gait}: a quadruped's gait; robot '{robot.name}' walks forward, sideways, "
                              "turning, both or combined" if self.gait in QUADRUPED_GAITS else
                              f"--gait {self.gait}: robot '{robot.name}' walks forward, sideways, turning, both or "
                              "combined")
-        return GaitOptions(gait=self.gait or GAIT.gait, steps=self.steps, step_length=self.step_length,
+        return GaitOptions(gait=self.gait, steps=self.steps, step_length=self.step_length,
                            step_width=self.step_width, turn_angle=self.turn_angle, lift_height=self.lift_height)
 
 

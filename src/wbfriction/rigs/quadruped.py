@@ -42,8 +42,8 @@ class QuadrupedSimulation(SensorsFileOptions):
         play: a three-feet stance ``excite`` wrote, played instead of a gait.
         substeps: physics steps per 2 ms period; None: 4 (8 playing a stance, :data:`PLAYED_SUBSTEPS`).
         foot_forces: the feet's force columns logged: none, normal or 3d.
-        gait: stand, step, trot (None: the default) or walk; duration [s] of gait (None: 8); excitation_seed: the
-            gait's swings and sway; speed: forward speed [m/s] (None: the gait's).
+        gait: stand, step, trot or walk; duration [s] of gait; speed: forward speed [m/s]; each None: the gait's
+            default (:class:`~wbfriction.walking.quadruped.GaitOptions`); excitation_seed: its swings and sway.
     """
 
     actuator: Optional[Literal["torque", "pd"]] = option(None)
@@ -125,7 +125,7 @@ class QuadrupedRig(Rig):
             raise InputError(f"{o.sensors}: delay: a walking quadruped's simulation has no measurement delay (its "
                              "drivers' is the robot's [pd] delay)")
         substeps = PLAYED_SUBSTEPS if o.substeps is None and o.play is not None else o.substeps
-        if (o.gait or "trot") not in GAITS:
+        if o.gait is not None and o.gait not in GAITS:
             raise InputError(f"--gait {o.gait}: robot '{robot.name}' stands on {robot.stands_on}: its gaits are "
                              f"{', '.join(GAITS)}")
         spec = None if o.friction is None else load_friction_spec(o.friction, robot.groups, robot.actuated)
@@ -146,8 +146,8 @@ class QuadrupedRig(Rig):
             progress.say(f"rebuilding the stance of {o.play.name} (its IK at every sample)")
             ref = played_tripod(robot, o.play)
             return ref, f"{robot.contact_frames[int(ref.contact[0].argmin())]} swung on three feet"
-        gait = GaitOptions(gait=o.gait or "trot", duration=8.0 if o.duration is None else o.duration,  # type: ignore[arg-type]
-                           speed=o.speed, seed=o.excitation_seed)  # type: ignore[arg-type]  # None: the gait's speed
+        given: dict[str, Any] = {"gait": o.gait, "duration": o.duration, "speed": o.speed}  # None: its default
+        gait = GaitOptions(seed=o.excitation_seed, **{k: v for k, v in given.items() if v is not None})
         progress.say(f"planning {gait.duration:g} s ({gait.gait})")
         return quadruped_reference(robot, gait), gait.gait
 
