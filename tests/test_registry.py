@@ -165,7 +165,8 @@ def test_a_broken_entry_point_fails_in_one_line_naming_it_and_its_package():
         with pytest.raises(EntryPointError, match="^the entry point 'lost = toys:Lost' of an unknown distribution "
                                                   "does not load: AttributeError: no Lost$"):
             registry.get("lost")
-        with pytest.raises(ValueError, match="^kind 'toy': advertised as 'liar' by the entry point toys:Toy$"):
+        with pytest.raises(EntryPointError, match="^the entry point 'liar = toys:Toy' of toy-kinds 0.1 does not load: "
+                                                  "its kind is named 'toy', not 'liar'$"):
             registry.get("liar")
         assert registry.loaded() == ()
 

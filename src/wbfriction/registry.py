@@ -11,15 +11,20 @@ What differs from one registry to the next is given when it is made: what its ki
 follows a registration (``on_register``, ``on_unregister``: a catalogue the help reads), and where kinds come from
 besides the calls: built-in kinds whose modules are imported when first named (``builtins``), and kinds installed
 packages advertise under an entry-point group (``entry_points``), read once, the first time the registry is asked,
-and each loaded when first named. An entry point that does not load fails in one line naming it and its distribution
-(:class:`EntryPointError`).
+and each loaded when first named. An entry point that does not give a valid kind of its name (its module missing or
+broken, its object another name's or refused by ``check``) is one line naming it and its distribution
+(:class:`EntryPointError`): raised where it is named, and, where every kind is asked for (:meth:`Registry.kinds`: a
+model chosen among every family), left out with that line as a :class:`PluginWarning` (said once; the command line
+prints it as its ``warning:`` line, :func:`one_line_warnings`), the others used.
 """
 
 from __future__ import annotations
 
 import copy
 import importlib
+import warnings
 from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any, Generic, Protocol, TypeVar
 
 from wbfriction.exceptions import WbfrictionError
@@ -40,13 +45,15 @@ K = TypeVar("K", bound=Named)
 
 
 class EntryPointError(WbfrictionError):
-    """An entry point an installed package advertises that does not load (its module missing or broken, its object
-    missing, or not callable without arguments): the environment, not the input.
+    """An entry point an installed package advertises that does not give a kind of its name (its module missing or
+    broken, its object missing or not callable without arguments, its kind another name's or not what the registry
+    holds): the environment, not the input.
 
     Attributes:
         entry_point: the entry point as its package declares it, ``name = module:object``.
         distribution: the package that advertises it (its name and version), or ``an unknown distribution``.
-        problem: what loading it raised, in one line (``ModuleNotFoundError: No module named 'x'``).
+        problem: what loading it raised, in one line (``ModuleNotFoundError: No module named 'x'``, ``its friction
+            family is named 'quadratic', not 'quad'``).
     """
 
     exit_status = 1
@@ -57,6 +64,30 @@ class EntryPointError(WbfrictionError):
 
     def __reduce__(self):  # picklable across worker processes, with its data
         return (type(self), (self.entry_point, self.distribution, self.problem))
+
+
+class PluginWarning(UserWarning):
+    """An entry point left out where every kind of its registry is asked for (:meth:`Registry.kinds`): its
+    :class:`EntryPointError`, one line, after the kind's name (``friction family 'quad' left out: the entry point
+    ...``)."""
+
+
+@contextmanager
+def one_line_warnings(say: Callable[[str], None]) -> Iterator[None]:
+    """Within it, each :class:`PluginWarning` is said by ``say`` as its one line (the command line's ``warning:``),
+    each time one is warned (the registry warns once per entry point); other warnings are shown as before."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", PluginWarning)
+        shown = warnings.showwarning
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if issubclass(category, PluginWarning):
+                say(str(message))
+            else:
+                shown(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = show
+        yield
 
 
 def distribution_of(ep: EntryPoint) -> str:
@@ -86,8 +117,6 @@ class Registry(Generic[K]):
         missing: the exception for a name not registered, from the name and the names that could be given instead
             (:meth:`get`: every name; :meth:`unregister`: those registered but built in); None: ``unknown``'s
             (:meth:`get`) or ``ValueError``'s (:meth:`unregister`), built from the message.
-        invalid: the exception for a kind of an entry point that is another name's, from its name and the problem
-            (``ValueError`` by default, ``"<what> '<name>': <problem>"``).
     """
 
     def __init__(self, what: str, precedence: Callable[[K], float] | None = None,
@@ -95,14 +124,16 @@ class Registry(Generic[K]):
                  check: Callable[[K], None] | None = None, on_register: Callable[[K], None] | None = None,
                  on_unregister: Callable[[str], None] | None = None, builtins: Mapping[str, str] | None = None,
                  entry_points: str | None = None,
-                 missing: Callable[[str, tuple[str, ...]], Exception] | None = None,
-                 invalid: Callable[[str, str], Exception] | None = None) -> None:
+                 missing: Callable[[str, tuple[str, ...]], Exception] | None = None) -> None:
         self.what, self.precedence, self.unknown, self.replace = what, precedence, unknown, replace
         self.check, self.on_register, self.on_unregister = check, on_register, on_unregister
         self.builtins: dict[str, str] = dict(builtins or {})
-        self.entry_points, self.missing, self.invalid = entry_points, missing, invalid
+        self.entry_points, self.missing = entry_points, missing
         self._kinds: dict[str, K] = {}
         self._advertised: dict[str, EntryPoint] | None = None
+        self._broken: dict[str, EntryPointError] = {}  # the entry points that gave no kind, by name
+        self._plugins: set[str] = set()  # the names of the kinds loaded from entry points
+        self._warned: set[str] = set()  # the entry points left out with a PluginWarning already
 
     def register(self, kind: K) -> K:
         """Register ``kind``; returns it.
@@ -161,8 +192,8 @@ class Registry(Generic[K]):
 
         Raises:
             the registry's ``unknown`` (or ``missing``) exception: none of that name (naming those there are).
-            EntryPointError: the entry point of that name does not load.
-            the registry's ``invalid`` exception: an entry point's kind that is another name's.
+            EntryPointError: the entry point of that name gives no kind of that name (it does not load, its kind is
+                another name's or refused by ``check``; each time it is named, loaded once).
         """
         kind = self._kinds.get(name)
         if kind is not None:
@@ -170,6 +201,9 @@ class Registry(Generic[K]):
         if name in self.builtins:
             importlib.import_module(self.builtins[name])
             return self._kinds[name]
+        broken = self._broken.get(name)
+        if broken is not None:  # raised anew from its data: one line, its traceback not grown by every ask
+            raise EntryPointError(broken.entry_point, broken.distribution, broken.problem)
         ep = self.advertised().get(name)
         if ep is not None:
             return self._load(name, ep)
@@ -189,38 +223,71 @@ class Registry(Generic[K]):
         return self._advertised
 
     def _load(self, name: str, ep: EntryPoint) -> K:
-        """The kind of the entry point ``ep``, advertised as ``name``, loaded and registered."""
+        """The kind of the entry point ``ep``, advertised as ``name``, loaded and registered; one that gives none (an
+        exception on the way, a kind of another name, one ``check`` or the registration refuses) kept aside
+        (:meth:`broken`) and raised as :class:`EntryPointError`, nothing registered."""
         try:
             loaded: Any = ep.load()
             kind = loaded() if isinstance(loaded, type) else loaded
+            named = getattr(kind, "name", None)
+            problem = (None if named == name else f"its {self.what} is named {named!r}, not '{name}'"
+                       if isinstance(named, str) else f"{type(kind).__name__} is no {self.what} (it has no name)")
+            if problem is None:
+                registered = self.register(kind)
+                self._plugins.add(name)
+                return registered
+            cause: Exception | None = None
         except Exception as exc:
-            problem = " ".join(f"{type(exc).__name__}: {exc}".split())
-            raise EntryPointError(f"{ep.name} = {ep.value}", distribution_of(ep), problem) from exc
-        if kind.name != name:
-            problem = f"advertised as '{name}' by the entry point {ep.value}"
-            if self.invalid is not None:
-                raise self.invalid(kind.name, problem)
-            raise ValueError(f"{self.what} '{kind.name}': {problem}")
-        return self.register(kind)
+            problem, cause = " ".join(f"{type(exc).__name__}: {exc}".split()), exc
+        error = self._broken[name] = EntryPointError(f"{ep.name} = {ep.value}", distribution_of(ep), problem)
+        raise error from cause
+
+    def _usable(self, name: str) -> K | None:
+        """The kind named ``name``, or None for an entry point that gives none: left out with one
+        :class:`PluginWarning` (the first time), its error kept aside (:meth:`broken`)."""
+        try:
+            return self.get(name)
+        except EntryPointError as exc:
+            if name not in self._warned:
+                self._warned.add(name)
+                warnings.warn(PluginWarning(f"{self.what} '{name}' left out: {exc}"), stacklevel=3)
+            return None
+
+    def broken(self) -> dict[str, EntryPointError]:
+        """The entry points tried so far that gave no kind (:class:`EntryPointError`), by name: the kinds
+        :meth:`kinds` leaves out."""
+        return dict(self._broken)
+
+    def reread(self) -> None:
+        """Read the entry points again the next time the registry is asked (a package installed or removed while the
+        program runs): the kinds loaded from the former ones unregistered, those that gave none forgotten."""
+        for name in self._plugins & set(self._kinds):
+            self.unregister(name)
+        self._plugins.clear()
+        self._broken.clear()
+        self._warned.clear()
+        self._advertised = None
 
     def _lazy(self) -> bool:
         """Whether kinds may be named before they are loaded (built-in modules, entry points)."""
         return bool(self.builtins) or self.entry_points is not None
 
     def kinds(self) -> tuple[K, ...]:
-        """The kinds, in the order they are asked in (each loaded)."""
+        """The kinds, in the order they are asked in (each loaded): an entry point that gives none left out, with one
+        :class:`PluginWarning` naming it and why (the first time)."""
         if self._lazy():
-            return tuple(self.get(n) for n in self.names())
+            return tuple(k for k in map(self._usable, self.names()) if k is not None)
         return tuple(self._kinds.values())
 
     def names(self) -> tuple[str, ...]:
-        """The kinds' names, in order, none loaded (but in precedence order, which loads them): the built-in ones,
-        those registered, those the entry points advertise."""
+        """The kinds' names, in order, none loaded (but in precedence order, which loads them, leaving out as
+        :meth:`kinds` does an entry point that gives none): the built-in ones, those registered, those the entry
+        points advertise."""
         if not self._lazy():
             return tuple(self._kinds)
         if self.precedence is not None:
             for n in (*self.builtins, *self.advertised()):
-                self.get(n)
+                self._usable(n)
             return tuple(self._kinds)
         return tuple(dict.fromkeys((*self.builtins, *self._kinds, *self.advertised())))
 
@@ -236,7 +303,8 @@ class Registry(Generic[K]):
     def copy(self) -> Registry[K]:
         """A registry of the same rules and kinds, changed on its own (what a test registers in and throws away)."""
         twin = copy.copy(self)
-        twin._kinds = dict(self._kinds)
+        twin._kinds, twin._broken = dict(self._kinds), dict(self._broken)
+        twin._plugins, twin._warned = set(self._plugins), set(self._warned)
         return twin
 
     def __contains__(self, name: object) -> bool:

@@ -26,6 +26,7 @@ from wbfriction.inertia.options import InertialOptions
 from wbfriction.logs.formats.catalog import table_formats
 from wbfriction.logs.options import LIMIT_MARGIN, MAX_GAP, MAX_GAP_LEAST
 from wbfriction.model.robots import BUILTIN_ROBOTS
+from wbfriction.registry import one_line_warnings
 from wbfriction.signals.options import NOISE_TARGET, FilterOptions
 from wbfriction.sim.options import IdealOptions, MujocoOptions
 from wbfriction.version import __version__
@@ -296,13 +297,15 @@ def overview(ctx: typer.Context,
 
 def main() -> None:
     """Entry point: run the app, turning wbfriction errors into one line and their exit status (2 for
-    the input, 1 for the environment: an output the system refused to write, a cluster gone;
-    :attr:`~wbfriction.exceptions.WbfrictionError.exit_status`). Interruptions (Ctrl-C, SIGTERM)
+    the input, 1 for the environment: an output the system refused to write, a cluster gone, a plugin that does not
+    load; :attr:`~wbfriction.exceptions.WbfrictionError.exit_status`), and a plugin left out (a
+    :class:`~wbfriction.registry.PluginWarning`) into a ``warning:`` line. Interruptions (Ctrl-C, SIGTERM)
     are :mod:`wbfriction.entry`'s, which calls this."""
     try:
         from wbfriction.pipeline.paths import refuse_empty_outputs
         refuse_empty_outputs(sys.argv[1:])  # -o "": Path("") is the working folder
-        status = app(standalone_mode=False)
+        with one_line_warnings(lambda line: warn([line])):  # a plugin left out: one line naming it
+            status = app(standalone_mode=False)
     except WbfrictionError as exc:
         console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
         sys.exit(exc.exit_status)

@@ -23,6 +23,7 @@ from wbfriction.fit.solve import fitted_rows, stick_speed
 from wbfriction.fit.term_selection import fit_terms, refit_terms
 from wbfriction.fit.terms import TermFit, term_signals
 from wbfriction.friction.estimated import FrictionEstimate
+from wbfriction.friction.families.registry import families
 from wbfriction.friction.models import (
     ModelName,
     ModelParams,
@@ -60,7 +61,11 @@ def _column_tasks(joints, qd: np.ndarray, tau_f: np.ndarray, valid: np.ndarray, 
                   stick_margin: int | None, still: ModelName | None = None,
                   pass_rows: float = PASS_ROWS, score_slow: bool = True,
                   stick_floor: float = STICK_FLOOR) -> list[tuple]:
-    """One :func:`_fit_column` task per joint (:func:`fit_joints`'s arguments)."""
+    """One :func:`_fit_column` task per joint (:func:`fit_joints`'s arguments). With ``auto``, its candidates (every
+    family) are loaded here, before the joints are fitted side by side: a plugin that gives none left out once, its
+    one line said in this process (:meth:`~wbfriction.registry.Registry.kinds`)."""
+    if AUTO in models:
+        families()
     noise = noise or {}
     tasks = []
     for i, joint in enumerate(joints):
@@ -300,8 +305,6 @@ def _with_fallbacks(fits: list[FitResult], tasks: list[tuple], others: Sequence[
     the data better carries its whole distance), so that a fit the data prefer another curve to is not ``ok`` on
     its tight statistical errors (on the project's crawl with 3-D foot forces, a hip's Coulomb-viscous fit was
     ``ok`` 15 % and 79 % off F_c and F_v beside a (3.5) fit 15 % and 16 % off, ``weak``)."""
-    from wbfriction.friction.families.registry import families
-
     simplest = families()[0].name
     wanted = [k for k, f in enumerate(fits)
               if f.verdict().status not in NO_FALLBACK and not (f.model == simplest and f.kept_terms is None)]

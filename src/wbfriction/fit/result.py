@@ -327,12 +327,13 @@ class FitResult(Generic[ParamsT]):
     def error_percent(self) -> dict[str, float] | None:
         """Relative error of each parameter against :attr:`target` [%] (Tables 6.1, 6.2); for a
         model other than the target's, against the target's values under its names
-        (:meth:`~wbfriction.friction.families.params.ModelParamsBase.values_in`)."""
+        (:meth:`~wbfriction.friction.families.params.ModelParamsBase.values_in`): a parameter the target has no
+        counterpart of (a plugin family's own, fitted to a built-in family's truth) is left out, none made up."""
         if self.params is None or self.target is None:
             return None
         target = self.target.values_in(self.model)
         out = {}
-        for name in self.params.names:
+        for name in (n for n in self.params.names if n in target):
             t, p = target[name], getattr(self.params, name)
             out[name] = 100.0 * abs(p - t) / abs(t) if t != 0 else float("nan")
         return out

@@ -79,11 +79,13 @@ def validate(fam: Any) -> None:
 
 FAMILIES: Registry[Any] = Registry(
     "friction family", replace=True, check=validate, builtins={n: module_of(n) for n in BUILTIN_NAMES},
-    entry_points=ENTRY_POINT_GROUP, missing=UnknownFamilyError, invalid=InvalidFamily)
+    entry_points=ENTRY_POINT_GROUP, missing=UnknownFamilyError)
 """The friction families (each a :class:`~wbfriction.friction.families.base.FrictionFamily`) by name: the built-in
 ones (simplest first, each loaded when first used), those registered
 (:func:`~wbfriction.friction.families.registry.register_family`: a family of the same name replaced, a definition
-that does not hold together refused), those installed packages advertise (each loaded when first named)."""
+that does not hold together refused), those installed packages advertise (each loaded when first named; one that
+gives no valid family of its name is one line, :class:`~wbfriction.registry.EntryPointError`, left out of ``auto``'s
+candidates with that line as a warning)."""
 
 
 def family_names() -> tuple[str, ...]:
@@ -93,11 +95,18 @@ def family_names() -> tuple[str, ...]:
 
 
 def check_family(name: str, option: str = "model", also: Sequence[str] = ()) -> str:
-    """``name`` if it is a family's (or one of ``also``, e.g. ``auto``), without loading the family.
+    """``name`` if it is a family's (or one of ``also``, e.g. ``auto``), without loading a built-in family; a family
+    an installed package advertises is loaded (what it needs imported), so that one that does not load fails here,
+    before any work.
 
     Raises:
         UnknownFamilyError: naming ``option``, the name and those known (``also`` first).
+        EntryPointError: the entry point of that name gives no valid family of its name
+            (:class:`~wbfriction.registry.EntryPointError`: one line naming it and its package).
     """
-    if name in also or name in FAMILIES:
+    if name in also or name in FAMILIES.builtins or name in FAMILIES.loaded():
+        return name
+    if name in FAMILIES:
+        FAMILIES.get(name)  # an entry point's family
         return name
     raise UnknownFamilyError(name, (*also, *family_names()), option)

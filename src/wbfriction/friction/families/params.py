@@ -50,15 +50,18 @@ class ModelParamsBase:
         raise NotImplementedError
 
     def values_in(self, model: str) -> dict[str, float]:
-        """These parameters under the names of ``model``'s (:meth:`quantities`), e.g. an injected friction of one
-        family against a fit of another.
+        """These parameters under the names of ``model``'s, e.g. an injected friction of one family against a fit of
+        another: of this family, its own values; of another, those of its names that :meth:`quantities` has (a
+        parameter only ``model`` has, such as a plugin's ``F_q``, has no counterpart here and is left out: no truth
+        for it, rather than one made up).
 
         Raises:
             UnknownFamilyError: no family named ``model``.
-            KeyError: a parameter of ``model`` that is not one of :data:`ALL_PARAM_NAMES`.
         """
+        if model == self.model:
+            return {n: getattr(self, n) for n in self.names}
         q = self.quantities()
-        return {n: q[n] for n in FAMILIES.get(model).names}
+        return {n: q[n] for n in FAMILIES.get(model).names if n in q}
 
     def to_target(self) -> dict[str, float | str]:
         """These parameters and their family's name, as a simulator's ``friction_true`` metadata holds them
