@@ -13,6 +13,7 @@ is a property over every way an entry point can fail, anywhere among good ones.
 from __future__ import annotations
 
 import json
+import math
 import re
 import sys
 import warnings
@@ -222,3 +223,19 @@ def test_reread_forgets_the_entry_points_loaded_and_broken():
         registry.reread()
         assert registry.loaded() == ("own",) and registry.broken() == {}
         assert [k.name for k in registry.kinds()] == ["own", "b"]
+
+
+def test_a_truth_is_compared_under_the_names_it_has(plugins):
+    """A fit of the guide's family against a built-in family's truth: its ``F_q`` has no counterpart there (left
+    out); against a truth of its own family, every parameter as it is; a built-in fit against the guide's truth,
+    every name (the guide's ``quantities()`` gives them all)."""
+    from guide_friction.quadratic import QuadraticParams
+
+    from wbfriction.friction.models import FrictionParams
+
+    guide = QuadraticParams(F_v=0.3, F_q=0.02, F_c=2.0, tau_os=0.1)
+    thesis = FrictionParams(F_v=0.5, F_c=1.0, S=0.3, v_s=0.05, a=40.0, tau_os=0.1)
+    assert thesis.values_in("quadratic") == {"F_v": 0.5, "F_c": 1.0, "tau_os": 0.1}
+    assert guide.values_in("quadratic") == {"F_v": 0.3, "F_q": 0.02, "F_c": 2.0, "tau_os": 0.1}
+    against = guide.values_in("thesis")
+    assert math.isnan(against.pop("v_s")) and against == {"F_v": 0.3, "F_c": 2.0, "S": 0.0, "a": 50.0, "tau_os": 0.1}

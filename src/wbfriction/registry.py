@@ -178,6 +178,7 @@ class Registry(Generic[K]):
                 raise self.missing(name, registered)
             raise ValueError(f"no {self.what} named '{name}' (registered: {', '.join(registered)})")
         kind = self._kinds.pop(name)
+        self._plugins.discard(name)
         if self.on_unregister is not None:
             self.on_unregister(name)
         return kind
@@ -226,17 +227,17 @@ class Registry(Generic[K]):
         """The kind of the entry point ``ep``, advertised as ``name``, loaded and registered; one that gives none (an
         exception on the way, a kind of another name, one ``check`` or the registration refuses) kept aside
         (:meth:`broken`) and raised as :class:`EntryPointError`, nothing registered."""
+        cause: Exception | None = None
         try:
             loaded: Any = ep.load()
             kind = loaded() if isinstance(loaded, type) else loaded
             named = getattr(kind, "name", None)
-            problem = (None if named == name else f"its {self.what} is named {named!r}, not '{name}'"
-                       if isinstance(named, str) else f"{type(kind).__name__} is no {self.what} (it has no name)")
-            if problem is None:
+            if named == name:
                 registered = self.register(kind)
                 self._plugins.add(name)
                 return registered
-            cause: Exception | None = None
+            problem = (f"its {self.what} is named {named!r}, not '{name}'" if isinstance(named, str)
+                       else f"{type(kind).__name__} is no {self.what} (it has no name)")
         except Exception as exc:
             problem, cause = " ".join(f"{type(exc).__name__}: {exc}".split()), exc
         error = self._broken[name] = EntryPointError(f"{ep.name} = {ep.value}", distribution_of(ep), problem)
