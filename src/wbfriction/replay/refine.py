@@ -459,11 +459,11 @@ def write_refined(model: str | Path, refinement: Refinement, robot: Robot, outpu
 
 
 def not_ok_lines(refinement: Refinement) -> list[str]:
-    """One line per refined value whose status is not ``ok``: ``"<joint> <value> <v> ± <se> <unit>: <status>"``, in
-    the robot's order, then the delay's (``not refined`` is no finding against it, and has none)."""
+    """One line per refined value whose status is not ``ok``: ``"<joint> <value> <v> ± <se> <unit>: <status>
+    (<reason>)"``, in the robot's order, then the delay's (``not refined`` is no finding against it, and has none)."""
+    why = refinement.reason or tuple(("",) * len(refinement.joints) for _ in PARAMETERS)
     lines = [f"{joint} {name} {refinement.value[k, j]:.4g} ± {refinement.stderr[k, j]:.2g} {UNITS[name]}: "
-             f"{refinement.status[k][j]}" + (f" ({refinement.reason[k][j]})" if refinement.reason and refinement.reason[k][j]
-                                            else "")
+             f"{refinement.status[k][j]}" + (f" ({why[k][j]})" if why[k][j] else "")
              for j, joint in enumerate(refinement.joints) for k, name in enumerate(PARAMETERS)
              if refinement.status[k][j] != "ok"]
     if refinement.delay_status not in ("ok", "not refined"):
