@@ -174,7 +174,7 @@ def test_a_delay_at_its_bound_leaves_no_value_ok(case, tmp_path):
     short.write_text(spec.to_xml())
     r = refine_mjcf(short, robot, sim.table, Replay(timestep=STEP, horizon=0.25), times=(0.0, 0.5))
     assert r.delay == pytest.approx(0.006) and r.delay_status == "at bound"
-    assert np.isfinite(r.stderr[:3]).all()  # four windows: the variances are estimated, the rule decides
+    assert np.isfinite(r.stderr[:3]).all()  # two windows: the variances are estimated, the rule decides
     assert {s for row in r.status for s in row} <= {"at bound", "not excited"}
     assert all("fitted under a delay at the search's bound (6 ms" in why for row in r.reason for why in row
                if why.startswith(("armature", "F_")))
