@@ -16,6 +16,11 @@ statuses (:mod:`wbfriction.fit.status`):
 * **weak** (F_c and the offset): the joint moved one way (the windows faster than
   :data:`~wbfriction.fit.status.MIN_SPEED` the other way fewer than :data:`~wbfriction.fit.status.MIN_REVERSE`):
   its Coulomb friction and its offset's torque are then one column but for those few windows.
+
+A drive's constant torque (``tau_os``, what ``refine`` moves in an exported MJCF: :mod:`wbfriction.replay.refine`)
+is judged as the offset: a constant torque, one column with F_c on a joint that moved one way, anywhere within
+``±F_c`` on one held still. ``refine`` takes the same windows of its stretch's logged angles
+(:func:`stretch_motion`).
 """
 
 from __future__ import annotations
@@ -24,12 +29,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wbfriction.actuator.options import WINDOW
 from wbfriction.actuator.rows import BalanceRows
 from wbfriction.fit.status import MIN_REVERSE, MIN_SPEED, reverse_share
 
-NOT_EXCITED = ("armature", "F_v", "F_c", "offset")
+NOT_EXCITED = ("armature", "F_v", "F_c", "offset", "tau_os")
 """The parameters a joint that hardly moved does not determine."""
-ONE_WAY = ("F_c", "offset")
+ONE_WAY = ("F_c", "offset", "tau_os")
 """The parameters a joint that moved one way does not separate."""
 
 
@@ -65,12 +71,24 @@ class JointMotion:
 
 def joint_motion(rows: BalanceRows) -> tuple[JointMotion, ...]:
     """Each joint's :class:`JointMotion` over its usable windows (module docstring)."""
-    out = []
-    for j in range(len(rows.joints)):
-        speed = rows.speed[rows.usable[:, j], j]
-        if len(speed) == 0:
-            out.append(JointMotion(0.0, 0.0))
-            continue
-        moving = speed[np.abs(speed) >= MIN_SPEED]
-        out.append(JointMotion(float(np.percentile(np.abs(speed), 95)), reverse_share(moving) if len(moving) else 0.0))
-    return tuple(out)
+    return tuple(window_motion(rows.speed[rows.usable[:, j], j]) for j in range(len(rows.joints)))
+
+
+def window_motion(speed: np.ndarray) -> JointMotion:
+    """One joint's :class:`JointMotion` from its windows' mean speeds ``speed`` (W,) [rad/s]; not excited without
+    a window."""
+    if len(speed) == 0:
+        return JointMotion(0.0, 0.0)
+    moving = speed[np.abs(speed) >= MIN_SPEED]
+    return JointMotion(float(np.percentile(np.abs(speed), 95)), reverse_share(moving) if len(moving) else 0.0)
+
+
+def stretch_motion(time: np.ndarray, q: np.ndarray, window: float = WINDOW) -> tuple[JointMotion, ...]:
+    """Each joint's :class:`JointMotion` over a stretch of a log, its ``time`` (N,) [s] and logged angles ``q``
+    (N, n) [rad]: cut into whole windows of ``window`` [s] (in samples, at the median period, as the balance's
+    rows cut a log), each window's ``Delta q / Delta t``; a stretch shorter than one window is not excited."""
+    period = float(np.median(np.diff(time))) if len(time) > 1 else np.inf
+    m = max(1, int(round(window / period))) if np.isfinite(period) and period > 0 else len(time)
+    ends = np.arange((len(time) - 1) // m + 1) * m
+    speed = (q[ends[1:]] - q[ends[:-1]]) / (time[ends[1:]] - time[ends[:-1]])[:, None]
+    return tuple(window_motion(speed[:, j]) for j in range(q.shape[1]))

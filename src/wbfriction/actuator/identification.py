@@ -418,13 +418,15 @@ def held_out_rms(rows: BalanceRows, offsets: bool, weight: np.ndarray, options: 
     return np.sqrt(np.bincount(test.joint, weights=e**2, minlength=n) / np.maximum(used, 1))
 
 
-def parameter_status(kind: str, value: float, se: float, crb: float, at_bound: bool) -> tuple[ActuatorStatus, str]:
+def parameter_status(kind: str, value: float, se: float, crb: float, at_bound: bool,
+                     reference: float | None = None) -> tuple[ActuatorStatus, str]:
     """A parameter's status, the first that applies: ``not excited`` (its bound is infinite: the data do not
     determine it), ``at bound`` (left on a bound of the search: an offset at ``--offset-bound``, or an armature at
     zero, which a rotor never has), ``weak`` (a standard error or bound above :data:`~wbfriction.fit.status.WEAK`
-    of its value; for an offset, above :data:`OFFSET_WEAK`, or the offset itself beyond :data:`OFFSET_PLAUSIBLE`),
+    of its value, or of ``reference`` where given (a drive's constant torque ``tau_os`` against the larger of it
+    and F_c [N·m]); for an offset, above :data:`OFFSET_WEAK`, or the offset itself beyond :data:`OFFSET_PLAUSIBLE`),
     ``ok``."""
-    unit = UNITS[kind]
+    unit = {**UNITS, "tau_os": "N·m"}[kind]
     if not np.isfinite(crb):
         return "not excited", f"{kind}: the log does not determine it"
     if at_bound or (kind == "armature" and value <= 0):
@@ -437,10 +439,47 @@ def parameter_status(kind: str, value: float, se: float, crb: float, at_bound: b
         if worst > OFFSET_WEAK:
             return "weak", f"offset ±{worst:.2g} rad (more than {OFFSET_WEAK:g})"
         return "ok", ""
-    if not np.isfinite(worst) or worst > WEAK * abs(value):
-        rel = worst / abs(value) if value else np.inf
+    scale = abs(value) if reference is None else abs(reference)
+    if not np.isfinite(worst) or worst > WEAK * scale:
+        rel = worst / scale if scale else np.inf
         return "weak", f"{kind} ±{rel:.0%}" if np.isfinite(rel) else f"{kind} not determined"
     return "ok", ""
+
+
+def delay_status(delay: float, se: float, top: float, period: float, crb: float | None = None
+                 ) -> tuple[ActuatorStatus, str]:
+    """The drivers' delay's status, the first that applies: ``not excited`` (an infinite bound ``crb``, or without
+    one an infinite standard error ``se`` [s]: the set-points do not determine it), ``at bound`` (at zero or at the
+    search's longest, ``top`` [s]), ``weak`` (a standard error above :data:`~wbfriction.fit.status.WEAK` of it and
+    above a log ``period`` [s], or infinite), ``ok``. ``identify --actuator pd``'s and ``refine``'s."""
+    if not np.isfinite(se if crb is None else crb):
+        return "not excited", "the set-points do not determine it"
+    if delay <= 0 or delay >= top - 1e-12:
+        return "at bound", f"at the search's bound ({delay * 1e3:.3g} ms; --max-delay)"
+    if not np.isfinite(se) or se > max(WEAK * delay, period):
+        return "weak", f"±{se * 1e3:.2g} ms"
+    return "ok", ""
+
+
+def fitted_under(delay: Identified, top: float, bound: str = "--max-delay") -> str:
+    """Why every value fitted under the delay ``delay`` is not ``ok`` where it is at the search's longest ``top``
+    [s], what sets it named by ``bound`` (round 4: the delay may be longer, and the values then hold what it
+    leaves), "" otherwise."""
+    if delay.status == "at bound" and delay.value >= top - 1e-12:
+        return f"fitted under a delay at the search's bound ({delay.value * 1e3:.3g} ms; {bound})"
+    return ""
+
+
+def judged(p: Identified, kind: str, motion: JointMotion | None, under: str = "") -> Identified:
+    """``p`` (of ``kind``) demoted by what its data do not determine (round 4's rule, ``identify``'s and
+    ``refine``'s alike): what its joint's ``motion`` does not excite (:meth:`~wbfriction.actuator.excitation.
+    JointMotion.verdict`), then a delay at its search's bound (``under``: :func:`fitted_under`'s reason)."""
+    by_motion = motion.verdict(kind) if motion is not None else None
+    if by_motion is not None:
+        p = _demoted(p, by_motion[0], by_motion[1])  # type: ignore[arg-type]
+    if under:
+        p = _demoted(p, "at bound", f"{kind}: {under}")
+    return p
 
 
 def _result(rows: BalanceRows, d: Design, sol: Solution, delay: Identified, profile: np.ndarray, held: np.ndarray,
@@ -479,16 +518,7 @@ def _delay_value(search: DelaySearch, rows: BalanceRows, sol: Solution, options:
     se = float(1.0 / np.sqrt(search.curvature)) if search.curvature > 0 else np.inf
     crb = se / scale if np.isfinite(se) and scale > 0 else np.inf
     se = max(float(np.hypot(se, moved)), crb) if np.isfinite(crb) else se  # with the nuisance model's sensitivity
-    top = (rows.max_steps + 1) * rows.period
-    status: ActuatorStatus
-    if not np.isfinite(se):
-        status, reason = "not excited", "the set-points do not determine it"
-    elif search.delay <= 0 or search.delay >= top - 1e-12:
-        status, reason = "at bound", f"at the search's bound ({search.delay * 1e3:.3g} ms; --max-delay)"
-    elif se > max(WEAK * search.delay, rows.period):
-        status, reason = "weak", f"±{se * 1e3:.2g} ms"
-    else:
-        status, reason = "ok", ""
+    status, reason = delay_status(search.delay, se, (rows.max_steps + 1) * rows.period, rows.period)
     return Identified(search.delay, se, crb, status, reason)
 
 
@@ -506,21 +536,10 @@ def _verdicts(result: ActuatorIdentification, motion: tuple[JointMotion, ...], m
     changes no status: it cannot tell the drivers' gains from the URDF's masses (:mod:`wbfriction.actuator.
     law_check`)."""
     d = result.delay
-    top = (max_steps + 1) * result.period
-    under = (f"fitted under a delay at the search's bound ({d.value * 1e3:.3g} ms; --max-delay)"
-             if d.status == "at bound" and d.value >= top - 1e-12 else "")
+    under = fitted_under(d, (max_steps + 1) * result.period)
     law = None if under else result.law  # a law checked under a wrong delay says nothing of the gains
-    joints = []
-    for j, m in zip(result.joints, motion):
-        values = {}
-        for kind, p in j.parameters().items():
-            by_motion = m.verdict(kind)
-            if by_motion is not None:
-                p = _demoted(p, by_motion[0], by_motion[1])  # type: ignore[arg-type]
-            if under:
-                p = _demoted(p, "at bound", f"{kind}: {under}")
-            values[kind] = p
-        joints.append(j.with_values(values))
+    joints = [j.with_values({kind: judged(p, kind, m, under) for kind, p in j.parameters().items()})
+              for j, m in zip(result.joints, motion)]
     lines = law.lines() if law is not None else []
     if under:
         lines.insert(0, f"the drivers' delay is beyond the search ({d.value * 1e3:.3g} ms, its bound): raise "

@@ -30,14 +30,28 @@ phase): refining the values at the file's delay alone leaves the file's delay er
 MuJoCo's friction: F_v 30-40 % low at the identified 16 ms, within 2 % at the 12 ms profiled). The values are then
 solved once more with each joint's weight its refined RMS.
 
-**Standard errors.** The sandwich of the weighted errors (:func:`wbfriction.actuator.solve.sandwich`): their
-products summed over the samples with Bartlett weights up to one window apart (a window's error is one rollout's,
-correlated over its length), each variance the least squares' or larger, the delay's column (central differences of
-one timestep) beside the values'. A value's status
-(:func:`~wbfriction.actuator.identification.parameter_status`): ``at bound`` on its floor of zero where the error
-presses it there, ``weak`` where its standard error is above :data:`~wbfriction.fit.status.WEAK` of it (for
-``tau_os``: of the larger of it and ``F_c``), ``not excited`` where the replay does not determine it; the delay
-``at bound`` at zero or at the longest the history holds.
+**Standard errors.** Each window is one rollout restarted from the log: the windows' errors are independent draws
+(the restart resets the error), a window's correlated over its length. The sandwich of the weighted errors
+(:func:`wbfriction.actuator.solve.sandwich`) sums each window's scores (cluster-robust: Cameron and Miller, "A
+Practitioner's Guide to Cluster-Robust Inference", 2015), each variance the least squares' or larger, the delay's
+column (central differences of one timestep) beside the values'. At the optimum the ``G`` windows' scores sum to
+zero: the variance has ``G - 1`` degrees of freedom, and the standard errors are put on the normal scale
+(:func:`window_scale`: ``sqrt(G / (G - 1))`` and ``t_{G-1}``'s quantile over the normal's; 1.9 at four windows, 1.14
+at fourteen); a stretch of one window (``horizon=None``, or a stretch no longer than ``horizon``) estimates no
+variance, and its standard errors are infinite. A solve stopped by its budget (:data:`MAX_REPLAYS`) has the values'
+remaining Gauss-Newton step (how far they would still move) added in quadrature.
+
+**Statuses** are ``identify --actuator pd``'s, by the same functions (:func:`judged_value`): a value's own
+(:func:`~wbfriction.actuator.identification.parameter_status`): ``not excited`` where the replay does not depend on
+it, ``at bound`` on its floor of zero where the error presses it there, ``weak`` where its standard error is above
+:data:`~wbfriction.fit.status.WEAK` of it (for ``tau_os``: of the larger of it and ``F_c``) or infinite; then what
+the stretch does not determine (:func:`~wbfriction.actuator.identification.judged`): a joint that hardly moved over
+the stretch leaves its values ``not excited``, one that moved one way its F_c and ``tau_os`` ``weak``
+(:func:`~wbfriction.actuator.excitation.stretch_motion`: the balance's windows of the logged angles), and a delay
+at the longest the file's history holds leaves every value fitted under it ``at bound`` (the delay may be longer,
+and the values then hold what it leaves). The delay's own status is
+:func:`~wbfriction.actuator.identification.delay_status`'s: ``at bound`` at zero or at the history's longest,
+``weak`` with a standard error above :data:`~wbfriction.fit.status.WEAK` of it and a log period.
 
 **What it is not.** The refined values are MuJoCo's: they make this file track, including what the file does
 otherwise than the robot (its timestep, its soft friction constraint, its implicit damping, a delay in another form
@@ -63,11 +77,13 @@ from typing import Any
 import numpy as np
 import pyarrow as pa
 
-from wbfriction.actuator.identification import parameter_status
+from wbfriction.actuator.excitation import JointMotion, stretch_motion
+from wbfriction.actuator.identification import Identified, fitted_under, judged, parameter_status
+from wbfriction.actuator.identification import delay_status as identified_delay_status
 from wbfriction.actuator.solve import sandwich
 from wbfriction.exceptions import InputError
 from wbfriction.export.drive import HOLD_EDGE
-from wbfriction.fit.status import WEAK
+from wbfriction.fit.block_spread import t_scale
 from wbfriction.model.robot import Robot
 from wbfriction.replay.mjcf import Replay, ReplayModel, load_replay
 from wbfriction.replay.rollout import LogSetpoints, read_log_setpoints, stretch_rows
@@ -101,6 +117,8 @@ class Refinement:
         delay: the refined delay [s] (:func:`delay_grid`'s best).
         delay_se: its standard error [s] (nan where not refined).
         delay_status: its status; ``not refined`` where :func:`delay_grid` is empty, ``at bound`` at the grid's end.
+        reason: why each value is not ``ok`` (4 tuples of n; "" where it is), as :attr:`status`; empty for a
+            refinement built without them.
     """
 
     joints: tuple[str, ...]
@@ -118,6 +136,7 @@ class Refinement:
     delay: float
     delay_se: float
     delay_status: str
+    reason: tuple[tuple[str, ...], ...] = ()
 
     def table(self) -> pa.Table:
         """A row per joint and value: ``joint``, ``parameter`` (:data:`PARAMETERS`, then ``delay``, each joint's
@@ -313,7 +332,7 @@ def _least_squares(problem: _Problem, x: np.ndarray, delay: float | None, weight
 def _refinement(problem: _Problem, x0: np.ndarray, d0: float, sol: _Solution, delay: float | None,
                 rms0: np.ndarray, grid: np.ndarray, replays: int, seconds: float) -> Refinement:
     """The refinement's values, their standard errors (the delay's column by central differences of one timestep
-    beside the values' Jacobian, in one sandwich) and statuses."""
+    beside the values' Jacobian, in one sandwich of the windows: module docstring) and statuses."""
     start, stop = problem.rows
     n = problem.robot.n_act
     jac, x = sol.jac, sol.x
@@ -324,19 +343,59 @@ def _refinement(problem: _Problem, x0: np.ndarray, d0: float, sol: _Solution, de
         jac = np.hstack([jac, (column.ravel() / (high - low))[:, None]])
         replays += 2
     shot = stop - start if problem.horizon is None else max(1, int(round(problem.horizon / problem.period)))
-    cov = sandwich(jac, sol.fun, np.repeat(np.arange(stop - start), n), lags=shot)
-    se_all = np.sqrt(np.diag(cov))
-    se = se_all[:4 * n].reshape(4, n)
-    delay_se = float(se_all[-1]) if delay is not None else float("nan")
+    window = np.arange(stop - start) // shot  # each row's window: one rollout restarted from the log
+    bound = np.sqrt(np.diag(sandwich(jac, sol.fun, np.repeat(window, n), lags=0)))  # inf: not determined
+    scale = window_scale(int(window[-1]) + 1)
+    se = np.hypot(scale * bound[:4 * n], _remaining(sol)).reshape(4, n)
+    delay_se = float(scale * bound[-1]) if delay is not None else float("nan")
     rms = np.sqrt(np.mean((sol.fun.reshape(stop - start, n) / sol.weight) ** 2, axis=0))
+    under = ""
     if delay is None:
         delay, delay_status = d0, "not refined"
-    elif delay in (float(grid[0]), float(grid[-1])):
-        delay_status = "at bound"
     else:
-        delay_status = parameter_status("delay", delay, delay_se, delay_se, False)[0]
-    return Refinement(problem.robot.actuated, x0, x, se, _statuses(x, se, sol.at_floor), rms0, rms, (start, stop),
-                      replays, seconds, sol.converged, d0, delay, delay_se, delay_status)
+        delay_status = identified_delay_status(delay, delay_se, float(grid[-1]), problem.period, float(bound[-1]))[0]
+        under = fitted_under(Identified(delay, delay_se, float(bound[-1]), delay_status), float(grid[-1]),
+                             "the longest the file's actuator history holds, its nsample")
+    motion = stretch_motion(problem.data.time[start:stop], problem.data.q[start:stop])
+    judged = [[judged_value(kind, x[k, j], se[k, j], bound[k * n + j], sol.at_floor[k, j], x[1, j], motion[j], under)
+               for j in range(n)] for k, kind in enumerate(PARAMETERS)]
+    return Refinement(problem.robot.actuated, x0, x, se, tuple(tuple(p.status for p in row) for row in judged), rms0,
+                      rms, (start, stop), replays, seconds, sol.converged, d0, delay, delay_se, delay_status,
+                      tuple(tuple(p.reason for p in row) for row in judged))
+
+
+def window_scale(windows: int) -> float:
+    """The factor on a sandwich's standard errors from ``windows`` independent windows (module docstring):
+    ``sqrt(G / (G - 1))`` (its scores sum to zero at the optimum: ``G - 1`` degrees of freedom) times ``t_{G-1}``'s
+    97.5 % quantile over the normal's (:func:`~wbfriction.fit.block_spread.t_scale`), inf below two windows (no
+    variance to estimate)."""
+    if windows < 2:
+        return float("inf")
+    return float(np.sqrt(windows / (windows - 1)) * t_scale(windows))
+
+
+def _remaining(sol: _Solution) -> np.ndarray:
+    """How far each value (4 n,) would still move [its unit]: the Gauss-Newton step from where the solve stopped
+    (the values off their floor), zero where it converged; what a solve stopped by its budget
+    (:data:`MAX_REPLAYS`) leaves undetermined."""
+    free = ~sol.at_floor.ravel()
+    step = np.zeros(sol.jac.shape[1])
+    if free.any():
+        step[free] = np.linalg.lstsq(sol.jac[:, free], sol.fun, rcond=None)[0]
+    return np.abs(step)
+
+
+def judged_value(kind: str, value: float, se: float, bound: float, at_floor: bool, f_c: float,
+                 motion: JointMotion, under: str) -> Identified:
+    """One refined value's status by ``identify --actuator pd``'s rule
+    (:func:`~wbfriction.actuator.identification.parameter_status`, then
+    :func:`~wbfriction.actuator.identification.judged`): its standard error ``se`` and ``bound`` (the sandwich's,
+    inf where the replay does not depend on it), its floor of zero, ``tau_os`` against the larger of it and the
+    joint's ``f_c`` [N·m], what the joint's ``motion`` over the stretch does not excite, a delay at its bound
+    (``under``)."""
+    reference = max(abs(value), f_c) if kind == "tau_os" else None
+    status, reason = parameter_status(kind, float(value), float(se), float(bound), bool(at_floor), reference)
+    return judged(Identified(float(value), float(se), float(bound), status, reason), kind, motion, under)
 
 
 def _scales(x0: np.ndarray) -> np.ndarray:
@@ -346,23 +405,6 @@ def _scales(x0: np.ndarray) -> np.ndarray:
     kind[3] = max(kind[3], kind[1])
     kind = np.where(kind > 0, kind, 1.0)
     return np.repeat(kind[:, None], x0.shape[1], axis=1)
-
-
-def _statuses(x: np.ndarray, se: np.ndarray, at_floor: np.ndarray) -> tuple[tuple[str, ...], ...]:
-    rows = []
-    for k, kind in enumerate(PARAMETERS):
-        row = []
-        for j in range(x.shape[1]):
-            if kind == "tau_os":
-                scale = max(abs(x[k, j]), x[1, j])
-                status = ("not excited" if not np.isfinite(se[k, j]) else
-                          "weak" if se[k, j] > WEAK * scale else "ok")
-            else:
-                status = parameter_status(kind, float(x[k, j]), float(se[k, j]), float(se[k, j]),
-                                          bool(at_floor[k, j]))[0]
-            row.append(status)
-        rows.append(tuple(row))
-    return tuple(rows)
 
 
 def write_refined(model: str | Path, refinement: Refinement, robot: Robot, output: str | Path,
@@ -417,10 +459,11 @@ def write_refined(model: str | Path, refinement: Refinement, robot: Robot, outpu
 
 
 def not_ok_lines(refinement: Refinement) -> list[str]:
-    """One line per refined value whose status is not ``ok``: ``"<joint> <value> <v> ± <se> <unit>: <status>"``, in
-    the robot's order, then the delay's (``not refined`` is no finding against it, and has none)."""
+    """One line per refined value whose status is not ``ok``: ``"<joint> <value> <v> ± <se> <unit>: <status>
+    (<reason>)"``, in the robot's order, then the delay's (``not refined`` is no finding against it, and has none)."""
+    why = refinement.reason or tuple(("",) * len(refinement.joints) for _ in PARAMETERS)
     lines = [f"{joint} {name} {refinement.value[k, j]:.4g} ± {refinement.stderr[k, j]:.2g} {UNITS[name]}: "
-             f"{refinement.status[k][j]}"
+             f"{refinement.status[k][j]}" + (f" ({why[k][j]})" if why[k][j] else "")
              for j, joint in enumerate(refinement.joints) for k, name in enumerate(PARAMETERS)
              if refinement.status[k][j] != "ok"]
     if refinement.delay_status not in ("ok", "not refined"):
