@@ -19,6 +19,10 @@ the rest of the body follows from them (:mod:`wbfriction.walking.single_support`
 of every actuated joint. A quadruped standing on three point feet (``excite --swing``) says the foot lifted
 (``swing``: its contact frame's name; the three others stand) and the base's height above the ground
 (``base_height`` [m]), its series the swing leg's (:mod:`wbfriction.walking.tripod_support`).
+
+The reader checks the table as ``identify`` checks a log, before anything is played: a table whose ``robot`` is
+another's (two robots of one class share their joints' names: a Go2's design on an Aliengo) is refused, naming both;
+so is a ``q_des`` beyond its joint's limits (:func:`~wbfriction.logs.angles.check_limits`: degrees for radians).
 """
 
 from __future__ import annotations
