@@ -140,7 +140,8 @@ def test_what_a_three_feet_stance_does_not_take_is_one_line(capsys, go2, tmp_pat
         assert code == 2 and line in " ".join(err.split()), (args, err)
     # a table of every Go2 joint, but not a three-feet stance's: no swing foot, no series; and motion options
     n = 10
-    columns = {"time": np.arange(n) / 500.0, **{f"q_des.{j}": np.zeros(n) for j in go2.actuated}}
+    columns = {"time": np.arange(n) / 500.0,  # standing: within the joints' limits (a calf at 0 is beyond them)
+               **{f"q_des.{j}": np.full(n, a) for j, a in zip(go2.actuated, go2.reference_angles)}}
     path = tmp_path / "plain.parquet"
     write_table(with_metadata(pa.table(columns), {"generator": "wbfriction.excite", "robot": go2.name}), path)
     assert read_metadata(pq.read_table(path)).get("swing") is None

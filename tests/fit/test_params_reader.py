@@ -10,6 +10,8 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from helpers import run_cli, said
 from term_params import JOINT, RANGES, edited, params_file, table_file, term_fit
@@ -100,3 +102,53 @@ def test_every_command_refuses_it_in_one_line_before_any_work(good, tmp_path, ca
     assert code == 2 and len(lines) == 1, err
     assert f"{bad}: joint '{JOINT}': " in lines[0] and needle in lines[0], err
     assert out is None or not out.exists()
+
+
+def _numbers(doc, key=()):
+    """The key paths of every number in a JSON document (not the booleans)."""
+    if isinstance(doc, dict):
+        return [p for k, v in doc.items() for p in _numbers(v, (*key, k))]
+    if isinstance(doc, list):
+        return [p for i, v in enumerate(doc) for p in _numbers(v, (*key, i))]
+    return [key] if isinstance(doc, (int, float)) and not isinstance(doc, bool) else []
+
+
+@pytest.fixture(scope="module")
+def rich(tmp_path_factory):
+    """A parameters file as ``fit`` writes it, with terms, standard errors, ranges and a covariance."""
+    path = params_file(tmp_path_factory.mktemp("rich") / "params.json", term_fit())
+    doc = json.loads(path.read_text())
+    doc["joints"][JOINT]["covariance"] = np.diag([4e-6, 1e-4, 1e-6]).tolist()
+    path.write_text(json.dumps(doc))
+    read_params(path)  # it reads back
+    return path, _numbers(doc["joints"][JOINT])
+
+
+@settings(max_examples=40, deadline=None)
+@given(data=st.data(), value=st.sampled_from([float("nan"), float("inf"), float("-inf"), "NaN", "nan", "-inf"]))
+def test_a_value_that_is_not_finite_is_refused_whatever_its_key(rich, tmp_path_factory, data, value):
+    """Round 5 (class 8): a parameters file whose ``speed`` is NaN read back ``ok`` (the verdict compares the speed
+    with its floor: NaN compares false); only the model's parameters were held finite. Every number of a joint's
+    entry, as ``NaN``, an infinity or a string spelling one, is refused in one line naming the file, the joint and
+    the key (``fit`` writes ``null`` where a value is not finite)."""
+    good, paths = rich
+    key = data.draw(st.sampled_from(paths))
+    path = tmp_path_factory.mktemp("nan") / "params.json"
+    doc = json.loads(good.read_text())
+    entry = doc["joints"][JOINT]
+    for k in key[:-1]:
+        entry = entry[k]
+    entry[key[-1]] = value
+    path.write_text(json.dumps(doc))
+    with pytest.raises(InputError) as err:
+        read_params(path)
+    shown = "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in key)[1:]
+    assert str(err.value).startswith(f"{path}: joint '{JOINT}': {shown} is "), (key, err.value)
+    assert "\n" not in str(err.value)
+
+
+def test_a_nan_speed_is_not_read_back_ok(good):
+    """The case of round 5: ``speed`` NaN (what Python's json writes for a float NaN)."""
+    bad = edited(good, _set("speed", value=float("nan")))
+    with pytest.raises(InputError, match=f"joint '{JOINT}': speed is nan: not a finite number"):
+        read_params(bad)

@@ -4,6 +4,8 @@ file and the column."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -26,7 +28,7 @@ def go2():
 def test_what_is_written_is_read_back(go2, tmp_path_factory, n, rate, seed, suffix, velocity):
     rng = np.random.default_rng(seed)
     time = np.arange(n) / rate
-    q_des, qd_des = rng.normal(size=(n, go2.n_act)), rng.normal(size=(n, go2.n_act)) * velocity
+    q_des, qd_des = _valid_table(go2, n, seed)[1], rng.normal(size=(n, go2.n_act)) * velocity
     path = tmp_path_factory.mktemp("sp") / f"design{suffix}"
     write_table(setpoint_table(go2.name, go2.actuated, time, q_des, qd_des), path)
     read = read_setpoint_table(path, go2)
@@ -38,7 +40,7 @@ def test_what_is_written_is_read_back(go2, tmp_path_factory, n, rate, seed, suff
 
 def test_a_table_that_cannot_be_played_is_refused_naming_its_column(go2, tmp_path):
     time = np.arange(10) / 200.0
-    q = np.zeros((10, go2.n_act))
+    q = _valid_table(go2, 10, 0)[1]
     table = setpoint_table(go2.name, go2.actuated, time, q, q)
     path = tmp_path / "d.parquet"
     write_table(table.drop_columns([f"q_des.{go2.actuated[3]}"]), path)
@@ -58,7 +60,7 @@ def test_a_table_that_cannot_be_played_is_refused_naming_its_column(go2, tmp_pat
 def test_a_stances_series_and_foot_are_read_back(go2, tmp_path, suffix):
     """A one-foot stance's table (``excite --stance``): the series of some joints only, named, and the foot."""
     time = np.arange(10) / 1000.0
-    q = np.zeros((10, go2.n_act))
+    q = _valid_table(go2, 10, 0)[1]
     series = {"center": [0.1, -0.2], "a": [[0.3, 0.4], [0.5, 0.6]], "b": [[0.0, 0.1], [0.2, 0.3]], "omega": 1.5}
     joints = (go2.actuated[2], go2.actuated[5])
     path = tmp_path / f"stance{suffix}"
@@ -85,7 +87,7 @@ def test_a_three_feet_stances_swing_foot_and_height_are_read_back(tmp_path, suff
     height, which the stance needs to be rebuilt."""
     go2 = wbfriction.load_robot("go2_walking")
     time = np.arange(10) / 500.0
-    q = np.zeros((10, go2.n_act))
+    q = _valid_table(go2, 10, 0)[1]
     series = {"center": [0.1], "a": [[0.3]], "b": [[0.2]], "omega": 1.5}
     path = tmp_path / f"tripod{suffix}"
     write_table(setpoint_table(go2.name, go2.actuated, time, q, q, series, fourier_joints=go2.actuated[3:4],
@@ -98,3 +100,62 @@ def test_a_three_feet_stances_swing_foot_and_height_are_read_back(tmp_path, suff
         write_table(setpoint_table(go2.name, go2.actuated, time, q, q, swing=swing, base_height=height), path)
         with pytest.raises(InputError, match=line.replace("(", r"\(")):
             read_setpoint_table(path, go2)
+
+
+def _valid_table(robot, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(time, q_des)``: ``n`` set-points within the joints' limits (encoder coordinates), at 500 Hz."""
+    rng = np.random.default_rng(seed)
+    lower, upper = robot.angle_limits
+    middle, half = (lower + upper) / 2, (upper - lower) / 2
+    return np.arange(n) / 500.0, middle + 0.9 * half * rng.uniform(-1, 1, (n, robot.n_act)) + robot.offset_vector
+
+
+def _first_beyond(robot, q: np.ndarray) -> tuple[str, int]:
+    """The first column (the robot's order) with a value beyond its limits by more than the margin, and its row."""
+    lower, upper = robot.angle_limits
+    for i, j in enumerate(robot.actuated):
+        off = robot.encoder_offset.get(j, 0.0)
+        out = np.flatnonzero((q[:, i] < lower[i] + off - 0.2) | (q[:, i] > upper[i] + off + 0.2))
+        if out.size:
+            return f"q_des.{j}", int(out[0])
+    raise AssertionError("nothing beyond the limits")
+
+
+@settings(max_examples=25, deadline=None)
+@given(factor=st.one_of(st.sampled_from([180 / np.pi, 1000.0, 0.0, 1 / (2 * np.pi)]), st.floats(4.0, 1e4),
+                        st.floats(0.0, 0.2)),
+       n=st.integers(2, 40), seed=st.integers(0, 2**16), suffix=st.sampled_from([".parquet", ".csv"]))
+def test_set_points_in_other_units_are_refused_naming_the_column_and_the_robot(go2, tmp_path_factory, factor, n, seed,
+                                                                               suffix):
+    """Round 5 (class 4): set-points in degrees drove a calf to -129 rad and wrote a log ``identify`` refused. A table
+    within the joints' limits reads; the same scaled by a factor no unit of angle makes plausible (degrees,
+    milliradians, turns: x4 and beyond, x0.2 and below put the Go2's calves beyond their limits) is refused as
+    ``identify`` refuses a log's, in one line naming the file, the first column beyond its limits, the row and the
+    robot."""
+    time, q = _valid_table(go2, n, seed)
+    path = tmp_path_factory.mktemp("units") / f"design{suffix}"
+    write_table(setpoint_table(go2.name, go2.actuated, time, q, np.zeros_like(q)), path)
+    np.testing.assert_array_equal(read_setpoint_table(path, go2).q_des, q)
+    write_table(setpoint_table(go2.name, go2.actuated, time, factor * q, np.zeros_like(q)), path)
+    column, row = _first_beyond(go2, factor * q)
+    with pytest.raises(ColumnError) as err:
+        read_setpoint_table(path, go2)
+    assert (err.value.column, err.value.row) == (column, row), err.value
+    line = str(err.value)
+    assert line.startswith(f"{path}: column '{column}' is ") and f"at row {row}, beyond its limits" in line
+    assert "wrong units" in line and "robot 'go2'" in line and "\n" not in line
+
+
+def test_a_table_made_for_another_robot_is_refused_naming_both(go2, tmp_path):
+    """Round 5 (class 4): a Go2's design played on the Aliengo (the same joints' names, the table's metadata says
+    ``go2``). The robot a table was made for is its metadata's; a table that records none (written by hand) is
+    played on any robot with its joints."""
+    time, q = _valid_table(go2, 10, 0)
+    path = tmp_path / "go2.parquet"
+    write_table(setpoint_table(go2.name, go2.actuated, time, q, q * 0), path)
+    aliengo = dataclasses.replace(go2, name="aliengo")
+    with pytest.raises(InputError, match=f"^{path}: set-points made for robot 'go2' \\(its metadata\\), not for "
+                                         "robot 'aliengo': play them on 'go2'"):
+        read_setpoint_table(path, aliengo)
+    write_table(setpoint_table(go2.name, go2.actuated, time, q, q * 0).replace_schema_metadata(None), path)
+    np.testing.assert_array_equal(read_setpoint_table(path, aliengo).q_des, q)

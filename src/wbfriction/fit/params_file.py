@@ -29,6 +29,7 @@ have written. ``tests/fit/test_roundtrip.py`` fits many tables and reads every f
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -248,11 +249,37 @@ def write_params(path: str | Path, fits: Iterable[FitResult], header: Mapping[st
     write_json(path, {**(header or {}), "joints": joints})
 
 
+def not_finite(doc: Any, key: str = "") -> tuple[str, Any] | None:
+    """The first value of a JSON document ``doc`` that is a number but not finite, and its key (``a.b[2].c``), or
+    None: a ``NaN``, ``Infinity`` or ``-Infinity`` (which JSON does not have and Python writes), a number too large
+    for a float (``1e999``), or a string that spells one (``"nan"``, ``"inf"``). No file the package writes holds
+    one (:func:`~wbfriction.logs.tables.finite_json` writes ``null``, its meaning the key's), whatever its key."""
+    if isinstance(doc, dict):
+        items: Iterable[tuple[str, Any]] = ((f"{key}.{k}" if key else str(k), v) for k, v in doc.items())
+    elif isinstance(doc, list):
+        items = ((f"{key}[{i}]", v) for i, v in enumerate(doc))
+    else:
+        if isinstance(doc, float) and not math.isfinite(doc):
+            return key, doc
+        if isinstance(doc, str):
+            try:
+                return (key, doc) if not math.isfinite(float(doc)) else None
+            except ValueError:
+                return None
+        return None
+    for k, v in items:
+        if (found := not_finite(v, k)) is not None:
+            return found
+    return None
+
+
 def read_params(path: str | Path) -> dict[str, FitResult]:
     """Fitted parameters written by :func:`write_params` (``wbfriction fit``, the demo), by joint name.
 
     Raises:
-        InputError: a file that is not such JSON (named with the key at fault).
+        InputError: a file that is not such JSON (named with the key at fault); a value that is a number but not
+            finite, whatever its key (:func:`not_finite`: ``fit`` writes ``null`` there), naming the file, the joint
+            and the key.
     """
     path = Path(path)
     if not path.is_file():
@@ -264,8 +291,14 @@ def read_params(path: str | Path) -> dict[str, FitResult]:
     joints = doc.get("joints") if isinstance(doc, dict) else None
     if not isinstance(joints, dict):
         raise InputError(f"{path}: no 'joints' object: not a parameter file from 'wbfriction fit'")
+    if (bad := not_finite({k: v for k, v in doc.items() if k != "joints"})) is not None:
+        raise InputError(f"{path}: {bad[0]} is {bad[1]!r}: not a finite number ('fit' writes null there)")
     out = {}
     for joint, d in joints.items():
+        where = f"{path}: joint '{joint}': "
+        if (bad := not_finite(d)) is not None:
+            raise InputError(f"{where}{bad[0]} is {bad[1]!r}: not a finite number ('fit' writes null where a value is "
+                             "not finite)")
         try:
             out[joint] = fit_from_dict(joint, d)
         except (InputError, AttributeError) as exc:

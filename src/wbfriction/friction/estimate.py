@@ -41,7 +41,7 @@ from wbfriction.friction.options import METHODS, EstimateOptions, Route
 from wbfriction.friction.point_contacts import point_contact_estimate
 from wbfriction.logs.log import Log
 from wbfriction.logs.torque import torque_record
-from wbfriction.model.dynamics import constrained_dynamics
+from wbfriction.model.dynamics import check_contact_patterns, constrained_dynamics
 from wbfriction.model.rerooted import stance_frame_pose, stance_model
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
@@ -293,10 +293,12 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
     the noise the fit reads (``noise``, :func:`~wbfriction.friction.noise.noise_record`).
 
     Raises:
-        InputError: what :func:`~wbfriction.signals.kinematics.measure` and :func:`estimate_friction`
-            raise (no segment can be estimated; with ``require_single_support``, no
-            single-support sample in the whole log).
+        InputError: contacts on the ground together that the robot's contact models make redundant
+            (:func:`~wbfriction.model.dynamics.check_contact_patterns`: a sole on a point foot); what
+            :func:`~wbfriction.signals.kinematics.measure` and :func:`estimate_friction` raise (no segment can be
+            estimated; with ``require_single_support``, no single-support sample in the whole log).
     """
+    check_contact_patterns(robot, log.contact, log.source)  # before any work: the KKT route's matrix singular
     positions, changes = longest_stretch(log)
     decision = decide_log(robot, options, positions, log.dt, segments=log.segments, rows=len(log.time),
                           source=log.source, route_rows=len(log.time),  # the whole log's rows: module docstring

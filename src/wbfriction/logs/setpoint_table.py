@@ -19,6 +19,10 @@ the rest of the body follows from them (:mod:`wbfriction.walking.single_support`
 of every actuated joint. A quadruped standing on three point feet (``excite --swing``) says the foot lifted
 (``swing``: its contact frame's name; the three others stand) and the base's height above the ground
 (``base_height`` [m]), its series the swing leg's (:mod:`wbfriction.walking.tripod_support`).
+
+The reader checks the table as ``identify`` checks a log, before anything is played: a table whose ``robot`` is
+another's (two robots of one class share their joints' names: a Go2's design on an Aliengo) is refused, naming both;
+so is a ``q_des`` beyond its joint's limits (:func:`~wbfriction.logs.angles.check_limits`: degrees for radians).
 """
 
 from __future__ import annotations
@@ -30,7 +34,9 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError, InputError
+from wbfriction.logs.angles import check_limits
 from wbfriction.logs.metadata import read_metadata, with_metadata
+from wbfriction.logs.options import LIMIT_MARGIN
 from wbfriction.logs.tables import numeric_column, numeric_columns, read_table
 from wbfriction.model.robot import Robot
 
@@ -103,13 +109,22 @@ def read_setpoint_table(path: str | Path, robot: Robot) -> SetpointTable:
 
     Raises:
         ColumnError: no ``time`` column, a joint's ``q_des`` column missing or not finite, a ``qd_des`` column
-            for some joints only, times not evenly spaced from 0.
-        InputError: fewer than two rows; Fourier coefficients of another number of joints than they name (all
+            for some joints only, times not evenly spaced from 0; a ``q_des`` beyond the joint's limits by more
+            than :data:`~wbfriction.logs.options.LIMIT_MARGIN` (degrees for radians: what ``identify`` refuses of
+            a log, :func:`~wbfriction.logs.angles.check_limits`), naming the column, the row and the robot.
+        InputError: a table made for another robot (its metadata's ``robot`` is not ``robot``'s name), naming
+            both; fewer than two rows; Fourier coefficients of another number of joints than they name (all
             the robot's where they name none), or of a joint the robot has not; a stance not ``left`` or
             ``right``; a swing foot not one of the robot's contact frames, or without a base height > 0.
     """
     source = str(path)
     table = read_table(path)
+    meta = read_metadata(table, source)
+    made = meta.get("robot")
+    if made is not None and made != robot.name:  # two robots of one class share their joints' names
+        raise InputError(f"{source}: set-points made for robot '{made}' (its metadata), not for robot "
+                         f"'{robot.name}': play them on '{made}', or design the motion for '{robot.name}' "
+                         f"(wbfriction excite --robot {robot.name})")
     for col in ("time", *(f"q_des.{j}" for j in robot.actuated)):
         if col not in table.column_names:
             raise ColumnError(source, col, None, f"missing column '{col}': robot '{robot.name}' plays time and "
@@ -126,6 +141,10 @@ def read_setpoint_table(path: str | Path, robot: Robot) -> SetpointTable:
         raise ColumnError(source, "time", row, f"row {row} of column 'time': set-points start at 0 and are evenly "
                           f"spaced (a rate of {rate:g} Hz)")
     q_des = numeric_columns(table, [f"q_des.{j}" for j in robot.actuated], source)
+    try:  # a set-point in degrees drives the joint to its limits (a calf to -129 rad), as a log's does
+        check_limits(q_des, robot, source, LIMIT_MARGIN, 0, "q_des")
+    except ColumnError as exc:
+        raise ColumnError(source, exc.column, exc.row, f"{exc.problem} (robot '{robot.name}')") from None
     velocity = [f"qd_des.{j}" for j in robot.actuated]
     there = [c in table.column_names for c in velocity]
     if any(there) and not all(there):
@@ -133,7 +152,6 @@ def read_setpoint_table(path: str | Path, robot: Robot) -> SetpointTable:
         raise ColumnError(source, missing, None, f"missing column '{missing}': qd_des.* is given for some joints "
                           "only; give it for every one, or for none")
     qd_des = numeric_columns(table, velocity, source) if all(there) else np.zeros_like(q_des)
-    meta = read_metadata(table, source)
     fourier, stance = meta.get("fourier"), meta.get("stance")
     series: tuple[str, ...] = ()
     if fourier is not None:

@@ -35,6 +35,7 @@ from typing import SupportsIndex
 import numpy as np
 import pinocchio as pin
 
+from wbfriction.exceptions import InputError
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
 
@@ -188,3 +189,84 @@ def constrained_dynamics(robot: Robot, angles: np.ndarray, qd: np.ndarray, qdd_m
         if progress is not None:
             progress(len(rows))
     return ConstrainedDynamics(qdd_est, Mmod_inv, q_all, v_all)
+
+
+@dataclass(frozen=True)
+class RedundantContacts:
+    """Contacts whose constraints are redundant at every posture (:func:`redundant_contacts`).
+
+    Attributes:
+        frames: the contact frames on the ground.
+        models: their contact models' names (``contact_model`` in the robot's TOML), in order.
+        constraints: the rows of the stacked constraint Jacobian ``[J_c; S_pc]`` (the contacts' and the
+            position-controlled joints').
+        rank: its rank at a generic posture (:func:`redundant_contacts`), below ``constraints``.
+    """
+
+    frames: tuple[str, ...]
+    models: tuple[str, ...]
+    constraints: int
+    rank: int
+
+
+def redundant_contacts(robot: Robot, flags: np.ndarray) -> RedundantContacts | None:
+    """Whether the contacts ``flags`` (n_contacts,) bool on the ground together are redundant constraints: their
+    stacked Jacobian (each contact model's, :meth:`~wbfriction.model.contacts.ContactModel.jacobian`, and a row per
+    position-controlled joint) of rank below its rows at a generic posture (joint angles drawn uniformly within their
+    limits, ±π where there are none, with a fixed seed: the rank almost every posture has, and no posture more), hence
+    at every posture. Then ``J_c M^-1 J_c^T`` is singular at every sample, the contact forces are not determined,
+    and the KKT route (5.10) cannot be solved: the robot's contact models do not fit its feet (a sole, six
+    constraints, on a foot that touches at a point: three or four of a quadruped's 3-DoF legs so held are 18 or 24
+    constraints on 15 or 18 degrees of freedom; two of one side, whose hips turn about one line, 12 of rank 11).
+    None where they are not (or none is down). Memoised on the robot per pattern.
+    """
+    key = ("redundant contacts", np.asarray(flags, dtype=bool).tobytes())
+    if key in robot.cache:
+        return robot.cache[key]
+    active = np.flatnonzero(flags)
+    found = None
+    if active.size:
+        lower, upper = robot.angle_limits
+        rng = np.random.default_rng(0)
+        angles = rng.uniform(np.where(np.isfinite(lower), lower, -np.pi), np.where(np.isfinite(upper), upper, np.pi))
+        model, data = robot.model, robot.model.createData()
+        pin.computeJointJacobians(model, data, robot.configuration(angles))
+        pin.updateFramePlacements(model, data)
+        rows = [robot.contact_models[c].jacobian(robot, data, robot.contact_frame_ids[c]) for c in active]
+        S_pc = np.zeros((len(robot.pc_index), model.nv))
+        S_pc[np.arange(len(robot.pc_index)), robot.act_v_index[robot.pc_index]] = 1.0
+        J = np.vstack([*rows, S_pc])
+        rank = int(np.linalg.matrix_rank(J))
+        if rank < J.shape[0]:
+            found = RedundantContacts(tuple(robot.contact_frames[c] for c in active),
+                                      tuple(robot.contact_models[c].name for c in active), J.shape[0], rank)
+    robot.cache[key] = found
+    return found
+
+
+def check_contact_patterns(robot: Robot, contact: np.ndarray, source: str) -> None:
+    """Refuse a log whose contact flags ``contact`` (N, n_contacts) put on the ground together contacts that are
+    redundant constraints of the robot's contact models (:func:`redundant_contacts`), before any work: the KKT route
+    would end in a singular matrix. Only a robot whose contacts each fix its base (the KKT route's, not
+    :attr:`Robot.partial_contacts <wbfriction.model.robot.Robot.partial_contacts>`, whose determination is asked
+    sample by sample) is checked.
+
+    Raises:
+        InputError: one line naming ``source``, the first row of such a pattern, its frames, the robot's
+            ``contact_model`` and the rank.
+    """
+    if not robot.floating_base or robot.partial_contacts or not len(contact):
+        return
+    flags = np.asarray(contact, dtype=bool)
+    codes, first = np.unique(flags @ (1 << np.arange(flags.shape[1], dtype=np.int64)), return_index=True)
+    for k in np.argsort(first):
+        found = redundant_contacts(robot, flags[first[k]])
+        if found is not None:
+            held = len(robot.pc_index)
+            models = ", ".join(dict.fromkeys(found.models))
+            raise InputError(
+                f"{source}: row {int(first[k])} has {', '.join(found.frames)} on the ground: robot '{robot.name}''s "
+                f"contact_model ({models}) makes them {found.constraints} constraints"
+                + (f" (with {held} position-controlled joints)" if held else "")
+                + f" of rank {found.rank} at any posture: redundant, their forces not determined (contact_model = "
+                "\"point\" for feet that touch the ground at a point)")

@@ -35,6 +35,7 @@ from wbfriction.logs.log import log_from_table
 from wbfriction.logs.options import ReadOptions
 from wbfriction.logs.source import LogSource, open_log
 from wbfriction.logs.tables import TableFile, read_metadata, scratch_folder, with_metadata, write_tables
+from wbfriction.model.dynamics import check_contact_patterns
 from wbfriction.model.loading import RobotSpec
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import (
@@ -220,7 +221,8 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
             (:meth:`~wbfriction.pipeline.chunks.Chunking.processes`). The table is the same.
 
     Raises:
-        InputError: what reading, validating and estimating raise, naming the file and row;
+        InputError: what reading, validating and estimating raise, naming the file and row (contacts the robot's
+            contact models make redundant, :func:`~wbfriction.model.dynamics.check_contact_patterns`, before any chunk);
             an output in no format that streams (:func:`~wbfriction.logs.formats.format_to_stream`); a log that
             leaves no valid sample (:func:`no_valid_sample`). Nothing is written then.
     """
@@ -231,6 +233,7 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
     file = TableFile(path)
     plan = plan_columns(file, robot, source, read)
     contact, clock, first = plan.contact, plan.clock, plan.first_positions
+    check_contact_patterns(robot, contact, source)  # before any chunk: the KKT route's matrix singular
     changes = None
     if first is not None:  # the noise is measured on one segment: a gap between two recordings is no noise
         a, b = longest_segment(clock.segments, len(first))
