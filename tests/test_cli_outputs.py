@@ -69,8 +69,8 @@ def test_an_output_of_a_suffix_its_kind_is_not_written_as_is_refused_before_any_
     code, out, err = run_cli_printed(capsys, command, option, path, *ARGUMENTS[command], *required)
     lines = err.strip().splitlines()
     assert code == 2 and len(lines) == 1, err
-    said = f"'{suffix.lower()}'" if suffix else "no suffix"
-    assert lines[0].startswith(f"error: {option} {path}: ") and lines[0].endswith(f", not {said}"), err
+    said = f", not '{suffix.lower()}'" if suffix else f", and '{path.name}' has no suffix"
+    assert lines[0].startswith(f"error: {option} {path}: ") and lines[0].endswith(said), err
     assert all(s in lines[0] for s in accepted)
     assert not path.exists() and out == ""
 

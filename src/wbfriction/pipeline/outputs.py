@@ -64,8 +64,8 @@ class OutputSuffixError(OptionError):
     def __init__(self, option: str, value: str, suffix: str, what: str, accepted: tuple[str, ...]):
         self.option, self.value, self.suffix, self.what, self.accepted = option, value, suffix, what, accepted
         self.expected = f"{what} named {spoken(accepted)}"
-        said = f"'{suffix}'" if suffix else "no suffix"
-        super(OptionError, self).__init__(f"{option} {value}: {what} is written as {spoken(accepted)}, not {said}")
+        said = f"not '{suffix}'" if suffix else f"and '{Path(value).name}' has no suffix"
+        super(OptionError, self).__init__(f"{option} {value}: {what} is written as {spoken(accepted)}, {said}")
 
     def __reduce__(self):  # picklable across worker processes, with its data
         return (type(self), (self.option, self.value, self.suffix, self.what, self.accepted))
@@ -91,7 +91,7 @@ unregister_output = OUTPUTS.unregister
 for _builtin in (
         OutputKind("table", "a table", written),
         OutputKind("text-table", "a table with text columns", lambda: written(text=True)),
-        OutputKind("streamed-table", "a table written as it is made", lambda: written(streamed=True)),
+        OutputKind("streamed-table", "a streamed table", lambda: written(streamed=True)),
         OutputKind("export", "an export", _targets),
         OutputKind("mjcf", "a MuJoCo model", _target("mjcf")),
         OutputKind("urdf", "a URDF", _target("urdf")),
@@ -116,7 +116,8 @@ def check_output(option: str, path: str | Path, kind: str) -> None:
         kind: the registered kind of document it is (:data:`OUTPUTS`).
 
     Raises:
-        OutputSuffixError: ``-o x.txt: a table is written as .parquet, .pq, ... or .npz, not '.txt'``.
+        OutputSuffixError: ``-o x.txt: a table is written as .parquet, .pq, ... or .npz, not '.txt'`` (a name without
+            a suffix: ``..., and 'x' has no suffix``).
     """
     found = output_kind(kind)
     suffix = Path(path).suffix.lower()
