@@ -197,8 +197,9 @@ def test_a_nan_force_read_through_a_map_is_not_no_contact(talos, walk, tmp_path,
 def test_an_output_that_is_the_input_is_refused(walk, walk_friction, tmp_path, capsys, command):
     source = tmp_path / ("log.parquet" if command == "estimate" else "friction.parquet")
     source.write_bytes((walk if command == "estimate" else walk_friction).read_bytes())
+    # fit's and report's outputs are no table: the friction table's name is refused by its suffix, before the paths
     _refused(capsys, tmp_path, [source], (command, source, "-o", tmp_path / ".." / tmp_path.name / source.name),
-             "is the input")
+             "is the input" if command == "estimate" else "not '.parquet'")
 
 
 # ----------------------------------------------------------------- 4./5./8. hangs, tracebacks, misleading messages
@@ -218,7 +219,9 @@ def test_bad_tables_and_paths_get_one_line(walk, tmp_path, capsys):
     cases.append(((tmp_path / "dup.csv", "-o", out), f"column '{names[1].strip(chr(34))}' appears 2 times"))
     (tmp_path / "folder").mkdir()
     cases.append(((tmp_path / "folder", "-o", out), "is a folder, not a table file"))
-    cases.append(((walk, "-o", tmp_path / "folder"), "-o " + str(tmp_path / "folder") + ": is a folder"))
+    (tmp_path / "folder.parquet").mkdir()  # a folder named as a table
+    named = tmp_path / "folder.parquet"
+    cases.append(((walk, "-o", named), f"-o {named}: is a folder"))
     cases.append(((walk, "-o", tmp_path / "none" / "x.parquet"), "does not exist"))
     for option, value in (("--chunk-rows", "0"), ("--chunk-rows", "-5"), ("--workers", "-1"), ("--lift-off", "nan"),
                           ("--max-gap", "0"), ("--ds-regularization", "-1"), ("--limit-margin", "-1")):

@@ -149,13 +149,14 @@ VALUES = {
     "driver_noise": ["--driver-noise", "none"], "velocity_noise": ["--velocity-noise", "0.01"],
     "speed": ["--speed", "0.1"], "foot_forces": ["--foot-forces", "3d"], "play": ["--play", "FILE"],
     # identify's
-    "output": ["-o", "OUT"], "json_output": ["--json", "OUT"], "stribeck_velocity": ["--stribeck-velocity", "0.1"],
+    "output": ["-o", "OUT.urdf"], "json_output": ["--json", "OUT.json"],
+    "stribeck_velocity": ["--stribeck-velocity", "0.1"],
     "passes": ["--passes", "1"], "holdout": ["--holdout", "0.3"], "stride": ["--stride", "2"],
     "prior": ["--prior", "10"], "armature": ["--armature", "identify"], "link_margin": ["--link-margin", "0.1"],
     "prior_tolerance": ["--prior-tolerance", "0.1"], "noise_target": ["--noise-target", "10"],
     "tanh_slope": ["--tanh-slope", "50"], "diff": ["--diff", "central"], "mask": ["--mask", "single"],
     "route": ["--route", "momentum"], "base_motion": ["--base-motion", "logged"], "workers": ["--workers", "1"],
-    "time_unit": ["--time-unit", "ms"], "config_output": ["--config-output", "OUT"], "wide": ["--wide"],
+    "time_unit": ["--time-unit", "ms"], "config_output": ["--config-output", "OUT.toml"], "wide": ["--wide"],
     "max_delay": ["--max-delay", "0.03"], "window": ["--window", "0.05"], "offset_bound": ["--offset-bound", "0.1"],
     "velocity": ["--velocity", "positions"], "delayed": ["--delayed", "torque"],
 }
@@ -167,7 +168,7 @@ SIMULATE_MODES = {  # the mode's command line, and the values its own options ta
     "mujoco": (["--robot", "talos", "--simulator", "mujoco"], {"gait": ["--gait", "forward"],
                                                                "simulator": ["--simulator", "mujoco"]}),
 }
-IDENTIFY_MODES = {"none": ["-o", "OUT"], "pd": ["--actuator", "pd"]}
+IDENTIFY_MODES = {"none": ["-o", "OUT.urdf"], "pd": ["--actuator", "pd"]}
 
 
 def _options(command: str, shared: tuple[str, ...]) -> list[str]:
@@ -176,7 +177,7 @@ def _options(command: str, shared: tuple[str, ...]) -> list[str]:
 
 def _argv(fragment: list[str], tmp_path) -> list[str]:
     (tmp_path / "FILE").touch()
-    return [str(tmp_path / a) if a in ("FILE", "OUT") else a for a in fragment]
+    return [str(tmp_path / a) if a == "FILE" or a.startswith("OUT") else a for a in fragment]
 
 
 class Accepted(InputError):

@@ -237,3 +237,40 @@ def test_the_help_lists_the_registered_targets_and_formats(tmp_path):
     assert export.returncode == 0 and simulate.returncode == 0, (export.stderr, simulate.stderr)
     assert f"{FrictionCsv.suffixes[0]} ({FrictionCsv.description})" in " ".join(export.stdout.split())
     assert Feather.suffixes[0] in simulate.stdout
+
+
+def effort_table(robot, extra: dict[str, pa.Array]) -> pa.Table:
+    """A still log of ``robot`` whose torque is the toy source's (``effort.<joint>`` [mN·m]), with ``extra`` columns
+    (a column of the same name replaced)."""
+    n = 50
+    columns = {"time": pa.array(np.arange(n) * 1e-3)}
+    columns |= {f"q.{j}": pa.array(np.zeros(n)) for j in robot.actuated}
+    columns |= {f"effort.{j}": pa.array(np.full(n, 100.0)) for j in robot.torque_controlled}
+    return pa.table(columns | extra)
+
+
+def test_the_schema_checks_a_registered_torque_source_s_columns_as_a_built_in_s(effort, tmp_path):
+    """The guide's torque source registered (``docs/extending.md``: ``effort.<joint>``): a column of it naming no
+    joint of the robot is refused, naming it, as ``tau.<joint>`` would be; one holding text (numbers written as text)
+    is refused, naming it, not read as numbers; the same log with its own columns only is read (issue 81)."""
+    from wbfriction.exceptions import ColumnError
+
+    robot = load_robot("panda")
+    joint = robot.torque_controlled[0]
+    good = tmp_path / "effort.parquet"
+    write_table(effort_table(robot, {}), good)
+    assert read_log(good, robot).torque_source == effort.name
+    for name, extra, said in (
+            ("unknown", {"effort.no_such_joint": pa.array(np.zeros(50))},
+             "column 'effort.no_such_joint' names an unknown joint 'no_such_joint'"),
+            ("text", {f"effort.{joint}": pa.array(["100.0"] * 50)},
+             f"column 'effort.{joint}' holds string values, not numbers")):
+        path = tmp_path / f"{name}.parquet"
+        write_table(effort_table(robot, extra), path)
+        with pytest.raises(ColumnError, match=said) as caught:
+            read_log(path, robot)
+        assert caught.value.column == next(iter(extra))
+    # the built-in sources' columns are asked the same way: the sensors' tau of an unknown joint is refused
+    write_table(effort_table(robot, {"tau.no_such_joint": pa.array(np.zeros(50))}), path := tmp_path / "tau.parquet")
+    with pytest.raises(ColumnError, match="column 'tau.no_such_joint' names an unknown joint"):
+        read_log(path, robot)

@@ -132,10 +132,10 @@ def test_a_group_that_is_not_a_list_of_joints_is_refused(tmp_path, groups, needl
 ])
 def test_an_option_out_of_range_is_refused_before_the_work(tmp_path, capsys, args, needle):
     """One line, exit 2, nothing written: the range's refusal, before the log is read or the simulation starts."""
-    out = tmp_path / "log.parquet"
     log = tmp_path / "in.parquet"
     log.write_bytes(b"refused before it is read")
     args = tuple(log if a == "LOG" else a for a in args)
+    out = tmp_path / ("log.parquet" if args[0] == "simulate" else "out.json")  # each output named as its kind
     code, err = run_cli(capsys, *args, *(("-o", out) if args[0] == "simulate" else ("--json", out)))
     assert code == 2 and err.startswith(f"error: {needle}"), err
     assert len(said(err)) == 1 and not out.exists()

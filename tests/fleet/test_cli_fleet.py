@@ -38,7 +38,7 @@ def test_trends_need_results_and_an_html_page(tmp_path):
     res = wbfriction("trends", "empty", "-o", "t.html", cwd=tmp_path)
     assert res.returncode == 2 and "empty: no results" in res.stderr
     res = wbfriction("trends", "empty", "-o", "t.txt", cwd=tmp_path)
-    assert res.returncode == 2 and "-o t.txt: the trends page is written as .html" in res.stderr
+    assert res.returncode == 2 and "-o t.txt: a page is written as .html or .htm, not '.txt'" in res.stderr
     assert not (tmp_path / "t.html").exists()
 
 

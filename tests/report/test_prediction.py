@@ -131,7 +131,7 @@ def test_a_bad_output_is_refused_before_any_work(written, tmp_path, capsys, monk
 
     monkeypatch.setattr("wbfriction.report.prediction.predict_table", no_work)
     for option, path, said in (("--table", tmp_path / "missing" / "p.parquet", "does not exist"),
-                               ("--figure", tmp_path / "p.svg", "name it .png"),
+                               ("--figure", tmp_path / "p.svg", "a figure is written as .png, not '.svg'"),
                                ("--table", friction, "is the input")):
         code, err = run_cli(capsys, "predict", friction, "--params", params, option, path)
         assert code == 2 and option in err and said in " ".join(err.split()), err

@@ -14,7 +14,7 @@ from rich.table import Table
 from wbfriction.exceptions import OptionError
 from wbfriction.friction.options import BaseMotion, EstimateOptions, Method, MomentumOptions, RouteOption
 from wbfriction.inertia.options import InertiaPart
-from wbfriction.logs.formats.catalog import mapped_formats, table_formats, written_suffixes
+from wbfriction.logs.formats.catalog import mapped_formats, table_formats
 from wbfriction.logs.options import ReadOptions, TimeBase, TimeUnit
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.signals.options import AlignmentOption, DiffOption, FilterOptions, Mask, SavgolWeights, Velocity
@@ -52,6 +52,7 @@ from wbfriction.cli.common import (
     warn,
 )
 from wbfriction.cli.helpformat import FRICTION, LOGS, STUDIES
+from wbfriction.cli.outputs import suffixes, written_as
 
 
 def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: EstimateOptions,
@@ -136,7 +137,8 @@ def estimate(ctx: typer.Context, log: Path = typer.Argument(..., metavar="LOG",
                                         help=f"Log in the wbfriction format: {table_formats()}; through --map: "
                                              f"{mapped_formats()}."),
              output: Path = typer.Option(..., "-o", "--output",
-                                         help=f"Friction table to write: {written_suffixes(streamed=True)}."),
+                                         help=f"Friction table to write: {suffixes('streamed-table')}.",
+                                         callback=written_as("streamed-table")),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              mjcf: Optional[Path] = MjcfOpt,
              bag_map: Optional[Path] = MapOpt, max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt,
@@ -235,7 +237,8 @@ def convert(bag: Path = typer.Argument(..., metavar="BAG", help=f"Log to convert
                                                                         "[joint_states] rename, [[contacts]] "
                                                                         "column, threshold."),
             output: Path = typer.Option(..., "-o", "--output",
-                                        help=f"Log to write: {written_suffixes(streamed=True)}."),
+                                        help=f"Log to write: {suffixes('streamed-table')}.",
+                                        callback=written_as("streamed-table")),
             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
             mjcf: Optional[Path] = MjcfOpt,
             max_gap: float = MaxGapOpt, limit_margin: float = LimitMarginOpt) -> None:
@@ -254,7 +257,8 @@ def convert(bag: Path = typer.Argument(..., metavar="BAG", help=f"Log to convert
 
 @app.command(rich_help_panel=STUDIES)
 def sensitivity(log: Path = LogArg,
-                output: Path = typer.Option(Path("sensitivity.png"), "-o", "--output", help="Figure to write (PNG)."),
+                output: Path = typer.Option(Path("sensitivity.png"), "-o", "--output", callback=written_as("png"),
+                                            help=f"Figure to write ({suffixes('png')})."),
                 robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
                 mjcf: Optional[Path] = MjcfOpt,
                 factors: str = typer.Option("0.9,0.95,1.05,1.1", help="Comma-separated inertia scaling factors."),
@@ -307,7 +311,8 @@ def sensitivity(log: Path = LogArg,
 
 @app.command(rich_help_panel=STUDIES)
 def spectrum(log: Path = LogArg,
-             output: Path = typer.Option(Path("spectrum.png"), "-o", "--output", help="Figure to write (PNG)."),
+             output: Path = typer.Option(Path("spectrum.png"), "-o", "--output", callback=written_as("png"),
+                                         help=f"Figure to write ({suffixes('png')})."),
              robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
              mjcf: Optional[Path] = MjcfOpt,
              joints: Optional[str] = typer.Option(None, help="Comma-separated joints (default: the legs' joints, "

@@ -19,6 +19,7 @@ from wbfriction.cli.common import (
     stages,
 )
 from wbfriction.cli.helpformat import ROBOT
+from wbfriction.cli.outputs import suffixes, written_as
 from wbfriction.cli.rigs import RigOptionOpt, rig_options
 from wbfriction.exceptions import InputError
 
@@ -38,16 +39,17 @@ Stance = Literal["left", "right"]
 @app.command(rich_help_panel=ROBOT,
              short_help="Design a motion to record whose identification determines every parameter")
 def excite(ctx: typer.Context,
-           output: list[Path] = typer.Option(..., "-o", "--output",
-                                             help="Set-points to write, as many as given (.parquet, .csv): time "
-                                                  "[s], q_des.<joint> [rad] in the encoders' coordinates, "
+           output: list[Path] = typer.Option(..., "-o", "--output", callback=written_as("table"),
+                                             help=f"Set-points to write, as many as given ({suffixes('table')}): "
+                                                  "time [s], q_des.<joint> [rad] in the encoders' coordinates, "
                                                   "qd_des.<joint> [rad/s], at the drivers' rate; then 'wbfriction "
                                                   "simulate --play FILE' or the robot plays it."),
-           prediction: Optional[Path] = typer.Option(None, "--json",
+           prediction: Optional[Path] = typer.Option(None, "--json", callback=written_as("json"),
                                                      help="Also write the predicted standard error of every "
                                                           "parameter, the limits' margins and the search (JSON)."),
-           figure: Optional[Path] = typer.Option(None, "--figure", help="Also write a PNG of the set-points within "
-                                                                        "the limits and of the predicted errors."),
+           figure: Optional[Path] = typer.Option(None, "--figure", callback=written_as("png"),
+                                                 help="Also write a PNG of the set-points within the limits and of "
+                                                      "the predicted errors."),
            duration: Optional[float] = typer.Option(None, help=f"The recording [s] (default {PD_EXCITE.duration:g} "
                                                                f"hung or an arm; a biped or a quadruped: the time "
                                                                f"on one or three feet, default "

@@ -53,6 +53,7 @@ from wbfriction.cli.common import (
     warn_energy,
 )
 from wbfriction.cli.helpformat import FRICTION
+from wbfriction.cli.outputs import suffixes, written_as
 
 
 def _print_fits(results: list[FitResult], wide: bool = False, verbose: bool = False) -> None:
@@ -89,7 +90,8 @@ families known)."""
 @app.command(rich_help_panel=FRICTION,
              short_help="Fit a friction model per joint, with standard errors and a status per fit")
 def fit(friction: Path = FrictionArg,
-        output: Path = typer.Option(..., "-o", "--output", help="Parameters to write (JSON)."),
+        output: Path = typer.Option(..., "-o", "--output", callback=written_as("json"),
+                                    help=f"Parameters to write (JSON, {suffixes('json')})."),
         min_samples: int = MinSamplesOpt,
         energy_threshold: float = EnergyThresholdOpt, energy_tolerance: float = EnergyToleranceOpt,
         workers: int = FitWorkersOpt, model: str = FitModelOpt,
@@ -123,7 +125,7 @@ def fit(friction: Path = FrictionArg,
              short_help="Write the fitted friction where simulators read it (MJCF, URDF, Isaac Lab)")
 def export(ctx: typer.Context,
            params: Path = typer.Argument(..., metavar="PARAMS", help="Parameters written by 'wbfriction fit'."),
-           outputs: list[Path] = typer.Option(..., "-o", "--output",
+           outputs: list[Path] = typer.Option(..., "-o", "--output", callback=written_as("export"),
                                               help=f"File to write, format by name: {targets_words()}; repeat -o "
                                                    "for several."),
            include: str = typer.Option("", "--include",
@@ -195,12 +197,12 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
                                                  " under test)."),
             params: Path = typer.Option(..., "--params", help="Parameters fitted on other logs estimated with "
                                                               "the same URDF ('wbfriction fit')."),
-            table_file: Optional[Path] = typer.Option(None, "--table",
-                                                 help="Also write the prediction table (.parquet; .csv, .h5 by "
-                                                      "name): per sample and joint, time from the log's start "
-                                                      "[s], qd, measured and predicted torque and friction, "
-                                                      "residual [N·m]; each joint's RMS in its metadata."),
-            figure: Optional[Path] = typer.Option(None, "--figure",
+            table_file: Optional[Path] = typer.Option(None, "--table", callback=written_as("table"),
+                                                 help=f"Also write the prediction table ({suffixes('table')}): per "
+                                                      "sample and joint, time from the log's start [s], qd, "
+                                                      "measured and predicted torque and friction, residual [N·m]; "
+                                                      "each joint's RMS in its metadata."),
+            figure: Optional[Path] = typer.Option(None, "--figure", callback=written_as("png"),
                                                   help="Also write a PNG: per joint, measured and predicted torque "
                                                        "over time (a panel per run) and friction against "
                                                        "velocity.")) -> None:
@@ -262,7 +264,8 @@ def predict(friction: Path = typer.Argument(..., metavar="FRICTION",
 @app.command(rich_help_panel=FRICTION,
              short_help="One self-contained HTML report of the friction, its fits and their checks")
 def report(friction: Path = FrictionArg,
-           output: Path = typer.Option(Path("report.html"), "-o", "--output", help="HTML file to write."),
+           output: Path = typer.Option(Path("report.html"), "-o", "--output", callback=written_as("html"),
+                                       help=f"HTML file to write ({suffixes('html')})."),
            params: Optional[Path] = typer.Option(None, help="Parameters written by 'wbfriction fit' (default: "
                                                             "fitted here)."),
            identification: Optional[Path] = typer.Option(None, help="JSON written by 'wbfriction identify --json': "

@@ -11,7 +11,6 @@ from rich.markup import escape
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
-from wbfriction.exceptions import InputError
 from wbfriction.fit.options import FitOptions, ModelChoice, model_choices
 from wbfriction.fleet.options import SHAPES, Shape
 from wbfriction.friction.options import EstimateOptions, TemperatureLaw
@@ -39,6 +38,7 @@ from wbfriction.cli.common import (
     term_options,
 )
 from wbfriction.cli.helpformat import FLEETS
+from wbfriction.cli.outputs import suffixes, written_as
 
 
 @app.command(rich_help_panel=FLEETS)
@@ -118,9 +118,10 @@ def batch(source: Path = typer.Argument(..., metavar="MANIFEST",
 @app.command(rich_help_panel=FLEETS)
 def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results folder written by 'wbfriction "
                                                                        "batch'."),
-           output: Path = typer.Option(..., "-o", "--output", help="HTML page to write (.html)."),
-           table: Optional[Path] = typer.Option(None, "--table", help="Also write the trends as a table "
-                                                                      "(.parquet or .csv)."),
+           output: Path = typer.Option(..., "-o", "--output", callback=written_as("html"),
+                                       help=f"HTML page to write ({suffixes('html')})."),
+           table: Optional[Path] = typer.Option(None, "--table", callback=written_as("text-table"),
+                                                help=f"Also write the trends as a table ({suffixes('text-table')})."),
            alpha: float = typer.Option(1e-3, min=1e-6, max=0.5, help="False-alarm probability per joint."),
            replicates: Optional[int] = typer.Option(None, min=1, help="Noise series of the p-values' Monte Carlo "
                                                                       "[default: 20000, more for a small --alpha]."),
@@ -144,10 +145,6 @@ def trends(results: Path = typer.Argument(..., metavar="RESULTS", help="Results 
     from wbfriction.report.numbers import p_value_text
     from wbfriction.report.trends import write_trends_html
 
-    if output.suffix.lower() not in (".html", ".htm"):
-        raise InputError(f"-o {output}: the trends page is written as .html")
-    if table is not None and table.suffix.lower() not in (".parquet", ".pq", ".csv"):
-        raise InputError(f"--table {table}: written as .parquet or .csv")
     check_paths({"RESULTS": results}, {"-o": output, **({"--table": table} if table is not None else {})})
     options = TrendOptions(alpha=alpha, min_change=min_change, replicates=replicates,
                            shapes=tuple(cast("Shape", s.strip()) for s in shapes.split(",") if s.strip()),

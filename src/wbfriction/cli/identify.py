@@ -47,13 +47,16 @@ from wbfriction.cli.common import (
     warn_energy,
 )
 from wbfriction.cli.helpformat import ROBOT
+from wbfriction.cli.outputs import suffixes, written_as
 
 Actuator = Literal["none", "pd"]
 ACTUATOR = ActuatorOptions()
-OutputOpt = typer.Option(None, "-o", "--output", help="Corrected URDF to write (the given one's structure, identified "
-                                                      "inertias); not with --actuator pd.")
-JsonOpt = typer.Option(None, "--json", help="Also write every figure as JSON (for 'wbfriction report "
-                                            "--identification').")
+OutputOpt = typer.Option(None, "-o", "--output", callback=written_as("urdf"),
+                         help=f"Corrected URDF to write ({suffixes('urdf')}: the given one's structure, identified "
+                              "inertias); not with --actuator pd.")
+JsonOpt = typer.Option(None, "--json", callback=written_as("json"),
+                       help=f"Also write every figure as JSON ({suffixes('json')}; for 'wbfriction report "
+                            "--identification').")
 StribeckOpt = typer.Option("auto", help="v_s of the Stribeck term [rad/s]: auto (from the acceleration route, refined "
                                         "each pass), a number, or none.")
 StrideOpt = typer.Option(INERTIAL.stride, min=1, help="Every stride-th single-support sample is used.")
@@ -70,7 +73,8 @@ PriorToleranceOpt = typer.Option(INERTIAL.prior_tolerance, help="With the prior'
                                                                 "strongest weight within this share of the best "
                                                                 "score.")
 TanhSlopeOpt = typer.Option(INERTIAL.tanh_slope, min=1e-12, help="a of the Coulomb term tanh(a qd) [s/rad].")
-ConfigOutputOpt = typer.Option(None, "--config-output", help="Also write the robot's configuration (TOML) for the "
+ConfigOutputOpt = typer.Option(None, "--config-output", callback=written_as("toml"),
+                               help="Also write the robot's configuration (TOML) for the "
                                                              "identified model: its urdf the corrected URDF, its "
                                                              "[armature] the identified one (--armature identify), "
                                                              "the rest as given; then 'wbfriction estimate LOG "

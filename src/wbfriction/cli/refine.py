@@ -11,6 +11,7 @@ from rich.table import Table
 
 from wbfriction.cli.common import ConfigOpt, LogArg, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of, stages
 from wbfriction.cli.helpformat import ROBOT
+from wbfriction.cli.outputs import suffixes, written_as
 from wbfriction.cli.rollout import replay_options
 from wbfriction.pipeline.paths import check_paths
 
@@ -20,13 +21,15 @@ def refine(log: Path = LogArg,
            model: Path = typer.Argument(..., metavar="MODEL",
                                         help="MuJoCo MJCF written by 'wbfriction export' for the robot (--config), "
                                              "its PD-driven joints' actuators named as the joints."),
-           output: Path = typer.Option(..., "-o", "--output", help="The refined MJCF to write (.xml)."),
+           output: Path = typer.Option(..., "-o", "--output", callback=written_as("mjcf"),
+                                       help=f"The refined MJCF to write ({suffixes('mjcf')})."),
            held_out: Optional[Path] = typer.Option(None, "--held-out",
                                                    help="A log not refined on: MODEL and the refined file replayed "
                                                         "on it, their tracking errors side by side."),
-           table: Optional[Path] = typer.Option(None, "--table",
-                                                help="Table to write (.parquet, .csv): per joint and parameter, the "
-                                                     "file's value, the refined one, its standard error and status."),
+           table: Optional[Path] = typer.Option(None, "--table", callback=written_as("text-table"),
+                                                help=f"Table to write ({suffixes('text-table')}): per joint and "
+                                                     "parameter, the file's value, the refined one, its standard "
+                                                     "error and status."),
            window: float = typer.Option(1.0, "--window",
                                         help="Restart each replay from the log's state every so many seconds [s]."),
            start: Optional[float] = typer.Option(None, "--from", help="Refine on the log from this time [s] "

@@ -11,6 +11,7 @@ from rich.table import Table
 
 from wbfriction.cli.common import ConfigOpt, LogArg, MjcfOpt, RobotOpt, UrdfOpt, app, console, out, robot_of, stages
 from wbfriction.cli.helpformat import ROBOT
+from wbfriction.cli.outputs import suffixes, written_as
 from wbfriction.exceptions import OptionError
 from wbfriction.pipeline.paths import check_paths
 
@@ -37,10 +38,11 @@ def rollout(log: Path = LogArg,
             timestep: Optional[float] = typer.Option(None, "--timestep",
                                                      help="Physics step [s] (default: the file's)."),
             label: str = typer.Option("model", "--label", help="What the figure calls the replay."),
-            output: Optional[Path] = typer.Option(None, "-o", "--output",
-                                                  help="Table to write (.parquet, .csv): per joint, the RMS "
-                                                       "tracking error [rad] in windows and in one shot."),
-            figure: Optional[Path] = typer.Option(None, "--figure", help="PNG of each joint's tracking error."),
+            output: Optional[Path] = typer.Option(None, "-o", "--output", callback=written_as("text-table"),
+                                                  help=f"Table to write ({suffixes('text-table')}): per joint, the "
+                                                       "RMS tracking error [rad] in windows and in one shot."),
+            figure: Optional[Path] = typer.Option(None, "--figure", callback=written_as("png"),
+                                                  help="PNG of each joint's tracking error."),
             robot: str = RobotOpt, urdf: Optional[Path] = UrdfOpt, config: Optional[Path] = ConfigOpt,
             mjcf: Optional[Path] = MjcfOpt) -> None:
     """Replay the log's set-points on an exported MuJoCo model, as MuJoCo runs it (the file's timestep, gains,

@@ -25,11 +25,11 @@ from wbfriction.cli.common import (
     stages,
 )
 from wbfriction.cli.helpformat import LOGS
+from wbfriction.cli.outputs import suffixes, written_as
 from wbfriction.cli.rigs import RigOptionOpt, check_engine, rig_options
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
-from wbfriction.logs.formats.catalog import written_suffixes
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.rigs import RigProgress, rig_for
 from wbfriction.sim.engines import engine_names, engines
@@ -50,7 +50,8 @@ DriverNoiseChoice = Literal["real", "none"]
 or none."""
 
 
-OutputOpt = typer.Option(..., "-o", "--output", help=f"Log to write: {written_suffixes()}.")
+OutputOpt = typer.Option(..., "-o", "--output", help=f"Log to write: {suffixes('table')}.",
+                         callback=written_as("table"))
 FrictionOpt = typer.Option(None, help="TOML with [friction.<group or joint>] tables (a model key: coulomb-viscous, "
                                       "stribeck or (3.5)), each with an optional terms table (F_L, dF_v, ripple, "
                                       "F_cT, F_vT, reference_temperature), and a [temperature] warm-up (start, end "

@@ -50,10 +50,17 @@ from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forc
 from wbfriction.logs.foot_forces import column_names as foot_force_names
 from wbfriction.logs.foot_forces import foot_force_columns, foot_force_table, read_foot_forces
 from wbfriction.logs.options import MAX_GAP, ReadOptions
-from wbfriction.logs.pd import PD_PREFIXES, PdSetpoints, pd_columns_named, read_setpoints, setpoint_columns
+from wbfriction.logs.pd import PdSetpoints, read_setpoints, setpoint_columns
 from wbfriction.logs.tables import numeric_column, numeric_columns, read_metadata, with_metadata, write_table
 from wbfriction.logs.temperature import screen_temperature
-from wbfriction.logs.torque import TorqueColumns, TorqueSource, check_torque_columns, torque_kind, torque_source_of
+from wbfriction.logs.torque import (
+    TorqueColumns,
+    TorqueSource,
+    check_torque_columns,
+    torque_columns_named,
+    torque_kind,
+    torque_source_of,
+)
 from wbfriction.model.robot import Robot
 
 
@@ -277,15 +284,18 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
                setpoints=setpoints, foot_force=foot_force)
 
 
-NUMERIC_PREFIXES = ("q", "tau", "current", "qd", "qd_true", "qdd_true", "tau_f_true", "base", "wrench", "force",
-                    "base_qd_true", "base_qdd_true", "imu", "temperature") + PD_PREFIXES
-"""Column prefixes whose values must be numbers."""
+NUMERIC_PREFIXES = ("q", "qd", "qd_true", "qdd_true", "tau_f_true", "base", "wrench", "force", "base_qd_true",
+                    "base_qdd_true", "imu", "temperature")
+"""Column prefixes whose values must be numbers, besides those of the torque sources (each source's own:
+:meth:`TorqueKind.named <wbfriction.logs.torque.TorqueKind.named>`)."""
 
 
 def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...]:
     """Check a log's columns against ``robot`` from its schema alone, before any row is read:
     names (no duplicate, none naming an unknown joint or frame, none required missing) and
-    types (numbers; contact flags as numbers or booleans; ``time`` as numbers or timestamps).
+    types (numbers; contact flags as numbers or booleans; ``time`` as numbers or timestamps). The torque
+    columns are those every registered torque source says it reads
+    (:meth:`TorqueKind.named <wbfriction.logs.torque.TorqueKind.named>`), a registered one's as a built-in one's.
 
     Returns:
         Warnings, one line each: float32 columns (7 significant digits: the accelerations
@@ -304,14 +314,15 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
     if "time" not in seen:
         raise ColumnError(source, "time", None, "missing column 'time'")
     act, tc = set(robot.actuated), set(robot.torque_controlled)
-    frames = set(robot.contact_frames)
     wrenches = {c.partition(".")[2] for s in robot.ft_sensors for c in s.columns()}
+    torque = torque_columns_named(robot)  # every registered source's columns, as it says them
+    named: dict[str, set[str] | None] = {
+        **torque, "q": act, "tau_f_true": tc, "temperature": tc, "contact": set(robot.contact_frames),
+        "qd_true": act, "qdd_true": act, "qd": act, "wrench": wrenches,
+        "imu": {c.partition(".")[2] for c in IMU_COLUMNS}, "force": foot_force_names(robot)}
     for col in names:
         prefix, _, item = col.partition(".")
-        known = {"q": act, "tau": act, "tau_f_true": tc, "temperature": tc, "contact": frames, "qd_true": act,
-                 "qdd_true": act, "qd": act, "current": act, "wrench": wrenches,
-                 "imu": {c.partition(".")[2] for c in IMU_COLUMNS}, "force": foot_force_names(robot),
-                 **pd_columns_named(robot)}.get(prefix)
+        known = named.get(prefix)
         if known is not None and item not in known:
             what = {"contact": "contact frame", "wrench": "force-torque sensor (or axis)", "force": "foot (or axis)",
                     "imu": "IMU axis"}.get(prefix, "joint")
@@ -332,7 +343,7 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
             ok = number or pa.types.is_timestamp(f.type)
         elif prefix == "contact":
             ok = number or pa.types.is_boolean(f.type)
-        elif prefix in NUMERIC_PREFIXES:
+        elif prefix in NUMERIC_PREFIXES or prefix in torque:
             ok = number
         else:
             continue  # a column the log format does not use

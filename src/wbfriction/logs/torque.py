@@ -29,7 +29,7 @@ import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError
-from wbfriction.logs.pd import PdSetpoints, driver_estimate, pd_law_torque, setpoint_columns
+from wbfriction.logs.pd import PdSetpoints, driver_estimate, pd_columns_named, pd_law_torque, setpoint_columns
 from wbfriction.logs.tables import numeric_columns
 from wbfriction.model.robot import Robot
 from wbfriction.registry import Registry
@@ -80,8 +80,8 @@ class TorqueKind:
     A subclass names itself (:attr:`name`, the string every output's metadata records; :attr:`what`, what the text
     outputs print), says which columns make a log its own (:attr:`prefix`, and where the default does not say it,
     :meth:`claims`), its place among the sources (:attr:`precedence`: the lowest that claims a log wins) and reads the
-    torque (:meth:`torque`). What it does not define has a default built on :attr:`prefix`: the schema's check of one
-    joint (:meth:`gives`), the log written back (:meth:`columns`).
+    torque (:meth:`torque`). What it does not define has a default built on :attr:`prefix`: the columns the schema
+    checks (:meth:`named`), the schema's check of one joint (:meth:`gives`), the log written back (:meth:`columns`).
     """
 
     name: ClassVar[str]
@@ -113,6 +113,14 @@ class TorqueKind:
             ColumnError: a column missing or not numbers, naming it.
         """
         return given.columns(self.prefix)
+
+    def named(self, robot: Robot) -> dict[str, set[str] | None]:
+        """The prefixes of the columns this source reads, each to the names its ``<prefix>.<name>`` columns may give
+        (None: any, refused where they are read, with the reason): what the log's schema checks before a row is read
+        (:func:`~wbfriction.logs.log.check_schema`: a column of another name is refused, naming it; every such column
+        must hold numbers). By default ``{prefix: the robot's actuated joints}`` (a column of a joint that is not
+        torque-controlled is allowed and not read, as ``tau.<joint>``)."""
+        return {self.prefix: set(robot.actuated)}
 
     def gives(self, robot: Robot, joint: str, seen: set[str]) -> bool:
         """Whether a log with the columns ``seen`` has ``joint``'s torque from this source (the schema's check, before
@@ -183,6 +191,21 @@ def torque_source_of(given: TorqueColumns) -> TorqueKind:
     return found
 
 
+def torque_columns_named(robot: Robot) -> dict[str, set[str] | None]:
+    """The column prefixes every registered torque source reads (:meth:`TorqueKind.named`), each to the names its
+    columns may give (None: any, refused where read); a prefix two sources read gives the names of either (None if
+    either says any)."""
+    named: dict[str, set[str] | None] = {}
+    for kind in SOURCES.kinds():
+        for prefix, names in kind.named(robot).items():
+            if prefix not in named:
+                named[prefix] = None if names is None else set(names)
+            else:
+                held = named[prefix]
+                named[prefix] = None if held is None or names is None else held | names
+    return named
+
+
 def check_torque_columns(robot: Robot, seen: set[str], source: str) -> None:
     """Every torque-controlled joint has a torque from some registered source (:meth:`TorqueKind.gives`: ``tau``,
     ``tau_est``, ``current`` with a torque constant, ``q_des`` of a PD-driven joint built in), checked on a log's
@@ -248,6 +271,10 @@ class DriverTorque(TorqueKind):
         estimated = driver_estimate(given.table, given.robot, given.source, given.first_row)
         assert estimated is not None  # claimed: some tau_est column
         return estimated
+
+    def named(self, robot: Robot) -> dict[str, set[str] | None]:
+        """``tau_est`` of the torque-controlled joints."""
+        return {self.prefix: set(robot.torque_controlled)}
 
     def hint(self, joint: str) -> str | None:
         """None (the message does not name it)."""
@@ -323,6 +350,12 @@ class PdLawTorque(TorqueKind):
         """
         assert given.setpoints is not None  # claimed
         return pd_law_torque(given.robot, given.setpoints, given.time, given.q, given.source)
+
+    def named(self, robot: Robot) -> dict[str, set[str] | None]:
+        """The set-points' and gains' prefixes (``q_des``, ``qd_des``, ``tau_ff``, ``kp``, ``kd``) of the PD-driven
+        joints (None without ``[pd]``: :func:`~wbfriction.logs.pd.read_setpoints` refuses them with the reason;
+        :func:`~wbfriction.logs.pd.pd_columns_named`)."""
+        return {p: names for p, names in pd_columns_named(robot).items() if p != DriverTorque.prefix}
 
     def gives(self, robot: Robot, joint: str, seen: set[str]) -> bool:
         """``q_des.<joint>`` of a PD-driven joint."""

@@ -129,6 +129,7 @@ class LogFormat(ABC):
         suffixes: the file name endings that are its own, lower case with the dot (``.parquet``, ``.pq``).
         writable: :meth:`write` writes a whole table.
         streamable: :meth:`open_writer` writes tables one after the other (a friction table, a converted bag).
+        text: :meth:`write` keeps a table's text columns (a table of joints' names and statuses), read back as text.
         needs_map: its files are read only through a map (a ROS 2 bag's topics): :meth:`read_log` and
             :meth:`log_blocks` are its own, and it is not a table file (:meth:`read` refuses).
         detail: what else the command line's help says of its files (a ROS 2 bag: ``or a folder with
@@ -143,6 +144,7 @@ class LogFormat(ABC):
     suffixes: ClassVar[tuple[str, ...]] = ()
     writable: ClassVar[bool] = False
     streamable: ClassVar[bool] = False
+    text: ClassVar[bool] = False
     needs_map: ClassVar[bool] = False
     detail: ClassVar[str] = ""
 
@@ -152,6 +154,7 @@ class LogFormat(ABC):
         if kind is not None:
             cls.name, cls.label, cls.suffixes, cls.detail = kind.name, kind.label, kind.suffixes, kind.detail
             cls.writable, cls.streamable, cls.needs_map = kind.writable, kind.streamable, kind.needs_map
+            cls.text = kind.text
 
     def __repr__(self) -> str:
         return f"<log format {self.name}>"
