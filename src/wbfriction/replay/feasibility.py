@@ -30,7 +30,7 @@ where the following hold; each limit follows from how the replay runs, none is t
 * **the file's robot against the TOML's** (:func:`check_robot`): ``wbfriction export`` writes the robot's model
   name (its URDF's ``<robot name>``, an MJCF's ``<mujoco model>``) as the file's ``<mujoco model>`` and exactly the
   robot's joints (:attr:`Robot.actuated`); a file of another name or other joints is another robot's (the Go2, the
-  Go1 and the Aliengo share their joints' names). The encoder offsets sit in the actuators' bias with the fits'
+  A1 and the Aliengo share their joints' names). The encoder offsets sit in the actuators' bias with the fits'
   constant, ``biasprm[0] = -kp offset - tau_os``, from which the offset cannot be told apart; the export lists them
   exactly in its note at the top of ``<actuator>`` (``"joint": rad``, :func:`~wbfriction.export.drive.offset_lines`),
   and the replay takes the log's angles to the model's with the TOML's: the two must be equal, bit for bit (a file
@@ -151,17 +151,18 @@ def check_window(source: str, horizon: float | None, period: float, rows: tuple[
                            f"(every model 0); give one of {1.5 * period:g} s (two samples) or more")
 
 
-def check_timestep(source: str, timestep: float, period: float) -> None:
-    """Refuse a physics step longer than the log period (module docstring).
+def check_timestep(source: str, timestep: float, period: float, log: str = "the log") -> None:
+    """Refuse a physics step of the file ``source`` longer than the period of ``log`` (module docstring).
 
     Raises:
-        ReplayInfeasible: naming ``--timestep``, the step and the period.
+        ReplayInfeasible: naming ``--timestep``, the step, the log and its period.
     """
     if timestep <= period * (1.0 + 1e-9):
         return
     raise ReplayInfeasible(source, "--timestep", timestep, f"a timestep <= {period:g} s",
-                           f"a timestep (--timestep) of {timestep:g} s is longer than the log's period {period:g} s: "
-                           f"its set-points would be skipped and its samples read late; give at most {period:g} s")
+                           f"a timestep (--timestep; the file's by default) of {timestep:g} s is longer than {log}'s "
+                           f"period {period:g} s: its set-points would be skipped and its samples read late; give at "
+                           f"most {period:g} s")
 
 
 def check_history(source: str, model: Any, acts: np.ndarray, names: Sequence[str]) -> None:

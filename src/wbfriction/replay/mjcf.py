@@ -238,7 +238,7 @@ def load_replay(model: str | Path, robot: Robot, data: LogSetpoints, replay: Rep
         m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_ACTUATION
     else:
         check_history(source, m, drives.acts, robot.actuated)
-    check_timestep(source, float(m.opt.timestep), period)
+    check_timestep(source, float(m.opt.timestep), period, Path(data.source).name)
     return ReplayModel(m, drives, replay, source)
 
 
