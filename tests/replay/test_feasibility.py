@@ -161,30 +161,32 @@ def test_a_log_with_gaps_is_replayed_as_its_runs_on_their_own(hung, go2, mjr, da
     gapped, pieces = cut(base, gaps)
     assert len(log_runs(gapped["time"].to_numpy())) == len(pieces)
     params = ActuatorParams(sim.friction, label="truth")
+
+    def run(t: pa.Table, replay: str) -> np.ndarray:
+        if replay == "rollout":
+            return rollout(go2, t, params, horizon=0.1, mjr=mjr).q_sim
+        return replay_mjcf(truth, robot, t, Replay(horizon=0.1 if replay == "windows" else None)).q_sim
+
     for replay in ("windows", "whole", "rollout"):
-        def run(t: pa.Table) -> np.ndarray:
-            if t.num_rows < 2:  # a run of one row: the log's state, nothing to replay
-                return t.select([f"q.{j}" for j in robot.actuated]).to_pandas().to_numpy()
-            if replay == "rollout":
-                return rollout(go2, t, params, horizon=0.1, mjr=mjr).q_sim
-            return replay_mjcf(truth, robot, t, Replay(horizon=0.1 if replay == "windows" else None)).q_sim
-        whole = run(gapped)
-        np.testing.assert_allclose(whole, np.vstack([run(p) for p in pieces]), rtol=0, atol=1e-12, err_msg=replay)
+        np.testing.assert_allclose(run(gapped, replay), np.vstack([run(p, replay) for p in pieces]), rtol=0,
+                                   atol=1e-12, err_msg=replay)
 
 
-def test_runs_split_at_a_sample_missing_not_at_jitter():
-    """A row belongs to its run while its time is within half a period of the run's grid: jitter of 0.4 period
-    either way (a late sample, the next on time) is one run; a sample missing, a time that repeats or goes back,
-    starts a new one."""
+def test_runs_split_at_a_sample_missing_not_at_jitter_nor_drift():
+    """A run goes on while each row's step rounds to one period: a sample late by 0.4 period, or an hour at 200 Hz
+    its times stored in float32 (steps quantised, their median off their mean: a grid from the start is half a
+    period off by row 513), are one run; a sample missing, a time that repeats or goes back, starts a new one."""
     t = np.arange(20) * 0.005
     assert log_runs(t) == ((0, 20),)
-    jitter = t.copy()
-    jitter[5] += 0.002
-    jitter[6] -= 0.002
-    assert log_runs(jitter) == ((0, 20),)
+    late = t.copy()
+    late[5] += 0.002
+    assert log_runs(late) == ((0, 20),)
+    hour = np.linspace(0.0, 3600.0, 200 * 3600 + 1).astype(np.float32).astype(float)
+    assert log_runs(hour) == ((0, hour.size),)
     assert log_runs(np.delete(t, 7)) == ((0, 7), (7, 19))
-    back = np.concatenate([t[:10], t[:10]])  # two logs read one after the other
-    assert log_runs(back) == ((0, 10), (10, 20))
+    assert log_runs(np.concatenate([t[:10], t[:10]])) == ((0, 10), (10, 20))  # two logs read one after the other
+    repeat = np.insert(t, 4, t[3])
+    assert log_runs(repeat) == ((0, 4), (4, 21))
     with pytest.raises(ReplayInfeasible, match="no period"):
         log_runs(np.zeros(5))
 
@@ -243,7 +245,8 @@ def test_another_robots_file_and_other_offsets_are_refused(hung, tmp_path):
 def test_cli_refuses_in_one_line_and_writes_nothing(hung, tmp_path, capsys):
     """``rollout --window`` below two samples wrote a table of zeros; ``--timestep`` below the history, ten periods,
     ``--torque-delay`` 10^5: each is one line naming the option, exit 2, no table written; ``refine --window``, and a
-    held-out log sampled faster than the file's timestep, refused before the refinement's minute."""
+    held-out log sampled faster than the file's timestep, refused before the refinement's minute. A log with a gap
+    is replayed, the table's caption saying where its runs start."""
     sim, robot, truth, _, log = hung
     config = hung_go2_toml(tmp_path / "go2.toml", robot, sim.driver.delay)
     table = tmp_path / "r.parquet"
@@ -252,6 +255,12 @@ def test_cli_refuses_in_one_line_and_writes_nothing(hung, tmp_path, capsys):
         code, _, err = run_cli_printed(capsys, "rollout", log, truth, "--config", config, option, value, "-o", table)
         assert code == 2 and len(said(err)) == 1 and f"({option}" in err, (option, err)
         assert not table.exists()
+    gapped = tmp_path / "gapped.parquet"
+    pq.write_table(cut(sim.table, [(100, 20)])[0], gapped)
+    code, printed, err = run_cli_printed(capsys, "rollout", gapped, truth, "--config", config, "-o", table)
+    assert code == 0, err
+    assert "the log's gaps cut it into 2 evenly sampled runs, each replayed on its own (restarted at rows 100)" \
+        in " ".join(printed.split())
     refined = tmp_path / "refined.xml"
     code, _, err = run_cli_printed(capsys, "refine", log, truth, "--config", config, "--window", "0.003", "-o", refined)
     assert code == 2 and len(said(err)) == 1 and "(--window)" in err and not refined.exists()

@@ -22,11 +22,14 @@ where the following hold; each limit follows from how the replay runs, none is t
 * **PACE's torque delay against the window**: its torque is computed once a period and applied ``D`` periods later,
   the window's first torque standing in before; a delay as long as the window (``D >= samples - 1``) applies only
   that stand-in (:func:`check_torque_delay`);
-* **the log's runs**: the replay takes row ``k`` of a run as sent at ``t_a + (k - a) P`` (``a`` the run's first
-  row); a row whose time is half a period or more off that grid (a gap: samples missing; a time that repeats or goes
-  back) starts a new run (:func:`log_runs`). Runs are replayed separately: every window restarts at a run's first
-  row, the history before it is that row's set-point (as before a log's first row), no window crosses a gap
-  (:func:`run_windows`). A stretch without a run of two rows has nothing to replay;
+* **the log's runs**: the replay takes each row as sent one period after the one before; a row whose step from
+  the one before does not round to one period (``|t_k - t_(k-1) - P| >= P / 2``: a gap, samples missing; a time
+  that repeats or goes back) starts a new run (:func:`log_runs`). The rule is the row's own step, not a grid from
+  the log's start: a slow drift of the clock, or times stored in float32 (a quantised step, its median a little off
+  its mean), never adds up to a gap, and a sample's jitter passes while it stays within half a period of the one
+  before's. Runs are replayed separately: every window restarts at a run's first row, the history before it is that
+  row's set-point (as before a log's first row), no window crosses a gap (:func:`run_windows`). A stretch without
+  a run of two rows has nothing to replay;
 * **the file's robot against the TOML's** (:func:`check_robot`): ``wbfriction export`` writes the robot's model
   name (its URDF's ``<robot name>``, an MJCF's ``<mujoco model>``) as the file's ``<mujoco model>`` and exactly the
   robot's joints (:attr:`Robot.actuated`); a file of another name or other joints is another robot's (the Go2, the
@@ -93,26 +96,14 @@ def log_period(time: np.ndarray, source: str = "<table>") -> float:
 
 def log_runs(time: np.ndarray, source: str = "<table>") -> tuple[tuple[int, int], ...]:
     """The log's evenly sampled runs, rows ``[a, b)`` each, in order, covering every row (module docstring): row
-    ``k`` is in the run of ``a`` while ``|t_k - t_a - (k - a) P| < P / 2``.
+    ``k`` is in the run of row ``k - 1`` while ``|t_k - t_(k-1) - P| < P / 2``.
 
     Raises:
         ReplayInfeasible: a time without a period (:func:`log_period`).
     """
-    n, period = len(time), log_period(time, source)
-    runs, a = [], 0
-    while a < n:
-        b, span = n, 64
-        while True:  # the run's end, looked for in doubling spans: a row per run at worst, not per row
-            stop = min(n, a + span)
-            off = np.abs(time[a:stop] - time[a] - np.arange(stop - a) * period)
-            bad = np.flatnonzero(~(off < 0.5 * period))
-            if bad.size or stop == n:
-                b = a + int(bad[0]) if bad.size else n
-                break
-            span *= 2
-        runs.append((a, b))
-        a = b
-    return tuple(runs)
+    period = log_period(time, source)
+    cuts = (np.flatnonzero(~(np.abs(np.diff(time) - period) < 0.5 * period)) + 1).tolist()
+    return tuple(zip([0, *cuts], [*cuts, len(time)]))
 
 
 def run_windows(runs: Sequence[tuple[int, int]], start: int, stop: int, shot: int) -> list[tuple[int, int]]:

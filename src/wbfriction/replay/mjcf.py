@@ -19,7 +19,13 @@ the file's. This is how a torque-delayed model, which no MJCF holds, is scored a
 
 **Windows.** As in :mod:`wbfriction.replay.rollout`, every ``horizon`` seconds the replay restarts from the log's
 state (the model's angle: the logged one less the encoder offset; the logged velocity): 1 s by default, the error
-a simulator's user sees over a second of its own motion; ``horizon=None`` replays the stretch in one shot.
+a simulator's user sees over a second of its own motion; ``horizon=None`` replays the stretch in one shot. A log with
+gaps is replayed run by run (:func:`~wbfriction.replay.feasibility.log_runs`): a window restarts at each run's first
+row too, its history that row's set-point.
+
+**What is refused.** Before any replay (:func:`checked_replay`) the file must be the robot's (its model, joints and
+encoder offsets), its timestep must hold the actuators' delay and the log's set-points, the windows two samples,
+PACE's torque delay less than a window (:mod:`wbfriction.replay.feasibility`).
 
 Sources: MuJoCo 4.0.0 ``mj_initCtrlHistory`` (the actuator's history), ``actuator_gainprm``/``biasprm`` (the
 affine law ``force = gainprm[0] ctrl + biasprm[0] + biasprm[1] qpos + biasprm[2] qvel``); PACE's actuator

@@ -18,7 +18,8 @@ where a model's slow drift (a joint that sticks in the model and not on the robo
 restart takes the log's velocity, the driver's noisy one (0.08 rad/s on a real driver), so short horizons add a
 transient of that noise to every shot. Measured on the hung Go2 (25 s, a real driver's noise, the true parameters):
 2.3e-4 rad RMS at worst in one shot, 5.6e-4 restarting every 2 s, 8.0e-4 every 0.5 s; with wrong parameters the
-three agree within 10 %.
+three agree within 10 %. A horizon must hold two of the log's samples, and a log with gaps is replayed run by run,
+each run's set-points only (:mod:`wbfriction.replay.feasibility`).
 
 **A peer's delay.** PACE (the peer's method) delays the PD's torque, its feedback with its set-point
 (:attr:`ActuatorParams.torque_delay`), where wbfriction's driver delays the set-points: replay a parameter set the
@@ -259,6 +260,8 @@ def rollout(robot: Robot, log: pa.Table | str | Path | LogSetpoints, params: Act
     Raises:
         InputError: a stretch out of the log, a horizon <= 0, values for unknown joints, friction that is no family's
             parameters, a robot that is not a fixed-base PD-driven one.
+        ReplayInfeasible: a horizon of fewer than two samples, a stretch without two rows a period apart, a torque
+            delay as long as a horizon (:mod:`wbfriction.replay.feasibility`), before any replay.
         UnknownFamilyError: parameters of a family the registry does not know.
         ColumnError: a column the replay needs is missing.
     """
