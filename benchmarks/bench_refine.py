@@ -9,7 +9,8 @@ wall time is printed against issue 64's 2 minutes and PACE's published 2 h 15 mi
 replayed on the last 40 % at the simulator's 1 ms (``--timestep``), and the refined values are compared with the
 truth (the armature as MuJoCo's Euler step holds it, less ``h F_v``: :mod:`wbfriction.replay.refine`), each error in its
 standard errors. With ``--true-offsets`` the refinement runs with the truth's encoder offsets (what it does not
-refine) instead of the identified ones.
+refine) instead of the identified ones, the export written again with them (a file's actuators hold the offsets it
+was exported with: ``wbfriction.replay.feasibility``).
 
     python benchmarks/bench_refine.py [--friction model|mujoco] [--timestep 0.001] [--true-offsets] [--keep DIR]
 """
@@ -76,12 +77,14 @@ def main() -> None:
              "wbfriction fit train_friction.parquet --model coulomb-viscous --terms none -o cv.json",
              f"wbfriction export cv.json --config {config} --include weak,at-bound -o go2.xml"]
     timed = list(run_route(route, folder))
-    if args.true_offsets:
+    exported = "go2.xml"
+    if args.true_offsets:  # the file exported with them: a file's actuators hold the offsets it was exported with
         text = (folder / config).read_text().split("[encoder_offset]")[0]
         offsets = "\n".join(f"{j} = {v!r}" for j, v in truth["encoder_offset_true"].items())
         (folder / "go2_true_offsets.toml").write_text(f"{text}[encoder_offset]\n{offsets}\n")
-        config = "go2_true_offsets.toml"
-    timed += run_route([f"wbfriction refine train.parquet go2.xml --config {config} -o refined.xml "
+        config, exported = "go2_true_offsets.toml", "go2_true_offsets.xml"
+        run_route([f"wbfriction export cv.json --config {config} --include weak,at-bound -o {exported}"], folder)
+    timed += run_route([f"wbfriction refine train.parquet {exported} --config {config} -o refined.xml "
                         f"--timestep {args.timestep!r} --table refined.parquet"], folder)
     total = sum(t.seconds for t in timed)
     print(f"hung Go2, 14 s, friction {args.friction}, refined at {1e3 * args.timestep:g} ms"
@@ -94,7 +97,7 @@ def main() -> None:
     robot = load_robot(None, config=folder / config)
     replay = Replay(timestep=args.timestep)
     print("\n| held-out, 1 s windows [mrad] | mean | worst |\n|---|---|---|")
-    for label, path, who in (("export", "go2.xml", robot), ("refined", "refined.xml", robot),
+    for label, path, who in (("export", exported, robot), ("refined", "refined.xml", robot),
                              ("the truth's file", "truth.xml", truth_robot)):
         rms = 1e3 * replay_mjcf(folder / path, who, folder / "held_out.parquet", replay).rms
         print(f"| {label} | {rms.mean():.2f} | {rms.max():.2f} |")

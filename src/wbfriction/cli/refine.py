@@ -51,6 +51,7 @@ def refine(log: Path = LogArg,
                  "--mjcf": mjcf}, {"-o": output, "--table": table})
     replay, times = replay_options(window, timestep, start, stop)
     the_robot = robot_of(robot, urdf, config, mjcf)
+    held = None if held_out is None else _held_out_checked(model, the_robot, held_out, replay)
     with stages() as stage:
         stage(f"refining {model.name} on {log.name} (a minute or so: MuJoCo replays the log some "
               "hundred times)")
@@ -65,8 +66,8 @@ def refine(log: Path = LogArg,
               f"(± {1e3 * result.delay_se:.2g}, {result.delay_status}); training RMS "
               f"{1e3 * result.rms_start.mean():.2f} -> {1e3 * result.rms.mean():.2f} mrad; {result.replays} replays in "
               f"{result.seconds:.0f} s" + ("" if result.converged else " (stopped at its budget of replays)"))
-    if held_out is not None:
-        out.print(_held_out(model, output, the_robot, held_out, replay))
+    if held_out is not None and held is not None:  # both or neither
+        out.print(_held_out(model, output, the_robot, held_out, held, replay))
     for path in (output, table):
         if path is not None:
             console.print(f"wrote {path}")
@@ -90,12 +91,22 @@ def _values(result) -> Table:
     return table
 
 
-def _held_out(model: Path, refined: Path, robot, held_out: Path, replay) -> Table:
-    """The file and the refined file replayed on the held-out log: their RMS per joint [mrad]."""
-    from wbfriction.replay.mjcf import replay_mjcf
+def _held_out_checked(model: Path, robot, held_out: Path, replay):
+    """The held-out log read, its replay on ``model`` checked feasible (:mod:`wbfriction.replay.feasibility`) before
+    the refinement's minute rather than after it."""
+    from wbfriction.replay.mjcf import checked_replay
     from wbfriction.replay.rollout import read_log_setpoints
 
     data = read_log_setpoints(robot, held_out)
+    checked_replay(model, robot, data, replay)
+    return data
+
+
+def _held_out(model: Path, refined: Path, robot, held_out: Path, data, replay) -> Table:
+    """The file and the refined file replayed on the held-out log (``data``, its reading): their RMS per joint
+    [mrad]."""
+    from wbfriction.replay.mjcf import replay_mjcf
+
     before, after = replay_mjcf(model, robot, data, replay), replay_mjcf(refined, robot, data, replay)
     table = Table(title=f"held out ({held_out.name}): RMS of simulated - logged angle \\[mrad], windows of "
                         f"{replay.horizon:g} s", box=None)

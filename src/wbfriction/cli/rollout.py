@@ -62,7 +62,7 @@ def rollout(log: Path = LogArg,
     w = check.windows
     table = Table(title="RMS of simulated - logged angle \\[mrad]", box=None, caption_justify="left",
                   caption=f"{model.name} replayed on rows {w.rows[0]} to {w.rows[1]} of {log.name}; windows: "
-                          f"restarted from the log every {window:g} s; whole: one shot")
+                          f"restarted from the log every {window:g} s; whole: one shot" + runs_note(w.runs))
     for col in ("joint", f"windows ({window:g} s)", "whole"):
         table.add_column(col, justify="left" if col == "joint" else "right")
     for joint, a, b in zip(w.joints, check.windows.rms, check.whole.rms):
@@ -72,6 +72,16 @@ def rollout(log: Path = LogArg,
     for path in (output, figure):
         if path is not None:
             console.print(f"wrote {path}")
+
+
+def runs_note(runs: tuple[tuple[int, int], ...]) -> str:
+    """What a table's caption says of a stretch replayed in several runs (the log's gaps: each run replayed on its
+    own, :mod:`wbfriction.replay.feasibility`); nothing for one."""
+    if len(runs) < 2:
+        return ""
+    starts = ", ".join(str(a) for a, _ in runs[1:4]) + (", ..." if len(runs) > 4 else "")
+    return (f"; the log's gaps cut it into {len(runs)} evenly sampled runs, each replayed on its own (restarted at "
+            f"rows {starts})")
 
 
 def replay_options(window: float, timestep: float | None, start: float | None, stop: float | None,

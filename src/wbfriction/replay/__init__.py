@@ -1,7 +1,8 @@
 """Replays of a log's set-points, the check of what an identification gives a simulator's user: the rollout of an
 identified parameter set on the project's own MuJoCo model of a PD-driven robot (:mod:`.rollout`), the replay of an
 exported MJCF as MuJoCo runs that file (:mod:`.mjcf`, the check ``wbfriction rollout`` runs), and that file's
-friction and drive values refined on its own tracking error (:mod:`.refine`, ``wbfriction refine``). It sits above
+friction and drive values refined on its own tracking error (:mod:`.refine`, ``wbfriction refine``), each checked
+before it starts to be a replay of what it scores (:mod:`.feasibility`). It sits above
 the simulators (:mod:`wbfriction.sim`) and the exports (:mod:`wbfriction.export`), both of which it runs."""
 
 import lazy_loader

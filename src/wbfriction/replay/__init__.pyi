@@ -1,5 +1,7 @@
+from .feasibility import ReplayInfeasible as ReplayInfeasible
 from .mjcf import Replay as Replay
 from .mjcf import ReplayCheck as ReplayCheck
+from .mjcf import checked_replay as checked_replay
 from .mjcf import replay_check as replay_check
 from .mjcf import replay_mjcf as replay_mjcf
 from .rollout import ActuatorParams as ActuatorParams

@@ -19,7 +19,13 @@ the file's. This is how a torque-delayed model, which no MJCF holds, is scored a
 
 **Windows.** As in :mod:`wbfriction.replay.rollout`, every ``horizon`` seconds the replay restarts from the log's
 state (the model's angle: the logged one less the encoder offset; the logged velocity): 1 s by default, the error
-a simulator's user sees over a second of its own motion; ``horizon=None`` replays the stretch in one shot.
+a simulator's user sees over a second of its own motion; ``horizon=None`` replays the stretch in one shot. A log with
+gaps is replayed run by run (:func:`~wbfriction.replay.feasibility.log_runs`): a window restarts at each run's first
+row too, its history that row's set-point.
+
+**What is refused.** Before any replay (:func:`checked_replay`) the file must be the robot's (its model, joints and
+encoder offsets), its timestep must hold the actuators' delay and the log's set-points, the windows two samples,
+PACE's torque delay less than a window (:mod:`wbfriction.replay.feasibility`).
 
 Sources: MuJoCo 4.0.0 ``mj_initCtrlHistory`` (the actuator's history), ``actuator_gainprm``/``biasprm`` (the
 affine law ``force = gainprm[0] ctrl + biasprm[0] + biasprm[1] qpos + biasprm[2] qvel``); PACE's actuator
@@ -42,6 +48,18 @@ import pyarrow as pa
 from wbfriction.exceptions import InputError
 from wbfriction.export.drive import HOLD_EDGE
 from wbfriction.model.robot import Robot
+from wbfriction.replay.feasibility import (
+    check_history,
+    check_robot,
+    check_runs,
+    check_timestep,
+    check_torque_delay,
+    check_window,
+    log_period,
+    run_windows,
+    stretch_runs,
+    window_rows,
+)
 from wbfriction.replay.rollout import LogSetpoints, RolloutResult, read_log_setpoints, stretch_rows
 
 
@@ -180,15 +198,14 @@ class ReplayModel:
         m, drives, replay = self.model, self.drives, self.replay
         period = float(np.median(np.diff(data.time)))
         offset = robot.offset_vector
-        shot = stop - start if horizon is None else max(1, int(round(horizon / period)))
         q_sim = np.empty((stop - start, robot.n_act))
         d = mujoco.MjData(m)
         run = _actuated if replay.torque_delay is None else functools.partial(_held_torque, delay=replay.torque_delay)
-        for first in range(start, stop, shot):
-            last = min(first + shot, stop)
+        for first, last in run_windows(data.runs, start, stop, window_rows(horizon, period, (start, stop))):
             mujoco.mj_resetData(m, d)
             d.qpos[drives.qpos], d.qvel[drives.dofs] = data.q[first] - offset, data.qd[first]
-            q_sim[first - start:last - start] = run(m, d, drives, data, first, last, period)
+            run_start = next(a for a, b in data.runs if a <= first < b)
+            q_sim[first - start:last - start] = run(m, d, drives, data, first, last, period, run_start)
             if not np.all(np.isfinite(q_sim[first - start:last - start])):
                 raise SimulationError(f"{self.source}: the replay diverged between rows {first} and {last}")
         return q_sim + offset
@@ -196,11 +213,15 @@ class ReplayModel:
 
 def load_replay(model: str | Path, robot: Robot, data: LogSetpoints, replay: Replay = Replay()) -> ReplayModel:
     """``model`` (an MJCF) loaded to replay ``data``, a log of ``robot`` (:func:`replay_mjcf`), its timestep set as
-    ``replay`` asks.
+    ``replay`` asks, once the file is this robot's and its timestep replays the log (:mod:`.feasibility`: the
+    file's model and offsets against the robot TOML's, the timestep against the log period and the actuators'
+    history).
 
     Raises:
         InputError: a file MuJoCo cannot load, a floating-base robot, a joint or actuator the file lacks, a log with
             velocity set-points, feed-forward torques or gains the file does not hold.
+        ReplayInfeasible: another robot's file, other encoder offsets, a log without a period, a timestep longer
+            than the log period or too short for the actuators' history (:mod:`.feasibility`).
     """
     import mujoco
 
@@ -212,15 +233,41 @@ def load_replay(model: str | Path, robot: Robot, data: LogSetpoints, replay: Rep
         m = mujoco.MjModel.from_xml_path(source)
     except (ValueError, OSError) as err:
         raise InputError(f"{source}: MuJoCo cannot load it: {err}") from None
+    check_robot(source, m, robot)
     drives = _drives(m, robot, source)
     _check_setpoints(data, drives, source)
+    period = log_period(data.time, data.source)
     if replay.timestep is not None:
         m.opt.timestep = replay.timestep
     if replay.torque_delay is not None:
-        period = float(np.median(np.diff(data.time)))
         m.opt.timestep = period / math.ceil(period / m.opt.timestep - 1e-9)
         m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_ACTUATION
+    else:
+        check_history(source, m, drives.acts, robot.actuated)
+    check_timestep(source, float(m.opt.timestep), period, Path(data.source).name)
     return ReplayModel(m, drives, replay, source)
+
+
+def checked_replay(model: str | Path, robot: Robot, data: LogSetpoints, replay: Replay = Replay(), *,
+                   rows: tuple[int, int] | None = None,
+                   times: tuple[float, float] | None = None) -> tuple[ReplayModel, tuple[int, int]]:
+    """``model`` loaded to replay a stretch of ``data`` (:func:`load_replay`) and the stretch's rows ``[start,
+    stop)`` (rows or times ``[t0, t1)`` [s]; neither: the whole log), once the replay is known feasible there
+    (:mod:`.feasibility`): its windows hold two samples at least, one of its runs two rows, PACE's torque delay is
+    shorter than a window. What :func:`replay_mjcf` and :func:`~wbfriction.replay.refine.refine_mjcf` start with,
+    before any replay.
+
+    Raises:
+        what :func:`load_replay` raises; InputError: a stretch out of the log; ReplayInfeasible: the above.
+    """
+    loaded = load_replay(model, robot, data, replay)
+    stretch = stretch_rows(data.time, rows, times)
+    period = log_period(data.time, data.source)
+    check_window(data.source, replay.horizon, period, stretch)
+    check_runs(data.source, data.runs, stretch)
+    if replay.torque_delay is not None:
+        check_torque_delay(loaded.source, replay.torque_delay, period, window_rows(replay.horizon, period, stretch))
+    return loaded, stretch
 
 
 def replay_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | LogSetpoints, replay: Replay = Replay(),
@@ -246,16 +293,17 @@ def replay_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | Lo
         SimulationError: the state diverged.
     """
     data = log if isinstance(log, LogSetpoints) else read_log_setpoints(robot, log)
-    loaded = load_replay(model, robot, data, replay)
-    start, stop = stretch_rows(data.time, rows, times)
+    loaded, (start, stop) = checked_replay(model, robot, data, replay, rows=rows, times=times)
     q_sim = loaded.run(robot, data, start, stop, replay.horizon)
     return RolloutResult(replay.label, robot.actuated, (start, stop), data.time[start:stop], q_sim,
-                         data.q[start:stop].copy(), replay.horizon)
+                         data.q[start:stop].copy(), replay.horizon, runs=stretch_runs(data.runs, (start, stop)))
 
 
-def _actuated(m, d, drives: _Drives, data: LogSetpoints, first: int, last: int, period: float) -> np.ndarray:
+def _actuated(m, d, drives: _Drives, data: LogSetpoints, first: int, last: int, period: float,
+              run_start: int = 0) -> np.ndarray:
     """Samples ``[first, last)`` run by the file's actuators: ``q_des`` held a period each, the history holding
-    those commanded before ``first`` (at their times); the model's angles at each sample (last - first, n)."""
+    those commanded before ``first`` (at their times) from the run's first row ``run_start`` on (before it, that
+    row's); the model's angles at each sample (last - first, n)."""
     import mujoco
 
     q_des, n = data.commands.q_des, len(data.time)
@@ -264,7 +312,7 @@ def _actuated(m, d, drives: _Drives, data: LogSetpoints, first: int, last: int, 
         samples = int(m.actuator_history[act, 0])
         if samples:
             times = -h * np.arange(samples - 1, -1, -1, dtype=float)
-            held = np.clip(first + np.floor(times / period + 1e-9).astype(int), 0, n - 1)
+            held = np.clip(first + np.floor(times / period + 1e-9).astype(int), run_start, n - 1)
             mujoco.mj_initCtrlHistory(m, d, int(act), times.reshape(-1, 1), np.ascontiguousarray(q_des[held, a:a + 1]))
     out = np.empty((last - first, len(drives.acts)))
     out[0] = d.qpos[drives.qpos]
@@ -277,7 +325,7 @@ def _actuated(m, d, drives: _Drives, data: LogSetpoints, first: int, last: int, 
 
 
 def _held_torque(m, d, drives: _Drives, data: LogSetpoints, first: int, last: int, period: float,
-                 delay: int) -> np.ndarray:
+                 run_start: int = 0, *, delay: int) -> np.ndarray:
     """Samples ``[first, last)`` run by PACE's actuator (module docstring): the law on the state at each sample,
     applied ``delay`` samples later (before then, the first torque); the model's angles at each sample."""
     import mujoco

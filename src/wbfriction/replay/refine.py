@@ -85,8 +85,8 @@ from wbfriction.exceptions import InputError
 from wbfriction.export.drive import HOLD_EDGE
 from wbfriction.fit.block_spread import t_scale
 from wbfriction.model.robot import Robot
-from wbfriction.replay.mjcf import Replay, ReplayModel, load_replay
-from wbfriction.replay.rollout import LogSetpoints, read_log_setpoints, stretch_rows
+from wbfriction.replay.mjcf import Replay, ReplayModel, checked_replay
+from wbfriction.replay.rollout import LogSetpoints, read_log_setpoints
 
 PARAMETERS = ("armature", "F_c", "F_v", "tau_os")
 """The refined values of each joint, in the order of :attr:`Refinement.value`'s rows."""
@@ -230,12 +230,13 @@ def refine_mjcf(model: str | Path, robot: Robot, log: pa.Table | str | Path | Lo
         :class:`Refinement`; :func:`write_refined` writes it into the file.
 
     Raises:
-        what :func:`~wbfriction.replay.mjcf.replay_mjcf` raises (a stretch of less than two samples among them).
+        what :func:`~wbfriction.replay.mjcf.replay_mjcf` raises (a stretch of less than two samples among them;
+        ReplayInfeasible: a replay that cannot replay the log, :mod:`wbfriction.replay.feasibility`), before any
+        replay.
     """
     began = clock.perf_counter()
     data = log if isinstance(log, LogSetpoints) else read_log_setpoints(robot, log)
-    loaded = load_replay(model, robot, data, replay)
-    rows = stretch_rows(data.time, None, times)
+    loaded, rows = checked_replay(model, robot, data, replay, times=times)  # feasible, before any replay
     problem = _Problem(loaded, robot, data, rows, replay.horizon)
     grid = delay_grid(loaded)
     x0, d0 = file_parameters(loaded, robot), loaded.delay

@@ -18,7 +18,8 @@ where a model's slow drift (a joint that sticks in the model and not on the robo
 restart takes the log's velocity, the driver's noisy one (0.08 rad/s on a real driver), so short horizons add a
 transient of that noise to every shot. Measured on the hung Go2 (25 s, a real driver's noise, the true parameters):
 2.3e-4 rad RMS at worst in one shot, 5.6e-4 restarting every 2 s, 8.0e-4 every 0.5 s; with wrong parameters the
-three agree within 10 %.
+three agree within 10 %. A horizon must hold two of the log's samples, and a log with gaps is replayed run by run,
+each run's set-points only (:mod:`wbfriction.replay.feasibility`).
 
 **A peer's delay.** PACE (the peer's method) delays the PD's torque, its feedback with its set-point
 (:attr:`ActuatorParams.torque_delay`), where wbfriction's driver delays the set-points: replay a parameter set the
@@ -29,6 +30,7 @@ way it was identified. On the real Aliengo's last 40 % the peer's parameters tra
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,6 +43,15 @@ from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.friction.models import ModelParams, ModelParamsBase
 from wbfriction.logs.tables import numeric_columns, read_table
 from wbfriction.model.robot import Robot
+from wbfriction.replay.feasibility import (
+    check_runs,
+    check_torque_delay,
+    check_window,
+    log_runs,
+    run_windows,
+    stretch_runs,
+    window_rows,
+)
 from wbfriction.sim.options import FrictionMode
 from wbfriction.sim.pd_robot import Commands, PdMujocoRobot, PdRun, build_pd_robot, joint_values
 
@@ -84,6 +95,8 @@ class RolloutResult:
         q_log: the log's angles (M, n) [rad].
         horizon: the shots' length [s] (None: one shot).
         no_friction: joints replayed without friction (a fit without parameters, or none given).
+        runs: the log's evenly sampled runs within the stretch, rows ``[a, b)`` each, each replayed on its own (one:
+            the stretch; :mod:`wbfriction.replay.feasibility`); empty: not recorded.
     """
 
     label: str
@@ -94,6 +107,7 @@ class RolloutResult:
     q_log: np.ndarray
     horizon: float | None
     no_friction: tuple[str, ...] = ()
+    runs: tuple[tuple[int, int], ...] = ()
 
     @property
     def error(self) -> np.ndarray:
@@ -150,12 +164,23 @@ def _friction(robot: Robot, given: Mapping[str, Any] | str | Path) -> tuple[dict
 @dataclass(frozen=True, eq=False)
 class LogSetpoints:
     """What the rollout reads of a PD-driven robot's log (every joint, in the robot's order): ``time`` (N,) [s], the
-    logged angles ``q`` and velocities ``qd`` (N, n), and the :class:`~wbfriction.sim.pd_robot.Commands`."""
+    logged angles ``q`` and velocities ``qd`` (N, n), the :class:`~wbfriction.sim.pd_robot.Commands`, and the log's
+    ``source`` (its file, or ``<table>``)."""
 
     time: np.ndarray
     q: np.ndarray
     qd: np.ndarray
     commands: Commands
+    source: str = "<table>"
+
+    @functools.cached_property
+    def runs(self) -> tuple[tuple[int, int], ...]:
+        """The log's evenly sampled runs, rows ``[a, b)`` (:func:`~wbfriction.replay.feasibility.log_runs`: one
+        without gaps).
+
+        Raises:
+            ReplayInfeasible: a time without a period."""
+        return log_runs(self.time, self.source)
 
 
 def read_log_setpoints(robot: Robot, log: pa.Table | str | Path) -> LogSetpoints:
@@ -193,7 +218,7 @@ def read_log_setpoints(robot: Robot, log: pa.Table | str | Path) -> LogSetpoints
     qd_des, tau_ff = group("qd_des", False), group("tau_ff", False)
     commands = Commands(q_des, zeros if qd_des is None else qd_des, zeros if tau_ff is None else tau_ff,
                         group("kp", False), group("kd", False))
-    return LogSetpoints(time, q, qd, commands)
+    return LogSetpoints(time, q, qd, commands, source)
 
 
 def stretch_rows(time: np.ndarray, rows: tuple[int, int] | None, times: tuple[float, float] | None) -> tuple[int, int]:
@@ -235,6 +260,8 @@ def rollout(robot: Robot, log: pa.Table | str | Path | LogSetpoints, params: Act
     Raises:
         InputError: a stretch out of the log, a horizon <= 0, values for unknown joints, friction that is no family's
             parameters, a robot that is not a fixed-base PD-driven one.
+        ReplayInfeasible: a horizon of fewer than two samples, a stretch without two rows a period apart, a torque
+            delay as long as a horizon (:mod:`wbfriction.replay.feasibility`), before any replay.
         UnknownFamilyError: parameters of a family the registry does not know.
         ColumnError: a column the replay needs is missing.
     """
@@ -251,11 +278,22 @@ def rollout(robot: Robot, log: pa.Table | str | Path | LogSetpoints, params: Act
     period = float(np.median(np.diff(data.time)))
     run = PdRun(mjr, period, substeps, driver, armature, offset, friction, friction_mode,
                 torque_delay=params.torque_delay)
-    shot = stop - start if horizon is None else max(1, int(round(horizon / period)))
+    shot = window_rows(horizon, period, (start, stop))
+    check_window(data.source, horizon, period, (start, stop))
+    check_runs(data.source, data.runs, (start, stop))
+    if run.torque_delay is not None:
+        check_torque_delay(data.source, run.torque_delay / substeps, period, shot)
     q_sim = np.empty((stop - start, robot.n_act))
-    for first in range(start, stop, shot):
-        last = min(first + shot, stop)
-        trajectory = run.run(data.commands, first, last, data.q[first] - offset, data.qd[first])
+    for first, last in run_windows(data.runs, start, stop, shot):
+        a, b = next(r for r in data.runs if r[0] <= first < r[1])  # the run's set-points only: none across a gap
+        trajectory = run.run(_rows(data.commands, a, b), first - a, last - a, data.q[first] - offset, data.qd[first])
         q_sim[first - start:last - start] = trajectory.q + offset
     return RolloutResult(params.label, robot.actuated, (start, stop), data.time[start:stop], q_sim,
-                         data.q[start:stop].copy(), horizon, bare)
+                         data.q[start:stop].copy(), horizon, bare, stretch_runs(data.runs, (start, stop)))
+
+
+def _rows(commands: Commands, a: int, b: int) -> Commands:
+    """The commands of rows ``[a, b)`` (views)."""
+    c = commands
+    return Commands(c.q_des[a:b], c.qd_des[a:b], c.tau_ff[a:b], None if c.kp is None else c.kp[a:b],
+                    None if c.kd is None else c.kd[a:b])
