@@ -52,9 +52,9 @@ class ArmDesignOptions:
     """
 
     duration: float = option(PD_EXCITE.duration, quantity="duration")
-    rate: float = option(ARM_RATE)
-    period: float = option(ARM_PERIOD)
-    torque_share: float = option(PD_EXCITE.torque_share)
+    rate: float = option(ARM_RATE, quantity="rate")
+    period: float = option(ARM_PERIOD, quantity="period")
+    torque_share: float = option(PD_EXCITE.torque_share, quantity="share")
     seed: int = option(PD_EXCITE.seed, quantity="seed")
     after: Optional[Path] = option(None)
 
