@@ -137,8 +137,8 @@ def design_pd(robot: Robot, options: PdExciteOptions = PdExciteOptions(),
 
     Raises:
         InputError: a robot the hung simulator does not take, a joint without limits
-            (:meth:`~.limits.JointLimits.of`); no candidate within the limits (every one dropped: how many for
-            each reason, and the first's).
+            (:meth:`~.limits.JointLimits.of`); no candidate within the limits (every one dropped: how many, and
+            the first's reason).
     """
     limits = JointLimits.of(robot)
     still = np.zeros(robot.n_act, dtype=bool) if moving is None else ~np.isin(robot.actuated, tuple(moving))
@@ -204,13 +204,13 @@ def beyond_log(limits: JointLimits, q: np.ndarray) -> str | None:
     i = int(np.argmax(excess))
     if excess[i] <= LIMIT_MARGIN:
         return None
-    return (f"its motion passes the position limit of joint '{limits.joints[i]}' by {excess[i]:.3g} rad, more than a log "
-            f"may ({LIMIT_MARGIN:g} rad)")
+    return (f"its motion passes the position limit of joint '{limits.joints[i]}' by {excess[i]:.3g} rad, more than "
+            f"a log may ({LIMIT_MARGIN:g} rad)")
 
 
 def none_left(robot: str, candidates: list[Candidate], torque_share: float) -> str:
-    """The one line of a search that kept no candidate: every one dropped (how many for each reason, and the first
-    reason), or those scored outside the limits."""
+    """The one line of a search that kept no candidate: every one dropped (how many, and the first's reason), or those
+    scored outside the limits (and how many dropped)."""
     dropped = [c.dropped for c in candidates if c.dropped is not None]
     if len(dropped) == len(candidates):
         return (f"robot '{robot}': no candidate motion can be scored: {len(dropped)} of {len(candidates)} dropped "
