@@ -37,7 +37,7 @@ def test_an_arm_without_torque_constants_logs_its_torques(arms):
     with_currents, with_torques = (recorded(r, friction, trajectory, options) for r in (panda, bare))
     assert f"current.{JOINT}" in with_currents.column_names and f"tau.{JOINT}" not in with_currents.column_names
     assert f"tau.{JOINT}" in with_torques.column_names and f"current.{JOINT}" not in with_torques.column_names
-    for i, joint in enumerate(panda.actuated):  # the same torque: current x constant
+    for joint in panda.actuated:  # the same torque: current x constant
         np.testing.assert_allclose(with_torques.column(f"tau.{joint}").to_numpy(),
                                    with_currents.column(f"current.{joint}").to_numpy() * panda.torque_constants[joint],
                                    rtol=1e-12, atol=1e-12)

@@ -16,9 +16,9 @@ import wbfriction
 import wbfriction.excite.pd_design as pd_design
 import wbfriction.excite.predict as predict
 from helpers import run_cli_printed, said
+from wbfriction.exceptions import InputError
 from wbfriction.excite.document import pd_document
 from wbfriction.excite.options import PdExciteOptions
-from wbfriction.exceptions import InputError
 from wbfriction.logs.options import LIMIT_MARGIN
 from wbfriction.sim.hung import simulate_hung
 

@@ -17,9 +17,9 @@ from hypothesis import strategies as st
 
 from helpers import run_cli_printed, said
 from test_quantities import inside, outside
+from wbfriction.exceptions import InputError, OptionError
 from wbfriction.excite.design import ExciteOptions
 from wbfriction.excite.options import DESIGN_MEMORY, JOINT_SAMPLE, check_design_size, design_samples
-from wbfriction.exceptions import InputError, OptionError
 from wbfriction.options import flag_of, read_options
 from wbfriction.rigs import Rig, rigs
 
