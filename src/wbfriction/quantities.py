@@ -81,6 +81,10 @@ RANGES: Mapping[str, Range] = MappingProxyType({
     "torque_std": Range(0.0, 100.0, "N·m", "a torque sensor's noise"),
     "velocity_std": Range(0.0, 10.0, "rad/s", "a driver's velocity noise"),
     "substeps": Range(1, 1000, "", "physics steps per control period", integer=True),
+    "rate": Range(0.0, 1e4, "Hz", "a drivers' set-point rate: a control bus's cycle, at most 10 kHz; a driver's "
+                  "faster current loop runs inside it", low_open=True),
+    "period": Range(0.0, 3600.0, "s", "a periodic excitation's period: at most a recording (an hour)", low_open=True),
+    "share": Range(0.0, 1.0, "", "a share of a range or of a limit", low_open=True),
 })
 """Each quantity's :class:`Range`, by the name :func:`in_range` takes."""
 

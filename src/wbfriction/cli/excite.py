@@ -14,6 +14,7 @@ from wbfriction.cli.common import (
     UrdfOpt,
     app,
     console,
+    given_options,
     print_items,
     robot_of,
     stages,
@@ -25,7 +26,7 @@ from wbfriction.exceptions import InputError
 
 # Loading this module (what `wbfriction --help` and every command pay before they start) imports only the
 # options, whose defaults the help shows: the design is imported when the command runs.
-from wbfriction.excite.options import ARM_PERIOD, ARM_RATE, PD_EXCITE
+from wbfriction.excite.options import ARM_PERIOD, ARM_RATE, PD_EXCITE, check_design_size
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.rigs import DesignOutput, RigProgress, rig_for
 from wbfriction.rigs.quadruped import STANDING_RATE
@@ -103,6 +104,10 @@ def excite(ctx: typer.Context,
     if rig.design_options is None:
         raise InputError(f"{rig.what(r)}: excite designs no motion for it")
     (options,) = rig_options(ctx, values, (rig.design_options,), rig.what(r), SHARED, rig_option)
+    length, samples = getattr(options, "duration", None), getattr(options, "rate", None)  # a rig's own may have none
+    if length is not None and samples is not None:
+        check_design_size(r.name, r.n_act, length, samples,
+                          "--rate" if "rate" in given_options(ctx) and duration is None else "--duration")
     with stages() as status:
         design = rig.design(r, options, RigProgress(status, status.steps))
     write_design(design, output, prediction, figure, rig.what(r))

@@ -69,6 +69,12 @@ class ExciteOptions:
     seed: int = 0
 
     def __post_init__(self) -> None:
+        if not self.rate > 0:
+            raise InputError(f"--rate {self.rate:g}: a rate is > 0 Hz")
+        if not self.period * self.rate > 2 * self.harmonics:  # a NaN too
+            raise InputError(f"--period {self.period:g}: its series' highest harmonic ({self.harmonics} per period) "
+                             f"must lie below half the rate ({self.rate:g} Hz): a period over "
+                             f"{2 * self.harmonics / self.rate:g} s")
         cycles = self.duration / self.period if self.period > 0 else np.nan
         if not (np.isfinite(cycles) and cycles >= 1 and abs(cycles - round(cycles)) < 1e-9):
             raise InputError(f"--period {self.period:g}: the recording of {self.duration:g} s must hold a whole "

@@ -7,7 +7,8 @@ benchmark).
 The document::
 
     {"robot": ..., "kind": "hung PD-driven", "criterion": ..., "worst": {"joint", "parameter", "share"},
-     "chosen": {"amplitude", "reversal"}, "candidates": [{"amplitude", "reversal", "worst", "within"}, ...],
+     "chosen": {"amplitude", "reversal"},
+     "candidates": [{"amplitude", "reversal", "worst", "within", "dropped" (a dropped one's: why)}, ...],
      "predicted": {"<joint>": {"<parameter>": {"value", "se", "model_error", "bound", "limit", "share", "status",
                                                "reason"}}},
      "delay": {...}, "delayed_known": bool,
@@ -16,7 +17,8 @@ The document::
                "logged": {"<joint>": {"status", "reason", "F_v": {"value", "se"}, "F_c": {...}}}}}
 
 Units: each parameter's own (:data:`~wbfriction.actuator.identification.UNITS`); ``share`` is ``se / limit``, below
-1 where the parameter is predicted ``ok``; margins are shares of each limit left unused (0: at it).
+1 where the parameter is predicted ``ok``; margins are shares of each limit left unused (0: at it). A candidate the
+search dropped unscored (:attr:`~wbfriction.excite.pd_design.Candidate.dropped`) has ``worst`` null and says why.
 """
 
 from __future__ import annotations
@@ -72,7 +74,8 @@ def pd_document(design: PdDesign) -> dict[str, Any]:
         "worst": {"joint": joint, "parameter": name, "share": share},
         "chosen": {"amplitude": design.chosen.amplitude, "reversal": list(design.chosen.reversal)},
         "candidates": [{"amplitude": c.amplitude, "reversal": list(c.reversal), "worst": c.worst[2],
-                        "within": c.within} for c in design.candidates],
+                        "within": c.within, **({} if c.dropped is None else {"dropped": c.dropped})}
+                       for c in design.candidates],
         "predicted": {j: {n: _parameter(n, p) for n, p in params.items()}
                       for j, params in design.prediction.joints.items()},
         "delay": _parameter("delay", design.prediction.delay),

@@ -27,6 +27,13 @@ range, then the reversal ranges at the best amplitude, each candidate scored by 
 two identifications, 5-10 s for 30 s of a quadruped); a candidate whose motion leaves a position or velocity limit or
 asks more than :attr:`PdExciteOptions.torque_share` of a driver's torque limit is refused; the lowest worst share
 kept. Derivative-free on a grid: the score of random levels is not smooth in these variables.
+
+**A candidate is scored, never raised.** Its motion is simulated without noise first; one that passes a position
+limit by more than a log may (:data:`~wbfriction.logs.options.LIMIT_MARGIN`: its log would be refused as read,
+so it has no identification to predict) is dropped, its reason kept (:attr:`Candidate.dropped`), as is one whose
+simulated log the log's checks refuse; the search goes on without it. Only when no candidate is left does the design
+fail, in one line saying why (issue 81: a hung Go2's 10 s design stopped on one fast candidate's overshoot, blaming
+the units).
 """
 
 from __future__ import annotations
@@ -39,15 +46,16 @@ import numpy as np
 
 from wbfriction.actuator.identification import OFFSET_WEAK
 from wbfriction.actuator.options import ActuatorOptions
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.excite.limits import JointLimits, Margins, margins
 from wbfriction.excite.options import PdExciteOptions
 from wbfriction.excite.predict import ActuatorPrediction, predict_pd, worst_share
 from wbfriction.fit.status import WEAK
 from wbfriction.friction.models import ModelParams
+from wbfriction.logs.options import LIMIT_MARGIN
 from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
-from wbfriction.sim.hung import setpoint_band, setpoints
+from wbfriction.sim.hung import setpoint_band, setpoints, simulate_hung
 from wbfriction.sim.pd_options import DriverNoise, HungOptions
 
 SHARE_LIMITS = {"offset": OFFSET_WEAK}
@@ -57,14 +65,17 @@ SHARE_LIMITS = {"offset": OFFSET_WEAK}
 @dataclass(frozen=True)
 class Candidate:
     """One candidate of the search: its ``amplitude``, ``reversal`` [s], the parameter predicted worst ``worst``
-    (joint, name, share of its limit), its motion's :class:`~.limits.Margins` ``margins`` and whether it was within
-    the limits (``within``)."""
+    (joint, name, share of its limit; a dropped candidate's: ``("", "", inf)``), its motion's
+    :class:`~.limits.Margins` ``margins``, whether it was within the limits (``within``), and why it was dropped
+    unscored (``dropped``: its motion passes a position limit further than a log may, or its simulated log is
+    refused; None: scored)."""
 
     amplitude: float
     reversal: tuple[float, float]
     worst: tuple[str, str, float]
     margins: Margins
     within: bool
+    dropped: str | None = None
 
 
 @dataclass(frozen=True)
@@ -101,6 +112,10 @@ class PdDesign:
         """The parameter predicted worst: (joint, name, share of its status's limit)."""
         return self.chosen.worst
 
+    def dropped(self) -> tuple[Candidate, ...]:
+        """The candidates dropped unscored (:attr:`Candidate.dropped`), in the search's order."""
+        return tuple(c for c in self.candidates if c.dropped is not None)
+
 
 def design_pd(robot: Robot, options: PdExciteOptions = PdExciteOptions(),
               prior: Mapping[str, ModelParams] | None = None,
@@ -122,27 +137,17 @@ def design_pd(robot: Robot, options: PdExciteOptions = PdExciteOptions(),
 
     Raises:
         InputError: a robot the hung simulator does not take, a joint without limits
-            (:meth:`~.limits.JointLimits.of`); no candidate within the limits.
+            (:meth:`~.limits.JointLimits.of`); no candidate within the limits (every one dropped: how many, and
+            the first's reason).
     """
     limits = JointLimits.of(robot)
     still = np.zeros(robot.n_act, dtype=bool) if moving is None else ~np.isin(robot.actuated, tuple(moving))
-    scored: dict[tuple[float, tuple[float, float]], tuple[Candidate, ActuatorPrediction]] = {}
+    scored: dict[tuple[float, tuple[float, float]], tuple[Candidate, ActuatorPrediction | None]] = {}
 
     def score(amplitude: float, reversal: tuple[float, float]) -> Candidate:
         key = (amplitude, reversal)
         if key not in scored:
-            hung = options.hung(amplitude, reversal)
-            prediction = predict_pd(robot, hung, prior, reference=held(robot, hung, still),
-                                    identification=identification)
-            assert prediction.motion is not None
-            run = prediction.motion.trajectory
-            m = margins(limits, run.q, run.qd, run.tau)
-            m = Margins(np.where(still, 1.0, m.position), np.where(still, 1.0, m.velocity), m.torque)
-            within = bool(min(m.position.min(), m.velocity.min()) > 0
-                          and m.torque.min() >= 1.0 - options.torque_share)
-            asked = {j: p for j, p in prediction.joints.items() if not still[robot.actuated.index(j)]}
-            scored[key] = (Candidate(amplitude, reversal, worst_share(asked, SHARE_LIMITS, WEAK), m, within),
-                           prediction)
+            scored[key] = scored_candidate(robot, limits, options, amplitude, reversal, still, prior, identification)
             if progress is not None:
                 progress(1)
         return scored[key][0]
@@ -155,14 +160,65 @@ def design_pd(robot: Robot, options: PdExciteOptions = PdExciteOptions(),
     amplitude = first.amplitude if first is not None else min(options.amplitudes)
     chosen = best([score(amplitude, r) for r in options.reversals])
     if chosen is None:
-        raise InputError(f"robot '{robot.name}': every candidate passes a limit or {options.torque_share:.0%} of a "
-                         "torque limit: lower --amplitude")
+        raise InputError(none_left(robot.name, [c for c, _ in scored.values()], options.torque_share))
     prediction = scored[(chosen.amplitude, chosen.reversal)][1]
-    assert prediction.motion is not None
+    assert prediction is not None and prediction.motion is not None  # within: scored
     commands = prediction.motion.commands
     return PdDesign(robot.name, robot.actuated, prediction.motion.time, commands.q_des, commands.qd_des, chosen,
                     tuple(c for c, _ in scored.values()), prediction, chosen.margins, options,
                     tuple(j for j, s in zip(robot.actuated, still) if not s))
+
+
+def scored_candidate(robot: Robot, limits: JointLimits, options: PdExciteOptions, amplitude: float,
+                     reversal: tuple[float, float], still: np.ndarray, prior: Mapping[str, ModelParams] | None,
+                     identification: ActuatorOptions) -> tuple[Candidate, ActuatorPrediction | None]:
+    """One candidate of :func:`design_pd` and its prediction (None: dropped unscored, module docstring): its motion
+    simulated without noise, its margins (a joint ``still`` (n_act,): 1), then its identification predicted unless
+    the motion passes a position limit further than a log may or its simulated log is refused."""
+    hung = options.hung(amplitude, reversal)
+    reference = held(robot, hung, still)
+    motion = simulate_hung(robot, dataclasses.replace(hung, noise=DriverNoise()), prior, reference=reference)
+    run = motion.trajectory
+    m = margins(limits, run.q, run.qd, run.tau)
+    m = Margins(np.where(still, 1.0, m.position), np.where(still, 1.0, m.velocity), m.torque)
+    dropped = beyond_log(limits, run.q)
+    prediction = None
+    if dropped is None:
+        try:
+            prediction = predict_pd(robot, hung, prior, reference=reference, identification=identification,
+                                    motion=motion)
+        except ColumnError as e:  # the log's checks refuse its simulated log
+            dropped = f"its simulated log is refused ({e})"
+    if prediction is None:
+        return Candidate(amplitude, reversal, ("", "", np.inf), m, False, dropped), None
+    within = bool(min(m.position.min(), m.velocity.min()) > 0 and m.torque.min() >= 1.0 - options.torque_share)
+    asked = {j: p for j, p in prediction.joints.items() if not still[robot.actuated.index(j)]}
+    return Candidate(amplitude, reversal, worst_share(asked, SHARE_LIMITS, WEAK), m, within), prediction
+
+
+def beyond_log(limits: JointLimits, q: np.ndarray) -> str | None:
+    """Why a motion ``q`` (N, n) [rad, the model's angles] cannot be identified: it passes a joint's position limit
+    by more than :data:`~wbfriction.logs.options.LIMIT_MARGIN`, past which a log is refused as read (its joint, by
+    how much); None: it does not."""
+    excess = np.maximum(limits.lower - q.min(axis=0), q.max(axis=0) - limits.upper)
+    i = int(np.argmax(excess))
+    if excess[i] <= LIMIT_MARGIN:
+        return None
+    return (f"its motion passes the position limit of joint '{limits.joints[i]}' by {excess[i]:.3g} rad, more than "
+            f"a log may ({LIMIT_MARGIN:g} rad)")
+
+
+def none_left(robot: str, candidates: list[Candidate], torque_share: float) -> str:
+    """The one line of a search that kept no candidate: every one dropped (how many, and the first's reason), or those
+    scored outside the limits (and how many dropped)."""
+    dropped = [c.dropped for c in candidates if c.dropped is not None]
+    if len(dropped) == len(candidates):
+        return (f"robot '{robot}': no candidate motion can be scored: {len(dropped)} of {len(candidates)} dropped "
+                f"(the first: amplitude {candidates[0].amplitude:g}, reversals {candidates[0].reversal[0]:g}-"
+                f"{candidates[0].reversal[1]:g} s: {dropped[0]}): lower --amplitude")
+    also = f" ({len(dropped)} of {len(candidates)} dropped unscored: {dropped[0]})" if dropped else ""
+    return (f"robot '{robot}': every candidate passes a limit or {torque_share:.0%} of a torque limit{also}: lower "
+            "--amplitude")
 
 
 def held(robot: Robot, options: HungOptions, still: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:

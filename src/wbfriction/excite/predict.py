@@ -102,20 +102,26 @@ def worst_share(joints: Mapping[str, Mapping[str, Any]], limits: Mapping[str, fl
 
 def predict_pd(robot: Robot, options: HungOptions, friction: Mapping[str, ModelParams] | None = None,
                reference: tuple[np.ndarray, np.ndarray] | None = None,
-               identification: ActuatorOptions = ActuatorOptions()) -> ActuatorPrediction:
+               identification: ActuatorOptions = ActuatorOptions(),
+               motion: HungSimulation | None = None) -> ActuatorPrediction:
     """:class:`ActuatorPrediction` (module docstring) for the hung PD-driven ``robot``'s motion: ``options``'
     set-points, or ``reference`` (:func:`~wbfriction.sim.hung.simulate_hung`), its drivers' noise
-    :attr:`HungOptions.noise`, the ``friction`` prior (None: the simulator's default).
+    :attr:`HungOptions.noise`, the ``friction`` prior (None: the simulator's default); ``motion``: the same motion
+    simulated without noise already (None: simulated here).
 
     Raises:
-        InputError: what :func:`~wbfriction.sim.hung.simulate_hung` and the identification raise.
+        InputError: what :func:`~wbfriction.sim.hung.simulate_hung` and the identification raise (a
+            :class:`~wbfriction.exceptions.ColumnError`: the log's checks refuse a simulated log).
     """
-    def identified(noise: DriverNoise, held: ActuatorOptions) -> tuple[HungSimulation, ActuatorIdentification]:
-        sim = simulate_hung(robot, dataclasses.replace(options, noise=noise), friction, reference=reference)
-        return sim, identify_actuators(robot, log_from_table(sim.table, robot, "excite"), held)
+    def simulated(noise: DriverNoise) -> HungSimulation:
+        return simulate_hung(robot, dataclasses.replace(options, noise=noise), friction, reference=reference)
 
-    _, noisy = identified(options.noise, identification)
-    motion, clean = identified(DriverNoise(), dataclasses.replace(identification, delayed=noisy.options.delayed))
+    def identified(sim: HungSimulation, held: ActuatorOptions) -> ActuatorIdentification:
+        return identify_actuators(robot, log_from_table(sim.table, robot, "excite"), held)
+
+    noisy = identified(simulated(options.noise), identification)
+    motion = simulated(DriverNoise()) if motion is None else motion
+    clean = identified(motion, dataclasses.replace(identification, delayed=noisy.options.delayed))
     joints = {}
     for jc, jn in zip(clean.joints, noisy.joints):
         theirs = jn.parameters()

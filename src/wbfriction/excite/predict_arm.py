@@ -34,6 +34,7 @@ from dataclasses import dataclass
 from typing import cast
 
 import numpy as np
+import pyarrow as pa
 
 from wbfriction.excite.predict import Predicted, worst_share
 from wbfriction.fit.joints import fit_estimate
@@ -114,9 +115,28 @@ def identify_arm(robot: Robot, friction: Mapping[str, ModelParams], trajectory: 
     Raises:
         InputError: what the simulator, the estimate and the fit raise.
     """
-    sim = simulate_arm(robot, friction, armature, options, trajectory=trajectory)
-    est = estimate_log(robot, log_from_table(sim.table, robot, "excite"), estimate)
+    table = recorded(robot, friction, trajectory, options, armature)
+    est = estimate_log(robot, log_from_table(table, robot, "excite"), estimate)
     return est, fit_estimate(est, fit, joints=joints)
+
+
+def recorded(robot: Robot, friction: Mapping[str, ModelParams], trajectory: Reference, options: ArmOptions,
+             armature: dict[str, float] | None = None) -> pa.Table:
+    """The arm's motion along ``trajectory`` simulated (:func:`~wbfriction.sim.arm.simulate_arm`) and logged as the
+    robot's own logs carry its torque: motor currents ``current.<joint>`` where its TOML gives every joint a torque
+    constant, else the joints' torques ``tau.<joint>`` [N·m] (a log without a joint's constant can only carry its
+    torque). The torque is the same either way: the constants are asked of no robot whose logs do not need them
+    (issue 81: an arm without ``[torque_constants]`` was refused after its whole design).
+
+    Raises:
+        InputError: what :func:`~wbfriction.sim.arm.simulate_arm` raises.
+    """
+    if all(j in robot.torque_constants for j in robot.actuated):
+        return simulate_arm(robot, friction, armature, options, trajectory=trajectory).table
+    unit = dataclasses.replace(robot, torque_constants=dict.fromkeys(robot.actuated, 1.0), cache={})
+    table = simulate_arm(unit, friction, armature, options, trajectory=trajectory).table  # current: N·m at 1 N·m/A
+    return table.rename_columns([f"tau.{n.removeprefix('current.')}" if n.startswith("current.") else n
+                                 for n in table.column_names])
 
 
 def predict_arm(robot: Robot, friction: Mapping[str, ModelParams], trajectory: Reference,

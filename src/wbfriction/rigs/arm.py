@@ -52,9 +52,9 @@ class ArmDesignOptions:
     """
 
     duration: float = option(PD_EXCITE.duration, quantity="duration")
-    rate: float = option(ARM_RATE)
-    period: float = option(ARM_PERIOD)
-    torque_share: float = option(PD_EXCITE.torque_share)
+    rate: float = option(ARM_RATE, quantity="rate")
+    period: float = option(ARM_PERIOD, quantity="period")
+    torque_share: float = option(PD_EXCITE.torque_share, quantity="share")
     seed: int = option(PD_EXCITE.seed, quantity="seed")
     after: Optional[Path] = option(None)
 
@@ -88,8 +88,10 @@ class ArmRig(Rig):
 
         o: ArmSimulation = options
         run = ArmOptions(duration=o.duration, encoder_bits=19 if o.encoder_bits is None else o.encoder_bits,
-                         position_std=o.position_noise or 0.0, torque_std=o.torque_noise or 0.0,
-                         seed=o.noise_seed or 0, excitation=ExcitationOptions(seed=o.excitation_seed))
+                         position_std=0.0 if o.position_noise is None else o.position_noise,
+                         torque_std=0.0 if o.torque_noise is None else o.torque_noise,
+                         seed=0 if o.noise_seed is None else o.noise_seed,
+                         excitation=ExcitationOptions(seed=o.excitation_seed))
         spec = None if o.friction is None else load_friction_spec(o.friction, robot.groups, robot.torque_controlled)
         params = default_arm_friction(robot) if spec is None else spec.params
         if spec is not None and spec.temperature is not None:

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any, Literal, Optional
 from wbfriction.exceptions import InputError
 from wbfriction.excite.options import PD_EXCITE
 from wbfriction.options import option
+from wbfriction.quantities import check_option
 from wbfriction.report.printed import Printed
 from wbfriction.rigs.base import DemoOutput, DesignOutput, Rig, RigProgress, SimulationOutput
 from wbfriction.sim.options import FrictionMode
@@ -92,12 +93,18 @@ class HungDesignOptions:
     """
 
     duration: float = option(PD_EXCITE.duration, quantity="duration")
-    rate: float = option(PD_EXCITE.rate)
+    rate: float = option(PD_EXCITE.rate, quantity="rate")
     amplitude: tuple[float, ...] = option(PD_EXCITE.amplitudes)
-    torque_share: float = option(PD_EXCITE.torque_share)
+    torque_share: float = option(PD_EXCITE.torque_share, quantity="share")
     velocity: bool = option(PD_EXCITE.velocity)
     seed: int = option(PD_EXCITE.seed, quantity="seed")
     after: Optional[Path] = option(None)
+
+    def __post_init__(self) -> None:
+        """Each ``amplitude`` a share (:data:`~wbfriction.quantities.RANGES`' ``share``; OptionError: naming
+        ``--amplitude``)."""
+        for share in self.amplitude:
+            check_option("--amplitude", "share", share)
 
 
 @dataclass(frozen=True)
@@ -182,6 +189,10 @@ class HungRig(Rig):
                           f"{design.worst()[2]:.2f} of its limit")
 
         printed = pd_design_printed(design, doc)
+        if dropped := design.dropped():
+            printed.append(Printed(f"{len(dropped)} of {len(design.candidates)} candidates dropped unscored (the "
+                                   f"first: amplitude {dropped[0].amplitude:g}, reversals {dropped[0].reversal[0]:g}-"
+                                   f"{dropped[0].reversal[1]:g} s: {dropped[0].dropped})"))
         if following is not None and o.after is not None:
             printed += next_printed(following, o.after)
         return DesignOutput(pd_setpoints(design), doc, figure, tuple(printed))

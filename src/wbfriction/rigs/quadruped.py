@@ -62,7 +62,7 @@ class QuadrupedDesignOptions(StandingDesignOptions):
     """What ``excite`` reads of a quadruped: a standing design's options (its rate its simulators' control rate),
     and the leg lifted (``swing``: FL, FR, RL, RR or its foot frame's name)."""
 
-    rate: float = option(STANDING_RATE)
+    rate: float = option(STANDING_RATE, quantity="rate")
     swing: str = option("FR")
 
 
@@ -157,7 +157,7 @@ class QuadrupedRig(Rig):
         from wbfriction.report.excite_tables import swing_printed
 
         o: QuadrupedDesignOptions = options
-        require_feet(robot, 4, "a quadruped's stance on three of four point feet")
+        require_feet(robot, 4, "a quadruped's stance on three of four point feet", model="point")
         tripod = TripodOptions(swing=o.swing, design=o.excite(TripodOptions().design.harmonics))
         progress.say("designing the swing leg's series, then the stance on the three other feet (its IK at every "
                      "sample)")

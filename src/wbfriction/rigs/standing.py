@@ -30,8 +30,8 @@ class StandingDesignOptions:
     starts."""
 
     duration: float = option(STANDING_DURATION, quantity="duration")
-    rate: float = option(ARM_RATE)
-    period: float = option(STANDING_PERIOD)
+    rate: float = option(ARM_RATE, quantity="rate")
+    period: float = option(STANDING_PERIOD, quantity="period")
     seed: int = option(PD_EXCITE.seed, quantity="seed")
 
     def excite(self, harmonics: int) -> ExciteOptions:
@@ -42,15 +42,22 @@ class StandingDesignOptions:
                              range_share=1.0, seed=self.seed)
 
 
-def require_feet(robot: Robot, feet: int, what: str) -> None:
-    """Refuse a robot not on ``feet`` contacts (``what``: the stance the design makes).
+def require_feet(robot: Robot, feet: int, what: str, model: str | None = None) -> None:
+    """Refuse a robot not on ``feet`` contacts, or (``model``: a contact model's name, ``"point"``) one whose
+    contacts are not all of that model (``what``: the stance the design makes): the contact model is asked, not the
+    feet counted (issue 81: four feet of any model that does not fix the base were taken for a quadruped's).
 
     Raises:
-        InputError: naming the robot, its contacts and the stance.
+        InputError: naming the robot, its contacts (the first of another model, and what it is) and the stance.
     """
     if len(robot.contact_frames) != feet:
         raise InputError(f"robot '{robot.name}' has a floating base on {len(robot.contact_frames)} "
                          f"{robot.stands_on}: excite designs {what}")
+    other = next(((f, m) for f, m in zip(robot.contact_frames, robot.contact_models) if m.name != model), None)
+    if model is not None and other is not None:
+        frame, kind = other
+        raise InputError(f"robot '{robot.name}' stands on contact model '{kind.name}' at '{frame}' ({kind.what}), "
+                         f"not '{model}': excite designs {what}")
 
 
 def standing_figure(robot: Robot, excitation: Any, table: pa.Table, doc: dict, title: str) -> Callable[[Path], None]:
