@@ -230,11 +230,15 @@ def stretch_rows(time: np.ndarray, rows: tuple[int, int] | None, times: tuple[fl
     if times is not None:
         start, stop = (int(np.searchsorted(time, t, side="left")) for t in times)
     if not 0 <= start < stop <= n or stop - start < 2:
-        where = "" if times is None else (f" (times {times[0]:g} to {times[1]:g} s; the log's run from {time[0]:g} to "
-                                          f"{time[-1]:g} s)")
-        raise InputError(f"the rollout's stretch (rows {start} to {stop}{where}) must hold at least two of the log's "
+        where = "" if times is None else (f" (times {_time_text(times[0], 'start')} to {_time_text(times[1], 'end')}; "
+                                          f"the log's run from {time[0]:g} to {time[-1]:g} s)")
+        raise InputError(f"the replay's stretch (rows {start} to {stop}{where}) must hold at least two of the log's "
                          f"{n} rows")
     return start, stop
+
+
+def _time_text(t: float, side: str) -> str:
+    return f"{t:g} s" if np.isfinite(t) else f"the log's {side}"
 
 
 def rollout(robot: Robot, log: pa.Table | str | Path | LogSetpoints, params: ActuatorParams, *,
