@@ -34,6 +34,10 @@ def test_a_design_written_then_played(cli, capsys, tmp_path):
     code, _, err = run_cli_printed(capsys, "simulate", "--robot", "go2", "--play", tmp_path / "d.csv", "--duration",
                                    "5", "-o", tmp_path / "other.parquet")
     assert code == 2 and "--duration: the set-points played (d.csv) fix the motion: it takes no motion option" in err
+    code, _, err = run_cli_printed(capsys, "simulate", "--robot", "go2", "--play", tmp_path / "d.csv", "--rig-option",
+                                   "duration=5", "-o", tmp_path / "other.parquet")  # by its name too (issue 81)
+    assert code == 2 and "--rig-option duration: the set-points played (d.csv) fix the motion" in err
+    assert not (tmp_path / "other.parquet").exists()
     played = pq.read_table(tmp_path / "played.parquet")
     assert played.num_rows == 800
     np.testing.assert_allclose(played.column("q_des.FL_calf_joint").to_numpy(), parquet.q_des[:, 2])

@@ -9,7 +9,7 @@ from typing import Any
 import typer
 
 from wbfriction.cli.common import given_options, refuse_options, refuse_unread
-from wbfriction.exceptions import OptionError
+from wbfriction.exceptions import InputError, OptionError
 from wbfriction.options import motion_names, option_names, parse_option, read_options
 from wbfriction.sim.engines import engine_names
 
@@ -28,7 +28,7 @@ def rig_options(ctx: typer.Context, values: Mapping[str, Any], classes: tuple[ty
 
     Raises:
         InputError: an option the operation does not read (naming ``mode`` and what it takes); a ``--rig-option``
-            not of its options, or not of its type.
+            not of its options, or not of its type, or (with ``play``) one that shapes the motion.
         OptionError: a value outside its range.
     """
     takes = {name for cls in classes for name in option_names(cls)}
@@ -38,7 +38,13 @@ def rig_options(ctx: typer.Context, values: Mapping[str, Any], classes: tuple[ty
                       [n for cls in classes for n in motion_names(cls)], "motion")
     given = {name: tuple(values[name]) if isinstance(values[name], list) else values[name]
              for name in given_options(ctx) if name in takes}
-    given.update(parse_option(tuple(c for c in classes if c is not None), text) for text in rig_option)
+    parsed = dict(parse_option(tuple(c for c in classes if c is not None), text) for text in rig_option)
+    motion = {n for cls in classes for n in motion_names(cls)}
+    if play is not None and motion & parsed.keys():
+        name = sorted(motion & parsed.keys())[0]
+        raise InputError(f"--rig-option {name}: the set-points played ({play.name}) fix the motion: it takes no "
+                         f"motion option")
+    given.update(parsed)
     return tuple(None if cls is None else read_options(cls, given) for cls in classes)
 
 
