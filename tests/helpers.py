@@ -362,3 +362,35 @@ def assert_same_tables(a: pa.Table, b: pa.Table, what: str, atol: float = 1e-9) 
             np.testing.assert_allclose(x, y, rtol=1e-9, atol=atol, err_msg=f"{what}: {name}")
         else:
             assert np.array_equal(x, y), (what, name)
+
+
+def hung_truth_mjcf(go2, mjr, folder: Path, duration: float):
+    """``duration`` s of the hung Go2, noise-free, its friction MuJoCo's own (frictionloss, damping; the constraint's
+    time constant MuJoCo's default, as an export leaves it), the MJCF of its true parameters and the log, in
+    ``folder``: ``(sim, robot, truth.xml, hung.parquet)``, ``robot`` the Go2 with the simulation's encoder offsets."""
+    import dataclasses
+
+    import pyarrow.parquet as pq
+
+    from wbfriction.export.mjcf import write_mjcf
+    from wbfriction.sim.hung import simulate_hung
+    from wbfriction.sim.pd_options import HungOptions
+
+    sim = simulate_hung(go2, HungOptions(duration=duration, friction="mujoco", friction_timeconst=0.02), mjr=mjr)
+    robot = dataclasses.replace(go2, encoder_offset=dict(zip(go2.actuated, sim.encoder_offset.tolist())), cache={})
+    truth, log = folder / "truth.xml", folder / "hung.parquet"
+    write_mjcf(robot, sim.friction, truth, armature=dict(zip(go2.actuated, sim.armature.tolist())))
+    pq.write_table(sim.table, log)
+    return sim, robot, truth, log
+
+
+def run_with_toy_format(code: str):
+    """Run Python ``code`` in a fresh interpreter with the toy Feather format (``tests/toys``) importable (registered
+    before the command line loads, as a plugin's would be), returning the JSON its last printed line holds."""
+    import json
+
+    tests = Path(__file__).resolve().parent
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tests), os.environ.get("PYTHONPATH", "")]))
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+    assert run.returncode == 0, run.stderr
+    return json.loads(run.stdout.splitlines()[-1])

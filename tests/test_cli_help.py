@@ -79,11 +79,7 @@ def test_every_help_that_lists_the_formats_lists_the_registrys():
     is made as the command line loads, and reads the formats' catalogue, not their modules) is in every help that
     lists the logs read, and in ``simulate -o`` (it writes whole tables), not in the streamed outputs' (it does not
     stream); ``.npz`` wherever a log is read."""
-    import json
-    import os
-    import subprocess
-    import sys
-    from pathlib import Path
+    from helpers import run_with_toy_format
 
     code = ("import json\nimport typer.testing\nfrom toys.toy_format import Feather\n"
             "from wbfriction.logs import register_format\nregister_format(Feather())\n"
@@ -93,11 +89,7 @@ def test_every_help_that_lists_the_formats_lists_the_registrys():
             "    r = typer.testing.CliRunner().invoke(app, [c, '--help'], terminal_width=10000)\n"
             "    assert r.exit_code == 0, r.output\n    out[c] = ' '.join(r.output.split())\n"
             "print(json.dumps(out))")
-    tests = Path(__file__).resolve().parent
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tests), os.environ.get("PYTHONPATH", "")]))
-    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
-    assert run.returncode == 0, run.stderr
-    shown = json.loads(run.stdout.splitlines()[-1])
+    shown = run_with_toy_format(code)
     table_formats = ("Parquet (.parquet, .pq)", "CSV (.csv)", "HDF5 (.h5, .hdf5, .he5)", "NumPy (.npz)",
                      "Feather (.feather)")
     for command, text in shown.items():  # every command that reads a log names every table format

@@ -5,18 +5,13 @@ the table formats by hand)."""
 
 from __future__ import annotations
 
-import json
-import os
 import re
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from helpers import run_cli_printed
+from helpers import run_cli_printed, run_with_toy_format
 from wbfriction.pipeline.outputs import OUTPUT_OPTIONS, OutputSuffixError, check_output, output_kind
 
 OUTPUTS = [(command, option, kind) for command, options in OUTPUT_OPTIONS.items() for option, kind in options.items()]
@@ -105,11 +100,7 @@ def test_every_output_s_help_lists_its_registry_s_suffixes():
             "            accepted = tuple(k.suffixes[0] for k in KINDS.values())\n"
             "        out.append([command, option, kind, param.help, list(accepted)])\n"
             "print(json.dumps(out))")
-    tests = Path(__file__).resolve().parent
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tests), os.environ.get("PYTHONPATH", "")]))
-    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
-    assert run.returncode == 0, run.stderr
-    shown = json.loads(run.stdout.splitlines()[-1])
+    shown = run_with_toy_format(code)
     for command, option, kind, text, accepted in shown:
         listed = re.findall(r"(?<![\w<])\.[a-z0-9]+\b", text)
         if not listed:  # "Also write a PNG ...", "(JSON)": a kind of one suffix, named by it

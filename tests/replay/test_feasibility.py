@@ -16,15 +16,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from helpers import hung_go2_toml, run_cli_printed, said
+from helpers import hung_go2_toml, hung_truth_mjcf, run_cli_printed, said
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.model.loading import load_robot
 from wbfriction.replay.feasibility import ReplayInfeasible, check_history, exported_offsets, log_runs
 from wbfriction.replay.mjcf import Replay, replay_mjcf
 from wbfriction.replay.refine import refine_mjcf
 from wbfriction.replay.rollout import ActuatorParams, rollout
-from wbfriction.sim.hung import simulate_hung
-from wbfriction.sim.pd_options import HungOptions
 
 PERIOD = 0.005
 """The hung simulator's log period [s] (200 Hz)."""
@@ -37,13 +35,8 @@ FEW = settings(max_examples=12, deadline=None, suppress_health_check=[HealthChec
 def hung(go2, mjr, tmp_path_factory):
     """1.5 s of the hung Go2, noise-free, its friction MuJoCo's own, and the MJCF of its true parameters (its
     actuators' history: 25 set-points, a 12 ms delay down to 0.48 ms)."""
-    sim = simulate_hung(go2, HungOptions(duration=1.5, friction="mujoco", friction_timeconst=0.02), mjr=mjr)
-    robot = dataclasses.replace(go2, encoder_offset=dict(zip(go2.actuated, sim.encoder_offset.tolist())), cache={})
     folder = tmp_path_factory.mktemp("feasibility")
-    truth = folder / "truth.xml"
-    write_mjcf(robot, sim.friction, truth, armature=dict(zip(go2.actuated, sim.armature.tolist())))
-    log = folder / "hung.parquet"
-    pq.write_table(sim.table, log)
+    sim, robot, truth, log = hung_truth_mjcf(go2, mjr, folder, 1.5)
     ample = folder / "ample.xml"  # the same file, its history ten times as long: the delay held at any step here
     text = truth.read_text()
     assert text.count('nsample="25"') == 12

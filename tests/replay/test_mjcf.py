@@ -12,13 +12,11 @@ import numpy as np
 import pyarrow as pa
 import pytest
 
-from helpers import assert_stages, hung_go2_toml, run_cli_printed, said
+from helpers import assert_stages, hung_go2_toml, hung_truth_mjcf, run_cli_printed, said
 from wbfriction.exceptions import InputError
 from wbfriction.export.mjcf import write_mjcf
 from wbfriction.logs.tables import read_table
 from wbfriction.replay.mjcf import Replay, replay_mjcf
-from wbfriction.sim.hung import simulate_hung
-from wbfriction.sim.pd_options import HungOptions
 
 AGREE = 1e-3
 """The truth's MJCF against the simulator that wrote the log, noise-free, the file stepped at the simulator's 1 ms:
@@ -31,14 +29,7 @@ Euler step, where the simulator applies the drivers' torque as computed at the s
 def hung(go2, mjr, tmp_path_factory):
     """6 s of the hung Go2, noise-free, its friction MuJoCo's own (frictionloss, damping; the constraint's time
     constant MuJoCo's default, as an export leaves it), and the MJCF of its true parameters."""
-    sim = simulate_hung(go2, HungOptions(duration=6.0, friction="mujoco", friction_timeconst=0.02), mjr=mjr)
-    robot = dataclasses.replace(go2, encoder_offset=dict(zip(go2.actuated, sim.encoder_offset.tolist())), cache={})
-    folder = tmp_path_factory.mktemp("replay")
-    truth = folder / "truth.xml"
-    write_mjcf(robot, sim.friction, truth, armature=dict(zip(go2.actuated, sim.armature.tolist())))
-    log = folder / "hung.parquet"
-    pa.parquet.write_table(sim.table, log)
-    return sim, robot, truth, log
+    return hung_truth_mjcf(go2, mjr, tmp_path_factory.mktemp("replay"), 6.0)
 
 
 def test_the_truths_file_tracks_the_simulators_log(hung):
