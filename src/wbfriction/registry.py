@@ -297,6 +297,33 @@ class Registry(Generic[K]):
         order."""
         return tuple(self._kinds)
 
+    def registered(self) -> tuple[K, ...]:
+        """The kinds registered so far, in order, none loaded: what a kind being registered is checked against (a
+        suffix another kind claims), and what help read as the program starts lists, without reading entry
+        points."""
+        return tuple(self._kinds.values())
+
+    def first(self, test: Callable[[K], bool]) -> K | None:
+        """The first kind, in the order they are asked in, that passes ``test`` (a format that reads a file, a
+        target that writes a suffix, a rig that claims a robot), or None. Kept in registration order, the entry
+        points are read, and loaded, only when no kind before them passes (the built-in ones first: a log in a
+        built-in format reads no entry point); kept in precedence order, every kind is loaded (:meth:`kinds`),
+        since one advertised may come first. An entry point that gives no kind is left out as :meth:`kinds` leaves
+        it out, with one :class:`PluginWarning`."""
+        if self.precedence is not None:
+            return next((k for k in self.kinds() if test(k)), None)
+        before = tuple(dict.fromkeys((*self.builtins, *self._kinds)))
+        for name in before:
+            kind = self.get(name)
+            if test(kind):
+                return kind
+        for name in self.advertised():
+            if name not in before:
+                kind = self._usable(name)
+                if kind is not None and test(kind):
+                    return kind
+        return None
+
     def listed(self) -> str:
         """The names as messages list them: ``a, b, c``."""
         return ", ".join(self.names())
