@@ -15,7 +15,8 @@ and each loaded when first named. An entry point that does not give a valid kind
 broken, its object another name's or refused by ``check``) is one line naming it and its distribution
 (:class:`EntryPointError`): raised where it is named, and, where every kind is asked for (:meth:`Registry.kinds`: a
 model chosen among every family), left out with that line as a :class:`PluginWarning` (said once; the command line
-prints it as its ``warning:`` line, :func:`one_line_warnings`), the others used.
+prints it as its ``warning:`` line, :func:`one_line_warnings`), the others used. A kind looked up by something other
+than its name (a file's suffix: :meth:`Registry.first`) loads the entry points only past the kinds registered.
 """
 
 from __future__ import annotations
@@ -318,10 +319,9 @@ class Registry(Generic[K]):
             if test(kind):
                 return kind
         for name in self.advertised():
-            if name not in before:
-                kind = self._usable(name)
-                if kind is not None and test(kind):
-                    return kind
+            plugin = None if name in before else self._usable(name)
+            if plugin is not None and test(plugin):
+                return plugin
         return None
 
     def listed(self) -> str:
