@@ -239,3 +239,27 @@ def test_a_truth_is_compared_under_the_names_it_has(plugins):
     assert guide.values_in("quadratic") == {"F_v": 0.3, "F_q": 0.02, "F_c": 2.0, "tau_os": 0.1}
     against = guide.values_in("thesis")
     assert math.isnan(against.pop("v_s")) and against == {"F_v": 0.3, "F_c": 2.0, "S": 0.0, "a": 50.0, "tau_os": 0.1}
+
+
+@given(plans, st.booleans(), st.integers(0, 8))
+@settings(max_examples=40, deadline=None)
+def test_the_first_kind_that_passes_is_the_first_of_every_kind_and_reads_no_entry_point_before_it_must(plan, ordered,
+                                                                                                        wanted):
+    """:meth:`Registry.first` (a file's format, an output's target, a robot's rig): the first of :meth:`kinds`
+    that passes, a failing entry point left out with its one warning; kept in registration order, the entry points
+    are not read when a kind registered passes (a log in a built-in format reads none)."""
+    advertised = [entry_point(f"good{k}" if how == "good" else f"plug{k}",
+                              Kind(f"good{k}", k + 1) if how == "good" else FAILURES[how](f"plug{k}"))
+                  for k, how in enumerate(plan) if how != "refused"]
+    test = (lambda kind: kind.name == ("own" if wanted == 0 else f"good{wanted}"))
+    with patch("importlib.metadata.entry_points", return_value=advertised) as read:
+        registry: Registry[Kind] = Registry("kind", (lambda k: k.precedence) if ordered else None,
+                                            entry_points="toys")
+        registry.register(Kind("own", 0.5))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PluginWarning)
+            found = registry.first(test)
+            assert read.called == (ordered or wanted != 0)
+            expected = next((k for k in registry.kinds() if test(k)), None)
+    assert found is expected
+    assert (found is None) == (wanted != 0 and (wanted >= len(plan) or plan[wanted] != "good"))

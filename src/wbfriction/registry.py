@@ -15,7 +15,8 @@ and each loaded when first named. An entry point that does not give a valid kind
 broken, its object another name's or refused by ``check``) is one line naming it and its distribution
 (:class:`EntryPointError`): raised where it is named, and, where every kind is asked for (:meth:`Registry.kinds`: a
 model chosen among every family), left out with that line as a :class:`PluginWarning` (said once; the command line
-prints it as its ``warning:`` line, :func:`one_line_warnings`), the others used.
+prints it as its ``warning:`` line, :func:`one_line_warnings`), the others used. A kind looked up by something other
+than its name (a file's suffix: :meth:`Registry.first`) loads the entry points only past the kinds registered.
 """
 
 from __future__ import annotations
@@ -296,6 +297,32 @@ class Registry(Generic[K]):
         """The names of the kinds registered so far (the built-in ones and the entry points' once named), in
         order."""
         return tuple(self._kinds)
+
+    def registered(self) -> tuple[K, ...]:
+        """The kinds registered so far, in order, none loaded: what a kind being registered is checked against (a
+        suffix another kind claims), and what help read as the program starts lists, without reading entry
+        points."""
+        return tuple(self._kinds.values())
+
+    def first(self, test: Callable[[K], bool]) -> K | None:
+        """The first kind, in the order they are asked in, that passes ``test`` (a format that reads a file, a
+        target that writes a suffix, a rig that claims a robot), or None. Kept in registration order, the entry
+        points are read, and loaded, only when no kind before them passes (the built-in ones first: a log in a
+        built-in format reads no entry point); kept in precedence order, every kind is loaded (:meth:`kinds`),
+        since one advertised may come first. An entry point that gives no kind is left out as :meth:`kinds` leaves
+        it out, with one :class:`PluginWarning`."""
+        if self.precedence is not None:
+            return next((k for k in self.kinds() if test(k)), None)
+        before = tuple(dict.fromkeys((*self.builtins, *self._kinds)))
+        for name in before:
+            kind = self.get(name)
+            if test(kind):
+                return kind
+        for name in self.advertised():
+            plugin = None if name in before else self._usable(name)
+            if plugin is not None and test(plugin):
+                return plugin
+        return None
 
     def listed(self) -> str:
         """The names as messages list them: ``a, b, c``."""

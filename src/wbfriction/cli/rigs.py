@@ -11,7 +11,7 @@ import typer
 from wbfriction.cli.common import given_options, refuse_options, refuse_unread
 from wbfriction.exceptions import InputError, OptionError
 from wbfriction.options import motion_names, option_names, parse_option, read_options
-from wbfriction.sim.engines import engine_names
+from wbfriction.sim.engines.registry import ENGINES
 
 RigOptionOpt = typer.Option([], "--rig-option", metavar="NAME=VALUE",
                             help="An option of the robot's rig by its name, for one no flag spells (a rig a program "
@@ -49,10 +49,16 @@ def rig_options(ctx: typer.Context, values: Mapping[str, Any], classes: tuple[ty
 
 
 def check_engine(simulator: str | None) -> None:
-    """Refuse, before the robot is loaded, a ``--simulator`` that names no registered engine (None: not given).
+    """Refuse, before the robot is loaded, a ``--simulator`` that names no registered engine (None: not given); an
+    engine an installed package advertises is loaded, so that one that does not load fails here.
 
     Raises:
         OptionError: listing the engines registered.
+        EntryPointError: the engine's entry point gives none (:class:`~wbfriction.registry.EntryPointError`: one
+            line naming it and its package).
     """
-    if simulator is not None and simulator not in engine_names():
-        raise OptionError("--simulator", simulator, f"one of {', '.join(engine_names())}")
+    if simulator is None:
+        return
+    if simulator not in ENGINES:
+        raise OptionError("--simulator", simulator, f"one of {', '.join(ENGINES.names())}")
+    ENGINES.get(simulator)

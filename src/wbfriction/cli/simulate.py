@@ -32,7 +32,7 @@ from wbfriction.cli.rigs import RigOptionOpt, check_engine, rig_options
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.rigs import RigProgress, rig_for
-from wbfriction.sim.engines import engine_names, engines
+from wbfriction.sim.engines.registry import ENGINES
 from wbfriction.sim.options import FrictionMode, Integrator
 from wbfriction.sim.pd_options import HungOptions, SetpointKind, SetpointOptions
 
@@ -65,10 +65,12 @@ StepLengthOpt = typer.Option(GAIT.step_length, help="A walk: forward distance be
 StepWidthOpt = typer.Option(GAIT.step_width, help="A walk: sideways step [m].")
 TurnAngleOpt = typer.Option(GAIT.turn_angle, help="A walk: heading change per turning step [rad].")
 LiftHeightOpt = typer.Option(GAIT.lift_height, help="A walk: swing-foot apex [m].")
-SimulatorOpt = typer.Option(None, metavar=f"[{'|'.join(engine_names())}]",
+# the engines registered as the command line loads (no entry point read: an installed package's engine is named)
+SimulatorOpt = typer.Option(None, metavar=f"[{'|'.join(ENGINES.loaded())}]",
                             help="A walk or a robot on point feet: the engine it runs in, "
-                                 + "; ".join(e.what for e in engines()) + " (default: the first); or one a program "
-                                 "registered (wbfriction.sim.engines.register_engine).")
+                                 + "; ".join(e.what for e in ENGINES.registered()) + " (default: the first); or one "
+                                 "a program registered (wbfriction.sim.engines.register_engine) or an installed "
+                                 "package advertises (entry-point group wbfriction.engines).")
 SubstepsOpt = typer.Option(None, help=f"Physics steps per control period (default: {IDEAL.substeps} ideal, "
                                       f"{MUJOCO.substeps} mujoco (1 ms periods), {HUNG.substeps} PD-driven (at "
                                       f"{HUNG.rate:g} Hz: 1 ms steps), 4 for a robot on point feet (2 ms periods: "

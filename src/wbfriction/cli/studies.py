@@ -17,7 +17,7 @@ from wbfriction.friction.options import RouteOption
 # options, whose defaults the help shows: each command imports the rest of the library when it runs.
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.signals.options import Diff, FilterOptions
-from wbfriction.sim.engines import engine_names
+from wbfriction.sim.engines.registry import ENGINES
 from wbfriction.sim.options import SensorNoise
 
 if TYPE_CHECKING:
@@ -45,7 +45,7 @@ def demo(ctx: typer.Context,
          robot: str = RobotOpt,
          steps: int = typer.Option(GAIT.steps, help="A biped: steps per direction of the combined walk (--simulator "
                                                     "mujoco: of the forward walks of Fig. 6.4-6.5 too, at most 5)."),
-         simulator: Optional[str] = typer.Option(None, metavar=f"[{'|'.join(engine_names())}]",
+         simulator: Optional[str] = typer.Option(None, metavar=f"[{'|'.join(ENGINES.loaded())}]",
                                                  help="The engine: ideal (a biped: Tables 6.1/6.2, Fig. 6.1-6.3) or "
                                                       "mujoco (the realistic simulator's study, Fig. 6.4-6.5); "
                                                       "default: the first the rig runs on."),
@@ -243,7 +243,7 @@ def study_filters(output_dir: Path = typer.Option(Path("wbfriction-filters"), "-
 def study_quadruped(output_dir: Path = typer.Option(Path("wbfriction-quadruped"), "-o", "--output-dir",
                                                     help="Where to write."),
                     robot: str = typer.Option("go2_walking", help="A built-in quadruped on point feet."),
-                    simulator: Optional[str] = typer.Option(None, metavar=f"[{'|'.join(engine_names())}]",
+                    simulator: Optional[str] = typer.Option(None, metavar=f"[{'|'.join(ENGINES.loaded())}]",
                                                             help="The engine: ideal (point feet welded while down) "
                                                                  "or mujoco (soft contacts, sphere feet); default: "
                                                                  "the first."),

@@ -5,7 +5,9 @@ The built-in targets are registered here, in the order errors name them: ``.urdf
 :class:`~wbfriction.export.mjcf.MjcfTarget`), ``.yaml``/``.yml`` (Isaac Lab actuators,
 :class:`~wbfriction.export.isaac.IsaacTarget`). Another format plugs in with :func:`register_target`
 (:mod:`wbfriction.export.target`'s docstring has an example); :func:`target_for` then picks it for its suffixes,
-in ``wbfriction.pipeline.export_step.export_files`` as for the built-in ones.
+in ``wbfriction.pipeline.export_step.export_files`` as for the built-in ones. An installed package advertises a target
+under the entry-point group :data:`ENTRY_POINT_GROUP` (``wbfriction.export_targets``): read, and its targets loaded,
+the first time an output's suffix is none of the targets registered so far, or every target is asked for.
 """
 
 from __future__ import annotations
@@ -67,7 +69,7 @@ def check_suffixes(target: ExportTarget) -> None:
     for suffix in target.suffixes:
         if not suffix.startswith(".") or suffix != suffix.lower():
             raise ValueError(f"export target '{target.name}': suffix {suffix!r} is not lower case with its dot")
-        holder = next((t for t in TARGETS if suffix in t.suffixes), None)
+        holder = next((t for t in TARGETS.registered() if suffix in t.suffixes), None)  # no entry point loaded
         if holder is not None and holder.name != target.name:
             raise SuffixTaken(suffix, target.name, holder.name)
 
@@ -82,10 +84,18 @@ def uncatalogue(name: str) -> None:
     catalog.KINDS.pop(name, None)
 
 
+ENTRY_POINT_GROUP = "wbfriction.export_targets"
+"""The entry-point group under which an installed package advertises its export targets: each entry's name is the
+target's and its object an :class:`~wbfriction.export.target.ExportTarget` (an instance, or a class called without
+arguments)."""
+
 TARGETS: Registry[ExportTarget] = Registry("export target", replace=True, check=check_suffixes,
-                                           on_register=catalogue, on_unregister=uncatalogue)
-"""The registered targets by name, in the order registered (a target registered again: last); each writes the
-outputs named with one of its suffixes (:func:`target_for`)."""
+                                           on_register=catalogue, on_unregister=uncatalogue,
+                                           entry_points=ENTRY_POINT_GROUP)
+"""The registered targets by name, in the order registered (a target registered again: last), then those installed
+packages advertise (loaded when an output's suffix is none of the others', or every target is asked for: one that
+does not load is left out with one :class:`~wbfriction.registry.PluginWarning` line); each writes the outputs named
+with one of its suffixes (:func:`target_for`)."""
 
 
 def register_target(target: ExportTarget) -> ExportTarget:
@@ -123,7 +133,7 @@ def target_for(path: str | Path) -> ExportTarget:
         UnknownExportFormat: a suffix no target writes, naming the file and the formats known.
     """
     suffix = Path(path).suffix.lower()
-    target = next((t for t in TARGETS if suffix in t.suffixes), None)
+    target = TARGETS.first(lambda t: suffix in t.suffixes)
     if target is None:
         raise UnknownExportFormat(path, suffix, known_formats())
     return target

@@ -154,8 +154,15 @@ class TorqueKind:
         return f"{type(self).__name__}({self.name!r})"
 
 
-SOURCES: Registry[TorqueKind] = Registry("torque source", precedence=lambda k: k.precedence)
-"""The registered torque sources, in precedence order."""
+ENTRY_POINT_GROUP = "wbfriction.torque_sources"
+"""The entry-point group under which an installed package advertises its torque sources: each entry's name is the
+source's and its object a :class:`TorqueKind` (an instance, or a class called without arguments)."""
+
+SOURCES: Registry[TorqueKind] = Registry("torque source", precedence=lambda k: k.precedence,
+                                         entry_points=ENTRY_POINT_GROUP)
+"""The registered torque sources, in precedence order: the built-in ones, those registered, those installed packages
+advertise (read, and each loaded, the first time a log's source is chosen, since one may come first; one that does
+not load is left out with one :class:`~wbfriction.registry.PluginWarning` line, the others used)."""
 
 
 register_torque_source = SOURCES.register

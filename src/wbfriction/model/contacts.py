@@ -142,8 +142,16 @@ def check_contact_model(kind: ContactModel) -> None:
                          f"{kind.dims} constraints, not their 3 components")
 
 
-MODELS: Registry[ContactModel] = Registry("contact model", unknown=InputError, check=check_contact_model)
-"""The registered contact models, in the order they were registered."""
+ENTRY_POINT_GROUP = "wbfriction.contact_models"
+"""The entry-point group under which an installed package advertises its contact models: each entry's name is the
+model's (what a robot TOML's ``contact_model`` names) and its object a :class:`ContactModel` (an instance, or a class
+called without arguments)."""
+
+MODELS: Registry[ContactModel] = Registry("contact model", unknown=InputError, check=check_contact_model,
+                                          entry_points=ENTRY_POINT_GROUP)
+"""The registered contact models, in the order they were registered, then those installed packages advertise (each
+loaded when a robot TOML first names it: one that does not load is its one line,
+:class:`~wbfriction.registry.EntryPointError`)."""
 
 
 register_contact_model = MODELS.register

@@ -22,7 +22,7 @@ import pinocchio as pin
 
 from wbfriction.config import read_toml
 from wbfriction.exceptions import InputError
-from wbfriction.model.contacts import ContactKind, contact_models
+from wbfriction.model.contacts import MODELS, ContactKind
 from wbfriction.model.force_torque import parse_sensors
 from wbfriction.model.imu import add_imu_frame
 from wbfriction.model.labels import parse_labels
@@ -379,7 +379,9 @@ def _contact_frames(config: dict, model: pin.Model, urdf: Path, source: str) -> 
 
 def _contact_kinds(value, frames: list[str], floating: bool, source: str) -> tuple[ContactKind, ...]:
     """``contact_model``: a registered contact model's name (:mod:`wbfriction.model.contacts`) for every contact frame,
-    or a table frame -> name (the others soles); () when not given (every frame a sole)."""
+    or a table frame -> name (the others soles); () when not given (every frame a sole). A model an installed package
+    advertises is loaded (:class:`~wbfriction.registry.EntryPointError`, one line naming it, for one that does not
+    load), the others left alone."""
     if value is None:
         return ()
     if not floating:
@@ -388,10 +390,10 @@ def _contact_kinds(value, frames: list[str], floating: bool, source: str) -> tup
     for frame, kind in table.items():
         if frame not in frames:
             raise InputError(f"{source}: contact_model names '{frame}', which is not one of contact_frames")
-        known = [m.name for m in contact_models()]
-        if kind not in known:
+        if not isinstance(kind, str) or kind not in MODELS:
             raise InputError(f"{source}: contact_model of '{frame}' is {kind!r}: choose one of the registered "
-                             f"contact models, {', '.join(known)}")
+                             f"contact models, {', '.join(MODELS.names())}")
+        MODELS.get(kind)  # an installed package's model, loaded now: one that does not load fails before any work
     return tuple(str(table.get(f, "sole")) for f in frames)
 
 

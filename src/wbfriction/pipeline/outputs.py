@@ -6,7 +6,9 @@ naming the option, the suffix and the suffixes its kind is written as.
 The tables' suffixes are the registered log formats' (:mod:`~wbfriction.logs.formats.catalog`: a format registered is
 a suffix accepted, and the help lists it), the models' and the exports' the registered export targets'
 (:mod:`~wbfriction.export.catalog`); neither catalogue imports anything heavy, so the command line checks its outputs
-as it parses its options (:mod:`wbfriction.cli.outputs`). A new kind of document is one call::
+as it parses its options (:mod:`wbfriction.cli.outputs`). A suffix none of those registered writes is checked again
+after the formats (or targets) installed packages advertise are loaded (their entry points read then, not as the
+command line starts). A new kind of document is one call::
 
     register_output(OutputKind("svg", "a vector figure", lambda: (".svg",)))
 
@@ -35,11 +37,14 @@ class OutputKind:
         what: the document as messages name it (``a table``).
         listed: the suffixes it is written as, lower case with the dot, the one to name first first: asked each time
             (read from the registry of its writers, e.g. the log formats', so that one registered there is one here).
+        advertised: what loads the writers installed packages advertise (a registry's entry points), asked before a
+            suffix not listed is refused; None: none.
     """
 
     name: str
     what: str
     listed: Callable[[], tuple[str, ...]]
+    advertised: Callable[[], object] | None = None
 
     def suffixes(self) -> tuple[str, ...]:
         """The suffixes it is written as, now: ``(".parquet", ".pq", ".csv")``."""
@@ -76,6 +81,20 @@ def _targets() -> tuple[str, ...]:
     return tuple(s for kind in TARGET_KINDS.values() for s in kind.suffixes)
 
 
+def _advertised_formats() -> object:
+    """Every log format, those installed packages advertise loaded (their kinds catalogued)."""
+    from wbfriction.logs.formats.registry import FORMATS
+
+    return FORMATS.kinds()
+
+
+def _advertised_targets() -> object:
+    """Every export target, those installed packages advertise loaded (their kinds catalogued)."""
+    from wbfriction.export.registry import TARGETS
+
+    return TARGETS.kinds()
+
+
 def _target(name: str) -> Callable[[], tuple[str, ...]]:
     """The suffixes of the registered export target ``name`` (none while it is not registered)."""
     return lambda: TARGET_KINDS[name].suffixes if name in TARGET_KINDS else ()
@@ -89,10 +108,10 @@ unregister_output = OUTPUTS.unregister
 """Remove the kind of document of a name; returns it (ValueError: none of that name)."""
 
 for _builtin in (
-        OutputKind("table", "a table", written),
-        OutputKind("text-table", "a table with text columns", lambda: written(text=True)),
-        OutputKind("streamed-table", "a streamed table", lambda: written(streamed=True)),
-        OutputKind("export", "an export", _targets),
+        OutputKind("table", "a table", written, _advertised_formats),
+        OutputKind("text-table", "a table with text columns", lambda: written(text=True), _advertised_formats),
+        OutputKind("streamed-table", "a streamed table", lambda: written(streamed=True), _advertised_formats),
+        OutputKind("export", "an export", _targets, _advertised_targets),
         OutputKind("mjcf", "a MuJoCo model", _target("mjcf")),
         OutputKind("urdf", "a URDF", _target("urdf")),
         OutputKind("json", "a JSON document", lambda: (".json",)),
@@ -122,6 +141,9 @@ def check_output(option: str, path: str | Path, kind: str) -> None:
     found = output_kind(kind)
     suffix = Path(path).suffix.lower()
     accepted = found.suffixes()
+    if suffix not in accepted and found.advertised is not None:  # an installed package's writer, loaded now
+        found.advertised()
+        accepted = found.suffixes()
     if suffix not in accepted:
         raise OutputSuffixError(option, str(path), suffix, found.what, accepted)
 

@@ -35,8 +35,14 @@ from wbfriction.rigs.quadruped import QuadrupedRig
 if TYPE_CHECKING:
     from wbfriction.model.robot import Robot
 
-RIGS: Registry[Rig] = Registry("rig", precedence=lambda r: r.precedence)
-"""The registered rigs, in precedence order."""
+ENTRY_POINT_GROUP = "wbfriction.rigs"
+"""The entry-point group under which an installed package advertises its rigs: each entry's name is the rig's and its
+object a :class:`~wbfriction.rigs.base.Rig` (an instance, or a class called without arguments)."""
+
+RIGS: Registry[Rig] = Registry("rig", precedence=lambda r: r.precedence, entry_points=ENTRY_POINT_GROUP)
+"""The registered rigs, in precedence order: the built-in ones, those registered, those installed packages advertise
+(read, and each loaded, the first time a robot's rig is decided, since one may come first; one that does not load is
+left out with one :class:`~wbfriction.registry.PluginWarning` line, the others asked)."""
 
 
 register_rig = RIGS.register

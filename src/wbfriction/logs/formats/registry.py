@@ -14,7 +14,10 @@ Five are built in, in this order: Parquet, CSV, HDF5, NumPy ``.npz`` and ROS 2 b
 
 after which every function that takes a log reads (and, if the format writes, writes) ``.tsv`` files: a folder's
 scan for logs (:func:`find_format`), and the command line's help, which lists the formats registered
-(:mod:`.catalog`) as the command line is loaded.
+(:mod:`.catalog`) as the command line is loaded. An installed package advertises a format under the entry-point group
+:data:`ENTRY_POINT_GROUP` (``wbfriction.log_formats``): read, and its formats loaded, the first time a path is not
+one of the formats registered so far (a log in a built-in format reads no entry point), or every format is asked
+for.
 """
 
 from __future__ import annotations
@@ -59,7 +62,8 @@ def check_suffixes(fmt: LogFormat) -> None:
     Raises:
         ValueError: naming the suffixes and the format that reads them.
     """
-    others = () if fmt.name in FORMATS else FORMATS.kinds()  # a name taken: FORMATS.register refuses it, naming it
+    # a name taken: FORMATS.register refuses it, naming it; the formats registered so far, no entry point loaded
+    others = () if fmt.name in FORMATS.loaded() else FORMATS.registered()
     for other in others:
         shared = sorted(set(fmt.suffixes) & set(other.suffixes))
         if shared:
@@ -77,9 +81,16 @@ def uncatalogue(name: str) -> None:
     KINDS.pop(name, None)
 
 
+ENTRY_POINT_GROUP = "wbfriction.log_formats"
+"""The entry-point group under which an installed package advertises its log formats: each entry's name is the
+format's and its object a :class:`~wbfriction.logs.formats.base.LogFormat` (an instance, or a class called without
+arguments)."""
+
 FORMATS: Registry[LogFormat] = Registry("log format", check=check_suffixes, on_register=catalogue,
-                                        on_unregister=uncatalogue)
-"""The registered formats by name, in the order they are tried."""
+                                        on_unregister=uncatalogue, entry_points=ENTRY_POINT_GROUP)
+"""The registered formats by name, in the order they are tried: the built-in ones, those registered, those installed
+packages advertise (loaded when a path is none of the others', or every format is asked for: one that does not load
+is left out with one :class:`~wbfriction.registry.PluginWarning` line, the others used)."""
 
 DEFAULT_FORMAT = "parquet"
 """The format a table is written in when no registered format claims its file's name."""
@@ -104,7 +115,7 @@ def find_format(path: str | Path) -> LogFormat | None:
     """The first registered format that detects the existing file (or folder) ``path``
     (:meth:`~wbfriction.logs.formats.base.LogFormat.detect`), or None: what a folder's scan for logs asks of each of
     its files."""
-    return next((f for f in FORMATS if f.detect(Path(path))), None)
+    return FORMATS.first(lambda f: f.detect(Path(path)))
 
 
 def format_of(path: str | Path) -> LogFormat:
@@ -134,7 +145,7 @@ def format_to_write(path: str | Path) -> LogFormat:
         InputError: a format that claims the name but writes no file (a ROS 2 bag).
     """
     path = Path(path)
-    fmt = next((f for f in FORMATS if f.claims(path)), FORMATS.get(DEFAULT_FORMAT))
+    fmt = FORMATS.first(lambda f: f.claims(path)) or FORMATS.get(DEFAULT_FORMAT)
     if not fmt.writable:
         raise InputError(f"{path}: {fmt.label} files are read, not written")
     return fmt
@@ -156,7 +167,7 @@ def format_to_stream(path: str | Path, what: str = "tables are streamed") -> Log
         InputError: a name no such format claims, naming the file and the suffixes there are.
     """
     path = Path(path)
-    fmt = next((f for f in FORMATS if f.claims(path)), None)
+    fmt = FORMATS.first(lambda f: f.claims(path))
     if fmt is None or not fmt.streamable:
         raise InputError(f"{path}: {what} as {', '.join(stream_suffixes())}")
     return fmt

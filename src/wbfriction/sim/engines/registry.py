@@ -1,5 +1,6 @@
 """The engines every rig's simulation asks: the project's ideal simulator and MuJoCo built in, any a program
-registers (:func:`register_engine`) after them in precedence order."""
+registers (:func:`register_engine`) or an installed package advertises (under :data:`ENTRY_POINT_GROUP`,
+``wbfriction.engines``) among them in precedence order."""
 
 from __future__ import annotations
 
@@ -9,8 +10,18 @@ from wbfriction.sim.engines.base import Engine
 from wbfriction.sim.engines.ideal import IdealEngine
 from wbfriction.sim.engines.mujoco import MujocoEngine
 
-ENGINES: Registry[Engine] = Registry("engine", precedence=lambda e: e.precedence, unknown=InputError)
-"""The registered engines, in precedence order."""
+ENTRY_POINT_GROUP = "wbfriction.engines"
+"""The entry-point group under which an installed package advertises its engines: each entry's name is the engine's
+(what ``--simulator`` names) and its object an :class:`~wbfriction.sim.engines.base.Engine` (an instance, or a class
+called without arguments)."""
+
+ENGINES: Registry[Engine] = Registry("engine", precedence=lambda e: e.precedence, unknown=InputError,
+                                     entry_points=ENTRY_POINT_GROUP)
+"""The registered engines, in precedence order: the built-in ones, those registered, those installed packages
+advertise (each loaded when ``--simulator`` names it, or every one when a rig's engines are asked for: one that does
+not load is left out with one :class:`~wbfriction.registry.PluginWarning` line, the others run). The command line's
+help, read as it starts, lists those registered then (:meth:`~wbfriction.registry.Registry.registered`): no entry
+point read."""
 
 
 engine_names = ENGINES.names
