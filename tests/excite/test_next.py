@@ -56,7 +56,7 @@ def test_only_what_the_log_left_undetermined_moves(following):
 
 @pytest.mark.xfail(strict=True, reason="with weak at 10 % of a value (issue 79) the design chosen changes, and on it "
                    "the prediction's noise-free identification reports 1.3-10 times the played log's standard errors "
-                   "on the front hips (offset 0.0099 against 0.00095 rad): the predictor's defect, left for issue 81")
+                   "on the front hips (offset 0.0099 against 0.00095 rad): the predictor's defect, still open")
 def test_played_it_determines_them_as_predicted(following):
     go2, _, nxt = following
     design = nxt.design
