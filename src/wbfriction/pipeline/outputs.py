@@ -12,7 +12,8 @@ command line starts). A new kind of document is one call::
 
     register_output(OutputKind("svg", "a vector figure", lambda: (".svg",)))
 
-Every output option of every command is of one kind (:data:`OUTPUT_OPTIONS`; ``docs/reference/files.md``, "Output names").
+Every output option of every command is of one kind (:data:`OUTPUT_OPTIONS`; ``docs/reference/files.md``, "Output
+names").
 """
 
 from __future__ import annotations
