@@ -181,6 +181,8 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
     n, tc, n_c = len(log.time), robot.tc_index, len(robot.contact_frames)
     phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip, gaps)
     rows_ok = _filter_rows(kin, log.contact) & np.all(np.isfinite(kin.q), axis=1) & np.all(np.isfinite(kin.qd), axis=1)
+    if log.unsure is not None:  # contact flags inferred without confidence (wbfriction.pipeline.raw_log)
+        rows_ok &= ~log.unsure
     # each row's closure: -1 none, c < n_c the rigid stance on contact c, n_c the wrenches, n_c + 1 the point feet
     closure = np.full(n, -1)
     p, b = np.full((n, robot.n_act), np.nan), np.full((n, robot.n_act), np.nan)

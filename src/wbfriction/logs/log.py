@@ -102,6 +102,8 @@ class Log:
         foot_force: the feet's measured forces (N, n_contacts, 3), world axes [N], NaN where not measured (columns
             ``force.<frame>.x`` ... ``.z``, or the normal ``force.<frame>``: :mod:`wbfriction.logs.foot_forces`),
             or None.
+        unsure: (N,) the rows whose contact flags were inferred without confidence (column ``unsure``, 0/1, written
+            by :mod:`wbfriction.pipeline.raw_log`): no route estimates them; None: every row's flags are sure.
         imu: the IMU's readings (N, 6): angular velocity [rad/s] and specific force [m/s^2] in its frame
             (columns ``imu.gyro_x`` ... ``imu.acc_z``, :mod:`wbfriction.model.imu`), or None.
         temperature: the torque-controlled joints' temperatures (N, n_tc) [°C] (``temperature.<joint>`` columns),
@@ -138,6 +140,7 @@ class Log:
     temperature: np.ndarray | None = None
     setpoints: PdSetpoints | None = None
     foot_force: np.ndarray | None = None
+    unsure: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.segments is None and self.clock is not None and len(self.clock.segments) > 1:
@@ -169,7 +172,7 @@ class Log:
                    base_qdd_true=cut(self.base_qdd_true), imu=cut(self.imu),
                    temperature=cut(self.temperature),
                    setpoints=None if self.setpoints is None else self.setpoints.rows(start, stop),
-                   foot_force=cut(self.foot_force))
+                   foot_force=cut(self.foot_force), unsure=cut(self.unsure))
 
     def __len__(self) -> int:
         return len(self.time)
@@ -202,6 +205,8 @@ class Log:
         for prefix, x in (("qd", self.qd_logged), ("qd_true", self.qd_true), ("qdd_true", self.qdd_true)):
             if x is not None:
                 cols.update({f"{prefix}.{n}": x[:, i] for i, n in enumerate(robot.actuated)})
+        if self.unsure is not None:
+            cols["unsure"] = self.unsure.astype(np.int8)
         return with_metadata(pa.table(cols), self.metadata)
 
 
@@ -281,7 +286,23 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
                qd_true=qd_true, qdd_true=qdd_true, segments=clock.segments, period=period, qd_logged=qd_logged,
                torque_source=kind.name, clock=clock, warnings=warnings, wrench=wrench,
                base_qd_true=base_qd_true, base_qdd_true=base_qdd_true, imu=imu, temperature=temperature,
-               setpoints=setpoints, foot_force=foot_force)
+               setpoints=setpoints, foot_force=foot_force, unsure=_read_unsure(table, source, first_row))
+
+
+def _read_unsure(table: pa.Table, source: str, first_row: int) -> np.ndarray | None:
+    """The ``unsure`` column (0/1) as booleans, or None.
+
+    Raises:
+        ColumnError: a value other than 0 and 1, naming the row.
+    """
+    if "unsure" not in table.column_names:
+        return None
+    x = numeric_column(table, "unsure", source, first_row)
+    bad = np.flatnonzero((x != 0) & (x != 1))
+    if bad.size:
+        raise ColumnError(source, "unsure", int(first_row + bad[0]),
+                          f"column 'unsure' must hold 0 or 1, found {x[bad[0]]:g} at row {first_row + bad[0]}")
+    return x.astype(bool)
 
 
 NUMERIC_PREFIXES = ("q", "qd", "qd_true", "qdd_true", "tau_f_true", "base", "wrench", "force", "base_qd_true",

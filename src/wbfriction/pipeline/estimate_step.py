@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import ExitStack, contextmanager, nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
 from typing import Any, Protocol
@@ -48,6 +48,7 @@ from wbfriction.pipeline.chunks import (
     release_freed_memory,
 )
 from wbfriction.pipeline.provenance import log_provenance
+from wbfriction.pipeline.raw_log import prepared_log
 from wbfriction.progress import Progress, StageProgress
 from wbfriction.signals.content import contact_changes
 from wbfriction.workers import process_pool
@@ -191,6 +192,7 @@ class ChunkedResult:
     differentiation: str = ""
     warnings: tuple[str, ...] = ()
     route: str = ""
+    prepared: tuple[str, ...] = ()
 
 
 def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options: EstimateOptions = EstimateOptions(),
@@ -290,9 +292,12 @@ def estimate_source(spec: RobotSpec, log: str | Path, output: str | Path,
         if source.is_mapped and stage is not None:
             stage(f"reading {log}")
         table = stack.enter_context(table_log(source, output))
+        table, raw = stack.enter_context(prepared_log(table, robot, str(log), file_options.get("read", ReadOptions()),
+                                                      output))
         advance = None if progress is None else progress(TableFile(table).row_count())
-        return estimate_file(spec, table, output, options, robot=robot, source=str(log), progress=advance,
-                             extra_metadata={"provenance": log_provenance(log, robot)}, **file_options)
+        result = estimate_file(spec, table, output, options, robot=robot, source=str(log), progress=advance,
+                               extra_metadata={"provenance": log_provenance(log, robot)}, **file_options)
+        return result if raw is None else replace(result, prepared=tuple(raw.lines()))
 
 
 @contextmanager

@@ -356,10 +356,10 @@ def measure(log: Log, diff: Diff = "central", *, compensate_delay: bool = True,
     q, qd, qdd, tau = q[:, :n_act], qd[:, :n_act], qdd[:, :n_act], tau[:, :n_tc]
     if velocity == "logged":
         qd = logged_velocity(log, qd, metadata)
-    return MeasuredKinematics(
+    return without_unsure(log, MeasuredKinematics(
         time=log.time, q=q, qd=qd, qdd=qdd, tau=tau, contact=log.contact, base=log.base,
         tau_f_true=log.tau_f_true, metadata=metadata, smoother=smoother, base_qd=base_qd, base_qdd=base_qdd,
-        wrench=wrench, imu=imu_rates, foot_force=foot_force)
+        wrench=wrench, imu=imu_rates, foot_force=foot_force))
 
 
 def _check_inputs(log: Log, velocity: Velocity, base_motion: bool, imu: bool) -> None:
@@ -392,11 +392,20 @@ def true_kinematics(log: Log, base_motion: bool = False, imu: bool = False) -> M
     if imu:
         assert log.imu is not None  # checked by measure
         imu_rates = np.hstack([log.imu[:, :3], np.gradient(log.imu[:, :3], log.time, axis=0), log.imu[:, 3:]])
-    return MeasuredKinematics(
+    return without_unsure(log, MeasuredKinematics(
         time=log.time, q=log.q, qd=log.qd_true, qdd=log.qdd_true, tau=log.tau, contact=log.contact,
         base=log.base, tau_f_true=log.tau_f_true, metadata=dict(log.metadata), wrench=log.wrench,
         base_qd=log.base_qd_true if base_motion else None, base_qdd=log.base_qdd_true if base_motion else None,
-        imu=imu_rates, foot_force=log.foot_force)
+        imu=imu_rates, foot_force=log.foot_force))
+
+
+def without_unsure(log: Log, kin: MeasuredKinematics) -> MeasuredKinematics:
+    """``kin`` with the log's rows whose contact flags are not sure (:attr:`Log.unsure
+    <wbfriction.logs.log.Log.unsure>`) not valid: no route estimates them."""
+    if log.unsure is not None:
+        assert kin.valid is not None  # set by MeasuredKinematics.__post_init__
+        kin.valid = kin.valid & ~log.unsure
+    return kin
 
 
 def logged_velocity(log: Log, qd: np.ndarray, metadata: dict) -> np.ndarray:

@@ -1,0 +1,186 @@
+"""A walking robot's log as its logger writes it, against the simulated twin's truth: ``benchmarks/bench_walking_logs.py``.
+
+Each case (a trot and a walk, noise-free and with a Unitree-like robot's noise) simulates the MuJoCo Go2 writing
+the raw log a real robot's logger writes (:mod:`wbfriction.sim.logger`: no contact flag, no foot force, no base
+pose, an IMU without accelerometer, torques from motor currents with torque constants a few per cent off, a logger
+repeating samples, no stamps), then scores each step of :mod:`wbfriction.pipeline.raw_log` against the truth the
+simulator wrote beside it:
+
+* **repeats**: whether the samples kept are exactly the drives' distinct samples (``sample_true``);
+* **contacts**: the share of samples (and feet) whose inferred state is the simulator's (``contact_true.<frame>``),
+  and the share left out as not confident;
+* **base velocity**: the RMS error of the base's linear velocity over its RMS speed (``base_qd_true``);
+* **friction**: ``estimate`` and ``fit`` run on the raw log as a user runs them, each fit scored against the
+  injected friction (:func:`~wbfriction.studies.status.fits_from_params`): good when F_c and F_v lie within 5 %
+  (noise-free) or 10 % (noisy);
+* **the inference's cost**: the same log with the simulator's contact flags and base pose given, estimated and
+  fitted the same way: where both fits are ``ok``, the largest relative difference of F_c and F_v.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pyarrow as pa
+
+from wbfriction.logs.columns import BASE_COLUMNS
+
+if TYPE_CHECKING:
+    from wbfriction.studies.status import JointFit
+
+TWIN_ROBOT = Path(__file__).resolve().parents[3] / "examples" / "inputs" / "go2_logged.toml"
+"""The twin's robot TOML (the repository's ``examples/inputs/go2_logged.toml``)."""
+DURATION = 8.0
+"""Simulated seconds per case."""
+
+
+@dataclass(frozen=True)
+class WalkingCase:
+    """One case: the gait and whether the sensors are a real robot's (noisy)."""
+
+    gait: str
+    noisy: bool
+
+    @property
+    def name(self) -> str:
+        """``trot``, ``walk-noisy``, ..."""
+        return self.gait + ("-noisy" if self.noisy else "")
+
+
+CASES = tuple(WalkingCase(g, n) for g in ("trot", "walk") for n in (False, True))
+"""The benchmark's cases."""
+
+
+@dataclass(frozen=True)
+class WalkingScore:
+    """One case's scores (module docstring); fits: per joint ``(status, F_c error, F_v error)`` (shares),
+    given_gap: the largest relative difference between the raw and the given route's values where both are ``ok``
+    (NaN: none both ``ok``)."""
+
+    case: str
+    rows: int
+    samples: int
+    repeats_exact: bool
+    contact_agreement: float
+    contact_agreement_confident: float
+    unsure_share: float
+    velocity_error: float
+    fits: dict[str, tuple[str, float, float]]
+    given_fits: dict[str, tuple[str, float, float]]
+    given_gap: float
+
+    def good(self, tolerance: float) -> tuple[int, int]:
+        """``(ok and within tolerance, ok)``."""
+        ok = [f for f in self.fits.values() if f[0] == "ok"]
+        return sum(1 for f in ok if max(f[1], f[2]) <= tolerance), len(ok)
+
+
+def _run(args: list[str], cwd: Path) -> None:
+    done = subprocess.run([sys.executable, "-m", "wbfriction", *args], cwd=cwd, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"wbfriction {' '.join(args)}: exit {done.returncode}: {done.stderr.strip()[-400:]}")
+
+
+def simulate(case: WalkingCase, folder: Path, seed: int = 0) -> Path:
+    """The raw log of ``case`` in ``folder`` (``wbfriction simulate ... --logger raw``)."""
+    out = folder / f"{case.name}_raw.parquet"
+    noise = ["--sensor-noise", "unitree", "--noise-seed", str(seed + 1)] if case.noisy else []
+    _run(["simulate", "--robot", str(TWIN_ROBOT), "--simulator", "mujoco", "--gait", case.gait, "--duration",
+          str(DURATION), "--logger", "raw", *noise, "-o", str(out)], folder)
+    return out
+
+
+def given_log(prepared: pa.Table, robot_frames: tuple[str, ...]) -> pa.Table:
+    """The prepared log with the simulator's contact flags and base pose in place of the inferred ones (and no
+    ``unsure`` row): the route a user with flags and a pose made outside the tool would take."""
+    names = [c for c in prepared.column_names if c != "unsure" and not c.startswith(("contact.", "base."))]
+    out = prepared.select(names)
+    for f in robot_frames:
+        out = out.append_column(f"contact.{f}", prepared.column(f"contact_true.{f}").cast(pa.int8()))
+    for c in BASE_COLUMNS:
+        out = out.append_column(c, prepared.column(c.replace("base.", "base_true.")))
+    return out.replace_schema_metadata(prepared.schema.metadata)
+
+
+def _estimate_fit(log: Path, robot: Path, stem: str, folder: Path, truth: dict) -> dict[str, JointFit]:
+    """``estimate`` and ``fit`` of ``log`` as a user runs them, each joint's fit against the truth."""
+    from wbfriction.studies.status import fits_from_params
+
+    friction, params = folder / f"{stem}_friction.parquet", folder / f"{stem}_params.json"
+    _run(["estimate", str(log), "--robot", str(robot), "-o", str(friction)], folder)
+    _run(["fit", str(friction), "-o", str(params)], folder)
+    return {f.joint: f for f in fits_from_params(params, truth["friction_true"])}
+
+
+def _summary(fits: dict[str, JointFit]) -> dict[str, tuple[str, float, float]]:
+    """Per joint ``(status, F_c error, F_v error)``."""
+    out = {}
+    for joint, fit in fits.items():
+        errors = {p.name: p.error for p in fit.parameters}
+        out[joint] = (fit.status, errors.get("F_c", float("nan")), errors.get("F_v", float("nan")))
+    return out
+
+
+def _gap(fits: dict[str, JointFit], given: dict[str, JointFit]) -> float:
+    """The largest relative difference of F_c and F_v between the raw route's fits and the given route's, where
+    both are ``ok`` (NaN: none)."""
+    gaps = []
+    for joint, fit in fits.items():
+        other = given.get(joint)
+        if fit.status != "ok" or other is None or other.status != "ok":
+            continue
+        theirs = {p.name: p.value for p in other.parameters}
+        gaps += [abs(p.value - theirs[p.name]) / abs(theirs[p.name]) for p in fit.parameters
+                 if p.name in theirs and theirs[p.name] != 0]
+    return max(gaps) if gaps else float("nan")
+
+
+def score_case(case: WalkingCase, folder: Path) -> WalkingScore:
+    """Simulate, prepare, estimate and fit ``case`` in ``folder`` (module docstring)."""
+    import pyarrow.parquet as pq
+
+    from wbfriction.model.loading import load_robot
+    from wbfriction.pipeline.raw_log import prepare_raw
+    from wbfriction.studies.status import log_truth
+
+    raw = simulate(case, folder)
+    robot = load_robot(str(TWIN_ROBOT))
+    table = pq.read_table(raw)
+    prepared = prepare_raw(table, robot, str(raw))
+    out = prepared.table
+    sample = np.asarray(out.column("sample_true"))
+    raw_sample = np.asarray(table.column("sample_true"))
+    exact = bool(np.array_equal(sample, raw_sample[np.r_[True, np.diff(raw_sample) != 0]]))
+    truth_c = np.column_stack([np.asarray(out.column(f"contact_true.{f}")) for f in robot.contact_frames]) > 0
+    inferred, confident = prepared.contacts.contact, prepared.contacts.confident
+    true_v = np.column_stack([np.asarray(out.column(f"base_qd_true.{a}")) for a in ("vx", "vy", "vz")])
+    error = prepared.base.twist[:, :3] - true_v
+    velocity_error = float(np.sqrt(np.mean(np.sum(error ** 2, axis=1)) / np.mean(np.sum(true_v ** 2, axis=1))))
+    truth = log_truth(raw)
+    fits = _estimate_fit(raw, TWIN_ROBOT, case.name, folder, truth)
+    given = folder / f"{case.name}_given.parquet"
+    pq.write_table(given_log(out, robot.contact_frames), given)
+    given_fits = _estimate_fit(given, TWIN_ROBOT, case.name + "_given", folder, truth)
+    return WalkingScore(case.name, len(table), len(sample), exact, float(np.mean(inferred == truth_c)),
+                        float(np.mean((inferred == truth_c)[confident])) if confident.any() else float("nan"),
+                        float(prepared.contacts.unconfident_rows().mean()), velocity_error, _summary(fits),
+                        _summary(given_fits), _gap(fits, given_fits))
+
+
+def markdown(scores: list[WalkingScore]) -> str:
+    """The benchmark's table (one row per case) and the per-joint fits."""
+    lines = ["| case | rows → samples | repeats exact | contacts agree | (confident) | left out | base velocity "
+             "error | fits ok | ok within 5 % / 10 % | given vs raw (both ok) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for s in scores:
+        tol = 0.10 if s.case.endswith("noisy") else 0.05
+        good, ok = s.good(tol)
+        lines.append(f"| {s.case} | {s.rows} → {s.samples} | {'yes' if s.repeats_exact else 'NO'} | "
+                     f"{s.contact_agreement:.1%} | {s.contact_agreement_confident:.1%} | {s.unsure_share:.1%} | "
+                     f"{s.velocity_error:.1%} | {ok}/{len(s.fits)} | {good}/{ok} | {s.given_gap:.1%} |")
+    return "\n".join(lines)
