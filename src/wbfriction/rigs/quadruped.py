@@ -9,7 +9,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, Optional
 
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import InputError, OptionError
 from wbfriction.options import option
 from wbfriction.report.printed import Printed
 from wbfriction.rigs.base import DemoOutput, DesignOutput, Rig, RigProgress, SimulationOutput
@@ -96,9 +96,11 @@ class QuadrupedSimulation(SensorsFileOptions):
                 raise InputError(f"{named[0]}: an option of the raw log (--logger raw); the full log has none")
             return None
         check_raw_robot(robot)
-        values = {k: v for k, v in given.items() if v is not None}
+        values: dict[str, Any] = {k: v for k, v in given.items() if v is not None}
         for k in ("period", "imu_period"):  # given in ms
             if k in values:
+                if not values[k] > 0:
+                    raise OptionError(flags[k], values[k], "> 0 [ms]")
                 values[k] = values[k] * 1e-3
         if self.sensor_noise == "unitree":
             values.update(orientation_std=ORIENTATION_STD, count_std=UNITREE_NOISE.force_std)

@@ -114,17 +114,17 @@ class LoggerOptions:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        for flag, value in (("--logger-period", self.period), ("--imu-period", self.imu_period)):
+        for flag, value in (("period", self.period), ("imu_period", self.imu_period)):
             if not (np.isfinite(value) and value > 0):
-                raise OptionError(flag, value, "> 0 [ms]")
+                raise OptionError(flag, value, "> 0 [s]")
         if not 0 <= self.kt_error < 0.5:
             raise OptionError("--kt-error", self.kt_error, "in [0, 0.5) (a share of the nominal torque constant)")
         for flag, value in (("orientation_std", self.orientation_std), ("count_std", self.count_std)):
             if not (np.isfinite(value) and value >= 0):
                 raise OptionError(flag, value, ">= 0")
-        for flag, value, choices in (("--angles", self.angles, ANGLES), ("stamps", self.stamps, STAMPS)):
-            if value not in choices:
-                raise OptionError(flag, value, f"one of {', '.join(choices)}")
+        for flag, choice, choices in (("--angles", self.angles, ANGLES), ("stamps", self.stamps, STAMPS)):
+            if choice not in choices:
+                raise OptionError(flag, choice, f"one of {', '.join(choices)}")
 
     def rng(self, stream: str) -> np.random.Generator:
         """The random generator of one draw (:data:`STREAMS`)."""
@@ -211,10 +211,12 @@ def foot_counts(normal: np.ndarray, options: LoggerOptions) -> tuple[np.ndarray,
     docstring), and their calibration (the metadata's ``offset``, ``scale`` per foot, in the feet's order)."""
     n_feet = normal.shape[1]
     rng = options.rng("counts")
-    offset, scale = rng.uniform(*COUNT_OFFSET, n_feet), rng.uniform(*COUNT_SCALE, n_feet)
-    noise = options.rng("count_noise").normal(0.0, options.count_std, normal.shape) if options.count_std > 0 else 0.0
+    offset = rng.uniform(COUNT_OFFSET[0], COUNT_OFFSET[1], size=n_feet)
+    scale = rng.uniform(COUNT_SCALE[0], COUNT_SCALE[1], size=n_feet)
+    noise = options.rng("count_noise").normal(0.0, options.count_std, normal.shape) if options.count_std > 0 \
+        else np.zeros(normal.shape)
     counts = np.round(offset + scale * (normal + noise))
-    return counts, {"offset": offset.tolist(), "scale": scale.tolist()}
+    return counts, {"offset": np.asarray(offset).tolist(), "scale": np.asarray(scale).tolist()}
 
 
 def check_raw_robot(robot: Robot) -> None:
