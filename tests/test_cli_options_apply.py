@@ -150,7 +150,8 @@ VALUES = {
     "driver_noise": ["--driver-noise", "none"], "velocity_noise": ["--velocity-noise", "0.01"],
     "speed": ["--speed", "0.1"], "foot_forces": ["--foot-forces", "3d"], "play": ["--play", "FILE"],
     "sensor_noise": ["--sensor-noise", "unitree"], "logger": ["--logger", "raw"],
-    "logger_period": ["--logger-period", "1"], "imu_period": ["--imu-period", "4"], "angles": ["--angles", "cos-sin"], "kt_error": ["--kt-error", "0.02"],
+    "logger_period": ["--logger-period", "1"], "imu_period": ["--imu-period", "4"],
+    "angles": ["--angles", "cos-sin"], "kt_error": ["--kt-error", "0.02"],
     "foot_counts": ["--foot-counts"],
     # identify's
     "output": ["-o", "OUT.urdf"], "json_output": ["--json", "OUT.json"],

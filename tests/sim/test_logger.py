@@ -228,3 +228,11 @@ def test_refused_in_one_line_before_the_simulation(capsys, tmp_path, args, messa
                                      "-o", tmp_path / "x.parquet")
     assert code != 0 and message in err and "simulate:" not in out + err
     assert not (tmp_path / "x.parquet").exists()
+
+
+def test_a_robot_named_by_its_toml():
+    """``--robot`` ending in ``.toml`` is the robot TOML (as ``--config``): the twin's loads so."""
+    from wbfriction.model.loading import RobotSpec
+
+    assert RobotSpec.given(str(TOML)) == RobotSpec(None, None, str(TOML))
+    assert RobotSpec.given("go2_walking") == RobotSpec("go2_walking")
