@@ -35,8 +35,8 @@ which).
 estimator never reads them): ``time_true`` [s] and ``sample_true`` (the time and index of the drive sample the row
 holds: the repeats are the rows whose ``sample_true`` is the previous row's), ``imu_sample_true`` (the sample the
 IMU's update holds), ``tau_f_true.<joint>``, ``qd_true.<joint>``, ``contact_true.<frame>`` (1 where the simulator's
-ground pushes on the foot: a normal force above zero), ``base_true.x`` ... ``base_true.qw`` (the base's pose) and
-``base_qd_true.*`` (its twist, Pinocchio's free-flyer convention). Metadata: the run's (``friction_true``,
+ground holds the foot: a contact with a nonzero normal force), ``base_true.x`` ... ``base_true.qw`` (the base's
+pose) and ``base_qd_true.*`` (its twist, Pinocchio's free-flyer convention). Metadata: the run's (``friction_true``,
 ``armature_true``, ...), ``logger`` (what the robot's user knows: the period, the angles' form, whether stamped) and
 ``logger_true`` (the clocks, the drawn errors, the seed).
 
@@ -319,7 +319,7 @@ def _truth_columns(run: QuadrupedRun, robot: Robot, clocks: LoggerClocks) -> dic
         cols.update({f"tau_f_true.{j}": log.tau_f_true[k, i] for i, j in enumerate(robot.torque_controlled)})
     qd = run.v[:, robot.act_v_index]
     cols.update({f"qd_true.{j}": qd[k, i] for i, j in enumerate(robot.actuated)})
-    contact = (run.force[..., 2] > 0).astype(np.int8)
+    contact = (run.force[..., 2] != 0).astype(np.int8)
     cols.update({f"contact_true.{f}": contact[k, c] for c, f in enumerate(robot.contact_frames)})
     cols.update({c: run.q[k, i] for i, c in enumerate(BASE_TRUE_COLUMNS)})
     cols.update({c: run.v[k, i] for i, c in enumerate(BASE_QD_TRUE_COLUMNS)})
