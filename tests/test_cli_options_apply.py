@@ -47,7 +47,8 @@ HUNG = ("robot 'go2' is a hung PD-driven robot (fixed base, [pd]): it takes --fr
         "--duration, --excitation-seed, --setpoints, --driver-noise, --velocity-noise, --play")
 QUADRUPED = ("robot 'go2_walking' stands on point feet (a walking quadruped), simulated in ideal: it takes --gait, "
              "--friction, --simulator, --substeps, --sensors, --position-noise, --encoder-bits, --torque-noise, "
-             "--noise-seed, --duration, --excitation-seed, --speed, --foot-forces, --play")
+             "--noise-seed, --duration, --excitation-seed, --speed, --foot-forces, --play, --sensor-noise, --logger, "
+             "--logger-period, --imu-period, --angles, --kt-error, --foot-counts/--no-foot-counts")
 ARM = ("robot 'panda' is a fixed-base arm (torque-driven, an excitation trajectory): it takes --friction, "
        "--position-noise, --encoder-bits, --torque-noise, --noise-seed, --duration, --excitation-seed, --play")
 PD = ("--actuator pd identifies a hung PD-driven robot's actuators (the URDF kept): it takes --json, --holdout, "
@@ -148,6 +149,10 @@ VALUES = {
     "excitation_seed": ["--excitation-seed", "2"], "setpoints": ["--setpoints", "chirps"],
     "driver_noise": ["--driver-noise", "none"], "velocity_noise": ["--velocity-noise", "0.01"],
     "speed": ["--speed", "0.1"], "foot_forces": ["--foot-forces", "3d"], "play": ["--play", "FILE"],
+    "sensor_noise": ["--sensor-noise", "unitree"], "logger": ["--logger", "raw"],
+    "logger_period": ["--logger-period", "1"], "imu_period": ["--imu-period", "4"],
+    "angles": ["--angles", "cos-sin"], "kt_error": ["--kt-error", "0.02"],
+    "foot_counts": ["--foot-counts"],
     # identify's
     "output": ["-o", "OUT.urdf"], "json_output": ["--json", "OUT.json"],
     "stribeck_velocity": ["--stribeck-velocity", "0.1"],

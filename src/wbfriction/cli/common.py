@@ -46,7 +46,8 @@ out = Console()  # as wide as the terminal (COLUMNS); tables fit it (--wide: eve
 WideOpt = typer.Option(False, "--wide", help="Every column in one table, as wide as it takes (default: tables that "
                                             "fit the terminal).")
 VerboseOpt = typer.Option(False, "--verbose", help="Each joint's own line for the notes shared by several.")
-RobotOpt = typer.Option("talos", "--robot", help=f"Built-in robot: {', '.join(BUILTIN_ROBOTS)}.")
+RobotOpt = typer.Option("talos", "--robot", help=f"Built-in robot: {', '.join(BUILTIN_ROBOTS)}; or a robot TOML "
+                                                  "(a path ending in .toml, as --config).")
 # the help names the log formats registered as it is loaded (their catalogue: no pyarrow imported)
 LogArg = typer.Argument(..., metavar="LOG", help=f"Log in the wbfriction format: {table_formats()}.")
 FrictionArg = typer.Argument(..., metavar="FRICTION", help="Friction table written by 'wbfriction estimate'.")

@@ -45,6 +45,12 @@ FootForces = Literal["none", "normal", "3d"]
 """``--foot-forces``: the feet's force columns a walking quadruped's log carries."""
 Actuator = Literal["torque", "pd"]
 """How a robot's joints are driven (``--actuator``): motors whose torque is logged, or PD motor drivers."""
+SensorNoiseChoice = Literal["none", "unitree"]
+"""A robot on point feet's every sensor's noise (``--sensor-noise``): the options' alone, or a Unitree-like robot's."""
+LoggerChoice = Literal["full", "raw"]
+"""What log a robot on point feet writes (``--logger``): the project's full log, or a robot logger's raw one."""
+AnglesChoice = Literal["angles", "cos-sin"]
+"""How a raw log holds the joint angles (``--angles``)."""
 DriverNoiseChoice = Literal["real", "none"]
 """The PD drivers' sensor noise (``--driver-noise``): a real driver's (:data:`~wbfriction.sim.pd_options.REAL_DRIVER`)
 or none."""
@@ -117,6 +123,25 @@ ActuatorOpt = typer.Option(None, "--actuator", "--drive",
 SpeedOpt = typer.Option(None, help="A robot on point feet: forward speed [m/s] (default 0.2 trot, 0.1 walk).")
 FootForcesOpt = typer.Option("none", help="A robot on point feet: the feet's force columns logged: none, normal "
                                           "(force.<foot>, as Unitree's foot sensors) or 3d (force.<foot>.x|y|z).")
+SensorNoiseOpt = typer.Option("none", help="A robot on point feet, mujoco: none (the options above alone) or unitree "
+                                           "(a Unitree-like robot's every sensor: 15-bit encoders, drives' velocity "
+                                           "0.02 rad/s, torque 0.05 N·m, gyro 0.005 rad/s, accelerometer 0.05 m/s², "
+                                           "foot forces 2 N; a raw log's IMU orientation 0.001 rad), seeded by "
+                                           "--noise-seed.")
+LoggerOpt = typer.Option("full", help="A robot on point feet: full (every column the simulator knows) or raw (the "
+                                      "log a robot's logger writes: no time, contacts, foot forces or base pose; "
+                                      "motor currents, the IMU's roll, pitch, yaw and rate; rows repeating the "
+                                      "drives' sample; the truth beside it: wbfriction.sim.logger).")
+LoggerPeriodOpt = typer.Option(None, help="--logger raw: the logger's period [ms] (default 1.22; the drives update "
+                                          "every 2 ms).")
+ImuPeriodOpt = typer.Option(None, help="--logger raw: the IMU's update period [ms] (default 5).")
+AnglesOpt = typer.Option(None, help="--logger raw: the joint angles as angles (q.<joint>, default) or cos-sin "
+                                    "(q_cos.<joint>, q_sin.<joint>).")
+KtErrorOpt = typer.Option(None, help="--logger raw: the bound of each joint's torque-constant error, a share (default "
+                                     "0.03: the true constant within ±3 % of the TOML's [torque_constants]).")
+FootCountsOpt = typer.Option(None, "--foot-counts/--no-foot-counts",
+                             help="--logger raw: log raw foot-force counts (foot_count.<foot>: an offset and a scale "
+                                  "per foot).")
 SetpointsOpt = typer.Option(SETPOINTS.kind, help="PD-driven: ramps (triangle ramps reversing every "
                                                  f"{SETPOINTS.reversal[0]:g}-{SETPOINTS.reversal[1]:g} s), chirps "
                                                  f"({SETPOINTS.chirp[0]:g}-{SETPOINTS.chirp[1]:g} Hz) or both "
@@ -157,7 +182,10 @@ def simulate(ctx: typer.Context, output: Path = OutputOpt, robot: str = RobotOpt
              driver_noise: DriverNoiseChoice = DriverNoiseOpt,
              velocity_noise: Optional[float] = VelocityNoiseOpt, speed: Optional[float] = SpeedOpt,
              foot_forces: FootForces = FootForcesOpt, play: Optional[Path] = PlayOpt,
-             rig_option: list[str] = RigOptionOpt) -> None:
+             sensor_noise: SensorNoiseChoice = SensorNoiseOpt, logger: LoggerChoice = LoggerOpt,
+             logger_period: Optional[float] = LoggerPeriodOpt, imu_period: Optional[float] = ImuPeriodOpt,
+             angles: Optional[AnglesChoice] = AnglesOpt, kt_error: Optional[float] = KtErrorOpt,
+             foot_counts: Optional[bool] = FootCountsOpt, rig_option: list[str] = RigOptionOpt) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents; a PD-driven one
     (--robot go2) hangs with its base fixed, its drivers tracking ramps and chirps; --simulator also takes an engine

@@ -519,8 +519,11 @@ class RobotSpec:
     def given(cls, name: str, urdf: str | Path | None = None, config: str | Path | None = None,
               mjcf: str | Path | None = None) -> RobotSpec:
         """The robot a command's ``--robot``, ``--urdf``, ``--config`` and ``--mjcf`` name (a ``--config`` stands
-        for the whole robot: the built-in name is then not used)."""
+        for the whole robot: the built-in name is then not used; a ``--robot`` ending in ``.toml`` is a robot TOML,
+        as ``--config``, where no ``--config`` is given)."""
         text = lambda p: None if p is None else str(p)  # noqa: E731
+        if config is None and str(name).endswith(".toml"):
+            name, config = "", name
         return cls(None if config else name, text(urdf), text(config), text(mjcf))
 
     def load(self) -> Robot:

@@ -5,11 +5,11 @@ what a gait gives each joint (:func:`~wbfriction.studies.quadruped.run_quadruped
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, Optional
 
-from wbfriction.exceptions import InputError
+from wbfriction.exceptions import InputError, OptionError
 from wbfriction.options import option
 from wbfriction.report.printed import Printed
 from wbfriction.rigs.base import DemoOutput, DesignOutput, Rig, RigProgress, SimulationOutput
@@ -19,6 +19,8 @@ from wbfriction.sim.noise_options import SensorsFileOptions
 if TYPE_CHECKING:
     from wbfriction.model.robot import Robot
     from wbfriction.sim.engines import Engine
+    from wbfriction.sim.logger import LoggerOptions
+    from wbfriction.sim.quadruped_mujoco import QuadrupedNoise
     from wbfriction.walking.quadruped import QuadrupedReference
 
 PLAYED_SUBSTEPS = 8
@@ -44,6 +46,16 @@ class QuadrupedSimulation(SensorsFileOptions):
         foot_forces: the feet's force columns logged: none, normal or 3d.
         gait: stand, step, trot or walk; duration [s] of gait; speed: forward speed [m/s]; each None: the gait's
             default (:class:`~wbfriction.walking.quadruped.GaitOptions`); excitation_seed: its swings and sway.
+        sensor_noise: ``none`` (the options' noise alone) or ``unitree``: on an engine with sensors of its own
+            (MuJoCo) a Unitree-like robot's (:data:`~wbfriction.sim.quadruped_mujoco.UNITREE_NOISE`; a raw log's
+            IMU orientation within :data:`~wbfriction.sim.logger.ORIENTATION_STD`, its foot counts within the foot
+            forces' 2 N), seeded by ``noise_seed``.
+        logger: ``full`` (the project's log: every column the simulator knows) or ``raw`` (the log a robot's logger
+            writes, the truth beside it: :func:`~wbfriction.sim.logger.write_raw_log`).
+        logger_period, imu_period: the raw logger's and the IMU's periods [ms]; angles: ``angles`` or ``cos-sin``;
+            kt_error: the torque constants' error bound (a share); foot_counts: raw foot-force counts logged; each
+            None: :class:`~wbfriction.sim.logger.LoggerOptions`' default (raw only; the draws seeded by
+            ``noise_seed``).
     """
 
     actuator: Optional[Literal["torque", "pd"]] = option(None)
@@ -55,6 +67,65 @@ class QuadrupedSimulation(SensorsFileOptions):
     duration: Optional[float] = option(None, quantity="duration", motion=True)
     excitation_seed: int = option(0, quantity="seed", motion=True)
     speed: Optional[float] = option(None, motion=True)
+    sensor_noise: Literal["none", "unitree"] = option("none")
+    logger: Literal["full", "raw"] = option("full")
+    logger_period: Optional[float] = option(None)
+    imu_period: Optional[float] = option(None)
+    angles: Optional[Literal["angles", "cos-sin"]] = option(None)
+    kt_error: Optional[float] = option(None)
+    foot_counts: Optional[bool] = option(None)
+
+    def logger_options(self, robot: Robot) -> LoggerOptions | None:
+        """The raw logger's options (None: the full log), checked with the robot before any simulation.
+
+        Raises:
+            InputError: a raw logger's option with ``logger = "full"``; what
+                :func:`~wbfriction.sim.logger.check_raw_robot` refuses.
+            OptionError: what :class:`~wbfriction.sim.logger.LoggerOptions` refuses.
+        """
+        from wbfriction.sim.logger import ORIENTATION_STD, LoggerOptions, check_raw_robot
+        from wbfriction.sim.quadruped_mujoco import UNITREE_NOISE
+
+        given = {"period": self.logger_period, "imu_period": self.imu_period, "angles": self.angles,
+                 "kt_error": self.kt_error, "foot_counts": self.foot_counts}
+        flags = {"period": "--logger-period", "imu_period": "--imu-period", "angles": "--angles",
+                 "kt_error": "--kt-error", "foot_counts": "--foot-counts"}
+        if self.logger == "full":
+            named = [flags[k] for k, v in given.items() if v is not None]
+            if named:
+                raise InputError(f"{named[0]}: an option of the raw log (--logger raw); the full log has none")
+            return None
+        check_raw_robot(robot)
+        values: dict[str, Any] = {k: v for k, v in given.items() if v is not None}
+        for k in ("period", "imu_period"):  # given in ms
+            if k in values:
+                if not values[k] > 0:
+                    raise OptionError(flags[k], values[k], "> 0 [ms]")
+                values[k] = values[k] * 1e-3
+        if self.sensor_noise == "unitree":
+            values.update(orientation_std=ORIENTATION_STD, count_std=UNITREE_NOISE.force_std)
+        return LoggerOptions(seed=self.noise_seed or 0, **values)
+
+    def engine_noise(self, engine: Engine) -> QuadrupedNoise | None:
+        """The engine's own sensor noise (``sensor_noise``; None: the options' noise alone).
+
+        Raises:
+            InputError: ``unitree`` on an engine without sensors of its own, or with a noise option it replaces.
+        """
+        from wbfriction.sim.quadruped_mujoco import UNITREE_NOISE
+
+        if self.sensor_noise == "none":
+            return None
+        if not engine.soft_contacts:
+            raise InputError(f"--sensor-noise {self.sensor_noise}: engine '{engine.name}' has no sensors of its own "
+                             "(its noise: --position-noise, --encoder-bits, --torque-noise); use --simulator mujoco")
+        replaced = [f for f, v in (("--sensors", self.sensors), ("--position-noise", self.position_noise),
+                                   ("--encoder-bits", self.encoder_bits), ("--torque-noise", self.torque_noise))
+                    if v is not None]
+        if replaced:
+            raise InputError(f"{replaced[0]}: --sensor-noise {self.sensor_noise} gives every sensor's noise "
+                             "(only --noise-seed with it)")
+        return replace(UNITREE_NOISE, seed=self.noise_seed or 0)
 
 
 @dataclass(frozen=True)
@@ -97,13 +168,22 @@ class QuadrupedRig(Rig):
         from wbfriction.sim.quadruped import QuadrupedOptions
 
         assert engine is not None  # a rig with a motion has one (Rig.engine)
+        o: QuadrupedSimulation = options
+        logger, sensors = o.logger_options(robot), o.engine_noise(engine)  # refused before the simulation
         opts = QuadrupedOptions(**self.run_options(robot, options))
         ref, motion = self.reference(robot, options, progress)
-        run = engine.quadruped(robot, ref, opts, progress=progress.count("simulate", len(ref), "samples"))
+        run = engine.quadruped(robot, ref, opts, progress=progress.count("simulate", len(ref), "samples"),
+                               sensors=sensors)
         drive = "PD set-points" if opts.drive == "pd" else "joint torques"
         normal = run.force[..., 2][run.log.contact]
         pulled = () if not normal.size or normal.min() >= 0 else \
             (f"a foot pulled on the ground at {int((normal < 0).sum())} samples (down to {normal.min():.1f} N)",)
+        if logger is not None:
+            from wbfriction.sim.logger import logged_summary, write_raw_log
+
+            table = write_raw_log(run, robot, logger)
+            return SimulationOutput(table=table, summary=logged_summary(table, f"{len(ref) * ref.dt:g} s, {motion}"),
+                                    warnings=pulled)
         return SimulationOutput(log=run.log, summary=f"{len(run.log)} samples, {len(ref) * ref.dt:g} s, {motion}, "
                                                      f"{drive}", warnings=pulled)
 
