@@ -8,24 +8,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from helpers import logger_sampling
 from wbfriction.logs.repeats import find_repeats, repeated_rows
-
-
-def logger_sampling(drive: float, logger: float, duration: float, hold: float = 0.0, phase: float = 0.3e-3,
-                    noise: float = 0.0, seed: int = 0):
-    """A drive clock at ``drive`` [s] (each period held with probability ``hold``: no new sample) read by a logger
-    at ``logger`` [s]: each row the drives' latest sample. Returns the rows' stamps (N,), their values (N, 3), the
-    true times of the samples (K,), which sample each row shows (N,)."""
-    rng = np.random.default_rng(seed)
-    ticks = np.arange(int(duration / drive))
-    held = rng.random(ticks.size) < hold
-    held[0] = False
-    true = phase + drive * ticks[~held]
-    values = np.column_stack([np.sin(true), np.cos(3 * true), true]) + noise * rng.normal(size=(true.size, 3))
-    stamps = logger * np.arange(int(true[-1] / logger) + 1)
-    shown = np.searchsorted(true, stamps, side="right") - 1  # the latest sample taken at or before the tick
-    keep = shown >= 0
-    return stamps[keep], values[shown[keep]], true, shown[keep]
 
 
 @pytest.mark.parametrize("noise", [0.0, 1e-3])
