@@ -70,3 +70,19 @@ def test_any_drive_clock_read_by_a_faster_logger_is_found(drive, ratio, hold, ph
     assert found.clock is not None and found.clock.period == pytest.approx(drive, rel=1e-3)
     err = np.abs(found.times(stamps) - true[np.unique(shown)])
     assert err.max() <= 0.5 * logger * (1 + 1e-6)  # the windows are one logger period wide: within half of one
+
+
+def test_merged_samples_are_read_as_the_drives_clock_not_as_jitter():
+    """The issue's clock: the repeats removed by hand, the first rows' stamps (logger ticks, 1-3 of them a sample)
+    read as receive-time jitter, regularised and cut into pieces; at the re-estimated times, one 2 ms clock whose
+    held periods are whole skips, on the stamps as recorded, in one piece."""
+    from wbfriction.logs.clock import read_clock
+
+    stamps, values, true, shown = logger_sampling(2e-3, 1.22e-3, 22.0, 0.02)
+    found = find_repeats(values, stamps)
+    q = np.sin(2 * true[np.unique(shown)])[:, None] + 1e-4 * np.random.default_rng(0).normal(size=(found.first.size, 1))
+    by_hand = read_clock(stamps[found.first], "by hand", q=q)
+    assert by_hand.kind == "jittered" and len(by_hand.segments) > 10  # the issue's symptom
+    clock = read_clock(found.times(stamps), "merged", q=q)
+    assert clock.kind == "skipping" and clock.lattice == pytest.approx(2e-3, rel=1e-4)
+    assert len(clock.segments) == 1 and "2 ms clock skipping samples" in clock.reason

@@ -85,6 +85,24 @@ def joint_stream(table: pa.Table, robot: Robot) -> list[str]:
     return [n for n in table.column_names if n.partition(".")[0] in prefixes]
 
 
+def repeated_columns(table: pa.Table, columns: list[str]) -> np.ndarray:
+    """Rows (N,) equal to the previous one in every one of ``columns`` (NaN equal to NaN; row 0 never; no column:
+    none), column by column (a log whose first column never repeats is read no further)."""
+    out = np.zeros(table.num_rows, dtype=bool)
+    if not columns or table.num_rows < 2:
+        return out
+    out[1:] = True
+    for c in columns:
+        x = table.column(c).to_numpy(zero_copy_only=False)
+        same = x[1:] == x[:-1]
+        if x.dtype.kind == "f":
+            same |= np.isnan(x[1:]) & np.isnan(x[:-1])
+        out[1:] &= same
+        if not out.any():
+            break
+    return out
+
+
 def _pairs_to_angles(table: pa.Table, robot: Robot, source: str) -> tuple[pa.Table, list[str]]:
     """The table with each cosine/sine pair replaced by its ``q.<joint>`` column, and those joints.
 
@@ -143,14 +161,15 @@ def condition_raw_table(table: pa.Table, robot: Robot, source: str, read: ReadOp
     """
     n = table.num_rows
     t, t0, nominal = _stamps(table, source, read)
-    if n >= 2:
-        split_at_gaps(t, source, read.max_gap)  # the stamps increase, are finite; what their gaps are is later's
     table, pairs = _pairs_to_angles(table, robot, source)
-    columns = joint_stream(table, robot)
-    joints = find_repeats(numeric_columns(table, columns, source, finite=False), t)
-    merge = read.repeats == "merge" and joints.merge
     streams = {s: stream_columns(table.column_names, s) for s in STREAMS}
-    found = {s: find_repeats(numeric_columns(table, c, source, finite=False), t) for s, c in streams.items() if c}
+    masks = {"joints": repeated_columns(table, joint_stream(table, robot)),
+             **{s: repeated_columns(table, c) for s, c in streams.items() if c}}
+    if n >= 2 and any(m.any() for m in masks.values()):
+        split_at_gaps(t, source, read.max_gap)  # increasing, finite stamps (their gaps are the clock's to read)
+    joints = find_repeats(None, t, masks.pop("joints"))
+    merge = read.repeats == "merge" and joints.merge
+    found = {s: find_repeats(None, t, m) for s, m in masks.items()}
     resampled = tuple(s for s, r in found.items() if read.repeats == "merge" and (merge or r.merge))
     lines = _lines(n, joints, merge, nominal, read, pairs, found, resampled)
     report = RawLogReport(n, len(joints.first) if merge else n, {"joints": joints.share, **{s: r.share for s, r in

@@ -119,18 +119,19 @@ def repeated_rows(values: np.ndarray) -> np.ndarray:
     return out
 
 
-def find_repeats(values: np.ndarray, stamps: np.ndarray) -> Repeats:
+def find_repeats(values: np.ndarray | None, stamps: np.ndarray, repeat: np.ndarray | None = None) -> Repeats:
     """The repeats of one stream (:func:`repeated_rows`) and the drives' clock of its distinct samples.
 
     Args:
-        values: the stream's columns (N, m), one row per logger tick.
+        values: the stream's columns (N, m), one row per logger tick (None: ``repeat`` given).
         stamps: the rows' times (N,) [s], strictly increasing (the logger's ticks).
+        repeat: the repeated rows (N,) when already found (:func:`repeated_rows`), else None.
 
     Returns:
         :class:`Repeats`; :attr:`Repeats.merge` says whether they are a logger faster than the drives.
     """
     stamps = np.asarray(stamps, dtype=float)
-    repeat = repeated_rows(values)
+    repeat = repeated_rows(values) if repeat is None else np.asarray(repeat, dtype=bool)
     first = np.flatnonzero(~repeat)
     steps = np.diff(stamps)
     logger = float(np.median(steps)) if steps.size else float("nan")
