@@ -269,7 +269,8 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
         table, raw = condition_raw_table(table, robot, source, read)
         read = replace(read, time_unit=None) if raw.restamped else read
     warnings = check_schema(table.schema, robot, source) + ((f"{source}: {raw.reason}",) if raw and raw.reason else ())
-    time, clock, q = _read_motion(table, robot, source, read, first_row, clock, raw is not None and raw.drive_period)
+    time, clock, q = _read_motion(table, robot, source, read, first_row, clock,
+                                   raw is not None and raw.drive_period is not None)
     qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
     setpoints = read_setpoints(table, robot, time, q, qd_logged, source, first_row)
     if setpoints is not None and robot.pd is not None:  # a set-point in degrees drives the joint to its limits
@@ -408,7 +409,7 @@ def _stack(table: pa.Table, columns: list[str], source: str, first_row: int) -> 
 
 
 def _read_motion(table: pa.Table, robot: Robot, source: str, read: ReadOptions, first_row: int,
-                 clock: Clock | None = None, drive: float | None | bool = None) -> tuple[np.ndarray, Clock, np.ndarray]:
+                 clock: Clock | None = None, drive: bool = False) -> tuple[np.ndarray, Clock, np.ndarray]:
     """Time [s] (checked, its unit too: :func:`~wbfriction.logs.clock.table_stamps`), its clock
     (``clock``, the whole log's cut to these rows, else read from the stamps and positions) and
     q [rad] (checked against the limits; continuous joints unwrapped, :func:`unwrap_positions`).

@@ -131,7 +131,9 @@ def find_repeats(values: np.ndarray | None, stamps: np.ndarray, repeat: np.ndarr
         :class:`Repeats`; :attr:`Repeats.merge` says whether they are a logger faster than the drives.
     """
     stamps = np.asarray(stamps, dtype=float)
-    repeat = repeated_rows(values) if repeat is None else np.asarray(repeat, dtype=bool)
+    if repeat is None:
+        repeat = repeated_rows(np.zeros((len(stamps), 0)) if values is None else values)
+    repeat = np.asarray(repeat, dtype=bool)
     first = np.flatnonzero(~repeat)
     steps = np.diff(stamps)
     logger = float(np.median(steps)) if steps.size else float("nan")
