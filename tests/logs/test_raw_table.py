@@ -161,3 +161,12 @@ def test_a_log_in_the_log_format_is_not_changed(combined_walk, talos):
     log = log_from_table(table, talos, "walk")
     assert not any("repeat" in w for w in log.warnings)
     np.testing.assert_array_equal(log.time, table.column("time").to_numpy())
+
+
+@pytest.mark.parametrize("kwargs, option", [({"rate": 0.0}, "--rate"), ({"rate": float("nan")}, "--rate"),
+                                            ({"repeats": "drop"}, "--repeats")])
+def test_read_options_refuse_a_rate_or_a_policy_out_of_range(kwargs, option):
+    from wbfriction.exceptions import OptionError
+
+    with pytest.raises(OptionError, match=rf"^{option} must be"):
+        ReadOptions(**kwargs)
