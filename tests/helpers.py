@@ -394,3 +394,20 @@ def run_with_toy_format(code: str):
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
     assert run.returncode == 0, run.stderr
     return json.loads(run.stdout.splitlines()[-1])
+
+
+def logger_sampling(drive: float, logger: float, duration: float, hold: float = 0.0, phase: float = 0.3e-3,
+                    noise: float = 0.0, seed: int = 0):
+    """A drive clock at ``drive`` [s] (each period held with probability ``hold``: no new sample) read by a logger
+    at ``logger`` [s]: each row the drives' latest sample. Returns the rows' stamps (N,), their values (N, 3), the
+    true times of the samples (K,), which sample each row shows (N,)."""
+    rng = np.random.default_rng(seed)
+    ticks = np.arange(int(duration / drive))
+    held = rng.random(ticks.size) < hold
+    held[0] = False
+    true = phase + drive * ticks[~held]
+    values = np.column_stack([np.sin(true), np.cos(3 * true), true]) + noise * rng.normal(size=(true.size, 3))
+    stamps = logger * np.arange(int(true[-1] / logger) + 1)
+    shown = np.searchsorted(true, stamps, side="right") - 1  # the latest sample taken at or before the tick
+    keep = shown >= 0
+    return stamps[keep], values[shown[keep]], true, shown[keep]

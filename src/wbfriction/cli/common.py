@@ -88,6 +88,11 @@ TimeBaseOpt = typer.Option("auto", help="Time base the positions are differentia
                                          "data and printed), recorded (the stamps as they are: a clock that "
                                          "skips samples) or regularised (a uniform clock fitted to "
                                          "receive-time stamps).")
+RepeatsOpt = typer.Option("merge", help="Rows that repeat the previous sample in every joint column (a logger faster "
+                                          "than the drives): merge (one row per sample, at its re-estimated time, "
+                                          "when a drive clock slower than the logger explains them) or keep.")
+RateOpt = typer.Option(None, "--rate", min=0.0, help="The logger's nominal rate [Hz] of a log without a time "
+                                                      "column: its rows are stamped k / rate.")
 LimitMarginOpt = typer.Option(LIMIT_MARGIN, min=0.0,
                               help="Positions beyond the URDF limits by more than this [rad] are refused (wrong "
                                    "units).")

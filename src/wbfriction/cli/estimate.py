@@ -15,7 +15,7 @@ from wbfriction.exceptions import OptionError
 from wbfriction.friction.options import BaseMotion, EstimateOptions, Method, MomentumOptions, RouteOption
 from wbfriction.inertia.options import InertiaPart
 from wbfriction.logs.formats.catalog import mapped_formats, table_formats
-from wbfriction.logs.options import ReadOptions, TimeBase, TimeUnit
+from wbfriction.logs.options import ReadOptions, RepeatsPolicy, TimeBase, TimeUnit
 from wbfriction.pipeline.paths import check_paths
 from wbfriction.signals.options import AlignmentOption, DiffOption, FilterOptions, Mask, SavgolWeights, Velocity
 
@@ -35,6 +35,8 @@ from wbfriction.cli.common import (
     MjcfOpt,
     MomentumWindowOpt,
     NoiseTargetOpt,
+    RateOpt,
+    RepeatsOpt,
     RobotOpt,
     RouteOpt,
     TimeBaseOpt,
@@ -174,6 +176,7 @@ def estimate(ctx: typer.Context, log: Path = typer.Argument(..., metavar="LOG",
              method: Method = typer.Option(ESTIMATE.method, help="Single-support route: rnea (fast) or kkt "
                                                         "(5.10-5.13)."),
              time_base: TimeBase = TimeBaseOpt, time_unit: Optional[TimeUnit] = TimeUnitOpt,
+             repeats: RepeatsPolicy = RepeatsOpt, rate: Optional[float] = RateOpt,
              velocity: Velocity = typer.Option(ESTIMATE.velocity,
                                                help="Joint velocities: differentiated (by --diff) or "
                                                     "logged (the log's qd.<joint> columns; their lag "
@@ -207,7 +210,8 @@ def estimate(ctx: typer.Context, log: Path = typer.Argument(..., metavar="LOG",
     r = spec.load()
     if not r.floating_base:
         refuse_unread(ctx, f"robot '{r.name}' has a fixed base", CONTACT_OPTIONS, "contact or base")
-    read = ReadOptions(max_gap=max_gap, limit_margin=limit_margin, time_base=time_base, time_unit=time_unit)
+    read = ReadOptions(max_gap=max_gap, limit_margin=limit_margin, time_base=time_base, time_unit=time_unit,
+                       repeats=repeats, rate=rate)
     _run_estimate(r, spec, log, output, opts, bag_map, read, workers, chunk_rows, companion)
 
 

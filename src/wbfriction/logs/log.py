@@ -36,14 +36,14 @@ through, e.g. the friction parameters a simulator injected.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 import pyarrow as pa
 
 from wbfriction.exceptions import ColumnError, InputError
-from wbfriction.logs.angles import check_limits, unwrap_positions
+from wbfriction.logs.angles import check_limits, imu_orientation, unwrap_positions
 from wbfriction.logs.clock import JITTER, Clock, read_clock, split_at_gaps, table_stamps
 from wbfriction.logs.columns import BASE_COLUMNS, BASE_QD_TRUE_COLUMNS, BASE_QDD_TRUE_COLUMNS, IMU_COLUMNS
 from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, sensed_contacts
@@ -51,6 +51,8 @@ from wbfriction.logs.foot_forces import column_names as foot_force_names
 from wbfriction.logs.foot_forces import foot_force_columns, foot_force_table, read_foot_forces
 from wbfriction.logs.options import MAX_GAP, ReadOptions
 from wbfriction.logs.pd import PdSetpoints, read_setpoints, setpoint_columns
+from wbfriction.logs.raw_table import condition_raw_table
+from wbfriction.logs.streams import ANGLE_COLUMNS, QUATERNION_COLUMNS
 from wbfriction.logs.tables import numeric_column, numeric_columns, read_metadata, with_metadata, write_table
 from wbfriction.logs.temperature import screen_temperature
 from wbfriction.logs.torque import (
@@ -105,7 +107,13 @@ class Log:
         unsure: (N,) the rows whose contact flags were inferred without confidence (column ``unsure``, 0/1, written
             by :mod:`wbfriction.pipeline.raw_log`): no route estimates them; None: every row's flags are sure.
         imu: the IMU's readings (N, 6): angular velocity [rad/s] and specific force [m/s^2] in its frame
-            (columns ``imu.gyro_x`` ... ``imu.acc_z``, :mod:`wbfriction.model.imu`), or None.
+            (columns ``imu.gyro_x`` ... ``imu.acc_z``, :mod:`wbfriction.model.imu`), or None; a gyro logged without
+            an accelerometer has NaN specific-force columns.
+        imu_orientation: the IMU frame's orientation in the world (N, 4), unit quaternions x, y, z, w (columns
+            ``imu.qx`` ... ``imu.qw``, or ``imu.roll``, ``imu.pitch``, ``imu.yaw`` in Pinocchio's convention
+            ``R = Rz(yaw) Ry(pitch) Rx(roll)``: :func:`~wbfriction.logs.angles.imu_orientation`), or None.
+        foot_counts: the feet's raw force-sensor counts (N, n_contacts) in :attr:`Robot.contact_frames` order
+            (columns ``foot_count.<frame>``, no unit: an offset and a scale unknown), or None.
         temperature: the torque-controlled joints' temperatures (N, n_tc) [°C] (``temperature.<joint>`` columns),
             NaN for a joint not logged, or None if no such column.
         base_qd_true, base_qdd_true: the base's true twist and its derivative (N, 6) in the base
@@ -140,6 +148,8 @@ class Log:
     temperature: np.ndarray | None = None
     setpoints: PdSetpoints | None = None
     foot_force: np.ndarray | None = None
+    imu_orientation: np.ndarray | None = None
+    foot_counts: np.ndarray | None = None
     unsure: np.ndarray | None = None
 
     def __post_init__(self) -> None:
@@ -172,7 +182,8 @@ class Log:
                    base_qdd_true=cut(self.base_qdd_true), imu=cut(self.imu),
                    temperature=cut(self.temperature),
                    setpoints=None if self.setpoints is None else self.setpoints.rows(start, stop),
-                   foot_force=cut(self.foot_force), unsure=cut(self.unsure))
+                   foot_force=cut(self.foot_force), imu_orientation=cut(self.imu_orientation),
+                   foot_counts=cut(self.foot_counts), unsure=cut(self.unsure))
 
     def __len__(self) -> int:
         return len(self.time)
@@ -190,9 +201,11 @@ class Log:
             cols.update({f"contact.{n}": self.contact[:, i].astype(np.int8)
                          for i, n in enumerate(robot.contact_frames)})
         for names, x in ((BASE_COLUMNS, self.base), (BASE_QD_TRUE_COLUMNS, self.base_qd_true),
-                         (BASE_QDD_TRUE_COLUMNS, self.base_qdd_true), (IMU_COLUMNS, self.imu)):
-            if x is not None:
-                cols.update({c: x[:, i] for i, c in enumerate(names)})
+                         (BASE_QDD_TRUE_COLUMNS, self.base_qdd_true), (IMU_COLUMNS, self.imu),
+                         (QUATERNION_COLUMNS, self.imu_orientation),
+                         ([f"foot_count.{f}" for f in robot.contact_frames], self.foot_counts)):
+            if x is not None:  # an accelerometer not logged is not written
+                cols.update({c: x[:, i] for i, c in enumerate(names) if not np.all(np.isnan(x[:, i]))})
         if self.foot_force is not None:
             cols.update(foot_force_table(robot, self.foot_force))
         if self.wrench is not None:
@@ -256,8 +269,13 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
             jump by more than pi between two samples (a wrapped angle), contact flags other than
             0/1, a partial base pose, or a non-unit quaternion.
     """
-    warnings = check_schema(table.schema, robot, source)
-    time, clock, q = _read_motion(table, robot, source, read, first_row, clock)
+    raw = None
+    if clock is None:  # a whole log (a chunk's table was conditioned with the whole log): as a logger wrote it
+        table, raw = condition_raw_table(table, robot, source, read)
+        read = replace(read, time_unit=None) if raw.restamped else read
+    warnings = check_schema(table.schema, robot, source) + ((f"{source}: {raw.reason}",) if raw and raw.reason else ())
+    time, clock, q = _read_motion(table, robot, source, read, first_row, clock,
+                                   raw is not None and raw.drive_period is not None)
     qd_logged = _read_true_rates(table, "qd", robot, source, first_row)
     setpoints = read_setpoints(table, robot, time, q, qd_logged, source, first_row)
     if setpoints is not None and robot.pd is not None:  # a set-point in degrees drives the joint to its limits
@@ -278,7 +296,12 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
     qdd_true = _read_true_rates(table, "qdd_true", robot, source, first_row)
     base_qd_true = _read_group(table, BASE_QD_TRUE_COLUMNS, source, first_row, "true base twist")
     base_qdd_true = _read_group(table, BASE_QDD_TRUE_COLUMNS, source, first_row, "true base acceleration")
-    imu = _read_group(table, IMU_COLUMNS, source, first_row, "the IMU's reading")
+    imu = _read_imu(table, source, first_row)
+    orientation = imu_orientation(_read_group(table, ANGLE_COLUMNS, source, first_row, "the IMU's roll, pitch, yaw"),
+                                  _read_group(table, QUATERNION_COLUMNS, source, first_row, "the IMU's quaternion"),
+                                  source, first_row)
+    foot_counts = _read_group(table, [f"foot_count.{f}" for f in robot.contact_frames], source, first_row,
+                              "the feet's force counts")
     metadata = read_metadata(table, source)
     if kind.alignment is not None:  # e.g. the PD law's: each sample's torque its period's mean (wbfriction.model.pd)
         metadata = {"torque_alignment": kind.alignment, **metadata}
@@ -286,7 +309,8 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
                qd_true=qd_true, qdd_true=qdd_true, segments=clock.segments, period=period, qd_logged=qd_logged,
                torque_source=kind.name, clock=clock, warnings=warnings, wrench=wrench,
                base_qd_true=base_qd_true, base_qdd_true=base_qdd_true, imu=imu, temperature=temperature,
-               setpoints=setpoints, foot_force=foot_force, unsure=_read_unsure(table, source, first_row))
+               setpoints=setpoints, foot_force=foot_force, imu_orientation=orientation, foot_counts=foot_counts,
+               unsure=_read_unsure(table, source, first_row))
 
 
 def _read_unsure(table: pa.Table, source: str, first_row: int) -> np.ndarray | None:
@@ -306,7 +330,7 @@ def _read_unsure(table: pa.Table, source: str, first_row: int) -> np.ndarray | N
 
 
 NUMERIC_PREFIXES = ("q", "qd", "qd_true", "qdd_true", "tau_f_true", "base", "wrench", "force", "base_qd_true",
-                    "base_qdd_true", "imu", "temperature")
+                    "base_qdd_true", "imu", "temperature", "q_cos", "q_sin", "foot_count")
 """Column prefixes whose values must be numbers, besides those of the torque sources (each source's own:
 :meth:`TorqueKind.named <wbfriction.logs.torque.TorqueKind.named>`)."""
 
@@ -333,14 +357,16 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
             raise ColumnError(source, col, None, f"column '{col}' appears {names.count(col)} times")
         seen.add(col)
     if "time" not in seen:
-        raise ColumnError(source, "time", None, "missing column 'time'")
+        raise ColumnError(source, "time", None, "missing column 'time': a log without stamps is read at its "
+                          "logger's nominal rate: give it with --rate HZ")
     act, tc = set(robot.actuated), set(robot.torque_controlled)
     wrenches = {c.partition(".")[2] for s in robot.ft_sensors for c in s.columns()}
     torque = torque_columns_named(robot)  # every registered source's columns, as it says them
     named: dict[str, set[str] | None] = {
         **torque, "q": act, "tau_f_true": tc, "temperature": tc, "contact": set(robot.contact_frames),
         "qd_true": act, "qdd_true": act, "qd": act, "wrench": wrenches,
-        "imu": {c.partition(".")[2] for c in IMU_COLUMNS}, "force": foot_force_names(robot)}
+        "imu": {c.partition(".")[2] for c in IMU_COLUMNS + ANGLE_COLUMNS + QUATERNION_COLUMNS},
+        "force": foot_force_names(robot), "q_cos": act, "q_sin": act, "foot_count": set(robot.contact_frames)}
     for col in names:
         prefix, _, item = col.partition(".")
         known = named.get(prefix)
@@ -352,7 +378,8 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
     contact = [f"contact.{f}" for f in robot.contact_frames] if robot.floating_base else []
     if contact and not any(c in seen for c in contact) and forces_give_contacts(robot, seen):
         contact = []  # flags from the measured forces (wbfriction.logs.contacts)
-    for col in [f"q.{n}" for n in robot.actuated] + contact:
+    paired = [f"q.{n}" for n in robot.actuated if f"q_cos.{n}" in seen and f"q_sin.{n}" in seen]  # a raw log's
+    for col in [f"q.{n}" for n in robot.actuated if f"q.{n}" not in paired] + contact:
         if col not in seen:
             raise ColumnError(source, col, None, f"missing column '{col}'")
     check_torque_columns(robot, seen, source)  # every joint's torque from a registered source
@@ -394,7 +421,7 @@ SINGLE_PRECISION_SCALE: dict[str, tuple[float, str]] = {
     "time": (1000.0, "s"), "q": (2.0, "rad"), "qd": (2.0, "rad/s"), "qd_true": (2.0, "rad/s"),
     "qdd_true": (20.0, "rad/s²"), "tau": (100.0, "N·m"), "tau_f_true": (10.0, "N·m"), "current": (10.0, "A"),
     "temperature": (50.0, "°C"), "wrench": (500.0, "N or N·m"), "contact": (1.0, ""), "base": (1.0, "m or rad"),
-    "imu": (10.0, "m/s² or rad/s")}
+    "imu": (10.0, "m/s² or rad/s"), "q_cos": (1.0, ""), "q_sin": (1.0, ""), "foot_count": (100.0, "")}
 """A typical value and the unit of each kind of column: what the float32 warning says its rounding is at."""
 
 
@@ -404,10 +431,12 @@ def _stack(table: pa.Table, columns: list[str], source: str, first_row: int) -> 
 
 
 def _read_motion(table: pa.Table, robot: Robot, source: str, read: ReadOptions, first_row: int,
-                 clock: Clock | None = None) -> tuple[np.ndarray, Clock, np.ndarray]:
+                 clock: Clock | None = None, drive: bool = False) -> tuple[np.ndarray, Clock, np.ndarray]:
     """Time [s] (checked, its unit too: :func:`~wbfriction.logs.clock.table_stamps`), its clock
     (``clock``, the whole log's cut to these rows, else read from the stamps and positions) and
-    q [rad] (checked against the limits; continuous joints unwrapped, :func:`unwrap_positions`)."""
+    q [rad] (checked against the limits; continuous joints unwrapped, :func:`unwrap_positions`).
+    ``drive``: the stamps are a drive clock's ticks re-estimated from repeated rows
+    (:mod:`wbfriction.logs.repeats`): exact by construction, never read as receive-time jitter."""
     stamps = table_stamps(table, source, first_row, read.time_unit)
     segments = check_time(stamps, source, read.max_gap, first_row=first_row)
     raw = _stack(table, [f"q.{n}" for n in robot.actuated], source, first_row)
@@ -415,6 +444,10 @@ def _read_motion(table: pa.Table, robot: Robot, source: str, read: ReadOptions, 
     q = unwrap_positions(raw, robot, source, segments, first_row)
     if clock is None:
         clock = read_clock(stamps, source, max_gap=read.max_gap, first_row=first_row, q=q, time_base=read.time_base)
+        if drive and clock.kind == "jittered" and read.time_base == "auto":
+            clock = read_clock(stamps, source, max_gap=read.max_gap, first_row=first_row, q=q, time_base="recorded")
+            clock = replace(clock, reason=clock.reason.replace(", as asked", ": the drives' clock re-estimated "
+                                                               "from the repeated rows, exact by construction"))
     elif len(clock) != len(stamps):
         raise InputError(f"{source}: a clock of {len(clock)} rows for a table of {len(stamps)} rows")
     if clock.segments != segments:  # samples the clock skipped are not gaps: unwrapped across them too
@@ -470,6 +503,19 @@ def _read_group(table: pa.Table, columns: tuple[str, ...] | list[str], source: s
     if missing:
         raise ColumnError(source, missing[0], None, f"{what} is partial: missing column '{missing[0]}'")
     return _stack(table, list(columns), source, first_row)
+
+
+def _read_imu(table: pa.Table, source: str, first_row: int) -> np.ndarray | None:
+    """The IMU's readings (N, 6) (:data:`IMU_COLUMNS`), or None if none is logged: the gyro's three columns needed,
+    the accelerometer's optional (NaN when not logged; refused if partial)."""
+    gyro = _read_group(table, IMU_COLUMNS[:3], source, first_row, "the IMU's gyro")
+    acc = _read_group(table, IMU_COLUMNS[3:], source, first_row, "the IMU's accelerometer")
+    if gyro is None and acc is not None:
+        raise ColumnError(source, IMU_COLUMNS[0], None, f"the IMU's reading is partial: missing column "
+                          f"'{IMU_COLUMNS[0]}'")
+    if gyro is None:
+        return None
+    return np.column_stack([gyro, acc if acc is not None else np.full_like(gyro, np.nan)])
 
 
 def _read_wrench(table: pa.Table, robot: Robot, source: str, first_row: int) -> np.ndarray | None:

@@ -25,13 +25,19 @@ TIME_BASES: tuple[TimeBase, ...] = get_args(TimeBase)
 TimeUnit = Literal["s", "ms", "us", "ns"]
 """The unit of a numeric ``time`` column (``--time-unit``)."""
 TIME_UNITS: tuple[TimeUnit, ...] = get_args(TimeUnit)
-
+RepeatsPolicy = Literal["merge", "keep"]
+"""What is made of rows that repeat the previous sample in every joint column (``--repeats``): merged into one
+sample at its re-estimated time when a drive clock slower than the logger explains them
+(:mod:`wbfriction.logs.repeats`), or kept as rows."""
+REPEATS_POLICIES: tuple[RepeatsPolicy, ...] = get_args(RepeatsPolicy)
+RATE_RANGE = (0.0, 1e5)
+"""A logger's nominal rate [Hz] (``--rate``): above 0, at most 100 kHz (a robot's fastest bus is tens of kHz)."""
 
 
 @dataclass(frozen=True)
 class ReadOptions:
     """How a log is read, one value passed whole wherever a log is read (the command line's ``--max-gap``,
-    ``--limit-margin``, ``--time-base`` and ``--time-unit``). Checked where made.
+    ``--limit-margin``, ``--time-base``, ``--time-unit``, ``--repeats`` and ``--rate``). Checked where made.
 
     Attributes:
         max_gap: a time step of at least this many local median steps splits the log into segments, estimated
@@ -42,6 +48,12 @@ class ReadOptions:
             stamps as recorded, or a regularised clock; :func:`~wbfriction.logs.clock.read_clock`).
         time_unit: the unit of a numeric ``time`` column (:data:`TimeUnit`; None: seconds for floats, needed for
             integers; :func:`~wbfriction.logs.clock.table_stamps`).
+        repeats: rows repeating the previous sample in every joint column merged (``merge``, when a drive clock
+            slower than the logger explains them) or kept as rows (``keep``) (:data:`RepeatsPolicy`,
+            :func:`~wbfriction.logs.raw_table.condition_raw_table`).
+        rate: the logger's nominal rate [Hz] of a log without a ``time`` column (its rows are stamped
+            ``k / rate``: exact ticks of the logger); None: a log must have a ``time`` column. Not used on a log
+            that has one.
 
     Raises:
         OptionError: a value out of its range or not one of its choices, naming the option as the command line
@@ -52,6 +64,8 @@ class ReadOptions:
     limit_margin: float = LIMIT_MARGIN
     time_base: TimeBase = "auto"
     time_unit: TimeUnit | None = None
+    repeats: RepeatsPolicy = "merge"
+    rate: float | None = None
 
     def __post_init__(self) -> None:
         if not (isinstance(self.max_gap, numbers.Real) and self.max_gap >= MAX_GAP_LEAST):
@@ -62,6 +76,11 @@ class ReadOptions:
             raise OptionError("--time-base", self.time_base, f"one of {', '.join(TIME_BASES)}")
         if self.time_unit is not None and self.time_unit not in TIME_UNITS:
             raise OptionError("--time-unit", self.time_unit, f"one of {', '.join(TIME_UNITS)}")
+        if self.repeats not in REPEATS_POLICIES:
+            raise OptionError("--repeats", self.repeats, f"one of {', '.join(REPEATS_POLICIES)}")
+        low, high = RATE_RANGE
+        if self.rate is not None and not (isinstance(self.rate, numbers.Real) and low < self.rate <= high):
+            raise OptionError("--rate", self.rate, f"a logger's rate in Hz, above {low:g} and at most {high:g}")
 
 
 PLAUSIBLE = (-60.0, 200.0)

@@ -370,8 +370,9 @@ def _check_inputs(log: Log, velocity: Velocity, base_motion: bool, imu: bool) ->
         raise InputError(f"{log.source}: --velocity logged needs the columns qd.<joint> of every actuated joint")
     if base_motion and log.base is None:
         raise InputError(f"{log.source}: a measured base motion needs the base pose columns base.x ... base.qw")
-    if imu and log.imu is None:
-        raise InputError(f"{log.source}: --base-motion imu needs the columns imu.gyro_x ... imu.acc_z")
+    if imu and (log.imu is None or np.isnan(log.imu[:, 3:]).all()):
+        what = "" if log.imu is None else " (the log has a gyro without an accelerometer)"
+        raise InputError(f"{log.source}: --base-motion imu needs the columns imu.gyro_x ... imu.acc_z{what}")
 
 
 def true_kinematics(log: Log, base_motion: bool = False, imu: bool = False) -> MeasuredKinematics:
