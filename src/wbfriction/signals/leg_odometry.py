@@ -36,17 +36,20 @@ sample by sample, in Pinocchio's free-flyer convention (:mod:`wbfriction.signals
 
 **Noise levels, from the data** (each may be given instead, :class:`OdometryOptions`):
 
-* ``sigma_leg`` per axis: the pooled spread of the stance feet's velocities about their mean, over the samples
-  with two or more confident stance feet (``sum |v_c - mean|^2 / sum (n - 1)``);
+* ``sigma_leg`` per axis: the robust spread of the stance feet's velocities about their mean, over the samples
+  with two or more confident stance feet (:func:`pooled_spread`); a foot the smoothed state rejects (a chi-square
+  test, :data:`GATE`: slipping, landing or lifting off while its flag says stance) is left out and the whole done
+  again (:func:`fused_velocity`);
 * the accelerometer's and the gyro's white noise: :func:`~wbfriction.signals.content.white_position_noise` of their
   second differences (robust to the impacts);
 * ``s`` per axis: the maximum of the measurements' likelihood (the innovations'), on a grid of decades of the
   dimensionless ``s T^3 / sigma_leg^2`` from 1e-14 to 1e4 (filters of bandwidth from minutes to the Nyquist
-  frequency), then half decades about the best.
+  frequency) two by two, then half decades about the best.
 
 The twist's and acceleration's linear standard deviations are the smoothed covariance's, turned into the base
 frame; the angular velocity's is the gyro's noise, its derivative's that noise through the fit's kernel (the fit's
-bias not counted). The position is the smoothed world velocity integrated (trapezoids) from 0: the base's pose in a
+bias not counted). They count the noise the data show, not a bias common to every foot (feet creeping together on a
+soft ground). The position is the smoothed world velocity integrated (trapezoids) from 0: the base's pose in a
 world whose origin is where the log starts, the orientation the IMU's (its yaw drifts as the IMU's does).
 """
 
@@ -326,7 +329,8 @@ def kalman_pass(dt: float, z_v: np.ndarray, r_v: np.ndarray, z_a: np.ndarray, r_
 def likeliest_jerk(dt: float, z_v: np.ndarray, r_v: np.ndarray, z_a: np.ndarray, r_a: np.ndarray,
                    leg_sd: np.ndarray, prior_sd: float) -> np.ndarray:
     """The jerk density per axis (3,) [m^2/s^5] of the measurements' greatest likelihood (module docstring): decades
-    of :data:`JERK_GRID` two by two, then half decades about the best (the axes searched together: they are independent)."""
+    of :data:`JERK_GRID` two by two, then half decades about the best (the axes searched together: they are
+    independent)."""
     scale = leg_sd**2 / dt**3
 
     def loglik(decades: np.ndarray) -> np.ndarray:
@@ -513,5 +517,5 @@ def base_from_legs(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
     return BaseEstimate(
         pose=pose, twist=np.hstack([v_lin, ang.omega]), acceleration=np.hstack([a_lin, ang.omega_d]),
         twist_sd=np.hstack([turned_sd(P[:, :3, :3]), np.full((n, 3), ang.gyro_sd)]),
-        acceleration_sd=np.hstack([turned_sd(P[:, 3:, 3:]), omega_d_sd]), stance=kept.sum(axis=1), leg_sd=leg_sd, jerk=jerk,
-        gyro_sd=ang.gyro_sd, acc_sd=float(acc_sd), gyro_window=ang.window)
+        acceleration_sd=np.hstack([turned_sd(P[:, 3:, 3:]), omega_d_sd]), stance=kept.sum(axis=1), leg_sd=leg_sd,
+        jerk=jerk, gyro_sd=ang.gyro_sd, acc_sd=float(acc_sd), gyro_window=ang.window)
