@@ -414,7 +414,8 @@ def _acceleration_measurements(robot: Robot, full_q: np.ndarray, rest: np.ndarra
         z_a = np.einsum("nij,nj->ni", base_rot, ang.acc_base)
         r_a[:] = acc_sd**2
         return z_a, r_a, acc_sd
-    flight = np.flatnonzero(~contact.any(axis=1) & confident.all(axis=1) & np.all(np.isfinite(ang.omega_d), axis=1))
+    known = np.all(np.isfinite(ang.omega_d), axis=1) & np.all(np.isfinite(qdd), axis=1)
+    flight = np.flatnonzero(~contact.any(axis=1) & confident.all(axis=1) & known)
     if flight.size:
         a = np.zeros_like(rest)
         a[:, 3:6] = ang.omega_d
