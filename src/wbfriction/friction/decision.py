@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from wbfriction.exceptions import InputError, OptionError
+from wbfriction.fit.status import UNMEASURED
 from wbfriction.friction.noise import noise_record
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.route import RouteDecision, resolve_route
@@ -144,8 +145,7 @@ def unmeasured_noise(record: dict | None, longest: int, options: EstimateOptions
     or for the simulators' true derivatives (no noise)."""
     if record is not None or options.diff == "true":
         return ""
-    return (f"the positions' noise could not be measured: the longest stretch without a time gap has {longest} "
-            "samples (no Cramér-Rao bound)")
+    return (f"{UNMEASURED}: the longest stretch without a time gap has {longest} samples (no Cramér-Rao bound)")
 
 
 FILTER_SPAN = 5_000_000
