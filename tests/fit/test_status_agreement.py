@@ -15,7 +15,8 @@ from hypothesis import strategies as st
 from wbfriction.fit.holdout import PredictionCheck
 from wbfriction.fit.params_file import fit_from_dict, fit_to_dict, written_unmeasured
 from wbfriction.fit.result import FitResult, RouteCheck
-from wbfriction.fit.status import FIT_STATUSES, MIN_SPEED, UNMEASURED
+from wbfriction.fit.status import FIT_STATUSES, MIN_SPEED
+from wbfriction.friction.decision import UNMEASURED
 from wbfriction.friction.models import CoulombViscousParams
 
 NOT_MEASURED = f"{UNMEASURED}: the longest stretch without a time gap has 50 samples (no Cramér-Rao bound)"

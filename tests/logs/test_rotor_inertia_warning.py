@@ -16,7 +16,6 @@ from wbfriction.logs.tables import write_table
 from wbfriction.model.loading import load_robot
 
 
-
 def panda_without_armature(tmp_path: Path) -> Path:
     """The built-in Panda's TOML with its ``[armature]`` table removed."""
     from importlib import resources

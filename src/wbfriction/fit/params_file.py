@@ -41,8 +41,8 @@ from wbfriction.fit.energy import JointEnergy
 from wbfriction.fit.holdout import PredictionCheck
 from wbfriction.fit.params_check import check_model_params, check_terms
 from wbfriction.fit.result import FitResult, HeldOutScore, ModelSelection, RouteCheck
-from wbfriction.fit.status import UNMEASURED
 from wbfriction.fit.terms import TermFit
+from wbfriction.friction.decision import UNMEASURED
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.models import check_model, params_from_dict, target_from_dict
 from wbfriction.logs.tables import file_sha256, write_json
@@ -155,10 +155,9 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
     """Inverse of :func:`fit_to_dict` (a ``null`` standard error reads back as ``inf``: not
     identifiable). Without ``model`` (files of earlier versions) the parameters are those of (3.5);
     without ``at_bound``, no parameter is known to be at a bound (an empty table); without ``speed``, how much
-    the joint moved is not known. ``status`` is not read: it follows from the rest
-    (:meth:`~wbfriction.fit.result.FitResult.verdict`), every input of which is written, ``unmeasured`` too (a file
-    of an earlier version without it: read from a ``weak`` status's reason, :func:`written_unmeasured`), so that what
-    reads the file (``predict``, ``export``, ``report``) gives the fit the status ``fit`` wrote. The values are held to what ``fit`` writes
+    the joint moved is not known. ``status`` is not read: it follows from the rest (:meth:`FitResult.verdict
+    <wbfriction.fit.result.FitResult.verdict>`), all written, ``unmeasured`` too (:func:`written_unmeasured`): every
+    reader gives the fit the status ``fit`` wrote. The values are held to what ``fit`` writes
     (:mod:`~wbfriction.fit.params_check`: dissipative parameters, terms whole and consistent with the model).
 
     Raises:

@@ -134,10 +134,6 @@ truth were 10.7 % of them at 0.25 and are 6.5 % at 0.10, fewer in every class.""
 TERM_WEAK = 0.5
 """The same for a term beyond velocity's coefficients (:mod:`~wbfriction.fit.terms`): a term is kept by the
 held-out samples it predicts, and its coefficient's standard error above half its value makes it weak."""
-UNMEASURED = "the positions' noise could not be measured"
-"""How the reason of a fit on an estimate without a measured noise starts
-(:func:`~wbfriction.friction.decision.unmeasured_noise`): a parameters file of an earlier version wrote it only there
-(:func:`~wbfriction.fit.params_file.written_unmeasured`)."""
 READ = ("F_c", "F_v")
 """The magnitudes a user reads off a fit (tau_os is judged against F_c: it may be zero)."""
 ZERO_FLOOR = ("F_v", "F_c", "S", "F_s")
