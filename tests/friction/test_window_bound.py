@@ -120,3 +120,15 @@ def test_the_command_line_says_it_in_one_line(trot, tmp_path, capsys):
     assert code == 0
     lines = [ln for ln in err.splitlines() if "window chosen from the noise" in ln]
     assert len(lines) == 1 and "-> 61 (0.122 s)" in lines[0] and "(FL_foot, 124 samples, 0.248 s" in lines[0]
+
+
+def test_a_swing_the_margins_leave_nothing_of_does_not_bound_the_window():
+    """A foot's bounce of 22 samples (0.044 s, a noisy MuJoCo walk's) beside swings of 119: with the default margins
+    (0.10 + 0.05 s) nothing of the bounce is estimated, and the shortest swing that bounds the window is a real one."""
+    flags = np.ones((600, 1), dtype=bool)
+    flags[100:122] = False
+    flags[300:419] = False
+    swings = log_swings(flags, ("foot",), 0.002)
+    assert [s.samples for s in swings.swings] == [22, 119]
+    assert swings.shortest().samples == 22
+    assert swings.shortest(margins=0.15).samples == 119

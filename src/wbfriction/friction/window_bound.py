@@ -7,7 +7,8 @@ where its whole window lies inside one phase, and a window longer than a swing l
 (:mod:`wbfriction.signals.phase_window`). So, once per log, before any work:
 
 * a window chosen from the noise longer than :func:`~wbfriction.signals.phase_window.window_bound` of the shortest
-  swing is bounded to it (the momentum route's momentum window first, then its velocity window; each at least its
+  swing (of those longer than the lift-off and touch-down margins: nothing of a shorter one is estimated) is bounded
+  to it (the momentum route's momentum window first, then its velocity window; each at least its
   scheme's least), the noise it then leaves recomputed, and the log's warnings say so in one line
   (:meth:`WindowBound.warning`); the estimate's metadata records it (``window_bound``);
 * a window given (``--window``, ``--momentum-window``, ``--velocity-window``) is kept, but one that leaves no sample
@@ -93,7 +94,7 @@ def refuse_given(given: EstimateOptions, options: EstimateOptions, swings: Swing
         OptionError: naming the option, its value, the swings and the longest window that keeps half the shortest
             swing.
     """
-    longest, shortest = swings.longest(), swings.shortest()
+    longest, shortest = swings.longest(), swings.shortest(1, options.lift_off_skip + options.touch_down_skip)
     if longest is None:
         return
     keep = window_bound((shortest or longest).samples)
@@ -129,9 +130,10 @@ def bound_windows(given: EstimateOptions, options: EstimateOptions, choice: Diff
         arguments then come back as they are).
     """
     bounds: list[WindowBound] = []
+    margins = options.lift_off_skip + options.touch_down_skip  # a swing no longer than them is lost anyway
     if choice is not None and options.diff == "savgol" and given.diff == "auto":
         order, weights = options.filtering.poly_order, options.filtering.weights
-        swing = swings.shortest(least_savgol(order))
+        swing = swings.shortest(least_savgol(order), margins)
         if swing is not None and options.filtering.window > window_bound(swing.samples):
             window = max(least_savgol(order), window_bound(swing.samples))
             bounds.append(WindowBound("the differentiation's savgol window", options.filtering.window, window, swing,
@@ -141,7 +143,7 @@ def bound_windows(given: EstimateOptions, options: EstimateOptions, choice: Diff
     m = options.momentum
     if m.window is not None and m.velocity_window is not None and (given.momentum.window is None
                                                                     or given.momentum.velocity_window is None):
-        swing = swings.shortest(sum(LEAST_MOMENTUM) - 1)
+        swing = swings.shortest(sum(LEAST_MOMENTUM) - 1, margins)
         span = m.velocity_window + m.window - 1
         if swing is not None and span > window_bound(swing.samples):
             vw, w = _momentum_windows(m.velocity_window, m.window, window_bound(swing.samples), given)

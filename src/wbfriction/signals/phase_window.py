@@ -16,9 +16,11 @@ swing was lost.
 
 The bound: a window may cost a swing at most as many samples as it leaves it, ``L + 1 <= P - 1 - L``, that is
 ``L <= (P - 2) / 2`` (:func:`window_bound`): the shortest swing keeps at least half its samples, every longer one more.
-It follows from how the window's support meets the phase, not from any log. Swings too short for the least window
-of a scheme to keep half of them (a flag's glitch, a foot's graze) are lost whatever the window; they do not bound it
-(:meth:`Swings.shortest`).
+It follows from how the window's support meets the phase, not from any log. Swings that are lost whatever the window
+do not bound it (:meth:`Swings.shortest`): those no longer than the thesis's margins after a lift-off and before a
+touch-down together (6.2.1: nothing of them is estimated; a flag's glitch, a foot's bounce on a soft contact: 22
+samples of a noisy MuJoCo walk against swings of 119), and those too short for the least window of a scheme to keep
+half of them.
 """
 
 from __future__ import annotations
@@ -63,10 +65,11 @@ class Swings:
 
     swings: tuple[Swing, ...]
 
-    def shortest(self, least_window: int = 1) -> Swing | None:
-        """The shortest swing whose bound (:func:`window_bound`) is at least ``least_window`` (the least window of the
-        scheme: a shorter swing is lost whatever the window), or None."""
-        kept = [s for s in self.swings if window_bound(s.samples) >= least_window]
+    def shortest(self, least_window: int = 1, margins: float = 0.0) -> Swing | None:
+        """The shortest swing longer than ``margins`` [s] (the lift-off and touch-down margins together) whose bound
+        (:func:`window_bound`) is at least ``least_window`` (the least window of the scheme), or None: a shorter one
+        is lost whatever the window (module docstring)."""
+        kept = [s for s in self.swings if window_bound(s.samples) >= least_window and s.seconds > margins + 1e-9]
         return min(kept, key=lambda s: (s.samples, s.start)) if kept else None
 
     def longest(self) -> Swing | None:
