@@ -44,6 +44,7 @@ from wbfriction.cli.common import (
     refuse_options,
     robot_of,
     stages,
+    warn,
     warn_energy,
 )
 from wbfriction.cli.helpformat import ROBOT
@@ -147,12 +148,13 @@ def identify(ctx: typer.Context, log: Path = LogArg, output: Optional[Path] = Ou
     stribeck = stribeck_option(stribeck_velocity)
     if not 0.0 < holdout < 1.0:
         raise InputError(f"--holdout must be between 0 and 1, got {holdout}")
-    from wbfriction.pipeline.identify_step import identify_file
+    from wbfriction.pipeline.identify_step import identify_file, rotor_inertia_notes
 
     r = robot_of(robot, urdf, config, mjcf)
     r.require_urdf("identify (it writes the corrected URDF)")
     opts = InertialOptions(tanh_slope=tanh_slope, stride=stride, holdout=holdout, prior=prior,
                            armature=armature, link_margin=link_margin, prior_tolerance=prior_tolerance)
+    warn(rotor_inertia_notes(r, log, opts))  # torques from currents, no rotor inertia: said before the work
     with stages() as status:
         estimate_options = EstimateOptions(diff=diff, mask=mask, route=route, noise_target=noise_target,
                                            base_motion=base_motion)

@@ -42,6 +42,7 @@ from wbfriction.fit.holdout import PredictionCheck
 from wbfriction.fit.params_check import check_model_params, check_terms
 from wbfriction.fit.result import FitResult, HeldOutScore, ModelSelection, RouteCheck
 from wbfriction.fit.terms import TermFit
+from wbfriction.friction.decision import UNMEASURED
 from wbfriction.friction.estimate import FrictionEstimate
 from wbfriction.friction.models import check_model, params_from_dict, target_from_dict
 from wbfriction.logs.tables import file_sha256, write_json
@@ -131,6 +132,8 @@ def fit_to_dict(fit: FitResult) -> dict[str, Any]:
     d["pass_rows"] = clean(fit.pass_rows)  # null: every reversal that changes sign passes
     if fit.later is not None:
         d["later_stretch"] = fit.later.to_dict()
+    if fit.unmeasured:  # never ok then: a reader's verdict must be the one written (issue 82)
+        d["unmeasured"] = fit.unmeasured
     verdict = fit.verdict()
     d["status"], d["status_reason"] = verdict.status, verdict.reason
     if fit.selection is not None:
@@ -152,8 +155,9 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
     """Inverse of :func:`fit_to_dict` (a ``null`` standard error reads back as ``inf``: not
     identifiable). Without ``model`` (files of earlier versions) the parameters are those of (3.5);
     without ``at_bound``, no parameter is known to be at a bound (an empty table); without ``speed``, how much
-    the joint moved is not known. ``status`` is not read: it follows from the rest
-    (:meth:`~wbfriction.fit.result.FitResult.verdict`). The values are held to what ``fit`` writes
+    the joint moved is not known. ``status`` is not read: it follows from the rest (:meth:`FitResult.verdict
+    <wbfriction.fit.result.FitResult.verdict>`), all written, ``unmeasured`` too (:func:`written_unmeasured`): every
+    reader gives the fit the status ``fit`` wrote. The values are held to what ``fit`` writes
     (:mod:`~wbfriction.fit.params_check`: dissipative parameters, terms whole and consistent with the model).
 
     Raises:
@@ -198,6 +202,7 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
                                          {str(k): _number(v) for k, v in (rc.get("stderr") or {}).items()},
                                          tuple(map(str, rc.get("disagree", ()))),
                                          {str(k): _number(v) for k, v in (rc.get("block_spread") or {}).items()})
+        res.unmeasured = written_unmeasured(d)
         res.velocity_noise = float(d.get("velocity_noise") or 0.0)  # null (not measured): none taken
         res.stick_speed = float(d.get("stick_speed") or 0.0)
         res.n_stuck = int(d.get("n_stuck", 0))
@@ -226,6 +231,18 @@ def fit_from_dict(joint: str, d: Mapping[str, Any]) -> FitResult:
     except (TypeError, ValueError, AttributeError) as exc:
         raise InputError(str(exc)) from None
     return res
+
+
+def written_unmeasured(d: Mapping[str, Any]) -> str:
+    """Why a joint's estimate had no measured noise (:attr:`~wbfriction.fit.result.FitResult.unmeasured`), as its
+    entry ``d`` says it: its ``unmeasured``; in a file of an earlier version, which wrote only the status, the part of
+    a ``weak`` status's reason that says so (:data:`~wbfriction.fit.status.UNMEASURED`); "" for none."""
+    if d.get("unmeasured") is not None:
+        return str(d["unmeasured"])
+    if d.get("status") != "weak":
+        return ""
+    first = str(d.get("status_reason") or "").split("; ")[0]
+    return first if first.startswith(UNMEASURED) else ""
 
 
 def energy_to_dict(energy: JointEnergy) -> dict[str, Any]:

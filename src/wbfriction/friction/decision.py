@@ -8,7 +8,9 @@ chunk from its file (:func:`~wbfriction.pipeline.estimate_step.estimate_file`), 
    from the positions' noise);
 2. the route ``route="auto"`` stands for and the momentum route's windows
    (:func:`~wbfriction.friction.route.resolve_route`, reusing the noise the first step measured);
-3. the windows checked against the log's longest stretch between time gaps (:func:`check_windows`);
+3. on a robot whose feet leave the ground, the windows chosen bounded by half the shortest swing, a window given that
+   no swing can hold refused (:mod:`~wbfriction.friction.window_bound`); then the windows checked against the log's
+   longest stretch between time gaps (:func:`check_windows`);
 4. the noise record the fit reads (:func:`~wbfriction.friction.noise.noise_record`), or why there is none
    (:func:`unmeasured_noise`).
 
@@ -29,11 +31,14 @@ from wbfriction.exceptions import InputError, OptionError
 from wbfriction.friction.noise import noise_record
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.route import RouteDecision, resolve_route
+from wbfriction.friction.window_bound import WindowBound, bound_windows, refuse_given
+from wbfriction.friction.window_bound import warning as window_warning
 from wbfriction.logs.clock import longest_segment
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
 from wbfriction.signals.choice import DiffChoice, choose_differentiation
 from wbfriction.signals.content import contact_changes
+from wbfriction.signals.phase_window import Swings
 
 
 @dataclass(frozen=True)
@@ -48,6 +53,9 @@ class LogDecision:
             all given).
         noise: the noise record the fit reads (:func:`~wbfriction.friction.noise.noise_record`), or None.
         noise_unmeasured: why a fit of the estimate cannot be called ``ok`` (:func:`unmeasured_noise`), or "".
+        bounds: the windows chosen from the noise that the shortest swing bounded
+            (:func:`~wbfriction.friction.window_bound.bound_windows`; empty: none).
+        source: the log's name, for :attr:`warnings`.
     """
 
     options: EstimateOptions
@@ -55,6 +63,13 @@ class LogDecision:
     route: RouteDecision | None
     noise: dict[str, Any] | None
     noise_unmeasured: str = ""
+    bounds: tuple[WindowBound, ...] = ()
+    source: str = "the log"
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """What the decision says before the work, one line each: the windows the shortest swing bounded."""
+        return (window_warning(self.bounds, self.source),) if self.bounds else ()
 
     def metadata(self) -> dict[str, Any]:
         """The estimate's metadata entries (fresh dictionaries, the noise record shared): ``noise_unmeasured``,
@@ -68,12 +83,15 @@ class LogDecision:
             out["route"] = self.route.to_dict()
         if self.noise is not None:
             out["noise"] = self.noise
+        if self.bounds:
+            out["window_bound"] = {"warning": self.warnings[0], "bounds": [b.to_dict() for b in self.bounds]}
         return out
 
 
 def decide_log(robot: Robot, options: EstimateOptions, positions: np.ndarray | None, dt: float, *,
                segments: list[tuple[int, int]] | None, rows: int, source: str,
-               route_rows: int | None = None, changes: np.ndarray | None = None) -> LogDecision:
+               route_rows: int | None = None, changes: np.ndarray | None = None, swings: Swings | None = None,
+               swings_only: bool = False) -> LogDecision:
     """Decide once for a log what ``options`` leave to the data, and measure its noise (module docstring).
 
     Args:
@@ -90,19 +108,29 @@ def decide_log(robot: Robot, options: EstimateOptions, positions: np.ndarray | N
             (:func:`~wbfriction.friction.route.choose_route`); default the rows of ``positions``.
         changes: the rows of ``positions`` where a contact flag changes
             (:func:`~wbfriction.signals.content.contact_changes`): their impacts are not counted as noise.
+        swings: the whole log's swings (:func:`~wbfriction.signals.phase_window.log_swings`), which bound the windows
+            chosen (:func:`~wbfriction.friction.window_bound.bound_windows`); None: none (a fixed base).
+        swings_only: the swings are the only phases estimated (no force sensed at the feet): a window given that none
+            of them holds is refused (:func:`~wbfriction.friction.window_bound.refuse_given`).
 
     Raises:
-        OptionError: a window given longer than the log's longest stretch; InputError: one the data chose, or
-            stretches too short for any scheme (:func:`check_windows`).
+        OptionError: a window given longer than the log's longest stretch, or than every swing (``swings_only``);
+            InputError: one the data chose, or stretches too short for any scheme (:func:`check_windows`).
     """
     given = options
     options, choice = resolve_differentiation(options, positions, dt, changes)
     options, route = resolve_route(options, positions, dt, choice, rows=route_rows, asked=given.filtering)
+    bounds: tuple[WindowBound, ...] = ()
+    if swings is not None and swings.swings:
+        if swings_only:
+            refuse_given(given, options, swings)
+        options, choice, route, bounds = bound_windows(given, options, choice, route, swings, dt)
     check_windows(given, options, segments, rows, dt, source)
     if positions is None:
-        return LogDecision(options, choice, route, None)
+        return LogDecision(options, choice, route, None, bounds=bounds, source=source)
     record = noise_record(robot, positions, dt, options, changes)
-    return LogDecision(options, choice, route, record, unmeasured_noise(record, len(positions), options))
+    return LogDecision(options, choice, route, record, unmeasured_noise(record, len(positions), options), bounds,
+                       source)
 
 
 def longest_stretch(log: Log) -> tuple[np.ndarray, np.ndarray | None]:
@@ -137,6 +165,11 @@ def resolve_differentiation(options: EstimateOptions, source: Log | np.ndarray |
     return replace(options, diff=choice.scheme, filtering=choice.filtering), choice
 
 
+UNMEASURED = "the positions' noise could not be measured"
+"""How :func:`unmeasured_noise` starts, and so the reason of a fit on such an estimate: a parameters file of an earlier
+version wrote it only there (:func:`~wbfriction.fit.params_file.written_unmeasured`)."""
+
+
 def unmeasured_noise(record: dict | None, longest: int, options: EstimateOptions) -> str:
     """Why a fit of this estimate cannot be called ``ok`` (the metadata's ``noise_unmeasured``,
     :attr:`~wbfriction.fit.result.FitResult.unmeasured`): the positions' noise not measured (``record`` None) on
@@ -144,8 +177,7 @@ def unmeasured_noise(record: dict | None, longest: int, options: EstimateOptions
     or for the simulators' true derivatives (no noise)."""
     if record is not None or options.diff == "true":
         return ""
-    return (f"the positions' noise could not be measured: the longest stretch without a time gap has {longest} "
-            "samples (no Cramér-Rao bound)")
+    return (f"{UNMEASURED}: the longest stretch without a time gap has {longest} samples (no Cramér-Rao bound)")
 
 
 FILTER_SPAN = 5_000_000

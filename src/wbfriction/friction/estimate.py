@@ -47,6 +47,7 @@ from wbfriction.model.robot import Robot
 from wbfriction.progress import Progress
 from wbfriction.signals.kinematics import MeasuredKinematics, joined_smoother, measure, straddling
 from wbfriction.signals.options import FILTERING_SCHEMES, Diff, Scheme
+from wbfriction.signals.phase_window import log_swings
 from wbfriction.signals.phases import Phases, joint_mask, segment
 
 CHUNK = 4096
@@ -300,9 +301,11 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
     """
     check_contact_patterns(robot, log.contact, log.source)  # before any work: the KKT route's matrix singular
     positions, changes = longest_stretch(log)
+    swings = log_swings(log.contact, robot.contact_frames, log.dt, log.segments) if robot.floating_base else None
     decision = decide_log(robot, options, positions, log.dt, segments=log.segments, rows=len(log.time),
                           source=log.source, route_rows=len(log.time),  # the whole log's rows: module docstring
-                          changes=changes)
+                          changes=changes, swings=swings,
+                          swings_only=not robot.ft_sensors and log.foot_force is None)
     est = estimate_resolved(robot, log, decision.options, progress, companion, require_single_support)
     for e in (est, est.route_check):
         if e is not None:

@@ -59,6 +59,7 @@ from wbfriction.logs.torque import (
     TorqueColumns,
     TorqueSource,
     check_torque_columns,
+    rotor_inertia_warnings,
     torque_columns_named,
     torque_kind,
     torque_source_of,
@@ -344,7 +345,8 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
 
     Returns:
         Warnings, one line each: float32 columns (7 significant digits: the accelerations
-        differentiated from such positions are noisier; nothing is refused).
+        differentiated from such positions are noisier; nothing is refused); torques from the motors' currents on a
+        robot whose model has no rotor inertia (:func:`~wbfriction.logs.torque.rotor_inertia_warnings`).
 
     Raises:
         ColumnError: a duplicated column name, a missing ``time`` or required column, a column
@@ -400,8 +402,9 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
             raise ColumnError(source, f.name, None, f"column '{f.name}' holds {f.type} values, not numbers{hint}")
         if pa.types.is_floating(f.type) and f.type.bit_width < 64:
             single.append(f.name)
+    motor = rotor_inertia_warnings(robot, seen, source)  # torques from currents, no rotor inertia in the model
     if not single:
-        return ()
+        return motor
     shown = ", ".join(single[:3]) + (f" and {len(single) - 3} more" if len(single) > 3 else "")
     prefixes = list(dict.fromkeys(n.partition(".")[0] for n in single))
     sizes = []  # each kind of column in its own unit: the rounding at a typical value (issue 53)
@@ -414,7 +417,7 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
     cost = f", whose rounding the accelerations differentiated from {', '.join(differentiated)} amplify" \
         if differentiated else ""
     return (f"{source}: {shown} are float{schema.field(single[0]).type.bit_width}: "
-            f"about 7 significant digits ({'; '.join(sizes)}){cost}; log float64",)
+            f"about 7 significant digits ({'; '.join(sizes)}){cost}; log float64",) + motor
 
 
 SINGLE_PRECISION_SCALE: dict[str, tuple[float, str]] = {

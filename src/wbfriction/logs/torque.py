@@ -99,6 +99,10 @@ class TorqueKind:
     """Whether the text outputs say where the torque comes from (not for the default, the torque sensors)."""
     pd_law: ClassVar[bool] = False
     """Whether its torque is the drivers' PD law on the set-points (what the actuator identification needs)."""
+    motor_side: ClassVar[bool] = False
+    """Whether its torque is the motor's, read from its current (the drivers' estimates, the currents times the torque
+    constants): the rotor's inertia torque (armature x qdd) is in it, which the model holds only through the robot
+    TOML's ``[armature]`` (:func:`rotor_inertia_warnings`)."""
 
     def claims(self, given: TorqueColumns) -> bool:
         """Whether a log is this source's: by default, it has ``<prefix>.<joint>`` for every torque-controlled
@@ -213,6 +217,27 @@ def torque_columns_named(robot: Robot) -> dict[str, set[str] | None]:
     return named
 
 
+def rotor_inertia_warnings(robot: Robot, seen: set[str], source: str) -> tuple[str, ...]:
+    """One line when a log whose columns are ``seen`` has its torques from the motors' currents
+    (:attr:`TorqueKind.motor_side`: the first registered source that gives every torque-controlled joint's) and the
+    robot's model has no rotor inertia (``[armature]``, ``model.armature``) for some torque-controlled joint: the
+    rotor's inertia torque (armature x qdd) is then in what is estimated, nothing refused; () otherwise. Said before
+    any row is read (:func:`~wbfriction.logs.log.check_schema`)."""
+    tc = robot.torque_controlled
+    kind = next((k for k in SOURCES if all(k.gives(robot, j, seen) for j in tc)), None)
+    if kind is None or not kind.motor_side:
+        return ()
+    armature = robot.model.armature[robot.act_v_index[robot.tc_index]]
+    bare = [j for j, a in zip(tc, armature) if not a > 0]
+    if not bare:
+        return ()
+    shown = ", ".join(bare[:3]) + (f" and {len(bare) - 3} more" if len(bare) > 3 else "")
+    return (f"{source}: the torques are {kind.what}: each motor's rotor inertia torque (armature x qdd) is in them, "
+            f"and robot '{robot.name}' gives no [armature] for {len(bare)} of its {len(tc)} torque-controlled joints "
+            f"({shown}): it stays in the friction estimated; give [armature] in its TOML (or find it: wbfriction "
+            "identify --armature identify)",)
+
+
 def check_torque_columns(robot: Robot, seen: set[str], source: str) -> None:
     """Every torque-controlled joint has a torque from some registered source (:meth:`TorqueKind.gives`: ``tau``,
     ``tau_est``, ``current`` with a torque constant, ``q_des`` of a PD-driven joint built in), checked on a log's
@@ -264,6 +289,7 @@ class DriverTorque(TorqueKind):
     this source's (:func:`~wbfriction.logs.pd.driver_estimate` refuses it for some joints only)."""
 
     name, what, prefix, precedence = "driver", "the motor drivers' own estimates (tau_est.<joint>)", "tau_est", 20
+    motor_side = True
 
     def claims(self, given: TorqueColumns) -> bool:
         """Any ``tau_est`` column."""
@@ -295,6 +321,7 @@ class CurrentTorque(TorqueKind):
 
     name, what, prefix, precedence = "current", "motor currents times the torque constants (current.<joint>)", \
         "current", 30
+    motor_side = True
 
     def claims(self, given: TorqueColumns) -> bool:
         """Any ``current`` column, or ``tau`` of some joints only (not every one: the sensors'), which is refused."""

@@ -366,15 +366,42 @@ def _joint_roles(config: dict, actuated: list[str], source: str) -> tuple[list[s
     return pc, tc_cfg
 
 
+FOOT_SUFFIXES = ("foot", "toe", "sole", "ankle")
+"""Ends of the frame names :func:`_contact_frames` lists beside a contact frame the model lacks (the candidates a
+user's TOML meant), whatever their case."""
+
+
 def _contact_frames(config: dict, model: pin.Model, urdf: Path, source: str) -> list[str]:
-    """The configured contact frames: at least one, each a frame of the model."""
+    """The configured contact frames: at least one, each a frame of the model, checked when the robot is loaded (a
+    model whose feet were left out, e.g. its toes commented out, is named before any log is read).
+
+    Raises:
+        InputError: no contact frame; one the model has not, naming the robot, the frame, the model's file, the
+            frames it has whose names end like a foot's (:data:`FOOT_SUFFIXES`) and the closest names
+            (:func:`difflib.get_close_matches`, among those feet first).
+    """
     frames = list(config.get("contact_frames", []))
     if not frames:
         raise InputError(f"{source}: 'contact_frames' is missing or empty")
     for f in frames:
         if not model.existFrame(f):
-            raise InputError(f"{source}: unknown contact frame '{f}' (not a frame of {urdf.name})")
+            raise InputError(missing_frame(str(config.get("name", urdf.stem)), f, [fr.name for fr in model.frames],
+                                           urdf, source))
     return frames
+
+
+def missing_frame(robot: str, frame: str, names: list[str], urdf: Path, source: str) -> str:
+    """The one line refusing contact frame ``frame`` of robot ``robot`` that the model ``urdf`` (its frames
+    ``names``) has not: the feet it has (names ending in :data:`FOOT_SUFFIXES`, or none) and the closest names."""
+    from difflib import get_close_matches
+
+    names = list(dict.fromkeys(n for n in names if n != "universe"))
+    feet = [n for n in names if n.lower().rstrip("_0123456789").endswith(FOOT_SUFFIXES)]
+    close = get_close_matches(frame, feet, n=3, cutoff=0.6) or get_close_matches(frame, names, n=3, cutoff=0.6)
+    has = f"its frames ending in {'/'.join(FOOT_SUFFIXES)}: {', '.join(feet)}" if feet else \
+        f"it has no frame ending in {'/'.join(FOOT_SUFFIXES)}: its feet may be left out or commented out"
+    hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
+    return (f"{source}: robot '{robot}': unknown contact frame '{frame}': not a frame of {urdf} ({has}){hint}")
 
 
 def _contact_kinds(value, frames: list[str], floating: bool, source: str) -> tuple[ContactKind, ...]:

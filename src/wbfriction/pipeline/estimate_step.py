@@ -51,6 +51,7 @@ from wbfriction.pipeline.provenance import log_provenance
 from wbfriction.pipeline.raw_log import prepared_log
 from wbfriction.progress import Progress, StageProgress
 from wbfriction.signals.content import contact_changes
+from wbfriction.signals.phase_window import log_swings
 from wbfriction.workers import process_pool
 
 
@@ -242,8 +243,10 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
         first, changes = first[a:b], contact_changes(contact[a:b])
     # the noise measured on the first rows, the route's windows bounded by them: all a file's plan reads (the whole
     # log's rows in memory, estimate_log: wbfriction.friction.decision)
+    swings = log_swings(contact, robot.contact_frames, clock.step, clock.segments) if robot.floating_base else None
+    feet = any(c.startswith("force.") for c in file.schema().names)  # the feet's forces: stances estimated too
     decision = decide_log(robot, options, first, clock.step, segments=clock.segments, rows=len(clock), source=source,
-                          changes=changes)
+                          changes=changes, swings=swings, swings_only=not robot.ft_sensors and not feet)
     options = decision.options
     extra_metadata = {**(extra_metadata or {}), **decision.metadata()}
     n = len(contact)
@@ -261,7 +264,8 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
                                           chunks, robot, source, extra_metadata, progress, first_meta, valid))
     return ChunkedResult(n, len(chunks), sum(1 for c in chunks if c.start - c.read_start > CONTEXT), first_meta,
                          clock.reason, "" if decision.differentiation is None else decision.differentiation.reason,
-                         plan.warnings + no_valid_warnings(source, valid) + force_sampling_warnings(first_meta),
+                         plan.warnings + decision.warnings + no_valid_warnings(source, valid)
+                         + force_sampling_warnings(first_meta),
                          "" if decision.route is None else decision.route.reason)
 
 

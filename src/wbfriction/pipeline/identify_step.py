@@ -57,6 +57,23 @@ class IdentifiedFile:
         return "[armature]\n" + "".join(f"{joint} = {value!r}\n" for joint, value in self.armature.items())
 
 
+def rotor_inertia_notes(robot: Robot, log: str | Path, options: InertialOptions) -> tuple[str, ...]:
+    """What :func:`identify_file` says before the work of a log whose torques come from the motors' currents on a
+    robot without ``[armature]`` (:func:`~wbfriction.logs.torque.rotor_inertia_warnings`, from the log's column names
+    alone): one line, unless the armature is identified (``options.armature = "identify"``); () for a log whose
+    columns cannot be read here (a bag: :func:`identify_file` reads it, and refuses what it must)."""
+    from wbfriction.logs.tables import TableFile
+    from wbfriction.logs.torque import rotor_inertia_warnings
+
+    if options.armature == "identify":
+        return ()
+    try:
+        names = set(TableFile(Path(log)).schema().names)
+    except (InputError, OSError, ValueError):
+        return ()
+    return rotor_inertia_warnings(robot, names, str(log))
+
+
 def identify_file(robot: Robot, log: str | Path, urdf_output: str | Path, json_output: str | Path | None = None, *,
                   estimate_options: EstimateOptions = EstimateOptions(), options: InertialOptions = InertialOptions(),
                   stribeck: float | Literal["auto"] | None = "auto", passes: int = 2,
