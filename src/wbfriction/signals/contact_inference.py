@@ -63,8 +63,6 @@ SWING_CEILING = 99.0
 ROBUST_SCALE = 0.6744897501960817
 """The standard normal's upper quartile: a median absolute deviation over it estimates a standard deviation."""
 
-LWA = pin.LOCAL_WORLD_ALIGNED
-
 
 @dataclass(frozen=True)
 class ContactOptions:
@@ -160,7 +158,7 @@ def feet_kinematics(robot: Robot, q: np.ndarray, tau: np.ndarray | None, rotatio
         for c, fid in enumerate(robot.contact_frame_ids):
             points[k, c] = data.oMf[fid].translation + offset
             if g is not None and tau is not None:
-                J = pin.getFrameJacobian(model, data, fid, LWA)
+                J = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
                 cols = iv[legs[c]]
                 Jl = (J[:3] - pin.skew(offset) @ J[3:])[:, cols]
                 forces[k, c] = np.linalg.solve(Jl.T, g[cols] - tau[k, legs[c]])
