@@ -74,6 +74,8 @@ EXCLUDED: dict[str, str] = {
     "friction.options.TEMPERATURE_LAWS": NAMES,
     # signals
     "signals.choice.PREFERENCES": NAMES,
+    "signals.contact_inference.CUES": NAMES + " (the contact cues)",
+    "signals.contact_inference.ROBUST_SCALE": PHYSICS + " (the standard normal's upper quartile)",
     "signals.content.SEGMENT": NUMERICAL + " (the spectrum's segment length)",
     "signals.content.MIN_SEGMENT": NUMERICAL,
     "signals.content.MIN_SEGMENTS": NUMERICAL + " (NOISE_MARGIN's level assumes it)",

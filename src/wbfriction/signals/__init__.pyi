@@ -1,5 +1,8 @@
 """Names of :mod:`wbfriction.signals`, imported on first use (:func:`lazy_loader.attach_stub`)."""
 
+from .contact_inference import ContactOptions as ContactOptions
+from .contact_inference import InferredContacts as InferredContacts
+from .contact_inference import infer_contacts as infer_contacts
 from .kinematics import MeasuredKinematics as MeasuredKinematics
 from .kinematics import measure as measure
 from .options import FilterOptions as FilterOptions
