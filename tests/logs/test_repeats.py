@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from helpers import logger_sampling
@@ -58,7 +58,7 @@ def test_repeats_at_the_loggers_own_period_are_kept():
     assert "kept" in found.describe()
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(drive=st.floats(1.5e-3, 5e-3), ratio=st.floats(1.5, 4.0), hold=st.sampled_from([0.0, 0.01, 0.05]),
        phase=st.floats(0.0, 1.0), seed=st.integers(0, 1000))
 def test_any_drive_clock_read_by_a_faster_logger_is_found(drive, ratio, hold, phase, seed):

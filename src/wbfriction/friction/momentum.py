@@ -109,12 +109,14 @@ def momentum_window(options: EstimateOptions, log: Log) -> MomentumWindow:
     return MomentumWindow(options.momentum.window // 2, log.dt, time_base(log))
 
 
-def _filter_rows(kin: MeasuredKinematics, contact: np.ndarray) -> np.ndarray:
+def _filter_rows(kin: MeasuredKinematics, log: Log) -> np.ndarray:
     """(N,) rows whose velocity is the filter's: its window inside the log and clear of every contact change
-    (elsewhere the kinematics fill in raw differences, which the momenta must not see)."""
+    (elsewhere the kinematics fill in raw differences, which the momenta must not see), and whose contact flags are
+    sure (:attr:`Log.unsure <wbfriction.logs.log.Log.unsure>`: inferred without confidence)."""
     assert kin.smoother is not None
-    blank = np.where(straddling(contact), np.nan, 0.0)[:, None]
-    return np.isfinite(kin.smoother(blank))[:, 0]
+    blank = np.where(straddling(log.contact), np.nan, 0.0)[:, None]
+    rows = np.isfinite(kin.smoother(blank))[:, 0]
+    return rows if log.unsure is None else rows & ~log.unsure
 
 
 def _base_twist(robot: Robot, kin: MeasuredKinematics, log: Log, base_motion: str, rows: np.ndarray
@@ -180,9 +182,7 @@ def momentum_estimate(robot: Robot, log: Log, options: EstimateOptions, progress
                   base_motion=floating and log.base is not None, imu=floating and base_motion == "imu")
     n, tc, n_c = len(log.time), robot.tc_index, len(robot.contact_frames)
     phases = segment(kin.time, kin.contact, options.lift_off_skip, options.touch_down_skip, gaps)
-    rows_ok = _filter_rows(kin, log.contact) & np.all(np.isfinite(kin.q), axis=1) & np.all(np.isfinite(kin.qd), axis=1)
-    if log.unsure is not None:  # contact flags inferred without confidence (wbfriction.pipeline.raw_log)
-        rows_ok &= ~log.unsure
+    rows_ok = _filter_rows(kin, log) & np.all(np.isfinite(kin.q), axis=1) & np.all(np.isfinite(kin.qd), axis=1)
     # each row's closure: -1 none, c < n_c the rigid stance on contact c, n_c the wrenches, n_c + 1 the point feet
     closure = np.full(n, -1)
     p, b = np.full((n, robot.n_act), np.nan), np.full((n, robot.n_act), np.nan)

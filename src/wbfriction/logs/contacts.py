@@ -14,7 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
+import pyarrow as pa
 
+from wbfriction.exceptions import ColumnError
+from wbfriction.logs.tables import numeric_column
 from wbfriction.model.robot import Robot
 
 ON_SHARE, OFF_SHARE = 0.10, 0.05
@@ -64,3 +67,20 @@ def hysteresis(x: np.ndarray, on: float, off: float) -> np.ndarray:
     initial = x[:1] > 0.5 * (on + off)
     state = np.take_along_axis(event, np.maximum(last, 0), axis=0) == 1
     return np.where(last >= 0, state, initial)
+
+
+def read_unsure(table: pa.Table, source: str, first_row: int) -> np.ndarray | None:
+    """The ``unsure`` column (0/1) as booleans, or None: the rows whose contact flags were inferred without
+    confidence (:mod:`wbfriction.pipeline.raw_log`), which no route estimates.
+
+    Raises:
+        ColumnError: a value other than 0 and 1, naming the row.
+    """
+    if "unsure" not in table.column_names:
+        return None
+    x = numeric_column(table, "unsure", source, first_row)
+    bad = np.flatnonzero((x != 0) & (x != 1))
+    if bad.size:
+        raise ColumnError(source, "unsure", int(first_row + bad[0]),
+                          f"column 'unsure' must hold 0 or 1, found {x[bad[0]]:g} at row {first_row + bad[0]}")
+    return x.astype(bool)

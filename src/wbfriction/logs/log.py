@@ -46,7 +46,7 @@ from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.logs.angles import check_limits, imu_orientation, unwrap_positions
 from wbfriction.logs.clock import JITTER, Clock, read_clock, split_at_gaps, table_stamps
 from wbfriction.logs.columns import BASE_COLUMNS, BASE_QD_TRUE_COLUMNS, BASE_QDD_TRUE_COLUMNS, IMU_COLUMNS
-from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, sensed_contacts
+from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, read_unsure, sensed_contacts
 from wbfriction.logs.foot_forces import column_names as foot_force_names
 from wbfriction.logs.foot_forces import foot_force_columns, foot_force_table, read_foot_forces
 from wbfriction.logs.options import MAX_GAP, ReadOptions
@@ -311,23 +311,7 @@ def log_from_table(table: pa.Table, robot: Robot, source: str = "<table>", read:
                torque_source=kind.name, clock=clock, warnings=warnings, wrench=wrench,
                base_qd_true=base_qd_true, base_qdd_true=base_qdd_true, imu=imu, temperature=temperature,
                setpoints=setpoints, foot_force=foot_force, imu_orientation=orientation, foot_counts=foot_counts,
-               unsure=_read_unsure(table, source, first_row))
-
-
-def _read_unsure(table: pa.Table, source: str, first_row: int) -> np.ndarray | None:
-    """The ``unsure`` column (0/1) as booleans, or None.
-
-    Raises:
-        ColumnError: a value other than 0 and 1, naming the row.
-    """
-    if "unsure" not in table.column_names:
-        return None
-    x = numeric_column(table, "unsure", source, first_row)
-    bad = np.flatnonzero((x != 0) & (x != 1))
-    if bad.size:
-        raise ColumnError(source, "unsure", int(first_row + bad[0]),
-                          f"column 'unsure' must hold 0 or 1, found {x[bad[0]]:g} at row {first_row + bad[0]}")
-    return x.astype(bool)
+               unsure=read_unsure(table, source, first_row))
 
 
 NUMERIC_PREFIXES = ("q", "qd", "qd_true", "qdd_true", "tau_f_true", "base", "wrench", "force", "base_qd_true",
@@ -403,8 +387,14 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
         if pa.types.is_floating(f.type) and f.type.bit_width < 64:
             single.append(f.name)
     motor = rotor_inertia_warnings(robot, seen, source)  # torques from currents, no rotor inertia in the model
+    return single_precision_warnings(schema, single, source) + motor
+
+
+def single_precision_warnings(schema: pa.Schema, single: list[str], source: str) -> tuple[str, ...]:
+    """One line on the ``single`` (float32 or shorter) columns of ``schema``: each kind's rounding in its unit, and
+    whether the accelerations differentiated from them amplify it; none if there is none."""
     if not single:
-        return motor
+        return ()
     shown = ", ".join(single[:3]) + (f" and {len(single) - 3} more" if len(single) > 3 else "")
     prefixes = list(dict.fromkeys(n.partition(".")[0] for n in single))
     sizes = []  # each kind of column in its own unit: the rounding at a typical value (issue 53)
@@ -417,7 +407,7 @@ def check_schema(schema: pa.Schema, robot: Robot, source: str) -> tuple[str, ...
     cost = f", whose rounding the accelerations differentiated from {', '.join(differentiated)} amplify" \
         if differentiated else ""
     return (f"{source}: {shown} are float{schema.field(single[0]).type.bit_width}: "
-            f"about 7 significant digits ({'; '.join(sizes)}){cost}; log float64",) + motor
+            f"about 7 significant digits ({'; '.join(sizes)}){cost}; log float64",)
 
 
 SINGLE_PRECISION_SCALE: dict[str, tuple[float, str]] = {

@@ -26,7 +26,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 import pyarrow as pa
@@ -159,6 +159,7 @@ def prepare_raw(table: pa.Table, robot: Robot, source: str, read: ReadOptions = 
     table, report = condition_raw_table(table, robot, source, read)
     t = numeric_columns(table, ["time"], source, 0)[:, 0]
     q = numeric_columns(table, [f"q.{j}" for j in robot.actuated], source, 0)
+    q = q - robot.offset_vector if robot.encoder_offset else q  # the model's angles (wbfriction.model.pd)
     tau = _torque(table, robot, source, t, q)
     dt = float(np.median(np.diff(t)))
     qd, qdd = _derivatives(table, robot, source, t, q, tau)
@@ -219,13 +220,14 @@ def _derivatives(table: pa.Table, robot: Robot, source: str, t: np.ndarray, q: n
     from wbfriction.logs.log import Log
     from wbfriction.logs.tables import numeric_columns
     from wbfriction.signals.kinematics import measure
+    from wbfriction.signals.options import SCHEMES, Diff
 
     dt = float(np.median(np.diff(t)))
     options = decide_log(robot, EstimateOptions(), q, dt, segments=None, rows=len(t), source=source).options
     contact = np.zeros((len(t), len(robot.contact_frames)), dtype=bool)
+    diff = cast(Diff, options.diff if options.diff in SCHEMES else "central")  # decided: no longer "auto"
     kin = measure(Log(t, q, tau[:, [robot.actuated.index(j) for j in robot.torque_controlled]], contact,
-                      source=source), options.diff if options.diff != "true" else "central",
-                  filtering=options.filtering)
+                      source=source), diff, filtering=options.filtering)
     qdd = np.nan_to_num(kin.qdd)
     qd_cols = [f"qd.{j}" for j in robot.actuated]
     if all(c in table.column_names for c in qd_cols):

@@ -1,0 +1,94 @@
+"""A walking robot's raw log made the project's log (wbfriction.pipeline.raw_log), against the simulated twin's truth:
+the repeats found exactly, the contacts inferred as the simulator's, the rows not confident left out of the friction,
+and ``estimate`` run on the raw log as a user runs it."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+from wbfriction.logs.options import ReadOptions
+from wbfriction.model.loading import RobotSpec
+
+TOML = Path(__file__).parents[2] / "examples" / "inputs" / "go2_logged.toml"
+RATE = 1 / 1.22e-3
+
+
+def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "wbfriction", *args], cwd=cwd, capture_output=True, text=True)
+
+
+@pytest.fixture(scope="module")
+def raw(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("raw")
+    done = _cli("simulate", "--robot", str(TOML), "--simulator", "mujoco", "--gait", "trot", "--duration", "8",
+                "--logger", "raw", "-o", "trot_raw.parquet", cwd=folder)
+    assert done.returncode == 0, done.stderr
+    return folder / "trot_raw.parquet"
+
+
+@pytest.fixture(scope="module")
+def prepared(raw):
+    from wbfriction.pipeline.raw_log import prepare_raw
+
+    robot = RobotSpec.given(str(TOML)).load()
+    return robot, pq.read_table(raw), prepare_raw(pq.read_table(raw), robot, str(raw), ReadOptions(rate=RATE))
+
+
+@pytest.mark.slow
+def test_the_raw_log_is_recognised_and_a_full_log_is_not(prepared):
+    from wbfriction.pipeline.raw_log import is_raw
+
+    robot, table, done = prepared
+    assert is_raw(robot, table.column_names)
+    assert not is_raw(robot, done.table.column_names)  # contacts and base pose written: read as any log
+
+
+@pytest.mark.slow
+def test_repeats_found_exactly_and_contacts_as_the_simulators(prepared):
+    robot, table, done = prepared
+    out = done.table
+    sample, raw_sample = np.asarray(out.column("sample_true")), np.asarray(table.column("sample_true"))
+    np.testing.assert_array_equal(sample, raw_sample[np.r_[True, np.diff(raw_sample) != 0]])
+    truth = np.column_stack([np.asarray(out.column(f"contact_true.{f}")) for f in robot.contact_frames]) > 0
+    flags = np.column_stack([np.asarray(out.column(f"contact.{f}")) for f in robot.contact_frames]) > 0
+    assert np.mean(flags == truth) >= 0.97  # the issue's target
+    unsure = np.asarray(out.column("unsure")) > 0
+    np.testing.assert_array_equal(unsure, done.contacts.unconfident_rows())
+    assert not any(c.startswith("imu.") for c in out.column_names)  # in base.* now
+
+
+@pytest.mark.slow
+def test_estimate_reads_the_raw_log_and_leaves_the_unsure_rows_out(raw, prepared, tmp_path):
+    _, _, done = prepared
+    out = tmp_path / "f.parquet"
+    run = _cli("estimate", str(raw), "--robot", str(TOML), "--rate", repr(RATE), "--route", "acceleration",
+               "-o", str(out), cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    said = run.stdout + run.stderr
+    assert "contacts inferred from" in said and "base velocity from the stance legs" in said
+    est = pq.read_table(out)
+    unsure = done.contacts.unconfident_rows()
+    assert est.num_rows == unsure.size and unsure.any()
+    valid = np.column_stack([np.asarray(est.column(c)) for c in est.column_names if c.startswith("valid.")])
+    assert valid.any() and not valid[unsure].any()
+
+
+def test_a_robot_without_imu_is_refused_in_one_line(tmp_path):
+    from wbfriction.exceptions import InputError
+    from wbfriction.pipeline.raw_log import prepare_raw
+
+    robot = RobotSpec.given("go2_walking").load()
+    table = pa.table({"q.FL_hip_joint": np.zeros(3)})
+    if robot.imu is not None:  # the built-in has one: drop it from a copy of the TOML
+        import dataclasses
+
+        robot = dataclasses.replace(robot, imu=None)
+    with pytest.raises(InputError, match="has no \\[imu\\]"):
+        prepare_raw(table, robot, "log.parquet")
