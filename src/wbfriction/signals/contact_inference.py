@@ -110,7 +110,7 @@ class InferredContacts:
 
     def unconfident_rows(self) -> np.ndarray:
         """(N,) bool: the samples where any foot's state is not confident."""
-        return np.asarray(~self.confident.all(axis=1))
+        return np.asarray(~self.confident.all(axis=1), dtype=bool)
 
 
 def _legs(robot: Robot) -> list[np.ndarray]:
