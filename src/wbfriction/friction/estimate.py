@@ -301,7 +301,8 @@ def estimate_log(robot: Robot, log: Log, options: EstimateOptions = EstimateOpti
     """
     check_contact_patterns(robot, log.contact, log.source)  # before any work: the KKT route's matrix singular
     positions, changes = longest_stretch(log)
-    swings = log_swings(log.contact, robot.contact_frames, log.dt, log.segments) if robot.floating_base else None
+    swings = log_swings(log.contact, robot.contact_frames, log.dt, log.segments,
+                        (options.lift_off_skip, options.touch_down_skip)) if robot.floating_base else None
     decision = decide_log(robot, options, positions, log.dt, segments=log.segments, rows=len(log.time),
                           source=log.source, route_rows=len(log.time),  # the whole log's rows: module docstring
                           changes=changes, swings=swings,

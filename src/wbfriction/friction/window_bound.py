@@ -67,11 +67,15 @@ class WindowBound:
     after: int
     swing: Swing
     dt: float
+    stretch: bool = False
 
     def phrase(self) -> str:
-        """What was bounded, before and after."""
+        """What was bounded, before and after (and by what, when it is a stretch, not a swing)."""
+        by = (f" by the shortest stretch estimated while {self.swing.frame} swings ({self.swing.samples} samples, "
+              f"{self.swing.seconds:.3g} s, from row {self.swing.start}: a swing less the switches' margins)"
+              if self.stretch else "")
         return (f"{self.what} {self.before} samples ({self.before * self.dt:.3g} s) -> {self.after} "
-                f"({self.after * self.dt:.3g} s)")
+                f"({self.after * self.dt:.3g} s){by}")
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready record: the window, its spans and the swing."""
@@ -82,6 +86,10 @@ class WindowBound:
 def warning(bounds: tuple[WindowBound, ...], source: str) -> str:
     """The one line saying ``bounds`` (not empty) were made."""
     s = bounds[0].swing
+    if bounds[0].stretch:
+        return (f"{source}: window chosen from the noise longer than half the rows it must lie in: "
+                f"{'; '.join(b.phrase() for b in bounds)}; a longer window would leave less of each stretch than it "
+                "costs")
     return (f"{source}: window chosen from the noise longer than half the shortest swing ({s.frame}, {s.samples} "
             f"samples, {s.seconds:.3g} s, from row {s.start}): {'; '.join(b.phrase() for b in bounds)}; a longer "
             "window would leave less of each swing than it costs")
@@ -150,7 +158,27 @@ def bound_windows(given: EstimateOptions, options: EstimateOptions, choice: Diff
             bounds.append(WindowBound("the momentum route's windows", span, vw + w - 1, swing, dt))
             options = replace(options, momentum=replace(m, velocity_window=vw, window=w))
             route = _bounded_route(route, vw, w, dt, swing) if route is not None else None
+        options, route = _bound_by_stretches(given, options, route, swings, dt, bounds)
     return options, choice, route, tuple(bounds)
+
+
+def _bound_by_stretches(given: EstimateOptions, options: EstimateOptions, route: RouteDecision | None,
+                        swings: Swings, dt: float, bounds: list[WindowBound]
+                        ) -> tuple[EstimateOptions, RouteDecision | None]:
+    """The momentum route's momentum window bounded by the shortest stretch it estimates while a foot swings
+    (:attr:`~wbfriction.signals.phase_window.Swings.stretches`: a swing less the lift-off and touch-down margins and
+    the other feet's switches): its impulses are summed over windows that lie whole inside those rows, so the same
+    bound as a swing's (:func:`~wbfriction.signals.phase_window.window_bound`) applies to it; ``bounds`` appended."""
+    m = options.momentum
+    stretch = swings.shortest_stretch(LEAST_MOMENTUM[1])
+    if given.momentum.window is not None or m.window is None or m.velocity_window is None or stretch is None:
+        return options, route
+    w = max(LEAST_MOMENTUM[1], window_bound(stretch.samples))
+    if w >= m.window:
+        return options, route
+    bounds.append(WindowBound("the momentum route's momentum window", m.window, w, stretch, dt, stretch=True))
+    options = replace(options, momentum=replace(m, window=w))
+    return options, _bounded_route(route, m.velocity_window, w, dt, stretch) if route is not None else None
 
 
 def _momentum_windows(vw: int, w: int, bound: int, given: EstimateOptions) -> tuple[int, int]:

@@ -243,7 +243,8 @@ def estimate_file(spec: RobotSpec, path: str | Path, output: str | Path, options
         first, changes = first[a:b], contact_changes(contact[a:b])
     # the noise measured on the first rows, the route's windows bounded by them: all a file's plan reads (the whole
     # log's rows in memory, estimate_log: wbfriction.friction.decision)
-    swings = log_swings(contact, robot.contact_frames, clock.step, clock.segments) if robot.floating_base else None
+    swings = log_swings(contact, robot.contact_frames, clock.step, clock.segments,
+                        (options.lift_off_skip, options.touch_down_skip)) if robot.floating_base else None
     feet = any(c.startswith("force.") for c in file.schema().names)  # the feet's forces: stances estimated too
     decision = decide_log(robot, options, first, clock.step, segments=clock.segments, rows=len(clock), source=source,
                           changes=changes, swings=swings, swings_only=not robot.ft_sensors and not feet)

@@ -64,6 +64,13 @@ class Swings:
     window must resolve on a robot whose feet leave the ground (:func:`log_swings`)."""
 
     swings: tuple[Swing, ...]
+    stretches: tuple[Swing, ...] = ()
+
+    def shortest_stretch(self, least_window: int = 1) -> Swing | None:
+        """The shortest of :attr:`stretches` (the rows estimated while a foot swings, :func:`log_swings`) whose bound
+        is at least ``least_window``, or None."""
+        kept = [s for s in self.stretches if window_bound(s.samples) >= least_window]
+        return min(kept, key=lambda s: (s.samples, s.start)) if kept else None
 
     def shortest(self, least_window: int = 1, margins: float = 0.0) -> Swing | None:
         """The shortest swing longer than ``margins`` [s] (the lift-off and touch-down margins together) whose bound
@@ -78,13 +85,17 @@ class Swings:
 
 
 def log_swings(contact: np.ndarray, frames: tuple[str, ...], dt: float,
-               segments: list[tuple[int, int]] | None = None) -> Swings:
-    """Every complete swing of a log's contact flags (module docstring).
+               segments: list[tuple[int, int]] | None = None, margins: tuple[float, float] | None = None) -> Swings:
+    """Every complete swing of a log's contact flags (module docstring), and with ``margins`` the stretches a point
+    feet route estimates while a foot swings.
 
     Args:
         contact: (N, n_c) the contact flags; frames: their frames (n_c,); dt: the sampling period [s].
         segments: the row ranges between time gaps (None: one): a swing that a gap or the log's end cuts is not
             complete (its length not known) and is left out.
+        margins: the lift-off and touch-down margins [s] (:func:`~wbfriction.signals.phases.settled`): the
+            stretches are the runs of rows with a foot off the ground outside every margin (a window that must lie
+            whole inside the rows estimated, the momentum route's, is bounded by them); None: none.
     """
     contact = np.asarray(contact, dtype=bool)
     out: list[Swing] = []
@@ -96,4 +107,23 @@ def log_swings(contact: np.ndarray, frames: tuple[str, ...], dt: float,
                 if not on[lift]:  # a lift-off at ``lift``, a touch-down at ``down``
                     n = int(down - lift)
                     out.append(Swing(frame, int(a + lift), n, n * dt))
-    return Swings(tuple(sorted(out, key=lambda s: (s.start, s.frame))))
+    stretches = () if margins is None else _stretches(contact, frames, dt, segments, margins)
+    return Swings(tuple(sorted(out, key=lambda s: (s.start, s.frame))), stretches)
+
+
+def _stretches(contact: np.ndarray, frames: tuple[str, ...], dt: float, segments: list[tuple[int, int]] | None,
+               margins: tuple[float, float]) -> tuple[Swing, ...]:
+    """The complete runs of rows with a foot off the ground and outside every switch's margins (:func:`log_swings`),
+    each named by the feet off the ground at its start."""
+    from wbfriction.signals.phases import settled
+
+    out = []
+    for a, b in segments or [(0, len(contact))]:
+        on = contact[a:b]
+        keep = np.r_[False, settled(np.arange(b - a) * dt, on, *margins) & ~on.all(axis=1), False]
+        edges = np.flatnonzero(keep[1:] != keep[:-1])
+        for start, stop in zip(edges[::2], edges[1::2]):
+            if start > 0 and stop < b - a:  # a run the log's ends cut is not complete
+                off = "+".join(f for f, c in zip(frames, on[start]) if not c)
+                out.append(Swing(off, int(a + start), int(stop - start), (stop - start) * dt))
+    return tuple(out)

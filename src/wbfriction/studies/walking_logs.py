@@ -40,10 +40,8 @@ DURATION = 8.0
 RATE = "819.672131"
 """The twin logger's nominal rate [Hz] (its 1.22 ms period), given as a user gives it (``--rate``): the raw log has
 no stamps."""
-ROUTE = ("--route", "acceleration")
-"""The route the cases take. The default (``auto``) takes the momentum route on these noise levels, whose whole
-windows leave about ten valid samples per joint between a trot's lift-off and touch-down margins: too few to fit
-(an open defect of the route's choice on short swings, the closing note of issue 82)."""
+ROUTE: tuple[str, ...] = ()
+"""The route options the cases take: none, the defaults a user runs."""
 
 
 @dataclass(frozen=True)
@@ -102,13 +100,32 @@ def simulate(case: WalkingCase, folder: Path, seed: int = 0) -> Path:
     return out
 
 
-def given_log(prepared: pa.Table, robot_frames: tuple[str, ...]) -> pa.Table:
-    """The prepared log with the simulator's contact flags and base pose in place of the inferred ones (and no
-    ``unsure`` row): the route a user with flags and a pose made outside the tool would take."""
+MARGINS = 0.15
+"""[s] The thesis's lift-off and touch-down margins together (6.2.1, the estimate's defaults): a phase no longer is
+not estimated, so a flag's run shorter than them is a bounce, merged into the phase around it (:func:`debounced`)."""
+
+
+def debounced(flags: np.ndarray, dt: float, shortest: float = MARGINS) -> np.ndarray:
+    """``flags`` (N,) bool with every run shorter than ``shortest`` [s] between two runs of the other state merged
+    into them: the simulator's contact state (a nonzero normal force) bounces on a soft contact's touch-down, a
+    user's flags (from a force or a toe's height, with hysteresis) do not."""
+    out = flags.copy()
+    edges = np.flatnonzero(np.diff(out.astype(np.int8))) + 1
+    bounds = np.r_[0, edges, out.size]
+    for a, b in zip(bounds[1:-2], bounds[2:-1]):  # inner runs only: a log's first and last are kept
+        if (b - a) * dt < shortest:
+            out[a:b] = out[a - 1]
+    return out
+
+
+def given_log(prepared: pa.Table, robot_frames: tuple[str, ...], dt: float) -> pa.Table:
+    """The prepared log with the simulator's contact flags (:func:`debounced`) and base pose in place of the inferred
+    ones (and no ``unsure`` row): the route a user with flags and a pose made outside the tool would take."""
     names = [c for c in prepared.column_names if c != "unsure" and not c.startswith(("contact.", "base."))]
     out = prepared.select(names)
     for f in robot_frames:
-        out = out.append_column(f"contact.{f}", prepared.column(f"contact_true.{f}").cast(pa.int8()))
+        flags = debounced(np.asarray(prepared.column(f"contact_true.{f}")) > 0, dt)
+        out = out.append_column(f"contact.{f}", pa.array(flags.astype(np.int8)))
     for c in BASE_COLUMNS:
         out = out.append_column(c, prepared.column(c.replace("base.", "base_true.")))
     return out.replace_schema_metadata(prepared.schema.metadata)
@@ -172,7 +189,8 @@ def score_case(case: WalkingCase, folder: Path) -> WalkingScore:
     truth = log_truth(raw)
     fits = _estimate_fit(raw, TWIN_ROBOT, case.name, folder, truth)
     given = folder / f"{case.name}_given.parquet"
-    pq.write_table(given_log(out, robot.contact_frames), given)
+    t = np.asarray(out.column("time"))
+    pq.write_table(given_log(out, robot.contact_frames, float(np.median(np.diff(t)))), given)
     given_fits = _estimate_fit(given, TWIN_ROBOT, case.name + "_given", folder, truth)
     return WalkingScore(case.name, len(table), len(sample), exact, float(np.mean(inferred == truth_c)),
                         float(np.mean((inferred == truth_c)[confident])) if confident.any() else float("nan"),
