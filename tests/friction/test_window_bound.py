@@ -132,3 +132,42 @@ def test_a_swing_the_margins_leave_nothing_of_does_not_bound_the_window():
     assert [s.samples for s in swings.swings] == [22, 119]
     assert swings.shortest().samples == 22
     assert swings.shortest(margins=0.15).samples == 119
+
+
+@settings(max_examples=50, deadline=None)
+@given(runs=st.lists(st.tuples(st.booleans(), st.integers(1, 40)), min_size=1, max_size=10),
+       lag=st.integers(0, 8), lift_off=st.integers(0, 6), touch_down=st.integers(0, 6))
+def test_stretches_are_the_swinging_rows_outside_every_margin(runs, lag, lift_off, touch_down):
+    """Two feet, the second's flags the first's ``lag`` rows late: the stretches are exactly the complete runs of rows
+    with a foot off the ground outside every switch's margins (signals.phases.settled), each as long as its run."""
+    from wbfriction.signals.phases import settled
+
+    first = np.concatenate([np.full(n, on) for on, n in runs])
+    contact = np.column_stack([first, np.r_[np.full(lag, first[0]), first][:first.size]])
+    dt = 0.01
+    margins = (lift_off * dt, touch_down * dt)
+    swings = log_swings(contact, ("A", "B"), dt, None, margins)
+    keep = settled(np.arange(first.size) * dt, contact, *margins) & ~contact.all(axis=1)
+    padded = np.r_[False, keep, False]
+    edges = np.flatnonzero(padded[1:] != padded[:-1])
+    expected = [(a, b - a) for a, b in zip(edges[::2], edges[1::2]) if a > 0 and b < first.size]
+    assert [(s.start, s.samples) for s in swings.stretches] == expected
+    assert all(abs(s.seconds - s.samples * dt) < 1e-12 for s in swings.stretches)
+
+
+def test_the_momentum_window_is_bounded_by_the_shortest_stretch():
+    """A momentum window longer than half the shortest stretch estimated while a foot swings is bounded to it, and
+    said; one shorter is kept; a window given is kept."""
+    from wbfriction.friction.window_bound import bound_windows
+    from wbfriction.signals.phase_window import Swing, Swings
+
+    swings = Swings((Swing("A", 10, 200, 0.4),), (Swing("A+B", 60, 24, 0.048), Swing("A+B", 400, 60, 0.12)))
+    given = EstimateOptions(route="momentum")
+    options = dataclasses.replace(given, momentum=MomentumOptions(window=19, velocity_window=7))
+    out, _, _, bounds = bound_windows(given, options, None, None, swings, 0.002)
+    assert out.momentum.window == window_bound(24) == 11 and out.momentum.velocity_window == 7
+    assert len(bounds) == 1 and bounds[0].stretch and "shortest stretch" in bounds[0].phrase()
+    short = dataclasses.replace(options, momentum=MomentumOptions(window=9, velocity_window=7))
+    assert bound_windows(given, short, None, None, swings, 0.002)[0].momentum.window == 9
+    asked = dataclasses.replace(given, momentum=MomentumOptions(window=19))
+    assert bound_windows(asked, options, None, None, swings, 0.002)[0].momentum.window == 19

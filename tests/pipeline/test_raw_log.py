@@ -92,3 +92,21 @@ def test_a_robot_without_imu_is_refused_in_one_line(tmp_path):
         robot = dataclasses.replace(robot, imu=None)
     with pytest.raises(InputError, match="has no \\[imu\\]"):
         prepare_raw(table, robot, "log.parquet")
+
+
+@pytest.mark.slow
+def test_a_standing_robot_and_too_few_samples_are_refused_in_one_line(tmp_path):
+    """A robot that stands (no foot ever unloaded and lifted) and a log whose repeats leave fewer distinct samples
+    than the contact inference needs: each one line, exit 2, nothing written."""
+    done = _cli("simulate", "--robot", str(TOML), "--simulator", "mujoco", "--gait", "stand", "--duration", "2",
+                "--logger", "raw", "-o", "stand.parquet", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    run = _cli("estimate", "stand.parquet", "--robot", str(TOML), "--rate", repr(RATE), "-o", "f.parquet",
+               cwd=tmp_path)
+    assert run.returncode == 2 and "no foot ever leaves the ground" in run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1 and not (tmp_path / "f.parquet").exists()
+    pq.write_table(pq.read_table(tmp_path / "stand.parquet").slice(0, 150), tmp_path / "short.parquet")
+    run = _cli("estimate", "short.parquet", "--robot", str(TOML), "--rate", repr(RATE), "-o", "f.parquet",
+               cwd=tmp_path)
+    assert run.returncode == 2 and "distinct samples" in run.stderr, run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1 and not (tmp_path / "f.parquet").exists()

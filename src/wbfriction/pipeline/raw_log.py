@@ -150,13 +150,13 @@ def prepare_raw(table: pa.Table, robot: Robot, source: str, read: ReadOptions = 
     """
     from wbfriction.logs.raw_table import condition_raw_table
     from wbfriction.logs.tables import numeric_columns
-    from wbfriction.signals.contact_inference import infer_contacts
+    from wbfriction.signals.contact_inference import MIN_SAMPLES, infer_contacts
     from wbfriction.signals.leg_odometry import base_from_legs, imu_rotation
 
     if robot.imu is None:
         raise InputError(f"{source}: robot '{robot.name}' has no [imu] in its TOML: a log without contact flags and "
                          "base pose needs the IMU's placement to take the base's motion from it")
-    table, report = condition_raw_table(table, robot, source, read)
+    table, report = condition_raw_table(table, robot, source, read, min_samples=MIN_SAMPLES)  # the inference's
     t = numeric_columns(table, ["time"], source, 0)[:, 0]
     q = numeric_columns(table, [f"q.{j}" for j in robot.actuated], source, 0)
     q = q - robot.offset_vector if robot.encoder_offset else q  # the model's angles (wbfriction.model.pd)

@@ -169,14 +169,15 @@ def score_case(case: WalkingCase, folder: Path) -> WalkingScore:
     """Simulate, prepare, estimate and fit ``case`` in ``folder`` (module docstring)."""
     import pyarrow.parquet as pq
 
-    from wbfriction.model.loading import load_robot
+    from wbfriction.logs.options import ReadOptions
+    from wbfriction.model.loading import RobotSpec
     from wbfriction.pipeline.raw_log import prepare_raw
     from wbfriction.studies.status import log_truth
 
     raw = simulate(case, folder)
-    robot = load_robot(str(TWIN_ROBOT))
+    robot = RobotSpec.given(str(TWIN_ROBOT)).load()
     table = pq.read_table(raw)
-    prepared = prepare_raw(table, robot, str(raw))
+    prepared = prepare_raw(table, robot, str(raw), ReadOptions(rate=float(RATE)))
     out = prepared.table
     sample = np.asarray(out.column("sample_true"))
     raw_sample = np.asarray(table.column("sample_true"))
