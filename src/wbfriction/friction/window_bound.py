@@ -178,7 +178,9 @@ def _bound_by_stretches(given: EstimateOptions, options: EstimateOptions, route:
         return options, route
     bounds.append(WindowBound("the momentum route's momentum window", m.window, w, stretch, dt, stretch=True))
     options = replace(options, momentum=replace(m, window=w))
-    return options, _bounded_route(route, m.velocity_window, w, dt, stretch) if route is not None else None
+    bounded = None if route is None else _bounded_route(route, m.velocity_window, w, dt, stretch,
+                                                        "stretch estimated while a foot swings")
+    return options, bounded
 
 
 def _momentum_windows(vw: int, w: int, bound: int, given: EstimateOptions) -> tuple[int, int]:
@@ -200,11 +202,13 @@ def _bounded_choice(choice: DiffChoice, window: int, order: int, weights: Any, d
                           f"{swing.samples} samples): it leaves {left:.2g} rad/s^2")
 
 
-def _bounded_route(route: RouteDecision, vw: int, w: int, dt: float, swing: Swing) -> RouteDecision:
-    """``route`` with the momentum route's windows bounded to ``vw`` and ``w`` by ``swing``, their noise recomputed."""
+def _bounded_route(route: RouteDecision, vw: int, w: int, dt: float, swing: Swing, what: str = "swing"
+                   ) -> RouteDecision:
+    """``route`` with the momentum route's windows bounded to ``vw`` and ``w`` by ``swing`` (the shortest ``what``:
+    a swing, or a stretch the route estimates while a foot swings), their noise recomputed."""
     sigma = route.position_noise
     velocity = sigma * velocity_noise_gain(vw, dt, MOMENTUM_ORDER) if math.isfinite(sigma) else math.nan
     left = sigma * momentum_noise_gain(vw, (w - 1) // 2, dt) if math.isfinite(sigma) else math.nan
     return replace(route, velocity_window=vw, window=w, velocity_noise=velocity, noise_left=left,
-                   reason=f"{route.reason}; windows bounded to {vw} and {w} by the shortest swing ({swing.frame}, "
+                   reason=f"{route.reason}; windows bounded to {vw} and {w} by the shortest {what} ({swing.frame}, "
                           f"{swing.samples} samples)")
