@@ -73,7 +73,10 @@ EXCLUDED: dict[str, str] = {
     "friction.options.TERMS": NAMES,
     "friction.options.TEMPERATURE_LAWS": NAMES,
     # signals
+    "pipeline.raw_log.IMU_ORIENTATION": NAMES + " (the IMU orientation's columns)",
     "signals.choice.PREFERENCES": NAMES,
+    "signals.leg_odometry.GATE_ROUNDS": NUMERICAL + " (rounds of the feet's gate)",
+    "signals.leg_odometry.JERK_GRID": NUMERICAL + " (the decades the jerk density's likelihood is searched over)",
     "signals.contact_inference.CUES": NAMES + " (the contact cues)",
     "signals.contact_inference.ROBUST_SCALE": PHYSICS + " (the standard normal's upper quartile)",
     "signals.content.SEGMENT": NUMERICAL + " (the spectrum's segment length)",
