@@ -110,3 +110,32 @@ def test_a_standing_robot_and_too_few_samples_are_refused_in_one_line(tmp_path):
                cwd=tmp_path)
     assert run.returncode == 2 and "distinct samples" in run.stderr, run.stderr
     assert len(run.stderr.strip().splitlines()) == 1 and not (tmp_path / "f.parquet").exists()
+
+
+@pytest.mark.slow
+def test_the_stance_check_tells_the_true_friction_from_none_and_from_a_wrong_one(raw, prepared):
+    """The self-consistency check (wbfriction.fit.stance_check) on the twin's stances: the true friction leaves the
+    base's balance a smaller residual than no friction, and than twice the true friction."""
+    import json
+
+    from wbfriction.fit.stance_check import log_stance_check
+    from wbfriction.friction.models import target_from_dict
+    from wbfriction.logs.log import log_from_table
+
+    robot, _, done = prepared
+    truth = json.loads(pq.read_schema(raw).metadata[b"wbfriction"])["friction_true"]
+    log = log_from_table(done.table, robot, "prepared")
+    true = log_stance_check(robot, log, {j: target_from_dict(p) for j, p in truth.items()})
+    doubled = log_stance_check(robot, log, {j: target_from_dict({**p, "F_c": 2 * p["F_c"], "F_v": 2 * p["F_v"]})
+                                            for j, p in truth.items()})
+    assert true.samples > 1000 and true.samples == doubled.samples
+    assert true.moment_with < 0.6 * true.moment_without and true.force_with < true.force_without
+    assert true.moment_with < 0.6 * doubled.moment_with
+
+
+def test_the_stance_check_refuses_a_robot_not_on_point_feet():
+    from wbfriction.exceptions import InputError
+    from wbfriction.fit.stance_check import stance_check
+
+    with pytest.raises(InputError, match="point feet"):
+        stance_check(RobotSpec.given("panda").load(), None, {})  # type: ignore[arg-type]

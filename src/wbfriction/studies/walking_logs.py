@@ -14,7 +14,9 @@ simulator wrote beside it:
   injected friction (:func:`~wbfriction.studies.status.fits_from_params`): good when F_c and F_v lie within 5 %
   (noise-free) or 10 % (noisy);
 * **the inference's cost**: the same log with the simulator's contact flags and base pose given, estimated and
-  fitted the same way: where both fits are ``ok``, the largest relative difference of F_c and F_v.
+  fitted the same way: where both fits are ``ok``, the largest relative difference of F_c and F_v;
+* **the self-consistency check** a user can run without truth (:mod:`wbfriction.fit.stance_check`): the base's
+  balance on the stances with no friction, with the friction fitted on the swings, and with the true friction.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ import pyarrow as pa
 from wbfriction.logs.columns import BASE_COLUMNS
 
 if TYPE_CHECKING:
+    from wbfriction.model.robot import Robot
     from wbfriction.studies.status import JointFit
 
 TWIN_ROBOT = Path(__file__).resolve().parents[3] / "examples" / "inputs" / "go2_logged.toml"
@@ -65,7 +68,8 @@ CASES = tuple(WalkingCase(g, n) for g in ("trot", "walk") for n in (False, True)
 class WalkingScore:
     """One case's scores (module docstring); fits: per joint ``(status, F_c error, F_v error)`` (shares),
     given_gap: the largest relative difference between the raw and the given route's values where both are ``ok``
-    (NaN: none both ``ok``)."""
+    (NaN: none both ``ok``); stance: the base's RMS moment residual on the stances [N·m] without friction, with the
+    friction fitted on the swings, with the true friction (:mod:`wbfriction.fit.stance_check`)."""
 
     case: str
     rows: int
@@ -78,6 +82,7 @@ class WalkingScore:
     fits: dict[str, tuple[str, float, float]]
     given_fits: dict[str, tuple[str, float, float]]
     given_gap: float
+    stance: tuple[float, float, float] = (float("nan"),) * 3
 
     def good(self, tolerance: float) -> tuple[int, int]:
         """``(ok and within tolerance, ok)``."""
@@ -196,18 +201,34 @@ def score_case(case: WalkingCase, folder: Path) -> WalkingScore:
     return WalkingScore(case.name, len(table), len(sample), exact, float(np.mean(inferred == truth_c)),
                         float(np.mean((inferred == truth_c)[confident])) if confident.any() else float("nan"),
                         float(prepared.contacts.unconfident_rows().mean()), velocity_error, _summary(fits),
-                        _summary(given_fits), _gap(fits, given_fits))
+                        _summary(given_fits), _gap(fits, given_fits),
+                        _stance(robot, out, folder / f"{case.name}_params.json", truth))
+
+
+def _stance(robot: Robot, prepared: pa.Table, params: Path, truth: dict) -> tuple[float, float, float]:
+    """The base's RMS moment residual on the stances without friction, with the fit's, with the truth's."""
+    from wbfriction.fit.params_file import read_params
+    from wbfriction.fit.stance_check import log_stance_check
+    from wbfriction.friction.models import target_from_dict
+    from wbfriction.logs.log import log_from_table
+
+    log = log_from_table(prepared, robot, "prepared")
+    fitted = log_stance_check(robot, log, {j: f.params for j, f in read_params(params).items() if f.params is not None})
+    true = log_stance_check(robot, log, {j: target_from_dict(p) for j, p in truth["friction_true"].items()})
+    return fitted.moment_without, fitted.moment_with, true.moment_with
 
 
 def markdown(scores: list[WalkingScore]) -> str:
     """The benchmark's table (one row per case) and the per-joint fits."""
     lines = ["| case | rows → samples | repeats exact | contacts agree | (confident) | left out | base velocity "
-             "error | fits ok | ok within 5 % / 10 % | given vs raw (both ok) |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "error | fits ok | ok within 5 % / 10 % | given vs raw (both ok) | stance moment [N·m]: none / fit / "
+             "truth |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for s in scores:
         tol = 0.10 if s.case.endswith("noisy") else 0.05
         good, ok = s.good(tol)
         lines.append(f"| {s.case} | {s.rows} → {s.samples} | {'yes' if s.repeats_exact else 'NO'} | "
                      f"{s.contact_agreement:.1%} | {s.contact_agreement_confident:.1%} | {s.unsure_share:.1%} | "
-                     f"{s.velocity_error:.1%} | {ok}/{len(s.fits)} | {good}/{ok} | {s.given_gap:.1%} |")
+                     f"{s.velocity_error:.1%} | {ok}/{len(s.fits)} | {good}/{ok} | {s.given_gap:.1%} | "
+                     f"{s.stance[0]:.3f} / {s.stance[1]:.3f} / {s.stance[2]:.3f} |")
     return "\n".join(lines)

@@ -1,0 +1,145 @@
+"""The friction fitted on the swings checked on the stances: a self-consistency measure where no truth exists.
+
+A robot on point feet without foot forces determines a joint's friction only while its leg swings
+(:mod:`wbfriction.model.determination`). In a stance the leg's three joint rows of the floating-base equations of
+motion hold three more unknowns, its foot's force ``f_c``:
+
+.. math:: (M a + h)_{leg} = \\tau_{leg} + \\tau_{f,leg} + J_{c,leg}^T f_c
+
+so, given a friction model, the stance feet's forces follow from their legs' rows (least squares where the legs hold
+more rows than the forces have components), and the base's six rows must then balance:
+
+.. math:: r = (M a + h)_{base} - \\sum_c J_{c,base}^T f_c = 0.
+
+Their residual ``r`` (a force [N] and a moment [N·m], base frame) carries every error of the model, the
+measurements and the friction. The friction fitted on the swings, predicted on the stances' velocities, should
+leave less of it than no friction at all, and about as little as any better friction: that is the check
+(:func:`stance_check`), on data the fit never saw (no stance sample enters the fit). It needs the base's motion
+(its pose logged, or made from the IMU and the legs: :mod:`wbfriction.pipeline.raw_log`).
+
+Sign convention: ``tau_f = -f(qd)``, the torque friction exerts on the joint (the README's).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import cast
+
+import numpy as np
+import pinocchio as pin
+
+from wbfriction.exceptions import InputError
+from wbfriction.fit.predict import FrictionCurve
+from wbfriction.logs.log import Log
+from wbfriction.model.robot import Robot
+from wbfriction.signals.kinematics import MeasuredKinematics
+
+
+@dataclass(frozen=True)
+class StanceCheck:
+    """The base's balance on the stance samples (module docstring), without friction and with the friction given.
+
+    Attributes:
+        samples: the stance samples checked (a foot down, every signal defined, the contact flags sure).
+        force_without, moment_without: RMS of the residual's force [N] and moment [N·m] components with no friction.
+        force_with, moment_with: the same with the friction given.
+    """
+
+    samples: int
+    force_without: float
+    moment_without: float
+    force_with: float
+    moment_with: float
+
+    def line(self) -> str:
+        """One line: the residuals without and with the friction."""
+        return (f"the base's balance on {self.samples} stance samples: RMS residual {self.force_without:.3g} N, "
+                f"{self.moment_without:.3g} N·m without friction; {self.force_with:.3g} N, {self.moment_with:.3g} "
+                "N·m with the friction fitted on the swings")
+
+
+def base_residuals(robot: Robot, kin: MeasuredKinematics, tau_f: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """(len(rows), 6) the base's residual (module docstring) at ``rows``: force [N] then moment [N·m], base frame.
+
+    Args:
+        robot: a floating-base robot on point feet.
+        kin: the log's kinematics with the base's motion (``kin.base``, ``base_qd``, ``base_qdd``).
+        tau_f: (N, n_act) the friction torque of every actuated joint [N·m] (0 for a joint without a model).
+        rows: the stance rows (a foot down at each).
+    """
+    model, data = robot.model, robot.model.createData()
+    frames = [model.getFrameId(f) for f in robot.contact_frames]
+    assert kin.base is not None and kin.base_qd is not None and kin.base_qdd is not None
+    out = np.empty((len(rows), 6))
+    tau = np.zeros(model.nv)
+    for i, k in enumerate(rows):
+        q = np.concatenate([kin.base[k], kin.q[k]])
+        v = np.concatenate([kin.base_qd[k], kin.qd[k]])
+        rhs = pin.rnea(model, data, q, v, np.concatenate([kin.base_qdd[k], kin.qdd[k]]))  # M a + h
+        pin.computeJointJacobians(model, data, q)
+        pin.framesForwardKinematics(model, data, q)
+        J = np.vstack([pin.getFrameJacobian(model, data, frames[c], pin.LOCAL_WORLD_ALIGNED)[:3]
+                       for c in np.flatnonzero(kin.contact[k])])
+        tau[robot.act_v_index[robot.tc_index]] = kin.tau[k] + tau_f[k, robot.tc_index]
+        legs = np.flatnonzero(np.abs(J[:, 6:]).sum(axis=0) > 0) + 6
+        f = np.linalg.lstsq(J[:, legs].T, (rhs - tau)[legs], rcond=None)[0]
+        out[i] = (rhs - tau - J.T @ f)[:6]
+    return out
+
+
+def stance_check(robot: Robot, kin: MeasuredKinematics, friction: Mapping[str, FrictionCurve]) -> StanceCheck:
+    """The base's balance on every stance sample of ``kin`` (module docstring) without friction and with ``friction``.
+
+    Args:
+        robot: a floating-base robot on point feet.
+        kin: the log's kinematics with the base's motion.
+        friction: a friction model per joint name (``wbfriction fit``'s parameters: ``read_params``); every joint of
+            a stance leg needs one, or its stance samples are not checked.
+
+    Raises:
+        InputError: a robot that is not on point feet, kinematics without the base's motion, or no stance sample with
+            every stance leg's joints modelled.
+    """
+    if not (robot.floating_base and robot.partial_contacts):
+        raise InputError(f"robot '{robot.name}': the stance check is for a floating base on point feet")
+    if kin.base is None or kin.base_qd is None or kin.base_qdd is None:
+        raise InputError(f"robot '{robot.name}': the stance check needs the base's motion (its pose, or the IMU's)")
+    tau_f = np.zeros((len(kin.time), robot.n_act))
+    for i, joint in enumerate(robot.actuated):
+        if joint in friction:
+            tau_f[:, i] = -np.asarray(friction[joint].f(kin.qd[:, i]))
+    known = np.array([j in friction for j in robot.torque_controlled])
+    modelled = np.array([known[leg].all() for leg in robot.limb_mask])  # (n_c,): every joint of the foot's leg
+    assert kin.valid is not None
+    finite = np.isfinite(kin.base_qdd).all(axis=1) & np.isfinite(kin.base_qd).all(axis=1)
+    rows = np.flatnonzero(kin.valid & finite & kin.contact.any(axis=1)
+                          & ~(kin.contact & ~modelled[None, :]).any(axis=1))
+    if rows.size == 0:
+        raise InputError(f"robot '{robot.name}': no stance sample whose stance legs' joints all have a friction model")
+    without = base_residuals(robot, kin, np.zeros_like(tau_f), rows)
+    with_model = base_residuals(robot, kin, tau_f, rows)
+    rms = lambda r: float(np.sqrt(np.mean(r ** 2)))  # noqa: E731
+    return StanceCheck(int(rows.size), rms(without[:, :3]), rms(without[:, 3:]), rms(with_model[:, :3]),
+                       rms(with_model[:, 3:]))
+
+
+def log_stance_check(robot: Robot, log: Log, friction: Mapping[str, FrictionCurve]) -> StanceCheck:
+    """:func:`stance_check` on a log: its kinematics measured as ``estimate``'s acceleration route measures them (the
+    scheme and window its decision takes on the log's noise, :func:`~wbfriction.friction.decision.decide_log`), the
+    base's motion from its logged pose.
+
+    Raises:
+        InputError: a log without the base's pose; what :func:`stance_check` raises.
+    """
+    from wbfriction.friction.decision import decide_log
+    from wbfriction.friction.options import EstimateOptions
+    from wbfriction.signals.kinematics import measure
+    from wbfriction.signals.options import SCHEMES, Diff
+
+    if log.base is None:
+        raise InputError(f"{log.source}: the stance check needs the base's pose (base.x ... base.qw)")
+    options = decide_log(robot, EstimateOptions(route="acceleration"), log.q, log.dt, segments=log.segments,
+                         rows=len(log), source=log.source).options
+    diff = cast(Diff, options.diff if options.diff in SCHEMES else "central")  # decided: no longer "auto"
+    return stance_check(robot, measure(log, diff, filtering=options.filtering, base_motion=True), friction)
