@@ -123,9 +123,10 @@ def stretch_runs(runs: Sequence[tuple[int, int]], rows: tuple[int, int]) -> tupl
 
 def window_rows(horizon: float | None, period: float, rows: tuple[int, int]) -> int:
     """The samples of a window (a shot) of ``horizon`` seconds (None: the stretch) at the log ``period`` [s]:
-    ``round(horizon / period)`` (at least one) and no more than the stretch's."""
+    ``horizon / period`` rounded half up (at least one), a half within rounding of the period (a period read as the
+    median of stamps, ``0.0050000000000000044`` for 5 ms) counted as a half, and no more than the stretch's."""
     length = rows[1] - rows[0]
-    return length if horizon is None else min(length, max(1, int(round(horizon / period))))
+    return length if horizon is None else min(length, max(1, math.floor(horizon / period + 0.5 + 1e-9)))
 
 
 def check_window(source: str, horizon: float | None, period: float, rows: tuple[int, int]) -> None:
