@@ -150,7 +150,7 @@ def prepare_raw(table: pa.Table, robot: Robot, source: str, read: ReadOptions = 
     from wbfriction.logs.raw_table import condition_raw_table
     from wbfriction.logs.tables import numeric_columns
     from wbfriction.signals.contact_inference import MIN_SAMPLES, infer_contacts
-    from wbfriction.signals.leg_odometry import base_from_legs, imu_rotation
+    from wbfriction.signals.leg_odometry import base_from_legs, base_rotation, imu_rotation
 
     if robot.imu is None:
         raise InputError(f"{source}: robot '{robot.name}' has no [imu] in its TOML: a log without contact flags and "
@@ -176,25 +176,6 @@ def prepare_raw(table: pa.Table, robot: Robot, source: str, read: ReadOptions = 
                           source=source)
     out = _with_columns(table, robot, contacts.contact, base.pose, contacts.unconfident_rows())
     return PreparedLog(out, report, contacts, base)
-
-
-def base_rotation(robot: Robot, q: np.ndarray, r_imu: np.ndarray) -> np.ndarray:
-    """(N, 3, 3) the base's world rotation from the IMU frame's ``r_imu`` (N, 3, 3): ``R_b = R_imu R_bi(q)^T``, with
-    ``R_bi`` the IMU frame's rotation in the base frame (through the joints if its link is not the base)."""
-    import pinocchio as pin
-
-    assert robot.imu is not None
-    model, data = robot.model, robot.model.createData()
-    full = pin.neutral(model)
-    if model.frames[robot.imu.frame].parentJoint == 1:  # on the base link: one placement for every row
-        pin.framesForwardKinematics(model, data, full)
-        return r_imu @ data.oMf[robot.imu.frame].rotation.T
-    out = np.empty_like(r_imu)
-    for k in range(len(q)):
-        full[robot.act_q_index] = q[k]
-        pin.framesForwardKinematics(model, data, full)
-        out[k] = r_imu[k] @ data.oMf[robot.imu.frame].rotation.T
-    return out
 
 
 def _torque(table: pa.Table, robot: Robot, source: str, t: np.ndarray, q: np.ndarray) -> np.ndarray:
