@@ -21,8 +21,7 @@ simulator wrote beside it:
 
 from __future__ import annotations
 
-import subprocess
-import sys
+import shlex
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -91,9 +90,10 @@ class WalkingScore:
 
 
 def _run(args: list[str], cwd: Path) -> None:
-    done = subprocess.run([sys.executable, "-m", "wbfriction", *args], cwd=cwd, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise RuntimeError(f"wbfriction {' '.join(args)}: exit {done.returncode}: {done.stderr.strip()[-400:]}")
+    """``wbfriction <args>`` in ``cwd`` (:func:`~wbfriction.studies.real_data.run_route`)."""
+    from wbfriction.studies.real_data import run_route
+
+    run_route([shlex.join(["wbfriction", *args])], cwd)
 
 
 def simulate(case: WalkingCase, folder: Path, seed: int = 0) -> Path:
