@@ -22,7 +22,7 @@ Sign convention: ``tau_f = -f(qd)``, the torque friction exerts on the joint (th
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import cast
 
@@ -59,32 +59,35 @@ class StanceCheck:
                 "N·m with the friction fitted on the swings")
 
 
-def base_residuals(robot: Robot, kin: MeasuredKinematics, tau_f: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """(len(rows), 6) the base's residual (module docstring) at ``rows``: force [N] then moment [N·m], base frame.
+def base_residuals(robot: Robot, kin: MeasuredKinematics, tau_fs: Sequence[np.ndarray], rows: np.ndarray
+                   ) -> list[np.ndarray]:
+    """Per friction of ``tau_fs``, (len(rows), 6) the base's residual (module docstring) at ``rows``: force [N] then
+    moment [N·m], base frame; each row's dynamics and Jacobians computed once for every friction.
 
     Args:
         robot: a floating-base robot on point feet.
         kin: the log's kinematics with the base's motion (``kin.base``, ``base_qd``, ``base_qdd``).
-        tau_f: (N, n_act) the friction torque of every actuated joint [N·m] (0 for a joint without a model).
+        tau_fs: each (N, n_act), the friction torque of every actuated joint [N·m] (0 for a joint without a model).
         rows: the stance rows (a foot down at each).
     """
     model, data = robot.model, robot.model.createData()
     frames = [model.getFrameId(f) for f in robot.contact_frames]
     assert kin.base is not None and kin.base_qd is not None and kin.base_qdd is not None
-    out = np.empty((len(rows), 6))
+    out = [np.empty((len(rows), 6)) for _ in tau_fs]
     tau = np.zeros(model.nv)
+    joints = robot.act_v_index[robot.tc_index]
     for i, k in enumerate(rows):
         q = np.concatenate([kin.base[k], kin.q[k]])
         v = np.concatenate([kin.base_qd[k], kin.qd[k]])
         rhs = pin.rnea(model, data, q, v, np.concatenate([kin.base_qdd[k], kin.qdd[k]]))  # M a + h
         pin.computeJointJacobians(model, data, q)
-        pin.framesForwardKinematics(model, data, q)
         J = np.vstack([pin.getFrameJacobian(model, data, frames[c], pin.LOCAL_WORLD_ALIGNED)[:3]
                        for c in np.flatnonzero(kin.contact[k])])
-        tau[robot.act_v_index[robot.tc_index]] = kin.tau[k] + tau_f[k, robot.tc_index]
         legs = np.flatnonzero(np.abs(J[:, 6:]).sum(axis=0) > 0) + 6
-        f = np.linalg.lstsq(J[:, legs].T, (rhs - tau)[legs], rcond=None)[0]
-        out[i] = (rhs - tau - J.T @ f)[:6]
+        for residual, tau_f in zip(out, tau_fs):
+            tau[joints] = kin.tau[k] + tau_f[k, robot.tc_index]
+            f = np.linalg.lstsq(J[:, legs].T, (rhs - tau)[legs], rcond=None)[0]
+            residual[i] = (rhs - tau - J.T @ f)[:6]
     return out
 
 
@@ -117,8 +120,7 @@ def stance_check(robot: Robot, kin: MeasuredKinematics, friction: Mapping[str, F
                           & ~(kin.contact & ~modelled[None, :]).any(axis=1))
     if rows.size == 0:
         raise InputError(f"robot '{robot.name}': no stance sample whose stance legs' joints all have a friction model")
-    without = base_residuals(robot, kin, np.zeros_like(tau_f), rows)
-    with_model = base_residuals(robot, kin, tau_f, rows)
+    without, with_model = base_residuals(robot, kin, (np.zeros_like(tau_f), tau_f), rows)
     rms = lambda r: float(np.sqrt(np.mean(r ** 2)))  # noqa: E731
     return StanceCheck(int(rows.size), rms(without[:, :3]), rms(without[:, 3:]), rms(with_model[:, :3]),
                        rms(with_model[:, 3:]))

@@ -69,6 +69,20 @@ def hysteresis(x: np.ndarray, on: float, off: float) -> np.ndarray:
     return np.where(last >= 0, state, initial)
 
 
+def flag_column(table: pa.Table, name: str, source: str, first_row: int = 0) -> np.ndarray:
+    """The column ``name`` of 0/1 flags (numbers or booleans) as booleans (N,).
+
+    Raises:
+        ColumnError: a value other than 0 and 1, naming the column and the row.
+    """
+    x = numeric_column(table, name, source, first_row)
+    bad = np.flatnonzero((x != 0) & (x != 1))
+    if bad.size:
+        raise ColumnError(source, name, int(first_row + bad[0]),
+                          f"column '{name}' must hold 0 or 1, found {x[bad[0]]:g} at row {first_row + bad[0]}")
+    return x.astype(bool)
+
+
 def read_unsure(table: pa.Table, source: str, first_row: int) -> np.ndarray | None:
     """The ``unsure`` column (0/1) as booleans, or None: the rows whose contact flags were inferred without
     confidence (:mod:`wbfriction.pipeline.raw_log`), which no route estimates.
@@ -76,11 +90,4 @@ def read_unsure(table: pa.Table, source: str, first_row: int) -> np.ndarray | No
     Raises:
         ColumnError: a value other than 0 and 1, naming the row.
     """
-    if "unsure" not in table.column_names:
-        return None
-    x = numeric_column(table, "unsure", source, first_row)
-    bad = np.flatnonzero((x != 0) & (x != 1))
-    if bad.size:
-        raise ColumnError(source, "unsure", int(first_row + bad[0]),
-                          f"column 'unsure' must hold 0 or 1, found {x[bad[0]]:g} at row {first_row + bad[0]}")
-    return x.astype(bool)
+    return flag_column(table, "unsure", source, first_row) if "unsure" in table.column_names else None

@@ -46,7 +46,14 @@ from wbfriction.exceptions import ColumnError, InputError
 from wbfriction.logs.angles import check_limits, imu_orientation, unwrap_positions
 from wbfriction.logs.clock import JITTER, Clock, read_clock, split_at_gaps, table_stamps
 from wbfriction.logs.columns import BASE_COLUMNS, BASE_QD_TRUE_COLUMNS, BASE_QDD_TRUE_COLUMNS, IMU_COLUMNS
-from wbfriction.logs.contacts import default_thresholds, hysteresis, normal_forces, read_unsure, sensed_contacts
+from wbfriction.logs.contacts import (
+    default_thresholds,
+    flag_column,
+    hysteresis,
+    normal_forces,
+    read_unsure,
+    sensed_contacts,
+)
 from wbfriction.logs.foot_forces import column_names as foot_force_names
 from wbfriction.logs.foot_forces import foot_force_columns, foot_force_table, read_foot_forces
 from wbfriction.logs.options import MAX_GAP, ReadOptions
@@ -475,14 +482,7 @@ def _read_contact(table: pa.Table, robot: Robot, source: str, first_row: int,
     if not any(f"contact.{f}" in table.column_names for f in robot.contact_frames) and \
             forces_give_contacts(robot, table.column_names):
         return contact_flags_from_forces(robot, wrench, foot_force)
-    contact_cols = []
-    for f in robot.contact_frames:
-        c = numeric_column(table, f"contact.{f}", source, first_row)
-        bad = np.flatnonzero((c != 0) & (c != 1))
-        if bad.size:
-            raise ColumnError(source, f"contact.{f}", int(first_row + bad[0]),
-                              f"column 'contact.{f}' must hold 0 or 1, found {c[bad[0]]:g} at row {first_row + bad[0]}")
-        contact_cols.append(c.astype(bool))
+    contact_cols = [flag_column(table, f"contact.{f}", source, first_row) for f in robot.contact_frames]
     return np.column_stack(contact_cols)
 
 
