@@ -71,8 +71,8 @@ def _run_estimate(r: Robot, spec: RobotSpec, log: Path, output: Path, opts: Esti
         result = estimate_source(spec, log, output, opts, bag_map=bag_map, robot=r, stage=status,
                                  progress=lambda total: status.steps("estimate", total, "samples"),
                                  chunking=Chunking(rows=chunk_rows, workers=workers), companion=companion, read=read)
-    for line in result.prepared:  # a raw walking log made the project's log (wbfriction.pipeline.raw_log)
-        console.print(escape(line), highlight=False, soft_wrap=True)
+    for line in result.prepared:  # a raw walking log made the project's log (wbfriction.pipeline.raw_log): wrapped
+        console.print(escape(line), highlight=False, soft_wrap=False)
     console.print(escape(result.clock), highlight=False, soft_wrap=True)
     warn(result.warnings)
     if result.differentiation:
