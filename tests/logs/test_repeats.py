@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from helpers import logger_sampling
+from wbfriction.logs.clock import LATTICE_TOL
 from wbfriction.logs.repeats import find_repeats, repeated_rows
 
 
@@ -61,15 +62,25 @@ def test_repeats_at_the_loggers_own_period_are_kept():
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(drive=st.floats(1.5e-3, 5e-3), ratio=st.floats(1.5, 4.0), hold=st.sampled_from([0.0, 0.01, 0.05]),
        phase=st.floats(0.0, 1.0), seed=st.integers(0, 1000))
+@example(drive=0.00390625, ratio=1.5546875, hold=0.05, phase=0.75, seed=849)  # a step misread by rounding
+@example(drive=0.0036926139374955573, ratio=2.023551390966379, hold=0.0, phase=0.5711078240273729, seed=307)
+@example(drive=0.002387418499341829, ratio=2.0007513657768, hold=0.0, phase=0.2865949204654039, seed=991)
+@example(drive=0.0022240138884349436, ratio=1.997102059059157, hold=0.05, phase=0.1042598370728598, seed=28)
+@example(drive=0.004990220654889142, ratio=1.5952104947597685, hold=0.05, phase=0.3511698467384696, seed=904)
 def test_any_drive_clock_read_by_a_faster_logger_is_found(drive, ratio, hold, phase, seed):
     logger = drive / ratio
     stamps, values, true, shown = logger_sampling(drive, logger, 600 * drive, hold, phase * drive, 1e-3, seed)
     found = find_repeats(values, stamps)
     np.testing.assert_array_equal(found.repeat, np.concatenate([[False], np.diff(shown) == 0]))
     assert found.merge
-    assert found.clock is not None and found.clock.period == pytest.approx(drive, rel=1e-3)
+    # what the stamps fix: a clock explaining every sample puts each in its window (one logger period, within
+    # LATTICE_TOL), so two such clocks differ by at most two windows over the span (near a rational ratio with
+    # holds, several do); the re-estimated times lie in their windows
+    window = (1 + LATTICE_TOL) * logger
+    assert found.clock is not None
+    assert found.clock.period == pytest.approx(drive, rel=2 * window / (stamps[-1] - stamps[0]))
     err = np.abs(found.times(stamps) - true[np.unique(shown)])
-    assert err.max() <= 0.5 * logger * (1 + 1e-6)  # the windows are one logger period wide: within half of one
+    assert err.max() <= window and np.median(err) <= 0.5 * logger
 
 
 def test_merged_samples_are_read_as_the_drives_clock_not_as_jitter():

@@ -11,13 +11,20 @@ re-estimates the distinct samples' true times from the runs with the drives' own
 * the drives' clock is regular: ``T_j = T0 + P_d n_j`` with whole tick numbers ``n_j``; a drive period that was
   held (no new sample: a run about twice as long) is a step of two ticks, a whole-period skip, not jitter.
 
-The clock is fitted by rounding the steps to whole periods, then refining the period by least squares on the
-whole tick numbers, over prefixes of the samples that double (the tick numbers stay right as the period sharpens),
-and ``T0`` is the middle of the offsets that put every sample in its window. The repeats are merged only when such
-a clock explains every sample (:attr:`DriveClock.feasible`) with a period longer than the logger's by more than
-:data:`~wbfriction.logs.clock.LATTICE_TOL`: repeats on a clock no slower than the logger's are the drives'
-own values sampled again (a still robot, a quantised sensor), kept as rows. A logger less than that share faster
-than its drives, or less than about 1.5 times as fast with many holds, is not told apart.
+The tick numbers come from rounding the steps to whole periods, then refining the period by least squares on the
+whole tick numbers over prefixes of the samples that double (the tick numbers stay right as the period sharpens). A
+single step is ambiguous when the logger is less than twice as fast as its drives, or a period was held, so the
+rounding starts from several first prefixes (:data:`START_SIZES`) at either end, from the whole span, and from no
+hold at all; of the clocks that explain every sample, the one holding the fewest periods is kept. At its tick
+numbers the period is the one that puts the samples' delays in the narrowest band (a minimax line: delays spread
+uniformly over a logger period fix it to O(1/K), least squares only to O(1/sqrt(K))), and ``T0`` is the middle of
+the offsets that put every sample in its window. Near a rational ratio with holds (a logger within about 0.1 % of 2
+or 3 times its drives' rate) several clocks explain every sample: the period is then fixed only to two windows over
+the span, each re-estimated time to its window. The repeats are merged only when such a clock explains every sample
+(:attr:`DriveClock.feasible`) with a period longer than the logger's by more than
+:data:`~wbfriction.logs.clock.LATTICE_TOL`: repeats on a clock no slower than the logger's are the drives' own
+values sampled again (a still robot, a quantised sensor), kept as rows. A logger less than that share faster than
+its drives, or less than about 1.5 times as fast with many holds, is not told apart.
 """
 
 from __future__ import annotations
@@ -25,11 +32,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from wbfriction.logs.clock import LATTICE_TOL
 
 MIN_DISTINCT = 8
 """Distinct samples below which no drive clock is fitted (two unknowns and their check need a few)."""
+
+START_SIZES = (32, 8, 16, 64, 128)
+"""The first prefixes the clock's ticks are rounded on: a step misread in one (an ambiguous step: a logger less
+than twice as fast as its drives, or a hold) is absent from another."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -163,6 +175,58 @@ def fit_drive_clock(first: np.ndarray, logger_period: float, jitter: float = 0.0
     """
     t = np.asarray(first, dtype=float)
     rel = t - t[0]
+    width = logger_period * (1.0 + LATTICE_TOL) + 2.0 * jitter
+    back = rel[-1] - rel[::-1]  # the samples read from the end: a step misread near the start is not near it
+    starts = [ticks for size in START_SIZES + (len(rel),) if size <= len(rel)
+              for ticks in (_ticks_by_rounding(rel, logger_period, size),
+                            _reversed(_ticks_by_rounding(back, logger_period, size)))]
+    starts.append(np.arange(len(rel), dtype=float))  # no period held: the longest clock there can be
+    clocks = [_clock(t, ticks, logger_period, width) for ticks in starts]
+    feasible = [c for c in clocks if c.feasible]
+    if feasible:  # the fewest periods held (a clock with more holds periods the drives did not), then the narrowest
+        return min(feasible, key=lambda c: (c.holds, c.spread))
+    return min(clocks, key=lambda c: c.spread)
+
+
+def _clock(t: np.ndarray, ticks: np.ndarray, logger_period: float, width: float) -> DriveClock:
+    """The clock at these tick numbers whose period puts the samples' delays in the narrowest band.
+
+    The band's width ``max_j r_j - min_j r_j`` of the residuals ``r_j = t_j - t_0 - P n_j`` is convex in ``P``
+    (a maximum of lines minus a minimum of lines); it is minimised around least squares' period. A true clock's
+    delays lie within one logger period."""
+    rel = t - t[0]
+    ticks = (ticks - ticks[0]).astype(float)
+    _, guess = _line(ticks, rel - 0.5 * logger_period)
+    if guess > 0 and ticks[-1] > 0:
+        def band(period: float) -> float:
+            r = rel - period * ticks
+            return float(np.max(r) - np.min(r))
+
+        reach = 2.0 * logger_period / ticks[-1]  # least squares is within a band's width over the span
+        best = minimize_scalar(band, bounds=(guess - reach, guess + reach), method="bounded",
+                               options={"xatol": 1e-12 * guess})
+        period = float(best.x) if best.fun <= band(guess) else guess
+    else:
+        period = guess
+    resid = rel - period * ticks
+    low = float(np.max(resid - logger_period))  # t0 > t_j - P_l - P n_j for every j
+    high = float(np.min(resid))  # t0 <= t_j - P n_j
+    spread = float(np.max(resid) - np.min(resid))
+    feasible = bool(period > 0 and spread <= width)
+    offset = 0.5 * (low + high)  # the band centred on the windows (any excess shared by both ends)
+    times = t[0] + offset + period * ticks
+    return DriveClock(period, float(t[0] + offset), ticks.astype(np.int64), times, spread, feasible)
+
+
+def _reversed(ticks: np.ndarray) -> np.ndarray:
+    """Tick numbers found on the samples read from the end, in the samples' order."""
+    return ticks[-1] - ticks[::-1]
+
+
+def _ticks_by_rounding(rel: np.ndarray, logger_period: float, size: int) -> np.ndarray:
+    """Tick numbers from the steps rounded to whole periods, then least squares on prefixes that double (the
+    ticks re-rounded from the sharper clock). Fast, and right unless a step is ambiguous (a logger less than
+    twice as fast as its drives, with holds)."""
     steps = np.diff(rel)
     period = float(rel[-1] / max(len(rel) - 1, 1))
     for _ in range(20):  # whole periods per step, the period from the whole span
@@ -173,25 +237,16 @@ def fit_drive_clock(first: np.ndarray, logger_period: float, jitter: float = 0.0
         period = new
     ticks = np.concatenate([[0.0], np.cumsum(np.maximum(1, np.rint(steps / period)))])
     centre = rel - 0.5 * logger_period  # the middle of each sample's window
-    size = min(len(rel), 32)
-    while True:  # least squares on prefixes that double; the ticks re-rounded from the sharper clock
+    size = min(len(rel), size)
+    while True:
         for _ in range(3):
             offset, period = _line(ticks[:size], centre[:size])
             if not period > 0:
-                break
+                return ticks
             ticks = _monotone(np.rint((centre - offset) / period))
-        if size == len(rel) or not period > 0:
-            break
+        if size == len(rel):
+            return ticks
         size = min(2 * size, len(rel))
-    ticks = ticks - ticks[0]
-    resid = rel - period * ticks
-    low = float(np.max(resid - logger_period))  # t0 > t_j - P_l - P n_j for every j
-    high = float(np.min(resid))  # t0 <= t_j - P n_j
-    spread = float(np.max(resid) - np.min(resid))
-    feasible = bool(period > 0 and spread <= logger_period * (1.0 + LATTICE_TOL) + 2.0 * jitter)
-    offset = 0.5 * (low + high) if high >= low else float(np.mean(resid)) - 0.5 * logger_period
-    times = t[0] + offset + period * ticks
-    return DriveClock(period, float(t[0] + offset), ticks.astype(np.int64), times, spread, feasible)
 
 
 def _line(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
