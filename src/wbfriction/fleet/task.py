@@ -2,7 +2,8 @@
 
 :func:`process_log` is what a Dask task runs, and what the serial run calls in order: the same function, so the
 results are the same bytes. It does what ``wbfriction estimate LOG`` and ``wbfriction fit`` do with the same
-options (:func:`~wbfriction.pipeline.estimate_step.estimate_file` on one process, then
+options (a walking robot's raw log first made the project's log, :func:`~wbfriction.pipeline.raw_log.prepared_log`;
+:func:`~wbfriction.pipeline.estimate_step.estimate_file` on one process, then
 :func:`~wbfriction.pipeline.fit_step.fit_table`, what ``fit`` runs before it writes).
 
 Sign convention: ``tau_f`` is the torque friction exerts on the joint; the model ``f(qd)`` is fitted to
@@ -30,11 +31,13 @@ from wbfriction.fit.terms import TermFit, load_torque
 from wbfriction.fleet.manifest import LogEntry
 from wbfriction.fleet.options import BatchOptions
 from wbfriction.fleet.schema import REFERENCE_SPEEDS, RESULT_SCHEMA, TREND_PARAMS, speed_column
+from wbfriction.logs.options import ReadOptions
 from wbfriction.logs.tables import file_sha256, scratch_folder
 from wbfriction.model.robot import Robot
 from wbfriction.pipeline.chunks import Chunking
 from wbfriction.pipeline.estimate_step import ChunkExecutor, RobotSpec, estimate_file, worker_robot
 from wbfriction.pipeline.fit_step import fit_table
+from wbfriction.pipeline.raw_log import prepared_log
 from wbfriction.version import __version__
 
 
@@ -125,9 +128,10 @@ def process_log(entry: LogEntry, key: ResultKey, options: BatchOptions, scratch:
         robot = worker_robot(entry.robot)
         with threadpool_limits(1), scratch_folder(scratch) as folder:
             friction = table if table is not None else folder / "friction.parquet"
-            estimate_file(entry.robot, entry.log, friction, options.estimate, chunking=Chunking(
-                rows=options.chunk_rows, workers=chunk_workers if executor is not None else 1), robot=robot,
-                executor=executor)
+            with prepared_log(Path(entry.log), robot, str(entry.log), ReadOptions(), friction) as (log, _):
+                estimate_file(entry.robot, log, friction, options.estimate, chunking=Chunking(
+                    rows=options.chunk_rows, workers=chunk_workers if executor is not None else 1), robot=robot,
+                    executor=executor, source=str(entry.log))
             fitted = fit_table(friction, options.fit, threshold=options.energy_threshold,
                                tolerance=options.energy_tolerance)
         est = fitted.est
