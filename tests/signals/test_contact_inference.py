@@ -14,6 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wbfriction.exceptions import InputError, OptionError
+from wbfriction.logs.contacts import OFF_SHARE
 from wbfriction.model.loading import load_robot
 from wbfriction.signals.contact_inference import (
     LIFT_SIGMAS,
@@ -27,10 +28,9 @@ from wbfriction.signals.contact_inference import (
     lifted_unloaded,
     weight,
 )
+from wbfriction.sim.logger import ORIENTATION_STD
 from wbfriction.sim.quadruped import QuadrupedOptions
 from wbfriction.sim.quadruped_mjcf import build_quadruped_model
-from wbfriction.logs.contacts import OFF_SHARE
-from wbfriction.sim.logger import ORIENTATION_STD
 from wbfriction.sim.quadruped_mujoco import UNITREE_NOISE, simulate_quadruped_mujoco
 from wbfriction.walking.quadruped import GaitOptions, quadruped_reference
 
@@ -118,8 +118,8 @@ def test_a_standing_log_with_noisy_feet_is_refused(robot, mjr):
     sigma = float(np.median(low[:, 1] - low[:, 0])) / ROBUST_SCALE
     assert lifted_unloaded(h, sigma, forces[..., 2], weight(robot)).any()  # what passed before
     with pytest.raises(InputError, match=r"^stand.parquet: no foot ever leaves the ground \(a standing log\): the "
-                       r"longest run of samples with a foot lifted and unloaded is \d+ \(\d+ ms, \w+_foot\), against the "
-                       r"24 \(48 ms\) a swing needs") as refused:
+                       r"longest run of samples with a foot lifted and unloaded is \d+ \(\d+ ms, \w+_foot\), "
+                       r"against the 24 \(48 ms\) a swing needs") as refused:
         infer_contacts(robot, log.q, log.qd_logged, log.tau, imu, reference.dt, source="stand.parquet")
     assert "\n" not in str(refused.value)
 

@@ -299,12 +299,20 @@ def least_swing(samples: int, feet: int) -> int:
     (:func:`lifted_unloaded`), so noise symmetric about them lifts and unloads it on each sample with a probability
     ``p <= 1/2``; on independent samples (the repeats merged) a run of ``k`` starts at a given sample with a
     probability ``p^k <= 2^-k``, and anywhere in the log's ``samples * feet`` with at most ``samples * feet * 2^-k``.
-    The least ``k`` that keeps this below :data:`SWING_LEVEL` follows: 23 samples for 2000 samples of 4 feet (4 s
-    at 2 ms), 29 for 100 000. It follows from the test level and the log's size, not from a gait: a swing is at least this long
-    lifted and unloaded, or noise alone could have made it. (The thesis's lift-off and touch-down margins, 0.15 s
-    together, are longer than what a swing holds lifted and unloaded: on the MuJoCo Go2 the leg's inertia, left out
-    of the torques' force, reads as load over the swing's second half, and a walk's runs last 72-84 ms of its
-    0.2 s swings.)"""
+    The least ``k`` that keeps this below :data:`SWING_LEVEL` follows: 23 samples for 2000 samples of 4 feet (4 s at
+    2 ms), 29 for 100 000. It follows from the test level and the log's size, not from a gait: a swing is at least
+    this long lifted and unloaded, or noise alone could have made it. A swing that holds its foot lifted and
+    unloaded for fewer samples (a log sampled coarsely: 5 ms and more for the Go2's walk below) is not told from
+    noise, and the log is refused.
+
+    The thesis's lift-off and touch-down margins (0.15 s together) are longer than what a swing holds lifted and
+    unloaded: on the MuJoCo Go2 the leg's inertia, left out of the torques' force, reads as load over a swing's second
+    half, and a foot's longest run in its walks and trots lasts 54-104 ms of 0.2-0.25 s swings (27-52 samples at
+    2 ms). The standing twin's noise makes runs of 2-6 samples.
+
+    Raises:
+        InputError: no samples or no feet.
+    """
     if samples < 1 or feet < 1:
         raise InputError(f"a swing's least run needs a log of samples and feet, got {samples} x {feet}")
     return int(np.ceil(np.log2(samples * feet / SWING_LEVEL)))
@@ -343,8 +351,9 @@ def check_swings(lifted: np.ndarray, dt: float, frames: tuple[str, ...], source:
     runs, need = longest_runs(lifted), least_swing(n, nc)
     if runs.max() < need:
         c = int(np.argmax(runs))
-        found = (f"the longest run of samples with a foot lifted and unloaded is {runs[c]} ({runs[c] * dt * 1e3:.3g} ms,"
-                 f" {frames[c]})" if runs[c] else "no sample has a foot lifted and unloaded")
+        run = f"{runs[c]} ({runs[c] * dt * 1e3:.3g} ms, {frames[c]})"
+        found = f"the longest run of samples with a foot lifted and unloaded is {run}" if runs[c] else \
+            "no sample has a foot lifted and unloaded"
         raise InputError(f"{source}: no foot ever leaves the ground (a standing log): {found}, against the "
                          f"{need} ({need * dt * 1e3:.3g} ms) a swing needs (noise alone makes a shorter one with a "
                          f"probability above {SWING_LEVEL:g}); contacts cannot be inferred without foot forces")
