@@ -30,6 +30,12 @@ Each foot is a two-state hidden Markov model (swing, stance) whose emission is t
 (``max(p, 1 - p)``), and a sample whose confidence is below ``options.level`` is not confident (the integrator
 leaves it out of the friction and counts it).
 
+A log where no foot swings is refused (:func:`check_swings`): a foot swings where it is lifted and unloaded
+(:func:`lifted_unloaded`) for a run of consecutive samples at least :func:`least_swing` long, the run that noise
+alone on a standing robot makes with a probability below :data:`SWING_LEVEL`; isolated samples that cross the
+thresholds (a stance foot's load near them, a bounce on a soft ground) are not a swing. Nothing is determined on a
+standing log without foot forces.
+
 The foot's velocity relative to the base against the stance group's (stance feet move together relative to the
 base) is not a cue here: on the MuJoCo Go2, whose spherical feet roll, it lowered the trot's agreement from 98 % to
 93 % (the rolling sphere's centre moves while the foot stands).
@@ -53,11 +59,16 @@ CUES = ("torque", "kinematics", "counts", "periodicity")
 """The cues, as :attr:`InferredContacts.cues` names them."""
 
 LIFT_SIGMAS = 5.0
-"""A foot leaves the ground where its height exceeds this many of the stance feet's height noise (``sigma_h``) and,
-with the torque cue, the force its leg's torques imply is below the contact flags' own off threshold
-(:data:`~wbfriction.logs.contacts.OFF_SHARE` of the weight): a standing robot on a soft ground sinks a foot by
-millimetres as its load shifts (2.1 mm against 5 sigma = 1.9 mm on the MuJoCo twin), and no such foot is unloaded
-(its least force 6-16 % of the weight)."""
+"""A sample has its foot lifted and unloaded where the foot's height exceeds this many of the stance feet's height
+noise (``sigma_h``) and, with the torque cue, the force its leg's torques imply is below the contact flags' own off
+threshold (:data:`~wbfriction.logs.contacts.OFF_SHARE` of the weight): a standing robot on a soft ground sinks a
+foot by millimetres as its load shifts (2.1 mm against 5 sigma = 1.9 mm on the MuJoCo twin). A foot leaves the
+ground only where such samples make a run of :func:`least_swing` (:func:`check_swings`)."""
+
+SWING_LEVEL = 0.00135
+"""The test level of the standing refusal (:func:`least_swing`): the probability that noise alone on a standing
+robot makes a run of lifted-and-unloaded samples as long as a swing needs, anywhere in the log (one-sided 3
+standard deviations, 0.13 %)."""
 
 MIN_SAMPLES = 100
 """Fewer samples: too short for the inference (the noise, the feet's highest and the period measured on them)."""
@@ -272,6 +283,83 @@ def _force_densities(f: np.ndarray, swing: np.ndarray, weight_n: float) -> np.nd
     return out
 
 
+def lifted_unloaded(h: np.ndarray, sigma: float, fz: np.ndarray | None, weight_n: float) -> np.ndarray:
+    """(N, n_c) bool: the samples whose foot is lifted (its height ``h`` [m] above :data:`LIFT_SIGMAS` times the
+    stance feet's height noise ``sigma`` [m]) and unloaded (the vertical force ``fz`` [N] its leg's torques imply
+    below :data:`~wbfriction.logs.contacts.OFF_SHARE` of the weight ``weight_n`` [N]; ``fz`` None: lifted alone)."""
+    lifted = np.asarray(h) > LIFT_SIGMAS * sigma
+    return lifted if fz is None else lifted & (np.asarray(fz) < OFF_SHARE * weight_n)
+
+
+def least_swing(samples: int, feet: int) -> int:
+    """The fewest consecutive samples of a foot lifted and unloaded that make a swing: ``ceil(log2(samples * feet /
+    SWING_LEVEL))``.
+
+    A foot that stands has its mean height and load on the stance side of both thresholds
+    (:func:`lifted_unloaded`), so noise symmetric about them lifts and unloads it on each sample with a probability
+    ``p <= 1/2``; on independent samples (the repeats merged) a run of ``k`` starts at a given sample with a
+    probability ``p^k <= 2^-k``, and anywhere in the log's ``samples * feet`` with at most ``samples * feet * 2^-k``.
+    The least ``k`` that keeps this below :data:`SWING_LEVEL` follows: 23 samples for 2000 samples of 4 feet (4 s at
+    2 ms), 29 for 100 000. It follows from the test level and the log's size, not from a gait: a swing is at least
+    this long lifted and unloaded, or noise alone could have made it. A swing that holds its foot lifted and
+    unloaded for fewer samples (a log sampled coarsely: 5 ms and more for the Go2's walk below) is not told from
+    noise, and the log is refused.
+
+    The thesis's lift-off and touch-down margins (0.15 s together) are longer than what a swing holds lifted and
+    unloaded: on the MuJoCo Go2 the leg's inertia, left out of the torques' force, reads as load over a swing's second
+    half, and a foot's longest run in its walks and trots lasts 54-104 ms of 0.2-0.25 s swings (27-52 samples at
+    2 ms). The standing twin's noise makes runs of 2-6 samples.
+
+    Raises:
+        InputError: no samples or no feet.
+    """
+    if samples < 1 or feet < 1:
+        raise InputError(f"a swing's least run needs a log of samples and feet, got {samples} x {feet}")
+    return int(np.ceil(np.log2(samples * feet / SWING_LEVEL)))
+
+
+def longest_runs(mask: np.ndarray) -> np.ndarray:
+    """(n_c,) int: each column's longest run of consecutive True in the (N, n_c) bool ``mask`` (0 for none)."""
+    mask = np.asarray(mask, dtype=bool)
+    out = np.zeros(mask.shape[1], dtype=int)
+    for c in range(mask.shape[1]):
+        edges = np.diff(np.r_[0, mask[:, c].astype(np.int8), 0])
+        starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        out[c] = int((ends - starts).max()) if len(starts) else 0
+    return out
+
+
+def check_swings(lifted: np.ndarray, dt: float, frames: tuple[str, ...], source: str = "<log>") -> np.ndarray:
+    """Refuse a log where no foot swings: no run of lifted-and-unloaded samples (``lifted``, (N, n_c) bool, from
+    :func:`lifted_unloaded`) as long as :func:`least_swing` (isolated samples are noise: a stance foot near the
+    thresholds, a bounce on a soft ground).
+
+    Args:
+        lifted: (N, n_c) bool, the samples whose foot is lifted and unloaded, feet in ``frames`` order.
+        dt: the sample period [s] (the message's durations).
+        frames: the feet's names.
+        source: the log's name, for the message.
+
+    Returns:
+        (n_c,) int: each foot's longest run [samples].
+
+    Raises:
+        InputError: no foot's longest run reaches :func:`least_swing`: one line with the longest run found (samples,
+            milliseconds, the foot) against the run a swing needs.
+    """
+    n, nc = lifted.shape
+    runs, need = longest_runs(lifted), least_swing(n, nc)
+    if runs.max() < need:
+        c = int(np.argmax(runs))
+        run = f"{runs[c]} ({runs[c] * dt * 1e3:.3g} ms, {frames[c]})"
+        found = f"the longest run of samples with a foot lifted and unloaded is {run}" if runs[c] else \
+            "no sample has a foot lifted and unloaded"
+        raise InputError(f"{source}: no foot ever leaves the ground (a standing log): {found}, against the "
+                         f"{need} ({need * dt * 1e3:.3g} ms) a swing needs (noise alone makes a shorter one with a "
+                         f"probability above {SWING_LEVEL:g}); contacts cannot be inferred without foot forces")
+    return runs
+
+
 def _check(robot: Robot, arrays: dict[str, np.ndarray], dt: float, source: str) -> int:
     n = len(arrays["q"])
     for name, x in arrays.items():
@@ -315,7 +403,8 @@ def infer_contacts(robot: Robot, q: np.ndarray, qd: np.ndarray, tau: np.ndarray,
 
     Raises:
         InputError: arrays of the wrong shape or not finite, fewer than :data:`MIN_SAMPLES` samples, a log where no
-            foot ever leaves the ground (a standing robot: nothing determined without foot forces).
+            foot ever leaves the ground (a standing robot: nothing determined without foot forces): no foot lifted
+            and unloaded for a run of :func:`least_swing` samples (:func:`check_swings`).
         OptionError: ``dt`` not > 0.
     """
     arrays = {"q": np.asarray(q, float), "qd": np.asarray(qd, float), "tau": np.asarray(tau, float)}
@@ -329,12 +418,9 @@ def infer_contacts(robot: Robot, q: np.ndarray, qd: np.ndarray, tau: np.ndarray,
     low = np.sort(z, axis=1)
     h = z - low[:, : max(1, nc // 2)].mean(axis=1, keepdims=True)
     sigma = max(float(np.median(low[:, 1] - low[:, 0])) / ROBUST_SCALE, 1e-6)
-    lifted = h > LIFT_SIGMAS * sigma
-    if options.torque:  # and unloaded: a stance foot sinks into a soft ground by millimetres as its load shifts
-        lifted &= forces[..., 2] < OFF_SHARE * weight(robot)
-    if not lifted.any():
-        raise InputError(f"{source}: no foot ever leaves the ground (a standing log): contacts cannot be inferred "
-                         "without foot forces")
+    # lifted and unloaded (a stance foot sinks into a soft ground by millimetres as its load shifts) for a run
+    check_swings(lifted_unloaded(h, sigma, forces[..., 2] if options.torque else None, weight(robot)), dt,
+                 robot.contact_frames, source)
     cues = ["kinematics"]
     logh = _height_densities(h, sigma)
     first = np.stack([_posterior(logh[:, c], 2.0 / n) for c in range(nc)], axis=1)
