@@ -5,9 +5,10 @@ and collision geometry and the URDF's ``<dynamics>`` dropped), with
 
 * a free joint at the root (a floating base) and a ground plane (``z = 0``, flat and horizontal);
 * one sphere per contact frame (:attr:`Robot.contact_frames <wbfriction.model.robot.Robot.contact_frames>`, the
-  robot's point feet), of the gait's radius (:func:`wbfriction.walking.quadruped.foot_sphere`: the robot's ``foot_radius``, else the
-  Go2's 2.3 cm: where the gait plans a standing foot's frame), **centred on the contact frame's origin** (Unitree's feet are rubber balls
-  about 2 cm in radius round the ``<leg>_foot`` frame), the only geometry that collides: soft point
+  robot's point feet), of the gait's radius (:func:`wbfriction.walking.quadruped.foot_sphere`: the robot's
+  ``foot_radius``, else the Go2's 2.3 cm: where the gait plans a standing foot's frame), **centred on the contact
+  frame's origin** (Unitree's feet are rubber balls about 2 cm in radius round the ``<leg>_foot`` frame), the only
+  geometry that collides: soft point
   contacts with MuJoCo's default ``solref``/``solimp``, ``condim`` 3 (normal and sliding friction, no torsional or
   rolling friction: the ground's action on a foot is one force at the contact point), sliding friction
   :data:`FOOT_FRICTION`;

@@ -208,16 +208,22 @@ def score_case(case: WalkingCase, folder: Path, twin: Path = TWIN_ROBOT) -> Walk
 
 
 def _stance(robot: Robot, prepared: pa.Table, params: Path, truth: dict) -> tuple[float, float, float]:
-    """The base's RMS moment residual on the stances without friction, with the fit's, with the truth's."""
+    """The base's RMS moment residual on the stances without friction, with the fit's, with the truth's (the fit's
+    NaN where the check refuses it: no stance whose legs' joints all have a fit)."""
+    from wbfriction.exceptions import InputError
     from wbfriction.fit.params_file import read_params
     from wbfriction.fit.stance_check import log_stance_check
     from wbfriction.friction.models import target_from_dict
     from wbfriction.logs.log import log_from_table
 
     log = log_from_table(prepared, robot, "prepared")
-    fitted = log_stance_check(robot, log, {j: f.params for j, f in read_params(params).items() if f.params is not None})
     true = log_stance_check(robot, log, {j: target_from_dict(p) for j, p in truth["friction_true"].items()})
-    return fitted.moment_without, fitted.moment_with, true.moment_with
+    try:
+        fitted = log_stance_check(robot, log, {j: f.params for j, f in read_params(params).items()
+                                               if f.params is not None}).moment_with
+    except InputError:
+        fitted = float("nan")
+    return true.moment_without, fitted, true.moment_with
 
 
 def markdown(scores: list[WalkingScore]) -> str:

@@ -23,11 +23,11 @@ sums of sines of their own frequencies, phases from ``seed``).
 The feet start at their places in the robot's reference configuration, moved together along the base so that
 their centre (the diagonals' crossing) lies under the centre of mass. A foot's planned position is its contact
 frame's origin (a foot sphere's centre), at the robot's ``foot_radius`` (:func:`foot_sphere`; the Go2's
-:data:`FOOT_RADIUS` where its TOML gives none) above the ground while it stands. A stance foot does not move, and the base pose is planned; the leg joints
-follow by inverse kinematics (Newton iterations per sample, from the previous sample's angles), their velocities
-from ``J v = pd`` and accelerations from ``J a = pdd - Jd v`` (Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians of the
-feet), all analytic: the reference ``(q, v, a)`` keeps every stance foot still to machine precision at the
-acceleration level.
+:data:`FOOT_RADIUS` where its TOML gives none) above the ground while it stands. A stance foot does not move, and
+the base pose is planned; the leg joints follow by inverse kinematics (Newton iterations per sample, from the
+previous sample's angles), their velocities from ``J v = pd`` and accelerations from ``J a = pdd - Jd v``
+(Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians of the feet), all analytic: the reference ``(q, v, a)`` keeps every
+stance foot still to machine precision at the acceleration level.
 """
 
 from __future__ import annotations

@@ -95,6 +95,7 @@ def scaled_gait(robot: Robot, given: dict[str, Any], seed: int = 0) -> GaitOptio
     given = {k: v for k, v in given.items() if v is not None}
     nominal = GaitOptions(seed=seed, **given)
     scale = robot_scale(robot)
-    scaled = {"base_height": nominal.base_height * scale.length, "step_height": nominal.step_height * scale.length,
-              "period": nominal.period * scale.time, "speed": nominal.speed * scale.time, "scale": scale.length}
+    scaled: dict[str, Any] = {"base_height": nominal.base_height * scale.length,
+                              "step_height": nominal.step_height * scale.length, "period": nominal.period * scale.time,
+                              "speed": nominal.speed * scale.time, "scale": scale.length}
     return replace(nominal, **{k: v for k, v in scaled.items() if k not in given})
