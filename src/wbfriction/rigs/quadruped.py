@@ -191,14 +191,17 @@ class QuadrupedRig(Rig):
     def run_options(robot: Robot, o: QuadrupedSimulation) -> dict[str, Any]:
         """The :class:`~wbfriction.sim.quadruped.QuadrupedOptions` fields the options give: ``drive`` (the
         ``actuator``), the sensor noise, ``foot_forces``, ``physics_dt`` (2 ms periods over ``substeps``) and the
-        friction.
+        friction; the torque drive's gains ``kp``, ``kd``, the defaults' scaled to the robot's size
+        (:func:`~wbfriction.walking.scale.robot_scale`: the Go2's as they are).
 
         Raises:
             InputError: a sensor delay; a friction file with terms beyond velocity or a temperature; a gait of a
                 walk.
         """
         from wbfriction.fit.targets import load_friction_spec
+        from wbfriction.sim.quadruped import QuadrupedOptions
         from wbfriction.walking.quadruped import GAITS
+        from wbfriction.walking.scale import robot_scale
 
         noise, lag = o.noise()
         if lag:
@@ -212,7 +215,9 @@ class QuadrupedRig(Rig):
         if spec is not None and (spec.terms or spec.temperature is not None):
             raise InputError(f"{o.friction}: a walking quadruped's simulation takes friction models per joint, "
                              "without terms beyond velocity or a temperature")
+        scale = robot_scale(robot)
         return {"drive": o.actuator or "torque", "noise": noise, "foot_forces": o.foot_forces,
+                "kp": QuadrupedOptions.kp * scale.torque, "kd": QuadrupedOptions.kd * scale.damping,
                 **({} if substeps is None else {"physics_dt": 0.002 / substeps}),
                 "friction": None if spec is None else spec.params}
 
@@ -220,14 +225,15 @@ class QuadrupedRig(Rig):
     def reference(robot: Robot, o: QuadrupedSimulation, progress: RigProgress) -> tuple[QuadrupedReference, str]:
         """The reference to simulate and its name: the played table's three-feet stance, else the gait planned."""
         from wbfriction.rigs.played import played_tripod
-        from wbfriction.walking.quadruped import GaitOptions, quadruped_reference
+        from wbfriction.walking.quadruped import quadruped_reference
+        from wbfriction.walking.scale import scaled_gait
 
         if o.play is not None:
             progress.say(f"rebuilding the stance of {o.play.name} (its IK at every sample)")
             ref = played_tripod(robot, o.play)
             return ref, f"{robot.contact_frames[int(ref.contact[0].argmin())]} swung on three feet"
         given: dict[str, Any] = {"gait": o.gait, "duration": o.duration, "speed": o.speed}  # None: its default
-        gait = GaitOptions(seed=o.excitation_seed, **{k: v for k, v in given.items() if v is not None})
+        gait = scaled_gait(robot, given, o.excitation_seed)  # the defaults to the robot's size
         progress.say(f"planning {gait.duration:g} s ({gait.gait})")
         return quadruped_reference(robot, gait), gait.gait
 

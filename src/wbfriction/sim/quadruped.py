@@ -187,11 +187,17 @@ def default_quadruped_friction(robot: Robot) -> dict[str, ModelParams]:
     (``F_v qd + F_c tanh(40 qd)``), every joint its own, made up and illustrative (joint ``i`` of ``n``:
     ``F_c = 0.2 + 0.4 ((7 i) mod n) / (n - 1)`` [N·m], ``F_v = 0.05 + 0.25 ((5 i) mod n) / (n - 1)`` [N·m·s/rad]:
     0.2-0.6 and 0.05-0.3, the two orders unlike each other and the joints', so that a joint mixed up with another
-    shows)."""
+    shows); on a robot of another size than the Go2 the same share of its torques, F_c times its torque ratio and F_v
+    times its damping ratio (:func:`~wbfriction.walking.scale.robot_scale`: dynamic similarity; the Go2's 1)."""
+    from wbfriction.walking.scale import robot_scale
+
     n = robot.n_act
     span = max(n - 1, 1)
-    return {j: FrictionParams(F_v=round(0.05 + 0.25 * ((5 * i) % n) / span, 4),
-                              F_c=round(0.2 + 0.4 * ((7 * i) % n) / span, 4), S=0.0, v_s=0.1, tau_os=0.0, a=40.0)
+    scale = robot_scale(robot) if robot.floating_base and robot.contact_frames else None
+    torque, damping = (1.0, 1.0) if scale is None else (scale.torque, scale.damping)
+    return {j: FrictionParams(F_v=round((0.05 + 0.25 * ((5 * i) % n) / span) * damping, 4),
+                              F_c=round((0.2 + 0.4 * ((7 * i) % n) / span) * torque, 4), S=0.0, v_s=0.1, tau_os=0.0,
+                              a=40.0)
             for i, j in enumerate(robot.actuated)}
 
 

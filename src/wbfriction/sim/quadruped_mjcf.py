@@ -5,9 +5,10 @@ and collision geometry and the URDF's ``<dynamics>`` dropped), with
 
 * a free joint at the root (a floating base) and a ground plane (``z = 0``, flat and horizontal);
 * one sphere per contact frame (:attr:`Robot.contact_frames <wbfriction.model.robot.Robot.contact_frames>`, the
-  robot's point feet), of the gait's radius (:data:`wbfriction.walking.quadruped.FOOT_RADIUS`, 2.3 cm: where the
-  gait plans a standing foot's frame), **centred on the contact frame's origin** (Unitree's feet are rubber balls
-  about 2 cm in radius round the ``<leg>_foot`` frame), the only geometry that collides: soft point
+  robot's point feet), of the gait's radius (:func:`wbfriction.walking.quadruped.foot_sphere`: the robot's
+  ``foot_radius``, else the Go2's 2.3 cm: where the gait plans a standing foot's frame), **centred on the contact
+  frame's origin** (Unitree's feet are rubber balls about 2 cm in radius round the ``<leg>_foot`` frame), the only
+  geometry that collides: soft point
   contacts with MuJoCo's default ``solref``/``solimp``, ``condim`` 3 (normal and sliding friction, no torsional or
   rolling friction: the ground's action on a foot is one force at the contact point), sliding friction
   :data:`FOOT_FRICTION`;
@@ -38,7 +39,7 @@ from wbfriction.model.mjspec import mujoco_message, urdf_spec
 from wbfriction.model.robot import Robot
 from wbfriction.sim.common import require_point_feet
 from wbfriction.sim.mujoco_model import MujocoRobot, route_mujoco_warnings
-from wbfriction.walking.quadruped import FOOT_RADIUS
+from wbfriction.walking.quadruped import foot_sphere
 
 if TYPE_CHECKING:
     import mujoco
@@ -50,15 +51,15 @@ SOLVER_TOLERANCE = 1e-10
 met the step's acceleration: 1.4e-3 N off in the equations of motion; with 1e-10 they meet to 1e-12, no slower)."""
 
 
-def build_quadruped_model(robot: Robot, timestep: float = 1e-3, foot_radius: float = FOOT_RADIUS,
+def build_quadruped_model(robot: Robot, timestep: float = 1e-3, foot_radius: float | None = None,
                           foot_friction: float = FOOT_FRICTION) -> MujocoRobot:
     """The MuJoCo model of a walking robot on point feet (module docstring).
 
     Args:
         robot: a floating-base robot whose contact frames are points (``contact_model = "point"``), from a URDF.
         timestep: the physics step [s].
-        foot_radius: the feet's sphere radius [m], > 0 (default the gait's
-            :data:`~wbfriction.walking.quadruped.FOOT_RADIUS`).
+        foot_radius: the feet's sphere radius [m], > 0; None: where the gait plans a standing foot's frame (the
+            robot's ``foot_radius``, else the Go2's: :func:`~wbfriction.walking.quadruped.foot_sphere`).
         foot_friction: their sliding friction coefficient, > 0.
 
     Returns:
@@ -74,6 +75,7 @@ def build_quadruped_model(robot: Robot, timestep: float = 1e-3, foot_radius: flo
     if not robot.floating_base or not robot.contact_frames:
         raise InputError(f"robot '{robot.name}': a walking quadruped needs a floating base and contact frames")
     require_point_feet(robot, "the quadruped's MuJoCo model")
+    foot_radius = foot_sphere(robot) if foot_radius is None else foot_radius
     if not (foot_radius > 0 and foot_friction > 0):
         raise InputError(f"foot radius ({foot_radius}) and friction ({foot_friction}) must be > 0")
     route_mujoco_warnings()

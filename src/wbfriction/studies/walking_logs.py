@@ -96,11 +96,12 @@ def _run(args: list[str], cwd: Path) -> None:
     run_route([shlex.join(["wbfriction", *args])], cwd)
 
 
-def simulate(case: WalkingCase, folder: Path, seed: int = 0) -> Path:
-    """The raw log of ``case`` in ``folder`` (``wbfriction simulate ... --logger raw``)."""
+def simulate(case: WalkingCase, folder: Path, seed: int = 0, robot: Path = TWIN_ROBOT) -> Path:
+    """The raw log of ``case`` in ``folder`` (``wbfriction simulate ... --logger raw``) of the twin ``robot``'s
+    TOML (default the Go2's, :data:`TWIN_ROBOT`)."""
     out = folder / f"{case.name}_raw.parquet"
     noise = ["--sensor-noise", "unitree", "--noise-seed", str(seed + 1)] if case.noisy else []
-    _run(["simulate", "--robot", str(TWIN_ROBOT), "--simulator", "mujoco", "--gait", case.gait, "--duration",
+    _run(["simulate", "--robot", str(robot), "--simulator", "mujoco", "--gait", case.gait, "--duration",
           str(DURATION), "--logger", "raw", *noise, "-o", str(out)], folder)
     return out
 
@@ -170,8 +171,9 @@ def _gap(fits: dict[str, JointFit], given: dict[str, JointFit]) -> float:
     return max(gaps) if gaps else float("nan")
 
 
-def score_case(case: WalkingCase, folder: Path) -> WalkingScore:
-    """Simulate, prepare, estimate and fit ``case`` in ``folder`` (module docstring)."""
+def score_case(case: WalkingCase, folder: Path, twin: Path = TWIN_ROBOT) -> WalkingScore:
+    """Simulate, prepare, estimate and fit ``case`` in ``folder`` (module docstring) on the twin robot's TOML
+    ``twin`` (default the Go2's)."""
     import pyarrow.parquet as pq
 
     from wbfriction.logs.options import ReadOptions
@@ -179,8 +181,8 @@ def score_case(case: WalkingCase, folder: Path) -> WalkingScore:
     from wbfriction.pipeline.raw_log import prepare_raw
     from wbfriction.studies.status import log_truth
 
-    raw = simulate(case, folder)
-    robot = RobotSpec.given(str(TWIN_ROBOT)).load()
+    raw = simulate(case, folder, robot=twin)
+    robot = RobotSpec.given(str(twin)).load()
     table = pq.read_table(raw)
     prepared = prepare_raw(table, robot, str(raw), ReadOptions(rate=float(RATE)))
     out = prepared.table
@@ -193,11 +195,11 @@ def score_case(case: WalkingCase, folder: Path) -> WalkingScore:
     error = prepared.base.twist[:, :3] - true_v
     velocity_error = float(np.sqrt(np.mean(np.sum(error ** 2, axis=1)) / np.mean(np.sum(true_v ** 2, axis=1))))
     truth = log_truth(raw)
-    fits = _estimate_fit(raw, TWIN_ROBOT, case.name, folder, truth)
+    fits = _estimate_fit(raw, twin, case.name, folder, truth)
     given = folder / f"{case.name}_given.parquet"
     t = np.asarray(out.column("time"))
     pq.write_table(given_log(out, robot.contact_frames, float(np.median(np.diff(t)))), given)
-    given_fits = _estimate_fit(given, TWIN_ROBOT, case.name + "_given", folder, truth)
+    given_fits = _estimate_fit(given, twin, case.name + "_given", folder, truth)
     return WalkingScore(case.name, len(table), len(sample), exact, float(np.mean(inferred == truth_c)),
                         float(np.mean((inferred == truth_c)[confident])) if confident.any() else float("nan"),
                         float(prepared.contacts.unconfident_rows().mean()), velocity_error, _summary(fits),
@@ -206,16 +208,22 @@ def score_case(case: WalkingCase, folder: Path) -> WalkingScore:
 
 
 def _stance(robot: Robot, prepared: pa.Table, params: Path, truth: dict) -> tuple[float, float, float]:
-    """The base's RMS moment residual on the stances without friction, with the fit's, with the truth's."""
+    """The base's RMS moment residual on the stances without friction, with the fit's, with the truth's (the fit's
+    NaN where the check refuses it: no stance whose legs' joints all have a fit)."""
+    from wbfriction.exceptions import InputError
     from wbfriction.fit.params_file import read_params
     from wbfriction.fit.stance_check import log_stance_check
     from wbfriction.friction.models import target_from_dict
     from wbfriction.logs.log import log_from_table
 
     log = log_from_table(prepared, robot, "prepared")
-    fitted = log_stance_check(robot, log, {j: f.params for j, f in read_params(params).items() if f.params is not None})
     true = log_stance_check(robot, log, {j: target_from_dict(p) for j, p in truth["friction_true"].items()})
-    return fitted.moment_without, fitted.moment_with, true.moment_with
+    try:
+        fitted = log_stance_check(robot, log, {j: f.params for j, f in read_params(params).items()
+                                               if f.params is not None}).moment_with
+    except InputError:
+        fitted = float("nan")
+    return true.moment_without, fitted, true.moment_with
 
 
 def markdown(scores: list[WalkingScore]) -> str:

@@ -22,12 +22,12 @@ sums of sines of their own frequencies, phases from ``seed``).
 
 The feet start at their places in the robot's reference configuration, moved together along the base so that
 their centre (the diagonals' crossing) lies under the centre of mass. A foot's planned position is its contact
-frame's origin (the Go2's foot sphere's centre), at :data:`FOOT_RADIUS`
-above the ground while it stands. A stance foot does not move, and the base pose is planned; the leg joints
-follow by inverse kinematics (Newton iterations per sample, from the previous sample's angles), their velocities
-from ``J v = pd`` and accelerations from ``J a = pdd - Jd v`` (Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians of the
-feet), all analytic: the reference ``(q, v, a)`` keeps every stance foot still to machine precision at the
-acceleration level.
+frame's origin (a foot sphere's centre), at the robot's ``foot_radius`` (:func:`foot_sphere`; the Go2's
+:data:`FOOT_RADIUS` where its TOML gives none) above the ground while it stands. A stance foot does not move, and
+the base pose is planned; the leg joints follow by inverse kinematics (Newton iterations per sample, from the
+previous sample's angles), their velocities from ``J v = pd`` and accelerations from ``J a = pdd - Jd v``
+(Pinocchio's ``LOCAL_WORLD_ALIGNED`` Jacobians of the feet), all analytic: the reference ``(q, v, a)`` keeps every
+stance foot still to machine precision at the acceleration level.
 """
 
 from __future__ import annotations
@@ -48,6 +48,14 @@ FOOT_RADIUS = 0.023
 """Height of a standing foot's contact frame above the ground [m]: the Go2's foot sphere's radius (its collision
 mesh reaches 0.0229 m below the frame; the SRDF's standing posture puts the frames 0.0226 m up)."""
 LWA = pin.LOCAL_WORLD_ALIGNED
+
+
+def foot_sphere(robot: Robot) -> float:
+    """A standing foot's contact frame's height above the ground [m]: the robot's ``foot_radius`` where its TOML
+    gives one, else :data:`FOOT_RADIUS` (the Go2's, the built-in ``go2_walking``'s)."""
+    return robot.foot_radius or FOOT_RADIUS
+
+
 _PERIOD = {"stand": 0.5, "step": 0.5, "trot": 0.5, "walk": 1.2}
 _SPEED = {"stand": 0.0, "step": 0.0, "trot": 0.2, "walk": 0.1}
 _CRAWL = (("rear", "left"), ("front", "left"), ("rear", "right"), ("front", "right"))
@@ -67,6 +75,8 @@ class GaitOptions:
         speed: forward speed [m/s]; None: 0.2 (trot), 0.1 (walk), 0 (stand, step). Set after construction.
         base_height: the base (root joint) origin's mean height above the ground [m] (a Go2 stands at ~0.30).
         seed: the swings' heights and bumps and the sway's phases.
+        scale: the robot's length scale against the Go2's (:mod:`wbfriction.walking.scale`): the sway's and the
+            swings' sideways amplitudes [m] are the Go2's times it (``simulate`` sets it with the heights).
 
     Raises:
         OptionError: an unknown gait, a duration shorter than two samples, a period, dt or height not > 0, a
@@ -81,6 +91,7 @@ class GaitOptions:
     speed: float = field(default=None)  # type: ignore[assignment]
     base_height: float = 0.30
     seed: int = 0
+    scale: float = 1.0
 
     def __post_init__(self) -> None:
         if self.gait not in GAITS:
@@ -89,7 +100,7 @@ class GaitOptions:
             object.__setattr__(self, "period", _PERIOD[self.gait])
         if self.speed is None:
             object.__setattr__(self, "speed", _SPEED[self.gait])
-        for name in ("dt", "period", "base_height", "duration"):
+        for name in ("dt", "period", "base_height", "duration", "scale"):
             if not float(getattr(self, name)) > 0:
                 raise OptionError(f"--{name.replace('_', '-')}", getattr(self, name), "> 0")
         if self.step_height < 0:
@@ -253,7 +264,7 @@ def _swings(options: GaitOptions, corners: list[tuple[str, str]], rng: np.random
                 return out
             for leg in group:
                 out.append(_Swing(leg, t0, t0 + length, options.step_height * rng.uniform(0.6, 1.4),
-                                  rng.uniform(-0.02, 0.03)))
+                                  rng.uniform(-0.02 * options.scale, 0.03 * options.scale)))
         cycle += 1
 
 
@@ -271,14 +282,15 @@ def _base_motion(t: np.ndarray, options: GaitOptions, rng: np.random.Generator) 
         waves = [(pos, 2, 0.012, 0.71, 0.71), (rp, 0, 0.05, 0.43, 0.43), (rp, 1, 0.04, 0.57, 0.57)]
         if options.gait != "walk":
             waves.append((pos, 1, 0.01, 0.31, 0.31))
-    for arr, axis, amplitude, f0, f1 in waves:
+    for arr, axis, amplitude, f0, f1 in waves:  # lengths the Go2's times the scale, angles as they are
+        amplitude *= options.scale if arr is pos else 1.0
         arr[:, :, axis] += np.array(_wave(t, amplitude, f0, f1, rng.uniform(0, 2 * np.pi), D))
     if options.gait == "walk":
-        pos[:, :, 1] += _crawl_shift(t, T)
+        pos[:, :, 1] += _crawl_shift(t, T, 0.06 * options.scale)
     return pos, rp
 
 
-def _crawl_shift(t: np.ndarray, T: float, amplitude: float = 0.06) -> np.ndarray:
+def _crawl_shift(t: np.ndarray, T: float, amplitude: float) -> np.ndarray:
     """The crawl's sideways shift of the base (3, N) [m] (value, rate, its rate): ``-A sin(2 pi (t - T/2) / T)``,
     right while the left legs swing (the first half of each cycle), left while the right ones do, crossing the middle
     while four feet are down; faded in over the first half period. A sine: its zero-moment point moves with it,
@@ -349,7 +361,7 @@ def quadruped_reference(robot: Robot, options: GaitOptions = GaitOptions()) -> Q
     rng = np.random.default_rng(options.seed)
     offsets, corners = _legs(robot)
     home = offsets.copy()
-    home[:, 2] = FOOT_RADIUS
+    home[:, 2] = foot_sphere(robot)
     swings = _swings(options, corners, rng)
     pos, rp = _base_motion(t, options, rng)
     R, omega, domega = _orientation(rp)
