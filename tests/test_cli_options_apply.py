@@ -48,7 +48,7 @@ HUNG = ("robot 'go2' is a hung PD-driven robot (fixed base, [pd]): it takes --fr
 QUADRUPED = ("robot 'go2_walking' stands on point feet (a walking quadruped), simulated in ideal: it takes --gait, "
              "--friction, --simulator, --substeps, --sensors, --position-noise, --encoder-bits, --torque-noise, "
              "--noise-seed, --duration, --excitation-seed, --speed, --foot-forces, --play, --sensor-noise, --logger, "
-             "--logger-period, --imu-period, --angles, --kt-error, --foot-counts/--no-foot-counts")
+             "--logger-period, --imu-period, --angles, --kt-error, --foot-counts/--no-foot-counts, --contacts")
 ARM = ("robot 'panda' is a fixed-base arm (torque-driven, an excitation trajectory): it takes --friction, "
        "--position-noise, --encoder-bits, --torque-noise, --noise-seed, --duration, --excitation-seed, --play")
 PD = ("--actuator pd identifies a hung PD-driven robot's actuators (the URDF kept): it takes --json, --holdout, "
@@ -152,7 +152,7 @@ VALUES = {
     "sensor_noise": ["--sensor-noise", "unitree"], "logger": ["--logger", "raw"],
     "logger_period": ["--logger-period", "1"], "imu_period": ["--imu-period", "4"],
     "angles": ["--angles", "cos-sin"], "kt_error": ["--kt-error", "0.02"],
-    "foot_counts": ["--foot-counts"],
+    "foot_counts": ["--foot-counts"], "contacts": ["--contacts", "firm"],
     # identify's
     "output": ["-o", "OUT.urdf"], "json_output": ["--json", "OUT.json"],
     "stribeck_velocity": ["--stribeck-velocity", "0.1"],

@@ -1,8 +1,8 @@
 """The base's motion from the IMU and the stance legs (issue 82, item 2): the IMU's rotation composed and inverted for
 any orientation; a base moving at a constant velocity and turning rigidly on feet fixed to the ground, exactly; the
-refusals in one line; and on the MuJoCo twin (trot and walk, clean and with a Unitree's noise, the true contacts) the
-orientation and the angular velocity to the IMU's precision, the linear velocity's error measured (numbers in the
-tests' docstrings and /work/notes/82/i82-odometry.md)."""
+refusals in one line; and on the MuJoCo twin (trot and walk, clean and with a Unitree's noise, the true contacts, its
+feet firm) the orientation and the angular velocity to the IMU's precision, the linear velocity within issue 82's 5 %
+(numbers in the tests' docstrings, /work/notes/82/i82-odometry.md and i82-creep.md)."""
 
 from __future__ import annotations
 
@@ -135,20 +135,22 @@ IMU_RPY_NOISE = 0.005
 """The white noise put on the IMU's roll, pitch and yaw in the noisy cases [rad] (a MEMS IMU's attitude filter's)."""
 
 
-@pytest.fixture(scope="module")
-def twin_runs(robot):
-    """3 s of each gait on the MuJoCo twin (torque-driven, 500 Hz, normal foot forces), clean and with
-    UNITREE_NOISE, simulated once per module."""
+def simulate_twin(robot, gait: str, noisy: bool = False, contacts: str = "firm"):
+    """3 s of ``gait`` on the MuJoCo twin (torque-driven, 500 Hz, normal foot forces; its feet firm, as ``simulate
+    --logger raw`` makes them, or MuJoCo's default soft ones), clean or with UNITREE_NOISE."""
     from wbfriction.sim.quadruped import QuadrupedOptions
     from wbfriction.sim.quadruped_mujoco import UNITREE_NOISE, simulate_quadruped_mujoco
     from wbfriction.walking.quadruped import GaitOptions, quadruped_reference
 
-    out = {}
-    for gait, noisy in CASES:
-        reference = quadruped_reference(robot, GaitOptions(gait, duration=3.0))
-        out[gait, noisy] = simulate_quadruped_mujoco(robot, reference, QuadrupedOptions(foot_forces="normal"),
-                                                     noise=UNITREE_NOISE if noisy else None)
-    return out
+    reference = quadruped_reference(robot, GaitOptions(gait, duration=3.0))
+    return simulate_quadruped_mujoco(robot, reference, QuadrupedOptions(foot_forces="normal", contacts=contacts),
+                                     noise=UNITREE_NOISE if noisy else None)
+
+
+@pytest.fixture(scope="module")
+def twin_runs(robot):
+    """Each case on the twin (:func:`simulate_twin`), simulated once per module."""
+    return {(gait, noisy): simulate_twin(robot, gait, noisy) for gait, noisy in CASES}
 
 
 def twin_inputs(robot, run, noisy: bool):
@@ -186,10 +188,11 @@ def twin_estimates(robot, twin_runs):
     return out
 
 
-MEASURED_VELOCITY = {("trot", False, False): 0.095, ("trot", False, True): 0.057, ("trot", True, False): 0.099,
-                     ("trot", True, True): 0.059, ("walk", False, False): 0.068, ("walk", False, True): 0.059,
-                     ("walk", True, False): 0.075, ("walk", True, True): 0.056}
-"""The linear velocity's relative error measured per (gait, noisy, accelerometer) (issue 82's closing note)."""
+MEASURED_VELOCITY = {("trot", False, False): 0.022, ("trot", False, True): 0.0098, ("trot", True, False): 0.028,
+                     ("trot", True, True): 0.020, ("walk", False, False): 0.0040, ("walk", False, True): 0.0041,
+                     ("walk", True, False): 0.0101, ("walk", True, True): 0.0104}
+"""The linear velocity's relative error measured per (gait, noisy, accelerometer) on the twin's firm feet
+(/work/notes/82/i82-creep.md; on MuJoCo's soft ones 5.6-9.9 %)."""
 
 
 @pytest.mark.slow
@@ -216,8 +219,8 @@ def test_on_the_twin_the_orientation_and_rates_are_the_imus(robot, twin_runs, tw
 @pytest.mark.parametrize("gait, noisy", CASES)
 def test_on_the_twin_the_linear_velocity_as_measured(robot, twin_runs, twin_estimates, gait, noisy):
     """The linear velocity's RMS error over the RMS speed, without and with the accelerometer, within 10 % of what
-    was measured (:data:`MEASURED_VELOCITY`: 5.6-9.9 %); the accelerometer helps (or does not hurt by more than 1 % of
-    the speed); the acceleration's error reported in the note."""
+    was measured on the twin's firm feet (:data:`MEASURED_VELOCITY`: 0.4-2.8 %); the accelerometer helps (or does not
+    hurt by more than 1 % of the speed)."""
     log = twin_runs[gait, noisy].log
     errors = {}
     for acc in (False, True):
@@ -229,30 +232,50 @@ def test_on_the_twin_the_linear_velocity_as_measured(robot, twin_runs, twin_esti
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="the MuJoCo twin's soft contacts let a stance foot creep (median 1.4-1.6 "
-                   "cm/s): the legs' velocity from the TRUE state is 8 % (walk) to 27 % (trot) off; see "
-                   "test_the_twins_feet_creep")
 @pytest.mark.parametrize("gait, noisy", CASES)
 def test_on_the_twin_the_linear_velocity_within_five_percent(robot, twin_runs, twin_estimates, gait, noisy):
-    """Issue 82's acceptance: the base's velocity within 5 % RMS of its speed, without and with accelerometer."""
+    """Issue 82's acceptance: the base's velocity within 5 % RMS of its speed, without and with accelerometer, on
+    the twin whose feet hold (firm contacts; with MuJoCo's soft ones this failed: 6.8-9.9 % without accelerometer,
+    test_the_twins_feet_hold_where_soft_feet_creep)."""
     log = twin_runs[gait, noisy].log
     for acc in (False, True):
         est, _ = twin_estimates[gait, noisy, acc]
         assert relative_error(est.twist[:, :3], log.base_qd_true[:, :3]) < 0.05
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("gait", ["trot", "walk"])
-def test_the_twins_feet_creep(robot, twin_runs, gait):
-    """Why the 5 % is out of reach on the twin: with the TRUE state (joints, base twist) the stance feet's contact
-    points (force > 0, sphere of the MuJoCo radius) move at a median of over 1 cm/s, and the mean of the stance feet's
-    velocities, each exact but for that, is more than 5 % of the speed off (measured: 8 % walk, 27 % trot)."""
-    run = twin_runs[gait, False]
+def feet_against_base(robot, run):
+    """Each stance foot's (force > 0) estimate of the base's velocity from the TRUE state (N, 4, 3), the base's
+    true velocity (N, 3), world, and each foot's distance to its nearest touch-down or lift-off [samples]."""
     contact = run.force[..., 2] > 0
     R = np.array([pin.Quaternion(b[3:]).matrix() for b in run.log.base])
     feet = stance_velocities(robot, run.q, run.v, R, contact)
     truth = np.einsum("nij,nj->ni", R, run.v[:, :3])
-    creep = np.linalg.norm(feet - truth[:, None], axis=2)
-    assert np.nanmedian(creep) > 0.01
-    rows = contact.any(axis=1)
-    assert relative_error(np.nanmean(feet[rows], axis=1), truth[rows]) > 0.05
+    n = np.arange(len(contact))
+    switch = np.full(contact.shape, np.inf)
+    for c in range(contact.shape[1]):
+        at = np.flatnonzero(np.diff(contact[:, c].astype(int))) + 0.5
+        if at.size:
+            switch[:, c] = np.min(np.abs(n[:, None] - at[None]), axis=1)
+    return feet, truth, switch
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("gait", ["trot", "walk"])
+def test_the_twins_feet_hold_where_soft_feet_creep(robot, twin_runs, gait):
+    """Why the twin's feet are firm: with MuJoCo's default soft contacts the stance feet (force > 0) slide on the
+    ground at a median of over 5 % of the base's RMS speed (measured 1.4-1.6 cm/s, 7 % of 0.19-0.24 m/s), and the
+    mean of the stance feet's velocities from the TRUE state is over 5 % off the base's even 10 ms (two firm time
+    constants) away from every touch-down and lift-off (measured 17 % trot, 7.3 % walk): no estimator on the legs
+    could meet issue 82's 5 %. On firm contacts the median is under 1 % of the speed (0.4 %: 0.07-0.10 cm/s) and the
+    mean away from the switches under 5 % (3.3 % trot, 0.9 % walk)."""
+    for contacts, run in (("soft", simulate_twin(robot, gait, contacts="soft")), ("firm", twin_runs[gait, False])):
+        feet, truth, switch = feet_against_base(robot, run)
+        speed = np.sqrt(np.mean(np.sum(truth**2, axis=1)))
+        creep = np.nanmedian(np.linalg.norm(feet - truth[:, None], axis=2))
+        away = np.where((switch > 5)[..., None], feet, np.nan)
+        rows = np.isfinite(away[..., 0]).any(axis=1)
+        error = relative_error(np.nanmean(away[rows], axis=1), truth[rows])
+        if contacts == "soft":
+            assert creep > 0.05 * speed and error > 0.05
+        else:
+            assert creep < 0.01 * speed and error < 0.05

@@ -13,6 +13,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from wbfriction.exceptions import OptionError
 from wbfriction.model.imu import imu_readings
 from wbfriction.model.loading import load_robot
 from wbfriction.model.pd import pd_torque
@@ -211,3 +212,23 @@ def test_the_held_torque_is_a_real_robots_zero_order_hold(robot, mjr):
     truth = default_quadruped_friction(robot)
     errors = {j: fits[j].params.F_v / truth[j].F_v - 1 for j in robot.actuated if "hip" in j}
     assert max(abs(e) for e in errors.values()) < 0.05, errors
+
+
+def test_firm_contacts_are_set_on_the_runs_copy_and_recorded_and_soft_logs_are_as_before(robot, mjr):
+    """``contacts = "firm"`` (issue 82): the run's model gets elliptic cones, impratio 10 and a 5 ms time constant
+    (recorded in the log's ``feet`` metadata and options), the shared model is left soft; a soft run's metadata has
+    no trace of the option (its log's bytes are those written before it); another value is refused naming
+    ``--contacts``."""
+    import mujoco
+
+    from wbfriction.sim.quadruped_mjcf import FIRM_IMPRATIO, FIRM_TIMECONST
+
+    reference = quadruped_reference(robot, GaitOptions("trot", duration=0.2))
+    firm = simulate_quadruped_mujoco(robot, reference, QuadrupedOptions(contacts="firm"), mjr=mjr).log.metadata
+    soft = simulate_quadruped_mujoco(robot, reference, QuadrupedOptions(), mjr=mjr).log.metadata
+    assert firm["feet"]["cone"] == "elliptic" and firm["feet"]["impratio"] == FIRM_IMPRATIO
+    assert firm["feet"]["timeconst"] == FIRM_TIMECONST and firm["options"]["contacts"] == "firm"
+    assert "contacts" not in soft["options"] and set(soft["feet"]) == {"radius", "friction", "contact_force"}
+    assert mjr.model.opt.cone == mujoco.mjtCone.mjCONE_PYRAMIDAL and mjr.model.opt.impratio == 1.0
+    with pytest.raises(OptionError, match="--contacts"):
+        QuadrupedOptions(contacts="hard")

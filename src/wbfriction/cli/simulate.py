@@ -50,6 +50,7 @@ SensorNoiseChoice = Literal["none", "unitree"]
 LoggerChoice = Literal["full", "raw"]
 """What log a robot on point feet writes (``--logger``): the project's full log, or a robot logger's raw one."""
 AnglesChoice = Literal["angles", "cos-sin"]
+ContactsChoice = Literal["soft", "firm"]
 """How a raw log holds the joint angles (``--angles``)."""
 DriverNoiseChoice = Literal["real", "none"]
 """The PD drivers' sensor noise (``--driver-noise``): a real driver's (:data:`~wbfriction.sim.pd_options.REAL_DRIVER`)
@@ -142,6 +143,10 @@ KtErrorOpt = typer.Option(None, help="--logger raw: the bound of each joint's to
 FootCountsOpt = typer.Option(None, "--foot-counts/--no-foot-counts",
                              help="--logger raw: log raw foot-force counts (foot_count.<foot>: an offset and a scale "
                                   "per foot).")
+ContactsOpt = typer.Option("soft", help="A robot on point feet, mujoco: its feet on the ground: soft (MuJoCo's "
+                                        "default contacts: a stance foot creeps about 1.5 cm/s) or firm (elliptic "
+                                        "friction cones, impratio 10, a 5 ms time constant: feet that hold, as "
+                                        "rubber on concrete).")
 SetpointsOpt = typer.Option(SETPOINTS.kind, help="PD-driven: ramps (triangle ramps reversing every "
                                                  f"{SETPOINTS.reversal[0]:g}-{SETPOINTS.reversal[1]:g} s), chirps "
                                                  f"({SETPOINTS.chirp[0]:g}-{SETPOINTS.chirp[1]:g} Hz) or both "
@@ -185,7 +190,8 @@ def simulate(ctx: typer.Context, output: Path = OutputOpt, robot: str = RobotOpt
              sensor_noise: SensorNoiseChoice = SensorNoiseOpt, logger: LoggerChoice = LoggerOpt,
              logger_period: Optional[float] = LoggerPeriodOpt, imu_period: Optional[float] = ImuPeriodOpt,
              angles: Optional[AnglesChoice] = AnglesOpt, kt_error: Optional[float] = KtErrorOpt,
-             foot_counts: Optional[bool] = FootCountsOpt, rig_option: list[str] = RigOptionOpt) -> None:
+             foot_counts: Optional[bool] = FootCountsOpt, contacts: ContactsChoice = ContactsOpt,
+             rig_option: list[str] = RigOptionOpt) -> None:
     """Simulate a walk with known friction: ideal (rigid contacts) or MuJoCo (realistic); a
     fixed-base robot (--robot panda) tracks an excitation trajectory, logging motor currents; a PD-driven one
     (--robot go2) hangs with its base fixed, its drivers tracking ramps and chirps; --simulator also takes an engine

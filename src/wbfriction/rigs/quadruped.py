@@ -56,6 +56,8 @@ class QuadrupedSimulation(SensorsFileOptions):
             kt_error: the torque constants' error bound (a share); foot_counts: raw foot-force counts logged; each
             None: :class:`~wbfriction.sim.logger.LoggerOptions`' default (raw only; the draws seeded by
             ``noise_seed``).
+        contacts: a soft-contact engine's (MuJoCo's) feet: ``soft`` (its default contacts: a stance foot creeps
+            about 1.5 cm/s) or ``firm`` (feet that hold: :func:`~wbfriction.sim.quadruped_mjcf.firm_contacts`).
     """
 
     actuator: Optional[Literal["torque", "pd"]] = option(None)
@@ -74,6 +76,7 @@ class QuadrupedSimulation(SensorsFileOptions):
     angles: Optional[Literal["angles", "cos-sin"]] = option(None)
     kt_error: Optional[float] = option(None)
     foot_counts: Optional[bool] = option(None)
+    contacts: Literal["soft", "firm"] = option("soft")
 
     def logger_options(self, robot: Robot) -> LoggerOptions | None:
         """The raw logger's options (None: the full log), checked with the robot before any simulation.
@@ -170,7 +173,10 @@ class QuadrupedRig(Rig):
         assert engine is not None  # a rig with a motion has one (Rig.engine)
         o: QuadrupedSimulation = options
         logger, sensors = o.logger_options(robot), o.engine_noise(engine)  # refused before the simulation
-        opts = QuadrupedOptions(**self.run_options(robot, options))
+        if o.contacts == "firm" and not engine.soft_contacts:
+            raise InputError(f"--contacts {o.contacts}: engine '{engine.name}' welds the standing feet (no soft "
+                             "contacts to firm up); use --simulator mujoco")
+        opts = QuadrupedOptions(**self.run_options(robot, options), contacts=o.contacts)
         ref, motion = self.reference(robot, options, progress)
         run = engine.quadruped(robot, ref, opts, progress=progress.count("simulate", len(ref), "samples"),
                                sensors=sensors)

@@ -88,6 +88,8 @@ FootForces = Literal["none", "normal", "3d"]
 FOOT_FORCES: tuple[FootForces, ...] = get_args(FootForces)
 Setpoints = Literal["model", "held"]
 SETPOINTS: tuple[Setpoints, ...] = get_args(Setpoints)
+Contacts = Literal["soft", "firm"]
+CONTACTS: tuple[Contacts, ...] = get_args(Contacts)
 
 
 @dataclass(frozen=True)
@@ -108,6 +110,9 @@ class QuadrupedOptions:
         setpoints: :data:`Setpoints`: how the PD drivers apply their set-points within a period.
         compensate: the feed-forward holds the friction of the reference's velocities.
         imu: log the IMU's readings (if the robot has an ``[imu]``).
+        contacts: :data:`Contacts`: a soft-contact engine's feet on the ground: ``soft`` (the model's own: MuJoCo's
+            default, a stance foot creeps about 1.5 cm/s) or ``firm`` (feet that hold:
+            :func:`~wbfriction.sim.quadruped_mjcf.firm_contacts`); the ideal simulator's feet are welded (neither).
         seed: recorded (the noise has its own).
 
     Raises:
@@ -127,12 +132,14 @@ class QuadrupedOptions:
     setpoints: Setpoints = "model"
     compensate: bool = True
     imu: bool = True
+    contacts: Contacts = "soft"
     seed: int = 0
 
     def __post_init__(self) -> None:
         for name, value, choices in (("--drive", self.drive, DRIVES), ("--foot-forces", self.foot_forces,
                                                                          FOOT_FORCES),
-                                     ("--setpoints", self.setpoints, SETPOINTS)):
+                                     ("--setpoints", self.setpoints, SETPOINTS), ("--contacts", self.contacts,
+                                                                                  CONTACTS)):
             if value not in choices:
                 raise OptionError(name, value, f"one of {', '.join(choices)}")
         if not self.physics_dt > 0:
@@ -146,6 +153,8 @@ class QuadrupedOptions:
     def metadata(self) -> dict:
         """The options as the log's metadata records them (the friction apart: ``friction_true``)."""
         out = {k: v for k, v in asdict(self).items() if k != "friction"}
+        if self.contacts == "soft":  # the logs written before the option existed: the same bytes
+            del out["contacts"]
         out["armature"] = None if self.armature is None else dict(self.armature)
         return out
 

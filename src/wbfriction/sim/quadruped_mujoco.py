@@ -2,7 +2,8 @@
 joint, torque-driven or PD-driven (issue 56, item 2).
 
 **Model** (:func:`~wbfriction.sim.quadruped_mjcf.build_quadruped_model`): the robot's URDF with a free joint, a ground
-plane and a sphere per foot round the foot frame's origin (soft contacts, ``condim`` 3).
+plane and a sphere per foot round the foot frame's origin (soft contacts, ``condim`` 3; firm ones with
+``options.contacts = "firm"``: :func:`~wbfriction.sim.quadruped_mjcf.firm_contacts`).
 
 **Controller**, at the log's samples (the reference's ``dt``), on the encoders' angles and the drivers' velocities
 (the base's true pose and twist: the simulator does not model a state estimator): the ideal simulator's balance
@@ -71,7 +72,7 @@ from wbfriction.sim.options import SensorNoise
 from wbfriction.sim.pd_robot import joint_values, step_setpoints
 from wbfriction.sim.quadruped import QuadrupedOptions, QuadrupedRun, default_quadruped_friction
 from wbfriction.sim.quadruped_control import BalanceController
-from wbfriction.sim.quadruped_mjcf import build_quadruped_model
+from wbfriction.sim.quadruped_mjcf import build_quadruped_model, firm_contacts
 from wbfriction.walking.quadruped import QuadrupedReference
 
 LWA = pin.LOCAL_WORLD_ALIGNED
@@ -181,6 +182,8 @@ class _Sim:
         self.mjr = mjr or build_quadruped_model(robot, self.h)
         self.model = copy.copy(self.mjr.model)  # the settings below must not leak into a shared model
         self.model.opt.timestep = self.h
+        if options.contacts == "firm":
+            firm_contacts(self.model)
         armature = joint_values(robot, options.armature, dict(zip(robot.actuated,
                                                                   robot.model.armature[robot.act_v_index])),
                                 "armature")
@@ -370,7 +373,10 @@ class _Sim:
                 "physics_step": self.h, "noise": asdict(self.noise),
                 "feet": {"radius": float(self.model.geom_size[self.mjr.sole_geoms[0], 0]),
                          "friction": float(self.model.geom_friction[self.mjr.sole_geoms[0], 0]),
-                         "contact_force": "summed mj_contactForce, world axes, the ground's on the foot"},
+                         "contact_force": "summed mj_contactForce, world axes, the ground's on the foot",
+                         **({} if opt.contacts == "soft" else  # soft: the bytes written before the option
+                            {"cone": "elliptic", "impratio": float(self.model.opt.impratio),
+                             "timeconst": float(self.model.geom_solref[self.mjr.sole_geoms[0], 0])})},
                 "contact_source": f"foot normal force: on above {on:.4g} N, off below {off:.4g} N"}
         common: dict[str, Any] = dict(
             base=Q[:, :7].copy(), tau_f_true=self.tau_f.copy(), source=GENERATOR.rsplit(".", 1)[-1],
