@@ -171,3 +171,15 @@ def test_the_momentum_window_is_bounded_by_the_shortest_stretch():
     assert bound_windows(given, short, None, None, swings, 0.002)[0].momentum.window == 9
     asked = dataclasses.replace(given, momentum=MomentumOptions(window=19))
     assert bound_windows(asked, options, None, None, swings, 0.002)[0].momentum.window == 19
+
+
+def test_margins_that_leave_no_row_of_any_swing_are_refused_naming_them(trot):
+    """Margins as long as the swings (a small robot's swings against the thesis's margins): one line naming
+    ``--lift-off`` and ``--touch-down`` and the longest swing, before the work; not "no valid sample" after it."""
+    robot, _, noisy = trot
+    with pytest.raises(OptionError) as info:
+        estimate_log(robot, noisy, EstimateOptions(base_motion="logged", lift_off_skip=0.15, touch_down_skip=0.1))
+    line = str(info.value)
+    assert info.value.option == "--lift-off" and info.value.value == 0.15
+    assert "--touch-down (0.1 s)" in line and "the longest 124 samples, 0.248 s, FL_foot" in line
+    estimate_log(robot, noisy, EstimateOptions(base_motion="logged", lift_off_skip=0.05, touch_down_skip=0.05))

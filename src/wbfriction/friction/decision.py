@@ -31,7 +31,7 @@ from wbfriction.exceptions import InputError, OptionError
 from wbfriction.friction.noise import noise_record
 from wbfriction.friction.options import EstimateOptions
 from wbfriction.friction.route import RouteDecision, resolve_route
-from wbfriction.friction.window_bound import WindowBound, bound_windows, refuse_given
+from wbfriction.friction.window_bound import WindowBound, bound_windows, refuse_given, refuse_margins
 from wbfriction.friction.window_bound import warning as window_warning
 from wbfriction.logs.clock import longest_segment
 from wbfriction.logs.log import Log
@@ -111,7 +111,8 @@ def decide_log(robot: Robot, options: EstimateOptions, positions: np.ndarray | N
         swings: the whole log's swings (:func:`~wbfriction.signals.phase_window.log_swings`), which bound the windows
             chosen (:func:`~wbfriction.friction.window_bound.bound_windows`); None: none (a fixed base).
         swings_only: the swings are the only phases estimated (no force sensed at the feet): a window given that none
-            of them holds is refused (:func:`~wbfriction.friction.window_bound.refuse_given`).
+            of them holds is refused (:func:`~wbfriction.friction.window_bound.refuse_given`), and margins that leave
+            none of them (:func:`~wbfriction.friction.window_bound.refuse_margins`).
 
     Raises:
         OptionError: a window given longer than the log's longest stretch, or than every swing (``swings_only``);
@@ -123,6 +124,7 @@ def decide_log(robot: Robot, options: EstimateOptions, positions: np.ndarray | N
     bounds: tuple[WindowBound, ...] = ()
     if swings is not None and swings.swings:
         if swings_only:
+            refuse_margins(options, swings)
             refuse_given(given, options, swings)
         options, choice, route, bounds = bound_windows(given, options, choice, route, swings, dt)
     check_windows(given, options, segments, rows, dt, source)

@@ -14,7 +14,9 @@ where its whole window lies inside one phase, and a window longer than a swing l
 * a window given (``--window``, ``--momentum-window``, ``--velocity-window``) is kept, but one that leaves no sample
   of even the longest swing is refused in one line naming it and the longest window that keeps half the shortest
   swing (:func:`refuse_given`), where the swings are the only phases estimated (no force sensed at the feet);
-  otherwise the refusal would come after the work, and blame the feet's forces.
+  otherwise the refusal would come after the work, and blame the feet's forces;
+* margins that leave no row of any swing are refused the same way, naming ``--lift-off`` and ``--touch-down``
+  (:func:`refuse_margins`).
 """
 
 from __future__ import annotations
@@ -121,6 +123,25 @@ def refuse_given(given: EstimateOptions, options: EstimateOptions, swings: Swing
         span = options.filtering.window
         if samples_left(span, longest.samples) == 0:
             raise OptionError("--window", span, why.format(span=span, seconds=span * dt))
+
+
+def refuse_margins(options: EstimateOptions, swings: Swings) -> None:
+    """Refuse lift-off and touch-down margins that leave no row of any swing, where the swings are the only phases
+    estimated (no force sensed at the feet): every swing is then shorter than the margins and the other feet's
+    switches leave of it (a small robot's swings, 0.2 s on a Solo-12, against the thesis's 0.10 + 0.05 s), and
+    the refusal would otherwise come after the work, as "no valid sample".
+
+    Raises:
+        OptionError: naming ``--lift-off``, both margins and the longest swing.
+    """
+    longest = swings.longest()
+    if longest is None or swings.stretches:
+        return
+    raise OptionError("--lift-off", options.lift_off_skip,
+                      f"shorter, with --touch-down ({options.touch_down_skip:g} s), than a swing: together they "
+                      f"leave no row of any swing (the longest {longest.samples} samples, {longest.seconds:.3g} s, "
+                      f"{longest.frame}, less both margins and the other feet's switches); without foot forces only "
+                      "the swings are estimated")
 
 
 def bound_windows(given: EstimateOptions, options: EstimateOptions, choice: DiffChoice | None,
