@@ -16,7 +16,6 @@ from wbfriction.fit.result import FitResult, compare_routes
 from wbfriction.fit.selection import fit_friction
 from wbfriction.fit.status import (
     FIT_STATUSES,
-    MIN_REVERSE,
     MIN_SPEED,
     PROMISE,
     WEAK,
@@ -24,7 +23,6 @@ from wbfriction.fit.status import (
     FitVerdict,
     fit_verdict,
     joint_speed,
-    reverse_share,
     solver_phrase,
 )
 from wbfriction.friction.models import CoulombViscousParams, FrictionParams
@@ -282,35 +280,3 @@ def test_the_thresholds_decide_each_rule():
     assert fit_verdict(later).status == "does not predict"
     assert fit_verdict(later, StatusThresholds(holdout_excess=0.1)).ok
     assert fit_verdict(later, DEFAULT_THRESHOLDS) == later.verdict()
-
-
-def _dips(n_cycles: int = 12, period: int = 100, dip: int = 8) -> np.ndarray:
-    """A crawl's calf seen while its leg swings: moving one way, the other for ``dip`` samples before each
-    reversal (a Coulomb level the other way measured only through windows that hold a reversal)."""
-    k = np.arange(n_cycles * period) % period
-    return np.where(k < dip, -0.5 * (dip - k) / dip, 1.0 + np.sin(np.pi * k / period))
-
-
-def test_samples_the_other_way_within_a_window_of_a_reversal_do_not_separate_the_coulomb_level():
-    qd = _dips()
-    assert reverse_share(qd) == pytest.approx(0.08)  # enough to pass MIN_REVERSE, counted sample by sample
-    assert reverse_share(qd, half_width=10) == 0.0  # none of them with a window that holds no reversal
-    assert 0 < reverse_share(qd, half_width=3) < MIN_REVERSE  # a narrower window: the middle of each dip alone
-    rows = np.flatnonzero(np.arange(qd.size) % 2 == 0)
-    assert reverse_share(qd, rows, 10) == 0.0 and reverse_share(qd, rows) == pytest.approx(0.08)
-
-
-def test_a_joint_that_stands_still_is_not_called_one_way():
-    assert reverse_share(np.zeros(50)) == 0.5 and reverse_share(np.zeros(50), half_width=5) == 0.5
-
-
-@settings(max_examples=40, deadline=None)
-@given(signs=st.lists(st.sampled_from([-1.0, 0.0, 1.0]), min_size=1, max_size=60), h=st.integers(0, 6))
-def test_a_sample_counts_for_a_way_when_its_whole_window_moves_that_way(signs, h):
-    qd = np.array(signs) * 0.3
-    n = qd.size
-    clean = [s for i, s in enumerate(np.sign(qd))
-             if s != 0 and all(np.sign(qd[min(max(j, 0), n - 1)]) == s for j in range(i - h, i + h + 1))]
-    up, down = clean.count(1.0), clean.count(-1.0)
-    expected = 0.5 if not np.any(qd) else (min(up, down) / (up + down) if up + down else 0.0)
-    assert reverse_share(qd, half_width=h) == pytest.approx(expected)

@@ -39,7 +39,6 @@ from wbfriction.fit.regression import (
     held_out_split,
 )
 from wbfriction.fit.result import FitResult, HeldOutScore, ModelSelection
-from wbfriction.fit.smoothing import smoother_half_width
 from wbfriction.fit.solve import (
     blas_controller,
     fit_model,
@@ -189,8 +188,7 @@ def fit_friction(qd: np.ndarray, tau_f: np.ndarray, *, delta_s: float = 2.0, joi
         else:
             res = fit_named(named, qd, y, use, x0=x0, still=still if speed < MIN_SPEED else None, **kwargs)
     res.n_screened, res.n_stuck = int(screened.sum()), int(stuck.sum())
-    res.speed, res.velocity_noise = speed, float(velocity_noise)
-    res.reverse = reverse_share(qd, use, smoother_half_width(smoother))
+    res.speed, res.velocity_noise, res.reverse = speed, float(velocity_noise), reverse_share(qd[use])
     res.stick_speed, res.pass_rows = float(stick), float(pass_rows)
     return res
 

@@ -28,8 +28,7 @@ status, the first that applies:
   (:mod:`~wbfriction.fit.holdout`): the friction changed over the log, or a model error the standard errors
   do not see (the errors and held-out RMS given); a term beyond velocity that departs on the later stretch makes
   its joint so too (:mod:`~wbfriction.fit.term_selection`);
-* ``weak``: the joint moved one way (the other on fewer than :data:`MIN_REVERSE` of its samples, each counted only
-  when its smoothing window holds no reversal, :func:`reverse_share`: its Coulomb
+* ``weak``: the joint moved one way (the other on fewer than :data:`MIN_REVERSE` of its samples: its Coulomb
   friction and offset are not separable, whatever their standard errors say), or
   a parameter a user reads (F_c, F_v; tau_os against F_c) has a standard error (with ``model="auto"`` the
   statistical one, the larger of the Newey-West and the block jackknife's, the model family's spread and the routes'
@@ -60,7 +59,6 @@ from types import SimpleNamespace
 from typing import Any, Literal, Protocol, cast, get_args
 
 import numpy as np
-from scipy.ndimage import maximum_filter1d, minimum_filter1d
 
 from wbfriction.fit.block_spread import statistical_error
 from wbfriction.fit.holdout import HOLDOUT_EXCESS, HOLDOUT_FRICTION, HOLDOUT_Z
@@ -82,31 +80,12 @@ quadruped's thigh seen only while its leg swings (issue 56) moves one way; no re
 (measured in the issue's note)."""
 
 
-def reverse_share(qd: np.ndarray, rows: np.ndarray | None = None, half_width: int = 0) -> float:
-    """The share of samples moving the less frequent way (``qd`` of the sign fewer of them have; zero counts as
-    neither); 0.5 for none moving, 0 when each moving sample's window holds a reversal.
-
-    Args:
-        qd: the joint's velocities (N,) [rad/s], the whole series when ``rows`` is given.
-        rows: the samples counted (indices into ``qd``), or None for all.
-        half_width: the estimate's smoother's reach on each side [samples]
-            (:func:`~wbfriction.fit.smoothing.smoother_half_width`). A sample counts for a way only when every sample
-            within it moves that way: a friction smoothed over a window that holds a reversal blends both ways'
-            Coulomb levels in a share set by the reversal's timing, which the smoothing blurs, so it does not
-            measure the other way's level (a crawl's calf seen while its leg swings reverses once per swing: its
-            8 % of samples the other way were all within a window of the reversal, and its F_c came out 18 % off
-            at 2.8 standard errors).
-    """
-    sign = np.sign(np.asarray(qd, dtype=float))
-    counted = slice(None) if rows is None else np.asarray(rows)
-    if not np.any(sign[counted]):
-        return 0.5
-    if half_width > 0:
-        size = 2 * int(half_width) + 1
-        lowest = minimum_filter1d(sign, size, mode="nearest")
-        sign = np.where(lowest == maximum_filter1d(sign, size, mode="nearest"), sign, 0.0)
-    up, down = int(np.sum(sign[counted] > 0)), int(np.sum(sign[counted] < 0))
-    return min(up, down) / (up + down) if up + down else 0.0
+def reverse_share(qd: np.ndarray) -> float:
+    """The share of samples ``qd`` (n,) [rad/s] moving the less frequent way (``qd`` of the sign fewer of them have;
+    zero counts as neither); 0.5 for none."""
+    qd = np.asarray(qd, dtype=float)
+    up, down = int(np.sum(qd > 0)), int(np.sum(qd < 0))
+    return min(up, down) / (up + down) if up + down else 0.5
 
 
 def joint_speed(qd: np.ndarray) -> float:
@@ -282,8 +261,7 @@ def _weak_verdict(fit: Fit, weak: list[str]) -> FitVerdict:
     not measured (``fit.unmeasured``), else ``ok``."""
     unmeasured = str(getattr(fit, "unmeasured", "") or "")
     reverse, names = getattr(fit, "reverse", None), fit.params.names
-    one_way = [f"it moved one way (the other on {100 * reverse:.1f} % of its samples, away from a reversal by the "
-               "smoothing's reach): F_c and tau_os are not "
+    one_way = [f"it moved one way (the other on {100 * reverse:.1f} % of its samples): F_c and tau_os are not "
                "separable"] if reverse is not None and reverse < MIN_REVERSE and {"F_c", "tau_os"} <= set(names) else []
     reasons = ([unmeasured] if unmeasured else []) + one_way + (
         ["large standard errors: " + ", ".join(weak)] if weak else [])
