@@ -33,10 +33,12 @@ leaves it out of the friction and counts it).
 A swing the chain finds whose foot never rises above the stance feet's noise (:data:`LIFT_SIGMAS` of it) is not a
 swing (:func:`unlifted_swings`): the foot is on the ground, its load near nothing (a walk's foot diagonal to the
 swinging one, the other three carrying the robot). Its samples are called stance with a confidence of 0.5 (not
-confident: the cues cannot tell a foot grazing the ground from one just above it). On Solo-12's MuJoCo walk such a
-foot carries 0.3-3 N of the 24.5 N weight for about 40 ms each gait cycle, 1.1-1.7 mm above the loaded feet (which
-sink into the soft ground): both cues read it as swing, and each foot had one such false swing a cycle (95.5 %
-agreement; 98.6 % now). The Go2's walk unloads no foot so far (99.2 %, unchanged).
+confident: the torques' force cannot tell a foot grazing the ground from one just above it). With foot counts, which
+measure the load itself, the chain's swings are kept (on the Go2's 4 s walk the rule would turn 100 % into
+99.3 %). On Solo-12's MuJoCo walk such a foot carries 0.3-3 N of the 24.5 N weight for about 40 ms each gait cycle,
+1.1-1.7 mm above the loaded feet (which sink into the soft ground): both cues read it as swing, and each foot had one
+such false swing a cycle (95.5 % agreement; 98.6 % now). On the Go2's 4 s walks (``go2_walking``) agreement rises
+from 97.8-97.9 to 98.7-98.8 %.
 
 A log where no foot swings is refused (:func:`check_swings`): a foot swings where it is lifted and unloaded
 (:func:`lifted_unloaded`) for a run of consecutive samples at least :func:`least_swing` long, the run that noise
@@ -471,7 +473,8 @@ def infer_contacts(robot: Robot, q: np.ndarray, qd: np.ndarray, tau: np.ndarray,
         logb += _force_densities((arrays["foot_counts"] - offset) / scale, swing, w)
     post = np.stack([_posterior(logb[:, c], p) for c in range(nc)], axis=1)
     contact = post > 0.5
-    grazing = unlifted_swings(contact, h, sigma)  # on the ground, its load near nothing: undetermined
+    # on the ground, its load near nothing: undetermined (foot counts measure the load: a run they call swing is)
+    grazing = unlifted_swings(contact, h, sigma) if foot_counts is None else np.zeros_like(contact)
     contact |= grazing
     confidence = np.where(grazing, 0.5, np.where(contact, post, 1.0 - post))
     return InferredContacts(contact, confidence, confidence >= options.level, tuple(c for c in CUES if c in cues),
