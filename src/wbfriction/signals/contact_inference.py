@@ -30,6 +30,16 @@ Each foot is a two-state hidden Markov model (swing, stance) whose emission is t
 (``max(p, 1 - p)``), and a sample whose confidence is below ``options.level`` is not confident (the integrator
 leaves it out of the friction and counts it).
 
+A swing the chain finds whose foot never rises above the stance feet's noise (:data:`LIFT_SIGMAS` of it) is not a
+swing (:func:`unlifted_swings`): the foot is on the ground, its load near nothing (a walk's foot diagonal to the
+swinging one, the other three carrying the robot). Its samples are called stance with a confidence of 0.5 (not
+confident: the torques' force cannot tell a foot grazing the ground from one just above it). With foot counts, which
+measure the load itself, the chain's swings are kept (on the Go2's 4 s walk the rule would turn 100 % into
+99.3 %). On Solo-12's MuJoCo walk such a foot carries 0.3-3 N of the 24.5 N weight for about 40 ms each gait cycle,
+1.1-1.7 mm above the loaded feet (which sink into the soft ground): both cues read it as swing, and each foot had one
+such false swing a cycle (95.5 % agreement; 98.6 % now). On the Go2's 4 s walks (``go2_walking``) agreement rises
+from 97.8-97.9 to 98.7-98.8 %.
+
 A log where no foot swings is refused (:func:`check_swings`): a foot swings where it is lifted and unloaded
 (:func:`lifted_unloaded`) for a run of consecutive samples at least :func:`least_swing` long, the run that noise
 alone on a standing robot makes with a probability below :data:`SWING_LEVEL`; isolated samples that cross the
@@ -112,7 +122,8 @@ class InferredContacts:
 
     Attributes:
         contact: (N, n_c) bool, the best guess per foot (``robot.contact_frames`` order): True on the ground.
-        confidence: (N, n_c) float in [0.5, 1]: the posterior probability that the guess is right.
+        confidence: (N, n_c) float in [0.5, 1]: the posterior probability that the guess is right; 0.5 on a swing
+            the foot never lifted in (:func:`unlifted_swings`: called stance, undetermined).
         confident: (N, n_c) bool: ``confidence >= options.level``.
         cues: the cues used (of :data:`CUES`).
         gait_period: the gait's period [s] from the periodicity, None if not periodic (or the cue is off).
@@ -329,6 +340,26 @@ def longest_runs(mask: np.ndarray) -> np.ndarray:
     return out
 
 
+def unlifted_swings(contact: np.ndarray, h: np.ndarray, sigma: float) -> np.ndarray:
+    """(N, n_c) bool: the samples of the swings (runs of ``~contact`` per foot, (N, n_c) bool) in which the foot is
+    never lifted: no sample's height ``h`` [m] above :data:`LIFT_SIGMAS` times the stance feet's height noise
+    ``sigma`` [m] (:func:`lifted_unloaded`'s height test).
+
+    A swing lifts its foot; a foot that stays within the stance feet's noise while its load falls to near nothing is
+    a foot grazing the ground (a walk's foot diagonal to the swinging one, whose load the other three carry: 0.3-3 N of
+    Solo-12's 24.5 N on its MuJoCo twin, 1-1.7 mm above the loaded feet, which sink into the soft ground), not a
+    swing, whatever its load's cue says.
+    """
+    contact, h = np.asarray(contact, dtype=bool), np.asarray(h, dtype=float)
+    lifted = h > LIFT_SIGMAS * sigma
+    out = np.zeros(contact.shape, dtype=bool)
+    for c in range(contact.shape[1]):
+        edges = np.diff(np.r_[0, (~contact[:, c]).astype(np.int8), 0])
+        for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+            out[a:b, c] = not lifted[a:b, c].any()
+    return out
+
+
 def check_swings(lifted: np.ndarray, dt: float, frames: tuple[str, ...], source: str = "<log>") -> np.ndarray:
     """Refuse a log where no foot swings: no run of lifted-and-unloaded samples (``lifted``, (N, n_c) bool, from
     :func:`lifted_unloaded`) as long as :func:`least_swing` (isolated samples are noise: a stance foot near the
@@ -442,6 +473,9 @@ def infer_contacts(robot: Robot, q: np.ndarray, qd: np.ndarray, tau: np.ndarray,
         logb += _force_densities((arrays["foot_counts"] - offset) / scale, swing, w)
     post = np.stack([_posterior(logb[:, c], p) for c in range(nc)], axis=1)
     contact = post > 0.5
-    confidence = np.where(contact, post, 1.0 - post)
+    # on the ground, its load near nothing: undetermined (foot counts measure the load: a run they call swing is)
+    grazing = unlifted_swings(contact, h, sigma) if foot_counts is None else np.zeros_like(contact)
+    contact |= grazing
+    confidence = np.where(grazing, 0.5, np.where(contact, post, 1.0 - post))
     return InferredContacts(contact, confidence, confidence >= options.level, tuple(c for c in CUES if c in cues),
                             period)
