@@ -188,11 +188,12 @@ def twin_estimates(robot, twin_runs):
     return out
 
 
-MEASURED_VELOCITY = {("trot", False, False): 0.022, ("trot", False, True): 0.0098, ("trot", True, False): 0.028,
-                     ("trot", True, True): 0.020, ("walk", False, False): 0.0040, ("walk", False, True): 0.0041,
-                     ("walk", True, False): 0.0101, ("walk", True, True): 0.0104}
-"""The linear velocity's relative error measured per (gait, noisy, accelerometer) on the twin's firm feet
-(/work/notes/82/i82-creep.md; on MuJoCo's soft ones 5.6-9.9 %)."""
+MEASURED_VELOCITY = {("trot", False, False): 0.0224, ("trot", False, True): 0.0108, ("trot", True, False): 0.021,
+                     ("trot", True, True): 0.017, ("walk", False, False): 0.0055, ("walk", False, True): 0.0034,
+                     ("walk", True, False): 0.0099, ("walk", True, True): 0.0108}
+"""The linear velocity's relative error measured per (gait, noisy, accelerometer) on the twin's firm feet with each
+foot's noise raised near its touch-down and lift-off (/work/notes/82/i82-odorobust.md; before, one legs' noise for
+every sample: 2.2, 0.98, 2.8, 2.0, 0.40, 0.41, 1.01, 1.04 %, i82-creep.md; on MuJoCo's soft feet 5.6-9.9 %)."""
 
 
 @pytest.mark.slow
@@ -219,7 +220,7 @@ def test_on_the_twin_the_orientation_and_rates_are_the_imus(robot, twin_runs, tw
 @pytest.mark.parametrize("gait, noisy", CASES)
 def test_on_the_twin_the_linear_velocity_as_measured(robot, twin_runs, twin_estimates, gait, noisy):
     """The linear velocity's RMS error over the RMS speed, without and with the accelerometer, within 10 % of what
-    was measured on the twin's firm feet (:data:`MEASURED_VELOCITY`: 0.4-2.8 %); the accelerometer helps (or does not
+    was measured on the twin's firm feet (:data:`MEASURED_VELOCITY`: 0.3-2.2 %); the accelerometer helps (or does not
     hurt by more than 1 % of the speed)."""
     log = twin_runs[gait, noisy].log
     errors = {}
@@ -279,3 +280,61 @@ def test_the_twins_feet_hold_where_soft_feet_creep(robot, twin_runs, gait):
             assert creep > 0.05 * speed and error > 0.05
         else:
             assert creep < 0.01 * speed and error < 0.05
+
+
+def test_a_landing_foots_noise_is_read_from_its_disagreement_with_the_others():
+    """Four feet agreeing to 1e-4 m/s; foot 0 lands every 50 samples off by 0.3, 0.1, 0.03 m/s on its first three
+    samples: :func:`~wbfriction.signals.leg_noise.stance_noise` gives those three a noise near that error,
+    non-increasing, the stance level (the pooled spread) to the other feet, and to foot 0 from its fifth sample on
+    (the fourth shares the third's octave, 3-4 samples) within the spread's sampling error (20 %); NaN where a foot
+    does not measure."""
+    from wbfriction.signals.leg_noise import pooled_spread, stance_noise
+
+    rng = np.random.default_rng(0)
+    n, period = 2000, 50
+    v = rng.normal(0.0, 1e-4, (n, 4, 3))
+    starts = np.arange(period, n - period, period)
+    for start in starts:
+        v[start - 25:start, 0] = np.nan  # foot 0 swings, lands at `start`
+        v[start:start + 3, 0] += np.array([0.3, 0.1, 0.03])[:, None] * rng.choice([-1, 1], (3, 3))
+    floor = pooled_spread(v)
+    sd = stance_noise(v, floor)
+    np.testing.assert_allclose(floor, 1e-4, rtol=0.2)
+    near = np.zeros(n, dtype=bool)
+    near[(starts[:, None] + np.arange(4)).ravel()] = True
+    np.testing.assert_array_equal(sd[:, 1:], np.broadcast_to(floor, (n, 3, 3)))
+    settled = ~near & np.isfinite(v[:, 0, 0])
+    np.testing.assert_allclose(sd[settled, 0], np.broadcast_to(floor, (settled.sum(), 3)), rtol=0.2)
+    first, second, third = (sd[starts + k, 0] for k in range(3))
+    assert np.all(first >= second) and np.all(second >= third)
+    assert np.all((first > 0.1) & (first < 0.5)) and np.all(third > 0.01)
+    assert np.all(np.isnan(sd[~np.isfinite(v[..., 0])]))
+
+
+@pytest.mark.slow
+def test_on_the_raw_twin_the_clean_firm_trot_within_five_percent(tmp_path):
+    """The raw route (contacts inferred, ``studies/walking_logs``' scoring) on 8 s of the firm twin's clean trot: the
+    base's velocity within 5 % RMS of its speed (measured 3.0 %). With one legs' noise for every sample it was 38 %:
+    on noise-free joints the stance feet agree to 0.1-0.8 mm/s, a landing foot is off by 3-400 mm/s for a few
+    samples, the gate rejected every foot of those samples and the smoother drifted by up to 0.86 m/s
+    (/work/notes/82/i82-odorobust.md)."""
+    import subprocess
+    import sys
+
+    import pyarrow.parquet as pq
+
+    from wbfriction.logs.options import ReadOptions
+    from wbfriction.model.loading import RobotSpec
+    from wbfriction.pipeline.raw_log import prepare_raw
+    from wbfriction.studies.walking_logs import RATE, TWIN_ROBOT
+
+    out = tmp_path / "trot_firm.parquet"
+    done = subprocess.run([sys.executable, "-m", "wbfriction", "simulate", "--robot", str(TWIN_ROBOT), "--simulator",
+                           "mujoco", "--gait", "trot", "--duration", "8", "--logger", "raw", "--contacts", "firm",
+                           "-o", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    robot = RobotSpec.given(str(TWIN_ROBOT)).load()
+    prepared = prepare_raw(pq.read_table(out), robot, str(out), ReadOptions(rate=float(RATE)))
+    table = prepared.table
+    truth = np.column_stack([np.asarray(table.column(f"base_qd_true.{a}")) for a in ("vx", "vy", "vz")])
+    assert relative_error(prepared.base.twist[:, :3], truth) < 0.05

@@ -23,10 +23,10 @@ sample by sample, in Pinocchio's free-flyer convention (:mod:`wbfriction.signals
 * **Fusion.** Per world axis a constant-acceleration model (state: velocity and acceleration, driven by a white
   jerk of spectral density ``s`` [m^2/s^5]) in ``filterpy``'s Kalman filter and Rauch-Tung-Striebel smoother (the
   log is offline: every sample's estimate uses the whole log). Measurements: the mean of the confident stance feet's
-  velocities (variance ``sigma_leg^2 / n_feet``), and with an accelerometer its specific force made the base
-  origin's acceleration in the world (:func:`~wbfriction.model.imu.base_motion_from_imu`, gravity added back, the
-  IMU's lever arm taken out). The accelerometer enters as a measurement of the state's acceleration rather than as
-  the process's input (Bloesch et al. 2013, "State estimation for legged robots: consistent fusion of leg
+  velocities weighted by their noise (variance ``1 / sum(1 / sd^2)``), and with an accelerometer its specific force
+  made the base origin's acceleration in the world (:func:`~wbfriction.model.imu.base_motion_from_imu`, gravity
+  added back, the IMU's lever arm taken out). The accelerometer enters as a measurement of the state's acceleration
+  rather than as the process's input (Bloesch et al. 2013, "State estimation for legged robots: consistent fusion of leg
   kinematics and IMU"): the two agree as the jerk's density grows, and the smoother then gives the acceleration its
   own standard deviation. Flight (no foot down, every foot's state confident) without an accelerometer: the
   centre of mass falls at ``g`` (a pseudo-measurement ``a = g - a_com|a_b=0``, Pinocchio's centre-of-mass
@@ -36,10 +36,15 @@ sample by sample, in Pinocchio's free-flyer convention (:mod:`wbfriction.signals
 
 **Noise levels, from the data** (each may be given instead, :class:`OdometryOptions`):
 
-* ``sigma_leg`` per axis: the robust spread of the stance feet's velocities about their mean, over the samples
-  with two or more confident stance feet (:func:`pooled_spread`); a foot the smoothed state rejects (a chi-square
-  test, :data:`GATE`: slipping, landing or lifting off while its flag says stance) is left out and the whole done
-  again (:func:`fused_velocity`);
+* each stance foot's velocity noise per axis (:mod:`~wbfriction.signals.leg_noise`): the stance level
+  ``sigma_leg``, the robust spread of the stance feet's velocities about their mean over the samples with two or
+  more confident stance feet (:func:`~wbfriction.signals.leg_noise.pooled_spread`), raised near the foot's own
+  touch-down and lift-off by as much as the feet disagree there (:func:`~wbfriction.signals.leg_noise.stance_noise`:
+  a landing foot is still stopping, a lifting one unloading); the velocity measurement is the feet's mean weighted
+  by ``1 / sd^2``. A foot the smoothed state rejects (a chi-square test, :data:`GATE`: slipping, landing or lifting
+  off beyond its noise) is left out and the whole done again (:func:`fused_velocity`); the test's variance is the
+  smoothed residual's, ``sd^2 - P`` for a foot the state used (the state holds part of its error) and
+  ``sd^2 + P`` for one it did not (``P`` the state's velocity variance);
 * the accelerometer's and the gyro's white noise: :func:`~wbfriction.signals.content.white_position_noise` of their
   second differences (robust to the impacts);
 * ``s`` per axis: the maximum of the measurements' likelihood (the innovations'), on a grid of decades of the
@@ -68,6 +73,7 @@ from wbfriction.model.robot import Robot
 from wbfriction.signals.base_motion import continuous_quaternions
 from wbfriction.signals.content import contact_changes, white_position_noise
 from wbfriction.signals.filters import fir, savgol_kernels
+from wbfriction.signals.leg_noise import pooled_spread, stance_noise
 from wbfriction.signals.options import NOISE_TARGET
 
 JERK_GRID = (-14.0, 4.0)
@@ -76,9 +82,9 @@ docstring): a filter's bandwidth is about ``(s / sigma^2)^(1/4)``, here from abo
 frequency at 500 Hz."""
 
 GATE = 16.27
-"""A foot's velocity is left out where its squared Mahalanobis distance to the smoothed state (three axes) exceeds
-this: the chi-square distribution's 99.9 % quantile with 3 degrees of freedom (a foot slipping, landing or lifting
-off while its flag says stance)."""
+"""A foot's velocity is left out where its squared Mahalanobis distance to the smoothed state (three axes; the
+smoothed residual's variance, module docstring) exceeds this: the chi-square distribution's 99.9 % quantile with 3
+degrees of freedom (a foot slipping, landing or lifting off while its flag says stance)."""
 GATE_ROUNDS = 3
 """Most rounds of :func:`fused_velocity` (the feet kept settle in two or three)."""
 
@@ -95,7 +101,8 @@ class OdometryOptions:
             :data:`~wbfriction.signals.options.NOISE_TARGET`); also the joints' acceleration noise a flight's
             gravity pseudo-measurement is given.
         jerk: the process's white jerk density [m^2/s^5] on every axis (> 0); None: per axis, the likelihood's best.
-        leg_sd: a stance foot's velocity noise [m/s] (> 0); None: the stance feet's spread.
+        leg_sd: a stance foot's velocity noise [m/s] (> 0), every foot and sample alike; None: the stance feet's
+            spread, raised near each foot's touch-down and lift-off (:mod:`~wbfriction.signals.leg_noise`).
         acc_sd: the accelerometer's white noise [m/s^2] (> 0); None: read from it.
         gyro_sd: the gyro's white noise [rad/s] (>= 0); None: read from it.
 
@@ -136,7 +143,8 @@ class BaseEstimate:
             w_dot)`` [m/s^2, rad/s^2], base frame; the angular part NaN where the gyro's fit has no whole window.
         twist_sd, acceleration_sd: (N, 6) their standard deviations (the flights' and the unconfident rows' grow).
         stance: (N,) the confident stance feet per sample (0: none measured the velocity there).
-        leg_sd: (3,) the stance feet's velocity noise used [m/s], world axes.
+        leg_sd: (3,) the stance feet's velocity noise used [m/s], world axes: the stance level (a foot near its
+            touch-down or lift-off counts more, :func:`~wbfriction.signals.leg_noise.stance_noise`).
         jerk: (3,) the process's jerk density used [m^2/s^5], world axes.
         gyro_sd, acc_sd: the gyro's [rad/s] and the accelerometer's [m/s^2] noise used (acc_sd NaN without one).
         gyro_window: the gyro fit's window [samples].
@@ -253,21 +261,6 @@ def stance_velocities(robot: Robot, full_q: np.ndarray, rest: np.ndarray, base_r
             v_lin = np.linalg.lstsq(J[:, :3], -(J[:, 3:] @ rest[k, 3:]), rcond=None)[0]
             out[k, c] = base_rot[k] @ v_lin
     return out
-
-
-def pooled_spread(velocities: np.ndarray) -> np.ndarray:
-    """The stance feet's velocity noise (3,) [m/s] per axis: their spread about their mean over the samples with two
-    or more measuring feet (``velocities`` (N, n_c, 3), NaN for a foot not measuring), robustly: each deviation
-    scaled by ``sqrt(n / (n - 1))`` (the mean of ``n`` takes ``1 / n`` of its variance), then 1.4826 times their
-    median absolute value (a normal's standard deviation; a foot slipping or landing does not count); NaN where no
-    sample has two."""
-    n = np.sum(np.isfinite(velocities[..., 0]), axis=1)
-    rows = n >= 2
-    if not rows.any():
-        return np.full(3, np.nan)
-    v = velocities[rows]
-    deviation = (v - np.nanmean(v, axis=1, keepdims=True)) * np.sqrt(n[rows] / (n[rows] - 1))[:, None, None]
-    return 1.4826 * np.nanmedian(np.abs(deviation).reshape(-1, 3), axis=0)
 
 
 def flight_gravity(robot: Robot, full_q: np.ndarray, v: np.ndarray, a: np.ndarray, rows: np.ndarray,
@@ -425,20 +418,28 @@ def _acceleration_measurements(robot: Robot, full_q: np.ndarray, rest: np.ndarra
     return z_a, r_a, acc_sd
 
 
-def fused_velocity(dt: float, feet_v: np.ndarray, leg_sd: np.ndarray, z_a: np.ndarray, r_a: np.ndarray,
-                   jerk: float | None, prior_sd: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def fused_velocity(dt: float, feet_v: np.ndarray, feet_sd: np.ndarray, leg_sd: np.ndarray, z_a: np.ndarray,
+                   r_a: np.ndarray, jerk: float | None, prior_sd: float
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The smoothed world velocity and acceleration (N, 6) and covariance (N, 6, 6), the jerk density used (3,) and
-    the feet kept (N, n_c) bool (module docstring): the filter and smoother on the mean of the measuring feet; the
-    feet whose velocity the smoothed state rejects (squared Mahalanobis distance over :data:`GATE`, the legs' noise
-    and the state's variance) left out and the whole done again until the feet kept stay the same (at most
-    :data:`GATE_ROUNDS` rounds), the jerk's density chosen again each round."""
-    use = np.isfinite(feet_v[..., 0])
+    the feet kept (N, n_c) bool (module docstring): the filter and smoother on the kept feet's velocities ``feet_v``
+    (N, n_c, 3), weighted by their noise ``feet_sd`` (N, n_c, 3) (:func:`~wbfriction.signals.leg_noise.stance_noise`:
+    their mean weighted by ``1 / sd^2``, its variance ``1 / sum(1 / sd^2)`` per axis); the feet whose velocity the
+    smoothed state rejects (:data:`GATE`) left out and the whole done again until the feet kept stay the same (at
+    most :data:`GATE_ROUNDS` rounds), the jerk's density chosen again each round (on the scale of the stance level
+    ``leg_sd`` (3,))."""
+    measuring = np.isfinite(feet_v[..., 0])
+    use = measuring
+    weight = np.where(measuring[..., None], 1.0 / np.where(measuring[..., None], feet_sd, 1.0) ** 2, 0.0)
+    v0 = np.where(measuring[..., None], feet_v, 0.0)
 
     def measured(use: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        count = use.sum(axis=1)
+        w = weight * use[..., None]
+        total = w.sum(axis=1)
+        has = np.asarray(use.any(axis=1), dtype=bool)
         z_v = np.full((len(feet_v), 3), np.nan)
-        z_v[count > 0] = np.sum(np.where(use[..., None], feet_v, 0.0), axis=1)[count > 0] / count[count > 0, None]
-        return z_v, leg_sd**2 / np.maximum(count, 1)[:, None]
+        z_v[has] = np.sum(w * v0, axis=1)[has] / total[has]
+        return z_v, 1.0 / np.where(has[:, None], total, 1.0)
 
     def likeliest(use: np.ndarray) -> np.ndarray:
         return np.full(3, jerk) if jerk is not None else likeliest_jerk(dt, *measured(use), z_a, r_a, leg_sd,
@@ -448,9 +449,11 @@ def fused_velocity(dt: float, feet_v: np.ndarray, leg_sd: np.ndarray, z_a: np.nd
         s = likeliest(use)
         xs, Ps, _, kf = kalman_pass(dt, *measured(use), z_a, r_a, s, prior_sd)
         x, P, _, _ = kf.rts_smoother(xs, Ps)  # type: ignore[attr-defined]
-        var = leg_sd**2 + np.diagonal(P[:, :3, :3], axis1=1, axis2=2)
-        d2 = np.sum((feet_v - x[:, None, :3, 0])**2 / var[:, None, :], axis=2)
-        kept = np.isfinite(feet_v[..., 0]) & (d2 <= GATE)
+        state = np.diagonal(P[:, :3, :3], axis1=1, axis2=2)[:, None, :]
+        var = np.where(use[..., None], feet_sd**2 - state, feet_sd**2 + state)
+        var = np.where(var > 0, var, np.inf)  # a foot the state holds to rounding: nothing to test it against
+        d2 = np.sum((feet_v - x[:, None, :3, 0])**2 / var, axis=2)
+        kept = measuring & (d2 <= GATE)
         if last or np.array_equal(kept, use):
             break
         use = kept
@@ -505,7 +508,9 @@ def base_from_legs(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
     z_a, r_a, acc_sd = _acceleration_measurements(robot, full_q, rest, qdd, base_rot, ang, contact, confident, acc,
                                                   dt, options)
     prior_sd = float(np.linalg.norm(robot.model.gravity.linear)) * 1.0  # a second of free fall: diffuse
-    x, P, jerk, kept = fused_velocity(dt, feet_v, leg_sd, z_a, r_a, options.jerk, prior_sd)
+    feet_sd = (np.where(np.isfinite(feet_v), options.leg_sd, np.nan) if options.leg_sd is not None
+               else stance_noise(feet_v, leg_sd))
+    x, P, jerk, kept = fused_velocity(dt, feet_v, feet_sd, leg_sd, z_a, r_a, options.jerk, prior_sd)
     v_w, a_w = x[:, :3], x[:, 3:]
     v_lin = np.einsum("nji,nj->ni", base_rot, v_w)
     a_lin = np.einsum("nji,nj->ni", base_rot, a_w) - np.cross(ang.omega, v_lin)
