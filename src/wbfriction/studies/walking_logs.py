@@ -48,15 +48,18 @@ ROUTE: tuple[str, ...] = ()
 
 @dataclass(frozen=True)
 class WalkingCase:
-    """One case: the gait and whether the sensors are a real robot's (noisy)."""
+    """One case: the gait, whether the sensors are a real robot's (noisy), and the twin's MuJoCo contacts
+    (``simulate --contacts``: ``soft``, MuJoCo's default, whose stance feet creep about 1.5 cm/s; ``firm``, feet that
+    hold)."""
 
     gait: str
     noisy: bool
+    contacts: str = "soft"
 
     @property
     def name(self) -> str:
-        """``trot``, ``walk-noisy``, ..."""
-        return self.gait + ("-noisy" if self.noisy else "")
+        """``trot``, ``walk-noisy``, ... (``-firm`` after on firm contacts)."""
+        return self.gait + ("-noisy" if self.noisy else "") + ("" if self.contacts == "soft" else f"-{self.contacts}")
 
 
 CASES = tuple(WalkingCase(g, n) for g in ("trot", "walk") for n in (False, True))
@@ -102,7 +105,7 @@ def simulate(case: WalkingCase, folder: Path, seed: int = 0, robot: Path = TWIN_
     out = folder / f"{case.name}_raw.parquet"
     noise = ["--sensor-noise", "unitree", "--noise-seed", str(seed + 1)] if case.noisy else []
     _run(["simulate", "--robot", str(robot), "--simulator", "mujoco", "--gait", case.gait, "--duration",
-          str(DURATION), "--logger", "raw", *noise, "-o", str(out)], folder)
+          str(DURATION), "--logger", "raw", "--contacts", case.contacts, *noise, "-o", str(out)], folder)
     return out
 
 
