@@ -26,6 +26,7 @@ from wbfriction.signals.contact_inference import (
     infer_contacts,
     least_swing,
     lifted_unloaded,
+    run_count,
     unlifted_swings,
     weight,
 )
@@ -107,8 +108,8 @@ def test_a_standing_log_with_noisy_feet_is_refused(robot, mjr):
     orientation noise (sim.logger.ORIENTATION_STD, white): near the end a foot's load falls to a few per cent of the
     weight and isolated samples (runs of 1-2, measured; 1-8 with other seeds of the IMU's noise) are lifted and
     unloaded. Before, any such sample passed the check and each foot was called off the ground on 43-49 % of the
-    samples, on a robot that never swings; now a swing needs a run of least_swing samples (24 here), and the message
-    says what was found."""
+    samples, on a robot that never swings; now a swing needs a run of least_swing samples (for the runs the log holds),
+    and the message says what was found."""
     reference = quadruped_reference(robot, GaitOptions("stand", duration=8.0))
     log = simulate_quadruped_mujoco(robot, reference, noise=UNITREE_NOISE, mjr=mjr).log
     rng = np.random.default_rng(0)
@@ -121,7 +122,7 @@ def test_a_standing_log_with_noisy_feet_is_refused(robot, mjr):
     assert lifted_unloaded(h, sigma, forces[..., 2], weight(robot)).any()  # what passed before
     with pytest.raises(InputError, match=r"^stand.parquet: no foot ever leaves the ground \(a standing log\): the "
                        r"longest run of samples with a foot lifted and unloaded is \d+ \(\d+ ms, \w+_foot\), "
-                       r"against the 24 \(48 ms\) a swing needs") as refused:
+                       r"against the \d+ \(\d+ ms\) a swing needs among the log's \d+ runs") as refused:
         infer_contacts(robot, log.q, log.qd_logged, log.tau, imu, reference.dt, source="stand.parquet")
     assert "\n" not in str(refused.value)
 
@@ -131,32 +132,44 @@ def test_a_standing_log_with_noisy_feet_is_refused(robot, mjr):
        share=st.floats(0.0, 0.3), torque=st.booleans())
 def test_isolated_lifted_samples_never_make_a_swing_and_one_run_does(seed, n, nc, share, torque):
     """Synthetic feet standing (heights within their noise, loads above the off threshold), with runs of lifted and
-    unloaded samples each shorter than least_swing, separated by one standing sample or more, on up to ``share`` of
-    the samples: refused. One run of exactly least_swing samples added on a foot: accepted, that foot's longest run
-    is it."""
+    unloaded samples each shorter than the least any log needs, separated by one standing sample or more, on up to
+    ``share`` of the samples: refused. One run as long as least_swing of the runs then held added on a foot:
+    accepted, that foot's longest run is it."""
     rng = np.random.default_rng(seed)
     sigma, w = 1e-3, 150.0
-    need = least_swing(n, nc)
+    shortest = least_swing(1)  # what a swing needs whatever the runs: noise runs shorter are refused
     h = rng.normal(0.0, sigma, (n, nc)).clip(-3 * sigma, 3 * sigma)
     fz = rng.uniform(OFF_SHARE * w * 1.01, w, (n, nc))
     for c in range(nc):
         k = 0
         while k < n:
-            length = int(rng.integers(1, need))
+            length = int(rng.integers(1, shortest))
             if rng.random() < share:
                 h[k: k + length, c] = rng.uniform(LIFT_SIGMAS * sigma * 1.01, 0.1, len(h[k: k + length]))
                 fz[k: k + length, c] = rng.uniform(-0.2 * w, OFF_SHARE * w * 0.99, len(h[k: k + length]))
             k += length + 1  # the next run after a standing sample
     frames = tuple(f"foot{c}" for c in range(nc))
+    before = lifted_unloaded(h, sigma, fz if torque else None, w)
     with pytest.raises(InputError, match="no foot ever leaves the ground"):
-        check_swings(lifted_unloaded(h, sigma, fz if torque else None, w), 0.002, frames)
-    c, start = int(rng.integers(nc)), int(rng.integers(0, n - need + 1))
+        check_swings(before, 0.002, frames)
+    need = least_swing(run_count(before) + 2)  # the run added, and one it may split in two
+    c, start = int(rng.integers(nc)), int(rng.integers(0, max(n - need, 0) + 1))
     h[start: start + need, c], fz[start: start + need, c] = 0.05, 0.0
     for k in (start - 1, start + need):  # standing on either side: the run is exactly ``need`` long
         if 0 <= k < n:
             h[k, c], fz[k, c] = 0.0, w
-    runs = check_swings(lifted_unloaded(h, sigma, fz if torque else None, w), 0.002, frames)
-    assert runs[c] == need and runs.max() == need
+    after = lifted_unloaded(h, sigma, fz if torque else None, w)
+    runs = check_swings(after, 0.002, frames)
+    assert least_swing(run_count(after)) <= need and runs[c] == min(need, n) and runs.max() == min(need, n)
+
+
+def test_the_run_a_swing_needs_grows_with_the_log_s_runs_not_its_samples():
+    """One more sample per doubling of the runs; the samples do not count (a minute's walk at 2 ms asked 27 samples
+    when every sample counted as a start, more than a Solo-12's swings hold)."""
+    assert least_swing(1) == 11 and least_swing(100) == 18 and least_swing(200) == 19
+    lifted = np.zeros((30_000, 4), dtype=bool)
+    lifted[100:121, 0] = True  # one run of 21 samples in a minute's log at 2 ms
+    assert run_count(lifted) == 1 and check_swings(lifted, 0.002, ("a", "b", "c", "d"))[0] == 21
 
 
 @settings(max_examples=80, deadline=None)

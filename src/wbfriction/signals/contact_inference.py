@@ -302,31 +302,33 @@ def lifted_unloaded(h: np.ndarray, sigma: float, fz: np.ndarray | None, weight_n
     return lifted if fz is None else lifted & (np.asarray(fz) < OFF_SHARE * weight_n)
 
 
-def least_swing(samples: int, feet: int) -> int:
-    """The fewest consecutive samples of a foot lifted and unloaded that make a swing: ``ceil(log2(samples * feet /
-    SWING_LEVEL))``.
+def least_swing(runs: int) -> int:
+    """The fewest consecutive samples of a foot lifted and unloaded that make a swing, given the log's ``runs`` of
+    such samples (every foot's, counted by :func:`run_count`): ``1 + ceil(log2(runs / SWING_LEVEL))``.
 
     A foot that stands has its mean height and load on the stance side of both thresholds
     (:func:`lifted_unloaded`), so noise symmetric about them lifts and unloads it on each sample with a probability
-    ``p <= 1/2``; on independent samples (the repeats merged) a run of ``k`` starts at a given sample with a
-    probability ``p^k <= 2^-k``, and anywhere in the log's ``samples * feet`` with at most ``samples * feet * 2^-k``.
-    The least ``k`` that keeps this below :data:`SWING_LEVEL` follows: 23 samples for 2000 samples of 4 feet (4 s at
-    2 ms), 29 for 100 000. It follows from the test level and the log's size, not from a gait: a swing is at least
-    this long lifted and unloaded, or noise alone could have made it. A swing that holds its foot lifted and
-    unloaded for fewer samples (a log sampled coarsely: 5 ms and more for the Go2's walk below) is not told from
-    noise, and the log is refused.
+    ``p <= 1/2``; on independent samples (the repeats merged) a run once started goes on ``k - 1`` more samples with a
+    probability ``p^(k-1) <= 2^-(k-1)``, and one of the log's ``runs`` does with at most ``runs * 2^-(k-1)``. The
+    least ``k`` that keeps this below :data:`SWING_LEVEL` follows: 18 samples for 100 runs, 21 for 1,000. It follows
+    from the test level and the runs the log holds, not from a gait: a swing is at least this long lifted and
+    unloaded, or noise alone could have made it. The runs are counted, not the samples: a log twice as long needs one
+    sample more only if it holds twice the runs (counting every sample as a start asked 27 samples of a minute's log
+    at 2 ms, more than a Solo-12's swings hold, 19-21). A swing that holds its foot lifted and unloaded for fewer
+    samples (a log sampled coarsely) is not told from noise, and the log is refused.
 
     The thesis's lift-off and touch-down margins (0.15 s together) are longer than what a swing holds lifted and
     unloaded: on the MuJoCo Go2 the leg's inertia, left out of the torques' force, reads as load over a swing's second
     half, and a foot's longest run in its walks and trots lasts 54-104 ms of 0.2-0.25 s swings (27-52 samples at
     2 ms). The standing twin's noise makes runs of 2-6 samples.
-
-    Raises:
-        InputError: no samples or no feet.
     """
-    if samples < 1 or feet < 1:
-        raise InputError(f"a swing's least run needs a log of samples and feet, got {samples} x {feet}")
-    return int(np.ceil(np.log2(samples * feet / SWING_LEVEL)))
+    return 1 + int(np.ceil(np.log2(max(int(runs), 1) / SWING_LEVEL)))
+
+
+def run_count(mask: np.ndarray) -> int:
+    """The runs of consecutive True in the (N, n_c) bool ``mask``, every column's together."""
+    m = np.asarray(mask, dtype=np.int8)
+    return int(np.sum(np.diff(np.vstack([np.zeros((1, m.shape[1]), np.int8), m]), axis=0) == 1))
 
 
 def longest_runs(mask: np.ndarray) -> np.ndarray:
@@ -378,16 +380,17 @@ def check_swings(lifted: np.ndarray, dt: float, frames: tuple[str, ...], source:
         InputError: no foot's longest run reaches :func:`least_swing`: one line with the longest run found (samples,
             milliseconds, the foot) against the run a swing needs.
     """
-    n, nc = lifted.shape
-    runs, need = longest_runs(lifted), least_swing(n, nc)
+    count = run_count(lifted)
+    runs, need = longest_runs(lifted), least_swing(count)
     if runs.max() < need:
         c = int(np.argmax(runs))
         run = f"{runs[c]} ({runs[c] * dt * 1e3:.3g} ms, {frames[c]})"
         found = f"the longest run of samples with a foot lifted and unloaded is {run}" if runs[c] else \
             "no sample has a foot lifted and unloaded"
         raise InputError(f"{source}: no foot ever leaves the ground (a standing log): {found}, against the "
-                         f"{need} ({need * dt * 1e3:.3g} ms) a swing needs (noise alone makes a shorter one with a "
-                         f"probability above {SWING_LEVEL:g}); contacts cannot be inferred without foot forces")
+                         f"{need} ({need * dt * 1e3:.3g} ms) a swing needs among the log's {count} runs (noise alone "
+                         f"makes one as long with a probability below {SWING_LEVEL:g}); contacts cannot be inferred "
+                         "without foot forces")
     return runs
 
 
