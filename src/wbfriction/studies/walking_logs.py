@@ -236,10 +236,11 @@ def markdown(scores: list[WalkingScore]) -> str:
              "truth |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for s in scores:
-        tol = 0.10 if s.case.endswith("noisy") else 0.05
+        tol = 0.10 if "-noisy" in s.case else 0.05
         good, ok = s.good(tol)
+        gap = "–" if np.isnan(s.given_gap) else f"{s.given_gap:.1%}"
         lines.append(f"| {s.case} | {s.rows} → {s.samples} | {'yes' if s.repeats_exact else 'NO'} | "
                      f"{s.contact_agreement:.1%} | {s.contact_agreement_confident:.1%} | {s.unsure_share:.1%} | "
-                     f"{s.velocity_error:.1%} | {ok}/{len(s.fits)} | {good}/{ok} | {s.given_gap:.1%} | "
+                     f"{s.velocity_error:.1%} | {ok}/{len(s.fits)} | {good}/{ok} | {gap} | "
                      f"{s.stance[0]:.3f} / {s.stance[1]:.3f} / {s.stance[2]:.3f} |")
     return "\n".join(lines)
