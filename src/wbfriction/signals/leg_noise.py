@@ -17,8 +17,8 @@ sample. Two levels:
   more samples pooled where it has settled, no width chosen); from the change outward while a bin's spread exceeds
   the stance level (the first that does not ends the transient: the foot is then a standing foot), made
   non-increasing away from the change (a transient does not grow away from its cause; the least-squares monotone
-  fit, adjacent violators pooled, weighted by their counts). A foot's noise is the larger of its two transients' and
-  the stance level.
+  fit weighted by their counts, SciPy's ``isotonic_regression``). A foot's noise is the larger of its two
+  transients' and the stance level.
 
 Without this, every foot near a touch-down is an outlier to the stance level: the chi-square gate
 (:data:`~wbfriction.signals.leg_odometry.GATE`) rejects every foot of such samples and the smoother bridges them by
@@ -28,6 +28,7 @@ its model alone (on the firm twin's clean trot, contacts inferred, 38 % of the s
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import isotonic_regression
 
 
 def pooled_spread(velocities: np.ndarray) -> np.ndarray:
@@ -72,18 +73,6 @@ def leave_one_out(velocities: np.ndarray) -> np.ndarray:
     return out
 
 
-def decreasing(values: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """The weighted least-squares non-increasing fit of ``values`` (m,) (pool-adjacent-violators)."""
-    blocks: list[list[float]] = []  # [value, weight, count]
-    for v, w in zip(values, weights):
-        blocks.append([float(v), float(w), 1])
-        while len(blocks) > 1 and blocks[-2][0] < blocks[-1][0]:
-            v2, w2, c2 = blocks.pop()
-            v1, w1, c1 = blocks.pop()
-            blocks.append([(v1 * w1 + v2 * w2) / (w1 + w2), w1 + w2, c1 + c2])
-    return np.concatenate([np.full(int(c), v) for v, _, c in blocks]) if blocks else np.zeros(0)
-
-
 def transient(deviation: np.ndarray, distance: np.ndarray, floor: np.ndarray) -> np.ndarray:
     """The noise (M, 3) [m/s] of M measuring feet at ``distance`` (M,) samples from their change (inf: none), from
     their deviations (M, 3) (NaN: not known) (module docstring): octaves of the distance from the change outward
@@ -105,7 +94,10 @@ def transient(deviation: np.ndarray, distance: np.ndarray, floor: np.ndarray) ->
             spreads.append(spread)
             counts.append(int(rows.sum()))
             bins.append(j)
-        for j, sd in zip(bins, decreasing(np.array(spreads), np.array(counts, dtype=float))):
+        if not spreads:
+            continue
+        fit = isotonic_regression(np.array(spreads), weights=np.array(counts, dtype=float), increasing=False).x
+        for j, sd in zip(bins, fit):
             out[octave == j, axis] = sd
     return out
 
