@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+from contextlib import contextmanager
 from datetime import UTC, datetime, timedelta, timezone
 from pathlib import Path
 from types import SimpleNamespace
@@ -181,9 +182,14 @@ def wiring(monkeypatch, tmp_path):
     calls: dict = {}
     robot = object()
 
-    def estimate_file(spec, log, output, options, *, chunking, robot, executor):
+    @contextmanager
+    def prepared_log(path, robot, source, read, near):  # a log in the project's format: as it is
+        calls["prepared"] = dict(path=path, robot=robot, source=source, near=Path(near))
+        yield Path(path), None
+
+    def estimate_file(spec, log, output, options, *, chunking, robot, executor, source):
         calls["estimate"] = dict(spec=spec, log=log, output=Path(output), options=options, chunking=chunking,
-                                 robot=robot, executor=executor,
+                                 robot=robot, executor=executor, source=source,
                                  threads={i["num_threads"] for i in threadpool_info()})
         if isinstance(calls.get("raise"), Exception):
             raise calls["raise"]
@@ -196,6 +202,7 @@ def wiring(monkeypatch, tmp_path):
                                                                           tau=None, tau_f=None))
 
     monkeypatch.setattr("wbfriction.fleet.task.worker_robot", lambda spec: robot)
+    monkeypatch.setattr("wbfriction.fleet.task.prepared_log", prepared_log)
     monkeypatch.setattr("wbfriction.fleet.task.estimate_file", estimate_file)
     monkeypatch.setattr("wbfriction.fleet.task.fit_table", fit_table)
     entry = LogEntry(tmp_path / "a.parquet", "007", KEY.start_time, RobotSpec("panda"))
@@ -211,8 +218,9 @@ def test_a_task_hands_its_options_to_the_estimate_and_the_fit(wiring, tmp_path):
     scratch.mkdir()
     outcome = process_log(entry, KEY, options, scratch, chunk_workers=3)
     est, fit = calls["estimate"], calls["fit"]
-    assert (est["spec"], est["log"], est["options"], est["robot"], est["executor"]) == (
-        entry.robot, entry.log, options.estimate, robot, None)
+    assert (est["spec"], est["log"], est["options"], est["robot"], est["executor"], est["source"]) == (
+        entry.robot, entry.log, options.estimate, robot, None, str(entry.log))
+    assert calls["prepared"] == dict(path=entry.log, robot=robot, source=str(entry.log), near=est["output"])
     assert (est["chunking"].rows, est["chunking"].workers) == (777, 1)  # no executor: chunks in this process
     assert est["output"].parent.parent == scratch and fit["friction"] == est["output"]
     assert {k: fit[k] for k in ("options", "threshold", "tolerance")} == dict(
