@@ -64,6 +64,7 @@ import pinocchio as pin
 from wbfriction.exceptions import InputError, OptionError
 from wbfriction.logs.contacts import OFF_SHARE
 from wbfriction.model.robot import Robot
+from wbfriction.signals.phases import true_runs
 
 CUES = ("torque", "kinematics", "counts", "periodicity")
 """The cues, as :attr:`InferredContacts.cues` names them."""
@@ -327,19 +328,15 @@ def least_swing(runs: int) -> int:
 
 def run_count(mask: np.ndarray) -> int:
     """The runs of consecutive True in the (N, n_c) bool ``mask``, every column's together."""
-    m = np.asarray(mask, dtype=np.int8)
-    return int(np.sum(np.diff(np.vstack([np.zeros((1, m.shape[1]), np.int8), m]), axis=0) == 1))
+    mask = np.asarray(mask, dtype=bool)
+    return sum(len(true_runs(mask[:, c])) for c in range(mask.shape[1]))
 
 
 def longest_runs(mask: np.ndarray) -> np.ndarray:
     """(n_c,) int: each column's longest run of consecutive True in the (N, n_c) bool ``mask`` (0 for none)."""
     mask = np.asarray(mask, dtype=bool)
-    out = np.zeros(mask.shape[1], dtype=int)
-    for c in range(mask.shape[1]):
-        edges = np.diff(np.r_[0, mask[:, c].astype(np.int8), 0])
-        starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-        out[c] = int((ends - starts).max()) if len(starts) else 0
-    return out
+    return np.array([max((b - a for a, b in true_runs(mask[:, c])), default=0) for c in range(mask.shape[1])],
+                    dtype=int)
 
 
 def unlifted_swings(contact: np.ndarray, h: np.ndarray, sigma: float) -> np.ndarray:
@@ -356,8 +353,7 @@ def unlifted_swings(contact: np.ndarray, h: np.ndarray, sigma: float) -> np.ndar
     lifted = h > LIFT_SIGMAS * sigma
     out = np.zeros(contact.shape, dtype=bool)
     for c in range(contact.shape[1]):
-        edges = np.diff(np.r_[0, (~contact[:, c]).astype(np.int8), 0])
-        for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+        for a, b in true_runs(~contact[:, c]):
             out[a:b, c] = not lifted[a:b, c].any()
     return out
 

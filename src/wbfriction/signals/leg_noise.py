@@ -30,6 +30,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import isotonic_regression
 
+from wbfriction.signals.phases import true_runs
+
 
 def pooled_spread(velocities: np.ndarray) -> np.ndarray:
     """The stance feet's velocity noise (3,) [m/s] per axis: their spread about their mean over the samples with two
@@ -53,8 +55,7 @@ def run_distances(measuring: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     n = len(measuring)
     after, before = np.full(measuring.shape, np.nan), np.full(measuring.shape, np.nan)
     for c in range(measuring.shape[1]):
-        edges = np.diff(np.r_[0, measuring[:, c].astype(int), 0])
-        for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+        for a, b in true_runs(measuring[:, c]):
             after[a:b, c] = np.arange(1, b - a + 1) if a > 0 else np.inf
             before[a:b, c] = np.arange(b - a, 0, -1) if b < n else np.inf
     return after, before

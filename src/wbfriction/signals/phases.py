@@ -60,9 +60,9 @@ class Phases:
         return out
 
 
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """Half-open index ranges [start, stop) of the True runs of ``mask``."""
-    edges = np.diff(np.concatenate(([0], mask.astype(np.int8), [0])))
+def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """Half-open index ranges [start, stop) of the True runs of the (N,) bool ``mask``."""
+    edges = np.diff(np.concatenate(([0], np.asarray(mask, dtype=np.int8), [0])))
     return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))
 
 
@@ -93,7 +93,7 @@ def segment(time: np.ndarray, contact: np.ndarray, lift_off_skip: float = 0.10,
     change = np.ones(len(time), dtype=bool)
     change[1:] = stance[1:] != stance[:-1]
     run_id = np.cumsum(change)
-    for start, stop in _runs(single):
+    for start, stop in true_runs(single):
         # split a single-support run where the stance foot changes without double support
         for s in np.unique(run_id[start:stop]):
             idx = np.flatnonzero(run_id[start:stop] == s) + start
