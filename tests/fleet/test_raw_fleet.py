@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +19,7 @@ from wbfriction.fleet.batch import run_batch
 from wbfriction.fleet.manifest import read_manifest
 from wbfriction.fleet.results import read_results
 
-TOML = Path(__file__).parents[2] / "examples" / "inputs" / "go2_logged.toml"
+TOML = Path(str(resources.files("wbfriction.model.robots").joinpath("go2_logged.toml")))  # the built-in twin's
 RATE = 1 / 1.22e-3
 
 

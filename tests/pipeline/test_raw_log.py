@@ -7,6 +7,7 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +18,7 @@ import pytest
 from wbfriction.logs.options import ReadOptions
 from wbfriction.model.loading import RobotSpec
 
-TOML = Path(__file__).parents[2] / "examples" / "inputs" / "go2_logged.toml"
+TOML = Path(str(resources.files("wbfriction.model.robots").joinpath("go2_logged.toml")))  # the built-in twin's
 RATE = 1 / 1.22e-3
 
 

@@ -2,7 +2,7 @@
 any orientation; a base moving at a constant velocity and turning rigidly on feet fixed to the ground, exactly; the
 refusals in one line; and on the MuJoCo twin (trot and walk, clean and with a Unitree's noise, the true contacts, its
 feet firm) the orientation and the angular velocity to the IMU's precision, the linear velocity within issue 82's 5 %
-(numbers in the tests' docstrings, /work/notes/82/i82-odometry.md and i82-creep.md)."""
+(the numbers measured are in the tests' docstrings)."""
 
 from __future__ import annotations
 
@@ -192,8 +192,8 @@ MEASURED_VELOCITY = {("trot", False, False): 0.0224, ("trot", False, True): 0.01
                      ("trot", True, True): 0.017, ("walk", False, False): 0.0055, ("walk", False, True): 0.0034,
                      ("walk", True, False): 0.0099, ("walk", True, True): 0.0108}
 """The linear velocity's relative error measured per (gait, noisy, accelerometer) on the twin's firm feet with each
-foot's noise raised near its touch-down and lift-off (/work/notes/82/i82-odorobust.md; before, one legs' noise for
-every sample: 2.2, 0.98, 2.8, 2.0, 0.40, 0.41, 1.01, 1.04 %, i82-creep.md; on MuJoCo's soft feet 5.6-9.9 %)."""
+foot's noise raised near its touch-down and lift-off (before, one legs' noise for every sample:
+2.2, 0.98, 2.8, 2.0, 0.40, 0.41, 1.01, 1.04 %; on MuJoCo's soft feet 5.6-9.9 %)."""
 
 
 @pytest.mark.slow
@@ -316,8 +316,7 @@ def test_on_the_raw_twin_the_clean_firm_trot_within_five_percent(tmp_path):
     """The raw route (contacts inferred, ``studies/walking_logs``' scoring) on 8 s of the firm twin's clean trot: the
     base's velocity within 5 % RMS of its speed (measured 3.0 %). With one legs' noise for every sample it was 38 %:
     on noise-free joints the stance feet agree to 0.1-0.8 mm/s, a landing foot is off by 3-400 mm/s for a few
-    samples, the gate rejected every foot of those samples and the smoother drifted by up to 0.86 m/s
-    (/work/notes/82/i82-odorobust.md)."""
+    samples, the gate rejected every foot of those samples and the smoother drifted by up to 0.86 m/s."""
     import subprocess
     import sys
 

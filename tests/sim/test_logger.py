@@ -6,6 +6,7 @@ no contact, base or force column; ``--logger full`` writes today's log byte for 
 from __future__ import annotations
 
 import io
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +28,7 @@ from wbfriction.sim.quadruped import QuadrupedOptions
 from wbfriction.sim.quadruped_mujoco import UNITREE_NOISE, simulate_quadruped_mujoco
 from wbfriction.walking.quadruped import GaitOptions, quadruped_reference
 
-TOML = Path(__file__).parents[2] / "examples" / "inputs" / "go2_logged.toml"
+TOML = Path(str(resources.files("wbfriction.model.robots").joinpath("go2_logged.toml")))  # the built-in twin's
 RAW_PREFIXES = ("q", "q_cos", "q_sin", "qd", "current", "foot_count")
 RAW_IMU = {f"imu.{a}" for a in ("roll", "pitch", "yaw", "gyro_x", "gyro_y", "gyro_z")}
 

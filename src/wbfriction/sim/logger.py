@@ -232,7 +232,7 @@ def check_raw_robot(robot: Robot) -> None:
     missing = [j for j in robot.torque_controlled if j not in robot.torque_constants]
     if missing:
         raise InputError(f"{where}: a raw log's currents need every joint's nominal torque constant: "
-                         f"[torque_constants] lacks '{missing[0]}' (examples/inputs/go2_logged.toml has them)")
+                         f"[torque_constants] lacks '{missing[0]}' (the built-in go2_logged's TOML has them)")
     armature = robot.model.armature[robot.act_v_index]
     bare = [j for j, a in zip(robot.actuated, armature) if not a > 0]
     if bare:

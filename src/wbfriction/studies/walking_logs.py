@@ -35,8 +35,8 @@ if TYPE_CHECKING:
     from wbfriction.model.robot import Robot
     from wbfriction.studies.status import JointFit
 
-TWIN_ROBOT = Path(__file__).resolve().parents[3] / "examples" / "inputs" / "go2_logged.toml"
-"""The twin's robot TOML (the repository's ``examples/inputs/go2_logged.toml``)."""
+TWIN_ROBOT = "go2_logged"
+"""The twin's robot (``--robot``): the built-in ``go2_logged``."""
 DURATION = 8.0
 """Simulated seconds per case."""
 RATE = "819.672131"
@@ -99,7 +99,7 @@ def _run(args: list[str], cwd: Path) -> None:
     run_route([shlex.join(["wbfriction", *args])], cwd)
 
 
-def simulate(case: WalkingCase, folder: Path, seed: int = 0, robot: Path = TWIN_ROBOT) -> Path:
+def simulate(case: WalkingCase, folder: Path, seed: int = 0, robot: str = TWIN_ROBOT) -> Path:
     """The raw log of ``case`` in ``folder`` (``wbfriction simulate ... --logger raw``) of the twin ``robot``'s
     TOML (default the Go2's, :data:`TWIN_ROBOT`)."""
     out = folder / f"{case.name}_raw.parquet"
@@ -140,7 +140,7 @@ def given_log(prepared: pa.Table, robot_frames: tuple[str, ...], dt: float) -> p
     return out.replace_schema_metadata(prepared.schema.metadata)
 
 
-def _estimate_fit(log: Path, robot: Path, stem: str, folder: Path, truth: dict) -> dict[str, JointFit]:
+def _estimate_fit(log: Path, robot: str, stem: str, folder: Path, truth: dict) -> dict[str, JointFit]:
     """``estimate`` and ``fit`` of ``log`` as a user runs them, each joint's fit against the truth."""
     from wbfriction.studies.status import fits_from_params
 
@@ -174,7 +174,7 @@ def _gap(fits: dict[str, JointFit], given: dict[str, JointFit]) -> float:
     return max(gaps) if gaps else float("nan")
 
 
-def score_case(case: WalkingCase, folder: Path, twin: Path = TWIN_ROBOT) -> WalkingScore:
+def score_case(case: WalkingCase, folder: Path, twin: str = TWIN_ROBOT) -> WalkingScore:
     """Simulate, prepare, estimate and fit ``case`` in ``folder`` (module docstring) on the twin robot's TOML
     ``twin`` (default the Go2's)."""
     import pyarrow.parquet as pq
