@@ -65,6 +65,8 @@ RANGES: Mapping[str, Range] = MappingProxyType({
     "foot_radius": Range(0.0, 0.25, "m", "a point foot's sphere: a quadruped's is a few centimetres"),
     "torque_constant": Range(0.0, 1e3, "N·m/A", "a motor's torque per ampere at the joint, its gear included",
                              low_open=True),
+    "torque_scale_sd": Range(0.0, 0.5, "", "the logged torque's relative scale error, one standard deviation: a "
+                             "torque constant or a sensor's calibration known to better than half its value"),
     "kp": Range(0.0, 1e5, "N·m/rad", "a driver's position gain, >= 0"),
     "kd": Range(0.0, 1e4, "N·m·s/rad", "a driver's velocity gain, >= 0"),
     "torque_limit": Range(0.0, 1e5, "N·m", "a driver's torque limit", low_open=True),

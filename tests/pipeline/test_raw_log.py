@@ -136,7 +136,8 @@ def test_a_standing_robot_with_noisy_sensors_is_refused(tmp_path):
 @pytest.mark.slow
 def test_the_stance_check_tells_the_true_friction_from_none_and_from_a_wrong_one(raw, prepared):
     """The self-consistency check (wbfriction.fit.stance_check) on the twin's stances: the true friction leaves the
-    base's balance a smaller residual than no friction, and than twice the true friction."""
+    base's balance a smaller residual than no friction, and than twice the true friction; one leg's true friction
+    alone (the others none, in both residuals) leaves less than none on the same samples."""
     import json
 
     from wbfriction.fit.stance_check import log_stance_check
@@ -152,6 +153,10 @@ def test_the_stance_check_tells_the_true_friction_from_none_and_from_a_wrong_one
     assert true.samples > 1000 and true.samples == doubled.samples
     assert true.moment_with < 0.6 * true.moment_without and true.force_with < true.force_without
     assert true.moment_with < 0.6 * doubled.moment_with
+    leg = [j for j in robot.actuated if j.startswith("FL_")]  # some joints' friction only, as a user's ok fits
+    part = log_stance_check(robot, log, {j: target_from_dict(truth[j]) for j in leg})
+    assert part.samples == true.samples and part.joints == tuple(leg) and len(true.joints) == 12
+    assert part.moment_without == true.moment_without and part.moment_with < part.moment_without
 
 
 def test_the_stance_check_refuses_a_robot_not_on_point_feet():

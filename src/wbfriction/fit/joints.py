@@ -22,6 +22,7 @@ from wbfriction.fit.smoothing import smoother_half_width
 from wbfriction.fit.solve import fitted_rows, stick_speed
 from wbfriction.fit.term_selection import fit_terms, refit_terms
 from wbfriction.fit.terms import TermFit, term_signals
+from wbfriction.fit.torque_scale import torque_scale_spread
 from wbfriction.friction.estimated import FrictionEstimate
 from wbfriction.friction.families.registry import families
 from wbfriction.friction.models import (
@@ -245,7 +246,7 @@ def fit_estimate(est: FrictionEstimate, options: FitOptions = FitOptions(), *, w
     if options.terms.terms:
         fits = _with_terms(fits, checked, tasks, others, est, idx, truth, targets, options,
                            None if progress is None else progress("terms", len(fits), "joints"))
-    fits = _with_delay_structure(fits, est.metadata)  # before the fallbacks: its spread can make a fit weak
+    fits = _with_torque_source(fits, est)  # before the fallbacks: its spread can make a fit weak
     if options.model == AUTO:
         _with_fallbacks(fits, tasks, others, est, idx, truth, targets, workers, progress)
     return fits
@@ -324,15 +325,30 @@ def _with_fallbacks(fits: list[FitResult], tasks: list[tuple], others: Sequence[
             theirs, mine = chosen.to_dict(), simple.params.to_dict()
             simple.model_spread = {n: math.hypot(simple.model_spread.get(n, 0.0), abs(mine[n] - theirs[n]))
                                    for n in SPREAD if n in mine and n in theirs}
-        fit.fallback = _with_delay_structure([simple], est.metadata)[0]
+        fit.fallback = _with_torque_source([simple], est)[0]
 
 
-def _with_delay_structure(fits: list[FitResult], metadata: Mapping[str, Any]) -> list[FitResult]:
-    """``fits`` with F_v's :func:`delay_structure_spread` in their ``model_spread`` (in quadrature)."""
-    structure = delay_structure_spread(metadata)
+def _with_torque_source(fits: list[FitResult], est: FrictionEstimate) -> list[FitResult]:
+    """``fits`` with what their torque's source leaves unknown in their ``model_spread`` (in quadrature): F_v's
+    :func:`delay_structure_spread`, and F_c's and F_v's from the torque's scale where the robot TOML gives its
+    ``[torque_scale_sd]`` (:func:`~wbfriction.fit.torque_scale.torque_scale_spread`, on the samples each fit used)."""
+    structure = delay_structure_spread(est.metadata)
+    torque = est.metadata.get("torque_source") or {}
+    scale_sd = torque.get("scale_sd") or {} if isinstance(torque, Mapping) else {}
     for f in fits:
-        if f.joint in structure and f.params is not None and "F_v" in f.params.names:
-            f.model_spread = {**f.model_spread, "F_v": math.hypot(f.model_spread.get("F_v", 0.0), structure[f.joint])}
+        if f.params is None:
+            continue
+        unknown = [("F_v", structure[f.joint])] if f.joint in structure and "F_v" in f.params.names else []
+        if f.joint in scale_sd and est.tau is not None:
+            i = est.joints.index(f.joint)
+            rows = fitted_rows(est.qd[:, i], est.tau_f[:, i], est.valid[:, i], est.smoother, f.stick_speed,
+                               stick_margin(est), f.pass_rows)[0]
+            free = [n for n, se in f.stderr.items() if np.isfinite(se) and se > 0 and not f.at_bound.get(n)]
+            unknown += torque_scale_spread(f.params, est.qd[:, i], est.tau[:, i], rows, float(scale_sd[f.joint]),
+                                           free, smoother=est.smoother, velocity_noise=f.velocity_noise,
+                                           magnitudes=SPREAD).items()
+        for n, v in unknown:
+            f.model_spread = {**f.model_spread, n: math.hypot(f.model_spread.get(n, 0.0), v)}
     return fits
 
 

@@ -31,6 +31,7 @@ import pinocchio as pin
 
 from wbfriction.exceptions import InputError
 from wbfriction.fit.predict import FrictionCurve
+from wbfriction.fit.result import FitResult
 from wbfriction.logs.log import Log
 from wbfriction.model.robot import Robot
 from wbfriction.signals.kinematics import MeasuredKinematics
@@ -44,6 +45,7 @@ class StanceCheck:
         samples: the stance samples checked (a foot down, every signal defined, the contact flags sure).
         force_without, moment_without: RMS of the residual's force [N] and moment [N·m] components with no friction.
         force_with, moment_with: the same with the friction given.
+        joints: the joints whose friction was given (the others have none in either residual).
     """
 
     samples: int
@@ -51,12 +53,19 @@ class StanceCheck:
     moment_without: float
     force_with: float
     moment_with: float
+    joints: tuple[str, ...] = ()
 
     def line(self) -> str:
         """One line: the residuals without and with the friction."""
         return (f"the base's balance on {self.samples} stance samples: RMS residual {self.force_without:.3g} N, "
                 f"{self.moment_without:.3g} N·m without friction; {self.force_with:.3g} N, {self.moment_with:.3g} "
-                "N·m with the friction fitted on the swings")
+                f"N·m with the friction of {len(self.joints)} joints fitted on the swings")
+
+
+def trusted_friction(fits: Mapping[str, FitResult], include: Sequence[str] = ("ok",)) -> dict[str, FrictionCurve]:
+    """The friction models of ``fits`` (``read_params``) whose status is in ``include``: a ``weak`` fit may be off
+    by several times its value, and would make the check say more of it than the data do."""
+    return {j: f.params for j, f in fits.items() if f.params is not None and f.verdict().status in include}
 
 
 def base_residuals(robot: Robot, kin: MeasuredKinematics, tau_fs: Sequence[np.ndarray], rows: np.ndarray
@@ -97,12 +106,13 @@ def stance_check(robot: Robot, kin: MeasuredKinematics, friction: Mapping[str, F
     Args:
         robot: a floating-base robot on point feet.
         kin: the log's kinematics with the base's motion.
-        friction: a friction model per joint name (``wbfriction fit``'s parameters: ``read_params``); every joint of
-            a stance leg needs one, or its stance samples are not checked.
+        friction: a friction model per joint name (``wbfriction fit``'s parameters: ``read_params``; the ``ok`` ones
+            only, :func:`trusted_friction`, to check what a user would export). A joint without one has no friction
+            in either residual, so the two differ by the friction given alone.
 
     Raises:
-        InputError: a robot that is not on point feet, kinematics without the base's motion, or no stance sample with
-            every stance leg's joints modelled.
+        InputError: a robot that is not on point feet, kinematics without the base's motion, no friction given, or
+            no stance sample.
     """
     if not (robot.floating_base and robot.partial_contacts):
         raise InputError(f"robot '{robot.name}': the stance check is for a floating base on point feet")
@@ -112,18 +122,17 @@ def stance_check(robot: Robot, kin: MeasuredKinematics, friction: Mapping[str, F
     for i, joint in enumerate(robot.actuated):
         if joint in friction:
             tau_f[:, i] = -np.asarray(friction[joint].f(kin.qd[:, i]))
-    known = np.array([j in friction for j in robot.torque_controlled])
-    modelled = np.array([known[leg].all() for leg in robot.limb_mask])  # (n_c,): every joint of the foot's leg
+    if not any(j in friction for j in robot.actuated):
+        raise InputError(f"robot '{robot.name}': no friction model of any of its joints to check")
     assert kin.valid is not None
     finite = np.isfinite(kin.base_qdd).all(axis=1) & np.isfinite(kin.base_qd).all(axis=1)
-    rows = np.flatnonzero(kin.valid & finite & kin.contact.any(axis=1)
-                          & ~(kin.contact & ~modelled[None, :]).any(axis=1))
+    rows = np.flatnonzero(kin.valid & finite & kin.contact.any(axis=1))
     if rows.size == 0:
-        raise InputError(f"robot '{robot.name}': no stance sample whose stance legs' joints all have a friction model")
+        raise InputError(f"robot '{robot.name}': no stance sample to check (a foot down, the base's motion known)")
     without, with_model = base_residuals(robot, kin, (np.zeros_like(tau_f), tau_f), rows)
     rms = lambda r: float(np.sqrt(np.mean(r ** 2)))  # noqa: E731
     return StanceCheck(int(rows.size), rms(without[:, :3]), rms(without[:, 3:]), rms(with_model[:, :3]),
-                       rms(with_model[:, 3:]))
+                       rms(with_model[:, 3:]), tuple(j for j in robot.actuated if j in friction))
 
 
 def log_stance_check(robot: Robot, log: Log, friction: Mapping[str, FrictionCurve]) -> StanceCheck:

@@ -264,13 +264,17 @@ def torque_record(robot: Robot, source: TorqueSource, setpoints: PdSetpoints | N
     ``identify`` found the delay on did not tell what it holds back (:attr:`~wbfriction.model.pd.PdDriver.delayed_known`
     false), ``delayed_known`` false and per joint the viscous coefficient the two differ by (``viscous_equivalent``
     [N·m·s/rad], ``kp delay``), which the friction's F_v carries (:func:`~wbfriction.fit.joints.fit_estimate`); a log
-    of measured torques that also holds set-points, ``setpoints`` "not used".
+    of measured torques that also holds set-points, ``setpoints`` "not used"; where the robot TOML states it, per
+    joint the torque's relative scale error (``scale_sd``, :mod:`wbfriction.fit.torque_scale`), which F_c and F_v
+    carry.
 
     Raises:
         ValueError: no source of that name registered.
     """
     kind = torque_kind(source)
-    return {"source": source, "what": kind.what, **kind.record(robot, setpoints)}
+    record = {"source": source, "what": kind.what, **kind.record(robot, setpoints)}
+    scale_sd = {j: robot.torque_scale_sd[j] for j in robot.torque_controlled if j in robot.torque_scale_sd}
+    return {**record, "scale_sd": scale_sd} if scale_sd else record
 
 
 class SensorTorque(TorqueKind):

@@ -112,7 +112,8 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
             (joint name -> angle [rad], set over it), ``locked_joints`` (joint name -> angle
             [rad or m]: removed from the model at that position, Pinocchio's reduced model:
             fingers, joints a log does not have), ``torque_constants`` (joint name -> N·m/A at
-            the joint, gear ratio included: ``current.<joint>`` columns give ``tau``),
+            the joint, gear ratio included: ``current.<joint>`` columns give ``tau``), ``torque_scale_sd`` (joint
+            name -> the logged torque's relative scale error, one standard deviation),
             ``armature`` (joint name -> reflected rotor inertia [kg·m^2], in the dynamics
             through ``model.armature``), ``pd`` (the PD-driven joints' drivers: gains, delay, torque
             limits, :func:`~wbfriction.model.pd.parse_pd`), ``encoder_offset`` (joint name -> the logged
@@ -162,6 +163,7 @@ def build_robot(urdf: Path, config: dict, source: str = "config", model_format: 
         floating_base=floating,
         locked_joints=locked,
         torque_constants=_joint_values(config, "torque_constants", actuated, source, "torque_constant"),
+        torque_scale_sd=_joint_values(config, "torque_scale_sd", actuated, source, "torque_scale_sd"),
         ft_sensors=parse_sensors(model, config.get("force_torque"), frames, source),
         contact_force=_contact_force(config.get("contact_force"), source),
         imu=add_imu_frame(model, config.get("imu"), source),

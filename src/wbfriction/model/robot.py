@@ -77,6 +77,9 @@ class Robot:
             (Pinocchio's reduced model): not in :attr:`actuated`, not needed in a log.
         torque_constants: joint -> torque constant [N·m/A] at the joint (gear ratio
             included), for logs that record motor currents ``current.<joint>`` [A].
+        torque_scale_sd: joint -> how well the scale of its logged torque is known, one relative standard deviation
+            (0.02: 2 %; a torque constant's, a torque sensor's calibration), carried into the friction's standard
+            errors (:mod:`wbfriction.fit.torque_scale`); a joint not in it: not stated, none carried.
         ft_sensors: six-axis force-torque sensors, one per contact at most
             (:mod:`wbfriction.model.force_torque`; ``[force_torque.<name>]`` in the TOML).
         imu: the inertial measurement unit (:mod:`wbfriction.model.imu`; ``[imu]`` in the TOML), or None.
@@ -109,6 +112,7 @@ class Robot:
     floating_base: bool = True
     locked_joints: dict[str, float] = field(default_factory=dict)
     torque_constants: dict[str, float] = field(default_factory=dict)
+    torque_scale_sd: dict[str, float] = field(default_factory=dict)
     ft_sensors: tuple[ForceTorqueSensor, ...] = ()
     contact_force: tuple[float, float] | None = None
     imu: Imu | None = None

@@ -8,7 +8,8 @@ simulator wrote beside it:
 
 * **repeats**: whether the samples kept are exactly the drives' distinct samples (``sample_true``);
 * **contacts**: the share of samples (and feet) whose inferred state is the simulator's (``contact_true.<frame>``),
-  and the share left out as not confident;
+  the share left out as not confident, and how many of the samples that differ the friction's fit used (a foot
+  grazing the ground with a few newtons near its lift-off or touch-down differs, inside the margins no fit uses);
 * **base velocity**: the RMS error of the base's linear velocity over its RMS speed (``base_qd_true``);
 * **friction**: ``estimate`` and ``fit`` run on the raw log as a user runs them, each fit scored against the
   injected friction (:func:`~wbfriction.studies.status.fits_from_params`): good when F_c and F_v lie within 5 %
@@ -16,7 +17,8 @@ simulator wrote beside it:
 * **the inference's cost**: the same log with the simulator's contact flags and base pose given, estimated and
   fitted the same way: where both fits are ``ok``, the largest relative difference of F_c and F_v;
 * **the self-consistency check** a user can run without truth (:mod:`wbfriction.fit.stance_check`): the base's
-  balance on the stances with no friction, with the friction fitted on the swings, and with the true friction.
+  balance on the stances with no friction, with the ``ok`` fits' friction (the fits a user would export), with the
+  true friction of the same joints and with the true friction of every joint.
 """
 
 from __future__ import annotations
@@ -71,7 +73,9 @@ class WalkingScore:
     """One case's scores (module docstring); fits: per joint ``(status, F_c error, F_v error)`` (shares),
     given_gap: the largest relative difference between the raw and the given route's values where both are ``ok``
     (NaN: none both ``ok``); stance: the base's RMS moment residual on the stances [N·m] without friction, with the
-    friction fitted on the swings, with the true friction (:mod:`wbfriction.fit.stance_check`)."""
+    ``ok`` fits' friction, with the true friction of the same joints, with every joint's true friction
+    (:mod:`wbfriction.fit.stance_check`; NaN where no fit is ``ok``); fitted_disagreement: the samples whose inferred
+    contact state differs from the simulator's at a foot whose leg's friction the fit used there."""
 
     case: str
     rows: int
@@ -84,7 +88,8 @@ class WalkingScore:
     fits: dict[str, tuple[str, float, float]]
     given_fits: dict[str, tuple[str, float, float]]
     given_gap: float
-    stance: tuple[float, float, float] = (float("nan"),) * 3
+    stance: tuple[float, float, float, float] = (float("nan"),) * 4
+    fitted_disagreement: int = 0
 
     def good(self, tolerance: float) -> tuple[int, int]:
         """``(ok and within tolerance, ok)``."""
@@ -207,34 +212,44 @@ def score_case(case: WalkingCase, folder: Path, twin: str = TWIN_ROBOT) -> Walki
                         float(np.mean((inferred == truth_c)[confident])) if confident.any() else float("nan"),
                         float(prepared.contacts.unconfident_rows().mean()), velocity_error, _summary(fits),
                         _summary(given_fits), _gap(fits, given_fits),
-                        _stance(robot, out, folder / f"{case.name}_params.json", truth))
+                        _stance(robot, out, folder / f"{case.name}_params.json", truth),
+                        _fitted_disagreement(robot, folder / f"{case.name}_friction.parquet", inferred != truth_c))
 
 
-def _stance(robot: Robot, prepared: pa.Table, params: Path, truth: dict) -> tuple[float, float, float]:
-    """The base's RMS moment residual on the stances without friction, with the fit's, with the truth's (the fit's
-    NaN where the check refuses it: no stance whose legs' joints all have a fit)."""
-    from wbfriction.exceptions import InputError
+def _fitted_disagreement(robot: Robot, friction: Path, disagree: np.ndarray) -> int:
+    """Of ``disagree`` (N, n_c), the samples at a foot whose leg has a joint the friction table ``friction`` marks
+    valid there (the samples a fit of that leg uses)."""
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(friction)
+    valid = np.column_stack([np.asarray(table.column(f"valid.{j}")) > 0 for j in robot.torque_controlled])
+    return int(sum((disagree[:, c] & valid[:, leg].any(axis=1)).sum() for c, leg in enumerate(robot.limb_mask)))
+
+
+def _stance(robot: Robot, prepared: pa.Table, params: Path, truth: dict) -> tuple[float, float, float, float]:
+    """:attr:`WalkingScore.stance`."""
     from wbfriction.fit.params_file import read_params
-    from wbfriction.fit.stance_check import log_stance_check
+    from wbfriction.fit.stance_check import log_stance_check, trusted_friction
     from wbfriction.friction.models import target_from_dict
     from wbfriction.logs.log import log_from_table
 
     log = log_from_table(prepared, robot, "prepared")
-    true = log_stance_check(robot, log, {j: target_from_dict(p) for j, p in truth["friction_true"].items()})
-    try:
-        fitted = log_stance_check(robot, log, {j: f.params for j, f in read_params(params).items()
-                                               if f.params is not None}).moment_with
-    except InputError:
-        fitted = float("nan")
-    return true.moment_without, fitted, true.moment_with
+    true = {j: target_from_dict(p) for j, p in truth["friction_true"].items()}
+    every = log_stance_check(robot, log, true)
+    ok = trusted_friction(read_params(params))
+    if not ok:
+        return every.moment_without, float("nan"), float("nan"), every.moment_with
+    fitted = log_stance_check(robot, log, ok).moment_with
+    return (every.moment_without, fitted, log_stance_check(robot, log, {j: true[j] for j in ok}).moment_with,
+            every.moment_with)
 
 
 def markdown(scores: list[WalkingScore]) -> str:
     """The benchmark's table (one row per case) and the per-joint fits."""
     lines = ["| case | rows → samples | repeats exact | contacts agree | (confident) | left out | base velocity "
-             "error | fits ok | ok within 5 % / 10 % | given vs raw (both ok) | stance moment [N·m]: none / fit / "
-             "truth |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "error | fits ok | ok within 5 % / 10 % | given vs raw (both ok) | stance moment [N·m]: none / ok fits "
+             "/ their truth / all truth | contacts differing where fitted |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for s in scores:
         tol = 0.10 if "-noisy" in s.case else 0.05
         good, ok = s.good(tol)
@@ -242,5 +257,5 @@ def markdown(scores: list[WalkingScore]) -> str:
         lines.append(f"| {s.case} | {s.rows} → {s.samples} | {'yes' if s.repeats_exact else 'NO'} | "
                      f"{s.contact_agreement:.1%} | {s.contact_agreement_confident:.1%} | {s.unsure_share:.1%} | "
                      f"{s.velocity_error:.1%} | {ok}/{len(s.fits)} | {good}/{ok} | {gap} | "
-                     f"{s.stance[0]:.3f} / {s.stance[1]:.3f} / {s.stance[2]:.3f} |")
+                     f"{' / '.join('–' if np.isnan(x) else f'{x:.3f}' for x in s.stance)} | {s.fitted_disagreement} |")
     return "\n".join(lines)
