@@ -67,6 +67,8 @@ def test_a_torque_without_load_moves_nothing_but_its_own_share():
 
 
 def test_the_robot_toml_states_it_and_its_range_is_checked(tmp_path):
+    from importlib import resources
+
     from wbfriction.exceptions import InputError
     from wbfriction.logs.torque import torque_record
     from wbfriction.model.loading import load_robot
@@ -75,7 +77,6 @@ def test_the_robot_toml_states_it_and_its_range_is_checked(tmp_path):
     assert robot.torque_scale_sd["RR_calf_joint"] == pytest.approx(0.0173)
     assert torque_record(robot, "current", None)["scale_sd"] == robot.torque_scale_sd
     assert "scale_sd" not in torque_record(load_robot("go2_walking"), "sensor", None)  # not stated: none carried
-    from importlib import resources
     text = resources.files("wbfriction.model.robots").joinpath("go2_logged.toml").read_text()
     bad = tmp_path / "bad.toml"
     bad.write_text(text.replace("FL_hip_joint = 0.0173", "FL_hip_joint = 0.8", 1))

@@ -140,7 +140,7 @@ def test_the_stance_check_tells_the_true_friction_from_none_and_from_a_wrong_one
     alone (the others none, in both residuals) leaves less than none on the same samples."""
     import json
 
-    from wbfriction.fit.stance_check import log_stance_check
+    from wbfriction.fit.stance_check import log_stance_check, log_stance_checks
     from wbfriction.friction.models import target_from_dict
     from wbfriction.logs.log import log_from_table
 
@@ -157,6 +157,9 @@ def test_the_stance_check_tells_the_true_friction_from_none_and_from_a_wrong_one
     part = log_stance_check(robot, log, {j: target_from_dict(truth[j]) for j in leg})
     assert part.samples == true.samples and part.joints == tuple(leg) and len(true.joints) == 12
     assert part.moment_without == true.moment_without and part.moment_with < part.moment_without
+    together = log_stance_checks(robot, log, [{j: target_from_dict(p) for j, p in truth.items()},
+                                              {j: target_from_dict(truth[j]) for j in leg}])
+    assert together == [true, part]  # the log measured and each row's dynamics computed once: the same numbers
 
 
 def test_the_stance_check_refuses_a_robot_not_on_point_feet():

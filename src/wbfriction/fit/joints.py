@@ -334,7 +334,7 @@ def _with_torque_source(fits: list[FitResult], est: FrictionEstimate) -> list[Fi
     ``[torque_scale_sd]`` (:func:`~wbfriction.fit.torque_scale.torque_scale_spread`, on the samples each fit used)."""
     structure = delay_structure_spread(est.metadata)
     torque = est.metadata.get("torque_source") or {}
-    scale_sd = torque.get("scale_sd") or {} if isinstance(torque, Mapping) else {}
+    scale_sd = (torque.get("scale_sd") or {}) if isinstance(torque, Mapping) else {}
     for f in fits:
         if f.params is None:
             continue

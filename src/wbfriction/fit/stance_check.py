@@ -114,25 +114,37 @@ def stance_check(robot: Robot, kin: MeasuredKinematics, friction: Mapping[str, F
         InputError: a robot that is not on point feet, kinematics without the base's motion, no friction given, or
             no stance sample.
     """
+    return stance_checks(robot, kin, [friction])[0]
+
+
+def stance_checks(robot: Robot, kin: MeasuredKinematics, frictions: Sequence[Mapping[str, FrictionCurve]]
+                  ) -> list[StanceCheck]:
+    """:func:`stance_check` of each friction of ``frictions`` on the same samples, each row's dynamics computed once.
+
+    Raises:
+        InputError: what :func:`stance_check` raises, for any of them.
+    """
     if not (robot.floating_base and robot.partial_contacts):
         raise InputError(f"robot '{robot.name}': the stance check is for a floating base on point feet")
     if kin.base is None or kin.base_qd is None or kin.base_qdd is None:
         raise InputError(f"robot '{robot.name}': the stance check needs the base's motion (its pose, or the IMU's)")
-    tau_f = np.zeros((len(kin.time), robot.n_act))
-    for i, joint in enumerate(robot.actuated):
-        if joint in friction:
-            tau_f[:, i] = -np.asarray(friction[joint].f(kin.qd[:, i]))
-    if not any(j in friction for j in robot.actuated):
+    if not all(any(j in friction for j in robot.actuated) for friction in frictions):
         raise InputError(f"robot '{robot.name}': no friction model of any of its joints to check")
+    tau_fs = [np.zeros((len(kin.time), robot.n_act)) for _ in frictions]
+    for tau_f, friction in zip(tau_fs, frictions):
+        for i, joint in enumerate(robot.actuated):
+            if joint in friction:
+                tau_f[:, i] = -np.asarray(friction[joint].f(kin.qd[:, i]))
     assert kin.valid is not None
     finite = np.isfinite(kin.base_qdd).all(axis=1) & np.isfinite(kin.base_qd).all(axis=1)
     rows = np.flatnonzero(kin.valid & finite & kin.contact.any(axis=1))
     if rows.size == 0:
         raise InputError(f"robot '{robot.name}': no stance sample to check (a foot down, the base's motion known)")
-    without, with_model = base_residuals(robot, kin, (np.zeros_like(tau_f), tau_f), rows)
+    without, *with_models = base_residuals(robot, kin, (np.zeros((len(kin.time), robot.n_act)), *tau_fs), rows)
     rms = lambda r: float(np.sqrt(np.mean(r ** 2)))  # noqa: E731
-    return StanceCheck(int(rows.size), rms(without[:, :3]), rms(without[:, 3:]), rms(with_model[:, :3]),
-                       rms(with_model[:, 3:]), tuple(j for j in robot.actuated if j in friction))
+    return [StanceCheck(int(rows.size), rms(without[:, :3]), rms(without[:, 3:]), rms(with_model[:, :3]),
+                        rms(with_model[:, 3:]), tuple(j for j in robot.actuated if j in friction))
+            for with_model, friction in zip(with_models, frictions)]
 
 
 def log_stance_check(robot: Robot, log: Log, friction: Mapping[str, FrictionCurve]) -> StanceCheck:
@@ -142,6 +154,16 @@ def log_stance_check(robot: Robot, log: Log, friction: Mapping[str, FrictionCurv
 
     Raises:
         InputError: a log without the base's pose; what :func:`stance_check` raises.
+    """
+    return log_stance_checks(robot, log, [friction])[0]
+
+
+def log_stance_checks(robot: Robot, log: Log, frictions: Sequence[Mapping[str, FrictionCurve]]
+                      ) -> list[StanceCheck]:
+    """:func:`log_stance_check` of each friction of ``frictions``, the log measured once (:func:`stance_checks`).
+
+    Raises:
+        InputError: what :func:`log_stance_check` raises.
     """
     from wbfriction.friction.decision import decide_log
     from wbfriction.friction.options import EstimateOptions
@@ -153,4 +175,4 @@ def log_stance_check(robot: Robot, log: Log, friction: Mapping[str, FrictionCurv
     options = decide_log(robot, EstimateOptions(route="acceleration"), log.q, log.dt, segments=log.segments,
                          rows=len(log), source=log.source).options
     diff = cast(Diff, options.diff if options.diff in SCHEMES else "central")  # decided: no longer "auto"
-    return stance_check(robot, measure(log, diff, filtering=options.filtering, base_motion=True), friction)
+    return stance_checks(robot, measure(log, diff, filtering=options.filtering, base_motion=True), frictions)

@@ -229,19 +229,18 @@ def _fitted_disagreement(robot: Robot, friction: Path, disagree: np.ndarray) -> 
 def _stance(robot: Robot, prepared: pa.Table, params: Path, truth: dict) -> tuple[float, float, float, float]:
     """:attr:`WalkingScore.stance`."""
     from wbfriction.fit.params_file import read_params
-    from wbfriction.fit.stance_check import log_stance_check, trusted_friction
+    from wbfriction.fit.stance_check import log_stance_checks, trusted_friction
     from wbfriction.friction.models import target_from_dict
     from wbfriction.logs.log import log_from_table
 
     log = log_from_table(prepared, robot, "prepared")
     true = {j: target_from_dict(p) for j, p in truth["friction_true"].items()}
-    every = log_stance_check(robot, log, true)
     ok = trusted_friction(read_params(params))
     if not ok:
+        every = log_stance_checks(robot, log, [true])[0]
         return every.moment_without, float("nan"), float("nan"), every.moment_with
-    fitted = log_stance_check(robot, log, ok).moment_with
-    return (every.moment_without, fitted, log_stance_check(robot, log, {j: true[j] for j in ok}).moment_with,
-            every.moment_with)
+    every, fitted, theirs = log_stance_checks(robot, log, [true, ok, {j: true[j] for j in ok}])
+    return every.moment_without, fitted.moment_with, theirs.moment_with, every.moment_with
 
 
 def markdown(scores: list[WalkingScore]) -> str:
